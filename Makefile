@@ -1,0 +1,29 @@
+# The only two commands a new machine needs: `make demo` and `make test`.
+PYTHON ?= python3
+VENV ?= .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.pkm-installed
+
+.PHONY: demo test bench venv clean
+
+venv: $(STAMP)
+
+# (Re)create the virtual environment and install pkm (editable) with its test tools
+# whenever pyproject.toml changes.
+$(STAMP): pyproject.toml
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e ".[dev]"
+	touch $(STAMP)
+
+demo: $(STAMP)
+	$(PY) -m pkm.demo
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+bench: $(STAMP)
+	$(PY) tools/bench_kinematics.py
+
+clean:
+	rm -rf $(VENV) build dist .pytest_cache

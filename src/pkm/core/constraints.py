@@ -1,0 +1,85 @@
+"""Loop-closure equations: residual, Jacobian and acceleration drift.
+
+Conventions (one row block per closure, in spec order):
+
+* point closure (``CONTACT_3D``, ``LOCAL_WORLD_ALIGNED``): residual
+  ``r = p_A - p_B`` (world axes, m). The Jacobian from
+  ``pin.getConstraintsJacobian`` is exactly ``dr/dq`` (on the tangent space).
+* frame closure (``CONTACT_6D``, ``LOCAL``): residual ``r = -log6(A^-1 B)``
+  (``[linear; angular]`` in frame A). Pinocchio's Jacobian is the velocity of
+  A relative to B seen in A, which equals ``dr/dq`` at closure; away from it,
+  Newton's method with this Jacobian still converges quadratically.
+
+The drift is ``gamma = dJ/dt v``, so that the closure holds at second order
+when ``J a + gamma = 0``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core.mechanism import Mechanism
+
+
+def residual(mech: Mechanism, q: np.ndarray, *, update: bool = True) -> np.ndarray:
+    """Closure residual at ``q`` (see module doc). ``update=False`` reuses ``mech.data`` placements."""
+    m, d = mech.model, mech.data
+    if update:
+        pin.framesForwardKinematics(m, d, q)
+    out = np.empty(mech.n_constraints)
+    k = 0
+    for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
+        if c.type == "point":
+            out[k:k + 3] = d.oMf[fa].translation - d.oMf[fb].translation
+            k += 3
+        else:
+            out[k:k + 6] = -pin.log6(d.oMf[fa].actInv(d.oMf[fb])).vector
+            k += 6
+    return out
+
+
+def jacobian(mech: Mechanism, q: np.ndarray, *, update: bool = True) -> np.ndarray:
+    """Constraint Jacobian (n_constraints x nv) from Pinocchio's constraint models.
+
+    With ``update=True`` it runs ``computeJointJacobians`` (which also places the joints)
+    and ``calc`` on every constraint; Pinocchio 4 returns a stale Jacobian without the latter.
+    """
+    m, d = mech.model, mech.data
+    if update:
+        pin.computeJointJacobians(m, d, q)
+    for cm, cd in zip(mech.constraint_models, mech.constraint_datas):
+        cm.calc(m, d, cd)
+    return pin.getConstraintsJacobian(m, d, mech.constraint_models, mech.constraint_datas)
+
+
+def residual_and_jacobian(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Both at once, with one kinematics pass."""
+    pin.computeJointJacobians(mech.model, mech.data, q)
+    pin.updateFramePlacements(mech.model, mech.data)
+    return residual(mech, q, update=False), jacobian(mech, q, update=False)
+
+
+def drift(mech: Mechanism, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``gamma = dJ/dt(q, v) v``: the closure acceleration produced by ``v`` alone (a = 0)."""
+    m, d = mech.model, mech.data
+    pin.forwardKinematics(m, d, q, v, np.zeros(m.nv))
+    pin.updateFramePlacements(m, d)
+    out = np.empty(mech.n_constraints)
+    k = 0
+    for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
+        if c.type == "point":
+            aa = pin.getFrameClassicalAcceleration(m, d, fa, pin.LOCAL_WORLD_ALIGNED).linear
+            ab = pin.getFrameClassicalAcceleration(m, d, fb, pin.LOCAL_WORLD_ALIGNED).linear
+            out[k:k + 3] = aa - ab
+            k += 3
+        else:
+            # relative acceleration of A w.r.t. B in A: a_A - X a_B - v_A x (X v_B), X = Ad(A^-1 B)
+            aMb = d.oMf[fa].actInv(d.oMf[fb])
+            va = pin.getFrameVelocity(m, d, fa, pin.LOCAL)
+            vb = aMb.act(pin.getFrameVelocity(m, d, fb, pin.LOCAL))
+            aa = pin.getFrameAcceleration(m, d, fa, pin.LOCAL)
+            ab = aMb.act(pin.getFrameAcceleration(m, d, fb, pin.LOCAL))
+            out[k:k + 6] = (aa - ab - va.cross(vb)).vector
+            k += 6
+    return out

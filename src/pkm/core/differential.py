@@ -1,0 +1,187 @@
+"""Velocity and acceleration kinematics of closed-loop mechanisms; singularity diagnostics.
+
+With ``J_c`` the constraint Jacobian (:mod:`pkm.core.constraints`), split into
+actuated columns ``J_a`` and passive columns ``J_p``, and ``J_t`` the task Jacobian
+(:mod:`pkm.core.task`):
+
+* passive rates: ``v_p = -J_p^+ J_a qd_a`` (``G = dq/dq_a``, :func:`passive_map`);
+  undefined when ``J_p`` loses column rank: a *direct* (type 2) singularity, the
+  actuators locked yet the mechanism movable;
+* forward Jacobian ``J_fwd = J_t G`` (task rates from actuated rates);
+* inverse Jacobian: ``[J_c; J_t] v = [0; yd]``, read on the actuated rows; undefined
+  when ``[J_c; J_t]`` loses column rank: an *inverse* (type 1) singularity, the task
+  frozen yet the joints movable;
+* accelerations: ``J_c a + gamma_c = 0`` with the drift ``gamma_c = dJ_c/dt v``, and
+  task accelerations ``J_t a + gamma_t``.
+
+Rank decisions use singular values relative to the largest one (``rtol``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pkm.core import constraints
+from pkm.core.mechanism import Mechanism
+from pkm.core.task import TaskMap
+from pkm.errors import SingularityError
+
+RTOL = 1e-9
+
+
+def _smin(A: np.ndarray, ncols: int | None = None) -> tuple[float, float]:
+    """(smallest, largest) of the first ``ncols`` singular values (column-rank measure)."""
+    s = np.linalg.svd(A, compute_uv=False)
+    n = A.shape[1] if ncols is None else ncols
+    if len(s) < n:
+        return 0.0, float(s[0]) if len(s) else 0.0
+    return float(s[n - 1]), float(s[0])
+
+
+def passive_map(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+    """``G = dq/dq_a`` (nv x na): all joint rates from the actuated rates.
+
+    Raises:
+        SingularityError: ``kind="direct"`` where the passive columns of the constraint
+            Jacobian lose rank.
+    """
+    q = mech.check_q(q)
+    Jc = constraints.jacobian(mech, q)
+    return _passive_map(mech, Jc, rtol)
+
+
+def _passive_map(mech: Mechanism, Jc: np.ndarray, rtol: float) -> np.ndarray:
+    Jp = Jc[:, mech.passive_v]
+    smin, smax = _smin(Jp)
+    if smin <= rtol * max(smax, 1.0):
+        raise SingularityError("direct", smin, "actuators locked, the mechanism can still move")
+    G = np.zeros((mech.nv, mech.na))
+    G[mech.act_v, np.arange(mech.na)] = 1.0
+    G[mech.passive_v] = -np.linalg.lstsq(Jp, Jc[:, mech.act_v], rcond=None)[0]
+    return G
+
+
+def forward_jacobian(mech: Mechanism, q) -> np.ndarray:
+    """Task rates from actuated rates, ``yd = J qd_a`` (n_task x na)."""
+    q = mech.check_q(q)
+    G = _passive_map(mech, constraints.jacobian(mech, q), RTOL)
+    return TaskMap(mech).jacobian(q, update=False) @ G
+
+
+def twist_jacobian(mech: Mechanism, q) -> np.ndarray:
+    """End-effector twist ``[v; w]`` (origin velocity, world axes) from actuated rates (6 x na)."""
+    import pinocchio as pin
+
+    q = mech.check_q(q)
+    G = _passive_map(mech, constraints.jacobian(mech, q), RTOL)
+    pin.updateFramePlacements(mech.model, mech.data)
+    return pin.getFrameJacobian(mech.model, mech.data, mech.ee_frame, pin.LOCAL_WORLD_ALIGNED) @ G
+
+
+def inverse_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+    """Actuated rates from task rates, ``qd_a = J yd`` (na x n_task).
+
+    Raises:
+        SingularityError: ``kind="inverse"`` where ``[J_c; J_t]`` loses column rank.
+    """
+    q = mech.check_q(q)
+    Jc = constraints.jacobian(mech, q)
+    A = np.vstack([Jc, TaskMap(mech).jacobian(q, update=False)])
+    smin, smax = _smin(A)
+    if smin <= rtol * max(smax, 1.0):
+        raise SingularityError("inverse", smin, "the task frozen, the joints can still move")
+    rhs = np.zeros((A.shape[0], mech.n_task))
+    rhs[mech.n_constraints:] = np.eye(mech.n_task)
+    return np.linalg.lstsq(A, rhs, rcond=None)[0][mech.act_v]
+
+
+def velocities(mech: Mechanism, q, qd_actuated) -> np.ndarray:
+    """All joint rates ``v`` (nv,) from the actuated rates."""
+    return passive_map(mech, q) @ mech.check_actuated(qd_actuated, "qd_actuated")
+
+
+def accelerations(mech: Mechanism, q, v, qdd_actuated) -> np.ndarray:
+    """All joint accelerations ``a`` (nv,) from the actuated ones, the drift included."""
+    q, v = mech.check_q(q), mech.check_v(v)
+    qdd = mech.check_actuated(qdd_actuated, "qdd_actuated")
+    gamma = constraints.drift(mech, q, v)
+    Jc = constraints.jacobian(mech, q)
+    _passive_map(mech, Jc, RTOL)  # raises at a direct singularity
+    a = np.zeros(mech.nv)
+    a[mech.act_v] = qdd
+    a[mech.passive_v] = -np.linalg.lstsq(Jc[:, mech.passive_v], Jc[:, mech.act_v] @ qdd + gamma, rcond=None)[0]
+    return a
+
+
+def task_velocity(mech: Mechanism, q, v) -> np.ndarray:
+    """Task rates for joint rates ``v``."""
+    q, v = mech.check_q(q), mech.check_v(v)
+    return TaskMap(mech).jacobian(q) @ v
+
+
+def task_acceleration(mech: Mechanism, q, v, a) -> np.ndarray:
+    """Task accelerations ``J_t a + dJ_t/dt v``."""
+    q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
+    task = TaskMap(mech)
+    return task.jacobian(q) @ a + task.bias(q, v)
+
+
+def inverse_velocities(mech: Mechanism, q, yd) -> np.ndarray:
+    """All joint rates ``v`` for task rates ``yd`` (nv,)."""
+    q = mech.check_q(q)
+    yd = np.asarray(yd, dtype=float)
+    Jc = constraints.jacobian(mech, q)
+    A = np.vstack([Jc, TaskMap(mech).jacobian(q, update=False)])
+    return np.linalg.lstsq(A, np.concatenate([np.zeros(mech.n_constraints), yd]), rcond=None)[0]
+
+
+def inverse_accelerations(mech: Mechanism, q, v, ydd) -> np.ndarray:
+    """All joint accelerations ``a`` for task accelerations ``ydd`` at state ``(q, v)``."""
+    q, v = mech.check_q(q), mech.check_v(v)
+    task = TaskMap(mech)
+    gamma_c = constraints.drift(mech, q, v)
+    gamma_t = task.bias(q, v)
+    Jc = constraints.jacobian(mech, q)
+    A = np.vstack([Jc, task.jacobian(q, update=False)])
+    rhs = np.concatenate([-gamma_c, np.asarray(ydd, dtype=float) - gamma_t])
+    return np.linalg.lstsq(A, rhs, rcond=None)[0]
+
+
+@dataclass(frozen=True)
+class Diagnostics:
+    """Rank and singularity measures at a configuration.
+
+    Attributes:
+        constraint_rank: Rank of the constraint Jacobian.
+        redundant_constraints: Equations that are linearly dependent on others (planar loops
+            closed with 3-D points have some).
+        mobility: Instantaneous degrees of freedom, ``nv - constraint_rank``.
+        sigma_direct: Smallest singular value of the passive columns ``J_p`` (type 2 measure).
+        sigma_inverse: Smallest singular value of ``[J_c; J_t]`` (type 1 measure).
+        classification: ``"regular"``, ``"inverse"``, ``"direct"`` or ``"combined"``.
+    """
+
+    constraint_rank: int
+    redundant_constraints: int
+    mobility: int
+    sigma_direct: float
+    sigma_inverse: float
+    classification: str
+
+
+def diagnose(mech: Mechanism, q, *, rtol: float = 1e-7) -> Diagnostics:
+    """Rank, mobility and singularity classification at ``q`` (which should be assembled)."""
+    q = mech.check_q(q)
+    Jc = constraints.jacobian(mech, q)
+    Jt = TaskMap(mech).jacobian(q, update=False)
+    s = np.linalg.svd(Jc, compute_uv=False)
+    rank = int(np.sum(s > rtol * max(s[0], 1.0))) if len(s) else 0
+    sd, sdmax = _smin(Jc[:, mech.passive_v])
+    si, simax = _smin(np.vstack([Jc, Jt]))
+    direct = sd <= rtol * max(sdmax, 1.0)
+    inverse = si <= rtol * max(simax, 1.0)
+    cls = {(False, False): "regular", (True, False): "inverse", (False, True): "direct",
+           (True, True): "combined"}[(inverse, direct)]
+    return Diagnostics(rank, mech.n_constraints - rank, mech.nv - rank, sd, si, cls)

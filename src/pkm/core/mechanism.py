@@ -1,0 +1,268 @@
+"""A closed-loop mechanism: a Pinocchio tree, its loop closures, actuation and task.
+
+:class:`Mechanism` holds no algorithm of its own beyond bookkeeping (names,
+indices, validated configuration vectors); the algorithms live in
+:mod:`pkm.core.solve` and :mod:`pkm.core.differential` and take a mechanism.
+
+Joint coordinates follow Pinocchio: ``q`` has ``model.nq`` entries (a free-flyer
+takes 7: position and quaternion x y z w), velocities ``v`` have ``model.nv``.
+Joints are indexed by name through ``idx_q``/``idx_v`` (Pinocchio orders them
+by tree traversal, not by file order). Mimic joints take no coordinate.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core.spec import ClosureSpec
+from pkm.core.urdf import load_model
+from pkm.errors import InvalidInputError, SpecError, UnknownNameError
+
+
+@dataclass(frozen=True)
+class JointInfo:
+    """Where a named joint sits in ``q`` and ``v``."""
+
+    name: str
+    id: int
+    idx_q: int
+    nq: int
+    idx_v: int
+    nv: int
+    kind: str
+
+
+class Mechanism:
+    """A parallel mechanism on Pinocchio.
+
+    Attributes:
+        model: The Pinocchio model of the tree (loops open).
+        data: A Pinocchio data owned by this mechanism (algorithms write into it).
+        spec: The closure spec.
+        params: The parameter object that generated it (None when loaded from files).
+        urdf: The URDF text, when known.
+        constraint_models: One ``pin.RigidConstraintModel`` per closure, in spec order.
+            Point closures are ``CONTACT_3D`` in ``LOCAL_WORLD_ALIGNED``: their Jacobian is
+            exactly d(p_A - p_B)/dq. Frame closures are ``CONTACT_6D`` in ``LOCAL`` (frame A):
+            their Jacobian maps v to the twist of B relative to A, expressed in A, with a sign
+            such that it is the derivative of ``-log6(A^-1 B)`` at closure.
+    """
+
+    def __init__(self, model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | None = None,
+                 source: str = "<model>"):
+        self.model = model
+        self.data = model.createData()
+        self.spec = spec
+        self.params = params
+        self.urdf = urdf
+        self.source = source
+        self.joints: dict[str, JointInfo] = {}
+        for jid in range(1, model.njoints):
+            jm = model.joints[jid]
+            self.joints[model.names[jid]] = JointInfo(model.names[jid], jid, jm.idx_q, jm.nq, jm.idx_v, jm.nv,
+                                                      jm.shortname())
+        frame_names = [f.name for f in model.frames]
+
+        def frame(name: str, what: str) -> int:
+            if not model.existFrame(name):
+                raise UnknownNameError("frame", name, frame_names, f"{source} ({what})")
+            return model.getFrameId(name)
+
+        def scalar_joint(name: str, what: str) -> JointInfo:
+            if name not in self.joints:
+                raise UnknownNameError("joint", name, self.scalar_joint_names(), f"{source} ({what})")
+            info = self.joints[name]
+            if info.nq != 1 or info.nv != 1:
+                raise SpecError(source, f"{what}: joint {name!r} ({info.kind}) must have one coordinate")
+            return info
+
+        self.ee_frame = frame(spec.end_effector, "end_effector")
+        self.closure_frames = [(frame(c.frame_a, f"closure {c.name!r}"), frame(c.frame_b, f"closure {c.name!r}"))
+                               for c in spec.closures]
+        self.actuated = tuple(scalar_joint(n, "actuated") for n in spec.actuated)
+        self.task_joints = tuple(scalar_joint(n, "task.joints") for n in spec.task.joints)
+        for b in spec.branches.values():
+            for n in b.signs:
+                scalar_joint(n, f"branch {b.name!r}")
+        self.act_q = np.array([j.idx_q for j in self.actuated])
+        self.act_v = np.array([j.idx_v for j in self.actuated])
+        self.passive_v = np.array([i for i in range(model.nv) if i not in set(self.act_v)], dtype=int)
+
+        self.constraint_models = []
+        for c, (fa, fb) in zip(spec.closures, self.closure_frames):
+            A, B = model.frames[fa], model.frames[fb]
+            if c.type == "point":
+                cm = pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, model, A.parentJoint, A.placement,
+                                              B.parentJoint, B.placement, pin.LOCAL_WORLD_ALIGNED)
+            else:
+                cm = pin.RigidConstraintModel(pin.ContactType.CONTACT_6D, model, A.parentJoint, A.placement,
+                                              B.parentJoint, B.placement, pin.LOCAL)
+            cm.name = c.name
+            self.constraint_models.append(cm)
+        self.constraint_datas = [cm.createData() for cm in self.constraint_models]
+        self.n_constraints = sum(cm.residualSize() for cm in self.constraint_models)
+
+        missing = [n for n, j in self.joints.items() if j.nq > 0 and n not in spec.reference]
+        unknown = [n for n in spec.reference if n not in self.joints]
+        if unknown:
+            raise UnknownNameError("joint", unknown[0], list(self.joints), f"{source} ([reference])")
+        if missing:
+            raise SpecError(source, f"[reference] lacks joints {missing}")
+        self.q_reference = self.q_from_dict(spec.reference, base=pin.neutral(model))
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_strings(cls, urdf: str, spec: ClosureSpec | str, params: Any = None,
+                     source: str = "<string>") -> Mechanism:
+        """Build from URDF text and a spec (object or TOML text)."""
+        if isinstance(spec, str):
+            spec = ClosureSpec.from_toml(spec, source + " (closures)")
+        return cls(load_model(urdf, source), spec, params, urdf, source)
+
+    @classmethod
+    def from_files(cls, spec_path: str | Path) -> Mechanism:
+        """Load ``<name>.closures.toml`` and the URDF it names (path relative to the spec)."""
+        spec_path = Path(spec_path)
+        spec = ClosureSpec.load(spec_path)
+        urdf_path = spec_path.parent / spec.urdf
+        try:
+            urdf = urdf_path.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise SpecError(str(urdf_path), f"cannot read URDF: {exc.strerror}") from None
+        return cls(load_model(urdf, str(urdf_path)), spec, None, urdf, str(spec_path))
+
+    # ------------------------------------------------------------------ sizes and names
+    @property
+    def name(self) -> str:
+        return self.spec.mechanism
+
+    @property
+    def nq(self) -> int:
+        return self.model.nq
+
+    @property
+    def nv(self) -> int:
+        return self.model.nv
+
+    @property
+    def na(self) -> int:
+        """Number of actuated coordinates."""
+        return len(self.actuated)
+
+    @property
+    def n_task(self) -> int:
+        """Number of output (task) coordinates."""
+        return self.spec.task.size
+
+    @property
+    def actuated_names(self) -> tuple[str, ...]:
+        return self.spec.actuated
+
+    def scalar_joint_names(self) -> list[str]:
+        return [n for n, j in self.joints.items() if j.nq == 1 and j.nv == 1]
+
+    def frame_id(self, name: str) -> int:
+        """Frame index by name; raises :class:`UnknownNameError` listing the valid names."""
+        if not self.model.existFrame(name):
+            raise UnknownNameError("frame", name, [f.name for f in self.model.frames], self.name)
+        return self.model.getFrameId(name)
+
+    def joint(self, name: str) -> JointInfo:
+        if name not in self.joints:
+            raise UnknownNameError("joint", name, list(self.joints), self.name)
+        return self.joints[name]
+
+    # ------------------------------------------------------------------ vectors
+    def check_q(self, q, name: str = "q") -> np.ndarray:
+        """``q`` as a float array of shape (nq,), finite, with unit quaternions; else raise."""
+        q = _vector(q, self.nq, name)
+        for j in self.joints.values():
+            if j.kind == "JointModelFreeFlyer":
+                quat = q[j.idx_q + 3:j.idx_q + 7]
+            elif j.kind == "JointModelSpherical":
+                quat = q[j.idx_q:j.idx_q + 4]
+            else:
+                continue
+            if abs(np.linalg.norm(quat) - 1.0) > 1e-6:
+                raise InvalidInputError(name, f"quaternion of joint {j.name!r} has norm {np.linalg.norm(quat):.6g}, "
+                                              "expected 1", quat)
+        return q
+
+    def check_v(self, v, name: str = "v") -> np.ndarray:
+        return _vector(v, self.nv, name)
+
+    def check_actuated(self, qa, name: str = "q_actuated") -> np.ndarray:
+        return _vector(qa, self.na, name)
+
+    def actuated_q(self, q) -> np.ndarray:
+        """The actuated coordinates of a configuration, in spec order."""
+        return np.asarray(q, dtype=float)[self.act_q].copy()
+
+    def with_actuated(self, q, qa) -> np.ndarray:
+        q = np.array(q, dtype=float)
+        q[self.act_q] = qa
+        return q
+
+    def q_from_dict(self, values: Mapping[str, Any], base=None) -> np.ndarray:
+        """A configuration from ``{joint name: value or vector}``; other joints from ``base``."""
+        q = np.array(self.q_reference if base is None else base, dtype=float)
+        for name, val in values.items():
+            j = self.joint(name)
+            arr = np.atleast_1d(np.asarray(val, dtype=float))
+            if arr.shape != (j.nq,):
+                raise InvalidInputError(name, f"joint {name!r} takes {j.nq} coordinate(s), got {arr.shape}", val)
+            if not np.all(np.isfinite(arr)):
+                raise InvalidInputError(name, "value is not finite", val)
+            q[j.idx_q:j.idx_q + j.nq] = arr
+        return q
+
+    def q_to_dict(self, q) -> dict[str, np.ndarray | float]:
+        """``{joint name: coordinate}`` (scalars for 1-DOF joints); mimic joints are left out."""
+        q = np.asarray(q, dtype=float)
+        out: dict[str, np.ndarray | float] = {}
+        for name, j in self.joints.items():
+            if j.nq == 1:
+                out[name] = float(q[j.idx_q])
+            elif j.nq > 1:
+                out[name] = q[j.idx_q:j.idx_q + j.nq].copy()
+        return out
+
+    def branch_signs(self, q, branch: str | None = None) -> dict[str, int]:
+        """Signs of the joints that define ``branch`` (default branch when None)."""
+        b = self.branch(branch)
+        q = np.asarray(q, dtype=float)
+        return {n: (1 if q[self.joints[n].idx_q] >= 0 else -1) for n in b.signs}
+
+    def on_branch(self, q, branch: str | None = None) -> bool:
+        b = self.branch(branch)
+        return self.branch_signs(q, b.name) == dict(b.signs)
+
+    def branch(self, name: str | None = None):
+        """The named branch (the spec's default when None)."""
+        key = self.spec.default_branch if name is None else name
+        if key is None or key not in self.spec.branches:
+            raise UnknownNameError("branch", str(name), list(self.spec.branches), self.name)
+        return self.spec.branches[key]
+
+    def __repr__(self) -> str:
+        return (f"Mechanism({self.name!r}: nq={self.nq}, nv={self.nv}, actuated={list(self.actuated_names)}, "
+                f"closures={len(self.spec.closures)} ({self.n_constraints} equations), "
+                f"task={list(self.spec.task.components) + list(self.spec.task.joints)})")
+
+
+def _vector(x, n: int, name: str) -> np.ndarray:
+    try:
+        arr = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInputError(name, f"expected {n} numbers, got {type(x).__name__}", x) from None
+    if arr.shape != (n,):
+        raise InvalidInputError(name, f"expected shape ({n},), got {arr.shape}", x)
+    if not np.all(np.isfinite(arr)):
+        raise InvalidInputError(name, f"holds non-finite values at {np.flatnonzero(~np.isfinite(arr)).tolist()}", x)
+    return arr.copy()

@@ -1,0 +1,217 @@
+"""Position problems of closed-loop mechanisms, solved on the Pinocchio tree.
+
+* :func:`close_loops` (forward kinematics): given the actuated coordinates, find
+  the passive ones so that every loop closes.
+* :func:`solve_ik` (inverse kinematics): given the task coordinates (end-effector
+  pose or components, plus any joint outputs), find every joint coordinate.
+
+Both are Gauss-Newton iterations on the tangent space (``pin.integrate``) with
+rank-revealing least-squares steps (a planar mechanism closed with 3-D point
+constraints has zero rows), a step-length cap and a backtracking line search.
+Far from the seed they follow a continuation path (actuated coordinates or task
+coordinates moved in steps of at most ``max_step``), each step corrected by
+Newton, so that the solution stays on the seed's assembly mode and working mode
+unless the path crosses a singularity. Every solver stops after a bounded number
+of iterations and raises :class:`~pkm.errors.ConvergenceError` with its residual.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core import constraints
+from pkm.core.mechanism import Mechanism
+from pkm.core.task import TaskMap
+from pkm.errors import BranchError, ConvergenceError
+
+DEFAULT_TOL = 1e-12
+
+
+@dataclass(frozen=True)
+class SolveResult:
+    """Outcome of a position solver.
+
+    Attributes:
+        q: The configuration found (nq,).
+        converged: Whether the residual reached the tolerance.
+        residual: Infinity norm of the equations at ``q`` (m for points, rad for angles).
+        iterations: Newton iterations, all continuation steps included.
+        steps: Continuation steps taken (1 when solved directly).
+        branch_signs: Signs of the default-branch joints at ``q`` (empty without branches).
+    """
+
+    q: np.ndarray
+    converged: bool
+    residual: float
+    iterations: int
+    steps: int = 1
+    branch_signs: dict[str, int] = field(default_factory=dict)
+
+
+def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray,
+            cols: np.ndarray | None, tol: float, max_iter: int, max_dq: float) -> tuple[np.ndarray, float, int]:
+    """Gauss-Newton with a step cap and backtracking; returns (q, residual inf-norm, iterations)."""
+    m = mech.model
+    r, J = fun(q)
+    res = float(np.max(np.abs(r)))
+    it = 0
+    while res > tol and it < max_iter:
+        it += 1
+        A = J if cols is None else J[:, cols]
+        step = -np.linalg.lstsq(A, r, rcond=None)[0]
+        nrm = np.max(np.abs(step))
+        if nrm > max_dq:
+            step *= max_dq / nrm
+        dq = step if cols is None else np.zeros(m.nv)
+        if cols is not None:
+            dq[cols] = step
+        alpha = 1.0
+        for _ in range(8):
+            q_try = pin.integrate(m, q, alpha * dq)
+            r_try, J_try = fun(q_try)
+            res_try = float(np.max(np.abs(r_try)))
+            if res_try < res or alpha < 0.02:
+                break
+            alpha *= 0.5
+        q, r, J, res = q_try, r_try, J_try, res_try
+    return q, res, it
+
+
+def close_loops(mech: Mechanism, q_actuated, q0=None, *, tol: float = DEFAULT_TOL, max_iter: int = 30,
+                max_step: float = 0.1, raise_on_failure: bool = True) -> SolveResult:
+    """Forward position problem: passive coordinates for given actuated ones.
+
+    Args:
+        mech: The mechanism.
+        q_actuated: Actuated coordinates in spec order (rad or m), shape (na,).
+        q0: Seed configuration (nq,); its assembly mode is kept. Default: the reference configuration.
+        tol: Tolerance on the infinity norm of the closure residual [m, rad].
+        max_iter: Newton iterations allowed per continuation step.
+        max_step: Largest change of an actuated coordinate per continuation step [rad or m].
+        raise_on_failure: Raise :class:`ConvergenceError` (default) instead of returning ``converged=False``.
+
+    Returns:
+        A :class:`SolveResult` whose ``q`` has the requested actuated coordinates.
+    """
+    qa1 = mech.check_actuated(q_actuated)
+    q = mech.q_reference.copy() if q0 is None else mech.check_q(q0, "q0")
+    qa0 = mech.actuated_q(q)
+    n_steps = max(1, int(np.ceil(np.max(np.abs(qa1 - qa0)) / max_step)))
+
+    def fun(qq):
+        return constraints.residual_and_jacobian(mech, qq)
+
+    total = 0
+    s, ds = 0.0, 1.0 / n_steps
+    steps = 0
+    while True:
+        s_next = min(1.0, s + ds)
+        q_try = mech.with_actuated(q, qa0 + s_next * (qa1 - qa0))
+        last = s_next >= 1.0
+        q_new, res, it = _newton(mech, fun, q_try, mech.passive_v, tol if last else max(tol, 1e-9),
+                                 max_iter, 0.5)
+        total += it
+        ok = res <= (tol if last else max(tol, 1e-9))
+        if ok:
+            q, s, steps = q_new, s_next, steps + 1
+            if last:
+                break
+            ds = min(ds * 1.5, 1.0 / n_steps)
+        else:
+            ds *= 0.5
+            if ds < 1e-4 / n_steps:
+                result = SolveResult(q_new, False, res, total, steps, _signs(mech, q_new))
+                if raise_on_failure:
+                    raise ConvergenceError("loop closure", res, total, tol, result)
+                return result
+    return SolveResult(q, True, res, total, steps, _signs(mech, q))
+
+
+def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol: float = DEFAULT_TOL,
+             max_iter: int = 30, max_step: float = 0.05, raise_on_failure: bool = True) -> SolveResult:
+    """Inverse position problem: every joint coordinate for given task coordinates.
+
+    Args:
+        mech: The mechanism.
+        target: Task coordinates (see :meth:`pkm.core.task.TaskMap.parse`).
+        q0: Seed configuration; default: the reference configuration (or, with ``branch``,
+            the reference with that branch's joint signs imposed and the loops re-closed).
+        branch: Working mode the solution must lie on; checked at the end (:class:`BranchError`).
+        tol: Tolerance on the infinity norm of closure residual and task error [m, rad].
+        max_iter: Newton iterations allowed per continuation step.
+        max_step: Largest task change per continuation step [m or rad].
+        raise_on_failure: Raise :class:`ConvergenceError` instead of returning ``converged=False``.
+    """
+    task = TaskMap(mech)
+    y1 = task.parse(target)
+    if q0 is None:
+        q = branch_seed(mech, branch) if branch is not None else mech.q_reference.copy()
+    else:
+        q = mech.check_q(q0, "q0")
+    y0 = task.value(q)
+    dist = np.max(np.abs(task.error(y1, y0)))
+    n_steps = max(1, int(np.ceil(dist / max_step)))
+
+    def make_fun(y_goal):
+        def fun(qq):
+            r, Jc = constraints.residual_and_jacobian(mech, qq)
+            e = -task.error(y_goal, task.value(qq, update=False))
+            return np.concatenate([r, e]), np.vstack([Jc, task.jacobian(qq, update=False)])
+        return fun
+
+    total, steps = 0, 0
+    s, ds = 0.0, 1.0 / n_steps
+    while True:
+        s_next = min(1.0, s + ds)
+        last = s_next >= 1.0
+        goal = y1 if last else task.interpolate(y0, y1, s_next)
+        t = tol if last else max(tol, 1e-9)
+        q_new, res, it = _newton(mech, make_fun(goal), q, None, t, max_iter, 0.5)
+        total += it
+        if res <= t:
+            q, s, steps = q_new, s_next, steps + 1
+            if last:
+                break
+            ds = min(ds * 1.5, 1.0 / n_steps)
+        else:
+            ds *= 0.5
+            if ds < 1e-4 / n_steps:
+                result = SolveResult(q_new, False, res, total, steps, _signs(mech, q_new))
+                if raise_on_failure:
+                    raise ConvergenceError("inverse kinematics", res, total, tol, result)
+                return result
+    result = SolveResult(q, True, res, total, steps, _signs(mech, q))
+    if branch is not None and not mech.on_branch(q, branch):
+        raise BranchError(branch, dict(mech.branch(branch).signs), mech.branch_signs(q, branch))
+    return result
+
+
+def branch_seed(mech: Mechanism, branch: str) -> np.ndarray:
+    """An assembled configuration on ``branch`` at the reference task coordinates.
+
+    The reference configuration with the branch's joint signs imposed (coordinates mirrored),
+    then re-solved for the reference task value. Raises :class:`BranchError` if Newton's method
+    falls back onto another branch.
+    """
+    b = mech.branch(branch)
+    q = mech.q_reference.copy()
+    if mech.on_branch(q, branch):
+        return q
+    task = TaskMap(mech)
+    y_ref = task.value(mech.q_reference)
+    for name, sign in b.signs.items():
+        j = mech.joints[name]
+        if np.sign(q[j.idx_q]) != sign:
+            q[j.idx_q] = -q[j.idx_q] if q[j.idx_q] != 0 else sign * 0.5
+    res = solve_ik(mech, y_ref, q, tol=DEFAULT_TOL, raise_on_failure=True)
+    if not mech.on_branch(res.q, branch):
+        raise BranchError(branch, dict(b.signs), mech.branch_signs(res.q, branch))
+    return res.q
+
+
+def _signs(mech: Mechanism, q: np.ndarray) -> dict[str, int]:
+    return mech.branch_signs(q) if mech.spec.default_branch is not None else {}

@@ -1,0 +1,212 @@
+"""Task (output) coordinates of a mechanism: values, differences, Jacobian, bias.
+
+The task of a mechanism (see :mod:`pkm.core.spec`) is either a list of
+end-effector components among ``x y z roll pitch yaw`` (position of the
+end-effector origin in the world, Z-Y-X Euler angles of its orientation), or the
+full placement ``pose``; optionally followed by joint coordinates.
+
+Values are flat vectors: the components in order; for ``pose``, the position
+then the quaternion ``x y z w`` (7 numbers). Velocities are time derivatives of
+the components; for ``pose``, the twist ``[v; w]`` of the end-effector origin in
+world axes (``LOCAL_WORLD_ALIGNED``). Joint outputs follow in both.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core.mechanism import Mechanism
+from pkm.errors import InvalidInputError, SingularityError
+
+_ANGLES = ("roll", "pitch", "yaw")
+_POS = {"x": 0, "y": 1, "z": 2}
+
+
+def zyx_angles(R: np.ndarray) -> np.ndarray:
+    """``(roll, pitch, yaw)`` with ``R = Rz(yaw) Ry(pitch) Rx(roll)``."""
+    pitch = np.arctan2(-R[2, 0], np.hypot(R[0, 0], R[1, 0]))
+    return np.array([np.arctan2(R[2, 1], R[2, 2]), pitch, np.arctan2(R[1, 0], R[0, 0])])
+
+
+def zyx_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
+    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]])
+
+
+def _rate_map(rpy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Columns of ``B`` with ``w = B [roll_dot, pitch_dot, yaw_dot]`` (world axes)."""
+    roll, pitch, yaw = rpy
+    e_yaw = np.array([0.0, 0.0, 1.0])
+    e_pitch = np.array([-np.sin(yaw), np.cos(yaw), 0.0])
+    e_roll = np.array([np.cos(yaw) * np.cos(pitch), np.sin(yaw) * np.cos(pitch), -np.sin(pitch)])
+    return e_roll, e_pitch, e_yaw
+
+
+class TaskMap:
+    """Evaluates the task coordinates of ``mech`` (see module doc)."""
+
+    def __init__(self, mech: Mechanism):
+        self.mech = mech
+        self.spec = mech.spec.task
+        self.pose = self.spec.is_pose
+        self.size = self.spec.size
+        self.value_size = (7 if self.pose else len(self.spec.components)) + len(self.spec.joints)
+        self._comp = () if self.pose else self.spec.components
+        self._jq = np.array([j.idx_q for j in mech.task_joints], dtype=int)
+        self._jv = np.array([j.idx_v for j in mech.task_joints], dtype=int)
+        self.names = (("x", "y", "z", "wx", "wy", "wz") if self.pose else self._comp) + self.spec.joints
+
+    # values ---------------------------------------------------------------
+    def value(self, q: np.ndarray, *, update: bool = True) -> np.ndarray:
+        m, d = self.mech.model, self.mech.data
+        if update:
+            pin.framesForwardKinematics(m, d, q)
+        M = d.oMf[self.mech.ee_frame]
+        if self.pose:
+            head = np.concatenate([M.translation, pin.Quaternion(M.rotation).coeffs()])
+        else:
+            rpy = zyx_angles(M.rotation) if any(c in _ANGLES for c in self._comp) else None
+            head = np.array([M.translation[_POS[c]] if c in _POS else rpy[_ANGLES.index(c)] for c in self._comp])
+        return np.concatenate([head, np.asarray(q)[self._jq]])
+
+    def parse(self, target) -> np.ndarray:
+        """A target value from user input.
+
+        Accepted: a flat vector of the task coordinates; a mapping ``{name: value}`` over all of
+        them (``"pose"`` maps to a ``pin.SE3`` or a 4x4 matrix); for a pose task, a ``pin.SE3``
+        or 4x4 matrix alone when there are no joint outputs.
+        """
+        nj = len(self.spec.joints)
+        if self.pose and (isinstance(target, pin.SE3) or np.shape(target) == (4, 4)):
+            if nj:
+                raise InvalidInputError("target", f"this task also needs the joints {list(self.spec.joints)}: "
+                                                  "pass {'pose': T, joint: value, ...}")
+            target = {"pose": target}
+        if isinstance(target, Mapping):
+            keys = (("pose",) if self.pose else self._comp) + self.spec.joints
+            if set(target) != set(keys):
+                raise InvalidInputError("target", f"expected keys {list(keys)}, got {list(target)}")
+            parts = []
+            for k in keys:
+                if k == "pose":
+                    M = _as_se3(target[k])
+                    parts += list(M.translation) + list(pin.Quaternion(M.rotation).coeffs())
+                else:
+                    parts.append(target[k])
+            target = parts
+        try:
+            y = np.asarray(target, dtype=float)
+        except (TypeError, ValueError):
+            raise InvalidInputError("target", f"cannot read {type(target).__name__} as task coordinates") from None
+        if y.shape != (self.value_size,):
+            raise InvalidInputError("target", f"expected {self.value_size} task coordinates "
+                                              f"{list(self.names)}, got shape {y.shape}", target)
+        if not np.all(np.isfinite(y)):
+            raise InvalidInputError("target", "holds non-finite values", target)
+        if self.pose:
+            qn = np.linalg.norm(y[3:7])
+            if abs(qn - 1.0) > 1e-6:
+                raise InvalidInputError("target", f"quaternion norm {qn:.6g}, expected 1", target)
+        return y
+
+    def error(self, y_target: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Tangent-space difference ``y_target - y`` (angles wrapped to (-pi, pi])."""
+        nj = len(self.spec.joints)
+        tail = y_target[len(y) - nj:] - y[len(y) - nj:]
+        if self.pose:
+            R_t = pin.Quaternion(*_wxyz(y_target[3:7])).toRotationMatrix()
+            R = pin.Quaternion(*_wxyz(y[3:7])).toRotationMatrix()
+            head = np.concatenate([y_target[:3] - y[:3], pin.log3(R_t @ R.T)])
+        else:
+            head = y_target[:len(self._comp)] - y[:len(self._comp)]
+            for i, c in enumerate(self._comp):
+                if c in _ANGLES:
+                    head[i] = (head[i] + np.pi) % (2 * np.pi) - np.pi
+        return np.concatenate([head, tail])
+
+    def interpolate(self, y0: np.ndarray, y1: np.ndarray, s: float) -> np.ndarray:
+        """The point at fraction ``s`` of the way from ``y0`` to ``y1`` (geodesic for rotations)."""
+        e = self.error(y1, y0)
+        if not self.pose:
+            return y0 + s * e
+        R0 = pin.Quaternion(*_wxyz(y0[3:7])).toRotationMatrix()
+        R = pin.exp3(s * e[3:6]) @ R0
+        return np.concatenate([y0[:3] + s * e[:3], pin.Quaternion(R).coeffs(), y0[7:] + s * e[6:]])
+
+    # derivatives ------------------------------------------------------------
+    def jacobian(self, q: np.ndarray, *, update: bool = True) -> np.ndarray:
+        """``d(task)/dq`` on the tangent space (size x nv). ``update=False`` needs joint Jacobians computed."""
+        m, d = self.mech.model, self.mech.data
+        if update:
+            pin.computeJointJacobians(m, d, q)
+            pin.updateFramePlacements(m, d)
+        J6 = pin.getFrameJacobian(m, d, self.mech.ee_frame, pin.LOCAL_WORLD_ALIGNED)
+        rows = [J6] if self.pose else []
+        if not self.pose:
+            Jw = self._euler_rows(d.oMf[self.mech.ee_frame].rotation) @ J6[3:] if self._has_angles else None
+            for c in self._comp:
+                rows.append(J6[_POS[c]][None] if c in _POS else Jw[_ANGLES.index(c)][None])
+        if len(self._jv):
+            Jj = np.zeros((len(self._jv), m.nv))
+            Jj[np.arange(len(self._jv)), self._jv] = 1.0
+            rows.append(Jj)
+        return np.vstack(rows)
+
+    @property
+    def _has_angles(self) -> bool:
+        return any(c in _ANGLES for c in self._comp)
+
+    def _euler_rows(self, R: np.ndarray) -> np.ndarray:
+        """``B^-1``: world angular velocity -> (roll, pitch, yaw) rates."""
+        B = np.column_stack(_rate_map(zyx_angles(R)))
+        if abs(np.cos(zyx_angles(R)[1])) < 1e-9:
+            raise SingularityError("representation", abs(np.cos(zyx_angles(R)[1])),
+                                   "Z-Y-X Euler angles are singular at pitch = +-90 deg")
+        return np.linalg.inv(B)
+
+    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``dJ/dt v``: task acceleration produced by ``v`` alone (a = 0)."""
+        m, d = self.mech.model, self.mech.data
+        pin.forwardKinematics(m, d, q, v, np.zeros(m.nv))
+        pin.updateFramePlacements(m, d)
+        f = self.mech.ee_frame
+        acc = pin.getFrameClassicalAcceleration(m, d, f, pin.LOCAL_WORLD_ALIGNED)
+        out = [np.concatenate([acc.linear, acc.angular])] if self.pose else []
+        if not self.pose:
+            ang = None
+            if self._has_angles:
+                R = d.oMf[f].rotation
+                rpy = zyx_angles(R)
+                w = pin.getFrameVelocity(m, d, f, pin.LOCAL_WORLD_ALIGNED).angular
+                Binv = self._euler_rows(R)
+                rates = Binv @ w
+                e_roll, e_pitch, e_yaw = _rate_map(rpy)
+                w_py = rates[2] * e_yaw + rates[1] * e_pitch  # angular velocity of the yaw-pitch frame
+                Bdot_rates = rates[0] * np.cross(w_py, e_roll) + rates[1] * np.cross(rates[2] * e_yaw, e_pitch)
+                ang = Binv @ (acc.angular - Bdot_rates)
+            out.append(np.array([acc.linear[_POS[c]] if c in _POS else ang[_ANGLES.index(c)] for c in self._comp]))
+        out.append(np.zeros(len(self._jv)))
+        return np.concatenate(out)
+
+
+def _wxyz(xyzw: np.ndarray) -> tuple[float, float, float, float]:
+    return float(xyzw[3]), float(xyzw[0]), float(xyzw[1]), float(xyzw[2])
+
+
+def _as_se3(T) -> pin.SE3:
+    if isinstance(T, pin.SE3):
+        return T
+    T = np.asarray(T, dtype=float)
+    if T.shape != (4, 4) or not np.all(np.isfinite(T)):
+        raise InvalidInputError("pose", f"expected a pin.SE3 or a finite 4x4 matrix, got shape {T.shape}", T)
+    R = T[:3, :3]
+    if np.abs(R.T @ R - np.eye(3)).max() > 2e-3 or np.linalg.det(R) < 0:
+        raise InvalidInputError("pose", "the rotation block is not a rotation matrix (orthonormal to 2e-3, det +1)", T)
+    # project onto SO(3): matrices printed to 4 digits (as in the papers) are accepted
+    U, _, Vt = np.linalg.svd(R)
+    return pin.SE3(U @ Vt, T[:3, 3].copy())

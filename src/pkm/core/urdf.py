@@ -1,0 +1,200 @@
+"""Building, validating and loading the URDF trees of mechanisms.
+
+The generators build each tree with :class:`UrdfBuilder` (yourdfpy objects,
+validated by yourdfpy), and :func:`load_model` turns URDF text into a Pinocchio
+model after pkm's own checks, so that a malformed file yields a
+:class:`~pkm.errors.SpecError` that says what is wrong instead of Pinocchio's
+bare ``ValueError``.
+
+What the loader refuses: a document with a DOCTYPE (hence any entity
+declaration), a root element other than ``<robot>``, links or joints without a
+name or with a duplicate name, a joint whose parent or child is not a link, a
+link with two parents or a tree with several roots, an unknown joint type, a
+zero axis, a revolute or prismatic joint without ``<limit lower upper>``,
+non-finite or absurd numbers (beyond 1e6 in SI), a ``<mimic>`` that names an
+unknown joint. yourdfpy drops ``<mimic>`` when it writes, so the builder puts
+those elements back itself.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+
+import numpy as np
+import pinocchio as pin
+import yourdfpy
+from lxml import etree
+
+from pkm.errors import SpecError
+
+_JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
+_ABSURD = 1e6  # |value| above this (m, rad, kg, N) is taken for a unit error
+_MAX_BYTES = 16 * 1024 * 1024
+
+
+def _origin(xyz=(0.0, 0.0, 0.0), rotation=None) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, 3] = xyz
+    if rotation is not None:
+        T[:3, :3] = rotation
+    return T
+
+
+class UrdfBuilder:
+    """Collects links and joints, then writes a validated URDF string.
+
+    Lengths in m, masses in kg, inertias in kg m^2 about the centre of mass,
+    angles in rad. Rotations are given as 3x3 matrices.
+    """
+
+    def __init__(self, name: str):
+        self.name = name
+        self._links: list[yourdfpy.Link] = []
+        self._joints: list[yourdfpy.Joint] = []
+        self._mimic: dict[str, tuple[str, float, float]] = {}
+
+    def link(self, name: str, mass: float = 0.0, com=(0.0, 0.0, 0.0), inertia=None) -> str:
+        """Add a link; a massless link gets no ``<inertial>``."""
+        inertial = None
+        if mass > 0.0:
+            I = np.zeros((3, 3)) if inertia is None else np.asarray(inertia, dtype=float)
+            inertial = yourdfpy.Inertial(origin=_origin(com), mass=float(mass), inertia=I)
+        self._links.append(yourdfpy.Link(name=name, inertial=inertial))
+        return name
+
+    def joint(self, name: str, type: str, parent: str, child: str, xyz=(0.0, 0.0, 0.0), rotation=None,
+              axis=(0.0, 0.0, 1.0), limits: tuple[float, float] | None = None, effort: float = 1e3,
+              velocity: float = 1e2, mimic: tuple[str, float, float] | None = None) -> str:
+        """Add a joint. ``mimic = (leader, multiplier, offset)`` makes it follow ``leader``."""
+        limit = None
+        if type in ("revolute", "prismatic"):
+            lo, hi = limits if limits is not None else (-math.pi, math.pi)
+            limit = yourdfpy.Limit(effort=float(effort), velocity=float(velocity), lower=float(lo), upper=float(hi))
+        ax = None if type in ("fixed", "floating") else np.asarray(axis, dtype=float)
+        self._joints.append(yourdfpy.Joint(name=name, type=type, parent=parent, child=child,
+                                           origin=_origin(xyz, rotation), axis=ax, limit=limit))
+        if mimic is not None:
+            self._mimic[name] = (mimic[0], float(mimic[1]), float(mimic[2]))
+        return name
+
+    def frame(self, name: str, parent: str, xyz=(0.0, 0.0, 0.0), rotation=None) -> str:
+        """Add a massless link ``name`` fixed to ``parent`` (a named frame for closures)."""
+        self.link(name)
+        self.joint(f"{name}_fixed", "fixed", parent, name, xyz, rotation)
+        return name
+
+    def to_xml(self) -> str:
+        """The URDF text: yourdfpy-validated, ``<mimic>`` restored, pretty-printed."""
+        robot = yourdfpy.Robot(name=self.name, links=self._links, joints=self._joints)
+        urdf = yourdfpy.URDF(robot=robot, build_scene_graph=False, load_meshes=False)
+        if not urdf.validate():
+            raise SpecError(f"<generated {self.name}>", "yourdfpy rejects the generated tree")
+        root = etree.fromstring(urdf.write_xml_string())
+        for jel in root.iter("joint"):
+            if jel.get("name") in self._mimic:
+                leader, mult, off = self._mimic[jel.get("name")]
+                etree.SubElement(jel, "mimic", joint=leader, multiplier=repr(mult), offset=repr(off))
+        etree.indent(root, space="  ")
+        text = etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True).decode()
+        check_urdf(text, f"<generated {self.name}>")
+        return text
+
+
+def _floats(text: str | None, n: int, what: str, source: str) -> list[float]:
+    try:
+        vals = [float(v) for v in (text or "").split()]
+    except ValueError:
+        raise SpecError(source, f"{what}: {text!r} is not a list of numbers") from None
+    if len(vals) != n:
+        raise SpecError(source, f"{what}: expected {n} numbers, got {text!r}")
+    for v in vals:
+        if not math.isfinite(v) or abs(v) > _ABSURD:
+            raise SpecError(source, f"{what}: value {v!r} is not finite or absurdly large (SI units expected)")
+    return vals
+
+
+def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
+    """Parse and check URDF text (see the module docstring); returns the root element."""
+    data = text.encode() if isinstance(text, str) else text
+    if len(data) > _MAX_BYTES:
+        raise SpecError(source, f"URDF larger than {_MAX_BYTES} bytes")
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False,
+                             dtd_validation=False)
+    try:
+        root = etree.fromstring(data, parser)
+    except etree.XMLSyntaxError as exc:
+        raise SpecError(source, f"not well-formed XML: {exc}") from None
+    if root.getroottree().docinfo.doctype:
+        raise SpecError(source, "URDF with a DOCTYPE (entity declarations) is refused")
+    if root.tag != "robot":
+        raise SpecError(source, f"root element is <{root.tag}>, expected <robot>")
+
+    links = [el.get("name") for el in root.findall("link")]
+    if any(not n for n in links):
+        raise SpecError(source, "a <link> has no name")
+    if len(set(links)) != len(links):
+        raise SpecError(source, "two links share a name")
+    joints = root.findall("joint")
+    jnames = [el.get("name") for el in joints]
+    if any(not n for n in jnames) or len(set(jnames)) != len(jnames):
+        raise SpecError(source, "a <joint> has no name or two joints share a name")
+    parent_of: dict[str, str] = {}
+    for el in joints:
+        name, typ = el.get("name"), el.get("type")
+        if typ not in _JOINT_TYPES:
+            raise SpecError(source, f"joint {name!r}: unknown type {typ!r}; URDF types are {sorted(_JOINT_TYPES)}")
+        par, chi = el.find("parent"), el.find("child")
+        if par is None or chi is None:
+            raise SpecError(source, f"joint {name!r} lacks <parent> or <child>")
+        for role, link in (("parent", par.get("link")), ("child", chi.get("link"))):
+            if link not in links:
+                raise SpecError(source, f"joint {name!r}: {role} link {link!r} does not exist")
+        if chi.get("link") in parent_of:
+            raise SpecError(source, f"link {chi.get('link')!r} has two parents (URDF is a tree; "
+                                    "put loops in the closure spec)")
+        parent_of[chi.get("link")] = par.get("link")
+        org = el.find("origin")
+        if org is not None:
+            _floats(org.get("xyz", "0 0 0"), 3, f"joint {name!r} origin xyz", source)
+            _floats(org.get("rpy", "0 0 0"), 3, f"joint {name!r} origin rpy", source)
+        if typ in ("revolute", "continuous", "prismatic"):
+            ax = el.find("axis")
+            axis = _floats(ax.get("xyz") if ax is not None else "1 0 0", 3, f"joint {name!r} axis", source)
+            if np.linalg.norm(axis) < 1e-9:
+                raise SpecError(source, f"joint {name!r} has a zero axis")
+        if typ in ("revolute", "prismatic"):
+            lim = el.find("limit")
+            if lim is None or lim.get("lower") is None or lim.get("upper") is None:
+                raise SpecError(source, f"joint {name!r} ({typ}) needs <limit lower=... upper=...>")
+            lo, hi = _floats(f"{lim.get('lower')} {lim.get('upper')}", 2, f"joint {name!r} limits", source)
+            if lo > hi:
+                raise SpecError(source, f"joint {name!r}: lower limit {lo} > upper limit {hi}")
+        mim = el.find("mimic")
+        if mim is not None and mim.get("joint") not in jnames:
+            raise SpecError(source, f"joint {name!r} mimics unknown joint {mim.get('joint')!r}")
+    roots = [n for n in links if n not in parent_of]
+    if len(roots) != 1:
+        raise SpecError(source, f"a URDF tree has one root link; found {roots}")
+    for lel in root.findall("link"):
+        inertial = lel.find("inertial")
+        if inertial is None:
+            continue
+        mass = inertial.find("mass")
+        m = _floats(mass.get("value") if mass is not None else None, 1, f"link {lel.get('name')!r} mass", source)[0]
+        if m < 0:
+            raise SpecError(source, f"link {lel.get('name')!r} has negative mass {m}")
+    return root
+
+
+def load_model(text: str, source: str = "<string>") -> pin.Model:
+    """Check URDF text and build the Pinocchio model (mimic joints honoured)."""
+    check_urdf(text, source)
+    try:
+        yourdfpy.URDF.load(io.BytesIO(text.encode()), build_scene_graph=False, load_meshes=False)
+    except Exception as exc:  # yourdfpy raises a variety of types
+        raise SpecError(source, f"yourdfpy rejects the URDF: {exc}") from None
+    try:
+        return pin.buildModelFromXML(text, mimic=True)
+    except (ValueError, RuntimeError) as exc:
+        raise SpecError(source, f"Pinocchio rejects the URDF: {exc}") from None

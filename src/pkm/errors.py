@@ -1,0 +1,150 @@
+"""The exceptions pkm raises. Every one derives from :class:`PkmError`.
+
+Each exception carries the data a caller needs to react (the offending value,
+the leg, the residual, the valid names) as attributes, and its message says
+what was wrong and, where possible, how to fix it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+
+class PkmError(Exception):
+    """Base class of every error raised by pkm."""
+
+
+class InvalidInputError(PkmError, ValueError):
+    """An argument has the wrong shape, is not finite, or is out of range.
+
+    Attributes:
+        name: Name of the offending argument.
+        value: The offending value (as received).
+    """
+
+    def __init__(self, name: str, message: str, value: object = None):
+        self.name = name
+        self.value = value
+        super().__init__(f"{name}: {message}")
+
+
+class InvalidParameterError(InvalidInputError):
+    """A mechanism parameter is invalid (negative length, geometry that cannot assemble...)."""
+
+
+class UnknownNameError(PkmError, LookupError):
+    """A frame, joint, branch or mechanism name does not exist.
+
+    Attributes:
+        kind: What was looked up ("frame", "joint", ...).
+        name: The name that was not found.
+        valid: The names that exist.
+    """
+
+    def __init__(self, kind: str, name: str, valid: Iterable[str], where: str = ""):
+        self.kind = kind
+        self.name = name
+        self.valid = tuple(valid)
+        loc = f" in {where}" if where else ""
+        shown = ", ".join(repr(v) for v in self.valid[:40])
+        more = f", ... ({len(self.valid)} in all)" if len(self.valid) > 40 else ""
+        super().__init__(f"{kind} {name!r} does not exist{loc}; valid {kind}s: {shown}{more}")
+
+    def __str__(self) -> str:  # LookupError would quote the message like a KeyError
+        return self.args[0]
+
+
+class SpecError(PkmError):
+    """A URDF or closure-spec file (or string) is malformed or inconsistent.
+
+    Attributes:
+        source: Where it came from (a path or "<string>").
+    """
+
+    def __init__(self, source: str, message: str):
+        self.source = source
+        super().__init__(f"{source}: {message}")
+
+
+class UnreachableError(PkmError):
+    """A pose cannot be reached.
+
+    Attributes:
+        leg: Index (1-based, as in the papers) of the first leg that cannot reach.
+        excess: By how much the leg misses, in ``unit`` (> 0).
+        unit: Unit of ``excess``.
+    """
+
+    def __init__(self, leg: int, excess: float, unit: str = "m", detail: str = ""):
+        self.leg = leg
+        self.excess = float(excess)
+        self.unit = unit
+        extra = f" ({detail})" if detail else ""
+        super().__init__(f"pose unreachable: leg {leg} misses by {self.excess:.6g} {unit}{extra}")
+
+
+class AssemblyError(PkmError):
+    """The given actuated coordinates admit no assembly of the mechanism.
+
+    Attributes:
+        deficit: How far the equations are from having a real solution (> 0), in ``unit``.
+        unit: Unit of ``deficit``.
+    """
+
+    def __init__(self, deficit: float, unit: str = "m", detail: str = ""):
+        self.deficit = float(deficit)
+        self.unit = unit
+        extra = f" ({detail})" if detail else ""
+        super().__init__(f"no assembly for these actuated coordinates: short by {self.deficit:.6g} {unit}{extra}")
+
+
+class SingularityError(PkmError):
+    """A configuration is singular for the requested operation.
+
+    Attributes:
+        kind: "inverse" (type 1), "direct" (type 2) or another descriptive kind.
+        sigma_min: Smallest singular value of the matrix that lost rank.
+    """
+
+    def __init__(self, kind: str, sigma_min: float, detail: str = ""):
+        self.kind = kind
+        self.sigma_min = float(sigma_min)
+        extra = f": {detail}" if detail else ""
+        super().__init__(f"{kind} singularity (smallest singular value {self.sigma_min:.3e}){extra}")
+
+
+class ConvergenceError(PkmError):
+    """An iterative solver did not converge.
+
+    Attributes:
+        residual: Final residual norm (infinity norm, SI units of the equations).
+        iterations: Iterations performed.
+        tolerance: Tolerance that was asked for.
+        result: The solver's last result object, for inspection (may be None).
+    """
+
+    def __init__(self, what: str, residual: float, iterations: int, tolerance: float, result: object = None):
+        self.residual = float(residual)
+        self.iterations = int(iterations)
+        self.tolerance = float(tolerance)
+        self.result = result
+        super().__init__(
+            f"{what} did not converge: residual {self.residual:.3e} > tolerance {self.tolerance:.1e} "
+            f"after {self.iterations} iterations"
+        )
+
+
+class BranchError(PkmError):
+    """A solution lies on another working mode / assembly branch than the one requested.
+
+    Attributes:
+        expected: The requested sign for each joint.
+        found: The sign found for each joint.
+    """
+
+    def __init__(self, branch: str, expected: dict[str, int], found: dict[str, int]):
+        self.branch = branch
+        self.expected = dict(expected)
+        self.found = dict(found)
+        diff = [k for k in expected if expected[k] != found.get(k)]
+        super().__init__(f"solution is not on branch {branch!r}: joints {diff} have the opposite sign")

@@ -1,0 +1,287 @@
+"""Delta robot (Hernández Reyna & Sandoval-Castro, 2018): tree, closures and closed forms.
+
+Geometry (paper eqs. 1-8, SI units): the base frame 0 is at the centre of the
+base, Z up. Arm ``i`` (``i = 1, 2, 3``) lies in the plane obtained by rotating the
+Y-Z plane by ``phi_i = 0, 120, 240 deg`` about Z; its motor sits at ``A_i = Rz(phi_i)
+(0, R, 0)`` and its axis is ``Rz(phi_i) X``: the arm swings in the (rotated) Y-Z plane
+as eqs. (1)-(2) say, ``B_i = Rz(phi_i) (0, R + La cos th_i, La sin th_i)``. (The text
+says the motor axis is aligned with Y; the equations, which we follow, make it X.)
+The forearm of length ``Lb`` joins ``B_i`` to the platform point ``E + Rz(phi_i)(0, r, 0)``.
+
+How the parallelograms are modelled: each parallelogram is represented by its
+centre line, a rod of length ``Lb`` hung from the elbow by a universal joint
+(``knee_i`` about the motor-axis direction, then ``knee_i_b`` across it) and tied to
+the platform by a point closure (the ball joints). What the three parallelograms do
+together, keeping the platform's orientation fixed, is represented by a massless
+translational guide of the platform (prismatic joints ``platform_x``, ``platform_y``,
+``platform_z`` from the base). The positions, velocities and accelerations of the
+platform and of the forearm centre lines are exact; the guide carries the moments
+that the parallelogram pairs would carry, which do no work and produce no actuator
+torque (each couple acts along the motor axis direction).
+
+Working modes: ``knee_i`` is the angle from the arm to the forearm's projection on the
+arm's plane; it is 0 or pi when the inverse problem has a double root. ``knee_out`` (the
+usual Delta, default) has ``knee_i < 0``; ``knee_in`` has ``knee_i > 0``.
+
+Masses are not given by the paper; the defaults are illustrative (a light robot
+of this size) and only matter for dynamics.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pkm.core.mechanism import Mechanism
+from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
+from pkm.core.urdf import UrdfBuilder
+from pkm.errors import AssemblyError, InvalidInputError, InvalidParameterError, UnreachableError
+from pkm.mechanisms._common import (check_positive, make_mechanism, rod_inertia, rot_z,
+                                    spec_parameters)
+
+NAME = "delta"
+PHI = (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0)
+BRANCHES = {"knee_out": -1, "knee_in": 1}
+
+
+@dataclass(frozen=True)
+class DeltaParams:
+    """Delta design (paper Table 1 by default).
+
+    Attributes:
+        La: Arm length [m] (110 mm).
+        Lb: Forearm (parallelogram) length [m] (330 mm).
+        r: Platform radius, centre to ball-joint line [m] (50 mm).
+        R: Base radius, centre to motor axis [m] (150 mm for the paper's Fig. 4; studied 100-200 mm,
+            120 mm chosen for construction).
+        home: Reference platform position [m] (the study point (0, 0, -375) mm).
+        m_arm: Arm mass [kg] (illustrative; not in the paper).
+        m_forearm: Mass of one parallelogram (both rods) [kg] (illustrative).
+        m_platform: Platform mass [kg] (illustrative).
+    """
+
+    La: float = 0.110
+    Lb: float = 0.330
+    r: float = 0.050
+    R: float = 0.150
+    home: tuple[float, float, float] = (0.0, 0.0, -0.375)
+    m_arm: float = 0.10
+    m_forearm: float = 0.05
+    m_platform: float = 0.20
+
+    def __post_init__(self):
+        check_positive(self, "La", "Lb", "r", "R", "m_arm", "m_forearm", "m_platform")
+        if len(self.home) != 3:
+            raise InvalidParameterError("home", "must be a point (x, y, z) in m", self.home)
+        for k, v in enumerate(self.home):
+            if not math.isfinite(v):
+                raise InvalidParameterError("home", f"component {k} is not finite", self.home)
+        # the reference pose must be reachable in the default working mode, away from singularity
+        try:
+            th = inverse_kinematics(self, self.home)
+        except UnreachableError as exc:
+            raise InvalidParameterError(
+                "home", f"reference pose {self.home} is unreachable with this design (leg {exc.leg} misses by "
+                        f"{exc.excess:.4g} m); choose another home or other lengths", self.home) from None
+        del th
+
+
+# ---------------------------------------------------------------------- closed forms
+def _arm_frame_point(p: np.ndarray, i: int) -> np.ndarray:
+    return rot_z(-PHI[i]) @ p
+
+
+def inverse_kinematics(params: DeltaParams, p, branch: str | tuple[str, str, str] = "knee_out") -> np.ndarray:
+    """Motor angles ``(th_1, th_2, th_3)`` [rad] placing the platform centre at ``p`` [m].
+
+    Per arm, ``B_i`` lies on a circle of radius ``La`` and at distance ``Lb`` from the
+    shifted platform point (eqs. 2-3, 8): ``Y cos th + z sin th = K`` with
+    ``Y = y_i - (R - r)``, ``K = (x_i^2 + Y^2 + z_i^2 + La^2 - Lb^2) / (2 La)``.
+
+    Args:
+        params: The design.
+        p: Platform centre [m], shape (3,).
+        branch: ``"knee_out"``/``"knee_in"`` for all arms, or one per arm.
+
+    Raises:
+        UnreachableError: with the first arm that cannot reach and by how much [m].
+    """
+    p = _point(p, "p")
+    branches = (branch,) * 3 if isinstance(branch, str) else tuple(branch)
+    if len(branches) != 3 or any(b not in BRANCHES for b in branches):
+        raise InvalidInputError("branch", f"use 'knee_out'/'knee_in' or a tuple of three, got {branch!r}", branch)
+    th = np.empty(3)
+    for i in range(3):
+        x, y, z = _arm_frame_point(p, i)
+        Y = y - (params.R - params.r)
+        K = (x * x + Y * Y + z * z + params.La**2 - params.Lb**2) / (2.0 * params.La)
+        rho = math.hypot(Y, z)
+        if abs(K) > rho:
+            # distance from the shifted point to the elbow circle vs Lb
+            raise UnreachableError(i + 1, _circle_gap(params, x, Y, z), "m",
+                                   f"arm {i + 1}: the forearm cannot span the distance to the elbow circle")
+        delta = math.acos(K / rho)
+        th[i] = math.atan2(z, Y) + (delta if branches[i] == "knee_out" else -delta)
+    return (th + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def _circle_gap(params: DeltaParams, x: float, Y: float, z: float) -> float:
+    """By how much |E' - B| misses Lb over the elbow circle (m, > 0)."""
+    rho = math.hypot(Y, z)
+    dmin = math.hypot(x, rho - params.La)
+    dmax = math.hypot(x, rho + params.La)
+    return dmin - params.Lb if dmin > params.Lb else params.Lb - dmax
+
+
+def sphere_centres(params: DeltaParams, theta) -> np.ndarray:
+    """Centres ``B'_i`` of the three spheres of radius Lb (eqs. 3-7), rows i = 1..3 [m]."""
+    theta = _point(theta, "theta")
+    return np.array([rot_z(PHI[i]) @ np.array([0.0, params.R + params.La * math.cos(theta[i]) - params.r,
+                                                params.La * math.sin(theta[i])]) for i in range(3)])
+
+
+def forward_kinematics(params: DeltaParams, theta, *, both: bool = False) -> np.ndarray:
+    """Platform centre [m] from motor angles [rad], by intersecting three spheres (eqs. 1-8).
+
+    As in the paper, (8c)-(8a) and (8c)-(8b) give x and y as affine functions of z, and (8a)
+    becomes a quadratic in z; the root with the lower z (the platform below the base) is
+    returned, or both (lower first) with ``both=True``.
+
+    Raises:
+        AssemblyError: when the spheres have no common point (by how much, in m^2 of the
+            discriminant scaled back to metres).
+    """
+    c = sphere_centres(params, theta)
+    # 2 (c_a - c_3) . p = |c_a|^2 - |c_3|^2 for a = 1, 2  ->  M [x, y] = b + n z
+    M = 2.0 * np.array([c[0, :2] - c[2, :2], c[1, :2] - c[2, :2]])
+    rhs = np.array([c[0] @ c[0] - c[2] @ c[2], c[1] @ c[1] - c[2] @ c[2]])
+    nz = -2.0 * np.array([c[0, 2] - c[2, 2], c[1, 2] - c[2, 2]])
+    det = np.linalg.det(M)
+    if abs(det) < 1e-15:
+        raise AssemblyError(0.0, "m", "sphere centres aligned in the base plane: x, y are not functions of z")
+    Minv = np.linalg.inv(M)
+    b0, b1 = Minv @ rhs, Minv @ nz  # [x, y] = b0 + b1 z
+    d0 = b0 - c[0, :2]
+    qa = b1 @ b1 + 1.0
+    qb = 2.0 * (d0 @ b1 - c[0, 2])
+    qc = d0 @ d0 + c[0, 2] ** 2 - params.Lb**2
+    disc = qb * qb - 4.0 * qa * qc
+    if disc < 0.0:
+        raise AssemblyError(math.sqrt(-disc) / (2.0 * qa), "m", "the three spheres do not intersect")
+    roots = sorted([(-qb - math.sqrt(disc)) / (2.0 * qa), (-qb + math.sqrt(disc)) / (2.0 * qa)])
+    sols = np.array([np.concatenate([b0 + b1 * z, [z]]) for z in roots])
+    return sols if both else sols[0]
+
+
+def joint_values(params: DeltaParams, p, branch: str | tuple[str, str, str] = "knee_out") -> dict[str, list[float]]:
+    """Every joint coordinate of the tree (closed form), for platform centre ``p``."""
+    p = _point(p, "p")
+    th = inverse_kinematics(params, p, branch)
+    out: dict[str, list[float]] = {}
+    for i in range(3):
+        Rz = rot_z(PHI[i])
+        c, s = math.cos(th[i]), math.sin(th[i])
+        L = Rz @ np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])  # arm frame after the motor
+        B = Rz @ np.array([0.0, params.R + params.La * c, params.La * s])
+        P = p + Rz @ np.array([0.0, params.r, 0.0])
+        f = L.T @ (P - B) / params.Lb  # forearm direction in the arm frame = Rx(k1) Rz(k2) e_y
+        out[f"motor_{i + 1}"] = [float(th[i])]
+        out[f"knee_{i + 1}"] = [math.atan2(f[2], f[1])]
+        out[f"knee_{i + 1}_b"] = [math.asin(max(-1.0, min(1.0, -f[0])))]
+    for k, axis in enumerate("xyz"):
+        out[f"platform_{axis}"] = [float(p[k])]
+    return out
+
+
+def configuration(mech: Mechanism, p, branch: str | tuple[str, str, str] = "knee_out") -> np.ndarray:
+    """Full configuration vector ``q`` of ``mech`` for platform centre ``p`` (closed form)."""
+    return mech.q_from_dict(joint_values(mech.params, p, branch))
+
+
+# ---------------------------------------------------------------------- uniform interface
+# Every mechanism module offers these three, over the task vector ``y`` laid out as
+# :class:`pkm.core.TaskMap` does (here: platform centre x, y, z).
+def closed_form_ik(params: DeltaParams, y, branch: str | None = None) -> np.ndarray:
+    """Actuated coordinates for task vector ``y`` (closed form)."""
+    return inverse_kinematics(params, y, branch or "knee_out")
+
+
+def closed_form_configuration(mech: Mechanism, y, branch: str | None = None) -> np.ndarray:
+    """Every joint coordinate for task vector ``y`` (closed form)."""
+    return configuration(mech, y, branch or "knee_out")
+
+
+def closed_form_fk(params: DeltaParams, q_actuated, seed=None) -> np.ndarray:
+    """Task vector from actuated coordinates (sphere intersection; ``seed`` unused)."""
+    return forward_kinematics(params, q_actuated)
+
+
+# ---------------------------------------------------------------------- tree and spec
+def urdf_xml(params: DeltaParams) -> str:
+    """The URDF tree (see the module doc for the modelling of the parallelograms)."""
+    b = UrdfBuilder(NAME)
+    b.link("base")
+    reach = 2.0 * (params.R + params.La + params.Lb)
+    for i in range(3):
+        n = i + 1
+        Rz = rot_z(PHI[i])
+        b.link(f"arm_{n}", params.m_arm, (0.0, params.La / 2, 0.0), rod_inertia(params.m_arm, params.La, 1))
+        b.joint(f"motor_{n}", "revolute", "base", f"arm_{n}", Rz @ np.array([0.0, params.R, 0.0]), Rz,
+                axis=(1.0, 0.0, 0.0))
+        b.link(f"knee_cross_{n}")
+        b.joint(f"knee_{n}", "revolute", f"arm_{n}", f"knee_cross_{n}", (0.0, params.La, 0.0), axis=(1.0, 0.0, 0.0))
+        b.link(f"forearm_{n}", params.m_forearm, (0.0, params.Lb / 2, 0.0),
+               rod_inertia(params.m_forearm, params.Lb, 1))
+        b.joint(f"knee_{n}_b", "revolute", f"knee_cross_{n}", f"forearm_{n}", axis=(0.0, 0.0, 1.0))
+        b.frame(f"forearm_{n}_tip", f"forearm_{n}", (0.0, params.Lb, 0.0))
+    b.link("guide_x")
+    b.link("guide_y")
+    mp, r = params.m_platform, params.r
+    b.link("platform", mp, inertia=np.diag([mp * r * r / 4, mp * r * r / 4, mp * r * r / 2]))
+    b.joint("platform_x", "prismatic", "base", "guide_x", axis=(1.0, 0.0, 0.0), limits=(-reach, reach))
+    b.joint("platform_y", "prismatic", "guide_x", "guide_y", axis=(0.0, 1.0, 0.0), limits=(-reach, reach))
+    b.joint("platform_z", "prismatic", "guide_y", "platform", axis=(0.0, 0.0, 1.0), limits=(-reach, reach))
+    for i in range(3):
+        b.frame(f"platform_ball_{i + 1}", "platform", rot_z(PHI[i]) @ np.array([0.0, params.r, 0.0]))
+    return b.to_xml()
+
+
+def closure_spec(params: DeltaParams) -> ClosureSpec:
+    reference = {k: tuple(v) for k, v in joint_values(params, params.home).items()}
+    return ClosureSpec(
+        mechanism=NAME,
+        description="Delta robot (Hernandez Reyna & Sandoval-Castro 2018); parallelograms as centre lines, "
+                    "platform orientation kept by a massless translational guide",
+        urdf=f"{NAME}.urdf",
+        end_effector="platform",
+        actuated=("motor_1", "motor_2", "motor_3"),
+        closures=tuple(Closure(f"ball_{n}", "point", f"forearm_{n}_tip", f"platform_ball_{n}") for n in (1, 2, 3)),
+        task=TaskSpec(("x", "y", "z")),
+        reference=reference,
+        branches={name: Branch(name, {f"knee_{n}": s for n in (1, 2, 3)},
+                               f"all elbows {'outward' if name == 'knee_out' else 'inward'} (knee_i "
+                               f"{'<' if s < 0 else '>'} 0)") for name, s in BRANCHES.items()},
+        default_branch="knee_out",
+        parameters=spec_parameters(params),
+    )
+
+
+Params = DeltaParams
+
+
+def build(params: DeltaParams | None = None) -> Mechanism:
+    """The Delta as a :class:`~pkm.core.Mechanism` (paper design when ``params`` is None)."""
+    params = DeltaParams() if params is None else params
+    return make_mechanism(urdf_xml(params), closure_spec(params), params)
+
+
+def _point(x, name: str) -> np.ndarray:
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInputError(name, "expected 3 numbers", x) from None
+    if a.shape != (3,) or not np.all(np.isfinite(a)):
+        raise InvalidInputError(name, f"expected 3 finite numbers, got shape {a.shape}", x)
+    return a
