@@ -129,14 +129,17 @@ class TaskMap:
                     head[i] = (head[i] + np.pi) % (2 * np.pi) - np.pi
         return np.concatenate([head, tail])
 
+    def retract(self, y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+        """``y`` moved by the tangent vector ``dy`` (the inverse of :meth:`error`)."""
+        y, dy = np.asarray(y, dtype=float), np.asarray(dy, dtype=float)
+        if not self.pose:
+            return y + dy
+        R = pin.exp3(dy[3:6]) @ pin.Quaternion(*_wxyz(y[3:7])).toRotationMatrix()
+        return np.concatenate([y[:3] + dy[:3], pin.Quaternion(R).coeffs(), y[7:] + dy[6:]])
+
     def interpolate(self, y0: np.ndarray, y1: np.ndarray, s: float) -> np.ndarray:
         """The point at fraction ``s`` of the way from ``y0`` to ``y1`` (geodesic for rotations)."""
-        e = self.error(y1, y0)
-        if not self.pose:
-            return y0 + s * e
-        R0 = pin.Quaternion(*_wxyz(y0[3:7])).toRotationMatrix()
-        R = pin.exp3(s * e[3:6]) @ R0
-        return np.concatenate([y0[:3] + s * e[:3], pin.Quaternion(R).coeffs(), y0[7:] + s * e[6:]])
+        return self.retract(y0, s * self.error(y1, y0))
 
     # derivatives ------------------------------------------------------------
     def jacobian(self, q: np.ndarray, *, update: bool = True) -> np.ndarray:

@@ -197,4 +197,6 @@ def load_model(text: str, source: str = "<string>") -> pin.Model:
     try:
         return pin.buildModelFromXML(text, mimic=True)
     except (ValueError, RuntimeError) as exc:
-        raise SpecError(source, f"Pinocchio rejects the URDF: {exc}") from None
+        hint = (" (a mimic joint must come after the joint it mimics in Pinocchio's traversal, "
+                "which visits sibling joints in name order)") if "mimic" in str(exc) else ""
+        raise SpecError(source, f"Pinocchio rejects the URDF: {exc}{hint}") from None

@@ -1,0 +1,67 @@
+"""The closure-spec format: round trip, and a clear SpecError or UnknownNameError for every defect."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from pkm.core import ClosureSpec, Mechanism
+from pkm.data import spec_path
+from pkm.errors import SpecError, UnknownNameError
+from pkm.mechanisms import NAMES
+
+
+@pytest.fixture(scope="module")
+def delta_text():
+    return spec_path("delta").read_text()
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_shipped_specs_round_trip_byte_for_byte(name):
+    """Parsing then writing a shipped spec reproduces the file exactly."""
+    text = spec_path(name).read_text()
+    assert ClosureSpec.from_toml(text).to_toml() == text
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda t: t.replace('format = "pkm.closures/1"', 'format = "pkm.closures/9"'), "unsupported format"),
+    (lambda t: t.replace('type = "point"', 'type = "hinge"', 1), "type 'hinge' unknown"),
+    (lambda t: t.replace('end_effector = "platform"\n', ''), "missing key 'end_effector'"),
+    (lambda t: t.replace('components = ["x", "y", "z"]', 'components = ["x", "w"]'), "task.components"),
+    (lambda t: t.replace('default_branch = "knee_out"', 'default_branch = "knee_sideways"'), "default_branch"),
+    (lambda t: t.replace("signs = { knee_1 = -1,", "signs = { knee_1 = 2,", 1), "+1 or -1"),
+    (lambda t: t.replace("platform_z = [-0.375]", "platform_z = [nan]"), "non-finite"),
+    (lambda t: "surprise = 1\n" + t, "unknown keys"),
+    (lambda t: t.replace("[task]", "[task"), "not valid TOML"),
+    (lambda t: t.replace('actuated = ["motor_1", "motor_2", "motor_3"]', 'actuated = ["motor_1", "motor_1"]'),
+     "twice"),
+])
+def test_malformed_spec_raises_spec_error_saying_what(delta_text, edit, message):
+    """Each defect of a spec file is reported as a SpecError naming the problem."""
+    with pytest.raises(SpecError, match=message):
+        ClosureSpec.from_toml(edit(delta_text))
+
+
+def test_missing_spec_file_is_a_spec_error(tmp_path):
+    """A spec path that does not exist gives a SpecError with the path."""
+    with pytest.raises(SpecError, match="cannot read"):
+        ClosureSpec.load(tmp_path / "nope.closures.toml")
+
+
+def test_spec_names_are_checked_against_the_urdf(built):
+    """Unknown frames and joints are refused with the list of valid names; so are multi-DOF actuators."""
+    mech = built("delta")
+    spec = mech.spec
+    bad_frame = dataclasses.replace(spec, end_effector="platfrom")
+    with pytest.raises(UnknownNameError, match="frame 'platfrom' does not exist.*'platform'"):
+        Mechanism.from_strings(mech.urdf, bad_frame)
+    bad_joint = dataclasses.replace(spec, actuated=("motor_1", "motor_2", "motr_3"))
+    with pytest.raises(UnknownNameError, match="joint 'motr_3'.*'motor_3'"):
+        Mechanism.from_strings(mech.urdf, bad_joint)
+    partial = dataclasses.replace(spec, reference={k: v for k, v in spec.reference.items() if k != "knee_2"})
+    with pytest.raises(SpecError, match="lacks joints"):
+        Mechanism.from_strings(mech.urdf, partial)
+    bad_closure = dataclasses.replace(spec, closures=(dataclasses.replace(spec.closures[0], frame_b="nowhere"),))
+    with pytest.raises(UnknownNameError, match="closure 'ball_1'"):
+        Mechanism.from_strings(mech.urdf, bad_closure)

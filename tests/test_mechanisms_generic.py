@@ -1,0 +1,145 @@
+"""The acceptance checks of every mechanism, run through the generic core and the uniform interface.
+
+For each mechanism, 200 random reachable configurations on the default working mode
+(task targets drawn around the reference, kept when regular):
+
+* the closed-form configuration closes every loop to <= 1e-10;
+* generic forward kinematics (loop closure from the reference) returns the task to <= 1e-9;
+* generic inverse kinematics (from the reference) equals the closed-form inverse to <= 1e-9;
+* the paper's forward kinematics (where it has one) returns the task to <= 1e-9;
+* on a subset: the forward and inverse Jacobians against central finite differences of the
+  position solvers (<= 1e-6 relative), the constraint Jacobian against finite differences of
+  the residual, and the joint and task accelerations against finite differences of velocities.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm.core import TaskMap, close_loops, constraints, diagnose, solve_ik
+from pkm.errors import UnreachableError
+from pkm.mechanisms import NAMES, module
+from tests import fd
+
+# Task perturbation scale around the reference: (position [m], angle [rad], joint outputs [rad]).
+SCALES = {"delta": (0.06, 0.0, 0.0), "rrr3": (0.12, 0.3, 0.0), "prs3": (0.06, 0.15, 0.0),
+          "hexapod": (0.03, 0.08, 0.3)}
+N_RANDOM = 200
+N_DIFFERENTIAL = 15
+
+
+def _tangent_scale(task: TaskMap, name: str) -> np.ndarray:
+    pos, ang, jnt = SCALES[name]
+    names = task.names
+    return np.array([pos if n in ("x", "y", "z") else ang if n in ("roll", "pitch", "yaw", "wx", "wy", "wz")
+                     else jnt for n in names])
+
+
+def sample(mech, name: str, n: int, seed: int = 0):
+    """n regular configurations (q, y) from the closed form, drawn around the reference."""
+    mod, task = module(name), TaskMap(mech)
+    rng = np.random.default_rng(seed)
+    y_ref = task.value(mech.q_reference)
+    scale = _tangent_scale(task, name)
+    out = []
+    while len(out) < n:
+        y = task.retract(y_ref, scale * rng.uniform(-1.0, 1.0, task.size))
+        try:
+            q = mod.closed_form_configuration(mech, y)
+        except UnreachableError:
+            continue
+        d = diagnose(mech, q)
+        if d.classification == "regular" and min(d.sigma_direct, d.sigma_inverse) > 1e-3:
+            out.append((q, y))
+    return out
+
+
+@pytest.fixture(scope="module", params=NAMES)
+def case(request, built):
+    mech = built(request.param)
+    return request.param, mech, sample(mech, request.param, N_RANDOM)
+
+
+def test_closed_form_configurations_close_every_loop(case):
+    """Every closed-form configuration closes the loops to 1e-10 and lands on the target task."""
+    name, mech, samples = case
+    task = TaskMap(mech)
+    worst_res = max(np.abs(constraints.residual(mech, q)).max() for q, _ in samples)
+    worst_task = max(np.abs(task.error(y, task.value(q))).max() for q, y in samples)
+    assert worst_res <= 1e-10
+    assert worst_task <= 1e-10
+
+
+def test_generic_forward_kinematics_round_trips(case):
+    """Closed-form inverse then generic loop closure from the reference gives back the task to 1e-9."""
+    name, mech, samples = case
+    task = TaskMap(mech)
+    for q, y in samples:
+        res = close_loops(mech, mech.actuated_q(q))
+        assert res.converged and res.residual <= 1e-10
+        assert np.abs(task.error(y, task.value(res.q))).max() <= 1e-9
+
+
+def test_generic_inverse_kinematics_equals_closed_form(case):
+    """The generic inverse kinematics from the reference equals the paper's closed form to 1e-9."""
+    name, mech, samples = case
+    mod = module(name)
+    for q, y in samples:
+        res = solve_ik(mech, y)
+        assert res.converged
+        assert np.abs(mech.actuated_q(res.q) - mod.closed_form_ik(mech.params, y)).max() <= 1e-9
+
+
+def test_paper_forward_kinematics_round_trips(case):
+    """Where the paper has a forward-kinematics method, it returns the task of the closed-form inverse."""
+    name, mech, samples = case
+    mod = module(name)
+    if not hasattr(mod, "closed_form_fk"):
+        pytest.skip(f"the {name} paper has no forward-kinematics method")
+    task = TaskMap(mech)
+    for q, y in samples:
+        y_fk = mod.closed_form_fk(mech.params, mech.actuated_q(q))
+        assert np.abs(task.error(y, y_fk)).max() <= 1e-9
+
+
+def test_jacobians_match_finite_differences(case):
+    """Forward, inverse and constraint Jacobians agree with central differences (<= 1e-6 relative)."""
+    name, mech, samples = case
+    mod = module(name)
+    for q, _ in samples[:N_DIFFERENTIAL]:
+        assert fd.forward_jacobian_error(mech, q) <= 1e-6
+        assert fd.inverse_jacobian_error(mech, q, lambda y: mod.closed_form_ik(mech.params, y)) <= 1e-6
+        assert fd.constraint_jacobian_error(mech, q) <= 1e-6
+        assert np.abs(pkm.forward_jacobian(mech, q) @ pkm.inverse_jacobian(mech, q) - np.eye(mech.n_task)).max() <= 1e-9
+
+
+def test_accelerations_match_finite_differences_of_velocities(case):
+    """Joint and task accelerations (drift included) are the time derivatives of the velocities."""
+    name, mech, samples = case
+    rng = np.random.default_rng(1)
+    for q, _ in samples[:N_DIFFERENTIAL]:
+        err = fd.acceleration_errors(mech, q, rng)
+        assert err["joint"] <= 1e-6 and err["task"] <= 1e-6
+        assert err["closure"] <= 1e-9 and err["inverse"] <= 1e-9
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_branch_has_a_seed_with_its_signs(name, built):
+    """Each working mode declared in the spec can be reached from the reference by the generic core."""
+    mech = built(name)
+    for bname in mech.spec.branches:
+        q = pkm.core.branch_seed(mech, bname)
+        assert mech.on_branch(q, bname)
+        assert np.abs(constraints.residual(mech, q)).max() <= 1e-10
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_reference_design_is_regular_with_expected_mobility(name, built):
+    """At the reference configuration the loops are closed and mobility equals the number of outputs."""
+    mech = built(name)
+    d = diagnose(mech, mech.q_reference)
+    assert np.abs(constraints.residual(mech, mech.q_reference)).max() <= 1e-10
+    assert d.classification == "regular"
+    assert d.mobility == mech.n_task == mech.na
