@@ -30,7 +30,7 @@ def test_shipped_specs_round_trip_byte_for_byte(name):
     (lambda t: t.replace('end_effector = "platform"\n', ''), "missing key 'end_effector'"),
     (lambda t: t.replace('components = ["x", "y", "z"]', 'components = ["x", "w"]'), "task.components"),
     (lambda t: t.replace('default_branch = "knee_out"', 'default_branch = "knee_sideways"'), "default_branch"),
-    (lambda t: t.replace("signs = { knee_1 = -1,", "signs = { knee_1 = 2,", 1), "+1 or -1"),
+    (lambda t: t.replace("signs = { knee_1 = -1,", "signs = { knee_1 = 2,", 1), r"\+1 or -1"),
     (lambda t: t.replace("platform_z = [-0.375]", "platform_z = [nan]"), "non-finite"),
     (lambda t: "surprise = 1\n" + t, "unknown keys"),
     (lambda t: t.replace("[task]", "[task"), "not valid TOML"),
