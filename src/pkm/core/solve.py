@@ -61,8 +61,7 @@ def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.nd
     it = 0
     while res > tol and it < max_iter:
         it += 1
-        A = J if cols is None else J[:, cols]
-        step = -np.linalg.lstsq(A, r, rcond=None)[0]
+        step = -_lsq(J if cols is None else J[:, cols], r)
         nrm = np.max(np.abs(step))
         if nrm > max_dq:
             step *= max_dq / nrm
@@ -79,6 +78,18 @@ def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.nd
             alpha *= 0.5
         q, r, J, res = q_try, r_try, J_try, res_try
     return q, res, it
+
+
+def _lsq(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Least-squares solution: LU when square and regular, SVD (rank-revealing) otherwise."""
+    if A.shape[0] == A.shape[1]:
+        try:
+            x = np.linalg.solve(A, b)
+            if np.all(np.isfinite(x)):
+                return x
+        except np.linalg.LinAlgError:
+            pass
+    return np.linalg.lstsq(A, b, rcond=None)[0]
 
 
 def close_loops(mech: Mechanism, q_actuated, q0=None, *, tol: float = DEFAULT_TOL, max_iter: int = 30,

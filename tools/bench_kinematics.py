@@ -1,0 +1,103 @@
+#!/usr/bin/env python3
+"""Position solvers of the four mechanisms: generic core against the papers' closed forms.
+
+For each mechanism, at N random regular configurations near its reference:
+
+* loop closure (generic forward kinematics) seeded from a neighbouring configuration (actuated
+  coordinates moved by ``--delta``): median time, median and max iterations to 1e-12;
+* the closed-form inverse kinematics (actuated coordinates) and full configuration;
+* the generic inverse kinematics from the same neighbouring configuration;
+* the paper's forward kinematics, where it has one;
+* ratios generic / closed form measured in the same run.
+
+Usage: ``python tools/bench_kinematics.py [--json] [-n 200] [--delta 0.01]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+
+import numpy as np
+
+import pkm
+from pkm.core import TaskMap, close_loops, solve_ik
+from pkm.errors import PkmError
+from pkm.mechanisms import NAMES, module
+
+
+def _time(fn, repeat: int = 5) -> float:
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best * 1e6
+
+
+def bench(name: str, n: int, delta: float, seed: int = 0) -> dict:
+    mech, mod = pkm.load(name), module(name)
+    task = TaskMap(mech)
+    rng = np.random.default_rng(seed)
+    y_ref = task.value(mech.q_reference)
+    rows = {"closure_us": [], "closure_iters": [], "cf_ik_us": [], "cf_config_us": [], "generic_ik_us": [],
+            "generic_ik_iters": [], "cf_fk_us": []}
+    while len(rows["closure_us"]) < n:
+        y = task.retract(y_ref, 0.02 * rng.uniform(-1, 1, task.size))
+        try:
+            q = mod.closed_form_configuration(mech, y)
+            qa = mech.actuated_q(q)
+            seed_q = close_loops(mech, qa + delta * rng.uniform(-1, 1, mech.na), q).q
+        except PkmError:
+            continue
+        res = close_loops(mech, qa, seed_q)
+        ik = solve_ik(mech, y, seed_q)
+        rows["closure_iters"].append(res.iterations)
+        rows["generic_ik_iters"].append(ik.iterations)
+        rows["closure_us"].append(_time(lambda: close_loops(mech, qa, seed_q)))
+        rows["generic_ik_us"].append(_time(lambda: solve_ik(mech, y, seed_q)))
+        rows["cf_ik_us"].append(_time(lambda: mod.closed_form_ik(mech.params, y)))
+        rows["cf_config_us"].append(_time(lambda: mod.closed_form_configuration(mech, y)))
+        if hasattr(mod, "closed_form_fk"):
+            rows["cf_fk_us"].append(_time(lambda: mod.closed_form_fk(mech.params, qa)))
+    med = {k: statistics.median(v) for k, v in rows.items() if v}
+    out = {
+        "mechanism": name, "samples": n, "seed_delta": delta,
+        "closure_median_us": med["closure_us"],
+        "closure_iterations_median": med["closure_iters"], "closure_iterations_max": max(rows["closure_iters"]),
+        "generic_ik_median_us": med["generic_ik_us"], "generic_ik_iterations_max": max(rows["generic_ik_iters"]),
+        "closed_form_ik_median_us": med["cf_ik_us"], "closed_form_configuration_median_us": med["cf_config_us"],
+        "ratio_generic_ik_over_closed_form_ik": med["generic_ik_us"] / med["cf_ik_us"],
+    }
+    if "cf_fk_us" in med:
+        out["closed_form_fk_median_us"] = med["cf_fk_us"]
+        out["ratio_generic_fk_over_closed_form_fk"] = med["closure_us"] / med["cf_fk_us"]
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    ap.add_argument("-n", type=int, default=50, help="configurations per mechanism")
+    ap.add_argument("--delta", type=float, default=0.01, help="seed offset of the actuated coordinates [rad or m]")
+    ap.add_argument("mechanisms", nargs="*", default=list(NAMES))
+    args = ap.parse_args()
+    results = [bench(name, args.n, args.delta) for name in args.mechanisms]
+    if args.json:
+        print(json.dumps(results, indent=2))
+        return
+    print(f"{'mechanism':9} {'closure us':>10} {'iters med/max':>13} {'gen. IK us':>10} {'CF IK us':>9} "
+          f"{'CF q us':>8} {'IK ratio':>8} {'CF FK us':>9} {'FK ratio':>8}")
+    for r in results:
+        fk = (f"{r['closed_form_fk_median_us']:9.1f} {r['ratio_generic_fk_over_closed_form_fk']:8.1f}"
+              if "closed_form_fk_median_us" in r else f"{'-':>9} {'-':>8}")
+        print(f"{r['mechanism']:9} {r['closure_median_us']:10.1f} "
+              f"{r['closure_iterations_median']:>6.0f}/{r['closure_iterations_max']:<6d} "
+              f"{r['generic_ik_median_us']:10.1f} {r['closed_form_ik_median_us']:9.1f} "
+              f"{r['closed_form_configuration_median_us']:8.1f} {r['ratio_generic_ik_over_closed_form_ik']:8.1f} {fk}")
+
+
+if __name__ == "__main__":
+    main()
