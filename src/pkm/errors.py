@@ -119,18 +119,24 @@ class ConvergenceError(PkmError):
     Attributes:
         residual: Final residual norm (infinity norm, SI units of the equations).
         iterations: Iterations performed.
+        worst_closure: Name of the loop left most open (None if not applicable).
+        worst_gap: Its gap (norm of its residual block, m or rad).
         tolerance: Tolerance that was asked for.
         result: The solver's last result object, for inspection (may be None).
     """
 
-    def __init__(self, what: str, residual: float, iterations: int, tolerance: float, result: object = None):
+    def __init__(self, what: str, residual: float, iterations: int, tolerance: float, result: object = None,
+                 detail: str = ""):
         self.residual = float(residual)
         self.iterations = int(iterations)
         self.tolerance = float(tolerance)
         self.result = result
+        self.worst_closure: str | None = None
+        self.worst_gap: float = 0.0
+        extra = f"; {detail}" if detail else ""
         super().__init__(
             f"{what} did not converge: residual {self.residual:.3e} > tolerance {self.tolerance:.1e} "
-            f"after {self.iterations} iterations"
+            f"after {self.iterations} iterations{extra}"
         )
 
 

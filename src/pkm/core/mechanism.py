@@ -37,6 +37,11 @@ class JointInfo:
     nv: int
     kind: str
 
+    @property
+    def revolute(self) -> bool:
+        """A bounded revolute joint (its coordinate is an angle defined modulo 2 pi)."""
+        return self.nq == 1 and self.kind.startswith("JointModelR")
+
 
 class Mechanism:
     """A parallel mechanism on Pinocchio.
@@ -92,6 +97,7 @@ class Mechanism:
                 scalar_joint(n, f"branch {b.name!r}")
         self.act_q = np.array([j.idx_q for j in self.actuated])
         self.act_v = np.array([j.idx_v for j in self.actuated])
+        self._revolute_q = np.array([j.idx_q for j in self.joints.values() if j.revolute], dtype=int)
         self.passive_v = np.array([i for i in range(model.nv) if i not in set(self.act_v)], dtype=int)
 
         self.constraint_models = []
@@ -209,6 +215,13 @@ class Mechanism:
         q[self.act_q] = qa
         return q
 
+    def wrap(self, q) -> np.ndarray:
+        """``q`` with every revolute coordinate brought into (-pi, pi]."""
+        q = np.array(q, dtype=float)
+        idx = self._revolute_q
+        q[idx] = np.pi - np.mod(np.pi - q[idx], 2.0 * np.pi)
+        return q
+
     def q_from_dict(self, values: Mapping[str, Any], base=None) -> np.ndarray:
         """A configuration from ``{joint name: value or vector}``; other joints from ``base``."""
         q = np.array(self.q_reference if base is None else base, dtype=float)
@@ -234,9 +247,12 @@ class Mechanism:
         return out
 
     def branch_signs(self, q, branch: str | None = None) -> dict[str, int]:
-        """Signs of the joints that define ``branch`` (default branch when None)."""
+        """Signs of the joints that define ``branch`` (default branch when None).
+
+        Angles are taken modulo 2 pi in (-pi, pi]: the sign of a revolute coordinate is that of its sine.
+        """
         b = self.branch(branch)
-        q = np.asarray(q, dtype=float)
+        q = self.wrap(q)
         return {n: (1 if q[self.joints[n].idx_q] >= 0 else -1) for n in b.signs}
 
     def on_branch(self, q, branch: str | None = None) -> bool:

@@ -134,11 +134,13 @@ def close_loops(mech: Mechanism, q_actuated, q0=None, *, tol: float = DEFAULT_TO
             ds = min(ds * 1.5, 1.0 / n_steps)
         else:
             ds *= 0.5
-            if ds < 1e-4 / n_steps:
-                result = SolveResult(q_new, False, res, total, steps, _signs(mech, q_new))
+            if ds < 1e-3 / n_steps:  # the path leaves the workspace: best effort at the target itself
+                q_new, res, it = _newton(mech, fun, mech.with_actuated(q, qa1), mech.passive_v, tol, max_iter, 0.5)
+                result = SolveResult(q_new, False, res, total + it, steps, _signs(mech, q_new))
                 if raise_on_failure:
-                    raise ConvergenceError("loop closure", res, total, tol, result)
+                    raise _failure(mech, "loop closure", result, tol)
                 return result
+    q = mech.wrap(q)
     return SolveResult(q, True, res, total, steps, _signs(mech, q))
 
 
@@ -190,38 +192,69 @@ def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol
             ds = min(ds * 1.5, 1.0 / n_steps)
         else:
             ds *= 0.5
-            if ds < 1e-4 / n_steps:
-                result = SolveResult(q_new, False, res, total, steps, _signs(mech, q_new))
+            if ds < 1e-3 / n_steps:  # the path leaves the workspace: best effort at the target itself
+                q_new, res, it = _newton(mech, make_fun(y1), q, None, tol, max_iter, 0.5)
+                result = SolveResult(q_new, False, res, total + it, steps, _signs(mech, q_new))
                 if raise_on_failure:
-                    raise ConvergenceError("inverse kinematics", res, total, tol, result)
+                    raise _failure(mech, "inverse kinematics", result, tol)
                 return result
+    q = mech.wrap(q)
     result = SolveResult(q, True, res, total, steps, _signs(mech, q))
     if branch is not None and not mech.on_branch(q, branch):
         raise BranchError(branch, dict(mech.branch(branch).signs), mech.branch_signs(q, branch))
     return result
 
 
-def branch_seed(mech: Mechanism, branch: str) -> np.ndarray:
+def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_iter: int = 50) -> np.ndarray:
     """An assembled configuration on ``branch`` at the reference task coordinates.
 
-    The reference configuration with the branch's joint signs imposed (coordinates mirrored),
-    then re-solved for the reference task value. Raises :class:`BranchError` if Newton's method
-    falls back onto another branch.
+    Two phases: the branch joints of the reference are pinned to their mirrored values
+    (sign imposed, magnitude kept) while Newton's method re-closes the loops, which puts every
+    leg on the requested side by construction; then the generic inverse kinematics brings the
+    task back to the reference value. Raises :class:`BranchError` if the second phase crosses
+    a singularity onto another branch.
     """
     b = mech.branch(branch)
     q = mech.q_reference.copy()
     if mech.on_branch(q, branch):
         return q
     task = TaskMap(mech)
-    y_ref = task.value(mech.q_reference)
-    for name, sign in b.signs.items():
-        j = mech.joints[name]
-        if np.sign(q[j.idx_q]) != sign:
-            q[j.idx_q] = -q[j.idx_q] if q[j.idx_q] != 0 else sign * 0.5
-    res = solve_ik(mech, y_ref, q, tol=DEFAULT_TOL, raise_on_failure=True)
-    if not mech.on_branch(res.q, branch):
-        raise BranchError(branch, dict(b.signs), mech.branch_signs(res.q, branch))
-    return res.q
+    y_ref = task.value(q)
+    wrapped = mech.wrap(q)
+    pins = np.array([mech.joints[n].idx_v for n in b.signs])
+    values = np.array([sign * max(abs(wrapped[mech.joints[n].idx_q]), 0.3) for n, sign in b.signs.items()])
+    pin_q = np.array([mech.joints[n].idx_q for n in b.signs])
+    q[pin_q] = values
+    S = np.zeros((len(pins), mech.nv))
+    S[np.arange(len(pins)), pins] = 1.0
+
+    def fun(qq):
+        r, Jc = constraints.residual_and_jacobian(mech, qq)
+        return np.concatenate([r, qq[pin_q] - values]), np.vstack([Jc, S])
+
+    q, res, it = _newton(mech, fun, q, None, tol, max_iter, 0.5)
+    if res > tol:
+        raise _failure(mech, f"re-closing the loops on branch {branch!r}", SolveResult(q, False, res, it), tol)
+    out = solve_ik(mech, y_ref, q, tol=tol).q
+    if not mech.on_branch(out, branch):
+        raise BranchError(branch, dict(b.signs), mech.branch_signs(out, branch))
+    return out
+
+
+def _failure(mech: Mechanism, what: str, result: SolveResult, tol: float) -> ConvergenceError:
+    """A ConvergenceError naming the loop that stays most open and by how much."""
+    r = constraints.residual(mech, result.q)
+    gaps, k = [], 0
+    for cm, c in zip(mech.constraint_models, mech.spec.closures):
+        n = cm.residualSize()
+        gaps.append((float(np.linalg.norm(r[k:k + n])), c.name))
+        k += n
+    gap, name = max(gaps) if gaps else (0.0, None)
+    detail = (f"closure {name!r} stays open by {gap:.3g} (m or rad) at the last iterate"
+              if name is not None and gap > tol else "the task target is not met")
+    err = ConvergenceError(what, result.residual, result.iterations, tol, result, detail)
+    err.worst_closure, err.worst_gap = name, gap
+    return err
 
 
 def _signs(mech: Mechanism, q: np.ndarray) -> dict[str, int]:

@@ -118,11 +118,10 @@ def inverse_kinematics(params: DeltaParams, p, branch: str | tuple[str, str, str
         Y = y - (params.R - params.r)
         K = (x * x + Y * Y + z * z + params.La**2 - params.Lb**2) / (2.0 * params.La)
         rho = math.hypot(Y, z)
-        if abs(K) > rho:
-            # distance from the shifted point to the elbow circle vs Lb
+        if abs(K) > rho * (1.0 + 1e-12):  # beyond round-off of a boundary (double-root) pose
             raise UnreachableError(i + 1, _circle_gap(params, x, Y, z), "m",
                                    f"arm {i + 1}: the forearm cannot span the distance to the elbow circle")
-        delta = math.acos(K / rho)
+        delta = math.acos(max(-1.0, min(1.0, K / rho)))
         th[i] = math.atan2(z, Y) + (delta if branches[i] == "knee_out" else -delta)
     return (th + math.pi) % (2.0 * math.pi) - math.pi
 

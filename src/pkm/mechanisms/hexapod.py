@@ -1,0 +1,549 @@
+"""Reconfigurable hexapod of two 3-RUS sub-manipulators (Sanchez-Alonso et al., RIAI 2016).
+
+Geometry (paper eqs. 1-3, SI units, base frame O with Y up): for leg ``i`` (``i = 1..6``)
+``e_r = (cos th_i, 0, sin th_i)``, ``e_y = (0, 1, 0)`` and the actuated axis
+``u_i = e_r x e_y = (-sin th_i, 0, cos th_i)``, tangent to the base circle. The *leg frame*
+has axes ``(e_r, e_y, u_i)`` (``= Ry(-th_i)``); a positive turn about ``u_i`` takes ``e_r``
+towards ``e_y``.
+
+* Sub-manipulator M1 (legs 1-3): the reconfiguration link of length ``Rr`` (Table 1's
+  ``R_r``, eq. 2's ``R_c``: the same 150 mm) turns by ``beta`` about ``u_i`` at
+  ``F_i = Rf e_r``, so ``A_i = F_i + Rr (cos beta e_r + sin beta e_y)``, i.e. eq. (2) with
+  ``R = Rf + Rr cos beta`` and ``D = Rr sin beta``.
+* Sub-manipulator M2 (legs 4-6): ``A_i = R2 e_r - H0 e_y``.
+* Both: ``B_i = A_i + LA (cos alpha_i e_r + sin alpha_i e_y)`` (eq. 3, ``alpha_i`` the paper's
+  *absolute* angle from the horizontal radial direction) and ``|C_i - B_i| = LB`` (eq. 6).
+
+Platform (a triangular prism): its frame sits at ``P``, the centroid of ``C4 C5 C6`` (eq. 8),
+its ``x`` axis points at ``C4`` (eq. 10) and its ``y`` axis is the unit normal from triangle
+``C4C5C6`` to triangle ``C1C2C3`` (up at the reference pose). In that frame
+``C*_{j+3} = r (cos psi_j, 0, sin psi_j)`` and ``C*_j = C*_{j+3} + h y`` (``j = 1, 2, 3``):
+M1 holds the upper triangle ``C1C2C3``, M2 the lower one (eq. 4 with ``g = -y``).
+
+Platform layouts (parameter ``layout``):
+
+* ``"sector"`` (default): ``psi = 0, 120, 240 deg`` for ``C4, C5, C6``; each ``C_i`` lies in the
+  angular sector of its base joint (``th_i`` near ``psi``). Seen from above (+Y) the triangles
+  run counter-clockwise, so two printed equations change sign. Exact departures: eq. (5)
+  becomes ``g = (2/sqrt 3) (C1 - C3) x (C2 - C3) / e^2`` (the factors of the cross product
+  swapped; as printed it gives the upward normal, which would put ``C4..C6`` *above*
+  ``C1..C3``), and eq. (11) becomes ``z = (C5 - C6) / |C5 - C6|`` (as printed it gives ``-z``, and
+  eq. (12) then turns ``y`` downwards: the frame of eqs. 10-12 would be rotated by pi about x).
+  Equivalently, the printed eqs. (5), (10)-(12) hold verbatim with the labels 2<->3 and 5<->6
+  exchanged on the platform.
+* ``"literal"``: eqs. (5), (10)-(12) read literally with Y up: ``psi = 0, 240, 120 deg``. It is
+  self-consistent but ``C5`` (at 240 deg) faces ``A6`` (``th6 = 265 deg``) and ``C6`` (120 deg)
+  faces ``A5`` (145 deg): legs 5 and 6 cross (and so do legs 2 and 3).
+
+Only the sector layout with the ``elbow_out`` branch reproduces the paper's pose-T optimum
+(sec. 4: both manipulabilities peak near ``beta = -11 deg``; this model gives -10 deg for
+``w_rot`` and -11 deg for ``w_tras``, see the tests). The other three layout/branch pairs
+peak at 82.5, 90, -59, 40, -49, 90 or 3.5 deg.
+
+Tree (URDF, loops open; Pinocchio model with ``nq = 26``, ``nv = 25``):
+
+* ``beta_1`` (actuated), ``beta_2``, ``beta_3``: revolute joints at ``F_i`` about ``u_i``
+  (frame axes ``(e_r, e_y, u_i)``, axis local z) carrying the reconfiguration links along
+  local x. ``beta_2`` and ``beta_3`` are URDF *mimic* joints of ``beta_1`` (multiplier 1,
+  offset 0), as the crossed-helical gear train of the paper's Fig. 2b couples the three
+  links: Pinocchio gives the three of them one coordinate.
+* ``alpha_i``: revolute at ``A_i`` about ``u_i``, arm ``LA`` along local x. For legs 1-3 the
+  joint is carried by the reconfiguration link, so its coordinate is *relative*:
+  ``alpha_i(joint) = alpha_i(paper) - beta`` (the screw model of eq. 18 uses relative rates,
+  ``beta_dot`` and ``alpha_i_dot`` on successive screws); for legs 4-6 it sits on the base and
+  equals the paper's ``alpha_i``. :func:`paper_alphas` and :func:`actuated_from_paper` convert.
+* Universal joint at ``B_i``: ``knee_i`` about ``u_i`` (local z), 0 when the projection of the
+  rod ``LB`` on the leg plane (normal ``u_i``) is collinear with ``LA`` (the double root of the
+  leg's inverse problem), then ``knee_i_b`` about the perpendicular axis (local y after the
+  first turn); rod ``LB`` along local x, frame ``leg_i_tip`` at its end.
+* The spherical joints are point closures ``c_i``: ``leg_i_tip`` = ``platform_c_i`` (frame at
+  ``C*_i`` on the platform).
+* The platform: URDF ``floating`` joint ``platform`` (free-flyer ``x y z qx qy qz qw``), end
+  effector frame ``platform`` at ``P``.
+
+Actuated joints, in this order: ``alpha_1 .. alpha_6, beta_1``. Task: the platform pose and
+``beta_1`` (``x y z qx qy qz qw beta``; 7 outputs for 7 actuators): the robot is redundant for
+a pose, and ``beta`` is chosen by the user (the paper picks it by maximising manipulability).
+
+Working modes: each leg has two solutions (``alpha = phi +- delta``, see
+:func:`inverse_kinematics`). ``elbow_out`` (default, the paper's, see above):
+``alpha = phi + delta``, the arm turned positively about ``u_i`` from the direction ``A_i C_i``,
+so that ``B_i`` lies on the outer/lower side of the line ``A_iC_i``; then ``knee_i < 0``.
+``elbow_in``: ``alpha = phi - delta``, ``knee_i > 0``.
+
+Reachability of pose T (sec. 4: "only for ``-60 <= beta <= 90 deg``"): leg 1 folds too much
+(``|C1 - A1| < LB - LA``) for ``beta`` below -59.51 deg (down to -121.8 deg); within the studied
+``[-90, 90] deg`` the pose is reachable exactly for ``beta >= -59.51 deg``. Reachability of a leg
+does not depend on its branch, and ``C1`` is the same in both layouts, so both branches and both
+layouts give this interval (legs 2 and 3 lose the pose below -60.02/-65.81 deg in the sector
+layout, -70.36/-91.81 deg in the literal one).
+
+Printed equations corrected (derived from the geometry, checked in the tests):
+
+* Eq. (17): ``Q_i = 2 C_xi cos th_i + 2 C_zi sin th_i`` (the second cosine is a sine).
+* Eq. (15): the radicand begins with ``4 (C_yi - D)^2``, not ``4 (D - 2 C_yi)^2``; the rest of
+  eqs. (15)-(16) is right. The ``+`` sign of eq. (15) gives ``elbow_in``, ``-`` gives ``elbow_out``.
+
+Forward kinematics: the paper's semi-closed system (eqs. 4-7, nine quadratic equations in
+``C1, C2, C3``) solved by Newton's method from a seed (:func:`forward_kinematics`), then the
+pose by eqs. (8)-(13) with the layout's convention. It does not use the generic core.
+
+Masses are not given by the paper; the defaults are illustrative and only matter for dynamics.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core.mechanism import Mechanism
+from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
+from pkm.core.urdf import UrdfBuilder
+from pkm.errors import ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
+from pkm.mechanisms._common import (check_finite, check_positive, make_mechanism, rod_inertia, rot_y, rot_z,
+                                    spec_parameters)
+
+NAME = "hexapod"
+LAYOUTS = {"sector": (0.0, 120.0, 240.0), "literal": (0.0, 240.0, 120.0)}  # psi of C4, C5, C6 [deg]
+BRANCHES = {"elbow_out": -1, "elbow_in": 1}  # sign of knee_i
+DEFAULT_BRANCH = "elbow_out"
+ACTUATED = ("alpha_1", "alpha_2", "alpha_3", "alpha_4", "alpha_5", "alpha_6", "beta_1")
+#: The paper's pose T (sec. 4) as printed: rotation rows (4 digits) and position [m].
+POSE_T_ROTATION = (0.9623, -0.1306, -0.2388, 0.0842, 0.9771, -0.1952, 0.2588, 0.1677, 0.9513)
+POSE_T_POSITION = (0.0, -0.350, 0.0)
+
+_E_Y = np.array([0.0, 1.0, 0.0])
+
+
+@dataclass(frozen=True)
+class HexapodParams:
+    """Reconfigurable hexapod design (paper Table 1 by default).
+
+    Attributes:
+        Rf: Radius of the reconfiguration pivots ``F_i`` (M1) [m] (50 mm).
+        Rr: Reconfiguration link length (``R_r`` of Table 1, ``R_c`` of eq. 2) [m] (150 mm).
+        R2: Radius of the actuated joints ``A_4..A_6`` (M2) [m] (450 mm).
+        H0: Depth of the plane of ``A_4..A_6`` below O [m] (200 mm).
+        LA: Arm length [m] (200 mm).
+        LB: Rod length (``B_i`` to ``C_i``) [m] (400 mm).
+        h: Height of the platform prism [m] (34 mm).
+        r: Circumradius of the platform triangles [m] (50 mm).
+        theta: Angular position ``th_i`` of leg i about Y, from +X [rad] (35, 155, 275, 25, 145, 265 deg).
+        layout: ``"sector"`` or ``"literal"`` platform layout (see the module doc).
+        home_rotation: Reference platform orientation, rows of a 3x3 matrix (the paper's pose T as
+            printed; projected on SO(3) by SVD).
+        home_position: Reference position of ``P`` [m] (pose T: (0, -350, 0) mm).
+        home_beta: Reference reconfiguration angle [rad] (0).
+        m_recon: Mass of a reconfiguration link [kg] (illustrative; not in the paper).
+        m_arm: Mass of an arm ``LA`` [kg] (illustrative).
+        m_rod: Mass of a rod ``LB`` [kg] (illustrative).
+        m_platform: Platform mass [kg] (illustrative).
+    """
+
+    Rf: float = 0.050
+    Rr: float = 0.150
+    R2: float = 0.450
+    H0: float = 0.200
+    LA: float = 0.200
+    LB: float = 0.400
+    h: float = 0.034
+    r: float = 0.050
+    theta: tuple[float, ...] = tuple(math.radians(a) for a in (35.0, 155.0, 275.0, 25.0, 145.0, 265.0))
+    layout: str = "sector"
+    home_rotation: tuple[float, ...] = POSE_T_ROTATION
+    home_position: tuple[float, float, float] = POSE_T_POSITION
+    home_beta: float = 0.0
+    m_recon: float = 0.15
+    m_arm: float = 0.25
+    m_rod: float = 0.15
+    m_platform: float = 0.80
+
+    def __post_init__(self):
+        check_positive(self, "Rf", "Rr", "R2", "LA", "LB", "h", "r", "m_recon", "m_arm", "m_rod", "m_platform")
+        check_finite(self, "H0", "home_beta")
+        if self.layout not in LAYOUTS:
+            raise InvalidParameterError("layout", f"must be one of {sorted(LAYOUTS)}, got {self.layout!r}",
+                                        self.layout)
+        for name, n in (("theta", 6), ("home_rotation", 9), ("home_position", 3)):
+            v = getattr(self, name)
+            if not isinstance(v, (tuple, list)) or len(v) != n or not all(
+                    isinstance(x, (int, float)) and math.isfinite(x) for x in v):
+                raise InvalidParameterError(name, f"must be {n} finite numbers (SI units), got {v!r}", v)
+        M = np.reshape(np.asarray(self.home_rotation, dtype=float), (3, 3))
+        if np.linalg.det(M) <= 0.0 or np.max(np.abs(M.T @ M - np.eye(3))) > 1e-2:
+            raise InvalidParameterError("home_rotation", "must be the rows of a rotation matrix (to 1e-2)",
+                                        self.home_rotation)
+        try:
+            inverse_kinematics(self, home_rotation(self), self.home_position, self.home_beta)
+        except UnreachableError as exc:
+            raise InvalidParameterError(
+                "home_position", f"the reference pose is unreachable with this design (leg {exc.leg} misses by "
+                                 f"{exc.excess:.4g} m); choose another home pose, home_beta or other lengths",
+                self.home_position) from None
+
+
+Params = HexapodParams
+
+
+# ---------------------------------------------------------------------- geometry
+def leg_frame(theta_i: float) -> np.ndarray:
+    """Axes ``(e_r, e_y, u_i)`` of leg frame i as columns (``= Ry(-th_i)``)."""
+    return rot_y(-theta_i)
+
+
+def home_rotation(params: HexapodParams) -> np.ndarray:
+    """The reference orientation: ``params.home_rotation`` projected on SO(3) (SVD)."""
+    U, _, Vt = np.linalg.svd(np.reshape(np.asarray(params.home_rotation, dtype=float), (3, 3)))
+    return U @ Vt
+
+
+def base_points(params: HexapodParams, beta: float) -> np.ndarray:
+    """Actuated joint centres ``A_1..A_6`` for reconfiguration angle ``beta`` [rad] (eqs. 1-2), rows [m]."""
+    out = np.empty((6, 3))
+    for i, th in enumerate(params.theta):
+        e_r = leg_frame(th)[:, 0]
+        if i < 3:
+            out[i] = params.Rf * e_r + params.Rr * (math.cos(beta) * e_r + math.sin(beta) * _E_Y)
+        else:
+            out[i] = params.R2 * e_r - params.H0 * _E_Y
+    return out
+
+
+def platform_local_points(params: HexapodParams) -> np.ndarray:
+    """Spherical joint centres ``C*_1..C*_6`` in the platform frame, rows [m]."""
+    low = np.array([[params.r * math.cos(math.radians(p)), 0.0, params.r * math.sin(math.radians(p))]
+                    for p in LAYOUTS[params.layout]])
+    return np.vstack([low + params.h * _E_Y, low])
+
+
+def platform_points(params: HexapodParams, R: np.ndarray, P) -> np.ndarray:
+    """``C_1..C_6`` in the base frame for platform orientation ``R`` and position ``P`` (eq. 14), rows [m]."""
+    return np.asarray(P, dtype=float) + platform_local_points(params) @ np.asarray(R, dtype=float).T
+
+
+def paper_alphas(q_actuated) -> np.ndarray:
+    """The paper's absolute ``alpha_1..alpha_6`` [rad] from the actuated vector (spec order).
+
+    Legs 1-3: ``alpha(paper) = alpha(joint) + beta``; legs 4-6 unchanged.
+    """
+    qa = _vector(q_actuated, 7, "q_actuated")
+    return np.concatenate([qa[:3] + qa[6], qa[3:6]])
+
+
+def actuated_from_paper(alphas, beta: float) -> np.ndarray:
+    """The actuated vector (``alpha_1..alpha_6`` joint coordinates, ``beta_1``) from the paper's angles."""
+    a = _vector(alphas, 6, "alphas")
+    b = float(_vector([beta], 1, "beta")[0])
+    return np.concatenate([_wrap(a[:3] - b), _wrap(a[3:]), [b]])
+
+
+# ---------------------------------------------------------------------- closed forms
+def inverse_kinematics(params: HexapodParams, R, P, beta: float,
+                       branch: str | tuple[str, ...] = DEFAULT_BRANCH) -> np.ndarray:
+    """The paper's absolute ``alpha_1..alpha_6`` [rad] for a platform pose and ``beta`` [rad].
+
+    Per leg, with ``d = C_i - A_i`` in the leg frame, ``|C_i - B_i| = LB`` reads
+    ``cos(alpha) d_r + sin(alpha) d_y = K``, ``K = (d.d + LA^2 - LB^2) / (2 LA)``, so
+    ``alpha = phi +- delta`` with ``phi = atan2(d_y, d_r)``, ``delta = acos(K / hypot(d_r, d_y))``
+    (``+`` for ``elbow_out``, ``-`` for ``elbow_in``).
+
+    Args:
+        params: The design.
+        R: Platform orientation (3x3 rotation).
+        P: Platform position [m], shape (3,).
+        beta: Reconfiguration angle [rad].
+        branch: ``"elbow_out"``/``"elbow_in"`` for all legs, or one per leg.
+
+    Raises:
+        UnreachableError: with the first leg that cannot reach and by how much [m].
+    """
+    branches = _branches(branch)
+    C = platform_points(params, R, P)
+    A = base_points(params, beta)
+    out = np.empty(6)
+    for i in range(6):
+        out[i] = _leg_angle(params, i, C[i] - A[i], branches[i])
+    return out
+
+
+def _leg_angle(params: HexapodParams, i: int, d: np.ndarray, branch: str) -> float:
+    dr, dy, du = leg_frame(params.theta[i]).T @ d
+    rho = math.hypot(dr, dy)
+    K = (d @ d + params.LA**2 - params.LB**2) / (2.0 * params.LA)
+    if abs(K) > rho:
+        dmin, dmax = math.hypot(du, rho - params.LA), math.hypot(du, rho + params.LA)
+        excess = dmin - params.LB if dmin > params.LB else params.LB - dmax
+        raise UnreachableError(i + 1, excess, "m", f"leg {i + 1}: the rod LB cannot span the distance from C_{i + 1} "
+                                                   "to the circle of B")
+    delta = math.acos(K / rho)
+    return float(_wrap(math.atan2(dy, dr) - BRANCHES[branch] * delta))
+
+
+def joint_values(params: HexapodParams, R, P, beta: float,
+                 branch: str | tuple[str, ...] = DEFAULT_BRANCH) -> dict[str, list[float]]:
+    """Every joint coordinate of the tree (closed form) for a platform pose and ``beta``.
+
+    Args:
+        params: The design.
+        R: Platform orientation (3x3 rotation).
+        P: Platform position [m].
+        beta: Reconfiguration angle [rad].
+        branch: As for :func:`inverse_kinematics`.
+
+    Returns:
+        ``{joint name: coordinates}``; the platform's quaternion is that of ``R``.
+    """
+    R = np.asarray(R, dtype=float)
+    alphas = inverse_kinematics(params, R, P, beta, branch)
+    return _joint_values(params, R, P, pin.Quaternion(R).coeffs(), beta, alphas)
+
+
+def _joint_values(params: HexapodParams, R: np.ndarray, P, quat: np.ndarray, beta: float,
+                  alphas: np.ndarray) -> dict[str, list[float]]:
+    C = platform_points(params, R, P)
+    A = base_points(params, beta)
+    qa = actuated_from_paper(alphas, beta)
+    out: dict[str, list[float]] = {"beta_1": [float(beta)]}
+    for i in range(6):
+        n, a = i + 1, alphas[i]
+        L = leg_frame(params.theta[i])
+        B = A[i] + params.LA * (L @ np.array([math.cos(a), math.sin(a), 0.0]))
+        w = rot_z(-a) @ (L.T @ (C[i] - B)) / params.LB  # rod direction in the arm frame = Rz(k) Ry(kb) x
+        out[f"alpha_{n}"] = [float(qa[i])]
+        out[f"knee_{n}"] = [math.atan2(w[1], w[0])]
+        out[f"knee_{n}_b"] = [math.asin(max(-1.0, min(1.0, -w[2])))]
+    out["platform"] = [float(x) for x in np.concatenate([np.asarray(P, dtype=float), quat])]
+    return out
+
+
+def configuration(mech: Mechanism, y, branch: str | tuple[str, ...] = DEFAULT_BRANCH) -> np.ndarray:
+    """Full configuration ``q`` of ``mech`` for task vector ``y = (x, y, z, qx, qy, qz, qw, beta)`` (closed form)."""
+    R, P, quat, beta = _task(y)
+    alphas = inverse_kinematics(mech.params, R, P, beta, branch)
+    return mech.q_from_dict(_joint_values(mech.params, R, P, quat, beta, alphas))
+
+
+def forward_kinematics(params: HexapodParams, alphas, beta: float, seed=None, *, tol: float = 1e-12,
+                       max_iter: int = 50) -> np.ndarray:
+    """``C_1..C_6`` [m] from the paper's absolute ``alpha_1..alpha_6`` and ``beta`` (eqs. 4-7).
+
+    Unknowns ``C1, C2, C3`` (9); equations (6) for the six legs, with ``C_{i+3} = C_i + h g``
+    (eq. 4, ``g`` from eq. 5 with the layout's sign, see the module doc), and (7) for the three
+    sides of ``C1C2C3``. Each equation is divided by twice its length (LB or e) so that the
+    residual is in metres. Newton's method with the exact Jacobian and a backtracking line search.
+
+    Args:
+        params: The design.
+        alphas: The paper's absolute arm angles [rad], shape (6,).
+        beta: Reconfiguration angle [rad].
+        seed: ``C1, C2, C3`` to start from [m], shape (3, 3); default: those of the reference pose.
+        tol: Tolerance on the infinity norm of the residual [m].
+        max_iter: Newton iterations allowed.
+
+    Returns:
+        ``C_1..C_6`` as rows [m].
+
+    Raises:
+        ConvergenceError: with the residual, when Newton's method does not reach ``tol``.
+    """
+    alphas = _vector(alphas, 6, "alphas")
+    A = base_points(params, beta)
+    B = np.array([A[i] + params.LA * (leg_frame(params.theta[i]) @ np.array([math.cos(alphas[i]),
+                                                                               math.sin(alphas[i]), 0.0]))
+                  for i in range(6)])
+    if seed is None:
+        seed = platform_points(params, home_rotation(params), params.home_position)[:3]
+    X = _vector(np.ravel(seed), 9, "seed").copy()
+    e = params.r * math.sqrt(3.0)
+    k = (-1.0 if params.layout == "sector" else 1.0) * 2.0 / (math.sqrt(3.0) * e * e)
+    pairs = ((0, 1), (1, 2), (0, 2))
+
+    def fun(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        C = x.reshape(3, 3)
+        g = k * np.cross(C[1] - C[2], C[0] - C[2])
+        dg = k * np.hstack([_skew(C[1] - C[2]), -_skew(C[0] - C[2]), _skew(C[0] - C[1])])  # dg/dX
+        f, J = np.empty(9), np.zeros((9, 9))
+        for i in range(3):
+            for j, Ci, sel in ((i, C[i], 0.0), (i + 3, C[i] + params.h * g, 1.0)):
+                dv = Ci - B[j]
+                f[j] = (dv @ dv - params.LB**2) / (2.0 * params.LB)
+                J[j, 3 * i:3 * i + 3] = dv / params.LB
+                J[j] += sel * params.h * (dv @ dg) / params.LB
+        for m, (a, b) in enumerate(pairs):
+            dv = C[a] - C[b]
+            f[6 + m] = (dv @ dv - e * e) / (2.0 * e)
+            J[6 + m, 3 * a:3 * a + 3] = dv / e
+            J[6 + m, 3 * b:3 * b + 3] = -dv / e
+        return f, J
+
+    f, J = fun(X)
+    res, it = float(np.max(np.abs(f))), 0
+    while res > tol and it < max_iter:
+        it += 1
+        step = -np.linalg.lstsq(J, f, rcond=None)[0]
+        t = 1.0
+        for _ in range(20):
+            f_try, J_try = fun(X + t * step)
+            res_try = float(np.max(np.abs(f_try)))
+            if res_try < res:
+                break
+            t *= 0.5
+        X, f, J, res = X + t * step, f_try, J_try, res_try
+    if not res <= tol:
+        raise ConvergenceError("semi-closed forward kinematics (eqs. 4-7)", res, it, tol)
+    C = X.reshape(3, 3)
+    g = k * np.cross(C[1] - C[2], C[0] - C[2])
+    return np.vstack([C, C + params.h * g])
+
+
+def pose_from_points(params: HexapodParams, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Platform orientation and position ``(R, P)`` from ``C_1..C_6`` (eqs. 8-13, layout's sign of eq. 11)."""
+    C = np.asarray(C, dtype=float)
+    P = C[3:].mean(axis=0)
+    x = (C[3] - P) / np.linalg.norm(C[3] - P)
+    z = C[4] - C[5] if params.layout == "sector" else C[5] - C[4]
+    z = z / np.linalg.norm(z)
+    return np.column_stack([x, np.cross(z, x), z]), P
+
+
+def task_vector(R, P, beta: float) -> np.ndarray:
+    """The task vector ``(x, y, z, qx, qy, qz, qw, beta)`` of a pose and ``beta``."""
+    return np.concatenate([np.asarray(P, dtype=float), pin.Quaternion(np.asarray(R, dtype=float)).coeffs(),
+                           [float(beta)]])
+
+
+# ---------------------------------------------------------------------- uniform interface
+# Task vector y (as pkm.core.TaskMap lays it out): x y z qx qy qz qw of the frame ``platform``, then beta_1.
+def closed_form_ik(params: HexapodParams, y, branch: str | tuple[str, ...] | None = None) -> np.ndarray:
+    """Actuated coordinates (``alpha_1..alpha_6`` joint coordinates, ``beta_1``) for task vector ``y``."""
+    R, P, _, beta = _task(y)
+    return actuated_from_paper(inverse_kinematics(params, R, P, beta, branch or DEFAULT_BRANCH), beta)
+
+
+def closed_form_configuration(mech: Mechanism, y, branch: str | tuple[str, ...] | None = None) -> np.ndarray:
+    """Every joint coordinate for task vector ``y`` (closed form)."""
+    return configuration(mech, y, branch or DEFAULT_BRANCH)
+
+
+def closed_form_fk(params: HexapodParams, q_actuated, seed=None) -> np.ndarray:
+    """Task vector from the actuated coordinates by the paper's semi-closed method (eqs. 4-13).
+
+    Args:
+        params: The design.
+        q_actuated: ``alpha_1..alpha_6`` (joint coordinates: relative for legs 1-3), ``beta_1`` [rad].
+        seed: A task vector whose pose seeds Newton's method (its ``beta`` is ignored); default:
+            the reference pose.
+
+    Raises:
+        ConvergenceError: when Newton's method fails (residual attached).
+    """
+    qa = _vector(q_actuated, 7, "q_actuated")
+    C0 = None
+    if seed is not None:
+        R0, P0, _, _ = _task(seed, "seed")
+        C0 = platform_points(params, R0, P0)[:3]
+    C = forward_kinematics(params, paper_alphas(qa), qa[6], C0)
+    R, P = pose_from_points(params, C)
+    return task_vector(R, P, qa[6])
+
+
+# ---------------------------------------------------------------------- tree and spec
+def urdf_xml(params: HexapodParams) -> str:
+    """The URDF tree (see the module doc)."""
+    b = UrdfBuilder(NAME)
+    b.link("base")
+    for i, th in enumerate(params.theta):
+        n = i + 1
+        L = leg_frame(th)
+        if i < 3:
+            b.link(f"recon_{n}", params.m_recon, (params.Rr / 2, 0.0, 0.0), rod_inertia(params.m_recon, params.Rr, 0))
+            b.joint(f"beta_{n}", "revolute", "base", f"recon_{n}", params.Rf * L[:, 0], L,
+                    mimic=None if n == 1 else ("beta_1", 1.0, 0.0))
+            b.link(f"arm_{n}", params.m_arm, (params.LA / 2, 0.0, 0.0), rod_inertia(params.m_arm, params.LA, 0))
+            b.joint(f"alpha_{n}", "revolute", f"recon_{n}", f"arm_{n}", (params.Rr, 0.0, 0.0))
+        else:
+            b.link(f"arm_{n}", params.m_arm, (params.LA / 2, 0.0, 0.0), rod_inertia(params.m_arm, params.LA, 0))
+            b.joint(f"alpha_{n}", "revolute", "base", f"arm_{n}", base_points(params, 0.0)[i], L)
+        b.link(f"knee_cross_{n}")
+        b.joint(f"knee_{n}", "revolute", f"arm_{n}", f"knee_cross_{n}", (params.LA, 0.0, 0.0))
+        b.link(f"rod_{n}", params.m_rod, (params.LB / 2, 0.0, 0.0), rod_inertia(params.m_rod, params.LB, 0))
+        b.joint(f"knee_{n}_b", "revolute", f"knee_cross_{n}", f"rod_{n}", axis=(0.0, 1.0, 0.0))
+        b.frame(f"leg_{n}_tip", f"rod_{n}", (params.LB, 0.0, 0.0))
+    mp, r = params.m_platform, params.r
+    b.link("platform", mp, (0.0, params.h / 2, 0.0), np.diag([mp * r * r / 4, mp * r * r / 2, mp * r * r / 4]))
+    b.joint("platform", "floating", "base", "platform")
+    for i, c in enumerate(platform_local_points(params)):
+        b.frame(f"platform_c_{i + 1}", "platform", c)
+    return b.to_xml()
+
+
+def closure_spec(params: HexapodParams) -> ClosureSpec:
+    """The closure spec: six point closures (the spherical joints), reference at the home pose."""
+    values = joint_values(params, home_rotation(params), params.home_position, params.home_beta)
+    return ClosureSpec(
+        mechanism=NAME,
+        description="Reconfigurable hexapod of two 3-RUS sub-manipulators (Sanchez-Alonso et al. 2016); "
+                    "beta_2, beta_3 mimic beta_1 (gear train); alpha_1..alpha_3 relative to the "
+                    "reconfiguration links",
+        urdf=f"{NAME}.urdf",
+        end_effector="platform",
+        actuated=ACTUATED,
+        closures=tuple(Closure(f"c_{n}", "point", f"leg_{n}_tip", f"platform_c_{n}") for n in range(1, 7)),
+        task=TaskSpec(("pose",), ("beta_1",)),
+        reference={k: tuple(v) for k, v in values.items()},
+        branches={name: Branch(name, {f"knee_{n}": s for n in range(1, 7)},
+                               f"arm turned {'+' if s < 0 else '-'}delta about u_i from A_iC_i, B_i on the "
+                               f"{'outer' if s < 0 else 'inner'} side (knee_i {'<' if s < 0 else '>'} 0)")
+                  for name, s in BRANCHES.items()},
+        default_branch=DEFAULT_BRANCH,
+        parameters=spec_parameters(params),
+    )
+
+
+def build(params: HexapodParams | None = None) -> Mechanism:
+    """The hexapod as a :class:`~pkm.core.Mechanism` (paper design when ``params`` is None)."""
+    params = HexapodParams() if params is None else params
+    return make_mechanism(urdf_xml(params), closure_spec(params), params)
+
+
+# ---------------------------------------------------------------------- helpers
+def _wrap(a):
+    """Angle(s) [rad] wrapped to [-pi, pi)."""
+    return (np.asarray(a, dtype=float) + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def _skew(a: np.ndarray) -> np.ndarray:
+    """``[a]x`` with ``[a]x b = a x b``."""
+    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+
+
+def _branches(branch: str | tuple[str, ...]) -> tuple[str, ...]:
+    branches = (branch,) * 6 if isinstance(branch, str) else tuple(branch)
+    if len(branches) != 6 or any(b not in BRANCHES for b in branches):
+        raise InvalidInputError("branch", f"use {sorted(BRANCHES)} or a tuple of six, got {branch!r}", branch)
+    return branches
+
+
+def _vector(x, n: int, name: str) -> np.ndarray:
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInputError(name, f"expected {n} numbers", x) from None
+    if a.shape != (n,) or not np.all(np.isfinite(a)):
+        raise InvalidInputError(name, f"expected {n} finite numbers, got shape {a.shape}", x)
+    return a
+
+
+def _task(y, name: str = "y") -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """``(R, P, quaternion xyzw, beta)`` from a task vector; the quaternion must have norm 1 (to 1e-6)."""
+    y = _vector(y, 8, name)
+    quat = y[3:7]
+    nrm = np.linalg.norm(quat)
+    if abs(nrm - 1.0) > 1e-6:
+        raise InvalidInputError(name, f"quaternion (qx, qy, qz, qw) has norm {nrm:.6g}, expected 1", y)
+    quat = quat / nrm
+    R = pin.Quaternion(quat[3], quat[0], quat[1], quat[2]).toRotationMatrix()
+    return R, y[:3].copy(), quat, float(y[7])

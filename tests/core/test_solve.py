@@ -1,0 +1,99 @@
+"""Position solvers and differential kinematics of the core: results, bounds, and errors on bad input."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm.core import close_loops, diagnose, solve_ik
+from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, SingularityError, UnknownNameError
+from pkm.mechanisms import delta as D
+
+
+@pytest.fixture(scope="module")
+def delta(built):
+    return built("delta")
+
+
+def test_solve_result_reports_convergence_residual_and_iterations(delta):
+    """A loop closure from a neighbouring configuration converges in a few iterations to 1e-12."""
+    qa = delta.actuated_q(delta.q_reference) + 0.01
+    res = close_loops(delta, qa, delta.q_reference)
+    assert res.converged and res.residual <= 1e-12 and 1 <= res.iterations <= 10 and res.steps == 1
+    assert res.branch_signs == {"knee_1": -1, "knee_2": -1, "knee_3": -1}
+
+
+@pytest.mark.parametrize("bad", [[0.1, 0.2], [0.1, math.nan, 0.2], [[0.1, 0.2, 0.3]], "abc", None])
+def test_bad_actuated_input_is_refused(delta, bad):
+    """Wrong shapes, NaN and non-numbers are InvalidInputErrors naming the argument."""
+    with pytest.raises(InvalidInputError, match="q_actuated"):
+        close_loops(delta, bad)
+
+
+def test_bad_configuration_and_target_are_refused(delta):
+    """A configuration of the wrong size or with inf, and a target of the wrong size, are refused."""
+    with pytest.raises(InvalidInputError, match="q0"):
+        close_loops(delta, [0.0, 0.0, 0.0], np.zeros(5))
+    with pytest.raises(InvalidInputError, match="target"):
+        solve_ik(delta, [0.0, 0.0])
+    with pytest.raises(InvalidInputError, match="target"):
+        solve_ik(delta, [0.0, math.inf, -0.3])
+    q = delta.q_reference.copy()
+    q[0] = math.inf
+    with pytest.raises(InvalidInputError):
+        pkm.forward_jacobian(delta, q)
+
+
+def test_unassemblable_motor_angles_raise_convergence_error_with_the_open_loop():
+    """Motor angles with no assembly: the solver stops, bounded, and says which loop stays open."""
+    short = D.build(D.DeltaParams(Lb=0.2, home=(0.0, 0.0, -0.2)))
+    theta = [-0.7, -0.4, 0.2]
+    with pytest.raises(AssemblyError):  # the paper's sphere intersection agrees: no assembly
+        D.forward_kinematics(short.params, theta)
+    with pytest.raises(ConvergenceError) as info:
+        close_loops(short, theta, max_iter=15)
+    err = info.value
+    assert err.residual > 1e-3 and err.worst_closure in {"ball_1", "ball_2", "ball_3"} and err.worst_gap > 1e-3
+    assert "stays open" in str(err)
+
+
+def test_unreachable_target_raises_convergence_error(delta):
+    """A platform position far outside the workspace gives a ConvergenceError, never NaN."""
+    with pytest.raises(ConvergenceError):
+        solve_ik(delta, [0.0, 0.0, -2.0], max_iter=10)
+
+
+def test_unknown_branch_and_frame_names_list_the_valid_ones(delta):
+    """Unknown names raise UnknownNameError with the valid names in the message."""
+    with pytest.raises(UnknownNameError, match="knee_out"):
+        solve_ik(delta, [0.0, 0.0, -0.35], branch="knees_out")
+    with pytest.raises(UnknownNameError, match="platform_ball_1"):
+        delta.frame_id("platform_bal_1")
+
+
+def test_other_branch_is_reached_from_a_branch_seed(delta):
+    """The generic IK on 'knee_in' equals the closed form on that branch."""
+    y = [0.01, 0.02, -0.36]
+    res = solve_ik(delta, y, branch="knee_in")
+    assert delta.on_branch(res.q, "knee_in")
+    assert np.abs(delta.actuated_q(res.q) - D.inverse_kinematics(delta.params, y, "knee_in")).max() < 1e-9
+
+
+def test_diagnose_classifies_a_folded_leg_as_inverse_singularity(delta):
+    """With forearm 1 folded back onto arm 1's plane direction (double root of its IK), the configuration
+    is an inverse singularity, and the inverse measure falls to zero on the way there."""
+    p = delta.params
+    th, eta = -3.1, -0.8
+    B1 = np.array([0.0, p.R - p.r + p.La * math.cos(th), p.La * math.sin(th)])
+    f = np.array([math.sin(eta), math.cos(eta) * math.cos(th), math.cos(eta) * math.sin(th)])
+    E = B1 - p.Lb * f  # forearm 1's projection on arm 1's plane lies along the arm
+    d = diagnose(delta, D.configuration(delta, E))
+    assert d.classification == "inverse" and d.sigma_inverse < 1e-7
+    with pytest.raises(SingularityError) as info:
+        pkm.inverse_jacobian(delta, D.configuration(delta, E))
+    assert info.value.kind == "inverse"
+    sig = [diagnose(delta, D.configuration(delta, B1 - (p.Lb + s) * f)).sigma_inverse for s in (1e-4, 1e-5, 1e-6)]
+    assert sig[0] > sig[1] > sig[2] > 0

@@ -1,0 +1,314 @@
+"""Planar 3-RRR: parameters, working modes, the paper's equations (6) and (9), reach, inputs.
+
+The generic harness (tests/test_mechanisms_generic.py) already checks loop closure, generic
+vs closed-form IK on the default mode, and the Jacobians; these tests cover what is
+specific to the paper and to this module's conventions.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from pkm.core import TaskMap, branch_seed, constraints, diagnose, forward_jacobian, solve_ik
+from pkm.errors import ConvergenceError, InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
+from pkm.mechanisms import rrr3
+
+P = rrr3.Rrr3Params()
+Y_REF = rrr3.home_task(P)
+MODE_NAMES = [f"mode{k}" for k in range(1, 9)]
+
+
+@pytest.fixture(scope="module")
+def mech():
+    return rrr3.build()
+
+
+def _wrap(a):
+    return (np.asarray(a) + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def _leg_targets(params, y):
+    """Platform vertex minus base vertex for each leg, built from eqs. (1)-(2) independently."""
+    G, phi, h, H = np.asarray(y[:2]), y[2], params.h, params.H
+    A = G - h / math.sqrt(3.0) * np.array([math.cos(phi + math.pi / 6), math.sin(phi + math.pi / 6)])
+    B = A + h * np.array([math.cos(phi), math.sin(phi)])
+    C = A + h * np.array([math.cos(phi + math.pi / 3), math.sin(phi + math.pi / 3)])
+    base = np.array([[0.0, 0.0], [H, 0.0], [H / 2, H * math.sqrt(3.0) / 2]])
+    return np.array([A, B, C]) - base
+
+
+def _eq6(params, target, theta):
+    """The paper's eq. (6) in a leg's base-vertex frame [m^2]."""
+    x, y = target
+    a, b = params.a, params.b
+    return x * x + y * y - 2 * x * a * math.cos(theta) - 2 * y * a * math.sin(theta) + a * a - b * b
+
+
+def _eq9(params, target):
+    """The paper's eq. (9) as printed (half-angle form): the ('+', '-') roots [rad]."""
+    x, y = target
+    a, b = params.a, params.b
+    e1, e2, e3 = -2 * y * a, -2 * x * a, x * x + y * y + a * a - b * b
+    s = math.sqrt(e1 * e1 + e2 * e2 - e3 * e3)
+    return 2 * math.atan((-e1 + s) / (e3 - e2)), 2 * math.atan((-e1 - s) / (e3 - e2))
+
+
+def _random_poses(n, seed, radius=0.12, dphi=0.3):
+    rng = np.random.default_rng(seed)
+    return [Y_REF + rng.uniform(-1, 1, 3) * [radius, radius, dphi] for _ in range(n)]
+
+
+# ---------------------------------------------------------------------- parameters
+def test_reference_design_is_the_papers_workspace_study():
+    """The default design is sec. III's (links 40 cm, platform 10 cm, actuators 100 cm apart), centred, Phi = 0."""
+    assert (P.a, P.b, P.h, P.H, P.mode) == (0.40, 0.40, 0.10, 1.00, 1)
+    np.testing.assert_allclose(Y_REF, [0.5, 0.5 / math.sqrt(3.0), 0.0], atol=1e-15)
+
+
+def test_reference_configuration_is_assembled_regular_and_in_mode1(mech):
+    """The spec's reference closes the loops, lands on the base centroid, is regular and has every psi_i = +99 deg."""
+    q = mech.q_reference
+    assert np.abs(constraints.residual(mech, q)).max() < 1e-15
+    np.testing.assert_allclose(TaskMap(mech).value(q), Y_REF, atol=1e-15)
+    assert diagnose(mech, q).classification == "regular"
+    psi = [mech.q_to_dict(q)[f"elbow_{n}"] for n in (1, 2, 3)]
+    np.testing.assert_allclose(np.degrees(psi), 98.98, atol=0.01)
+    assert mech.on_branch(q, "mode1") and mech.spec.default_branch == "mode1"
+
+
+@pytest.mark.parametrize("field, value", [("h", 0.0), ("a", 0.0), ("a", -0.1), ("b", float("nan")),
+                                          ("H", float("inf")), ("m_platform", 0.0)])
+def test_non_positive_or_non_finite_lengths_and_masses_are_refused(field, value):
+    """h = 0, a <= 0 and any non-finite length raise InvalidParameterError naming the field."""
+    with pytest.raises(InvalidParameterError) as exc:
+        rrr3.Rrr3Params(**{field: value})
+    assert exc.value.name == field
+
+
+@pytest.mark.parametrize("mode", [0, 9, True, "mode1", 1.0])
+def test_mode_must_be_an_integer_from_1_to_8(mode):
+    """A working mode outside 1..8 (or not an integer) raises InvalidParameterError."""
+    with pytest.raises(InvalidParameterError, match="mode"):
+        rrr3.Rrr3Params(mode=mode)
+
+
+@pytest.mark.parametrize("home", [(0.0, 0.0), (0.0, float("nan"), 0.0), "centre"])
+def test_malformed_home_is_refused(home):
+    """A home that is not three finite numbers raises InvalidParameterError."""
+    with pytest.raises(InvalidParameterError, match="home"):
+        rrr3.Rrr3Params(home=home)
+
+
+def test_unreachable_home_is_refused_with_the_leg():
+    """A reference pose out of reach raises InvalidParameterError that names the leg and the miss."""
+    with pytest.raises(InvalidParameterError, match="leg 1 misses by"):
+        rrr3.Rrr3Params(home=(0.5, 0.0, 0.0))
+
+
+def test_stretched_home_is_refused_as_inverse_singular():
+    """Links exactly spanning the centred pose (a + b = |PA|) put every leg at psi = 0: refused."""
+    d = (1.0 - 0.1) / math.sqrt(3.0)
+    with pytest.raises(InvalidParameterError, match="inverse"):
+        rrr3.Rrr3Params(a=d / 2, b=d / 2)
+
+
+def test_direct_singular_home_is_refused():
+    """A centred pose at the orientation where det J_x = 0 (mode1, Phi ~ 0.76 rad) is refused as direct-singular."""
+    def det(phi):
+        return np.linalg.det(rrr3.jacobians(P, [Y_REF[0], Y_REF[1], phi])[0])
+
+    phi_s = brentq(det, 0.6, 0.9, xtol=1e-14)
+    with pytest.raises(InvalidParameterError, match="direct"):
+        rrr3.Rrr3Params(home=(0.0, 0.0, phi_s))
+    rrr3.Rrr3Params(home=(0.0, 0.0, phi_s - 0.05))  # nearby orientations are fine
+
+
+# ---------------------------------------------------------------------- working modes
+def test_mode_names_follow_the_bits_of_k_minus_1():
+    """mode k <-> bits of k-1 with leg 1 most significant, bit 0 -> psi > 0: mode1 = +++, mode3 = +-+, mode8 = ---."""
+    assert rrr3.MODES["mode1"] == (1, 1, 1)
+    assert rrr3.MODES["mode3"] == (1, -1, 1)
+    assert rrr3.MODES["mode5"] == (-1, 1, 1)
+    assert rrr3.MODES["mode8"] == (-1, -1, -1)
+    assert rrr3.mode_signs(3) == rrr3.mode_signs("mode3") == rrr3.mode_signs(np.int64(3))
+    for bad in (0, "mode9", "knee_out", None):
+        with pytest.raises(InvalidInputError):
+            rrr3.mode_signs(bad)
+
+
+def test_spec_lists_the_eight_modes_on_the_elbows(mech):
+    """The spec has branches mode1..mode8 whose signs are those of (elbow_1, elbow_2, elbow_3)."""
+    assert list(mech.spec.branches) == MODE_NAMES
+    for name in MODE_NAMES:
+        assert mech.spec.branches[name].signs == dict(zip(("elbow_1", "elbow_2", "elbow_3"), rrr3.MODES[name]))
+
+
+def test_eight_modes_give_eight_distinct_closed_configurations(mech):
+    """At the reference pose the 8 modes give 8 distinct assembled configurations, each on its own mode."""
+    task = TaskMap(mech)
+    configs = []
+    for name in MODE_NAMES:
+        q = rrr3.closed_form_configuration(mech, Y_REF, name)
+        assert np.abs(constraints.residual(mech, q)).max() < 1e-15
+        assert np.abs(task.error(Y_REF, task.value(q))).max() < 1e-15
+        assert mech.on_branch(q, name)
+        assert [m for m in MODE_NAMES if mech.on_branch(q, m)] == [name]
+        configs.append(q)
+    gaps = [np.abs(_wrap(p - q)).max() for i, p in enumerate(configs) for q in configs[i + 1:]]
+    assert min(gaps) > 1.0  # rad
+
+
+def test_closed_form_satisfies_eq6_for_every_leg_and_mode():
+    """Each motor angle of the closed form makes the paper's eq. (6) vanish (to 1e-15 m^2) on every leg."""
+    worst = 0.0
+    for y in _random_poses(40, seed=1):
+        targets = _leg_targets(P, y)
+        for name in MODE_NAMES:
+            theta = rrr3.closed_form_ik(P, y, name)
+            worst = max(worst, max(abs(_eq6(P, t, th)) for t, th in zip(targets, theta)))
+    assert worst < 1e-15
+
+
+def test_plus_root_of_eq9_is_negative_psi():
+    """Where eq. (9) as printed is defined, its '+' root is the psi_i < 0 posture and its '-' root psi_i > 0."""
+    for y in _random_poses(20, seed=2):
+        targets = _leg_targets(P, y)
+        plus, minus = np.array([_eq9(P, t) for t in targets]).T
+        np.testing.assert_allclose(_wrap(rrr3.closed_form_ik(P, y, "mode8") - plus), 0.0, atol=1e-12)
+        np.testing.assert_allclose(_wrap(rrr3.closed_form_ik(P, y, "mode1") - minus), 0.0, atol=1e-12)
+
+
+def test_atan2_form_is_defined_where_the_half_angle_form_divides_by_zero():
+    """Departure: at e3 = e2 (a regular pose) eq. (9) gives 0/0; the atan2 form gives theta_1 = pi/2 (+) and pi (-)."""
+    params = rrr3.Rrr3Params(a=2.0, b=2.0)
+    A = np.array([-2.0, 2.0])  # leg 1: e1 = -8, e2 = e3 = 8
+    with pytest.raises(ZeroDivisionError):
+        _eq9(params, A)
+    th_pos = rrr3.inverse_kinematics(params, A, 0.0, "mode1")[0]
+    th_neg = rrr3.inverse_kinematics(params, A, 0.0, "mode5")[0]
+    assert th_pos == pytest.approx(math.pi / 2, abs=1e-15)
+    assert abs(th_neg) == pytest.approx(math.pi, abs=1e-15)
+    assert abs(_eq6(params, A, th_pos)) < 1e-14 and abs(_eq6(params, A, th_neg)) < 1e-14
+
+
+def test_generic_ik_agrees_with_the_closed_form_in_every_mode(mech):
+    """pkm.core.solve_ik on branch modeK, seeded on that mode, equals the closed form (to 1e-12 rad) at a few poses."""
+    seeds = {name: rrr3.closed_form_configuration(mech, Y_REF, name) for name in MODE_NAMES}
+    worst = 0.0
+    for y in _random_poses(3, seed=3, radius=0.04, dphi=0.15):
+        for name in MODE_NAMES:
+            res = solve_ik(mech, y, q0=seeds[name], branch=name)
+            worst = max(worst, np.abs(_wrap(mech.actuated_q(res.q) - rrr3.closed_form_ik(P, y, name))).max())
+    assert worst < 1e-12
+
+
+@pytest.mark.parametrize("name", MODE_NAMES[1:4])
+def test_generic_branch_seed_reaches_modes_that_keep_leg_1(mech, name):
+    """The core's own branch seed (elbows mirrored from the reference) reaches modes 2-4 and matches the closed form."""
+    y = Y_REF + [0.02, -0.01, 0.1]
+    res = solve_ik(mech, y, branch=name)
+    assert np.abs(_wrap(mech.actuated_q(res.q) - rrr3.closed_form_ik(P, y, name))).max() < 1e-12
+
+
+@pytest.mark.xfail(raises=ConvergenceError, reason="branch_seed mirrors psi_1 with theta_1 and wrist_1 kept: leg 1 "
+                                                   "carries the platform, which jumps away and Newton stalls")
+def test_generic_branch_seed_reaches_modes_that_flip_leg_1(mech):
+    """Known core limitation: the mirrored seed for modes 5-8 does not converge (seed with the closed form instead)."""
+    branch_seed(mech, "mode5")
+
+
+# ---------------------------------------------------------------------- paper helpers
+def test_centroid_and_a_conversions_are_inverse_and_match_eqs_1_2():
+    """G is the mean of A, B, C of eqs. (1)-(2), and a_from_centroid undoes centroid_from_a."""
+    rng = np.random.default_rng(4)
+    for _ in range(10):
+        A, phi = rng.uniform(-1, 1, 2), rng.uniform(-4, 4)
+        G = rrr3.centroid_from_a(P, A, phi)
+        np.testing.assert_allclose(G, rrr3.platform_vertices(P, A, phi).mean(axis=0), atol=1e-15)
+        np.testing.assert_allclose(rrr3.a_from_centroid(P, G, phi), A, atol=1e-15)
+
+
+def test_platform_frames_sit_on_the_vertices_and_yaw_is_phi(mech):
+    """In the tree, platform_A/B/C sit at eqs. (1)-(2)'s vertices and the task yaw equals Phi."""
+    import pinocchio as pin
+
+    for y in _random_poses(5, seed=5):
+        q = rrr3.closed_form_configuration(mech, y)
+        pin.framesForwardKinematics(mech.model, mech.data, q)
+        V = rrr3.platform_vertices(P, rrr3.a_from_centroid(P, y[:2], y[2]), y[2])
+        for k, v in enumerate("ABC"):
+            np.testing.assert_allclose(mech.data.oMf[mech.frame_id(f"platform_{v}")].translation, [*V[k], 0.0],
+                                       atol=1e-15)
+        assert TaskMap(mech).value(q)[2] == pytest.approx(y[2], abs=1e-15)
+
+
+def test_rebuilt_eq19_20_give_the_generic_forward_jacobian(mech):
+    """J_x^-1 J_q from the rebuilt eqs. (19)-(20) equals the core's forward Jacobian, and J_q = diag(a sin psi)."""
+    worst = 0.0
+    for y in _random_poses(10, seed=6):
+        for name in ("mode1", "mode8", "mode6"):
+            q = rrr3.closed_form_configuration(mech, y, name)
+            if diagnose(mech, q).classification != "regular":
+                continue
+            Jx, Jq = rrr3.jacobians(P, y, name)
+            worst = max(worst, np.abs(np.linalg.solve(Jx, Jq) - forward_jacobian(mech, q)).max())
+            psi = [mech.q_to_dict(q)[f"elbow_{n}"] for n in (1, 2, 3)]
+            np.testing.assert_allclose(np.diag(Jq), P.a * np.sin(psi), atol=1e-15)
+    assert worst < 1e-10
+
+
+# ---------------------------------------------------------------------- reach and inputs
+@pytest.mark.parametrize("offset, leg", [((0.5, 0.0, 0.0), 1), ((-0.45, 0.2, 0.0), 2), ((0.0, -0.5, 0.0), 3)])
+def test_out_of_reach_names_the_leg_and_the_excess(offset, leg):
+    """A pose beyond a + b raises UnreachableError with the first failing leg and excess = distance - (a + b)."""
+    y = Y_REF + offset
+    d = np.hypot(*_leg_targets(P, y)[leg - 1])
+    with pytest.raises(UnreachableError) as exc:
+        rrr3.closed_form_ik(P, y)
+    assert exc.value.leg == leg
+    assert exc.value.excess == pytest.approx(d - (P.a + P.b), abs=1e-15) and exc.value.excess > 0
+
+
+def test_inside_the_inner_circle_names_the_leg_and_the_excess():
+    """With a != b, a platform vertex closer than |a - b| to its base vertex raises with excess |a - b| - distance."""
+    params = rrr3.Rrr3Params(a=0.55, b=0.35)
+    G = rrr3.centroid_from_a(params, [0.85, 0.05], 0.0)  # B = (0.95, 0.05), 0.07 m from Q
+    with pytest.raises(UnreachableError) as exc:
+        rrr3.closed_form_ik(params, [*G, 0.0])
+    assert exc.value.leg == 2
+    assert exc.value.excess == pytest.approx(0.2 - math.hypot(0.05, 0.05), abs=1e-15)
+
+
+def test_stretched_leg_is_reachable_with_psi_zero():
+    """A platform vertex exactly at a + b from its base vertex is reached (inverse singular) with psi = 0."""
+    u = np.array([math.cos(0.3), math.sin(0.3)])
+    vals = rrr3.joint_values(P, [*rrr3.centroid_from_a(P, 0.8 * u, 0.0), 0.0])
+    assert vals["elbow_1"][0] == pytest.approx(0.0, abs=1e-7)
+    assert vals["motor_1"][0] == pytest.approx(0.3, abs=1e-7)
+
+
+def test_platform_vertex_on_its_base_vertex_is_singular_when_a_equals_b():
+    """With a = b, A = P leaves theta_1 undetermined: SingularityError, not NaN."""
+    with pytest.raises(SingularityError):
+        rrr3.inverse_kinematics(P, [0.0, 0.0], 0.5)
+
+
+@pytest.mark.parametrize("y", [[0.5, float("nan"), 0.0], [0.5, 0.3], [[0.5, 0.3, 0.0]], "pose", None])
+def test_bad_task_vectors_are_refused(mech, y):
+    """Non-finite or wrongly shaped task vectors raise InvalidInputError in every closed form."""
+    with pytest.raises(InvalidInputError):
+        rrr3.closed_form_ik(P, y)
+    with pytest.raises(InvalidInputError):
+        rrr3.closed_form_configuration(mech, y)
+
+
+def test_bad_paper_inputs_are_refused():
+    """inverse_kinematics refuses a malformed A, a non-finite Phi and an unknown mode with InvalidInputError."""
+    for args in (([0.4], 0.0, 1), ([0.4, 0.2], float("inf"), 1), ([0.4, 0.2], [0.0, 1.0], 1),
+                 ([0.4, 0.2], 0.0, "mode0")):
+        with pytest.raises(InvalidInputError):
+            rrr3.inverse_kinematics(P, *args)
