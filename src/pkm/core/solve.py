@@ -208,11 +208,11 @@ def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol
 def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_iter: int = 50) -> np.ndarray:
     """An assembled configuration on ``branch`` at the reference task coordinates.
 
-    Two phases: the branch joints of the reference are pinned to their mirrored values
-    (sign imposed, magnitude kept) while Newton's method re-closes the loops, which puts every
-    leg on the requested side by construction; then the generic inverse kinematics brings the
-    task back to the reference value. Raises :class:`BranchError` if the second phase crosses
-    a singularity onto another branch.
+    Two phases: Gauss-Newton on the closures, the reference task and the branch joints pinned
+    to their mirrored values (sign imposed, magnitude kept), which moves every leg to the
+    requested side with the platform held; then the generic inverse kinematics removes what
+    the least-squares compromise left. Raises :class:`BranchError` if the result is on
+    another branch.
     """
     b = mech.branch(branch)
     q = mech.q_reference.copy()
@@ -230,11 +230,12 @@ def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_i
 
     def fun(qq):
         r, Jc = constraints.residual_and_jacobian(mech, qq)
-        return np.concatenate([r, qq[pin_q] - values]), np.vstack([Jc, S])
+        e = -task.error(y_ref, task.value(qq, update=False))
+        return (np.concatenate([r, e, qq[pin_q] - values]),
+                np.vstack([Jc, task.jacobian(qq, update=False), S]))
 
-    q, res, it = _newton(mech, fun, q, None, tol, max_iter, 0.5)
-    if res > tol:
-        raise _failure(mech, f"re-closing the loops on branch {branch!r}", SolveResult(q, False, res, it), tol)
+    # over-determined when a pinned magnitude is not the mirrored leg's: Gauss-Newton lands close
+    q, _, _ = _newton(mech, fun, q, None, tol, max_iter, 0.5)
     out = solve_ik(mech, y_ref, q, tol=tol).q
     if not mech.on_branch(out, branch):
         raise BranchError(branch, dict(b.signs), mech.branch_signs(out, branch))

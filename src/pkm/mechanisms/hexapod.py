@@ -58,8 +58,9 @@ Tree (URDF, loops open; Pinocchio model with ``nq = 26``, ``nv = 25``):
   first turn); rod ``LB`` along local x, frame ``leg_i_tip`` at its end.
 * The spherical joints are point closures ``c_i``: ``leg_i_tip`` = ``platform_c_i`` (frame at
   ``C*_i`` on the platform).
-* The platform: URDF ``floating`` joint ``platform`` (free-flyer ``x y z qx qy qz qw``), end
-  effector frame ``platform`` at ``P``.
+* The platform: link ``platform_body`` on the URDF ``floating`` joint ``platform`` (free-flyer
+  ``x y z qx qy qz qw``); the end effector is that joint's frame ``platform``, at ``P``. (The link
+  cannot share the joint's name: Pinocchio 4.1 refuses a frame name that matches two frames.)
 
 Actuated joints, in this order: ``alpha_1 .. alpha_6, beta_1``. Task: the platform pose and
 ``beta_1`` (``x y z qx qy qz qw beta``; 7 outputs for 7 actuators): the robot is redundant for
@@ -273,12 +274,12 @@ def _leg_angle(params: HexapodParams, i: int, d: np.ndarray, branch: str) -> flo
     dr, dy, du = leg_frame(params.theta[i]).T @ d
     rho = math.hypot(dr, dy)
     K = (d @ d + params.LA**2 - params.LB**2) / (2.0 * params.LA)
-    if abs(K) > rho:
+    if abs(K) > rho * (1.0 + 1e-12):  # beyond round-off of a boundary (double-root) pose
         dmin, dmax = math.hypot(du, rho - params.LA), math.hypot(du, rho + params.LA)
         excess = dmin - params.LB if dmin > params.LB else params.LB - dmax
         raise UnreachableError(i + 1, excess, "m", f"leg {i + 1}: the rod LB cannot span the distance from C_{i + 1} "
                                                    "to the circle of B")
-    delta = math.acos(K / rho)
+    delta = math.acos(max(-1.0, min(1.0, K / rho)))
     return float(_wrap(math.atan2(dy, dr) - BRANCHES[branch] * delta))
 
 
@@ -473,10 +474,10 @@ def urdf_xml(params: HexapodParams) -> str:
         b.joint(f"knee_{n}_b", "revolute", f"knee_cross_{n}", f"rod_{n}", axis=(0.0, 1.0, 0.0))
         b.frame(f"leg_{n}_tip", f"rod_{n}", (params.LB, 0.0, 0.0))
     mp, r = params.m_platform, params.r
-    b.link("platform", mp, (0.0, params.h / 2, 0.0), np.diag([mp * r * r / 4, mp * r * r / 2, mp * r * r / 4]))
-    b.joint("platform", "floating", "base", "platform")
+    b.link("platform_body", mp, (0.0, params.h / 2, 0.0), np.diag([mp * r * r / 4, mp * r * r / 2, mp * r * r / 4]))
+    b.joint("platform", "floating", "base", "platform_body")
     for i, c in enumerate(platform_local_points(params)):
-        b.frame(f"platform_c_{i + 1}", "platform", c)
+        b.frame(f"platform_c_{i + 1}", "platform_body", c)
     return b.to_xml()
 
 
@@ -511,8 +512,8 @@ def build(params: HexapodParams | None = None) -> Mechanism:
 
 # ---------------------------------------------------------------------- helpers
 def _wrap(a):
-    """Angle(s) [rad] wrapped to [-pi, pi)."""
-    return (np.asarray(a, dtype=float) + math.pi) % (2.0 * math.pi) - math.pi
+    """Angle(s) [rad] brought into (-pi, pi] (as :meth:`Mechanism.wrap`)."""
+    return math.pi - np.mod(math.pi - np.asarray(a, dtype=float), 2.0 * math.pi)
 
 
 def _skew(a: np.ndarray) -> np.ndarray:

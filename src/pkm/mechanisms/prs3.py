@@ -84,6 +84,7 @@ BRANCHES = {"slider_below": 1, "slider_above": -1}
 DEFAULT_BRANCH = "slider_below"
 ACTUATIONS = {"P": "slider", "R": "knee"}
 TABLE2_FILE = "prs3_table2.toml"
+TABLE2_FORMAT = "pkm.prs3_table2/1"
 TABLE2_KEYS = {"kinematics": ("gamma", "l", "h", "g"),
                "dynamics": ("m1", "m2", "mp", "Izz2", "mx2", "my2", "Ixx3", "Iyy3", "Izz3", "Ixy3", "Ixz3", "Iyz3")}
 _ROOT_TOL = 1e-12  # radicands of eq. (10) above -_ROOT_TOL l^2 count as the double root
@@ -99,7 +100,7 @@ def table2() -> Mapping[str, float]:
         ``mx2 my2`` [kg m], ``Ixx3 Iyy3 Izz3 Ixy3 Ixz3 Iyz3`` [kg m^2].
 
     Raises:
-        SpecError: The file is missing, not TOML, or lacks a key or a number.
+        SpecError: The file is missing, not TOML, of another format, or lacks a key or a number.
     """
     path = dynamics_path(TABLE2_FILE)
     try:
@@ -108,6 +109,8 @@ def table2() -> Mapping[str, float]:
         raise SpecError(str(path), f"cannot read Table 2: {exc.strerror}") from None
     except tomllib.TOMLDecodeError as exc:
         raise SpecError(str(path), f"not valid TOML: {exc}") from None
+    if raw.get("format") != TABLE2_FORMAT:
+        raise SpecError(str(path), f"format {raw.get('format')!r}; this pkm reads {TABLE2_FORMAT!r}")
     out: dict[str, float] = {}
     for section, keys in TABLE2_KEYS.items():
         table = raw.get(section)
@@ -357,6 +360,7 @@ def urdf_xml(params: Prs3Params) -> str:
 
 
 def closure_spec(params: Prs3Params) -> ClosureSpec:
+    """Closures, actuation (``params.actuation``), task, branches and the reference configuration."""
     reference = {k: tuple(v) for k, v in joint_values(params, params.reference).items()}
     joint = ACTUATIONS[params.actuation]
     return ClosureSpec(
@@ -370,8 +374,8 @@ def closure_spec(params: Prs3Params) -> ClosureSpec:
         task=TaskSpec(("z", "pitch", "roll")),
         reference=reference,
         branches={name: Branch(name, {f"knee_{n}": s for n in (1, 2, 3)},
-                               f"every slider {name.split('_')[1]} its spherical joint (knee_i {'>' if s > 0 else '<'} 0)")
-                  for name, s in BRANCHES.items()},
+                               f"every slider {name.split('_')[1]} its spherical joint "
+                               f"(knee_i {'>' if s > 0 else '<'} 0)") for name, s in BRANCHES.items()},
         default_branch=DEFAULT_BRANCH,
         parameters=spec_parameters(params),
     )
