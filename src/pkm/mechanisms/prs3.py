@@ -221,6 +221,13 @@ def _legs(params: Prs3Params) -> tuple[np.ndarray, ...]:
     return params.g * er, cg * er + sg * ez, -sg * er + cg * ez, et, params.h * er
 
 
+def _yaw(pitch: float, roll: float) -> tuple[float, tuple[float, ...]]:
+    """``alpha = atan2(s_b s_f, c_f + c_b)`` (eq. 15) and ``(s_a, c_a, s_b, c_b, s_f, c_f)``."""
+    sb, cb, sf, cf = math.sin(pitch), math.cos(pitch), math.sin(roll), math.cos(roll)
+    alpha = math.atan2(sb * sf, cf + cb)
+    return alpha, (math.sin(alpha), math.cos(alpha), sb, cb, sf, cf)
+
+
 def parasitic_motion(h: float, pitch: float, roll: float) -> tuple[float, float, float]:
     """Dependent coordinates ``(x_p [m], y_p [m], alpha [rad])`` from ``beta``, ``phi`` (derived, eqs. 12-14).
 
@@ -233,9 +240,7 @@ def parasitic_motion(h: float, pitch: float, roll: float) -> tuple[float, float,
         pitch: beta [rad].
         roll: phi [rad].
     """
-    sb, cb, sf, cf = math.sin(pitch), math.cos(pitch), math.sin(roll), math.cos(roll)
-    alpha = math.atan2(sb * sf, cf + cb)
-    sa, ca = math.sin(alpha), math.cos(alpha)
+    alpha, (sa, ca, sb, cb, sf, cf) = _yaw(pitch, roll)
     return 0.5 * h * (ca * cb - sa * sb * sf - ca * cf), -h * sa * cb, alpha
 
 
@@ -247,9 +252,7 @@ def paper_parasitic_motion(h: float, pitch: float, roll: float) -> tuple[float, 
     layout rotated by 90 deg about Z (``phi_i = 90, 210, 330 deg``), not for eqs. (6)-(7), where
     :func:`parasitic_motion` holds; ``alpha`` is right for both.
     """
-    sb, cb, sf, cf = math.sin(pitch), math.cos(pitch), math.sin(roll), math.cos(roll)
-    alpha = math.atan2(sb * sf, cf + cb)
-    sa, ca = math.sin(alpha), math.cos(alpha)
+    alpha, (sa, ca, sb, cb, sf, cf) = _yaw(pitch, roll)
     return -h * sa * cb, -0.5 * h * (ca * cb - sa * sb * sf - ca * cf), alpha
 
 
