@@ -187,7 +187,7 @@ class Mechanism:
     # ------------------------------------------------------------------ vectors
     def check_q(self, q, name: str = "q") -> np.ndarray:
         """``q`` as a float array of shape (nq,), finite, with unit quaternions; else raise."""
-        q = _vector(q, self.nq, name)
+        q = as_vector(q, self.nq, name)
         for j in self.joints.values():
             if j.kind == "JointModelFreeFlyer":
                 quat = q[j.idx_q + 3:j.idx_q + 7]
@@ -201,10 +201,10 @@ class Mechanism:
         return q
 
     def check_v(self, v, name: str = "v") -> np.ndarray:
-        return _vector(v, self.nv, name)
+        return as_vector(v, self.nv, name)
 
     def check_actuated(self, qa, name: str = "q_actuated") -> np.ndarray:
-        return _vector(qa, self.na, name)
+        return as_vector(qa, self.na, name)
 
     def actuated_q(self, q) -> np.ndarray:
         """The actuated coordinates of a configuration, in spec order."""
@@ -218,8 +218,7 @@ class Mechanism:
     def wrap(self, q) -> np.ndarray:
         """``q`` with every revolute coordinate brought into (-pi, pi]."""
         q = np.array(q, dtype=float)
-        idx = self._revolute_q
-        q[idx] = np.pi - np.mod(np.pi - q[idx], 2.0 * np.pi)
+        q[self._revolute_q] = wrap_angle(q[self._revolute_q])
         return q
 
     def q_from_dict(self, values: Mapping[str, Any], base=None) -> np.ndarray:
@@ -272,7 +271,13 @@ class Mechanism:
                 f"task={list(self.spec.task.components) + list(self.spec.task.joints)})")
 
 
-def _vector(x, n: int, name: str) -> np.ndarray:
+def wrap_angle(angle):
+    """Angle(s) brought into (-pi, pi] [rad]."""
+    return np.pi - np.mod(np.pi - np.asarray(angle, dtype=float), 2.0 * np.pi)
+
+
+def as_vector(x, n: int, name: str) -> np.ndarray:
+    """``x`` as a finite float vector of shape (n,), or :class:`InvalidInputError` naming ``name``."""
     try:
         arr = np.asarray(x, dtype=float)
     except (TypeError, ValueError):

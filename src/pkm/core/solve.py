@@ -92,6 +92,38 @@ def _lsq(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.linalg.lstsq(A, b, rcond=None)[0]
 
 
+def _follow(mech: Mechanism, what: str, solve_at, q: np.ndarray, n_steps: int, tol: float,
+            raise_on_failure: bool) -> SolveResult:
+    """Continuation from ``s = 0`` (the seed ``q``) to ``s = 1`` (the target).
+
+    ``solve_at(q, s, tol) -> (q, residual, iterations)`` corrects at path parameter ``s`` from ``q``.
+    Steps start at ``1 / n_steps``, halve on failure, grow again on success; intermediate points
+    are solved to 1e-9, the target to ``tol``. When the step falls below 1e-3 of its initial length
+    the path has left the workspace: a last correction at the target gives the residual reported.
+    """
+    total, steps = 0, 0
+    s, ds = 0.0, 1.0 / n_steps
+    while True:
+        s_next = min(1.0, s + ds)
+        t = tol if s_next >= 1.0 else max(tol, 1e-9)
+        q_new, res, it = solve_at(q, s_next, t)
+        total += it
+        if res <= t:
+            q, s, steps = q_new, s_next, steps + 1
+            if s >= 1.0:
+                q = mech.wrap(q)
+                return SolveResult(q, True, res, total, steps, _signs(mech, q))
+            ds = min(ds * 1.5, 1.0 / n_steps)
+        else:
+            ds *= 0.5
+            if ds < 1e-3 / n_steps:
+                q_new, res, it = solve_at(q, 1.0, tol)
+                result = SolveResult(q_new, False, res, total + it, steps, _signs(mech, q_new))
+                if raise_on_failure:
+                    raise _failure(mech, what, result, tol)
+                return result
+
+
 def close_loops(mech: Mechanism, q_actuated, q0=None, *, tol: float = DEFAULT_TOL, max_iter: int = 30,
                 max_step: float = 0.1, raise_on_failure: bool = True) -> SolveResult:
     """Forward position problem: passive coordinates for given actuated ones.
@@ -116,32 +148,10 @@ def close_loops(mech: Mechanism, q_actuated, q0=None, *, tol: float = DEFAULT_TO
     def fun(qq):
         return constraints.residual_and_jacobian(mech, qq)
 
-    total = 0
-    s, ds = 0.0, 1.0 / n_steps
-    steps = 0
-    while True:
-        s_next = min(1.0, s + ds)
-        q_try = mech.with_actuated(q, qa0 + s_next * (qa1 - qa0))
-        last = s_next >= 1.0
-        q_new, res, it = _newton(mech, fun, q_try, mech.passive_v, tol if last else max(tol, 1e-9),
-                                 max_iter, 0.5)
-        total += it
-        ok = res <= (tol if last else max(tol, 1e-9))
-        if ok:
-            q, s, steps = q_new, s_next, steps + 1
-            if last:
-                break
-            ds = min(ds * 1.5, 1.0 / n_steps)
-        else:
-            ds *= 0.5
-            if ds < 1e-3 / n_steps:  # the path leaves the workspace: best effort at the target itself
-                q_new, res, it = _newton(mech, fun, mech.with_actuated(q, qa1), mech.passive_v, tol, max_iter, 0.5)
-                result = SolveResult(q_new, False, res, total + it, steps, _signs(mech, q_new))
-                if raise_on_failure:
-                    raise _failure(mech, "loop closure", result, tol)
-                return result
-    q = mech.wrap(q)
-    return SolveResult(q, True, res, total, steps, _signs(mech, q))
+    def solve_at(q, s, t):
+        return _newton(mech, fun, mech.with_actuated(q, qa0 + s * (qa1 - qa0)), mech.passive_v, t, max_iter, 0.5)
+
+    return _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure)
 
 
 def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol: float = DEFAULT_TOL,
@@ -176,31 +186,12 @@ def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol
             return np.concatenate([r, e]), np.vstack([Jc, task.jacobian(qq, update=False)])
         return fun
 
-    total, steps = 0, 0
-    s, ds = 0.0, 1.0 / n_steps
-    while True:
-        s_next = min(1.0, s + ds)
-        last = s_next >= 1.0
-        goal = y1 if last else task.interpolate(y0, y1, s_next)
-        t = tol if last else max(tol, 1e-9)
-        q_new, res, it = _newton(mech, make_fun(goal), q, None, t, max_iter, 0.5)
-        total += it
-        if res <= t:
-            q, s, steps = q_new, s_next, steps + 1
-            if last:
-                break
-            ds = min(ds * 1.5, 1.0 / n_steps)
-        else:
-            ds *= 0.5
-            if ds < 1e-3 / n_steps:  # the path leaves the workspace: best effort at the target itself
-                q_new, res, it = _newton(mech, make_fun(y1), q, None, tol, max_iter, 0.5)
-                result = SolveResult(q_new, False, res, total + it, steps, _signs(mech, q_new))
-                if raise_on_failure:
-                    raise _failure(mech, "inverse kinematics", result, tol)
-                return result
-    q = mech.wrap(q)
-    result = SolveResult(q, True, res, total, steps, _signs(mech, q))
-    if branch is not None and not mech.on_branch(q, branch):
+    def solve_at(q, s, t):
+        return _newton(mech, make_fun(y1 if s >= 1.0 else task.interpolate(y0, y1, s)), q, None, t, max_iter, 0.5)
+
+    result = _follow(mech, "inverse kinematics", solve_at, q, n_steps, tol, raise_on_failure)
+    q = result.q
+    if result.converged and branch is not None and not mech.on_branch(q, branch):
         raise BranchError(branch, dict(mech.branch(branch).signs), mech.branch_signs(q, branch))
     return result
 

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.mechanism import Mechanism
+from pkm.core.mechanism import Mechanism, as_vector
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.urdf import UrdfBuilder
 from pkm.errors import AssemblyError, InvalidInputError, InvalidParameterError, UnreachableError
@@ -108,7 +108,7 @@ def inverse_kinematics(params: DeltaParams, p, branch: str | tuple[str, str, str
     Raises:
         UnreachableError: with the first arm that cannot reach and by how much [m].
     """
-    p = _point(p, "p")
+    p = as_vector(p, 3, "p")
     branches = (branch,) * 3 if isinstance(branch, str) else tuple(branch)
     if len(branches) != 3 or any(b not in BRANCHES for b in branches):
         raise InvalidInputError("branch", f"use 'knee_out'/'knee_in' or a tuple of three, got {branch!r}", branch)
@@ -136,7 +136,7 @@ def _circle_gap(params: DeltaParams, x: float, Y: float, z: float) -> float:
 
 def sphere_centres(params: DeltaParams, theta) -> np.ndarray:
     """Centres ``B'_i`` of the three spheres of radius Lb (eqs. 3-7), rows i = 1..3 [m]."""
-    theta = _point(theta, "theta")
+    theta = as_vector(theta, 3, "theta")
     return np.array([rot_z(PHI[i]) @ np.array([0.0, params.R + params.La * math.cos(theta[i]) - params.r,
                                                 params.La * math.sin(theta[i])]) for i in range(3)])
 
@@ -176,7 +176,7 @@ def forward_kinematics(params: DeltaParams, theta, *, both: bool = False) -> np.
 
 def joint_values(params: DeltaParams, p, branch: str | tuple[str, str, str] = "knee_out") -> dict[str, list[float]]:
     """Every joint coordinate of the tree (closed form), for platform centre ``p``."""
-    p = _point(p, "p")
+    p = as_vector(p, 3, "p")
     th = inverse_kinematics(params, p, branch)
     out: dict[str, list[float]] = {}
     for i in range(3):
@@ -274,13 +274,3 @@ def build(params: DeltaParams | None = None) -> Mechanism:
     """The Delta as a :class:`~pkm.core.Mechanism` (paper design when ``params`` is None)."""
     params = DeltaParams() if params is None else params
     return make_mechanism(urdf_xml(params), closure_spec(params), params)
-
-
-def _point(x, name: str) -> np.ndarray:
-    try:
-        a = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidInputError(name, "expected 3 numbers", x) from None
-    if a.shape != (3,) or not np.all(np.isfinite(a)):
-        raise InvalidInputError(name, f"expected 3 finite numbers, got shape {a.shape}", x)
-    return a

@@ -77,7 +77,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.mechanism import Mechanism
+from pkm.core.mechanism import Mechanism, as_vector, wrap_angle
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.urdf import UrdfBuilder
 from pkm.errors import InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
@@ -173,7 +173,7 @@ def base_centroid(params: Rrr3Params) -> np.ndarray:
 
 def platform_vertices(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
     """Platform vertices ``A, B, C`` as rows [m] (eqs. 1-2), from ``A`` [m] and ``Phi`` [rad]."""
-    A = _vector(a_point, 2, "a_point")
+    A = as_vector(a_point, 2, "a_point")
     phi = _scalar(phi, "phi")
     h = params.h
     return np.array([A, A + h * np.array([math.cos(phi), math.sin(phi)]),
@@ -182,14 +182,14 @@ def platform_vertices(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
 
 def centroid_from_a(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
     """Platform centroid ``G`` [m] from the paper's ``A`` [m] and ``Phi`` [rad]."""
-    A = _vector(a_point, 2, "a_point")
+    A = as_vector(a_point, 2, "a_point")
     phi = _scalar(phi, "phi")
     return A + params.h / SQRT3 * np.array([math.cos(phi + math.pi / 6.0), math.sin(phi + math.pi / 6.0)])
 
 
 def a_from_centroid(params: Rrr3Params, g_point, phi: float) -> np.ndarray:
     """The paper's platform point ``A`` [m] from the centroid ``G`` [m] and ``Phi`` [rad]."""
-    G = _vector(g_point, 2, "g_point")
+    G = as_vector(g_point, 2, "g_point")
     phi = _scalar(phi, "phi")
     return G - params.h / SQRT3 * np.array([math.cos(phi + math.pi / 6.0), math.sin(phi + math.pi / 6.0)])
 
@@ -222,7 +222,7 @@ def _solve(params: Rrr3Params, a_point: np.ndarray, phi: float, mode: int | str)
         sigma = signs[i]  # psi > 0 <-> the '-' root of eq. (9)
         theta[i] = math.atan2(-e1, -e2) - sigma * math.atan2(s, e3)
         psi[i] = sigma * math.atan2(s, d * d - a * a - b * b)
-    return _wrap(theta), psi
+    return wrap_angle(theta), psi
 
 
 def inverse_kinematics(params: Rrr3Params, a_point, phi: float, mode: int | str | None = None) -> np.ndarray:
@@ -244,13 +244,13 @@ def inverse_kinematics(params: Rrr3Params, a_point, phi: float, mode: int | str 
 
 def joint_values(params: Rrr3Params, y, mode: int | str | None = None) -> dict[str, list[float]]:
     """Every joint coordinate of the tree (closed form) for the task vector ``y = (x_G, y_G, Phi)``."""
-    y = _vector(y, 3, "y")
+    y = as_vector(y, 3, "y")
     theta, psi = _solve(params, a_from_centroid(params, y[:2], y[2]), y[2], params.mode if mode is None else mode)
     out: dict[str, list[float]] = {}
     for i in range(3):
         out[f"motor_{i + 1}"] = [float(theta[i])]
         out[f"elbow_{i + 1}"] = [float(psi[i])]
-    out["wrist_1"] = [float(_wrap(y[2] - theta[0] - psi[0]))]
+    out["wrist_1"] = [float(wrap_angle(y[2] - theta[0] - psi[0]))]
     return out
 
 
@@ -273,7 +273,7 @@ def jacobians(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[np.
     Returns:
         ``(J_x, J_q)``: (3, 3) arrays; ``J_x`` columns in [1, 1, m], ``J_q`` in [m].
     """
-    y = _vector(y, 3, "y")
+    y = as_vector(y, 3, "y")
     A = a_from_centroid(params, y[:2], y[2])
     theta, psi = _solve(params, A, y[2], params.mode if mode is None else mode)
     V = platform_vertices(params, A, y[2])
@@ -292,7 +292,7 @@ def jacobians(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[np.
 # kinematics: the paper gives none (up to 6 assembly modes; the generic core solves it).
 def closed_form_ik(params: Rrr3Params, y, branch: str | None = None) -> np.ndarray:
     """Actuated coordinates for task vector ``y`` (closed form); ``branch`` = working mode name."""
-    y = _vector(y, 3, "y")
+    y = as_vector(y, 3, "y")
     return inverse_kinematics(params, a_from_centroid(params, y[:2], y[2]), y[2], branch)
 
 
@@ -361,20 +361,5 @@ def build(params: Rrr3Params | None = None) -> Mechanism:
 
 
 # ---------------------------------------------------------------------- helpers
-def _wrap(angle):
-    """Angle(s) wrapped to (-pi, pi] [rad]."""
-    return np.pi - np.mod(np.pi - np.asarray(angle, dtype=float), 2.0 * np.pi)
-
-
-def _vector(x, n: int, name: str) -> np.ndarray:
-    try:
-        arr = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidInputError(name, f"expected {n} numbers, got {type(x).__name__}", x) from None
-    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-        raise InvalidInputError(name, f"expected {n} finite numbers, got shape {arr.shape}", x)
-    return arr
-
-
 def _scalar(x, name: str) -> float:
-    return float(_vector([x] if np.ndim(x) == 0 else x, 1, name)[0])
+    return float(as_vector([x] if np.ndim(x) == 0 else x, 1, name)[0])
