@@ -112,6 +112,14 @@ def test_jacobians_and_accelerations_match_finite_differences(mech):
     assert err["joint"] <= 1e-6 and err["task"] <= 1e-6 and err["closure"] <= 1e-9
 
 
+def test_constraint_jacobian_equals_pinocchios(mech, built):
+    """The frame-Jacobian construction equals ``pin.getConstraintsJacobian`` (6-D here, 3-D on the
+    mechanisms without mimic joints)."""
+    for m in (mech, built("delta"), built("rrr3"), built("prs3")):
+        q = m.q_reference
+        assert np.abs(constraints.jacobian(m, q) - constraints.pinocchio_jacobian(m, q)).max() <= 1e-14
+
+
 def test_top_level_api_exports_the_core():
     """``pkm`` re-exports the core entry points used above."""
     assert pkm.close_loops is close_loops and pkm.solve_ik is solve_ik

@@ -3,8 +3,8 @@
 Conventions (one row block per closure, in spec order):
 
 * point closure (``CONTACT_3D``, ``LOCAL_WORLD_ALIGNED``): residual
-  ``r = p_A - p_B`` (world axes, m). The Jacobian from
-  ``pin.getConstraintsJacobian`` is exactly ``dr/dq`` (on the tangent space).
+  ``r = p_A - p_B`` (world axes, m). The Jacobian is
+  exactly ``dr/dq`` (on the tangent space).
 * frame closure (``CONTACT_6D``, ``LOCAL``): residual ``r = -log6(A^-1 B)``
   (``[linear; angular]`` in frame A). Pinocchio's Jacobian is the velocity of
   A relative to B seen in A, which equals ``dr/dq`` at closure; away from it,
@@ -40,16 +40,36 @@ def residual(mech: Mechanism, q: np.ndarray, *, update: bool = True) -> np.ndarr
 
 
 def jacobian(mech: Mechanism, q: np.ndarray, *, update: bool = True) -> np.ndarray:
-    """Constraint Jacobian (n_constraints x nv) from Pinocchio's constraint models.
+    """Constraint Jacobian (n_constraints x nv), in the conventions of ``mech.constraint_models``.
 
-    With ``update=True`` it runs ``computeJointJacobians`` (which also places the joints)
-    and ``calc`` on every constraint; Pinocchio 4 returns a stale Jacobian without the latter.
+    Built from frame Jacobians: ``J_A - J_B`` (world-aligned, linear rows) for a point closure,
+    ``J_A - Ad(A^-1 B) J_B`` (local) for a frame closure. This equals
+    ``pin.getConstraintsJacobian`` (a test pins it to 1e-15), which Pinocchio 4.1 refuses for
+    models with mimic joints. ``update=False`` reuses the joint Jacobians and frame placements
+    already in ``mech.data``.
     """
     m, d = mech.model, mech.data
     if update:
         pin.computeJointJacobians(m, d, q)
+        pin.updateFramePlacements(m, d)
+    rows = []
+    for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
+        if c.type == "point":
+            rows.append(pin.getFrameJacobian(m, d, fa, pin.LOCAL_WORLD_ALIGNED)[:3]
+                        - pin.getFrameJacobian(m, d, fb, pin.LOCAL_WORLD_ALIGNED)[:3])
+        else:
+            aMb = d.oMf[fa].actInv(d.oMf[fb])
+            rows.append(pin.getFrameJacobian(m, d, fa, pin.LOCAL)
+                        - aMb.toActionMatrix() @ pin.getFrameJacobian(m, d, fb, pin.LOCAL))
+    return np.vstack(rows)
+
+
+def pinocchio_jacobian(mech: Mechanism, q: np.ndarray) -> np.ndarray:
+    """The same matrix from ``pin.getConstraintsJacobian`` (models without mimic joints only)."""
+    m, d = mech.model, mech.data
+    pin.computeJointJacobians(m, d, q)
     for cm, cd in zip(mech.constraint_models, mech.constraint_datas):
-        cm.calc(m, d, cd)
+        cm.calc(m, d, cd)  # Pinocchio 4 returns a stale Jacobian without it
     return pin.getConstraintsJacobian(m, d, mech.constraint_models, mech.constraint_datas)
 
 

@@ -36,9 +36,13 @@ Platform layouts (parameter ``layout``):
   faces ``A5`` (145 deg): legs 5 and 6 cross (and so do legs 2 and 3).
 
 Only the sector layout with the ``elbow_out`` branch reproduces the paper's pose-T optimum
-(sec. 4: both manipulabilities peak near ``beta = -11 deg``; this model gives -10 deg for
-``w_rot`` and -11 deg for ``w_tras``, see the tests). The other three layout/branch pairs
-peak at 82.5, 90, -59, 40, -49, 90 or 3.5 deg.
+(sec. 4: both manipulabilities of eq. 37 peak near ``beta = -11 deg``; this model gives -10 deg
+for ``w_rot`` and -11 deg for ``w_tras``, see the tests). With the same branch on both
+sub-manipulators, the other layout/branch pairs peak at -59 deg (sector, elbow_in), 40 deg
+(literal, elbow_out), 3.5/90 deg (literal, elbow_in). Note that ``sqrt(det(J J^T))`` grows as
+``J_x`` nears a direct singularity: along ``beta`` at pose T, ``|det J_x|`` is smallest at -17.4 deg
+(no crossing), and the smallest singular value of the passive-joint constraint columns is only
+6.5e-3 at the reference configuration, so pose T lies close to a direct singularity.
 
 Tree (URDF, loops open; Pinocchio model with ``nq = 26``, ``nv = 25``):
 
@@ -52,10 +56,11 @@ Tree (URDF, loops open; Pinocchio model with ``nq = 26``, ``nv = 25``):
   ``alpha_i(joint) = alpha_i(paper) - beta`` (the screw model of eq. 18 uses relative rates,
   ``beta_dot`` and ``alpha_i_dot`` on successive screws); for legs 4-6 it sits on the base and
   equals the paper's ``alpha_i``. :func:`paper_alphas` and :func:`actuated_from_paper` convert.
-* Universal joint at ``B_i``: ``knee_i`` about ``u_i`` (local z), 0 when the projection of the
-  rod ``LB`` on the leg plane (normal ``u_i``) is collinear with ``LA`` (the double root of the
-  leg's inverse problem), then ``knee_i_b`` about the perpendicular axis (local y after the
-  first turn); rod ``LB`` along local x, frame ``leg_i_tip`` at its end.
+* Universal joint at ``B_i``: ``knee_i`` about ``u_i`` (local z), the angle from ``LA`` to the
+  projection of the rod ``LB`` on the leg plane (normal ``u_i``): 0 when that projection extends
+  ``LA`` and +-pi when it folds back over it (the two double roots of the leg's inverse problem);
+  then ``knee_i_b`` about the perpendicular axis (local y after the first turn); rod ``LB``
+  along local x, frame ``leg_i_tip`` at its end.
 * The spherical joints are point closures ``c_i``: ``leg_i_tip`` = ``platform_c_i`` (frame at
   ``C*_i`` on the platform).
 * The platform: link ``platform_body`` on the URDF ``floating`` joint ``platform`` (free-flyer
@@ -76,18 +81,25 @@ Reachability of pose T (sec. 4: "only for ``-60 <= beta <= 90 deg``"): leg 1 fol
 (``|C1 - A1| < LB - LA``) for ``beta`` below -59.51 deg (down to -121.8 deg); within the studied
 ``[-90, 90] deg`` the pose is reachable exactly for ``beta >= -59.51 deg``. Reachability of a leg
 does not depend on its branch, and ``C1`` is the same in both layouts, so both branches and both
-layouts give this interval (legs 2 and 3 lose the pose below -60.02/-65.81 deg in the sector
+layouts give this interval (legs 2 and 3 lose the pose below -65.81/-60.02 deg in the sector
 layout, -70.36/-91.81 deg in the literal one).
 
 Printed equations corrected (derived from the geometry, checked in the tests):
 
 * Eq. (17): ``Q_i = 2 C_xi cos th_i + 2 C_zi sin th_i`` (the second cosine is a sine).
 * Eq. (15): the radicand begins with ``4 (C_yi - D)^2``, not ``4 (D - 2 C_yi)^2``; the rest of
-  eqs. (15)-(16) is right. The ``+`` sign of eq. (15) gives ``elbow_in``, ``-`` gives ``elbow_out``.
+  eqs. (15)-(16) is right. Its two signs give the two branches (at pose T, ``+`` gives
+  ``elbow_out``; which sign gives which branch depends on the sign of the denominator).
 
 Forward kinematics: the paper's semi-closed system (eqs. 4-7, nine quadratic equations in
 ``C1, C2, C3``) solved by Newton's method from a seed (:func:`forward_kinematics`), then the
-pose by eqs. (8)-(13) with the layout's convention. It does not use the generic core.
+pose by eqs. (8)-(13) with the layout's convention. It does not use the generic core. Newton's
+method keeps the seed's assembly mode only when the seed is close enough: in the literal layout
+at ``beta = 85 deg``, from pose T, it lands on another assembly about 35 mm away.
+
+Pinocchio 4.1 and the mimic joints: the tree, frame Jacobians, frame accelerations, ``rnea`` and
+``crba`` handle them; ``getConstraintsJacobian`` and ``aba`` raise ``RuntimeError`` and
+``constraintDynamics`` aborts the interpreter on this model.
 
 Masses are not given by the paper; the defaults are illustrative and only matter for dynamics.
 """
@@ -100,12 +112,19 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.mechanism import Mechanism
+from pkm.core.mechanism import Mechanism, as_vector, wrap_angle
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.urdf import UrdfBuilder
 from pkm.errors import ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
-from pkm.mechanisms._common import (check_finite, check_positive, make_mechanism, rod_inertia, rot_y, rot_z,
-                                    spec_parameters)
+from pkm.mechanisms._common import (
+    check_finite,
+    check_positive,
+    make_mechanism,
+    rod_inertia,
+    rot_y,
+    rot_z,
+    spec_parameters,
+)
 
 NAME = "hexapod"
 LAYOUTS = {"sector": (0.0, 120.0, 240.0), "literal": (0.0, 240.0, 120.0)}  # psi of C4, C5, C6 [deg]
@@ -225,20 +244,28 @@ def platform_points(params: HexapodParams, R: np.ndarray, P) -> np.ndarray:
     return np.asarray(P, dtype=float) + platform_local_points(params) @ np.asarray(R, dtype=float).T
 
 
+def elbow_points(params: HexapodParams, alphas, beta: float) -> np.ndarray:
+    """Universal-joint centres ``B_1..B_6`` from the paper's absolute ``alpha_i`` and ``beta`` [rad] (eq. 3), rows [m]."""
+    alphas = as_vector(alphas, 6, "alphas")
+    A = base_points(params, beta)
+    return np.array([A[i] + params.LA * (leg_frame(params.theta[i]) @ [math.cos(alphas[i]), math.sin(alphas[i]), 0.0])
+                     for i in range(6)])
+
+
 def paper_alphas(q_actuated) -> np.ndarray:
     """The paper's absolute ``alpha_1..alpha_6`` [rad] from the actuated vector (spec order).
 
     Legs 1-3: ``alpha(paper) = alpha(joint) + beta``; legs 4-6 unchanged.
     """
-    qa = _vector(q_actuated, 7, "q_actuated")
+    qa = as_vector(q_actuated, 7, "q_actuated")
     return np.concatenate([qa[:3] + qa[6], qa[3:6]])
 
 
 def actuated_from_paper(alphas, beta: float) -> np.ndarray:
     """The actuated vector (``alpha_1..alpha_6`` joint coordinates, ``beta_1``) from the paper's angles."""
-    a = _vector(alphas, 6, "alphas")
-    b = float(_vector([beta], 1, "beta")[0])
-    return np.concatenate([_wrap(a[:3] - b), _wrap(a[3:]), [b]])
+    a = as_vector(alphas, 6, "alphas")
+    b = _scalar(beta, "beta")
+    return np.concatenate([wrap_angle(a[:3] - b), wrap_angle(a[3:]), [b]])
 
 
 # ---------------------------------------------------------------------- closed forms
@@ -262,8 +289,9 @@ def inverse_kinematics(params: HexapodParams, R, P, beta: float,
         UnreachableError: with the first leg that cannot reach and by how much [m].
     """
     branches = _branches(branch)
-    C = platform_points(params, R, P)
-    A = base_points(params, beta)
+    R = np.reshape(as_vector(np.ravel(R), 9, "R"), (3, 3))
+    C = platform_points(params, R, as_vector(P, 3, "P"))
+    A = base_points(params, _scalar(beta, "beta"))
     out = np.empty(6)
     for i in range(6):
         out[i] = _leg_angle(params, i, C[i] - A[i], branches[i])
@@ -279,8 +307,8 @@ def _leg_angle(params: HexapodParams, i: int, d: np.ndarray, branch: str) -> flo
         excess = dmin - params.LB if dmin > params.LB else params.LB - dmax
         raise UnreachableError(i + 1, excess, "m", f"leg {i + 1}: the rod LB cannot span the distance from C_{i + 1} "
                                                    "to the circle of B")
-    delta = math.acos(max(-1.0, min(1.0, K / rho)))
-    return float(_wrap(math.atan2(dy, dr) - BRANCHES[branch] * delta))
+    delta = math.acos(max(-1.0, min(1.0, K / max(rho, 1e-300))))  # rho = 0: C on the axis, any alpha
+    return float(wrap_angle(math.atan2(dy, dr) - BRANCHES[branch] * delta))
 
 
 def joint_values(params: HexapodParams, R, P, beta: float,
@@ -305,14 +333,13 @@ def joint_values(params: HexapodParams, R, P, beta: float,
 def _joint_values(params: HexapodParams, R: np.ndarray, P, quat: np.ndarray, beta: float,
                   alphas: np.ndarray) -> dict[str, list[float]]:
     C = platform_points(params, R, P)
-    A = base_points(params, beta)
+    B = elbow_points(params, alphas, beta)
     qa = actuated_from_paper(alphas, beta)
     out: dict[str, list[float]] = {"beta_1": [float(beta)]}
     for i in range(6):
-        n, a = i + 1, alphas[i]
-        L = leg_frame(params.theta[i])
-        B = A[i] + params.LA * (L @ np.array([math.cos(a), math.sin(a), 0.0]))
-        w = rot_z(-a) @ (L.T @ (C[i] - B)) / params.LB  # rod direction in the arm frame = Rz(k) Ry(kb) x
+        n = i + 1
+        # rod direction in the arm frame = Rz(knee) Ry(knee_b) x
+        w = rot_z(-alphas[i]) @ (leg_frame(params.theta[i]).T @ (C[i] - B[i])) / params.LB
         out[f"alpha_{n}"] = [float(qa[i])]
         out[f"knee_{n}"] = [math.atan2(w[1], w[0])]
         out[f"knee_{n}_b"] = [math.asin(max(-1.0, min(1.0, -w[2])))]
@@ -350,22 +377,21 @@ def forward_kinematics(params: HexapodParams, alphas, beta: float, seed=None, *,
     Raises:
         ConvergenceError: with the residual, when Newton's method does not reach ``tol``.
     """
-    alphas = _vector(alphas, 6, "alphas")
-    A = base_points(params, beta)
-    B = np.array([A[i] + params.LA * (leg_frame(params.theta[i]) @ np.array([math.cos(alphas[i]),
-                                                                               math.sin(alphas[i]), 0.0]))
-                  for i in range(6)])
+    B = elbow_points(params, alphas, _scalar(beta, "beta"))
     if seed is None:
         seed = platform_points(params, home_rotation(params), params.home_position)[:3]
-    X = _vector(np.ravel(seed), 9, "seed").copy()
+    X = as_vector(np.ravel(seed), 9, "seed").copy()
     e = params.r * math.sqrt(3.0)
     k = (-1.0 if params.layout == "sector" else 1.0) * 2.0 / (math.sqrt(3.0) * e * e)
     pairs = ((0, 1), (1, 2), (0, 2))
 
+    def normal(C: np.ndarray) -> np.ndarray:  # eq. (5), unit when C1C2C3 is the platform's triangle
+        return k * np.cross(C[1] - C[2], C[0] - C[2])
+
     def fun(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         C = x.reshape(3, 3)
-        g = k * np.cross(C[1] - C[2], C[0] - C[2])
-        dg = k * np.hstack([_skew(C[1] - C[2]), -_skew(C[0] - C[2]), _skew(C[0] - C[1])])  # dg/dX
+        g = normal(C)
+        dg = k * np.hstack([pin.skew(C[1] - C[2]), -pin.skew(C[0] - C[2]), pin.skew(C[0] - C[1])])  # dg/dX
         f, J = np.empty(9), np.zeros((9, 9))
         for i in range(3):
             for j, Ci, sel in ((i, C[i], 0.0), (i + 3, C[i] + params.h * g, 1.0)):
@@ -396,8 +422,7 @@ def forward_kinematics(params: HexapodParams, alphas, beta: float, seed=None, *,
     if not res <= tol:
         raise ConvergenceError("semi-closed forward kinematics (eqs. 4-7)", res, it, tol)
     C = X.reshape(3, 3)
-    g = k * np.cross(C[1] - C[2], C[0] - C[2])
-    return np.vstack([C, C + params.h * g])
+    return np.vstack([C, C + params.h * normal(C)])
 
 
 def pose_from_points(params: HexapodParams, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -441,7 +466,7 @@ def closed_form_fk(params: HexapodParams, q_actuated, seed=None) -> np.ndarray:
     Raises:
         ConvergenceError: when Newton's method fails (residual attached).
     """
-    qa = _vector(q_actuated, 7, "q_actuated")
+    qa = as_vector(q_actuated, 7, "q_actuated")
     C0 = None
     if seed is not None:
         R0, P0, _, _ = _task(seed, "seed")
@@ -511,16 +536,6 @@ def build(params: HexapodParams | None = None) -> Mechanism:
 
 
 # ---------------------------------------------------------------------- helpers
-def _wrap(a):
-    """Angle(s) [rad] brought into (-pi, pi] (as :meth:`Mechanism.wrap`)."""
-    return math.pi - np.mod(math.pi - np.asarray(a, dtype=float), 2.0 * math.pi)
-
-
-def _skew(a: np.ndarray) -> np.ndarray:
-    """``[a]x`` with ``[a]x b = a x b``."""
-    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
-
-
 def _branches(branch: str | tuple[str, ...]) -> tuple[str, ...]:
     branches = (branch,) * 6 if isinstance(branch, str) else tuple(branch)
     if len(branches) != 6 or any(b not in BRANCHES for b in branches):
@@ -528,19 +543,13 @@ def _branches(branch: str | tuple[str, ...]) -> tuple[str, ...]:
     return branches
 
 
-def _vector(x, n: int, name: str) -> np.ndarray:
-    try:
-        a = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidInputError(name, f"expected {n} numbers", x) from None
-    if a.shape != (n,) or not np.all(np.isfinite(a)):
-        raise InvalidInputError(name, f"expected {n} finite numbers, got shape {a.shape}", x)
-    return a
+def _scalar(x, name: str) -> float:
+    return float(as_vector([x], 1, name)[0])
 
 
 def _task(y, name: str = "y") -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """``(R, P, quaternion xyzw, beta)`` from a task vector; the quaternion must have norm 1 (to 1e-6)."""
-    y = _vector(y, 8, name)
+    y = as_vector(y, 8, name)
     quat = y[3:7]
     nrm = np.linalg.norm(quat)
     if abs(nrm - 1.0) > 1e-6:
