@@ -22,6 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from pkm.core import constraints
 from pkm.core.mechanism import Mechanism
@@ -72,8 +73,6 @@ def forward_jacobian(mech: Mechanism, q) -> np.ndarray:
 
 def twist_jacobian(mech: Mechanism, q) -> np.ndarray:
     """End-effector twist ``[v; w]`` (origin velocity, world axes) from actuated rates (6 x na)."""
-    import pinocchio as pin
-
     q = mech.check_q(q)
     G = _passive_map(mech, constraints.jacobian(mech, q), RTOL)
     pin.updateFramePlacements(mech.model, mech.data)

@@ -14,8 +14,9 @@ Newton, so that the solution stays on the seed's assembly mode and working mode
 unless the path crosses a singularity. A straight path in actuated coordinates can
 leave the workspace through a fold near a direct singularity: loop closure then
 raises :class:`~pkm.errors.ConvergenceError` rather than jump to another assembly
-mode; follow a path inside the workspace instead (seed each solve with the last). Every solver stops after a bounded number
-of iterations and raises :class:`~pkm.errors.ConvergenceError` with its residual.
+mode; follow a path inside the workspace instead (seed each solve with the last).
+Every solver stops after a bounded number of iterations and raises
+:class:`~pkm.errors.ConvergenceError` with its residual.
 """
 
 from __future__ import annotations

@@ -166,11 +166,11 @@ class TaskMap:
 
     def _euler_rows(self, R: np.ndarray) -> np.ndarray:
         """``B^-1``: world angular velocity -> (roll, pitch, yaw) rates."""
-        B = np.column_stack(_rate_map(zyx_angles(R)))
-        if abs(np.cos(zyx_angles(R)[1])) < 1e-9:
-            raise SingularityError("representation", abs(np.cos(zyx_angles(R)[1])),
+        rpy = zyx_angles(R)
+        if abs(np.cos(rpy[1])) < 1e-9:
+            raise SingularityError("representation", abs(np.cos(rpy[1])),
                                    "Z-Y-X Euler angles are singular at pitch = +-90 deg")
-        return np.linalg.inv(B)
+        return np.linalg.inv(np.column_stack(_rate_map(rpy)))
 
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``dJ/dt v``: task acceleration produced by ``v`` alone (a = 0)."""

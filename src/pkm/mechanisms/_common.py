@@ -7,9 +7,9 @@ import math
 
 import numpy as np
 
-from pkm.core.mechanism import Mechanism
+from pkm.core.mechanism import Mechanism, wrap_angle
 from pkm.core.spec import ClosureSpec
-from pkm.errors import InvalidParameterError
+from pkm.errors import InvalidParameterError, UnreachableError
 
 
 def rot_x(a: float) -> np.ndarray:
@@ -32,6 +32,25 @@ def rod_inertia(mass: float, length: float, axis: int) -> np.ndarray:
     I = np.full(3, mass * length**2 / 12.0)
     I[axis] = 0.0
     return np.diag(I)
+
+
+def arm_angle(u: float, v: float, w: float, arm: float, rod: float, sign: int, leg: int, detail: str) -> float:
+    """Angle ``t`` of an arm turning in its (u, v) plane so that its tip lies at distance ``rod`` from
+    the point ``(u, v, w)`` (arm frame: the arm's tip is ``arm (cos t, sin t, 0)``).
+
+    ``u cos t + v sin t = K`` with ``K = (u^2 + v^2 + w^2 + arm^2 - rod^2) / (2 arm)``, so
+    ``t = atan2(v, u) + sign * acos(K / hypot(u, v))``, wrapped to (-pi, pi].
+
+    Raises:
+        UnreachableError: for ``leg`` (1-based), with how much the rod misses the arm-tip circle [m].
+    """
+    rho = math.hypot(u, v)
+    K = (u * u + v * v + w * w + arm * arm - rod * rod) / (2.0 * arm)
+    if abs(K) > rho * (1.0 + 1e-12):  # beyond round-off of a boundary (double-root) pose
+        dmin, dmax = math.hypot(w, rho - arm), math.hypot(w, rho + arm)
+        raise UnreachableError(leg, dmin - rod if dmin > rod else rod - dmax, "m", detail)
+    delta = math.acos(max(-1.0, min(1.0, K / max(rho, 1e-300))))  # rho = 0: point on the axis, any t
+    return float(wrap_angle(math.atan2(v, u) + sign * delta))
 
 
 def check_positive(obj, *names: str) -> None:

@@ -38,7 +38,7 @@ from pkm.core.mechanism import Mechanism, as_vector
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.urdf import UrdfBuilder
 from pkm.errors import AssemblyError, InvalidInputError, InvalidParameterError, UnreachableError
-from pkm.mechanisms._common import (check_positive, make_mechanism, rod_inertia, rot_z,
+from pkm.mechanisms._common import (arm_angle, check_positive, make_mechanism, rod_inertia, rot_z,
                                     spec_parameters)
 
 NAME = "delta"
@@ -115,23 +115,9 @@ def inverse_kinematics(params: DeltaParams, p, branch: str | tuple[str, str, str
     th = np.empty(3)
     for i in range(3):
         x, y, z = _arm_frame_point(p, i)
-        Y = y - (params.R - params.r)
-        K = (x * x + Y * Y + z * z + params.La**2 - params.Lb**2) / (2.0 * params.La)
-        rho = math.hypot(Y, z)
-        if abs(K) > rho * (1.0 + 1e-12):  # beyond round-off of a boundary (double-root) pose
-            raise UnreachableError(i + 1, _circle_gap(params, x, Y, z), "m",
-                                   f"arm {i + 1}: the forearm cannot span the distance to the elbow circle")
-        delta = math.acos(max(-1.0, min(1.0, K / rho)))
-        th[i] = math.atan2(z, Y) + (delta if branches[i] == "knee_out" else -delta)
-    return (th + math.pi) % (2.0 * math.pi) - math.pi
-
-
-def _circle_gap(params: DeltaParams, x: float, Y: float, z: float) -> float:
-    """By how much |E' - B| misses Lb over the elbow circle (m, > 0)."""
-    rho = math.hypot(Y, z)
-    dmin = math.hypot(x, rho - params.La)
-    dmax = math.hypot(x, rho + params.La)
-    return dmin - params.Lb if dmin > params.Lb else params.Lb - dmax
+        th[i] = arm_angle(y - (params.R - params.r), z, x, params.La, params.Lb, 1 if branches[i] == "knee_out" else -1,
+                          i + 1, f"arm {i + 1}: the forearm cannot span the distance to the elbow circle")
+    return th
 
 
 def sphere_centres(params: DeltaParams, theta) -> np.ndarray:

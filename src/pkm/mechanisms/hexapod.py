@@ -117,6 +117,7 @@ from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.urdf import UrdfBuilder
 from pkm.errors import ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.mechanisms._common import (
+    arm_angle,
     check_finite,
     check_positive,
     make_mechanism,
@@ -300,15 +301,8 @@ def inverse_kinematics(params: HexapodParams, R, P, beta: float,
 
 def _leg_angle(params: HexapodParams, i: int, d: np.ndarray, branch: str) -> float:
     dr, dy, du = leg_frame(params.theta[i]).T @ d
-    rho = math.hypot(dr, dy)
-    K = (d @ d + params.LA**2 - params.LB**2) / (2.0 * params.LA)
-    if abs(K) > rho * (1.0 + 1e-12):  # beyond round-off of a boundary (double-root) pose
-        dmin, dmax = math.hypot(du, rho - params.LA), math.hypot(du, rho + params.LA)
-        excess = dmin - params.LB if dmin > params.LB else params.LB - dmax
-        raise UnreachableError(i + 1, excess, "m", f"leg {i + 1}: the rod LB cannot span the distance from C_{i + 1} "
-                                                   "to the circle of B")
-    delta = math.acos(max(-1.0, min(1.0, K / max(rho, 1e-300))))  # rho = 0: C on the axis, any alpha
-    return float(wrap_angle(math.atan2(dy, dr) - BRANCHES[branch] * delta))
+    return arm_angle(dr, dy, du, params.LA, params.LB, -BRANCHES[branch], i + 1,
+                     f"leg {i + 1}: the rod LB cannot span the distance from C_{i + 1} to the circle of B")
 
 
 def joint_values(params: HexapodParams, R, P, beta: float,
