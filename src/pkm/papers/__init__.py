@@ -1,0 +1,80 @@
+"""Paper studies: one module per paper, each reproducing its published numbers and figures.
+
+Every study module ``pkm.papers.<name>`` (``<name>`` one of :data:`NAMES`) provides
+
+* ``TITLE``: the paper, in one line;
+* ``reproduce() -> list[Row]``: the published numbers next to ours;
+* ``figures(out_dir) -> list[pathlib.Path]``: the paper's figures redrawn (PNG);
+* optionally ``series(out_dir) -> list[pathlib.Path]``: time series or maps as CSV.
+
+Row ids are a contract (issues name them): keep them stable. ``pkm report`` gathers
+the rows of every paper into ``summary.json`` and a table.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from dataclasses import asdict, dataclass
+from types import ModuleType
+from typing import Any
+
+from pkm.errors import UnknownNameError
+
+NAMES = ("hexapod", "rrr3", "delta", "prs3")
+
+Value = float | int | bool | str | None
+
+
+@dataclass(frozen=True)
+class Row:
+    """One published quantity next to ours.
+
+    Attributes:
+        id: Stable identifier, ``<paper>.<figure or case>.<quantity>``.
+        published: The paper's value (``None`` where the paper gives none, a string
+            for a qualitative claim).
+        computed: Ours, in the same unit.
+        unit: Unit of both values, as the paper prints it (``"deg"``, ``"N"``, ``""``).
+        tolerance: Largest ``|computed - published|`` that counts as a match (numbers),
+            ``None`` where only equality (booleans, strings) or nothing can be checked.
+        source: Where in the paper (``"Fig. 7"``, ``"Table 3"``, ``"sec. 5, case 2"``).
+        note: How ours was computed and, where it differs, why.
+    """
+
+    id: str
+    published: Value
+    computed: Value
+    unit: str
+    tolerance: float | None
+    source: str
+    note: str = ""
+
+    @property
+    def matches(self) -> bool | None:
+        """Whether ours reproduces the published value (``None``: nothing to compare)."""
+        p, c = self.published, self.computed
+        if p is None or c is None:
+            return None
+        if isinstance(p, bool) or isinstance(c, bool) or isinstance(p, str) or isinstance(c, str):
+            return p == c
+        if not (math.isfinite(float(p)) and math.isfinite(float(c))):
+            return False
+        if self.tolerance is None:
+            return None
+        return abs(float(c) - float(p)) <= self.tolerance
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["matches"] = self.matches
+        return d
+
+
+def module(name: str) -> ModuleType:
+    """The study module of paper ``name`` (one of :data:`NAMES`)."""
+    if name not in NAMES:
+        raise UnknownNameError("paper", name, NAMES)
+    return importlib.import_module(f"pkm.papers.{name}")
+
+
+__all__ = ["NAMES", "Row", "module"]
