@@ -1,0 +1,282 @@
+"""Inverse dynamics of closed-loop mechanisms by Khalil's projection, and its independent checks.
+
+The mechanism is cut at its closures into *legs* and a *platform* (Khalil & Ibrahim 2007):
+
+* the **platform** is the subtree of the Pinocchio model that carries the end-effector
+  frame (a free joint, or the massless guide joints of a Delta); its joint velocity
+  ``v_p`` (``n_p`` coordinates) is the platform's motion;
+* a **leg** is a subtree hanging from the base whose tip frames meet platform frames
+  through closures; legs that share a joint are merged into one.
+
+With the constraint Jacobian rows of leg ``k`` written ``J_k qd_k = P_k v_p`` (leg tip
+velocity = velocity of the platform point it meets), an SVD of the leg's own Jacobian
+``J_k = U S V^T`` splits them into
+
+* the leg's inverse kinematics of velocity, ``qd_k = L_k v_p``, ``L_k = V S^-1 U_r^T P_k``
+  (undefined when the leg loses rank: an inverse singularity of that leg);
+* the motions of the platform the leg forbids, ``K_k v_p = 0``, ``K_k = U_n^T P_k``
+  (the leg's constraint wrenches).
+
+Stacking the actuated rows of the ``L_k`` (``A``) and the ``K_k`` gives the square
+``M = [A; K]``; ``J_k = M^-1 [I; 0]`` maps actuated rates to the platform motion
+(undefined where ``M`` loses rank: a direct singularity). Then
+
+    ``tau = h_a + J_k^T (f_p + sum_k L_{k,p}^T h_{k,p} - P_e^T w)``        (paper eq. 38)
+
+where ``h`` is the tree's inverse dynamics (``pin.rnea``: each leg is its own serial chain,
+so this is the recursive Newton-Euler of every leg, and the platform's free joint gives its
+Newton-Euler wrench ``f_p``), ``h_a``/``h_{k,p}`` its actuated/passive leg entries, ``L_{k,p}``
+the passive rows of ``L_k`` (the paper's ``G_2``) and ``w`` an external wrench on the
+platform (world-aligned, at the end-effector frame: force then moment) of Jacobian ``P_e``.
+
+Independent routes, used by the tests: :func:`virtual_work_dynamics` (``G^T h`` with the
+core's passive map ``G = dq/dq_a``), :func:`forward_dynamics` (Pinocchio's
+``constraintDynamics``: the forces must give back the accelerations) and :func:`energy`
+(power balance).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core import constraints
+from pkm.core.differential import passive_map
+from pkm.core.mechanism import Mechanism, as_vector
+from pkm.errors import PkmError, SingularityError, SpecError
+
+RTOL = 1e-9
+
+
+@dataclass(frozen=True)
+class Leg:
+    """One leg of the cut mechanism.
+
+    Attributes:
+        closures: Names of the closures at the leg's tips.
+        rows: Their rows in the constraint Jacobian.
+        v: Velocity indices of the leg's joints (tree order).
+        actuated: Positions in ``v`` of the actuated joints.
+        actuated_index: Their positions in ``mech.actuated`` (the order of ``tau``).
+    """
+
+    closures: tuple[str, ...]
+    rows: np.ndarray
+    v: np.ndarray
+    actuated: np.ndarray
+    actuated_index: np.ndarray
+
+    @property
+    def passive(self) -> np.ndarray:
+        """Positions in ``v`` of the passive joints."""
+        return np.setdiff1d(np.arange(len(self.v)), self.actuated)
+
+
+@dataclass(frozen=True)
+class Partition:
+    """The platform's velocity indices and the legs."""
+
+    platform_v: np.ndarray
+    legs: tuple[Leg, ...]
+
+
+def _support_v(model: pin.Model, joint_id: int) -> set[int]:
+    out: set[int] = set()
+    for j in model.supports[joint_id]:
+        if j > 0:
+            jm = model.joints[j]
+            out.update(range(jm.idx_v, jm.idx_v + jm.nv))
+    return out
+
+
+def partition(mech: Mechanism) -> Partition:
+    """Cut ``mech`` into platform and legs (see the module doc).
+
+    Raises:
+        SpecError: The structure does not fit the projection: a closure that does not join a
+            leg to the platform, an actuated joint on the platform side, a joint that belongs to
+            no leg, or mimic joints (not supported).
+    """
+    model = mech.model
+    src = mech.source
+    if _has_mimic(model):
+        raise SpecError(src, "the Khalil projection does not support mimic joints yet")
+    plat = _support_v(model, model.frames[mech.ee_frame].parentJoint)
+    if not plat:
+        raise SpecError(src, f"end effector {mech.spec.end_effector!r} is fixed to the base: no platform to cut")
+    act = {int(v): k for k, v in enumerate(mech.act_v)}
+    if plat & set(act):
+        raise SpecError(src, "an actuated joint drives the platform directly: the projection expects actuated "
+                             "joints in the legs")
+    groups: list[tuple[list[str], list[int], set[int]]] = []
+    row = 0
+    for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
+        n = 3 if c.type == "point" else 6
+        sa, sb = (_support_v(model, model.frames[f].parentJoint) for f in (fa, fb))
+        leg = sa - plat if sb <= plat and not sa <= plat else sb - plat if sa <= plat and not sb <= plat else None
+        if not leg or (sa & sb) - plat:
+            raise SpecError(src, f"closure {c.name!r} does not join a leg to the platform: the projection needs "
+                                 "every closure between a leg tip and the platform")
+        rows = list(range(row, row + n))
+        row += n
+        merged = [g for g in groups if g[2] & leg]
+        for g in merged:
+            groups.remove(g)
+            rows = g[1] + rows
+            leg = leg | g[2]
+        groups.append(([n for g in merged for n in g[0]] + [c.name], rows, leg))
+    covered = plat.union(*(g[2] for g in groups))
+    if len(covered) != model.nv:
+        raise SpecError(src, f"joints with velocity indices {sorted(set(range(model.nv)) - covered)} belong to "
+                             "neither the platform nor a leg")
+    legs = []
+    for names, rows, vs in groups:
+        v = np.array(sorted(vs))
+        a = [i for i, vi in enumerate(v) if int(vi) in act]
+        legs.append(Leg(tuple(names), np.array(sorted(rows)), v, np.array(a, dtype=int),
+                        np.array([act[int(v[i])] for i in a], dtype=int)))
+    return Partition(np.array(sorted(plat)), tuple(legs))
+
+
+@dataclass(frozen=True)
+class Projection:
+    """The projection matrices at one configuration.
+
+    Attributes:
+        Jk: Platform joint velocity from actuated rates (``n_p x n_a``).
+        L: Per leg, its joint rates from the platform velocity (``n_k x n_p``).
+        sigma_leg: Per leg, the smallest singular value of its Jacobian (inverse singularity measure).
+        sigma_direct: Smallest singular value of ``M = [A; K]`` (direct singularity measure).
+    """
+
+    Jk: np.ndarray
+    L: tuple[np.ndarray, ...]
+    sigma_leg: tuple[float, ...]
+    sigma_direct: float
+
+
+class KhalilProjection:
+    """Actuator efforts of a closed-loop mechanism by Khalil's projection (module doc).
+
+    Args:
+        mech: The mechanism; its platform and legs are found by :func:`partition`.
+        rtol: Relative singular-value threshold for the rank decisions.
+    """
+
+    def __init__(self, mech: Mechanism, *, rtol: float = RTOL):
+        self.mech = mech
+        self.partition = partition(mech)
+        self.rtol = rtol
+
+    def projection(self, q) -> Projection:
+        """``J_k`` and the legs' velocity maps at ``q`` (assembled).
+
+        Raises:
+            SingularityError: ``"inverse"`` where a leg's Jacobian loses rank (leg named in the
+                message), ``"direct"`` where ``M`` does.
+        """
+        mech, part = self.mech, self.partition
+        q = mech.check_q(q)
+        Jc = constraints.jacobian(mech, q)
+        na, n_p = mech.na, len(part.platform_v)
+        A = np.zeros((na, n_p))
+        K, Ls, sig = [], [], []
+        for leg in part.legs:
+            Jl = Jc[np.ix_(leg.rows, leg.v)]
+            P = -Jc[np.ix_(leg.rows, part.platform_v)]
+            U, s, Vt = np.linalg.svd(Jl)
+            r = len(leg.v)
+            sig.append(float(s[r - 1]) if len(s) >= r else 0.0)
+            if len(s) < r or s[r - 1] <= self.rtol * max(float(s[0]), 1.0):
+                raise SingularityError("inverse", sig[-1], f"leg of closures {', '.join(leg.closures)} loses rank: "
+                                                           "its joint rates are not fixed by the platform motion")
+            L = Vt.T @ ((U[:, :r].T @ P) / s[:r, None])
+            Ls.append(L)
+            K.append(U[:, r:].T @ P)
+            A[leg.actuated_index] = L[leg.actuated]
+        M = np.vstack([A, *K])
+        sv = np.linalg.svd(M, compute_uv=False)
+        smin = float(sv[n_p - 1]) if len(sv) >= n_p else 0.0
+        if smin <= self.rtol * max(float(sv[0]), 1.0):
+            raise SingularityError("direct", smin, "the actuated legs do not fix the platform motion")
+        rhs = np.zeros((M.shape[0], na))
+        rhs[:na] = np.eye(na)
+        Jk = np.linalg.lstsq(M, rhs, rcond=None)[0]
+        return Projection(Jk, tuple(Ls), tuple(sig), smin)
+
+    def inverse_dynamics(self, q, v, a, wrench=None) -> np.ndarray:
+        """Actuator efforts (N or N m, in ``mech.actuated`` order) for a consistent state.
+
+        Args:
+            q: Assembled configuration (nq,).
+            v: Joint velocities satisfying the closures (nv,).
+            a: Joint accelerations satisfying the closures (nv,).
+            wrench: Optional external wrench on the platform at the end-effector frame,
+                world-aligned ``(f [N], m [N m])``, shape (6,).
+        """
+        mech, part = self.mech, self.partition
+        q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
+        proj = self.projection(q)  # leaves the frame Jacobians of q in mech.data
+        Pe = None if wrench is None else pin.getFrameJacobian(
+            mech.model, mech.data, mech.ee_frame, pin.LOCAL_WORLD_ALIGNED)[:, part.platform_v]
+        h = pin.rnea(mech.model, mech.data, q, v, a)
+        f = h[part.platform_v].copy()
+        if Pe is not None:
+            f -= Pe.T @ as_vector(wrench, 6, "wrench")
+        tau = np.zeros(mech.na)
+        for leg, L in zip(part.legs, proj.L):
+            hk = h[leg.v]
+            tau[leg.actuated_index] = hk[leg.actuated]
+            p = leg.passive
+            f += L[p].T @ hk[p]
+        return tau + proj.Jk.T @ f
+
+
+def _has_mimic(model: pin.Model) -> bool:
+    return any(jm.shortname() == "JointModelMimic" for jm in model.joints)
+
+
+def inverse_dynamics(mech: Mechanism, q, v, a, wrench=None) -> np.ndarray:
+    """Actuator efforts by Khalil's projection (see :class:`KhalilProjection`)."""
+    return KhalilProjection(mech).inverse_dynamics(q, v, a, wrench)
+
+
+def virtual_work_dynamics(mech: Mechanism, q, v, a) -> np.ndarray:
+    """Actuator efforts as ``G^T rnea(q, v, a)``, ``G = dq/dq_a``: the whole-tree virtual-work route."""
+    q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
+    return passive_map(mech, q).T @ pin.rnea(mech.model, mech.data, q, v, a)
+
+
+def forward_dynamics(mech: Mechanism, q, v, tau_actuated, *, mu: float = 0.0) -> np.ndarray:
+    """Joint accelerations under actuator efforts, by Pinocchio's ``constraintDynamics``.
+
+    The closures are enforced at the acceleration level with no Baumgarte correction
+    (the state must be assembled and consistent).
+
+    Raises:
+        PkmError: The model has mimic joints (Pinocchio 4.1's ``constraintDynamics`` does not
+            handle them).
+    """
+    q, v = mech.check_q(q), mech.check_v(v)
+    tau_a = mech.check_actuated(tau_actuated, "tau_actuated")
+    if _has_mimic(mech.model):
+        raise PkmError("constraintDynamics does not support mimic joints on Pinocchio 4.1")
+    tau = np.zeros(mech.nv)
+    tau[mech.act_v] = tau_a
+    pin.initConstraintDynamics(mech.model, mech.data, mech.constraint_models, mech.constraint_datas)
+    settings = pin.ProximalSettings(1e-14, mu, 10)
+    return pin.constraintDynamics(mech.model, mech.data, q, v, tau, mech.constraint_models, mech.constraint_datas,
+                                  settings).copy()
+
+
+def energy(mech: Mechanism, q, v) -> tuple[float, float]:
+    """Kinetic [J] and potential [J] energy of every body (gravity ``mech.model.gravity``)."""
+    q, v = mech.check_q(q), mech.check_v(v)
+    return (float(pin.computeKineticEnergy(mech.model, mech.data, q, v)),
+            float(pin.computePotentialEnergy(mech.model, mech.data, q)))
+
+
+__all__ = ["KhalilProjection", "Leg", "Partition", "Projection", "energy", "forward_dynamics", "inverse_dynamics",
+           "partition", "virtual_work_dynamics"]

@@ -1,0 +1,148 @@
+"""Motions in task coordinates, described in data files: position, velocity and acceleration in closed form.
+
+A motion file (format ``pkm.motion/1``, TOML) names the coordinates and, per case, a duration, a
+sampling step and one law per coordinate::
+
+    format = "pkm.motion/1"
+    mechanism = "prs3"
+    coordinates = ["z", "beta", "phi"]
+
+    [case.2]
+    description = "harmonic vertical motion"
+    source = "sec. 5, eqs. (41)-(43)"
+    duration = 5.0
+    dt = 0.01
+    z = { law = "cosine", offset = 0.81, amplitude = 0.005, omega = 1.0471975511965976 }
+    beta = { law = "constant", value = 0.0 }
+    phi = { law = "constant", value = 0.0 }
+
+Laws, with ``t`` in seconds: ``constant`` (``value``), ``linear`` (``start + rate t``) and
+``cosine`` (``offset + amplitude (1 - cos(omega t))``). Their derivatives are exact.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pkm.data import dynamics_path
+from pkm.errors import InvalidInputError, SpecError
+
+FORMAT = "pkm.motion/1"
+LAWS = {"constant": ("value",), "linear": ("start", "rate"), "cosine": ("offset", "amplitude", "omega")}
+
+
+@dataclass(frozen=True)
+class Law:
+    """One coordinate's law of motion: ``kind`` (a key of :data:`LAWS`) and its coefficients (SI)."""
+
+    kind: str
+    coef: tuple[float, ...]
+
+    def __call__(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, velocity and acceleration at times ``t`` [s]."""
+        t = np.asarray(t, dtype=float)
+        z = np.zeros_like(t)
+        if self.kind == "constant":
+            return z + self.coef[0], z, z
+        if self.kind == "linear":
+            start, rate = self.coef
+            return start + rate * t, z + rate, z
+        off, amp, om = self.coef
+        c, s = np.cos(om * t), np.sin(om * t)
+        return off + amp * (1.0 - c), amp * om * s, amp * om * om * c
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A motion case: laws per coordinate over ``[0, duration]``, sampled every ``dt``.
+
+    Attributes:
+        name: The case's name in its file.
+        coordinates: Coordinate names, in task order.
+        laws: One :class:`Law` per coordinate.
+        duration: [s].
+        dt: Sampling step [s].
+        description: What the motion is.
+        source: Where it comes from.
+    """
+
+    name: str
+    coordinates: tuple[str, ...]
+    laws: tuple[Law, ...]
+    duration: float
+    dt: float
+    description: str = ""
+    source: str = ""
+
+    def times(self) -> np.ndarray:
+        """Sample times ``0, dt, ..., duration`` [s]."""
+        n = int(round(self.duration / self.dt))
+        return np.arange(n + 1) * self.dt
+
+    def sample(self, t=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(t, Y, Yd, Ydd)``: times (N,) and positions, velocities, accelerations (N, n)."""
+        t = self.times() if t is None else np.atleast_1d(np.asarray(t, dtype=float))
+        if t.ndim != 1 or not np.all(np.isfinite(t)):
+            raise InvalidInputError("t", f"expected finite times of shape (N,), got shape {t.shape}")
+        parts = [law(t) for law in self.laws]
+        return t, *(np.column_stack([p[k] for p in parts]) for k in range(3))
+
+
+def load_motions(file: str | Path) -> dict[str, Motion]:
+    """Every case of a motion file; a bare name is looked up in the shipped ``dynamics/`` data.
+
+    Raises:
+        SpecError: The file is missing, not TOML, of another format, or a case is malformed.
+    """
+    path = Path(file) if Path(file).parent != Path(".") or Path(file).exists() else dynamics_path(str(file))
+    src = str(path)
+    try:
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise SpecError(src, f"cannot read the motion file: {exc.strerror}") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise SpecError(src, f"not valid TOML: {exc}") from None
+    if raw.get("format") != FORMAT:
+        raise SpecError(src, f"format {raw.get('format')!r}; this pkm reads {FORMAT!r}")
+    coords = raw.get("coordinates")
+    if not (isinstance(coords, list) and coords and all(isinstance(c, str) for c in coords)):
+        raise SpecError(src, "'coordinates' must be a non-empty list of names")
+    cases = raw.get("case")
+    if not isinstance(cases, dict) or not cases:
+        raise SpecError(src, "no [case.NAME] tables")
+    return {name: _motion(src, name, body, tuple(coords)) for name, body in cases.items()}
+
+
+def _number(src: str, where: str, v) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise SpecError(src, f"{where} must be a finite number, got {v!r}")
+    return float(v)
+
+
+def _motion(src: str, name: str, body, coords: tuple[str, ...]) -> Motion:
+    if not isinstance(body, dict):
+        raise SpecError(src, f"case {name!r} must be a table")
+    duration = _number(src, f"case {name!r} duration", body.get("duration"))
+    dt = _number(src, f"case {name!r} dt", body.get("dt"))
+    if not (0.0 < dt <= duration <= 1e6):
+        raise SpecError(src, f"case {name!r}: need 0 < dt <= duration <= 1e6 s, got dt={dt}, duration={duration}")
+    laws = []
+    for c in coords:
+        spec = body.get(c)
+        if not isinstance(spec, dict) or spec.get("law") not in LAWS:
+            raise SpecError(src, f"case {name!r}: coordinate {c!r} needs a law, one of {sorted(LAWS)}")
+        keys = LAWS[spec["law"]]
+        extra = set(spec) - {"law", *keys}
+        if extra:
+            raise SpecError(src, f"case {name!r}: coordinate {c!r} ({spec['law']}) has unknown keys {sorted(extra)}")
+        laws.append(Law(spec["law"], tuple(_number(src, f"case {name!r} {c}.{k}", spec.get(k)) for k in keys)))
+    return Motion(name, coords, tuple(laws), duration, dt, str(body.get("description", "")),
+                  str(body.get("source", "")))
+
+
+__all__ = ["FORMAT", "LAWS", "Law", "Motion", "load_motions"]
