@@ -27,3 +27,12 @@ def test_qualitative_rows_compare_by_equality_and_serialise():
 def test_unknown_paper_names_are_refused():
     with pytest.raises(UnknownNameError):
         papers.module("stewart")
+
+
+def test_bounds_compare_in_their_direction():
+    """A published bound or baseline: "<=" matches at or under it, ">=" at or over it."""
+    assert papers.Row("x", 860, 333, "", None, "sec. 4", relation="<=").matches is True
+    assert papers.Row("x", 0.1, 0.2, "", None, "sec. 5", relation="<=").matches is False
+    assert papers.Row("x", 0.0, 0.5, "", None, "Fig. 9", relation=">=").matches is True
+    with pytest.raises(Exception):
+        papers.Row("x", 1, 1, "", None, "", relation="~")

@@ -347,6 +347,8 @@ BOUNDARY = ("in: z_p, beta, phi and their first and second time derivatives (9 n
             "position, velocity and acceleration, leg recursive Newton-Euler with gravity, platform Newton-Euler, "
             "Khalil's projection (passive efforts and J_k^T by elimination). No external wrench.")
 MODES = ("symbolic", "inertial", "numeric")
+_ZERO6 = np.zeros(6)
+_HALF_PI = math.pi / 2
 
 
 def twin(params: Prs3Params | None = None, *, mode: str = "numeric", outputs: str = "tau", wrench: bool = False,
@@ -471,10 +473,21 @@ class Prs3Dynamics:
 
     @functools.cached_property
     def _function(self):
-        return twin(self.params, mode="numeric", outputs="all", wrench=True, branch=self.branch)
+        """The twin with one packed input ``(y, yd, ydd, wrench)`` (15) and one packed output
+        ``(tau, qa, qa_d, radicand, sigma, pivots)`` (21), evaluated in place on numpy buffers
+        (CasADi's ``Function.buffer``: no conversion per call; one object per thread)."""
+        ca, _ = _casadi()
+        f = twin(self.params, mode="numeric", outputs="all", wrench=True, branch=self.branch)
+        x = ca.SX.sym("x", 15)
+        packed = ca.Function("prs3_id_packed", [x], [ca.vertcat(*f(x[0:3], x[3:6], x[6:9], x[9:15]))])
+        buf, run = packed.buffer()
+        arg, res = np.zeros(15), np.zeros(21)
+        buf.set_arg(0, memoryview(arg))
+        buf.set_res(0, memoryview(res))
+        return packed, buf, run, arg, res
 
     def forces(self, y, yd, ydd, wrench=None) -> np.ndarray:
-        """Actuator efforts (3,) for one sample, through the twin's compiled expression graph.
+        """Actuator efforts (3,) for one sample, through the twin's expression graph.
 
         Args:
             y: ``(z_p [m], beta [rad], phi [rad])``.
@@ -488,17 +501,30 @@ class Prs3Dynamics:
             UnreachableError: A leg cannot reach (which, and by how much).
             SingularityError: An inverse (leg) or direct singularity at this configuration.
         """
-        y, yd, ydd, w = self._sample(y, yd, ydd, wrench)
-        tau, _, _, checks = self._function(y, yd, ydd, w)
-        self._check(np.asarray(checks).reshape(1, -1), None)
-        return np.asarray(tau).ravel()
+        return self._evaluate(y, yd, ydd, wrench)[0:3]
 
     def evaluate(self, y, yd, ydd, wrench=None) -> DynamicsResult:
         """Efforts, actuated coordinates and rates for one sample (see :meth:`forces`)."""
-        y, yd, ydd, w = self._sample(y, yd, ydd, wrench)
-        tau, qa, qad, checks = self._function(y, yd, ydd, w)
-        self._check(np.asarray(checks).reshape(1, -1), None)
-        return DynamicsResult(np.asarray(tau).ravel(), np.asarray(qa).ravel(), np.asarray(qad).ravel())
+        r = self._evaluate(y, yd, ydd, wrench)
+        return DynamicsResult(r[0:3], r[3:6], r[6:9])
+
+    def _evaluate(self, y, yd, ydd, wrench) -> np.ndarray:
+        try:
+            x = np.concatenate((y, yd, ydd, _ZERO6 if wrench is None else wrench), dtype=float)
+            ok = x.shape == (15,) and abs(x[1]) < _HALF_PI and np.isfinite(x).all()
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:  # the slow path names what is wrong
+            x = np.concatenate(self._sample(y, yd, ydd, wrench))
+        _, _, run, arg, res = self._function
+        arg[:] = x
+        run()
+        r = res.copy()
+        c = r[9:]
+        if not (c[0:3].min() >= 0.0 and np.abs(c[3:6]).min() > SIGMA_TOL * self.params.l
+                and np.abs(c[6:12]).min() > PIVOT_TOL * max(1.0, self.params.h)):
+            self._check(c.reshape(1, -1), None)
+        return r
 
     def batch(self, Y, Yd, Ydd, wrench=None, *, t=None, chunk: int = 16384) -> DynamicsResult:
         """Efforts along N samples at once (vectorised numpy, the same algorithm as the twin).

@@ -19,9 +19,10 @@ from dataclasses import asdict, dataclass
 from types import ModuleType
 from typing import Any
 
-from pkm.errors import UnknownNameError
+from pkm.errors import InvalidInputError, UnknownNameError
 
 NAMES = ("hexapod", "rrr3", "delta", "prs3")
+RELATIONS = ("==", "<=", ">=")
 
 Value = float | int | bool | str | None
 
@@ -40,6 +41,8 @@ class Row:
             ``None`` where only equality (booleans, strings) or nothing can be checked.
         source: Where in the paper (``"Fig. 7"``, ``"Table 3"``, ``"sec. 5, case 2"``).
         note: How ours was computed and, where it differs, why.
+        relation: How ours must relate to the published value: ``"=="`` (within ``tolerance``),
+            ``"<="`` or ``">="`` (a published bound or a baseline to beat).
     """
 
     id: str
@@ -49,6 +52,11 @@ class Row:
     tolerance: float | None
     source: str
     note: str = ""
+    relation: str = "=="
+
+    def __post_init__(self):
+        if self.relation not in RELATIONS:
+            raise InvalidInputError("relation", f"use one of {RELATIONS}", self.relation)
 
     @property
     def matches(self) -> bool | None:
@@ -60,6 +68,10 @@ class Row:
             return p == c
         if not (math.isfinite(float(p)) and math.isfinite(float(c))):
             return False
+        if self.relation == "<=":
+            return float(c) <= float(p) + (self.tolerance or 0.0)
+        if self.relation == ">=":
+            return float(c) >= float(p) - (self.tolerance or 0.0)
         if self.tolerance is None:
             return None
         return abs(float(c) - float(p)) <= self.tolerance
