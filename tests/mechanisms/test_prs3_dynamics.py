@@ -167,3 +167,53 @@ def test_malformed_trajectories_are_rejected(bad):
 def test_pitch_beyond_the_euler_range_is_rejected():
     with pytest.raises(InvalidInputError):
         PD.Prs3Dynamics().forces([0.81, math.pi / 2, 0.0], [0, 0, 0], [0, 0, 0])
+
+
+def _ik_difference(params, y, h):
+    return np.column_stack([(prs3.closed_form_ik(params, y + e) - prs3.closed_form_ik(params, y - e)) / (2 * h)
+                            for e in h * np.eye(3)])
+
+
+def test_jacobian_equals_differences_of_the_ik_and_the_generic_core(dyn):
+    """J = dq_a/dy: Richardson differences of the closed-form IK (1e-7 rel.) and the core's inverse
+    Jacobian (1e-9) agree, beta = phi = 0 included."""
+    import pkm
+    from tests.fd import rel, richardson
+    for y in (np.array(dyn.params.reference), np.array(dyn.params.reference) + [0.02, 0.1, -0.07]):
+        J = dyn.jacobian(y)
+        assert rel(J, richardson(lambda h: _ik_difference(dyn.params, y, h), 1e-4)) < 1e-7
+        q = prs3.configuration(dyn.mechanism, y)
+        assert rel(J, pkm.inverse_jacobian(dyn.mechanism, q)) < 1e-9
+
+
+def test_actuated_accelerations_are_the_derivatives_of_the_rates():
+    """q_a'' from the closed form = Richardson differences of q_a' along case 4's motion (1e-8 rel.)."""
+    from tests.fd import rel, richardson
+    m = load_motions("prs3_motions.toml")["4"]
+    dyn = PD.Prs3Dynamics()
+    t = np.array([0.5, 2.0, 3.3])
+
+    def rates(tt):
+        return dyn.batch(*m.sample(tt)[1:]).qd_actuated
+
+    fd = richardson(lambda h: (rates(t + h) - rates(t - h)) / (2 * h), 1e-3)
+    assert rel(dyn.batch(*m.sample(t)[1:]).qdd_actuated, fd) < 1e-8
+
+
+def test_the_papers_eq26_cannot_be_evaluated_where_the_trajectories_start():
+    """At beta = phi = 0, J_r2 of eq. (25) has rank 1 (eq. 26 inverts it); ours is regular there."""
+    p = prs3.Prs3Params()
+    Jr1, Jr2 = prs3.paper_constraint_jacobians(p, [0.81, 0.0, 0.0])
+    assert np.linalg.matrix_rank(Jr2, tol=1e-12) == 1 and np.linalg.matrix_rank(Jr1) == 2
+    assert np.linalg.matrix_rank(prs3.paper_constraint_jacobians(p, [0.81, 0.2, -0.1])[1]) == 3
+    assert np.linalg.cond(PD.Prs3Dynamics(p).homogeneous_jacobian([0.81, 0.0, 0.0])) < 10
+
+
+def test_homogeneous_jacobian_does_not_depend_on_the_unit_of_length():
+    """Scaling every length by 1000 (m -> mm) leaves the homogeneous Jacobian unchanged."""
+    p = prs3.Prs3Params(gamma=1.2, actuation="R")
+    mm = prs3.Prs3Params(gamma=1.2, actuation="R", l=1000 * p.l, h=1000 * p.h, g=1000 * p.g,
+                         reference=(1000 * p.reference[0], 0.0, 0.0))
+    y = np.array([0.8, 0.05, -0.1])
+    J, Jmm = (PD.Prs3Dynamics(x).homogeneous_jacobian(y * [s, 1, 1]) for x, s in ((p, 1), (mm, 1000)))
+    assert np.allclose(J, Jmm, rtol=1e-9)

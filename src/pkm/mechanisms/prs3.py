@@ -256,6 +256,22 @@ def paper_parasitic_motion(h: float, pitch: float, roll: float) -> tuple[float, 
     return -h * sa * cb, -0.5 * h * (ca * cb - sa * sb * sf - ca * cf), alpha
 
 
+def paper_constraint_jacobians(params: Prs3Params, y) -> tuple[np.ndarray, np.ndarray]:
+    """``J_r1``, ``J_r2`` of eq. (25), ``J_r1 v_p = J_r2 omega_p`` (the leg-plane velocity conditions).
+
+    Row ``i`` is eq. (24) for leg ``i``: ``e_t,i . v_p + (r_i x e_t,i) . omega_p = 0``, with ``e_t,i``
+    the knee axis (third row of ``^{i,2}R_o``) and ``r_i = R b_i``. The paper solves it as
+    ``omega_p = J_r2^-1 J_r1 v_p`` (eq. 26); at ``beta = phi = 0`` every ``r_i x e_t,i`` is ``h e_z``,
+    so ``J_r2`` has rank 1 and eq. (26) cannot be evaluated where the sec. 5 trajectories start.
+    :class:`pkm.mechanisms.prs3_dynamics.Prs3Dynamics` takes ``(z_p, beta, phi)`` as independent
+    instead (its ``jacobian``).
+    """
+    p, R = platform_pose(params, y)
+    _, _, _, et, b = _legs(params)
+    r = b @ R.T
+    return et.copy(), -np.cross(r, et)
+
+
 def platform_pose(params: Prs3Params, y) -> tuple[np.ndarray, np.ndarray]:
     """Platform position ``p`` [m] and rotation ``R`` for task vector ``y = (z_p, beta, phi)``."""
     z, pitch, roll = _task_vector(y, "y")

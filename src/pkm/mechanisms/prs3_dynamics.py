@@ -162,7 +162,8 @@ def algorithm(y, yd, ydd, wrench, P: dict, X, *, actuation: str = "P", signs=(1,
         signs: Per leg, +1 for ``slider_below``, -1 for ``slider_above``.
 
     Returns:
-        ``tau`` (3 actuator efforts), ``qa``/``qa_d`` (actuated coordinates and rates), the
+        ``tau`` (3 actuator efforts), ``qa``/``qa_d``/``qa_dd`` (actuated coordinates, rates and
+        accelerations), the
         singularity measures ``sigma`` (``l sin theta_i`` per leg), ``radicand`` (per leg) and
         ``pivots`` (of the 6x6 elimination, with their column scales).
     """
@@ -216,7 +217,7 @@ def algorithm(y, yd, ydd, wrench, P: dict, X, *, actuation: str = "P", signs=(1,
         M = [_sub(M[j], wrench[3 + j]) for j in range(3)]
 
     # 3-4. legs: kinematics, recursive Newton-Euler, passive efforts as forces at B_i
-    cols_c, cols_a, tau_leg, qa, qa_d, sigmas, rads = [], [], [], [], [], [], []
+    cols_c, cols_a, tau_leg, qa, qa_d, qa_dd, sigmas, rads = [], [], [], [], [], [], [], []
     aSw = _mul(G, P["cg"])  # gravity as base acceleration, w component (constant)
     for i in range(3):
         er, et, u1, w = _leg_axes(i, P)
@@ -250,12 +251,14 @@ def algorithm(y, yd, ydd, wrench, P: dict, X, *, actuation: str = "P", signs=(1,
             tau_leg.append(hd)
             qa.append(cu - sigma)
             qa_d.append(dd)
+            qa_dd.append(ddd)
         else:
             act_dir = w                                                     # dtheta = -(w . dB) / sigma
             fpass = tuple(_mul(hd, _add(u1[j], _mul(cw * inv_sigma, w[j]))) for j in range(3))
             tau_leg.append(ht)
             qa.append(X.atan2(sigma, cw))
             qa_d.append(td)
+            qa_dd.append(tdd)
         for j, m in enumerate(_cross(r, fpass)):
             F[j] = _add(F[j], fpass[j])
             M[j] = _add(M[j], m)
@@ -275,7 +278,8 @@ def algorithm(y, yd, ydd, wrench, P: dict, X, *, actuation: str = "P", signs=(1,
         tau = [tau_leg[i] + f[i] for i in range(3)]
     else:
         tau = [tau_leg[i] - sigmas[i] * f[i] for i in range(3)]
-    return {"tau": tau, "qa": qa, "qa_d": qa_d, "sigma": sigmas, "radicand": rads, "pivots": pivots}
+    return {"tau": tau, "qa": qa, "qa_d": qa_d, "qa_dd": qa_dd, "sigma": sigmas, "radicand": rads,
+            "pivots": pivots}
 
 
 def _solve_last3(A, b):
@@ -440,12 +444,14 @@ class DynamicsResult:
         tau: Efforts [N] (sliders) or [N m] (knees).
         q_actuated: Actuated coordinates ``d_i`` [m] or ``theta_i`` [rad].
         qd_actuated: Their rates [m/s] or [rad/s].
+        qdd_actuated: Their accelerations [m/s^2] or [rad/s^2] (batch results only, else None).
         power: ``tau * qd_actuated`` [W].
     """
 
     tau: np.ndarray
     q_actuated: np.ndarray
     qd_actuated: np.ndarray
+    qdd_actuated: np.ndarray | None = None
 
     @property
     def power(self) -> np.ndarray:
@@ -556,7 +562,7 @@ class Prs3Dynamics:
         if len(bad):
             raise InvalidInputError("Y", f"{_where(bad[0], t)}: pitch beta = {Y[bad[0], 1]!r} rad; Z-Y-X angles "
                                          "need |beta| < pi/2", Y[bad[0]])
-        tau, qa, qad = (np.empty((N, 3)) for _ in range(3))
+        tau, qa, qad, qadd = (np.empty((N, 3)) for _ in range(4))
         with np.errstate(invalid="ignore", divide="ignore"):
             for s in range(0, N, chunk):
                 sl = slice(s, s + chunk)
@@ -565,8 +571,28 @@ class Prs3Dynamics:
                 n = len(Y[sl])
                 checks = _columns([*out["radicand"], *out["sigma"], *out["pivots"]], n)
                 self._check(checks, None if t is None else t[sl], offset=s)
-                tau[sl], qa[sl], qad[sl] = (_columns(out[k], n) for k in ("tau", "qa", "qa_d"))
-        return DynamicsResult(tau, qa, qad)
+                tau[sl], qa[sl], qad[sl], qadd[sl] = (_columns(out[k], n) for k in ("tau", "qa", "qa_d", "qa_dd"))
+        return DynamicsResult(tau, qa, qad, qadd)
+
+    def jacobian(self, y) -> np.ndarray:
+        """``J = d q_a / d y`` (3x3) at ``y = (z_p, beta, phi)``: ``qd_a = J yd`` (closed form).
+
+        Column ``k`` is the actuated rate for ``yd = e_k``; it is defined wherever the Euler angles
+        are and no leg is singular, ``beta = phi = 0`` included (see the module doc on eq. 26).
+        """
+        y = self._sample(y, np.zeros(3), np.zeros(3), None)[0]
+        return self.batch(np.tile(y, (3, 1)), np.eye(3), np.zeros((3, 3))).qd_actuated.T
+
+    def homogeneous_jacobian(self, y) -> np.ndarray:
+        """The Jacobian in dimensionally homogeneous form, its characteristic lengths explicit.
+
+        Inputs ``(zd_p, h beta_d, h phi_d)`` (m/s: the platform radius ``h`` turns rates of
+        rotation into speeds of the spherical joints), outputs ``dd_i`` (m/s, P-actuated) or
+        ``l theta_d_i`` (m/s, R-actuated: the coupler length ``l``). Its condition number does not
+        depend on the unit of length.
+        """
+        J = self.jacobian(y) / np.array([1.0, self.params.h, self.params.h])
+        return J * self.params.l if self.params.actuation == "R" else J
 
     def pinocchio(self, y, yd, ydd, wrench=None) -> np.ndarray:
         """The reference route: closed-form IK, the generic core's velocities and accelerations,
