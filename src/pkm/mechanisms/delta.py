@@ -23,6 +23,10 @@ Working modes: ``knee_i`` is the angle from the arm to the forearm's projection 
 arm's plane; it is 0 or pi when the inverse problem has a double root. ``knee_out`` (the
 usual Delta, default) has ``knee_i < 0``; ``knee_in`` has ``knee_i > 0``.
 
+Velocities: ``J = dX/dth`` (eq. 12) in closed form from the sphere equations
+(:func:`jacobian`, :func:`jacobian_factors`). Grids of poses: :mod:`pkm.mechanisms.delta_workspace`;
+the choice of R: :mod:`pkm.mechanisms.delta_design`.
+
 Masses are not given by the paper; the defaults are illustrative (a light robot
 of this size) and only matter for dynamics.
 """
@@ -37,9 +41,8 @@ import numpy as np
 from pkm.core.mechanism import Mechanism, as_vector
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.urdf import UrdfBuilder
-from pkm.errors import AssemblyError, InvalidInputError, InvalidParameterError, UnreachableError
-from pkm.mechanisms._common import (arm_angle, check_positive, make_mechanism, rod_inertia, rot_z,
-                                    spec_parameters)
+from pkm.errors import AssemblyError, InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
+from pkm.mechanisms._common import arm_angle, check_positive, make_mechanism, rod_inertia, rot_z, spec_parameters
 
 NAME = "delta"
 PHI = (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0)
@@ -112,11 +115,19 @@ def inverse_kinematics(params: DeltaParams, p, branch: str | tuple[str, str, str
     branches = (branch,) * 3 if isinstance(branch, str) else tuple(branch)
     if len(branches) != 3 or any(b not in BRANCHES for b in branches):
         raise InvalidInputError("branch", f"use 'knee_out'/'knee_in' or a tuple of three, got {branch!r}", branch)
+    return arm_angles(params.La, params.Lb, params.R - params.r, p, tuple(-BRANCHES[b] for b in branches))
+
+
+def arm_angles(La: float, Lb: float, offset: float, p: np.ndarray, signs: tuple[int, int, int],
+               where: str = "") -> np.ndarray:
+    """The motor angles [rad] of :func:`inverse_kinematics` from raw dimensions [m]:
+    ``offset = R - r``, ``signs[i] = +1`` for knee out, ``-1`` for knee in; ``where`` ends
+    the message of the :class:`UnreachableError` (for example the design studied)."""
     th = np.empty(3)
     for i in range(3):
         x, y, z = _arm_frame_point(p, i)
-        th[i] = arm_angle(y - (params.R - params.r), z, x, params.La, params.Lb, 1 if branches[i] == "knee_out" else -1,
-                          i + 1, f"arm {i + 1}: the forearm cannot span the distance to the elbow circle")
+        th[i] = arm_angle(y - offset, z, x, La, Lb, signs[i], i + 1,
+                          f"arm {i + 1}: the forearm cannot span the distance to the elbow circle{where}")
     return th
 
 
@@ -132,7 +143,9 @@ def forward_kinematics(params: DeltaParams, theta, *, both: bool = False) -> np.
 
     As in the paper, (8c)-(8a) and (8c)-(8b) give x and y as affine functions of z, and (8a)
     becomes a quadratic in z; the root with the lower z (the platform below the base) is
-    returned, or both (lower first) with ``both=True``.
+    returned, or both (lower first) with ``both=True``. The paper keeps "the negative root";
+    with the arms raised both roots can be negative. The two roots are mirror images through the
+    plane of the three sphere centres; the lower one is the platform below that plane.
 
     Raises:
         AssemblyError: when the spheres have no common point (by how much, in m^2 of the
@@ -158,6 +171,66 @@ def forward_kinematics(params: DeltaParams, theta, *, both: bool = False) -> np.
     roots = sorted([(-qb - math.sqrt(disc)) / (2.0 * qa), (-qb + math.sqrt(disc)) / (2.0 * qa)])
     sols = np.array([np.concatenate([b0 + b1 * z, [z]]) for z in roots])
     return sols if both else sols[0]
+
+
+def jacobian_factors(params: DeltaParams, p, theta) -> tuple[np.ndarray, np.ndarray]:
+    """The two factors of the velocity equations ``A Xd = diag(d) thd``, over stacks of poses.
+
+    Differentiating the sphere equations (8), ``f_i = |E + Rz(phi_i)(0, r, 0) - B_i(th_i)|^2 - Lb^2 = 0``,
+    gives ``u_i . Ed = (u_i . dB_i/dth_i) thd_i`` with ``u_i`` the forearm vector from ``B_i`` to the
+    ball joint. So ``A`` has rows ``u_i`` [m] (it loses rank at direct singularities) and
+    ``d_i = u_i . dB_i/dth_i`` [m^2/rad] (it vanishes at inverse singularities, arm and forearm aligned).
+
+    Args:
+        params: The design.
+        p: Platform centres [m], shape (..., 3).
+        theta: Motor angles [rad] assembled with ``p``, shape (..., 3).
+
+    Returns:
+        ``A`` of shape (..., 3, 3) and ``d`` of shape (..., 3).
+    """
+    p, theta = np.asarray(p, dtype=float), np.asarray(theta, dtype=float)
+    c, s = np.cos(theta), np.sin(theta)
+    A = np.empty(p.shape[:-1] + (3, 3))
+    d = np.empty(p.shape[:-1] + (3,))
+    for i in range(3):
+        ci, si = math.cos(PHI[i]), math.sin(PHI[i])
+        # arm frame: forearm vector (x, y, z) and dB/dth = (0, -La s, La c); back to the base by Rz(phi_i)
+        x = ci * p[..., 0] + si * p[..., 1]
+        y = -si * p[..., 0] + ci * p[..., 1] + params.r - params.R - params.La * c[..., i]
+        z = p[..., 2] - params.La * s[..., i]
+        A[..., i, 0], A[..., i, 1], A[..., i, 2] = ci * x - si * y, si * x + ci * y, z
+        d[..., i] = params.La * (z * c[..., i] - y * s[..., i])
+    return A, d
+
+
+def jacobian(params: DeltaParams, theta, p=None) -> np.ndarray:
+    """``J = dX/dth`` [m/rad] (eq. 12), in closed form from the sphere equations: ``J = A^-1 diag(d)``.
+
+    See :func:`jacobian_factors`. The paper differentiates its explicit forward solution; the
+    implicit route gives the same matrix without the long symbolic expressions.
+
+    Args:
+        params: The design.
+        theta: Motor angles [rad], shape (3,).
+        p: The platform centre assembled with ``theta`` [m]; default: :func:`forward_kinematics`
+            (the lower root). Pass the other root for the other assembly.
+
+    Raises:
+        InvalidInputError: if ``p`` is not assembled with ``theta`` (a forearm off its length by > 1e-9 m).
+        SingularityError: ``kind="direct"`` where the forearm vectors are linearly dependent.
+    """
+    theta = as_vector(theta, 3, "theta")
+    p = forward_kinematics(params, theta) if p is None else as_vector(p, 3, "p")
+    A, d = jacobian_factors(params, p, theta)
+    gap = np.abs(np.linalg.norm(A, axis=1) - params.Lb)
+    if gap.max() > 1e-9:
+        k = int(np.argmax(gap))
+        raise InvalidInputError("p", f"not assembled with theta: forearm {k + 1} is off its length by {gap[k]:.3g} m", p)
+    sv = np.linalg.svd(A, compute_uv=False)
+    if sv[-1] <= 1e-12 * params.Lb:
+        raise SingularityError("direct", sv[-1], "forearms linearly dependent: the platform moves with the motors locked")
+    return np.linalg.solve(A, np.diag(d))
 
 
 def joint_values(params: DeltaParams, p, branch: str | tuple[str, str, str] = "knee_out") -> dict[str, list[float]]:
@@ -260,3 +333,8 @@ def build(params: DeltaParams | None = None) -> Mechanism:
     """The Delta as a :class:`~pkm.core.Mechanism` (paper design when ``params`` is None)."""
     params = DeltaParams() if params is None else params
     return make_mechanism(urdf_xml(params), closure_spec(params), params)
+
+
+__all__ = ["BRANCHES", "NAME", "PHI", "DeltaParams", "Params", "arm_angles", "build", "closed_form_configuration",
+           "closed_form_fk", "closed_form_ik", "closure_spec", "configuration", "forward_kinematics",
+           "inverse_kinematics", "jacobian", "jacobian_factors", "joint_values", "sphere_centres", "urdf_xml"]

@@ -1,0 +1,179 @@
+"""Delta workspace and condition-number maps, vectorised over grids of platform positions.
+
+The same closed forms as :mod:`pkm.mechanisms.delta` (arm circle against forearm sphere for the
+inverse kinematics, :func:`~pkm.mechanisms.delta.jacobian_factors` for the Jacobian), evaluated
+on arrays of points at once instead of one pose at a time. Unreachable points are not errors
+here: they are reported in an explicit ``reachable`` mask, and their condition numbers are
+``inf`` (never NaN), so that no average can silently include them.
+
+The workspace is the set of platform centres every arm can reach (no motor or ball-joint
+limits: the paper gives none), restricted to the half-space below the base (``z < 0``), as the
+paper admits only the negative root of its forward kinematics. That set is symmetric about the
+base plane, so this is half of the full reach set.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pkm.core.indices import KINDS, condition_number
+from pkm.core.mechanism import wrap_angle
+from pkm.errors import InvalidInputError
+from pkm.mechanisms.delta import BRANCHES, PHI, DeltaParams, jacobian_factors
+
+__all__ = ["WorkspaceGrid", "condition_numbers", "inverse_kinematics_batch", "workspace"]
+
+
+def _points(P) -> np.ndarray:
+    P = np.asarray(P, dtype=float)
+    if P.ndim < 1 or P.shape[-1] != 3:
+        raise InvalidInputError("points", f"expected an array of shape (..., 3) [m], got {P.shape}", P)
+    if not np.all(np.isfinite(P)):
+        raise InvalidInputError("points", "holds non-finite coordinates", P)
+    return P
+
+
+def _branch_signs(branch) -> tuple[int, int, int]:
+    branches = (branch,) * 3 if isinstance(branch, str) else tuple(branch)
+    if len(branches) != 3 or any(b not in BRANCHES for b in branches):
+        raise InvalidInputError("branch", f"use 'knee_out'/'knee_in' or a tuple of three, got {branch!r}", branch)
+    return tuple(-BRANCHES[b] for b in branches)
+
+
+def inverse_kinematics_batch(params: DeltaParams, points, branch="knee_out") -> tuple[np.ndarray, np.ndarray]:
+    """Motor angles for many platform centres at once (the closed form of
+    :func:`pkm.mechanisms.delta.inverse_kinematics`, same branches and wrapping).
+
+    Args:
+        params: The design.
+        points: Platform centres [m], shape (..., 3).
+        branch: ``"knee_out"``/``"knee_in"`` for all arms, or one per arm.
+
+    Returns:
+        ``theta`` [rad] of shape (..., 3) and ``reachable`` (bool, shape (...)): every arm reaches.
+        Where an arm does not reach, its angle is that of the nearest elbow position (the
+        clipped arc cosine), finite but meaningless: use the mask.
+    """
+    P = _points(points)
+    signs = _branch_signs(branch)
+    theta = np.empty(P.shape)
+    reachable = np.ones(P.shape[:-1], dtype=bool)
+    for i in range(3):
+        ci, si = math.cos(PHI[i]), math.sin(PHI[i])
+        w = ci * P[..., 0] + si * P[..., 1]  # along the motor axis
+        u = -si * P[..., 0] + ci * P[..., 1] - (params.R - params.r)
+        v = P[..., 2]
+        rho = np.hypot(u, v)
+        K = (u * u + v * v + w * w + params.La**2 - params.Lb**2) / (2.0 * params.La)
+        reachable &= np.abs(K) <= rho * (1.0 + 1e-12)
+        delta = np.arccos(np.clip(K / np.maximum(rho, 1e-300), -1.0, 1.0))
+        theta[..., i] = wrap_angle(np.arctan2(v, u) + signs[i] * delta)
+    return theta, reachable
+
+
+def condition_numbers(params: DeltaParams, points, branch="knee_out", kinds=KINDS) -> tuple[dict[str, np.ndarray],
+                                                                                             np.ndarray]:
+    """Condition numbers of ``J = dX/dth`` at many platform centres.
+
+    They are computed on ``J^-1 = diag(d)^-1 A`` (no inversion needed; every kind of
+    :func:`pkm.core.indices.condition_number` takes the same value on a matrix and its inverse).
+
+    Args:
+        params: The design.
+        points: Platform centres [m], shape (..., 3).
+        branch: Working mode (see :func:`inverse_kinematics_batch`).
+        kinds: Which conventions (``"fro"``: raw ``||J||_F ||J^-1||_F`` >= 3; ``"fro_normalized"``:
+            the same over 3, >= 1; ``"2"``: ``sigma_max / sigma_min`` >= 1).
+
+    Returns:
+        ``{kind: K}`` each of shape (...), ``inf`` at unreachable points and where an arm is
+        stretched or folded onto its forearm, and the ``reachable`` mask.
+    """
+    P = _points(points)
+    unknown = [k for k in kinds if k not in KINDS]
+    if unknown or not kinds:
+        raise InvalidInputError("kinds", f"choose among {KINDS}, got {tuple(kinds)!r}", kinds)
+    theta, reachable = inverse_kinematics_batch(params, P, branch)
+    A, d = jacobian_factors(params, P[reachable], theta[reachable])
+    ok = np.all(d != 0.0, axis=-1)
+    Jinv = A / np.where(ok[..., None], d, 1.0)[..., None]
+    out = {}
+    for kind in kinds:
+        K = np.full(P.shape[:-1], np.inf)
+        k = np.full(len(A), np.inf)
+        if ok.any():
+            k[ok] = condition_number(Jinv[ok], kind)
+        K[reachable] = k
+        out[kind] = K
+    return out, reachable
+
+
+@dataclass(frozen=True)
+class WorkspaceGrid:
+    """The workspace below the base sampled on a regular grid (cell centres), with condition maps.
+
+    Attributes:
+        params: The design.
+        branch: Working mode the condition numbers were computed on.
+        spacing: Grid step [m] (cells are cubes of this side).
+        axes: The grid's x, y and z node coordinates [m].
+        reachable: Mask of shape ``(nx, ny, nz)``: every arm reaches the node.
+        K: ``{kind: array (nx, ny, nz)}``, ``inf`` where unreachable or singular.
+    """
+
+    params: DeltaParams
+    branch: object
+    spacing: float
+    axes: tuple[np.ndarray, np.ndarray, np.ndarray]
+    reachable: np.ndarray
+    K: dict[str, np.ndarray]
+
+    @property
+    def volume(self) -> float:
+        """Reachable volume below the base [m^3] (node count times cell volume)."""
+        return float(np.count_nonzero(self.reachable)) * self.spacing**3
+
+    def conditioned_volume(self, k_max: float, kind: str = "2") -> float:
+        """Volume [m^3] of the nodes where ``K <= k_max`` (condition number of convention ``kind``)."""
+        if kind not in self.K:
+            raise InvalidInputError("kind", f"not computed on this grid; computed: {sorted(self.K)}", kind)
+        if not (math.isfinite(k_max) and k_max >= 1.0):
+            raise InvalidInputError("k_max", f"must be a finite bound >= 1, got {k_max!r}", k_max)
+        return float(np.count_nonzero(self.K[kind] <= k_max)) * self.spacing**3
+
+    def weighted_volume(self, kind: str = "2") -> float:
+        """``integral of 1/K over the workspace`` [m^3]: the volume times the mean of ``1/K``
+        (Gosselin and Angeles' global condition index), a trade-off with no threshold."""
+        if kind not in self.K:
+            raise InvalidInputError("kind", f"not computed on this grid; computed: {sorted(self.K)}", kind)
+        return float(np.sum(1.0 / self.K[kind])) * self.spacing**3
+
+
+def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", kinds=KINDS) -> WorkspaceGrid:
+    """Sample the workspace below the base on a grid of cubes of side ``spacing`` [m].
+
+    The grid covers ``|x|, |y| <= La + Lb`` and ``-(La + Lb) <= z <= 0``, which contains every
+    reachable point (each ball joint lies within ``La + Lb`` of its motor, and the motors
+    surround the axis). Computed z slice by z slice to bound memory.
+
+    Raises:
+        InvalidInputError: if ``spacing`` is not a finite length in (0, (La + Lb) / 4].
+    """
+    L = params.La + params.Lb
+    if not (isinstance(spacing, (int, float)) and math.isfinite(spacing) and 0.0 < spacing <= L / 4):
+        raise InvalidInputError("spacing", f"must be a length in (0, {L / 4:.4g}] m, got {spacing!r}", spacing)
+    n = math.ceil(L / spacing)
+    xy = (np.arange(-n, n) + 0.5) * spacing
+    z = -(np.arange(n)[::-1] + 0.5) * spacing
+    reachable = np.zeros((len(xy), len(xy), len(z)), dtype=bool)
+    K = {kind: np.full(reachable.shape, np.inf) for kind in kinds}
+    X, Y = np.meshgrid(xy, xy, indexing="ij")
+    for k, zk in enumerate(z):
+        pts = np.stack([X, Y, np.full_like(X, zk)], axis=-1)
+        Kk, reachable[:, :, k] = condition_numbers(params, pts, branch, kinds)
+        for kind in kinds:
+            K[kind][:, :, k] = Kk[kind]
+    return WorkspaceGrid(params, branch, float(spacing), (xy, xy.copy(), z), reachable, K)
