@@ -24,6 +24,8 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) tools/bench_kinematics.py
+	$(PY) tools/bench_dynamics.py
+	$(PY) tools/bench_opcount.py
 
 clean:
 	rm -rf $(VENV) build dist .pytest_cache
