@@ -1,4 +1,4 @@
-"""Planar 3-RRR: parameters, working modes, the paper's equations (6) and (9), reach, inputs.
+"""Planar 3-RRR: parameters, working modes, eqs. (6), (9), (19)-(20), (25), singularities, forward kinematics.
 
 The generic harness (tests/test_mechanisms_generic.py) already checks loop closure, generic
 vs closed-form IK on the default mode, and the Jacobians; these tests cover what is
@@ -14,9 +14,10 @@ import pinocchio as pin
 import pytest
 from scipy.optimize import brentq
 
-from pkm.core import TaskMap, constraints, diagnose, forward_jacobian, solve_ik
-from pkm.errors import InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
+from pkm.core import TaskMap, close_loops, constraints, diagnose, forward_jacobian, solve_ik
+from pkm.errors import AssemblyError, InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
 from pkm.mechanisms import rrr3
+from tests.fd import rel, richardson
 
 P = rrr3.Rrr3Params()
 Y_REF = rrr3.home_task(P)
@@ -303,3 +304,191 @@ def test_bad_paper_inputs_are_refused():
                  ([0.4, 0.2], 0.0, "mode0")):
         with pytest.raises(InvalidInputError):
             rrr3.inverse_kinematics(P, *args)
+
+
+# ---------------------------------------------------------------------- homogenised Jacobians (eq. 25)
+def _fd_inverse(fun, x, h=1e-6):
+    """Richardson central differences of ``fun`` (motor angles) at ``x``, one column per coordinate."""
+    def diff(hh):
+        return np.column_stack([_wrap(fun(x + e) - fun(x - e)) / (2 * hh) for e in hh * np.eye(3)])
+    return richardson(diff, h)
+
+
+@pytest.mark.parametrize("mode", ["mode1", "mode4", "mode8"])
+def test_homogenised_jacobian_about_the_centroid_is_the_derivative_of_the_ik(mode):
+    """J_q^-1 J_x (moment column / L, moments about G) equals d theta / d(x_G, y_G, L Phi) by FD of the IK (1e-6 rel)."""
+    L = rrr3.characteristic_length(P)
+    for y in _random_poses(5, seed=7, radius=0.05, dphi=0.2):
+        Jx, Jq = rrr3.homogenized_jacobians(P, y, mode)
+        fd_ = _fd_inverse(lambda z: rrr3.closed_form_ik(P, [z[0], z[1], z[2] / L], mode), np.r_[y[:2], L * y[2]])
+        assert rel(np.linalg.solve(Jq, Jx), fd_) <= 1e-6
+
+
+def test_homogenised_jacobian_about_a_is_the_derivative_of_the_papers_ik():
+    """With moments about A, J_q^-1 J_x equals d theta / d(x_A, y_A, L Phi) of eq. (9) by FD, for any explicit L."""
+    for L in (0.03, 0.25):
+        for y in _random_poses(3, seed=8, radius=0.05, dphi=0.2):
+            A = rrr3.a_from_centroid(P, y[:2], y[2])
+            Jx, Jq = rrr3.homogenized_jacobians(P, y, length=L, reference="A")
+            fd_ = _fd_inverse(lambda z, L=L: rrr3.inverse_kinematics(P, z[:2], z[2] / L), np.r_[A, L * y[2]])
+            assert rel(np.linalg.solve(Jq, Jx), fd_) <= 1e-6
+
+
+def test_moments_about_the_origin_describe_the_same_motion():
+    """About the origin O the task rates are (v_O, L w) with v_O = v_G + w x (O - G): both give the same motor rates."""
+    rng = np.random.default_rng(9)
+    for y in _random_poses(5, seed=9):
+        KG = np.linalg.solve(*rrr3.homogenized_jacobians(P, y)[::-1])
+        KO = np.linalg.solve(*rrr3.homogenized_jacobians(P, y, reference="origin")[::-1])
+        vG, w = rng.normal(size=2), rng.normal()
+        vO = vG + w * np.array([y[1], -y[0]])  # w z x (O - G), O = 0
+        L = rrr3.characteristic_length(P)
+        np.testing.assert_allclose(KO @ np.r_[vO, L * w], KG @ np.r_[vG, L * w], rtol=1e-12, atol=1e-12)
+
+
+def test_printed_eq25_depends_on_the_unit_of_length_ours_does_not():
+    """Departure: eq. (25) as printed (direction column / L) gives a CI that changes from m to cm; ours (moment / L) does not."""
+    y = Y_REF + [0.03, -0.02, 0.1]
+    Pcm = rrr3.Rrr3Params(a=40.0, b=40.0, h=10.0, H=100.0)
+    y_cm = np.r_[100 * y[:2], y[2]]
+
+    def ci(params, yy, printed):
+        Jx, Jq = rrr3.jacobians(params, yy)
+        if printed:
+            Jx = Jx.copy()
+            Jx[:, :2] /= rrr3.characteristic_length(params)
+        else:
+            Jx, Jq = rrr3.homogenized_jacobians(params, yy)
+        return 1.0 / np.linalg.cond(np.linalg.solve(Jq, Jx))
+
+    assert ci(P, y, False) == pytest.approx(ci(Pcm, y_cm, False), rel=1e-10)
+    assert abs(ci(P, y, True) - ci(Pcm, y_cm, True)) > 0.01
+
+
+def test_bad_length_and_reference_are_refused():
+    """A non-positive or non-finite L and an unknown reference point raise InvalidInputError."""
+    for kwargs in ({"length": 0.0}, {"length": float("nan")}, {"reference": "B"}):
+        with pytest.raises(InvalidInputError):
+            rrr3.homogenized_jacobians(P, Y_REF, **kwargs)
+
+
+# ---------------------------------------------------------------------- singularity classification
+def test_classification_agrees_with_the_generic_core(mech):
+    """Regular at the reference; a stretched leg is 'inverse' and a det J_x = 0 pose 'direct', for us and for diagnose."""
+    assert rrr3.classify_singularity(P, Y_REF) == "regular" == diagnose(mech, mech.q_reference).classification
+    u = np.array([math.cos(0.3), math.sin(0.3)])
+    y_inv = np.r_[rrr3.centroid_from_a(P, (P.a + P.b) * u, 0.0), 0.0]
+    assert rrr3.classify_singularity(P, y_inv, tol=1e-6) == "inverse"
+    assert diagnose(mech, rrr3.closed_form_configuration(mech, y_inv)).classification == "inverse"
+    phi_s = brentq(lambda p: np.linalg.det(rrr3.jacobians(P, [Y_REF[0], Y_REF[1], p])[0]), 0.6, 0.9, xtol=1e-15)
+    y_dir = np.r_[Y_REF[:2], phi_s]
+    assert rrr3.classify_singularity(P, y_dir) == "direct"
+    assert diagnose(mech, rrr3.closed_form_configuration(mech, y_dir)).classification == "direct"
+
+
+def test_combined_singularity_is_found_with_a_stretched_leg_on_a_direct_singularity():
+    """Leg 1 stretched (psi_1 = 0) at the angle where det J_x vanishes: classified 'combined' (eqs. 19-20 both singular)."""
+    phi = 0.3
+
+    def pose(alpha):
+        A = (P.a + P.b) * np.array([math.cos(alpha), math.sin(alpha)])
+        return np.r_[rrr3.centroid_from_a(P, A, phi), phi]
+
+    def det(alpha):
+        return np.linalg.det(rrr3.homogenized_jacobians(P, pose(alpha))[0])
+
+    alphas = np.linspace(0.2, 0.3, 21)
+    vals = [det(a) for a in alphas]
+    k = next(i for i in range(20) if vals[i] * vals[i + 1] < 0)
+    alpha = brentq(det, alphas[k], alphas[k + 1], xtol=1e-15)
+    assert rrr3.classify_singularity(P, pose(alpha), tol=1e-6) == "combined"
+    inv, direct = rrr3.singularity_measures(P, pose(alpha))
+    assert inv < 1e-6 and direct < 1e-9
+    assert rrr3.classify_singularity(P, pose(alpha - 0.02), tol=1e-6) == "inverse"
+
+
+# ---------------------------------------------------------------------- forward kinematics
+def _multistart(params, theta, n, rng):
+    """Brute force: vectorised Newton on the three leg equations from n random (x_A, y_A, Phi); distinct solutions."""
+    D = rrr3.base_vertices(params) + params.a * np.column_stack([np.cos(theta), np.sin(theta)])
+    span = params.H + params.a + params.b
+    x = np.column_stack([rng.uniform(-span, span + params.H, (n, 2)), rng.uniform(-np.pi, np.pi, n)])
+    off = np.array([0.0, 0.0, math.pi / 3])
+    for _ in range(60):
+        ang = x[:, 2:3] + off
+        cos, sin = np.cos(ang) * [0, 1, 1], np.sin(ang) * [0, 1, 1]
+        ex = x[:, :1] + params.h * cos - D[:, 0]
+        ey = x[:, 1:2] + params.h * sin - D[:, 1]
+        f = ex * ex + ey * ey - params.b ** 2
+        J = np.stack([2 * ex, 2 * ey, 2 * params.h * (-ex * sin + ey * cos)], axis=-1)
+        ok = np.abs(np.linalg.det(J)) > 1e-14
+        x[ok] -= np.linalg.solve(J[ok], f[ok][..., None])[..., 0]
+    found = []
+    for xa in x:
+        V = rrr3.platform_vertices(params, xa[:2], xa[2]) if np.all(np.isfinite(xa)) else None
+        if V is None or np.max(np.abs(np.linalg.norm(V - D, axis=1) - params.b)) > 1e-10:
+            continue
+        y = np.r_[rrr3.centroid_from_a(params, xa[:2], xa[2]), _wrap(xa[2])]
+        if not any(np.max(np.abs(np.r_[y[:2] - z[:2], _wrap(y[2] - z[2])])) < 1e-7 for z in found):
+            found.append(y)
+    return found
+
+
+def test_forward_kinematics_loses_no_solution_against_a_brute_force_multistart():
+    """On 40 random designs and motor angles, every solution of a 400-start Newton multistart is among ours (1e-7),
+    and we return nothing it does not find; the sample includes 6-solution cases."""
+    rng = np.random.default_rng(11)
+    counts, checked = [], 0
+    while checked < 40:
+        a, b = rng.uniform(0.2, 1.0, 2)
+        h = rng.uniform(0.05, 1.0)
+        try:
+            params = rrr3.Rrr3Params(a=a, b=b, h=h)
+        except InvalidParameterError:
+            continue
+        theta = rng.uniform(-np.pi, np.pi, 3)
+        try:
+            ours = [s.y for s in rrr3.forward_kinematics(params, theta)]
+        except AssemblyError:
+            continue
+        brute = _multistart(params, theta, 400, rng)
+        for z in brute:
+            assert any(np.max(np.abs(np.r_[z[:2] - o[:2], _wrap(z[2] - o[2])])) < 1e-7 for o in ours)
+        assert len(brute) == len(ours)
+        counts.append(len(ours))
+        checked += 1
+    assert max(counts) == 6 and min(counts) >= 2
+
+
+def test_every_forward_solution_closes_the_loops_in_the_generic_core():
+    """Each assembly mode, rebuilt as a tree configuration, has the given motors, closes to 1e-10 and is a fixed point
+    of pkm.core.close_loops; the pose the motors came from is among them (every working mode)."""
+    built = {}
+    for y in _random_poses(4, seed=12, radius=0.08, dphi=0.3):
+        for name in ("mode1", "mode3", "mode8"):
+            theta = rrr3.closed_form_ik(P, y, name)
+            sols = rrr3.forward_kinematics(P, theta)
+            assert any(np.max(np.abs(np.r_[s.y[:2] - y[:2], _wrap(s.y[2] - y[2])])) < 1e-10 for s in sols)
+            for s in sols:
+                assert s.residual <= 1e-10 and s.mode is not None
+                mech = built.setdefault(s.mode, rrr3.build(rrr3.Rrr3Params()))
+                q = rrr3.closed_form_configuration(mech, s.y, s.mode)
+                assert np.abs(_wrap(mech.actuated_q(q) - theta)).max() <= 1e-10
+                assert np.abs(constraints.residual(mech, q)).max() <= 1e-10
+                res = close_loops(mech, theta, q)
+                assert res.converged and np.abs(_wrap(res.q - q)).max() <= 1e-9
+
+
+def test_no_assembly_raises_assembly_error_with_the_deficit():
+    """Motors turned so the elbows are far apart (all outward) admit no platform: AssemblyError with deficit > 0."""
+    theta = np.radians([-150.0, -30.0, 90.0])
+    with pytest.raises(AssemblyError) as exc:
+        rrr3.forward_kinematics(P, theta)
+    assert exc.value.deficit > 0.1
+
+
+@pytest.mark.parametrize("theta", [[0.1, 0.2], [0.1, float("nan"), 0.2], "up"])
+def test_bad_motor_angles_are_refused(theta):
+    """Wrongly shaped or non-finite motor angles raise InvalidInputError."""
+    with pytest.raises(InvalidInputError):
+        rrr3.forward_kinematics(P, theta)

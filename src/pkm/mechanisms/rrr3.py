@@ -62,6 +62,22 @@ Departures from the paper:
   measured from the world ``+x`` axis.
 * Eqs. (19)-(20) are rebuilt in :func:`jacobians` with the moments taken about ``G``
   (the task point) and without the homogenisation of eq. (25).
+* Eq. (25) as printed divides the *direction* column ``s_ri`` by the characteristic length
+  ``L``, which mixes 1 and 1/m in one row. :func:`homogenized_jacobians` divides the
+  *moment* column ``(a_i x s_ri)`` by ``L`` instead, i.e. it uses the task rates
+  ``(v_P, L Phi_dot)``, all in m/s; both the moment reference point ``P`` (``"centroid"``
+  by default, ``"A"``, ``"origin"`` = the paper's ``O = P``) and ``L`` (default the platform
+  circumradius ``h / sqrt 3``, Lou's "mean radius of the moving platform") are arguments.
+
+Forward kinematics (:func:`forward_kinematics`; the paper gives none). With the motor
+angles known the elbows ``D_i`` are known and the 3-RRR is a 3-RPR with three legs of fixed
+length ``b``: ``|V_i(A, Phi) - D_i| = b``. Subtracting leg 1's equation from legs 2 and 3
+leaves two equations linear in ``A``; substituting ``A(Phi)`` into leg 1's equation gives a
+trigonometric polynomial of degree 4 in ``Phi`` (a degree-8 polynomial in ``z = e^{i Phi}``
+whose roots on the unit circle are the assembly modes; for the 3-RPR at most 6 are real).
+Its coefficients are read exactly off 16 samples by an FFT, its roots found from the
+companion matrix, and every candidate is polished by Newton on the three leg equations and
+kept only if they hold to ``tol``; duplicates (double roots at direct singularities) merge.
 
 The reference design (paper sec. III, workspace study): links ``a = b = 40 cm``,
 platform side ``h = 10 cm``, actuator separation ``H = 100 cm``, ``mode1``, centroid at
@@ -80,7 +96,14 @@ import numpy as np
 from pkm.core.mechanism import Mechanism, as_vector, wrap_angle
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.urdf import UrdfBuilder
-from pkm.errors import InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
+from pkm.errors import (
+    AssemblyError,
+    BranchError,
+    InvalidInputError,
+    InvalidParameterError,
+    SingularityError,
+    UnreachableError,
+)
 from pkm.mechanisms._common import check_positive, make_mechanism, rod_inertia, spec_parameters
 
 NAME = "rrr3"
@@ -132,7 +155,7 @@ class Rrr3Params:
             if not isinstance(v, (int, float)) or not math.isfinite(v):
                 raise InvalidParameterError("home", f"component {k} is not a finite number", self.home)
         try:
-            Jx, Jq = jacobians(self, home_task(self), self.mode)
+            margin_inv, margin_dir = singularity_measures(self, home_task(self), self.mode)
         except UnreachableError as exc:
             raise InvalidParameterError(
                 "home", f"reference pose {tuple(self.home)} is unreachable with this design (leg {exc.leg} misses "
@@ -141,9 +164,6 @@ class Rrr3Params:
             raise InvalidParameterError(
                 "home", f"reference pose {tuple(self.home)} puts a platform vertex on its base vertex (a = b); "
                         "choose another home", self.home) from None
-        margin_inv = float(np.min(np.abs(np.diag(Jq)))) / self.a  # min |sin psi_i|
-        Jn = Jx * np.array([1.0, 1.0, SQRT3 / self.h])  # moments per platform circumradius: scale-free
-        margin_dir = abs(float(np.linalg.det(Jn)))
         if margin_inv < _SINGULAR_TOL or margin_dir < _SINGULAR_TOL:
             kind = "inverse (a leg stretched or folded)" if margin_inv < _SINGULAR_TOL else "direct"
             raise InvalidParameterError(
@@ -286,10 +306,248 @@ def jacobians(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[np.
     return Jx, Jq
 
 
+REFERENCES = ("centroid", "A", "origin")
+"""Moment reference points of :func:`homogenized_jacobians`: the platform centroid ``G``, vertex ``A``,
+the world origin ``O = P`` (the paper's eq. 14)."""
+
+
+def characteristic_length(params: Rrr3Params) -> float:
+    """Default ``L`` of eq. (25) [m]: the platform circumradius ``h / sqrt 3`` (Lou's mean platform radius)."""
+    return params.h / SQRT3
+
+
+def reference_point(params: Rrr3Params, y, reference: str = "centroid") -> np.ndarray:
+    """The point [m] about which moments are taken (one of :data:`REFERENCES`) for task vector ``y``."""
+    y = as_vector(y, 3, "y")
+    if reference == "centroid":
+        return y[:2].copy()
+    if reference == "A":
+        return a_from_centroid(params, y[:2], y[2])
+    if reference == "origin":
+        return np.zeros(2)
+    raise InvalidInputError("reference", f"use one of {REFERENCES}, got {reference!r}", reference)
+
+
+def homogenized_jacobians(params: Rrr3Params, y, mode: int | str | None = None, *, length: float | None = None,
+                          reference: str = "centroid") -> tuple[np.ndarray, np.ndarray]:
+    """Eq. (25), read consistently: ``J_x`` with its moment column divided by ``L``, and ``J_q``.
+
+    ``J_x[i] = [u_i, ((V_i - P) x u_i) / L]`` and ``J_x (v_P, L Phi_dot) = J_q theta_dot``, where
+    ``v_P`` is the velocity of the platform point at the reference ``P`` (see the module doc for
+    why the moment column, not the direction column, carries ``L``). All of ``J_x`` is then
+    dimensionless and ``J_q = diag(a sin psi_i)`` is in m, so ``J_q^-1 J_x`` (motor rates per
+    m/s) has a unit-free condition number.
+
+    Args:
+        params: The design.
+        y: Task vector ``(x_G, y_G, Phi)`` [m, m, rad].
+        mode: Working mode; default ``params.mode``.
+        length: Characteristic length ``L`` [m], finite and > 0; default :func:`characteristic_length`.
+        reference: Moment reference point, one of :data:`REFERENCES`.
+
+    Returns:
+        ``(J_x, J_q)``: (3, 3) arrays, ``J_x`` dimensionless, ``J_q`` in [m].
+    """
+    L = characteristic_length(params) if length is None else _length(length)
+    Jx, Jq = jacobians(params, y, mode)
+    d = as_vector(y, 3, "y")[:2] - reference_point(params, y, reference)  # G - P
+    Jx[:, 2] += d[0] * Jx[:, 1] - d[1] * Jx[:, 0]  # (V - P) x u = (V - G) x u + (G - P) x u
+    Jx[:, 2] /= L
+    return Jx, Jq
+
+
+def singularity_measures(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[float, float]:
+    """Dimensionless distances to the two kinds of singularity at task vector ``y``.
+
+    Returns:
+        ``(inverse, direct)``: ``min_i |sin psi_i|`` (0 when a leg is stretched or folded, eq. 20)
+        and ``|det J_x|`` of :func:`homogenized_jacobians` with the default ``L`` and the centroid
+        (0 when the three distal-link lines meet in a point or are parallel, eq. 19); both are
+        unchanged by a uniform scaling of the design.
+    """
+    Jx, Jq = homogenized_jacobians(params, y, mode)
+    return float(np.min(np.abs(np.diag(Jq)))) / params.a, abs(float(np.linalg.det(Jx)))
+
+
+def classify_singularity(params: Rrr3Params, y, mode: int | str | None = None, *, tol: float = 1e-8) -> str:
+    """``"regular"``, ``"inverse"`` (``J_q`` singular), ``"direct"`` (``J_x`` singular) or ``"combined"`` (both).
+
+    Args:
+        params: The design.
+        y: Task vector ``(x_G, y_G, Phi)`` [m, m, rad].
+        mode: Working mode; default ``params.mode``.
+        tol: A measure of :func:`singularity_measures` at or below ``tol`` counts as singular.
+    """
+    if not (math.isfinite(tol) and tol >= 0.0):
+        raise InvalidInputError("tol", f"must be finite and >= 0, got {tol!r}", tol)
+    inv, direct = singularity_measures(params, y, mode)
+    return {(False, False): "regular", (True, False): "inverse", (False, True): "direct",
+            (True, True): "combined"}[(inv <= tol, direct <= tol)]
+
+
+# ---------------------------------------------------------------------- forward kinematics
+@dataclass(frozen=True)
+class FkSolution:
+    """One assembly mode of the forward kinematics.
+
+    Attributes:
+        y: Task vector ``(x_G, y_G, Phi)`` [m, m, rad], ``Phi`` in (-pi, pi].
+        a_point: The paper's platform vertex ``A`` [m].
+        psi: Elbow angles ``(psi_1, psi_2, psi_3)`` [rad] (see the module doc).
+        mode: Working mode name of the solution (signs of ``psi``), ``None`` if a leg is exactly stretched
+            or folded.
+        residual: Largest ``| |V_i - D_i| - b |`` over the legs [m].
+    """
+
+    y: np.ndarray
+    a_point: np.ndarray
+    psi: np.ndarray
+    mode: str | None
+    residual: float
+
+
+_FK_SAMPLES = 16  # FFT samples of the degree-4 trigonometric polynomial (>= 9 makes the coefficients exact)
+_FK_NEWTON = 30  # Newton iterations allowed per candidate
+
+
+def _fk_offsets(h: float, phi):
+    """Vertex offsets ``r_k(Phi)`` from ``A`` (eqs. 1-2), shape (3, 2, ...), and their derivatives."""
+    phi = np.asarray(phi, dtype=float)
+    zero = np.zeros_like(phi)
+    r = np.array([[zero, zero], [h * np.cos(phi), h * np.sin(phi)],
+                  [h * np.cos(phi + math.pi / 3.0), h * np.sin(phi + math.pi / 3.0)]])
+    dr = np.array([[zero, zero], [-h * np.sin(phi), h * np.cos(phi)],
+                   [-h * np.sin(phi + math.pi / 3.0), h * np.cos(phi + math.pi / 3.0)]])
+    return r, dr
+
+
+def _fk_eliminated(D: np.ndarray, b: float, h: float, phi):
+    """Leg 1's equation times ``delta^2`` with ``A(Phi) = N / delta`` from legs 2, 3 minus leg 1; and ``N``, ``delta``."""
+    r, _ = _fk_offsets(h, phi)
+    M = np.empty((2, 2) + np.shape(phi))
+    c = np.empty((2,) + np.shape(phi))
+    for k in (1, 2):
+        w = [r[k][j] - D[k][j] + D[0][j] for j in range(2)]
+        M[k - 1, 0], M[k - 1, 1] = 2.0 * w[0], 2.0 * w[1]
+        c[k - 1] = D[0] @ D[0] - ((r[k][0] - D[k][0]) ** 2 + (r[k][1] - D[k][1]) ** 2)
+    delta = M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]
+    N = np.array([M[1, 1] * c[0] - M[0, 1] * c[1], M[0, 0] * c[1] - M[1, 0] * c[0]])
+    F = N[0] ** 2 + N[1] ** 2 - 2.0 * delta * (N[0] * D[0][0] + N[1] * D[0][1]) + delta ** 2 * (D[0] @ D[0] - b * b)
+    return F, N, delta
+
+
+def _fk_legs(D: np.ndarray, b: float, h: float, x: np.ndarray):
+    """Leg equations ``|V_k - D_k|^2 - b^2`` [m^2] at ``x = (x_A, y_A, Phi)`` and their Jacobian."""
+    r, dr = _fk_offsets(h, x[2])
+    e = x[:2] + r - D  # (3, 2)
+    f = np.sum(e * e, axis=1) - b * b
+    J = np.column_stack([2.0 * e[:, 0], 2.0 * e[:, 1], 2.0 * np.sum(e * dr, axis=1)])
+    return f, J, e
+
+
+def forward_kinematics(params: Rrr3Params, theta, *, tol: float = 1e-10) -> tuple[FkSolution, ...]:
+    """Every real assembly mode (up to 6) for the motor angles ``theta`` (see the module doc).
+
+    Args:
+        params: The design.
+        theta: Motor angles ``(theta_1, theta_2, theta_3)`` [rad].
+        tol: Largest leg-length error [m] accepted for a solution.
+
+    Returns:
+        The solutions sorted by ``Phi``, each verified to ``tol``.
+
+    Raises:
+        AssemblyError: no real assembly exists (``deficit``: the smallest leg-1 length error over ``Phi``, m).
+        SingularityError: the equations are degenerate (a continuum of assemblies, e.g. a self-motion).
+    """
+    theta = as_vector(theta, 3, "theta")
+    if not (math.isfinite(tol) and tol > 0.0):
+        raise InvalidInputError("tol", f"must be finite and > 0, got {tol!r}", tol)
+    a, b, h = params.a, params.b, params.h
+    D = base_vertices(params) + a * np.column_stack([np.cos(theta), np.sin(theta)])
+    phis = 2.0 * math.pi * np.arange(_FK_SAMPLES) / _FK_SAMPLES
+    F, _, delta = _fk_eliminated(D, b, h, phis)
+    coef = np.fft.fft(F) / _FK_SAMPLES  # coef[k] multiplies e^{i k Phi}; k = -4..4 used
+    scale = float(np.max(np.abs(F)))
+    if scale == 0.0 or np.max(np.abs(coef)) <= 1e-13 * max(scale, 1e-300):
+        raise SingularityError("direct", 0.0, "the forward-kinematics equations vanish identically: the platform "
+                                              "has a continuum of assemblies (self-motion)")
+    poly = np.array([coef[k % _FK_SAMPLES] for k in range(4, -5, -1)])  # z^4 F(z): highest power first
+    big = np.abs(poly) > 1e-12 * np.max(np.abs(poly))
+    lead, trail = int(np.argmax(big)), len(poly) - int(np.argmax(big[::-1]))
+    roots = np.roots(poly[lead:trail]) if trail - lead > 1 else np.array([])
+    candidates = [float(np.angle(z)) for z in roots if abs(abs(z) - 1.0) < 1e-4]
+    solutions: list[FkSolution] = []
+    for phi in candidates:
+        _, Np, dp = _fk_eliminated(D, b, h, phi)
+        if abs(dp) > 1e-9 * float(np.max(np.abs(delta))):
+            A = Np / dp
+        else:  # delta and N vanish together at this root: A(Phi) is 0/0 there, take its limit
+            _, Nn, dn = _fk_eliminated(D, b, h, np.array([phi - 1e-6, phi + 1e-6]))
+            A = np.mean(Nn / dn, axis=1)
+        sol = _fk_polish(params, D, np.array([A[0], A[1], phi]), theta, tol)
+        if sol is not None and not any(np.max(np.abs(np.r_[s.y[:2] - sol.y[:2], wrap_angle(s.y[2] - sol.y[2])]))
+                                       < 1e-8 for s in solutions):
+            solutions.append(sol)
+    if not solutions:
+        dense = np.linspace(0.0, 2.0 * math.pi, 721)
+        _, Nd, dd = _fk_eliminated(D, b, h, dense)
+        ok = np.abs(dd) > 1e-12 * max(float(np.max(np.abs(dd))), 1e-300)
+        gap = np.abs(np.hypot(Nd[0][ok] / dd[ok] - D[0][0], Nd[1][ok] / dd[ok] - D[0][1]) - b)
+        raise AssemblyError(float(np.min(gap)) if gap.size else float("inf"), "m",
+                            f"motor angles {tuple(np.round(theta, 6))} rad admit no assembly of this design")
+    return tuple(sorted(solutions, key=lambda s: s.y[2]))
+
+
+def _fk_polish(params: Rrr3Params, D: np.ndarray, x: np.ndarray, theta: np.ndarray, tol: float) -> FkSolution | None:
+    """Newton on the three leg equations from ``x = (x_A, y_A, Phi)``; the solution if it holds to ``tol``."""
+    b = params.b
+    for _ in range(_FK_NEWTON):
+        f, J, e = _fk_legs(D, b, params.h, x)
+        if np.max(np.abs(np.sqrt(np.sum(e * e, axis=1)) - b)) <= 0.01 * tol:
+            break
+        step = np.linalg.lstsq(J, -f, rcond=None)[0]
+        x = x + step
+        if not np.all(np.isfinite(x)):
+            return None
+    _, _, e = _fk_legs(D, b, params.h, x)
+    residual = float(np.max(np.abs(np.sqrt(np.sum(e * e, axis=1)) - b)))
+    if residual > tol:
+        return None
+    phi = float(wrap_angle(x[2]))
+    A = x[:2].copy()
+    link_a = np.column_stack([np.cos(theta), np.sin(theta)])
+    u = e / b  # distal directions D -> V
+    psi = np.arctan2(link_a[:, 0] * u[:, 1] - link_a[:, 1] * u[:, 0], np.sum(link_a * u, axis=1))
+    signs = tuple(int(np.sign(p)) for p in psi)
+    mode = next((name for name, s in MODES.items() if s == signs), None)
+    y = np.concatenate([centroid_from_a(params, A, phi), [phi]])
+    return FkSolution(y, A, psi, mode, residual)
+
+
 # ---------------------------------------------------------------------- uniform interface
 # Every mechanism module offers these, over the task vector ``y`` laid out as
-# :class:`pkm.core.TaskMap` does (here: centroid x, y and yaw Phi). No closed-form forward
-# kinematics: the paper gives none (up to 6 assembly modes; the generic core solves it).
+# :class:`pkm.core.TaskMap` does (here: centroid x, y and yaw Phi).
+def closed_form_fk(params: Rrr3Params, q_actuated, seed=None) -> np.ndarray:
+    """One assembly mode of :func:`forward_kinematics`: on ``params.mode``, nearest to ``seed``.
+
+    Args:
+        params: The design.
+        q_actuated: Motor angles [rad].
+        seed: Task vector the solution should be nearest to (default :func:`home_task`).
+
+    Raises:
+        AssemblyError: no assembly at all; BranchError: none on ``params.mode``.
+    """
+    target = home_task(params) if seed is None else as_vector(seed, 3, "seed")
+    sols = [s for s in forward_kinematics(params, q_actuated) if s.mode == f"mode{params.mode}"]
+    if not sols:
+        expected = dict(zip(("elbow_1", "elbow_2", "elbow_3"), MODES[f"mode{params.mode}"]))
+        raise BranchError(f"mode{params.mode}", expected, {})
+    return min(sols, key=lambda s: float(np.max(np.abs(np.r_[s.y[:2] - target[:2],
+                                                              wrap_angle(s.y[2] - target[2])])))).y.copy()
+
+
 def closed_form_ik(params: Rrr3Params, y, branch: str | None = None) -> np.ndarray:
     """Actuated coordinates for task vector ``y`` (closed form); ``branch`` = working mode name."""
     y = as_vector(y, 3, "y")
@@ -361,5 +619,12 @@ def build(params: Rrr3Params | None = None) -> Mechanism:
 
 
 # ---------------------------------------------------------------------- helpers
+def _length(length) -> float:
+    L = _scalar(length, "length")
+    if L <= 0.0:
+        raise InvalidInputError("length", f"the characteristic length must be > 0 m, got {L!r}", length)
+    return L
+
+
 def _scalar(x, name: str) -> float:
     return float(as_vector([x] if np.ndim(x) == 0 else x, 1, name)[0])

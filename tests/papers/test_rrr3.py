@@ -1,0 +1,55 @@
+"""Planar 3-RRR paper study: the row contract, the published GCIs, Fig. 7's dimensions and the working modes."""
+
+from __future__ import annotations
+
+import pytest
+
+from pkm.mechanisms.rrr3_maps import Design
+from pkm.papers import rrr3 as study
+
+IDS = ["rrr3.fig5.gci", "rrr3.fig5.gci_area", "rrr3.fig6.gci", "rrr3.fig6.gci_area", "rrr3.fig7.gci",
+       "rrr3.fig7.gci_area", "rrr3.fig9.gci", "rrr3.fig9.gci_area", "rrr3.modes.suitable"]
+
+
+@pytest.fixture(scope="module")
+def rows():
+    return {r.id: r for r in study.reproduce()}
+
+
+def test_rows_are_the_contract_ids_with_published_values(rows):
+    """reproduce() returns exactly the issue's ids, each with the paper's value and a note naming the reading."""
+    assert list(rows) == IDS
+    assert [rows[i].published for i in IDS[:-1]] == [0.1155, 0.2008, 0.1885, 0.5816, 0.4214, 0.7448, 0.4215, 0.7953]
+    assert all("L = h/sqrt3" in rows[i].note for i in IDS[:-1])
+
+
+def test_figs_6_7_9_reproduce_to_the_printed_decimals(rows):
+    """Figs. 6 and 9 (both numbers) and Fig. 7's area GCI match to half a unit of the 4th decimal (Figs. 6, 7, 9)."""
+    for i in ("rrr3.fig6.gci", "rrr3.fig6.gci_area", "rrr3.fig7.gci_area", "rrr3.fig9.gci", "rrr3.fig9.gci_area"):
+        assert rows[i].matches is True, (i, rows[i].computed)
+
+
+def test_remaining_gcis_are_within_a_few_units_of_the_4th_decimal(rows):
+    """Fig. 5's two GCIs and Fig. 7's overall GCI differ from print by 1.3e-4 (overall) and 8e-4 (Fig. 5 area) at most.
+
+    Fig. 7's overall GCI is the similarity law's scale-invariant value, printed 0.4215 for Fig. 9 and 0.4214 here.
+    """
+    for i in ("rrr3.fig5.gci", "rrr3.fig7.gci"):
+        assert abs(rows[i].computed - rows[i].published) < 2e-4
+    assert abs(rows["rrr3.fig5.gci_area"].computed - 0.2008) < 1e-3
+
+
+def test_only_modes_1_and_8_are_suitable(rows):
+    """Sec. VIII: only the first and last working modes are free of direct singularities in the workspace (Fig. 8)."""
+    assert rows["rrr3.modes.suitable"].computed == "1,8" and rows["rrr3.modes.suitable"].matches
+    gcis = {m: g for m, g, _, _ in study.mode_study()}
+    assert gcis[1] == pytest.approx(gcis[8], abs=1e-12) and all(gcis[1] > 2 * gcis[m] for m in range(2, 8))
+
+
+def test_fig7_belongs_to_the_similarity_law_design_with_H_150_cm():
+    """The candidate search puts a = b = 60, h = 15, H = 150 cm first, well ahead of the rest and of the caption's design."""
+    ranked = study.fig7_search()
+    assert ranked[0][0] == Design(0.6, 0.6, 0.15, 1.5)
+    assert ranked[0][3] < 3e-3 < ranked[1][3]
+    caption = next(r for r in ranked if r[0] == Design(0.6, 0.6, 0.1, 1.0))
+    assert caption[3] > 0.1  # the caption's dimensions give Fig. 6's numbers, not Fig. 7's

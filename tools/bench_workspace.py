@@ -1,0 +1,120 @@
+#!/usr/bin/env python3
+"""Planar 3-RRR workspace and condition-index maps: vectorised numpy against a per-node loop.
+
+Two cases, each timed vectorised (best of ``--repeat``) and as a naive Python loop over a
+random sample of its nodes (closed-form IK + per-pose Jacobians + SVD per node, from
+``pkm.mechanisms.rrr3_maps.naive_condition_index``), extrapolated to all nodes; the ratio is
+measured in the same run, and the sample's CIs are compared between the two routes:
+
+* ``workspace_ci_3d``: the paper's Fig. 3 count, 101 x 101 positions over ``[0, H]^2`` times 361
+  orientations (1 deg) = 3,682,561 nodes, reference design (a = b = 40, h = 10, H = 100 cm);
+  reachability and CI of every node, area and GCI per orientation. Goal <= 5 s.
+* ``gci_paper_grid``: one design (Fig. 9's) on the paper's map grid, 801 x 801 nodes every 2 mm,
+  overall and area GCI. Goal <= 0.5 s.
+
+Usage: ``python tools/bench_workspace.py [--json] [--sample 2000] [--repeat 3]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import numpy as np
+
+from pkm.mechanisms import rrr3
+from pkm.mechanisms import rrr3_maps as maps
+
+
+def _best(fn, repeat: int) -> float:
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def _naive(design, nodes: np.ndarray, settings: maps.CiSettings) -> tuple[float, np.ndarray]:
+    """Seconds per node and the CIs of the per-node loop over ``nodes`` (rows ``x, y, phi``)."""
+    t0 = time.perf_counter()
+    out = np.array([maps.naive_condition_index(design, node, maps.CiSettings(float(node[2]), settings.mode))
+                    for node in nodes])
+    return (time.perf_counter() - t0) / len(nodes), out
+
+
+def bench_3d(sample: int, repeat: int, rng: np.random.Generator) -> dict:
+    p = rrr3.Rrr3Params()
+    xs = np.linspace(0.0, p.H, 101)
+    phis = np.radians(np.arange(-180, 181))
+    settings = maps.CiSettings()
+    result = {}
+
+    def run():
+        result["sweep"] = maps.orientation_sweep(p, xs, xs, phis, settings)
+
+    t_vec = _best(run, repeat)
+    sw = result["sweep"]
+    nodes = np.column_stack([rng.choice(xs, sample), rng.choice(xs, sample), rng.choice(phis, sample)])
+    per_node, naive = _naive(p, nodes, settings)
+    vec, _ = maps.condition_index_phi(p, nodes[:, 0], nodes[:, 1], nodes[:, 2], settings)
+    both = np.isfinite(naive)
+    return {
+        "case": "workspace_ci_3d", "nodes": sw.nodes, "reachable_nodes": int(sw.reachable_nodes.sum()),
+        "vectorised_s": t_vec, "goal_s": 5.0,
+        "naive_sample_nodes": sample, "naive_per_node_us": per_node * 1e6,
+        "naive_extrapolated_s": per_node * sw.nodes, "ratio_naive_over_vectorised": per_node * sw.nodes / t_vec,
+        "sample_reach_agrees": bool(np.array_equal(both, np.isfinite(vec))),
+        "sample_max_ci_difference": float(np.max(np.abs(vec[both] - naive[both]))) if both.any() else 0.0,
+        "area_phi0_cm2": float(sw.areas[180] * 1e4), "gci_phi0": float(sw.gci[180]),
+    }
+
+
+def bench_gci(sample: int, repeat: int, rng: np.random.Generator) -> dict:
+    d = maps.Design.similarity_law(2.0)
+    grid = maps.paper_grid(d)
+    settings = maps.CiSettings()
+    result = {}
+
+    def run():
+        m = maps.ci_map(d, grid, settings)
+        result["gci"], result["area"] = m.gci(), m.area_gci()
+
+    t_vec = _best(run, repeat)
+    nodes = np.column_stack([rng.choice(grid.xs, sample), rng.choice(grid.ys, sample), np.zeros(sample)])
+    per_node, naive = _naive(d, nodes, settings)
+    vec, _ = maps.condition_index(d, nodes[:, 0], nodes[:, 1], settings)
+    both = np.isfinite(naive)
+    return {
+        "case": "gci_paper_grid", "design_cm": [d.a * 100, d.b * 100, d.h * 100, d.H * 100], "nodes": grid.size,
+        "vectorised_s": t_vec, "goal_s": 0.5,
+        "naive_sample_nodes": sample, "naive_per_node_us": per_node * 1e6,
+        "naive_extrapolated_s": per_node * grid.size, "ratio_naive_over_vectorised": per_node * grid.size / t_vec,
+        "sample_reach_agrees": bool(np.array_equal(both, np.isfinite(vec))),
+        "sample_max_ci_difference": float(np.max(np.abs(vec[both] - naive[both]))) if both.any() else 0.0,
+        "gci": result["gci"].value, "gci_area": result["area"].value,
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    ap.add_argument("--sample", type=int, default=2000, help="nodes timed in the naive loop, per case")
+    ap.add_argument("--repeat", type=int, default=3, help="vectorised runs per case (best is kept)")
+    args = ap.parse_args()
+    rng = np.random.default_rng(0)
+    results = [bench_3d(args.sample, args.repeat, rng), bench_gci(args.sample, args.repeat, rng)]
+    if args.json:
+        print(json.dumps(results, indent=2))
+        return
+    print(f"{'case':16} {'nodes':>10} {'vector s':>9} {'goal s':>7} {'naive us/node':>14} {'naive s (extr.)':>16} "
+          f"{'ratio':>7} {'max |dCI|':>10}")
+    for r in results:
+        print(f"{r['case']:16} {r['nodes']:10d} {r['vectorised_s']:9.3f} {r['goal_s']:7.1f} "
+              f"{r['naive_per_node_us']:14.1f} {r['naive_extrapolated_s']:16.1f} "
+              f"{r['ratio_naive_over_vectorised']:7.0f} {r['sample_max_ci_difference']:10.1e}")
+
+
+if __name__ == "__main__":
+    main()
