@@ -26,6 +26,7 @@ bench: $(STAMP)
 	$(PY) tools/bench_kinematics.py
 	$(PY) tools/bench_dynamics.py
 	$(PY) tools/bench_opcount.py
+	$(PY) tools/bench_workspace.py
 
 clean:
 	rm -rf $(VENV) build dist .pytest_cache
