@@ -15,7 +15,7 @@ import pinocchio as pin
 import pytest
 
 from pkm.core import TaskMap, constraints, solve_ik
-from pkm.errors import ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
+from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.mechanisms import hexapod as hx
 
 DEG = math.pi / 180.0
@@ -362,11 +362,8 @@ def test_literal_layout_crosses_legs_5_and_6(params):
 
 
 # ---------------------------------------------------------------------- sec. 4 claims about pose T
-def _reachability_limit(params, layout) -> float:
-    """Lowest beta in [-90, 0] deg where pose T is reachable (bisection) [rad]."""
-    p = hx.Params(layout=layout)
-    R, P = pose_t(p)
-    lo, hi = -90 * DEG, 0.0
+def bisect_beta_limit(p, R, P, lo, hi) -> float:
+    """Edge of reachability in beta between an unreachable ``lo`` and a reachable ``hi`` (60 bisections) [rad]."""
     for _ in range(60):
         mid = 0.5 * (lo + hi)
         try:
@@ -375,6 +372,12 @@ def _reachability_limit(params, layout) -> float:
         except UnreachableError:
             lo = mid
     return hi
+
+
+def _reachability_limit(params, layout) -> float:
+    """Lowest beta in [-90, 0] deg where pose T is reachable (bisection) [rad]."""
+    p = hx.Params(layout=layout)
+    return bisect_beta_limit(p, *pose_t(p), -90 * DEG, 0.0)
 
 
 @pytest.mark.parametrize("layout", ["sector", "literal"])
@@ -450,3 +453,45 @@ def test_generic_inverse_kinematics_matches_the_closed_form_on_both_branches(mec
 
 def _rot(y):
     return pin.Quaternion(y[6], y[3], y[4], y[5]).toRotationMatrix()
+
+
+# ---------------------------------------------------------------------- assembly modes, rotation input
+def test_assembly_mode_search_finds_the_reference_and_verifies_each_mode_with_the_core(mech, params):
+    """Multistart FK (32 seeds) at pose T's actuated coordinates: the reference pose is among the modes, every
+    mode closes the tree's loops (generic core residual <= 1e-9 m), holds the same actuators and they are distinct.
+
+    Pose T lies near a direct singularity, so a second assembly mode sits about 3 mm away.
+    """
+    qa = mech.actuated_q(mech.q_reference)
+    modes = hx.assembly_modes(mech, qa)
+    R, P = pose_t(params)
+    assert np.abs(modes[0].P - P).max() < 1e-10 and np.abs(pin.log3(modes[0].R.T @ R)).max() < 1e-10
+    for m in modes:
+        assert m.core_residual <= 1e-9 and np.abs(constraints.residual(mech, m.q)).max() <= 1e-9
+        assert np.abs(mech.actuated_q(m.q) - qa).max() < 1e-12
+    assert len(modes) >= 2
+    for i, a in enumerate(modes):
+        for b in modes[i + 1:]:
+            assert np.abs(a.C - b.C).max() > 1e-6
+
+
+def test_assembly_mode_search_without_assembly_raises(mech):
+    """Actuated angles that admit no assembly raise AssemblyError after every seed failed."""
+    with pytest.raises(AssemblyError, match="from all 4 seeds"):
+        hx.assembly_modes(mech, np.zeros(7), n_starts=4)
+
+
+@pytest.mark.parametrize("R, defect", [(np.diag([1.0, 1.0, 1.05]), "0.103"), (np.diag([1.0, 1.0, -1.0]), "0")])
+def test_non_orthonormal_rotation_is_rejected_with_the_size_of_the_defect(params, R, defect):
+    """The inverse kinematics refuses a non-rotation, quoting max|R^T R - I| and det R."""
+    with pytest.raises(InvalidInputError, match=rf"max\|R\^T R - I\| = {defect} .*det R"):
+        hx.inverse_kinematics(params, R, params.home_position, 0.0)
+
+
+def test_printed_four_digit_rotation_is_accepted_and_projected(params):
+    """The pose T matrix as printed (defect ~1e-4) is accepted and projected on SO(3): same IK as the projection."""
+    printed = np.reshape(hx.POSE_T_ROTATION, (3, 3))
+    assert 1e-6 < np.abs(printed.T @ printed - np.eye(3)).max() < hx.ROTATION_TOL
+    a = hx.inverse_kinematics(params, printed, params.home_position, 0.0)
+    assert np.allclose(a, hx.inverse_kinematics(params, hx.home_rotation(params), params.home_position, 0.0),
+                       atol=1e-14)

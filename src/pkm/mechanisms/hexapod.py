@@ -96,6 +96,18 @@ Forward kinematics: the paper's semi-closed system (eqs. 4-7, nine quadratic equ
 pose by eqs. (8)-(13) with the layout's convention. It does not use the generic core. Newton's
 method keeps the seed's assembly mode only when the seed is close enough: in the literal layout
 at ``beta = 85 deg``, from pose T, it lands on another assembly about 35 mm away.
+:func:`assembly_modes` searches for other assembly modes (multistart from random platform poses)
+and checks each with the generic core's closure residual; at pose T it finds a second mode about
+3 mm from the first (pose T lies near a direct singularity).
+
+Platform rotations given by the user are checked by :func:`as_rotation`: a defect
+``max|R^T R - I|`` up to :data:`ROTATION_TOL` (matrices printed with 4 digits) is projected away,
+a larger one is refused with its size.
+
+Companion modules: :mod:`pkm.mechanisms.hexapod_screws` (screw-theory velocity and acceleration,
+eqs. 18-33), :mod:`pkm.mechanisms.hexapod_singularities` (types 1-3, sec. 3.3),
+:mod:`pkm.mechanisms.hexapod_indices` (``w_rot``, ``w_tras``, eqs. 34-37) and
+:mod:`pkm.mechanisms.hexapod_reconfigure` (the choice of ``beta``, sec. 4).
 
 Pinocchio 4.1 and the mimic joints: the tree, frame Jacobians, frame accelerations, ``rnea`` and
 ``crba`` handle them; ``getConstraintsJacobian`` and ``aba`` raise ``RuntimeError`` and
@@ -112,10 +124,11 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from pkm.core import constraints
 from pkm.core.mechanism import Mechanism, as_vector, wrap_angle
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.urdf import UrdfBuilder
-from pkm.errors import ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
+from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.mechanisms._common import (
     arm_angle,
     check_finite,
@@ -135,6 +148,9 @@ ACTUATED = ("alpha_1", "alpha_2", "alpha_3", "alpha_4", "alpha_5", "alpha_6", "b
 #: The paper's pose T (sec. 4) as printed: rotation rows (4 digits) and position [m].
 POSE_T_ROTATION = (0.9623, -0.1306, -0.2388, 0.0842, 0.9771, -0.1952, 0.2588, 0.1677, 0.9513)
 POSE_T_POSITION = (0.0, -0.350, 0.0)
+
+#: Largest ``max|R^T R - I|`` accepted for a platform rotation given by the user (then projected on SO(3)).
+ROTATION_TOL = 2e-3
 
 _E_Y = np.array([0.0, 1.0, 0.0])
 
@@ -215,6 +231,26 @@ def leg_frame(theta_i: float) -> np.ndarray:
     return rot_y(-theta_i)
 
 
+def as_rotation(R, name: str = "R", tol: float = ROTATION_TOL) -> np.ndarray:
+    """``R`` checked to be a rotation matrix and projected on SO(3) (SVD).
+
+    Matrices printed with a few digits (the paper's poses carry 4) are accepted: the defect
+    ``max|R^T R - I|`` may reach ``tol``; beyond it, or with ``det R < 0``, ``R`` is refused.
+
+    Raises:
+        InvalidInputError: with the size of the defect and the determinant.
+    """
+    M = np.reshape(as_vector(np.ravel(R), 9, name), (3, 3))
+    defect, det = float(np.abs(M.T @ M - np.eye(3)).max()), float(np.linalg.det(M))
+    if defect > tol or det <= 0.0:
+        raise InvalidInputError(name, f"not a rotation matrix: max|R^T R - I| = {defect:.3g} (tolerance {tol:.0e}), "
+                                      f"det R = {det:.6g}", R)
+    if defect < 1e-15:
+        return M
+    U, _, Vt = np.linalg.svd(M)
+    return U @ Vt
+
+
 def home_rotation(params: HexapodParams) -> np.ndarray:
     """The reference orientation: ``params.home_rotation`` projected on SO(3) (SVD)."""
     U, _, Vt = np.linalg.svd(np.reshape(np.asarray(params.home_rotation, dtype=float), (3, 3)))
@@ -287,11 +323,11 @@ def inverse_kinematics(params: HexapodParams, R, P, beta: float,
         branch: ``"elbow_out"``/``"elbow_in"`` for all legs, or one per leg.
 
     Raises:
+        InvalidInputError: ``R`` is not a rotation (see :func:`as_rotation`).
         UnreachableError: with the first leg that cannot reach and by how much [m].
     """
     branches = _branches(branch)
-    R = np.reshape(as_vector(np.ravel(R), 9, "R"), (3, 3))
-    C = platform_points(params, R, as_vector(P, 3, "P"))
+    C = platform_points(params, as_rotation(R), as_vector(P, 3, "P"))
     A = base_points(params, _scalar(beta, "beta"))
     out = np.empty(6)
     for i in range(6):
@@ -319,7 +355,7 @@ def joint_values(params: HexapodParams, R, P, beta: float,
     Returns:
         ``{joint name: coordinates}``; the platform's quaternion is that of ``R``.
     """
-    R = np.asarray(R, dtype=float)
+    R = as_rotation(R)
     alphas = inverse_kinematics(params, R, P, beta, branch)
     return _joint_values(params, R, P, pin.Quaternion(R).coeffs(), beta, alphas)
 
@@ -417,6 +453,88 @@ def forward_kinematics(params: HexapodParams, alphas, beta: float, seed=None, *,
         raise ConvergenceError("semi-closed forward kinematics (eqs. 4-7)", res, it, tol)
     C = X.reshape(3, 3)
     return np.vstack([C, C + params.h * normal(C)])
+
+
+@dataclass(frozen=True)
+class AssemblyMode:
+    """One solution of the forward kinematics.
+
+    Attributes:
+        C: ``C_1..C_6`` as rows [m].
+        R: Platform orientation (eqs. 9-12).
+        P: Platform position [m] (eq. 8).
+        q: The full configuration of the tree (closed-form joint values of this assembly).
+        core_residual: Largest closure residual of the generic core at ``q`` [m]
+            (:func:`pkm.core.constraints.residual`): the independent check of the solution.
+    """
+
+    C: np.ndarray
+    R: np.ndarray
+    P: np.ndarray
+    q: np.ndarray
+    core_residual: float
+
+
+def assembly_modes(mech: Mechanism, q_actuated, *, n_starts: int = 32, seed: int = 0, tol: float = 1e-12,
+                   max_iter: int = 25, distinct: float = 1e-6, verify_tol: float = 1e-9) -> list[AssemblyMode]:
+    """Assembly modes for given actuated coordinates: the semi-closed FK (eqs. 4-13) from many seeds.
+
+    Multistart: Newton's method (:func:`forward_kinematics`) from the reference pose and from
+    ``n_starts - 1`` random platform poses (uniform rotations, positions in a box below the base
+    spanning the legs' reach); solutions closer than ``distinct`` (max over ``C_i`` [m]) are merged.
+    Each solution is then checked by the generic core: the full configuration built from it must
+    close every loop to ``verify_tol`` (it always does when Newton converged; a failure would mean
+    eqs. 4-13 and the tree disagree). There is no guarantee that every mode is found.
+
+    Args:
+        mech: The hexapod (:func:`build`).
+        q_actuated: ``alpha_1..alpha_6`` (joint coordinates, relative for legs 1-3), ``beta_1`` [rad].
+        n_starts: Seeds tried (>= 1).
+        seed: Seed of the random generator (reproducible results).
+        tol: Newton tolerance [m].
+        max_iter: Newton iterations per seed.
+        distinct: Distance under which two solutions are the same [m].
+        verify_tol: Largest closure residual of the generic core accepted [m].
+
+    Returns:
+        The modes found, sorted by distance of ``P`` from the reference pose.
+
+    Raises:
+        AssemblyError: no seed converged (the actuated coordinates probably admit no assembly).
+    """
+    params = mech.params
+    qa = as_vector(q_actuated, 7, "q_actuated")
+    if not (isinstance(n_starts, int) and n_starts >= 1):
+        raise InvalidInputError("n_starts", f"needs an integer >= 1, got {n_starts!r}", n_starts)
+    alphas, beta = paper_alphas(qa), float(qa[6])
+    rng = np.random.default_rng(seed)
+    reach = params.LA + params.LB
+    seeds = [None]
+    for _ in range(n_starts - 1):
+        Rs = pin.Quaternion(*rng.normal(size=4)).normalized().toRotationMatrix()
+        Ps = rng.uniform([-reach / 2, -reach - params.H0, -reach / 2], [reach / 2, params.Rr, reach / 2])
+        seeds.append(platform_points(params, Rs, Ps)[:3])
+    found: list[AssemblyMode] = []
+    best_res = math.inf
+    for s0 in seeds:
+        try:
+            C = forward_kinematics(params, alphas, beta, s0, tol=tol, max_iter=max_iter)
+        except ConvergenceError as exc:
+            best_res = min(best_res, exc.residual)
+            continue
+        if any(np.abs(C - m.C).max() < distinct for m in found):
+            continue
+        R, P = pose_from_points(params, C)
+        q = mech.q_from_dict(_joint_values(params, R, P, pin.Quaternion(R).coeffs(), beta, alphas))
+        res = float(np.abs(constraints.residual(mech, q)).max())
+        if res > verify_tol or np.abs(mech.actuated_q(q) - actuated_from_paper(alphas, beta)).max() > 1e-12:
+            raise ConvergenceError("assembly-mode check by the generic core", res, 0, verify_tol,
+                                   detail="the semi-closed FK and the tree disagree")
+        found.append(AssemblyMode(C, R, P, q, res))
+    if not found:
+        raise AssemblyError(best_res, "m", f"Newton's method failed from all {n_starts} seeds")
+    P0 = np.asarray(params.home_position)
+    return sorted(found, key=lambda m: float(np.linalg.norm(m.P - P0)))
 
 
 def pose_from_points(params: HexapodParams, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

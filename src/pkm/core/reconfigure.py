@@ -1,0 +1,412 @@
+"""Choosing a redundant scalar reconfiguration parameter by sequential QPs (proxsuite.proxqp).
+
+A reconfigurable mechanism has one more actuator than its task needs: a scalar ``x`` (an angle,
+a length) that can be chosen freely within an interval. Given a performance index
+``f_k(x)`` for each pose ``k`` of a task (a manipulability, an inverse condition number...) this
+module finds
+
+* per pose, ``x*_k`` maximising ``f_k`` on ``[lower_k, upper_k]`` (:func:`maximise`);
+* along a path of poses, the whole profile ``x_0..x_{n-1}`` (:func:`optimise_profile`) that
+  maximises ``sum_k f_k(x_k) / s - (mu / 2) sum_k (x_{k+1} - x_k)^2`` subject to the interval of
+  every pose and the rate limit ``|x_{k+1} - x_k| <= delta``; ``s`` is the largest pointwise
+  optimum ``max_k f_k(x*_k)``, so that ``mu`` is in 1/unit(x)^2 whatever the index.
+
+The index is a callback ``index(k, x) -> f`` vectorised over arrays of pose indices and values
+(same shape). It must be finite on ``[lower_k, upper_k]``; the caller supplies those intervals
+(for a mechanism: the parameter's limits intersected with the interval where the pose is
+reachable). Derivatives are central differences (step ``fd_step``, the stencil kept inside the
+interval), so the index only needs to be twice differentiable.
+
+Method: a trust-region SQP. Each iteration builds the concave quadratic model of the objective
+(curvature ``min(f'', -eta)``: a convex QP even where ``f`` is locally convex) and solves it with
+``proxsuite.proxqp.dense`` (box constraints for the intervals and the trust region, one inequality
+row per rate limit); a step is accepted when the objective increases, and the trust radius grows
+or shrinks with the ratio of actual to predicted gain. :func:`maximise` starts from the best node
+of a grid (the index may have several local maxima); :func:`optimise_profile` starts from the
+pointwise optima clipped to the rate limit (:func:`clip_to_rate`), so its objective is never worse.
+
+The profile's QPs are written in the new values ``y = x + d`` (not in the steps ``d``), so that the
+previous solution is a good warm start: proxqp then needs 1-5 iterations instead of about 25 cold.
+The pointwise QPs are written in the steps divided by the trust radius, each pose's model scaled to
+O(1), since an index can be tiny near the edge of its interval. Known
+traps of proxqp are guarded (:class:`WarmQP`): ``update()`` is never called before the first
+``solve()`` (reported to leave the workspace half set up; not reproduced with proxsuite 0.8.0 on
+a small box QP, guarded anyway); the duality-gap check (``settings.check_duality_gap``) is on, as
+a warm start near an active bound can otherwise stop on small primal and dual residuals with a
+wrong "solved" answer; and a warm solve that does not end ``PROXQP_SOLVED`` is redone cold (with
+step variables, proxsuite 0.8.0 warm-started from the previous step reported a feasible QP
+``PROXQP_PRIMAL_INFEASIBLE``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import proxsuite
+
+from pkm.errors import ConvergenceError, InvalidInputError
+
+IndexFn = Callable[[np.ndarray, np.ndarray], np.ndarray]
+
+#: proxqp accuracy (absolute primal/dual residuals and duality gap).
+QP_EPS = 1e-10
+
+
+class WarmQP:
+    """A dense proxqp problem with fixed inequality rows, solved repeatedly and warm-started.
+
+    Minimise ``1/2 y^T H y + g^T y`` s.t. ``l <= C y <= u`` (fixed at construction) and
+    ``l_box <= y <= u_box``. The first :meth:`solve` calls ``init`` then ``solve``; later ones
+    ``update`` then ``solve`` with ``WARM_START_WITH_PREVIOUS_RESULT``, so ``update`` never precedes
+    the first ``solve``. The duality-gap check is on. A warm solve that does not report
+    ``PROXQP_SOLVED`` is redone cold; if that fails too, :class:`ConvergenceError`.
+
+    Attributes:
+        solves: QPs solved so far; iterations: proxqp iterations, all solves included;
+        cold_restarts: warm solves that had to be redone cold; statuses: status of every solve.
+    """
+
+    def __init__(self, n: int, C: np.ndarray | None = None, l=None, u=None, *, eps: float = QP_EPS,
+                 max_iter: int = 1000):
+        self.n = n
+        self._C = np.zeros((0, n)) if C is None else np.asarray(C, dtype=float)
+        self._l = np.zeros(0) if l is None else np.asarray(l, dtype=float)
+        self._u = np.zeros(0) if u is None else np.asarray(u, dtype=float)
+        self._qp = None
+        self._eps, self._max_iter = eps, max_iter
+        self.solves = self.iterations = self.cold_restarts = 0
+        self.statuses: list[str] = []
+
+    def _cold(self, H, g, l_box, u_box) -> None:
+        qp = proxsuite.proxqp.dense.QP(self.n, 0, self._C.shape[0], True)
+        s = qp.settings
+        s.eps_abs, s.eps_rel = self._eps, 0.0
+        s.check_duality_gap = True
+        s.eps_duality_gap_abs, s.eps_duality_gap_rel = self._eps, 0.0
+        s.max_iter = self._max_iter
+        s.verbose = False
+        qp.init(H, g, None, None, self._C, self._l, self._u, l_box, u_box)
+        qp.solve()  # before any update(): proxqp's workspace is only set up by the first solve
+        s.initial_guess = proxsuite.proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT
+        self._qp = qp
+
+    def solve(self, H, g, l_box, u_box) -> np.ndarray:
+        """The minimiser ``y`` (see the class doc)."""
+        if self._qp is None:
+            self._cold(H, g, l_box, u_box)
+        else:
+            self._qp.update(H, g, None, None, None, None, None, l_box, u_box)
+            self._qp.solve()
+            if self._qp.results.info.status != proxsuite.proxqp.PROXQP_SOLVED:
+                self.cold_restarts += 1
+                self.iterations += self._qp.results.info.iter
+                self._cold(H, g, l_box, u_box)
+        info = self._qp.results.info
+        self.solves += 1
+        self.iterations += info.iter
+        self.statuses.append(str(info.status).rsplit(".", 1)[-1])
+        if info.status != proxsuite.proxqp.PROXQP_SOLVED:
+            raise ConvergenceError("proxqp", max(info.pri_res, info.dua_res), info.iter, self._eps,
+                                   detail=f"status {info.status}")
+        return np.array(self._qp.results.x)
+
+
+@dataclass(frozen=True)
+class PointOptimum:
+    """Pointwise maxima of an index (one entry per pose).
+
+    Attributes:
+        x: The maximisers, shape (n,).
+        value: The index there.
+        lower, upper: The intervals searched.
+        iterations: SQP iterations.
+        qp_solves, qp_iterations: proxqp solves and iterations.
+        converged: Whether every step fell below ``tol`` within ``max_iter``.
+    """
+
+    x: np.ndarray
+    value: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    iterations: int
+    qp_solves: int
+    qp_iterations: int
+    converged: bool
+
+
+@dataclass(frozen=True)
+class ProfileOptimum:
+    """A profile along a path of poses and how it was found.
+
+    Attributes:
+        x: The profile, shape (n,).
+        value: The index along it, shape (n,).
+        objective: ``sum f_k(x_k) / scale - (mu / 2) sum (x_{k+1} - x_k)^2``.
+        scale: ``s``, the largest pointwise optimum of the index.
+        pointwise: The pointwise optima (:class:`PointOptimum`).
+        start: The pointwise optima clipped to the rate limit (:func:`clip_to_rate`), where the SQP starts.
+        start_objective: The objective there (the result is never worse).
+        baseline_value: The index at the baseline parameter (the model without reconfiguration),
+            ``nan`` where the baseline lies outside ``[lower_k, upper_k]`` (see ``baseline_ok``).
+        baseline_ok: Where the baseline is admissible.
+        relative_gain: ``value / baseline_value - 1`` where ``baseline_ok``, else ``nan``.
+        max_rate: ``max |x_{k+1} - x_k|``.
+        iterations: SQP iterations; qp_solves, qp_iterations, cold_restarts: proxqp counters.
+        converged: Whether the SQP converged within its iteration budget.
+        qp_status: Status of every QP solve.
+    """
+
+    x: np.ndarray
+    value: np.ndarray
+    objective: float
+    scale: float
+    pointwise: PointOptimum
+    start: np.ndarray
+    start_objective: float
+    baseline_value: np.ndarray
+    baseline_ok: np.ndarray
+    relative_gain: np.ndarray
+    max_rate: float
+    iterations: int
+    qp_solves: int
+    qp_iterations: int
+    cold_restarts: int
+    converged: bool
+    qp_status: tuple[str, ...] = field(default=())
+
+    def mean_gain(self, start: int = 0) -> float:
+        """Mean relative gain over the poses ``k >= start`` where the baseline is admissible."""
+        g = self.relative_gain[start:][self.baseline_ok[start:]]
+        if g.size == 0:
+            raise InvalidInputError("start", f"no pose from {start} on admits the baseline", start)
+        return float(np.mean(g))
+
+
+# ---------------------------------------------------------------------- derivatives
+def _derivatives(index: IndexFn, k: np.ndarray, x: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                 h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``f, f', f''`` at ``x``; the 3-point stencil is centred at ``c`` inside ``[lo + h, hi - h]``."""
+    c = np.clip(x, lo + h, hi - h)
+    c = np.where(hi - lo < 2 * h, 0.5 * (lo + hi), c)
+    hh = np.minimum(h, 0.5 * (hi - lo))
+    kk = np.concatenate([k, k, k])
+    f = index(kk, np.concatenate([c - hh, c, c + hh]))
+    _check_finite(f, kk, np.concatenate([c - hh, c, c + hh]))
+    fm, f0, fp = np.split(f, 3)
+    safe = np.where(hh > 0, hh, 1.0)
+    d1 = np.where(hh > 0, (fp - fm) / (2 * safe), 0.0)
+    d2 = np.where(hh > 0, (fp - 2 * f0 + fm) / safe**2, 0.0)
+    moved = c != x
+    if np.any(moved):  # Taylor back to x (x near an end of its interval)
+        f0 = np.where(moved, index(k, x), f0)
+        d1 = d1 + d2 * (x - c)
+    return f0, d1, d2
+
+
+def _check_finite(f: np.ndarray, k: np.ndarray, x: np.ndarray) -> None:
+    bad = ~np.isfinite(f)
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        raise InvalidInputError("index", f"the index is not finite at pose {int(k[i])}, x = {x[i]:.6g}; "
+                                         "it must be finite on the whole interval given", f[i])
+
+
+def _intervals(lower, upper) -> tuple[np.ndarray, np.ndarray]:
+    lo, hi = np.atleast_1d(np.asarray(lower, dtype=float)), np.atleast_1d(np.asarray(upper, dtype=float))
+    if lo.shape != hi.shape or lo.ndim != 1:
+        raise InvalidInputError("lower", f"lower and upper must be vectors of one shape, got {lo.shape}, {hi.shape}")
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+        raise InvalidInputError("lower", "the intervals must be finite")
+    if np.any(lo > hi):
+        k = int(np.flatnonzero(lo > hi)[0])
+        raise InvalidInputError("lower", f"empty interval at pose {k}: [{lo[k]:.6g}, {hi[k]:.6g}]")
+    return lo, hi
+
+
+# ---------------------------------------------------------------------- pointwise
+def maximise(index: IndexFn, lower, upper, *, grid: int = 31, tol: float = 1e-9, fd_step: float = 1e-5,
+             max_iter: int = 50, eta: float = 1e-6) -> PointOptimum:
+    """Maximise ``f_k`` on ``[lower_k, upper_k]`` for every pose ``k`` at once.
+
+    The start of pose ``k`` is the best of ``grid`` evenly spaced nodes of its interval; then a
+    trust-region SQP, the ``n`` separable one-variable QPs solved as one proxqp problem per iteration
+    (in the steps scaled by the trust radius, each pose's model scaled to O(1)).
+
+    Args:
+        index: ``index(k, x)``, vectorised (see the module doc).
+        lower, upper: The intervals, shape (n,) or scalars for one pose.
+        grid: Nodes of the starting grid per pose (>= 2).
+        tol: Stop when every accepted step is below ``tol`` (unit of x).
+        fd_step: Finite-difference step (unit of x).
+        max_iter: SQP iterations allowed.
+        eta: Least curvature of the model, relative to ``|f|`` per unit(x)^2.
+
+    Returns:
+        The maximisers and diagnostics.
+    """
+    lo, hi = _intervals(lower, upper)
+    if not (isinstance(grid, int) and grid >= 2):
+        raise InvalidInputError("grid", f"needs an integer >= 2, got {grid!r}", grid)
+    n = lo.size
+    k = np.arange(n)
+    t = np.linspace(0.0, 1.0, grid)
+    nodes = lo[:, None] + (hi - lo)[:, None] * t
+    fg = index(np.repeat(k, grid), nodes.ravel()).reshape(n, grid)
+    _check_finite(fg.ravel(), np.repeat(k, grid), nodes.ravel())
+    best = np.argmax(fg, axis=1)
+    x = nodes[k, best]
+    radius = np.maximum((hi - lo) / (grid - 1), tol)
+    qp = WarmQP(n)
+    f, g, H = _derivatives(index, k, x, lo, hi, fd_step)
+    it, converged = 0, False
+    while it < max_iter:
+        it += 1
+        # model f + g d - curv d^2 / 2 in the scaled step z = d / radius (|z| <= 1), each pose divided by
+        # the size s of its model over the trust region, so that every QP entry is O(1) whatever the index
+        curv = np.maximum(-H, eta * np.maximum(np.abs(f), 1e-300))
+        s = np.maximum(np.maximum(np.abs(g) * radius, curv * radius**2), 1e-300)
+        z = qp.solve(np.diag(curv * radius**2 / s), -g * radius / s, np.maximum(lo - x, -radius) / radius,
+                     np.minimum(hi - x, radius) / radius)
+        x_new = np.clip(x + z * radius, lo, hi)
+        d = x_new - x
+        if np.all((np.abs(d) <= tol) | (radius <= tol)):  # no step left above tol
+            converged = True
+            break
+        predicted = g * d - 0.5 * curv * d * d
+        f_new, g_new, H_new = _derivatives(index, k, x_new, lo, hi, fd_step)
+        ok = (f_new >= f) & (np.abs(d) > 0)
+        ratio = np.where(predicted > 0, (f_new - f) / np.where(predicted > 0, predicted, 1.0), 0.0)
+        radius = np.where(ratio > 0.75, np.minimum(2 * radius, hi - lo + tol),
+                          np.where(ratio < 0.25, np.maximum(0.25 * np.minimum(radius, np.abs(d)), tol), radius))
+        x, f, g, H = (np.where(ok, a, b) for a, b in ((x_new, x), (f_new, f), (g_new, g), (H_new, H)))
+    return PointOptimum(x, f, lo, hi, it, qp.solves, qp.iterations, converged)
+
+
+# ---------------------------------------------------------------------- path
+def feasible_bounds(lower, upper, rate_limit: float) -> tuple[np.ndarray, np.ndarray]:
+    """The tightest intervals that admit a profile within ``[lower_k, upper_k]`` and the rate limit.
+
+    Forward then backward propagation of the intervals by ``+- rate_limit``.
+
+    Raises:
+        InvalidInputError: when no profile satisfies both (with the first pose that cannot be met).
+    """
+    lo, hi = _intervals(lower, upper)
+    if not (np.isfinite(rate_limit) and rate_limit > 0):
+        raise InvalidInputError("rate_limit", f"must be finite and > 0, got {rate_limit!r}", rate_limit)
+    L, U = lo.copy(), hi.copy()
+    for k in range(1, L.size):
+        L[k], U[k] = max(L[k], L[k - 1] - rate_limit), min(U[k], U[k - 1] + rate_limit)
+        if L[k] > U[k]:
+            raise InvalidInputError("rate_limit", f"no profile within the rate limit {rate_limit:.6g} reaches pose "
+                                                  f"{k}: its interval [{lo[k]:.6g}, {hi[k]:.6g}] is too far from "
+                                                  "the previous ones", rate_limit)
+    for k in range(L.size - 2, -1, -1):
+        L[k], U[k] = max(L[k], L[k + 1] - rate_limit), min(U[k], U[k + 1] + rate_limit)
+    return L, U
+
+
+def clip_to_rate(x, lower, upper, rate_limit: float) -> np.ndarray:
+    """``x`` clipped pose by pose, from the first, into the feasible bounds and the rate limit.
+
+    ``y_0 = clip(x_0, L_0, U_0)``, ``y_k = clip(x_k, max(L_k, y_{k-1} - delta), min(U_k, y_{k-1} + delta))``
+    with ``L, U`` from :func:`feasible_bounds` (which keeps every interval non-empty).
+    """
+    L, U = feasible_bounds(lower, upper, rate_limit)
+    x = np.asarray(x, dtype=float)
+    y = np.empty_like(L)
+    y[0] = min(max(x[0], L[0]), U[0])
+    for k in range(1, y.size):
+        y[k] = min(max(x[k], L[k], y[k - 1] - rate_limit), U[k], y[k - 1] + rate_limit)
+    return y
+
+
+def optimise_profile(index: IndexFn, lower, upper, *, rate_limit: float, smoothness: float = 1.0,
+                     baseline: float | None = 0.0, tol: float = 1e-9, fd_step: float = 1e-5, max_iter: int = 100,
+                     eta: float = 1e-6, pointwise: PointOptimum | None = None) -> ProfileOptimum:
+    """The profile maximising the summed index minus a smoothness penalty (see the module doc).
+
+    Args:
+        index: ``index(k, x)``, vectorised, for the poses ``k = 0..n-1`` of the path.
+        lower, upper: Admissible interval of each pose, shape (n,).
+        rate_limit: ``delta`` >= ``|x_{k+1} - x_k|`` (unit of x per pose).
+        smoothness: ``mu`` >= 0 [1/unit(x)^2].
+        baseline: The parameter of the model without reconfiguration (``None``: no comparison).
+        tol: Stop when the step is below ``tol`` (unit of x).
+        fd_step: Finite-difference step.
+        max_iter: SQP iterations allowed.
+        eta: Least curvature of the model per pose, in units of the scaled objective per unit(x)^2.
+        pointwise: The pointwise optima if already computed (else :func:`maximise`).
+
+    Raises:
+        InvalidInputError: bad arguments, or no profile fits the intervals and the rate limit.
+        ConvergenceError: a QP could not be solved.
+    """
+    lo, hi = _intervals(lower, upper)
+    n = lo.size
+    if not (np.isfinite(smoothness) and smoothness >= 0):
+        raise InvalidInputError("smoothness", f"must be finite and >= 0, got {smoothness!r}", smoothness)
+    Lb, Ub = feasible_bounds(lo, hi, rate_limit)
+    pw = maximise(index, lo, hi, tol=tol, fd_step=fd_step, eta=eta) if pointwise is None else pointwise
+    scale = float(np.max(np.abs(pw.value)))
+    if not scale > 0:
+        raise InvalidInputError("index", "the index is zero at every pointwise optimum: nothing to maximise")
+    k = np.arange(n)
+    D = np.diff(np.eye(n), axis=0)  # (n-1, n): (D x)_k = x_{k+1} - x_k
+    DtD = D.T @ D
+
+    def objective(x, f):
+        return float(np.sum(f) / scale - 0.5 * smoothness * np.sum(np.diff(x) ** 2))
+
+    x = clip_to_rate(pw.x, lo, hi, rate_limit)
+    f, g, H = _derivatives(index, k, x, Lb, Ub, fd_step)
+    start, start_obj = x.copy(), objective(x, f)
+    obj = start_obj
+    radius = max(float(np.max(Ub - Lb)) / 4, tol)
+    qp = WarmQP(n, D, np.full(n - 1, -rate_limit), np.full(n - 1, rate_limit))
+    it, converged = 0, False
+    while it < max_iter:
+        it += 1
+        # the model in the new profile y = x + d: 1/2 y^T (diag(curv) + mu D^T D) y - (g + curv x)^T y
+        curv = np.maximum(-H / scale, eta)
+        Hq = np.diag(curv) + smoothness * DtD
+        gq = -g / scale - curv * x
+        x_new = np.clip(qp.solve(Hq, gq, np.maximum(Lb, x - radius), np.minimum(Ub, x + radius)), Lb, Ub)
+        d = x_new - x
+        step = float(np.max(np.abs(d)))
+        if step <= tol or radius <= tol:
+            converged = True
+            break
+        predicted = float(g @ d / scale - 0.5 * curv @ (d * d)
+                          - 0.5 * smoothness * (np.sum(np.diff(x_new) ** 2) - np.sum(np.diff(x) ** 2)))
+        f_new, g_new, H_new = _derivatives(index, k, x_new, Lb, Ub, fd_step)
+        obj_new = objective(x_new, f_new)
+        ratio = (obj_new - obj) / predicted if predicted > 0 else 0.0
+        if obj_new >= obj and step > 0:
+            x, f, g, H, obj = x_new, f_new, g_new, H_new, obj_new
+        if ratio > 0.75 and step >= 0.5 * radius:
+            radius = 2 * radius
+        elif ratio < 0.25:
+            radius = max(0.25 * min(radius, step), tol)
+        if 0 <= predicted <= 1e-14 * max(abs(obj), 1.0):
+            converged = True
+            break
+    if baseline is None:
+        base_ok = np.zeros(n, dtype=bool)
+        base = np.full(n, np.nan)
+    else:
+        base_ok = (lo <= baseline) & (baseline <= hi)
+        base = np.full(n, np.nan)
+        if np.any(base_ok):
+            base[base_ok] = index(k[base_ok], np.full(int(base_ok.sum()), float(baseline)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gain = np.where(base_ok, f / base - 1.0, np.nan)
+    return ProfileOptimum(x, f, obj, scale, pw, start, start_obj, base, base_ok, gain,
+                          float(np.max(np.abs(np.diff(x)))) if n > 1 else 0.0, it, qp.solves, qp.iterations,
+                          qp.cold_restarts, converged, tuple(qp.statuses))
+
+
+__all__ = ["PointOptimum", "ProfileOptimum", "WarmQP", "clip_to_rate", "feasible_bounds", "maximise",
+           "optimise_profile"]

@@ -1,0 +1,47 @@
+"""The hexapod paper study (pkm.papers.hexapod): row contract, pose-T rows, figures."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from pkm import papers
+from pkm.papers import hexapod as study
+
+IDS = ("hexapod.poseT.beta_min_reachable_deg", "hexapod.poseT.beta_opt_wrot_deg", "hexapod.poseT.beta_opt_wtras_deg",
+       "hexapod.spiral.max_gap_rot_tras_deg", "hexapod.spiral.gain_after_40_wrot")
+
+
+def test_rows_carry_the_ids_of_the_issue_with_notes():
+    """reproduce() returns exactly the five contract ids, each with a source and a note; numbers are finite."""
+    rows = study.reproduce()
+    assert tuple(r.id for r in rows) == IDS
+    assert all(isinstance(r, papers.Row) and r.source and r.note for r in rows)
+    assert all(math.isfinite(r.computed) for r in rows)
+
+
+def test_pose_t_rows_match_the_paper():
+    """Sec. 4: reachable from -60 deg (printed to the degree), both optima 'approximately -11 deg' (1 deg)."""
+    rows = {r.id: r for r in study.reproduce()}
+    assert all(rows[i].matches for i in IDS[:3])
+    assert abs(rows[IDS[0]].computed - (-59.50)) < 0.01
+    assert abs(rows[IDS[2]].computed - (-10.98)) < 0.01
+
+
+def test_spiral_rows_are_reported_honestly():
+    """The spiral's gap is computed from the pointwise optima and does not match 2 deg (see the note); the gain is
+    the mean of w_rot(beta*)/w_rot(0) - 1 from pose 40 on, in percent."""
+    rows = {r.id: r for r in study.reproduce()}
+    s = study.spiral()["profiles"]
+    gap = np.degrees(np.abs(s["w_rot"].pointwise - s["w_tras"].pointwise)).max()
+    assert math.isclose(rows[IDS[3]].computed, gap) and rows[IDS[3]].matches is False
+    pr = s["w_rot"]
+    assert math.isclose(rows[IDS[4]].computed, 100 * np.mean(pr.pointwise_value[40:] / pr.base_value[40:] - 1))
+    assert rows[IDS[4]].published is None and "no clear gain" in rows[IDS[4]].note
+
+
+def test_figures_are_written(tmp_path):
+    """Figs. 7, 9 and 10 as PNG files."""
+    paths = study.figures(tmp_path)
+    assert len(paths) == 3 and all(p.exists() and p.stat().st_size > 10_000 for p in paths)
