@@ -27,6 +27,7 @@ bench: $(STAMP)
 	$(PY) tools/bench_dynamics.py
 	$(PY) tools/bench_opcount.py
 	$(PY) tools/bench_workspace.py
+	$(PY) tools/bench_hexapod.py
 
 clean:
 	rm -rf $(VENV) build dist .pytest_cache
