@@ -18,7 +18,7 @@ from collections.abc import Mapping
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.mechanism import Mechanism
+from pkm.core.mechanism import Mechanism, as_vector
 from pkm.errors import InvalidInputError, SingularityError
 
 _ANGLES = ("roll", "pitch", "yaw")
@@ -201,15 +201,33 @@ def _wxyz(xyzw: np.ndarray) -> tuple[float, float, float, float]:
     return float(xyzw[3]), float(xyzw[0]), float(xyzw[1]), float(xyzw[2])
 
 
+ROTATION_TOL = 2e-3  # max|R^T R - I| projected away: matrices printed to 4 digits, as in the papers
+
+
+def as_rotation(R, name: str = "R", tol: float = ROTATION_TOL) -> np.ndarray:
+    """``R`` checked to be a rotation matrix and projected on SO(3) (SVD).
+
+    Matrices printed with a few digits (the papers' poses carry 4) are accepted: the defect
+    ``max|R^T R - I|`` may reach ``tol``; beyond it, or with ``det R <= 0``, ``R`` is refused.
+
+    Raises:
+        InvalidInputError: with the size of the defect and the determinant.
+    """
+    M = np.reshape(as_vector(np.ravel(R), 9, name), (3, 3))
+    defect, det = float(np.abs(M.T @ M - np.eye(3)).max()), float(np.linalg.det(M))
+    if defect > tol or det <= 0.0:
+        raise InvalidInputError(name, f"not a rotation matrix: max|R^T R - I| = {defect:.3g} (tolerance {tol:.0e}), "
+                                      f"det R = {det:.6g}", R)
+    if defect < 1e-15:
+        return M
+    U, _, Vt = np.linalg.svd(M)
+    return U @ Vt
+
+
 def _as_se3(T) -> pin.SE3:
     if isinstance(T, pin.SE3):
         return T
     T = np.asarray(T, dtype=float)
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
         raise InvalidInputError("pose", f"expected a pin.SE3 or a finite 4x4 matrix, got shape {T.shape}", T)
-    R = T[:3, :3]
-    if np.abs(R.T @ R - np.eye(3)).max() > 2e-3 or np.linalg.det(R) < 0:
-        raise InvalidInputError("pose", "the rotation block is not a rotation matrix (orthonormal to 2e-3, det +1)", T)
-    # project onto SO(3): matrices printed to 4 digits (as in the papers) are accepted
-    U, _, Vt = np.linalg.svd(R)
-    return pin.SE3(U @ Vt, T[:3, 3].copy())
+    return pin.SE3(as_rotation(T[:3, :3], "pose"), T[:3, 3].copy())

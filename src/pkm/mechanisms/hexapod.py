@@ -100,8 +100,8 @@ at ``beta = 85 deg``, from pose T, it lands on another assembly about 35 mm away
 and checks each with the generic core's closure residual; at pose T it finds a second mode about
 3 mm from the first (pose T lies near a direct singularity).
 
-Platform rotations given by the user are checked by :func:`as_rotation`: a defect
-``max|R^T R - I|`` up to :data:`ROTATION_TOL` (matrices printed with 4 digits) is projected away,
+Platform rotations given by the user are checked by :func:`pkm.core.task.as_rotation`: a defect
+``max|R^T R - I|`` up to :data:`pkm.core.task.ROTATION_TOL` (matrices printed with 4 digits) is projected away,
 a larger one is refused with its size.
 
 Companion modules: :mod:`pkm.mechanisms.hexapod_screws` (screw-theory velocity and acceleration,
@@ -127,6 +127,7 @@ import pinocchio as pin
 from pkm.core import constraints
 from pkm.core.mechanism import Mechanism, as_vector, wrap_angle
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
+from pkm.core.task import as_rotation
 from pkm.core.urdf import UrdfBuilder
 from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.mechanisms._common import (
@@ -150,7 +151,7 @@ POSE_T_ROTATION = (0.9623, -0.1306, -0.2388, 0.0842, 0.9771, -0.1952, 0.2588, 0.
 POSE_T_POSITION = (0.0, -0.350, 0.0)
 
 #: Largest ``max|R^T R - I|`` accepted for a platform rotation given by the user (then projected on SO(3)).
-ROTATION_TOL = 2e-3
+HOME_ROTATION_TOL = 1e-2  # parameter files may carry coarser matrices
 
 _E_Y = np.array([0.0, 1.0, 0.0])
 
@@ -209,10 +210,11 @@ class HexapodParams:
             if not isinstance(v, (tuple, list)) or len(v) != n or not all(
                     isinstance(x, (int, float)) and math.isfinite(x) for x in v):
                 raise InvalidParameterError(name, f"must be {n} finite numbers (SI units), got {v!r}", v)
-        M = np.reshape(np.asarray(self.home_rotation, dtype=float), (3, 3))
-        if np.linalg.det(M) <= 0.0 or np.max(np.abs(M.T @ M - np.eye(3))) > 1e-2:
-            raise InvalidParameterError("home_rotation", "must be the rows of a rotation matrix (to 1e-2)",
-                                        self.home_rotation)
+        try:
+            as_rotation(self.home_rotation, "home_rotation", HOME_ROTATION_TOL)
+        except InvalidInputError as exc:
+            raise InvalidParameterError("home_rotation", f"must be the rows of a rotation matrix ({exc})",
+                                        self.home_rotation) from None
         try:
             inverse_kinematics(self, home_rotation(self), self.home_position, self.home_beta)
         except UnreachableError as exc:
@@ -231,30 +233,9 @@ def leg_frame(theta_i: float) -> np.ndarray:
     return rot_y(-theta_i)
 
 
-def as_rotation(R, name: str = "R", tol: float = ROTATION_TOL) -> np.ndarray:
-    """``R`` checked to be a rotation matrix and projected on SO(3) (SVD).
-
-    Matrices printed with a few digits (the paper's poses carry 4) are accepted: the defect
-    ``max|R^T R - I|`` may reach ``tol``; beyond it, or with ``det R < 0``, ``R`` is refused.
-
-    Raises:
-        InvalidInputError: with the size of the defect and the determinant.
-    """
-    M = np.reshape(as_vector(np.ravel(R), 9, name), (3, 3))
-    defect, det = float(np.abs(M.T @ M - np.eye(3)).max()), float(np.linalg.det(M))
-    if defect > tol or det <= 0.0:
-        raise InvalidInputError(name, f"not a rotation matrix: max|R^T R - I| = {defect:.3g} (tolerance {tol:.0e}), "
-                                      f"det R = {det:.6g}", R)
-    if defect < 1e-15:
-        return M
-    U, _, Vt = np.linalg.svd(M)
-    return U @ Vt
-
-
 def home_rotation(params: HexapodParams) -> np.ndarray:
     """The reference orientation: ``params.home_rotation`` projected on SO(3) (SVD)."""
-    U, _, Vt = np.linalg.svd(np.reshape(np.asarray(params.home_rotation, dtype=float), (3, 3)))
-    return U @ Vt
+    return as_rotation(params.home_rotation, "home_rotation", HOME_ROTATION_TOL)
 
 
 def base_points(params: HexapodParams, beta: float) -> np.ndarray:
