@@ -101,7 +101,7 @@ and checks each with the generic core's closure residual; at pose T it finds a s
 3 mm from the first (pose T lies near a direct singularity).
 
 Platform rotations given by the user are checked by :func:`pkm.core.task.as_rotation`: a defect
-``max|R^T R - I|`` up to :data:`pkm.core.task.ROTATION_TOL` (matrices printed with 4 digits) is projected away,
+``max|R^T R - I|`` up to :data:`ROTATION_TOL` (matrices printed with 4 digits) is projected away,
 a larger one is refused with its size.
 
 Companion modules: :mod:`pkm.mechanisms.hexapod_screws` (screw-theory velocity and acceleration,
@@ -127,7 +127,7 @@ import pinocchio as pin
 from pkm.core import constraints
 from pkm.core.mechanism import Mechanism, as_vector, wrap_angle
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
-from pkm.core.task import as_rotation
+from pkm.core.task import ROTATION_TOL, as_rotation  # noqa: F401 (ROTATION_TOL: part of this module's API)
 from pkm.core.urdf import UrdfBuilder
 from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.mechanisms._common import (
