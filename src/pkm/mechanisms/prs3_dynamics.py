@@ -55,13 +55,16 @@ from __future__ import annotations
 
 import functools
 import math
+import pathlib
 from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
 
+from pkm.core.differential import inverse_accelerations, inverse_velocities
+from pkm.core.dynamics import KhalilProjection
 from pkm.errors import InvalidInputError, SingularityError, UnreachableError
-from pkm.mechanisms.prs3 import BRANCHES, PHI, Prs3Params, _branches
+from pkm.mechanisms.prs3 import BRANCHES, PHI, Prs3Params, _branches, _task_vector, build, configuration
 
 G = 9.81
 INERTIAL = ("m1", "m2", "MSa", "MSp", "ZZ2", "mp", "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")
@@ -424,8 +427,6 @@ def generate_c(path, params: Prs3Params | None = None, *, mode: str = "numeric")
     The generated function has CasADi's calling convention
     (``int NAME(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem)``).
     """
-    import pathlib
-
     ca, _ = _casadi()
     f = twin(params, mode=mode)
     path = pathlib.Path(path)
@@ -602,9 +603,6 @@ class Prs3Dynamics:
 
     def state(self, y, yd, ydd) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Joint configuration, velocities and accelerations of the tree model for a sample."""
-        from pkm.core.differential import inverse_accelerations, inverse_velocities
-        from pkm.mechanisms.prs3 import configuration
-
         y, yd, ydd, _ = self._sample(y, yd, ydd, None)
         q = configuration(self.mechanism, y, self.branch)
         v = inverse_velocities(self.mechanism, q, yd)
@@ -613,21 +611,15 @@ class Prs3Dynamics:
     @functools.cached_property
     def mechanism(self):
         """The Pinocchio model of the same design."""
-        from pkm.mechanisms.prs3 import build
-
         return build(self.params)
 
     @functools.cached_property
     def _projection(self):
-        from pkm.core.dynamics import KhalilProjection
-
         return KhalilProjection(self.mechanism)
 
     # -------------------------------------------------------------- checks
     @staticmethod
     def _sample(y, yd, ydd, wrench):
-        from pkm.mechanisms.prs3 import _task_vector
-
         y = _task_vector(y, "y")
         yd, ydd = (_samples(np.asarray(a, dtype=float).reshape(1, -1), 3, n)[0] for a, n in ((yd, "yd"),
                                                                                             (ydd, "ydd")))

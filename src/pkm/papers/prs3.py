@@ -28,11 +28,16 @@ MOTIONS = "prs3_motions.toml"
 
 
 @functools.cache
+def motions():
+    """The sec. 5 motion cases (``dynamics/prs3_motions.toml``), read once."""
+    return load_motions(MOTIONS)
+
+
+@functools.cache
 def simulate(case: str):
-    """``(t, Y, result)`` of a sec. 5 motion case on the Table 2 design (P-actuated, slider below)."""
-    motion = load_motions(MOTIONS)[case]
-    t, Y, Yd, Ydd = motion.sample()
-    return t, Y, Prs3Dynamics(Prs3Params()).batch(Y, Yd, Ydd, t=t)
+    """``(t, Ydd, result)`` of a sec. 5 motion case on the Table 2 design (P-actuated, slider below)."""
+    t, Y, Yd, Ydd = motions()[case].sample()
+    return t, Ydd, Prs3Dynamics(Prs3Params()).batch(Y, Yd, Ydd, t=t)
 
 
 @functools.cache
@@ -61,7 +66,7 @@ def reproduce() -> list[Row]:
             Row("prs3.opcount.add", 680, ours.add, "", None, "sec. 4, after eq. (40)", note, "<=")]
 
     p = Prs3Params()
-    t2, Y2, r2 = simulate("2")
+    t2, Ydd2, r2 = simulate("2")
     spread = float(np.ptp(r2.power, axis=1).max())
     rows.append(Row("prs3.case2.power_spread_W", 0.0, spread, "W", 1e-6, "sec. 5, Fig. 3",
                     "largest difference between the three actuator powers over the 5 s (the paper: all equal)"))
@@ -80,12 +85,9 @@ def reproduce() -> list[Row]:
     for case, (t, r) in (("2", (t2, r2)), ("3", (t3, r3))):
         for key, time in FORCE_TIMES.items():
             k = _at(t, time)
+            extra = f"; closed form (m_p/3 + m1 + m2)(g + z'') = {m_leg * (G + Ydd2[k, 0]):.13g} N" if case == "2" \
+                else ""
             for i in range(3):
-                if case == "2":
-                    zdd = load_motions(MOTIONS)["2"].sample(np.array([time]))[3][0, 0]
-                    extra = f"; closed form (m_p/3 + m1 + m2)(g + z'') = {m_leg * (G + zdd):.13g} N"
-                else:
-                    extra = ""
                 rows.append(Row(f"prs3.case{case}.F{i + 1}_{key}_N", None, float(r.tau[k, i]), "N", None,
                                 f"sec. 5, case {case}", f"slider force at t = {time} s; the paper prints no "
                                                         f"force values{extra}"))
@@ -97,7 +99,7 @@ def series(out_dir) -> list[Path]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = []
-    for case in sorted(load_motions(MOTIONS)):
+    for case in sorted(motions()):
         t, _, r = simulate(case)
         path = out / f"prs3_case{case}.csv"
         with path.open("w", newline="") as fh:
@@ -123,15 +125,16 @@ def figures(out_dir) -> list[Path]:
         ax.legend()
         paths.append(save(fig, out_dir, fig_name))
     fig, axes = figure(ncols=2, nrows=2)
-    for ax, case in zip(axes.ravel(), sorted(load_motions(MOTIONS))):
+    for ax, case in zip(axes.ravel(), sorted(motions())):
         t, _, r = simulate(case)
         for i in range(3):
             ax.plot(t, r.tau[:, i], label=f"F{i + 1}", linestyle=("-", "--", ":")[i])
-        ax.set(xlabel="t [s]", ylabel="slider force [N]", title=f"case {case}: {load_motions(MOTIONS)[case].description}")
+        ax.set(xlabel="t [s]", ylabel="slider force [N]", title=f"case {case}: {motions()[case].description}")
         ax.grid(True, alpha=0.3)
         ax.legend()
     paths.append(save(fig, out_dir, "prs3_forces"))
     return paths
 
 
-__all__ = ["FORCE_TIMES", "PUBLISHED_COUNTS", "TITLE", "counts", "figures", "reproduce", "series", "simulate"]
+__all__ = ["FORCE_TIMES", "PUBLISHED_COUNTS", "TITLE", "counts", "figures", "motions", "reproduce", "series",
+           "simulate"]
