@@ -60,6 +60,7 @@ class Leg:
         v: Velocity indices of the leg's joints (tree order).
         actuated: Positions in ``v`` of the actuated joints.
         actuated_index: Their positions in ``mech.actuated`` (the order of ``tau``).
+        passive: Positions in ``v`` of the passive joints.
     """
 
     closures: tuple[str, ...]
@@ -67,11 +68,7 @@ class Leg:
     v: np.ndarray
     actuated: np.ndarray
     actuated_index: np.ndarray
-
-    @property
-    def passive(self) -> np.ndarray:
-        """Positions in ``v`` of the passive joints."""
-        return np.setdiff1d(np.arange(len(self.v)), self.actuated)
+    passive: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -136,7 +133,8 @@ def partition(mech: Mechanism) -> Partition:
         v = np.array(sorted(vs))
         a = [i for i, vi in enumerate(v) if int(vi) in act]
         legs.append(Leg(tuple(names), np.array(sorted(rows)), v, np.array(a, dtype=int),
-                        np.array([act[int(v[i])] for i in a], dtype=int)))
+                        np.array([act[int(v[i])] for i in a], dtype=int),
+                        np.array([i for i in range(len(v)) if i not in a], dtype=int)))
     return Partition(np.array(sorted(plat)), tuple(legs))
 
 
