@@ -639,7 +639,7 @@ class Prs3Dynamics:
             return
         k = int(np.argmax(bad))
         where = _where(k + offset, None if t is None else t[k:k + 1], local=True)
-        if bad_rad[k].any() or bad_sig[k].any() and not np.isfinite(sigma[k]).all():
+        if bad_rad[k].any() or not np.isfinite(sigma[k]).all():  # NaN sigma: radicand below zero
             leg = int(np.argmax(bad_rad[k] | ~np.isfinite(sigma[k])))
             excess = math.sqrt(max(l * l - rad[k, leg], 0.0)) - l
             raise UnreachableError(leg + 1, excess, "m", f"{where}: the spherical joint is farther than l from "
