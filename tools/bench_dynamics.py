@@ -97,7 +97,7 @@ def main() -> None:
     n = args.n
     Y = np.array([0.81, 0.0, 0.0]) + rng.uniform(-1, 1, (n, 3)) * [0.05, 0.15, 0.15]
     Yd, Ydd = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
-    sample = [(Y[k], Yd[k], Ydd[k]) for k in range(200)]
+    sample = [(Y[k], Yd[k], Ydd[k]) for k in range(min(200, len(Y)))]
 
     base = np.array([via_constraint_dynamics(dyn, *s) for s in sample])
     t_base = _median_us(lambda *s: via_constraint_dynamics(dyn, *s), sample, repeat=400)

@@ -12,6 +12,8 @@ Quick start::
 
 from __future__ import annotations
 
+import dataclasses
+
 from pkm import errors
 from pkm.core import (
     ClosureSpec,
@@ -34,7 +36,7 @@ from pkm.core import (
     velocities,
 )
 from pkm.data import spec_path
-from pkm.errors import PkmError
+from pkm.errors import PkmError, UnknownNameError
 from pkm.mechanisms import NAMES as MECHANISMS
 from pkm.mechanisms import module as mechanism_module
 
@@ -42,7 +44,12 @@ __version__ = "0.1.0"
 
 
 def load(name: str) -> Mechanism:
-    """The reference design of mechanism ``name`` from the shipped ``urdf/`` files."""
+    """The reference design of mechanism ``name`` from the shipped ``urdf/`` files.
+
+    Raises:
+        UnknownNameError: ``name`` is not one of :data:`MECHANISMS`.
+        SpecError: the shipped files are damaged.
+    """
     mod = mechanism_module(name)
     mech = Mechanism.from_files(spec_path(name))
     mech.params = mod.Params()
@@ -50,8 +57,18 @@ def load(name: str) -> Mechanism:
 
 
 def build(name: str, **params) -> Mechanism:
-    """Mechanism ``name`` generated from parameters (SI units; unspecified ones keep the paper's values)."""
+    """Mechanism ``name`` generated from parameters (SI units; unspecified ones keep the paper's values).
+
+    Raises:
+        UnknownNameError: an unknown mechanism or parameter name (the valid ones listed).
+        InvalidParameterError: a parameter out of range, or a design that cannot assemble at its
+            reference pose (see the mechanism's ``Params``).
+    """
     mod = mechanism_module(name)
+    fields = [f.name for f in dataclasses.fields(mod.Params)]
+    for key in params:
+        if key not in fields:
+            raise UnknownNameError("parameter", key, fields, f"pkm.build({name!r})")
     return mod.build(mod.Params(**params))
 
 

@@ -32,6 +32,10 @@ class InvalidParameterError(InvalidInputError):
     """A mechanism parameter is invalid (negative length, geometry that cannot assemble...)."""
 
 
+def _plural(noun: str) -> str:
+    return noun + ("es" if noun.endswith(("s", "sh", "ch", "x")) else "s")
+
+
 class UnknownNameError(PkmError, LookupError):
     """A frame, joint, branch or mechanism name does not exist.
 
@@ -48,7 +52,7 @@ class UnknownNameError(PkmError, LookupError):
         loc = f" in {where}" if where else ""
         shown = ", ".join(repr(v) for v in self.valid[:40])
         more = f", ... ({len(self.valid)} in all)" if len(self.valid) > 40 else ""
-        super().__init__(f"{kind} {name!r} does not exist{loc}; valid {kind}s: {shown}{more}")
+        PkmError.__init__(self, f"{kind} {name!r} does not exist{loc}; valid {_plural(kind)}: {shown}{more}")
 
     def __str__(self) -> str:  # LookupError would quote the message like a KeyError
         return self.args[0]
@@ -64,6 +68,18 @@ class SpecError(PkmError):
     def __init__(self, source: str, message: str):
         self.source = source
         super().__init__(f"{source}: {message}")
+
+
+class SpecNameError(UnknownNameError, SpecError):
+    """A closure spec names a frame, joint or branch that its URDF does not have.
+
+    Both an :class:`UnknownNameError` (``kind``, ``name``, ``valid``) and a :class:`SpecError`
+    (``source``): a file that references a missing link or frame is a malformed file.
+    """
+
+    def __init__(self, source: str, kind: str, name: str, valid: Iterable[str], where: str = ""):
+        self.source = source
+        UnknownNameError.__init__(self, kind, name, valid, f"{source} ({where})" if where else source)
 
 
 class UnreachableError(PkmError):
@@ -117,6 +133,7 @@ class ConvergenceError(PkmError):
     """An iterative solver did not converge.
 
     Attributes:
+        what: The solver that failed (e.g. "loop closure").
         residual: Final residual norm (infinity norm, SI units of the equations).
         iterations: Iterations performed.
         worst_closure: Name of the loop left most open (None if not applicable).
@@ -127,6 +144,7 @@ class ConvergenceError(PkmError):
 
     def __init__(self, what: str, residual: float, iterations: int, tolerance: float, result: object = None,
                  detail: str = ""):
+        self.what = what
         self.residual = float(residual)
         self.iterations = int(iterations)
         self.tolerance = float(tolerance)
@@ -138,6 +156,23 @@ class ConvergenceError(PkmError):
             f"{what} did not converge: residual {self.residual:.3e} > tolerance {self.tolerance:.1e} "
             f"after {self.iterations} iterations{extra}"
         )
+
+
+class NonFiniteError(PkmError, ArithmeticError):
+    """A computation produced NaN or infinity from finite inputs (overflow, a vanishing divisor...).
+
+    Raised at the boundary of a public routine instead of returning the non-finite value.
+
+    Attributes:
+        what: The quantity that came out non-finite.
+        value: The offending value (as computed).
+    """
+
+    def __init__(self, what: str, value: object = None, detail: str = ""):
+        self.what = what
+        self.value = value
+        extra = f"; {detail}" if detail else ""
+        super().__init__(f"{what} is not finite (NaN or infinity){extra}")
 
 
 class BranchError(PkmError):

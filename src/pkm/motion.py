@@ -18,6 +18,12 @@ sampling step and one law per coordinate::
 
 Laws, with ``t`` in seconds: ``constant`` (``value``), ``linear`` (``start + rate t``) and
 ``cosine`` (``offset + amplitude (1 - cos(omega t))``). Their derivatives are exact.
+
+What the loader refuses (:class:`~pkm.errors.SpecError`): a path that is not a regular file
+(FIFOs and devices are not opened for reading), a file over 16 MiB or not UTF-8, TOML that does
+not parse or nests too deeply, another ``format``, a case without a law for every coordinate,
+unknown keys, numbers that are not finite or beyond 1e6 (SI), booleans or strings for numbers,
+``dt > duration`` and a case of more than 10^7 samples.
 """
 
 from __future__ import annotations
@@ -29,10 +35,14 @@ from pathlib import Path
 
 import numpy as np
 
+from pkm.core.mechanism import ABSURD, as_array, finite_result
+from pkm.core.spec import as_path, read_text_file
 from pkm.data import dynamics_path
 from pkm.errors import InvalidInputError, SpecError
 
 FORMAT = "pkm.motion/1"
+MAX_SAMPLES = 10_000_000  #: samples of one case at most (memory)
+MAX_TIME = 1e9  #: |t| [s] accepted by :meth:`Motion.sample`
 LAWS = {"constant": ("value",), "linear": ("start", "rate"), "cosine": ("offset", "amplitude", "omega")}
 
 
@@ -86,11 +96,15 @@ class Motion:
 
     def sample(self, t=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(t, Y, Yd, Ydd)``: times (N,) and positions, velocities, accelerations (N, n)."""
-        t = self.times() if t is None else np.atleast_1d(np.asarray(t, dtype=float))
+        t = self.times() if t is None else np.atleast_1d(as_array(t, "t", "times [s]"))
         if t.ndim != 1 or not np.all(np.isfinite(t)):
             raise InvalidInputError("t", f"expected finite times of shape (N,), got shape {t.shape}")
+        if t.size and np.max(np.abs(t)) > MAX_TIME:
+            raise InvalidInputError("t", f"times beyond {MAX_TIME:g} s are refused (are they in seconds?)", t)
         parts = [law(t) for law in self.laws]
-        return t, *(np.column_stack([p[k] for p in parts]) for k in range(3))
+        out = tuple(np.column_stack([p[k] for p in parts]) for k in range(3))
+        finite_result(out, f"motion {self.name!r}", "a law overflows at these times")
+        return (t, *out)
 
 
 def load_motions(file: str | Path) -> dict[str, Motion]:
@@ -99,14 +113,16 @@ def load_motions(file: str | Path) -> dict[str, Motion]:
     Raises:
         SpecError: The file is missing, not TOML, of another format, or a case is malformed.
     """
-    path = Path(file) if Path(file).parent != Path(".") or Path(file).exists() else dynamics_path(str(file))
+    path = as_path(file, "file")
+    path = path if path.parent != Path(".") or path.exists() else dynamics_path(str(path))
     src = str(path)
+    text = read_text_file(path, "motion file")
     try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise SpecError(src, f"cannot read the motion file: {exc.strerror}") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
         raise SpecError(src, f"not valid TOML: {exc}") from None
+    except RecursionError:
+        raise SpecError(src, "not valid TOML for pkm: arrays or tables nested too deeply") from None
     if raw.get("format") != FORMAT:
         raise SpecError(src, f"format {raw.get('format')!r}; this pkm reads {FORMAT!r}")
     coords = raw.get("coordinates")
@@ -119,8 +135,8 @@ def load_motions(file: str | Path) -> dict[str, Motion]:
 
 
 def _number(src: str, where: str, v) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise SpecError(src, f"{where} must be a finite number, got {v!r}")
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or abs(v) > ABSURD:
+        raise SpecError(src, f"{where} must be a finite number of magnitude <= {ABSURD:g} (SI units), got {v!r}")
     return float(v)
 
 
@@ -131,10 +147,13 @@ def _motion(src: str, name: str, body, coords: tuple[str, ...]) -> Motion:
     dt = _number(src, f"case {name!r} dt", body.get("dt"))
     if not (0.0 < dt <= duration <= 1e6):
         raise SpecError(src, f"case {name!r}: need 0 < dt <= duration <= 1e6 s, got dt={dt}, duration={duration}")
+    if duration / dt > MAX_SAMPLES:
+        raise SpecError(src, f"case {name!r}: duration / dt = {duration / dt:.3g} samples, more than {MAX_SAMPLES}; "
+                             "take a larger dt")
     laws = []
     for c in coords:
         spec = body.get(c)
-        if not isinstance(spec, dict) or spec.get("law") not in LAWS:
+        if not isinstance(spec, dict) or not isinstance(spec.get("law"), str) or spec["law"] not in LAWS:
             raise SpecError(src, f"case {name!r}: coordinate {c!r} needs a law, one of {sorted(LAWS)}")
         keys = LAWS[spec["law"]]
         extra = set(spec) - {"law", *keys}

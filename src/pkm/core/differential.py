@@ -25,16 +25,38 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core import constraints
-from pkm.core.mechanism import Mechanism
+from pkm.core.mechanism import Mechanism, as_tolerance, as_vector, check_mechanism, finite_result
 from pkm.core.task import TaskMap
 from pkm.errors import SingularityError
 
 RTOL = 1e-9
 
 
+def _check(mech, q) -> tuple[Mechanism, np.ndarray]:
+    """The mechanism and ``q`` checked (type, shape, finiteness, unit quaternions)."""
+    mech = check_mechanism(mech)
+    return mech, mech.check_q(q)
+
+
+def _lstsq(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.linalg.lstsq`` with its failure (entries overflowing) reported as a PkmError."""
+    finite_result(A, "Jacobian")
+    finite_result(b, "right-hand side")
+    try:
+        return np.linalg.lstsq(A, b, rcond=None)[0]
+    except np.linalg.LinAlgError as exc:
+        finite_result(np.nan, "least-squares solution", f"numpy: {exc}")
+        raise
+
+
 def _smin(A: np.ndarray, ncols: int | None = None) -> tuple[float, float]:
     """(smallest, largest) of the first ``ncols`` singular values (column-rank measure)."""
-    s = np.linalg.svd(A, compute_uv=False)
+    finite_result(A, "Jacobian")
+    try:
+        s = np.linalg.svd(A, compute_uv=False)
+    except np.linalg.LinAlgError as exc:
+        finite_result(np.nan, "singular values", f"numpy: {exc}")
+        raise
     n = A.shape[1] if ncols is None else ncols
     if len(s) < n:
         return 0.0, float(s[0]) if len(s) else 0.0
@@ -48,9 +70,10 @@ def passive_map(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
         SingularityError: ``kind="direct"`` where the passive columns of the constraint
             Jacobian lose rank.
     """
-    q = mech.check_q(q)
+    mech, q = _check(mech, q)
+    rtol = as_tolerance(rtol, "rtol")
     Jc = constraints.jacobian(mech, q)
-    return _passive_map(mech, Jc, rtol)
+    return finite_result(_passive_map(mech, Jc, rtol), "passive map G")
 
 
 def _passive_map(mech: Mechanism, Jc: np.ndarray, rtol: float) -> np.ndarray:
@@ -60,23 +83,24 @@ def _passive_map(mech: Mechanism, Jc: np.ndarray, rtol: float) -> np.ndarray:
         raise SingularityError("direct", smin, "actuators locked, the mechanism can still move")
     G = np.zeros((mech.nv, mech.na))
     G[mech.act_v, np.arange(mech.na)] = 1.0
-    G[mech.passive_v] = -np.linalg.lstsq(Jp, Jc[:, mech.act_v], rcond=None)[0]
+    G[mech.passive_v] = -_lstsq(Jp, Jc[:, mech.act_v])
     return G
 
 
 def forward_jacobian(mech: Mechanism, q) -> np.ndarray:
     """Task rates from actuated rates, ``yd = J qd_a`` (n_task x na)."""
-    q = mech.check_q(q)
+    mech, q = _check(mech, q)
     G = _passive_map(mech, constraints.jacobian(mech, q), RTOL)
-    return TaskMap(mech).jacobian(q, update=False) @ G
+    return finite_result(TaskMap(mech).jacobian(q, update=False) @ G, "forward Jacobian")
 
 
 def twist_jacobian(mech: Mechanism, q) -> np.ndarray:
     """End-effector twist ``[v; w]`` (origin velocity, world axes) from actuated rates (6 x na)."""
-    q = mech.check_q(q)
+    mech, q = _check(mech, q)
     G = _passive_map(mech, constraints.jacobian(mech, q), RTOL)
     pin.updateFramePlacements(mech.model, mech.data)
-    return pin.getFrameJacobian(mech.model, mech.data, mech.ee_frame, pin.LOCAL_WORLD_ALIGNED) @ G
+    return finite_result(pin.getFrameJacobian(mech.model, mech.data, mech.ee_frame, pin.LOCAL_WORLD_ALIGNED) @ G,
+                         "twist Jacobian")
 
 
 def inverse_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
@@ -85,7 +109,8 @@ def inverse_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
     Raises:
         SingularityError: ``kind="inverse"`` where ``[J_c; J_t]`` loses column rank.
     """
-    q = mech.check_q(q)
+    mech, q = _check(mech, q)
+    rtol = as_tolerance(rtol, "rtol")
     Jc = constraints.jacobian(mech, q)
     A = np.vstack([Jc, TaskMap(mech).jacobian(q, update=False)])
     smin, smax = _smin(A)
@@ -93,59 +118,65 @@ def inverse_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
         raise SingularityError("inverse", smin, "the task frozen, the joints can still move")
     rhs = np.zeros((A.shape[0], mech.n_task))
     rhs[mech.n_constraints:] = np.eye(mech.n_task)
-    return np.linalg.lstsq(A, rhs, rcond=None)[0][mech.act_v]
+    return finite_result(_lstsq(A, rhs)[mech.act_v], "inverse Jacobian")
 
 
 def velocities(mech: Mechanism, q, qd_actuated) -> np.ndarray:
     """All joint rates ``v`` (nv,) from the actuated rates."""
-    return passive_map(mech, q) @ mech.check_actuated(qd_actuated, "qd_actuated")
+    G = passive_map(mech, q)
+    return finite_result(G @ mech.check_actuated(qd_actuated, "qd_actuated"), "joint velocities")
 
 
 def accelerations(mech: Mechanism, q, v, qdd_actuated) -> np.ndarray:
     """All joint accelerations ``a`` (nv,) from the actuated ones, the drift included."""
-    q, v = mech.check_q(q), mech.check_v(v)
+    mech, q = _check(mech, q)
+    v = mech.check_v(v)
     qdd = mech.check_actuated(qdd_actuated, "qdd_actuated")
     gamma = constraints.drift(mech, q, v)
     Jc = constraints.jacobian(mech, q)
     _passive_map(mech, Jc, RTOL)  # raises at a direct singularity
     a = np.zeros(mech.nv)
     a[mech.act_v] = qdd
-    a[mech.passive_v] = -np.linalg.lstsq(Jc[:, mech.passive_v], Jc[:, mech.act_v] @ qdd + gamma, rcond=None)[0]
-    return a
+    a[mech.passive_v] = -_lstsq(Jc[:, mech.passive_v], Jc[:, mech.act_v] @ qdd + gamma)
+    return finite_result(a, "joint accelerations")
 
 
 def task_velocity(mech: Mechanism, q, v) -> np.ndarray:
     """Task rates for joint rates ``v``."""
-    q, v = mech.check_q(q), mech.check_v(v)
-    return TaskMap(mech).jacobian(q) @ v
+    mech, q = _check(mech, q)
+    v = mech.check_v(v)
+    return finite_result(TaskMap(mech).jacobian(q) @ v, "task velocity")
 
 
 def task_acceleration(mech: Mechanism, q, v, a) -> np.ndarray:
     """Task accelerations ``J_t a + dJ_t/dt v``."""
-    q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
+    mech, q = _check(mech, q)
+    v, a = mech.check_v(v), mech.check_v(a, "a")
     task = TaskMap(mech)
-    return task.jacobian(q) @ a + task.bias(q, v)
+    return finite_result(task.jacobian(q) @ a + task.bias(q, v), "task acceleration")
 
 
 def inverse_velocities(mech: Mechanism, q, yd) -> np.ndarray:
     """All joint rates ``v`` for task rates ``yd`` (nv,)."""
-    q = mech.check_q(q)
-    yd = np.asarray(yd, dtype=float)
+    mech, q = _check(mech, q)
+    yd = as_vector(yd, mech.n_task, "yd")
     Jc = constraints.jacobian(mech, q)
     A = np.vstack([Jc, TaskMap(mech).jacobian(q, update=False)])
-    return np.linalg.lstsq(A, np.concatenate([np.zeros(mech.n_constraints), yd]), rcond=None)[0]
+    return finite_result(_lstsq(A, np.concatenate([np.zeros(mech.n_constraints), yd])), "joint velocities")
 
 
 def inverse_accelerations(mech: Mechanism, q, v, ydd) -> np.ndarray:
     """All joint accelerations ``a`` for task accelerations ``ydd`` at state ``(q, v)``."""
-    q, v = mech.check_q(q), mech.check_v(v)
+    mech, q = _check(mech, q)
+    v = mech.check_v(v)
+    ydd = as_vector(ydd, mech.n_task, "ydd")
     task = TaskMap(mech)
     gamma_c = constraints.drift(mech, q, v)
     gamma_t = task.bias(q, v)
     Jc = constraints.jacobian(mech, q)
     A = np.vstack([Jc, task.jacobian(q, update=False)])
-    rhs = np.concatenate([-gamma_c, np.asarray(ydd, dtype=float) - gamma_t])
-    return np.linalg.lstsq(A, rhs, rcond=None)[0]
+    rhs = np.concatenate([-gamma_c, ydd - gamma_t])
+    return finite_result(_lstsq(A, rhs), "joint accelerations")
 
 
 @dataclass(frozen=True)
@@ -172,9 +203,11 @@ class Diagnostics:
 
 def diagnose(mech: Mechanism, q, *, rtol: float = 1e-7) -> Diagnostics:
     """Rank, mobility and singularity classification at ``q`` (which should be assembled)."""
-    q = mech.check_q(q)
+    mech, q = _check(mech, q)
+    rtol = as_tolerance(rtol, "rtol")
     Jc = constraints.jacobian(mech, q)
     Jt = TaskMap(mech).jacobian(q, update=False)
+    finite_result(Jc, "constraint Jacobian")
     s = np.linalg.svd(Jc, compute_uv=False)
     rank = int(np.sum(s > rtol * max(s[0], 1.0))) if len(s) else 0
     sd, sdmax = _smin(Jc[:, mech.passive_v])

@@ -44,7 +44,7 @@ import pinocchio as pin
 
 from pkm.core import constraints
 from pkm.core.differential import passive_map
-from pkm.core.mechanism import Mechanism, as_vector
+from pkm.core.mechanism import Mechanism, as_scalar, as_tolerance, as_vector, check_mechanism, finite_result
 from pkm.errors import PkmError, SingularityError, SpecError
 
 RTOL = 1e-9
@@ -96,6 +96,7 @@ def partition(mech: Mechanism) -> Partition:
             leg to the platform, an actuated joint on the platform side, a joint that belongs to
             no leg, or mimic joints (not supported).
     """
+    mech = check_mechanism(mech)
     model = mech.model
     src = mech.source
     if _has_mimic(model):
@@ -164,9 +165,9 @@ class KhalilProjection:
     """
 
     def __init__(self, mech: Mechanism, *, rtol: float = RTOL):
-        self.mech = mech
+        self.mech = check_mechanism(mech)
         self.partition = partition(mech)
-        self.rtol = rtol
+        self.rtol = as_tolerance(rtol, "rtol")
 
     def projection(self, q) -> Projection:
         """``J_k`` and the legs' velocity maps at ``q`` (assembled).
@@ -177,7 +178,7 @@ class KhalilProjection:
         """
         mech, part = self.mech, self.partition
         q = mech.check_q(q)
-        Jc = constraints.jacobian(mech, q)
+        Jc = finite_result(constraints.jacobian(mech, q), "constraint Jacobian")
         na, n_p = mech.na, len(part.platform_v)
         A = np.zeros((na, n_p))
         K, Ls, sig = [], [], []
@@ -229,7 +230,8 @@ class KhalilProjection:
             tau[leg.actuated_index] = hk[leg.actuated]
             p = leg.passive
             f += L[p].T @ hk[p]
-        return tau + proj.Jk.T @ f
+        return finite_result(tau + proj.Jk.T @ f, "actuator efforts", "the state is too large for the inertias "
+                                                                      "(overflow); check the units")
 
 
 def _has_mimic(model: pin.Model) -> bool:
@@ -243,8 +245,9 @@ def inverse_dynamics(mech: Mechanism, q, v, a, wrench=None) -> np.ndarray:
 
 def virtual_work_dynamics(mech: Mechanism, q, v, a) -> np.ndarray:
     """Actuator efforts as ``G^T rnea(q, v, a)``, ``G = dq/dq_a``: the whole-tree virtual-work route."""
+    mech = check_mechanism(mech)
     q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
-    return passive_map(mech, q).T @ pin.rnea(mech.model, mech.data, q, v, a)
+    return finite_result(passive_map(mech, q).T @ pin.rnea(mech.model, mech.data, q, v, a), "actuator efforts")
 
 
 def forward_dynamics(mech: Mechanism, q, v, tau_actuated, *, mu: float = 0.0) -> np.ndarray:
@@ -257,23 +260,40 @@ def forward_dynamics(mech: Mechanism, q, v, tau_actuated, *, mu: float = 0.0) ->
         PkmError: The model has mimic joints (Pinocchio 4.1's ``constraintDynamics`` does not
             handle them).
     """
+    mech = check_mechanism(mech)
     q, v = mech.check_q(q), mech.check_v(v)
     tau_a = mech.check_actuated(tau_actuated, "tau_actuated")
+    mu = as_scalar(mu, "mu", low=0.0)
     if _has_mimic(mech.model):
         raise PkmError("constraintDynamics does not support mimic joints on Pinocchio 4.1")
     tau = np.zeros(mech.nv)
     tau[mech.act_v] = tau_a
     pin.initConstraintDynamics(mech.model, mech.data, mech.constraint_models, mech.constraint_datas)
     settings = pin.ProximalSettings(1e-14, mu, 10)
-    return pin.constraintDynamics(mech.model, mech.data, q, v, tau, mech.constraint_models, mech.constraint_datas,
-                                  settings).copy()
+    a = pin.constraintDynamics(mech.model, mech.data, q, v, tau, mech.constraint_models, mech.constraint_datas,
+                               settings).copy()
+    if not np.all(np.isfinite(a)):
+        s = np.linalg.svd(finite_result(constraints.jacobian(mech, q), "constraint Jacobian"), compute_uv=False)
+        if mu == 0.0 and s[-1] <= 1e-9 * max(s[0], 1.0):
+            raise SingularityError("constraint", float(s[-1]), "the closure equations are redundant (a planar "
+                                   "mechanism closed with 3-D points?): pass mu > 0, e.g. mu=1e-8")
+        finite_result(a, "joint accelerations", "constraintDynamics failed (a singular configuration?)")
+    return a
 
 
 def energy(mech: Mechanism, q, v) -> tuple[float, float]:
     """Kinetic [J] and potential [J] energy of every body (gravity ``mech.model.gravity``)."""
+    mech = check_mechanism(mech)
     q, v = mech.check_q(q), mech.check_v(v)
-    return (float(pin.computeKineticEnergy(mech.model, mech.data, q, v)),
-            float(pin.computePotentialEnergy(mech.model, mech.data, q)))
+    m, d = mech.model, mech.data
+    if not _has_mimic(m):
+        return float(pin.computeKineticEnergy(m, d, q, v)), float(pin.computePotentialEnergy(m, d, q))
+    # Pinocchio 4.1's energy routines refuse mimic joints (the hexapod): sum over the bodies instead
+    pin.forwardKinematics(m, d, q, v)
+    bodies = range(1, m.njoints)
+    kinetic = sum(0.5 * m.inertias[i].vtiv(d.v[i]) for i in bodies)
+    potential = -sum(m.inertias[i].mass * float(m.gravity.linear @ d.oMi[i].act(m.inertias[i].lever)) for i in bodies)
+    return float(kinetic), float(potential)
 
 
 __all__ = ["KhalilProjection", "Leg", "Partition", "Projection", "energy", "forward_dynamics", "inverse_dynamics",

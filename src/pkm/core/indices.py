@@ -10,29 +10,50 @@ here, so a study says which one it uses:
 
 A Jacobian mixing translations and rotations must be made dimensionally homogeneous
 first (:func:`homogenize`), otherwise every one of these depends on the unit of length.
+
+Condition numbers are computed on each matrix divided by its largest entry (they do not change),
+so that matrices with huge or tiny entries neither overflow nor underflow; ``inf`` marks a
+singular matrix (or a condition number beyond the float range), never NaN.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from pkm.core.mechanism import as_array, as_scalar, finite_result
 from pkm.errors import InvalidInputError
 
 KINDS = ("2", "fro", "fro_normalized")
 
 
 def _stack(J) -> np.ndarray:
-    J = np.asarray(J, dtype=float)
+    J = as_array(J, "J", "a matrix (m, n) or a stack (..., m, n) of numbers")
     if J.ndim < 2:
         raise InvalidInputError("J", f"a Jacobian needs at least 2 dimensions, got shape {J.shape}")
+    if 0 in J.shape:
+        raise InvalidInputError("J", f"the Jacobian is empty (shape {J.shape})")
     if not np.all(np.isfinite(J)):
         raise InvalidInputError("J", "the Jacobian has non-finite entries")
     return J
 
 
+def _normalized(J: np.ndarray) -> np.ndarray:
+    """Each matrix of the stack divided by its largest |entry| (zero matrices left as they are)."""
+    scale = np.max(np.abs(J), axis=(-2, -1), keepdims=True)
+    return J / np.where(scale > 0.0, scale, 1.0)
+
+
 def singular_values(J) -> np.ndarray:
-    """Singular values, largest first, over the last two axes."""
-    return np.linalg.svd(_stack(J), compute_uv=False)
+    """Singular values, largest first, over the last two axes.
+
+    Raises:
+        NonFiniteError: a singular value overflows the float range.
+    """
+    J = _stack(J)
+    scale = np.max(np.abs(J), axis=(-2, -1))
+    s = np.linalg.svd(_normalized(J), compute_uv=False)
+    with np.errstate(over="ignore"):
+        return finite_result(s * np.where(scale > 0.0, scale, 1.0)[..., None], "singular values")
 
 
 def condition_number(J, kind: str = "2") -> np.ndarray | float:
@@ -45,8 +66,8 @@ def condition_number(J, kind: str = "2") -> np.ndarray | float:
     Returns:
         A float for one matrix, an array of shape ``J.shape[:-2]`` for a stack.
     """
-    J = _stack(J)
-    if kind not in KINDS:
+    J = _normalized(_stack(J))
+    if not isinstance(kind, str) or kind not in KINDS:
         raise InvalidInputError("kind", f"unknown condition number kind {kind!r}; known: {', '.join(KINDS)}", kind)
     s = np.linalg.svd(J, compute_uv=False)
     smax, smin = s[..., 0], s[..., -1]
@@ -74,7 +95,10 @@ def inverse_condition(J, kind: str = "2") -> np.ndarray | float:
 
 def manipulability(J) -> np.ndarray | float:
     """Yoshikawa's ``sqrt(det(J J^T))`` (= product of the singular values)."""
-    w = np.prod(singular_values(J), axis=-1)
+    with np.errstate(over="ignore"):
+        w = np.prod(singular_values(J), axis=-1)
+    w = finite_result(w, "manipulability",
+                      "the product of the singular values overflows: express J in other units")
     return float(w) if np.ndim(w) == 0 else w
 
 
@@ -87,10 +111,14 @@ def homogenize(J, rotation_rows, length: float) -> np.ndarray:
     mask over the second-to-last axis); ``length`` in [m] must be finite and > 0.
     """
     J = _stack(J).copy()
-    if not (np.isfinite(length) and length > 0.0):
-        raise InvalidInputError("length", f"must be finite and > 0 [m], got {length!r}", length)
-    J[..., rotation_rows, :] *= length
-    return J
+    length = as_scalar(length, "length", low=0.0, strict_low=True, unit="m")
+    try:
+        J[..., rotation_rows, :] *= length
+    except (IndexError, TypeError, ValueError) as exc:
+        raise InvalidInputError("rotation_rows", f"cannot select rows of a {J.shape[-2]}-row Jacobian with "
+                                                 f"{rotation_rows!r} ({exc}); pass an index, slice or mask",
+                                rotation_rows) from None
+    return finite_result(J, "homogenized Jacobian", "the rows scaled by length overflow")
 
 
 __all__ = ["KINDS", "condition_number", "homogenize", "inverse_condition", "manipulability", "singular_values"]

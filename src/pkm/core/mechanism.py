@@ -12,6 +12,7 @@ by tree traversal, not by file order). Mimic joints take no coordinate.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,9 +21,9 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.spec import ClosureSpec
+from pkm.core.spec import ClosureSpec, as_path, read_text_file
 from pkm.core.urdf import load_model
-from pkm.errors import InvalidInputError, SpecError, UnknownNameError
+from pkm.errors import InvalidInputError, NonFiniteError, SpecError, SpecNameError, UnknownNameError
 
 
 @dataclass(frozen=True)
@@ -61,6 +62,10 @@ class Mechanism:
 
     def __init__(self, model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | None = None,
                  source: str = "<model>"):
+        if not isinstance(model, pin.Model):
+            raise InvalidInputError("model", f"expected a pinocchio.Model, got {type(model).__name__}", model)
+        if not isinstance(spec, ClosureSpec):
+            raise InvalidInputError("spec", f"expected a ClosureSpec, got {type(spec).__name__}", spec)
         self.model = model
         self.data = model.createData()
         self.spec = spec
@@ -75,13 +80,14 @@ class Mechanism:
         frame_names = [f.name for f in model.frames]
 
         def frame(name: str, what: str) -> int:
-            if not model.existFrame(name):
-                raise UnknownNameError("frame", name, frame_names, f"{source} ({what})")
-            return model.getFrameId(name)
+            fid = _frame_id(model, name, source)
+            if fid is None:
+                raise SpecNameError(source, "frame", name, frame_names, what)
+            return fid
 
         def scalar_joint(name: str, what: str) -> JointInfo:
             if name not in self.joints:
-                raise UnknownNameError("joint", name, self.scalar_joint_names(), f"{source} ({what})")
+                raise SpecNameError(source, "joint", name, self.scalar_joint_names(), what)
             info = self.joints[name]
             if info.nq != 1 or info.nv != 1:
                 raise SpecError(source, f"{what}: joint {name!r} ({info.kind}) must have one coordinate")
@@ -117,30 +123,55 @@ class Mechanism:
         missing = [n for n, j in self.joints.items() if j.nq > 0 and n not in spec.reference]
         unknown = [n for n in spec.reference if n not in self.joints]
         if unknown:
-            raise UnknownNameError("joint", unknown[0], list(self.joints), f"{source} ([reference])")
+            raise SpecNameError(source, "joint", unknown[0], list(self.joints), "[reference]")
         if missing:
             raise SpecError(source, f"[reference] lacks joints {missing}")
-        self.q_reference = self.q_from_dict(spec.reference, base=pin.neutral(model))
+        try:
+            self.q_reference = self.check_q(self.q_from_dict(spec.reference, base=pin.neutral(model)), "[reference]")
+        except InvalidInputError as exc:
+            raise SpecError(source, f"{exc}; fix the [reference] table of the closure spec") from None
 
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_strings(cls, urdf: str, spec: ClosureSpec | str, params: Any = None,
                      source: str = "<string>") -> Mechanism:
-        """Build from URDF text and a spec (object or TOML text)."""
+        """Build from URDF text and a spec (object or TOML text).
+
+        Raises:
+            SpecError: The URDF or the spec is malformed, or they do not fit together (see
+                :mod:`pkm.core.urdf` and :mod:`pkm.core.spec` for what the loaders refuse).
+            InvalidInputError: ``urdf`` is not a string, ``spec`` neither a string nor a ClosureSpec.
+        """
+        if not isinstance(urdf, str):
+            raise InvalidInputError("urdf", f"expected the URDF text as a str, got {type(urdf).__name__}", urdf)
+        if not isinstance(spec, (str, ClosureSpec)):
+            raise InvalidInputError("spec", f"expected a ClosureSpec or its TOML text, got {type(spec).__name__}",
+                                    spec)
         if isinstance(spec, str):
             spec = ClosureSpec.from_toml(spec, source + " (closures)")
         return cls(load_model(urdf, source), spec, params, urdf, source)
 
     @classmethod
     def from_files(cls, spec_path: str | Path) -> Mechanism:
-        """Load ``<name>.closures.toml`` and the URDF it names (path relative to the spec)."""
-        spec_path = Path(spec_path)
+        """Load ``<name>.closures.toml`` and the URDF it names (path relative to the spec).
+
+        The spec's ``urdf`` must stay inside the spec's folder once symbolic links are resolved;
+        nothing else is read (see :mod:`pkm.core.spec`).
+
+        Raises:
+            SpecError: A file is missing, too large, malformed, or the URDF path leaves the folder.
+        """
+        spec_path = as_path(spec_path, "spec_path")
         spec = ClosureSpec.load(spec_path)
-        urdf_path = spec_path.parent / spec.urdf
         try:
-            urdf = urdf_path.read_text(encoding="utf-8")
-        except OSError as exc:
-            raise SpecError(str(urdf_path), f"cannot read URDF: {exc.strerror}") from None
+            folder = spec_path.parent.resolve()
+            urdf_path = (folder / spec.urdf).resolve()
+        except (OSError, RuntimeError) as exc:  # a loop of symbolic links
+            raise SpecError(str(spec_path), f"cannot resolve urdf = {spec.urdf!r}: {exc}") from None
+        if not urdf_path.is_relative_to(folder):
+            raise SpecError(str(spec_path), f"urdf = {spec.urdf!r} resolves to {urdf_path}, outside the spec's folder "
+                                            f"{folder}; copy the URDF next to the spec")
+        urdf = read_text_file(urdf_path, "URDF")
         return cls(load_model(urdf, str(urdf_path)), spec, None, urdf, str(spec_path))
 
     # ------------------------------------------------------------------ sizes and names
@@ -175,12 +206,13 @@ class Mechanism:
 
     def frame_id(self, name: str) -> int:
         """Frame index by name; raises :class:`UnknownNameError` listing the valid names."""
-        if not self.model.existFrame(name):
+        fid = _frame_id(self.model, name, self.source)
+        if fid is None:
             raise UnknownNameError("frame", name, [f.name for f in self.model.frames], self.name)
-        return self.model.getFrameId(name)
+        return fid
 
     def joint(self, name: str) -> JointInfo:
-        if name not in self.joints:
+        if not isinstance(name, str) or name not in self.joints:
             raise UnknownNameError("joint", name, list(self.joints), self.name)
         return self.joints[name]
 
@@ -223,10 +255,13 @@ class Mechanism:
 
     def q_from_dict(self, values: Mapping[str, Any], base=None) -> np.ndarray:
         """A configuration from ``{joint name: value or vector}``; other joints from ``base``."""
+        if not isinstance(values, Mapping):
+            raise InvalidInputError("values", f"expected a mapping {{joint name: value}}, got {type(values).__name__}",
+                                    values)
         q = np.array(self.q_reference if base is None else base, dtype=float)
         for name, val in values.items():
             j = self.joint(name)
-            arr = np.atleast_1d(np.asarray(val, dtype=float))
+            arr = np.atleast_1d(as_array(val, name, f"{j.nq} coordinate(s) of joint {name!r}"))
             if arr.shape != (j.nq,):
                 raise InvalidInputError(name, f"joint {name!r} takes {j.nq} coordinate(s), got {arr.shape}", val)
             if not np.all(np.isfinite(arr)):
@@ -261,7 +296,7 @@ class Mechanism:
     def branch(self, name: str | None = None):
         """The named branch (the spec's default when None)."""
         key = self.spec.default_branch if name is None else name
-        if key is None or key not in self.spec.branches:
+        if not isinstance(key, str) or key not in self.spec.branches:
             raise UnknownNameError("branch", str(name), list(self.spec.branches), self.name)
         return self.spec.branches[key]
 
@@ -271,19 +306,123 @@ class Mechanism:
                 f"task={list(self.spec.task.components) + list(self.spec.task.joints)})")
 
 
+def _frame_id(model: pin.Model, name, source: str) -> int | None:
+    """The frame called ``name`` (a link's frame when a joint shares its name); None if there is none."""
+    if not isinstance(name, str) or not model.existFrame(name):
+        return None
+    try:
+        return model.getFrameId(name)
+    except ValueError:  # several frames of that name: a link and a joint named alike
+        if model.existFrame(name, pin.FrameType.BODY):
+            return model.getFrameId(name, pin.FrameType.BODY)
+        raise SpecError(source, f"several frames are named {name!r}; give the links and joints distinct names") \
+            from None
+
+
 def wrap_angle(angle):
     """Angle(s) brought into (-pi, pi] [rad]."""
     return np.pi - np.mod(np.pi - np.asarray(angle, dtype=float), 2.0 * np.pi)
 
 
+#: |value| above this, in SI units (m, rad, kg, s...), is taken for a unit error or garbage.
+ABSURD = 1e6
+
+
+def as_array(x, name: str, what: str = "numbers") -> np.ndarray:
+    """``x`` as a float array of any shape, refusing what is not numbers.
+
+    Strings, booleans, ``None``, complex numbers, ragged nestings and objects are refused with an
+    :class:`InvalidInputError` naming ``name`` (numpy would turn ``"1.5"`` into 1.5 and ``True``
+    into 1.0 silently); so are integers too large for a float. Finiteness is not checked here.
+    """
+    if isinstance(x, (str, bytes)) or x is None:
+        raise InvalidInputError(name, f"expected {what}, got {type(x).__name__}", x)
+    try:
+        raw = np.asarray(x)
+        if raw.dtype.kind not in "iuf":
+            if raw.dtype.kind == "b":
+                raise InvalidInputError(name, f"expected {what}, got booleans", x)
+            if raw.dtype.kind != "O":
+                raise InvalidInputError(name, f"expected {what}, got an array of {raw.dtype}", x)
+            if any(isinstance(v, (str, bytes, bool, np.bool_, complex)) or v is None for v in raw.ravel()):
+                raise InvalidInputError(name, f"expected {what}, got {type(x).__name__} holding non-numbers", x)
+        arr = np.asarray(raw, dtype=float)
+    except InvalidInputError:
+        raise
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidInputError(name, f"expected {what}, got {type(x).__name__} that is not a (regular) array of "
+                                      "real numbers", x) from None
+    return arr
+
+
 def as_vector(x, n: int, name: str) -> np.ndarray:
     """``x`` as a finite float vector of shape (n,), or :class:`InvalidInputError` naming ``name``."""
-    try:
-        arr = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidInputError(name, f"expected {n} numbers, got {type(x).__name__}", x) from None
+    arr = as_array(x, name, f"{n} numbers")
     if arr.shape != (n,):
-        raise InvalidInputError(name, f"expected shape ({n},), got {arr.shape}", x)
+        raise InvalidInputError(name, f"expected shape ({n},), got {arr.shape}; pass a flat list of {n} numbers", x)
     if not np.all(np.isfinite(arr)):
-        raise InvalidInputError(name, f"holds non-finite values at {np.flatnonzero(~np.isfinite(arr)).tolist()}", x)
+        raise InvalidInputError(name, f"holds non-finite values at {np.flatnonzero(~np.isfinite(arr)).tolist()}; "
+                                      "pass finite numbers", x)
     return arr.copy()
+
+
+def as_scalar(x, name: str, *, low: float | None = None, high: float | None = None, strict_low: bool = False,
+              unit: str = "") -> float:
+    """``x`` as one finite float (a number or a one-element array), optionally within bounds.
+
+    Args:
+        x: The value.
+        name: Its name, for the message.
+        low, high: Bounds (inclusive; ``low`` exclusive with ``strict_low``).
+        unit: Unit shown in the message.
+
+    Raises:
+        InvalidInputError: Not a number, not finite, or out of bounds.
+    """
+    arr = as_array(x, name, "a number")
+    if arr.size != 1:
+        raise InvalidInputError(name, f"expected one number, got shape {arr.shape}", x)
+    v = float(arr.reshape(()))
+    u = f" {unit}" if unit else ""
+    if not math.isfinite(v):
+        raise InvalidInputError(name, f"must be a finite number{u}, got {v!r}", x)
+    if low is not None and (v <= low if strict_low else v < low):
+        raise InvalidInputError(name, f"must be {'>' if strict_low else '>='} {low:g}{u}, got {v!r}", x)
+    if high is not None and v > high:
+        raise InvalidInputError(name, f"must be <= {high:g}{u}, got {v!r}", x)
+    return v
+
+
+def as_count(x, name: str, *, low: int = 1, high: int = 10**7) -> int:
+    """``x`` as an integer in ``[low, high]`` (iteration limits, numbers of seeds or nodes)."""
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)):
+        raise InvalidInputError(name, f"expected an integer in [{low}, {high}], got {type(x).__name__} {x!r}", x)
+    if not low <= int(x) <= high:
+        raise InvalidInputError(name, f"expected an integer in [{low}, {high}], got {int(x)}", x)
+    return int(x)
+
+
+def as_tolerance(x, name: str = "tol", *, high: float = 1.0) -> float:
+    """``x`` as a tolerance: a finite number in ``(0, high]``."""
+    return as_scalar(x, name, low=0.0, high=high, strict_low=True)
+
+
+def check_mechanism(mech, name: str = "mech") -> Mechanism:
+    """``mech`` itself if it is a :class:`Mechanism`, else :class:`InvalidInputError` saying how to get one."""
+    if not isinstance(mech, Mechanism):
+        raise InvalidInputError(name, f"expected a pkm.Mechanism (from pkm.load(name) or pkm.build(name, ...)), "
+                                      f"got {type(mech).__name__}", mech)
+    return mech
+
+
+def finite_result(x, what: str, detail: str = ""):
+    """``x`` unchanged if every number in it is finite, else :class:`~pkm.errors.NonFiniteError`.
+
+    The last guard of a public routine: a NaN or an infinity that slipped past the input checks
+    (an overflow, a vanishing divisor) becomes an error instead of a silent result.
+    """
+    arr = np.asarray(x, dtype=float)
+    if not np.all(np.isfinite(arr)):
+        raise NonFiniteError(what, x, detail or "the inputs are probably too large or the configuration is "
+                                               "degenerate; check the units (SI) and the magnitudes")
+    return x

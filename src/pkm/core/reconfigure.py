@@ -46,7 +46,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import proxsuite
 
-from pkm.errors import ConvergenceError, InvalidInputError
+from pkm.core.mechanism import as_array, as_count, as_scalar, as_tolerance, finite_result
+from pkm.errors import ConvergenceError, InvalidInputError, PkmError
 
 IndexFn = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
@@ -79,12 +80,20 @@ class WarmQP:
         self.solves = self.iterations = self.cold_restarts = 0
         self.statuses: list[str] = []
 
-    def _cold(self, H, g, l_box, u_box) -> None:
+    def _cold(self, H, g, l_box, u_box, *, careful: bool = False) -> None:
         qp = proxsuite.proxqp.dense.QP(self.n, 0, self._C.shape[0], True)
         s = qp.settings
-        s.eps_abs, s.eps_rel = self._eps, 0.0
+        # the QPs here are feasible and bounded by construction (feasible_bounds, boxes): with proxqp's default
+        # thresholds (1e-4) a well-posed 3-pose QP was reported PRIMAL_INFEASIBLE; detect infeasibility strictly
+        s.eps_primal_inf = s.eps_dual_inf = 1e-12
+        if careful:
+            s.primal_infeasibility_solving = True
+        s.eps_abs, s.eps_rel = self._eps, 1e-14  # relative part: see the duality gap below
+        s.max_iter_in = 200  # inner iterations per outer one (proxqp's default 1500 lets a bad QP run 1.5e6)
         s.check_duality_gap = True
-        s.eps_duality_gap_abs, s.eps_duality_gap_rel = self._eps, 0.0
+        # the gap also relative (1e-14) to the objective's terms: a pose near the edge of its interval can carry a
+        # curvature of 1e10, where an absolute 1e-10 gap is out of reach in floating point (MAX_ITER_REACHED)
+        s.eps_duality_gap_abs, s.eps_duality_gap_rel = self._eps, 1e-14
         s.max_iter = self._max_iter
         s.verbose = False
         qp.init(H, g, None, None, self._C, self._l, self._u, l_box, u_box)
@@ -93,7 +102,14 @@ class WarmQP:
         self._qp = qp
 
     def solve(self, H, g, l_box, u_box) -> np.ndarray:
-        """The minimiser ``y`` (see the class doc)."""
+        """The minimiser ``y`` (see the class doc).
+
+        Raises:
+            NonFiniteError: the QP data hold a NaN or an infinity (proxqp would spin to its iteration limit).
+        """
+        for name, v in (("H", H), ("g", g), ("l_box", l_box), ("u_box", u_box)):
+            finite_result(v, f"QP data {name}", "the index or its finite-difference derivatives overflow; "
+                                                "rescale the index")
         if self._qp is None:
             self._cold(H, g, l_box, u_box)
         else:
@@ -103,13 +119,18 @@ class WarmQP:
                 self.cold_restarts += 1
                 self.iterations += self._qp.results.info.iter
                 self._cold(H, g, l_box, u_box)
+        if self._qp.results.info.status != proxsuite.proxqp.PROXQP_SOLVED:  # one careful cold try more
+            self.cold_restarts += 1
+            self.iterations += self._qp.results.info.iter
+            self._cold(H, g, l_box, u_box, careful=True)
         info = self._qp.results.info
         self.solves += 1
         self.iterations += info.iter
         self.statuses.append(str(info.status).rsplit(".", 1)[-1])
         if info.status != proxsuite.proxqp.PROXQP_SOLVED:
-            raise ConvergenceError("proxqp", max(info.pri_res, info.dua_res), info.iter, self._eps,
-                                   detail=f"status {info.status}")
+            raise ConvergenceError("proxqp", max(info.pri_res, info.dua_res, abs(info.duality_gap)), info.iter,
+                                   self._eps, detail=f"status {info.status} (primal {info.pri_res:.2e}, dual "
+                                                     f"{info.dua_res:.2e}, duality gap {info.duality_gap:.2e})")
         return np.array(self._qp.results.x)
 
 
@@ -151,7 +172,8 @@ class ProfileOptimum:
         baseline_value: The index at the baseline parameter (the model without reconfiguration),
             ``nan`` where the baseline lies outside ``[lower_k, upper_k]`` (see ``baseline_ok``).
         baseline_ok: Where the baseline is admissible.
-        relative_gain: ``value / baseline_value - 1`` where ``baseline_ok``, else ``nan``.
+        relative_gain: ``value / baseline_value - 1`` where ``baseline_ok``, else ``nan`` (``nan`` too
+            where the baseline's index is 0: no relative gain exists there).
         max_rate: ``max |x_{k+1} - x_k|``.
         iterations: SQP iterations; qp_solves, qp_iterations, cold_restarts: proxqp counters.
         converged: Whether the SQP converged within its iteration budget.
@@ -177,8 +199,10 @@ class ProfileOptimum:
     qp_status: tuple[str, ...] = field(default=())
 
     def mean_gain(self, start: int = 0) -> float:
-        """Mean relative gain over the poses ``k >= start`` where the baseline is admissible."""
+        """Mean relative gain over the poses ``k >= start`` where the baseline is admissible (and its index > 0)."""
+        start = as_count(start, "start", low=0, high=max(len(self.x) - 1, 0))
         g = self.relative_gain[start:][self.baseline_ok[start:]]
+        g = g[np.isfinite(g)]
         if g.size == 0:
             raise InvalidInputError("start", f"no pose from {start} on admits the baseline", start)
         return float(np.mean(g))
@@ -192,17 +216,48 @@ def _derivatives(index: IndexFn, k: np.ndarray, x: np.ndarray, lo: np.ndarray, h
     c = np.where(hi - lo < 2 * h, 0.5 * (lo + hi), c)
     hh = np.minimum(h, 0.5 * (hi - lo))
     kk = np.concatenate([k, k, k])
-    f = index(kk, np.concatenate([c - hh, c, c + hh]))
-    _check_finite(f, kk, np.concatenate([c - hh, c, c + hh]))
+    f = _call(index, kk, np.concatenate([c - hh, c, c + hh]))
     fm, f0, fp = np.split(f, 3)
     safe = np.where(hh > 0, hh, 1.0)
-    d1 = np.where(hh > 0, (fp - fm) / (2 * safe), 0.0)
-    d2 = np.where(hh > 0, (fp - 2 * f0 + fm) / safe**2, 0.0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        d1 = np.where(hh > 0, (fp - fm) / (2 * safe), 0.0)
+        d2 = np.where(hh > 0, (fp - 2 * f0 + fm) / safe**2, 0.0)
+    if not (np.all(np.isfinite(d1)) and np.all(np.isfinite(d2))):
+        i = int(np.flatnonzero(~(np.isfinite(d1) & np.isfinite(d2)))[0])
+        raise InvalidInputError("index", f"the finite-difference derivatives of the index overflow at pose "
+                                         f"{int(k[i])}, x = {x[i]:.6g} (index values up to {np.max(np.abs(f)):.3g}); rescale the "
+                                         "index", index)
     moved = c != x
     if np.any(moved):  # Taylor back to x (x near an end of its interval)
-        f0 = np.where(moved, index(k, x), f0)
+        f0 = np.where(moved, _call(index, k, x), f0)
         d1 = d1 + d2 * (x - c)
     return f0, d1, d2
+
+
+def _call(index: IndexFn, k: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``index(k, x)`` checked: an array of numbers shaped like ``x``, finite."""
+    try:
+        f = index(k, x)
+    except PkmError:
+        raise
+    except Exception as exc:  # the caller's callback: its failure is reported, not leaked  # noqa: BLE001
+        raise InvalidInputError("index", f"index(k, x) raised {type(exc).__name__}: {exc}; it must accept arrays "
+                                         "k (pose indices) and x (values) of one shape", index) from None
+    f = as_array(f, "index", "an array of index values shaped like x")
+    if f.shape != np.shape(x):
+        if f.size == 1 or f.shape == ():
+            f = np.full(np.shape(x), float(f.reshape(())) if f.size == 1 else np.nan)
+        else:
+            raise InvalidInputError("index", f"index(k, x) returned shape {f.shape} for x of shape {np.shape(x)}; "
+                                             "it must be vectorised (one value per (k, x) pair)", index)
+    _check_finite(f, k, x)
+    return f
+
+
+def _check_index(index) -> None:
+    if not callable(index):
+        raise InvalidInputError("index", f"expected a callable index(k, x) -> values, got {type(index).__name__}",
+                                index)
 
 
 def _check_finite(f: np.ndarray, k: np.ndarray, x: np.ndarray) -> None:
@@ -214,11 +269,16 @@ def _check_finite(f: np.ndarray, k: np.ndarray, x: np.ndarray) -> None:
 
 
 def _intervals(lower, upper) -> tuple[np.ndarray, np.ndarray]:
-    lo, hi = np.atleast_1d(np.asarray(lower, dtype=float)), np.atleast_1d(np.asarray(upper, dtype=float))
+    lo = np.atleast_1d(as_array(lower, "lower", "interval ends (n,)"))
+    hi = np.atleast_1d(as_array(upper, "upper", "interval ends (n,)"))
     if lo.shape != hi.shape or lo.ndim != 1:
         raise InvalidInputError("lower", f"lower and upper must be vectors of one shape, got {lo.shape}, {hi.shape}")
+    if lo.size == 0:
+        raise InvalidInputError("lower", "needs at least one interval")
     if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
         raise InvalidInputError("lower", "the intervals must be finite")
+    if max(np.max(np.abs(lo)), np.max(np.abs(hi))) > 1e150:
+        raise InvalidInputError("lower", "interval ends beyond 1e150 are refused (rescale the parameter)")
     if np.any(lo > hi):
         k = int(np.flatnonzero(lo > hi)[0])
         raise InvalidInputError("lower", f"empty interval at pose {k}: [{lo[k]:.6g}, {hi[k]:.6g}]")
@@ -246,15 +306,17 @@ def maximise(index: IndexFn, lower, upper, *, grid: int = 31, tol: float = 1e-9,
     Returns:
         The maximisers and diagnostics.
     """
+    _check_index(index)
     lo, hi = _intervals(lower, upper)
-    if not (isinstance(grid, int) and grid >= 2):
-        raise InvalidInputError("grid", f"needs an integer >= 2, got {grid!r}", grid)
+    grid = as_count(grid, "grid", low=2, high=100_000)
+    tol, fd_step, eta = as_tolerance(tol, "tol", high=np.inf), as_tolerance(fd_step, "fd_step", high=np.inf), \
+        as_tolerance(eta, "eta", high=np.inf)
+    max_iter = as_count(max_iter, "max_iter", low=1, high=100_000)
     n = lo.size
     k = np.arange(n)
     t = np.linspace(0.0, 1.0, grid)
     nodes = lo[:, None] + (hi - lo)[:, None] * t
-    fg = index(np.repeat(k, grid), nodes.ravel()).reshape(n, grid)
-    _check_finite(fg.ravel(), np.repeat(k, grid), nodes.ravel())
+    fg = _call(index, np.repeat(k, grid), nodes.ravel()).reshape(n, grid)
     best = np.argmax(fg, axis=1)
     x = nodes[k, best]
     radius = np.maximum((hi - lo) / (grid - 1), tol)
@@ -294,8 +356,7 @@ def feasible_bounds(lower, upper, rate_limit: float) -> tuple[np.ndarray, np.nda
         InvalidInputError: when no profile satisfies both (with the first pose that cannot be met).
     """
     lo, hi = _intervals(lower, upper)
-    if not (np.isfinite(rate_limit) and rate_limit > 0):
-        raise InvalidInputError("rate_limit", f"must be finite and > 0, got {rate_limit!r}", rate_limit)
+    rate_limit = as_scalar(rate_limit, "rate_limit", low=0.0, strict_low=True)
     L, U = lo.copy(), hi.copy()
     for k in range(1, L.size):
         L[k], U[k] = max(L[k], L[k - 1] - rate_limit), min(U[k], U[k - 1] + rate_limit)
@@ -315,7 +376,9 @@ def clip_to_rate(x, lower, upper, rate_limit: float) -> np.ndarray:
     with ``L, U`` from :func:`feasible_bounds` (which keeps every interval non-empty).
     """
     L, U = feasible_bounds(lower, upper, rate_limit)
-    x = np.asarray(x, dtype=float)
+    x = as_array(x, "x", "a profile (n,)")
+    if x.shape != L.shape or not np.all(np.isfinite(x)):
+        raise InvalidInputError("x", f"expected a finite profile of shape {L.shape}, got shape {x.shape}", x)
     y = np.empty_like(L)
     y[0] = min(max(x[0], L[0]), U[0])
     for k in range(1, y.size):
@@ -344,10 +407,18 @@ def optimise_profile(index: IndexFn, lower, upper, *, rate_limit: float, smoothn
         InvalidInputError: bad arguments, or no profile fits the intervals and the rate limit.
         ConvergenceError: a QP could not be solved.
     """
+    _check_index(index)
     lo, hi = _intervals(lower, upper)
     n = lo.size
-    if not (np.isfinite(smoothness) and smoothness >= 0):
-        raise InvalidInputError("smoothness", f"must be finite and >= 0, got {smoothness!r}", smoothness)
+    smoothness = as_scalar(smoothness, "smoothness", low=0.0, high=1e12)
+    rate_limit = as_scalar(rate_limit, "rate_limit", low=0.0, strict_low=True)
+    baseline = None if baseline is None else as_scalar(baseline, "baseline")
+    tol, fd_step, eta = as_tolerance(tol, "tol", high=np.inf), as_tolerance(fd_step, "fd_step", high=np.inf), \
+        as_tolerance(eta, "eta", high=np.inf)
+    max_iter = as_count(max_iter, "max_iter", low=1, high=100_000)
+    if pointwise is not None and (not isinstance(pointwise, PointOptimum) or pointwise.x.shape != lo.shape):
+        raise InvalidInputError("pointwise", f"expected the PointOptimum of these {n} poses (from maximise)",
+                                pointwise)
     Lb, Ub = feasible_bounds(lo, hi, rate_limit)
     pw = maximise(index, lo, hi, tol=tol, fd_step=fd_step, eta=eta) if pointwise is None else pointwise
     scale = float(np.max(np.abs(pw.value)))
@@ -400,9 +471,10 @@ def optimise_profile(index: IndexFn, lower, upper, *, rate_limit: float, smoothn
         base_ok = (lo <= baseline) & (baseline <= hi)
         base = np.full(n, np.nan)
         if np.any(base_ok):
-            base[base_ok] = index(k[base_ok], np.full(int(base_ok.sum()), float(baseline)))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        gain = np.where(base_ok, f / base - 1.0, np.nan)
+            base[base_ok] = _call(index, k[base_ok], np.full(int(base_ok.sum()), float(baseline)))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        gain = np.where(base_ok & (base != 0.0), f / np.where(base != 0.0, base, 1.0) - 1.0, np.nan)
+    gain = np.where(np.isfinite(gain), gain, np.nan)
     return ProfileOptimum(x, f, obj, scale, pw, start, start_obj, base, base_ok, gain,
                           float(np.max(np.abs(np.diff(x)))) if n > 1 else 0.0, it, qp.solves, qp.iterations,
                           qp.cold_restarts, converged, tuple(qp.statuses))

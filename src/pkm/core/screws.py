@@ -30,21 +30,31 @@ from __future__ import annotations
 
 import numpy as np
 
+from pkm.core.mechanism import as_array, as_scalar, finite_result
 from pkm.errors import InvalidInputError
 
 #: The polarity operator ``[[0, I], [I, 0]]`` (swaps primal and dual parts): ``{a; b} = a^T DELTA b``.
 DELTA = np.block([[np.zeros((3, 3)), np.eye(3)], [np.eye(3), np.zeros((3, 3))]])
 
 
+def _compatible(a: np.ndarray, b: np.ndarray, names: str, tail_a: int = 1, tail_b: int = 1) -> None:
+    """The stack shapes of ``a`` and ``b`` (all but their last ``tail`` axes) must broadcast together."""
+    try:
+        np.broadcast_shapes(a.shape[:a.ndim - tail_a], b.shape[:b.ndim - tail_b])
+    except ValueError:
+        raise InvalidInputError(names, f"stacks of shapes {a.shape} and {b.shape} do not broadcast together; "
+                                       "pass one of each or stacks of one length") from None
+
+
 def _vec3(x, name: str) -> np.ndarray:
-    x = np.asarray(x, dtype=float)
+    x = as_array(x, name, "3-vectors (..., 3)")
     if x.shape[-1:] != (3,) or not np.all(np.isfinite(x)):
         raise InvalidInputError(name, f"expected finite 3-vectors (..., 3), got shape {x.shape}", x)
     return x
 
 
 def _screw(x, name: str = "screw") -> np.ndarray:
-    x = np.asarray(x, dtype=float)
+    x = as_array(x, name, "screws (..., 6)")
     if x.shape[-1:] != (6,) or not np.all(np.isfinite(x)):
         raise InvalidInputError(name, f"expected finite screws (..., 6) = [primal; dual], got shape {x.shape}", x)
     return x
@@ -64,11 +74,13 @@ def screw(direction, point, pitch: float = 0.0) -> np.ndarray:
     ``[s; r x s + h s]``. ``direction`` is normalised; it must not be zero.
     """
     s, r = _vec3(direction, "direction"), _vec3(point, "point")
+    _compatible(s, r, "direction, point")
+    pitch = as_scalar(pitch, "pitch", unit="m/rad")
     n = np.linalg.norm(s, axis=-1, keepdims=True)
     if np.any(n < 1e-12):
         raise InvalidInputError("direction", "a screw axis needs a non-zero direction", direction)
     s = s / n
-    return np.concatenate(np.broadcast_arrays(s, cross(r, s) + pitch * s), axis=-1)
+    return finite_result(np.concatenate(np.broadcast_arrays(s, cross(r, s) + pitch * s), axis=-1), "screw")
 
 
 def line(direction, point) -> np.ndarray:
@@ -88,15 +100,17 @@ def prismatic(direction) -> np.ndarray:
 def klein(a, b) -> np.ndarray | float:
     """Klein form (reciprocal product) ``{a; b} = a_primal . b_dual + a_dual . b_primal``."""
     a, b = _screw(a, "a"), _screw(b, "b")
-    k = np.sum(a[..., :3] * b[..., 3:] + a[..., 3:] * b[..., :3], axis=-1)
+    _compatible(a, b, "a, b")
+    k = finite_result(np.sum(a[..., :3] * b[..., 3:] + a[..., 3:] * b[..., :3], axis=-1), "Klein form")
     return float(k) if np.ndim(k) == 0 else k
 
 
 def lie(a, b) -> np.ndarray:
     """Lie product ``[a, b] = [a_p x b_p; a_p x b_d - b_p x a_d]`` (antisymmetric)."""
     a, b = _screw(a, "a"), _screw(b, "b")
+    _compatible(a, b, "a, b")
     ap, ad, bp, bd = a[..., :3], a[..., 3:], b[..., :3], b[..., 3:]
-    return np.concatenate([cross(ap, bp), cross(ap, bd) - cross(bp, ad)], axis=-1)
+    return finite_result(np.concatenate([cross(ap, bp), cross(ap, bd) - cross(bp, ad)], axis=-1), "Lie product")
 
 
 def shift(s, point) -> np.ndarray:
@@ -105,7 +119,9 @@ def shift(s, point) -> np.ndarray:
     ``s_Q = s_O - Q x s`` (for a twist: ``v_Q = v_O + w x Q``).
     """
     s, q = _screw(s, "s"), _vec3(point, "point")
-    return np.concatenate(np.broadcast_arrays(s[..., :3], s[..., 3:] - cross(q, s[..., :3])), axis=-1)
+    _compatible(s, q, "s, point")
+    return finite_result(np.concatenate(np.broadcast_arrays(s[..., :3], s[..., 3:] - cross(q, s[..., :3])), axis=-1),
+                         "shifted screw")
 
 
 def transform(s, rotation, translation) -> np.ndarray:
@@ -115,7 +131,8 @@ def transform(s, rotation, translation) -> np.ndarray:
     world (the adjoint action). ``rotation`` must be a 3x3 rotation (orthonormal to 1e-9, det +1).
     """
     s, p = _screw(s, "s"), _vec3(translation, "translation")
-    R = np.asarray(rotation, dtype=float)
+    _compatible(s, p, "s, translation")
+    R = as_array(rotation, "rotation", "a 3x3 rotation matrix")
     if R.shape != (3, 3) or not np.all(np.isfinite(R)):
         raise InvalidInputError("rotation", f"expected a finite 3x3 matrix, got shape {R.shape}", rotation)
     defect = float(np.abs(R.T @ R - np.eye(3)).max())
@@ -123,7 +140,8 @@ def transform(s, rotation, translation) -> np.ndarray:
         raise InvalidInputError("rotation", f"not a rotation: max|R^T R - I| = {defect:.3g}, "
                                             f"det = {np.linalg.det(R):.6g}", rotation)
     Rs = s[..., :3] @ R.T
-    return np.concatenate(np.broadcast_arrays(Rs, s[..., 3:] @ R.T + cross(p, Rs)), axis=-1)
+    return finite_result(np.concatenate(np.broadcast_arrays(Rs, s[..., 3:] @ R.T + cross(p, Rs)), axis=-1),
+                         "transformed screw")
 
 
 def pitch(s) -> np.ndarray | float:
@@ -141,13 +159,13 @@ def axis_point(s) -> np.ndarray:
     ss = np.sum(s[..., :3] ** 2, axis=-1, keepdims=True)
     if np.any(ss < 1e-24):
         raise InvalidInputError("s", "a pure translation/couple has no axis (zero primal part)", s)
-    return cross(s[..., :3], s[..., 3:]) / ss
+    return finite_result(cross(s[..., :3], s[..., 3:]) / ss, "axis point")
 
 
 def chain_twist(screws, rates) -> np.ndarray:
     """Twist ``sum_j w_j $_j`` of the last body of a serial chain (screws ``(..., n, 6)``, rates ``(..., n)``)."""
-    S, w = _screw(screws, "screws"), np.asarray(rates, dtype=float)
-    return np.einsum("...j,...jk->...k", w, S)
+    S, w = _chain(screws, rates)
+    return finite_result(np.einsum("...j,...jk->...k", w, S), "chain twist")
 
 
 def chain_lie_term(screws, rates) -> np.ndarray:
@@ -163,10 +181,20 @@ def chain_lie_term(screws, rates) -> np.ndarray:
     Returns:
         Shape ``(..., 6)``.
     """
-    S, w = _screw(screws, "screws"), np.asarray(rates, dtype=float)
+    S, w = _chain(screws, rates)
     ws = w[..., None] * S
     before = np.cumsum(ws, axis=-2) - ws  # sum_{j<k} w_j $_j, for each k
-    return np.sum(lie(before, ws), axis=-2)
+    return finite_result(np.sum(lie(before, ws), axis=-2), "chain Lie term")
+
+
+def _chain(screws, rates) -> tuple[np.ndarray, np.ndarray]:
+    S = _screw(screws, "screws")
+    w = as_array(rates, "rates", "joint rates (..., n)")
+    if S.ndim < 2 or w.ndim < 1 or w.shape[-1] != S.shape[-2] or not np.all(np.isfinite(w)):
+        raise InvalidInputError("rates", f"expected finite rates (..., n) for screws (..., n, 6) of shape {S.shape}, "
+                                         f"got shape {w.shape}", rates)
+    _compatible(S, w, "screws, rates", 2, 1)
+    return S, w
 
 
 __all__ = ["DELTA", "axis_point", "chain_lie_term", "chain_twist", "cross", "klein", "lie", "line", "pitch",

@@ -16,7 +16,10 @@ leave the workspace through a fold near a direct singularity: loop closure then
 raises :class:`~pkm.errors.ConvergenceError` rather than jump to another assembly
 mode; follow a path inside the workspace instead (seed each solve with the last).
 Every solver stops after a bounded number of iterations and raises
-:class:`~pkm.errors.ConvergenceError` with its residual.
+:class:`~pkm.errors.ConvergenceError` with its residual: at most ``max_iter`` Newton iterations
+per continuation step, at most :data:`MAX_STEPS` steps planned (a farther target takes longer
+steps, which fail early when it is out of reach), and at most :data:`MAX_TOTAL_ITER` Newton
+iterations for a whole solve. No solver returns a non-finite configuration.
 """
 
 from __future__ import annotations
@@ -28,11 +31,13 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core import constraints
-from pkm.core.mechanism import Mechanism
+from pkm.core.mechanism import Mechanism, as_count, as_scalar, as_tolerance, check_mechanism
 from pkm.core.task import TaskMap
-from pkm.errors import BranchError, ConvergenceError
+from pkm.errors import BranchError, ConvergenceError, InvalidInputError
 
 DEFAULT_TOL = 1e-12
+MAX_STEPS = 1000  #: continuation steps planned at most (a farther target gets longer steps)
+MAX_TOTAL_ITER = 5_000  #: Newton iterations at most for one solve, every continuation step included
 
 
 @dataclass(frozen=True)
@@ -58,12 +63,17 @@ class SolveResult:
 
 def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray,
             cols: np.ndarray | None, tol: float, max_iter: int, max_dq: float) -> tuple[np.ndarray, float, int]:
-    """Gauss-Newton with a step cap and backtracking; returns (q, residual inf-norm, iterations)."""
+    """Gauss-Newton with a step cap and backtracking; returns (q, residual inf-norm, iterations).
+
+    Stops at ``tol``, after ``max_iter`` iterations, after 3 iterations in a row that lower the
+    residual by less than 1% (a least-squares point of an unreachable target), or before a step
+    that would make the residual or ``q`` non-finite.
+    """
     m = mech.model
     r, J = fun(q)
     res = float(np.max(np.abs(r)))
-    it = 0
-    while res > tol and it < max_iter:
+    it = stalled = 0
+    while res > tol and it < max_iter and stalled < 3:  # 3 iterations in a row without progress: stuck
         it += 1
         step = -_lsq(J if cols is None else J[:, cols], r)
         nrm = np.max(np.abs(step))
@@ -80,12 +90,20 @@ def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.nd
             if res_try < res or alpha < 0.02:
                 break
             alpha *= 0.5
+        if not (np.isfinite(res_try) and np.all(np.isfinite(q_try))):  # overflow far from the solution: stop here
+            return q, res, it
+        stalled = stalled + 1 if res_try >= 0.99 * res else 0
         q, r, J, res = q_try, r_try, J_try, res_try
+    if not np.isfinite(res):
+        res = np.inf
     return q, res, it
 
 
 def _lsq(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Least-squares solution: LU when square and regular, SVD (rank-revealing) otherwise."""
+    """Least-squares solution: LU when square and regular, SVD (rank-revealing) otherwise; no step (zeros)
+    when ``A`` or ``b`` is not finite (LAPACK would print a complaint and fail)."""
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
+        return np.zeros(A.shape[1])
     if A.shape[0] == A.shape[1]:
         try:
             x = np.linalg.solve(A, b)
@@ -93,7 +111,10 @@ def _lsq(A: np.ndarray, b: np.ndarray) -> np.ndarray:
                 return x
         except np.linalg.LinAlgError:
             pass
-    return np.linalg.lstsq(A, b, rcond=None)[0]
+    try:
+        return np.linalg.lstsq(A, b, rcond=None)[0]
+    except np.linalg.LinAlgError:  # SVD did not converge (entries overflowing): no step
+        return np.zeros(A.shape[1])
 
 
 def _follow(mech: Mechanism, what: str, solve_at, q: np.ndarray, n_steps: int, tol: float,
@@ -108,6 +129,15 @@ def _follow(mech: Mechanism, what: str, solve_at, q: np.ndarray, n_steps: int, t
     total, steps = 0, 0
     s, ds = 0.0, 1.0 / n_steps
     while True:
+        if total >= MAX_TOTAL_ITER:
+            q_new, res, it = solve_at(q, 1.0, tol)
+            result = SolveResult(q_new, False, res, total + it, steps, _signs(mech, q_new))
+            if raise_on_failure:
+                err = _failure(mech, what, result, tol)
+                raise ConvergenceError(what, err.residual, err.iterations, tol, result,
+                                       f"gave up after {MAX_TOTAL_ITER} Newton iterations at {s:.0%} of the path; "
+                                       "seed nearer the target (q0) or split the path")
+            return result
         s_next = min(1.0, s + ds)
         t = tol if s_next >= 1.0 else max(tol, 1e-9)
         q_new, res, it = solve_at(q, s_next, t)
@@ -144,10 +174,14 @@ def close_loops(mech: Mechanism, q_actuated, q0=None, *, tol: float = DEFAULT_TO
     Returns:
         A :class:`SolveResult` whose ``q`` has the requested actuated coordinates.
     """
+    mech = check_mechanism(mech)
     qa1 = mech.check_actuated(q_actuated)
     q = mech.q_reference.copy() if q0 is None else mech.check_q(q0, "q0")
+    tol, max_iter, max_step = _settings(tol, max_iter, max_step)
     qa0 = mech.actuated_q(q)
-    n_steps = max(1, int(np.ceil(np.max(np.abs(qa1 - qa0)) / max_step)))
+    rev = np.array([j.revolute for j in mech.actuated], dtype=bool)  # angles go the short way round (+-pi)
+    qa1 = np.where(rev, qa0 + (qa1 - qa0 + np.pi) % (2.0 * np.pi) - np.pi, qa1)
+    n_steps = _n_steps(np.max(np.abs(qa1 - qa0)), max_step)
 
     def fun(qq):
         return constraints.residual_and_jacobian(mech, qq)
@@ -173,15 +207,19 @@ def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol
         max_step: Largest task change per continuation step [m or rad].
         raise_on_failure: Raise :class:`ConvergenceError` instead of returning ``converged=False``.
     """
+    mech = check_mechanism(mech)
     task = TaskMap(mech)
     y1 = task.parse(target)
+    tol, max_iter, max_step = _settings(tol, max_iter, max_step)
+    if branch is not None:
+        mech.branch(branch)  # an unknown branch is refused before any work
     if q0 is None:
         q = branch_seed(mech, branch) if branch is not None else mech.q_reference.copy()
     else:
         q = mech.check_q(q0, "q0")
     y0 = task.value(q)
     dist = np.max(np.abs(task.error(y1, y0)))
-    n_steps = max(1, int(np.ceil(dist / max_step)))
+    n_steps = _n_steps(dist, max_step)
 
     def make_fun(y_goal):
         def fun(qq):
@@ -209,7 +247,9 @@ def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_i
     the least-squares compromise left. Raises :class:`BranchError` if the result is on
     another branch.
     """
+    mech = check_mechanism(mech)
     b = mech.branch(branch)
+    tol, max_iter, _ = _settings(tol, max_iter, 1.0)
     q = mech.q_reference.copy()
     if mech.on_branch(q, branch):
         return q
@@ -251,6 +291,19 @@ def _failure(mech: Mechanism, what: str, result: SolveResult, tol: float) -> Con
     err = ConvergenceError(what, result.residual, result.iterations, tol, result, detail)
     err.worst_closure, err.worst_gap = name, gap
     return err
+
+
+def _settings(tol, max_iter, max_step) -> tuple[float, int, float]:
+    """The solver settings checked: ``tol`` in (0, 1], ``max_iter`` in [1, 10^4], ``max_step`` > 0."""
+    return (as_tolerance(tol, "tol"), as_count(max_iter, "max_iter", low=1, high=10_000),
+            as_scalar(max_step, "max_step", low=0.0, strict_low=True))
+
+
+def _n_steps(dist: float, max_step: float) -> int:
+    """Continuation steps for a path of length ``dist`` in steps of at most ``max_step``, capped at MAX_STEPS."""
+    if not np.isfinite(dist):
+        raise InvalidInputError("target", f"the distance to the target is not finite ({dist!r})", dist)
+    return int(min(MAX_STEPS, max(1, np.ceil(dist / max_step))))
 
 
 def _signs(mech: Mechanism, q: np.ndarray) -> dict[str, int]:

@@ -43,19 +43,49 @@ velocity is the twist ``[v; w]`` of the end-effector origin in world axes.
 
 A branch fixes the sign of joint coordinates that vanish at a singularity that
 separates working modes (for example the relative elbow angle of a leg).
+
+What the loaders refuse
+-----------------------
+
+:meth:`ClosureSpec.load`, :meth:`ClosureSpec.from_toml` and :meth:`Mechanism.from_files
+<pkm.core.mechanism.Mechanism.from_files>` raise :class:`~pkm.errors.SpecError` for:
+
+* a path that is not a regular file: FIFOs, devices (``/dev/zero``) and directories are refused
+  from ``fstat`` before anything is read, so a load never blocks; a file larger than 16 MiB
+  (refused from its size) or not UTF-8; a path that is not a ``str``/``PathLike`` is an
+  :class:`~pkm.errors.InvalidInputError`;
+* TOML that does not parse (truncated files included) or nests too deeply;
+* another ``format`` than ``pkm.closures/1``, unknown top-level keys, missing keys, a value of
+  the wrong TOML type (a string or a boolean where a number is expected, a number where a
+  name is expected...), empty names, a name listed twice, unknown task components or closure
+  types, a closure that ties a frame to itself, branch signs other than the integers +1/-1;
+* ``[reference]`` values that are not lists of finite numbers of magnitude <= 1e6 (SI);
+  ``[parameters]`` values that are not finite numbers or strings;
+* a ``urdf`` path that is absolute, contains ``..`` or would leave the spec's folder once
+  symbolic links are resolved (:meth:`~pkm.core.mechanism.Mechanism.from_files` opens the
+  spec and that URDF, nothing else);
+* once the URDF is loaded (see :mod:`pkm.core.urdf` for what it refuses): a frame or joint
+  named by the spec that the URDF lacks (:class:`~pkm.errors.SpecNameError`, also an
+  :class:`~pkm.errors.UnknownNameError` listing the valid names), an actuated, task or branch
+  joint with more than one coordinate, a ``[reference]`` that misses a joint, gives it the
+  wrong number of coordinates or a non-unit quaternion.
 """
 
 from __future__ import annotations
 
 import math
+import os
+import stat
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
-from pkm.errors import SpecError
+from pkm.errors import InvalidInputError, SpecError
 
 FORMAT = "pkm.closures/1"
+MAX_FILE_BYTES = 16 * 1024 * 1024  # URDF, spec and motion files larger than this are refused
+_ABSURD = 1e6  # |value| above this in a file (m, rad) is taken for a unit error
 CLOSURE_TYPES = ("point", "frame")
 TASK_COMPONENTS = ("x", "y", "z", "roll", "pitch", "yaw")
 
@@ -127,21 +157,27 @@ class ClosureSpec:
     @classmethod
     def from_toml(cls, text: str, source: str = "<string>") -> ClosureSpec:
         """Parse a spec from TOML text. Raises :class:`SpecError` on any problem."""
+        if not isinstance(text, str):
+            raise InvalidInputError("text", f"expected the spec's TOML text as a str, got {type(text).__name__}", text)
+        if len(text) > MAX_FILE_BYTES:
+            raise SpecError(source, f"closure spec longer than {MAX_FILE_BYTES} characters")
+        try:
+            text.encode("utf-8")  # names end up in Pinocchio (C++), which takes UTF-8 only
+        except UnicodeEncodeError as exc:
+            raise SpecError(source, f"closure spec text cannot be encoded as UTF-8 (character {exc.start})") from None
         try:
             raw = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise SpecError(source, f"not valid TOML: {exc}") from None
+        except RecursionError:
+            raise SpecError(source, "not valid TOML for pkm: arrays or tables nested too deeply") from None
         return cls.from_dict(raw, source)
 
     @classmethod
     def load(cls, path: str | Path) -> ClosureSpec:
         """Read a spec file. Raises :class:`SpecError` if it is missing or malformed."""
-        path = Path(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except OSError as exc:
-            raise SpecError(str(path), f"cannot read closure spec: {exc.strerror}") from None
-        return cls.from_toml(text, str(path))
+        path = as_path(path, "path")
+        return cls.from_toml(read_text_file(path, "closure spec"), str(path))
 
     @classmethod
     def from_dict(cls, raw: Mapping, source: str = "<dict>") -> ClosureSpec:
@@ -195,8 +231,12 @@ class ClosureSpec:
             typ = need(c, "type", str, where)
             if typ not in CLOSURE_TYPES:
                 raise SpecError(source, f"{where}type {typ!r} unknown; use one of {list(CLOSURE_TYPES)}")
-            closures.append(Closure(need(c, "name", str, where), typ, need(c, "frame_a", str, where),
-                                    need(c, "frame_b", str, where)))
+            closure = Closure(need(c, "name", str, where), typ, need(c, "frame_a", str, where),
+                              need(c, "frame_b", str, where))
+            if closure.frame_a == closure.frame_b:
+                raise SpecError(source, f"{where}frame_a and frame_b are both {closure.frame_a!r}: a closure ties "
+                                        "two different frames")
+            closures.append(closure)
         if len({c.name for c in closures}) != len(closures):
             raise SpecError(source, "two closures share a name")
 
@@ -205,24 +245,40 @@ class ClosureSpec:
             if not isinstance(b, dict):
                 raise SpecError(source, f"branch.{bname} must be a table")
             signs = need(b, "signs", dict, f"branch.{bname}.")
-            if not all(v in (-1, 1) and isinstance(v, int) for v in signs.values()):
+            if not all(isinstance(v, int) and not isinstance(v, bool) and v in (-1, 1) for v in signs.values()):
                 raise SpecError(source, f"branch.{bname}.signs values must be +1 or -1")
             branches[bname] = Branch(bname, dict(signs), str(b.get("description", "")))
         default_branch = raw.get("default_branch")
+        if default_branch is not None and not isinstance(default_branch, str):
+            raise SpecError(source, f"default_branch must be a string, got {type(default_branch).__name__}")
         if default_branch is not None and default_branch not in branches:
             raise SpecError(source, f"default_branch {default_branch!r} is not among the branches {sorted(branches)}")
 
         reference = {}
         for jname, vals in need(raw, "reference", dict).items():
-            if not isinstance(vals, list) or not all(isinstance(v, (int, float)) for v in vals):
+            if not isinstance(vals, list) or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                     for v in vals):
                 raise SpecError(source, f"reference.{jname} must be a list of numbers")
             if not all(math.isfinite(v) for v in vals):
                 raise SpecError(source, f"reference.{jname} holds a non-finite number")
+            if not all(abs(v) <= _ABSURD for v in vals):
+                raise SpecError(source, f"reference.{jname} holds a number beyond {_ABSURD:g} (SI units: m, rad)")
             reference[jname] = tuple(float(v) for v in vals)
 
         params = raw.get("parameters", {})
-        if not isinstance(params, dict) or not all(isinstance(v, (int, float, str)) for v in params.values()):
-            raise SpecError(source, "parameters must be a table of numbers or strings")
+        if not isinstance(params, dict) or not all(
+                isinstance(v, str) or (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v))
+                for v in params.values()):
+            raise SpecError(source, "parameters must be a table of finite numbers or strings")
+        for key in ("mechanism", "urdf", "end_effector"):
+            if not need(raw, key, str):
+                raise SpecError(source, f"key {key!r} must not be empty")
+        if not isinstance(raw.get("description", ""), str):
+            raise SpecError(source, "description must be a string")
+        urdf = PurePosixPath(raw["urdf"])
+        if urdf.is_absolute() or ".." in urdf.parts or "\0" in raw["urdf"] or "\\" in raw["urdf"]:
+            raise SpecError(source, f"urdf = {raw['urdf']!r}: the URDF path must be relative to the spec's folder "
+                                    "and stay inside it (no absolute path, no '..'); copy the URDF next to the spec")
 
         return cls(
             mechanism=need(raw, "mechanism", str),
@@ -274,6 +330,56 @@ class ClosureSpec:
 
     def dump(self, path: str | Path) -> None:
         Path(path).write_text(self.to_toml(), encoding="utf-8")
+
+
+def as_path(path, name: str = "path") -> Path:
+    """``path`` (str or path-like) as a :class:`~pathlib.Path`, or :class:`InvalidInputError`."""
+    if isinstance(path, (str, os.PathLike)) and not isinstance(path, bytes):
+        text = os.fspath(path)
+        if isinstance(text, str) and text and "\0" not in text:
+            return Path(text)
+    raise InvalidInputError(name, f"expected a file path (str or pathlib.Path), got {type(path).__name__} {path!r}",
+                            path)
+
+
+def read_text_file(path: str | Path, what: str, max_bytes: int = MAX_FILE_BYTES) -> str:
+    """The UTF-8 text of a regular file of at most ``max_bytes``.
+
+    Never blocks and never reads without bound: a FIFO, a device (``/dev/zero``), a directory or
+    a file larger than ``max_bytes`` is refused before reading.
+
+    Raises:
+        SpecError: The file is missing, unreadable, not a regular file, too large, or not UTF-8.
+    """
+    path = as_path(path)
+    src = str(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as exc:
+        raise SpecError(src, f"cannot read {what}: {exc.strerror}") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise SpecError(src, f"cannot read {what}: not a regular file")
+        if st.st_size > max_bytes:
+            raise SpecError(src, f"{what} is {st.st_size} bytes, more than the {max_bytes} accepted")
+        chunks, size = [], 0
+        while size <= max_bytes:
+            chunk = os.read(fd, min(1 << 20, max_bytes + 1 - size))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+    except OSError as exc:
+        raise SpecError(src, f"cannot read {what}: {exc.strerror}") from None
+    finally:
+        os.close(fd)
+    if size > max_bytes:
+        raise SpecError(src, f"{what} grew beyond the {max_bytes} bytes accepted while being read")
+    try:
+        return b"".join(chunks).decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise SpecError(src, f"{what} is not UTF-8 text (byte {exc.start})") from None
 
 
 def _typename(typ: type | tuple[type, ...]) -> str:

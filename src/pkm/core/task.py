@@ -18,7 +18,7 @@ from collections.abc import Mapping
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.mechanism import Mechanism, as_vector
+from pkm.core.mechanism import Mechanism, as_array, as_vector
 from pkm.errors import InvalidInputError, SingularityError
 
 _ANGLES = ("roll", "pitch", "yaw")
@@ -82,7 +82,7 @@ class TaskMap:
         or 4x4 matrix alone when there are no joint outputs.
         """
         nj = len(self.spec.joints)
-        if self.pose and (isinstance(target, pin.SE3) or np.shape(target) == (4, 4)):
+        if self.pose and (isinstance(target, pin.SE3) or _shape(target) == (4, 4)):
             if nj:
                 raise InvalidInputError("target", f"this task also needs the joints {list(self.spec.joints)}: "
                                                   "pass {'pose': T, joint: value, ...}")
@@ -99,10 +99,7 @@ class TaskMap:
                 else:
                     parts.append(target[k])
             target = parts
-        try:
-            y = np.asarray(target, dtype=float)
-        except (TypeError, ValueError):
-            raise InvalidInputError("target", f"cannot read {type(target).__name__} as task coordinates") from None
+        y = as_array(target, "target", f"{self.value_size} task coordinates {list(self.names)}")
         if y.shape != (self.value_size,):
             raise InvalidInputError("target", f"expected {self.value_size} task coordinates "
                                               f"{list(self.names)}, got shape {y.shape}", target)
@@ -197,6 +194,14 @@ class TaskMap:
         return np.concatenate(out)
 
 
+def _shape(x) -> tuple[int, ...] | None:
+    """``np.shape(x)``, or None for what numpy cannot shape (ragged nestings)."""
+    try:
+        return np.shape(x)
+    except (ValueError, TypeError):
+        return None
+
+
 def _wxyz(xyzw: np.ndarray) -> tuple[float, float, float, float]:
     return float(xyzw[3]), float(xyzw[0]), float(xyzw[1]), float(xyzw[2])
 
@@ -213,7 +218,7 @@ def as_rotation(R, name: str = "R", tol: float = ROTATION_TOL) -> np.ndarray:
     Raises:
         InvalidInputError: with the size of the defect and the determinant.
     """
-    M = np.reshape(as_vector(np.ravel(R), 9, name), (3, 3))
+    M = np.reshape(as_vector(np.ravel(as_array(R, name, "a 3x3 rotation matrix")), 9, name), (3, 3))
     defect, det = float(np.abs(M.T @ M - np.eye(3)).max()), float(np.linalg.det(M))
     if defect > tol or det <= 0.0:
         raise InvalidInputError(name, f"not a rotation matrix: max|R^T R - I| = {defect:.3g} (tolerance {tol:.0e}), "
@@ -226,8 +231,10 @@ def as_rotation(R, name: str = "R", tol: float = ROTATION_TOL) -> np.ndarray:
 
 def _as_se3(T) -> pin.SE3:
     if isinstance(T, pin.SE3):
-        return T
-    T = np.asarray(T, dtype=float)
+        if not (np.all(np.isfinite(T.translation)) and np.all(np.isfinite(T.rotation))):
+            raise InvalidInputError("pose", "the pin.SE3 holds non-finite values", T)
+        return pin.SE3(as_rotation(T.rotation, "pose"), T.translation.copy())
+    T = as_array(T, "pose", "a pin.SE3 or a 4x4 matrix")
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
         raise InvalidInputError("pose", f"expected a pin.SE3 or a finite 4x4 matrix, got shape {T.shape}", T)
     return pin.SE3(as_rotation(T[:3, :3], "pose"), T[:3, 3].copy())

@@ -6,31 +6,53 @@ model after pkm's own checks, so that a malformed file yields a
 :class:`~pkm.errors.SpecError` that says what is wrong instead of Pinocchio's
 bare ``ValueError``.
 
-What the loader refuses: a document with a DOCTYPE (hence any entity
-declaration), a root element other than ``<robot>``, links or joints without a
-name or with a duplicate name, a joint whose parent or child is not a link, a
-link with two parents or a tree with several roots, an unknown joint type, a
-zero axis, a revolute or prismatic joint without ``<limit lower upper>``,
-non-finite or absurd numbers (beyond 1e6 in SI), a ``<mimic>`` that names an
-unknown joint. yourdfpy drops ``<mimic>`` when it writes, so the builder puts
-those elements back itself.
+What the loaders refuse
+-----------------------
+
+:func:`check_urdf` (run by :func:`load_model`, hence by every ``Mechanism`` constructor)
+raises :class:`~pkm.errors.SpecError` for:
+
+* text that is not a ``str``/``bytes``, that cannot be encoded as UTF-8, or that is larger
+  than 16 MiB; a document that is not well-formed XML (truncated files included) or nests
+  deeper than libxml2's default limit (256);
+* any ``DOCTYPE``, hence any entity declaration: internal entity expansion ("billion
+  laughs") and external entities (``<!ENTITY x SYSTEM "file:///etc/passwd">``) are refused
+  by a scan of the text before the parser runs, so nothing is expanded or opened. The parser
+  runs with entity resolution, DTD loading and network access off; XInclude elements are
+  refused too; nothing but the given text is ever read (meshes are not loaded);
+* a root element other than ``<robot>``; more than 10,000 links or joints;
+* links or joints without a name or with a duplicate name, a joint whose parent or child is
+  not a link, a link with two parents, a tree with several roots (or none), an unknown joint
+  type;
+* a zero axis; a revolute or prismatic joint without ``<limit lower=... upper=...>`` or with
+  ``lower > upper``;
+* a number that is not finite or absurd (``|x| > 1e6`` in SI units, taken for a unit error):
+  origins, axes, limits, efforts, velocities, masses, inertias, mimic coefficients;
+* a negative mass, an inertia tensor that is not positive semi-definite (beyond round-off);
+* a ``<mimic>`` naming an unknown joint.
+
+Whatever Pinocchio or yourdfpy still reject after these checks is reported as a
+:class:`~pkm.errors.SpecError` too, never as their own exception types.
+yourdfpy drops ``<mimic>`` when it writes, so the builder puts those elements back itself.
 """
 
 from __future__ import annotations
 
 import io
 import math
+import re
 
 import numpy as np
 import pinocchio as pin
 import yourdfpy
 from lxml import etree
 
-from pkm.errors import SpecError
+from pkm.errors import InvalidInputError, SpecError
 
 _JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
 _ABSURD = 1e6  # |value| above this (m, rad, kg, N) is taken for a unit error
 _MAX_BYTES = 16 * 1024 * 1024
+_MAX_ELEMENTS = 10_000  # links + joints
 
 
 def _origin(xyz=(0.0, 0.0, 0.0), rotation=None) -> np.ndarray:
@@ -101,11 +123,14 @@ class UrdfBuilder:
         return text
 
 
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(nan|inf|infinity)", re.IGNORECASE)
+
+
 def _floats(text: str | None, n: int, what: str, source: str) -> list[float]:
-    try:
-        vals = [float(v) for v in (text or "").split()]
-    except ValueError:
-        raise SpecError(source, f"{what}: {text!r} is not a list of numbers") from None
+    words = (text or "").split()
+    if not all(_NUMBER.fullmatch(w) for w in words):  # float() would also take "1_000" and non-ASCII digits
+        raise SpecError(source, f"{what}: {text!r} is not a list of numbers")
+    vals = [float(v) for v in words]
     if len(vals) != n:
         raise SpecError(source, f"{what}: expected {n} numbers, got {text!r}")
     for v in vals:
@@ -116,7 +141,19 @@ def _floats(text: str | None, n: int, what: str, source: str) -> list[float]:
 
 def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
     """Parse and check URDF text (see the module docstring); returns the root element."""
-    data = text.encode() if isinstance(text, str) else text
+    if not isinstance(text, (str, bytes)):
+        raise InvalidInputError("text", f"expected the URDF text as a str, got {type(text).__name__}", text)
+    if len(text) > _MAX_BYTES:
+        raise SpecError(source, f"URDF larger than {_MAX_BYTES} bytes")
+    try:
+        data = text.encode() if isinstance(text, str) else text.decode("utf-8").encode()
+    except UnicodeEncodeError as exc:
+        raise SpecError(source, f"URDF text cannot be encoded as UTF-8 (character {exc.start})") from None
+    except UnicodeDecodeError as exc:
+        raise SpecError(source, f"URDF bytes are not UTF-8 (byte {exc.start})") from None
+    if b"<!DOCTYPE" in data or b"<!ENTITY" in data:  # refused before the parser sees (and expands) anything
+        raise SpecError(source, "URDF with a DOCTYPE (entity declarations) is refused; remove the <!DOCTYPE ...> "
+                                "block (URDF needs none)")
     if len(data) > _MAX_BYTES:
         raise SpecError(source, f"URDF larger than {_MAX_BYTES} bytes")
     parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False,
@@ -129,7 +166,11 @@ def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
         raise SpecError(source, "URDF with a DOCTYPE (entity declarations) is refused")
     if root.tag != "robot":
         raise SpecError(source, f"root element is <{root.tag}>, expected <robot>")
+    if any(isinstance(el.tag, str) and el.tag.startswith("{http://www.w3.org/2001/XInclude}") for el in root.iter()):
+        raise SpecError(source, "XInclude elements are refused (pkm reads one self-contained URDF; expand it first)")
 
+    if len(root) > _MAX_ELEMENTS:
+        raise SpecError(source, f"more than {_MAX_ELEMENTS} elements under <robot>")
     links = [el.get("name") for el in root.findall("link")]
     if any(not n for n in links):
         raise SpecError(source, "a <link> has no name")
@@ -170,9 +211,18 @@ def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
             lo, hi = _floats(f"{lim.get('lower')} {lim.get('upper')}", 2, f"joint {name!r} limits", source)
             if lo > hi:
                 raise SpecError(source, f"joint {name!r}: lower limit {lo} > upper limit {hi}")
+        lim = el.find("limit")
+        if lim is not None:
+            for key in ("effort", "velocity"):
+                if lim.get(key) is not None:
+                    _floats(lim.get(key), 1, f"joint {name!r} limit {key}", source)
         mim = el.find("mimic")
         if mim is not None and mim.get("joint") not in jnames:
             raise SpecError(source, f"joint {name!r} mimics unknown joint {mim.get('joint')!r}")
+        if mim is not None:
+            for key in ("multiplier", "offset"):
+                if mim.get(key) is not None:
+                    _floats(mim.get(key), 1, f"joint {name!r} mimic {key}", source)
     roots = [n for n in links if n not in parent_of]
     if len(roots) != 1:
         raise SpecError(source, f"a URDF tree has one root link; found {roots}")
@@ -181,22 +231,45 @@ def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
         if inertial is None:
             continue
         mass = inertial.find("mass")
-        m = _floats(mass.get("value") if mass is not None else None, 1, f"link {lel.get('name')!r} mass", source)[0]
+        lname = lel.get("name")
+        m = _floats(mass.get("value") if mass is not None else None, 1, f"link {lname!r} mass", source)[0]
         if m < 0:
-            raise SpecError(source, f"link {lel.get('name')!r} has negative mass {m}")
+            raise SpecError(source, f"link {lname!r} has negative mass {m}")
+        org = inertial.find("origin")
+        if org is not None:
+            _floats(org.get("xyz", "0 0 0"), 3, f"link {lname!r} inertial origin xyz", source)
+            _floats(org.get("rpy", "0 0 0"), 3, f"link {lname!r} inertial origin rpy", source)
+        iel = inertial.find("inertia")
+        if iel is None:
+            raise SpecError(source, f"link {lname!r}: <inertial> needs <inertia ixx=... ixy=... ixz=... iyy=... "
+                                    "iyz=... izz=...>")
+        if iel is not None:
+            keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+            ixx, ixy, ixz, iyy, iyz, izz = _floats(" ".join(iel.get(k, "0") for k in keys), 6,
+                                                   f"link {lname!r} inertia {'/'.join(keys)}", source)
+            ev = np.linalg.eigvalsh(np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]))
+            if ev[0] < -1e-9 * max(1.0, float(np.abs(ev).max())):
+                raise SpecError(source, f"link {lname!r}: inertia tensor has a negative principal moment "
+                                        f"{ev[0]:.6g} kg m^2 (not physical); check ixx..izz")
     return root
 
 
 def load_model(text: str, source: str = "<string>") -> pin.Model:
-    """Check URDF text and build the Pinocchio model (mimic joints honoured)."""
+    """Check URDF text and build the Pinocchio model (mimic joints honoured).
+
+    Raises:
+        SpecError: see the module docstring for what is refused.
+    """
     check_urdf(text, source)
+    if isinstance(text, bytes):
+        text = text.decode("utf-8", errors="replace")
     try:
         yourdfpy.URDF.load(io.BytesIO(text.encode()), build_scene_graph=False, load_meshes=False)
     except Exception as exc:  # yourdfpy raises a variety of types
         raise SpecError(source, f"yourdfpy rejects the URDF: {exc}") from None
     try:
         return pin.buildModelFromXML(text, mimic=True)
-    except (ValueError, RuntimeError) as exc:
+    except Exception as exc:  # Pinocchio's own exception types must not leak  # noqa: BLE001
         hint = (" (a mimic joint must come after the joint it mimics in Pinocchio's traversal, "
                 "which visits sibling joints in name order)") if "mimic" in str(exc) else ""
         raise SpecError(source, f"Pinocchio rejects the URDF: {exc}{hint}") from None

@@ -24,6 +24,6 @@ TITLES = {
 
 def module(name: str) -> ModuleType:
     """The module of mechanism ``name``."""
-    if name not in NAMES:
-        raise UnknownNameError("mechanism", name, NAMES)
+    if not isinstance(name, str) or name not in NAMES:
+        raise UnknownNameError("mechanism", repr(name) if not isinstance(name, str) else name, NAMES)
     return importlib.import_module(f"pkm.mechanisms.{name}")

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 
 import numpy as np
 
-from pkm.core.mechanism import Mechanism, wrap_angle
+from pkm.core.mechanism import ABSURD, Mechanism, wrap_angle
 from pkm.core.spec import ClosureSpec
 from pkm.errors import InvalidParameterError, UnreachableError
 
@@ -44,8 +45,11 @@ def arm_angle(u: float, v: float, w: float, arm: float, rod: float, sign: int, l
     Raises:
         UnreachableError: for ``leg`` (1-based), with how much the rod misses the arm-tip circle [m].
     """
+    u, v, w = float(u), float(v), float(w)  # Python floats: a far pose overflows to inf without a warning
     rho = math.hypot(u, v)
     K = (u * u + v * v + w * w + arm * arm - rod * rod) / (2.0 * arm)
+    if not (math.isfinite(K) and math.isfinite(rho)):
+        raise UnreachableError(leg, math.inf, "m", f"{detail} (the point is beyond the float range: check the units)")
     if abs(K) > rho * (1.0 + 1e-12):  # beyond round-off of a boundary (double-root) pose
         dmin, dmax = math.hypot(w, rho - arm), math.hypot(w, rho + arm)
         raise UnreachableError(leg, dmin - rod if dmin > rod else rod - dmax, "m", detail)
@@ -53,26 +57,62 @@ def arm_angle(u: float, v: float, w: float, arm: float, rod: float, sign: int, l
     return float(wrap_angle(math.atan2(v, u) + sign * delta))
 
 
-def check_positive(obj, *names: str) -> None:
-    """Each named field of ``obj`` must be a finite number > 0."""
+def real(v) -> float | None:
+    """``v`` as a finite float if it is a real number (not a bool, not a string), else None."""
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
+        return None
+    try:
+        f = float(v)
+    except (OverflowError, ValueError, TypeError):
+        return None
+    return f if math.isfinite(f) else None
+
+
+def _check(obj, names, ok, what: str) -> None:
     for n in names:
         v = getattr(obj, n)
-        if not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
-            raise InvalidParameterError(n, f"must be a finite number > 0 (SI units), got {v!r}", v)
+        f = real(v)
+        if f is None or not ok(f) or abs(f) > ABSURD:
+            raise InvalidParameterError(n, f"must be a finite number {what} (SI units: m, kg, rad; |value| <= "
+                                           f"{ABSURD:g}), got {v!r}", v)
+
+
+def check_positive(obj, *names: str) -> None:
+    """Each named field of ``obj`` must be a finite number in (0, 1e6] (larger: a unit error)."""
+    _check(obj, names, lambda f: f > 0, "> 0")
 
 
 def check_nonnegative(obj, *names: str) -> None:
-    for n in names:
-        v = getattr(obj, n)
-        if not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
-            raise InvalidParameterError(n, f"must be a finite number >= 0 (SI units), got {v!r}", v)
+    """Each named field of ``obj`` must be a finite number in [0, 1e6]."""
+    _check(obj, names, lambda f: f >= 0, ">= 0")
 
 
 def check_finite(obj, *names: str) -> None:
-    for n in names:
-        v = getattr(obj, n)
-        if not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise InvalidParameterError(n, f"must be a finite number, got {v!r}", v)
+    """Each named field of ``obj`` must be a finite number of magnitude <= 1e6."""
+    _check(obj, names, lambda f: True, "")
+
+
+def check_numbers(obj, name: str, n: int, what: str) -> tuple[float, ...]:
+    """Field ``name`` of ``obj`` must be a tuple or list of ``n`` finite numbers (``what`` describes them).
+
+    The field is stored back as a tuple of floats (the dataclass stays hashable and printable).
+    """
+    v = getattr(obj, name)
+    flat = isinstance(v, (tuple, list)) or (isinstance(v, np.ndarray) and v.ndim == 1)
+    vals = [real(x) for x in v] if flat else None
+    if vals is None or len(vals) != n or any(x is None or abs(x) > ABSURD for x in vals):
+        raise InvalidParameterError(name, f"must be {n} finite numbers {what} (|value| <= {ABSURD:g}), got {v!r}", v)
+    object.__setattr__(obj, name, tuple(vals))
+    return tuple(vals)
+
+
+def check_params(params, cls: type, name: str = "params"):
+    """``params`` itself if it is a ``cls``, else :class:`InvalidParameterError` saying what to pass."""
+    if not isinstance(params, cls):
+        mod = cls.__module__
+        raise InvalidParameterError(name, f"expected a {cls.__name__} ({mod}.Params(...) or the .params of "
+                                          f"pkm.load/pkm.build), got {type(params).__name__}", params)
+    return params
 
 
 def spec_parameters(params) -> dict[str, float | str]:
@@ -80,7 +120,7 @@ def spec_parameters(params) -> dict[str, float | str]:
     out: dict[str, float | str] = {}
     for f in dataclasses.fields(params):
         v = getattr(params, f.name)
-        if isinstance(v, (tuple, list)):
+        if isinstance(v, (tuple, list, np.ndarray)):
             for k, x in enumerate(v):
                 out[f"{f.name}_{k + 1}"] = float(x)
         elif isinstance(v, str):

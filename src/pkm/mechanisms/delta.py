@@ -38,11 +38,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.mechanism import Mechanism, as_vector
+from pkm.core.mechanism import Mechanism, as_vector, check_mechanism, finite_result
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.urdf import UrdfBuilder
 from pkm.errors import AssemblyError, InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
-from pkm.mechanisms._common import arm_angle, check_positive, make_mechanism, rod_inertia, rot_z, spec_parameters
+from pkm.mechanisms._common import (
+    arm_angle,
+    check_numbers,
+    check_params,
+    check_positive,
+    make_mechanism,
+    rod_inertia,
+    rot_z,
+    spec_parameters,
+)
 
 NAME = "delta"
 PHI = (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0)
@@ -76,11 +85,7 @@ class DeltaParams:
 
     def __post_init__(self):
         check_positive(self, "La", "Lb", "r", "R", "m_arm", "m_forearm", "m_platform")
-        if len(self.home) != 3:
-            raise InvalidParameterError("home", "must be a point (x, y, z) in m", self.home)
-        for k, v in enumerate(self.home):
-            if not math.isfinite(v):
-                raise InvalidParameterError("home", f"component {k} is not finite", self.home)
+        check_numbers(self, "home", 3, "(a point x, y, z in m)")
         # the reference pose must be reachable in the default working mode, away from singularity
         try:
             th = inverse_kinematics(self, self.home)
@@ -111,9 +116,10 @@ def inverse_kinematics(params: DeltaParams, p, branch: str | tuple[str, str, str
     Raises:
         UnreachableError: with the first arm that cannot reach and by how much [m].
     """
+    params = check_params(params, DeltaParams)
     p = as_vector(p, 3, "p")
-    branches = (branch,) * 3 if isinstance(branch, str) else tuple(branch)
-    if len(branches) != 3 or any(b not in BRANCHES for b in branches):
+    branches = (branch,) * 3 if isinstance(branch, str) else tuple(branch) if isinstance(branch, (tuple, list)) else ()
+    if len(branches) != 3 or any(not isinstance(b, str) or b not in BRANCHES for b in branches):
         raise InvalidInputError("branch", f"use 'knee_out'/'knee_in' or a tuple of three, got {branch!r}", branch)
     return arm_angles(params.La, params.Lb, params.R - params.r, p, tuple(-BRANCHES[b] for b in branches))
 
@@ -133,6 +139,7 @@ def arm_angles(La: float, Lb: float, offset: float, p: np.ndarray, signs: tuple[
 
 def sphere_centres(params: DeltaParams, theta) -> np.ndarray:
     """Centres ``B'_i`` of the three spheres of radius Lb (eqs. 3-7), rows i = 1..3 [m]."""
+    params = check_params(params, DeltaParams)
     theta = as_vector(theta, 3, "theta")
     return np.array([rot_z(PHI[i]) @ np.array([0.0, params.R + params.La * math.cos(theta[i]) - params.r,
                                                 params.La * math.sin(theta[i])]) for i in range(3)])
@@ -169,7 +176,8 @@ def forward_kinematics(params: DeltaParams, theta, *, both: bool = False) -> np.
     if disc < 0.0:
         raise AssemblyError(math.sqrt(-disc) / (2.0 * qa), "m", "the three spheres do not intersect")
     roots = sorted([(-qb - math.sqrt(disc)) / (2.0 * qa), (-qb + math.sqrt(disc)) / (2.0 * qa)])
-    sols = np.array([np.concatenate([b0 + b1 * z, [z]]) for z in roots])
+    sols = finite_result(np.array([np.concatenate([b0 + b1 * z, [z]]) for z in roots]), "platform position",
+                         "the sphere centres are nearly aligned (x, y barely determined by z)")
     return sols if both else sols[0]
 
 
@@ -189,6 +197,7 @@ def jacobian_factors(params: DeltaParams, p, theta) -> tuple[np.ndarray, np.ndar
     Returns:
         ``A`` of shape (..., 3, 3) and ``d`` of shape (..., 3).
     """
+    params = check_params(params, DeltaParams)
     p, theta = np.asarray(p, dtype=float), np.asarray(theta, dtype=float)
     c, s = np.cos(theta), np.sin(theta)
     A = np.empty(p.shape[:-1] + (3, 3))
@@ -220,6 +229,7 @@ def jacobian(params: DeltaParams, theta, p=None) -> np.ndarray:
         InvalidInputError: if ``p`` is not assembled with ``theta`` (a forearm off its length by > 1e-9 m).
         SingularityError: ``kind="direct"`` where the forearm vectors are linearly dependent.
     """
+    params = check_params(params, DeltaParams)
     theta = as_vector(theta, 3, "theta")
     p = forward_kinematics(params, theta) if p is None else as_vector(p, 3, "p")
     A, d = jacobian_factors(params, p, theta)
@@ -235,6 +245,7 @@ def jacobian(params: DeltaParams, theta, p=None) -> np.ndarray:
 
 def joint_values(params: DeltaParams, p, branch: str | tuple[str, str, str] = "knee_out") -> dict[str, list[float]]:
     """Every joint coordinate of the tree (closed form), for platform centre ``p``."""
+    params = check_params(params, DeltaParams)
     p = as_vector(p, 3, "p")
     th = inverse_kinematics(params, p, branch)
     out: dict[str, list[float]] = {}
@@ -255,6 +266,7 @@ def joint_values(params: DeltaParams, p, branch: str | tuple[str, str, str] = "k
 
 def configuration(mech: Mechanism, p, branch: str | tuple[str, str, str] = "knee_out") -> np.ndarray:
     """Full configuration vector ``q`` of ``mech`` for platform centre ``p`` (closed form)."""
+    mech = check_mechanism(mech)
     return mech.q_from_dict(joint_values(mech.params, p, branch))
 
 
@@ -279,6 +291,7 @@ def closed_form_fk(params: DeltaParams, q_actuated, seed=None) -> np.ndarray:
 # ---------------------------------------------------------------------- tree and spec
 def urdf_xml(params: DeltaParams) -> str:
     """The URDF tree (see the module doc for the modelling of the parallelograms)."""
+    params = check_params(params, DeltaParams)
     b = UrdfBuilder(NAME)
     b.link("base")
     reach = 2.0 * (params.R + params.La + params.Lb)
@@ -307,6 +320,7 @@ def urdf_xml(params: DeltaParams) -> str:
 
 
 def closure_spec(params: DeltaParams) -> ClosureSpec:
+    params = check_params(params, DeltaParams)
     reference = {k: tuple(v) for k, v in joint_values(params, params.home).items()}
     return ClosureSpec(
         mechanism=NAME,

@@ -21,8 +21,9 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from pkm.core.indices import KINDS
-from pkm.core.mechanism import as_vector
+from pkm.core.mechanism import as_array, as_count, as_vector
 from pkm.errors import InvalidInputError, UnreachableError
+from pkm.mechanisms._common import check_params, real
 from pkm.mechanisms.delta import PHI, DeltaParams, arm_angles
 from pkm.mechanisms.delta_workspace import condition_numbers, workspace
 
@@ -48,6 +49,7 @@ def reachable_radii(params: DeltaParams, p) -> tuple[tuple[float, float], ...]:
     Returns:
         Disjoint closed intervals ``(R_lo, R_hi)`` [m], in increasing order; empty when no R works.
     """
+    params = check_params(params, DeltaParams)
     p = as_vector(p, 3, "p")
     allowed = [(0.0, math.inf)]
     for i in range(3):
@@ -81,8 +83,9 @@ def condition_vs_radius(params: DeltaParams, p, R_values, branch="knee_out", kin
     Raises:
         UnreachableError: if ``p`` is out of reach for one of the radii (arm and distance named).
     """
+    params = check_params(params, DeltaParams)
     p = as_vector(p, 3, "p")
-    R_values = np.atleast_1d(np.asarray(R_values, dtype=float))
+    R_values = np.atleast_1d(as_array(R_values, "R_values", "base radii [m]"))
     if R_values.ndim != 1 or not np.all(np.isfinite(R_values)) or np.any(R_values <= 0.0):
         raise InvalidInputError("R_values", "must be finite radii > 0 [m]", R_values)
     out = {kind: np.empty(len(R_values)) for kind in kinds}
@@ -105,6 +108,7 @@ def radius_minimising_condition(params: DeltaParams, p, branch="knee_out", kind:
         UnreachableError: if no radius reaches ``p``.
     """
     p = as_vector(p, 3, "p")
+    n_scan = as_count(n_scan, "n_scan", low=1, high=100_000)
     intervals = reachable_radii(params, p)
     if not intervals:
         raise UnreachableError(1, math.inf, "m", f"no base radius reaches {p.tolist()}")
@@ -146,7 +150,7 @@ class RadiusStudy:
 
     def conditioned_volume(self, k_max: float) -> np.ndarray:
         """Volume [m^3] of the part of each workspace where ``K <= k_max``."""
-        if not (math.isfinite(k_max) and k_max >= 1.0):
+        if real(k_max) is None or not k_max >= 1.0:
             raise InvalidInputError("k_max", f"must be a finite bound >= 1, got {k_max!r}", k_max)
         return np.array([np.searchsorted(K, k_max, side="right") for K in self.K_sorted]) * self.spacing**3
 
@@ -174,7 +178,8 @@ def workspace_vs_radius(params: DeltaParams, R_values, *, kind: str = "2", spaci
         spacing: Grid step [m].
         branch: Working mode.
     """
-    R_values = np.atleast_1d(np.asarray(R_values, dtype=float))
+    params = check_params(params, DeltaParams)
+    R_values = np.atleast_1d(as_array(R_values, "R_values", "base radii [m]"))
     volume, K_sorted = [], []
     for R in R_values:
         grid = workspace(dataclasses.replace(params, R=float(R)), spacing, branch, (kind,))
@@ -190,11 +195,12 @@ def region_mean_condition(params: DeltaParams, R_values, region, *, kind: str = 
     A radius for which some point of the region is out of reach (or singular) scores ``inf``:
     it cannot serve that task. The best R for the region is ``R_values[argmin]``.
     """
-    region = np.asarray(region, dtype=float)
+    params = check_params(params, DeltaParams)
+    region = as_array(region, "region", "points (N, 3) [m]")
     if region.ndim != 2 or region.shape[1] != 3 or len(region) == 0:
         raise InvalidInputError("region", f"expected N >= 1 points of shape (N, 3) [m], got {region.shape}", region)
     out = []
-    for R in np.atleast_1d(np.asarray(R_values, dtype=float)):
+    for R in np.atleast_1d(as_array(R_values, "R_values", "base radii [m]")):
         K, reachable = condition_numbers(dataclasses.replace(params, R=float(R)), region, branch, (kind,))
         out.append(float(np.mean(K[kind])) if reachable.all() and np.all(np.isfinite(K[kind])) else math.inf)
     return np.array(out)

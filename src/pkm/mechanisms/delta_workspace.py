@@ -20,15 +20,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from pkm.core.indices import KINDS, condition_number
-from pkm.core.mechanism import wrap_angle
+from pkm.core.mechanism import as_array, wrap_angle
 from pkm.errors import InvalidInputError
+from pkm.mechanisms._common import check_params, real
 from pkm.mechanisms.delta import BRANCHES, PHI, DeltaParams, jacobian_factors
+
+MAX_NODES = 16_000_000  #: grid nodes of :func:`workspace` at most (memory)
 
 __all__ = ["WorkspaceGrid", "condition_numbers", "inverse_kinematics_batch", "workspace"]
 
 
 def _points(P) -> np.ndarray:
-    P = np.asarray(P, dtype=float)
+    P = as_array(P, "points", "platform centres (..., 3) [m]")
     if P.ndim < 1 or P.shape[-1] != 3:
         raise InvalidInputError("points", f"expected an array of shape (..., 3) [m], got {P.shape}", P)
     if not np.all(np.isfinite(P)):
@@ -37,8 +40,8 @@ def _points(P) -> np.ndarray:
 
 
 def _branch_signs(branch) -> tuple[int, int, int]:
-    branches = (branch,) * 3 if isinstance(branch, str) else tuple(branch)
-    if len(branches) != 3 or any(b not in BRANCHES for b in branches):
+    branches = (branch,) * 3 if isinstance(branch, str) else tuple(branch) if isinstance(branch, (tuple, list)) else ()
+    if len(branches) != 3 or any(not isinstance(b, str) or b not in BRANCHES for b in branches):
         raise InvalidInputError("branch", f"use 'knee_out'/'knee_in' or a tuple of three, got {branch!r}", branch)
     return tuple(-BRANCHES[b] for b in branches)
 
@@ -57,6 +60,7 @@ def inverse_kinematics_batch(params: DeltaParams, points, branch="knee_out") -> 
         Where an arm does not reach, its angle is that of the nearest elbow position (the
         clipped arc cosine), finite but meaningless: use the mask.
     """
+    params = check_params(params, DeltaParams)
     P = _points(points)
     signs = _branch_signs(branch)
     theta = np.empty(P.shape)
@@ -92,8 +96,11 @@ def condition_numbers(params: DeltaParams, points, branch="knee_out", kinds=KIND
         ``{kind: K}`` each of shape (...), ``inf`` at unreachable points and where an arm is
         stretched or folded onto its forearm, and the ``reachable`` mask.
     """
+    params = check_params(params, DeltaParams)
     P = _points(points)
-    unknown = [k for k in kinds if k not in KINDS]
+    if isinstance(kinds, str) or not isinstance(kinds, (tuple, list)):
+        raise InvalidInputError("kinds", f"expected a tuple of kinds among {KINDS}, got {kinds!r}", kinds)
+    unknown = [k for k in kinds if not isinstance(k, str) or k not in KINDS]
     if unknown or not kinds:
         raise InvalidInputError("kinds", f"choose among {KINDS}, got {tuple(kinds)!r}", kinds)
     theta, reachable = inverse_kinematics_batch(params, P, branch)
@@ -162,10 +169,14 @@ def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", ki
     Raises:
         InvalidInputError: if ``spacing`` is not a finite length in (0, (La + Lb) / 4].
     """
+    params = check_params(params, DeltaParams)
     L = params.La + params.Lb
-    if not (isinstance(spacing, (int, float)) and math.isfinite(spacing) and 0.0 < spacing <= L / 4):
+    if real(spacing) is None or not 0.0 < spacing <= L / 4:
         raise InvalidInputError("spacing", f"must be a length in (0, {L / 4:.4g}] m, got {spacing!r}", spacing)
     n = math.ceil(L / spacing)
+    if 4 * n**3 > MAX_NODES:
+        raise InvalidInputError("spacing", f"{4 * n**3} grid nodes exceed {MAX_NODES}; take a spacing of at least "
+                                           f"{L / (MAX_NODES / 4) ** (1 / 3):.4g} m", spacing)
     xy = (np.arange(-n, n) + 0.5) * spacing
     z = -(np.arange(n)[::-1] + 0.5) * spacing
     reachable = np.zeros((len(xy), len(xy), len(z)), dtype=bool)

@@ -125,7 +125,16 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core import constraints
-from pkm.core.mechanism import Mechanism, as_vector, wrap_angle
+from pkm.core.mechanism import (
+    Mechanism,
+    as_array,
+    as_count,
+    as_scalar,
+    as_tolerance,
+    as_vector,
+    check_mechanism,
+    wrap_angle,
+)
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.task import ROTATION_TOL, as_rotation  # noqa: F401 (ROTATION_TOL: part of this module's API)
 from pkm.core.urdf import UrdfBuilder
@@ -133,6 +142,8 @@ from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, Inval
 from pkm.mechanisms._common import (
     arm_angle,
     check_finite,
+    check_numbers,
+    check_params,
     check_positive,
     make_mechanism,
     rod_inertia,
@@ -171,7 +182,7 @@ class HexapodParams:
         r: Circumradius of the platform triangles [m] (50 mm).
         theta: Angular position ``th_i`` of leg i about Y, from +X [rad] (35, 155, 275, 25, 145, 265 deg).
         layout: ``"sector"`` or ``"literal"`` platform layout (see the module doc).
-        home_rotation: Reference platform orientation, rows of a 3x3 matrix (the paper's pose T as
+        home_rotation: Reference platform orientation, rows of a 3x3 matrix [-] (the paper's pose T as
             printed; projected on SO(3) by SVD).
         home_position: Reference position of ``P`` [m] (pose T: (0, -350, 0) mm).
         home_beta: Reference reconfiguration angle [rad] (0).
@@ -202,14 +213,12 @@ class HexapodParams:
     def __post_init__(self):
         check_positive(self, "Rf", "Rr", "R2", "LA", "LB", "h", "r", "m_recon", "m_arm", "m_rod", "m_platform")
         check_finite(self, "H0", "home_beta")
-        if self.layout not in LAYOUTS:
+        if not isinstance(self.layout, str) or self.layout not in LAYOUTS:
             raise InvalidParameterError("layout", f"must be one of {sorted(LAYOUTS)}, got {self.layout!r}",
                                         self.layout)
-        for name, n in (("theta", 6), ("home_rotation", 9), ("home_position", 3)):
-            v = getattr(self, name)
-            if not isinstance(v, (tuple, list)) or len(v) != n or not all(
-                    isinstance(x, (int, float)) and math.isfinite(x) for x in v):
-                raise InvalidParameterError(name, f"must be {n} finite numbers (SI units), got {v!r}", v)
+        for name, n, what in (("theta", 6, "(angles in rad)"), ("home_rotation", 9, "(rows of a rotation)"),
+                              ("home_position", 3, "(a point in m)")):
+            check_numbers(self, name, n, what)
         try:
             as_rotation(self.home_rotation, "home_rotation", HOME_ROTATION_TOL)
         except InvalidInputError as exc:
@@ -235,11 +244,13 @@ def leg_frame(theta_i: float) -> np.ndarray:
 
 def home_rotation(params: HexapodParams) -> np.ndarray:
     """The reference orientation: ``params.home_rotation`` projected on SO(3) (SVD)."""
+    params = check_params(params, HexapodParams)
     return as_rotation(params.home_rotation, "home_rotation", HOME_ROTATION_TOL)
 
 
 def base_points(params: HexapodParams, beta: float) -> np.ndarray:
     """Actuated joint centres ``A_1..A_6`` for reconfiguration angle ``beta`` [rad] (eqs. 1-2), rows [m]."""
+    params = check_params(params, HexapodParams)
     out = np.empty((6, 3))
     for i, th in enumerate(params.theta):
         e_r = leg_frame(th)[:, 0]
@@ -252,6 +263,7 @@ def base_points(params: HexapodParams, beta: float) -> np.ndarray:
 
 def platform_local_points(params: HexapodParams) -> np.ndarray:
     """Spherical joint centres ``C*_1..C*_6`` in the platform frame, rows [m]."""
+    params = check_params(params, HexapodParams)
     low = np.array([[params.r * math.cos(math.radians(p)), 0.0, params.r * math.sin(math.radians(p))]
                     for p in LAYOUTS[params.layout]])
     return np.vstack([low + params.h * _E_Y, low])
@@ -259,11 +271,13 @@ def platform_local_points(params: HexapodParams) -> np.ndarray:
 
 def platform_points(params: HexapodParams, R: np.ndarray, P) -> np.ndarray:
     """``C_1..C_6`` in the base frame for platform orientation ``R`` and position ``P`` (eq. 14), rows [m]."""
+    params = check_params(params, HexapodParams)
     return np.asarray(P, dtype=float) + platform_local_points(params) @ np.asarray(R, dtype=float).T
 
 
 def elbow_points(params: HexapodParams, alphas, beta: float) -> np.ndarray:
     """Universal-joint centres ``B_1..B_6`` from the paper's absolute ``alpha_i`` and ``beta`` [rad] (eq. 3), rows [m]."""
+    params = check_params(params, HexapodParams)
     alphas = as_vector(alphas, 6, "alphas")
     A = base_points(params, beta)
     return np.array([A[i] + params.LA * (leg_frame(params.theta[i]) @ [math.cos(alphas[i]), math.sin(alphas[i]), 0.0])
@@ -307,6 +321,7 @@ def inverse_kinematics(params: HexapodParams, R, P, beta: float,
         InvalidInputError: ``R`` is not a rotation (see :func:`as_rotation`).
         UnreachableError: with the first leg that cannot reach and by how much [m].
     """
+    params = check_params(params, HexapodParams)
     branches = _branches(branch)
     C = platform_points(params, as_rotation(R), as_vector(P, 3, "P"))
     A = base_points(params, _scalar(beta, "beta"))
@@ -336,6 +351,7 @@ def joint_values(params: HexapodParams, R, P, beta: float,
     Returns:
         ``{joint name: coordinates}``; the platform's quaternion is that of ``R``.
     """
+    params = check_params(params, HexapodParams)
     R = as_rotation(R)
     alphas = inverse_kinematics(params, R, P, beta, branch)
     return _joint_values(params, R, P, pin.Quaternion(R).coeffs(), beta, alphas)
@@ -360,6 +376,7 @@ def _joint_values(params: HexapodParams, R: np.ndarray, P, quat: np.ndarray, bet
 
 def configuration(mech: Mechanism, y, branch: str | tuple[str, ...] = DEFAULT_BRANCH) -> np.ndarray:
     """Full configuration ``q`` of ``mech`` for task vector ``y = (x, y, z, qx, qy, qz, qw, beta)`` (closed form)."""
+    mech = check_mechanism(mech)
     R, P, quat, beta = _task(y)
     alphas = inverse_kinematics(mech.params, R, P, beta, branch)
     return mech.q_from_dict(_joint_values(mech.params, R, P, quat, beta, alphas))
@@ -388,50 +405,70 @@ def forward_kinematics(params: HexapodParams, alphas, beta: float, seed=None, *,
     Raises:
         ConvergenceError: with the residual, when Newton's method does not reach ``tol``.
     """
+    params = check_params(params, HexapodParams)
     B = elbow_points(params, alphas, _scalar(beta, "beta"))
     if seed is None:
         seed = platform_points(params, home_rotation(params), params.home_position)[:3]
-    X = as_vector(np.ravel(seed), 9, "seed").copy()
+    X = as_vector(np.ravel(as_array(seed, "seed", "C1, C2, C3 (3, 3) [m]")), 9, "seed").copy()
+    tol = as_tolerance(tol, "tol")
+    max_iter = as_count(max_iter, "max_iter", low=1, high=10_000)
     e = params.r * math.sqrt(3.0)
     k = (-1.0 if params.layout == "sector" else 1.0) * 2.0 / (math.sqrt(3.0) * e * e)
-    pairs = ((0, 1), (1, 2), (0, 2))
+    LB, h = params.LB, params.h
+    pa, pb = np.array([0, 1, 0]), np.array([1, 2, 2])  # the sides C1C2, C2C3, C1C3
+    legs, cols = np.arange(6), np.array([0, 1, 2, 0, 1, 2])
 
     def normal(C: np.ndarray) -> np.ndarray:  # eq. (5), unit when C1C2C3 is the platform's triangle
-        return k * np.cross(C[1] - C[2], C[0] - C[2])
+        a, b = C[1] - C[2], C[0] - C[2]
+        return k * np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
-    def fun(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        C = x.reshape(3, 3)
-        g = normal(C)
+    def fun(x: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        C = x.reshape(3, 3)  # vectorised over the legs and the sides
+        dv = np.vstack([C, C + h * normal(C)]) - B  # legs 1-3 at C_i, legs 4-6 at C_i + h g
+        D = C[pa] - C[pb]
+        f = np.empty(9)
+        f[:6] = (np.einsum("ij,ij->i", dv, dv) - LB**2) / (2.0 * LB)
+        f[6:] = (np.einsum("ij,ij->i", D, D) - e * e) / (2.0 * e)
+        if not jacobian:
+            return f, None
         dg = k * np.hstack([pin.skew(C[1] - C[2]), -pin.skew(C[0] - C[2]), pin.skew(C[0] - C[1])])  # dg/dX
-        f, J = np.empty(9), np.zeros((9, 9))
-        for i in range(3):
-            for j, Ci, sel in ((i, C[i], 0.0), (i + 3, C[i] + params.h * g, 1.0)):
-                dv = Ci - B[j]
-                f[j] = (dv @ dv - params.LB**2) / (2.0 * params.LB)
-                J[j, 3 * i:3 * i + 3] = dv / params.LB
-                J[j] += sel * params.h * (dv @ dg) / params.LB
-        for m, (a, b) in enumerate(pairs):
-            dv = C[a] - C[b]
-            f[6 + m] = (dv @ dv - e * e) / (2.0 * e)
-            J[6 + m, 3 * a:3 * a + 3] = dv / e
-            J[6 + m, 3 * b:3 * b + 3] = -dv / e
+        J = np.zeros((9, 9))
+        J6 = np.zeros((6, 3, 3))
+        J6[legs, cols] = dv / LB
+        J[:6] = J6.reshape(6, 9)
+        J[3:6] += h * (dv[3:] @ dg) / LB
+        J3 = np.zeros((3, 3, 3))
+        J3[np.arange(3), pa] = D / e
+        J3[np.arange(3), pb] = -D / e
+        J[6:] = J3.reshape(3, 9)
         return f, J
 
     f, J = fun(X)
     res, it = float(np.max(np.abs(f))), 0
     while res > tol and it < max_iter:
         it += 1
-        step = -np.linalg.lstsq(J, f, rcond=None)[0]
+        if not (np.all(np.isfinite(J)) and np.all(np.isfinite(f))):  # a seed beyond the float range
+            res = np.inf
+            break
+        try:
+            step = -np.linalg.lstsq(J, f, rcond=None)[0]
+        except np.linalg.LinAlgError:  # entries overflowing: no step
+            break
         t = 1.0
         for _ in range(20):
-            f_try, J_try = fun(X + t * step)
+            f_try, _ = fun(X + t * step, False)
             res_try = float(np.max(np.abs(f_try)))
             if res_try < res:
                 break
             t *= 0.5
-        X, f, J, res = X + t * step, f_try, J_try, res_try
+        if not np.isfinite(res_try):  # overflow far from any solution: stop at the last finite iterate
+            break
+        X, res = X + t * step, res_try
+        f, J = fun(X)
     if not res <= tol:
-        raise ConvergenceError("semi-closed forward kinematics (eqs. 4-7)", res, it, tol)
+        raise ConvergenceError("semi-closed forward kinematics (eqs. 4-7)", res if np.isfinite(res) else np.inf, it,
+                               tol, detail="the actuated angles may admit no assembly near the seed; try another "
+                                           "seed or assembly_modes()")
     C = X.reshape(3, 3)
     return np.vstack([C, C + params.h * normal(C)])
 
@@ -483,10 +520,14 @@ def assembly_modes(mech: Mechanism, q_actuated, *, n_starts: int = 32, seed: int
     Raises:
         AssemblyError: no seed converged (the actuated coordinates probably admit no assembly).
     """
-    params = mech.params
+    mech = check_mechanism(mech)
+    params = check_params(mech.params, HexapodParams, "mech.params")
     qa = as_vector(q_actuated, 7, "q_actuated")
-    if not (isinstance(n_starts, int) and n_starts >= 1):
-        raise InvalidInputError("n_starts", f"needs an integer >= 1, got {n_starts!r}", n_starts)
+    n_starts = as_count(n_starts, "n_starts", low=1, high=100_000)
+    seed = as_count(seed, "seed", low=0, high=2**63 - 1)
+    tol, verify_tol = as_tolerance(tol, "tol"), as_tolerance(verify_tol, "verify_tol")
+    max_iter = as_count(max_iter, "max_iter", low=1, high=10_000)
+    distinct = as_scalar(distinct, "distinct", low=0.0, strict_low=True, unit="m")
     alphas, beta = paper_alphas(qa), float(qa[6])
     rng = np.random.default_rng(seed)
     reach = params.LA + params.LB
@@ -520,6 +561,7 @@ def assembly_modes(mech: Mechanism, q_actuated, *, n_starts: int = 32, seed: int
 
 def pose_from_points(params: HexapodParams, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Platform orientation and position ``(R, P)`` from ``C_1..C_6`` (eqs. 8-13, layout's sign of eq. 11)."""
+    params = check_params(params, HexapodParams)
     C = np.asarray(C, dtype=float)
     P = C[3:].mean(axis=0)
     x = (C[3] - P) / np.linalg.norm(C[3] - P)
@@ -538,6 +580,7 @@ def task_vector(R, P, beta: float) -> np.ndarray:
 # Task vector y (as pkm.core.TaskMap lays it out): x y z qx qy qz qw of the frame ``platform``, then beta_1.
 def closed_form_ik(params: HexapodParams, y, branch: str | tuple[str, ...] | None = None) -> np.ndarray:
     """Actuated coordinates (``alpha_1..alpha_6`` joint coordinates, ``beta_1``) for task vector ``y``."""
+    params = check_params(params, HexapodParams)
     R, P, _, beta = _task(y)
     return actuated_from_paper(inverse_kinematics(params, R, P, beta, branch or DEFAULT_BRANCH), beta)
 
@@ -559,6 +602,7 @@ def closed_form_fk(params: HexapodParams, q_actuated, seed=None) -> np.ndarray:
     Raises:
         ConvergenceError: when Newton's method fails (residual attached).
     """
+    params = check_params(params, HexapodParams)
     qa = as_vector(q_actuated, 7, "q_actuated")
     C0 = None
     if seed is not None:
@@ -572,6 +616,7 @@ def closed_form_fk(params: HexapodParams, q_actuated, seed=None) -> np.ndarray:
 # ---------------------------------------------------------------------- tree and spec
 def urdf_xml(params: HexapodParams) -> str:
     """The URDF tree (see the module doc)."""
+    params = check_params(params, HexapodParams)
     b = UrdfBuilder(NAME)
     b.link("base")
     for i, th in enumerate(params.theta):
@@ -601,6 +646,7 @@ def urdf_xml(params: HexapodParams) -> str:
 
 def closure_spec(params: HexapodParams) -> ClosureSpec:
     """The closure spec: six point closures (the spherical joints), reference at the home pose."""
+    params = check_params(params, HexapodParams)
     values = joint_values(params, home_rotation(params), params.home_position, params.home_beta)
     return ClosureSpec(
         mechanism=NAME,
@@ -630,8 +676,8 @@ def build(params: HexapodParams | None = None) -> Mechanism:
 
 # ---------------------------------------------------------------------- helpers
 def _branches(branch: str | tuple[str, ...]) -> tuple[str, ...]:
-    branches = (branch,) * 6 if isinstance(branch, str) else tuple(branch)
-    if len(branches) != 6 or any(b not in BRANCHES for b in branches):
+    branches = (branch,) * 6 if isinstance(branch, str) else tuple(branch) if isinstance(branch, (tuple, list)) else ()
+    if len(branches) != 6 or any(not isinstance(b, str) or b not in BRANCHES for b in branches):
         raise InvalidInputError("branch", f"use {sorted(BRANCHES)} or a tuple of six, got {branch!r}", branch)
     return branches
 

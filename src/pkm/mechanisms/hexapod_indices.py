@@ -24,13 +24,14 @@ check it against the generic core.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 
 from pkm.core import indices as core_indices
 from pkm.core import screws
-from pkm.core.mechanism import as_vector
+from pkm.core.mechanism import as_scalar, as_vector
 from pkm.errors import InvalidInputError
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms import hexapod_screws as hs
@@ -77,7 +78,7 @@ def indices(params: hx.HexapodParams, R, P, beta: float, branch=hx.DEFAULT_BRANC
         UnreachableError: a leg cannot reach; SingularityError: ``J_x`` is singular.
     """
     J = base_jacobian(params, R, P, beta, branch, point)
-    L = params.LA if length is None else float(length)
+    L = params.LA if length is None else as_scalar(length, "length", low=0.0, strict_low=True, unit="m")
     return Indices(core_indices.manipulability(J[:3]), core_indices.manipulability(J[3:]),
                    core_indices.condition_number(J[:3]), core_indices.condition_number(J[3:]),
                    core_indices.condition_number(core_indices.homogenize(J, slice(0, 3), L)), point, L)
@@ -101,11 +102,14 @@ class PoseIndex:
 
     def __init__(self, params: hx.HexapodParams, poses, index: str = "w_rot", branch=hx.DEFAULT_BRANCH,
                  point: str = "O"):
-        if index not in INDICES:
+        hx.check_params(params, hx.HexapodParams)
+        if not isinstance(index, str) or index not in INDICES:
             raise InvalidInputError("index", f"use one of {list(INDICES)}, got {index!r}", index)
         self.params, self.index, self.point = params, index, _point(point)
         self.signs = np.array([-hx.BRANCHES[b] for b in hx._branches(branch)], dtype=float)
         Rs, Ps = [], []
+        if isinstance(poses, (str, bytes, np.ndarray)) or not isinstance(poses, Iterable):
+            raise InvalidInputError("poses", f"expected a sequence of (R, P) pairs, got {type(poses).__name__}", poses)
         for j, pose in enumerate(poses):
             try:
                 R, P = pose
@@ -141,7 +145,7 @@ class PoseIndex:
 
 
 def _point(point: str) -> str:
-    if point not in POINTS:
+    if not isinstance(point, str) or point not in POINTS:
         raise InvalidInputError("point", f"use 'O' (the paper's) or 'P', got {point!r}", point)
     return point
 

@@ -121,10 +121,13 @@ def reachable_intervals(params: hx.HexapodParams, R, P, limits=LIMITS) -> tuple[
 def _limits(limits) -> tuple[float, float]:
     try:
         lo, up = (float(v) for v in limits)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidInputError("limits", f"expected (lower, upper) in rad, got {limits!r}", limits) from None
     if not (math.isfinite(lo) and math.isfinite(up) and lo < up):
         raise InvalidInputError("limits", f"need finite lower < upper [rad], got {limits!r}", limits)
+    if up - lo > 2.0 * math.pi + 1e-9 or max(abs(lo), abs(up)) > 1e3:
+        raise InvalidInputError("limits", f"(lower, upper) = {limits!r} rad spans more than one turn or lies beyond "
+                                          "1000 rad; beta is an angle: give at most one turn (2 pi rad)", limits)
     return lo, up
 
 

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pkm.core import screws
-from pkm.errors import InvalidInputError
+from pkm.core.mechanism import as_scalar, finite_result
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms import hexapod_screws as hs
 
@@ -88,19 +88,19 @@ def classify(params: hx.HexapodParams, R, P, beta: float, branch=hx.DEFAULT_BRAN
     Raises:
         UnreachableError: a leg cannot reach the pose; InvalidInputError: bad input.
     """
-    if not (np.isfinite(tol) and tol > 0):
-        raise InvalidInputError("tol", f"must be finite and > 0, got {tol!r}", tol)
-    L = params.r if length is None else float(length)
-    if not (np.isfinite(L) and L > 0):
-        raise InvalidInputError("length", f"must be finite and > 0, got {length!r}", length)
+    hx.check_params(params, hx.HexapodParams)
+    tol = as_scalar(tol, "tol", low=0.0, strict_low=True)
+    L = params.r if length is None else as_scalar(length, "length", low=0.0, strict_low=True, unit="m")
     J = hs.jacobians(params, R, P, beta, branch)
     jq, jqp = np.diag(J.Jq), np.diag(J.Jq_prime)
     trans = np.abs(jq) / params.LA
     trans_r = np.abs(jqp[:3]) / (params.Rr + params.LA)
     S = screws.shift(J.Jx.T, np.asarray(P, dtype=float))  # rows: $6_i with the pole at P
-    S[:, 3:] /= L
+    with np.errstate(over="ignore"):  # a tiny L overflows: reported by smin below
+        S[:, 3:] /= L
 
     def smin(A: np.ndarray) -> float:
+        finite_result(A, "screw matrix", f"length = {L!r} m is too small to scale the moments (overflow)")
         return float(np.linalg.svd(A, compute_uv=False)[-1])
 
     sd, s1, s2 = smin(S), smin(S[:3].T), smin(S[3:].T)

@@ -69,14 +69,14 @@ import numpy as np
 import pinocchio as pin
 import tomllib
 
-from pkm.core.mechanism import Mechanism
+from pkm.core.mechanism import Mechanism, as_array, check_mechanism, finite_result
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.task import zyx_matrix
 from pkm.core.urdf import UrdfBuilder
 from pkm.data import dynamics_path
 from pkm.errors import InvalidInputError, InvalidParameterError, SpecError, UnreachableError
-from pkm.mechanisms._common import (check_finite, check_nonnegative, check_positive, make_mechanism, rod_inertia,
-                                    rot_y, rot_z, spec_parameters)
+from pkm.mechanisms._common import (check_finite, check_nonnegative, check_params, check_positive, make_mechanism,
+                                    rod_inertia, rot_y, rot_z, spec_parameters)
 
 NAME = "prs3"
 PHI = (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0)
@@ -173,7 +173,7 @@ class Prs3Params:
         if not 0.0 < self.gamma < math.pi:
             raise InvalidParameterError("gamma", f"rail angle must lie in (0, pi) rad (pi/2: vertical rails), "
                                                  f"got {self.gamma!r}", self.gamma)
-        if self.actuation not in ACTUATIONS:
+        if not isinstance(self.actuation, str) or self.actuation not in ACTUATIONS:
             raise InvalidParameterError("actuation", f"use 'P' (sliders) or 'R' (knees), got {self.actuation!r}",
                                         self.actuation)
         _check_inertia(self.platform_inertia)
@@ -181,6 +181,7 @@ class Prs3Params:
             y = _task_vector(self.reference, "reference")
         except InvalidInputError as exc:
             raise InvalidParameterError("reference", str(exc), self.reference) from None
+        object.__setattr__(self, "reference", tuple(float(v) for v in y))
         try:
             rad = _leg_vectors(self, y)[1]
         except UnreachableError as exc:
@@ -266,6 +267,7 @@ def paper_constraint_jacobians(params: Prs3Params, y) -> tuple[np.ndarray, np.nd
     :class:`pkm.mechanisms.prs3_dynamics.Prs3Dynamics` takes ``(z_p, beta, phi)`` as independent
     instead (its ``jacobian``).
     """
+    params = check_params(params, Prs3Params)
     p, R = platform_pose(params, y)
     _, _, _, et, b = _legs(params)
     r = b @ R.T
@@ -274,6 +276,7 @@ def paper_constraint_jacobians(params: Prs3Params, y) -> tuple[np.ndarray, np.nd
 
 def platform_pose(params: Prs3Params, y) -> tuple[np.ndarray, np.ndarray]:
     """Platform position ``p`` [m] and rotation ``R`` for task vector ``y = (z_p, beta, phi)``."""
+    params = check_params(params, Prs3Params)
     z, pitch, roll = _task_vector(y, "y")
     x, yp, alpha = parasitic_motion(params.h, pitch, roll)
     return np.array([x, yp, z]), zyx_matrix(roll, pitch, alpha)
@@ -289,7 +292,8 @@ def _leg_vectors(params: Prs3Params, y: np.ndarray) -> tuple[np.ndarray, np.ndar
     a, u1, _, _, b = _legs(params)
     c = p + b @ R.T - a
     cu = np.einsum("ij,ij->i", c, u1)
-    rad = cu**2 - np.einsum("ij,ij->i", c, c) + params.l**2
+    with np.errstate(over="ignore", invalid="ignore"):  # a pose 1e155 m away: NaN, reported by inverse_kinematics
+        rad = cu**2 - np.einsum("ij,ij->i", c, c) + params.l**2
     for i in range(3):
         if rad[i] < -_ROOT_TOL * params.l**2:
             dist = math.sqrt(params.l**2 - rad[i])
@@ -315,6 +319,7 @@ def inverse_kinematics(params: Prs3Params, y, branch: str | tuple[str, str, str]
             with the excess distance [m].
         InvalidInputError: Bad ``y`` or branch.
     """
+    params = check_params(params, Prs3Params)
     signs = np.array([BRANCHES[b] for b in _branches(branch)], dtype=float)
     y = _task_vector(y, "y")
     c, rad = _leg_vectors(params, y)
@@ -322,11 +327,13 @@ def inverse_kinematics(params: Prs3Params, y, branch: str | tuple[str, str, str]
     cu = np.einsum("ij,ij->i", c, u1)
     d = cu - signs * np.sqrt(rad)
     theta = np.arctan2(cu - d, np.einsum("ij,ij->i", c, w))
+    finite_result((d, theta), "slider positions and knee angles", f"y = {y.tolist()} is too far out (overflow)")
     return d, theta
 
 
 def joint_values(params: Prs3Params, y, branch: str | tuple[str, str, str] | None = None) -> dict[str, list[float]]:
     """Every joint coordinate of the tree (closed form) for ``y = (z_p, beta, phi)``."""
+    params = check_params(params, Prs3Params)
     d, theta = inverse_kinematics(params, y, branch)
     p, R = platform_pose(params, y)
     # "+ 0.0" turns the -0.0 of the closed forms into 0.0
@@ -339,12 +346,14 @@ def joint_values(params: Prs3Params, y, branch: str | tuple[str, str, str] | Non
 
 def configuration(mech: Mechanism, y, branch: str | tuple[str, str, str] | None = None) -> np.ndarray:
     """Full configuration vector ``q`` of ``mech`` for ``y = (z_p, beta, phi)`` (closed form)."""
+    mech = check_mechanism(mech)
     return mech.q_from_dict(joint_values(mech.params, y, branch))
 
 
 # ---------------------------------------------------------------------- uniform interface
 def closed_form_ik(params: Prs3Params, y, branch: str | None = None) -> np.ndarray:
     """Actuated coordinates for ``y = (z, pitch, roll)``: ``d_i`` [m] (actuation P) or ``theta_i`` [rad] (R)."""
+    params = check_params(params, Prs3Params)
     d, theta = inverse_kinematics(params, y, branch)
     return d if params.actuation == "P" else theta
 
@@ -357,6 +366,7 @@ def closed_form_configuration(mech: Mechanism, y, branch: str | None = None) -> 
 # ---------------------------------------------------------------------- tree and spec
 def urdf_xml(params: Prs3Params) -> str:
     """The URDF tree: free platform, and per leg base -> slider -> coupler (see the module doc)."""
+    params = check_params(params, Prs3Params)
     b = UrdfBuilder(NAME)
     b.link("base")
     reach = 2.0 * (params.g + params.h + params.l + abs(params.reference[0]))
@@ -380,6 +390,7 @@ def urdf_xml(params: Prs3Params) -> str:
 
 def closure_spec(params: Prs3Params) -> ClosureSpec:
     """Closures, actuation (``params.actuation``), task, branches and the reference configuration."""
+    params = check_params(params, Prs3Params)
     reference = {k: tuple(v) for k, v in joint_values(params, params.reference).items()}
     joint = ACTUATIONS[params.actuation]
     return ClosureSpec(
@@ -411,10 +422,7 @@ def build(params: Prs3Params | None = None) -> Mechanism:
 
 # ---------------------------------------------------------------------- input checks
 def _task_vector(y, name: str) -> np.ndarray:
-    try:
-        arr = np.asarray(y, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidInputError(name, "expected 3 numbers (z_p [m], beta [rad], phi [rad])", y) from None
+    arr = as_array(y, name, "3 numbers (z_p [m], beta [rad], phi [rad])")
     if arr.shape != (3,) or not np.all(np.isfinite(arr)):
         raise InvalidInputError(name, f"expected 3 finite numbers (z_p, beta, phi), got shape {arr.shape}", y)
     if abs(arr[1]) >= math.pi / 2:
@@ -424,7 +432,7 @@ def _task_vector(y, name: str) -> np.ndarray:
 
 def _branches(branch: str | tuple[str, str, str] | None) -> tuple[str, str, str]:
     branch = DEFAULT_BRANCH if branch is None else branch
-    out = (branch,) * 3 if isinstance(branch, str) else tuple(branch)
-    if len(out) != 3 or any(b not in BRANCHES for b in out):
+    out = (branch,) * 3 if isinstance(branch, str) else tuple(branch) if isinstance(branch, (tuple, list)) else ()
+    if len(out) != 3 or any(not isinstance(b, str) or b not in BRANCHES for b in out):
         raise InvalidInputError("branch", f"use {list(BRANCHES)} or a tuple of three, got {branch!r}", branch)
     return out

@@ -63,7 +63,8 @@ import numpy as np
 
 from pkm.core.differential import inverse_accelerations, inverse_velocities
 from pkm.core.dynamics import KhalilProjection
-from pkm.errors import InvalidInputError, SingularityError, UnreachableError
+from pkm.core.mechanism import as_array, as_count
+from pkm.errors import InvalidInputError, NonFiniteError, SingularityError, UnreachableError
 from pkm.mechanisms.prs3 import BRANCHES, PHI, Prs3Params, _branches, _task_vector, build, configuration
 
 G = 9.81
@@ -519,7 +520,7 @@ class Prs3Dynamics:
         try:
             x = np.concatenate((y, yd, ydd, _ZERO6 if wrench is None else wrench), dtype=float)
             ok = x.shape == (15,) and abs(x[1]) < _HALF_PI and np.isfinite(x).all()
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             ok = False
         if not ok:  # the slow path names what is wrong
             x = np.concatenate(self._sample(y, yd, ydd, wrench))
@@ -531,6 +532,9 @@ class Prs3Dynamics:
         if not (c[0:3].min() >= 0.0 and np.abs(c[3:6]).min() > SIGMA_TOL * self.params.l
                 and np.abs(c[6:12]).min() > PIVOT_TOL * max(1.0, self.params.h)):
             self._check(c.reshape(1, -1), None)
+        if not np.all(np.isfinite(r[:9])):
+            raise NonFiniteError("actuator efforts", r[:9], "the rates or accelerations are too large (overflow); "
+                                                           "check the units (m/s, rad/s)")
         return r
 
     def batch(self, Y, Yd, Ydd, wrench=None, *, t=None, chunk: int = 16384) -> DynamicsResult:
@@ -551,20 +555,24 @@ class Prs3Dynamics:
         if len(Yd) != N or len(Ydd) != N:
             raise InvalidInputError("Yd", f"Y, Yd and Ydd need the same number of samples, got {N}, {len(Yd)}, "
                                           f"{len(Ydd)}")
+        chunk = as_count(chunk, "chunk", low=1, high=10**7)
         W = None
         if wrench is not None:
-            W = np.asarray(wrench, dtype=float)
-            W = np.broadcast_to(W, (N, 6)) if W.shape == (6,) else _samples(W, 6, "wrench")
+            W = as_array(wrench, "wrench", "a wrench (6,) or (N, 6) [N, N m]")
+            W = np.broadcast_to(_samples(W[None], 6, "wrench")[0], (N, 6)) if W.shape == (6,) else \
+                _samples(W, 6, "wrench")
             if len(W) != N:
                 raise InvalidInputError("wrench", f"expected (6,) or ({N}, 6), got {W.shape}")
         if t is not None:
-            t = _samples(np.asarray(t, dtype=float).reshape(-1, 1), 1, "t").ravel()
+            t = _samples(as_array(t, "t", "sample times (N,) [s]").reshape(-1, 1), 1, "t").ravel()
+            if len(t) != N:
+                raise InvalidInputError("t", f"expected {N} sample times, got {len(t)}", t)
         bad = np.nonzero(np.abs(Y[:, 1]) >= math.pi / 2)[0]
         if len(bad):
             raise InvalidInputError("Y", f"{_where(bad[0], t)}: pitch beta = {Y[bad[0], 1]!r} rad; Z-Y-X angles "
                                          "need |beta| < pi/2", Y[bad[0]])
         tau, qa, qad, qadd = (np.empty((N, 3)) for _ in range(4))
-        with np.errstate(invalid="ignore", divide="ignore"):
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # overflow is reported below
             for s in range(0, N, chunk):
                 sl = slice(s, s + chunk)
                 out = algorithm(Y[sl].T, Yd[sl].T, Ydd[sl].T, None if W is None else W[sl].T, self.P, NUMPY,
@@ -573,6 +581,11 @@ class Prs3Dynamics:
                 checks = _columns([*out["radicand"], *out["sigma"], *out["pivots"]], n)
                 self._check(checks, None if t is None else t[sl], offset=s)
                 tau[sl], qa[sl], qad[sl], qadd[sl] = (_columns(out[k], n) for k in ("tau", "qa", "qa_d", "qa_dd"))
+        for name, arr in (("tau", tau), ("q_actuated", qa), ("qd_actuated", qad), ("qdd_actuated", qadd)):
+            if not np.all(np.isfinite(arr)):
+                k = int(np.argmax(~np.isfinite(arr).all(axis=1)))
+                raise NonFiniteError(f"{name} at {_where(k, t)}", arr[k], "the rates or accelerations are too large "
+                                     "(overflow); check the units (m/s, rad/s)")
         return DynamicsResult(tau, qa, qad, qadd)
 
     def jacobian(self, y) -> np.ndarray:
@@ -621,9 +634,9 @@ class Prs3Dynamics:
     @staticmethod
     def _sample(y, yd, ydd, wrench):
         y = _task_vector(y, "y")
-        yd, ydd = (_samples(np.asarray(a, dtype=float).reshape(1, -1), 3, n)[0] for a, n in ((yd, "yd"),
-                                                                                            (ydd, "ydd")))
-        w = np.zeros(6) if wrench is None else _samples(np.asarray(wrench, dtype=float).reshape(1, -1), 6,
+        yd, ydd = (_samples(as_array(a, n, "3 rates").reshape(1, -1), 3, n)[0] for a, n in ((yd, "yd"),
+                                                                                           (ydd, "ydd")))
+        w = np.zeros(6) if wrench is None else _samples(as_array(wrench, "wrench", "a wrench (6,)").reshape(1, -1), 6,
                                                         "wrench")[0]
         return y, yd, ydd, w
 
@@ -639,14 +652,14 @@ class Prs3Dynamics:
             return
         k = int(np.argmax(bad))
         where = _where(k + offset, None if t is None else t[k:k + 1], local=True)
-        if bad_rad[k].any() or not np.isfinite(sigma[k]).all():  # NaN sigma: radicand below zero
-            leg = int(np.argmax(bad_rad[k] | ~np.isfinite(sigma[k])))
+        if bad_rad[k].any():  # a radicand rounded to within -1e-12 l^2 of 0 (NaN sigma) is the double root
+            leg = int(np.argmax(bad_rad[k]))
             excess = math.sqrt(max(l * l - rad[k, leg], 0.0)) - l
             raise UnreachableError(leg + 1, excess, "m", f"{where}: the spherical joint is farther than l from "
                                                           "the rail")
         if bad_sig[k].any():
             leg = int(np.argmax(bad_sig[k]))
-            raise SingularityError("inverse", abs(float(sigma[k, leg])),
+            raise SingularityError("inverse", float(np.nan_to_num(abs(sigma[k, leg]))),
                                    f"{where}: leg {leg + 1}'s coupler is perpendicular to its rail")
         raise SingularityError("direct", float(np.min(np.abs(piv[k]))),
                                f"{where}: the legs' actuation and constraint wrenches are dependent")
@@ -658,10 +671,7 @@ def _columns(values, n: int) -> np.ndarray:
 
 
 def _samples(a, n: int, name: str) -> np.ndarray:
-    try:
-        arr = np.asarray(a, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidInputError(name, f"expected an array of shape (N, {n}) of numbers", a) from None
+    arr = as_array(a, name, f"an array of shape (N, {n}) of numbers")
     if arr.ndim != 2 or arr.shape[1] != n or arr.shape[0] == 0:
         raise InvalidInputError(name, f"expected shape (N, {n}) with N >= 1, got {arr.shape}")
     if not np.all(np.isfinite(arr)):

@@ -93,7 +93,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.mechanism import Mechanism, as_vector, wrap_angle
+from pkm.core.mechanism import (Mechanism, as_scalar, as_tolerance, as_vector, check_mechanism, finite_result,
+                                wrap_angle)
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.urdf import UrdfBuilder
 from pkm.errors import (
@@ -104,7 +105,14 @@ from pkm.errors import (
     SingularityError,
     UnreachableError,
 )
-from pkm.mechanisms._common import check_positive, make_mechanism, rod_inertia, spec_parameters
+from pkm.mechanisms._common import (
+    check_numbers,
+    check_params,
+    check_positive,
+    make_mechanism,
+    rod_inertia,
+    spec_parameters,
+)
 
 NAME = "rrr3"
 SQRT3 = math.sqrt(3.0)
@@ -149,11 +157,7 @@ class Rrr3Params:
         if isinstance(self.mode, bool) or not isinstance(self.mode, int) or not 1 <= self.mode <= 8:
             raise InvalidParameterError("mode", f"must be an integer 1..8 (working mode), got {self.mode!r}",
                                         self.mode)
-        if not isinstance(self.home, (tuple, list)) or len(self.home) != 3:
-            raise InvalidParameterError("home", "must be (dx, dy, Phi) in m, m, rad", self.home)
-        for k, v in enumerate(self.home):
-            if not isinstance(v, (int, float)) or not math.isfinite(v):
-                raise InvalidParameterError("home", f"component {k} is not a finite number", self.home)
+        check_numbers(self, "home", 3, "(dx, dy, Phi) in m, m, rad")
         try:
             margin_inv, margin_dir = singularity_measures(self, home_task(self), self.mode)
         except UnreachableError as exc:
@@ -175,24 +179,27 @@ class Rrr3Params:
 def mode_signs(mode: int | str) -> tuple[int, int, int]:
     """Signs of ``(psi_1, psi_2, psi_3)`` of a working mode given as ``k`` or ``"modek"`` (k = 1..8)."""
     key = f"mode{mode}" if isinstance(mode, (int, np.integer)) and not isinstance(mode, bool) else mode
-    if key not in MODES:
+    if not isinstance(key, str) or key not in MODES:
         raise InvalidInputError("mode", f"use 1..8 or 'mode1'..'mode8', got {mode!r}", mode)
     return MODES[key]
 
 
 def base_vertices(params: Rrr3Params) -> np.ndarray:
     """Base vertices ``P, Q, R`` as rows [m], shape (3, 2)."""
+    params = check_params(params, Rrr3Params)
     H = params.H
     return np.array([[0.0, 0.0], [H, 0.0], [H / 2.0, H * SQRT3 / 2.0]])
 
 
 def base_centroid(params: Rrr3Params) -> np.ndarray:
     """Centroid of the base triangle [m], shape (2,)."""
+    params = check_params(params, Rrr3Params)
     return np.array([params.H / 2.0, params.H / (2.0 * SQRT3)])
 
 
 def platform_vertices(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
     """Platform vertices ``A, B, C`` as rows [m] (eqs. 1-2), from ``A`` [m] and ``Phi`` [rad]."""
+    params = check_params(params, Rrr3Params)
     A = as_vector(a_point, 2, "a_point")
     phi = _scalar(phi, "phi")
     h = params.h
@@ -202,6 +209,7 @@ def platform_vertices(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
 
 def centroid_from_a(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
     """Platform centroid ``G`` [m] from the paper's ``A`` [m] and ``Phi`` [rad]."""
+    params = check_params(params, Rrr3Params)
     A = as_vector(a_point, 2, "a_point")
     phi = _scalar(phi, "phi")
     return A + params.h / SQRT3 * np.array([math.cos(phi + math.pi / 6.0), math.sin(phi + math.pi / 6.0)])
@@ -209,6 +217,7 @@ def centroid_from_a(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
 
 def a_from_centroid(params: Rrr3Params, g_point, phi: float) -> np.ndarray:
     """The paper's platform point ``A`` [m] from the centroid ``G`` [m] and ``Phi`` [rad]."""
+    params = check_params(params, Rrr3Params)
     G = as_vector(g_point, 2, "g_point")
     phi = _scalar(phi, "phi")
     return G - params.h / SQRT3 * np.array([math.cos(phi + math.pi / 6.0), math.sin(phi + math.pi / 6.0)])
@@ -216,12 +225,14 @@ def a_from_centroid(params: Rrr3Params, g_point, phi: float) -> np.ndarray:
 
 def home_task(params: Rrr3Params) -> np.ndarray:
     """The reference task vector ``(x_G, y_G, Phi)`` [m, m, rad] of ``params.home``."""
+    params = check_params(params, Rrr3Params)
     return np.concatenate([base_centroid(params) + np.asarray(params.home[:2], dtype=float), [params.home[2]]])
 
 
 # ---------------------------------------------------------------------- closed forms
 def _solve(params: Rrr3Params, a_point: np.ndarray, phi: float, mode: int | str) -> tuple[np.ndarray, np.ndarray]:
     """``(theta, psi)`` [rad] of the three legs for the paper's ``(A, Phi)`` in ``mode`` (eqs. 6-9)."""
+    params = check_params(params, Rrr3Params)
     signs = mode_signs(mode)
     a, b = params.a, params.b
     lo, hi = abs(a - b), a + b
@@ -264,6 +275,7 @@ def inverse_kinematics(params: Rrr3Params, a_point, phi: float, mode: int | str 
 
 def joint_values(params: Rrr3Params, y, mode: int | str | None = None) -> dict[str, list[float]]:
     """Every joint coordinate of the tree (closed form) for the task vector ``y = (x_G, y_G, Phi)``."""
+    params = check_params(params, Rrr3Params)
     y = as_vector(y, 3, "y")
     theta, psi = _solve(params, a_from_centroid(params, y[:2], y[2]), y[2], params.mode if mode is None else mode)
     out: dict[str, list[float]] = {}
@@ -276,6 +288,7 @@ def joint_values(params: Rrr3Params, y, mode: int | str | None = None) -> dict[s
 
 def configuration(mech: Mechanism, y, mode: int | str | None = None) -> np.ndarray:
     """Full configuration vector ``q`` of ``mech`` for the task vector ``y`` (closed form)."""
+    mech = check_mechanism(mech)
     return mech.q_from_dict(joint_values(mech.params, y, mode))
 
 
@@ -293,6 +306,7 @@ def jacobians(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[np.
     Returns:
         ``(J_x, J_q)``: (3, 3) arrays; ``J_x`` columns in [1, 1, m], ``J_q`` in [m].
     """
+    params = check_params(params, Rrr3Params)
     y = as_vector(y, 3, "y")
     A = a_from_centroid(params, y[:2], y[2])
     theta, psi = _solve(params, A, y[2], params.mode if mode is None else mode)
@@ -313,11 +327,13 @@ the world origin ``O = P`` (the paper's eq. 14)."""
 
 def characteristic_length(params: Rrr3Params) -> float:
     """Default ``L`` of eq. (25) [m]: the platform circumradius ``h / sqrt 3`` (Lou's mean platform radius)."""
+    params = check_params(params, Rrr3Params)
     return params.h / SQRT3
 
 
 def reference_point(params: Rrr3Params, y, reference: str = "centroid") -> np.ndarray:
     """The point [m] about which moments are taken (one of :data:`REFERENCES`) for task vector ``y``."""
+    params = check_params(params, Rrr3Params)
     y = as_vector(y, 3, "y")
     if reference == "centroid":
         return y[:2].copy()
@@ -348,12 +364,14 @@ def homogenized_jacobians(params: Rrr3Params, y, mode: int | str | None = None, 
     Returns:
         ``(J_x, J_q)``: (3, 3) arrays, ``J_x`` dimensionless, ``J_q`` in [m].
     """
+    params = check_params(params, Rrr3Params)
     L = characteristic_length(params) if length is None else _length(length)
     Jx, Jq = jacobians(params, y, mode)
     d = as_vector(y, 3, "y")[:2] - reference_point(params, y, reference)  # G - P
     Jx[:, 2] += d[0] * Jx[:, 1] - d[1] * Jx[:, 0]  # (V - P) x u = (V - G) x u + (G - P) x u
-    Jx[:, 2] /= L
-    return Jx, Jq
+    with np.errstate(over="ignore"):  # a tiny L overflows: reported below
+        Jx[:, 2] /= L
+    return finite_result(Jx, "homogenized J_x", f"length = {L!r} m is too small (the moment column overflows)"), Jq
 
 
 def singularity_measures(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[float, float]:
@@ -365,6 +383,7 @@ def singularity_measures(params: Rrr3Params, y, mode: int | str | None = None) -
         (0 when the three distal-link lines meet in a point or are parallel, eq. 19); both are
         unchanged by a uniform scaling of the design.
     """
+    params = check_params(params, Rrr3Params)
     Jx, Jq = homogenized_jacobians(params, y, mode)
     return float(np.min(np.abs(np.diag(Jq)))) / params.a, abs(float(np.linalg.det(Jx)))
 
@@ -378,8 +397,8 @@ def classify_singularity(params: Rrr3Params, y, mode: int | str | None = None, *
         mode: Working mode; default ``params.mode``.
         tol: A measure of :func:`singularity_measures` at or below ``tol`` counts as singular.
     """
-    if not (math.isfinite(tol) and tol >= 0.0):
-        raise InvalidInputError("tol", f"must be finite and >= 0, got {tol!r}", tol)
+    params = check_params(params, Rrr3Params)
+    tol = as_scalar(tol, "tol", low=0.0)
     inv, direct = singularity_measures(params, y, mode)
     return {(False, False): "regular", (True, False): "inverse", (False, True): "direct",
             (True, True): "combined"}[(inv <= tol, direct <= tol)]
@@ -460,9 +479,9 @@ def forward_kinematics(params: Rrr3Params, theta, *, tol: float = 1e-10) -> tupl
         AssemblyError: no real assembly exists (``deficit``: the smallest leg-1 length error over ``Phi``, m).
         SingularityError: the equations are degenerate (a continuum of assemblies, e.g. a self-motion).
     """
+    params = check_params(params, Rrr3Params)
     theta = as_vector(theta, 3, "theta")
-    if not (math.isfinite(tol) and tol > 0.0):
-        raise InvalidInputError("tol", f"must be finite and > 0, got {tol!r}", tol)
+    tol = as_tolerance(tol, "tol")
     a, b, h = params.a, params.b, params.h
     D = base_vertices(params) + a * np.column_stack([np.cos(theta), np.sin(theta)])
     phis = 2.0 * math.pi * np.arange(_FK_SAMPLES) / _FK_SAMPLES
@@ -495,7 +514,7 @@ def forward_kinematics(params: Rrr3Params, theta, *, tol: float = 1e-10) -> tupl
         ok = np.abs(dd) > 1e-12 * max(float(np.max(np.abs(dd))), 1e-300)
         gap = np.abs(np.hypot(Nd[0][ok] / dd[ok] - D[0][0], Nd[1][ok] / dd[ok] - D[0][1]) - b)
         raise AssemblyError(float(np.min(gap)) if gap.size else float("inf"), "m",
-                            f"motor angles {tuple(np.round(theta, 6))} rad admit no assembly of this design")
+                            f"motor angles {tuple(round(float(t), 6) for t in theta)} rad admit no assembly of this design")
     return tuple(sorted(solutions, key=lambda s: s.y[2]))
 
 
@@ -506,6 +525,8 @@ def _fk_polish(params: Rrr3Params, D: np.ndarray, x: np.ndarray, theta: np.ndarr
         f, J, e = _fk_legs(D, b, params.h, x)
         if np.max(np.abs(np.sqrt(np.sum(e * e, axis=1)) - b)) <= 0.01 * tol:
             break
+        if not (np.all(np.isfinite(J)) and np.all(np.isfinite(f))):
+            return None
         step = np.linalg.lstsq(J, -f, rcond=None)[0]
         x = x + step
         if not np.all(np.isfinite(x)):
@@ -539,6 +560,7 @@ def closed_form_fk(params: Rrr3Params, q_actuated, seed=None) -> np.ndarray:
     Raises:
         AssemblyError: no assembly at all; BranchError: none on ``params.mode``.
     """
+    params = check_params(params, Rrr3Params)
     target = home_task(params) if seed is None else as_vector(seed, 3, "seed")
     sols = [s for s in forward_kinematics(params, q_actuated) if s.mode == f"mode{params.mode}"]
     if not sols:
@@ -550,6 +572,7 @@ def closed_form_fk(params: Rrr3Params, q_actuated, seed=None) -> np.ndarray:
 
 def closed_form_ik(params: Rrr3Params, y, branch: str | None = None) -> np.ndarray:
     """Actuated coordinates for task vector ``y`` (closed form); ``branch`` = working mode name."""
+    params = check_params(params, Rrr3Params)
     y = as_vector(y, 3, "y")
     return inverse_kinematics(params, a_from_centroid(params, y[:2], y[2]), y[2], branch)
 
@@ -562,6 +585,7 @@ def closed_form_configuration(mech: Mechanism, y, branch: str | None = None) -> 
 # ---------------------------------------------------------------------- tree and spec
 def urdf_xml(params: Rrr3Params) -> str:
     """The URDF tree (see the module doc)."""
+    params = check_params(params, Rrr3Params)
     b = UrdfBuilder(NAME)
     b.link("base")
     for i, vertex in enumerate(base_vertices(params)):
@@ -586,6 +610,7 @@ def urdf_xml(params: Rrr3Params) -> str:
 
 
 def closure_spec(params: Rrr3Params) -> ClosureSpec:
+    params = check_params(params, Rrr3Params)
     reference = {k: tuple(v) for k, v in joint_values(params, home_task(params)).items()}
     branches = {}
     for name, signs in MODES.items():

@@ -40,12 +40,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pkm.core.indices import inverse_condition
+from pkm.core.mechanism import as_array, as_scalar, as_vector
 from pkm.errors import InvalidInputError, SingularityError, UnreachableError
 from pkm.mechanisms import rrr3
-from pkm.mechanisms._common import check_positive
+from pkm.mechanisms._common import check_positive, real
 
 NORMS = ("2", "fro_normalized")
 MAX_NODES_PER_AXIS = 20001  # a grid larger than this per axis is refused (memory)
+MAX_NODES = 4001 ** 2  # a grid of more nodes in all is refused (memory: several float arrays of this size)
 _CHUNK = 1 << 15  # nodes evaluated at once (fits the cache: faster than larger blocks)
 _VERTEX_ANGLES = (7.0 * math.pi / 6.0, -math.pi / 6.0, math.pi / 2.0)  # directions G -> A, B, C at Phi = 0
 
@@ -109,15 +111,14 @@ class CiSettings:
     reference: str = "centroid"
 
     def __post_init__(self):
-        if not (isinstance(self.phi, (int, float)) and math.isfinite(self.phi)):
+        if real(self.phi) is None:
             raise InvalidInputError("phi", f"must be a finite angle in rad, got {self.phi!r}", self.phi)
         rrr3.mode_signs(self.mode)
-        if self.norm not in NORMS:
+        if not isinstance(self.norm, str) or self.norm not in NORMS:
             raise InvalidInputError("norm", f"use one of {NORMS}, got {self.norm!r}", self.norm)
-        if self.length is not None and not (isinstance(self.length, (int, float)) and math.isfinite(self.length)
-                                            and self.length > 0.0):
+        if self.length is not None and not (real(self.length) is not None and self.length > 0.0):
             raise InvalidInputError("length", f"must be finite and > 0 m (or None), got {self.length!r}", self.length)
-        if self.reference not in rrr3.REFERENCES:
+        if not isinstance(self.reference, str) or self.reference not in rrr3.REFERENCES:
             raise InvalidInputError("reference", f"use one of {rrr3.REFERENCES}, got {self.reference!r}",
                                     self.reference)
 
@@ -142,26 +143,31 @@ class Grid:
 
     def __post_init__(self):
         c = self.centre
-        if not (isinstance(c, (tuple, list)) and len(c) == 2 and all(isinstance(v, (int, float)) and math.isfinite(v)
-                                                                      for v in c)):
+        if not (isinstance(c, (tuple, list)) and len(c) == 2 and all(real(v) is not None for v in c)):
             raise InvalidInputError("centre", "must be (x, y), finite, in m", c)
         if isinstance(self.n, bool) or not isinstance(self.n, (int, np.integer)) or self.n < 0:
             raise InvalidInputError("n", f"must be an integer >= 0, got {self.n!r}", self.n)
         if 2 * self.n + 1 > MAX_NODES_PER_AXIS:
             raise InvalidInputError("n", f"{2 * self.n + 1} nodes per axis exceeds {MAX_NODES_PER_AXIS}", self.n)
-        if not (isinstance(self.step, (int, float)) and math.isfinite(self.step) and self.step > 0.0):
+        if (2 * self.n + 1) ** 2 > MAX_NODES:
+            raise InvalidInputError("n", f"{(2 * self.n + 1) ** 2} nodes exceed {MAX_NODES}; take a larger step",
+                                    self.n)
+        if real(self.step) is None or not self.step > 0.0:
             raise InvalidInputError("step", f"must be finite and > 0 m, got {self.step!r}", self.step)
 
     @classmethod
     def square(cls, centre, half_width: float, step: float) -> Grid:
         """The grid covering ``centre +- half_width`` [m] with spacing ``step`` [m] (``n = round(half_width / step)``)."""
-        if not (math.isfinite(half_width) and half_width >= 0.0 and math.isfinite(step) and step > 0.0):
-            raise InvalidInputError("half_width", f"needs half_width >= 0 and step > 0, finite (m); got "
-                                                  f"{half_width!r}, {step!r}", (half_width, step))
+        half_width = as_scalar(half_width, "half_width", low=0.0, unit="m")
+        step = as_scalar(step, "step", low=0.0, strict_low=True, unit="m")
+        c = as_vector(centre, 2, "centre")
+        if half_width / step >= MAX_NODES_PER_AXIS:
+            raise InvalidInputError("step", f"half_width / step = {half_width / step:.3g} exceeds {MAX_NODES_PER_AXIS} "
+                                            "nodes per axis; take a larger step", step)
         n = round(half_width / step)
         if 2 * n + 1 > MAX_NODES_PER_AXIS:
             raise InvalidInputError("step", f"{2 * n + 1} nodes per axis exceeds {MAX_NODES_PER_AXIS}", step)
-        return cls((float(centre[0]), float(centre[1])), int(n), float(step))
+        return cls((float(c[0]), float(c[1])), int(n), float(step))
 
     @property
     def axis(self) -> np.ndarray:
@@ -185,9 +191,8 @@ class Grid:
 
         Nodes on the square's edges count as inside (to 1e-9 of a step).
         """
-        if not (math.isfinite(side) and side > 0.0):
-            raise InvalidInputError("side", f"must be finite and > 0 m, got {side!r}", side)
-        c = self.centre if centre is None else centre
+        side = as_scalar(side, "side", low=0.0, strict_low=True, unit="m")
+        c = self.centre if centre is None else as_vector(centre, 2, "centre")
         tol = side / 2.0 + 1e-9 * self.step
         inx = np.abs(self.xs - c[0]) <= tol
         iny = np.abs(self.ys - c[1]) <= tol
@@ -319,15 +324,17 @@ def condition_index(design, gx, gy, settings: CiSettings = CiSettings()) -> tupl
     Returns:
         ``(ci, reachable)`` of the broadcast shape; ``ci`` in [0, 1], 0 at a singularity.
     """
-    gx, gy = np.broadcast_arrays(np.asarray(gx, dtype=float), np.asarray(gy, dtype=float))
-    return condition_index_phi(design, gx, gy, settings.phi, settings)
+    gx, gy = _broadcast(("gx", gx), ("gy", gy))
+    return condition_index_phi(design, gx, gy, _settings(settings).phi, settings)
 
 
 def condition_index_phi(design, gx, gy, phi, settings: CiSettings = CiSettings()) -> tuple[np.ndarray, np.ndarray]:
     """As :func:`condition_index` with the orientation ``phi`` [rad] given per node (broadcast with ``gx``)."""
     d = Design.of(design)
-    gx, gy, phi = np.broadcast_arrays(np.asarray(gx, dtype=float), np.asarray(gy, dtype=float),
-                                      np.asarray(phi, dtype=float))
+    settings = _settings(settings)
+    gx, gy, phi = _broadcast(("gx", gx), ("gy", gy), ("phi", phi))
+    if gx.size > MAX_NODES:
+        raise InvalidInputError("gx", f"{gx.size} nodes exceed {MAX_NODES}; evaluate in parts", gx.shape)
     if not (np.all(np.isfinite(gx)) and np.all(np.isfinite(gy)) and np.all(np.isfinite(phi))):
         raise InvalidInputError("gx, gy, phi", "must be finite (m, m, rad)")
     shape = gx.shape
@@ -420,7 +427,7 @@ class CiMap:
 def ci_map(design, grid: Grid | None = None, settings: CiSettings = CiSettings()) -> CiMap:
     """The CI map of ``design`` over ``grid`` (default :func:`paper_grid`)."""
     d = Design.of(design)
-    g = paper_grid(d) if grid is None else grid
+    g = paper_grid(d) if grid is None else _grid(grid)
     ci, reach = condition_index(d, g.xs[None, :], g.ys[:, None], settings)
     return CiMap(d, settings, g, ci, reach)
 
@@ -465,7 +472,7 @@ def workspace(design, phi: float = 0.0, grid: Grid | None = None) -> Workspace:
     """Reachable centroid positions at orientation ``phi`` [rad] (eq. 9 real on every leg), Fig. 3."""
     d = Design.of(design)
     phi = float(rrr3._scalar(phi, "phi"))
-    g = workspace_grid(d) if grid is None else grid
+    g = workspace_grid(d) if grid is None else _grid(grid)
     reach, _ = _legs(d, g.xs[None, :], g.ys[:, None], phi, (1, 1, 1))
     return Workspace(d, phi, g, reach)
 
@@ -597,7 +604,7 @@ def sweep(designs: Iterable, *, step: float = 0.01, side: float = AREA_SIDE, set
     iterator = designs
     if progress:
         from tqdm import tqdm
-        iterator = tqdm(designs, desc="3-RRR designs", unit="design")
+        iterator = tqdm(designs, desc="3-RRR designs", unit="design", disable=None)
     for k, d in enumerate(iterator):
         m = ci_map(d, workspace_grid(d, step), settings)
         overall, area = m.gci(), m.area_gci(side)
@@ -625,15 +632,35 @@ def naive_condition_index(design, y, settings: CiSettings = CiSettings()) -> flo
     return float(inverse_condition(Jx / np.diag(Jq)[:, None], kind))
 
 
+def _broadcast(*named) -> tuple[np.ndarray, ...]:
+    """The named arrays as floats broadcast together; InvalidInputError naming them otherwise."""
+    arrays = [as_array(v, n, "coordinates (m) or angles (rad)") for n, v in named]
+    try:
+        return tuple(np.broadcast_arrays(*arrays))
+    except ValueError:
+        raise InvalidInputError(", ".join(n for n, _ in named), "shapes " + ", ".join(str(a.shape) for a in arrays)
+                                + " do not broadcast together; pass arrays of one shape") from None
+
+
+def _settings(settings) -> CiSettings:
+    if not isinstance(settings, CiSettings):
+        raise InvalidInputError("settings", f"expected a CiSettings, got {type(settings).__name__}", settings)
+    return settings
+
+
+def _grid(grid) -> Grid:
+    if not isinstance(grid, Grid):
+        raise InvalidInputError("grid", f"expected a Grid (Grid.square(centre, half_width, step)), got "
+                                        f"{type(grid).__name__}", grid)
+    return grid
+
+
 @dataclass(frozen=True)
-class _LooseParams:
+class _LooseParams(rrr3.Rrr3Params):
     """The four lengths the closed forms read, without Rrr3Params' reference-pose checks."""
 
-    a: float
-    b: float
-    h: float
-    H: float
-    mode: int = 1
+    def __post_init__(self):
+        check_positive(self, "a", "b", "h", "H")
 
 
 __all__ = [
