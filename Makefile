@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(PY) -m pkm.demo
+	$(PY) -m pkm report --out out
 
 test: $(STAMP)
 	$(PY) -m pytest -q

@@ -1,0 +1,644 @@
+"""The ``pkm`` command line (also ``python -m pkm``).
+
+Usage::
+
+    pkm list [--json]
+    pkm preview MECH [--param K=V ...] [--pose K=V ... | --joints NAME=V ...] [--html FILE] [--no-wait]
+    pkm ik MECH --pose K=V ... [--param K=V ...] [--branch NAME]
+    pkm fk MECH --joints NAME=V ... [--param K=V ...]
+    pkm report [--out DIR] [--paper NAME ...] [--no-figures] [--no-series]
+    pkm bench [NAME ...] [--json] [-- ARGS passed to each benchmark]
+
+Values are SI (m, rad, kg) unless they carry a unit: ``R=120mm``, ``beta=-11deg``, ``z=81cm``
+(lengths m, cm, mm; angles rad, deg; masses kg, g). A parameter's unit is the one in brackets in
+its ``Params`` docstring (``La: Arm length [m] (110 mm).``); a suffix of another kind is refused.
+Tuple parameters take comma-separated values (``home=0,0,-375mm``). Task coordinates not given
+to ``--pose`` keep their reference values, and so do actuated joints not given to ``--joints``.
+``ik`` and ``fk`` print JSON in SI units (lengths m, angles rad).
+
+Exit status: 0 on success, 2 when the command line is wrong (syntax, unknown names, units),
+1 when pkm refuses or fails (any :class:`~pkm.errors.PkmError`: unreachable pose, invalid
+parameter, no convergence). Errors print one line ``pkm: error: ...`` on stderr; ``--debug``
+adds the traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import inspect
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import traceback
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import pkm
+from pkm.errors import ConvergenceError, InvalidInputError, PkmError, SpecError, UnknownNameError
+
+PROG = "pkm"
+
+#: Unit suffixes accepted on the command line: suffix -> (kind, factor to SI).
+SUFFIXES: dict[str, tuple[str, float]] = {
+    "m": ("length", 1.0), "cm": ("length", 1e-2), "mm": ("length", 1e-3),
+    "rad": ("angle", 1.0), "deg": ("angle", math.pi / 180.0),
+    "kg": ("mass", 1.0), "g": ("mass", 1e-3),
+}
+#: The SI unit of each kind a suffix can convert to.
+SI_UNITS = {"length": "m", "angle": "rad", "mass": "kg"}
+_KIND_OF_UNIT = {v: k for k, v in SI_UNITS.items()}
+_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z]*)\s*$")
+_UNIT = re.compile(r"\[([A-Za-z][A-Za-z0-9^ /*.-]*|-)\]")
+_ITEM = re.compile(r"^([A-Za-z_]\w*(?:\s*,\s*[A-Za-z_]\w*)*):\s*(.*)$")
+_UNITLESS_TYPES = ("str", "int", "bool")
+
+
+class UsageError(InvalidInputError):
+    """The command line is malformed (exit status 2)."""
+
+    def __init__(self, message: str, value: object = None):
+        super().__init__("usage", message, value)
+
+    def __str__(self) -> str:
+        return str(self.args[0]).removeprefix("usage: ")
+
+
+# ---------------------------------------------------------------------- parameters and their units
+@dataclass(frozen=True)
+class ParamInfo:
+    """One field of a mechanism's ``Params`` dataclass, as documented.
+
+    Attributes:
+        name: Field name.
+        type: Its annotation, as written (``"float"``, ``"tuple[float, ...]"``, ``"str"``).
+        default: The default value (SI).
+        units: Units in brackets in the field's docstring entry, in order of appearance, without
+            repeats (``("m",)``, ``("m", "rad")``); empty for a field without one.
+        description: The docstring entry, backticks removed.
+    """
+
+    name: str
+    type: str
+    default: Any
+    units: tuple[str, ...]
+    description: str
+
+    @property
+    def unitless(self) -> bool:
+        """A text, integer or boolean field: no unit by nature."""
+        return self.type in _UNITLESS_TYPES
+
+    @property
+    def unit(self) -> str:
+        """The units for display (``"-"`` when none)."""
+        return ", ".join(self.units) or "-"
+
+    @property
+    def summary(self) -> str:
+        """The first sentence of the description, units and defaults in brackets left out."""
+        first = re.split(r"(?<=\.)\s", self.description, maxsplit=1)[0]
+        return re.sub(r"\s+", " ", _UNIT.sub("", first)).strip().rstrip(".")
+
+
+def attribute_docs(cls: type) -> dict[str, str]:
+    """``{field: description}`` from the ``Attributes:`` section of a Google-style class docstring.
+
+    An entry may name several fields (``Ixx3, Iyy3, Izz3: ...``); continuation lines are joined.
+    """
+    lines = inspect.cleandoc(cls.__doc__ or "").splitlines()
+    try:
+        start = next(i for i, ln in enumerate(lines) if ln.strip() == "Attributes:") + 1
+    except StopIteration:
+        return {}
+    base = len(lines[start - 1]) - len(lines[start - 1].lstrip())
+    out: dict[str, str] = {}
+    names: list[str] = []
+    indent = None
+    for ln in lines[start:]:
+        if not ln.strip():
+            continue
+        ind = len(ln) - len(ln.lstrip())
+        if ind <= base:
+            break
+        if indent is None:
+            indent = ind
+        m = _ITEM.match(ln.strip()) if ind == indent else None
+        if m:
+            names = [n.strip() for n in m.group(1).split(",")]
+            for n in names:
+                out[n] = m.group(2).strip()
+        else:
+            for n in names:
+                out[n] += " " + ln.strip()
+    return out
+
+
+def param_info(mechanism: str) -> dict[str, ParamInfo]:
+    """The parameters of ``mechanism`` with their defaults and their units parsed from the docstring.
+
+    Raises:
+        UnknownNameError: ``mechanism`` is not one of :data:`pkm.MECHANISMS`.
+    """
+    cls = pkm.mechanism_module(mechanism).Params
+    docs = attribute_docs(cls)
+    defaults = cls()
+    out = {}
+    for f in dataclasses.fields(cls):
+        text = docs.get(f.name, "").replace("``", "")
+        units = tuple(dict.fromkeys(u.strip() for u in _UNIT.findall(text)))
+        ftype = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))
+        out[f.name] = ParamInfo(f.name, ftype, getattr(defaults, f.name), units, text)
+    return out
+
+
+def _kinds(units: Sequence[str]) -> set[str | None]:
+    return {_KIND_OF_UNIT.get(u) for u in units}
+
+
+def parse_quantity(text: str, kinds: set[str | None], what: str, unit: str) -> float:
+    """A number with an optional unit suffix, converted to SI.
+
+    Args:
+        text: ``"120mm"``, ``"-11deg"``, ``"0.81"``.
+        kinds: Kinds the quantity may have (``"length"``, ``"angle"``, ``"mass"``; ``None``: a unit
+            without suffixes, e.g. ``kg m^2``); a plain number is always accepted (SI).
+        what: Name of the quantity, for messages.
+        unit: Its unit(s) as documented, for messages.
+
+    Raises:
+        UsageError: Not a number, an unknown suffix, or a suffix of another kind.
+    """
+    m = _NUMBER.match(text)
+    if not m:
+        raise UsageError(f"{what}={text!r} is not a number (with an optional unit: m, cm, mm, rad, deg, kg, g)")
+    value, suffix = float(m.group(1)), m.group(2)
+    if not suffix:
+        return value
+    if suffix not in SUFFIXES:
+        raise UsageError(f"{what}={text}: unknown unit {suffix!r}; use m, cm, mm (lengths), rad, deg (angles), "
+                         f"kg, g (masses), or no unit for SI")
+    kind, factor = SUFFIXES[suffix]
+    if kind not in kinds:
+        accepted = [s for s, (k, _) in SUFFIXES.items() if k in kinds]
+        hint = f"use {', '.join(accepted)} or no unit" if accepted else "give the number in that unit, no suffix"
+        article = "an" if kind[0] in "aeiou" else "a"
+        raise UsageError(f"{what}={text}: {suffix!r} is {article} {kind} unit but {what} is in [{unit}]; {hint}")
+    return value * factor
+
+
+def _split(item: str, what: str) -> tuple[str, str]:
+    name, eq, value = item.partition("=")
+    if not eq or not name.strip() or not value.strip():
+        raise UsageError(f"{what} {item!r} must read NAME=VALUE (e.g. R=120mm)")
+    return name.strip(), value.strip()
+
+
+def parse_params(mechanism: str, items: Sequence[str]) -> dict[str, Any]:
+    """``--param`` items ``NAME=VALUE`` as keyword arguments of the mechanism's ``Params`` (SI).
+
+    Raises:
+        UsageError: Missing ``=``, a bad number or unit, or the wrong number of tuple entries.
+        UnknownNameError: A name that is not a parameter (the valid names listed).
+    """
+    info = param_info(mechanism)
+    out: dict[str, Any] = {}
+    for item in items:
+        name, text = _split(item, "--param")
+        if name not in info:
+            raise UnknownNameError("parameter", name, list(info), mechanism)
+        p = info[name]
+        if p.type == "str":
+            out[name] = text
+        elif p.type == "int":
+            try:
+                out[name] = int(text)
+            except ValueError:
+                raise UsageError(f"{name}={text!r}: {name} takes an integer") from None
+        elif p.type == "bool":
+            if text.lower() not in ("true", "false", "1", "0"):
+                raise UsageError(f"{name}={text!r}: {name} takes true or false")
+            out[name] = text.lower() in ("true", "1")
+        elif isinstance(p.default, tuple):
+            parts = text.split(",")
+            if len(parts) != len(p.default):
+                raise UsageError(f"{name} takes {len(p.default)} comma-separated values, got {len(parts)} in {text!r}")
+            per = [{_KIND_OF_UNIT.get(u)} for u in p.units] if len(p.units) == len(parts) else \
+                [_kinds(p.units)] * len(parts)
+            out[name] = tuple(parse_quantity(s, k, name, p.unit) for s, k in zip(parts, per))
+        else:
+            out[name] = parse_quantity(text, _kinds(p.units), name, p.unit)
+    return out
+
+
+# ---------------------------------------------------------------------- mechanisms, poses, joints
+def _joint_kind(mech: pkm.Mechanism, name: str) -> str:
+    return "angle" if mech.joints[name].kind.startswith("JointModelR") else "length"
+
+
+def task_keys(mech: pkm.Mechanism) -> tuple[str, ...]:
+    """The names ``--pose`` takes: the task components (a pose task: x y z roll pitch yaw), then joints."""
+    task = mech.spec.task
+    head = ("x", "y", "z", "roll", "pitch", "yaw") if task.is_pose else task.components
+    return tuple(head) + tuple(task.joints)
+
+
+def _key_kind(mech: pkm.Mechanism, key: str) -> str:
+    if key in ("x", "y", "z"):
+        return "length"
+    if key in ("roll", "pitch", "yaw"):
+        return "angle"
+    return _joint_kind(mech, key)
+
+
+def task_values(mech: pkm.Mechanism, q) -> dict[str, float]:
+    """The task coordinates of ``q`` by name (see :func:`task_keys`; angles Z-Y-X Euler) [m, rad]."""
+    from pkm.core import TaskMap, zyx_angles
+
+    y = TaskMap(mech).value(q)
+    if not mech.spec.task.is_pose:
+        return dict(zip(task_keys(mech), map(float, y)))
+    M = mech.data.oMf[mech.ee_frame]
+    head = list(M.translation) + list(zyx_angles(M.rotation))
+    return dict(zip(task_keys(mech), map(float, head + list(y[7:]))))
+
+
+def parse_pose(mech: pkm.Mechanism, items: Sequence[str]) -> tuple[dict[str, float], Any]:
+    """``--pose`` items as (named values, target for :func:`pkm.solve_ik`); others keep the reference.
+
+    Raises:
+        UsageError: Missing ``=`` or a bad number or unit.
+        UnknownNameError: A name that is not a task coordinate.
+    """
+    import pinocchio as pin
+
+    from pkm.core import zyx_matrix
+
+    values = task_values(mech, mech.q_reference)
+    for item in items:
+        name, text = _split(item, "--pose")
+        if name not in values:
+            raise UnknownNameError("task coordinate", name, list(values), mech.name)
+        kind = _key_kind(mech, name)
+        values[name] = parse_quantity(text, {kind}, name, SI_UNITS[kind])
+    task = mech.spec.task
+    if not task.is_pose:
+        return values, [values[k] for k in task_keys(mech)]
+    M = pin.SE3(zyx_matrix(values["roll"], values["pitch"], values["yaw"]),
+                np.array([values["x"], values["y"], values["z"]]))
+    return values, {"pose": M, **{j: values[j] for j in task.joints}}
+
+
+def parse_joints(mech: pkm.Mechanism, items: Sequence[str]) -> np.ndarray:
+    """``--joints`` items ``NAME=VALUE`` as actuated coordinates; actuated joints not named keep the reference.
+
+    Raises:
+        UsageError: Missing ``=`` or a bad number or unit.
+        UnknownNameError: A name that is not an actuated joint.
+    """
+    qa = mech.actuated_q(mech.q_reference)
+    names = list(mech.actuated_names)
+    for item in items:
+        name, text = _split(item, "--joints")
+        if name not in names:
+            raise UnknownNameError("actuated joint", name, names, mech.name)
+        kind = _joint_kind(mech, name)
+        qa[names.index(name)] = parse_quantity(text, {kind}, name, SI_UNITS[kind])
+    return qa
+
+
+def _mechanism(args) -> pkm.Mechanism:
+    params = parse_params(args.mechanism, args.param or [])
+    return pkm.build(args.mechanism, **params) if params else pkm.load(args.mechanism)
+
+
+def _branch_of(mech: pkm.Mechanism, q) -> str | None:
+    return next((b for b in mech.spec.branches if mech.on_branch(q, b)), None)
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {k: _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple, np.ndarray)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, np.generic):
+        return x.item()
+    return x
+
+
+def solution_dict(mech: pkm.Mechanism, res: pkm.SolveResult, **extra) -> dict[str, Any]:
+    """What ``ik`` and ``fk`` print: the solution by name, in SI, with the solver's report."""
+    return _jsonable({
+        "mechanism": mech.name,
+        "units": {"length": "m", "angle": "rad",
+                  "note": "SI throughout: lengths in m, angles in rad (task angles: Z-Y-X Euler roll, pitch, yaw); "
+                          "a free-flyer joint is x y z qx qy qz qw"},
+        **extra,
+        "actuated": dict(zip(mech.actuated_names, mech.actuated_q(res.q))),
+        "task": task_values(mech, res.q),
+        "joints": mech.q_to_dict(res.q),
+        "residual": res.residual,
+        "iterations": res.iterations,
+        "converged": res.converged,
+        "branch": _branch_of(mech, res.q) if mech.spec.branches else None,
+    })
+
+
+# ---------------------------------------------------------------------- commands
+def cmd_list(args) -> int:
+    from pkm.mechanisms import TITLES
+
+    data = {}
+    for name in pkm.MECHANISMS:
+        mech = pkm.load(name)
+        data[name] = {
+            "title": TITLES[name],
+            "actuated": {j: SI_UNITS[_joint_kind(mech, j)] for j in mech.actuated_names},
+            "task": {k: SI_UNITS[_key_kind(mech, k)] for k in task_keys(mech)},
+            "branches": list(mech.spec.branches),
+            "default_branch": mech.spec.default_branch,
+            "parameters": {p.name: {"default": p.default, "unit": p.unit, "type": p.type,
+                                    "description": p.description} for p in param_info(name).values()},
+        }
+    if args.json:
+        print(json.dumps(_jsonable({"units": "SI (m, rad, kg) unless a parameter says otherwise",
+                                    "mechanisms": data}), indent=2))
+        return 0
+
+    def named(m: dict[str, str]) -> str:
+        return ", ".join(f"{k} [{u}]" for k, u in m.items())
+
+    for name, d in data.items():
+        branches = ", ".join(b + (" (default)" if b == d["default_branch"] else "") for b in d["branches"])
+        print(f"{name}: {d['title']}")
+        print(f"  actuated (--joints): {named(d['actuated'])}")
+        print(f"  task (--pose): {named(d['task'])}")
+        if branches:
+            print(f"  branches (--branch): {branches}")
+        print("  parameters (--param NAME=VALUE, SI unless a unit suffix is given):")
+        infos = param_info(name).values()
+        rows = [(p.name, _fmt_default(p.default), p.unit, p.summary) for p in infos]
+        w = [max(len(r[i]) for r in rows) for i in range(3)]
+        for r in rows:
+            print(f"    {r[0].ljust(w[0])}  {r[1].ljust(w[1])}  {r[2].ljust(w[2])}  {r[3]}")
+        print()
+    return 0
+
+
+def _fmt_default(v: Any) -> str:
+    if isinstance(v, tuple):
+        return ",".join(_fmt_default(x) for x in v)
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
+
+
+def _configuration(mech: pkm.Mechanism, args) -> np.ndarray:
+    if args.pose:
+        _, target = parse_pose(mech, args.pose)
+        return _solve_ik(mech, target, getattr(args, "branch", None)).q
+    if args.joints:
+        return _close_loops(mech, parse_joints(mech, args.joints)).q
+    return mech.q_reference
+
+
+def _solve_ik(mech: pkm.Mechanism, target, branch: str | None) -> pkm.SolveResult:
+    """The generic IK; when it fails, the paper's closed form says which leg cannot reach, if one cannot."""
+    from pkm.core import TaskMap
+    from pkm.errors import UnreachableError
+
+    try:
+        return pkm.solve_ik(mech, target, branch=branch)
+    except ConvergenceError as exc:
+        mod = pkm.mechanism_module(mech.name)
+        try:
+            mod.closed_form_ik(mech.params, TaskMap(mech).parse(target), branch)
+        except UnreachableError as unreachable:
+            raise unreachable from exc
+        except PkmError:
+            pass
+        raise
+
+
+def _close_loops(mech: pkm.Mechanism, qa) -> pkm.SolveResult:
+    """Generic loop closure; when it fails, the paper's forward kinematics says if no assembly exists."""
+    from pkm.errors import AssemblyError
+
+    try:
+        return pkm.close_loops(mech, qa)
+    except ConvergenceError as exc:
+        mod = pkm.mechanism_module(mech.name)
+        if hasattr(mod, "closed_form_fk"):
+            try:
+                mod.closed_form_fk(mech.params, qa)
+            except AssemblyError as none:
+                raise none from exc
+            except PkmError:
+                pass
+        raise
+
+
+def cmd_preview(args) -> int:
+    mech = _mechanism(args)
+    q = _configuration(mech, args)
+    from pkm import viz
+
+    if args.html:
+        path = viz.write_html(args.html, mech, q)
+        print(f"wrote {path}")
+        return 0
+    vis = viz.show(mech, q)
+    print(f"viewer: {vis.url()}", flush=True)
+    if args.no_wait:
+        return 0
+    print("press Ctrl-C to quit", file=sys.stderr, flush=True)
+    try:
+        import time
+
+        while True:
+            time.sleep(1.0)
+    except KeyboardInterrupt:
+        return 0
+
+
+def cmd_ik(args) -> int:
+    mech = _mechanism(args)
+    if args.branch is not None:
+        mech.branch(args.branch)  # UnknownNameError listing the branches
+    values, target = parse_pose(mech, args.pose)
+    res = _solve_ik(mech, target, args.branch)
+    print(json.dumps(solution_dict(mech, res, target=values), indent=2))
+    return 0
+
+
+def cmd_fk(args) -> int:
+    mech = _mechanism(args)
+    qa = parse_joints(mech, args.joints)
+    res = _close_loops(mech, qa)
+    print(json.dumps(solution_dict(mech, res), indent=2))
+    return 0
+
+
+def cmd_report(args) -> int:
+    from pkm import papers, report
+
+    names = tuple(args.paper) if args.paper else papers.NAMES
+    for n in names:
+        papers.module(n)  # UnknownNameError listing the papers
+    if len(set(names)) != len(names):
+        raise UsageError(f"name each paper once, got {list(names)}")
+    result = report.run(args.out, names, figures=not args.no_figures, series=not args.no_series)
+    print(report.format_table(result))
+    return 0
+
+
+def tools_dir() -> Path | None:
+    """The ``tools/`` folder of the source checkout holding ``bench_*.py``, or None.
+
+    Looked for next to ``src/`` above the installed package (an editable install), then in the
+    current directory.
+    """
+    pkg = Path(pkm.__file__).resolve().parent
+    candidates = [pkg.parent.parent / "tools"] if pkg.parent.name == "src" else []
+    candidates.append(Path.cwd() / "tools")
+    return next((c for c in candidates if any(c.glob("bench_*.py"))), None)
+
+
+def cmd_bench(args) -> int:
+    tools = tools_dir()
+    if tools is None:
+        raise UsageError("benchmarks need a source checkout (tools/bench_*.py next to src/, "
+                         "or run from the repository root)")
+    available = sorted(p.stem.removeprefix("bench_") for p in tools.glob("bench_*.py"))
+    for n in args.names:
+        if n not in available:
+            raise UnknownNameError("benchmark", n, available, str(tools))
+    names = args.names or available
+    extra = (["--json"] if args.json else []) + list(args.extra)
+    results: dict[str, Any] = {}
+    for n in names:
+        cmd = [sys.executable, str(tools / f"bench_{n}.py"), *extra]
+        if not args.json:
+            print(f"== bench {n}", flush=True)
+        proc = subprocess.run(cmd, check=False, stdout=subprocess.PIPE if args.json else None, text=True)
+        if proc.returncode != 0:
+            raise PkmError(f"benchmark {n!r} exited with status {proc.returncode} ({' '.join(cmd[1:])})")
+        if args.json:
+            try:
+                results[n] = json.loads(proc.stdout)
+            except json.JSONDecodeError:
+                raise PkmError(f"benchmark {n!r} printed no JSON with --json") from None
+    if args.json:
+        print(json.dumps(results, indent=2))
+    return 0
+
+
+# ---------------------------------------------------------------------- parser
+class _Parser(argparse.ArgumentParser):
+    """argparse that raises :class:`UsageError` instead of printing usage and exiting."""
+
+    def error(self, message: str):
+        raise UsageError(f"{message} (see '{self.prog} --help')")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``pkm`` argument parser (one subparser per command)."""
+    mechs = ", ".join(pkm.MECHANISMS)
+    ap = _Parser(prog=PROG, description="Parallel kinematic machines on Pinocchio: the papers' mechanisms, "
+                                        "their kinematics and the papers' results.",
+                 epilog="Values are SI (m, rad, kg) unless a unit is given: R=120mm, beta=-11deg, z=81cm.")
+    ap.add_argument("--debug", action="store_true", help="show the traceback of an error")
+    ap.add_argument("--version", action="version", version=f"pkm {pkm.__version__}")
+    debug = argparse.ArgumentParser(add_help=False)
+    debug.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help="show the traceback of an error")
+    sub = ap.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    p = sub.add_parser("list", parents=[debug], help="the mechanisms, their joints, task and parameters (units, defaults)")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=cmd_list)
+
+    def mech_args(p, pose: str | None, joints: str | None):
+        p.add_argument("mechanism", metavar="MECH", help=f"one of {mechs}")
+        p.add_argument("--param", metavar="K=V", action="extend", nargs="+", default=[],
+                       help="a design parameter (see 'pkm list'); default: the paper's design")
+        g = p.add_mutually_exclusive_group() if pose and joints else p
+        if pose:
+            g.add_argument("--pose", metavar="K=V", action="extend", nargs="+", required=pose == "required",
+                           help="task coordinates (others keep the reference; see 'pkm list')")
+        if joints:
+            g.add_argument("--joints", metavar="NAME=V", action="extend", nargs="+", required=joints == "required",
+                           help="actuated joint values (others keep the reference; see 'pkm list')")
+
+    p = sub.add_parser("preview", parents=[debug], help="show a configuration in the meshcat viewer or as HTML")
+    mech_args(p, "optional", "optional")
+    p.add_argument("--html", metavar="FILE", help="write a self-contained HTML scene instead of opening the viewer")
+    p.add_argument("--no-wait", action="store_true", help="return once the viewer is up instead of waiting for Ctrl-C")
+    p.set_defaults(func=cmd_preview)
+
+    p = sub.add_parser("ik", parents=[debug], help="inverse kinematics: every joint for a pose (JSON, SI)")
+    mech_args(p, "required", None)
+    p.add_argument("--branch", metavar="NAME", help="working mode the solution must lie on (see 'pkm list')")
+    p.set_defaults(func=cmd_ik)
+
+    p = sub.add_parser("fk", parents=[debug], help="forward kinematics: the pose for actuated values (JSON, SI)")
+    mech_args(p, None, "required")
+    p.set_defaults(func=cmd_fk)
+
+    from pkm.papers import NAMES as PAPERS
+
+    p = sub.add_parser("report", parents=[debug], help="reproduce the papers: summary.json, report.md, figures")
+    p.add_argument("--out", metavar="DIR", default="out", help="output directory (default: out)")
+    p.add_argument("--paper", metavar="NAME", action="append", help=f"only these papers ({', '.join(PAPERS)})")
+    p.add_argument("--no-figures", action="store_true", help="skip the figures")
+    p.add_argument("--no-series", action="store_true", help="skip the CSV series")
+    p.set_defaults(func=cmd_report)
+
+    p = sub.add_parser("bench", parents=[debug], help="run the benchmarks of the source checkout (tools/bench_*.py)",
+                       epilog="Arguments after '--' go to each benchmark, e.g. pkm bench kinematics -- -n 20.")
+    p.add_argument("names", metavar="NAME", nargs="*",
+                   help="kinematics, dynamics, opcount, workspace, hexapod (default: all)")
+    p.add_argument("--json", action="store_true", help="ask each benchmark for JSON; print them as one object")
+    p.set_defaults(func=cmd_bench, extra=[])
+    return ap
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``pkm`` command line; returns the exit status (see the module doc)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    extra: list[str] = []
+    if "--" in argv:  # the rest goes to the benchmarks
+        k = argv.index("--")
+        argv, extra = argv[:k], argv[k + 1:]
+    debug = "--debug" in argv
+    try:
+        try:
+            args = build_parser().parse_args(argv)
+        except SystemExit as exc:  # --help, --version
+            return int(exc.code or 0)
+        if extra and args.command != "bench":
+            raise UsageError(f"arguments after '--' are only for 'pkm bench', got {extra}")
+        args.extra = extra
+        return args.func(args)
+    except PkmError as exc:
+        if debug:
+            traceback.print_exc()
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        named_wrong = isinstance(exc, UnknownNameError) and not isinstance(exc, SpecError)  # not a broken file
+        return 2 if isinstance(exc, UsageError) or named_wrong else 1
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # output piped into head & co.
+        sys.stdout = open(os.devnull, "w")  # noqa: SIM115 (the interpreter flushes it at exit)
+        return 0
+
+
+__all__ = ["SUFFIXES", "ParamInfo", "UsageError", "attribute_docs", "build_parser", "main", "param_info",
+           "parse_joints", "parse_params", "parse_pose", "parse_quantity", "solution_dict", "task_values"]

@@ -1,0 +1,213 @@
+"""The ``pkm`` command line (pkm.cli), run through its real entry points: ``python -m pkm`` and the ``pkm`` script."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm import cli
+from pkm.mechanisms import delta as D
+from pkm.mechanisms import module
+
+
+def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    """``python -m pkm ARGS`` in a subprocess (text output, no check)."""
+    return subprocess.run([sys.executable, "-m", "pkm", *args], check=False, capture_output=True, text=True,
+                          cwd=cwd, timeout=120)
+
+
+def one_error_line(proc: subprocess.CompletedProcess) -> str:
+    """The single ``pkm: error: ...`` line a failing command prints (asserted: nothing else, no traceback)."""
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("pkm: error: "), proc.stderr
+    assert proc.stdout == ""
+    return lines[0]
+
+
+# ---------------------------------------------------------------------- units of the parameters
+CASES = [(name, f.name) for name in pkm.MECHANISMS for f in dataclasses.fields(module(name).Params)]
+
+
+@pytest.mark.parametrize("mechanism,field", CASES)
+def test_every_parameter_has_a_unit_in_its_docstring(mechanism, field):
+    """Every Params field is documented with a unit in brackets that the CLI knows, unless it is text or an integer."""
+    info = cli.param_info(mechanism)[field]
+    assert info.description, f"{mechanism}.{field} is not in the Attributes section"
+    if info.unitless:
+        return
+    assert info.units, f"{mechanism}.{field}: no [unit] in {info.description!r}"
+    known = {"m", "rad", "kg", "kg m^2", "-"}
+    assert set(info.units) <= known, info.units
+
+
+def test_attribute_parser_reads_grouped_entries_and_continuations():
+    """A grouped docstring entry gives each field the same unit; a continued entry keeps its continuation."""
+    prs3 = cli.param_info("prs3")
+    assert prs3["Ixx3"].units == prs3["Izz3"].units == ("kg m^2",)
+    assert prs3["reference"].units == ("m", "rad")
+    assert "(eq. 41" in prs3["reference"].description
+    assert cli.param_info("delta")["La"].units == ("m",) and cli.param_info("delta")["La"].default == 0.11
+
+
+@pytest.mark.parametrize("text,kinds,expected", [
+    ("120mm", {"length"}, 0.12), ("81cm", {"length"}, 0.81), ("0.2", {"length"}, 0.2), ("-11deg", {"angle"},
+     math.radians(-11)), ("2.5e-1 rad", {"angle"}, 0.25), ("500g", {"mass"}, 0.5), ("3", {None}, 3.0)])
+def test_quantities_convert_to_si(text, kinds, expected):
+    """Unit suffixes convert to SI (mm, cm, deg, g); a plain number is taken as SI."""
+    assert math.isclose(cli.parse_quantity(text, kinds, "v", "?"), expected, rel_tol=1e-12)
+
+
+@pytest.mark.parametrize("text,kinds,message", [
+    ("3deg", {"length"}, "'deg' is an angle unit but R is in [m]; use m, cm, mm or no unit"),
+    ("3in", {"length"}, "unknown unit 'in'"), ("abc", {"length"}, "is not a number"),
+    ("1g", {None}, "give the number in that unit")])
+def test_bad_quantities_are_refused(text, kinds, message):
+    """A suffix of the wrong kind, an unknown suffix or a non-number raise UsageError saying so."""
+    with pytest.raises(cli.UsageError) as exc:
+        cli.parse_quantity(text, kinds, "R", "m")
+    assert message in str(exc.value)
+
+
+# ---------------------------------------------------------------------- list
+def test_console_script_lists_every_mechanism_as_json():
+    """The installed ``pkm`` script prints every mechanism's parameters with defaults and units, SI."""
+    script = Path(sys.executable).with_name("pkm")
+    proc = subprocess.run([str(script), "list", "--json"], check=False, capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(proc.stdout)["mechanisms"]
+    assert list(data) == list(pkm.MECHANISMS)
+    assert data["delta"]["parameters"]["R"] == {**data["delta"]["parameters"]["R"], "default": 0.15, "unit": "m"}
+    assert data["delta"]["actuated"] == {"motor_1": "rad", "motor_2": "rad", "motor_3": "rad"}
+    assert data["prs3"]["actuated"]["slider_1"] == "m" and data["hexapod"]["task"]["beta_1"] == "rad"
+
+
+def test_list_as_text_and_a_bad_option():
+    """``pkm list`` names each mechanism and its parameters; an unknown option exits 2 with one line."""
+    ok = run("list")
+    assert ok.returncode == 0
+    assert all(f"{m}: " in ok.stdout for m in pkm.MECHANISMS) and "task (--pose): x [m], y [m], z [m]" in ok.stdout
+    bad = run("list", "--bad")
+    assert bad.returncode == 2 and "unrecognized arguments: --bad" in one_error_line(bad)
+
+
+# ---------------------------------------------------------------------- ik, fk
+def test_ik_prints_si_json_matching_the_closed_form():
+    """``pkm ik delta --pose x=2cm z=-360mm --param R=120mm``: converged, SI, motors equal to the paper's IK."""
+    proc = run("ik", "delta", "--pose", "x=2cm", "z=-360mm", "--param", "R=120mm", "--branch", "knee_out")
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    assert out["units"]["length"] == "m" and out["units"]["angle"] == "rad"
+    assert out["converged"] and out["residual"] < 1e-9 and out["branch"] == "knee_out"
+    assert out["target"] == {"x": 0.02, "y": 0.0, "z": -0.36}
+    assert np.allclose([out["task"][k] for k in "xyz"], [0.02, 0.0, -0.36], atol=1e-9)
+    expected = D.inverse_kinematics(D.DeltaParams(R=0.12), [0.02, 0.0, -0.36], "knee_out")
+    assert np.allclose(list(out["actuated"].values()), expected, atol=1e-8)
+    assert out["joints"]["motor_1"] == out["actuated"]["motor_1"] and "knee_1" in out["joints"]
+
+
+def test_ik_of_an_unreachable_pose_names_the_leg():
+    """An unreachable pose exits 1 with one line naming the leg; with --debug the traceback comes first."""
+    proc = run("ik", "delta", "--pose", "z=-1")
+    assert proc.returncode == 1
+    assert "pose unreachable: leg 1 misses by" in one_error_line(proc)
+    debug = run("--debug", "ik", "delta", "--pose", "z=-1")
+    assert debug.returncode == 1 and debug.stderr.startswith("Traceback")
+    assert "UnreachableError" in debug.stderr and debug.stderr.strip().splitlines()[-1].startswith("pkm: error: pose")
+
+
+def test_fk_prints_the_pose_of_the_closed_form():
+    """``pkm fk delta --joints motor_1=-50deg``: the platform position equals the paper's sphere intersection."""
+    proc = run("fk", "delta", "--joints", "motor_1=-50deg")
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    qa = list(out["actuated"].values())
+    assert math.isclose(qa[0], math.radians(-50), rel_tol=1e-12) and out["converged"]
+    assert np.allclose([out["task"][k] for k in "xyz"], D.forward_kinematics(D.DeltaParams(), qa), atol=1e-9)
+
+
+@pytest.mark.parametrize("args,status,message", [
+    (("fk", "delta", "--joints", "motor_9=1"), 2, "valid actuated joints: 'motor_1', 'motor_2', 'motor_3'"),
+    (("ik", "scara", "--pose", "x=0"), 2, "mechanism 'scara' does not exist; valid mechanisms: 'hexapod'"),
+    (("ik", "delta", "--param", "Rb=0.1", "--pose", "z=-0.36"), 2, "parameter 'Rb' does not exist in delta"),
+    (("ik", "delta", "--param", "R=3deg", "--pose", "z=-0.36"), 2, "'deg' is an angle unit but R is in [m]"),
+    (("ik", "delta", "--pose", "z=-36in"), 2, "unknown unit 'in'"),
+    (("ik", "delta", "--pose", "z"), 2, "'z' must read NAME=VALUE"),
+    (("ik", "delta", "--param", "R=-0.1", "--pose", "z=-0.36"), 1, "R: must be"),
+    (("ik", "delta", "--pose", "z=-0.36", "--branch", "up"), 2, "'knee_out', 'knee_in'"),
+])
+def test_bad_command_lines_give_one_helpful_line(args, status, message):
+    """Unknown names, bad units, a missing '=' exit 2, an invalid parameter value exits 1; one line each."""
+    proc = run(*args)
+    assert proc.returncode == status
+    assert message in one_error_line(proc)
+
+
+# ---------------------------------------------------------------------- preview, report, bench
+def test_preview_writes_html_and_refuses_an_unknown_mechanism(tmp_path):
+    """``pkm preview delta --pose z=-0.36 --html F`` writes an HTML scene; an unknown mechanism exits 2."""
+    bad = run("preview", "scara", "--html", str(tmp_path / "x.html"))
+    assert bad.returncode == 2 and "mechanism 'scara' does not exist" in one_error_line(bad)
+    pytest.importorskip("pkm.viz", reason="pkm.viz is written in the same issue")
+    page = tmp_path / "delta.html"
+    ok = run("preview", "delta", "--pose", "z=-0.36", "--html", str(page))
+    assert ok.returncode == 0, ok.stderr
+    assert page.stat().st_size > 1000 and "<html" in page.read_text()[:1000].lower()
+
+
+def test_preview_opens_the_viewer_at_given_joints_and_returns_with_no_wait():
+    """``pkm preview delta --joints motor_1=-50deg --no-wait`` starts a meshcat viewer, prints its URL and exits 0;
+    an unknown joint exits 2 before any viewer starts."""
+    pytest.importorskip("pkm.viz", reason="pkm.viz is written in the same issue")
+    ok = run("preview", "delta", "--joints", "motor_1=-50deg", "--no-wait")
+    assert ok.returncode == 0, ok.stderr
+    assert ok.stdout.startswith("viewer: http://")
+    bad = run("preview", "delta", "--joints", "elbow=1", "--no-wait")
+    assert bad.returncode == 2 and "valid actuated joints" in one_error_line(bad)
+
+
+def test_report_writes_the_hexapod_rows_and_refuses_an_unknown_paper(tmp_path):
+    """``pkm report --paper hexapod --no-figures`` writes summary.json and prints every row; a bad paper exits 2."""
+    proc = run("report", "--out", str(tmp_path), "--paper", "hexapod", "--no-figures")
+    assert proc.returncode == 0, proc.stderr
+    rows = json.loads((tmp_path / "summary.json").read_text())["papers"]["hexapod"]["rows"]
+    assert rows and all(r["id"] in proc.stdout for r in rows)
+    assert (tmp_path / "report.md").exists() and not (tmp_path / "figures").exists()
+    bad = run("report", "--out", str(tmp_path), "--paper", "hexapod", "--paper", "ufo")
+    assert bad.returncode == 2 and "valid papers: 'hexapod', 'rrr3', 'delta', 'prs3'" in one_error_line(bad)
+
+
+def test_bench_runs_a_benchmark_and_refuses_an_unknown_one(tmp_path):
+    """``pkm bench opcount --json`` (about 2 s) prints its JSON under its name, from any directory; an unknown
+    benchmark exits 2 listing the five."""
+    proc = run("bench", "opcount", "--json", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    assert list(out) == ["opcount"] and out["opcount"]
+    bad = run("bench", "speed")
+    line = one_error_line(bad)
+    assert bad.returncode == 2 and "'dynamics', 'hexapod', 'kinematics', 'opcount', 'workspace'" in line
+
+
+def test_bench_outside_a_source_checkout_says_so(tmp_path, monkeypatch, capsys):
+    """Without tools/ next to src/ nor in the current directory, ``pkm bench`` exits 2 with one line."""
+    monkeypatch.setattr(pkm, "__file__", str(tmp_path / "site-packages" / "pkm" / "__init__.py"))
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["bench", "kinematics"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "benchmarks need a source checkout" in err[0]
+
+
+def test_help_exits_zero():
+    """``pkm --help`` prints the commands and exits 0; no command at all is a usage error (2)."""
+    ok = run("--help")
+    assert ok.returncode == 0 and all(c in ok.stdout for c in ("list", "preview", "ik", "fk", "report", "bench"))
+    bad = run()
+    assert bad.returncode == 2 and "required" in one_error_line(bad)

@@ -1,0 +1,120 @@
+"""pkm.viz in a real browser: headless Chromium renders the Delta's snapshot, and the picture shows it.
+
+Skipped when Chromium is not installed, unless ``PKM_REQUIRE_BROWSER`` is set (CI sets it and
+installs the Debian package ``chromium``): then a missing Chromium is a failure.
+
+The screenshot is checked against the snapshot's own camera: each actuated joint's centre,
+projected with meshcat's default perspective camera (75 degree vertical field of view, looking
+at meshcat's origin, z up) from the position the snapshot gives it, must land on pixels of the
+actuated colour; passive joints and the platform must show in their colours; the mechanism
+must fill a good part of the picture, away from its edges.
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import matplotlib.colors as mcolors
+import matplotlib.image as mimage
+import numpy as np
+import pinocchio as pin
+import pytest
+import umsgpack
+
+import pkm
+from pkm import viz
+
+WIDTH, HEIGHT = 800, 600
+FOV = 75.0  # deg, vertical field of view of meshcat's default camera
+
+
+def chromium() -> str:
+    """The Chromium executable; skip (or fail when PKM_REQUIRE_BROWSER is set) if there is none."""
+    exe = shutil.which("chromium") or ("/usr/bin/chromium" if Path("/usr/bin/chromium").exists() else None)
+    if exe is None:
+        if os.environ.get("PKM_REQUIRE_BROWSER", "") not in ("", "0"):
+            pytest.fail("PKM_REQUIRE_BROWSER is set but chromium is not installed (Debian package 'chromium')")
+        pytest.skip("chromium is not installed; set PKM_REQUIRE_BROWSER=1 to make this a failure")
+    return exe
+
+
+def screenshot(page: str, folder: Path) -> np.ndarray:
+    """RGB image (HEIGHT, WIDTH, 3) in [0, 1] of ``page`` rendered by headless Chromium."""
+    html, png = folder / "page.html", folder / "shot.png"
+    html.write_text(page, encoding="utf-8")
+    cmd = [chromium(), "--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+           "--disable-background-networking", f"--window-size={WIDTH},{HEIGHT}", "--virtual-time-budget=5000",
+           f"--screenshot={png}", html.as_uri()]
+    run = subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=60)
+    assert run.returncode == 0 and png.exists(), f"chromium failed ({run.returncode}): {run.stderr[-2000:]}"
+    return mimage.imread(png)[..., :3]
+
+
+def colour_mask(img: np.ndarray, rgb: int) -> np.ndarray:
+    """Pixels of the hue of ``rgb`` (within 7 degrees), saturated and not dark: its lit and shaded surfaces."""
+    ref = mcolors.rgb_to_hsv(np.array([(rgb >> 16) & 255, (rgb >> 8) & 255, rgb & 255]) / 255.0)
+    hsv = mcolors.rgb_to_hsv(img)
+    dh = np.abs((hsv[..., 0] - ref[0] + 0.5) % 1.0 - 0.5)
+    return (dh < 0.02) & (hsv[..., 1] > 0.5) & (hsv[..., 2] > 0.25)
+
+
+def camera(cmds: list[dict]):
+    """Camera position in meshcat's world, and the shift of the mechanism's node, from the snapshot's commands."""
+    pos = [c for c in cmds if c["type"] == "set_property" and c["path"] == "/Cameras/default/rotated/<object>"]
+    a, b, c = pos[0]["value"]  # in the camera's parent frame, turned +90 deg about x
+    root = [c for c in cmds if c["type"] == "set_transform" and c["path"] == viz.ROOT]
+    shift = np.array(root[0]["matrix"]).reshape(4, 4).T[:3, 3]
+    return np.array([a, -c, b]), shift
+
+
+def project(points: np.ndarray, eye: np.ndarray) -> np.ndarray:
+    """Pixel coordinates (column, row) of world points seen from ``eye`` looking at the origin, z up."""
+    f = -eye / np.linalg.norm(eye)
+    r = np.cross(f, [0.0, 0.0, 1.0])
+    r /= np.linalg.norm(r)
+    u = np.cross(r, f)
+    rel = points - eye
+    t = np.tan(np.radians(FOV) / 2)
+    depth = rel @ f
+    return np.c_[WIDTH / 2 + (rel @ r) / depth / t * HEIGHT / 2, HEIGHT / 2 - (rel @ u) / depth / t * HEIGHT / 2]
+
+
+def test_headless_chromium_shows_the_delta_where_the_camera_looks(tmp_path):
+    """The Delta's snapshot renders with its motors, passive joints and platform in their colours, framed."""
+    mech = pkm.load("delta")
+    page = viz.snapshot_html(mech)
+    img = screenshot(page, tmp_path)
+    assert img.shape == (HEIGHT, WIDTH, 3)
+    assert img.std() > 0.05  # not blank
+
+    actuated, passive = colour_mask(img, viz.ACTUATED_COLOR), colour_mask(img, viz.PASSIVE_COLOR)
+    platform = colour_mask(img, viz.PLATFORM_COLOR)
+    assert actuated.sum() > 600 and passive.sum() > 600 and platform.sum() > 150
+
+    # where the snapshot's camera says each joint and the platform are
+    cmds = [umsgpack.unpackb(base64.b64decode(s)) for s in json.loads(
+        re.search(r'id="pkm-meshcat-commands">(.*?)</script>', page, re.DOTALL).group(1))]
+    eye, shift = camera(cmds)
+    data = mech.model.createData()
+    pin.forwardKinematics(mech.model, data, mech.q_reference)
+    pin.updateFramePlacements(mech.model, data)
+    motors = np.array([data.oMi[mech.model.getJointId(n)].translation for n in mech.actuated_names])
+    for col, row in project(motors + shift, eye).round().astype(int):
+        assert 0 <= col < WIDTH and 0 <= row < HEIGHT
+        assert actuated[max(row - 4, 0):row + 5, max(col - 4, 0):col + 5].sum() >= 10
+    centre = data.oMf[mech.ee_frame].translation
+    (col, row), = project(centre[None] + shift, eye)
+    rows, cols = np.nonzero(platform)
+    assert abs(cols.mean() - col) < 15 and abs(rows.mean() - row) < 15
+
+    # framed: the joints spread over much of the picture, inside its margins
+    rows, cols = np.nonzero(actuated | passive)
+    assert cols.max() - cols.min() > 0.4 * WIDTH and rows.max() - rows.min() > 0.3 * HEIGHT
+    assert cols.min() > 0.05 * WIDTH and cols.max() < 0.95 * WIDTH
+    assert rows.min() > 0.02 * HEIGHT and rows.max() < 0.95 * HEIGHT
