@@ -11,6 +11,7 @@ import pkm
 from pkm.core import close_loops, diagnose, solve_ik
 from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, SingularityError, UnknownNameError
 from pkm.mechanisms import delta as D
+from pkm.mechanisms import rrr3
 
 
 @pytest.fixture(scope="module")
@@ -97,3 +98,15 @@ def test_diagnose_classifies_a_folded_leg_as_inverse_singularity(delta):
     assert info.value.kind == "inverse"
     sig = [diagnose(delta, D.configuration(delta, B1 - (p.Lb + s) * f)).sigma_inverse for s in (1e-4, 1e-5, 1e-6)]
     assert sig[0] > sig[1] > sig[2] > 0
+
+
+def test_a_path_that_leaves_the_workspace_is_reported_as_such_when_the_target_itself_closes():
+    """When continuation from the seed fails but a direct correction at the target closes, the error says the path
+    left the workspace and asks for a nearer seed, instead of reporting a tiny residual as too large."""
+    m = rrr3.build()
+    qa = rrr3.closed_form_ik(m.params, [0.501, 0.025, 0.750])
+    seed = rrr3.closed_form_configuration(m, [0.716, 0.203, 0.793])
+    with pytest.raises(ConvergenceError, match="left the workspace") as info:
+        close_loops(m, qa, seed)
+    assert info.value.residual > info.value.tolerance
+    assert info.value.result.residual <= info.value.tolerance

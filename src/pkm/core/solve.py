@@ -151,8 +151,15 @@ def _follow(mech: Mechanism, what: str, solve_at, q: np.ndarray, n_steps: int, t
         else:
             ds *= 0.5
             if ds < 1e-3 / n_steps:
+                res_path = res
                 q_new, res, it = solve_at(q, 1.0, tol)
                 result = SolveResult(q_new, False, res, total + it, steps, _signs(mech, q_new))
+                if raise_on_failure and res <= tol:  # the target closes, but not by following the seed's branch
+                    raise ConvergenceError(f"{what} along the path from the seed", res_path, result.iterations,
+                                           tol, result,
+                                           f"the path left the workspace at {s:.0%} of the way; "
+                                           "a direct correction at the target closes, possibly in "
+                                           "another assembly mode: seed nearer the target (q0)")
                 if raise_on_failure:
                     raise _failure(mech, what, result, tol)
                 return result
