@@ -43,6 +43,7 @@ import numpy as np
 
 import pkm
 from pkm.errors import ConvergenceError, InvalidInputError, PkmError, SpecError, UnknownNameError
+from pkm.report import jsonable
 
 PROG = "pkm"
 
@@ -240,7 +241,7 @@ def parse_params(mechanism: str, items: Sequence[str]) -> dict[str, Any]:
 
 # ---------------------------------------------------------------------- mechanisms, poses, joints
 def _joint_kind(mech: pkm.Mechanism, name: str) -> str:
-    return "angle" if mech.joints[name].kind.startswith("JointModelR") else "length"
+    return "angle" if mech.joints[name].revolute else "length"
 
 
 def task_keys(mech: pkm.Mechanism) -> tuple[str, ...]:
@@ -323,19 +324,9 @@ def _branch_of(mech: pkm.Mechanism, q) -> str | None:
     return next((b for b in mech.spec.branches if mech.on_branch(q, b)), None)
 
 
-def _jsonable(x: Any) -> Any:
-    if isinstance(x, dict):
-        return {k: _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple, np.ndarray)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, np.generic):
-        return x.item()
-    return x
-
-
 def solution_dict(mech: pkm.Mechanism, res: pkm.SolveResult, **extra) -> dict[str, Any]:
     """What ``ik`` and ``fk`` print: the solution by name, in SI, with the solver's report."""
-    return _jsonable({
+    return jsonable({
         "mechanism": mech.name,
         "units": {"length": "m", "angle": "rad",
                   "note": "SI throughout: lengths in m, angles in rad (task angles: Z-Y-X Euler roll, pitch, yaw); "
@@ -368,7 +359,7 @@ def cmd_list(args) -> int:
                                     "description": p.description} for p in param_info(name).values()},
         }
     if args.json:
-        print(json.dumps(_jsonable({"units": "SI (m, rad, kg) unless a parameter says otherwise",
+        print(json.dumps(jsonable({"units": "SI (m, rad, kg) unless a parameter says otherwise",
                                     "mechanisms": data}), indent=2))
         return 0
 

@@ -202,7 +202,7 @@ def summary_dict(report: Report) -> dict[str, Any]:
                 "title": p.title,
                 "counts": p.counts.to_dict(),
                 "mismatches": [r.id for r in p.mismatches],
-                "rows": [_json_safe(r.to_dict()) for r in p.rows],
+                "rows": [jsonable(r.to_dict()) for r in p.rows],
                 "figures": [_rel(f, report.out_dir) for f in p.figures],
                 "series": [_rel(f, report.out_dir) for f in p.series],
                 "seconds": {k: round(v, 3) for k, v in p.seconds.items()},
@@ -212,11 +212,12 @@ def summary_dict(report: Report) -> dict[str, Any]:
     }
 
 
-def _json_safe(x: Any) -> Any:
+def jsonable(x: Any) -> Any:
+    """``x`` with numpy arrays and scalars made plain Python, non-finite floats spelled as strings (valid JSON)."""
     if isinstance(x, dict):
-        return {k: _json_safe(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_json_safe(v) for v in x]
+        return {k: jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple, np.ndarray)):
+        return [jsonable(v) for v in x]
     if isinstance(x, np.generic):
         x = x.item()
     if isinstance(x, float) and not math.isfinite(x):
