@@ -75,6 +75,16 @@ class Sines:
         A = self.amplitude * np.asarray(scale, dtype=float)
         return s @ A, (w * c) @ A, (-w * w * s) @ A
 
+    def through(self, y, scale):
+        """The task motion ``t -> (y0 + x, xd, xdd)`` that passes through ``y`` at :attr:`t`."""
+        y0 = np.asarray(y, dtype=float) - self.at(self.t, scale)[0]
+
+        def motion_at(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            x, xd, xdd = self.at(t, scale)
+            return y0 + x, xd, xdd
+
+        return motion_at
+
 
 def _moving(A: np.ndarray) -> np.ndarray:
     """Amplitudes with at least one of magnitude 0.1 or more: a motion, not a rest below rounding."""

@@ -104,11 +104,7 @@ def test_accelerations_match_differences_of_velocities(p, u, branches, motion, s
     forward accelerations (drift included) are those of its loop closure (all 1e-6 relative)."""
     mech, y, _, q0 = _case(p, u, branches)
     scale = np.full(3, 0.05 * p.La)
-    y0 = y - motion.at(motion.t, scale)[0]  # the motion passes through the drawn pose at t
-
-    def motion_at(t):
-        dy, dyd, dydd = motion.at(t, scale)
-        return y0 + dy, dyd, dydd
+    motion_at = motion.through(y, scale)
 
     def state(t):
         return path_state(mech, lambda y: D.configuration(mech, y, branches), motion_at, t)
@@ -195,11 +191,7 @@ def test_power_balance_along_random_motions(p, u, branches, motion):
     mech, y, _, _ = _case(p, u, branches)
     proj = KhalilProjection(mech)
     scale = np.full(3, 0.05 * p.La)
-    y0 = y - motion.at(motion.t, scale)[0]  # the motion passes through the drawn pose at t
-
-    def motion_at(t):
-        dy, dyd, dydd = motion.at(t, scale)
-        return y0 + dy, dyd, dydd
+    motion_at = motion.through(y, scale)
 
     def state(t):
         return path_state(mech, lambda y: D.configuration(mech, y, branches), motion_at, t)

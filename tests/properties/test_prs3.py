@@ -60,9 +60,7 @@ def _case(p, u, branches, margin=1e-2):
 
 def _motion(p, y, motion):
     """The task motion ``y0 + sines`` through ``y`` at ``motion.t`` (1 % of l, 0.05 rad)."""
-    scale = np.array([0.01 * p.l, 0.05, 0.05])
-    y0 = y - motion.at(motion.t, scale)[0]
-    return lambda t: (y0 + motion.at(t, scale)[0], *motion.at(t, scale)[1:])
+    return motion.through(y, np.array([0.01 * p.l, 0.05, 0.05]))
 
 
 @examples(100)

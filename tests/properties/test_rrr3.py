@@ -107,12 +107,10 @@ def test_accelerations_match_differences_of_velocities(p, u, mode, motion, seed)
     closed-form configuration and of the velocities; along an actuated parabola, its forward accelerations
     are those of its loop closure (1e-6 relative)."""
     mech, y, _, q = _case(p, u, mode)
-    scale = np.array([0.02 * p.H, 0.02 * p.H, 0.05])
-    y0 = y - motion.at(motion.t, scale)[0]
+    motion_at = motion.through(y, np.array([0.02 * p.H, 0.02 * p.H, 0.05]))
 
     def state(t):
-        return path_state(mech, lambda yy: rrr3.closed_form_configuration(mech, yy, mode),
-                          lambda tt: (y0 + motion.at(tt, scale)[0], *motion.at(tt, scale)[1:]), t)
+        return path_state(mech, lambda yy: rrr3.closed_form_configuration(mech, yy, mode), motion_at, t)
 
     ev, ea = path_derivative_errors(mech, state, motion.t)
     assert record("rrr3 inverse velocities vs FD (rel)", ev) <= 1e-6
@@ -225,12 +223,10 @@ def test_power_balance_along_random_motions(p, u, mode, motion):
     the rate of change of the bodies' energy (1e-8 of the gross power). (Khalil's projection does not cut
     the 3-RRR: its platform closes on two legs through leg 1's chain.)"""
     mech, y, _, _ = _case(p, u, mode)
-    scale = np.array([0.02 * p.H, 0.02 * p.H, 0.05])
-    y0 = y - motion.at(motion.t, scale)[0]
+    motion_at = motion.through(y, np.array([0.02 * p.H, 0.02 * p.H, 0.05]))
 
     def state(t):
-        return path_state(mech, lambda yy: rrr3.closed_form_configuration(mech, yy, mode),
-                          lambda tt: (y0 + motion.at(tt, scale)[0], *motion.at(tt, scale)[1:]), t)
+        return path_state(mech, lambda yy: rrr3.closed_form_configuration(mech, yy, mode), motion_at, t)
 
     efforts = lambda q, v, a: virtual_work_dynamics(mech, q, v, a)
     err = power_balance_error(mech, state, efforts, motion.t)
