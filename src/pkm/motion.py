@@ -29,14 +29,13 @@ unknown keys, numbers that are not finite or beyond 1e6 (SI), booleans or string
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from pkm.core.mechanism import ABSURD, as_array, finite_result
-from pkm.core.spec import as_path, read_text_file
+from pkm.core.spec import as_path, parse_toml, read_text_file
 from pkm.data import dynamics_path
 from pkm.errors import InvalidInputError, SpecError
 
@@ -116,13 +115,7 @@ def load_motions(file: str | Path) -> dict[str, Motion]:
     path = as_path(file, "file")
     path = path if path.parent != Path(".") or path.exists() else dynamics_path(str(path))
     src = str(path)
-    text = read_text_file(path, "motion file")
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError(src, f"not valid TOML: {exc}") from None
-    except RecursionError:
-        raise SpecError(src, "not valid TOML for pkm: arrays or tables nested too deeply") from None
+    raw = parse_toml(read_text_file(path, "motion file"), src)
     if raw.get("format") != FORMAT:
         raise SpecError(src, f"format {raw.get('format')!r}; this pkm reads {FORMAT!r}")
     coords = raw.get("coordinates")

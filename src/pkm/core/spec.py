@@ -165,13 +165,7 @@ class ClosureSpec:
             text.encode("utf-8")  # names end up in Pinocchio (C++), which takes UTF-8 only
         except UnicodeEncodeError as exc:
             raise SpecError(source, f"closure spec text cannot be encoded as UTF-8 (character {exc.start})") from None
-        try:
-            raw = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise SpecError(source, f"not valid TOML: {exc}") from None
-        except RecursionError:
-            raise SpecError(source, "not valid TOML for pkm: arrays or tables nested too deeply") from None
-        return cls.from_dict(raw, source)
+        return cls.from_dict(parse_toml(text, source), source)
 
     @classmethod
     def load(cls, path: str | Path) -> ClosureSpec:
@@ -340,6 +334,16 @@ def as_path(path, name: str = "path") -> Path:
             return Path(text)
     raise InvalidInputError(name, f"expected a file path (str or pathlib.Path), got {type(path).__name__} {path!r}",
                             path)
+
+
+def parse_toml(text: str, source: str) -> dict:
+    """The TOML document ``text``; :class:`SpecError` naming ``source`` when it does not parse."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(source, f"not valid TOML: {exc}") from None
+    except RecursionError:
+        raise SpecError(source, "not valid TOML for pkm: arrays or tables nested too deeply") from None
 
 
 def read_text_file(path: str | Path, what: str, max_bytes: int = MAX_FILE_BYTES) -> str:

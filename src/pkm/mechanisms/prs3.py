@@ -67,10 +67,9 @@ from types import MappingProxyType
 
 import numpy as np
 import pinocchio as pin
-import tomllib
 
 from pkm.core.mechanism import Mechanism, as_array, check_mechanism, finite_result
-from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
+from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec, parse_toml, read_text_file
 from pkm.core.task import zyx_matrix
 from pkm.core.urdf import UrdfBuilder
 from pkm.data import dynamics_path
@@ -103,12 +102,7 @@ def table2() -> Mapping[str, float]:
         SpecError: The file is missing, not TOML, of another format, or lacks a key or a number.
     """
     path = dynamics_path(TABLE2_FILE)
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise SpecError(str(path), f"cannot read Table 2: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError(str(path), f"not valid TOML: {exc}") from None
+    raw = parse_toml(read_text_file(path, "Table 2"), str(path))
     if raw.get("format") != TABLE2_FORMAT:
         raise SpecError(str(path), f"format {raw.get('format')!r}; this pkm reads {TABLE2_FORMAT!r}")
     out: dict[str, float] = {}
