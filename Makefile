@@ -23,11 +23,7 @@ test: $(STAMP)
 	$(PY) -m pytest -q
 
 bench: $(STAMP)
-	$(PY) tools/bench_kinematics.py
-	$(PY) tools/bench_dynamics.py
-	$(PY) tools/bench_opcount.py
-	$(PY) tools/bench_workspace.py
-	$(PY) tools/bench_hexapod.py
+	$(PY) -m pkm bench
 
 clean:
 	rm -rf $(VENV) build dist .pytest_cache

@@ -5,6 +5,8 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import signal
+import socket
 import subprocess
 import sys
 from pathlib import Path
@@ -173,6 +175,64 @@ def test_preview_opens_the_viewer_at_given_joints_and_returns_with_no_wait():
     assert bad.returncode == 2 and "valid actuated joints" in one_error_line(bad)
 
 
+def children(pid: int) -> list[int]:
+    """Processes whose parent is ``pid`` (from /proc)."""
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        if int(fields[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out
+
+
+def port_is_free(port: int) -> bool:
+    with socket.socket() as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            s.bind(("127.0.0.1", port))
+        except OSError:
+            return False
+    return True
+
+
+def default_sigint() -> None:
+    """In the child: Ctrl-C as in a terminal's foreground (a suite run from a background job ignores SIGINT, and
+    Python keeps an ignored SIGINT ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def start_live_preview(*args: str) -> tuple[subprocess.Popen, str]:
+    """``python -m pkm preview ARGS`` (live viewer, waiting) started; returns it once it printed its URL."""
+    proc = subprocess.Popen([sys.executable, "-m", "pkm", "preview", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, preexec_fn=default_sigint)
+    line = proc.stdout.readline()
+    assert line.startswith("viewer: http://"), (line, proc.stderr.read() if proc.poll() is not None else "")
+    return proc, line.split()[1]
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads the process table from /proc")
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP, signal.SIGINT])
+def test_a_killed_live_preview_leaves_no_meshcat_server_behind(sig):
+    """``pkm preview delta`` killed with SIGTERM (or SIGHUP, Ctrl-C) stops its meshcat server, whose port is then
+    free: meshcat starts the server in a session of its own and would otherwise leave it running."""
+    pytest.importorskip("meshcat")
+    proc, url = start_live_preview("delta")
+    port = int(url.split(":")[2].split("/")[0])
+    try:
+        servers = children(proc.pid)
+        assert servers and not port_is_free(port)
+        proc.send_signal(sig)
+        assert proc.wait(timeout=20) == 0
+    finally:
+        proc.kill()
+    for pid in servers:
+        assert not Path(f"/proc/{pid}").exists(), f"meshcat server {pid} outlived 'pkm preview'"
+    assert port_is_free(port)
+
+
 def test_report_writes_the_hexapod_rows_and_refuses_an_unknown_paper(tmp_path):
     """``pkm report --paper hexapod --no-figures`` writes summary.json and prints every row; a bad paper exits 2."""
     proc = run("report", "--out", str(tmp_path), "--paper", "hexapod", "--no-figures")
@@ -196,13 +256,17 @@ def test_bench_runs_a_benchmark_and_refuses_an_unknown_one(tmp_path):
     assert bad.returncode == 2 and "'dynamics', 'hexapod', 'kinematics', 'opcount', 'workspace'" in line
 
 
-def test_bench_outside_a_source_checkout_says_so(tmp_path, monkeypatch, capsys):
-    """Without tools/ next to src/ nor in the current directory, ``pkm bench`` exits 2 with one line."""
-    monkeypatch.setattr(pkm, "__file__", str(tmp_path / "site-packages" / "pkm" / "__init__.py"))
-    monkeypatch.chdir(tmp_path)
-    assert cli.main(["bench", "kinematics"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "benchmarks need a source checkout" in err[0]
+def test_bench_quick_runs_every_benchmark_and_refuses_bad_arguments(tmp_path):
+    """``pkm bench --quick --json`` runs all five (shipped in the package, so from any directory) with small
+    sizes; arguments a benchmark does not take exit 2 with one line."""
+    proc = run("bench", "--quick", "--json", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    assert sorted(out) == ["dynamics", "hexapod", "kinematics", "opcount", "workspace"]
+    assert [r["samples"] for r in out["kinematics"]] == [3] * 4
+    assert out["dynamics"]["max_force_difference_to_baseline_N"]["pkm"] < 1e-9
+    bad = run("bench", "kinematics", "--", "--samples", "3")
+    assert bad.returncode == 2 and "unrecognized arguments: --samples" in one_error_line(bad)
 
 
 def test_help_exits_zero():

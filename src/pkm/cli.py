@@ -7,7 +7,7 @@ Usage::
     pkm ik MECH --pose K=V ... [--param K=V ...] [--branch NAME]
     pkm fk MECH --joints NAME=V ... [--param K=V ...]
     pkm report [--out DIR] [--paper NAME ...] [--no-figures] [--no-series]
-    pkm bench [NAME ...] [--json] [-- ARGS passed to each benchmark]
+    pkm bench [NAME ...] [--json] [--quick] [-- ARGS passed to each benchmark]
 
 Values are SI (m, rad, kg) unless they carry a unit: ``R=120mm``, ``beta=-11deg``, ``z=81cm``
 (lengths m, cm, mm; angles rad, deg; masses kg, g). A parameter's unit is the one in brackets in
@@ -31,12 +31,12 @@ import json
 import math
 import os
 import re
-import subprocess
+import signal
 import sys
+import time
 import traceback
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -446,17 +446,25 @@ def cmd_preview(args) -> int:
         print(f"wrote {path}")
         return 0
     vis = viz.show(mech, q)
-    print(f"viewer: {vis.url()}", flush=True)
     if args.no_wait:
-        return 0
-    print("press Ctrl-C to quit", file=sys.stderr, flush=True)
-    try:
-        import time
+        print(f"viewer: {vis.url()}", flush=True)
+        return 0  # the server stops with this process (meshcat's atexit hook)
 
+    def stop(signum, frame):
+        raise KeyboardInterrupt
+
+    previous = {s: signal.signal(s, stop) for s in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        print(f"viewer: {vis.url()}", flush=True)
+        print("press Ctrl-C to quit", file=sys.stderr, flush=True)
         while True:
             time.sleep(1.0)
     except KeyboardInterrupt:
         return 0
+    finally:  # SIGTERM, SIGHUP or Ctrl-C: the meshcat server goes too, and frees its ports
+        viz.close(vis)
+        for s, handler in previous.items():
+            signal.signal(s, handler)
 
 
 def cmd_ik(args) -> int:
@@ -490,42 +498,20 @@ def cmd_report(args) -> int:
     return 0
 
 
-def tools_dir() -> Path | None:
-    """The ``tools/`` folder of the source checkout holding ``bench_*.py``, or None.
-
-    Looked for next to ``src/`` above the installed package (an editable install), then in the
-    current directory.
-    """
-    pkg = Path(pkm.__file__).resolve().parent
-    candidates = [pkg.parent.parent / "tools"] if pkg.parent.name == "src" else []
-    candidates.append(Path.cwd() / "tools")
-    return next((c for c in candidates if any(c.glob("bench_*.py"))), None)
-
-
 def cmd_bench(args) -> int:
-    tools = tools_dir()
-    if tools is None:
-        raise UsageError("benchmarks need a source checkout (tools/bench_*.py next to src/, "
-                         "or run from the repository root)")
-    available = sorted(p.stem.removeprefix("bench_") for p in tools.glob("bench_*.py"))
+    from pkm import bench
+
     for n in args.names:
-        if n not in available:
-            raise UnknownNameError("benchmark", n, available, str(tools))
-    names = args.names or available
-    extra = (["--json"] if args.json else []) + list(args.extra)
+        bench.module(n)  # UnknownNameError listing the benchmarks
     results: dict[str, Any] = {}
-    for n in names:
-        cmd = [sys.executable, str(tools / f"bench_{n}.py"), *extra]
+    for n in args.names or bench.NAMES:
+        mod = bench.module(n)
+        options = bench.arguments(mod, args.extra, quick=args.quick, cls=_Parser)  # UsageError if refused
         if not args.json:
             print(f"== bench {n}", flush=True)
-        proc = subprocess.run(cmd, check=False, stdout=subprocess.PIPE if args.json else None, text=True)
-        if proc.returncode != 0:
-            raise PkmError(f"benchmark {n!r} exited with status {proc.returncode} ({' '.join(cmd[1:])})")
-        if args.json:
-            try:
-                results[n] = json.loads(proc.stdout)
-            except json.JSONDecodeError:
-                raise PkmError(f"benchmark {n!r} printed no JSON with --json") from None
+        results[n] = mod.run(options)
+        if not args.json:
+            print(mod.table(results[n]), flush=True)
     if args.json:
         print(json.dumps(results, indent=2))
     return 0
@@ -591,11 +577,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-series", action="store_true", help="skip the CSV series")
     p.set_defaults(func=cmd_report)
 
-    p = sub.add_parser("bench", parents=[debug], help="run the benchmarks of the source checkout (tools/bench_*.py)",
+    from pkm.bench import NAMES as BENCHMARKS
+
+    p = sub.add_parser("bench", parents=[debug], help="run the benchmarks (pkm.bench): ratios against baselines",
                        epilog="Arguments after '--' go to each benchmark, e.g. pkm bench kinematics -- -n 20.")
-    p.add_argument("names", metavar="NAME", nargs="*",
-                   help="kinematics, dynamics, opcount, workspace, hexapod (default: all)")
-    p.add_argument("--json", action="store_true", help="ask each benchmark for JSON; print them as one object")
+    p.add_argument("names", metavar="NAME", nargs="*", help=f"{', '.join(BENCHMARKS)} (default: all)")
+    p.add_argument("--json", action="store_true", help="print the results of all as one JSON object")
+    p.add_argument("--quick", action="store_true", help="small sizes: checks that they run, in seconds")
     p.set_defaults(func=cmd_bench, extra=[])
     return ap
 

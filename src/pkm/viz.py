@@ -44,6 +44,7 @@ import html
 import io
 import json
 import math
+import subprocess
 import uuid
 import warnings
 from dataclasses import dataclass, field
@@ -734,7 +735,26 @@ def show(mech: Mechanism, q=None, *, trajectory=None, times=None, vis=None):
     return vis
 
 
+def close(vis, timeout: float = 5.0) -> None:
+    """Stop the meshcat server process that :func:`show` started for ``vis`` and wait for it.
+
+    meshcat starts its server in a session of its own and stops it only from an ``atexit`` hook,
+    which a process ended by a signal never runs: without this call the server outlives its
+    parent and keeps its ports (7000 on), and the next viewer silently moves to 7001. Safe to
+    call twice, and on a visualizer connected to a server it did not start (then it does nothing).
+    """
+    proc = getattr(getattr(vis, "window", None), "server_proc", None)
+    if proc is None or proc.poll() is not None:
+        return
+    proc.terminate()
+    try:
+        proc.wait(timeout)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+
+
 __all__ = [
-    "ACTUATED_COLOR", "FPS", "MIMIC_COLOR", "PASSIVE_COLOR", "ROOT", "Body", "Scene", "VizDependencyError",
+    "ACTUATED_COLOR", "FPS", "MIMIC_COLOR", "PASSIVE_COLOR", "ROOT", "Body", "Scene", "VizDependencyError", "close",
     "pack_commands", "read_commands", "scene_commands", "show", "snapshot_html", "write_html",
 ]

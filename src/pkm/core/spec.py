@@ -290,7 +290,9 @@ class ClosureSpec:
 
     # ------------------------------------------------------------------ writing
     def to_toml(self) -> str:
-        """Serialise deterministically (the checked-in files are compared byte for byte)."""
+        """Serialise deterministically: keys in a fixed order, every float as its shortest round-trip
+        ``repr`` (the exact double; the checked-in files are compared as models, see
+        :mod:`pkm.core.compare`, so another CPU's last bits do not matter)."""
         out = [
             "# pkm loop-closure spec (see pkm.core.spec). Units: SI (m, rad).",
             f"format = {_tv(FORMAT)}",

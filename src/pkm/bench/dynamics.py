@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """3-PRS inverse dynamics: time per call, per sample in a batch, and per evaluation in C.
 
 Routes, all on the Table 2 design (P-actuated), from (z_p, beta, phi) and derivatives to forces:
@@ -14,13 +13,11 @@ Routes, all on the Table 2 design (P-actuated), from (z_p, beta, phi) and deriva
 
 Every route's forces are compared with the baseline's on the timed samples (max difference, N).
 
-Usage: ``python tools/bench_dynamics.py [--json] [-n 100000]``.
+Usage: ``python -m pkm.bench.dynamics [--json] [--quick] [-n 100000]``.
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 import shutil
 import statistics
 import subprocess
@@ -30,8 +27,11 @@ from pathlib import Path
 
 import numpy as np
 
+from pkm.bench import best_time, main
 from pkm.core.dynamics import forward_dynamics
 from pkm.mechanisms.prs3_dynamics import Prs3Dynamics, generate_c
+
+QUICK = {"n": 2000, "repeat": 40, "c_evaluations": 20000}
 
 HARNESS = r"""
 #include <stdio.h>
@@ -44,7 +44,7 @@ int main(void) {
   casadi_real y[3] = {0.81, 0.05, -0.04}, yd[3] = {0.01, 0.2, -0.1}, ydd[3] = {0.1, -0.5, 0.3}, tau[3];
   const casadi_real* arg[16] = {y, yd, ydd}; casadi_real* res[16] = {tau};
   if (sz_w > 4096 || sz_iw > 64) return 2;
-  const long n = 2000000; double acc = 0.0; struct timespec a, b;
+  const long n = N_EVALUATIONS; double acc = 0.0; struct timespec a, b;
   clock_gettime(CLOCK_MONOTONIC, &a);
   for (long k = 0; k < n; ++k) { y[1] = 0.05 + 1e-9 * (k & 1023); NAME(arg, res, iw, w, 0); acc += tau[0]; }
   clock_gettime(CLOCK_MONOTONIC, &b);
@@ -75,23 +75,26 @@ def via_constraint_dynamics(dyn: Prs3Dynamics, y, yd, ydd) -> np.ndarray:
     return np.linalg.solve(B, a[mech.act_v] - a0)
 
 
-def c_time(dyn: Prs3Dynamics) -> dict | None:
+def c_time(dyn: Prs3Dynamics, evaluations: int) -> dict | None:
     cc = shutil.which("cc") or shutil.which("gcc")
     if cc is None:
         return None
     with tempfile.TemporaryDirectory() as d:
         name = generate_c(Path(d) / "twin.c", dyn.params)
-        (Path(d) / "main.c").write_text(HARNESS.replace("NAME", name))
+        (Path(d) / "main.c").write_text(HARNESS.replace("NAME", name).replace("N_EVALUATIONS", str(evaluations)))
         subprocess.run([cc, "-O2", "-o", f"{d}/bench", f"{d}/twin.c", f"{d}/main.c", "-lm"], check=True)
         ns, mean_tau = subprocess.run([f"{d}/bench"], check=True, capture_output=True, text=True).stdout.split()
     return {"ns_per_eval": float(ns), "mean_F1_N": float(mean_tau), "compiler": cc}
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--json", action="store_true", help="print JSON instead of a table")
+def add_arguments(ap) -> None:
     ap.add_argument("-n", type=int, default=100_000, help="samples in the batch (default 10^5)")
-    args = ap.parse_args()
+    ap.add_argument("--repeat", type=int, default=2000, help="timed calls per single-call route (a fifth for the "
+                                                              "Pinocchio routes)")
+    ap.add_argument("--c-evaluations", type=int, default=2_000_000, help="evaluations timed in C")
+
+
+def run(args) -> dict:
     dyn = Prs3Dynamics()
     rng = np.random.default_rng(0)
     n = args.n
@@ -100,23 +103,20 @@ def main() -> None:
     sample = [(Y[k], Yd[k], Ydd[k]) for k in range(min(200, len(Y)))]
 
     base = np.array([via_constraint_dynamics(dyn, *s) for s in sample])
-    t_base = _median_us(lambda *s: via_constraint_dynamics(dyn, *s), sample, repeat=400)
-    t_khalil = _median_us(dyn.pinocchio, sample, repeat=400)
-    t_pkm = _median_us(dyn.forces, sample)
+    slow = max(1, args.repeat // 5)
+    t_base = _median_us(lambda *s: via_constraint_dynamics(dyn, *s), sample, repeat=slow)
+    t_khalil = _median_us(dyn.pinocchio, sample, repeat=slow)
+    t_pkm = _median_us(dyn.forces, sample, repeat=args.repeat)
     dyn.batch(Y[:1000], Yd[:1000], Ydd[:1000])
-    best = float("inf")
-    for _ in range(3):
-        t0 = time.perf_counter()
-        res = dyn.batch(Y, Yd, Ydd)
-        best = min(best, time.perf_counter() - t0)
+    best, res = best_time(lambda: dyn.batch(Y, Yd, Ydd), 3)
     t_batch = best / n * 1e6
     diff = {
         "pkm": float(np.abs(np.array([dyn.forces(*s) for s in sample]) - base).max()),
         "pkm_batch": float(np.abs(res.tau[:200] - base).max()),
         "pinocchio_khalil": float(np.abs(np.array([dyn.pinocchio(*s) for s in sample]) - base).max()),
     }
-    c = c_time(dyn)
-    out = {
+    c = c_time(dyn, args.c_evaluations)
+    return {
         "design": "Table 2, P-actuated, slider below; samples z in 0.81 +- 0.05 m, beta, phi in +- 0.15 rad",
         "us_per_call": {"constraint_dynamics": t_base, "pinocchio_khalil": t_khalil, "pkm": t_pkm},
         "us_per_sample_batch": {"pkm_batch": t_batch, "n": n},
@@ -126,18 +126,25 @@ def main() -> None:
         "c": None if c is None else {**c, "ratio_to_constraint_dynamics": t_base * 1e3 / c["ns_per_eval"]},
         "goals": {"pkm_us": 50, "batch_us_per_sample": 1, "c_us": 1},
     }
-    if args.json:
-        print(json.dumps(out, indent=2))
-        return
-    print(f"{'route':24s} {'time':>12s} {'speed-up vs constraintDynamics':>32s}")
-    print(f"{'constraint_dynamics':24s} {t_base:9.1f} us {1.0:32.1f}")
-    print(f"{'pinocchio_khalil':24s} {t_khalil:9.1f} us {t_base / t_khalil:32.1f}")
-    print(f"{'pkm (single call)':24s} {t_pkm:9.1f} us {t_base / t_pkm:32.1f}")
-    print(f"{'pkm batch (per sample)':24s} {t_batch:9.3f} us {t_base / t_batch:32.1f}")
+
+
+def table(out: dict) -> str:
+    t = out["us_per_call"]
+    t_base, t_khalil, t_pkm = t["constraint_dynamics"], t["pinocchio_khalil"], t["pkm"]
+    t_batch = out["us_per_sample_batch"]["pkm_batch"]
+    lines = [f"{'route':24s} {'time':>12s} {'speed-up vs constraintDynamics':>32s}",
+             f"{'constraint_dynamics':24s} {t_base:9.1f} us {1.0:32.1f}",
+             f"{'pinocchio_khalil':24s} {t_khalil:9.1f} us {t_base / t_khalil:32.1f}",
+             f"{'pkm (single call)':24s} {t_pkm:9.1f} us {t_base / t_pkm:32.1f}",
+             f"{'pkm batch (per sample)':24s} {t_batch:9.3f} us {t_base / t_batch:32.1f}"]
+    c = out["c"]
     if c is not None:
-        print(f"{'C (per evaluation)':24s} {c['ns_per_eval'] / 1e3:9.3f} us {t_base * 1e3 / c['ns_per_eval']:32.1f}")
-    print("max |F - F_baseline| [N]:", ", ".join(f"{k} {v:.2e}" for k, v in diff.items()))
+        lines.append(f"{'C (per evaluation)':24s} {c['ns_per_eval'] / 1e3:9.3f} us "
+                     f"{t_base * 1e3 / c['ns_per_eval']:32.1f}")
+    lines.append("max |F - F_baseline| [N]: " + ", ".join(
+        f"{k} {v:.2e}" for k, v in out["max_force_difference_to_baseline_N"].items()))
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main("dynamics"))

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Choice of the hexapod's reconfiguration angle: proxqp SQP against a dense grid sweep, same run.
 
 * ``beta*`` of pose T (paper sec. 4) for ``w_rot`` and ``w_tras``: time of
@@ -14,19 +13,17 @@
 Times are the best of ``--repeat`` runs. Goals (issue 3): beta* <= 2 ms, profile <= 100 ms,
 differences <= 0.01 deg.
 
-Usage: ``python tools/bench_hexapod.py [--json] [--repeat 5]``.
+Usage: ``python -m pkm.bench.hexapod [--json] [--quick] [--repeat 5]``.
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
-import time
 
 import numpy as np
 
 import pkm
+from pkm.bench import best_time, main
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms import hexapod_indices as hi
 from pkm.mechanisms import hexapod_reconfigure as hr
@@ -35,13 +32,7 @@ from pkm.papers.hexapod import spiral_poses
 STEP = math.radians(0.1)
 
 
-def best_time(fn, repeat: int) -> tuple[float, object]:
-    best, out = math.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
+QUICK = {"repeat": 1}
 
 
 def sweep(f: hi.PoseIndex, k: int, lo: float, up: float) -> float:
@@ -107,25 +98,28 @@ def bench(repeat: int) -> dict:
     return out
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--json", action="store_true", help="print JSON")
-    ap.add_argument("--repeat", type=int, default=5)
-    args = ap.parse_args()
-    res = bench(args.repeat)
-    if args.json:
-        print(json.dumps(res, indent=2))
-        return
+def add_arguments(ap) -> None:
+    ap.add_argument("--repeat", type=int, default=5, help="runs per case (best is kept)")
+
+
+def run(args) -> dict:
+    return bench(args.repeat)
+
+
+def table(res: dict) -> str:
+    lines = []
     for idx, r in res["pose_T"].items():
-        print(f"pose T {idx:6s}: SQP {r['sqp_ms']:.2f} ms, sweep {r['sweep_ms']:.2f} ms "
-              f"(x{r['ratio_sweep_over_sqp']:.1f}), beta* {r['beta_sqp_deg']:.4f} deg, diff {r['diff_deg']:.2e} deg")
+        lines.append(f"pose T {idx:6s}: SQP {r['sqp_ms']:.2f} ms, sweep {r['sweep_ms']:.2f} ms "
+                     f"(x{r['ratio_sweep_over_sqp']:.1f}), beta* {r['beta_sqp_deg']:.4f} deg, "
+                     f"diff {r['diff_deg']:.2e} deg")
     for idx, r in res["spiral"].items():
-        print(f"spiral {idx:6s}: profile {r['profile_ms']:.1f} ms, sweep {r['sweep_ms']:.1f} ms "
-              f"(x{r['ratio_sweep_over_profile']:.1f}), max diff {r['max_diff_pointwise_deg']:.2e} deg")
+        lines.append(f"spiral {idx:6s}: profile {r['profile_ms']:.1f} ms, sweep {r['sweep_ms']:.1f} ms "
+                     f"(x{r['ratio_sweep_over_profile']:.1f}), max diff {r['max_diff_pointwise_deg']:.2e} deg")
     e = res["index_evaluation"]
-    print(f"one index evaluation: batch {e['batch_us']:.1f} us, generic core {e['generic_core_us']:.0f} us "
-          f"(x{e['ratio_core_over_batch']:.0f})")
+    lines.append(f"one index evaluation: batch {e['batch_us']:.1f} us, generic core {e['generic_core_us']:.0f} us "
+                 f"(x{e['ratio_core_over_batch']:.0f})")
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main("hexapod"))

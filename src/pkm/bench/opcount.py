@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Operation count of the 3-PRS inverse dynamics (symbolic twin) next to the published ones.
 
 The twin is :func:`pkm.mechanisms.prs3_dynamics.twin`: the same algorithm as the numeric routes,
@@ -7,26 +6,27 @@ multiplications, + - as additions, negations free, sin/cos/sqrt/atan2 apart. Thr
 and inertia symbolic; inertia symbolic (Table 2 geometry); all numeric (Table 2). P- and R-actuated
 (R needs inclined rails: gamma = 1.2 rad for the R rows).
 
-Usage: ``python tools/bench_opcount.py [--json]``.
+Usage: ``python -m pkm.bench.opcount [--json]``.
 """
 
 from __future__ import annotations
 
-import argparse
-import json
-
+from pkm.bench import main
 from pkm.mechanisms.prs3 import Prs3Params
 from pkm.mechanisms.prs3_dynamics import BOUNDARY, MODES, operation_count
 from pkm.papers.prs3 import PUBLISHED_COUNTS
 
+QUICK: dict = {}  # the counts take about 2 s: no smaller size
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    args = ap.parse_args()
+
+def add_arguments(ap) -> None:
+    pass
+
+
+def run(args) -> dict:
     designs = {"P": Prs3Params(), "R": Prs3Params(actuation="R", gamma=1.2)}
     ours = [operation_count(designs[a], mode=m) for a in ("P", "R") for m in MODES]
-    result = {
+    return {
         "boundary": BOUNDARY,
         "published": {k: {"mul_div": m, "add_sub": a} for k, (m, a) in PUBLISHED_COUNTS.items()},
         "ours": [{"actuation": c.actuation, "mode": c.mode, "mul_div": c.mul, "add_sub": c.add,
@@ -35,17 +35,19 @@ def main() -> None:
                  for c in ours],
         "goals": {"inertial": {"mul_div": 700, "add_sub": 550}, "numeric": {"mul_div": 550, "add_sub": 450}},
     }
-    if args.json:
-        print(json.dumps(result, indent=2))
-        return
-    print(f"{'source':38s} {'mult/div':>9s} {'add/sub':>8s}  functions")
-    for k, (m, a) in PUBLISHED_COUNTS.items():
-        print(f"{k:38s} {m:9d} {a:8d}")
-    for c in ours:
-        fn = ", ".join(f"{v} {k}" for k, v in c.functions.items())
-        print(f"{'pkm, ' + c.actuation + '-actuated, ' + c.mode:38s} {c.mul:9d} {c.add:8d}  {fn}")
-    print(f"\nboundary: {BOUNDARY}")
+
+
+def table(result: dict) -> str:
+    lines = [f"{'source':38s} {'mult/div':>9s} {'add/sub':>8s}  functions"]
+    for k, v in result["published"].items():
+        lines.append(f"{k:38s} {v['mul_div']:9d} {v['add_sub']:8d}")
+    for c in result["ours"]:
+        fn = ", ".join(f"{v} {k}" for k, v in c["functions"].items())
+        lines.append(f"{'pkm, ' + c['actuation'] + '-actuated, ' + c['mode']:38s} {c['mul_div']:9d} "
+                     f"{c['add_sub']:8d}  {fn}")
+    lines.append(f"\nboundary: {result['boundary']}")
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main("opcount"))

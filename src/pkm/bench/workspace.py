@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Planar 3-RRR workspace and condition-index maps: vectorised numpy against a per-node loop.
 
 Two cases, each timed vectorised (best of ``--repeat``) and as a naive Python loop over a
@@ -12,28 +11,24 @@ measured in the same run, and the sample's CIs are compared between the two rout
 * ``gci_paper_grid``: one design (Fig. 9's) on the paper's map grid, 801 x 801 nodes every 2 mm,
   overall and area GCI. Goal <= 0.5 s.
 
-Usage: ``python tools/bench_workspace.py [--json] [--sample 2000] [--repeat 3]``.
+Usage: ``python -m pkm.bench.workspace [--json] [--quick] [--sample 2000] [--repeat 3]``.
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 import time
 
 import numpy as np
 
+from pkm.bench import best_time, main
 from pkm.mechanisms import rrr3
 from pkm.mechanisms import rrr3_maps as maps
 
+QUICK = {"sample": 50, "repeat": 1}
+
 
 def _best(fn, repeat: int) -> float:
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
+    return best_time(fn, repeat)[0]
 
 
 def _naive(design, nodes: np.ndarray, settings: maps.CiSettings) -> tuple[float, np.ndarray]:
@@ -97,24 +92,25 @@ def bench_gci(sample: int, repeat: int, rng: np.random.Generator) -> dict:
     }
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--json", action="store_true", help="print JSON instead of a table")
+def add_arguments(ap) -> None:
     ap.add_argument("--sample", type=int, default=2000, help="nodes timed in the naive loop, per case")
     ap.add_argument("--repeat", type=int, default=3, help="vectorised runs per case (best is kept)")
-    args = ap.parse_args()
+
+
+def run(args) -> list[dict]:
     rng = np.random.default_rng(0)
-    results = [bench_3d(args.sample, args.repeat, rng), bench_gci(args.sample, args.repeat, rng)]
-    if args.json:
-        print(json.dumps(results, indent=2))
-        return
-    print(f"{'case':16} {'nodes':>10} {'vector s':>9} {'goal s':>7} {'naive us/node':>14} {'naive s (extr.)':>16} "
-          f"{'ratio':>7} {'max |dCI|':>10}")
+    return [bench_3d(args.sample, args.repeat, rng), bench_gci(args.sample, args.repeat, rng)]
+
+
+def table(results: list[dict]) -> str:
+    lines = [(f"{'case':16} {'nodes':>10} {'vector s':>9} {'goal s':>7} {'naive us/node':>14} "
+              f"{'naive s (extr.)':>16} {'ratio':>7} {'max |dCI|':>10}")]
     for r in results:
-        print(f"{r['case']:16} {r['nodes']:10d} {r['vectorised_s']:9.3f} {r['goal_s']:7.1f} "
-              f"{r['naive_per_node_us']:14.1f} {r['naive_extrapolated_s']:16.1f} "
-              f"{r['ratio_naive_over_vectorised']:7.0f} {r['sample_max_ci_difference']:10.1e}")
+        lines.append(f"{r['case']:16} {r['nodes']:10d} {r['vectorised_s']:9.3f} {r['goal_s']:7.1f} "
+                     f"{r['naive_per_node_us']:14.1f} {r['naive_extrapolated_s']:16.1f} "
+                     f"{r['ratio_naive_over_vectorised']:7.0f} {r['sample_max_ci_difference']:10.1e}")
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main("workspace"))

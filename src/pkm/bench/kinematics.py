@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Position solvers of the four mechanisms: generic core against the papers' closed forms.
 
 For each mechanism, at N random regular configurations near its reference:
@@ -10,31 +9,26 @@ For each mechanism, at N random regular configurations near its reference:
 * the paper's forward kinematics, where it has one;
 * ratios generic / closed form measured in the same run.
 
-Usage: ``python tools/bench_kinematics.py [--json] [-n 200] [--delta 0.01]``.
+Usage: ``python -m pkm.bench.kinematics [--json] [--quick] [-n 50] [--delta 0.01] [MECH ...]``.
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 import statistics
-import time
 
 import numpy as np
 
 import pkm
+from pkm.bench import best_time, main
 from pkm.core import TaskMap, close_loops, solve_ik
 from pkm.errors import PkmError
 from pkm.mechanisms import NAMES, module
 
+QUICK = {"n": 3}
+
 
 def _time(fn, repeat: int = 5) -> float:
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best * 1e6
+    return best_time(fn, repeat)[0] * 1e6
 
 
 def bench(name: str, n: int, delta: float, seed: int = 0) -> dict:
@@ -77,27 +71,29 @@ def bench(name: str, n: int, delta: float, seed: int = 0) -> dict:
     return out
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--json", action="store_true", help="print JSON instead of a table")
+def add_arguments(ap) -> None:
     ap.add_argument("-n", type=int, default=50, help="configurations per mechanism")
     ap.add_argument("--delta", type=float, default=0.01, help="seed offset of the actuated coordinates [rad or m]")
     ap.add_argument("mechanisms", nargs="*", default=list(NAMES))
-    args = ap.parse_args()
-    results = [bench(name, args.n, args.delta) for name in args.mechanisms]
-    if args.json:
-        print(json.dumps(results, indent=2))
-        return
-    print(f"{'mechanism':9} {'closure us':>10} {'iters med/max':>13} {'gen. IK us':>10} {'CF IK us':>9} "
-          f"{'CF q us':>8} {'IK ratio':>8} {'CF FK us':>9} {'FK ratio':>8}")
+
+
+def run(args) -> list[dict]:
+    return [bench(name, args.n, args.delta) for name in args.mechanisms]
+
+
+def table(results: list[dict]) -> str:
+    lines = [(f"{'mechanism':9} {'closure us':>10} {'iters med/max':>13} {'gen. IK us':>10} {'CF IK us':>9} "
+              f"{'CF q us':>8} {'IK ratio':>8} {'CF FK us':>9} {'FK ratio':>8}")]
     for r in results:
         fk = (f"{r['closed_form_fk_median_us']:9.1f} {r['ratio_generic_fk_over_closed_form_fk']:8.1f}"
               if "closed_form_fk_median_us" in r else f"{'-':>9} {'-':>8}")
-        print(f"{r['mechanism']:9} {r['closure_median_us']:10.1f} "
-              f"{r['closure_iterations_median']:>6.0f}/{r['closure_iterations_max']:<6d} "
-              f"{r['generic_ik_median_us']:10.1f} {r['closed_form_ik_median_us']:9.1f} "
-              f"{r['closed_form_configuration_median_us']:8.1f} {r['ratio_generic_ik_over_closed_form_ik']:8.1f} {fk}")
+        lines.append(f"{r['mechanism']:9} {r['closure_median_us']:10.1f} "
+                     f"{r['closure_iterations_median']:>6.0f}/{r['closure_iterations_max']:<6d} "
+                     f"{r['generic_ik_median_us']:10.1f} {r['closed_form_ik_median_us']:9.1f} "
+                     f"{r['closed_form_configuration_median_us']:8.1f} "
+                     f"{r['ratio_generic_ik_over_closed_form_ik']:8.1f} {fk}")
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main("kinematics"))

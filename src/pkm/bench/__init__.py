@@ -1,0 +1,84 @@
+"""Benchmarks: each measures pkm against a baseline timed in the same run, and reports ratios.
+
+They ship inside the package, so ``pkm bench`` works from an installed wheel. One module a
+benchmark, each with the same four names:
+
+* ``add_arguments(parser)``: its options (sizes, repeats);
+* ``QUICK``: the option values of a quick run (``pkm bench --quick``: seconds, not minutes; for
+  checking that a benchmark runs, not for its numbers);
+* ``run(args) -> dict``: the measurements (JSON-ready);
+* ``table(result) -> str``: the same as a table.
+
+``python -m pkm.bench.NAME [--json] [--quick] ...`` runs one; ``pkm bench`` runs several.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import math
+import time
+from collections.abc import Callable, Sequence
+from types import ModuleType
+from typing import Any
+
+from pkm.errors import UnknownNameError
+
+NAMES = ("dynamics", "hexapod", "kinematics", "opcount", "workspace")
+
+
+def module(name: str) -> ModuleType:
+    """The module of benchmark ``name``; :class:`UnknownNameError` listing :data:`NAMES` otherwise."""
+    if not isinstance(name, str) or name not in NAMES:
+        raise UnknownNameError("benchmark", str(name), NAMES)
+    return importlib.import_module(f"pkm.bench.{name}")
+
+
+def best_time(fn: Callable[[], Any], repeat: int) -> tuple[float, Any]:
+    """Best wall time of ``repeat`` calls of ``fn`` [s], and the last call's result."""
+    best, out = math.inf, None
+    for _ in range(max(1, repeat)):
+        t0 = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t0)
+    return best, out
+
+
+def parser(mod: ModuleType, cls: type[argparse.ArgumentParser] = argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """The command-line options of benchmark module ``mod`` (an argparse parser of class ``cls``)."""
+    doc = mod.__doc__ or ""
+    ap = cls(prog=f"python -m {mod.__name__}", description=doc.strip().splitlines()[0])
+    ap.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    ap.add_argument("--quick", action="store_true", help="small sizes: checks that it runs, in seconds")
+    mod.add_arguments(ap)
+    return ap
+
+
+def arguments(mod: ModuleType, argv: Sequence[str] = (), quick: bool = False,
+              cls: type[argparse.ArgumentParser] = argparse.ArgumentParser) -> argparse.Namespace:
+    """Parsed options of ``mod``; ``quick`` (or ``--quick`` in ``argv``) applies its ``QUICK`` sizes
+    to the options that ``argv`` does not set."""
+    ap = parser(mod, cls)
+    args = ap.parse_args(list(argv))
+    if quick or args.quick:
+        defaults = ap.parse_args([])
+        for key, value in mod.QUICK.items():
+            if getattr(args, key) == getattr(defaults, key):
+                setattr(args, key, value)
+        args.quick = True
+    return args
+
+
+def main(name: str, argv: Sequence[str] | None = None) -> int:
+    """``python -m pkm.bench.NAME``: run one benchmark and print its table (or JSON)."""
+    import sys
+
+    mod = module(name)
+    args = arguments(mod, sys.argv[1:] if argv is None else argv)
+    result = mod.run(args)
+    print(json.dumps(result, indent=2) if args.json else mod.table(result))
+    return 0
+
+
+__all__ = ["NAMES", "arguments", "best_time", "main", "module", "parser"]

@@ -1,0 +1,77 @@
+"""Every third-party module that ``src/pkm`` imports is declared in ``pyproject.toml``.
+
+A module that arrives only as another package's dependency (scipy through proxsuite, umsgpack
+through meshcat) works until that package drops it; so every import must name its own distribution.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+import sys
+import tomllib
+from importlib.metadata import distributions, packages_distributions
+from importlib.util import find_spec
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _canonical(name: str) -> str:
+    return re.sub(r"[-_.]+", "-", name).lower()
+
+
+def imported_modules(src: Path) -> dict[str, set[str]]:
+    """Top-level names of the absolute imports under ``src`` (anywhere in a module), with the files."""
+    found: dict[str, set[str]] = {}
+    for path in sorted(src.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names = [node.module]
+            else:
+                continue
+            for n in names:
+                found.setdefault(n.split(".")[0], set()).add(str(path.relative_to(src.parent)))
+    return found
+
+
+def owners(module: str) -> set[str]:
+    """The distributions that install ``module``: from their top-level names, else (packages such as
+    pin that install under a prefix, ``cmeel.prefix/...``) the ones whose file lists hold its origin."""
+    found = packages_distributions().get(module)
+    if found:
+        return {_canonical(d) for d in found}
+    spec = find_spec(module)
+    if spec is None or not spec.origin:
+        return set()
+    origin = Path(spec.origin).resolve()
+    return {_canonical(d.metadata["Name"]) for d in distributions()
+            if any(f.name == origin.name and Path(d.locate_file(f)).resolve() == origin for f in d.files or ())}
+
+
+def declared() -> set[str]:
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    return {_canonical(re.split(r"[\s<>=!~;\[]", d, maxsplit=1)[0]) for d in project["dependencies"]}
+
+
+def test_every_third_party_import_is_a_declared_dependency():
+    third_party = {m: files for m, files in imported_modules(ROOT / "src" / "pkm").items()
+                   if m not in sys.stdlib_module_names and m not in ("pkm", "__future__")}
+    assert {"numpy", "pinocchio", "casadi"} <= set(third_party)  # the scan sees the imports
+    deps = declared()
+    missing = {}
+    for mod, files in sorted(third_party.items()):
+        dists = owners(mod)
+        assert dists, f"{mod!r} (imported by {sorted(files)}) belongs to no installed distribution"
+        if not dists & deps:
+            missing[mod] = (sorted(dists), sorted(files))
+    assert not missing, f"imported but not declared in pyproject.toml [project] dependencies: {missing}"
+
+
+def test_the_scan_catches_an_undeclared_import(tmp_path):
+    """A module importing scipy inside a function is found (the scan is not limited to the top)."""
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg" / "m.py").write_text("def f():\n    from scipy.optimize import brentq\n    import os\n")
+    assert set(imported_modules(tmp_path / "pkg")) == {"scipy", "os"}
