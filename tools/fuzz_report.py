@@ -709,7 +709,7 @@ def _pose(g: Gen, adversarial: bool):
 
 @entry("hexapod_indices.indices")
 def _hex_indices(g, adv):
-    from pkm.mechanisms import hexapod_indices as hi
+    from pkm.mechanisms.hexapod import indices as hi
     R, P = _pose(g, adv)
     kw = {}
     if g.chance(0.2):
@@ -721,7 +721,7 @@ def _hex_indices(g, adv):
 
 @entry("hexapod_singularities.classify")
 def _hex_classify(g, adv):
-    from pkm.mechanisms import hexapod_singularities as hsg
+    from pkm.mechanisms.hexapod import singularities as hsg
     R, P = _pose(g, adv)
     kw = {}
     if g.chance(0.2):
@@ -753,7 +753,7 @@ def _baseline_nan_ok(res) -> bool:
 
 @entry("hexapod_reconfigure.optimal_beta")
 def _hex_beta(g, adv):
-    from pkm.mechanisms import hexapod_reconfigure as hr
+    from pkm.mechanisms.hexapod import reconfiguration as hr
     R, P = _pose(g, adv)
     kw = {}
     if g.chance(0.3):
@@ -768,7 +768,7 @@ def _hex_beta(g, adv):
 
 @entry("hexapod_reconfigure.beta_profile", sentinel=_baseline_nan_ok)
 def _hex_profile(g, adv):
-    from pkm.mechanisms import hexapod_reconfigure as hr
+    from pkm.mechanisms.hexapod import reconfiguration as hr
     k = int(g.rng.integers(2, 5))
     R0, P0 = _pose(g, False)
     poses = [(R0, P0 + np.array([0.0, 0.0, 0.003 * j])) for j in range(k)]
@@ -787,7 +787,7 @@ def _hex_profile(g, adv):
 
 @entry("hexapod_reconfigure.reachable_intervals")
 def _hex_intervals(g, adv):
-    from pkm.mechanisms import hexapod_reconfigure as hr
+    from pkm.mechanisms.hexapod import reconfiguration as hr
     R, P = _pose(g, adv)
     return hr.reachable_intervals, (_params(g, "hexapod", adv), R, P), {}
 
@@ -805,9 +805,9 @@ def _index_fn(g: Gen, adversarial: bool):
                    lambda k, x: np.exp(1e3 * x), smooth, smooth, 3))
 
 
-@entry("reconfigure.maximise")
+@entry("redundant_parameter.maximise")
 def _maximise(g, adv):
-    from pkm.core import reconfigure
+    from pkm.core import redundant_parameter
     n = int(g.rng.integers(1, 5))
     lo = g.rng.uniform(-2, 0, n)
     hi_ = lo + g.rng.uniform(0, 2, n)
@@ -818,12 +818,12 @@ def _maximise(g, adv):
         kw[g.pick(("grid", "tol", "fd_step", "max_iter", "eta"))] = g.pick(ADV_NUMBERS + (None, 0, 1, -3, 2.5)) \
             if adv else None
         kw = {k: v for k, v in kw.items() if v is not None}
-    return reconfigure.maximise, (_index_fn(g, adv), lo, hi_), kw
+    return redundant_parameter.maximise, (_index_fn(g, adv), lo, hi_), kw
 
 
-@entry("reconfigure.optimise_profile", sentinel=_baseline_nan_ok)
+@entry("redundant_parameter.optimise_profile", sentinel=_baseline_nan_ok)
 def _optimise_profile(g, adv):
-    from pkm.core import reconfigure
+    from pkm.core import redundant_parameter
     n = int(g.rng.integers(2, 6))
     lo = np.full(n, -1.0) + 0.1 * g.rng.normal(size=n)
     hi_ = lo + g.rng.uniform(0.2, 2, n)
@@ -836,7 +836,7 @@ def _optimise_profile(g, adv):
             kw[k] = g.pick(ADV_NUMBERS + (None, "x", -1, 0))
     elif g.chance(0.3):
         kw["baseline"] = g.pick((None, 0.0, -0.5, 5.0))
-    return reconfigure.optimise_profile, (_index_fn(g, adv), lo, hi_), kw
+    return redundant_parameter.optimise_profile, (_index_fn(g, adv), lo, hi_), kw
 
 
 # indices ----------------------------------------------------------------
@@ -896,7 +896,7 @@ def _ci_sentinel(res) -> bool:
 
 @entry("rrr3_maps.condition_index", sentinel=_ci_sentinel)
 def _rrr3_ci(g, adv):
-    from pkm.mechanisms import rrr3_maps as rm
+    from pkm.mechanisms.rrr3 import workspace as rm
     c = ctx()
     base = c.y_ref["rrr3"][:2]
     m = int(g.rng.integers(1, 30))
@@ -922,7 +922,7 @@ def _rrr3_ci(g, adv):
 
 @entry("rrr3_maps.ci_map")
 def _rrr3_map(g, adv):
-    from pkm.mechanisms import rrr3_maps as rm
+    from pkm.mechanisms.rrr3 import workspace as rm
     c = ctx()
     centre = c.y_ref["rrr3"][:2]
     half, step = float(g.rng.uniform(0.01, 0.3)), float(g.rng.uniform(0.02, 0.1))
@@ -943,7 +943,7 @@ def _rrr3_map(g, adv):
 
 @entry("rrr3_maps.naive_condition_index")
 def _rrr3_naive(g, adv):
-    from pkm.mechanisms import rrr3_maps as rm
+    from pkm.mechanisms.rrr3 import workspace as rm
     y = _target(g, "rrr3", adv)
 
     def naive(design, y):
@@ -954,7 +954,7 @@ def _rrr3_naive(g, adv):
 
 @entry("delta_workspace.condition_numbers", sentinel=_kappa_sentinel)
 def _delta_kappa(g, adv):
-    from pkm.mechanisms import delta_workspace as dw
+    from pkm.mechanisms.delta import workspace as dw
     c = ctx()
     pts = c.y_ref["delta"] + g.rng.normal(0, g.pick((0.01, 0.1, 0.5)), (int(g.rng.integers(1, 20)), 3))
     if adv:
@@ -973,7 +973,7 @@ def _delta_kappa(g, adv):
 
 @entry("delta_design.radius_minimising_condition")
 def _delta_radius(g, adv):
-    from pkm.mechanisms import delta_design as dd
+    from pkm.mechanisms.delta import design as dd
     c = ctx()
     p = g.value(c.y_ref["delta"], adv, g.pick((0.01, 0.05, 0.3)))
     kw = {"n_scan": int(g.rng.integers(2, 8))}
@@ -986,13 +986,13 @@ def _delta_radius(g, adv):
 
 @entry("delta_design.reachable_radii")
 def _delta_radii(g, adv):
-    from pkm.mechanisms import delta_design as dd
+    from pkm.mechanisms.delta import design as dd
     return dd.reachable_radii, (_params(g, "delta", adv), g.value(ctx().y_ref["delta"], adv, g.pick((0.01, 0.3)))), {}
 
 
 # dynamics ----------------------------------------------------------------
 def _prs3(g: Gen, adversarial: bool):
-    from pkm.mechanisms.prs3_dynamics import Prs3Dynamics
+    from pkm.mechanisms.prs3.dynamics import Prs3Dynamics
     c = ctx()
     return c.lazy("prs3dyn", Prs3Dynamics)
 

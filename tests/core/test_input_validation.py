@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import pkm
-from pkm.core import indices, reconfigure, screws
+from pkm.core import indices, redundant_parameter, screws
 from pkm.core.dynamics import KhalilProjection, forward_dynamics
 from pkm.core.mechanism import as_count, as_scalar, as_vector, finite_result
 from pkm.core.solve import MAX_TOTAL_ITER
@@ -197,7 +197,7 @@ def test_bad_index_functions_are_reported_quickly(index, match):
     InvalidInputError within a second (proxqp never sees non-finite data)."""
     t0 = time.perf_counter()
     with pytest.raises((InvalidInputError, NonFiniteError), match=match):
-        reconfigure.maximise(index, [-0.6, -1.9], [0.15, 0.7])
+        redundant_parameter.maximise(index, [-0.6, -1.9], [0.15, 0.7])
     assert time.perf_counter() - t0 < 1.0
 
 
@@ -205,7 +205,7 @@ def test_relative_gain_is_nan_where_the_baseline_index_is_zero():
     """Where the baseline's index is 0 the relative gain is NaN (documented), and mean_gain skips it."""
     def index(k, x):
         return np.where(k == 0, np.abs(x), 1.0 + 0.1 * np.cos(x))
-    res = reconfigure.optimise_profile(index, [-1.0, -1.0], [1.0, 1.0], rate_limit=2.0, smoothness=0.0)
+    res = redundant_parameter.optimise_profile(index, [-1.0, -1.0], [1.0, 1.0], rate_limit=2.0, smoothness=0.0)
     assert res.baseline_ok.all() and res.baseline_value[0] == 0.0
     assert np.isnan(res.relative_gain[0]) and np.isfinite(res.relative_gain[1])
     assert res.mean_gain() == pytest.approx(res.relative_gain[1])
@@ -217,7 +217,7 @@ def test_relative_gain_is_nan_where_the_baseline_index_is_zero():
 def test_profile_settings_are_validated(kwargs):
     """Rate limit, smoothness, iteration budget, baseline and tolerance are checked before any QP."""
     with pytest.raises(InvalidInputError):
-        reconfigure.optimise_profile(lambda k, x: np.cos(x), [-1.0, -1.0], [1.0, 1.0], **kwargs)
+        redundant_parameter.optimise_profile(lambda k, x: np.cos(x), [-1.0, -1.0], [1.0, 1.0], **kwargs)
 
 
 # ---------------------------------------------------------------------- errors carry their data
@@ -245,14 +245,14 @@ def test_warm_qp_solves_feasible_qps_proxqp_defaults_gave_up_on():
     g3 = np.array([-0.30422296823013717, -0.818957539963395, -0.30422296823013717])
     lb3 = np.array([-0.46115120646480606, -0.8637522299428041, -0.46115120646480606])
     ub3 = np.array([-0.301566499769425, -0.704167523247423, -0.301566499769425])
-    qp = reconfigure.WarmQP(3, D3, np.full(2, -0.40260102347799803), np.full(2, 0.40260102347799803))
+    qp = redundant_parameter.WarmQP(3, D3, np.full(2, -0.40260102347799803), np.full(2, 0.40260102347799803))
     y = qp.solve(H3, g3, lb3, ub3)
     assert qp.statuses == ["PROXQP_SOLVED"] and np.all(lb3 - 1e-9 <= y) and np.all(y <= ub3 + 1e-9)
     D4 = np.diff(np.eye(4), axis=0)
     H4 = np.diag([1.9163e10, 0.2, 1.5, 3.2]) + D4.T @ D4
     g4 = np.array([1.9120e10, 4.3243e-03, 1.4953e-03, 8.5535e-04])
     lb4, ub4 = np.array([-0.9992, -0.9932, -0.9874, -0.9817]), np.array([-0.3553, -0.3353, -0.3153, -0.2953])
-    qp = reconfigure.WarmQP(4, D4, np.full(3, -0.02), np.full(3, 0.02))
+    qp = redundant_parameter.WarmQP(4, D4, np.full(3, -0.02), np.full(3, 0.02))
     y = qp.solve(H4, g4, lb4, ub4)
     assert qp.statuses == ["PROXQP_SOLVED"] and np.all(np.abs(np.diff(y)) <= 0.02 + 1e-9)
     assert y[0] == pytest.approx(-g4[0] / H4[0, 0], abs=1e-6)  # the stiff pose sits at its own minimiser
@@ -260,6 +260,6 @@ def test_warm_qp_solves_feasible_qps_proxqp_defaults_gave_up_on():
 
 def test_warm_qp_refuses_non_finite_data():
     """NaN or infinite QP data raise NonFiniteError before proxqp runs (it would spin to its iteration limit)."""
-    qp = reconfigure.WarmQP(2)
+    qp = redundant_parameter.WarmQP(2)
     with pytest.raises(NonFiniteError, match="QP data H"):
         qp.solve(np.diag([1.0, np.inf]), np.zeros(2), -np.ones(2), np.ones(2))

@@ -18,19 +18,14 @@ from pkm.errors import (
     PkmError,
     UnknownNameError,
 )
-from pkm.mechanisms import (
-    delta,
-    delta_design,
-    delta_workspace,
-    hexapod,
-    hexapod_indices,
-    hexapod_reconfigure,
-    hexapod_singularities,
-    prs3,
-    rrr3,
-    rrr3_maps,
-)
-from pkm.mechanisms.prs3_dynamics import Prs3Dynamics
+from pkm.mechanisms import delta, hexapod, prs3, rrr3
+from pkm.mechanisms.delta import design as delta_design
+from pkm.mechanisms.delta import workspace as delta_workspace
+from pkm.mechanisms.hexapod import indices as hexapod_indices
+from pkm.mechanisms.hexapod import reconfiguration as hexapod_reconfigure
+from pkm.mechanisms.hexapod import singularities as hexapod_singularities
+from pkm.mechanisms.rrr3 import workspace as rrr3_maps
+from pkm.mechanisms.prs3.dynamics import Prs3Dynamics
 
 
 def test_build_refuses_unknown_parameters_with_the_valid_names():

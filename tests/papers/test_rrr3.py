@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from pkm.mechanisms.rrr3_maps import Design
+from pkm.mechanisms.rrr3.workspace import Design
 from pkm.papers import rrr3 as study
 
 IDS = ["rrr3.fig5.gci", "rrr3.fig5.gci_area", "rrr3.fig6.gci", "rrr3.fig6.gci_area", "rrr3.fig7.gci",
@@ -53,3 +53,15 @@ def test_fig7_belongs_to_the_similarity_law_design_with_H_150_cm():
     assert ranked[0][3] < 3e-3 < ranked[1][3]
     caption = next(r for r in ranked if r[0] == Design(0.6, 0.6, 0.1, 1.0))
     assert caption[3] > 0.1  # the caption's dimensions give Fig. 6's numbers, not Fig. 7's
+
+
+def test_paper_grid_is_801_nodes_per_axis_with_a_151_node_area():
+    """The paper grid spans +-80 cm about the base centroid every 2 mm; the 30 cm area holds 151 x 151 nodes."""
+    g = study.paper_grid(Design(0.60, 0.60, 0.10, 1.00))
+    assert g.n == 400 and g.step == 0.002 and g.size == 801 ** 2
+    assert g.square_mask(0.30, g.centre).sum() == 151 ** 2
+
+
+def test_the_sweep_has_the_papers_1000_designs():
+    designs = study.paper_sweep_designs()
+    assert len(designs) == 1000 and len(set(designs)) == 1000

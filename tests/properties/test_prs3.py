@@ -22,7 +22,7 @@ from pkm.core.dynamics import KhalilProjection
 from pkm.core.task import zyx_matrix
 from pkm.errors import SingularityError
 from pkm.mechanisms import prs3
-from pkm.mechanisms import prs3_dynamics as PD
+from pkm.mechanisms.prs3 import dynamics as PD
 from tests import fd
 from tests.properties import (
     DECADES,
@@ -144,7 +144,7 @@ def test_a_leg_at_full_reach_is_approached_as_an_inverse_singularity(p, tilt, se
     mech = prs3.build(p)
     direction = sector * math.pi / 3 + offset  # near multiples of 60 deg one leg is clearly the farthest
     pitch, roll = tilt * math.cos(direction), tilt * math.sin(direction)
-    a, u1, w, _, b = prs3._legs(p)
+    a, u1, w, _, b = prs3.leg_geometry(p)
     xp, yp, alpha = prs3.parasitic_motion(p.h, pitch, roll)
     c0 = np.array([xp, yp, 0.0]) + b @ zyx_matrix(roll, pitch, alpha).T - a  # B_i - a_i at z = 0
     cw0 = np.einsum("ij,ij->i", c0, w)

@@ -29,7 +29,7 @@ import numpy as np
 
 from pkm.bench import best_time, main
 from pkm.core.dynamics import forward_dynamics
-from pkm.mechanisms.prs3_dynamics import Prs3Dynamics, generate_c
+from pkm.mechanisms.prs3.dynamics import Prs3Dynamics, generate_c
 
 QUICK = {"n": 2000, "repeat": 40, "c_evaluations": 20000}
 

@@ -1,10 +1,10 @@
 """Choice of the hexapod's reconfiguration angle: proxqp SQP against a dense grid sweep, same run.
 
 * ``beta*`` of pose T (paper sec. 4) for ``w_rot`` and ``w_tras``: time of
-  :func:`pkm.mechanisms.hexapod_reconfigure.optimal_beta` (reachable interval, grid start, SQP)
+  :func:`pkm.mechanisms.hexapod.reconfiguration.optimal_beta` (reachable interval, grid start, SQP)
   next to a dense 0.1-deg sweep of the reachable interval (vectorised index, argmax refined by a
   parabola through the 3 best nodes); ratio sweep / SQP; ``|beta*_SQP - beta*_sweep|`` [deg].
-* The 101-pose spiral: time of :func:`~pkm.mechanisms.hexapod_reconfigure.beta_profile` (reachable
+* The 101-pose spiral: time of :func:`~pkm.mechanisms.hexapod.reconfiguration.beta_profile` (reachable
   intervals, pointwise optima, rate-limited profile) next to the same 0.1-deg sweep at every pose;
   ratio; largest difference of the pointwise optima [deg].
 * One index evaluation: the batch route (closed-form IK + screw Jacobians) against the generic
@@ -25,8 +25,8 @@ import numpy as np
 import pkm
 from pkm.bench import best_time, main
 from pkm.mechanisms import hexapod as hx
-from pkm.mechanisms import hexapod_indices as hi
-from pkm.mechanisms import hexapod_reconfigure as hr
+from pkm.mechanisms.hexapod import indices as hi
+from pkm.mechanisms.hexapod import reconfiguration as hr
 from pkm.papers.hexapod import spiral_poses
 
 STEP = math.radians(0.1)

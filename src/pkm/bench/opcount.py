@@ -1,6 +1,6 @@
 """Operation count of the 3-PRS inverse dynamics (symbolic twin) next to the published ones.
 
-The twin is :func:`pkm.mechanisms.prs3_dynamics.twin`: the same algorithm as the numeric routes,
+The twin is :func:`pkm.mechanisms.prs3.dynamics.twin`: the same algorithm as the numeric routes,
 on CasADi SX, after common-subexpression elimination. Counted as SYMORO counts: * / and squares as
 multiplications, + - as additions, negations free, sin/cos/sqrt/atan2 apart. Three modes: geometry
 and inertia symbolic; inertia symbolic (Table 2 geometry); all numeric (Table 2). P- and R-actuated
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from pkm.bench import main
 from pkm.mechanisms.prs3 import Prs3Params
-from pkm.mechanisms.prs3_dynamics import BOUNDARY, MODES, operation_count
+from pkm.mechanisms.prs3.dynamics import BOUNDARY, MODES, operation_count
 from pkm.papers.prs3 import PUBLISHED_COUNTS
 
 QUICK: dict = {}  # the counts take about 2 s: no smaller size

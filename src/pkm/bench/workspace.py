@@ -2,7 +2,7 @@
 
 Two cases, each timed vectorised (best of ``--repeat``) and as a naive Python loop over a
 random sample of its nodes (closed-form IK + per-pose Jacobians + SVD per node, from
-``pkm.mechanisms.rrr3_maps.naive_condition_index``), extrapolated to all nodes; the ratio is
+``pkm.mechanisms.rrr3.workspace.naive_condition_index``), extrapolated to all nodes; the ratio is
 measured in the same run, and the sample's CIs are compared between the two routes:
 
 * ``workspace_ci_3d``: the paper's Fig. 3 count, 101 x 101 positions over ``[0, H]^2`` times 361
@@ -22,7 +22,8 @@ import numpy as np
 
 from pkm.bench import best_time, main
 from pkm.mechanisms import rrr3
-from pkm.mechanisms import rrr3_maps as maps
+from pkm.mechanisms.rrr3 import workspace as maps
+from pkm.papers.rrr3 import paper_grid
 
 QUICK = {"sample": 50, "repeat": 1}
 
@@ -68,7 +69,7 @@ def bench_3d(sample: int, repeat: int, rng: np.random.Generator) -> dict:
 
 def bench_gci(sample: int, repeat: int, rng: np.random.Generator) -> dict:
     d = maps.Design.similarity_law(2.0)
-    grid = maps.paper_grid(d)
+    grid = paper_grid(d)
     settings = maps.CiSettings()
     result = {}
 

@@ -1,6 +1,6 @@
 """The four mechanisms of the papers, one module each.
 
-Every module offers ``NAME``, ``Params`` (frozen dataclass, SI units), ``build(params)``,
+Every package offers ``NAME``, ``Params`` (frozen dataclass, SI units), ``build(params)``,
 ``urdf_xml(params)``, ``closure_spec(params)`` and the closed forms
 ``closed_form_ik``, ``closed_form_configuration`` (and ``closed_form_fk`` where the paper
 has one) over the task vector of :class:`pkm.core.TaskMap`.

@@ -39,8 +39,8 @@ from pathlib import Path
 
 import numpy as np
 
-from pkm.mechanisms import delta_design as design
 from pkm.mechanisms.delta import DeltaParams
+from pkm.mechanisms.delta import design as design
 from pkm.papers import Row
 from pkm.papers._plot import figure, save
 

@@ -2,8 +2,8 @@
 
 Model: :mod:`pkm.mechanisms.hexapod` with its defaults (Table 1, sector layout, ``elbow_out``);
 indices ``w_rot``, ``w_tras`` of eqs. (35)-(37) with the twist referred to O
-(:mod:`pkm.mechanisms.hexapod_indices`); ``beta*`` and the profiles by proxqp sequential QPs
-(:mod:`pkm.mechanisms.hexapod_reconfigure`); the base model is ``beta = 0`` at every pose.
+(:mod:`pkm.mechanisms.hexapod.indices`); ``beta*`` and the profiles by proxqp sequential QPs
+(:mod:`pkm.mechanisms.hexapod.reconfiguration`); the base model is ``beta = 0`` at every pose.
 
 * Pose T (Figs. 7-8): the printed matrix (rotation rounded to 4 digits, projected on SO(3)),
   ``P = (0, -350, 0) mm``; reachable interval within ``[-90, 90] deg``; ``beta*`` of each index.
@@ -20,9 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
+from pkm.core.task import as_rotation
 from pkm.mechanisms import hexapod as hx
-from pkm.mechanisms import hexapod_indices as hi
-from pkm.mechanisms import hexapod_reconfigure as hr
+from pkm.mechanisms.hexapod import indices as hi
+from pkm.mechanisms.hexapod import reconfiguration as hr
 from pkm.papers import Row
 from pkm.papers._plot import figure, save
 
@@ -37,7 +38,7 @@ RATE_LIMIT = math.radians(2.0)
 
 def spiral_poses(n: int = 101) -> list[tuple[np.ndarray, np.ndarray]]:
     """The poses ``T(s)``, ``s = 0 .. 1`` in ``n`` steps: rotation as printed (projected), position [m]."""
-    R = hx.as_rotation(SPIRAL_ROTATION)
+    R = as_rotation(SPIRAL_ROTATION)
     return [(R, np.array([0.025 * math.cos(2 * math.pi * s), -0.250 - 0.100 * s, 0.025 * math.sin(2 * math.pi * s)]))
             for s in np.linspace(0.0, 1.0, n)]
 

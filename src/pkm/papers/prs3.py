@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from pkm.mechanisms.prs3 import Prs3Params
-from pkm.mechanisms.prs3_dynamics import BOUNDARY, G, Prs3Dynamics, operation_count
+from pkm.mechanisms.prs3.dynamics import BOUNDARY, G, Prs3Dynamics, operation_count
 from pkm.motion import load_motions
 from pkm.papers import Row
 from pkm.papers._plot import figure, save
@@ -42,7 +42,7 @@ def simulate(case: str):
 
 @functools.cache
 def counts():
-    """Our operation counts, per mode (see :func:`pkm.mechanisms.prs3_dynamics.operation_count`)."""
+    """Our operation counts, per mode (see :func:`pkm.mechanisms.prs3.dynamics.operation_count`)."""
     return {mode: operation_count(Prs3Params(), mode=mode) for mode in ("symbolic", "inertial", "numeric")}
 
 

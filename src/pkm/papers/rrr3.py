@@ -1,7 +1,7 @@
 """Planar 3-RRR: singularity analysis and global condition index (IEEE Latin America Trans. 13(2), 2015).
 
 The reading under which the paper's GCIs reproduce (every choice also an argument of
-:mod:`pkm.mechanisms.rrr3_maps`):
+:mod:`pkm.mechanisms.rrr3.workspace`):
 
 * CI (eqs. 22-23) of ``J = J_x^-1 J_q`` in the spectral norm, ``J_x`` homogenised as eq. (25)
   read consistently: the *moment* column divided by ``L = h / sqrt 3`` (the platform
@@ -37,9 +37,10 @@ from pathlib import Path
 
 import numpy as np
 
+from pkm.errors import InvalidInputError
 from pkm.mechanisms import rrr3
-from pkm.mechanisms import rrr3_maps as maps
-from pkm.mechanisms.rrr3_maps import CiSettings, Design
+from pkm.mechanisms.rrr3 import workspace as maps
+from pkm.mechanisms.rrr3.workspace import CiSettings, Design
 from pkm.papers import Row
 from pkm.papers._plot import figure, save
 
@@ -61,6 +62,29 @@ CAPTIONS = {  # a, b, h, H in cm, as printed
 }
 TOLERANCE = 5e-5  # half a unit of the 4th printed decimal
 SUITABLE_MODES = "1,8"  # sec. VIII, Fig. 8
+
+
+PAPER_MAP_HALF_WIDTH = 0.80  # m: the maps' axes run over +-80 cm about the base centroid
+PAPER_MAP_STEP = 0.002  # m
+
+
+def paper_grid(design) -> maps.Grid:
+    """The map grid of this study's reading: ``+-80 cm`` about the base centroid, 2 mm steps (801 x 801 nodes)."""
+    return maps.Grid.square(Design.of(design).base_centroid, PAPER_MAP_HALF_WIDTH, PAPER_MAP_STEP)
+
+
+def paper_sweep_designs(H: float = 1.0, n: int = 10) -> tuple[Design, ...]:
+    """``n^3`` designs (1,000 by default) with base side ``H`` [m]: ``a, b`` in ``[0.2, 0.65] H``, ``h`` in ``[0.05, 0.5] H``.
+
+    The paper sweeps 1,000 designs without printing the ranges; these cover its figures' ratios
+    (``a/H`` 0.4-0.6, ``h/H`` 0.1-0.57).
+    """
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise InvalidInputError("n", f"must be an integer >= 1, got {n!r}", n)
+    ratios_ab = np.linspace(0.2, 0.65, n)
+    ratios_h = np.linspace(0.05, 0.5, n)
+    return tuple(Design(float(a * H), float(b * H), float(h * H), float(H))
+                 for a in ratios_ab for b in ratios_ab for h in ratios_h)
 
 
 def _design_cm(a: float, b: float, h: float, H: float) -> Design:
@@ -95,7 +119,7 @@ def fig7_search(step: float = 0.005) -> tuple[tuple[Design, float, float, float]
     p_all, p_area = PUBLISHED["fig7"]
     rows = []
     for d in fig7_candidates():
-        m = maps.ci_map(d, maps.Grid.square(d.base_centroid, maps.PAPER_MAP_HALF_WIDTH, step))
+        m = maps.ci_map(d, maps.Grid.square(d.base_centroid, PAPER_MAP_HALF_WIDTH, step))
         g, ga = m.gci(), m.area_gci()
         if g.empty or ga.empty:
             rows.append((d, math.nan, math.nan, math.inf))
@@ -118,7 +142,7 @@ def figure_design(name: str) -> Design:
 @functools.cache
 def figure_map(name: str, mode: int = 1) -> maps.CiMap:
     """The CI map of a figure (``"fig5"``, ``"fig6"``, ``"fig7"``, ``"fig9"``) on the paper grid."""
-    return maps.ci_map(figure_design(name), None, CiSettings(mode=mode))
+    return maps.ci_map(figure_design(name), paper_grid(figure_design(name)), CiSettings(mode=mode))
 
 
 @functools.cache
@@ -131,7 +155,7 @@ def mode_study() -> tuple[tuple[int, float, float, int], ...]:
         workspace). A mode is *suitable* when it has none.
     """
     d = figure_design("fig9")
-    grid = maps.paper_grid(d)
+    grid = paper_grid(d)
     out = []
     for mode in range(1, 9):
         st = CiSettings(mode=mode)
@@ -150,7 +174,7 @@ def grid_sensitivity(name: str, steps=(0.01, 0.005, 0.004, 0.0025, 0.002, 0.001)
     d = figure_design(name)
     out = []
     for s in steps:
-        m = maps.ci_map(d, maps.Grid.square(d.base_centroid, maps.PAPER_MAP_HALF_WIDTH, s))
+        m = maps.ci_map(d, maps.Grid.square(d.base_centroid, PAPER_MAP_HALF_WIDTH, s))
         out.append((s, m.gci().value, m.area_gci().value))
     return out
 
@@ -292,14 +316,14 @@ def _similarity() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         d = Design.similarity_law(float(H))
         scaled = maps.Grid.square(d.base_centroid, 0.8 * H / 2.0, 0.004 * H / 2.0)
         overall.append(maps.ci_map(d, scaled).gci().value)
-        area.append(maps.ci_map(d, maps.paper_grid(d)).area_gci().value)
+        area.append(maps.ci_map(d, paper_grid(d)).area_gci().value)
     return Hs, np.array(overall), np.array(area)
 
 
 @functools.cache
 def design_sweep(step: float = 0.01) -> maps.SweepResult:
-    """The 1,000-design sweep of sec. VII (:func:`pkm.mechanisms.rrr3_maps.paper_sweep_designs`), with a progress bar."""
-    return maps.sweep(maps.paper_sweep_designs(), step=step)
+    """The 1,000-design sweep of sec. VII (:func:`paper_sweep_designs`), with a progress bar."""
+    return maps.sweep(paper_sweep_designs(), step=step)
 
 
 def series(out_dir) -> list[Path]:

@@ -65,7 +65,7 @@ from pkm.core.differential import inverse_accelerations, inverse_velocities
 from pkm.core.dynamics import KhalilProjection
 from pkm.core.mechanism import as_array, as_count
 from pkm.errors import InvalidInputError, NonFiniteError, SingularityError, UnreachableError
-from pkm.mechanisms.prs3 import BRANCHES, PHI, Prs3Params, _branches, _task_vector, build, configuration
+from pkm.mechanisms.prs3 import BRANCHES, PHI, Prs3Params, as_task, branch_names, build, configuration
 
 G = 9.81
 INERTIAL = ("m1", "m2", "MSa", "MSp", "ZZ2", "mp", "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")
@@ -389,7 +389,7 @@ def twin(params: Prs3Params | None = None, *, mode: str = "numeric", outputs: st
         syms.append(P[k])
     y, yd, ydd = ca.SX.sym("y", 3), ca.SX.sym("yd", 3), ca.SX.sym("ydd", 3)
     w = ca.SX.sym("wrench", 6) if wrench else None
-    signs = [BRANCHES[b] for b in _branches(branch)]
+    signs = [BRANCHES[b] for b in branch_names(branch)]
     out = algorithm([y[i] for i in range(3)], [yd[i] for i in range(3)], [ydd[i] for i in range(3)],
                     None if w is None else [w[i] for i in range(6)], P, ops, actuation=params.actuation, signs=signs)
     res = [ca.vertcat(*out["tau"])]
@@ -475,7 +475,7 @@ class Prs3Dynamics:
 
     def __init__(self, params: Prs3Params | None = None, branch=None):
         self.params = Prs3Params() if params is None else params
-        self.branch = _branches(branch)
+        self.branch = branch_names(branch)
         self.signs = tuple(BRANCHES[b] for b in self.branch)
         self.P = numeric_parameters(self.params)
 
@@ -633,7 +633,7 @@ class Prs3Dynamics:
     # -------------------------------------------------------------- checks
     @staticmethod
     def _sample(y, yd, ydd, wrench):
-        y = _task_vector(y, "y")
+        y = as_task(y, "y")
         yd, ydd = (_samples(as_array(a, n, "3 rates").reshape(1, -1), 3, n)[0] for a, n in ((yd, "yd"),
                                                                                            (ydd, "ydd")))
         w = np.zeros(6) if wrench is None else _samples(as_array(wrench, "wrench", "a wrench (6,)").reshape(1, -1), 6,

@@ -12,7 +12,7 @@ import pytest
 from pkm.core.indices import KINDS
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms import delta as D
-from pkm.mechanisms import delta_design as G
+from pkm.mechanisms.delta import design as G
 
 P = D.DeltaParams()
 POSE = np.array([0.0, 0.0, -0.375])

@@ -12,7 +12,7 @@ import pytest
 from pkm.core.indices import KINDS, condition_number
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms import delta as D
-from pkm.mechanisms.delta_workspace import condition_numbers, inverse_kinematics_batch, workspace
+from pkm.mechanisms.delta.workspace import condition_numbers, inverse_kinematics_batch, workspace
 
 P = D.DeltaParams()
 

@@ -12,7 +12,7 @@ import pkm
 from pkm.core import indices as core_indices
 from pkm.errors import InvalidInputError
 from pkm.mechanisms import hexapod as hx
-from pkm.mechanisms import hexapod_indices as hi
+from pkm.mechanisms.hexapod import indices as hi
 
 DEG = math.pi / 180.0
 

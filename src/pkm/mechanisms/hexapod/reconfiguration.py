@@ -11,17 +11,17 @@ Here:
   ``[|LA - s|, LA + s]``, ``s = sqrt(LB^2 - c_u^2)`` (``c_u`` the offset of ``C_i`` from the leg
   plane, which ``beta`` does not change); and ``rho^2 = a - b cos(beta - phi)`` as ``A_i`` turns
   on its circle about ``F_i``, so each bound is an arc of ``beta``.
-* :func:`optimal_beta`: ``beta*`` of one pose, by :func:`pkm.core.reconfigure.maximise`
+* :func:`optimal_beta`: ``beta*`` of one pose, by :func:`pkm.core.redundant_parameter.maximise`
   (a grid start then a trust-region SQP on proxqp QPs) on the reachable interval that holds the
   best grid node.
 * :func:`beta_profile`: the whole profile along a path, by
-  :func:`pkm.core.reconfigure.optimise_profile`: maximise ``sum_k f_k(beta_k) / s - (mu/2)
+  :func:`pkm.core.redundant_parameter.optimise_profile`: maximise ``sum_k f_k(beta_k) / s - (mu/2)
   sum_k (beta_{k+1} - beta_k)^2`` with ``|beta_{k+1} - beta_k| <= delta`` and each ``beta_k`` in
   its reachable interval. The *base model* is the robot without reconfiguration: ``beta = 0`` at
   every pose (Fig. 1 of the paper; the gain is ``f(beta_k) / f(0) - 1``).
 
 Both use the closed-form inverse kinematics and the screw Jacobians, vectorised
-(:class:`pkm.mechanisms.hexapod_indices.PoseIndex`), not the generic core (the tests check the
+(:class:`pkm.mechanisms.hexapod.indices.PoseIndex`), not the generic core (the tests check the
 two agree). A pose that no ``beta`` within the limits reaches raises
 :class:`~pkm.errors.UnreachableError` saying so.
 """
@@ -33,11 +33,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core import reconfigure
+from pkm.core import redundant_parameter
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms import hexapod as hx
-from pkm.mechanisms import hexapod_indices as hi
-from pkm.mechanisms import hexapod_screws as hs
+from pkm.mechanisms.hexapod import indices as hi
+from pkm.mechanisms.hexapod import screws as hs
 
 #: The paper's range of beta (sec. 4) [rad].
 LIMITS = (-math.pi / 2, math.pi / 2)
@@ -55,7 +55,7 @@ class BetaChoice:
         index: Its name.
         interval: The reachable interval searched ``(lo, hi)`` [rad].
         intervals: Every reachable interval within the limits [rad].
-        optimum: The solver's record (:class:`pkm.core.reconfigure.PointOptimum`).
+        optimum: The solver's record (:class:`pkm.core.redundant_parameter.PointOptimum`).
     """
 
     beta: float
@@ -63,7 +63,7 @@ class BetaChoice:
     index: str
     interval: tuple[float, float]
     intervals: tuple[tuple[float, float], ...]
-    optimum: reconfigure.PointOptimum
+    optimum: redundant_parameter.PointOptimum
 
     @property
     def beta_deg(self) -> float:
@@ -85,7 +85,7 @@ class BetaProfile:
         relative_gain: ``value / base_value - 1`` (``nan`` where the base model cannot reach).
         lower, upper: The reachable interval used at each pose [rad].
         rate_limit: ``delta`` [rad per pose]; smoothness: ``mu`` [1/rad^2].
-        result: The solver's record (:class:`pkm.core.reconfigure.ProfileOptimum`): objective,
+        result: The solver's record (:class:`pkm.core.redundant_parameter.ProfileOptimum`): objective,
             iterations, QP statuses, ...
     """
 
@@ -101,7 +101,7 @@ class BetaProfile:
     upper: np.ndarray
     rate_limit: float
     smoothness: float
-    result: reconfigure.ProfileOptimum
+    result: redundant_parameter.ProfileOptimum
 
     def mean_gain(self, start: int = 0) -> float:
         """Mean of ``relative_gain`` over the poses ``k >= start`` the base model reaches."""
@@ -240,7 +240,7 @@ def _best_interval(f: hi.PoseIndex, k: int, spans, limits, tol: float):
     best, choice = None, None
     for span in spans:
         lo, up = _inner(span, limits)
-        opt = reconfigure.maximise(lambda kk, x: f(np.full_like(kk, k), x), [lo], [up], tol=tol)
+        opt = redundant_parameter.maximise(lambda kk, x: f(np.full_like(kk, k), x), [lo], [up], tol=tol)
         if best is None or opt.value[0] > best.value[0]:
             best, choice = opt, span
     return choice, best
@@ -274,8 +274,8 @@ def beta_profile(params: hx.HexapodParams, poses, index: str = "w_rot", *, rate_
         spans = _intervals(f, k, lims, f"pose {k}: ")
         chosen.append(spans[0] if len(spans) == 1 else _best_interval(f, k, spans, lims, tol)[0])
     lower, upper = np.array([_inner(s, lims) for s in chosen]).T
-    pw = reconfigure.maximise(f, lower, upper, tol=tol)
-    res = reconfigure.optimise_profile(f, lower, upper, rate_limit=rate_limit, smoothness=smoothness,
+    pw = redundant_parameter.maximise(f, lower, upper, tol=tol)
+    res = redundant_parameter.optimise_profile(f, lower, upper, rate_limit=rate_limit, smoothness=smoothness,
                                        baseline=0.0, tol=tol, pointwise=pw)
     return BetaProfile(res.x, res.value, index, pw.x, pw.value, res.start, res.baseline_value, res.relative_gain,
                        lower, upper, float(rate_limit), float(smoothness), res)

@@ -1,104 +1,25 @@
-"""Delta robot (Hernández Reyna & Sandoval-Castro, 2018): tree, closures and closed forms.
-
-Geometry (paper eqs. 1-8, SI units): the base frame 0 is at the centre of the
-base, Z up. Arm ``i`` (``i = 1, 2, 3``) lies in the plane obtained by rotating the
-Y-Z plane by ``phi_i = 0, 120, 240 deg`` about Z; its motor sits at ``A_i = Rz(phi_i)
-(0, R, 0)`` and its axis is ``Rz(phi_i) X``: the arm swings in the (rotated) Y-Z plane
-as eqs. (1)-(2) say, ``B_i = Rz(phi_i) (0, R + La cos th_i, La sin th_i)``. (The text
-says the motor axis is aligned with Y; the equations, which we follow, make it X.)
-The forearm of length ``Lb`` joins ``B_i`` to the platform point ``E + Rz(phi_i)(0, r, 0)``.
-
-How the parallelograms are modelled: each parallelogram is represented by its
-centre line, a rod of length ``Lb`` hung from the elbow by a universal joint
-(``knee_i`` about the motor-axis direction, then ``knee_i_b`` across it) and tied to
-the platform by a point closure (the ball joints). What the three parallelograms do
-together, keeping the platform's orientation fixed, is represented by a massless
-translational guide of the platform (prismatic joints ``platform_x``, ``platform_y``,
-``platform_z`` from the base). The positions, velocities and accelerations of the
-platform and of the forearm centre lines are exact; the guide carries the moments
-that the parallelogram pairs would carry, which do no work and produce no actuator
-torque (each couple acts along the motor axis direction).
-
-Working modes: ``knee_i`` is the angle from the arm to the forearm's projection on the
-arm's plane; it is 0 or pi when the inverse problem has a double root. ``knee_out`` (the
-usual Delta, default) has ``knee_i < 0``; ``knee_in`` has ``knee_i > 0``.
-
-Velocities: ``J = dX/dth`` (eq. 12) in closed form from the sphere equations
-(:func:`jacobian`, :func:`jacobian_factors`). Grids of poses: :mod:`pkm.mechanisms.delta_workspace`;
-the choice of R: :mod:`pkm.mechanisms.delta_design`.
-
-Masses are not given by the paper; the defaults are illustrative (a light robot
-of this size) and only matter for dynamics.
-"""
+"""Closed-form kinematics of the Delta: inverse and forward position, velocities, the task vector."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from pkm.core.mechanism import Mechanism, as_vector, check_mechanism, finite_result
-from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
-from pkm.core.urdf import UrdfBuilder
-from pkm.errors import AssemblyError, InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
+from pkm.errors import AssemblyError, InvalidInputError, SingularityError
 from pkm.mechanisms._common import (
     arm_angle,
-    check_numbers,
     check_params,
-    check_positive,
-    make_mechanism,
-    rod_inertia,
     rot_z,
-    spec_parameters,
 )
-
-NAME = "delta"
-PHI = (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0)
-BRANCHES = {"knee_out": -1, "knee_in": 1}
-
-
-@dataclass(frozen=True)
-class DeltaParams:
-    """Delta design (paper Table 1 by default).
-
-    Attributes:
-        La: Arm length [m] (110 mm).
-        Lb: Forearm (parallelogram) length [m] (330 mm).
-        r: Platform radius, centre to ball-joint line [m] (50 mm).
-        R: Base radius, centre to motor axis [m] (150 mm for the paper's Fig. 4; studied 100-200 mm,
-            120 mm chosen for construction).
-        home: Reference platform position [m] (the study point (0, 0, -375) mm).
-        m_arm: Arm mass [kg] (illustrative; not in the paper).
-        m_forearm: Mass of one parallelogram (both rods) [kg] (illustrative).
-        m_platform: Platform mass [kg] (illustrative).
-    """
-
-    La: float = 0.110
-    Lb: float = 0.330
-    r: float = 0.050
-    R: float = 0.150
-    home: tuple[float, float, float] = (0.0, 0.0, -0.375)
-    m_arm: float = 0.10
-    m_forearm: float = 0.05
-    m_platform: float = 0.20
-
-    def __post_init__(self):
-        check_positive(self, "La", "Lb", "r", "R", "m_arm", "m_forearm", "m_platform")
-        check_numbers(self, "home", 3, "(a point x, y, z in m)")
-        # the reference pose must be reachable in the default working mode, away from singularity
-        try:
-            th = inverse_kinematics(self, self.home)
-        except UnreachableError as exc:
-            raise InvalidParameterError(
-                "home", f"reference pose {self.home} is unreachable with this design (leg {exc.leg} misses by "
-                        f"{exc.excess:.4g} m); choose another home or other lengths", self.home) from None
-        del th
+from pkm.mechanisms.delta.params import BRANCHES, PHI, DeltaParams
 
 
 # ---------------------------------------------------------------------- closed forms
 def _arm_frame_point(p: np.ndarray, i: int) -> np.ndarray:
     return rot_z(-PHI[i]) @ p
+
 
 
 def inverse_kinematics(params: DeltaParams, p, branch: str | tuple[str, str, str] = "knee_out") -> np.ndarray:
@@ -124,6 +45,7 @@ def inverse_kinematics(params: DeltaParams, p, branch: str | tuple[str, str, str
     return arm_angles(params.La, params.Lb, params.R - params.r, p, tuple(-BRANCHES[b] for b in branches))
 
 
+
 def arm_angles(La: float, Lb: float, offset: float, p: np.ndarray, signs: tuple[int, int, int],
                where: str = "") -> np.ndarray:
     """The motor angles [rad] of :func:`inverse_kinematics` from raw dimensions [m]:
@@ -137,12 +59,14 @@ def arm_angles(La: float, Lb: float, offset: float, p: np.ndarray, signs: tuple[
     return th
 
 
+
 def sphere_centres(params: DeltaParams, theta) -> np.ndarray:
     """Centres ``B'_i`` of the three spheres of radius Lb (eqs. 3-7), rows i = 1..3 [m]."""
     params = check_params(params, DeltaParams)
     theta = as_vector(theta, 3, "theta")
     return np.array([rot_z(PHI[i]) @ np.array([0.0, params.R + params.La * math.cos(theta[i]) - params.r,
                                                 params.La * math.sin(theta[i])]) for i in range(3)])
+
 
 
 def forward_kinematics(params: DeltaParams, theta, *, both: bool = False) -> np.ndarray:
@@ -181,6 +105,7 @@ def forward_kinematics(params: DeltaParams, theta, *, both: bool = False) -> np.
     return sols if both else sols[0]
 
 
+
 def jacobian_factors(params: DeltaParams, p, theta) -> tuple[np.ndarray, np.ndarray]:
     """The two factors of the velocity equations ``A Xd = diag(d) thd``, over stacks of poses.
 
@@ -213,6 +138,7 @@ def jacobian_factors(params: DeltaParams, p, theta) -> tuple[np.ndarray, np.ndar
     return A, d
 
 
+
 def jacobian(params: DeltaParams, theta, p=None) -> np.ndarray:
     """``J = dX/dth`` [m/rad] (eq. 12), in closed form from the sphere equations: ``J = A^-1 diag(d)``.
 
@@ -243,6 +169,7 @@ def jacobian(params: DeltaParams, theta, p=None) -> np.ndarray:
     return np.linalg.solve(A, np.diag(d))
 
 
+
 def joint_values(params: DeltaParams, p, branch: str | tuple[str, str, str] = "knee_out") -> dict[str, list[float]]:
     """Every joint coordinate of the tree (closed form), for platform centre ``p``."""
     params = check_params(params, DeltaParams)
@@ -264,10 +191,12 @@ def joint_values(params: DeltaParams, p, branch: str | tuple[str, str, str] = "k
     return out
 
 
+
 def configuration(mech: Mechanism, p, branch: str | tuple[str, str, str] = "knee_out") -> np.ndarray:
     """Full configuration vector ``q`` of ``mech`` for platform centre ``p`` (closed form)."""
     mech = check_mechanism(mech)
     return mech.q_from_dict(joint_values(mech.params, p, branch))
+
 
 
 # ---------------------------------------------------------------------- uniform interface
@@ -278,9 +207,11 @@ def closed_form_ik(params: DeltaParams, y, branch: str | None = None) -> np.ndar
     return inverse_kinematics(params, y, branch or "knee_out")
 
 
+
 def closed_form_configuration(mech: Mechanism, y, branch: str | None = None) -> np.ndarray:
     """Every joint coordinate for task vector ``y`` (closed form)."""
     return configuration(mech, y, branch or "knee_out")
+
 
 
 def closed_form_fk(params: DeltaParams, q_actuated, seed=None) -> np.ndarray:
@@ -288,67 +219,5 @@ def closed_form_fk(params: DeltaParams, q_actuated, seed=None) -> np.ndarray:
     return forward_kinematics(params, q_actuated)
 
 
-# ---------------------------------------------------------------------- tree and spec
-def urdf_xml(params: DeltaParams) -> str:
-    """The URDF tree (see the module doc for the modelling of the parallelograms)."""
-    params = check_params(params, DeltaParams)
-    b = UrdfBuilder(NAME)
-    b.link("base")
-    reach = 2.0 * (params.R + params.La + params.Lb)
-    for i in range(3):
-        n = i + 1
-        Rz = rot_z(PHI[i])
-        b.link(f"arm_{n}", params.m_arm, (0.0, params.La / 2, 0.0), rod_inertia(params.m_arm, params.La, 1))
-        b.joint(f"motor_{n}", "revolute", "base", f"arm_{n}", Rz @ np.array([0.0, params.R, 0.0]), Rz,
-                axis=(1.0, 0.0, 0.0))
-        b.link(f"knee_cross_{n}")
-        b.joint(f"knee_{n}", "revolute", f"arm_{n}", f"knee_cross_{n}", (0.0, params.La, 0.0), axis=(1.0, 0.0, 0.0))
-        b.link(f"forearm_{n}", params.m_forearm, (0.0, params.Lb / 2, 0.0),
-               rod_inertia(params.m_forearm, params.Lb, 1))
-        b.joint(f"knee_{n}_b", "revolute", f"knee_cross_{n}", f"forearm_{n}", axis=(0.0, 0.0, 1.0))
-        b.frame(f"forearm_{n}_tip", f"forearm_{n}", (0.0, params.Lb, 0.0))
-    b.link("guide_x")
-    b.link("guide_y")
-    mp, r = params.m_platform, params.r
-    b.link("platform", mp, inertia=np.diag([mp * r * r / 4, mp * r * r / 4, mp * r * r / 2]))
-    b.joint("platform_x", "prismatic", "base", "guide_x", axis=(1.0, 0.0, 0.0), limits=(-reach, reach))
-    b.joint("platform_y", "prismatic", "guide_x", "guide_y", axis=(0.0, 1.0, 0.0), limits=(-reach, reach))
-    b.joint("platform_z", "prismatic", "guide_y", "platform", axis=(0.0, 0.0, 1.0), limits=(-reach, reach))
-    for i in range(3):
-        b.frame(f"platform_ball_{i + 1}", "platform", rot_z(PHI[i]) @ np.array([0.0, params.r, 0.0]))
-    return b.to_xml()
-
-
-def closure_spec(params: DeltaParams) -> ClosureSpec:
-    params = check_params(params, DeltaParams)
-    reference = {k: tuple(v) for k, v in joint_values(params, params.home).items()}
-    return ClosureSpec(
-        mechanism=NAME,
-        description="Delta robot (Hernandez Reyna & Sandoval-Castro 2018); parallelograms as centre lines, "
-                    "platform orientation kept by a massless translational guide",
-        urdf=f"{NAME}.urdf",
-        end_effector="platform",
-        actuated=("motor_1", "motor_2", "motor_3"),
-        closures=tuple(Closure(f"ball_{n}", "point", f"forearm_{n}_tip", f"platform_ball_{n}") for n in (1, 2, 3)),
-        task=TaskSpec(("x", "y", "z")),
-        reference=reference,
-        branches={name: Branch(name, {f"knee_{n}": s for n in (1, 2, 3)},
-                               f"all elbows {'outward' if name == 'knee_out' else 'inward'} (knee_i "
-                               f"{'<' if s < 0 else '>'} 0)") for name, s in BRANCHES.items()},
-        default_branch="knee_out",
-        parameters=spec_parameters(params),
-    )
-
 
 Params = DeltaParams
-
-
-def build(params: DeltaParams | None = None) -> Mechanism:
-    """The Delta as a :class:`~pkm.core.Mechanism` (paper design when ``params`` is None)."""
-    params = DeltaParams() if params is None else params
-    return make_mechanism(urdf_xml(params), closure_spec(params), params)
-
-
-__all__ = ["BRANCHES", "NAME", "PHI", "DeltaParams", "Params", "arm_angles", "build", "closed_form_configuration",
-           "closed_form_fk", "closed_form_ik", "closure_spec", "configuration", "forward_kinematics",
-           "inverse_kinematics", "jacobian", "jacobian_factors", "joint_values", "sphere_centres", "urdf_xml"]

@@ -16,8 +16,8 @@ import pytest
 import pkm
 from pkm.core import screws
 from pkm.mechanisms import hexapod as hx
-from pkm.mechanisms import hexapod_screws as hs
-from pkm.mechanisms import hexapod_singularities as hsg
+from pkm.mechanisms.hexapod import screws as hs
+from pkm.mechanisms.hexapod import singularities as hsg
 from pkm.mechanisms._common import rot_y
 
 DEG = math.pi / 180.0

@@ -199,14 +199,7 @@ class Grid:
         return iny[:, None] & inx[None, :]
 
 
-PAPER_MAP_HALF_WIDTH = 0.80  # m: the maps' axes run over +-80 cm about the base centroid
-PAPER_MAP_STEP = 0.002  # m
-AREA_SIDE = 0.30  # m: the paper's 30 cm x 30 cm area of interest
-
-
-def paper_grid(design) -> Grid:
-    """The map grid of this study's reading: ``+-80 cm`` about the base centroid, 2 mm steps (801 x 801 nodes)."""
-    return Grid.square(Design.of(design).base_centroid, PAPER_MAP_HALF_WIDTH, PAPER_MAP_STEP)
+AREA_SIDE = 0.30  # m: default side of the square area of interest of area_gci (the GCI paper's 30 cm x 30 cm)
 
 
 # ---------------------------------------------------------------------- vectorised closed forms
@@ -229,7 +222,7 @@ def _legs(d: Design, gx: np.ndarray, gy: np.ndarray, phi, signs):
         tx, ty = vx - base[i, 0], vy - base[i, 1]
         d2 = tx * tx + ty * ty
         dist = np.sqrt(d2)
-        reach &= (dist <= hi * (1.0 + rrr3._REACH_TOL)) & (dist >= lo - hi * rrr3._REACH_TOL) & (dist > 0.0)
+        reach &= (dist <= hi * (1.0 + rrr3.REACH_TOL)) & (dist >= lo - hi * rrr3.REACH_TOL) & (dist > 0.0)
         safe = np.where(dist > 0.0, dist, 1.0)
         ex, ey = tx / safe, ty / safe
         along = (d.a * d.a - d.b * d.b + d2) / (2.0 * safe)  # elbow's projection on base vertex -> platform vertex
@@ -425,9 +418,9 @@ class CiMap:
 
 
 def ci_map(design, grid: Grid | None = None, settings: CiSettings = CiSettings()) -> CiMap:
-    """The CI map of ``design`` over ``grid`` (default :func:`paper_grid`)."""
+    """The CI map of ``design`` over ``grid`` (default :func:`workspace_grid`: every reachable centroid)."""
     d = Design.of(design)
-    g = paper_grid(d) if grid is None else _grid(grid)
+    g = workspace_grid(d) if grid is None else _grid(grid)
     ci, reach = condition_index(d, g.xs[None, :], g.ys[:, None], settings)
     return CiMap(d, settings, g, ci, reach)
 
@@ -471,7 +464,7 @@ class Workspace:
 def workspace(design, phi: float = 0.0, grid: Grid | None = None) -> Workspace:
     """Reachable centroid positions at orientation ``phi`` [rad] (eq. 9 real on every leg), Fig. 3."""
     d = Design.of(design)
-    phi = float(rrr3._scalar(phi, "phi"))
+    phi = as_scalar(phi, "phi", unit="rad")
     g = workspace_grid(d) if grid is None else _grid(grid)
     reach, _ = _legs(d, g.xs[None, :], g.ys[:, None], phi, (1, 1, 1))
     return Workspace(d, phi, g, reach)
@@ -580,20 +573,6 @@ class SweepResult:
         return int(np.flatnonzero(ok)[np.argmax(self.area_gci.data[ok])]) if ok.any() else None
 
 
-def paper_sweep_designs(H: float = 1.0, n: int = 10) -> tuple[Design, ...]:
-    """``n^3`` designs (1,000 by default) with base side ``H`` [m]: ``a, b`` in ``[0.2, 0.65] H``, ``h`` in ``[0.05, 0.5] H``.
-
-    The paper sweeps 1,000 designs without printing the ranges; these cover its figures' ratios
-    (``a/H`` 0.4-0.6, ``h/H`` 0.1-0.57).
-    """
-    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-        raise InvalidInputError("n", f"must be an integer >= 1, got {n!r}", n)
-    ratios_ab = np.linspace(0.2, 0.65, n)
-    ratios_h = np.linspace(0.05, 0.5, n)
-    return tuple(Design(float(a * H), float(b * H), float(h * H), float(H))
-                 for a in ratios_ab for b in ratios_ab for h in ratios_h)
-
-
 def sweep(designs: Iterable, *, step: float = 0.01, side: float = AREA_SIDE, settings: CiSettings = CiSettings(),
           progress: bool = True) -> SweepResult:
     """Overall and area GCI of every design (a :func:`workspace_grid` box at ``step`` [m]), with a tqdm bar."""
@@ -666,8 +645,6 @@ class _LooseParams(rrr3.Rrr3Params):
 __all__ = [
     "AREA_SIDE",
     "NORMS",
-    "PAPER_MAP_HALF_WIDTH",
-    "PAPER_MAP_STEP",
     "CiMap",
     "CiSettings",
     "Design",
@@ -683,8 +660,6 @@ __all__ = [
     "inverse_jacobian_stack",
     "naive_condition_index",
     "orientation_sweep",
-    "paper_grid",
-    "paper_sweep_designs",
     "sweep",
     "workspace",
     "workspace_grid",

@@ -12,13 +12,13 @@ import math
 import numpy as np
 import pytest
 
-from pkm.core import reconfigure
+from pkm.core import redundant_parameter
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms import hexapod as hx
-from pkm.mechanisms import hexapod_indices as hi
-from pkm.mechanisms import hexapod_reconfigure as hr
+from pkm.mechanisms.hexapod import indices as hi
+from pkm.mechanisms.hexapod import reconfiguration as hr
 from pkm.papers.hexapod import spiral_poses
-from tests.mechanisms.test_hexapod import bisect_beta_limit
+from tests.mechanisms.hexapod.test_kinematics import bisect_beta_limit
 
 DEG = math.pi / 180.0
 
@@ -93,7 +93,7 @@ def test_spiral_profile_respects_the_rate_limit_and_reachability_and_beats_the_c
     assert np.abs(np.diff(prof.beta)).max() <= delta + 1e-9
     for (R, P), b in zip(poses, prof.beta):
         hx.inverse_kinematics(params, R, P, b)
-    clipped = reconfigure.clip_to_rate(prof.pointwise, prof.lower, prof.upper, delta)
+    clipped = redundant_parameter.clip_to_rate(prof.pointwise, prof.lower, prof.upper, delta)
     f = hi.PoseIndex(params, poses, "w_rot")
     k = np.arange(len(poses))
 

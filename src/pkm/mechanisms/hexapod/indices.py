@@ -17,8 +17,8 @@ its rotation rows multiplied by a characteristic length (default: the arm length
 ``w LA`` compares with the speed ``alpha_dot LA`` of the elbows).
 
 Batches: :class:`PoseIndex` evaluates an index for many (pose, beta) pairs at once with the
-closed-form inverse kinematics and the screw Jacobians (:mod:`pkm.mechanisms.hexapod_screws`),
-which is what the beta selection (:mod:`pkm.mechanisms.hexapod_reconfigure`) calls; the tests
+closed-form inverse kinematics and the screw Jacobians (:mod:`pkm.mechanisms.hexapod.screws`),
+which is what the beta selection (:mod:`pkm.mechanisms.hexapod.reconfiguration`) calls; the tests
 check it against the generic core.
 """
 
@@ -32,9 +32,11 @@ import numpy as np
 from pkm.core import indices as core_indices
 from pkm.core import screws
 from pkm.core.mechanism import as_scalar, as_vector
+from pkm.core.task import as_rotation
 from pkm.errors import InvalidInputError
 from pkm.mechanisms import hexapod as hx
-from pkm.mechanisms import hexapod_screws as hs
+from pkm.mechanisms._common import check_params
+from pkm.mechanisms.hexapod import screws as hs
 
 #: Index names accepted by :class:`PoseIndex` and the beta selection.
 INDICES = ("w_rot", "w_tras")
@@ -102,11 +104,11 @@ class PoseIndex:
 
     def __init__(self, params: hx.HexapodParams, poses, index: str = "w_rot", branch=hx.DEFAULT_BRANCH,
                  point: str = "O"):
-        hx.check_params(params, hx.HexapodParams)
+        check_params(params, hx.HexapodParams)
         if not isinstance(index, str) or index not in INDICES:
             raise InvalidInputError("index", f"use one of {list(INDICES)}, got {index!r}", index)
         self.params, self.index, self.point = params, index, _point(point)
-        self.signs = np.array([-hx.BRANCHES[b] for b in hx._branches(branch)], dtype=float)
+        self.signs = np.array([-hx.BRANCHES[b] for b in hx.branch_names(branch)], dtype=float)
         Rs, Ps = [], []
         if isinstance(poses, (str, bytes, np.ndarray)) or not isinstance(poses, Iterable):
             raise InvalidInputError("poses", f"expected a sequence of (R, P) pairs, got {type(poses).__name__}", poses)
@@ -115,7 +117,7 @@ class PoseIndex:
                 R, P = pose
             except (TypeError, ValueError):
                 raise InvalidInputError("poses", f"pose {j}: expected a pair (R, P)", pose) from None
-            Rs.append(hx.as_rotation(R, f"poses[{j}].R"))
+            Rs.append(as_rotation(R, f"poses[{j}].R"))
             Ps.append(as_vector(P, 3, f"poses[{j}].P"))
         if not Rs:
             raise InvalidInputError("poses", "needs at least one pose", poses)
@@ -126,7 +128,7 @@ class PoseIndex:
         return len(self.P)
 
     def legs(self, k, beta) -> hs.LegBatch:
-        """The legs of poses ``k`` at ``beta`` (see :func:`pkm.mechanisms.hexapod_screws.leg_batch`)."""
+        """The legs of poses ``k`` at ``beta`` (see :func:`pkm.mechanisms.hexapod.screws.leg_batch`)."""
         return hs.leg_batch(self.params, self.C[np.asarray(k)], beta, self.signs)
 
     def __call__(self, k, beta) -> np.ndarray:

@@ -7,7 +7,7 @@ import pytest
 
 from pkm.errors import InvalidInputError, SingularityError, UnreachableError
 from pkm.mechanisms import prs3
-from pkm.mechanisms import prs3_dynamics as PD
+from pkm.mechanisms.prs3 import dynamics as PD
 from pkm.motion import load_motions
 
 DESIGNS = {

@@ -15,7 +15,7 @@ import pytest
 import pkm
 from pkm.core import screws
 from pkm.mechanisms import hexapod as hx
-from pkm.mechanisms import hexapod_screws as hs
+from pkm.mechanisms.hexapod import screws as hs
 from tests.fd import forward_jacobian_error, rel, richardson
 
 DEG = math.pi / 180.0

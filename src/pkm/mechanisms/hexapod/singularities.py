@@ -1,7 +1,7 @@
 """Singularities of the reconfigurable hexapod (paper sec. 3.3): classification and distance measures.
 
 From the velocity equation ``J_x^T DELTA V = J'_q qd_beta + J_q qd_alpha`` (eq. 22,
-:mod:`pkm.mechanisms.hexapod_screws`):
+:mod:`pkm.mechanisms.hexapod.screws`):
 
 * type 1 (inverse kinematics): ``det J_q = 0``: in some leg the arm ``LA`` and the rod ``LB``
   are fully extended or folded, ``{$1_i; $6_i} = 0``; or ``det J'_q = 0``: in some leg of M1 the
@@ -37,7 +37,8 @@ import numpy as np
 from pkm.core import screws
 from pkm.core.mechanism import as_scalar, finite_result
 from pkm.mechanisms import hexapod as hx
-from pkm.mechanisms import hexapod_screws as hs
+from pkm.mechanisms._common import check_params
+from pkm.mechanisms.hexapod import screws as hs
 
 KINDS = {0: "regular", 1: "inverse", 2: "direct", 3: "combined"}
 
@@ -88,7 +89,7 @@ def classify(params: hx.HexapodParams, R, P, beta: float, branch=hx.DEFAULT_BRAN
     Raises:
         UnreachableError: a leg cannot reach the pose; InvalidInputError: bad input.
     """
-    hx.check_params(params, hx.HexapodParams)
+    check_params(params, hx.HexapodParams)
     tol = as_scalar(tol, "tol", low=0.0, strict_low=True)
     L = params.r if length is None else as_scalar(length, "length", low=0.0, strict_low=True, unit="m")
     J = hs.jacobians(params, R, P, beta, branch)

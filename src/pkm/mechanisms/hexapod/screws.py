@@ -44,6 +44,7 @@ import numpy as np
 
 from pkm.core import screws
 from pkm.core.mechanism import as_vector
+from pkm.core.task import as_rotation
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.mechanisms import hexapod as hx
 
@@ -311,10 +312,10 @@ def acceleration(params: hx.HexapodParams, R, P, beta: float, qd, qdd, branch=hx
 # ---------------------------------------------------------------------- helpers
 def _legs(params, R, P, beta, branch) -> tuple[LegBatch, float]:
     beta = float(as_vector([beta], 1, "beta")[0])
-    R = hx.as_rotation(R)
+    R = as_rotation(R)
     P = as_vector(P, 3, "P")
     hx.inverse_kinematics(params, R, P, beta, branch)  # validates, raises UnreachableError with the leg
-    signs = np.array([-hx.BRANCHES[b] for b in hx._branches(branch)], dtype=float)
+    signs = np.array([-hx.BRANCHES[b] for b in hx.branch_names(branch)], dtype=float)
     return leg_batch(params, hx.platform_points(params, R, P), beta, signs), beta
 
 

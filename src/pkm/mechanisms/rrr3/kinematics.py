@@ -1,90 +1,4 @@
-"""Planar 3-RRR parallel robot (singularities and global condition index): tree, closures, closed forms.
-
-Geometry (paper sec. II.A, SI units). The base triangle ``P, Q, R`` is equilateral
-with side ``H``; the world origin is at ``P``, ``x`` along ``PQ``, ``z`` out of the
-plane: ``P = (0, 0)``, ``Q = (H, 0)``, ``R = (H/2, H sqrt(3)/2)``. The moving
-platform ``A, B, C`` is equilateral with side ``h``; the paper places it by ``A``
-and the orientation ``Phi`` (eqs. 1-2)::
-
-    B = A + h (cos Phi, sin Phi),    C = A + h (cos(Phi + pi/3), sin(Phi + pi/3)).
-
-Leg 1 is ``P -> D1 -> A``, leg 2 ``Q -> D2 -> B``, leg 3 ``R -> D3 -> C``: a proximal
-link ``a`` driven at the base vertex (``theta_i`` measured from ``+x``), then a distal
-link ``b``; ``psi_i`` is the relative angle of the distal link (eq. 4):
-``A = P + a (cos th_1, sin th_1) + b (cos(th_1 + psi_1), sin(th_1 + psi_1))``.
-
-Tree: every joint axis is ``z``. Leg ``i``: ``motor_i`` (actuated, coordinate
-``theta_i``) at its base vertex, link ``a`` along local ``x``, ``elbow_i`` (coordinate
-``psi_i``: 0 = leg fully extended, +-pi = folded, both singular), link ``b`` along
-local ``x``. Leg 1 carries the platform through ``wrist_1`` at ``A`` (coordinate
-``Phi - theta_1 - psi_1``); legs 2 and 3 end at frames ``leg2_tip``, ``leg3_tip``,
-tied by point closures ``wrist_2``, ``wrist_3`` to the platform frames ``platform_B``,
-``platform_C``. The platform body frame has its origin at ``A`` and ``x`` along ``AB``
-(its yaw is ``Phi``); frames ``platform_A`` (at ``A``) and ``platform_center`` (the
-end effector, at the centroid ``G``, same axes) are attached to it.
-
-Task: ``["x", "y", "yaw"]`` of the centroid ``G``, i.e. ``y = (x_G, y_G, Phi)``. The
-paper locates the platform by ``A`` and ``Phi``; ``G = A + (h / sqrt 3)(cos(Phi + pi/6),
-sin(Phi + pi/6))`` and the helpers :func:`centroid_from_a` / :func:`a_from_centroid`
-convert. :func:`inverse_kinematics` takes the paper's ``(A, Phi)``.
-
-Inverse kinematics (eqs. 6-9). In leg ``i``'s base-vertex frame (translated, not
-rotated: ``(x, y)`` = platform vertex minus base vertex) eq. (6) reads
-``e1 sin th + e2 cos th + e3 = 0`` with ``e1 = -2 y a``, ``e2 = -2 x a``,
-``e3 = x^2 + y^2 + a^2 - b^2`` (eqs. 7-8), whose half-angle solution is eq. (9)::
-
-    th = 2 atan((-e1 +/- sqrt(e1^2 + e2^2 - e3^2)) / (e3 - e2)).
-
-Working modes. The two roots of eq. (9) are the two elbow postures of a leg:
-the ``+`` root has ``psi_i < 0``, the ``-`` root ``psi_i > 0``. (With ``d = |(x, y)|``,
-``alpha = atan2(y, x)``, ``delta`` the angle at the base vertex of the triangle
-vertex-elbow-platform vertex, the ``+/-`` root is ``th = alpha +/- delta``.) The eight
-working modes are the sign combinations of ``(psi_1, psi_2, psi_3)``, named
-``"mode1"`` .. ``"mode8"``: mode ``k`` <-> the bits of ``k - 1``, leg 1 the most
-significant; bit 0 -> ``psi_i > 0`` (``-`` root), bit 1 -> ``psi_i < 0`` (``+`` root).
-``mode1`` = ``(+, +, +)`` (all ``-`` roots), ``mode8`` = ``(-, -, -)`` (all ``+`` roots);
-for example ``mode3`` = bits ``010`` = ``(+, -, +)``. Modes 1 and 8 are the two that
-keep the three legs alike, which agrees with the paper's finding (sec. VIII, Fig. 8)
-that only the first and last modes are suitable; the paper does not print the
-sign convention behind its numbering, so this correspondence is ours.
-
-Departures from the paper:
-
-* Eq. (9) is rebuilt (the OCR lost part of it) and evaluated in the equivalent form
-  ``th = atan2(-e1, -e2) +/- atan2(sqrt(e1^2 + e2^2 - e3^2), e3)``, equal to it modulo
-  ``2 pi``. The half-angle form divides by ``e3 - e2``, which vanishes at regular poses
-  (where the other root is ``th = pi``); the atan2 form is defined at every reachable
-  pose except the degenerate ``d = 0`` (only possible when ``a = b``; then ``theta_i`` is
-  undetermined and :class:`~pkm.errors.SingularityError` is raised).
-* The task point is the centroid ``G``, not the paper's ``A`` (see above).
-* Eqs. (6)-(8) are written by the paper for leg 1, whose base vertex is the origin;
-  for legs 2 and 3 they hold in the translated base-vertex frames, with ``theta_i`` still
-  measured from the world ``+x`` axis.
-* Eqs. (19)-(20) are rebuilt in :func:`jacobians` with the moments taken about ``G``
-  (the task point) and without the homogenisation of eq. (25).
-* Eq. (25) as printed divides the *direction* column ``s_ri`` by the characteristic length
-  ``L``, which mixes 1 and 1/m in one row. :func:`homogenized_jacobians` divides the
-  *moment* column ``(a_i x s_ri)`` by ``L`` instead, i.e. it uses the task rates
-  ``(v_P, L Phi_dot)``, all in m/s; both the moment reference point ``P`` (``"centroid"``
-  by default, ``"A"``, ``"origin"`` = the paper's ``O = P``) and ``L`` (default the platform
-  circumradius ``h / sqrt 3``, Lou's "mean radius of the moving platform") are arguments.
-
-Forward kinematics (:func:`forward_kinematics`; the paper gives none). With the motor
-angles known the elbows ``D_i`` are known and the 3-RRR is a 3-RPR with three legs of fixed
-length ``b``: ``|V_i(A, Phi) - D_i| = b``. Subtracting leg 1's equation from legs 2 and 3
-leaves two equations linear in ``A``; substituting ``A(Phi)`` into leg 1's equation gives a
-trigonometric polynomial of degree 4 in ``Phi`` (a degree-8 polynomial in ``z = e^{i Phi}``
-whose roots on the unit circle are the assembly modes; for the 3-RPR at most 6 are real).
-Its coefficients are read exactly off 16 samples by an FFT, its roots found from the
-companion matrix, and every candidate is polished by Newton on the three leg equations and
-kept only if they hold to ``tol``; duplicates (double roots at direct singularities) merge.
-
-The reference design (paper sec. III, workspace study): links ``a = b = 40 cm``,
-platform side ``h = 10 cm``, actuator separation ``H = 100 cm``, ``mode1``, centroid at
-the base centroid with ``Phi = 0``. There every leg has ``|psi_i| = 99 deg`` and the
-platform is far from a direct singularity (see the tests). Masses are not given by
-the paper; the defaults are illustrative and only matter for dynamics.
-"""
+"""Closed-form kinematics of the planar 3-RRR: inverse and forward position, velocities, the task vector."""
 
 from __future__ import annotations
 
@@ -93,108 +7,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.mechanism import (Mechanism, as_scalar, as_tolerance, as_vector, check_mechanism, finite_result,
-                                wrap_angle)
-from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
-from pkm.core.urdf import UrdfBuilder
+from pkm.core.mechanism import Mechanism, as_scalar, as_tolerance, as_vector, check_mechanism, finite_result, wrap_angle
 from pkm.errors import (
     AssemblyError,
     BranchError,
     InvalidInputError,
-    InvalidParameterError,
     SingularityError,
     UnreachableError,
 )
 from pkm.mechanisms._common import (
-    check_numbers,
     check_params,
-    check_positive,
-    make_mechanism,
-    rod_inertia,
-    spec_parameters,
 )
-
-NAME = "rrr3"
-SQRT3 = math.sqrt(3.0)
-MODES: dict[str, tuple[int, int, int]] = {
-    f"mode{k + 1}": tuple(-1 if (k >> (2 - i)) & 1 else 1 for i in range(3)) for k in range(8)
-}
-"""Working mode name -> signs of ``(psi_1, psi_2, psi_3)`` (see the module doc)."""
-
-_REACH_TOL = 1e-12  # relative to a + b: a distance this close to the reach limits counts as on them
-_SINGULAR_TOL = 1e-6  # the reference pose must be at least this far (dimensionless) from singularities
-
-
-@dataclass(frozen=True)
-class Rrr3Params:
-    """Planar 3-RRR design (paper sec. III workspace study by default).
-
-    Attributes:
-        a: Proximal (actuated) link length [m] (40 cm).
-        b: Distal link length [m] (40 cm).
-        h: Platform side ``AB = BC = CA`` [m] (10 cm).
-        H: Base side, the actuator separation ``PQ = QR = RP`` [m] (100 cm).
-        mode: Working mode 1..8 of the reference configuration (see the module doc).
-        home: Reference placement ``(dx, dy, Phi)``: the platform centroid's offset from the
-            base centroid [m] and the orientation [rad]; ``(0, 0, 0)``: centred, ``Phi = 0``.
-        m_proximal: Mass of a proximal link [kg] (illustrative; not in the paper).
-        m_distal: Mass of a distal link [kg] (illustrative).
-        m_platform: Platform mass [kg] (illustrative).
-    """
-
-    a: float = 0.40
-    b: float = 0.40
-    h: float = 0.10
-    H: float = 1.00
-    mode: int = 1
-    home: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    m_proximal: float = 0.20
-    m_distal: float = 0.15
-    m_platform: float = 0.10
-
-    def __post_init__(self):
-        check_positive(self, "a", "b", "h", "H", "m_proximal", "m_distal", "m_platform")
-        if isinstance(self.mode, bool) or not isinstance(self.mode, int) or not 1 <= self.mode <= 8:
-            raise InvalidParameterError("mode", f"must be an integer 1..8 (working mode), got {self.mode!r}",
-                                        self.mode)
-        check_numbers(self, "home", 3, "(dx, dy, Phi) in m, m, rad")
-        try:
-            margin_inv, margin_dir = singularity_measures(self, home_task(self), self.mode)
-        except UnreachableError as exc:
-            raise InvalidParameterError(
-                "home", f"reference pose {tuple(self.home)} is unreachable with this design (leg {exc.leg} misses "
-                        f"by {exc.excess:.4g} m); choose another home or other lengths", self.home) from None
-        except SingularityError:
-            raise InvalidParameterError(
-                "home", f"reference pose {tuple(self.home)} puts a platform vertex on its base vertex (a = b); "
-                        "choose another home", self.home) from None
-        if margin_inv < _SINGULAR_TOL or margin_dir < _SINGULAR_TOL:
-            kind = "inverse (a leg stretched or folded)" if margin_inv < _SINGULAR_TOL else "direct"
-            raise InvalidParameterError(
-                "home", f"reference pose {tuple(self.home)} is {kind}-singular in mode{self.mode}; choose another "
-                        "home or mode", self.home)
-
-
-# ---------------------------------------------------------------------- geometry
-def mode_signs(mode: int | str) -> tuple[int, int, int]:
-    """Signs of ``(psi_1, psi_2, psi_3)`` of a working mode given as ``k`` or ``"modek"`` (k = 1..8)."""
-    key = f"mode{mode}" if isinstance(mode, (int, np.integer)) and not isinstance(mode, bool) else mode
-    if not isinstance(key, str) or key not in MODES:
-        raise InvalidInputError("mode", f"use 1..8 or 'mode1'..'mode8', got {mode!r}", mode)
-    return MODES[key]
-
-
-def base_vertices(params: Rrr3Params) -> np.ndarray:
-    """Base vertices ``P, Q, R`` as rows [m], shape (3, 2)."""
-    params = check_params(params, Rrr3Params)
-    H = params.H
-    return np.array([[0.0, 0.0], [H, 0.0], [H / 2.0, H * SQRT3 / 2.0]])
-
-
-def base_centroid(params: Rrr3Params) -> np.ndarray:
-    """Centroid of the base triangle [m], shape (2,)."""
-    params = check_params(params, Rrr3Params)
-    return np.array([params.H / 2.0, params.H / (2.0 * SQRT3)])
+from pkm.mechanisms.rrr3.params import MODES, REACH_TOL, SQRT3, Rrr3Params, base_vertices, home_task, mode_signs
 
 
 def platform_vertices(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
@@ -207,12 +31,14 @@ def platform_vertices(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
                      A + h * np.array([math.cos(phi + math.pi / 3.0), math.sin(phi + math.pi / 3.0)])])
 
 
+
 def centroid_from_a(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
     """Platform centroid ``G`` [m] from the paper's ``A`` [m] and ``Phi`` [rad]."""
     params = check_params(params, Rrr3Params)
     A = as_vector(a_point, 2, "a_point")
     phi = _scalar(phi, "phi")
     return A + params.h / SQRT3 * np.array([math.cos(phi + math.pi / 6.0), math.sin(phi + math.pi / 6.0)])
+
 
 
 def a_from_centroid(params: Rrr3Params, g_point, phi: float) -> np.ndarray:
@@ -222,11 +48,6 @@ def a_from_centroid(params: Rrr3Params, g_point, phi: float) -> np.ndarray:
     phi = _scalar(phi, "phi")
     return G - params.h / SQRT3 * np.array([math.cos(phi + math.pi / 6.0), math.sin(phi + math.pi / 6.0)])
 
-
-def home_task(params: Rrr3Params) -> np.ndarray:
-    """The reference task vector ``(x_G, y_G, Phi)`` [m, m, rad] of ``params.home``."""
-    params = check_params(params, Rrr3Params)
-    return np.concatenate([base_centroid(params) + np.asarray(params.home[:2], dtype=float), [params.home[2]]])
 
 
 # ---------------------------------------------------------------------- closed forms
@@ -240,12 +61,12 @@ def _solve(params: Rrr3Params, a_point: np.ndarray, phi: float, mode: int | str)
     theta, psi = np.empty(3), np.empty(3)
     for i, (x, y) in enumerate(targets):
         d = math.hypot(x, y)
-        if d > hi * (1.0 + _REACH_TOL) or d < lo - hi * _REACH_TOL:
+        if d > hi * (1.0 + REACH_TOL) or d < lo - hi * REACH_TOL:
             excess = d - hi if d > hi else lo - d
             raise UnreachableError(i + 1, excess, "m", f"leg {i + 1}: distance {d:.6g} m from its base vertex to "
                                                         f"its platform vertex is outside [|a-b|, a+b] = "
                                                         f"[{lo:.6g}, {hi:.6g}] m")
-        if d <= hi * _REACH_TOL:
+        if d <= hi * REACH_TOL:
             raise SingularityError("inverse", 0.0, f"leg {i + 1}: platform vertex on the base vertex (a = b), "
                                                    "the motor angle is undetermined")
         e1, e2, e3 = -2.0 * y * a, -2.0 * x * a, d * d + a * a - b * b
@@ -254,6 +75,7 @@ def _solve(params: Rrr3Params, a_point: np.ndarray, phi: float, mode: int | str)
         theta[i] = math.atan2(-e1, -e2) - sigma * math.atan2(s, e3)
         psi[i] = sigma * math.atan2(s, d * d - a * a - b * b)
     return wrap_angle(theta), psi
+
 
 
 def inverse_kinematics(params: Rrr3Params, a_point, phi: float, mode: int | str | None = None) -> np.ndarray:
@@ -273,6 +95,7 @@ def inverse_kinematics(params: Rrr3Params, a_point, phi: float, mode: int | str 
     return _solve(params, a_point, phi, params.mode if mode is None else mode)[0]
 
 
+
 def joint_values(params: Rrr3Params, y, mode: int | str | None = None) -> dict[str, list[float]]:
     """Every joint coordinate of the tree (closed form) for the task vector ``y = (x_G, y_G, Phi)``."""
     params = check_params(params, Rrr3Params)
@@ -286,10 +109,12 @@ def joint_values(params: Rrr3Params, y, mode: int | str | None = None) -> dict[s
     return out
 
 
+
 def configuration(mech: Mechanism, y, mode: int | str | None = None) -> np.ndarray:
     """Full configuration vector ``q`` of ``mech`` for the task vector ``y`` (closed form)."""
     mech = check_mechanism(mech)
     return mech.q_from_dict(joint_values(mech.params, y, mode))
+
 
 
 def jacobians(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -320,15 +145,18 @@ def jacobians(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[np.
     return Jx, Jq
 
 
+
 REFERENCES = ("centroid", "A", "origin")
 """Moment reference points of :func:`homogenized_jacobians`: the platform centroid ``G``, vertex ``A``,
 the world origin ``O = P`` (the paper's eq. 14)."""
+
 
 
 def characteristic_length(params: Rrr3Params) -> float:
     """Default ``L`` of eq. (25) [m]: the platform circumradius ``h / sqrt 3`` (Lou's mean platform radius)."""
     params = check_params(params, Rrr3Params)
     return params.h / SQRT3
+
 
 
 def reference_point(params: Rrr3Params, y, reference: str = "centroid") -> np.ndarray:
@@ -342,6 +170,7 @@ def reference_point(params: Rrr3Params, y, reference: str = "centroid") -> np.nd
     if reference == "origin":
         return np.zeros(2)
     raise InvalidInputError("reference", f"use one of {REFERENCES}, got {reference!r}", reference)
+
 
 
 def homogenized_jacobians(params: Rrr3Params, y, mode: int | str | None = None, *, length: float | None = None,
@@ -374,6 +203,7 @@ def homogenized_jacobians(params: Rrr3Params, y, mode: int | str | None = None, 
     return finite_result(Jx, "homogenized J_x", f"length = {L!r} m is too small (the moment column overflows)"), Jq
 
 
+
 def singularity_measures(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[float, float]:
     """Dimensionless distances to the two kinds of singularity at task vector ``y``.
 
@@ -386,6 +216,7 @@ def singularity_measures(params: Rrr3Params, y, mode: int | str | None = None) -
     params = check_params(params, Rrr3Params)
     Jx, Jq = homogenized_jacobians(params, y, mode)
     return float(np.min(np.abs(np.diag(Jq)))) / params.a, abs(float(np.linalg.det(Jx)))
+
 
 
 def classify_singularity(params: Rrr3Params, y, mode: int | str | None = None, *, tol: float = 1e-8) -> str:
@@ -402,6 +233,7 @@ def classify_singularity(params: Rrr3Params, y, mode: int | str | None = None, *
     inv, direct = singularity_measures(params, y, mode)
     return {(False, False): "regular", (True, False): "inverse", (False, True): "direct",
             (True, True): "combined"}[(inv <= tol, direct <= tol)]
+
 
 
 # ---------------------------------------------------------------------- forward kinematics
@@ -425,8 +257,13 @@ class FkSolution:
     residual: float
 
 
+
 _FK_SAMPLES = 16  # FFT samples of the degree-4 trigonometric polynomial (>= 9 makes the coefficients exact)
+
+
+
 _FK_NEWTON = 30  # Newton iterations allowed per candidate
+
 
 
 def _fk_offsets(h: float, phi):
@@ -438,6 +275,7 @@ def _fk_offsets(h: float, phi):
     dr = np.array([[zero, zero], [-h * np.sin(phi), h * np.cos(phi)],
                    [-h * np.sin(phi + math.pi / 3.0), h * np.cos(phi + math.pi / 3.0)]])
     return r, dr
+
 
 
 def _fk_eliminated(D: np.ndarray, b: float, h: float, phi):
@@ -455,6 +293,7 @@ def _fk_eliminated(D: np.ndarray, b: float, h: float, phi):
     return F, N, delta
 
 
+
 def _fk_legs(D: np.ndarray, b: float, h: float, x: np.ndarray):
     """Leg equations ``|V_k - D_k|^2 - b^2`` [m^2] at ``x = (x_A, y_A, Phi)`` and their Jacobian."""
     r, dr = _fk_offsets(h, x[2])
@@ -462,6 +301,7 @@ def _fk_legs(D: np.ndarray, b: float, h: float, x: np.ndarray):
     f = np.sum(e * e, axis=1) - b * b
     J = np.column_stack([2.0 * e[:, 0], 2.0 * e[:, 1], 2.0 * np.sum(e * dr, axis=1)])
     return f, J, e
+
 
 
 def forward_kinematics(params: Rrr3Params, theta, *, tol: float = 1e-10) -> tuple[FkSolution, ...]:
@@ -518,6 +358,7 @@ def forward_kinematics(params: Rrr3Params, theta, *, tol: float = 1e-10) -> tupl
     return tuple(sorted(solutions, key=lambda s: s.y[2]))
 
 
+
 def _fk_polish(params: Rrr3Params, D: np.ndarray, x: np.ndarray, theta: np.ndarray, tol: float) -> FkSolution | None:
     """Newton on the three leg equations from ``x = (x_A, y_A, Phi)``; the solution if it holds to ``tol``."""
     b = params.b
@@ -546,6 +387,7 @@ def _fk_polish(params: Rrr3Params, D: np.ndarray, x: np.ndarray, theta: np.ndarr
     return FkSolution(y, A, psi, mode, residual)
 
 
+
 # ---------------------------------------------------------------------- uniform interface
 # Every mechanism module offers these, over the task vector ``y`` laid out as
 # :class:`pkm.core.TaskMap` does (here: centroid x, y and yaw Phi).
@@ -570,6 +412,7 @@ def closed_form_fk(params: Rrr3Params, q_actuated, seed=None) -> np.ndarray:
                                                               wrap_angle(s.y[2] - target[2])])))).y.copy()
 
 
+
 def closed_form_ik(params: Rrr3Params, y, branch: str | None = None) -> np.ndarray:
     """Actuated coordinates for task vector ``y`` (closed form); ``branch`` = working mode name."""
     params = check_params(params, Rrr3Params)
@@ -577,70 +420,15 @@ def closed_form_ik(params: Rrr3Params, y, branch: str | None = None) -> np.ndarr
     return inverse_kinematics(params, a_from_centroid(params, y[:2], y[2]), y[2], branch)
 
 
+
 def closed_form_configuration(mech: Mechanism, y, branch: str | None = None) -> np.ndarray:
     """Every joint coordinate for task vector ``y`` (closed form); ``branch`` = working mode name."""
     return configuration(mech, y, branch)
 
 
-# ---------------------------------------------------------------------- tree and spec
-def urdf_xml(params: Rrr3Params) -> str:
-    """The URDF tree (see the module doc)."""
-    params = check_params(params, Rrr3Params)
-    b = UrdfBuilder(NAME)
-    b.link("base")
-    for i, vertex in enumerate(base_vertices(params)):
-        n = i + 1
-        b.link(f"proximal_{n}", params.m_proximal, (params.a / 2.0, 0.0, 0.0),
-               rod_inertia(params.m_proximal, params.a, 0))
-        b.joint(f"motor_{n}", "revolute", "base", f"proximal_{n}", (vertex[0], vertex[1], 0.0))
-        b.link(f"distal_{n}", params.m_distal, (params.b / 2.0, 0.0, 0.0), rod_inertia(params.m_distal, params.b, 0))
-        b.joint(f"elbow_{n}", "revolute", f"proximal_{n}", f"distal_{n}", (params.a, 0.0, 0.0))
-        if n > 1:
-            b.frame(f"leg{n}_tip", f"distal_{n}", (params.b, 0.0, 0.0))
-    h, m = params.h, params.m_platform
-    g_local = (h / 2.0, h / (2.0 * SQRT3), 0.0)
-    # thin equilateral plate of side h: polar moment m h^2 / 12 about its centroid
-    b.link("platform", m, g_local, np.diag([m * h * h / 24.0, m * h * h / 24.0, m * h * h / 12.0]))
-    b.joint("wrist_1", "revolute", "distal_1", "platform", (params.b, 0.0, 0.0))
-    b.frame("platform_A", "platform")
-    b.frame("platform_B", "platform", (h, 0.0, 0.0))
-    b.frame("platform_C", "platform", (h / 2.0, h * SQRT3 / 2.0, 0.0))
-    b.frame("platform_center", "platform", g_local)
-    return b.to_xml()
-
-
-def closure_spec(params: Rrr3Params) -> ClosureSpec:
-    params = check_params(params, Rrr3Params)
-    reference = {k: tuple(v) for k, v in joint_values(params, home_task(params)).items()}
-    branches = {}
-    for name, signs in MODES.items():
-        psi = ", ".join("+" if s > 0 else "-" for s in signs)
-        roots = ", ".join("-" if s > 0 else "+" for s in signs)
-        branches[name] = Branch(name, {f"elbow_{n}": s for n, s in zip((1, 2, 3), signs)},
-                                f"signs of (psi_1, psi_2, psi_3) = ({psi}); eq. (9) roots ({roots})")
-    return ClosureSpec(
-        mechanism=NAME,
-        description="planar 3-RRR (singularities and GCI); revolutes at B and C as point closures, "
-                    "task = platform centroid x, y and orientation Phi",
-        urdf=f"{NAME}.urdf",
-        end_effector="platform_center",
-        actuated=("motor_1", "motor_2", "motor_3"),
-        closures=tuple(Closure(f"wrist_{n}", "point", f"leg{n}_tip", f"platform_{v}") for n, v in ((2, "B"), (3, "C"))),
-        task=TaskSpec(("x", "y", "yaw")),
-        reference=reference,
-        branches=branches,
-        default_branch=f"mode{params.mode}",
-        parameters=spec_parameters(params),
-    )
-
 
 Params = Rrr3Params
 
-
-def build(params: Rrr3Params | None = None) -> Mechanism:
-    """The planar 3-RRR as a :class:`~pkm.core.Mechanism` (reference design when ``params`` is None)."""
-    params = Rrr3Params() if params is None else params
-    return make_mechanism(urdf_xml(params), closure_spec(params), params)
 
 
 # ---------------------------------------------------------------------- helpers
@@ -649,6 +437,7 @@ def _length(length) -> float:
     if L <= 0.0:
         raise InvalidInputError("length", f"the characteristic length must be > 0 m, got {L!r}", length)
     return L
+
 
 
 def _scalar(x, name: str) -> float:

@@ -1,4 +1,4 @@
-"""Tests of the sequential-QP choice of a scalar reconfiguration parameter (pkm.core.reconfigure)."""
+"""Tests of the sequential-QP choice of a scalar reconfiguration parameter (pkm.core.redundant_parameter)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import proxsuite
 import pytest
 
-from pkm.core import reconfigure as rc
+from pkm.core import redundant_parameter as rc
 from pkm.errors import InvalidInputError
 
 C = np.linspace(-1.0, 1.0, 41)

@@ -25,7 +25,7 @@ from pkm.core.mechanism import as_array, as_count, as_vector
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms._common import check_params, real
 from pkm.mechanisms.delta import PHI, DeltaParams, arm_angles
-from pkm.mechanisms.delta_workspace import condition_numbers, workspace
+from pkm.mechanisms.delta.workspace import condition_numbers, workspace
 
 __all__ = ["RadiusStudy", "condition_vs_radius", "radius_minimising_condition", "reachable_radii",
            "region_mean_condition", "workspace_vs_radius"]
@@ -169,7 +169,7 @@ class RadiusStudy:
 
 def workspace_vs_radius(params: DeltaParams, R_values, *, kind: str = "2", spacing: float = 0.008,
                         branch="knee_out") -> RadiusStudy:
-    """Sample the workspace (:func:`pkm.mechanisms.delta_workspace.workspace`) for each base radius.
+    """Sample the workspace (:func:`pkm.mechanisms.delta.workspace.workspace`) for each base radius.
 
     Args:
         params: The design; its ``home`` must stay reachable for every R (it is the reference pose).

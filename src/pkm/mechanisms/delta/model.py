@@ -1,0 +1,78 @@
+"""The Delta as a Pinocchio tree plus loop closures: URDF, closure spec and the mechanism built from parameters."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pkm.core.mechanism import Mechanism
+from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
+from pkm.core.urdf import UrdfBuilder
+from pkm.mechanisms._common import (
+    check_params,
+    make_mechanism,
+    rod_inertia,
+    rot_z,
+    spec_parameters,
+)
+from pkm.mechanisms.delta.kinematics import joint_values
+from pkm.mechanisms.delta.params import BRANCHES, NAME, PHI, DeltaParams
+
+
+# ---------------------------------------------------------------------- tree and spec
+def urdf_xml(params: DeltaParams) -> str:
+    """The URDF tree (see the module doc for the modelling of the parallelograms)."""
+    params = check_params(params, DeltaParams)
+    b = UrdfBuilder(NAME)
+    b.link("base")
+    reach = 2.0 * (params.R + params.La + params.Lb)
+    for i in range(3):
+        n = i + 1
+        Rz = rot_z(PHI[i])
+        b.link(f"arm_{n}", params.m_arm, (0.0, params.La / 2, 0.0), rod_inertia(params.m_arm, params.La, 1))
+        b.joint(f"motor_{n}", "revolute", "base", f"arm_{n}", Rz @ np.array([0.0, params.R, 0.0]), Rz,
+                axis=(1.0, 0.0, 0.0))
+        b.link(f"knee_cross_{n}")
+        b.joint(f"knee_{n}", "revolute", f"arm_{n}", f"knee_cross_{n}", (0.0, params.La, 0.0), axis=(1.0, 0.0, 0.0))
+        b.link(f"forearm_{n}", params.m_forearm, (0.0, params.Lb / 2, 0.0),
+               rod_inertia(params.m_forearm, params.Lb, 1))
+        b.joint(f"knee_{n}_b", "revolute", f"knee_cross_{n}", f"forearm_{n}", axis=(0.0, 0.0, 1.0))
+        b.frame(f"forearm_{n}_tip", f"forearm_{n}", (0.0, params.Lb, 0.0))
+    b.link("guide_x")
+    b.link("guide_y")
+    mp, r = params.m_platform, params.r
+    b.link("platform", mp, inertia=np.diag([mp * r * r / 4, mp * r * r / 4, mp * r * r / 2]))
+    b.joint("platform_x", "prismatic", "base", "guide_x", axis=(1.0, 0.0, 0.0), limits=(-reach, reach))
+    b.joint("platform_y", "prismatic", "guide_x", "guide_y", axis=(0.0, 1.0, 0.0), limits=(-reach, reach))
+    b.joint("platform_z", "prismatic", "guide_y", "platform", axis=(0.0, 0.0, 1.0), limits=(-reach, reach))
+    for i in range(3):
+        b.frame(f"platform_ball_{i + 1}", "platform", rot_z(PHI[i]) @ np.array([0.0, params.r, 0.0]))
+    return b.to_xml()
+
+
+
+def closure_spec(params: DeltaParams) -> ClosureSpec:
+    params = check_params(params, DeltaParams)
+    reference = {k: tuple(v) for k, v in joint_values(params, params.home).items()}
+    return ClosureSpec(
+        mechanism=NAME,
+        description="Delta robot (Hernandez Reyna & Sandoval-Castro 2018); parallelograms as centre lines, "
+                    "platform orientation kept by a massless translational guide",
+        urdf=f"{NAME}.urdf",
+        end_effector="platform",
+        actuated=("motor_1", "motor_2", "motor_3"),
+        closures=tuple(Closure(f"ball_{n}", "point", f"forearm_{n}_tip", f"platform_ball_{n}") for n in (1, 2, 3)),
+        task=TaskSpec(("x", "y", "z")),
+        reference=reference,
+        branches={name: Branch(name, {f"knee_{n}": s for n in (1, 2, 3)},
+                               f"all elbows {'outward' if name == 'knee_out' else 'inward'} (knee_i "
+                               f"{'<' if s < 0 else '>'} 0)") for name, s in BRANCHES.items()},
+        default_branch="knee_out",
+        parameters=spec_parameters(params),
+    )
+
+
+
+def build(params: DeltaParams | None = None) -> Mechanism:
+    """The Delta as a :class:`~pkm.core.Mechanism` (paper design when ``params`` is None)."""
+    params = DeltaParams() if params is None else params
+    return make_mechanism(urdf_xml(params), closure_spec(params), params)

@@ -1,0 +1,63 @@
+"""The design parameters of the Delta (SI units, validated) and its fixed geometry."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from pkm.errors import InvalidParameterError, UnreachableError
+from pkm.mechanisms._common import (
+    check_numbers,
+    check_positive,
+)
+
+NAME = "delta"
+
+
+
+PHI = (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0)
+
+
+
+BRANCHES = {"knee_out": -1, "knee_in": 1}
+
+
+
+@dataclass(frozen=True)
+class DeltaParams:
+    """Delta design (paper Table 1 by default).
+
+    Attributes:
+        La: Arm length [m] (110 mm).
+        Lb: Forearm (parallelogram) length [m] (330 mm).
+        r: Platform radius, centre to ball-joint line [m] (50 mm).
+        R: Base radius, centre to motor axis [m] (150 mm for the paper's Fig. 4; studied 100-200 mm,
+            120 mm chosen for construction).
+        home: Reference platform position [m] (the study point (0, 0, -375) mm).
+        m_arm: Arm mass [kg] (illustrative; not in the paper).
+        m_forearm: Mass of one parallelogram (both rods) [kg] (illustrative).
+        m_platform: Platform mass [kg] (illustrative).
+    """
+
+    La: float = 0.110
+    Lb: float = 0.330
+    r: float = 0.050
+    R: float = 0.150
+    home: tuple[float, float, float] = (0.0, 0.0, -0.375)
+    m_arm: float = 0.10
+    m_forearm: float = 0.05
+    m_platform: float = 0.20
+
+    def __post_init__(self):
+        from pkm.mechanisms.delta.kinematics import inverse_kinematics  # (kinematics imports this module)
+
+        check_positive(self, "La", "Lb", "r", "R", "m_arm", "m_forearm", "m_platform")
+        check_numbers(self, "home", 3, "(a point x, y, z in m)")
+        # the reference pose must be reachable in the default working mode, away from singularity
+        try:
+            th = inverse_kinematics(self, self.home)
+        except UnreachableError as exc:
+            raise InvalidParameterError(
+                "home", f"reference pose {self.home} is unreachable with this design (leg {exc.leg} misses by "
+                        f"{exc.excess:.4g} m); choose another home or other lengths", self.home) from None
+        del th

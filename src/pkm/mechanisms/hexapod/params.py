@@ -1,0 +1,133 @@
+"""The design parameters of the reconfigurable hexapod (SI units, validated) and its fixed geometry."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pkm.core.task import ROTATION_TOL, as_rotation  # noqa: F401 (ROTATION_TOL: part of this module's API)
+from pkm.errors import InvalidInputError, InvalidParameterError, UnreachableError
+from pkm.mechanisms._common import (
+    check_finite,
+    check_numbers,
+    check_params,
+    check_positive,
+    rot_y,
+)
+
+NAME = "hexapod"
+
+
+
+LAYOUTS = {"sector": (0.0, 120.0, 240.0), "literal": (0.0, 240.0, 120.0)}  # psi of C4, C5, C6 [deg]
+
+
+
+BRANCHES = {"elbow_out": -1, "elbow_in": 1}  # sign of knee_i
+
+
+
+DEFAULT_BRANCH = "elbow_out"
+
+
+
+ACTUATED = ("alpha_1", "alpha_2", "alpha_3", "alpha_4", "alpha_5", "alpha_6", "beta_1")
+
+
+
+#: The paper's pose T (sec. 4) as printed: rotation rows (4 digits) and position [m].
+POSE_T_ROTATION = (0.9623, -0.1306, -0.2388, 0.0842, 0.9771, -0.1952, 0.2588, 0.1677, 0.9513)
+
+
+
+POSE_T_POSITION = (0.0, -0.350, 0.0)
+
+
+
+#: Largest ``max|R^T R - I|`` accepted for a platform rotation given by the user (then projected on SO(3)).
+HOME_ROTATION_TOL = 1e-2  # parameter files may carry coarser matrices
+
+
+
+@dataclass(frozen=True)
+class HexapodParams:
+    """Reconfigurable hexapod design (paper Table 1 by default).
+
+    Attributes:
+        Rf: Radius of the reconfiguration pivots ``F_i`` (M1) [m] (50 mm).
+        Rr: Reconfiguration link length (``R_r`` of Table 1, ``R_c`` of eq. 2) [m] (150 mm).
+        R2: Radius of the actuated joints ``A_4..A_6`` (M2) [m] (450 mm).
+        H0: Depth of the plane of ``A_4..A_6`` below O [m] (200 mm).
+        LA: Arm length [m] (200 mm).
+        LB: Rod length (``B_i`` to ``C_i``) [m] (400 mm).
+        h: Height of the platform prism [m] (34 mm).
+        r: Circumradius of the platform triangles [m] (50 mm).
+        theta: Angular position ``th_i`` of leg i about Y, from +X [rad] (35, 155, 275, 25, 145, 265 deg).
+        layout: ``"sector"`` or ``"literal"`` platform layout (see the module doc).
+        home_rotation: Reference platform orientation, rows of a 3x3 matrix [-] (the paper's pose T as
+            printed; projected on SO(3) by SVD).
+        home_position: Reference position of ``P`` [m] (pose T: (0, -350, 0) mm).
+        home_beta: Reference reconfiguration angle [rad] (0).
+        m_recon: Mass of a reconfiguration link [kg] (illustrative; not in the paper).
+        m_arm: Mass of an arm ``LA`` [kg] (illustrative).
+        m_rod: Mass of a rod ``LB`` [kg] (illustrative).
+        m_platform: Platform mass [kg] (illustrative).
+    """
+
+    Rf: float = 0.050
+    Rr: float = 0.150
+    R2: float = 0.450
+    H0: float = 0.200
+    LA: float = 0.200
+    LB: float = 0.400
+    h: float = 0.034
+    r: float = 0.050
+    theta: tuple[float, ...] = tuple(math.radians(a) for a in (35.0, 155.0, 275.0, 25.0, 145.0, 265.0))
+    layout: str = "sector"
+    home_rotation: tuple[float, ...] = POSE_T_ROTATION
+    home_position: tuple[float, float, float] = POSE_T_POSITION
+    home_beta: float = 0.0
+    m_recon: float = 0.15
+    m_arm: float = 0.25
+    m_rod: float = 0.15
+    m_platform: float = 0.80
+
+    def __post_init__(self):
+        from pkm.mechanisms.hexapod.kinematics import inverse_kinematics  # (kinematics imports this module)
+
+        check_positive(self, "Rf", "Rr", "R2", "LA", "LB", "h", "r", "m_recon", "m_arm", "m_rod", "m_platform")
+        check_finite(self, "H0", "home_beta")
+        if not isinstance(self.layout, str) or self.layout not in LAYOUTS:
+            raise InvalidParameterError("layout", f"must be one of {sorted(LAYOUTS)}, got {self.layout!r}",
+                                        self.layout)
+        for name, n, what in (("theta", 6, "(angles in rad)"), ("home_rotation", 9, "(rows of a rotation)"),
+                              ("home_position", 3, "(a point in m)")):
+            check_numbers(self, name, n, what)
+        try:
+            as_rotation(self.home_rotation, "home_rotation", HOME_ROTATION_TOL)
+        except InvalidInputError as exc:
+            raise InvalidParameterError("home_rotation", f"must be the rows of a rotation matrix ({exc})",
+                                        self.home_rotation) from None
+        try:
+            inverse_kinematics(self, home_rotation(self), self.home_position, self.home_beta)
+        except UnreachableError as exc:
+            raise InvalidParameterError(
+                "home_position", f"the reference pose is unreachable with this design (leg {exc.leg} misses by "
+                                 f"{exc.excess:.4g} m); choose another home pose, home_beta or other lengths",
+                self.home_position) from None
+
+
+
+# ---------------------------------------------------------------------- geometry
+def leg_frame(theta_i: float) -> np.ndarray:
+    """Axes ``(e_r, e_y, u_i)`` of leg frame i as columns (``= Ry(-th_i)``)."""
+    return rot_y(-theta_i)
+
+
+
+def home_rotation(params: HexapodParams) -> np.ndarray:
+    """The reference orientation: ``params.home_rotation`` projected on SO(3) (SVD)."""
+    params = check_params(params, HexapodParams)
+    return as_rotation(params.home_rotation, "home_rotation", HOME_ROTATION_TOL)

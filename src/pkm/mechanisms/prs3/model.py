@@ -1,0 +1,73 @@
+"""The 3-PRS as a Pinocchio tree plus loop closures: URDF, closure spec and the mechanism built from parameters."""
+
+from __future__ import annotations
+
+from pkm.core.mechanism import Mechanism
+from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
+from pkm.core.urdf import UrdfBuilder
+from pkm.mechanisms._common import (
+    check_params,
+    make_mechanism,
+    rod_inertia,
+    rot_y,
+    rot_z,
+    spec_parameters,
+)
+from pkm.mechanisms.prs3.kinematics import joint_values, leg_geometry
+from pkm.mechanisms.prs3.params import ACTUATIONS, BRANCHES, DEFAULT_BRANCH, NAME, PHI, Prs3Params
+
+
+# ---------------------------------------------------------------------- tree and spec
+def urdf_xml(params: Prs3Params) -> str:
+    """The URDF tree: free platform, and per leg base -> slider -> coupler (see the module doc)."""
+    params = check_params(params, Prs3Params)
+    b = UrdfBuilder(NAME)
+    b.link("base")
+    reach = 2.0 * (params.g + params.h + params.l + abs(params.reference[0]))
+    a, _, _, _, bp = leg_geometry(params)
+    for i in range(3):
+        n = i + 1
+        # slider frame: x along the rail u_1, y along e_t (knee axis), z along w (coupler at theta = 0)
+        b.link(f"slider_link_{n}", params.m_slider)
+        b.joint(f"slider_{n}", "prismatic", "base", f"slider_link_{n}", a[i], rot_z(PHI[i]) @ rot_y(-params.gamma),
+                axis=(1.0, 0.0, 0.0), limits=(-reach, reach))
+        b.link(f"coupler_{n}", params.m_coupler, (0.0, 0.0, params.l / 2), rod_inertia(params.m_coupler, params.l, 2))
+        b.joint(f"knee_{n}", "revolute", f"slider_link_{n}", f"coupler_{n}", axis=(0.0, 1.0, 0.0))
+        b.frame(f"coupler_{n}_tip", f"coupler_{n}", (0.0, 0.0, params.l))
+    # link "platform_link": Pinocchio 4.1 refuses a name shared by a body frame and a joint frame
+    b.link("platform_link", params.m_platform, inertia=params.platform_inertia)
+    b.joint("platform", "floating", "base", "platform_link")
+    for i in range(3):
+        b.frame(f"platform_ball_{i + 1}", "platform_link", bp[i])
+    return b.to_xml()
+
+
+
+def closure_spec(params: Prs3Params) -> ClosureSpec:
+    """Closures, actuation (``params.actuation``), task, branches and the reference configuration."""
+    params = check_params(params, Prs3Params)
+    reference = {k: tuple(v) for k, v in joint_values(params, params.reference).items()}
+    joint = ACTUATIONS[params.actuation]
+    return ClosureSpec(
+        mechanism=NAME,
+        description=f"3-PRS (Diaz-Rodriguez et al. 2016), actuated in the {params.actuation} joints; spherical "
+                    "joints as point closures, free platform",
+        urdf=f"{NAME}.urdf",
+        end_effector="platform",
+        actuated=tuple(f"{joint}_{n}" for n in (1, 2, 3)),
+        closures=tuple(Closure(f"ball_{n}", "point", f"coupler_{n}_tip", f"platform_ball_{n}") for n in (1, 2, 3)),
+        task=TaskSpec(("z", "pitch", "roll")),
+        reference=reference,
+        branches={name: Branch(name, {f"knee_{n}": s for n in (1, 2, 3)},
+                               f"every slider {name.split('_')[1]} its spherical joint "
+                               f"(knee_i {'>' if s > 0 else '<'} 0)") for name, s in BRANCHES.items()},
+        default_branch=DEFAULT_BRANCH,
+        parameters=spec_parameters(params),
+    )
+
+
+
+def build(params: Prs3Params | None = None) -> Mechanism:
+    """The 3-PRS as a :class:`~pkm.core.Mechanism` (Table 2 design when ``params`` is None)."""
+    params = Prs3Params() if params is None else params
+    return make_mechanism(urdf_xml(params), closure_spec(params), params)

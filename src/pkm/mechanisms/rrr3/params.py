@@ -1,0 +1,126 @@
+"""The design parameters of the planar 3-RRR (SI units, validated) and its fixed geometry."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pkm.errors import (
+    InvalidInputError,
+    InvalidParameterError,
+    SingularityError,
+    UnreachableError,
+)
+from pkm.mechanisms._common import (
+    check_numbers,
+    check_params,
+    check_positive,
+)
+
+NAME = "rrr3"
+
+
+
+SQRT3 = math.sqrt(3.0)
+
+
+
+MODES: dict[str, tuple[int, int, int]] = {
+    f"mode{k + 1}": tuple(-1 if (k >> (2 - i)) & 1 else 1 for i in range(3)) for k in range(8)
+}
+"""Working mode name -> signs of ``(psi_1, psi_2, psi_3)`` (see the module doc)."""
+
+
+
+REACH_TOL = 1e-12  # relative to a + b: a distance this close to the reach limits counts as on them
+
+
+
+_SINGULAR_TOL = 1e-6  # the reference pose must be at least this far (dimensionless) from singularities
+
+
+
+@dataclass(frozen=True)
+class Rrr3Params:
+    """Planar 3-RRR design (paper sec. III workspace study by default).
+
+    Attributes:
+        a: Proximal (actuated) link length [m] (40 cm).
+        b: Distal link length [m] (40 cm).
+        h: Platform side ``AB = BC = CA`` [m] (10 cm).
+        H: Base side, the actuator separation ``PQ = QR = RP`` [m] (100 cm).
+        mode: Working mode 1..8 of the reference configuration (see the module doc).
+        home: Reference placement ``(dx, dy, Phi)``: the platform centroid's offset from the
+            base centroid [m] and the orientation [rad]; ``(0, 0, 0)``: centred, ``Phi = 0``.
+        m_proximal: Mass of a proximal link [kg] (illustrative; not in the paper).
+        m_distal: Mass of a distal link [kg] (illustrative).
+        m_platform: Platform mass [kg] (illustrative).
+    """
+
+    a: float = 0.40
+    b: float = 0.40
+    h: float = 0.10
+    H: float = 1.00
+    mode: int = 1
+    home: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    m_proximal: float = 0.20
+    m_distal: float = 0.15
+    m_platform: float = 0.10
+
+    def __post_init__(self):
+        from pkm.mechanisms.rrr3.kinematics import singularity_measures  # (kinematics imports this module)
+
+        check_positive(self, "a", "b", "h", "H", "m_proximal", "m_distal", "m_platform")
+        if isinstance(self.mode, bool) or not isinstance(self.mode, int) or not 1 <= self.mode <= 8:
+            raise InvalidParameterError("mode", f"must be an integer 1..8 (working mode), got {self.mode!r}",
+                                        self.mode)
+        check_numbers(self, "home", 3, "(dx, dy, Phi) in m, m, rad")
+        try:
+            margin_inv, margin_dir = singularity_measures(self, home_task(self), self.mode)
+        except UnreachableError as exc:
+            raise InvalidParameterError(
+                "home", f"reference pose {tuple(self.home)} is unreachable with this design (leg {exc.leg} misses "
+                        f"by {exc.excess:.4g} m); choose another home or other lengths", self.home) from None
+        except SingularityError:
+            raise InvalidParameterError(
+                "home", f"reference pose {tuple(self.home)} puts a platform vertex on its base vertex (a = b); "
+                        "choose another home", self.home) from None
+        if margin_inv < _SINGULAR_TOL or margin_dir < _SINGULAR_TOL:
+            kind = "inverse (a leg stretched or folded)" if margin_inv < _SINGULAR_TOL else "direct"
+            raise InvalidParameterError(
+                "home", f"reference pose {tuple(self.home)} is {kind}-singular in mode{self.mode}; choose another "
+                        "home or mode", self.home)
+
+
+
+# ---------------------------------------------------------------------- geometry
+def mode_signs(mode: int | str) -> tuple[int, int, int]:
+    """Signs of ``(psi_1, psi_2, psi_3)`` of a working mode given as ``k`` or ``"modek"`` (k = 1..8)."""
+    key = f"mode{mode}" if isinstance(mode, (int, np.integer)) and not isinstance(mode, bool) else mode
+    if not isinstance(key, str) or key not in MODES:
+        raise InvalidInputError("mode", f"use 1..8 or 'mode1'..'mode8', got {mode!r}", mode)
+    return MODES[key]
+
+
+
+def base_vertices(params: Rrr3Params) -> np.ndarray:
+    """Base vertices ``P, Q, R`` as rows [m], shape (3, 2)."""
+    params = check_params(params, Rrr3Params)
+    H = params.H
+    return np.array([[0.0, 0.0], [H, 0.0], [H / 2.0, H * SQRT3 / 2.0]])
+
+
+
+def base_centroid(params: Rrr3Params) -> np.ndarray:
+    """Centroid of the base triangle [m], shape (2,)."""
+    params = check_params(params, Rrr3Params)
+    return np.array([params.H / 2.0, params.H / (2.0 * SQRT3)])
+
+
+
+def home_task(params: Rrr3Params) -> np.ndarray:
+    """The reference task vector ``(x_G, y_G, Phi)`` [m, m, rad] of ``params.home``."""
+    params = check_params(params, Rrr3Params)
+    return np.concatenate([base_centroid(params) + np.asarray(params.home[:2], dtype=float), [params.home[2]]])
