@@ -17,7 +17,7 @@ import pytest
 import pkm
 from pkm import cli
 from pkm.mechanisms import delta as D
-from pkm.mechanisms import module
+from pkm.mechanisms import module, names
 
 
 def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
@@ -85,7 +85,7 @@ def test_console_script_lists_every_mechanism_as_json():
     proc = subprocess.run([str(script), "list", "--json"], check=False, capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     data = json.loads(proc.stdout)["mechanisms"]
-    assert list(data) == list(pkm.MECHANISMS)
+    assert list(data) == list(names(with_files=True))  # a subprocess: the shipped registry
     assert data["delta"]["parameters"]["R"] == {**data["delta"]["parameters"]["R"], "default": 0.15, "unit": "m"}
     assert data["delta"]["actuated"] == {"motor_1": "rad", "motor_2": "rad", "motor_3": "rad"}
     assert data["prs3"]["actuated"]["slider_1"] == "m" and data["hexapod"]["task"]["beta_1"] == "rad"
@@ -95,7 +95,7 @@ def test_list_as_text_and_a_bad_option():
     """``pkm list`` names each mechanism and its parameters; an unknown option exits 2 with one line."""
     ok = run("list")
     assert ok.returncode == 0
-    assert all(f"{m}: " in ok.stdout for m in pkm.MECHANISMS) and "task (--pose): x [m], y [m], z [m]" in ok.stdout
+    assert all(f"{m}: " in ok.stdout for m in names(with_files=True)) and "task (--pose): x [m], y [m], z [m]" in ok.stdout
     bad = run("list", "--bad")
     assert bad.returncode == 2 and "unrecognized arguments: --bad" in one_error_line(bad)
 

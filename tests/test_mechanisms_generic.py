@@ -20,21 +20,11 @@ import pytest
 import pkm
 from pkm.core import TaskMap, close_loops, constraints, diagnose, solve_ik
 from pkm.errors import UnreachableError
-from pkm.mechanisms import NAMES, module
+from pkm.mechanisms import definition, module, names
 from tests import fd
 
-# Task perturbation scale around the reference: (position [m], angle [rad], joint outputs [rad]).
-SCALES = {"delta": (0.06, 0.0, 0.0), "rrr3": (0.12, 0.3, 0.0), "prs3": (0.06, 0.15, 0.0),
-          "hexapod": (0.03, 0.08, 0.3)}
 N_RANDOM = 200
 N_DIFFERENTIAL = 15
-
-
-def _tangent_scale(task: TaskMap, name: str) -> np.ndarray:
-    pos, ang, jnt = SCALES[name]
-    names = task.names
-    return np.array([pos if n in ("x", "y", "z") else ang if n in ("roll", "pitch", "yaw", "wx", "wy", "wz")
-                     else jnt for n in names])
 
 
 def sample(mech, name: str, n: int, seed: int = 0):
@@ -42,7 +32,7 @@ def sample(mech, name: str, n: int, seed: int = 0):
     mod, task = module(name), TaskMap(mech)
     rng = np.random.default_rng(seed)
     y_ref = task.value(mech.q_reference)
-    scale = _tangent_scale(task, name)
+    scale = np.array(definition(name).tangent_scale(task.names))
     out = []
     while len(out) < n:
         y = task.retract(y_ref, scale * rng.uniform(-1.0, 1.0, task.size))
@@ -56,7 +46,7 @@ def sample(mech, name: str, n: int, seed: int = 0):
     return out
 
 
-@pytest.fixture(scope="module", params=NAMES)
+@pytest.fixture(scope="module", params=names())
 def case(request, built):
     mech = built(request.param)
     return request.param, mech, sample(mech, request.param, N_RANDOM)
@@ -108,7 +98,7 @@ def test_paper_forward_kinematics_round_trips(case):
     """Where the paper has a forward-kinematics method, it returns the task of the closed-form inverse."""
     name, mech, samples = case
     mod = module(name)
-    if not hasattr(mod, "closed_form_fk"):
+    if mod.closed_form_fk is None:
         pytest.skip(f"the {name} paper has no forward-kinematics method")
     task = TaskMap(mech)
     for q, y in samples:
@@ -137,7 +127,7 @@ def test_accelerations_match_finite_differences_of_velocities(case):
         assert err["closure"] <= 1e-9 and err["inverse"] <= 1e-9
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", names())
 def test_every_branch_has_a_seed_with_its_signs(name, built):
     """Each working mode declared in the spec can be reached from the reference by the generic core."""
     mech = built(name)
@@ -147,7 +137,7 @@ def test_every_branch_has_a_seed_with_its_signs(name, built):
         assert np.abs(constraints.residual(mech, q)).max() <= 1e-10
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", names())
 def test_reference_design_is_regular_with_expected_mobility(name, built):
     """At the reference configuration the loops are closed and mobility equals the number of outputs."""
     mech = built(name)

@@ -15,7 +15,7 @@ import pytest
 import pkm
 from pkm.core.compare import document_differences, mechanism_differences
 from pkm.data import spec_path, urdf_path
-from pkm.mechanisms import NAMES, module
+from pkm.mechanisms import module, names
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -25,7 +25,7 @@ def _report(what: str, diffs: list[str]) -> str:
     return "\n".join([head, *diffs[:20], *(["..."] if len(diffs) > 20 else [])])
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", names(with_files=True))
 def test_checked_in_files_equal_generator_output(name):
     """``urdf/<name>.urdf`` and ``.closures.toml`` parse to what the generator writes: same elements,
     attributes, keys and strings, numbers within tolerance."""
@@ -37,7 +37,7 @@ def test_checked_in_files_equal_generator_output(name):
     assert not diffs, _report(f"urdf/{name}.closures.toml", diffs)
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", names(with_files=True))
 def test_loading_the_files_gives_the_generated_mechanism(name, built):
     """``pkm.load`` (files) and the generator build the same model at the same reference."""
     diffs = mechanism_differences(pkm.load(name), built(name))
@@ -49,9 +49,9 @@ def test_wheel_ships_urdf_and_dynamics(tmp_path):
     subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps", "--no-build-isolation",
                     "-q", "-w", str(tmp_path)], check=True)
     wheel = next(tmp_path.glob("pkm-*.whl"))
-    names = set(zipfile.ZipFile(wheel).namelist())
-    for name in NAMES:
-        assert f"pkm/_data/urdf/{name}.urdf" in names
-        assert f"pkm/_data/urdf/{name}.closures.toml" in names
-    assert "pkm/_data/dynamics/prs3_table2.toml" in names
-    assert "pkm/py.typed" in names
+    shipped = set(zipfile.ZipFile(wheel).namelist())
+    for name in names(with_files=True):
+        assert f"pkm/_data/urdf/{name}.urdf" in shipped
+        assert f"pkm/_data/urdf/{name}.closures.toml" in shipped
+    assert "pkm/_data/dynamics/prs3_table2.toml" in shipped
+    assert "pkm/py.typed" in shipped

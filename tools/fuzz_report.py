@@ -53,6 +53,9 @@ from pathlib import Path
 
 import numpy as np
 
+from pkm.mechanisms import module as mechanism_module
+from pkm.mechanisms import names as mechanism_names
+
 CHUNK = 250  # calls per task handed to a worker
 EXAMPLES = 5  # "other" / "nonfinite" examples kept per entry point
 
@@ -351,7 +354,7 @@ def _build_entry(n: str):
     return _build
 
 
-for _n in ("hexapod", "rrr3", "delta", "prs3"):
+for _n in mechanism_names():
     _build_entry(_n)
 
 
@@ -603,8 +606,7 @@ def _closed_forms(n: str):
         _, m = _mech(g, adv, (n,))
         return c.mod[n].closed_form_configuration, (m, _target(g, n, adv)), {}
 
-    import importlib
-    if hasattr(importlib.import_module(f"pkm.mechanisms.{n}"), "closed_form_fk"):
+    if mechanism_module(n).closed_form_fk is not None:
         @entry(f"{n}.closed_form_fk")
         def _fk(g, adv):
             c = ctx()
@@ -1068,7 +1070,7 @@ def _screw_transform(g, adv):
     return screws.transform, (s, R, t), {}
 
 
-for _n in ("hexapod", "rrr3", "delta", "prs3"):
+for _n in mechanism_names():
     _closed_forms(_n)
 
 

@@ -15,7 +15,7 @@ import argparse
 from pathlib import Path
 
 from pkm.core.compare import document_differences
-from pkm.mechanisms import NAMES, module
+from pkm.mechanisms import module, names
 
 ROOT = Path(__file__).resolve().parents[1] / "urdf"
 
@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parents[1] / "urdf"
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--check", action="store_true", help="write nothing; list the differences")
-    ap.add_argument("names", nargs="*", default=list(NAMES))
+    ap.add_argument("names", nargs="*", default=list(names(with_files=True)))
     args = ap.parse_args()
     status = 0
     for name in args.names:

@@ -13,45 +13,65 @@ Quick start::
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 from pkm import errors
-from pkm.core import (
-    ClosureSpec,
-    Diagnostics,
-    Mechanism,
-    SolveResult,
-    TaskMap,
-    accelerations,
-    close_loops,
-    diagnose,
-    forward_jacobian,
-    inverse_accelerations,
-    inverse_jacobian,
-    inverse_velocities,
-    passive_map,
-    solve_ik,
-    task_acceleration,
-    task_velocity,
-    twist_jacobian,
-    velocities,
-)
-from pkm.data import spec_path
+from pkm._lazy import lazy
 from pkm.errors import PkmError, UnknownNameError
-from pkm.mechanisms import NAMES as MECHANISMS
+from pkm.mechanisms import REGISTRY as MECHANISMS
+from pkm.mechanisms import definition as mechanism_definition
 from pkm.mechanisms import module as mechanism_module
+
+#: Names of the generic core, imported on first use (``import pkm`` stays cheap: no Pinocchio until needed).
+_CORE = ("ClosureSpec", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "accelerations", "close_loops",
+         "diagnose", "forward_jacobian", "inverse_accelerations", "inverse_jacobian", "inverse_velocities",
+         "passive_map", "solve_ik", "task_acceleration", "task_velocity", "twist_jacobian", "velocities")
+
+if TYPE_CHECKING:  # the static view of the lazy names
+    # ruff: noqa: F401
+    from pkm.core import (
+        ClosureSpec,
+        Diagnostics,
+        Mechanism,
+        SolveResult,
+        TaskMap,
+        accelerations,
+        close_loops,
+        diagnose,
+        forward_jacobian,
+        inverse_accelerations,
+        inverse_jacobian,
+        inverse_velocities,
+        passive_map,
+        solve_ik,
+        task_acceleration,
+        task_velocity,
+        twist_jacobian,
+        velocities,
+    )
+
+
+__getattr__, __dir__ = lazy("pkm", globals(), dict.fromkeys(_CORE, "pkm.core"))
 
 __version__ = "0.1.0"
 
 
 def load(name: str) -> Mechanism:
-    """The reference design of mechanism ``name`` from the shipped ``urdf/`` files.
+    """The reference design of mechanism ``name``: from its shipped ``urdf/`` files, or built from its
+    default parameters when it ships none.
 
     Raises:
-        UnknownNameError: ``name`` is not one of :data:`MECHANISMS`.
+        UnknownNameError: ``name`` is not one of :data:`MECHANISMS` (the registry).
         SpecError: the shipped files are damaged.
     """
-    mod = mechanism_module(name)
-    mech = Mechanism.from_files(spec_path(name))
+    entry = mechanism_definition(name)
+    mod = entry.module()
+    if entry.reference is None:
+        return mod.build(mod.Params())
+    from pkm.core.mechanism import Mechanism
+    from pkm.data import data_dir
+
+    mech = Mechanism.from_files(data_dir("urdf") / entry.reference)
     mech.params = mod.Params()
     return mech
 
@@ -75,6 +95,6 @@ def build(name: str, **params) -> Mechanism:
 __all__ = [
     "MECHANISMS", "ClosureSpec", "Diagnostics", "Mechanism", "PkmError", "SolveResult", "TaskMap",
     "accelerations", "build", "close_loops", "diagnose", "errors", "forward_jacobian", "inverse_accelerations",
-    "inverse_jacobian", "inverse_velocities", "load", "mechanism_module", "passive_map", "solve_ik",
+    "inverse_jacobian", "inverse_velocities", "load", "mechanism_definition", "mechanism_module", "passive_map", "solve_ik",
     "task_acceleration", "task_velocity", "twist_jacobian", "velocities",
 ]

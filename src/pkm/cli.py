@@ -344,13 +344,11 @@ def solution_dict(mech: pkm.Mechanism, res: pkm.SolveResult, **extra) -> dict[st
 
 # ---------------------------------------------------------------------- commands
 def cmd_list(args) -> int:
-    from pkm.mechanisms import TITLES
-
     data = {}
-    for name in pkm.MECHANISMS:
+    for name, entry in pkm.MECHANISMS.items():
         mech = pkm.load(name)
         data[name] = {
-            "title": TITLES[name],
+            "title": entry.title,
             "actuated": {j: SI_UNITS[_joint_kind(mech, j)] for j in mech.actuated_names},
             "task": {k: SI_UNITS[_key_kind(mech, k)] for k in task_keys(mech)},
             "branches": list(mech.spec.branches),
@@ -426,7 +424,7 @@ def _close_loops(mech: pkm.Mechanism, qa) -> pkm.SolveResult:
         return pkm.close_loops(mech, qa)
     except ConvergenceError as exc:
         mod = pkm.mechanism_module(mech.name)
-        if hasattr(mod, "closed_form_fk"):
+        if mod.closed_form_fk is not None:
             try:
                 mod.closed_form_fk(mech.params, qa)
             except AssemblyError as none:
@@ -488,7 +486,7 @@ def cmd_fk(args) -> int:
 def cmd_report(args) -> int:
     from pkm import papers, report
 
-    names = tuple(args.paper) if args.paper else papers.NAMES
+    names = tuple(args.paper) if args.paper else papers.names()
     for n in names:
         papers.module(n)  # UnknownNameError listing the papers
     if len(set(names)) != len(names):
@@ -568,11 +566,11 @@ def build_parser() -> argparse.ArgumentParser:
     mech_args(p, None, "required")
     p.set_defaults(func=cmd_fk)
 
-    from pkm.papers import NAMES as PAPERS
+    from pkm.papers import names as paper_names
 
     p = sub.add_parser("report", parents=[debug], help="reproduce the papers: summary.json, report.md, figures")
     p.add_argument("--out", metavar="DIR", default="out", help="output directory (default: out)")
-    p.add_argument("--paper", metavar="NAME", action="append", help=f"only these papers ({', '.join(PAPERS)})")
+    p.add_argument("--paper", metavar="NAME", action="append", help=f"only these papers ({', '.join(paper_names())})")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
     p.add_argument("--no-series", action="store_true", help="skip the CSV series")
     p.set_defaults(func=cmd_report)

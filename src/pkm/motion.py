@@ -34,10 +34,10 @@ from pathlib import Path
 
 import numpy as np
 
-from pkm.core.mechanism import ABSURD, as_array, finite_result
 from pkm.core.spec import as_path, parse_toml, read_text_file
 from pkm.data import dynamics_path
 from pkm.errors import InvalidInputError, SpecError
+from pkm.validation import ABSURD, as_array, finite_result
 
 FORMAT = "pkm.motion/1"
 MAX_SAMPLES = 10_000_000  #: samples of one case at most (memory)

@@ -27,7 +27,7 @@ import numpy as np
 import pkm
 from pkm import papers as _papers
 from pkm.errors import InvalidInputError
-from pkm.papers import NAMES, Row
+from pkm.papers import Row
 
 STEPS = ("reproduce", "figures", "series")
 
@@ -78,7 +78,7 @@ class PaperResult:
     """What the report gathered for one paper.
 
     Attributes:
-        name: The paper's study module name (one of :data:`pkm.papers.NAMES`).
+        name: The paper's study module name (one of :func:`pkm.papers.names`).
         title: Its ``TITLE``.
         rows: Its rows, in the order ``reproduce()`` gives them.
         figures: PNG files written (absolute paths).
@@ -128,13 +128,13 @@ class Report:
         return total
 
 
-def run(out_dir, papers: Sequence[str] = NAMES, *, figures: bool = True, series: bool = True,
+def run(out_dir, papers: Sequence[str] | None = None, *, figures: bool = True, series: bool = True,
         progress: bool = True) -> Report:
     """Reproduce the papers and write the report under ``out_dir`` (see the module doc for the layout).
 
     Args:
         out_dir: Output directory (created if needed; files of a previous run are overwritten).
-        papers: Study names among :data:`pkm.papers.NAMES`, in the order to report them.
+        papers: Study names among :func:`pkm.papers.names`, in the order to report them.
         figures: Redraw the figures (PNG) too.
         series: Write the CSV series too (for papers whose study has ``series``).
         progress: Show a tqdm bar on stderr (only when stderr is a terminal).
@@ -146,9 +146,9 @@ def run(out_dir, papers: Sequence[str] = NAMES, *, figures: bool = True, series:
         UnknownNameError: A name is not a paper (listing the valid ones), before anything runs.
         InvalidInputError: No paper, or one named twice.
     """
-    names = tuple(papers)
+    names = _papers.names() if papers is None else tuple(papers)
     if not names:
-        raise InvalidInputError("papers", f"name at least one paper among {list(NAMES)}", papers)
+        raise InvalidInputError("papers", f"name at least one paper among {list(_papers.names())}", papers)
     if len(set(names)) != len(names):
         raise InvalidInputError("papers", f"each paper once, got {list(names)}", papers)
     modules = {n: _papers.module(n) for n in names}
@@ -157,7 +157,7 @@ def run(out_dir, papers: Sequence[str] = NAMES, *, figures: bool = True, series:
 
     plan = [(n, "reproduce") for n in names]
     plan += [(n, "figures") for n in names if figures]
-    plan += [(n, "series") for n in names if series and hasattr(modules[n], "series")]
+    plan += [(n, "series") for n in names if series and modules[n].series is not None]
     plan.sort(key=lambda step: names.index(step[0]))  # paper by paper, steps in STEPS order (stable sort)
 
     from tqdm import tqdm

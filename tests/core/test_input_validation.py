@@ -11,7 +11,6 @@ import pytest
 import pkm
 from pkm.core import indices, redundant_parameter, screws
 from pkm.core.dynamics import KhalilProjection, forward_dynamics
-from pkm.core.mechanism import as_count, as_scalar, as_vector, finite_result
 from pkm.core.solve import MAX_TOTAL_ITER
 from pkm.errors import (
     ConvergenceError,
@@ -23,6 +22,7 @@ from pkm.errors import (
     SpecNameError,
     UnknownNameError,
 )
+from pkm.validation import as_count, as_scalar, as_vector, finite_result
 
 
 @pytest.fixture(scope="module")

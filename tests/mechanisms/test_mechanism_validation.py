@@ -24,8 +24,8 @@ from pkm.mechanisms.delta import workspace as delta_workspace
 from pkm.mechanisms.hexapod import indices as hexapod_indices
 from pkm.mechanisms.hexapod import reconfiguration as hexapod_reconfigure
 from pkm.mechanisms.hexapod import singularities as hexapod_singularities
-from pkm.mechanisms.rrr3 import workspace as rrr3_maps
 from pkm.mechanisms.prs3.dynamics import Prs3Dynamics
+from pkm.mechanisms.rrr3 import workspace as rrr3_maps
 
 
 def test_build_refuses_unknown_parameters_with_the_valid_names():

@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 
 import pkm
 from pkm.errors import InvalidParameterError, PkmError
-from pkm.mechanisms import delta, hexapod, prs3, rrr3
+from pkm.mechanisms import definition, delta, hexapod, prs3, rrr3
 from pkm.mechanisms._common import rot_y
 
 #: ``max_examples`` of the ``ci`` profile; :func:`examples` scales every test's count from it.
@@ -156,6 +156,21 @@ def assert_vanishes(index: np.ndarray, what: str, *, final: float = 1e-6) -> Non
 
 
 # ---------------------------------------------------------------------- designs
+def generic_case(name: str):
+    """``(designs, pose, n, length)`` for a registered mechanism without strategies of its own (the toy five-bar):
+    its default design, poses about the reference within the registry's task scale."""
+    entry = definition(name)
+    mod = entry.module()
+    p0 = mod.Params()
+    mech = mod.build(p0)
+    task = pkm.TaskMap(mech)
+    y_ref = task.value(mech.q_reference)
+    scale = np.array(entry.tangent_scale(task.names))
+
+    def pose(p, u: np.ndarray) -> np.ndarray:
+        return task.retract(y_ref, scale * u)
+
+    return st.just(p0), pose, task.size, lambda p: float(max(entry.task_scale))
 @st.composite
 def delta_designs(draw, offset: tuple[float, float] = (0.2, 1.0)) -> delta.DeltaParams:
     """A Delta whose reference pose is on the axis with the arms at a drawn angle (knee out); ``R - r``

@@ -14,12 +14,13 @@ from hypothesis import strategies as st
 
 import pkm
 from pkm.core import TaskMap, close_loops, constraints, dynamics, solve_ik
-from pkm.mechanisms import NAMES, module
+from pkm.mechanisms import module, names
 from tests import fd
 from tests.properties import (
     delta_designs,
     delta_pose,
     examples,
+    generic_case,
     hexapod_designs,
     hexapod_pose,
     prs3_designs,
@@ -43,9 +44,14 @@ CASES = {
 }
 
 
+def case(name: str):
+    """The strategies of ``name``: its own, or :func:`generic_case` for a mechanism registered without them."""
+    return CASES[name] if name in CASES else generic_case(name)
+
+
 def _draw(data, name):
     """A random design of ``name``, its mechanism and a regular assembled configuration about its reference."""
-    designs, pose, n, length = CASES[name]
+    designs, pose, n, length = case(name)
     p = data.draw(designs, label="design")
     mod = module(name)
     mech = mod.build(p)
@@ -60,7 +66,7 @@ def _unassembled(data, mech, spread=0.3):
     return pin.integrate(mech.model, mech.q_reference, spread * data.draw(unit_box(mech.nv), label="dq"))
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", names())
 @examples(48)
 @given(data=st.data())
 def test_solve_ik_then_close_loops_round_trips(name, data):
@@ -82,14 +88,14 @@ def test_solve_ik_then_close_loops_round_trips(name, data):
     assert record("core solve_ik->close_loops (task)", np.abs(task.error(y, task.value(back.q))).max()) <= tol
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", names())
 @examples(60)
 @given(data=st.data())
 def test_constraint_jacobian_drift_and_task_bias_are_derivatives_anywhere(name, data):
     """At an arbitrary configuration (loops open), the constraint Jacobian is the derivative of the closure
     residual (point closures: exactly, 1e-7), and the drift and the task bias are the derivatives of J_c v
     and J_t v along q(t) = q (+) t v (Richardson differences, 1e-6)."""
-    p = data.draw(CASES[name][0], label="design")
+    p = data.draw(case(name)[0], label="design")
     mech = module(name).build(p)
     q = _unassembled(data, mech)
     v = data.draw(unit_box(mech.nv), label="v")
@@ -109,7 +115,7 @@ def test_constraint_jacobian_drift_and_task_bias_are_derivatives_anywhere(name, 
     assert record("core task bias vs FD (rel)", err(task.bias(q, v), diff(lambda qq: task.jacobian(qq) @ v))) <= 1e-6
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", names())
 @examples(60)
 @given(data=st.data())
 def test_velocity_maps_are_consistent(name, data):
@@ -132,13 +138,13 @@ def test_velocity_maps_are_consistent(name, data):
     assert d.constraint_rank + d.redundant_constraints == mech.n_constraints
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", names())
 @examples(60)
 @given(data=st.data())
 def test_task_retract_and_error_are_inverse(name, data):
     """TaskMap.retract(y, dy) moves y by the tangent vector dy: error(retract(y, dy), y) = dy (1e-12), and
     interpolate runs from y0 (s = 0) to y1 (s = 1)."""
-    p = data.draw(CASES[name][0], label="design")
+    p = data.draw(case(name)[0], label="design")
     mech = module(name).build(p)
     task = TaskMap(mech)
     y0 = task.value(_unassembled(data, mech))
@@ -149,13 +155,13 @@ def test_task_retract_and_error_are_inverse(name, data):
     assert np.abs(task.error(task.interpolate(y0, y1, 1.0), y1)).max() <= 1e-12
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", names())
 @examples(40)
 @given(data=st.data())
 def test_energy_is_that_of_the_mass_matrix_and_the_centre_of_mass(name, data):
     """dynamics.energy at an arbitrary state: kinetic = v^T M(q) v / 2 (Pinocchio's CRBA) and potential =
     -m g . c (total mass, centre of mass), to 1e-12 relative; the hexapod's mimic joints included."""
-    p = data.draw(CASES[name][0], label="design")
+    p = data.draw(case(name)[0], label="design")
     mech = module(name).build(p)
     q = _unassembled(data, mech)
     v = data.draw(unit_box(mech.nv), label="v")

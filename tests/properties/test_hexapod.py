@@ -20,9 +20,9 @@ import pkm
 from pkm.core import TaskMap, close_loops, constraints
 from pkm.core.dynamics import virtual_work_dynamics
 from pkm.mechanisms import hexapod as hx
+from pkm.mechanisms._common import rot_y
 from pkm.mechanisms.hexapod import screws as hs
 from pkm.mechanisms.hexapod import singularities as hsg
-from pkm.mechanisms._common import rot_y
 from tests import fd
 from tests.properties import (
     DECADES,

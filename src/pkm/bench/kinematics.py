@@ -22,7 +22,7 @@ import pkm
 from pkm.bench import best_time, main
 from pkm.core import TaskMap, close_loops, solve_ik
 from pkm.errors import PkmError
-from pkm.mechanisms import NAMES, module
+from pkm.mechanisms import module, names
 
 QUICK = {"n": 3}
 
@@ -54,7 +54,7 @@ def bench(name: str, n: int, delta: float, seed: int = 0) -> dict:
         rows["generic_ik_us"].append(_time(lambda: solve_ik(mech, y, seed_q)))
         rows["cf_ik_us"].append(_time(lambda: mod.closed_form_ik(mech.params, y)))
         rows["cf_config_us"].append(_time(lambda: mod.closed_form_configuration(mech, y)))
-        if hasattr(mod, "closed_form_fk"):
+        if mod.closed_form_fk is not None:
             rows["cf_fk_us"].append(_time(lambda: mod.closed_form_fk(mech.params, qa)))
     med = {k: statistics.median(v) for k, v in rows.items() if v}
     out = {
@@ -74,7 +74,7 @@ def bench(name: str, n: int, delta: float, seed: int = 0) -> dict:
 def add_arguments(ap) -> None:
     ap.add_argument("-n", type=int, default=50, help="configurations per mechanism")
     ap.add_argument("--delta", type=float, default=0.01, help="seed offset of the actuated coordinates [rad or m]")
-    ap.add_argument("mechanisms", nargs="*", default=list(NAMES))
+    ap.add_argument("mechanisms", nargs="*", default=list(names()))
 
 
 def run(args) -> list[dict]:

@@ -1,27 +1,48 @@
-"""The generic closed-loop core: knows no particular robot."""
+"""The generic closed-loop core: knows no particular robot.
 
-from pkm.core.differential import (
-    Diagnostics,
-    accelerations,
-    diagnose,
-    forward_jacobian,
-    inverse_accelerations,
-    inverse_jacobian,
-    inverse_velocities,
-    passive_map,
-    task_acceleration,
-    task_velocity,
-    twist_jacobian,
-    velocities,
-)
-from pkm.core.mechanism import Mechanism
-from pkm.core.solve import SolveResult, branch_seed, close_loops, solve_ik
-from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
-from pkm.core.task import TaskMap, zyx_angles, zyx_matrix
+Its names are imported on first use (PEP 562), so that ``import pkm.core.screws`` or
+``pkm.core.indices`` (numpy only) does not load Pinocchio.
+"""
 
-__all__ = [
-    "Branch", "Closure", "ClosureSpec", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "TaskSpec",
-    "accelerations", "branch_seed", "close_loops", "diagnose", "forward_jacobian", "inverse_accelerations",
-    "inverse_jacobian", "inverse_velocities", "passive_map", "solve_ik", "task_acceleration", "task_velocity",
-    "twist_jacobian", "velocities", "zyx_angles", "zyx_matrix",
-]
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from pkm._lazy import lazy
+
+_EXPORTS = {
+    "pkm.core.differential": ("Diagnostics", "accelerations", "diagnose", "forward_jacobian", "inverse_accelerations",
+                              "inverse_jacobian", "inverse_velocities", "passive_map", "task_acceleration",
+                              "task_velocity", "twist_jacobian", "velocities"),
+    "pkm.core.mechanism": ("Mechanism",),
+    "pkm.core.solve": ("SolveResult", "branch_seed", "close_loops", "solve_ik"),
+    "pkm.core.spec": ("Branch", "Closure", "ClosureSpec", "TaskSpec"),
+    "pkm.core.task": ("TaskMap", "zyx_angles", "zyx_matrix"),
+}
+_WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
+
+if TYPE_CHECKING:  # the static view of the lazy names
+    # ruff: noqa: F401
+    from pkm.core.differential import (
+        Diagnostics,
+        accelerations,
+        diagnose,
+        forward_jacobian,
+        inverse_accelerations,
+        inverse_jacobian,
+        inverse_velocities,
+        passive_map,
+        task_acceleration,
+        task_velocity,
+        twist_jacobian,
+        velocities,
+    )
+    from pkm.core.mechanism import Mechanism
+    from pkm.core.solve import SolveResult, branch_seed, close_loops, solve_ik
+    from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
+    from pkm.core.task import TaskMap, zyx_angles, zyx_matrix
+
+
+__getattr__, __dir__ = lazy("pkm.core", globals(), _WHERE)
+
+__all__ = sorted(_WHERE)

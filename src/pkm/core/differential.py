@@ -25,9 +25,10 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core import constraints
-from pkm.core.mechanism import Mechanism, as_tolerance, as_vector, check_mechanism, finite_result
+from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.task import TaskMap
 from pkm.errors import SingularityError
+from pkm.validation import as_tolerance, as_vector, finite_result
 
 RTOL = 1e-9
 

@@ -44,8 +44,9 @@ import pinocchio as pin
 
 from pkm.core import constraints
 from pkm.core.differential import passive_map
-from pkm.core.mechanism import Mechanism, as_scalar, as_tolerance, as_vector, check_mechanism, finite_result
+from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.errors import PkmError, SingularityError, SpecError
+from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
 
 RTOL = 1e-9
 

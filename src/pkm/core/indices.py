@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pkm.core.mechanism import as_array, as_scalar, finite_result
 from pkm.errors import InvalidInputError
+from pkm.validation import as_array, as_scalar, finite_result
 
 KINDS = ("2", "fro", "fro_normalized")
 

@@ -46,8 +46,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import proxsuite
 
-from pkm.core.mechanism import as_array, as_count, as_scalar, as_tolerance, finite_result
 from pkm.errors import ConvergenceError, InvalidInputError, PkmError
+from pkm.validation import as_array, as_count, as_scalar, as_tolerance, finite_result
 
 IndexFn = Callable[[np.ndarray, np.ndarray], np.ndarray]
 

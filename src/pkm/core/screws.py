@@ -30,8 +30,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pkm.core.mechanism import as_array, as_scalar, finite_result
 from pkm.errors import InvalidInputError
+from pkm.validation import as_array, as_scalar, finite_result
 
 #: The polarity operator ``[[0, I], [I, 0]]`` (swaps primal and dual parts): ``{a; b} = a^T DELTA b``.
 DELTA = np.block([[np.zeros((3, 3)), np.eye(3)], [np.eye(3), np.zeros((3, 3))]])

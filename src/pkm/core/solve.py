@@ -31,9 +31,10 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core import constraints
-from pkm.core.mechanism import Mechanism, as_count, as_scalar, as_tolerance, check_mechanism
+from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.task import TaskMap
 from pkm.errors import BranchError, ConvergenceError, InvalidInputError
+from pkm.validation import as_count, as_scalar, as_tolerance
 
 DEFAULT_TOL = 1e-12
 MAX_STEPS = 1000  #: continuation steps planned at most (a farther target gets longer steps)

@@ -82,10 +82,10 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
 from pkm.errors import InvalidInputError, SpecError
+from pkm.validation import ABSURD
 
 FORMAT = "pkm.closures/1"
 MAX_FILE_BYTES = 16 * 1024 * 1024  # URDF, spec and motion files larger than this are refused
-_ABSURD = 1e6  # |value| above this in a file (m, rad) is taken for a unit error
 CLOSURE_TYPES = ("point", "frame")
 TASK_COMPONENTS = ("x", "y", "z", "roll", "pitch", "yaw")
 
@@ -255,8 +255,8 @@ class ClosureSpec:
                 raise SpecError(source, f"reference.{jname} must be a list of numbers")
             if not all(math.isfinite(v) for v in vals):
                 raise SpecError(source, f"reference.{jname} holds a non-finite number")
-            if not all(abs(v) <= _ABSURD for v in vals):
-                raise SpecError(source, f"reference.{jname} holds a number beyond {_ABSURD:g} (SI units: m, rad)")
+            if not all(abs(v) <= ABSURD for v in vals):
+                raise SpecError(source, f"reference.{jname} holds a number beyond {ABSURD:g} (SI units: m, rad)")
             reference[jname] = tuple(float(v) for v in vals)
 
         params = raw.get("parameters", {})

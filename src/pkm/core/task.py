@@ -18,8 +18,9 @@ from collections.abc import Mapping
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.mechanism import Mechanism, as_array, as_vector
+from pkm.core.mechanism import Mechanism
 from pkm.errors import InvalidInputError, SingularityError
+from pkm.validation import as_array, as_vector
 
 _ANGLES = ("roll", "pitch", "yaw")
 _POS = {"x": 0, "y": 1, "z": 2}

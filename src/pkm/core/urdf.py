@@ -48,9 +48,9 @@ import yourdfpy
 from lxml import etree
 
 from pkm.errors import InvalidInputError, SpecError
+from pkm.validation import ABSURD
 
 _JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
-_ABSURD = 1e6  # |value| above this (m, rad, kg, N) is taken for a unit error
 _MAX_BYTES = 16 * 1024 * 1024
 _MAX_ELEMENTS = 10_000  # links + joints
 
@@ -134,7 +134,7 @@ def _floats(text: str | None, n: int, what: str, source: str) -> list[float]:
     if len(vals) != n:
         raise SpecError(source, f"{what}: expected {n} numbers, got {text!r}")
     for v in vals:
-        if not math.isfinite(v) or abs(v) > _ABSURD:
+        if not math.isfinite(v) or abs(v) > ABSURD:
             raise SpecError(source, f"{what}: value {v!r} is not finite or absurdly large (SI units expected)")
     return vals
 

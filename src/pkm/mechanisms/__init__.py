@@ -1,29 +1,148 @@
-"""The four mechanisms of the papers, one module each.
+"""The mechanisms pkm ships, one package each, and the registry every consumer iterates.
 
-Every package offers ``NAME``, ``Params`` (frozen dataclass, SI units), ``build(params)``,
-``urdf_xml(params)``, ``closure_spec(params)`` and the closed forms
-``closed_form_ik``, ``closed_form_configuration`` (and ``closed_form_fk`` where the paper
-has one) over the task vector of :class:`pkm.core.TaskMap`.
+A mechanism package ``pkm.mechanisms.<name>`` implements :class:`MechanismModule`: its design
+dataclass ``Params`` (SI units, validated), the generators ``urdf_xml``, ``closure_spec`` and
+``build``, and the closed forms over the task vector of :class:`pkm.core.TaskMap`
+(``closed_form_ik``, ``closed_form_configuration``, and ``closed_form_fk`` or None where it has
+no closed-form forward kinematics). :data:`REGISTRY` maps each name to its
+:class:`MechanismDefinition`; the command line, the report, the papers, the benchmarks, the
+generic and property tests and the fuzzing iterate it.
+
+Adding a mechanism: one package implementing the protocol, and one :data:`REGISTRY` entry (or
+:func:`register` at run time, as the tests do for their toy five-bar). See the README's
+contributor section.
 """
 
 from __future__ import annotations
 
 import importlib
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from types import ModuleType
+from typing import Any, Protocol, cast, runtime_checkable
 
-from pkm.errors import UnknownNameError
+from pkm.errors import InvalidInputError, UnknownNameError
 
-NAMES = ("hexapod", "rrr3", "delta", "prs3")
-TITLES = {
-    "hexapod": "reconfigurable hexapod of two 3-RUS sub-manipulators (Sanchez-Alonso et al. 2016)",
-    "rrr3": "planar 3-RRR (singularities and global condition index)",
-    "delta": "Delta robot with reconfigurable base radius R (Hernandez Reyna & Sandoval-Castro 2018)",
-    "prs3": "3-PRS (Diaz-Rodriguez et al. 2016: kinematics and inverse dynamics)",
+
+@runtime_checkable
+class MechanismModule(Protocol):
+    """What a mechanism package provides (its ``__init__`` re-exports these)."""
+
+    NAME: str
+    Params: type
+
+    def urdf_xml(self, params: Any) -> str: ...
+
+    def closure_spec(self, params: Any) -> Any: ...
+
+    def build(self, params: Any = None) -> Any: ...
+
+    def closed_form_ik(self, params: Any, y: Any, branch: str | None = None) -> Any: ...
+
+    def closed_form_configuration(self, mech: Any, y: Any, branch: str | None = None) -> Any: ...
+
+    #: Closed-form forward kinematics ``(params, q_actuated, seed=None) -> task vector``, or None.
+    closed_form_fk: Callable[..., Any] | None
+
+
+@dataclass(frozen=True)
+class MechanismDefinition:
+    """One registered mechanism.
+
+    Attributes:
+        name: Its name (``pkm.load(name)``, ``pkm ik NAME``).
+        title: One line: what it is and where it comes from.
+        package: Import path of the package implementing :class:`MechanismModule`.
+        paper: The study module in :mod:`pkm.papers` that reproduces its paper, or None.
+        task_scale: Typical excursion of the task about the reference: position [m], angle [rad],
+            joint outputs [rad]; used to draw poses near the reference (tests, fuzzing, benchmarks).
+        reference: The closure spec of the reference design, a file name in pkm's ``urdf/`` data
+            folder (shipped in the wheel; ``pkm.load`` reads it and its URDF), or None: ``pkm.load``
+            builds the default ``Params()``.
+    """
+
+    name: str
+    title: str
+    package: str
+    paper: str | None = None
+    task_scale: tuple[float, float, float] = (0.05, 0.1, 0.1)
+    reference: str | None = None
+
+    def tangent_scale(self, coordinates: Sequence[str]) -> list[float]:
+        """:attr:`task_scale` spread over task coordinates (``x y z`` positions, ``roll pitch yaw wx wy wz``
+        angles, anything else a joint output), for drawing poses about the reference."""
+        pos, ang, joint = self.task_scale
+        return [pos if c in ("x", "y", "z") else ang if c in ("roll", "pitch", "yaw", "wx", "wy", "wz") else joint
+                for c in coordinates]
+
+    def module(self) -> MechanismModule:
+        """The mechanism's package, imported on first use."""
+        return cast(MechanismModule, importlib.import_module(self.package))
+
+
+#: name -> definition, in the order the report and ``pkm list`` show them.
+REGISTRY: dict[str, MechanismDefinition] = {
+    d.name: d for d in (
+        MechanismDefinition("hexapod", "reconfigurable hexapod of two 3-RUS sub-manipulators (Sanchez-Alonso et al. "
+                                       "2016)", "pkm.mechanisms.hexapod", "hexapod", (0.03, 0.08, 0.3),
+                            "hexapod.closures.toml"),
+        MechanismDefinition("rrr3", "planar 3-RRR (singularities and global condition index)", "pkm.mechanisms.rrr3",
+                            "rrr3", (0.12, 0.3, 0.0), "rrr3.closures.toml"),
+        MechanismDefinition("delta", "Delta robot with reconfigurable base radius R (Hernandez Reyna & "
+                                     "Sandoval-Castro 2018)", "pkm.mechanisms.delta", "delta", (0.06, 0.0, 0.0),
+                            "delta.closures.toml"),
+        MechanismDefinition("prs3", "3-PRS (Diaz-Rodriguez et al. 2016: kinematics and inverse dynamics)",
+                            "pkm.mechanisms.prs3", "prs3", (0.06, 0.15, 0.0), "prs3.closures.toml"),
+    )
 }
 
 
+def names(*, with_files: bool = False) -> tuple[str, ...]:
+    """The registered mechanisms, in registry order; ``with_files``: only those whose reference design
+    ships as files (URDF + closure spec in pkm's data folder)."""
+    return tuple(n for n, d in REGISTRY.items() if d.reference is not None or not with_files)
+
+
+def definition(name: str) -> MechanismDefinition:
+    """The registry entry of ``name``; :class:`UnknownNameError` listing the registered ones otherwise."""
+    if not isinstance(name, str) or name not in REGISTRY:
+        raise UnknownNameError("mechanism", repr(name) if not isinstance(name, str) else name, names())
+    return REGISTRY[name]
+
+
 def module(name: str) -> ModuleType:
-    """The module of mechanism ``name``."""
-    if not isinstance(name, str) or name not in NAMES:
-        raise UnknownNameError("mechanism", repr(name) if not isinstance(name, str) else name, NAMES)
-    return importlib.import_module(f"pkm.mechanisms.{name}")
+    """The package of mechanism ``name``."""
+    return cast(ModuleType, definition(name).module())
+
+
+def register(entry: MechanismDefinition, *, replace: bool = False) -> MechanismDefinition:
+    """Add ``entry`` to :data:`REGISTRY` (a mechanism of one's own; the tests register a toy five-bar).
+
+    Its package must import and implement :class:`MechanismModule`.
+
+    Raises:
+        InvalidInputError: not a :class:`MechanismDefinition`, the name is taken (unless
+            ``replace``), or the package lacks part of the protocol.
+    """
+    if not isinstance(entry, MechanismDefinition):
+        raise InvalidInputError("entry", f"expected a MechanismDefinition, got {type(entry).__name__}", entry)
+    if entry.name in REGISTRY and not replace:
+        raise InvalidInputError("entry", f"a mechanism named {entry.name!r} is registered already", entry.name)
+    mod = entry.module()
+    missing = [n for n in ("NAME", "Params", "urdf_xml", "closure_spec", "build", "closed_form_ik",
+                           "closed_form_configuration", "closed_form_fk") if not hasattr(mod, n)]
+    if missing:
+        raise InvalidInputError("entry", f"{entry.package} does not implement MechanismModule: no {missing}",
+                                entry.package)
+    REGISTRY[entry.name] = entry
+    return entry
+
+
+def unregister(name: str) -> None:
+    """Remove ``name`` from :data:`REGISTRY` (undoes :func:`register`)."""
+    definition(name)
+    del REGISTRY[name]
+
+
+__all__ = ["REGISTRY", "MechanismDefinition", "MechanismModule", "definition", "module", "names", "register",
+           "unregister"]

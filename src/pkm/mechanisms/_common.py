@@ -8,9 +8,10 @@ import numbers
 
 import numpy as np
 
-from pkm.core.mechanism import ABSURD, Mechanism, wrap_angle
+from pkm.core.mechanism import Mechanism
 from pkm.core.spec import ClosureSpec
 from pkm.errors import InvalidParameterError, UnreachableError
+from pkm.validation import ABSURD, wrap_angle
 
 
 def rot_x(a: float) -> np.ndarray:

@@ -1,11 +1,12 @@
 """Paper studies: one module per paper, each reproducing its published numbers and figures.
 
-Every study module ``pkm.papers.<name>`` (``<name>`` one of :data:`NAMES`) provides
+Every study module ``pkm.papers.<name>`` (``<name>`` one of :func:`names`: the ``paper`` of the
+registered mechanisms, :data:`pkm.mechanisms.REGISTRY`) provides
 
 * ``TITLE``: the paper, in one line;
 * ``reproduce() -> list[Row]``: the published numbers next to ours;
 * ``figures(out_dir) -> list[pathlib.Path]``: the paper's figures redrawn (PNG);
-* optionally ``series(out_dir) -> list[pathlib.Path]``: time series or maps as CSV.
+* ``series(out_dir) -> list[pathlib.Path]``: time series or maps as CSV, or ``series = None``.
 
 Row ids are a contract (issues name them): keep them stable. ``pkm report`` gathers
 the rows of every paper into ``summary.json`` and a table.
@@ -20,8 +21,8 @@ from types import ModuleType
 from typing import Any
 
 from pkm.errors import InvalidInputError, UnknownNameError
+from pkm.mechanisms import REGISTRY
 
-NAMES = ("hexapod", "rrr3", "delta", "prs3")
 RELATIONS = ("==", "<=", ">=")
 
 Value = float | int | bool | str | None
@@ -82,11 +83,16 @@ class Row:
         return d
 
 
+def names() -> tuple[str, ...]:
+    """The paper studies, in registry order: the ``paper`` of every registered mechanism that has one."""
+    return tuple(d.paper for d in REGISTRY.values() if d.paper is not None)
+
+
 def module(name: str) -> ModuleType:
-    """The study module of paper ``name`` (one of :data:`NAMES`)."""
-    if name not in NAMES:
-        raise UnknownNameError("paper", name, NAMES)
+    """The study module of paper ``name`` (one of :func:`names`)."""
+    if name not in names():
+        raise UnknownNameError("paper", name, names())
     return importlib.import_module(f"pkm.papers.{name}")
 
 
-__all__ = ["NAMES", "Row", "module"]
+__all__ = ["Row", "module", "names"]

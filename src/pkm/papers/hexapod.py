@@ -145,4 +145,7 @@ def figures(out_dir) -> list[Path]:
     return out
 
 
-__all__ = ["TITLE", "figures", "pose_t", "reproduce", "spiral", "spiral_poses"]
+#: No CSV series yet (the figures issue adds them).
+series = None
+
+__all__ = ["TITLE", "figures", "pose_t", "reproduce", "series", "spiral", "spiral_poses"]

@@ -16,9 +16,9 @@ import pytest
 import pkm
 from pkm.core import screws
 from pkm.mechanisms import hexapod as hx
+from pkm.mechanisms._common import rot_y
 from pkm.mechanisms.hexapod import screws as hs
 from pkm.mechanisms.hexapod import singularities as hsg
-from pkm.mechanisms._common import rot_y
 
 DEG = math.pi / 180.0
 COINCIDENT = tuple(a * DEG for a in (35.0, 155.0, 275.0, 35.0, 155.0, 275.0))  # theta_i = theta_{i+3}

@@ -34,7 +34,6 @@ of this size) and only matter for dynamics.
 from __future__ import annotations
 
 from pkm.mechanisms.delta.kinematics import (  # noqa: F401 (the mechanism's API)
-    Params,
     arm_angles,
     closed_form_configuration,
     closed_form_fk,
@@ -54,28 +53,10 @@ from pkm.mechanisms.delta.model import (  # noqa: F401 (the mechanism's API)
 )
 from pkm.mechanisms.delta.params import (  # noqa: F401 (the mechanism's API)
     BRANCHES,
-    DeltaParams,
     NAME,
     PHI,
-)
-from pkm.mechanisms.delta.kinematics import (  # noqa: F401 (the mechanism's API)
+    DeltaParams,
     Params,
-    arm_angles,
-    closed_form_configuration,
-    closed_form_fk,
-    closed_form_ik,
-    configuration,
-    forward_kinematics,
-    inverse_kinematics,
-    jacobian,
-    jacobian_factors,
-    joint_values,
-    sphere_centres,
-)
-from pkm.mechanisms.delta.model import (  # noqa: F401 (the mechanism's API)
-    build,
-    closure_spec,
-    urdf_xml,
 )
 
 __all__ = [

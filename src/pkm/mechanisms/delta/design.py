@@ -21,11 +21,11 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from pkm.core.indices import KINDS
-from pkm.core.mechanism import as_array, as_count, as_vector
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms._common import check_params, real
 from pkm.mechanisms.delta import PHI, DeltaParams, arm_angles
 from pkm.mechanisms.delta.workspace import condition_numbers, workspace
+from pkm.validation import as_array, as_count, as_vector
 
 __all__ = ["RadiusStudy", "condition_vs_radius", "radius_minimising_condition", "reachable_radii",
            "region_mean_condition", "workspace_vs_radius"]

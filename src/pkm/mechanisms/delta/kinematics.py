@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from pkm.core.mechanism import Mechanism, as_vector, check_mechanism, finite_result
+from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.errors import AssemblyError, InvalidInputError, SingularityError
 from pkm.mechanisms._common import (
     arm_angle,
@@ -14,12 +14,12 @@ from pkm.mechanisms._common import (
     rot_z,
 )
 from pkm.mechanisms.delta.params import BRANCHES, PHI, DeltaParams
+from pkm.validation import as_vector, finite_result
 
 
 # ---------------------------------------------------------------------- closed forms
 def _arm_frame_point(p: np.ndarray, i: int) -> np.ndarray:
     return rot_z(-PHI[i]) @ p
-
 
 
 def inverse_kinematics(params: DeltaParams, p, branch: str | tuple[str, str, str] = "knee_out") -> np.ndarray:
@@ -45,7 +45,6 @@ def inverse_kinematics(params: DeltaParams, p, branch: str | tuple[str, str, str
     return arm_angles(params.La, params.Lb, params.R - params.r, p, tuple(-BRANCHES[b] for b in branches))
 
 
-
 def arm_angles(La: float, Lb: float, offset: float, p: np.ndarray, signs: tuple[int, int, int],
                where: str = "") -> np.ndarray:
     """The motor angles [rad] of :func:`inverse_kinematics` from raw dimensions [m]:
@@ -59,14 +58,12 @@ def arm_angles(La: float, Lb: float, offset: float, p: np.ndarray, signs: tuple[
     return th
 
 
-
 def sphere_centres(params: DeltaParams, theta) -> np.ndarray:
     """Centres ``B'_i`` of the three spheres of radius Lb (eqs. 3-7), rows i = 1..3 [m]."""
     params = check_params(params, DeltaParams)
     theta = as_vector(theta, 3, "theta")
     return np.array([rot_z(PHI[i]) @ np.array([0.0, params.R + params.La * math.cos(theta[i]) - params.r,
                                                 params.La * math.sin(theta[i])]) for i in range(3)])
-
 
 
 def forward_kinematics(params: DeltaParams, theta, *, both: bool = False) -> np.ndarray:
@@ -105,7 +102,6 @@ def forward_kinematics(params: DeltaParams, theta, *, both: bool = False) -> np.
     return sols if both else sols[0]
 
 
-
 def jacobian_factors(params: DeltaParams, p, theta) -> tuple[np.ndarray, np.ndarray]:
     """The two factors of the velocity equations ``A Xd = diag(d) thd``, over stacks of poses.
 
@@ -138,7 +134,6 @@ def jacobian_factors(params: DeltaParams, p, theta) -> tuple[np.ndarray, np.ndar
     return A, d
 
 
-
 def jacobian(params: DeltaParams, theta, p=None) -> np.ndarray:
     """``J = dX/dth`` [m/rad] (eq. 12), in closed form from the sphere equations: ``J = A^-1 diag(d)``.
 
@@ -169,7 +164,6 @@ def jacobian(params: DeltaParams, theta, p=None) -> np.ndarray:
     return np.linalg.solve(A, np.diag(d))
 
 
-
 def joint_values(params: DeltaParams, p, branch: str | tuple[str, str, str] = "knee_out") -> dict[str, list[float]]:
     """Every joint coordinate of the tree (closed form), for platform centre ``p``."""
     params = check_params(params, DeltaParams)
@@ -191,12 +185,10 @@ def joint_values(params: DeltaParams, p, branch: str | tuple[str, str, str] = "k
     return out
 
 
-
 def configuration(mech: Mechanism, p, branch: str | tuple[str, str, str] = "knee_out") -> np.ndarray:
     """Full configuration vector ``q`` of ``mech`` for platform centre ``p`` (closed form)."""
     mech = check_mechanism(mech)
     return mech.q_from_dict(joint_values(mech.params, p, branch))
-
 
 
 # ---------------------------------------------------------------------- uniform interface
@@ -207,11 +199,9 @@ def closed_form_ik(params: DeltaParams, y, branch: str | None = None) -> np.ndar
     return inverse_kinematics(params, y, branch or "knee_out")
 
 
-
 def closed_form_configuration(mech: Mechanism, y, branch: str | None = None) -> np.ndarray:
     """Every joint coordinate for task vector ``y`` (closed form)."""
     return configuration(mech, y, branch or "knee_out")
-
 
 
 def closed_form_fk(params: DeltaParams, q_actuated, seed=None) -> np.ndarray:
@@ -219,5 +209,3 @@ def closed_form_fk(params: DeltaParams, q_actuated, seed=None) -> np.ndarray:
     return forward_kinematics(params, q_actuated)
 
 
-
-Params = DeltaParams

@@ -49,7 +49,6 @@ def urdf_xml(params: DeltaParams) -> str:
     return b.to_xml()
 
 
-
 def closure_spec(params: DeltaParams) -> ClosureSpec:
     params = check_params(params, DeltaParams)
     reference = {k: tuple(v) for k, v in joint_values(params, params.home).items()}
@@ -69,7 +68,6 @@ def closure_spec(params: DeltaParams) -> ClosureSpec:
         default_branch="knee_out",
         parameters=spec_parameters(params),
     )
-
 
 
 def build(params: DeltaParams | None = None) -> Mechanism:

@@ -14,13 +14,10 @@ from pkm.mechanisms._common import (
 NAME = "delta"
 
 
-
 PHI = (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0)
 
 
-
 BRANCHES = {"knee_out": -1, "knee_in": 1}
-
 
 
 @dataclass(frozen=True)
@@ -61,3 +58,7 @@ class DeltaParams:
                 "home", f"reference pose {self.home} is unreachable with this design (leg {exc.leg} misses by "
                         f"{exc.excess:.4g} m); choose another home or other lengths", self.home) from None
         del th
+
+
+#: The protocol's name for the design dataclass.
+Params = DeltaParams

@@ -20,10 +20,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from pkm.core.indices import KINDS, condition_number
-from pkm.core.mechanism import as_array, wrap_angle
 from pkm.errors import InvalidInputError
 from pkm.mechanisms._common import check_params, real
 from pkm.mechanisms.delta import BRANCHES, PHI, DeltaParams, jacobian_factors
+from pkm.validation import as_array, wrap_angle
 
 MAX_NODES = 16_000_000  #: grid nodes of :func:`workspace` at most (memory)
 

@@ -121,7 +121,6 @@ from __future__ import annotations
 from pkm.core.task import ROTATION_TOL  # noqa: F401 (a user's rotation within this of SO(3) is projected)
 from pkm.mechanisms.hexapod.kinematics import (  # noqa: F401 (the mechanism's API)
     AssemblyMode,
-    Params,
     actuated_from_paper,
     assembly_modes,
     base_points,
@@ -150,39 +149,14 @@ from pkm.mechanisms.hexapod.params import (  # noqa: F401 (the mechanism's API)
     BRANCHES,
     DEFAULT_BRANCH,
     HOME_ROTATION_TOL,
-    HexapodParams,
     LAYOUTS,
     NAME,
     POSE_T_POSITION,
     POSE_T_ROTATION,
+    HexapodParams,
+    Params,
     home_rotation,
     leg_frame,
-)
-from pkm.mechanisms.hexapod.kinematics import (  # noqa: F401 (the mechanism's API)
-    AssemblyMode,
-    Params,
-    actuated_from_paper,
-    assembly_modes,
-    base_points,
-    branch_names,
-    closed_form_configuration,
-    closed_form_fk,
-    closed_form_ik,
-    configuration,
-    elbow_points,
-    forward_kinematics,
-    inverse_kinematics,
-    joint_values,
-    paper_alphas,
-    platform_local_points,
-    platform_points,
-    pose_from_points,
-    task_vector,
-)
-from pkm.mechanisms.hexapod.model import (  # noqa: F401 (the mechanism's API)
-    build,
-    closure_spec,
-    urdf_xml,
 )
 
 __all__ = [

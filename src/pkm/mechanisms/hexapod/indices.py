@@ -31,12 +31,12 @@ import numpy as np
 
 from pkm.core import indices as core_indices
 from pkm.core import screws
-from pkm.core.mechanism import as_scalar, as_vector
 from pkm.core.task import as_rotation
 from pkm.errors import InvalidInputError
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms._common import check_params
 from pkm.mechanisms.hexapod import screws as hs
+from pkm.validation import as_scalar, as_vector
 
 #: Index names accepted by :class:`PoseIndex` and the beta selection.
 INDICES = ("w_rot", "w_tras")

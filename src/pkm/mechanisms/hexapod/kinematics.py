@@ -9,16 +9,7 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core import constraints
-from pkm.core.mechanism import (
-    Mechanism,
-    as_array,
-    as_count,
-    as_scalar,
-    as_tolerance,
-    as_vector,
-    check_mechanism,
-    wrap_angle,
-)
+from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.task import as_rotation
 from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError
 from pkm.mechanisms._common import (
@@ -27,13 +18,9 @@ from pkm.mechanisms._common import (
     rot_z,
 )
 from pkm.mechanisms.hexapod.params import BRANCHES, DEFAULT_BRANCH, LAYOUTS, HexapodParams, home_rotation, leg_frame
+from pkm.validation import as_array, as_count, as_scalar, as_tolerance, as_vector, wrap_angle
 
 _E_Y = np.array([0.0, 1.0, 0.0])
-
-
-
-Params = HexapodParams
-
 
 
 def base_points(params: HexapodParams, beta: float) -> np.ndarray:
@@ -49,7 +36,6 @@ def base_points(params: HexapodParams, beta: float) -> np.ndarray:
     return out
 
 
-
 def platform_local_points(params: HexapodParams) -> np.ndarray:
     """Spherical joint centres ``C*_1..C*_6`` in the platform frame, rows [m]."""
     params = check_params(params, HexapodParams)
@@ -58,12 +44,10 @@ def platform_local_points(params: HexapodParams) -> np.ndarray:
     return np.vstack([low + params.h * _E_Y, low])
 
 
-
 def platform_points(params: HexapodParams, R: np.ndarray, P) -> np.ndarray:
     """``C_1..C_6`` in the base frame for platform orientation ``R`` and position ``P`` (eq. 14), rows [m]."""
     params = check_params(params, HexapodParams)
     return np.asarray(P, dtype=float) + platform_local_points(params) @ np.asarray(R, dtype=float).T
-
 
 
 def elbow_points(params: HexapodParams, alphas, beta: float) -> np.ndarray:
@@ -75,7 +59,6 @@ def elbow_points(params: HexapodParams, alphas, beta: float) -> np.ndarray:
                      for i in range(6)])
 
 
-
 def paper_alphas(q_actuated) -> np.ndarray:
     """The paper's absolute ``alpha_1..alpha_6`` [rad] from the actuated vector (spec order).
 
@@ -85,13 +68,11 @@ def paper_alphas(q_actuated) -> np.ndarray:
     return np.concatenate([qa[:3] + qa[6], qa[3:6]])
 
 
-
 def actuated_from_paper(alphas, beta: float) -> np.ndarray:
     """The actuated vector (``alpha_1..alpha_6`` joint coordinates, ``beta_1``) from the paper's angles."""
     a = as_vector(alphas, 6, "alphas")
     b = _scalar(beta, "beta")
     return np.concatenate([wrap_angle(a[:3] - b), wrap_angle(a[3:]), [b]])
-
 
 
 # ---------------------------------------------------------------------- closed forms
@@ -125,12 +106,10 @@ def inverse_kinematics(params: HexapodParams, R, P, beta: float,
     return out
 
 
-
 def _leg_angle(params: HexapodParams, i: int, d: np.ndarray, branch: str) -> float:
     dr, dy, du = leg_frame(params.theta[i]).T @ d
     return arm_angle(dr, dy, du, params.LA, params.LB, -BRANCHES[branch], i + 1,
                      f"leg {i + 1}: the rod LB cannot span the distance from C_{i + 1} to the circle of B")
-
 
 
 def joint_values(params: HexapodParams, R, P, beta: float,
@@ -153,7 +132,6 @@ def joint_values(params: HexapodParams, R, P, beta: float,
     return _joint_values(params, R, P, pin.Quaternion(R).coeffs(), beta, alphas)
 
 
-
 def _joint_values(params: HexapodParams, R: np.ndarray, P, quat: np.ndarray, beta: float,
                   alphas: np.ndarray) -> dict[str, list[float]]:
     C = platform_points(params, R, P)
@@ -171,14 +149,12 @@ def _joint_values(params: HexapodParams, R: np.ndarray, P, quat: np.ndarray, bet
     return out
 
 
-
 def configuration(mech: Mechanism, y, branch: str | tuple[str, ...] = DEFAULT_BRANCH) -> np.ndarray:
     """Full configuration ``q`` of ``mech`` for task vector ``y = (x, y, z, qx, qy, qz, qw, beta)`` (closed form)."""
     mech = check_mechanism(mech)
     R, P, quat, beta = _task(y)
     alphas = inverse_kinematics(mech.params, R, P, beta, branch)
     return mech.q_from_dict(_joint_values(mech.params, R, P, quat, beta, alphas))
-
 
 
 def forward_kinematics(params: HexapodParams, alphas, beta: float, seed=None, *, tol: float = 1e-12,
@@ -272,7 +248,6 @@ def forward_kinematics(params: HexapodParams, alphas, beta: float, seed=None, *,
     return np.vstack([C, C + params.h * normal(C)])
 
 
-
 @dataclass(frozen=True)
 class AssemblyMode:
     """One solution of the forward kinematics.
@@ -291,7 +266,6 @@ class AssemblyMode:
     P: np.ndarray
     q: np.ndarray
     core_residual: float
-
 
 
 def assembly_modes(mech: Mechanism, q_actuated, *, n_starts: int = 32, seed: int = 0, tol: float = 1e-12,
@@ -360,7 +334,6 @@ def assembly_modes(mech: Mechanism, q_actuated, *, n_starts: int = 32, seed: int
     return sorted(found, key=lambda m: float(np.linalg.norm(m.P - P0)))
 
 
-
 def pose_from_points(params: HexapodParams, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Platform orientation and position ``(R, P)`` from ``C_1..C_6`` (eqs. 8-13, layout's sign of eq. 11)."""
     params = check_params(params, HexapodParams)
@@ -372,12 +345,10 @@ def pose_from_points(params: HexapodParams, C: np.ndarray) -> tuple[np.ndarray, 
     return np.column_stack([x, np.cross(z, x), z]), P
 
 
-
 def task_vector(R, P, beta: float) -> np.ndarray:
     """The task vector ``(x, y, z, qx, qy, qz, qw, beta)`` of a pose and ``beta``."""
     return np.concatenate([np.asarray(P, dtype=float), pin.Quaternion(np.asarray(R, dtype=float)).coeffs(),
                            [float(beta)]])
-
 
 
 # ---------------------------------------------------------------------- uniform interface
@@ -389,11 +360,9 @@ def closed_form_ik(params: HexapodParams, y, branch: str | tuple[str, ...] | Non
     return actuated_from_paper(inverse_kinematics(params, R, P, beta, branch or DEFAULT_BRANCH), beta)
 
 
-
 def closed_form_configuration(mech: Mechanism, y, branch: str | tuple[str, ...] | None = None) -> np.ndarray:
     """Every joint coordinate for task vector ``y`` (closed form)."""
     return configuration(mech, y, branch or DEFAULT_BRANCH)
-
 
 
 def closed_form_fk(params: HexapodParams, q_actuated, seed=None) -> np.ndarray:
@@ -419,7 +388,6 @@ def closed_form_fk(params: HexapodParams, q_actuated, seed=None) -> np.ndarray:
     return task_vector(R, P, qa[6])
 
 
-
 # ---------------------------------------------------------------------- helpers
 def branch_names(branch: str | tuple[str, ...]) -> tuple[str, ...]:
     branches = (branch,) * 6 if isinstance(branch, str) else tuple(branch) if isinstance(branch, (tuple, list)) else ()
@@ -428,10 +396,8 @@ def branch_names(branch: str | tuple[str, ...]) -> tuple[str, ...]:
     return branches
 
 
-
 def _scalar(x, name: str) -> float:
     return float(as_vector([x], 1, name)[0])
-
 
 
 def _task(y, name: str = "y") -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:

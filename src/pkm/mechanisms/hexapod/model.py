@@ -58,7 +58,6 @@ def urdf_xml(params: HexapodParams) -> str:
     return b.to_xml()
 
 
-
 def closure_spec(params: HexapodParams) -> ClosureSpec:
     """The closure spec: six point closures (the spherical joints), reference at the home pose."""
     params = check_params(params, HexapodParams)
@@ -81,7 +80,6 @@ def closure_spec(params: HexapodParams) -> ClosureSpec:
         default_branch=DEFAULT_BRANCH,
         parameters=spec_parameters(params),
     )
-
 
 
 def build(params: HexapodParams | None = None) -> Mechanism:

@@ -20,35 +20,27 @@ from pkm.mechanisms._common import (
 NAME = "hexapod"
 
 
-
 LAYOUTS = {"sector": (0.0, 120.0, 240.0), "literal": (0.0, 240.0, 120.0)}  # psi of C4, C5, C6 [deg]
-
 
 
 BRANCHES = {"elbow_out": -1, "elbow_in": 1}  # sign of knee_i
 
 
-
 DEFAULT_BRANCH = "elbow_out"
 
 
-
 ACTUATED = ("alpha_1", "alpha_2", "alpha_3", "alpha_4", "alpha_5", "alpha_6", "beta_1")
-
 
 
 #: The paper's pose T (sec. 4) as printed: rotation rows (4 digits) and position [m].
 POSE_T_ROTATION = (0.9623, -0.1306, -0.2388, 0.0842, 0.9771, -0.1952, 0.2588, 0.1677, 0.9513)
 
 
-
 POSE_T_POSITION = (0.0, -0.350, 0.0)
-
 
 
 #: Largest ``max|R^T R - I|`` accepted for a platform rotation given by the user (then projected on SO(3)).
 HOME_ROTATION_TOL = 1e-2  # parameter files may carry coarser matrices
-
 
 
 @dataclass(frozen=True)
@@ -119,15 +111,17 @@ class HexapodParams:
                 self.home_position) from None
 
 
-
 # ---------------------------------------------------------------------- geometry
 def leg_frame(theta_i: float) -> np.ndarray:
     """Axes ``(e_r, e_y, u_i)`` of leg frame i as columns (``= Ry(-th_i)``)."""
     return rot_y(-theta_i)
 
 
-
 def home_rotation(params: HexapodParams) -> np.ndarray:
     """The reference orientation: ``params.home_rotation`` projected on SO(3) (SVD)."""
     params = check_params(params, HexapodParams)
     return as_rotation(params.home_rotation, "home_rotation", HOME_ROTATION_TOL)
+
+
+#: The protocol's name for the design dataclass.
+Params = HexapodParams

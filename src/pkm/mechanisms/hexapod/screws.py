@@ -43,10 +43,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from pkm.core import screws
-from pkm.core.mechanism import as_vector
 from pkm.core.task import as_rotation
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.mechanisms import hexapod as hx
+from pkm.validation import as_vector
 
 #: Chain order of the screws of a leg (rows of :func:`leg_screws`).
 CHAIN = ("r", "1", "2", "3", "4", "5", "6", "f")

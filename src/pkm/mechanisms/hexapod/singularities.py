@@ -35,10 +35,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from pkm.core import screws
-from pkm.core.mechanism import as_scalar, finite_result
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms._common import check_params
 from pkm.mechanisms.hexapod import screws as hs
+from pkm.validation import as_scalar, finite_result
 
 KINDS = {0: "regular", 1: "inverse", 2: "direct", 3: "combined"}
 

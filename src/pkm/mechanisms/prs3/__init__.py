@@ -60,38 +60,6 @@ direction) and 0 about its own axis.
 from __future__ import annotations
 
 from pkm.mechanisms.prs3.kinematics import (  # noqa: F401 (the mechanism's API)
-    Params,
-    as_task,
-    branch_names,
-    closed_form_configuration,
-    closed_form_ik,
-    configuration,
-    inverse_kinematics,
-    joint_values,
-    paper_constraint_jacobians,
-    paper_parasitic_motion,
-    parasitic_motion,
-    platform_pose,
-)
-from pkm.mechanisms.prs3.model import (  # noqa: F401 (the mechanism's API)
-    build,
-    closure_spec,
-    urdf_xml,
-)
-from pkm.mechanisms.prs3.params import (  # noqa: F401 (the mechanism's API)
-    ACTUATIONS,
-    BRANCHES,
-    DEFAULT_BRANCH,
-    NAME,
-    PHI,
-    Prs3Params,
-    TABLE2_FILE,
-    TABLE2_FORMAT,
-    TABLE2_KEYS,
-    table2,
-)
-from pkm.mechanisms.prs3.kinematics import (  # noqa: F401 (the mechanism's API)
-    Params,
     ROOT_TOL,
     as_task,
     branch_names,
@@ -112,6 +80,22 @@ from pkm.mechanisms.prs3.model import (  # noqa: F401 (the mechanism's API)
     closure_spec,
     urdf_xml,
 )
+from pkm.mechanisms.prs3.params import (  # noqa: F401 (the mechanism's API)
+    ACTUATIONS,
+    BRANCHES,
+    DEFAULT_BRANCH,
+    NAME,
+    PHI,
+    TABLE2_FILE,
+    TABLE2_FORMAT,
+    TABLE2_KEYS,
+    Params,
+    Prs3Params,
+    table2,
+)
+
+#: The paper has no forward-kinematics method (the generic core's ``close_loops`` solves it).
+closed_form_fk = None
 
 __all__ = [
     "ACTUATIONS",
@@ -129,6 +113,7 @@ __all__ = [
     "branch_names",
     "build",
     "closed_form_configuration",
+    "closed_form_fk",
     "closed_form_ik",
     "closure_spec",
     "configuration",

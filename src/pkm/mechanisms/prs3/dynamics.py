@@ -63,9 +63,9 @@ import numpy as np
 
 from pkm.core.differential import inverse_accelerations, inverse_velocities
 from pkm.core.dynamics import KhalilProjection
-from pkm.core.mechanism import as_array, as_count
 from pkm.errors import InvalidInputError, NonFiniteError, SingularityError, UnreachableError
 from pkm.mechanisms.prs3 import BRANCHES, PHI, Prs3Params, as_task, branch_names, build, configuration
+from pkm.validation import as_array, as_count
 
 G = 9.81
 INERTIAL = ("m1", "m2", "MSa", "MSp", "ZZ2", "mp", "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")

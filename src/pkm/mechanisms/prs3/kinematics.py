@@ -7,16 +7,16 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.mechanism import Mechanism, as_array, check_mechanism, finite_result
+from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.task import zyx_matrix
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms._common import (
     check_params,
 )
 from pkm.mechanisms.prs3.params import BRANCHES, DEFAULT_BRANCH, PHI, Prs3Params
+from pkm.validation import as_array, finite_result
 
 ROOT_TOL = 1e-12  # radicands of eq. (10) above -ROOT_TOL l^2 count as the double root
-
 
 
 # ---------------------------------------------------------------------- closed forms
@@ -29,13 +29,11 @@ def leg_geometry(params: Prs3Params) -> tuple[np.ndarray, ...]:
     return params.g * er, cg * er + sg * ez, -sg * er + cg * ez, et, params.h * er
 
 
-
 def _yaw(pitch: float, roll: float) -> tuple[float, tuple[float, ...]]:
     """``alpha = atan2(s_b s_f, c_f + c_b)`` (eq. 15) and ``(s_a, c_a, s_b, c_b, s_f, c_f)``."""
     sb, cb, sf, cf = math.sin(pitch), math.cos(pitch), math.sin(roll), math.cos(roll)
     alpha = math.atan2(sb * sf, cf + cb)
     return alpha, (math.sin(alpha), math.cos(alpha), sb, cb, sf, cf)
-
 
 
 def parasitic_motion(h: float, pitch: float, roll: float) -> tuple[float, float, float]:
@@ -54,7 +52,6 @@ def parasitic_motion(h: float, pitch: float, roll: float) -> tuple[float, float,
     return 0.5 * h * (ca * cb - sa * sb * sf - ca * cf), -h * sa * cb, alpha
 
 
-
 def paper_parasitic_motion(h: float, pitch: float, roll: float) -> tuple[float, float, float]:
     """Eq. (15) as printed: ``(x_p [m], y_p [m], alpha [rad])`` from ``beta``, ``phi``.
 
@@ -65,7 +62,6 @@ def paper_parasitic_motion(h: float, pitch: float, roll: float) -> tuple[float, 
     """
     alpha, (sa, ca, sb, cb, sf, cf) = _yaw(pitch, roll)
     return -h * sa * cb, -0.5 * h * (ca * cb - sa * sb * sf - ca * cf), alpha
-
 
 
 def paper_constraint_jacobians(params: Prs3Params, y) -> tuple[np.ndarray, np.ndarray]:
@@ -85,14 +81,12 @@ def paper_constraint_jacobians(params: Prs3Params, y) -> tuple[np.ndarray, np.nd
     return et.copy(), -np.cross(r, et)
 
 
-
 def platform_pose(params: Prs3Params, y) -> tuple[np.ndarray, np.ndarray]:
     """Platform position ``p`` [m] and rotation ``R`` for task vector ``y = (z_p, beta, phi)``."""
     params = check_params(params, Prs3Params)
     z, pitch, roll = as_task(y, "y")
     x, yp, alpha = parasitic_motion(params.h, pitch, roll)
     return np.array([x, yp, z]), zyx_matrix(roll, pitch, alpha)
-
 
 
 def leg_vectors(params: Prs3Params, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -113,7 +107,6 @@ def leg_vectors(params: Prs3Params, y: np.ndarray) -> tuple[np.ndarray, np.ndarr
             raise UnreachableError(i + 1, dist - params.l, "m",
                                    f"leg {i + 1}: the spherical joint is farther than l from the rail")
     return c, np.maximum(rad, 0.0)
-
 
 
 def inverse_kinematics(params: Prs3Params, y, branch: str | tuple[str, str, str] | None = None
@@ -145,7 +138,6 @@ def inverse_kinematics(params: Prs3Params, y, branch: str | tuple[str, str, str]
     return d, theta
 
 
-
 def joint_values(params: Prs3Params, y, branch: str | tuple[str, str, str] | None = None) -> dict[str, list[float]]:
     """Every joint coordinate of the tree (closed form) for ``y = (z_p, beta, phi)``."""
     params = check_params(params, Prs3Params)
@@ -159,12 +151,10 @@ def joint_values(params: Prs3Params, y, branch: str | tuple[str, str, str] | Non
     return out
 
 
-
 def configuration(mech: Mechanism, y, branch: str | tuple[str, str, str] | None = None) -> np.ndarray:
     """Full configuration vector ``q`` of ``mech`` for ``y = (z_p, beta, phi)`` (closed form)."""
     mech = check_mechanism(mech)
     return mech.q_from_dict(joint_values(mech.params, y, branch))
-
 
 
 # ---------------------------------------------------------------------- uniform interface
@@ -175,15 +165,9 @@ def closed_form_ik(params: Prs3Params, y, branch: str | None = None) -> np.ndarr
     return d if params.actuation == "P" else theta
 
 
-
 def closed_form_configuration(mech: Mechanism, y, branch: str | None = None) -> np.ndarray:
     """Every joint coordinate for task vector ``y`` (closed form)."""
     return configuration(mech, y, branch)
-
-
-
-Params = Prs3Params
-
 
 
 # ---------------------------------------------------------------------- input checks
@@ -194,7 +178,6 @@ def as_task(y, name: str) -> np.ndarray:
     if abs(arr[1]) >= math.pi / 2:
         raise InvalidInputError(name, f"pitch beta = {arr[1]!r} rad: Z-Y-X angles need |beta| < pi/2", y)
     return arr
-
 
 
 def branch_names(branch: str | tuple[str, str, str] | None) -> tuple[str, str, str]:

@@ -42,7 +42,6 @@ def urdf_xml(params: Prs3Params) -> str:
     return b.to_xml()
 
 
-
 def closure_spec(params: Prs3Params) -> ClosureSpec:
     """Closures, actuation (``params.actuation``), task, branches and the reference configuration."""
     params = check_params(params, Prs3Params)
@@ -64,7 +63,6 @@ def closure_spec(params: Prs3Params) -> ClosureSpec:
         default_branch=DEFAULT_BRANCH,
         parameters=spec_parameters(params),
     )
-
 
 
 def build(params: Prs3Params | None = None) -> Mechanism:

@@ -22,34 +22,26 @@ from pkm.mechanisms._common import (
 NAME = "prs3"
 
 
-
 PHI = (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0)
-
 
 
 BRANCHES = {"slider_below": 1, "slider_above": -1}
 
 
-
 DEFAULT_BRANCH = "slider_below"
-
 
 
 ACTUATIONS = {"P": "slider", "R": "knee"}
 
 
-
 TABLE2_FILE = "prs3_table2.toml"
-
 
 
 TABLE2_FORMAT = "pkm.prs3_table2/1"
 
 
-
 TABLE2_KEYS = {"kinematics": ("gamma", "l", "h", "g"),
                "dynamics": ("m1", "m2", "mp", "Izz2", "mx2", "my2", "Ixx3", "Iyy3", "Izz3", "Ixy3", "Ixz3", "Iyz3")}
-
 
 
 # ---------------------------------------------------------------------- Table 2
@@ -81,10 +73,8 @@ def table2() -> Mapping[str, float]:
     return MappingProxyType(out)
 
 
-
 def _from_table2(key: str):
     return field(default_factory=lambda: table2()[key])
-
 
 
 # ---------------------------------------------------------------------- parameters
@@ -165,10 +155,13 @@ class Prs3Params:
                          [self.Ixz3, self.Iyz3, self.Izz3]])
 
 
-
 def _check_inertia(I: np.ndarray) -> None:
     ev = np.linalg.eigvalsh(I)
     tol = 1e-12 * max(1.0, float(np.abs(ev).max()))
     if ev[0] < -tol or ev[0] + ev[1] < ev[2] - tol:
         raise InvalidParameterError("Ixx3", f"platform inertia (Ixx3 ... Iyz3) is not physical: principal moments "
                                             f"{ev.tolist()} must be >= 0 and obey the triangle inequality", I)
+
+
+#: The protocol's name for the design dataclass.
+Params = Prs3Params

@@ -91,7 +91,6 @@ from __future__ import annotations
 from pkm.mechanisms.rrr3.kinematics import (  # noqa: F401 (the mechanism's API)
     REFERENCES,
     FkSolution,
-    Params,
     a_from_centroid,
     centroid_from_a,
     characteristic_length,
@@ -118,38 +117,13 @@ from pkm.mechanisms.rrr3.params import (  # noqa: F401 (the mechanism's API)
     MODES,
     NAME,
     REACH_TOL,
-    Rrr3Params,
     SQRT3,
+    Params,
+    Rrr3Params,
     base_centroid,
     base_vertices,
     home_task,
     mode_signs,
-)
-from pkm.mechanisms.rrr3.kinematics import (  # noqa: F401 (the mechanism's API)
-    FkSolution,
-    Params,
-    REFERENCES,
-    a_from_centroid,
-    centroid_from_a,
-    characteristic_length,
-    classify_singularity,
-    closed_form_configuration,
-    closed_form_fk,
-    closed_form_ik,
-    configuration,
-    forward_kinematics,
-    homogenized_jacobians,
-    inverse_kinematics,
-    jacobians,
-    joint_values,
-    platform_vertices,
-    reference_point,
-    singularity_measures,
-)
-from pkm.mechanisms.rrr3.model import (  # noqa: F401 (the mechanism's API)
-    build,
-    closure_spec,
-    urdf_xml,
 )
 
 __all__ = [

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.mechanism import Mechanism, as_scalar, as_tolerance, as_vector, check_mechanism, finite_result, wrap_angle
+from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.errors import (
     AssemblyError,
     BranchError,
@@ -19,6 +19,7 @@ from pkm.mechanisms._common import (
     check_params,
 )
 from pkm.mechanisms.rrr3.params import MODES, REACH_TOL, SQRT3, Rrr3Params, base_vertices, home_task, mode_signs
+from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result, wrap_angle
 
 
 def platform_vertices(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
@@ -31,7 +32,6 @@ def platform_vertices(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
                      A + h * np.array([math.cos(phi + math.pi / 3.0), math.sin(phi + math.pi / 3.0)])])
 
 
-
 def centroid_from_a(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
     """Platform centroid ``G`` [m] from the paper's ``A`` [m] and ``Phi`` [rad]."""
     params = check_params(params, Rrr3Params)
@@ -40,14 +40,12 @@ def centroid_from_a(params: Rrr3Params, a_point, phi: float) -> np.ndarray:
     return A + params.h / SQRT3 * np.array([math.cos(phi + math.pi / 6.0), math.sin(phi + math.pi / 6.0)])
 
 
-
 def a_from_centroid(params: Rrr3Params, g_point, phi: float) -> np.ndarray:
     """The paper's platform point ``A`` [m] from the centroid ``G`` [m] and ``Phi`` [rad]."""
     params = check_params(params, Rrr3Params)
     G = as_vector(g_point, 2, "g_point")
     phi = _scalar(phi, "phi")
     return G - params.h / SQRT3 * np.array([math.cos(phi + math.pi / 6.0), math.sin(phi + math.pi / 6.0)])
-
 
 
 # ---------------------------------------------------------------------- closed forms
@@ -77,7 +75,6 @@ def _solve(params: Rrr3Params, a_point: np.ndarray, phi: float, mode: int | str)
     return wrap_angle(theta), psi
 
 
-
 def inverse_kinematics(params: Rrr3Params, a_point, phi: float, mode: int | str | None = None) -> np.ndarray:
     """Motor angles ``(theta_1, theta_2, theta_3)`` [rad] in (-pi, pi], in the paper's terms (eq. 9).
 
@@ -95,7 +92,6 @@ def inverse_kinematics(params: Rrr3Params, a_point, phi: float, mode: int | str 
     return _solve(params, a_point, phi, params.mode if mode is None else mode)[0]
 
 
-
 def joint_values(params: Rrr3Params, y, mode: int | str | None = None) -> dict[str, list[float]]:
     """Every joint coordinate of the tree (closed form) for the task vector ``y = (x_G, y_G, Phi)``."""
     params = check_params(params, Rrr3Params)
@@ -109,12 +105,10 @@ def joint_values(params: Rrr3Params, y, mode: int | str | None = None) -> dict[s
     return out
 
 
-
 def configuration(mech: Mechanism, y, mode: int | str | None = None) -> np.ndarray:
     """Full configuration vector ``q`` of ``mech`` for the task vector ``y`` (closed form)."""
     mech = check_mechanism(mech)
     return mech.q_from_dict(joint_values(mech.params, y, mode))
-
 
 
 def jacobians(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -145,18 +139,15 @@ def jacobians(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[np.
     return Jx, Jq
 
 
-
 REFERENCES = ("centroid", "A", "origin")
 """Moment reference points of :func:`homogenized_jacobians`: the platform centroid ``G``, vertex ``A``,
 the world origin ``O = P`` (the paper's eq. 14)."""
-
 
 
 def characteristic_length(params: Rrr3Params) -> float:
     """Default ``L`` of eq. (25) [m]: the platform circumradius ``h / sqrt 3`` (Lou's mean platform radius)."""
     params = check_params(params, Rrr3Params)
     return params.h / SQRT3
-
 
 
 def reference_point(params: Rrr3Params, y, reference: str = "centroid") -> np.ndarray:
@@ -170,7 +161,6 @@ def reference_point(params: Rrr3Params, y, reference: str = "centroid") -> np.nd
     if reference == "origin":
         return np.zeros(2)
     raise InvalidInputError("reference", f"use one of {REFERENCES}, got {reference!r}", reference)
-
 
 
 def homogenized_jacobians(params: Rrr3Params, y, mode: int | str | None = None, *, length: float | None = None,
@@ -203,7 +193,6 @@ def homogenized_jacobians(params: Rrr3Params, y, mode: int | str | None = None, 
     return finite_result(Jx, "homogenized J_x", f"length = {L!r} m is too small (the moment column overflows)"), Jq
 
 
-
 def singularity_measures(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[float, float]:
     """Dimensionless distances to the two kinds of singularity at task vector ``y``.
 
@@ -216,7 +205,6 @@ def singularity_measures(params: Rrr3Params, y, mode: int | str | None = None) -
     params = check_params(params, Rrr3Params)
     Jx, Jq = homogenized_jacobians(params, y, mode)
     return float(np.min(np.abs(np.diag(Jq)))) / params.a, abs(float(np.linalg.det(Jx)))
-
 
 
 def classify_singularity(params: Rrr3Params, y, mode: int | str | None = None, *, tol: float = 1e-8) -> str:
@@ -233,7 +221,6 @@ def classify_singularity(params: Rrr3Params, y, mode: int | str | None = None, *
     inv, direct = singularity_measures(params, y, mode)
     return {(False, False): "regular", (True, False): "inverse", (False, True): "direct",
             (True, True): "combined"}[(inv <= tol, direct <= tol)]
-
 
 
 # ---------------------------------------------------------------------- forward kinematics
@@ -257,13 +244,10 @@ class FkSolution:
     residual: float
 
 
-
 _FK_SAMPLES = 16  # FFT samples of the degree-4 trigonometric polynomial (>= 9 makes the coefficients exact)
 
 
-
 _FK_NEWTON = 30  # Newton iterations allowed per candidate
-
 
 
 def _fk_offsets(h: float, phi):
@@ -275,7 +259,6 @@ def _fk_offsets(h: float, phi):
     dr = np.array([[zero, zero], [-h * np.sin(phi), h * np.cos(phi)],
                    [-h * np.sin(phi + math.pi / 3.0), h * np.cos(phi + math.pi / 3.0)]])
     return r, dr
-
 
 
 def _fk_eliminated(D: np.ndarray, b: float, h: float, phi):
@@ -293,7 +276,6 @@ def _fk_eliminated(D: np.ndarray, b: float, h: float, phi):
     return F, N, delta
 
 
-
 def _fk_legs(D: np.ndarray, b: float, h: float, x: np.ndarray):
     """Leg equations ``|V_k - D_k|^2 - b^2`` [m^2] at ``x = (x_A, y_A, Phi)`` and their Jacobian."""
     r, dr = _fk_offsets(h, x[2])
@@ -301,7 +283,6 @@ def _fk_legs(D: np.ndarray, b: float, h: float, x: np.ndarray):
     f = np.sum(e * e, axis=1) - b * b
     J = np.column_stack([2.0 * e[:, 0], 2.0 * e[:, 1], 2.0 * np.sum(e * dr, axis=1)])
     return f, J, e
-
 
 
 def forward_kinematics(params: Rrr3Params, theta, *, tol: float = 1e-10) -> tuple[FkSolution, ...]:
@@ -358,7 +339,6 @@ def forward_kinematics(params: Rrr3Params, theta, *, tol: float = 1e-10) -> tupl
     return tuple(sorted(solutions, key=lambda s: s.y[2]))
 
 
-
 def _fk_polish(params: Rrr3Params, D: np.ndarray, x: np.ndarray, theta: np.ndarray, tol: float) -> FkSolution | None:
     """Newton on the three leg equations from ``x = (x_A, y_A, Phi)``; the solution if it holds to ``tol``."""
     b = params.b
@@ -387,7 +367,6 @@ def _fk_polish(params: Rrr3Params, D: np.ndarray, x: np.ndarray, theta: np.ndarr
     return FkSolution(y, A, psi, mode, residual)
 
 
-
 # ---------------------------------------------------------------------- uniform interface
 # Every mechanism module offers these, over the task vector ``y`` laid out as
 # :class:`pkm.core.TaskMap` does (here: centroid x, y and yaw Phi).
@@ -412,7 +391,6 @@ def closed_form_fk(params: Rrr3Params, q_actuated, seed=None) -> np.ndarray:
                                                               wrap_angle(s.y[2] - target[2])])))).y.copy()
 
 
-
 def closed_form_ik(params: Rrr3Params, y, branch: str | None = None) -> np.ndarray:
     """Actuated coordinates for task vector ``y`` (closed form); ``branch`` = working mode name."""
     params = check_params(params, Rrr3Params)
@@ -420,15 +398,9 @@ def closed_form_ik(params: Rrr3Params, y, branch: str | None = None) -> np.ndarr
     return inverse_kinematics(params, a_from_centroid(params, y[:2], y[2]), y[2], branch)
 
 
-
 def closed_form_configuration(mech: Mechanism, y, branch: str | None = None) -> np.ndarray:
     """Every joint coordinate for task vector ``y`` (closed form); ``branch`` = working mode name."""
     return configuration(mech, y, branch)
-
-
-
-Params = Rrr3Params
-
 
 
 # ---------------------------------------------------------------------- helpers
@@ -437,7 +409,6 @@ def _length(length) -> float:
     if L <= 0.0:
         raise InvalidInputError("length", f"the characteristic length must be > 0 m, got {L!r}", length)
     return L
-
 
 
 def _scalar(x, name: str) -> float:

@@ -44,7 +44,6 @@ def urdf_xml(params: Rrr3Params) -> str:
     return b.to_xml()
 
 
-
 def closure_spec(params: Rrr3Params) -> ClosureSpec:
     params = check_params(params, Rrr3Params)
     reference = {k: tuple(v) for k, v in joint_values(params, home_task(params)).items()}
@@ -68,7 +67,6 @@ def closure_spec(params: Rrr3Params) -> ClosureSpec:
         default_branch=f"mode{params.mode}",
         parameters=spec_parameters(params),
     )
-
 
 
 def build(params: Rrr3Params | None = None) -> Mechanism:

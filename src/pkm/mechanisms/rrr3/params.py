@@ -22,9 +22,7 @@ from pkm.mechanisms._common import (
 NAME = "rrr3"
 
 
-
 SQRT3 = math.sqrt(3.0)
-
 
 
 MODES: dict[str, tuple[int, int, int]] = {
@@ -33,13 +31,10 @@ MODES: dict[str, tuple[int, int, int]] = {
 """Working mode name -> signs of ``(psi_1, psi_2, psi_3)`` (see the module doc)."""
 
 
-
 REACH_TOL = 1e-12  # relative to a + b: a distance this close to the reach limits counts as on them
 
 
-
 _SINGULAR_TOL = 1e-6  # the reference pose must be at least this far (dimensionless) from singularities
-
 
 
 @dataclass(frozen=True)
@@ -94,7 +89,6 @@ class Rrr3Params:
                         "home or mode", self.home)
 
 
-
 # ---------------------------------------------------------------------- geometry
 def mode_signs(mode: int | str) -> tuple[int, int, int]:
     """Signs of ``(psi_1, psi_2, psi_3)`` of a working mode given as ``k`` or ``"modek"`` (k = 1..8)."""
@@ -104,13 +98,11 @@ def mode_signs(mode: int | str) -> tuple[int, int, int]:
     return MODES[key]
 
 
-
 def base_vertices(params: Rrr3Params) -> np.ndarray:
     """Base vertices ``P, Q, R`` as rows [m], shape (3, 2)."""
     params = check_params(params, Rrr3Params)
     H = params.H
     return np.array([[0.0, 0.0], [H, 0.0], [H / 2.0, H * SQRT3 / 2.0]])
-
 
 
 def base_centroid(params: Rrr3Params) -> np.ndarray:
@@ -119,8 +111,11 @@ def base_centroid(params: Rrr3Params) -> np.ndarray:
     return np.array([params.H / 2.0, params.H / (2.0 * SQRT3)])
 
 
-
 def home_task(params: Rrr3Params) -> np.ndarray:
     """The reference task vector ``(x_G, y_G, Phi)`` [m, m, rad] of ``params.home``."""
     params = check_params(params, Rrr3Params)
     return np.concatenate([base_centroid(params) + np.asarray(params.home[:2], dtype=float), [params.home[2]]])
+
+
+#: The protocol's name for the design dataclass.
+Params = Rrr3Params

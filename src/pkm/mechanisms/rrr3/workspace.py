@@ -40,10 +40,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pkm.core.indices import inverse_condition
-from pkm.core.mechanism import as_array, as_scalar, as_vector
 from pkm.errors import InvalidInputError, SingularityError, UnreachableError
 from pkm.mechanisms import rrr3
 from pkm.mechanisms._common import check_positive, real
+from pkm.validation import as_array, as_scalar, as_vector
 
 NORMS = ("2", "fro_normalized")
 MAX_NODES_PER_AXIS = 20001  # a grid larger than this per axis is refused (memory)

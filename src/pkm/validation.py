@@ -1,0 +1,117 @@
+"""Validation of inputs at pkm's public entry points: numpy only, so that pure-numpy modules import cheaply.
+
+Each helper turns what a user may pass (lists, tuples, numpy arrays, numbers) into a validated
+float or array, and anything else (strings, booleans, None, complex numbers, ragged lists,
+overflowing ints, non-finite values) into an :class:`~pkm.errors.InvalidInputError` naming the
+argument; :func:`finite_result` turns a NaN or infinity that arose inside into a
+:class:`~pkm.errors.NonFiniteError` instead of returning it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from pkm.errors import InvalidInputError, NonFiniteError
+
+
+def wrap_angle(angle):
+    """Angle(s) brought into (-pi, pi] [rad]."""
+    return np.pi - np.mod(np.pi - np.asarray(angle, dtype=float), 2.0 * np.pi)
+
+
+#: |value| above this, in SI units (m, rad, kg, s...), is taken for a unit error or garbage (inputs and files).
+ABSURD = 1e6
+
+
+def as_array(x, name: str, what: str = "numbers") -> np.ndarray:
+    """``x`` as a float array of any shape, refusing what is not numbers.
+
+    Strings, booleans, ``None``, complex numbers, ragged nestings and objects are refused with an
+    :class:`InvalidInputError` naming ``name`` (numpy would turn ``"1.5"`` into 1.5 and ``True``
+    into 1.0 silently); so are integers too large for a float. Finiteness is not checked here.
+    """
+    if isinstance(x, (str, bytes)) or x is None:
+        raise InvalidInputError(name, f"expected {what}, got {type(x).__name__}", x)
+    try:
+        raw = np.asarray(x)
+        if raw.dtype.kind not in "iuf":
+            if raw.dtype.kind == "b":
+                raise InvalidInputError(name, f"expected {what}, got booleans", x)
+            if raw.dtype.kind != "O":
+                raise InvalidInputError(name, f"expected {what}, got an array of {raw.dtype}", x)
+            if any(isinstance(v, (str, bytes, bool, np.bool_, complex)) or v is None for v in raw.ravel()):
+                raise InvalidInputError(name, f"expected {what}, got {type(x).__name__} holding non-numbers", x)
+        arr = np.asarray(raw, dtype=float)
+    except InvalidInputError:
+        raise
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidInputError(name, f"expected {what}, got {type(x).__name__} that is not a (regular) array of "
+                                      "real numbers", x) from None
+    return arr
+
+
+def as_vector(x, n: int, name: str) -> np.ndarray:
+    """``x`` as a finite float vector of shape (n,), or :class:`InvalidInputError` naming ``name``."""
+    arr = as_array(x, name, f"{n} numbers")
+    if arr.shape != (n,):
+        raise InvalidInputError(name, f"expected shape ({n},), got {arr.shape}; pass a flat list of {n} numbers", x)
+    if not np.all(np.isfinite(arr)):
+        raise InvalidInputError(name, f"holds non-finite values at {np.flatnonzero(~np.isfinite(arr)).tolist()}; "
+                                      "pass finite numbers", x)
+    return arr.copy()
+
+
+def as_scalar(x, name: str, *, low: float | None = None, high: float | None = None, strict_low: bool = False,
+              unit: str = "") -> float:
+    """``x`` as one finite float (a number or a one-element array), optionally within bounds.
+
+    Args:
+        x: The value.
+        name: Its name, for the message.
+        low, high: Bounds (inclusive; ``low`` exclusive with ``strict_low``).
+        unit: Unit shown in the message.
+
+    Raises:
+        InvalidInputError: Not a number, not finite, or out of bounds.
+    """
+    arr = as_array(x, name, "a number")
+    if arr.size != 1:
+        raise InvalidInputError(name, f"expected one number, got shape {arr.shape}", x)
+    v = float(arr.reshape(()))
+    u = f" {unit}" if unit else ""
+    if not math.isfinite(v):
+        raise InvalidInputError(name, f"must be a finite number{u}, got {v!r}", x)
+    if low is not None and (v <= low if strict_low else v < low):
+        raise InvalidInputError(name, f"must be {'>' if strict_low else '>='} {low:g}{u}, got {v!r}", x)
+    if high is not None and v > high:
+        raise InvalidInputError(name, f"must be <= {high:g}{u}, got {v!r}", x)
+    return v
+
+
+def as_count(x, name: str, *, low: int = 1, high: int = 10**7) -> int:
+    """``x`` as an integer in ``[low, high]`` (iteration limits, numbers of seeds or nodes)."""
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)):
+        raise InvalidInputError(name, f"expected an integer in [{low}, {high}], got {type(x).__name__} {x!r}", x)
+    if not low <= int(x) <= high:
+        raise InvalidInputError(name, f"expected an integer in [{low}, {high}], got {int(x)}", x)
+    return int(x)
+
+
+def as_tolerance(x, name: str = "tol", *, high: float = 1.0) -> float:
+    """``x`` as a tolerance: a finite number in ``(0, high]``."""
+    return as_scalar(x, name, low=0.0, high=high, strict_low=True)
+
+
+def finite_result(x, what: str, detail: str = ""):
+    """``x`` unchanged if every number in it is finite, else :class:`~pkm.errors.NonFiniteError`.
+
+    The last guard of a public routine: a NaN or an infinity that slipped past the input checks
+    (an overflow, a vanishing divisor) becomes an error instead of a silent result.
+    """
+    arr = np.asarray(x, dtype=float)
+    if not np.all(np.isfinite(arr)):
+        raise NonFiniteError(what, x, detail or "the inputs are probably too large or the configuration is "
+                                               "degenerate; check the units (SI) and the magnitudes")
+    return x
