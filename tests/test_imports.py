@@ -24,5 +24,6 @@ def test_the_lazy_names_resolve():
 
     assert pkm.solve_ik is solve.solve_ik and pkm.core.TaskMap is task.TaskMap
     assert "close_loops" in dir(pkm) and "zyx_matrix" in dir(pkm.core)
+    assert sorted(pkm.core.__all__) == sorted(pkm.core._WHERE)  # the literal list names every lazy export
     with pytest.raises(AttributeError, match="no attribute 'nothing'"):
         pkm.nothing  # noqa: B018

@@ -45,4 +45,9 @@ if TYPE_CHECKING:  # the static view of the lazy names
 
 __getattr__, __dir__ = lazy("pkm.core", globals(), _WHERE)
 
-__all__ = sorted(_WHERE)
+__all__ = [
+    "Branch", "Closure", "ClosureSpec", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "TaskSpec",
+    "accelerations", "branch_seed", "close_loops", "diagnose", "forward_jacobian", "inverse_accelerations",
+    "inverse_jacobian", "inverse_velocities", "passive_map", "solve_ik", "task_acceleration", "task_velocity",
+    "twist_jacobian", "velocities", "zyx_angles", "zyx_matrix",
+]
