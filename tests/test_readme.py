@@ -18,6 +18,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.test_cli import default_sigint
+
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text(encoding="utf-8")
 BLOCKS = re.findall(r"^```(\w*)\n(.*?)^```", README, flags=re.S | re.M)
@@ -31,10 +33,6 @@ def _env() -> dict[str, str]:
     env = dict(os.environ, MPLBACKEND="Agg")
     env["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{env.get('PATH', '')}"
     return env
-
-
-def _restore_sigint() -> None:  # as in a terminal's foreground (a background job ignores SIGINT)
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def test_the_readme_has_python_blocks_and_shell_lines():
@@ -56,7 +54,7 @@ def test_shell_line_runs(line, tmp_path):
     cwd = ROOT if command.startswith("make ") else tmp_path
     if "Ctrl-C" in line:
         proc = subprocess.Popen(["bash", "-c", f"exec {command}"], cwd=cwd, env=_env(), stdout=subprocess.PIPE,
-                                stderr=subprocess.PIPE, text=True, preexec_fn=_restore_sigint)
+                                stderr=subprocess.PIPE, text=True, preexec_fn=default_sigint)
         try:
             first = proc.stdout.readline()
             assert first.strip(), f"{command!r} printed nothing: {proc.stderr.read() if proc.poll() else ''}"
