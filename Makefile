@@ -20,6 +20,7 @@ demo: $(STAMP)
 	$(PY) -m pkm report --out out
 
 test: $(STAMP)
+	$(PY) -m ruff check src tests tools
 	$(PY) -m pytest -q
 
 bench: $(STAMP)

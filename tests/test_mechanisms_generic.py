@@ -54,7 +54,7 @@ def case(request, built):
 
 def test_closed_form_configurations_close_every_loop(case):
     """Every closed-form configuration closes the loops to 1e-10 and lands on the target task."""
-    name, mech, samples = case
+    _name, mech, samples = case
     task = TaskMap(mech)
     worst_res = max(np.abs(constraints.residual(mech, q)).max() for q, _ in samples)
     worst_task = max(np.abs(task.error(y, task.value(q))).max() for q, y in samples)
@@ -88,7 +88,7 @@ def test_generic_inverse_kinematics_equals_closed_form(case):
     """The generic inverse kinematics from the reference equals the paper's closed form to 1e-9."""
     name, mech, samples = case
     mod = module(name)
-    for q, y in samples:
+    for _q, y in samples:
         res = solve_ik(mech, y)
         assert res.converged
         assert np.abs(mech.actuated_q(res.q) - mod.closed_form_ik(mech.params, y)).max() <= 1e-9
@@ -119,7 +119,7 @@ def test_jacobians_match_finite_differences(case):
 
 def test_accelerations_match_finite_differences_of_velocities(case):
     """Joint and task accelerations (drift included) are the time derivatives of the velocities."""
-    name, mech, samples = case
+    _name, mech, samples = case
     rng = np.random.default_rng(1)
     for q, _ in samples[:N_DIFFERENTIAL]:
         err = fd.acceleration_errors(mech, q, rng)

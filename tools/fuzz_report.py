@@ -1166,7 +1166,7 @@ def run_chunk(task: tuple) -> dict:
         except CallTimeout:
             verdict = "other"
             _keep(out, name, "Timeout", f"ran past {timeout} s", fn, args, kwargs, "")
-        except Exception as exc:  # noqa: BLE001 - classifying is the point
+        except Exception as exc:
             verdict = "other"
             _keep(out, name, type(exc).__name__, str(exc)[:500], fn, args, kwargs,
                   "".join(traceback.format_exception(exc)[-3:])[-1500:])
@@ -1180,7 +1180,7 @@ def run_chunk(task: tuple) -> dict:
 def _safe(check, res) -> bool:
     try:
         return bool(check(res))
-    except Exception:  # noqa: BLE001
+    except Exception:
         return False
 
 

@@ -28,7 +28,6 @@ _CORE = ("ClosureSpec", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "a
          "passive_map", "solve_ik", "task_acceleration", "task_velocity", "twist_jacobian", "velocities")
 
 if TYPE_CHECKING:  # the static view of the lazy names
-    # ruff: noqa: F401
     from pkm.core import (
         ClosureSpec,
         Diagnostics,

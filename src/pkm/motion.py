@@ -90,7 +90,7 @@ class Motion:
 
     def times(self) -> np.ndarray:
         """Sample times ``0, dt, ..., duration`` [s]."""
-        n = int(round(self.duration / self.dt))
+        n = round(self.duration / self.dt)
         return np.arange(n + 1) * self.dt
 
     def sample(self, t=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -37,10 +37,10 @@ def _gantry_ur5() -> Mechanism:
     tool = data.oMf[arm.getFrameId("tool0")]
 
     root = etree.fromstring(text.encode())
-    world = [el.get("name") for el in root.findall("link")
-             if el.get("name") not in {j.find("child").get("link") for j in root.findall("joint")}][0]
+    world = next(el.get("name") for el in root.findall("link")
+             if el.get("name") not in {j.find("child").get("link") for j in root.findall("joint")})
     rpy = " ".join(repr(float(a)) for a in pin.rpy.matrixToRpy(tool.rotation))
-    for k, (axis, parent) in enumerate(zip("xyz", (world, "gantry_x", "gantry_y"))):
+    for _k, (axis, parent) in enumerate(zip("xyz", (world, "gantry_x", "gantry_y"))):
         etree.SubElement(root, "link", name=f"gantry_{axis}")
         j = etree.SubElement(root, "joint", name=f"gantry_{axis}_joint", type="prismatic")
         etree.SubElement(j, "parent", link=parent)
@@ -104,7 +104,7 @@ def test_inverse_kinematics_round_trip(mech):
 def test_jacobians_and_accelerations_match_finite_differences(mech):
     """The 6-D closure's Jacobian, drift, and the derived Jacobians and accelerations match differences."""
     q = close_loops(mech, mech.actuated_q(mech.q_reference) + [0.05, -0.04, 0.03]).q
-    ik = lambda y: mech.actuated_q(solve_ik(mech, y, q).q)  # noqa: E731
+    ik = lambda y: mech.actuated_q(solve_ik(mech, y, q).q)
     assert fd.constraint_jacobian_error(mech, q) <= 1e-6
     assert fd.forward_jacobian_error(mech, q) <= 1e-6
     assert fd.inverse_jacobian_error(mech, q, ik) <= 1e-6

@@ -96,7 +96,7 @@ def test_power_balance_along_a_smooth_motion(case):
     for t in (0.0, 0.4, 1.7):
         q, v, a = _state(mech, conf, *motion(t))
         power = dynamics.inverse_dynamics(mech, q, v, a) @ v[mech.act_v]
-        dE = richardson(lambda h: np.array([(energy(t + h) - energy(t - h)) / (2 * h)]), 1e-3)[0]
+        dE = richardson(lambda h, t=t: np.array([(energy(t + h) - energy(t - h)) / (2 * h)]), 1e-3)[0]
         scale_p = np.abs(dynamics.inverse_dynamics(mech, q, v, a)).max() * np.abs(v[mech.act_v]).max()
         assert abs(power - dE) <= 1e-8 * max(scale_p, 1e-12), (t, power, dE)
 

@@ -73,7 +73,7 @@ def test_scalar_count_and_finite_result_helpers():
 @pytest.mark.parametrize("mech", [None, "delta", 3])
 def test_core_functions_refuse_what_is_not_a_mechanism(fn, mech, delta):
     """Passing a name, None or a number where a Mechanism belongs says how to get one (not AttributeError)."""
-    with pytest.raises(InvalidInputError, match="pkm.load"):
+    with pytest.raises(InvalidInputError, match=r"pkm\.load"):
         fn(mech, delta.q_reference)
 
 

@@ -47,7 +47,7 @@ def outcome(fn, *args, limit: float = LIMIT, **kwargs):
     def target():
         try:
             box["value"] = fn(*args, **kwargs)
-        except BaseException as exc:  # noqa: BLE001 - the exception is the outcome
+        except BaseException as exc:
             box["value"] = exc
 
     _OPENED = []

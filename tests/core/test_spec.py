@@ -54,10 +54,10 @@ def test_spec_names_are_checked_against_the_urdf(built):
     mech = built("delta")
     spec = mech.spec
     bad_frame = dataclasses.replace(spec, end_effector="platfrom")
-    with pytest.raises(UnknownNameError, match="frame 'platfrom' does not exist.*'platform'"):
+    with pytest.raises(UnknownNameError, match=r"frame 'platfrom' does not exist.*'platform'"):
         Mechanism.from_strings(mech.urdf, bad_frame)
     bad_joint = dataclasses.replace(spec, actuated=("motor_1", "motor_2", "motr_3"))
-    with pytest.raises(UnknownNameError, match="joint 'motr_3'.*'motor_3'"):
+    with pytest.raises(UnknownNameError, match=r"joint 'motr_3'.*'motor_3'"):
         Mechanism.from_strings(mech.urdf, bad_joint)
     partial = dataclasses.replace(spec, reference={k: v for k, v in spec.reference.items() if k != "knee_2"})
     with pytest.raises(SpecError, match="lacks joints"):

@@ -72,6 +72,6 @@ def test_external_entity_is_not_read(tmp_path):
     secret.write_text("TOP-SECRET")
     doc = (f'<?xml version="1.0"?><!DOCTYPE r [<!ENTITY x SYSTEM "file://{secret}">]>'
            '<robot name="&x;"><link name="base"/></robot>')
-    with pytest.raises(SpecError, match="DOCTYPE|entity") as info:
+    with pytest.raises(SpecError, match=r"DOCTYPE|entity") as info:
         check_urdf(doc)
     assert "TOP-SECRET" not in str(info.value)

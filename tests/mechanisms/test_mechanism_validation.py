@@ -77,7 +77,7 @@ def test_closed_forms_refuse_another_mechanisms_params():
     """Passing the Delta's parameters to the 3-RRR's closed forms is refused, not an AttributeError."""
     with pytest.raises(InvalidParameterError, match="Rrr3Params"):
         rrr3.jacobians(delta.DeltaParams(), [0.5, 0.29, 0.0])
-    with pytest.raises(InvalidInputError, match="pkm.Mechanism"):
+    with pytest.raises(InvalidInputError, match=r"pkm\.Mechanism"):
         delta.closed_form_configuration(pkm.load("delta").model, [0.0, 0.0, -0.36])
 
 

@@ -40,7 +40,7 @@ def test_series_are_written_every_10_ms_with_forces_and_powers(tmp_path):
     assert data[0] == ["t_s", "d1_m", "d2_m", "d3_m", "F1_N", "F2_N", "F3_N", "P1_W", "P2_W", "P3_W"]
     assert len(data) == 502 and data[-1][0] == "5.00"
     values = np.array(data[1:], dtype=float)
-    t, _, r = study.simulate("3")
+    _t, _, r = study.simulate("3")
     assert np.allclose(values[:, 4:7], r.tau, rtol=1e-9) and np.allclose(values[:, 7:], r.power, atol=1e-9)
 
 

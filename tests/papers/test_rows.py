@@ -5,7 +5,7 @@ import math
 import pytest
 
 from pkm import papers
-from pkm.errors import UnknownNameError
+from pkm.errors import InvalidInputError, UnknownNameError
 
 
 def test_numeric_rows_match_within_their_tolerance():
@@ -34,5 +34,5 @@ def test_bounds_compare_in_their_direction():
     assert papers.Row("x", 860, 333, "", None, "sec. 4", relation="<=").matches is True
     assert papers.Row("x", 0.1, 0.2, "", None, "sec. 5", relation="<=").matches is False
     assert papers.Row("x", 0.0, 0.5, "", None, "Fig. 9", relation=">=").matches is True
-    with pytest.raises(Exception):
+    with pytest.raises(InvalidInputError, match="relation"):
         papers.Row("x", 1, 1, "", None, "", relation="~")

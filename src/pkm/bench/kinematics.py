@@ -50,12 +50,12 @@ def bench(name: str, n: int, delta: float, seed: int = 0) -> dict:
         ik = solve_ik(mech, y, seed_q)
         rows["closure_iters"].append(res.iterations)
         rows["generic_ik_iters"].append(ik.iterations)
-        rows["closure_us"].append(_time(lambda: close_loops(mech, qa, seed_q)))
-        rows["generic_ik_us"].append(_time(lambda: solve_ik(mech, y, seed_q)))
-        rows["cf_ik_us"].append(_time(lambda: mod.closed_form_ik(mech.params, y)))
-        rows["cf_config_us"].append(_time(lambda: mod.closed_form_configuration(mech, y)))
+        rows["closure_us"].append(_time(lambda qa=qa, seed_q=seed_q: close_loops(mech, qa, seed_q)))
+        rows["generic_ik_us"].append(_time(lambda y=y, seed_q=seed_q: solve_ik(mech, y, seed_q)))
+        rows["cf_ik_us"].append(_time(lambda y=y: mod.closed_form_ik(mech.params, y)))
+        rows["cf_config_us"].append(_time(lambda y=y: mod.closed_form_configuration(mech, y)))
         if mod.closed_form_fk is not None:
-            rows["cf_fk_us"].append(_time(lambda: mod.closed_form_fk(mech.params, qa)))
+            rows["cf_fk_us"].append(_time(lambda qa=qa: mod.closed_form_fk(mech.params, qa)))
     med = {k: statistics.median(v) for k, v in rows.items() if v}
     out = {
         "mechanism": name, "samples": n, "seed_delta": delta,

@@ -22,7 +22,6 @@ _EXPORTS = {
 _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
 if TYPE_CHECKING:  # the static view of the lazy names
-    # ruff: noqa: F401
     from pkm.core.differential import (
         Diagnostics,
         accelerations,

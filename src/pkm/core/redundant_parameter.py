@@ -240,7 +240,7 @@ def _call(index: IndexFn, k: np.ndarray, x: np.ndarray) -> np.ndarray:
         f = index(k, x)
     except PkmError:
         raise
-    except Exception as exc:  # the caller's callback: its failure is reported, not leaked  # noqa: BLE001
+    except Exception as exc:  # the caller's callback: its failure is reported, not leaked
         raise InvalidInputError("index", f"index(k, x) raised {type(exc).__name__}: {exc}; it must accept arrays "
                                          "k (pose indices) and x (values) of one shape", index) from None
     f = as_array(f, "index", "an array of index values shaped like x")

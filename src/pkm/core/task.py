@@ -41,7 +41,7 @@ def zyx_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
 
 def _rate_map(rpy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Columns of ``B`` with ``w = B [roll_dot, pitch_dot, yaw_dot]`` (world axes)."""
-    roll, pitch, yaw = rpy
+    _roll, pitch, yaw = rpy
     e_yaw = np.array([0.0, 0.0, 1.0])
     e_pitch = np.array([-np.sin(yaw), np.cos(yaw), 0.0])
     e_roll = np.array([np.cos(yaw) * np.cos(pitch), np.sin(yaw) * np.cos(pitch), -np.sin(pitch)])

@@ -269,7 +269,7 @@ def load_model(text: str, source: str = "<string>") -> pin.Model:
         raise SpecError(source, f"yourdfpy rejects the URDF: {exc}") from None
     try:
         return pin.buildModelFromXML(text, mimic=True)
-    except Exception as exc:  # Pinocchio's own exception types must not leak  # noqa: BLE001
+    except Exception as exc:  # Pinocchio's own exception types must not leak
         hint = (" (a mimic joint must come after the joint it mimics in Pinocchio's traversal, "
                 "which visits sibling joints in name order)") if "mimic" in str(exc) else ""
         raise SpecError(source, f"Pinocchio rejects the URDF: {exc}{hint}") from None

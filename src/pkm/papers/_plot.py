@@ -7,7 +7,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
 
 def figure(*, ncols: int = 1, nrows: int = 1, size: tuple[float, float] = (6.4, 4.0)):

@@ -74,5 +74,5 @@ def test_bad_index_point_and_rotation_are_refused(mech):
         hi.PoseIndex(p, [(R, P)], "w_both")
     with pytest.raises(InvalidInputError):
         hi.indices(p, R, P, 0.0, point="Q")
-    with pytest.raises(InvalidInputError, match="max\\|R\\^T R - I\\| = 0.21"):
+    with pytest.raises(InvalidInputError, match=r"max\|R\^T R - I\| = 0\.21"):
         hi.PoseIndex(p, [(1.1 * R, P)])

@@ -79,7 +79,7 @@ def test_sec5_claims_equal_powers_in_case_2_and_opposite_powers_in_case_3():
 
 def test_a_constant_height_offset_changes_no_effort_in_case_3():
     """Vertical rails: case 3 at z = h (as printed) and at z = 0.81 m give the same forces (to 1e-9 N)."""
-    t, Y, Yd, Ydd = load_motions("prs3_motions.toml")["3"].sample()
+    _t, Y, Yd, Ydd = load_motions("prs3_motions.toml")["3"].sample()
     dyn = PD.Prs3Dynamics()
     lifted = Y.copy()
     lifted[:, 0] = 0.81
@@ -181,7 +181,7 @@ def test_jacobian_equals_differences_of_the_ik_and_the_generic_core(dyn):
     from tests.fd import rel, richardson
     for y in (np.array(dyn.params.reference), np.array(dyn.params.reference) + [0.02, 0.1, -0.07]):
         J = dyn.jacobian(y)
-        assert rel(J, richardson(lambda h: _ik_difference(dyn.params, y, h), 1e-4)) < 1e-7
+        assert rel(J, richardson(lambda h, y=y: _ik_difference(dyn.params, y, h), 1e-4)) < 1e-7
         q = prs3.configuration(dyn.mechanism, y)
         assert rel(J, pkm.inverse_jacobian(dyn.mechanism, q)) < 1e-9
 

@@ -33,7 +33,7 @@ of this size) and only matter for dynamics.
 
 from __future__ import annotations
 
-from pkm.mechanisms.delta.kinematics import (  # noqa: F401 (the mechanism's API)
+from pkm.mechanisms.delta.kinematics import (
     arm_angles,
     closed_form_configuration,
     closed_form_fk,
@@ -46,12 +46,12 @@ from pkm.mechanisms.delta.kinematics import (  # noqa: F401 (the mechanism's API
     joint_values,
     sphere_centres,
 )
-from pkm.mechanisms.delta.model import (  # noqa: F401 (the mechanism's API)
+from pkm.mechanisms.delta.model import (
     build,
     closure_spec,
     urdf_xml,
 )
-from pkm.mechanisms.delta.params import (  # noqa: F401 (the mechanism's API)
+from pkm.mechanisms.delta.params import (
     BRANCHES,
     NAME,
     PHI,
@@ -61,9 +61,9 @@ from pkm.mechanisms.delta.params import (  # noqa: F401 (the mechanism's API)
 
 __all__ = [
     "BRANCHES",
-    "DeltaParams",
     "NAME",
     "PHI",
+    "DeltaParams",
     "Params",
     "arm_angles",
     "build",

@@ -118,8 +118,8 @@ Masses are not given by the paper; the defaults are illustrative and only matter
 
 from __future__ import annotations
 
-from pkm.core.task import ROTATION_TOL  # noqa: F401 (a user's rotation within this of SO(3) is projected)
-from pkm.mechanisms.hexapod.kinematics import (  # noqa: F401 (the mechanism's API)
+from pkm.core.task import ROTATION_TOL
+from pkm.mechanisms.hexapod.kinematics import (
     AssemblyMode,
     actuated_from_paper,
     assembly_modes,
@@ -139,12 +139,12 @@ from pkm.mechanisms.hexapod.kinematics import (  # noqa: F401 (the mechanism's A
     pose_from_points,
     task_vector,
 )
-from pkm.mechanisms.hexapod.model import (  # noqa: F401 (the mechanism's API)
+from pkm.mechanisms.hexapod.model import (
     build,
     closure_spec,
     urdf_xml,
 )
-from pkm.mechanisms.hexapod.params import (  # noqa: F401 (the mechanism's API)
+from pkm.mechanisms.hexapod.params import (
     ACTUATED,
     BRANCHES,
     DEFAULT_BRANCH,
@@ -161,17 +161,17 @@ from pkm.mechanisms.hexapod.params import (  # noqa: F401 (the mechanism's API)
 
 __all__ = [
     "ACTUATED",
-    "AssemblyMode",
     "BRANCHES",
     "DEFAULT_BRANCH",
     "HOME_ROTATION_TOL",
-    "HexapodParams",
     "LAYOUTS",
     "NAME",
     "POSE_T_POSITION",
     "POSE_T_ROTATION",
-    "Params",
     "ROTATION_TOL",
+    "AssemblyMode",
+    "HexapodParams",
+    "Params",
     "actuated_from_paper",
     "assembly_modes",
     "base_points",

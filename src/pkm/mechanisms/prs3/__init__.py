@@ -59,7 +59,7 @@ direction) and 0 about its own axis.
 
 from __future__ import annotations
 
-from pkm.mechanisms.prs3.kinematics import (  # noqa: F401 (the mechanism's API)
+from pkm.mechanisms.prs3.kinematics import (
     ROOT_TOL,
     as_task,
     branch_names,
@@ -75,12 +75,12 @@ from pkm.mechanisms.prs3.kinematics import (  # noqa: F401 (the mechanism's API)
     parasitic_motion,
     platform_pose,
 )
-from pkm.mechanisms.prs3.model import (  # noqa: F401 (the mechanism's API)
+from pkm.mechanisms.prs3.model import (
     build,
     closure_spec,
     urdf_xml,
 )
-from pkm.mechanisms.prs3.params import (  # noqa: F401 (the mechanism's API)
+from pkm.mechanisms.prs3.params import (
     ACTUATIONS,
     BRANCHES,
     DEFAULT_BRANCH,
@@ -103,12 +103,12 @@ __all__ = [
     "DEFAULT_BRANCH",
     "NAME",
     "PHI",
-    "Params",
-    "Prs3Params",
     "ROOT_TOL",
     "TABLE2_FILE",
     "TABLE2_FORMAT",
     "TABLE2_KEYS",
+    "Params",
+    "Prs3Params",
     "as_task",
     "branch_names",
     "build",

@@ -686,5 +686,17 @@ def _where(k: int, t, *, local: bool = False) -> str:
     return f"sample {k} (t = {float(t[0] if local else t[k]):.6g} s)"
 
 
-__all__ = ["BOUNDARY", "DynamicsResult", "GEOMETRY", "INERTIAL", "MODES", "OpCount", "Prs3Dynamics", "algorithm",
-           "generate_c", "numeric_parameters", "operation_count", "twin"]
+__all__ = [
+    "BOUNDARY",
+    "GEOMETRY",
+    "INERTIAL",
+    "MODES",
+    "DynamicsResult",
+    "OpCount",
+    "Prs3Dynamics",
+    "algorithm",
+    "generate_c",
+    "numeric_parameters",
+    "operation_count",
+    "twin",
+]

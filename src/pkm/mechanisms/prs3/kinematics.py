@@ -75,7 +75,7 @@ def paper_constraint_jacobians(params: Prs3Params, y) -> tuple[np.ndarray, np.nd
     instead (its ``jacobian``).
     """
     params = check_params(params, Prs3Params)
-    p, R = platform_pose(params, y)
+    _p, R = platform_pose(params, y)
     _, _, _, et, b = leg_geometry(params)
     r = b @ R.T
     return et.copy(), -np.cross(r, et)

@@ -100,7 +100,7 @@ class Prs3Params:
     """
 
     gamma: float = _from_table2("gamma")
-    l: float = _from_table2("l")  # noqa: E741 (the paper's name)
+    l: float = _from_table2("l")
     h: float = _from_table2("h")
     g: float = _from_table2("g")
     actuation: str = "P"

@@ -88,7 +88,7 @@ the paper; the defaults are illustrative and only matter for dynamics.
 
 from __future__ import annotations
 
-from pkm.mechanisms.rrr3.kinematics import (  # noqa: F401 (the mechanism's API)
+from pkm.mechanisms.rrr3.kinematics import (
     REFERENCES,
     FkSolution,
     a_from_centroid,
@@ -108,12 +108,12 @@ from pkm.mechanisms.rrr3.kinematics import (  # noqa: F401 (the mechanism's API)
     reference_point,
     singularity_measures,
 )
-from pkm.mechanisms.rrr3.model import (  # noqa: F401 (the mechanism's API)
+from pkm.mechanisms.rrr3.model import (
     build,
     closure_spec,
     urdf_xml,
 )
-from pkm.mechanisms.rrr3.params import (  # noqa: F401 (the mechanism's API)
+from pkm.mechanisms.rrr3.params import (
     MODES,
     NAME,
     REACH_TOL,
@@ -127,14 +127,14 @@ from pkm.mechanisms.rrr3.params import (  # noqa: F401 (the mechanism's API)
 )
 
 __all__ = [
-    "FkSolution",
     "MODES",
     "NAME",
-    "Params",
     "REACH_TOL",
     "REFERENCES",
-    "Rrr3Params",
     "SQRT3",
+    "FkSolution",
+    "Params",
+    "Rrr3Params",
     "a_from_centroid",
     "base_centroid",
     "base_vertices",
