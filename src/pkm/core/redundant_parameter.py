@@ -42,6 +42,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import proxsuite
@@ -75,7 +76,7 @@ class WarmQP:
         self._C = np.zeros((0, n)) if C is None else np.asarray(C, dtype=float)
         self._l = np.zeros(0) if l is None else np.asarray(l, dtype=float)
         self._u = np.zeros(0) if u is None else np.asarray(u, dtype=float)
-        self._qp = None
+        self._qp: Any = None  # a proxsuite.proxqp.dense.QP once set up
         self._eps, self._max_iter = eps, max_iter
         self.solves = self.iterations = self.cold_restarts = 0
         self.statuses: list[str] = []

@@ -10,7 +10,7 @@ import numpy as np
 
 from pkm.core.mechanism import Mechanism
 from pkm.core.spec import ClosureSpec
-from pkm.errors import InvalidParameterError, UnreachableError
+from pkm.errors import InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.validation import ABSURD, wrap_angle
 
 
@@ -56,6 +56,21 @@ def arm_angle(u: float, v: float, w: float, arm: float, rod: float, sign: int, l
         raise UnreachableError(leg, dmin - rod if dmin > rod else rod - dmax, "m", detail)
     delta = math.acos(max(-1.0, min(1.0, K / max(rho, 1e-300))))  # rho = 0: point on the axis, any t
     return float(wrap_angle(math.atan2(v, u) + sign * delta))
+
+
+def leg_branches(branch, valid, n: int, default: str | None = None) -> tuple[str, ...]:
+    """A working mode per leg: one name for all ``n`` legs, or a tuple (list) of ``n`` names from ``valid``;
+    None stands for ``default`` where one is given.
+
+    Raises:
+        InvalidInputError: another value, an unknown name or a tuple of another length.
+    """
+    if branch is None and default is not None:
+        branch = default
+    out = (branch,) * n if isinstance(branch, str) else tuple(branch) if isinstance(branch, (tuple, list)) else ()
+    if len(out) != n or any(not isinstance(b, str) or b not in valid for b in out):
+        raise InvalidInputError("branch", f"use one of {list(valid)} or a tuple of {n} of them, got {branch!r}", branch)
+    return out
 
 
 def real(v) -> float | None:

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 from pkm.mechanisms.delta.kinematics import (
     arm_angles,
+    branch_signs,
     closed_form_configuration,
     closed_form_fk,
     closed_form_ik,
@@ -66,6 +67,7 @@ __all__ = [
     "DeltaParams",
     "Params",
     "arm_angles",
+    "branch_signs",
     "build",
     "closed_form_configuration",
     "closed_form_fk",

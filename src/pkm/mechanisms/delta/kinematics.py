@@ -11,6 +11,7 @@ from pkm.errors import AssemblyError, InvalidInputError, SingularityError
 from pkm.mechanisms._common import (
     arm_angle,
     check_params,
+    leg_branches,
     rot_z,
 )
 from pkm.mechanisms.delta.params import BRANCHES, PHI, DeltaParams
@@ -39,10 +40,13 @@ def inverse_kinematics(params: DeltaParams, p, branch: str | tuple[str, str, str
     """
     params = check_params(params, DeltaParams)
     p = as_vector(p, 3, "p")
-    branches = (branch,) * 3 if isinstance(branch, str) else tuple(branch) if isinstance(branch, (tuple, list)) else ()
-    if len(branches) != 3 or any(not isinstance(b, str) or b not in BRANCHES for b in branches):
-        raise InvalidInputError("branch", f"use 'knee_out'/'knee_in' or a tuple of three, got {branch!r}", branch)
-    return arm_angles(params.La, params.Lb, params.R - params.r, p, tuple(-BRANCHES[b] for b in branches))
+    return arm_angles(params.La, params.Lb, params.R - params.r, p, branch_signs(branch))
+
+
+def branch_signs(branch) -> tuple[int, int, int]:
+    """The sign of each arm's root (``-BRANCHES[name]``) for one working-mode name or a tuple of three."""
+    a, b, c = (-BRANCHES[name] for name in leg_branches(branch, BRANCHES, 3))
+    return a, b, c
 
 
 def arm_angles(La: float, Lb: float, offset: float, p: np.ndarray, signs: tuple[int, int, int],

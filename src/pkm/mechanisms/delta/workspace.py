@@ -22,7 +22,8 @@ import numpy as np
 from pkm.core.indices import KINDS, condition_number
 from pkm.errors import InvalidInputError
 from pkm.mechanisms._common import check_params, real
-from pkm.mechanisms.delta import BRANCHES, PHI, DeltaParams, jacobian_factors
+from pkm.mechanisms.delta import PHI, DeltaParams, jacobian_factors
+from pkm.mechanisms.delta.kinematics import branch_signs
 from pkm.validation import as_array, wrap_angle
 
 MAX_NODES = 16_000_000  #: grid nodes of :func:`workspace` at most (memory)
@@ -37,13 +38,6 @@ def _points(P) -> np.ndarray:
     if not np.all(np.isfinite(P)):
         raise InvalidInputError("points", "holds non-finite coordinates", P)
     return P
-
-
-def _branch_signs(branch) -> tuple[int, int, int]:
-    branches = (branch,) * 3 if isinstance(branch, str) else tuple(branch) if isinstance(branch, (tuple, list)) else ()
-    if len(branches) != 3 or any(not isinstance(b, str) or b not in BRANCHES for b in branches):
-        raise InvalidInputError("branch", f"use 'knee_out'/'knee_in' or a tuple of three, got {branch!r}", branch)
-    return tuple(-BRANCHES[b] for b in branches)
 
 
 def inverse_kinematics_batch(params: DeltaParams, points, branch="knee_out") -> tuple[np.ndarray, np.ndarray]:
@@ -62,7 +56,7 @@ def inverse_kinematics_batch(params: DeltaParams, points, branch="knee_out") -> 
     """
     params = check_params(params, DeltaParams)
     P = _points(points)
-    signs = _branch_signs(branch)
+    signs = branch_signs(branch)
     theta = np.empty(P.shape)
     reachable = np.ones(P.shape[:-1], dtype=bool)
     for i in range(3):

@@ -15,6 +15,7 @@ from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError
 from pkm.mechanisms._common import (
     arm_angle,
     check_params,
+    leg_branches,
     rot_z,
 )
 from pkm.mechanisms.hexapod.params import BRANCHES, DEFAULT_BRANCH, LAYOUTS, HexapodParams, home_rotation, leg_frame
@@ -390,10 +391,8 @@ def closed_form_fk(params: HexapodParams, q_actuated, seed=None) -> np.ndarray:
 
 # ---------------------------------------------------------------------- helpers
 def branch_names(branch: str | tuple[str, ...]) -> tuple[str, ...]:
-    branches = (branch,) * 6 if isinstance(branch, str) else tuple(branch) if isinstance(branch, (tuple, list)) else ()
-    if len(branches) != 6 or any(not isinstance(b, str) or b not in BRANCHES for b in branches):
-        raise InvalidInputError("branch", f"use {sorted(BRANCHES)} or a tuple of six, got {branch!r}", branch)
-    return branches
+    """The working mode of each of the six legs (one name for all, or six)."""
+    return leg_branches(branch, BRANCHES, 6)
 
 
 def _scalar(x, name: str) -> float:

@@ -12,6 +12,7 @@ from pkm.core.task import zyx_matrix
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms._common import (
     check_params,
+    leg_branches,
 )
 from pkm.mechanisms.prs3.params import BRANCHES, DEFAULT_BRANCH, PHI, Prs3Params
 from pkm.validation import as_array, finite_result
@@ -180,9 +181,6 @@ def as_task(y, name: str) -> np.ndarray:
     return arr
 
 
-def branch_names(branch: str | tuple[str, str, str] | None) -> tuple[str, str, str]:
-    branch = DEFAULT_BRANCH if branch is None else branch
-    out = (branch,) * 3 if isinstance(branch, str) else tuple(branch) if isinstance(branch, (tuple, list)) else ()
-    if len(out) != 3 or any(not isinstance(b, str) or b not in BRANCHES for b in out):
-        raise InvalidInputError("branch", f"use {list(BRANCHES)} or a tuple of three, got {branch!r}", branch)
-    return out
+def branch_names(branch: str | tuple[str, str, str] | None) -> tuple[str, ...]:
+    """The working mode of each of the three legs (one name for all, or three; None: the default)."""
+    return leg_branches(branch, BRANCHES, 3, DEFAULT_BRANCH)
