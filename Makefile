@@ -21,6 +21,7 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m ruff check src tests tools
+	$(PY) -m mypy src/pkm
 	$(PY) -m pytest -q
 
 bench: $(STAMP)

@@ -344,7 +344,7 @@ def solution_dict(mech: pkm.Mechanism, res: pkm.SolveResult, **extra) -> dict[st
 
 # ---------------------------------------------------------------------- commands
 def cmd_list(args) -> int:
-    data = {}
+    data: dict[str, dict[str, Any]] = {}
     for name, entry in pkm.MECHANISMS.items():
         mech = pkm.load(name)
         data[name] = {
@@ -531,7 +531,7 @@ def build_parser() -> argparse.ArgumentParser:
                  epilog="Values are SI (m, rad, kg) unless a unit is given: R=120mm, beta=-11deg, z=81cm.")
     ap.add_argument("--debug", action="store_true", help="show the traceback of an error")
     ap.add_argument("--version", action="version", version=f"pkm {pkm.__version__}")
-    debug = argparse.ArgumentParser(add_help=False)
+    debug = _Parser(add_help=False)
     debug.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help="show the traceback of an error")
     sub = ap.add_subparsers(dest="command", metavar="COMMAND", required=True)
 

@@ -50,6 +50,7 @@ import warnings
 from dataclasses import dataclass, field
 from itertools import combinations
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -346,10 +347,10 @@ def _build_bodies(mech: Mechanism, root: str) -> tuple[list[Body], float, str | 
 
     # closures: a small sphere on frame_a inside a bubble on frame_b
     for c in mech.spec.closures:
-        for side, fname, radius, opacity in (("a", c.frame_a, 0.55 * r_joint, 1.0),
-                                             ("b", c.frame_b, 1.3 * r_joint, 0.35)):
+        for side, fname, size, opacity in (("a", c.frame_a, 0.55 * r_joint, 1.0),
+                                           ("b", c.frame_b, 1.3 * r_joint, 0.35)):
             bodies.append(Body(f"{root}/closures/{_clean(c.name)}/{side}", "sphere", "closure", fname, eye.copy(),
-                               CLOSURE_COLOR, (radius,), opacity, ends=(c.name, fname)))
+                               CLOSURE_COLOR, (size,), opacity, ends=(c.name, fname)))
 
     # triads: world and end effector
     world = model.frames[0].name
@@ -467,7 +468,8 @@ def _convex_hull(points: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray
 
 def _fans(rings: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """Vertices and fan triangles of convex polygons (each an ordered ring of points)."""
-    verts, faces = [], []
+    verts: list[np.ndarray] = []
+    faces: list[tuple[int, int, int]] = []
     for ring in rings:
         base = len(verts)
         verts.extend(ring)
@@ -494,7 +496,7 @@ def _layered_polygons(points: np.ndarray, tol: float) -> tuple[np.ndarray, np.nd
         layers = np.split(order, cuts)
         hulls = [_convex_hull(pts[layer], tol) if len(layer) >= 3 else None for layer in layers]
         if len(layers) > 1 and all(h is not None and len(h[1]) == len(h[0]) - 2 for h in hulls):
-            return _fans([h[0] for h in hulls])
+            return _fans([h[0] for h in hulls if h is not None])
     return _convex_hull(pts, tol)
 
 
@@ -536,7 +538,7 @@ def _primitive(mc, body: Body):
         geom = g.Cylinder(float(body.size[0]), float(body.size[1]))
     else:
         geom = g.TriangularMeshGeometry(body.vertices, body.faces)
-    extra = {"depthWrite": body.opacity == 1.0, "side": 1 if body.halo else 2}  # three.js BackSide, DoubleSide
+    extra: dict[str, Any] = {"depthWrite": body.opacity == 1.0, "side": 1 if body.halo else 2}  # three.js BackSide, DoubleSide
     if body.role == "base":  # behind anything drawn in its plane (a planar mechanism's platform)
         extra.update(polygonOffset=True, polygonOffsetFactor=1.0, polygonOffsetUnits=1.0)
     mat = g.MeshLambertMaterial(color=int(body.color), opacity=float(body.opacity), **extra)
@@ -595,6 +597,7 @@ def scene_commands(scene: Scene, q=None, *, trajectory=None, times=None, loop: b
     if traj is not None:
         anim = mc.animation.Animation(default_framerate=FPS)
         clips = {b.path: mc.animation.AnimationClip(fps=FPS) for b in scene.bodies}
+        assert tm is not None  # given with the trajectory
         for qk, tk in zip(traj, tm):
             frame = float(tk * FPS)
             for path, m in scene.transforms(qk).items():

@@ -51,7 +51,10 @@ def bench(repeat: int) -> dict:
     R, P = hx.home_rotation(p), np.array(p.home_position)
     out: dict = {"pose_T": {}, "spiral": {}}
     for idx in hi.INDICES:
-        t_qp, choice = best_time(lambda idx=idx: hr.optimal_beta(p, R, P, idx), repeat)
+        def sqp(idx: str = idx) -> hr.BetaChoice:
+            return hr.optimal_beta(p, R, P, idx)
+
+        t_qp, choice = best_time(sqp, repeat)
 
         def grid_search(idx=idx):
             f = hi.PoseIndex(p, [(R, P)], idx)
@@ -65,7 +68,10 @@ def bench(repeat: int) -> dict:
                               "sqp_iterations": choice.optimum.iterations}
     poses = spiral_poses()
     for idx in hi.INDICES:
-        t_qp, prof = best_time(lambda idx=idx: hr.beta_profile(p, poses, idx), repeat)
+        def profile(idx: str = idx) -> hr.BetaProfile:
+            return hr.beta_profile(p, poses, idx)
+
+        t_qp, prof = best_time(profile, repeat)
 
         def grid_search(idx=idx):
             f = hi.PoseIndex(p, poses, idx)

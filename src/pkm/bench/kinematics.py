@@ -36,7 +36,7 @@ def bench(name: str, n: int, delta: float, seed: int = 0) -> dict:
     task = TaskMap(mech)
     rng = np.random.default_rng(seed)
     y_ref = task.value(mech.q_reference)
-    rows = {"closure_us": [], "closure_iters": [], "cf_ik_us": [], "cf_config_us": [], "generic_ik_us": [],
+    rows: dict[str, list[float]] = {"closure_us": [], "closure_iters": [], "cf_ik_us": [], "cf_config_us": [], "generic_ik_us": [],
             "generic_ik_iters": [], "cf_fk_us": []}
     while len(rows["closure_us"]) < n:
         y = task.retract(y_ref, 0.02 * rng.uniform(-1, 1, task.size))

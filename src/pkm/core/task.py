@@ -71,7 +71,7 @@ class TaskMap:
         if self.pose:
             head = np.concatenate([M.translation, pin.Quaternion(M.rotation).coeffs()])
         else:
-            rpy = zyx_angles(M.rotation) if any(c in _ANGLES for c in self._comp) else None
+            rpy = zyx_angles(M.rotation) if any(c in _ANGLES for c in self._comp) else np.zeros(3)  # (unused)
             head = np.array([M.translation[_POS[c]] if c in _POS else rpy[_ANGLES.index(c)] for c in self._comp])
         return np.concatenate([head, np.asarray(q)[self._jq]])
 
@@ -149,7 +149,7 @@ class TaskMap:
         J6 = pin.getFrameJacobian(m, d, self.mech.ee_frame, pin.LOCAL_WORLD_ALIGNED)
         rows = [J6] if self.pose else []
         if not self.pose:
-            Jw = self._euler_rows(d.oMf[self.mech.ee_frame].rotation) @ J6[3:] if self._has_angles else None
+            Jw = self._euler_rows(d.oMf[self.mech.ee_frame].rotation) @ J6[3:] if self._has_angles else J6[3:]
             for c in self._comp:
                 rows.append(J6[_POS[c]][None] if c in _POS else Jw[_ANGLES.index(c)][None])
         if len(self._jv):
@@ -179,7 +179,7 @@ class TaskMap:
         acc = pin.getFrameClassicalAcceleration(m, d, f, pin.LOCAL_WORLD_ALIGNED)
         out = [np.concatenate([acc.linear, acc.angular])] if self.pose else []
         if not self.pose:
-            ang = None
+            ang = acc.angular  # replaced by the Euler-angle accelerations when the task has angles
             if self._has_angles:
                 R = d.oMf[f].rotation
                 rpy = zyx_angles(R)

@@ -118,8 +118,9 @@ def check_numbers(obj, name: str, n: int, what: str) -> tuple[float, ...]:
     vals = [real(x) for x in v] if flat else None
     if vals is None or len(vals) != n or any(x is None or abs(x) > ABSURD for x in vals):
         raise InvalidParameterError(name, f"must be {n} finite numbers {what} (|value| <= {ABSURD:g}), got {v!r}", v)
-    object.__setattr__(obj, name, tuple(vals))
-    return tuple(vals)
+    out = tuple(float(x) for x in vals if x is not None)  # (none is None here)
+    object.__setattr__(obj, name, out)
+    return out
 
 
 def check_params(params, cls: type, name: str = "params"):

@@ -120,11 +120,11 @@ def fig7_search(step: float = 0.005) -> tuple[tuple[Design, float, float, float]
     rows = []
     for d in fig7_candidates():
         m = maps.ci_map(d, maps.Grid.square(d.base_centroid, PAPER_MAP_HALF_WIDTH, step))
-        g, ga = m.gci(), m.area_gci()
-        if g.empty or ga.empty:
+        g, ga = m.gci().value, m.area_gci().value
+        if g is None or ga is None:  # an empty workspace
             rows.append((d, math.nan, math.nan, math.inf))
             continue
-        rows.append((d, g.value, ga.value, max(abs(g.value - p_all), abs(ga.value - p_area))))
+        rows.append((d, g, ga, max(abs(g - p_all), abs(ga - p_area))))
     return tuple(sorted(rows, key=lambda r: r[3]))
 
 
@@ -146,7 +146,7 @@ def figure_map(name: str, mode: int = 1) -> maps.CiMap:
 
 
 @functools.cache
-def mode_study() -> tuple[tuple[int, float, float, int], ...]:
+def mode_study() -> tuple[tuple[int, float | None, float | None, int], ...]:
     """Fig. 8: per working mode of the chosen design (Fig. 9's, the similarity law at H = 200 cm).
 
     Returns:
@@ -169,7 +169,8 @@ def suitable_modes() -> str:
     return ",".join(str(m) for m, _, _, crossings in mode_study() if crossings == 0)
 
 
-def grid_sensitivity(name: str, steps=(0.01, 0.005, 0.004, 0.0025, 0.002, 0.001)) -> list[tuple[float, float, float]]:
+def grid_sensitivity(name: str, steps=(0.01, 0.005, 0.004, 0.0025, 0.002, 0.001)
+                     ) -> list[tuple[float, float | None, float | None]]:
     """``(step, gci, area_gci)`` of a figure's design on the ``+-80 cm`` square at other node spacings [m]."""
     d = figure_design(name)
     out = []

@@ -112,13 +112,13 @@ def radius_minimising_condition(params: DeltaParams, p, branch="knee_out", kind:
     intervals = reachable_radii(params, p)
     if not intervals:
         raise UnreachableError(1, math.inf, "m", f"no base radius reaches {p.tolist()}")
-    best = (math.inf, math.nan, None)
+    best: tuple[float, float, tuple[float, float]] = (math.inf, math.nan, (math.nan, math.nan))
     for lo, hi in intervals:
         grid = np.linspace(lo, hi, n_scan + 2)[1:-1]
         K = condition_vs_radius(params, p, grid, branch, (kind,))[kind]
         j = int(np.argmin(K))
         if K[j] < best[0]:
-            best = (K[j], grid[j], (grid[max(j - 1, 0)], grid[min(j + 1, len(grid) - 1)]))
+            best = (float(K[j]), float(grid[j]), (float(grid[max(j - 1, 0)]), float(grid[min(j + 1, len(grid) - 1)])))
     if not math.isfinite(best[0]):
         raise UnreachableError(1, 0.0, "m", "singular at every reachable radius")
     a, b = best[2]

@@ -99,7 +99,7 @@ def forward_kinematics(params: DeltaParams, theta, *, both: bool = False) -> np.
     qc = d0 @ d0 + c[0, 2] ** 2 - params.Lb**2
     disc = qb * qb - 4.0 * qa * qc
     if disc < 0.0:
-        raise AssemblyError(math.sqrt(-disc) / (2.0 * qa), "m", "the three spheres do not intersect")
+        raise AssemblyError(float(math.sqrt(-disc) / (2.0 * qa)), "m", "the three spheres do not intersect")
     roots = sorted([(-qb - math.sqrt(disc)) / (2.0 * qa), (-qb + math.sqrt(disc)) / (2.0 * qa)])
     sols = finite_result(np.array([np.concatenate([b0 + b1 * z, [z]]) for z in roots]), "platform position",
                          "the sphere centres are nearly aligned (x, y barely determined by z)")

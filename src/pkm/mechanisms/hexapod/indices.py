@@ -81,9 +81,9 @@ def indices(params: hx.HexapodParams, R, P, beta: float, branch=hx.DEFAULT_BRANC
     """
     J = base_jacobian(params, R, P, beta, branch, point)
     L = params.LA if length is None else as_scalar(length, "length", low=0.0, strict_low=True, unit="m")
-    return Indices(core_indices.manipulability(J[:3]), core_indices.manipulability(J[3:]),
-                   core_indices.condition_number(J[:3]), core_indices.condition_number(J[3:]),
-                   core_indices.condition_number(core_indices.homogenize(J, slice(0, 3), L)), point, L)
+    return Indices(float(core_indices.manipulability(J[:3])), float(core_indices.manipulability(J[3:])),
+                   float(core_indices.condition_number(J[:3])), float(core_indices.condition_number(J[3:])),
+                   float(core_indices.condition_number(core_indices.homogenize(J, slice(0, 3), L))), point, L)
 
 
 class PoseIndex:

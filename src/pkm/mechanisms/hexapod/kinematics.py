@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -198,7 +199,7 @@ def forward_kinematics(params: HexapodParams, alphas, beta: float, seed=None, *,
         a, b = C[1] - C[2], C[0] - C[2]
         return k * np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
-    def fun(x: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+    def fun(x: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, Any]:  # (residual, Jacobian or None)
         C = x.reshape(3, 3)  # vectorised over the legs and the sides
         dv = np.vstack([C, C + h * normal(C)]) - B  # legs 1-3 at C_i, legs 4-6 at C_i + h g
         D = C[pa] - C[pb]
@@ -307,7 +308,7 @@ def assembly_modes(mech: Mechanism, q_actuated, *, n_starts: int = 32, seed: int
     alphas, beta = paper_alphas(qa), float(qa[6])
     rng = np.random.default_rng(seed)
     reach = params.LA + params.LB
-    seeds = [None]
+    seeds: list[np.ndarray | None] = [None]
     for _ in range(n_starts - 1):
         Rs = pin.Quaternion(*rng.normal(size=4)).normalized().toRotationMatrix()
         Ps = rng.uniform([-reach / 2, -reach - params.H0, -reach / 2], [reach / 2, params.Rr, reach / 2])

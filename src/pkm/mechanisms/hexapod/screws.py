@@ -286,7 +286,7 @@ def complementary_acceleration(params: hx.HexapodParams, R, P, beta: float, qd,
     legs, beta = _legs(params, R, P, beta, branch)
     S = _chain_screws(params, legs)
     L = screws.chain_lie_term(S, _rates(params, legs, beta, S, qd))
-    return screws.klein(L, S[:, 6])
+    return np.asarray(screws.klein(L, S[:, 6]))
 
 
 def acceleration(params: hx.HexapodParams, R, P, beta: float, qd, qdd, branch=hx.DEFAULT_BRANCH) -> np.ndarray:

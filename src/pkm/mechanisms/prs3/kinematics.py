@@ -110,7 +110,7 @@ def leg_vectors(params: Prs3Params, y: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return c, np.maximum(rad, 0.0)
 
 
-def inverse_kinematics(params: Prs3Params, y, branch: str | tuple[str, str, str] | None = None
+def inverse_kinematics(params: Prs3Params, y, branch: str | tuple[str, ...] | None = None
                        ) -> tuple[np.ndarray, np.ndarray]:
     """Slider positions ``d_i`` [m] and knee angles ``theta_i`` [rad] for ``y = (z_p, beta, phi)`` (eqs. 8-11).
 
@@ -139,7 +139,7 @@ def inverse_kinematics(params: Prs3Params, y, branch: str | tuple[str, str, str]
     return d, theta
 
 
-def joint_values(params: Prs3Params, y, branch: str | tuple[str, str, str] | None = None) -> dict[str, list[float]]:
+def joint_values(params: Prs3Params, y, branch: str | tuple[str, ...] | None = None) -> dict[str, list[float]]:
     """Every joint coordinate of the tree (closed form) for ``y = (z_p, beta, phi)``."""
     params = check_params(params, Prs3Params)
     d, theta = inverse_kinematics(params, y, branch)
@@ -152,7 +152,7 @@ def joint_values(params: Prs3Params, y, branch: str | tuple[str, str, str] | Non
     return out
 
 
-def configuration(mech: Mechanism, y, branch: str | tuple[str, str, str] | None = None) -> np.ndarray:
+def configuration(mech: Mechanism, y, branch: str | tuple[str, ...] | None = None) -> np.ndarray:
     """Full configuration vector ``q`` of ``mech`` for ``y = (z_p, beta, phi)`` (closed form)."""
     mech = check_mechanism(mech)
     return mech.q_from_dict(joint_values(mech.params, y, branch))
@@ -181,6 +181,6 @@ def as_task(y, name: str) -> np.ndarray:
     return arr
 
 
-def branch_names(branch: str | tuple[str, str, str] | None) -> tuple[str, ...]:
+def branch_names(branch: str | tuple[str, ...] | None) -> tuple[str, ...]:
     """The working mode of each of the three legs (one name for all, or three; None: the default)."""
     return leg_branches(branch, BRANCHES, 3, DEFAULT_BRANCH)

@@ -26,7 +26,7 @@ SQRT3 = math.sqrt(3.0)
 
 
 MODES: dict[str, tuple[int, int, int]] = {
-    f"mode{k + 1}": tuple(-1 if (k >> (2 - i)) & 1 else 1 for i in range(3)) for k in range(8)
+    f"mode{k + 1}": (-1 if k & 4 else 1, -1 if k & 2 else 1, -1 if k & 1 else 1) for k in range(8)
 }
 """Working mode name -> signs of ``(psi_1, psi_2, psi_3)`` (see the module doc)."""
 

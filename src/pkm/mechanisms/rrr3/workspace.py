@@ -34,10 +34,11 @@ the map square ``+-80 cm`` about the base centroid with 2 mm steps, unreachable 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pkm.core.indices import inverse_condition
 from pkm.errors import InvalidInputError, SingularityError, UnreachableError
@@ -506,25 +507,25 @@ class OrientationSweep:
         return np.ma.masked_array(self.ci_sum / np.where(empty, 1, self.reachable_nodes), mask=empty)
 
 
-def orientation_sweep(design, xs: Sequence[float], ys: Sequence[float], phis: Sequence[float],
+def orientation_sweep(design, xs: ArrayLike, ys: ArrayLike, phis: ArrayLike,
                       settings: CiSettings = CiSettings()) -> OrientationSweep:
     """Reachability and CI on every node of ``xs x ys x phis`` (m, m, rad); ``settings.phi`` is ignored.
 
     ``xs`` must be evenly spaced (its step sets the node area).
     """
-    xs, ys, phis = (np.asarray(v, dtype=float).ravel() for v in (xs, ys, phis))
-    if min(xs.size, ys.size, phis.size) == 0:
+    gx, gy, gphi = (np.asarray(v, dtype=float).ravel() for v in (xs, ys, phis))
+    if min(gx.size, gy.size, gphi.size) == 0:
         raise InvalidInputError("xs, ys, phis", "each needs at least one value")
-    step = float(xs[1] - xs[0]) if xs.size > 1 else 0.0
-    per = max(1, _CHUNK // (xs.size * ys.size))
-    reach_n, ci_sum = np.zeros(phis.size, dtype=np.int64), np.zeros(phis.size)
-    X, Y = np.meshgrid(xs, ys)
-    for k in range(0, phis.size, per):
-        ph = phis[k:k + per]
+    step = float(gx[1] - gx[0]) if gx.size > 1 else 0.0
+    per = max(1, _CHUNK // (gx.size * gy.size))
+    reach_n, ci_sum = np.zeros(gphi.size, dtype=np.int64), np.zeros(gphi.size)
+    X, Y = np.meshgrid(gx, gy)
+    for k in range(0, gphi.size, per):
+        ph = gphi[k:k + per]
         ci, reach = condition_index_phi(design, X[None], Y[None], ph[:, None, None], settings)
         reach_n[k:k + per] = reach.sum(axis=(1, 2))
         ci_sum[k:k + per] = np.where(reach, ci, 0.0).sum(axis=(1, 2))
-    return OrientationSweep(phis, reach_n, ci_sum, xs.size * ys.size * phis.size, step)
+    return OrientationSweep(gphi, reach_n, ci_sum, gx.size * gy.size * gphi.size, step)
 
 
 # ---------------------------------------------------------------------- singularities inside a region
