@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
 import signal
 import socket
 import subprocess
@@ -39,15 +40,18 @@ CASES = [(name, f.name) for name in pkm.MECHANISMS for f in dataclasses.fields(m
 
 
 @pytest.mark.parametrize("mechanism,field", CASES)
-def test_every_parameter_has_a_unit_in_its_docstring(mechanism, field):
-    """Every Params field is documented with a unit in brackets that the CLI knows, unless it is text or an integer."""
+def test_every_parameter_has_a_unit_in_its_metadata_and_docstring(mechanism, field):
+    """Every Params field carries units that the CLI knows in its metadata, the same as in brackets in its docstring,
+    unless it is text or an integer."""
     info = cli.param_info(mechanism)[field]
     assert info.description, f"{mechanism}.{field} is not in the Attributes section"
     if info.unitless:
         return
-    assert info.units, f"{mechanism}.{field}: no [unit] in {info.description!r}"
+    assert info.units, f"{mechanism}.{field}: no unit in its metadata (pkm.mechanisms._common.param)"
     known = {"m", "rad", "kg", "kg m^2", "-"}
     assert set(info.units) <= known, info.units
+    documented = tuple(dict.fromkeys(re.findall(r"\[([A-Za-z][A-Za-z0-9^ /*.-]*|-)\]", info.description)))
+    assert info.units == documented, f"{mechanism}.{field}: metadata {info.units} but the docstring says {documented}"
 
 
 def test_attribute_parser_reads_grouped_entries_and_continuations():

@@ -42,6 +42,7 @@ def test_loading_the_files_gives_the_generated_mechanism(name, built):
     """``pkm.load`` (files) and the generator build the same model at the same reference."""
     diffs = mechanism_differences(pkm.load(name), built(name))
     assert not diffs, _report(f"pkm.load({name!r})", diffs)
+    assert pkm.load(name).params == module(name).Params()  # read from the spec's [parameters], not assumed
 
 
 def test_wheel_ships_urdf_and_dynamics(tmp_path):

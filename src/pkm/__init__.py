@@ -69,9 +69,10 @@ def load(name: str) -> Mechanism:
         return mod.build(mod.Params())
     from pkm.core.mechanism import Mechanism
     from pkm.data import data_dir
+    from pkm.mechanisms._common import params_from_table
 
     mech = Mechanism.from_files(data_dir("urdf") / entry.reference)
-    mech.params = mod.Params()
+    mech.params = params_from_table(mod.Params, mech.spec.parameters)  # the design the files state
     return mech
 
 

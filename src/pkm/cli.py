@@ -10,8 +10,9 @@ Usage::
     pkm bench [NAME ...] [--json] [--quick] [-- ARGS passed to each benchmark]
 
 Values are SI (m, rad, kg) unless they carry a unit: ``R=120mm``, ``beta=-11deg``, ``z=81cm``
-(lengths m, cm, mm; angles rad, deg; masses kg, g). A parameter's unit is the one in brackets in
-its ``Params`` docstring (``La: Arm length [m] (110 mm).``); a suffix of another kind is refused.
+(lengths m, cm, mm; angles rad, deg; masses kg, g). A parameter's units are those of its field's
+metadata (``La: float = param(0.110, "m")``, stated in brackets in the docstring too); a suffix of
+another kind is refused.
 Tuple parameters take comma-separated values (``home=0,0,-375mm``). Task coordinates not given
 to ``--pose`` keep their reference values, and so do actuated joints not given to ``--joints``.
 ``ik`` and ``fk`` print JSON in SI units (lengths m, angles rad).
@@ -81,8 +82,8 @@ class ParamInfo:
         name: Field name.
         type: Its annotation, as written (``"float"``, ``"tuple[float, ...]"``, ``"str"``).
         default: The default value (SI).
-        units: Units in brackets in the field's docstring entry, in order of appearance, without
-            repeats (``("m",)``, ``("m", "rad")``); empty for a field without one.
+        units: The field's units from its metadata (``("m",)``, ``("m", "rad")``); empty for a field
+            without one (text, integers).
         description: The docstring entry, backticks removed.
     """
 
@@ -143,7 +144,8 @@ def attribute_docs(cls: type) -> dict[str, str]:
 
 
 def param_info(mechanism: str) -> dict[str, ParamInfo]:
-    """The parameters of ``mechanism`` with their defaults and their units parsed from the docstring.
+    """The parameters of ``mechanism`` with their defaults, their units (the fields' metadata, see
+    :func:`pkm.mechanisms._common.param`) and their descriptions (the class docstring).
 
     Raises:
         UnknownNameError: ``mechanism`` is not one of :data:`pkm.MECHANISMS`.
@@ -154,7 +156,7 @@ def param_info(mechanism: str) -> dict[str, ParamInfo]:
     out = {}
     for f in dataclasses.fields(cls):
         text = docs.get(f.name, "").replace("``", "")
-        units = tuple(dict.fromkeys(u.strip() for u in _UNIT.findall(text)))
+        units = tuple(f.metadata.get("units", ()))
         ftype = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))
         out[f.name] = ParamInfo(f.name, ftype, getattr(defaults, f.name), units, text)
     return out

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pkm.mechanisms._common import check_numbers, check_positive
+from pkm.mechanisms._common import check_numbers, check_positive, param
 
 NAME = "fivebar"
 #: Working mode -> sign of the root taken for each motor (``theta_i = atan2(v_i) + s_i acos(...)``).
@@ -23,11 +23,11 @@ class FiveBarParams:
         m_link: Mass of each link [kg].
     """
 
-    d: float = 0.20
-    l1: float = 0.25
-    l2: float = 0.30
-    home: tuple[float, float] = (0.0, 0.35)
-    m_link: float = 0.1
+    d: float = param(0.20, "m")
+    l1: float = param(0.25, "m")
+    l2: float = param(0.30, "m")
+    home: tuple[float, float] = param((0.0, 0.35), "m")
+    m_link: float = param(0.1, "kg")
 
     def __post_init__(self):
         check_positive(self, "d", "l1", "l2", "m_link")

@@ -5,6 +5,8 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+from collections.abc import Mapping
+from typing import TypeVar, cast
 
 import numpy as np
 
@@ -12,6 +14,15 @@ from pkm.core.mechanism import Mechanism
 from pkm.core.spec import ClosureSpec
 from pkm.errors import InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.validation import ABSURD, wrap_angle
+
+T = TypeVar("T")
+
+
+def param(default: T, *units: str) -> T:
+    """A design field: its default and its units (SI: ``"m"``, ``"rad"``, ``"kg"``, ``"kg m^2"``, ``"-"``;
+    several for a tuple of mixed quantities, none for text and integers), kept in the field's metadata,
+    where the command line and the docs read them (``dataclasses.fields(Params)[k].metadata["units"]``)."""
+    return cast(T, dataclasses.field(default=default, metadata={"units": units}))
 
 
 def rot_x(a: float) -> np.ndarray:
@@ -145,6 +156,24 @@ def spec_parameters(params) -> dict[str, float | str]:
         else:
             out[f.name] = float(v)
     return out
+
+
+def params_from_table(cls: type, table: Mapping[str, float | str]):
+    """The ``cls`` instance a closure spec's ``[parameters]`` table states (the inverse of
+    :func:`spec_parameters`: tuple fields were written ``name_1 .. name_n``); fields the table lacks keep
+    their defaults, integer fields come back as integers."""
+    kw: dict[str, object] = {}
+    for f in dataclasses.fields(cls):
+        default = f.default
+        if isinstance(default, tuple):
+            values = [table[k] for k in (f"{f.name}_{i + 1}" for i in range(len(default))) if k in table]
+            if values:
+                kw[f.name] = tuple(values)
+        elif f.name in table:
+            v = table[f.name]
+            is_int = isinstance(default, int) and not isinstance(default, bool)
+            kw[f.name] = int(v) if is_int and isinstance(v, float) and v.is_integer() else v
+    return cls(**kw)
 
 
 def make_mechanism(urdf: str, spec: ClosureSpec, params) -> Mechanism:

@@ -9,6 +9,7 @@ from pkm.errors import InvalidParameterError, UnreachableError
 from pkm.mechanisms._common import (
     check_numbers,
     check_positive,
+    param,
 )
 
 NAME = "delta"
@@ -36,14 +37,14 @@ class DeltaParams:
         m_platform: Platform mass [kg] (illustrative).
     """
 
-    La: float = 0.110
-    Lb: float = 0.330
-    r: float = 0.050
-    R: float = 0.150
-    home: tuple[float, float, float] = (0.0, 0.0, -0.375)
-    m_arm: float = 0.10
-    m_forearm: float = 0.05
-    m_platform: float = 0.20
+    La: float = param(0.110, "m")
+    Lb: float = param(0.330, "m")
+    r: float = param(0.050, "m")
+    R: float = param(0.150, "m")
+    home: tuple[float, float, float] = param((0.0, 0.0, -0.375), "m")
+    m_arm: float = param(0.10, "kg")
+    m_forearm: float = param(0.05, "kg")
+    m_platform: float = param(0.20, "kg")
 
     def __post_init__(self):
         from pkm.mechanisms.delta.kinematics import inverse_kinematics  # (kinematics imports this module)

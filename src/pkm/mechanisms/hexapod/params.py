@@ -14,6 +14,7 @@ from pkm.mechanisms._common import (
     check_numbers,
     check_params,
     check_positive,
+    param,
     rot_y,
 )
 
@@ -68,23 +69,23 @@ class HexapodParams:
         m_platform: Platform mass [kg] (illustrative).
     """
 
-    Rf: float = 0.050
-    Rr: float = 0.150
-    R2: float = 0.450
-    H0: float = 0.200
-    LA: float = 0.200
-    LB: float = 0.400
-    h: float = 0.034
-    r: float = 0.050
-    theta: tuple[float, ...] = tuple(math.radians(a) for a in (35.0, 155.0, 275.0, 25.0, 145.0, 265.0))
-    layout: str = "sector"
-    home_rotation: tuple[float, ...] = POSE_T_ROTATION
-    home_position: tuple[float, float, float] = POSE_T_POSITION
-    home_beta: float = 0.0
-    m_recon: float = 0.15
-    m_arm: float = 0.25
-    m_rod: float = 0.15
-    m_platform: float = 0.80
+    Rf: float = param(0.050, "m")
+    Rr: float = param(0.150, "m")
+    R2: float = param(0.450, "m")
+    H0: float = param(0.200, "m")
+    LA: float = param(0.200, "m")
+    LB: float = param(0.400, "m")
+    h: float = param(0.034, "m")
+    r: float = param(0.050, "m")
+    theta: tuple[float, ...] = param(tuple(math.radians(a) for a in (35.0, 155.0, 275.0, 25.0, 145.0, 265.0)), "rad")
+    layout: str = param("sector")
+    home_rotation: tuple[float, ...] = param(POSE_T_ROTATION, "-")
+    home_position: tuple[float, float, float] = param(POSE_T_POSITION, "m")
+    home_beta: float = param(0.0, "rad")
+    m_recon: float = param(0.15, "kg")
+    m_arm: float = param(0.25, "kg")
+    m_rod: float = param(0.15, "kg")
+    m_platform: float = param(0.80, "kg")
 
     def __post_init__(self):
         from pkm.mechanisms.hexapod.kinematics import inverse_kinematics  # (kinematics imports this module)

@@ -7,6 +7,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import cast
 
 import numpy as np
 
@@ -17,6 +18,7 @@ from pkm.mechanisms._common import (
     check_finite,
     check_nonnegative,
     check_positive,
+    param,
 )
 
 NAME = "prs3"
@@ -73,8 +75,9 @@ def table2() -> Mapping[str, float]:
     return MappingProxyType(out)
 
 
-def _from_table2(key: str):
-    return field(default_factory=lambda: table2()[key])
+def _from_table2(key: str, *units: str) -> float:
+    """A field whose default is Table 2's ``key`` (read when a ``Prs3Params`` is made), with its units."""
+    return cast(float, field(default_factory=lambda: table2()[key], metadata={"units": units}))
 
 
 # ---------------------------------------------------------------------- parameters
@@ -99,21 +102,21 @@ class Prs3Params:
             of the sec. 5 trajectories (eq. 41: z = 0.81 m, beta = phi = 0).
     """
 
-    gamma: float = _from_table2("gamma")
-    l: float = _from_table2("l")
-    h: float = _from_table2("h")
-    g: float = _from_table2("g")
-    actuation: str = "P"
-    m_slider: float = _from_table2("m1")
-    m_coupler: float = _from_table2("m2")
-    m_platform: float = _from_table2("mp")
-    Ixx3: float = _from_table2("Ixx3")
-    Iyy3: float = _from_table2("Iyy3")
-    Izz3: float = _from_table2("Izz3")
-    Ixy3: float = _from_table2("Ixy3")
-    Ixz3: float = _from_table2("Ixz3")
-    Iyz3: float = _from_table2("Iyz3")
-    reference: tuple[float, float, float] = (0.81, 0.0, 0.0)
+    gamma: float = _from_table2("gamma", "rad")
+    l: float = _from_table2("l", "m")
+    h: float = _from_table2("h", "m")
+    g: float = _from_table2("g", "m")
+    actuation: str = param("P")
+    m_slider: float = _from_table2("m1", "kg")
+    m_coupler: float = _from_table2("m2", "kg")
+    m_platform: float = _from_table2("mp", "kg")
+    Ixx3: float = _from_table2("Ixx3", "kg m^2")
+    Iyy3: float = _from_table2("Iyy3", "kg m^2")
+    Izz3: float = _from_table2("Izz3", "kg m^2")
+    Ixy3: float = _from_table2("Ixy3", "kg m^2")
+    Ixz3: float = _from_table2("Ixz3", "kg m^2")
+    Iyz3: float = _from_table2("Iyz3", "kg m^2")
+    reference: tuple[float, float, float] = param((0.81, 0.0, 0.0), "m", "rad")
 
     def __post_init__(self):
         from pkm.mechanisms.prs3.kinematics import ROOT_TOL, as_task, leg_vectors  # (kinematics imports this module)

@@ -17,6 +17,7 @@ from pkm.mechanisms._common import (
     check_numbers,
     check_params,
     check_positive,
+    param,
 )
 
 NAME = "rrr3"
@@ -54,15 +55,15 @@ class Rrr3Params:
         m_platform: Platform mass [kg] (illustrative).
     """
 
-    a: float = 0.40
-    b: float = 0.40
-    h: float = 0.10
-    H: float = 1.00
-    mode: int = 1
-    home: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    m_proximal: float = 0.20
-    m_distal: float = 0.15
-    m_platform: float = 0.10
+    a: float = param(0.40, "m")
+    b: float = param(0.40, "m")
+    h: float = param(0.10, "m")
+    H: float = param(1.00, "m")
+    mode: int = param(1)
+    home: tuple[float, float, float] = param((0.0, 0.0, 0.0), "m", "rad")
+    m_proximal: float = param(0.20, "kg")
+    m_distal: float = param(0.15, "kg")
+    m_platform: float = param(0.10, "kg")
 
     def __post_init__(self):
         from pkm.mechanisms.rrr3.kinematics import singularity_measures  # (kinematics imports this module)
