@@ -12,6 +12,7 @@ by tree traversal, not by file order). Mimic joints take no coordinate.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,9 +48,14 @@ class JointInfo:
 class Mechanism:
     """A parallel mechanism on Pinocchio.
 
+    The model, the spec and every index are fixed once built; the Pinocchio data the algorithms
+    write into are per thread (:attr:`data`, :attr:`constraint_datas`), so that one mechanism can be
+    used from several threads at once. A mechanism pickles (it is rebuilt from its URDF and spec),
+    so it can travel to worker processes.
+
     Attributes:
         model: The Pinocchio model of the tree (loops open).
-        data: A Pinocchio data owned by this mechanism (algorithms write into it).
+        data: This thread's Pinocchio data of the model (algorithms write into it).
         spec: The closure spec.
         params: The parameter object that generated it (None when loaded from files).
         urdf: The URDF text, when known.
@@ -67,7 +73,7 @@ class Mechanism:
         if not isinstance(spec, ClosureSpec):
             raise InvalidInputError("spec", f"expected a ClosureSpec, got {type(spec).__name__}", spec)
         self.model = model
-        self.data = model.createData()
+        self._local = threading.local()
         self.spec = spec
         self.params = params
         self.urdf = urdf
@@ -117,7 +123,6 @@ class Mechanism:
                                               B.parentJoint, B.placement, pin.LOCAL)
             cm.name = c.name
             self.constraint_models.append(cm)
-        self.constraint_datas = [cm.createData() for cm in self.constraint_models]
         self.n_constraints = sum(cm.residualSize() for cm in self.constraint_models)
 
         missing = [n for n, j in self.joints.items() if j.nq > 0 and n not in spec.reference]
@@ -130,6 +135,31 @@ class Mechanism:
             self.q_reference = self.check_q(self.q_from_dict(spec.reference, base=pin.neutral(model)), "[reference]")
         except InvalidInputError as exc:
             raise SpecError(source, f"{exc}; fix the [reference] table of the closure spec") from None
+
+    # ------------------------------------------------------------------ per-thread data, pickling
+    @property
+    def data(self) -> pin.Data:
+        """This thread's ``pin.Data`` (made on first use in each thread)."""
+        try:
+            return self._local.data
+        except AttributeError:
+            self._local.data = self.model.createData()
+            return self._local.data
+
+    @property
+    def constraint_datas(self) -> list[pin.RigidConstraintData]:
+        """This thread's data of :attr:`constraint_models`."""
+        try:
+            return self._local.constraint_datas
+        except AttributeError:
+            self._local.constraint_datas = [cm.createData() for cm in self.constraint_models]
+            return self._local.constraint_datas
+
+    def __reduce__(self):
+        if self.urdf is None:
+            raise InvalidInputError("mech", "a Mechanism built from a pinocchio.Model (no URDF text) cannot be "
+                                            "pickled; build it with Mechanism.from_strings or from_files", self)
+        return (_rebuild, (self.urdf, self.spec.to_toml(), self.params, self.source))
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -304,6 +334,11 @@ class Mechanism:
         return (f"Mechanism({self.name!r}: nq={self.nq}, nv={self.nv}, actuated={list(self.actuated_names)}, "
                 f"closures={len(self.spec.closures)} ({self.n_constraints} equations), "
                 f"task={list(self.spec.task.components) + list(self.spec.task.joints)})")
+
+
+def _rebuild(urdf: str, spec: str, params: Any, source: str) -> Mechanism:
+    """Unpickling: the mechanism again from its URDF and spec texts."""
+    return Mechanism.from_strings(urdf, spec, params, source=source)
 
 
 def _frame_id(model: pin.Model, name, source: str) -> int | None:
