@@ -5,7 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import TypeVar, cast
 
 import numpy as np
@@ -47,26 +47,48 @@ def rod_inertia(mass: float, length: float, axis: int) -> np.ndarray:
     return np.diag(I)
 
 
-def arm_angle(u: float, v: float, w: float, arm: float, rod: float, sign: int, leg: int, detail: str) -> float:
+def circle_sphere(u, v, w, arm: float, rod: float, sign) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Angle ``t`` of an arm turning in its (u, v) plane so that its tip lies at distance ``rod`` from
-    the point ``(u, v, w)`` (arm frame: the arm's tip is ``arm (cos t, sin t, 0)``).
+    the point ``(u, v, w)`` (arm frame: the arm's tip is ``arm (cos t, sin t, 0)``), vectorised over
+    the leading axes of ``u, v, w`` (and ``sign``).
 
     ``u cos t + v sin t = K`` with ``K = (u^2 + v^2 + w^2 + arm^2 - rod^2) / (2 arm)``, so
     ``t = atan2(v, u) + sign * acos(K / hypot(u, v))``, wrapped to (-pi, pi].
 
-    Raises:
-        UnreachableError: for ``leg`` (1-based), with how much the rod misses the arm-tip circle [m].
+    Returns:
+        ``(t, reachable, rho, K)``: where ``|K| > rho`` (beyond the round-off of a double root) the
+        rod misses the circle, ``reachable`` is False and ``t`` is that of the clipped ``acos`` (the
+        nearest elbow position: finite, but no assembly).
     """
-    u, v, w = float(u), float(v), float(w)  # Python floats: a far pose overflows to inf without a warning
-    rho = math.hypot(u, v)
-    K = (u * u + v * v + w * w + arm * arm - rod * rod) / (2.0 * arm)
-    if not (math.isfinite(K) and math.isfinite(rho)):
-        raise UnreachableError(leg, math.inf, "m", f"{detail} (the point is beyond the float range: check the units)")
-    if abs(K) > rho * (1.0 + 1e-12):  # beyond round-off of a boundary (double-root) pose
-        dmin, dmax = math.hypot(w, rho - arm), math.hypot(w, rho + arm)
-        raise UnreachableError(leg, dmin - rod if dmin > rod else rod - dmax, "m", detail)
-    delta = math.acos(max(-1.0, min(1.0, K / max(rho, 1e-300))))  # rho = 0: point on the axis, any t
-    return float(wrap_angle(math.atan2(v, u) + sign * delta))
+    u, v, w = (np.asarray(x, dtype=float) for x in (u, v, w))
+    with np.errstate(over="ignore", invalid="ignore"):  # a point beyond the float range: K is inf or NaN
+        rho = np.hypot(u, v)
+        K = (u * u + v * v + w * w + arm * arm - rod * rod) / (2.0 * arm)
+        reachable = np.abs(K) <= rho * (1.0 + 1e-12)
+        delta = np.arccos(np.clip(K / np.maximum(rho, 1e-300), -1.0, 1.0))  # rho = 0: point on the axis, any t
+        t = wrap_angle(np.arctan2(v, u) + sign * delta)
+    return t, reachable, rho, K
+
+
+def leg_arm_angles(u, v, w, arm: float, rod: float, signs, detail: Callable[[int], str]) -> np.ndarray:
+    """:func:`circle_sphere` for one point per leg (arrays of shape (n,)), or the error of the first leg
+    that cannot reach.
+
+    Raises:
+        UnreachableError: for that leg (1-based), with how much its rod misses the arm-tip circle [m] and
+            ``detail(leg)`` as the explanation.
+    """
+    t, reachable, rho, K = circle_sphere(u, v, w, arm, rod, np.asarray(signs, dtype=float))
+    bad = ~(np.isfinite(K) & np.isfinite(rho) & reachable)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        if not (math.isfinite(K[i]) and math.isfinite(rho[i])):
+            raise UnreachableError(i + 1, math.inf, "m", f"{detail(i + 1)} (the point is beyond the float range: "
+                                                         "check the units)")
+        wi, ri = float(np.asarray(w, dtype=float)[i]), float(rho[i])
+        dmin, dmax = math.hypot(wi, ri - arm), math.hypot(wi, ri + arm)
+        raise UnreachableError(i + 1, dmin - rod if dmin > rod else rod - dmax, "m", detail(i + 1))
+    return t
 
 
 def leg_branches(branch, valid, n: int, default: str | None = None) -> tuple[str, ...]:

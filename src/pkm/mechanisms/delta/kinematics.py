@@ -9,18 +9,21 @@ import numpy as np
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.errors import AssemblyError, InvalidInputError, SingularityError
 from pkm.mechanisms._common import (
-    arm_angle,
     check_params,
+    leg_arm_angles,
     leg_branches,
     rot_z,
 )
 from pkm.mechanisms.delta.params import BRANCHES, PHI, DeltaParams
 from pkm.validation import as_vector, finite_result
 
-
 # ---------------------------------------------------------------------- closed forms
-def _arm_frame_point(p: np.ndarray, i: int) -> np.ndarray:
-    return rot_z(-PHI[i]) @ p
+_COS_PHI, _SIN_PHI = np.cos(PHI), np.sin(PHI)
+
+
+def _arm_frame_points(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``Rz(-phi_i) p`` for the three arms: coordinates ``x, y, z`` of shape (3,) [m]."""
+    return _COS_PHI * p[0] + _SIN_PHI * p[1], -_SIN_PHI * p[0] + _COS_PHI * p[1], np.full(3, p[2])
 
 
 def inverse_kinematics(params: DeltaParams, p, branch: str | tuple[str, str, str] = "knee_out") -> np.ndarray:
@@ -54,12 +57,9 @@ def arm_angles(La: float, Lb: float, offset: float, p: np.ndarray, signs: tuple[
     """The motor angles [rad] of :func:`inverse_kinematics` from raw dimensions [m]:
     ``offset = R - r``, ``signs[i] = +1`` for knee out, ``-1`` for knee in; ``where`` ends
     the message of the :class:`UnreachableError` (for example the design studied)."""
-    th = np.empty(3)
-    for i in range(3):
-        x, y, z = _arm_frame_point(p, i)
-        th[i] = arm_angle(y - offset, z, x, La, Lb, signs[i], i + 1,
-                          f"arm {i + 1}: the forearm cannot span the distance to the elbow circle{where}")
-    return th
+    x, y, z = _arm_frame_points(p)
+    return leg_arm_angles(y - offset, z, x, La, Lb, signs,
+                      lambda leg: f"arm {leg}: the forearm cannot span the distance to the elbow circle{where}")
 
 
 def sphere_centres(params: DeltaParams, theta) -> np.ndarray:

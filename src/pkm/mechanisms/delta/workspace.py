@@ -21,10 +21,10 @@ import numpy as np
 
 from pkm.core.indices import KINDS, condition_number
 from pkm.errors import InvalidInputError
-from pkm.mechanisms._common import check_params, real
+from pkm.mechanisms._common import check_params, circle_sphere, real
 from pkm.mechanisms.delta import PHI, DeltaParams, jacobian_factors
 from pkm.mechanisms.delta.kinematics import branch_signs
-from pkm.validation import as_array, wrap_angle
+from pkm.validation import as_array
 
 MAX_NODES = 16_000_000  #: grid nodes of :func:`workspace` at most (memory)
 
@@ -63,12 +63,8 @@ def inverse_kinematics_batch(params: DeltaParams, points, branch="knee_out") -> 
         ci, si = math.cos(PHI[i]), math.sin(PHI[i])
         w = ci * P[..., 0] + si * P[..., 1]  # along the motor axis
         u = -si * P[..., 0] + ci * P[..., 1] - (params.R - params.r)
-        v = P[..., 2]
-        rho = np.hypot(u, v)
-        K = (u * u + v * v + w * w + params.La**2 - params.Lb**2) / (2.0 * params.La)
-        reachable &= np.abs(K) <= rho * (1.0 + 1e-12)
-        delta = np.arccos(np.clip(K / np.maximum(rho, 1e-300), -1.0, 1.0))
-        theta[..., i] = wrap_angle(np.arctan2(v, u) + signs[i] * delta)
+        theta[..., i], reach_i, _, _ = circle_sphere(u, P[..., 2], w, params.La, params.Lb, signs[i])
+        reachable &= reach_i
     return theta, reachable
 
 

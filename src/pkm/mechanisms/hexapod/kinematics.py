@@ -14,8 +14,8 @@ from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.task import as_rotation
 from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError
 from pkm.mechanisms._common import (
-    arm_angle,
     check_params,
+    leg_arm_angles,
     leg_branches,
     rot_z,
 )
@@ -102,16 +102,10 @@ def inverse_kinematics(params: HexapodParams, R, P, beta: float,
     branches = branch_names(branch)
     C = platform_points(params, as_rotation(R), as_vector(P, 3, "P"))
     A = base_points(params, _scalar(beta, "beta"))
-    out = np.empty(6)
-    for i in range(6):
-        out[i] = _leg_angle(params, i, C[i] - A[i], branches[i])
-    return out
-
-
-def _leg_angle(params: HexapodParams, i: int, d: np.ndarray, branch: str) -> float:
-    dr, dy, du = leg_frame(params.theta[i]).T @ d
-    return arm_angle(dr, dy, du, params.LA, params.LB, -BRANCHES[branch], i + 1,
-                     f"leg {i + 1}: the rod LB cannot span the distance from C_{i + 1} to the circle of B")
+    frames = np.stack([leg_frame(t) for t in params.theta])  # (6, 3, 3): columns e_r, e_y, u of each leg
+    dr, dy, du = np.einsum("nij,ni->jn", frames, C - A)  # C_i - A_i in leg i's frame
+    return leg_arm_angles(dr, dy, du, params.LA, params.LB, [-BRANCHES[b] for b in branches],
+                      lambda leg: f"leg {leg}: the rod LB cannot span the distance from C_{leg} to the circle of B")
 
 
 def joint_values(params: HexapodParams, R, P, beta: float,

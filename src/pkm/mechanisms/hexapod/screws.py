@@ -75,7 +75,7 @@ class LegBatch:
         w: Rod unit directions ``(C - B) / LB`` (world), ``(*S, 6, 3)``.
         margin: Reachability margin ``rho - |K|`` of each leg, ``(*S, 6)`` [m]: >= 0 where the leg
             reaches (``rho`` the distance from ``C`` to ``A`` within the leg plane, ``K`` as in
-            :func:`pkm.mechanisms._common.arm_angle`).
+            :func:`pkm.mechanisms._common.circle_sphere`).
         klein_1: ``{$1_i; $6_i} = u.((C - A) x w)`` [m], ``(*S, 6)`` (the diagonal of ``J_q``).
         klein_r: ``{$r_i; $6_i} = u.((C - F) x w)`` [m], ``(*S, 6)`` (0 for legs 4-6).
         a_r, a_y: ``A`` in the leg frame [m]; cos_a, sin_a: ``cos alpha``, ``sin alpha``; cos_t, sin_t:
