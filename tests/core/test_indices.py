@@ -49,3 +49,12 @@ def test_bad_jacobians_and_kinds_raise(bad, kind):
         indices.condition_number(bad, kind)
     with pytest.raises(InvalidInputError):
         indices.homogenize(np.eye(2), [0], -1.0)
+
+
+def test_singularity_class_names_the_four_cases():
+    """One mapping for the core's diagnose, the 3-RRR and the hexapod (whose paper numbers the types 0-3)."""
+    from pkm.mechanisms.hexapod.singularities import KINDS
+
+    assert [indices.singularity_class(i, d) for d in (False, True) for i in (False, True)] == list(
+        indices.SINGULARITY_CLASSES) == ["regular", "inverse", "direct", "combined"]
+    assert KINDS == dict(enumerate(indices.SINGULARITY_CLASSES))

@@ -25,6 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core import constraints
+from pkm.core.indices import singularity_class
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.task import TaskMap
 from pkm.errors import SingularityError
@@ -215,6 +216,4 @@ def diagnose(mech: Mechanism, q, *, rtol: float = 1e-7) -> Diagnostics:
     si, simax = _smin(np.vstack([Jc, Jt]))
     direct = sd <= rtol * max(sdmax, 1.0)
     inverse = si <= rtol * max(simax, 1.0)
-    cls = {(False, False): "regular", (True, False): "inverse", (False, True): "direct",
-           (True, True): "combined"}[(inverse, direct)]
-    return Diagnostics(rank, mech.n_constraints - rank, mech.nv - rank, sd, si, cls)
+    return Diagnostics(rank, mech.n_constraints - rank, mech.nv - rank, sd, si, singularity_class(inverse, direct))

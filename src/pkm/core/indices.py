@@ -26,6 +26,17 @@ from pkm.validation import as_array, as_scalar, finite_result
 KINDS = ("2", "fro", "fro_normalized")
 
 
+#: The classes of singularity (Gosselin and Angeles): the inverse kinematics degenerates (``J_q``
+#: singular: a leg at a reach limit), the direct kinematics does (``J_x`` singular: the platform moves
+#: with the actuators locked), or both.
+SINGULARITY_CLASSES = ("regular", "inverse", "direct", "combined")
+
+
+def singularity_class(inverse: bool, direct: bool) -> str:
+    """The class of a configuration from its two singular flags (one of :data:`SINGULARITY_CLASSES`)."""
+    return SINGULARITY_CLASSES[int(bool(inverse)) + 2 * int(bool(direct))]
+
+
 def _stack(J) -> np.ndarray:
     J = as_array(J, "J", "a matrix (m, n) or a stack (..., m, n) of numbers")
     if J.ndim < 2:

@@ -35,12 +35,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from pkm.core import screws
+from pkm.core.indices import singularity_class
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms._common import check_params
 from pkm.mechanisms.hexapod import screws as hs
 from pkm.validation import as_scalar, finite_result
 
-KINDS = {0: "regular", 1: "inverse", 2: "direct", 3: "combined"}
+KINDS = {t: singularity_class(bool(t & 1), bool(t & 2)) for t in range(4)}  # the paper's types 0-3
 
 
 @dataclass(frozen=True)

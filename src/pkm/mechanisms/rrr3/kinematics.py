@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pkm.core.indices import singularity_class
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.errors import (
     AssemblyError,
@@ -219,8 +220,7 @@ def classify_singularity(params: Rrr3Params, y, mode: int | str | None = None, *
     params = check_params(params, Rrr3Params)
     tol = as_scalar(tol, "tol", low=0.0)
     inv, direct = singularity_measures(params, y, mode)
-    return {(False, False): "regular", (True, False): "inverse", (False, True): "direct",
-            (True, True): "combined"}[(inv <= tol, direct <= tol)]
+    return singularity_class(inv <= tol, direct <= tol)
 
 
 # ---------------------------------------------------------------------- forward kinematics
