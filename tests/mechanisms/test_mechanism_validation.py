@@ -106,7 +106,7 @@ def test_hexapod_forward_kinematics_settings_and_bounded_failure():
     t0 = time.perf_counter()
     with pytest.raises(ConvergenceError) as info:
         hexapod.forward_kinematics(p, alphas, 0.0)
-    assert time.perf_counter() - t0 < 1.0 and np.isfinite(info.value.residual) and info.value.iterations == 50
+    assert time.perf_counter() - t0 < 1.0 and np.isfinite(info.value.residual) and 3 <= info.value.iterations < 50  # stops on stall
     with pytest.raises(InvalidParameterError):
         hexapod.assembly_modes(pkm.load("delta"), np.zeros(7), n_starts=1)
     with pytest.raises(InvalidInputError):

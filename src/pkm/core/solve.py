@@ -32,6 +32,7 @@ import pinocchio as pin
 
 from pkm.core import constraints
 from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.newton import gauss_newton
 from pkm.core.task import TaskMap
 from pkm.errors import BranchError, ConvergenceError, InvalidInputError
 from pkm.validation import as_count, as_scalar, as_tolerance
@@ -64,58 +65,23 @@ class SolveResult:
 
 def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray,
             cols: np.ndarray | None, tol: float, max_iter: int, max_dq: float) -> tuple[np.ndarray, float, int]:
-    """Gauss-Newton with a step cap and backtracking; returns (q, residual inf-norm, iterations).
-
-    Stops at ``tol``, after ``max_iter`` iterations, after 3 iterations in a row that lower the
-    residual by less than 1% (a least-squares point of an unreachable target), or before a step
-    that would make the residual or ``q`` non-finite.
-    """
+    """:func:`pkm.core.newton.gauss_newton` on the configuration manifold (``pin.integrate``), moving only the
+    velocity columns ``cols`` (all when None); returns (q, residual inf-norm, iterations)."""
     m = mech.model
-    r, J = fun(q)
-    res = float(np.max(np.abs(r)))
-    it = stalled = 0
-    while res > tol and it < max_iter and stalled < 3:  # 3 iterations in a row without progress: stuck
-        it += 1
-        step = -_lsq(J if cols is None else J[:, cols], r)
-        nrm = np.max(np.abs(step))
-        if nrm > max_dq:
-            step *= max_dq / nrm
-        dq = step if cols is None else np.zeros(m.nv)
-        if cols is not None:
-            dq[cols] = step
-        alpha = 1.0
-        for _ in range(8):
-            q_try = pin.integrate(m, q, alpha * dq)
-            r_try, J_try = fun(q_try)
-            res_try = float(np.max(np.abs(r_try)))
-            if res_try < res or alpha < 0.02:
-                break
-            alpha *= 0.5
-        if not (np.isfinite(res_try) and np.all(np.isfinite(q_try))):  # overflow far from the solution: stop here
-            return q, res, it
-        stalled = stalled + 1 if res_try >= 0.99 * res else 0
-        q, r, J, res = q_try, r_try, J_try, res_try
-    if not np.isfinite(res):
-        res = np.inf
-    return q, res, it
+    if cols is None:
+        return gauss_newton(fun, q, tol=tol, max_iter=max_iter, max_step=max_dq,
+                            retract=lambda x, dx: pin.integrate(m, x, dx))
 
+    def restricted(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        r, J = fun(x)
+        return r, J[:, cols]
 
-def _lsq(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Least-squares solution: LU when square and regular, SVD (rank-revealing) otherwise; no step (zeros)
-    when ``A`` or ``b`` is not finite (LAPACK would print a complaint and fail)."""
-    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
-        return np.zeros(A.shape[1])
-    if A.shape[0] == A.shape[1]:
-        try:
-            x = np.linalg.solve(A, b)
-            if np.all(np.isfinite(x)):
-                return x
-        except np.linalg.LinAlgError:
-            pass
-    try:
-        return np.linalg.lstsq(A, b, rcond=None)[0]
-    except np.linalg.LinAlgError:  # SVD did not converge (entries overflowing): no step
-        return np.zeros(A.shape[1])
+    def retract(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
+        full = np.zeros(m.nv)
+        full[cols] = dx
+        return pin.integrate(m, x, full)
+
+    return gauss_newton(restricted, q, tol=tol, max_iter=max_iter, max_step=max_dq, retract=retract)
 
 
 def _follow(mech: Mechanism, what: str, solve_at, q: np.ndarray, n_steps: int, tol: float,

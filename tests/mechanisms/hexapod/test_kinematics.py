@@ -328,10 +328,11 @@ def test_forward_kinematics_accepts_a_task_vector_as_seed(params):
 
 
 def test_forward_kinematics_without_assembly_raises_convergence_error(params):
-    """Actuated angles that admit no assembly make Newton's method fail with its residual attached."""
+    """Actuated angles that admit no assembly make Newton's method fail with its residual attached, as soon as it
+    stalls (3 iterations without 1 % progress) rather than after all 50 allowed."""
     with pytest.raises(ConvergenceError) as exc:
         hx.closed_form_fk(params, np.zeros(7))
-    assert exc.value.residual > 1e-3 and exc.value.iterations == 50
+    assert exc.value.residual > 1e-3 and 3 <= exc.value.iterations < 50
 
 
 # ---------------------------------------------------------------------- layouts (paper departures)

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from pkm.core import constraints
 from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.newton import gauss_newton
 from pkm.core.task import as_rotation
 from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError
 from pkm.mechanisms._common import (
@@ -193,15 +193,13 @@ def forward_kinematics(params: HexapodParams, alphas, beta: float, seed=None, *,
         a, b = C[1] - C[2], C[0] - C[2]
         return k * np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
-    def fun(x: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, Any]:  # (residual, Jacobian or None)
+    def fun(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         C = x.reshape(3, 3)  # vectorised over the legs and the sides
         dv = np.vstack([C, C + h * normal(C)]) - B  # legs 1-3 at C_i, legs 4-6 at C_i + h g
         D = C[pa] - C[pb]
         f = np.empty(9)
         f[:6] = (np.einsum("ij,ij->i", dv, dv) - LB**2) / (2.0 * LB)
         f[6:] = (np.einsum("ij,ij->i", D, D) - e * e) / (2.0 * e)
-        if not jacobian:
-            return f, None
         dg = k * np.hstack([pin.skew(C[1] - C[2]), -pin.skew(C[0] - C[2]), pin.skew(C[0] - C[1])])  # dg/dX
         J = np.zeros((9, 9))
         J6 = np.zeros((6, 3, 3))
@@ -214,28 +212,7 @@ def forward_kinematics(params: HexapodParams, alphas, beta: float, seed=None, *,
         J[6:] = J3.reshape(3, 9)
         return f, J
 
-    f, J = fun(X)
-    res, it = float(np.max(np.abs(f))), 0
-    while res > tol and it < max_iter:
-        it += 1
-        if not (np.all(np.isfinite(J)) and np.all(np.isfinite(f))):  # a seed beyond the float range
-            res = np.inf
-            break
-        try:
-            step = -np.linalg.lstsq(J, f, rcond=None)[0]
-        except np.linalg.LinAlgError:  # entries overflowing: no step
-            break
-        t = 1.0
-        for _ in range(20):
-            f_try, _ = fun(X + t * step, False)
-            res_try = float(np.max(np.abs(f_try)))
-            if res_try < res:
-                break
-            t *= 0.5
-        if not np.isfinite(res_try):  # overflow far from any solution: stop at the last finite iterate
-            break
-        X, res = X + t * step, res_try
-        f, J = fun(X)
+    X, res, it = gauss_newton(fun, X, tol=tol, max_iter=max_iter, halvings=20, min_alpha=0.0)
     if not res <= tol:
         raise ConvergenceError("semi-closed forward kinematics (eqs. 4-7)", res if np.isfinite(res) else np.inf, it,
                                tol, detail="the actuated angles may admit no assembly near the seed; try another "

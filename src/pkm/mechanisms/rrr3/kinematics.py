@@ -9,6 +9,7 @@ import numpy as np
 
 from pkm.core.indices import singularity_class
 from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.newton import gauss_newton
 from pkm.errors import (
     AssemblyError,
     BranchError,
@@ -342,16 +343,14 @@ def forward_kinematics(params: Rrr3Params, theta, *, tol: float = 1e-10) -> tupl
 def _fk_polish(params: Rrr3Params, D: np.ndarray, x: np.ndarray, theta: np.ndarray, tol: float) -> FkSolution | None:
     """Newton on the three leg equations from ``x = (x_A, y_A, Phi)``; the solution if it holds to ``tol``."""
     b = params.b
-    for _ in range(_FK_NEWTON):
-        f, J, e = _fk_legs(D, b, params.h, x)
-        if np.max(np.abs(np.sqrt(np.sum(e * e, axis=1)) - b)) <= 0.01 * tol:
-            break
-        if not (np.all(np.isfinite(J)) and np.all(np.isfinite(f))):
-            return None
-        step = np.linalg.lstsq(J, -f, rcond=None)[0]
-        x = x + step
-        if not np.all(np.isfinite(x)):
-            return None
+
+    def fun(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # (|e|^2 - b^2) / 2b: the distance error, to first order
+        f, J, _ = _fk_legs(D, b, params.h, z)
+        return f / (2.0 * b), J / (2.0 * b)
+
+    x, _, _ = gauss_newton(fun, x, tol=0.01 * tol, max_iter=_FK_NEWTON)
+    if not np.all(np.isfinite(x)):
+        return None
     _, _, e = _fk_legs(D, b, params.h, x)
     residual = float(np.max(np.abs(np.sqrt(np.sum(e * e, axis=1)) - b)))
     if residual > tol:
