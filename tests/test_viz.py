@@ -14,6 +14,7 @@ import json
 import re
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -379,3 +380,24 @@ def test_a_joint_on_its_parents_origin_is_a_ring_around_its_sphere():
     delta = viz.Scene.from_mechanism(pkm.load("delta"))
     guide = [delta.body(f"{viz.ROOT}/joints/platform_{a}") for a in "xyz"]
     assert len({b.size[0] for b in guide}) == 1 and not any(b.halo for b in guide)
+
+
+def test_viewer_displays_and_plays_like_pinocchios_visualizers():
+    """Viewer(mech).display(q) sends every body's placement at q; play(Q, dt) displays each row, dt apart."""
+    mech = pkm.load("delta")
+    vis = _FakeVisualizer()
+    viewer = viz.Viewer(mech, vis=vis)
+    q = assembled(mech)
+    drawn = len(vis.window.sent)
+    viewer.display(q)
+    sent = vis.window.sent[drawn:]
+    expected = viewer.scene.transforms(q)
+    assert [c["type"] for c in sent] == ["set_transform"] * len(expected)
+    for c, (path, T) in zip(sent, expected.items()):
+        assert c["path"] == path and np.allclose(matrix(c), T, atol=1e-15)
+    before = len(vis.window.sent)
+    t0 = time.perf_counter()
+    viewer.play(np.array([mech.q_reference, q, mech.q_reference]), 0.05)
+    assert len(vis.window.sent) - before == 3 * len(expected) and time.perf_counter() - t0 >= 0.15
+    with pytest.raises(InvalidInputError):
+        viewer.play(np.zeros((2, 3)), 0.05)

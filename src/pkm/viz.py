@@ -57,6 +57,7 @@ import pinocchio as pin
 
 from pkm.core.mechanism import Mechanism
 from pkm.errors import InvalidInputError, PkmError
+from pkm.validation import as_scalar
 
 ACTUATED_COLOR = 0xE7298A
 """Colour of actuated joints (pink)."""
@@ -738,6 +739,48 @@ def show(mech: Mechanism, q=None, *, trajectory=None, times=None, vis=None):
     return vis
 
 
+class Viewer:
+    """A live meshcat view of a mechanism with Pinocchio's visualizer interface: ``display(q)`` and
+    ``play(q_trajectory, dt)`` (as ``pinocchio.visualize.MeshcatVisualizer``), drawn from pkm's scene.
+
+    Args:
+        mech: The mechanism.
+        vis: A ``meshcat.Visualizer``; None starts one (a server process: :meth:`close` stops it).
+    """
+
+    def __init__(self, mech: Mechanism, vis=None):
+        self.mech = mech
+        self.vis = show(mech, vis=vis)
+        self.scene = Scene.from_mechanism(mech, root=self.vis.path.append("pkm").lower())  # where show() drew it
+
+    def url(self) -> str:
+        """The viewer's web address."""
+        return self.vis.url()
+
+    def display(self, q=None) -> None:
+        """Move every body to configuration ``q`` (default the reference); the geometry is sent once, here
+        only the placements."""
+        mc, _ = _meshcat()
+        q = self.mech.q_reference if q is None else q
+        for body, T in zip(self.scene.bodies, self.scene.transforms(q).values()):
+            self.vis.window.send(mc.commands.SetTransform(T, _path(mc, body.path)))
+
+    def play(self, q_trajectory, dt: float) -> None:
+        """Display the configurations of ``q_trajectory`` (N, nq) one after the other, ``dt`` [s] apart."""
+        import time
+
+        dt = as_scalar(dt, "dt", low=0.0, unit="s")
+        Q = _check_trajectory(self.mech, q_trajectory, None)[0]
+        for q in Q:
+            t0 = time.perf_counter()
+            self.display(q)
+            time.sleep(max(0.0, dt - (time.perf_counter() - t0)))
+
+    def close(self) -> None:
+        """Stop the viewer's server if this viewer started it (see :func:`close`)."""
+        close(self.vis)
+
+
 def close(vis, timeout: float = 5.0) -> None:
     """Stop the meshcat server process that :func:`show` started for ``vis`` and wait for it.
 
@@ -758,6 +801,6 @@ def close(vis, timeout: float = 5.0) -> None:
 
 
 __all__ = [
-    "ACTUATED_COLOR", "FPS", "MIMIC_COLOR", "PASSIVE_COLOR", "ROOT", "Body", "Scene", "VizDependencyError", "close",
+    "ACTUATED_COLOR", "FPS", "MIMIC_COLOR", "PASSIVE_COLOR", "ROOT", "Body", "Scene", "Viewer", "VizDependencyError", "close",
     "pack_commands", "read_commands", "scene_commands", "show", "snapshot_html", "write_html",
 ]
