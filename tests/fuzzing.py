@@ -1,0 +1,1066 @@
+"""The fuzzing entries of pkm's public API, driven by the mechanism registry (``tools/fuzz_report.py`` runs them).
+
+:class:`Gen` makes random and adversarial inputs; :class:`Context` holds, per worker process, every
+registered mechanism with its reference values and files; :data:`ENTRIES` lists one
+:class:`Entry` per public entry point (loaders, generic core, each mechanism's closed forms,
+indices, maps, dynamics), each a function ``(gen, adversarial) -> (callable, args, kwargs)``.
+A mechanism added to the registry gets its build, closed-form and file entries without an edit here.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from pkm.mechanisms import module as mechanism_module
+from pkm.mechanisms import names as mechanism_names
+
+NAN, INF = float("nan"), float("inf")
+ADV_NUMBERS = (NAN, INF, -INF, 1e308, -1e308, 1e-308, 5e-324, 0.0, -0.0, 1e30, -1e30, 1e7, -1.0, -1e-3,
+               10**400, -(10**400), np.float32(np.nan), np.int64(2**62))
+ADV_OBJECTS = (None, "abc", "1.5", "", "nan", b"1", [], {}, (), object(), True, False, 1 + 2j, [[1.0, 2.0], [3.0]],
+               {"a": 1}, np.array([]), np.array(["a", "b"]), np.array([1 + 1j]), set(), Ellipsis, slice(3),
+               np.zeros((2, 2)), [None] * 3, ["1", "2", "3"], np.array([True, False, True]))
+
+
+def finite(x, depth: int = 0) -> bool:
+    """Every number in ``x`` finite (arrays, dataclasses, sequences, mappings walked)."""
+    if depth > 8 or x is None or isinstance(x, (str, bytes, bool, int, np.bool_, np.integer, type)):
+        return True
+    if isinstance(x, (float, np.floating, complex, np.complexfloating)):
+        return bool(np.isfinite(x))
+    if isinstance(x, np.ma.MaskedArray):
+        return finite(x.compressed(), depth + 1)
+    if isinstance(x, np.ndarray):
+        if x.dtype.kind in "fc":
+            return bool(np.all(np.isfinite(x)))
+        if x.dtype.kind == "O":
+            return all(finite(v, depth + 1) for v in x.ravel()[:10000])
+        return True
+    pkm = ctx().pkm
+    if isinstance(x, pkm.Mechanism):
+        return finite(x.q_reference) and finite(dict(x.spec.parameters))
+    if dataclasses.is_dataclass(x) and not isinstance(x, type):
+        return all(finite(getattr(x, f.name), depth + 1) for f in dataclasses.fields(x))
+    if isinstance(x, dict):
+        return all(finite(v, depth + 1) for v in x.values())
+    if isinstance(x, (list, tuple)):
+        return all(finite(v, depth + 1) for v in x[:10000])
+    if hasattr(x, "translation") and hasattr(x, "rotation"):
+        return finite(np.asarray(x.translation)) and finite(np.asarray(x.rotation))
+    return True
+
+
+# ---------------------------------------------------------------------- input generators
+class Gen:
+    """Random values, valid-looking or hostile, from one numpy generator."""
+
+    def __init__(self, rng: np.random.Generator):
+        self.rng = rng
+
+    def pick(self, seq):
+        return seq[int(self.rng.integers(len(seq)))]
+
+    def chance(self, p: float) -> bool:
+        return bool(self.rng.random() < p)
+
+    def hostile(self):
+        """Any hostile scalar or object."""
+        return self.pick(ADV_NUMBERS + ADV_OBJECTS)
+
+    def scale(self) -> float:
+        return float(self.pick((1e-6, 1e-3, 1e-2, 0.05, 0.2, 1.0, 10.0)))
+
+    def near(self, base, scale: float | None = None) -> np.ndarray:
+        """``base`` plus Gaussian noise of a random scale (valid-looking to far off)."""
+        base = np.asarray(base, dtype=float)
+        return base + (self.scale() if scale is None else scale) * self.rng.standard_normal(base.shape)
+
+    def corrupt(self, base):
+        """A hostile variant of the array ``base``: a bad element, shape, type or magnitude."""
+        base = np.asarray(base, dtype=float)
+        r = int(self.rng.integers(12))
+        flat = base.ravel().copy()
+        if r == 0 and flat.size:
+            out = flat.astype(object)
+            out[int(self.rng.integers(flat.size))] = self.pick(ADV_NUMBERS)
+            try:
+                return np.asarray(out.tolist(), dtype=float).reshape(base.shape)
+            except (OverflowError, ValueError, TypeError):
+                return out.reshape(base.shape).tolist()
+        if r == 1:
+            return flat[:-1] if flat.size > 1 and self.chance(0.5) else np.append(flat, 0.1)
+        if r == 2:
+            return self.pick((flat.reshape(-1, 1), flat.reshape(1, -1), np.tile(flat, (2, 1)), flat.sum(),
+                              np.stack([base, base]), flat[:0]))
+        if r == 3:
+            return self.hostile()
+        if r == 4:
+            return base * float(self.pick((1e6, 1e10, 1e100, 1e300, -1e300)))
+        if r == 5:
+            return base * float(self.pick((1e-10, 1e-100, 1e-300, 0.0)))
+        if r == 6 and flat.size:
+            out = flat.tolist()
+            out[int(self.rng.integers(len(out)))] = self.pick(("x", None, [1.0], "1e3", True))
+            return out
+        if r == 7:
+            return np.full(base.shape, self.pick((NAN, INF, -INF)))
+        if r == 8:
+            return self.pick((base.astype(np.float32), base.astype(np.int64), base.astype(complex), base.tolist(),
+                              tuple(flat.tolist()), base.astype(object)))
+        if r == 9:
+            return base + 10.0 ** float(self.rng.uniform(0, 8)) * self.rng.standard_normal(base.shape)
+        if r == 10:
+            return {"value": base}
+        return np.where(self.rng.random(base.shape) < 0.5, base, -base) * 1e3
+
+    def value(self, base, adversarial: bool, scale: float | None = None):
+        return self.corrupt(base) if adversarial else self.near(base, scale)
+
+    def maybe(self, valid, adversarial: bool, p: float = 0.3):
+        """``valid`` or, for adversarial inputs with probability ``p``, a hostile value."""
+        return self.hostile() if adversarial and self.chance(p) else valid
+
+    def text_mutation(self, text: str) -> str:
+        """Cheap mutations of file text: truncations, deletions, duplications, swapped numbers and names."""
+        rng = self.rng
+        n = len(text)
+        for _ in range(int(rng.integers(1, 4))):
+            n = len(text)
+            if n == 0:
+                return text
+            r = int(rng.integers(11))
+            i = int(rng.integers(n))
+            j = min(n, i + int(rng.integers(1, 200)))
+            if r == 0:
+                text = text[:i]
+            elif r == 1:
+                text = text[:i] + text[j:]
+            elif r == 2:
+                text = text[:j] + text[i:j] + text[j:]
+            elif r in (3, 4, 5):  # a number replaced by a hostile one
+                import re
+                nums = [m.span() for m in re.finditer(r"-?\d+(\.\d+)?(e-?\d+)?", text)]
+                if nums:
+                    a, b = nums[int(rng.integers(len(nums)))]
+                    text = text[:a] + self.pick(("nan", "inf", "-inf", "1e308", "-1e308", "1e-320", "-1", "0",
+                                                 "1e9", "abc", "", "1 2", "0x10", "1_000", "--1", "+inf",
+                                                 "\"3\"", "true", "[1]")) + text[b:]
+            elif r == 6:
+                text = text[:i] + self.pick(("<", ">", "&", "\"", "'", "\x00", "\ud800", "]]>", "<!--", "\n[x]\n",
+                                             "= ", "[[closure]]\n", "<link/>", "</robot>", "\\", "&amp;",
+                                             "\u202e", "ÿ")) + text[i:]
+            elif r == 7:
+                import re
+                names = re.findall(r'"([A-Za-z_][A-Za-z0-9_]*)"', text)
+                if len(names) >= 2:
+                    a, b = self.pick(names), self.pick(names)
+                    text = text.replace(f'"{a}"', f'"{b}"', int(rng.integers(1, 3)))
+            elif r == 8:
+                text = text[:i] + text[i:j].upper() + text[j:]
+            elif r == 9:
+                lines = text.split("\n")
+                k = int(rng.integers(len(lines)))
+                lines.insert(int(rng.integers(len(lines) + 1)), lines[k])
+                text = "\n".join(lines)
+            else:
+                text = text[:i] + "".join(chr(int(c)) for c in rng.integers(32, 127, size=int(rng.integers(1, 9)))) \
+                    + text[i:]
+        return text
+
+
+HOSTILE_XML = (
+    ('<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;">'
+    '<!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;"><!ENTITY d "&c;&c;&c;&c;&c;&c;&c;&c;&c;&c;">]>'
+    '<robot name="&d;"><link name="base"/></robot>'),
+    ('<?xml version="1.0"?><!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]><robot name="&x;">'
+    '<link name="base"/></robot>'),
+    '<?xml version="1.0"?><!DOCTYPE r SYSTEM "file:///etc/passwd"><robot name="r"><link name="base"/></robot>',
+    ('<robot name="r" xmlns:xi="http://www.w3.org/2001/XInclude"><xi:include href="/etc/passwd" parse="text"/>'
+    '<link name="base"/></robot>'),
+    '<robot name="r"><link name="base"/>' + "<a>" * 300 + "</a>" * 300 + "</robot>",
+    '<robot name="r">' + "".join(f'<link name="l{k}"/>' for k in range(10_050)) + "</robot>",
+    ('<robot name="r"><link name="base"/><link name="a"><inertial><mass value="-1"/>'
+    '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
+    '<joint name="j" type="fixed"><parent link="base"/><child link="a"/></joint></robot>'),
+    ('<robot name="r"><link name="base"/><link name="a"><inertial><mass value="1"/>'
+    '<inertia ixx="nan" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
+    '<joint name="j" type="fixed"><parent link="base"/><child link="a"/></joint></robot>'),
+    ('<robot name="r"><link name="base"/><link name="a"><inertial><mass value="1"/>'
+    '<inertia ixx="-5" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
+    '<joint name="j" type="fixed"><parent link="base"/><child link="a"/></joint></robot>'),
+    "", "<robot", "\x00\x01\x02", "<robot name='r'></robot>",
+)
+
+
+# ---------------------------------------------------------------------- per-worker context
+class Context:
+    """Mechanisms, reference values and files built once per worker process."""
+
+    def __init__(self):
+        import pkm
+        from pkm.core.task import TaskMap
+        from pkm.data import dynamics_path
+        from pkm.mechanisms import module
+
+        self.pkm = pkm
+        self.names = tuple(pkm.MECHANISMS)
+        self.mech = {n: pkm.load(n) for n in self.names}
+        self.mod = {n: module(n) for n in self.names}
+        self.task = {n: TaskMap(m) for n, m in self.mech.items()}
+        self.y_ref = {n: self.task[n].value(m.q_reference) for n, m in self.mech.items()}
+        self.qa_ref = {n: m.actuated_q(m.q_reference) for n, m in self.mech.items()}
+        self.urdf = {n: m.urdf for n, m in self.mech.items()}
+        self.spec = {n: m.spec.to_toml() for n, m in self.mech.items()}
+        self.motion_text = dynamics_path("prs3_motions.toml").read_text()
+        self.tmp = Path(tempfile.mkdtemp(prefix="pkm_fuzz_"))
+        self._lazy: dict[str, object] = {}
+        # assembled configurations near the reference, by the closed forms
+        rng = np.random.default_rng(0)
+        self.assembled: dict[str, list[np.ndarray]] = {}
+        for n, m in self.mech.items():
+            qs = [m.q_reference.copy()]
+            for _ in range(40):
+                y = self.task[n].retract(self.y_ref[n], 0.02 * rng.standard_normal(self.task[n].size))
+                try:
+                    qs.append(self.mod[n].closed_form_configuration(m, y))
+                except pkm.PkmError:
+                    pass
+            self.assembled[n] = qs
+
+    def lazy(self, key: str, make: Callable[[], object]):
+        if key not in self._lazy:
+            self._lazy[key] = make()
+        return self._lazy[key]
+
+
+CTX: Context | None = None
+
+
+def ctx() -> Context:
+    global CTX
+    if CTX is None:
+        CTX = Context()
+    return CTX
+
+
+# ---------------------------------------------------------------------- entry points
+@dataclasses.dataclass(frozen=True)
+class Entry:
+    """One public entry point: ``make(gen, adversarial) -> (function, args, kwargs)``.
+
+    ``sentinel(result) -> bool`` says whether the non-finite values of a result are documented ones.
+    """
+
+    name: str
+    make: Callable[[Gen, bool], tuple]
+    sentinel: Callable[[object], bool] | None = None
+
+
+ENTRIES: list[Entry] = []
+
+
+def entry(name: str, sentinel=None):
+    def deco(fn):
+        ENTRIES.append(Entry(name, fn, sentinel))
+        return fn
+    return deco
+
+
+def _mech(g: Gen, adversarial: bool, names=None):
+    c = ctx()
+    n = g.pick(tuple(names or c.names))
+    if adversarial and g.chance(0.05):
+        return n, g.pick((None, n, "delta", c.mech[n].model, 3))
+    return n, c.mech[n]
+
+
+def _q(g: Gen, n: str, adversarial: bool):
+    """A configuration: assembled, perturbed (not assembled) or hostile."""
+    c = ctx()
+    q = g.pick(c.assembled[n])
+    if adversarial:
+        return g.corrupt(q)
+    if g.chance(0.3):
+        m = c.mech[n]
+        import pinocchio as pin
+        return pin.integrate(m.model, q, g.near(np.zeros(m.nv)))
+    return q
+
+
+def _solver_kwargs(g: Gen, adversarial: bool, names=("tol", "max_iter", "max_step")) -> dict:
+    kw = {}
+    if g.chance(0.3):
+        k = g.pick(names)
+        if adversarial:
+            kw[k] = g.pick(ADV_NUMBERS + (None, "1", -5, 0, 10**9, 1.5))
+        else:
+            kw[k] = {"tol": 10.0 ** float(g.rng.uniform(-14, -4)), "max_iter": int(g.rng.integers(1, 40)),
+                     "max_step": float(g.rng.uniform(0.01, 0.5)), "n_starts": int(g.rng.integers(1, 4)),
+                     "rtol": 10.0 ** float(g.rng.uniform(-12, -3))}[k]
+    return kw
+
+
+# loaders ----------------------------------------------------------------
+@entry("pkm.load")
+def _load(g, adv):
+    c = ctx()
+    name = g.pick(c.names) if not adv else g.pick(("Delta", "delta ", "../delta", "/etc/passwd", "rrr3\x00",
+                                                    "hexapod.urdf", "") + ADV_OBJECTS[:12])
+    return c.pkm.load, (name,), {}
+
+
+def _param_kwargs(g: Gen, n: str, adversarial: bool) -> dict:
+    c = ctx()
+    params = c.mod[n].Params()
+    fields = [f.name for f in dataclasses.fields(params)]
+    kw = {}
+    for f in g.rng.choice(fields, size=int(g.rng.integers(1, min(4, len(fields)) + 1)), replace=False):
+        v = getattr(params, str(f))
+        if isinstance(v, str):
+            kw[str(f)] = v if not adversarial else g.pick(("", "x", None, 3, "P", "R", "literal", "sector"))
+        elif isinstance(v, (tuple, list)):
+            kw[str(f)] = tuple(g.near(v, 0.02 * g.scale()).tolist()) if not adversarial else g.corrupt(v)
+        elif isinstance(v, (bool, int)):
+            kw[str(f)] = int(g.rng.integers(0, 10)) if not adversarial else g.hostile()
+        else:
+            kw[str(f)] = float(v * (1.0 + 0.1 * g.scale() * g.rng.standard_normal())) if not adversarial else \
+                g.pick(ADV_NUMBERS + ADV_OBJECTS[:14] + (-v, 0.0, v * 1e9, v * 1e-12))
+    if adversarial and g.chance(0.1):
+        kw["no_such_parameter"] = 1.0
+    return kw
+
+
+def _build_entry(n: str):
+    @entry(f"pkm.build[{n}]")
+    def _build(g, adv):
+        return ctx().pkm.build, (n,), _param_kwargs(g, n, adv)
+    return _build
+
+
+for _n in mechanism_names():
+    _build_entry(_n)
+
+
+def _mutated_urdf(g: Gen, n: str, adversarial: bool) -> str:
+    c = ctx()
+    if adversarial and g.chance(0.3):
+        return g.pick(HOSTILE_XML)
+    return g.text_mutation(c.urdf[n]) if adversarial or g.chance(0.7) else c.urdf[n]
+
+
+def _mutated_spec(g: Gen, n: str, adversarial: bool) -> str:
+    c = ctx()
+    if adversarial and g.chance(0.2):
+        return g.pick(('format = "pkm.closures/2"\n', 'format = 1\n', "a = " + "[" * 2000 + "]" * 2000,
+                       c.spec[n].replace('urdf = "', 'urdf = "../../etc/'),
+                       c.spec[n].replace("format", "# format"), c.spec[n].replace("= [", "= \"[", 3),
+                       c.spec[n] + "\n[reference]\nx = [1]\n", c.spec[n].replace("-1 }", "true }"),
+                       c.spec[n].replace('default_branch = "', 'default_branch = ["') ,
+                       c.spec[n].replace("[reference]", "[reference]\nbogus = [1e308]")))
+    return g.text_mutation(c.spec[n]) if adversarial or g.chance(0.7) else c.spec[n]
+
+
+@entry("Mechanism.from_strings")
+def _from_strings(g, adv):
+    c = ctx()
+    n = g.pick(("rrr3", "delta", "prs3", "rrr3", "delta", "prs3", "hexapod"))
+    urdf, spec = c.urdf[n], c.spec[n]
+    which = int(g.rng.integers(3))
+    if which in (0, 2):
+        urdf = _mutated_urdf(g, n, adv)
+    if which in (1, 2):
+        spec = _mutated_spec(g, n, adv)
+    if adv and g.chance(0.05):
+        urdf, spec = g.pick(((None, spec), (urdf, None), (urdf.encode("utf-8", "surrogatepass"), spec), (urdf, 3),
+                             ([urdf], spec)))
+    return c.pkm.Mechanism.from_strings, (urdf, spec), {}
+
+
+@entry("ClosureSpec.from_toml")
+def _from_toml(g, adv):
+    c = ctx()
+    n = g.pick(c.names)
+    text = _mutated_spec(g, n, adv)
+    if adv and g.chance(0.05):
+        text = g.hostile()
+    return c.pkm.ClosureSpec.from_toml, (text,), {}
+
+
+@entry("urdf.load_model")
+def _load_model(g, adv):
+    from pkm.core.urdf import load_model
+    n = g.pick(("rrr3", "delta", "prs3", "hexapod"))
+    text = _mutated_urdf(g, n, adv)
+    if adv and g.chance(0.05):
+        text = g.hostile()
+    return load_model, (text,), {}
+
+
+@entry("Mechanism.from_files")
+def _from_files(g, adv):
+    c = ctx()
+    n = g.pick(("rrr3", "delta", "prs3"))
+    d = c.tmp / f"f{int(g.rng.integers(1 << 30))}"
+    d.mkdir()
+    urdf, spec = _mutated_urdf(g, n, adv), _mutated_spec(g, n, adv)
+    try:
+        (d / f"{n}.urdf").write_text(urdf, encoding="utf-8", errors="surrogatepass")
+        (d / f"{n}.closures.toml").write_text(spec, encoding="utf-8", errors="surrogatepass")
+    except (UnicodeEncodeError, ValueError):
+        pass
+    path = d / f"{n}.closures.toml"
+    if adv and g.chance(0.2):
+        r = int(g.rng.integers(5))
+        if r == 0:  # the URDF named through a symbolic link that leaves the folder
+            os.symlink("/etc/hostname", d / "link.urdf")
+            path.write_text(c.spec[n].replace(f'urdf = "{n}.urdf"', 'urdf = "link.urdf"'))
+        elif r == 1:
+            os.mkfifo(d / "fifo.urdf")
+            path.write_text(c.spec[n].replace(f'urdf = "{n}.urdf"', 'urdf = "fifo.urdf"'))
+        elif r == 2:
+            path = g.pick(("/dev/zero", "/nonexistent/x.toml", str(d), "/etc/passwd", None, 3, "", b"x"))
+        elif r == 3:
+            os.mkfifo(d / "spec.toml")
+            path = d / "spec.toml"
+        else:
+            path.write_text(c.spec[n].replace(f'urdf = "{n}.urdf"', f'urdf = "{d.name}/../{n}.urdf"'))
+    return c.pkm.Mechanism.from_files, (path,), {}
+
+
+@entry("motion.load_motions")
+def _load_motions(g, adv):
+    from pkm.motion import load_motions
+    c = ctx()
+    d = c.tmp / f"m{int(g.rng.integers(1 << 30))}.toml"
+    text = g.text_mutation(c.motion_text) if adv or g.chance(0.7) else c.motion_text
+    if adv and g.chance(0.2):
+        text = g.pick((('format = "pkm.motion/1"\ncoordinates = ["z"]\n[case.a]\nduration = 1e6\ndt = 1e-300\n'
+                       'z = { law = "constant", value = 1.0 }\n'),
+                       ('format = "pkm.motion/1"\ncoordinates = ["z"]\n[case.a]\nduration = 1.0\ndt = 0.5\n'
+                       'z = { law = "cosine", offset = 1e308, amplitude = 1e308, omega = 1e308 }\n'),
+                       ('format = "pkm.motion/1"\ncoordinates = ["z"]\n[case.a]\nduration = 1.0\ndt = 0.5\n'
+                       'z = { law = "linear", start = true, rate = 1 }\n'), "x = " + "[" * 3000))
+    try:
+        d.write_text(text, encoding="utf-8", errors="surrogatepass")
+    except (UnicodeEncodeError, ValueError):
+        d.write_text("")
+    path = d if not (adv and g.chance(0.1)) else g.pick(("/dev/zero", None, 3, "prs3_motions.toml", "nope.toml"))
+
+    def load_and_sample(p):
+        return {k: m.sample() for k, m in load_motions(p).items()}
+    return load_and_sample, (path,), {}
+
+
+@entry("Motion.sample")
+def _motion_sample(g, adv):
+    from pkm.motion import load_motions
+    c = ctx()
+    motions = c.lazy("motions", lambda: load_motions("prs3_motions.toml"))
+    m = g.pick(list(motions.values()))
+    t = None if g.chance(0.2) else (g.near(np.linspace(0, m.duration, 5), 1.0) if not adv
+                                     else g.corrupt(np.linspace(0, m.duration, 5)))
+    return m.sample, (t,), {}
+
+
+# generic core -----------------------------------------------------------
+def _target(g: Gen, n: str, adversarial: bool):
+    c = ctx()
+    task = c.task[n]
+    y = task.value(g.pick(c.assembled[n]))
+    if adversarial:
+        if g.chance(0.15):
+            return g.pick(({"x": 0.0}, {k: 0.0 for k in task.names}, np.eye(4), np.ones((4, 4))))
+        return g.corrupt(y)
+    return task.retract(y, g.near(np.zeros(task.size), g.pick((1e-3, 1e-2, 0.05, 0.2, 1.0))))
+
+
+@entry("pkm.solve_ik")
+def _solve_ik(g, adv):
+    n, m = _mech(g, adv)
+    kw = _solver_kwargs(g, adv)
+    if g.chance(0.2):
+        kw["q0"] = _q(g, n, adv)
+    if g.chance(0.2):
+        branches = list(ctx().mech[n].spec.branches)
+        kw["branch"] = g.pick(branches) if not adv else g.pick(branches + ["nope", None, 3])
+    return ctx().pkm.solve_ik, (m, _target(g, n, adv)), kw
+
+
+@entry("pkm.close_loops")
+def _close_loops(g, adv):
+    n, m = _mech(g, adv)
+    qa = ctx().qa_ref[n]
+    kw = _solver_kwargs(g, adv)
+    if g.chance(0.2):
+        kw["q0"] = _q(g, n, adv)
+    if adv and g.chance(0.1):
+        kw["raise_on_failure"] = False
+    return ctx().pkm.close_loops, (m, g.value(qa, adv, g.pick((1e-3, 1e-2, 0.05, 0.2)))), kw
+
+
+@entry("core.branch_seed")
+def _branch_seed(g, adv):
+    from pkm.core import branch_seed
+    n, m = _mech(g, adv)
+    branches = list(ctx().mech[n].spec.branches)
+    return branch_seed, (m, g.pick(branches) if not adv else g.pick(branches + ["nope", None, 3, ""])), {}
+
+
+def _q_entry(name: str, fn_name: str):
+    @entry(name)
+    def _e(g, adv):
+        n, m = _mech(g, adv)
+        return getattr(ctx().pkm, fn_name), (m, _q(g, n, adv)), {}
+    return _e
+
+
+for _fn in ("forward_jacobian", "inverse_jacobian", "twist_jacobian", "passive_map", "diagnose"):
+    _q_entry(f"pkm.{_fn}", _fn)
+
+
+@entry("pkm.velocities")
+def _velocities(g, adv):
+    n, m = _mech(g, adv)
+    q = _q(g, n, adv and g.chance(0.5))
+    qd = g.value(np.zeros(ctx().mech[n].na), adv and g.chance(0.7), 1.0)
+    return ctx().pkm.velocities, (m, q, qd), {}
+
+
+@entry("pkm.accelerations")
+def _accelerations(g, adv):
+    n, m = _mech(g, adv)
+    nv, na = ctx().mech[n].nv, ctx().mech[n].na
+    return ctx().pkm.accelerations, (m, _q(g, n, adv and g.chance(0.4)), g.value(np.zeros(nv), adv and g.chance(0.4)),
+                                     g.value(np.zeros(na), adv and g.chance(0.4))), {}
+
+
+@entry("pkm.inverse_velocities")
+def _inverse_velocities(g, adv):
+    n, m = _mech(g, adv)
+    return ctx().pkm.inverse_velocities, (m, _q(g, n, adv and g.chance(0.5)),
+                                          g.value(np.zeros(ctx().task[n].size), adv and g.chance(0.7), 1.0)), {}
+
+
+@entry("pkm.inverse_accelerations")
+def _inverse_accelerations(g, adv):
+    n, m = _mech(g, adv)
+    nv, nt = ctx().mech[n].nv, ctx().task[n].size
+    return ctx().pkm.inverse_accelerations, (m, _q(g, n, adv and g.chance(0.4)),
+                                             g.value(np.zeros(nv), adv and g.chance(0.4)),
+                                             g.value(np.zeros(nt), adv and g.chance(0.4))), {}
+
+
+@entry("pkm.task_acceleration")
+def _task_acceleration(g, adv):
+    n, m = _mech(g, adv)
+    nv = ctx().mech[n].nv
+    return ctx().pkm.task_acceleration, (m, _q(g, n, adv and g.chance(0.4)),
+                                         g.value(np.zeros(nv), adv and g.chance(0.4)),
+                                         g.value(np.zeros(nv), adv and g.chance(0.4))), {}
+
+
+# mechanisms' closed forms -------------------------------------------------
+def _params(g: Gen, n: str, adversarial: bool):
+    """The reference design, or a random valid one, or (adversarial) a hostile object."""
+    c = ctx()
+    if adversarial and g.chance(0.05):
+        return g.pick((None, "delta", 3, c.mech[n], c.mod[g.pick(c.names)].Params()))
+    if g.chance(0.3):
+        try:
+            return c.mod[n].Params(**_param_kwargs(g, n, False))
+        except c.pkm.PkmError:
+            pass
+    return c.mech[n].params
+
+
+def _closed_forms(n: str):
+    @entry(f"{n}.closed_form_ik")
+    def _ik(g, adv):
+        c = ctx()
+        kw = {}
+        if g.chance(0.2):
+            branches = list(c.mech[n].spec.branches)
+            kw["branch"] = g.pick(branches) if not adv else g.pick(branches + ["nope", 3, ("a",)])
+        return c.mod[n].closed_form_ik, (_params(g, n, adv), _target(g, n, adv)), kw
+
+    @entry(f"{n}.closed_form_configuration")
+    def _conf(g, adv):
+        c = ctx()
+        _, m = _mech(g, adv, (n,))
+        return c.mod[n].closed_form_configuration, (m, _target(g, n, adv)), {}
+
+    if mechanism_module(n).closed_form_fk is not None:
+        @entry(f"{n}.closed_form_fk")
+        def _fk(g, adv):
+            c = ctx()
+            kw = {}
+            if g.chance(0.2):
+                kw["seed"] = _target(g, n, adv)
+            qa = g.value(c.qa_ref[n], adv, g.pick((1e-3, 0.05, 0.3)))
+            return c.mod[n].closed_form_fk, (_params(g, n, adv), qa), kw
+
+
+@entry("delta.forward_kinematics")
+def _delta_fk(g, adv):
+    from pkm.mechanisms import delta
+    return delta.forward_kinematics, (_params(g, "delta", adv), g.value(ctx().qa_ref["delta"], adv, 0.5)), \
+        {"both": g.chance(0.5)}
+
+
+@entry("delta.jacobian")
+def _delta_jac(g, adv):
+    from pkm.mechanisms import delta
+    c = ctx()
+    th = g.value(c.qa_ref["delta"], adv and g.chance(0.6), 0.3)
+    kw = {}
+    if g.chance(0.3):
+        kw["p"] = g.value(c.y_ref["delta"], adv, 0.01)
+    return delta.jacobian, (_params(g, "delta", adv), th), kw
+
+
+@entry("rrr3.forward_kinematics")
+def _rrr3_fk(g, adv):
+    from pkm.mechanisms import rrr3
+    kw = _solver_kwargs(g, adv, ("tol",))
+    return rrr3.forward_kinematics, (_params(g, "rrr3", adv), g.value(ctx().qa_ref["rrr3"], adv, 0.5)), kw
+
+
+@entry("rrr3.jacobians")
+def _rrr3_jac(g, adv):
+    from pkm.mechanisms import rrr3
+    kw = {"mode": g.pick((None, 1, 5, "mode3"))} if not adv else {"mode": g.pick((0, 9, "mode0", None, 2.5, True))}
+    return rrr3.jacobians, (_params(g, "rrr3", adv), _target(g, "rrr3", adv)), kw
+
+
+@entry("rrr3.homogenized_jacobians")
+def _rrr3_hjac(g, adv):
+    from pkm.mechanisms import rrr3
+    kw = {}
+    if g.chance(0.3):
+        kw["length"] = float(g.rng.uniform(0.01, 1)) if not adv else g.pick(ADV_NUMBERS + ADV_OBJECTS[:10])
+    if g.chance(0.3):
+        kw["reference"] = g.pick(rrr3.REFERENCES) if not adv else g.pick(("B", None, 3, ""))
+    return rrr3.homogenized_jacobians, (_params(g, "rrr3", adv), _target(g, "rrr3", adv)), kw
+
+
+@entry("rrr3.classify_singularity")
+def _rrr3_classify(g, adv):
+    from pkm.mechanisms import rrr3
+    kw = {"tol": g.pick((1e-8, 1e-3)) if not adv else g.pick(ADV_NUMBERS + (None, "x"))} if g.chance(0.3) else {}
+    return rrr3.classify_singularity, (_params(g, "rrr3", adv), _target(g, "rrr3", adv)), kw
+
+
+@entry("hexapod.forward_kinematics")
+def _hex_fk(g, adv):
+    from pkm.mechanisms import hexapod as hx
+    c = ctx()
+    alphas = hx.paper_alphas(c.qa_ref["hexapod"])
+    alphas = g.value(alphas, adv and g.chance(0.6), g.pick((1e-3, 0.02, 0.2)))
+    kw = _solver_kwargs(g, adv, ("tol", "max_iter"))
+    args = [_params(g, "hexapod", adv), alphas, g.maybe(0.0 if not g.chance(0.5) else float(g.rng.normal(0, 0.3)),
+                                                        adv, 0.15)]
+    if g.chance(0.2):
+        args.append(g.value(hx.platform_points(hx.HexapodParams(), hx.home_rotation(hx.HexapodParams()),
+                                               hx.POSE_T_POSITION)[:3], adv, 0.01))
+    return hx.forward_kinematics, tuple(args), kw
+
+
+@entry("hexapod.assembly_modes")
+def _hex_modes(g, adv):
+    from pkm.mechanisms import hexapod as hx
+    c = ctx()
+    _, m = _mech(g, adv, ("hexapod",))
+    kw = {"n_starts": int(g.rng.integers(1, 3))}
+    kw.update(_solver_kwargs(g, adv, ("tol", "max_iter", "n_starts")))
+    if "max_iter" not in kw:
+        kw["max_iter"] = int(g.rng.integers(3, 15))
+    return hx.assembly_modes, (m, g.value(c.qa_ref["hexapod"], adv, g.pick((1e-3, 0.02, 0.2)))), kw
+
+
+def _pose(g: Gen, adversarial: bool):
+    """(R, P) near the hexapod's pose T, or hostile."""
+    from pkm.core.task import zyx_matrix
+    from pkm.mechanisms import hexapod as hx
+    p = hx.HexapodParams()
+    R = hx.home_rotation(p) @ zyx_matrix(*g.near(np.zeros(3), g.pick((0.01, 0.1, 0.5))))
+    P = g.near(p.home_position, g.pick((0.001, 0.01, 0.05, 0.3)))
+    if adversarial:
+        if g.chance(0.5):
+            R = g.pick((g.corrupt(R), R * 1.1, -R, R.T @ np.diag([1, 1, -1]), np.zeros((3, 3)), R[:2]))
+        else:
+            P = g.corrupt(P)
+    return R, P
+
+
+@entry("hexapod_indices.indices")
+def _hex_indices(g, adv):
+    from pkm.mechanisms.hexapod import indices as hi
+    R, P = _pose(g, adv)
+    kw = {}
+    if g.chance(0.2):
+        kw["point"] = g.pick(("O", "P")) if not adv else g.pick(("Q", None, 1))
+    if g.chance(0.2):
+        kw["length"] = float(g.rng.uniform(0.01, 1)) if not adv else g.pick(ADV_NUMBERS + ADV_OBJECTS[:8])
+    return hi.indices, (_params(g, "hexapod", adv), R, P, g.maybe(float(g.rng.normal(0, 0.3)), adv, 0.2)), kw
+
+
+@entry("hexapod_singularities.classify")
+def _hex_classify(g, adv):
+    from pkm.mechanisms.hexapod import singularities as hsg
+    R, P = _pose(g, adv)
+    kw = {}
+    if g.chance(0.2):
+        kw["tol"] = 1e-6 if not adv else g.pick(ADV_NUMBERS + (None,))
+    if g.chance(0.2):
+        kw["length"] = 0.05 if not adv else g.pick(ADV_NUMBERS + ADV_OBJECTS[:8])
+    return hsg.classify, (_params(g, "hexapod", adv), R, P, g.maybe(float(g.rng.normal(0, 0.3)), adv, 0.2)), kw
+
+
+def _baseline_nan_ok(res) -> bool:
+    """NaN only in the baseline comparison: baseline values where ``baseline_ok`` is False, relative gains
+    there and where the baseline's index is 0 (documented in ProfileOptimum); everything else finite."""
+    r = getattr(res, "result", res)  # a BetaProfile holds its ProfileOptimum in .result
+    ok = np.asarray(r.baseline_ok)
+    base, gain = np.asarray(r.baseline_value), np.asarray(r.relative_gain)
+    if r is not res and not (np.array_equal(np.asarray(res.base_value), base, equal_nan=True)
+                             and np.array_equal(np.asarray(res.relative_gain), gain, equal_nan=True)):
+        return False
+    comparable = ok & (np.nan_to_num(base) != 0.0)
+    if not (np.all(np.isnan(base[~ok])) and np.all(np.isfinite(base[ok]))
+            and np.all(np.isnan(gain[~comparable])) and np.all(np.isfinite(gain[comparable]))):
+        return False
+    if r is not res:
+        return (finite(dataclasses.replace(res, result=None, base_value=np.zeros(1), relative_gain=np.zeros(1)))
+                and _baseline_nan_ok(r))
+    return (finite(dataclasses.replace(r, pointwise=None, baseline_value=np.zeros(1), relative_gain=np.zeros(1)))
+            and finite(r.pointwise))
+
+
+@entry("hexapod_reconfigure.optimal_beta")
+def _hex_beta(g, adv):
+    from pkm.mechanisms.hexapod import reconfiguration as hr
+    R, P = _pose(g, adv)
+    kw = {}
+    if g.chance(0.3):
+        kw["index"] = g.pick(("w_rot", "w_tras")) if not adv else g.pick(("w", None, 0))
+    if g.chance(0.2):
+        kw["limits"] = g.pick(((-1.0, 1.0), (-0.2, 0.3))) if not adv else g.pick(((1.0, -1.0), (NAN, 1.0), None,
+                                                                                   "ab", (0, 0), (-1e300, 1e300)))
+    if g.chance(0.1):
+        kw["tol"] = 1e-6 if not adv else g.pick(ADV_NUMBERS + (None,))
+    return hr.optimal_beta, (_params(g, "hexapod", adv), R, P), kw
+
+
+@entry("hexapod_reconfigure.beta_profile", sentinel=_baseline_nan_ok)
+def _hex_profile(g, adv):
+    from pkm.mechanisms.hexapod import reconfiguration as hr
+    k = int(g.rng.integers(2, 5))
+    R0, P0 = _pose(g, False)
+    poses = [(R0, P0 + np.array([0.0, 0.0, 0.003 * j])) for j in range(k)]
+    if adv:
+        j = int(g.rng.integers(k))
+        poses[j] = _pose(g, True) if g.chance(0.7) else g.hostile()
+        if g.chance(0.1):
+            poses = g.pick(([], None, "poses", poses[0]))
+    kw = {}
+    if g.chance(0.3):
+        kw["rate_limit"] = float(g.rng.uniform(0.001, 0.1)) if not adv else g.pick(ADV_NUMBERS + (None,))
+    if g.chance(0.2):
+        kw["smoothness"] = float(g.rng.uniform(0, 10)) if not adv else g.pick(ADV_NUMBERS + (None,))
+    return hr.beta_profile, (_params(g, "hexapod", adv), poses), kw
+
+
+@entry("hexapod_reconfigure.reachable_intervals")
+def _hex_intervals(g, adv):
+    from pkm.mechanisms.hexapod import reconfiguration as hr
+    R, P = _pose(g, adv)
+    return hr.reachable_intervals, (_params(g, "hexapod", adv), R, P), {}
+
+
+# generic reconfiguration layer ---------------------------------------------
+def _index_fn(g: Gen, adversarial: bool):
+    a, b, c = g.rng.normal(size=3)
+    smooth = g.pick((lambda k, x: np.exp(-(x - a) ** 2) + 0.1 * np.sin(3 * x + b) + 0 * k,
+                     lambda k, x: np.cos(x * (1 + abs(c))) + 2.0 + 0 * k,
+                     lambda k, x: 1e-12 * (x - a) ** 2 + 0 * k))
+    if not adversarial:
+        return smooth
+    return g.pick((lambda k, x: np.full(np.shape(x), np.nan), lambda k, x: 1.0 / (x - x),
+                   lambda k, x: np.zeros(3), lambda k, x: "x", lambda k, x: None, lambda k, x: np.inf * x,
+                   lambda k, x: np.exp(1e3 * x), smooth, smooth, 3))
+
+
+@entry("redundant_parameter.maximise")
+def _maximise(g, adv):
+    from pkm.core import redundant_parameter
+    n = int(g.rng.integers(1, 5))
+    lo = g.rng.uniform(-2, 0, n)
+    hi_ = lo + g.rng.uniform(0, 2, n)
+    if adv and g.chance(0.5):
+        lo, hi_ = g.pick(((g.corrupt(lo), hi_), (lo, g.corrupt(hi_)), (hi_ + 1, lo), (lo, hi_[:-1])))
+    kw = {}
+    if g.chance(0.2):
+        kw[g.pick(("grid", "tol", "fd_step", "max_iter", "eta"))] = g.pick(ADV_NUMBERS + (None, 0, 1, -3, 2.5)) \
+            if adv else None
+        kw = {k: v for k, v in kw.items() if v is not None}
+    return redundant_parameter.maximise, (_index_fn(g, adv), lo, hi_), kw
+
+
+@entry("redundant_parameter.optimise_profile", sentinel=_baseline_nan_ok)
+def _optimise_profile(g, adv):
+    from pkm.core import redundant_parameter
+    n = int(g.rng.integers(2, 6))
+    lo = np.full(n, -1.0) + 0.1 * g.rng.normal(size=n)
+    hi_ = lo + g.rng.uniform(0.2, 2, n)
+    kw = {"rate_limit": float(g.rng.uniform(0.01, 0.5))}
+    if adv:
+        k = g.pick(("rate_limit", "smoothness", "baseline", "tol", "max_iter", "eta", "lower"))
+        if k == "lower":
+            lo = g.corrupt(lo)
+        else:
+            kw[k] = g.pick(ADV_NUMBERS + (None, "x", -1, 0))
+    elif g.chance(0.3):
+        kw["baseline"] = g.pick((None, 0.0, -0.5, 5.0))
+    return redundant_parameter.optimise_profile, (_index_fn(g, adv), lo, hi_), kw
+
+
+# indices ----------------------------------------------------------------
+def _kappa_sentinel(res) -> bool:
+    """``inf`` (never NaN) is the documented condition number of a singular matrix (or an unreachable point)."""
+    if isinstance(res, dict):
+        return all(_kappa_sentinel(v) for v in res.values())
+    arr = np.asarray(res, dtype=float)
+    return not np.any(np.isnan(arr)) and np.all(arr[~np.isfinite(arr)] > 0)
+
+
+def _matrix(g: Gen, adversarial: bool):
+    shape = g.pick(((3, 3), (6, 6), (2, 3), (4, 3, 3), (2, 2, 6, 6)))
+    J = g.rng.normal(size=shape) * g.scale()
+    if g.chance(0.2):
+        J[..., -1, :] = J[..., 0, :]  # singular
+    return g.corrupt(J) if adversarial else J
+
+
+@entry("indices.condition_number", sentinel=_kappa_sentinel)
+def _cond(g, adv):
+    from pkm.core import indices
+    kind = g.pick(indices.KINDS) if not (adv and g.chance(0.2)) else g.pick(("3", None, 2, "FRO"))
+    return indices.condition_number, (_matrix(g, adv), kind), {}
+
+
+@entry("indices.inverse_condition")
+def _icond(g, adv):
+    from pkm.core import indices
+    return indices.inverse_condition, (_matrix(g, adv), g.pick(indices.KINDS)), {}
+
+
+@entry("indices.manipulability")
+def _manip(g, adv):
+    from pkm.core import indices
+    return indices.manipulability, (_matrix(g, adv),), {}
+
+
+@entry("indices.homogenize")
+def _homog(g, adv):
+    from pkm.core import indices
+    J0 = _matrix(g, False)
+    J = g.corrupt(J0) if adv and g.chance(0.5) else J0
+    L = float(g.rng.uniform(0.01, 2)) if not adv else g.pick(ADV_NUMBERS + ADV_OBJECTS[:10] + (0.1,))
+    rows = g.pick((slice(0, 1), 0, [0], np.array([True] + [False] * (J0.shape[-2] - 1))))
+    if adv and g.chance(0.2):
+        rows = g.pick((10, "a", None, slice(None), [True]))
+    return indices.homogenize, (J, rows, L), {}
+
+
+def _ci_sentinel(res) -> bool:
+    """``NaN`` only at unreachable nodes (mask ``reachable``)."""
+    ci, reach = res
+    ci = np.asarray(ci)
+    return bool(np.all(np.isnan(ci[~reach])) and np.all(np.isfinite(ci[reach])))
+
+
+@entry("rrr3_maps.condition_index", sentinel=_ci_sentinel)
+def _rrr3_ci(g, adv):
+    from pkm.mechanisms.rrr3 import workspace as rm
+    c = ctx()
+    base = c.y_ref["rrr3"][:2]
+    m = int(g.rng.integers(1, 30))
+    gx = base[0] + g.rng.normal(0, g.pick((0.01, 0.1, 0.5)), m)
+    gy = base[1] + g.rng.normal(0, g.pick((0.01, 0.1, 0.5)), m)
+    if adv:
+        if g.chance(0.5):
+            gx = g.corrupt(gx)
+        else:
+            gy = g.corrupt(gy)
+    settings = {}
+    if g.chance(0.3):
+        settings = {"phi": float(g.rng.normal()) if not adv else g.hostile(), "norm": g.pick(rm.NORMS),
+                    "mode": int(g.rng.integers(1, 9))}
+    design = _params(g, "rrr3", adv)
+    if adv and g.chance(0.1):
+        design = g.pick((rm.Design(0.4, 0.4, 0.1, 1.0), None, "x"))
+
+    def condition_index(design, gx, gy, **settings):
+        return rm.condition_index(design, gx, gy, rm.CiSettings(**settings))
+    return condition_index, (design, gx, gy), settings
+
+
+@entry("rrr3_maps.ci_map")
+def _rrr3_map(g, adv):
+    from pkm.mechanisms.rrr3 import workspace as rm
+    c = ctx()
+    centre = c.y_ref["rrr3"][:2]
+    half, step = float(g.rng.uniform(0.01, 0.3)), float(g.rng.uniform(0.02, 0.1))
+    if adv:
+        k = int(g.rng.integers(3))
+        if k == 0:
+            centre = g.corrupt(centre)
+        elif k == 1:
+            half = g.pick(ADV_NUMBERS + ADV_OBJECTS[:10])
+        else:
+            step = g.pick(ADV_NUMBERS + ADV_OBJECTS[:10] + (1e-9,))
+
+    def grid_and_map(design, centre, half, step):
+        m = rm.ci_map(design, rm.Grid.square(centre, half, step))
+        return m.gci(), m.area_gci()
+    return grid_and_map, (_params(g, "rrr3", adv), centre, half, step), {}
+
+
+@entry("rrr3_maps.naive_condition_index")
+def _rrr3_naive(g, adv):
+    from pkm.mechanisms.rrr3 import workspace as rm
+    y = _target(g, "rrr3", adv)
+
+    def naive(design, y):
+        v = rm.naive_condition_index(design, y)
+        return None if math.isnan(v) else v  # NaN: documented for an unreachable pose
+    return naive, (_params(g, "rrr3", adv), y), {}
+
+
+@entry("delta_workspace.condition_numbers", sentinel=_kappa_sentinel)
+def _delta_kappa(g, adv):
+    from pkm.mechanisms.delta import workspace as dw
+    c = ctx()
+    pts = c.y_ref["delta"] + g.rng.normal(0, g.pick((0.01, 0.1, 0.5)), (int(g.rng.integers(1, 20)), 3))
+    if adv:
+        pts = g.corrupt(pts)
+    kw = {}
+    if g.chance(0.2):
+        kw["kinds"] = g.pick((("2",), ("fro", "2"))) if not adv else g.pick(((), ("x",), None, "2", 3))
+    if g.chance(0.2):
+        kw["branch"] = g.pick(("knee_in", ("knee_in", "knee_out", "knee_in"))) if not adv else g.pick(("x", None, 3))
+
+    def kappas(params, pts, **kw):
+        K, _reach = dw.condition_numbers(params, pts, **kw)
+        return K
+    return kappas, (_params(g, "delta", adv), pts), kw
+
+
+@entry("delta_design.radius_minimising_condition")
+def _delta_radius(g, adv):
+    from pkm.mechanisms.delta import design as dd
+    c = ctx()
+    p = g.value(c.y_ref["delta"], adv, g.pick((0.01, 0.05, 0.3)))
+    kw = {"n_scan": int(g.rng.integers(2, 8))}
+    if adv and g.chance(0.3):
+        kw["n_scan"] = g.pick((0, -1, 1, None, 2.5, "3", 10**9))
+    if g.chance(0.2):
+        kw["kind"] = g.pick(("2", "fro")) if not adv else g.pick(("x", None))
+    return dd.radius_minimising_condition, (_params(g, "delta", adv), p), kw
+
+
+@entry("delta_design.reachable_radii")
+def _delta_radii(g, adv):
+    from pkm.mechanisms.delta import design as dd
+    return dd.reachable_radii, (_params(g, "delta", adv), g.value(ctx().y_ref["delta"], adv, g.pick((0.01, 0.3)))), {}
+
+
+# dynamics ----------------------------------------------------------------
+def _prs3(g: Gen, adversarial: bool):
+    from pkm.mechanisms.prs3.dynamics import Prs3Dynamics
+    c = ctx()
+    return c.lazy("prs3dyn", Prs3Dynamics)
+
+
+@entry("Prs3Dynamics.forces")
+def _prs3_forces(g, adv):
+    y0 = np.array([0.81, 0.0, 0.0])
+    y = g.value(y0, adv and g.chance(0.5), g.pick((0.01, 0.1, 0.5)))
+    yd = g.value(np.zeros(3), adv and g.chance(0.3), 1.0)
+    ydd = g.value(np.zeros(3), adv and g.chance(0.3), 1.0)
+    args = [y, yd, ydd]
+    if g.chance(0.3):
+        args.append(g.value(np.zeros(6), adv, 10.0))
+    return _prs3(g, adv).forces, tuple(args), {}
+
+
+@entry("Prs3Dynamics.batch")
+def _prs3_batch(g, adv):
+    N = int(g.rng.integers(1, 40))
+    Y = np.array([0.81, 0.0, 0.0]) + g.rng.normal(0, g.pick((0.01, 0.1, 0.5)), (N, 3))
+    Yd, Ydd = g.rng.normal(size=(N, 3)), g.rng.normal(size=(N, 3))
+    args = [Y, Yd, Ydd]
+    if adv:
+        k = int(g.rng.integers(3))
+        args[k] = g.corrupt(args[k])
+    kw = {}
+    if g.chance(0.3):
+        kw["wrench"] = g.value(np.zeros(6), adv, 10.0)
+    if g.chance(0.3):
+        kw["t"] = g.value(np.arange(N, dtype=float), adv, 0.0)
+    if adv and g.chance(0.1):
+        kw["chunk"] = g.pick((0, -1, None, 2.5))
+    return _prs3(g, adv).batch, tuple(args), kw
+
+
+@entry("Prs3Dynamics.jacobian")
+def _prs3_jac(g, adv):
+    return _prs3(g, adv).jacobian, (g.value(np.array([0.81, 0.0, 0.0]), adv, g.pick((0.01, 0.1, 0.5))),), {}
+
+
+@entry("KhalilProjection.inverse_dynamics")
+def _khalil(g, adv):
+    from pkm.core.dynamics import KhalilProjection
+    c = ctx()
+    n = g.pick(("delta", "prs3"))
+    kp = c.lazy(f"khalil_{n}", lambda: KhalilProjection(c.mech[n]))
+    m = c.mech[n]
+    q = _q(g, n, adv and g.chance(0.4))
+    v = g.value(np.zeros(m.nv), adv and g.chance(0.3), 1.0)
+    a = g.value(np.zeros(m.nv), adv and g.chance(0.3), 1.0)
+    kw = {"wrench": g.value(np.zeros(6), adv, 10.0)} if g.chance(0.3) else {}
+    return kp.inverse_dynamics, (q, v, a), kw
+
+
+@entry("dynamics.forward_dynamics")
+def _fwd_dyn(g, adv):
+    from pkm.core.dynamics import forward_dynamics
+    n, m = _mech(g, adv, ("delta", "prs3", "rrr3"))
+    mm = ctx().mech[n]
+    return forward_dynamics, (m, _q(g, n, adv and g.chance(0.4)), g.value(np.zeros(mm.nv), adv and g.chance(0.3)),
+                              g.value(np.zeros(mm.na), adv and g.chance(0.3), 1.0)), {}
+
+
+@entry("screws.transform")
+def _screw_transform(g, adv):
+    from pkm.core import screws
+    s = g.rng.normal(size=g.pick(((6,), (4, 6))))
+    R = np.eye(3)
+    t = g.rng.normal(size=3)
+    if adv:
+        k = int(g.rng.integers(3))
+        s, R, t = (g.corrupt(s), R, t) if k == 0 else (s, g.corrupt(R), t) if k == 1 else (s, R, g.corrupt(t))
+    return screws.transform, (s, R, t), {}
+
+
+for _n in mechanism_names():
+    _closed_forms(_n)
+
+
