@@ -263,9 +263,9 @@ def _key_kind(mech: pkm.Mechanism, key: str) -> str:
 
 def task_values(mech: pkm.Mechanism, q) -> dict[str, float]:
     """The task coordinates of ``q`` by name (see :func:`task_keys`; angles Z-Y-X Euler) [m, rad]."""
-    from pkm.core import TaskMap, zyx_angles
+    from pkm.core import zyx_angles
 
-    y = TaskMap(mech).value(q)
+    y = mech.task_map.value(q)
     if not mech.spec.task.is_pose:
         return dict(zip(task_keys(mech), map(float, y)))
     M = mech.data.oMf[mech.ee_frame]
@@ -402,7 +402,6 @@ def _configuration(mech: pkm.Mechanism, args) -> np.ndarray:
 
 def _solve_ik(mech: pkm.Mechanism, target, branch: str | None) -> pkm.SolveResult:
     """The generic IK; when it fails, the paper's closed form says which leg cannot reach, if one cannot."""
-    from pkm.core import TaskMap
     from pkm.errors import UnreachableError
 
     try:
@@ -410,7 +409,7 @@ def _solve_ik(mech: pkm.Mechanism, target, branch: str | None) -> pkm.SolveResul
     except ConvergenceError as exc:
         mod = pkm.mechanism_module(mech.name)
         try:
-            mod.closed_form_ik(mech.params, TaskMap(mech).parse(target), branch)
+            mod.closed_form_ik(mech.params, mech.task_map.parse(target), branch)
         except UnreachableError as unreachable:
             raise unreachable from exc
         except PkmError:

@@ -27,7 +27,6 @@ import pinocchio as pin
 from pkm.core import constraints
 from pkm.core.indices import singularity_class
 from pkm.core.mechanism import Mechanism, check_mechanism
-from pkm.core.task import TaskMap
 from pkm.errors import SingularityError
 from pkm.validation import as_tolerance, as_vector, finite_result
 
@@ -93,7 +92,7 @@ def forward_jacobian(mech: Mechanism, q) -> np.ndarray:
     """Task rates from actuated rates, ``yd = J qd_a`` (n_task x na)."""
     mech, q = _check(mech, q)
     G = _passive_map(mech, constraints.jacobian(mech, q), RTOL)
-    return finite_result(TaskMap(mech).jacobian(q, update=False) @ G, "forward Jacobian")
+    return finite_result(mech.task_map.jacobian(q, update=False) @ G, "forward Jacobian")
 
 
 def twist_jacobian(mech: Mechanism, q) -> np.ndarray:
@@ -114,7 +113,7 @@ def inverse_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
     mech, q = _check(mech, q)
     rtol = as_tolerance(rtol, "rtol")
     Jc = constraints.jacobian(mech, q)
-    A = np.vstack([Jc, TaskMap(mech).jacobian(q, update=False)])
+    A = np.vstack([Jc, mech.task_map.jacobian(q, update=False)])
     smin, smax = _smin(A)
     if smin <= rtol * max(smax, 1.0):
         raise SingularityError("inverse", smin, "the task frozen, the joints can still move")
@@ -147,14 +146,14 @@ def task_velocity(mech: Mechanism, q, v) -> np.ndarray:
     """Task rates for joint rates ``v``."""
     mech, q = _check(mech, q)
     v = mech.check_v(v)
-    return finite_result(TaskMap(mech).jacobian(q) @ v, "task velocity")
+    return finite_result(mech.task_map.jacobian(q) @ v, "task velocity")
 
 
 def task_acceleration(mech: Mechanism, q, v, a) -> np.ndarray:
     """Task accelerations ``J_t a + dJ_t/dt v``."""
     mech, q = _check(mech, q)
     v, a = mech.check_v(v), mech.check_v(a, "a")
-    task = TaskMap(mech)
+    task = mech.task_map
     return finite_result(task.jacobian(q) @ a + task.bias(q, v), "task acceleration")
 
 
@@ -163,7 +162,7 @@ def inverse_velocities(mech: Mechanism, q, yd) -> np.ndarray:
     mech, q = _check(mech, q)
     yd = as_vector(yd, mech.n_task, "yd")
     Jc = constraints.jacobian(mech, q)
-    A = np.vstack([Jc, TaskMap(mech).jacobian(q, update=False)])
+    A = np.vstack([Jc, mech.task_map.jacobian(q, update=False)])
     return finite_result(_lstsq(A, np.concatenate([np.zeros(mech.n_constraints), yd])), "joint velocities")
 
 
@@ -172,7 +171,7 @@ def inverse_accelerations(mech: Mechanism, q, v, ydd) -> np.ndarray:
     mech, q = _check(mech, q)
     v = mech.check_v(v)
     ydd = as_vector(ydd, mech.n_task, "ydd")
-    task = TaskMap(mech)
+    task = mech.task_map
     gamma_c = constraints.drift(mech, q, v)
     gamma_t = task.bias(q, v)
     Jc = constraints.jacobian(mech, q)
@@ -208,7 +207,7 @@ def diagnose(mech: Mechanism, q, *, rtol: float = 1e-7) -> Diagnostics:
     mech, q = _check(mech, q)
     rtol = as_tolerance(rtol, "rtol")
     Jc = constraints.jacobian(mech, q)
-    Jt = TaskMap(mech).jacobian(q, update=False)
+    Jt = mech.task_map.jacobian(q, update=False)
     finite_result(Jc, "constraint Jacobian")
     s = np.linalg.svd(Jc, compute_uv=False)
     rank = int(np.sum(s > rtol * max(s[0], 1.0))) if len(s) else 0

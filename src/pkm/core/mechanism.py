@@ -12,11 +12,12 @@ by tree traversal, not by file order). Mimic joints take no coordinate.
 
 from __future__ import annotations
 
+import functools
 import threading
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -25,6 +26,9 @@ from pkm.core.spec import ClosureSpec, as_path, read_text_file
 from pkm.core.urdf import load_model
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
 from pkm.validation import as_array, as_vector, wrap_angle
+
+if TYPE_CHECKING:
+    from pkm.core.task import TaskMap
 
 
 @dataclass(frozen=True)
@@ -154,6 +158,13 @@ class Mechanism:
         except AttributeError:
             self._local.constraint_datas = [cm.createData() for cm in self.constraint_models]
             return self._local.constraint_datas
+
+    @functools.cached_property
+    def task_map(self) -> TaskMap:
+        """The mechanism's :class:`~pkm.core.task.TaskMap` (made once; it holds no per-call state)."""
+        from pkm.core.task import TaskMap  # (pkm.core.task imports this module)
+
+        return TaskMap(self)
 
     def __reduce__(self):
         if self.urdf is None:

@@ -33,7 +33,6 @@ import pinocchio as pin
 from pkm.core import constraints
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.newton import gauss_newton
-from pkm.core.task import TaskMap
 from pkm.errors import BranchError, ConvergenceError, InvalidInputError
 from pkm.validation import as_count, as_scalar, as_tolerance
 
@@ -182,7 +181,7 @@ def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol
         raise_on_failure: Raise :class:`ConvergenceError` instead of returning ``converged=False``.
     """
     mech = check_mechanism(mech)
-    task = TaskMap(mech)
+    task = mech.task_map
     y1 = task.parse(target)
     tol, max_iter, max_step = _settings(tol, max_iter, max_step)
     if branch is not None:
@@ -227,7 +226,7 @@ def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_i
     q = mech.q_reference.copy()
     if mech.on_branch(q, branch):
         return q
-    task = TaskMap(mech)
+    task = mech.task_map
     y_ref = task.value(q)
     wrapped = mech.wrap(q)
     pins = np.array([mech.joints[n].idx_v for n in b.signs])
