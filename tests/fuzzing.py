@@ -20,6 +20,7 @@ import numpy as np
 
 from pkm.mechanisms import module as mechanism_module
 from pkm.mechanisms import names as mechanism_names
+from pkm.papers.hexapod import pose_T_placement
 
 NAN, INF = float("nan"), float("inf")
 ADV_NUMBERS = (NAN, INF, -INF, 1e308, -1e308, 1e-308, 5e-324, 0.0, -0.0, 1e30, -1e30, 1e7, -1.0, -1e-3,
@@ -323,6 +324,11 @@ def _param_kwargs(g: Gen, n: str, adversarial: bool) -> dict:
     kw = {}
     for f in g.rng.choice(fields, size=int(g.rng.integers(1, min(4, len(fields)) + 1)), replace=False):
         v = getattr(params, str(f))
+        if v is None:  # found for the design (the reference pose): stated only to corrupt it
+            if adversarial:
+                length = next(x.metadata["length"] for x in dataclasses.fields(params) if x.name == f)
+                kw[str(f)] = g.corrupt(tuple(g.rng.normal(0.0, 0.1, length).tolist()))
+            continue
         if isinstance(v, str):
             kw[str(f)] = v if not adversarial else g.pick(("", "x", None, 3, "P", "R", "literal", "sector"))
         elif isinstance(v, (tuple, list)):
@@ -667,8 +673,7 @@ def _hex_fk(g, adv):
     args = [_params(g, "hexapod", adv), alphas, g.maybe(0.0 if not g.chance(0.5) else float(g.rng.normal(0, 0.3)),
                                                         adv, 0.15)]
     if g.chance(0.2):
-        args.append(g.value(hx.platform_points(hx.HexapodParams(), hx.home_rotation(hx.HexapodParams()),
-                                               hx.POSE_T_POSITION)[:3], adv, 0.01))
+        args.append(g.value(hx.platform_points(hx.HexapodParams(), *pose_T_placement())[:3], adv, 0.01))
     return hx.forward_kinematics, tuple(args), kw
 
 
@@ -687,10 +692,9 @@ def _hex_modes(g, adv):
 def _pose(g: Gen, adversarial: bool):
     """(R, P) near the hexapod's pose T, or hostile."""
     from pkm.core.task import zyx_matrix
-    from pkm.mechanisms import hexapod as hx
-    p = hx.HexapodParams()
-    R = hx.home_rotation(p) @ zyx_matrix(*g.near(np.zeros(3), g.pick((0.01, 0.1, 0.5))))
-    P = g.near(p.home_position, g.pick((0.001, 0.01, 0.05, 0.3)))
+    R0, P0 = pose_T_placement()
+    R = R0 @ zyx_matrix(*g.near(np.zeros(3), g.pick((0.01, 0.1, 0.5))))
+    P = g.near(P0, g.pick((0.001, 0.01, 0.05, 0.3)))
     if adversarial:
         if g.chance(0.5):
             R = g.pick((g.corrupt(R), R * 1.1, -R, R.T @ np.diag([1, 1, -1]), np.zeros((3, 3)), R[:2]))

@@ -59,7 +59,7 @@ def test_attribute_parser_reads_grouped_entries_and_continuations():
     prs3 = cli.param_info("prs3")
     assert prs3["Ixx3"].units == prs3["Izz3"].units == ("kg m^2",)
     assert prs3["reference"].units == ("m", "rad")
-    assert "(eq. 41" in prs3["reference"].description
+    assert "(eq. 41)" in prs3["reference"].description and prs3["reference"].length == 3
     assert cli.param_info("delta")["La"].units == ("m",) and cli.param_info("delta")["La"].default == 0.11
 
 

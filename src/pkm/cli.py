@@ -81,10 +81,11 @@ class ParamInfo:
     Attributes:
         name: Field name.
         type: Its annotation, as written (``"float"``, ``"tuple[float, ...]"``, ``"str"``).
-        default: The default value (SI).
+        default: The default value (SI; None: found for the design, such as the reference pose).
         units: The field's units from its metadata (``("m",)``, ``("m", "rad")``); empty for a field
             without one (text, integers).
         description: The docstring entry, backticks removed.
+        length: The number of values of a tuple field (its metadata), None for a scalar.
     """
 
     name: str
@@ -92,6 +93,7 @@ class ParamInfo:
     default: Any
     units: tuple[str, ...]
     description: str
+    length: int | None = None
 
     @property
     def unitless(self) -> bool:
@@ -107,7 +109,7 @@ class ParamInfo:
     def summary(self) -> str:
         """The first sentence of the description, units and defaults in brackets left out."""
         first = re.split(r"(?<=\.)\s", self.description, maxsplit=1)[0]
-        return re.sub(r"\s+", " ", _UNIT.sub("", first)).strip().rstrip(".")
+        return re.sub(r"\s+([;,)])", r"\1", re.sub(r"\s+", " ", _UNIT.sub("", first))).strip().rstrip(".")
 
 
 def attribute_docs(cls: type) -> dict[str, str]:
@@ -158,7 +160,7 @@ def param_info(mechanism: str) -> dict[str, ParamInfo]:
         text = docs.get(f.name, "").replace("``", "")
         units = tuple(f.metadata.get("units", ()))
         ftype = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))
-        out[f.name] = ParamInfo(f.name, ftype, getattr(defaults, f.name), units, text)
+        out[f.name] = ParamInfo(f.name, ftype, getattr(defaults, f.name), units, text, f.metadata.get("length"))
     return out
 
 
@@ -229,10 +231,10 @@ def parse_params(mechanism: str, items: Sequence[str]) -> dict[str, Any]:
             if text.lower() not in ("true", "false", "1", "0"):
                 raise UsageError(f"{name}={text!r}: {name} takes true or false")
             out[name] = text.lower() in ("true", "1")
-        elif isinstance(p.default, tuple):
+        elif p.length is not None:
             parts = text.split(",")
-            if len(parts) != len(p.default):
-                raise UsageError(f"{name} takes {len(p.default)} comma-separated values, got {len(parts)} in {text!r}")
+            if len(parts) != p.length:
+                raise UsageError(f"{name} takes {p.length} comma-separated values, got {len(parts)} in {text!r}")
             per = [{_KIND_OF_UNIT.get(u)} for u in p.units] if len(p.units) == len(parts) else \
                 [_kinds(p.units)] * len(parts)
             out[name] = tuple(parse_quantity(s, k, name, p.unit) for s, k in zip(parts, per))
@@ -384,6 +386,8 @@ def cmd_list(args) -> int:
 
 
 def _fmt_default(v: Any) -> str:
+    if v is None:
+        return "found"
     if isinstance(v, tuple):
         return ",".join(_fmt_default(x) for x in v)
     if isinstance(v, float):

@@ -86,9 +86,10 @@ _PLATFORM_FRACTION = 0.15  # largest joint radius, of the platform's diameter
 _NESTED_SCALE = 1.35  # radius of a joint's ring around its parent's sphere
 _TRIAD_LENGTH = 0.12
 _TRIAD_RADIUS = 0.2 * _JOINT_RADIUS
-# Camera: direction (world) from the mechanism's centre, distance in bounding radii.
+# Camera: direction (world) from the mechanism's centre, distance in bounding radii: the bounding sphere
+# fits meshcat's vertical field of view (75 deg).
 _VIEW_DIRECTION = np.array([1.0, 0.5, 0.9])
-_VIEW_DISTANCE = 1.45
+_VIEW_DISTANCE = 1.0 / math.sin(math.radians(75.0 / 2.0))
 _UUID_NAMESPACE = uuid.UUID("6f1b4c1e-8d4a-4e0b-9a51-7c6d2f3e9b10")
 
 

@@ -8,9 +8,16 @@ closure between the two distal tips. Working modes: the elbows' bending signs.
 
 from __future__ import annotations
 
-from tests.fivebar.kinematics import closed_form_configuration, closed_form_fk, closed_form_ik, inverse_kinematics
+from tests.fivebar.kinematics import (
+    closed_form_configuration,
+    closed_form_fk,
+    closed_form_ik,
+    inverse_kinematics,
+    reference_pose,
+)
 from tests.fivebar.model import build, closure_spec, urdf_xml
 from tests.fivebar.params import BRANCHES, NAME, FiveBarParams, Params
 
 __all__ = ["BRANCHES", "NAME", "FiveBarParams", "Params", "build", "closed_form_configuration", "closed_form_fk",
-           "closed_form_ik", "closure_spec", "inverse_kinematics", "urdf_xml"]
+           "closed_form_ik", "closure_spec", "inverse_kinematics", "reference_pose",
+           "urdf_xml"]

@@ -8,13 +8,28 @@ import numpy as np
 
 from pkm.core.mechanism import check_mechanism
 from pkm.errors import AssemblyError, InvalidInputError, UnreachableError
-from pkm.mechanisms._common import check_params
+from pkm.mechanisms._common import best_reference, check_params
 from pkm.validation import as_vector, wrap_angle
 from tests.fivebar.params import BRANCHES, FiveBarParams
 
 
 def _bases(p: FiveBarParams) -> np.ndarray:
     return np.array([[-p.d / 2.0, 0.0], [p.d / 2.0, 0.0]])
+
+
+def reference_pose(p: FiveBarParams) -> np.ndarray:
+    """``p.home``, or the tip on the axis ``x = 0`` whose elbows are farthest from folded or stretched."""
+    p = check_params(p, FiveBarParams)
+    if p.home is not None:
+        inverse_kinematics(p, p.home)
+        return np.array(p.home)
+
+    def score(y) -> float:
+        q = inverse_kinematics(p, y)
+        return min(abs(math.sin(q[f"elbow_{n}"][0])) for n in (1, 2))
+
+    return np.array(best_reference("home", ((0.0, (p.l1 + p.l2) * k / 32) for k in range(1, 33)), score,
+                                   minimum=1e-3))
 
 
 def inverse_kinematics(p: FiveBarParams, y, branch: str | None = None) -> dict[str, list[float]]:

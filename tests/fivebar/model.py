@@ -7,7 +7,7 @@ import math
 from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.urdf import UrdfBuilder
 from pkm.mechanisms._common import make_mechanism, rod_inertia, spec_parameters
-from tests.fivebar.kinematics import inverse_kinematics
+from tests.fivebar.kinematics import inverse_kinematics, reference_pose
 from tests.fivebar.params import BRANCHES, NAME, FiveBarParams
 
 
@@ -25,10 +25,10 @@ def urdf_xml(p: FiveBarParams) -> str:
 
 
 def closure_spec(p: FiveBarParams) -> ClosureSpec:
-    reference = {k: tuple(v) for k, v in inverse_kinematics(p, p.home).items()}
+    reference = {k: tuple(v) for k, v in inverse_kinematics(p, reference_pose(p)).items()}
     branches = {}
     for name in BRANCHES:
-        q = inverse_kinematics(p, p.home, name)
+        q = inverse_kinematics(p, reference_pose(p), name)
         branches[name] = Branch(name, {f"elbow_{n}": int(math.copysign(1, q[f"elbow_{n}"][0])) for n in (1, 2)})
     return ClosureSpec(mechanism=NAME, description="toy planar five-bar (tests only)", urdf=f"{NAME}.urdf",
                        end_effector="tip_1", actuated=("motor_1", "motor_2"),

@@ -19,19 +19,20 @@ class FiveBarParams:
         d: Distance between the motors [m].
         l1: Proximal link length [m].
         l2: Distal link length [m].
-        home: Reference tip position (x, y) [m].
+        home: Reference tip position (x, y) [m], or None (default): found by ``reference_pose``.
         m_link: Mass of each link [kg].
     """
 
     d: float = param(0.20, "m")
     l1: float = param(0.25, "m")
     l2: float = param(0.30, "m")
-    home: tuple[float, float] = param((0.0, 0.35), "m")
+    home: tuple[float, float] | None = param(None, "m", length=2)
     m_link: float = param(0.1, "kg")
 
     def __post_init__(self):
         check_positive(self, "d", "l1", "l2", "m_link")
-        check_numbers(self, "home", 2, "(x, y in m)")
+        if self.home is not None:
+            check_numbers(self, "home", 2, "(x, y in m)")
 
 
 Params = FiveBarParams

@@ -26,6 +26,7 @@ from pkm.mechanisms.hexapod import reconfiguration as hexapod_reconfigure
 from pkm.mechanisms.hexapod import singularities as hexapod_singularities
 from pkm.mechanisms.prs3.dynamics import Prs3Dynamics
 from pkm.mechanisms.rrr3 import workspace as rrr3_maps
+from pkm.papers.hexapod import pose_T_placement
 
 
 def test_build_refuses_unknown_parameters_with_the_valid_names():
@@ -116,7 +117,7 @@ def test_hexapod_forward_kinematics_settings_and_bounded_failure():
 def test_hexapod_indices_and_reconfiguration_check_their_arguments():
     """Lengths, tolerances, index names, limits and pose lists are validated with the argument named."""
     p = hexapod.HexapodParams()
-    R, P = hexapod.home_rotation(p), p.home_position
+    R, P = pose_T_placement()
     with pytest.raises(InvalidInputError, match="length"):
         hexapod_indices.indices(p, R, P, 0.0, length="0.2")
     with pytest.raises(InvalidInputError, match="tol"):
@@ -191,14 +192,14 @@ def test_every_closed_form_result_is_finite_or_an_error(name):
 def test_params_dataclasses_stay_frozen_and_comparable():
     """Normalising tuple fields does not break equality or replace()."""
     a = delta.DeltaParams(home=np.array([0.0, 0.0, -0.375]))
-    assert a == delta.DeltaParams() and dataclasses.replace(a, R=0.12).R == 0.12
+    assert a == delta.DeltaParams(home=(0.0, 0.0, -0.375)) and dataclasses.replace(a, R=0.12).R == 0.12
 
 
 def test_subnormal_characteristic_lengths_are_errors_not_infinities():
     """A characteristic length of 5e-324 m passes the > 0 check but overflows the moments: NonFiniteError."""
     p = rrr3.Rrr3Params()
     with pytest.raises(NonFiniteError, match="length"):
-        rrr3.homogenized_jacobians(p, rrr3.home_task(p), length=5e-324)
+        rrr3.homogenized_jacobians(p, rrr3.reference_pose(p), length=5e-324)
     h = hexapod.HexapodParams()
     with pytest.raises(NonFiniteError, match="length"):
-        hexapod_singularities.classify(h, hexapod.home_rotation(h), h.home_position, 0.0, length=5e-324)
+        hexapod_singularities.classify(h, *pose_T_placement(), 0.0, length=5e-324)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import dataclasses
 import math
 
 import numpy as np
@@ -23,7 +24,7 @@ def rows():
 def test_the_study_uses_table_1_explicitly():
     """The study's design is Table 1 (La 110, Lb 330, r 50 mm) at the pose (0, 0, -375) mm, whatever the defaults."""
     assert (S.PAPER.La, S.PAPER.Lb, S.PAPER.r, S.PAPER.home) == (0.110, 0.330, 0.050, (0.0, 0.0, -0.375))
-    assert S.PAPER == DeltaParams()  # today's defaults are the same design
+    assert dataclasses.replace(S.PAPER, home=None) == DeltaParams()  # today's defaults are the same lengths
 
 
 def test_rows_are_the_contract(rows):

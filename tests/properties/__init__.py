@@ -192,11 +192,12 @@ def rrr3_designs(draw, mode=None) -> rrr3.Rrr3Params:
     a, b, h = H * draw(floats(0.35, 0.6)), H * draw(floats(0.35, 0.6)), H * draw(floats(0.05, 0.25))
     mode = draw(st.integers(1, 8)) if mode is None else mode
     try:
-        p = rrr3.Rrr3Params(a=a, b=b, h=h, H=H, mode=mode, m_proximal=draw(floats(0.01, 1.0)),
+        p = rrr3.Rrr3Params(a=a, b=b, h=h, H=H, mode=mode, home=(0.0, 0.0, 0.0), m_proximal=draw(floats(0.01, 1.0)),
                             m_distal=draw(floats(0.01, 1.0)), m_platform=draw(floats(0.01, 1.0)))
+        rrr3.reference_pose(p)
     except InvalidParameterError:
         assume(False)
-    assume(min(rrr3.singularity_measures(p, rrr3.home_task(p))) > 1e-2)
+    assume(min(rrr3.singularity_measures(p, rrr3.reference_pose(p))) > 1e-2)
     return p
 
 
@@ -256,6 +257,7 @@ def hexapod_designs(draw, layout: str | None = None) -> hexapod.HexapodParams:
                                   home_beta=draw(floats(-0.3, 0.3)), m_recon=draw(floats(0.05, 0.5)),
                                   m_arm=draw(floats(0.05, 0.5)), m_rod=draw(floats(0.05, 0.5)),
                                   m_platform=draw(floats(0.2, 2.0)))
+        hexapod.reference_pose(p)
     except InvalidParameterError:
         assume(False)
     return p
@@ -264,23 +266,23 @@ def hexapod_designs(draw, layout: str | None = None) -> hexapod.HexapodParams:
 # ---------------------------------------------------------------------- poses: offsets u in [-1, 1]^n
 def delta_pose(p: delta.DeltaParams, u: np.ndarray) -> np.ndarray:
     """Platform centre ``home + 0.25 La u`` [m]."""
-    return np.asarray(p.home) + 0.25 * p.La * u
+    return delta.reference_pose(p) + 0.25 * p.La * u
 
 
 def rrr3_pose(p: rrr3.Rrr3Params, u: np.ndarray) -> np.ndarray:
     """Task ``home + (0.05 H, 0.05 H, 0.2 rad) u``."""
-    return rrr3.home_task(p) + np.array([0.05 * p.H, 0.05 * p.H, 0.2]) * u
+    return rrr3.reference_pose(p) + np.array([0.05 * p.H, 0.05 * p.H, 0.2]) * u
 
 
 def prs3_pose(p: prs3.Prs3Params, u: np.ndarray) -> np.ndarray:
     """Task ``reference + (0.05 l, 0.15 rad, 0.15 rad) u``."""
-    return np.asarray(p.reference) + np.array([0.05 * p.l, 0.15, 0.15]) * u
+    return prs3.reference_pose(p) + np.array([0.05 * p.l, 0.15, 0.15]) * u
 
 
 def hexapod_pose(p: hexapod.HexapodParams, u: np.ndarray) -> np.ndarray:
     """Task vector of the reference moved by ``0.05 LA`` (position), 0.05 rad (rotation), 0.2 rad (beta)."""
-    R = pin.exp3(0.05 * u[3:6]) @ hexapod.home_rotation(p)
-    return hexapod.task_vector(R, np.asarray(p.home_position) + 0.05 * p.LA * u[:3], p.home_beta + 0.2 * u[6])
+    R, P, beta = hexapod.reference_pose(p)
+    return hexapod.task_vector(pin.exp3(0.05 * u[3:6]) @ R, P + 0.05 * p.LA * u[:3], beta + 0.2 * u[6])
 
 
 def regular(mech, q, margin: float = 1e-3) -> bool:

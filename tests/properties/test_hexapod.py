@@ -203,7 +203,7 @@ def test_stretched_legs_of_m1_are_approached_as_an_inverse_singularity(L, first,
     H0 = -math.sqrt(L["LA"] ** 2 + L["LB"] ** 2 - horiz**2) - depth
     p = reachable(hx.HexapodParams, **L, H0=H0, theta=theta, home_rotation=tuple(R.ravel()),
                   home_position=(0.0, depth, 0.0), home_beta=beta)
-    mech = hx.build(p)
+    mech = reachable(hx.build, p)
     index_cf, index_core = [], []
     for k, s in enumerate([*(sign * s_max * DECADES), 0.0]):
         alpha, rel_y = two_link_reach(p.LA, p.LB, s, x)
@@ -248,7 +248,7 @@ def test_concurrent_rods_of_m2_are_approached_as_a_direct_singularity(L, first, 
     P = np.array([0.0, -H0 - L["LA"], 0.0])
     p = reachable(hx.HexapodParams, **L, H0=H0, theta=theta, home_rotation=tuple(rot_y(-first - sign * s_max).ravel()),
                   home_position=tuple(P), home_beta=beta)
-    mech = hx.build(p)
+    mech = reachable(hx.build, p)
     index = {"cf": [], "m2": [], "core": []}
     for k, s in enumerate([*(sign * s_max * DECADES), 0.0]):
         R = rot_y(-(first + s))

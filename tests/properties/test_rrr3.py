@@ -181,7 +181,7 @@ def test_concurrent_distal_links_are_approached_as_a_direct_singularity(p, u, fr
     with the class regular at s_max and direct at s = 1e-8 s_max (closed form and core)."""
     mech = rrr3.build(p)
     mode = f"mode{p.mode}"
-    xy = rrr3.home_task(p)[:2] + 0.03 * p.H * u
+    xy = rrr3.reference_pose(p)[:2] + 0.03 * p.H * u
 
     def det(phi):
         return np.linalg.det(rrr3.homogenized_jacobians(p, np.r_[xy, phi], mode)[0])

@@ -27,7 +27,7 @@ from pkm.bench import best_time, main
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi
 from pkm.mechanisms.hexapod import reconfiguration as hr
-from pkm.papers.hexapod import spiral_poses
+from pkm.papers.hexapod import pose_T_placement, spiral_poses
 
 STEP = math.radians(0.1)
 
@@ -48,7 +48,7 @@ def sweep(f: hi.PoseIndex, k: int, lo: float, up: float) -> float:
 
 def bench(repeat: int) -> dict:
     p = hx.Params()
-    R, P = hx.home_rotation(p), np.array(p.home_position)
+    R, P = pose_T_placement()
     out: dict = {"pose_T": {}, "spiral": {}}
     for idx in hi.INDICES:
         def sqp(idx: str = idx) -> hr.BetaChoice:

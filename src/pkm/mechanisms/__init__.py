@@ -1,8 +1,9 @@
 """The mechanisms pkm ships, one package each, and the registry every consumer iterates.
 
 A mechanism package ``pkm.mechanisms.<name>`` implements :class:`MechanismModule`: its design
-dataclass ``Params`` (SI units, validated), the generators ``urdf_xml``, ``closure_spec`` and
-``build``, and the closed forms over the task vector of :class:`pkm.core.TaskMap`
+dataclass ``Params`` (the geometry in SI units, validated for sign and finiteness, and an optional
+reference pose), ``reference_pose(params)`` (the given pose, checked, or one found for the design:
+reachable and well conditioned), the generators ``urdf_xml``, ``closure_spec`` and ``build``, and the closed forms over the task vector of :class:`pkm.core.TaskMap`
 (``closed_form_ik``, ``closed_form_configuration``, and ``closed_form_fk`` or None where it has
 no closed-form forward kinematics). :data:`REGISTRY` maps each name to its
 :class:`MechanismDefinition`; the command line, the report, the papers, the benchmarks, the
@@ -36,6 +37,8 @@ class MechanismModule(Protocol):
     def closure_spec(self, params: Any) -> Any: ...
 
     def build(self, params: Any = None) -> Any: ...
+
+    def reference_pose(self, params: Any) -> Any: ...
 
     def closed_form_ik(self, params: Any, y: Any, branch: str | None = None) -> Any: ...
 
@@ -129,7 +132,7 @@ def register(entry: MechanismDefinition, *, replace: bool = False) -> MechanismD
     if entry.name in REGISTRY and not replace:
         raise InvalidInputError("entry", f"a mechanism named {entry.name!r} is registered already", entry.name)
     mod = entry.module()
-    missing = [n for n in ("NAME", "Params", "urdf_xml", "closure_spec", "build", "closed_form_ik",
+    missing = [n for n in ("NAME", "Params", "urdf_xml", "closure_spec", "build", "reference_pose", "closed_form_ik",
                            "closed_form_configuration", "closed_form_fk") if not hasattr(mod, n)]
     if missing:
         raise InvalidInputError("entry", f"{entry.package} does not implement MechanismModule: no {missing}",

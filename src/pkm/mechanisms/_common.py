@@ -3,26 +3,30 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 import numbers
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from typing import TypeVar, cast
 
 import numpy as np
 
 from pkm.core.mechanism import Mechanism
 from pkm.core.spec import ClosureSpec
-from pkm.errors import InvalidInputError, InvalidParameterError, UnreachableError
+from pkm.errors import InvalidInputError, InvalidParameterError, PkmError, UnreachableError
 from pkm.validation import ABSURD, wrap_angle
 
 T = TypeVar("T")
 
 
-def param(default: T, *units: str) -> T:
-    """A design field: its default and its units (SI: ``"m"``, ``"rad"``, ``"kg"``, ``"kg m^2"``, ``"-"``;
-    several for a tuple of mixed quantities, none for text and integers), kept in the field's metadata,
-    where the command line and the docs read them (``dataclasses.fields(Params)[k].metadata["units"]``)."""
-    return cast(T, dataclasses.field(default=default, metadata={"units": units}))
+def param(default: T, *units: str, length: int | None = None) -> T:
+    """A design field: its default, its units (SI: ``"m"``, ``"rad"``, ``"kg"``, ``"kg m^2"``, ``"-"``;
+    several for a tuple of mixed quantities, none for text and integers) and, for a tuple, its length
+    (default: that of the default), kept in the field's metadata, where the command line and the docs
+    read them (``dataclasses.fields(Params)[k].metadata["units"]``, ``["length"]``)."""
+    if length is None and isinstance(default, tuple):
+        length = len(default)
+    return cast(T, dataclasses.field(default=default, metadata={"units": units, "length": length}))
 
 
 def rot_x(a: float) -> np.ndarray:
@@ -165,11 +169,42 @@ def check_params(params, cls: type, name: str = "params"):
     return params
 
 
+def best_reference(field: str, candidates: Iterable[T], score: Callable[[T], float], *, minimum: float) -> T:
+    """The reference pose of a design that does not state one: the candidate of largest ``score`` (a
+    dimensionless distance to singularity, such as an inverse condition number; the first of scores
+    equal to 1e-9, so the order of ``candidates`` is the order of preference); candidates where ``score`` raises
+    a :class:`~pkm.errors.PkmError` (the pose does not assemble, or is singular) are skipped.
+
+    Raises:
+        InvalidParameterError: (``field``) no candidate scores at least ``minimum``: give the pose.
+    """
+    scored: list[tuple[float, T]] = []
+    n, first_error = 0, None
+    for c in candidates:
+        n += 1
+        try:
+            s = float(score(c))
+        except PkmError as exc:
+            first_error = first_error or exc
+            continue
+        if math.isfinite(s):
+            scored.append((s, c))
+    best = max((s for s, _ in scored), default=None)
+    if best is None or best < minimum:
+        found = (f"none of them assembles; the first: {first_error}" if best is None
+                 else f"the best is {best:.3g} from singular (< {minimum:g})")
+        raise InvalidParameterError(field, f"no reachable, well-conditioned reference pose found for this design among "
+                                           f"{n} candidates ({found}); give {field} or other lengths", None)
+    return next(c for s, c in scored if s >= best * (1.0 - 1e-9))
+
+
 def spec_parameters(params) -> dict[str, float | str]:
-    """The dataclass fields as a flat table for the closure spec (tuples expanded)."""
+    """The dataclass fields as a flat table for the closure spec (tuples expanded, None left out)."""
     out: dict[str, float | str] = {}
     for f in dataclasses.fields(params):
         v = getattr(params, f.name)
+        if v is None:
+            continue
         if isinstance(v, (tuple, list, np.ndarray)):
             for k, x in enumerate(v):
                 out[f"{f.name}_{k + 1}"] = float(x)
@@ -187,8 +222,9 @@ def params_from_table(cls: type, table: Mapping[str, float | str]):
     kw: dict[str, object] = {}
     for f in dataclasses.fields(cls):
         default = f.default
-        if isinstance(default, tuple):
-            values = [table[k] for k in (f"{f.name}_{i + 1}" for i in range(len(default))) if k in table]
+        if isinstance(default, tuple) or (default is None and f"{f.name}_1" in table):
+            values = [table[k] for k in itertools.takewhile(table.__contains__,
+                                                            (f"{f.name}_{i + 1}" for i in itertools.count()))]
             if values:
                 kw[f.name] = tuple(values)
         elif f.name in table:

@@ -7,8 +7,9 @@ The paper (sec. 5, Fig. 5) varies R from 100 to 200 mm in 0.1 mm steps, at the p
 
 What this study does, and its reading of the paper:
 
-* The design is the paper's Table 1, given explicitly (:data:`PAPER`); it equals the module's
-  default :class:`~pkm.mechanisms.delta.DeltaParams`, but the study does not rely on that.
+* The design is the paper's Table 1, given explicitly (:data:`PAPER`, with the study pose as its
+  reference); its lengths equal the module's default :class:`~pkm.mechanisms.delta.DeltaParams`, but
+  the study does not rely on that.
 * Three condition numbers, named: ``"fro"`` (raw ``||J||_F ||J^-1||_F``, eqs. 13-14 as printed,
   >= 3 for a 3x3 matrix), ``"fro_normalized"`` (the same over 3, >= 1) and ``"2"``
   (``sigma_max / sigma_min``, >= 1). The paper's "minimum K = 1" holds only for the last two.

@@ -29,11 +29,19 @@ from pkm.papers._plot import figure, save
 
 TITLE = "Sanchez-Alonso et al. (2016), Kinematic analysis of a novel reconfigurable parallel robot, RIAI 13:247-257"
 
+#: Pose T (sec. 4) as printed: rotation rows (4 digits) and position [m].
+POSE_T_ROTATION = (0.9623, -0.1306, -0.2388, 0.0842, 0.9771, -0.1952, 0.2588, 0.1677, 0.9513)
+POSE_T_POSITION = (0.0, -0.350, 0.0)
 #: The spiral's rotation as printed (sec. 4) and its position [m] for path parameter s.
 SPIRAL_ROTATION = ((0.9811, -0.0558, 0.1855), (0.0858, 0.9837, -0.1581), (-0.1736, 0.1710, 0.9698))
 #: First pose of the spiral from which the paper sees a clear gain (Fig. 9).
 GAIN_FROM = 40
 RATE_LIMIT = math.radians(2.0)
+
+
+def pose_T_placement() -> tuple[np.ndarray, np.ndarray]:
+    """Pose T: the rotation as printed projected on SO(3) (its defect is 1e-4), and the position [m]."""
+    return as_rotation(POSE_T_ROTATION, "POSE_T_ROTATION", hx.HOME_ROTATION_TOL), np.array(POSE_T_POSITION)
 
 
 def spiral_poses(n: int = 101) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -47,7 +55,7 @@ def spiral_poses(n: int = 101) -> list[tuple[np.ndarray, np.ndarray]]:
 def pose_t() -> dict:
     """Pose T: reachable interval, ``beta*`` of both indices and the curves of Fig. 7 (0.1 deg grid)."""
     p = hx.Params()
-    R, P = hx.home_rotation(p), np.array(p.home_position)
+    R, P = pose_T_placement()
     spans = hr.reachable_intervals(p, R, P)
     choice = {idx: hr.optimal_beta(p, R, P, idx) for idx in hi.INDICES}
     grid = np.radians(np.arange(-90.0, 90.05, 0.1))
@@ -148,4 +156,5 @@ def figures(out_dir) -> list[Path]:
 #: No CSV series yet (the figures issue adds them).
 series = None
 
-__all__ = ["TITLE", "figures", "pose_t", "reproduce", "series", "spiral", "spiral_poses"]
+__all__ = ["POSE_T_POSITION", "POSE_T_ROTATION", "TITLE", "figures", "pose_T_placement", "pose_t", "reproduce", "series", "spiral",
+           "spiral_poses"]

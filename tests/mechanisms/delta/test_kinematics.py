@@ -52,8 +52,8 @@ def _fk_jacobian_fd(theta, root):
 
 
 def test_defaults_are_the_papers_table_1():
-    """La = 110, Lb = 330, r = 50 mm, R = 150 mm (Fig. 4) and the study pose (0, 0, -375) mm."""
-    assert (P.La, P.Lb, P.r, P.R, P.home) == (0.110, 0.330, 0.050, 0.150, (0.0, 0.0, -0.375))
+    """La = 110, Lb = 330, r = 50 mm, R = 150 mm (Fig. 4); the reference pose is found, not stated."""
+    assert (P.La, P.Lb, P.r, P.R, P.home) == (0.110, 0.330, 0.050, 0.150, None)
 
 
 def test_sphere_centres_are_eqs_4_6_7_as_printed():
@@ -149,9 +149,10 @@ def test_jacobian_at_the_upper_root_matches_its_differences():
 
 def test_jacobian_refuses_a_pose_not_assembled_with_the_motors():
     """A platform point 1 mm off the assembly is refused with the forearm that does not fit."""
-    th = D.inverse_kinematics(P, P.home)
+    home = D.reference_pose(P)
+    th = D.inverse_kinematics(P, home)
     with pytest.raises(InvalidInputError, match="forearm"):
-        D.jacobian(P, th, np.array(P.home) + [0.0, 0.0, 1e-3])
+        D.jacobian(P, th, home + [0.0, 0.0, 1e-3])
 
 
 def test_jacobian_raises_at_the_knee_in_direct_singularity():
@@ -187,7 +188,7 @@ def test_bad_inputs_raise_pkm_errors():
     with pytest.raises(InvalidInputError):
         D.jacobian(P, [0.0, np.nan, 0.0])
     with pytest.raises(InvalidInputError):
-        D.inverse_kinematics(P, P.home, "elbow_up")
+        D.inverse_kinematics(P, D.reference_pose(P), "elbow_up")
     short = D.DeltaParams(La=0.2, Lb=0.15, home=(0.0, 0.0, -0.25))  # forearms too short to join level arms
     with pytest.raises(AssemblyError):
         D.forward_kinematics(short, [0.0, 0.0, 0.0])

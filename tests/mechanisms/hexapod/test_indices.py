@@ -13,6 +13,7 @@ from pkm.core import indices as core_indices
 from pkm.errors import InvalidInputError
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi
+from pkm.papers.hexapod import pose_T_placement
 
 DEG = math.pi / 180.0
 
@@ -34,7 +35,7 @@ def core_indices_at(mech, R, P, beta, point):
 def test_indices_equal_those_of_the_generic_core(mech, point):
     """w_rot, w_tras and kappa of the screw Jacobian (eq. 37) = the core's, for several beta (rel. 1e-9)."""
     p = mech.params
-    R, P = hx.home_rotation(p), np.array(p.home_position)
+    R, P = pose_T_placement()
     for beta in (-45 * DEG, -11 * DEG, 20 * DEG, 70 * DEG):
         ind = hi.indices(p, R, P, beta, point=point)
         w_rot, w_tras, Jt = core_indices_at(mech, R, P, beta, point)
@@ -49,7 +50,7 @@ def test_batch_index_over_poses_and_branches_matches_one_by_one(mech):
     """PoseIndex over (pose, beta) pairs equals indices() per configuration, elbow_in included (1e-10)."""
     p = mech.params
     rng = np.random.default_rng(0)
-    R0, P0 = hx.home_rotation(p), np.array(p.home_position)
+    R0, P0 = pose_T_placement()
     poses = [(pin.exp3(0.05 * rng.uniform(-1, 1, 3)) @ R0, P0 + 0.02 * rng.uniform(-1, 1, 3)) for _ in range(3)]
     k, betas = np.array([0, 1, 2, 1]), np.array([-0.3, 0.0, 0.5, 0.9])
     for branch in ("elbow_out", "elbow_in"):
@@ -61,7 +62,7 @@ def test_batch_index_over_poses_and_branches_matches_one_by_one(mech):
 def test_unreachable_betas_have_zero_index(mech):
     """Below the reachability limit of pose T (-59.5 deg) the batch index is 0; just above it, small."""
     p = mech.params
-    f = hi.PoseIndex(p, [(hx.home_rotation(p), p.home_position)], "w_rot")
+    f = hi.PoseIndex(p, [pose_T_placement()], "w_rot")
     v = f(np.zeros(3, int), np.radians([-70.0, -59.6, -59.4]))
     assert v[0] == v[1] == 0.0 and 0 < v[2] < 0.2 * f(np.zeros(1, int), np.radians([-11.0]))[0]
 
@@ -69,7 +70,7 @@ def test_unreachable_betas_have_zero_index(mech):
 def test_bad_index_point_and_rotation_are_refused(mech):
     """Unknown index or point names and non-rotations raise InvalidInputError."""
     p = mech.params
-    R, P = hx.home_rotation(p), p.home_position
+    R, P = pose_T_placement()
     with pytest.raises(InvalidInputError):
         hi.PoseIndex(p, [(R, P)], "w_both")
     with pytest.raises(InvalidInputError):

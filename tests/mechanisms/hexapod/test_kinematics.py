@@ -14,27 +14,32 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+import pkm
 from pkm.core import TaskMap, constraints, solve_ik
 from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.mechanisms import hexapod as hx
+from pkm.papers.hexapod import POSE_T_POSITION, POSE_T_ROTATION, pose_T_placement
 
 DEG = math.pi / 180.0
 #: Lower end of the interval of beta where pose T is reachable (found by bisection, see below) [deg].
 BETA_MIN_POSE_T = -59.51
 
 
+POSE_T_DESIGN = hx.Params(home_rotation=POSE_T_ROTATION, home_position=POSE_T_POSITION)  # reference: pose T
+
+
 @pytest.fixture(scope="module")
 def mech():
-    return hx.build()
+    return hx.build(POSE_T_DESIGN)
 
 
 @pytest.fixture(scope="module")
 def params():
-    return hx.Params()
+    return POSE_T_DESIGN
 
 
 def pose_t(params):
-    return hx.home_rotation(params), np.array(params.home_position)
+    return pose_T_placement()
 
 
 def near_pose_t(params, rng, n, pos=0.02, ang=0.05):
@@ -80,14 +85,14 @@ def paper_manipulabilities(params, R, P, beta, branch="elbow_out"):
 def test_invalid_parameters_raise_invalid_parameter_error(kwargs, field):
     """Non-positive or non-finite lengths, unknown layouts, bad home poses and unreachable home poses are refused."""
     with pytest.raises(InvalidParameterError) as exc:
-        hx.Params(**kwargs)
+        hx.reference_pose(hx.Params(**kwargs))
     assert exc.value.name == field
 
 
 def test_unreachable_home_pose_message_names_the_leg():
     """An unreachable reference pose says which leg misses and how to fix the design."""
     with pytest.raises(InvalidParameterError, match=r"leg 1 misses by .* choose another home pose"):
-        hx.Params(home_position=(0.0, -1.2, 0.0))
+        pkm.build("hexapod", home_position=(0.0, -1.2, 0.0))
 
 
 # ---------------------------------------------------------------------- model
@@ -116,9 +121,9 @@ def test_moving_beta_1_turns_the_three_reconfiguration_links_together(mech, para
             assert math.isclose(A[n - 1][1], params.Rr * math.sin(beta), abs_tol=1e-15)
 
 
-def test_reference_is_pose_t_with_beta_zero(mech, params):
-    """The reference configuration is the paper's pose T (SVD-projected) at beta = 0, on elbow_out."""
-    printed = np.reshape(hx.POSE_T_ROTATION, (3, 3))
+def test_a_given_home_pose_is_the_reference(mech, params):
+    """Given pose T as its home, the reference configuration is pose T (SVD-projected) at beta = 0, on elbow_out."""
+    printed = np.reshape(POSE_T_ROTATION, (3, 3))
     R, P = pose_t(params)
     assert np.allclose(R.T @ R, np.eye(3), atol=1e-14) and np.abs(R - printed).max() < 1e-4
     task = TaskMap(mech)
@@ -486,13 +491,13 @@ def test_assembly_mode_search_without_assembly_raises(mech):
 def test_non_orthonormal_rotation_is_rejected_with_the_size_of_the_defect(params, R, defect):
     """The inverse kinematics refuses a non-rotation, quoting max|R^T R - I| and det R."""
     with pytest.raises(InvalidInputError, match=rf"max\|R\^T R - I\| = {defect} .*det R"):
-        hx.inverse_kinematics(params, R, params.home_position, 0.0)
+        hx.inverse_kinematics(params, R, pose_T_placement()[1], 0.0)
 
 
 def test_printed_four_digit_rotation_is_accepted_and_projected(params):
     """The pose T matrix as printed (defect ~1e-4) is accepted and projected on SO(3): same IK as the projection."""
-    printed = np.reshape(hx.POSE_T_ROTATION, (3, 3))
+    printed = np.reshape(POSE_T_ROTATION, (3, 3))
     assert 1e-6 < np.abs(printed.T @ printed - np.eye(3)).max() < hx.ROTATION_TOL
-    a = hx.inverse_kinematics(params, printed, params.home_position, 0.0)
-    assert np.allclose(a, hx.inverse_kinematics(params, hx.home_rotation(params), params.home_position, 0.0),
+    a = hx.inverse_kinematics(params, printed, pose_T_placement()[1], 0.0)
+    assert np.allclose(a, hx.inverse_kinematics(params, *pose_T_placement(), 0.0),
                        atol=1e-14)

@@ -17,7 +17,7 @@ from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi
 from pkm.mechanisms.hexapod import reconfiguration as hr
-from pkm.papers.hexapod import spiral_poses
+from pkm.papers.hexapod import POSE_T_ROTATION, pose_T_placement, spiral_poses
 from tests.mechanisms.hexapod.test_kinematics import bisect_beta_limit
 
 DEG = math.pi / 180.0
@@ -29,7 +29,7 @@ def params():
 
 
 def pose_t(p):
-    return hx.home_rotation(p), np.array(p.home_position)
+    return pose_T_placement()
 
 
 def test_reachable_interval_of_pose_t_matches_bisection_on_the_inverse_kinematics(params):
@@ -63,7 +63,7 @@ def test_optimal_beta_at_pose_t_matches_a_dense_sweep(params, index):
 
 def test_pose_unreachable_for_every_beta_says_so(params):
     """A pose no beta in [-90, 90] deg reaches raises UnreachableError naming the leg and the limits."""
-    R = hx.home_rotation(params)
+    R = pose_T_placement()[0]
     with pytest.raises(UnreachableError, match=r"unreachable for every beta in \[-90, 90\] deg") as exc:
         hr.optimal_beta(params, R, (0.0, -0.9, 0.0))
     assert exc.value.excess > 0
@@ -78,7 +78,7 @@ def test_non_orthonormal_rotation_is_rejected_with_its_defect(params):
     R, P = pose_t(params)
     with pytest.raises(InvalidInputError, match=r"max\|R\^T R - I\| = 0.0609"):
         hr.optimal_beta(params, 1.03 * R, P)
-    printed = np.reshape(hx.POSE_T_ROTATION, (3, 3))
+    printed = np.reshape(POSE_T_ROTATION, (3, 3))
     assert abs(hr.optimal_beta(params, printed, P).beta - hr.optimal_beta(params, R, P).beta) < 1e-6
 
 
@@ -110,7 +110,7 @@ def test_spiral_profile_respects_the_rate_limit_and_reachability_and_beats_the_c
 def test_split_reachable_set_agrees_with_the_inverse_kinematics_and_the_best_piece_is_chosen(params):
     """At P = (100, -460, 0) mm the pose is reachable on two intervals of [-90, 90] deg: the closed-form
     intervals agree with the IK on a 0.1-deg grid, and beta* lies in the piece holding the larger maximum."""
-    R, P = hx.home_rotation(params), (0.1, -0.46, 0.0)
+    R, P = pose_T_placement()[0], (0.1, -0.46, 0.0)
     spans = hr.reachable_intervals(params, R, P)
     assert len(spans) == 2
     for b in np.arange(-90.0, 90.0, 0.1) * DEG:

@@ -16,6 +16,7 @@ import pkm
 from pkm.core import screws
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import screws as hs
+from pkm.papers.hexapod import pose_T_placement
 from tests.fd import forward_jacobian_error, rel, richardson
 
 DEG = math.pi / 180.0
@@ -30,7 +31,7 @@ def mech():
 
 def pose(params, k=0):
     rng = np.random.default_rng(10 + k)
-    R0, P0 = hx.home_rotation(params), np.array(params.home_position)
+    R0, P0 = pose_T_placement()
     return pin.exp3(0.05 * rng.uniform(-1, 1, 3)) @ R0, P0 + 0.02 * rng.uniform(-1, 1, 3)
 
 

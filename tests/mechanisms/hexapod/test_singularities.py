@@ -19,6 +19,7 @@ from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms._common import rot_y
 from pkm.mechanisms.hexapod import screws as hs
 from pkm.mechanisms.hexapod import singularities as hsg
+from pkm.papers.hexapod import pose_T_placement
 
 DEG = math.pi / 180.0
 COINCIDENT = tuple(a * DEG for a in (35.0, 155.0, 275.0, 35.0, 155.0, 275.0))  # theta_i = theta_{i+3}
@@ -46,10 +47,10 @@ def core_diagnosis(p, R, P, beta, branch="elbow_out"):
 
 def test_pose_t_is_regular(params):
     """Pose T at beta = 0: every distance well above the threshold; the core agrees."""
-    rep = hsg.classify(params, hx.home_rotation(params), params.home_position, 0.0)
+    rep = hsg.classify(params, *pose_T_placement(), 0.0)
     assert rep.kind == "regular" and rep.type == 0
     assert rep.transmission.min() > 0.5 and rep.sigma_direct > 0.05
-    assert core_diagnosis(params, hx.home_rotation(params), params.home_position, 0.0).classification == "regular"
+    assert core_diagnosis(params, *pose_T_placement(), 0.0).classification == "regular"
 
 
 def test_fully_extended_legs_of_m1_are_an_inverse_singularity(params):
@@ -122,5 +123,5 @@ def test_distances_shrink_continuously_towards_a_singularity(params):
 
 def test_klein_form_of_the_rod_with_a_spin_about_y_is_its_dual_y_component(params):
     """{[e_y; 0]; $6_i} = (C_i x w_i)_y: the reason the coincident case is singular (exact)."""
-    S = hs.leg_screws(params, hx.home_rotation(params), params.home_position, 0.0)[:, 6]
+    S = hs.leg_screws(params, *pose_T_placement(), 0.0)[:, 6]
     assert np.allclose(screws.klein(np.r_[0.0, 1.0, 0.0, 0.0, 0.0, 0.0], S), S[:, 4], atol=0)

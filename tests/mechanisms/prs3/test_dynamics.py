@@ -29,7 +29,7 @@ def test_twin_equals_the_pinocchio_route_everywhere_it_is_evaluated(dyn):
     Random states around the reference, a random external wrench, both working modes.
     """
     rng = np.random.default_rng(11)
-    y0 = np.array(dyn.params.reference)
+    y0 = prs3.reference_pose(dyn.params)
     Y = y0 + rng.uniform(-1, 1, (6, 3)) * [0.03, 0.1, 0.1]
     Yd, Ydd, W = rng.normal(size=(6, 3)), rng.normal(size=(6, 3)), rng.normal(size=(6, 6))
     batch = dyn.batch(Y, Yd, Ydd, W)
@@ -179,7 +179,7 @@ def test_jacobian_equals_differences_of_the_ik_and_the_generic_core(dyn):
     Jacobian (1e-9) agree, beta = phi = 0 included."""
     import pkm
     from tests.fd import rel, richardson
-    for y in (np.array(dyn.params.reference), np.array(dyn.params.reference) + [0.02, 0.1, -0.07]):
+    for y in (prs3.reference_pose(dyn.params), prs3.reference_pose(dyn.params) + [0.02, 0.1, -0.07]):
         J = dyn.jacobian(y)
         assert rel(J, richardson(lambda h, y=y: _ik_difference(dyn.params, y, h), 1e-4)) < 1e-7
         q = prs3.configuration(dyn.mechanism, y)
@@ -213,7 +213,7 @@ def test_homogeneous_jacobian_does_not_depend_on_the_unit_of_length():
     """Scaling every length by 1000 (m -> mm) leaves the homogeneous Jacobian unchanged."""
     p = prs3.Prs3Params(gamma=1.2, actuation="R")
     mm = prs3.Prs3Params(gamma=1.2, actuation="R", l=1000 * p.l, h=1000 * p.h, g=1000 * p.g,
-                         reference=(1000 * p.reference[0], 0.0, 0.0))
+                         reference=(1000 * prs3.reference_pose(p)[0], 0.0, 0.0))
     y = np.array([0.8, 0.05, -0.1])
     J, Jmm = (PD.Prs3Dynamics(x).homogeneous_jacobian(y * [s, 1, 1]) for x, s in ((p, 1), (mm, 1000)))
     assert np.allclose(J, Jmm, rtol=1e-9)

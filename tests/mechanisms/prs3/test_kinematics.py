@@ -19,7 +19,7 @@ PHI = np.deg2rad([0.0, 120.0, 240.0])
 
 @pytest.fixture(scope="module")
 def mech():
-    return prs3.build()
+    return prs3.build(prs3.Params(reference=tuple(REF)))
 
 
 def eq1(alpha: float, beta: float, phi: float) -> np.ndarray:
@@ -98,21 +98,24 @@ def test_table2_masses_and_inertias_are_the_link_inertias_of_the_pinocchio_model
     {"actuation": "PR"}, {"m_platform": 0.0}, {"m_slider": -0.1}, {"m_coupler": math.nan},
     {"Izz3": 1.0},  # principal moments 0.3125, 0.3125, 1.0 break the triangle inequality
     {"Ixx3": -0.1},
-    {"l": 0.4},  # the spherical joints are 0.5 m from the rails at the reference: unreachable
-    {"l": 0.5},  # exactly reachable: couplers perpendicular to the rails (double root) at the reference
+    {"l": 0.4},  # the spherical joints are 0.5 m from the rails at every level pose: unreachable
+    {"l": 0.5},  # exactly reachable: couplers perpendicular to the rails (double root) at every level pose
+    {"l": 0.5, "reference": (0.81, 0.0, 0.0)},
     {"reference": (0.81, 2.0, 0.0)}, {"reference": (0.81, 0.0)}, {"reference": (math.nan, 0.0, 0.0)},
 ])
 def test_invalid_parameters_are_refused(kwargs):
     """Non-positive lengths, rails outside (0, pi), bad actuation, masses or inertia, and designs that cannot
     assemble at their reference pose (or only at a double root) raise InvalidParameterError."""
     with pytest.raises(InvalidParameterError):
-        prs3.Params(**kwargs)
+        prs3.reference_pose(prs3.Params(**kwargs))
 
 
 def test_unreachable_reference_message_says_how_to_fix_it():
     """The error for an unreachable reference names the leg, the miss and what to change."""
     with pytest.raises(InvalidParameterError, match=r"leg 1 misses by 0\.1 m\); lengthen l"):
-        prs3.Params(l=0.4)
+        prs3.build(prs3.Params(l=0.4, reference=(0.81, 0.0, 0.0)))
+    with pytest.raises(InvalidParameterError, match=r"none of them assembles; the first: .*leg 1 misses by 0\.1 m"):
+        prs3.build(prs3.Params(l=0.4))
 
 
 # ---------------------------------------------------------------------- eq. (10)
@@ -235,7 +238,7 @@ def test_reference_is_regular_with_slider_actuation(mech):
 def test_knee_actuation_builds_with_mobility_3_and_needs_inclined_rails(gamma):
     """Actuating the knees gives mobility 3 and the closed form returns the knee angles; with vertical rails the
     passive sliders are parallel and the platform can rise with the knees locked (a direct singularity)."""
-    m = prs3.build(prs3.Params(actuation="R", gamma=gamma))
+    m = prs3.build(prs3.Params(actuation="R", gamma=gamma, reference=tuple(REF)))
     assert m.actuated_names == ("knee_1", "knee_2", "knee_3")
     d = diagnose(m, m.q_reference)
     assert d.mobility == 3
@@ -244,6 +247,8 @@ def test_knee_actuation_builds_with_mobility_3_and_needs_inclined_rails(gamma):
     np.testing.assert_allclose(prs3.closed_form_ik(m.params, y), m.actuated_q(q), atol=1e-15)
     if gamma == math.pi / 2:
         assert d.classification == "direct" and d.sigma_direct < 1e-12
+        with pytest.raises(InvalidParameterError, match="well-conditioned"):  # singular everywhere: no default
+            prs3.build(prs3.Params(actuation="R", gamma=gamma))
     else:
         assert d.classification == "regular"
         res = solve_ik(m, y)

@@ -20,7 +20,7 @@ from pkm.mechanisms import rrr3
 from tests.fd import rel, richardson
 
 P = rrr3.Rrr3Params()
-Y_REF = rrr3.home_task(P)
+Y_REF = rrr3.reference_pose(P)
 MODE_NAMES = [f"mode{k}" for k in range(1, 9)]
 
 
@@ -66,16 +66,23 @@ def _random_poses(n, seed, radius=0.12, dphi=0.3):
 
 # ---------------------------------------------------------------------- parameters
 def test_reference_design_is_the_papers_workspace_study():
-    """The default design is sec. III's (links 40 cm, platform 10 cm, actuators 100 cm apart), centred, Phi = 0."""
-    assert (P.a, P.b, P.h, P.H, P.mode) == (0.40, 0.40, 0.10, 1.00, 1)
-    np.testing.assert_allclose(Y_REF, [0.5, 0.5 / math.sqrt(3.0), 0.0], atol=1e-15)
+    """The default design is sec. III's (links 40 cm, platform 10 cm, actuators 100 cm apart); its reference pose is
+    found: centred, at the orientation of largest condition index on the 2.5 deg grid (5 deg; 0.93 at Phi = 0)."""
+    assert (P.a, P.b, P.h, P.H, P.mode, P.home) == (0.40, 0.40, 0.10, 1.00, 1, None)
+    np.testing.assert_allclose(Y_REF[:2], [0.5, 0.5 / math.sqrt(3.0)], atol=1e-15)
+    grid = np.linspace(-math.pi / 3, math.pi / 3, rrr3.kinematics.REFERENCE_ORIENTATIONS)
+    ci = [rrr3.kinematics.condition_index(P, [Y_REF[0], Y_REF[1], phi]) for phi in grid]
+    assert Y_REF[2] == grid[int(np.argmax(ci))] and math.isclose(Y_REF[2], math.radians(5.0), abs_tol=1e-12)
+    assert rrr3.kinematics.condition_index(P, Y_REF) > rrr3.kinematics.condition_index(P, [*Y_REF[:2], 0.0]) > 0.9
 
 
-def test_reference_configuration_is_assembled_regular_and_in_mode1(mech):
-    """The spec's reference closes the loops, lands on the base centroid, is regular and has every psi_i = +99 deg."""
+def test_reference_configuration_is_assembled_regular_and_in_mode1():
+    """Centred at Phi = 0 (sec. III), the spec's reference closes the loops, lands on the base centroid, is regular
+    and has every psi_i = +99 deg."""
+    mech = rrr3.build(rrr3.Params(home=(0.0, 0.0, 0.0)))
     q = mech.q_reference
     assert np.abs(constraints.residual(mech, q)).max() < 1e-15
-    np.testing.assert_allclose(TaskMap(mech).value(q), Y_REF, atol=1e-15)
+    np.testing.assert_allclose(TaskMap(mech).value(q), [0.5, 0.5 / math.sqrt(3.0), 0.0], atol=1e-15)
     assert diagnose(mech, q).classification == "regular"
     psi = [mech.q_to_dict(q)[f"elbow_{n}"] for n in (1, 2, 3)]
     np.testing.assert_allclose(np.degrees(psi), 98.98, atol=0.01)
@@ -102,20 +109,20 @@ def test_mode_must_be_an_integer_from_1_to_8(mode):
 def test_malformed_home_is_refused(home):
     """A home that is not three finite numbers raises InvalidParameterError."""
     with pytest.raises(InvalidParameterError, match="home"):
-        rrr3.Rrr3Params(home=home)
+        rrr3.reference_pose(rrr3.Rrr3Params(home=home))
 
 
 def test_unreachable_home_is_refused_with_the_leg():
     """A reference pose out of reach raises InvalidParameterError that names the leg and the miss."""
     with pytest.raises(InvalidParameterError, match="leg 1 misses by"):
-        rrr3.Rrr3Params(home=(0.5, 0.0, 0.0))
+        rrr3.build(rrr3.Rrr3Params(home=(0.5, 0.0, 0.0)))
 
 
 def test_stretched_home_is_refused_as_inverse_singular():
     """Links exactly spanning the centred pose (a + b = |PA|) put every leg at psi = 0: refused."""
     d = (1.0 - 0.1) / math.sqrt(3.0)
     with pytest.raises(InvalidParameterError, match="inverse"):
-        rrr3.Rrr3Params(a=d / 2, b=d / 2)
+        rrr3.reference_pose(rrr3.Rrr3Params(a=d / 2, b=d / 2, home=(0.0, 0.0, 0.0)))
 
 
 def test_direct_singular_home_is_refused():
@@ -125,8 +132,8 @@ def test_direct_singular_home_is_refused():
 
     phi_s = brentq(det, 0.6, 0.9, xtol=1e-14)
     with pytest.raises(InvalidParameterError, match="direct"):
-        rrr3.Rrr3Params(home=(0.0, 0.0, phi_s))
-    rrr3.Rrr3Params(home=(0.0, 0.0, phi_s - 0.05))  # nearby orientations are fine
+        rrr3.reference_pose(rrr3.Rrr3Params(home=(0.0, 0.0, phi_s)))
+    rrr3.reference_pose(rrr3.Rrr3Params(home=(0.0, 0.0, phi_s - 0.05)))  # nearby orientations are fine
 
 
 # ---------------------------------------------------------------------- working modes
@@ -443,7 +450,8 @@ def test_forward_kinematics_loses_no_solution_against_a_brute_force_multistart()
         a, b = rng.uniform(0.2, 1.0, 2)
         h = rng.uniform(0.05, 1.0)
         try:
-            params = rrr3.Rrr3Params(a=a, b=b, h=h)
+            params = rrr3.Rrr3Params(a=a, b=b, h=h, home=(0.0, 0.0, 0.0))
+            rrr3.reference_pose(params)  # the designs that assemble centred
         except InvalidParameterError:
             continue
         theta = rng.uniform(-np.pi, np.pi, 3)

@@ -45,6 +45,7 @@ from pkm.mechanisms.delta.kinematics import (
     jacobian,
     jacobian_factors,
     joint_values,
+    reference_pose,
     sphere_centres,
 )
 from pkm.mechanisms.delta.model import (
@@ -79,6 +80,7 @@ __all__ = [
     "jacobian",
     "jacobian_factors",
     "joint_values",
+    "reference_pose",
     "sphere_centres",
     "urdf_xml",
 ]

@@ -91,7 +91,7 @@ def condition_vs_radius(params: DeltaParams, p, R_values, branch="knee_out", kin
     out = {kind: np.empty(len(R_values)) for kind in kinds}
     for j, R in enumerate(R_values):
         arm_angles(params.La, params.Lb, R - params.r, p, (1, 1, 1), f" at R = {R:.6g} m")  # reach, or which arm
-        K, _ = condition_numbers(dataclasses.replace(params, R=float(R), home=tuple(p)), p, branch, kinds)
+        K, _ = condition_numbers(dataclasses.replace(params, R=float(R)), p, branch, kinds)
         for kind in kinds:
             out[kind][j] = K[kind]
     return out
@@ -172,7 +172,7 @@ def workspace_vs_radius(params: DeltaParams, R_values, *, kind: str = "2", spaci
     """Sample the workspace (:func:`pkm.mechanisms.delta.workspace.workspace`) for each base radius.
 
     Args:
-        params: The design; its ``home`` must stay reachable for every R (it is the reference pose).
+        params: The design (its ``R`` replaced by each value).
         R_values: Base radii [m].
         kind: Condition-number convention kept per node.
         spacing: Grid step [m].

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 
+from pkm.core.indices import inverse_condition
 from pkm.core.mechanism import Mechanism, check_mechanism
-from pkm.errors import AssemblyError, InvalidInputError, SingularityError
+from pkm.errors import AssemblyError, InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
 from pkm.mechanisms._common import (
+    best_reference,
     check_params,
     leg_arm_angles,
     leg_branches,
@@ -193,6 +196,43 @@ def configuration(mech: Mechanism, p, branch: str | tuple[str, str, str] = "knee
     """Full configuration vector ``q`` of ``mech`` for platform centre ``p`` (closed form)."""
     mech = check_mechanism(mech)
     return mech.q_from_dict(joint_values(mech.params, p, branch))
+
+
+# ---------------------------------------------------------------------- reference pose
+REFERENCE_DEPTHS = 64  # candidate reference positions on the axis below the base
+
+
+def reference_pose(params: DeltaParams) -> np.ndarray:
+    """The design's reference platform position [m], where its reference configuration is assembled.
+
+    ``params.home`` when given; otherwise the position ``(0, 0, z)`` of largest inverse condition
+    number of ``J`` (eq. 12, knee out) among ``z = -(La + Lb) k / 64``, ``k = 1..64``.
+
+    Raises:
+        InvalidParameterError: (``home``) the given pose is unreachable (which leg, by how much), or no
+            candidate assembles away from singularity (inverse condition number >= 1e-3).
+    """
+    params = check_params(params, DeltaParams)
+    return np.array(_reference(params))
+
+
+@functools.lru_cache(maxsize=256)
+def _reference(params: DeltaParams) -> tuple[float, float, float]:
+    if params.home is not None:
+        try:
+            inverse_kinematics(params, params.home)
+        except UnreachableError as exc:
+            raise InvalidParameterError(
+                "home", f"reference pose {params.home} is unreachable with this design (leg {exc.leg} misses by "
+                        f"{exc.excess:.4g} m); choose another home or other lengths", params.home) from None
+        return params.home
+
+    def score(p: tuple[float, float, float]) -> float:
+        return float(inverse_condition(jacobian(params, inverse_kinematics(params, p), p)))
+
+    reach = params.La + params.Lb
+    depths = (-reach * k / REFERENCE_DEPTHS for k in range(1, REFERENCE_DEPTHS + 1))
+    return best_reference("home", ((0.0, 0.0, z) for z in depths), score, minimum=1e-3)
 
 
 # ---------------------------------------------------------------------- uniform interface

@@ -14,7 +14,7 @@ from pkm.mechanisms._common import (
     rot_z,
     spec_parameters,
 )
-from pkm.mechanisms.delta.kinematics import joint_values
+from pkm.mechanisms.delta.kinematics import joint_values, reference_pose
 from pkm.mechanisms.delta.params import BRANCHES, NAME, PHI, DeltaParams
 
 
@@ -51,7 +51,7 @@ def urdf_xml(params: DeltaParams) -> str:
 
 def closure_spec(params: DeltaParams) -> ClosureSpec:
     params = check_params(params, DeltaParams)
-    reference = {k: tuple(v) for k, v in joint_values(params, params.home).items()}
+    reference = {k: tuple(v) for k, v in joint_values(params, reference_pose(params)).items()}
     return ClosureSpec(
         mechanism=NAME,
         description="Delta robot (Hernandez Reyna & Sandoval-Castro 2018); parallelograms as centre lines, "

@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from pkm.errors import InvalidParameterError, UnreachableError
 from pkm.mechanisms._common import (
     check_numbers,
     check_positive,
@@ -31,7 +30,9 @@ class DeltaParams:
         r: Platform radius, centre to ball-joint line [m] (50 mm).
         R: Base radius, centre to motor axis [m] (150 mm for the paper's Fig. 4; studied 100-200 mm,
             120 mm chosen for construction).
-        home: Reference platform position [m] (the study point (0, 0, -375) mm).
+        home: Reference platform position [m]; None (default): found for the design
+            (``reference_pose``: the best-conditioned point on the axis). The paper's study point
+            (0, 0, -375) mm is ``pkm.papers.delta.POSE``.
         m_arm: Arm mass [kg] (illustrative; not in the paper).
         m_forearm: Mass of one parallelogram (both rods) [kg] (illustrative).
         m_platform: Platform mass [kg] (illustrative).
@@ -41,24 +42,15 @@ class DeltaParams:
     Lb: float = param(0.330, "m")
     r: float = param(0.050, "m")
     R: float = param(0.150, "m")
-    home: tuple[float, float, float] = param((0.0, 0.0, -0.375), "m")
+    home: tuple[float, float, float] | None = param(None, "m", length=3)
     m_arm: float = param(0.10, "kg")
     m_forearm: float = param(0.05, "kg")
     m_platform: float = param(0.20, "kg")
 
     def __post_init__(self):
-        from pkm.mechanisms.delta.kinematics import inverse_kinematics  # (kinematics imports this module)
-
         check_positive(self, "La", "Lb", "r", "R", "m_arm", "m_forearm", "m_platform")
-        check_numbers(self, "home", 3, "(a point x, y, z in m)")
-        # the reference pose must be reachable in the default working mode, away from singularity
-        try:
-            th = inverse_kinematics(self, self.home)
-        except UnreachableError as exc:
-            raise InvalidParameterError(
-                "home", f"reference pose {self.home} is unreachable with this design (leg {exc.leg} misses by "
-                        f"{exc.excess:.4g} m); choose another home or other lengths", self.home) from None
-        del th
+        if self.home is not None:
+            check_numbers(self, "home", 3, "(a point x, y, z in m)")
 
 
 #: The protocol's name for the design dataclass.

@@ -42,7 +42,7 @@ sub-manipulators, the other layout/branch pairs peak at -59 deg (sector, elbow_i
 (literal, elbow_out), 3.5/90 deg (literal, elbow_in). Note that ``sqrt(det(J J^T))`` grows as
 ``J_x`` nears a direct singularity: along ``beta`` at pose T, ``|det J_x|`` is smallest at -17.4 deg
 (no crossing), and the smallest singular value of the passive-joint constraint columns is only
-6.5e-3 at the reference configuration, so pose T lies close to a direct singularity.
+6.5e-3 there, so pose T lies close to a direct singularity.
 
 Tree (URDF, loops open; Pinocchio model with ``nq = 26``, ``nv = 25``):
 
@@ -137,6 +137,7 @@ from pkm.mechanisms.hexapod.kinematics import (
     platform_local_points,
     platform_points,
     pose_from_points,
+    reference_pose,
     task_vector,
 )
 from pkm.mechanisms.hexapod.model import (
@@ -151,11 +152,8 @@ from pkm.mechanisms.hexapod.params import (
     HOME_ROTATION_TOL,
     LAYOUTS,
     NAME,
-    POSE_T_POSITION,
-    POSE_T_ROTATION,
     HexapodParams,
     Params,
-    home_rotation,
     leg_frame,
 )
 
@@ -166,8 +164,6 @@ __all__ = [
     "HOME_ROTATION_TOL",
     "LAYOUTS",
     "NAME",
-    "POSE_T_POSITION",
-    "POSE_T_ROTATION",
     "ROTATION_TOL",
     "AssemblyMode",
     "HexapodParams",
@@ -184,7 +180,6 @@ __all__ = [
     "configuration",
     "elbow_points",
     "forward_kinematics",
-    "home_rotation",
     "inverse_kinematics",
     "joint_values",
     "leg_frame",
@@ -192,6 +187,7 @@ __all__ = [
     "platform_local_points",
     "platform_points",
     "pose_from_points",
+    "reference_pose",
     "task_vector",
     "urdf_xml",
 ]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -9,17 +10,26 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core import constraints
+from pkm.core.indices import inverse_condition
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.newton import gauss_newton
 from pkm.core.task import as_rotation
-from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError
+from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.mechanisms._common import (
+    best_reference,
     check_params,
     leg_arm_angles,
     leg_branches,
     rot_z,
 )
-from pkm.mechanisms.hexapod.params import BRANCHES, DEFAULT_BRANCH, LAYOUTS, HexapodParams, home_rotation, leg_frame
+from pkm.mechanisms.hexapod.params import (
+    BRANCHES,
+    DEFAULT_BRANCH,
+    HOME_ROTATION_TOL,
+    LAYOUTS,
+    HexapodParams,
+    leg_frame,
+)
 from pkm.validation import as_array, as_count, as_scalar, as_tolerance, as_vector, wrap_angle
 
 _E_Y = np.array([0.0, 1.0, 0.0])
@@ -179,7 +189,7 @@ def forward_kinematics(params: HexapodParams, alphas, beta: float, seed=None, *,
     params = check_params(params, HexapodParams)
     B = elbow_points(params, alphas, _scalar(beta, "beta"))
     if seed is None:
-        seed = platform_points(params, home_rotation(params), params.home_position)[:3]
+        seed = platform_points(params, *reference_pose(params)[:2])[:3]
     X = as_vector(np.ravel(as_array(seed, "seed", "C1, C2, C3 (3, 3) [m]")), 9, "seed").copy()
     tol = as_tolerance(tol, "tol")
     max_iter = as_count(max_iter, "max_iter", low=1, high=10_000)
@@ -303,7 +313,7 @@ def assembly_modes(mech: Mechanism, q_actuated, *, n_starts: int = 32, seed: int
         found.append(AssemblyMode(C, R, P, q, res))
     if not found:
         raise AssemblyError(best_res, "m", f"Newton's method failed from all {n_starts} seeds")
-    P0 = np.asarray(params.home_position)
+    P0 = reference_pose(params)[1]
     return sorted(found, key=lambda m: float(np.linalg.norm(m.P - P0)))
 
 
@@ -322,6 +332,55 @@ def task_vector(R, P, beta: float) -> np.ndarray:
     """The task vector ``(x, y, z, qx, qy, qz, qw, beta)`` of a pose and ``beta``."""
     return np.concatenate([np.asarray(P, dtype=float), pin.Quaternion(np.asarray(R, dtype=float)).coeffs(),
                            [float(beta)]])
+
+
+# ---------------------------------------------------------------------- reference pose
+REFERENCE_DEPTHS = 64  # candidate reference depths of P below the base
+
+
+def reference_pose(params: HexapodParams) -> tuple[np.ndarray, np.ndarray, float]:
+    """The design's reference pose ``(R, P, beta)`` [-, m, rad], where its reference configuration is
+    assembled (elbows out).
+
+    ``R``: ``params.home_rotation`` projected on SO(3), or the identity (level platform); ``beta``:
+    ``params.home_beta``; ``P``: ``params.home_position`` when given, otherwise the point
+    ``(0, -(LA + LB) k / 64, 0)``, ``k = 1..64``, of largest inverse condition number of the twist
+    Jacobian (velocities of P divided by ``LA``, per ``alpha_1..alpha_6``).
+
+    Raises:
+        InvalidParameterError: (``home_position``) the given pose is unreachable (which leg, by how
+            much), or no candidate assembles at an inverse condition number >= 1e-3.
+    """
+    params = check_params(params, HexapodParams)
+    R, P, beta = _reference(params)
+    return R.copy(), P.copy(), beta
+
+
+@functools.lru_cache(maxsize=256)
+def _reference(params: HexapodParams) -> tuple[np.ndarray, np.ndarray, float]:
+    from pkm.mechanisms.hexapod import screws  # (screws imports the package, which imports this module)
+
+    R = np.eye(3) if params.home_rotation is None else as_rotation(params.home_rotation, "home_rotation",
+                                                                   HOME_ROTATION_TOL)
+    beta = params.home_beta
+    if params.home_position is not None:
+        try:
+            inverse_kinematics(params, R, params.home_position, beta)
+        except UnreachableError as exc:
+            raise InvalidParameterError(
+                "home_position", f"the reference pose is unreachable with this design (leg {exc.leg} misses by "
+                                 f"{exc.excess:.4g} m); choose another home pose, home_beta or other lengths",
+                params.home_position) from None
+        return R, np.array(params.home_position), beta
+    scale = np.r_[np.ones(3), np.full(3, 1.0 / params.LA)]
+
+    def score(P: np.ndarray) -> float:
+        J = screws.jacobians(params, R, P, beta).twist_jacobian("P")[:, :6]
+        return float(inverse_condition(scale[:, None] * J))
+
+    reach = params.LA + params.LB
+    depths = (np.array([0.0, -reach * k / REFERENCE_DEPTHS, 0.0]) for k in range(1, REFERENCE_DEPTHS + 1))
+    return R, best_reference("home_position", depths, score, minimum=1e-3), beta
 
 
 # ---------------------------------------------------------------------- uniform interface

@@ -15,14 +15,13 @@ from pkm.mechanisms._common import (
     rod_inertia,
     spec_parameters,
 )
-from pkm.mechanisms.hexapod.kinematics import base_points, joint_values, platform_local_points
+from pkm.mechanisms.hexapod.kinematics import base_points, joint_values, platform_local_points, reference_pose
 from pkm.mechanisms.hexapod.params import (
     ACTUATED,
     BRANCHES,
     DEFAULT_BRANCH,
     NAME,
     HexapodParams,
-    home_rotation,
     leg_frame,
 )
 
@@ -61,7 +60,7 @@ def urdf_xml(params: HexapodParams) -> str:
 def closure_spec(params: HexapodParams) -> ClosureSpec:
     """The closure spec: six point closures (the spherical joints), reference at the home pose."""
     params = check_params(params, HexapodParams)
-    values = joint_values(params, home_rotation(params), params.home_position, params.home_beta)
+    values = joint_values(params, *reference_pose(params))
     return ClosureSpec(
         mechanism=NAME,
         description="Reconfigurable hexapod of two 3-RUS sub-manipulators (Sanchez-Alonso et al. 2016); "

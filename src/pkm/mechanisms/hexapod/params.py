@@ -8,11 +8,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from pkm.core.task import ROTATION_TOL, as_rotation  # noqa: F401 (ROTATION_TOL: part of this module's API)
-from pkm.errors import InvalidInputError, InvalidParameterError, UnreachableError
+from pkm.errors import InvalidInputError, InvalidParameterError
 from pkm.mechanisms._common import (
     check_finite,
     check_numbers,
-    check_params,
     check_positive,
     param,
     rot_y,
@@ -31,13 +30,6 @@ DEFAULT_BRANCH = "elbow_out"
 
 
 ACTUATED = ("alpha_1", "alpha_2", "alpha_3", "alpha_4", "alpha_5", "alpha_6", "beta_1")
-
-
-#: The paper's pose T (sec. 4) as printed: rotation rows (4 digits) and position [m].
-POSE_T_ROTATION = (0.9623, -0.1306, -0.2388, 0.0842, 0.9771, -0.1952, 0.2588, 0.1677, 0.9513)
-
-
-POSE_T_POSITION = (0.0, -0.350, 0.0)
 
 
 #: Largest ``max|R^T R - I|`` accepted for a platform rotation given by the user (then projected on SO(3)).
@@ -59,9 +51,11 @@ class HexapodParams:
         r: Circumradius of the platform triangles [m] (50 mm).
         theta: Angular position ``th_i`` of leg i about Y, from +X [rad] (35, 155, 275, 25, 145, 265 deg).
         layout: ``"sector"`` or ``"literal"`` platform layout (see the module doc).
-        home_rotation: Reference platform orientation, rows of a 3x3 matrix [-] (the paper's pose T as
-            printed; projected on SO(3) by SVD).
-        home_position: Reference position of ``P`` [m] (pose T: (0, -350, 0) mm).
+        home_rotation: Reference platform orientation, rows of a 3x3 matrix [-] (projected on SO(3) by
+            SVD); None (default): level. The paper's pose T is ``pkm.papers.hexapod.POSE_T_ROTATION``.
+        home_position: Reference position of ``P`` [m]; None (default): found for the design
+            (``reference_pose``: the best-conditioned depth below the base). Pose T's is
+            ``pkm.papers.hexapod.POSE_T_POSITION``.
         home_beta: Reference reconfiguration angle [rad] (0).
         m_recon: Mass of a reconfiguration link [kg] (illustrative; not in the paper).
         m_arm: Mass of an arm ``LA`` [kg] (illustrative).
@@ -79,8 +73,8 @@ class HexapodParams:
     r: float = param(0.050, "m")
     theta: tuple[float, ...] = param(tuple(math.radians(a) for a in (35.0, 155.0, 275.0, 25.0, 145.0, 265.0)), "rad")
     layout: str = param("sector")
-    home_rotation: tuple[float, ...] = param(POSE_T_ROTATION, "-")
-    home_position: tuple[float, float, float] = param(POSE_T_POSITION, "m")
+    home_rotation: tuple[float, ...] | None = param(None, "-", length=9)
+    home_position: tuple[float, float, float] | None = param(None, "m", length=3)
     home_beta: float = param(0.0, "rad")
     m_recon: float = param(0.15, "kg")
     m_arm: float = param(0.25, "kg")
@@ -88,40 +82,27 @@ class HexapodParams:
     m_platform: float = param(0.80, "kg")
 
     def __post_init__(self):
-        from pkm.mechanisms.hexapod.kinematics import inverse_kinematics  # (kinematics imports this module)
-
         check_positive(self, "Rf", "Rr", "R2", "LA", "LB", "h", "r", "m_recon", "m_arm", "m_rod", "m_platform")
         check_finite(self, "H0", "home_beta")
         if not isinstance(self.layout, str) or self.layout not in LAYOUTS:
             raise InvalidParameterError("layout", f"must be one of {sorted(LAYOUTS)}, got {self.layout!r}",
                                         self.layout)
-        for name, n, what in (("theta", 6, "(angles in rad)"), ("home_rotation", 9, "(rows of a rotation)"),
-                              ("home_position", 3, "(a point in m)")):
-            check_numbers(self, name, n, what)
-        try:
-            as_rotation(self.home_rotation, "home_rotation", HOME_ROTATION_TOL)
-        except InvalidInputError as exc:
-            raise InvalidParameterError("home_rotation", f"must be the rows of a rotation matrix ({exc})",
-                                        self.home_rotation) from None
-        try:
-            inverse_kinematics(self, home_rotation(self), self.home_position, self.home_beta)
-        except UnreachableError as exc:
-            raise InvalidParameterError(
-                "home_position", f"the reference pose is unreachable with this design (leg {exc.leg} misses by "
-                                 f"{exc.excess:.4g} m); choose another home pose, home_beta or other lengths",
-                self.home_position) from None
+        check_numbers(self, "theta", 6, "(angles in rad)")
+        if self.home_position is not None:
+            check_numbers(self, "home_position", 3, "(a point in m)")
+        if self.home_rotation is not None:
+            check_numbers(self, "home_rotation", 9, "(rows of a rotation)")
+            try:
+                as_rotation(self.home_rotation, "home_rotation", HOME_ROTATION_TOL)
+            except InvalidInputError as exc:
+                raise InvalidParameterError("home_rotation", f"must be the rows of a rotation matrix ({exc})",
+                                            self.home_rotation) from None
 
 
 # ---------------------------------------------------------------------- geometry
 def leg_frame(theta_i: float) -> np.ndarray:
     """Axes ``(e_r, e_y, u_i)`` of leg frame i as columns (``= Ry(-th_i)``)."""
     return rot_y(-theta_i)
-
-
-def home_rotation(params: HexapodParams) -> np.ndarray:
-    """The reference orientation: ``params.home_rotation`` projected on SO(3) (SVD)."""
-    params = check_params(params, HexapodParams)
-    return as_rotation(params.home_rotation, "home_rotation", HOME_ROTATION_TOL)
 
 
 #: The protocol's name for the design dataclass.

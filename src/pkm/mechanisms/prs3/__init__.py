@@ -61,7 +61,6 @@ from __future__ import annotations
 
 from pkm.mechanisms.prs3.kinematics import (
     ROOT_TOL,
-    as_task,
     branch_names,
     closed_form_configuration,
     closed_form_ik,
@@ -74,6 +73,7 @@ from pkm.mechanisms.prs3.kinematics import (
     paper_parasitic_motion,
     parasitic_motion,
     platform_pose,
+    reference_pose,
 )
 from pkm.mechanisms.prs3.model import (
     build,
@@ -91,6 +91,7 @@ from pkm.mechanisms.prs3.params import (
     TABLE2_KEYS,
     Params,
     Prs3Params,
+    as_task,
     table2,
 )
 
@@ -125,6 +126,7 @@ __all__ = [
     "paper_parasitic_motion",
     "parasitic_motion",
     "platform_pose",
+    "reference_pose",
     "table2",
     "urdf_xml",
 ]

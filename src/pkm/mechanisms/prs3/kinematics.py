@@ -2,20 +2,23 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 import pinocchio as pin
 
+from pkm.core.indices import inverse_condition
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.task import zyx_matrix
-from pkm.errors import InvalidInputError, UnreachableError
+from pkm.errors import InvalidParameterError, UnreachableError
 from pkm.mechanisms._common import (
+    best_reference,
     check_params,
     leg_branches,
 )
-from pkm.mechanisms.prs3.params import BRANCHES, DEFAULT_BRANCH, PHI, Prs3Params
-from pkm.validation import as_array, finite_result
+from pkm.mechanisms.prs3.params import BRANCHES, DEFAULT_BRANCH, PHI, Prs3Params, as_task
+from pkm.validation import finite_result
 
 ROOT_TOL = 1e-12  # radicands of eq. (10) above -ROOT_TOL l^2 count as the double root
 
@@ -171,16 +174,60 @@ def closed_form_configuration(mech: Mechanism, y, branch: str | None = None) -> 
     return configuration(mech, y, branch)
 
 
+# ---------------------------------------------------------------------- reference pose
+REFERENCE_HEIGHTS = 64  # candidate reference heights z_p of the level platform
+
+
+def reference_pose(params: Prs3Params) -> np.ndarray:
+    """The design's reference independent coordinates ``(z_p, beta, phi)`` [m, rad, rad].
+
+    ``params.reference`` when given; otherwise the level platform at the height of largest inverse
+    condition number of ``d q_a / d(z_p, h beta, h phi)`` (the actuated coordinates, knee angles times
+    ``l``; central differences) among ``z_p = 2 l k / 64``, ``k = 1..64`` (of equal ones, the nearest
+    ``l``).
+
+    Raises:
+        InvalidParameterError: (``reference``) the given pose is unreachable (which leg, by how much)
+            or puts a coupler perpendicular to its rail, or no candidate scores at least 1e-3.
+    """
+    params = check_params(params, Prs3Params)
+    return np.array(_reference(params))
+
+
+@functools.lru_cache(maxsize=256)
+def _reference(params: Prs3Params) -> tuple[float, float, float]:
+    if params.reference is None:
+        step = 1e-6 * params.l
+        scale = np.array([1.0, params.h, params.h])
+
+        def actuated(y: np.ndarray) -> np.ndarray:
+            d, theta = inverse_kinematics(params, y)
+            return d if params.actuation == "P" else params.l * theta
+
+        def score(y: tuple[float, float, float]) -> float:
+            cols = [(actuated(y + e) - actuated(y - e)) / (2.0 * step) for e in np.diag(step / scale)]
+            return float(inverse_condition(np.column_stack(cols)))
+
+        heights = sorted((2.0 * params.l * k / REFERENCE_HEIGHTS for k in range(1, REFERENCE_HEIGHTS + 1)),
+                         key=lambda z: abs(z - params.l))
+        return best_reference("reference", ((z, 0.0, 0.0) for z in heights), score, minimum=1e-3)
+    y = params.reference
+    try:
+        rad = leg_vectors(params, np.array(y))[1]
+    except UnreachableError as exc:
+        raise InvalidParameterError(
+            "reference", f"reference pose {y} is unreachable with this design (leg {exc.leg} misses by "
+                         f"{exc.excess:.4g} m); lengthen l, bring g and h closer, or choose another reference",
+            y) from None
+    if np.min(rad) <= ROOT_TOL * params.l**2:
+        leg = int(np.argmin(rad)) + 1
+        raise InvalidParameterError(
+            "reference", f"at the reference pose {y} the coupler of leg {leg} is perpendicular to its rail "
+                         f"(double root of eq. 10, branches undefined); change l, g, h or the reference", y)
+    return y
+
+
 # ---------------------------------------------------------------------- input checks
-def as_task(y, name: str) -> np.ndarray:
-    arr = as_array(y, name, "3 numbers (z_p [m], beta [rad], phi [rad])")
-    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise InvalidInputError(name, f"expected 3 finite numbers (z_p, beta, phi), got shape {arr.shape}", y)
-    if abs(arr[1]) >= math.pi / 2:
-        raise InvalidInputError(name, f"pitch beta = {arr[1]!r} rad: Z-Y-X angles need |beta| < pi/2", y)
-    return arr
-
-
 def branch_names(branch: str | tuple[str, ...] | None) -> tuple[str, ...]:
     """The working mode of each of the three legs (one name for all, or three; None: the default)."""
     return leg_branches(branch, BRANCHES, 3, DEFAULT_BRANCH)

@@ -13,7 +13,7 @@ from pkm.mechanisms._common import (
     rot_z,
     spec_parameters,
 )
-from pkm.mechanisms.prs3.kinematics import joint_values, leg_geometry
+from pkm.mechanisms.prs3.kinematics import joint_values, leg_geometry, reference_pose
 from pkm.mechanisms.prs3.params import ACTUATIONS, BRANCHES, DEFAULT_BRANCH, NAME, PHI, Prs3Params
 
 
@@ -23,7 +23,7 @@ def urdf_xml(params: Prs3Params) -> str:
     params = check_params(params, Prs3Params)
     b = UrdfBuilder(NAME)
     b.link("base")
-    reach = 2.0 * (params.g + params.h + params.l + abs(params.reference[0]))
+    reach = 2.0 * (params.g + params.h + 2.0 * params.l)  # slider travel (informative: pkm reads no limits)
     a, _, _, _, bp = leg_geometry(params)
     for i in range(3):
         n = i + 1
@@ -45,7 +45,7 @@ def urdf_xml(params: Prs3Params) -> str:
 def closure_spec(params: Prs3Params) -> ClosureSpec:
     """Closures, actuation (``params.actuation``), task, branches and the reference configuration."""
     params = check_params(params, Prs3Params)
-    reference = {k: tuple(v) for k, v in joint_values(params, params.reference).items()}
+    reference = {k: tuple(v) for k, v in joint_values(params, reference_pose(params)).items()}
     joint = ACTUATIONS[params.actuation]
     return ClosureSpec(
         mechanism=NAME,

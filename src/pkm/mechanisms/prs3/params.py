@@ -13,13 +13,14 @@ import numpy as np
 
 from pkm.core.spec import parse_toml, read_text_file
 from pkm.data import dynamics_path
-from pkm.errors import InvalidInputError, InvalidParameterError, SpecError, UnreachableError
+from pkm.errors import InvalidInputError, InvalidParameterError, SpecError
 from pkm.mechanisms._common import (
     check_finite,
     check_nonnegative,
     check_positive,
     param,
 )
+from pkm.validation import as_array
 
 NAME = "prs3"
 
@@ -77,7 +78,7 @@ def table2() -> Mapping[str, float]:
 
 def _from_table2(key: str, *units: str) -> float:
     """A field whose default is Table 2's ``key`` (read when a ``Prs3Params`` is made), with its units."""
-    return cast(float, field(default_factory=lambda: table2()[key], metadata={"units": units}))
+    return cast(float, field(default_factory=lambda: table2()[key], metadata={"units": units, "length": None}))
 
 
 # ---------------------------------------------------------------------- parameters
@@ -98,8 +99,9 @@ class Prs3Params:
         Ixx3, Iyy3, Izz3: Platform principal inertias about its centre of mass [kg m^2]
             (m_p h^2/4, m_p h^2/4, m_p h^2/2).
         Ixy3, Ixz3, Iyz3: Platform inertia tensor products (URDF ``ixy ixz iyz``) [kg m^2] (0).
-        reference: Reference independent coordinates ``(z_p [m], beta [rad], phi [rad])``: the start
-            of the sec. 5 trajectories (eq. 41: z = 0.81 m, beta = phi = 0).
+        reference: Reference independent coordinates ``(z_p [m], beta [rad], phi [rad])``; None
+            (default): found for the design (``reference_pose``: level, at the best-conditioned
+            height). The sec. 5 trajectories start at z = 0.81 m (eq. 41).
     """
 
     gamma: float = _from_table2("gamma", "rad")
@@ -116,11 +118,9 @@ class Prs3Params:
     Ixy3: float = _from_table2("Ixy3", "kg m^2")
     Ixz3: float = _from_table2("Ixz3", "kg m^2")
     Iyz3: float = _from_table2("Iyz3", "kg m^2")
-    reference: tuple[float, float, float] = param((0.81, 0.0, 0.0), "m", "rad")
+    reference: tuple[float, float, float] | None = param(None, "m", "rad", length=3)
 
     def __post_init__(self):
-        from pkm.mechanisms.prs3.kinematics import ROOT_TOL, as_task, leg_vectors  # (kinematics imports this module)
-
         check_positive(self, "l", "h", "g", "m_platform")
         check_nonnegative(self, "m_slider", "m_coupler")
         check_finite(self, "gamma", "Ixx3", "Iyy3", "Izz3", "Ixy3", "Ixz3", "Iyz3")
@@ -131,24 +131,12 @@ class Prs3Params:
             raise InvalidParameterError("actuation", f"use 'P' (sliders) or 'R' (knees), got {self.actuation!r}",
                                         self.actuation)
         _check_inertia(self.platform_inertia)
-        try:
-            y = as_task(self.reference, "reference")
-        except InvalidInputError as exc:
-            raise InvalidParameterError("reference", str(exc), self.reference) from None
-        object.__setattr__(self, "reference", tuple(float(v) for v in y))
-        try:
-            rad = leg_vectors(self, y)[1]
-        except UnreachableError as exc:
-            raise InvalidParameterError(
-                "reference", f"reference pose {self.reference} is unreachable with this design (leg {exc.leg} "
-                             f"misses by {exc.excess:.4g} m); lengthen l, bring g and h closer, or choose another "
-                             f"reference", self.reference) from None
-        if np.min(rad) <= ROOT_TOL * self.l**2:
-            leg = int(np.argmin(rad)) + 1
-            raise InvalidParameterError(
-                "reference", f"at the reference pose {self.reference} the coupler of leg {leg} is perpendicular "
-                             f"to its rail (double root of eq. 10, branches undefined); change l, g, h or the "
-                             f"reference", self.reference)
+        if self.reference is not None:
+            try:
+                y = as_task(self.reference, "reference")
+            except InvalidInputError as exc:
+                raise InvalidParameterError("reference", str(exc), self.reference) from None
+            object.__setattr__(self, "reference", tuple(float(v) for v in y))
 
     @property
     def platform_inertia(self) -> np.ndarray:
@@ -156,6 +144,15 @@ class Prs3Params:
         return np.array([[self.Ixx3, self.Ixy3, self.Ixz3],
                          [self.Ixy3, self.Iyy3, self.Iyz3],
                          [self.Ixz3, self.Iyz3, self.Izz3]])
+
+
+def as_task(y, name: str) -> np.ndarray:
+    arr = as_array(y, name, "3 numbers (z_p [m], beta [rad], phi [rad])")
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise InvalidInputError(name, f"expected 3 finite numbers (z_p, beta, phi), got shape {arr.shape}", y)
+    if abs(arr[1]) >= math.pi / 2:
+        raise InvalidInputError(name, f"pitch beta = {arr[1]!r} rad: Z-Y-X angles need |beta| < pi/2", y)
+    return arr
 
 
 def _check_inertia(I: np.ndarray) -> None:

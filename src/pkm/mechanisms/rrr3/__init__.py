@@ -106,6 +106,7 @@ from pkm.mechanisms.rrr3.kinematics import (
     joint_values,
     platform_vertices,
     reference_point,
+    reference_pose,
     singularity_measures,
 )
 from pkm.mechanisms.rrr3.model import (
@@ -122,7 +123,6 @@ from pkm.mechanisms.rrr3.params import (
     Rrr3Params,
     base_centroid,
     base_vertices,
-    home_task,
     mode_signs,
 )
 
@@ -148,7 +148,6 @@ __all__ = [
     "closure_spec",
     "configuration",
     "forward_kinematics",
-    "home_task",
     "homogenized_jacobians",
     "inverse_kinematics",
     "jacobians",
@@ -156,6 +155,7 @@ __all__ = [
     "mode_signs",
     "platform_vertices",
     "reference_point",
+    "reference_pose",
     "singularity_measures",
     "urdf_xml",
 ]

@@ -2,25 +2,28 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.indices import singularity_class
+from pkm.core.indices import inverse_condition, singularity_class
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.newton import gauss_newton
 from pkm.errors import (
     AssemblyError,
     BranchError,
     InvalidInputError,
+    InvalidParameterError,
     SingularityError,
     UnreachableError,
 )
 from pkm.mechanisms._common import (
+    best_reference,
     check_params,
 )
-from pkm.mechanisms.rrr3.params import MODES, REACH_TOL, SQRT3, Rrr3Params, base_vertices, home_task, mode_signs
+from pkm.mechanisms.rrr3.params import MODES, REACH_TOL, SQRT3, Rrr3Params, base_centroid, base_vertices, mode_signs
 from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result, wrap_angle
 
 
@@ -375,13 +378,13 @@ def closed_form_fk(params: Rrr3Params, q_actuated, seed=None) -> np.ndarray:
     Args:
         params: The design.
         q_actuated: Motor angles [rad].
-        seed: Task vector the solution should be nearest to (default :func:`home_task`).
+        seed: Task vector the solution should be nearest to (default :func:`reference_pose`).
 
     Raises:
         AssemblyError: no assembly at all; BranchError: none on ``params.mode``.
     """
     params = check_params(params, Rrr3Params)
-    target = home_task(params) if seed is None else as_vector(seed, 3, "seed")
+    target = reference_pose(params) if seed is None else as_vector(seed, 3, "seed")
     sols = [s for s in forward_kinematics(params, q_actuated) if s.mode == f"mode{params.mode}"]
     if not sols:
         expected = dict(zip(("elbow_1", "elbow_2", "elbow_3"), MODES[f"mode{params.mode}"]))
@@ -400,6 +403,68 @@ def closed_form_ik(params: Rrr3Params, y, branch: str | None = None) -> np.ndarr
 def closed_form_configuration(mech: Mechanism, y, branch: str | None = None) -> np.ndarray:
     """Every joint coordinate for task vector ``y`` (closed form); ``branch`` = working mode name."""
     return configuration(mech, y, branch)
+
+
+# ---------------------------------------------------------------------- reference pose
+REFERENCE_ORIENTATIONS = 49  # candidate reference orientations Phi in [-pi/3, pi/3] (the platform's symmetry)
+SINGULAR_TOL = 1e-6  # a given reference pose must be at least this far (dimensionless) from singularity
+
+
+def reference_pose(params: Rrr3Params) -> np.ndarray:
+    """The design's reference task vector ``(x_G, y_G, Phi)`` [m, m, rad] in working mode ``params.mode``.
+
+    ``params.home`` (offset from the base centroid, orientation) when given; otherwise the centred
+    platform at the orientation of largest condition index (the inverse condition number of
+    ``J_q^-1 J_x`` of :func:`homogenized_jacobians`, the paper's CI) among 49 values of ``Phi`` in
+    ``[-pi/3, pi/3]`` (the one nearest ``Phi = 0`` of equal ones).
+
+    Raises:
+        InvalidParameterError: (``home``) the given pose is unreachable (which leg, by how much) or
+            within 1e-6 of a singularity, or no candidate assembles at least 1e-3 from singularity.
+    """
+    params = check_params(params, Rrr3Params)
+    return np.array(_reference(params))
+
+
+@functools.lru_cache(maxsize=256)
+def _reference(params: Rrr3Params) -> tuple[float, float, float]:
+    G = base_centroid(params)
+    if params.home is None:
+        phis = sorted(np.linspace(-math.pi / 3.0, math.pi / 3.0, REFERENCE_ORIENTATIONS), key=abs)
+        return best_reference("home", ((float(G[0]), float(G[1]), float(phi)) for phi in phis),
+                              lambda y: condition_index(params, y), minimum=1e-3)
+    y = (float(G[0] + params.home[0]), float(G[1] + params.home[1]), params.home[2])
+    home = tuple(params.home)
+    try:
+        margin_inv, margin_dir = singularity_measures(params, y, params.mode)
+    except UnreachableError as exc:
+        raise InvalidParameterError(
+            "home", f"reference pose {home} is unreachable with this design (leg {exc.leg} misses by "
+                    f"{exc.excess:.4g} m); choose another home or other lengths", params.home) from None
+    except SingularityError:
+        raise InvalidParameterError(
+            "home", f"reference pose {home} puts a platform vertex on its base vertex (a = b); choose another "
+                    "home", params.home) from None
+    if margin_inv < SINGULAR_TOL or margin_dir < SINGULAR_TOL:
+        kind = "inverse (a leg stretched or folded)" if margin_inv < SINGULAR_TOL else "direct"
+        raise InvalidParameterError(
+            "home", f"reference pose {home} is {kind}-singular in mode{params.mode}; choose another home or mode",
+            params.home)
+    return y
+
+
+def condition_index(params: Rrr3Params, y) -> float:
+    """The inverse condition number of ``J_q^-1 J_x`` (:func:`homogenized_jacobians`, centroid, default
+    length) at ``y`` in ``params.mode``: in [0, 1], 0 at a singularity.
+
+    Raises:
+        UnreachableError, SingularityError: as :func:`homogenized_jacobians`.
+    """
+    Jx, Jq = homogenized_jacobians(params, y, params.mode)
+    q = np.diag(Jq)
+    if np.min(np.abs(q)) == 0.0:
+        raise SingularityError("inverse", 0.0, "a leg stretched or folded")
+    return float(inverse_condition(Jx / q[:, None]))
 
 
 # ---------------------------------------------------------------------- helpers

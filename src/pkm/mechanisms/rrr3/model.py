@@ -13,8 +13,8 @@ from pkm.mechanisms._common import (
     rod_inertia,
     spec_parameters,
 )
-from pkm.mechanisms.rrr3.kinematics import joint_values
-from pkm.mechanisms.rrr3.params import MODES, NAME, SQRT3, Rrr3Params, base_vertices, home_task
+from pkm.mechanisms.rrr3.kinematics import joint_values, reference_pose
+from pkm.mechanisms.rrr3.params import MODES, NAME, SQRT3, Rrr3Params, base_vertices
 
 
 # ---------------------------------------------------------------------- tree and spec
@@ -46,7 +46,7 @@ def urdf_xml(params: Rrr3Params) -> str:
 
 def closure_spec(params: Rrr3Params) -> ClosureSpec:
     params = check_params(params, Rrr3Params)
-    reference = {k: tuple(v) for k, v in joint_values(params, home_task(params)).items()}
+    reference = {k: tuple(v) for k, v in joint_values(params, reference_pose(params)).items()}
     branches = {}
     for name, signs in MODES.items():
         psi = ", ".join("+" if s > 0 else "-" for s in signs)

@@ -7,12 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.errors import (
-    InvalidInputError,
-    InvalidParameterError,
-    SingularityError,
-    UnreachableError,
-)
+from pkm.errors import InvalidInputError, InvalidParameterError
 from pkm.mechanisms._common import (
     check_numbers,
     check_params,
@@ -35,9 +30,6 @@ MODES: dict[str, tuple[int, int, int]] = {
 REACH_TOL = 1e-12  # relative to a + b: a distance this close to the reach limits counts as on them
 
 
-_SINGULAR_TOL = 1e-6  # the reference pose must be at least this far (dimensionless) from singularities
-
-
 @dataclass(frozen=True)
 class Rrr3Params:
     """Planar 3-RRR design (paper sec. III workspace study by default).
@@ -49,7 +41,9 @@ class Rrr3Params:
         H: Base side, the actuator separation ``PQ = QR = RP`` [m] (100 cm).
         mode: Working mode 1..8 of the reference configuration (see the module doc).
         home: Reference placement ``(dx, dy, Phi)``: the platform centroid's offset from the
-            base centroid [m] and the orientation [rad]; ``(0, 0, 0)``: centred, ``Phi = 0``.
+            base centroid [m] and the orientation [rad]; ``(0, 0, 0)``: centred, ``Phi = 0``; None
+            (default): found for the design (``reference_pose``: centred, the orientation of
+            largest condition index in ``mode``).
         m_proximal: Mass of a proximal link [kg] (illustrative; not in the paper).
         m_distal: Mass of a distal link [kg] (illustrative).
         m_platform: Platform mass [kg] (illustrative).
@@ -60,34 +54,18 @@ class Rrr3Params:
     h: float = param(0.10, "m")
     H: float = param(1.00, "m")
     mode: int = param(1)
-    home: tuple[float, float, float] = param((0.0, 0.0, 0.0), "m", "rad")
+    home: tuple[float, float, float] | None = param(None, "m", "rad", length=3)
     m_proximal: float = param(0.20, "kg")
     m_distal: float = param(0.15, "kg")
     m_platform: float = param(0.10, "kg")
 
     def __post_init__(self):
-        from pkm.mechanisms.rrr3.kinematics import singularity_measures  # (kinematics imports this module)
-
         check_positive(self, "a", "b", "h", "H", "m_proximal", "m_distal", "m_platform")
         if isinstance(self.mode, bool) or not isinstance(self.mode, int) or not 1 <= self.mode <= 8:
             raise InvalidParameterError("mode", f"must be an integer 1..8 (working mode), got {self.mode!r}",
                                         self.mode)
-        check_numbers(self, "home", 3, "(dx, dy, Phi) in m, m, rad")
-        try:
-            margin_inv, margin_dir = singularity_measures(self, home_task(self), self.mode)
-        except UnreachableError as exc:
-            raise InvalidParameterError(
-                "home", f"reference pose {tuple(self.home)} is unreachable with this design (leg {exc.leg} misses "
-                        f"by {exc.excess:.4g} m); choose another home or other lengths", self.home) from None
-        except SingularityError:
-            raise InvalidParameterError(
-                "home", f"reference pose {tuple(self.home)} puts a platform vertex on its base vertex (a = b); "
-                        "choose another home", self.home) from None
-        if margin_inv < _SINGULAR_TOL or margin_dir < _SINGULAR_TOL:
-            kind = "inverse (a leg stretched or folded)" if margin_inv < _SINGULAR_TOL else "direct"
-            raise InvalidParameterError(
-                "home", f"reference pose {tuple(self.home)} is {kind}-singular in mode{self.mode}; choose another "
-                        "home or mode", self.home)
+        if self.home is not None:
+            check_numbers(self, "home", 3, "(dx, dy, Phi) in m, m, rad")
 
 
 # ---------------------------------------------------------------------- geometry
@@ -110,12 +88,6 @@ def base_centroid(params: Rrr3Params) -> np.ndarray:
     """Centroid of the base triangle [m], shape (2,)."""
     params = check_params(params, Rrr3Params)
     return np.array([params.H / 2.0, params.H / (2.0 * SQRT3)])
-
-
-def home_task(params: Rrr3Params) -> np.ndarray:
-    """The reference task vector ``(x_G, y_G, Phi)`` [m, m, rad] of ``params.home``."""
-    params = check_params(params, Rrr3Params)
-    return np.concatenate([base_centroid(params) + np.asarray(params.home[:2], dtype=float), [params.home[2]]])
 
 
 #: The protocol's name for the design dataclass.
