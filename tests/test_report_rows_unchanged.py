@@ -1,5 +1,7 @@
 """The architecture change of issue 13 changes no row of the report: same ids, published values and match flags,
-ours within 1e-12 relative of the rows saved before it (``tests/data/report_rows_before_issue13.json``)."""
+ours within 1e-12 relative of the rows saved before it (``tests/data/report_rows_before_issue13.json``), except the
+rows that are the location of an optimum found by a solver to a stated accuracy: those within that accuracy (one
+closed form of the arm-and-rod leg for the Delta and the hexapod moved them by 3e-10..4e-8 relative)."""
 
 from __future__ import annotations
 
@@ -10,6 +12,14 @@ from pathlib import Path
 import pytest
 
 from pkm import papers
+
+#: Row id -> absolute accuracy of the solver that computes it, in the row's unit.
+SOLVER_ACCURACY = {
+    "hexapod.poseT.beta_opt_wrot_deg": math.degrees(1e-8),  # optimal_beta(tol=1e-8 rad)
+    "hexapod.poseT.beta_opt_wtras_deg": math.degrees(1e-8),
+    "hexapod.spiral.max_gap_rot_tras_deg": math.degrees(2e-8),  # the difference of two such optima
+    "delta.fig5.R_min_K2_mm": 1e3 * 1e-10,  # radius_minimising_condition: bounded Brent, xatol 1e-10 m
+}
 
 BEFORE = json.loads((Path(__file__).parent / "data" / "report_rows_before_issue13.json").read_text())["papers"]
 
@@ -22,6 +32,7 @@ def test_rows_equal_the_rows_before_the_architecture_change(paper):
         assert (row.published, row.unit, row.matches) == (old["published"], old["unit"], old["matches"]), row.id
         new = row.computed
         if isinstance(new, float) and isinstance(old["computed"], (int, float)) and not isinstance(new, bool):
-            assert math.isclose(new, old["computed"], rel_tol=1e-12, abs_tol=1e-300), (row.id, new, old["computed"])
+            assert math.isclose(new, old["computed"], rel_tol=1e-12, abs_tol=SOLVER_ACCURACY.get(row.id, 1e-300)), \
+                (row.id, new, old["computed"])
         else:
             assert new == old["computed"], row.id

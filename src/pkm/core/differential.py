@@ -27,6 +27,7 @@ import pinocchio as pin
 from pkm.core import constraints
 from pkm.core.indices import singularity_class
 from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.newton import least_squares
 from pkm.errors import SingularityError
 from pkm.validation import as_tolerance, as_vector, finite_result
 
@@ -37,17 +38,6 @@ def _check(mech, q) -> tuple[Mechanism, np.ndarray]:
     """The mechanism and ``q`` checked (type, shape, finiteness, unit quaternions)."""
     mech = check_mechanism(mech)
     return mech, mech.check_q(q)
-
-
-def _lstsq(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``np.linalg.lstsq`` with its failure (entries overflowing) reported as a PkmError."""
-    finite_result(A, "Jacobian")
-    finite_result(b, "right-hand side")
-    try:
-        return np.linalg.lstsq(A, b, rcond=None)[0]
-    except np.linalg.LinAlgError as exc:
-        finite_result(np.nan, "least-squares solution", f"numpy: {exc}")
-        raise
 
 
 def _smin(A: np.ndarray, ncols: int | None = None) -> tuple[float, float]:
@@ -84,7 +74,7 @@ def _passive_map(mech: Mechanism, Jc: np.ndarray, rtol: float) -> np.ndarray:
         raise SingularityError("direct", smin, "actuators locked, the mechanism can still move")
     G = np.zeros((mech.nv, mech.na))
     G[mech.act_v, np.arange(mech.na)] = 1.0
-    G[mech.passive_v] = -_lstsq(Jp, Jc[:, mech.act_v])
+    G[mech.passive_v] = -least_squares(Jp, Jc[:, mech.act_v])
     return G
 
 
@@ -119,7 +109,7 @@ def inverse_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
         raise SingularityError("inverse", smin, "the task frozen, the joints can still move")
     rhs = np.zeros((A.shape[0], mech.n_task))
     rhs[mech.n_constraints:] = np.eye(mech.n_task)
-    return finite_result(_lstsq(A, rhs)[mech.act_v], "inverse Jacobian")
+    return finite_result(least_squares(A, rhs)[mech.act_v], "inverse Jacobian")
 
 
 def velocities(mech: Mechanism, q, qd_actuated) -> np.ndarray:
@@ -138,7 +128,7 @@ def accelerations(mech: Mechanism, q, v, qdd_actuated) -> np.ndarray:
     _passive_map(mech, Jc, RTOL)  # raises at a direct singularity
     a = np.zeros(mech.nv)
     a[mech.act_v] = qdd
-    a[mech.passive_v] = -_lstsq(Jc[:, mech.passive_v], Jc[:, mech.act_v] @ qdd + gamma)
+    a[mech.passive_v] = -least_squares(Jc[:, mech.passive_v], Jc[:, mech.act_v] @ qdd + gamma)
     return finite_result(a, "joint accelerations")
 
 
@@ -163,7 +153,7 @@ def inverse_velocities(mech: Mechanism, q, yd) -> np.ndarray:
     yd = as_vector(yd, mech.n_task, "yd")
     Jc = constraints.jacobian(mech, q)
     A = np.vstack([Jc, mech.task_map.jacobian(q, update=False)])
-    return finite_result(_lstsq(A, np.concatenate([np.zeros(mech.n_constraints), yd])), "joint velocities")
+    return finite_result(least_squares(A, np.concatenate([np.zeros(mech.n_constraints), yd])), "joint velocities")
 
 
 def inverse_accelerations(mech: Mechanism, q, v, ydd) -> np.ndarray:
@@ -177,7 +167,7 @@ def inverse_accelerations(mech: Mechanism, q, v, ydd) -> np.ndarray:
     Jc = constraints.jacobian(mech, q)
     A = np.vstack([Jc, task.jacobian(q, update=False)])
     rhs = np.concatenate([-gamma_c, ydd - gamma_t])
-    return finite_result(_lstsq(A, rhs), "joint accelerations")
+    return finite_result(least_squares(A, rhs), "joint accelerations")
 
 
 @dataclass(frozen=True)

@@ -12,14 +12,24 @@ from collections.abc import Callable
 
 import numpy as np
 
+from pkm.validation import finite_result
+
 Fun = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 
 
-def least_squares_step(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The least-squares solution of ``A x = b``: LU when square and regular, SVD (rank-revealing) otherwise;
-    zeros (no step) when ``A`` or ``b`` is not finite or the SVD fails (LAPACK would complain and fail)."""
+def least_squares(A: np.ndarray, b: np.ndarray, *, strict: bool = True) -> np.ndarray:
+    """The least-squares solution of ``A x = b`` (``b`` a vector or columns): LU when ``A`` is square and
+    regular, SVD (rank-revealing, minimum norm) otherwise.
+
+    Where ``A`` or ``b`` is not finite, or LAPACK fails (entries overflowing), ``strict`` raises
+    :class:`~pkm.errors.NonFiniteError` (an analysis: its caller must know); otherwise the result is
+    zeros, no step (Newton's method, which then backtracks or stops).
+    """
     if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
-        return np.zeros(A.shape[1])
+        if strict:
+            finite_result(A, "matrix")
+            finite_result(b, "right-hand side")
+        return np.zeros(A.shape[1:2] + np.shape(b)[1:])
     if A.shape[0] == A.shape[1]:
         try:
             x = np.linalg.solve(A, b)
@@ -29,8 +39,10 @@ def least_squares_step(A: np.ndarray, b: np.ndarray) -> np.ndarray:
             pass
     try:
         return np.linalg.lstsq(A, b, rcond=None)[0]
-    except np.linalg.LinAlgError:  # SVD did not converge (entries overflowing): no step
-        return np.zeros(A.shape[1])
+    except np.linalg.LinAlgError as exc:  # SVD did not converge
+        if strict:
+            finite_result(np.nan, "least-squares solution", f"numpy: {exc}")
+        return np.zeros(A.shape[1:2] + np.shape(b)[1:])
 
 
 def gauss_newton(fun: Fun, x: np.ndarray, *, tol: float, max_iter: int, max_step: float = math.inf,
@@ -60,7 +72,7 @@ def gauss_newton(fun: Fun, x: np.ndarray, *, tol: float, max_iter: int, max_step
     it = stalled = 0
     while res > tol and it < max_iter and stalled < stall:
         it += 1
-        step = -least_squares_step(J, r)
+        step = -least_squares(J, r, strict=False)
         nrm = float(np.max(np.abs(step))) if step.size else 0.0
         if nrm > max_step:
             step *= max_step / nrm
@@ -79,4 +91,4 @@ def gauss_newton(fun: Fun, x: np.ndarray, *, tol: float, max_iter: int, max_step
     return x, (res if math.isfinite(res) else math.inf), it
 
 
-__all__ = ["gauss_newton", "least_squares_step"]
+__all__ = ["gauss_newton", "least_squares"]

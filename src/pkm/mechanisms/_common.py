@@ -51,27 +51,45 @@ def rod_inertia(mass: float, length: float, axis: int) -> np.ndarray:
     return np.diag(I)
 
 
+def _circle_sphere_terms(u, v, w, arm: float, rod: float) -> tuple[np.ndarray, ...]:
+    """``(u, v, rho, K, 1 / rho, cos delta)`` of :func:`circle_sphere` (arrays; inf or NaN beyond the float range)."""
+    u, v, w = (np.asarray(x, dtype=float) for x in (u, v, w))
+    with np.errstate(over="ignore", invalid="ignore"):
+        rho = np.hypot(u, v)
+        K = (u * u + v * v + w * w + arm * arm - rod * rod) / (2.0 * arm)
+        inv = 1.0 / np.maximum(rho, 1e-300)  # rho = 0: the point on the axis, any t
+        return u, v, rho, K, inv, np.clip(K / np.maximum(rho, 1e-300), -1.0, 1.0)
+
+
 def circle_sphere(u, v, w, arm: float, rod: float, sign) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Angle ``t`` of an arm turning in its (u, v) plane so that its tip lies at distance ``rod`` from
     the point ``(u, v, w)`` (arm frame: the arm's tip is ``arm (cos t, sin t, 0)``), vectorised over
-    the leading axes of ``u, v, w`` (and ``sign``).
+    the leading axes of ``u, v, w`` (and ``sign``): the one closed form of every arm-and-rod leg
+    (:func:`circle_sphere_cs` gives its cosine and sine).
 
     ``u cos t + v sin t = K`` with ``K = (u^2 + v^2 + w^2 + arm^2 - rod^2) / (2 arm)``, so
-    ``t = atan2(v, u) + sign * acos(K / hypot(u, v))``, wrapped to (-pi, pi].
+    ``t = phi + sign * delta``, ``phi = atan2(v, u)``, ``cos delta = K / rho`` with ``rho = hypot(u, v)``,
+    wrapped to (-pi, pi].
 
     Returns:
         ``(t, reachable, rho, K)``: where ``|K| > rho`` (beyond the round-off of a double root) the
-        rod misses the circle, ``reachable`` is False and ``t`` is that of the clipped ``acos`` (the
+        rod misses the circle, ``reachable`` is False and ``t`` is that of the clipped cosine (the
         nearest elbow position: finite, but no assembly).
     """
-    u, v, w = (np.asarray(x, dtype=float) for x in (u, v, w))
-    with np.errstate(over="ignore", invalid="ignore"):  # a point beyond the float range: K is inf or NaN
-        rho = np.hypot(u, v)
-        K = (u * u + v * v + w * w + arm * arm - rod * rod) / (2.0 * arm)
+    u, v, rho, K, _, cd = _circle_sphere_terms(u, v, w, arm, rod)
+    with np.errstate(invalid="ignore"):
         reachable = np.abs(K) <= rho * (1.0 + 1e-12)
-        delta = np.arccos(np.clip(K / np.maximum(rho, 1e-300), -1.0, 1.0))  # rho = 0: point on the axis, any t
-        t = wrap_angle(np.arctan2(v, u) + sign * delta)
-    return t, reachable, rho, K
+        return wrap_angle(np.arctan2(v, u) + sign * np.arccos(cd)), reachable, rho, K
+
+
+def circle_sphere_cs(u, v, w, arm: float, rod: float, sign) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(cos t, sin t, rho, K)`` of :func:`circle_sphere`, from products (``(cos phi, sin phi) = (u, v) / rho``,
+    ``sin delta = sign sqrt(1 - cos^2 delta)``) without evaluating an angle: for batches that need the
+    arm's direction, not its angle."""
+    u, v, rho, K, inv, cd = _circle_sphere_terms(u, v, w, arm, rod)
+    with np.errstate(invalid="ignore"):
+        sd = sign * np.sqrt(1.0 - cd * cd)
+        return (u * cd - v * sd) * inv, (v * cd + u * sd) * inv, rho, K
 
 
 def leg_arm_angles(u, v, w, arm: float, rod: float, signs, detail: Callable[[int], str]) -> np.ndarray:

@@ -46,6 +46,7 @@ from pkm.core import screws
 from pkm.core.task import as_rotation
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.mechanisms import hexapod as hx
+from pkm.mechanisms._common import circle_sphere_cs
 from pkm.validation import as_vector
 
 #: Chain order of the screws of a leg (rows of :func:`leg_screws`).
@@ -117,8 +118,8 @@ class LegBatch:
 def leg_batch(params: hx.HexapodParams, C: np.ndarray, beta, signs: np.ndarray) -> LegBatch:
     """Closed-form inverse kinematics of the six legs, vectorised over a batch.
 
-    In leg frame ``(e_r, e_y, u)`` with ``d = C - A``: ``alpha = phi + s delta``, ``phi`` the
-    direction of ``(d_r, d_y)``, ``cos delta = K / rho`` (see :func:`pkm.mechanisms.hexapod.inverse_kinematics`);
+    In leg frame ``(e_r, e_y, u)`` with ``d = C - A``: ``(cos alpha, sin alpha)`` of
+    :func:`pkm.mechanisms._common.circle_sphere_cs` (as :func:`pkm.mechanisms.hexapod.inverse_kinematics`);
     the Klein forms are computed there too (``u`` is the third axis): ``{$1; $6} = d_r w_y - d_y w_r``.
 
     Args:
@@ -146,14 +147,7 @@ def leg_batch(params: hx.HexapodParams, C: np.ndarray, beta, signs: np.ndarray) 
     c_r = Cx * ct + Cz * st
     c_u = Cz * ct - Cx * st
     d_r, d_y = c_r - a_r, Cy - a_y
-    rho2 = d_r * d_r + d_y * d_y
-    rho = np.sqrt(rho2)
-    K = (rho2 + c_u * c_u + (params.LA**2 - params.LB**2)) * (0.5 / params.LA)
-    inv = 1.0 / np.maximum(rho, 1e-300)
-    cd = np.clip(K * inv, -1.0, 1.0)
-    sd = signs * np.sqrt(1.0 - cd * cd)
-    ca = (d_r * cd - d_y * sd) * inv  # cos(phi + s delta)
-    sa = (d_y * cd + d_r * sd) * inv
+    ca, sa, rho, K = circle_sphere_cs(d_r, d_y, c_u, params.LA, params.LB, signs)
     w_r, w_y, w_u = (d_r - params.LA * ca) / params.LB, (d_y - params.LA * sa) / params.LB, c_u / params.LB
     kr = np.zeros(shape + (6,))
     kr[..., :3] = ((c_r - params.Rf) * w_y - Cy * w_r)[..., :3]

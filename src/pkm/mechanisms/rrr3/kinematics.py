@@ -54,30 +54,51 @@ def a_from_centroid(params: Rrr3Params, g_point, phi: float) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------- closed forms
+def leg_elbows(a: float, b: float, tx, ty, sign) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The elbow of an RR leg, vectorised over the leading axes of ``tx, ty`` (and ``sign``): the one
+    closed form of the 3-RRR leg (eqs. 6-9), for single poses and for maps.
+
+    Args:
+        a, b: Proximal and distal lengths [m].
+        tx, ty: The platform vertex relative to the leg's base vertex [m].
+        sign: ``+1`` for ``psi > 0`` (the elbow on the right of base vertex -> platform vertex), ``-1``.
+
+    Returns:
+        ``(Dx, Dy, dist, reachable)``: the elbow relative to the base vertex [m], the distance from the
+        base vertex to the platform vertex [m] and whether it lies in ``[|a - b|, a + b]`` (to
+        ``REACH_TOL``) and is not 0 (there the elbow is the clipped one: finite, but no assembly).
+    """
+    lo, hi = abs(a - b), a + b
+    with np.errstate(over="ignore", invalid="ignore"):  # beyond the float range: not reachable
+        d2 = tx * tx + ty * ty
+        dist = np.sqrt(d2)
+        reachable = (dist <= hi * (1.0 + REACH_TOL)) & (dist >= lo - hi * REACH_TOL) & (dist > 0.0)
+        safe = np.where(dist > 0.0, dist, 1.0)
+        ex, ey = tx / safe, ty / safe
+        along = (a * a - b * b + d2) / (2.0 * safe)  # the elbow's projection on base vertex -> platform vertex
+        off = np.sqrt(np.clip(a * a - along * along, 0.0, None))
+        return along * ex + sign * off * ey, along * ey - sign * off * ex, dist, reachable
+
+
 def _solve(params: Rrr3Params, a_point: np.ndarray, phi: float, mode: int | str) -> tuple[np.ndarray, np.ndarray]:
     """``(theta, psi)`` [rad] of the three legs for the paper's ``(A, Phi)`` in ``mode`` (eqs. 6-9)."""
     params = check_params(params, Rrr3Params)
-    signs = mode_signs(mode)
     a, b = params.a, params.b
-    lo, hi = abs(a - b), a + b
-    targets = platform_vertices(params, a_point, phi) - base_vertices(params)
-    theta, psi = np.empty(3), np.empty(3)
-    for i, (x, y) in enumerate(targets):
-        d = math.hypot(x, y)
+    T = platform_vertices(params, a_point, phi) - base_vertices(params)
+    Dx, Dy, dist, reachable = leg_elbows(a, b, T[:, 0], T[:, 1], np.array(mode_signs(mode), dtype=float))
+    for i in np.flatnonzero(~reachable):
+        d, lo, hi = float(dist[i]), abs(a - b), a + b
+        if not math.isfinite(d):
+            raise UnreachableError(int(i) + 1, math.inf, "m", f"leg {i + 1}: the platform vertex is beyond the float "
+                                                              "range (check the units)")
         if d > hi * (1.0 + REACH_TOL) or d < lo - hi * REACH_TOL:
-            excess = d - hi if d > hi else lo - d
-            raise UnreachableError(i + 1, excess, "m", f"leg {i + 1}: distance {d:.6g} m from its base vertex to "
-                                                        f"its platform vertex is outside [|a-b|, a+b] = "
-                                                        f"[{lo:.6g}, {hi:.6g}] m")
-        if d <= hi * REACH_TOL:
-            raise SingularityError("inverse", 0.0, f"leg {i + 1}: platform vertex on the base vertex (a = b), "
-                                                   "the motor angle is undetermined")
-        e1, e2, e3 = -2.0 * y * a, -2.0 * x * a, d * d + a * a - b * b
-        s = math.sqrt(max(0.0, e1 * e1 + e2 * e2 - e3 * e3))  # 2 a d sin(delta) = 2 a b |sin psi|
-        sigma = signs[i]  # psi > 0 <-> the '-' root of eq. (9)
-        theta[i] = math.atan2(-e1, -e2) - sigma * math.atan2(s, e3)
-        psi[i] = sigma * math.atan2(s, d * d - a * a - b * b)
-    return wrap_angle(theta), psi
+            raise UnreachableError(int(i) + 1, d - hi if d > hi else lo - d, "m",
+                                   f"leg {i + 1}: distance {d:.6g} m from its base vertex to its platform vertex is "
+                                   f"outside [|a-b|, a+b] = [{lo:.6g}, {hi:.6g}] m")
+        raise SingularityError("inverse", 0.0, f"leg {i + 1}: platform vertex on the base vertex (a = b), "
+                                               "the motor angle is undetermined")
+    ux, uy = T[:, 0] - Dx, T[:, 1] - Dy  # the distal link
+    return wrap_angle(np.arctan2(Dy, Dx)), np.arctan2(Dx * uy - Dy * ux, Dx * ux + Dy * uy)
 
 
 def inverse_kinematics(params: Rrr3Params, a_point, phi: float, mode: int | str | None = None) -> np.ndarray:

@@ -214,22 +214,14 @@ def _legs(d: Design, gx: np.ndarray, gy: np.ndarray, phi, signs):
     rc = d.h / rrr3.SQRT3
     reach = np.ones(np.broadcast_shapes(np.shape(gx), np.shape(gy), np.shape(phi)), dtype=bool)
     out = []
-    lo, hi = abs(d.a - d.b), d.a + d.b
     cphi, sphi = rc * np.cos(phi), rc * np.sin(phi)
     for i, ang in enumerate(_VERTEX_ANGLES):
         ca, sa = math.cos(ang), math.sin(ang)
         vx = gx + (cphi * ca - sphi * sa)  # G + rc (cos(phi + ang), sin(phi + ang))
         vy = gy + (sphi * ca + cphi * sa)
         tx, ty = vx - base[i, 0], vy - base[i, 1]
-        d2 = tx * tx + ty * ty
-        dist = np.sqrt(d2)
-        reach &= (dist <= hi * (1.0 + rrr3.REACH_TOL)) & (dist >= lo - hi * rrr3.REACH_TOL) & (dist > 0.0)
-        safe = np.where(dist > 0.0, dist, 1.0)
-        ex, ey = tx / safe, ty / safe
-        along = (d.a * d.a - d.b * d.b + d2) / (2.0 * safe)  # elbow's projection on base vertex -> platform vertex
-        off = np.sqrt(np.clip(d.a * d.a - along * along, 0.0, None))
-        sgn = signs[i]  # psi > 0: elbow on the right of base -> platform vertex
-        Dx, Dy = along * ex + sgn * off * ey, along * ey - sgn * off * ex
+        Dx, Dy, _, reach_i = rrr3.leg_elbows(d.a, d.b, tx, ty, signs[i])
+        reach &= reach_i
         ux, uy = (tx - Dx) / d.b, (ty - Dy) / d.b
         s = Dx * uy - Dy * ux  # (D - O) x u = a sin psi
         out.append((vx, vy, ux, uy, s))
