@@ -23,13 +23,14 @@ from pkm.mechanisms import definition as mechanism_definition
 from pkm.mechanisms import module as mechanism_module
 
 #: Names of the generic core, imported on first use (``import pkm`` stays cheap: no Pinocchio until needed).
-_CORE = ("ClosureSpec", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "accelerations", "close_loops",
+_CORE = ("ClosureSpec", "Configuration", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "accelerations", "close_loops",
          "diagnose", "forward_jacobian", "inverse_accelerations", "inverse_jacobian", "inverse_velocities",
          "passive_map", "solve_ik", "task_acceleration", "task_velocity", "twist_jacobian", "velocities")
 
 if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core import (
         ClosureSpec,
+        Configuration,
         Diagnostics,
         Mechanism,
         SolveResult,
@@ -93,7 +94,7 @@ def build(name: str, **params) -> Mechanism:
 
 
 __all__ = [
-    "MECHANISMS", "ClosureSpec", "Diagnostics", "Mechanism", "PkmError", "SolveResult", "TaskMap",
+    "MECHANISMS", "ClosureSpec", "Configuration", "Diagnostics", "Mechanism", "PkmError", "SolveResult", "TaskMap",
     "accelerations", "build", "close_loops", "diagnose", "errors", "forward_jacobian", "inverse_accelerations",
     "inverse_jacobian", "inverse_velocities", "load", "mechanism_definition", "mechanism_module", "passive_map", "solve_ik",
     "task_acceleration", "task_velocity", "twist_jacobian", "velocities",

@@ -265,13 +265,15 @@ def _key_kind(mech: pkm.Mechanism, key: str) -> str:
 
 def task_values(mech: pkm.Mechanism, q) -> dict[str, float]:
     """The task coordinates of ``q`` by name (see :func:`task_keys`; angles Z-Y-X Euler) [m, rad]."""
+    import pinocchio as pin
+
     from pkm.core import zyx_angles
 
     y = mech.task_map.value(q)
     if not mech.spec.task.is_pose:
         return dict(zip(task_keys(mech), map(float, y)))
-    M = mech.data.oMf[mech.ee_frame]
-    head = list(M.translation) + list(zyx_angles(M.rotation))
+    R = pin.Quaternion(y[6], y[3], y[4], y[5]).toRotationMatrix()  # (x, y, z, w) in the task vector
+    head = list(y[:3]) + list(zyx_angles(R))
     return dict(zip(task_keys(mech), map(float, head + list(y[7:]))))
 
 

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 from pkm._lazy import lazy
 
 _EXPORTS = {
+    "pkm.core.configuration": ("Configuration",),
     "pkm.core.differential": ("Diagnostics", "accelerations", "diagnose", "forward_jacobian", "inverse_accelerations",
                               "inverse_jacobian", "inverse_velocities", "passive_map", "task_acceleration",
                               "task_velocity", "twist_jacobian", "velocities"),
@@ -22,6 +23,7 @@ _EXPORTS = {
 _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
 if TYPE_CHECKING:  # the static view of the lazy names
+    from pkm.core.configuration import Configuration
     from pkm.core.differential import (
         Diagnostics,
         accelerations,
@@ -45,7 +47,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
 __getattr__, __dir__ = lazy("pkm.core", globals(), _WHERE)
 
 __all__ = [
-    "Branch", "Closure", "ClosureSpec", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "TaskSpec",
+    "Branch", "Closure", "ClosureSpec", "Configuration", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "TaskSpec",
     "accelerations", "branch_seed", "close_loops", "diagnose", "forward_jacobian", "inverse_accelerations",
     "inverse_jacobian", "inverse_velocities", "passive_map", "solve_ik", "task_acceleration", "task_velocity",
     "twist_jacobian", "velocities", "zyx_angles", "zyx_matrix",

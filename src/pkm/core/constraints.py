@@ -22,11 +22,14 @@ import pinocchio as pin
 from pkm.core.mechanism import Mechanism
 
 
-def residual(mech: Mechanism, q: np.ndarray, *, update: bool = True) -> np.ndarray:
-    """Closure residual at ``q`` (see module doc). ``update=False`` reuses ``mech.data`` placements."""
-    m, d = mech.model, mech.data
-    if update:
-        pin.framesForwardKinematics(m, d, q)
+def residual(mech: Mechanism, q: np.ndarray) -> np.ndarray:
+    """Closure residual at ``q`` (see module doc)."""
+    pin.framesForwardKinematics(mech.model, mech.data, q)
+    return residual_from(mech, mech.data)
+
+
+def residual_from(mech: Mechanism, d: pin.Data) -> np.ndarray:
+    """The closure residual from the frame placements already in ``d`` (see :class:`pkm.core.Configuration`)."""
     out = np.empty(mech.n_constraints)
     k = 0
     for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
@@ -39,19 +42,22 @@ def residual(mech: Mechanism, q: np.ndarray, *, update: bool = True) -> np.ndarr
     return out
 
 
-def jacobian(mech: Mechanism, q: np.ndarray, *, update: bool = True) -> np.ndarray:
+def jacobian(mech: Mechanism, q: np.ndarray) -> np.ndarray:
     """Constraint Jacobian (n_constraints x nv), in the conventions of ``mech.constraint_models``.
 
     Built from frame Jacobians: ``J_A - J_B`` (world-aligned, linear rows) for a point closure,
     ``J_A - Ad(A^-1 B) J_B`` (local) for a frame closure. This equals
     ``pin.getConstraintsJacobian`` (a test pins it to 1e-15), which Pinocchio 4.1 refuses for
-    models with mimic joints. ``update=False`` reuses the joint Jacobians and frame placements
-    already in ``mech.data``.
+    models with mimic joints.
     """
-    m, d = mech.model, mech.data
-    if update:
-        pin.computeJointJacobians(m, d, q)
-        pin.updateFramePlacements(m, d)
+    pin.computeJointJacobians(mech.model, mech.data, q)
+    pin.updateFramePlacements(mech.model, mech.data)
+    return jacobian_from(mech, mech.data)
+
+
+def jacobian_from(mech: Mechanism, d: pin.Data) -> np.ndarray:
+    """The constraint Jacobian from the joint Jacobians and frame placements already in ``d``."""
+    m = mech.model
     rows = []
     for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
         if c.type == "point":
@@ -74,10 +80,10 @@ def pinocchio_jacobian(mech: Mechanism, q: np.ndarray) -> np.ndarray:
 
 
 def residual_and_jacobian(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Both at once, with one kinematics pass."""
+    """Both at once, with one kinematics pass (the loop closure's Newton step)."""
     pin.computeJointJacobians(mech.model, mech.data, q)
     pin.updateFramePlacements(mech.model, mech.data)
-    return residual(mech, q, update=False), jacobian(mech, q, update=False)
+    return residual_from(mech, mech.data), jacobian_from(mech, mech.data)
 
 
 def drift(mech: Mechanism, q: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -22,9 +22,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
 
 from pkm.core import constraints
+from pkm.core.configuration import Configuration
 from pkm.core.indices import singularity_class
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.newton import least_squares
@@ -81,17 +81,15 @@ def _passive_map(mech: Mechanism, Jc: np.ndarray, rtol: float) -> np.ndarray:
 def forward_jacobian(mech: Mechanism, q) -> np.ndarray:
     """Task rates from actuated rates, ``yd = J qd_a`` (n_task x na)."""
     mech, q = _check(mech, q)
-    G = _passive_map(mech, constraints.jacobian(mech, q), RTOL)
-    return finite_result(mech.task_map.jacobian(q, update=False) @ G, "forward Jacobian")
+    c = Configuration.compute(mech, q)
+    return finite_result(c.task_jacobian @ _passive_map(mech, c.constraint_jacobian, RTOL), "forward Jacobian")
 
 
 def twist_jacobian(mech: Mechanism, q) -> np.ndarray:
     """End-effector twist ``[v; w]`` (origin velocity, world axes) from actuated rates (6 x na)."""
     mech, q = _check(mech, q)
-    G = _passive_map(mech, constraints.jacobian(mech, q), RTOL)
-    pin.updateFramePlacements(mech.model, mech.data)
-    return finite_result(pin.getFrameJacobian(mech.model, mech.data, mech.ee_frame, pin.LOCAL_WORLD_ALIGNED) @ G,
-                         "twist Jacobian")
+    c = Configuration.compute(mech, q)
+    return finite_result(c.ee_jacobian @ _passive_map(mech, c.constraint_jacobian, RTOL), "twist Jacobian")
 
 
 def inverse_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
@@ -102,8 +100,7 @@ def inverse_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
     """
     mech, q = _check(mech, q)
     rtol = as_tolerance(rtol, "rtol")
-    Jc = constraints.jacobian(mech, q)
-    A = np.vstack([Jc, mech.task_map.jacobian(q, update=False)])
+    A = Configuration.compute(mech, q).closure_and_task_jacobian
     smin, smax = _smin(A)
     if smin <= rtol * max(smax, 1.0):
         raise SingularityError("inverse", smin, "the task frozen, the joints can still move")
@@ -151,8 +148,7 @@ def inverse_velocities(mech: Mechanism, q, yd) -> np.ndarray:
     """All joint rates ``v`` for task rates ``yd`` (nv,)."""
     mech, q = _check(mech, q)
     yd = as_vector(yd, mech.n_task, "yd")
-    Jc = constraints.jacobian(mech, q)
-    A = np.vstack([Jc, mech.task_map.jacobian(q, update=False)])
+    A = Configuration.compute(mech, q).closure_and_task_jacobian
     return finite_result(least_squares(A, np.concatenate([np.zeros(mech.n_constraints), yd])), "joint velocities")
 
 
@@ -164,8 +160,7 @@ def inverse_accelerations(mech: Mechanism, q, v, ydd) -> np.ndarray:
     task = mech.task_map
     gamma_c = constraints.drift(mech, q, v)
     gamma_t = task.bias(q, v)
-    Jc = constraints.jacobian(mech, q)
-    A = np.vstack([Jc, task.jacobian(q, update=False)])
+    A = Configuration.compute(mech, q).closure_and_task_jacobian
     rhs = np.concatenate([-gamma_c, ydd - gamma_t])
     return finite_result(least_squares(A, rhs), "joint accelerations")
 
@@ -196,13 +191,12 @@ def diagnose(mech: Mechanism, q, *, rtol: float = 1e-7) -> Diagnostics:
     """Rank, mobility and singularity classification at ``q`` (which should be assembled)."""
     mech, q = _check(mech, q)
     rtol = as_tolerance(rtol, "rtol")
-    Jc = constraints.jacobian(mech, q)
-    Jt = mech.task_map.jacobian(q, update=False)
-    finite_result(Jc, "constraint Jacobian")
+    c = Configuration.compute(mech, q)
+    Jc = finite_result(c.constraint_jacobian, "constraint Jacobian")
     s = np.linalg.svd(Jc, compute_uv=False)
     rank = int(np.sum(s > rtol * max(s[0], 1.0))) if len(s) else 0
     sd, sdmax = _smin(Jc[:, mech.passive_v])
-    si, simax = _smin(np.vstack([Jc, Jt]))
+    si, simax = _smin(c.closure_and_task_jacobian)
     direct = sd <= rtol * max(sdmax, 1.0)
     inverse = si <= rtol * max(simax, 1.0)
     return Diagnostics(rank, mech.n_constraints - rank, mech.nv - rank, sd, si, singularity_class(inverse, direct))

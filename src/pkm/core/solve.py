@@ -31,6 +31,7 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core import constraints
+from pkm.core.configuration import Configuration
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.newton import gauss_newton
 from pkm.errors import BranchError, ConvergenceError, InvalidInputError
@@ -196,9 +197,8 @@ def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol
 
     def make_fun(y_goal):
         def fun(qq):
-            r, Jc = constraints.residual_and_jacobian(mech, qq)
-            e = -task.error(y_goal, task.value(qq, update=False))
-            return np.concatenate([r, e]), np.vstack([Jc, task.jacobian(qq, update=False)])
+            c = Configuration.compute(mech, qq)
+            return np.concatenate([c.residual, -task.error(y_goal, c.task_value)]), c.closure_and_task_jacobian
         return fun
 
     def solve_at(q, s, t):
@@ -237,10 +237,9 @@ def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_i
     S[np.arange(len(pins)), pins] = 1.0
 
     def fun(qq):
-        r, Jc = constraints.residual_and_jacobian(mech, qq)
-        e = -task.error(y_ref, task.value(qq, update=False))
-        return (np.concatenate([r, e, qq[pin_q] - values]),
-                np.vstack([Jc, task.jacobian(qq, update=False), S]))
+        c = Configuration.compute(mech, qq)
+        return (np.concatenate([c.residual, -task.error(y_ref, c.task_value), qq[pin_q] - values]),
+                np.vstack([c.closure_and_task_jacobian, S]))
 
     # over-determined when a pinned magnitude is not the mirrored leg's: Gauss-Newton lands close
     q, _, _ = _newton(mech, fun, q, None, tol, max_iter, 0.5)

@@ -63,10 +63,13 @@ class TaskMap:
         self.names = (("x", "y", "z", "wx", "wy", "wz") if self.pose else self._comp) + self.spec.joints
 
     # values ---------------------------------------------------------------
-    def value(self, q: np.ndarray, *, update: bool = True) -> np.ndarray:
-        m, d = self.mech.model, self.mech.data
-        if update:
-            pin.framesForwardKinematics(m, d, q)
+    def value(self, q: np.ndarray) -> np.ndarray:
+        """The task coordinates at ``q``."""
+        pin.framesForwardKinematics(self.mech.model, self.mech.data, q)
+        return self.value_from(self.mech.data, q)
+
+    def value_from(self, d: pin.Data, q: np.ndarray) -> np.ndarray:
+        """The task coordinates from the frame placements already in ``d`` (see :class:`pkm.core.Configuration`)."""
         M = d.oMf[self.mech.ee_frame]
         if self.pose:
             head = np.concatenate([M.translation, pin.Quaternion(M.rotation).coeffs()])
@@ -140,12 +143,15 @@ class TaskMap:
         return self.retract(y0, s * self.error(y1, y0))
 
     # derivatives ------------------------------------------------------------
-    def jacobian(self, q: np.ndarray, *, update: bool = True) -> np.ndarray:
-        """``d(task)/dq`` on the tangent space (size x nv). ``update=False`` needs joint Jacobians computed."""
-        m, d = self.mech.model, self.mech.data
-        if update:
-            pin.computeJointJacobians(m, d, q)
-            pin.updateFramePlacements(m, d)
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """``d(task)/dq`` on the tangent space (size x nv)."""
+        pin.computeJointJacobians(self.mech.model, self.mech.data, q)
+        pin.updateFramePlacements(self.mech.model, self.mech.data)
+        return self.jacobian_from(self.mech.data)
+
+    def jacobian_from(self, d: pin.Data) -> np.ndarray:
+        """``d(task)/dq`` from the joint Jacobians and frame placements already in ``d``."""
+        m = self.mech.model
         J6 = pin.getFrameJacobian(m, d, self.mech.ee_frame, pin.LOCAL_WORLD_ALIGNED)
         rows = [J6] if self.pose else []
         if not self.pose:
