@@ -142,3 +142,78 @@ def test_a_bad_rank_tolerance_is_refused(rtol, built):
     for fn in (pkm.passive_map, pkm.inverse_jacobian, pkm.diagnose):
         with pytest.raises(InvalidInputError):
             fn(mech, mech.q_reference, rtol=rtol)
+
+
+# ---------------------------------------------------------------------- idle motions
+def _fivebar_with_spinning_rod():
+    """The toy five-bar with distal link 1 free to spin about its own axis: the spin moves neither the closure
+    point nor the tip, an idle motion, as a rod between two ball joints. Returns it and the plain five-bar."""
+    import dataclasses
+
+    from pkm.core import Mechanism
+    from tests import fivebar
+
+    p = fivebar.Params()
+    spec = fivebar.closure_spec(p)
+    spec = dataclasses.replace(spec, reference={**spec.reference, "spin_1": (0.0,)})
+    return Mechanism.from_strings(fivebar.urdf_xml(p, spinning_rod=True), spec), fivebar.build(p)
+
+
+def test_an_idle_rod_spin_is_reported_and_is_not_a_singularity():
+    """The spinning rod gives one idle motion (spin_1): diagnose says regular with idle_motions 1; the passive map,
+    forward and inverse Jacobians, velocities and accelerations exist and equal those of the five-bar without the
+    spin (1e-12), with no spin rate or acceleration."""
+    spin, plain = _fivebar_with_spinning_rod()
+    rng = np.random.default_rng(7)
+    for _ in range(5):
+        y = plain.task_map.value(plain.q_reference) + 0.03 * rng.uniform(-1, 1, 2)
+        q0 = plain.q_from_dict(fivebar_ik(plain.params, y))
+        q1 = spin.q_from_dict({**fivebar_ik(plain.params, y), "spin_1": [float(rng.uniform(-3, 3))]})
+        d = pkm.diagnose(spin, q1)
+        assert (d.classification, d.idle_motions, d.idle_joints, d.near) == ("regular", 1, ("spin_1",), ())
+        assert d.mobility == pkm.diagnose(plain, q0).mobility + 1
+        np.testing.assert_allclose(pkm.forward_jacobian(spin, q1), pkm.forward_jacobian(plain, q0), rtol=0, atol=1e-12)
+        np.testing.assert_allclose(pkm.inverse_jacobian(spin, q1), pkm.inverse_jacobian(plain, q0), rtol=0, atol=1e-11)
+        qd, qdd = rng.uniform(-1, 1, 2), rng.uniform(-1, 1, 2)
+        v1, v0 = pkm.velocities(spin, q1, qd), pkm.velocities(plain, q0, qd)
+        s = spin.joints["spin_1"].idx_v
+        assert v1[s] == 0.0
+        np.testing.assert_allclose(np.delete(v1, s), v0, rtol=0, atol=1e-12)
+        a1, a0 = pkm.accelerations(spin, q1, v1, qdd), pkm.accelerations(plain, q0, v0, qdd)
+        assert abs(a1[s]) < 1e-12
+        np.testing.assert_allclose(np.delete(a1, s), a0, rtol=0, atol=1e-11)
+        yd = pkm.task_velocity(plain, q0, v0)
+        np.testing.assert_allclose(pkm.inverse_velocities(spin, q1, yd), v1, rtol=0, atol=1e-11)
+
+
+def test_rank_decisions_are_relative_to_the_largest_singular_value():
+    """Scaling the whole five-bar by 1e-4 (a 20 um mechanism) leaves its distances to singularity unchanged
+    (the old absolute floor max(smax, 1) made every small mechanism singular)."""
+    from tests import fivebar
+
+    big = fivebar.build()
+    small = fivebar.build(fivebar.Params(d=0.2e-4, l1=0.25e-4, l2=0.3e-4))
+    q_big = big.q_reference
+    d_big = pkm.diagnose(big, q_big)
+    q_small = small.q_from_dict(fivebar_ik(small.params, 1e-4 * big.task_map.value(q_big)))
+    d_small = pkm.diagnose(small, q_small)
+    assert d_small.classification == d_big.classification == "regular"
+    assert math.isclose(d_small.direct_distance, d_big.direct_distance, rel_tol=1e-9)
+    assert math.isclose(d_small.inverse_distance, d_big.inverse_distance, rel_tol=1e-9)
+    pkm.passive_map(small, q_small)
+    pkm.inverse_jacobian(small, q_small)
+
+
+def test_diagnose_grades_the_approach_to_a_direct_singularity(built):
+    """Along the five-bar's approach to collinear distal links, the direct distance falls linearly; below 1e-3 it
+    is reported as near; the weakest direction tends to the tip moving across the links (along y)."""
+    mech = built("fivebar")
+    dists = []
+    for eps in (1e-1, 1e-2, 1e-3, 1e-4):
+        d = pkm.diagnose(mech, _fivebar_at(mech, (0.0, 0.15 + eps), "elbows_out"))
+        dists.append(d.direct_distance)
+        assert d.classification == "regular" and d.near == (("direct",) if d.direct_distance < 1e-3 else ())
+        if eps <= 1e-3:
+            assert abs(abs(d.direct_direction[1]) - 1.0) < 1e-3
+    ratios = np.array(dists[:-1]) / np.array(dists[1:])
+    assert np.all(ratios > 5) and np.all(ratios < 20)

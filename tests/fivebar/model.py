@@ -11,7 +11,9 @@ from tests.fivebar.kinematics import inverse_kinematics, reference_pose
 from tests.fivebar.params import BRANCHES, NAME, FiveBarParams
 
 
-def urdf_xml(p: FiveBarParams) -> str:
+def urdf_xml(p: FiveBarParams, *, spinning_rod: bool = False) -> str:
+    """The tree; ``spinning_rod``: distal link 1 may also spin about its own axis (joint ``spin_1`` after
+    ``elbow_1``), an idle motion like a rod's between two ball joints (for the tests of idle motions)."""
     b = UrdfBuilder(NAME)
     b.link("base")
     for i, x in enumerate((-p.d / 2.0, p.d / 2.0)):
@@ -19,7 +21,12 @@ def urdf_xml(p: FiveBarParams) -> str:
         b.link(f"proximal_{n}", p.m_link, (p.l1 / 2.0, 0.0, 0.0), rod_inertia(p.m_link, p.l1, 0))
         b.joint(f"motor_{n}", "revolute", "base", f"proximal_{n}", (x, 0.0, 0.0))
         b.link(f"distal_{n}", p.m_link, (p.l2 / 2.0, 0.0, 0.0), rod_inertia(p.m_link, p.l2, 0))
-        b.joint(f"elbow_{n}", "revolute", f"proximal_{n}", f"distal_{n}", (p.l1, 0.0, 0.0))
+        if spinning_rod and n == 1:
+            b.link("hub_1")
+            b.joint("elbow_1", "revolute", "proximal_1", "hub_1", (p.l1, 0.0, 0.0))
+            b.joint("spin_1", "revolute", "hub_1", "distal_1", axis=(1.0, 0.0, 0.0))
+        else:
+            b.joint(f"elbow_{n}", "revolute", f"proximal_{n}", f"distal_{n}", (p.l1, 0.0, 0.0))
         b.frame(f"tip_{n}", f"distal_{n}", (p.l2, 0.0, 0.0))
     return b.to_xml()
 

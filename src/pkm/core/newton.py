@@ -12,24 +12,16 @@ from collections.abc import Callable
 
 import numpy as np
 
-from pkm.validation import finite_result
-
 Fun = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 
 
-def least_squares(A: np.ndarray, b: np.ndarray, *, strict: bool = True) -> np.ndarray:
-    """The least-squares solution of ``A x = b`` (``b`` a vector or columns): LU when ``A`` is square and
-    regular, SVD (rank-revealing, minimum norm) otherwise.
-
-    Where ``A`` or ``b`` is not finite, or LAPACK fails (entries overflowing), ``strict`` raises
-    :class:`~pkm.errors.NonFiniteError` (an analysis: its caller must know); otherwise the result is
-    zeros, no step (Newton's method, which then backtracks or stops).
-    """
+def least_squares(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Newton's step: the least-squares solution of ``A x = b``, by LU when ``A`` is square and regular, SVD
+    (rank-revealing, minimum norm) otherwise; zeros (no step: Newton's method then backtracks or stops) where
+    ``A`` or ``b`` is not finite or LAPACK fails (entries overflowing). The analyses solve by the SVD of
+    :mod:`pkm.core.differential`, which separates idle motions and raises at singularities."""
     if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
-        if strict:
-            finite_result(A, "matrix")
-            finite_result(b, "right-hand side")
-        return np.zeros(A.shape[1:2] + np.shape(b)[1:])
+        return np.zeros(A.shape[1])
     if A.shape[0] == A.shape[1]:
         try:
             x = np.linalg.solve(A, b)
@@ -39,10 +31,8 @@ def least_squares(A: np.ndarray, b: np.ndarray, *, strict: bool = True) -> np.nd
             pass
     try:
         return np.linalg.lstsq(A, b, rcond=None)[0]
-    except np.linalg.LinAlgError as exc:  # SVD did not converge
-        if strict:
-            finite_result(np.nan, "least-squares solution", f"numpy: {exc}")
-        return np.zeros(A.shape[1:2] + np.shape(b)[1:])
+    except np.linalg.LinAlgError:  # SVD did not converge
+        return np.zeros(A.shape[1])
 
 
 def gauss_newton(fun: Fun, x: np.ndarray, *, tol: float, max_iter: int, max_step: float = math.inf,
@@ -72,7 +62,7 @@ def gauss_newton(fun: Fun, x: np.ndarray, *, tol: float, max_iter: int, max_step
     it = stalled = 0
     while res > tol and it < max_iter and stalled < stall:
         it += 1
-        step = -least_squares(J, r, strict=False)
+        step = -least_squares(J, r)
         nrm = float(np.max(np.abs(step))) if step.size else 0.0
         if nrm > max_step:
             step *= max_step / nrm
