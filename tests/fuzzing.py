@@ -1043,6 +1043,24 @@ def _khalil(g, adv):
     return kp.inverse_dynamics, (q, v, a), kw
 
 
+@entry("pkm.inverse_dynamics")
+def _inverse_dynamics(g, adv):
+    c = ctx()
+    n, m = _mech(g, adv)
+    mm = c.mech[n]
+    q = _q(g, n, adv and g.chance(0.4))
+    v = g.value(np.zeros(mm.nv), adv and g.chance(0.3), 1.0)
+    a = g.value(np.zeros(mm.nv), adv and g.chance(0.3), 1.0)
+    kw: dict = {"method": g.pick(("auto", "khalil", "virtual_work") + (("newton", None) if adv else ()))}
+    if g.chance(0.3):
+        kw["wrench"] = g.value(np.zeros(6), adv, 10.0)
+    if g.chance(0.3):
+        frame = g.pick((mm.model.frames[mm.ee_frame].name, mm.model.frames[len(mm.model.frames) - 1].name)
+                       + (("no_such_frame", 3) if adv else ()))
+        kw["wrenches"] = {frame: g.value(np.zeros(6), adv, 10.0)} if not (adv and g.chance(0.2)) else g.hostile()
+    return ctx().pkm.inverse_dynamics, (m, q, v, a), kw
+
+
 @entry("dynamics.forward_dynamics")
 def _fwd_dyn(g, adv):
     from pkm.core.dynamics import forward_dynamics

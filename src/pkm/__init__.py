@@ -24,7 +24,7 @@ from pkm.mechanisms import module as mechanism_module
 
 #: Names of the generic core, imported on first use (``import pkm`` stays cheap: no Pinocchio until needed).
 _CORE = ("ClosureSpec", "Configuration", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "accelerations", "close_loops",
-         "diagnose", "forward_jacobian", "inverse_accelerations", "inverse_jacobian", "inverse_velocities",
+         "diagnose", "forward_jacobian", "inverse_accelerations", "inverse_dynamics", "inverse_jacobian", "inverse_velocities",
          "passive_map", "solve_ik", "task_acceleration", "task_velocity", "twist_jacobian", "velocities")
 
 if TYPE_CHECKING:  # the static view of the lazy names
@@ -40,6 +40,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         diagnose,
         forward_jacobian,
         inverse_accelerations,
+        inverse_dynamics,
         inverse_jacobian,
         inverse_velocities,
         passive_map,
@@ -96,6 +97,6 @@ def build(name: str, **params) -> Mechanism:
 __all__ = [
     "MECHANISMS", "ClosureSpec", "Configuration", "Diagnostics", "Mechanism", "PkmError", "SolveResult", "TaskMap",
     "accelerations", "build", "close_loops", "diagnose", "errors", "forward_jacobian", "inverse_accelerations",
-    "inverse_jacobian", "inverse_velocities", "load", "mechanism_definition", "mechanism_module", "passive_map", "solve_ik",
+    "inverse_dynamics", "inverse_jacobian", "inverse_velocities", "load", "mechanism_definition", "mechanism_module", "passive_map", "solve_ik",
     "task_acceleration", "task_velocity", "twist_jacobian", "velocities",
 ]

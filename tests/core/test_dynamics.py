@@ -6,10 +6,11 @@ prescribed accelerations) and the energy balance of the bodies along a motion.
 """
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import pkm
-from pkm.core import dynamics
+from pkm.core import Configuration, dynamics
 from pkm.errors import SingularityError, SpecError
 from pkm.mechanisms import delta, prs3
 from tests.fd import richardson
@@ -124,3 +125,91 @@ def test_structures_the_projection_cannot_cut_are_refused(built):
     for name in ("rrr3", "hexapod"):
         with pytest.raises(SpecError):
             dynamics.partition(built(name))
+
+
+# ---------------------------------------------------------------------- one call for every mechanism
+def _actuated_motion(mech, seed: int):
+    """A state function ``t -> (q, v, a)`` along the actuated parabola ``qa0 + t qd + t^2 qdd / 2`` from the
+    reference, by the generic core (loop closure, velocities, accelerations)."""
+    rng = np.random.default_rng(seed)
+    qa0 = mech.actuated_q(mech.q_reference)
+    qd, qdd = 0.2 * rng.uniform(-1, 1, mech.na), 0.2 * rng.uniform(-1, 1, mech.na)
+
+    def state(t):
+        q = pkm.close_loops(mech, qa0 + t * qd + 0.5 * t * t * qdd, mech.q_reference).q
+        v = pkm.velocities(mech, q, qd + t * qdd)
+        return q, v, pkm.accelerations(mech, q, v, qdd)
+    return state
+
+
+@pytest.mark.parametrize("name", pkm.mechanisms.names())
+def test_every_mechanism_gets_efforts_that_balance_the_power(name, built):
+    """pkm.inverse_dynamics on every registered mechanism (the hexapod's mimic joints and the 3-RRR's platform chain
+    included): sum tau_i qd_i = dE/dt to 1e-8 relative along an actuated motion, dE/dt by Richardson differences of
+    the energy of every body."""
+    mech = built(name)
+    state = _actuated_motion(mech, 11)
+
+    def energy(t):
+        q, v, _ = state(t)
+        return sum(dynamics.energy(mech, q, v))
+
+    q, v, a = state(0.0)
+    tau = pkm.inverse_dynamics(mech, q, v, a)
+    power = tau @ v[mech.act_v]
+    dE = richardson(lambda h: np.array([(energy(h) - energy(-h)) / (2 * h)]), 1e-3)[0]
+    assert abs(power - dE) <= 1e-8 * max(np.abs(tau).max() * np.abs(v[mech.act_v]).max(), 1e-12), (power, dE)
+
+
+@pytest.mark.parametrize("name", ["delta", "prs3"])
+def test_khalil_and_virtual_work_agree_where_both_apply_with_wrenches_on_any_frame(name, built):
+    """On the mechanisms Khalil's projection cuts, both methods give the same efforts (1e-10 relative), with an
+    external wrench at the end effector and another on a leg's frame; the wrench's share balances its power."""
+    mech = built(name)
+    q, v, a = _actuated_motion(mech, 12)(0.0)
+    leg_frame = "forearm_1_tip" if name == "delta" else "coupler_1_tip"
+    w_ee, w_leg = np.array([1.0, -2.0, 3.0, 0.1, 0.2, -0.3]), np.array([-0.5, 0.4, 0.3, 0.02, -0.01, 0.05])
+    kw = {"wrench": w_ee, "wrenches": {leg_frame: w_leg}}
+    t_k = pkm.inverse_dynamics(mech, q, v, a, method="khalil", **kw)
+    t_v = pkm.inverse_dynamics(mech, q, v, a, method="virtual_work", **kw)
+    assert np.abs(t_k - t_v).max() <= 1e-10 * np.abs(t_v).max()
+    share = t_k - pkm.inverse_dynamics(mech, q, v, a, method="khalil")
+    c = Configuration.at(mech, q)
+    data = mech.model.createData()
+    pin.computeJointJacobians(mech.model, data, q)
+    pin.updateFramePlacements(mech.model, data)
+    leg_twist = pin.getFrameJacobian(mech.model, data, mech.model.getFrameId(leg_frame), pin.LOCAL_WORLD_ALIGNED) @ v
+    external = w_ee @ (c.ee_jacobian @ v) + w_leg @ leg_twist  # the wrenches' power on the mechanism
+    assert abs(share @ v[mech.act_v] + external) <= 1e-10 * max(abs(external), 1.0)  # the actuators take it back
+
+
+def test_an_idle_motion_changes_no_effort():
+    """The five-bar with a massless-about-its-axis spinning rod needs the efforts of the plain five-bar (1e-12)."""
+    from tests.core.test_differential import _fivebar_with_spinning_rod
+    from tests.fivebar import inverse_kinematics
+
+    spin, plain = _fivebar_with_spinning_rod()
+    y = plain.task_map.value(plain.q_reference) + np.array([0.01, -0.02])
+    q0 = plain.q_from_dict(inverse_kinematics(plain.params, y))
+    q1 = spin.q_from_dict({**inverse_kinematics(plain.params, y), "spin_1": [0.7]})
+    qd, qdd = np.array([0.3, -0.2]), np.array([1.0, 0.5])
+    v0, v1 = pkm.velocities(plain, q0, qd), pkm.velocities(spin, q1, qd)
+    a0, a1 = pkm.accelerations(plain, q0, v0, qdd), pkm.accelerations(spin, q1, v1, qdd)
+    np.testing.assert_allclose(pkm.inverse_dynamics(spin, q1, v1, a1), pkm.inverse_dynamics(plain, q0, v0, a0),
+                               rtol=0, atol=1e-12)
+
+
+def test_bad_methods_frames_and_refused_structures_say_so(built):
+    from pkm.errors import InvalidInputError, UnknownNameError
+
+    mech = built("delta")
+    q, v = mech.q_reference, np.zeros(mech.nv)
+    with pytest.raises(InvalidInputError, match="method"):
+        pkm.inverse_dynamics(mech, q, v, v, method="newton")
+    with pytest.raises(UnknownNameError, match="no_such_frame"):
+        pkm.inverse_dynamics(mech, q, v, v, wrenches={"no_such_frame": np.zeros(6)})
+    with pytest.raises(InvalidInputError):
+        pkm.inverse_dynamics(mech, q, v, v, wrenches={"platform": np.zeros(5)})
+    with pytest.raises(SpecError, match="drives the platform directly"):
+        pkm.inverse_dynamics(built("rrr3"), built("rrr3").q_reference, np.zeros(built("rrr3").nv),
+                             np.zeros(built("rrr3").nv), method="khalil")

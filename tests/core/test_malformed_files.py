@@ -104,8 +104,8 @@ def test_truncated_urdf_is_a_spec_error(delta_urdf, fraction):
 @pytest.mark.parametrize("edit, match", [
     (('<child link="a"/>', '<child link="ghost"/>'), "child link 'ghost' does not exist"),
     (('<parent link="base"/>', '<parent link="nowhere"/>'), "parent link 'nowhere' does not exist"),
-    (('<limit lower="-1" upper="1" effort="1" velocity="1"/>', ""), r"needs <limit"),
-    (('<limit lower="-1" upper="1"', '<limit upper="1"'), r"needs <limit"),
+    (('<limit lower="-1" upper="1" effort="1" velocity="1"/>', ""), r"needs a <limit> element"),
+    (('<limit lower="-1" upper="1"', '<limit upper="1"'), r"states only its upper limit"),
     (('<origin xyz="0.1 0 0"', '<origin xyz="1e308 0 0"'), "absurdly large"),
     (('<origin xyz="0.1 0 0"', '<origin xyz="nan 0 0"'), "not finite"),
     (('rpy="0 0 0"/>\n<axis', 'rpy="0 inf 0"/>\n<axis'), "not finite"),

@@ -37,7 +37,7 @@ def test_good_urdf_loads():
 @pytest.mark.parametrize("text, message", [
     (GOOD[:120], "not well-formed"),
     (GOOD.replace('<child link="a"/>', '<child link="ghost"/>'), "child link 'ghost' does not exist"),
-    (GOOD.replace('<limit lower="-1" upper="1" effort="1" velocity="1"/>', ""), "needs <limit"),
+    (GOOD.replace('<limit lower="-1" upper="1" effort="1" velocity="1"/>', ""), "needs a <limit> element"),
     (GOOD.replace('xyz="0 0 1"', 'xyz="0 0 nan"'), "not finite"),
     (GOOD.replace('xyz="0 0 1"', 'xyz="0 0 0"'), "zero axis"),
     (GOOD.replace('lower="-1"', 'lower="-1e9"'), "absurdly large"),
@@ -75,3 +75,52 @@ def test_external_entity_is_not_read(tmp_path):
     with pytest.raises(SpecError, match=r"DOCTYPE|entity") as info:
         check_urdf(doc)
     assert "TOP-SECRET" not in str(info.value)
+
+
+# ---------------------------------------------------------------------- optional position limits
+def _fivebar_urdf(limit_attrs: str) -> str:
+    """The toy five-bar's URDF with each ``<limit>`` rewritten as ``<limit effort="1000.0" velocity="100.0" ...>``."""
+    import re
+
+    from tests import fivebar
+
+    return re.sub(r'<limit effort="1000.0" velocity="100.0" lower="[^"]*" upper="[^"]*"/>',
+                  f'<limit effort="1000.0" velocity="100.0"{limit_attrs}/>', fivebar.urdf_xml(fivebar.Params()))
+
+
+def test_joints_without_position_limits_load_and_have_none():
+    """``<limit effort velocity/>`` (as onshape-to-robot writes it) loads; the mechanism states no limits and no
+    solver result reports a violation."""
+    import pkm
+    from pkm.core import Mechanism
+    from tests import fivebar
+
+    text = _fivebar_urdf("")
+    assert "lower=" not in text
+    mech = Mechanism.from_strings(text, fivebar.closure_spec(fivebar.Params()))
+    assert mech.limits == {}
+    assert pkm.solve_ik(mech, mech.task_map.value(mech.q_reference) + [0.01, 0.0]).outside_limits == ()
+
+
+def test_one_sided_limits_are_refused_naming_the_joint():
+    with pytest.raises(SpecError, match=r"joint 'motor_1' \(revolute\) states only its lower limit"):
+        check_urdf(_fivebar_urdf(' lower="-1.0"'))
+
+
+def test_stated_limits_are_carried_and_violations_reported_by_the_solvers():
+    """With |motor| <= 0.1 rad stated, the five-bar's reference solution (motors near 2 and 1 rad) is reported
+    outside the limits, joint by joint, by solve_ik and close_loops; pkm does not enforce them."""
+    import pkm
+    from pkm.core import Mechanism
+    from tests import fivebar
+
+    mech = Mechanism.from_strings(_fivebar_urdf(' lower="-0.1" upper="0.1"'), fivebar.closure_spec(fivebar.Params()))
+    assert set(mech.limits.values()) == {(-0.1, 0.1)} and set(mech.limits) == {"motor_1", "motor_2", "elbow_1",
+                                                                                 "elbow_2"}
+    ik = pkm.solve_ik(mech, mech.task_map.value(mech.q_reference))
+    expected = tuple(n for n in mech.limits if abs(float(np.ravel(mech.q_to_dict(ik.q)[n])[0])) > 0.1)
+    assert expected and ik.outside_limits == expected
+    assert pkm.close_loops(mech, mech.actuated_q(ik.q)).outside_limits == expected
+    inside = mech.q_reference.copy()
+    inside[[mech.joints[n].idx_q for n in mech.limits]] = 0.05
+    assert mech.outside_limits(inside) == ()

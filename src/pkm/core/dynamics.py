@@ -37,15 +37,18 @@ core's passive map ``G = dq/dq_a``), :func:`forward_dynamics` (Pinocchio's
 
 from __future__ import annotations
 
+import weakref
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
 
 from pkm.core import constraints
+from pkm.core.configuration import Configuration
 from pkm.core.differential import passive_map
 from pkm.core.mechanism import Mechanism, check_mechanism
-from pkm.errors import PkmError, SingularityError, SpecError
+from pkm.errors import InvalidInputError, PkmError, SingularityError, SpecError, UnknownNameError
 from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
 
 RTOL = 1e-9
@@ -177,9 +180,11 @@ class KhalilProjection:
             SingularityError: ``"inverse"`` where a leg's Jacobian loses rank (leg named in the
                 message), ``"direct"`` where ``M`` does.
         """
+        return self._projection(constraints.jacobian(self.mech, self.mech.check_q(q)))
+
+    def _projection(self, Jc: np.ndarray) -> Projection:
         mech, part = self.mech, self.partition
-        q = mech.check_q(q)
-        Jc = finite_result(constraints.jacobian(mech, q), "constraint Jacobian")
+        Jc = finite_result(Jc, "constraint Jacobian")
         na, n_p = mech.na, len(part.platform_v)
         A = np.zeros((na, n_p))
         K, Ls, sig = [], [], []
@@ -189,7 +194,7 @@ class KhalilProjection:
             U, s, Vt = np.linalg.svd(Jl)
             r = len(leg.v)
             sig.append(float(s[r - 1]) if len(s) >= r else 0.0)
-            if len(s) < r or s[r - 1] <= self.rtol * max(float(s[0]), 1.0):
+            if len(s) < r or s[r - 1] <= self.rtol * float(s[0]):
                 raise SingularityError("inverse", sig[-1], f"leg of closures {', '.join(leg.closures)} loses rank: "
                                                            "its joint rates are not fixed by the platform motion")
             L = Vt.T @ ((U[:, :r].T @ P) / s[:r, None])
@@ -199,14 +204,14 @@ class KhalilProjection:
         M = np.vstack([A, *K])
         sv = np.linalg.svd(M, compute_uv=False)
         smin = float(sv[n_p - 1]) if len(sv) >= n_p else 0.0
-        if smin <= self.rtol * max(float(sv[0]), 1.0):
+        if smin <= self.rtol * float(sv[0]):
             raise SingularityError("direct", smin, "the actuated legs do not fix the platform motion")
         rhs = np.zeros((M.shape[0], na))
         rhs[:na] = np.eye(na)
         Jk = np.linalg.lstsq(M, rhs, rcond=None)[0]
         return Projection(Jk, tuple(Ls), tuple(sig), smin)
 
-    def inverse_dynamics(self, q, v, a, wrench=None) -> np.ndarray:
+    def inverse_dynamics(self, q, v, a, wrench=None, *, wrenches=None) -> np.ndarray:
         """Actuator efforts (N or N m, in ``mech.actuated`` order) for a consistent state.
 
         Args:
@@ -215,16 +220,15 @@ class KhalilProjection:
             a: Joint accelerations satisfying the closures (nv,).
             wrench: Optional external wrench on the platform at the end-effector frame,
                 world-aligned ``(f [N], m [N m])``, shape (6,).
+            wrenches: Optional external wrenches on any frames, ``{frame name: (f, m)}``, each
+                world-aligned at the frame's origin.
         """
         mech, part = self.mech, self.partition
         q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
-        proj = self.projection(q)  # leaves the frame Jacobians of q in mech.data
-        Pe = None if wrench is None else pin.getFrameJacobian(
-            mech.model, mech.data, mech.ee_frame, pin.LOCAL_WORLD_ALIGNED)[:, part.platform_v]
-        h = pin.rnea(mech.model, mech.data, q, v, a)
+        c = Configuration.compute(mech, q)
+        proj = self._projection(c.constraint_jacobian)
+        h = _external(mech, c, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches)
         f = h[part.platform_v].copy()
-        if Pe is not None:
-            f -= Pe.T @ as_vector(wrench, 6, "wrench")
         tau = np.zeros(mech.na)
         for leg, L in zip(part.legs, proj.L):
             hk = h[leg.v]
@@ -235,20 +239,89 @@ class KhalilProjection:
                                                                       "(overflow); check the units")
 
 
+def _external(mech: Mechanism, c: Configuration, h: np.ndarray, wrench, wrenches) -> np.ndarray:
+    """``h - sum_f J_f^T w_f``: the tree's joint forces less those of the external wrenches (world-aligned at
+    each frame's origin, force then moment); ``wrench`` acts at the end-effector frame."""
+    if wrenches is not None and not (isinstance(wrenches, Mapping) and all(isinstance(k, str) for k in wrenches)):
+        raise InvalidInputError("wrenches", "expected {frame name: (fx, fy, fz, mx, my, mz)}", wrenches)
+    loads = dict(wrenches or {})
+    out = h.copy()
+    if wrench is not None:
+        out -= c.ee_jacobian.T @ as_vector(wrench, 6, "wrench")
+    m = mech.model
+    if loads:
+        pin.computeJointJacobians(m, mech.data, c.q)
+        pin.updateFramePlacements(m, mech.data)
+    for name, w in loads.items():
+        if not m.existFrame(name):
+            raise UnknownNameError("frame", name, [f.name for f in m.frames], mech.spec.mechanism)
+        J = pin.getFrameJacobian(m, mech.data, m.getFrameId(name), pin.LOCAL_WORLD_ALIGNED)
+        out -= J.T @ as_vector(w, 6, f"wrenches[{name!r}]")
+    return out
+
+
+_KHALIL: weakref.WeakKeyDictionary[Mechanism, KhalilProjection | SpecError] = weakref.WeakKeyDictionary()
+
+
+def _khalil(mech: Mechanism) -> KhalilProjection | SpecError:
+    """The mechanism's Khalil projection, or the SpecError saying why its structure does not allow one (cached)."""
+    if mech not in _KHALIL:
+        try:
+            _KHALIL[mech] = KhalilProjection(mech)
+        except SpecError as exc:
+            _KHALIL[mech] = exc
+    return _KHALIL[mech]
+
+
 def _has_mimic(model: pin.Model) -> bool:
     return any(jm.shortname() == "JointModelMimic" for jm in model.joints)
 
 
-def inverse_dynamics(mech: Mechanism, q, v, a, wrench=None) -> np.ndarray:
-    """Actuator efforts by Khalil's projection (see :class:`KhalilProjection`)."""
-    return KhalilProjection(mech).inverse_dynamics(q, v, a, wrench)
+METHODS = ("auto", "khalil", "virtual_work")
 
 
-def virtual_work_dynamics(mech: Mechanism, q, v, a) -> np.ndarray:
-    """Actuator efforts as ``G^T rnea(q, v, a)``, ``G = dq/dq_a``: the whole-tree virtual-work route."""
+def inverse_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=None, method: str = "auto") -> np.ndarray:
+    """Actuator efforts (N or N m, in ``mech.actuated`` order) of any mechanism at a consistent state.
+
+    Args:
+        mech: The mechanism.
+        q, v, a: Assembled configuration, joint velocities and accelerations satisfying the closures
+            (:func:`pkm.velocities`, :func:`pkm.accelerations` or their inverse-kinematics twins).
+        wrench: External wrench at the end-effector frame, world-aligned ``(f [N], m [N m])``.
+        wrenches: External wrenches on any frames, ``{frame name: (f, m)}``, world-aligned at each origin.
+        method: ``"khalil"`` (:class:`KhalilProjection`: legs cut from the platform; refuses the
+            structures it cannot cut, such as actuators on the platform chain or mimic joints),
+            ``"virtual_work"`` (:func:`virtual_work_dynamics`: ``G^T`` of the tree's forces, any
+            structure: mimic couplings, idle motions, redundant planar closures), or ``"auto"``: Khalil's
+            where the structure allows it, virtual work otherwise. Both give the same efforts to 1e-10
+            where both apply (tests).
+
+    Raises:
+        SingularityError: at a direct singularity (and, for ``"khalil"``, where a leg loses rank).
+        SpecError: ``"khalil"`` on a structure it cannot cut (says why).
+    """
+    mech = check_mechanism(mech)
+    if method not in METHODS:
+        raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
+    if method == "virtual_work":
+        return virtual_work_dynamics(mech, q, v, a, wrench, wrenches=wrenches)
+    k = _khalil(mech)
+    if isinstance(k, SpecError):
+        if method == "khalil":
+            raise k
+        return virtual_work_dynamics(mech, q, v, a, wrench, wrenches=wrenches)
+    return k.inverse_dynamics(q, v, a, wrench, wrenches=wrenches)
+
+
+def virtual_work_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=None) -> np.ndarray:
+    """Actuator efforts as ``G^T (rnea(q, v, a) - sum J_f^T w_f)``, ``G = dq/dq_a`` without idle motions: the
+    whole-tree virtual-work route (external wrenches as in :func:`inverse_dynamics`)."""
     mech = check_mechanism(mech)
     q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
-    return finite_result(passive_map(mech, q).T @ pin.rnea(mech.model, mech.data, q, v, a), "actuator efforts")
+    G = passive_map(mech, q)
+    h = pin.rnea(mech.model, mech.data, q, v, a)
+    h = _external(mech, Configuration.compute(mech, q), h, wrench, wrenches)
+    return finite_result(G.T @ h, "actuator efforts")
 
 
 def forward_dynamics(mech: Mechanism, q, v, tau_actuated, *, mu: float = 0.0) -> np.ndarray:
@@ -297,5 +370,5 @@ def energy(mech: Mechanism, q, v) -> tuple[float, float]:
     return float(kinetic), float(potential)
 
 
-__all__ = ["KhalilProjection", "Leg", "Partition", "Projection", "energy", "forward_dynamics", "inverse_dynamics",
+__all__ = ["METHODS", "KhalilProjection", "Leg", "Partition", "Projection", "energy", "forward_dynamics", "inverse_dynamics",
            "partition", "virtual_work_dynamics"]

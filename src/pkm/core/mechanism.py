@@ -23,7 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core.spec import ClosureSpec, as_path, read_text_file
-from pkm.core.urdf import load_model
+from pkm.core.urdf import load_model, position_limits
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
 from pkm.validation import as_array, as_vector, wrap_angle
 
@@ -82,6 +82,8 @@ class Mechanism:
         self.params = params
         self.urdf = urdf
         self.source = source
+        #: ``{joint: (lower, upper)}`` position limits stated by the URDF (none when built from a model).
+        self.limits: dict[str, tuple[float, float]] = position_limits(urdf, source) if urdf is not None else {}
         self.joints: dict[str, JointInfo] = {}
         for jid in range(1, model.njoints):
             jm = model.joints[jid]
@@ -139,6 +141,13 @@ class Mechanism:
             self.q_reference = self.check_q(self.q_from_dict(spec.reference, base=pin.neutral(model)), "[reference]")
         except InvalidInputError as exc:
             raise SpecError(source, f"{exc}; fix the [reference] table of the closure spec") from None
+
+    def outside_limits(self, q, *, tol: float = 1e-9) -> tuple[str, ...]:
+        """The joints whose coordinate in ``q`` lies outside their stated position limits by more than ``tol``
+        (m or rad), in model order. pkm's solvers do not enforce limits; their results report these."""
+        q = np.asarray(q, dtype=float)
+        return tuple(n for n, (lo, hi) in self.limits.items()
+                     if n in self.joints and not lo - tol <= q[self.joints[n].idx_q] <= hi + tol)
 
     # ------------------------------------------------------------------ per-thread data, pickling
     @property

@@ -53,6 +53,8 @@ class SolveResult:
         iterations: Newton iterations, all continuation steps included.
         steps: Continuation steps taken (1 when solved directly).
         branch_signs: Signs of the default-branch joints at ``q`` (empty without branches).
+        outside_limits: The joints whose coordinate at ``q`` lies outside the position limits their URDF
+            states (:meth:`pkm.core.Mechanism.outside_limits`); pkm's solvers do not enforce limits.
     """
 
     q: np.ndarray
@@ -61,6 +63,7 @@ class SolveResult:
     iterations: int
     steps: int = 1
     branch_signs: dict[str, int] = field(default_factory=dict)
+    outside_limits: tuple[str, ...] = ()
 
 
 def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray,
@@ -84,6 +87,11 @@ def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.nd
     return gauss_newton(restricted, q, tol=tol, max_iter=max_iter, max_step=max_dq, retract=retract)
 
 
+def _result(mech: Mechanism, q: np.ndarray, converged: bool, residual: float, iterations: int,
+            steps: int) -> SolveResult:
+    return SolveResult(q, converged, residual, iterations, steps, _signs(mech, q), mech.outside_limits(q))
+
+
 def _follow(mech: Mechanism, what: str, solve_at, q: np.ndarray, n_steps: int, tol: float,
             raise_on_failure: bool) -> SolveResult:
     """Continuation from ``s = 0`` (the seed ``q``) to ``s = 1`` (the target).
@@ -98,7 +106,7 @@ def _follow(mech: Mechanism, what: str, solve_at, q: np.ndarray, n_steps: int, t
     while True:
         if total >= MAX_TOTAL_ITER:
             q_new, res, it = solve_at(q, 1.0, tol)
-            result = SolveResult(q_new, False, res, total + it, steps, _signs(mech, q_new))
+            result = _result(mech, q_new, False, res, total + it, steps)
             if raise_on_failure:
                 err = _failure(mech, what, result, tol)
                 raise ConvergenceError(what, err.residual, err.iterations, tol, result,
@@ -113,14 +121,14 @@ def _follow(mech: Mechanism, what: str, solve_at, q: np.ndarray, n_steps: int, t
             q, s, steps = q_new, s_next, steps + 1
             if s >= 1.0:
                 q = mech.wrap(q)
-                return SolveResult(q, True, res, total, steps, _signs(mech, q))
+                return _result(mech, q, True, res, total, steps)
             ds = min(ds * 1.5, 1.0 / n_steps)
         else:
             ds *= 0.5
             if ds < 1e-3 / n_steps:
                 res_path = res
                 q_new, res, it = solve_at(q, 1.0, tol)
-                result = SolveResult(q_new, False, res, total + it, steps, _signs(mech, q_new))
+                result = _result(mech, q_new, False, res, total + it, steps)
                 if raise_on_failure and res <= tol:  # the target closes, but not by following the seed's branch
                     raise ConvergenceError(f"{what} along the path from the seed", res_path, result.iterations,
                                            tol, result,

@@ -24,8 +24,9 @@ raises :class:`~pkm.errors.SpecError` for:
 * links or joints without a name or with a duplicate name, a joint whose parent or child is
   not a link, a link with two parents, a tree with several roots (or none), an unknown joint
   type;
-* a zero axis; a revolute or prismatic joint without ``<limit lower=... upper=...>`` or with
-  ``lower > upper``;
+* a zero axis; a revolute or prismatic joint without ``<limit>`` (URDF requires one), or whose
+  ``<limit>`` states only one of ``lower`` and ``upper``, or ``lower > upper`` (position limits are optional: without them a joint has none;
+  with them :meth:`pkm.core.Mechanism.outside_limits` and every solver result report violations);
 * a number that is not finite or absurd (``|x| > 1e6`` in SI units, taken for a unit error):
   origins, axes, limits, efforts, velocities, masses, inertias, mimic coefficients;
 * a negative mass, an inertia tensor that is not positive semi-definite (beyond round-off);
@@ -205,12 +206,18 @@ def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
             if np.linalg.norm(axis) < 1e-9:
                 raise SpecError(source, f"joint {name!r} has a zero axis")
         if typ in ("revolute", "prismatic"):
-            lim = el.find("limit")
-            if lim is None or lim.get("lower") is None or lim.get("upper") is None:
-                raise SpecError(source, f"joint {name!r} ({typ}) needs <limit lower=... upper=...>")
-            lo, hi = _floats(f"{lim.get('lower')} {lim.get('upper')}", 2, f"joint {name!r} limits", source)
-            if lo > hi:
-                raise SpecError(source, f"joint {name!r}: lower limit {lo} > upper limit {hi}")
+            lim = el.find("limit")  # position limits are optional (onshape-to-robot writes effort and velocity only)
+            if lim is None:
+                raise SpecError(source, f"joint {name!r} ({typ}) needs a <limit> element (URDF requires one; "
+                                        "effort and velocity suffice, lower and upper are optional)")
+            stated = [] if lim is None else [k for k in ("lower", "upper") if lim.get(k) is not None]
+            if len(stated) == 1:
+                raise SpecError(source, f"joint {name!r} ({typ}) states only its {stated[0]} limit; give both "
+                                        "lower and upper, or neither (no position limits)")
+            if stated:
+                lo, hi = _floats(f"{lim.get('lower')} {lim.get('upper')}", 2, f"joint {name!r} limits", source)
+                if lo > hi:
+                    raise SpecError(source, f"joint {name!r}: lower limit {lo} > upper limit {hi}")
         lim = el.find("limit")
         if lim is not None:
             for key in ("effort", "velocity"):
@@ -252,6 +259,19 @@ def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
                 raise SpecError(source, f"link {lname!r}: inertia tensor has a negative principal moment "
                                         f"{ev[0]:.6g} kg m^2 (not physical); check ixx..izz")
     return root
+
+
+def position_limits(text: str | bytes, source: str = "<string>") -> dict[str, tuple[float, float]]:
+    """``{joint: (lower, upper)}`` for the revolute and prismatic joints whose ``<limit>`` states both (checked
+    URDF text; the others have none: Pinocchio's parser gives them ``[0, 0]``, which pkm does not read)."""
+    out: dict[str, tuple[float, float]] = {}
+    for el in check_urdf(text, source).findall("joint"):
+        lim = el.find("limit")
+        if el.get("type") in ("revolute", "prismatic") and lim is not None and lim.get("lower") is not None \
+                and lim.get("upper") is not None:
+            lo, hi = _floats(f"{lim.get('lower')} {lim.get('upper')}", 2, "limits", source)
+            out[str(el.get("name"))] = (lo, hi)
+    return out
 
 
 def load_model(text: str, source: str = "<string>") -> pin.Model:
