@@ -23,9 +23,10 @@ from pkm.mechanisms import definition as mechanism_definition
 from pkm.mechanisms import module as mechanism_module
 
 #: Names of the generic core, imported on first use (``import pkm`` stays cheap: no Pinocchio until needed).
-_CORE = ("ClosureSpec", "Configuration", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "accelerations", "close_loops",
-         "diagnose", "forward_jacobian", "inverse_accelerations", "inverse_dynamics", "inverse_jacobian", "inverse_velocities",
-         "passive_map", "solve_ik", "task_acceleration", "task_velocity", "twist_jacobian", "velocities")
+_CORE = ("ClosureSpec", "Configuration", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "accelerations",
+         "assemble", "close_loops", "diagnose", "forward_jacobian", "inverse_accelerations", "inverse_dynamics",
+         "inverse_jacobian", "inverse_velocities", "passive_map", "solve_ik", "task_acceleration", "task_velocity",
+         "twist_jacobian", "velocities")
 
 if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core import (
@@ -36,6 +37,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         SolveResult,
         TaskMap,
         accelerations,
+        assemble,
         close_loops,
         diagnose,
         forward_jacobian,
@@ -96,7 +98,7 @@ def build(name: str, **params) -> Mechanism:
 
 __all__ = [
     "MECHANISMS", "ClosureSpec", "Configuration", "Diagnostics", "Mechanism", "PkmError", "SolveResult", "TaskMap",
-    "accelerations", "build", "close_loops", "diagnose", "errors", "forward_jacobian", "inverse_accelerations",
+    "accelerations", "assemble", "build", "close_loops", "diagnose", "errors", "forward_jacobian", "inverse_accelerations",
     "inverse_dynamics", "inverse_jacobian", "inverse_velocities", "load", "mechanism_definition", "mechanism_module", "passive_map", "solve_ik",
     "task_acceleration", "task_velocity", "twist_jacobian", "velocities",
 ]

@@ -8,10 +8,17 @@ import numpy as np
 import pytest
 
 import pkm
-from pkm.core import close_loops, diagnose, solve_ik
-from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, SingularityError, UnknownNameError
+from pkm.core import Mechanism, close_loops, constraints, diagnose, solve_ik
+from pkm.errors import (
+    AssemblyError,
+    ConvergenceError,
+    InvalidInputError,
+    SingularityError,
+    SpecError,
+    UnknownNameError,
+)
 from pkm.mechanisms import delta as D
-from pkm.mechanisms import rrr3
+from pkm.mechanisms import names, rrr3
 
 
 @pytest.fixture(scope="module")
@@ -110,3 +117,58 @@ def test_a_path_that_leaves_the_workspace_is_reported_as_such_when_the_target_it
         close_loops(m, qa, seed)
     assert info.value.residual > info.value.tolerance
     assert info.value.result.residual <= info.value.tolerance
+
+
+# ---------------------------------------------------------------------- assembly and the reference
+def _without_reference(mech):
+    import dataclasses
+
+    return dataclasses.replace(mech.spec, reference={})
+
+
+@pytest.mark.parametrize("name", names())
+def test_a_spec_without_reference_is_assembled(name, built):
+    """With no [reference], every registered mechanism is assembled from its neutral configuration (Levenberg-
+    Marquardt with restarts) to 1e-10, and that configuration is accepted as its reference."""
+    mech = built(name)
+    again = Mechanism.from_strings(mech.urdf, _without_reference(mech))
+    assert np.abs(constraints.residual(again, again.q_reference)).max() <= 1e-10
+
+
+def test_assemble_closes_from_far_seeds_and_says_which_closure_stays_open_when_nothing_can():
+    """pkm.assemble closes the Delta from seeds 1 rad away; a five-bar whose motors are 2 m apart (links 1.1 m
+    in all) cannot close: the SpecError names the closure and its gap (about 0.9 m)."""
+    import pinocchio as pin
+
+    import pkm
+    from tests import fivebar
+
+    delta = pkm.load("delta")
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        q0 = pin.integrate(delta.model, delta.q_reference, rng.uniform(-1, 1, delta.nv))
+        res = pkm.assemble(delta, q0)
+        assert res.converged and np.abs(constraints.residual(delta, res.q)).max() <= 1e-10
+    plain = fivebar.build()
+    with pytest.raises(SpecError, match=r"no assembly was found .*closure 'tip' stays open by 0\.[89]"):
+        Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params(d=2.0)), _without_reference(plain))
+
+
+def test_an_open_reference_is_refused_with_the_closure_and_the_gap(built):
+    """A [reference] 8 cm off its closure (the Delta's platform moved down) is refused, naming the open closure."""
+    import dataclasses
+
+    mech = built("delta")
+    ref = dict(mech.spec.reference)
+    ref["platform_z"] = (ref["platform_z"][0] - 0.08,)
+    with pytest.raises(SpecError, match=r"leaves closure 'ball_\d' open by 0\.0[78]"):
+        Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))
+
+
+def test_a_reference_in_degrees_is_refused(built):
+    import dataclasses
+
+    mech = built("delta")
+    ref = {**mech.spec.reference, "motor_1": (45.0,)}
+    with pytest.raises(SpecError, match=r"motor_1 = 45, beyond 2 pi: angles are in rad"):
+        Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))

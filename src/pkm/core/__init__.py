@@ -17,7 +17,7 @@ _EXPORTS = {
                               "task_velocity", "twist_jacobian", "velocities"),
     "pkm.core.dynamics": ("inverse_dynamics",),
     "pkm.core.mechanism": ("Mechanism",),
-    "pkm.core.solve": ("SolveResult", "branch_seed", "close_loops", "solve_ik"),
+    "pkm.core.solve": ("SolveResult", "assemble", "branch_seed", "close_loops", "solve_ik"),
     "pkm.core.spec": ("Branch", "Closure", "ClosureSpec", "TaskSpec"),
     "pkm.core.task": ("TaskMap", "zyx_angles", "zyx_matrix"),
 }
@@ -41,7 +41,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
     )
     from pkm.core.dynamics import inverse_dynamics
     from pkm.core.mechanism import Mechanism
-    from pkm.core.solve import SolveResult, branch_seed, close_loops, solve_ik
+    from pkm.core.solve import SolveResult, assemble, branch_seed, close_loops, solve_ik
     from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
     from pkm.core.task import TaskMap, zyx_angles, zyx_matrix
 
@@ -50,7 +50,7 @@ __getattr__, __dir__ = lazy("pkm.core", globals(), _WHERE)
 
 __all__ = [
     "Branch", "Closure", "ClosureSpec", "Configuration", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "TaskSpec",
-    "accelerations", "branch_seed", "close_loops", "diagnose", "forward_jacobian", "inverse_accelerations",
+    "accelerations", "assemble", "branch_seed", "close_loops", "diagnose", "forward_jacobian", "inverse_accelerations",
     "inverse_dynamics", "inverse_jacobian", "inverse_velocities", "passive_map", "solve_ik", "task_acceleration", "task_velocity",
     "twist_jacobian", "velocities", "zyx_angles", "zyx_matrix",
 ]

@@ -24,8 +24,11 @@ import pinocchio as pin
 
 from pkm.core.spec import ClosureSpec, as_path, read_text_file
 from pkm.core.urdf import load_model, position_limits
-from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
+from pkm.errors import AssemblyError, InvalidInputError, SpecError, SpecNameError, UnknownNameError
 from pkm.validation import as_array, as_vector, wrap_angle
+
+#: A spec's [reference] must close every loop to this (m or rad); one that lacks joints is assembled.
+REFERENCE_TOL = 1e-9
 
 if TYPE_CHECKING:
     from pkm.core.task import TaskMap
@@ -135,12 +138,27 @@ class Mechanism:
         unknown = [n for n in spec.reference if n not in self.joints]
         if unknown:
             raise SpecNameError(source, "joint", unknown[0], list(self.joints), "[reference]")
-        if missing:
-            raise SpecError(source, f"[reference] lacks joints {missing}")
+        degrees = [n for n, v in spec.reference.items() if self.joints[n].revolute and abs(v[0]) > 2.0 * np.pi]
+        if degrees:
+            raise SpecError(source, f"[reference] gives {degrees[0]} = {spec.reference[degrees[0]][0]:g}, beyond "
+                                    "2 pi: angles are in rad (degrees?)")
         try:
             self.q_reference = self.check_q(self.q_from_dict(spec.reference, base=pin.neutral(model)), "[reference]")
         except InvalidInputError as exc:
             raise SpecError(source, f"{exc}; fix the [reference] table of the closure spec") from None
+        gap, closure = self._worst_gap(self.q_reference)
+        if missing:  # a partial (or no) reference: assembled from it, the other joints from the neutral configuration
+            from pkm.core.solve import assemble  # (solve imports this module)
+
+            try:
+                self.q_reference = assemble(self, self.q_reference).q
+            except AssemblyError as exc:
+                raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found from it and "
+                                        f"the neutral configuration ({exc}); give an assembled [reference]") from None
+        elif gap > REFERENCE_TOL:
+            raise SpecError(source, f"the [reference] configuration leaves closure {closure!r} open by {gap:.3g} "
+                                    f"(m or rad; closed means <= {REFERENCE_TOL:g}): fix it, or leave joints out of "
+                                    "[reference] to have pkm assemble the mechanism (pkm.assemble)")
 
     def outside_limits(self, q, *, tol: float = 1e-9) -> tuple[str, ...]:
         """The joints whose coordinate in ``q`` lies outside their stated position limits by more than ``tol``
@@ -148,6 +166,18 @@ class Mechanism:
         q = np.asarray(q, dtype=float)
         return tuple(n for n, (lo, hi) in self.limits.items()
                      if n in self.joints and not lo - tol <= q[self.joints[n].idx_q] <= hi + tol)
+
+    def _worst_gap(self, q: np.ndarray) -> tuple[float, str | None]:
+        """The largest closure gap at ``q`` (norm of its residual block, m or rad) and the closure's name."""
+        d = self.data
+        pin.framesForwardKinematics(self.model, d, q)
+        worst: tuple[float, str | None] = (0.0, None)
+        for c, (fa, fb) in zip(self.spec.closures, self.closure_frames):
+            A, B = d.oMf[fa], d.oMf[fb]
+            g = float(np.linalg.norm(A.translation - B.translation)) if c.type == "point" else \
+                float(np.linalg.norm(pin.log6(A.actInv(B)).vector))
+            worst = max(worst, (g, c.name), key=lambda t: t[0])
+        return worst
 
     # ------------------------------------------------------------------ per-thread data, pickling
     @property

@@ -34,7 +34,7 @@ from pkm.core import constraints
 from pkm.core.configuration import Configuration
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.newton import gauss_newton
-from pkm.errors import BranchError, ConvergenceError, InvalidInputError
+from pkm.errors import AssemblyError, BranchError, ConvergenceError, InvalidInputError
 from pkm.validation import as_count, as_scalar, as_tolerance
 
 DEFAULT_TOL = 1e-12
@@ -255,6 +255,60 @@ def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_i
     if not mech.on_branch(out, branch):
         raise BranchError(branch, dict(b.signs), mech.branch_signs(out, branch))
     return out
+
+
+def assemble(mech: Mechanism, q0=None, *, tol: float = 1e-10, restarts: int = 16, seed: int = 0,
+             max_iter: int = 200) -> SolveResult:
+    """A configuration that closes every loop, from any seed (the mechanism's own files need not be closed).
+
+    Levenberg-Marquardt on the closure residual over every joint, on the configuration manifold, from
+    ``q0`` (default: the reference); when it stalls above ``tol``, restarts from ``q0`` perturbed by
+    normal draws of growing size (0.1, 0.3, 1 rad or m), ``restarts`` times at most (seeded: the same
+    answer every run). The actuated joints move too: this finds *an* assembly, not the one for given
+    actuators (that is :func:`close_loops`).
+
+    Raises:
+        AssemblyError: no start closes: the best residual, and the closure that stays most open and by how much.
+    """
+    mech = check_mechanism(mech)
+    q_seed = mech.q_reference.copy() if q0 is None else mech.check_q(q0, "q0")
+    tol = as_tolerance(tol, "tol")
+    restarts = as_count(restarts, "restarts", low=0, high=10_000)
+    max_iter = as_count(max_iter, "max_iter", low=1, high=100_000)
+    rng = np.random.default_rng(as_count(seed, "seed", low=0, high=2**63 - 1))
+    m = mech.model
+    best: tuple[float, np.ndarray] = (np.inf, q_seed)
+    total = 0
+    for k in range(restarts + 1):
+        scale = (0.0, 0.1, 0.3, 1.0)[min(k, 3)]
+        q = pin.integrate(m, q_seed, scale * rng.standard_normal(m.nv)) if k else q_seed.copy()
+        r, J = constraints.residual_and_jacobian(mech, q)
+        cost, lam = float(r @ r), 1e-3
+        for _ in range(max_iter):
+            total += 1
+            if np.abs(r).max() <= tol:
+                break
+            JtJ, g = J.T @ J, J.T @ r
+            dq = -np.linalg.solve(JtJ + lam * (np.diag(np.diag(JtJ)) + 1e-12 * np.eye(m.nv)), g)
+            q_try = pin.integrate(m, q, dq)
+            r_try, J_try = constraints.residual_and_jacobian(mech, q_try)
+            cost_try = float(r_try @ r_try)
+            if np.isfinite(cost_try) and cost_try < cost:
+                q, r, J, cost, lam = q_try, r_try, J_try, cost_try, max(lam / 3.0, 1e-12)
+            else:
+                lam *= 5.0
+                if lam > 1e12:
+                    break
+        res = float(np.abs(r).max())
+        if res < best[0]:
+            best = (res, q)
+        if res <= tol:
+            q = mech.wrap(q)
+            return _result(mech, q, True, res, total, k + 1)
+    result = _result(mech, best[1], False, best[0], total, restarts + 1)
+    err = _failure(mech, "assembly", result, tol)
+    raise AssemblyError(best[0], "m or rad", f"{restarts + 1} starts of Levenberg-Marquardt; best: closure "
+                                             f"{err.worst_closure!r} stays open by {err.worst_gap:.3g}")
 
 
 def _failure(mech: Mechanism, what: str, result: SolveResult, tol: float) -> ConvergenceError:

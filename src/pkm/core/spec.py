@@ -249,7 +249,9 @@ class ClosureSpec:
             raise SpecError(source, f"default_branch {default_branch!r} is not among the branches {sorted(branches)}")
 
         reference = {}
-        for jname, vals in need(raw, "reference", dict).items():
+        if not isinstance(raw.get("reference", {}), dict):
+            raise SpecError(source, f"key 'reference' must be a table, got {type(raw['reference']).__name__}")
+        for jname, vals in raw.get("reference", {}).items():
             if not isinstance(vals, list) or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
                                                      for v in vals):
                 raise SpecError(source, f"reference.{jname} must be a list of numbers")
