@@ -29,6 +29,8 @@ _CORE = ("ClosureSpec", "Configuration", "Diagnostics", "Mechanism", "SolveResul
          "twist_jacobian", "velocities")
 
 if TYPE_CHECKING:  # the static view of the lazy names
+    from pathlib import Path
+
     from pkm.core import (
         ClosureSpec,
         Configuration,
@@ -59,14 +61,26 @@ __getattr__, __dir__ = lazy("pkm", globals(), dict.fromkeys(_CORE, "pkm.core"))
 __version__ = "0.1.0"
 
 
-def load(name: str) -> Mechanism:
-    """The reference design of mechanism ``name``: from its shipped ``urdf/`` files, or built from its
-    default parameters when it ships none.
+def load(name) -> Mechanism:
+    """A mechanism: a registered name's reference design (from its shipped ``urdf/`` files, or built from
+    its default parameters when it ships none), or a closure spec file of one's own
+    (``path/to/my.closures.toml``, naming its URDF; see :mod:`pkm.core.spec`).
 
     Raises:
-        UnknownNameError: ``name`` is not one of :data:`MECHANISMS` (the registry).
-        SpecError: the shipped files are damaged.
+        UnknownNameError: ``name`` is neither registered (:data:`MECHANISMS`) nor an existing file.
+        SpecError: the files are missing, damaged or do not fit together.
     """
+    import os
+    from pathlib import Path
+
+    if isinstance(name, os.PathLike) or (isinstance(name, str) and name not in MECHANISMS
+                                         and (name.endswith(".toml") or Path(name).is_file())):
+        from pkm.core.mechanism import Mechanism
+
+        return Mechanism.from_files(Path(name))
+    if isinstance(name, str) and name not in MECHANISMS:
+        raise UnknownNameError("mechanism", name, MECHANISMS, "the registry, nor is it a file (give a closure spec's "
+                                                              "path, such as path/to/my.closures.toml)")
     entry = mechanism_definition(name)
     mod = entry.module()
     if entry.reference is None:
@@ -78,6 +92,39 @@ def load(name: str) -> Mechanism:
     mech = Mechanism.from_files(data_dir("urdf") / entry.reference)
     mech.params = params_from_table(mod.Params, mech.spec.parameters)  # the design the files state
     return mech
+
+
+def save(mech: Mechanism, spec_path) -> Path:
+    """Write ``mech`` as a closure spec at ``spec_path`` and its URDF beside it (``<stem>.urdf``, the
+    spec's ``urdf`` key set to it), so that :func:`load` gives the same model back; any joint names.
+
+    Returns:
+        The spec's path.
+
+    Raises:
+        InvalidInputError: not a Mechanism, a bad path, or a mechanism built from a Pinocchio model
+            without URDF text (nothing to write).
+    """
+    import dataclasses as dc
+
+    import numpy as np
+
+    from pkm.core.mechanism import check_mechanism
+    from pkm.core.spec import as_path
+
+    mech = check_mechanism(mech)
+    path = as_path(spec_path, "spec_path")
+    if mech.urdf is None:
+        raise errors.InvalidInputError("mech", "it was built from a Pinocchio model, not URDF text: no URDF to write",
+                                       mech.source)
+    stem = path.name.removesuffix(".toml").removesuffix(".closures")
+    urdf_path = path.with_name(f"{stem}.urdf")
+    reference = {k: tuple(float(x) for x in np.atleast_1d(v)) for k, v in mech.q_to_dict(mech.q_reference).items()}
+    spec = dc.replace(mech.spec, urdf=urdf_path.name, reference=reference)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    urdf_path.write_text(mech.urdf, encoding="utf-8")
+    spec.dump(path)
+    return path
 
 
 def build(name: str, **params) -> Mechanism:
@@ -97,8 +144,33 @@ def build(name: str, **params) -> Mechanism:
 
 
 __all__ = [
-    "MECHANISMS", "ClosureSpec", "Configuration", "Diagnostics", "Mechanism", "PkmError", "SolveResult", "TaskMap",
-    "accelerations", "assemble", "build", "close_loops", "diagnose", "errors", "forward_jacobian", "inverse_accelerations",
-    "inverse_dynamics", "inverse_jacobian", "inverse_velocities", "load", "mechanism_definition", "mechanism_module", "passive_map", "solve_ik",
-    "task_acceleration", "task_velocity", "twist_jacobian", "velocities",
+    "MECHANISMS",
+    "ClosureSpec",
+    "Configuration",
+    "Diagnostics",
+    "Mechanism",
+    "PkmError",
+    "SolveResult",
+    "TaskMap",
+    "accelerations",
+    "assemble",
+    "build",
+    "close_loops",
+    "diagnose",
+    "errors",
+    "forward_jacobian",
+    "inverse_accelerations",
+    "inverse_dynamics",
+    "inverse_jacobian",
+    "inverse_velocities",
+    "load",
+    "mechanism_definition",
+    "mechanism_module",
+    "passive_map",
+    "save",
+    "solve_ik",
+    "task_acceleration",
+    "task_velocity",
+    "twist_jacobian",
+    "velocities",
 ]

@@ -322,6 +322,11 @@ def parse_joints(mech: pkm.Mechanism, items: Sequence[str]) -> np.ndarray:
 
 
 def _mechanism(args) -> pkm.Mechanism:
+    """A shipped mechanism (its design changed by ``--param``) or one's own closure spec file."""
+    if args.mechanism not in pkm.MECHANISMS:
+        if args.param:
+            raise UsageError(f"--param sets the design of a shipped mechanism; {args.mechanism} states its own")
+        return pkm.load(args.mechanism)
     params = parse_params(args.mechanism, args.param or [])
     return pkm.build(args.mechanism, **params) if params else pkm.load(args.mechanism)
 
@@ -406,13 +411,20 @@ def _configuration(mech: pkm.Mechanism, args) -> np.ndarray:
     return mech.q_reference
 
 
+def _has_closed_forms(mech: pkm.Mechanism) -> bool:
+    """Whether ``mech`` is a registered mechanism built from its parameters (so its closed forms apply)."""
+    return mech.name in pkm.MECHANISMS and isinstance(mech.params, pkm.mechanism_module(mech.name).Params)
+
+
 def _solve_ik(mech: pkm.Mechanism, target, branch: str | None) -> pkm.SolveResult:
-    """The generic IK; when it fails, the paper's closed form says which leg cannot reach, if one cannot."""
+    """The generic IK; when it fails, a shipped mechanism's closed form says which leg cannot reach, if one cannot."""
     from pkm.errors import UnreachableError
 
     try:
         return pkm.solve_ik(mech, target, branch=branch)
-    except ConvergenceError as exc:
+    except (ConvergenceError, UnreachableError) as exc:
+        if not _has_closed_forms(mech):
+            raise
         mod = pkm.mechanism_module(mech.name)
         try:
             mod.closed_form_ik(mech.params, mech.task_map.parse(target), branch)
@@ -430,6 +442,8 @@ def _close_loops(mech: pkm.Mechanism, qa) -> pkm.SolveResult:
     try:
         return pkm.close_loops(mech, qa)
     except ConvergenceError as exc:
+        if not _has_closed_forms(mech):
+            raise
         mod = pkm.mechanism_module(mech.name)
         if mod.closed_form_fk is not None:
             try:
@@ -547,7 +561,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_list)
 
     def mech_args(p, pose: str | None, joints: str | None):
-        p.add_argument("mechanism", metavar="MECH", help=f"one of {mechs}")
+        p.add_argument("mechanism", metavar="MECH", help=f"one of {mechs}, or a closure spec file "
+                                                         "(path/to/my.closures.toml, naming its URDF)")
         p.add_argument("--param", metavar="K=V", action="extend", nargs="+", default=[],
                        help="a design parameter (see 'pkm list'); default: the paper's design")
         g = p.add_mutually_exclusive_group() if pose and joints else p

@@ -66,3 +66,14 @@ def test_a_mechanism_without_urdf_text_says_why_it_does_not_pickle(built):
     bare = pkm.Mechanism(mech.model, mech.spec)
     with pytest.raises(InvalidInputError, match="cannot be pickled"):
         pickle.dumps(bare)
+
+
+@pytest.mark.parametrize("name", pkm.mechanisms.names())
+def test_save_and_load_give_the_same_model(name, built, tmp_path):
+    """pkm.save writes a spec and its URDF; pkm.load of that path gives the same model, closures, actuation, task
+    and reference (pkm.core.compare, 1e-12)."""
+    mech = built(name)
+    path = pkm.save(mech, tmp_path / "sub" / f"{name}.closures.toml")
+    assert path.is_file() and (tmp_path / "sub" / f"{name}.urdf").is_file()
+    assert mechanism_differences(pkm.load(path), mech) == []
+    assert mechanism_differences(pkm.load(str(path)), mech) == []

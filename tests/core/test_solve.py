@@ -68,10 +68,23 @@ def test_unassemblable_motor_angles_raise_convergence_error_with_the_open_loop()
     assert "stays open" in str(err)
 
 
-def test_unreachable_target_raises_convergence_error(delta):
-    """A platform position far outside the workspace gives a ConvergenceError, never NaN."""
-    with pytest.raises(ConvergenceError):
+def test_a_target_outside_the_workspace_is_unreachable_not_a_convergence_failure(delta, built):
+    """A platform position far outside the workspace, and the five-bar's tip beyond its reach (0.7 m up, links
+    0.55 m), give UnreachableError naming the closure left open at the least-squares minimum, never NaN nor
+    "did not converge"."""
+    from pkm.errors import UnreachableError
+
+    with pytest.raises(UnreachableError, match=r"out of the workspace.*closure 'ball_\d' stays open"):
         solve_ik(delta, [0.0, 0.0, -2.0], max_iter=10)
+    with pytest.raises(UnreachableError, match=r"closure 'tip' stays open by .* the task misses by 0\.1"):
+        solve_ik(built("fivebar"), [0.0, 0.7])
+
+
+def test_a_reachable_target_the_solver_cannot_reach_is_a_convergence_failure(delta):
+    """One Newton iteration per step to a reachable target: "did not converge", with the residual."""
+    with pytest.raises(ConvergenceError) as exc:
+        solve_ik(delta, [0.05, 0.0, -0.3], max_iter=1, max_step=1.0)
+    assert not isinstance(exc.value, UnknownNameError) and exc.value.residual > 1e-12
 
 
 def test_unknown_branch_and_frame_names_list_the_valid_ones(delta):

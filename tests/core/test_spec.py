@@ -67,3 +67,16 @@ def test_spec_names_are_checked_against_the_urdf(built):
     bad_closure = dataclasses.replace(spec, closures=(dataclasses.replace(spec.closures[0], frame_b="nowhere"),))
     with pytest.raises(UnknownNameError, match="closure 'ball_1'"):
         Mechanism.from_strings(mech.urdf, bad_closure)
+
+
+@pytest.mark.parametrize("odd", ["a/b", "knee 1", 'say "hi"', "dot.ted", "élan", "tab\there", "new\nline", "back\\slash"])
+def test_any_names_round_trip_through_toml(odd, delta_text):
+    """Joint, branch and parameter names TOML cannot write bare are quoted (and escaped): the text parses back to
+    the same spec."""
+    spec = ClosureSpec.from_toml(delta_text)
+    ref = dict(spec.reference)
+    ref[odd] = ref.pop("knee_1")
+    branches = {odd: dataclasses.replace(next(iter(spec.branches.values())), name=odd, signs={odd: 1})}
+    odd_spec = dataclasses.replace(spec, reference=ref, branches=branches, default_branch=odd,
+                                   parameters={**spec.parameters, odd: 1.5}, description=odd)
+    assert ClosureSpec.from_toml(odd_spec.to_toml()) == odd_spec

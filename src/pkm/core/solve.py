@@ -34,7 +34,7 @@ from pkm.core import constraints
 from pkm.core.configuration import Configuration
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.newton import gauss_newton
-from pkm.errors import AssemblyError, BranchError, ConvergenceError, InvalidInputError
+from pkm.errors import AssemblyError, BranchError, ConvergenceError, InvalidInputError, UnreachableError
 from pkm.validation import as_count, as_scalar, as_tolerance
 
 DEFAULT_TOL = 1e-12
@@ -212,7 +212,12 @@ def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol
     def solve_at(q, s, t):
         return _newton(mech, make_fun(y1 if s >= 1.0 else task.interpolate(y0, y1, s)), q, None, t, max_iter, 0.5)
 
-    result = _follow(mech, "inverse kinematics", solve_at, q, n_steps, tol, raise_on_failure)
+    try:
+        result = _follow(mech, "inverse kinematics", solve_at, q, n_steps, tol, raise_on_failure)
+    except ConvergenceError as exc:
+        if isinstance(exc.result, SolveResult):
+            _raise_if_out_of_reach(mech, make_fun(y1), exc.result.q, tol)
+        raise
     q = result.q
     if result.converged and branch is not None and not mech.on_branch(q, branch):
         raise BranchError(branch, dict(mech.branch(branch).signs), mech.branch_signs(q, branch))
@@ -282,23 +287,9 @@ def assemble(mech: Mechanism, q0=None, *, tol: float = 1e-10, restarts: int = 16
     for k in range(restarts + 1):
         scale = (0.0, 0.1, 0.3, 1.0)[min(k, 3)]
         q = pin.integrate(m, q_seed, scale * rng.standard_normal(m.nv)) if k else q_seed.copy()
-        r, J = constraints.residual_and_jacobian(mech, q)
-        cost, lam = float(r @ r), 1e-3
-        for _ in range(max_iter):
-            total += 1
-            if np.abs(r).max() <= tol:
-                break
-            JtJ, g = J.T @ J, J.T @ r
-            dq = -np.linalg.solve(JtJ + lam * (np.diag(np.diag(JtJ)) + 1e-12 * np.eye(m.nv)), g)
-            q_try = pin.integrate(m, q, dq)
-            r_try, J_try = constraints.residual_and_jacobian(mech, q_try)
-            cost_try = float(r_try @ r_try)
-            if np.isfinite(cost_try) and cost_try < cost:
-                q, r, J, cost, lam = q_try, r_try, J_try, cost_try, max(lam / 3.0, 1e-12)
-            else:
-                lam *= 5.0
-                if lam > 1e12:
-                    break
+        q, r, it = _levenberg_marquardt(mech, lambda qq: constraints.residual_and_jacobian(mech, qq), q, tol,
+                                        max_iter)
+        total += it
         res = float(np.abs(r).max())
         if res < best[0]:
             best = (res, q)
@@ -309,6 +300,54 @@ def assemble(mech: Mechanism, q0=None, *, tol: float = 1e-10, restarts: int = 16
     err = _failure(mech, "assembly", result, tol)
     raise AssemblyError(best[0], "m or rad", f"{restarts + 1} starts of Levenberg-Marquardt; best: closure "
                                              f"{err.worst_closure!r} stays open by {err.worst_gap:.3g}")
+
+
+def _levenberg_marquardt(mech: Mechanism, fun, q: np.ndarray, tol: float, max_iter: int
+                         ) -> tuple[np.ndarray, np.ndarray, int]:
+    """Levenberg-Marquardt on ``|F(q)|^2`` over every joint (``fun(q) -> (F, J)``, J on the tangent space), on the
+    configuration manifold; stops at ``|F|_inf <= tol``, at a stationary point (no decrease for any damping) or
+    after ``max_iter`` iterations. Returns ``(q, F, iterations)``."""
+    m = mech.model
+    F, J = fun(q)
+    cost, lam, it = float(F @ F), 1e-3, 0
+    while it < max_iter and np.abs(F).max() > tol:
+        it += 1
+        JtJ, g = J.T @ J, J.T @ F
+        dq = -np.linalg.solve(JtJ + lam * (np.diag(np.diag(JtJ)) + 1e-12 * np.eye(m.nv)), g)
+        q_try = pin.integrate(m, q, dq)
+        F_try, J_try = fun(q_try)
+        cost_try = float(F_try @ F_try)
+        if np.isfinite(cost_try) and cost_try < cost:
+            q, F, J, cost, lam = q_try, F_try, J_try, cost_try, max(lam / 3.0, 1e-12)
+        else:
+            lam *= 5.0
+            if lam > 1e12:
+                break
+    return q, F, it
+
+
+def _raise_if_out_of_reach(mech: Mechanism, fun, q: np.ndarray, tol: float) -> None:
+    """:class:`UnreachableError` when the IK equations ``fun`` have a least-squares minimum that is not a solution
+    near ``q`` (Levenberg-Marquardt from ``q`` stalls with ``|F|_inf > max(tol, 1e-9)``): the target lies outside
+    the workspace. It names the closure left most open there (or the task, when every loop closes)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        q, F, _ = _levenberg_marquardt(mech, fun, q, tol, 500)
+        gaps, k = [], 0
+        for i, (cm, c) in enumerate(zip(mech.constraint_models, mech.spec.closures)):
+            n = cm.residualSize()
+            gaps.append((float(np.linalg.norm(F[k:k + n])), i + 1, c.name))
+            k += n
+        task_gap = float(np.linalg.norm(F[mech.n_constraints:]))
+    gap, index, name = max(gaps) if gaps else (0.0, 0, "")
+    if not (np.isfinite(gap) and np.isfinite(task_gap) and np.abs(F).max() > max(tol, 1e-9)):
+        return  # solved after all, or beyond the float range: the ConvergenceError stands
+    if gap > tol:
+        raise UnreachableError(index, gap, "m or rad",
+                               f"the target is out of the workspace: at the nearest configuration (a least-squares "
+                               f"minimum) closure {name!r} stays open by {gap:.3g} and the task misses by "
+                               f"{task_gap:.3g}")
+    raise UnreachableError(0, task_gap, "m or rad", "the target is out of the workspace: every loop closes at the "
+                                                    f"nearest configuration, where the task misses by {task_gap:.3g}")
 
 
 def _failure(mech: Mechanism, what: str, result: SolveResult, tol: float) -> ConvergenceError:

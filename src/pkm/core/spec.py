@@ -73,8 +73,10 @@ What the loaders refuse
 
 from __future__ import annotations
 
+import json
 import math
 import os
+import re
 import stat
 import tomllib
 from collections.abc import Mapping
@@ -315,15 +317,15 @@ class ClosureSpec:
             out += ["", "[[closure]]", f"name = {_tv(c.name)}", f"type = {_tv(c.type)}",
                     f"frame_a = {_tv(c.frame_a)}", f"frame_b = {_tv(c.frame_b)}"]
         for b in self.branches.values():
-            out += ["", f"[branch.{b.name}]"]
+            out += ["", f"[branch.{_key(b.name)}]"]
             if b.description:
                 out.append(f"description = {_tv(b.description)}")
-            out.append("signs = { " + ", ".join(f"{k} = {v:d}" for k, v in b.signs.items()) + " }")
+            out.append("signs = { " + ", ".join(f"{_key(k)} = {v:d}" for k, v in b.signs.items()) + " }")
         out += ["", "[reference]"]
-        out += [f"{k} = {_tv(list(v))}" for k, v in self.reference.items()]
+        out += [f"{_key(k)} = {_tv(list(v))}" for k, v in self.reference.items()]
         if self.parameters:
             out += ["", "[parameters]"]
-            out += [f"{k} = {_tv(v)}" for k, v in self.parameters.items()]
+            out += [f"{_key(k)} = {_tv(v)}" for k, v in self.parameters.items()]
         return "\n".join(out) + "\n"
 
     def dump(self, path: str | Path) -> None:
@@ -397,12 +399,20 @@ def _typename(typ: type | tuple[type, ...]) -> str:
     return names.get(typ, typ.__name__)
 
 
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+
+
+def _key(name: str) -> str:
+    """A TOML key: bare when TOML allows it, else a quoted string (a joint named ``a/b`` or ``knee 1``)."""
+    return name if _BARE_KEY.fullmatch(name) else _tv(name)
+
+
 def _tv(value) -> str:
-    """A TOML literal for the few value types the spec uses."""
+    """A TOML literal for the few value types the spec uses (strings with every control character escaped)."""
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        return json.dumps(value, ensure_ascii=False).replace("\x7f", "\\u007f")
     if isinstance(value, int):
         return str(value)
     if isinstance(value, float):
