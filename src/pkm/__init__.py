@@ -63,8 +63,10 @@ __version__ = "0.1.0"
 
 def load(name) -> Mechanism:
     """A mechanism: a registered name's reference design (from its shipped ``urdf/`` files, or built from
-    its default parameters when it ships none), or a closure spec file of one's own
-    (``path/to/my.closures.toml``, naming its URDF; see :mod:`pkm.core.spec`).
+    its default parameters when it ships none), or one's own files: a closure spec
+    (``path/to/my.closures.toml``, naming its URDF; see :mod:`pkm.core.spec`), or a URDF + ``robot.yaml``
+    in the convention of Gepetto's toolbox-parallel-robots (the folder, or the YAML file; see
+    :mod:`pkm.core.formats`).
 
     Raises:
         UnknownNameError: ``name`` is neither registered (:data:`MECHANISMS`) nor an existing file.
@@ -74,10 +76,12 @@ def load(name) -> Mechanism:
     from pathlib import Path
 
     if isinstance(name, os.PathLike) or (isinstance(name, str) and name not in MECHANISMS
-                                         and (name.endswith(".toml") or Path(name).is_file())):
+                                         and (name.endswith((".toml", ".yaml", ".yml")) or Path(name).exists())):
+        from pkm.core.formats import gepetto_files, load_gepetto
         from pkm.core.mechanism import Mechanism
 
-        return Mechanism.from_files(Path(name))
+        gepetto = gepetto_files(Path(name))
+        return load_gepetto(*gepetto) if gepetto else Mechanism.from_files(Path(name))
     if isinstance(name, str) and name not in MECHANISMS:
         raise UnknownNameError("mechanism", name, MECHANISMS, "the registry, nor is it a file (give a closure spec's "
                                                               "path, such as path/to/my.closures.toml)")

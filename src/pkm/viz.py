@@ -356,8 +356,10 @@ def _build_bodies(mech: Mechanism, root: str) -> tuple[list[Body], float, str | 
 
     # triads: world and end effector
     world = model.frames[0].name
-    for label, fname, size in (("world", world, _TRIAD_LENGTH * length),
-                               (mech.spec.end_effector, mech.spec.end_effector, ee_triad)):
+    triads = [("world", world, _TRIAD_LENGTH * length)]
+    if mech.spec.end_effector is not None:
+        triads.append((mech.spec.end_effector, mech.spec.end_effector, ee_triad))
+    for label, fname, size in triads:
         for k, axis in enumerate("xyz"):
             tip = np.zeros(3)
             tip[k] = size

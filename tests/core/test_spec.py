@@ -29,7 +29,7 @@ def test_shipped_specs_round_trip_byte_for_byte(name):
 @pytest.mark.parametrize("edit, message", [
     (lambda t: t.replace('format = "pkm.closures/1"', 'format = "pkm.closures/9"'), "unsupported format"),
     (lambda t: t.replace('type = "point"', 'type = "hinge"', 1), "type 'hinge' unknown"),
-    (lambda t: t.replace('end_effector = "platform"\n', ''), "missing key 'end_effector'"),
+    (lambda t: t.replace('end_effector = "platform"\n', ''), "need an end_effector"),
     (lambda t: t.replace('components = ["x", "y", "z"]', 'components = ["x", "w"]'), "task.components"),
     (lambda t: t.replace('default_branch = "knee_out"', 'default_branch = "knee_sideways"'), "default_branch"),
     (lambda t: t.replace("signs = { knee_1 = -1,", "signs = { knee_1 = 2,", 1), r"\+1 or -1"),
@@ -80,3 +80,54 @@ def test_any_names_round_trip_through_toml(odd, delta_text):
     odd_spec = dataclasses.replace(spec, reference=ref, branches=branches, default_branch=odd,
                                    parameters={**spec.parameters, odd: 1.5}, description=odd)
     assert ClosureSpec.from_toml(odd_spec.to_toml()) == odd_spec
+
+
+MINIMAL = """format = "pkm.closures/1"
+mechanism = "five"
+urdf = "five.urdf"
+actuated = ["motor_1", "motor_2"]
+
+[[closure]]
+name = "tip"
+type = "point"
+frame_a = "tip_1"
+frame_b = "tip_2"
+"""
+
+
+def test_a_minimal_spec_names_only_closures_and_actuators():
+    """Closures and actuated joints suffice: no end effector, no task (the outputs are then the actuated joints),
+    no reference (assembled); the generic answers follow (IK, FK, Jacobians, dynamics by virtual work)."""
+    import pkm
+    from tests import fivebar
+
+    mech = Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params()), MINIMAL)
+    assert mech.spec.end_effector is None and mech.spec.task.joints == ("motor_1", "motor_2")
+    q = mech.q_reference
+    assert np.abs(constraints.residual(mech, q)).max() <= 1e-10
+    qa = mech.actuated_q(q) + [0.05, -0.03]
+    ik = pkm.solve_ik(mech, qa)
+    np.testing.assert_allclose(mech.actuated_q(ik.q), qa, atol=1e-10)
+    np.testing.assert_allclose(pkm.forward_jacobian(mech, ik.q), np.eye(2), atol=1e-12)
+    v = pkm.velocities(mech, ik.q, [0.1, 0.2])
+    a = pkm.accelerations(mech, ik.q, v, [0.0, 0.0])
+    assert np.all(np.isfinite(pkm.inverse_dynamics(mech, ik.q, v, a)))
+    assert ClosureSpec.from_toml(mech.spec.to_toml()) == mech.spec
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda t: t + '\n[task]\ncomponents = ["x", "y"]\n', r"need an end_effector"),
+    (lambda t: t.replace('actuated =', 'end_effector = "tip_1"\nactuated ='), r"missing key 'task'"),
+    (lambda t: t.replace('actuated =', 'end_effector = ""\nactuated ='), r"non-empty string"),
+])
+def test_a_minimal_spec_says_what_it_misses(edit, message):
+    with pytest.raises(SpecError, match=message):
+        ClosureSpec.from_toml(edit(MINIMAL))
+
+
+def test_more_task_coordinates_than_actuators_are_refused():
+    from tests import fivebar
+
+    text = MINIMAL.replace('actuated =', 'end_effector = "tip_1"\nactuated =') + '\n[task]\ncomponents = ["x", "y", "z"]\n'
+    with pytest.raises(SpecError, match=r"the task has 3 coordinates but only 2 joints are actuated"):
+        Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params()), text)

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
+from pkm.core.joints import retype_joints
 from pkm.core.spec import ClosureSpec, as_path, read_text_file
 from pkm.core.urdf import load_model, position_limits
 from pkm.errors import AssemblyError, InvalidInputError, SpecError, SpecNameError, UnknownNameError
@@ -108,11 +109,15 @@ class Mechanism:
                 raise SpecError(source, f"{what}: joint {name!r} ({info.kind}) must have one coordinate")
             return info
 
-        self.ee_frame = frame(spec.end_effector, "end_effector")
+        #: The end-effector frame's id; 0 (the world frame, fixed) for a mechanism without one.
+        self.ee_frame = frame(spec.end_effector, "end_effector") if spec.end_effector is not None else 0
         self.closure_frames = [(frame(c.frame_a, f"closure {c.name!r}"), frame(c.frame_b, f"closure {c.name!r}"))
                                for c in spec.closures]
         self.actuated = tuple(scalar_joint(n, "actuated") for n in spec.actuated)
         self.task_joints = tuple(scalar_joint(n, "task.joints") for n in spec.task.joints)
+        if spec.task.size > len(self.actuated):
+            raise SpecError(source, f"the task has {spec.task.size} coordinates but only {len(self.actuated)} joints are "
+                                    "actuated: give as many task coordinates as degrees of freedom, or fewer")
         for b in spec.branches.values():
             for n in b.signs:
                 scalar_joint(n, f"branch {b.name!r}")
@@ -229,7 +234,7 @@ class Mechanism:
                                     spec)
         if isinstance(spec, str):
             spec = ClosureSpec.from_toml(spec, source + " (closures)")
-        return cls(load_model(urdf, source), spec, params, urdf, source)
+        return cls(retype_joints(load_model(urdf, source), spec.joint_types, source), spec, params, urdf, source)
 
     @classmethod
     def from_files(cls, spec_path: str | Path) -> Mechanism:
@@ -252,7 +257,8 @@ class Mechanism:
             raise SpecError(str(spec_path), f"urdf = {spec.urdf!r} resolves to {urdf_path}, outside the spec's folder "
                                             f"{folder}; copy the URDF next to the spec")
         urdf = read_text_file(urdf_path, "URDF")
-        return cls(load_model(urdf, str(urdf_path)), spec, None, urdf, str(spec_path))
+        model = retype_joints(load_model(urdf, str(urdf_path)), spec.joint_types, str(spec_path))
+        return cls(model, spec, None, urdf, str(spec_path))
 
     # ------------------------------------------------------------------ sizes and names
     @property

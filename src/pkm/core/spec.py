@@ -145,7 +145,7 @@ class ClosureSpec:
 
     mechanism: str
     urdf: str
-    end_effector: str
+    end_effector: str | None  # None: no end effector (the task is joint outputs only)
     actuated: tuple[str, ...]
     closures: tuple[Closure, ...]
     task: TaskSpec
@@ -154,6 +154,9 @@ class ClosureSpec:
     default_branch: str | None = None
     parameters: Mapping[str, float | str] = field(default_factory=dict)
     description: str = ""
+    #: Joints the URDF writes as revolutes that are ``"spherical"``, ``"universal"`` or ``"fixed"``
+    #: (:mod:`pkm.core.joints`).
+    joint_types: Mapping[str, str] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ reading
     @classmethod
@@ -199,7 +202,7 @@ class ClosureSpec:
         if fmt != FORMAT:
             raise SpecError(source, f"unsupported format {fmt!r}; this pkm reads {FORMAT!r}")
         known = {"format", "mechanism", "urdf", "end_effector", "actuated", "default_branch", "task",
-                 "closure", "branch", "reference", "parameters", "description"}
+                 "closure", "branch", "reference", "parameters", "description", "joint_types"}
         unknown = sorted(set(raw) - known)
         if unknown:
             raise SpecError(source, f"unknown keys {unknown}; known keys: {sorted(known)}")
@@ -208,9 +211,18 @@ class ClosureSpec:
         if not actuated:
             raise SpecError(source, "'actuated' must name at least one joint")
 
-        task_raw = need(raw, "task", dict)
-        components = names(task_raw, "components", "task.")
+        end_effector = raw.get("end_effector")
+        if end_effector is not None and (not isinstance(end_effector, str) or not end_effector):
+            raise SpecError(source, "key 'end_effector' must be a non-empty string (or left out: no end effector)")
+        if "task" not in raw and end_effector is not None:
+            raise SpecError(source, "missing key 'task': with an end_effector, [task] says which of its coordinates "
+                                    "are outputs (components = ['x', 'y', 'z'], or ['pose'])")
+        task_raw = need(raw, "task", dict) if "task" in raw else {"components": [], "joints": list(actuated)}
+        components = names(task_raw, "components", "task.") if "components" in task_raw else ()
         joints = names(task_raw, "joints", "task.") if "joints" in task_raw else ()
+        if components and end_effector is None:
+            raise SpecError(source, f"task.components {list(components)} need an end_effector frame; without one "
+                                    "the task is joint outputs only (task.joints)")
         if components != ("pose",):
             bad = [c for c in components if c not in TASK_COMPONENTS]
             if bad:
@@ -263,12 +275,17 @@ class ClosureSpec:
                 raise SpecError(source, f"reference.{jname} holds a number beyond {ABSURD:g} (SI units: m, rad)")
             reference[jname] = tuple(float(v) for v in vals)
 
+        joint_types = raw.get("joint_types", {})
+        if not isinstance(joint_types, dict) or not all(isinstance(v, str) for v in joint_types.values()):
+            raise SpecError(source, "joint_types must be a table of joint name = \"spherical\" | \"universal\" | "
+                                    "\"fixed\"")
+
         params = raw.get("parameters", {})
         if not isinstance(params, dict) or not all(
                 isinstance(v, str) or (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v))
                 for v in params.values()):
             raise SpecError(source, "parameters must be a table of finite numbers or strings")
-        for key in ("mechanism", "urdf", "end_effector"):
+        for key in ("mechanism", "urdf"):
             if not need(raw, key, str):
                 raise SpecError(source, f"key {key!r} must not be empty")
         if not isinstance(raw.get("description", ""), str):
@@ -281,7 +298,7 @@ class ClosureSpec:
         return cls(
             mechanism=need(raw, "mechanism", str),
             urdf=need(raw, "urdf", str),
-            end_effector=need(raw, "end_effector", str),
+            end_effector=end_effector,
             actuated=actuated,
             closures=tuple(closures),
             task=task,
@@ -290,6 +307,7 @@ class ClosureSpec:
             default_branch=default_branch,
             parameters=dict(params),
             description=str(raw.get("description", "")),
+            joint_types=dict(joint_types),
         )
 
     # ------------------------------------------------------------------ writing
@@ -306,9 +324,10 @@ class ClosureSpec:
             out.append(f"description = {_tv(self.description)}")
         out += [
             f"urdf = {_tv(self.urdf)}",
-            f"end_effector = {_tv(self.end_effector)}",
-            f"actuated = {_tv(list(self.actuated))}",
         ]
+        if self.end_effector is not None:
+            out.append(f"end_effector = {_tv(self.end_effector)}")
+        out.append(f"actuated = {_tv(list(self.actuated))}")
         if self.default_branch is not None:
             out.append(f"default_branch = {_tv(self.default_branch)}")
         out += ["", "[task]", f"components = {_tv(list(self.task.components))}",
@@ -321,6 +340,8 @@ class ClosureSpec:
             if b.description:
                 out.append(f"description = {_tv(b.description)}")
             out.append("signs = { " + ", ".join(f"{_key(k)} = {v:d}" for k, v in b.signs.items()) + " }")
+        if self.joint_types:
+            out += ["", "[joint_types]"] + [f"{_key(k)} = {_tv(v)}" for k, v in self.joint_types.items()]
         out += ["", "[reference]"]
         out += [f"{_key(k)} = {_tv(list(v))}" for k, v in self.reference.items()]
         if self.parameters:
