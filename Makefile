@@ -20,7 +20,7 @@ demo: $(STAMP)
 	$(PY) -m pkm report --out out
 
 test: $(STAMP)
-	$(PY) -m ruff check src tests tools
+	$(PY) -m ruff check src tests tools examples
 	$(PY) -m mypy src/pkm
 	$(PY) -m pytest -q
 

@@ -1,7 +1,7 @@
 """pkm.core.formats and pkm.core.joints: models in Gepetto's URDF + robot.yaml convention, with ball joints the
 URDF writes as revolutes, loaded with no hand edits and given every generic answer.
 
-The two models in ``tests/data/`` were written for these tests in that convention (limits as onshape-to-robot
+The two models in ``examples/`` were written for pkm in that convention (limits as onshape-to-robot
 writes them: effort and velocity only): a planar five-bar (``gepetto_fivebar``) and a spatial RSSR four-bar whose
 coupler hangs between two ball joints (``gepetto_rssr``: one is a URDF revolute made ``SPHERICAL`` by the YAML,
 the other the 3-D closure), so that the coupler's spin about its own axis is an idle motion.
@@ -22,7 +22,7 @@ from pkm.core.formats import spec_from_gepetto
 from pkm.errors import SpecError, SpecNameError
 from tests import fd
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[2] / "examples"
 MODELS = {"gepetto_fivebar": DATA / "gepetto_fivebar", "gepetto_rssr": DATA / "gepetto_rssr" / "robot.yaml"}
 
 
