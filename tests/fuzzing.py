@@ -399,6 +399,27 @@ def _from_toml(g, adv):
     return c.pkm.ClosureSpec.from_toml, (text,), {}
 
 
+@entry("formats.spec_from_gepetto")
+def _gepetto(g, adv):
+    from pkm.core.formats import spec_from_gepetto
+    text = (Path(__file__).resolve().parents[1] / "examples" / "gepetto_rssr" / "robot.yaml").read_text()
+    text = g.text_mutation(text) if adv else text
+    if adv and g.chance(0.05):
+        text = g.hostile()
+    joints = ["motor", "ball_b", "rocker_joint"]
+    return spec_from_gepetto, (text, "robot.urdf", joints, "rssr"), {}
+
+
+@entry("pkm.assemble")
+def _assemble(g, adv):
+    c = ctx()
+    n, m = _mech(g, adv)
+    kw: dict = {"restarts": int(g.rng.integers(0, 3)), "seed": int(g.rng.integers(0, 100)), "max_iter": 30}
+    if adv and g.chance(0.5):
+        kw[g.pick(("restarts", "seed", "max_iter", "tol"))] = g.hostile()
+    return c.pkm.assemble, (m, _q(g, n, adv and g.chance(0.5))), kw
+
+
 @entry("urdf.load_model")
 def _load_model(g, adv):
     from pkm.core.urdf import load_model

@@ -22,7 +22,7 @@ import re
 from pathlib import Path
 
 from pkm.core.spec import MAX_FILE_BYTES, Closure, ClosureSpec, TaskSpec, read_text_file
-from pkm.errors import SpecError
+from pkm.errors import InvalidInputError, SpecError
 
 _YAML_TYPES = {"3d": "point", "6d": "frame"}
 _JOINT_TYPES = {"SPHERICAL": "spherical", "CARDAN": "universal", "FIXED": "fixed"}
@@ -57,6 +57,9 @@ def spec_from_gepetto(yaml_text: str, urdf_name: str, joint_names: list[str], me
     """
     import yaml
 
+    if not isinstance(yaml_text, str):
+        raise InvalidInputError("yaml_text", f"expected the YAML text as a str, got {type(yaml_text).__name__}",
+                                yaml_text)
     if len(yaml_text) > MAX_FILE_BYTES:
         raise SpecError(source, f"YAML file longer than {MAX_FILE_BYTES} characters")
     try:
