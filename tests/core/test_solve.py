@@ -178,10 +178,13 @@ def test_an_open_reference_is_refused_with_the_closure_and_the_gap(built):
         Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))
 
 
-def test_a_reference_in_degrees_is_refused(built):
+def test_a_reference_in_degrees_or_without_values_is_refused(built):
     import dataclasses
 
     mech = built("delta")
     ref = {**mech.spec.reference, "motor_1": (45.0,)}
     with pytest.raises(SpecError, match=r"motor_1 = 45, beyond 2 pi: angles are in rad"):
+        Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))
+    ref = {**mech.spec.reference, "motor_1": ()}  # (found by the fuzzing: an IndexError before)
+    with pytest.raises(SpecError, match=r"joint 'motor_1' takes 1 coordinate\(s\), got \(0,\)"):
         Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))

@@ -135,7 +135,7 @@ class _Split:
     def joint_solve(self, rhs: np.ndarray) -> np.ndarray:
         """The joint rates ``v`` off the idle motions with ``[J_c; J_t] v = rhs`` (least squares)."""
         n = self.C.shape[1]
-        keep = self.sa[:n] > 0.0
+        keep = self.sa[:n] > np.finfo(float).eps * max(self.Ua.shape[0], n) * self.smax_inverse  # as lstsq's rcond
         y = (self.Ua[:, :n][:, keep].T @ rhs) / self.sa[:n][keep].reshape((-1,) + (1,) * (rhs.ndim - 1))
         return self.C @ (self.Vat[:n][keep].T @ y)
 

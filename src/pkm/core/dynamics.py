@@ -227,7 +227,7 @@ class KhalilProjection:
         q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
         c = Configuration.compute(mech, q)
         proj = self._projection(c.constraint_jacobian)
-        h = _external(mech, c, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches)
+        h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches, c)
         f = h[part.platform_v].copy()
         tau = np.zeros(mech.na)
         for leg, L in zip(part.legs, proj.L):
@@ -239,18 +239,21 @@ class KhalilProjection:
                                                                       "(overflow); check the units")
 
 
-def _external(mech: Mechanism, c: Configuration, h: np.ndarray, wrench, wrenches) -> np.ndarray:
+def _external(mech: Mechanism, q: np.ndarray, h: np.ndarray, wrench, wrenches,
+              c: Configuration | None = None) -> np.ndarray:
     """``h - sum_f J_f^T w_f``: the tree's joint forces less those of the external wrenches (world-aligned at
-    each frame's origin, force then moment); ``wrench`` acts at the end-effector frame."""
+    each frame's origin, force then moment); ``wrench`` acts at the end-effector frame. ``c``: the
+    configuration's kinematics when the caller has them (computed here only when a wrench needs them)."""
     if wrenches is not None and not (isinstance(wrenches, Mapping) and all(isinstance(k, str) for k in wrenches)):
         raise InvalidInputError("wrenches", "expected {frame name: (fx, fy, fz, mx, my, mz)}", wrenches)
     loads = dict(wrenches or {})
     out = h.copy()
     if wrench is not None:
+        c = Configuration.compute(mech, q) if c is None else c
         out -= c.ee_jacobian.T @ as_vector(wrench, 6, "wrench")
     m = mech.model
     if loads:
-        pin.computeJointJacobians(m, mech.data, c.q)
+        pin.computeJointJacobians(m, mech.data, q)
         pin.updateFramePlacements(m, mech.data)
     for name, w in loads.items():
         if not m.existFrame(name):
@@ -319,8 +322,7 @@ def virtual_work_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=Non
     mech = check_mechanism(mech)
     q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
     G = passive_map(mech, q)
-    h = pin.rnea(mech.model, mech.data, q, v, a)
-    h = _external(mech, Configuration.compute(mech, q), h, wrench, wrenches)
+    h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches)
     return finite_result(G.T @ h, "actuator efforts")
 
 

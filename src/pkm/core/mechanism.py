@@ -143,7 +143,8 @@ class Mechanism:
         unknown = [n for n in spec.reference if n not in self.joints]
         if unknown:
             raise SpecNameError(source, "joint", unknown[0], list(self.joints), "[reference]")
-        degrees = [n for n, v in spec.reference.items() if self.joints[n].revolute and abs(v[0]) > 2.0 * np.pi]
+        degrees = [n for n, v in spec.reference.items()
+                   if self.joints[n].revolute and len(v) == 1 and abs(v[0]) > 2.0 * np.pi]
         if degrees:
             raise SpecError(source, f"[reference] gives {degrees[0]} = {spec.reference[degrees[0]][0]:g}, beyond "
                                     "2 pi: angles are in rad (degrees?)")
