@@ -59,11 +59,6 @@ class Configuration:
                    pin.getFrameJacobian(m, d, mech.ee_frame, pin.LOCAL_WORLD_ALIGNED))
 
     @property
-    def passive_constraint_jacobian(self) -> np.ndarray:
-        """The constraint Jacobian's columns of the passive joints (n_constraints x (nv - na))."""
-        return self.constraint_jacobian[:, self.mech.passive_v]
-
-    @property
     def closure_and_task_jacobian(self) -> np.ndarray:
         """``[J_c; J_t]`` ((n_constraints + n_task) x nv): its column rank is lost at inverse singularities."""
         return np.vstack([self.constraint_jacobian, self.task_jacobian])
