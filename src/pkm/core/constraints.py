@@ -79,6 +79,20 @@ def pinocchio_jacobian(mech: Mechanism, q: np.ndarray) -> np.ndarray:
     return pin.getConstraintsJacobian(m, d, mech.constraint_models, mech.constraint_datas)
 
 
+def worst_closure(mech: Mechanism, r: np.ndarray) -> tuple[float, int, str | None]:
+    """The closure left most open by the residual ``r`` (its first ``n_constraints`` entries, in spec order):
+    ``(norm of its block [m or rad], its 1-based index, its name)``; ``(0.0, 0, None)`` without closures."""
+    worst: tuple[float, int, str | None] = (0.0, 0, None)
+    k = 0
+    for i, (cm, c) in enumerate(zip(mech.constraint_models, mech.spec.closures)):
+        n = cm.residualSize()
+        gap = float(np.linalg.norm(r[k:k + n]))
+        if worst[2] is None or gap > worst[0]:
+            worst = (gap, i + 1, c.name)
+        k += n
+    return worst
+
+
 def residual_and_jacobian(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Both at once, with one kinematics pass (the loop closure's Newton step)."""
     pin.computeJointJacobians(mech.model, mech.data, q)

@@ -152,7 +152,6 @@ class Mechanism:
             self.q_reference = self.check_q(self.q_from_dict(spec.reference, base=pin.neutral(model)), "[reference]")
         except InvalidInputError as exc:
             raise SpecError(source, f"{exc}; fix the [reference] table of the closure spec") from None
-        gap, closure = self._worst_gap(self.q_reference)
         if missing:  # a partial (or no) reference: assembled from it, the other joints from the neutral configuration
             from pkm.core.solve import assemble  # (solve imports this module)
 
@@ -161,7 +160,8 @@ class Mechanism:
             except AssemblyError as exc:
                 raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found from it and "
                                         f"the neutral configuration ({exc}); give an assembled [reference]") from None
-        elif gap > REFERENCE_TOL:
+        elif (worst := self._worst_closure(self.q_reference))[0] > REFERENCE_TOL:
+            gap, closure = worst
             raise SpecError(source, f"the [reference] configuration leaves closure {closure!r} open by {gap:.3g} "
                                     f"(m or rad; closed means <= {REFERENCE_TOL:g}): fix it, or leave joints out of "
                                     "[reference] to have pkm assemble the mechanism (pkm.assemble)")
@@ -173,17 +173,12 @@ class Mechanism:
         return tuple(n for n, (lo, hi) in self.limits.items()
                      if n in self.joints and not lo - tol <= q[self.joints[n].idx_q] <= hi + tol)
 
-    def _worst_gap(self, q: np.ndarray) -> tuple[float, str | None]:
-        """The largest closure gap at ``q`` (norm of its residual block, m or rad) and the closure's name."""
-        d = self.data
-        pin.framesForwardKinematics(self.model, d, q)
-        worst: tuple[float, str | None] = (0.0, None)
-        for c, (fa, fb) in zip(self.spec.closures, self.closure_frames):
-            A, B = d.oMf[fa], d.oMf[fb]
-            g = float(np.linalg.norm(A.translation - B.translation)) if c.type == "point" else \
-                float(np.linalg.norm(pin.log6(A.actInv(B)).vector))
-            worst = max(worst, (g, c.name), key=lambda t: t[0])
-        return worst
+    def _worst_closure(self, q: np.ndarray) -> tuple[float, str | None]:
+        """The largest closure gap at ``q`` (m or rad) and the closure's name (:func:`pkm.core.constraints.worst_closure`)."""
+        from pkm.core import constraints  # (constraints imports this module)
+
+        gap, _, name = constraints.worst_closure(self, constraints.residual(self, q))
+        return gap, name
 
     # ------------------------------------------------------------------ per-thread data, pickling
     @property

@@ -332,13 +332,8 @@ def _raise_if_out_of_reach(mech: Mechanism, fun, q: np.ndarray, tol: float) -> N
     the workspace. It names the closure left most open there (or the task, when every loop closes)."""
     with np.errstate(over="ignore", invalid="ignore"):
         q, F, _ = _levenberg_marquardt(mech, fun, q, tol, 500)
-        gaps, k = [], 0
-        for i, (cm, c) in enumerate(zip(mech.constraint_models, mech.spec.closures)):
-            n = cm.residualSize()
-            gaps.append((float(np.linalg.norm(F[k:k + n])), i + 1, c.name))
-            k += n
+        gap, index, name = constraints.worst_closure(mech, F)
         task_gap = float(np.linalg.norm(F[mech.n_constraints:]))
-    gap, index, name = max(gaps) if gaps else (0.0, 0, "")
     if not (np.isfinite(gap) and np.isfinite(task_gap) and np.abs(F).max() > max(tol, 1e-9)):
         return  # solved after all, or beyond the float range: the ConvergenceError stands
     if gap > tol:
@@ -352,13 +347,7 @@ def _raise_if_out_of_reach(mech: Mechanism, fun, q: np.ndarray, tol: float) -> N
 
 def _failure(mech: Mechanism, what: str, result: SolveResult, tol: float) -> ConvergenceError:
     """A ConvergenceError naming the loop that stays most open and by how much."""
-    r = constraints.residual(mech, result.q)
-    gaps, k = [], 0
-    for cm, c in zip(mech.constraint_models, mech.spec.closures):
-        n = cm.residualSize()
-        gaps.append((float(np.linalg.norm(r[k:k + n])), c.name))
-        k += n
-    gap, name = max(gaps) if gaps else (0.0, None)
+    gap, _, name = constraints.worst_closure(mech, constraints.residual(mech, result.q))
     detail = (f"closure {name!r} stays open by {gap:.3g} (m or rad) at the last iterate"
               if name is not None and gap > tol else "the task target is not met")
     err = ConvergenceError(what, result.residual, result.iterations, tol, result, detail)
