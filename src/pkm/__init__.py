@@ -65,8 +65,10 @@ def load(name) -> Mechanism:
     """A mechanism: a registered name's reference design (from its shipped ``urdf/`` files, or built from
     its default parameters when it ships none), or one's own files: a closure spec
     (``path/to/my.closures.toml``, naming its URDF; see :mod:`pkm.core.spec`), or a URDF + ``robot.yaml``
-    in the convention of Gepetto's toolbox-parallel-robots (the folder, or the YAML file; see
-    :mod:`pkm.core.formats`).
+    in the convention of Gepetto's toolbox-parallel-robots (the folder, or the YAML file), an MJCF file
+    (``.xml``, loops as ``<equality>`` connect/weld, actuators from ``<actuator>``) or an SDF file (loops
+    as links with several parents; it names no actuators, so it comes through a spec): see
+    :mod:`pkm.core.formats`.
 
     Raises:
         UnknownNameError: ``name`` is neither registered (:data:`MECHANISMS`) nor an existing file.
@@ -76,12 +78,18 @@ def load(name) -> Mechanism:
     from pathlib import Path
 
     if isinstance(name, os.PathLike) or (isinstance(name, str) and name not in MECHANISMS
-                                         and (name.endswith((".toml", ".yaml", ".yml")) or Path(name).exists())):
-        from pkm.core.formats import gepetto_files, load_gepetto
+                                         and (name.endswith((".toml", ".yaml", ".yml", ".xml", ".mjcf", ".sdf"))
+                                              or Path(name).exists())):
+        from pkm.core.formats import SUFFIXES, gepetto_files, load_gepetto
+        from pkm.core.formats.imported import load_model_file
         from pkm.core.mechanism import Mechanism
 
-        gepetto = gepetto_files(Path(name))
-        return load_gepetto(*gepetto) if gepetto else Mechanism.from_files(Path(name))
+        path = Path(name)
+        gepetto = gepetto_files(path)
+        if gepetto:
+            return load_gepetto(*gepetto)
+        return load_model_file(path) if SUFFIXES.get(path.suffix.lower()) in ("mjcf", "sdf") \
+            else Mechanism.from_files(path)
     if isinstance(name, str) and name not in MECHANISMS:
         raise UnknownNameError("mechanism", name, MECHANISMS, "the registry, nor is it a file (give a closure spec's "
                                                               "path, such as path/to/my.closures.toml)")

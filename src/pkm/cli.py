@@ -6,6 +6,7 @@ Usage::
     pkm preview MECH [--param K=V ...] [--pose K=V ... | --joints NAME=V ...] [--html FILE] [--no-wait]
     pkm ik MECH --pose K=V ... [--param K=V ...] [--branch NAME]
     pkm fk MECH --joints NAME=V ... [--param K=V ...]
+    pkm spec init MODEL [--out FILE] [--force]
     pkm report [--out DIR] [--paper NAME ...] [--no-figures] [--no-series]
     pkm bench [NAME ...] [--json] [--quick] [-- ARGS passed to each benchmark]
 
@@ -504,6 +505,23 @@ def cmd_fk(args) -> int:
     return 0
 
 
+def cmd_spec_init(args) -> int:
+    from pathlib import Path
+
+    from pkm.core.formats.imported import spec_skeleton
+
+    model = Path(args.model)
+    out = Path(args.out) if args.out else model.with_name(f"{model.stem}.closures.toml")
+    if out.exists() and not args.force:
+        raise UsageError(f"{out} exists; pass --force to overwrite it")
+    if out.resolve().parent != model.resolve().parent:
+        raise UsageError(f"write the spec beside the model ({model.resolve().parent}): its urdf path is relative")
+    text, complete = spec_skeleton(model)
+    out.write_text(text, encoding="utf-8")
+    print(f"wrote {out}" + ("" if complete else ": fill in the lines marked TODO"))
+    return 0
+
+
 def cmd_report(args) -> int:
     from pkm import papers, report
 
@@ -587,6 +605,14 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("fk", parents=[debug], help="forward kinematics: the pose for actuated values (JSON, SI)")
     mech_args(p, None, "required")
     p.set_defaults(func=cmd_fk)
+
+    p = sub.add_parser("spec", parents=[debug], help="closure specs: 'pkm spec init MODEL' writes one to fill in")
+    spec_sub = p.add_subparsers(dest="spec_command", metavar="ACTION", required=True)
+    p = spec_sub.add_parser("init", parents=[debug], help="write a commented closure spec for a URDF, MJCF or SDF file")
+    p.add_argument("model", metavar="MODEL", help="the model file (.urdf, .xml MJCF, .sdf)")
+    p.add_argument("--out", metavar="FILE", help="where to write it (default: MODEL's folder, <stem>.closures.toml)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing file")
+    p.set_defaults(func=cmd_spec_init)
 
     from pkm.papers import names as paper_names
 

@@ -191,7 +191,7 @@ class Scene:
         root = "/" + "/".join(p for p in str(root).split("/") if p)
         bodies, length, platform = _build_bodies(mech, root)
         model = mech.model
-        ids = tuple(model.getFrameId(b.frame) for b in bodies)
+        ids = tuple(mech.frame_id(b.frame) for b in bodies)
         return cls(mech, root, tuple(bodies), length, platform, ids, model.createData())
 
     def body(self, path: str) -> Body:

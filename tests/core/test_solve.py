@@ -167,6 +167,33 @@ def test_assemble_closes_from_far_seeds_and_says_which_closure_stays_open_when_n
         Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params(d=2.0)), _without_reference(plain))
 
 
+def test_assemble_holds_the_joints_it_is_told_to_and_a_partial_reference_holds_what_it_states(built):
+    """pkm.assemble(hold=...) keeps the held coordinates exactly; a [reference] that states only the actuators is
+    assembled at those actuators (the 3-RPR of the acceptance set: its leg lengths)."""
+    import pinocchio as pin
+
+    delta = built("delta")
+    rng = np.random.default_rng(2)
+    q0 = pin.integrate(delta.model, delta.q_reference, 0.2 * rng.uniform(-1, 1, delta.nv))
+    res = pkm.assemble(delta, q0, hold=delta.actuated_names)
+    assert np.abs(delta.actuated_q(res.q) - delta.actuated_q(q0)).max() <= 1e-15
+    assert np.abs(constraints.residual(delta, res.q)).max() <= 1e-10
+    with pytest.raises(InvalidInputError, match="joint names"):
+        pkm.assemble(delta, q0, hold="motor_1")
+    from pathlib import Path
+
+    rpr = pkm.load(Path(__file__).resolve().parents[2] / "examples" / "rpr3" / "rpr3.closures.toml")
+    assert np.abs(rpr.actuated_q(rpr.q_reference) - 0.35).max() <= 1e-15
+
+
+def test_a_spec_without_any_loop_is_refused(built):
+    import dataclasses
+
+    mech = built("delta")
+    with pytest.raises(SpecError, match="no loop closure"):
+        Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, closures=()))
+
+
 def test_an_open_reference_is_refused_with_the_closure_and_the_gap(built):
     """A [reference] 8 cm off its closure (the Delta's platform moved down) is refused, naming the open closure."""
     import dataclasses

@@ -161,6 +161,14 @@ def _passive_map(mech: Mechanism, sp: _Split, Jc: np.ndarray) -> np.ndarray:
     return G
 
 
+def idle_motions(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+    """An orthonormal basis (nv x k) of the idle motions at ``q``: joint rates that the closures allow with the
+    actuators locked and that the task does not see (a rod spinning about its axis between two ball joints);
+    k = 0 for most mechanisms. Their rates and accelerations are not fixed by the kinematics."""
+    mech, q = _check(mech, q)
+    return _split(mech, Configuration.compute(mech, q), as_tolerance(rtol, "rtol")).idle
+
+
 def passive_map(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
     """``G = dq/dq_a`` (nv x na): all joint rates from the actuated rates, without idle motion.
 

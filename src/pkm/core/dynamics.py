@@ -46,9 +46,9 @@ import pinocchio as pin
 
 from pkm.core import constraints
 from pkm.core.configuration import Configuration
-from pkm.core.differential import passive_map
+from pkm.core.differential import idle_motions, passive_map
 from pkm.core.mechanism import Mechanism, check_mechanism
-from pkm.errors import InvalidInputError, PkmError, SingularityError, SpecError, UnknownNameError
+from pkm.errors import InvalidInputError, PkmError, SingularityError, SpecError
 from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
 
 RTOL = 1e-9
@@ -256,9 +256,7 @@ def _external(mech: Mechanism, q: np.ndarray, h: np.ndarray, wrench, wrenches,
         pin.computeJointJacobians(m, mech.data, q)
         pin.updateFramePlacements(m, mech.data)
     for name, w in loads.items():
-        if not m.existFrame(name):
-            raise UnknownNameError("frame", name, [f.name for f in m.frames], mech.spec.mechanism)
-        J = pin.getFrameJacobian(m, mech.data, m.getFrameId(name), pin.LOCAL_WORLD_ALIGNED)
+        J = pin.getFrameJacobian(m, mech.data, mech.frame_id(name), pin.LOCAL_WORLD_ALIGNED)
         out -= J.T @ as_vector(w, 6, f"wrenches[{name!r}]")
     return out
 
@@ -281,6 +279,33 @@ def _has_mimic(model: pin.Model) -> bool:
 
 
 METHODS = ("auto", "khalil", "virtual_work")
+_IDLE: weakref.WeakKeyDictionary[Mechanism, bool] = weakref.WeakKeyDictionary()
+
+
+def _settle_idle(mech: Mechanism, q, v, a, wrench, wrenches) -> np.ndarray:
+    """``a`` with its idle-motion part set by the dynamics, ``a + N alpha`` with ``N^T (M a' + h - J^T w) = 0``.
+
+    The kinematics fixes no idle acceleration (:func:`~pkm.core.differential.idle_motions` ``N``: a rod spinning
+    between two ball joints), and the one in ``a`` (the minimum-norm one of :func:`pkm.accelerations`) is in general
+    not the one the efforts produce: nothing drives an idle motion, so its generalised force must vanish. Without
+    this, ``G^T`` of the tree's forces depends on how ``G`` splits the idle motion (by up to 1e-4 of the efforts on
+    the RSSR four-bar). Mechanisms with no idle motion at their reference skip it (cached per mechanism);
+    massless idle motions (no inertia about the rod's axis) keep the acceleration given.
+    """
+    if mech not in _IDLE:
+        _IDLE[mech] = idle_motions(mech, mech.q_reference).shape[1] > 0
+    if not _IDLE[mech]:
+        return a
+    q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
+    N = idle_motions(mech, q)
+    if not N.shape[1]:
+        return a
+    m, d = mech.model, mech.data
+    h = _external(mech, q, pin.rnea(m, d, q, v, a), wrench, wrenches)
+    M = pin.crba(m, d, q)
+    M = np.triu(M) + np.triu(M, 1).T
+    alpha = np.linalg.lstsq(N.T @ M @ N, -(N.T @ h), rcond=1e-12)[0]
+    return a + N @ alpha
 
 
 def inverse_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=None, method: str = "auto") -> np.ndarray:
@@ -306,6 +331,7 @@ def inverse_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=None, me
     mech = check_mechanism(mech)
     if method not in METHODS:
         raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
+    a = _settle_idle(mech, q, v, a, wrench, wrenches)
     if method == "virtual_work":
         return virtual_work_dynamics(mech, q, v, a, wrench, wrenches=wrenches)
     k = _khalil(mech)

@@ -23,7 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core.joints import retype_joints
-from pkm.core.spec import ClosureSpec, as_path, read_text_file
+from pkm.core.spec import ClosureSpec, as_path
 from pkm.core.urdf import load_model, position_limits
 from pkm.errors import AssemblyError, InvalidInputError, SpecError, SpecNameError, UnknownNameError
 from pkm.validation import as_array, as_vector, wrap_angle
@@ -110,6 +110,9 @@ class Mechanism:
             return info
 
         #: The end-effector frame's id; 0 (the world frame, fixed) for a mechanism without one.
+        if not spec.closures:
+            raise SpecError(source, "no loop closure: give [[closure]] tables (or a model file with loops); pkm "
+                                    "models closed-loop mechanisms, a tree alone needs none of it")
         self.ee_frame = frame(spec.end_effector, "end_effector") if spec.end_effector is not None else 0
         self.closure_frames = [(frame(c.frame_a, f"closure {c.name!r}"), frame(c.frame_b, f"closure {c.name!r}"))
                                for c in spec.closures]
@@ -156,10 +159,11 @@ class Mechanism:
             from pkm.core.solve import assemble  # (solve imports this module)
 
             try:
-                self.q_reference = assemble(self, self.q_reference).q
+                self.q_reference = assemble(self, self.q_reference, hold=tuple(spec.reference), tol=1e-12).q
             except AssemblyError as exc:
-                raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found from it and "
-                                        f"the neutral configuration ({exc}); give an assembled [reference]") from None
+                raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found that keeps the "
+                                        f"joints it states, the others starting from the neutral configuration "
+                                        f"({exc}); give an assembled [reference]") from None
         elif (worst := self._worst_closure(self.q_reference))[0] > REFERENCE_TOL:
             gap, closure = worst
             raise SpecError(source, f"the [reference] configuration leaves closure {closure!r} open by {gap:.3g} "
@@ -234,7 +238,8 @@ class Mechanism:
 
     @classmethod
     def from_files(cls, spec_path: str | Path) -> Mechanism:
-        """Load ``<name>.closures.toml`` and the URDF it names (path relative to the spec).
+        """Load ``<name>.closures.toml`` and the model file it names (path relative to the spec): a URDF, or an
+        MJCF or SDF file whose own loops and joint types are added to the spec's (:mod:`pkm.core.formats`).
 
         The spec's ``urdf`` must stay inside the spec's folder once symbolic links are resolved;
         nothing else is read (see :mod:`pkm.core.spec`).
@@ -252,9 +257,12 @@ class Mechanism:
         if not urdf_path.is_relative_to(folder):
             raise SpecError(str(spec_path), f"urdf = {spec.urdf!r} resolves to {urdf_path}, outside the spec's folder "
                                             f"{folder}; copy the URDF next to the spec")
-        urdf = read_text_file(urdf_path, "URDF")
-        model = retype_joints(load_model(urdf, str(urdf_path)), spec.joint_types, str(spec_path))
-        return cls(model, spec, None, urdf, str(spec_path))
+        from pkm.core.formats.imported import import_model, with_file  # (formats import this module)
+
+        imported = import_model(urdf_path)
+        spec = with_file(spec, imported, str(spec_path))
+        model = retype_joints(load_model(imported.urdf, str(urdf_path)), spec.joint_types, str(spec_path))
+        return cls(model, spec, None, imported.urdf, str(spec_path))
 
     # ------------------------------------------------------------------ sizes and names
     @property

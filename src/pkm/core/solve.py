@@ -262,15 +262,16 @@ def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_i
     return out
 
 
-def assemble(mech: Mechanism, q0=None, *, tol: float = 1e-10, restarts: int = 16, seed: int = 0,
+def assemble(mech: Mechanism, q0=None, *, hold=(), tol: float = 1e-10, restarts: int = 16, seed: int = 0,
              max_iter: int = 200) -> SolveResult:
     """A configuration that closes every loop, from any seed (the mechanism's own files need not be closed).
 
     Levenberg-Marquardt on the closure residual over every joint, on the configuration manifold, from
     ``q0`` (default: the reference); when it stalls above ``tol``, restarts from ``q0`` perturbed by
     normal draws of growing size (0.1, 0.3, 1 rad or m), ``restarts`` times at most (seeded: the same
-    answer every run). The actuated joints move too: this finds *an* assembly, not the one for given
-    actuators (that is :func:`close_loops`).
+    answer every run). Every joint moves but those named in ``hold``, which keep their values in ``q0``
+    (a spec's partial ``[reference]`` holds the joints it states): with no ``hold`` this finds *an*
+    assembly, not the one for given actuators (that is :func:`close_loops`).
 
     Raises:
         AssemblyError: no start closes: the best residual, and the closure that stays most open and by how much.
@@ -281,14 +282,25 @@ def assemble(mech: Mechanism, q0=None, *, tol: float = 1e-10, restarts: int = 16
     restarts = as_count(restarts, "restarts", low=0, high=10_000)
     max_iter = as_count(max_iter, "max_iter", low=1, high=100_000)
     rng = np.random.default_rng(as_count(seed, "seed", low=0, high=2**63 - 1))
+    if isinstance(hold, str) or not all(isinstance(n, str) for n in hold):
+        raise InvalidInputError("hold", "expected a sequence of joint names", hold)
+    held = np.zeros(mech.nv, dtype=bool)
+    for name in hold:
+        j = mech.joint(name)
+        held[j.idx_v:j.idx_v + j.nv] = True
+
+    def closure(qq):
+        F, J = constraints.residual_and_jacobian(mech, qq)
+        J[:, held] = 0.0  # (Levenberg-Marquardt's damping then leaves the held coordinates where they are)
+        return F, J
+
     m = mech.model
     best: tuple[float, np.ndarray] = (np.inf, q_seed)
     total = 0
     for k in range(restarts + 1):
         scale = (0.0, 0.1, 0.3, 1.0)[min(k, 3)]
-        q = pin.integrate(m, q_seed, scale * rng.standard_normal(m.nv)) if k else q_seed.copy()
-        q, r, it = _levenberg_marquardt(mech, lambda qq: constraints.residual_and_jacobian(mech, qq), q, tol,
-                                        max_iter)
+        q = pin.integrate(m, q_seed, np.where(held, 0.0, scale * rng.standard_normal(m.nv))) if k else q_seed.copy()
+        q, r, it = _levenberg_marquardt(mech, closure, q, tol, max_iter)
         total += it
         res = float(np.abs(r).max())
         if res < best[0]:

@@ -42,6 +42,7 @@ from __future__ import annotations
 import io
 import math
 import re
+from collections.abc import Sequence
 
 import numpy as np
 import pinocchio as pin
@@ -127,7 +128,8 @@ class UrdfBuilder:
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(nan|inf|infinity)", re.IGNORECASE)
 
 
-def _floats(text: str | None, n: int, what: str, source: str) -> list[float]:
+def floats(text: str | None, n: int, what: str, source: str, bound: float = ABSURD) -> list[float]:
+    """``n`` finite numbers of magnitude <= ``bound`` from whitespace-separated text (the model formats share it)."""
     words = (text or "").split()
     if not all(_NUMBER.fullmatch(w) for w in words):  # float() would also take "1_000" and non-ASCII digits
         raise SpecError(source, f"{what}: {text!r} is not a list of numbers")
@@ -135,28 +137,34 @@ def _floats(text: str | None, n: int, what: str, source: str) -> list[float]:
     if len(vals) != n:
         raise SpecError(source, f"{what}: expected {n} numbers, got {text!r}")
     for v in vals:
-        if not math.isfinite(v) or abs(v) > ABSURD:
+        if not math.isfinite(v) or abs(v) > bound:
             raise SpecError(source, f"{what}: value {v!r} is not finite or absurdly large (SI units expected)")
     return vals
 
 
-def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
-    """Parse and check URDF text (see the module docstring); returns the root element."""
+def parse_xml(text: str | bytes, source: str = "<string>", root_tag: str = "robot", what: str = "URDF") \
+        -> etree._Element:
+    """Parse XML text safely (no DOCTYPE, entities, DTD, network or XInclude; at most 16 MiB) and check that its
+    root element is ``<root_tag>``; the model formats (URDF, MJCF, SDF) share it.
+
+    Raises:
+        SpecError: the text is not UTF-8, too large, not well-formed, or refused as above.
+    """
     if not isinstance(text, (str, bytes)):
-        raise InvalidInputError("text", f"expected the URDF text as a str, got {type(text).__name__}", text)
+        raise InvalidInputError("text", f"expected the {what} text as a str, got {type(text).__name__}", text)
     if len(text) > _MAX_BYTES:
-        raise SpecError(source, f"URDF larger than {_MAX_BYTES} bytes")
+        raise SpecError(source, f"{what} larger than {_MAX_BYTES} bytes")
     try:
         data = text.encode() if isinstance(text, str) else text.decode("utf-8").encode()
     except UnicodeEncodeError as exc:
-        raise SpecError(source, f"URDF text cannot be encoded as UTF-8 (character {exc.start})") from None
+        raise SpecError(source, f"{what} text cannot be encoded as UTF-8 (character {exc.start})") from None
     except UnicodeDecodeError as exc:
-        raise SpecError(source, f"URDF bytes are not UTF-8 (byte {exc.start})") from None
+        raise SpecError(source, f"{what} bytes are not UTF-8 (byte {exc.start})") from None
     if b"<!DOCTYPE" in data or b"<!ENTITY" in data:  # refused before the parser sees (and expands) anything
-        raise SpecError(source, "URDF with a DOCTYPE (entity declarations) is refused; remove the <!DOCTYPE ...> "
-                                "block (URDF needs none)")
+        raise SpecError(source, f"{what} with a DOCTYPE (entity declarations) is refused; remove the <!DOCTYPE ...> "
+                                f"block ({what} needs none)")
     if len(data) > _MAX_BYTES:
-        raise SpecError(source, f"URDF larger than {_MAX_BYTES} bytes")
+        raise SpecError(source, f"{what} larger than {_MAX_BYTES} bytes")
     parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False,
                              dtd_validation=False)
     try:
@@ -164,12 +172,17 @@ def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
     except etree.XMLSyntaxError as exc:
         raise SpecError(source, f"not well-formed XML: {exc}") from None
     if root.getroottree().docinfo.doctype:
-        raise SpecError(source, "URDF with a DOCTYPE (entity declarations) is refused")
-    if root.tag != "robot":
-        raise SpecError(source, f"root element is <{root.tag}>, expected <robot>")
+        raise SpecError(source, f"{what} with a DOCTYPE (entity declarations) is refused")
+    if root.tag != root_tag:
+        raise SpecError(source, f"root element is <{root.tag}>, expected <{root_tag}>")
     if any(isinstance(el.tag, str) and el.tag.startswith("{http://www.w3.org/2001/XInclude}") for el in root.iter()):
-        raise SpecError(source, "XInclude elements are refused (pkm reads one self-contained URDF; expand it first)")
+        raise SpecError(source, f"XInclude elements are refused (pkm reads one self-contained {what}; expand it first)")
+    return root
 
+
+def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
+    """Parse and check URDF text (see the module docstring); returns the root element."""
+    root = parse_xml(text, source)
     if len(root) > _MAX_ELEMENTS:
         raise SpecError(source, f"more than {_MAX_ELEMENTS} elements under <robot>")
     links = [el.get("name") for el in root.findall("link")]
@@ -198,11 +211,11 @@ def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
         parent_of[chi.get("link")] = par.get("link")
         org = el.find("origin")
         if org is not None:
-            _floats(org.get("xyz", "0 0 0"), 3, f"joint {name!r} origin xyz", source)
-            _floats(org.get("rpy", "0 0 0"), 3, f"joint {name!r} origin rpy", source)
+            floats(org.get("xyz", "0 0 0"), 3, f"joint {name!r} origin xyz", source)
+            floats(org.get("rpy", "0 0 0"), 3, f"joint {name!r} origin rpy", source)
         if typ in ("revolute", "continuous", "prismatic"):
             ax = el.find("axis")
-            axis = _floats(ax.get("xyz") if ax is not None else "1 0 0", 3, f"joint {name!r} axis", source)
+            axis = floats(ax.get("xyz") if ax is not None else "1 0 0", 3, f"joint {name!r} axis", source)
             if np.linalg.norm(axis) < 1e-9:
                 raise SpecError(source, f"joint {name!r} has a zero axis")
         if typ in ("revolute", "prismatic"):
@@ -215,21 +228,21 @@ def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
                 raise SpecError(source, f"joint {name!r} ({typ}) states only its {stated[0]} limit; give both "
                                         "lower and upper, or neither (no position limits)")
             if stated:
-                lo, hi = _floats(f"{lim.get('lower')} {lim.get('upper')}", 2, f"joint {name!r} limits", source)
+                lo, hi = floats(f"{lim.get('lower')} {lim.get('upper')}", 2, f"joint {name!r} limits", source)
                 if lo > hi:
                     raise SpecError(source, f"joint {name!r}: lower limit {lo} > upper limit {hi}")
         lim = el.find("limit")
         if lim is not None:
             for key in ("effort", "velocity"):
                 if lim.get(key) is not None:
-                    _floats(lim.get(key), 1, f"joint {name!r} limit {key}", source)
+                    floats(lim.get(key), 1, f"joint {name!r} limit {key}", source)
         mim = el.find("mimic")
         if mim is not None and mim.get("joint") not in jnames:
             raise SpecError(source, f"joint {name!r} mimics unknown joint {mim.get('joint')!r}")
         if mim is not None:
             for key in ("multiplier", "offset"):
                 if mim.get(key) is not None:
-                    _floats(mim.get(key), 1, f"joint {name!r} mimic {key}", source)
+                    floats(mim.get(key), 1, f"joint {name!r} mimic {key}", source)
     roots = [n for n in links if n not in parent_of]
     if len(roots) != 1:
         raise SpecError(source, f"a URDF tree has one root link; found {roots}")
@@ -239,20 +252,20 @@ def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
             continue
         mass = inertial.find("mass")
         lname = lel.get("name")
-        m = _floats(mass.get("value") if mass is not None else None, 1, f"link {lname!r} mass", source)[0]
+        m = floats(mass.get("value") if mass is not None else None, 1, f"link {lname!r} mass", source)[0]
         if m < 0:
             raise SpecError(source, f"link {lname!r} has negative mass {m}")
         org = inertial.find("origin")
         if org is not None:
-            _floats(org.get("xyz", "0 0 0"), 3, f"link {lname!r} inertial origin xyz", source)
-            _floats(org.get("rpy", "0 0 0"), 3, f"link {lname!r} inertial origin rpy", source)
+            floats(org.get("xyz", "0 0 0"), 3, f"link {lname!r} inertial origin xyz", source)
+            floats(org.get("rpy", "0 0 0"), 3, f"link {lname!r} inertial origin rpy", source)
         iel = inertial.find("inertia")
         if iel is None:
             raise SpecError(source, f"link {lname!r}: <inertial> needs <inertia ixx=... ixy=... ixz=... iyy=... "
                                     "iyz=... izz=...>")
         if iel is not None:
             keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-            ixx, ixy, ixz, iyy, iyz, izz = _floats(" ".join(iel.get(k, "0") for k in keys), 6,
+            ixx, ixy, ixz, iyy, iyz, izz = floats(" ".join(iel.get(k, "0") for k in keys), 6,
                                                    f"link {lname!r} inertia {'/'.join(keys)}", source)
             ev = np.linalg.eigvalsh(np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]))
             if ev[0] < -1e-9 * max(1.0, float(np.abs(ev).max())):
@@ -269,7 +282,7 @@ def position_limits(text: str | bytes, source: str = "<string>") -> dict[str, tu
         lim = el.find("limit")
         if el.get("type") in ("revolute", "prismatic") and lim is not None and lim.get("lower") is not None \
                 and lim.get("upper") is not None:
-            lo, hi = _floats(f"{lim.get('lower')} {lim.get('upper')}", 2, "limits", source)
+            lo, hi = floats(f"{lim.get('lower')} {lim.get('upper')}", 2, "limits", source)
             out[str(el.get("name"))] = (lo, hi)
     return out
 
@@ -293,3 +306,142 @@ def load_model(text: str, source: str = "<string>") -> pin.Model:
         hint = (" (a mimic joint must come after the joint it mimics in Pinocchio's traversal, "
                 "which visits sibling joints in name order)") if "mimic" in str(exc) else ""
         raise SpecError(source, f"Pinocchio rejects the URDF: {exc}{hint}") from None
+
+
+_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+
+
+def num(x) -> str:
+    """Numbers as URDF attribute text, each written exactly (``repr``)."""
+    return " ".join(repr(float(v)) for v in np.ravel(x))
+
+
+def origin(el: etree._Element, M: pin.SE3) -> None:
+    """An ``<origin xyz rpy>`` child of ``el`` for the placement ``M``."""
+    etree.SubElement(el, "origin", xyz=num(M.translation), rpy=num(pin.rpy.matrixToRpy(M.rotation)))
+
+
+def _urdf_joint_kind(jm, where: str, source: str) -> tuple[str, np.ndarray | None, str | None]:
+    """``(URDF type, axis, pkm joint type or None)`` of one (non-composite) Pinocchio joint model."""
+    kind = jm.shortname().removeprefix("JointModel")
+    if kind in ("RX", "RY", "RZ", "PX", "PY", "PZ"):
+        return ("revolute" if kind[0] == "R" else "prismatic"), np.array(_AXES[kind[1]]), None
+    if kind in ("RevoluteUnaligned", "PrismaticUnaligned"):
+        return ("revolute" if kind[0] == "R" else "prismatic"), np.asarray(jm.extract().axis, dtype=float), None
+    if kind in ("RUBX", "RUBY", "RUBZ"):
+        return "continuous", np.array(_AXES[kind[3]]), None
+    if kind == "Spherical":  # URDF has none: a revolute placeholder that [joint_types] makes spherical
+        return "revolute", np.array(_AXES["Z"]), "spherical"
+    if kind == "FreeFlyer":
+        return "floating", None, None
+    if kind == "Universal":
+        uj = jm.extract()
+        if np.allclose(uj.axis1, _AXES["X"], atol=1e-12) and np.allclose(uj.axis2, _AXES["Y"], atol=1e-12):
+            return "revolute", np.array(_AXES["Z"]), "universal"
+    raise SpecError(source, f"{where}: a Pinocchio {jm.shortname()} cannot be written as URDF (pkm writes revolute, "
+                            "prismatic, continuous, spherical, universal about x then y, and free-flyer joints)")
+
+
+def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: dict[str, list[str]] | None = None,
+                    limits: dict[str, tuple[float, float]] | None = None,
+                    frames: Sequence[tuple[str, int, pin.SE3]] = (), skip_frames: tuple[str, ...] = (),
+                    source: str = "<model>") -> tuple[str, dict[str, str]]:
+    """The URDF text of a Pinocchio tree, and the ``[joint_types]`` that URDF cannot state.
+
+    The other formats (MJCF, SDF) reach pkm through this: one representation downstream. Each joint
+    becomes a URDF joint of its name, its child link carrying the joint's inertia and named after the body
+    frame at the joint's origin (``<joint>_link`` when there is none); a composite joint (a MuJoCo body
+    with several joints) becomes a chain through massless links, its parts named by ``joint_names``;
+    every other body and operational frame, and each of ``frames`` (``(name, parent joint id,
+    placement in that joint's frame)``), becomes a massless link on a fixed joint ``<frame>_fixed``.
+    ``limits`` gives the position limits ``{joint: (lower, upper)}`` to state; the other revolute and
+    prismatic joints get a ``<limit>`` without bounds. :func:`load_model` and
+    :func:`pkm.core.joints.retype_joints` give the same tree back (same ``q`` layout, frames, inertias).
+
+    Raises:
+        SpecError: a joint kind URDF and ``[joint_types]`` cannot express (planar, helical...), mimic joints.
+    """
+    joint_names = joint_names or {}
+    limits = limits or {}
+    fnames = {f.name for f in model.frames}
+    taken: set[str] = set()
+
+    def unique(base: str) -> str:
+        out, k = base, 1
+        while out in taken or (out != base and out in fnames):
+            out, k = f"{base}_{k}", k + 1
+        taken.add(out)
+        return out
+
+    robot = etree.Element("robot", name=name or model.name or "robot")
+
+    def link(lname: str, inertia: pin.Inertia | None = None) -> None:
+        lel = etree.SubElement(robot, "link", name=lname)
+        if inertia is not None and inertia.mass > 0.0:
+            iel = etree.SubElement(lel, "inertial")
+            origin(iel, pin.SE3(np.eye(3), inertia.lever))
+            etree.SubElement(iel, "mass", value=repr(float(inertia.mass)))
+            I = inertia.inertia
+            etree.SubElement(iel, "inertia", ixx=num(I[0, 0]), ixy=num(I[0, 1]), ixz=num(I[0, 2]),
+                             iyy=num(I[1, 1]), iyz=num(I[1, 2]), izz=num(I[2, 2]))
+
+    def joint(jname: str, kind: str, parent: str, child: str, M: pin.SE3, axis=None) -> None:
+        jel = etree.SubElement(robot, "joint", name=jname, type=kind)
+        origin(jel, M)
+        etree.SubElement(jel, "parent", link=parent)
+        etree.SubElement(jel, "child", link=child)
+        if axis is not None:
+            etree.SubElement(jel, "axis", xyz=num(axis))
+        if kind in ("revolute", "prismatic"):
+            bounds = {"lower": repr(float(limits[jname][0])), "upper": repr(float(limits[jname][1]))} \
+                if jname in limits else {}
+            etree.SubElement(jel, "limit", effort="0", velocity="0", **bounds)
+
+    root = unique("world")
+    taken.update(skip_frames)
+    link(root)
+    link_of = {0: root}
+    primary = set()
+    types: dict[str, str] = {}
+    for jid in range(1, model.njoints):
+        jm, jname = model.joints[jid], model.names[jid]
+        if jm.shortname() == "JointModelMimic":
+            raise SpecError(source, f"joint {jname!r}: mimic joints cannot be written as URDF by pkm yet")
+        if jm.shortname() == "JointModelComposite":
+            comp = jm.extract()
+            parts = list(zip(comp.joints, comp.jointPlacements))
+            names = joint_names.get(jname) or [f"{jname}_{k}" for k in range(len(parts))]
+            if len(names) != len(parts):
+                raise SpecError(source, f"joint {jname!r} has {len(parts)} parts but {len(names)} names")
+        else:
+            parts, names = [(jm, pin.SE3.Identity())], [jname]
+        body = next((f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == jid
+                     and f.placement.isIdentity(1e-12) and f.name not in taken), None)
+        parent = link_of[model.parents[jid]]
+        for k, ((part, placement), pname) in enumerate(zip(parts, names)):
+            kind, axis, pkm_type = _urdf_joint_kind(part, f"joint {pname!r}", source)
+            last = k == len(parts) - 1
+            child = (unique(body) if body is not None else unique(f"{pname}_link")) if last else unique(f"{pname}_link")
+            link(child, model.inertias[jid] if last else None)
+            M = model.jointPlacements[jid] * placement if k == 0 else placement
+            joint(pname, kind, parent, child, M, axis)
+            if pkm_type:
+                types[pname] = pkm_type
+            parent = child
+        link_of[jid] = parent
+        if body is not None:
+            primary.add(body)
+    extra = [(f.name, f.parentJoint, f.placement) for f in model.frames[1:]
+             if f.type in (pin.FrameType.BODY, pin.FrameType.OP_FRAME) and f.name not in primary
+             and f.name not in skip_frames]
+    for fname, _, _ in frames:
+        if fname in taken or fname in fnames:
+            raise SpecError(source, f"frame {fname!r} to add is already a name of the model")
+    for fname, jid, M in extra + list(frames):
+        child = unique(fname)
+        link(child)
+        joint(unique(f"{child}_fixed"), "fixed", link_of[jid], child, M)
+    etree.indent(robot, space="  ")
+    text = etree.tostring(robot, xml_declaration=True, encoding="utf-8", pretty_print=True).decode()
+    check_urdf(text, source)
+    return text, types

@@ -1,4 +1,4 @@
-"""pkm.core.formats and pkm.core.joints: models in Gepetto's URDF + robot.yaml convention, with ball joints the
+"""pkm.core.formats.gepetto and pkm.core.joints: models in Gepetto's URDF + robot.yaml convention, with ball joints the
 URDF writes as revolutes, loaded with no hand edits and given every generic answer.
 
 The two models in ``examples/`` were written for pkm in that convention (limits as onshape-to-robot
@@ -22,7 +22,7 @@ from pkm.core.formats import spec_from_gepetto
 from pkm.errors import SpecError, SpecNameError
 from tests import fd
 
-DATA = Path(__file__).resolve().parents[2] / "examples"
+DATA = Path(__file__).resolve().parents[3] / "examples"
 MODELS = {"gepetto_fivebar": DATA / "gepetto_fivebar", "gepetto_rssr": DATA / "gepetto_rssr" / "robot.yaml"}
 
 
@@ -57,7 +57,12 @@ def test_forward_and_inverse_kinematics_round_trip_and_the_jacobian_matches_diff
 
 
 def test_inverse_dynamics_balances_the_power(model):
-    """sum tau qd = dE/dt to 1e-8 relative along an actuated motion (the virtual-work route: no platform to cut)."""
+    """sum tau qd = dE/dt to 1e-8 relative along an actuated motion (the virtual-work route: no platform to cut).
+
+    With an idle motion (the RSSR's coupler spin) the efforts let the dynamics choose the spin's acceleration, which
+    a motion built from the kinematics alone does not follow: there ``constraintDynamics`` under the efforts gives
+    back the actuated accelerations instead (1e-8).
+    """
     _, mech = model
     qa0 = mech.actuated_q(mech.q_reference)
     qd, qdd = np.full(mech.na, 0.3), np.full(mech.na, -0.2)
@@ -69,6 +74,10 @@ def test_inverse_dynamics_balances_the_power(model):
 
     q, v, a = state(0.0)
     tau = pkm.inverse_dynamics(mech, q, v, a)
+    if pkm.diagnose(mech, q).idle_motions:
+        a_back = dynamics.forward_dynamics(mech, q, v, tau)
+        assert np.abs(a_back[mech.act_v] - qdd).max() <= 1e-8
+        return
     dE = fd.richardson(lambda h: np.array([(sum(dynamics.energy(mech, *state(h)[:2]))
                                             - sum(dynamics.energy(mech, *state(-h)[:2]))) / (2 * h)]), 1e-3)[0]
     assert abs(tau @ qd - dE) <= 1e-8 * max(np.abs(tau).max() * np.abs(qd).max(), 1e-12)

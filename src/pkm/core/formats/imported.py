@@ -1,0 +1,158 @@
+"""A model file in any format pkm reads, turned into its one representation: URDF text plus what a
+closure spec adds (loops, joint types, actuators)."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+
+from pkm.core.spec import Closure, ClosureSpec, TaskSpec, read_text_file
+from pkm.core.urdf import check_urdf
+from pkm.errors import SpecError
+
+#: File suffixes and the format they are read as.
+SUFFIXES = {".urdf": "urdf", ".xml": "mjcf", ".mjcf": "mjcf", ".sdf": "sdf"}
+
+
+@dataclass(frozen=True)
+class Imported:
+    """A model file read into pkm's one representation.
+
+    Attributes:
+        urdf: The tree as URDF text (frames for the closures' anchors included).
+        closures: The loops the file closes (none for a URDF).
+        joint_types: Joints URDF cannot state (``spherical``, ``universal``), for ``[joint_types]``.
+        actuated: The actuated joints the file names (empty when it names none).
+        name: The model's name.
+        format: ``"urdf"``, ``"mjcf"`` or ``"sdf"``.
+    """
+
+    urdf: str
+    closures: tuple[Closure, ...]
+    joint_types: dict[str, str]
+    actuated: tuple[str, ...]
+    name: str
+    format: str
+
+
+def import_model(path: Path) -> Imported:
+    """Read the model file at ``path``, by its suffix (:data:`SUFFIXES`; another suffix is read as URDF).
+
+    Raises:
+        SpecError: the file is missing, too large, malformed, or uses what its reader refuses.
+    """
+    kind = SUFFIXES.get(path.suffix.lower(), "urdf")
+    text = read_text_file(path, kind.upper())
+    if kind == "mjcf":
+        from pkm.core.formats.mjcf import read_mjcf
+
+        return read_mjcf(text, str(path))
+    if kind == "sdf":
+        from pkm.core.formats.sdf import read_sdf
+
+        return read_sdf(text, str(path))
+    root = check_urdf(text, str(path))
+    return Imported(text, (), {}, (), str(root.get("name") or path.stem), "urdf")
+
+
+def with_file(spec: ClosureSpec, imp: Imported, source: str) -> ClosureSpec:
+    """``spec`` with the loops and joint types of the model file it names added (the spec's joint types win).
+
+    Raises:
+        SpecError: a closure named both in the spec and in the file.
+    """
+    if not imp.closures and not imp.joint_types:
+        return spec
+    clash = sorted({c.name for c in spec.closures} & {c.name for c in imp.closures})
+    if clash:
+        raise SpecError(source, f"closure {clash[0]!r} is both in the spec and in {spec.urdf!r}; rename the spec's")
+    return dataclasses.replace(spec, closures=imp.closures + spec.closures,
+                               joint_types={**imp.joint_types, **spec.joint_types})
+
+
+def load_model_file(path: Path):
+    """The :class:`~pkm.core.Mechanism` of an MJCF or SDF file alone: its loops, its actuators, the actuated
+    joints as the task, no end effector, assembled (:func:`pkm.assemble`).
+
+    Raises:
+        SpecError: as :func:`import_model`, or a file that names no actuated joint (SDF never does):
+            then a closure spec must say which joints are driven.
+    """
+    from pkm.core.mechanism import Mechanism
+
+    imp = import_model(path)
+    if not imp.actuated:
+        raise SpecError(str(path), f"the {imp.format.upper()} file names no actuated joint; write a closure spec with "
+                                   f"urdf = {path.name!r} and actuated = [...] beside it (`pkm spec init {path}` "
+                                   "writes one to fill in), and load the spec")
+    spec = ClosureSpec(mechanism=imp.name, urdf=path.name, end_effector=None, actuated=imp.actuated,
+                       closures=imp.closures, task=TaskSpec((), imp.actuated), reference={},
+                       description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types)
+    return Mechanism.from_strings(imp.urdf, spec, source=str(path))
+
+
+def spec_skeleton(path: Path) -> tuple[str, bool]:
+    """A commented closure spec for the model file at ``path`` (URDF, MJCF or SDF), to fill in: what the file
+    states is written out (its loops as comments, its actuators), the rest is commented with the names the model
+    offers. Returns ``(text, complete)``: complete when it loads as it is (the file states loops and actuators).
+    ``pkm spec init FILE`` writes it.
+
+    Raises:
+        SpecError: as :func:`import_model`.
+    """
+    import json
+
+    import pinocchio as pin
+
+    from pkm.core.joints import retype_joints
+    from pkm.core.urdf import load_model
+
+    imp = import_model(path)
+    model = retype_joints(load_model(imp.urdf, str(path)), imp.joint_types, str(path))
+    scalar = [model.names[j] for j in range(1, model.njoints) if model.joints[j].nq == 1]
+    frames = [f.name for f in model.frames[1:] if f.type in (pin.FrameType.BODY, pin.FrameType.OP_FRAME)]
+
+    def listing(names: list[str], limit: int = 40) -> str:
+        shown = ", ".join(names[:limit])
+        return shown + (f", ... ({len(names)} in all)" if len(names) > limit else "")
+
+    q = json.dumps
+    lines = [f"# pkm closure spec for {path.name}, written by `pkm spec init`: fill in the lines marked TODO, then",
+             f"#   pkm fk {path.stem}.closures.toml --joints NAME=VALUE ...",
+             "# Values SI (m, rad). Format: the docstring of pkm.core.spec.",
+             'format = "pkm.closures/1"',
+             f"mechanism = {q(imp.name)}",
+             f"urdf = {q(path.name)}"
+             + ("" if imp.format == "urdf" else f"  # an {imp.format.upper()} file: its loops and joint types count"),
+             f"# end_effector = {q(frames[-1] if frames else 'FRAME')}  # optional: a frame whose placement is the "
+             "task; frames: " + listing(frames)]
+    if imp.actuated:
+        lines.append(f"actuated = {q(list(imp.actuated))}  # from the file's actuators")
+    else:
+        lines += ["actuated = []  # TODO: the driven joints (one coordinate each); the model's: " + listing(scalar)]
+    lines += ["",
+              "# [task]  # optional; without it the task is the actuated joints",
+              '# components = ["x", "y", "z"]  # of end_effector: x y z roll pitch yaw, or ["pose"]',
+              "# joints = []  # joints whose coordinates are outputs too", ""]
+    if imp.closures:
+        lines.append("# The loops the file closes (nothing to add):")
+        lines += [f"#   {c.name}: {c.type} closure between {c.frame_a} and {c.frame_b}" for c in imp.closures]
+    else:
+        lines += ["# TODO: one [[closure]] per loop, between two frames of the tree that the loop ties",
+                  "[[closure]]",
+                  'name = "loop1"',
+                  'type = "point"  # "point": the frames\' origins meet (a ball joint); "frame": the frames coincide',
+                  f"frame_a = {q(frames[0] if frames else 'FRAME_A')}  # TODO",
+                  f"frame_b = {q(frames[-1] if frames else 'FRAME_B')}  # TODO"]
+    lines += ["",
+              "# [joint_types]  # joints the file writes as revolutes that are \"spherical\", \"universal\" or "
+              "\"fixed\""]
+    lines += [f"# {k} = {q(v)}  # (from the file)" for k, v in imp.joint_types.items()]
+    lines += ["",
+              "# [reference]  # optional: pkm assembles the mechanism (pkm.assemble); the joints stated here are held",
+              f"# {scalar[0] if scalar else 'joint'} = [0.0]", ""]
+    return "\n".join(lines), bool(imp.actuated and imp.closures)
+
+
+__all__ = ["SUFFIXES", "Imported", "import_model", "load_model_file", "spec_skeleton", "with_file"]

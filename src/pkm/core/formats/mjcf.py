@@ -1,0 +1,219 @@
+"""MuJoCo's MJCF: a ``<mujoco>`` file whose ``<equality>`` section closes the loops.
+
+Pinocchio parses the tree, the inertias (including those MuJoCo computes from geoms) and the
+equality constraints (:func:`pinocchio.buildModelAndConstraintsFromMJCF`); pkm reads what Pinocchio
+does not keep, from the file itself:
+
+* ``<connect>`` gives a ``point`` closure and ``<weld>`` a ``frame`` closure, named by the equality's
+  ``name`` (else ``connect1``, ``weld2``...); their anchors become frames ``<name>_a`` (on ``body1``)
+  and ``<name>_b`` (on ``body2``, the world when it is omitted);
+* the actuated joints: the ``joint`` of each ``<actuator>`` element (``motor``, ``position``,
+  ``general``...), in file order; actuators on tendons or sites are not joint inputs and are skipped;
+* joint names and position limits (``range``, in degrees unless ``<compiler angle="radian">``, for
+  hinges only; a slide's range is a length), with ``<default>`` classes and ``childclass``; a body with
+  several joints keeps each one's name (Pinocchio joins them into one composite joint);
+* ``ball`` joints become Pinocchio spherical joints, ``<freejoint>`` a free-flyer (a floating base).
+
+What Pinocchio 4.1's parser gets wrong is worked around, each by a test: it reads only the first body
+under ``<worldbody>`` (pkm wraps them all in one fixed body), ignores the sites of bodies without
+joints (pkm adds them from the file), drops the equalities' names, and converts a slide's range as
+an angle. Refused with a :class:`~pkm.errors.SpecError`: ``<include>`` (pkm reads one self-contained
+file), equalities other than ``connect``/``weld``, joint types other than hinge, slide, ball, free.
+Meshes are not read (kinematics and dynamics need none).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+
+import numpy as np
+import pinocchio as pin
+from lxml import etree
+
+from pkm.core.formats.imported import Imported
+from pkm.core.spec import Closure
+from pkm.core.urdf import floats, parse_xml, urdf_from_model
+from pkm.errors import SpecError
+
+_ACTUATORS = ("motor", "position", "velocity", "general", "intvelocity", "damper", "cylinder", "muscle",
+              "adhesion")
+_JOINT_TYPES = ("hinge", "slide", "ball", "free")
+_WORLD = "pkm_mjcf_world"  # the fixed body pkm wraps the worldbody's children in (Pinocchio reads only one)
+
+
+def _floats(text: str | None, n: int, what: str, source: str) -> np.ndarray:
+    return np.array(floats(text, n, what, source))
+
+
+class _Defaults:
+    """MJCF attribute defaults: ``<default>`` classes (nested), ``class`` and ``childclass``."""
+
+    def __init__(self, root: etree._Element):
+        self.parent: dict[str, str | None] = {}
+        self.attrs: dict[tuple[str, str], dict[str, str]] = {}
+        for top in root.findall("default"):
+            self._walk(top, None)
+
+    def _walk(self, el: etree._Element, parent: str | None) -> None:
+        name = el.get("class", "main")
+        self.parent[name] = parent
+        for child in el:
+            if child.tag == "default":
+                self._walk(child, name)
+            elif isinstance(child.tag, str):
+                self.attrs[(name, child.tag)] = dict(child.attrib)
+
+    def get(self, el: etree._Element, key: str, default: str | None = None) -> str | None:
+        if el.get(key) is not None:
+            return el.get(key)
+        cls = el.get("class")
+        node = el.getparent()
+        while cls is None and node is not None:
+            cls = node.get("childclass")
+            node = node.getparent()
+        cls = cls or "main"
+        while cls is not None:
+            value = self.attrs.get((cls, el.tag), {}).get(key)
+            if value is not None:
+                return value
+            cls = self.parent.get(cls)
+        return default
+
+
+def _rotation(el: etree._Element, degrees: bool, source: str) -> np.ndarray:
+    """The orientation an MJCF element states (quat, axisangle, euler xyz, xyaxes, zaxis)."""
+    what = f"<{el.tag} name={el.get('name')!r}>"
+    if el.get("quat") is not None:
+        w, x, y, z = _floats(el.get("quat"), 4, f"{what} quat", source)
+        return pin.Quaternion(w, x, y, z).normalized().matrix()
+    if el.get("axisangle") is not None:
+        a = _floats(el.get("axisangle"), 4, f"{what} axisangle", source)
+        return pin.AngleAxis(np.deg2rad(a[3]) if degrees else a[3], a[:3] / np.linalg.norm(a[:3])).matrix()
+    if el.get("euler") is not None:
+        e = _floats(el.get("euler"), 3, f"{what} euler", source)
+        e = np.deg2rad(e) if degrees else e
+        R = np.eye(3)
+        for axis, angle in zip("xyz", e):  # MuJoCo's default eulerseq "xyz": rotations about the moving axes
+            R = R @ pin.AngleAxis(angle, np.eye(3)["xyz".index(axis)]).matrix()
+        return R
+    if el.get("xyaxes") is not None:
+        a = _floats(el.get("xyaxes"), 6, f"{what} xyaxes", source)
+        x = a[:3] / np.linalg.norm(a[:3])
+        y = a[3:] - x * (x @ a[3:])
+        y /= np.linalg.norm(y)
+        return np.column_stack([x, y, np.cross(x, y)])
+    if el.get("zaxis") is not None:
+        z = _floats(el.get("zaxis"), 3, f"{what} zaxis", source)
+        return pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), z / np.linalg.norm(z)).matrix()
+    return np.eye(3)
+
+
+def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
+    """Read MJCF text (see the module doc).
+
+    Raises:
+        SpecError: malformed XML, a refused feature, or a file Pinocchio rejects.
+    """
+    root = parse_xml(text, source, "mujoco", "MJCF")
+    if root.find(".//include") is not None:
+        raise SpecError(source, "<include> is refused: pkm reads one self-contained MJCF file; merge the included "
+                                "files into it")
+    compiler = root.find("compiler")
+    degrees = compiler is None or compiler.get("angle", "degree") != "radian"
+    if compiler is not None and compiler.get("eulerseq", "xyz") != "xyz":
+        raise SpecError(source, f"<compiler eulerseq={compiler.get('eulerseq')!r}>: pkm reads the default 'xyz' only")
+    defaults = _Defaults(root)
+    world = root.find("worldbody")
+    if world is None:
+        raise SpecError(source, "no <worldbody>")
+
+    body_joints: dict[str, list[str]] = {}  # a composite's first joint -> the names of all its parts
+    limits: dict[str, tuple[float, float]] = {}
+    for body in world.iter("body"):
+        joints = [j for j in body if j.tag in ("joint", "freejoint")]
+        names = []
+        for j in joints:
+            kind = "free" if j.tag == "freejoint" else defaults.get(j, "type", "hinge")
+            if kind not in _JOINT_TYPES:
+                raise SpecError(source, f"joint {j.get('name')!r}: type {kind!r} is not one of {list(_JOINT_TYPES)}")
+            if not j.get("name"):
+                raise SpecError(source, f"a {kind} joint of body {body.get('name')!r} has no name; name every joint")
+            names.append(j.get("name"))
+            rng, limited = defaults.get(j, "range"), defaults.get(j, "limited", "auto")
+            if kind in ("hinge", "slide") and rng is not None and limited != "false":
+                lo, hi = _floats(rng, 2, f"joint {j.get('name')!r} range", source)
+                limits[j.get("name")] = tuple(np.deg2rad([lo, hi])) if kind == "hinge" and degrees else (lo, hi)
+        if names:
+            body_joints[names[0]] = names
+
+    equalities = [el for el in root.findall("equality/*") if isinstance(el.tag, str)]
+    for el in equalities:
+        if el.tag not in ("connect", "weld"):
+            raise SpecError(source, f"<equality><{el.tag}> is not a loop closure pkm reads (connect and weld are)")
+    counts = {"connect": 0, "weld": 0}
+    eq_names = []
+    for el in equalities:
+        counts[el.tag] += 1
+        eq_names.append((el.tag, el.get("name") or f"{el.tag}{counts[el.tag]}"))
+    actuated = []
+    for el in root.findall("actuator/*"):
+        joint = el.get("joint") or el.get("jointinparent")
+        if isinstance(el.tag, str) and el.tag in _ACTUATORS and joint and joint not in actuated:
+            actuated.append(joint)
+
+    # Pinocchio reads one body under <worldbody>: wrap everything in one fixed body at the origin
+    wrapper = etree.Element("body", name=_WORLD)
+    for child in list(world):
+        wrapper.append(child)
+    world.append(wrapper)
+    with tempfile.TemporaryDirectory(prefix="pkm-mjcf-") as tmp:
+        path = os.path.join(tmp, "model.xml")
+        with open(path, "wb") as fh:
+            fh.write(etree.tostring(root))
+        try:
+            model, points, welds = pin.buildModelAndConstraintsFromMJCF(path)
+        except Exception as exc:  # Pinocchio's own exception types must not leak
+            raise SpecError(source, f"Pinocchio rejects the MJCF: {exc}") from None
+    if len(points) != counts["connect"] or len(welds) != counts["weld"]:
+        raise SpecError(source, f"Pinocchio read {len(points)} connect and {len(welds)} weld constraints, the file "
+                                f"states {counts['connect']} and {counts['weld']}")
+
+    taken = set(model.names) | {f.name for f in model.frames}
+    extra: list[tuple[str, int, pin.SE3]] = []
+    for site in world.iter("site"):  # the sites Pinocchio dropped (those of bodies without joints)
+        if site.get("name") and site.get("name") not in taken:
+            body = site.getparent().get("name")
+            if not model.existFrame(body, pin.FrameType.BODY):
+                continue
+            bf = model.frames[model.getFrameId(body, pin.FrameType.BODY)]
+            pos = _floats(defaults.get(site, "pos", "0 0 0"), 3, f"site {site.get('name')!r} pos", source)
+            extra.append((site.get("name"), bf.parentJoint, bf.placement * pin.SE3(_rotation(site, degrees, source),
+                                                                                     pos)))
+            taken.add(site.get("name"))
+    closures = []
+    iters = {"connect": iter(points), "weld": iter(welds)}
+    for tag, name in eq_names:
+        cm = next(iters[tag])
+        frames = []
+        for end, jid, M in (("a", cm.joint1_id, cm.joint1_placement), ("b", cm.joint2_id, cm.joint2_placement)):
+            fname = f"{name}_{end}"
+            while fname in taken:
+                fname += "_"
+            taken.add(fname)
+            extra.append((fname, jid, M))
+            frames.append(fname)
+        closures.append(Closure(name, "point" if tag == "connect" else "frame", *frames))
+
+    joint_names = {f"Composite_{first}": parts for first, parts in body_joints.items() if len(parts) > 1}
+    name = root.get("model", "mjcf")
+    urdf, types = urdf_from_model(model, name=name, joint_names=joint_names, limits=limits, frames=extra,
+                                  skip_frames=(_WORLD,), source=source)
+    known = {p for parts in body_joints.values() for p in parts}
+    for a in actuated:
+        if a not in known:
+            raise SpecError(source, f"an actuator drives joint {a!r}, which the file does not define")
+    return Imported(urdf, tuple(closures), types, tuple(actuated), name, "mjcf")
+
+
+__all__ = ["read_mjcf"]

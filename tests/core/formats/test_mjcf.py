@@ -1,0 +1,142 @@
+"""pkm.core.formats.mjcf: MuJoCo files read through Pinocchio's parser into pkm's one representation, with the
+parser's gaps worked around, each checked here against Pinocchio's own model or the file's numbers."""
+
+from __future__ import annotations
+
+import pickle
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import pkm
+from pkm.core.compare import mechanism_differences
+from pkm.core.formats.mjcf import read_mjcf
+from pkm.core.joints import retype_joints
+from pkm.core.urdf import load_model
+from pkm.errors import SpecError
+
+FOURBAR = Path(__file__).resolve().parents[3] / "examples" / "mjcf_fourbar" / "fourbar.xml"
+
+#: A body with two hinges (Pinocchio's composite joint), a ball and a slide in one body, ranges in degrees,
+#: a site on the body without joints, a second body under <worldbody>, a connect to the world and a weld.
+PROBE = """<mujoco model="probe">
+  <compiler angle="degree"/>
+  <default><default class="stiff"><joint range="-30 30"/></default></default>
+  <worldbody>
+    <body name="stand" pos="0 0 0.2"><site name="stand_tip" pos="0 1 0" euler="0 0 90"/></body>
+    <body name="a" pos="0 0 0.5" euler="0 0 90">
+      <joint name="ja" type="hinge" axis="1 0 0" range="-90 45"/>
+      <joint name="jb" type="hinge" axis="0 1 0" pos="0 0 0.1" class="stiff"/>
+      <geom type="sphere" size="0.1" mass="1"/>
+      <body name="b" pos="0.2 0 0">
+        <joint name="jball" type="ball"/>
+        <joint name="jslide" type="slide" axis="0 0 1" range="-0.1 0.1"/>
+        <geom type="box" size="0.1 0.05 0.02" mass="2"/>
+        <site name="bs" pos="0.1 0 0"/>
+      </body>
+    </body>
+    <body name="c" pos="1 0 0"><joint name="jc" type="slide" axis="1 0 0"/><geom type="sphere" size="0.05" mass="0.5"/></body>
+  </worldbody>
+  <equality>
+    <connect name="tie" body1="b" anchor="0.1 0 0"/>
+    <weld body1="a" body2="b"/>
+  </equality>
+  <actuator><motor joint="ja"/><position joint="jc"/></actuator>
+</mujoco>"""
+
+
+@pytest.fixture(scope="module")
+def probe():
+    return read_mjcf(PROBE, "probe.xml")
+
+
+def _pinocchio_model(tmp_path: Path, text: str) -> pin.Model:
+    """Pinocchio's own reading of ``text`` with every worldbody child wrapped in one body (what it reads)."""
+    wrapped = text.replace("<worldbody>", "<worldbody><body name='w'>").replace("</worldbody>", "</body></worldbody>")
+    (tmp_path / "m.xml").write_text(wrapped)
+    return pin.buildModelAndConstraintsFromMJCF(str(tmp_path / "m.xml"))[0]
+
+
+def test_the_urdf_gives_pinocchios_tree_back(probe, tmp_path):
+    """Same q layout; every body and site frame and RNEA agree with Pinocchio's model at random states (1e-12)."""
+    ours = retype_joints(load_model(probe.urdf), probe.joint_types)
+    ref = _pinocchio_model(tmp_path, PROBE)
+    assert (ours.nq, ours.nv) == (ref.nq, ref.nv)
+    d1, d2 = ref.createData(), ours.createData()
+    rng = np.random.default_rng(0)
+    names = [f.name for f in ref.frames if f.type in (pin.FrameType.BODY, pin.FrameType.OP_FRAME) and f.name != "w"]
+    assert {"a", "b", "c", "bs", "stand"} <= set(names)
+    for _ in range(5):
+        q = pin.randomConfiguration(ref, -np.ones(ref.nq), np.ones(ref.nq))
+        v, a = rng.normal(size=ref.nv), rng.normal(size=ref.nv)
+        pin.framesForwardKinematics(ref, d1, q)
+        pin.framesForwardKinematics(ours, d2, q)
+        for n in names:
+            M1, M2 = d1.oMf[ref.getFrameId(n)], d2.oMf[ours.getFrameId(n, pin.FrameType.BODY)]
+            assert np.abs(M1.homogeneous - M2.homogeneous).max() <= 1e-12, n
+        assert np.abs(pin.rnea(ref, d1, q, v, a) - pin.rnea(ours, d2, q, v, a)).max() <= 1e-12
+
+
+def test_what_pinocchio_drops_is_read_from_the_file(probe):
+    """The second body under <worldbody>, the site of a body without joints, the composite's joint names, the
+    equalities' names, ranges (hinges in degrees, a slide's as a length, a default class's), the actuators."""
+    model = load_model(probe.urdf)
+    assert {"ja", "jb", "jball", "jslide", "jc"} <= set(model.names)
+    assert probe.actuated == ("ja", "jc")
+    assert probe.joint_types == {"jball": "spherical"}
+    assert [(c.name, c.type) for c in probe.closures] == [("tie", "point"), ("weld1", "frame")]
+    mech = pkm.Mechanism.from_strings(probe.urdf, pkm.ClosureSpec(
+        mechanism="probe", urdf="probe.urdf", end_effector=None, actuated=probe.actuated, closures=probe.closures,
+        task=pkm.core.spec.TaskSpec((), probe.actuated), reference={}, joint_types=probe.joint_types))
+    assert mech.limits["ja"] == pytest.approx((-np.pi / 2, np.pi / 4), abs=1e-15)
+    assert mech.limits["jb"] == pytest.approx((-np.pi / 6, np.pi / 6), abs=1e-15)
+    assert mech.limits["jslide"] == (-0.1, 0.1)
+    pin.framesForwardKinematics(mech.model, mech.data, pin.neutral(mech.model))
+    tip = mech.data.oMf[mech.frame_id("stand_tip")]
+    assert np.allclose(tip.translation, [0, 1, 0.2], atol=1e-15)
+    assert np.allclose(tip.rotation, pin.AngleAxis(np.pi / 2, np.array([0, 0, 1.0])).matrix(), atol=1e-15)
+
+
+def test_a_file_loads_pickles_and_saves_as_a_spec_that_round_trips(tmp_path):
+    mech = pkm.load(FOURBAR)
+    assert mech.actuated_names == ("crank_joint",) and mech.spec.closures[0].name == "pin_c"
+    assert mechanism_differences(mech, pickle.loads(pickle.dumps(mech))) == []
+    again = pkm.load(pkm.save(mech, tmp_path / "fourbar.closures.toml"))
+    assert mechanism_differences(mech, again) == []
+
+
+def test_a_spec_may_name_an_mjcf_file_and_add_a_task(tmp_path):
+    (tmp_path / "fourbar.xml").write_text(FOURBAR.read_text())
+    spec = tmp_path / "fourbar.closures.toml"
+    spec.write_text('format = "pkm.closures/1"\nmechanism = "fb"\nurdf = "fourbar.xml"\nend_effector = "coupler_point"\n'
+                    'actuated = ["crank_joint"]\n[task]\ncomponents = ["x"]\n')
+    mech = pkm.load(spec)
+    assert [c.name for c in mech.spec.closures] == ["pin_c"] and mech.task_map.names == ("x",)
+    clash = spec.read_text() + '[[closure]]\nname = "pin_c"\ntype = "point"\nframe_a = "crank"\nframe_b = "rocker"\n'
+    spec.write_text(clash)
+    with pytest.raises(SpecError, match="'pin_c' is both in the spec"):
+        pkm.load(spec)
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda s: s.replace("<worldbody>", "<include file='x.xml'/><worldbody>"), "<include> is refused"),
+    (lambda s: s.replace("</equality>", "<joint joint1='jb' joint2='jc'/></equality>"), "<joint> is not a loop"),
+    (lambda s: s.replace('<joint name="jc"', '<joint'), "has no name"),
+    (lambda s: s.replace('<joint name="jb" type="hinge"', '<joint name="jb" type="screw"'), "type 'screw'"),
+    (lambda s: s.replace('<position joint="jc"/>', '<position joint="nope"/>'), "joint 'nope'"),
+    (lambda s: s.replace("<mujoco", "<robot").replace("</mujoco>", "</robot>"), "expected <mujoco>"),
+    (lambda s: s.replace("<compiler", "<compiler eulerseq='zyx'"), "eulerseq"),
+    (lambda s: s[:200], "not well-formed"),
+])
+def test_what_it_refuses_it_says(edit, message):
+    with pytest.raises(SpecError, match=message):
+        read_mjcf(edit(PROBE), "probe.xml")
+
+
+def test_a_file_without_actuators_says_how_to_name_them(tmp_path):
+    path = tmp_path / "passive.xml"
+    path.write_text(FOURBAR.read_text().replace('<motor name="drive" joint="crank_joint" gear="1"/>', ""))
+    with pytest.raises(SpecError, match=r"names no actuated joint.*pkm spec init"):
+        pkm.load(path)

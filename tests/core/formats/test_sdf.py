@@ -1,0 +1,118 @@
+"""pkm.core.formats.sdf: SDFormat models with loops, read by pkm itself (the PyPI Pinocchio has no SDFormat), with
+SDFormat's pose semantics; each cut joint becomes closures that are exactly that joint."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import pkm
+from pkm.core.formats.sdf import read_sdf
+from pkm.core.spec import TaskSpec
+from pkm.errors import SpecError
+
+INERTIA = ("<inertial><mass>0.2</mass><inertia><ixx>1e-4</ixx><iyy>1e-4</iyy><izz>1e-4</izz><ixy>0</ixy><ixz>0</ixz>"
+           "<iyz>0</iyz></inertia></inertial>")
+
+
+def fourbar(cut: str = "revolute", extra: str = "", version: str = "1.7") -> str:
+    """A spatial four-bar about y: crank at the origin, rocker at x = 0.3 (posed in degrees, relative to the
+    crank's pose), the loop cut at the coupler-rocker joint, of type ``cut``."""
+    axis = "" if cut in ("ball", "fixed") else "<axis><xyz expressed_in='__model__'>0 1 0</xyz></axis>"
+    return f"""<sdf version="{version}"><model name="fb">
+      <link name="crank">{INERTIA}</link>
+      <link name="coupler"><pose relative_to="crank">0 0 0.1 0 0 0</pose>{INERTIA}</link>
+      <link name="rocker"><pose degrees="true">0.3 0 0 0 0 0</pose>{INERTIA}</link>
+      <frame name="tip" attached_to="coupler"><pose relative_to="coupler">0.15 0 0.07 0 0 0</pose></frame>
+      <joint name="crank_joint" type="revolute"><parent>world</parent><child>crank</child>
+        <axis><xyz>0 1 0</xyz><limit><lower>-2</lower><upper>2</upper></limit></axis></joint>
+      <joint name="coupler_joint" type="revolute"><parent>crank</parent><child>coupler</child>
+        <axis><xyz>0 1 0</xyz><use_parent_model_frame>true</use_parent_model_frame></axis></joint>
+      <joint name="rocker_joint" type="revolute"><parent>world</parent><child>rocker</child>
+        <axis><xyz>0 1 0</xyz></axis></joint>
+      <joint name="cut" type="{cut}"><parent>coupler</parent><child>rocker</child>
+        <pose>0 0 0.15 0 0 0</pose>{axis}</joint>
+      {extra}
+    </model></sdf>"""
+
+
+def mechanism(text: str, actuated=("crank_joint",)) -> pkm.Mechanism:
+    imp = read_sdf(text, "fb.sdf")
+    spec = pkm.ClosureSpec(mechanism="fb", urdf="fb.sdf", end_effector=None, actuated=tuple(actuated),
+                           closures=imp.closures, task=TaskSpec((), tuple(actuated)), reference={},
+                           joint_types=imp.joint_types)
+    return pkm.Mechanism.from_strings(imp.urdf, spec, source="fb.sdf")
+
+
+def placements(mech, q, *names):
+    pin.framesForwardKinematics(mech.model, mech.data, q)
+    return [mech.data.oMf[mech.frame_id(n)] for n in names]
+
+
+def test_poses_follow_sdformat():
+    """relative_to, degrees, a <frame>; the joint pose in the child's frame; axes in the joint or the model frame."""
+    mech = mechanism(fourbar())
+    coupler, rocker, tip, cut = placements(mech, mech.q_reference, "coupler", "rocker", "tip", "cut_child")
+    assert np.allclose(coupler.translation, [0, 0, 0.1]) and np.allclose(rocker.translation, [0.3, 0, 0])
+    assert np.allclose(tip.translation, [0.15, 0, 0.17]) and np.allclose(cut.translation, [0.3, 0, 0.15])
+    assert mech.limits == {"crank_joint": (-2.0, 2.0)}
+
+
+@pytest.mark.parametrize("cut, closures", [("revolute", [("cut", "point"), ("cut_axis", "point")]),
+                                           ("ball", [("cut", "point")])])
+def test_a_cut_joint_becomes_closures_that_are_exactly_that_joint(cut, closures):
+    """Moved by the crank: the two halves of the cut keep their origin and, for a revolute, its axis."""
+    mech = mechanism(fourbar(cut))
+    assert [(c.name, c.type) for c in mech.spec.closures] == closures
+    q = pkm.close_loops(mech, [0.4], mech.q_reference).q
+    child, parent = placements(mech, q, "cut_child", "cut_parent")
+    assert np.allclose(child.translation, parent.translation, atol=1e-12)
+    if cut == "revolute":
+        assert np.allclose(child.rotation[:, 1], parent.rotation[:, 1], atol=1e-12)  # the y axis, the joint's
+        assert np.allclose(child.rotation[:, 1], [0, 1, 0], atol=1e-12)
+    assert pkm.diagnose(mech, q).mobility == 1  # (the rocker's revolute to the world keeps a ball cut planar)
+
+
+def test_a_cut_prismatic_joint_stays_in_the_tree():
+    text = fourbar("revolute").replace('name="cut" type="revolute"', 'name="cut" type="prismatic"')
+    imp = read_sdf(text, "fb.sdf")
+    assert [(c.name, c.type, c.frame_a) for c in imp.closures] == [("cut", "frame", "cut_cut")]
+    assert "<joint name=\"cut\" type=\"prismatic\">" in imp.urdf
+
+
+def test_a_fixed_cut_is_a_frame_closure():
+    imp = read_sdf(fourbar("fixed"), "fb.sdf")
+    assert [(c.name, c.type) for c in imp.closures] == [("cut", "frame")]
+
+
+def test_a_base_link_without_a_parent_is_fixed_where_it_is_posed():
+    text = fourbar().replace("<parent>world</parent><child>rocker</child>", "<parent>ground</parent><child>rocker</child>")
+    text = text.replace("<parent>world</parent><child>crank</child>", "<parent>ground</parent><child>crank</child>")
+    text = text.replace('<link name="crank">', '<link name="ground"><pose>0 0 1 0 0 0</pose></link><link name="crank">')
+    mech = mechanism(text)
+    (ground,) = placements(mech, mech.q_reference, "ground")
+    assert np.allclose(ground.translation, [0, 0, 1])
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda s: s.replace('type="revolute"><parent>crank', 'type="universal"><parent>crank'), "'universal' is not"),
+    (lambda s: s.replace("<parent>crank</parent>", "<parent>nope</parent>"), "parent 'nope' is not a link"),
+    (lambda s: s.replace('relative_to="crank"', 'relative_to="nowhere"'), "relative_to 'nowhere'"),
+    (lambda s: s.replace("</model>", "<link name='s1'/><link name='s2'/></model>"), "have no parent joint"),
+    (lambda s: s.replace("</model>", "<model name='inner'/></model>"), "nested models"),
+    (lambda s: s.replace("<axis><xyz>0 1 0</xyz></axis></joint>\n      <joint name=\"cut\"", "</joint>\n      "
+                         "<joint name=\"cut\""), "needs <axis><xyz>"),
+    (lambda s: s.replace("<sdf", "<robot").replace("</sdf>", "</robot>"), "expected <sdf>"),
+    (lambda s: s.replace('<link name="coupler">', '<link name="coupler_">'), "not a link"),
+])
+def test_what_it_refuses_it_says(edit, message):
+    with pytest.raises(SpecError, match=message):
+        read_sdf(edit(fourbar()), "fb.sdf")
+
+
+def test_an_sdf_file_alone_says_that_a_spec_must_name_the_actuators(tmp_path):
+    path = tmp_path / "fb.sdf"
+    path.write_text(fourbar())
+    with pytest.raises(SpecError, match="names no actuated joint"):
+        pkm.load(path)
