@@ -63,25 +63,6 @@ def test_attribute_parser_reads_grouped_entries_and_continuations():
     assert cli.param_info("delta")["La"].units == ("m",) and cli.param_info("delta")["La"].default == 0.11
 
 
-@pytest.mark.parametrize("text,kinds,expected", [
-    ("120mm", {"length"}, 0.12), ("81cm", {"length"}, 0.81), ("0.2", {"length"}, 0.2), ("-11deg", {"angle"},
-     math.radians(-11)), ("2.5e-1 rad", {"angle"}, 0.25), ("500g", {"mass"}, 0.5), ("3", {None}, 3.0)])
-def test_quantities_convert_to_si(text, kinds, expected):
-    """Unit suffixes convert to SI (mm, cm, deg, g); a plain number is taken as SI."""
-    assert math.isclose(cli.parse_quantity(text, kinds, "v", "?"), expected, rel_tol=1e-12)
-
-
-@pytest.mark.parametrize("text,kinds,message", [
-    ("3deg", {"length"}, "'deg' is an angle unit but R is in [m]; use m, cm, mm or no unit"),
-    ("3in", {"length"}, "unknown unit 'in'"), ("abc", {"length"}, "is not a number"),
-    ("1g", {None}, "give the number in that unit")])
-def test_bad_quantities_are_refused(text, kinds, message):
-    """A suffix of the wrong kind, an unknown suffix or a non-number raise UsageError saying so."""
-    with pytest.raises(cli.UsageError) as exc:
-        cli.parse_quantity(text, kinds, "R", "m")
-    assert message in str(exc.value)
-
-
 # ---------------------------------------------------------------------- list
 def test_console_script_lists_every_mechanism_as_json():
     """The installed ``pkm`` script prints every mechanism's parameters with defaults and units, SI."""

@@ -183,13 +183,18 @@ def test_platform_polygon_passes_through_the_closure_frames(case, which):
 
 
 def test_base_polygons_pass_through_the_anchors(case):
-    """The base mesh's vertices are anchors of the joints hung on the world: one triangle, two for the hexapod."""
+    """The base mesh's vertices are anchors of the joints hung on the world: one triangle, two for the hexapod; two
+    anchors get a bar between them."""
     mech, scene, _ = case
     model = mech.model
     anchors = np.array([model.jointPlacements[j].translation for j in range(1, model.njoints)
                         if model.parents[j] == 0 and model.joints[j].shortname() != "JointModelFreeFlyer"])
-    if len(anchors) < 3:  # two motors (the five-bar): no polygon to draw
-        assert not [b for b in scene.bodies if b.role == "base"]
+    if len(anchors) < 3:  # two motors (the five-bar): a bar between them
+        (bar,) = [b for b in scene.bodies if b.role == "base"]
+        half = bar.offset[:3, 1] * bar.size[0] / 2  # (a cylinder's axis is its local y)
+        ends = np.array([bar.offset[:3, 3] - half, bar.offset[:3, 3] + half])
+        dist = np.linalg.norm(ends[:, None] - anchors[None], axis=-1)
+        assert bar.kind == "cylinder" and dist.min(axis=1).max() <= TOL and dist.min(axis=0).max() <= TOL
         return
     body = scene.body(f"{viz.ROOT}/base")
     dist = np.linalg.norm(body.vertices[:, None] - anchors[None], axis=-1)

@@ -23,10 +23,10 @@ from pkm.mechanisms import definition as mechanism_definition
 from pkm.mechanisms import module as mechanism_module
 
 #: Names of the generic core, imported on first use (``import pkm`` stays cheap: no Pinocchio until needed).
-_CORE = ("ClosureSpec", "Configuration", "Diagnostics", "Mechanism", "SolveResult", "TaskMap", "accelerations",
-         "assemble", "close_loops", "diagnose", "forward_jacobian", "inverse_accelerations", "inverse_dynamics",
-         "inverse_jacobian", "inverse_velocities", "passive_map", "solve_ik", "task_acceleration", "task_velocity",
-         "twist_jacobian", "velocities")
+_CORE = ("ClosureSpec", "Configuration", "Diagnostics", "Jump", "Mechanism", "SolveResult", "TaskMap", "Trajectory",
+         "accelerations", "assemble", "close_loops", "diagnose", "follow_actuators", "follow_task", "forward_jacobian",
+         "idle_motions", "inverse_accelerations", "inverse_dynamics", "inverse_jacobian", "inverse_velocities",
+         "passive_map", "solve_ik", "task_acceleration", "task_values", "task_velocity", "twist_jacobian", "velocities")
 
 if TYPE_CHECKING:  # the static view of the lazy names
     from pathlib import Path
@@ -35,14 +35,19 @@ if TYPE_CHECKING:  # the static view of the lazy names
         ClosureSpec,
         Configuration,
         Diagnostics,
+        Jump,
         Mechanism,
         SolveResult,
         TaskMap,
+        Trajectory,
         accelerations,
         assemble,
         close_loops,
         diagnose,
+        follow_actuators,
+        follow_task,
         forward_jacobian,
+        idle_motions,
         inverse_accelerations,
         inverse_dynamics,
         inverse_jacobian,
@@ -50,13 +55,15 @@ if TYPE_CHECKING:  # the static view of the lazy names
         passive_map,
         solve_ik,
         task_acceleration,
+        task_values,
         task_velocity,
         twist_jacobian,
         velocities,
     )
+    from pkm.units import quantity
 
 
-__getattr__, __dir__ = lazy("pkm", globals(), dict.fromkeys(_CORE, "pkm.core"))
+__getattr__, __dir__ = lazy("pkm", globals(), {**dict.fromkeys(_CORE, "pkm.core"), "quantity": "pkm.units"})
 
 __version__ = "0.1.0"
 
@@ -140,18 +147,39 @@ def save(mech: Mechanism, spec_path) -> Path:
 
 
 def build(name: str, **params) -> Mechanism:
-    """Mechanism ``name`` generated from parameters (SI units; unspecified ones keep the paper's values).
+    """Mechanism ``name`` generated from parameters (SI units, or strings with units: ``R="120mm"``;
+    unspecified ones keep the paper's values).
 
     Raises:
         UnknownNameError: an unknown mechanism or parameter name (the valid ones listed).
         InvalidParameterError: a parameter out of range, or a design that cannot assemble at its
             reference pose (see the mechanism's ``Params``).
     """
+    from pkm.units import KIND_OF_UNIT, parse_quantity
+
     mod = mechanism_module(name)
-    fields = [f.name for f in dataclasses.fields(mod.Params)]
+    fields = {f.name: f for f in dataclasses.fields(mod.Params)}
     for key in params:
         if key not in fields:
             raise UnknownNameError("parameter", key, fields, f"pkm.build({name!r})")
+
+    def si(key: str, value, units: tuple[str, ...]):  # a string with a unit, by the field's units
+        if not isinstance(value, str):
+            return value
+        try:
+            return parse_quantity(value, {KIND_OF_UNIT.get(u) for u in units}, key, "/".join(units))
+        except errors.UnitError as exc:
+            raise errors.InvalidParameterError(key, str(exc), value) from None
+
+    for key, value in params.items():
+        units = tuple(fields[key].metadata.get("units", ()))
+        if not units:
+            continue
+        if isinstance(value, (tuple, list)):
+            per = [(u,) for u in units] if len(units) == len(value) else [units] * len(value)
+            params[key] = tuple(si(key, v, u) for v, u in zip(value, per))
+        else:
+            params[key] = si(key, value, units)
     return mod.build(mod.Params(**params))
 
 
@@ -160,17 +188,22 @@ __all__ = [
     "ClosureSpec",
     "Configuration",
     "Diagnostics",
+    "Jump",
     "Mechanism",
     "PkmError",
     "SolveResult",
     "TaskMap",
+    "Trajectory",
     "accelerations",
     "assemble",
     "build",
     "close_loops",
     "diagnose",
     "errors",
+    "follow_actuators",
+    "follow_task",
     "forward_jacobian",
+    "idle_motions",
     "inverse_accelerations",
     "inverse_dynamics",
     "inverse_jacobian",
@@ -179,9 +212,11 @@ __all__ = [
     "mechanism_definition",
     "mechanism_module",
     "passive_map",
+    "quantity",
     "save",
     "solve_ik",
     "task_acceleration",
+    "task_values",
     "task_velocity",
     "twist_jacobian",
     "velocities",

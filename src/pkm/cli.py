@@ -30,7 +30,6 @@ import argparse
 import dataclasses
 import inspect
 import json
-import math
 import os
 import re
 import signal
@@ -44,21 +43,12 @@ from typing import Any
 import numpy as np
 
 import pkm
-from pkm.errors import ConvergenceError, InvalidInputError, PkmError, SpecError, UnknownNameError
+from pkm.errors import ConvergenceError, InvalidInputError, PkmError, SpecError, UnitError, UnknownNameError
 from pkm.report import jsonable
+from pkm.units import KIND_OF_UNIT, SI_UNITS, SUFFIXES, parse_quantity
 
 PROG = "pkm"
 
-#: Unit suffixes accepted on the command line: suffix -> (kind, factor to SI).
-SUFFIXES: dict[str, tuple[str, float]] = {
-    "m": ("length", 1.0), "cm": ("length", 1e-2), "mm": ("length", 1e-3),
-    "rad": ("angle", 1.0), "deg": ("angle", math.pi / 180.0),
-    "kg": ("mass", 1.0), "g": ("mass", 1e-3),
-}
-#: The SI unit of each kind a suffix can convert to.
-SI_UNITS = {"length": "m", "angle": "rad", "mass": "kg"}
-_KIND_OF_UNIT = {v: k for k, v in SI_UNITS.items()}
-_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z]*)\s*$")
 _UNIT = re.compile(r"\[([A-Za-z][A-Za-z0-9^ /*.-]*|-)\]")
 _ITEM = re.compile(r"^([A-Za-z_]\w*(?:\s*,\s*[A-Za-z_]\w*)*):\s*(.*)$")
 _UNITLESS_TYPES = ("str", "int", "bool")
@@ -166,38 +156,7 @@ def param_info(mechanism: str) -> dict[str, ParamInfo]:
 
 
 def _kinds(units: Sequence[str]) -> set[str | None]:
-    return {_KIND_OF_UNIT.get(u) for u in units}
-
-
-def parse_quantity(text: str, kinds: set[str | None], what: str, unit: str) -> float:
-    """A number with an optional unit suffix, converted to SI.
-
-    Args:
-        text: ``"120mm"``, ``"-11deg"``, ``"0.81"``.
-        kinds: Kinds the quantity may have (``"length"``, ``"angle"``, ``"mass"``; ``None``: a unit
-            without suffixes, e.g. ``kg m^2``); a plain number is always accepted (SI).
-        what: Name of the quantity, for messages.
-        unit: Its unit(s) as documented, for messages.
-
-    Raises:
-        UsageError: Not a number, an unknown suffix, or a suffix of another kind.
-    """
-    m = _NUMBER.match(text)
-    if not m:
-        raise UsageError(f"{what}={text!r} is not a number (with an optional unit: m, cm, mm, rad, deg, kg, g)")
-    value, suffix = float(m.group(1)), m.group(2)
-    if not suffix:
-        return value
-    if suffix not in SUFFIXES:
-        raise UsageError(f"{what}={text}: unknown unit {suffix!r}; use m, cm, mm (lengths), rad, deg (angles), "
-                         f"kg, g (masses), or no unit for SI")
-    kind, factor = SUFFIXES[suffix]
-    if kind not in kinds:
-        accepted = [s for s, (k, _) in SUFFIXES.items() if k in kinds]
-        hint = f"use {', '.join(accepted)} or no unit" if accepted else "give the number in that unit, no suffix"
-        article = "an" if kind[0] in "aeiou" else "a"
-        raise UsageError(f"{what}={text}: {suffix!r} is {article} {kind} unit but {what} is in [{unit}]; {hint}")
-    return value * factor
+    return {KIND_OF_UNIT.get(u) for u in units}
 
 
 def _split(item: str, what: str) -> tuple[str, str]:
@@ -236,7 +195,7 @@ def parse_params(mechanism: str, items: Sequence[str]) -> dict[str, Any]:
             parts = text.split(",")
             if len(parts) != p.length:
                 raise UsageError(f"{name} takes {p.length} comma-separated values, got {len(parts)} in {text!r}")
-            per = [{_KIND_OF_UNIT.get(u)} for u in p.units] if len(p.units) == len(parts) else \
+            per = [{KIND_OF_UNIT.get(u)} for u in p.units] if len(p.units) == len(parts) else \
                 [_kinds(p.units)] * len(parts)
             out[name] = tuple(parse_quantity(s, k, name, p.unit) for s, k in zip(parts, per))
         else:
@@ -249,59 +208,27 @@ def _joint_kind(mech: pkm.Mechanism, name: str) -> str:
     return "angle" if mech.joints[name].revolute else "length"
 
 
-def task_keys(mech: pkm.Mechanism) -> tuple[str, ...]:
-    """The names ``--pose`` takes: the task components (a pose task: x y z roll pitch yaw), then joints."""
-    task = mech.spec.task
-    head = ("x", "y", "z", "roll", "pitch", "yaw") if task.is_pose else task.components
-    return tuple(head) + tuple(task.joints)
-
-
-def _key_kind(mech: pkm.Mechanism, key: str) -> str:
-    if key in ("x", "y", "z"):
-        return "length"
-    if key in ("roll", "pitch", "yaw"):
-        return "angle"
-    return _joint_kind(mech, key)
-
-
 def task_values(mech: pkm.Mechanism, q) -> dict[str, float]:
-    """The task coordinates of ``q`` by name (see :func:`task_keys`; angles Z-Y-X Euler) [m, rad]."""
-    import pinocchio as pin
-
-    from pkm.core import zyx_angles
-
-    y = mech.task_map.value(q)
-    if not mech.spec.task.is_pose:
-        return dict(zip(task_keys(mech), map(float, y)))
-    R = pin.Quaternion(y[6], y[3], y[4], y[5]).toRotationMatrix()  # (x, y, z, w) in the task vector
-    head = list(y[:3]) + list(zyx_angles(R))
-    return dict(zip(task_keys(mech), map(float, head + list(y[7:]))))
+    """The task coordinates of ``q`` by name (:meth:`pkm.core.TaskMap.named`; angles Z-Y-X Euler) [m, rad]."""
+    return mech.task_map.named(q)
 
 
 def parse_pose(mech: pkm.Mechanism, items: Sequence[str]) -> tuple[dict[str, float], Any]:
     """``--pose`` items as (named values, target for :func:`pkm.solve_ik`); others keep the reference.
 
     Raises:
-        UsageError: Missing ``=`` or a bad number or unit.
+        UnitError: a bad number or unit; UsageError: a missing ``=``.
         UnknownNameError: A name that is not a task coordinate.
     """
-    import pinocchio as pin
-
-    from pkm.core import zyx_matrix
-
-    values = task_values(mech, mech.q_reference)
+    task = mech.task_map
+    values = task.named(mech.q_reference)
     for item in items:
         name, text = _split(item, "--pose")
         if name not in values:
             raise UnknownNameError("task coordinate", name, list(values), mech.name)
-        kind = _key_kind(mech, name)
+        kind = task.kinds[name]
         values[name] = parse_quantity(text, {kind}, name, SI_UNITS[kind])
-    task = mech.spec.task
-    if not task.is_pose:
-        return values, [values[k] for k in task_keys(mech)]
-    M = pin.SE3(zyx_matrix(values["roll"], values["pitch"], values["yaw"]),
-                np.array([values["x"], values["y"], values["z"]]))
-    return values, {"pose": M, **{j: values[j] for j in task.joints}}
+    return values, values
 
 
 def parse_joints(mech: pkm.Mechanism, items: Sequence[str]) -> np.ndarray:
@@ -362,7 +289,7 @@ def cmd_list(args) -> int:
         data[name] = {
             "title": entry.title,
             "actuated": {j: SI_UNITS[_joint_kind(mech, j)] for j in mech.actuated_names},
-            "task": {k: SI_UNITS[_key_kind(mech, k)] for k in task_keys(mech)},
+            "task": {k: SI_UNITS[kind] for k, kind in mech.task_map.kinds.items()},
             "branches": list(mech.spec.branches),
             "default_branch": mech.spec.default_branch,
             "parameters": {p.name: {"default": p.default, "unit": p.unit, "type": p.type,
@@ -656,7 +583,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             traceback.print_exc()
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         named_wrong = isinstance(exc, UnknownNameError) and not isinstance(exc, SpecError)  # not a broken file
-        return 2 if isinstance(exc, UsageError) or named_wrong else 1
+        return 2 if isinstance(exc, (UsageError, UnitError)) or named_wrong else 1
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130

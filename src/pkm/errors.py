@@ -28,6 +28,10 @@ class InvalidInputError(PkmError, ValueError):
         super().__init__(f"{name}: {message}")
 
 
+class UnitError(InvalidInputError):
+    """A quantity's text is not a number with a known unit of the right kind (``"3deg"`` for a length)."""
+
+
 class InvalidParameterError(InvalidInputError):
     """A mechanism parameter is invalid (negative length, geometry that cannot assemble...)."""
 

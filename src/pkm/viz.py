@@ -82,6 +82,7 @@ ROOT = "/meshcat/pkm"
 # Sizes relative to the mechanism's characteristic length (diagonal of its bounding box).
 _JOINT_RADIUS = 0.02
 _LINK_RADIUS = 0.4  # of the joint radius
+_BASE_BAR = 0.6  # the radius of the bar drawn between two base anchors, of the joint radius
 _PLATFORM_FRACTION = 0.15  # largest joint radius, of the platform's diameter
 _NESTED_SCALE = 1.35  # radius of a joint's ring around its parent's sphere
 _TRIAD_LENGTH = 0.12
@@ -312,6 +313,11 @@ def _build_bodies(mech: Mechanism, root: str) -> tuple[list[Body], float, str | 
     if hull is not None:
         bodies.append(Body(f"{root}/base", "mesh", "base", joint_frame(0), eye.copy(), BASE_COLOR, opacity=0.5,
                            vertices=hull[0], faces=hull[1], joint=model.names[0]))
+    elif len(ends := _unique(np.array(anchors).reshape(-1, 3), eps)) >= 2:  # two anchors, or a line: a bar
+        far = np.linalg.norm(ends[:, None] - ends[None], axis=-1)
+        a, b = np.unravel_index(int(np.argmax(far)), far.shape)
+        bodies.append(Body(f"{root}/base", "cylinder", "base", joint_frame(0), _segment(ends[a], ends[b]),
+                           BASE_COLOR, (float(far[a, b]), _BASE_BAR * r_joint), joint=model.names[0]))
 
     # links: cylinders from each joint's origin to its children and to the frames it carries
     rank = {pin.FrameType.BODY: 1, pin.FrameType.OP_FRAME: 2, pin.FrameType.FIXED_JOINT: 3}

@@ -39,7 +39,7 @@ def test_build_refuses_unknown_parameters_with_the_valid_names():
 
 
 @pytest.mark.parametrize("name, kwargs", [
-    ("delta", {"La": 10**400}), ("delta", {"La": "0.11"}), ("delta", {"La": True}), ("delta", {"La": 2e6}),
+    ("delta", {"La": 10**400}), ("delta", {"La": "0.11deg"}), ("delta", {"La": True}), ("delta", {"La": 2e6}),
     ("delta", {"home": "abc"}), ("delta", {"home": (0.0, 0.0)}), ("delta", {"home": (0.0, None, -0.3)}),
     ("rrr3", {"home": (0.0, 10**400, 0.0)}), ("rrr3", {"mode": 2.0}), ("rrr3", {"a": -0.4}),
     ("hexapod", {"layout": ["sector"]}), ("hexapod", {"theta": (1.0,) * 5}), ("hexapod", {"H0": np.nan}),

@@ -26,6 +26,7 @@ from pkm.core.joints import retype_joints
 from pkm.core.spec import ClosureSpec, as_path
 from pkm.core.urdf import load_model, position_limits
 from pkm.errors import AssemblyError, InvalidInputError, SpecError, SpecNameError, UnknownNameError
+from pkm.units import quantities
 from pkm.validation import as_array, as_vector, wrap_angle
 
 #: A spec's [reference] must close every loop to this (m or rad); one that lacks joints is assembled.
@@ -127,6 +128,7 @@ class Mechanism:
         self.act_q = np.array([j.idx_q for j in self.actuated])
         self.act_v = np.array([j.idx_v for j in self.actuated])
         self._revolute_q = np.array([j.idx_q for j in self.joints.values() if j.revolute], dtype=int)
+        self._revolute_v = np.array([j.idx_v for j in self.joints.values() if j.revolute], dtype=int)
         self.passive_v = np.array([i for i in range(model.nv) if i not in set(self.act_v)], dtype=int)
 
         self.constraint_models = []
@@ -326,7 +328,9 @@ class Mechanism:
         return as_vector(v, self.nv, name)
 
     def check_actuated(self, qa, name: str = "q_actuated") -> np.ndarray:
-        return as_vector(qa, self.na, name)
+        """Actuated values as a vector (``na``, SI); entries may be strings with units (``"5deg"``, ``"20mm"``)."""
+        return as_vector(quantities(qa, ["angle" if j.revolute else "length" for j in self.actuated], name),
+                         self.na, name)
 
     def actuated_q(self, q) -> np.ndarray:
         """The actuated coordinates of a configuration, in spec order."""
@@ -336,6 +340,13 @@ class Mechanism:
         q = np.array(q, dtype=float)
         q[self.act_q] = qa
         return q
+
+    def difference(self, q0, q1) -> np.ndarray:
+        """The tangent step from ``q0`` to ``q1`` (``pin.difference``), revolute angles taken the short way round
+        (a crank passing pi moves by a little, not by 2 pi)."""
+        dq = pin.difference(self.model, np.asarray(q0, dtype=float), np.asarray(q1, dtype=float))
+        dq[self._revolute_v] = wrap_angle(dq[self._revolute_v])
+        return dq
 
     def wrap(self, q) -> np.ndarray:
         """``q`` with every revolute coordinate brought into (-pi, pi]."""

@@ -180,7 +180,8 @@ def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol
 
     Args:
         mech: The mechanism.
-        target: Task coordinates (see :meth:`pkm.core.task.TaskMap.parse`).
+        target: Task coordinates (see :meth:`pkm.core.task.TaskMap.parse`): a vector, or a mapping by name of
+            some of them (``{"z": "-36cm"}``), the others those of the reference; values may carry units.
         q0: Seed configuration; default: the reference configuration (or, with ``branch``,
             the reference with that branch's joint signs imposed and the loops re-closed).
         branch: Working mode the solution must lie on; checked at the end (:class:`BranchError`).

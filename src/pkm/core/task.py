@@ -20,6 +20,7 @@ import pinocchio as pin
 
 from pkm.core.mechanism import Mechanism
 from pkm.errors import InvalidInputError, SingularityError
+from pkm.units import quantities, quantity
 from pkm.validation import as_array, as_vector
 
 _ANGLES = ("roll", "pitch", "yaw")
@@ -61,6 +62,12 @@ class TaskMap:
         self._jq = np.array([j.idx_q for j in mech.task_joints], dtype=int)
         self._jv = np.array([j.idx_v for j in mech.task_joints], dtype=int)
         self.names = (("x", "y", "z", "wx", "wy", "wz") if self.pose else self._comp) + self.spec.joints
+        #: The task coordinates by name, as :meth:`named` gives them and targets may state them (a pose:
+        #: ``x y z roll pitch yaw``), then the joint outputs.
+        self.keys = (("x", "y", "z", "roll", "pitch", "yaw") if self.pose else self._comp) + self.spec.joints
+        #: Each key's kind (``"length"`` or ``"angle"``), for units.
+        self.kinds = {k: ("length" if k in _POS else "angle" if k in _ANGLES
+                          else "angle" if mech.joints[k].revolute else "length") for k in self.keys}
 
     # values ---------------------------------------------------------------
     def value(self, q: np.ndarray) -> np.ndarray:
@@ -78,12 +85,22 @@ class TaskMap:
             head = np.array([M.translation[_POS[c]] if c in _POS else rpy[_ANGLES.index(c)] for c in self._comp])
         return np.concatenate([head, np.asarray(q)[self._jq]])
 
-    def parse(self, target) -> np.ndarray:
+    def named(self, q: np.ndarray) -> dict[str, float]:
+        """The task coordinates at ``q`` by name (:attr:`keys`; a pose as x y z and Z-Y-X Euler angles) [m, rad]."""
+        y = self.value(q)
+        if not self.pose:
+            return dict(zip(self.keys, map(float, y)))
+        R = pin.Quaternion(*_wxyz(y[3:7])).toRotationMatrix()
+        return dict(zip(self.keys, map(float, list(y[:3]) + list(zyx_angles(R)) + list(y[7:]))))
+
+    def parse(self, target, base: np.ndarray | None = None) -> np.ndarray:
         """A target value from user input.
 
-        Accepted: a flat vector of the task coordinates; a mapping ``{name: value}`` over all of
-        them (``"pose"`` maps to a ``pin.SE3`` or a 4x4 matrix); for a pose task, a ``pin.SE3``
-        or 4x4 matrix alone when there are no joint outputs.
+        Accepted: a flat vector of the task coordinates; a mapping ``{name: value}`` over some of
+        :attr:`keys` (a pose by ``x y z roll pitch yaw``), the others taken from the configuration ``base``
+        (default: the reference); a mapping with ``"pose"`` (a ``pin.SE3`` or a 4x4 matrix) and the
+        joint outputs; for a pose task, a ``pin.SE3`` or 4x4 matrix alone. Values may be strings with
+        units (``"20mm"``, ``"5deg"``; :mod:`pkm.units`).
         """
         nj = len(self.spec.joints)
         if self.pose and (isinstance(target, pin.SE3) or _shape(target) == (4, 4)):
@@ -91,18 +108,30 @@ class TaskMap:
                 raise InvalidInputError("target", f"this task also needs the joints {list(self.spec.joints)}: "
                                                   "pass {'pose': T, joint: value, ...}")
             target = {"pose": target}
-        if isinstance(target, Mapping):
-            keys = (("pose",) if self.pose else self._comp) + self.spec.joints
-            if set(target) != set(keys):
-                raise InvalidInputError("target", f"expected keys {list(keys)}, got {list(target)}")
-            parts = []
-            for k in keys:
-                if k == "pose":
-                    M = _as_se3(target[k])
-                    parts += list(M.translation) + list(pin.Quaternion(M.rotation).coeffs())
-                else:
-                    parts.append(target[k])
-            target = parts
+        if isinstance(target, Mapping) and "pose" in target and self.pose:
+            unknown = [k for k in target if k != "pose" and k not in self.spec.joints]
+            if unknown:
+                raise InvalidInputError("target", f"with 'pose' give only the joint outputs {list(self.spec.joints)}, "
+                                                  f"got {unknown}", target)
+            M = _as_se3(target["pose"])
+            rest = self.named(self.mech.q_reference if base is None else base)
+            target = list(M.translation) + list(pin.Quaternion(M.rotation).coeffs()) + [
+                quantity(target.get(j, rest[j]), self.kinds[j], j) for j in self.spec.joints]
+        elif isinstance(target, Mapping):
+            unknown = [k for k in target if k not in self.keys]
+            if unknown:
+                raise InvalidInputError("target", f"unknown task coordinates {unknown}; this task has {list(self.keys)}",
+                                        target)
+            values = self.named(self.mech.q_reference if base is None else base)
+            values.update({k: quantity(v, self.kinds[k], k) for k, v in target.items()})
+            if self.pose:
+                R = zyx_matrix(values["roll"], values["pitch"], values["yaw"])
+                target = [values["x"], values["y"], values["z"], *pin.Quaternion(R).coeffs(),
+                          *(values[j] for j in self.spec.joints)]
+            else:
+                target = [values[k] for k in self.keys]
+        elif not self.pose:
+            target = quantities(target, [self.kinds[k] for k in self.keys], "target")
         y = as_array(target, "target", f"{self.value_size} task coordinates {list(self.names)}")
         if y.shape != (self.value_size,):
             raise InvalidInputError("target", f"expected {self.value_size} task coordinates "

@@ -1,0 +1,106 @@
+"""Quantities with units at the edges: ``"20mm"``, ``"5deg"``, ``"81cm"`` to SI, in the Python API as on the
+command line.
+
+pkm computes in SI (m, rad, kg). Wherever the API takes a joint value, a task coordinate or a design
+parameter, it also takes a string with a unit suffix, converted here: lengths ``m cm mm``, angles
+``rad deg``, masses ``kg g``. A plain number (or a string without suffix) is SI. A suffix of another kind
+than the value's is refused (``"3deg"`` for a length), never silently converted::
+
+    pkm.quantity("20mm")             # 0.02
+    pkm.quantity("5deg", "angle")    # 0.0873
+    pkm.close_loops(delta, ["-30deg", "-25deg", "-35deg"])
+    pkm.solve_ik(delta, {"z": "-36cm"})       # the other task coordinates from the reference
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Collection
+
+from pkm.errors import InvalidInputError, UnitError
+
+#: Unit suffixes: suffix -> (kind, factor to SI).
+SUFFIXES: dict[str, tuple[str, float]] = {
+    "m": ("length", 1.0), "cm": ("length", 1e-2), "mm": ("length", 1e-3),
+    "rad": ("angle", 1.0), "deg": ("angle", math.pi / 180.0),
+    "kg": ("mass", 1.0), "g": ("mass", 1e-3),
+}
+#: The SI unit of each kind a suffix can convert to.
+SI_UNITS = {"length": "m", "angle": "rad", "mass": "kg"}
+#: The kind of each SI unit (``"m" -> "length"``).
+KIND_OF_UNIT = {v: k for k, v in SI_UNITS.items()}
+_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z]*)\s*$")
+
+
+def parse_quantity(text: str, kinds: Collection[str | None], what: str = "value", unit: str = "SI") -> float:
+    """A number with an optional unit suffix, converted to SI.
+
+    Args:
+        text: ``"120mm"``, ``"-11deg"``, ``"0.81"``.
+        kinds: Kinds the quantity may have (``"length"``, ``"angle"``, ``"mass"``; ``None``: a unit
+            without suffixes, e.g. ``kg m^2``); a plain number is always accepted (SI).
+        what: Name of the quantity, for messages.
+        unit: Its unit(s) as documented, for messages.
+
+    Raises:
+        UnitError: Not a number, an unknown suffix, or a suffix of another kind.
+    """
+    if not isinstance(text, str):
+        raise UnitError(what, f"expected a number or a string such as '20mm', got {type(text).__name__}", text)
+    m = _NUMBER.match(text)
+    if not m:
+        raise UnitError(what, f"{what}={text!r} is not a number (with an optional unit: m, cm, mm, rad, deg, kg, g)",
+                        text)
+    value, suffix = float(m.group(1)), m.group(2)
+    if not math.isfinite(value):
+        raise UnitError(what, f"{what}={text!r} is not finite", text)
+    if not suffix:
+        return value
+    if suffix not in SUFFIXES:
+        raise UnitError(what, f"{what}={text}: unknown unit {suffix!r}; use m, cm, mm (lengths), rad, deg (angles), "
+                              f"kg, g (masses), or no unit for SI", text)
+    kind, factor = SUFFIXES[suffix]
+    if kind not in kinds:
+        accepted = [s for s, (k, _) in SUFFIXES.items() if k in kinds]
+        hint = f"use {', '.join(accepted)} or no unit" if accepted else "give the number in that unit, no suffix"
+        article = "an" if kind[0] in "aeiou" else "a"
+        raise UnitError(what, f"{what}={text}: {suffix!r} is {article} {kind} unit but {what} is in [{unit}]; {hint}",
+                        text)
+    return value * factor
+
+
+def quantity(value, kind: str | None = None, what: str = "value") -> float:
+    """``value`` in SI: a number as it is, a string parsed with its unit (:func:`parse_quantity`).
+
+    Args:
+        value: ``0.02``, ``"20mm"``, ``"5deg"``.
+        kind: ``"length"``, ``"angle"`` or ``"mass"`` to accept only that kind's units; None: any.
+        what: Its name, for messages.
+
+    Raises:
+        UnitError: a bad string (see :func:`parse_quantity`); InvalidInputError: neither a number nor a string.
+    """
+    if kind is not None and kind not in SI_UNITS:
+        raise InvalidInputError("kind", f"use one of {list(SI_UNITS)} or None", kind)
+    if isinstance(value, str):
+        kinds = {kind} if kind else set(SI_UNITS)
+        return parse_quantity(value, kinds, what, SI_UNITS[kind] if kind else "SI")
+    if isinstance(value, bool) or (not isinstance(value, (int, float)) and not hasattr(value, "__float__")):
+        raise InvalidInputError(what, f"expected a number or a string such as '20mm', got {type(value).__name__}",
+                                value)
+    return float(value)
+
+
+def quantities(values, kinds, what: str):
+    """``values`` (a sequence) with every string entry converted by the kind at its position; other entries as
+    they are (the numeric checks follow in :func:`pkm.validation.as_vector`)."""
+    if isinstance(values, (str, bytes)) or not isinstance(values, (list, tuple)):
+        return values
+    if not any(isinstance(v, str) for v in values):
+        return values
+    return [quantity(v, k, f"{what}[{i}]") if isinstance(v, str) else v for i, (v, k) in
+            enumerate(zip(values, kinds))] + list(values[len(kinds):])
+
+
+__all__ = ["KIND_OF_UNIT", "SI_UNITS", "SUFFIXES", "parse_quantity", "quantities", "quantity"]

@@ -1,0 +1,65 @@
+"""pkm.units: quantities with units wherever the Python API takes a value (joints, task coordinates, parameters)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm.errors import InvalidInputError, UnitError
+from pkm.units import parse_quantity
+
+
+@pytest.mark.parametrize("text,kinds,expected", [
+    ("120mm", {"length"}, 0.12), ("81cm", {"length"}, 0.81), ("0.2", {"length"}, 0.2), ("-11deg", {"angle"},
+     math.radians(-11)), ("2.5e-1 rad", {"angle"}, 0.25), ("500g", {"mass"}, 0.5), ("3", {None}, 3.0)])
+def test_quantities_convert_to_si(text, kinds, expected):
+    """Unit suffixes convert to SI (mm, cm, deg, g); a plain number is taken as SI."""
+    assert math.isclose(parse_quantity(text, kinds, "v", "?"), expected, rel_tol=1e-12)
+
+
+@pytest.mark.parametrize("text,kinds,message", [
+    ("3deg", {"length"}, "'deg' is an angle unit but R is in [m]; use m, cm, mm or no unit"),
+    ("3in", {"length"}, "unknown unit 'in'"), ("abc", {"length"}, "is not a number"),
+    ("1g", {None}, "give the number in that unit")])
+def test_bad_quantities_are_refused(text, kinds, message):
+    """A suffix of the wrong kind, an unknown suffix or a non-number raise UnitError saying so."""
+    with pytest.raises(UnitError) as exc:
+        parse_quantity(text, kinds, "R", "m")
+    assert message in str(exc.value)
+
+
+
+def test_quantity_converts_and_checks_the_kind():
+    assert pkm.quantity("20mm") == pytest.approx(0.02, rel=1e-15)
+    assert pkm.quantity("5deg", "angle") == pytest.approx(math.radians(5), rel=1e-15)
+    assert pkm.quantity(0.3, "length") == 0.3
+    with pytest.raises(UnitError, match="'deg' is an angle unit"):
+        pkm.quantity("5deg", "length")
+    with pytest.raises(InvalidInputError, match="kind"):
+        pkm.quantity(1.0, "volume")
+    with pytest.raises(InvalidInputError, match="a number or a string"):
+        pkm.quantity([1.0])
+
+
+def test_joint_values_task_targets_and_parameters_take_units():
+    """close_loops takes "-30deg"; solve_ik a partial mapping with units (the rest from the reference); build a
+    parameter in mm, and a tuple parameter with one unit per entry."""
+    delta = pkm.build("delta", R="120mm", La="0.11")  # (a string without unit is SI)
+    assert (delta.params.R, delta.params.La) == pytest.approx((0.12, 0.11), rel=1e-15)
+    fk = pkm.close_loops(delta, ["-30deg", "-25deg", -0.6])
+    assert np.allclose(delta.actuated_q(fk.q), [math.radians(-30), math.radians(-25), -0.6], atol=1e-12)
+    ik = pkm.solve_ik(delta, {"z": "-36cm", "x": "1cm"})
+    assert pkm.task_values(delta, ik.q) == pytest.approx({"x": 0.01, "y": 0.0, "z": -0.36}, abs=1e-10)
+    with pytest.raises(UnitError, match="'deg' is an angle unit"):
+        pkm.solve_ik(delta, {"z": "3deg"})
+    with pytest.raises(InvalidInputError, match="unknown task coordinates"):
+        pkm.solve_ik(delta, {"w": 0.0})
+    prs3 = pkm.build("prs3", reference=("95cm", "1deg", "0deg"))
+    assert prs3.params.reference == pytest.approx((0.95, math.radians(1), 0.0), rel=1e-15)
+    hexapod = pkm.load("hexapod")
+    ref = pkm.task_values(hexapod, hexapod.q_reference)
+    ik = pkm.solve_ik(hexapod, {"yaw": "2deg"})
+    assert pkm.task_values(hexapod, ik.q) == pytest.approx({**ref, "yaw": math.radians(2)}, abs=1e-9)
