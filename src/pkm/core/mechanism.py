@@ -115,6 +115,8 @@ class Mechanism:
             raise SpecError(source, "no loop closure: give [[closure]] tables (or a model file with loops); pkm "
                                     "models closed-loop mechanisms, a tree alone needs none of it")
         self.ee_frame = frame(spec.end_effector, "end_effector") if spec.end_effector is not None else 0
+        #: The ids of the task's other frames (``[task.frames]``), in spec order.
+        self.task_frames = [frame(f, "task.frames") for f in spec.task.frames]
         self.closure_frames = [(frame(c.frame_a, f"closure {c.name!r}"), frame(c.frame_b, f"closure {c.name!r}"))
                                for c in spec.closures]
         self.actuated = tuple(scalar_joint(n, "actuated") for n in spec.actuated)

@@ -19,6 +19,9 @@ Format ``pkm.closures/1`` (all values SI: m, rad)::
     components = ["x", "y", "z"]     # subset of x y z roll pitch yaw, or ["pose"]
     joints = []                      # joints whose coordinates are also outputs
 
+    [task.frames]                    # optional: other frames' coordinates (several feet)
+    right_toe = ["x", "z"]           # named right_toe.x, right_toe.z
+
     [[closure]]                      # one table per loop
     name = "ball_1"
     type = "point"                   # "point": frame origins coincide (3 eq.)
@@ -116,10 +119,13 @@ class TaskSpec:
     Attributes:
         components: End-effector components (see module doc) or ``("pose",)``.
         joints: Joint names whose coordinates are outputs too (e.g. a reconfiguration angle).
+        frames: Other frames and their components (``[task.frames]``), after the end effector's.
     """
 
     components: tuple[str, ...]
     joints: tuple[str, ...] = ()
+    #: Other frames whose coordinates are outputs too, ``{frame: components}`` (several feet of a leg).
+    frames: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
     @property
     def is_pose(self) -> bool:
@@ -127,7 +133,9 @@ class TaskSpec:
 
     @property
     def size(self) -> int:
-        return (6 if self.is_pose else len(self.components)) + len(self.joints)
+        def n(components: tuple[str, ...]) -> int:
+            return 6 if components == ("pose",) else len(components)
+        return n(self.components) + sum(n(c) for c in self.frames.values()) + len(self.joints)
 
 
 @dataclass(frozen=True)
@@ -223,11 +231,25 @@ class ClosureSpec:
         if components and end_effector is None:
             raise SpecError(source, f"task.components {list(components)} need an end_effector frame; without one "
                                     "the task is joint outputs only (task.joints)")
-        if components != ("pose",):
-            bad = [c for c in components if c not in TASK_COMPONENTS]
-            if bad:
-                raise SpecError(source, f"task.components {bad} unknown; use {list(TASK_COMPONENTS)} or ['pose']")
-        task = TaskSpec(components, joints)
+        def checked(components: tuple[str, ...], where: str) -> tuple[str, ...]:
+            if not components and where != "task.components":
+                raise SpecError(source, f"{where} is empty: give its components (x y z roll pitch yaw, or pose)")
+            if components != ("pose",):
+                bad = [c for c in components if c not in TASK_COMPONENTS]
+                if bad:
+                    raise SpecError(source, f"{where} {bad} unknown; use {list(TASK_COMPONENTS)} or ['pose']")
+            return components
+
+        checked(components, "task.components")
+        frames_raw = need(task_raw, "frames", dict, "task.") if "frames" in task_raw else {}
+        frames = {str(f): checked(names(frames_raw, f, "task.frames."), f"task.frames.{f}") for f in frames_raw}
+        if end_effector in frames:
+            raise SpecError(source, f"task.frames names the end effector {end_effector!r}: give its components in "
+                                    "task.components")
+        unknown_task = sorted(set(task_raw) - {"components", "joints", "frames"})
+        if unknown_task:
+            raise SpecError(source, f"unknown keys {unknown_task} in [task]; known: components, joints, frames")
+        task = TaskSpec(components, joints, frames)
         if task.size == 0:
             raise SpecError(source, "the task has no coordinates")
 
@@ -332,6 +354,8 @@ class ClosureSpec:
             out.append(f"default_branch = {_tv(self.default_branch)}")
         out += ["", "[task]", f"components = {_tv(list(self.task.components))}",
                 f"joints = {_tv(list(self.task.joints))}"]
+        if self.task.frames:
+            out += ["", "[task.frames]"] + [f"{_key(k)} = {_tv(list(v))}" for k, v in self.task.frames.items()]
         for c in self.closures:
             out += ["", "[[closure]]", f"name = {_tv(c.name)}", f"type = {_tv(c.type)}",
                     f"frame_a = {_tv(c.frame_a)}", f"frame_b = {_tv(c.frame_b)}"]

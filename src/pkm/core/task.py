@@ -49,25 +49,121 @@ def _rate_map(rpy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return e_roll, e_pitch, e_yaw
 
 
+class _FrameTask:
+    """The coordinates of one frame in the task: components among x y z roll pitch yaw, or its pose."""
+
+    def __init__(self, mech: Mechanism, fid: int, components: tuple[str, ...], prefix: str):
+        self.mech, self.fid = mech, fid
+        self.pose = components == ("pose",)
+        self.comp = () if self.pose else components
+        self.value_size, self.size = (7, 6) if self.pose else (len(components), len(components))
+        self.keys = tuple(prefix + k for k in (("x", "y", "z", "roll", "pitch", "yaw") if self.pose else self.comp))
+        self.names = tuple(prefix + k for k in (("x", "y", "z", "wx", "wy", "wz") if self.pose else self.comp))
+        self.kinds = {prefix + k: ("length" if k in _POS else "angle")
+                      for k in (("x", "y", "z", "roll", "pitch", "yaw") if self.pose else self.comp)}
+        self.has_angles = any(c in _ANGLES for c in self.comp)
+
+    def value(self, d: pin.Data) -> np.ndarray:
+        M = d.oMf[self.fid]
+        if self.pose:
+            return np.concatenate([M.translation, pin.Quaternion(M.rotation).coeffs()])
+        rpy = zyx_angles(M.rotation) if self.has_angles else np.zeros(3)
+        return np.array([M.translation[_POS[c]] if c in _POS else rpy[_ANGLES.index(c)] for c in self.comp])
+
+    def named(self, y: np.ndarray) -> list[float]:
+        if not self.pose:
+            return [float(v) for v in y]
+        return [float(v) for v in list(y[:3]) + list(zyx_angles(pin.Quaternion(*_wxyz(y[3:7])).toRotationMatrix()))]
+
+    def from_named(self, values: Mapping[str, float]) -> list[float]:
+        v = [values[k] for k in self.keys]
+        if not self.pose:
+            return v
+        return v[:3] + list(pin.Quaternion(zyx_matrix(*v[3:6])).coeffs())
+
+    def error(self, y_target: np.ndarray, y: np.ndarray) -> np.ndarray:
+        if self.pose:
+            R_t = pin.Quaternion(*_wxyz(y_target[3:7])).toRotationMatrix()
+            R = pin.Quaternion(*_wxyz(y[3:7])).toRotationMatrix()
+            return np.concatenate([y_target[:3] - y[:3], pin.log3(R_t @ R.T)])
+        out = y_target - y
+        for i, c in enumerate(self.comp):
+            if c in _ANGLES:
+                out[i] = (out[i] + np.pi) % (2 * np.pi) - np.pi
+        return out
+
+    def retract(self, y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+        if not self.pose:
+            return y + dy
+        R = pin.exp3(dy[3:6]) @ pin.Quaternion(*_wxyz(y[3:7])).toRotationMatrix()
+        return np.concatenate([y[:3] + dy[:3], pin.Quaternion(R).coeffs()])
+
+    def jacobian(self, d: pin.Data) -> np.ndarray:
+        J6 = pin.getFrameJacobian(self.mech.model, d, self.fid, pin.LOCAL_WORLD_ALIGNED)
+        if self.pose:
+            return J6
+        Jw = _euler_rows(d.oMf[self.fid].rotation) @ J6[3:] if self.has_angles else J6[3:]
+        return np.vstack([J6[_POS[c]][None] if c in _POS else Jw[_ANGLES.index(c)][None] for c in self.comp])
+
+    def bias(self, d: pin.Data) -> np.ndarray:
+        """``dJ/dt v`` of these coordinates, from the kinematics (with velocity, zero acceleration) in ``d``."""
+        m, f = self.mech.model, self.fid
+        acc = pin.getFrameClassicalAcceleration(m, d, f, pin.LOCAL_WORLD_ALIGNED)
+        if self.pose:
+            return np.concatenate([acc.linear, acc.angular])
+        ang = acc.angular  # replaced by the Euler-angle accelerations when the task has angles
+        if self.has_angles:
+            R = d.oMf[f].rotation
+            rpy = zyx_angles(R)
+            w = pin.getFrameVelocity(m, d, f, pin.LOCAL_WORLD_ALIGNED).angular
+            Binv = _euler_rows(R)
+            rates = Binv @ w
+            e_roll, e_pitch, e_yaw = _rate_map(rpy)
+            w_py = rates[2] * e_yaw + rates[1] * e_pitch  # angular velocity of the yaw-pitch frame
+            Bdot_rates = rates[0] * np.cross(w_py, e_roll) + rates[1] * np.cross(rates[2] * e_yaw, e_pitch)
+            ang = Binv @ (acc.angular - Bdot_rates)
+        return np.array([acc.linear[_POS[c]] if c in _POS else ang[_ANGLES.index(c)] for c in self.comp])
+
+
+def _euler_rows(R: np.ndarray) -> np.ndarray:
+    """``B^-1``: world angular velocity -> (roll, pitch, yaw) rates."""
+    rpy = zyx_angles(R)
+    if abs(np.cos(rpy[1])) < 1e-9:
+        raise SingularityError("representation", abs(np.cos(rpy[1])),
+                               "Z-Y-X Euler angles are singular at pitch = +-90 deg")
+    return np.linalg.inv(np.column_stack(_rate_map(rpy)))
+
+
 class TaskMap:
-    """Evaluates the task coordinates of ``mech`` (see module doc)."""
+    """Evaluates the task coordinates of ``mech`` (see module doc): the end effector's components, those of
+    the task's other frames (``[task.frames]``, keys ``frame.x``...), then the joint outputs."""
 
     def __init__(self, mech: Mechanism):
         self.mech = mech
         self.spec = mech.spec.task
-        self.pose = self.spec.is_pose
+        groups = [_FrameTask(mech, mech.ee_frame, self.spec.components, "")] if self.spec.components else []
+        groups += [_FrameTask(mech, fid, comps, f"{name}.")
+                   for (name, comps), fid in zip(self.spec.frames.items(), mech.task_frames)]
+        self._groups = groups
+        #: A task that is the end effector's pose (and joint outputs): targets may be a pin.SE3.
+        self.pose = len(groups) == 1 and groups[0].pose and not self.spec.frames
         self.size = self.spec.size
-        self.value_size = (7 if self.pose else len(self.spec.components)) + len(self.spec.joints)
-        self._comp = () if self.pose else self.spec.components
+        self.value_size = sum(g.value_size for g in groups) + len(self.spec.joints)
         self._jq = np.array([j.idx_q for j in mech.task_joints], dtype=int)
         self._jv = np.array([j.idx_v for j in mech.task_joints], dtype=int)
-        self.names = (("x", "y", "z", "wx", "wy", "wz") if self.pose else self._comp) + self.spec.joints
+        self._value_at = np.cumsum([0] + [g.value_size for g in groups])
+        self._tangent_at = np.cumsum([0] + [g.size for g in groups])
+        self.names = tuple(n for g in groups for n in g.names) + self.spec.joints
         #: The task coordinates by name, as :meth:`named` gives them and targets may state them (a pose:
-        #: ``x y z roll pitch yaw``), then the joint outputs.
-        self.keys = (("x", "y", "z", "roll", "pitch", "yaw") if self.pose else self._comp) + self.spec.joints
+        #: ``x y z roll pitch yaw``; another frame's prefixed, ``foot.z``), then the joint outputs.
+        self.keys = tuple(k for g in groups for k in g.keys) + self.spec.joints
         #: Each key's kind (``"length"`` or ``"angle"``), for units.
-        self.kinds = {k: ("length" if k in _POS else "angle" if k in _ANGLES
-                          else "angle" if mech.joints[k].revolute else "length") for k in self.keys}
+        self.kinds = {k: v for g in groups for k, v in g.kinds.items()}
+        self.kinds.update({j: "angle" if mech.joints[j].revolute else "length" for j in self.spec.joints})
+
+    def _parts(self, y: np.ndarray, tangent: bool = False):
+        at = self._tangent_at if tangent else self._value_at
+        return [y[at[i]:at[i + 1]] for i in range(len(self._groups))], y[at[-1]:]
 
     # values ---------------------------------------------------------------
     def value(self, q: np.ndarray) -> np.ndarray:
@@ -77,21 +173,13 @@ class TaskMap:
 
     def value_from(self, d: pin.Data, q: np.ndarray) -> np.ndarray:
         """The task coordinates from the frame placements already in ``d`` (see :class:`pkm.core.Configuration`)."""
-        M = d.oMf[self.mech.ee_frame]
-        if self.pose:
-            head = np.concatenate([M.translation, pin.Quaternion(M.rotation).coeffs()])
-        else:
-            rpy = zyx_angles(M.rotation) if any(c in _ANGLES for c in self._comp) else np.zeros(3)  # (unused)
-            head = np.array([M.translation[_POS[c]] if c in _POS else rpy[_ANGLES.index(c)] for c in self._comp])
-        return np.concatenate([head, np.asarray(q)[self._jq]])
+        return np.concatenate([g.value(d) for g in self._groups] + [np.asarray(q)[self._jq]])
 
     def named(self, q: np.ndarray) -> dict[str, float]:
         """The task coordinates at ``q`` by name (:attr:`keys`; a pose as x y z and Z-Y-X Euler angles) [m, rad]."""
-        y = self.value(q)
-        if not self.pose:
-            return dict(zip(self.keys, map(float, y)))
-        R = pin.Quaternion(*_wxyz(y[3:7])).toRotationMatrix()
-        return dict(zip(self.keys, map(float, list(y[:3]) + list(zyx_angles(R)) + list(y[7:]))))
+        heads, tail = self._parts(self.value(q))
+        values = [v for g, y in zip(self._groups, heads) for v in g.named(y)] + [float(v) for v in tail]
+        return dict(zip(self.keys, values))
 
     def parse(self, target, base: np.ndarray | None = None) -> np.ndarray:
         """A target value from user input.
@@ -124,13 +212,8 @@ class TaskMap:
                                         target)
             values = self.named(self.mech.q_reference if base is None else base)
             values.update({k: quantity(v, self.kinds[k], k) for k, v in target.items()})
-            if self.pose:
-                R = zyx_matrix(values["roll"], values["pitch"], values["yaw"])
-                target = [values["x"], values["y"], values["z"], *pin.Quaternion(R).coeffs(),
-                          *(values[j] for j in self.spec.joints)]
-            else:
-                target = [values[k] for k in self.keys]
-        elif not self.pose:
+            target = [v for g in self._groups for v in g.from_named(values)] + [values[j] for j in self.spec.joints]
+        elif not any(g.pose for g in self._groups):
             target = quantities(target, [self.kinds[k] for k in self.keys], "target")
         y = as_array(target, "target", f"{self.value_size} task coordinates {list(self.names)}")
         if y.shape != (self.value_size,):
@@ -138,34 +221,21 @@ class TaskMap:
                                               f"{list(self.names)}, got shape {y.shape}", target)
         if not np.all(np.isfinite(y)):
             raise InvalidInputError("target", "holds non-finite values", target)
-        if self.pose:
-            qn = np.linalg.norm(y[3:7])
-            if abs(qn - 1.0) > 1e-6:
+        for g, part in zip(self._groups, self._parts(y)[0]):
+            if g.pose and abs((qn := float(np.linalg.norm(part[3:7]))) - 1.0) > 1e-6:
                 raise InvalidInputError("target", f"quaternion norm {qn:.6g}, expected 1", target)
         return y
 
     def error(self, y_target: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Tangent-space difference ``y_target - y`` (angles wrapped to (-pi, pi])."""
-        nj = len(self.spec.joints)
-        tail = y_target[len(y) - nj:] - y[len(y) - nj:]
-        if self.pose:
-            R_t = pin.Quaternion(*_wxyz(y_target[3:7])).toRotationMatrix()
-            R = pin.Quaternion(*_wxyz(y[3:7])).toRotationMatrix()
-            head = np.concatenate([y_target[:3] - y[:3], pin.log3(R_t @ R.T)])
-        else:
-            head = y_target[:len(self._comp)] - y[:len(self._comp)]
-            for i, c in enumerate(self._comp):
-                if c in _ANGLES:
-                    head[i] = (head[i] + np.pi) % (2 * np.pi) - np.pi
-        return np.concatenate([head, tail])
+        (heads_t, tail_t), (heads, tail) = self._parts(np.asarray(y_target)), self._parts(np.asarray(y))
+        return np.concatenate([g.error(a, b) for g, a, b in zip(self._groups, heads_t, heads)] + [tail_t - tail])
 
     def retract(self, y: np.ndarray, dy: np.ndarray) -> np.ndarray:
         """``y`` moved by the tangent vector ``dy`` (the inverse of :meth:`error`)."""
         y, dy = np.asarray(y, dtype=float), np.asarray(dy, dtype=float)
-        if not self.pose:
-            return y + dy
-        R = pin.exp3(dy[3:6]) @ pin.Quaternion(*_wxyz(y[3:7])).toRotationMatrix()
-        return np.concatenate([y[:3] + dy[:3], pin.Quaternion(R).coeffs(), y[7:] + dy[6:]])
+        (heads, tail), (dheads, dtail) = self._parts(y), self._parts(dy, tangent=True)
+        return np.concatenate([g.retract(a, b) for g, a, b in zip(self._groups, heads, dheads)] + [tail + dtail])
 
     def interpolate(self, y0: np.ndarray, y1: np.ndarray, s: float) -> np.ndarray:
         """The point at fraction ``s`` of the way from ``y0`` to ``y1`` (geodesic for rotations)."""
@@ -180,54 +250,16 @@ class TaskMap:
 
     def jacobian_from(self, d: pin.Data) -> np.ndarray:
         """``d(task)/dq`` from the joint Jacobians and frame placements already in ``d``."""
-        m = self.mech.model
-        J6 = pin.getFrameJacobian(m, d, self.mech.ee_frame, pin.LOCAL_WORLD_ALIGNED)
-        rows = [J6] if self.pose else []
-        if not self.pose:
-            Jw = self._euler_rows(d.oMf[self.mech.ee_frame].rotation) @ J6[3:] if self._has_angles else J6[3:]
-            for c in self._comp:
-                rows.append(J6[_POS[c]][None] if c in _POS else Jw[_ANGLES.index(c)][None])
-        if len(self._jv):
-            Jj = np.zeros((len(self._jv), m.nv))
-            Jj[np.arange(len(self._jv)), self._jv] = 1.0
-            rows.append(Jj)
-        return np.vstack(rows)
-
-    @property
-    def _has_angles(self) -> bool:
-        return any(c in _ANGLES for c in self._comp)
-
-    def _euler_rows(self, R: np.ndarray) -> np.ndarray:
-        """``B^-1``: world angular velocity -> (roll, pitch, yaw) rates."""
-        rpy = zyx_angles(R)
-        if abs(np.cos(rpy[1])) < 1e-9:
-            raise SingularityError("representation", abs(np.cos(rpy[1])),
-                                   "Z-Y-X Euler angles are singular at pitch = +-90 deg")
-        return np.linalg.inv(np.column_stack(_rate_map(rpy)))
+        Jj = np.zeros((len(self._jv), self.mech.model.nv))
+        Jj[np.arange(len(self._jv)), self._jv] = 1.0
+        return np.vstack([g.jacobian(d) for g in self._groups] + [Jj])
 
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``dJ/dt v``: task acceleration produced by ``v`` alone (a = 0)."""
         m, d = self.mech.model, self.mech.data
         pin.forwardKinematics(m, d, q, v, np.zeros(m.nv))
         pin.updateFramePlacements(m, d)
-        f = self.mech.ee_frame
-        acc = pin.getFrameClassicalAcceleration(m, d, f, pin.LOCAL_WORLD_ALIGNED)
-        out = [np.concatenate([acc.linear, acc.angular])] if self.pose else []
-        if not self.pose:
-            ang = acc.angular  # replaced by the Euler-angle accelerations when the task has angles
-            if self._has_angles:
-                R = d.oMf[f].rotation
-                rpy = zyx_angles(R)
-                w = pin.getFrameVelocity(m, d, f, pin.LOCAL_WORLD_ALIGNED).angular
-                Binv = self._euler_rows(R)
-                rates = Binv @ w
-                e_roll, e_pitch, e_yaw = _rate_map(rpy)
-                w_py = rates[2] * e_yaw + rates[1] * e_pitch  # angular velocity of the yaw-pitch frame
-                Bdot_rates = rates[0] * np.cross(w_py, e_roll) + rates[1] * np.cross(rates[2] * e_yaw, e_pitch)
-                ang = Binv @ (acc.angular - Bdot_rates)
-            out.append(np.array([acc.linear[_POS[c]] if c in _POS else ang[_ANGLES.index(c)] for c in self._comp]))
-        out.append(np.zeros(len(self._jv)))
-        return np.concatenate(out)
+        return np.concatenate([g.bias(d) for g in self._groups] + [np.zeros(len(self._jv))])
 
 
 def _shape(x) -> tuple[int, ...] | None:
