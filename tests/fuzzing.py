@@ -461,6 +461,110 @@ def _from_files(g, adv):
     return c.pkm.Mechanism.from_files, (path,), {}
 
 
+_EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+#: The acceptance set's files in the formats pkm reads: (folder, the file pkm.load takes, the files beside it).
+_MODEL_FILES = (("mjcf_fourbar", "fourbar.xml", ()), ("sdf_slider_crank", "slider_crank.closures.toml",
+                                                     ("slider_crank.sdf",)),
+                ("gepetto_rssr", "robot.yaml", ("robot.urdf",)), ("ankle", "ankle.closures.toml", ("ankle.urdf",)))
+
+
+@entry("formats.read_mjcf")
+def _read_mjcf(g, adv):
+    from pkm.core.formats.mjcf import read_mjcf
+    text = (_EXAMPLES / "mjcf_fourbar" / "fourbar.xml").read_text()
+    text = g.text_mutation(text) if adv or g.chance(0.5) else text
+    return read_mjcf, (g.hostile() if adv and g.chance(0.05) else text,), {}
+
+
+@entry("formats.read_sdf")
+def _read_sdf(g, adv):
+    from pkm.core.formats.sdf import read_sdf
+    text = (_EXAMPLES / "sdf_slider_crank" / "slider_crank.sdf").read_text()
+    text = g.text_mutation(text) if adv or g.chance(0.5) else text
+    return read_sdf, (g.hostile() if adv and g.chance(0.05) else text,), {}
+
+
+def _model_folder(g, adv) -> Path:
+    """One of :data:`_MODEL_FILES` copied to a fresh folder, one of its files mutated; the path pkm.load takes."""
+    folder, main, others = g.pick(_MODEL_FILES)
+    d = ctx().tmp / f"m{int(g.rng.integers(1 << 30))}"
+    d.mkdir()
+    files = (main, *others)
+    victim = g.pick(files)
+    for name in files:
+        text = (_EXAMPLES / folder / name).read_text()
+        if name == victim and (adv or g.chance(0.5)):
+            text = g.text_mutation(text)
+        try:
+            (d / name).write_text(text, encoding="utf-8", errors="surrogatepass")
+        except (UnicodeEncodeError, ValueError):
+            pass
+    return d / main
+
+
+@entry("pkm.load(file)")
+def _load_file(g, adv):
+    path = _model_folder(g, adv)
+    if adv and g.chance(0.1):
+        path = path.with_suffix(g.pick((".xml", ".sdf", ".yaml", ".mjcf")))
+    return ctx().pkm.load, (path,), {}
+
+
+@entry("formats.spec_skeleton")
+def _spec_skeleton(g, adv):
+    from pkm.core.formats.imported import spec_skeleton
+    path = _model_folder(g, adv)
+    model = {".toml": ".sdf", ".yaml": ".urdf"}.get(path.suffix)
+    return spec_skeleton, (path.with_name(path.name.split(".")[0] + model) if model else path,), {}
+
+
+@entry("pkm.quantity")
+def _quantity(g, adv):
+    text = g.pick(("20mm", "5deg", "-3.5e-2 m", "0.81", "1g", "12 cm", "7 rad"))
+    if adv:
+        text = g.pick((g.hostile(), text[::-1], text + "x", "1e999mm", "--3mm", "mm", " ", "5 deg deg", "nanmm"))
+    kind = g.pick((None, "length", "angle", "mass") + (("volume", 3) if adv else ()))
+    return ctx().pkm.quantity, (text, kind), {}
+
+
+def _follow(g, adv, task: bool):
+    c = ctx()
+    n, m = _mech(g, adv)
+    mm = c.mech[n]
+    k = int(g.rng.integers(1, 4))
+    if task:
+        y0 = mm.task_map.value(mm.q_reference)
+        samples = np.array([y0] * k)
+        if not mm.task_map.pose:
+            samples = samples + g.near(np.zeros_like(samples), 0.01)
+    else:
+        samples = np.array([mm.actuated_q(mm.q_reference)] * k) + g.near(np.zeros((k, mm.na)), 0.01)
+    if adv:
+        samples = g.corrupt(samples)
+    kw: dict = {"efforts": g.chance(0.5)}
+    if adv and g.chance(0.3):
+        kw[g.pick(("q0", "tol", "wrench", "efforts"))] = g.hostile()
+    fn = c.pkm.follow_task if task else c.pkm.follow_actuators
+    return fn, (m, samples), kw
+
+
+def _nan_at_jumps(traj) -> bool:
+    """A trajectory's NaN rates and efforts are documented at the samples its jumps name (a singular map)."""
+    bad = {k for arr in (traj.v, traj.a, traj.efforts) if arr is not None for k in np.flatnonzero(
+        ~np.all(np.isfinite(arr), axis=1))}
+    return bad <= {j.index for j in traj.jumps} and bool(np.all(np.isfinite(traj.q)))
+
+
+@entry("pkm.follow_task", sentinel=_nan_at_jumps)
+def _follow_task(g, adv):
+    return _follow(g, adv, True)
+
+
+@entry("pkm.follow_actuators", sentinel=_nan_at_jumps)
+def _follow_actuators(g, adv):
+    return _follow(g, adv, False)
+
+
 @entry("motion.load_motions")
 def _load_motions(g, adv):
     from pkm.motion import load_motions

@@ -19,6 +19,7 @@ import re
 from collections.abc import Collection
 
 from pkm.errors import InvalidInputError, UnitError
+from pkm.validation import as_scalar
 
 #: Unit suffixes: suffix -> (kind, factor to SI).
 SUFFIXES: dict[str, tuple[str, float]] = {
@@ -79,17 +80,15 @@ def quantity(value, kind: str | None = None, what: str = "value") -> float:
         what: Its name, for messages.
 
     Raises:
-        UnitError: a bad string (see :func:`parse_quantity`); InvalidInputError: neither a number nor a string.
+        UnitError: a bad string (see :func:`parse_quantity`); InvalidInputError: neither a number nor a string,
+            or not finite.
     """
     if kind is not None and kind not in SI_UNITS:
         raise InvalidInputError("kind", f"use one of {list(SI_UNITS)} or None", kind)
     if isinstance(value, str):
         kinds = {kind} if kind else set(SI_UNITS)
         return parse_quantity(value, kinds, what, SI_UNITS[kind] if kind else "SI")
-    if isinstance(value, bool) or (not isinstance(value, (int, float)) and not hasattr(value, "__float__")):
-        raise InvalidInputError(what, f"expected a number or a string such as '20mm', got {type(value).__name__}",
-                                value)
-    return float(value)
+    return as_scalar(value, what)
 
 
 def quantities(values, kinds, what: str):

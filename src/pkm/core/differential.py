@@ -111,7 +111,9 @@ class _Split:
         move = Jtp @ weakest
         idle = np.zeros((nv, idle_p.shape[1]))
         idle[pv] = idle_p
-        C = _complement(idle, nv)
+        base = np.zeros((nv, len(mech.base_v)))
+        base[mech.base_v, np.arange(len(mech.base_v))] = 1.0  # a floating base is an input: it does not move here
+        C = _complement(np.hstack([idle, base]), nv)
         A = np.vstack([Jc, Jt])
         Ua, sa, Vat = _svd(A @ C)
         w = C @ Vat[-1] if C.shape[1] else np.zeros(nv)

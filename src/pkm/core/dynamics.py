@@ -105,6 +105,8 @@ def partition(mech: Mechanism) -> Partition:
     src = mech.source
     if _has_mimic(model):
         raise SpecError(src, "the Khalil projection does not support mimic joints yet")
+    if mech.base is not None:
+        raise SpecError(src, "the Khalil projection cuts a fixed base; a floating base takes the virtual-work route")
     plat = _support_v(model, model.frames[mech.ee_frame].parentJoint)
     if not plat:
         raise SpecError(src, f"end effector {mech.spec.end_effector!r} is fixed to the base: no platform to cut")

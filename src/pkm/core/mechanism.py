@@ -68,6 +68,10 @@ class Mechanism:
         spec: The closure spec.
         params: The parameter object that generated it (None when loaded from files).
         urdf: The URDF text, when known.
+        base: The floating base's joint (``spec.floating_base``: a free-flyer on the world carrying the whole
+            tree), or None. Its pose is an input like the actuators' values: the solvers hold it where ``q``
+            puts it, the rate maps give it no velocity, the efforts are those with the base held (its
+            reaction is not computed); Pinocchio's ``constraintDynamics`` lets it float.
         constraint_models: One ``pin.RigidConstraintModel`` per closure, in spec order.
             Point closures are ``CONTACT_3D`` in ``LOCAL_WORLD_ALIGNED``: their Jacobian is
             exactly d(p_A - p_B)/dq. Frame closures are ``CONTACT_6D`` in ``LOCAL`` (frame A):
@@ -131,7 +135,20 @@ class Mechanism:
         self.act_v = np.array([j.idx_v for j in self.actuated])
         self._revolute_q = np.array([j.idx_q for j in self.joints.values() if j.revolute], dtype=int)
         self._revolute_v = np.array([j.idx_v for j in self.joints.values() if j.revolute], dtype=int)
-        self.passive_v = np.array([i for i in range(model.nv) if i not in set(self.act_v)], dtype=int)
+        self.base: JointInfo | None = None
+        if spec.floating_base is not None:
+            if spec.floating_base not in self.joints:
+                raise SpecNameError(source, "joint", spec.floating_base, list(self.joints), "floating_base")
+            self.base = self.joints[spec.floating_base]
+            if self.base.kind != "JointModelFreeFlyer" or model.parents[self.base.id] != 0:
+                raise SpecError(source, f"floating_base {spec.floating_base!r} is a {self.base.kind} on "
+                                        f"{model.names[model.parents[self.base.id]]!r}: it must be a free-flyer "
+                                        "joint on the world")
+        self.base_v = np.arange(self.base.idx_v, self.base.idx_v + 6) if self.base else np.zeros(0, dtype=int)
+        inputs = set(self.act_v) | set(self.base_v)
+        self.passive_v = np.array([i for i in range(model.nv) if i not in inputs], dtype=int)
+        #: The velocity columns the solvers move (all but the floating base's); None: all of them.
+        self.free_v = np.array([i for i in range(model.nv) if i not in set(self.base_v)]) if self.base else None
 
         self.constraint_models = []
         for c, (fa, fb) in zip(spec.closures, self.closure_frames):

@@ -211,7 +211,8 @@ def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol
         return fun
 
     def solve_at(q, s, t):
-        return _newton(mech, make_fun(y1 if s >= 1.0 else task.interpolate(y0, y1, s)), q, None, t, max_iter, 0.5)
+        return _newton(mech, make_fun(y1 if s >= 1.0 else task.interpolate(y0, y1, s)), q, mech.free_v, t, max_iter,
+                       0.5)
 
     try:
         result = _follow(mech, "inverse kinematics", solve_at, q, n_steps, tol, raise_on_failure)
@@ -256,7 +257,7 @@ def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_i
                 np.vstack([c.closure_and_task_jacobian, S]))
 
     # over-determined when a pinned magnitude is not the mirrored leg's: Gauss-Newton lands close
-    q, _, _ = _newton(mech, fun, q, None, tol, max_iter, 0.5)
+    q, _, _ = _newton(mech, fun, q, mech.free_v, tol, max_iter, 0.5)
     out = solve_ik(mech, y_ref, q, tol=tol).q
     if not mech.on_branch(out, branch):
         raise BranchError(branch, dict(b.signs), mech.branch_signs(out, branch))
@@ -286,6 +287,7 @@ def assemble(mech: Mechanism, q0=None, *, hold=(), tol: float = 1e-10, restarts:
     if isinstance(hold, str) or not all(isinstance(n, str) for n in hold):
         raise InvalidInputError("hold", "expected a sequence of joint names", hold)
     held = np.zeros(mech.nv, dtype=bool)
+    held[mech.base_v] = True  # (a floating base is an input)
     for name in hold:
         j = mech.joint(name)
         held[j.idx_v:j.idx_v + j.nv] = True

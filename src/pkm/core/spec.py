@@ -14,6 +14,8 @@ Format ``pkm.closures/1`` (all values SI: m, rad)::
     end_effector = "platform"        # a frame of the URDF
     actuated = ["motor_1", ...]      # 1-DOF joints driven by motors
     default_branch = "knee_out"      # optional, a key of [branch]
+    floating_base = "pelvis"         # optional: a free-flyer joint on the world carrying everything;
+                                     # its pose is an input the solvers hold
 
     [task]                           # the output coordinates
     components = ["x", "y", "z"]     # subset of x y z roll pitch yaw, or ["pose"]
@@ -165,6 +167,9 @@ class ClosureSpec:
     #: Joints the URDF writes as revolutes that are ``"spherical"``, ``"universal"`` or ``"fixed"``
     #: (:mod:`pkm.core.joints`).
     joint_types: Mapping[str, str] = field(default_factory=dict)
+    #: A free-flyer joint on the world that carries the whole mechanism (a legged robot's pelvis): its pose is an
+    #: input, held by the solvers where ``q`` puts it (see :class:`pkm.core.Mechanism`).
+    floating_base: str | None = None
 
     # ------------------------------------------------------------------ reading
     @classmethod
@@ -210,7 +215,7 @@ class ClosureSpec:
         if fmt != FORMAT:
             raise SpecError(source, f"unsupported format {fmt!r}; this pkm reads {FORMAT!r}")
         known = {"format", "mechanism", "urdf", "end_effector", "actuated", "default_branch", "task",
-                 "closure", "branch", "reference", "parameters", "description", "joint_types"}
+                 "closure", "branch", "reference", "parameters", "description", "joint_types", "floating_base"}
         unknown = sorted(set(raw) - known)
         if unknown:
             raise SpecError(source, f"unknown keys {unknown}; known keys: {sorted(known)}")
@@ -302,6 +307,10 @@ class ClosureSpec:
             raise SpecError(source, "joint_types must be a table of joint name = \"spherical\" | \"universal\" | "
                                     "\"fixed\"")
 
+        floating_base = raw.get("floating_base")
+        if floating_base is not None and (not isinstance(floating_base, str) or not floating_base):
+            raise SpecError(source, "key 'floating_base' must name the free-flyer joint of the base")
+
         params = raw.get("parameters", {})
         if not isinstance(params, dict) or not all(
                 isinstance(v, str) or (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v))
@@ -330,6 +339,7 @@ class ClosureSpec:
             parameters=dict(params),
             description=str(raw.get("description", "")),
             joint_types=dict(joint_types),
+            floating_base=floating_base,
         )
 
     # ------------------------------------------------------------------ writing
@@ -350,6 +360,8 @@ class ClosureSpec:
         if self.end_effector is not None:
             out.append(f"end_effector = {_tv(self.end_effector)}")
         out.append(f"actuated = {_tv(list(self.actuated))}")
+        if self.floating_base is not None:
+            out.append(f"floating_base = {_tv(self.floating_base)}")
         if self.default_branch is not None:
             out.append(f"default_branch = {_tv(self.default_branch)}")
         out += ["", "[task]", f"components = {_tv(list(self.task.components))}",

@@ -30,7 +30,7 @@ from pkm.core.dynamics import inverse_dynamics
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.solve import close_loops, solve_ik
 from pkm.errors import InvalidInputError, SingularityError
-from pkm.validation import as_array
+from pkm.validation import ABSURD, as_array
 
 #: A sample's joint step beyond this multiple of the first-order prediction (plus 1e-9) is a jump.
 JUMP_RATIO = 1.0
@@ -99,6 +99,8 @@ def _samples(x, n: int | None, size: int, what: str) -> np.ndarray:
                                 x)
     if not np.all(np.isfinite(arr)):
         raise InvalidInputError(what, "holds non-finite values", x)
+    if np.abs(arr).max() > ABSURD:
+        raise InvalidInputError(what, f"holds values beyond {ABSURD:g} (SI units: m, rad)", x)
     return arr
 
 

@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 
+import pkm
 from pkm.errors import InvalidInputError, SingularityError, UnreachableError
 from pkm.mechanisms import prs3
 from pkm.mechanisms.prs3 import dynamics as PD
@@ -217,3 +218,15 @@ def test_homogeneous_jacobian_does_not_depend_on_the_unit_of_length():
     y = np.array([0.8, 0.05, -0.1])
     J, Jmm = (PD.Prs3Dynamics(x).homogeneous_jacobian(y * [s, 1, 1]) for x, s in ((p, 1), (mm, 1000)))
     assert np.allclose(J, Jmm, rtol=1e-9)
+
+
+def test_the_generic_call_gives_the_hand_written_twins_efforts(dyn):
+    """pkm.inverse_dynamics on the 3-PRS model, both methods, at the states of sec. 5 case 3: the efforts of the
+    hand-written twin Prs3Dynamics.forces (1e-9 relative)."""
+    t, Y, Yd, Ydd = load_motions("prs3_motions.toml")["3"].sample()
+    for k in range(0, len(t), max(1, len(t) // 6)):
+        ref = dyn.forces(Y[k], Yd[k], Ydd[k])
+        q, v, a = dyn.state(Y[k], Yd[k], Ydd[k])
+        for method in ("khalil", "virtual_work"):
+            tau = pkm.inverse_dynamics(dyn.mechanism, q, v, a, method=method)
+            assert np.abs(tau - ref).max() <= 1e-9 * np.abs(ref).max(), (k, method)

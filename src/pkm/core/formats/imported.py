@@ -26,6 +26,7 @@ class Imported:
         actuated: The actuated joints the file names (empty when it names none).
         name: The model's name.
         format: ``"urdf"``, ``"mjcf"`` or ``"sdf"``.
+        floating_base: The free-flyer joint that carries the whole tree (an MJCF root ``<freejoint>``), or None.
     """
 
     urdf: str
@@ -34,6 +35,7 @@ class Imported:
     actuated: tuple[str, ...]
     name: str
     format: str
+    floating_base: str | None = None
 
 
 def import_model(path: Path) -> Imported:
@@ -57,18 +59,19 @@ def import_model(path: Path) -> Imported:
 
 
 def with_file(spec: ClosureSpec, imp: Imported, source: str) -> ClosureSpec:
-    """``spec`` with the loops and joint types of the model file it names added (the spec's joint types win).
+    """``spec`` with the loops, joint types and floating base of the model file it names added (the spec's win).
 
     Raises:
         SpecError: a closure named both in the spec and in the file.
     """
-    if not imp.closures and not imp.joint_types:
+    if not imp.closures and not imp.joint_types and imp.floating_base is None:
         return spec
     clash = sorted({c.name for c in spec.closures} & {c.name for c in imp.closures})
     if clash:
         raise SpecError(source, f"closure {clash[0]!r} is both in the spec and in {spec.urdf!r}; rename the spec's")
     return dataclasses.replace(spec, closures=imp.closures + spec.closures,
-                               joint_types={**imp.joint_types, **spec.joint_types})
+                               joint_types={**imp.joint_types, **spec.joint_types},
+                               floating_base=spec.floating_base or imp.floating_base)
 
 
 def load_model_file(path: Path):
@@ -88,7 +91,8 @@ def load_model_file(path: Path):
                                    "writes one to fill in), and load the spec")
     spec = ClosureSpec(mechanism=imp.name, urdf=path.name, end_effector=None, actuated=imp.actuated,
                        closures=imp.closures, task=TaskSpec((), imp.actuated), reference={},
-                       description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types)
+                       description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types,
+                       floating_base=imp.floating_base)
     return Mechanism.from_strings(imp.urdf, spec, source=str(path))
 
 

@@ -12,7 +12,8 @@ does not keep, from the file itself:
 * joint names and position limits (``range``, in degrees unless ``<compiler angle="radian">``, for
   hinges only; a slide's range is a length), with ``<default>`` classes and ``childclass``; a body with
   several joints keeps each one's name (Pinocchio joins them into one composite joint);
-* ``ball`` joints become Pinocchio spherical joints, ``<freejoint>`` a free-flyer (a floating base).
+* ``ball`` joints become Pinocchio spherical joints, ``<freejoint>`` a free-flyer: on the root body that
+  carries every other joint, the mechanism's floating base (``spec.floating_base``).
 
 What Pinocchio 4.1's parser gets wrong is worked around, each by a test: it reads only the first body
 under ``<worldbody>`` (pkm wraps them all in one fixed body), ignores the sites of bodies without
@@ -213,7 +214,14 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
     for a in actuated:
         if a not in known:
             raise SpecError(source, f"an actuator drives joint {a!r}, which the file does not define")
-    return Imported(urdf, tuple(closures), types, tuple(actuated), name, "mjcf")
+    return Imported(urdf, tuple(closures), types, tuple(actuated), name, "mjcf", _floating_base(model))
+
+
+def _floating_base(model: pin.Model) -> str | None:
+    """The root free-flyer joint when every other joint hangs below it (a floating base), else None."""
+    if model.njoints < 2 or model.joints[1].shortname() != "JointModelFreeFlyer" or model.parents[1] != 0:
+        return None
+    return model.names[1] if all(model.parents[j] != 0 for j in range(2, model.njoints)) else None
 
 
 __all__ = ["read_mjcf"]
