@@ -90,8 +90,9 @@ class UnreachableError(PkmError):
     """A pose cannot be reached.
 
     Attributes:
-        leg: Index (1-based, as in the papers) of the first leg that cannot reach.
-        excess: By how much the leg misses, in ``unit`` (> 0).
+        leg: Index (1-based, as in the papers) of the first leg that cannot reach; 0 when no leg is to blame:
+            every loop closes and the task as a whole misses.
+        excess: By how much the leg (or the task) misses, in ``unit`` (> 0).
         unit: Unit of ``excess``.
     """
 
@@ -100,7 +101,8 @@ class UnreachableError(PkmError):
         self.excess = float(excess)
         self.unit = unit
         extra = f" ({detail})" if detail else ""
-        super().__init__(f"pose unreachable: leg {leg} misses by {self.excess:.6g} {unit}{extra}")
+        who = f"leg {leg}" if leg else "the task"
+        super().__init__(f"pose unreachable: {who} misses by {self.excess:.6g} {unit}{extra}")
 
 
 class AssemblyError(PkmError):

@@ -78,6 +78,17 @@ def test_a_target_outside_the_workspace_is_unreachable_not_a_convergence_failure
         solve_ik(delta, [0.0, 0.0, -2.0], max_iter=10)
     with pytest.raises(UnreachableError, match=r"closure 'tip' stays open by .* the task misses by 0\.1"):
         solve_ik(built("fivebar"), [0.0, 0.7])
+    import dataclasses
+    from pathlib import Path
+
+    from pkm.core.spec import TaskSpec
+
+    files = pkm.load(Path(__file__).resolve().parents[2] / "examples" / "gepetto_fivebar")
+    gepetto = Mechanism.from_strings(files.urdf, dataclasses.replace(files.spec, end_effector="closedloop1_A",
+                                                                     task=TaskSpec(("x", "y"))))
+    with pytest.raises(UnreachableError, match=r"the task misses by 4\.\d+ m or rad .*the loops close") as exc:
+        solve_ik(gepetto, {"x": 5.0})  # so far that the least-squares minimum has the loop (all but) closed
+    assert exc.value.leg == 0
 
 
 def test_a_reachable_target_the_solver_cannot_reach_is_a_convergence_failure(delta):

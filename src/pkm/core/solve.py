@@ -344,20 +344,22 @@ def _levenberg_marquardt(mech: Mechanism, fun, q: np.ndarray, tol: float, max_it
 def _raise_if_out_of_reach(mech: Mechanism, fun, q: np.ndarray, tol: float) -> None:
     """:class:`UnreachableError` when the IK equations ``fun`` have a least-squares minimum that is not a solution
     near ``q`` (Levenberg-Marquardt from ``q`` stalls with ``|F|_inf > max(tol, 1e-9)``): the target lies outside
-    the workspace. It names the closure left most open there (or the task, when every loop closes)."""
+    the workspace. It names the closure left most open there, or the task when the loops close there (to a
+    thousandth of the task's miss: the least-squares minimum trades a little closure for a far target)."""
     with np.errstate(over="ignore", invalid="ignore"):
         q, F, _ = _levenberg_marquardt(mech, fun, q, tol, 500)
         gap, index, name = constraints.worst_closure(mech, F)
         task_gap = float(np.linalg.norm(F[mech.n_constraints:]))
     if not (np.isfinite(gap) and np.isfinite(task_gap) and np.abs(F).max() > max(tol, 1e-9)):
         return  # solved after all, or beyond the float range: the ConvergenceError stands
-    if gap > tol:
+    if gap > tol and gap > 1e-3 * task_gap:  # a loop that cannot close, not a trade-off with a task far away
         raise UnreachableError(index, gap, "m or rad",
                                f"the target is out of the workspace: at the nearest configuration (a least-squares "
                                f"minimum) closure {name!r} stays open by {gap:.3g} and the task misses by "
                                f"{task_gap:.3g}")
-    raise UnreachableError(0, task_gap, "m or rad", "the target is out of the workspace: every loop closes at the "
-                                                    f"nearest configuration, where the task misses by {task_gap:.3g}")
+    raise UnreachableError(0, task_gap, "m or rad", "the target is out of the workspace: the loops close (to "
+                                                    f"{gap:.1e}) at the nearest configuration, where the task misses "
+                                                    f"by {task_gap:.3g}")
 
 
 def _failure(mech: Mechanism, what: str, result: SolveResult, tol: float) -> ConvergenceError:
