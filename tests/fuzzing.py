@@ -434,8 +434,7 @@ def _load_model(g, adv):
 def _from_files(g, adv):
     c = ctx()
     n = g.pick(("rrr3", "delta", "prs3"))
-    d = c.tmp / f"f{int(g.rng.integers(1 << 30))}"
-    d.mkdir()
+    d = Path(tempfile.mkdtemp(dir=c.tmp))
     urdf, spec = _mutated_urdf(g, n, adv), _mutated_spec(g, n, adv)
     try:
         (d / f"{n}.urdf").write_text(urdf, encoding="utf-8", errors="surrogatepass")
@@ -487,8 +486,7 @@ def _read_sdf(g, adv):
 def _model_folder(g, adv) -> Path:
     """One of :data:`_MODEL_FILES` copied to a fresh folder, one of its files mutated; the path pkm.load takes."""
     folder, main, others = g.pick(_MODEL_FILES)
-    d = ctx().tmp / f"m{int(g.rng.integers(1 << 30))}"
-    d.mkdir()
+    d = Path(tempfile.mkdtemp(dir=ctx().tmp))
     files = (main, *others)
     victim = g.pick(files)
     for name in files:

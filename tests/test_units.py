@@ -64,3 +64,10 @@ def test_joint_values_task_targets_and_parameters_take_units():
     ref = pkm.task_values(hexapod, hexapod.q_reference)
     ik = pkm.solve_ik(hexapod, {"yaw": "2deg"})
     assert pkm.task_values(hexapod, ik.q) == pytest.approx({**ref, "yaw": math.radians(2)}, abs=1e-9)
+
+
+def test_rates_and_efforts_take_numbers_only():
+    """Positions take units; a rate or an effort with a length or angle unit is refused (rad/s is not rad)."""
+    delta = pkm.load("delta")
+    with pytest.raises(InvalidInputError):
+        pkm.velocities(delta, delta.q_reference, ["5deg", 0.0, 0.0])

@@ -107,11 +107,17 @@ def test_unknown_branch_is_refused_before_any_work(delta):
         pkm.solve_ik(delta, [0.0, 0.0, -0.36], branch="knee_sideways")
 
 
-@pytest.mark.parametrize("target", [[0.0, 0.0, 6e5], [1e300, 0.0, -0.36], [3.0, -2.0, 50.0]])
+def test_absurd_targets_are_refused(delta):
+    """A target beyond 1e6 (SI: a unit error) is an InvalidInputError before any iteration."""
+    with pytest.raises(InvalidInputError, match="beyond 1e\\+06"):
+        pkm.solve_ik(delta, [1e300, 0.0, -0.36])
+
+
+@pytest.mark.parametrize("target", [[0.0, 0.0, 6e5], [3.0, -2.0, 50.0]])
 def test_far_targets_fail_fast_with_a_finite_residual(delta, target):
     """Targets far outside the workspace end in an UnreachableError with a finite miss (a least-squares minimum
-    that is not a solution), or, beyond the float range, a ConvergenceError with a finite residual and a bounded
-    iteration count; in well under three seconds (continuation capped at MAX_STEPS, stalls detected)."""
+    that is not a solution), or a ConvergenceError with a finite residual and a bounded iteration count; in well
+    under three seconds (continuation capped at MAX_STEPS, stalls detected)."""
     t0 = time.perf_counter()
     with pytest.raises((ConvergenceError, UnreachableError)) as info:
         pkm.solve_ik(delta, target)

@@ -152,3 +152,23 @@ def test_an_mjcf_root_freejoint_is_a_floating_base(tmp_path):
     assert mech.base is not None and mech.base.name == "root"
     q = pkm.close_loops(mech, [0.4], mech.q_reference).q
     assert np.abs(q[mech.base.idx_q:mech.base.idx_q + 7] - mech.q_reference[:7]).max() == 0.0
+
+
+def test_an_unreachable_target_holds_the_floating_base_too(tmp_path):
+    """The MJCF four-bar on a free pelvis, its coupler point 5 m up: unreachable (the least-squares search holds the
+    base too), as on the fixed four-bar."""
+    from pathlib import Path
+
+    from pkm.errors import UnreachableError
+
+    text = (Path(__file__).resolve().parents[2] / "examples" / "mjcf_fourbar" / "fourbar.xml").read_text()
+    text = text.replace("<worldbody>", '<worldbody>\n    <body name="pelvis" pos="0 0 1"><freejoint name="root"/>'
+                        '<geom type="sphere" size="0.05" mass="2"/>').replace("</worldbody>", "</body></worldbody>")
+    (tmp_path / "floating.xml").write_text(text)
+    (tmp_path / "floating.closures.toml").write_text('format = "pkm.closures/1"\nmechanism = "f"\nurdf = "floating.xml"\n'
+                                                     'end_effector = "coupler_point"\nactuated = ["crank_joint"]\n'
+                                                     '[task]\ncomponents = ["z"]\n')
+    mech = pkm.load(tmp_path / "floating.closures.toml")
+    assert mech.base is not None
+    with pytest.raises(UnreachableError):
+        pkm.solve_ik(mech, {"z": 5.0})

@@ -333,7 +333,6 @@ def inverse_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=None, me
     mech = check_mechanism(mech)
     if method not in METHODS:
         raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
-    a = _settle_idle(mech, q, v, a, wrench, wrenches)
     if method == "virtual_work":
         return virtual_work_dynamics(mech, q, v, a, wrench, wrenches=wrenches)
     k = _khalil(mech)
@@ -341,14 +340,16 @@ def inverse_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=None, me
         if method == "khalil":
             raise k
         return virtual_work_dynamics(mech, q, v, a, wrench, wrenches=wrenches)
-    return k.inverse_dynamics(q, v, a, wrench, wrenches=wrenches)
+    return k.inverse_dynamics(q, v, _settle_idle(mech, q, v, a, wrench, wrenches), wrench, wrenches=wrenches)
 
 
 def virtual_work_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=None) -> np.ndarray:
     """Actuator efforts as ``G^T (rnea(q, v, a) - sum J_f^T w_f)``, ``G = dq/dq_a`` without idle motions: the
-    whole-tree virtual-work route (external wrenches as in :func:`inverse_dynamics`)."""
+    whole-tree virtual-work route (external wrenches as in :func:`inverse_dynamics`; idle accelerations set by the
+    dynamics, see :func:`_settle_idle`)."""
     mech = check_mechanism(mech)
     q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
+    a = _settle_idle(mech, q, v, a, wrench, wrenches)
     G = passive_map(mech, q)
     h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches)
     return finite_result(G.T @ h, "actuator efforts")

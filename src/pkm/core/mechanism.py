@@ -346,10 +346,12 @@ class Mechanism:
     def check_v(self, v, name: str = "v") -> np.ndarray:
         return as_vector(v, self.nv, name)
 
-    def check_actuated(self, qa, name: str = "q_actuated") -> np.ndarray:
-        """Actuated values as a vector (``na``, SI); entries may be strings with units (``"5deg"``, ``"20mm"``)."""
-        return as_vector(quantities(qa, ["angle" if j.revolute else "length" for j in self.actuated], name),
-                         self.na, name)
+    def check_actuated(self, qa, name: str = "q_actuated", *, positions: bool = False) -> np.ndarray:
+        """Actuated values as a vector (``na``, SI). With ``positions``, entries may be strings with units
+        (``"5deg"``, ``"20mm"``); rates and efforts take numbers only (SI: m/s, rad/s, N, N m)."""
+        if positions:
+            qa = quantities(qa, ["angle" if j.revolute else "length" for j in self.actuated], name)
+        return as_vector(qa, self.na, name)
 
     def actuated_q(self, q) -> np.ndarray:
         """The actuated coordinates of a configuration, in spec order."""

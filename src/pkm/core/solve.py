@@ -157,7 +157,7 @@ def close_loops(mech: Mechanism, q_actuated, q0=None, *, tol: float = DEFAULT_TO
         A :class:`SolveResult` whose ``q`` has the requested actuated coordinates.
     """
     mech = check_mechanism(mech)
-    qa1 = mech.check_actuated(q_actuated)
+    qa1 = mech.check_actuated(q_actuated, positions=True)
     q = mech.q_reference.copy() if q0 is None else mech.check_q(q0, "q0")
     tol, max_iter, max_step = _settings(tol, max_iter, max_step)
     qa0 = mech.actuated_q(q)
@@ -346,8 +346,13 @@ def _raise_if_out_of_reach(mech: Mechanism, fun, q: np.ndarray, tol: float) -> N
     near ``q`` (Levenberg-Marquardt from ``q`` stalls with ``|F|_inf > max(tol, 1e-9)``): the target lies outside
     the workspace. It names the closure left most open there, or the task when the loops close there (to a
     thousandth of the task's miss: the least-squares minimum trades a little closure for a far target)."""
+    def held(qq):  # (a floating base stays where it is)
+        F, J = fun(qq)
+        J[:, mech.base_v] = 0.0
+        return F, J
+
     with np.errstate(over="ignore", invalid="ignore"):
-        q, F, _ = _levenberg_marquardt(mech, fun, q, tol, 500)
+        q, F, _ = _levenberg_marquardt(mech, held, q, tol, 500)
         gap, index, name = constraints.worst_closure(mech, F)
         task_gap = float(np.linalg.norm(F[mech.n_constraints:]))
     if not (np.isfinite(gap) and np.isfinite(task_gap) and np.abs(F).max() > max(tol, 1e-9)):

@@ -21,7 +21,7 @@ import pinocchio as pin
 from pkm.core.mechanism import Mechanism
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.units import quantities, quantity
-from pkm.validation import as_array, as_vector
+from pkm.validation import ABSURD, as_array, as_vector
 
 _ANGLES = ("roll", "pitch", "yaw")
 _POS = {"x": 0, "y": 1, "z": 2}
@@ -59,6 +59,8 @@ class _FrameTask:
         self.value_size, self.size = (7, 6) if self.pose else (len(components), len(components))
         self.keys = tuple(prefix + k for k in (("x", "y", "z", "roll", "pitch", "yaw") if self.pose else self.comp))
         self.names = tuple(prefix + k for k in (("x", "y", "z", "wx", "wy", "wz") if self.pose else self.comp))
+        self.value_names = tuple(prefix + k for k in (("x", "y", "z", "qx", "qy", "qz", "qw") if self.pose
+                                                      else self.comp))
         self.kinds = {prefix + k: ("length" if k in _POS else "angle")
                       for k in (("x", "y", "z", "roll", "pitch", "yaw") if self.pose else self.comp)}
         self.has_angles = any(c in _ANGLES for c in self.comp)
@@ -154,6 +156,8 @@ class TaskMap:
         self._value_at = np.cumsum([0] + [g.value_size for g in groups])
         self._tangent_at = np.cumsum([0] + [g.size for g in groups])
         self.names = tuple(n for g in groups for n in g.names) + self.spec.joints
+        #: The entries of a task value (a pose's orientation as its quaternion ``qx qy qz qw``).
+        self.value_names = tuple(n for g in groups for n in g.value_names) + self.spec.joints
         #: The task coordinates by name, as :meth:`named` gives them and targets may state them (a pose:
         #: ``x y z roll pitch yaw``; another frame's prefixed, ``foot.z``), then the joint outputs.
         self.keys = tuple(k for g in groups for k in g.keys) + self.spec.joints
@@ -215,12 +219,14 @@ class TaskMap:
             target = [v for g in self._groups for v in g.from_named(values)] + [values[j] for j in self.spec.joints]
         elif not any(g.pose for g in self._groups):
             target = quantities(target, [self.kinds[k] for k in self.keys], "target")
-        y = as_array(target, "target", f"{self.value_size} task coordinates {list(self.names)}")
+        y = as_array(target, "target", f"{self.value_size} task coordinates {list(self.value_names)}")
         if y.shape != (self.value_size,):
             raise InvalidInputError("target", f"expected {self.value_size} task coordinates "
-                                              f"{list(self.names)}, got shape {y.shape}", target)
+                                              f"{list(self.value_names)}, got shape {y.shape}", target)
         if not np.all(np.isfinite(y)):
             raise InvalidInputError("target", "holds non-finite values", target)
+        if np.abs(y).max() > ABSURD:
+            raise InvalidInputError("target", f"holds values beyond {ABSURD:g} (SI units: m, rad)", target)
         for g, part in zip(self._groups, self._parts(y)[0]):
             if g.pose and abs((qn := float(np.linalg.norm(part[3:7]))) - 1.0) > 1e-6:
                 raise InvalidInputError("target", f"quaternion norm {qn:.6g}, expected 1", target)

@@ -9,7 +9,8 @@ the branch: a singularity between the samples), or where the spec's branch signs
 
 The rates and accelerations come from :func:`pkm.inverse_velocities`/:func:`pkm.velocities` and their
 acceleration twins, the efforts from :func:`pkm.inverse_dynamics`, per sample; all in SI (the result's
-``units`` says which). A sample where a map is singular gets NaN rates and efforts and a Jump.
+``units`` says which). A sample that did not converge, or where a map is singular, gets NaN rates and
+efforts and a Jump.
 """
 
 from __future__ import annotations
@@ -42,9 +43,10 @@ class Jump:
 
     Attributes:
         index: The sample (0-based) reached by the jump.
-        reason: ``"did not converge"``, ``"fold"`` (the step far beyond the first-order prediction: a
-            singularity between the samples), ``"singular"`` (a map singular at the sample) or
-            ``"branch"`` (the spec's branch signs changed).
+        reason: ``"did not converge"`` (the sample's rates and efforts are NaN), ``"corrected"`` (reached,
+            but by a direct correction after the continuation failed), ``"fold"`` (the step far beyond the
+            first-order prediction: a singularity between the samples), ``"singular"`` (a map singular at
+            the sample: its rates and efforts are NaN) or ``"branch"`` (the spec's branch signs changed).
         detail: What was measured.
     """
 
@@ -64,7 +66,9 @@ class Trajectory:
         efforts: Actuator efforts (N x na) [N or N m], None when not asked for.
         residual: The closure (and task) residual of each solve (N).
         jumps: Where the path leaves its branch (empty: it stays on the one it starts on).
-        units: The unit of every actuated joint and task coordinate (``{"actuated": {...}, "task": {...}}``).
+        units: The unit of every actuated joint and named task coordinate (``{"actuated": {...}, "task": {...}}``;
+            the task's keys are :attr:`pkm.core.TaskMap.keys`, a pose's orientation by its Z-Y-X angles, while
+            :attr:`task` holds its quaternion).
     """
 
     q: np.ndarray
@@ -110,7 +114,7 @@ def _units(mech: Mechanism) -> dict[str, dict[str, str]]:
             "task": {k: unit[kind] for k, kind in mech.task_map.kinds.items()}}
 
 
-def _follow(mech: Mechanism, n: int, solve, predict, rates, efforts: bool, wrench) -> Trajectory:
+def _follow(mech: Mechanism, n: int, solve, predict, rates, efforts: bool, wrench, tol: float) -> Trajectory:
     na, nv = mech.na, mech.nv
     q = np.empty((n, mech.nq))
     v, a = np.full((n, nv), np.nan), np.full((n, nv), np.nan)
@@ -123,7 +127,9 @@ def _follow(mech: Mechanism, n: int, solve, predict, rates, efforts: bool, wrenc
         res = solve(k, mech.q_reference if prev is None else prev)
         q[k], residual[k] = res.q, res.residual
         if not res.converged:
-            jumps.append(Jump(k, "did not converge", f"residual {res.residual:.3g} (m or rad)"))
+            jumps.append(Jump(k, "did not converge", f"residual {res.residual:.3g} (m or rad)") if res.residual > tol
+                         else Jump(k, "corrected", "the continuation failed and a direct correction reached the "
+                                                   "sample, possibly on another branch"))
         if prev is not None:
             try:
                 dq_pred = predict(k, prev)
@@ -139,6 +145,9 @@ def _follow(mech: Mechanism, n: int, solve, predict, rates, efforts: bool, wrenc
             jumps.append(Jump(k, "branch", f"on {[b for b, on in now.items() if on]}, was on "
                                            f"{[b for b, on in signs.items() if on]}"))
         signs = now
+        if res.residual > tol:  # no rates nor efforts where the loops or the task are open
+            prev = res.q
+            continue
         try:
             v[k], a[k] = rates(k, res.q)
             if tau is not None:
@@ -191,7 +200,7 @@ def follow_task(mech: Mechanism, y, yd=None, ydd=None, *, q0=None, efforts: bool
         vk = inverse_velocities(mech, qk, Yd[k])
         return vk, inverse_accelerations(mech, qk, vk, Ydd[k])
 
-    return _follow(mech, n, solve, predict, rates, efforts, wrench)
+    return _follow(mech, n, solve, predict, rates, efforts, wrench, tol)
 
 
 def follow_actuators(mech: Mechanism, qa, qd=None, qdd=None, *, q0=None, efforts: bool = True, wrench=None,
@@ -224,7 +233,7 @@ def follow_actuators(mech: Mechanism, qa, qd=None, qdd=None, *, q0=None, efforts
         vk = velocities(mech, qk, Ad[k])
         return vk, accelerations(mech, qk, vk, Add[k])
 
-    return _follow(mech, n, solve, predict, rates, efforts, wrench)
+    return _follow(mech, n, solve, predict, rates, efforts, wrench, tol)
 
 
 def task_values(mech: Mechanism, q) -> dict[str, float]:

@@ -140,3 +140,41 @@ def test_a_file_without_actuators_says_how_to_name_them(tmp_path):
     path.write_text(FOURBAR.read_text().replace('<motor name="drive" joint="crank_joint" gear="1"/>', ""))
     with pytest.raises(SpecError, match=r"names no actuated joint.*pkm spec init"):
         pkm.load(path)
+
+
+def test_equalities_on_sites_are_refused_before_pinocchio_sees_them():
+    """(Pinocchio 4.1 crashes the process on site-based equalities.)"""
+    text = PROBE.replace('<weld body1="a" body2="b"/>', '<weld site1="bs" site2="stand_tip"/>')
+    with pytest.raises(SpecError, match=r"between bodies .* not sites"):
+        read_mjcf(text, "probe.xml")
+
+
+def test_the_world_body_and_free_bodies_are_where_mujoco_puts_them(tmp_path):
+    """body2="world" names the world; a free body keeps its pose at qpos0 (Pinocchio 4.1 applies it twice), its
+    loop closed there, its sites where MuJoCo puts them."""
+    text = """<mujoco model="free"><compiler angle="degree"/><worldbody>
+      <body name="plat" pos="0.1 0.2 0.5" euler="0 0 30"><freejoint name="pf"/>
+        <geom type="sphere" size="0.05" mass="1"/><site name="s" pos="0.1 0 0"/></body>
+      <body name="arm"><joint name="j" type="hinge" axis="0 0 1"/>
+        <geom type="capsule" fromto="0 0 0 0.1 0 0" size="0.01" mass="0.1"/></body>
+    </worldbody><equality><connect body1="plat" body2="arm" anchor="0 0 0"/>
+      <connect body1="arm" body2="world" anchor="0 0 0"/></equality>
+    <actuator><motor joint="j"/></actuator></mujoco>"""
+    (tmp_path / "free.xml").write_text(text)
+    mech = pkm.load(tmp_path / "free.xml")
+    at = mech.joint("pf").idx_q
+    R = pin.AngleAxis(np.radians(30), np.array([0, 0, 1.0])).matrix()
+    assert np.allclose(mech.q_reference[at:at + 7], pin.SE3ToXYZQUAT(pin.SE3(R, np.array([0.1, 0.2, 0.5]))))
+    from pkm.core import constraints
+
+    assert np.abs(constraints.residual(mech, mech.q_reference)).max() <= 1e-12
+    pin.framesForwardKinematics(mech.model, mech.data, mech.q_reference)
+    assert np.allclose(mech.data.oMf[mech.frame_id("s")].translation, [0.1, 0.2, 0.5] + R @ [0.1, 0, 0])
+
+
+def test_a_urdf_named_xml_is_read_as_a_urdf(tmp_path):
+    knee = Path(__file__).resolve().parents[3] / "examples" / "knee"
+    (tmp_path / "knee.xml").write_text((knee / "knee.urdf").read_text())
+    (tmp_path / "knee.closures.toml").write_text((knee / "knee.closures.toml").read_text().replace("knee.urdf",
+                                                                                                     "knee.xml"))
+    assert pkm.load(tmp_path / "knee.closures.toml").actuated_names == ("knee_front",)

@@ -116,3 +116,25 @@ def test_an_sdf_file_alone_says_that_a_spec_must_name_the_actuators(tmp_path):
     path.write_text(fourbar())
     with pytest.raises(SpecError, match="names no actuated joint"):
         pkm.load(path)
+
+
+def test_a_ball_joint_in_the_tree_and_link_frames_at_their_sdf_poses():
+    """A ball joint of the tree is a Pinocchio spherical joint; a link whose joint is posed away from it keeps a
+    frame of its name at its SDF pose (the URDF link, at the joint, is <link>__joint)."""
+    text = fourbar().replace('<joint name="coupler_joint" type="revolute">', '<joint name="coupler_joint" type="ball">')
+    text = text.replace("<axis><xyz>0 1 0</xyz><use_parent_model_frame>true</use_parent_model_frame></axis>", "")
+    text = text.replace('<parent>crank</parent><child>coupler</child>',
+                        '<parent>crank</parent><child>coupler</child><pose>0 0 -0.02 0 0 0</pose>')
+    mech = mechanism(text)
+    assert mech.joints["coupler_joint"].kind == "JointModelSpherical"
+    (coupler,) = placements(mech, mech.q_reference, "coupler")
+    assert np.allclose(coupler.translation, [0, 0, 0.1])  # the SDF pose, not the joint's (0, 0, 0.08)
+    assert mech.model.existFrame("coupler__joint")
+
+
+def test_a_chain_deeper_than_the_recursion_limit_is_a_spec_error():
+    links = "".join(f"<link name='l{k}'/>" for k in range(1499, -1, -1))  # children first
+    joints = "".join(f"<joint name='j{k}' type='fixed'><parent>l{k - 1}</parent><child>l{k}</child></joint>"
+                     for k in range(1499, 0, -1))
+    with pytest.raises(SpecError, match="nested deeper"):
+        read_sdf(f"<sdf version='1.7'><model name='deep'>{links}{joints}</model></sdf>", "deep.sdf")

@@ -4,6 +4,7 @@ closure spec adds (loops, joint types, actuators)."""
 from __future__ import annotations
 
 import dataclasses
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -27,6 +28,7 @@ class Imported:
         name: The model's name.
         format: ``"urdf"``, ``"mjcf"`` or ``"sdf"``.
         floating_base: The free-flyer joint that carries the whole tree (an MJCF root ``<freejoint>``), or None.
+        reference: Joint values the file states (an MJCF free body's pose), for ``[reference]``.
     """
 
     urdf: str
@@ -36,16 +38,26 @@ class Imported:
     name: str
     format: str
     floating_base: str | None = None
+    reference: dict[str, tuple[float, ...]] = dataclasses.field(default_factory=dict)
+
+
+def _root_tag(text: str) -> str | None:
+    """The name of the document's first element (after the declaration and comments), or None."""
+    body = re.sub(r"<\?.*?\?>|<!--.*?-->", "", text[:65536], flags=re.DOTALL)
+    m = re.search(r"<\s*([A-Za-z_][\w.-]*)", body)
+    return m.group(1) if m else None
 
 
 def import_model(path: Path) -> Imported:
-    """Read the model file at ``path``, by its suffix (:data:`SUFFIXES`; another suffix is read as URDF).
+    """Read the model file at ``path``, by its root element (``robot``, ``mujoco``, ``sdf``), else by its suffix
+    (:data:`SUFFIXES`; another suffix is read as URDF).
 
     Raises:
         SpecError: the file is missing, too large, malformed, or uses what its reader refuses.
     """
     kind = SUFFIXES.get(path.suffix.lower(), "urdf")
     text = read_text_file(path, kind.upper())
+    kind = {"robot": "urdf", "mujoco": "mjcf", "sdf": "sdf"}.get(_root_tag(text) or "", kind)  # (a URDF named .xml)
     if kind == "mjcf":
         from pkm.core.formats.mjcf import read_mjcf
 
@@ -64,14 +76,15 @@ def with_file(spec: ClosureSpec, imp: Imported, source: str) -> ClosureSpec:
     Raises:
         SpecError: a closure named both in the spec and in the file.
     """
-    if not imp.closures and not imp.joint_types and imp.floating_base is None:
+    if not imp.closures and not imp.joint_types and imp.floating_base is None and not imp.reference:
         return spec
     clash = sorted({c.name for c in spec.closures} & {c.name for c in imp.closures})
     if clash:
         raise SpecError(source, f"closure {clash[0]!r} is both in the spec and in {spec.urdf!r}; rename the spec's")
     return dataclasses.replace(spec, closures=imp.closures + spec.closures,
                                joint_types={**imp.joint_types, **spec.joint_types},
-                               floating_base=spec.floating_base or imp.floating_base)
+                               floating_base=spec.floating_base or imp.floating_base,
+                               reference={**imp.reference, **spec.reference})
 
 
 def load_model_file(path: Path):
@@ -90,7 +103,7 @@ def load_model_file(path: Path):
                                    f"urdf = {path.name!r} and actuated = [...] beside it (`pkm spec init {path}` "
                                    "writes one to fill in), and load the spec")
     spec = ClosureSpec(mechanism=imp.name, urdf=path.name, end_effector=None, actuated=imp.actuated,
-                       closures=imp.closures, task=TaskSpec((), imp.actuated), reference={},
+                       closures=imp.closures, task=TaskSpec((), imp.actuated), reference=dict(imp.reference),
                        description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types,
                        floating_base=imp.floating_base)
     return Mechanism.from_strings(imp.urdf, spec, source=str(path))

@@ -40,7 +40,8 @@ from pkm.errors import SpecError
 _ACTUATORS = ("motor", "position", "velocity", "general", "intvelocity", "damper", "cylinder", "muscle",
               "adhesion")
 _JOINT_TYPES = ("hinge", "slide", "ball", "free")
-_WORLD = "pkm_mjcf_world"  # the fixed body pkm wraps the worldbody's children in (Pinocchio reads only one)
+_WORLD = "world"  # the fixed body pkm wraps the worldbody's children in (Pinocchio reads only one): MuJoCo's name
+# for the world body, which equalities may name (body2="world") and no body of the file may take
 
 
 def _floats(text: str | None, n: int, what: str, source: str) -> np.ndarray:
@@ -82,15 +83,22 @@ class _Defaults:
         return default
 
 
+def _unit(x: np.ndarray, what: str, source: str) -> np.ndarray:
+    n = float(np.linalg.norm(x))
+    if n < 1e-12:
+        raise SpecError(source, f"{what}: a zero vector gives no direction")
+    return x / n
+
+
 def _rotation(el: etree._Element, degrees: bool, source: str) -> np.ndarray:
     """The orientation an MJCF element states (quat, axisangle, euler xyz, xyaxes, zaxis)."""
     what = f"<{el.tag} name={el.get('name')!r}>"
     if el.get("quat") is not None:
-        w, x, y, z = _floats(el.get("quat"), 4, f"{what} quat", source)
-        return pin.Quaternion(w, x, y, z).normalized().matrix()
+        w, x, y, z = _unit(_floats(el.get("quat"), 4, f"{what} quat", source), f"{what} quat", source)
+        return pin.Quaternion(w, x, y, z).matrix()
     if el.get("axisangle") is not None:
         a = _floats(el.get("axisangle"), 4, f"{what} axisangle", source)
-        return pin.AngleAxis(np.deg2rad(a[3]) if degrees else a[3], a[:3] / np.linalg.norm(a[:3])).matrix()
+        return pin.AngleAxis(np.deg2rad(a[3]) if degrees else a[3], _unit(a[:3], f"{what} axisangle", source)).matrix()
     if el.get("euler") is not None:
         e = _floats(el.get("euler"), 3, f"{what} euler", source)
         e = np.deg2rad(e) if degrees else e
@@ -100,13 +108,12 @@ def _rotation(el: etree._Element, degrees: bool, source: str) -> np.ndarray:
         return R
     if el.get("xyaxes") is not None:
         a = _floats(el.get("xyaxes"), 6, f"{what} xyaxes", source)
-        x = a[:3] / np.linalg.norm(a[:3])
-        y = a[3:] - x * (x @ a[3:])
-        y /= np.linalg.norm(y)
+        x = _unit(a[:3], f"{what} xyaxes", source)
+        y = _unit(a[3:] - x * (x @ a[3:]), f"{what} xyaxes", source)
         return np.column_stack([x, y, np.cross(x, y)])
     if el.get("zaxis") is not None:
         z = _floats(el.get("zaxis"), 3, f"{what} zaxis", source)
-        return pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), z / np.linalg.norm(z)).matrix()
+        return pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), _unit(z, f"{what} zaxis", source)).matrix()
     return np.eye(3)
 
 
@@ -152,6 +159,10 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
     for el in equalities:
         if el.tag not in ("connect", "weld"):
             raise SpecError(source, f"<equality><{el.tag}> is not a loop closure pkm reads (connect and weld are)")
+    for el in equalities:  # (Pinocchio 4.1 crashes on site-based equalities: refused before it sees them)
+        if el.get("site1") is not None or el.get("site2") is not None or not el.get("body1"):
+            raise SpecError(source, f"<equality><{el.tag} name={el.get('name')!r}>: pkm reads equalities between "
+                                    "bodies (body1, optional body2, anchor or relpose), not sites")
     counts = {"connect": 0, "weld": 0}
     eq_names = []
     for el in equalities:
@@ -180,6 +191,12 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
         raise SpecError(source, f"Pinocchio read {len(points)} connect and {len(welds)} weld constraints, the file "
                                 f"states {counts['connect']} and {counts['weld']}")
 
+    free = _free_bodies(model, world, degrees, source)
+    if free:
+        if any(el.tag == "weld" and el.get("relpose") is not None for el in equalities):
+            raise SpecError(source, "a weld's relpose with free bodies is not read: leave relpose out (the bodies are "
+                                    "then welded as they are at qpos0)")
+        points, welds = _anchored(model, free, points), _anchored(model, free, welds)
     taken = set(model.names) | {f.name for f in model.frames}
     extra: list[tuple[str, int, pin.SE3]] = []
     for site in world.iter("site"):  # the sites Pinocchio dropped (those of bodies without joints)
@@ -214,7 +231,41 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
     for a in actuated:
         if a not in known:
             raise SpecError(source, f"an actuator drives joint {a!r}, which the file does not define")
-    return Imported(urdf, tuple(closures), types, tuple(actuated), name, "mjcf", _floating_base(model))
+    reference = {model.names[j]: tuple(map(float, pin.SE3ToXYZQUAT(X))) for j, X in free.items()}
+    return Imported(urdf, tuple(closures), types, tuple(actuated), name, "mjcf", _floating_base(model), reference)
+
+
+def _free_bodies(model: pin.Model, world: etree._Element, degrees: bool, source: str) -> dict[int, pin.SE3]:
+    """``{free-flyer joint: the body's pose at qpos0}`` for MuJoCo's free bodies. Pinocchio 4.1 misplaces them
+    (the body's pose is applied twice), so their joints are reset to the world origin here (``model`` edited) and
+    their pose moves into the reference."""
+    out = {}
+    for body in world.iter("body"):
+        free = [j for j in body if j.tag == "freejoint" or (j.tag == "joint" and j.get("type") == "free")]
+        if not free or not model.existJointName(free[0].get("name")):
+            continue
+        jid = model.getJointId(free[0].get("name"))
+        pos = _floats(body.get("pos", "0 0 0"), 3, f"body {body.get('name')!r} pos", source)
+        out[jid] = pin.SE3(_rotation(body, degrees, source), pos)
+        model.jointPlacements[jid] = pin.SE3.Identity()
+    return out
+
+
+def _anchored(model: pin.Model, free: dict[int, pin.SE3], constraints):
+    """The constraints with their second end re-anchored where the first is at qpos0 (free bodies at their poses)."""
+    q0 = pin.neutral(model)
+    for jid, X in free.items():
+        jm = model.joints[jid]
+        q0[jm.idx_q:jm.idx_q + 7] = pin.SE3ToXYZQUAT(X)
+    d = model.createData()
+    pin.forwardKinematics(model, d, q0)
+    out = []
+    for cm in constraints:
+        world_a = d.oMi[cm.joint1_id] * cm.joint1_placement
+        out.append(type("Anchors", (), {"joint1_id": cm.joint1_id, "joint1_placement": cm.joint1_placement,
+                                        "joint2_id": cm.joint2_id,
+                                        "joint2_placement": d.oMi[cm.joint2_id].actInv(world_a)})())
+    return out
 
 
 def _floating_base(model: pin.Model) -> str | None:

@@ -22,7 +22,9 @@ independent equations). A cut prismatic joint stays in the tree, from its parent
 ``<joint>_cut`` tied to ``<joint>_child`` by a ``frame`` closure: exact too, but the massless link makes
 the tree's mass matrix singular, so Pinocchio's ``constraintDynamics`` cannot run on it (pkm's inverse
 dynamics can). A link that
-no joint has as child is the base, fixed to the world at its pose (SDFormat would leave it free).
+no joint has as child is the base, fixed to the world at its pose (SDFormat would leave it free). Every
+SDF link and ``<frame>`` keeps its name and pose as a frame (a URDF link's frame is at its joint: where the
+SDF link's pose differs, the URDF link is named ``<link>__joint``).
 SDFormat names no actuators: a closure spec whose ``urdf`` is the SDF file says which joints are.
 
 Refused with a :class:`~pkm.errors.SpecError`: nested models, ``<include>``, universal, screw and
@@ -76,6 +78,13 @@ def read_sdf(text: str, source: str = "<sdf>") -> Imported:
     Raises:
         SpecError: malformed XML or a refused feature.
     """
+    try:
+        return _read_sdf(text, source)
+    except RecursionError:
+        raise SpecError(source, "poses or parent links nested deeper than Python's recursion limit") from None
+
+
+def _read_sdf(text: str, source: str) -> Imported:
     root = parse_xml(text, source, "sdf", "SDF")
     models = root.findall("model") or root.findall("world/model")
     if len(models) != 1:
@@ -158,7 +167,7 @@ def read_sdf(text: str, source: str = "<sdf>") -> Imported:
     urdf_frame: dict[str, pin.SE3] = {"world": pin.SE3.Identity()}  # the URDF frame of each link (at its joint)
 
     def add_link(name: str, el: etree._Element | None = None) -> None:
-        lel = etree.SubElement(robot, "link", name=name)
+        lel = etree.SubElement(robot, "link", name=ulink.get(name, name))
         inertial = el.find("inertial") if el is not None else None
         if inertial is None:
             return
@@ -176,9 +185,12 @@ def read_sdf(text: str, source: str = "<sdf>") -> Imported:
     def add_joint(name: str, kind: str, parent: str, child: str, X: pin.SE3, j: etree._Element | None = None):
         jel = etree.SubElement(robot, "joint", name=name, type=kind)
         origin(jel, urdf_frame[parent].inverse() * X)
-        etree.SubElement(jel, "parent", link=parent)
-        etree.SubElement(jel, "child", link=child)
-        if j is not None and kind in ("revolute", "prismatic"):
+        etree.SubElement(jel, "parent", link=ulink.get(parent, parent))
+        etree.SubElement(jel, "child", link=ulink.get(child, child))
+        if j is not None and j.get("type") == "ball":  # a placeholder that [joint_types] makes spherical
+            etree.SubElement(jel, "axis", xyz="0 0 1")
+            etree.SubElement(jel, "limit", effort="0", velocity="0")
+        elif j is not None and kind in ("revolute", "prismatic"):
             etree.SubElement(jel, "axis", xyz=num(axis(j, X)))
             lo, hi = _text(j, "axis/limit/lower"), _text(j, "axis/limit/upper")
             bounds = {}
@@ -215,6 +227,15 @@ def read_sdf(text: str, source: str = "<sdf>") -> Imported:
 
     for name in links:
         visit(name)
+    # a URDF link's frame is its joint's; where an SDF link's pose differs, the URDF link is <name>__joint and a
+    # frame <name> marks the SDF link's own pose
+    ulink: dict[str, str] = {}
+    for name in order:
+        if not urdf_frame[name].isApprox(pose_of(name), 1e-12):
+            ulink[name] = f"{name}__joint"
+            if ulink[name] in names:
+                raise SpecError(source, f"pkm names a link {ulink[name]!r}, which the model already uses; rename it")
+            names.add(ulink[name])
     types: dict[str, str] = {}
     for name in order:
         add_link(name, links[name])
@@ -226,6 +247,12 @@ def read_sdf(text: str, source: str = "<sdf>") -> Imported:
         add_joint(j.get("name"), kinds.get(j.get("type"), j.get("type")), parent, name, urdf_frame[name], j)
         if j.get("type") == "ball":
             types[j.get("name")] = "spherical"
+    for name, urdf_name in ulink.items():
+        etree.SubElement(robot, "link", name=name)
+        jel = etree.SubElement(robot, "joint", name=f"{name}_fixed", type="fixed")
+        origin(jel, urdf_frame[name].inverse() * pose_of(name))
+        etree.SubElement(jel, "parent", link=urdf_name)
+        etree.SubElement(jel, "child", link=name)
     closures = []
     for j in cuts:
         jname, X = j.get("name"), joint_frame(j)
