@@ -6,7 +6,9 @@ symbols ``q`` (nq), ``v`` (nv) and ``a`` (nv):
 * joint and frame placements, world-aligned frame Jacobians (``LOCAL_WORLD_ALIGNED``, as Pinocchio's);
 * the closure residual (the conventions of :mod:`pkm.core.constraints`), its Jacobian and drift
   ``gamma = dJ/dt v``;
-* RNEA (joint torques for ``q, v, a`` under ``model.gravity``), kinetic and potential energy.
+* RNEA (joint torques for ``q, v, a`` under ``model.gravity``), kinetic and potential energy;
+* the actuator efforts ``G^T rnea`` at a consistent state (mechanisms without idle motions), whose CasADi
+  function maps over batches (``Function.map``) and differentiates (``casadi.jacobian``).
 
 Everything is derived from the model: each joint's placement, its motion subspace ``S`` (constant in
 the joint's frame for every joint kind handled) and the exponential of ``S`` for one-coordinate joints,
@@ -370,6 +372,27 @@ class Twin:
             com = self.oMi[j].p + self.oMi[j].R @ cs.DM(I.lever)
             out = out - I.mass * cs.dot(g, com)
         return out
+
+    @functools.cached_property
+    def actuated_efforts(self):
+        """Actuator efforts (na) at a consistent state, ``G^T rnea(q, v, a)`` with ``G = dq/dq_a`` from the closure
+        Jacobian (:func:`pkm.core.dynamics.virtual_work_dynamics`), ``J_p`` solved in least squares (redundant
+        planar rows allowed).
+
+        Raises:
+            SpecError: the mechanism has idle motions (their accelerations need the dynamics:
+                :func:`pkm.inverse_dynamics` handles them).
+        """
+        from pkm.core.differential import idle_motions
+
+        mech = self.mech
+        if idle_motions(mech, mech.q_reference).shape[1]:
+            raise SpecError(mech.source, "the twin's efforts need a mechanism without idle motions; "
+                                         "pkm.inverse_dynamics handles them")
+        Jc, h = self.closure_jacobian, self.rnea
+        Jp, Ja = Jc[:, mech.passive_v.tolist()], Jc[:, mech.act_v.tolist()]
+        X = cs.solve(Jp.T @ Jp, Jp.T @ Ja)  # dq_p/dq_a = -X
+        return h[mech.act_v.tolist()] - X.T @ h[mech.passive_v.tolist()]
 
     # ---------------------------------------------------------------- functions
     def function(self, name: str, outputs: dict, inputs: tuple[str, ...] = ("q", "v", "a")) -> cs.Function:
