@@ -167,3 +167,23 @@ def test_the_twins_efforts_equal_the_generic_inverse_dynamics(name):
 def test_idle_motions_are_left_to_the_generic_route():
     with pytest.raises(SpecError, match="idle motions"):
         Twin(_mechanism("ankle")).actuated_efforts  # noqa: B018
+
+
+def test_a_twin_function_compiles_to_c_or_says_why_not(tmp_path, monkeypatch):
+    """With a C compiler the efforts run as compiled C and equal the SX function (1e-13); without one the SX
+    function comes back, saying so."""
+    import shutil
+
+    from pkm.core.twin import compile_function
+
+    mech = _mechanism("prs3")
+    tw = Twin(mech)
+    fun = tw.function("prs3_tau", {"tau": tw.actuated_efforts})
+    q, v, a = mech.q_reference, np.full(mech.nv, 0.1), np.full(mech.nv, -0.2)
+    compiled, how = compile_function(fun, tmp_path)
+    if shutil.which("cc") or shutil.which("gcc") or shutil.which("clang"):
+        assert how.startswith("C (") and (tmp_path / "prs3_tau.so").exists()
+    assert np.abs(np.array(compiled(q, v, a)) - np.array(fun(q, v, a))).max() <= 1e-13
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    same, how = compile_function(fun, tmp_path / "none")
+    assert same is fun and "no C compiler" in how
