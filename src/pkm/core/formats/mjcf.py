@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+from typing import NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -262,10 +263,17 @@ def _anchored(model: pin.Model, free: dict[int, pin.SE3], constraints):
     out = []
     for cm in constraints:
         world_a = d.oMi[cm.joint1_id] * cm.joint1_placement
-        out.append(type("Anchors", (), {"joint1_id": cm.joint1_id, "joint1_placement": cm.joint1_placement,
-                                        "joint2_id": cm.joint2_id,
-                                        "joint2_placement": d.oMi[cm.joint2_id].actInv(world_a)})())
+        out.append(_Anchors(cm.joint1_id, cm.joint1_placement, cm.joint2_id, d.oMi[cm.joint2_id].actInv(world_a)))
     return out
+
+
+class _Anchors(NamedTuple):
+    """The two ends of an equality: each a joint and a placement in its frame (as Pinocchio's constraint models)."""
+
+    joint1_id: int
+    joint1_placement: pin.SE3
+    joint2_id: int
+    joint2_placement: pin.SE3
 
 
 def _floating_base(model: pin.Model) -> str | None:
