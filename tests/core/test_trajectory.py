@@ -83,6 +83,8 @@ def test_bad_samples_are_refused(knee):
         pkm.follow_actuators(knee, [0.0, np.nan])
     with pytest.raises(InvalidInputError, match="3 x 1"):
         pkm.follow_actuators(knee, [0.0, 0.1, 0.2], qd=[0.0, 0.1])
+    with pytest.raises(InvalidInputError, match="True or False"):
+        pkm.follow_actuators(knee, [0.0, 0.1], efforts=np.zeros(2))
 
 
 def test_task_values_are_named():

@@ -31,7 +31,7 @@ from pkm.core.dynamics import inverse_dynamics
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.solve import close_loops, solve_ik
 from pkm.errors import InvalidInputError, SingularityError
-from pkm.validation import ABSURD, as_array
+from pkm.validation import ABSURD, as_array, as_tolerance
 
 #: A sample's joint step beyond this multiple of the first-order prediction (plus 1e-9) is a jump.
 JUMP_RATIO = 1.0
@@ -115,6 +115,9 @@ def _units(mech: Mechanism) -> dict[str, dict[str, str]]:
 
 
 def _follow(mech: Mechanism, n: int, solve, predict, rates, efforts: bool, wrench, tol: float) -> Trajectory:
+    if not isinstance(efforts, (bool, np.bool_)):
+        raise InvalidInputError("efforts", f"expected True or False, got {type(efforts).__name__}", efforts)
+    tol = as_tolerance(tol, "tol")
     na, nv = mech.na, mech.nv
     q = np.empty((n, mech.nq))
     v, a = np.full((n, nv), np.nan), np.full((n, nv), np.nan)

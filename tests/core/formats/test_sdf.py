@@ -105,6 +105,7 @@ def test_a_base_link_without_a_parent_is_fixed_where_it_is_posed():
                          "<joint name=\"cut\""), "needs <axis><xyz>"),
     (lambda s: s.replace("<sdf", "<robot").replace("</sdf>", "</robot>"), "expected <sdf>"),
     (lambda s: s.replace('<link name="coupler">', '<link name="coupler_">'), "not a link"),
+    (lambda s: s.replace('<frame name="tip"', '<frame'), "every <frame> needs a distinct name"),
 ])
 def test_what_it_refuses_it_says(edit, message):
     with pytest.raises(SpecError, match=message):

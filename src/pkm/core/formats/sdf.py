@@ -96,6 +96,8 @@ def _read_sdf(text: str, source: str) -> Imported:
     if not links or any(not n for n in links) or len(links) != len(model.findall("link")):
         raise SpecError(source, "every <link> needs a distinct name")
     frames = {el.get("name"): el for el in model.findall("frame")}
+    if any(not n for n in frames) or len(frames) != len(model.findall("frame")):
+        raise SpecError(source, "every <frame> needs a distinct name")
     joints = model.findall("joint")
     for j in joints:
         if not j.get("name") or j.get("type") not in _TYPES:
