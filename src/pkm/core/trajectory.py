@@ -114,7 +114,10 @@ def _units(mech: Mechanism) -> dict[str, dict[str, str]]:
             "task": {k: unit[kind] for k, kind in mech.task_map.kinds.items()}}
 
 
-def _follow(mech: Mechanism, n: int, solve, predict, rates, efforts: bool, wrench, tol: float) -> Trajectory:
+def _follow(mech: Mechanism, n: int, q0, solve, predict, rates, efforts: bool, wrench, tol: float) -> Trajectory:
+    """The samples one by one: ``solve(k, q_from)`` from the previous sample (``q0`` for the first),
+    ``predict(k, q_prev)`` the first-order step, ``rates(k, q) -> (v, a)``."""
+    start = mech.q_reference if q0 is None else mech.check_q(q0, "q0")
     if not isinstance(efforts, (bool, np.bool_)):
         raise InvalidInputError("efforts", f"expected True or False, got {type(efforts).__name__}", efforts)
     tol = as_tolerance(tol, "tol")
@@ -127,7 +130,7 @@ def _follow(mech: Mechanism, n: int, solve, predict, rates, efforts: bool, wrenc
     prev = None
     signs = None
     for k in range(n):
-        res = solve(k, mech.q_reference if prev is None else prev)
+        res = solve(k, start if prev is None else prev)
         q[k], residual[k] = res.q, res.residual
         if not res.converged:
             jumps.append(Jump(k, "did not converge", f"residual {res.residual:.3g} (m or rad)") if res.residual > tol
@@ -191,10 +194,9 @@ def follow_task(mech: Mechanism, y, yd=None, ydd=None, *, q0=None, efforts: bool
     Y = _samples(y, None, task.value_size, "y")
     n = len(Y)
     Yd, Ydd = _samples(yd, n, task.size, "yd"), _samples(ydd, n, task.size, "ydd")
-    start = mech.q_reference if q0 is None else mech.check_q(q0, "q0")
 
-    def solve(k, prev):
-        return solve_ik(mech, Y[k], start if k == 0 else prev, tol=tol, raise_on_failure=False)
+    def solve(k, q_from):
+        return solve_ik(mech, Y[k], q_from, tol=tol, raise_on_failure=False)
 
     def predict(k, prev):
         return inverse_velocities(mech, prev, task.error(Y[k], Y[k - 1]))
@@ -203,7 +205,7 @@ def follow_task(mech: Mechanism, y, yd=None, ydd=None, *, q0=None, efforts: bool
         vk = inverse_velocities(mech, qk, Yd[k])
         return vk, inverse_accelerations(mech, qk, vk, Ydd[k])
 
-    return _follow(mech, n, solve, predict, rates, efforts, wrench, tol)
+    return _follow(mech, n, q0, solve, predict, rates, efforts, wrench, tol)
 
 
 def follow_actuators(mech: Mechanism, qa, qd=None, qdd=None, *, q0=None, efforts: bool = True, wrench=None,
@@ -224,10 +226,9 @@ def follow_actuators(mech: Mechanism, qa, qd=None, qdd=None, *, q0=None, efforts
     A = _samples(qa, None, mech.na, "qa")
     n = len(A)
     Ad, Add = _samples(qd, n, mech.na, "qd"), _samples(qdd, n, mech.na, "qdd")
-    start = mech.q_reference if q0 is None else mech.check_q(q0, "q0")
 
-    def solve(k, prev):
-        return close_loops(mech, A[k], start if k == 0 else prev, tol=tol, raise_on_failure=False)
+    def solve(k, q_from):
+        return close_loops(mech, A[k], q_from, tol=tol, raise_on_failure=False)
 
     def predict(k, prev):
         return velocities(mech, prev, A[k] - A[k - 1])
@@ -236,7 +237,7 @@ def follow_actuators(mech: Mechanism, qa, qd=None, qdd=None, *, q0=None, efforts
         vk = velocities(mech, qk, Ad[k])
         return vk, accelerations(mech, qk, vk, Add[k])
 
-    return _follow(mech, n, solve, predict, rates, efforts, wrench, tol)
+    return _follow(mech, n, q0, solve, predict, rates, efforts, wrench, tol)
 
 
 def task_values(mech: Mechanism, q) -> dict[str, float]:
