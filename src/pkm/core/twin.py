@@ -7,8 +7,10 @@ symbols ``q`` (nq), ``v`` (nv) and ``a`` (nv):
 * the closure residual (the conventions of :mod:`pkm.core.constraints`), its Jacobian and drift
   ``gamma = dJ/dt v``;
 * RNEA (joint torques for ``q, v, a`` under ``model.gravity``), kinetic and potential energy;
-* the actuator efforts ``G^T rnea`` at a consistent state (mechanisms without idle motions), whose CasADi
-  function maps over batches (``Function.map``) and differentiates (``casadi.jacobian``).
+* for mechanisms without idle motions: the passive map ``G``, the joint rates and accelerations from the
+  actuated ones, the loop closure's Gauss-Newton step, and the actuator efforts ``G^T rnea`` at a consistent
+  state; their CasADi functions map over batches (``Function.map``), differentiate (``casadi.jacobian``) and
+  compile to C (:func:`compile_function`).
 
 Everything is derived from the model: each joint's placement, its motion subspace ``S`` (constant in
 the joint's frame for every joint kind handled) and the exponential of ``S`` for one-coordinate joints,
@@ -230,6 +232,8 @@ class Twin:
         self.mech = mech = check_mechanism(mech)
         model = mech.model
         self.q, self.v, self.a = cs.SX.sym("q", model.nq), cs.SX.sym("v", model.nv), cs.SX.sym("a", model.nv)
+        #: The actuated rates and accelerations (symbols, na), inputs of :attr:`velocities` and :attr:`accelerations`.
+        self.qd, self.qdd = cs.SX.sym("qd", mech.na), cs.SX.sym("qdd", mech.na)
         self.joints: list = [None] + [_Joint(model, j, mech.source) for j in range(1, model.njoints)]
         self._inertia = [model.inertias[j] for j in range(model.njoints)]
         self._forward()
@@ -373,31 +377,75 @@ class Twin:
             out = out - I.mass * cs.dot(g, com)
         return out
 
+    def _no_idle(self) -> None:
+        from pkm.core.differential import idle_motions
+
+        if idle_motions(self.mech, self.mech.q_reference).shape[1]:
+            raise SpecError(self.mech.source, "the twin's rate maps and efforts need a mechanism without idle motions; "
+                                              "pkm.passive_map and pkm.inverse_dynamics handle them")
+
+    def _passive_solve(self, rhs):
+        """``x`` with ``J_p x = rhs`` in least squares (redundant planar rows allowed), ``J_p`` the passive columns."""
+        Jp = self.closure_jacobian[:, self.mech.passive_v.tolist()]
+        return cs.solve(Jp.T @ Jp, Jp.T @ rhs)
+
+    @functools.cached_property
+    def passive_map(self):
+        """``G = dq/dq_a`` (nv x na), as :func:`pkm.passive_map` (mechanisms without idle motions)."""
+        self._no_idle()
+        mech = self.mech
+        G = cs.SX.zeros(mech.nv, mech.na)
+        for k, col in enumerate(mech.act_v):
+            G[int(col), k] = 1
+        X = -self._passive_solve(self.closure_jacobian[:, mech.act_v.tolist()])
+        for r, row in enumerate(mech.passive_v):
+            G[int(row), :] = X[r, :]
+        return G
+
+    @functools.cached_property
+    def velocities(self):
+        """All joint rates for the actuated rates :attr:`qd` (symbol, na), as :func:`pkm.velocities`."""
+        return self.passive_map @ self.qd
+
+    @functools.cached_property
+    def accelerations(self):
+        """All joint accelerations at ``(q, v)`` for the actuated accelerations :attr:`qdd` (symbol, na), as
+        :func:`pkm.accelerations`: the passive ones close the loops at the acceleration level (drift included)."""
+        mech = self.mech
+        self._no_idle()
+        a = cs.SX.zeros(mech.nv)
+        for k, col in enumerate(mech.act_v):
+            a[int(col)] = self.qdd[k]
+        ap = -self._passive_solve(self.closure_jacobian[:, mech.act_v.tolist()] @ self.qdd + self.closure_drift)
+        for r, row in enumerate(mech.passive_v):
+            a[int(row)] = ap[r]
+        return a
+
+    @functools.cached_property
+    def closure_step(self):
+        """The Gauss-Newton step of the loop closure at ``q`` (actuators held): the passive rates ``dq`` (nv, zero on
+        the actuated and base rows) with ``J_p dq_p = -residual`` in least squares; ``pin.integrate(q, dq)`` applies it."""
+        mech = self.mech
+        dq = cs.SX.zeros(mech.nv)
+        step = -self._passive_solve(self.closure_residual)
+        for r, row in enumerate(mech.passive_v):
+            dq[int(row)] = step[r]
+        return dq
+
     @functools.cached_property
     def actuated_efforts(self):
-        """Actuator efforts (na) at a consistent state, ``G^T rnea(q, v, a)`` with ``G = dq/dq_a`` from the closure
-        Jacobian (:func:`pkm.core.dynamics.virtual_work_dynamics`), ``J_p`` solved in least squares (redundant
-        planar rows allowed).
+        """Actuator efforts (na) at a consistent state, ``G^T rnea(q, v, a)`` (:func:`pkm.core.dynamics.virtual_work_dynamics`).
 
         Raises:
             SpecError: the mechanism has idle motions (their accelerations need the dynamics:
                 :func:`pkm.inverse_dynamics` handles them).
         """
-        from pkm.core.differential import idle_motions
-
-        mech = self.mech
-        if idle_motions(mech, mech.q_reference).shape[1]:
-            raise SpecError(mech.source, "the twin's efforts need a mechanism without idle motions; "
-                                         "pkm.inverse_dynamics handles them")
-        Jc, h = self.closure_jacobian, self.rnea
-        Jp, Ja = Jc[:, mech.passive_v.tolist()], Jc[:, mech.act_v.tolist()]
-        X = cs.solve(Jp.T @ Jp, Jp.T @ Ja)  # dq_p/dq_a = -X
-        return h[mech.act_v.tolist()] - X.T @ h[mech.passive_v.tolist()]
+        return self.passive_map.T @ self.rnea
 
     # ---------------------------------------------------------------- functions
     def function(self, name: str, outputs: dict, inputs: tuple[str, ...] = ("q", "v", "a")) -> cs.Function:
         """``casadi.Function(name, inputs, outputs)`` over the twin's symbols."""
-        sym = {"q": self.q, "v": self.v, "a": self.a}
+        sym = {"q": self.q, "v": self.v, "a": self.a, "qd": self.qd, "qdd": self.qdd}
         return cs.Function(name, [sym[i] for i in inputs], list(outputs.values()), list(inputs), list(outputs))
 
 
