@@ -425,6 +425,7 @@ class Twin:
     def closure_step(self):
         """The Gauss-Newton step of the loop closure at ``q`` (actuators held): the passive rates ``dq`` (nv, zero on
         the actuated and base rows) with ``J_p dq_p = -residual`` in least squares; ``pin.integrate(q, dq)`` applies it."""
+        self._no_idle()
         mech = self.mech
         dq = cs.SX.zeros(mech.nv)
         step = -self._passive_solve(self.closure_residual)
