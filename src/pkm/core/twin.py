@@ -278,12 +278,12 @@ class Twin:
             j = Jt.parent
         return J
 
-    def frame_classical_acceleration(self, fid: int, with_a: bool = True):
-        """The frame origin's acceleration ``[a; alpha]`` in world axes (classical: ``a + w x v``)."""
+    def frame_classical_acceleration(self, fid: int):
+        """The frame origin's acceleration ``[a; alpha]`` in world axes with ``a = 0`` (classical: ``a + w x v``)."""
         f = self.mech.model.frames[fid]
         X = _SE3.of(f.placement)
         vf = X.inv_act_motion(self.vel[f.parentJoint])
-        af = X.inv_act_motion((self.acc if with_a else self.acc0)[f.parentJoint])
+        af = X.inv_act_motion(self.acc0[f.parentJoint])
         R = self.frame_placement(fid).R
         return cs.vertcat(R @ (af[:3] + _cross(vf[3:], vf[:3])), R @ af[3:])
 
@@ -322,8 +322,7 @@ class Twin:
         out = []
         for c, (fa, fb) in zip(self.mech.spec.closures, self.mech.closure_frames):
             if c.type == "point":
-                out.append(self.frame_classical_acceleration(fa, False)[:3]
-                           - self.frame_classical_acceleration(fb, False)[:3])
+                out.append(self.frame_classical_acceleration(fa)[:3] - self.frame_classical_acceleration(fb)[:3])
             else:  # relative acceleration of A w.r.t. B in A: a_A - X a_B - v_A x (X v_B), X = Ad(A^-1 B)
                 Xa, Xb = (_SE3.of(self.mech.model.frames[f].placement) for f in (fa, fb))
                 ja, jb = (self.mech.model.frames[f].parentJoint for f in (fa, fb))
@@ -346,14 +345,10 @@ class Twin:
         model = self.mech.model
         n = len(self.joints)
         g = cs.DM(model.gravity.vector)
-        acc = [-g] + [None] * (n - 1)
-        for j in range(1, n):
-            J = self.joints[j]
-            acc[j] = self.liMi[j].inv_act_motion(acc[J.parent]) + J.velocity(self.q, self.a) + J.bias(self.q, self.v) \
-                + _motion_cross(self.vel[j], J.velocity(self.q, self.v))
         f = [cs.DM.zeros(6)] * n
-        for j in range(1, n):
-            f[j] = self._inertia_times(j, acc[j]) + _force_cross(self.vel[j], self._inertia_times(j, self.vel[j]))
+        for j in range(1, n):  # gravity as the world's acceleration -g, seen in each frame (the recursion is linear)
+            acc = self.acc[j] + self.oMi[j].inv_act_motion(-g)
+            f[j] = self._inertia_times(j, acc) + _force_cross(self.vel[j], self._inertia_times(j, self.vel[j]))
         tau = cs.SX.zeros(model.nv)
         for j in range(n - 1, 0, -1):
             J = self.joints[j]
