@@ -95,3 +95,46 @@ class Joint:
         R2 = rodrigues(self.axes[1], cs.cos(q2), cs.sin(q2))
         w1 = R2.T @ cs.DM(self.axes[0])
         return cs.vertcat(cs.DM.zeros(3), -cross(cs.DM(self.axes[1]) * q2d, w1) * q1d)
+
+    def tangent(self, q):
+        """``d(q + T dq)/d(dq)``: the joint's own coordinates' derivative along its velocity coordinates, the block
+        ``(nq_j x nv_j)`` of Pinocchio's ``integrate(q, dq)`` at ``dq = 0`` (None for a mimic joint: no coordinates
+        of its own)."""
+        k, i = self.kind, self.idx_q
+        if k == "mimic":
+            return None
+        if k in ("RUBX", "RUBY", "RUBZ"):
+            return cs.vertcat(-q[i + 1], q[i])
+        if k == "Spherical":
+            return _quat_tangent(q[i:i + 4])
+        if k == "FreeFlyer":
+            R = quat_matrix(q[i + 3], q[i + 4], q[i + 5], q[i + 6])
+            return cs.vertcat(cs.horzcat(R, cs.DM.zeros(3, 3)), cs.horzcat(cs.DM.zeros(4, 3), _quat_tangent(q[i + 3:i + 7])))
+        if k == "Planar":
+            c, s = q[i + 2], q[i + 3]
+            return cs.vertcat(cs.horzcat(c, -s, 0), cs.horzcat(s, c, 0), cs.horzcat(0, 0, -s), cs.horzcat(0, 0, c))
+        return cs.DM.eye(len(self.cols))  # one-coordinate joints, universal
+
+    def retract(self, q, dq):
+        """The joint's coordinates moved by its velocity coordinates ``dq`` (``(index, value)`` pairs): ``q + T dq``,
+        unit blocks (quaternions, ``cos, sin`` pairs) renormalised. A retraction: it agrees with Pinocchio's
+        ``integrate`` to first order, which keeps Newton's quadratic convergence."""
+        T = self.tangent(q)
+        if T is None:
+            return []
+        nq = T.shape[0]
+        new = q[self.idx_q:self.idx_q + nq] + T @ cs.vertcat(*[dq[c] for c in self.cols])
+        unit = {"RUBX": (0, 2), "RUBY": (0, 2), "RUBZ": (0, 2), "Spherical": (0, 4), "FreeFlyer": (3, 7),
+                "Planar": (2, 4)}.get(self.kind)
+        if unit is not None:
+            a, b = unit
+            block = new[a:b] / cs.norm_2(new[a:b])
+            new = cs.vertcat(new[:a], block, new[b:])
+        return [(self.idx_q + r, new[r]) for r in range(nq)]
+
+
+def _quat_tangent(quat):
+    """``d(quat * (dw/2, 1))/d(dw)`` for a unit quaternion ``(x, y, z, w)``: right multiplication by the rotation
+    ``exp(dw)`` to first order (4 x 3)."""
+    x, y, z, w = quat[0], quat[1], quat[2], quat[3]
+    return 0.5 * cs.vertcat(cs.horzcat(w, -z, y), cs.horzcat(z, w, -x), cs.horzcat(-y, x, w), cs.horzcat(-x, -y, -z))

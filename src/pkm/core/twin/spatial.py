@@ -100,3 +100,16 @@ def log6(M: SE3):
     W = skew(w)
     Vinv = cs.DM(np.eye(3)) - 0.5 * W + coeff * (W @ W)
     return cs.vertcat(Vinv @ M.p, w)
+
+
+def zyx_angles(R):
+    """``(roll, pitch, yaw)`` with ``R = Rz(yaw) Ry(pitch) Rx(roll)`` (as :func:`pkm.core.task.zyx_angles`)."""
+    return cs.vertcat(cs.atan2(R[2, 1], R[2, 2]), cs.atan2(-R[2, 0], cs.sqrt(R[0, 0] ** 2 + R[1, 0] ** 2)),
+                      cs.atan2(R[1, 0], R[0, 0]))
+
+
+def euler_rates(R):
+    """``B^-1`` (3 x 3): world angular velocity to Z-Y-X Euler-angle rates (singular at pitch = +-90 deg)."""
+    _, pitch, yaw = (zyx_angles(R)[i] for i in range(3))
+    cp, sp, cy, sy = cs.cos(pitch), cs.sin(pitch), cs.cos(yaw), cs.sin(yaw)
+    return cs.vertcat(cs.horzcat(cy / cp, sy / cp, 0), cs.horzcat(-sy, cy, 0), cs.horzcat(sp * cy / cp, sp * sy / cp, 1))

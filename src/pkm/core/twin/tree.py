@@ -37,8 +37,22 @@ import numpy as np
 
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.joint import Joint
-from pkm.core.twin.spatial import SE3, cross, force_cross, log6, motion_cross
+from pkm.core.twin.linear import PivotedLU
+from pkm.core.twin.spatial import (
+    SE3,
+    cross,
+    euler_rates,
+    force_cross,
+    log3,
+    log6,
+    motion_cross,
+    quat_matrix,
+    zyx_angles,
+)
 from pkm.errors import SpecError
+
+_POS = {"x": 0, "y": 1, "z": 2}
+_ANGLES = ("roll", "pitch", "yaw")
 
 
 # ---------------------------------------------------------------------- the twin
@@ -71,8 +85,9 @@ class Twin:
             self.liMi[j] = M
             self.oMi[j] = self.oMi[J.parent] * M
             vj = J.velocity(q, v)
-            self.vel[j] = M.inv_act_motion(self.vel[J.parent]) + vj
-            c = J.bias(q, v) + motion_cross(self.vel[j], vj)
+            v_parent = M.inv_act_motion(self.vel[J.parent])
+            self.vel[j] = v_parent + vj
+            c = J.bias(q, v) + motion_cross(v_parent, vj)  # (v_parent + vj) x vj, without vj x vj = 0
             self.acc[j] = M.inv_act_motion(self.acc[J.parent]) + J.velocity(q, a) + c
             self.acc0[j] = M.inv_act_motion(self.acc0[J.parent]) + c
 
@@ -150,6 +165,68 @@ class Twin:
                 out.append(aa - ab - motion_cross(va, vb))
         return cs.vertcat(*out)
 
+    def frame_jacobian_local(self, fid: int):
+        """The frame's Jacobian in ``LOCAL`` axes (6 x nv), by a backward pass from the frame: a joint right above
+        it (a free-flyer platform's) costs nothing."""
+        model = self.mech.model
+        f = model.frames[fid]
+        J = cs.SX.zeros(6, model.nv)
+        M = SE3.of(f.placement).inverse()  # the frame from joint j
+        j = f.parentJoint
+        while j > 0:
+            Jt = self.joints[j]
+            S = Jt.subspace(self.q)
+            for k, col in enumerate(Jt.cols):
+                J[:, col] = J[:, col] + M.act_motion(S[:, k])
+            if Jt.parent > 0:
+                M = M * self.liMi[j].inverse()
+            j = Jt.parent
+        return J
+
+    @functools.cached_property
+    def _rows(self) -> dict:
+        """The closure's velocity-level rows in the axes that make them cheapest: a point closure's in the axes of
+        whichever of its frames hangs from the joint with more velocity coordinates (a free-flyer platform's: its
+        columns are then constants), a frame closure's in frame A's (as :attr:`closure_jacobian`). Returns
+        ``jacobian`` (``W J``), ``drift`` (``W gamma``) and ``rotations`` (the blocks of ``W``, None for identity).
+        Any invertible ``W`` gives the same rates, accelerations and efforts."""
+        model = self.mech.model
+        rows: list = []
+        drift: list = []
+        rotations: list = []
+        J_all, g_all = self.closure_jacobian, self.closure_drift
+        nv_of = lambda f: model.joints[model.frames[f].parentJoint].nv
+        at = 0
+        for c, (fa, fb) in zip(self.mech.spec.closures, self.mech.closure_frames):
+            if c.type != "point":
+                rows.append(J_all[at:at + 6, :])
+                drift.append(g_all[at:at + 6])
+                rotations.append(None)
+                at += 6
+                continue
+            F, G, sign = (fa, fb, 1) if nv_of(fa) >= nv_of(fb) else (fb, fa, -1)
+            R = self.frame_placement(F).R
+            J = self.frame_jacobian_local(F)[:3, :] - R.T @ self.frame_jacobian(G)[:3, :]
+            X = SE3.of(model.frames[F].placement)
+            vf = X.inv_act_motion(self.vel[model.frames[F].parentJoint])
+            af = X.inv_act_motion(self.acc0[model.frames[F].parentJoint])
+            gF = af[:3] + cross(vf[3:], vf[:3])
+            gamma = gF - R.T @ self.frame_classical_acceleration(G)[:3]
+            rows.append(sign * J)
+            drift.append(sign * gamma)
+            rotations.append(R)
+            at += 3
+        return {"jacobian": cs.vertcat(*rows), "drift": cs.vertcat(*drift), "rotations": rotations}
+
+    def _rotated(self, residual):
+        """``W residual`` for the rows of :attr:`_rows`."""
+        out, at = [], 0
+        for R in self._rows["rotations"]:
+            n = 6 if R is None else 3
+            out.append(residual[at:at + n] if R is None else R.T @ residual[at:at + n])
+            at += n
+        return cs.vertcat(*out)
+
     # ---------------------------------------------------------------- dynamics
     def _inertia_times(self, j: int, m):
         I = self._inertia[j]
@@ -197,69 +274,240 @@ class Twin:
             raise SpecError(self.mech.source, "the twin's rate maps and efforts need a mechanism without idle motions; "
                                               "pkm.passive_map and pkm.inverse_dynamics handle them")
 
-    def _passive_solve(self, rhs):
-        """``x`` with ``J_p x = rhs`` in least squares (redundant planar rows allowed), ``J_p`` the passive columns."""
-        Jp = self.closure_jacobian[:, self.mech.passive_v.tolist()]
-        return cs.solve(Jp.T @ Jp, Jp.T @ rhs)
+    def at_reference(self, expr) -> np.ndarray:
+        """The value of an expression of ``q`` at the mechanism's reference configuration."""
+        return np.array(cs.Function("at_reference", [self.q], [expr])(self.mech.q_reference))
+
+    @functools.cached_property
+    def passive_lu(self) -> PivotedLU:
+        """The closure Jacobian's passive columns ``J_p``, factored (pivots fixed at the reference)."""
+        self._no_idle()
+        Jp = self._rows["jacobian"][:, self.mech.passive_v.tolist()]
+        return PivotedLU(Jp, self.at_reference(Jp))
+
+    def _passive(self, values) -> cs.SX:
+        """An nv vector: ``values`` (passive) on the passive rows, zero elsewhere."""
+        out = cs.SX.zeros(self.mech.nv)
+        for r, row in enumerate(self.mech.passive_v):
+            out[int(row)] = values[r]
+        return out
+
+    def _actuated(self, values) -> cs.SX:
+        out = cs.SX.zeros(self.mech.nv)
+        for k, col in enumerate(self.mech.act_v):
+            out[int(col)] = values[k]
+        return out
 
     @functools.cached_property
     def passive_map(self):
         """``G = dq/dq_a`` (nv x na), as :func:`pkm.passive_map` (mechanisms without idle motions)."""
-        self._no_idle()
-        mech = self.mech
-        G = cs.SX.zeros(mech.nv, mech.na)
-        for k, col in enumerate(mech.act_v):
-            G[int(col), k] = 1
-        X = -self._passive_solve(self.closure_jacobian[:, mech.act_v.tolist()])
-        for r, row in enumerate(mech.passive_v):
-            G[int(row), :] = X[r, :]
-        return G
+        Ja = self._rows["jacobian"][:, self.mech.act_v.tolist()]
+        return cs.horzcat(*[self._actuated(np.eye(self.mech.na)[k]) - self._passive(self.passive_lu.solve(Ja[:, k]))
+                            for k in range(self.mech.na)])
 
     @functools.cached_property
     def velocities(self):
         """All joint rates for the actuated rates :attr:`qd` (symbol, na), as :func:`pkm.velocities`."""
-        return self.passive_map @ self.qd
+        Ja = self._rows["jacobian"][:, self.mech.act_v.tolist()]
+        return self._actuated(self.qd) - self._passive(self.passive_lu.solve(Ja @ self.qd))
 
     @functools.cached_property
     def accelerations(self):
         """All joint accelerations at ``(q, v)`` for the actuated accelerations :attr:`qdd` (symbol, na), as
         :func:`pkm.accelerations`: the passive ones close the loops at the acceleration level (drift included)."""
-        mech = self.mech
-        self._no_idle()
-        a = cs.SX.zeros(mech.nv)
-        for k, col in enumerate(mech.act_v):
-            a[int(col)] = self.qdd[k]
-        ap = -self._passive_solve(self.closure_jacobian[:, mech.act_v.tolist()] @ self.qdd + self.closure_drift)
-        for r, row in enumerate(mech.passive_v):
-            a[int(row)] = ap[r]
-        return a
+        Ja = self._rows["jacobian"][:, self.mech.act_v.tolist()]
+        return self._actuated(self.qdd) - self._passive(self.passive_lu.solve(Ja @ self.qdd + self._rows["drift"]))
 
     @functools.cached_property
     def closure_step(self):
-        """The Gauss-Newton step of the loop closure at ``q`` (actuators held): the passive rates ``dq`` (nv, zero on
-        the actuated and base rows) with ``J_p dq_p = -residual`` in least squares; ``pin.integrate(q, dq)`` applies it."""
-        self._no_idle()
-        mech = self.mech
-        dq = cs.SX.zeros(mech.nv)
-        step = -self._passive_solve(self.closure_residual)
-        for r, row in enumerate(mech.passive_v):
-            dq[int(row)] = step[r]
-        return dq
+        """The Newton step of the loop closure at ``q`` (actuators held): the passive rates ``dq`` (nv, zero on the
+        actuated and base rows) with ``J_p dq_p = -residual``; ``pin.integrate(q, dq)`` applies it."""
+        return -self._passive(self.passive_lu.solve(self._rotated(self.closure_residual)))
 
     @functools.cached_property
     def actuated_efforts(self):
-        """Actuator efforts (na) at a consistent state, ``G^T rnea(q, v, a)`` (:func:`pkm.core.dynamics.virtual_work_dynamics`).
+        """Actuator efforts (na) at a consistent state ``(q, v, a)``: ``G^T rnea``
+        (:func:`pkm.core.dynamics.virtual_work_dynamics`), computed as ``tau_a - J_a^T lambda`` with
+        ``J_p^T lambda = tau_p`` (one transposed solve instead of the matrix ``G``).
 
         Raises:
             SpecError: the mechanism has idle motions (their accelerations need the dynamics:
                 :func:`pkm.inverse_dynamics` handles them).
         """
-        return self.passive_map.T @ self.rnea
+        mech, tau = self.mech, self.rnea
+        lam = self.passive_lu.solve_transposed(cs.vertcat(*[tau[int(r)] for r in mech.passive_v]))
+        Ja = self._rows["jacobian"][:, mech.act_v.tolist()]
+        return cs.vertcat(*[tau[int(c)] for c in mech.act_v]) - Ja.T @ lam
+
+    @functools.cached_property
+    def inverse_dynamics(self):
+        """Actuator efforts (na) from the closed configuration :attr:`q` and the actuated rates and accelerations
+        :attr:`qd`, :attr:`qdd`: joint rates, accelerations (drift included), RNEA under gravity, projection. A
+        floating base is held still (its pose in ``q``)."""
+        v = self.velocities
+        a = cs.substitute(self.accelerations, self.v, v)
+        return cs.substitute(self.actuated_efforts, cs.vertcat(self.v, self.a), cs.vertcat(v, a))
+
+    @functools.cached_property
+    def inverse_dynamics_derivatives(self) -> dict:
+        """Derivatives of :attr:`inverse_dynamics` for trajectory optimisation (each na x na): ``dtau_dqa``, the total
+        derivative along the closure (the configuration moved by the actuated coordinates, ``dq = G dq_a``, rates
+        and accelerations held); ``dtau_dqd``, ``dtau_dqdd``."""
+        tau = self.inverse_dynamics
+        return {"dtau_dqa": cs.jacobian(tau, self.q) @ self.tangent @ self.passive_map,
+                "dtau_dqd": cs.jacobian(tau, self.qd), "dtau_dqdd": cs.jacobian(tau, self.qdd)}
+
+    # ---------------------------------------------------------------- task
+    def _task_groups(self) -> list[tuple[int, tuple[str, ...]]]:
+        spec = self.mech.spec.task
+        groups = [(self.mech.ee_frame, spec.components)] if spec.components else []
+        return groups + list(zip(self.mech.task_frames, spec.frames.values()))
+
+    @functools.cached_property
+    def task_target(self):
+        """The symbol of a task target, laid out as :meth:`pkm.core.task.TaskMap.value` gives values."""
+        from pkm.core.task import TaskMap
+
+        return cs.SX.sym("y", TaskMap(self.mech).value_size)
+
+    @functools.cached_property
+    def task_error(self):
+        """``target - task(q)`` on the task's tangent space, as :meth:`pkm.core.task.TaskMap.error` (angles wrapped to
+        ``(-pi, pi]``, a pose's orientation as ``log3(R_target R^T)``)."""
+        y, out, at = self.task_target, [], 0
+        for fid, comps in self._task_groups():
+            M = self.frame_placement(fid)
+            if comps == ("pose",):
+                R_t = quat_matrix(y[at + 3], y[at + 4], y[at + 5], y[at + 6])
+                out += [y[at:at + 3] - M.p, log3(R_t @ M.R.T)]
+                at += 7
+                continue
+            rpy = zyx_angles(M.R)
+            for c in comps:
+                if c in _POS:
+                    out.append(y[at] - M.p[_POS[c]])
+                else:
+                    d = y[at] - rpy[_ANGLES.index(c)]
+                    out.append(d - 2 * np.pi * cs.floor((d + np.pi) / (2 * np.pi)))
+                at += 1
+        for k, j in enumerate(self.mech.task_joints):
+            out.append(y[at + k] - self.q[j.idx_q])
+        return cs.vertcat(*out)
+
+    @functools.cached_property
+    def task_jacobian(self):
+        """``d(task)/dq`` on the tangent space (task size x nv), as :meth:`pkm.core.task.TaskMap.jacobian`."""
+        rows = []
+        for fid, comps in self._task_groups():
+            J6 = self.frame_jacobian(fid)
+            if comps == ("pose",):
+                rows.append(J6)
+                continue
+            Jw = euler_rates(self.frame_placement(fid).R) @ J6[3:, :]
+            rows += [J6[_POS[c], :] if c in _POS else Jw[_ANGLES.index(c), :] for c in comps]
+        for j in self.mech.task_joints:
+            e = cs.SX.zeros(1, self.mech.nv)
+            e[0, j.idx_v] = 1
+            rows.append(e)
+        return cs.vertcat(*rows)
+
+    @functools.cached_property
+    def ik_lu(self) -> PivotedLU:
+        """``[closure rows; task Jacobian]`` over every velocity coordinate but a floating base's, factored (pivots
+        fixed at the reference)."""
+        A = cs.vertcat(self._rows["jacobian"], self.task_jacobian)[:, self._free_cols]
+        try:
+            return PivotedLU(A, self.at_reference(A))
+        except ValueError as e:
+            raise SpecError(self.mech.source, f"the closure and the task do not fix every joint at the reference ({e}): "
+                                              "the task has fewer coordinates than the mechanism has degrees of "
+                                              "freedom, or the reference is singular") from None
+
+    @functools.cached_property
+    def _free_cols(self) -> list[int]:
+        base = set(self.mech.base_v.tolist())
+        return [i for i in range(self.mech.nv) if i not in base]
+
+    def _on_free(self, values) -> cs.SX:
+        out = cs.SX.zeros(self.mech.nv)
+        for r, col in enumerate(self._free_cols):
+            out[col] = values[r]
+        return out
+
+    @functools.cached_property
+    def ik_newton(self) -> dict:
+        """One Newton iteration of the inverse kinematics toward :attr:`task_target` from :attr:`q` (closure and task
+        together, a floating base held): ``q`` (the next iterate), ``residual`` (the largest closure residual or task
+        error at the iterate it starts from), ``pivot`` (as in :attr:`closure_newton`)."""
+        rhs = cs.vertcat(-self._rotated(self.closure_residual), self.task_error)
+        step = self._on_free(self.ik_lu.solve(rhs))
+        return {"q": self.retract(step), "residual": cs.mmax(cs.fabs(cs.vertcat(self.closure_residual, self.task_error))),
+                "pivot": self.ik_lu.smallest_relative_pivot()}
+
+    @functools.cached_property
+    def forward_jacobian(self):
+        """Task rates per actuated rate (task size x na): ``J_task G``."""
+        return self.task_jacobian @ self.passive_map
+
+    @functools.cached_property
+    def inverse_jacobian(self):
+        """Actuated rates per task rate (na x task size): the actuated rows of ``[W J; J_task]^-1 [0; I]``."""
+        n_closure = self._rows["jacobian"].shape[0]
+        at = {c: r for r, c in enumerate(self._free_cols)}
+        cols = []
+        for k in range(self.task_jacobian.shape[0]):
+            e = cs.DM.zeros(n_closure + self.task_jacobian.shape[0])
+            e[n_closure + k] = 1
+            x = self.ik_lu.solve(e)
+            cols.append(cs.vertcat(*[x[at[int(c)]] for c in self.mech.act_v]))
+        return cs.horzcat(*cols)
+
+    # ---------------------------------------------------------------- configuration space
+    @functools.cached_property
+    def tangent(self):
+        """``T(q)`` (nq x nv), ``dq/d(dq)`` of Pinocchio's ``integrate(q, dq)`` at ``dq = 0``."""
+        T = cs.SX.zeros(self.mech.model.nq, self.mech.nv)
+        for J in self.joints[1:]:
+            block = J.tangent(self.q)
+            if block is not None:
+                T[J.idx_q:J.idx_q + block.shape[0], J.cols[0]:J.cols[-1] + 1] = block
+        return T
+
+    def retract(self, dq):
+        """:attr:`q` moved by the tangent vector ``dq`` (nv): ``q + T dq`` with unit blocks renormalised, which
+        agrees with ``pin.integrate`` to first order (see :meth:`Joint.retract`)."""
+        out = [self.q[i] for i in range(self.mech.model.nq)]
+        for J in self.joints[1:]:
+            for i, x in J.retract(self.q, dq):
+                out[i] = x
+        return cs.vertcat(*out)
+
+    @functools.cached_property
+    def target(self):
+        """The symbol of a Newton iteration's target: the actuated coordinates (na) for :attr:`closure_newton`."""
+        return cs.SX.sym("qa", self.mech.na)
+
+    def with_actuated(self, expr):
+        """``expr`` at :attr:`q` with its actuated coordinates replaced by :attr:`target`."""
+        q = [self.q[i] for i in range(self.mech.model.nq)]
+        for k, i in enumerate(self.mech.act_q):
+            q[int(i)] = self.target[k]
+        return cs.substitute(expr, self.q, cs.vertcat(*q))
+
+    @functools.cached_property
+    def closure_newton(self) -> dict:
+        """One Newton iteration of the loop closure for the actuated coordinates :attr:`target`, from :attr:`q`:
+        ``q`` (the next iterate, its actuated coordinates set), ``residual`` (the largest closure residual at the
+        iterate it starts from) and ``pivot`` (:meth:`PivotedLU.smallest_relative_pivot` there)."""
+        return {name: self.with_actuated(x) for name, x in (
+            ("q", self.retract(self.closure_step)), ("residual", cs.mmax(cs.fabs(self.closure_residual))),
+            ("pivot", self.passive_lu.smallest_relative_pivot()))}
 
     # ---------------------------------------------------------------- functions
     def function(self, name: str, outputs: dict, inputs: tuple[str, ...] = ("q", "v", "a")) -> cs.Function:
         """``casadi.Function(name, inputs, outputs)`` over the twin's symbols."""
-        sym = {"q": self.q, "v": self.v, "a": self.a, "qd": self.qd, "qdd": self.qdd}
+        sym = {"q": self.q, "v": self.v, "a": self.a, "qd": self.qd, "qdd": self.qdd, "target": self.target,
+               "y": self.task_target}
         return cs.Function(name, [sym[i] for i in inputs], list(outputs.values()), list(inputs), list(outputs))
 
 
