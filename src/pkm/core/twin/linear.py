@@ -47,7 +47,7 @@ class PivotedLU:
         free_rows, free_cols = set(range(m)), set(range(n))
         #: ``(row, column)`` of each elimination step, in order.
         self.order: list[tuple[int, int]] = []
-        self._factors: list[list[tuple[int, object]]] = []  # per step: (row, factor) of the rows it eliminated
+        self._factors: list[list[tuple[int, cs.SX]]] = []  # per step: (row, factor) of the rows it eliminated
         self.pivots: list = []
         for _ in range(n):
             best = None
