@@ -60,10 +60,12 @@ if TYPE_CHECKING:  # the static view of the lazy names
         twist_jacobian,
         velocities,
     )
+    from pkm.core.twin import Kernels, Twin
     from pkm.units import quantity
 
 
-__getattr__, __dir__ = lazy("pkm", globals(), {**dict.fromkeys(_CORE, "pkm.core"), "quantity": "pkm.units"})
+__getattr__, __dir__ = lazy("pkm", globals(), {**dict.fromkeys(_CORE, "pkm.core"), "quantity": "pkm.units",
+                                                "Kernels": "pkm.core.twin", "Twin": "pkm.core.twin"})
 
 __version__ = "0.1.0"
 
@@ -189,11 +191,13 @@ __all__ = [
     "Configuration",
     "Diagnostics",
     "Jump",
+    "Kernels",
     "Mechanism",
     "PkmError",
     "SolveResult",
     "TaskMap",
     "Trajectory",
+    "Twin",
     "accelerations",
     "assemble",
     "build",

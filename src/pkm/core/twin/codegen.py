@@ -1,37 +1,149 @@
-"""The twin's functions as compiled C."""
+"""The twin's functions as generated C, compiled and loaded; with drivers that run them over batches and paths.
+
+:func:`compile_library` writes a CasADi function as C (CasADi's code generator), appends two drivers, compiles the
+whole with the system's C compiler (``cc -O2 -shared``, ``-O0`` above :data:`LARGE` instructions) and loads it with :mod:`ctypes`:
+
+* ``NAME_batch(n, in, out)``: the function on ``n`` samples, each input and output a sample-major array;
+* ``NAME_follow(n, q0, targets, q_out, residual, pivot, iterations, max_iter, tol)``, for a Newton iteration
+  (inputs ``q, target``; outputs ``q_next, residual, pivot``): per target, iterate from the previous solution
+  (the first from ``q0``) until the residual is at most ``tol`` or ``max_iter`` iterations were made.
+
+Libraries are cached by the hash of their source (the folder :func:`cache_dir`), so a mechanism is compiled once per
+machine. Without a C compiler (or when it fails) :func:`compile_library` returns None and says why; the callers run
+CasADi's virtual machine instead.
+"""
 
 from __future__ import annotations
 
+import ctypes
+import hashlib
+import os
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
 import casadi as cs
+
+_FLAGS = ("-shared", "-fPIC")
+#: Functions with more instructions than this are compiled with ``-O0``: gcc 12's ``-O2`` takes 40 s on the hexapod's
+#: 52,000-instruction derivatives (one basic block), ``-O0`` 2.5 s.
+LARGE = 20_000
+
+_BATCH = r"""
+/* pkm drivers */
+#include <stdlib.h>
+#include <string.h>
+static const casadi_int NAME_isz[] = {ISZ}, NAME_osz[] = {OSZ};
+
+static int NAME_pkm_alloc(const casadi_real*** arg, casadi_real*** res, casadi_int** iw, casadi_real** w) {
+  casadi_int sz_arg, sz_res, sz_iw, sz_w;
+  NAME_work(&sz_arg, &sz_res, &sz_iw, &sz_w);
+  *arg = malloc(sizeof(casadi_real*) * (sz_arg + 1)); *res = malloc(sizeof(casadi_real*) * (sz_res + 1));
+  *iw = malloc(sizeof(casadi_int) * (sz_iw + 1)); *w = malloc(sizeof(casadi_real) * (sz_w + 1));
+  return !(*arg && *res && *iw && *w);
+}
+
+static void NAME_pkm_free(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w) {
+  free((void*) arg); free(res); free(iw); free(w);
+}
+
+int NAME_batch(casadi_int n, const casadi_real** in, casadi_real** out) {
+  const casadi_real** arg; casadi_real** res; casadi_int* iw; casadi_real* w; int flag = 0;
+  if (NAME_pkm_alloc(&arg, &res, &iw, &w)) return 2;
+  for (casadi_int k = 0; k < n && !flag; ++k) {
+    for (int i = 0; i < NIN; ++i) arg[i] = in[i] + k * NAME_isz[i];
+    for (int i = 0; i < NOUT; ++i) res[i] = out[i] + k * NAME_osz[i];
+    flag = NAME(arg, res, iw, w, 0);
+  }
+  NAME_pkm_free(arg, res, iw, w);
+  return flag;
+}
+"""
+
+_FOLLOW = r"""
+int NAME_follow(casadi_int n, const casadi_real* q0, const casadi_real* targets, casadi_real* q_out,
+                casadi_real* residual, casadi_real* pivot, casadi_int* iterations, casadi_int max_iter,
+                casadi_real tol) {
+  const casadi_real** arg; casadi_real** res; casadi_int* iw; casadi_real* w;
+  const casadi_int nq = NAME_isz[0], nt = NAME_isz[1];
+  casadi_real* cur = malloc(sizeof(casadi_real) * nq); casadi_real* next = malloc(sizeof(casadi_real) * nq);
+  if (!cur || !next || NAME_pkm_alloc(&arg, &res, &iw, &w)) return 2;
+  memcpy(cur, q0, sizeof(casadi_real) * nq);
+  for (casadi_int k = 0; k < n; ++k) {
+    casadi_real r = 0.0, p = 0.0; casadi_int it = 0;
+    arg[1] = targets + k * nt; res[0] = next; res[1] = &r; res[2] = &p;
+    do {
+      arg[0] = cur;
+      if (NAME(arg, res, iw, w, 0)) { NAME_pkm_free(arg, res, iw, w); free(cur); free(next); return 1; }
+      memcpy(cur, next, sizeof(casadi_real) * nq);
+      ++it;
+    } while (!(r <= tol) && it < max_iter && r == r);
+    memcpy(q_out + k * nq, cur, sizeof(casadi_real) * nq);
+    residual[k] = r; pivot[k] = p; iterations[k] = it;
+  }
+  NAME_pkm_free(arg, res, iw, w); free(cur); free(next);
+  return 0;
+}
+"""
+
+
+def cache_dir() -> Path:
+    """Where compiled twins are kept: ``$PKM_CACHE_DIR``, else ``$XDG_CACHE_HOME/pkm/twin`` (``~/.cache/pkm/twin``)."""
+    if os.environ.get("PKM_CACHE_DIR"):
+        return Path(os.environ["PKM_CACHE_DIR"])
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "pkm" / "twin"
+
+
+def source(fun: cs.Function, *, follow: bool = False) -> str:
+    """The C source of ``fun`` (CasADi's code generator) with the batch driver, and the path driver if ``follow``."""
+    name = fun.name()
+    gen = cs.CodeGenerator(f"{name}.c", {"with_header": False})
+    gen.add(fun)
+    sizes = lambda n, f: ", ".join(str(f(i)) for i in range(n))
+    drivers = (_BATCH + (_FOLLOW if follow else "")).replace("NIN", str(fun.n_in())).replace("NOUT", str(fun.n_out()))
+    drivers = drivers.replace("ISZ", sizes(fun.n_in(), fun.nnz_in)).replace("OSZ", sizes(fun.n_out(), fun.nnz_out))
+    return gen.dump() + drivers.replace("NAME", name)
+
+
+def compile_library(fun: cs.Function, *, follow: bool = False, directory=None) -> tuple[ctypes.CDLL | None, str]:
+    """``fun`` and its drivers compiled and loaded. Returns ``(library, how)``; ``library`` is None, and ``how`` says
+    why, when there is no C compiler on the PATH (``cc``, ``gcc`` or ``clang``) or it failed.
+
+    Args:
+        fun: A CasADi function with dense inputs and outputs.
+        follow: Add the path driver (``fun`` is a Newton iteration: see the module doc).
+        directory: Where the source and library go (default :func:`cache_dir`).
+    """
+    cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+    if cc is None:
+        return None, "CasADi's virtual machine (no C compiler on the PATH: cc, gcc or clang)"
+    text = source(fun, follow=follow)
+    folder = Path(directory) if directory is not None else cache_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    flags = ("-O2" if fun.n_instructions() <= LARGE else "-O0", *_FLAGS)
+    digest = hashlib.sha256((text + " ".join(flags)).encode()).hexdigest()[:20]
+    library = folder / f"{fun.name()}-{digest}.so"
+    if not library.exists():
+        with tempfile.TemporaryDirectory(dir=folder) as tmp:  # compiled aside, then moved: safe for parallel builds
+            c_file = Path(tmp) / f"{fun.name()}.c"
+            c_file.write_text(text)
+            built = Path(tmp) / library.name
+            run = subprocess.run([cc, *flags, "-o", str(built), str(c_file)], capture_output=True, text=True,
+                                 check=False, timeout=900)
+            if run.returncode != 0:
+                return None, f"CasADi's virtual machine (the C compiler failed: {run.stderr.strip()[-300:]})"
+            os.replace(built, library)
+    return ctypes.CDLL(str(library)), f"C ({Path(cc).name} {flags[0]}, {library})"
 
 
 def compile_function(fun: cs.Function, directory=None) -> tuple[cs.Function, str]:
-    """``fun`` as generated C, compiled (``cc -O2 -shared``) and loaded, when a C compiler is present; else ``fun``
-    itself, run by CasADi's virtual machine. Returns ``(function, how)``, ``how`` saying which (and why).
+    """``fun`` as compiled C loaded back as a ``casadi.Function`` (``casadi.external``) when a C compiler is present;
+    else ``fun`` itself, run by CasADi's virtual machine. Returns ``(function, how)``."""
+    lib, how = compile_library(fun, directory=directory)
+    if lib is None:
+        return fun, how
+    return cs.external(fun.name(), lib._name), how
 
-    Args:
-        fun: A CasADi function (from :meth:`Twin.function`).
-        directory: Where the C source and the shared library go (default: a new temporary folder, kept for the
-            life of the process: the library stays loaded).
-    """
-    import shutil
-    import subprocess
-    import tempfile
-    from pathlib import Path
 
-    cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
-    if cc is None:
-        return fun, "CasADi's virtual machine (no C compiler on the PATH: cc, gcc or clang)"
-    folder = Path(directory) if directory is not None else Path(tempfile.mkdtemp(prefix="pkm-twin-"))
-    folder.mkdir(parents=True, exist_ok=True)
-    name = fun.name()
-    source = folder / f"{name}.c"
-    gen = cs.CodeGenerator(source.name)
-    gen.add(fun)
-    gen.generate(str(folder) + "/")
-    library = folder / f"{name}.so"
-    run = subprocess.run([cc, "-O2", "-shared", "-fPIC", "-o", str(library), str(source)], capture_output=True,
-                         text=True, check=False, timeout=600)
-    if run.returncode != 0:
-        return fun, f"CasADi's virtual machine (the C compiler failed: {run.stderr.strip()[-300:]})"
-    return cs.external(name, str(library)), f"C ({Path(cc).name} -O2, {library})"
+__all__ = ["cache_dir", "compile_function", "compile_library", "source"]

@@ -354,7 +354,7 @@ class Twin:
         derivative along the closure (the configuration moved by the actuated coordinates, ``dq = G dq_a``, rates
         and accelerations held); ``dtau_dqd``, ``dtau_dqdd``."""
         tau = self.inverse_dynamics
-        return {"dtau_dqa": cs.jacobian(tau, self.q) @ self.tangent @ self.passive_map,
+        return {"dtau_dqa": cs.jtimes(tau, self.q, self.tangent @ self.passive_map),  # na forward sweeps, not nq
                 "dtau_dqd": cs.jacobian(tau, self.qd), "dtau_dqdd": cs.jacobian(tau, self.qdd)}
 
     # ---------------------------------------------------------------- task
@@ -437,11 +437,12 @@ class Twin:
     @functools.cached_property
     def ik_newton(self) -> dict:
         """One Newton iteration of the inverse kinematics toward :attr:`task_target` from :attr:`q` (closure and task
-        together, a floating base held): ``q`` (the next iterate), ``residual`` (the largest closure residual or task
-        error at the iterate it starts from), ``pivot`` (as in :attr:`closure_newton`)."""
+        together, a floating base held): ``q_next`` (the next iterate), ``residual`` (the largest closure residual or task
+        error there), ``pivot`` (as in :attr:`closure_newton`)."""
         rhs = cs.vertcat(-self._rotated(self.closure_residual), self.task_error)
-        step = self._on_free(self.ik_lu.solve(rhs))
-        return {"q": self.retract(step), "residual": cs.mmax(cs.fabs(cs.vertcat(self.closure_residual, self.task_error))),
+        q_next = self.retract(self._on_free(self.ik_lu.solve(rhs)))
+        return {"q_next": q_next,
+                "residual": self._largest_at(cs.vertcat(self.closure_residual, self.task_error), q_next),
                 "pivot": self.ik_lu.smallest_relative_pivot()}
 
     @functools.cached_property
@@ -497,11 +498,14 @@ class Twin:
     @functools.cached_property
     def closure_newton(self) -> dict:
         """One Newton iteration of the loop closure for the actuated coordinates :attr:`target`, from :attr:`q`:
-        ``q`` (the next iterate, its actuated coordinates set), ``residual`` (the largest closure residual at the
-        iterate it starts from) and ``pivot`` (:meth:`PivotedLU.smallest_relative_pivot` there)."""
-        return {name: self.with_actuated(x) for name, x in (
-            ("q", self.retract(self.closure_step)), ("residual", cs.mmax(cs.fabs(self.closure_residual))),
-            ("pivot", self.passive_lu.smallest_relative_pivot()))}
+        ``q_next`` (the next iterate, its actuated coordinates set), ``residual`` (the largest closure residual there) and
+        ``pivot`` (:meth:`PivotedLU.smallest_relative_pivot` at the iterate it starts from)."""
+        q_next = self.with_actuated(self.retract(self.closure_step))
+        return {"q_next": q_next, "residual": self._largest_at(self.closure_residual, q_next),
+                "pivot": self.with_actuated(self.passive_lu.smallest_relative_pivot())}
+
+    def _largest_at(self, residual, q):
+        return cs.mmax(cs.fabs(cs.substitute(residual, self.q, q)))
 
     # ---------------------------------------------------------------- functions
     def function(self, name: str, outputs: dict, inputs: tuple[str, ...] = ("q", "v", "a")) -> cs.Function:

@@ -16,7 +16,7 @@ from pkm.core.spec import Closure, ClosureSpec, TaskSpec
 from pkm.core.twin import Twin
 from pkm.errors import SpecError
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 FILES = {"rssr": EXAMPLES / "gepetto_rssr" / "robot.yaml",
          "gough_stewart": EXAMPLES / "gough_stewart" / "gough_stewart.closures.toml",
          "ankle": EXAMPLES / "ankle" / "ankle.closures.toml",
@@ -184,7 +184,7 @@ def test_a_twin_function_compiles_to_c_or_says_why_not(tmp_path, monkeypatch):
     q, v, a = mech.q_reference, np.full(mech.nv, 0.1), np.full(mech.nv, -0.2)
     compiled, how = compile_function(fun, tmp_path)
     if shutil.which("cc") or shutil.which("gcc") or shutil.which("clang"):
-        assert how.startswith("C (") and (tmp_path / "prs3_tau.so").exists()
+        assert how.startswith("C (") and len(list(tmp_path.glob("prs3_tau-*.so"))) == 1
     assert np.abs(np.array(compiled(q, v, a)) - np.array(fun(q, v, a))).max() <= 1e-13
     monkeypatch.setattr(shutil, "which", lambda name: None)
     same, how = compile_function(fun, tmp_path / "none")

@@ -1,0 +1,287 @@
+"""Generated kernels of any mechanism: its twin's expressions as functions, compiled to C, run on one state, on numpy
+batches and warm-started along paths.
+
+:class:`Kernels` builds each kernel on first use from :class:`~pkm.core.twin.tree.Twin` (expressions after
+common-subexpression elimination), compiles it with :func:`~pkm.core.twin.codegen.compile_library` when a C compiler
+is present (:attr:`Kernels.how` says, per kernel, what runs it) and otherwise evaluates it with CasADi's virtual
+machine (``Function.map`` for batches). Every kernel takes and returns SI values in Pinocchio's conventions.
+
+The linear solves use pivots fixed at the reference (:mod:`~pkm.core.twin.linear`). Where the smallest relative
+pivot falls under :data:`PIVOT_FLOOR`, the kernel's answer for that sample is replaced by the generic core's
+(:func:`pkm.inverse_dynamics`, :func:`pkm.close_loops`, :func:`pkm.solve_ik`) and the sample is listed in the
+result's ``fallback``; a path sample that does not converge in the kernel is handed to the core the same way.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from dataclasses import dataclass, field
+
+import casadi as cs
+import numpy as np
+
+from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.twin.codegen import compile_library
+from pkm.core.twin.tree import Twin
+from pkm.errors import InvalidInputError
+
+#: Smallest relative pivot (:meth:`PivotedLU.smallest_relative_pivot`) at which a kernel's solve is trusted.
+PIVOT_FLOOR = 1e-6
+
+_P = ctypes.POINTER(ctypes.c_double)
+_I = ctypes.c_longlong
+
+
+@dataclass(frozen=True)
+class PathResult:
+    """A warm-started Newton solve along a path of targets.
+
+    Attributes:
+        q: The configurations (n x nq).
+        residual: The largest closure residual (and task error, for the IK) at each (n) [m, rad].
+        iterations: Newton iterations per sample in the kernel (n).
+        fallback: The samples solved by the generic core instead (pivot under :data:`PIVOT_FLOOR`, or no
+            convergence in ``max_iter`` kernel iterations).
+        how: What ran the kernel.
+    """
+
+    q: np.ndarray
+    residual: np.ndarray
+    iterations: np.ndarray
+    fallback: tuple[int, ...] = field(default=())
+    how: str = ""
+
+
+class _Kernel:
+    """One function, compiled (``lib``) or not; ``__call__`` takes sample-major arrays (n x size) and returns a list
+    of sample-major outputs."""
+
+    def __init__(self, fun: cs.Function, follow: bool, compiled: bool, directory):
+        self.fun = fun
+        self.lib, self.how = compile_library(fun, follow=follow, directory=directory) if compiled else (
+            None, "CasADi's virtual machine (compiled=False)")
+        self.in_size = [fun.nnz_in(i) for i in range(fun.n_in())]
+        self.out_size = [fun.nnz_out(i) for i in range(fun.n_out())]
+        if self.lib is not None:
+            self._batch = getattr(self.lib, f"{fun.name()}_batch")
+            self._batch.argtypes = [_I, ctypes.POINTER(_P), ctypes.POINTER(_P)]
+            self._batch.restype = ctypes.c_int
+            if follow:
+                self._follow = getattr(self.lib, f"{fun.name()}_follow")
+                self._follow.argtypes = [_I, _P, _P, _P, _P, _P, ctypes.POINTER(_I), _I, ctypes.c_double]
+                self._follow.restype = ctypes.c_int
+
+    def __call__(self, *arrays: np.ndarray) -> list[np.ndarray]:
+        n = arrays[0].shape[0]
+        if self.lib is None:
+            outs = self.fun.map(n)(*[a.T for a in arrays])
+            outs = outs if isinstance(outs, tuple) else (outs,)
+            return [np.array(o).reshape(s, n, order="F").T.copy() for o, s in zip(outs, self.out_size)]
+        ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
+        outs = [np.empty((n, s)) for s in self.out_size]
+        in_p = (_P * len(ins))(*[a.ctypes.data_as(_P) for a in ins])
+        out_p = (_P * len(outs))(*[o.ctypes.data_as(_P) for o in outs])
+        if self._batch(n, in_p, out_p):
+            raise RuntimeError(f"the compiled kernel {self.fun.name()} failed")
+        return outs
+
+    def follow(self, q0: np.ndarray, targets: np.ndarray, max_iter: int, tol: float):
+        n, nq = targets.shape[0], q0.shape[0]
+        if self.lib is None:
+            q, out = q0.copy(), (np.empty((n, nq)), np.empty(n), np.empty(n), np.zeros(n, dtype=np.int64))
+            for k in range(n):
+                it = 0
+                while True:
+                    nxt, r, p = self.fun(q, targets[k])
+                    q, it = np.array(nxt).ravel(), it + 1
+                    if float(r) <= tol or it >= max_iter or not np.isfinite(float(r)):
+                        break
+                out[0][k], out[1][k], out[2][k], out[3][k] = q, float(r), float(p), it
+            return out
+        q_out, res, piv = np.empty((n, nq)), np.empty(n), np.empty(n)
+        its = np.zeros(n, dtype=np.int64)
+        t = np.ascontiguousarray(targets, dtype=float)
+        q0 = np.ascontiguousarray(q0, dtype=float)
+        flag = self._follow(n, q0.ctypes.data_as(_P), t.ctypes.data_as(_P), q_out.ctypes.data_as(_P),
+                            res.ctypes.data_as(_P), piv.ctypes.data_as(_P), its.ctypes.data_as(ctypes.POINTER(_I)),
+                            max_iter, tol)
+        if flag:
+            raise RuntimeError(f"the compiled kernel {self.fun.name()} failed")
+        return q_out, res, piv, its
+
+
+class Kernels:
+    """The generated kernels of ``mech`` (see the module doc).
+
+    Args:
+        mech: Any mechanism pkm loads, without idle motions.
+        compiled: Compile to C when a C compiler is present (default); False runs CasADi's virtual machine.
+        directory: Where compiled libraries go (default :func:`pkm.core.twin.codegen.cache_dir`).
+
+    Raises:
+        SpecError: ``mech`` has idle motions (on the first kernel that needs the passive solve).
+    """
+
+    def __init__(self, mech: Mechanism, *, compiled: bool = True, directory=None):
+        self.mech = check_mechanism(mech)
+        self.twin = Twin(self.mech)
+        self.compiled, self.directory = compiled, directory
+        self._kernels: dict[str, _Kernel] = {}
+
+    # ---------------------------------------------------------------- kernels
+    def function(self, name: str) -> cs.Function:
+        """The CasADi function of a kernel (:data:`KERNELS`), inputs and outputs dense, after CSE."""
+        tw = self.twin
+        if name not in KERNELS:
+            raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", name)
+        inputs, outputs = KERNELS[name]
+        exprs = {"inverse_dynamics": lambda: {"tau": tw.inverse_dynamics,
+                                              "pivot": tw.passive_lu.smallest_relative_pivot()},
+                 "inverse_dynamics_derivatives": lambda: {"tau": tw.inverse_dynamics,
+                                                          **tw.inverse_dynamics_derivatives},
+                 "velocities": lambda: {"v": tw.velocities},
+                 "accelerations": lambda: {"a": tw.accelerations},
+                 "forward_jacobian": lambda: {"J": tw.forward_jacobian},
+                 "inverse_jacobian": lambda: {"J": tw.inverse_jacobian},
+                 "closure_newton": lambda: tw.closure_newton, "ik_newton": lambda: tw.ik_newton,
+                 }[name]()
+        assert tuple(exprs) == outputs
+        sym = {"q": tw.q, "v": tw.v, "qd": tw.qd, "qdd": tw.qdd, "target": tw.target, "y": tw.task_target}
+        values = cs.cse([cs.densify(cs.SX(e)) for e in exprs.values()])
+        return cs.Function(f"pkm_{name}", [sym[i] for i in inputs], values, list(inputs), list(outputs))
+
+    def kernel(self, name: str) -> _Kernel:
+        """The kernel ``name`` (built, and compiled, on first use)."""
+        if name not in self._kernels:
+            self._kernels[name] = _Kernel(self.function(name), name.endswith("_newton"), self.compiled,
+                                          self.directory)
+        return self._kernels[name]
+
+    @property
+    def how(self) -> dict[str, str]:
+        """What runs each kernel built so far."""
+        return {k: v.how for k, v in self._kernels.items()}
+
+    # ---------------------------------------------------------------- evaluation
+    def _run(self, name: str, *args) -> tuple[list[np.ndarray], bool]:
+        inputs = KERNELS[name][0]
+        sizes = {"q": self.mech.model.nq, "v": self.mech.nv, "qd": self.mech.na, "qdd": self.mech.na,
+                 "target": self.mech.na, "y": self.twin.task_target.shape[0]}
+        arrays, single = [], None
+        for what, x in zip(inputs, args):
+            a = np.asarray(x, dtype=float)
+            if a.ndim not in (1, 2) or a.shape[-1] != sizes[what]:
+                raise InvalidInputError(what, f"expected ({sizes[what]},) or (n, {sizes[what]})", x)
+            if single is None:
+                single = a.ndim == 1
+            elif single != (a.ndim == 1):
+                raise InvalidInputError(what, "give every input as one sample or every input as a batch", x)
+            arrays.append(np.atleast_2d(a))
+        if len({a.shape[0] for a in arrays}) > 1:
+            raise InvalidInputError(name, f"batches of different lengths {[a.shape[0] for a in arrays]}")
+        return self.kernel(name)(*arrays), bool(single)
+
+    def _shaped(self, name: str, outs: list[np.ndarray], single: bool) -> list[np.ndarray]:
+        fun = self.kernel(name).fun
+        shaped = []
+        for i, o in enumerate(outs):
+            r, c = fun.size_out(i)
+            x = o.reshape(-1, c, r).transpose(0, 2, 1) if c > 1 else o
+            shaped.append(x[0] if single else x)
+        return shaped
+
+    def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
+        """Actuator efforts (na, or n x na) at closed configurations ``q`` (nq or n x nq) for actuated rates and
+        accelerations ``qd, qdd`` (na or n x na) [N, N m]: :attr:`Twin.inverse_dynamics`, samples under the pivot
+        floor recomputed by :func:`pkm.inverse_dynamics`."""
+        (tau, pivot), single = self._run("inverse_dynamics", q, qd, qdd)
+        bad = np.flatnonzero(~(pivot[:, 0] >= PIVOT_FLOOR))
+        if bad.size:
+            from pkm.core.differential import accelerations, velocities
+            from pkm.core.dynamics import inverse_dynamics
+
+            Q, QD, QDD = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, qd, qdd))
+            for k in bad:
+                v = velocities(self.mech, Q[k], QD[k])
+                tau[k] = inverse_dynamics(self.mech, Q[k], v, accelerations(self.mech, Q[k], v, QDD[k]))
+        return tau[0] if single else tau
+
+    def inverse_dynamics_derivatives(self, q, qd, qdd) -> dict[str, np.ndarray]:
+        """``tau`` and its derivatives ``dtau_dqa`` (along the closure), ``dtau_dqd``, ``dtau_dqdd`` (na x na each, or
+        n x na x na) at closed configurations (see :attr:`Twin.inverse_dynamics_derivatives`)."""
+        outs, single = self._run("inverse_dynamics_derivatives", q, qd, qdd)
+        return dict(zip(KERNELS["inverse_dynamics_derivatives"][1], self._shaped("inverse_dynamics_derivatives",
+                                                                                 outs, single)))
+
+    def velocities(self, q, qd) -> np.ndarray:
+        """All joint rates (nv) for actuated rates ``qd`` at closed configurations ``q``."""
+        outs, single = self._run("velocities", q, qd)
+        return outs[0][0] if single else outs[0]
+
+    def accelerations(self, q, v, qdd) -> np.ndarray:
+        """All joint accelerations (nv) at ``(q, v)`` for actuated accelerations ``qdd``."""
+        outs, single = self._run("accelerations", q, v, qdd)
+        return outs[0][0] if single else outs[0]
+
+    def forward_jacobian(self, q) -> np.ndarray:
+        """Task rates per actuated rate (task size x na) at closed configurations."""
+        outs, single = self._run("forward_jacobian", q)
+        return self._shaped("forward_jacobian", outs, single)[0]
+
+    def inverse_jacobian(self, q) -> np.ndarray:
+        """Actuated rates per task rate (na x task size) at closed configurations."""
+        outs, single = self._run("inverse_jacobian", q)
+        return self._shaped("inverse_jacobian", outs, single)[0]
+
+    # ---------------------------------------------------------------- paths
+    def close_loops_path(self, q_actuated, q0=None, *, tol: float = 1e-12, max_iter: int = 10) -> PathResult:
+        """The loop closure along a path of actuated coordinates (n x na), each solve warm-started from the previous
+        solution (the first from ``q0``, default the reference), as :func:`pkm.close_loops` per sample."""
+        from pkm.core.solve import close_loops
+
+        return self._path("closure_newton", q_actuated, q0, tol, max_iter,
+                          lambda q, t: close_loops(self.mech, t, q, tol=tol))
+
+    def ik_path(self, targets, q0=None, *, tol: float = 1e-12, max_iter: int = 10) -> PathResult:
+        """The inverse kinematics along a path of task values (n x task value size, laid out as
+        :meth:`pkm.core.task.TaskMap.value`), warm-started, as :func:`pkm.solve_ik` per sample."""
+        from pkm.core.solve import solve_ik
+
+        return self._path("ik_newton", targets, q0, tol, max_iter, lambda q, t: solve_ik(self.mech, t, q, tol=tol))
+
+    def _path(self, name: str, targets, q0, tol: float, max_iter: int, core) -> PathResult:
+        kernel = self.kernel(name)
+        t = np.atleast_2d(np.asarray(targets, dtype=float))
+        if t.shape[1] != kernel.in_size[1] or not np.all(np.isfinite(t)):
+            raise InvalidInputError("targets", f"expected finite values of shape (n, {kernel.in_size[1]})", targets)
+        prev = self.mech.q_reference.copy() if q0 is None else self.mech.check_q(q0, "q0")
+        n = len(t)
+        Q, res, its = np.empty((n, len(prev))), np.empty(n), np.zeros(n, dtype=np.int64)
+        fallback, start = [], 0
+        while start < n:
+            q_k, r_k, p_k, i_k = kernel.follow(prev, t[start:], max_iter, tol)
+            bad = np.flatnonzero(~((r_k <= tol) & (p_k >= PIVOT_FLOOR)))
+            end = start + (int(bad[0]) if bad.size else len(q_k))
+            Q[start:end], res[start:end], its[start:end] = q_k[:end - start], r_k[:end - start], i_k[:end - start]
+            if end == n:
+                break
+            solved = core(prev if end == start else Q[end - 1], t[end])  # the core, from the last good sample
+            Q[end], res[end], its[end] = solved.q, solved.residual, 0
+            fallback.append(end)
+            prev, start = solved.q, end + 1
+        return PathResult(Q, res, its, tuple(fallback), kernel.how)
+
+
+#: Each kernel's inputs and outputs.
+KERNELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    "inverse_dynamics": (("q", "qd", "qdd"), ("tau", "pivot")),
+    "inverse_dynamics_derivatives": (("q", "qd", "qdd"), ("tau", "dtau_dqa", "dtau_dqd", "dtau_dqdd")),
+    "velocities": (("q", "qd"), ("v",)),
+    "accelerations": (("q", "v", "qdd"), ("a",)),
+    "forward_jacobian": (("q",), ("J",)),
+    "inverse_jacobian": (("q",), ("J",)),
+    "closure_newton": (("q", "target"), ("q_next", "residual", "pivot")),
+    "ik_newton": (("q", "y"), ("q_next", "residual", "pivot")),
+}
+
+__all__ = ["KERNELS", "PIVOT_FLOOR", "Kernels", "PathResult"]

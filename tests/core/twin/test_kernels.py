@@ -1,0 +1,159 @@
+"""pkm.core.twin.kernels: the generated kernels (compiled C and CasADi's virtual machine) equal the generic core on
+closed states of shipped and user mechanisms; the derivatives equal finite differences; paths warm-start and fall
+back to the core where the fixed pivots fail."""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm.core.task import TaskMap
+from pkm.core.twin import kernels as kmod
+from pkm.core.twin.kernels import Kernels
+from pkm.errors import InvalidInputError, SpecError
+from tests.core.twin.test_tree import FILES
+from tests.fd import rel, richardson
+
+NAMES = ["prs3", "delta", "rrr3", "hexapod", "gough_stewart", "mjcf_fourbar"]
+HAS_CC = bool(shutil.which("cc") or shutil.which("gcc") or shutil.which("clang"))
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _cache(tmp_path_factory):
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("PKM_CACHE_DIR", str(tmp_path_factory.mktemp("twin-cache")))
+        yield
+
+
+def _mechanism(name: str) -> pkm.Mechanism:
+    return pkm.load(FILES[name]) if name in FILES else pkm.load(name)
+
+
+def _states(mech: pkm.Mechanism, n: int, seed: int = 0):
+    """``n`` closed configurations near the reference, with random actuated rates and accelerations."""
+    rng = np.random.default_rng(seed)
+    qa = mech.actuated_q(mech.q_reference)
+    Q = np.array([pkm.close_loops(mech, qa + 0.01 * rng.standard_normal(mech.na)).q for _ in range(n)])
+    return Q, rng.standard_normal((n, mech.na)), rng.standard_normal((n, mech.na))
+
+
+@pytest.mark.parametrize("compiled", [True, False], ids=["C", "vm"])
+@pytest.mark.parametrize("name", NAMES)
+def test_the_kernels_equal_the_generic_core(name, compiled):
+    """Efforts, joint rates and accelerations, forward and inverse Jacobians from the kernels, one sample and a batch
+    of 6: the generic core's (pkm.inverse_dynamics, pkm.velocities, pkm.accelerations, pkm.forward_jacobian) to
+    1e-10 relative."""
+    mech = _mechanism(name)
+    K = Kernels(mech, compiled=compiled)
+    Q, QD, QDD = _states(mech, 6)
+    tau = K.inverse_dynamics(Q, QD, QDD)
+    V = K.velocities(Q, QD)
+    for k in range(len(Q)):
+        v = pkm.velocities(mech, Q[k], QD[k])
+        a = pkm.accelerations(mech, Q[k], v, QDD[k])
+        assert rel(V[k], v) <= 1e-10
+        assert rel(K.accelerations(Q[k], v, QDD[k]), a) <= 1e-10
+        assert rel(tau[k], pkm.inverse_dynamics(mech, Q[k], v, a)) <= 1e-10
+        assert rel(K.inverse_dynamics(Q[k], QD[k], QDD[k]), tau[k]) <= 1e-14
+        J = pkm.forward_jacobian(mech, Q[k])
+        assert rel(K.forward_jacobian(Q[k]), J) <= 1e-10
+        if J.shape[0] == J.shape[1]:
+            assert rel(K.inverse_jacobian(Q[k]) @ J, np.eye(mech.na)) <= 1e-10
+    assert len(K.how) == 5 and all(h.startswith("C (" if compiled and HAS_CC else "CasADi") for h in K.how.values())
+
+
+@pytest.mark.parametrize("name", ["prs3", "delta", "gough_stewart"])
+def test_the_derivatives_of_the_efforts_equal_finite_differences(name):
+    """dtau/dqa along the closure (the configuration re-solved by pkm.close_loops), dtau/dqd and dtau/dqdd: central
+    differences, Richardson-extrapolated, to 1e-6 relative."""
+    mech = _mechanism(name)
+    K = Kernels(mech)
+    Q, QD, QDD = _states(mech, 2, seed=3)
+    for q, qd, qdd in zip(Q, QD, QDD):
+        d = K.inverse_dynamics_derivatives(q, qd, qdd)
+        assert rel(d["tau"], K.inverse_dynamics(q, qd, qdd)) <= 1e-14
+        for key, arg in (("dtau_dqa", "dqa"), ("dtau_dqd", "dqd"), ("dtau_dqdd", "dqdd")):
+            assert rel(d[key], _differences(K, q, qd, qdd, arg)) <= 1e-6, key
+
+
+def _differences(K: Kernels, q, qd, qdd, arg: str) -> np.ndarray:
+    """Central differences of the efforts in one of their inputs (``dqa``: the configuration re-solved)."""
+    qa = K.mech.actuated_q(q)
+
+    def at(dqa=0.0, dqd=0.0, dqdd=0.0):
+        qq = q if np.isscalar(dqa) else pkm.close_loops(K.mech, qa + dqa, q, tol=1e-14).q
+        return K.inverse_dynamics(qq, qd + dqd, qdd + dqdd)
+
+    return richardson(lambda h: np.column_stack([(at(**{arg: e}) - at(**{arg: -e})) / (2 * h)
+                                                 for e in h * np.eye(K.mech.na)]), 1e-4)
+
+
+@pytest.mark.parametrize("name", ["prs3", "delta", "rrr3", "gough_stewart"])
+def test_paths_warm_start_and_equal_the_core(name):
+    """The loop closure along 60 samples of a smooth actuated path equals pkm.close_loops per sample (1e-9) with at
+    most 3 kernel iterations per sample; the IK along the task values of every 6th sample comes back to the same
+    configurations."""
+    mech = _mechanism(name)
+    K = Kernels(mech)
+    qa = mech.actuated_q(mech.q_reference)
+    s = np.sin(np.linspace(0.0, 3.0, 60))[:, None]
+    path = qa + 0.02 * s * np.linspace(1.0, -1.0, mech.na)
+    r = K.close_loops_path(path)
+    assert r.fallback == () and r.residual.max() <= 1e-12 and r.iterations.max() <= 3
+    q = mech.q_reference
+    for k in range(0, 60, 7):
+        q = pkm.close_loops(mech, path[k], q).q
+        assert np.abs(mech.difference(r.q[k], q)).max() <= 1e-9
+    task = TaskMap(mech)
+    Y = np.array([task.value(x) for x in r.q[::6]])
+    ik = K.ik_path(Y)
+    assert ik.fallback == () and ik.residual.max() <= 1e-12
+    assert max(np.abs(mech.difference(a, b)).max() for a, b in zip(ik.q, r.q[::6])) <= 1e-9
+
+
+def test_samples_under_the_pivot_floor_fall_back_to_the_core(monkeypatch):
+    """With the floor above every pivot, each path sample and each effort comes from the core, listed as such, and
+    the answers are the same."""
+    mech = _mechanism("delta")
+    K = Kernels(mech)
+    qa = mech.actuated_q(mech.q_reference)
+    path = qa + np.linspace(0.0, 0.05, 8)[:, None]
+    Q, QD, QDD = _states(mech, 3)
+    expected_q, expected_tau = K.close_loops_path(path).q, K.inverse_dynamics(Q, QD, QDD)
+    monkeypatch.setattr(kmod, "PIVOT_FLOOR", 2.0)
+    r = K.close_loops_path(path)
+    assert r.fallback == tuple(range(8))
+    assert max(np.abs(mech.difference(a, b)).max() for a, b in zip(r.q, expected_q)) <= 1e-10
+    assert rel(K.inverse_dynamics(Q, QD, QDD), expected_tau) <= 1e-10
+
+
+def test_without_a_compiler_the_virtual_machine_runs_and_says_so(monkeypatch):
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    K = Kernels(_mechanism("prs3"))
+    Q, QD, QDD = _states(K.mech, 2)
+    K.inverse_dynamics(Q, QD, QDD)
+    assert "no C compiler" in K.how["inverse_dynamics"]
+
+
+def test_bad_input_is_refused_clearly():
+    K = Kernels(_mechanism("delta"), compiled=False)
+    q = K.mech.q_reference
+    with pytest.raises(InvalidInputError, match="qd"):
+        K.inverse_dynamics(q, np.zeros(4), np.zeros(3))
+    with pytest.raises(InvalidInputError, match="one sample"):
+        K.inverse_dynamics(q, np.zeros((2, 3)), np.zeros(3))
+    with pytest.raises(InvalidInputError, match="different lengths"):
+        K.inverse_dynamics(np.array([q, q]), np.zeros((3, 3)), np.zeros((3, 3)))
+    with pytest.raises(InvalidInputError, match="kernel"):
+        K.function("nope")
+    with pytest.raises(InvalidInputError, match="targets"):
+        K.close_loops_path(np.full((2, 3), np.nan))
+
+
+def test_a_mechanism_with_idle_motions_is_refused():
+    mech = pkm.load(FILES["rssr"])
+    with pytest.raises(SpecError, match="idle motions"):
+        Kernels(mech).inverse_dynamics(mech.q_reference, np.zeros(mech.na), np.zeros(mech.na))
