@@ -1,7 +1,8 @@
 """The architecture change of issue 13 changes no row of the report: same ids, published values and match flags,
 ours within 1e-12 relative of the rows saved before it (``tests/data/report_rows_before_issue13.json``), except the
 rows that are the location of an optimum found by a solver to a stated accuracy: those within that accuracy (one
-closed form of the arm-and-rod leg for the Delta and the hexapod moved them by 3e-10..4e-8 relative)."""
+closed form of the arm-and-rod leg for the Delta and the hexapod moved them by 3e-10..4e-8 relative). Rows added
+since (:data:`ADDED`) are left out of the comparison."""
 
 from __future__ import annotations
 
@@ -21,12 +22,16 @@ SOLVER_ACCURACY = {
     "delta.fig5.R_min_K2_mm": 1e3 * 1e-10,  # radius_minimising_condition: bounded Brent, xatol 1e-10 m
 }
 
+#: Rows added since, by the issue that names them (each paper's rows before them keep their order).
+ADDED = {"prs3.opcount.generic_mul", "prs3.opcount.generic_add", "delta.opcount.mul", "delta.opcount.add",
+         "hexapod.opcount.mul", "hexapod.opcount.add"}  # issue 15
+
 BEFORE = json.loads((Path(__file__).parent / "data" / "report_rows_before_issue13.json").read_text())["papers"]
 
 
 @pytest.mark.parametrize("paper", sorted(BEFORE))
 def test_rows_equal_the_rows_before_the_architecture_change(paper):
-    rows = papers.module(paper).reproduce()
+    rows = [r for r in papers.module(paper).reproduce() if r.id not in ADDED]
     assert [r.id for r in rows] == [r["id"] for r in BEFORE[paper]]
     for row, old in zip(rows, BEFORE[paper]):
         assert (row.published, row.unit, row.matches) == (old["published"], old["unit"], old["matches"]), row.id

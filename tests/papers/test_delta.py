@@ -13,7 +13,7 @@ from pkm.mechanisms.delta import DeltaParams
 from pkm.papers import delta as S
 
 IDS = ["delta.fig5.K_F_R100", "delta.fig5.K_F_R200", "delta.fig5.K_2_R120", "delta.fig5.monotone_100_200",
-       "delta.fig5.R_min_K2_mm", "delta.choice.R_mm"]
+       "delta.fig5.R_min_K2_mm", "delta.choice.R_mm", "delta.opcount.mul", "delta.opcount.add"]  # the last two: issue 15
 
 
 @pytest.fixture(scope="module")

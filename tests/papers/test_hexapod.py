@@ -10,11 +10,12 @@ from pkm import papers
 from pkm.papers import hexapod as study
 
 IDS = ("hexapod.poseT.beta_min_reachable_deg", "hexapod.poseT.beta_opt_wrot_deg", "hexapod.poseT.beta_opt_wtras_deg",
-       "hexapod.spiral.max_gap_rot_tras_deg", "hexapod.spiral.gain_after_40_wrot")
+       "hexapod.spiral.max_gap_rot_tras_deg", "hexapod.spiral.gain_after_40_wrot",
+       "hexapod.opcount.mul", "hexapod.opcount.add")  # the last two: issue 15
 
 
 def test_rows_carry_the_ids_of_the_issue_with_notes():
-    """reproduce() returns exactly the five contract ids, each with a source and a note; numbers are finite."""
+    """reproduce() returns exactly the contract ids, each with a source and a note; numbers are finite."""
     rows = study.reproduce()
     assert tuple(r.id for r in rows) == IDS
     assert all(isinstance(r, papers.Row) and r.source and r.note for r in rows)

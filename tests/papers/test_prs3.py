@@ -7,7 +7,8 @@ import pytest
 
 from pkm.papers import prs3 as study
 
-CONTRACT = ["prs3.opcount.mul", "prs3.opcount.add", "prs3.case2.power_spread_W", "prs3.case3.p1_peak_ratio",
+CONTRACT = ["prs3.opcount.mul", "prs3.opcount.add", "prs3.opcount.generic_mul", "prs3.opcount.generic_add",
+            "prs3.case2.power_spread_W", "prs3.case3.p1_peak_ratio",
             "prs3.case3.p2p3_opposite"] + [f"prs3.case{c}.F{i}_{k}_N" for c in (2, 3) for k in ("t0", "t1", "t2p5")
                                            for i in (1, 2, 3)]
 
@@ -22,6 +23,15 @@ def test_every_contract_row_is_there_and_every_comparable_one_matches(rows):
     for r in rows.values():
         assert r.matches in (True, None), r
         assert r.source and r.note
+
+
+def test_the_generic_count_is_within_1_5_times_the_hand_written_one(rows):
+    """Issue 15: the generic inverse dynamics of the Pinocchio model, counted at its boundary, within 1.5x the
+    hand-written twin's count (both its numeric and its inertial-symbolic modes)."""
+    numeric = study.counts()["numeric"]
+    for kind, hand in (("mul", rows["prs3.opcount.mul"].computed), ("add", rows["prs3.opcount.add"].computed)):
+        generic = rows[f"prs3.opcount.generic_{kind}"].computed
+        assert generic <= 1.5 * min(hand, getattr(numeric, kind)), (kind, generic, hand)
 
 
 def test_case2_force_rows_equal_the_translating_closed_form(rows):

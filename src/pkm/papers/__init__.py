@@ -14,6 +14,7 @@ the rows of every paper into ``summary.json`` and a table.
 
 from __future__ import annotations
 
+import functools
 import importlib
 import math
 from dataclasses import asdict, dataclass
@@ -83,6 +84,25 @@ class Row:
         return d
 
 
+@functools.cache
+def generic_count(mechanism: str):
+    """:meth:`pkm.Kernels.operation_count` of a shipped mechanism's generic inverse dynamics."""
+    import pkm
+
+    return pkm.Kernels(pkm.load(mechanism)).operation_count()
+
+
+def opcount_rows(mechanism: str, prefix: str, note: str = "") -> list[Row]:
+    """Rows ``<prefix>mul`` and ``<prefix>add``: :func:`generic_count` (the papers publish none), its boundary in
+    the note, after ``note``."""
+    c = generic_count(mechanism)
+    fn = ", ".join(f"{v} {k}" for k, v in sorted(c.functions.items()))
+    text = (f"pkm.Kernels(pkm.load({mechanism!r})).operation_count(): the twin of the Pinocchio model after CSE "
+            f"({c.mul} mult/div, {c.add} add/sub, {fn}). {note}Boundary: {c.boundary}")
+    return [Row(f"{prefix}mul", None, c.mul, "", None, "generic route (no published count)", text),
+            Row(f"{prefix}add", None, c.add, "", None, "generic route (no published count)", text)]
+
+
 def names() -> tuple[str, ...]:
     """The paper studies, in registry order: the ``paper`` of every registered mechanism that has one."""
     return tuple(d.paper for d in REGISTRY.values() if d.paper is not None)
@@ -95,4 +115,4 @@ def module(name: str) -> ModuleType:
     return importlib.import_module(f"pkm.papers.{name}")
 
 
-__all__ = ["Row", "module", "names"]
+__all__ = ["Row", "generic_count", "module", "names", "opcount_rows"]

@@ -42,7 +42,7 @@ import numpy as np
 
 from pkm.mechanisms.delta import DeltaParams
 from pkm.mechanisms.delta import design as design
-from pkm.papers import Row
+from pkm.papers import Row, opcount_rows
 from pkm.papers._plot import figure, save
 
 TITLE = "Hernández Reyna & Sandoval-Castro (2018): kinematics and base-radius reconfiguration of a Delta robot"
@@ -153,7 +153,7 @@ def reproduce() -> list[Row]:
             f"largest at R = {study.R[peak] * 1e3:.0f} mm of the sweep (R close to r) and "
             f"{'strictly decreasing' if shrinks else 'not monotone'} from there to {study.R[-1] * 1e3:.0f} mm: "
             "it shrinks as R grows over the paper's range, as the paper says"),
-    ]
+    ] + opcount_rows("delta", "delta.opcount.")
 
 
 def figures(out_dir) -> list[Path]:

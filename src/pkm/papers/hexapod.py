@@ -24,7 +24,7 @@ from pkm.core.task import as_rotation
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi
 from pkm.mechanisms.hexapod import reconfiguration as hr
-from pkm.papers import Row
+from pkm.papers import Row, opcount_rows
 from pkm.papers._plot import figure, save
 
 TITLE = "Sanchez-Alonso et al. (2016), Kinematic analysis of a novel reconfigurable parallel robot, RIAI 13:247-257"
@@ -115,7 +115,7 @@ def reproduce() -> list[Row]:
             f"{gain40:.2f} % after point 40 against {gain_before:.2f} % before it, i.e. no clear gain: beta* "
             f"approaches 0 along the spiral ({math.degrees(pr.pointwise[-1]):.2f} deg at the end). The rate-limited "
             f"QP profile gives {100 * pr.mean_gain(GAIN_FROM):.2f} %."),
-    ]
+    ] + opcount_rows("hexapod", "hexapod.opcount.")
 
 
 def figures(out_dir) -> list[Path]:

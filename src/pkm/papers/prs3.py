@@ -17,7 +17,7 @@ import numpy as np
 from pkm.mechanisms.prs3 import Prs3Params
 from pkm.mechanisms.prs3.dynamics import BOUNDARY, G, Prs3Dynamics, operation_count
 from pkm.motion import load_motions
-from pkm.papers import Row
+from pkm.papers import Row, generic_count, opcount_rows
 from pkm.papers._plot import figure, save
 
 TITLE = "Díaz-Rodríguez, Carretero, Bautista-Quintero & Chacón (2016): 3-PRS kinematics and inverse dynamics"
@@ -64,6 +64,12 @@ def reproduce() -> list[Row]:
             f"1352/778. Boundary: {BOUNDARY}")
     rows = [Row("prs3.opcount.mul", 860, ours.mul, "", None, "sec. 4, after eq. (40)", note, "<="),
             Row("prs3.opcount.add", 680, ours.add, "", None, "sec. 4, after eq. (40)", note, "<=")]
+    num, g = c["numeric"], generic_count("prs3")
+    rows += opcount_rows("prs3", "prs3.opcount.generic_", (
+        f"{g.mul / num.mul:.2f}x / {g.add / num.add:.2f}x the hand-written twin with the same numeric parameters "
+        f"({num.mul}/{num.add}), {g.mul / ours.mul:.2f}x / {g.add / ours.add:.2f}x its count with symbolic inertial "
+        f"parameters (prs3.opcount.mul/add, {ours.mul}/{ours.add}); the hand-written count also includes the "
+        "closed-form leg inverse kinematics from the task pose, which the generic route takes as its input q. "))
 
     p = Prs3Params()
     t2, Ydd2, r2 = simulate("2")

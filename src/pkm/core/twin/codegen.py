@@ -137,6 +137,17 @@ def compile_library(fun: cs.Function, *, follow: bool = False, directory=None) -
     return ctypes.CDLL(str(library)), f"C ({Path(cc).name} {flags[0]}, {library})"
 
 
+def count_operations(fun: cs.Function) -> dict[str, int]:
+    """The instructions of ``fun`` by CasADi operation (``mul``, ``add``, ``sin``...; inputs, outputs and constants
+    included), counted on its virtual machine's instruction list (after whatever CSE built it)."""
+    op = {getattr(cs, n): n[3:].lower() for n in dir(cs) if n.startswith("OP_")}
+    counts: dict[str, int] = {}
+    for k in range(fun.n_instructions()):
+        name = op[fun.instruction_id(k)]
+        counts[name] = counts.get(name, 0) + 1
+    return counts
+
+
 def compile_function(fun: cs.Function, directory=None) -> tuple[cs.Function, str]:
     """``fun`` as compiled C loaded back as a ``casadi.Function`` (``casadi.external``) when a C compiler is present;
     else ``fun`` itself, run by CasADi's virtual machine. Returns ``(function, how)``."""
@@ -146,4 +157,4 @@ def compile_function(fun: cs.Function, directory=None) -> tuple[cs.Function, str
     return cs.external(fun.name(), lib._name), how
 
 
-__all__ = ["cache_dir", "compile_function", "compile_library", "source"]
+__all__ = ["cache_dir", "compile_function", "compile_library", "count_operations", "source"]

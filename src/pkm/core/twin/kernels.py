@@ -33,6 +33,41 @@ _I = ctypes.c_longlong
 
 
 @dataclass(frozen=True)
+class OperationCount:
+    """The operations of one kernel's main output after common-subexpression elimination, counted as the papers
+    and SYMORO count: ``*``, ``/``, squares and doublings as multiplications, ``+ -`` as additions, negations free;
+    every other operation apart, in ``functions`` (``sin``, ``cos``, ``sqrt``, ``atan2``, ...).
+
+    Attributes:
+        kernel: Which kernel (:data:`KERNELS`).
+        mul: Multiplications and divisions.
+        add: Additions and subtractions.
+        functions: Count per other operation.
+        boundary: What the count covers, in words (:data:`BOUNDARIES`).
+    """
+
+    kernel: str
+    mul: int
+    add: int
+    functions: dict
+    boundary: str
+
+
+#: What each counted kernel covers.
+BOUNDARIES = {
+    "inverse_dynamics": (
+        "in: a closed configuration q (nq numbers) and the actuated rates and accelerations (na each); out: the na "
+        "actuator efforts. Included: every joint's placement, velocity and acceleration, the closure Jacobian and "
+        "drift, the passive rates and accelerations (sparse LU, pivots fixed at the reference), RNEA with gravity "
+        "and the projection (one transposed solve). Not included: the position-level loop closure (a Newton "
+        "iteration is counted apart), an external wrench. Inertial parameters and geometry numeric (the model's)."),
+    "closure_newton": (
+        "in: q (nq) and the actuated coordinates (na); out: the next Newton iterate (nq). Included: forward "
+        "kinematics, closure residual and Jacobian, the sparse LU and solve, the retraction; not the convergence test."),
+}
+
+
+@dataclass(frozen=True)
 class PathResult:
     """A warm-started Newton solve along a path of targets.
 
@@ -161,6 +196,22 @@ class Kernels:
     def how(self) -> dict[str, str]:
         """What runs each kernel built so far."""
         return {k: v.how for k, v in self._kernels.items()}
+
+    def operation_count(self, name: str = "inverse_dynamics") -> OperationCount:
+        """The operations of the kernel's main output (``tau``, ``q_next``) after CSE: see :class:`OperationCount`."""
+        from pkm.core.twin.codegen import count_operations
+
+        if name not in BOUNDARIES:
+            raise InvalidInputError("kernel", f"operation counts are stated for {sorted(BOUNDARIES)}", name)
+        fun = self.function(name)
+        args = fun.sx_in()
+        counted = cs.Function("count", args, cs.cse([fun.call(args)[0]]))
+        counts = count_operations(counted)
+        mul = sum(counts.pop(k, 0) for k in ("mul", "div", "sq", "twice"))
+        add = sum(counts.pop(k, 0) for k in ("add", "sub"))
+        for k in ("neg", "input", "output", "const"):
+            counts.pop(k, None)
+        return OperationCount(name, mul, add, counts, BOUNDARIES[name])
 
     # ---------------------------------------------------------------- evaluation
     def _run(self, name: str, *args) -> tuple[list[np.ndarray], bool]:

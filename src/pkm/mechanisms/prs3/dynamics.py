@@ -406,14 +406,10 @@ def twin(params: Prs3Params | None = None, *, mode: str = "numeric", outputs: st
 
 def operation_count(params: Prs3Params | None = None, *, mode: str = "inertial") -> OpCount:
     """Count the twin's operations (see :class:`OpCount`, :data:`BOUNDARY`)."""
-    ca, _ = _casadi()
+    from pkm.core.twin.codegen import count_operations
+
     params = Prs3Params() if params is None else params
-    f = twin(params, mode=mode)
-    op = {getattr(ca, n): n[3:].lower() for n in dir(ca) if n.startswith("OP_")}
-    counts: dict[str, int] = {}
-    for k in range(f.n_instructions()):
-        name = op[f.instruction_id(k)]
-        counts[name] = counts.get(name, 0) + 1
+    counts = count_operations(twin(params, mode=mode))
     known = {"mul", "div", "sq", "add", "sub", "neg", "sin", "cos", "sqrt", "atan2", "input", "output", "const"}
     if set(counts) - known:
         raise RuntimeError(f"operations the counter does not classify: {sorted(set(counts) - known)}")
