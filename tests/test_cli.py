@@ -238,7 +238,7 @@ def test_bench_runs_a_benchmark_and_refuses_an_unknown_one(tmp_path):
     assert list(out) == ["opcount"] and out["opcount"]
     bad = run("bench", "speed")
     line = one_error_line(bad)
-    assert bad.returncode == 2 and "'dynamics', 'hexapod', 'kinematics', 'opcount', 'workspace'" in line
+    assert bad.returncode == 2 and "'dynamics', 'hexapod', 'kinematics', 'opcount', 'twin', 'workspace'" in line
 
 
 def test_bench_quick_runs_every_benchmark_and_refuses_bad_arguments(tmp_path):
@@ -247,7 +247,7 @@ def test_bench_quick_runs_every_benchmark_and_refuses_bad_arguments(tmp_path):
     proc = run("bench", "--quick", "--json", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
-    assert sorted(out) == ["dynamics", "hexapod", "kinematics", "opcount", "workspace"]
+    assert sorted(out) == ["dynamics", "hexapod", "kinematics", "opcount", "twin", "workspace"]
     assert [r["samples"] for r in out["kinematics"]] == [3] * 4
     assert out["dynamics"]["max_force_difference_to_baseline_N"]["pkm"] < 1e-9
     bad = run("bench", "kinematics", "--", "--samples", "3")

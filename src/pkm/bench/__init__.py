@@ -25,7 +25,7 @@ from typing import Any
 
 from pkm.errors import UnknownNameError
 
-NAMES = ("dynamics", "hexapod", "kinematics", "opcount", "workspace")
+NAMES = ("dynamics", "hexapod", "kinematics", "opcount", "twin", "workspace")
 
 
 def module(name: str) -> ModuleType:

@@ -142,11 +142,20 @@ def test_a_file_without_actuators_says_how_to_name_them(tmp_path):
         pkm.load(path)
 
 
-def test_equalities_on_sites_are_refused_before_pinocchio_sees_them():
-    """(Pinocchio 4.1 crashes the process on site-based equalities.)"""
-    text = PROBE.replace('<weld body1="a" body2="b"/>', '<weld site1="bs" site2="stand_tip"/>')
-    with pytest.raises(SpecError, match=r"between bodies .* not sites"):
-        read_mjcf(text, "probe.xml")
+def test_equalities_on_sites_close_the_sites_frames():
+    """(Pinocchio 4.1 crashes the process on site-based equalities: pkm takes them out of Pinocchio's copy.) A weld
+    between two sites is a frame closure between those sites, a connect a point closure; one site alone, or no body
+    and no site, is refused."""
+    text = PROBE.replace('<weld body1="a" body2="b"/>', '<weld name="w" site1="bs" site2="stand_tip"/>')
+    imported = read_mjcf(text, "probe.xml")
+    assert [(c.name, c.type, c.frame_a, c.frame_b) for c in imported.closures] == [
+        ("tie", "point", "tie_a", "tie_b"), ("w", "frame", "bs", "stand_tip")]
+    with pytest.raises(SpecError, match="give both site1 and site2"):
+        read_mjcf(PROBE.replace('<weld body1="a" body2="b"/>', '<weld site1="bs"/>'), "probe.xml")
+    with pytest.raises(SpecError, match="no site 'nope'"):
+        read_mjcf(PROBE.replace('<weld body1="a" body2="b"/>', '<connect site1="bs" site2="nope"/>'), "probe.xml")
+    with pytest.raises(SpecError, match="no body1 and no sites"):
+        read_mjcf(PROBE.replace('<weld body1="a" body2="b"/>', '<connect anchor="0 0 0"/>'), "probe.xml")
 
 
 def test_the_world_body_and_free_bodies_are_where_mujoco_puts_them(tmp_path):

@@ -8,6 +8,7 @@ representation (:class:`~pkm.core.formats.imported.Imported`: URDF text, loops, 
 
 A closure spec's ``urdf`` key may name an MJCF or SDF file as well as a URDF: the file's loops and
 joint types are added to the spec's (:func:`~pkm.core.formats.imported.import_model`).
+:mod:`~pkm.core.formats.to_mjcf` writes any mechanism as MJCF (for MuJoCo, and back).
 """
 
 from pkm.core.formats.gepetto import gepetto_files, load_gepetto, spec_from_gepetto

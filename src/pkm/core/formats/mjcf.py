@@ -6,7 +6,8 @@ does not keep, from the file itself:
 
 * ``<connect>`` gives a ``point`` closure and ``<weld>`` a ``frame`` closure, named by the equality's
   ``name`` (else ``connect1``, ``weld2``...); their anchors become frames ``<name>_a`` (on ``body1``)
-  and ``<name>_b`` (on ``body2``, the world when it is omitted);
+  and ``<name>_b`` (on ``body2``, the world when it is omitted); an equality between two sites
+  (``site1``, ``site2``) closes those sites' frames (origins for a connect, frames for a weld);
 * the actuated joints: the ``joint`` of each ``<actuator>`` element (``motor``, ``position``,
   ``general``...), in file order; actuators on tendons or sites are not joint inputs and are skipped;
 * joint names and position limits (``range``, in degrees unless ``<compiler angle="radian">``, for
@@ -17,8 +18,8 @@ does not keep, from the file itself:
 
 What Pinocchio 4.1's parser gets wrong is worked around, each by a test: it reads only the first body
 under ``<worldbody>`` (pkm wraps them all in one fixed body), ignores the sites of bodies without
-joints (pkm adds them from the file), drops the equalities' names, and converts a slide's range as
-an angle. Refused with a :class:`~pkm.errors.SpecError`: ``<include>`` (pkm reads one self-contained
+joints (pkm adds them from the file), drops the equalities' names, converts a slide's range as
+an angle, and crashes on equalities between sites (pkm takes them out of its copy and closes them itself). Refused with a :class:`~pkm.errors.SpecError`: ``<include>`` (pkm reads one self-contained
 file), equalities other than ``connect``/``weld``, joint types other than hinge, slide, ball, free.
 Meshes are not read (kinematics and dynamics need none).
 """
@@ -160,15 +161,24 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
     for el in equalities:
         if el.tag not in ("connect", "weld"):
             raise SpecError(source, f"<equality><{el.tag}> is not a loop closure pkm reads (connect and weld are)")
-    for el in equalities:  # (Pinocchio 4.1 crashes on site-based equalities: refused before it sees them)
-        if el.get("site1") is not None or el.get("site2") is not None or not el.get("body1"):
-            raise SpecError(source, f"<equality><{el.tag} name={el.get('name')!r}>: pkm reads equalities between "
-                                    "bodies (body1, optional body2, anchor or relpose), not sites")
+    on_sites = []
+    for el in equalities:
+        sites = (el.get("site1"), el.get("site2"))
+        if any(sites) and not all(sites):
+            raise SpecError(source, f"<equality><{el.tag} name={el.get('name')!r}>: give both site1 and site2, or "
+                                    "body1 (optional body2)")
+        if not any(sites) and not el.get("body1"):
+            raise SpecError(source, f"<equality><{el.tag} name={el.get('name')!r}>: no body1 and no sites")
+        if all(sites):  # Pinocchio 4.1 crashes on site-based equalities: pkm closes them itself, on the sites
+            on_sites.append(el)
+            el.getparent().remove(el)
     counts = {"connect": 0, "weld": 0}
     eq_names = []
     for el in equalities:
         counts[el.tag] += 1
-        eq_names.append((el.tag, el.get("name") or f"{el.tag}{counts[el.tag]}"))
+        eq_names.append((el.tag, el.get("name") or f"{el.tag}{counts[el.tag]}",
+                         (el.get("site1"), el.get("site2")) if el in on_sites else None))
+    body_based = {t: counts[t] - sum(1 for el in on_sites if el.tag == t) for t in counts}
     actuated = []
     for el in root.findall("actuator/*"):
         joint = el.get("joint") or el.get("jointinparent")
@@ -188,9 +198,9 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             model, points, welds = pin.buildModelAndConstraintsFromMJCF(path)
         except Exception as exc:  # Pinocchio's own exception types must not leak
             raise SpecError(source, f"Pinocchio rejects the MJCF: {exc}") from None
-    if len(points) != counts["connect"] or len(welds) != counts["weld"]:
+    if len(points) != body_based["connect"] or len(welds) != body_based["weld"]:
         raise SpecError(source, f"Pinocchio read {len(points)} connect and {len(welds)} weld constraints, the file "
-                                f"states {counts['connect']} and {counts['weld']}")
+                                f"states {body_based['connect']} and {body_based['weld']} between bodies")
 
     free = _free_bodies(model, world, degrees, source)
     if free:
@@ -212,7 +222,13 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             taken.add(site.get("name"))
     closures = []
     iters = {"connect": iter(points), "weld": iter(welds)}
-    for tag, name in eq_names:
+    for tag, name, on in eq_names:
+        if on is not None:  # the two sites coincide (connect: their origins; weld: their frames)
+            for site_name in on:
+                if site_name not in taken:
+                    raise SpecError(source, f"<equality><{tag} name={name!r}>: no site {site_name!r} on a body")
+            closures.append(Closure(name, "point" if tag == "connect" else "frame", *on))
+            continue
         cm = next(iters[tag])
         frames = []
         for end, jid, M in (("a", cm.joint1_id, cm.joint1_placement), ("b", cm.joint2_id, cm.joint2_placement)):

@@ -117,7 +117,7 @@ def compile_library(fun: cs.Function, *, follow: bool = False, directory=None) -
     """
     cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
     if cc is None:
-        return None, "CasADi's virtual machine (no C compiler on the PATH: cc, gcc or clang)"
+        return None, "no C compiler on the PATH: cc, gcc or clang"
     text = source(fun, follow=follow)
     folder = Path(directory) if directory is not None else cache_dir()
     folder.mkdir(parents=True, exist_ok=True)
@@ -132,7 +132,7 @@ def compile_library(fun: cs.Function, *, follow: bool = False, directory=None) -
             run = subprocess.run([cc, *flags, "-o", str(built), str(c_file)], capture_output=True, text=True,
                                  check=False, timeout=900)
             if run.returncode != 0:
-                return None, f"CasADi's virtual machine (the C compiler failed: {run.stderr.strip()[-300:]})"
+                return None, f"the C compiler failed: {run.stderr.strip()[-300:]}"
             os.replace(built, library)
     return ctypes.CDLL(str(library)), f"C ({Path(cc).name} {flags[0]}, {library})"
 
@@ -148,13 +148,73 @@ def count_operations(fun: cs.Function) -> dict[str, int]:
     return counts
 
 
+#: numpy expressions of CasADi's scalar operations (``a``, ``b``: the operands).
+_NUMPY = {
+    "ADD": "{a} + {b}", "SUB": "{a} - {b}", "MUL": "{a} * {b}", "DIV": "{a} / {b}", "NEG": "-{a}", "SQ": "{a} * {a}",
+    "TWICE": "2.0 * {a}", "INV": "1.0 / {a}", "ASSIGN": "{a}", "POW": "{a} ** {b}", "CONSTPOW": "{a} ** {b}",
+    "SIN": "np.sin({a})", "COS": "np.cos({a})", "TAN": "np.tan({a})", "ASIN": "np.arcsin({a})",
+    "ACOS": "np.arccos({a})", "ATAN": "np.arctan({a})", "ATAN2": "np.arctan2({a}, {b})", "SQRT": "np.sqrt({a})",
+    "EXP": "np.exp({a})", "LOG": "np.log({a})", "FABS": "np.abs({a})", "FMIN": "np.minimum({a}, {b})",
+    "FMAX": "np.maximum({a}, {b})", "FLOOR": "np.floor({a})", "CEIL": "np.ceil({a})", "FMOD": "np.fmod({a}, {b})",
+    "SIGN": "np.sign({a})", "COPYSIGN": "np.copysign({a}, {b})", "HYPOT": "np.hypot({a}, {b})",
+    "SINH": "np.sinh({a})", "COSH": "np.cosh({a})", "TANH": "np.tanh({a})",
+    "IF_ELSE_ZERO": "np.where({a} != 0, {b}, 0.0)", "LT": "1.0 * ({a} < {b})", "LE": "1.0 * ({a} <= {b})",
+    "EQ": "1.0 * ({a} == {b})", "NE": "1.0 * ({a} != {b})", "NOT": "1.0 * ({a} == 0)",
+    "AND": "1.0 * (({a} != 0) & ({b} != 0))", "OR": "1.0 * (({a} != 0) | ({b} != 0))",
+}
+
+
+def numpy_source(fun: cs.Function) -> str:
+    """Python source of ``fun`` vectorised over samples: ``def f(np, n, in0, in1, ...)`` with each input an
+    ``(n, nnz)`` array, returning the outputs as ``(n, nnz)`` arrays, one numpy statement per instruction of the
+    SX function (its work vector reused as the variables ``w0, w1, ...``).
+
+    Raises:
+        ValueError: ``fun`` is not an SX function, or uses an operation :data:`_NUMPY` lacks.
+    """
+    if not fun.is_a("SXFunction"):
+        raise ValueError(f"{fun.name()}: numpy_source needs an SX function")
+    names = {getattr(cs, f"OP_{k}"): k for k in _NUMPY}
+    ins = ", ".join(f"in{i}" for i in range(fun.n_in()))
+    lines = [f"def f(np, n, {ins}):"]
+    lines += [f"    out{i} = np.zeros((n, {fun.nnz_out(i)}))" for i in range(fun.n_out())]
+    for k in range(fun.n_instructions()):
+        op, i, o = fun.instruction_id(k), fun.instruction_input(k), fun.instruction_output(k)
+        if op == cs.OP_INPUT:
+            lines.append(f"    w{o[0]} = in{i[0]}[:, {i[1]}]")
+        elif op == cs.OP_OUTPUT:
+            lines.append(f"    out{o[0]}[:, {o[1]}] = w{i[0]}")
+        elif op == cs.OP_CONST:
+            lines.append(f"    w{o[0]} = {float(fun.instruction_constant(k))!r}")
+        elif op in names:
+            expr = _NUMPY[names[op]].format(a=f"w{i[0]}", b=f"w{i[1]}" if len(i) > 1 else "")
+            lines.append(f"    w{o[0]} = {expr}")
+        else:
+            op_name = next((n[3:] for n in dir(cs) if n.startswith("OP_") and getattr(cs, n) == op), op)
+            raise ValueError(f"{fun.name()}: the operation {op_name} has no numpy form here")
+    lines.append(f"    return [{', '.join(f'out{i}' for i in range(fun.n_out()))}]")
+    return "\n".join(lines) + "\n"
+
+
+def numpy_function(fun: cs.Function):
+    """``fun`` vectorised over samples with numpy (see :func:`numpy_source`): ``g(*inputs) -> outputs``, each an
+    ``(n, nnz)`` array."""
+    import numpy as np
+
+    namespace: dict = {}
+    exec(compile(numpy_source(fun), f"<pkm numpy {fun.name()}>", "exec"), namespace)  # source built above, no input
+    f = namespace["f"]
+    return lambda *arrays: f(np, arrays[0].shape[0], *arrays)
+
+
 def compile_function(fun: cs.Function, directory=None) -> tuple[cs.Function, str]:
     """``fun`` as compiled C loaded back as a ``casadi.Function`` (``casadi.external``) when a C compiler is present;
     else ``fun`` itself, run by CasADi's virtual machine. Returns ``(function, how)``."""
     lib, how = compile_library(fun, directory=directory)
     if lib is None:
-        return fun, how
+        return fun, f"CasADi's virtual machine ({how})"
     return cs.external(fun.name(), lib._name), how
 
 
-__all__ = ["cache_dir", "compile_function", "compile_library", "count_operations", "source"]
+__all__ = ["cache_dir", "compile_function", "compile_library", "count_operations", "numpy_function", "numpy_source",
+           "source"]

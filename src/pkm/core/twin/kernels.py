@@ -3,8 +3,9 @@ batches and warm-started along paths.
 
 :class:`Kernels` builds each kernel on first use from :class:`~pkm.core.twin.tree.Twin` (expressions after
 common-subexpression elimination), compiles it with :func:`~pkm.core.twin.codegen.compile_library` when a C compiler
-is present (:attr:`Kernels.how` says, per kernel, what runs it) and otherwise evaluates it with CasADi's virtual
-machine (``Function.map`` for batches). Every kernel takes and returns SI values in Pinocchio's conventions.
+is present (:attr:`Kernels.how` says, per kernel, what runs it); otherwise batches run as numpy vectorised over
+the samples (one numpy statement per instruction) and single samples on CasADi's virtual machine. Every kernel
+takes and returns SI values in Pinocchio's conventions.
 
 The linear solves use pivots fixed at the reference (:mod:`~pkm.core.twin.linear`). Where the smallest relative
 pivot falls under :data:`PIVOT_FLOOR`, the kernel's answer for that sample is replaced by the generic core's
@@ -21,7 +22,7 @@ import casadi as cs
 import numpy as np
 
 from pkm.core.mechanism import Mechanism, check_mechanism
-from pkm.core.twin.codegen import compile_library
+from pkm.core.twin.codegen import compile_library, numpy_function
 from pkm.core.twin.tree import Twin
 from pkm.errors import InvalidInputError
 
@@ -89,29 +90,46 @@ class PathResult:
 
 class _Kernel:
     """One function, compiled (``lib``) or not; ``__call__`` takes sample-major arrays (n x size) and returns a list
-    of sample-major outputs."""
+    of sample-major outputs: the C batch driver when compiled, else numpy vectorised over the samples
+    (:func:`~pkm.core.twin.codegen.numpy_function`; CasADi's virtual machine for one sample)."""
 
     def __init__(self, fun: cs.Function, follow: bool, compiled: bool, directory):
         self.fun = fun
         self.lib, self.how = compile_library(fun, follow=follow, directory=directory) if compiled else (
-            None, "CasADi's virtual machine (compiled=False)")
+            None, "compiled=False")
         self.in_size = [fun.nnz_in(i) for i in range(fun.n_in())]
         self.out_size = [fun.nnz_out(i) for i in range(fun.n_out())]
-        if self.lib is not None:
-            self._batch = getattr(self.lib, f"{fun.name()}_batch")
-            self._batch.argtypes = [_I, ctypes.POINTER(_P), ctypes.POINTER(_P)]
-            self._batch.restype = ctypes.c_int
-            if follow:
-                self._follow = getattr(self.lib, f"{fun.name()}_follow")
-                self._follow.argtypes = [_I, _P, _P, _P, _P, _P, ctypes.POINTER(_I), _I, ctypes.c_double]
-                self._follow.restype = ctypes.c_int
+        if self.lib is None:
+            self.how = f"numpy over samples, CasADi's virtual machine for one ({self.how})"
+            self._numpy = numpy_function(fun)
+            return
+        self._batch = getattr(self.lib, f"{fun.name()}_batch")
+        self._batch.argtypes = [_I, ctypes.POINTER(_P), ctypes.POINTER(_P)]
+        self._batch.restype = ctypes.c_int
+        if follow:
+            self._follow = getattr(self.lib, f"{fun.name()}_follow")
+            self._follow.argtypes = [_I, _P, _P, _P, _P, _P, ctypes.POINTER(_I), _I, ctypes.c_double]
+            self._follow.restype = ctypes.c_int
+        # one sample: fixed buffers and pointer arrays, so that a call costs a copy in and out
+        self._one_in = [np.zeros(n) for n in self.in_size]
+        self._one_out = [np.zeros(n) for n in self.out_size]
+        self._one_in_p = (_P * len(self._one_in))(*[a.ctypes.data_as(_P) for a in self._one_in])
+        self._one_out_p = (_P * len(self._one_out))(*[o.ctypes.data_as(_P) for o in self._one_out])
 
     def __call__(self, *arrays: np.ndarray) -> list[np.ndarray]:
         n = arrays[0].shape[0]
         if self.lib is None:
-            outs = self.fun.map(n)(*[a.T for a in arrays])
-            outs = outs if isinstance(outs, tuple) else (outs,)
-            return [np.array(o).reshape(s, n, order="F").T.copy() for o, s in zip(outs, self.out_size)]
+            if n == 1:
+                outs = self.fun(*[a[0] for a in arrays])
+                outs = outs if isinstance(outs, tuple) else (outs,)
+                return [np.array(o).reshape(1, -1, order="F") for o in outs]
+            return self._numpy(*arrays)
+        if n == 1:
+            for buf, a in zip(self._one_in, arrays):
+                buf[:] = a[0]
+            if self._batch(1, self._one_in_p, self._one_out_p):
+                raise RuntimeError(f"the compiled kernel {self.fun.name()} failed")
+            return [o[None].copy() for o in self._one_out]
         ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
         outs = [np.empty((n, s)) for s in self.out_size]
         in_p = (_P * len(ins))(*[a.ctypes.data_as(_P) for a in ins])
@@ -150,7 +168,8 @@ class Kernels:
 
     Args:
         mech: Any mechanism pkm loads, without idle motions.
-        compiled: Compile to C when a C compiler is present (default); False runs CasADi's virtual machine.
+        compiled: Compile to C when a C compiler is present (default); False runs numpy (batches) and CasADi's
+            virtual machine (one sample).
         directory: Where compiled libraries go (default :func:`pkm.core.twin.codegen.cache_dir`).
 
     Raises:

@@ -1,0 +1,135 @@
+"""Any mechanism pkm loads written as MuJoCo's MJCF: the Pinocchio tree, its inertias, the loops as equalities.
+
+:func:`mjcf_from_mechanism` writes one body per Pinocchio joint (placement and inertia as Pinocchio has them, after
+fixed joints are merged), the joint itself (``hinge``, ``slide``, ``ball``, ``free``; a universal joint as two
+hinges of one body, about its first axis and then its second; a mimic joint as a joint of its own tied to its
+leader by a ``<joint>`` equality ``q = offset + scale q_leader``), a site at each closure frame, a ``<connect>``
+(point closure) or ``<weld>`` (frame closure) between the two sites, a ``<motor>`` on each actuated joint.
+Gravity is the model's, contacts are disabled, no joint is limited (MuJoCo would add limit rows).
+
+pkm's own MJCF reader loads the file back (:mod:`pkm.core.formats.mjcf`), which tests the writer; MuJoCo reads it
+for the benchmark baseline (:mod:`pkm.bench.mujoco_baseline`). Not written: planar and other composite joints, a
+free-flyer below the root (MuJoCo allows free joints only on top-level bodies), geometry; each refusal is a
+:class:`~pkm.errors.SpecError`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+from lxml import etree
+
+from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.errors import SpecError
+
+_REVOLUTE = {"RX", "RY", "RZ", "RUBX", "RUBY", "RUBZ"}
+_PRISMATIC = {"PX", "PY", "PZ"}
+#: MuJoCo refuses moving bodies lighter than this, or with a principal inertia under ``MIN_INERTIA`` (a point
+#: mass): the compiler raises them to these bounds (``boundmass``, ``boundinertia``), which changes efforts by
+#: about ``MIN_INERTIA`` times an angular acceleration.
+MIN_MASS, MIN_INERTIA = 1e-9, 1e-12
+
+
+def _num(x) -> str:
+    return " ".join(repr(float(v)) for v in np.atleast_1d(x))
+
+
+def _pose(el: etree._Element, M: pin.SE3) -> None:
+    q = pin.Quaternion(M.rotation)
+    el.set("pos", _num(M.translation))
+    el.set("quat", _num([q.w, q.x, q.y, q.z]))
+
+
+def body_names(mech: Mechanism) -> list[str]:
+    """The MJCF body of each Pinocchio joint (index 0: ``world``): the joint's name with ``_body``."""
+    return ["world"] + [f"{mech.model.names[j]}_body" for j in range(1, mech.model.njoints)]
+
+
+def _joints(el: etree._Element, jm, name: str, source: str) -> list[str]:
+    """The MJCF joint elements of one Pinocchio joint; returns their names."""
+    kind = jm.shortname().removeprefix("JointModel")
+    if kind == "Mimic" or kind in _REVOLUTE or kind in _PRISMATIC or kind.endswith("Unaligned"):
+        jd = jm.createData()
+        jm.calc(jd, np.zeros(max(jm.idx_q + jm.nq, jm.idx_q + 1)))  # S does not depend on q for these
+        S = np.asarray(jd.S, dtype=float).reshape(6, -1)[:, 0]
+        if kind == "Mimic":
+            S = S / float(jm.extract().scaling)
+        revolute = np.abs(S[3:]).max() > 0
+        etree.SubElement(el, "joint", name=name, type="hinge" if revolute else "slide",
+                         axis=_num(S[3:] if revolute else S[:3]))
+        return [name]
+    if kind == "Universal":
+        u = jm.extract()
+        for k, axis in ((1, u.axis1), (2, u.axis2)):
+            etree.SubElement(el, "joint", name=f"{name}__{k}", type="hinge", axis=_num(np.asarray(axis, dtype=float)))
+        return [f"{name}__1", f"{name}__2"]
+    if kind == "Spherical":
+        etree.SubElement(el, "joint", name=name, type="ball")
+        return [name]
+    if kind == "FreeFlyer":
+        etree.SubElement(el, "freejoint", name=name)
+        return [name]
+    raise SpecError(source, f"joint {name!r}: MJCF has no {jm.shortname()} (pkm writes revolute, prismatic, "
+                            "universal, spherical, free-flyer and mimic joints)")
+
+
+def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None) -> str:
+    """The MJCF text of ``mech`` (see the module doc).
+
+    Raises:
+        SpecError: A joint MJCF cannot express (see the module doc).
+    """
+    mech = check_mechanism(mech)
+    model = mech.model
+    root = etree.Element("mujoco", model=model_name or model.name or "pkm")
+    etree.SubElement(root, "compiler", angle="radian", boundmass=repr(MIN_MASS), boundinertia=repr(MIN_INERTIA))
+    option = etree.SubElement(root, "option", gravity=_num(model.gravity.linear))
+    etree.SubElement(option, "flag", contact="disable")
+    world = etree.SubElement(root, "worldbody")
+    bodies: list[etree._Element] = [world]
+    names = body_names(mech)
+    equality = etree.Element("equality")
+    for j in range(1, model.njoints):
+        jm, parent = model.joints[j], int(model.parents[j])
+        if jm.shortname() == "JointModelFreeFlyer" and parent != 0:
+            raise SpecError(mech.source, f"joint {model.names[j]!r}: MuJoCo allows free joints only on bodies "
+                                         "right below the world")
+        body = etree.SubElement(bodies[parent], "body", name=names[j])
+        _pose(body, model.jointPlacements[j])
+        inertia = model.inertias[j]
+        I = inertia.inertia
+        etree.SubElement(body, "inertial", pos=_num(inertia.lever), mass=repr(max(float(inertia.mass), MIN_MASS)),
+                         fullinertia=_num([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]))
+        _joints(body, jm, model.names[j], mech.source)
+        if jm.shortname() == "JointModelMimic":
+            mimic = jm.extract()
+            leader = model.names[_leader(model, j)]
+            etree.SubElement(equality, "joint", joint1=model.names[j], joint2=leader,
+                             polycoef=_num([mimic.offset, mimic.scaling, 0, 0, 0]))
+        bodies.append(body)
+    for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
+        sites = []
+        for side, f in (("a", fa), ("b", fb)):
+            frame = model.frames[f]
+            site = etree.SubElement(bodies[frame.parentJoint], "site", name=f"{c.name}_{side}")
+            _pose(site, frame.placement)
+            sites.append(site.get("name"))
+        etree.SubElement(equality, "connect" if c.type == "point" else "weld", name=c.name, site1=sites[0],
+                         site2=sites[1])
+    root.append(equality)
+    actuator = etree.SubElement(root, "actuator")
+    for joint in mech.actuated:
+        etree.SubElement(actuator, "motor", name=f"{model.names[joint.id]}_motor", joint=model.names[joint.id])
+    return etree.tostring(root, pretty_print=True, encoding="unicode")
+
+
+def _leader(model: pin.Model, j: int) -> int:
+    """The joint a mimic joint follows: the one whose coordinates it reads."""
+    idx_q = model.joints[j].idx_q
+    for k in range(1, model.njoints):
+        if k != j and model.joints[k].shortname() != "JointModelMimic" and model.joints[k].idx_q == idx_q:
+            return k
+    raise SpecError(model.name, f"mimic joint {model.names[j]!r}: no leader found")
+
+
+__all__ = ["MIN_INERTIA", "MIN_MASS", "body_names", "mjcf_from_mechanism"]
