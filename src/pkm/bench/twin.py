@@ -6,7 +6,7 @@ actuator, all timed in this run:
 * ``hand_written_batch`` (3-PRS only, the baseline of the issue): :meth:`Prs3Dynamics.batch`, vectorised numpy;
 * ``kernel_batch_c``: :meth:`pkm.Kernels.inverse_dynamics` on the whole path at once, generated C (the C loop of
   the batch driver; the per-sample time is the C time plus one ctypes call over the path);
-* ``kernel_batch_vm``: the same kernel run by CasADi's virtual machine (``Function.map``: no compiler needed);
+* ``kernel_batch_numpy``: the same kernel run by CasADi's virtual machine (``Function.map``: no compiler needed);
 * ``kernel_call``: one sample from Python (compiled);
 * ``core``: :func:`pkm.inverse_dynamics` at a precomputed state (the generic route before the twin);
 * ``closure_path``: :meth:`pkm.Kernels.close_loops_path`, per solve, warm-started along the path (compiled), next to
@@ -102,12 +102,12 @@ def _one(name: str, args) -> dict:
     core_us = _median_us(lambda: pkm.inverse_dynamics(mech, *states[len(states) // 2]), max(20, args.calls // 20))
     closure_core_us = _median_us(lambda: pkm.close_loops(mech, QA[k + 1], Q[k]), max(20, args.calls // 20))
     diff = {"kernel_batch_c": float(np.abs(tau[idx] - core_tau).max()),
-            "kernel_batch_vm": float(np.abs(tau_vm - tau[:m]).max())}
+            "kernel_batch_numpy": float(np.abs(tau_vm - tau[:m]).max())}
     if name == "prs3":
         diff["hand_written_batch"] = float(np.abs(hand.tau[idx] - core_tau).max())
     out.update({
         "kernel_batch_c_us": c_t / n * 1e6,
-        "kernel_batch_vm_us": vm_t / m * 1e6,
+        "kernel_batch_numpy_us": vm_t / m * 1e6,
         "kernel_call_us": call_us,
         "core_us": core_us,
         "closure_path_us_per_solve": closure_t / n * 1e6,
@@ -130,7 +130,7 @@ def _one(name: str, args) -> dict:
         out["mujoco"] = reason
     if name == "prs3":
         out["ratio_to_hand_written_batch"] = {"kernel_batch_c": out["kernel_batch_c_us"] / out["hand_written_batch_us"],
-                                              "kernel_batch_vm": out["kernel_batch_vm_us"] / out["hand_written_batch_us"]}
+                                              "kernel_batch_numpy": out["kernel_batch_numpy_us"] / out["hand_written_batch_us"]}
     out["max_effort_difference_to_core"] = diff
     return out
 
@@ -145,7 +145,7 @@ def run(args) -> dict:
 
 def table(result: dict) -> str:
     rows = [("hand-written batch (3-PRS)", "hand_written_batch_us"), ("kernel batch, C", "kernel_batch_c_us"),
-            ("kernel batch, CasADi VM", "kernel_batch_vm_us"), ("kernel, one call", "kernel_call_us"),
+            ("kernel batch, numpy", "kernel_batch_numpy_us"), ("kernel, one call", "kernel_call_us"),
             ("generic core, one call", "core_us"), ("MuJoCo rigid solve", "mujoco_rigid_us"),
             ("closure path, per solve", "closure_path_us_per_solve"),
             ("close_loops, per solve", "closure_core_us_per_solve")]

@@ -147,6 +147,8 @@ def test_bad_input_is_refused_clearly():
         K.inverse_dynamics(q, np.zeros((2, 3)), np.zeros(3))
     with pytest.raises(InvalidInputError, match="different lengths"):
         K.inverse_dynamics(np.array([q, q]), np.zeros((3, 3)), np.zeros((3, 3)))
+    with pytest.raises(InvalidInputError, match="non-finite"):
+        K.inverse_dynamics(np.full_like(q, np.nan), np.zeros(3), np.zeros(3))
     with pytest.raises(InvalidInputError, match="kernel"):
         K.function("nope")
     with pytest.raises(InvalidInputError, match="targets"):

@@ -24,7 +24,7 @@ import numpy as np
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.codegen import compile_library, numpy_function
 from pkm.core.twin.tree import Twin
-from pkm.errors import InvalidInputError
+from pkm.errors import InvalidInputError, NonFiniteError
 
 #: Smallest relative pivot (:meth:`PivotedLU.smallest_relative_pivot`) at which a kernel's solve is trusted.
 PIVOT_FLOOR = 1e-6
@@ -233,23 +233,34 @@ class Kernels:
         return OperationCount(name, mul, add, counts, BOUNDARIES[name])
 
     # ---------------------------------------------------------------- evaluation
-    def _run(self, name: str, *args) -> tuple[list[np.ndarray], bool]:
-        inputs = KERNELS[name][0]
-        sizes = {"q": self.mech.model.nq, "v": self.mech.nv, "qd": self.mech.na, "qdd": self.mech.na,
-                 "target": self.mech.na, "y": self.twin.task_target.shape[0]}
-        arrays, single = [], None
-        for what, x in zip(inputs, args):
-            a = np.asarray(x, dtype=float)
-            if a.ndim not in (1, 2) or a.shape[-1] != sizes[what]:
-                raise InvalidInputError(what, f"expected ({sizes[what]},) or (n, {sizes[what]})", x)
-            if single is None:
-                single = a.ndim == 1
-            elif single != (a.ndim == 1):
-                raise InvalidInputError(what, "give every input as one sample or every input as a batch", x)
-            arrays.append(np.atleast_2d(a))
-        if len({a.shape[0] for a in arrays}) > 1:
+    def _run(self, name: str, *args, pivoted: bool = False) -> tuple[list[np.ndarray], bool]:
+        """The kernel on one sample (each input 1-D) or a batch (each 2-D, the same length); a non-finite output
+        is diagnosed: non-finite input (:class:`InvalidInputError`) or a failed evaluation (:class:`NonFiniteError`;
+        with ``pivoted``, only at samples whose pivot, the last output, is above the floor: the others are the
+        caller's to redo)."""
+        kernel = self._kernels.get(name) or self.kernel(name)
+        arrays = []
+        for what, size, x in zip(KERNELS[name][0], kernel.in_size, args):
+            a = x if type(x) is np.ndarray and x.dtype == np.float64 else np.asarray(x, dtype=float)
+            if a.ndim not in (1, 2) or a.shape[-1] != size:
+                raise InvalidInputError(what, f"expected ({size},) or (n, {size})", x)
+            arrays.append(a)
+        single = arrays[0].ndim == 1
+        if any((a.ndim == 1) != single for a in arrays):
+            raise InvalidInputError(name, "give every input as one sample or every input as a batch")
+        if single:
+            arrays = [a[None] for a in arrays]
+        elif len({a.shape[0] for a in arrays}) > 1:
             raise InvalidInputError(name, f"batches of different lengths {[a.shape[0] for a in arrays]}")
-        return self.kernel(name)(*arrays), bool(single)
+        outs = kernel(*arrays)
+        if not np.isfinite(outs[0]).all():
+            for what, a in zip(KERNELS[name][0], arrays):
+                if not np.isfinite(a).all():
+                    raise InvalidInputError(what, "holds non-finite values")
+            if pivoted and np.isfinite(outs[0][outs[-1][:, 0] >= PIVOT_FLOOR]).all():
+                return outs, single
+            raise NonFiniteError(f"kernel {name}", outs[0], "non-finite values at finite inputs (a singular state?)")
+        return outs, single
 
     def _shaped(self, name: str, outs: list[np.ndarray], single: bool) -> list[np.ndarray]:
         fun = self.kernel(name).fun
@@ -264,9 +275,9 @@ class Kernels:
         """Actuator efforts (na, or n x na) at closed configurations ``q`` (nq or n x nq) for actuated rates and
         accelerations ``qd, qdd`` (na or n x na) [N, N m]: :attr:`Twin.inverse_dynamics`, samples under the pivot
         floor recomputed by :func:`pkm.inverse_dynamics`."""
-        (tau, pivot), single = self._run("inverse_dynamics", q, qd, qdd)
-        bad = np.flatnonzero(~(pivot[:, 0] >= PIVOT_FLOOR))
-        if bad.size:
+        (tau, pivot), single = self._run("inverse_dynamics", q, qd, qdd, pivoted=True)
+        if not pivot.min() >= PIVOT_FLOOR:
+            bad = np.flatnonzero(~(pivot[:, 0] >= PIVOT_FLOOR))
             from pkm.core.differential import accelerations, velocities
             from pkm.core.dynamics import inverse_dynamics
 
