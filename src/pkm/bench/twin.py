@@ -6,7 +6,7 @@ actuator, all timed in this run:
 * ``hand_written_batch`` (3-PRS only, the baseline of the issue): :meth:`Prs3Dynamics.batch`, vectorised numpy;
 * ``kernel_batch_c``: :meth:`pkm.Kernels.inverse_dynamics` on the whole path at once, generated C (the C loop of
   the batch driver; the per-sample time is the C time plus one ctypes call over the path);
-* ``kernel_batch_numpy``: the same kernel run by CasADi's virtual machine (``Function.map``: no compiler needed);
+* ``kernel_batch_numpy``: the same kernel as numpy vectorised over the samples (what runs without a compiler);
 * ``kernel_call``: one sample from Python (compiled);
 * ``core``: :func:`pkm.inverse_dynamics` at a precomputed state (the generic route before the twin);
 * ``closure_path``: :meth:`pkm.Kernels.close_loops_path`, per solve, warm-started along the path (compiled), next to
@@ -88,9 +88,9 @@ def _one(name: str, args) -> dict:
     Q = path.q
     K.inverse_dynamics(Q[:10], QD[:10], QDD[:10])
     c_t, tau = best_time(lambda: K.inverse_dynamics(Q, QD, QDD), args.repeat)
-    vm = pkm.Kernels(mech, compiled=False)
+    numpy_route = pkm.Kernels(mech, compiled=False)
     m = min(n, 2000)
-    vm_t, tau_vm = best_time(lambda: vm.inverse_dynamics(Q[:m], QD[:m], QDD[:m]), max(1, args.repeat // 2))
+    numpy_t, tau_numpy = best_time(lambda: numpy_route.inverse_dynamics(Q[:m], QD[:m], QDD[:m]), max(1, args.repeat // 2))
     k = n // 3
     call_us = _median_us(lambda: K.inverse_dynamics(Q[k], QD[k], QDD[k]), args.calls)
     idx = np.linspace(0, n - 1, min(n, 50)).astype(int)
@@ -102,12 +102,12 @@ def _one(name: str, args) -> dict:
     core_us = _median_us(lambda: pkm.inverse_dynamics(mech, *states[len(states) // 2]), max(20, args.calls // 20))
     closure_core_us = _median_us(lambda: pkm.close_loops(mech, QA[k + 1], Q[k]), max(20, args.calls // 20))
     diff = {"kernel_batch_c": float(np.abs(tau[idx] - core_tau).max()),
-            "kernel_batch_numpy": float(np.abs(tau_vm - tau[:m]).max())}
+            "kernel_batch_numpy": float(np.abs(tau_numpy - tau[:m]).max())}
     if name == "prs3":
         diff["hand_written_batch"] = float(np.abs(hand.tau[idx] - core_tau).max())
     out.update({
         "kernel_batch_c_us": c_t / n * 1e6,
-        "kernel_batch_numpy_us": vm_t / m * 1e6,
+        "kernel_batch_numpy_us": numpy_t / m * 1e6,
         "kernel_call_us": call_us,
         "core_us": core_us,
         "closure_path_us_per_solve": closure_t / n * 1e6,
