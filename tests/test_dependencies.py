@@ -2,6 +2,7 @@
 
 A module that arrives only as another package's dependency (scipy through proxsuite, umsgpack
 through meshcat) works until that package drops it; so every import must name its own distribution.
+A benchmark baseline (the ``bench`` extra, MuJoCo) may be imported by ``pkm/bench`` alone.
 """
 
 from __future__ import annotations
@@ -51,18 +52,31 @@ def owners(module: str) -> set[str]:
             if any(f.name == origin.name and Path(d.locate_file(f)).resolve() == origin for f in d.files or ())}
 
 
+def _names(requirements) -> set[str]:
+    return {_canonical(re.split(r"[\s<>=!~;\[]", d, maxsplit=1)[0]) for d in requirements}
+
+
 def declared() -> set[str]:
     project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
-    return {_canonical(re.split(r"[\s<>=!~;\[]", d, maxsplit=1)[0]) for d in project["dependencies"]}
+    return _names(project["dependencies"])
+
+
+def benchmark_only() -> set[str]:
+    """The ``bench`` extra: baselines that only ``pkm/bench`` may import."""
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    return _names(project["optional-dependencies"]["bench"])
 
 
 def test_every_third_party_import_is_a_declared_dependency():
     third_party = {m: files for m, files in imported_modules(ROOT / "src" / "pkm").items()
                    if m not in sys.stdlib_module_names and m not in ("pkm", "__future__")}
     assert {"numpy", "pinocchio", "casadi"} <= set(third_party)  # the scan sees the imports
-    deps = declared()
+    deps, bench = declared(), benchmark_only()
     missing = {}
     for mod, files in sorted(third_party.items()):
+        if _canonical(mod) in bench:
+            assert all(f.startswith("pkm/bench/") for f in files), (mod, sorted(files))
+            continue
         dists = owners(mod)
         assert dists, f"{mod!r} (imported by {sorted(files)}) belongs to no installed distribution"
         if not dists & deps:

@@ -32,14 +32,12 @@ LARGE = 20_000
 
 _BATCH = r"""
 /* pkm drivers */
-#include <stdlib.h>
-#include <string.h>
 static const casadi_int NAME_isz[] = {ISZ}, NAME_osz[] = {OSZ};
 
 static int NAME_pkm_alloc(const casadi_real*** arg, casadi_real*** res, casadi_int** iw, casadi_real** w) {
   casadi_int sz_arg, sz_res, sz_iw, sz_w;
   NAME_work(&sz_arg, &sz_res, &sz_iw, &sz_w);
-  *arg = malloc(sizeof(casadi_real*) * (sz_arg + 1)); *res = malloc(sizeof(casadi_real*) * (sz_res + 1));
+  *arg = calloc(sz_arg + 1, sizeof(casadi_real*)); *res = calloc(sz_res + 1, sizeof(casadi_real*));
   *iw = malloc(sizeof(casadi_int) * (sz_iw + 1)); *w = malloc(sizeof(casadi_real) * (sz_w + 1));
   return !(*arg && *res && *iw && *w);
 }
@@ -88,6 +86,111 @@ int NAME_follow(casadi_int n, const casadi_real* q0, const casadi_real* targets,
 """
 
 
+_GRID = r"""
+/* pkm map driver: STEP (q, y -> q_next, step) and INDEX (q, y, scale -> K, residual, branch) over a grid of task
+   targets (dims[0] fastest), breadth first from root nodes: a node is solved from the neighbour that reached it
+   (one seed), each root from q0; its neighbours are queued with its solution. */
+static void STEP_pkm_sv(casadi_int m, casadi_int n, casadi_real* A, casadi_real* s) {
+  /* singular values (descending) of the column-major m x n matrix A (m >= n), one-sided Jacobi; A is destroyed */
+  for (int sweep = 0; sweep < 60; ++sweep) {
+    casadi_real off = 0.0;
+    for (casadi_int p = 0; p < n; ++p) for (casadi_int r = p + 1; r < n; ++r) {
+      casadi_real a = 0.0, b = 0.0, g = 0.0;
+      for (casadi_int i = 0; i < m; ++i) { a += A[p*m+i]*A[p*m+i]; b += A[r*m+i]*A[r*m+i]; g += A[p*m+i]*A[r*m+i]; }
+      if (a == 0.0 || b == 0.0 || fabs(g) <= 1e-17 * sqrt(a * b)) continue;
+      if (fabs(g) / sqrt(a * b) > off) off = fabs(g) / sqrt(a * b);
+      casadi_real z = (b - a) / (2.0 * g), t = (z >= 0 ? 1.0 : -1.0) / (fabs(z) + sqrt(1.0 + z * z));
+      casadi_real c = 1.0 / sqrt(1.0 + t * t), sn = c * t;
+      for (casadi_int i = 0; i < m; ++i) {
+        casadi_real x = A[p*m+i], y = A[r*m+i]; A[p*m+i] = c * x - sn * y; A[r*m+i] = sn * x + c * y;
+      }
+    }
+    if (off <= 1e-16) break;
+  }
+  for (casadi_int j = 0; j < n; ++j) { casadi_real a = 0.0; for (casadi_int i = 0; i < m; ++i) a += A[j*m+i]*A[j*m+i]; s[j] = sqrt(a); }
+  for (casadi_int j = 1; j < n; ++j) for (casadi_int k = j; k > 0 && s[k] > s[k-1]; --k) { casadi_real t = s[k]; s[k] = s[k-1]; s[k-1] = t; }
+}
+
+int STEP_grid(const casadi_int* dims, casadi_int ndim, const casadi_real* targets, const casadi_real* q0,
+              const casadi_real* scale, const casadi_real* signs, const casadi_int* roots, casadi_int nroots,
+              casadi_int max_iter, casadi_real step_tol, casadi_real tol,
+              signed char* state, casadi_real* sv, casadi_int* iterations) {
+  /* state: 0 not reached, 1 solved, -1 tried and failed (-2 while queued) */
+  const casadi_int nq = NQ, nt = NT, m = KROWS, n = KCOLS, nb = NB, nsv = (m < n ? m : n);
+  casadi_int total = 1, stride[3] = {1, 1, 1};
+  for (casadi_int d = 0; d < ndim; ++d) { stride[d] = total; total *= dims[d]; }
+  const casadi_real **sa, **ia; casadi_real **sr, **ir; casadi_int *siw, *iiw; casadi_real *sw, *iw_;
+  casadi_int cap = 1024, head = 0, size = 0;
+  casadi_int* qnode = malloc(sizeof(casadi_int) * cap);
+  casadi_real* qseed = malloc(sizeof(casadi_real) * cap * nq);
+  casadi_real *cur = malloc(sizeof(casadi_real) * nq), *next = malloc(sizeof(casadi_real) * nq);
+  casadi_real *K = malloc(sizeof(casadi_real) * (m * n + 1)), *Kt = malloc(sizeof(casadi_real) * (m * n + 1));
+  casadi_real *branch = malloc(sizeof(casadi_real) * (nb + 1));
+  casadi_real stepv = 0.0, resid = 0.0;
+  if (!qnode || !qseed || !cur || !next || !K || !Kt || !branch || STEP_pkm_alloc(&sa, &sr, &siw, &sw)
+      || INDEX_pkm_alloc(&ia, &ir, &iiw, &iw_)) return 2;
+  for (casadi_int k = 0; k < total; ++k) { state[k] = 0; iterations[k] = 0; for (casadi_int j = 0; j < nsv; ++j) sv[k * nsv + j] = NAN; }
+  for (casadi_int r = 0; r < nroots; ++r) {  /* each root not reached from an earlier one starts a search */
+    if (state[roots[r]] != 0) continue;
+    qnode[head] = roots[r]; memcpy(qseed + head * nq, q0, sizeof(casadi_real) * nq); size = 1; state[roots[r]] = -2;
+    while (size > 0) {
+      casadi_int k = qnode[head];
+      memcpy(cur, qseed + head * nq, sizeof(casadi_real) * nq);
+      head = (head + 1) % cap; --size;
+      const casadi_real* target = targets + k * nt;
+      int converged = 0;
+      for (casadi_int it = 0; it < max_iter; ++it) {
+        sa[0] = cur; sa[1] = target; sr[0] = next; sr[1] = &stepv;
+        if (STEP(sa, sr, siw, sw, 0)) return 1;
+        memcpy(cur, next, sizeof(casadi_real) * nq);
+        iterations[k] += 1;
+        if (!(stepv == stepv)) break;
+        if (stepv <= step_tol) { converged = 1; break; }
+      }
+      state[k] = -1;
+      if (!converged) continue;
+      ia[0] = cur; ia[1] = target; ia[2] = scale; ir[0] = K; ir[1] = &resid; ir[2] = branch;
+      if (INDEX(ia, ir, iiw, iw_, 0)) return 1;
+      if (!(resid <= tol)) continue;
+      int same = 1;
+      for (casadi_int b = 0; b < nb; ++b) if (signs[b] != 0.0 && !(signs[b] * branch[b] > 0.0)) same = 0;
+      if (!same) continue;
+      state[k] = 1;
+      if (m >= n) { memcpy(Kt, K, sizeof(casadi_real) * m * n); STEP_pkm_sv(m, n, Kt, sv + k * nsv); }
+      else {  /* K^T, column-major n x m */
+        for (casadi_int i = 0; i < m; ++i) for (casadi_int j = 0; j < n; ++j) Kt[i * n + j] = K[j * m + i];
+        STEP_pkm_sv(n, m, Kt, sv + k * nsv);
+      }
+      for (casadi_int d = 0; d < ndim; ++d) {  /* queue the neighbours not reached yet, with this solution */
+        casadi_int c = (k / stride[d]) % dims[d];
+        for (int dir = -1; dir <= 1; dir += 2) {
+          if ((dir < 0 && c == 0) || (dir > 0 && c == dims[d] - 1)) continue;
+          casadi_int nb_k = k + dir * stride[d];
+          if (state[nb_k] != 0) continue;
+          if (size == cap) {  /* grow the ring buffer, unrolled from head */
+            casadi_int* n2 = malloc(sizeof(casadi_int) * 2 * cap);
+            casadi_real* s2 = malloc(sizeof(casadi_real) * 2 * cap * nq);
+            if (!n2 || !s2) return 2;
+            for (casadi_int i = 0; i < size; ++i) {
+              n2[i] = qnode[(head + i) % cap];
+              memcpy(s2 + i * nq, qseed + ((head + i) % cap) * nq, sizeof(casadi_real) * nq);
+            }
+            free(qnode); free(qseed); qnode = n2; qseed = s2; head = 0; cap *= 2;
+          }
+          casadi_int tail = (head + size) % cap;
+          qnode[tail] = nb_k; memcpy(qseed + tail * nq, cur, sizeof(casadi_real) * nq); ++size;
+          state[nb_k] = -2;  /* queued */
+        }
+      }
+    }
+  }
+  STEP_pkm_free(sa, sr, siw, sw); INDEX_pkm_free(ia, ir, iiw, iw_);
+  free(qnode); free(qseed); free(cur); free(next); free(K); free(Kt); free(branch);
+  return 0;
+}
+"""
+
+
 def cache_dir() -> Path:
     """Where compiled twins are kept: ``$PKM_CACHE_DIR``, else ``$XDG_CACHE_HOME/pkm/twin`` (``~/.cache/pkm/twin``)."""
     if os.environ.get("PKM_CACHE_DIR"):
@@ -95,41 +198,62 @@ def cache_dir() -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "pkm" / "twin"
 
 
-def source(fun: cs.Function, *, follow: bool = False) -> str:
-    """The C source of ``fun`` (CasADi's code generator) with the batch driver, and the path driver if ``follow``."""
-    name = fun.name()
-    gen = cs.CodeGenerator(f"{name}.c", {"with_header": False})
-    gen.add(fun)
+def source(funs, *, follow: bool = False) -> str:
+    """The C source of one CasADi function or a list (CasADi's code generator, one preamble), each with its batch
+    driver, and the path driver if ``follow``."""
+    funs = [funs] if isinstance(funs, cs.Function) else list(funs)
+    gen = cs.CodeGenerator(f"{funs[0].name()}.c", {"with_header": False})
+    for fun in funs:
+        gen.add(fun)
     sizes = lambda n, f: ", ".join(str(f(i)) for i in range(n))
-    drivers = (_BATCH + (_FOLLOW if follow else "")).replace("NIN", str(fun.n_in())).replace("NOUT", str(fun.n_out()))
-    drivers = drivers.replace("ISZ", sizes(fun.n_in(), fun.nnz_in)).replace("OSZ", sizes(fun.n_out(), fun.nnz_out))
-    return gen.dump() + drivers.replace("NAME", name)
+    text = gen.dump() + "#include <math.h>\n#include <stdlib.h>\n#include <string.h>\n"
+    for fun in funs:
+        drivers = (_BATCH + (_FOLLOW if follow else "")).replace("NIN", str(fun.n_in())).replace("NOUT", str(fun.n_out()))
+        drivers = drivers.replace("ISZ", sizes(fun.n_in(), fun.nnz_in)).replace("OSZ", sizes(fun.n_out(), fun.nnz_out))
+        text += drivers.replace("NAME", fun.name())
+    return text
 
 
-def compile_library(fun: cs.Function, *, follow: bool = False, directory=None) -> tuple[ctypes.CDLL | None, str]:
-    """``fun`` and its drivers compiled and loaded. Returns ``(library, how)``; ``library`` is None, and ``how`` says
-    why, when there is no C compiler on the PATH (``cc``, ``gcc`` or ``clang``) or it failed.
+def map_source(step: cs.Function, index: cs.Function) -> str:
+    """The C source of a map: ``step`` and ``index`` (see :data:`_GRID`) with their batch drivers and the grid
+    driver ``<step>_grid``."""
+    nq, nt = step.nnz_in(0), step.nnz_in(1)
+    m, n = index.size_out(0)
+    grid = (_GRID.replace("STEP", step.name()).replace("INDEX", index.name()).replace("NQ1", str(nq))
+            .replace("NQ", str(nq)).replace("NT", str(nt)).replace("KROWS", str(m)).replace("KCOLS", str(n))
+            .replace("NB", str(index.nnz_out(2))))
+    return source([step, index]) + grid
+
+
+def compile_library(fun, *, follow: bool = False, directory=None, text: str | None = None
+                    ) -> tuple[ctypes.CDLL | None, str]:
+    """``fun`` (one CasADi function or a list) and its drivers compiled and loaded. Returns ``(library, how)``;
+    ``library`` is None, and ``how`` says why, when there is no C compiler on the PATH (``cc``, ``gcc`` or
+    ``clang``) or it failed.
 
     Args:
-        fun: A CasADi function with dense inputs and outputs.
+        fun: CasADi functions with dense inputs and outputs.
         follow: Add the path driver (``fun`` is a Newton iteration: see the module doc).
         directory: Where the source and library go (default :func:`cache_dir`).
+        text: The C source, when not :func:`source` of ``fun`` (:func:`map_source`).
     """
+    funs = [fun] if isinstance(fun, cs.Function) else list(fun)
     cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
     if cc is None:
         return None, "no C compiler on the PATH: cc, gcc or clang"
-    text = source(fun, follow=follow)
+    text = source(funs, follow=follow) if text is None else text
     folder = Path(directory) if directory is not None else cache_dir()
     folder.mkdir(parents=True, exist_ok=True)
-    flags = ("-O2" if fun.n_instructions() <= LARGE else "-O0", *_FLAGS)
+    flags = ("-O2" if sum(f.n_instructions() for f in funs) <= LARGE else "-O0", *_FLAGS)
     digest = hashlib.sha256((text + " ".join(flags)).encode()).hexdigest()[:20]
-    library = folder / f"{fun.name()}-{digest}.so"
+    name = funs[0].name()
+    library = folder / f"{name}-{digest}.so"
     if not library.exists():
         with tempfile.TemporaryDirectory(dir=folder) as tmp:  # compiled aside, then moved: safe for parallel builds
-            c_file = Path(tmp) / f"{fun.name()}.c"
+            c_file = Path(tmp) / f"{name}.c"
             c_file.write_text(text)
             built = Path(tmp) / library.name
-            run = subprocess.run([cc, *flags, "-o", str(built), str(c_file)], capture_output=True, text=True,
+            run = subprocess.run([cc, *flags, "-o", str(built), str(c_file), "-lm"], capture_output=True, text=True,
                                  check=False, timeout=900)
             if run.returncode != 0:
                 return None, f"the C compiler failed: {run.stderr.strip()[-300:]}"
@@ -216,5 +340,5 @@ def compile_function(fun: cs.Function, directory=None) -> tuple[cs.Function, str
     return cs.external(fun.name(), lib._name), how
 
 
-__all__ = ["cache_dir", "compile_function", "compile_library", "count_operations", "numpy_function", "numpy_source",
-           "source"]
+__all__ = ["cache_dir", "compile_function", "compile_library", "count_operations", "map_source", "numpy_function",
+           "numpy_source", "source"]

@@ -198,16 +198,18 @@ class Kernels:
                  "forward_jacobian": lambda: {"J": tw.forward_jacobian},
                  "inverse_jacobian": lambda: {"J": tw.inverse_jacobian},
                  "closure_newton": lambda: tw.closure_newton, "ik_newton": lambda: tw.ik_newton,
+                 "map_newton": lambda: tw.map_newton, "map_indices": lambda: tw.map_indices,
                  }[name]()
         assert tuple(exprs) == outputs
-        sym = {"q": tw.q, "v": tw.v, "qd": tw.qd, "qdd": tw.qdd, "target": tw.target, "y": tw.task_target}
+        sym = {"q": tw.q, "v": tw.v, "qd": tw.qd, "qdd": tw.qdd, "target": tw.target, "y": tw.task_target,
+               "scale": tw.scale}
         values = cs.cse([cs.densify(cs.SX(e)) for e in exprs.values()])
         return cs.Function(f"pkm_{name}", [sym[i] for i in inputs], values, list(inputs), list(outputs))
 
     def kernel(self, name: str) -> _Kernel:
         """The kernel ``name`` (built, and compiled, on first use)."""
         if name not in self._kernels:
-            self._kernels[name] = _Kernel(self.function(name), name.endswith("_newton"), self.compiled,
+            self._kernels[name] = _Kernel(self.function(name), name in _PATHS, self.compiled,
                                           self.directory)
         return self._kernels[name]
 
@@ -353,6 +355,8 @@ class Kernels:
         return PathResult(Q, res, its, tuple(fallback), kernel.how)
 
 
+_PATHS = ("closure_newton", "ik_newton")  # the kernels with the path driver
+
 #: Each kernel's inputs and outputs.
 KERNELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "inverse_dynamics": (("q", "qd", "qdd"), ("tau", "pivot")),
@@ -363,6 +367,8 @@ KERNELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "inverse_jacobian": (("q",), ("J",)),
     "closure_newton": (("q", "target"), ("q_next", "residual", "pivot")),
     "ik_newton": (("q", "y"), ("q_next", "residual", "pivot")),
+    "map_newton": (("q", "y"), ("q_next", "step")),
+    "map_indices": (("q", "y", "scale"), ("K", "residual", "branch")),
 }
 
 __all__ = ["KERNELS", "PIVOT_FLOOR", "Kernels", "PathResult"]

@@ -446,6 +446,36 @@ class Twin:
                 "pivot": self.ik_lu.smallest_relative_pivot()}
 
     @functools.cached_property
+    def map_newton(self) -> dict:
+        """The Newton iteration of the maps (:mod:`pkm.core.maps`): ``q_next`` as :attr:`ik_newton`, ``step`` the
+        largest entry of the step (no residual at the new iterate: convergence is tested on the step, then on
+        :attr:`map_indices`' residual)."""
+        rhs = cs.vertcat(-self._rotated(self.closure_residual), self.task_error)
+        step = self._on_free(self.ik_lu.solve(rhs))
+        return {"q_next": self.retract(step), "step": cs.mmax(cs.fabs(step))}
+
+    @functools.cached_property
+    def scale(self):
+        """The symbol of the task rates' scales (task size): :attr:`map_indices` homogenises with ``K diag(scale)``."""
+        return cs.SX.sym("scale", self.task_jacobian.shape[0])
+
+    @functools.cached_property
+    def map_indices(self) -> dict:
+        """What a map needs at a solved node: ``K`` (na x task size), :attr:`inverse_jacobian` times
+        ``diag(scale)``; ``residual`` (the largest closure residual or task error at ``q``); ``branch``, the quantities
+        whose signs define the default branch (the sine of a revolute coordinate, a prismatic coordinate)."""
+        mech = self.mech
+        branch = []
+        if mech.spec.default_branch is not None:
+            for name in mech.branch().signs:
+                j = mech.joints[name]
+                x = self.q[j.idx_q]
+                branch.append(cs.sin(x) if j.revolute else x)
+        return {"K": self.inverse_jacobian @ cs.diag(self.scale),
+                "residual": cs.mmax(cs.fabs(cs.vertcat(self.closure_residual, self.task_error))),
+                "branch": cs.vertcat(*branch) if branch else cs.SX(0, 1)}
+
+    @functools.cached_property
     def forward_jacobian(self):
         """Task rates per actuated rate (task size x na): ``J_task G``."""
         return self.task_jacobian @ self.passive_map
@@ -511,7 +541,7 @@ class Twin:
     def function(self, name: str, outputs: dict, inputs: tuple[str, ...] = ("q", "v", "a")) -> cs.Function:
         """``casadi.Function(name, inputs, outputs)`` over the twin's symbols."""
         sym = {"q": self.q, "v": self.v, "a": self.a, "qd": self.qd, "qdd": self.qdd, "target": self.target,
-               "y": self.task_target}
+               "y": self.task_target, "scale": self.scale}
         return cs.Function(name, [sym[i] for i in inputs], list(outputs.values()), list(inputs), list(outputs))
 
 

@@ -1,0 +1,219 @@
+"""Maps of any mechanism over a grid of task coordinates: the reachable workspace in one working mode and the
+velocity map's indices at every reachable node, through the twin's compiled kernels.
+
+:func:`task_map` solves the inverse kinematics at every node of a grid of one, two or three task coordinates (the
+others fixed), breadth first from the node nearest the seed configuration: each node's Newton iteration starts from
+the solution of the neighbour that reached it, so that the whole reachable region connected to the seed is covered
+in the seed's working mode; a node whose solution leaves that mode (the default branch's signs) counts as not
+reached. Roots on a coarse sub-grid (every :data:`ROOT_STRIDE` nodes, seeded from the seed configuration) start
+new searches for parts of the workspace that are not connected to the first: a part narrower than that, or one
+the seed's Newton iteration does not reach in its mode, is missed.
+
+At a reachable node the map keeps the singular values of ``K diag(s)``: ``K`` the inverse Jacobian (actuated
+rates per task rate), ``s`` the task rates' scales (1 for lengths, ``1/L`` for angles: the homogenisation by a
+characteristic length ``L``). The indices follow from them (:class:`TaskGridMap`): the condition index
+``1/kappa`` in the conventions of :mod:`pkm.core.indices` (``"2"``: ``sigma_min / sigma_max``;
+``"fro_normalized"``: ``n / (||K||_F ||K^-1||_F)``), the global condition index over a region, Yoshikawa's
+manipulability of the forward Jacobian ``J = K^-1`` and its smallest singular value (both 0 at an inverse
+singularity: graded singularity measures), the workspace's size.
+
+Newton's convergence is tested on the step (``max |dq| <= step_tol``), then the residual at the node on every
+equation (closure and task, ``<= tol``).
+"""
+
+from __future__ import annotations
+
+import ctypes
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.task import TaskMap
+from pkm.errors import InvalidInputError
+
+#: Spacing of the root nodes that start a new search where the first did not reach.
+ROOT_STRIDE = 16
+#: Grids larger than this are refused (memory: the singular values and states of every node).
+MAX_NODES = 50_000_000
+KINDS = ("2", "fro_normalized")
+
+_P = ctypes.POINTER(ctypes.c_double)
+_I = ctypes.c_longlong
+
+
+@dataclass(frozen=True, eq=False)
+class TaskGridMap:
+    """A map over a grid of task coordinates (see the module doc).
+
+    Attributes:
+        axes: ``(name, values)`` per grid axis, the first the fastest; arrays are shaped ``(n_last, ..., n_first)``
+            (rows along the second axis, as :func:`numpy.meshgrid`).
+        fixed: The other task coordinates (the task value laid out as :meth:`TaskMap.value`).
+        scale: The task rates' scales (1 for lengths, ``1/L`` for angles).
+        reachable: Solved nodes in the working mode.
+        singular_values: Of ``K diag(scale)`` per node, descending (NaN where unreachable).
+        iterations: Newton iterations per node.
+        how: What ran the kernels.
+    """
+
+    axes: tuple[tuple[str, np.ndarray], ...]
+    fixed: np.ndarray = field(repr=False)
+    scale: np.ndarray
+    reachable: np.ndarray = field(repr=False)
+    singular_values: np.ndarray = field(repr=False)
+    iterations: np.ndarray = field(repr=False)
+    how: str = ""
+
+    @property
+    def nodes(self) -> int:
+        return int(self.reachable.sum())
+
+    @property
+    def cell(self) -> float:
+        """The size of one grid cell: the product of the axes' steps (m, m^2, m^3 or with rad)."""
+        return float(np.prod([abs(v[1] - v[0]) if len(v) > 1 else 1.0 for _, v in self.axes]))
+
+    @property
+    def size(self) -> float:
+        """The reachable region's length, area or volume: reachable nodes times :attr:`cell`."""
+        return self.nodes * self.cell
+
+    def condition_index(self, kind: str = "2") -> np.ndarray:
+        """``1/kappa`` of ``K diag(scale)`` per node (NaN where unreachable; 0 at a singularity)."""
+        s = self.singular_values
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if kind == "2":
+                out = s[..., -1] / s[..., 0]
+            elif kind == "fro_normalized":
+                out = s.shape[-1] / np.sqrt(np.sum(s * s, axis=-1) * np.sum(1.0 / (s * s), axis=-1))
+            else:
+                raise InvalidInputError("kind", f"use one of {KINDS}", kind)
+        return np.where(self.reachable, np.nan_to_num(out, nan=0.0, posinf=0.0), np.nan)
+
+    def manipulability(self) -> np.ndarray:
+        """Yoshikawa's ``sqrt(det(J J^T))`` of the forward Jacobian ``J = (K diag(scale))^-1`` (square maps)."""
+        with np.errstate(divide="ignore"):
+            return np.where(self.reachable, 1.0 / np.prod(self.singular_values, axis=-1), np.nan)
+
+    def sigma_min(self) -> np.ndarray:
+        """The smallest singular value of ``J = (K diag(scale))^-1``: ``1 / sigma_max(K diag(scale))``."""
+        return np.where(self.reachable, 1.0 / self.singular_values[..., 0], np.nan)
+
+    def gci(self, kind: str = "2", region=None) -> float | None:
+        """The mean condition index over the reachable nodes of ``region`` (a boolean mask; default all): the
+        global condition index as a node average. None when no node of the region is reachable."""
+        ci = self.condition_index(kind)
+        mask = self.reachable if region is None else self.reachable & np.asarray(region, dtype=bool)
+        return float(ci[mask].mean()) if mask.any() else None
+
+
+def _library(mech: Mechanism, kernels):
+    from pkm.core.twin.codegen import compile_library, map_source
+
+    step, index = kernels.function("map_newton"), kernels.function("map_indices")
+    lib, how = compile_library([step, index], directory=kernels.directory, text=map_source(step, index))
+    if lib is None:
+        raise RuntimeError(f"maps need a C compiler ({how})")
+    grid = getattr(lib, f"{step.name()}_grid")
+    grid.argtypes = [ctypes.POINTER(_I), _I, _P, _P, _P, _P, ctypes.POINTER(_I), _I, _I, ctypes.c_double,
+                     ctypes.c_double, ctypes.POINTER(ctypes.c_byte), _P, ctypes.POINTER(_I)]
+    grid.restype = ctypes.c_int
+    return grid, index.size_out(0), how
+
+
+def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, object] | None = None, *,
+             branch: str | None = None, length: float | None = None, seed=None, tol: float = 1e-10,
+             step_tol: float = 1e-8, max_iter: int = 12, kernels=None) -> TaskGridMap:
+    """The map of ``mech`` over the grid ``axes`` (see the module doc).
+
+    Args:
+        mech: Any mechanism pkm loads, without idle motions, whose task has as many coordinates as it has degrees
+            of freedom.
+        axes: Task coordinate name -> values (SI) of 1 to 3 axes, the first the fastest; names among
+            :attr:`TaskMap.keys` that are entries of the task value (a pose task's ``x y z``).
+        fixed: The other task coordinates by name (the rest from the seed configuration).
+        branch: The working mode (default: the spec's default branch); its signs are checked at every node.
+        length: Characteristic length ``L`` [m] dividing the angular task rates; needed when the task mixes lengths
+            and angles.
+        seed: A configuration in the working mode to start from (default: the reference, or the branch's seed).
+        tol: Largest residual of any equation at a solved node [m, rad].
+        step_tol: Newton's convergence test on the step [m, rad].
+        max_iter: Newton iterations allowed per node.
+        kernels: A :class:`pkm.Kernels` of ``mech`` to reuse.
+
+    Raises:
+        InvalidInputError: bad axes, a missing ``length``, or a grid beyond :data:`MAX_NODES`.
+    """
+    from pkm.core.twin import Kernels
+
+    mech = check_mechanism(mech)
+    task = TaskMap(mech)
+    kernels = Kernels(mech) if kernels is None else kernels
+    if not isinstance(axes, Mapping) or not 1 <= len(axes) <= 3:
+        raise InvalidInputError("axes", "give 1 to 3 task coordinates as {name: values}", axes)
+    names = list(task.value_names)
+    grid_axes = []
+    for name, values in axes.items():
+        if name not in task.keys or name not in names:
+            raise InvalidInputError("axes", f"{name!r} is not a task coordinate a grid can run along: use one of "
+                                            f"{[k for k in task.keys if k in names]}", name)
+        v = np.asarray(values, dtype=float).ravel()
+        if v.size == 0 or not np.all(np.isfinite(v)):
+            raise InvalidInputError("axes", f"{name!r}: give finite values (SI)", values)
+        grid_axes.append((name, v))
+    dims = [len(v) for _, v in grid_axes]
+    total = int(np.prod(dims))
+    if total > MAX_NODES:
+        raise InvalidInputError("axes", f"{total} nodes exceed {MAX_NODES}; map in parts", dims)
+    q0 = mech.q_reference.copy() if seed is None else mech.check_q(seed, "seed")
+    base = task.parse(dict(fixed or {}), base=q0)
+    kinds = [task.kinds[k] for k in task.keys]
+    if "angle" in kinds and "length" in kinds and length is None:
+        raise InvalidInputError("length", "the task mixes lengths and angles: give the characteristic length L [m] "
+                                          "that homogenises the angular rates")
+    tangent_kinds = [task.kinds[k] for k in task.keys]  # (a pose's tangent: x y z then three angles, as its keys)
+    scale = np.array([1.0 if k == "length" else 1.0 / (length or 1.0) for k in tangent_kinds])
+
+    targets = np.empty((total, len(base)))
+    targets[:] = base
+    mesh = np.meshgrid(*[v for _, v in grid_axes], indexing="ij")  # axis 0 first: flattened below, axis 0 fastest
+    for (name, _), m in zip(grid_axes, mesh):
+        targets[:, names.index(name)] = m.ravel(order="F")
+    signs = np.zeros(0)
+    if mech.spec.default_branch is not None:
+        chosen = mech.branch(branch)
+        default = mech.branch()
+        if set(chosen.signs) != set(default.signs):
+            raise InvalidInputError("branch", f"branch {chosen.name!r} fixes other joints than the default branch")
+        signs = np.array([float(chosen.signs[n]) for n in default.signs])
+        if branch is not None and seed is None:
+            from pkm.core.solve import branch_seed
+
+            q0 = branch_seed(mech, chosen.name)
+    y0 = task.value(q0)
+    first = int(np.argmin(np.sum((targets - y0) ** 2, axis=1)))
+    coarse = np.meshgrid(*[np.arange(0, n, ROOT_STRIDE) for n in dims], indexing="ij")
+    strides = np.cumprod([1] + dims[:-1])
+    roots = np.concatenate([[first], sum(c.ravel() * s for c, s in zip(coarse, strides))]).astype(np.int64)
+
+    grid, (m, n), how = _library(mech, kernels)
+    nsv = min(m, n)
+    state = np.zeros(total, dtype=np.int8)
+    sv = np.empty((total, nsv))
+    its = np.zeros(total, dtype=np.int64)
+    c_dims = np.array(dims, dtype=np.int64)
+    arrays = [np.ascontiguousarray(a, dtype=float) for a in (targets, q0, scale, signs if signs.size else np.zeros(1))]
+    flag = grid(c_dims.ctypes.data_as(ctypes.POINTER(_I)), len(dims), *[a.ctypes.data_as(_P) for a in arrays],
+                roots.ctypes.data_as(ctypes.POINTER(_I)), len(roots), max_iter, step_tol, tol,
+                state.ctypes.data_as(ctypes.POINTER(ctypes.c_byte)), sv.ctypes.data_as(_P),
+                its.ctypes.data_as(ctypes.POINTER(_I)))
+    if flag:
+        raise RuntimeError(f"the map driver failed (code {flag})")
+    shape = tuple(reversed(dims))
+    return TaskGridMap(tuple(grid_axes), base, scale, (state == 1).reshape(shape), sv.reshape(shape + (nsv,)),
+                       its.reshape(shape), how)
+
+
+__all__ = ["KINDS", "MAX_NODES", "ROOT_STRIDE", "TaskGridMap", "task_map"]
