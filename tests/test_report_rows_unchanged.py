@@ -2,7 +2,8 @@
 ours within 1e-12 relative of the rows saved before it (``tests/data/report_rows_before_issue13.json``), except the
 rows that are the location of an optimum found by a solver to a stated accuracy: those within that accuracy (one
 closed form of the arm-and-rod leg for the Delta and the hexapod moved them by 3e-10..4e-8 relative). Rows added
-since (:data:`ADDED`) are left out of the comparison."""
+since (:data:`ADDED`) are left out of the comparison, rows corrected since (:data:`CORRECTED`) compared within
+their correction."""
 
 from __future__ import annotations
 
@@ -22,6 +23,11 @@ SOLVER_ACCURACY = {
     "delta.fig5.R_min_K2_mm": 1e3 * 1e-10,  # radius_minimising_condition: bounded Brent, xatol 1e-10 m
 }
 
+#: Rows corrected since, with how far they moved: the 3-RRR closed-form CI was 1 instead of 0 at nodes exactly on an
+#: inverse singularity (a straight elbow, sin = 1e-17; two of Fig. 5's 214,742 nodes), found by the generic route of
+#: issue 15 (tests/core/test_maps.py).
+CORRECTED = {"rrr3.fig5.gci": 1e-5, "rrr3.fig5.gci_area": 1e-4}
+
 #: Rows added since, by the issue that names them (each paper's rows before them keep their order).
 ADDED = {"prs3.opcount.generic_mul", "prs3.opcount.generic_add", "delta.opcount.mul", "delta.opcount.add",
          "hexapod.opcount.mul", "hexapod.opcount.add"}  # issue 15
@@ -37,6 +43,9 @@ def test_rows_equal_the_rows_before_the_architecture_change(paper):
         assert (row.published, row.unit, row.matches) == (old["published"], old["unit"], old["matches"]), row.id
         new = row.computed
         if isinstance(new, float) and isinstance(old["computed"], (int, float)) and not isinstance(new, bool):
+            if row.id in CORRECTED:
+                assert 0 < abs(new - old["computed"]) <= CORRECTED[row.id], (row.id, new, old["computed"])
+                continue
             assert math.isclose(new, old["computed"], rel_tol=1e-12, abs_tol=SOLVER_ACCURACY.get(row.id, 1e-300)), \
                 (row.id, new, old["computed"])
         else:

@@ -35,6 +35,8 @@ from pkm.errors import InvalidInputError
 
 #: Spacing of the root nodes that start a new search where the first did not reach.
 ROOT_STRIDE = 16
+#: Where the fixed-pivot LU's smallest relative pivot falls under this, the Newton step is taken by QR instead.
+PIVOT_FLOOR = 1e-3
 #: Grids larger than this are refused (memory: the singular values and states of every node).
 MAX_NODES = 50_000_000
 KINDS = ("2", "fro_normalized")
@@ -112,8 +114,9 @@ class TaskGridMap:
 def _library(mech: Mechanism, kernels):
     from pkm.core.twin.codegen import compile_library, map_source
 
-    step, index = kernels.function("map_newton"), kernels.function("map_indices")
-    lib, how = compile_library([step, index], directory=kernels.directory, text=map_source(step, index))
+    step, qr_step, index = (kernels.function(k) for k in ("map_newton", "map_newton_qr", "map_indices"))
+    lib, how = compile_library([step, qr_step, index], directory=kernels.directory,
+                               text=map_source(step, qr_step, index, PIVOT_FLOOR))
     if lib is None:
         raise RuntimeError(f"maps need a C compiler ({how})")
     grid = getattr(lib, f"{step.name()}_grid")
@@ -125,7 +128,7 @@ def _library(mech: Mechanism, kernels):
 
 def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, object] | None = None, *,
              branch: str | None = None, length: float | None = None, seed=None, tol: float = 1e-10,
-             step_tol: float = 1e-8, max_iter: int = 12, kernels=None) -> TaskGridMap:
+             step_tol: float = 1e-8, max_iter: int = 40, kernels=None) -> TaskGridMap:
     """The map of ``mech`` over the grid ``axes`` (see the module doc).
 
     Args:
@@ -140,7 +143,9 @@ def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, ob
         seed: A configuration in the working mode to start from (default: the reference, or the branch's seed).
         tol: Largest residual of any equation at a solved node [m, rad].
         step_tol: Newton's convergence test on the step [m, rad].
-        max_iter: Newton iterations allowed per node.
+        max_iter: Newton iterations allowed per node; a node whose step stops shrinking (by 10 % an iteration
+            from the third) is given up earlier. Near an inverse singularity the root is (nearly) double and the
+            step only halves: those nodes take tens of iterations.
         kernels: A :class:`pkm.Kernels` of ``mech`` to reuse.
 
     Raises:
@@ -216,4 +221,4 @@ def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, ob
                        its.reshape(shape), how)
 
 
-__all__ = ["KINDS", "MAX_NODES", "ROOT_STRIDE", "TaskGridMap", "task_map"]
+__all__ = ["KINDS", "MAX_NODES", "PIVOT_FLOOR", "ROOT_STRIDE", "TaskGridMap", "task_map"]

@@ -26,6 +26,10 @@ from pathlib import Path
 import casadi as cs
 
 _FLAGS = ("-shared", "-fPIC")
+#: A branch quantity (the sine of an elbow) this close to 0 lies on the boundary between working modes: a map counts
+#: the node in both. (Newton locates a double root, where the elbow is straight, to about the square root of the
+#: machine precision: the sign of a sine under 1e-6 there is noise.)
+BRANCH_TOL = 1e-6
 #: Functions with more instructions than this are compiled with ``-O0``: gcc 12's ``-O2`` takes 40 s on the hexapod's
 #: 52,000-instruction derivatives (one basic block), ``-O0`` 2.5 s.
 LARGE = 20_000
@@ -87,9 +91,10 @@ int NAME_follow(casadi_int n, const casadi_real* q0, const casadi_real* targets,
 
 
 _GRID = r"""
-/* pkm map driver: STEP (q, y -> q_next, step) and INDEX (q, y, scale -> K, residual, branch) over a grid of task
-   targets (dims[0] fastest), breadth first from root nodes: a node is solved from the neighbour that reached it
-   (one seed), each root from q0; its neighbours are queued with its solution. */
+/* pkm map driver: STEP (q, y -> q_next, step, pivot), its fallback QRSTEP (q, y -> q_next, step: taken where
+   STEP's smallest relative pivot is under PIVOT_FLOOR) and INDEX (q, y, scale -> K, residual, branch) over a grid of
+   task targets (dims[0] fastest), breadth first from root nodes: a node is solved from the neighbour that reached
+   it (one seed), each root from q0; its neighbours are queued with its solution. */
 static void STEP_pkm_sv(casadi_int m, casadi_int n, casadi_real* A, casadi_real* s) {
   /* singular values (descending) of the column-major m x n matrix A (m >= n), one-sided Jacobi; A is destroyed */
   for (int sweep = 0; sweep < 60; ++sweep) {
@@ -115,7 +120,8 @@ int STEP_grid(const casadi_int* dims, casadi_int ndim, const casadi_real* target
               const casadi_real* scale, const casadi_real* signs, const casadi_int* roots, casadi_int nroots,
               casadi_int max_iter, casadi_real step_tol, casadi_real tol,
               signed char* state, casadi_real* sv, casadi_int* iterations) {
-  /* state: 0 not reached, 1 solved, -1 tried and failed (-2 while queued) */
+  /* state: 0 not reached, 1 solved, -3 failed (not converged, or in another mode), -2 queued; a node is queued
+     by each solved neighbour (2 ndim tries at most) until one solves it */
   const casadi_int nq = NQ, nt = NT, m = KROWS, n = KCOLS, nb = NB, nsv = (m < n ? m : n);
   casadi_int total = 1, stride[3] = {1, 1, 1};
   for (casadi_int d = 0; d < ndim; ++d) { stride[d] = total; total *= dims[d]; }
@@ -126,35 +132,46 @@ int STEP_grid(const casadi_int* dims, casadi_int ndim, const casadi_real* target
   casadi_real *cur = malloc(sizeof(casadi_real) * nq), *next = malloc(sizeof(casadi_real) * nq);
   casadi_real *K = malloc(sizeof(casadi_real) * (m * n + 1)), *Kt = malloc(sizeof(casadi_real) * (m * n + 1));
   casadi_real *branch = malloc(sizeof(casadi_real) * (nb + 1));
-  casadi_real stepv = 0.0, resid = 0.0;
+  casadi_real stepv = 0.0, resid = 0.0, pivot = 0.0;
+  const casadi_real **qa; casadi_real **qr; casadi_int *qiw; casadi_real *qw;
   if (!qnode || !qseed || !cur || !next || !K || !Kt || !branch || STEP_pkm_alloc(&sa, &sr, &siw, &sw)
-      || INDEX_pkm_alloc(&ia, &ir, &iiw, &iw_)) return 2;
+      || INDEX_pkm_alloc(&ia, &ir, &iiw, &iw_) || QRSTEP_pkm_alloc(&qa, &qr, &qiw, &qw)) return 2;
+  unsigned char* tries = calloc((size_t) total, 1);
+  if (!tries) return 2;
   for (casadi_int k = 0; k < total; ++k) { state[k] = 0; iterations[k] = 0; for (casadi_int j = 0; j < nsv; ++j) sv[k * nsv + j] = NAN; }
   for (casadi_int r = 0; r < nroots; ++r) {  /* each root not reached from an earlier one starts a search */
     if (state[roots[r]] != 0) continue;
     qnode[head] = roots[r]; memcpy(qseed + head * nq, q0, sizeof(casadi_real) * nq); size = 1; state[roots[r]] = -2;
+    ++tries[roots[r]];
     while (size > 0) {
       casadi_int k = qnode[head];
       memcpy(cur, qseed + head * nq, sizeof(casadi_real) * nq);
       head = (head + 1) % cap; --size;
+      if (state[k] == 1) continue;  /* solved from an earlier entry */
       const casadi_real* target = targets + k * nt;
-      int converged = 0;
+      casadi_real previous = INFINITY;
       for (casadi_int it = 0; it < max_iter; ++it) {
-        sa[0] = cur; sa[1] = target; sr[0] = next; sr[1] = &stepv;
+        sa[0] = cur; sa[1] = target; sr[0] = next; sr[1] = &stepv; sr[2] = &pivot;
         if (STEP(sa, sr, siw, sw, 0)) return 1;
-        memcpy(cur, next, sizeof(casadi_real) * nq);
+        if (!(pivot >= PIVOT_FLOOR)) {
+          qa[0] = cur; qa[1] = target; qr[0] = next; qr[1] = &stepv;
+          if (QRSTEP(qa, qr, qiw, qw, 0)) return 1;
+        }
         iterations[k] += 1;
-        if (!(stepv == stepv)) break;
-        if (stepv <= step_tol) { converged = 1; break; }
+        if (!(stepv <= INFINITY)) break;  /* a singular matrix at the root: keep the last finite iterate */
+        memcpy(cur, next, sizeof(casadi_real) * nq);
+        if (stepv <= step_tol) break;
+        if (it >= 2 && stepv > 0.9 * previous) break;  /* not converging (a singular root still halves its step) */
+        previous = stepv;
       }
-      state[k] = -1;
-      if (!converged) continue;
+      state[k] = -3;  /* failed from this seed: another neighbour may do better */
+      /* converged, stalled or stopped: the residual decides (a double root stalls at a residual of 1e-16) */
       ia[0] = cur; ia[1] = target; ia[2] = scale; ir[0] = K; ir[1] = &resid; ir[2] = branch;
       if (INDEX(ia, ir, iiw, iw_, 0)) return 1;
       if (!(resid <= tol)) continue;
-      int same = 1;
-      for (casadi_int b = 0; b < nb; ++b) if (signs[b] != 0.0 && !(signs[b] * branch[b] > 0.0)) same = 0;
-      if (!same) continue;
+      int same = 1;  /* (a branch quantity within BRANCH_TOL of 0: on the boundary between modes, in both) */
+      for (casadi_int b = 0; b < nb; ++b) if (signs[b] != 0.0 && !(signs[b] * branch[b] > -BRANCH_TOL)) same = 0;
+      if (!same) continue;  /* solved in another mode */
       state[k] = 1;
       if (m >= n) { memcpy(Kt, K, sizeof(casadi_real) * m * n); STEP_pkm_sv(m, n, Kt, sv + k * nsv); }
       else {  /* K^T, column-major n x m */
@@ -166,7 +183,7 @@ int STEP_grid(const casadi_int* dims, casadi_int ndim, const casadi_real* target
         for (int dir = -1; dir <= 1; dir += 2) {
           if ((dir < 0 && c == 0) || (dir > 0 && c == dims[d] - 1)) continue;
           casadi_int nb_k = k + dir * stride[d];
-          if (state[nb_k] != 0) continue;
+          if (state[nb_k] == 1 || tries[nb_k] >= 2 * ndim) continue;  /* (queued again: tried from each side) */
           if (size == cap) {  /* grow the ring buffer, unrolled from head */
             casadi_int* n2 = malloc(sizeof(casadi_int) * 2 * cap);
             casadi_real* s2 = malloc(sizeof(casadi_real) * 2 * cap * nq);
@@ -179,13 +196,13 @@ int STEP_grid(const casadi_int* dims, casadi_int ndim, const casadi_real* target
           }
           casadi_int tail = (head + size) % cap;
           qnode[tail] = nb_k; memcpy(qseed + tail * nq, cur, sizeof(casadi_real) * nq); ++size;
-          state[nb_k] = -2;  /* queued */
+          state[nb_k] = -2; ++tries[nb_k];  /* queued */
         }
       }
     }
   }
-  STEP_pkm_free(sa, sr, siw, sw); INDEX_pkm_free(ia, ir, iiw, iw_);
-  free(qnode); free(qseed); free(cur); free(next); free(K); free(Kt); free(branch);
+  STEP_pkm_free(sa, sr, siw, sw); INDEX_pkm_free(ia, ir, iiw, iw_); QRSTEP_pkm_free(qa, qr, qiw, qw);
+  free(tries); free(qnode); free(qseed); free(cur); free(next); free(K); free(Kt); free(branch);
   return 0;
 }
 """
@@ -214,15 +231,15 @@ def source(funs, *, follow: bool = False) -> str:
     return text
 
 
-def map_source(step: cs.Function, index: cs.Function) -> str:
-    """The C source of a map: ``step`` and ``index`` (see :data:`_GRID`) with their batch drivers and the grid
-    driver ``<step>_grid``."""
+def map_source(step: cs.Function, qr_step: cs.Function, index: cs.Function, pivot_floor: float) -> str:
+    """The C source of a map: ``step``, its fallback ``qr_step`` and ``index`` (see :data:`_GRID`) with their batch
+    drivers and the grid driver ``<step>_grid``."""
     nq, nt = step.nnz_in(0), step.nnz_in(1)
     m, n = index.size_out(0)
-    grid = (_GRID.replace("STEP", step.name()).replace("INDEX", index.name()).replace("NQ1", str(nq))
-            .replace("NQ", str(nq)).replace("NT", str(nt)).replace("KROWS", str(m)).replace("KCOLS", str(n))
-            .replace("NB", str(index.nnz_out(2))))
-    return source([step, index]) + grid
+    grid = (_GRID.replace("QRSTEP", qr_step.name()).replace("STEP", step.name()).replace("INDEX", index.name())
+            .replace("PIVOT_FLOOR", repr(float(pivot_floor))).replace("BRANCH_TOL", repr(BRANCH_TOL)).replace("NQ", str(nq)).replace("NT", str(nt))
+            .replace("KROWS", str(m)).replace("KCOLS", str(n)).replace("NB", str(index.nnz_out(2))))
+    return source([step, qr_step, index]) + grid
 
 
 def compile_library(fun, *, follow: bool = False, directory=None, text: str | None = None

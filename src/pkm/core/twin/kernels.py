@@ -198,7 +198,8 @@ class Kernels:
                  "forward_jacobian": lambda: {"J": tw.forward_jacobian},
                  "inverse_jacobian": lambda: {"J": tw.inverse_jacobian},
                  "closure_newton": lambda: tw.closure_newton, "ik_newton": lambda: tw.ik_newton,
-                 "map_newton": lambda: tw.map_newton, "map_indices": lambda: tw.map_indices,
+                 "map_newton": lambda: tw.map_newton, "map_newton_qr": lambda: tw.map_newton_qr,
+                 "map_indices": lambda: tw.map_indices,
                  }[name]()
         assert tuple(exprs) == outputs
         sym = {"q": tw.q, "v": tw.v, "qd": tw.qd, "qdd": tw.qdd, "target": tw.target, "y": tw.task_target,
@@ -367,7 +368,8 @@ KERNELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "inverse_jacobian": (("q",), ("J",)),
     "closure_newton": (("q", "target"), ("q_next", "residual", "pivot")),
     "ik_newton": (("q", "y"), ("q_next", "residual", "pivot")),
-    "map_newton": (("q", "y"), ("q_next", "step")),
+    "map_newton": (("q", "y"), ("q_next", "step", "pivot")),
+    "map_newton_qr": (("q", "y"), ("q_next", "step")),
     "map_indices": (("q", "y", "scale"), ("K", "residual", "branch")),
 }
 

@@ -449,9 +449,20 @@ class Twin:
     def map_newton(self) -> dict:
         """The Newton iteration of the maps (:mod:`pkm.core.maps`): ``q_next`` as :attr:`ik_newton`, ``step`` the
         largest entry of the step (no residual at the new iterate: convergence is tested on the step, then on
-        :attr:`map_indices`' residual)."""
+        :attr:`map_indices`' residual), ``pivot`` as in :attr:`ik_newton` (at ``q``)."""
         rhs = cs.vertcat(-self._rotated(self.closure_residual), self.task_error)
         step = self._on_free(self.ik_lu.solve(rhs))
+        return {"q_next": self.retract(step), "step": cs.mmax(cs.fabs(step)),
+                "pivot": self.ik_lu.smallest_relative_pivot()}
+
+    @functools.cached_property
+    def map_newton_qr(self) -> dict:
+        """:attr:`map_newton` with the step from CasADi's QR factorisation of the rows the LU pivots on (no
+        pivoting needed: the maps' fallback where the LU's fixed pivots fail although the matrix is regular)."""
+        rows = sorted(r for r, _ in self.ik_lu.order)
+        A = cs.vertcat(self._rows["jacobian"], self.task_jacobian)[rows, self._free_cols]
+        rhs = cs.vertcat(-self._rotated(self.closure_residual), self.task_error)[rows]
+        step = self._on_free(cs.solve(A, rhs))
         return {"q_next": self.retract(step), "step": cs.mmax(cs.fabs(step))}
 
     @functools.cached_property

@@ -293,7 +293,10 @@ def _condition_index(rows, s, norm: str) -> np.ndarray:
             lmax = np.where(pp > 0.0, q + 2.0 * pp * np.cos(ang), q)
             half = (tr - lmax) / 2.0  # (lambda_mid + lambda_min) / 2
             prod = p3 / np.where(lmax > 0.0, lmax, 1.0)  # lambda_mid * lambda_min
-            lmin = prod / (half + np.sqrt(np.clip(half * half - prod, 0.0, None)))
+            # At a node exactly on an inverse singularity M has rank 1 and half cancels to +-1e-17: a denominator
+            # <= 0 means lambda_min = 0 (it gave CI = 1 there before issue 15, found by the generic route)
+            den = half + np.sqrt(np.clip(half * half - prod, 0.0, None))
+            lmin = np.where(den > 0.0, prod / np.where(den > 0.0, den, 1.0), 0.0)
             ci = np.where((lmax > 0.0) & (p3 > 0.0), np.sqrt(np.clip(lmin / lmax, 0.0, 1.0)), 0.0)
     return np.clip(np.nan_to_num(ci, nan=0.0), 0.0, 1.0)
 
