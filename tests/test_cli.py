@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import dataclasses
 import json
 import math
@@ -129,12 +130,29 @@ def test_fk_prints_the_pose_of_the_closed_form():
     (("ik", "delta", "--pose", "z"), 2, "'z' must read NAME=VALUE"),
     (("ik", "delta", "--param", "R=-0.1", "--pose", "z=-0.36"), 1, "R: must be"),
     (("ik", "delta", "--pose", "z=-0.36", "--branch", "up"), 2, "'knee_out', 'knee_in'"),
+    (("map", "rrr3", "--axis", "x=0:1"), 2, "expected NAME=START:STOP:COUNT"),
+    (("map", "rrr3", "--axis", "q=0:1:3"), 2, "valid task coordinates: 'x', 'y', 'yaw'"),
+    (("map", "rrr3", "--axis", "x=20cm:80cm:5"), 1, "give the characteristic length"),
 ])
 def test_bad_command_lines_give_one_helpful_line(args, status, message):
     """Unknown names, bad units, a missing '=' exit 2, an invalid parameter value exits 1; one line each."""
     proc = run(*args)
     assert proc.returncode == status
     assert message in one_error_line(proc)
+
+
+def test_map_prints_a_summary_and_writes_the_figure_and_the_numbers(tmp_path):
+    """``pkm map`` with units on the axes: the summary's GCI is the mean of the CSV's CIs; the PNG exists."""
+    proc = run("map", "rrr3", "--axis", "x=30cm:70cm:41", "--axis", "y=10cm:50cm:41", "--pose", "yaw=0deg",
+               "--length", "5.7735cm", "--png", str(tmp_path / "m.png"), "--csv", str(tmp_path / "m.csv"))
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    assert out["nodes"] == 41 * 41 and 0 < out["reachable"] <= out["nodes"]
+    rows = list(csv.DictReader((tmp_path / "m.csv").open()))
+    assert len(rows) == 41 * 41 and sum(int(r["reachable"]) for r in rows) == out["reachable"]
+    ci = [float(r["ci_2"]) for r in rows if r["reachable"] == "1"]
+    assert math.isclose(sum(ci) / len(ci), out["gci_2"], rel_tol=1e-12)
+    assert (tmp_path / "m.png").stat().st_size > 10_000
 
 
 # ---------------------------------------------------------------------- preview, report, bench

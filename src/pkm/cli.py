@@ -449,6 +449,50 @@ def cmd_spec_init(args) -> int:
     return 0
 
 
+def parse_axis(mech: pkm.Mechanism, item: str) -> tuple[str, np.ndarray]:
+    """An ``--axis`` item ``NAME=START:STOP:COUNT`` (units allowed on START and STOP) as ``(name, values)`` in SI.
+
+    Raises:
+        UsageError: not of that form; UnitError: a bad number or unit; UnknownNameError: not a task coordinate.
+    """
+    name, text = _split(item, "--axis")
+    task = mech.task_map
+    if name not in task.kinds:
+        raise UnknownNameError("task coordinate", name, list(task.keys), mech.name)
+    parts = text.split(":")
+    if len(parts) != 3 or not parts[2].strip().isdigit() or int(parts[2]) < 1:
+        raise UsageError(f"--axis {item!r}: expected NAME=START:STOP:COUNT, e.g. x=-5cm:5cm:101")
+    kind = task.kinds[name]
+    start, stop = (parse_quantity(t, {kind}, name, SI_UNITS[kind]) for t in parts[:2])
+    return name, np.linspace(start, stop, int(parts[2]))
+
+
+def cmd_map(args) -> int:
+    from pkm.core.maps import task_map
+
+    mech = _mechanism(args)
+    axes = dict(parse_axis(mech, item) for item in args.axis)
+    if len(axes) != len(args.axis):
+        raise UsageError("name each --axis once")
+    fixed = {}
+    for item in args.pose or []:
+        name, text = _split(item, "--pose")
+        if name not in mech.task_map.kinds:
+            raise UnknownNameError("task coordinate", name, list(mech.task_map.keys), mech.name)
+        fixed[name] = parse_quantity(text, {mech.task_map.kinds[name]}, name, SI_UNITS[mech.task_map.kinds[name]])
+    length = None if args.length is None else parse_quantity(args.length, {"length"}, "--length", "m")
+    m = task_map(mech, axes, fixed, branch=args.branch, length=length)
+    out = {"mechanism": mech.name, "axes": {n: [float(v[0]), float(v[-1]), len(v)] for n, v in m.axes},
+           "nodes": int(m.reachable.size), "reachable": m.nodes, "size_SI": m.size,
+           "gci_2": m.gci("2"), "gci_fro_normalized": m.gci("fro_normalized"), "how": m.how}
+    if args.csv:
+        out["csv"] = str(m.write_csv(args.csv))
+    if args.png:
+        out["png"] = str(m.figure(args.png, slab=None if len(m.axes) < 3 else len(m.axes[2][1]) // 2))
+    print(json.dumps(out, indent=2))
+    return 0
+
+
 def cmd_report(args) -> int:
     from pkm import papers, report
 
@@ -532,6 +576,20 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("fk", parents=[debug], help="forward kinematics: the pose for actuated values (JSON, SI)")
     mech_args(p, None, "required")
     p.set_defaults(func=cmd_fk)
+
+    p = sub.add_parser("map", parents=[debug], help="a workspace and condition-index map over 1-3 task coordinates "
+                                                  "(JSON summary, PNG, CSV)")
+    mech_args(p, None, None)
+    p.add_argument("--axis", metavar="NAME=START:STOP:COUNT", action="append", required=True,
+                   help="a grid axis over a task coordinate, e.g. x=-5cm:5cm:101 (1 to 3 axes)")
+    p.add_argument("--pose", metavar="K=V", action="extend", nargs="+", default=[],
+                   help="the other task coordinates (default: the reference's)")
+    p.add_argument("--length", metavar="L", help="characteristic length dividing the angular rates, e.g. 5cm "
+                                                 "(needed when the task mixes lengths and angles)")
+    p.add_argument("--branch", metavar="NAME", help="working mode of the map (see 'pkm list')")
+    p.add_argument("--png", metavar="FILE", help="draw the condition index (a 3-D map: its middle slab)")
+    p.add_argument("--csv", metavar="FILE", help="write one row per node")
+    p.set_defaults(func=cmd_map)
 
     p = sub.add_parser("spec", parents=[debug], help="closure specs: 'pkm spec init MODEL' writes one to fill in")
     spec_sub = p.add_subparsers(dest="spec_command", metavar="ACTION", required=True)

@@ -1,9 +1,11 @@
-"""Planar 3-RRR workspace and condition-index maps: vectorised numpy against a per-node loop.
+"""Planar 3-RRR workspace and condition-index maps: vectorised numpy against a per-node loop and the generic route.
 
-Two cases, each timed vectorised (best of ``--repeat``) and as a naive Python loop over a
+Two cases, each timed vectorised (best of ``--repeat``), as a naive Python loop over a
 random sample of its nodes (closed-form IK + per-pose Jacobians + SVD per node, from
-``pkm.mechanisms.rrr3.workspace.naive_condition_index``), extrapolated to all nodes; the ratio is
-measured in the same run, and the sample's CIs are compared between the two routes:
+``pkm.mechanisms.rrr3.workspace.naive_condition_index``), extrapolated to all nodes, and through the generic
+route of any mechanism (:func:`pkm.core.maps.task_map`: the compiled twin's IK warm-started across the grid, its
+inverse Jacobian, singular values; compilation not timed); the ratios are measured in the same run, and the CIs
+compared between the routes:
 
 * ``workspace_ci_3d``: the paper's Fig. 3 count, 101 x 101 positions over ``[0, H]^2`` times 361
   orientations (1 deg) = 3,682,561 nodes, reference design (a = b = 40, h = 10, H = 100 cm);
@@ -40,6 +42,19 @@ def _naive(design, nodes: np.ndarray, settings: maps.CiSettings) -> tuple[float,
     return (time.perf_counter() - t0) / len(nodes), out
 
 
+def _generic(design, axes: dict, fixed: dict, repeat: int):
+    """The generic route (:func:`pkm.core.maps.task_map` through the compiled twin) on the same grid: best time
+    [s] (the compilation done beforehand, on a 2-node grid) and the map."""
+    import pkm
+    from pkm.core.maps import task_map
+
+    mech = pkm.build("rrr3", a=design.a, b=design.b, h=design.h, H=design.H)
+    length = design.h / rrr3.SQRT3
+    kernels = pkm.Kernels(mech)
+    task_map(mech, {k: v[:2] for k, v in axes.items()}, fixed, length=length, kernels=kernels)
+    return best_time(lambda: task_map(mech, axes, fixed, length=length, kernels=kernels), repeat)
+
+
 def bench_3d(sample: int, repeat: int, rng: np.random.Generator) -> dict:
     p = rrr3.Rrr3Params()
     xs = np.linspace(0.0, p.H, 101)
@@ -56,9 +71,16 @@ def bench_3d(sample: int, repeat: int, rng: np.random.Generator) -> dict:
     per_node, naive = _naive(p, nodes, settings)
     vec, _ = maps.condition_index_phi(p, nodes[:, 0], nodes[:, 1], nodes[:, 2], settings)
     both = np.isfinite(naive)
+    t_gen, gen = _generic(maps.Design.of(p), {"x": xs, "y": xs, "yaw": phis}, {}, repeat)
+    X, Y, P = np.meshgrid(xs, xs, phis, indexing="ij")  # the generic map's layout is (phi, y, x)
+    ci_vec, reach_vec = maps.condition_index_phi(p, X.T, Y.T, P.T, settings)
+    same = reach_vec & gen.reachable
     return {
         "case": "workspace_ci_3d", "nodes": sw.nodes, "reachable_nodes": int(sw.reachable_nodes.sum()),
         "vectorised_s": t_vec, "goal_s": 5.0,
+        "generic_s": t_gen, "ratio_generic_over_vectorised": t_gen / t_vec, "generic_goal_ratio": 5.0,
+        "generic_reach_agrees": bool(np.array_equal(reach_vec, gen.reachable)),
+        "generic_max_ci_difference": float(np.max(np.abs(gen.condition_index("2")[same] - ci_vec[same]))),
         "naive_sample_nodes": sample, "naive_per_node_us": per_node * 1e6,
         "naive_extrapolated_s": per_node * sw.nodes, "ratio_naive_over_vectorised": per_node * sw.nodes / t_vec,
         "sample_reach_agrees": bool(np.array_equal(both, np.isfinite(vec))),
@@ -82,9 +104,12 @@ def bench_gci(sample: int, repeat: int, rng: np.random.Generator) -> dict:
     per_node, naive = _naive(d, nodes, settings)
     vec, _ = maps.condition_index(d, nodes[:, 0], nodes[:, 1], settings)
     both = np.isfinite(naive)
+    t_gen, gen = _generic(d, {"x": grid.xs, "y": grid.ys}, {"yaw": 0.0}, repeat)
     return {
         "case": "gci_paper_grid", "design_cm": [d.a * 100, d.b * 100, d.h * 100, d.H * 100], "nodes": grid.size,
         "vectorised_s": t_vec, "goal_s": 0.5,
+        "generic_s": t_gen, "ratio_generic_over_vectorised": t_gen / t_vec, "generic_goal_s": 1.0,
+        "generic_gci_difference": abs(gen.gci() - result["gci"].value),
         "naive_sample_nodes": sample, "naive_per_node_us": per_node * 1e6,
         "naive_extrapolated_s": per_node * grid.size, "ratio_naive_over_vectorised": per_node * grid.size / t_vec,
         "sample_reach_agrees": bool(np.array_equal(both, np.isfinite(vec))),
@@ -105,11 +130,12 @@ def run(args) -> list[dict]:
 
 def table(results: list[dict]) -> str:
     lines = [(f"{'case':16} {'nodes':>10} {'vector s':>9} {'goal s':>7} {'naive us/node':>14} "
-              f"{'naive s (extr.)':>16} {'ratio':>7} {'max |dCI|':>10}")]
+              f"{'naive s (extr.)':>16} {'ratio':>7} {'max |dCI|':>10} {'generic s':>10} {'generic/vector':>15}")]
     for r in results:
         lines.append(f"{r['case']:16} {r['nodes']:10d} {r['vectorised_s']:9.3f} {r['goal_s']:7.1f} "
                      f"{r['naive_per_node_us']:14.1f} {r['naive_extrapolated_s']:16.1f} "
-                     f"{r['ratio_naive_over_vectorised']:7.0f} {r['sample_max_ci_difference']:10.1e}")
+                     f"{r['ratio_naive_over_vectorised']:7.0f} {r['sample_max_ci_difference']:10.1e} "
+                     f"{r['generic_s']:10.3f} {r['ratio_generic_over_vectorised']:15.2f}")
     return "\n".join(lines)
 
 

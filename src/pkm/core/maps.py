@@ -26,6 +26,7 @@ from __future__ import annotations
 import ctypes
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -58,6 +59,7 @@ class TaskGridMap:
         singular_values: Of ``K diag(scale)`` per node, descending (NaN where unreachable).
         iterations: Newton iterations per node.
         how: What ran the kernels.
+        kinds: Each axis's kind, ``"length"`` or ``"angle"``.
     """
 
     axes: tuple[tuple[str, np.ndarray], ...]
@@ -67,6 +69,7 @@ class TaskGridMap:
     singular_values: np.ndarray = field(repr=False)
     iterations: np.ndarray = field(repr=False)
     how: str = ""
+    kinds: tuple[str, ...] = ()
 
     @property
     def nodes(self) -> int:
@@ -102,6 +105,74 @@ class TaskGridMap:
     def sigma_min(self) -> np.ndarray:
         """The smallest singular value of ``J = (K diag(scale))^-1``: ``1 / sigma_max(K diag(scale))``."""
         return np.where(self.reachable, 1.0 / self.singular_values[..., 0], np.nan)
+
+    def _plane(self, slab: int | None):
+        """The 2-D (or 1-D) part of the map to draw: the whole map, or one slab of a 3-D map."""
+        if len(self.axes) < 3:
+            return self.axes, slice(None)
+        if slab is None or not 0 <= slab < len(self.axes[2][1]):
+            raise InvalidInputError("slab", f"a 3-D map is drawn one slab at a time: give an index along "
+                                            f"{self.axes[2][0]!r} in [0, {len(self.axes[2][1])})", slab)
+        return self.axes[:2], slab
+
+    def figure(self, path, kind: str = "2", *, slab: int | None = None, title: str = "") -> Path:
+        """Draw the condition index (``kind``) over the map as a PNG at ``path``: a colour map with its colour bar
+        (2-D), a curve (1-D); unreachable nodes white. Axes in mm or deg."""
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        axes, sl = self._plane(slab)
+        ci = self.condition_index(kind)[sl]
+        labels, values = [], []
+        for (name, v), axis_kind in zip(axes, self.kinds):
+            angle = axis_kind == "angle"
+            labels.append(f"{name} [{'deg' if angle else 'mm'}]")
+            values.append(np.degrees(v) if angle else 1e3 * v)
+        fig, ax = plt.subplots(figsize=(6.4, 5.0))
+        label = {"2": r"$1/\kappa_2$", "fro_normalized": r"$n/(\|K\|_F\|K^{-1}\|_F)$"}[kind]
+        if len(axes) == 1:
+            ax.plot(values[0], ci, label=label)
+            ax.set_xlabel(labels[0])
+            ax.set_ylabel("condition index [-]")
+            ax.legend()
+        else:
+            im = ax.pcolormesh(values[0], values[1], ci, shading="nearest", vmin=0.0, vmax=1.0, cmap="viridis")
+            fig.colorbar(im, ax=ax, label=f"condition index {label} [-]")
+            ax.set_xlabel(labels[0])
+            ax.set_ylabel(labels[1])
+            ax.set_aspect("equal" if labels[0][-4:] == labels[1][-4:] else "auto")
+        extra = "" if slab is None else f", {self.axes[2][0]} = {self.axes[2][1][slab]:.4g}"
+        ax.set_title(title or f"{self.nodes} reachable nodes, GCI {self.gci(kind) or 0.0:.4f}{extra}")
+        out = Path(path)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        fig.tight_layout()
+        fig.savefig(out, dpi=150)
+        plt.close(fig)
+        return out
+
+    def write_csv(self, path) -> Path:
+        """The numbers behind the map: one row per node, the axes' coordinates (SI), ``reachable``, the condition
+        indices, the manipulability and the smallest singular value (empty where unreachable)."""
+        import csv
+
+        grids = np.meshgrid(*[v for _, v in reversed(self.axes)], indexing="ij")
+        cols = {name: g.ravel() for (name, _), g in zip(reversed(self.axes), grids)}
+        values = {"ci_2": self.condition_index("2"), "ci_fro_normalized": self.condition_index("fro_normalized"),
+                  "manipulability": self.manipulability(), "sigma_min": self.sigma_min()}
+        out = Path(path)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        names = [n for n, _ in self.axes]
+        with out.open("w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow([*names, "reachable", *values])
+            reach = self.reachable.ravel()
+            flat = {k: v.ravel() for k, v in values.items()}
+            for i in range(reach.size):
+                w.writerow([repr(float(cols[n][i])) for n in names] + [int(reach[i])]
+                           + [repr(float(flat[k][i])) if reach[i] else "" for k in values])
+        return out
 
     def gci(self, kind: str = "2", region=None) -> float | None:
         """The mean condition index over the reachable nodes of ``region`` (a boolean mask; default all): the
@@ -218,7 +289,7 @@ def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, ob
         raise RuntimeError(f"the map driver failed (code {flag})")
     shape = tuple(reversed(dims))
     return TaskGridMap(tuple(grid_axes), base, scale, (state == 1).reshape(shape), sv.reshape(shape + (nsv,)),
-                       its.reshape(shape), how)
+                       its.reshape(shape), how, tuple(task.kinds[name] for name, _ in grid_axes))
 
 
 __all__ = ["KINDS", "MAX_NODES", "PIVOT_FLOOR", "ROOT_STRIDE", "TaskGridMap", "task_map"]
