@@ -113,6 +113,21 @@ def test_a_users_mechanism_gets_its_map():
     assert math.isclose(m.size, m.nodes * 0.001 ** 2, rel_tol=1e-9)
 
 
+def test_the_workspace_over_orientations():
+    """A 3-D map (x, y, yaw) of the 3-RRR: its maximal and total-orientation workspaces equal the closed form's
+    reachability over the same orientations, any and all."""
+    mech = pkm.load("rrr3")
+    d = W.Design.of(mech.params)
+    xs, phis = np.linspace(0.0, d.H, 41), np.radians(np.arange(-30.0, 31.0, 10.0))
+    m = task_map(mech, {"x": xs, "y": xs, "yaw": phis}, length=d.h / math.sqrt(3))
+    X, Y, P = np.meshgrid(xs, xs, phis)  # (y, x, phi)
+    _, reach = W.condition_index_phi(d, X, Y, P, W.CiSettings())
+    assert np.array_equal(m.reachable_over("yaw", "any"), reach.any(axis=-1))
+    assert np.array_equal(m.reachable_over("yaw", "all"), reach.all(axis=-1))
+    with pytest.raises(InvalidInputError, match="mode"):
+        m.reachable_over("yaw", "some")
+
+
 def test_bad_maps_are_refused():
     mech = pkm.load("rrr3")
     with pytest.raises(InvalidInputError, match="not a task coordinate"):

@@ -85,6 +85,15 @@ class TaskGridMap:
         """The reachable region's length, area or volume: reachable nodes times :attr:`cell`."""
         return self.nodes * self.cell
 
+    def reachable_over(self, axis: str, mode: str = "any") -> np.ndarray:
+        """The workspace over one axis (an orientation, say): nodes of the other axes reachable at some value of
+        ``axis`` (``"any"``: the maximal workspace) or at every value (``"all"``: the total-orientation workspace)."""
+        names = [n for n, _ in self.axes]
+        if axis not in names or mode not in ("any", "all"):
+            raise InvalidInputError("axis", f"give one of {names} and mode 'any' or 'all'", (axis, mode))
+        along = len(names) - 1 - names.index(axis)  # arrays run (last axis, ..., first axis)
+        return self.reachable.any(axis=along) if mode == "any" else self.reachable.all(axis=along)
+
     def condition_index(self, kind: str = "2") -> np.ndarray:
         """``1/kappa`` of ``K diag(scale)`` per node (NaN where unreachable; 0 at a singularity)."""
         s = self.singular_values

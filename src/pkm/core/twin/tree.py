@@ -8,9 +8,14 @@ symbols ``q`` (nq), ``v`` (nv) and ``a`` (nv):
   ``gamma = dJ/dt v``;
 * RNEA (joint torques for ``q, v, a`` under ``model.gravity``), kinetic and potential energy;
 * for mechanisms without idle motions: the passive map ``G``, the joint rates and accelerations from the
-  actuated ones, the loop closure's Gauss-Newton step, and the actuator efforts ``G^T rnea`` at a consistent
-  state; their CasADi functions map over batches (``Function.map``), differentiate (``casadi.jacobian``) and
-  compile to C (:func:`compile_function`).
+  actuated ones, the actuator efforts at a consistent state and from ``(q, qd, qdd)`` with their derivatives,
+  every linear solve a sparse LU with pivots fixed at the reference (:mod:`~pkm.core.twin.linear`), the closure
+  rows in the axes that make them cheapest;
+* the task's error and Jacobian, the forward and inverse Jacobians, and the Newton iterations of the loop
+  closure, the inverse kinematics and the maps (:mod:`pkm.core.maps`), with a retraction on the configuration
+  space.
+
+:class:`~pkm.core.twin.kernels.Kernels` turns them into functions run on states, batches and paths, compiled to C.
 
 Everything is derived from the model: each joint's placement, its motion subspace ``S`` (constant in
 the joint's frame for every joint kind handled) and the exponential of ``S`` for one-coordinate joints,
