@@ -92,7 +92,7 @@ class TaskGridMap:
         if axis not in names or mode not in ("any", "all"):
             raise InvalidInputError("axis", f"give one of {names} and mode 'any' or 'all'", (axis, mode))
         along = len(names) - 1 - names.index(axis)  # arrays run (last axis, ..., first axis)
-        return self.reachable.any(axis=along) if mode == "any" else self.reachable.all(axis=along)
+        return np.asarray(self.reachable.any(axis=along) if mode == "any" else self.reachable.all(axis=along))
 
     def condition_index(self, kind: str = "2") -> np.ndarray:
         """``1/kappa`` of ``K diag(scale)`` per node (NaN where unreachable; 0 at a singularity)."""
