@@ -563,6 +563,78 @@ def _follow_actuators(g, adv):
     return _follow(g, adv, False)
 
 
+def _kernels(n: str):
+    c = ctx()
+    return c.lazy(f"kernels:{n}", lambda: c.pkm.Kernels(c.mech[n]))
+
+
+@entry("Kernels.inverse_dynamics")
+def _kernels_inverse_dynamics(g, adv):
+    c = ctx()
+    n = g.pick(c.names)
+    m = c.mech[n]
+    batch = g.chance(0.3)
+    q = np.array([_q(g, n, False) for _ in range(3)]) if batch else _q(g, n, False)
+    qd = g.near(np.zeros((3, m.na) if batch else m.na), 1.0)
+    qdd = g.near(np.zeros((3, m.na) if batch else m.na), 1.0)
+    args = [q, qd, qdd]
+    if adv:
+        i = int(g.rng.integers(3))
+        args[i] = g.corrupt(args[i]) if g.chance(0.7) else g.hostile()
+
+    def run(*a):
+        return _kernels(n).inverse_dynamics(*a)
+    return run, tuple(args), {}
+
+
+@entry("Kernels.close_loops_path")
+def _kernels_path(g, adv):
+    c = ctx()
+    n = g.pick(c.names)
+    k = int(g.rng.integers(1, 5))
+    targets = np.array([c.qa_ref[n]] * k) + g.near(np.zeros((k, c.mech[n].na)), 0.005)
+    kw: dict = {}
+    if adv:
+        targets = g.corrupt(targets)
+        if g.chance(0.3):
+            kw[g.pick(("q0", "tol", "max_iter"))] = g.hostile()
+
+    def run(t, **kwargs):
+        return _kernels(n).close_loops_path(t, **kwargs).q
+    return run, (targets,), kw
+
+
+@entry("maps.task_map")
+def _task_map(g, adv):
+    from pkm.core.maps import task_map
+
+    c = ctx()
+    n = g.pick(c.names)
+    task = c.task[n]
+    names = [k for k in task.keys if k in task.value_names]
+    y0 = task.named(c.mech[n].q_reference)
+    axes = {k: y0[k] + np.linspace(-0.01, 0.01, int(g.rng.integers(1, 6))) for k in names[:2]}
+    kw: dict = {"length": 0.1}
+    if adv:
+        key = g.pick(names[:2] or ["x"])
+        axes[key] = g.corrupt(axes.get(key, np.zeros(2)))
+        if g.chance(0.3):
+            kw[g.pick(("length", "tol", "max_iter", "branch", "seed"))] = g.hostile()
+
+    def run(a, **kwargs):
+        m = task_map(c.mech[n], a, kernels=_kernels(n), **kwargs)
+        return m.condition_index("2")[m.reachable], m.size
+    return run, (axes,), kw
+
+
+@entry("formats.mjcf_from_mechanism")
+def _to_mjcf(g, adv):
+    from pkm.core.formats.to_mjcf import mjcf_from_mechanism
+
+    _, m = _mech(g, adv)
+    return mjcf_from_mechanism, (m,), {}
+
+
 @entry("motion.load_motions")
 def _load_motions(g, adv):
     from pkm.motion import load_motions

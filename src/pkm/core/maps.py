@@ -33,6 +33,7 @@ import numpy as np
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.task import TaskMap
 from pkm.errors import InvalidInputError
+from pkm.validation import as_array, as_count, as_scalar, as_tolerance
 
 #: Spacing of the root nodes that start a new search where the first did not reach.
 ROOT_STRIDE = 16
@@ -234,8 +235,14 @@ def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, ob
     from pkm.core.twin import Kernels
 
     mech = check_mechanism(mech)
+    tol, step_tol = as_tolerance(tol, "tol"), as_tolerance(step_tol, "step_tol")
+    max_iter = as_count(max_iter, "max_iter", high=1000)
+    if length is not None:
+        length = as_scalar(length, "length", low=0.0, strict_low=True, unit="m")
     task = TaskMap(mech)
     kernels = Kernels(mech) if kernels is None else kernels
+    if not isinstance(kernels, Kernels) or kernels.mech is not mech:
+        raise InvalidInputError("kernels", "give the pkm.Kernels of this mechanism", kernels)
     if not isinstance(axes, Mapping) or not 1 <= len(axes) <= 3:
         raise InvalidInputError("axes", "give 1 to 3 task coordinates as {name: values}", axes)
     names = list(task.value_names)
@@ -244,7 +251,7 @@ def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, ob
         if name not in task.keys or name not in names:
             raise InvalidInputError("axes", f"{name!r} is not a task coordinate a grid can run along: use one of "
                                             f"{[k for k in task.keys if k in names]}", name)
-        v = np.asarray(values, dtype=float).ravel()
+        v = as_array(values, "axes", f"values of {name!r} (SI)").ravel()
         if v.size == 0 or not np.all(np.isfinite(v)):
             raise InvalidInputError("axes", f"{name!r}: give finite values (SI)", values)
         grid_axes.append((name, v))

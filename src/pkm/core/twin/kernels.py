@@ -25,6 +25,7 @@ from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.codegen import compile_library, numpy_function
 from pkm.core.twin.tree import Twin
 from pkm.errors import InvalidInputError, NonFiniteError
+from pkm.validation import as_array, as_count, as_tolerance
 
 #: Smallest relative pivot (:meth:`PivotedLU.smallest_relative_pivot`) at which a kernel's solve is trusted.
 PIVOT_FLOOR = 1e-6
@@ -244,7 +245,7 @@ class Kernels:
         kernel = self._kernels.get(name) or self.kernel(name)
         arrays = []
         for what, size, x in zip(KERNELS[name][0], kernel.in_size, args):
-            a = x if type(x) is np.ndarray and x.dtype == np.float64 else np.asarray(x, dtype=float)
+            a = x if type(x) is np.ndarray and x.dtype == np.float64 else as_array(x, what)
             if a.ndim not in (1, 2) or a.shape[-1] != size:
                 raise InvalidInputError(what, f"expected ({size},) or (n, {size})", x)
             arrays.append(a)
@@ -334,8 +335,9 @@ class Kernels:
         return self._path("ik_newton", targets, q0, tol, max_iter, lambda q, t: solve_ik(self.mech, t, q, tol=tol))
 
     def _path(self, name: str, targets, q0, tol: float, max_iter: int, core) -> PathResult:
+        tol, max_iter = as_tolerance(tol, "tol"), as_count(max_iter, "max_iter", high=1000)
         kernel = self.kernel(name)
-        t = np.atleast_2d(np.asarray(targets, dtype=float))
+        t = np.atleast_2d(as_array(targets, "targets"))
         if t.shape[1] != kernel.in_size[1] or not np.all(np.isfinite(t)):
             raise InvalidInputError("targets", f"expected finite values of shape (n, {kernel.in_size[1]})", targets)
         prev = self.mech.q_reference.copy() if q0 is None else self.mech.check_q(q0, "q0")
