@@ -1,16 +1,19 @@
-"""The twin's functions as generated C, compiled and loaded; with drivers that run them over batches and paths.
+"""The twin's functions as generated C, compiled and loaded; with drivers that run them over batches, paths and grids.
 
-:func:`compile_library` writes a CasADi function as C (CasADi's code generator), appends two drivers, compiles the
-whole with the system's C compiler (``cc -O2 -shared``, ``-O0`` above :data:`LARGE` instructions) and loads it with :mod:`ctypes`:
+:func:`compile_library` writes CasADi functions as C (CasADi's code generator, one file), appends drivers, compiles
+the whole with the system's C compiler (``cc -O2 -shared``; ``-O0`` above :data:`LARGE` instructions) and loads it
+with :mod:`ctypes`:
 
 * ``NAME_batch(n, in, out)``: the function on ``n`` samples, each input and output a sample-major array;
 * ``NAME_follow(n, q0, targets, q_out, residual, pivot, iterations, max_iter, tol)``, for a Newton iteration
   (inputs ``q, target``; outputs ``q_next, residual, pivot``): per target, iterate from the previous solution
-  (the first from ``q0``) until the residual is at most ``tol`` or ``max_iter`` iterations were made.
+  (the first from ``q0``) until the residual is at most ``tol`` or ``max_iter`` iterations were made;
+* ``NAME_grid(...)`` (:func:`map_source`): the maps' breadth-first solve over a grid (:mod:`pkm.core.maps`).
 
-Libraries are cached by the hash of their source (the folder :func:`cache_dir`), so a mechanism is compiled once per
-machine. Without a C compiler (or when it fails) :func:`compile_library` returns None and says why; the callers run
-CasADi's virtual machine instead.
+:func:`numpy_function` runs a function vectorised over samples with numpy instead (one statement per instruction),
+for machines without a compiler. Libraries are cached by the hash of their source (the folder :func:`cache_dir`), so
+a mechanism is compiled once per machine. Without a C compiler (or when it fails) :func:`compile_library` returns
+None and says why.
 """
 
 from __future__ import annotations
