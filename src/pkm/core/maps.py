@@ -192,7 +192,7 @@ class TaskGridMap:
         return float(ci[mask].mean()) if mask.any() else None
 
 
-def _library(mech: Mechanism, kernels):
+def _library(kernels):
     from pkm.core.twin.codegen import compile_library, map_source
 
     step, qr_step, index = (kernels.function(k) for k in ("map_newton", "map_newton_qr", "map_indices"))
@@ -231,6 +231,8 @@ def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, ob
 
     Raises:
         InvalidInputError: bad axes, a missing ``length``, or a grid beyond :data:`MAX_NODES`.
+        RuntimeError: no C compiler on the machine (the maps run only compiled: a grid of 10^6 nodes through the
+            virtual machine would take an hour).
     """
     from pkm.core.twin import Kernels
 
@@ -265,8 +267,8 @@ def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, ob
     if "angle" in kinds and "length" in kinds and length is None:
         raise InvalidInputError("length", "the task mixes lengths and angles: give the characteristic length L [m] "
                                           "that homogenises the angular rates")
-    tangent_kinds = [task.kinds[k] for k in task.keys]  # (a pose's tangent: x y z then three angles, as its keys)
-    scale = np.array([1.0 if k == "length" else 1.0 / (length or 1.0) for k in tangent_kinds])
+    # (a pose's tangent: x y z then three angles, in the order of its keys)
+    scale = np.array([1.0 if k == "length" else 1.0 / (length or 1.0) for k in kinds])
 
     targets = np.empty((total, len(base)))
     targets[:] = base
@@ -290,7 +292,7 @@ def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, ob
     strides = np.cumprod([1] + dims[:-1])
     roots = np.concatenate([[first], sum(c.ravel() * s for c, s in zip(coarse, strides))]).astype(np.int64)
 
-    grid, (m, n), how = _library(mech, kernels)
+    grid, (m, n), how = _library(kernels)
     nsv = min(m, n)
     state = np.zeros(total, dtype=np.int8)
     sv = np.empty((total, nsv))
