@@ -627,6 +627,32 @@ def _task_map(g, adv):
     return run, (axes,), kw
 
 
+@entry("pkm.reconfigure")
+def _reconfigure(g, adv):
+    c = ctx()
+    m = c.mech["hexapod"]
+    y = c.task["hexapod"].retract(c.y_ref["hexapod"], g.near(np.zeros(c.task["hexapod"].size), 0.01))
+    limits = [(-0.5, 0.5)]
+    kw: dict = {"length": 0.1, "grid": 7}
+    if g.chance(0.3):
+        kw["rate_limit"] = 0.05
+    poses, params = [y, y], ["beta_1"]
+    if adv:
+        what = g.pick(("poses", "params", "limits", "kw"))
+        if what == "poses":
+            poses = [g.corrupt(y)]
+        elif what == "params":
+            params = g.pick((["alpha_1"], [], ["beta_1", "beta_1"], "beta_1", [None]))
+        elif what == "limits":
+            limits = g.pick(([(0.5, -0.5)], [(np.nan, 1.0)], [(-1e9, 1e9)], [], g.hostile()))
+        else:
+            kw[g.pick(("length", "index", "rate_limit", "grid", "tol", "branch"))] = g.hostile()
+
+    def run(*a, **k):
+        return c.pkm.reconfigure(*a, **k).x
+    return run, (m, poses, params, limits), kw
+
+
 @entry("formats.mjcf_from_mechanism")
 def _to_mjcf(g, adv):
     from pkm.core.formats.to_mjcf import mjcf_from_mechanism

@@ -60,12 +60,15 @@ if TYPE_CHECKING:  # the static view of the lazy names
         twist_jacobian,
         velocities,
     )
+    from pkm.core.maps import task_map
+    from pkm.core.reconfiguration import reconfigure
     from pkm.core.twin import Kernels, Twin
     from pkm.units import quantity
 
 
 __getattr__, __dir__ = lazy("pkm", globals(), {**dict.fromkeys(_CORE, "pkm.core"), "quantity": "pkm.units",
-                                                "Kernels": "pkm.core.twin", "Twin": "pkm.core.twin"})
+                                                "Kernels": "pkm.core.twin", "Twin": "pkm.core.twin",
+                                                "task_map": "pkm.core.maps", "reconfigure": "pkm.core.reconfiguration"})
 
 __version__ = "0.1.0"
 
@@ -217,9 +220,11 @@ __all__ = [
     "mechanism_module",
     "passive_map",
     "quantity",
+    "reconfigure",
     "save",
     "solve_ik",
     "task_acceleration",
+    "task_map",
     "task_values",
     "task_velocity",
     "twist_jacobian",
