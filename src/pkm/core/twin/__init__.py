@@ -4,6 +4,7 @@
 * :mod:`~pkm.core.twin.joint`: one joint of a Pinocchio tree as SX;
 * :mod:`~pkm.core.twin.linear`: sparse LU with pivots fixed at a reference;
 * :mod:`~pkm.core.twin.tree`: :class:`Twin`, the tree's kinematics, closures and dynamics as expressions;
+* :mod:`~pkm.core.twin.task`: its task, inverse kinematics and map iterations;
 * :mod:`~pkm.core.twin.codegen`: generated C with batch and path drivers, compiled and loaded;
 * :mod:`~pkm.core.twin.kernels`: :class:`Kernels`, the twin's functions run on states, batches and paths.
 """

@@ -186,7 +186,7 @@ class Kernels:
     # ---------------------------------------------------------------- kernels
     def function(self, name: str) -> cs.Function:
         """The CasADi function of a kernel (:data:`KERNELS`), inputs and outputs dense, after CSE."""
-        tw = self.twin
+        tw, tk = self.twin, self.twin.task
         if name not in KERNELS:
             raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", name)
         inputs, outputs = KERNELS[name]
@@ -196,15 +196,15 @@ class Kernels:
                                                           **tw.inverse_dynamics_derivatives},
                  "velocities": lambda: {"v": tw.velocities},
                  "accelerations": lambda: {"a": tw.accelerations},
-                 "forward_jacobian": lambda: {"J": tw.forward_jacobian},
-                 "inverse_jacobian": lambda: {"J": tw.inverse_jacobian},
-                 "closure_newton": lambda: tw.closure_newton, "ik_newton": lambda: tw.ik_newton,
-                 "map_newton": lambda: tw.map_newton, "map_newton_qr": lambda: tw.map_newton_qr,
-                 "map_indices": lambda: tw.map_indices,
+                 "forward_jacobian": lambda: {"J": tk.forward_jacobian},
+                 "inverse_jacobian": lambda: {"J": tk.inverse_jacobian},
+                 "closure_newton": lambda: tw.closure_newton, "ik_newton": lambda: tk.ik_newton,
+                 "map_newton": lambda: tk.map_newton, "map_newton_qr": lambda: tk.map_newton_qr,
+                 "map_indices": lambda: tk.map_indices,
                  }[name]()
         assert tuple(exprs) == outputs
-        sym = {"q": tw.q, "v": tw.v, "qd": tw.qd, "qdd": tw.qdd, "target": tw.target, "y": tw.task_target,
-               "scale": tw.scale}
+        sym = {"q": tw.q, "v": tw.v, "qd": tw.qd, "qdd": tw.qdd, "target": tw.target, "y": tk.task_target,
+               "scale": tk.scale}
         values = cs.cse([cs.densify(cs.SX(e)) for e in exprs.values()])
         return cs.Function(f"pkm_{name}", [sym[i] for i in inputs], values, list(inputs), list(outputs))
 

@@ -11,9 +11,9 @@ symbols ``q`` (nq), ``v`` (nv) and ``a`` (nv):
   actuated ones, the actuator efforts at a consistent state and from ``(q, qd, qdd)`` with their derivatives,
   every linear solve a sparse LU with pivots fixed at the reference (:mod:`~pkm.core.twin.linear`), the closure
   rows in the axes that make them cheapest;
-* the task's error and Jacobian, the forward and inverse Jacobians, and the Newton iterations of the loop
-  closure, the inverse kinematics and the maps (:mod:`pkm.core.maps`), with a retraction on the configuration
-  space.
+* the loop closure's Newton iteration, with a retraction on the configuration space; the task's expressions and
+  the Newton iterations of the inverse kinematics and the maps in :attr:`Twin.task`
+  (:class:`~pkm.core.twin.task.TaskTwin`).
 
 :class:`~pkm.core.twin.kernels.Kernels` turns them into functions run on states, batches and paths, compiled to C.
 
@@ -46,18 +46,11 @@ from pkm.core.twin.linear import PivotedLU
 from pkm.core.twin.spatial import (
     SE3,
     cross,
-    euler_rates,
     force_cross,
-    log3,
     log6,
     motion_cross,
-    quat_matrix,
-    zyx_angles,
 )
 from pkm.errors import SpecError
-
-_POS = {"x": 0, "y": 1, "z": 2}
-_ANGLES = ("roll", "pitch", "yaw")
 
 
 # ---------------------------------------------------------------------- the twin
@@ -189,7 +182,7 @@ class Twin:
         return J
 
     @functools.cached_property
-    def _rows(self) -> dict:
+    def closure_rows(self) -> dict:
         """The closure's velocity-level rows in the axes that make them cheapest: a point closure's in the axes of
         whichever of its frames hangs from the joint with more velocity coordinates (a free-flyer platform's: its
         columns are then constants), a frame closure's in frame A's (as :attr:`closure_jacobian`). Returns
@@ -223,10 +216,10 @@ class Twin:
             at += 3
         return {"jacobian": cs.vertcat(*rows), "drift": cs.vertcat(*drift), "rotations": rotations}
 
-    def _rotated(self, residual):
-        """``W residual`` for the rows of :attr:`_rows`."""
+    def rotate_rows(self, residual):
+        """``W residual`` for the rows of :attr:`closure_rows`."""
         out, at = [], 0
-        for R in self._rows["rotations"]:
+        for R in self.closure_rows["rotations"]:
             n = 6 if R is None else 3
             out.append(residual[at:at + n] if R is None else R.T @ residual[at:at + n])
             at += n
@@ -287,7 +280,7 @@ class Twin:
     def passive_lu(self) -> PivotedLU:
         """The closure Jacobian's passive columns ``J_p``, factored (pivots fixed at the reference)."""
         self._no_idle()
-        Jp = self._rows["jacobian"][:, self.mech.passive_v.tolist()]
+        Jp = self.closure_rows["jacobian"][:, self.mech.passive_v.tolist()]
         return PivotedLU(Jp, self.at_reference(Jp))
 
     def _passive(self, values) -> cs.SX:
@@ -306,28 +299,28 @@ class Twin:
     @functools.cached_property
     def passive_map(self):
         """``G = dq/dq_a`` (nv x na), as :func:`pkm.passive_map` (mechanisms without idle motions)."""
-        Ja = self._rows["jacobian"][:, self.mech.act_v.tolist()]
+        Ja = self.closure_rows["jacobian"][:, self.mech.act_v.tolist()]
         return cs.horzcat(*[self._actuated(np.eye(self.mech.na)[k]) - self._passive(self.passive_lu.solve(Ja[:, k]))
                             for k in range(self.mech.na)])
 
     @functools.cached_property
     def velocities(self):
         """All joint rates for the actuated rates :attr:`qd` (symbol, na), as :func:`pkm.velocities`."""
-        Ja = self._rows["jacobian"][:, self.mech.act_v.tolist()]
+        Ja = self.closure_rows["jacobian"][:, self.mech.act_v.tolist()]
         return self._actuated(self.qd) - self._passive(self.passive_lu.solve(Ja @ self.qd))
 
     @functools.cached_property
     def accelerations(self):
         """All joint accelerations at ``(q, v)`` for the actuated accelerations :attr:`qdd` (symbol, na), as
         :func:`pkm.accelerations`: the passive ones close the loops at the acceleration level (drift included)."""
-        Ja = self._rows["jacobian"][:, self.mech.act_v.tolist()]
-        return self._actuated(self.qdd) - self._passive(self.passive_lu.solve(Ja @ self.qdd + self._rows["drift"]))
+        Ja = self.closure_rows["jacobian"][:, self.mech.act_v.tolist()]
+        return self._actuated(self.qdd) - self._passive(self.passive_lu.solve(Ja @ self.qdd + self.closure_rows["drift"]))
 
     @functools.cached_property
     def closure_step(self):
         """The Newton step of the loop closure at ``q`` (actuators held): the passive rates ``dq`` (nv, zero on the
         actuated and base rows) with ``J_p dq_p = -residual``; ``pin.integrate(q, dq)`` applies it."""
-        return -self._passive(self.passive_lu.solve(self._rotated(self.closure_residual)))
+        return -self._passive(self.passive_lu.solve(self.rotate_rows(self.closure_residual)))
 
     @functools.cached_property
     def actuated_efforts(self):
@@ -341,7 +334,7 @@ class Twin:
         """
         mech, tau = self.mech, self.rnea
         lam = self.passive_lu.solve_transposed(cs.vertcat(*[tau[int(r)] for r in mech.passive_v]))
-        Ja = self._rows["jacobian"][:, mech.act_v.tolist()]
+        Ja = self.closure_rows["jacobian"][:, mech.act_v.tolist()]
         return cs.vertcat(*[tau[int(c)] for c in mech.act_v]) - Ja.T @ lam
 
     @functools.cached_property
@@ -362,152 +355,12 @@ class Twin:
         return {"dtau_dqa": cs.jtimes(tau, self.q, self.tangent @ self.passive_map),  # na forward sweeps, not nq
                 "dtau_dqd": cs.jacobian(tau, self.qd), "dtau_dqdd": cs.jacobian(tau, self.qdd)}
 
-    # ---------------------------------------------------------------- task
-    def _task_groups(self) -> list[tuple[int, tuple[str, ...]]]:
-        spec = self.mech.spec.task
-        groups = [(self.mech.ee_frame, spec.components)] if spec.components else []
-        return groups + list(zip(self.mech.task_frames, spec.frames.values()))
-
     @functools.cached_property
-    def task_target(self):
-        """The symbol of a task target, laid out as :meth:`pkm.core.task.TaskMap.value` gives values."""
-        from pkm.core.task import TaskMap
+    def task(self):
+        """The task's expressions and the Newton iterations of the IK and the maps (:class:`TaskTwin`)."""
+        from pkm.core.twin.task import TaskTwin
 
-        return cs.SX.sym("y", TaskMap(self.mech).value_size)
-
-    @functools.cached_property
-    def task_error(self):
-        """``target - task(q)`` on the task's tangent space, as :meth:`pkm.core.task.TaskMap.error` (angles wrapped to
-        ``(-pi, pi]``, a pose's orientation as ``log3(R_target R^T)``)."""
-        y, out, at = self.task_target, [], 0
-        for fid, comps in self._task_groups():
-            M = self.frame_placement(fid)
-            if comps == ("pose",):
-                R_t = quat_matrix(y[at + 3], y[at + 4], y[at + 5], y[at + 6])
-                out += [y[at:at + 3] - M.p, log3(R_t @ M.R.T)]
-                at += 7
-                continue
-            rpy = zyx_angles(M.R)
-            for c in comps:
-                if c in _POS:
-                    out.append(y[at] - M.p[_POS[c]])
-                else:
-                    d = y[at] - rpy[_ANGLES.index(c)]
-                    out.append(d - 2 * np.pi * cs.floor((d + np.pi) / (2 * np.pi)))
-                at += 1
-        for k, j in enumerate(self.mech.task_joints):
-            out.append(y[at + k] - self.q[j.idx_q])
-        return cs.vertcat(*out)
-
-    @functools.cached_property
-    def task_jacobian(self):
-        """``d(task)/dq`` on the tangent space (task size x nv), as :meth:`pkm.core.task.TaskMap.jacobian`."""
-        rows = []
-        for fid, comps in self._task_groups():
-            J6 = self.frame_jacobian(fid)
-            if comps == ("pose",):
-                rows.append(J6)
-                continue
-            Jw = euler_rates(self.frame_placement(fid).R) @ J6[3:, :]
-            rows += [J6[_POS[c], :] if c in _POS else Jw[_ANGLES.index(c), :] for c in comps]
-        for j in self.mech.task_joints:
-            e = cs.SX.zeros(1, self.mech.nv)
-            e[0, j.idx_v] = 1
-            rows.append(e)
-        return cs.vertcat(*rows)
-
-    @functools.cached_property
-    def ik_lu(self) -> PivotedLU:
-        """``[closure rows; task Jacobian]`` over every velocity coordinate but a floating base's, factored (pivots
-        fixed at the reference)."""
-        A = cs.vertcat(self._rows["jacobian"], self.task_jacobian)[:, self._free_cols]
-        try:
-            return PivotedLU(A, self.at_reference(A))
-        except ValueError as e:
-            raise SpecError(self.mech.source, f"the closure and the task do not fix every joint at the reference ({e}): "
-                                              "the task has fewer coordinates than the mechanism has degrees of "
-                                              "freedom, or the reference is singular") from None
-
-    @functools.cached_property
-    def _free_cols(self) -> list[int]:
-        base = set(self.mech.base_v.tolist())
-        return [i for i in range(self.mech.nv) if i not in base]
-
-    def _on_free(self, values) -> cs.SX:
-        out = cs.SX.zeros(self.mech.nv)
-        for r, col in enumerate(self._free_cols):
-            out[col] = values[r]
-        return out
-
-    @functools.cached_property
-    def ik_newton(self) -> dict:
-        """One Newton iteration of the inverse kinematics toward :attr:`task_target` from :attr:`q` (closure and task
-        together, a floating base held): ``q_next`` (the next iterate), ``residual`` (the largest closure residual or task
-        error there), ``pivot`` (as in :attr:`closure_newton`)."""
-        rhs = cs.vertcat(-self._rotated(self.closure_residual), self.task_error)
-        q_next = self.retract(self._on_free(self.ik_lu.solve(rhs)))
-        return {"q_next": q_next,
-                "residual": self._largest_at(cs.vertcat(self.closure_residual, self.task_error), q_next),
-                "pivot": self.ik_lu.smallest_relative_pivot()}
-
-    @functools.cached_property
-    def map_newton(self) -> dict:
-        """The Newton iteration of the maps (:mod:`pkm.core.maps`): ``q_next`` as :attr:`ik_newton`, ``step`` the
-        largest entry of the step (no residual at the new iterate: convergence is tested on the step, then on
-        :attr:`map_indices`' residual), ``pivot`` as in :attr:`ik_newton` (at ``q``)."""
-        rhs = cs.vertcat(-self._rotated(self.closure_residual), self.task_error)
-        step = self._on_free(self.ik_lu.solve(rhs))
-        return {"q_next": self.retract(step), "step": cs.mmax(cs.fabs(step)),
-                "pivot": self.ik_lu.smallest_relative_pivot()}
-
-    @functools.cached_property
-    def map_newton_qr(self) -> dict:
-        """:attr:`map_newton` with the step from CasADi's QR factorisation of the rows the LU pivots on (no
-        pivoting needed: the maps' fallback where the LU's fixed pivots fail although the matrix is regular)."""
-        rows = sorted(r for r, _ in self.ik_lu.order)
-        A = cs.vertcat(self._rows["jacobian"], self.task_jacobian)[rows, self._free_cols]
-        rhs = cs.vertcat(-self._rotated(self.closure_residual), self.task_error)[rows]
-        step = self._on_free(cs.solve(A, rhs))
-        return {"q_next": self.retract(step), "step": cs.mmax(cs.fabs(step))}
-
-    @functools.cached_property
-    def scale(self):
-        """The symbol of the task rates' scales (task size): :attr:`map_indices` homogenises with ``K diag(scale)``."""
-        return cs.SX.sym("scale", self.task_jacobian.shape[0])
-
-    @functools.cached_property
-    def map_indices(self) -> dict:
-        """What a map needs at a solved node: ``K`` (na x task size), :attr:`inverse_jacobian` times
-        ``diag(scale)``; ``residual`` (the largest closure residual or task error at ``q``); ``branch``, the quantities
-        whose signs define the default branch (the sine of a revolute coordinate, a prismatic coordinate)."""
-        mech = self.mech
-        branch = []
-        if mech.spec.default_branch is not None:
-            for name in mech.branch().signs:
-                j = mech.joints[name]
-                x = self.q[j.idx_q]
-                branch.append(cs.sin(x) if j.revolute else x)
-        return {"K": self.inverse_jacobian @ cs.diag(self.scale),
-                "residual": cs.mmax(cs.fabs(cs.vertcat(self.closure_residual, self.task_error))),
-                "branch": cs.vertcat(*branch) if branch else cs.SX(0, 1)}
-
-    @functools.cached_property
-    def forward_jacobian(self):
-        """Task rates per actuated rate (task size x na): ``J_task G``."""
-        return self.task_jacobian @ self.passive_map
-
-    @functools.cached_property
-    def inverse_jacobian(self):
-        """Actuated rates per task rate (na x task size): the actuated rows of ``[W J; J_task]^-1 [0; I]``."""
-        n_closure = self._rows["jacobian"].shape[0]
-        at = {c: r for r, c in enumerate(self._free_cols)}
-        cols = []
-        for k in range(self.task_jacobian.shape[0]):
-            e = cs.DM.zeros(n_closure + self.task_jacobian.shape[0])
-            e[n_closure + k] = 1
-            x = self.ik_lu.solve(e)
-            cols.append(cs.vertcat(*[x[at[int(c)]] for c in self.mech.act_v]))
-        return cs.horzcat(*cols)
+        return TaskTwin(self)
 
     # ---------------------------------------------------------------- configuration space
     @functools.cached_property
@@ -547,17 +400,18 @@ class Twin:
         ``q_next`` (the next iterate, its actuated coordinates set), ``residual`` (the largest closure residual there) and
         ``pivot`` (:meth:`PivotedLU.smallest_relative_pivot` at the iterate it starts from)."""
         q_next = self.with_actuated(self.retract(self.closure_step))
-        return {"q_next": q_next, "residual": self._largest_at(self.closure_residual, q_next),
+        return {"q_next": q_next, "residual": self.largest_at(self.closure_residual, q_next),
                 "pivot": self.with_actuated(self.passive_lu.smallest_relative_pivot())}
 
-    def _largest_at(self, residual, q):
+    def largest_at(self, residual, q):
+        """The largest entry of ``residual`` (an expression of :attr:`q`) at the configuration ``q``."""
         return cs.mmax(cs.fabs(cs.substitute(residual, self.q, q)))
 
     # ---------------------------------------------------------------- functions
     def function(self, name: str, outputs: dict, inputs: tuple[str, ...] = ("q", "v", "a")) -> cs.Function:
         """``casadi.Function(name, inputs, outputs)`` over the twin's symbols."""
         sym = {"q": self.q, "v": self.v, "a": self.a, "qd": self.qd, "qdd": self.qdd, "target": self.target,
-               "y": self.task_target, "scale": self.scale}
+               "y": self.task.task_target, "scale": self.task.scale}
         return cs.Function(name, [sym[i] for i in inputs], list(outputs.values()), list(inputs), list(outputs))
 
 
