@@ -101,6 +101,7 @@ def _one(name: str, args) -> dict:
     core_tau = np.array([pkm.inverse_dynamics(mech, *s) for s in states])
     core_us = _median_us(lambda: pkm.inverse_dynamics(mech, *states[len(states) // 2]), max(20, args.calls // 20))
     closure_core_us = _median_us(lambda: pkm.close_loops(mech, QA[k + 1], Q[k]), max(20, args.calls // 20))
+    count = K.operation_count()
     diff = {"kernel_batch_c": float(np.abs(tau[idx] - core_tau).max()),
             "kernel_batch_numpy": float(np.abs(tau_numpy - tau[:m]).max())}
     if name == "prs3":
@@ -114,7 +115,7 @@ def _one(name: str, args) -> dict:
         "closure_path_iterations_mean": float(path.iterations.mean()),
         "closure_path_fallbacks": len(path.fallback),
         "closure_core_us_per_solve": closure_core_us,
-        "operation_count": {"mul": K.operation_count().mul, "add": K.operation_count().add},
+        "operation_count": {"mul": count.mul, "add": count.add},
         "how": K.how["inverse_dynamics"],
     })
     reason = unavailable()
