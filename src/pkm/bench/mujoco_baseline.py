@@ -48,11 +48,11 @@ class MujocoRigid:
             jnt = int(m.body_jntadr[b])
             jm = pm.joints[j]
             kind = jm.shortname().removeprefix("JointModel")
-            scale, offset, src = 1.0, 0.0, jm
+            scale, offset = 1.0, 0.0
             if kind == "Mimic":
                 e = jm.extract()
                 scale, offset = float(e.scaling), float(e.offset)
-            self._joints.append((src, kind, int(m.jnt_qposadr[jnt]), int(m.jnt_dofadr[jnt]), scale, offset))
+            self._joints.append((jm, kind, int(m.jnt_qposadr[jnt]), int(m.jnt_dofadr[jnt]), scale, offset))
         self._act = [int(m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, pm.names[j.id])])
                      for j in mech.actuated]
 
