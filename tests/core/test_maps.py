@@ -19,13 +19,6 @@ from pkm.papers import delta as delta_study
 from pkm.papers import rrr3 as rrr3_study
 
 
-@pytest.fixture(scope="module", autouse=True)
-def _cache(tmp_path_factory):
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("PKM_CACHE_DIR", str(tmp_path_factory.mktemp("twin-cache")))
-        yield
-
-
 def _rrr3_map(figure: str):
     d = rrr3_study.figure_design(figure)
     mech = pkm.build("rrr3", a=d.a, b=d.b, h=d.h, H=d.H)

@@ -20,13 +20,6 @@ from pkm.papers import hexapod as study
 from tests.core.twin.test_tree import EXAMPLES
 
 
-@pytest.fixture(scope="module", autouse=True)
-def _cache(tmp_path_factory):
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("PKM_CACHE_DIR", str(tmp_path_factory.mktemp("twin-cache")))
-        yield
-
-
 def _core_index(mech, target: dict, params, length: float, kind: str = "ci_2") -> float:
     """1/kappa_2 (or the normalised Frobenius index) of the inverse Jacobian with the parameters held, by the
     generic core (no twin)."""

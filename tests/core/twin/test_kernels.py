@@ -21,12 +21,6 @@ NAMES = ["prs3", "delta", "rrr3", "hexapod", "gough_stewart", "mjcf_fourbar"]
 HAS_CC = bool(shutil.which("cc") or shutil.which("gcc") or shutil.which("clang"))
 
 
-@pytest.fixture(scope="module", autouse=True)
-def _cache(tmp_path_factory):
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("PKM_CACHE_DIR", str(tmp_path_factory.mktemp("twin-cache")))
-        yield
-
 
 def _mechanism(name: str) -> pkm.Mechanism:
     return pkm.load(FILES[name]) if name in FILES else pkm.load(name)
