@@ -18,6 +18,7 @@ import argparse
 import importlib
 import json
 import math
+import statistics
 import time
 from collections.abc import Callable, Sequence
 from types import ModuleType
@@ -43,6 +44,20 @@ def best_time(fn: Callable[[], Any], repeat: int) -> tuple[float, Any]:
         out = fn()
         best = min(best, time.perf_counter() - t0)
     return best, out
+
+
+def median_us(fn: Callable[..., Any], args: Sequence[tuple] = ((),), repeat: int = 2000) -> float:
+    """Median wall time of one call ``fn(*a)`` [us] over ``repeat`` calls cycling through ``args``, after up to 50
+    warm-up calls."""
+    for a in list(args[:50]) * max(1, 50 // max(len(args), 1)):
+        fn(*a)
+    times = []
+    for k in range(repeat):
+        a = args[k % len(args)]
+        t0 = time.perf_counter()
+        fn(*a)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times) * 1e6
 
 
 def parser(mod: ModuleType, cls: type[argparse.ArgumentParser] = argparse.ArgumentParser) -> argparse.ArgumentParser:
@@ -81,4 +96,4 @@ def main(name: str, argv: Sequence[str] | None = None) -> int:
     return 0
 
 
-__all__ = ["NAMES", "arguments", "best_time", "main", "module", "parser"]
+__all__ = ["NAMES", "arguments", "best_time", "main", "median_us", "module", "parser"]

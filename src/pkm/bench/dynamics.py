@@ -19,15 +19,13 @@ Usage: ``python -m pkm.bench.dynamics [--json] [--quick] [-n 100000]``.
 from __future__ import annotations
 
 import shutil
-import statistics
 import subprocess
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 
-from pkm.bench import best_time, main
+from pkm.bench import best_time, main, median_us
 from pkm.core.dynamics import forward_dynamics
 from pkm.mechanisms.prs3.dynamics import Prs3Dynamics, generate_c
 
@@ -52,18 +50,6 @@ int main(void) {
   return 0;
 }
 """
-
-
-def _median_us(fn, args, repeat: int = 2000) -> float:
-    for a in args[:50]:
-        fn(*a)
-    times = []
-    for k in range(repeat):
-        a = args[k % len(args)]
-        t0 = time.perf_counter()
-        fn(*a)
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times) * 1e6
 
 
 def via_constraint_dynamics(dyn: Prs3Dynamics, y, yd, ydd) -> np.ndarray:
@@ -104,9 +90,9 @@ def run(args) -> dict:
 
     base = np.array([via_constraint_dynamics(dyn, *s) for s in sample])
     slow = max(1, args.repeat // 5)
-    t_base = _median_us(lambda *s: via_constraint_dynamics(dyn, *s), sample, repeat=slow)
-    t_khalil = _median_us(dyn.pinocchio, sample, repeat=slow)
-    t_pkm = _median_us(dyn.forces, sample, repeat=args.repeat)
+    t_base = median_us(lambda *s: via_constraint_dynamics(dyn, *s), sample, repeat=slow)
+    t_khalil = median_us(dyn.pinocchio, sample, repeat=slow)
+    t_pkm = median_us(dyn.forces, sample, repeat=args.repeat)
     dyn.batch(Y[:1000], Yd[:1000], Ydd[:1000])
     best, res = best_time(lambda: dyn.batch(Y, Yd, Ydd), 3)
     t_batch = best / n * 1e6

@@ -22,12 +22,9 @@ Usage: ``python -m pkm.bench.twin [--json] [--quick] [-n 20000]``.
 
 from __future__ import annotations
 
-import statistics
-import time
-
 import numpy as np
 
-from pkm.bench import best_time, main
+from pkm.bench import best_time, main, median_us
 
 QUICK = {"n": 400, "repeat": 2, "calls": 200}
 MECHANISMS = ("prs3", "delta", "hexapod")
@@ -37,17 +34,6 @@ def add_arguments(ap) -> None:
     ap.add_argument("-n", type=int, default=20_000, help="samples along each path (default 20,000)")
     ap.add_argument("--repeat", type=int, default=5, help="timed repeats of each batch route (best kept)")
     ap.add_argument("--calls", type=int, default=2000, help="timed single calls (median kept)")
-
-
-def _median_us(fn, calls: int) -> float:
-    for _ in range(min(50, calls)):
-        fn()
-    times = []
-    for _ in range(calls):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times) * 1e6
 
 
 def _path(mech, n: int):
@@ -92,15 +78,15 @@ def _one(name: str, args) -> dict:
     m = min(n, 2000)
     numpy_t, tau_numpy = best_time(lambda: numpy_route.inverse_dynamics(Q[:m], QD[:m], QDD[:m]), max(1, args.repeat // 2))
     k = n // 3
-    call_us = _median_us(lambda: K.inverse_dynamics(Q[k], QD[k], QDD[k]), args.calls)
+    call_us = median_us(lambda: K.inverse_dynamics(Q[k], QD[k], QDD[k]), [()], args.calls)
     idx = np.linspace(0, n - 1, min(n, 50)).astype(int)
     states = []
     for i in idx:
         v = pkm.velocities(mech, Q[i], QD[i])
         states.append((Q[i], v, pkm.accelerations(mech, Q[i], v, QDD[i])))
     core_tau = np.array([pkm.inverse_dynamics(mech, *s) for s in states])
-    core_us = _median_us(lambda: pkm.inverse_dynamics(mech, *states[len(states) // 2]), max(20, args.calls // 20))
-    closure_core_us = _median_us(lambda: pkm.close_loops(mech, QA[k + 1], Q[k]), max(20, args.calls // 20))
+    core_us = median_us(lambda: pkm.inverse_dynamics(mech, *states[len(states) // 2]), [()], max(20, args.calls // 20))
+    closure_core_us = median_us(lambda: pkm.close_loops(mech, QA[k + 1], Q[k]), [()], max(20, args.calls // 20))
     count = K.operation_count()
     diff = {"kernel_batch_c": float(np.abs(tau[idx] - core_tau).max()),
             "kernel_batch_numpy": float(np.abs(tau_numpy - tau[:m]).max())}
@@ -121,7 +107,7 @@ def _one(name: str, args) -> dict:
     reason = unavailable()
     if reason is None:
         rigid = MujocoRigid(mech)
-        mj_us = _median_us(lambda: rigid.efforts(*states[len(states) // 2]), max(20, args.calls // 10))
+        mj_us = median_us(lambda: rigid.efforts(*states[len(states) // 2]), [()], max(20, args.calls // 10))
         diff["mujoco"] = float(np.abs(np.array([rigid.efforts(*s) for s in states]) - core_tau).max())
         out["mujoco_rigid_us"] = mj_us
         out["ratio_to_mujoco"] = {"kernel_batch_c": mj_us / out["kernel_batch_c_us"],
