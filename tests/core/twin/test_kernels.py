@@ -34,10 +34,12 @@ def _states(mech: pkm.Mechanism, n: int, seed: int = 0):
     return Q, rng.standard_normal((n, mech.na)), rng.standard_normal((n, mech.na))
 
 
-@pytest.mark.parametrize("compiled", [True, False], ids=["C", "vm"])
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize(("name", "compiled"), [(n, True) for n in NAMES]
+                         + [(n, False) for n in ("prs3", "rrr3", "mjcf_fourbar")],
+                         ids=[f"{n}-C" for n in NAMES] + [f"{n}-numpy" for n in ("prs3", "rrr3", "mjcf_fourbar")])
 def test_the_kernels_equal_the_generic_core(name, compiled):
-    """Efforts, joint rates and accelerations, forward and inverse Jacobians from the kernels, one sample and a batch
+    """Efforts, joint rates and accelerations, forward and inverse Jacobians from the kernels (compiled for every
+    mechanism; numpy and the virtual machine, the same expressions, for three), one sample and a batch
     of 6: the generic core's (pkm.inverse_dynamics, pkm.velocities, pkm.accelerations, pkm.forward_jacobian) to
     1e-10 relative."""
     mech = _mechanism(name)
