@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core import redundant_parameter
+from pkm.core import indices, redundant_parameter
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.task import TaskMap
 from pkm.errors import InvalidInputError, UnreachableError
@@ -128,13 +128,9 @@ class _Index:
 
     def values(self, Q: np.ndarray) -> np.ndarray:
         K = self.kernels.inverse_jacobian(Q)[:, self.keep_act][:, :, self.keep_task] * self.scale
-        s = np.linalg.svd(K, compute_uv=False)
-        with np.errstate(divide="ignore"):
-            if self.kind == "ci_2":
-                return s[:, -1] / s[:, 0]
-            if self.kind == "ci_fro":
-                return s.shape[1] / np.sqrt(np.sum(s * s, axis=1) * np.sum(1.0 / (s * s), axis=1))
-            return 1.0 / np.prod(s, axis=1)
+        if self.kind == "manipulability":  # of the forward map K^-1
+            return 1.0 / np.asarray(indices.manipulability(K))
+        return np.asarray(indices.inverse_condition(K, "2" if self.kind == "ci_2" else "fro_normalized"))
 
     def __call__(self, k, x) -> np.ndarray:
         k = np.asarray(k, dtype=int)
