@@ -32,6 +32,8 @@ import numpy as np
 
 from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.task import TaskMap
+from pkm.core.twin.codegen import C_INT as _I
+from pkm.core.twin.codegen import C_REAL_P as _P
 from pkm.errors import InvalidInputError
 from pkm.validation import as_array, as_count, as_scalar, as_tolerance
 
@@ -43,8 +45,6 @@ PIVOT_FLOOR = 1e-3
 MAX_NODES = 50_000_000
 KINDS = ("2", "fro_normalized")
 
-_P = ctypes.POINTER(ctypes.c_double)
-_I = ctypes.c_longlong
 
 
 @dataclass(frozen=True, eq=False)

@@ -29,6 +29,9 @@ from pathlib import Path
 import casadi as cs
 
 _FLAGS = ("-shared", "-fPIC")
+#: ctypes types of the generated code's ``casadi_real*`` and ``casadi_int`` (``long long``).
+C_REAL_P = ctypes.POINTER(ctypes.c_double)
+C_INT = ctypes.c_longlong
 #: A branch quantity (the sine of an elbow) this close to 0 lies on the boundary between working modes: a map counts
 #: the node in both. (Newton locates a double root, where the elbow is straight, to about the square root of the
 #: machine precision: the sign of a sine under 1e-6 there is noise.)
@@ -360,5 +363,5 @@ def compile_function(fun: cs.Function, directory=None) -> tuple[cs.Function, str
     return cs.external(fun.name(), lib._name), how
 
 
-__all__ = ["cache_dir", "compile_function", "compile_library", "count_operations", "map_source", "numpy_function",
+__all__ = ["C_INT", "C_REAL_P", "cache_dir", "compile_function", "compile_library", "count_operations", "map_source", "numpy_function",
            "numpy_source", "source"]

@@ -22,6 +22,8 @@ import casadi as cs
 import numpy as np
 
 from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.twin.codegen import C_INT as _I
+from pkm.core.twin.codegen import C_REAL_P as _P
 from pkm.core.twin.codegen import compile_library, numpy_function
 from pkm.core.twin.tree import Twin
 from pkm.errors import InvalidInputError, NonFiniteError
@@ -30,8 +32,6 @@ from pkm.validation import as_array, as_count, as_tolerance
 #: Smallest relative pivot (:meth:`PivotedLU.smallest_relative_pivot`) at which a kernel's solve is trusted.
 PIVOT_FLOOR = 1e-6
 
-_P = ctypes.POINTER(ctypes.c_double)
-_I = ctypes.c_longlong
 
 
 @dataclass(frozen=True)
