@@ -63,12 +63,14 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.maps import task_map
     from pkm.core.reconfiguration import reconfigure
     from pkm.core.twin import Kernels, Twin
+    from pkm.sweeps import sweep
     from pkm.units import quantity
 
 
 __getattr__, __dir__ = lazy("pkm", globals(), {**dict.fromkeys(_CORE, "pkm.core"), "quantity": "pkm.units",
                                                 "Kernels": "pkm.core.twin", "Twin": "pkm.core.twin",
-                                                "task_map": "pkm.core.maps", "reconfigure": "pkm.core.reconfiguration"})
+                                                "task_map": "pkm.core.maps", "reconfigure": "pkm.core.reconfiguration",
+                                                "sweep": "pkm.sweeps"})
 
 __version__ = "0.1.0"
 
@@ -151,14 +153,13 @@ def save(mech: Mechanism, spec_path) -> Path:
     return path
 
 
-def build(name: str, **params) -> Mechanism:
-    """Mechanism ``name`` generated from parameters (SI units, or strings with units: ``R="120mm"``;
-    unspecified ones keep the paper's values).
+def design_params(name: str, **params):
+    """The design dataclass (``Params``) of mechanism ``name`` from parameters (SI units, or strings with units:
+    ``R="120mm"``; unspecified ones keep the paper's values), validated as :func:`build` does, without building.
 
     Raises:
         UnknownNameError: an unknown mechanism or parameter name (the valid ones listed).
-        InvalidParameterError: a parameter out of range, or a design that cannot assemble at its
-            reference pose (see the mechanism's ``Params``).
+        InvalidParameterError: a parameter out of range or with a unit of another kind.
     """
     from pkm.units import KIND_OF_UNIT, parse_quantity
 
@@ -185,7 +186,19 @@ def build(name: str, **params) -> Mechanism:
             params[key] = tuple(si(key, v, u) for v, u in zip(value, per))
         else:
             params[key] = si(key, value, units)
-    return mod.build(mod.Params(**params))
+    return mod.Params(**params)
+
+
+def build(name: str, **params) -> Mechanism:
+    """Mechanism ``name`` generated from parameters (SI units, or strings with units: ``R="120mm"``;
+    unspecified ones keep the paper's values).
+
+    Raises:
+        UnknownNameError: an unknown mechanism or parameter name (the valid ones listed).
+        InvalidParameterError: a parameter out of range, or a design that cannot assemble at its
+            reference pose (see the mechanism's ``Params``).
+    """
+    return mechanism_module(name).build(design_params(name, **params))
 
 
 __all__ = [
@@ -205,6 +218,7 @@ __all__ = [
     "assemble",
     "build",
     "close_loops",
+    "design_params",
     "diagnose",
     "errors",
     "follow_actuators",
@@ -223,6 +237,7 @@ __all__ = [
     "reconfigure",
     "save",
     "solve_ik",
+    "sweep",
     "task_acceleration",
     "task_map",
     "task_values",

@@ -9,6 +9,9 @@ Usage::
     pkm spec init MODEL [--out FILE] [--force]
     pkm report [--out DIR] [--paper NAME ...] [--no-figures] [--no-series]
     pkm bench [NAME ...] [--json] [--quick] [-- ARGS passed to each benchmark]
+    pkm sweep MECH NAME=START:STOP:COUNT ... --objective SPEC ... [--out FILE.parquet] [--scheduler ADDR]
+    pkm sweep plot FILE.parquet [--out DIR] [--pareto A,B]
+    pkm sweep best FILE.parquet --by OBJECTIVE [--n N] [--out DIR]
 
 Values are SI (m, rad, kg) unless they carry a unit: ``R=120mm``, ``beta=-11deg``, ``z=81cm``
 (lengths m, cm, mm; angles rad, deg; masses kg, g). A parameter's units are those of its field's
@@ -525,12 +528,70 @@ def cmd_bench(args) -> int:
     return 0
 
 
+def cmd_sweep(args) -> int:
+    from pkm import sweeps
+
+    axes = dict(_split(item, "sweep") for item in args.parameters)
+    if len(axes) != len(args.parameters):
+        raise UsageError("name each swept parameter once")
+    if args.table:
+        if axes:
+            raise UsageError("--table gives the designs; name no NAME=... ranges beside it")
+        space = sweeps.table(args.table)
+    elif args.sample == "grid":
+        if args.n is not None or args.seed is not None:
+            raise UsageError("--n and --seed are for --sample sobol or lhs (a grid's size is its axes')")
+        space = sweeps.grid(**axes)
+    else:
+        if args.n is None:
+            raise UsageError(f"--sample {args.sample} needs --n (the number of designs)")
+        draw = sweeps.sobol if args.sample == "sobol" else sweeps.latin_hypercube
+        space = draw(args.n, seed=args.seed, **axes)
+    if not args.table and not axes:
+        raise UsageError("name the parameters to vary, e.g. a=30cm:80cm:11 (see 'pkm list')")
+    fixed = dict(_split(item, "--fixed") for item in args.fixed)
+    res = sweeps.sweep(args.mechanism, space, args.objective, out=args.out, fixed=fixed or None,
+                       scheduler=args.scheduler, workers=args.workers, chunk_size=args.chunk,
+                       progress=False if args.no_progress else None, overwrite=args.overwrite)
+    st = res.stats
+    out = {"mechanism": res.manifest["family"], "designs": len(res), "failed": st.failed,
+           "evaluated_now": st.evaluated, "space": res.manifest["space"], "out": args.out,
+           "workers": st.workers, "wall_seconds": st.wall_seconds, "work_seconds": st.work_seconds,
+           "best": {c: res.best(c, 1)[0] if o["sense"] and res.best(c, 1) else None
+                    for c, o in res.objectives.items()}}
+    print(json.dumps(jsonable(out), indent=2))
+    return 0
+
+
+def cmd_sweep_plot(args) -> int:
+    from pkm import sweeps
+
+    pareto = [n.strip() for n in args.pareto.split(",")] if args.pareto else None
+    paths = sweeps.plot(args.results, args.out, pareto)
+    print(json.dumps([str(p) for p in paths], indent=2))
+    return 0
+
+
+def cmd_sweep_best(args) -> int:
+    from pkm import sweeps
+
+    paths = sweeps.write_best(args.results, args.by, args.out, n=args.n, mechanism=args.mechanism)
+    print(json.dumps([str(p) for p in paths], indent=2))
+    return 0
+
+
 # ---------------------------------------------------------------------- parser
 class _Parser(argparse.ArgumentParser):
     """argparse that raises :class:`UsageError` instead of printing usage and exiting."""
 
     def error(self, message: str):
         raise UsageError(f"{message} (see '{self.prog} --help')")
+
+
+def _objective_names() -> list[str]:
+    from pkm.sweeps.objectives import OBJECTIVES
+
+    return list(OBJECTIVES)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -616,6 +677,47 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the results of all as one JSON object")
     p.add_argument("--quick", action="store_true", help="small sizes: checks that they run, in seconds")
     p.set_defaults(func=cmd_bench, extra=[])
+
+    p = sub.add_parser("sweep", parents=[debug], help="a design sweep on Dask: objectives of every design, Parquet "
+                                                      "results ('pkm sweep plot', 'pkm sweep best' read them)",
+                       epilog="Objectives: " + ", ".join(_objective_names()) + "; options as gci:step=1cm, a "
+                              "column name as label=SPEC, or path/to/file.py:function. A killed sweep run again "
+                              "with the same --out resumes.")
+    p.add_argument("mechanism", metavar="MECH", help=f"one of {mechs}, or a closure spec file (its URDF joint "
+                                                     "origins JOINT.x ... JOINT.yaw are the parameters)")
+    p.add_argument("parameters", metavar="NAME=RANGE", nargs="*",
+                   help="grid: a=30cm:80cm:11 (START:STOP:COUNT) or a=0.3; sampled: a=30cm:80cm (LOW:HIGH)")
+    p.add_argument("--objective", metavar="SPEC", action="append", required=True, help="an objective (repeat)")
+    p.add_argument("--sample", choices=("grid", "sobol", "lhs"), default="grid", help="how to draw the designs")
+    p.add_argument("--n", type=int, help="designs to draw (sobol, lhs)")
+    p.add_argument("--seed", type=int, help="the samples' seed (default: drawn and recorded in the results)")
+    p.add_argument("--table", metavar="FILE", help="explicit designs: a .csv (header of parameter names) or .parquet")
+    p.add_argument("--fixed", metavar="K=V", action="extend", nargs="+", default=[],
+                   help="parameters not swept (default: the paper's design)")
+    p.add_argument("--out", metavar="FILE", help="the results, .parquet (resumed if it holds this sweep's parts)")
+    p.add_argument("--scheduler", metavar="ADDR", help="a Dask scheduler (tcp://host:8786), or 'serial' (this "
+                                                       "process); default: a local cluster, one worker per core")
+    p.add_argument("--workers", type=int, help="local workers (default: one per core); with --scheduler, wait for")
+    p.add_argument("--chunk", type=int, help="designs per task (default: about 32 tasks per worker)")
+    p.add_argument("--overwrite", action="store_true", help="replace an output that holds another sweep")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_sweep)
+
+    p = sub.add_parser("sweep-plot", parents=[debug], prog=f"{PROG} sweep plot",
+                       help="(pkm sweep plot FILE) parameter-objective plots and Pareto fronts of a sweep's results")
+    p.add_argument("results", metavar="FILE", help="a sweep's .parquet results")
+    p.add_argument("--out", metavar="DIR", default=".", help="where to write the PNGs (default: .)")
+    p.add_argument("--pareto", metavar="A,B", help="objectives of the Pareto fronts (default: all with a sense)")
+    p.set_defaults(func=cmd_sweep_plot)
+
+    p = sub.add_parser("sweep-best", parents=[debug], prog=f"{PROG} sweep best",
+                       help="(pkm sweep best FILE --by OBJ) the best designs as closure specs for pkm preview")
+    p.add_argument("results", metavar="FILE", help="a sweep's .parquet results")
+    p.add_argument("--by", metavar="OBJECTIVE", required=True, help="the objective column to rank by (its sense)")
+    p.add_argument("--n", type=int, default=3, help="how many (default: 3)")
+    p.add_argument("--out", metavar="DIR", default="best", help="where to write them (default: best/)")
+    p.add_argument("--mechanism", metavar="SPEC", help="the files of a loaded mechanism the sweep varied")
+    p.set_defaults(func=cmd_sweep_best)
     return ap
 
 
@@ -626,6 +728,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if "--" in argv:  # the rest goes to the benchmarks
         k = argv.index("--")
         argv, extra = argv[:k], argv[k + 1:]
+    if argv[:1] == ["sweep"] and argv[1:2] in (["plot"], ["best"]):  # 'pkm sweep plot' is the parser's sweep-plot
+        argv = [f"sweep-{argv[1]}"] + argv[2:]
     debug = "--debug" in argv
     try:
         try:

@@ -195,3 +195,15 @@ class BranchError(PkmError):
         self.found = dict(found)
         diff = [k for k in expected if expected[k] != found.get(k)]
         super().__init__(f"solution is not on branch {branch!r}: joints {diff} have the opposite sign")
+
+
+class SweepError(PkmError):
+    """A design sweep cannot run as asked: its output holds another sweep, or its scheduler cannot be reached.
+
+    Attributes:
+        path: The output or scheduler address concerned (None when neither).
+    """
+
+    def __init__(self, message: str, path: object = None):
+        self.path = path
+        super().__init__(message)

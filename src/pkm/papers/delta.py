@@ -92,6 +92,25 @@ def radius_study() -> design.RadiusStudy:
     return design.workspace_vs_radius(PAPER, R_STUDY, kind=CHOICE_KIND, spacing=SPACING)
 
 
+def radius_sweep(R_values=R_STUDY, scheduler: str | None = None):
+    """The study of R through :func:`pkm.sweep`: for each base radius (the other dimensions the paper's), the
+    reachable volume, the volume where ``K_2 <= 3``, the integral of ``1/K_2`` (8 mm grid) and ``K_2``, ``K_F`` at
+    the study pose; the same numbers as :func:`radius_study` and :func:`fig5_sweep` (tested).
+
+    Returns:
+        The :class:`pkm.sweeps.SweepResult` (columns ``volume``, ``volume_K3``, ``weighted``, ``K_2``, ``K_fro``).
+    """
+    import pkm
+    from pkm import sweeps
+
+    fixed = {"La": PAPER.La, "Lb": PAPER.Lb, "r": PAPER.r, "home": PAPER.home}
+    spacing = f"spacing={SPACING!r}"
+    return pkm.sweep("delta", sweeps.table({"R": np.asarray(R_values, dtype=float)}),
+                     [f"volume=workspace_volume:{spacing}", f"volume_K3=conditioned_volume:{spacing},k_max={K_MAX!r}",
+                      f"weighted=weighted_volume:{spacing}", "K_2=condition:kind=2", "K_fro=condition:kind=fro"],
+                     fixed=fixed, scheduler=scheduler)
+
+
 def choose_radius(k_max: float = K_MAX, R_range: tuple[float, float] = R_RANGE) -> float:
     """The R [m] in ``R_range`` with the largest workspace volume where ``K_2 <= k_max``."""
     study = radius_study()
@@ -222,4 +241,4 @@ def series(out_dir) -> list[Path]:
 
 
 __all__ = ["PAPER", "POSE", "TITLE", "arms_vertical_radius", "choose_radius", "fig5_sweep", "figures",
-           "knee_in_singularity", "radius_study", "reach_limit", "reproduce", "series"]
+           "knee_in_singularity", "radius_study", "radius_sweep", "reach_limit", "reproduce", "series"]

@@ -1,0 +1,30 @@
+"""Design sweeps on Dask: every design of a space scored by the library's analyses, results in Parquet.
+
+::
+
+    import pkm
+    from pkm import sweeps
+
+    res = pkm.sweep("rrr3", sweeps.grid(a="20cm:65cm:10", b="20cm:65cm:10", h="5cm:50cm:10"),
+                    ["gci", "gci_area", "coverage"], out="rrr3.parquet")   # a LocalCluster, one worker per core
+    res.best("gci_area", 3)                                                 # rows, best first
+    res.pareto(["gci_area", "coverage"])                                    # rows on the front
+    sweeps.plot(res, "figures/")                                            # parameter-objective and Pareto plots
+    sweeps.write_best(res, "gci_area", "best/", n=3)                        # closure specs for pkm preview
+
+The pieces: :mod:`~pkm.sweeps.space` (grids, Sobol', Latin hypercubes, tables), :mod:`~pkm.sweeps.family`
+(what varies: a registered mechanism's design fields or a loaded one's joint origins), :mod:`~pkm.sweeps.objectives`
+(what is scored), :mod:`~pkm.sweeps.engine` (Dask, chunks, Parquet, resume) and :mod:`~pkm.sweeps.plot`.
+"""
+
+from __future__ import annotations
+
+from pkm.sweeps.engine import FORMAT, Stats, SweepError, SweepResult, pareto_front, read, sweep
+from pkm.sweeps.family import Candidate, Family, ModelFamily, RegisteredFamily, family_of
+from pkm.sweeps.objectives import OBJECTIVES, Objective, objective
+from pkm.sweeps.plot import plot, write_best
+from pkm.sweeps.space import Designs, Space, grid, latin_hypercube, sobol, table
+
+__all__ = ["FORMAT", "OBJECTIVES", "Candidate", "Designs", "Family", "ModelFamily", "Objective", "RegisteredFamily",
+           "Space", "Stats", "SweepError", "SweepResult", "family_of", "grid", "latin_hypercube", "objective",
+           "pareto_front", "plot", "read", "sobol", "sweep", "table", "write_best"]

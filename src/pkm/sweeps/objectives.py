@@ -1,0 +1,543 @@
+"""What a sweep scores: objectives taken from the library's analyses, and user callables.
+
+An objective is named by a spec ``NAME`` or ``NAME:OPTION=VALUE,...`` (``gci:step=1cm``,
+``condition:pose=x=2cm/z=-36cm,kind=fro``), optionally given a column name of its own (``centre=condition:...``);
+:data:`OBJECTIVES` lists them. Each has a generic route, which works on any mechanism pkm loads (the task-space
+maps of :func:`pkm.task_map`, the inverse Jacobian at a pose, the trajectory follower, the symbolic twin), and,
+for some registered mechanisms, a closed-form fast path that is also the papers' route (the 3-RRR's vectorised CI
+maps, the Delta's workspace grid and K(R), the hexapod's reachable beta intervals); ``route=generic`` or
+``route=closed_form`` forces one (the default, ``auto``, takes the closed form where there is one). A region is
+``region=x=-5cm:5cm:11/y=-5cm:5cm:11`` (1 to 3 task coordinates, ``START:STOP:COUNT``), a pose
+``pose=x=2cm/y=0/z=-36cm`` (the other coordinates from the reference).
+
+A user callable ``f(design) -> float | None`` receives the :class:`~pkm.sweeps.family.Candidate` (``design.mechanism``,
+``design.params``, ``design.values``); :func:`objective` wraps it (``objective(f, sense="max")``), and the command
+line takes ``path/to/file.py:function`` or ``module:function``, with ``@max`` or ``@min`` for its sense.
+
+An objective returns a float, or None where it has no value (an empty workspace has no GCI): a null in the results,
+not a failure. Any exception fails the design (recorded with its class and message), never the sweep.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import math
+import re
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pkm.errors import InvalidInputError, UnknownNameError
+from pkm.sweeps.family import Candidate
+from pkm.units import parse_quantity
+
+SENSES = ("max", "min", "")
+ROUTES = ("auto", "closed_form", "generic")
+_NAME = re.compile(r"^[A-Za-z_][\w.-]*$")
+
+
+@dataclass(frozen=True)
+class Definition:
+    """One objective of :data:`OBJECTIVES`.
+
+    Attributes:
+        name: Its name in a spec.
+        sense: ``"max"`` or ``"min"``: which way is better (Pareto fronts, best designs).
+        unit: Of its value (SI).
+        doc: One line.
+        options: ``{option: (kind, default, doc)}``; kinds ``length``, ``angle``, ``float``, ``int``, ``text``, and
+            ``pose`` / ``region`` (read against the mechanism's task).
+        generic: ``(design, options) -> value`` on any mechanism, or None.
+        closed_forms: ``{registered mechanism: (design, options) -> value}``.
+    """
+
+    name: str
+    sense: str
+    unit: str
+    doc: str
+    options: Mapping[str, tuple[str, Any, str]]
+    generic: Callable[[Candidate, Mapping[str, Any]], float | None] | None
+    closed_forms: Mapping[str, Callable[[Candidate, Mapping[str, Any]], float | None]] = field(default_factory=dict)
+
+    def route(self, family, route: str) -> Callable[[Candidate, Mapping[str, Any]], float | None]:
+        closed = self.closed_forms.get(family.registered or "")
+        if route in ("auto", "closed_form") and closed is not None:
+            return closed
+        if route in ("auto", "generic") and self.generic is not None:
+            return self.generic
+        which = "closed form" if route == "closed_form" else "route"
+        has = sorted(self.closed_forms) + (["any mechanism (generic)"] if self.generic else [])
+        raise InvalidInputError("objective", f"{self.name} has no {which} for {family.registered or 'this mechanism'}"
+                                             f" (it has: {', '.join(has) or 'none'})", self.name)
+
+
+@dataclass(frozen=True)
+class Objective:
+    """An objective with its options, as a sweep evaluates it.
+
+    Attributes:
+        column: The results' column.
+        spec: Its spec text (``gci:step=1cm``), or ``module:function`` for a callable.
+        sense: ``"max"``, ``"min"`` or ``""`` (unknown: a callable given none).
+        unit: Its unit.
+        definition: The library objective, or None for a callable.
+        options: Its options (SI), for a library objective.
+        function: The callable, or None.
+    """
+
+    column: str
+    spec: str
+    sense: str
+    unit: str
+    definition: Definition | None = None
+    options: Mapping[str, Any] = field(default_factory=dict)
+    function: Callable[[Candidate], Any] | None = None
+
+    def bind(self, family) -> Callable[[Candidate], float | None]:
+        """The function that scores one design of ``family`` (the route chosen once, here)."""
+        if self.function is not None:
+            return self.function
+        assert self.definition is not None
+        fn = self.definition.route(family, self.options.get("route", "auto"))
+        return lambda c: fn(c, self.options)
+
+    def describe(self) -> dict[str, str]:
+        return {"column": self.column, "spec": self.spec, "sense": self.sense, "unit": self.unit}
+
+
+def objective(spec, *, column: str | None = None, sense: str | None = None, unit: str = "") -> Objective:
+    """An :class:`Objective` from a spec (``"gci:step=1cm"``, ``"name=spec"``, ``"file.py:function"``), a callable
+    (``column`` default its ``__name__``; ``sense`` ``"max"``/``"min"`` for fronts and best designs), or itself.
+
+    Raises:
+        UnknownNameError: an unknown objective or option (the valid ones listed).
+        InvalidInputError, UnitError: a malformed option value.
+    """
+    if isinstance(spec, Objective):
+        return spec
+    if callable(spec):
+        name = str(column or getattr(spec, "__name__", ""))
+        _check_column(name)
+        return Objective(name, f"{getattr(spec, '__module__', '?')}:{getattr(spec, '__qualname__', name)}",
+                         _sense(sense or ""), unit, function=spec)
+    if not isinstance(spec, str) or not spec.strip():
+        raise InvalidInputError("objective", "give an objective's name (see pkm.sweeps.OBJECTIVES), a spec such as "
+                                             "'gci:step=1cm', or a callable", spec)
+    spec = spec.strip()
+    head = spec.split(":", 1)[0]
+    if "=" in head:  # column=spec
+        column, spec = (s.strip() for s in spec.split("=", 1))
+        head = spec.split(":", 1)[0]
+    if head.endswith(".py") or (":" in spec and head not in OBJECTIVES and "=" not in spec.split(":", 1)[1]):
+        where, at, given = spec.rpartition("@")  # file.py:function@max
+        if at and given in ("max", "min"):
+            spec, sense = where, sense or given
+        fn = load_callable(spec)
+        return objective(fn, column=column, sense=sense, unit=unit)
+    if head not in OBJECTIVES:
+        raise UnknownNameError("objective", head, OBJECTIVES, "pkm.sweeps (or path/to/file.py:function)")
+    d = OBJECTIVES[head]
+    options = _options(d, spec.split(":", 1)[1] if ":" in spec else "")
+    column = str(column or spec)
+    _check_column(column)
+    return Objective(column, spec, _sense(d.sense if sense is None else sense), d.unit, d, options)
+
+
+def load_callable(spec: str) -> Callable:
+    """``path/to/file.py:function`` or ``package.module:function``."""
+    where, _, name = spec.rpartition(":")
+    if not where or not name.isidentifier():
+        raise InvalidInputError("objective", f"{spec!r}: expected path/to/file.py:function or module:function", spec)
+    if where.endswith(".py"):
+        path = Path(where)
+        if not path.is_file():
+            raise InvalidInputError("objective", f"{spec!r}: no such file {path}", spec)
+        mod_spec = importlib.util.spec_from_file_location(f"pkm_user_{path.stem}", path)
+        assert mod_spec is not None and mod_spec.loader is not None
+        module = importlib.util.module_from_spec(mod_spec)
+        mod_spec.loader.exec_module(module)
+    else:
+        try:
+            module = importlib.import_module(where)
+        except ImportError as exc:
+            raise InvalidInputError("objective", f"{spec!r}: cannot import {where} ({exc})", spec) from None
+    fn = getattr(module, name, None)
+    if not callable(fn):
+        raise InvalidInputError("objective", f"{spec!r}: {where} has no function {name}", spec)
+    return fn
+
+
+def _check_column(name: str) -> None:
+    if not name or name in RESERVED:
+        raise InvalidInputError("objective", f"{name!r} cannot name a column (empty, or one of {sorted(RESERVED)})",
+                                name)
+
+
+def _sense(sense: str) -> str:
+    if sense not in SENSES:
+        raise InvalidInputError("sense", f"one of 'max', 'min' (or '' for neither), got {sense!r}", sense)
+    return sense
+
+
+def _options(d: Definition, text: str) -> dict[str, Any]:
+    out: dict[str, Any] = {"route": "auto"}
+    for item in filter(None, (s.strip() for s in text.split(","))):
+        key, eq, value = item.partition("=")
+        key = key.strip()
+        if key == "route":
+            if value not in ROUTES:
+                raise InvalidInputError("route", f"one of {', '.join(ROUTES)}, got {value!r}", value)
+            out["route"] = value
+            continue
+        if not eq or key not in d.options:
+            raise UnknownNameError("option", key, list(d.options) + ["route"], f"objective {d.name}")
+        out[key] = _option(key, d.options[key][0], value.strip())
+    for key, (_, default, _) in d.options.items():
+        out.setdefault(key, default)
+    return out
+
+
+def _option(key: str, kind: str, value: str):
+    if kind in ("length", "angle"):
+        return parse_quantity(value, {kind}, key, "m" if kind == "length" else "rad")
+    if kind in ("float", "int"):
+        try:
+            return int(value) if kind == "int" else float(value)
+        except ValueError:
+            raise InvalidInputError(key, f"{key}={value!r}: expected a number", value) from None
+    if kind == "pose":
+        return dict(_split_items(key, value))
+    if kind == "region":
+        axes = {}
+        for name, text in _split_items(key, value):
+            parts = text.split(":")
+            if len(parts) != 3 or not parts[2].isdigit() or int(parts[2]) < 1:
+                raise InvalidInputError(key, f"{key}: {name}={text!r}: expected START:STOP:COUNT", value)
+            axes[name] = (parts[0], parts[1], int(parts[2]))
+        if not 1 <= len(axes) <= 3:
+            raise InvalidInputError(key, f"{key}: 1 to 3 task coordinates", value)
+        return axes
+    return value
+
+
+def _split_items(key: str, value: str) -> list[tuple[str, str]]:
+    out = []
+    for item in filter(None, value.split("/")):
+        name, eq, text = item.partition("=")
+        if not eq or not name:
+            raise InvalidInputError(key, f"{key}={value!r}: expected NAME=VALUE/NAME=VALUE...", value)
+        out.append((name.strip(), text.strip()))
+    return out
+
+
+# ---------------------------------------------------------------------- generic routes
+def _task_value(mech, name: str, text: str) -> float:
+    task = mech.task_map
+    if name not in task.kinds:
+        raise UnknownNameError("task coordinate", name, list(task.keys), mech.name)
+    kind = task.kinds[name]
+    return parse_quantity(text, {kind}, name, "m" if kind == "length" else "rad")
+
+
+def _generic_map(c: Candidate, o: Mapping[str, Any]):
+    """The :func:`pkm.task_map` of the design over ``region`` (cached per design and region)."""
+    if not o.get("region"):
+        raise InvalidInputError("region", "the generic route maps a region: give region=x=START:STOP:COUNT/...")
+
+    def make():
+        from pkm.core.maps import task_map
+
+        mech = c.mechanism
+        axes = {n: np.linspace(_task_value(mech, n, a), _task_value(mech, n, b), k)
+                for n, (a, b, k) in o["region"].items()}
+        fixed = {n: _task_value(mech, n, v) for n, v in (o.get("pose") or {}).items()}
+        return task_map(mech, axes, fixed, length=o.get("length"), branch=o.get("branch") or None)
+
+    key = ("task_map", tuple(o["region"].items()), tuple((o.get("pose") or {}).items()), o.get("length"),
+           o.get("branch"))
+    return c.cached(key, make)
+
+
+def _generic_gci(c, o):
+    return _generic_map(c, o).gci(o["kind"])
+
+
+def _generic_coverage(c, o):
+    m = _generic_map(c, o)
+    return float(np.count_nonzero(m.reachable) / m.reachable.size)
+
+
+def _generic_min_ci(c, o):
+    m = _generic_map(c, o)
+    return float(np.min(m.condition_index(o["kind"])[m.reachable])) if m.reachable.any() else None
+
+
+def _generic_volume(c, o):
+    return float(_generic_map(c, o).size)
+
+
+def _generic_conditioned_volume(c, o):
+    m = _generic_map(c, o)
+    ci = m.condition_index(o["kind"])[m.reachable]
+    return float(np.count_nonzero(ci >= 1.0 / o["k_max"]) * m.cell)
+
+
+def _generic_weighted_volume(c, o):
+    m = _generic_map(c, o)
+    return float(np.sum(m.condition_index(o["kind"])[m.reachable]) * m.cell)
+
+
+def _generic_condition(c, o):
+    """``kappa`` of the inverse Jacobian at the pose, the angular rates divided by ``length`` (as the maps do)."""
+    import pkm
+    from pkm.core.indices import condition_number
+    from pkm.errors import SingularityError
+
+    mech = c.mechanism
+    target = {n: _task_value(mech, n, v) for n, v in (o.get("pose") or {}).items()}
+    res = pkm.solve_ik(mech, target, branch=o.get("branch") or None)
+    task = mech.task_map
+    kinds = [task.kinds[k] for k in task.keys]
+    if "angle" in kinds and "length" in kinds and o.get("length") is None:
+        raise InvalidInputError("length", "the task mixes lengths and angles: give length=L (the characteristic "
+                                          "length dividing the angular rates)")
+    scale = np.array([1.0 if k == "length" else 1.0 / (o.get("length") or 1.0) for k in kinds])
+    try:
+        K = pkm.inverse_jacobian(mech, res.q)
+    except SingularityError:
+        return math.inf
+    return float(condition_number(K * scale, o["kind"]))
+
+
+def _motion(c: Candidate, o: Mapping[str, Any]):
+    """``(trajectory, motion)`` of the design along its motion case (cached)."""
+    def make():
+        import pkm
+        from pkm.motion import load_motions
+
+        mech = c.mechanism
+        file = o.get("file") or f"{c.family.registered}_motions.toml"
+        motions = load_motions(file)
+        if o["motion"] not in motions:
+            raise UnknownNameError("motion case", o["motion"], motions, str(file))
+        motion = motions[o["motion"]]
+        coords = tuple(o["coordinates"].split("/")) if o.get("coordinates") else motion.coordinates
+        if len(coords) != len(motion.coordinates):
+            raise InvalidInputError("coordinates", f"name the motion's {len(motion.coordinates)} coordinates "
+                                                   f"{motion.coordinates} as task coordinates", o.get("coordinates"))
+        task = mech.task_map
+        missing = [k for k in coords if k not in task.value_names]
+        if missing or len(coords) != len(task.keys):
+            raise InvalidInputError("coordinates", f"the motion's coordinates {coords} must be the task's "
+                                                   f"{task.keys} (rename them: coordinates={'/'.join(task.keys)})",
+                                    coords)
+        _, Y, Yd, Ydd = motion.sample(None if not o.get("samples") else np.linspace(0.0, motion.duration,
+                                                                                   int(o["samples"])))
+        order = [coords.index(k) for k in task.keys]
+        return pkm.follow_task(mech, Y[:, order], Yd[:, order], Ydd[:, order], efforts=True)
+
+    return c.cached(("motion", o.get("file"), o["motion"], o.get("coordinates"), o.get("samples")), make)
+
+
+def _peak_effort(c, o):
+    return float(np.max(np.abs(_motion(c, o).efforts)))
+
+
+def _peak_power(c, o):
+    traj = _motion(c, o)
+    return float(np.max(np.abs(traj.efforts * traj.actuated_velocity)))
+
+
+def _operation_count(c, o):
+    import pkm
+
+    count = c.cached(("opcount", o["kernel"]), lambda: pkm.Kernels(c.mechanism).operation_count(o["kernel"]))
+    if o["count"] not in ("total", "mul", "add"):
+        raise InvalidInputError("count", f"one of total, mul, add, got {o['count']!r}", o["count"])
+    return float({"total": count.mul + count.add, "mul": count.mul, "add": count.add}[o["count"]])
+
+
+def _generic_interval(c, o):
+    """Length of the reachable part of ``parameter`` (a task joint) over ``range`` at the pose: a 1-D map."""
+    name = o.get("parameter")
+    if not name or not o.get("range"):
+        raise InvalidInputError("parameter", "give parameter=TASK_JOINT and range=START:STOP:COUNT")
+    region = {name: tuple(o["range"].split(":"))}
+    if len(region[name]) != 3 or not region[name][2].isdigit():
+        raise InvalidInputError("range", f"range={o['range']!r}: expected START:STOP:COUNT", o["range"])
+    a, b, k = region[name]
+    m = _generic_map(c, {**o, "region": {name: (a, b, int(k))}, "length": o.get("length") or 1.0})  # (reach only)
+    (_, values), = m.axes
+    step = float(values[1] - values[0]) if len(values) > 1 else 0.0
+    return float(np.count_nonzero(m.reachable) * step)
+
+
+# ---------------------------------------------------------------------- closed forms (the papers' routes)
+def _rrr3_map(c: Candidate, o):
+    from pkm.mechanisms.rrr3 import workspace as ws
+
+    d = ws.Design.of(c.params)
+    return c.cached(("rrr3_map", o["step"], o["kind"]), lambda: ws.ci_map(
+        d, ws.workspace_grid(d, o["step"]), ws.CiSettings(norm=o["kind"])))
+
+
+def _rrr3_gci(c, o):
+    g = _rrr3_map(c, o).gci()
+    return None if g.empty else g.value
+
+
+def _rrr3_area(c, o):
+    g = _rrr3_map(c, o).area_gci(o["side"])
+    return None if g.empty else g.value
+
+
+def _centroid(c):
+    from pkm.mechanisms.rrr3 import workspace as ws
+
+    return ws.Design.of(c.params).base_centroid
+
+
+def _rrr3_coverage(c, o):
+    g = _rrr3_map(c, o).area_gci(o["side"])
+    return g.reachable / g.nodes
+
+
+def _rrr3_min_area_ci(c, o):
+    m = _rrr3_map(c, o)
+    region = m.grid.square_mask(o["side"], _centroid(c)) & m.reachable
+    return float(np.min(m.ci[region])) if region.any() else None
+
+
+def _rrr3_volume(c, o):
+    m = _rrr3_map(c, o)
+    return float(np.count_nonzero(m.reachable) * m.grid.step**2)
+
+
+def _delta_grid(c, o):
+    from pkm.mechanisms.delta.workspace import workspace
+
+    kind = o["kind"]
+    return c.cached(("delta_grid", o["spacing"], kind, o["branch"]),
+                    lambda: workspace(c.params, o["spacing"], o["branch"] or "knee_out", (kind,)))
+
+
+def _delta_volume(c, o):
+    return float(_delta_grid(c, o).volume)
+
+
+def _delta_K(c, o):
+    g = _delta_grid(c, o)
+    return g.K[o["kind"]][g.reachable]
+
+
+def _delta_conditioned_volume(c, o):
+    return float(np.count_nonzero(_delta_K(c, o) <= o["k_max"]) * o["spacing"] ** 3)
+
+
+def _delta_weighted_volume(c, o):  # (summed in ascending K, as the serial study's sorted nodes: the same float)
+    return float(np.sum(1.0 / np.sort(_delta_K(c, o))) * o["spacing"] ** 3)
+
+
+def _delta_condition(c, o):
+    from pkm.mechanisms.delta import reference_pose
+    from pkm.mechanisms.delta.design import condition_vs_radius
+
+    p = np.array(reference_pose(c.params), dtype=float)
+    for n, v in (o.get("pose") or {}).items():
+        if n not in ("x", "y", "z"):
+            raise UnknownNameError("task coordinate", n, ("x", "y", "z"), "delta")
+        p["xyz".index(n)] = parse_quantity(v, {"length"}, n, "m")
+    kind = o["kind"]
+    return float(condition_vs_radius(c.params, p, [c.params.R], o["branch"] or "knee_out", (kind,))[kind][0])
+
+
+def _hexapod_pose(c, o):
+    from pkm.mechanisms.hexapod import kinematics as hk
+
+    if o.get("pose"):
+        raise InvalidInputError("pose", "the hexapod's closed form scores its reference pose; use route=generic "
+                                        "for another pose")
+    R, P, _ = hk.reference_pose(c.params)
+    return R, P
+
+
+def _hexapod_interval(c, o):
+    from pkm.errors import UnreachableError
+    from pkm.mechanisms.hexapod.reconfiguration import reachable_intervals
+
+    R, P = _hexapod_pose(c, o)
+    try:
+        spans = reachable_intervals(c.params, R, P)
+    except UnreachableError:
+        return 0.0
+    return float(sum(hi - lo for lo, hi in spans))
+
+
+def _hexapod_gain(c, o):
+    from pkm.mechanisms.hexapod import indices as hi
+    from pkm.mechanisms.hexapod.reconfiguration import optimal_beta
+
+    R, P = _hexapod_pose(c, o)
+    best = optimal_beta(c.params, R, P, o["index"])
+    nominal = hi.PoseIndex(c.params, [(R, P)], o["index"])([0], [c.params.home_beta])
+    return float(best.value / float(np.ravel(nominal)[0]) - 1.0)
+
+
+_MAP = {"region": ("region", None, "task coordinates mapped (generic): x=START:STOP:COUNT/y=..."),
+        "pose": ("pose", None, "the other task coordinates (generic): x=2cm/z=-36cm"),
+        "length": ("length", None, "characteristic length dividing angular rates (generic), e.g. 5cm"),
+        "branch": ("text", "", "working mode (default: the spec's)"),
+        "kind": ("text", "2", "condition-number convention: 2, fro, fro_normalized")}
+_RRR3 = {"step": ("length", 0.01, "3-RRR closed form: grid step"),
+         "side": ("length", 0.30, "3-RRR closed form: side of the square area of interest")}
+_DELTA = {"spacing": ("length", 0.008, "Delta closed form: workspace grid step")}
+
+#: name -> :class:`Definition`: every library objective.
+OBJECTIVES: dict[str, Definition] = {d.name: d for d in (
+    Definition("gci", "max", "-", "global condition index: mean 1/kappa over the reachable nodes",
+               {**_MAP, **_RRR3}, _generic_gci, {"rrr3": _rrr3_gci}),
+    Definition("gci_area", "max", "-", "GCI over the area of interest (generic: the region)",
+               {**_MAP, **_RRR3}, _generic_gci, {"rrr3": _rrr3_area}),
+    Definition("coverage", "max", "-", "reachable fraction of the area of interest (generic: the region)",
+               {**_MAP, **_RRR3}, _generic_coverage, {"rrr3": _rrr3_coverage}),
+    Definition("min_area_ci", "max", "-", "smallest 1/kappa over the reachable nodes of the area (generic: region)",
+               {**_MAP, **_RRR3}, _generic_min_ci, {"rrr3": _rrr3_min_area_ci}),
+    Definition("workspace_volume", "max", "m^k", "reachable length, area or volume (generic: of the region)",
+               {**_MAP, **_RRR3, **_DELTA}, _generic_volume, {"rrr3": _rrr3_volume, "delta": _delta_volume}),
+    Definition("conditioned_volume", "max", "m^k", "volume of the reachable nodes with kappa <= k_max",
+               {**_MAP, **_DELTA, "k_max": ("float", 3.0, "bound on kappa")}, _generic_conditioned_volume,
+               {"delta": _delta_conditioned_volume}),
+    Definition("weighted_volume", "max", "m^k", "integral of 1/kappa over the workspace (volume x GCI)",
+               {**_MAP, **_DELTA}, _generic_weighted_volume, {"delta": _delta_weighted_volume}),
+    Definition("condition", "min", "-", "condition number kappa at a pose (default: the reference)",
+               {k: _MAP[k] for k in ("pose", "length", "branch", "kind")}, _generic_condition,
+               {"delta": _delta_condition}),
+    Definition("reachable_interval", "max", "m or rad", "reachable length of a task joint's range at a pose "
+               "(generic: parameter=beta_1,range=-90deg:90deg:181; hexapod closed form: beta's intervals)",
+               {**_MAP, "parameter": ("text", "", "the task joint (generic)"),
+                "range": ("text", "", "its range START:STOP:COUNT (generic)")}, _generic_interval,
+               {"hexapod": _hexapod_interval}),
+    Definition("beta_gain", "max", "-", "hexapod: index at beta* over the index at the reference beta, minus 1",
+               {"pose": _MAP["pose"], "index": ("text", "w_rot", "w_rot or w_tras")}, None,
+               {"hexapod": _hexapod_gain}),
+    Definition("peak_effort", "min", "N or N m", "largest |actuator effort| along a motion case",
+               {"motion": ("text", "1", "the case's name"), "file": ("text", "", "motion file (default: "
+                "<mechanism>_motions.toml)"), "coordinates": ("text", "", "the motion's coordinates as task "
+                "coordinates, z/pitch/roll"), "samples": ("int", 0, "samples (default: the case's dt)")},
+               _peak_effort),
+    Definition("peak_power", "min", "W", "largest |effort x actuator rate| along a motion case",
+               {"motion": ("text", "1", "the case's name"), "file": ("text", "", "motion file"),
+                "coordinates": ("text", "", "as peak_effort"), "samples": ("int", 0, "as peak_effort")},
+               _peak_power),
+    Definition("operation_count", "min", "operations", "operations of a generated kernel after CSE",
+               {"kernel": ("text", "inverse_dynamics", "the kernel"), "count": ("text", "total", "total, mul, add")},
+               _operation_count),
+)}
+
+RESERVED = frozenset({"design", "status", "error", "message"})
+
+__all__ = ["OBJECTIVES", "ROUTES", "SENSES", "Definition", "Objective", "load_callable", "objective"]

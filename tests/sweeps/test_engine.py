@@ -1,0 +1,136 @@
+"""Running sweeps (pkm.sweeps.engine): Dask against the serial loop, Parquet results, resume after a kill,
+failing designs recorded, an existing scheduler reached by its address."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm import sweeps
+from pkm.errors import SweepError
+from pkm.mechanisms.rrr3 import workspace as maps
+from pkm.papers import rrr3 as paper
+
+COLUMNS = [f"{c}={c}:step=0.04" for c in ("gci", "gci_area", "coverage", "min_area_ci")]
+SMALL = sweeps.grid(a="30cm:60cm:4", b="40cm", h="5cm:20cm:4")
+
+
+def serial_columns(res: maps.SweepResult) -> list[np.ndarray]:
+    return [np.ma.filled(res.gci, np.nan), np.ma.filled(res.area_gci, np.nan), res.coverage,
+            np.ma.filled(res.min_area_ci, np.nan)]
+
+
+def test_the_paper_sweep_on_two_local_workers_equals_the_serial_loop_exactly():
+    """The 1,000 designs of sec. VII on a 2-worker LocalCluster (the default path) give, bit for bit, what the
+    serial loop of pkm.mechanisms.rrr3.workspace.sweep gives; so does the paper module's own route."""
+    designs = paper.paper_sweep_designs()
+    space = sweeps.table({k: [getattr(d, k) for d in designs] for k in ("a", "b", "h", "H")})
+    res = pkm.sweep("rrr3", space, COLUMNS, workers=2, progress=False)
+    assert res.stats.workers == 2 and res.stats.chunks >= 2 * 16 and res.stats.failed == 0
+    loop = maps.sweep(designs, step=0.04, progress=False)
+    for name, expected in zip(("gci", "gci_area", "coverage", "min_area_ci"), serial_columns(loop)):
+        np.testing.assert_array_equal(res.column(name), expected)
+    np.testing.assert_array_equal(res.column("design"), np.arange(1000))
+    assert np.isnan(res.column("gci")).any() and res.ok.all()  # empty workspaces: nulls, not failures
+
+
+def test_a_failing_design_is_recorded_and_the_others_go_on(tmp_path):
+    bad = sweeps.table([{"a": 0.4, "h": 0.1}, {"a": 0.4, "h": -0.1}, {"a": 0.5, "h": 0.1}])
+    res = pkm.sweep("rrr3", bad, ["gci:step=4cm"], scheduler="serial", out=tmp_path / "r.parquet")
+    assert res.ok.tolist() == [True, False, True] and res.stats.failed == 1
+    (fail,) = res.failures()
+    assert fail["design"] == 1 and fail["error"] == "InvalidParameterError" and "h" in fail["message"]
+    assert np.isnan(res.column("gci:step=4cm")[1]) and np.isfinite(res.column("gci:step=4cm")[[0, 2]]).all()
+    again = sweeps.read(tmp_path / "r.parquet")
+    assert again.table.equals(res.table) and again.failures() == res.failures()
+
+
+def test_a_finished_output_is_not_evaluated_again_and_another_sweep_is_refused(tmp_path):
+    out = tmp_path / "r.parquet"
+    first = pkm.sweep("rrr3", SMALL, ["gci:step=4cm"], scheduler="serial", out=out)
+    second = pkm.sweep("rrr3", SMALL, ["gci:step=4cm"], scheduler="serial", out=out)
+    assert second.stats.evaluated == 0 and second.table.equals(first.table)
+    with pytest.raises(SweepError, match="another sweep"):
+        pkm.sweep("rrr3", SMALL, ["gci:step=2cm"], scheduler="serial", out=out)
+    third = pkm.sweep("rrr3", SMALL, ["gci:step=2cm"], scheduler="serial", out=out, overwrite=True)
+    assert third.stats.evaluated == len(third)
+
+
+KILLER = '''
+import os, signal
+from pkm.mechanisms.rrr3 import workspace as ws
+
+def area(design):
+    """The platform triangle's area, and a SIGKILL of this process at the design named by PKM_TEST_KILL_AT."""
+    at = os.environ.get("PKM_TEST_KILL_AT")
+    if at and max(abs(float(x) - design.values[k]) for x, k in zip(at.split(","), "ah")) < 1e-12:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return 3 ** 0.5 / 4 * design.values["h"] ** 2
+'''
+
+
+def test_a_killed_sweep_resumes_where_it_stopped_and_gives_the_uninterrupted_table(tmp_path):
+    """`pkm sweep` killed (SIGKILL, mid-sweep) leaves the chunks it finished; the same sweep run again evaluates
+    only the others and gives the table of a run that was never interrupted."""
+    objective_file = tmp_path / "killer.py"
+    objective_file.write_text(KILLER, encoding="utf-8")
+    out = tmp_path / "r.parquet"
+    objectives = ["gci:step=4cm", f"{objective_file}:area@max"]
+    args = [sys.executable, "-m", "pkm", "sweep", "rrr3", "a=30cm:60cm:4", "b=40cm", "h=5cm:20cm:4",
+            "--objective", *objectives[:1], "--objective", objectives[1], "--scheduler", "serial", "--chunk", "1",
+            "--out", str(out), "--no-progress"]
+    env = {**os.environ, "PKM_TEST_KILL_AT": "0.5,0.15"}  # design 4 * 2 + 2 = 10 of 16
+    proc = subprocess.run(args, env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == -signal.SIGKILL, proc.stderr
+    parts = sorted((tmp_path / "r.parquet.parts").glob("part-*.parquet"))
+    assert len(parts) == 10 and not out.exists()
+    resumed = pkm.sweep("rrr3", SMALL, ["gci:step=4cm", objectives[1]], scheduler="serial", out=out)
+    assert resumed.stats.evaluated == 6 and not (tmp_path / "r.parquet.parts").exists()
+    whole = pkm.sweep("rrr3", SMALL, ["gci:step=4cm", objectives[1]], scheduler="serial")
+    assert resumed.table.equals(whole.table)
+    assert resumed.manifest["objectives"][1]["sense"] == "max"
+
+
+def test_an_existing_scheduler_and_worker_started_as_processes(tmp_path):
+    """`dask scheduler` and `dask worker` as separate processes on this machine; the sweep goes to the
+    scheduler's address and gives the serial loop's table."""
+    dask = Path(sys.executable).with_name("dask")
+    file = tmp_path / "scheduler.json"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    common = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+    sched = subprocess.Popen([str(dask), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                              "--scheduler-file", str(file)], **common)
+    worker = None
+    try:
+        deadline = time.monotonic() + 60
+        while not file.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        address = json.loads(file.read_text())["address"]
+        worker = subprocess.Popen([str(dask), "worker", address, "--nworkers", "1", "--nthreads", "1",
+                                   "--no-dashboard"], **common)
+        res = pkm.sweep("rrr3", SMALL, ["gci:step=4cm"], scheduler=address, workers=1, progress=False)
+        assert res.stats.workers == 1
+        serial = pkm.sweep("rrr3", SMALL, ["gci:step=4cm"], scheduler="serial")
+        assert res.table.equals(serial.table)
+    finally:
+        for p in (worker, sched):
+            if p is not None:
+                p.terminate()
+                p.wait(timeout=30)
+
+
+def test_an_unreachable_scheduler_is_a_clear_error():
+    import dask
+
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}), \
+            pytest.raises(SweepError, match=r"cannot reach the Dask scheduler at tcp://127\.0\.0\.1:9"):
+        pkm.sweep("rrr3", SMALL, ["gci:step=4cm"], scheduler="tcp://127.0.0.1:9")

@@ -1,0 +1,110 @@
+"""Objectives (pkm.sweeps.objectives): the papers' studies through pkm.sweep equal the serial ones; the generic
+routes agree with the closed forms; loaded mechanisms vary their joint origins; user callables; bad specs."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm import sweeps
+from pkm.errors import InvalidInputError, UnknownNameError
+from pkm.mechanisms.delta import design
+from pkm.mechanisms.rrr3 import workspace as maps
+from pkm.papers import delta as delta_paper
+from pkm.papers import rrr3 as rrr3_paper
+
+
+def test_the_delta_radius_study_through_the_sweep_equals_the_serial_study():
+    """Volumes (8 mm grid) and K(R) at the study pose: bit for bit the serial study's and Fig. 5's curves."""
+    R = delta_paper.R_STUDY[[2, 12, 24]]
+    res = delta_paper.radius_sweep(R, scheduler="serial")
+    study = design.workspace_vs_radius(delta_paper.PAPER, R, kind="2", spacing=delta_paper.SPACING)
+    np.testing.assert_array_equal(res.column("volume"), study.volume)
+    np.testing.assert_array_equal(res.column("volume_K3"), study.conditioned_volume(delta_paper.K_MAX))
+    np.testing.assert_array_equal(res.column("weighted"), study.weighted_volume())
+    K = design.condition_vs_radius(delta_paper.PAPER, delta_paper.POSE, R, "knee_out", ("2", "fro"))
+    np.testing.assert_array_equal(res.column("K_2"), K["2"])
+    np.testing.assert_array_equal(res.column("K_fro"), K["fro"])
+
+
+def test_the_rrr3_paper_route_is_the_serial_loop():
+    res = rrr3_paper.design_sweep(step=0.04, scheduler="serial")
+    loop = maps.sweep(rrr3_paper.paper_sweep_designs(), step=0.04, progress=False)
+    for a, b in zip((res.gci, res.area_gci, res.coverage, res.min_area_ci),
+                    (loop.gci, loop.area_gci, loop.coverage, loop.min_area_ci)):
+        np.testing.assert_array_equal(np.ma.filled(a, np.nan), np.ma.filled(b, np.nan))
+
+
+def test_the_generic_condition_number_agrees_with_the_delta_closed_form():
+    """kappa_2 and kappa_F of the inverse Jacobian at a pose off the axis, generic (solve_ik, inverse_jacobian)
+    against the closed form (the paper's eq. 12 Jacobians), over three base radii."""
+    pose = "pose=x=2cm/y=-1cm/z=-36cm"
+    res = pkm.sweep("delta", sweeps.grid(R="12cm:18cm:3"), [f"c2=condition:{pose}", f"g2=condition:{pose},route=generic",
+                                                             f"cf=condition:{pose},kind=fro",
+                                                             f"gf=condition:{pose},kind=fro,route=generic"],
+                    scheduler="serial")
+    assert res.ok.all()
+    np.testing.assert_allclose(res.column("g2"), res.column("c2"), rtol=1e-9)
+    np.testing.assert_allclose(res.column("gf"), res.column("cf"), rtol=1e-9)
+    assert len(set(np.round(res.column("c2"), 6))) == 3
+
+
+def test_the_generic_reachable_interval_agrees_with_the_hexapod_closed_form():
+    """beta's reachable length at the reference pose: a 1-degree scan of the compiled map against the exact
+    intervals (within two scan steps)."""
+    res = pkm.sweep("hexapod", sweeps.table({"h": [0.034]}),
+                    ["reachable_interval", "scan=reachable_interval:route=generic,parameter=beta_1,"
+                                           "range=-90deg:90deg:181", "beta_gain"], scheduler="serial")
+    assert res.ok.all(), res.failures()
+    exact, scan = res.column("reachable_interval")[0], res.column("scan")[0]
+    assert 1.0 < exact <= math.pi and abs(scan - exact) <= 2 * math.radians(1.0)
+    assert res.column("beta_gain")[0] > 0.0  # beta* beats the reference beta (0)
+
+
+def test_a_loaded_mechanism_sweeps_its_joint_origins():
+    """pkm's delta files as a user's own mechanism: motor_1's origin y [m] varied (one motor moved: a design no
+    generator makes); at the file's own value the objective is that of the mechanism as loaded."""
+    mech = pkm.load("delta")
+    res = pkm.sweep(mech, sweeps.grid(**{"motor_1.y": "13cm:15cm:3"}), ["condition"], scheduler="serial")
+    assert res.manifest["family"]["source"] == mech.source and res.manifest["units"] == {"motor_1.y": "m"}
+    K = res.column("condition")
+    unchanged = pkm.sweep(mech, sweeps.table({"motor_1.y": [0.15]}), ["condition"], scheduler="serial")
+    assert K[2] == unchanged.column("condition")[0] and len(set(K)) == 3
+    closed = pkm.sweep("delta", sweeps.table({"R": [0.15]}), ["condition"], scheduler="serial")
+    np.testing.assert_allclose(K[2], closed.column("condition")[0], rtol=1e-9)
+    with pytest.raises(UnknownNameError, match=r"motor_1\.w"):
+        pkm.sweep(mech, sweeps.grid(**{"motor_1.w": [0.1]}), ["condition"], scheduler="serial")
+
+
+def test_user_callables_their_nulls_and_their_failures():
+    def triangle(design):
+        h = design.values["h"]
+        return None if h > 0.15 else 3**0.5 / 4 * h**2
+
+    def text(design):
+        return "large"
+
+    res = pkm.sweep("rrr3", sweeps.grid(h="10cm:20cm:3"), [sweeps.objective(triangle, sense="min"), text],
+                    scheduler="serial")
+    area = res.column("triangle")
+    assert area[0] == pytest.approx(3**0.5 / 4 * 0.01, rel=1e-15) and np.isnan(area[2])
+    assert not res.ok.any() and {f["error"] for f in res.failures()} == {"InvalidInputError"}
+    assert res.objectives["triangle"]["sense"] == "min" and res.best("triangle", 1)[0]["design"] == 0
+
+
+@pytest.mark.parametrize("objectives,error,match", [
+    (["gcii"], UnknownNameError, "gcii"),
+    (["gci:stp=1cm"], UnknownNameError, "stp"),
+    (["gci:step=3deg"], InvalidInputError, "deg"),
+    (["beta_gain"], InvalidInputError, "beta_gain has no route for rrr3"),
+    (["workspace_volume:route=closed_form", "x=gci"], InvalidInputError, "no closed form"),
+    (["gci", "gci"], InvalidInputError, "named twice"),
+])
+def test_bad_objectives_are_refused_before_any_design_is_evaluated(objectives, error, match):
+    space = sweeps.grid(h="10cm:20cm:3")
+    mech = "prs3" if "closed_form" in objectives[0] else "rrr3"
+    with pytest.raises(error, match=match):
+        pkm.sweep(mech, space if mech == "rrr3" else sweeps.grid(h=[0.1]), objectives, scheduler="serial")
