@@ -18,6 +18,7 @@ import pytest
 
 import pkm
 from pkm import cli
+from pkm.bench import NAMES as BENCHMARKS
 from pkm.mechanisms import delta as D
 from pkm.mechanisms import module, names
 
@@ -249,23 +250,25 @@ def test_report_writes_the_hexapod_rows_and_refuses_an_unknown_paper(tmp_path):
 
 def test_bench_runs_a_benchmark_and_refuses_an_unknown_one(tmp_path):
     """``pkm bench opcount --json`` (about 2 s) prints its JSON under its name, from any directory; an unknown
-    benchmark exits 2 listing the five."""
+    benchmark exits 2 listing them."""
     proc = run("bench", "opcount", "--json", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
     assert list(out) == ["opcount"] and out["opcount"]
     bad = run("bench", "speed")
     line = one_error_line(bad)
-    assert bad.returncode == 2 and "'dynamics', 'hexapod', 'kinematics', 'opcount', 'twin', 'workspace'" in line
+    assert bad.returncode == 2 and ", ".join(repr(n) for n in BENCHMARKS) in line
 
 
 def test_bench_quick_runs_every_benchmark_and_refuses_bad_arguments(tmp_path):
-    """``pkm bench --quick --json`` runs all five (shipped in the package, so from any directory) with small
+    """``pkm bench --quick --json`` runs every one (shipped in the package, so from any directory) with small
     sizes; arguments a benchmark does not take exit 2 with one line."""
     proc = run("bench", "--quick", "--json", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
-    assert sorted(out) == ["dynamics", "hexapod", "kinematics", "opcount", "twin", "workspace"]
+    assert sorted(out) == sorted(BENCHMARKS) == ["dynamics", "hexapod", "kinematics", "opcount", "sweep", "twin",
+                                                 "workspace"]
+    assert all(r["equals_serial"] for k, r in out["sweep"]["runs"].items() if k != "serial")
     assert [r["samples"] for r in out["kinematics"]] == [3] * 4
     assert out["dynamics"]["max_force_difference_to_baseline_N"]["pkm"] < 1e-9
     bad = run("bench", "kinematics", "--", "--samples", "3")

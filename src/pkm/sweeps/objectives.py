@@ -62,6 +62,7 @@ class Definition:
     options: Mapping[str, tuple[str, Any, str]]
     generic: Callable[[Candidate, Mapping[str, Any]], float | None] | None
     closed_forms: Mapping[str, Callable[[Candidate, Mapping[str, Any]], float | None]] = field(default_factory=dict)
+    units: Mapping[str, str] = field(default_factory=dict)  # {registered mechanism: unit of its closed form}
 
     def route(self, family, route: str) -> Callable[[Candidate, Mapping[str, Any]], float | None]:
         closed = self.closed_forms.get(family.registered or "")
@@ -105,8 +106,12 @@ class Objective:
         fn = self.definition.route(family, self.options.get("route", "auto"))
         return lambda c: fn(c, self.options)
 
-    def describe(self) -> dict[str, str]:
-        return {"column": self.column, "spec": self.spec, "sense": self.sense, "unit": self.unit}
+    def describe(self, family) -> dict[str, str]:
+        """JSON-able, with the unit this family's route gives (a volume is m^2 for a planar closed form)."""
+        unit = self.unit
+        if self.definition is not None and self.options.get("route") != "generic":
+            unit = self.definition.units.get(family.registered or "", unit)
+        return {"column": self.column, "spec": self.spec, "sense": self.sense, "unit": unit}
 
 
 def objective(spec, *, column: str | None = None, sense: str | None = None, unit: str = "") -> Objective:
@@ -487,6 +492,7 @@ def _hexapod_gain(c, o):
     return float(best.value / float(np.ravel(nominal)[0]) - 1.0)
 
 
+_REGION_UNIT = "m^i rad^j"  # (the product of the region's axes' units)
 _MAP = {"region": ("region", None, "task coordinates mapped (generic): x=START:STOP:COUNT/y=..."),
         "pose": ("pose", None, "the other task coordinates (generic): x=2cm/z=-36cm"),
         "length": ("length", None, "characteristic length dividing angular rates (generic), e.g. 5cm"),
@@ -506,13 +512,14 @@ OBJECTIVES: dict[str, Definition] = {d.name: d for d in (
                {**_MAP, **_RRR3}, _generic_coverage, {"rrr3": _rrr3_coverage}),
     Definition("min_area_ci", "max", "-", "smallest 1/kappa over the reachable nodes of the area (generic: region)",
                {**_MAP, **_RRR3}, _generic_min_ci, {"rrr3": _rrr3_min_area_ci}),
-    Definition("workspace_volume", "max", "m^k", "reachable length, area or volume (generic: of the region)",
-               {**_MAP, **_RRR3, **_DELTA}, _generic_volume, {"rrr3": _rrr3_volume, "delta": _delta_volume}),
-    Definition("conditioned_volume", "max", "m^k", "volume of the reachable nodes with kappa <= k_max",
+    Definition("workspace_volume", "max", _REGION_UNIT, "reachable length, area or volume (generic: of the region)",
+               {**_MAP, **_RRR3, **_DELTA}, _generic_volume, {"rrr3": _rrr3_volume, "delta": _delta_volume},
+               {"rrr3": "m^2", "delta": "m^3"}),
+    Definition("conditioned_volume", "max", _REGION_UNIT, "volume of the reachable nodes with kappa <= k_max",
                {**_MAP, **_DELTA, "k_max": ("float", 3.0, "bound on kappa")}, _generic_conditioned_volume,
-               {"delta": _delta_conditioned_volume}),
-    Definition("weighted_volume", "max", "m^k", "integral of 1/kappa over the workspace (volume x GCI)",
-               {**_MAP, **_DELTA}, _generic_weighted_volume, {"delta": _delta_weighted_volume}),
+               {"delta": _delta_conditioned_volume}, {"delta": "m^3"}),
+    Definition("weighted_volume", "max", _REGION_UNIT, "integral of 1/kappa over the workspace (volume x GCI)",
+               {**_MAP, **_DELTA}, _generic_weighted_volume, {"delta": _delta_weighted_volume}, {"delta": "m^3"}),
     Definition("condition", "min", "-", "condition number kappa at a pose (default: the reference)",
                {k: _MAP[k] for k in ("pose", "length", "branch", "kind")}, _generic_condition,
                {"delta": _delta_condition}),
@@ -520,7 +527,7 @@ OBJECTIVES: dict[str, Definition] = {d.name: d for d in (
                "(generic: parameter=beta_1,range=-90deg:90deg:181; hexapod closed form: beta's intervals)",
                {**_MAP, "parameter": ("text", "", "the task joint (generic)"),
                 "range": ("text", "", "its range START:STOP:COUNT (generic)")}, _generic_interval,
-               {"hexapod": _hexapod_interval}),
+               {"hexapod": _hexapod_interval}, {"hexapod": "rad"}),
     Definition("beta_gain", "max", "-", "hexapod: index at beta* over the index at the reference beta, minus 1",
                {"pose": _MAP["pose"], "index": ("text", "w_rot", "w_rot or w_tras")}, None,
                {"hexapod": _hexapod_gain}),
