@@ -9,7 +9,7 @@ import pytest
 
 import pkm
 from pkm import cli, sweeps
-from pkm.sweeps.engine import pareto_front
+from pkm.sweeps.results import pareto_front
 
 
 def test_pareto_front_of_a_known_set():

@@ -19,11 +19,14 @@ The pieces: :mod:`~pkm.sweeps.space` (grids, Sobol', Latin hypercubes, tables), 
 
 from __future__ import annotations
 
-from pkm.sweeps.engine import FORMAT, Stats, SweepError, SweepResult, pareto_front, read, sweep
+from pkm.errors import SweepError
+from pkm.sweeps.engine import sweep
 from pkm.sweeps.family import Candidate, Family, ModelFamily, RegisteredFamily, family_of
 from pkm.sweeps.objectives import OBJECTIVES, Objective, objective
 from pkm.sweeps.plot import plot, write_best
+from pkm.sweeps.results import Stats, SweepResult, pareto_front, read
 from pkm.sweeps.space import Designs, Space, grid, latin_hypercube, sobol, table
+from pkm.sweeps.store import FORMAT
 
 __all__ = ["FORMAT", "OBJECTIVES", "Candidate", "Designs", "Family", "ModelFamily", "Objective", "RegisteredFamily",
            "Space", "Stats", "SweepError", "SweepResult", "family_of", "grid", "latin_hypercube", "objective",

@@ -8,16 +8,14 @@ scattered to the workers once, the chunks carry only their designs' values. With
 pkm); ``scheduler="serial"`` evaluates them in this process, one after the other (the reference the parallel runs
 are tested against, and the route for a debugger).
 
-With ``out="results.parquet"``, every finished chunk is written at once to ``results.parquet.parts/`` (a file per
-chunk, written whole or not at all) beside a manifest of the sweep (family, space with its seed, objectives); when
-every design is done the parts become the one file ``results.parquet`` (the manifest in its metadata) and the folder
-goes. A sweep started again with the same output resumes: designs already in a part are not evaluated again, and
-the table is the same as that of an uninterrupted run (the values of a design do not depend on the chunk, the
-worker or the order). A different sweep on an existing output is refused unless ``overwrite=True``.
+With ``out="results.parquet"`` every finished chunk is written at once, and a sweep started again with the same
+output resumes (:mod:`pkm.sweeps.store`): designs already written are not evaluated again, and the table is the
+one an uninterrupted run gives (the values of a design do not depend on its chunk, worker or order). A different
+sweep on an existing output is refused unless ``overwrite=True``.
 
 Each design is evaluated alone: an exception in an objective fails that design (``status="failed"``, the first
-failing objective's error class and message; that objective's cell null, the others kept), not the sweep; a chunk whose worker dies (Dask retries it on others first) records its designs as failed with the
-scheduler's error.
+failing objective's error class and message; that objective's cell null, the others kept), not the sweep; a chunk
+whose worker dies (Dask retries it on others first) records its designs as failed with the scheduler's error.
 """
 
 from __future__ import annotations
@@ -29,9 +27,7 @@ import os
 import shutil
 import time
 import traceback
-import uuid
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -40,46 +36,13 @@ import numpy as np
 from pkm.errors import InvalidInputError, PkmError, SweepError
 from pkm.sweeps.family import Family, family_of
 from pkm.sweeps.objectives import Objective, objective
+from pkm.sweeps.results import Stats, SweepResult
 from pkm.sweeps.space import Designs, Space
+from pkm.sweeps.store import chunk_table, combine, count_failed, manifest_of, parts_folder, resume, write_atomic
 
-FORMAT = "pkm.sweep/1"
 MAX_CHUNK = 500
 #: glibc's allocator settings of the local workers (see :func:`local_cluster`) [bytes].
 WORKER_MALLOC = {"MALLOC_MMAP_THRESHOLD_": 32 * 2**20, "MALLOC_TRIM_THRESHOLD_": 128 * 2**20}
-
-
-@dataclass(frozen=True)
-class Stats:
-    """How a run went.
-
-    Attributes:
-        designs: Designs in the sweep.
-        evaluated: Designs evaluated in this run (the others came from an earlier, interrupted one).
-        failed: Designs whose status is ``failed``.
-        chunks: Chunks evaluated in this run.
-        chunk_size: Designs per chunk.
-        workers: Worker processes (1 for ``serial``).
-        wall_seconds: From the first chunk submitted to the last result written.
-        work_seconds: Sum of the chunks' evaluation times on the workers.
-        startup_seconds: Starting the local cluster and sending the sweep's data (0 when given a client).
-    """
-
-    designs: int
-    evaluated: int
-    failed: int
-    chunks: int
-    chunk_size: int
-    workers: int
-    wall_seconds: float
-    work_seconds: float
-    startup_seconds: float
-
-    @property
-    def overhead(self) -> float:
-        """Time the workers were not evaluating designs, as a fraction of the work:
-        ``(workers x wall - work) / work`` (scheduling, transfers, writing, and the tail where some workers idle)."""
-        return (self.workers * self.wall_seconds - self.work_seconds) / self.work_seconds if self.work_seconds \
-            else math.nan
 
 
 class _Context:
@@ -159,117 +122,6 @@ def _run_chunk(context: _Context, ids: np.ndarray, values: np.ndarray) -> tuple[
     return cols, time.perf_counter() - t0
 
 
-# ---------------------------------------------------------------------- the results table
-def _schema(names: Sequence[str], objectives: Sequence[Objective]):
-    import pyarrow as pa
-
-    return pa.schema([("design", pa.int64())] + [(n, pa.float64()) for n in names]
-                     + [(o.column, pa.float64()) for o in objectives]
-                     + [("status", pa.string()), ("error", pa.string()), ("message", pa.string())])
-
-
-def _chunk_table(designs: Designs, objectives: Sequence[Objective], cols: Mapping[str, list]):
-    import pyarrow as pa
-
-    ids = np.asarray(cols["design"], dtype=np.int64)
-    data: dict[str, Any] = {"design": ids}
-    for k, n in enumerate(designs.names):
-        data[n] = designs.values[ids, k]
-    for o in objectives:
-        data[o.column] = cols[o.column]
-    for key in ("status", "error", "message"):
-        data[key] = cols[key]
-    return pa.Table.from_pydict(data, schema=_schema(designs.names, objectives))
-
-
-def _write_atomic(table, path: Path, metadata: Mapping[str, str] | None = None) -> None:
-    import pyarrow.parquet as pq
-
-    if metadata:
-        table = table.replace_schema_metadata({**(table.schema.metadata or {}), **metadata})
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
-    pq.write_table(table, tmp)
-    os.replace(tmp, path)
-
-
-def _parts(out: Path) -> Path:
-    return out.with_name(out.name + ".parts")
-
-
-def _manifest(family: Family, designs: Designs, objectives: Sequence[Objective]) -> dict[str, Any]:
-    import pkm
-
-    return {"format": FORMAT, "pkm": pkm.__version__, "family": family.describe(), "space": designs.description,
-            "parameters": list(designs.names), "units": {n: family.units(n)[1] for n in designs.names},
-            "designs": len(designs),
-            "objectives": [o.describe(family) for o in objectives],
-            "values_sha256": _sha(designs.values)}
-
-
-def _sha(values: np.ndarray) -> str:
-    import hashlib
-
-    return hashlib.sha256(np.ascontiguousarray(values, dtype="<f8").tobytes()).hexdigest()
-
-
-def _same(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
-    keys = ("format", "family", "parameters", "designs", "objectives", "values_sha256")
-    return all(json.dumps(a.get(k), sort_keys=True) == json.dumps(b.get(k), sort_keys=True) for k in keys)
-
-
-def read_manifest(path) -> dict[str, Any]:
-    """The manifest of a results file (or of an unfinished sweep's parts folder)."""
-    import pyarrow.parquet as pq
-
-    path = Path(path)
-    if path.is_dir():
-        return json.loads((path / "manifest.json").read_text(encoding="utf-8"))
-    if not path.is_file():
-        raise InvalidInputError("path", f"no such file: {path}", str(path))
-    try:
-        meta = pq.read_schema(path).metadata or {}
-    except Exception as exc:  # pyarrow's ArrowInvalid & co.: not Parquet, or damaged
-        raise InvalidInputError("path", f"{path} is not a Parquet file ({exc})", str(path)) from None
-    if b"pkm.sweep" not in meta:
-        raise InvalidInputError("path", f"{path} is not a pkm sweep's results (no manifest in its metadata)", str(path))
-    return json.loads(meta[b"pkm.sweep"])
-
-
-def _resume(out: Path, manifest: dict[str, Any], overwrite: bool):
-    """Designs already done (their tables), or None when the output is complete already (then its table)."""
-    import pyarrow.parquet as pq
-
-    parts = _parts(out)
-    if overwrite:
-        shutil.rmtree(parts, ignore_errors=True)
-        out.unlink(missing_ok=True)
-    if out.exists():
-        try:
-            old = read_manifest(out)
-        except Exception as exc:
-            raise SweepError(f"{out} exists and is not a pkm sweep's results ({exc}); pass overwrite=True "
-                             "(--overwrite) to replace it", out) from None
-        if not _same(old, manifest):
-            raise SweepError(f"{out} holds another sweep (other designs, objectives or mechanism); pass "
-                             "overwrite=True (--overwrite) to replace it, or choose another output", out)
-        return None, pq.read_table(out)
-    tables = []
-    if parts.exists():
-        try:
-            old = read_manifest(parts)
-        except (OSError, ValueError):
-            old = {}
-        if not _same(old, manifest):
-            raise SweepError(f"{parts} holds the parts of another sweep; pass overwrite=True (--overwrite) to "
-                             "start again, or choose another output", parts)
-        for p in sorted(parts.glob("part-*.parquet")):
-            tables.append(pq.read_table(p))
-    else:
-        parts.mkdir(parents=True)
-        (parts / "manifest.json").write_text(json.dumps(manifest, indent=1), encoding="utf-8")
-    return tables, None
-
-
 # ---------------------------------------------------------------------- the run
 def _local_workers() -> int:
     try:
@@ -330,12 +182,14 @@ def _client(scheduler, client, workers: int | None):
                                 scheduler)
     try:
         c = Client(scheduler)  # within dask's distributed.comm.timeouts.connect
-    except (OSError, TimeoutError) as exc:
+    except (OSError, TimeoutError, ValueError) as exc:  # (ValueError: not an address)
         raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: {exc}", scheduler) from None
-    if workers is None:
-        c.wait_for_workers(1, timeout=60)
-    else:
-        c.wait_for_workers(workers, timeout=60)
+    try:
+        c.wait_for_workers(1 if workers is None else workers, timeout=60)
+    except TimeoutError:
+        c.close()
+        raise SweepError(f"the Dask scheduler at {scheduler} has fewer than {workers or 1} workers after 60 s",
+                         scheduler) from None
     return c, (c,), max(1, len(c.scheduler_info().get("workers", {})))
 
 
@@ -383,23 +237,23 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
     context = _Context(family, designs.names, objectives)
     for o in objectives:
         o.bind(family)  # a route that does not exist fails here, not in every design
-    manifest = _manifest(family, designs, objectives)
+    manifest = manifest_of(family, designs, objectives)
     out_path = None if out is None else Path(out)
     done_tables: list = []
     if out_path is not None:
         if out_path.suffix != ".parquet":
             raise InvalidInputError("out", f"the results are a .parquet file, got {out_path}", str(out_path))
-        done_tables, complete = _resume(out_path, manifest, overwrite)
+        done_tables, complete = resume(out_path, manifest, overwrite)
         if done_tables is None:
-            return SweepResult(complete, manifest, Stats(len(designs), 0, _failed(complete), 0, 0, 0, 0.0, 0.0, 0.0))
+            return SweepResult(complete, manifest, Stats(len(designs), 0, count_failed(complete), 0, 0, 0, 0.0, 0.0, 0.0))
     done = np.zeros(len(designs), dtype=bool)
     for t in done_tables:
         done[np.asarray(t.column("design"))] = True
     todo = np.flatnonzero(~done)
 
     t_start = time.perf_counter()
-    serial = scheduler == "serial"
-    cl, owned, n_workers = (None, (), 1) if serial else _client(scheduler, client, workers)
+    in_process = scheduler == "serial" or not len(todo)  # (nothing left to do: no cluster to start)
+    cl, owned, n_workers = (None, (), 1) if in_process else _client(scheduler, client, workers)
     try:
         size = chunk_size if chunk_size is not None else max(1, min(MAX_CHUNK, math.ceil(len(todo) / (32 * n_workers))))
         if isinstance(size, bool) or not isinstance(size, int) or size < 1:
@@ -415,9 +269,9 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
         bar = _bar(progress, len(designs), int(done.sum()))
         try:
             for ids, cols, seconds in _results(cl, shared, chunks, designs, objectives):
-                table = _chunk_table(designs, objectives, cols)
+                table = chunk_table(designs, objectives, cols)
                 if out_path is not None:
-                    _write_atomic(table, _parts(out_path) / f"part-{ids[0]:09d}-{ids[-1]:09d}.parquet")
+                    write_atomic(table, parts_folder(out_path) / f"part-{ids[0]:09d}-{ids[-1]:09d}.parquet")
                 new_tables.append(table)
                 work += seconds
                 if bar is not None:
@@ -429,12 +283,12 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
     finally:
         for thing in owned:
             thing.close()
-    table = _combine(done_tables + new_tables, designs, objectives)
+    table = combine(done_tables + new_tables, designs, objectives)
     if out_path is not None:
-        _write_atomic(table, out_path, {"pkm.sweep": json.dumps(manifest)})
-        shutil.rmtree(_parts(out_path), ignore_errors=True)
+        write_atomic(table, out_path, {"pkm.sweep": json.dumps(manifest)})
+        shutil.rmtree(parts_folder(out_path), ignore_errors=True)
     evaluated = int(sum(len(c) for c in chunks))
-    return SweepResult(table, manifest, Stats(len(designs), evaluated, _failed(table), len(chunks), size, n_workers,
+    return SweepResult(table, manifest, Stats(len(designs), evaluated, count_failed(table), len(chunks), size, n_workers,
                                               wall, work, startup))
 
 
@@ -462,20 +316,6 @@ def _results(cl, shared, chunks, designs: Designs, objectives):
         yield ids, cols, seconds
 
 
-def _combine(tables, designs: Designs, objectives):
-    import pyarrow as pa
-
-    schema = _schema(designs.names, objectives)
-    if not tables:
-        return schema.empty_table()
-    table = pa.concat_tables([t.cast(schema) for t in tables])
-    return table.take(np.argsort(np.asarray(table.column("design")), kind="stable"))
-
-
-def _failed(table) -> int:
-    return int(sum(1 for s in table.column("status").to_pylist() if s == "failed"))
-
-
 def _bar(progress, total: int, initial: int):
     if progress is False:
         return None
@@ -485,104 +325,4 @@ def _bar(progress, total: int, initial: int):
                 else not progress)
 
 
-# ---------------------------------------------------------------------- results
-class SweepResult:
-    """The results of a sweep: one row per design, in design order.
-
-    Attributes:
-        table: The ``pyarrow.Table`` (``design``, the parameters [SI], the objectives, ``status``, ``error``,
-            ``message``), as written to the Parquet file.
-        manifest: What was swept (family, space and seed, objectives with their senses and units).
-        stats: How the run went (:class:`Stats`); zeros for a result read from a file.
-    """
-
-    def __init__(self, table, manifest: Mapping[str, Any], stats: Stats | None = None):
-        self.table = table
-        self.manifest = dict(manifest)
-        self.stats = stats or Stats(table.num_rows, 0, _failed(table), 0, 0, 0, 0.0, 0.0, 0.0)
-
-    def __len__(self) -> int:
-        return self.table.num_rows
-
-    def __repr__(self) -> str:
-        return (f"SweepResult({len(self)} designs of {self.manifest['family']}, {self.stats.failed} failed; "
-                f"objectives {list(self.objectives)})")
-
-    @property
-    def parameters(self) -> tuple[str, ...]:
-        return tuple(self.manifest["parameters"])
-
-    @property
-    def objectives(self) -> dict[str, dict[str, str]]:
-        """``{column: {"spec", "sense", "unit"}}``."""
-        return {o["column"]: o for o in self.manifest["objectives"]}
-
-    def column(self, name: str) -> np.ndarray:
-        """A parameter or objective as floats (NaN where null)."""
-        if name not in self.table.column_names:
-            from pkm.errors import UnknownNameError
-
-            raise UnknownNameError("column", name, self.table.column_names, "the sweep's results")
-        return np.array([np.nan if v is None else v for v in self.table.column(name).to_pylist()], dtype=float)
-
-    @property
-    def ok(self) -> np.ndarray:
-        return np.array([s == "ok" for s in self.table.column("status").to_pylist()])
-
-    def failures(self) -> list[dict[str, Any]]:
-        """The failed designs: ``{design, error, message, **parameters}``."""
-        rows = self.table.to_pylist()
-        return [{k: r[k] for k in ("design", "error", "message", *self.parameters)} for r in rows
-                if r["status"] == "failed"]
-
-    def _signed(self, names: Sequence[str]) -> np.ndarray:
-        """The objectives as columns to maximise (NaN where null)."""
-        cols = []
-        for n in names:
-            sense = self.objectives.get(n, {}).get("sense", "")
-            if sense not in ("max", "min"):
-                raise InvalidInputError("objectives", f"{n} has no sense (max or min): give one to rank by it", n)
-            cols.append(self.column(n) * (1.0 if sense == "max" else -1.0))
-        return np.column_stack(cols)
-
-    def best(self, by: str, n: int = 1) -> list[dict[str, Any]]:
-        """The ``n`` best designs by objective ``by`` (its sense), as rows (dicts), nulls last."""
-        score = self._signed([by])[:, 0]
-        order = [int(k) for k in np.argsort(-np.where(np.isnan(score), -np.inf, score), kind="stable")
-                 if not np.isnan(score[k])]
-        rows = self.table.take(order[:n]).to_pylist()
-        return rows
-
-    def pareto(self, names: Sequence[str]) -> np.ndarray:
-        """Indices (rows) of the designs on the Pareto front of ``names`` (each by its sense; rows with a null out)."""
-        return pareto_front(self._signed(names))
-
-    @classmethod
-    def read(cls, path) -> SweepResult:
-        """The results file a sweep wrote."""
-        import pyarrow.parquet as pq
-
-        manifest = read_manifest(path)
-        return cls(pq.read_table(path), manifest)
-
-
-def pareto_front(F: np.ndarray) -> np.ndarray:
-    """Rows of ``F`` (n x m, each column to maximise; rows with NaN excluded) that no other row dominates, sorted."""
-    F = np.asarray(F, dtype=float)
-    keep = np.flatnonzero(~np.isnan(F).any(axis=1))
-    G = F[keep]
-    order = np.lexsort(tuple(-G[:, j] for j in reversed(range(G.shape[1]))))  # best first on the first column
-    front: list[int] = []
-    for i in order:
-        if not any(np.all(G[j] >= G[i]) and np.any(G[j] > G[i]) for j in front):
-            front.append(int(i))
-    return np.sort(keep[front])
-
-
-def read(path) -> SweepResult:
-    """:meth:`SweepResult.read`."""
-    return SweepResult.read(path)
-
-
-__all__ = ["FORMAT", "MAX_CHUNK", "Stats", "SweepError", "SweepResult", "local_cluster", "pareto_front", "read",
-           "sweep"]
+__all__ = ["MAX_CHUNK", "WORKER_MALLOC", "local_cluster", "sweep"]

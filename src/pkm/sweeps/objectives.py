@@ -319,12 +319,14 @@ def _generic_condition(c, o):
 
 
 def _motion(c: Candidate, o: Mapping[str, Any]):
-    """``(trajectory, motion)`` of the design along its motion case (cached)."""
+    """The :class:`pkm.Trajectory` (efforts included) of the design along its motion case (cached)."""
     def make():
         import pkm
         from pkm.motion import load_motions
 
         mech = c.mechanism
+        if not o.get("file") and not c.family.registered:
+            raise InvalidInputError("file", "name the motion file (file=path/to/motions.toml) of a loaded mechanism")
         file = o.get("file") or f"{c.family.registered}_motions.toml"
         motions = load_motions(file)
         if o["motion"] not in motions:

@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from pkm.errors import InvalidInputError
-from pkm.sweeps.engine import SweepResult
 from pkm.sweeps.family import from_description
+from pkm.sweeps.results import SweepResult
 
 
 def _result(result) -> SweepResult:
