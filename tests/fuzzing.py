@@ -627,6 +627,58 @@ def _task_map(g, adv):
     return run, (axes,), kw
 
 
+@entry("sweeps.space")
+def _sweep_space(g, adv):
+    from pkm import sweeps
+    from pkm.sweeps.family import RegisteredFamily
+
+    kind = g.pick(("grid", "sobol", "latin_hypercube", "table"))
+    spec: object = g.pick(("5cm:20cm:3", "5cm:20cm", [0.05, 0.1], "10cm", (0.05, 0.2)))
+    n: object = int(g.rng.integers(1, 20))
+    if adv:
+        what = g.pick(("spec", "n", "name"))
+        if what == "spec":
+            spec = g.pick((g.hostile(), "5cm:20deg:3", "5cm:20cm:-1", "20cm:5cm", "::", "5cm:20cm:3:4", [g.hostile()]))
+        elif what == "n":
+            n = g.hostile()
+    name = g.pick(("h", "a", "R", "", "mode")) if adv and g.chance(0.3) else "h"
+
+    def run(kind, spec, n):
+        space = {"grid": lambda: sweeps.grid(**{name: spec}), "table": lambda: sweeps.table({name: spec}),
+                 "sobol": lambda: sweeps.sobol(n, seed=1, **{name: spec}),
+                 "latin_hypercube": lambda: sweeps.latin_hypercube(n, seed=1, **{name: spec})}[kind]()
+        return space.designs(RegisteredFamily("rrr3").units).values
+    return run, (kind, spec, n), {}
+
+
+@entry("pkm.sweep")
+def _sweep(g, adv):
+    from pkm import sweeps
+
+    n = g.pick(("rrr3", "delta"))
+    param = {"rrr3": "h", "delta": "R"}[n]
+    values: object = [float(v) for v in np.round(g.rng.uniform(0.05, 0.2, int(g.rng.integers(1, 4))), 4)]
+    objectives: object = {"rrr3": ["gci:step=5cm", "cov=coverage:step=5cm"],
+                          "delta": ["condition", "workspace_volume:spacing=3cm"]}[n]
+    kw: dict = {"scheduler": "serial", "progress": False}
+    if adv:
+        what = g.pick(("values", "objective", "kw"))
+        if what == "values":
+            values = g.corrupt(np.asarray(values)) if g.chance(0.5) else [g.hostile()]
+        elif what == "objective":
+            objectives = [g.pick(("gci:step=", "gci:step=-1cm", "gci:step=1e-9", "condition:pose=x=", ":", "gci:route=x",
+                                  "condition:pose=q=1", "condition:kind=7", "=gci", "design=gci", "nope.py:f",
+                                  "peak_effort:motion=99", g.hostile()))]
+        else:
+            kw[g.pick(("chunk_size", "fixed", "out", "progress", "scheduler"))] = g.pick(ADV_OBJECTS + ADV_NUMBERS)
+
+    def run(values, objectives, **k):
+        res = c.pkm.sweep(n, sweeps.table({param: values}), objectives, **k)
+        return [v[~np.isnan(v)] for v in (res.column(o)[res.ok] for o in res.objectives)]  # (NaN: a null)
+    c = ctx()
+    return run, (values, objectives), kw
+
+
 @entry("pkm.reconfigure")
 def _reconfigure(g, adv):
     c = ctx()

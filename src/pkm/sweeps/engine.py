@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from pkm.core.spec import as_path
 from pkm.errors import InvalidInputError, PkmError, SweepError
 from pkm.sweeps.family import Family, family_of
 from pkm.sweeps.objectives import Objective, objective
@@ -177,9 +178,6 @@ def _client(scheduler, client, workers: int | None):
         cluster = local_cluster(workers)
         c = Client(cluster)
         return c, (c, cluster), len(cluster.workers)
-    if not isinstance(scheduler, str):
-        raise InvalidInputError("scheduler", f"expected an address such as tcp://host:8786, got {scheduler!r}",
-                                scheduler)
     try:
         c = Client(scheduler)  # within dask's distributed.comm.timeouts.connect
     except (OSError, TimeoutError, ValueError) as exc:  # (ValueError: not an address)
@@ -218,6 +216,9 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
         InvalidInputError: a malformed space, objective or option.
         SweepError: ``out`` holds another sweep; the scheduler cannot be reached.
     """
+    if scheduler is not None and not isinstance(scheduler, str):
+        raise InvalidInputError("scheduler", f"'serial' or an address such as tcp://host:8786, got {scheduler!r}",
+                                scheduler)
     family = family_of(mechanism, fixed)
     if not isinstance(space, Space):
         raise InvalidInputError("space", "give pkm.sweeps.grid(...), sobol(...), latin_hypercube(...) or "
@@ -238,7 +239,7 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
     for o in objectives:
         o.bind(family)  # a route that does not exist fails here, not in every design
     manifest = manifest_of(family, designs, objectives)
-    out_path = None if out is None else Path(out)
+    out_path = None if out is None else as_path(out, "out")
     done_tables: list = []
     if out_path is not None:
         if out_path.suffix != ".parquet":

@@ -182,6 +182,8 @@ def family_of(mechanism, fixed: Mapping[str, Any] | None = None) -> Family:
 
     if isinstance(mechanism, Family):
         return mechanism
+    if fixed is not None and not isinstance(fixed, Mapping):
+        raise InvalidInputError("fixed", f"expected {{parameter: value}}, got {type(fixed).__name__}", fixed)
     if isinstance(mechanism, str) and mechanism in pkm.MECHANISMS:
         return RegisteredFamily(mechanism, fixed)
     if fixed:

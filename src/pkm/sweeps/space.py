@@ -26,6 +26,7 @@ import numpy as np
 
 from pkm.errors import InvalidInputError
 from pkm.units import parse_quantity
+from pkm.validation import as_scalar
 
 KINDS = ("grid", "sobol", "latin_hypercube", "table")
 MAX_DESIGNS = 10**8  # a space beyond this is a typo (a grid of 8 axes of 100 values), refused before it is built
@@ -205,9 +206,9 @@ def _value(name: str, v, units: Units) -> float:
     kinds, unit = units(name)
     if isinstance(v, str):
         return parse_quantity(v, kinds, name, unit)
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
         raise InvalidInputError(name, f"expected a finite number (SI, {unit}) or a string with a unit, got {v!r}", v)
-    return float(v)
+    return as_scalar(v, name, unit=unit)
 
 
 def _axis(name: str, spec, units: Units) -> list[float]:
