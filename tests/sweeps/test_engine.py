@@ -63,6 +63,10 @@ def test_a_finished_output_is_not_evaluated_again_and_another_sweep_is_refused(t
         pkm.sweep("rrr3", SMALL, ["gci:step=2cm"], scheduler="serial", out=out)
     third = pkm.sweep("rrr3", SMALL, ["gci:step=2cm"], scheduler="serial", out=out, overwrite=True)
     assert third.stats.evaluated == len(third)
+    sampled = sweeps.sobol(8, a="30cm:60cm", h="5cm:20cm")  # no seed: drawn, recorded, and found again
+    drawn = pkm.sweep("rrr3", sampled, ["gci:step=4cm"], scheduler="serial", out=out, overwrite=True)
+    again = pkm.sweep("rrr3", sampled, ["gci:step=4cm"], scheduler="serial", out=out)
+    assert again.stats.evaluated == 0 and again.manifest["space"]["seed"] == drawn.manifest["space"]["seed"]
 
 
 KILLER = '''

@@ -10,8 +10,9 @@ are tested against, and the route for a debugger).
 
 With ``out="results.parquet"`` every finished chunk is written at once, and a sweep started again with the same
 output resumes (:mod:`pkm.sweeps.store`): designs already written are not evaluated again, and the table is the
-one an uninterrupted run gives (the values of a design do not depend on its chunk, worker or order). A different
-sweep on an existing output is refused unless ``overwrite=True``.
+one an uninterrupted run gives (the values of a design do not depend on its chunk, worker or order); a sampled
+space given no seed takes the one the output records, so that it draws the same designs again. A different sweep
+on an existing output is refused unless ``overwrite=True``.
 
 Each design is evaluated alone: an exception in an objective fails that design (``status="failed"``, the first
 failing objective's error class and message; that objective's cell null, the others kept), not the sweep; a chunk
@@ -20,6 +21,7 @@ whose worker dies (Dask retries it on others first) records its designs as faile
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import math
@@ -39,7 +41,16 @@ from pkm.sweeps.family import Family, family_of
 from pkm.sweeps.objectives import Objective, objective
 from pkm.sweeps.results import Stats, SweepResult
 from pkm.sweeps.space import Designs, Space
-from pkm.sweeps.store import chunk_table, combine, count_failed, manifest_of, parts_folder, resume, write_atomic
+from pkm.sweeps.store import (
+    chunk_table,
+    combine,
+    count_failed,
+    manifest_of,
+    parts_folder,
+    recorded_seed,
+    resume,
+    write_atomic,
+)
 
 MAX_CHUNK = 500
 #: glibc's allocator settings of the local workers (see :func:`local_cluster`) [bytes].
@@ -225,6 +236,9 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
                                          f"table(...), got {type(space).__name__}", space)
     for name in space.names:
         family.units(name)  # UnknownNameError listing the parameters
+    out_path = None if out is None else as_path(out, "out")
+    if out_path is not None and space.seed is None and space.kind in ("sobol", "latin_hypercube") and not overwrite:
+        space = dataclasses.replace(space, seed=recorded_seed(out_path))  # resuming: the samples drawn before
     designs = space.designs(family.units)
     if isinstance(objectives, (str, Objective)) or callable(objectives):
         objectives = [objectives]
@@ -239,7 +253,6 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
     for o in objectives:
         o.bind(family)  # a route that does not exist fails here, not in every design
     manifest = manifest_of(family, designs, objectives)
-    out_path = None if out is None else as_path(out, "out")
     done_tables: list = []
     if out_path is not None:
         if out_path.suffix != ".parquet":

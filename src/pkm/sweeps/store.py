@@ -103,6 +103,19 @@ def read_manifest(path) -> dict[str, Any]:
     return json.loads(meta[b"pkm.sweep"])
 
 
+def recorded_seed(out: Path) -> int | None:
+    """The seed of the samples of the sweep ``out`` holds (finished or not), or None: a sampled sweep started
+    again without a seed resumes with the samples it drew (:meth:`pkm.sweeps.Space.with_seed`)."""
+    for where in (out, parts_folder(out)):
+        if where.exists():
+            try:
+                seed = read_manifest(where).get("space", {}).get("seed")
+            except (OSError, ValueError):
+                return None
+            return seed if isinstance(seed, int) else None
+    return None
+
+
 def resume(out: Path, manifest: dict[str, Any], overwrite: bool):
     """Designs already done (their tables), or None when the output is complete already (then its table)."""
     import pyarrow.parquet as pq
@@ -154,4 +167,4 @@ def count_failed(table) -> int:
 
 
 __all__ = ["FORMAT", "SAME", "chunk_table", "combine", "count_failed", "manifest_of", "parts_folder", "read_manifest",
-           "resume", "schema", "write_atomic"]
+           "recorded_seed", "resume", "schema", "write_atomic"]
