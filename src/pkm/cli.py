@@ -48,7 +48,7 @@ import numpy as np
 import pkm
 from pkm.errors import ConvergenceError, InvalidInputError, PkmError, SpecError, UnitError, UnknownNameError
 from pkm.report import jsonable
-from pkm.units import KIND_OF_UNIT, SI_UNITS, SUFFIXES, parse_quantity
+from pkm.units import KIND_OF_UNIT, SI_UNITS, SUFFIXES, parse_quantity, split_range
 
 PROG = "pkm"
 
@@ -462,12 +462,13 @@ def parse_axis(mech: pkm.Mechanism, item: str) -> tuple[str, np.ndarray]:
     task = mech.task_map
     if name not in task.kinds:
         raise UnknownNameError("task coordinate", name, list(task.keys), mech.name)
-    parts = text.split(":")
-    if len(parts) != 3 or not parts[2].strip().isdigit() or int(parts[2]) < 1:
-        raise UsageError(f"--axis {item!r}: expected NAME=START:STOP:COUNT, e.g. x=-5cm:5cm:101")
+    try:
+        a, b, count = split_range(text, name)
+    except InvalidInputError:
+        raise UsageError(f"--axis {item!r}: expected NAME=START:STOP:COUNT, e.g. x=-5cm:5cm:101") from None
     kind = task.kinds[name]
-    start, stop = (parse_quantity(t, {kind}, name, SI_UNITS[kind]) for t in parts[:2])
-    return name, np.linspace(start, stop, int(parts[2]))
+    start, stop = (parse_quantity(t, {kind}, name, SI_UNITS[kind]) for t in (a, b))
+    return name, np.linspace(start, stop, count)
 
 
 def cmd_map(args) -> int:
@@ -547,8 +548,6 @@ def cmd_sweep(args) -> int:
             raise UsageError(f"--sample {args.sample} needs --n (the number of designs)")
         draw = sweeps.sobol if args.sample == "sobol" else sweeps.latin_hypercube
         space = draw(args.n, seed=args.seed, **axes)
-    if not args.table and not axes:
-        raise UsageError("name the parameters to vary, e.g. a=30cm:80cm:11 (see 'pkm list')")
     fixed = dict(_split(item, "--fixed") for item in args.fixed)
     res = sweeps.sweep(args.mechanism, space, args.objective, out=args.out, fixed=fixed or None,
                        scheduler=args.scheduler, workers=args.workers, chunk_size=args.chunk,

@@ -71,6 +71,20 @@ def parse_quantity(text: str, kinds: Collection[str | None], what: str = "value"
     return value * factor
 
 
+def split_range(text: str, what: str, max_count: int = 10**7) -> tuple[str, str, int]:
+    """``START:STOP:COUNT`` as its two texts (units parsed by the caller, who knows the kind) and the count.
+
+    Raises:
+        InvalidInputError: not three fields, or a count that is not a whole number in ``[1, max_count]``.
+    """
+    parts = text.split(":") if isinstance(text, str) else []
+    count = parts[2].strip() if len(parts) == 3 else ""
+    if not (count.isascii() and count.isdigit()) or not 1 <= int(count) <= max_count:
+        raise InvalidInputError(what, f"{what}={text!r}: expected START:STOP:COUNT with a COUNT in [1, {max_count}], "
+                                      "e.g. 30cm:80cm:11", text)
+    return parts[0], parts[1], int(count)
+
+
 def quantity(value, kind: str | None = None, what: str = "value") -> float:
     """``value`` in SI: a number as it is, a string parsed with its unit (:func:`parse_quantity`).
 

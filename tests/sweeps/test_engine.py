@@ -97,6 +97,8 @@ def test_a_killed_sweep_resumes_where_it_stopped_and_gives_the_uninterrupted_tab
     assert proc.returncode == -signal.SIGKILL, proc.stderr
     parts = sorted((tmp_path / "r.parquet.parts").glob("part-*.parquet"))
     assert len(parts) == 10 and not out.exists()
+    (parts[0].parent / "part-000000002-000000003.parquet").write_bytes(parts[2].read_bytes())  # overlapping parts,
+    # as runs with other chunk sizes leave: each design once in the result
     resumed = pkm.sweep("rrr3", SMALL, ["gci:step=4cm", objectives[1]], scheduler="serial", out=out)
     assert resumed.stats.evaluated == 6 and not (tmp_path / "r.parquet.parts").exists()
     whole = pkm.sweep("rrr3", SMALL, ["gci:step=4cm", objectives[1]], scheduler="serial")
@@ -138,3 +140,31 @@ def test_an_unreachable_scheduler_is_a_clear_error():
     with dask.config.set({"distributed.comm.timeouts.connect": "1s"}), \
             pytest.raises(SweepError, match=r"cannot reach the Dask scheduler at tcp://127\.0\.0\.1:9"):
         pkm.sweep("rrr3", SMALL, ["gci:step=4cm"], scheduler="tcp://127.0.0.1:9")
+
+
+EXIT = '''
+import os
+
+def area(design):
+    """The platform triangle's area; the worker process ends (os._exit) at h = 10 cm."""
+    if abs(design.values["h"] - 0.10) < 1e-12:
+        os._exit(1)
+    return 3 ** 0.5 / 4 * design.values["h"] ** 2
+'''
+
+
+def test_a_design_that_kills_its_worker_fails_alone(tmp_path):
+    """On a 2-worker cluster, the design whose evaluation ends its worker process is recorded as failed
+    (KilledWorker; Dask's retries set to none to keep the test short); the others of its chunk and every other
+    chunk are evaluated, and the sweep's context survives the dead workers."""
+    import dask
+
+    (tmp_path / "exit.py").write_text(EXIT, encoding="utf-8")
+    space = sweeps.grid(a="30cm:60cm:3", h="5cm:20cm:4")
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        res = pkm.sweep("rrr3", space, [f"{tmp_path / 'exit.py'}:area"], workers=2, chunk_size=4, progress=False)
+    h = res.column("h")
+    failed = ~res.ok
+    assert np.array_equal(failed, np.isclose(h, 0.10)) and failed.sum() == 3
+    assert {f["error"] for f in res.failures()} == {"KilledWorker"}
+    np.testing.assert_allclose(res.column("area")[~failed], 3**0.5 / 4 * h[~failed] ** 2, rtol=1e-15)

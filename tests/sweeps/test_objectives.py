@@ -102,9 +102,35 @@ def test_user_callables_their_nulls_and_their_failures():
     (["beta_gain"], InvalidInputError, "beta_gain has no route for rrr3"),
     (["workspace_volume:route=closed_form", "x=gci"], InvalidInputError, "no closed form"),
     (["gci", "gci"], InvalidInputError, "named twice"),
+    (["gci:kind=fro"], InvalidInputError, "fro_normalized"),
+    (["operation_count:count=bogus"], InvalidInputError, "total"),
+    (["peak_effort:samples=-1"], InvalidInputError, "samples"),
+    (["gci:region=x=0:1:\u00b2"], InvalidInputError, "COUNT"),
 ])
 def test_bad_objectives_are_refused_before_any_design_is_evaluated(objectives, error, match):
     space = sweeps.grid(h="10cm:20cm:3")
     mech = "prs3" if "closed_form" in objectives[0] else "rrr3"
     with pytest.raises(error, match=match):
         pkm.sweep(mech, space if mech == "rrr3" else sweeps.grid(h=[0.1]), objectives, scheduler="serial")
+
+
+def test_the_3rrr_closed_form_maps_the_designs_working_mode():
+    """mode is a design field: each design's map is of its own working mode (or of the option's)."""
+    res = pkm.sweep("rrr3", sweeps.grid(mode=[1, 2]), ["gci:step=4cm", "m3=gci:step=4cm,branch=mode3"],
+                    scheduler="serial")
+    d = maps.Design.of(pkm.design_params("rrr3"))
+    direct = [maps.ci_map(d, maps.workspace_grid(d, 0.04), maps.CiSettings(mode=m)).gci().value for m in (1, 2, 3)]
+    np.testing.assert_array_equal(res.column("gci:step=4cm"), direct[:2])
+    np.testing.assert_array_equal(res.column("m3"), [direct[2]] * 2)
+    assert direct[0] != direct[1]
+
+
+@pytest.mark.parametrize("call,match", [
+    (lambda: pkm.sweep("rrr3", sweeps.sobol(4, mode="1:8"), ["gci"], scheduler="serial"), "integers"),
+    (lambda: pkm.sweep("rrr3", sweeps.grid(a=[0.4]), ["gci"], fixed={"a": 0.5}, scheduler="serial"), "swept and"),
+    (lambda: pkm.sweep("rrr3", sweeps.grid(a=[0.4]), ["gci"], workers=2, scheduler="serial"), "workers"),
+    (lambda: pkm.sweep("rrr3", sweeps.grid(a=[0.4]), ["gci"], chunk_size=0, scheduler="serial"), "chunk_size"),
+])
+def test_conflicting_arguments_are_refused(call, match):
+    with pytest.raises(InvalidInputError, match=match):
+        call()

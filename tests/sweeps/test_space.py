@@ -49,6 +49,9 @@ def test_tables_from_rows_columns_and_csv(tmp_path):
     (lambda: sweeps.sobol(0, a="30cm:80cm"), InvalidInputError, "number of samples"),
     (lambda: sweeps.grid(**{f"p{k}": "0:1:100" for k in range(5)}), InvalidInputError, "sample the space"),
     (lambda: sweeps.table([{"a": 1}, {"h": 2}]), InvalidInputError, "row 1"),
+    (lambda: sweeps.grid(a="30cm:40cm:\u00b2"), InvalidInputError, "COUNT"),  # (a digit to str.isdigit)
+    (lambda: sweeps.grid(a="30cm:40cm:1000000000000"), InvalidInputError, "COUNT"),
+    (lambda: sweeps.grid(a="-1e308:1e308:3"), InvalidInputError, "overflows"),
 ])
 def test_malformed_spaces_are_refused_with_the_parameter_named(space, error, match):
     with pytest.raises(error, match=match):

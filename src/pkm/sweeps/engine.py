@@ -15,8 +15,10 @@ space given no seed takes the one the output records, so that it draws the same 
 on an existing output is refused unless ``overwrite=True``.
 
 Each design is evaluated alone: an exception in an objective fails that design (``status="failed"``, the first
-failing objective's error class and message; that objective's cell null, the others kept), not the sweep; a chunk
-whose worker dies (Dask retries it on others first) records its designs as failed with the scheduler's error.
+failing objective's error class and message; that objective's cell null, the others kept), not the sweep; a design
+that kills its worker process (after Dask's retries) is recorded as failed with ``KilledWorker``, the other designs
+of its chunk run again one by one. Designs lost to the cluster itself are not recorded: the sweep raises
+:class:`~pkm.errors.SweepError` after keeping the chunks that finished, and a rerun resumes.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+import cloudpickle
 import numpy as np
 
 from pkm.core.spec import as_path
@@ -108,6 +111,10 @@ def _as_value(v, column: str) -> float | None:
     return None if math.isnan(x) else x
 
 
+def _unpickle(blob: bytes) -> _Context:
+    return cloudpickle.loads(blob)
+
+
 def _prepare(registered: str | None) -> None:
     """On a worker: import what evaluating designs needs (pkm, the mechanism's package)."""
     import pkm.sweeps
@@ -152,8 +159,10 @@ def local_cluster(workers: int | None = None):
     with dask's ``MALLOC_TRIM_THRESHOLD_=65536``, which also turns off glibc's adaptive mmap threshold, every array
     the maps allocate went back to the system and was faulted in again (a million page faults, 2.3 s of system time,
     twice the work), and without any setting the tasks' thread arena trimmed its heap as often. And the workers'
-    statistical profiler is off (it samples the running thread every 10 ms: 25 % slower). The workers of an
-    existing cluster keep their own configuration (the README says how to set the same).
+    statistical profiler is off (it samples the running thread every 10 ms: 25 % slower). Its scheduler gives a
+    worker one chunk at a time (``worker-saturation`` 1.0, dask's default 1.1 queues two on a single thread): a
+    design that kills its worker then takes no other chunk's retries with it. The workers of an existing cluster
+    keep their own configuration (the README says how to set the same).
 
     Raises:
         SweepError: the workers could not start.
@@ -167,7 +176,8 @@ def local_cluster(workers: int | None = None):
     environ = {**(dask.config.get("distributed.nanny.pre-spawn-environ", None) or {}), **WORKER_MALLOC}
     try:
         with dask.config.set({"distributed.nanny.pre-spawn-environ": environ,
-                              "distributed.worker.profile.enabled": False}):
+                              "distributed.worker.profile.enabled": False,
+                              "distributed.scheduler.worker-saturation": 1.0}):
             return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                 silence_logs=logging.ERROR)
     except RuntimeError as exc:  # the workers could not start (a __main__ they cannot re-import: stdin, -c)
@@ -220,7 +230,7 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
             wait for.
         chunk_size: Designs per chunk (default: about 32 chunks per worker, at most :data:`MAX_CHUNK`).
         progress: A tqdm bar (None: when writing to a terminal).
-        overwrite: Replace an output that holds another sweep.
+        overwrite: Start afresh: delete what ``out`` holds (another sweep's results, or this one's parts).
 
     Raises:
         UnknownNameError: an unknown mechanism, parameter or objective.
@@ -230,12 +240,26 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
     if scheduler is not None and not isinstance(scheduler, str):
         raise InvalidInputError("scheduler", f"'serial' or an address such as tcp://host:8786, got {scheduler!r}",
                                 scheduler)
+    if scheduler is not None and client is not None:
+        raise InvalidInputError("client", "give a scheduler or a client, not both", client)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
+                                or scheduler == "serial" or client is not None):
+        raise InvalidInputError("workers", "a positive integer, for a local cluster or to wait for on a scheduler "
+                                           f"(not with 'serial' or a client), got {workers!r}", workers)
+    if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1):
+        raise InvalidInputError("chunk_size", f"a positive integer, got {chunk_size!r}", chunk_size)
     family = family_of(mechanism, fixed)
     if not isinstance(space, Space):
         raise InvalidInputError("space", "give pkm.sweeps.grid(...), sobol(...), latin_hypercube(...) or "
                                          f"table(...), got {type(space).__name__}", space)
     for name in space.names:
         family.units(name)  # UnknownNameError listing the parameters
+        if family.integer(name) and space.kind in ("sobol", "latin_hypercube"):
+            raise InvalidInputError(name, f"{name} takes integers: give it as a grid axis or a table column, not "
+                                          "sampled", name)
+    both = sorted(set(space.names) & set(fixed or {}))
+    if both:
+        raise InvalidInputError("fixed", f"{both} are swept and fixed at once", both)
     out_path = None if out is None else as_path(out, "out")
     if out_path is not None and space.seed is None and space.kind in ("sobol", "latin_hypercube") and not overwrite:
         space = dataclasses.replace(space, seed=recorded_seed(out_path))  # resuming: the samples drawn before
@@ -255,7 +279,7 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
     manifest = manifest_of(family, designs, objectives)
     done_tables: list = []
     if out_path is not None:
-        if out_path.suffix != ".parquet":
+        if out_path.suffix != ".parquet" or (out_path.exists() and not out_path.is_file()):
             raise InvalidInputError("out", f"the results are a .parquet file, got {out_path}", str(out_path))
         done_tables, complete = resume(out_path, manifest, overwrite)
         if done_tables is None:
@@ -270,13 +294,13 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
     cl, owned, n_workers = (None, (), 1) if in_process else _client(scheduler, client, workers)
     try:
         size = chunk_size if chunk_size is not None else max(1, min(MAX_CHUNK, math.ceil(len(todo) / (32 * n_workers))))
-        if isinstance(size, bool) or not isinstance(size, int) or size < 1:
-            raise InvalidInputError("chunk_size", f"a positive integer, got {chunk_size!r}", chunk_size)
         chunks = [todo[k:k + size] for k in range(0, len(todo), size)]
         shared: Any = context
         if cl is not None:
             cl.run(_prepare, family.registered)  # the imports, once per worker, before the clock of the work starts
-            shared = cl.scatter(context, broadcast=True, hash=False)
+            # a task, not scattered data: a worker that dies takes its copy with it, and Dask recomputes a task's
+            # result where scattered data would be lost (with every chunk waiting on it)
+            shared = cl.submit(_unpickle, cloudpickle.dumps(context), pure=False)
         startup = time.perf_counter() - t_start
         t0 = time.perf_counter()
         new_tables, work = [], 0.0
@@ -307,27 +331,51 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
 
 
 def _results(cl, shared, chunks, designs: Designs, objectives):
-    """``(ids, columns, seconds)`` of each chunk as it finishes."""
+    """``(ids, columns, seconds)`` of each chunk as it finishes.
+
+    A chunk whose workers died on it (``KilledWorker``, after Dask's retries) is run again one design a task, so
+    that only the designs that kill their worker are recorded as failed. A chunk lost to the cluster itself (the
+    scheduler gone, a connection closed) is not a result: the chunks that finished are kept and
+    :class:`~pkm.errors.SweepError` says how many designs are left for a rerun to resume.
+    """
     if cl is None:
         for ids in chunks:
             cols, seconds = _run_chunk(shared, ids, designs.values[ids])
             yield ids, cols, seconds
         return
-    from dask.distributed import as_completed
+    from dask.distributed import KilledWorker, as_completed
 
-    futures = {cl.submit(_run_chunk, shared, ids, designs.values[ids], pure=False): ids for ids in chunks}
-    for fut in as_completed(futures):
+    def submit(ids):
+        return cl.submit(_run_chunk, shared, ids, designs.values[ids], pure=False)
+
+    futures = {submit(ids): ids for ids in chunks}
+    pending = as_completed(list(futures))
+    lost: list[tuple[np.ndarray, BaseException]] = []
+    for fut in pending:
         ids = futures.pop(fut)
         try:
             cols, seconds = fut.result()
-        except Exception as exc:  # the worker died on this chunk (after Dask's retries), or the cluster went
-            n = len(ids)
-            cols = {o.column: [None] * n for o in objectives}
-            cols.update(design=[int(i) for i in ids], status=["failed"] * n, error=[type(exc).__name__] * n,
-                        message=[_message(exc)] * n)
+        except KilledWorker as exc:
+            if len(ids) > 1:  # find the design(s) that kill their worker
+                for one in ids:
+                    f = submit(np.array([one]))
+                    futures[f] = np.array([one])
+                    pending.add(f)
+                continue
+            cols = {o.column: [None] for o in objectives}
+            cols.update(design=[int(ids[0])], status=["failed"], error=["KilledWorker"],
+                        message=[f"its worker process died evaluating it ({_message(exc)})"])
             seconds = 0.0
-        fut.release()
+        except Exception as exc:  # the cluster, not the design: nothing to record, left for a rerun
+            lost.append((ids, exc))
+            continue
+        finally:
+            fut.release()
         yield ids, cols, seconds
+    if lost:
+        n = sum(len(ids) for ids, _ in lost)
+        raise SweepError(f"{n} designs were lost to the cluster ({type(lost[0][1]).__name__}: {_message(lost[0][1])}); "
+                         "the finished chunks are kept: run the same sweep again (same out) to resume")
 
 
 def _bar(progress, total: int, initial: int):

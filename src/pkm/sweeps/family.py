@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import json
 import math
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -71,6 +70,10 @@ class Family:
     def parameters(self) -> tuple[str, ...]:
         raise NotImplementedError
 
+    def integer(self, name: str) -> bool:
+        """Whether parameter ``name`` takes integers only (a working mode)."""
+        return False
+
     def params(self, values: Mapping[str, float]):
         return None
 
@@ -80,9 +83,6 @@ class Family:
     def describe(self) -> dict[str, Any]:
         """JSON-able, enough to rebuild the family (:func:`from_description`)."""
         raise NotImplementedError
-
-    def fingerprint(self) -> str:
-        return hashlib.sha256(json.dumps(self.describe(), sort_keys=True).encode()).hexdigest()[:16]
 
     def candidate(self, values: Mapping[str, float]) -> Candidate:
         return Candidate(self, values)
@@ -105,6 +105,9 @@ class RegisteredFamily(Family):
 
     def parameters(self) -> tuple[str, ...]:
         return tuple(n for n, f in self.fields.items() if f.type in _SCALAR_TYPES)
+
+    def integer(self, name: str) -> bool:
+        return self.fields[name].type == "int"
 
     def units(self, name: str) -> tuple[set[str | None], str]:
         from pkm.units import KIND_OF_UNIT

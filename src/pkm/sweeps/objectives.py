@@ -33,7 +33,7 @@ import numpy as np
 
 from pkm.errors import InvalidInputError, UnknownNameError
 from pkm.sweeps.family import Candidate
-from pkm.units import parse_quantity
+from pkm.units import parse_quantity, split_range
 
 SENSES = ("max", "min", "")
 ROUTES = ("auto", "closed_form", "generic")
@@ -49,7 +49,8 @@ class Definition:
         sense: ``"max"`` or ``"min"``: which way is better (Pareto fronts, best designs).
         unit: Of its value (SI).
         doc: One line.
-        options: ``{option: (kind, default, doc)}``; kinds ``length``, ``angle``, ``float``, ``int``, ``text``, and
+        options: ``{option: (kind, default, doc[, check])}``; kinds ``length`` (> 0), ``angle``, ``float``, ``int``
+            (``check``: a lower bound), ``text`` (``check``: the choices), ``range`` (``START:STOP:COUNT``), and
             ``pose`` / ``region`` (read against the mechanism's task).
         generic: ``(design, options) -> value`` on any mechanism, or None.
         closed_forms: ``{registered mechanism: (design, options) -> value}``.
@@ -59,7 +60,7 @@ class Definition:
     sense: str
     unit: str
     doc: str
-    options: Mapping[str, tuple[str, Any, str]]
+    options: Mapping[str, tuple[Any, ...]]
     generic: Callable[[Candidate, Mapping[str, Any]], float | None] | None
     closed_forms: Mapping[str, Callable[[Candidate, Mapping[str, Any]], float | None]] = field(default_factory=dict)
     units: Mapping[str, str] = field(default_factory=dict)  # {registered mechanism: unit of its closed form}
@@ -111,7 +112,10 @@ class Objective:
         unit = self.unit
         if self.definition is not None and self.options.get("route") != "generic":
             unit = self.definition.units.get(family.registered or "", unit)
-        return {"column": self.column, "spec": self.spec, "sense": self.sense, "unit": unit}
+        out = {"column": self.column, "spec": self.spec, "sense": self.sense, "unit": unit}
+        if self.options.get("motions"):  # (what the file said: a resumed sweep must read the same cases)
+            out["motions"] = repr(sorted(self.options["motions"].items()))
+        return out
 
 
 def objective(spec, *, column: str | None = None, sense: str | None = None, unit: str = "") -> Objective:
@@ -164,7 +168,11 @@ def load_callable(spec: str) -> Callable:
         mod_spec = importlib.util.spec_from_file_location(f"pkm_user_{path.stem}", path)
         assert mod_spec is not None and mod_spec.loader is not None
         module = importlib.util.module_from_spec(mod_spec)
-        mod_spec.loader.exec_module(module)
+        try:
+            mod_spec.loader.exec_module(module)
+        except Exception as exc:  # the user's file: its own error, named, as a pkm error
+            raise InvalidInputError("objective", f"{spec!r}: running {path} raised {type(exc).__name__}: {exc} (a "
+                                                 "file objective may import installed packages only)", spec) from None
     else:
         try:
             module = importlib.import_module(where)
@@ -200,32 +208,46 @@ def _options(d: Definition, text: str) -> dict[str, Any]:
             continue
         if not eq or key not in d.options:
             raise UnknownNameError("option", key, list(d.options) + ["route"], f"objective {d.name}")
-        out[key] = _option(key, d.options[key][0], value.strip())
-    for key, (_, default, _) in d.options.items():
-        out.setdefault(key, default)
+        out[key] = _option(key, d.options[key], value.strip())
+    for key, spec in d.options.items():
+        out.setdefault(key, spec[1])
+    if out.get("file"):  # a motion file: read here, where its path means something (the workers may not share it)
+        from pkm.motion import load_motions
+
+        out["motions"] = load_motions(out["file"])
+        out["file"] = str(Path(out["file"]).resolve()) if Path(out["file"]).exists() else out["file"]
     return out
 
 
-def _option(key: str, kind: str, value: str):
+def _option(key: str, spec: tuple, value: str):
+    """An option's text read as its kind (``spec``: ``(kind, default, doc[, check])``; ``check`` the choices of a
+    text option or the lower bound of a number, lengths being > 0 unless told)."""
+    kind, check = spec[0], spec[3] if len(spec) > 3 else None
     if kind in ("length", "angle"):
-        return parse_quantity(value, {kind}, key, "m" if kind == "length" else "rad")
+        v = parse_quantity(value, {kind}, key, "m" if kind == "length" else "rad")
+        if kind == "length" and not v > 0.0:
+            raise InvalidInputError(key, f"{key}={value!r}: a length > 0", value)
+        return v
     if kind in ("float", "int"):
         try:
-            return int(value) if kind == "int" else float(value)
+            v = int(value) if kind == "int" else float(value)
         except ValueError:
-            raise InvalidInputError(key, f"{key}={value!r}: expected a number", value) from None
+            raise InvalidInputError(key, f"{key}={value!r}: expected {'an integer' if kind == 'int' else 'a number'}",
+                                    value) from None
+        if not math.isfinite(v) or (check is not None and v < check):
+            raise InvalidInputError(key, f"{key}={value!r}: a finite number >= {check}", value)
+        return v
     if kind == "pose":
         return dict(_split_items(key, value))
+    if kind == "range":
+        return split_range(value, key)
     if kind == "region":
-        axes = {}
-        for name, text in _split_items(key, value):
-            parts = text.split(":")
-            if len(parts) != 3 or not parts[2].isdigit() or int(parts[2]) < 1:
-                raise InvalidInputError(key, f"{key}: {name}={text!r}: expected START:STOP:COUNT", value)
-            axes[name] = (parts[0], parts[1], int(parts[2]))
+        axes = {name: split_range(text, f"{key}: {name}") for name, text in _split_items(key, value)}
         if not 1 <= len(axes) <= 3:
             raise InvalidInputError(key, f"{key}: 1 to 3 task coordinates", value)
         return axes
+    if check is not None and value not in check:
+        raise InvalidInputError(key, f"{key}={value!r}: one of {', '.join(check)}", value)
     return value
 
 
@@ -328,7 +350,7 @@ def _motion(c: Candidate, o: Mapping[str, Any]):
         if not o.get("file") and not c.family.registered:
             raise InvalidInputError("file", "name the motion file (file=path/to/motions.toml) of a loaded mechanism")
         file = o.get("file") or f"{c.family.registered}_motions.toml"
-        motions = load_motions(file)
+        motions = o.get("motions") or load_motions(file)  # (a given file was read where the sweep was started)
         if o["motion"] not in motions:
             raise UnknownNameError("motion case", o["motion"], motions, str(file))
         motion = motions[o["motion"]]
@@ -363,8 +385,6 @@ def _operation_count(c, o):
     import pkm
 
     count = c.cached(("opcount", o["kernel"]), lambda: pkm.Kernels(c.mechanism).operation_count(o["kernel"]))
-    if o["count"] not in ("total", "mul", "add"):
-        raise InvalidInputError("count", f"one of total, mul, add, got {o['count']!r}", o["count"])
     return float({"total": count.mul + count.add, "mul": count.mul, "add": count.add}[o["count"]])
 
 
@@ -373,11 +393,7 @@ def _generic_interval(c, o):
     name = o.get("parameter")
     if not name or not o.get("range"):
         raise InvalidInputError("parameter", "give parameter=TASK_JOINT and range=START:STOP:COUNT")
-    region = {name: tuple(o["range"].split(":"))}
-    if len(region[name]) != 3 or not region[name][2].isdigit():
-        raise InvalidInputError("range", f"range={o['range']!r}: expected START:STOP:COUNT", o["range"])
-    a, b, k = region[name]
-    m = _generic_map(c, {**o, "region": {name: (a, b, int(k))}, "length": o.get("length") or 1.0})  # (reach only)
+    m = _generic_map(c, {**o, "region": {name: o["range"]}, "length": o.get("length") or 1.0})  # (reach only)
     (_, values), = m.axes
     step = float(values[1] - values[0]) if len(values) > 1 else 0.0
     return float(np.count_nonzero(m.reachable) * step)
@@ -388,8 +404,9 @@ def _rrr3_map(c: Candidate, o):
     from pkm.mechanisms.rrr3 import workspace as ws
 
     d = ws.Design.of(c.params)
-    return c.cached(("rrr3_map", o["step"], o["kind"]), lambda: ws.ci_map(
-        d, ws.workspace_grid(d, o["step"]), ws.CiSettings(norm=o["kind"])))
+    mode = o.get("branch") or c.params.mode  # the option's working mode, else the design's
+    return c.cached(("rrr3_map", o["step"], o["kind"], mode), lambda: ws.ci_map(
+        d, ws.workspace_grid(d, o["step"]), ws.CiSettings(mode=mode, norm=o["kind"])))
 
 
 def _rrr3_gci(c, o):
@@ -498,8 +515,8 @@ _REGION_UNIT = "m^i rad^j"  # (the product of the region's axes' units)
 _MAP = {"region": ("region", None, "task coordinates mapped (generic): x=START:STOP:COUNT/y=..."),
         "pose": ("pose", None, "the other task coordinates (generic): x=2cm/z=-36cm"),
         "length": ("length", None, "characteristic length dividing angular rates (generic), e.g. 5cm"),
-        "branch": ("text", "", "working mode (default: the spec's)"),
-        "kind": ("text", "2", "condition-number convention: 2, fro, fro_normalized")}
+        "branch": ("text", "", "working mode (default: the spec's; the 3-RRR's closed form: mode1..mode8)"),
+        "kind": ("text", "2", "condition-index convention: 2 or fro_normalized", ("2", "fro_normalized"))}
 _RRR3 = {"step": ("length", 0.01, "3-RRR closed form: grid step"),
          "side": ("length", 0.30, "3-RRR closed form: side of the square area of interest")}
 _DELTA = {"spacing": ("length", 0.008, "Delta closed form: workspace grid step")}
@@ -518,32 +535,34 @@ OBJECTIVES: dict[str, Definition] = {d.name: d for d in (
                {**_MAP, **_RRR3, **_DELTA}, _generic_volume, {"rrr3": _rrr3_volume, "delta": _delta_volume},
                {"rrr3": "m^2", "delta": "m^3"}),
     Definition("conditioned_volume", "max", _REGION_UNIT, "volume of the reachable nodes with kappa <= k_max",
-               {**_MAP, **_DELTA, "k_max": ("float", 3.0, "bound on kappa")}, _generic_conditioned_volume,
+               {**_MAP, **_DELTA, "k_max": ("float", 3.0, "bound on kappa", 1.0)}, _generic_conditioned_volume,
                {"delta": _delta_conditioned_volume}, {"delta": "m^3"}),
     Definition("weighted_volume", "max", _REGION_UNIT, "integral of 1/kappa over the workspace (volume x GCI)",
                {**_MAP, **_DELTA}, _generic_weighted_volume, {"delta": _delta_weighted_volume}, {"delta": "m^3"}),
     Definition("condition", "min", "-", "condition number kappa at a pose (default: the reference)",
-               {k: _MAP[k] for k in ("pose", "length", "branch", "kind")}, _generic_condition,
+               {**{k: _MAP[k] for k in ("pose", "length", "branch")},
+                "kind": ("text", "2", "2, fro or fro_normalized", ("2", "fro", "fro_normalized"))}, _generic_condition,
                {"delta": _delta_condition}),
     Definition("reachable_interval", "max", "m or rad", "reachable length of a task joint's range at a pose "
                "(generic: parameter=beta_1,range=-90deg:90deg:181; hexapod closed form: beta's intervals)",
                {**_MAP, "parameter": ("text", "", "the task joint (generic)"),
-                "range": ("text", "", "its range START:STOP:COUNT (generic)")}, _generic_interval,
+                "range": ("range", None, "its range START:STOP:COUNT (generic)")}, _generic_interval,
                {"hexapod": _hexapod_interval}, {"hexapod": "rad"}),
     Definition("beta_gain", "max", "-", "hexapod: index at beta* over the index at the reference beta, minus 1",
-               {"pose": _MAP["pose"], "index": ("text", "w_rot", "w_rot or w_tras")}, None,
+               {"pose": _MAP["pose"], "index": ("text", "w_rot", "w_rot or w_tras", ("w_rot", "w_tras"))}, None,
                {"hexapod": _hexapod_gain}),
     Definition("peak_effort", "min", "N or N m", "largest |actuator effort| along a motion case",
                {"motion": ("text", "1", "the case's name"), "file": ("text", "", "motion file (default: "
                 "<mechanism>_motions.toml)"), "coordinates": ("text", "", "the motion's coordinates as task "
-                "coordinates, z/pitch/roll"), "samples": ("int", 0, "samples (default: the case's dt)")},
+                "coordinates, z/pitch/roll"), "samples": ("int", 0, "samples (default: the case's dt)", 0)},
                _peak_effort),
     Definition("peak_power", "min", "W", "largest |effort x actuator rate| along a motion case",
                {"motion": ("text", "1", "the case's name"), "file": ("text", "", "motion file"),
-                "coordinates": ("text", "", "as peak_effort"), "samples": ("int", 0, "as peak_effort")},
+                "coordinates": ("text", "", "as peak_effort"), "samples": ("int", 0, "as peak_effort", 0)},
                _peak_power),
     Definition("operation_count", "min", "operations", "operations of a generated kernel after CSE",
-               {"kernel": ("text", "inverse_dynamics", "the kernel"), "count": ("text", "total", "total, mul, add")},
+               {"kernel": ("text", "inverse_dynamics", "the kernel"),
+                "count": ("text", "total", "total, mul, add", ("total", "mul", "add"))},
                _operation_count),
 )}
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -97,6 +98,8 @@ class SweepResult:
 
     def _signed(self, names: Sequence[str]) -> np.ndarray:
         """The objectives as columns to maximise (NaN where null)."""
+        if isinstance(names, str) or not names:
+            raise InvalidInputError("objectives", "name one objective or more (a list)", names)
         cols = []
         for n in names:
             sense = self.objectives.get(n, {}).get("sense", "")
@@ -106,12 +109,14 @@ class SweepResult:
         return np.column_stack(cols)
 
     def best(self, by: str, n: int = 1) -> list[dict[str, Any]]:
-        """The ``n`` best designs by objective ``by`` (its sense), as rows (dicts), nulls last."""
+        """The ``n`` best designs by objective ``by`` (its sense), as rows (dicts); designs without a value of it
+        (null, failed) are not ranked."""
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+            raise InvalidInputError("n", f"how many designs: an integer >= 1, got {n!r}", n)
         score = self._signed([by])[:, 0]
         order = [int(k) for k in np.argsort(-np.where(np.isnan(score), -np.inf, score), kind="stable")
                  if not np.isnan(score[k])]
-        rows = self.table.take(order[:n]).to_pylist()
-        return rows
+        return self.table.take(order[:n]).to_pylist()
 
     def pareto(self, names: Sequence[str]) -> np.ndarray:
         """Indices (rows) of the designs on the Pareto front of ``names`` (each by its sense; rows with a null out)."""
@@ -122,20 +127,39 @@ class SweepResult:
         """The results file a sweep wrote."""
         import pyarrow.parquet as pq
 
+        if Path(path).is_dir():
+            raise InvalidInputError("path", f"{path} holds the parts of an unfinished sweep: run the same sweep again "
+                                            "(same out) to finish it", str(path))
         manifest = read_manifest(path)
         return cls(pq.read_table(path), manifest)
 
 
 def pareto_front(F: np.ndarray) -> np.ndarray:
-    """Rows of ``F`` (n x m, each column to maximise; rows with NaN excluded) that no other row dominates, sorted."""
+    """Rows of ``F`` (n x m, each column to maximise; rows with NaN excluded) that no other row dominates, sorted
+    (equal rows both kept). Two columns: one sort, O(n log n); more: each row against the front so far."""
     F = np.asarray(F, dtype=float)
     keep = np.flatnonzero(~np.isnan(F).any(axis=1))
     G = F[keep]
-    order = np.lexsort(tuple(-G[:, j] for j in reversed(range(G.shape[1]))))  # best first on the first column
-    front: list[int] = []
-    for i in order:
-        if not any(np.all(G[j] >= G[i]) and np.any(G[j] > G[i]) for j in front):
-            front.append(int(i))
+    if len(G) == 0:
+        return keep
+    order = np.lexsort(tuple(-G[:, j] for j in reversed(range(G.shape[1]))))  # best first, lexicographically
+    if G.shape[1] == 2:
+        a, b = G[order, 0], G[order, 1]
+        new_a = np.r_[True, a[1:] != a[:-1]]  # the first row of each value of the first column
+        group = np.cumsum(new_a) - 1
+        top = b[new_a][group]  # the best second column within the row's group
+        before = np.r_[-np.inf, np.maximum.accumulate(b[new_a])[:-1]][group]  # best of the groups before
+        front = order[(b == top) & (top > before)]
+    else:
+        chosen: list[int] = []
+        for i in order:
+            if not chosen:
+                chosen.append(int(i))
+                continue
+            R = G[chosen]
+            if not np.any(np.all(R >= G[i], axis=1) & np.any(R > G[i], axis=1)):
+                chosen.append(int(i))
+        front = np.array(chosen, dtype=int)
     return np.sort(keep[front])
 
 

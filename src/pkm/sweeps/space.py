@@ -14,7 +14,6 @@ sweep knows each parameter's unit (the family's, :mod:`pkm.sweeps.family`):
 from __future__ import annotations
 
 import csv
-import itertools
 import math
 import secrets
 from collections.abc import Callable, Mapping, Sequence
@@ -25,11 +24,11 @@ from typing import Any
 import numpy as np
 
 from pkm.errors import InvalidInputError
-from pkm.units import parse_quantity
+from pkm.units import parse_quantity, split_range
 from pkm.validation import as_scalar
 
 KINDS = ("grid", "sobol", "latin_hypercube", "table")
-MAX_DESIGNS = 10**8  # a space beyond this is a typo (a grid of 8 axes of 100 values), refused before it is built
+MAX_DESIGNS = 10**7  # a space beyond this is a typo (a grid of 8 axes of 10 values), refused before it is built
 
 #: ``name -> (kinds a unit suffix may have, the unit as documented)``: how a family tells the space its units.
 Units = Callable[[str], tuple[set[str | None], str]]
@@ -55,10 +54,6 @@ class Designs:
 
     def __len__(self) -> int:
         return len(self.values)
-
-    def row(self, k: int) -> dict[str, float]:
-        """Design ``k`` as ``{parameter: value}`` (SI)."""
-        return {n: float(v) for n, v in zip(self.names, self.values[k])}
 
 
 @dataclass(frozen=True)
@@ -97,7 +92,8 @@ class Space:
             axes = [_axis(name, spec, units) for name, spec in space.specs]
             total = math.prod(len(a) for a in axes)
             _check_size(total)
-            values = np.array(list(itertools.product(*axes)), dtype=float).reshape(total, len(axes))
+            mesh = np.meshgrid(*[np.asarray(a, dtype=float) for a in axes], indexing="ij")  # first axis slowest
+            values = np.stack([m.ravel() for m in mesh], axis=1).reshape(total, len(axes))
             description = {"axes": {n: [float(x) for x in a] for n, a in zip(names, axes)}}
         elif space.kind in ("sobol", "latin_hypercube"):
             from scipy.stats import qmc
@@ -126,7 +122,7 @@ class Space:
 
 def grid(**axes) -> Space:
     """The full grid of ``axes``: ``name="START:STOP:COUNT"`` (units allowed, both ends included), a number, or a
-    sequence of values; the first parameter varies slowest (row order of :func:`itertools.product`)."""
+    sequence of values; the first parameter varies slowest (the row order of :func:`itertools.product`)."""
     return Space("grid", _specs(axes, "grid"))
 
 
@@ -214,15 +210,17 @@ def _value(name: str, v, units: Units) -> float:
 def _axis(name: str, spec, units: Units) -> list[float]:
     """A grid axis: ``"START:STOP:COUNT"``, one value, or a sequence of values."""
     if isinstance(spec, str) and ":" in spec:
-        parts = spec.split(":")
-        if len(parts) != 3 or not parts[2].strip().isdigit() or int(parts[2]) < 1:
-            raise InvalidInputError(name, f"{name}={spec!r}: expected START:STOP:COUNT, e.g. 30cm:80cm:11", spec)
-        start, stop = (_value(name, t, units) for t in parts[:2])
-        return [float(x) for x in np.linspace(start, stop, int(parts[2]))]
-    values = list(spec) if isinstance(spec, tuple) else [spec]
-    if not values:
+        a, b, count = split_range(spec, name, MAX_DESIGNS)
+        start, stop = (_value(name, t, units) for t in (a, b))
+        with np.errstate(over="ignore", invalid="ignore"):
+            axis = np.linspace(start, stop, count)
+        if not np.all(np.isfinite(axis)):
+            raise InvalidInputError(name, f"{name}={spec!r}: the axis overflows", spec)
+        return [float(x) for x in axis]
+    given = list(spec) if isinstance(spec, tuple) else [spec]
+    if not given:
         raise InvalidInputError(name, f"{name}: an empty axis", spec)
-    return [_value(name, v, units) for v in values]
+    return [_value(name, v, units) for v in given]
 
 
 def _bounds(name: str, spec, units: Units) -> tuple[float, float]:
@@ -240,20 +238,26 @@ def _read_table(path: Path) -> dict[str, list]:
     if not path.is_file():
         raise InvalidInputError("designs", f"no such file: {path}", str(path))
     if path.suffix.lower() == ".parquet":
+        import pyarrow as pa
         import pyarrow.parquet as pq
 
-        return {k: list(v) for k, v in pq.read_table(path).to_pydict().items()}
+        try:
+            return {k: list(v) for k, v in pq.read_table(path).to_pydict().items()}
+        except (OSError, pa.ArrowException) as exc:
+            raise InvalidInputError("designs", f"{path} is not a Parquet file ({exc})", str(path)) from None
     if path.suffix.lower() != ".csv":
         raise InvalidInputError("designs", f"{path}: a design table is a .csv or .parquet file", str(path))
-    with path.open(newline="", encoding="utf-8") as f:
+    with path.open(newline="", encoding="utf-8-sig") as f:  # (-sig: a spreadsheet's byte-order mark)
         rows = list(csv.reader(f))
     if len(rows) < 2:
         raise InvalidInputError("designs", f"{path}: expected a header row of parameter names and one row per design",
                                 str(path))
-    header, body = rows[0], rows[1:]
+    header, body = [h.strip() for h in rows[0]], rows[1:]
+    if len(set(header)) != len(header):
+        raise InvalidInputError("designs", f"{path}: a column is named twice in {header}", str(path))
     if any(len(r) != len(header) for r in body):
         raise InvalidInputError("designs", f"{path}: every row must have {len(header)} cells", str(path))
-    return {h.strip(): [r[k].strip() for r in body] for k, h in enumerate(header)}
+    return {h: [r[k].strip() for r in body] for k, h in enumerate(header)}
 
 
 __all__ = ["KINDS", "MAX_DESIGNS", "Designs", "Space", "grid", "latin_hypercube", "sobol", "table"]

@@ -133,6 +133,7 @@ def resume(out: Path, manifest: dict[str, Any], overwrite: bool):
         if not _same(old, manifest):
             raise SweepError(f"{out} holds another sweep (other designs, objectives or mechanism); pass "
                              "overwrite=True (--overwrite) to replace it, or choose another output", out)
+        shutil.rmtree(parts, ignore_errors=True)  # (left by a run stopped between the final write and its cleanup)
         return None, pq.read_table(out)
     tables = []
     if parts.exists():
@@ -152,13 +153,21 @@ def resume(out: Path, manifest: dict[str, Any], overwrite: bool):
 
 
 def combine(tables, designs: Designs, objectives):
+    """One table of every design, in design order: the parts' rows, each design once (parts of runs with other
+    chunk sizes may overlap; a design's row is the same in each).
+
+    Raises:
+        SweepError: a design has no row (a bug: the caller evaluates every design the parts lack).
+    """
     import pyarrow as pa
 
     target = schema(designs.names, objectives)
-    if not tables:
-        return target.empty_table()
-    table = pa.concat_tables([t.cast(target) for t in tables])
-    return table.take(np.argsort(np.asarray(table.column("design")), kind="stable"))
+    table = pa.concat_tables([t.cast(target) for t in tables]) if tables else target.empty_table()
+    ids = np.asarray(table.column("design"), dtype=np.int64)
+    first = np.unique(ids, return_index=True)[1]
+    if len(first) != len(designs) or (len(first) and (ids[first[0]] != 0 or ids[first[-1]] != len(designs) - 1)):
+        raise SweepError(f"the results hold {len(first)} of the {len(designs)} designs", None)
+    return table.take(first)  # (np.unique's indices: sorted by design, the first row of each)
 
 
 def count_failed(table) -> int:
