@@ -235,7 +235,8 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
     Raises:
         UnknownNameError: an unknown mechanism, parameter or objective.
         InvalidInputError: a malformed space, objective or option.
-        SweepError: ``out`` holds another sweep; the scheduler cannot be reached.
+        SweepError: ``out`` holds another sweep; the scheduler cannot be reached or has no workers; designs were
+            lost to the cluster (the finished chunks kept: a rerun resumes).
     """
     if scheduler is not None and not isinstance(scheduler, str):
         raise InvalidInputError("scheduler", f"'serial' or an address such as tcp://host:8786, got {scheduler!r}",
