@@ -106,7 +106,8 @@ def test_counts_and_formatting_of_a_synthetic_paper():
     """Counts split rows into 1 match, 2 mismatches, 1 unchecked; report.md escapes '|' and flags both
     mismatches; the terminal table explains each mismatch by its note; JSON turns NaN into "nan"."""
     rep = _synthetic()
-    assert rep.counts == report.Counts(rows=4, matches=1, mismatches=2, unchecked=1, no_published=1)
+    assert rep.counts == report.Counts(rows=4, matches=1, mismatches=2, unchecked=1, no_published=1, unexplained=2)
+    assert "2 do not (2 without a reason)" in rep.counts.line()
     md = report.format_markdown(rep)
     lines = _table_lines(md)
     assert len(lines) == 4 and "off because \\| the paper rounds" in lines[1]
@@ -124,6 +125,9 @@ def test_terminal_table_lists_every_row(hexapod_report):
     """format_table prints the paper title, every row id with our value, and the totals."""
     text = report.format_table(hexapod_report)
     assert hexapod_study.TITLE in text and text.splitlines()[-1].startswith("total: ")
+    assert "do not (each explained)" in text.splitlines()[-1] or "does not (each explained)" in text.splitlines()[-1]
+    for r in hexapod_report.papers[0].mismatches:  # one line each, with its reason, above the total
+        assert f"did not match: {r.id} " in text and r.why in text
     for r in hexapod_report.papers[0].rows:
         assert r.id in text and report.fmt_value(r.computed) in text
 

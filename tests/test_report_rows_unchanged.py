@@ -41,6 +41,7 @@ def test_rows_equal_the_rows_before_the_architecture_change(paper):
     assert [r.id for r in rows] == [r["id"] for r in BEFORE[paper]]
     for row, old in zip(rows, BEFORE[paper]):
         assert (row.published, row.unit, row.matches) == (old["published"], old["unit"], old["matches"]), row.id
+        assert row.matches is not False or len(row.why) > 20, f"{row.id} does not match and states no why"
         new = row.computed
         if isinstance(new, float) and isinstance(old["computed"], (int, float)) and not isinstance(new, bool):
             if row.id in CORRECTED:

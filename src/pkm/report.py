@@ -42,6 +42,7 @@ class Counts:
         mismatches: Rows that do not (``Row.matches is False``).
         unchecked: Rows with nothing to compare (``Row.matches is None``).
         no_published: Rows whose paper gives no value (``published is None``; a subset of ``unchecked``).
+        unexplained: Mismatches without a :attr:`Row.why`.
     """
 
     rows: int
@@ -49,27 +50,35 @@ class Counts:
     mismatches: int
     unchecked: int
     no_published: int
+    unexplained: int = 0
 
     @classmethod
     def of(cls, rows: Iterable[Row]) -> Counts:
         rows = list(rows)
         m = [r.matches for r in rows]
-        return cls(len(rows), m.count(True), m.count(False), m.count(None), sum(r.published is None for r in rows))
+        return cls(len(rows), m.count(True), m.count(False), m.count(None), sum(r.published is None for r in rows),
+                   sum(r.matches is False and not r.why for r in rows))
 
     def __add__(self, other: Counts) -> Counts:
         return Counts(*(a + b for a, b in zip(self.as_tuple(), other.as_tuple())))
 
     def as_tuple(self) -> tuple[int, ...]:
-        return self.rows, self.matches, self.mismatches, self.unchecked, self.no_published
+        return self.rows, self.matches, self.mismatches, self.unchecked, self.no_published, self.unexplained
 
     def to_dict(self) -> dict[str, int]:
-        return dict(zip(("rows", "matches", "mismatches", "unchecked", "no_published"), self.as_tuple()))
+        return dict(zip(("rows", "matches", "mismatches", "unchecked", "no_published", "unexplained"),
+                        self.as_tuple()))
 
     def line(self) -> str:
-        """``"5 rows: 3 match, 1 mismatch, 1 unchecked (1 without a published value)"``."""
-        s = f"{self.rows} rows: {self.matches} match, {self.mismatches} mismatch{'es' * (self.mismatches != 1)}"
-        if self.unchecked:
-            s += f", {self.unchecked} unchecked ({self.no_published} without a published value)"
+        """``"5 rows: 3 match the paper, 1 does not (explained), 1 has no published value (ours recorded)"``."""
+        said = "each explained" if not self.unexplained else f"{self.unexplained} without a reason"
+        s = (f"{self.rows} rows: {self.matches} match{'es' * (self.matches == 1)} the paper, {self.mismatches} "
+             f"do{'es' * (self.mismatches == 1)} not ({said})")
+        if self.no_published:
+            s += (f", {self.no_published} ha{'s' if self.no_published == 1 else 've'} no published value "
+                  "(ours recorded)")
+        if self.unchecked - self.no_published:
+            s += f", {self.unchecked - self.no_published} cannot be compared"
         return s
 
 
@@ -273,6 +282,7 @@ def format_markdown(report: Report) -> str:
          "[summary.json](summary.json)."),
         "",
     ]
+    lines += summary_lines(report, markdown=True) + [""]
     for p in report.papers:
         pc = p.counts
         lines += [f"## {p.name}: {p.title}", ""]
@@ -294,6 +304,27 @@ def format_markdown(report: Report) -> str:
         if p.series:
             lines += ["Series (CSV): " + ", ".join(f"[{f.name}]({_rel(f, report.out_dir)})" for f in p.series), ""]
     return "\n".join(lines)
+
+
+def summary_lines(report: Report, *, markdown: bool = False) -> list[str]:
+    """What matched, what did not and why (a line each), and what has no published value: the report's opening."""
+    rows = [r for p in report.papers for r in p.rows]
+    code = (lambda t: f"`{t}`") if markdown else (lambda t: t)
+    bullet = "- " if markdown else "  "
+    matched = [r.id for r in rows if r.matches is True]
+    missed = [r for r in rows if r.matches is False]
+    blank = [r.id for r in rows if r.published is None]
+    out = [f"{bullet}matched ({len(matched)}): ours within the stated tolerance of the printed value"
+           + (f": {', '.join(code(i) for i in matched)}" if markdown else "")]
+    out += [f"{bullet}did not match: {code(r.id)} (published {fmt_value(r.published)}, ours {fmt_value(r.computed)}"
+            f"{' ' + r.unit if r.unit else ''}): {r.why or 'see its note'}" for r in missed]
+    by_paper = ", ".join(f"{p.name} {sum(r.published is None for r in p.rows)}" for p in report.papers
+                         if any(r.published is None for r in p.rows))
+    if blank:
+        out.append(f"{bullet}no published value ({len(blank)}; {by_paper}): numbers the papers do not print (curves "
+                   "whose image is lost, forces shown only as plots, our kernels' operation counts), recorded so that "
+                   "a change shows")
+    return out
 
 
 def _md_cell(text: str) -> str:
@@ -327,8 +358,10 @@ def format_table(report: Report | Sequence[PaperResult], *, width: int = 100) ->
             out.append(f"   {len(p.figures)} figure(s), {len(p.series)} series file(s)")
         out.append("")
     if isinstance(report, Report):
+        out += summary_lines(report)
         out.append(f"total: {report.counts.line()}; {report.markdown} ({report.seconds:.1f} s)")
     return "\n".join(out)
 
 
-__all__ = ["STEPS", "Counts", "PaperResult", "Report", "format_markdown", "format_table", "run", "summary_dict"]
+__all__ = ["STEPS", "Counts", "PaperResult", "Report", "format_markdown", "format_table", "run", "summary_dict",
+           "summary_lines"]

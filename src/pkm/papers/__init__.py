@@ -45,6 +45,8 @@ class Row:
         note: How ours was computed and, where it differs, why.
         relation: How ours must relate to the published value: ``"=="`` (within ``tolerance``),
             ``"<="`` or ``">="`` (a published bound or a baseline to beat).
+        why: One line, for a row that does not match: why (the report's summary quotes it; the note has the
+            detail). Every mismatching row states one (tested).
     """
 
     id: str
@@ -55,6 +57,7 @@ class Row:
     source: str
     note: str = ""
     relation: str = "=="
+    why: str = ""
 
     def __post_init__(self):
         if self.relation not in RELATIONS:

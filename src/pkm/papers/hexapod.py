@@ -108,7 +108,9 @@ def reproduce() -> list[Row]:
             f"{math.degrees(pr.pointwise[-1]):.1f} deg, beta*_tras from {math.degrees(pt.pointwise[0]):.1f} to "
             f"{math.degrees(pt.pointwise[-1]):.1f} deg. With w_tras at P instead of O the gap is "
             f"{gap_p.max():.2f} deg. Independent re-derivations reported the same mismatch (shared notes); "
-            "the printed spiral may differ from the one computed (4-digit rotation, unstated conventions)."),
+            "the printed spiral may differ from the one computed (4-digit rotation, unstated conventions).",
+            why=f"the model that reproduces pose T gives {gap.max():.1f} deg along the spiral; independent "
+                "re-derivations agree (the printed spiral's conventions are not stated)"),
         Row("hexapod.spiral.gain_after_40_wrot", None, gain40, "%", None, "sec. 4, Fig. 9a",
             f"Mean of w_rot(beta*_k) / w_rot(0) - 1 over poses 40..100 (base model: beta = 0 throughout). "
             f"The paper prints no number, only 'from about point 40 the improvement is very clear'. Ours: "
