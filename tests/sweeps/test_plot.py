@@ -10,6 +10,7 @@ import pytest
 import pkm
 from pkm import cli, sweeps
 from pkm.sweeps.results import pareto_front
+from tests.papers.figures import inspected
 
 
 def test_pareto_front_of_a_known_set():
@@ -28,8 +29,11 @@ def results(tmp_path_factory):
 
 
 def test_plots_from_the_results_file(results, tmp_path, capsys):
+    """`pkm sweep plot` writes both figures, each with units on its axes and every line in a legend."""
     capsys.readouterr()
-    assert cli.main(["sweep", "plot", str(results), "--out", str(tmp_path)]) == 0
+    with inspected() as found:
+        assert cli.main(["sweep", "plot", str(results), "--out", str(tmp_path)]) == 0
+    assert found == {"sweep_parameters": [], "sweep_pareto": []}
     paths = json.loads(capsys.readouterr().out)
     assert [p.rsplit("/", 1)[1] for p in paths] == ["sweep_parameters.png", "sweep_pareto.png"]
     assert all((tmp_path / p.rsplit("/", 1)[1]).stat().st_size > 10_000 for p in paths)

@@ -53,8 +53,9 @@ POSE = np.array(PAPER.home)
 R_RANGE = (0.100, 0.200)
 R_STEP = 1e-4  # the paper's 0.1 mm
 KINDS = ("fro", "fro_normalized", "2")
-LABELS = {"fro": "raw Frobenius ||J||_F ||J^-1||_F", "fro_normalized": "normalised (1/3)||J||_F ||J^-1||_F",
-          "2": "2-norm sigma_max / sigma_min"}
+LABELS = {"fro": r"raw Frobenius $\|J\|_F\,\|J^{-1}\|_F$",
+          "fro_normalized": r"normalised $\frac{1}{3}\|J\|_F\,\|J^{-1}\|_F$",
+          "2": r"2-norm $\sigma_{max}/\sigma_{min}$"}
 K_MAX = 3.0
 CHOICE_KIND = "2"
 SPACING = 0.008
@@ -186,42 +187,55 @@ def figures(out_dir) -> list[Path]:
     out = []
     R, K = fig5_sweep("knee_out")
     R_in, K_in = fig5_sweep("knee_in")
-    fig, axes = figure(ncols=3, size=(4.6, 3.8))
+    fig, axes = figure(ncols=3, size=(4.6, 4.0))
     for ax, kind in zip(axes[0], KINDS):
         ax.plot(R * 1e3, K[kind], label="knee out")
         ax.plot(R_in * 1e3, K_in[kind], "--", lw=0.8, label="knee in")
         lower = 3.0 if kind == "fro" else 1.0
-        ax.axhline(lower, color="grey", lw=0.6, ls=":")
-        ax.axvspan(R_RANGE[0] * 1e3, R_RANGE[1] * 1e3, color="0.92", zorder=0, label="paper's range")
-        ax.axvline(arms_vertical_radius() * 1e3, color="C2", lw=0.8, label="min K (arms vertical)")
-        ax.axvline(reach_limit() * 1e3, color="C3", lw=0.8, label="reach limit")
-        ax.axvline(120.0, color="k", lw=0.6, ls="-.", label="paper's choice")
+        ax.axhline(lower, color="grey", lw=0.6, ls=":", label="least possible K (isotropic J)")
+        ax.axvspan(R_RANGE[0] * 1e3, R_RANGE[1] * 1e3, color="0.92", zorder=0, label="paper's range of R")
+        ax.axvline(arms_vertical_radius() * 1e3, color="C2", lw=0.8, label="least K (arms vertical)")
+        ax.axvline(reach_limit() * 1e3, color="C3", lw=0.8, label="reach limit of the pose")
+        ax.axvline(120.0, color="k", lw=0.6, ls="-.", label="paper's choice, 120 mm")
         top = float(np.max(K[kind])) * 1.6
         ax.set_ylim(lower * 0.9, top)
-        ax.set_xlabel("R [mm]")
+        ax.set_xlabel("base radius R [mm]")
+        ax.set_ylabel("K [-]")
         ax.set_title(LABELS[kind], fontsize=9)
-    axes[0, 0].set_ylabel("K at (0, 0, -375) mm")
-    axes[0, 0].legend(fontsize=7)
-    out.append(save(fig, out_dir, "delta_fig5_K_vs_R"))
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=7, frameon=False)
+    fig.suptitle(f"Delta, La = {PAPER.La * 1e3:.0f}, Lb = {PAPER.Lb * 1e3:.0f}, r = {PAPER.r * 1e3:.0f} mm: condition "
+                 f"number K at (0, 0, {POSE[2] * 1e3:.0f}) mm against R (paper's Fig. 5; its image is not legible "
+                 "in our copy)", fontsize=9)
+    fig.tight_layout(rect=(0, 0.1, 1, 1))
+    out.append(save(fig, out_dir, "delta_fig5_K_vs_R", layout=False))
 
     study = radius_study()
     fig, axes = figure(ncols=2, size=(5.6, 4.0))
     ax1, ax2 = axes[0]
     ax1.plot(study.R * 1e3, study.volume * 1e3, "k", label="reachable (z < 0)")
     for k_max in (2.5, 3.0, 4.0, 5.0):
-        ax1.plot(study.R * 1e3, study.conditioned_volume(k_max) * 1e3, label=f"K_2 <= {k_max:g}")
-    ax1.axvspan(R_RANGE[0] * 1e3, R_RANGE[1] * 1e3, color="0.92", zorder=0)
-    ax1.axvline(choose_radius() * 1e3, color="C1", lw=0.8, ls="--", label=f"choice (K_2 <= {K_MAX:g})")
-    ax1.axvline(120.0, color="k", lw=0.6, ls="-.", label="paper's choice")
-    ax1.set_xlabel("R [mm]")
+        ax1.plot(study.R * 1e3, study.conditioned_volume(k_max) * 1e3, label=rf"$K_2 \leq {k_max:g}$")
+    ax1.axvspan(R_RANGE[0] * 1e3, R_RANGE[1] * 1e3, color="0.92", zorder=0, label="paper's range of R")
+    ax1.axvline(choose_radius() * 1e3, color="C1", lw=0.8, ls="--", label=rf"our choice ($K_2 \leq {K_MAX:g}$)")
+    ax1.axvline(120.0, color="k", lw=0.6, ls="-.", label="paper's choice, 120 mm")
+    ax1.set_xlabel("base radius R [mm]")
     ax1.set_ylabel("workspace volume [L]")
     ax1.legend(fontsize=7)
     bounds = np.linspace(2.2, 8.0, 59)
-    ax2.plot(bounds, [choose_radius(b) * 1e3 for b in bounds], ".-")
-    ax2.axhline(120.0, color="k", lw=0.6, ls="-.")
-    ax2.set_xlabel("bound k_max on K_2")
+    chosen = np.array([choose_radius(b) * 1e3 for b in bounds])
+    at_end = np.isclose(chosen, R_RANGE[0] * 1e3) | np.isclose(chosen, R_RANGE[1] * 1e3)
+    ax2.plot(bounds, chosen, "-", color="C0", lw=0.8, label="R of the largest volume")
+    ax2.plot(bounds[~at_end], chosen[~at_end], ".", color="C0", label="inside the range: an optimum")
+    ax2.plot(bounds[at_end], chosen[at_end], "o", mfc="none", color="C3", ms=4,
+             label="at an end of the range: a bound, not an optimum")
+    ax2.axhline(120.0, color="k", lw=0.6, ls="-.", label="paper's choice, 120 mm")
+    ax2.set_xlabel(r"bound $k_{max}$ on $K_2$ [-]")
     ax2.set_ylabel("chosen R [mm]")
-    ax2.set_title("R with the largest volume where K_2 <= k_max", fontsize=9)
+    ax2.set_title(r"R with the largest volume where $K_2 \leq k_{max}$", fontsize=9)
+    ax2.legend(fontsize=7)
+    fig.suptitle(f"Delta, La = {PAPER.La * 1e3:.0f}, Lb = {PAPER.Lb * 1e3:.0f}, r = {PAPER.r * 1e3:.0f} mm: workspace "
+                 f"against R ({SPACING * 1e3:.0f} mm grid; the paper's sec. 6 choice, no figure)", fontsize=9)
     out.append(save(fig, out_dir, "delta_workspace_vs_R"))
     return out
 

@@ -120,43 +120,89 @@ def reproduce() -> list[Row]:
     ] + opcount_rows("hexapod", "hexapod.opcount.")
 
 
+UNITS = {"w_rot": "[-]", "w_tras": "[m$^3$]"}  # w = sqrt(det(X X^T)) of the angular (1/1) or linear (m) rows
+NAMES = {"w_rot": "$w_{rot}$", "w_tras": "$w_{tras}$"}
+CAPTION = "Hexapod (the paper's design, two 3-RUS)"
+
+
 def figures(out_dir) -> list[Path]:
-    """Fig. 7 (indices vs beta at pose T), Fig. 9 (base vs reconfigured along the spiral), Fig. 10 (beta profiles)."""
+    """Fig. 7 (indices vs beta at pose T), Fig. 9 (base vs reconfigured along the spiral, and the gain, which the
+    curves alone do not show), Fig. 10 (beta profiles)."""
     t, s = pose_t(), spiral()
     out = []
     fig, axes = figure(ncols=2)
-    for ax, idx, label in zip(axes[0], hi.INDICES, ("$w_{rot}$", "$w_{tras}$ [m$^3$]")):
-        v = np.where(t["reach"], t["curves"][idx], np.nan)
-        ax.plot(np.degrees(t["grid"]), v)
-        ax.axvline(t["choice"][idx].beta_deg, ls="--", c="k", lw=0.8,
-                   label=f"beta* = {t['choice'][idx].beta_deg:.2f} deg")
-        ax.axvline(math.degrees(t["spans"][0][0]), ls=":", c="r", lw=0.8, label="reachability limit")
-        ax.set(xlabel="beta [deg]", ylabel=label, title=f"Fig. 7: {idx} at pose T")
-        ax.legend()
-    out.append(save(fig, out_dir, "hexapod_fig7_indices_vs_beta"))
-    fig, axes = figure(ncols=2)
-    k = np.arange(101)
     for ax, idx in zip(axes[0], hi.INDICES):
+        v = np.where(t["reach"], t["curves"][idx], np.nan)
+        ax.plot(np.degrees(t["grid"]), v, label=f"{NAMES[idx]} at pose T")
+        ax.axvline(t["choice"][idx].beta_deg, ls="--", c="k", lw=0.8,
+                   label=rf"$\beta^*$ = {t['choice'][idx].beta_deg:.2f} deg")
+        ax.axvline(math.degrees(t["spans"][0][0]), ls=":", c="r", lw=0.8, label="reachability limit")
+        ax.set(xlabel=r"reconfiguration angle $\beta$ [deg]", ylabel=f"{NAMES[idx]} {UNITS[idx]}",
+               title=f"{NAMES[idx]} against $\\beta$")
+        ax.legend(fontsize=8)
+    fig.suptitle(f"{CAPTION} at pose T (paper's Fig. 7)", fontsize=10)
+    out.append(save(fig, out_dir, "hexapod_fig7_indices_vs_beta"))
+    fig, axes = figure(ncols=2, nrows=2, size=(6.4, 3.4))
+    k = np.arange(len(s["profiles"]["w_rot"].base_value))
+    for col, idx in enumerate(hi.INDICES):
         pr = s["profiles"][idx]
-        ax.plot(k, pr.base_value, label="base model (beta = 0)")
-        ax.plot(k, pr.pointwise_value, label="reconfigured (pointwise beta*)")
-        ax.plot(k, pr.value, ls="--", label="reconfigured (QP profile, 2 deg/pose)")
-        ax.set(xlabel="point of the spiral", ylabel=idx, title=f"Fig. 9: {idx} along the spiral")
-        ax.legend()
+        top, low = axes[0, col], axes[1, col]
+        top.plot(k, pr.base_value, label=r"base model ($\beta$ = 0)")
+        top.plot(k, pr.pointwise_value, label=r"reconfigured (pointwise $\beta^*$)")
+        top.plot(k, pr.value, ls="--", label="reconfigured (QP profile, 2 deg/pose)")
+        top.set(xlabel="pose along the spiral, k [-]", ylabel=f"{NAMES[idx]} {UNITS[idx]}",
+                title=f"{NAMES[idx]} along the spiral")
+        top.legend(fontsize=7)
+        low.plot(k, 100.0 * (pr.pointwise_value / pr.base_value - 1.0), c="C1", label=r"pointwise $\beta^*$")
+        low.plot(k, 100.0 * (pr.value / pr.base_value - 1.0), c="C2", ls="--", label="QP profile")
+        low.axhline(0.0, c="C0", lw=0.8, label=r"base model ($\beta$ = 0)")
+        low.set(xlabel="pose along the spiral, k [-]", ylabel="gain over the base model [%]",
+                title=f"what reconfiguring gains in {NAMES[idx]}")
+        low.legend(fontsize=7)
+    fig.suptitle(f"{CAPTION} along the spiral of sec. 4 (paper's Fig. 9)", fontsize=10)
     out.append(save(fig, out_dir, "hexapod_fig9_manipulability_spiral"))
     fig, ax = figure()
     for idx in hi.INDICES:
         pr = s["profiles"][idx]
-        ax.plot(k, np.degrees(pr.pointwise), label=f"beta* ({idx}, pointwise)")
-        ax.plot(k, np.degrees(pr.beta), ls="--", label=f"QP profile ({idx})")
-    ax.set(xlabel="point of the spiral", ylabel="beta [deg]", title="Fig. 10: reconfiguration angle along the spiral")
-    ax.legend()
+        ax.plot(k, np.degrees(pr.pointwise), label=rf"$\beta^*$ of {NAMES[idx]}, pointwise")
+        ax.plot(k, np.degrees(pr.beta), ls="--", label=f"QP profile of {NAMES[idx]} (2 deg/pose)")
+    ax.set(xlabel="pose along the spiral, k [-]", ylabel=r"$\beta$ [deg]",
+           title=f"{CAPTION}: reconfiguration angle along the spiral (paper's Fig. 10)")
+    ax.title.set_fontsize(9)
+    ax.legend(fontsize=8)
     out.append(save(fig, out_dir, "hexapod_fig10_beta_profiles"))
     return out
 
 
-#: No CSV series yet (the figures issue adds them).
-series = None
+def series(out_dir) -> list[Path]:
+    """CSV: Fig. 7's curves at pose T, and along the spiral each index's base, pointwise and QP values and angles."""
+    import csv
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    t, s = pose_t(), spiral()
+    f1 = out_dir / "hexapod_fig7_indices_vs_beta.csv"
+    with f1.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["beta_deg", "reachable", "w_rot", "w_tras_m3"])
+        for b, r, wr, wt in zip(np.degrees(t["grid"]), t["reach"], t["curves"]["w_rot"], t["curves"]["w_tras"]):
+            w.writerow([f"{b:.4f}", int(bool(r)), f"{wr:.10g}" if r else "", f"{wt:.10g}" if r else ""])
+    f2 = out_dir / "hexapod_spiral_profiles.csv"
+    with f2.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        head = ["k"]
+        for idx in hi.INDICES:
+            head += [f"{idx}_base", f"{idx}_pointwise", f"{idx}_qp", f"beta_star_{idx}_deg", f"beta_qp_{idx}_deg"]
+        w.writerow(head)
+        pr = [s["profiles"][idx] for idx in hi.INDICES]
+        for j in range(len(pr[0].base_value)):
+            row: list = [j]
+            for p in pr:
+                row += [f"{p.base_value[j]:.10g}", f"{p.pointwise_value[j]:.10g}", f"{p.value[j]:.10g}",
+                        f"{math.degrees(p.pointwise[j]):.6f}", f"{math.degrees(p.beta[j]):.6f}"]
+            w.writerow(row)
+    return [f1, f2]
+
 
 __all__ = ["POSE_T_POSITION", "POSE_T_ROTATION", "TITLE", "figures", "pose_T_placement", "pose_t", "reproduce", "series", "spiral",
            "spiral_poses"]

@@ -54,7 +54,7 @@ def plot(result, out_dir, pareto: Sequence[str] | None = None) -> list[Path]:
         if (~ok).any():
             floor = np.nanmin(y[ok]) if np.isfinite(y[ok]).any() else 0.0
             ax.scatter(x[~ok], np.full((~ok).sum(), floor), s=10, marker="x", color="tab:red", label="failed")
-        ax.set(xlabel=_label(res, p) if i == len(objs) - 1 else "", ylabel=_label(res, o) if j == 0 else "")
+        ax.set(xlabel=_label(res, p), ylabel=_label(res, o))
         if i == 0 and j == 0:
             ax.legend(fontsize="small")
     fig.suptitle(f"{_family_title(res)}: {len(res)} designs ({int((~ok).sum())} failed)")
