@@ -48,6 +48,8 @@ def problems(fig) -> list[str]:
     bars = {ax for ax in fig.axes if getattr(ax, "_colorbar", None) is not None or ax.get_label() == "<colorbar>"}
     legends = [lg for lg in fig.legends] + [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None]
     shown = {t.get_text() for lg in legends for t in lg.get_texts()}  # (a legend may serve several panels)
+    barred = [im for ax in fig.axes for im in ax.get_images() + list(ax.collections)
+              if getattr(im, "colorbar", None) is not None]  # (one bar may serve images of one colour scale)
     for k, ax in enumerate(fig.axes):
         if ax in bars or not ax.get_visible():
             continue
@@ -68,6 +70,11 @@ def problems(fig) -> list[str]:
                 if label.startswith("_") or label not in shown:
                     out.append(f"{name}: a line or marker set ({label!r}) is not in the legend")
         for im in images:
-            if getattr(im, "colorbar", None) is None:
+            if getattr(im, "colorbar", None) is None and not any(_same_scale(im, other) for other in barred):
                 out.append(f"{name}: an image without a colour bar")
     return out
+
+
+def _same_scale(a, b) -> bool:
+    """Two images coloured by one colour map over one range (a shared colour bar reads both)."""
+    return a.get_cmap().name == b.get_cmap().name and tuple(a.get_clim()) == tuple(b.get_clim())

@@ -240,61 +240,104 @@ def reproduce() -> list[Row]:
 
 
 # ---------------------------------------------------------------------- figures and series
-def _draw_map(ax, m: maps.CiMap, title: str):
+def _unreachable_patch():
+    from matplotlib.patches import Patch
+
+    return Patch(facecolor="white", edgecolor="0.5", label="unreachable (outside the workspace)")
+
+
+def _draw_map(ax, m: maps.CiMap, title: str, *, legend: bool = True, short: bool = False):
+    """The CI map about the base centroid [cm], the area of interest in red, unreachable nodes white (``short``:
+    axis labels for small panels)."""
+
     g = m.grid
     im = ax.imshow(np.ma.masked_invalid(m.ci), origin="lower", vmin=0.0, vmax=1.0, cmap="viridis",
                    extent=[(g.xs[0] - g.centre[0]) / CM, (g.xs[-1] - g.centre[0]) / CM,
                            (g.ys[0] - g.centre[1]) / CM, (g.ys[-1] - g.centre[1]) / CM])
     half = maps.AREA_SIDE / 2.0 / CM
-    ax.plot([-half, half, half, -half, -half], [-half, -half, half, half, -half], "r-", lw=1.0)
-    ax.set_xlabel("x_G - base centroid [cm]")
-    ax.set_ylabel("y_G - base centroid [cm]")
-    ax.set_title(title, fontsize=9)
+    ax.plot([-half, half, half, -half, -half], [-half, -half, half, half, -half], "r-", lw=1.0,
+            label=f"{maps.AREA_SIDE / CM:.0f} x {maps.AREA_SIDE / CM:.0f} cm area of interest")
+    ax.set_xlabel(r"$x_G$ [cm]" if short else r"$x_G$ from the base centroid [cm]")
+    ax.set_ylabel(r"$y_G$ [cm]" if short else r"$y_G$ from the base centroid [cm]")
+    ax.set_title(title, fontsize=8)
+    if legend:
+        handles, _ = ax.get_legend_handles_labels()
+        ax.legend(handles=handles + [_unreachable_patch()], fontsize=7, loc="lower right")
     return im
 
 
+CI_LABEL = r"CI = $1/\kappa_2$ [-]"
+FIGURE_NUMBERS = {"fig5": "Fig. 5", "fig6": "Fig. 6", "fig7": "Fig. 7", "fig9": "Fig. 9"}
+
+
+def _dims(d) -> str:
+    return f"a = {d.a / CM:.0f}, b = {d.b / CM:.0f}, h = {d.h / CM:.0f}, H = {d.H / CM:.0f} cm"
+
+
 def figures(out_dir) -> list[Path]:
-    """Figs. 3, 5-9 redrawn, plus the similarity-law check and the 1,000-design sweep (PNG)."""
+    """Figs. 3, 5-9 redrawn, plus the similarity-law check and the 1,000-design sweep (PNG). Positions are of the
+    platform centroid G from the base centroid, in cm, in every figure."""
     out = []
     base = rrr3.Rrr3Params()
-    fig, axes = figure(ncols=2, size=(5.5, 4.5))
+    centre = maps.Design.of(base).base_centroid
+    fig, axes = figure(ncols=2, size=(5.5, 4.8))
     axes = axes.ravel()
+    fine = maps.Grid.square(centre, maps.AREA_SIDE * 3.0, 0.0025)  # (2.5 mm: smooth contours)
+    extent = np.zeros(4)
     for k, deg in enumerate((0, 30, 60, 90)):
-        ws = maps.workspace(base, math.radians(deg))
-        axes[0].contour(ws.grid.xs / CM, ws.grid.ys / CM, ws.reachable.astype(float), levels=[0.5], colors=f"C{k}")
-        axes[0].plot([], [], f"C{k}", label=f"Phi = {deg} deg, {ws.area * 1e4:.0f} cm^2")
-    axes[0].set_aspect("equal")
-    axes[0].set_xlabel("x_G [cm]")
-    axes[0].set_ylabel("y_G [cm]")
+        ws = maps.workspace(base, math.radians(deg), fine)
+        xs, ys = (ws.grid.xs - centre[0]) / CM, (ws.grid.ys - centre[1]) / CM
+        axes[0].contour(xs, ys, ws.reachable.astype(float), levels=[0.5], colors=f"C{k}")
+        axes[0].plot([], [], f"C{k}", label=rf"$\Phi$ = {deg} deg: {ws.area * 1e4:.0f} cm$^2$")
+        yy, xx = np.nonzero(ws.reachable)
+        if k == 0 and len(xx):
+            extent = np.array([xs[xx.min()], xs[xx.max()], ys[yy.min()], ys[yy.max()]])
+    pad = 0.1 * max(extent[1] - extent[0], extent[3] - extent[2])
+    axes[0].set(xlim=(extent[0] - pad, extent[1] + pad), ylim=(extent[2] - pad, extent[3] + pad), aspect="equal",
+                xlabel=r"$x_G$ from the base centroid [cm]", ylabel=r"$y_G$ from the base centroid [cm]",
+                title=r"workspace of G at fixed $\Phi$")
+    axes[0].title.set_fontsize(9)
     axes[0].legend(fontsize=7)
     sw = _fig3_sweep()
-    axes[1].plot(np.degrees(sw.phis), sw.areas * 1e4)
-    axes[1].set_xlabel("Phi [deg]")
-    axes[1].set_ylabel("workspace area [cm^2]")
-    axes[1].set_title(f"{sw.nodes:,} nodes (101 x 101 x 361)", fontsize=9)
+    axes[1].plot(np.degrees(sw.phis), sw.areas * 1e4, label=f"{sw.nodes:,} nodes (101 x 101 x 361)")
+    axes[1].set(xlabel=r"platform orientation $\Phi$ [deg]", ylabel="workspace area [cm$^2$]",
+                title=r"workspace area against $\Phi$")
+    axes[1].title.set_fontsize(9)
+    axes[1].legend(fontsize=7)
+    fig.suptitle(f"3-RRR, {_dims(base)} (the paper's reference design): its Fig. 3", fontsize=9)
     out.append(save(fig, out_dir, "rrr3_fig3_workspace"))
     for name in ("fig5", "fig6", "fig7", "fig9"):
         m = figure_map(name)
-        d = m.design
-        fig, ax = figure(size=(5.5, 4.5))
-        im = _draw_map(ax, m, f"{name}: a={d.a / CM:.0f}, b={d.b / CM:.0f}, h={d.h / CM:.0f}, H={d.H / CM:.0f} cm; "
-                              f"GCI={m.gci().value:.4f}, area {m.area_gci().value:.4f}")
-        fig.colorbar(im, ax=ax, label="CI")
+        p_all, p_area = PUBLISHED[name]
+        fig, ax = figure(size=(6.2, 5.0))
+        im = _draw_map(ax, m, f"paper's {FIGURE_NUMBERS[name]}: {_dims(m.design)}, mode 1, $\\Phi$ = 0\nGCI "
+                              f"{m.gci().value:.4f} (paper {p_all}), area GCI {m.area_gci().value:.4f} (paper {p_area})")
+        fig.colorbar(im, ax=ax, label=CI_LABEL)
         out.append(save(fig, out_dir, f"rrr3_{name}_ci_map"))
-    fig, axes = figure(ncols=4, nrows=2, size=(3.6, 3.2))
+    fig, axes = figure(ncols=4, nrows=2, size=(3.0, 3.0))
     for (mode, g, _, c), ax in zip(mode_study(), axes.ravel()):
-        _draw_map(ax, figure_map("fig9", mode), f"mode{mode}: GCI {g:.3f}, {c} crossings")
-    out.append(save(fig, out_dir, "rrr3_fig8_modes"))
+        im = _draw_map(ax, figure_map("fig9", mode), f"mode {mode}: GCI {g:.3f}\n{c} sign changes of det $J_x$",
+                       legend=False, short=True)
+    fig.suptitle(f"3-RRR, {_dims(figure_design('fig9'))}: the eight working modes (paper's Fig. 8), positions of G "
+                 "from the base centroid\nsign changes: pairs of neighbouring reachable nodes where det $J_x$ changes "
+                 f"sign, a direct singularity inside the workspace; suitable modes (no sign change): {SUITABLE_MODES}",
+                 fontsize=9)
+    handles, _ = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles=handles + [_unreachable_patch()], loc="lower center", ncol=2, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.05, 0.9, 0.92))
+    fig.colorbar(im, ax=list(axes.ravel()), label=CI_LABEL, shrink=0.8, fraction=0.03)
+    out.append(save(fig, out_dir, "rrr3_fig8_modes", layout=False))
     fig, ax = figure()
     Hs, overall, area = _similarity()
     ax.plot(Hs / CM, overall, "o-", label="GCI, whole workspace (grid scaled with H)")
     ax.plot(Hs / CM, area, "s-", label="GCI, fixed 30 x 30 cm area")
-    ax.set_xlabel("H [cm] (h = H/10, a = b = 0.4 H)")
-    ax.set_ylabel("GCI")
+    ax.set_xlabel("base side H [cm] (h = H/10, a = b = 0.4 H)")
+    ax.set_ylabel("GCI [-]")
+    ax.set_title("3-RRR similarity law: the GCI does not depend on the scale, the area GCI does", fontsize=9)
     ax.legend(fontsize=8)
     out.append(save(fig, out_dir, "rrr3_similarity_law"))
     res = design_sweep()
-    fig, ax = figure()
+    fig, ax = figure(size=(6.4, 4.6))
     full = res.coverage >= 1.0 - 1e-12
     shown = ~np.ma.getmaskarray(res.area_gci)
     ax.scatter(res.gci[~full & shown], res.area_gci[~full & shown], s=4, c="0.7", label="area partly reachable")
@@ -303,10 +346,11 @@ def figures(out_dir) -> list[Path]:
     if law is not None:
         d = res.designs[law]
         ax.scatter([res.gci[law]], [res.area_gci[law]], marker="*", s=80, c="r",
-                   label=f"best area GCI: a={d.a:.2f}, b={d.b:.2f}, h={d.h:.2f} m")
-    ax.set_xlabel("GCI, whole workspace")
-    ax.set_ylabel("GCI, 30 x 30 cm area")
-    ax.set_title(f"{len(res.designs)} designs, H = 1 m", fontsize=9)
+                   label=f"best area GCI: a = {d.a / CM:.0f}, b = {d.b / CM:.0f}, h = {d.h / CM:.0f} cm")
+    ax.set_xlabel("GCI over the whole workspace [-]")
+    ax.set_ylabel("GCI over the 30 x 30 cm area [-]")
+    ax.set_title(f"3-RRR: {len(res.designs)} designs with H = {res.designs[0].H / CM:.0f} cm (the paper's sec. VII "
+                 "sweep, through pkm.sweep)", fontsize=9)
     ax.legend(fontsize=8)
     out.append(save(fig, out_dir, "rrr3_design_sweep"))
     return out
