@@ -398,7 +398,8 @@ def design_sweep(step: float = 0.01, scheduler: str | None = None) -> maps.Sweep
 
 
 def series(out_dir) -> list[Path]:
-    """CSV: the Fig. 7 candidate search, the working-mode study and the 1,000-design sweep."""
+    """CSV: the Fig. 7 candidate search, the working-mode study, the CI maps of Figs. 5-7, 9, Fig. 3's area against
+    Phi, the similarity law and the 1,000-design sweep: the numbers behind every figure."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     paths = []
@@ -414,6 +415,24 @@ def series(out_dir) -> list[Path]:
         w = csv.writer(f)
         w.writerow(["mode", "gci", "gci_area", "det_Jx_sign_changes"])
         w.writerows(mode_study())
+    paths.append(path)
+    for name in ("fig5", "fig6", "fig7", "fig9"):  # the maps: reachable nodes only (the rest is white)
+        m = figure_map(name)
+        path = out_dir / f"rrr3_{name}_ci_map.csv"
+        X, Y = np.meshgrid((m.grid.xs - m.grid.centre[0]) / CM, (m.grid.ys - m.grid.centre[1]) / CM)
+        keep = m.reachable
+        np.savetxt(path, np.column_stack([X[keep], Y[keep], m.ci[keep]]), fmt=["%.1f", "%.1f", "%.6g"],
+                   delimiter=",", header="x_G_cm,y_G_cm,ci", comments="")
+        paths.append(path)
+    sw = _fig3_sweep()
+    path = out_dir / "rrr3_fig3_area_vs_phi.csv"
+    np.savetxt(path, np.column_stack([np.degrees(sw.phis), sw.areas * 1e4]), fmt=["%.1f", "%.6g"], delimiter=",",
+               header="phi_deg,area_cm2", comments="")
+    paths.append(path)
+    Hs, overall, area = _similarity()
+    path = out_dir / "rrr3_similarity_law.csv"
+    np.savetxt(path, np.column_stack([Hs / CM, overall, area]), fmt=["%.1f", "%.6g", "%.6g"], delimiter=",",
+               header="H_cm,gci,gci_area", comments="")
     paths.append(path)
     res = design_sweep()
     path = out_dir / "rrr3_design_sweep.csv"
