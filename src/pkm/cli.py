@@ -548,7 +548,9 @@ def cmd_sweep(args) -> int:
             raise UsageError(f"--sample {args.sample} needs --n (the number of designs)")
         draw = sweeps.sobol if args.sample == "sobol" else sweeps.latin_hypercube
         space = draw(args.n, seed=args.seed, **axes)
-    fixed = dict(_split(item, "--fixed") for item in args.fixed)
+    if args.fixed and args.mechanism not in pkm.MECHANISMS:
+        raise UsageError(f"--fixed sets the design of a shipped mechanism; {args.mechanism} states its own")
+    fixed = parse_params(args.mechanism, args.fixed) if args.fixed else {}  # (tuples and units as --param's)
     res = sweeps.sweep(args.mechanism, space, args.objective, out=args.out, fixed=fixed or None,
                        scheduler=args.scheduler, workers=args.workers, chunk_size=args.chunk,
                        progress=False if args.no_progress else None, overwrite=args.overwrite)
@@ -556,8 +558,7 @@ def cmd_sweep(args) -> int:
     out = {"mechanism": res.manifest["family"], "designs": len(res), "failed": st.failed,
            "evaluated_now": st.evaluated, "space": res.manifest["space"], "out": args.out,
            "workers": st.workers, "wall_seconds": st.wall_seconds, "work_seconds": st.work_seconds,
-           "best": {c: res.best(c, 1)[0] if o["sense"] and res.best(c, 1) else None
-                    for c, o in res.objectives.items()}}
+           "best": {c: next(iter(res.best(c, 1)), None) if o["sense"] else None for c, o in res.objectives.items()}}
     print(json.dumps(jsonable(out), indent=2))
     return 0
 
