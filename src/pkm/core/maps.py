@@ -263,12 +263,7 @@ def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, ob
         raise InvalidInputError("axes", f"{total} nodes exceed {MAX_NODES}; map in parts", dims)
     q0 = mech.q_reference.copy() if seed is None else mech.check_q(seed, "seed")
     base = task.parse(dict(fixed or {}), base=q0)
-    kinds = [task.kinds[k] for k in task.keys]
-    if "angle" in kinds and "length" in kinds and length is None:
-        raise InvalidInputError("length", "the task mixes lengths and angles: give the characteristic length L [m] "
-                                          "that homogenises the angular rates")
-    # (a pose's tangent: x y z then three angles, in the order of its keys)
-    scale = np.array([1.0 if k == "length" else 1.0 / (length or 1.0) for k in kinds])
+    scale = task.rate_scale(length)  # (a pose's tangent: x y z then three angles, in the order of its keys)
 
     targets = np.empty((total, len(base)))
     targets[:] = base

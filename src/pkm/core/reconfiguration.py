@@ -71,8 +71,7 @@ class _Index:
         self.parameter_names = params
         self.cols = [task.value_names.index(n) for n in params]  # (task joints: the same place in value and tangent)
         self.keep_task = [i for i, key in enumerate(task.keys) if key not in params]
-        self.scale = np.array([1.0 if task.kinds[task.keys[i]] == "length" else 1.0 / (length or 1.0)
-                               for i in self.keep_task])
+        self.scale = task.rate_scale(length, [task.keys[i] for i in self.keep_task])
         self.keep_act = [i for i, name in enumerate(mech.actuated_names) if name not in params]
         signs = {} if mech.spec.default_branch is None else mech.branch(branch).signs
         self._signs = [(mech.joints[j].idx_q, s, mech.joints[j].revolute) for j, s in signs.items()]
@@ -196,9 +195,7 @@ def reconfigure(mech: Mechanism, poses, parameters: Sequence[str], limits, *, in
     if length is not None:
         length = as_scalar(length, "length", low=0.0, strict_low=True, unit="m")
     tol = as_tolerance(tol, "tol")
-    kinds = [task.kinds[k] for k in task.keys if k not in params]
-    if "angle" in kinds and "length" in kinds and length is None:
-        raise InvalidInputError("length", "the pose mixes lengths and angles: give the characteristic length L [m]")
+    task.rate_scale(length, [k for k in task.keys if k not in params])  # (mixed and no length: refused here)
     grid = as_count(grid, "grid", low=3, high=10_000)
     targets = poses if isinstance(poses, np.ndarray) and poses.ndim == 2 else list(poses)
     Y = np.array([task.parse(t) for t in targets]) if len(targets) else np.zeros((0, task.value_size))

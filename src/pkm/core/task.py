@@ -165,6 +165,19 @@ class TaskMap:
         self.kinds = {k: v for g in groups for k, v in g.kinds.items()}
         self.kinds.update({j: "angle" if mech.joints[j].revolute else "length" for j in self.spec.joints})
 
+    def rate_scale(self, length: float | None, keys=None) -> np.ndarray:
+        """The scales of the task rates ``keys`` (default: all, in :attr:`keys` order): 1 for a length, ``1/length``
+        for an angle, the homogenisation by a characteristic length ``L`` [m] that makes every rate a speed.
+
+        Raises:
+            InvalidInputError: the rates mix lengths and angles and no ``length`` is given.
+        """
+        kinds = [self.kinds[k] for k in (self.keys if keys is None else keys)]
+        if "angle" in kinds and "length" in kinds and length is None:
+            raise InvalidInputError("length", "the task mixes lengths and angles: give the characteristic length L "
+                                              "[m] that homogenises the angular rates")
+        return np.array([1.0 if k == "length" else 1.0 / (length or 1.0) for k in kinds])
+
     def _parts(self, y: np.ndarray, tangent: bool = False):
         at = self._tangent_at if tangent else self._value_at
         return [y[at[i]:at[i + 1]] for i in range(len(self._groups))], y[at[-1]:]

@@ -23,7 +23,6 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import math
-import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,11 +32,10 @@ import numpy as np
 
 from pkm.errors import InvalidInputError, UnknownNameError
 from pkm.sweeps.family import Candidate
-from pkm.units import parse_quantity, split_range
+from pkm.units import SI_UNITS, parse_quantity, split_range
 
 SENSES = ("max", "min", "")
 ROUTES = ("auto", "closed_form", "generic")
-_NAME = re.compile(r"^[A-Za-z_][\w.-]*$")
 
 
 @dataclass(frozen=True)
@@ -224,7 +222,7 @@ def _option(key: str, spec: tuple, value: str):
     text option or the lower bound of a number, lengths being > 0 unless told)."""
     kind, check = spec[0], spec[3] if len(spec) > 3 else None
     if kind in ("length", "angle"):
-        v = parse_quantity(value, {kind}, key, "m" if kind == "length" else "rad")
+        v = parse_quantity(value, {kind}, key, SI_UNITS[kind])
         if kind == "length" and not v > 0.0:
             raise InvalidInputError(key, f"{key}={value!r}: a length > 0", value)
         return v
@@ -267,7 +265,7 @@ def _task_value(mech, name: str, text: str) -> float:
     if name not in task.kinds:
         raise UnknownNameError("task coordinate", name, list(task.keys), mech.name)
     kind = task.kinds[name]
-    return parse_quantity(text, {kind}, name, "m" if kind == "length" else "rad")
+    return parse_quantity(text, {kind}, name, SI_UNITS[kind])
 
 
 def _generic_map(c: Candidate, o: Mapping[str, Any]):
@@ -327,12 +325,7 @@ def _generic_condition(c, o):
     mech = c.mechanism
     target = {n: _task_value(mech, n, v) for n, v in (o.get("pose") or {}).items()}
     res = pkm.solve_ik(mech, target, branch=o.get("branch") or None)
-    task = mech.task_map
-    kinds = [task.kinds[k] for k in task.keys]
-    if "angle" in kinds and "length" in kinds and o.get("length") is None:
-        raise InvalidInputError("length", "the task mixes lengths and angles: give length=L (the characteristic "
-                                          "length dividing the angular rates)")
-    scale = np.array([1.0 if k == "length" else 1.0 / (o.get("length") or 1.0) for k in kinds])
+    scale = mech.task_map.rate_scale(o.get("length"))  # (as the maps do)
     try:
         K = pkm.inverse_jacobian(mech, res.q)
     except SingularityError:
