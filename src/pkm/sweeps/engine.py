@@ -284,7 +284,7 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
             raise InvalidInputError("out", f"the results are a .parquet file, got {out_path}", str(out_path))
         done_tables, complete = resume(out_path, manifest, overwrite)
         if done_tables is None:
-            return SweepResult(complete, manifest, Stats(len(designs), 0, count_failed(complete), 0, 0, 0, 0.0, 0.0, 0.0))
+            return SweepResult(complete, manifest)  # (nothing evaluated: its stats say so)
     done = np.zeros(len(designs), dtype=bool)
     for t in done_tables:
         done[np.asarray(t.column("design"))] = True

@@ -147,7 +147,7 @@ class ModelFamily(Family):
                                                  "(load it from files)", mech.source)
         self.urdf, self.spec, self.source = mech.urdf, mech.spec.to_toml(), mech.source
         self._base = mech
-        self.joint_names = tuple(_urdf_joints(self.urdf))
+        self.joint_names = tuple(_joints(self.urdf)[1])
 
     def __getstate__(self):
         return {"urdf": self.urdf, "spec": self.spec, "source": self.source, "joint_names": self.joint_names}
@@ -195,19 +195,19 @@ def family_of(mechanism, fixed: Mapping[str, Any] | None = None) -> Family:
     return ModelFamily(mechanism if isinstance(mechanism, pkm.Mechanism) else pkm.load(mechanism))
 
 
-def _urdf_joints(urdf: str) -> list[str]:
-    from lxml import etree
+def _joints(urdf: str):
+    """The URDF's root and its joints by name (pkm's hardened parser, :func:`pkm.core.urdf.parse_xml`)."""
+    from pkm.core.urdf import parse_xml
 
-    root = etree.fromstring(urdf.encode(), etree.XMLParser(resolve_entities=False, no_network=True))
-    return [j.get("name") for j in root.iter("joint") if j.get("name") and j.getparent() is root]
+    root = parse_xml(urdf)
+    return root, {j.get("name"): j for j in root.iter("joint") if j.get("name") and j.getparent() is root}
 
 
 def origins_set(urdf: str, values: Mapping[str, float]) -> str:
     """The URDF text with the joint origins named by ``values`` (``JOINT.x`` ... ``JOINT.yaw``, SI) set."""
     from lxml import etree
 
-    root = etree.fromstring(urdf.encode(), etree.XMLParser(resolve_entities=False, no_network=True))
-    joints = {j.get("name"): j for j in root.iter("joint") if j.getparent() is root}
+    root, joints = _joints(urdf)
     for name, value in values.items():
         joint, _, comp = name.rpartition(".")
         if joint not in joints or comp not in ORIGIN:
