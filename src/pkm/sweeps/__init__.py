@@ -19,14 +19,30 @@ The pieces: :mod:`~pkm.sweeps.space` (grids, Sobol', Latin hypercubes, tables), 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+from pkm._lazy import lazy
 from pkm.errors import SweepError
-from pkm.sweeps.engine import sweep
-from pkm.sweeps.family import Candidate, Family, ModelFamily, RegisteredFamily, family_of
-from pkm.sweeps.objectives import OBJECTIVES, Objective, objective
-from pkm.sweeps.plot import plot, write_best
-from pkm.sweeps.results import Stats, SweepResult, pareto_front, read
-from pkm.sweeps.space import Designs, Space, grid, latin_hypercube, sobol, table
-from pkm.sweeps.store import FORMAT
+
+#: Where each name lives, imported on first use (the command line reads the objectives' names without the engine).
+_WHERE = {"sweep": "pkm.sweeps.engine",
+          **dict.fromkeys(("Candidate", "Family", "ModelFamily", "RegisteredFamily", "family_of"), "pkm.sweeps.family"),
+          **dict.fromkeys(("OBJECTIVES", "Objective", "objective"), "pkm.sweeps.objectives"),
+          **dict.fromkeys(("plot", "write_best"), "pkm.sweeps.plot"),
+          **dict.fromkeys(("Stats", "SweepResult", "pareto_front", "read"), "pkm.sweeps.results"),
+          **dict.fromkeys(("Designs", "Space", "grid", "latin_hypercube", "sobol", "table"), "pkm.sweeps.space"),
+          "FORMAT": "pkm.sweeps.store"}
+
+if TYPE_CHECKING:  # the static view of the lazy names
+    from pkm.sweeps.engine import sweep
+    from pkm.sweeps.family import Candidate, Family, ModelFamily, RegisteredFamily, family_of
+    from pkm.sweeps.objectives import OBJECTIVES, Objective, objective
+    from pkm.sweeps.plot import plot, write_best
+    from pkm.sweeps.results import Stats, SweepResult, pareto_front, read
+    from pkm.sweeps.space import Designs, Space, grid, latin_hypercube, sobol, table
+    from pkm.sweeps.store import FORMAT
+
+__getattr__, __dir__ = lazy("pkm.sweeps", globals(), _WHERE)
 
 __all__ = ["FORMAT", "OBJECTIVES", "Candidate", "Designs", "Family", "ModelFamily", "Objective", "RegisteredFamily",
            "Space", "Stats", "SweepError", "SweepResult", "family_of", "grid", "latin_hypercube", "objective",
