@@ -2,7 +2,8 @@
 
 A module that arrives only as another package's dependency (scipy through proxsuite, umsgpack
 through meshcat) works until that package drops it; so every import must name its own distribution.
-A benchmark baseline (the ``bench`` extra, MuJoCo) may be imported by ``pkm/bench`` alone.
+A benchmark baseline (the ``bench`` extra, MuJoCo) may be imported by ``pkm/bench`` alone, and the optional
+homotopy solver (the ``homotopy`` extra, Bertini 2, GPL-3) by ``pkm/core/modes/continuation.py`` alone.
 """
 
 from __future__ import annotations
@@ -61,21 +62,24 @@ def declared() -> set[str]:
     return _names(project["dependencies"])
 
 
-def benchmark_only() -> set[str]:
-    """The ``bench`` extra: baselines that only ``pkm/bench`` may import."""
+def extra(name: str) -> set[str]:
+    """An optional extra's distributions (``bench``: baselines only ``pkm/bench`` may import)."""
     project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
-    return _names(project["optional-dependencies"]["bench"])
+    return _names(project["optional-dependencies"][name])
 
 
 def test_every_third_party_import_is_a_declared_dependency():
     third_party = {m: files for m, files in imported_modules(ROOT / "src" / "pkm").items()
                    if m not in sys.stdlib_module_names and m not in ("pkm", "__future__")}
     assert {"numpy", "pinocchio", "casadi"} <= set(third_party)  # the scan sees the imports
-    deps, bench = declared(), benchmark_only()
+    deps, bench, homotopy = declared(), extra("bench"), extra("homotopy")
     missing = {}
     for mod, files in sorted(third_party.items()):
         if _canonical(mod) in bench:
             assert all(f.startswith("pkm/bench/") for f in files), (mod, sorted(files))
+            continue
+        if owners(mod) & homotopy:
+            assert sorted(files) == ["pkm/core/modes/continuation.py"], (mod, sorted(files))
             continue
         dists = owners(mod)
         assert dists, f"{mod!r} (imported by {sorted(files)}) belongs to no installed distribution"

@@ -61,6 +61,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         velocities,
     )
     from pkm.core.maps import task_map
+    from pkm.core.modes import assembly_modes
     from pkm.core.reconfiguration import reconfigure
     from pkm.core.twin import Kernels, Twin
     from pkm.sweeps import sweep
@@ -70,7 +71,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
 __getattr__, __dir__ = lazy("pkm", globals(), {**dict.fromkeys(_CORE, "pkm.core"), "quantity": "pkm.units",
                                                 "Kernels": "pkm.core.twin", "Twin": "pkm.core.twin",
                                                 "task_map": "pkm.core.maps", "reconfigure": "pkm.core.reconfiguration",
-                                                "sweep": "pkm.sweeps"})
+                                                "sweep": "pkm.sweeps", "assembly_modes": "pkm.core.modes"})
 
 __version__ = "0.1.0"
 
@@ -216,6 +217,7 @@ __all__ = [
     "Twin",
     "accelerations",
     "assemble",
+    "assembly_modes",
     "build",
     "close_loops",
     "design_params",

@@ -207,3 +207,29 @@ class SweepError(PkmError):
     def __init__(self, message: str, path: object = None):
         self.path = path
         super().__init__(message)
+
+
+class MissingDependencyError(PkmError, ImportError):
+    """An optional dependency that a capability needs is not installed.
+
+    Attributes:
+        package: The PyPI package to install.
+        extra: The pkm extra that installs it (``pip install "pkm[extra]"``).
+    """
+
+    def __init__(self, package: str, extra: str, what: str):
+        self.package = package
+        self.extra = extra
+        super().__init__(f"{what} needs {package}: pip install {package} (or pip install \"pkm[{extra}]\")")
+
+
+class StructureError(PkmError):
+    """A mechanism's structure is outside what a method covers (the method says which structures it covers).
+
+    Attributes:
+        part: The leg, closure or joint that does not fit.
+    """
+
+    def __init__(self, part: str, message: str):
+        self.part = part
+        super().__init__(f"{part}: {message}")

@@ -1,0 +1,262 @@
+"""Every assembly mode (forward kinematics) of a mechanism: the reduced system solved by homotopy continuation,
+each real solution turned into a full configuration by the core and verified.
+
+:func:`assembly_modes` reduces the mechanism (:mod:`~pkm.core.modes.reduce`), builds the reduced equations for the
+actuator values (:mod:`~pkm.core.modes.equations`), tracks every path of a total-degree homotopy with Bertini 2
+(:mod:`~pkm.core.modes.continuation`), keeps the real solutions that are poses, polishes and certifies each
+(Smale's alpha test, :mod:`~pkm.core.modes.certify`), places the platform, closes every leg with the core
+(:func:`pkm.core.solve.assemble`, the actuators and the platform held) and checks the closure residual. The
+:class:`ModeSet` it returns states its completeness: the paths tracked, the bound they start from, the solutions
+at infinity, on the exceptional set and complex, and every failed path; one failed path and it is not complete.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core import constraints
+from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.modes.certify import Certificate, alpha_test, polish
+from pkm.core.modes.continuation import Continuation, Path, solve, track
+from pkm.core.modes.equations import FKSystem, equations
+from pkm.core.modes.polynomial import System, variables
+from pkm.core.modes.reduce import Reduction, reduce_mechanism
+from pkm.core.modes.starts import generic_start, path_parameters
+from pkm.core.solve import _levenberg_marquardt, assemble
+from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError
+
+#: A solution is real when its imaginary part is below this, relative to its size.
+REAL_TOL = 1e-8
+#: Every recovered configuration closes its loops to this [m or rad].
+VERIFY_TOL = 1e-10
+
+
+@dataclass(frozen=True)
+class Mode:
+    """One real solution: an assembly mode (or, from :func:`~pkm.core.modes.working.working_modes`, a working mode).
+
+    Attributes:
+        label: Its number in the set (0, 1, ...), sorted by distance from the reference configuration.
+        q: The full configuration (every joint), recovered by the core.
+        residual: Its closure residual (infinity norm) [m or rad], <= :data:`VERIFY_TOL`.
+        point: The polynomial system's solution (real; the unknowns of the reduced equations).
+        certificate: Smale's alpha test on the polished point.
+        path: The index of the Bertini path that ended there (several when a mode is reached twice).
+    """
+
+    label: int
+    q: np.ndarray
+    residual: float
+    point: np.ndarray
+    certificate: Certificate
+    path: tuple[int, ...]
+
+
+@dataclass(frozen=True)
+class ModeSet:
+    """Every real solution found, and the account of how it was found.
+
+    Attributes:
+        modes: The real solutions as :class:`Mode` (configurations verified by the core).
+        complete: Every path ended (finite or at infinity), so the set holds every isolated real solution
+            (with probability one); False as soon as one path failed.
+        method: How the set was found (the homotopy, its start system and bound).
+        n_paths: Paths tracked.
+        bound: The Bezout number the start system has (total degree or multihomogeneous).
+        n_complex: Finite solutions that are not real.
+        n_infinite: Paths that went to infinity.
+        n_exceptional: Finite real solutions that are not poses (Study's exceptional set ``e = 0``).
+        failed: The paths that failed, with Bertini's code.
+        reduction: The reduced structure (:meth:`pkm.core.modes.reduce.Reduction.describe`).
+        seconds: Wall time of the homotopy [s].
+    """
+
+    modes: tuple[Mode, ...]
+    complete: bool
+    method: str
+    n_paths: int
+    bound: int
+    n_complex: int
+    n_infinite: int
+    n_exceptional: int
+    failed: tuple[Path, ...]
+    reduction: str
+    seconds: float
+
+    def __len__(self) -> int:
+        return len(self.modes)
+
+    def __iter__(self):
+        return iter(self.modes)
+
+    def __getitem__(self, k: int) -> Mode:
+        return self.modes[k]
+
+    def summary(self) -> str:
+        state = "complete" if self.complete else f"NOT complete: {len(self.failed)} path(s) failed"
+        return (f"{len(self.modes)} real solutions ({self.n_complex} complex, {self.n_exceptional} exceptional, "
+                f"{self.n_infinite} at infinity) from {self.n_paths} paths of {self.method}; {state}")
+
+
+def _place_platform(mech: Mechanism, red: Reduction, q: np.ndarray, T: pin.SE3, rng) -> np.ndarray:
+    """``q`` with the joints that carry the platform moved so that it sits at ``T`` (a free-flyer is set; a chain is
+    solved by Levenberg-Marquardt from a few starts)."""
+    m = mech.model
+    jp = red.platform_joint
+    if red.group == "SE3" and len(red.chain) == 1 and m.joints[jp].shortname() == "JointModelFreeFlyer":
+        M = m.jointPlacements[jp].inverse() * T
+        q = q.copy()
+        q[m.joints[jp].idx_q:m.joints[jp].idx_q + 7] = pin.SE3ToXYZQUAT(M)
+        return q
+    cols = np.zeros(m.nv, dtype=bool)
+    for name in red.chain:
+        j = mech.joints[name]
+        cols[j.idx_v:j.idx_v + j.nv] = True
+    d = m.createData()
+
+    def fun(qq):
+        pin.forwardKinematics(m, d, qq)
+        err = pin.log6(T.actInv(d.oMi[jp])).vector
+        J = pin.Jlog6(T.actInv(d.oMi[jp])) @ pin.computeJointJacobian(m, d, qq, jp)
+        J[:, ~cols] = 0.0
+        return err, J
+
+    best = (math.inf, q)
+    for k in range(12):
+        q0 = q if k == 0 else pin.integrate(m, q, np.where(cols, rng.normal(scale=1.0, size=m.nv), 0.0))
+        qq, F, _ = _levenberg_marquardt(mech, fun, q0, 1e-13, 100)
+        if np.abs(F).max() < best[0]:
+            best = (float(np.abs(F).max()), qq)
+        if best[0] <= 1e-12:
+            break
+    if best[0] > 1e-10:
+        raise ConvergenceError("placing the platform on its chain", best[0], 0, 1e-10)
+    return best[1]
+
+
+def recover(mech: Mechanism, red: Reduction, q_actuated, R: np.ndarray, t: np.ndarray, *, seed: int = 0) -> np.ndarray:
+    """The full configuration of a platform displacement ``(R, t)`` (world, from the reference pose) at the given
+    actuator values: the platform placed, every leg closed by :func:`pkm.core.solve.assemble` (the actuators
+    and the platform held). Raises :class:`~pkm.errors.ConvergenceError` when a leg does not close to
+    :data:`VERIFY_TOL`."""
+    rng = np.random.default_rng(seed)
+    T = pin.SE3(R, t) * red.platform_ref
+    q = mech.with_actuated(mech.q_reference, q_actuated)
+    q = _place_platform(mech, red, q, T, rng)
+    hold = [j.name for j in mech.actuated] + list(red.chain)
+    try:
+        q = assemble(mech, q, hold=hold, tol=1e-12, restarts=24, seed=seed).q
+    except AssemblyError as exc:
+        raise ConvergenceError("closing the legs on a solution of the reduced equations", exc.deficit, 0,
+                               VERIFY_TOL, detail=str(exc)) from None
+    return q
+
+
+def _check(mech: Mechanism, q: np.ndarray) -> float:
+    res = float(np.abs(constraints.residual(mech, q)).max())
+    if not res <= VERIFY_TOL:
+        raise ConvergenceError("the core's check of a recovered mode", res, 0, VERIFY_TOL)
+    return res
+
+
+def real_solutions(cont: Continuation, sys_: FKSystem, distinct: float = 1e-7):
+    """The finite real solutions of a continuation, polished and certified, merged when closer than ``distinct``;
+    returns ``(solutions, n_complex, n_exceptional)`` with solutions ``[(point, certificate, paths)]``."""
+    found: list[tuple[np.ndarray, Certificate, list[int]]] = []
+    n_complex = n_exc = 0
+    for p in cont.paths:
+        if p.point is None:
+            continue
+        polys, x, k = sys_.affine(p.point)
+        S = System(polys)
+        x = polish(S, x)
+        cert = alpha_test(S, x)
+        full = x if k is None else np.insert(x, k, 1.0)
+        if not sys_.is_pose(full):
+            n_exc += 1
+            continue
+        if np.abs(full.imag).max() > REAL_TOL * max(1.0, np.abs(full).max()):
+            n_complex += 1
+            continue
+        full = full.real / (np.linalg.norm(full.real[:4]) if sys_.projective else 1.0)
+        for f in found:
+            if min(np.abs(f[0] - full).max(), np.abs(f[0] + full).max() if sys_.projective else math.inf) < distinct:
+                f[2].append(p.index)
+                break
+        else:
+            found.append((full, cert, [p.index]))
+    return found, n_complex, n_exc
+
+
+def parameter_homotopy(system: FKSystem, *, precision: str = "adaptive", threads: int = 2) -> Continuation:
+    """The system solved from its family's generic start (:mod:`pkm.core.modes.starts`): a path per generic
+    solution, along the straight line from the generic parameters to this system's."""
+    start = generic_start(system.signature)
+    n = system.polys[0].n
+    x = variables(n + 1)
+    H = equations(system.red.group, path_parameters(system.params, start, x[n]), x[:n])
+    cont = track(H, system.polys, start.points, projective=system.projective, precision=precision,
+                 threads=threads)
+    cont.settings.update(generic_paths=start.total_degree, start_complete=start.complete)
+    return cont
+
+
+def assembly_modes(mech: Mechanism, q_actuated, *, method: str = "auto", precision: str = "adaptive",
+                   threads: int = 2, continuation: Continuation | None = None) -> ModeSet:
+    """Every real assembly mode of ``mech`` at the actuator values ``q_actuated`` (module doc).
+
+    Args:
+        mech: Any mechanism the reduction covers (:mod:`pkm.core.modes.reduce`; others are refused with a
+            :class:`~pkm.errors.StructureError`).
+        q_actuated: The actuated coordinates in spec order [rad or m].
+        method: ``"total-degree"`` (Bertini's total-degree start), ``"parameter"`` (a parameter homotopy from the
+            family's generic solutions, :mod:`pkm.core.modes.starts`) or ``"auto"`` (parameter for a spatial
+            platform, total degree for the small planar and translational systems).
+        precision: Bertini's precision mode (``"adaptive"``: the safe default).
+        threads: Bertini's tracking threads.
+        continuation: A finished :class:`~pkm.core.modes.continuation.Continuation` of this very system to use
+            instead of solving (tests plant failures this way).
+
+    Returns:
+        A :class:`ModeSet`; its modes sorted by distance from the reference configuration.
+
+    Raises:
+        StructureError: the mechanism's structure is outside the reduction.
+        MissingDependencyError: bertini2 is not installed.
+        ConvergenceError: a real solution whose legs the core cannot close (a defect: the reduction and the tree
+            disagree).
+    """
+    mech = check_mechanism(mech)
+    qa = mech.check_actuated(q_actuated, positions=True)
+    red = reduce_mechanism(mech)
+    d = mech.model.createData()
+    pin.forwardKinematics(mech.model, d, mech.with_actuated(mech.q_reference, qa))
+    system = FKSystem(red, d)
+    if continuation is not None:
+        cont = continuation
+    elif method == "parameter" or (method == "auto" and red.group == "SE3"):
+        cont = parameter_homotopy(system, precision=precision, threads=threads)
+    elif method in ("auto", "total-degree"):
+        cont = solve(system.polys, system.groups, projective=system.projective, precision=precision,
+                     threads=threads)
+    else:
+        raise InvalidInputError("method", "expected 'auto', 'parameter' or 'total-degree'", method)
+    found, n_complex, n_exc = real_solutions(cont, system)
+    modes = []
+    for x, cert, paths in found:
+        R, t = system.displacement(x)
+        q = recover(mech, red, qa, R, t)
+        modes.append((q, _check(mech, q), x, cert, tuple(paths)))
+    ref = mech.q_reference
+    modes.sort(key=lambda m: float(np.linalg.norm(mech.difference(ref, m[0]))))
+    out = tuple(Mode(k, q, res, x, cert, paths) for k, (q, res, x, cert, paths) in enumerate(modes))
+    how = f"a {cont.start} (Bertini 2, {cont.settings.get('mptype')} precision)"
+    if cont.start == "parameter homotopy":
+        how += (f" from the {cont.bound} generic solutions of family {system.signature} (a "
+                f"{cont.settings['generic_paths']}-path total-degree solve)")
+    return ModeSet(out, cont.complete and cont.settings.get("start_complete", True), how, len(cont.paths), cont.bound, n_complex, cont.count("infinite"),
+                   n_exc, cont.failed, red.describe(), cont.seconds)

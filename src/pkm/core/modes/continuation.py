@@ -1,0 +1,243 @@
+"""Polynomial homotopy continuation by Bertini 2 (``pip install bertini2``): every isolated complex solution of a
+square polynomial system, with the account of every path.
+
+:func:`solve` hands a list of :class:`~pkm.core.modes.polynomial.Poly` to Bertini's ``ZeroDimSolver`` (total-degree
+start system, or the multihomogeneous one for several variable groups; adaptive precision, power-series endgame)
+and returns a :class:`Continuation`: one :class:`Path` per start point, classified from Bertini's own metadata as
+
+* ``finite``: the endgame succeeded at a finite point (``singular`` says whether its Jacobian is);
+* ``infinite``: the path went to infinity (``GoingToInfinity`` / ``SecurityMaxNormReached``): a solution at
+  infinity of the start's compactification, not a solution;
+* ``failed``: anything else (step failures, cycle detection failed, ...): a path that says nothing, so a set with
+  one such path is not known to be complete.
+
+Why Bertini 2: it is the Bertini team's maintained library, with adaptive multiprecision path tracking (paths near
+singular ends or ill-conditioned stretches switch to higher precision instead of jumping to another path) and
+the endgames that make singular ends detectable. It is GPL-3; pkm (BSD-3) imports it only here, on first use, as
+the optional extra ``pkm[homotopy]``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from fractions import Fraction
+
+import numpy as np
+
+from pkm.core.modes.polynomial import Poly
+from pkm.errors import MissingDependencyError
+
+#: Bertini's success codes of paths that went to infinity.
+_INFINITE = {"GoingToInfinity", "SecurityMaxNormReached"}
+
+
+@dataclass(frozen=True)
+class Path:
+    """One tracked path and where it ended.
+
+    Attributes:
+        index: The path's number (Bertini's).
+        status: ``"finite"``, ``"infinite"`` or ``"failed"`` (module doc).
+        code: Bertini's endgame success code.
+        point: The end point (complex, the system's variables; for a projective group, normalised so that its
+            largest coordinate is 1), None unless finite.
+        singular: Bertini's verdict on the end point's Jacobian.
+        condition: The Jacobian's condition number at the end point.
+        residual: ``|F|`` at the end point.
+        cycle: The endgame's winding number (> 1 at a singular end).
+    """
+
+    index: int
+    status: str
+    code: str
+    point: np.ndarray | None
+    singular: bool
+    condition: float
+    residual: float
+    cycle: int
+
+
+@dataclass(frozen=True)
+class Continuation:
+    """The outcome of one homotopy: every path, the bound they start from, and the settings.
+
+    Attributes:
+        paths: One :class:`Path` per start point.
+        bound: The number of start points: the total-degree Bezout number (product of the degrees) for one
+            group, the multihomogeneous Bezout number for several.
+        start: ``"total-degree homotopy"``, ``"multihomogeneous homotopy"`` or ``"parameter homotopy"``.
+        seconds: Wall time of the solve [s].
+        settings: Bertini's settings used (precision mode, endgame, threads).
+    """
+
+    paths: tuple[Path, ...]
+    bound: int
+    start: str
+    seconds: float
+    settings: dict = field(default_factory=dict)
+
+    def count(self, status: str) -> int:
+        return sum(p.status == status for p in self.paths)
+
+    @property
+    def failed(self) -> tuple[Path, ...]:
+        return tuple(p for p in self.paths if p.status == "failed")
+
+    @property
+    def complete(self) -> bool:
+        """Every start path ended at a finite point or at infinity: the finite ends hold every isolated solution
+        (with probability one, Bertini's gamma trick). One failed path and this is False."""
+        return len(self.paths) == self.bound and not self.failed
+
+    def without(self, indices: Sequence[int]) -> Continuation:
+        """The same run with the paths ``indices`` marked failed (``code="dropped"``): what a lost path looks like,
+        for tests of the bookkeeping downstream."""
+        drop = set(indices)
+        paths = tuple(Path(p.index, "failed", "dropped", None, False, math.nan, math.nan, 0) if p.index in drop else p
+                      for p in self.paths)
+        return Continuation(paths, self.bound, self.start, self.seconds, self.settings)
+
+
+def _bertini():
+    try:
+        import bertini
+    except ImportError as exc:  # pragma: no cover - the dev install has it
+        raise MissingDependencyError("bertini2", "homotopy", "every assembly mode (polynomial homotopy "
+                                     "continuation)") from exc
+    bertini.recording(False)  # (by default it writes ./bertini_output and reuses old results)
+    return bertini
+
+
+def _coefficient(b, c: complex):
+    """An exact Bertini coefficient from a double (its binary value, as a fraction: no digits invented)."""
+    re, im = Fraction(float(c.real)), Fraction(float(c.imag))
+    out = b.coefficient(re) if re else None
+    if im:
+        out = (b.I * b.coefficient(im)) if out is None else out + b.I * b.coefficient(im)
+    return b.coefficient(0) if out is None else out
+
+
+def _expression(b, p: Poly, xs):
+    out = None
+    for e, c in p.terms.items():
+        term = _coefficient(b, c)
+        for i, k in enumerate(e):
+            if k:
+                term = term * (xs[i] ** k if k > 1 else xs[i])
+        out = term if out is None else out + term
+    return _coefficient(b, 0.0) if out is None else out
+
+
+def bezout(polys: Sequence[Poly], groups: Sequence[Sequence[int]]) -> int:
+    """The Bezout number of the start system Bertini builds: total degree for one group; for several, the
+    multihomogeneous count (the coefficient of ``prod z_g^{dim_g}`` in ``prod_f sum_g deg_g(f) z_g``)."""
+    if len(groups) == 1:
+        return math.prod(p.degree for p in polys)
+    dims = [len(g) for g in groups]
+    degs = [[max((sum(e[i] for i in g) for e in p.terms), default=0) for g in groups] for p in polys]
+    # expand the product group by group: states are remaining-dimension tuples
+    states = {tuple(dims): 1}
+    for row in degs:
+        nxt: dict[tuple[int, ...], int] = {}
+        for rem, c in states.items():
+            for g, d in enumerate(row):
+                if d and rem[g]:
+                    r = list(rem)
+                    r[g] -= 1
+                    nxt[tuple(r)] = nxt.get(tuple(r), 0) + c * d
+        states = nxt
+    return states.get((0,) * len(groups), 0)
+
+
+def solve(polys: Sequence[Poly], groups: Sequence[Sequence[int]] | None = None, *, projective: bool = False,
+          precision: str = "adaptive", endgame: str = "powerseries", threads: int = 1) -> Continuation:
+    """Every isolated solution of the square system ``polys`` by homotopy continuation (module doc).
+
+    Args:
+        polys: As many polynomials as unknowns (or, with ``projective``, one fewer: homogeneous ones).
+        groups: Variable indices per group (default: one group of every variable). Several groups take
+            Bertini's multihomogeneous start system, which tracks fewer paths when the groups fit the equations.
+        projective: The single group is homogeneous coordinates of a projective space (each polynomial
+            homogeneous); Bertini works on a random affine patch of it.
+        precision: Bertini's ``mptype``: ``"adaptive"`` (default: the safe one), ``"double"``, ``"multiple"``.
+        endgame: ``"powerseries"`` or ``"cauchy"``.
+        threads: Bertini's worker threads.
+    """
+    b = _bertini()
+    n = polys[0].n
+    groups = [list(range(n))] if groups is None else [list(g) for g in groups]
+    if projective and len(groups) != 1:
+        raise ValueError("a projective system takes one variable group")
+    if projective and not all(p.homogeneous() for p in polys):
+        raise ValueError("a projective system's polynomials must be homogeneous")
+    xs = b.variables([f"x{i}" for i in range(n)])
+    system = b.System()
+    for g in groups:
+        group = b.VariableGroup([xs[i] for i in g])
+        (system.add_hom_variable_group if projective else system.add_variable_group)(group)
+    for p in polys:
+        system.add_function(_expression(b, p, xs))
+    start = "total-degree homotopy" if len(groups) == 1 else "multihomogeneous homotopy"
+    bound = bezout(polys, groups) if not projective else math.prod(p.degree for p in polys)
+    t0 = time.perf_counter()
+    zd = b.ZeroDimSolver(system, startsystem="infer", endgame=endgame, mptype=precision)
+    zd.set(num_threads=threads)
+    zd.solve(show_progress=False)
+    settings = {"mptype": precision, "endgame": endgame, "threads": threads, "projective": projective}
+    return _collect(zd, start, bound, time.perf_counter() - t0, projective, settings)
+
+
+def track(homotopy: Sequence[Poly], target: Sequence[Poly], start_points: Sequence[np.ndarray], *,
+          projective: bool = False, precision: str = "adaptive", endgame: str = "powerseries",
+          threads: int = 1, start: str = "parameter homotopy") -> Continuation:
+    """Track the given start points along a homotopy to the target system (a parameter homotopy).
+
+    Args:
+        homotopy: Polynomials in the target's ``n`` variables and a last one, the path variable ``t``: at
+            ``t = 1`` they vanish at ``start_points``, at ``t = 0`` they are ``target``.
+        target: The target system (``n`` variables).
+        start_points: The start system's solutions (complex, ``n`` coordinates).
+        projective: The variables are homogeneous coordinates (one group).
+    """
+    b = _bertini()
+    n = target[0].n
+    xs = b.variables([f"x{i}" for i in range(n)])
+    t = b.variables(["t"])[0]
+    H, T = b.System(), b.System()
+    for s in (H, T):
+        (s.add_hom_variable_group if projective else s.add_variable_group)(b.VariableGroup(list(xs)))
+    H.add_path_variable(t)
+    for p in homotopy:
+        H.add_function(_expression(b, p, [*xs, t]))
+    for p in target:
+        T.add_function(_expression(b, p, xs))
+    points = [np.asarray(x, dtype=complex) for x in start_points]
+    if projective:
+        H.auto_patch()
+        T.copy_patches(H)
+        points = [np.asarray(H.rescale_point_to_fit_patch(x), dtype=complex) for x in points]
+    t0 = time.perf_counter()
+    solver = b.HomotopySolver(H, points, T, mptype=precision, endgame=endgame)
+    solver.set(num_threads=threads)
+    solver.solve(show_progress=False)
+    settings = {"mptype": precision, "endgame": endgame, "threads": threads, "projective": projective}
+    return _collect(solver, start, len(points), time.perf_counter() - t0, projective, settings)
+
+
+def _collect(solver, start: str, bound: int, seconds: float, projective: bool, settings: dict) -> Continuation:
+    paths = []
+    for k, (pt, md) in enumerate(zip(solver.all_solutions(), solver.solution_metadata())):
+        code = str(md.endgame_success_code).rsplit(".", 1)[-1]
+        if code == "Success" and md.is_finite:
+            x = np.array([complex(float(v[0]), float(v[1])) if isinstance(v, tuple) else complex(v) for v in pt])
+            if projective:
+                x = x / x[np.argmax(np.abs(x))]
+            paths.append(Path(k, "finite", code, x, bool(md.is_singular), float(md.condition_number),
+                              float(md.function_residual), int(md.cycle_num)))
+        else:
+            status = "infinite" if code in _INFINITE or (code == "Success" and not md.is_finite) else "failed"
+            paths.append(Path(k, status, code, None, False, math.nan, math.nan, int(md.cycle_num)))
+    return Continuation(tuple(paths), bound, start, seconds, settings)
