@@ -2,7 +2,7 @@
 compiled twin kernels for the whole session (``PKM_CACHE_DIR``, inherited by the subprocesses the tests start), so
 that a kernel is compiled once and nothing is written to the user's cache.
 
-``tests/fivebar`` is a fifth mechanism that exists only here: registering it (one line) puts it
+``tests/fivebar`` is a mechanism that exists only here: registering it (one line) puts it
 through every test that iterates the registry (generic core, property tests, fuzzing, scenes),
 which proves that a mechanism is one folder plus one registry entry.
 """

@@ -269,7 +269,7 @@ def test_bench_quick_runs_every_benchmark_and_refuses_bad_arguments(tmp_path):
     assert sorted(out) == sorted(BENCHMARKS) == ["dynamics", "hexapod", "kinematics", "opcount", "sweep", "twin",
                                                  "workspace"]
     assert all(r["equals_serial"] for k, r in out["sweep"]["runs"].items() if k != "serial")
-    assert [r["samples"] for r in out["kinematics"]] == [3] * 4
+    assert [r["samples"] for r in out["kinematics"]] == [3] * 5  # one row per shipped mechanism
     assert out["dynamics"]["max_force_difference_to_baseline_N"]["pkm"] < 1e-9
     bad = run("bench", "kinematics", "--", "--samples", "3")
     assert bad.returncode == 2 and "unrecognized arguments: --samples" in one_error_line(bad)

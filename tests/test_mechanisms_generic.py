@@ -99,7 +99,7 @@ def test_paper_forward_kinematics_round_trips(case):
     name, mech, samples = case
     mod = module(name)
     if mod.closed_form_fk is None:
-        pytest.skip(f"the {name} paper has no forward-kinematics method")
+        pytest.skip(f"{name} has no closed-form forward kinematics (its paper gives none, or it has no paper)")
     task = TaskMap(mech)
     for q, y in samples:
         y_fk = mod.closed_form_fk(mech.params, mech.actuated_q(q))

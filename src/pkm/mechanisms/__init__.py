@@ -96,6 +96,9 @@ REGISTRY: dict[str, MechanismDefinition] = {
                             "delta.closures.toml"),
         MechanismDefinition("prs3", "3-PRS (Diaz-Rodriguez et al. 2016: kinematics and inverse dynamics)",
                             "pkm.mechanisms.prs3", "prs3", (0.06, 0.15, 0.0), "prs3.closures.toml"),
+        MechanismDefinition("gough_stewart", "6-UPS Gough-Stewart platform (every assembly mode by homotopy "
+                                             "continuation)", "pkm.mechanisms.gough_stewart", None, (0.03, 0.08, 0.0),
+                            "gough_stewart.closures.toml"),
     )
 }
 

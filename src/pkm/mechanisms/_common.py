@@ -217,14 +217,15 @@ def best_reference(field: str, candidates: Iterable[T], score: Callable[[T], flo
 
 
 def spec_parameters(params) -> dict[str, float | str]:
-    """The dataclass fields as a flat table for the closure spec (tuples expanded, None left out)."""
+    """The dataclass fields as a flat table for the closure spec (tuples expanded, tuples of points row by row,
+    None left out)."""
     out: dict[str, float | str] = {}
     for f in dataclasses.fields(params):
         v = getattr(params, f.name)
         if v is None:
             continue
         if isinstance(v, (tuple, list, np.ndarray)):
-            for k, x in enumerate(v):
+            for k, x in enumerate(np.ravel(np.asarray(v, dtype=float))):  # (points: row by row)
                 out[f"{f.name}_{k + 1}"] = float(x)
         elif isinstance(v, str):
             out[f.name] = v
