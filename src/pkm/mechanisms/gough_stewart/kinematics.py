@@ -53,7 +53,7 @@ def inverse_kinematics(params: GoughStewartParams, y, *, check_limits: bool = Tr
         for i, r in enumerate(rho):
             excess = max(params.leg_min - r, r - params.leg_max)
             if excess > 0.0:
-                raise UnreachableError(str(i + 1), excess, "m", f"leg length {r:.6g} m outside "
+                raise UnreachableError(i + 1, excess, "m", f"leg length {r:.6g} m outside "
                                                                 f"[{params.leg_min:g}, {params.leg_max:g}] m")
     return rho
 
