@@ -61,7 +61,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         velocities,
     )
     from pkm.core.maps import task_map
-    from pkm.core.modes import assembly_modes
+    from pkm.core.modes import assembly_modes, track_assembly_mode, track_working_mode, working_modes
     from pkm.core.reconfiguration import reconfigure
     from pkm.core.twin import Kernels, Twin
     from pkm.sweeps import sweep
@@ -71,7 +71,9 @@ if TYPE_CHECKING:  # the static view of the lazy names
 __getattr__, __dir__ = lazy("pkm", globals(), {**dict.fromkeys(_CORE, "pkm.core"), "quantity": "pkm.units",
                                                 "Kernels": "pkm.core.twin", "Twin": "pkm.core.twin",
                                                 "task_map": "pkm.core.maps", "reconfigure": "pkm.core.reconfiguration",
-                                                "sweep": "pkm.sweeps", "assembly_modes": "pkm.core.modes"})
+                                                "sweep": "pkm.sweeps",
+                                                **dict.fromkeys(("assembly_modes", "working_modes", "track_assembly_mode",
+                                                                 "track_working_mode"), "pkm.core.modes")})
 
 __version__ = "0.1.0"
 
@@ -244,6 +246,9 @@ __all__ = [
     "task_map",
     "task_values",
     "task_velocity",
+    "track_assembly_mode",
+    "track_working_mode",
     "twist_jacobian",
     "velocities",
+    "working_modes",
 ]

@@ -11,5 +11,8 @@
 """
 
 from pkm.core.modes.assembly import Mode, ModeSet, assembly_modes
+from pkm.core.modes.tracking import Meeting, ModeTrack, track_assembly_mode, track_working_mode
+from pkm.core.modes.working import working_modes
 
-__all__ = ["Mode", "ModeSet", "assembly_modes"]
+__all__ = ["Meeting", "Mode", "ModeSet", "ModeTrack", "assembly_modes", "track_assembly_mode", "track_working_mode",
+           "working_modes"]

@@ -45,7 +45,10 @@ class Mode:
         residual: Its closure residual (infinity norm) [m or rad], <= :data:`VERIFY_TOL`.
         point: The polynomial system's solution (real; the unknowns of the reduced equations).
         certificate: Smale's alpha test on the polished point.
-        path: The index of the Bertini path that ended there (several when a mode is reached twice).
+        path: The index of the Bertini path that ended there (several when a mode is reached twice; one per leg for
+            a working mode).
+        outside_limits: The joints outside the position limits the files state (kept: a mode is geometry; whether
+            the machine can reach it is the limits' business).
     """
 
     label: int
@@ -54,6 +57,7 @@ class Mode:
     point: np.ndarray
     certificate: Certificate
     path: tuple[int, ...]
+    outside_limits: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -250,10 +254,10 @@ def assembly_modes(mech: Mechanism, q_actuated, *, method: str = "auto", precisi
     for x, cert, paths in found:
         R, t = system.displacement(x)
         q = recover(mech, red, qa, R, t)
-        modes.append((q, _check(mech, q), x, cert, tuple(paths)))
+        modes.append((q, _check(mech, q), x, cert, tuple(paths), mech.outside_limits(q)))
     ref = mech.q_reference
     modes.sort(key=lambda m: float(np.linalg.norm(mech.difference(ref, m[0]))))
-    out = tuple(Mode(k, q, res, x, cert, paths) for k, (q, res, x, cert, paths) in enumerate(modes))
+    out = tuple(Mode(k, *m) for k, m in enumerate(modes))
     how = f"a {cont.start} (Bertini 2, {cont.settings.get('mptype')} precision)"
     if cont.start == "parameter homotopy":
         how += (f" from the {cont.bound} generic solutions of family {system.signature} (a "

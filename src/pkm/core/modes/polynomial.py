@@ -70,6 +70,11 @@ class Poly:
 
     __rmul__ = __mul__
 
+    def cleaned(self, scale: float, rel: float = 1e-12) -> Poly:
+        """Without the terms below ``rel * scale``: the rounding left where exact arithmetic cancels (a
+        coordinate that drops out of an equation must not stay in it at 1e-17, raising its degree)."""
+        return Poly(self.n, {e: c for e, c in self.terms.items() if abs(c) > rel * scale})
+
     @property
     def degree(self) -> int:
         return max((sum(e) for e in self.terms), default=0)

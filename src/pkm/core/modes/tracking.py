@@ -1,0 +1,123 @@
+"""One mode followed along a path: the forward kinematics along actuator samples stays on the assembly mode the
+user picked, the inverse along task samples on the working mode, and where two modes meet (a singularity between
+two samples) the track stops there and says so, instead of carrying on in another mode.
+
+The track starts from a :class:`~pkm.core.modes.assembly.Mode` (its configuration: the polynomial solution's label
+picks it) and runs the core's continuation (:func:`pkm.core.follow_actuators`, :func:`pkm.core.follow_task`),
+whose every step is checked against its first-order prediction: a step far beyond it, a map singular at a sample,
+or (inverse kinematics) a working mode's joint signs changing mark a meeting. Samples from the meeting on are
+not reached (NaN). The meeting is then located by bisection between the last sample reached and the next
+(the mode followed in ever smaller steps, to 1e-9 of the interval): its fraction ``s`` of the interval, the
+configuration there, and the smallest singular value (relative to the largest) of the map that loses rank where
+the modes meet: the closure Jacobian in the passive joints (forward), closure and task in every joint (inverse).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pkm.core import constraints
+from pkm.core.configuration import Configuration
+from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.modes.assembly import Mode
+from pkm.core.solve import close_loops, solve_ik
+from pkm.core.trajectory import follow_actuators, follow_task
+
+#: Largest joint step [rad or m] accepted while bisecting towards a meeting (a larger one: another mode).
+_STEP = 0.5
+#: The core's jump reasons that are two modes meeting (forward: assembly modes; inverse: working modes too).
+_FK_MEETING = {"fold", "singular", "did not converge", "corrected"}
+_IK_MEETING = _FK_MEETING | {"branch"}
+
+
+@dataclass(frozen=True)
+class Meeting:
+    """Where the followed mode meets another.
+
+    Attributes:
+        index: The first sample not reached on the mode (the meeting lies between it and the one before).
+        reason: The core's verdict (``"fold"``, ``"singular"``, ``"branch"``, ...).
+        detail: What was measured.
+    """
+
+    index: int
+    reason: str
+    detail: str
+    s: float
+    q: np.ndarray
+    sigma_min: float
+
+
+@dataclass(frozen=True)
+class ModeTrack:
+    """A mode followed along N samples.
+
+    Attributes:
+        label: The mode's label in the set it came from.
+        q: The configurations (N x nq); NaN from the meeting on.
+        reached: Samples reached on the mode (N when no meeting).
+        meeting: Where the mode meets another, or None.
+    """
+
+    label: int
+    q: np.ndarray
+    reached: int
+    meeting: Meeting | None
+
+
+def _sigma(J: np.ndarray) -> float:
+    sv = np.linalg.svd(J, compute_uv=False)
+    return float(sv[-1] / sv[0]) if sv.size and sv[0] > 0 else 0.0
+
+
+def _track(mech: Mechanism, mode: Mode, traj, reasons: set[str], solve_between, jacobian) -> ModeTrack:
+    q = traj.q.copy()
+    stop = next((j for j in traj.jumps if j.reason in reasons), None)
+    if stop is None:
+        return ModeTrack(mode.label, q, len(q), None)
+    k = stop.index
+    lo, hi, q_lo = 0.0, 1.0, q[k - 1].copy()
+    while hi - lo > 1e-9:
+        mid = 0.5 * (lo + hi)
+        res = solve_between(k, mid, q_lo)
+        if res.converged and np.abs(mech.difference(q_lo, res.q)).max() <= _STEP:
+            lo, q_lo = mid, res.q
+        else:
+            hi = mid
+    q[k:] = np.nan
+    return ModeTrack(mode.label, q, k, Meeting(k, stop.reason, stop.detail, lo, q_lo, _sigma(jacobian(q_lo))))
+
+
+def track_assembly_mode(mech: Mechanism, mode: Mode, q_actuated) -> ModeTrack:
+    """The assembly mode ``mode`` (of :func:`pkm.assembly_modes` at the first sample) along actuator samples
+    ``q_actuated`` (N x na) [rad or m]."""
+    mech = check_mechanism(mech)
+    traj = follow_actuators(mech, q_actuated, q0=mode.q, efforts=False)
+    A = traj.actuated
+
+    def between(k, s, q_from):
+        qa = np.asarray(q_actuated, dtype=float).reshape(len(A), -1)
+        return close_loops(mech, qa[k - 1] + s * (qa[k] - qa[k - 1]), q_from, raise_on_failure=False)
+
+    return _track(mech, mode, traj, _FK_MEETING, between,
+                  lambda qq: constraints.jacobian(mech, qq)[:, mech.passive_v])
+
+
+def track_working_mode(mech: Mechanism, mode: Mode, task) -> ModeTrack:
+    """The working mode ``mode`` (of :func:`pkm.working_modes` at the first sample) along task samples ``task``
+    (N x the task's value size, as :meth:`pkm.core.TaskMap.value`)."""
+    mech = check_mechanism(mech)
+    traj = follow_task(mech, task, q0=mode.q, efforts=False)
+    Y = np.asarray(task, dtype=float).reshape(len(traj.q), -1)
+    tm = mech.task_map
+
+    def between(k, s, q_from):
+        return solve_ik(mech, tm.interpolate(Y[k - 1], Y[k], s), q_from, raise_on_failure=False)
+
+    def jac(qq):
+        J = Configuration.compute(mech, qq).closure_and_task_jacobian
+        return J if mech.free_v is None else J[:, mech.free_v]
+
+    return _track(mech, mode, traj, _IK_MEETING, between, jac)
