@@ -26,6 +26,13 @@ def test_every_contract_row_is_there_and_every_comparable_one_matches(rows):
         assert r.source and r.note
 
 
+def test_the_forward_kinematics_has_eight_real_modes_at_the_reference(rows):
+    """prs3.fk.modes_reference: 8 real of the family's 16, and the note states the 8 working modes too."""
+    pytest.importorskip("bertini")
+    row = rows["prs3.fk.modes_reference"]
+    assert row.computed == 8 and "; complete;" in row.note and "8 working modes" in row.note
+
+
 def test_the_generic_count_is_within_1_5_times_the_hand_written_one(rows):
     """Issue 15: the generic inverse dynamics of the Pinocchio model, counted at its boundary, within 1.5x the
     hand-written twin's count (both its numeric and its inertial-symbolic modes)."""

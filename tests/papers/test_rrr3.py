@@ -8,7 +8,9 @@ from pkm.mechanisms.rrr3.workspace import Design
 from pkm.papers import rrr3 as study
 
 IDS = ["rrr3.fig5.gci", "rrr3.fig5.gci_area", "rrr3.fig6.gci", "rrr3.fig6.gci_area", "rrr3.fig7.gci",
-       "rrr3.fig7.gci_area", "rrr3.fig9.gci", "rrr3.fig9.gci_area", "rrr3.modes.suitable"]
+       "rrr3.fig7.gci_area", "rrr3.fig9.gci", "rrr3.fig9.gci_area", "rrr3.modes.suitable",
+       "rrr3.fk.modes_reference"]  # the last: issue 17
+GCI = IDS[:8]
 
 
 @pytest.fixture(scope="module")
@@ -19,8 +21,14 @@ def rows():
 def test_rows_are_the_contract_ids_with_published_values(rows):
     """reproduce() returns exactly the issue's ids, each with the paper's value and a note naming the reading."""
     assert list(rows) == IDS
-    assert [rows[i].published for i in IDS[:-1]] == [0.1155, 0.2008, 0.1885, 0.5816, 0.4214, 0.7448, 0.4215, 0.7953]
-    assert all("L = h/sqrt3" in rows[i].note for i in IDS[:-1])
+    assert [rows[i].published for i in GCI] == [0.1155, 0.2008, 0.1885, 0.5816, 0.4214, 0.7448, 0.4215, 0.7953]
+    assert all("L = h/sqrt3" in rows[i].note for i in GCI)
+
+
+def test_the_homotopys_modes_at_the_reference_are_the_exact_polynomials(rows):
+    pytest.importorskip("bertini")
+    row = rows["rrr3.fk.modes_reference"]
+    assert row.computed == 2 and "has 2 real roots; the same set" in row.note
 
 
 def test_figs_6_7_9_reproduce_to_the_printed_decimals(rows):

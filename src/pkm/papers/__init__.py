@@ -17,6 +17,7 @@ from __future__ import annotations
 import functools
 import importlib
 import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from types import ModuleType
 from typing import Any
@@ -106,6 +107,28 @@ def opcount_rows(mechanism: str, prefix: str, note: str = "") -> list[Row]:
             Row(f"{prefix}add", None, c.add, "", None, "generic route (no published count)", text)]
 
 
+@functools.cache
+def modes_row(mechanism: str, row_id: str, compare: Callable[[Any, Any], str] | None = None) -> Row:
+    """Row ``row_id``: the number of real assembly modes at the reference design's reference actuators
+    (:func:`pkm.assembly_modes`; the papers publish none), with the set's account and, from ``compare(mech,
+    modes) -> note``, what another method finds. Without Bertini the row says so (computed None)."""
+    import pkm
+    from pkm.errors import MissingDependencyError
+
+    mech = pkm.load(mechanism)
+    qa = mech.actuated_q(mech.q_reference)
+    try:
+        modes = pkm.assembly_modes(mech, qa)
+    except MissingDependencyError as exc:
+        return Row(row_id, None, None, "", None, "reference configuration (no published count)", str(exc))
+    poses = "; ".join(", ".join(f"{k} {v:.4g}" for k, v in mech.task_map.named(m.q).items()) for m in modes)
+    note = compare(mech, modes) if compare is not None else ""
+    text = (f"pkm.assembly_modes at the reference actuators: {modes.summary()}; every mode closed by the core "
+            f"(worst {max(m.residual for m in modes):.1e}) and certified by Smale's alpha test (largest alpha "
+            f"{max(m.certificate.alpha for m in modes):.1e}). Task values [m, rad]: {poses}. {note}")
+    return Row(row_id, None, len(modes), "", None, "reference configuration (no published count)", text)
+
+
 def names() -> tuple[str, ...]:
     """The paper studies, in registry order: the ``paper`` of every registered mechanism that has one."""
     return tuple(d.paper for d in REGISTRY.values() if d.paper is not None)
@@ -118,4 +141,4 @@ def module(name: str) -> ModuleType:
     return importlib.import_module(f"pkm.papers.{name}")
 
 
-__all__ = ["Row", "generic_count", "module", "names", "opcount_rows"]
+__all__ = ["Row", "generic_count", "modes_row", "module", "names", "opcount_rows"]

@@ -17,7 +17,7 @@ import numpy as np
 from pkm.mechanisms.prs3 import Prs3Params
 from pkm.mechanisms.prs3.dynamics import BOUNDARY, G, Prs3Dynamics, operation_count
 from pkm.motion import load_motions
-from pkm.papers import Row, generic_count, opcount_rows
+from pkm.papers import Row, generic_count, modes_row, opcount_rows
 from pkm.papers._plot import figure, save
 
 TITLE = "Díaz-Rodríguez, Carretero, Bautista-Quintero & Chacón (2016): 3-PRS kinematics and inverse dynamics"
@@ -53,6 +53,17 @@ def _at(t: np.ndarray, time: float) -> int:
     return k
 
 
+def _working_modes_too(mech, modes) -> str:
+    """The 3-PRS has no closed-form FK to compare with: the generic core's Newton from the reference, and the
+    working modes at the reference pose."""
+    import pkm
+
+    ws = pkm.working_modes(mech, mech.task_map.value(mech.q_reference))
+    return (f"The 3-PRS family has 16 generic solutions (the 16 paths: a parameter homotopy from them). At the "
+            f"reference pose the inverse kinematics has {len(ws)} working modes (pkm.working_modes: each leg's two "
+            "slider positions of eq. (10)). The paper gives no forward kinematics.")
+
+
 def reproduce() -> list[Row]:
     """The paper's numbers and claims next to ours."""
     c = counts()
@@ -71,6 +82,7 @@ def reproduce() -> list[Row]:
         f"parameters (prs3.opcount.mul/add, {ours.mul}/{ours.add}); the hand-written count also includes the "
         "closed-form leg inverse kinematics from the task pose, which the generic route takes as its input q. "))
 
+    rows.append(modes_row("prs3", "prs3.fk.modes_reference", _working_modes_too))
     p = Prs3Params()
     t2, Ydd2, r2 = simulate("2")
     spread = float(np.ptp(r2.power, axis=1).max())

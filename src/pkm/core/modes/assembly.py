@@ -262,5 +262,6 @@ def assembly_modes(mech: Mechanism, q_actuated, *, method: str = "auto", precisi
     if cont.start == "parameter homotopy":
         how += (f" from the {cont.bound} generic solutions of family {system.signature} (a "
                 f"{cont.settings['generic_paths']}-path total-degree solve)")
-    return ModeSet(out, cont.complete and cont.settings.get("start_complete", True), how, len(cont.paths), cont.bound, n_complex, cont.count("infinite"),
-                   n_exc, cont.failed, red.describe(), cont.seconds)
+    complete = cont.complete and cont.settings.get("start_complete", True)
+    return ModeSet(out, complete, how, len(cont.paths), cont.bound, n_complex, cont.count("infinite"), n_exc,
+                   cont.failed, red.describe(), cont.seconds)

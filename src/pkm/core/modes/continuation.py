@@ -9,7 +9,8 @@ and returns a :class:`Continuation`: one :class:`Path` per start point, classifi
 * ``infinite``: the path went to infinity (``GoingToInfinity`` / ``SecurityMaxNormReached``): a solution at
   infinity of the start's compactification, not a solution;
 * ``failed``: anything else (step failures, cycle detection failed, ...): a path that says nothing, so a set with
-  one such path is not known to be complete.
+  one such path is not known to be complete; so is a path that ended at another's nonsingular end (a path
+  crossing: one of the two jumped, ``PathCrossing``).
 
 Why Bertini 2: it is the Bertini team's maintained library, with adaptive multiprecision path tracking (paths near
 singular ends or ill-conditioned stretches switch to higher precision instead of jumping to another path) and
@@ -240,4 +241,20 @@ def _collect(solver, start: str, bound: int, seconds: float, projective: bool, s
         else:
             status = "infinite" if code in _INFINITE or (code == "Success" and not md.is_finite) else "failed"
             paths.append(Path(k, status, code, None, False, math.nan, math.nan, int(md.cycle_num)))
-    return Continuation(tuple(paths), bound, start, seconds, settings)
+    return Continuation(_crossings(paths), bound, start, seconds, settings)
+
+
+def _crossings(paths: list[Path], tol: float = 1e-8) -> tuple[Path, ...]:
+    """Paths that ended at the nonsingular end of another: one of them jumped (a path crossing) and a solution
+    may be lost, so every such later path is marked failed (``PathCrossing``). Several paths may end at one
+    *singular* point (its multiplicity); a nonsingular point ends exactly one."""
+    out, seen = [], []
+    for p in paths:
+        if p.point is not None and not p.singular:
+            x = p.point
+            if any(np.abs(x - y).max() <= tol * max(1.0, float(np.abs(x).max())) for y in seen):
+                out.append(Path(p.index, "failed", "PathCrossing", None, False, p.condition, p.residual, p.cycle))
+                continue
+            seen.append(x)
+        out.append(p)
+    return tuple(out)
