@@ -248,7 +248,8 @@ def _crossings(paths: list[Path], tol: float = 1e-8) -> tuple[Path, ...]:
     """Paths that ended at the nonsingular end of another: one of them jumped (a path crossing) and a solution
     may be lost, so every such later path is marked failed (``PathCrossing``). Several paths may end at one
     *singular* point (its multiplicity); a nonsingular point ends exactly one."""
-    out, seen = [], []
+    out: list[Path] = []
+    seen: list[np.ndarray] = []
     for p in paths:
         if p.point is not None and not p.singular:
             x = p.point
