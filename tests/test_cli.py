@@ -327,3 +327,14 @@ def test_spec_init_writes_a_spec_that_loads_once_filled_in(tmp_path):
     assert pkm.diagnose(mech, mech.q_reference).idle_motions == 2
     again = run("spec", "init", str(tmp_path / "ankle.urdf"))
     assert again.returncode == 2 and "--force" in one_error_line(again)
+
+
+def test_fk_and_ik_all_print_every_mode_and_the_sets_account():
+    """``pkm fk --all`` / ``pkm ik --all``: every mode (homotopy continuation) with the set's account, SI."""
+    pytest.importorskip("bertini")
+    fk = json.loads(run("fk", "delta", "--joints", "motor_1=0.1", "--all").stdout)
+    assert fk["complete"] and fk["paths"] == 8 and len(fk["modes"]) == 2 and not fk["failed"]
+    assert {round(m["actuated"]["motor_1"], 12) for m in fk["modes"]} == {0.1}
+    ik = json.loads(run("ik", "prs3", "--pose", "z=90cm", "pitch=3deg", "--all").stdout)
+    assert ik["complete"] and len(ik["modes"]) == 8
+    assert all(abs(m["task"]["z"] - 0.9) < 1e-9 for m in ik["modes"])

@@ -284,6 +284,22 @@ def solution_dict(mech: pkm.Mechanism, res: pkm.SolveResult, **extra) -> dict[st
     })
 
 
+def modes_dict(mech: pkm.Mechanism, modes, **extra) -> dict[str, Any]:
+    """What ``ik --all`` and ``fk --all`` print: every mode by name, in SI, and the set's account."""
+    return jsonable({
+        "mechanism": mech.name, "units": {"length": "m", "angle": "rad"}, **extra,
+        "complete": modes.complete, "summary": modes.summary(), "method": modes.method, "paths": modes.n_paths,
+        "bound": modes.bound, "complex": modes.n_complex, "at_infinity": modes.n_infinite,
+        "exceptional": modes.n_exceptional, "failed": [{"path": p.index, "code": p.code} for p in modes.failed],
+        "reduction": modes.reduction,
+        "modes": [{"label": m.label, "actuated": dict(zip(mech.actuated_names, mech.actuated_q(m.q))),
+                   "task": task_values(mech, m.q), "residual": m.residual, "alpha": m.certificate.alpha,
+                   "certified_within": m.certificate.radius if m.certificate.certified else None,
+                   "outside_limits": list(m.outside_limits),
+                   "branch": _branch_of(mech, m.q) if mech.spec.branches else None} for m in modes],
+    })
+
+
 # ---------------------------------------------------------------------- commands
 def cmd_list(args) -> int:
     data: dict[str, dict[str, Any]] = {}
@@ -422,6 +438,9 @@ def cmd_ik(args) -> int:
     if args.branch is not None:
         mech.branch(args.branch)  # UnknownNameError listing the branches
     values, target = parse_pose(mech, args.pose)
+    if args.all:
+        print(json.dumps(modes_dict(mech, pkm.working_modes(mech, target), target=values), indent=2))
+        return 0
     res = _solve_ik(mech, target, args.branch)
     print(json.dumps(solution_dict(mech, res, target=values), indent=2))
     return 0
@@ -430,6 +449,9 @@ def cmd_ik(args) -> int:
 def cmd_fk(args) -> int:
     mech = _mechanism(args)
     qa = parse_joints(mech, args.joints)
+    if args.all:
+        print(json.dumps(modes_dict(mech, pkm.assembly_modes(mech, qa)), indent=2))
+        return 0
     res = _close_loops(mech, qa)
     print(json.dumps(solution_dict(mech, res), indent=2))
     return 0
@@ -632,10 +654,12 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("ik", parents=[debug], help="inverse kinematics: every joint for a pose (JSON, SI)")
     mech_args(p, "required", None)
     p.add_argument("--branch", metavar="NAME", help="working mode the solution must lie on (see 'pkm list')")
+    p.add_argument("--all", action="store_true", help="every working mode (homotopy continuation, pkm[homotopy])")
     p.set_defaults(func=cmd_ik)
 
     p = sub.add_parser("fk", parents=[debug], help="forward kinematics: the pose for actuated values (JSON, SI)")
     mech_args(p, None, "required")
+    p.add_argument("--all", action="store_true", help="every assembly mode (homotopy continuation, pkm[homotopy])")
     p.set_defaults(func=cmd_fk)
 
     p = sub.add_parser("map", parents=[debug], help="a workspace and condition-index map over 1-3 task coordinates "
