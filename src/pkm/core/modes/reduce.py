@@ -101,10 +101,6 @@ class Reduction:
     legs: tuple[Leg, ...]
     chain: tuple[str, ...]
 
-    @property
-    def dof(self) -> int:
-        return 6 if self.group == "SE3" else 3
-
     def describe(self) -> str:
         kinds = ", ".join(f"{leg.name}: {leg.kind}" for leg in self.legs)
         return f"platform in {self.group}; legs {kinds}"
@@ -236,7 +232,7 @@ def reduce_mechanism(mech: Mechanism) -> Reduction:
         B, center, axis, rank, end, joints, act = _analyse(mech, d, chain, np.zeros(3), "platform chain", tol,
                                                              platform_end=True)
         need = 1 if planar else 3
-        if _rank(end) < need if end else True:
+        if not end or _rank(end) < need:
             raise StructureError("platform chain", "the platform does not turn freely about the chain's last point "
                                                    f"(a {'revolute' if planar else 'spherical'} group is needed)")
         kind = "circle" if (axis is not None and not planar) else "sphere"

@@ -95,11 +95,10 @@ def track_assembly_mode(mech: Mechanism, mode: Mode, q_actuated) -> ModeTrack:
     ``q_actuated`` (N x na) [rad or m]."""
     mech = check_mechanism(mech)
     traj = follow_actuators(mech, q_actuated, q0=mode.q, efforts=False)
-    A = traj.actuated
+    A = np.asarray(q_actuated, dtype=float).reshape(len(traj.q), -1)  # the samples asked for (checked by the core)
 
     def between(k, s, q_from):
-        qa = np.asarray(q_actuated, dtype=float).reshape(len(A), -1)
-        return close_loops(mech, qa[k - 1] + s * (qa[k] - qa[k - 1]), q_from, raise_on_failure=False)
+        return close_loops(mech, A[k - 1] + s * (A[k] - A[k - 1]), q_from, raise_on_failure=False)
 
     return _track(mech, mode, traj, _FK_MEETING, between,
                   lambda qq: constraints.jacobian(mech, qq)[:, mech.passive_v])
