@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.mechanism import Mechanism
+from pkm.core.mechanism import Mechanism, check_mechanism
 from pkm.core.task import zyx_matrix
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms._common import check_params
@@ -79,6 +79,8 @@ def closed_form_ik(params: GoughStewartParams, y, branch: str | None = None) -> 
 
 
 def closed_form_configuration(mech: Mechanism, y, branch: str | None = None) -> np.ndarray:
+    """Every joint coordinate for task vector ``y`` (closed form; the working mode ``extended``)."""
+    mech = check_mechanism(mech)
     return mech.q_from_dict(joint_values(check_params(mech.params, GoughStewartParams, "mech.params"), y))
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from pkm.core.mechanism import Mechanism
-from pkm.core.spec import Closure, ClosureSpec, TaskSpec
+from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.urdf import UrdfBuilder
 from pkm.mechanisms._common import check_params, make_mechanism, rod_inertia, spec_parameters
 from pkm.mechanisms.gough_stewart.kinematics import joint_values, reference_pose
@@ -53,6 +53,10 @@ def closure_spec(params: GoughStewartParams) -> ClosureSpec:
         task=TaskSpec(("pose",)),
         reference=reference,
         joint_types={f"u{n}": "universal" for n in range(1, 7)},
+        branches={"extended": Branch("extended", {f"leg{n}": 1 for n in range(1, 7)},
+                                     "every leg length positive (the other working modes reverse legs through their "
+                                     "universal joints)")},
+        default_branch="extended",
         parameters=spec_parameters(params),
     )
 

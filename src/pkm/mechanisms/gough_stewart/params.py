@@ -33,7 +33,7 @@ def _points(obj, name: str) -> None:
     v = getattr(obj, name)
     try:
         arr = np.asarray(v, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         arr = np.zeros(0)
     if arr.size == 18:
         arr = arr.reshape(6, 3)
