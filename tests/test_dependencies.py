@@ -9,6 +9,7 @@ homotopy solver (the ``homotopy`` extra, Bertini 2, GPL-3) by ``pkm/core/modes/c
 from __future__ import annotations
 
 import ast
+import functools
 import re
 import sys
 import tomllib
@@ -42,15 +43,30 @@ def imported_modules(src: Path) -> dict[str, set[str]]:
 def owners(module: str) -> set[str]:
     """The distributions that install ``module``: from their top-level names, else (packages such as
     pin that install under a prefix, ``cmeel.prefix/...``) the ones whose file lists hold its origin."""
-    found = packages_distributions().get(module)
+    found = _packages().get(module)
     if found:
         return {_canonical(d) for d in found}
     spec = find_spec(module)
     if spec is None or not spec.origin:
         return set()
     origin = Path(spec.origin).resolve()
-    return {_canonical(d.metadata["Name"]) for d in distributions()
-            if any(f.name == origin.name and Path(d.locate_file(f)).resolve() == origin for f in d.files or ())}
+    return {_canonical(d.metadata["Name"]) for d, f in _files_by_name().get(origin.name, ())
+            if Path(d.locate_file(f)).resolve() == origin}
+
+
+@functools.cache
+def _packages() -> dict:
+    return packages_distributions()
+
+
+@functools.cache
+def _files_by_name() -> dict[str, list]:
+    """Every installed distribution's files by file name (one pass: some distributions list tens of thousands)."""
+    out: dict[str, list] = {}
+    for d in distributions():
+        for f in d.files or ():
+            out.setdefault(f.name, []).append((d, f))
+    return out
 
 
 def _names(requirements) -> set[str]:

@@ -25,7 +25,7 @@ import pkm
 from pkm.bench import main
 from pkm.errors import PkmError
 
-QUICK = {"mechanisms": ["delta", "rrr3", "prs3"], "from_scratch": False}
+QUICK = {"mechanisms": ["delta", "rrr3"], "from_scratch": False, "budget_factor": 0.5}
 GENERIC = "gough_stewart_generic"
 
 
