@@ -22,7 +22,7 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(PY) -m ruff check src tests tools examples
 	$(PY) -m mypy src/pkm
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n 2  # two workers: the suite is CPU-bound and the machine has 2 cores
 
 bench: $(STAMP)
 	$(PY) -m pkm bench
