@@ -16,6 +16,7 @@ Mechanisms: the shipped ones, and ``gough_stewart_generic``: a Gough-Stewart wit
 
 from __future__ import annotations
 
+import importlib.util
 import time
 
 import numpy as np
@@ -98,6 +99,9 @@ def add_arguments(ap) -> None:
 
 
 def run(args) -> list[dict]:
+    if importlib.util.find_spec("bertini") is None:  # the homotopy's solver: the optional extra pkm[homotopy]
+        return [{"mechanism": name, "skipped": "bertini2 is not installed (pip install \"pkm[homotopy]\")"}
+                for name in args.mechanisms]
     return [bench(name, args.budget_factor, args.from_scratch) for name in args.mechanisms]
 
 
@@ -105,6 +109,9 @@ def table(results: list[dict]) -> str:
     lines = [f"{'mechanism':22} {'homotopy s':>10} {'modes':>5} {'paths':>5} {'complete':>8} "
              f"{'multistart':>10} {'found':>5} {'of ours':>7} {'128-path s':>10}"]
     for r in results:
+        if "skipped" in r:
+            lines.append(f"{r['mechanism']:22} skipped: {r['skipped']}")
+            continue
         scratch = f"{r['total_degree_s']:10.1f}" if "total_degree_s" in r else f"{'-':>10}"
         lines.append(f"{r['mechanism']:22} {r['homotopy_s']:10.2f} {r['modes']:5d} {r['paths']:5d} "
                      f"{r['complete']!s:>8} {r['multistart_starts']:10d} {r['multistart_modes']:5d} "
