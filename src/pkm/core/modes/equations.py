@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.modes.polynomial import Poly, dot, variables
+from pkm.core.modes.polynomial import Poly, dot, fix, variables
 from pkm.core.modes.reduce import Reduction
 
 
@@ -187,8 +187,6 @@ class FKSystem:
         coordinate (set to 1, removed), an affine one as it is. Returns ``(polys, point, fixed index)``."""
         if not self.projective:
             return self.polys, np.asarray(x, dtype=complex), None
-        from pkm.core.modes.polynomial import fix
-
         k = int(np.argmax(np.abs(x)))
         x = np.asarray(x, dtype=complex) / x[k]
         return [fix(p, k, 1.0) for p in self.polys], np.delete(x, k), k
