@@ -182,13 +182,13 @@ def solve(polys: Sequence[Poly], groups: Sequence[Sequence[int]] | None = None, 
     for p in polys:
         system.add_function(_expression(b, p, xs))
     start = "total-degree homotopy" if len(groups) == 1 else "multihomogeneous homotopy"
-    bound = bezout(polys, groups) if not projective else math.prod(p.degree for p in polys)
+    bound = bezout(polys, groups)
     t0 = time.perf_counter()
     zd = b.ZeroDimSolver(system, startsystem="infer", endgame=endgame, mptype=precision)
     zd.set(num_threads=threads)
     zd.solve(show_progress=False)
     settings = {"mptype": precision, "endgame": endgame, "threads": threads, "projective": projective}
-    return _collect(zd, start, bound, time.perf_counter() - t0, projective, settings)
+    return _collect(zd, start, bound, time.perf_counter() - t0, settings)
 
 
 def track(homotopy: Sequence[Poly], target: Sequence[Poly], start_points: Sequence[np.ndarray], *,
@@ -225,16 +225,16 @@ def track(homotopy: Sequence[Poly], target: Sequence[Poly], start_points: Sequen
     solver.set(num_threads=threads)
     solver.solve(show_progress=False)
     settings = {"mptype": precision, "endgame": endgame, "threads": threads, "projective": projective}
-    return _collect(solver, start, len(points), time.perf_counter() - t0, projective, settings)
+    return _collect(solver, start, len(points), time.perf_counter() - t0, settings)
 
 
-def _collect(solver, start: str, bound: int, seconds: float, projective: bool, settings: dict) -> Continuation:
+def _collect(solver, start: str, bound: int, seconds: float, settings: dict) -> Continuation:
     paths = []
     for k, (pt, md) in enumerate(zip(solver.all_solutions(), solver.solution_metadata())):
         code = str(md.endgame_success_code).rsplit(".", 1)[-1]
         if code == "Success" and md.is_finite:
             x = np.array([complex(float(v[0]), float(v[1])) if isinstance(v, tuple) else complex(v) for v in pt])
-            if projective:
+            if settings["projective"]:
                 x = x / x[np.argmax(np.abs(x))]
             paths.append(Path(k, "finite", code, x, bool(md.is_singular), float(md.condition_number),
                               float(md.function_residual), int(md.cycle_num)))
