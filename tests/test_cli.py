@@ -21,6 +21,7 @@ from pkm import cli
 from pkm.bench import NAMES as BENCHMARKS
 from pkm.mechanisms import delta as D
 from pkm.mechanisms import module, names
+from tests.papers.figures import inspected
 
 
 def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
@@ -78,11 +79,17 @@ def test_console_script_lists_every_mechanism_as_json():
     assert data["prs3"]["actuated"]["slider_1"] == "m" and data["hexapod"]["task"]["beta_1"] == "rad"
 
 
-def test_list_as_text_and_a_bad_option():
-    """``pkm list`` names each mechanism and its parameters; an unknown option exits 2 with one line."""
+def test_list_as_text_and_a_bad_option(capsys):
+    """``pkm list`` names each mechanism, its task origin, a reachable pose (which ``pkm ik`` takes back as it is
+    printed) and its parameters; an unknown option exits 2 with one line."""
     ok = run("list")
     assert ok.returncode == 0
     assert all(f"{m}: " in ok.stdout for m in names(with_files=True)) and "task (--pose): x [m], y [m], z [m]" in ok.stdout
+    rrr3 = ok.stdout[ok.stdout.index("rrr3: "):]
+    assert "task origin: the base joint A1" in rrr3
+    pose = re.search(r"reference pose \(reachable\): (.*)", rrr3).group(1).split()
+    assert pose == ["x=50cm", "y=28.87cm", "yaw=5deg"]
+    assert cli.main(["ik", "rrr3", "--pose", *pose]) == 0 and json.loads(capsys.readouterr().out)["converged"]
     bad = run("list", "--bad")
     assert bad.returncode == 2 and "unrecognized arguments: --bad" in one_error_line(bad)
 
@@ -154,6 +161,15 @@ def test_map_prints_a_summary_and_writes_the_figure_and_the_numbers(tmp_path):
     ci = [float(r["ci_2"]) for r in rows if r["reachable"] == "1"]
     assert math.isclose(sum(ci) / len(ci), out["gci_2"], rel_tol=1e-12)
     assert (tmp_path / "m.png").stat().st_size > 10_000
+
+
+def test_the_map_figure_passes_the_figure_check(tmp_path, capsys):
+    """The PNG of ``pkm map`` (in process, coarse): a caption naming the mechanism, units on both axes, a colour bar,
+    the white of unreachable nodes in a legend."""
+    with inspected(paper=False) as found:
+        assert cli.main(["map", "rrr3", "--axis", "x=0cm:100cm:21", "--axis", "y=-10cm:90cm:21", "--pose", "yaw=0deg",
+                         "--length", "5.7735cm", "--png", str(tmp_path / "m.png")]) == 0
+    assert found == {"m": []}
 
 
 # ---------------------------------------------------------------------- preview, report, bench

@@ -227,6 +227,47 @@ def test_world_and_end_effector_triads_are_drawn(case):
             assert np.abs(m[:3, 1] - placement[:3, k]).max() <= TOL  # cylinder axis (its y) along the frame axis
 
 
+def test_each_leg_has_one_colour_of_its_own_and_the_legend_lists_every_colour_drawn(case):
+    """Links are coloured per leg (the tree cut at the world and the platform): the links of one leg share a colour,
+    no two legs share one (up to len(LEG_COLORS) legs), a leg is named after its actuated joints; the legend lists
+    every colour drawn, and the page shows it."""
+    mech, scene, _ = case
+    legs: dict[str, set[int]] = {}
+    for b in scene.bodies:
+        if b.role == "link" and b.leg is not None:
+            legs.setdefault(b.leg, set()).add(b.color)
+    assert len(legs) >= 2 and all(len(c) == 1 for c in legs.values())  # (the five-bar has two)
+    colours = [c for cs in legs.values() for c in cs]
+    assert len(set(colours)) == len(colours) and set(colours) <= set(viz.LEG_COLORS)
+    assert set(mech.actuated_names) <= {n for leg in legs for n in leg.split(", ")} | {b.joint for b in scene.bodies
+                                                                                      if b.leg is None}
+    listed = {c for _, cs in scene.legend() for c in cs}
+    assert {b.color for b in scene.bodies} <= listed
+    assert [f"leg {leg}" for leg in legs] == [label for label, _ in scene.legend() if label.startswith("leg ")]
+    page = viz.snapshot_html(mech)
+    assert 'id="pkm-legend"' in page and all(f"#{c:06x}" in page for c in listed)
+    assert 'id="pkm-legend"' not in viz.snapshot_html(mech, legend=False)
+
+
+def test_the_camera_frames_every_joint_inside_the_view(case):
+    """The snapshot's camera sees every joint and frame origin within the fill fraction of its field of view (75 deg
+    vertical, a 4:3 window), and no nearer would: the farthest point lies near that edge."""
+    _, scene, qs = case
+    direction = scene.view_direction(qs[0])
+    t = scene.camera_distance([qs[0]], direction)
+    centre, _ = scene.bounds([qs[0]])
+    pts = np.array([m[:3, 3] for m in scene.frame_placements(qs[0])]) - centre
+    f = -direction
+    right = np.cross(f, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, f)
+    rel = pts + t * f
+    depth = rel @ f
+    reach = np.maximum(np.abs(rel @ right) / depth / (4 / 3), np.abs(rel @ up) / depth).max()
+    edge = np.tan(np.radians(37.5)) * 0.8
+    assert 0.8 * edge < reach < edge  # (the rest of the edge: the joint radius padding every point)
+
+
 # ---------------------------------------------------------------------------------------- animation
 @pytest.mark.parametrize("times, keys", [(None, [0.0, 1.0, 2.0]), ([0.0, 0.5, 2.0], [0.0, 15.0, 60.0])])
 def test_animation_keyframes_are_forward_kinematics(case, times, keys):

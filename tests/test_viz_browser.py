@@ -7,7 +7,8 @@ The screenshot is checked against the snapshot's own camera: each actuated joint
 projected with meshcat's default perspective camera (75 degree vertical field of view, looking
 at meshcat's origin, z up) from the position the snapshot gives it, must land on pixels of the
 actuated colour; passive joints and the platform must show in their colours; the mechanism
-must fill a good part of the picture, away from its edges.
+must fill a good part of the picture, away from its edges. The hexapod's page shows its legend,
+and each of its six legs in its own colour.
 """
 
 from __future__ import annotations
@@ -57,11 +58,12 @@ def screenshot(page: str, folder: Path) -> np.ndarray:
 
 
 def colour_mask(img: np.ndarray, rgb: int) -> np.ndarray:
-    """Pixels of the hue of ``rgb`` (within 7 degrees), saturated and not dark: its lit and shaded surfaces."""
+    """Pixels of the hue of ``rgb`` (within 7 degrees), saturated (at least 0.6 of its saturation, 0.5 at most) and
+    not dark: its lit and shaded surfaces."""
     ref = mcolors.rgb_to_hsv(np.array([(rgb >> 16) & 255, (rgb >> 8) & 255, rgb & 255]) / 255.0)
     hsv = mcolors.rgb_to_hsv(img)
     dh = np.abs((hsv[..., 0] - ref[0] + 0.5) % 1.0 - 0.5)
-    return (dh < 0.02) & (hsv[..., 1] > 0.5) & (hsv[..., 2] > 0.25)
+    return (dh < 0.02) & (hsv[..., 1] > min(0.5, 0.6 * ref[1])) & (hsv[..., 2] > 0.2)
 
 
 def camera(cmds: list[dict]):
@@ -88,7 +90,7 @@ def project(points: np.ndarray, eye: np.ndarray) -> np.ndarray:
 def test_headless_chromium_shows_the_delta_where_the_camera_looks(tmp_path):
     """The Delta's snapshot renders with its motors, passive joints and platform in their colours, framed."""
     mech = pkm.load("delta")
-    page = viz.snapshot_html(mech)
+    page = viz.snapshot_html(mech, legend=False)  # (the 3-D drawing alone; the legend: the last test)
     img = screenshot(page, tmp_path)
     assert img.shape == (HEIGHT, WIDTH, 3)
     assert img.std() > 0.05  # not blank
@@ -126,7 +128,7 @@ def test_a_five_bar_from_its_files_shows_every_joint_link_and_the_base(tmp_path)
     between the motors (a bar, off the world triad) and the closure point land on drawn pixels, not on the
     background."""
     mech = pkm.load(Path(__file__).resolve().parents[1] / "examples" / "gepetto_fivebar")
-    page = viz.snapshot_html(mech)
+    page = viz.snapshot_html(mech, legend=False)  # (the 3-D drawing alone; the legend: the last test)
     img = screenshot(page, tmp_path)
     cmds = [umsgpack.unpackb(base64.b64decode(s)) for s in json.loads(
         re.search(r'id="pkm-meshcat-commands">(.*?)</script>', page, re.DOTALL).group(1))]
@@ -155,3 +157,21 @@ def test_a_five_bar_from_its_files_shows_every_joint_link_and_the_base(tmp_path)
     motors = [data.oMi[model.getJointId(n)].translation for n in mech.actuated_names]
     for col, row in at(np.array(links + [0.75 * motors[0] + 0.25 * motors[1], data.oMf[fa].translation])):
         assert drawn[max(row - 3, 0):row + 4, max(col - 3, 0):col + 4].any(), (col, row)
+
+
+def test_the_hexapods_legs_show_in_their_colours_and_the_legend_in_the_corner(tmp_path):
+    """The hexapod, cluttered in grey before: each of its six legs shows in its own colour (hundreds of pixels each),
+    and the page with its legend differs from the page without only in the lower left corner, where the legend
+    shows every leg's colour."""
+    mech = pkm.load("hexapod")
+    bare = screenshot(viz.snapshot_html(mech, legend=False), tmp_path)
+    shown = screenshot(viz.snapshot_html(mech), tmp_path)
+    legs = [colors[0] for label, colors in viz.Scene.from_mechanism(mech).legend() if label.startswith("leg ")]
+    assert len(legs) == 6
+    for color in legs:
+        assert colour_mask(bare, color).sum() > 150, f"#{color:06x}"
+    rows, cols = np.nonzero(np.abs(shown - bare).max(axis=-1) > 0.05)
+    assert len(rows) > 2000 and cols.max() < 0.6 * WIDTH and rows.min() > 0.2 * HEIGHT  # the corner
+    corner = shown[rows.min():, :cols.max() + 1]
+    for color in legs:
+        assert colour_mask(corner, color).sum() >= 40, f"#{color:06x} not in the legend"

@@ -33,6 +33,7 @@ import argparse
 import dataclasses
 import inspect
 import json
+import math
 import os
 import re
 import signal
@@ -309,6 +310,8 @@ def cmd_list(args) -> int:
             "title": entry.title,
             "actuated": {j: SI_UNITS[_joint_kind(mech, j)] for j in mech.actuated_names},
             "task": {k: SI_UNITS[kind] for k, kind in mech.task_map.kinds.items()},
+            "task_origin": entry.origin,
+            "reference_pose": mech.task_map.named(mech.q_reference),
             "branches": list(mech.spec.branches),
             "default_branch": mech.spec.default_branch,
             "parameters": {p.name: {"default": p.default, "unit": p.unit, "type": p.type,
@@ -327,6 +330,9 @@ def cmd_list(args) -> int:
         print(f"{name}: {d['title']}")
         print(f"  actuated (--joints): {named(d['actuated'])}")
         print(f"  task (--pose): {named(d['task'])}")
+        print(f"  task origin: {d['task_origin']}")
+        print("  reference pose (reachable): " + " ".join(f"{k}={_fmt_value(v, d['task'][k])}"
+                                                       for k, v in d["reference_pose"].items()))
         if branches:
             print(f"  branches (--branch): {branches}")
         print("  parameters (--param NAME=VALUE, SI unless a unit suffix is given):")
@@ -337,6 +343,14 @@ def cmd_list(args) -> int:
             print(f"    {r[0].ljust(w[0])}  {r[1].ljust(w[1])}  {r[2].ljust(w[2])}  {r[3]}")
         print()
     return 0
+
+
+def _fmt_value(v: float, unit: str) -> str:
+    """A task value for the eye, in the unit a user would type: cm or deg (``pkm ik --pose`` takes them back)."""
+    v += 0.0  # (no "-0")
+    if unit == "m":
+        return f"{v * 100 + 0.0:.4g}cm"
+    return f"{math.degrees(v) + 0.0:.4g}deg" if unit == "rad" else f"{v:.4g}"
 
 
 def _fmt_default(v: Any) -> str:

@@ -9,7 +9,9 @@ closure spec say:
   joint's second axis, a knee on a slider) is a larger sphere around its parent's, drawn by its
   back faces only, so that it shows as a ring around it;
 * every body as cylinders from its joint's origin to the origins of its child joints and to
-  the frames it carries (leg tips, closure frames);
+  the frames it carries (leg tips, closure frames), each leg in a colour of its own
+  (:data:`LEG_COLORS`; a leg: the joints hung on the world, or on the platform, with their
+  descendants up to the platform), named after its actuated joints;
 * the platform (the body holding the end-effector frame) as the convex hull of the closure
   frames it carries: a triangle for the 3-RRR, Delta and 3-PRS, a prism for the hexapod;
 * the base, translucent, through the anchor points of the joints hung on the world
@@ -19,6 +21,8 @@ closure spec say:
 * the world and end-effector frames as triads (x red, y green, z blue);
 * each closure as a small white sphere on ``frame_a`` inside a translucent bubble on
   ``frame_b``: the two are concentric when the loop is closed.
+
+The page of :func:`snapshot_html` carries a legend of these colours (:meth:`Scene.legend`).
 
 :class:`Scene` lists these bodies (meshcat path, primitive, the Pinocchio frame it rides
 on, its offset in that frame) and gives their placements at any configuration;
@@ -66,10 +70,17 @@ PASSIVE_COLOR = 0xE6AB02
 MIMIC_COLOR = 0xF4A6CF
 """Colour of mimic joints, driven by another joint (light pink)."""
 LINK_COLOR = 0xBDBDBD
+"""Colour of links that belong to no leg (those of the platform's own body)."""
+LEG_COLORS = (0x1F77B4, 0x9467BD, 0x8C564B, 0x17BECF, 0x393B79, 0x637939, 0x843C39, 0x7B4173)
+"""Colours of the legs' links, in the order of the legs' first joints (then again from the first): hues apart from
+the joints', the platform's, the triads' and the grey background's."""
 PLATFORM_COLOR = 0x1B9E77
 BASE_COLOR = 0x525252
 CLOSURE_COLOR = 0xFFFFFF
 AXIS_COLORS = (0xFF0000, 0x00C000, 0x0000FF)
+
+BACKGROUND = ((0.97, 0.97, 0.97), (0.78, 0.78, 0.80))
+"""The page's background, top and bottom colours (RGB in [0, 1])."""
 
 JOINT_COLORS = {"actuated": ACTUATED_COLOR, "passive": PASSIVE_COLOR, "mimic": MIMIC_COLOR}
 
@@ -87,10 +98,13 @@ _PLATFORM_FRACTION = 0.15  # largest joint radius, of the platform's diameter
 _NESTED_SCALE = 1.35  # radius of a joint's ring around its parent's sphere
 _TRIAD_LENGTH = 0.12
 _TRIAD_RADIUS = 0.2 * _JOINT_RADIUS
-# Camera: direction (world) from the mechanism's centre, distance in bounding radii: the bounding sphere
-# fits meshcat's vertical field of view (75 deg).
+# Camera: direction (world) from the mechanism's centre; placed as near as lets every joint and frame origin (and a
+# joint radius about it) fill at most _FILL of meshcat's vertical field of view (75 deg), and of the horizontal one
+# of a 4:3 window (wider windows show more).
 _VIEW_DIRECTION = np.array([1.0, 0.5, 0.9])
-_VIEW_DISTANCE = 1.0 / math.sin(math.radians(75.0 / 2.0))
+_FOV = math.radians(75.0)
+_ASPECT = 4.0 / 3.0
+_FILL = 0.8
 _UUID_NAMESPACE = uuid.UUID("6f1b4c1e-8d4a-4e0b-9a51-7c6d2f3e9b10")
 
 
@@ -142,6 +156,7 @@ class Body:
         ends: For a link: the names of the joint or frame at each end; for a closure marker,
             the closure's name and the frame it marks.
         halo: Drawn by its back faces only: a sphere around another shows as a ring around it.
+        leg: For a link of a leg, the leg's name (see :meth:`Scene.legend`).
     """
 
     path: str
@@ -158,6 +173,7 @@ class Body:
     actuation: str | None = None
     ends: tuple[str, str] | None = None
     halo: bool = False
+    leg: str | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -219,6 +235,33 @@ class Scene:
         oMf = self.frame_placements(q)
         return {b.path: oMf[i] @ b.offset for b, i in zip(self.bodies, self._frame_ids)}
 
+    def camera_distance(self, qs, direction) -> float:
+        """Distance [m] from the centre of :meth:`bounds` along unit ``direction`` at which the camera frames the
+        mechanism over configurations ``qs``: every joint and frame origin, padded by a joint radius, within
+        ``_FILL`` of the half field of view (vertical 75 deg; horizontal of a 4:3 window)."""
+        centre, radius = self.bounds(qs)
+        pts = np.concatenate([np.array([m[:3, 3] for m in self.frame_placements(q)]) for q in qs]) - centre
+        f = -np.asarray(direction, float)
+        right = np.cross(f, [0.0, 0.0, 1.0])
+        right /= np.linalg.norm(right)
+        up = np.cross(right, f)
+        pad, tan = _JOINT_RADIUS * self.length, math.tan(_FOV / 2.0) * _FILL
+
+        def fits(t: float) -> bool:
+            rel = pts + t * f  # (points seen from the eye at -t f)
+            depth = rel @ f - pad
+            if np.any(depth <= 0.0):
+                return False
+            x = (np.abs(rel @ right) + pad) / depth / _ASPECT
+            y = (np.abs(rel @ up) + pad) / depth
+            return bool(max(x.max(), y.max()) <= tan)
+
+        lo, hi = 0.0, radius / math.sin(math.atan(tan / _ASPECT)) + radius  # (the bounding sphere always fits at hi)
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (lo, mid) if fits(mid) else (mid, hi)
+        return hi
+
     def bounds(self, qs) -> tuple[np.ndarray, float]:
         """Centre [m] and radius [m] of a sphere around the mechanism over configurations ``qs``.
 
@@ -228,6 +271,28 @@ class Scene:
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         radius = 0.5 * float(np.linalg.norm(hi - lo)) + _JOINT_RADIUS * self.length
         return 0.5 * (lo + hi), max(radius, 0.05 * self.length)
+
+    def legend(self) -> list[tuple[str, tuple[int, ...]]]:
+        """``(label, colours)`` of everything drawn, in the order the page lists them: the joints' actuation, the
+        platform, the base, the closures, each leg (named after its actuated joints), the triads' axes."""
+        out: list[tuple[str, int | tuple[int, ...]]] = []
+        roles = {b.role for b in self.bodies}
+        for kind in ("actuated", "passive", "mimic"):
+            if any(b.actuation == kind for b in self.bodies):
+                out.append((f"{kind} joint" + (" (driven by another)" if kind == "mimic" else ""), JOINT_COLORS[kind]))
+        if "platform" in roles:
+            out.append(("platform", PLATFORM_COLOR))
+        if "base" in roles:
+            out.append(("base", BASE_COLOR))
+        if "closure" in roles:
+            out.append(("loop closure (dot centred in its bubble: closed)", CLOSURE_COLOR))
+        legs = dict.fromkeys((b.leg, b.color) for b in self.bodies if b.role == "link" and b.leg is not None)
+        out += [(f"leg {name}", color) for name, color in legs]
+        if any(b.role == "link" and b.leg is None for b in self.bodies):
+            out.append(("link of the platform", LINK_COLOR))
+        if "triad" in roles:
+            out.append(("x, y, z axes (world, end effector)", AXIS_COLORS))
+        return [(label, c if isinstance(c, tuple) else (c,)) for label, c in out]
 
     def view_direction(self, q) -> np.ndarray:
         """Unit vector from the mechanism towards the camera, for configuration ``q``.
@@ -319,7 +384,8 @@ def _build_bodies(mech: Mechanism, root: str) -> tuple[list[Body], float, str | 
         bodies.append(Body(f"{root}/base", "cylinder", "base", joint_frame(0), _segment(ends[a], ends[b]),
                            BASE_COLOR, (float(far[a, b]), _BASE_BAR * r_joint), joint=model.names[0]))
 
-    # links: cylinders from each joint's origin to its children and to the frames it carries
+    # links: cylinders from each joint's origin to its children and to the frames it carries, coloured by leg
+    legs = _legs(mech, pj)
     rank = {pin.FrameType.BODY: 1, pin.FrameType.OP_FRAME: 2, pin.FrameType.FIXED_JOINT: 3}
     for j in range(1, model.njoints):
         targets = [(model.names[c], np.array(model.jointPlacements[c].translation))
@@ -334,10 +400,11 @@ def _build_bodies(mech: Mechanism, root: str) -> tuple[list[Body], float, str | 
             if np.linalg.norm(p) <= eps or any(np.linalg.norm(p - s) <= eps for s in seen):
                 continue
             seen.append(p)
+            leg, color = legs.get(j, (None, LINK_COLOR))
             bodies.append(Body(f"{root}/links/{_clean(model.names[j])}-{_clean(name)}", "cylinder", "link",
-                               joint_frame(j), _segment(np.zeros(3), p), LINK_COLOR,
+                               joint_frame(j), _segment(np.zeros(3), p), color,
                                (float(np.linalg.norm(p)), _LINK_RADIUS * r_joint), joint=model.names[j],
-                               ends=(model.names[j], name)))
+                               ends=(model.names[j], name), leg=leg))
 
     # joints; a joint whose origin never leaves its parent's (a universal joint's second axis,
     # a knee on a slider) is a larger sphere around its parent's, seen as a ring (back faces only)
@@ -372,6 +439,28 @@ def _build_bodies(mech: Mechanism, root: str) -> tuple[list[Body], float, str | 
             bodies.append(Body(f"{root}/frames/{_clean(label)}/{axis}", "cylinder", "triad", fname,
                                _segment(np.zeros(3), tip), AXIS_COLORS[k], (size, _TRIAD_RADIUS * length)))
     return bodies, length, platform_joint
+
+
+def _legs(mech: Mechanism, platform: int) -> dict[int, tuple[str, int]]:
+    """Joint index -> ``(leg name, colour)``: the tree cut at the world and at the platform's joint, each piece a
+    leg, named after its actuated joints (else its first joint) and coloured in the order of its first joint."""
+    model = mech.model
+    first: dict[int, int] = {}
+    for j in range(1, model.njoints):
+        if j == platform:
+            continue
+        k = j
+        while model.parents[k] not in (0, platform):
+            k = model.parents[k]
+        first[j] = k
+    actuated = set(mech.actuated_names)
+    out = {}
+    for n, head in enumerate(sorted(set(first.values()))):
+        members = [j for j in first if first[j] == head]
+        names = [model.names[j] for j in members if model.names[j] in actuated] or [model.names[head]]
+        for j in members:
+            out[j] = (", ".join(names), LEG_COLORS[n % len(LEG_COLORS)])
+    return out
 
 
 def _nested_joints(mech: Mechanism) -> set[int]:
@@ -588,13 +677,17 @@ def scene_commands(scene: Scene, q=None, *, trajectory=None, times=None, loop: b
     q = mech.check_q(q)
 
     views = [q] if traj is None else [q, *traj[:: max(1, len(traj) // 50)], traj[-1]]
-    centre, radius = scene.bounds(views)
+    centre, _ = scene.bounds(views)
     shift = np.eye(4)
     shift[:3, 3] = -centre
-    d = scene.view_direction(q) * _VIEW_DISTANCE * radius
+    direction = scene.view_direction(q)
+    d = direction * scene.camera_distance(views, direction)
     cmds = [
         mc.commands.SetProperty("visible", False, _path(mc, "/Axes")),
         mc.commands.SetProperty("visible", False, _path(mc, "/Grid")),
+        # a light grey background, against which every colour of the legend stands out (meshcat's is sky blue)
+        mc.commands.SetProperty("top_color", list(BACKGROUND[0]), _path(mc, "/Background")),
+        mc.commands.SetProperty("bottom_color", list(BACKGROUND[1]), _path(mc, "/Background")),
         mc.commands.SetTransform(shift, _path(mc, "/Grid")),
         # the camera hangs in a frame turned by +90 deg about x (its y is the world z)
         mc.commands.SetProperty("position", [float(d[0]), float(d[2]), float(-d[1])],
@@ -628,10 +721,16 @@ _PAGE = """<!DOCTYPE html>
 <style>
 body {{ margin: 0; }}
 #meshcat-pane {{ width: 100vw; height: 100vh; overflow: hidden; }}
+#pkm-legend {{ position: absolute; left: 8px; bottom: 8px; padding: 6px 8px; border-radius: 4px;
+  background: rgba(255, 255, 255, 0.85); font: 11px sans-serif; color: #222; line-height: 1.45; }}
+#pkm-legend b {{ display: block; margin-bottom: 2px; }}
+#pkm-legend i {{ display: inline-block; width: 10px; height: 10px; margin-right: 5px; vertical-align: -1px;
+  border: 1px solid #555; }}
 </style>
 </head>
 <body>
 <div id="meshcat-pane"></div>
+{legend}
 <script>
 {viewer_js}
 </script>
@@ -670,7 +769,8 @@ def _viewer_js(mc) -> str:
         raise VizDependencyError(f"meshcat viewer ({path}: {exc.strerror})") from None
 
 
-def snapshot_html(mech: Mechanism, q=None, *, trajectory=None, times=None, loop: bool = True) -> str:
+def snapshot_html(mech: Mechanism, q=None, *, trajectory=None, times=None, loop: bool = True,
+                  legend: bool = True) -> str:
     """A self-contained HTML page showing ``mech`` at ``q``, and animating ``trajectory`` if given.
 
     The page inlines meshcat's viewer and carries the drawing commands itself; it needs no
@@ -682,6 +782,7 @@ def snapshot_html(mech: Mechanism, q=None, *, trajectory=None, times=None, loop:
         trajectory: Configurations to animate, (N, nq), or None.
         times: Time of each configuration [s], (N,); default 30 configurations per second.
         loop: Whether the animation repeats forever.
+        legend: Whether the page shows the legend of the colours (:meth:`Scene.legend`) in its lower left corner.
 
     Returns:
         The HTML text. The commands are a JSON list of base64 strings in the element
@@ -695,7 +796,15 @@ def snapshot_html(mech: Mechanism, q=None, *, trajectory=None, times=None, loop:
     scene = Scene.from_mechanism(mech)
     packed = pack_commands(scene_commands(scene, q, trajectory=trajectory, times=times, loop=loop))
     return _PAGE.format(title=html.escape(f"pkm: {mech.name}"), viewer_js=_viewer_js(mc),
+                        legend=_legend_html(scene) if legend else "",
                         commands="[\n" + ",\n".join(json.dumps(p) for p in packed) + "\n]")
+
+
+def _legend_html(scene: Scene) -> str:
+    """The ``<div id="pkm-legend">`` listing :meth:`Scene.legend`: a swatch and a label per colour."""
+    rows = "".join("<div>" + "".join(f'<i style="background:#{c:06x}"></i>' for c in colors)
+                   + f"{html.escape(label)}</div>" for label, colors in scene.legend())
+    return f'<div id="pkm-legend"><b>{html.escape(scene.mechanism.name)}</b>{rows}</div>'
 
 
 def read_commands(page: str) -> list[dict]:

@@ -11,7 +11,7 @@ import pytest
 
 from pkm.mechanisms.delta import DeltaParams
 from pkm.papers import delta as S
-from tests.papers.figures import draw_checked
+from tests.papers.figures import draw_checked, uncovered
 
 IDS = ["delta.fig5.K_F_R100", "delta.fig5.K_F_R200", "delta.fig5.K_2_R120", "delta.fig5.monotone_100_200",
        "delta.fig5.R_min_K2_mm", "delta.choice.R_mm", "delta.opcount.mul", "delta.opcount.add"]  # the last two: issue 15
@@ -64,13 +64,15 @@ def test_choice_is_in_the_papers_range_and_follows_the_procedure(rows):
 
 
 def test_figures_and_series_are_written(tmp_path, rows):
-    """figures() writes the two PNGs, each with units on its axes, every line in a legend; series() writes the
-    K(R) and volume(R) tables with their headers."""
+    """figures() writes the two PNGs, each passing the figure check; series() writes the numbers behind each (the
+    K(R) and volume(R) tables, the choice against the bound) with their headers."""
     paths, problems = draw_checked(S, tmp_path)
     assert problems == {"delta_fig5_K_vs_R": [], "delta_workspace_vs_R": []}
     assert [p.name for p in paths] == ["delta_fig5_K_vs_R.png", "delta_workspace_vs_R.png"]
     assert all(p.stat().st_size > 10_000 for p in paths)
-    f1, f2 = S.series(tmp_path)
+    series = S.series(tmp_path)
+    assert uncovered(S, paths, series) == []
+    f1, f2, _ = series
     with f1.open() as fh:
         table = list(csv.reader(fh))
     assert table[0][:4] == ["R_mm", "K_fro_knee_out", "K_fro_normalized_knee_out", "K_2_knee_out"]

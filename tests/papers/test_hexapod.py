@@ -10,7 +10,7 @@ import pytest
 
 from pkm import papers
 from pkm.papers import hexapod as study
-from tests.papers.figures import draw_checked
+from tests.papers.figures import draw_checked, uncovered
 
 IDS = ("hexapod.poseT.beta_min_reachable_deg", "hexapod.poseT.beta_opt_wrot_deg", "hexapod.poseT.beta_opt_wtras_deg",
        "hexapod.spiral.max_gap_rot_tras_deg", "hexapod.spiral.gain_after_40_wrot",
@@ -60,12 +60,14 @@ def test_spiral_rows_are_reported_honestly(reproduced):
 
 
 def test_figures_and_series_are_written(tmp_path):
-    """Figs. 7, 9 and 10 as PNG files, each with units on its axes and every line in a legend; the numbers behind
-    them as CSV (Fig. 7's curves, the spiral's profiles)."""
+    """Figs. 7, 9 and 10 as PNG files, each passing the figure check; the numbers behind each as CSV (Fig. 7's
+    curves, the spiral's profiles)."""
     paths, problems = draw_checked(study, tmp_path)
     assert len(paths) == 3 and all(p.exists() and p.stat().st_size > 10_000 for p in paths)
     assert problems == {p.stem: [] for p in paths}
-    f7, spiral = study.series(tmp_path)
+    series = study.series(tmp_path)
+    assert uncovered(study, paths, series) == []
+    f7, spiral = series
     with f7.open() as fh:
         rows = list(csv.reader(fh))
     assert rows[0] == ["beta_deg", "reachable", "w_rot", "w_tras_m3"] and len(rows) > 100

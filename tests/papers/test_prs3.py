@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pkm.papers import prs3 as study
-from tests.papers.figures import draw_checked
+from tests.papers.figures import draw_checked, uncovered
 
 CONTRACT = ["prs3.opcount.mul", "prs3.opcount.add", "prs3.opcount.generic_mul", "prs3.opcount.generic_add",
             "prs3.case2.power_spread_W", "prs3.case3.p1_peak_ratio",
@@ -63,7 +63,9 @@ def test_series_are_written_every_10_ms_with_forces_and_powers(tmp_path):
 
 
 def test_figures_are_written(tmp_path):
+    """Figs. 3, 4 and the forces pass the figure check, and the series hold the numbers behind each."""
     paths, problems = draw_checked(study, tmp_path)
     assert problems == {p.stem: [] for p in paths}
+    assert uncovered(study, paths, study.series(tmp_path)) == []
     assert {p.name for p in paths} == {"prs3_fig3_power_case2.png", "prs3_fig4_power_case3.png", "prs3_forces.png"}
     assert all(p.stat().st_size > 10_000 for p in paths)

@@ -6,6 +6,7 @@ import pytest
 
 from pkm.mechanisms.rrr3.workspace import Design
 from pkm.papers import rrr3 as study
+from tests.papers.figures import draw_checked, uncovered
 
 IDS = ["rrr3.fig5.gci", "rrr3.fig5.gci_area", "rrr3.fig6.gci", "rrr3.fig6.gci_area", "rrr3.fig7.gci",
        "rrr3.fig7.gci_area", "rrr3.fig9.gci", "rrr3.fig9.gci_area", "rrr3.modes.suitable",
@@ -73,3 +74,33 @@ def test_paper_grid_is_801_nodes_per_axis_with_a_151_node_area():
 def test_the_sweep_has_the_papers_1000_designs():
     designs = study.paper_sweep_designs()
     assert len(designs) == 1000 and len(set(designs)) == 1000
+
+
+@pytest.fixture
+def coarse(monkeypatch):
+    """The study's figures at coarse sizes (a 2 cm map grid, 27 designs on the serial scheduler, a 21 x 21 x 37 Fig. 3
+    count, 1 cm boundaries), its caches emptied before and after so that no other test sees them."""
+    cached = (study.figure_map, study.mode_study, study._fig3_boundaries, study._fig3_sweep, study._similarity,
+              study.design_sweep)
+    sweep = study.design_sweep.__wrapped__
+    monkeypatch.setattr(study, "PAPER_MAP_STEP", 0.02)
+    monkeypatch.setattr(study, "FIG3_STEP", 0.01)
+    monkeypatch.setattr(study, "FIG3_SWEEP", (21, 37))
+    monkeypatch.setattr(study, "fig7_design", lambda: Design.similarity_law(1.5))
+    monkeypatch.setattr(study, "paper_sweep_designs", lambda: PAPER_SWEEP(n=3))
+    monkeypatch.setattr(study, "design_sweep", lambda: sweep(step=0.05, scheduler="serial"))
+    for f in cached:
+        f.cache_clear()
+    yield
+    for f in cached:
+        f.cache_clear()
+
+
+PAPER_SWEEP = study.paper_sweep_designs
+
+
+def test_figures_pass_the_check_and_the_series_hold_their_numbers(coarse, tmp_path):
+    """Every 3-RRR figure (coarse sizes, the same code) passes the figure check, and the series cover each one."""
+    paths, problems = draw_checked(study, tmp_path)
+    assert problems == {p.stem: [] for p in paths} and len(paths) == 8
+    assert uncovered(study, paths, study.series(tmp_path)) == []

@@ -31,7 +31,7 @@ def results(tmp_path_factory):
 def test_plots_from_the_results_file(results, tmp_path, capsys):
     """`pkm sweep plot` writes both figures, each with units on its axes and every line in a legend."""
     capsys.readouterr()
-    with inspected() as found:
+    with inspected(paper=False) as found:
         assert cli.main(["sweep", "plot", str(results), "--out", str(tmp_path)]) == 0
     assert found == {"sweep_parameters": [], "sweep_pareto": []}
     paths = json.loads(capsys.readouterr().out)

@@ -61,6 +61,7 @@ class TaskGridMap:
         iterations: Newton iterations per node.
         how: What ran the kernels.
         kinds: Each axis's kind, ``"length"`` or ``"angle"``.
+        mechanism: The mechanism's name (the figure's caption).
     """
 
     axes: tuple[tuple[str, np.ndarray], ...]
@@ -71,6 +72,7 @@ class TaskGridMap:
     iterations: np.ndarray = field(repr=False)
     how: str = ""
     kinds: tuple[str, ...] = ()
+    mechanism: str = ""
 
     @property
     def nodes(self) -> int:
@@ -127,7 +129,8 @@ class TaskGridMap:
 
     def figure(self, path, kind: str = "2", *, slab: int | None = None, title: str = "") -> Path:
         """Draw the condition index (``kind``) over the map as a PNG at ``path``: a colour map with its colour bar
-        (2-D), a curve (1-D); unreachable nodes white. Axes in mm or deg."""
+        (2-D), a curve (1-D); unreachable nodes white (said in a legend). Axes in mm or deg; the caption (``title``
+        by default) names the mechanism, the reachable nodes and the GCI."""
         import matplotlib
 
         matplotlib.use("Agg")
@@ -153,8 +156,14 @@ class TaskGridMap:
             ax.set_xlabel(labels[0])
             ax.set_ylabel(labels[1])
             ax.set_aspect("equal" if labels[0][-4:] == labels[1][-4:] else "auto")
+            if not self.reachable[sl].all():
+                from matplotlib.patches import Patch
+
+                ax.legend(handles=[Patch(facecolor="white", edgecolor="0.5", label="unreachable")], fontsize=7,
+                          loc="lower right")
         extra = "" if slab is None else f", {self.axes[2][0]} = {self.axes[2][1][slab]:.4g}"
-        ax.set_title(title or f"{self.nodes} reachable nodes, GCI {self.gci(kind) or 0.0:.4f}{extra}")
+        ax.set_title(title or f"{self.mechanism or 'map'}: {self.nodes} reachable nodes, GCI "
+                              f"{self.gci(kind) or 0.0:.4f}{extra}", fontsize=9)
         out = Path(path)
         out.parent.mkdir(parents=True, exist_ok=True)
         fig.tight_layout()
@@ -302,7 +311,7 @@ def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, ob
         raise RuntimeError(f"the map driver failed (code {flag})")
     shape = tuple(reversed(dims))
     return TaskGridMap(tuple(grid_axes), base, scale, (state == 1).reshape(shape), sv.reshape(shape + (nsv,)),
-                       its.reshape(shape), how, tuple(task.kinds[name] for name, _ in grid_axes))
+                       its.reshape(shape), how, tuple(task.kinds[name] for name, _ in grid_axes), mech.name)
 
 
 __all__ = ["KINDS", "MAX_NODES", "PIVOT_FLOOR", "ROOT_STRIDE", "TaskGridMap", "task_map"]

@@ -62,6 +62,7 @@ class MechanismDefinition:
         reference: The closure spec of the reference design, a file name in pkm's ``urdf/`` data
             folder (shipped in the wheel; ``pkm.load`` reads it and its URDF), or None: ``pkm.load``
             builds the default ``Params()``.
+        origin: Where the task coordinates are measured from, and along which axes (``pkm list`` says it).
     """
 
     name: str
@@ -70,6 +71,7 @@ class MechanismDefinition:
     paper: str | None = None
     task_scale: tuple[float, float, float] = (0.05, 0.1, 0.1)
     reference: str | None = None
+    origin: str = "the world frame of the URDF"
 
     def tangent_scale(self, coordinates: Sequence[str]) -> list[float]:
         """:attr:`task_scale` spread over task coordinates (``x y z`` positions, ``roll pitch yaw wx wy wz``
@@ -88,17 +90,24 @@ REGISTRY: dict[str, MechanismDefinition] = {
     d.name: d for d in (
         MechanismDefinition("hexapod", "reconfigurable hexapod of two 3-RUS sub-manipulators (Sanchez-Alonso et al. "
                                        "2016)", "pkm.mechanisms.hexapod", "hexapod", (0.03, 0.08, 0.3),
-                            "hexapod.closures.toml"),
+                            "hexapod.closures.toml", "O, the centre of the reconfiguration pivots F1 F2 F3 (the "
+                            "paper's frame: Y the hexapod's axis); position of P, the centre of C4 C5 C6"),
         MechanismDefinition("rrr3", "planar 3-RRR (singularities and global condition index)", "pkm.mechanisms.rrr3",
-                            "rrr3", (0.12, 0.3, 0.0), "rrr3.closures.toml"),
+                            "rrr3", (0.12, 0.3, 0.0), "rrr3.closures.toml",
+                            "the base joint A1 of leg 1, x along A1 A2 (the paper's frame): the base centroid is at "
+                            "x = H/2, y = H/(2 sqrt 3); position of the platform centroid G"),
         MechanismDefinition("delta", "Delta robot with reconfigurable base radius R (Hernandez Reyna & "
                                      "Sandoval-Castro 2018)", "pkm.mechanisms.delta", "delta", (0.06, 0.0, 0.0),
-                            "delta.closures.toml"),
+                            "delta.closures.toml", "the centre of the base, in the plane of the motor axes (the "
+                            "paper's frame 0), z up; position of the end-effector centre"),
         MechanismDefinition("prs3", "3-PRS (Diaz-Rodriguez et al. 2016: kinematics and inverse dynamics)",
-                            "pkm.mechanisms.prs3", "prs3", (0.06, 0.15, 0.0), "prs3.closures.toml"),
+                            "pkm.mechanisms.prs3", "prs3", (0.06, 0.15, 0.0), "prs3.closures.toml",
+                            "the base centre {O}, z along the sliders' axis of symmetry; height and tilts of the "
+                            "platform frame {p}"),
         MechanismDefinition("gough_stewart", "6-UPS Gough-Stewart platform (every assembly mode by homotopy "
                                              "continuation)", "pkm.mechanisms.gough_stewart", None, (0.03, 0.08, 0.0),
-                            "gough_stewart.closures.toml"),
+                            "gough_stewart.closures.toml", "the centre of the base anchors, z up; pose of the "
+                            "platform frame at the centre of its anchors"),
     )
 }
 

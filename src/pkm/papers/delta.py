@@ -183,7 +183,25 @@ def reproduce() -> list[Row]:
     ] + opcount_rows("delta", "delta.opcount.")
 
 
+K_BOUNDS = (2.5, 3.0, 4.0, 5.0)  # the bounds on K_2 whose conditioned volumes the R study draws
+
+
+@lru_cache(maxsize=1)
+def _choice_against_bound() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(bounds, chosen R [mm], at an end of the paper's range)`` for bounds 2.2..8 on K_2 (0.1 steps)."""
+    bounds = np.linspace(2.2, 8.0, 59)
+    chosen = np.array([choose_radius(b) * 1e3 for b in bounds])
+    return bounds, chosen, np.isclose(chosen, R_RANGE[0] * 1e3) | np.isclose(chosen, R_RANGE[1] * 1e3)
+
+
+#: Each figure and the CSV series that hold its numbers.
+SERIES = {"delta_fig5_K_vs_R": ("delta_fig5_K_vs_R",),
+          "delta_workspace_vs_R": ("delta_workspace_vs_R", "delta_choice_vs_bound")}
+
+
 def figures(out_dir) -> list[Path]:
+    """Fig. 5 (K against R, three conventions, both knee branches) and the workspace study behind sec. 6's
+    choice (volume against R for several bounds on K_2; the R chosen against the bound)."""
     out = []
     R, K = fig5_sweep("knee_out")
     R_in, K_in = fig5_sweep("knee_in")
@@ -214,7 +232,7 @@ def figures(out_dir) -> list[Path]:
     fig, axes = figure(ncols=2, size=(5.6, 4.0))
     ax1, ax2 = axes[0]
     ax1.plot(study.R * 1e3, study.volume * 1e3, "k", label="reachable (z < 0)")
-    for k_max in (2.5, 3.0, 4.0, 5.0):
+    for k_max in K_BOUNDS:
         ax1.plot(study.R * 1e3, study.conditioned_volume(k_max) * 1e3, label=rf"$K_2 \leq {k_max:g}$")
     ax1.axvspan(R_RANGE[0] * 1e3, R_RANGE[1] * 1e3, color="0.92", zorder=0, label="paper's range of R")
     ax1.axvline(choose_radius() * 1e3, color="C1", lw=0.8, ls="--", label=rf"our choice ($K_2 \leq {K_MAX:g}$)")
@@ -222,9 +240,7 @@ def figures(out_dir) -> list[Path]:
     ax1.set_xlabel("base radius R [mm]")
     ax1.set_ylabel("workspace volume [L]")
     ax1.legend(fontsize=7)
-    bounds = np.linspace(2.2, 8.0, 59)
-    chosen = np.array([choose_radius(b) * 1e3 for b in bounds])
-    at_end = np.isclose(chosen, R_RANGE[0] * 1e3) | np.isclose(chosen, R_RANGE[1] * 1e3)
+    bounds, chosen, at_end = _choice_against_bound()
     ax2.plot(bounds, chosen, "-", color="C0", lw=0.8, label="R of the largest volume")
     ax2.plot(bounds[~at_end], chosen[~at_end], ".", color="C0", label="inside the range: an optimum")
     ax2.plot(bounds[at_end], chosen[at_end], "o", mfc="none", color="C3", ms=4,
@@ -251,15 +267,23 @@ def series(out_dir) -> list[Path]:
         w.writerow(["R_mm"] + [f"K_{k}_knee_out" for k in KINDS] + [f"K_{k}_knee_in" for k in KINDS])
         for j in range(len(R)):
             w.writerow([f"{R[j] * 1e3:.1f}"] + [f"{K[k][j]:.10g}" for k in KINDS] + [f"{K_in[k][j]:.10g}" for k in KINDS])
-    study = _radius_sweep()  # (through pkm.sweep: the numbers of radius_study, tested equal)
+    sweep = _radius_sweep()  # (through pkm.sweep: the numbers of radius_study, tested equal)
+    study = radius_study()
     f2 = path / "delta_workspace_vs_R.csv"
     with f2.open("w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["R_mm", "volume_L", f"volume_K2_le_{K_MAX:g}_L", "integral_inv_K2_L"])
-        for R_j, v, c, g in zip(*(study.column(k) for k in ("R", "volume", "volume_K3", "weighted"))):
-            w.writerow([f"{R_j * 1e3:.1f}", f"{v * 1e3:.6g}", f"{c * 1e3:.6g}", f"{g * 1e3:.6g}"])
-    return [f1, f2]
+        w.writerow(["R_mm", "volume_L"] + [f"volume_K2_le_{b:g}_L" for b in K_BOUNDS] + ["integral_inv_K2_L"])
+        conditioned = [study.conditioned_volume(b) for b in K_BOUNDS]
+        for j, (R_j, v, g) in enumerate(zip(*(sweep.column(k) for k in ("R", "volume", "weighted")))):
+            w.writerow([f"{R_j * 1e3:.1f}", f"{v * 1e3:.6g}"] + [f"{c[j] * 1e3:.6g}" for c in conditioned]
+                       + [f"{g * 1e3:.6g}"])
+    f3 = path / "delta_choice_vs_bound.csv"
+    with f3.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["k_max", "chosen_R_mm", "at_range_end"])
+        w.writerows([f"{b:.1f}", f"{c:.1f}", int(e)] for b, c, e in zip(*_choice_against_bound()))
+    return [f1, f2, f3]
 
 
-__all__ = ["PAPER", "POSE", "TITLE", "arms_vertical_radius", "choose_radius", "fig5_sweep", "figures",
+__all__ = ["K_BOUNDS", "PAPER", "POSE", "SERIES", "TITLE", "arms_vertical_radius", "choose_radius", "fig5_sweep", "figures",
            "knee_in_singularity", "radius_study", "radius_sweep", "reach_limit", "reproduce", "series"]

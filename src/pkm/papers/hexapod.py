@@ -140,7 +140,13 @@ def _against_multistart(mech, modes) -> str:
 
 UNITS = {"w_rot": "[-]", "w_tras": "[m$^3$]"}  # w = sqrt(det(X X^T)) of the angular (1/1) or linear (m) rows
 NAMES = {"w_rot": "$w_{rot}$", "w_tras": "$w_{tras}$"}
-CAPTION = "Hexapod (the paper's design, two 3-RUS)"
+CAPTION = ("Hexapod of two 3-RUS, Table 1 design (R_f = 50, R_r = 150, R_2 = 450, H_o = 200, LA = 200, LB = 400, "
+           "h = 34, r = 50 mm)")
+PAPER = "0.5"  # grey: what the paper states, drawn beside our curves
+#: Each figure and the CSV series that hold its numbers.
+SERIES = {"hexapod_fig7_indices_vs_beta": ("hexapod_fig7_indices_vs_beta",),
+          "hexapod_fig9_manipulability_spiral": ("hexapod_spiral_profiles",),
+          "hexapod_fig10_beta_profiles": ("hexapod_spiral_profiles",)}
 
 
 def figures(out_dir) -> list[Path]:
@@ -155,10 +161,12 @@ def figures(out_dir) -> list[Path]:
         ax.axvline(t["choice"][idx].beta_deg, ls="--", c="k", lw=0.8,
                    label=rf"$\beta^*$ = {t['choice'][idx].beta_deg:.2f} deg")
         ax.axvline(math.degrees(t["spans"][0][0]), ls=":", c="r", lw=0.8, label="reachability limit")
+        ax.axvline(-11.0, ls="-.", c=PAPER, lw=1.0, label=r"paper: $\beta^*$ about -11 deg")
+        ax.axvline(-60.0, ls=(0, (1, 3)), c=PAPER, lw=1.5, label="paper: reachable from -60 deg")
         ax.set(xlabel=r"reconfiguration angle $\beta$ [deg]", ylabel=f"{NAMES[idx]} {UNITS[idx]}",
                title=f"{NAMES[idx]} against $\\beta$")
         ax.legend(fontsize=8)
-    fig.suptitle(f"{CAPTION} at pose T (paper's Fig. 7)", fontsize=10)
+    fig.suptitle(f"{CAPTION}\nat pose T (paper's Fig. 7)", fontsize=10)
     out.append(save(fig, out_dir, "hexapod_fig7_indices_vs_beta"))
     fig, axes = figure(ncols=2, nrows=2, size=(6.4, 3.4))
     k = np.arange(len(s["profiles"]["w_rot"].base_value))
@@ -174,20 +182,27 @@ def figures(out_dir) -> list[Path]:
         low.plot(k, 100.0 * (pr.pointwise_value / pr.base_value - 1.0), c="C1", label=r"pointwise $\beta^*$")
         low.plot(k, 100.0 * (pr.value / pr.base_value - 1.0), c="C2", ls="--", label="QP profile")
         low.axhline(0.0, c="C0", lw=0.8, label=r"base model ($\beta$ = 0)")
+        low.axvline(GAIN_FROM, c=PAPER, ls="-.", lw=1.0, label=f"paper: 'a clear gain from pose {GAIN_FROM} on'")
         low.set(xlabel="pose along the spiral, k [-]", ylabel="gain over the base model [%]",
                 title=f"what reconfiguring gains in {NAMES[idx]}")
         low.legend(fontsize=7)
-    fig.suptitle(f"{CAPTION} along the spiral of sec. 4 (paper's Fig. 9)", fontsize=10)
+    fig.suptitle(f"{CAPTION}\nalong the spiral of sec. 4 (paper's Fig. 9)", fontsize=10)
     out.append(save(fig, out_dir, "hexapod_fig9_manipulability_spiral"))
-    fig, ax = figure()
+    fig, axes = figure(ncols=2)
+    ax, gap = axes[0]
     for idx in hi.INDICES:
         pr = s["profiles"][idx]
         ax.plot(k, np.degrees(pr.pointwise), label=rf"$\beta^*$ of {NAMES[idx]}, pointwise")
         ax.plot(k, np.degrees(pr.beta), ls="--", label=f"QP profile of {NAMES[idx]} (2 deg/pose)")
-    ax.set(xlabel="pose along the spiral, k [-]", ylabel=r"$\beta$ [deg]",
-           title=f"{CAPTION}: reconfiguration angle along the spiral (paper's Fig. 10)")
-    ax.title.set_fontsize(9)
+    ax.set(xlabel="pose along the spiral, k [-]", ylabel=r"$\beta$ [deg]", title="reconfiguration angle")
     ax.legend(fontsize=8)
+    pr, pt = s["profiles"]["w_rot"], s["profiles"]["w_tras"]
+    gap.plot(k, np.degrees(np.abs(pr.pointwise - pt.pointwise)), label=r"ours, pointwise $\beta^*$")
+    gap.axhline(2.0, c=PAPER, ls="-.", label="paper: 'about two degrees at most'")
+    gap.set(xlabel="pose along the spiral, k [-]", ylabel=r"$|\beta^*_{rot} - \beta^*_{tras}|$ [deg]",
+            title=r"how far the two indices' $\beta^*$ lie apart", ylim=(0.0, None))
+    gap.legend(fontsize=8)
+    fig.suptitle(f"{CAPTION}\nalong the spiral of sec. 4 (paper's Fig. 10)", fontsize=10)
     out.append(save(fig, out_dir, "hexapod_fig10_beta_profiles"))
     return out
 
@@ -222,5 +237,5 @@ def series(out_dir) -> list[Path]:
     return [f1, f2]
 
 
-__all__ = ["POSE_T_POSITION", "POSE_T_ROTATION", "TITLE", "figures", "pose_T_placement", "pose_t", "reproduce", "series", "spiral",
+__all__ = ["POSE_T_POSITION", "POSE_T_ROTATION", "SERIES", "TITLE", "figures", "pose_T_placement", "pose_t", "reproduce", "series", "spiral",
            "spiral_poses"]

@@ -129,30 +129,52 @@ def series(out_dir) -> list[Path]:
     return paths
 
 
+#: Each figure and the CSV series that hold its numbers.
+SERIES = {"prs3_fig3_power_case2": ("prs3_case2",), "prs3_fig4_power_case3": ("prs3_case3",),
+          "prs3_forces": ("prs3_case1", "prs3_case2", "prs3_case3", "prs3_case4")}
+
+
+def _design() -> str:
+    p = Prs3Params()
+    return (f"3-PRS of Table 2 (l = {p.l:g} m, h = {p.h:g} m, g = {p.g:g} m, m_p = {p.m_platform:g} kg, "
+            "P-actuated)")
+
+
+def _legs(ax, t, values, symbol: str) -> None:
+    """One curve per leg, labelled ``symbol_i``; a leg whose curve lies on an earlier one (1e-9 of the range) says
+    so in its label, since the eye cannot tell them apart."""
+    scale = max(float(np.ptp(values)), float(np.abs(values).max()), 1e-300)
+    for i in range(3):
+        same = [j for j in range(i) if np.abs(values[:, i] - values[:, j]).max() <= 1e-9 * scale]
+        label = f"${symbol}_{i + 1}$" + (f" (= ${symbol}_{same[0] + 1}$)" if same else "")
+        ax.plot(t, values[:, i], label=label, linestyle=("-", "--", ":")[i])
+
+
 def figures(out_dir) -> list[Path]:
-    """Figs. 3 and 4 (actuator powers, cases 2 and 3), and the forces of every case."""
+    """Figs. 3 and 4 (actuator powers, cases 2 and 3), and the forces of every case (no figure in the paper)."""
     paths = []
-    for case, fig_name in (("2", "prs3_fig3_power_case2"), ("3", "prs3_fig4_power_case3")):
+    for case, number in (("2", 3), ("3", 4)):
         t, _, r = simulate(case)
         fig, ax = figure()
-        for i in range(3):
-            ax.plot(t, r.power[:, i], label=f"P{i + 1}", linestyle=("-", "--", ":")[i])
-        ax.set(xlabel="t [s]", ylabel="power [W]",
-               title=f"3-PRS, case {case}: actuator powers (paper Fig. {3 if case == '2' else 4})")
+        _legs(ax, t, r.power, "P")
+        ax.set(xlabel="t [s]", ylabel="actuator power [W]",
+               title=f"{_design()}\ncase {case}, {motions()[case].description}: actuator powers (paper's Fig. {number})")
+        ax.title.set_fontsize(9)
         ax.grid(True, alpha=0.3)
         ax.legend()
-        paths.append(save(fig, out_dir, fig_name))
+        paths.append(save(fig, out_dir, f"prs3_fig{number}_power_case{case}"))
     fig, axes = figure(ncols=2, nrows=2)
     for ax, case in zip(axes.ravel(), sorted(motions())):
         t, _, r = simulate(case)
-        for i in range(3):
-            ax.plot(t, r.tau[:, i], label=f"F{i + 1}", linestyle=("-", "--", ":")[i])
+        _legs(ax, t, r.tau, "F")
         ax.set(xlabel="t [s]", ylabel="slider force [N]", title=f"case {case}: {motions()[case].description}")
         ax.grid(True, alpha=0.3)
         ax.legend()
+    fig.suptitle(f"{_design()}: slider forces of the four motion cases of sec. 5 (no figure in the paper, which "
+                 "prints no force)", fontsize=10)
     paths.append(save(fig, out_dir, "prs3_forces"))
     return paths
 
 
-__all__ = ["FORCE_TIMES", "PUBLISHED_COUNTS", "TITLE", "counts", "figures", "motions", "reproduce", "series",
+__all__ = ["FORCE_TIMES", "PUBLISHED_COUNTS", "SERIES", "TITLE", "counts", "figures", "motions", "reproduce", "series",
            "simulate"]

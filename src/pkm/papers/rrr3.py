@@ -290,32 +290,29 @@ def figures(out_dir) -> list[Path]:
     platform centroid G from the base centroid, in cm, in every figure."""
     out = []
     base = rrr3.Rrr3Params()
-    centre = maps.Design.of(base).base_centroid
     fig, axes = figure(ncols=2, size=(5.5, 4.8))
     axes = axes.ravel()
-    fine = maps.Grid.square(centre, maps.AREA_SIDE * 3.0, 0.0025)  # (2.5 mm: smooth contours)
-    extent = np.zeros(4)
-    for k, deg in enumerate((0, 30, 60, 90)):
-        ws = maps.workspace(base, math.radians(deg), fine)
-        xs, ys = (ws.grid.xs - centre[0]) / CM, (ws.grid.ys - centre[1]) / CM
-        axes[0].contour(xs, ys, ws.reachable.astype(float), levels=[0.5], colors=f"C{k}")
-        axes[0].plot([], [], f"C{k}", label=rf"$\Phi$ = {deg} deg: {ws.area * 1e4:.0f} cm$^2$")
-        yy, xx = np.nonzero(ws.reachable)
-        if k == 0 and len(xx):
-            extent = np.array([xs[xx.min()], xs[xx.max()], ys[yy.min()], ys[yy.max()]])
-    pad = 0.1 * max(extent[1] - extent[0], extent[3] - extent[2])
-    axes[0].set(xlim=(extent[0] - pad, extent[1] + pad), ylim=(extent[2] - pad, extent[3] + pad), aspect="equal",
+    every = np.concatenate([seg for _, _, segments in _fig3_boundaries() for seg in segments])
+    for k, (deg, area_cm2, segments) in enumerate(_fig3_boundaries()):
+        line = np.concatenate([np.vstack([seg, [np.nan, np.nan]]) for seg in segments])  # (one line per Phi)
+        axes[0].plot(line[:, 0], line[:, 1], f"C{k}", label=rf"$\Phi$ = {deg} deg: {area_cm2:.0f} cm$^2$")
+    lo, hi = every.min(axis=0), every.max(axis=0)
+    pad = 0.1 * float(np.max(hi - lo))
+    axes[0].set(xlim=(lo[0] - pad, hi[0] + pad), ylim=(lo[1] - pad, hi[1] + pad), aspect="equal",
                 xlabel=r"$x_G$ from the base centroid [cm]", ylabel=r"$y_G$ from the base centroid [cm]",
-                title=r"workspace of G at fixed $\Phi$")
+                title=r"workspace of G at fixed $\Phi$ (boundaries)")
     axes[0].title.set_fontsize(9)
     axes[0].legend(fontsize=7)
     sw = _fig3_sweep()
-    axes[1].plot(np.degrees(sw.phis), sw.areas * 1e4, label=f"{sw.nodes:,} nodes (101 x 101 x 361)")
+    n_xy, n_phi = FIG3_SWEEP
+    axes[1].plot(np.degrees(sw.phis), sw.areas * 1e4,
+                 label=f"{sw.nodes:,} nodes ({n_xy} x {n_xy} x {n_phi}; the paper's count: 3,682,561)")
     axes[1].set(xlabel=r"platform orientation $\Phi$ [deg]", ylabel="workspace area [cm$^2$]",
                 title=r"workspace area against $\Phi$")
     axes[1].title.set_fontsize(9)
     axes[1].legend(fontsize=7)
-    fig.suptitle(f"3-RRR, {_dims(base)} (the paper's reference design): its Fig. 3", fontsize=9)
+    fig.suptitle(f"3-RRR, {_dims(base)} (the paper's reference design): the workspace against the orientation "
+                 "(paper's Fig. 3)", fontsize=9)
     out.append(save(fig, out_dir, "rrr3_fig3_workspace"))
     for name in ("fig5", "fig6", "fig7", "fig9"):
         m = figure_map(name)
@@ -342,9 +339,15 @@ def figures(out_dir) -> list[Path]:
     Hs, overall, area = _similarity()
     ax.plot(Hs / CM, overall, "o-", label="GCI, whole workspace (grid scaled with H)")
     ax.plot(Hs / CM, area, "s-", label="GCI, fixed 30 x 30 cm area")
+    on_law = [(figure_design(n).H, PUBLISHED[n]) for n in ("fig7", "fig9")]
+    ax.plot([H / CM for H, _ in on_law], [g for _, (g, _) in on_law], "kx", ms=8,
+            label="paper, Figs. 7 and 9: GCI")
+    ax.plot([H / CM for H, _ in on_law], [g for _, (_, g) in on_law], "k+", ms=10,
+            label="paper, Figs. 7 and 9: area GCI")
     ax.set_xlabel("base side H [cm] (h = H/10, a = b = 0.4 H)")
     ax.set_ylabel("GCI [-]")
-    ax.set_title("3-RRR similarity law: the GCI does not depend on the scale, the area GCI does", fontsize=9)
+    ax.set_title("3-RRR similarity law (sec. IX): the GCI does not depend on the scale, the area GCI does\n"
+                 "(no figure in the paper; its Figs. 7 and 9 are two designs of the law)", fontsize=9)
     ax.legend(fontsize=8)
     out.append(save(fig, out_dir, "rrr3_similarity_law"))
     res = design_sweep()
@@ -358,21 +361,54 @@ def figures(out_dir) -> list[Path]:
         d = res.designs[law]
         ax.scatter([res.gci[law]], [res.area_gci[law]], marker="*", s=80, c="r",
                    label=f"best area GCI: a = {d.a / CM:.0f}, b = {d.b / CM:.0f}, h = {d.h / CM:.0f} cm")
+    H = res.designs[0].H
+    law_at = [k for k, d in enumerate(res.designs)
+              if np.allclose([d.a, d.b, d.h], [0.4 * H, 0.4 * H, 0.1 * H], rtol=1e-9)]
+    if law_at:
+        ax.scatter([res.gci[law_at[0]]], [res.area_gci[law_at[0]]], marker="D", s=40, facecolors="none",
+                   edgecolors="k", label="the paper's law (a = b = 0.4 H, h = 0.1 H)")
     ax.set_xlabel("GCI over the whole workspace [-]")
     ax.set_ylabel("GCI over the 30 x 30 cm area [-]")
-    ax.set_title(f"3-RRR: {len(res.designs)} designs with H = {res.designs[0].H / CM:.0f} cm (the paper's sec. VII "
-                 "sweep, through pkm.sweep)", fontsize=9)
+    ax.set_title(f"3-RRR: {len(res.designs)} designs with H = {H / CM:.0f} cm (the paper's sec. VII sweep,\n"
+                 "no figure in the paper; through pkm.sweep)", fontsize=9)
     ax.legend(fontsize=8)
     out.append(save(fig, out_dir, "rrr3_design_sweep"))
     return out
 
 
+FIG3_PHIS_DEG = (0, 30, 60, 90)  # the orientations whose workspace boundaries Fig. 3's left panel draws
+FIG3_SWEEP = (101, 361)  # positions per side of [0, H]^2, orientations over [-180, 180] deg: the paper's 3,682,561
+FIG3_STEP = 0.0025  # m: the grid on which the boundaries are traced (a continuous margin: no stair steps)
+
+
+@functools.cache
+def _fig3_boundaries() -> tuple[tuple[int, float, tuple[np.ndarray, ...]], ...]:
+    """Per orientation of :data:`FIG3_PHIS_DEG`: ``(deg, area [cm^2], boundary polylines)``, each polyline ``(n, 2)``
+    positions of G from the base centroid [cm]: the zero contour of
+    :func:`pkm.mechanisms.rrr3.workspace.reach_margin`; the area is that of the reachable nodes."""
+    from matplotlib.figure import Figure
+
+    base = rrr3.Rrr3Params()
+    centre = maps.Design.of(base).base_centroid
+    fine = maps.Grid.square(centre, maps.AREA_SIDE * 3.0, FIG3_STEP)
+    xs, ys = (fine.xs - centre[0]) / CM, (fine.ys - centre[1]) / CM
+    ax = Figure().subplots()  # (a throwaway axes: matplotlib's contour tracer)
+    out = []
+    for deg in FIG3_PHIS_DEG:
+        phi = math.radians(deg)
+        margin = maps.reach_margin(base, fine.xs[None, :], fine.ys[:, None], phi)
+        segments = ax.contour(xs, ys, margin, levels=[0.0]).allsegs[0]
+        out.append((deg, maps.workspace(base, phi, fine).area * 1e4, tuple(np.asarray(g) for g in segments)))
+    return tuple(out)
+
+
 @functools.cache
 def _fig3_sweep() -> maps.OrientationSweep:
-    """The paper's Fig. 3 count: 101 x 101 positions over [0, H]^2 times 361 orientations (1 deg)."""
+    """The paper's Fig. 3 count: 101 x 101 positions over [0, H]^2 times 361 orientations (1 deg): :data:`FIG3_SWEEP`."""
     p = rrr3.Rrr3Params()
-    xs = np.linspace(0.0, p.H, 101)
-    return maps.orientation_sweep(p, xs, xs, np.radians(np.arange(-180, 181)))
+    n_xy, n_phi = FIG3_SWEEP
+    xs = np.linspace(0.0, p.H, n_xy)
+    return maps.orientation_sweep(p, xs, xs, np.radians(np.linspace(-180.0, 180.0, n_phi)))
 
 
 @functools.cache
@@ -408,9 +444,18 @@ def design_sweep(step: float = 0.01, scheduler: str | None = None) -> maps.Sweep
                             np.ma.masked_invalid(least))
 
 
+#: Each figure and the CSV series that hold its numbers.
+SERIES = {"rrr3_fig3_workspace": ("rrr3_fig3_boundaries", "rrr3_fig3_area_vs_phi"),
+          **{f"rrr3_{n}_ci_map": (f"rrr3_{n}_ci_map",) for n in ("fig5", "fig6", "fig7", "fig9")},
+          "rrr3_fig8_modes": ("rrr3_fig8_modes_ci_maps", "rrr3_modes"),
+          "rrr3_similarity_law": ("rrr3_similarity_law",),
+          "rrr3_design_sweep": ("rrr3_design_sweep",)}
+
+
 def series(out_dir) -> list[Path]:
-    """CSV: the Fig. 7 candidate search, the working-mode study, the CI maps of Figs. 5-7, 9, Fig. 3's area against
-    Phi, the similarity law and the 1,000-design sweep: the numbers behind every figure."""
+    """CSV: the Fig. 7 candidate search, the working-mode study and its eight maps, the CI maps of Figs. 5-7, 9,
+    Fig. 3's boundaries and area against Phi, the similarity law and the 1,000-design sweep: the numbers behind every
+    figure (:data:`SERIES`)."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     paths = []
@@ -435,6 +480,22 @@ def series(out_dir) -> list[Path]:
         np.savetxt(path, np.column_stack([X[keep], Y[keep], m.ci[keep]]), fmt=["%.1f", "%.1f", "%.6g"],
                    delimiter=",", header="x_G_cm,y_G_cm,ci", comments="")
         paths.append(path)
+    path = out_dir / "rrr3_fig8_modes_ci_maps.csv"  # the eight maps share one workspace: one column per mode
+    maps8 = [figure_map("fig9", mode) for mode, *_ in mode_study()]
+    grid8, keep = maps8[0].grid, maps8[0].reachable
+    X, Y = np.meshgrid((grid8.xs - grid8.centre[0]) / CM, (grid8.ys - grid8.centre[1]) / CM)
+    np.savetxt(path, np.column_stack([X[keep], Y[keep]] + [m.ci[keep] for m in maps8]),
+               fmt=["%.1f", "%.1f"] + ["%.5g"] * len(maps8), delimiter=",", comments="",
+               header="x_G_cm,y_G_cm," + ",".join(f"ci_mode{mode}" for mode, *_ in mode_study()))
+    paths.append(path)
+    path = out_dir / "rrr3_fig3_boundaries.csv"
+    with path.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["phi_deg", "area_cm2", "polyline", "x_G_cm", "y_G_cm"])
+        for deg, area_cm2, segments in _fig3_boundaries():
+            for j, seg in enumerate(segments):
+                w.writerows([deg, f"{area_cm2:.6g}", j, f"{x:.4f}", f"{y:.4f}"] for x, y in seg)
+    paths.append(path)
     sw = _fig3_sweep()
     path = out_dir / "rrr3_fig3_area_vs_phi.csv"
     np.savetxt(path, np.column_stack([np.degrees(sw.phis), sw.areas * 1e4]), fmt=["%.1f", "%.6g"], delimiter=",",
@@ -449,15 +510,15 @@ def series(out_dir) -> list[Path]:
     path = out_dir / "rrr3_design_sweep.csv"
     with path.open("w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["a_m", "b_m", "h_m", "H_m", "gci", "gci_area", "area_coverage", "min_area_ci"])
+        w.writerow(["a_cm", "b_cm", "h_cm", "H_cm", "gci", "gci_area", "area_coverage", "min_area_ci"])
         for k, d in enumerate(res.designs):  # empty workspace or area: blank cells, not NaN
-            w.writerow([d.a, d.b, d.h, d.H] + ["" if v is np.ma.masked else float(v)
+            w.writerow([f"{v / CM:.6g}" for v in (d.a, d.b, d.h, d.H)] + ["" if v is np.ma.masked else float(v)
                                                 for v in (res.gci[k], res.area_gci[k])]
                        + [res.coverage[k], "" if res.min_area_ci[k] is np.ma.masked else float(res.min_area_ci[k])])
     paths.append(path)
     return paths
 
 
-__all__ = ["CAPTIONS", "PUBLISHED", "TITLE", "design_sweep", "fig7_candidates", "fig7_design", "fig7_search",
+__all__ = ["CAPTIONS", "PUBLISHED", "SERIES", "TITLE", "design_sweep", "fig7_candidates", "fig7_design", "fig7_search",
            "figure_design", "figure_map", "figures", "grid_sensitivity", "mode_study", "reproduce", "series",
            "suitable_modes"]

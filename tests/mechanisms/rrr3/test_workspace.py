@@ -131,6 +131,21 @@ def test_workspace_matches_the_closed_form_reach_and_orientation_sweep():
     assert sw.areas[0] > sw.areas[1]  # largest at Phi = 0 (sec. III)
 
 
+def test_reach_margin_is_positive_exactly_on_the_workspace_and_zero_where_a_leg_stretches():
+    """The continuous margin drawn as Fig. 3's boundary: > 0 on reachable nodes, < 0 elsewhere (nodes within 1e-9 m of
+    the boundary aside), and 0 where a leg is stretched (the platform vertex at a + b from its base vertex)."""
+    P = rrr3.Rrr3Params()
+    ws = maps.workspace(P, 0.3)
+    margin = maps.reach_margin(P, ws.grid.xs[None, :], ws.grid.ys[:, None], 0.3)
+    clear = np.abs(margin) > 1e-9
+    assert np.array_equal((margin > 0)[clear], ws.reachable[clear])
+    # G such that vertex 1 (at angle phi + _VERTEX_ANGLES[0] from G) lies a + b from the base vertex A1 = (0, 0)
+    rc, ang = P.h / math.sqrt(3.0), 0.3 + maps._VERTEX_ANGLES[0]
+    v = (P.a + P.b) * np.array([math.cos(math.pi / 6), math.sin(math.pi / 6)])  # (towards the base centroid)
+    G = v - rc * np.array([math.cos(ang), math.sin(ang)])
+    assert maps.reach_margin(P, G[0], G[1], 0.3) == pytest.approx(0.0, abs=1e-12)
+
+
 def test_direct_singularity_crossings_separate_the_working_modes():
     """On Fig. 9's design no det J_x sign change lies inside the workspace in mode 1; mode 2 has a singularity curve."""
     d = Design.similarity_law(2.0)

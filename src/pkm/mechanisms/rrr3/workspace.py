@@ -210,22 +210,41 @@ def _legs(d: Design, gx: np.ndarray, gy: np.ndarray, phi, signs):
     ``phi`` broadcasts against ``gx``. Same conventions as :func:`pkm.mechanisms.rrr3.inverse_kinematics`:
     ``psi_i`` has the sign of the working mode.
     """
-    base = np.array([[0.0, 0.0], [d.H, 0.0], [d.H / 2.0, d.H * rrr3.SQRT3 / 2.0]])
-    rc = d.h / rrr3.SQRT3
     reach = np.ones(np.broadcast_shapes(np.shape(gx), np.shape(gy), np.shape(phi)), dtype=bool)
     out = []
-    cphi, sphi = rc * np.cos(phi), rc * np.sin(phi)
-    for i, ang in enumerate(_VERTEX_ANGLES):
-        ca, sa = math.cos(ang), math.sin(ang)
-        vx = gx + (cphi * ca - sphi * sa)  # G + rc (cos(phi + ang), sin(phi + ang))
-        vy = gy + (sphi * ca + cphi * sa)
-        tx, ty = vx - base[i, 0], vy - base[i, 1]
+    for i, vx, vy, tx, ty in _vertices(d, gx, gy, phi):
         Dx, Dy, _, reach_i = rrr3.leg_elbows(d.a, d.b, tx, ty, signs[i])
         reach &= reach_i
         ux, uy = (tx - Dx) / d.b, (ty - Dy) / d.b
         s = Dx * uy - Dy * ux  # (D - O) x u = a sin psi
         out.append((vx, vy, ux, uy, s))
     return reach, out
+
+
+def _vertices(d: Design, gx, gy, phi):
+    """Per leg ``(i, vx, vy, tx, ty)``: the platform vertex, and relative to the leg's base vertex [m]."""
+    base = np.array([[0.0, 0.0], [d.H, 0.0], [d.H / 2.0, d.H * rrr3.SQRT3 / 2.0]])
+    rc = d.h / rrr3.SQRT3
+    cphi, sphi = rc * np.cos(phi), rc * np.sin(phi)
+    for i, ang in enumerate(_VERTEX_ANGLES):
+        ca, sa = math.cos(ang), math.sin(ang)
+        vx = gx + (cphi * ca - sphi * sa)  # G + rc (cos(phi + ang), sin(phi + ang))
+        vy = gy + (sphi * ca + cphi * sa)
+        yield i, vx, vy, vx - base[i, 0], vy - base[i, 1]
+
+
+def reach_margin(design, gx, gy, phi: float = 0.0) -> np.ndarray:
+    """How far inside the workspace the centroid ``(gx, gy)`` lies at orientation ``phi`` [m]: the least, over the
+    legs, distance of ``|platform vertex - base vertex|`` to the ends of ``[|a - b|, a + b]``; positive inside,
+    negative outside, 0 on the boundary (a leg stretched or folded). Continuous, so its zero contour draws the
+    boundary without a grid's stair steps."""
+    d = Design.of(design)
+    lo, hi = abs(d.a - d.b), d.a + d.b
+    margin = np.full(np.broadcast_shapes(np.shape(gx), np.shape(gy)), np.inf)
+    for _, _, _, tx, ty in _vertices(d, np.asarray(gx, float), np.asarray(gy, float), phi):
+        dist = np.hypot(tx, ty)
+        margin = np.minimum(margin, np.minimum(dist - lo, hi - dist))
+    return margin
 
 
 def _moment_point(d: Design, gx, gy, phi, reference: str):
@@ -656,6 +675,7 @@ __all__ = [
     "inverse_jacobian_stack",
     "naive_condition_index",
     "orientation_sweep",
+    "reach_margin",
     "sweep",
     "workspace",
     "workspace_grid",
