@@ -62,7 +62,8 @@ def test_report_md_has_one_table_row_per_row_and_flags_mismatches(hexapod_report
 
 
 def test_figures_are_real_pngs_linked_from_the_report(hexapod_report):
-    """Every figure lands under figures/hexapod/, is a PNG of more than 10 kB, and report.md links it."""
+    """Every figure lands under figures/hexapod/, is a PNG of more than 10 kB, and report.md links it, with the CSV
+    series of its numbers linked just below it."""
     out, figs = hexapod_report.out_dir, hexapod_report.papers[0].figures
     assert len(figs) >= 3
     md = hexapod_report.markdown.read_text()
@@ -72,6 +73,9 @@ def test_figures_are_real_pngs_linked_from_the_report(hexapod_report):
         assert f.read_bytes()[:8] == PNG and f.stat().st_size > 10_000
         rel = f.relative_to(out).as_posix()
         assert f"]({rel})" in md and rel in listed
+        below = md[md.index(f"]({rel})"):].split("\n\n", 2)[1]
+        assert below.startswith("Its numbers: ") and all(f"series/hexapod/{n}.csv" in below
+                                                          for n in hexapod_study.SERIES[f.stem])
 
 
 def test_series_are_csv_files_that_parse(tmp_path):

@@ -299,8 +299,14 @@ def format_markdown(report: Report) -> str:
         lines.append("")
         if p.figures:
             lines += ["Figures:", ""]
+            behind = getattr(_papers.module(p.name), "SERIES", {})
+            written = {f.stem: f for f in p.series}
             for f in p.figures:
                 lines += [f"![{f.stem}]({_rel(f, report.out_dir)})", ""]
+                numbers = [written[n] for n in behind.get(f.stem, ()) if n in written]
+                if numbers:
+                    lines += ["Its numbers: " + ", ".join(f"[{c.name}]({_rel(c, report.out_dir)})" for c in numbers),
+                              ""]
         if p.series:
             lines += ["Series (CSV): " + ", ".join(f"[{f.name}]({_rel(f, report.out_dir)})" for f in p.series), ""]
     return "\n".join(lines)

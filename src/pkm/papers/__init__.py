@@ -6,7 +6,9 @@ registered mechanisms, :data:`pkm.mechanisms.REGISTRY`) provides
 * ``TITLE``: the paper, in one line;
 * ``reproduce() -> list[Row]``: the published numbers next to ours;
 * ``figures(out_dir) -> list[pathlib.Path]``: the paper's figures redrawn (PNG);
-* ``series(out_dir) -> list[pathlib.Path]``: time series or maps as CSV, or ``series = None``.
+* ``series(out_dir) -> list[pathlib.Path]``: time series or maps as CSV, or ``series = None``;
+* ``SERIES``: each figure's file stem -> the stems of the CSV series that hold its numbers (the report links them
+  under each figure; the tests check that every figure drawn has its numbers written).
 
 Row ids are a contract (issues name them): keep them stable. ``pkm report`` gathers
 the rows of every paper into ``summary.json`` and a table.
