@@ -347,10 +347,8 @@ def cmd_list(args) -> int:
 
 def _fmt_value(v: float, unit: str) -> str:
     """A task value for the eye, in the unit a user would type: cm or deg (``pkm ik --pose`` takes them back)."""
-    v += 0.0  # (no "-0")
-    if unit == "m":
-        return f"{v * 100 + 0.0:.4g}cm"
-    return f"{math.degrees(v) + 0.0:.4g}deg" if unit == "rad" else f"{v:.4g}"
+    x, suffix = (v * 100.0, "cm") if unit == "m" else (math.degrees(v), "deg") if unit == "rad" else (v, "")
+    return f"{round(x, 6) + 0.0:.4g}{suffix}"  # (rounded, + 0.0: no "-0" nor "1e-15")
 
 
 def _fmt_default(v: Any) -> str:

@@ -256,7 +256,11 @@ class Scene:
             y = (np.abs(rel @ up) + pad) / depth
             return bool(max(x.max(), y.max()) <= tan)
 
-        lo, hi = 0.0, radius / math.sin(math.atan(tan / _ASPECT)) + radius  # (the bounding sphere always fits at hi)
+        lo, hi = 0.0, radius / math.sin(math.atan(tan / _ASPECT)) + radius  # (about where the bounding sphere fits)
+        for _ in range(60):
+            if fits(hi):
+                break
+            lo, hi = hi, 2.0 * hi
         for _ in range(40):
             mid = 0.5 * (lo + hi)
             lo, hi = (lo, mid) if fits(mid) else (mid, hi)

@@ -76,6 +76,9 @@ def test_the_sweep_has_the_papers_1000_designs():
     assert len(designs) == 1000 and len(set(designs)) == 1000
 
 
+PAPER_SWEEP = study.paper_sweep_designs
+
+
 @pytest.fixture
 def coarse(monkeypatch):
     """The study's figures at coarse sizes (a 2 cm map grid, 27 designs on the serial scheduler, a 21 x 21 x 37 Fig. 3
@@ -94,9 +97,6 @@ def coarse(monkeypatch):
     yield
     for f in cached:
         f.cache_clear()
-
-
-PAPER_SWEEP = study.paper_sweep_designs
 
 
 def test_figures_pass_the_check_and_the_series_hold_their_numbers(coarse, tmp_path):

@@ -38,11 +38,12 @@ def problems(fig, *, paper: bool = True) -> list[str]:
     """What keeps ``fig`` from being published as it is, one line each (empty: none).
 
     The figure has a caption line (its suptitle, or the title of its only axes) that, for a ``paper`` study's
-    figure, names the paper's figure (``Fig. N``) or says that the paper has none (``no figure``); every axes that shows data has x and y labels
-    with a unit in brackets (``[-]`` for a pure number); every line and scatter drawn carries a label that a
-    legend of the figure shows (one legend may serve several panels; an axes with a single one may go without);
-    every image or filled contour has a colour bar; no title, label or legend text runs past the figure's edge
-    (judged as the figure stands: check it after its layout, as it is saved).
+    figure, names the paper's figure (``Fig. N``) or says that the paper has none (``no figure``); every axes
+    that shows data has x and y labels with a unit in brackets (``[-]`` for a pure number); every line and
+    scatter drawn carries a label that a legend of the figure shows (one legend may serve several panels; an axes
+    with a single one may go without); every image, mesh or filled contour has a colour bar; no title, label or
+    legend text runs past the figure's edge (judged as the figure stands: check it after its layout, as it is
+    saved).
     """
     import matplotlib.collections as mcoll
     import matplotlib.contour as mcontour
