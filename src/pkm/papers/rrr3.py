@@ -318,7 +318,8 @@ def figures(out_dir) -> list[Path]:
         m = figure_map(name)
         p_all, p_area = PUBLISHED[name]
         fig, ax = figure(size=(6.2, 5.0))
-        im = _draw_map(ax, m, f"paper's {FIGURE_NUMBERS[name]}: {_dims(m.design)}, mode 1, $\\Phi$ = 0\nGCI "
+        found = "\n(dimensions found by fig7_search: the caption repeats Fig. 6's)" if name == "fig7" else ""
+        im = _draw_map(ax, m, f"paper's {FIGURE_NUMBERS[name]}: {_dims(m.design)}, mode 1, $\\Phi$ = 0{found}\nGCI "
                               f"{m.gci().value:.4f} (paper {p_all}), area GCI {m.area_gci().value:.4f} (paper {p_area})")
         fig.colorbar(im, ax=ax, label=CI_LABEL)
         out.append(save(fig, out_dir, f"rrr3_{name}_ci_map"))
