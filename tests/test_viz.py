@@ -243,7 +243,8 @@ def test_each_leg_has_one_colour_of_its_own_and_the_legend_lists_every_colour_dr
     assert set(mech.actuated_names) - {scene.platform_joint} <= named  # (a leg without links is not drawn)
     listed = {c for _, cs in scene.legend() for c in cs}
     assert {b.color for b in scene.bodies} <= listed
-    assert [f"leg {leg}" for leg in legs] == [label for label, _ in scene.legend() if label.startswith("leg ")]
+    assert [leg if leg.startswith("leg") else f"leg {leg}" for leg in legs] == \
+        [label for label, (c, *_) in scene.legend() if c in viz.LEG_COLORS]
     page = viz.snapshot_html(mech)
     assert 'id="pkm-legend"' in page and all(f"#{c:06x}" in page for c in listed)
     assert 'id="pkm-legend"' not in viz.snapshot_html(mech, legend=False)

@@ -166,7 +166,7 @@ def test_the_hexapods_legs_show_in_their_colours_and_the_legend_in_the_corner(tm
     mech = pkm.load("hexapod")
     bare = screenshot(viz.snapshot_html(mech, legend=False), tmp_path)
     shown = screenshot(viz.snapshot_html(mech), tmp_path)
-    legs = [colors[0] for label, colors in viz.Scene.from_mechanism(mech).legend() if label.startswith("leg ")]
+    legs = [c for _, (c, *_) in viz.Scene.from_mechanism(mech).legend() if c in viz.LEG_COLORS]
     assert len(legs) == 6
     for color in legs:
         assert colour_mask(bare, color).sum() > 150, f"#{color:06x}"

@@ -291,7 +291,7 @@ class Scene:
         if "closure" in roles:
             out.append(("loop closure (dot centred in its bubble: closed)", CLOSURE_COLOR))
         legs = dict.fromkeys((b.leg, b.color) for b in self.bodies if b.role == "link" and b.leg is not None)
-        out += [(f"leg {name}", color) for name, color in legs]
+        out += [(name if name.lower().startswith("leg") else f"leg {name}", color) for name, color in legs]
         if any(b.role == "link" and b.leg is None for b in self.bodies):
             out.append(("link of the platform", LINK_COLOR))
         if "triad" in roles:
