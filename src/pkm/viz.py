@@ -239,8 +239,9 @@ class Scene:
         """Distance [m] from the centre of :meth:`bounds` along unit ``direction`` at which the camera frames the
         mechanism over configurations ``qs``: every joint and frame origin, padded by a joint radius, within
         ``_FILL`` of the half field of view (vertical 75 deg; horizontal of a 4:3 window)."""
-        centre, radius = self.bounds(qs)
-        pts = np.concatenate([np.array([m[:3, 3] for m in self.frame_placements(q)]) for q in qs]) - centre
+        origins = self._origins(qs)
+        centre, radius = self._sphere(origins)
+        pts = origins - centre
         f = -np.asarray(direction, float)
         right = np.cross(f, [0.0, 0.0, 1.0])
         right /= np.linalg.norm(right)
@@ -271,7 +272,13 @@ class Scene:
 
         The sphere bounds the box of every joint and frame origin over ``qs``, padded by a joint radius.
         """
-        pts = np.concatenate([np.array([m[:3, 3] for m in self.frame_placements(q)]) for q in qs])
+        return self._sphere(self._origins(qs))
+
+    def _origins(self, qs) -> np.ndarray:
+        """Every frame origin (world, m) at every configuration of ``qs``, stacked."""
+        return np.concatenate([np.array([m[:3, 3] for m in self.frame_placements(q)]) for q in qs])
+
+    def _sphere(self, pts: np.ndarray) -> tuple[np.ndarray, float]:
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         radius = 0.5 * float(np.linalg.norm(hi - lo)) + _JOINT_RADIUS * self.length
         return 0.5 * (lo + hi), max(radius, 0.05 * self.length)
