@@ -93,11 +93,6 @@ def radius_study() -> design.RadiusStudy:
     return design.workspace_vs_radius(PAPER, R_STUDY, kind=CHOICE_KIND, spacing=SPACING)
 
 
-@lru_cache(maxsize=1)
-def _radius_sweep():
-    return radius_sweep()
-
-
 def radius_sweep(R_values=R_STUDY, scheduler: str | None = None):
     """The study of R through :func:`pkm.sweep`: for each base radius (the other dimensions the paper's), the
     reachable volume, the volume where ``K_2 <= 3``, the integral of ``1/K_2`` (8 mm grid) and ``K_2``, ``K_F`` at
@@ -267,16 +262,14 @@ def series(out_dir) -> list[Path]:
         w.writerow(["R_mm"] + [f"K_{k}_knee_out" for k in KINDS] + [f"K_{k}_knee_in" for k in KINDS])
         for j in range(len(R)):
             w.writerow([f"{R[j] * 1e3:.1f}"] + [f"{K[k][j]:.10g}" for k in KINDS] + [f"{K_in[k][j]:.10g}" for k in KINDS])
-    sweep = _radius_sweep()  # (through pkm.sweep: the numbers of radius_study, tested equal)
-    study = radius_study()
+    study = radius_study()  # (the figure's numbers; radius_sweep gives the same through pkm.sweep, tested)
     f2 = path / "delta_workspace_vs_R.csv"
     with f2.open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["R_mm", "volume_L"] + [f"volume_K2_le_{b:g}_L" for b in K_BOUNDS] + ["integral_inv_K2_L"])
-        conditioned = [study.conditioned_volume(b) for b in K_BOUNDS]
-        for j, (R_j, v, g) in enumerate(zip(*(sweep.column(k) for k in ("R", "volume", "weighted")))):
-            w.writerow([f"{R_j * 1e3:.1f}", f"{v * 1e3:.6g}"] + [f"{c[j] * 1e3:.6g}" for c in conditioned]
-                       + [f"{g * 1e3:.6g}"])
+        columns = [study.volume, *(study.conditioned_volume(b) for b in K_BOUNDS), study.weighted_volume()]
+        for j, R_j in enumerate(study.R):
+            w.writerow([f"{R_j * 1e3:.1f}"] + [f"{c[j] * 1e3:.6g}" for c in columns])
     f3 = path / "delta_choice_vs_bound.csv"
     with f3.open("w", newline="") as fh:
         w = csv.writer(fh)
