@@ -679,6 +679,58 @@ def _sweep(g, adv):
     return run, (values, objectives), kw
 
 
+_SWEEP_RESULTS: dict = {}
+
+
+def _sweep_results() -> dict:
+    """Two small sweeps' results, made once per process: one whose designs succeed, one whose every design fails."""
+    if not _SWEEP_RESULTS:
+        from pkm import sweeps
+
+        for key, h in (("ok", [0.1, 0.15]), ("failed", [-0.1, -0.15])):
+            _SWEEP_RESULTS[key] = ctx().pkm.sweep("rrr3", sweeps.table({"h": h}),
+                                                  ["gci:step=5cm", "cov=coverage:step=5cm"], scheduler="serial")
+    return _SWEEP_RESULTS
+
+
+@entry("SweepResult")
+def _sweep_result(g, adv):
+    """What a sweep returns, asked for its best designs, fronts, columns, failures; and files read as results."""
+    from pkm import sweeps
+    from pkm.sweeps.results import pareto_front
+
+    res = _sweep_results()["failed" if adv and g.chance(0.3) else "ok"]
+    names = ["gci:step=5cm", "cov"]
+    method = g.pick(("best", "pareto", "column", "failures", "check", "pareto_front", "read"))
+    arg: object = {"best": g.pick(names), "pareto": names, "column": g.pick([*names, "h", "design"]),
+                   "pareto_front": g.rng.uniform(0, 1, (int(g.rng.integers(0, 6)), 2)),
+                   "read": ctx().tmp / "missing.parquet"}.get(method)
+    n: object = int(g.rng.integers(1, 4))
+    if adv:
+        if g.chance(0.7):
+            arg = g.pick((g.hostile(), "nope", "h", "status", "message", [g.hostile()], [*names, "nope"], [],
+                          g.corrupt(np.ones((3, 2))), ctx().tmp))
+        else:
+            n = g.hostile()
+
+    def run(method, arg, n):
+        if method == "best":
+            return res.best(arg, n)
+        if method == "pareto":
+            return res.pareto(arg)
+        if method == "column":
+            v = res.column(arg)
+            return v[~np.isnan(v)]  # (NaN: a null)
+        if method == "failures":
+            return res.failures()
+        if method == "check":
+            return res.check().stats
+        if method == "pareto_front":
+            return pareto_front(arg)
+        return sweeps.read(arg).stats
+    return run, (method, arg, n), {}
+
+
 @entry("pkm.reconfigure")
 def _reconfigure(g, adv):
     c = ctx()

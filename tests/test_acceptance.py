@@ -81,20 +81,27 @@ def test_forward_jacobian_matches_finite_differences(name):
     assert forward_jacobian_error(load(name), moved(load(name))) <= 1e-6
 
 
-@pytest.mark.parametrize("name", ACCEPTANCE)
-def test_inverse_dynamics_gives_back_the_accelerations_and_balances_the_power(name):
-    mech = load(name)
-    q = moved(mech)
+def check_efforts_give_back_accelerations(mech: pkm.Mechanism, q: np.ndarray):
+    """Efforts for random actuated rates and accelerations at ``q``, fed to Pinocchio's ``constraintDynamics``:
+    the actuated and task accelerations come back (1e-8 relative). Returns ``(qd, qdd, tau)``."""
     rng = np.random.default_rng(3)
     qd, qdd = rng.normal(size=mech.na), rng.normal(size=mech.na)
     v = pkm.velocities(mech, q, qd)
     a = pkm.accelerations(mech, q, v, qdd)
     tau = pkm.inverse_dynamics(mech, q, v, a)
-    redundant = pkm.diagnose(mech, q).redundant_constraints
+    redundant = pkm.diagnose(mech, q).redundant_constraints  # (planar loops closed by 3-D or 6-D equations)
     a_back = dynamics.forward_dynamics(mech, q, v, tau, mu=1e-9 if redundant else 0.0)
     assert np.abs(a_back[mech.act_v] - qdd).max() <= 1e-8 * max(1.0, np.abs(qdd).max())
     J, bias = mech.task_map.jacobian(q), mech.task_map.bias(q, v)
     assert np.abs(J @ (a_back - a)).max() <= 1e-8 * max(1.0, np.abs(J @ a + bias).max())
+    return qd, qdd, tau
+
+
+@pytest.mark.parametrize("name", ACCEPTANCE)
+def test_inverse_dynamics_gives_back_the_accelerations_and_balances_the_power(name):
+    mech = load(name)
+    q = moved(mech)
+    qd, qdd, tau = check_efforts_give_back_accelerations(mech, q)
 
     if pkm.diagnose(mech, q).idle_motions:
         return  # the power balance needs the idle accelerations the efforts produce, which only the dynamics gives

@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import importlib.util
+import os
+import signal
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -17,7 +20,7 @@ TOOL = Path(__file__).resolve().parents[1] / "tools" / "fuzz_report.py"
 def fuzz():
     spec = importlib.util.spec_from_file_location("pkm_fuzz_report", TOOL)
     mod = importlib.util.module_from_spec(spec)
-    sys.modules["pkm_fuzz_report"] = mod  # the worker processes unpickle run_chunk from this name
+    sys.modules["pkm_fuzz_report"] = mod  # (its workers are forked: they see what a test plants in it)
     spec.loader.exec_module(mod)
     return mod
 
@@ -40,7 +43,7 @@ def test_harness_covers_the_public_entry_points(fuzz):
                 "pkm.inverse_dynamics", "pkm.assemble", "formats.spec_from_gepetto", "formats.read_mjcf",
                 "formats.read_sdf", "pkm.load(file)", "formats.spec_skeleton", "pkm.quantity", "pkm.follow_task",
                 "pkm.follow_actuators", "Kernels.inverse_dynamics", "Kernels.close_loops_path", "maps.task_map",
-                "formats.mjcf_from_mechanism", "pkm.reconfigure", "pkm.sweep", "sweeps.space"}
+                "formats.mjcf_from_mechanism", "pkm.reconfigure", "pkm.sweep", "sweeps.space", "SweepResult"}
     expected |= {f"pkm.build[{m}]" for m in names()}  # the registry, the tests' five-bar included
     expected |= {f"{m}.closed_form_ik" for m in names()}
     expected |= {f"{m}.closed_form_fk" for m in names() if module(m).closed_form_fk is not None}
@@ -49,17 +52,19 @@ def test_harness_covers_the_public_entry_points(fuzz):
 
 
 def test_no_other_exception_and_no_silent_non_finite_result(report):
-    """At 30 inputs per entry point, nothing but ok (finite) and PkmError comes out, and no error carries a NaN."""
-    bad = {nm: (e["other"], e["nonfinite"], e["examples_other"][:1] + e["examples_nonfinite"][:1])
-           for nm, e in report["entries"].items() if e["other"] or e["nonfinite"] or e["error_nan"]}
+    """At 30 inputs per entry point, nothing but ok (finite) and PkmError comes out, nothing hangs, and no error
+    carries a NaN."""
+    bad = {nm: (e["other"], e["nonfinite"], e["hang"],
+                e["examples_other"][:1] + e["examples_nonfinite"][:1] + e["examples_hang"][:1])
+           for nm, e in report["entries"].items() if e["other"] or e["nonfinite"] or e["hang"] or e["error_nan"]}
     assert not bad, bad
 
 
 def test_every_entry_point_was_tried_with_both_kinds_of_input(report):
     """Each entry point ran its 30 calls, half random and half adversarial, and some of each outcome occurred."""
     for nm, e in report["entries"].items():
-        assert e["tried"] == 30 and e["ok"] + e["pkm_error"] + e["other"] + e["nonfinite"] == 30, nm
-        assert sum(e["random"].values()) == 15 and sum(e["adversarial"].values()) == 15, nm
+        assert e["tried"] == 30 and e["ok"] + e["pkm_error"] + e["other"] + e["nonfinite"] + e["hang"] == 30, nm
+        assert sum(e["random"].values()) == 15 and sum(e["adversarial"].values()) == 15 and e["cut"] is None, nm
     assert report["total"]["ok"] > 0 and report["total"]["pkm_error"] > 0
 
 
@@ -79,3 +84,51 @@ def test_a_planted_bug_is_classified_as_other(fuzz, monkeypatch):
     assert te["other"] == 4 and te["examples_other"][0]["type"] == "TypeError"
     assert "planted.type_error" in te["examples_other"][0]["repro"]
     assert nn["nonfinite"] == 4 and nn["ok"] == 0
+
+
+def test_a_call_that_hangs_is_a_hang_never_waited_on(fuzz, monkeypatch):
+    """A call past the timeout that gives control back (a sleep) is interrupted there; one that does not (SIGALRM
+    ignored, as a thread blocked on a lock is deaf to it) has its worker killed and replaced, and the rest of its
+    chunk runs in the new worker: both counted as hang with their repro, the other calls as usual."""
+    def sleeper(g, adversarial):
+        return (lambda s: time.sleep(s) if adversarial else s), (30.0,), {}
+
+    def deaf(g, adversarial):
+        def block(s):
+            if adversarial:
+                signal.signal(signal.SIGALRM, signal.SIG_IGN)
+                time.sleep(s)
+            return s
+        return block, (30.0,), {}
+
+    def exits(g, adversarial):
+        return (lambda s: os._exit(3) if adversarial else s), (30.0,), {}
+
+    monkeypatch.setattr(fuzz, "ENTRIES", fuzz.ENTRIES + [fuzz.Entry("planted.sleep", sleeper),
+                                                        fuzz.Entry("planted.deaf", deaf),
+                                                        fuzz.Entry("planted.exit", exits)])
+    t0 = time.monotonic()
+    rep = fuzz.run(["planted.sleep", "planted.deaf", "planted.exit"], 3, jobs=2, timeout=0.2, grace=0.3)
+    assert time.monotonic() - t0 < 10
+    for nm, outcome in (("planted.sleep", "hang"), ("planted.deaf", "hang"), ("planted.exit", "other")):
+        e = rep["entries"][nm]
+        assert (e["tried"], e["ok"], e[outcome]) == (3, 2, 1), (nm, e)
+        repro = e[f"examples_{outcome}"][0]["repro"]  # (the call, from the worker that took over)
+        assert repro.startswith(f"[{nm}] tests.test_fuzz.") and repro.endswith("(30.0)"), repro
+    assert rep["entries"]["planted.exit"]["examples_other"][0]["type"] == "WorkerDied"
+    assert rep["total"]["hang"] == 2
+
+
+def test_the_time_bounds_cut_an_entry_and_say_so(fuzz, monkeypatch):
+    """An entry point whose calls use up its seconds gets fewer calls, reported (tried, cut); so does the run
+    past its total bound."""
+    def slow(g, adversarial):
+        return (lambda: time.sleep(0.05)), (), {}
+
+    monkeypatch.setattr(fuzz, "ENTRIES", fuzz.ENTRIES + [fuzz.Entry("planted.slow", slow)])
+    rep = fuzz.run(["planted.slow"], 1000, jobs=1, entry_seconds=0.2)
+    e = rep["entries"]["planted.slow"]
+    assert 3 <= e["tried"] <= 8 and e["ok"] == e["tried"] and e["cut"] == "entry", e
+    rep = fuzz.run(["planted.slow"], 1000, jobs=1, total_seconds=0.2)
+    assert 3 <= rep["entries"]["planted.slow"]["tried"] <= 8 and rep["entries"]["planted.slow"]["cut"] == "total"
+    assert "1 entry point(s) stopped by a time bound" in fuzz.table(rep)

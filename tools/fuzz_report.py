@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Fuzz report: every public entry point of pkm fed random and adversarial inputs.
+"""Fuzz report: every public entry point of pkm fed random and adversarial inputs, within time bounds.
 
 For each entry point of :data:`tests.fuzzing.ENTRIES`, ``--n`` inputs are generated (half *random*: valid-looking
 or near-valid values around a reference configuration, pose or parameter set; half *adversarial*:
@@ -14,22 +14,32 @@ is classified:
   inadmissible, each flagged by a mask in the same result;
 * ``nonfinite``: it returned a NaN or an infinity that is not a documented sentinel;
 * ``pkm_error``: it raised a :class:`pkm.errors.PkmError` (the expected way to refuse);
-* ``other``: it raised anything else (or ran past ``--timeout``): a bug. The type, message,
-  entry point and a repro (the call with its arguments) are kept for the first few.
+* ``other``: it raised anything else, or its worker process died in it (``WorkerDied``): a bug. The type,
+  message, entry point and a repro (the call with its arguments) are kept for the first few;
+* ``hang``: it ran past ``--timeout`` seconds: interrupted there (``SIGALRM``) when the call gives control back,
+  else its worker process is killed ``--grace`` seconds later and replaced (a deadlock, a C loop), and the rest
+  of its chunk goes on in the new worker. Never waited on longer: a bug, with its repro.
 
 A PkmError whose numeric attributes (residual, excess, sigma_min, deficit) are NaN is counted
 in ``error_nan``.
 
+Time bounds: every entry point may spend ``--entry-seconds`` (its calls' wall time, summed over its chunks;
+default: its fair share of the total, ``--total-seconds x --jobs / entries``), the whole run ``--total-seconds``
+(default 2700: 45 minutes) plus at most one call's bound. An entry point stopped by either before its ``--n`` calls
+is reported with the calls it got (``tried``) and why (``cut``: ``entry`` or ``total``); the table marks it ``*``.
+The full default run (86 entry points x 10,000 inputs on 2 cores) ends within the hour: the entry points that are
+cheap get all 10,000, the slow ones their share of the time.
+
 Usage::
 
-    python tools/fuzz_report.py                 # 10,000 inputs per entry point, table
+    python tools/fuzz_report.py                 # 10,000 inputs per entry point, table, within 45 minutes
     python tools/fuzz_report.py --n 30 --json   # quick, machine output
-    python tools/fuzz_report.py --only solve_ik --n 2000 --seed 3
+    python tools/fuzz_report.py --only solve_ik --n 2000 --seed 3 --entry-seconds 600
 
-``--jobs`` worker processes (default: the CPU count) share the work in chunks; every chunk has
-its own seed derived from ``--seed``, the entry's name and the chunk index, so a run is
-reproducible whatever the number of workers. Exit status 1 when any ``other`` or ``nonfinite``
-was found.
+``--jobs`` worker processes (default: the CPU count, each forked from this one) share the work in chunks of
+:data:`CHUNK` calls; every chunk has its own seed derived from ``--seed``, the entry's name and the chunk index,
+so a run is reproducible whatever the number of workers (the calls an entry gets within a time bound excepted).
+Exit status 1 when any ``other``, ``nonfinite`` or ``hang`` was found.
 """
 
 from __future__ import annotations
@@ -37,6 +47,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import multiprocessing
 import os
 import signal
 import sys
@@ -44,8 +55,8 @@ import time
 import traceback
 import warnings
 import zlib
-from collections import Counter
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from collections import Counter, deque
+from multiprocessing.connection import wait
 from pathlib import Path
 
 import numpy as np
@@ -54,9 +65,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the checkout: th
 from tests.fuzzing import ENTRIES, Entry, Gen, ctx, finite  # noqa: F401 (Entry: to plant entries in tests)
 
 CHUNK = 250  # calls per task handed to a worker
-EXAMPLES = 5  # "other" / "nonfinite" examples kept per entry point
+EXAMPLES = 5  # "other" / "nonfinite" / "hang" examples kept per entry point
+OUTCOMES = ("ok", "pkm_error", "other", "nonfinite", "hang")
+TOTAL_SECONDS = 2700.0  # default bound of the whole run (45 minutes)
+BETWEEN_CALLS = 300.0  # a worker silent this long outside a call (making inputs, starting) is killed as hung
 
-# ---------------------------------------------------------------------- classification
+
+# ---------------------------------------------------------------------- classification (in a worker process)
 class CallTimeout(BaseException):
     """A call ran past ``--timeout`` (a BaseException, so that no ``except Exception`` swallows it)."""
 
@@ -74,27 +89,38 @@ def _repro(entry_name: str, fn, args, kwargs) -> str:
     return f"[{entry_name}] {name}({', '.join(parts)})"
 
 
-def run_chunk(task: tuple) -> dict:
-    """Run ``count`` calls of one entry point; returns its tallies."""
-    name, seed, chunk_index, count, timeout = task
+def run_chunk(task: tuple, send) -> None:
+    """Run the calls ``start..count-1`` of one chunk of an entry point, telling ``send`` about each: ``("start",
+    k)`` before call ``k``, ``("done", k, outcome)`` after it, and ``("end", stopped)`` at the end (``stopped``:
+    the chunk's ``budget`` of seconds ran out first). The calls before ``start`` are generated again (the inputs
+    are one stream a chunk) but not run; ``hung`` (a call that hung in an earlier worker) gets its repro sent,
+    ``("hung", k, repro)``."""
+    name, seed, chunk_index, count, timeout, start, hung, budget = task
     warnings.simplefilter("ignore")
     signal.signal(signal.SIGALRM, _alarm)
     c = ctx()
     e = next(e for e in ENTRIES if e.name == name)
     rng = np.random.default_rng([seed, zlib.crc32(name.encode()), chunk_index])
     g = Gen(rng)
-    out = {"tried": 0, "ok": 0, "pkm_error": 0, "other": 0, "nonfinite": 0, "documented": 0, "error_nan": 0,
-           "seconds": 0.0, "by_kind": {"random": Counter(), "adversarial": Counter()}, "errors": Counter(),
-           "examples_other": [], "examples_nonfinite": []}
     PkmError = c.pkm.PkmError
+    spent = 0.0
     for k in range(count):
+        if k >= start and budget is not None and spent >= budget:
+            send(("end", True))
+            return
+        t0 = time.perf_counter()
         adversarial = (chunk_index * CHUNK + k) % 2 == 1
-        kind = "adversarial" if adversarial else "random"
         try:
             fn, args, kwargs = e.make(g, adversarial)
         except Exception as exc:  # a bug of this harness, not of pkm
-            raise RuntimeError(f"generator of {name} failed: {exc!r}") from exc
-        t0 = time.perf_counter()
+            send(("fail", f"generator of {name} failed: {exc!r}"))
+            return
+        if k < start:
+            if k == hung:
+                send(("hung", k, _repro(name, fn, args, kwargs)))
+            continue
+        send(("start", k))
+        out = {"verdict": "", "error": None, "documented": False, "error_nan": False, "example": None}
         signal.setitimer(signal.ITIMER_REAL, timeout)
         try:
             try:
@@ -102,33 +128,28 @@ def run_chunk(task: tuple) -> dict:
             finally:
                 signal.setitimer(signal.ITIMER_REAL, 0)
             if finite(res):
-                verdict = "ok"
+                out["verdict"] = "ok"
             elif e.sentinel is not None and _safe(e.sentinel, res):
-                verdict = "ok"
-                out["documented"] += 1
+                out.update(verdict="ok", documented=True)
             else:
-                verdict = "nonfinite"
-                if len(out["examples_nonfinite"]) < EXAMPLES:
-                    out["examples_nonfinite"].append({"result": repr(res)[:500],
-                                                      "repro": _repro(name, fn, args, kwargs)})
+                out.update(verdict="nonfinite", example={"result": repr(res)[:500],
+                                                         "repro": _repro(name, fn, args, kwargs)})
         except PkmError as exc:
-            verdict = "pkm_error"
-            out["errors"][type(exc).__name__] += 1
-            if any(isinstance(getattr(exc, a, None), float) and math.isnan(getattr(exc, a))
-                   for a in ("residual", "excess", "sigma_min", "deficit")):
-                out["error_nan"] += 1
+            out.update(verdict="pkm_error", error=type(exc).__name__)
+            out["error_nan"] = any(isinstance(getattr(exc, a, None), float) and math.isnan(getattr(exc, a))
+                                   for a in ("residual", "excess", "sigma_min", "deficit"))
         except CallTimeout:
-            verdict = "other"
-            _keep(out, name, "Timeout", f"ran past {timeout} s", fn, args, kwargs, "")
+            out.update(verdict="hang", example={"type": "Timeout", "message": f"ran past {timeout} s",
+                                                "repro": _repro(name, fn, args, kwargs), "traceback": ""})
         except Exception as exc:
-            verdict = "other"
-            _keep(out, name, type(exc).__name__, str(exc)[:500], fn, args, kwargs,
-                  "".join(traceback.format_exception(exc)[-3:])[-1500:])
-        out["seconds"] += time.perf_counter() - t0
-        out["tried"] += 1
-        out[verdict] += 1
-        out["by_kind"][kind][verdict] += 1
-    return {"name": name, **out}
+            out.update(verdict="other", error=type(exc).__name__,
+                       example={"type": type(exc).__name__, "message": str(exc)[:500],
+                                "repro": _repro(name, fn, args, kwargs),
+                                "traceback": "".join(traceback.format_exception(exc)[-3:])[-1500:]})
+        seconds = time.perf_counter() - t0
+        spent += seconds
+        send(("done", k, out, seconds))
+    send(("end", False))
 
 
 def _safe(check, res) -> bool:
@@ -138,46 +159,104 @@ def _safe(check, res) -> bool:
         return False
 
 
-def _keep(out, name, typ, msg, fn, args, kwargs, tb) -> None:
-    out["errors"][typ] += 0  # keep the key out of the PkmError tally
-    if len(out["examples_other"]) < EXAMPLES:
-        out["examples_other"].append({"type": typ, "message": msg, "repro": _repro(name, fn, args, kwargs),
-                                      "traceback": tb})
+def _serve(conn) -> None:
+    """A worker process: runs the chunks it is sent until it is sent None."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # (Ctrl-C is the parent's to handle)
+    while True:
+        task = conn.recv()
+        if task is None:
+            return
+        run_chunk(task, conn.send)
 
 
-def merge(total: dict, part: dict) -> None:
-    for k in ("tried", "ok", "pkm_error", "other", "nonfinite", "documented", "error_nan", "seconds"):
-        total[k] += part[k]
-    for kind in ("random", "adversarial"):
-        total["by_kind"][kind].update(part["by_kind"][kind])
-    total["errors"].update(part["errors"])
-    for key in ("examples_other", "examples_nonfinite"):
-        total[key] += part[key][:max(0, EXAMPLES - len(total[key]))]
+# ---------------------------------------------------------------------- the tallies (in this process)
+def _tally() -> dict:
+    return {"tried": 0, **dict.fromkeys(OUTCOMES, 0), "documented": 0, "error_nan": 0, "seconds": 0.0,
+            "by_kind": {"random": Counter(), "adversarial": Counter()}, "errors": Counter(),
+            "examples_other": [], "examples_nonfinite": [], "examples_hang": [], "cut": None}
 
 
-def run(names: list[str], n: int, *, seed: int = 0, jobs: int = 1, timeout: float = 30.0,
-        progress: bool = False) -> dict:
-    """Fuzz the entry points ``names`` with ``n`` inputs each; the report as a dict (see ``--json``)."""
-    tasks = [(nm, seed, k, min(CHUNK, n - k * CHUNK), timeout)
-             for k in range(math.ceil(n / CHUNK)) for nm in names]  # chunk-major: slow entries spread out
-    totals = {nm: {"tried": 0, "ok": 0, "pkm_error": 0, "other": 0, "nonfinite": 0, "documented": 0,
-                   "error_nan": 0, "seconds": 0.0, "by_kind": {"random": Counter(), "adversarial": Counter()},
-                   "errors": Counter(), "examples_other": [], "examples_nonfinite": []} for nm in names}
+def _count(t: dict, chunk_index: int, k: int, verdict: str, seconds: float, *, error: str | None = None,
+           example: dict | None = None, documented: bool = False, error_nan: bool = False) -> None:
+    kind = "adversarial" if (chunk_index * CHUNK + k) % 2 == 1 else "random"
+    t["tried"] += 1
+    t[verdict] += 1
+    t["by_kind"][kind][verdict] += 1
+    t["seconds"] += seconds
+    t["documented"] += documented
+    t["error_nan"] += error_nan
+    if error is not None:
+        t["errors"][error] += 1 if verdict == "pkm_error" else 0  # (an other's type: its key, not a PkmError)
+    if example is not None:
+        key = {"other": "examples_other", "nonfinite": "examples_nonfinite", "hang": "examples_hang"}[verdict]
+        if len(t[key]) < EXAMPLES:
+            t[key].append(example)
+
+
+class _Worker:
+    """One worker process and the chunk it runs: ``task``, the call in progress (``call``, since ``since``)."""
+
+    def __init__(self, mp):
+        self.conn, child = mp.Pipe()
+        self.proc = mp.Process(target=_serve, args=(child,), daemon=True)
+        self.proc.start()
+        child.close()
+        self.task: tuple | None = None
+        self.call: int | None = None
+        self.last = 0.0  # the chunk's last call done (or -1)
+        self.since = time.monotonic()
+
+    def give(self, task: tuple) -> None:
+        self.task, self.call, self.last, self.since = task, None, task[5] - 1, time.monotonic()
+        self.conn.send(task)
+
+    def kill(self) -> None:
+        self.proc.kill()
+        self.proc.join()
+        self.conn.close()
+
+    def stop(self) -> None:
+        try:
+            self.conn.send(None)
+        except OSError:
+            pass
+        self.proc.join(timeout=5)
+        if self.proc.is_alive():
+            self.kill()
+        self.conn.close()
+
+
+def run(names: list[str], n: int, *, seed: int = 0, jobs: int = 1, timeout: float = 30.0, grace: float = 5.0,
+        entry_seconds: float | None = None, total_seconds: float | None = None, progress: bool = False) -> dict:
+    """Fuzz the entry points ``names`` with ``n`` inputs each; the report as a dict (see ``--json``).
+
+    ``timeout``: seconds a call may run before it counts as a hang (its worker killed ``grace`` seconds later
+    when it does not give control back); ``entry_seconds`` and ``total_seconds``: the time bounds (see the module
+    doc; None: none). ``jobs`` worker processes, forked from this one.
+    """
+    tasks = deque((nm, seed, k, min(CHUNK, n - k * CHUNK), timeout, 0, -1)
+                  for k in range(math.ceil(n / CHUNK)) for nm in names)  # chunk-major: slow entries spread out
+    totals = {nm: _tally() for nm in names}
     t0 = time.perf_counter()
     sys.stdout.flush()
     saved_stdout = os.dup(1)
     os.dup2(2, 1)  # what C libraries print (LAPACK's "On entry to DLASCL...") must not mix with --json
     try:
-        _run_tasks(tasks, totals, jobs, progress, len(names) * n)
+        _run_tasks(tasks, totals, max(1, jobs), progress, len(names) * n, timeout + grace, entry_seconds,
+                   None if total_seconds is None else time.monotonic() + total_seconds)
     finally:
         sys.stdout.flush()
         os.dup2(saved_stdout, 1)
         os.close(saved_stdout)
-    report = {"n": n, "seed": seed, "jobs": jobs, "wall_seconds": round(time.perf_counter() - t0, 1), "entries": {}}
+    report = {"n": n, "seed": seed, "jobs": jobs, "timeout": timeout, "entry_seconds": entry_seconds,
+              "total_seconds": total_seconds, "wall_seconds": round(time.perf_counter() - t0, 1), "entries": {}}
     return _report_entries(report, names, totals)
 
 
-def _run_tasks(tasks: list, totals: dict, jobs: int, progress: bool, calls: int) -> None:
+def _run_tasks(tasks: deque, totals: dict, jobs: int, progress: bool, calls: int, kill_after: float,
+               entry_seconds: float | None, deadline: float | None) -> None:
+    """Hand the chunks to ``jobs`` workers; count every call; kill a worker whose call outlives ``kill_after``
+    and go on with the rest of its chunk in a new one; stop giving an entry (or anything) chunks past its bound."""
     bar = None
     if progress:
         try:
@@ -185,52 +264,138 @@ def _run_tasks(tasks: list, totals: dict, jobs: int, progress: bool, calls: int)
             bar = tqdm(total=calls, unit="call", file=sys.stderr, smoothing=0.05)
         except ImportError:  # pragma: no cover
             bar = None
-    if jobs <= 1:
-        for t in tasks:
-            part = run_chunk(t)
-            merge(totals[part["name"]], part)
+    mp = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+    workers = [_Worker(mp) for _ in range(min(jobs, len(tasks)) or 1)]
+    reason: dict[str, str] = {}  # (the bound a chunk was given: entry or total)
+
+    def replace(w: _Worker, verdict: str, example: dict) -> None:
+        """``w``'s call in progress ended as ``verdict``: counted, ``w`` replaced, the rest of its chunk queued."""
+        nm, seed, chunk_index, count, timeout = w.task[:5]
+        k = w.call if w.call is not None else w.last + 1
+        spent = time.monotonic() - w.since
+        w.kill()
+        if k < count:
+            _count(totals[nm], chunk_index, k, verdict, spent, error=example["type"], example=example)
             if bar:
-                bar.update(part["tried"])
-    else:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            futures = [pool.submit(run_chunk, t) for t in tasks]
-            for f in as_completed(futures):
-                part = f.result()
-                merge(totals[part["name"]], part)
-                if bar:
-                    bar.update(part["tried"])
-    if bar:
-        bar.close()
+                bar.update(1)
+        tasks.appendleft((nm, seed, chunk_index, count, timeout, k + 1, k))  # (k: its repro, from the new one)
+        workers[workers.index(w)] = _Worker(mp)
+
+    try:
+        while True:
+            now = time.monotonic()
+            for w in workers:  # hand out chunks
+                while w.task is None and tasks:
+                    nm, seed, chunk_index, count, timeout, start, hung = tasks.popleft()
+                    t = totals[nm]
+                    left = {}
+                    if entry_seconds is not None:
+                        left["entry"] = entry_seconds - t["seconds"]
+                    if deadline is not None:
+                        left["total"] = deadline - now
+                    why = min(left, key=left.__getitem__) if left else None
+                    if why is not None and left[why] <= 0 and start < count:
+                        t["cut"] = t["cut"] or why
+                        if hung < 0:
+                            continue  # (else given no time: to send the repro of its hung call)
+                    reason[nm] = why or ""
+                    w.give((nm, seed, chunk_index, count, timeout, start, hung, max(0.0, left[why]) if why else None))
+            busy = [w for w in workers if w.task is not None]
+            if not busy:
+                break
+            for conn in wait([w.conn for w in busy], timeout=0.25):
+                w = next(w for w in busy if w.conn is conn)
+                try:
+                    msg = conn.recv()
+                except (EOFError, OSError):  # the process died (a segfault, the OOM killer)
+                    w.proc.join(1)
+                    k = w.call if w.call is not None else w.last + 1
+                    replace(w, "other", {"type": "WorkerDied", "message": f"the worker process ended in the call "
+                                         f"(exit code {w.proc.exitcode})", "repro": "", "traceback": "",
+                                         "k": (w.task[2], k)})
+                    continue
+                nm, chunk_index = w.task[0], w.task[2]
+                if msg[0] == "start":
+                    w.call, w.since = msg[1], time.monotonic()
+                elif msg[0] == "done":
+                    _, k, out, seconds = msg
+                    _count(totals[nm], chunk_index, k, out["verdict"], seconds, error=out["error"],
+                           example=out["example"], documented=out["documented"], error_nan=out["error_nan"])
+                    w.call, w.last, w.since = None, k, time.monotonic()
+                    if bar:
+                        bar.update(1)
+                elif msg[0] == "hung":
+                    _, k, repro = msg
+                    for ex in totals[nm]["examples_hang"] + totals[nm]["examples_other"]:
+                        if ex.get("k") == (chunk_index, k):
+                            ex["repro"] = repro
+                elif msg[0] == "end":
+                    if msg[1]:
+                        totals[nm]["cut"] = totals[nm]["cut"] or reason.get(nm) or "entry"
+                    w.task, w.call = None, None
+                elif msg[0] == "fail":
+                    raise RuntimeError(msg[1])
+            now = time.monotonic()
+            for w in list(workers):
+                if w.task is None:
+                    continue
+                if w.call is not None and now - w.since > kill_after:
+                    replace(w, "hang", {"type": "Hang", "message": f"no answer after {kill_after:g} s: killed",
+                                        "repro": "", "traceback": "", "k": (w.task[2], w.call)})
+                elif w.call is None and now - w.since > BETWEEN_CALLS:
+                    replace(w, "hang", {"type": "Hang", "message": f"silent {BETWEEN_CALLS:g} s between calls: "
+                                        "killed", "repro": "", "traceback": "", "k": (w.task[2], w.last + 1)})
+    finally:
+        for w in workers:
+            if w.task is None:
+                w.stop()
+            else:
+                w.kill()
+        if bar:
+            bar.close()
 
 
 def _report_entries(report: dict, names: list[str], totals: dict) -> dict:
     for nm in names:
         t = totals[nm]
         report["entries"][nm] = {
-            "tried": t["tried"], "ok": t["ok"], "pkm_error": t["pkm_error"], "other": t["other"],
-            "nonfinite": t["nonfinite"], "documented": t["documented"], "error_nan": t["error_nan"],
-            "seconds": round(t["seconds"], 2),
+            "tried": t["tried"], **{k: t[k] for k in OUTCOMES}, "documented": t["documented"],
+            "error_nan": t["error_nan"], "seconds": round(t["seconds"], 2), "cut": t["cut"],
             "random": dict(t["by_kind"]["random"]), "adversarial": dict(t["by_kind"]["adversarial"]),
             "errors": dict(t["errors"].most_common()),
-            "examples_other": t["examples_other"], "examples_nonfinite": t["examples_nonfinite"]}
+            "examples_other": [_public(ex) for ex in t["examples_other"]],
+            "examples_nonfinite": t["examples_nonfinite"],
+            "examples_hang": [_public(ex) for ex in t["examples_hang"]]}
     report["total"] = {k: sum(e[k] for e in report["entries"].values())
-                       for k in ("tried", "ok", "pkm_error", "other", "nonfinite", "documented", "error_nan")}
+                       for k in ("tried", *OUTCOMES, "documented", "error_nan")}
+    report["total"]["cut"] = sum(1 for e in report["entries"].values() if e["cut"])
     return report
 
 
+def _public(example: dict) -> dict:
+    return {k: v for k, v in example.items() if k != "k"}  # (k: which call, to put its repro in)
+
+
 def table(report: dict) -> str:
-    """The human table of a report, then the examples of "other" and "nonfinite"."""
+    """The human table of a report (``*``: the entry point was stopped by a time bound before its ``n`` calls),
+    then the examples of "other", "nonfinite" and "hang"."""
     names = list(report["entries"])
     w = max(len(nm) for nm in names)
-    lines = [f"{'entry point':{w}}  {'tried':>7} {'ok':>7} {'PkmError':>8} {'other':>6} {'nonfin':>6} {'s':>7}"]
+    lines = [f"{'entry point':{w}}  {'tried':>8} {'ok':>7} {'PkmError':>8} {'other':>6} {'nonfin':>6} {'hang':>5} "
+             f"{'s':>7}"]
     for nm, e in report["entries"].items():
-        lines.append(f"{nm:{w}}  {e['tried']:7d} {e['ok']:7d} {e['pkm_error']:8d} {e['other']:6d} {e['nonfinite']:6d} "
-                     f"{e['seconds']:7.1f}")
+        cut = "*" if e["cut"] else " "
+        lines.append(f"{nm:{w}}  {e['tried']:7d}{cut} {e['ok']:7d} {e['pkm_error']:8d} {e['other']:6d} "
+                     f"{e['nonfinite']:6d} {e['hang']:5d} {e['seconds']:7.1f}")
     tot = report["total"]
-    lines.append(f"{'total':{w}}  {tot['tried']:7d} {tot['ok']:7d} {tot['pkm_error']:8d} {tot['other']:6d} "
-                 f"{tot['nonfinite']:6d}   wall {report['wall_seconds']:.0f} s on {report['jobs']} worker(s)")
+    lines.append(f"{'total':{w}}  {tot['tried']:7d}  {tot['ok']:7d} {tot['pkm_error']:8d} {tot['other']:6d} "
+                 f"{tot['nonfinite']:6d} {tot['hang']:5d}   wall {report['wall_seconds']:.0f} s on "
+                 f"{report['jobs']} worker(s)")
+    if tot["cut"]:
+        lines.append(f"* {tot['cut']} entry point(s) stopped by a time bound before their {report['n']} calls "
+                     f"(--entry-seconds {report['entry_seconds']}, --total-seconds {report['total_seconds']})")
     for nm, e in report["entries"].items():
-        for ex in e["examples_other"] + e["examples_nonfinite"]:
+        for ex in e["examples_other"] + e["examples_nonfinite"] + e["examples_hang"]:
             lines.append(f"\n{nm}: {ex.get('type', 'nonfinite')}: {ex.get('message', ex.get('result'))}\n"
                          f"  {ex['repro']}")
     return "\n".join(lines)
@@ -243,7 +408,14 @@ def main(argv=None) -> int:
     ap.add_argument("--only", action="append", default=[], help="entry points whose name contains this (repeatable)")
     ap.add_argument("--json", action="store_true", help="machine output on stdout")
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
-    ap.add_argument("--timeout", type=float, default=30.0, help="seconds allowed per call before it counts as other")
+    ap.add_argument("--timeout", type=float, default=30.0, help="seconds a call may run before it counts as a hang "
+                                                               "(default 30)")
+    ap.add_argument("--grace", type=float, default=5.0, help="seconds more before the worker of a call that does "
+                                                             "not give control back is killed (default 5)")
+    ap.add_argument("--entry-seconds", type=float, help="seconds of calls each entry point may spend (default: "
+                                                        "its share, total-seconds x jobs / entry points)")
+    ap.add_argument("--total-seconds", type=float, default=TOTAL_SECONDS,
+                    help=f"seconds the whole run may take (default {TOTAL_SECONDS:g}; 0: no bound)")
     ap.add_argument("--list", action="store_true", help="list the entry points and exit")
     ap.add_argument("--no-progress", action="store_true")
     args = ap.parse_args(argv)
@@ -251,17 +423,21 @@ def main(argv=None) -> int:
     if args.list:
         print("\n".join(names))
         return 0
-    if not names or args.n < 1:
-        print(f"nothing to run (--only {args.only}, --n {args.n})", file=sys.stderr)
+    if not names or args.n < 1 or args.jobs < 1 or min(args.timeout, args.grace) <= 0:
+        print(f"nothing to run (--only {args.only}, --n {args.n}, --jobs {args.jobs}, --timeout {args.timeout}, "
+              f"--grace {args.grace})", file=sys.stderr)
         return 2
-    report = run(names, args.n, seed=args.seed, jobs=args.jobs, timeout=args.timeout,
-                 progress=not args.no_progress)
+    total = args.total_seconds or None
+    entry = args.entry_seconds if args.entry_seconds is not None else \
+        (None if total is None else total * args.jobs / len(names))
+    report = run(names, args.n, seed=args.seed, jobs=args.jobs, timeout=args.timeout, grace=args.grace,
+                 entry_seconds=entry, total_seconds=total, progress=not args.no_progress)
     if args.json:
         json.dump(report, sys.stdout, indent=1)
         print()
     else:
         print(table(report))
-    return 1 if report["total"]["other"] or report["total"]["nonfinite"] else 0
+    return 1 if report["total"]["other"] or report["total"]["nonfinite"] or report["total"]["hang"] else 0
 
 
 if __name__ == "__main__":

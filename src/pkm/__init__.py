@@ -81,32 +81,34 @@ __version__ = "0.1.0"
 def load(name) -> Mechanism:
     """A mechanism: a registered name's reference design (from its shipped ``urdf/`` files, or built from
     its default parameters when it ships none), or one's own files: a closure spec
-    (``path/to/my.closures.toml``, naming its URDF; see :mod:`pkm.core.spec`), or a URDF + ``robot.yaml``
-    in the convention of Gepetto's toolbox-parallel-robots (the folder, or the YAML file), an MJCF file
+    (``path/to/my.closures.toml``, naming its URDF; see :mod:`pkm.core.spec`), or a URDF + YAML
+    in the convention of Gepetto's toolbox-parallel-robots (the folder, the YAML or the URDF, whatever their
+    names: recognised by content), an MJCF file
     (``.xml``, loops as ``<equality>`` connect/weld, actuators from ``<actuator>``) or an SDF file (loops
     as links with several parents; it names no actuators, so it comes through a spec): see
-    :mod:`pkm.core.formats`.
+    :mod:`pkm.core.formats`. Or a model an installed package ships, by name ``"<package>:<model>"``
+    (``"example-robot-data:cassie"``: :mod:`pkm.core.formats.packages`).
 
     Raises:
         UnknownNameError: ``name`` is neither registered (:data:`MECHANISMS`) nor an existing file.
-        SpecError: the files are missing, damaged or do not fit together.
+        SpecError: the files are missing, damaged or do not fit together; no reader takes the path (the
+            message says why each declined: :func:`pkm.core.formats.imported.load_path`).
     """
     import os
     from pathlib import Path
 
-    if isinstance(name, os.PathLike) or (isinstance(name, str) and name not in MECHANISMS
-                                         and (name.endswith((".toml", ".yaml", ".yml", ".xml", ".mjcf", ".sdf"))
-                                              or Path(name).exists())):
-        from pkm.core.formats import SUFFIXES, gepetto_files, load_gepetto
-        from pkm.core.formats.imported import load_model_file
-        from pkm.core.mechanism import Mechanism
+    if isinstance(name, str) and ":" in name and not Path(name).exists():  # "example-robot-data:cassie"
+        from pkm.core.formats.packages import PACKAGES, load_package_model
 
-        path = Path(name)
-        gepetto = gepetto_files(path)
-        if gepetto:
-            return load_gepetto(*gepetto)
-        return load_model_file(path) if SUFFIXES.get(path.suffix.lower()) in ("mjcf", "sdf") \
-            else Mechanism.from_files(path)
+        if name.partition(":")[0] in PACKAGES:
+            return load_package_model(name)
+    if isinstance(name, os.PathLike) or (isinstance(name, str) and name not in MECHANISMS
+                                         and (name.endswith((".toml", ".yaml", ".yml", ".xml", ".mjcf", ".sdf",
+                                                             ".urdf"))
+                                              or Path(name).exists())):
+        from pkm.core.formats.imported import load_path
+
+        return load_path(Path(name))  # by content: Gepetto URDF + YAML, closure spec, MJCF or SDF
     if isinstance(name, str) and name not in MECHANISMS:
         raise UnknownNameError("mechanism", name, MECHANISMS, "the registry, nor is it a file (give a closure spec's "
                                                               "path, such as path/to/my.closures.toml)")

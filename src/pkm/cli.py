@@ -588,11 +588,19 @@ def cmd_sweep(args) -> int:
     res = sweeps.sweep(args.mechanism, space, args.objective, out=args.out, fixed=fixed or None,
                        scheduler=args.scheduler, workers=args.workers, chunk_size=args.chunk,
                        progress=False if args.no_progress else None, overwrite=args.overwrite)
+    try:
+        res.check()  # every design failed: one line naming them (their table is written already)
+    except sweeps.SweepError as exc:
+        kept = f"; each design's error is in {args.out}" if args.out else "; --out FILE.parquet keeps each design's"
+        raise sweeps.SweepError(f"{exc}{kept}", args.out) from None
     st = res.stats
+    best = {}
+    for c, o in res.objectives.items():
+        rows = res.best(c, 1) if o["sense"] and not np.isnan(res.column(c)).all() else []  # (none: no value of it)
+        best[c] = rows[0] if rows else None
     out = {"mechanism": res.manifest["family"], "designs": len(res), "failed": st.failed,
            "evaluated_now": st.evaluated, "space": res.manifest["space"], "out": args.out,
-           "workers": st.workers, "wall_seconds": st.wall_seconds, "work_seconds": st.work_seconds,
-           "best": {c: next(iter(res.best(c, 1)), None) if o["sense"] else None for c, o in res.objectives.items()}}
+           "workers": st.workers, "wall_seconds": st.wall_seconds, "work_seconds": st.work_seconds, "best": best}
     print(json.dumps(jsonable(out), indent=2))
     return 0
 

@@ -7,11 +7,78 @@ what was wrong and, where possible, how to fix it.
 
 from __future__ import annotations
 
+import difflib
+import unicodedata
 from collections.abc import Iterable
+
+#: Letters that look like Latin ones (Cyrillic, Greek, dotless i, dashes), read as those by :func:`fold_name`
+#: (written as code points: the look-alikes themselves would be unreadable here).
+_CONFUSABLES = str.maketrans({
+    **dict(zip("\u0430\u0435\u043e\u0440\u0441\u0443\u0445\u0455\u0456\u0458\u0501\u04bb\u04cf\u043a"  # Cyrillic
+               "\u0410\u0412\u0415\u041a\u041c\u041d\u041e\u0420\u0421\u0422\u0425\u0423\u0405\u0406\u0408",
+               "aeopcyxsijdhlkABEKMHOPCTXYSIJ")),
+    **dict(zip("\u03b1\u03bf\u03c1\u03bd\u03c5\u03b9\u03ba\u03c7"  # Greek
+               "\u0391\u0392\u0395\u0396\u0397\u0399\u039a\u039c\u039d\u039f\u03a1\u03a4\u03a5\u03a7",
+               "aopvuikxABEZHIKMNOPTYX")),
+    "\u0131": "i", **dict.fromkeys("\u2010\u2011\u2012\u2013\u2014\u2212", "-"),  # dotless i; hyphens, dashes, minus
+})
+#: Up to this many valid names, an :class:`UnknownNameError` lists them all.
+SHORT_LIST = 20
+
+
+def fold_name(name: str) -> str:
+    """``name`` as plain lower-case ASCII where it can be: compatibility-decomposed (NFKD: full-width letters,
+    ligatures), accents dropped (``ö`` is ``o``), Cyrillic and Greek look-alikes read as the Latin letters they
+    resemble (Cyrillic ``\\u043e`` is ``o``), case folded. Two names that fold alike look alike to a reader."""
+    text = unicodedata.normalize("NFKD", name)
+    return "".join(c for c in text if not unicodedata.combining(c)).translate(_CONFUSABLES).casefold()
+
+
+def closest(name: object, valid: Iterable[str], *, cutoff: float = 0.75) -> tuple[str, ...]:
+    """The valid names ``name`` was most likely meant to be, best first (empty when none is close).
+
+    A valid name that folds to the same text (:func:`fold_name`: one accent, one Cyrillic letter, the case) is the
+    answer alone; else the valid names whose folded text is closest by :class:`difflib.SequenceMatcher` ratio
+    (at least ``cutoff``), when one is closest or two or three tie (more ties, or ties that are every valid name,
+    name none: no guess is better).
+    """
+    if not isinstance(name, str):
+        return ()
+    folded: dict[str, str] = {}
+    for v in valid:
+        if isinstance(v, str) and v != name:
+            folded.setdefault(fold_name(v), v)
+    key = fold_name(name)
+    if key in folded:
+        return (folded[key],)
+    matcher = difflib.SequenceMatcher(b=key, autojunk=False)
+    scored = []
+    for f, v in folded.items():
+        matcher.set_seq1(f)
+        if matcher.real_quick_ratio() >= cutoff and matcher.quick_ratio() >= cutoff and matcher.ratio() >= cutoff:
+            scored.append((matcher.ratio(), v))
+    if not scored:
+        return ()
+    best = max(r for r, _ in scored)
+    ties = [v for r, v in scored if r >= best - 1e-12]
+    return tuple(ties) if len(ties) <= 3 and (len(ties) == 1 or len(ties) < len(folded)) else ()
+
+
+def did_you_mean(names: tuple[str, ...]) -> str:
+    """``"did you mean 'a'?"``, ``"did you mean 'a' or 'b'?"``; empty for no names."""
+    if not names:
+        return ""
+    quoted = [repr(n) for n in names]
+    return "did you mean " + (quoted[0] if len(quoted) == 1 else ", ".join(quoted[:-1]) + " or " + quoted[-1]) + "?"
 
 
 class PkmError(Exception):
     """Base class of every error raised by pkm."""
+
+
+class PkmWarning(UserWarning):
+    """What pkm accepts but a user should know: a model whose actuators do not fit its mobility, a value read
+    as something else. The same sentence is kept in :attr:`pkm.core.Mechanism.notes`."""
 
 
 class InvalidInputError(PkmError, ValueError):
@@ -43,20 +110,32 @@ def _plural(noun: str) -> str:
 class UnknownNameError(PkmError, LookupError):
     """A frame, joint, branch or mechanism name does not exist.
 
+    The message names the closest valid names (:func:`closest`: ``"did you mean 'motor_1'?"`` for ``motör_1``
+    or a Cyrillic ``\\u043e``), and lists the valid names when there are at most :data:`SHORT_LIST` of them, or when
+    none is close (then the first :data:`SHORT_LIST` and their count).
+
     Attributes:
         kind: What was looked up ("frame", "joint", ...).
         name: The name that was not found.
         valid: The names that exist.
+        suggestions: The valid names it was most likely meant to be, best first (may be empty).
     """
 
     def __init__(self, kind: str, name: str, valid: Iterable[str], where: str = ""):
         self.kind = kind
         self.name = name
         self.valid = tuple(valid)
+        self.suggestions = closest(name, self.valid)
         loc = f" in {where}" if where else ""
-        shown = ", ".join(repr(v) for v in self.valid[:40])
-        more = f", ... ({len(self.valid)} in all)" if len(self.valid) > 40 else ""
-        PkmError.__init__(self, f"{kind} {name!r} does not exist{loc}; valid {_plural(kind)}: {shown}{more}")
+        hint = f" {did_you_mean(self.suggestions)}" if self.suggestions else ""
+        if len(self.valid) <= SHORT_LIST:
+            listing = f" valid {_plural(kind)}: " + ", ".join(repr(v) for v in self.valid)
+        elif self.suggestions:
+            listing = f" ({len(self.valid)} valid {_plural(kind)})"
+        else:
+            listing = (f" valid {_plural(kind)}: " + ", ".join(repr(v) for v in self.valid[:SHORT_LIST])
+                       + f", ... ({len(self.valid)} in all)")
+        PkmError.__init__(self, f"{kind} {name!r} does not exist{loc};{hint}{listing}")
 
     def __str__(self) -> str:  # LookupError would quote the message like a KeyError
         return self.args[0]
@@ -111,13 +190,16 @@ class AssemblyError(PkmError):
     Attributes:
         deficit: How far the equations are from having a real solution (> 0), in ``unit``.
         unit: Unit of ``deficit``.
+        closures: The closures found to stay open, each ``(name, gap)``, worst first (empty when not known).
     """
 
-    def __init__(self, deficit: float, unit: str = "m", detail: str = ""):
+    def __init__(self, deficit: float, unit: str = "m", detail: str = "", *,
+                 subject: str = "these actuated coordinates", closures: Iterable[tuple[str, float]] = ()):
         self.deficit = float(deficit)
         self.unit = unit
+        self.closures = tuple(closures)
         extra = f" ({detail})" if detail else ""
-        super().__init__(f"no assembly for these actuated coordinates: short by {self.deficit:.6g} {unit}{extra}")
+        super().__init__(f"no assembly for {subject}: short by {self.deficit:.6g} {unit}{extra}")
 
 
 class SingularityError(PkmError):

@@ -213,7 +213,59 @@ def test_diagnose_grades_the_approach_to_a_direct_singularity(built):
         d = pkm.diagnose(mech, _fivebar_at(mech, (0.0, 0.15 + eps), "elbows_out"))
         dists.append(d.direct_distance)
         assert d.classification == "regular" and d.near == (("direct",) if d.direct_distance < 1e-3 else ())
+        assert str(d).startswith("regular, but near a direct singularity (distance ") if d.near else str(d) == "regular"
         if eps <= 1e-3:
             assert abs(abs(d.direct_direction[1]) - 1.0) < 1e-3
     ratios = np.array(dists[:-1]) / np.array(dists[1:])
     assert np.all(ratios > 5) and np.all(ratios < 20)
+
+
+def _fivebar_driven_by(actuated, task):
+    import dataclasses
+
+    from pkm.core.mechanism import Mechanism
+    from pkm.core.spec import TaskSpec
+    from tests import fivebar
+
+    plain = fivebar.build()
+    spec = dataclasses.replace(plain.spec, actuated=actuated, task=TaskSpec(task), branches={}, default_branch=None)
+    return Mechanism.from_strings(plain.urdf, spec)
+
+
+def test_actuators_beyond_the_mobility_are_named_when_the_model_loads_and_by_diagnose():
+    """Issue 27: a five-bar (mobility 2) driven by three joints loads with a PkmWarning naming the dependent one
+    (kept in mech.notes); diagnose names it; loop closure from values that disagree says so instead of only 'did
+    not converge'."""
+    from pkm.core.differential import actuation
+    from pkm.errors import ConvergenceError, PkmWarning
+
+    with pytest.warns(PkmWarning, match=r"actuator\(s\) \['elbow_1'\] depend on the others \(mobility 2, 2 "):
+        mech = _fivebar_driven_by(("motor_1", "motor_2", "elbow_1"), ("x", "y"))
+    assert mech.dependent_actuators == ("elbow_1",) and "elbow_1" in mech.notes[-1]
+    fit = actuation(mech)
+    assert (fit.mobility, fit.independent, fit.unactuated) == (2, 2, 0)
+    d = pkm.diagnose(mech, mech.q_reference)
+    assert d.dependent_actuators == ("elbow_1",) and "['elbow_1'] depend on the others" in str(d)
+    qa = mech.actuated_q(mech.q_reference) + [0.01, -0.01, 0.3]  # elbow_1 disagrees with the motors
+    with pytest.raises(ConvergenceError, match=r"\['elbow_1'\] depend on the others"):
+        pkm.close_loops(mech, qa)
+
+
+def test_actuators_short_of_the_mobility_are_reported():
+    """A five-bar driven by one motor keeps one degree of freedom with it locked, which moves the tip: reported
+    (not an idle motion); the registered mechanisms and the toy five-bar fit theirs exactly."""
+    from pkm.core.differential import actuation
+    from pkm.errors import PkmWarning
+
+    with pytest.warns(PkmWarning, match=r"1 degree\(s\) of freedom move the task with every actuator locked"):
+        mech = _fivebar_driven_by(("motor_1",), ("x",))
+    fit = actuation(mech)
+    assert (fit.mobility, fit.independent, fit.dependent, fit.unactuated, fit.idle_motions) == (2, 1, (), 1, 0)
+    assert pkm.diagnose(mech, mech.q_reference).unactuated == 1
+    from tests import fivebar
+
+    assert actuation(fivebar.build()).problem == ""
+    from pkm.errors import SpecError
+
+    with pytest.raises(SpecError, match="no actuated joint"):  # (an IndexError before)
+        _fivebar_driven_by((), ())

@@ -174,8 +174,39 @@ def test_assemble_closes_from_far_seeds_and_says_which_closure_stays_open_when_n
         res = pkm.assemble(delta, q0)
         assert res.converged and np.abs(constraints.residual(delta, res.q)).max() <= 1e-10
     plain = fivebar.build()
-    with pytest.raises(SpecError, match=r"no assembly was found .*closure 'tip' stays open by 0\.[89]"):
+    with pytest.raises(SpecError, match=r"loops cannot be closed: .*'tip' \('tip_1'/'tip_2'\) open by 0\.[89]"):
         Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params(d=2.0)), _without_reference(plain))
+
+
+def test_a_frame_closure_that_cannot_close_is_named_with_its_gap_and_what_would_close_it():
+    """Issue 27 (Gepetto's kangaroo_like: 6-D loops whose frames no joint can align): a planar five-bar closed by a
+    frame closure whose second frame is tilted 0.3 rad about x cannot close, even alone; the error names the
+    closure, its frames, the gap left at best (0 m, 0.3 rad: the tilt no joint can take) and that a point closure
+    closes it, and carries the closures with their gaps (its cause, an AssemblyError). As a point closure it
+    assembles, its frames then 0.3 rad apart about x at least."""
+    import dataclasses
+
+    import pinocchio as pin
+
+    from pkm.core.spec import Closure
+    from tests import fivebar
+
+    tilted = ('<link name="tilted"/><joint name="tilted_fixed" type="fixed"><parent link="distal_2"/>'
+              '<child link="tilted"/><origin xyz="0.3 0 0" rpy="0.3 0 0"/></joint></robot>')
+    urdf = fivebar.urdf_xml(fivebar.Params()).replace("</robot>", tilted)
+    spec = dataclasses.replace(fivebar.build().spec, reference={},
+                               closures=(Closure("tips", "frame", "tip_1", "tilted"),))
+    with pytest.raises(SpecError, match=r"cannot be closed: .*'tips' \('tip_1'/'tilted'\) open by 0 m and 0\.3 rad "
+                                        r"at best \(its origins can meet\); each closes alone as a point closure") as info:
+        Mechanism.from_strings(urdf, spec)
+    (name, gap), = info.value.__cause__.closures
+    assert name == "tips" and gap > 0.01
+    mech = Mechanism.from_strings(urdf, dataclasses.replace(spec, closures=(Closure("tips", "point", "tip_1",
+                                                                                      "tilted"),)))
+    assert np.abs(constraints.residual(mech, mech.q_reference)).max() <= 1e-10
+    pin.framesForwardKinematics(mech.model, mech.data, mech.q_reference)
+    tilt = mech.data.oMf[mech.frame_id("tilted")].rotation.T @ mech.data.oMf[mech.frame_id("tip_1")].rotation
+    assert np.linalg.norm(pin.log3(tilt)) >= 0.3 - 1e-9  # (no joint turns about x)
 
 
 def test_assemble_holds_the_joints_it_is_told_to_and_a_partial_reference_holds_what_it_states(built):

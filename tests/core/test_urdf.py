@@ -7,7 +7,7 @@ import time
 import numpy as np
 import pytest
 
-from pkm.core.urdf import UrdfBuilder, check_urdf, load_model
+from pkm.core.urdf import UrdfBuilder, check_urdf, limit_notes, load_model, position_limits
 from pkm.errors import SpecError
 
 GOOD = """<robot name="r"><link name="base"/><link name="a"/>
@@ -40,7 +40,16 @@ def test_good_urdf_loads():
     (GOOD.replace('<limit lower="-1" upper="1" effort="1" velocity="1"/>', ""), "needs a <limit> element"),
     (GOOD.replace('xyz="0 0 1"', 'xyz="0 0 nan"'), "not finite"),
     (GOOD.replace('xyz="0 0 1"', 'xyz="0 0 0"'), "zero axis"),
-    (GOOD.replace('lower="-1"', 'lower="-1e9"'), "absurdly large"),
+    (GOOD.replace('lower="-1"', 'lower="1e9"'), "value 1000000000.0 is absurd for a lower limit"),
+    (GOOD.replace('upper="1"', 'upper="-1e6"'), "absurd for a upper limit"),
+    (GOOD.replace('velocity="1"', 'velocity="nan"'), "limit velocity: value nan is not finite"),
+    (GOOD.replace('effort="1"', 'effort="-inf"'), "limit effort: value -inf is not finite"),
+    (GOOD.replace('<axis xyz="0 0 1"/>', '<origin xyz="1e8 0 0"/><axis xyz="0 0 1"/>'), "absurdly large"),
+    (GOOD.replace('<link name="a"/>', '<link name="a"><inertial><mass value="1e8"/><inertia ixx="1" ixy="0" ixz="0" '
+                                      'iyy="1" iyz="0" izz="1"/></inertial></link>'), "mass: value 100000000.0 is not "
+                                                                                       "finite or absurdly large"),
+    (GOOD.replace('<link name="a"/>', '<link name="a"><inertial><mass value="1"/><inertia ixx="1e7" ixy="0" ixz="0" '
+                                      'iyy="1" iyz="0" izz="1"/></inertial></link>'), "inertia .* absurdly large"),
     (GOOD.replace('lower="-1" upper="1"', 'lower="1" upper="-1"'), "lower limit"),
     (GOOD.replace('type="revolute"', 'type="spherical"'), "unknown type"),
     (GOOD.replace("</robot>", '<joint name="k" type="fixed"><parent link="base"/><child link="a"/></joint></robot>'),
@@ -124,3 +133,32 @@ def test_stated_limits_are_carried_and_violations_reported_by_the_solvers():
     inside = mech.q_reference.copy()
     inside[[mech.joints[n].idx_q for n in mech.limits]] = 0.05
     assert mech.outside_limits(inside) == ()
+
+
+# ---------------------------------------------------------------------- exporters' "unlimited" limits
+@pytest.mark.parametrize("attrs, limits", [
+    ('lower="-1e8" upper="0.5" effort="1" velocity="1"', {"j": (-np.inf, 0.5)}),
+    ('lower="-0.25" upper="1e6" effort="1" velocity="1"', {"j": (-0.25, np.inf)}),
+    ('lower="-1e16" upper="1e16" effort="1" velocity="1"', {}),
+    ('lower="-1" upper="1" effort="1e8" velocity="1e8"', {"j": (-1.0, 1.0)}),
+    ('lower="-999999.0" upper="999999.0" effort="999999.0" velocity="999999.0"', {"j": (-999999.0, 999999.0)}),
+])
+def test_limits_of_a_million_or_more_are_read_as_none(attrs, limits):
+    """A limit of magnitude >= 1e6 (UNLIMITED) is no limit: that side of the position range is infinite, and a joint
+    with neither side bounded has no entry; just below 1e6 the limit is kept as stated."""
+    text = GOOD.replace('lower="-1" upper="1" effort="1" velocity="1"', attrs)
+    assert load_model(text).nq == 1
+    assert position_limits(text) == limits
+
+
+def test_the_limits_read_as_none_are_noted_once_per_value():
+    text = GOOD.replace('effort="1" velocity="1"', 'effort="1e+30" velocity="1e8"').replace("</robot>", (
+        '<link name="b"/><joint name="k" type="revolute"><parent link="a"/><child link="b"/>'
+        '<limit lower="-1e8" upper="1e8" effort="2" velocity="1e8"/></joint></robot>'))
+    assert limit_notes(check_urdf(text)) == (  # in the file's order
+        "joint 'j': effort limit 1e+30 read as none (|x| >= 1e+06)",
+        "joints 'j', 'k': velocity limit 1e8 read as none (|x| >= 1e+06)",
+        "joint 'k': lower limit -1e8 read as none (|x| >= 1e+06)",
+        "joint 'k': upper limit 1e8 read as none (|x| >= 1e+06)")
+    assert limit_notes(check_urdf(GOOD)) == ()
+

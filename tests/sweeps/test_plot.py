@@ -1,7 +1,8 @@
-"""Looking at sweeps (pkm.sweeps.plot, `pkm sweep plot|best`): figures, Pareto fronts, best designs as specs."""
+"""Looking at sweeps (pkm.sweeps.figures, `pkm sweep plot|best`): figures, Pareto fronts, best designs as specs."""
 
 from __future__ import annotations
 
+import importlib.util
 import json
 
 import numpy as np
@@ -11,6 +12,15 @@ import pkm
 from pkm import cli, sweeps
 from pkm.sweeps.results import pareto_front
 from tests.papers.figures import inspected
+
+
+def test_no_submodule_shadows_a_name_of_the_package():
+    """A submodule named as one of pkm.sweeps' names replaces that name in the package once imported: with the
+    figures in pkm/sweeps/plot.py, `sweeps.write_best` first made `sweeps.plot` that module (not callable)."""
+    clash = [n for n in sweeps.__all__ if importlib.util.find_spec(f"pkm.sweeps.{n}") is not None]
+    assert not clash
+    sweeps.write_best  # noqa: B018 (imports the figures' module)
+    assert callable(sweeps.plot) and callable(sweeps.write_best)
 
 
 def test_pareto_front_of_a_known_set():

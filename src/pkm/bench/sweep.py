@@ -56,15 +56,10 @@ def run(args) -> dict:
     results = {}
     for n in (1, 2):
         t0 = time.perf_counter()
-        cluster = local_cluster(n)
-        client = Client(cluster)
-        started = time.perf_counter() - t0
-        try:
+        with local_cluster(n) as cluster, Client(cluster) as client:  # (both closed, whatever happens)
+            started = time.perf_counter() - t0
             res = pkm.sweep("rrr3", _space(args.designs), objectives, client=client, progress=False)
             rss = client.run(_peak_rss_mb)
-        finally:
-            client.close()
-            cluster.close()
         st = res.stats
         results[n] = res
         out["runs"][f"local_{n}"] = {

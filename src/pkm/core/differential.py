@@ -307,6 +307,9 @@ class Diagnostics:
         direct_direction: The task motion (unit, task tangent coordinates) of the weakest passive
             motion with the actuators locked: where the platform gives way near a direct singularity.
         inverse_direction: The actuated rates (unit) of the weakest motion with the task frozen.
+        dependent_actuators: Actuators whose rates the others fix here (:class:`Actuation`).
+        unactuated: Degrees of freedom that move the task with every actuator locked (:class:`Actuation`).
+        near_threshold: The ``near`` argument: the distance below which :attr:`near` lists a kind.
     """
 
     constraint_rank: int
@@ -322,10 +325,103 @@ class Diagnostics:
     near: tuple[str, ...] = ()
     direct_direction: np.ndarray | None = None
     inverse_direction: np.ndarray | None = None
+    dependent_actuators: tuple[str, ...] = ()
+    unactuated: int = 0
+    near_threshold: float = 1e-3
+
+    @property
+    def summary(self) -> str:
+        """One sentence: the class, how near a singularity a regular configuration is, the actuators that do not
+        fit the mobility (``str(diagnostics)``)."""
+        out = self.classification
+        if self.near:
+            dist = {"direct": self.direct_distance, "inverse": self.inverse_distance}
+            out += ", but near " + " and ".join(f"{'an' if k == 'inverse' else 'a'} {k} singularity (distance "
+                                                 f"{dist[k]:.2g} < {self.near_threshold:g})" for k in self.near)
+        if self.dependent_actuators:
+            out += f"; actuators {list(self.dependent_actuators)} depend on the others"
+        if self.unactuated:
+            out += f"; {self.unactuated} degree(s) of freedom move the task with every actuator locked"
+        return out
+
+    def __str__(self) -> str:
+        return self.summary
+
+
+@dataclass(frozen=True)
+class Actuation:
+    """How the actuators match the mechanism's mobility at a configuration (:func:`actuation`).
+
+    Attributes:
+        mobility: Degrees of freedom the closures leave (idle motions included, a floating base's six not).
+        independent: How many actuators move independently: the rank of the actuated rates over the motions the
+            closures allow.
+        dependent: Actuators whose rates the others' fix (redundant actuation, or a joint held that leaves an
+            actuator no freedom), in spec order: each one's value must agree with the others'.
+        unactuated: Degrees of freedom left with every actuator locked that are not idle motions (they move the
+            task): the actuators fall short of the mobility by this.
+        idle_motions: Motions left with every actuator locked that the task does not see.
+    """
+
+    mobility: int
+    independent: int
+    dependent: tuple[str, ...]
+    unactuated: int
+    idle_motions: int
+
+    @property
+    def problem(self) -> str:
+        """A sentence naming the dependent or missing actuators, or ``""`` when the actuators fit the mobility."""
+        out = []
+        if self.dependent:
+            out.append(f"actuator(s) {list(self.dependent)} depend on the others (mobility {self.mobility}, "
+                       f"{self.independent} independent actuators): their values must agree with the others'")
+        if self.unactuated:
+            out.append(f"{self.unactuated} degree(s) of freedom move the task with every actuator locked: the "
+                       f"actuators fall short of the mobility ({self.mobility}, of which {self.idle_motions} idle)")
+        return "; ".join(out)
+
+
+def actuation(mech: Mechanism, q=None, *, rtol: float = 1e-7) -> Actuation:
+    """The actuators against the mobility at ``q`` (default: the reference configuration): which actuators depend
+    on the others, and how many degrees of freedom no actuator drives (:class:`Actuation`).
+
+    With ``N`` a basis of the motions the closures allow (the null space of ``J_c``, the floating base held), the
+    actuators are independent as far as the rows ``N[act]`` are (their rank, judged against ``rtol`` times the
+    largest singular value of ``J_c`` and 1e-6 for the unit-free rows), taken greedily in spec order: an actuator
+    whose row adds no rank depends on those before it. Judged at one configuration: at a singular one more
+    actuators look dependent than elsewhere.
+    """
+    mech = check_mechanism(mech)
+    q = mech.q_reference if q is None else mech.check_q(q)
+    rtol = as_tolerance(rtol, "rtol")
+    c = Configuration.compute(mech, q)
+    return _actuation(mech, c, _split(mech, c, rtol), rtol)
+
+
+def _actuation(mech: Mechanism, c: Configuration, sp: _Split, rtol: float) -> Actuation:
+    Jc = finite_result(c.constraint_jacobian, "constraint Jacobian")
+    keep = np.setdiff1d(np.arange(mech.nv), mech.base_v)
+    _, s, Vt = _svd(Jc[:, keep])
+    rank = int(np.sum(s > rtol * s[0])) if len(s) and s[0] > 0.0 else 0
+    N = Vt[rank:].T
+    rows = N[np.searchsorted(keep, mech.act_v)]
+    dependent, basis = [], np.zeros((0, N.shape[1]))
+    for name, row in zip(mech.actuated_names, rows):
+        trial = np.vstack([basis, row])
+        if len(trial) <= N.shape[1] and np.linalg.svd(trial, compute_uv=False)[-1] > 1e-6:
+            basis = trial
+        else:
+            dependent.append(name)
+    idle = sp.idle.shape[1]
+    mobility = N.shape[1]
+    return Actuation(mobility, len(basis), tuple(dependent), max(mobility - len(basis) - idle, 0), idle)
 
 
 def diagnose(mech: Mechanism, q, *, rtol: float = 1e-7, near: float = 1e-3) -> Diagnostics:
-    """Rank, mobility, idle motions and graded singularity measures at ``q`` (which should be assembled).
+    """Rank, mobility, idle motions, graded singularity measures and the actuators against the mobility at ``q``
+    (which should be assembled). ``str()`` of the result is one sentence (:attr:`Diagnostics.summary`): a regular
+    configuration inside the ``near`` band says how near it is.
 
     Args:
         rtol: Relative rank tolerance: a kind is singular where its distance is at most ``rtol``.
@@ -345,7 +441,8 @@ def diagnose(mech: Mechanism, q, *, rtol: float = 1e-7, near: float = 1e-3) -> D
     direct, inverse = dd <= rtol, di <= rtol
     moved = np.abs(sp.idle).max(axis=1) > 1e-6 if sp.idle.shape[1] else np.zeros(mech.nv, dtype=bool)
     idle_joints = tuple(j.name for j in mech.joints.values() if moved[j.idx_v:j.idx_v + j.nv].any())
+    fit = _actuation(mech, c, sp, rtol)
     return Diagnostics(rank, mech.n_constraints - rank, mech.nv - rank, sp.sigma_direct, sp.sigma_inverse,
                        singularity_class(inverse, direct), sp.idle.shape[1], idle_joints, dd, di,
                        tuple(k for k, d in (("direct", dd), ("inverse", di)) if rtol < d < near),
-                       sp.direct_direction, sp.inverse_direction)
+                       sp.direct_direction, sp.inverse_direction, fit.dependent, fit.unactuated, near)

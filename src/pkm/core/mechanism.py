@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import threading
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,7 +26,7 @@ import pinocchio as pin
 from pkm.core.joints import retype_joints
 from pkm.core.spec import ClosureSpec, as_path
 from pkm.core.urdf import load_model, position_limits
-from pkm.errors import AssemblyError, InvalidInputError, SpecError, SpecNameError, UnknownNameError
+from pkm.errors import AssemblyError, InvalidInputError, PkmWarning, SpecError, SpecNameError, UnknownNameError
 from pkm.units import quantities
 from pkm.validation import as_array, as_vector, wrap_angle
 
@@ -80,7 +81,7 @@ class Mechanism:
     """
 
     def __init__(self, model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | None = None,
-                 source: str = "<model>"):
+                 source: str = "<model>", notes: tuple[str, ...] = ()):
         if not isinstance(model, pin.Model):
             raise InvalidInputError("model", f"expected a pinocchio.Model, got {type(model).__name__}", model)
         if not isinstance(spec, ClosureSpec):
@@ -91,6 +92,9 @@ class Mechanism:
         self.params = params
         self.urdf = urdf
         self.source = source
+        #: What the file's reader interpreted or ignored (:attr:`pkm.core.formats.imported.Imported.notes`), and
+        #: actuators that do not fit the mobility (:func:`pkm.core.differential.actuation`).
+        self.notes: tuple[str, ...] = tuple(notes)
         #: ``{joint: (lower, upper)}`` position limits stated by the URDF (none when built from a model).
         self.limits: dict[str, tuple[float, float]] = position_limits(urdf, source) if urdf is not None else {}
         self.joints: dict[str, JointInfo] = {}
@@ -123,6 +127,8 @@ class Mechanism:
         self.task_frames = [frame(f, "task.frames") for f in spec.task.frames]
         self.closure_frames = [(frame(c.frame_a, f"closure {c.name!r}"), frame(c.frame_b, f"closure {c.name!r}"))
                                for c in spec.closures]
+        if not spec.actuated:
+            raise SpecError(source, "no actuated joint: name the driven joints (actuated = [...] in a closure spec)")
         self.actuated = tuple(scalar_joint(n, "actuated") for n in spec.actuated)
         self.task_joints = tuple(scalar_joint(n, "task.joints") for n in spec.task.joints)
         if spec.task.size > len(self.actuated):
@@ -182,6 +188,8 @@ class Mechanism:
             try:
                 self.q_reference = assemble(self, self.q_reference, hold=tuple(spec.reference), tol=1e-12).q
             except AssemblyError as exc:
+                if not spec.reference:  # (the file states no configuration: the loops themselves do not close)
+                    raise SpecError(source, f"the loops cannot be closed: {exc}") from exc  # (its closures, gaps)
                 raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found that keeps the "
                                         f"joints it states, the others starting from the neutral configuration "
                                         f"({exc}); give an assembled [reference]") from None
@@ -190,6 +198,14 @@ class Mechanism:
             raise SpecError(source, f"the [reference] configuration leaves closure {closure!r} open by {gap:.3g} "
                                     f"(m or rad; closed means <= {REFERENCE_TOL:g}): fix it, or leave joints out of "
                                     "[reference] to have pkm assemble the mechanism (pkm.assemble)")
+        from pkm.core.differential import actuation  # (differential imports this module)
+
+        fit = actuation(self)
+        #: Actuators whose values the others fix at the reference (redundant actuation): see ``notes``.
+        self.dependent_actuators: tuple[str, ...] = fit.dependent
+        if fit.problem:
+            self.notes += (f"at the reference configuration, {fit.problem}",)
+            warnings.warn(f"{source}: at the reference configuration, {fit.problem}", PkmWarning, stacklevel=2)
 
     def outside_limits(self, q, *, tol: float = 1e-9) -> tuple[str, ...]:
         """The joints whose coordinate in ``q`` lies outside their stated position limits by more than ``tol``
@@ -240,8 +256,9 @@ class Mechanism:
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_strings(cls, urdf: str, spec: ClosureSpec | str, params: Any = None,
-                     source: str = "<string>") -> Mechanism:
-        """Build from URDF text and a spec (object or TOML text).
+                     source: str = "<string>", notes: tuple[str, ...] = ()) -> Mechanism:
+        """Build from URDF text and a spec (object or TOML text); ``notes``: what the reader of its files interpreted
+        or ignored (:attr:`notes`).
 
         Raises:
             SpecError: The URDF or the spec is malformed, or they do not fit together (see
@@ -255,7 +272,8 @@ class Mechanism:
                                     spec)
         if isinstance(spec, str):
             spec = ClosureSpec.from_toml(spec, source + " (closures)")
-        return cls(retype_joints(load_model(urdf, source), spec.joint_types, source), spec, params, urdf, source)
+        return cls(retype_joints(load_model(urdf, source), spec.joint_types, source), spec, params, urdf, source,
+                   notes)
 
     @classmethod
     def from_files(cls, spec_path: str | Path) -> Mechanism:
@@ -283,7 +301,7 @@ class Mechanism:
         imported = import_model(urdf_path)
         spec = with_file(spec, imported, str(spec_path))
         model = retype_joints(load_model(imported.urdf, str(urdf_path)), spec.joint_types, str(spec_path))
-        return cls(model, spec, None, imported.urdf, str(spec_path))
+        return cls(model, spec, None, imported.urdf, str(spec_path), imported.notes)
 
     # ------------------------------------------------------------------ sizes and names
     @property

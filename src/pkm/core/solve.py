@@ -313,8 +313,68 @@ def assemble(mech: Mechanism, q0=None, *, hold=(), tol: float = 1e-10, restarts:
             return _result(mech, q, True, res, total, k + 1)
     result = _result(mech, best[1], False, best[0], total, restarts + 1)
     err = _failure(mech, "assembly", result, tol)
-    raise AssemblyError(best[0], "m or rad", f"{restarts + 1} starts of Levenberg-Marquardt; best: closure "
-                                             f"{err.worst_closure!r} stays open by {err.worst_gap:.3g}")
+    alone, detail = _open_alone(mech, q_seed, held, tol, max_iter, rng)
+    detail = detail or (f"{restarts + 1} starts of Levenberg-Marquardt: each closure closes alone, not all of them "
+                        f"together; at the best start closure {err.worst_closure!r} "
+                        f"({_frames(mech, err.worst_closure)}) stays open by {err.worst_gap:.3g}")
+    raise AssemblyError(best[0], "m or rad", detail, subject="this mechanism",
+                        closures=alone or ((str(err.worst_closure), err.worst_gap),))
+
+
+def _frames(mech: Mechanism, closure: str | None) -> str:
+    """``"frames 'A' and 'B'"`` of the named closure, as its file names them."""
+    c = next((c for c in mech.spec.closures if c.name == closure), None)
+    return f"frames {c.frame_a!r} and {c.frame_b!r}" if c is not None else "no closure"
+
+
+def _open_alone(mech: Mechanism, q_seed: np.ndarray, held: np.ndarray, tol: float, max_iter: int, rng
+                ) -> tuple[list[tuple[str, float]], str]:
+    """Why no assembly was found: the closures that do not close even alone (each tried with the others cut, from
+    the seed and three perturbed starts) with their gaps, worst first, and a sentence saying so and what would close
+    them: a frame closure whose origins can meet but whose frames stay turned apart closes as a point closure.
+    ``([], "")`` when every closure closes alone (then they fail only together)."""
+    sizes = [cm.residualSize() for cm in mech.constraint_models]
+    starts = np.cumsum([0, *sizes])
+
+    def gap(rows: np.ndarray) -> tuple[float, np.ndarray]:
+        def fun(qq):
+            F, J = constraints.residual_and_jacobian(mech, qq)
+            J[:, held] = 0.0
+            return F[rows], J[rows]
+
+        best = (np.inf, q_seed)
+        for k in range(4):
+            q = pin.integrate(mech.model, q_seed, np.where(held, 0.0, 0.3 * k * rng.standard_normal(mech.nv)))
+            q, r, _ = _levenberg_marquardt(mech, fun, q, tol, max_iter)
+            if np.abs(r).max() < best[0]:
+                best = (float(np.abs(r).max()), q)
+            if best[0] <= tol:
+                break
+        return best
+
+    open_: list[tuple[str, float, str]] = []
+    as_points = 0
+    for c, a, n in zip(mech.spec.closures, starts, sizes):
+        g, q = gap(np.arange(a, a + n))
+        if g <= tol:
+            continue
+        r = constraints.residual(mech, q)[a:a + n]
+        apart, turned = (float(np.linalg.norm(part)) if part.size and np.abs(part).max() > tol else 0.0
+                         for part in (r[:3], r[3:]))
+        what = f"{c.name!r} ({c.frame_a!r}/{c.frame_b!r}) open by {apart:.3g} m"
+        if c.type == "frame":
+            what += f" and {turned:.3g} rad at best"
+            if gap(np.arange(a, a + 3))[0] <= tol:
+                as_points += 1
+                what += " (its origins can meet)"
+        open_.append((c.name, g, what))
+    if not open_:
+        return [], ""
+    open_.sort(key=lambda t: -t[1])
+    fix = (f"; {'each' if as_points == len(open_) else f'{as_points} of them'} closes alone as a point closure (the "
+           "frames' origins meet: type 'point' in a closure spec, '3d' in a robot.yaml)" if as_points else "")
+    return ([(name, g) for name, g, _ in open_],
+            f"{len(open_)} closure(s) cannot close even alone: " + "; ".join(w for _, _, w in open_) + fix)
 
 
 def _levenberg_marquardt(mech: Mechanism, fun, q: np.ndarray, tol: float, max_iter: int
@@ -372,6 +432,9 @@ def _failure(mech: Mechanism, what: str, result: SolveResult, tol: float) -> Con
     gap, _, name = constraints.worst_closure(mech, constraints.residual(mech, result.q))
     detail = (f"closure {name!r} stays open by {gap:.3g} (m or rad) at the last iterate"
               if name is not None and gap > tol else "the task target is not met")
+    if what == "loop closure" and mech.dependent_actuators:
+        detail += (f"; actuators {list(mech.dependent_actuators)} depend on the others (see mech.notes): values "
+                   "that do not agree with the others' admit no assembly")
     err = ConvergenceError(what, result.residual, result.iterations, tol, result, detail)
     err.worst_closure, err.worst_gap = name, gap
     return err

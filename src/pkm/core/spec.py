@@ -41,6 +41,15 @@ Format ``pkm.closures/1`` (all values SI: m, rad)::
     [parameters]                     # the design that generated the files (informative)
     R = 0.15
 
+    [joint_types]                    # joints the URDF writes as revolutes that are not
+    ball_1 = "spherical"             # a ball joint (a unit quaternion, 3 velocities)
+    cardan_1 = "universal_zy"        # a universal joint: about the joint frame's z, then its (turned) y
+    lock_1 = "fixed"                 # welded at its neutral value
+
+``[joint_types]`` values (:mod:`pkm.core.joints`): ``"spherical"``; ``"universal_ab"`` with ``a``, ``b`` two
+distinct axes of ``x``, ``y``, ``z`` (``R = exp(q1 [a]) exp(q2 [b])``, Gepetto's ``UJOINT_AB``), ``"universal"``
+being ``"universal_xy"``; ``"fixed"``.
+
 Task components: ``x, y, z`` are the end-effector origin in the world frame;
 ``roll, pitch, yaw`` are the Z-Y-X Euler angles of its orientation,
 ``R = Rz(yaw) Ry(pitch) Rx(roll)``. ``pose`` stands for the full placement; its
@@ -164,8 +173,8 @@ class ClosureSpec:
     default_branch: str | None = None
     parameters: Mapping[str, float | str] = field(default_factory=dict)
     description: str = ""
-    #: Joints the URDF writes as revolutes that are ``"spherical"``, ``"universal"`` or ``"fixed"``
-    #: (:mod:`pkm.core.joints`).
+    #: Joints the URDF writes as revolutes that are ``"spherical"``, ``"universal"`` / ``"universal_ab"`` (``ab``
+    #: two distinct of ``x``, ``y``, ``z``) or ``"fixed"`` (:mod:`pkm.core.joints`).
     joint_types: Mapping[str, str] = field(default_factory=dict)
     #: A free-flyer joint on the world that carries the whole mechanism (a legged robot's pelvis): its pose is an
     #: input, held by the solvers where ``q`` puts it (see :class:`pkm.core.Mechanism`).
@@ -304,8 +313,8 @@ class ClosureSpec:
 
         joint_types = raw.get("joint_types", {})
         if not isinstance(joint_types, dict) or not all(isinstance(v, str) for v in joint_types.values()):
-            raise SpecError(source, "joint_types must be a table of joint name = \"spherical\" | \"universal\" | "
-                                    "\"fixed\"")
+            raise SpecError(source, "joint_types must be a table of joint name = \"spherical\" | \"universal_ab\" | "
+                                    "\"fixed\" (see pkm.core.joints)")
 
         floating_base = raw.get("floating_base")
         if floating_base is not None and (not isinstance(floating_base, str) or not floating_base):

@@ -28,7 +28,11 @@ raises :class:`~pkm.errors.SpecError` for:
   ``<limit>`` states only one of ``lower`` and ``upper``, or ``lower > upper`` (position limits are optional: without them a joint has none;
   with them :meth:`pkm.core.Mechanism.outside_limits` and every solver result report violations);
 * a number that is not finite or absurd (``|x| > 1e6`` in SI units, taken for a unit error):
-  origins, axes, limits, efforts, velocities, masses, inertias, mimic coefficients;
+  origins, axes, masses, inertias, mimic coefficients; a non-finite limit. A joint limit of magnitude
+  ``>= 1e6`` (:data:`UNLIMITED`: exporters write ``velocity="1e8"`` or ``effort="1e30"`` for "unlimited") is
+  read as no limit: an effort or velocity limit of any sign, a lower limit ``<= -1e6``, an upper limit
+  ``>= 1e6`` (:func:`position_limits` gives that side as infinite); :func:`limit_notes` says which were read so;
+  a lower limit ``>= 1e6`` or an upper one ``<= -1e6`` is refused;
 * a negative mass, an inertia tensor that is not positive semi-definite (beyond round-off);
 * a ``<mimic>`` naming an unknown joint.
 
@@ -42,7 +46,7 @@ from __future__ import annotations
 import io
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pinocchio as pin
@@ -125,6 +129,10 @@ class UrdfBuilder:
         return text
 
 
+#: A joint limit of at least this magnitude (SI: m, rad, m/s, rad/s, N, N m) is read as no limit.
+UNLIMITED = 1e6
+_LIMIT_SIGN = {"lower": -1.0, "upper": 1.0, "effort": 0.0, "velocity": 0.0}  # the side a limit opens (0: either)
+
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(nan|inf|infinity)", re.IGNORECASE)
 
 
@@ -140,6 +148,45 @@ def floats(text: str | None, n: int, what: str, source: str, bound: float = ABSU
         if not math.isfinite(v) or abs(v) > bound:
             raise SpecError(source, f"{what}: value {v!r} is not finite or absurdly large (SI units expected)")
     return vals
+
+
+def limit_value(text: str | None, key: str, what: str, source: str) -> float | None:
+    """A joint ``<limit>`` attribute (``key``: ``lower``, ``upper``, ``effort`` or ``velocity``) as a number, or
+    None when it states no limit: magnitude ``>= UNLIMITED`` (a lower limit ``<= -1e6``, an upper ``>= 1e6``, an
+    effort or velocity of either sign).
+
+    Raises:
+        SpecError: not a finite number; a lower limit ``>= 1e6`` or an upper one ``<= -1e6`` (no joint moves
+            there: a unit error).
+    """
+    v = floats(text, 1, what, source, bound=math.inf)[0]
+    if abs(v) < UNLIMITED:
+        return v
+    side = _LIMIT_SIGN[key]
+    if side and v * side < 0:
+        raise SpecError(source, f"{what}: value {v!r} is absurd for a {key} limit (SI units expected)")
+    return None
+
+
+def limit_notes(root: etree._Element) -> tuple[str, ...]:
+    """One sentence per limit value a checked URDF states that :func:`limit_value` reads as none, the joints
+    that state it named: ``"joint 'j': velocity limit 1e8 read as none"``."""
+    found: dict[tuple[str, str], list[str]] = {}
+    for el in root.findall("joint"):
+        lim = el.find("limit")
+        if lim is None:
+            continue
+        keys = tuple(_LIMIT_SIGN) if el.get("type") in ("revolute", "prismatic") else ("effort", "velocity")
+        for key in keys:  # (the position limits of other joints are neither checked nor read)
+            text = lim.get(key)
+            if text is not None and abs(float(text)) >= UNLIMITED:
+                found.setdefault((key, text.strip()), []).append(str(el.get("name")))
+    out = []
+    for (key, text), joints in found.items():
+        shown = ", ".join(repr(j) for j in joints[:6]) + (f", ... ({len(joints)} joints)" if len(joints) > 6 else "")
+        out.append(f"joint{'s' if len(joints) > 1 else ''} {shown}: {key} limit {text} read as none "
+                   f"(|x| >= {UNLIMITED:g})")
+    return tuple(out)
 
 
 def parse_xml(text: str | bytes, source: str = "<string>", root_tag: str = "robot", what: str = "URDF") \
@@ -228,14 +275,14 @@ def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
                 raise SpecError(source, f"joint {name!r} ({typ}) states only its {stated[0]} limit; give both "
                                         "lower and upper, or neither (no position limits)")
             if stated:
-                lo, hi = floats(f"{lim.get('lower')} {lim.get('upper')}", 2, f"joint {name!r} limits", source)
-                if lo > hi:
+                lo, hi = (limit_value(lim.get(k), k, f"joint {name!r} {k} limit", source) for k in ("lower", "upper"))
+                if lo is not None and hi is not None and lo > hi:
                     raise SpecError(source, f"joint {name!r}: lower limit {lo} > upper limit {hi}")
         lim = el.find("limit")
         if lim is not None:
             for key in ("effort", "velocity"):
                 if lim.get(key) is not None:
-                    floats(lim.get(key), 1, f"joint {name!r} limit {key}", source)
+                    limit_value(lim.get(key), key, f"joint {name!r} limit {key}", source)
         mim = el.find("mimic")
         if mim is not None and mim.get("joint") not in jnames:
             raise SpecError(source, f"joint {name!r} mimics unknown joint {mim.get('joint')!r}")
@@ -275,15 +322,19 @@ def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
 
 
 def position_limits(text: str | bytes, source: str = "<string>") -> dict[str, tuple[float, float]]:
-    """``{joint: (lower, upper)}`` for the revolute and prismatic joints whose ``<limit>`` states both (checked
-    URDF text; the others have none: Pinocchio's parser gives them ``[0, 0]``, which pkm does not read)."""
+    """``{joint: (lower, upper)}`` [m or rad] for the revolute and prismatic joints whose ``<limit>`` states both
+    (checked URDF text; the others have none: Pinocchio's parser gives them ``[0, 0]``, which pkm does not read).
+    A side stated beyond :data:`UNLIMITED` is infinite (``-inf`` or ``inf``); a joint with neither side bounded
+    has no entry."""
     out: dict[str, tuple[float, float]] = {}
     for el in check_urdf(text, source).findall("joint"):
         lim = el.find("limit")
         if el.get("type") in ("revolute", "prismatic") and lim is not None and lim.get("lower") is not None \
                 and lim.get("upper") is not None:
-            lo, hi = floats(f"{lim.get('lower')} {lim.get('upper')}", 2, "limits", source)
-            out[str(el.get("name"))] = (lo, hi)
+            lo, hi = (limit_value(lim.get(k), k, f"joint {el.get('name')!r} {k} limit", source)
+                      for k in ("lower", "upper"))
+            if lo is not None or hi is not None:
+                out[str(el.get("name"))] = (-math.inf if lo is None else lo, math.inf if hi is None else hi)
     return out
 
 
@@ -342,9 +393,21 @@ def _urdf_joint_kind(jm, where: str, source: str) -> tuple[str, np.ndarray | Non
                             "prismatic, continuous, spherical, universal about x then y, and free-flyer joints)")
 
 
+def _joint_motion(jm, value: float, where: str, source: str) -> pin.SE3:
+    """The placement a revolute or prismatic joint model gives its child at ``q = value`` (rad or m)."""
+    kind, axis, pkm_type = _urdf_joint_kind(jm, where, source)
+    if kind not in ("revolute", "prismatic") or pkm_type is not None or axis is None:
+        raise SpecError(source, f"{where}: only a revolute or prismatic joint can be locked at a value")
+    if kind == "revolute":
+        return pin.SE3(pin.AngleAxis(float(value), axis / np.linalg.norm(axis)).matrix(), np.zeros(3))
+    return pin.SE3(np.eye(3), float(value) * axis / np.linalg.norm(axis))
+
+
 def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: dict[str, list[str]] | None = None,
                     limits: dict[str, tuple[float, float]] | None = None,
                     frames: Sequence[tuple[str, int, pin.SE3]] = (), skip_frames: tuple[str, ...] = (),
+                    mimic: Mapping[str, tuple[str, float, float]] | None = None,
+                    locked: Mapping[str, float] | None = None,
                     source: str = "<model>") -> tuple[str, dict[str, str]]:
     """The URDF text of a Pinocchio tree, and the ``[joint_types]`` that URDF cannot state.
 
@@ -355,14 +418,21 @@ def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: d
     every other body and operational frame, and each of ``frames`` (``(name, parent joint id,
     placement in that joint's frame)``), becomes a massless link on a fixed joint ``<frame>_fixed``.
     ``limits`` gives the position limits ``{joint: (lower, upper)}`` to state; the other revolute and
-    prismatic joints get a ``<limit>`` without bounds. :func:`load_model` and
-    :func:`pkm.core.joints.retype_joints` give the same tree back (same ``q`` layout, frames, inertias).
+    prismatic joints get a ``<limit>`` without bounds. ``mimic`` makes joints followers,
+    ``{joint: (leader, multiplier, offset)}``: a URDF ``<mimic>``, ``q_joint = multiplier q_leader + offset``
+    (:func:`load_model` builds Pinocchio's mimic joints; the leader must come first in its traversal).
+    ``locked`` welds one-coordinate joints at a value, ``{joint: q [rad or m]}``: a fixed joint at the
+    placement the joint has there. :func:`load_model` and :func:`pkm.core.joints.retype_joints` give the
+    same tree back (same ``q`` layout but for the mimic and locked joints, frames, inertias).
 
     Raises:
-        SpecError: a joint kind URDF and ``[joint_types]`` cannot express (planar, helical...), mimic joints.
+        SpecError: a joint kind URDF and ``[joint_types]`` cannot express (planar, helical...), mimic joints
+            in ``model``, a locked joint with more than one coordinate.
     """
     joint_names = joint_names or {}
     limits = limits or {}
+    mimic = mimic or {}
+    locked = locked or {}
     fnames = {f.name for f in model.frames}
     taken: set[str] = set()
 
@@ -424,7 +494,13 @@ def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: d
             child = (unique(body) if body is not None else unique(f"{pname}_link")) if last else unique(f"{pname}_link")
             link(child, model.inertias[jid] if last else None)
             M = model.jointPlacements[jid] * placement if k == 0 else placement
+            if pname in locked:
+                M, kind, axis, pkm_type = M * _joint_motion(part, locked[pname], f"joint {pname!r}", source), \
+                    "fixed", None, None
             joint(pname, kind, parent, child, M, axis)
+            if pname in mimic:
+                leader, mult, off = mimic[pname]
+                etree.SubElement(robot[-1], "mimic", joint=leader, multiplier=repr(float(mult)), offset=repr(float(off)))
             if pkm_type:
                 types[pname] = pkm_type
             parent = child

@@ -113,12 +113,32 @@ def opcount_rows(mechanism: str, prefix: str, note: str = "") -> list[Row]:
 def modes_row(mechanism: str, row_id: str, compare: Callable[[Any, Any], str] | None = None) -> Row:
     """Row ``row_id``: the number of real assembly modes at the reference design's reference actuators
     (:func:`pkm.assembly_modes`; the papers publish none), with the set's account and, from ``compare(mech,
-    modes) -> note``, what another method finds. Without Bertini the row says so (computed None)."""
+    modes) -> note``, what another method finds. Without Bertini the row says so (computed None). The row is
+    cached on disk (:mod:`pkm.cache`) under its inputs: the mechanism's files, the actuator values, Bertini's
+    version and the code that computes it (the homotopy takes seconds, and every ``pkm report`` process would
+    solve it again)."""
+    import importlib.metadata
+
     import pkm
-    from pkm.errors import MissingDependencyError
+    from pkm.cache import cached
 
     mech = pkm.load(mechanism)
     qa = mech.actuated_q(mech.q_reference)
+    try:
+        bertini: str | None = importlib.metadata.version("bertini2")
+    except importlib.metadata.PackageNotFoundError:
+        bertini = None
+    key = [row_id, mech.urdf, mech.spec.to_toml(), qa.tolist(), bertini]
+    code = ["pkm.core.modes", "pkm.core.solve", "pkm.papers", *([compare.__module__] if compare is not None else [])]
+    row = cached("rows", key, lambda: _modes_row(mech, qa, row_id, compare).to_dict(), code=code)
+    row.pop("matches", None)
+    return Row(**row)
+
+
+def _modes_row(mech, qa, row_id: str, compare: Callable[[Any, Any], str] | None) -> Row:
+    import pkm
+    from pkm.errors import MissingDependencyError
+
     try:
         modes = pkm.assembly_modes(mech, qa)
     except MissingDependencyError as exc:

@@ -14,7 +14,8 @@
 
 The pieces: :mod:`~pkm.sweeps.space` (grids, Sobol', Latin hypercubes, tables), :mod:`~pkm.sweeps.family`
 (what varies: a registered mechanism's design fields or a loaded one's joint origins), :mod:`~pkm.sweeps.objectives`
-(what is scored), :mod:`~pkm.sweeps.engine` (Dask, chunks, Parquet, resume) and :mod:`~pkm.sweeps.plot`.
+(what is scored), :mod:`~pkm.sweeps.engine` (Dask, chunks, Parquet, resume) and :mod:`~pkm.sweeps.figures`. No
+submodule is named as one of the package's names (importing it would replace that name in the package).
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from pkm.errors import SweepError
 _WHERE = {"sweep": "pkm.sweeps.engine",
           **dict.fromkeys(("Candidate", "Family", "ModelFamily", "RegisteredFamily", "family_of"), "pkm.sweeps.family"),
           **dict.fromkeys(("OBJECTIVES", "Objective", "objective"), "pkm.sweeps.objectives"),
-          **dict.fromkeys(("plot", "write_best"), "pkm.sweeps.plot"),
+          **dict.fromkeys(("plot", "write_best"), "pkm.sweeps.figures"),
           **dict.fromkeys(("Stats", "SweepResult", "pareto_front", "read"), "pkm.sweeps.results"),
           **dict.fromkeys(("Designs", "Space", "grid", "latin_hypercube", "sobol", "table"), "pkm.sweeps.space"),
           "FORMAT": "pkm.sweeps.store"}
@@ -36,8 +37,8 @@ _WHERE = {"sweep": "pkm.sweeps.engine",
 if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.sweeps.engine import sweep
     from pkm.sweeps.family import Candidate, Family, ModelFamily, RegisteredFamily, family_of
+    from pkm.sweeps.figures import plot, write_best
     from pkm.sweeps.objectives import OBJECTIVES, Objective, objective
-    from pkm.sweeps.plot import plot, write_best
     from pkm.sweeps.results import Stats, SweepResult, pareto_front, read
     from pkm.sweeps.space import Designs, Space, grid, latin_hypercube, sobol, table
     from pkm.sweeps.store import FORMAT

@@ -17,12 +17,26 @@ on an existing output is refused unless ``overwrite=True``.
 Each design is evaluated alone: an exception in an objective fails that design (``status="failed"``, the first
 failing objective's error class and message; that objective's cell null, the others kept), not the sweep; a design
 that kills its worker process (after Dask's retries) is recorded as failed with ``KilledWorker``, the other designs
-of its chunk run again one by one. Designs lost to the cluster itself are not recorded: the sweep raises
-:class:`~pkm.errors.SweepError` after keeping the chunks that finished, and a rerun resumes.
+of its chunk run again one by one. A sweep whose every design failed returns (and writes) its table as any other;
+:meth:`SweepResult.check() <pkm.sweeps.SweepResult.check>` raises :class:`~pkm.errors.SweepError` naming how many
+and the first failure (as ``pkm sweep`` does), and ranking by an objective that no design has is one too. Designs
+lost to the cluster itself are not recorded: the sweep raises :class:`~pkm.errors.SweepError` after keeping the
+chunks that finished, and a rerun resumes.
+
+Every Dask client and local cluster a sweep makes is its own, and is closed before :func:`sweep` returns or raises
+(an error, a ``KeyboardInterrupt``), a client whose constructor failed part way included (:func:`_construct`);
+nothing is left to the garbage collector. Not one client kept per process: a sweep's local cluster is shaped by its
+call (``workers``, the allocator settings of :func:`local_cluster`), its workers hold the imports and memory of the
+mechanism swept, and a cluster a design damaged (killed workers) would carry over into the next sweep; starting one
+costs about a second, small beside a sweep worth distributing. And closing late is not only a leak: dask closes a
+forgotten client from its ``__del__``, wherever the collector runs, and when that is inside the next client's
+start both wait on dask's one loop-runner lock: the process hangs for good. A ``client=`` given by the caller is
+the caller's: used, never closed.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import logging
@@ -178,38 +192,70 @@ def local_cluster(workers: int | None = None):
         with dask.config.set({"distributed.nanny.pre-spawn-environ": environ,
                               "distributed.worker.profile.enabled": False,
                               "distributed.scheduler.worker-saturation": 1.0}):
-            return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                                silence_logs=logging.ERROR)
+            return _construct(LocalCluster, n_workers=n, threads_per_worker=1, processes=True,
+                              dashboard_address=None, silence_logs=logging.ERROR)
     except RuntimeError as exc:  # the workers could not start (a __main__ they cannot re-import: stdin, -c)
         raise SweepError(f"could not start {n} local Dask workers ({exc}): run the sweep from a script (with an "
                          "`if __name__ == '__main__':` guard), a notebook or `pkm sweep`, or pass "
                          "scheduler='serial'") from None
 
 
-def _client(scheduler, client, workers: int | None):
-    """``(client, what to close when done: the client and its local cluster, or nothing, workers)``."""
+def _construct(cls, *args, **kwargs):
+    """``cls(*args, **kwargs)`` for a dask ``Client`` or cluster, closed at once if its constructor raises (or is
+    interrupted) part way: ``Client("tcp://unreachable:8786")`` has started its IO loop (and, made the default,
+    registered itself) before its connection fails; the exception does not hand it back, and it would stay open
+    until the garbage collector found it (see the module doc)."""
+    obj = cls.__new__(cls)
+    try:
+        obj.__init__(*args, **kwargs)
+    except BaseException:
+        _close(obj)  # (a client that never connected, status "newly-created", ignores this: its loop goes next)
+        runner = getattr(obj, "_loop_runner", None)
+        if runner is not None:
+            runner.stop()  # (idempotent)
+        raise
+    return obj
+
+
+def _close(thing) -> None:
+    """Close a client or cluster of ours; a failure to close (the scheduler already gone) is logged, not raised:
+    it must not hide the sweep's own outcome."""
+    try:
+        thing.close()
+    except Exception as exc:  # (AttributeError: a constructor that failed before its first attribute)
+        logging.getLogger(__name__).debug("closing %s: %r", type(thing).__name__, exc)
+
+
+def _client(scheduler, client, workers: int | None, stack: contextlib.ExitStack):
+    """``(client, workers)``; what this makes (a client, a local cluster) is closed by ``stack``, registered the
+    moment it exists. Its clients are not made dask's default (``set_as_default=False``): a ``dask.compute`` of the
+    caller's, while a sweep runs, stays on the caller's scheduler."""
     from dask.distributed import Client
 
     if client is not None:
         if not isinstance(client, Client):
             raise InvalidInputError("client", f"expected a dask.distributed.Client, got {type(client).__name__}",
                                     client)
-        return client, (), max(1, len(client.scheduler_info().get("workers", {})))
+        if client.status != "running":
+            raise InvalidInputError("client", f"the client is {client.status}: give a running one", client)
+        return client, max(1, len(client.scheduler_info().get("workers", {})))
     if scheduler is None:
         cluster = local_cluster(workers)
-        c = Client(cluster)
-        return c, (c, cluster), len(cluster.workers)
+        stack.callback(_close, cluster)
+        c = _construct(Client, cluster, set_as_default=False)
+        stack.callback(_close, c)
+        return c, len(cluster.workers)
     try:
-        c = Client(scheduler)  # within dask's distributed.comm.timeouts.connect
+        c = _construct(Client, scheduler, set_as_default=False)  # (within distributed.comm.timeouts.connect)
     except (OSError, TimeoutError, ValueError) as exc:  # (ValueError: not an address)
         raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: {exc}", scheduler) from None
+    stack.callback(_close, c)
     try:
         c.wait_for_workers(1 if workers is None else workers, timeout=60)
     except TimeoutError:
-        c.close()
         raise SweepError(f"the Dask scheduler at {scheduler} has fewer than {workers or 1} workers after 60 s",
                          scheduler) from None
-    return c, (c,), max(1, len(c.scheduler_info().get("workers", {})))
+    return c, max(1, len(c.scheduler_info().get("workers", {})))
 
 
 def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, Any] | None = None,
@@ -292,13 +338,17 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
 
     t_start = time.perf_counter()
     in_process = scheduler == "serial" or not len(todo)  # (nothing left to do: no cluster to start)
-    cl, owned, n_workers = (None, (), 1) if in_process else _client(scheduler, client, workers)
-    try:
+    with contextlib.ExitStack() as owned:  # closes the client and cluster made here, however this block ends
+        cl, n_workers = (None, 1) if in_process else _client(scheduler, client, workers, owned)
         size = chunk_size if chunk_size is not None else max(1, min(MAX_CHUNK, math.ceil(len(todo) / (32 * n_workers))))
         chunks = [todo[k:k + size] for k in range(0, len(todo), size)]
         shared: Any = context
         if cl is not None:
-            cl.run(_prepare, family.registered)  # the imports, once per worker, before the clock of the work starts
+            try:
+                cl.run(_prepare, family.registered)  # the imports, once per worker, before the clock of the work
+            except OSError as exc:  # (CommClosedError: the scheduler or its workers gone)
+                raise SweepError(f"the Dask cluster was lost before the sweep started ({type(exc).__name__}: "
+                                 f"{_message(exc)})", scheduler) from None
             # a task, not scattered data: a worker that dies takes its copy with it, and Dask recomputes a task's
             # result where scattered data would be lost (with every chunk waiting on it)
             shared = cl.submit(_unpickle, cloudpickle.dumps(context), pure=False)
@@ -319,9 +369,6 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
             if bar is not None:
                 bar.close()
         wall = time.perf_counter() - t0
-    finally:
-        for thing in owned:
-            thing.close()
     table = combine(done_tables + new_tables, designs, objectives)
     if out_path is not None:
         write_atomic(table, out_path, {"pkm.sweep": json.dumps(manifest)})
@@ -350,7 +397,7 @@ def _results(cl, shared, chunks, designs: Designs, objectives):
         return cl.submit(_run_chunk, shared, ids, designs.values[ids], pure=False)
 
     futures = {submit(ids): ids for ids in chunks}
-    pending = as_completed(list(futures))
+    pending = as_completed(list(futures), loop=cl.loop)  # (the loop of this client: it is not the default)
     lost: list[tuple[np.ndarray, BaseException]] = []
     for fut in pending:
         ids = futures.pop(fut)

@@ -122,12 +122,12 @@ def test_a_spec_may_name_an_mjcf_file_and_add_a_task(tmp_path):
 
 @pytest.mark.parametrize("edit, message", [
     (lambda s: s.replace("<worldbody>", "<include file='x.xml'/><worldbody>"), "<include> is refused"),
-    (lambda s: s.replace("</equality>", "<joint joint1='jb' joint2='jc'/></equality>"), "<joint> is not a loop"),
-    (lambda s: s.replace('<joint name="jc"', '<joint'), "has no name"),
+    (lambda s: s.replace("</equality>", "<tendon tendon1='t'/></equality>"), "<tendon> is not a constraint"),
+    (lambda s: s.replace("</equality>", "<joint joint1='jb' joint2='jball'/></equality>"), "'jball' is a ball joint"),
     (lambda s: s.replace('<joint name="jb" type="hinge"', '<joint name="jb" type="screw"'), "type 'screw'"),
     (lambda s: s.replace('<position joint="jc"/>', '<position joint="nope"/>'), "joint 'nope'"),
     (lambda s: s.replace("<mujoco", "<robot").replace("</mujoco>", "</robot>"), "expected <mujoco>"),
-    (lambda s: s.replace("<compiler", "<compiler eulerseq='zyx'"), "eulerseq"),
+    (lambda s: s.replace("<compiler", "<compiler eulerseq='zyxz'"), "eulerseq"),
     (lambda s: s[:200], "not well-formed"),
 ])
 def test_what_it_refuses_it_says(edit, message):

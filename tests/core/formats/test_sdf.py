@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 import pytest
+from lxml import etree
 
 import pkm
 from pkm.core.formats.sdf import read_sdf
@@ -139,3 +140,28 @@ def test_a_chain_deeper_than_the_recursion_limit_is_a_spec_error():
                      for k in range(1499, 0, -1))
     with pytest.raises(SpecError, match="nested deeper"):
         read_sdf(f"<sdf version='1.7'><model name='deep'>{links}{joints}</model></sdf>", "deep.sdf")
+
+
+@pytest.mark.parametrize("flag", ["1", "true", "True"])
+def test_use_parent_model_frame_is_an_sdformat_boolean(flag):
+    """SDFormat booleans are ``true`` or ``1`` (Cassie's files write ``1``): the axis is then in the model frame,
+    here the model's x, i.e. -y of the rocker turned 90 degrees about z."""
+    text = fourbar().replace('<link name="rocker"><pose degrees="true">0.3 0 0 0 0 0</pose>',
+                             '<link name="rocker"><pose degrees="true">0.3 0 0 0 0 90</pose>')
+    text = text.replace("<parent>world</parent><child>rocker</child>\n        <axis><xyz>0 1 0</xyz></axis>",
+                        "<parent>world</parent><child>rocker</child>\n        <axis><xyz>1 0 0</xyz>"
+                        f"<use_parent_model_frame>{flag}</use_parent_model_frame></axis>")
+    imp = read_sdf(text, "fb.sdf")
+    (axis,) = [j.find("axis").get("xyz") for j in etree.fromstring(imp.urdf.encode()).findall("joint")
+               if j.get("name") == "rocker_joint"]
+    assert np.allclose([float(x) for x in axis.split()], [0, -1, 0], atol=1e-12)
+
+
+def test_links_that_are_each_others_parents_are_refused():
+    """A cycle of parents above a link that reaches the world through it (the walk is linear: each link once)."""
+    text = fourbar().replace("</model>", """<link name="a"/><link name="b"/><link name="c"/>
+      <joint name="ab" type="fixed"><parent>b</parent><child>a</child></joint>
+      <joint name="bc" type="fixed"><parent>c</parent><child>b</child></joint>
+      <joint name="ca" type="fixed"><parent>a</parent><child>c</child></joint></model>""")
+    with pytest.raises(SpecError, match=r"links \['a', 'b', 'c'\] are each other's parents"):
+        read_sdf(text, "fb.sdf")

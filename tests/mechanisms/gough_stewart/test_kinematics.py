@@ -41,11 +41,35 @@ def test_the_closed_form_inverse_is_the_cores():
         gs.inverse_kinematics(mech.params, gs.task_vector(np.eye(3), np.array([0.0, 0.0, 2.0])))
 
 
+def _general(seed: int) -> pkm.Mechanism:
+    """A design of general geometry, given by its points alone: base and platform points up to 1.4 m off their
+    planes (as in Dietmaier's 40-real-solution examples), the stroke left at its default."""
+    rng = np.random.default_rng(seed)
+    base, platform = rng.uniform(-0.6, 0.6, (6, 3)), rng.uniform(-0.4, 0.4, (6, 3))
+    base[:, 2], platform[:, 2] = rng.uniform(-1.4, 1.4, 6), rng.uniform(-1.4, 1.4, 6)
+    return pkm.build("gough_stewart", base=base.tolist(), platform=platform.tolist())
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_a_design_of_general_geometry_builds_from_its_points_alone(seed):
+    """Issue 27: the level platform above the base centre cannot hold such legs mid-stroke; the reference is a
+    pose with every leg inside the stroke where one is found (else the legs outside are named), away from a
+    singularity (a least-squares fit over the whole pose would end on one)."""
+    mech = _general(seed)
+    rho = gs.inverse_kinematics(mech.params, mech.task_map.value(mech.q_reference), check_limits=False)
+    outside = {f"leg{i + 1}" for i, r in enumerate(rho) if not mech.params.leg_min <= r <= mech.params.leg_max}
+    assert set(mech.outside_limits(mech.q_reference)) == outside
+    assert pkm.diagnose(mech, mech.q_reference).classification == "regular"
+    if seed < 3:  # (these three designs have such a pose: found)
+        assert not outside
+
+
 def test_generic_data_have_forty_complex_assembly_modes():
     """Raghavan 1993, Husty 1996: 40 complex solutions for generic data; every path of the parameter homotopy
-    ends at one of them (none at infinity or on Study's exceptional set), the real ones verified by the core."""
+    ends at one of them (none at infinity or on Study's exceptional set), the real ones verified by the core.
+    The design is of general geometry (:func:`_general`), built from its points alone."""
     pytest.importorskip("bertini")
-    mech = _generic(3)
+    mech = _general(3)
     modes = pkm.assembly_modes(mech, mech.actuated_q(mech.q_reference))
     assert modes.complete and modes.n_paths == 40
     assert len(modes) + modes.n_complex == 40 and modes.n_infinite == modes.n_exceptional == 0

@@ -237,8 +237,18 @@ def test_reference_is_regular_with_slider_actuation(mech):
 @pytest.mark.parametrize("gamma", [math.pi / 2, math.pi / 3, 2 * math.pi / 3])
 def test_knee_actuation_builds_with_mobility_3_and_needs_inclined_rails(gamma):
     """Actuating the knees gives mobility 3 and the closed form returns the knee angles; with vertical rails the
-    passive sliders are parallel and the platform can rise with the knees locked (a direct singularity)."""
-    m = prs3.build(prs3.Params(actuation="R", gamma=gamma, reference=tuple(REF)))
+    passive sliders are parallel and the platform can rise with the knees locked (a direct singularity: the load
+    warns that the knees fall short of the mobility there, and only there)."""
+    import warnings
+
+    from pkm.errors import PkmWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        m = prs3.build(prs3.Params(actuation="R", gamma=gamma, reference=tuple(REF)))
+    warned = [w for w in caught if issubclass(w.category, PkmWarning)]
+    assert len(warned) == (gamma == math.pi / 2) and all("3 degree(s) of freedom move the task" in str(w.message)
+                                                         for w in warned)
     assert m.actuated_names == ("knee_1", "knee_2", "knee_3")
     d = diagnose(m, m.q_reference)
     assert d.mobility == 3

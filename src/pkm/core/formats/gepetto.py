@@ -1,8 +1,8 @@
 """Closed-loop model formats other than pkm's closure spec, read into one.
 
 **URDF + YAML in the convention of Gepetto's toolbox-parallel-robots** (the format of
-example-parallel-robots; models exported with onshape-to-robot). A folder holds ``robot.urdf`` and
-``robot.yaml`` with the keys:
+example-parallel-robots; models exported with onshape-to-robot). A folder holds a URDF and a YAML file
+(``robot.urdf`` and ``robot.yaml`` in the toolbox's examples) with the keys:
 
 * ``closed_loop``: pairs of frame names ``[[frame_a, frame_b], ...]``, one per loop;
 * ``type``: per loop ``"3d"`` (the two frames' origins meet: a ball joint, pkm's ``point`` closure) or
@@ -10,7 +10,16 @@ example-parallel-robots; models exported with onshape-to-robot). A folder holds 
 * ``name_mot``: the actuated joints: exact joint names, or, as the toolbox reads them, patterns
   searched in the joint names (``"mot"`` matches ``mot1`` and ``motor_knee``), in model order;
 * optional ``joint_name`` / ``joint_type``: joints the URDF writes as revolutes that are ``SPHERICAL``,
-  ``CARDAN`` (a universal joint) or ``FIXED`` (see :mod:`pkm.core.joints`).
+  ``CARDAN`` (a universal joint about x then y), ``UJOINT_AB`` (a universal joint about the joint frame's
+  axis ``A`` then ``B``, two distinct of ``X``, ``Y``, ``Z``: pkm's ``universal_ab``) or ``FIXED`` (see
+  :mod:`pkm.core.joints`). The toolbox splits a universal joint into two revolutes ``<name>_A``, ``<name>_B``;
+  pkm keeps one joint ``<name>`` of two coordinates.
+
+The convention is recognised by content, whatever the files are named (:func:`find_gepetto`): a YAML mapping
+with a ``closed_loop`` or ``name_mot`` key. Its URDF is the one of the YAML's stem (``leg.yaml``: ``leg.urdf``),
+else ``robot.urdf``, else the folder's only URDF; a URDF given by its path is paired with the YAML of its stem,
+or the folder's only Gepetto YAML. What the reader chose or interpreted is in the mechanism's
+:attr:`~pkm.core.Mechanism.notes`.
 
 The spec made from it has no end effector (the task is the actuated joints) and no reference (the
 mechanism is assembled, :func:`pkm.core.solve.assemble`). :func:`pkm.save` writes it as a pkm spec.
@@ -20,54 +29,168 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from pkm.core.spec import MAX_FILE_BYTES, Closure, ClosureSpec, TaskSpec, read_text_file
-from pkm.errors import InvalidInputError, SpecError
+from pkm.errors import InvalidInputError, SpecError, SpecNameError, closest, did_you_mean
+
+if TYPE_CHECKING:
+    from pkm.core.mechanism import Mechanism
 
 _YAML_TYPES = {"3d": "point", "6d": "frame"}
-_JOINT_TYPES = {"SPHERICAL": "spherical", "CARDAN": "universal", "FIXED": "fixed"}
+#: The toolbox's ``joint_type`` values and pkm's ``[joint_types]`` for them.
+JOINT_TYPES = {"SPHERICAL": "spherical", "CARDAN": "universal", "FIXED": "fixed",
+               **{f"UJOINT_{a}{b}": f"universal_{a.lower()}{b.lower()}" for a in "XYZ" for b in "XYZ" if a != b}}
+#: The keys pkm reads; a YAML mapping with one of :data:`MARKERS` is taken for the convention.
+KEYS = ("closed_loop", "type", "name_mot", "joint_name", "joint_type")
+MARKERS = ("closed_loop", "name_mot")
+_YAML_SUFFIXES = (".yaml", ".yml")
 
 
-def gepetto_files(path: Path) -> tuple[Path, Path] | None:
-    """``(urdf, yaml)`` when ``path`` is a Gepetto-convention model: a folder holding ``robot.urdf`` and
-    ``robot.yaml``, or a ``.yaml`` file beside a URDF of the same stem (or ``robot.urdf``); else None."""
-    if path.is_dir():
-        urdf, yml = path / "robot.urdf", path / "robot.yaml"
-        return (urdf, yml) if urdf.is_file() and yml.is_file() else None
-    if path.suffix.lower() in (".yaml", ".yml") and path.is_file():
-        for urdf in (path.with_suffix(".urdf"), path.parent / "robot.urdf"):
-            if urdf.is_file():
-                return urdf, path
+def parse_yaml(text: str, source: str = "<yaml>") -> object:
+    """The document of YAML text (``yaml.safe_load``: no Python objects are built).
+
+    Raises:
+        SpecError: longer than 16 MiB, or not YAML (the parser's message on one line).
+    """
+    import yaml
+
+    if not isinstance(text, str):
+        raise InvalidInputError("yaml_text", f"expected the YAML text as a str, got {type(text).__name__}", text)
+    if len(text) > MAX_FILE_BYTES:
+        raise SpecError(source, f"YAML file longer than {MAX_FILE_BYTES} characters")
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise SpecError(source, f"not valid YAML: {' '.join(str(exc).split())}") from None
+
+
+def gepetto_yaml(path: Path) -> str | None:
+    """None when the file at ``path`` is a YAML mapping in Gepetto's convention (a ``closed_loop`` or ``name_mot``
+    key), else why it is not (one line)."""
+    try:
+        raw = parse_yaml(read_text_file(path, "YAML"), str(path))
+    except SpecError as exc:
+        return str(exc).removeprefix(f"{path}: ")
+    if not isinstance(raw, dict):
+        return f"YAML, but a {type(raw).__name__}, not a mapping with keys {', '.join(KEYS[:3])}"
+    if not any(k in raw for k in MARKERS):
+        keys = ", ".join(map(str, list(raw)[:6])) or "none"
+        return f"a YAML mapping without the keys {' or '.join(MARKERS)} (its keys: {keys})"
     return None
 
 
-def spec_from_gepetto(yaml_text: str, urdf_name: str, joint_names: list[str], mechanism: str,
-                      source: str = "<yaml>") -> ClosureSpec:
-    """The closure spec a Gepetto ``robot.yaml`` states (see the module doc).
+def _only(files: list[Path], what: str, folder: Path, ask: str) -> Path:
+    """The one file of ``files``; else a SpecError naming them (``what``: their plural) and asking ``ask``."""
+    if len(files) == 1:
+        return files[0]
+    raise SpecError(str(folder), f"{len(files)} {what} in the folder ({', '.join(f.name for f in files)}): {ask}")
+
+
+def _urdf_for(yml: Path) -> tuple[Path, str | None]:
+    """The URDF of a Gepetto YAML, and a note when it was found by elimination (see the module doc)."""
+    for urdf in (yml.with_suffix(".urdf"), yml.parent / "robot.urdf"):
+        if urdf.is_file():
+            return urdf, None
+    urdfs = sorted(p for p in yml.parent.glob("*.urdf") if p.is_file())
+    if not urdfs:
+        raise SpecError(str(yml), f"a YAML in Gepetto's convention with no URDF beside it ({yml.stem}.urdf, "
+                                  "robot.urdf or any other)")
+    urdf = _only(urdfs, "URDFs", yml.parent, f"none is named {yml.stem}.urdf or robot.urdf; load the one that goes "
+                                            f"with {yml.name} by its path (pkm.load('{yml.parent / urdfs[0].name}'))")
+    return urdf, f"{yml.name} read with {urdf.name}, the folder's only URDF"
+
+
+def _yamls(folder: Path) -> tuple[list[Path], list[str]]:
+    """The Gepetto YAML files of a folder, and why each other YAML file is not one."""
+    found, others = [], []
+    for p in sorted(folder.iterdir()):
+        if p.suffix.lower() in _YAML_SUFFIXES and p.is_file():
+            why = gepetto_yaml(p)
+            if why is None:
+                found.append(p)
+            else:
+                others.append(f"{p.name}: {why}")
+    return found, others
+
+
+def find_gepetto(path: Path) -> tuple[Path, Path, tuple[str, ...]] | str:
+    """``(urdf, yaml, notes)`` when ``path`` is a Gepetto-convention model, else why it is not (one line).
+
+    ``path`` is a folder holding a YAML in the convention (by content: a mapping with a ``closed_loop`` or
+    ``name_mot`` key) and its URDF, or such a YAML file (whatever its suffix, but ``.toml``, ``.xml``, ``.mjcf``,
+    ``.sdf``), or a URDF beside such a YAML (see the module doc).
+
+    Raises:
+        SpecError: it is one, but which file goes with which cannot be told (several URDFs and none of the
+            YAML's name, several YAMLs in the convention): the message names them and says how to choose.
+    """
+    path = Path(path)
+    if path.is_dir():
+        found, others = _yamls(path)
+        if not found:
+            why = f" ({'; '.join(others)})" if others else ""
+            return f"a folder with no YAML file in Gepetto's convention{why}"
+        if len(found) > 1:
+            paired = [y for y in found if y.with_suffix(".urdf").is_file()]
+            standard = [y for y in found if y.name == "robot.yaml" and y in paired]
+            found = standard or paired or found
+        yml = _only(found, "YAML files in Gepetto's convention", path,
+                    "load the one you mean by its path (pkm.load('" + str(path / found[0].name) + "'))")
+        urdf, note = _urdf_for(yml)
+        return urdf, yml, (note,) if note else ()
+    suffix = path.suffix.lower()
+    if suffix in _YAML_SUFFIXES or (path.is_file() and suffix not in (".urdf", ".toml", ".xml", ".mjcf", ".sdf")):
+        reason = gepetto_yaml(path)  # (a YAML of another suffix is taken by content too)
+        if reason is not None:
+            return reason
+        urdf, note = _urdf_for(path)
+        return urdf, path, (note,) if note else ()
+    if suffix == ".urdf" and path.is_file():
+        for yml in (path.with_suffix(s) for s in _YAML_SUFFIXES):
+            if yml.is_file() and gepetto_yaml(yml) is None:
+                return path, yml, ()
+        found, _ = _yamls(path.parent)
+        if len(found) == 1:
+            return path, found[0], (f"{path.name} read with {found[0].name}, the folder's only YAML in Gepetto's "
+                                    "convention",)
+        if found:
+            return f"a URDF beside {len(found)} YAML files in Gepetto's convention, none named {path.stem}.yaml"
+        return f"a URDF with no YAML file in Gepetto's convention beside it ({path.stem}.yaml)"
+    return "neither a folder, nor YAML, nor a URDF"
+
+
+def gepetto_files(path: Path) -> tuple[Path, Path] | None:
+    """``(urdf, yaml)`` when ``path`` is a Gepetto-convention model (:func:`find_gepetto`); else None."""
+    found = find_gepetto(path)
+    return None if isinstance(found, str) else found[:2]
+
+
+def read_gepetto(yaml_text: str, urdf_name: str, joint_names: list[str], mechanism: str,
+                 source: str = "<yaml>") -> tuple[ClosureSpec, tuple[str, ...]]:
+    """The closure spec a Gepetto ``robot.yaml`` states (see the module doc), and the notes on what was
+    interpreted or ignored (patterns in ``name_mot``, keys pkm does not read, universal joints kept whole).
 
     Args:
         yaml_text: The YAML text.
         urdf_name: The URDF's file name, relative to the spec's folder.
         joint_names: The URDF's joint names, in model order (for the ``name_mot`` patterns).
         mechanism: The mechanism's name.
+        source: Where the text came from, for the messages.
 
     Raises:
-        SpecError: not YAML, keys missing or of the wrong type, a ``type`` or ``joint_type`` unknown, a
-            ``name_mot`` that matches no joint.
+        SpecError: not YAML, keys missing or of the wrong type, a ``type`` or ``joint_type`` unknown.
+        SpecNameError: a ``name_mot`` that matches no joint, a ``joint_name`` that is not a joint of the URDF
+            (naming the closest ones).
     """
-    import yaml
-
-    if not isinstance(yaml_text, str):
-        raise InvalidInputError("yaml_text", f"expected the YAML text as a str, got {type(yaml_text).__name__}",
-                                yaml_text)
-    if len(yaml_text) > MAX_FILE_BYTES:
-        raise SpecError(source, f"YAML file longer than {MAX_FILE_BYTES} characters")
-    try:
-        raw = yaml.safe_load(yaml_text)
-    except yaml.YAMLError as exc:
-        raise SpecError(source, f"not valid YAML: {' '.join(str(exc).split())}") from None
+    raw = parse_yaml(yaml_text, source)
     if not isinstance(raw, dict):
-        raise SpecError(source, "a robot.yaml is a mapping with keys closed_loop, type, name_mot")
+        raise SpecError(source, f"a Gepetto robot.yaml is a mapping with keys {', '.join(KEYS[:3])}")
+    notes: list[str] = []
+    ignored = [str(k) for k in raw if k not in KEYS]
+    if ignored:
+        notes.append(f"{Path(source).name}: key{'s' if len(ignored) > 1 else ''} {', '.join(ignored)} ignored "
+                     f"(pkm reads {', '.join(KEYS)})")
 
     def strings(key: str, required: bool = True) -> list:
         value = raw.get(key, None if required else [])
@@ -93,34 +216,68 @@ def spec_from_gepetto(yaml_text: str, urdf_name: str, joint_names: list[str], me
             raise SpecError(source, f"name_mot entries are joint names or patterns, got {pattern!r}")
         found = [pattern] if pattern in joint_names else [n for n in joint_names if re.search(re.escape(pattern), n)]
         if not found:
-            raise SpecError(source, f"name_mot {pattern!r} matches no joint of the URDF; joints: {joint_names}")
+            raise SpecNameError(source, "joint", pattern, joint_names, "name_mot: neither a joint name nor a part "
+                                                                       "of one")
+        if found != [pattern]:
+            notes.append(f"name_mot {pattern!r} read as a pattern, as the toolbox reads it: "
+                         + ", ".join(repr(n) for n in found))
         actuated += [n for n in found if n not in actuated]
     actuated.sort(key=joint_names.index)
     names, kinds = strings("joint_name", False), strings("joint_type", False)
     if len(names) != len(kinds):
         raise SpecError(source, f"{len(names)} joint_name entries but {len(kinds)} joint_type entries")
-    joint_types = {}
+    joint_types: dict[str, str] = {}
     for name, kind in zip(names, kinds):
-        if not isinstance(kind, str) or kind.upper() not in _JOINT_TYPES:
-            raise SpecError(source, f"joint_type {kind!r} of {name!r}: use one of {list(_JOINT_TYPES)}")
-        joint_types[str(name)] = _JOINT_TYPES[kind.upper()]
-    return ClosureSpec(mechanism=mechanism, urdf=urdf_name, end_effector=None, actuated=tuple(actuated),
+        if not isinstance(name, str) or name not in joint_names:
+            raise SpecNameError(source, "joint", str(name), joint_names, "joint_name")
+        if name in joint_types:
+            raise SpecError(source, f"joint_name lists {name!r} twice")
+        if not isinstance(kind, str) or kind.upper() not in JOINT_TYPES:
+            hint = closest(kind, JOINT_TYPES) if isinstance(kind, str) else ()
+            raise SpecError(source, f"joint_type {kind!r} of {name!r}: " + (did_you_mean(hint) + " " if hint else "")
+                                    + f"use one of {list(JOINT_TYPES)}")
+        joint_types[name] = JOINT_TYPES[kind.upper()]
+    split = [n for n, k in joint_types.items() if k.startswith("universal")]
+    if split:
+        notes.append("universal joints kept whole, two coordinates each (the toolbox splits each into two revolutes "
+                     "<name>_A, <name>_B): " + ", ".join(split))
+    spec = ClosureSpec(mechanism=mechanism, urdf=urdf_name, end_effector=None, actuated=tuple(actuated),
                        closures=tuple(closures), task=TaskSpec((), tuple(actuated)), reference={},
-                       description=f"read from {source} (Gepetto toolbox-parallel-robots convention)",
+                       description=f"read from {Path(source).name} (Gepetto toolbox-parallel-robots convention)",
                        joint_types=joint_types)
+    return spec, tuple(notes)
 
 
-def load_gepetto(urdf_path: Path, yaml_path: Path):
-    """The :class:`~pkm.core.Mechanism` of a Gepetto-convention URDF + YAML pair (see the module doc)."""
+def spec_from_gepetto(yaml_text: str, urdf_name: str, joint_names: list[str], mechanism: str,
+                      source: str = "<yaml>") -> ClosureSpec:
+    """The closure spec a Gepetto ``robot.yaml`` states: :func:`read_gepetto` without its notes."""
+    return read_gepetto(yaml_text, urdf_name, joint_names, mechanism, source)[0]
+
+
+def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = ()) -> Mechanism:
+    """The :class:`~pkm.core.Mechanism` of a Gepetto-convention URDF + YAML pair (see the module doc); its
+    :attr:`~pkm.core.Mechanism.notes` say what was interpreted (``notes`` first: how the files were paired)."""
+    from pkm.core.formats.imported import import_model
     from pkm.core.mechanism import Mechanism
+
+    urdf_path, yaml_path = Path(urdf_path), Path(yaml_path)
+    imported = import_model(urdf_path)
+    if imported.format != "urdf":
+        raise SpecError(str(urdf_path), f"the model beside {yaml_path.name} is {imported.format.upper()}, not URDF: "
+                                        "Gepetto's convention pairs a YAML with a URDF")
+    joints = [str(j.get("name")) for j in _joints(imported.urdf, str(urdf_path))]
+    name = urdf_path.parent.name if urdf_path.stem == "robot" else urdf_path.stem
+    spec, read = read_gepetto(read_text_file(yaml_path, "YAML"), urdf_path.name, joints, name or "robot",
+                              str(yaml_path))
+    return Mechanism.from_strings(imported.urdf, spec, source=str(yaml_path),
+                                  notes=tuple(notes) + imported.notes + read)
+
+
+def _joints(urdf: str, source: str) -> list:
     from pkm.core.urdf import check_urdf
 
-    urdf = read_text_file(urdf_path, "URDF")
-    joints = [str(j.get("name")) for j in check_urdf(urdf, str(urdf_path)).findall("joint")]
-    name = urdf_path.parent.name if urdf_path.stem == "robot" else urdf_path.stem
-    spec = spec_from_gepetto(read_text_file(yaml_path, "YAML"), urdf_path.name, joints, name or "robot",
-                             str(yaml_path))
-    return Mechanism.from_strings(urdf, spec, source=str(yaml_path))
+    return check_urdf(urdf, source).findall("joint")
 
 
-__all__ = ["gepetto_files", "load_gepetto", "spec_from_gepetto"]
+__all__ = ["JOINT_TYPES", "KEYS", "MARKERS", "find_gepetto", "gepetto_files", "gepetto_yaml", "load_gepetto",
+           "parse_yaml", "read_gepetto", "spec_from_gepetto"]

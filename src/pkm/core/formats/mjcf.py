@@ -8,20 +8,49 @@ does not keep, from the file itself:
   ``name`` (else ``connect1``, ``weld2``...); their anchors become frames ``<name>_a`` (on ``body1``)
   and ``<name>_b`` (on ``body2``, the world when it is omitted); an equality between two sites
   (``site1``, ``site2``) closes those sites' frames (origins for a connect, frames for a weld);
+  an equality with ``active="false"`` is left out (a note says so);
+* ``<equality><joint joint1 joint2 polycoef="a0 a1 a2 a3 a4">`` (MuJoCo:
+  ``q1 - q1_0 = a0 + a1 (q2 - q2_0) + a2 (q2 - q2_0)^2 + ...``, ``q_0`` the joint's ``ref``): a linear one
+  (``a2 = a3 = a4 = 0``) is a mimic joint, ``q1 = a1 q2 + a0 + q1_0 - a1 q2_0`` (Pinocchio's
+  ``JointModelMimic``, a URDF ``<mimic>``; the follower is whichever of the two comes second in Pinocchio's
+  traversal, chains resolved to one leader); without ``joint2`` (or with ``a1 = 0``) the joint is locked at
+  ``q1_0 + a0`` (a fixed joint). A non-linear polynomial is refused;
 * the actuated joints: the ``joint`` of each ``<actuator>`` element (``motor``, ``position``,
-  ``general``...), in file order; actuators on tendons or sites are not joint inputs and are skipped;
+  ``general``...), in file order; a mimic joint's actuator drives its leader; an actuator on a
+  ``<tendon><fixed>`` drives the one independent joint the tendon's length is an affine function of, once
+  the mimic couplings are substituted (Robotiq's ``0.5 right + 0.5 left`` with ``right = left`` drives
+  ``left`` with factor 1). A tendon of several independent joints (a differential) or a ``<spatial>``
+  tendon is refused; actuators on sites or bodies (forces, not joint inputs) are left out with a note;
 * joint names and position limits (``range``, in degrees unless ``<compiler angle="radian">``, for
   hinges only; a slide's range is a length), with ``<default>`` classes and ``childclass``; a body with
-  several joints keeps each one's name (Pinocchio joins them into one composite joint);
+  several joints keeps each one's name (Pinocchio joins them into one composite joint). ``q`` is MuJoCo's
+  ``qpos`` (a joint's ``ref`` is where its body has the pose the file states, as in MuJoCo). Joints and
+  bodies without a name (MuJoCo's are optional) are named from their body: ``<body>_free``,
+  ``<body>_hinge``, ``<body>_hinge_2`` (the second), ``<body>_slide``, ``<body>_ball``; a body
+  ``<parent>_child`` (``_child_2``...); a derived name never takes one the file uses;
+* ``euler`` angles in any ``<compiler eulerseq>`` (three of ``xyzXYZ``: lower case about the moving axes,
+  upper case about the fixed ones, mixed allowed): pkm writes each ``euler`` (bodies, geoms, sites,
+  inertials, cameras, default classes...) as the ``quat`` MuJoCo computes, in the copy Pinocchio reads;
 * ``ball`` joints become Pinocchio spherical joints, ``<freejoint>`` a free-flyer: on the root body that
   carries every other joint, the mechanism's floating base (``spec.floating_base``).
 
 What Pinocchio 4.1's parser gets wrong is worked around, each by a test: it reads only the first body
 under ``<worldbody>`` (pkm wraps them all in one fixed body), ignores the sites of bodies without
 joints (pkm adds them from the file), drops the equalities' names, converts a slide's range as
-an angle, and crashes on equalities between sites (pkm takes them out of its copy and closes them itself). Refused with a :class:`~pkm.errors.SpecError`: ``<include>`` (pkm reads one self-contained
-file), equalities other than ``connect``/``weld``, joint types other than hinge, slide, ball, free.
-Meshes are not read (kinematics and dynamics need none).
+an angle, and crashes on equalities between sites (pkm takes them out of its copy and closes them
+itself); it reads only the first top-level ``<default>`` element, so a ``class`` defined in a second one
+(onshape-to-robot's Reachy Mini has three) makes it throw ``unordered_map::at`` (pkm merges them into
+one); it reads an upper-case (fixed-axes) ``eulerseq`` letter as a lower-case one (pkm hands it
+quaternions); it loses the bodies inside a MuJoCo 3 ``<frame>`` (pkm moves them out, composing the
+frame's pose) and the unnamed bodies (it names them all ``<parent>Bis``; pkm names them); it returns the
+equalities in the order of their names (or of ``<body1>_<body2>_constraint``), keeping one of those that share
+a name (pkm names them in file order in its copy); it drops the
+``pos`` a default class gives a joint (Robotiq 2F-85's followers), a geom or a site (pkm writes every class
+attribute on the joints, geoms and sites of its copy). Refused with a
+:class:`~pkm.errors.SpecError`: ``<include>`` (pkm reads one self-contained file), equalities other than
+``connect``/``weld``/``joint``, joint types other than hinge, slide, ball, free. What the reader interprets
+or leaves out (tendons read as joints, contacts, sensors...) is listed in :attr:`Imported.notes`. Meshes are
+not read (kinematics and dynamics need none).
 """
 
 from __future__ import annotations
@@ -36,14 +65,18 @@ from lxml import etree
 
 from pkm.core.formats.imported import Imported
 from pkm.core.spec import Closure
-from pkm.core.urdf import floats, parse_xml, urdf_from_model
-from pkm.errors import SpecError
+from pkm.core.urdf import floats, num, parse_xml, urdf_from_model
+from pkm.errors import SpecError, SpecNameError
 
 _ACTUATORS = ("motor", "position", "velocity", "general", "intvelocity", "damper", "cylinder", "muscle",
               "adhesion")
 _JOINT_TYPES = ("hinge", "slide", "ball", "free")
 _WORLD = "world"  # the fixed body pkm wraps the worldbody's children in (Pinocchio reads only one): MuJoCo's name
 # for the world body, which equalities may name (body2="world") and no body of the file may take
+_UNREAD = ("contact", "sensor", "keyframe", "visual", "option", "size", "statistic", "custom", "extension",
+           "deformable")  # top-level sections kinematics and dynamics need nothing from
+_ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
+_SMALL = 1e-12  # a coefficient below this is zero (a tendon's factor on a joint, a redundant coupling's misfit)
 
 
 def _floats(text: str | None, n: int, what: str, source: str) -> np.ndarray:
@@ -66,23 +99,36 @@ class _Defaults:
             if child.tag == "default":
                 self._walk(child, name)
             elif isinstance(child.tag, str):
-                self.attrs[(name, child.tag)] = dict(child.attrib)
+                self.attrs.setdefault((name, child.tag), {}).update(child.attrib)
 
-    def get(self, el: etree._Element, key: str, default: str | None = None) -> str | None:
-        if el.get(key) is not None:
-            return el.get(key)
+    def chain(self, el: etree._Element) -> list[dict[str, str]]:
+        """The attributes the classes give ``el``, its own class (or the nearest ``childclass``) first."""
         cls = el.get("class")
         node = el.getparent()
         while cls is None and node is not None:
             cls = node.get("childclass")
             node = node.getparent()
-        cls = cls or "main"
-        while cls is not None:
-            value = self.attrs.get((cls, el.tag), {}).get(key)
-            if value is not None:
-                return value
-            cls = self.parent.get(cls)
-        return default
+        out, at = [], cls or "main"
+        while at is not None:
+            out.append(self.attrs.get((at, el.tag), {}))
+            at = self.parent.get(at)
+        return out
+
+    def get(self, el: etree._Element, key: str, default: str | None = None) -> str | None:
+        if el.get(key) is not None:
+            return el.get(key)
+        return next((attrs[key] for attrs in self.chain(el) if key in attrs), default)
+
+    def materialize(self, world: etree._Element) -> None:
+        """Every attribute the classes give a joint, geom or site written on it (Pinocchio 4.1 drops a class's
+        ``pos``; an orientation or a ``pos``/``fromto`` the element states keeps the class's out)."""
+        groups = (set(_ORIENTATIONS), {"pos", "fromto"})
+        for el in world.iter("joint", "geom", "site"):
+            for attrs in self.chain(el):
+                for key, value in attrs.items():
+                    group = next((g for g in groups if key in g), {key})
+                    if key != "class" and not any(el.get(k) is not None for k in group):
+                        el.set(key, value)
 
 
 def _unit(x: np.ndarray, what: str, source: str) -> np.ndarray:
@@ -92,8 +138,19 @@ def _unit(x: np.ndarray, what: str, source: str) -> np.ndarray:
     return x / n
 
 
-def _rotation(el: etree._Element, degrees: bool, source: str) -> np.ndarray:
-    """The orientation an MJCF element states (quat, axisangle, euler xyz, xyaxes, zaxis)."""
+def euler_matrix(angles, seq: str = "xyz") -> np.ndarray:
+    """The rotation of MuJoCo's ``euler`` attribute, ``angles`` [rad] in the sequence ``seq`` (``<compiler
+    eulerseq>``): one rotation per letter, about the moving axes for a lower-case letter (``R = R R_i``), about
+    the fixed (parent) axes for an upper-case one (``R = R_i R``), as MuJoCo composes them."""
+    R = np.eye(3)
+    for axis, angle in zip(seq, angles):
+        Ri = pin.AngleAxis(float(angle), np.eye(3)["xyz".index(axis.lower())]).matrix()
+        R = R @ Ri if axis.islower() else Ri @ R
+    return R
+
+
+def _rotation(el: etree._Element, degrees: bool, source: str, seq: str = "xyz") -> np.ndarray:
+    """The orientation an MJCF element states (quat, axisangle, euler in ``seq``, xyaxes, zaxis)."""
     what = f"<{el.tag} name={el.get('name')!r}>"
     if el.get("quat") is not None:
         w, x, y, z = _unit(_floats(el.get("quat"), 4, f"{what} quat", source), f"{what} quat", source)
@@ -103,11 +160,7 @@ def _rotation(el: etree._Element, degrees: bool, source: str) -> np.ndarray:
         return pin.AngleAxis(np.deg2rad(a[3]) if degrees else a[3], _unit(a[:3], f"{what} axisangle", source)).matrix()
     if el.get("euler") is not None:
         e = _floats(el.get("euler"), 3, f"{what} euler", source)
-        e = np.deg2rad(e) if degrees else e
-        R = np.eye(3)
-        for axis, angle in zip("xyz", e):  # MuJoCo's default eulerseq "xyz": rotations about the moving axes
-            R = R @ pin.AngleAxis(angle, np.eye(3)["xyz".index(axis)]).matrix()
-        return R
+        return euler_matrix(np.deg2rad(e) if degrees else e, seq)
     if el.get("xyaxes") is not None:
         a = _floats(el.get("xyaxes"), 6, f"{what} xyaxes", source)
         x = _unit(a[:3], f"{what} xyaxes", source)
@@ -117,6 +170,150 @@ def _rotation(el: etree._Element, degrees: bool, source: str) -> np.ndarray:
         z = _floats(el.get("zaxis"), 3, f"{what} zaxis", source)
         return pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), _unit(z, f"{what} zaxis", source)).matrix()
     return np.eye(3)
+
+
+def _set_rotation(el: etree._Element, R: np.ndarray) -> None:
+    """``el``'s orientation written as a ``quat`` (w x y z), its other orientation attributes removed."""
+    for key in _ORIENTATIONS:
+        el.attrib.pop(key, None)
+    x, y, z, w = pin.Quaternion(R).coeffs()
+    el.set("quat", num([w, x, y, z]))
+
+
+def _eulers_to_quats(root: etree._Element, degrees: bool, source: str) -> str:
+    """Every ``euler`` of the file (any element, default classes included) written as a ``quat``, in the
+    ``<compiler eulerseq>`` of the file, which is then dropped. Returns the sequence."""
+    compiler = root.find("compiler")
+    seq = "xyz" if compiler is None else compiler.get("eulerseq", "xyz")
+    if len(seq) != 3 or any(c not in "xyzXYZ" for c in seq):
+        raise SpecError(source, f"<compiler eulerseq={seq!r}>: give three letters of xyzXYZ (lower case: about the "
+                                "moving axes, upper case: about the fixed axes)")
+    for el in root.iter():
+        if isinstance(el.tag, str) and el.get("euler") is not None:
+            stated = [k for k in _ORIENTATIONS if el.get(k) is not None]
+            if len(stated) > 1:
+                raise SpecError(source, f"<{el.tag} name={el.get('name')!r}> states its orientation twice ({stated})")
+            _set_rotation(el, _rotation(el, degrees, source, seq))
+    if compiler is not None:
+        compiler.attrib.pop("eulerseq", None)
+    return seq
+
+
+def _merge_defaults(root: etree._Element) -> int:
+    """The top-level ``<default>`` elements merged into the first (Pinocchio reads the first only); their number."""
+    tops = root.findall("default")
+    for extra in tops[1:]:
+        for child in list(extra):
+            if not isinstance(child.tag, str):
+                continue
+            same = tops[0].find(child.tag) if child.tag != "default" else None
+            if same is not None:
+                same.attrib.update(child.attrib)
+            else:
+                tops[0].append(child)
+        root.remove(extra)
+    return len(tops)
+
+
+def _flatten_frames(world: etree._Element, degrees: bool, source: str) -> int:
+    """MuJoCo 3's ``<frame>`` elements removed, their pose composed into their children's (Pinocchio 4.1 loses
+    what they hold); their number."""
+    frames = list(world.iter("frame"))
+    for fr in reversed(frames):  # the innermost first
+        if fr.get("childclass") is not None:
+            raise SpecError(source, f"<frame name={fr.get('name')!r} childclass=...>: put the class on its children")
+        X = pin.SE3(_rotation(fr, degrees, source), _floats(fr.get("pos", "0 0 0"), 3, "<frame> pos", source))
+        parent, at = fr.getparent(), fr.getparent().index(fr)
+        for child in list(fr):
+            if isinstance(child.tag, str) and child.get("fromto") is not None:
+                ends = _floats(child.get("fromto"), 6, f"<{child.tag}> fromto", source).reshape(2, 3)
+                child.set("fromto", num([X.act(p) for p in ends]))
+            elif isinstance(child.tag, str):
+                M = X * pin.SE3(_rotation(child, degrees, source),
+                                _floats(child.get("pos", "0 0 0"), 3, f"<{child.tag}> pos", source))
+                child.set("pos", num(M.translation))
+                _set_rotation(child, M.rotation)
+            parent.insert(at, child)
+            at += 1
+        parent.remove(fr)
+    return len(frames)
+
+
+def _fresh(base: str, used: set[str]) -> str:
+    """``base``, else ``base_2``, ``base_3``...: the first that ``used`` lacks (added to it)."""
+    name, k = base, 1
+    while name in used:
+        k += 1
+        name = f"{base}_{k}"
+    used.add(name)
+    return name
+
+
+class _Affine(NamedTuple):
+    """A joint coordinate as ``scale * q[root] + offset`` (a leader's own: scale 1, offset 0)."""
+
+    root: str
+    scale: float
+    offset: float
+
+
+class _Couplings:
+    """The joint equalities: groups of joints tied by linear couplings, each joint affine in its group's root;
+    locked groups hold constants."""
+
+    def __init__(self, source: str):
+        self.source = source
+        self.of: dict[str, _Affine] = {}
+        self.locked: dict[str, float] = {}  # root -> its locked value
+
+    def get(self, j: str) -> _Affine:
+        return self.of.get(j, _Affine(j, 1.0, 0.0))
+
+    def members(self, root: str) -> list[str]:
+        return [j for j, a in self.of.items() if a.root == root] + ([] if root in self.of else [root])
+
+    def tie(self, name: str, j1: str, j2: str, a1: float, c: float) -> None:
+        """``q[j1] = a1 q[j2] + c`` (``a1 != 0``)."""
+        r1, r2 = self.get(j1), self.get(j2)
+        if r1.root == r2.root:  # a redundant (or contradicting) coupling
+            if abs(r1.scale - a1 * r2.scale) > _SMALL or abs(r1.offset - (a1 * r2.offset + c)) > _SMALL:
+                raise SpecError(self.source, f"<equality><joint name={name!r}> contradicts the couplings before it")
+            return
+        # r1.root = (q[j1] - r1.offset) / r1.scale, with q[j1] = a1 (r2.scale q[r2.root] + r2.offset) + c
+        s, o = a1 * r2.scale / r1.scale, (a1 * r2.offset + c - r1.offset) / r1.scale
+        for j in self.members(r1.root):
+            a = self.get(j)
+            self.of[j] = _Affine(r2.root, a.scale * s, a.scale * o + a.offset)
+        if r1.root in self.locked:
+            self.lock(name, r2.root, (self.locked.pop(r1.root) - o) / s)
+
+    def lock(self, name: str, j: str, value: float) -> None:
+        a = self.get(j)
+        root_value = (value - a.offset) / a.scale
+        if a.root in self.locked and abs(self.locked[a.root] - root_value) > _SMALL:
+            raise SpecError(self.source, f"<equality><joint name={name!r}> locks joint {j!r} at another value than "
+                                         "the couplings before it")
+        self.locked[a.root] = root_value
+
+    def value(self, j: str) -> float | None:
+        """The constant a locked joint holds, else None."""
+        a = self.get(j)
+        return a.scale * self.locked[a.root] + a.offset if a.root in self.locked else None
+
+    def lead(self, order: dict[str, int]) -> None:
+        """Each free group re-rooted at its member that comes first in ``order`` (Pinocchio's traversal: a mimic
+        joint's leader must come before it)."""
+        for root in {a.root for a in self.of.values()} - set(self.locked):
+            first = min(self.members(root), key=order.__getitem__)
+            f = self.get(first)
+            for j in self.members(root):
+                a = self.get(j)
+                self.of[j] = _Affine(first, a.scale / f.scale, a.offset - a.scale * f.offset / f.scale)
+            self.of.pop(first)
+
+    def followers(self) -> dict[str, tuple[str, float, float]]:
+        """``{joint: (leader, multiplier, offset)}`` for the joints of free groups but their roots."""
+        return {j: (a.root, a.scale, a.offset) for j, a in self.of.items() if a.root not in self.locked}
 
 
 def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
@@ -129,17 +326,31 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
     if root.find(".//include") is not None:
         raise SpecError(source, "<include> is refused: pkm reads one self-contained MJCF file; merge the included "
                                 "files into it")
+    notes: list[str] = []
     compiler = root.find("compiler")
     degrees = compiler is None or compiler.get("angle", "degree") != "radian"
-    if compiler is not None and compiler.get("eulerseq", "xyz") != "xyz":
-        raise SpecError(source, f"<compiler eulerseq={compiler.get('eulerseq')!r}>: pkm reads the default 'xyz' only")
-    defaults = _Defaults(root)
     world = root.find("worldbody")
     if world is None:
         raise SpecError(source, "no <worldbody>")
+    if _merge_defaults(root) > 1:
+        notes.append("the top-level <default> elements were merged into one (as MuJoCo reads them)")
+    _eulers_to_quats(root, degrees, source)
+    defaults = _Defaults(root)
+    defaults.materialize(world)
+    if _flatten_frames(world, degrees, source):
+        notes.append("the <frame> elements' poses were composed into their children's")
+    used = {str(el.get("name")) for el in root.iter() if isinstance(el.tag, str) and el.get("name")} | {_WORLD}
+    derived = []
+    for body in world.iter("body"):
+        if not body.get("name"):
+            parent = body.getparent()
+            body.set("name", _fresh(f"{parent.get('name') if parent.tag == 'body' else _WORLD}_child", used))
+            derived.append(f"body {body.get('name')}")
 
     body_joints: dict[str, list[str]] = {}  # a composite's first joint -> the names of all its parts
     limits: dict[str, tuple[float, float]] = {}
+    kinds: dict[str, str] = {}
+    refs: dict[str, float] = {}
     for body in world.iter("body"):
         joints = [j for j in body if j.tag in ("joint", "freejoint")]
         names = []
@@ -148,19 +359,34 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             if kind not in _JOINT_TYPES:
                 raise SpecError(source, f"joint {j.get('name')!r}: type {kind!r} is not one of {list(_JOINT_TYPES)}")
             if not j.get("name"):
-                raise SpecError(source, f"a {kind} joint of body {body.get('name')!r} has no name; name every joint")
-            names.append(j.get("name"))
+                j.set("name", _fresh(f"{body.get('name')}_{kind}", used))
+                derived.append(f"{kind} joint {j.get('name')}")
+            name = str(j.get("name"))
+            names.append(name)
+            kinds[name] = kind
+            if kind in ("hinge", "slide"):
+                ref = _floats(defaults.get(j, "ref", "0"), 1, f"joint {name!r} ref", source)[0]
+                refs[name] = float(np.deg2rad(ref)) if kind == "hinge" and degrees else float(ref)
             rng, limited = defaults.get(j, "range"), defaults.get(j, "limited", "auto")
             if kind in ("hinge", "slide") and rng is not None and limited != "false":
-                lo, hi = _floats(rng, 2, f"joint {j.get('name')!r} range", source)
-                limits[j.get("name")] = tuple(np.deg2rad([lo, hi])) if kind == "hinge" and degrees else (lo, hi)
+                lo, hi = _floats(rng, 2, f"joint {name!r} range", source)
+                limits[name] = tuple(np.deg2rad([lo, hi])) if kind == "hinge" and degrees else (lo, hi)
         if names:
             body_joints[names[0]] = names
+    if derived:
+        notes.append(f"names derived for what the file leaves unnamed: {', '.join(derived)}")
 
-    equalities = [el for el in root.findall("equality/*") if isinstance(el.tag, str)]
-    for el in equalities:
-        if el.tag not in ("connect", "weld"):
-            raise SpecError(source, f"<equality><{el.tag}> is not a loop closure pkm reads (connect and weld are)")
+    equalities = []
+    for el in [el for el in root.findall("equality/*") if isinstance(el.tag, str)]:
+        if el.get("active", "true") == "false":
+            notes.append(f"the inactive equality <{el.tag} name={el.get('name')!r}> is left out")
+            el.getparent().remove(el)
+        elif el.tag not in ("connect", "weld", "joint"):
+            raise SpecError(source, f"<equality><{el.tag}> is not a constraint pkm reads (connect, weld and joint are)")
+        else:
+            equalities.append(el)
+    couplings = _joint_equalities([el for el in equalities if el.tag == "joint"], kinds, refs, notes, source)
+    equalities = [el for el in equalities if el.tag != "joint"]
     on_sites = []
     for el in equalities:
         sites = (el.get("site1"), el.get("site2"))
@@ -179,11 +405,12 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
         eq_names.append((el.tag, el.get("name") or f"{el.tag}{counts[el.tag]}",
                          (el.get("site1"), el.get("site2")) if el in on_sites else None))
     body_based = {t: counts[t] - sum(1 for el in on_sites if el.tag == t) for t in counts}
-    actuated = []
-    for el in root.findall("actuator/*"):
-        joint = el.get("joint") or el.get("jointinparent")
-        if isinstance(el.tag, str) and el.tag in _ACTUATORS and joint and joint not in actuated:
-            actuated.append(joint)
+    for k, el in enumerate(el for el in equalities if el not in on_sites):  # Pinocchio returns them by name
+        el.set("name", f"pkm{k:06d}")
+    unread = [el.tag for el in root if isinstance(el.tag, str) and el.tag in _UNREAD]
+    if unread:
+        notes.append(f"{', '.join(f'<{t}>' for t in dict.fromkeys(unread))} not read (kinematics and dynamics need "
+                     "none of it)")
 
     # Pinocchio reads one body under <worldbody>: wrap everything in one fixed body at the origin
     wrapper = etree.Element("body", name=_WORLD)
@@ -242,14 +469,135 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
 
     joint_names = {f"Composite_{first}": parts for first, parts in body_joints.items() if len(parts) > 1}
     name = root.get("model", "mjcf")
-    urdf, types = urdf_from_model(model, name=name, joint_names=joint_names, limits=limits, frames=extra,
-                                  skip_frames=(_WORLD,), source=source)
-    known = {p for parts in body_joints.values() for p in parts}
-    for a in actuated:
-        if a not in known:
-            raise SpecError(source, f"an actuator drives joint {a!r}, which the file does not define")
+    locked = {j: v for j in kinds if (v := couplings.value(j)) is not None}
+    kwargs = dict(name=name, joint_names=joint_names, frames=extra, skip_frames=(_WORLD,), locked=locked,
+                  source=source)
+    if couplings.of:  # the leaders: first in Pinocchio's traversal of the URDF (which a mimic needs)
+        plain, _ = urdf_from_model(model, limits=limits, **kwargs)
+        order = {n: k for k, n in enumerate(pin.buildModelFromXML(plain).names)}
+        couplings.lead(order)
+    actuated = _actuated(root, kinds, couplings, notes, source)
+    mimic = couplings.followers()
+    for j, (lead, m, c) in mimic.items():  # a follower's range bounds its leader; Pinocchio gives a mimic none
+        if j in limits:
+            lo, hi = sorted(((limits[j][0] - c) / m, (limits[j][1] - c) / m))
+            own = limits.get(lead, (-np.inf, np.inf))
+            limits[lead] = (max(lo, own[0]), min(hi, own[1]))
+            del limits[j]
+    for j in locked:
+        limits.pop(j, None)
+    urdf, types = urdf_from_model(model, limits=limits, mimic=mimic, **kwargs)
     reference = {model.names[j]: tuple(map(float, pin.SE3ToXYZQUAT(X))) for j, X in free.items()}
-    return Imported(urdf, tuple(closures), types, tuple(actuated), name, "mjcf", _floating_base(model), reference)
+    if len(set(actuated)) < len(actuated):
+        notes.append("several actuators drive the same joint: it is one input")
+    return Imported(urdf, tuple(closures), types, tuple(dict.fromkeys(actuated)), name, "mjcf", _floating_base(model), reference,
+                    tuple(notes))
+
+
+def _joint_equalities(els: list[etree._Element], kinds: dict[str, str], refs: dict[str, float], notes: list[str],
+                      source: str) -> _Couplings:
+    """The ``<equality><joint>`` elements as couplings (linear: mimic joints; no ``joint2``: locked joints), in
+    ``qpos`` (the polynomial is MuJoCo's, about the joints' ``ref``); taken out of Pinocchio's copy."""
+    couplings = _Couplings(source)
+    for k, el in enumerate(els, 1):
+        name = el.get("name") or f"joint{k}"
+        where = f"<equality><joint name={name!r}>"
+        j1, j2 = el.get("joint1"), el.get("joint2")
+        if not j1:
+            raise SpecError(source, f"{where}: no joint1")
+        for j in (j1, j2):
+            if j is not None and j not in kinds:
+                raise SpecNameError(source, "joint", j, list(kinds), where)
+            if j is not None and kinds[j] not in ("hinge", "slide"):
+                raise SpecError(source, f"{where}: joint {j!r} is a {kinds[j]} joint (MuJoCo couples hinges and "
+                                        "slides only)")
+        a = _floats(el.get("polycoef", "0 1 0 0 0"), 5, f"{where} polycoef", source)
+        if j2 is not None and np.any(a[2:] != 0.0):
+            raise SpecError(source, f"{where}: polycoef {el.get('polycoef')!r} makes {j1} a polynomial of degree "
+                                    f"{int(np.flatnonzero(a)[-1])} in {j2}; pkm represents only the linear coupling "
+                                    "(a2 = a3 = a4 = 0), a mimic joint")
+        if j2 is None or a[1] == 0.0:
+            couplings.lock(name, j1, refs[j1] + a[0])
+            notes.append(f"{where} read as joint {j1} locked at {refs[j1] + a[0]:.6g}")
+        else:
+            c = a[0] + refs[j1] - a[1] * refs[j2]
+            couplings.tie(name, j1, j2, float(a[1]), float(c))
+            notes.append(f"{where} read as a mimic coupling: {j1} = {a[1]:.6g} {j2} + {c:.6g}")
+        el.getparent().remove(el)
+    return couplings
+
+
+def _tendons(root: etree._Element, source: str) -> dict[str, list[tuple[str, float]] | None]:
+    """``{tendon: [(joint, coef)...]}`` for the fixed tendons, ``None`` for the spatial ones."""
+    out: dict[str, list[tuple[str, float]] | None] = {}
+    for t in root.findall("tendon/*"):
+        if isinstance(t.tag, str) and t.get("name"):
+            out[t.get("name")] = None if t.tag != "fixed" else [
+                (str(j.get("joint")), _floats(j.get("coef", "1"), 1, f"tendon {t.get('name')!r} coef", source)[0])
+                for j in t if j.tag == "joint"]
+    return out
+
+
+def _actuated(root: etree._Element, kinds: dict[str, str], couplings: _Couplings, notes: list[str],
+              source: str) -> list[str]:
+    """The independent joints the ``<actuator>`` elements drive, in file order (see the module doc)."""
+    tendons = _tendons(root, source)
+    driven = {el.get("tendon") for el in root.findall("actuator/*") if isinstance(el.tag, str)}
+    if set(tendons) - driven:
+        notes.append(f"tendons no actuator drives ({', '.join(sorted(set(tendons) - driven))}) not read")
+    out: list[str] = []
+    for k, el in enumerate(root.findall("actuator/*"), 1):
+        if not isinstance(el.tag, str):
+            continue
+        label = f"<{el.tag} name={el.get('name')!r}>" if el.get("name") else f"actuator {k} (<{el.tag}>)"
+        if el.tag not in _ACTUATORS:
+            notes.append(f"{label} is not an actuator pkm reads: left out")
+            continue
+        joint, tendon = el.get("joint") or el.get("jointinparent"), el.get("tendon")
+        if joint:
+            if joint not in kinds:
+                raise SpecNameError(source, "joint", joint, list(kinds), f"{label}, an actuator")
+            if couplings.value(joint) is not None:
+                raise SpecError(source, f"{label} drives joint {joint!r}, which an <equality><joint> locks")
+            a = couplings.get(joint)
+            if a.root != joint:
+                notes.append(f"{label} drives {joint} = {a.scale:.6g} {a.root} + {a.offset:.6g}: read as actuated "
+                             f"joint {a.root}")
+            out.append(a.root)
+        elif tendon:
+            out.append(_tendon_joint(label, tendon, tendons, kinds, couplings, notes, source))
+        else:
+            target = next((f"{key} {el.get(key)!r}" for key in ("site", "body", "refsite") if el.get(key)), "nothing")
+            notes.append(f"{label} acts on {target}, not on a joint coordinate: left out")
+    return out
+
+
+def _tendon_joint(label: str, tendon: str, tendons: dict[str, list[tuple[str, float]] | None],
+                  kinds: dict[str, str], couplings: _Couplings, notes: list[str], source: str) -> str:
+    """The one independent joint a fixed tendon's length is an affine function of, with the mimic couplings."""
+    if tendon not in tendons:
+        raise SpecNameError(source, "tendon", tendon, list(tendons), label)
+    parts = tendons[tendon]
+    if parts is None:
+        raise SpecError(source, f"{label} acts on the spatial tendon {tendon!r}: its length is not a joint "
+                                "coordinate (pkm reads actuators on joints and on fixed tendons)")
+    factors: dict[str, float] = {}
+    for j, coef in parts:
+        if j not in kinds:
+            raise SpecNameError(source, "joint", j, list(kinds), f"tendon {tendon!r}")
+        if couplings.value(j) is None:
+            a = couplings.get(j)
+            factors[a.root] = factors.get(a.root, 0.0) + coef * a.scale
+    moving = {j: f for j, f in factors.items() if abs(f) > _SMALL}
+    text = " + ".join(f"{c:.6g} {j}" for j, c in parts)
+    if len(moving) != 1:
+        raise SpecError(source, f"{label} acts on tendon {tendon!r} ({text}), " + (
+            "whose length no joint moves" if not moving else
+            f"a differential of the independent joints {sorted(moving)}: pkm reads an actuator as one joint input"))
+    (joint, factor), = moving.items()
+    notes.append(f"tendon {tendon!r} ({text}) of {label} read as actuated joint {joint} (length = {factor:.6g} "
+                 f"{joint} + constant)")
+    return joint
 
 
 def _free_bodies(model: pin.Model, world: etree._Element, degrees: bool, source: str) -> dict[int, pin.SE3]:

@@ -1,4 +1,4 @@
-"""SDFormat: a ``<model>`` whose joints form loops (a link with several parent joints).
+r"""SDFormat: a ``<model>`` whose joints form loops (a link with several parent joints).
 
 Pinocchio's SDF parser needs SDFormat, which the PyPI wheel of Pinocchio 4.1 is built without
 (``pinocchio.WITH_SDFORMAT`` is False), so pkm reads the subset closed-loop mechanisms use itself, with
@@ -12,7 +12,8 @@ SDFormat's pose semantics (1.6 to 1.11):
   ``<axis><xyz>`` in the joint frame (or ``expressed_in``; SDFormat 1.6's ``use_parent_model_frame``),
   ``<limit><lower><upper>`` (SDFormat's default ±1e16 means none);
 * ``<frame name attached_to>`` with a ``<pose>``: named frames (an end effector, a tool point);
-* ``<pose degrees="true">`` (SDFormat 1.9).
+* ``<pose degrees="true">`` (SDFormat 1.9);
+* ``<joint type="gearbox">`` (below).
 
 The tree: each link's parent joint is the first joint in the file that has it as child; every other
 joint cuts a loop, between frames ``<joint>_parent`` and ``<joint>_child`` at the joint: a cut ``ball``
@@ -27,9 +28,30 @@ SDF link and ``<frame>`` keeps its name and pose as a frame (a URDF link's frame
 SDF link's pose differs, the URDF link is named ``<link>__joint``).
 SDFormat names no actuators: a closure spec whose ``urdf`` is the SDF file says which joints are.
 
-Refused with a :class:`~pkm.errors.SpecError`: nested models, ``<include>``, universal, screw and
-gearbox joints, poses relative to what is not a link or frame, several base links, a cycle of
-parents.
+A ``gearbox`` joint is no tree joint and no loop: it couples the angles of its ``<parent>`` and ``<child>``
+links, :math:`\theta_2 = -r\,\theta_1` with :math:`r` its ``<gearbox_ratio>``, where :math:`\theta_1` is the
+angle of the parent link about ``<axis>`` and :math:`\theta_2` that of the child link about ``<axis2>``, both
+relative to its ``<gearbox_reference_body>`` (SDFormat's definition; Gazebo's gear joints, and Cassie's motor
+rotors). pkm requires each of the two links to hang on a revolute (or continuous) joint from the reference body
+about that axis (parallel, either sense; its angle zero at the model's pose, as SDFormat's are), and writes the
+coupling as a URDF ``<mimic>``, which Pinocchio models exactly: the slower link's joint (the output: the child
+when :math:`|r| \le 1`) keeps its coordinate, the faster one (the motor's rotor) follows it with multiplier
+:math:`-s_1 s_2 / r` (or :math:`-s_1 s_2 r` when the parent is the slower), :math:`s_i = \pm 1` the sense of
+joint :math:`i`'s axis along the gearbox's, offset 0. The rotor has no coordinate of its own, but its inertia
+counts: at an output rate :math:`\omega` it spins at :math:`\omega / r`, so it adds :math:`I_\mathrm{rotor}/r^2`
+to the output's inertia about the axis. Pinocchio adds a mimic joint only after the joint it follows, in its
+traversal of the URDF, which visits the children of a link in the order of their joints' names: when the rotor's
+joint name sorts first (Cassie's ``left-knee-ip`` before ``left-knee-op``), pkm hangs the rotor's joint from a
+massless link ``<gearbox>__rotor_mount``, fixed to the reference body by a joint ``<output joint>__<gearbox>``,
+which sorts after the output's (a workaround of that Pinocchio 4.1 restriction, pinned by a test). The rotor's
+SDF position limits, if any, are dropped: its coordinate is the output's. Each gearbox so read, and the joints
+whose ``<spring_stiffness>`` is left unread, are listed in :attr:`Imported.notes
+<pkm.core.formats.imported.Imported.notes>`. SDFormat booleans (``use_parent_model_frame``) are ``true`` or ``1``.
+
+Refused with a :class:`~pkm.errors.SpecError`: nested models, ``<include>``, universal and screw joints, a
+gearbox whose links do not hang on revolutes about its axes from its reference body (or with a zero or
+non-finite ratio, or a link geared twice), poses relative to what is not a link or frame, several base links,
+a cycle of parents.
 """
 
 from __future__ import annotations
@@ -43,7 +65,8 @@ from pkm.core.spec import Closure
 from pkm.core.urdf import check_urdf, floats, num, origin, parse_xml
 from pkm.errors import SpecError
 
-_TYPES = ("revolute", "continuous", "prismatic", "ball", "fixed")
+_TYPES = ("revolute", "continuous", "prismatic", "ball", "fixed", "gearbox")
+_PARALLEL = 1e-6  # |sin| of the angle between a gearbox's axis and its joint's axis above which they differ
 _NO_LIMIT = 1e6  # |bound| above this (SDFormat writes 1e16) is no bound
 _AXIS_POINT = 0.1  # m: a cut revolute is two point closures, at the joint and this far along its axis
 
@@ -70,6 +93,54 @@ def _text(el: etree._Element, path: str, default: str | None = None) -> str | No
 def _end(joint: etree._Element, role: str) -> str:
     """A joint's ``parent`` or ``child`` link name (``""`` when it has none)."""
     return _text(joint, role) or ""
+
+
+def _gears(gearboxes: list[etree._Element], parent_joint: dict[str, etree._Element], joint_frame, axis,
+           source: str) -> dict[str, tuple[str, float, str]]:
+    """The mimic couplings of the ``gearbox`` joints (see the module doc): ``{rotor joint: (output joint,
+    multiplier, gearbox)}``.
+
+    Raises:
+        SpecError: a gearbox whose links do not hang on revolutes about its axes from its reference body, a zero
+            or non-finite ratio, a joint geared twice.
+    """
+    out: dict[str, tuple[str, float, str]] = {}
+    for g in gearboxes:
+        name = g.get("name")
+        ref = _text(g, "gearbox_reference_body")
+        if not ref:
+            raise SpecError(source, f"gearbox {name!r} needs a <gearbox_reference_body>")
+        ratio = float(_numbers(_text(g, "gearbox_ratio", "1"), 1, f"gearbox {name!r} ratio", source)[0])
+        if not np.isfinite(ratio) or ratio == 0.0:
+            raise SpecError(source, f"gearbox {name!r}: gearbox_ratio {ratio!r} must be finite and nonzero")
+        Xg = joint_frame(g)
+        ends = []
+        for role, tag in (("parent", "axis"), ("child", "axis2")):
+            link = _end(g, role)
+            j = parent_joint.get(link)
+            if link == "world" or j is None or j.get("type") not in ("revolute", "continuous") or _end(j, "parent") != ref:
+                raise SpecError(source, f"gearbox {name!r}: its {role} link {link!r} must hang on a revolute joint from "
+                                        f"its gearbox_reference_body {ref!r}")
+            a = Xg.rotation @ axis(g, Xg, tag)
+            Xj = joint_frame(j)
+            b = Xj.rotation @ axis(j, Xj)
+            a, b = a / np.linalg.norm(a), b / np.linalg.norm(b)
+            if np.linalg.norm(np.cross(a, b)) > _PARALLEL:
+                raise SpecError(source, f"gearbox {name!r}: its <{tag}> {np.round(a, 6).tolist()} is not the axis "
+                                        f"{np.round(b, 6).tolist()} of joint {j.get('name')!r}, on which its {role} link "
+                                        f"{link!r} turns")
+            ends.append((j.get("name"), 1.0 if a @ b > 0 else -1.0))
+        (j1, s1), (j2, s2) = ends
+        if j1 == j2:
+            raise SpecError(source, f"gearbox {name!r} gears link {_end(g, 'child')!r} to itself")
+        # theta_2 = -ratio theta_1, q_i = s_i theta_i: the slower side (the output) leads
+        rotor, output, mult = (j1, j2, -s1 * s2 / ratio) if abs(ratio) <= 1.0 else (j2, j1, -s1 * s2 * ratio)
+        geared = {k for k in out} | {v[0] for v in out.values()}
+        if rotor in geared or output in geared:
+            raise SpecError(source, f"gearbox {name!r}: joint {rotor if rotor in geared else output!r} is already "
+                                    "geared by another gearbox; pkm reads one gearbox per joint")
+        out[rotor] = (output, mult, name)
+    return out
 
 
 def read_sdf(text: str, source: str = "<sdf>") -> Imported:
@@ -108,6 +179,8 @@ def _read_sdf(text: str, source: str) -> Imported:
                 raise SpecError(source, f"joint {j.get('name')!r}: {role} {name!r} is not a link of the model")
     if len({j.get("name") for j in joints}) != len(joints):
         raise SpecError(source, "two joints share a name")
+    gearboxes = [j for j in joints if j.get("type") == "gearbox"]
+    joints = [j for j in joints if j.get("type") != "gearbox"]
 
     placed: dict[str, pin.SE3] = {}  # world pose of each link and frame (model frame = world)
 
@@ -139,30 +212,34 @@ def _read_sdf(text: str, source: str) -> Imported:
     if len(bases) > 1:
         raise SpecError(source, f"links {bases} have no parent joint: a model for pkm has one base (join the others "
                                 "with joints)")
+    reached: set[str] = set()  # links known to reach the base or the world (each link walked once: linear)
     for name in links:  # every link reaches the base or the world
-        seen: list[str] = []
+        seen: dict[str, None] = {}
         node = name
-        while node in parent_joint:
+        while node in parent_joint and node not in reached:
             if node in seen:
-                raise SpecError(source, f"links {seen} are each other's parents: no base")
-            seen.append(node)
+                raise SpecError(source, f"links {list(seen)} are each other's parents: no base")
+            seen[node] = None
             node = _end(parent_joint[node], "parent")
+        reached.update(seen)
 
     def joint_frame(j: etree._Element) -> pin.SE3:
         M, rel = _pose(j, f"joint {j.get('name')!r}", source)
         return pose_of(rel or _end(j, "child")) * M
 
-    def axis(j: etree._Element, X: pin.SE3) -> np.ndarray:
-        ax = j.find("axis/xyz")
+    def axis(j: etree._Element, X: pin.SE3, tag: str = "axis") -> np.ndarray:
+        ax = j.find(f"{tag}/xyz")
         if ax is None:
-            raise SpecError(source, f"joint {j.get('name')!r} ({j.get('type')}) needs <axis><xyz>")
-        a = _numbers(ax.text, 3, f"joint {j.get('name')!r} axis", source)
+            raise SpecError(source, f"joint {j.get('name')!r} ({j.get('type')}) needs <{tag}><xyz>")
+        a = _numbers(ax.text, 3, f"joint {j.get('name')!r} {tag}", source)
         if np.linalg.norm(a) < 1e-9:
-            raise SpecError(source, f"joint {j.get('name')!r} has a zero axis")
+            raise SpecError(source, f"joint {j.get('name')!r} has a zero {tag}")
         frame = ax.get("expressed_in")
-        if frame is None and _text(j, "axis/use_parent_model_frame", "false") == "true":
+        if frame is None and (_text(j, f"{tag}/use_parent_model_frame") or "").lower() in ("true", "1"):
             frame = "__model__"
         return a if frame is None else X.rotation.T @ pose_of(frame).rotation @ a
+
+    mimic = _gears(gearboxes, parent_joint, joint_frame, axis, source)  # {rotor joint: (output joint, multiplier)}
 
     names = set(links) | {j.get("name") for j in joints} | set(frames)
     robot = etree.Element("robot", name=model.get("name") or "sdf")
@@ -196,19 +273,22 @@ def _read_sdf(text: str, source: str) -> Imported:
             etree.SubElement(jel, "axis", xyz=num(axis(j, X)))
             lo, hi = _text(j, "axis/limit/lower"), _text(j, "axis/limit/upper")
             bounds = {}
-            if lo is not None and hi is not None and j.get("type") != "continuous":
+            if name in mimic:  # a gearbox's rotor: no coordinate, no bounds of its own
+                etree.SubElement(jel, "mimic", joint=mimic[name][0], multiplier=repr(mimic[name][1]), offset="0")
+            elif lo is not None and hi is not None and j.get("type") != "continuous":
                 b = _numbers(f"{lo} {hi}", 2, f"joint {name!r} limits", source)
                 if np.abs(b).max() < _NO_LIMIT:
                     bounds = {"lower": repr(float(b[0])), "upper": repr(float(b[1]))}
             etree.SubElement(jel, "limit", effort="0", velocity="0", **bounds)
 
-    def fixed_frame(name: str, parent: str, X: pin.SE3) -> None:
-        if name in names:
-            raise SpecError(source, f"pkm names a frame {name!r}, which the model already uses; rename it")
-        names.add(name)
+    def fixed_frame(name: str, parent: str, X: pin.SE3, joint: str | None = None) -> None:
+        for n in (name, joint or f"{name}_fixed"):
+            if n in names:
+                raise SpecError(source, f"pkm names a frame {n!r}, which the model already uses; rename it")
+            names.add(n)
         urdf_frame[name] = X
         etree.SubElement(robot, "link", name=name)
-        add_joint(f"{name}_fixed", "fixed", parent, name, X)
+        add_joint(joint or f"{name}_fixed", "fixed", parent, name, X)
 
     robot_root = "world" if "world" not in names else "world_"
     if robot_root != "world":
@@ -246,6 +326,11 @@ def _read_sdf(text: str, source: str) -> Imported:
             add_joint(f"{name}_base", "fixed", robot_root, name, urdf_frame[name])
             continue
         parent = robot_root if _end(j, "parent") == "world" else _end(j, "parent")
+        if j.get("name") in mimic and j.get("name") < mimic[j.get("name")][0]:  # Pinocchio needs the output first
+            output, _, gear = mimic[j.get("name")]
+            mount = f"{gear}__rotor_mount"
+            fixed_frame(mount, parent, urdf_frame[parent], f"{output}__{gear}")
+            parent = mount
         add_joint(j.get("name"), kinds.get(j.get("type"), j.get("type")), parent, name, urdf_frame[name], j)
         if j.get("type") == "ball":
             types[j.get("name")] = "spherical"
@@ -290,7 +375,12 @@ def _read_sdf(text: str, source: str) -> Imported:
     etree.indent(robot, space="  ")
     urdf = etree.tostring(robot, xml_declaration=True, encoding="utf-8", pretty_print=True).decode()
     check_urdf(urdf, source)
-    return Imported(urdf, tuple(closures), types, (), robot.get("name"), "sdf")
+    notes = [f"gearbox {gear!r} read as a mimic joint: {rotor} = {mult:.6g} {output}"
+             for rotor, (output, mult, gear) in mimic.items()]
+    springs = [j.get("name") for j in joints if _text(j, "axis/dynamics/spring_stiffness") is not None]
+    if springs:
+        notes.append(f"the spring stiffness of joints {springs} is not read: they are plain joints")
+    return Imported(urdf, tuple(closures), types, (), robot.get("name"), "sdf", notes=tuple(notes))
 
 
 __all__ = ["read_sdf"]

@@ -215,10 +215,11 @@ int STEP_grid(const casadi_int* dims, casadi_int ndim, const casadi_real* target
 
 
 def cache_dir() -> Path:
-    """Where compiled twins are kept: ``$PKM_CACHE_DIR``, else ``$XDG_CACHE_HOME/pkm/twin`` (``~/.cache/pkm/twin``)."""
-    if os.environ.get("PKM_CACHE_DIR"):
-        return Path(os.environ["PKM_CACHE_DIR"])
-    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "pkm" / "twin"
+    """Where compiled twins are kept: the folder ``twin`` of pkm's cache (:func:`pkm.cache.cache_dir`:
+    ``$PKM_CACHE_DIR``, else ``$XDG_CACHE_HOME/pkm``, ``~/.cache/pkm``)."""
+    from pkm.cache import cache_dir as root
+
+    return root() / "twin"
 
 
 def source(funs, *, follow: bool = False) -> str:

@@ -1,4 +1,8 @@
-"""Looking at a sweep: parameter-objective plots, Pareto fronts, and the best designs as closure specs."""
+"""Looking at a sweep: parameter-objective plots, Pareto fronts, and the best designs as closure specs.
+
+(Not ``pkm/sweeps/plot.py``: a submodule named as the package's function :func:`pkm.sweeps.plot` replaces it in
+the package as soon as the module is imported, ``sweeps.write_best`` first, say.)
+"""
 
 from __future__ import annotations
 
@@ -8,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pkm.errors import InvalidInputError
+from pkm.errors import InvalidInputError, SweepError
 from pkm.sweeps.family import from_description
 from pkm.sweeps.results import SweepResult
 
@@ -70,7 +74,10 @@ def plot(result, out_dir, pareto: Sequence[str] | None = None) -> list[Path]:
             ax.set_visible(False)
         for ax, (a, b) in zip(panels, pairs):
             x, y = res.column(a), res.column(b)
-            front = res.pareto([a, b])
+            try:
+                front = res.pareto([a, b])
+            except SweepError:  # no design has both values (every design failed, say): no front to draw
+                front = np.zeros(0, dtype=int)
             ax.scatter(x, y, s=6, color="0.7", label="designs")
             k = front[np.argsort(x[front])]
             ax.plot(x[k], y[k], "o-", color="tab:orange", ms=4, label=f"Pareto front ({len(front)})")
@@ -91,7 +98,8 @@ def write_best(result, by: str, out_dir, *, n: int = 3, mechanism=None) -> list[
     ``out_dir``, ready for ``pkm preview``; ``mechanism``: the files of a loaded mechanism the sweep varied.
 
     Raises:
-        InvalidInputError: no design has a value of ``by``; a loaded mechanism's files not given or not the same.
+        SweepError: no design has a value of ``by`` (:meth:`~pkm.sweeps.SweepResult.best`).
+        InvalidInputError: a loaded mechanism's files not given or not the same.
         Whatever building the design raises (it could not assemble at its reference pose).
     """
     import pkm
@@ -99,8 +107,6 @@ def write_best(result, by: str, out_dir, *, n: int = 3, mechanism=None) -> list[
     res = _result(result)
     family = from_description(res.manifest["family"], mechanism)
     rows = res.best(by, n)
-    if not rows:
-        raise InvalidInputError("by", f"no design has a value of {by}", by)
     out = []
     for k, row in enumerate(rows, 1):
         mech = family.mechanism({p: row[p] for p in res.parameters})
