@@ -864,6 +864,26 @@ def _velocities(g, adv):
     return ctx().pkm.velocities, (m, q, qd), {}
 
 
+@entry("differential.actuation")
+def _actuation(g, adv):
+    from pkm.core.differential import actuation
+
+    n, m = _mech(g, adv)
+    q = _q(g, n, adv and g.chance(0.5)) if g.chance(0.7) else None
+    rtol = g.pick((1e-7, 1e-9, 1e-3)) if not adv else g.pick((0.0, -1.0, 2.0, float("nan"), "1e-7", None, 1e-7))
+    return actuation, (m, q), {"rtol": rtol}
+
+
+@entry("pkm.load(package)")
+def _load_package(g, adv):
+    name = g.pick(("example-robot-data:cassie", "example-robot-data:cassie_v2"))
+    if adv:
+        name = g.pick(("example-robot-data:", "example-robot-data:Cassie", "example-robot-data:../cassie",
+                       "example-robot-data:cassie\x00", "example-robot-data:cassie:v2", "example-robot-data::",
+                       "example-robot-data:" + "c" * 10_000, "example-robot-data:/etc/passwd", name[::-1]))
+    return ctx().pkm.load, (name,), {}
+
+
 @entry("pkm.accelerations")
 def _accelerations(g, adv):
     n, m = _mech(g, adv)

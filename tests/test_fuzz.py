@@ -43,7 +43,8 @@ def test_harness_covers_the_public_entry_points(fuzz):
                 "pkm.inverse_dynamics", "pkm.assemble", "formats.spec_from_gepetto", "formats.read_mjcf",
                 "formats.read_sdf", "pkm.load(file)", "formats.spec_skeleton", "pkm.quantity", "pkm.follow_task",
                 "pkm.follow_actuators", "Kernels.inverse_dynamics", "Kernels.close_loops_path", "maps.task_map",
-                "formats.mjcf_from_mechanism", "pkm.reconfigure", "pkm.sweep", "sweeps.space", "SweepResult"}
+                "formats.mjcf_from_mechanism", "pkm.reconfigure", "pkm.sweep", "sweeps.space", "SweepResult",
+                "differential.actuation", "pkm.load(package)"}
     expected |= {f"pkm.build[{m}]" for m in names()}  # the registry, the tests' five-bar included
     expected |= {f"{m}.closed_form_ik" for m in names()}
     expected |= {f"{m}.closed_form_fk" for m in names() if module(m).closed_form_fk is not None}

@@ -97,7 +97,13 @@ def load(name) -> Mechanism:
     import os
     from pathlib import Path
 
-    if isinstance(name, str) and ":" in name and not Path(name).exists():  # "example-robot-data:cassie"
+    def exists(path: str) -> bool:
+        try:
+            return Path(path).exists()
+        except (OSError, ValueError):  # (a name too long for a path, a NUL in it)
+            return False
+
+    if isinstance(name, str) and ":" in name and not exists(name):  # "example-robot-data:cassie"
         from pkm.core.formats.packages import PACKAGES, load_package_model
 
         if name.partition(":")[0] in PACKAGES:
@@ -105,7 +111,7 @@ def load(name) -> Mechanism:
     if isinstance(name, os.PathLike) or (isinstance(name, str) and name not in MECHANISMS
                                          and (name.endswith((".toml", ".yaml", ".yml", ".xml", ".mjcf", ".sdf",
                                                              ".urdf"))
-                                              or Path(name).exists())):
+                                              or exists(name))):
         from pkm.core.formats.imported import load_path
 
         return load_path(Path(name))  # by content: Gepetto URDF + YAML, closure spec, MJCF or SDF

@@ -79,7 +79,10 @@ class GoughStewartParams:
                 raise InvalidParameterError(name, "the six points are collinear: the platform would turn freely "
                                                   "about their line", getattr(self, name))
         if self.reference is not None:
-            ref = np.asarray(self.reference, dtype=float)
+            try:
+                ref = np.asarray(self.reference, dtype=float)
+            except (TypeError, ValueError, OverflowError):
+                ref = np.zeros(0)
             if ref.shape != (6,) or not np.all(np.isfinite(ref)):
                 raise InvalidParameterError("reference", f"must be 6 finite numbers (x, y, z, roll, pitch, yaw), got "
                                                          f"{self.reference!r}", self.reference)
