@@ -15,7 +15,8 @@ import numpy as np
 import pinocchio as pin
 
 import pkm
-from pkm.core import TaskMap, close_loops, constraints
+from pkm.core import TaskMap, close_loops
+from pkm.core.kinematics import constraints
 
 
 def richardson(diff: Callable[[float], np.ndarray], h: float) -> np.ndarray:

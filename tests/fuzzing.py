@@ -206,7 +206,7 @@ class Context:
 
     def __init__(self):
         import pkm
-        from pkm.core.task import TaskMap
+        from pkm.core.kinematics.task import TaskMap
         from pkm.data import dynamics_path
         from pkm.mechanisms import module
 
@@ -422,7 +422,7 @@ def _assemble(g, adv):
 
 @entry("urdf.load_model")
 def _load_model(g, adv):
-    from pkm.core.urdf import load_model
+    from pkm.core.model.urdf import load_model
     n = g.pick(("rrr3", "delta", "prs3", "hexapod"))
     text = _mutated_urdf(g, n, adv)
     if adv and g.chance(0.05):
@@ -606,7 +606,7 @@ def _kernels_path(g, adv):
 
 @entry("maps.task_map")
 def _task_map(g, adv):
-    from pkm.core.maps import task_map
+    from pkm.core.analysis.maps import task_map
 
     c = ctx()
     n = g.pick(c.names)
@@ -866,7 +866,7 @@ def _velocities(g, adv):
 
 @entry("differential.actuation")
 def _actuation(g, adv):
-    from pkm.core.differential import actuation
+    from pkm.core.differential.velocity import actuation
 
     n, m = _mech(g, adv)
     q = _q(g, n, adv and g.chance(0.5)) if g.chance(0.7) else None
@@ -1036,7 +1036,7 @@ def _hex_modes(g, adv):
 
 def _pose(g: Gen, adversarial: bool):
     """(R, P) near the hexapod's pose T, or hostile."""
-    from pkm.core.task import zyx_matrix
+    from pkm.core.kinematics.task import zyx_matrix
     R0, P0 = pose_T_placement()
     R = R0 @ zyx_matrix(*g.near(np.zeros(3), g.pick((0.01, 0.1, 0.5))))
     P = g.near(P0, g.pick((0.001, 0.01, 0.05, 0.3)))
@@ -1148,7 +1148,7 @@ def _index_fn(g: Gen, adversarial: bool):
 
 @entry("redundant_parameter.maximise")
 def _maximise(g, adv):
-    from pkm.core import redundant_parameter
+    from pkm.core.analysis import redundant_parameter
     n = int(g.rng.integers(1, 5))
     lo = g.rng.uniform(-2, 0, n)
     hi_ = lo + g.rng.uniform(0, 2, n)
@@ -1164,7 +1164,7 @@ def _maximise(g, adv):
 
 @entry("redundant_parameter.optimise_profile", sentinel=_baseline_nan_ok)
 def _optimise_profile(g, adv):
-    from pkm.core import redundant_parameter
+    from pkm.core.analysis import redundant_parameter
     n = int(g.rng.integers(2, 6))
     lo = np.full(n, -1.0) + 0.1 * g.rng.normal(size=n)
     hi_ = lo + g.rng.uniform(0.2, 2, n)
@@ -1199,26 +1199,26 @@ def _matrix(g: Gen, adversarial: bool):
 
 @entry("indices.condition_number", sentinel=_kappa_sentinel)
 def _cond(g, adv):
-    from pkm.core import indices
+    from pkm.core.differential import indices
     kind = g.pick(indices.KINDS) if not (adv and g.chance(0.2)) else g.pick(("3", None, 2, "FRO"))
     return indices.condition_number, (_matrix(g, adv), kind), {}
 
 
 @entry("indices.inverse_condition")
 def _icond(g, adv):
-    from pkm.core import indices
+    from pkm.core.differential import indices
     return indices.inverse_condition, (_matrix(g, adv), g.pick(indices.KINDS)), {}
 
 
 @entry("indices.manipulability")
 def _manip(g, adv):
-    from pkm.core import indices
+    from pkm.core.differential import indices
     return indices.manipulability, (_matrix(g, adv),), {}
 
 
 @entry("indices.homogenize")
 def _homog(g, adv):
-    from pkm.core import indices
+    from pkm.core.differential import indices
     J0 = _matrix(g, False)
     J = g.corrupt(J0) if adv and g.chance(0.5) else J0
     L = float(g.rng.uniform(0.01, 2)) if not adv else g.pick(ADV_NUMBERS + ADV_OBJECTS[:10] + (0.1,))
@@ -1376,7 +1376,7 @@ def _prs3_jac(g, adv):
 
 @entry("KhalilProjection.inverse_dynamics")
 def _khalil(g, adv):
-    from pkm.core.dynamics import KhalilProjection
+    from pkm.core.dynamics.projection import KhalilProjection
     c = ctx()
     n = g.pick(("delta", "prs3"))
     kp = c.lazy(f"khalil_{n}", lambda: KhalilProjection(c.mech[n]))
@@ -1408,7 +1408,7 @@ def _inverse_dynamics(g, adv):
 
 @entry("dynamics.forward_dynamics")
 def _fwd_dyn(g, adv):
-    from pkm.core.dynamics import forward_dynamics
+    from pkm.core.dynamics.projection import forward_dynamics
     n, m = _mech(g, adv, ("delta", "prs3", "rrr3"))
     mm = ctx().mech[n]
     return forward_dynamics, (m, _q(g, n, adv and g.chance(0.4)), g.value(np.zeros(mm.nv), adv and g.chance(0.3)),
@@ -1417,7 +1417,7 @@ def _fwd_dyn(g, adv):
 
 @entry("screws.transform")
 def _screw_transform(g, adv):
-    from pkm.core import screws
+    from pkm.core.differential import screws
     s = g.rng.normal(size=g.pick(((6,), (4, 6))))
     R = np.eye(3)
     t = g.rng.normal(size=3)

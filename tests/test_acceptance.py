@@ -19,7 +19,8 @@ import pytest
 
 import pkm
 from pkm import cli
-from pkm.core import constraints, dynamics
+from pkm.core import dynamics
+from pkm.core.kinematics import constraints
 from tests.fd import forward_jacobian_error, richardson
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

@@ -22,7 +22,7 @@ import pinocchio as pin
 import pytest
 
 import pkm
-from pkm.core import constraints
+from pkm.core.kinematics import constraints
 from pkm.errors import PkmError
 from tests.fd import forward_jacobian_error
 from tests.test_acceptance import check_efforts_give_back_accelerations, moved
@@ -89,7 +89,7 @@ def test_constraint_dynamics_gives_back_the_accelerations_the_efforts_were_compu
 
 def test_battobot_saved_as_a_pkm_spec_loads_back_the_same(root, tmp_path):
     """Its universal joints (UJOINT_ZY, UJOINT_YZ) written as [joint_types] and read back: the same model."""
-    from pkm.core.compare import mechanism_differences
+    from pkm.core.model.compare import mechanism_differences
 
     mech = load(root, "battobot_6d")
     text = pkm.save(mech, tmp_path / "battobot.closures.toml").read_text()

@@ -18,7 +18,8 @@ import numpy as np
 import pytest
 
 import pkm
-from pkm.core import TaskMap, close_loops, constraints, diagnose, solve_ik
+from pkm.core import TaskMap, close_loops, diagnose, solve_ik
+from pkm.core.kinematics import constraints
 from pkm.errors import UnreachableError
 from pkm.mechanisms import definition, module, names
 from tests import fd

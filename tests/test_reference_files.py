@@ -1,5 +1,5 @@
 """The checked-in ``urdf/`` files are the generators' output for the papers' reference designs,
-as models (numbers to :data:`pkm.core.compare.RTOL` relative, :data:`~pkm.core.compare.ATOL`
+as models (numbers to :data:`pkm.core.model.compare.RTOL` relative, :data:`~pkm.core.model.compare.ATOL`
 absolute: another CPU's arithmetic rounds the last bits differently), and the wheel ships them
 together with ``dynamics/``."""
 
@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 import pkm
-from pkm.core.compare import document_differences, mechanism_differences
+from pkm.core.model.compare import document_differences, mechanism_differences
 from pkm.data import spec_path, urdf_path
 from pkm.mechanisms import module, names
 

@@ -27,7 +27,7 @@ SOLVER_ACCURACY = {
 
 #: Rows corrected since, with how far they moved: the 3-RRR closed-form CI was 1 instead of 0 at nodes exactly on an
 #: inverse singularity (a straight elbow, sin = 1e-17; two of Fig. 5's 214,742 nodes), found by the generic route of
-#: issue 15 (tests/core/test_maps.py).
+#: issue 15 (tests/core/analysis/test_maps.py).
 CORRECTED = {"rrr3.fig5.gci": 1e-5, "rrr3.fig5.gci_area": 1e-4}
 
 #: Rows added since, by the issue that names them (each paper's rows before them keep their order).

@@ -4,7 +4,7 @@
 Usage: ``python tools/generate_urdf.py [--check] [NAME ...]`` (all mechanisms by default).
 
 A file is rewritten only when the generator's output differs from it *as a model* (see
-:mod:`pkm.core.compare`): regenerating on a CPU whose arithmetic rounds the last bits differently
+:mod:`pkm.core.model.compare`): regenerating on a CPU whose arithmetic rounds the last bits differently
 leaves the files as they are. ``--check`` writes nothing and lists the differences (exit status 1
 when there are any), as ``tests/test_reference_files.py`` does.
 """
@@ -14,7 +14,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from pkm.core.compare import document_differences
+from pkm.core.model.compare import document_differences
 from pkm.mechanisms import module, names
 
 ROOT = Path(__file__).resolve().parents[1] / "urdf"

@@ -60,9 +60,9 @@ if TYPE_CHECKING:  # the static view of the lazy names
         twist_jacobian,
         velocities,
     )
-    from pkm.core.maps import task_map
+    from pkm.core.analysis.maps import task_map
+    from pkm.core.analysis.reconfiguration import reconfigure
     from pkm.core.modes import assembly_modes, track_assembly_mode, track_working_mode, working_modes
-    from pkm.core.reconfiguration import reconfigure
     from pkm.core.twin import Kernels, Twin
     from pkm.sweeps import sweep
     from pkm.units import quantity
@@ -70,7 +70,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
 
 __getattr__, __dir__ = lazy("pkm", globals(), {**dict.fromkeys(_CORE, "pkm.core"), "quantity": "pkm.units",
                                                 "Kernels": "pkm.core.twin", "Twin": "pkm.core.twin",
-                                                "task_map": "pkm.core.maps", "reconfigure": "pkm.core.reconfiguration",
+                                                "task_map": "pkm.core.analysis.maps", "reconfigure": "pkm.core.analysis.reconfiguration",
                                                 "sweep": "pkm.sweeps",
                                                 **dict.fromkeys(("assembly_modes", "working_modes", "track_assembly_mode",
                                                                  "track_working_mode"), "pkm.core.modes")})
@@ -81,7 +81,7 @@ __version__ = "0.1.0"
 def load(name) -> Mechanism:
     """A mechanism: a registered name's reference design (from its shipped ``urdf/`` files, or built from
     its default parameters when it ships none), or one's own files: a closure spec
-    (``path/to/my.closures.toml``, naming its URDF; see :mod:`pkm.core.spec`), or a URDF + YAML
+    (``path/to/my.closures.toml``, naming its URDF; see :mod:`pkm.core.model.spec`), or a URDF + YAML
     in the convention of Gepetto's toolbox-parallel-robots (the folder, the YAML or the URDF, whatever their
     names: recognised by content), an MJCF file
     (``.xml``, loops as ``<equality>`` connect/weld, actuators from ``<actuator>``) or an SDF file (loops
@@ -122,7 +122,7 @@ def load(name) -> Mechanism:
     mod = entry.module()
     if entry.reference is None:
         return mod.build(mod.Params())
-    from pkm.core.mechanism import Mechanism
+    from pkm.core.model.mechanism import Mechanism
     from pkm.data import data_dir
     from pkm.mechanisms._common import params_from_table
 
@@ -146,8 +146,8 @@ def save(mech: Mechanism, spec_path) -> Path:
 
     import numpy as np
 
-    from pkm.core.mechanism import check_mechanism
-    from pkm.core.spec import as_path
+    from pkm.core.model.mechanism import check_mechanism
+    from pkm.core.model.spec import as_path
 
     mech = check_mechanism(mech)
     path = as_path(spec_path, "spec_path")

@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pkm.core.spec import as_path, parse_toml, read_text_file
+from pkm.core.model.spec import as_path, parse_toml, read_text_file
 from pkm.data import dynamics_path
 from pkm.errors import InvalidInputError, SpecError
 from pkm.validation import ABSURD, as_array, finite_result

@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 import pkm
-from pkm.core import indices, redundant_parameter, screws
-from pkm.core.dynamics import KhalilProjection, forward_dynamics
-from pkm.core.solve import MAX_TOTAL_ITER
+from pkm.core.analysis import redundant_parameter
+from pkm.core.differential import indices, screws
+from pkm.core.dynamics.projection import KhalilProjection, forward_dynamics
+from pkm.core.kinematics.solve import MAX_TOTAL_ITER
 from pkm.errors import (
     ConvergenceError,
     InvalidInputError,

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from pkm.core.mechanism import check_mechanism
+from pkm.core.model.mechanism import check_mechanism
 from pkm.errors import AssemblyError, InvalidInputError, UnreachableError
 from pkm.mechanisms._common import best_reference, check_params
 from pkm.validation import as_vector, wrap_angle

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import math
 
-from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
-from pkm.core.urdf import UrdfBuilder
+from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
+from pkm.core.model.urdf import UrdfBuilder
 from pkm.mechanisms._common import make_mechanism, rod_inertia, spec_parameters
 from tests.fivebar.kinematics import inverse_kinematics, reference_pose
 from tests.fivebar.params import BRANCHES, NAME, FiveBarParams

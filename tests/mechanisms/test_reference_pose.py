@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import pkm
-from pkm.core import constraints
+from pkm.core.kinematics import constraints
 from pkm.errors import InvalidParameterError, UnreachableError
 from pkm.mechanisms import names
 from pkm.mechanisms._common import best_reference
@@ -43,7 +43,7 @@ def test_a_design_with_other_lengths_builds_without_a_pose(name, lengths):
 def test_the_delta_reference_is_the_best_conditioned_pose_of_the_axis_grid():
     """On the axis grid no candidate has a larger inverse condition number than the found pose; 2 cm off the axis
     either way none has either (the search on the axis misses no better pose nearby)."""
-    from pkm.core.indices import inverse_condition
+    from pkm.core.differential.indices import inverse_condition
     from pkm.mechanisms import delta as D
 
     P = D.Params()

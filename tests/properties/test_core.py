@@ -13,7 +13,8 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 import pkm
-from pkm.core import TaskMap, close_loops, constraints, dynamics, solve_ik
+from pkm.core import TaskMap, close_loops, dynamics, solve_ik
+from pkm.core.kinematics import constraints
 from pkm.mechanisms import module, names
 from tests import fd
 from tests.properties import (

@@ -15,8 +15,9 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 import pkm
-from pkm.core import TaskMap, close_loops, constraints
-from pkm.core.dynamics import KhalilProjection, virtual_work_dynamics
+from pkm.core import TaskMap, close_loops
+from pkm.core.dynamics.projection import KhalilProjection, virtual_work_dynamics
+from pkm.core.kinematics import constraints
 from pkm.errors import SingularityError
 from pkm.mechanisms import delta as D
 from tests import fd

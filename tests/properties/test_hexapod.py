@@ -17,8 +17,9 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 import pkm
-from pkm.core import TaskMap, close_loops, constraints
-from pkm.core.dynamics import virtual_work_dynamics
+from pkm.core import TaskMap, close_loops
+from pkm.core.dynamics.projection import virtual_work_dynamics
+from pkm.core.kinematics import constraints
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms._common import rot_y
 from pkm.mechanisms.hexapod import screws as hs

@@ -17,9 +17,10 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 import pkm
-from pkm.core import TaskMap, close_loops, constraints
-from pkm.core.dynamics import KhalilProjection
-from pkm.core.task import zyx_matrix
+from pkm.core import TaskMap, close_loops
+from pkm.core.dynamics.projection import KhalilProjection
+from pkm.core.kinematics import constraints
+from pkm.core.kinematics.task import zyx_matrix
 from pkm.errors import SingularityError
 from pkm.mechanisms import prs3
 from pkm.mechanisms.prs3 import dynamics as PD

@@ -15,8 +15,9 @@ from hypothesis import strategies as st
 from scipy.optimize import brentq
 
 import pkm
-from pkm.core import TaskMap, close_loops, constraints
-from pkm.core.dynamics import virtual_work_dynamics
+from pkm.core import TaskMap, close_loops
+from pkm.core.dynamics.projection import virtual_work_dynamics
+from pkm.core.kinematics import constraints
 from pkm.mechanisms import rrr3
 from tests import fd
 from tests.properties import (

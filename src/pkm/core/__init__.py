@@ -1,7 +1,7 @@
 """The generic closed-loop core: knows no particular robot.
 
-Its names are imported on first use (PEP 562), so that ``import pkm.core.screws`` or
-``pkm.core.indices`` (numpy only) does not load Pinocchio.
+Its names are imported on first use (PEP 562), so that ``import pkm.core.differential.screws`` or
+``pkm.core.differential.indices`` (numpy only) does not load Pinocchio.
 """
 
 from __future__ import annotations
@@ -11,22 +11,21 @@ from typing import TYPE_CHECKING
 from pkm._lazy import lazy
 
 _EXPORTS = {
-    "pkm.core.configuration": ("Configuration",),
-    "pkm.core.differential": ("Diagnostics", "accelerations", "diagnose", "forward_jacobian", "idle_motions",
+    "pkm.core.kinematics.configuration": ("Configuration",),
+    "pkm.core.differential.velocity": ("Diagnostics", "accelerations", "diagnose", "forward_jacobian", "idle_motions",
                               "inverse_accelerations", "inverse_jacobian", "inverse_velocities", "passive_map",
                               "task_acceleration", "task_velocity", "twist_jacobian", "velocities"),
-    "pkm.core.dynamics": ("inverse_dynamics",),
-    "pkm.core.mechanism": ("Mechanism",),
-    "pkm.core.solve": ("SolveResult", "assemble", "branch_seed", "close_loops", "solve_ik"),
-    "pkm.core.spec": ("Branch", "Closure", "ClosureSpec", "TaskSpec"),
-    "pkm.core.task": ("TaskMap", "zyx_angles", "zyx_matrix"),
-    "pkm.core.trajectory": ("Jump", "Trajectory", "follow_actuators", "follow_task", "task_values"),
+    "pkm.core.dynamics.projection": ("inverse_dynamics",),
+    "pkm.core.model.mechanism": ("Mechanism",),
+    "pkm.core.kinematics.solve": ("SolveResult", "assemble", "branch_seed", "close_loops", "solve_ik"),
+    "pkm.core.model.spec": ("Branch", "Closure", "ClosureSpec", "TaskSpec"),
+    "pkm.core.kinematics.task": ("TaskMap", "zyx_angles", "zyx_matrix"),
+    "pkm.core.kinematics.trajectory": ("Jump", "Trajectory", "follow_actuators", "follow_task", "task_values"),
 }
 _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
 if TYPE_CHECKING:  # the static view of the lazy names
-    from pkm.core.configuration import Configuration
-    from pkm.core.differential import (
+    from pkm.core.differential.velocity import (
         Diagnostics,
         accelerations,
         diagnose,
@@ -41,12 +40,13 @@ if TYPE_CHECKING:  # the static view of the lazy names
         twist_jacobian,
         velocities,
     )
-    from pkm.core.dynamics import inverse_dynamics
-    from pkm.core.mechanism import Mechanism
-    from pkm.core.solve import SolveResult, assemble, branch_seed, close_loops, solve_ik
-    from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
-    from pkm.core.task import TaskMap, zyx_angles, zyx_matrix
-    from pkm.core.trajectory import Jump, Trajectory, follow_actuators, follow_task, task_values
+    from pkm.core.dynamics.projection import inverse_dynamics
+    from pkm.core.kinematics.configuration import Configuration
+    from pkm.core.kinematics.solve import SolveResult, assemble, branch_seed, close_loops, solve_ik
+    from pkm.core.kinematics.task import TaskMap, zyx_angles, zyx_matrix
+    from pkm.core.kinematics.trajectory import Jump, Trajectory, follow_actuators, follow_task, task_values
+    from pkm.core.model.mechanism import Mechanism
+    from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 
 
 __getattr__, __dir__ = lazy("pkm.core", globals(), _WHERE)

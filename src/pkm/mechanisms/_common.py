@@ -11,8 +11,8 @@ from typing import TypeVar, cast
 
 import numpy as np
 
-from pkm.core.mechanism import Mechanism
-from pkm.core.spec import ClosureSpec
+from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.spec import ClosureSpec
 from pkm.errors import InvalidInputError, InvalidParameterError, PkmError, UnreachableError
 from pkm.validation import ABSURD, wrap_angle
 

@@ -1,4 +1,4 @@
-"""pkm.core.formats.gepetto and pkm.core.joints: models in Gepetto's URDF + robot.yaml convention, with ball joints the
+"""pkm.core.formats.gepetto and pkm.core.model.joints: models in Gepetto's URDF + robot.yaml convention, with ball joints the
 URDF writes as revolutes, loaded with no hand edits and given every generic answer.
 
 The two models in ``examples/`` were written for pkm in that convention (limits as onshape-to-robot
@@ -16,9 +16,10 @@ import pinocchio as pin
 import pytest
 
 import pkm
-from pkm.core import constraints, dynamics
-from pkm.core.compare import mechanism_differences
+from pkm.core import dynamics
 from pkm.core.formats import spec_from_gepetto
+from pkm.core.kinematics import constraints
+from pkm.core.model.compare import mechanism_differences
 from pkm.errors import SpecError, SpecNameError
 from tests import fd
 
@@ -213,7 +214,7 @@ def test_name_mot_patterns_match_as_the_toolbox_reads_them():
 
 
 def test_retyping_an_unknown_joint_names_the_valid_ones():
-    from pkm.core.joints import retype_joints
+    from pkm.core.model.joints import retype_joints
 
     model = pkm.load(MODELS["gepetto_fivebar"]).model
     with pytest.raises(SpecNameError, match="free3"):

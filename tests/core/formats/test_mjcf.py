@@ -11,10 +11,10 @@ import pinocchio as pin
 import pytest
 
 import pkm
-from pkm.core.compare import mechanism_differences
 from pkm.core.formats.mjcf import read_mjcf
-from pkm.core.joints import retype_joints
-from pkm.core.urdf import load_model
+from pkm.core.model.compare import mechanism_differences
+from pkm.core.model.joints import retype_joints
+from pkm.core.model.urdf import load_model
 from pkm.errors import SpecError
 
 FOURBAR = Path(__file__).resolve().parents[3] / "examples" / "mjcf_fourbar" / "fourbar.xml"
@@ -89,7 +89,7 @@ def test_what_pinocchio_drops_is_read_from_the_file(probe):
     assert [(c.name, c.type) for c in probe.closures] == [("tie", "point"), ("weld1", "frame")]
     mech = pkm.Mechanism.from_strings(probe.urdf, pkm.ClosureSpec(
         mechanism="probe", urdf="probe.urdf", end_effector=None, actuated=probe.actuated, closures=probe.closures,
-        task=pkm.core.spec.TaskSpec((), probe.actuated), reference={}, joint_types=probe.joint_types))
+        task=pkm.core.model.spec.TaskSpec((), probe.actuated), reference={}, joint_types=probe.joint_types))
     assert mech.limits["ja"] == pytest.approx((-np.pi / 2, np.pi / 4), abs=1e-15)
     assert mech.limits["jb"] == pytest.approx((-np.pi / 6, np.pi / 6), abs=1e-15)
     assert mech.limits["jslide"] == (-0.1, 0.1)
@@ -174,7 +174,7 @@ def test_the_world_body_and_free_bodies_are_where_mujoco_puts_them(tmp_path):
     at = mech.joint("pf").idx_q
     R = pin.AngleAxis(np.radians(30), np.array([0, 0, 1.0])).matrix()
     assert np.allclose(mech.q_reference[at:at + 7], pin.SE3ToXYZQUAT(pin.SE3(R, np.array([0.1, 0.2, 0.5]))))
-    from pkm.core import constraints
+    from pkm.core.kinematics import constraints
 
     assert np.abs(constraints.residual(mech, mech.q_reference)).max() <= 1e-12
     pin.framesForwardKinematics(mech.model, mech.data, mech.q_reference)

@@ -12,8 +12,8 @@ import pinocchio as pin
 import pytest
 
 from pkm.core.formats.mjcf import euler_matrix, read_mjcf
-from pkm.core.joints import retype_joints
-from pkm.core.urdf import load_model
+from pkm.core.model.joints import retype_joints
+from pkm.core.model.urdf import load_model
 from pkm.errors import SpecError
 
 TOL = 1e-12  # [m] or [-] (rotation-matrix entries): both routes compose the same few rotations
@@ -137,7 +137,7 @@ def test_a_tendon_on_coupled_joints_drives_their_leader_and_the_ranges_bound_it(
     j2 = np.radians([-30, 60])
     bound = sorted((j2 - 0.1 - np.radians(-10)) / -2 + np.radians(20))
     lo, hi = max(bound[0], np.radians(-90)), min(bound[1], np.radians(90))
-    from pkm.core.urdf import position_limits
+    from pkm.core.model.urdf import position_limits
 
     assert position_limits(imp.urdf)["j1"] == pytest.approx((lo, hi), abs=1e-15) and "j2" not in position_limits(
         imp.urdf)

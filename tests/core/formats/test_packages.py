@@ -10,10 +10,10 @@ import pinocchio as pin
 import pytest
 
 import pkm
-from pkm.core.constraints import residual, worst_closure
 from pkm.core.formats.imported import import_model, with_file
 from pkm.core.formats.packages import PACKAGE_MODELS, PACKAGES, model_file, package_dir
-from pkm.core.spec import ClosureSpec
+from pkm.core.kinematics.constraints import residual, worst_closure
+from pkm.core.model.spec import ClosureSpec
 from pkm.errors import PkmWarning, SpecError, UnknownNameError
 
 MOTORS = tuple(f"{side}-{joint}-op" for side in ("left", "right") for joint in ("roll", "yaw", "pitch", "knee", "foot"))

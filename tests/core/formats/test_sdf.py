@@ -10,7 +10,7 @@ from lxml import etree
 
 import pkm
 from pkm.core.formats.sdf import read_sdf
-from pkm.core.spec import TaskSpec
+from pkm.core.model.spec import TaskSpec
 from pkm.errors import SpecError
 
 INERTIA = ("<inertial><mass>0.2</mass><inertia><ixx>1e-4</ixx><iyy>1e-4</iyy><izz>1e-4</izz><ixy>0</ixy><ixz>0</ixz>"

@@ -1,5 +1,5 @@
 """pkm.core.formats.sdf: SDFormat ``gearbox`` joints (Cassie's motor rotors) read as Pinocchio mimic joints, and the
-Pinocchio 4.1 restrictions the reader and :func:`pkm.core.joints.retype_joints` work around."""
+Pinocchio 4.1 restrictions the reader and :func:`pkm.core.model.joints.retype_joints` work around."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ import pinocchio as pin
 import pytest
 
 import pkm
-from pkm.core.dynamics import energy
+from pkm.core.dynamics.projection import energy
 from pkm.core.formats.sdf import read_sdf
-from pkm.core.spec import TaskSpec
-from pkm.core.urdf import load_model
+from pkm.core.model.spec import TaskSpec
+from pkm.core.model.urdf import load_model
 from pkm.errors import SpecError
 
 I_ROTOR, I_OUT = 2e-5, 3e-3  # kg m^2 about z (each body's centre of mass on its axis)
@@ -91,7 +91,7 @@ def _pair(mimic_on: str) -> str:
 
 
 def test_pinocchio_adds_a_mimic_only_after_its_leader():
-    """The upstream restrictions worked around (module docs of pkm.core.formats.sdf and pkm.core.joints):
+    """The upstream restrictions worked around (module docs of pkm.core.formats.sdf and pkm.core.model.joints):
     Pinocchio 4.1 visits a link's child joints in name order and refuses a mimic joint met before its leader,
     and it cannot reduce a model with mimic joints. When these start to pass, the workarounds can go."""
     assert pin.buildModelFromXML(_pair("b"), mimic=True).nq == 1

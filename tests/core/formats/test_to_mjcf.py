@@ -54,7 +54,7 @@ def test_a_written_mechanism_loads_back_as_itself(name, tmp_path):
     for seed in range(3):
         q, v, a = _state(mech, seed)
         qb, vb, ab = _moved(mech, back, q, v, a)
-        assert np.abs(pkm.core.constraints.residual(back, qb)).max() <= 1e-12
+        assert np.abs(pkm.core.kinematics.constraints.residual(back, qb)).max() <= 1e-12
         tau, tau_b = pkm.inverse_dynamics(mech, q, v, a), pkm.inverse_dynamics(back, qb, vb, ab)
         bound = 1e-8 if name == "delta" else 1e-12
         assert np.linalg.norm(tau_b - tau) <= bound * max(np.linalg.norm(tau), 1e-12)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import pkm
-from pkm.core.task import TaskMap
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.twin import kernels as kmod
 from pkm.core.twin.kernels import Kernels
 from pkm.errors import InvalidInputError, SpecError

@@ -11,8 +11,9 @@ import pinocchio as pin
 import pytest
 
 import pkm
-from pkm.core import constraints, dynamics
-from pkm.core.spec import Closure, ClosureSpec, TaskSpec
+from pkm.core import dynamics
+from pkm.core.kinematics import constraints
+from pkm.core.model.spec import Closure, ClosureSpec, TaskSpec
 from pkm.core.twin import Twin
 from pkm.errors import SpecError
 

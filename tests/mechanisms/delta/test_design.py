@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from pkm.core.indices import KINDS
+from pkm.core.differential.indices import KINDS
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms import delta as D
 from pkm.mechanisms.delta import design as G

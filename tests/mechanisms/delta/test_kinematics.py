@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 import pkm
-from pkm.core import TaskMap, close_loops, constraints, solve_ik
+from pkm.core import TaskMap, close_loops, solve_ik
+from pkm.core.kinematics import constraints
 from pkm.errors import AssemblyError, InvalidInputError, SingularityError, UnreachableError
 from pkm.mechanisms import delta as D
 from tests import fd

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from pkm.core.indices import KINDS, condition_number
+from pkm.core.differential.indices import KINDS, condition_number
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms import delta as D
 from pkm.mechanisms.delta.workspace import condition_numbers, inverse_kinematics_batch, workspace
@@ -40,7 +40,7 @@ def test_batch_inverse_kinematics_is_the_scalar_one(cloud, branch):
 
 
 def test_batch_condition_numbers_are_those_of_the_jacobian(cloud):
-    """Each convention, computed on J^-1 = diag(d)^-1 A, equals pkm.core.indices on the one-pose Jacobian
+    """Each convention, computed on J^-1 = diag(d)^-1 A, equals pkm.core.differential.indices on the one-pose Jacobian
     (1e-9 relative); unreachable points are inf, never NaN."""
     K, reachable = condition_numbers(P, cloud, "knee_out")
     for kind in KINDS:

@@ -9,7 +9,7 @@ import pinocchio as pin
 import pytest
 
 import pkm
-from pkm.core import indices as core_indices
+from pkm.core.differential import indices as core_indices
 from pkm.errors import InvalidInputError
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi

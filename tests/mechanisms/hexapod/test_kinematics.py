@@ -15,7 +15,8 @@ import pinocchio as pin
 import pytest
 
 import pkm
-from pkm.core import TaskMap, constraints, solve_ik
+from pkm.core import TaskMap, solve_ik
+from pkm.core.kinematics import constraints
 from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.mechanisms import hexapod as hx
 from pkm.papers.hexapod import POSE_T_POSITION, POSE_T_ROTATION, pose_T_placement

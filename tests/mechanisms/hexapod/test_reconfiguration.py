@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from pkm.core import redundant_parameter
+from pkm.core.analysis import redundant_parameter
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi

@@ -13,7 +13,7 @@ import pinocchio as pin
 import pytest
 
 import pkm
-from pkm.core import screws
+from pkm.core.differential import screws
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import screws as hs
 from pkm.papers.hexapod import pose_T_placement

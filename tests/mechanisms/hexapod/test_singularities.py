@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import pkm
-from pkm.core import screws
+from pkm.core.differential import screws
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms._common import rot_y
 from pkm.mechanisms.hexapod import screws as hs

@@ -9,7 +9,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from pkm.core import TaskMap, branch_seed, constraints, diagnose, solve_ik
+from pkm.core import TaskMap, branch_seed, diagnose, solve_ik
+from pkm.core.kinematics import constraints
 from pkm.errors import InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.mechanisms import prs3
 

@@ -14,7 +14,8 @@ import pinocchio as pin
 import pytest
 from scipy.optimize import brentq
 
-from pkm.core import TaskMap, close_loops, constraints, diagnose, forward_jacobian, solve_ik
+from pkm.core import TaskMap, close_loops, diagnose, forward_jacobian, solve_ik
+from pkm.core.kinematics import constraints
 from pkm.errors import AssemblyError, InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
 from pkm.mechanisms import rrr3
 from tests.fd import rel, richardson

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from pkm.core.indices import inverse_condition
+from pkm.core.differential.indices import inverse_condition
 from pkm.errors import InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.mechanisms import rrr3
 from pkm.mechanisms.rrr3 import workspace as maps
@@ -28,7 +28,7 @@ def _nodes(design, n, seed, spread=0.35):
                                       CiSettings(mode=6, reference="origin", norm="fro_normalized")],
                          ids=["default", "phi-mode3", "mode8-fro", "A-L", "origin-fro"])
 def test_vectorised_ci_equals_the_svd_of_the_per_pose_jacobians(design, settings):
-    """On 150 random nodes the closed-form eigenvalue CI equals pkm.core.indices on rrr3.homogenized_jacobians (1e-9 rel),
+    """On 150 random nodes the closed-form eigenvalue CI equals pkm.core.differential.indices on rrr3.homogenized_jacobians (1e-9 rel),
     and the reachable mask equals the closed-form IK's success."""
     pts = _nodes(design, 150, seed=1)
     ci, ok = maps.condition_index(design, pts[:, 0], pts[:, 1], settings)

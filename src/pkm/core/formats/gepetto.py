@@ -12,7 +12,7 @@ example-parallel-robots; models exported with onshape-to-robot). A folder holds 
 * optional ``joint_name`` / ``joint_type``: joints the URDF writes as revolutes that are ``SPHERICAL``,
   ``CARDAN`` (a universal joint about x then y), ``UJOINT_AB`` (a universal joint about the joint frame's
   axis ``A`` then ``B``, two distinct of ``X``, ``Y``, ``Z``: pkm's ``universal_ab``) or ``FIXED`` (see
-  :mod:`pkm.core.joints`). The toolbox splits a universal joint into two revolutes ``<name>_A``, ``<name>_B``;
+  :mod:`pkm.core.model.joints`). The toolbox splits a universal joint into two revolutes ``<name>_A``, ``<name>_B``;
   pkm keeps one joint ``<name>`` of two coordinates.
 
 The convention is recognised by content, whatever the files are named (:func:`find_gepetto`): a YAML mapping
@@ -22,7 +22,7 @@ or the folder's only Gepetto YAML. What the reader chose or interpreted is in th
 :attr:`~pkm.core.Mechanism.notes`.
 
 The spec made from it has no end effector (the task is the actuated joints) and no reference (the
-mechanism is assembled, :func:`pkm.core.solve.assemble`). :func:`pkm.save` writes it as a pkm spec.
+mechanism is assembled, :func:`pkm.core.kinematics.solve.assemble`). :func:`pkm.save` writes it as a pkm spec.
 """
 
 from __future__ import annotations
@@ -31,11 +31,11 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from pkm.core.spec import MAX_FILE_BYTES, Closure, ClosureSpec, TaskSpec, read_text_file
+from pkm.core.model.spec import MAX_FILE_BYTES, Closure, ClosureSpec, TaskSpec, read_text_file
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, closest, did_you_mean
 
 if TYPE_CHECKING:
-    from pkm.core.mechanism import Mechanism
+    from pkm.core.model.mechanism import Mechanism
 
 _YAML_TYPES = {"3d": "point", "6d": "frame"}
 #: The toolbox's ``joint_type`` values and pkm's ``[joint_types]`` for them.
@@ -258,7 +258,7 @@ def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = ()) 
     """The :class:`~pkm.core.Mechanism` of a Gepetto-convention URDF + YAML pair (see the module doc); its
     :attr:`~pkm.core.Mechanism.notes` say what was interpreted (``notes`` first: how the files were paired)."""
     from pkm.core.formats.imported import import_model
-    from pkm.core.mechanism import Mechanism
+    from pkm.core.model.mechanism import Mechanism
 
     urdf_path, yaml_path = Path(urdf_path), Path(yaml_path)
     imported = import_model(urdf_path)
@@ -274,7 +274,7 @@ def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = ()) 
 
 
 def _joints(urdf: str, source: str) -> list:
-    from pkm.core.urdf import check_urdf
+    from pkm.core.model.urdf import check_urdf
 
     return check_urdf(urdf, source).findall("joint")
 

@@ -10,12 +10,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from pkm.core.spec import Closure, ClosureSpec, TaskSpec, read_text_file
-from pkm.core.urdf import check_urdf, limit_notes
+from pkm.core.model.spec import Closure, ClosureSpec, TaskSpec, read_text_file
+from pkm.core.model.urdf import check_urdf, limit_notes
 from pkm.errors import SpecError
 
 if TYPE_CHECKING:
-    from pkm.core.mechanism import Mechanism
+    from pkm.core.model.mechanism import Mechanism
 
 #: File suffixes and the format they are read as.
 SUFFIXES = {".urdf": "urdf", ".xml": "mjcf", ".mjcf": "mjcf", ".sdf": "sdf"}
@@ -103,7 +103,7 @@ def load_model_file(path: Path):
         SpecError: as :func:`import_model`, or a file that names no actuated joint (SDF never does):
             then a closure spec must say which joints are driven.
     """
-    from pkm.core.mechanism import Mechanism
+    from pkm.core.model.mechanism import Mechanism
 
     imp = import_model(path)
     if not imp.actuated:
@@ -150,7 +150,7 @@ def _head(path: Path) -> str | None:
 def _closure_spec(path: Path) -> Callable[[], Mechanism] | str:
     import tomllib
 
-    from pkm.core.mechanism import Mechanism
+    from pkm.core.model.mechanism import Mechanism
 
     if path.is_dir():
         specs = sorted(p.name for p in path.glob("*.toml"))
@@ -224,8 +224,8 @@ def spec_skeleton(path: Path) -> tuple[str, bool]:
 
     import pinocchio as pin
 
-    from pkm.core.joints import retype_joints
-    from pkm.core.urdf import load_model
+    from pkm.core.model.joints import retype_joints
+    from pkm.core.model.urdf import load_model
 
     imp = import_model(path)
     model = retype_joints(load_model(imp.urdf, str(path)), imp.joint_types, str(path))
@@ -239,7 +239,7 @@ def spec_skeleton(path: Path) -> tuple[str, bool]:
     q = json.dumps
     lines = [f"# pkm closure spec for {path.name}, written by `pkm spec init`: fill in the lines marked TODO, then",
              f"#   pkm fk {path.stem}.closures.toml --joints NAME=VALUE ...",
-             "# Values SI (m, rad). Format: the docstring of pkm.core.spec.",
+             "# Values SI (m, rad). Format: the docstring of pkm.core.model.spec.",
              'format = "pkm.closures/1"',
              f"mechanism = {q(imp.name)}",
              f"urdf = {q(path.name)}"

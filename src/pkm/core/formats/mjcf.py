@@ -64,8 +64,8 @@ import pinocchio as pin
 from lxml import etree
 
 from pkm.core.formats.imported import Imported
-from pkm.core.spec import Closure
-from pkm.core.urdf import floats, num, parse_xml, urdf_from_model
+from pkm.core.model.spec import Closure
+from pkm.core.model.urdf import floats, num, parse_xml, urdf_from_model
 from pkm.errors import SpecError, SpecNameError
 
 _ACTUATORS = ("motor", "position", "velocity", "general", "intvelocity", "damper", "cylinder", "muscle",

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING
 from pkm.errors import SpecError, UnknownNameError
 
 if TYPE_CHECKING:
-    from pkm.core.mechanism import Mechanism
+    from pkm.core.model.mechanism import Mechanism
 
 #: The packages pkm reads models from: distribution name -> its model folder, relative to the distribution's
 #: install location (:meth:`importlib.metadata.Distribution.locate_file`).
@@ -95,7 +95,7 @@ def model_file(name: str) -> tuple[Path, Path]:
         UnknownNameError: no such model (the valid names listed).
         SpecError: the package is not installed, the file is missing, or the spec's path leaves the package.
     """
-    from pkm.core.spec import ClosureSpec
+    from pkm.core.model.spec import ClosureSpec
     from pkm.data import data_dir
 
     if name not in PACKAGE_MODELS:
@@ -120,8 +120,8 @@ def load_package_model(name: str) -> Mechanism:
         SpecError: the package is not installed, or its file is missing or refused by its reader.
     """
     from pkm.core.formats.imported import import_model, with_file
-    from pkm.core.mechanism import Mechanism
-    from pkm.core.spec import ClosureSpec
+    from pkm.core.model.mechanism import Mechanism
+    from pkm.core.model.spec import ClosureSpec
 
     spec_path, path = model_file(name)
     imported = import_model(path)

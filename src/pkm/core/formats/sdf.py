@@ -61,8 +61,8 @@ import pinocchio as pin
 from lxml import etree
 
 from pkm.core.formats.imported import Imported
-from pkm.core.spec import Closure
-from pkm.core.urdf import check_urdf, floats, num, origin, parse_xml
+from pkm.core.model.spec import Closure
+from pkm.core.model.urdf import check_urdf, floats, num, origin, parse_xml
 from pkm.errors import SpecError
 
 _TYPES = ("revolute", "continuous", "prismatic", "ball", "fixed", "gearbox")

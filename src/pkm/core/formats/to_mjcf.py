@@ -19,7 +19,7 @@ import numpy as np
 import pinocchio as pin
 from lxml import etree
 
-from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import SpecError
 
 _REVOLUTE = {"RX", "RY", "RZ", "RUBX", "RUBY", "RUBZ"}

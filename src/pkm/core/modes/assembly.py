@@ -5,7 +5,7 @@ each real solution turned into a full configuration by the core and verified.
 actuator values (:mod:`~pkm.core.modes.equations`), tracks every path of a total-degree homotopy with Bertini 2
 (:mod:`~pkm.core.modes.continuation`), keeps the real solutions that are poses, polishes and certifies each
 (Smale's alpha test, :mod:`~pkm.core.modes.certify`), places the platform, closes every leg with the core
-(:func:`pkm.core.solve.assemble`, the actuators and the platform held) and checks the closure residual. The
+(:func:`pkm.core.kinematics.solve.assemble`, the actuators and the platform held) and checks the closure residual. The
 :class:`ModeSet` it returns states its completeness: the paths tracked, the bound they start from, the solutions
 at infinity, on the exceptional set and complex, and every failed path; one failed path and it is not complete.
 """
@@ -18,15 +18,15 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from pkm.core import constraints
-from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.kinematics import constraints
+from pkm.core.kinematics.solve import _levenberg_marquardt, assemble
+from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.modes.certify import Certificate, alpha_test, polish
 from pkm.core.modes.continuation import Continuation, Path, solve, track
 from pkm.core.modes.equations import FKSystem, equations
 from pkm.core.modes.polynomial import System, variables
 from pkm.core.modes.reduce import Reduction, reduce_mechanism
 from pkm.core.modes.starts import generic_start, path_parameters
-from pkm.core.solve import _levenberg_marquardt, assemble
 from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError
 
 #: A solution is real when its imaginary part is below this, relative to its size.
@@ -144,7 +144,7 @@ def _place_platform(mech: Mechanism, red: Reduction, q: np.ndarray, T: pin.SE3, 
 
 def recover(mech: Mechanism, red: Reduction, q_actuated, R: np.ndarray, t: np.ndarray, *, seed: int = 0) -> np.ndarray:
     """The full configuration of a platform displacement ``(R, t)`` (world, from the reference pose) at the given
-    actuator values: the platform placed, every leg closed by :func:`pkm.core.solve.assemble` (the actuators
+    actuator values: the platform placed, every leg closed by :func:`pkm.core.kinematics.solve.assemble` (the actuators
     and the platform held). Raises :class:`~pkm.errors.ConvergenceError` when a leg does not close to
     :data:`VERIFY_TOL`."""
     rng = np.random.default_rng(seed)

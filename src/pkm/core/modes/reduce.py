@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.mechanism import Mechanism
+from pkm.core.model.mechanism import Mechanism
 from pkm.errors import StructureError
 
 #: Incidence tolerance (relative to the mechanism's size) for "this axis passes through that point".

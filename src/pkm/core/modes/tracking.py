@@ -18,12 +18,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core import constraints
-from pkm.core.configuration import Configuration
-from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.kinematics import constraints
+from pkm.core.kinematics.configuration import Configuration
+from pkm.core.kinematics.solve import close_loops, solve_ik
+from pkm.core.kinematics.trajectory import follow_actuators, follow_task
+from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.modes.assembly import Mode
-from pkm.core.solve import close_loops, solve_ik
-from pkm.core.trajectory import follow_actuators, follow_task
 
 #: Largest joint step [rad or m] accepted while bisecting towards a meeting (a larger one: another mode).
 _STEP = 0.5

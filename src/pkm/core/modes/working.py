@@ -22,13 +22,13 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.kinematics.solve import solve_ik
+from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.modes.assembly import REAL_TOL, Mode, ModeSet, _check, recover
 from pkm.core.modes.certify import Certificate, alpha_test, polish
 from pkm.core.modes.continuation import Path, solve
 from pkm.core.modes.polynomial import Poly, System, dot, matvec, variables
 from pkm.core.modes.reduce import Leg, reduce_mechanism
-from pkm.core.solve import solve_ik
 from pkm.errors import StructureError, UnreachableError
 
 _REVOLUTE = {"RX", "RY", "RZ", "RevoluteUnaligned"}
@@ -121,7 +121,7 @@ def working_modes(mech: Mechanism, task, *, precision: str = "adaptive") -> Mode
 
     Args:
         mech: Any mechanism the reduction covers (:mod:`pkm.core.modes.reduce`).
-        task: Task coordinates (:meth:`pkm.core.task.TaskMap.parse`: a vector or a mapping by name, with units).
+        task: Task coordinates (:meth:`pkm.core.kinematics.task.TaskMap.parse`: a vector or a mapping by name, with units).
         precision: Bertini's precision mode.
 
     Returns:

@@ -8,7 +8,7 @@ with :mod:`ctypes`:
 * ``NAME_follow(n, q0, targets, q_out, residual, pivot, iterations, max_iter, tol)``, for a Newton iteration
   (inputs ``q, target``; outputs ``q_next, residual, pivot``): per target, iterate from the previous solution
   (the first from ``q0``) until the residual is at most ``tol`` or ``max_iter`` iterations were made;
-* ``NAME_grid(...)`` (:func:`map_source`): the maps' breadth-first solve over a grid (:mod:`pkm.core.maps`).
+* ``NAME_grid(...)`` (:func:`map_source`): the maps' breadth-first solve over a grid (:mod:`pkm.core.analysis.maps`).
 
 :func:`numpy_function` runs a function vectorised over samples with numpy instead (one statement per instruction),
 for machines without a compiler. Libraries are cached by the hash of their source (the folder :func:`cache_dir`), so

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import casadi as cs
 import numpy as np
 
-from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.codegen import C_INT as _I
 from pkm.core.twin.codegen import C_REAL_P as _P
 from pkm.core.twin.codegen import compile_library, numpy_function
@@ -282,8 +282,8 @@ class Kernels:
         (tau, pivot), single = self._run("inverse_dynamics", q, qd, qdd, pivoted=True)
         if not pivot.min() >= PIVOT_FLOOR:
             bad = np.flatnonzero(~(pivot[:, 0] >= PIVOT_FLOOR))
-            from pkm.core.differential import accelerations, velocities
-            from pkm.core.dynamics import inverse_dynamics
+            from pkm.core.differential.velocity import accelerations, velocities
+            from pkm.core.dynamics.projection import inverse_dynamics
 
             Q, QD, QDD = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, qd, qdd))
             for k in bad:
@@ -322,15 +322,15 @@ class Kernels:
     def close_loops_path(self, q_actuated, q0=None, *, tol: float = 1e-12, max_iter: int = 10) -> PathResult:
         """The loop closure along a path of actuated coordinates (n x na), each solve warm-started from the previous
         solution (the first from ``q0``, default the reference), as :func:`pkm.close_loops` per sample."""
-        from pkm.core.solve import close_loops
+        from pkm.core.kinematics.solve import close_loops
 
         return self._path("closure_newton", q_actuated, q0, tol, max_iter,
                           lambda q, t: close_loops(self.mech, t, q, tol=tol))
 
     def ik_path(self, targets, q0=None, *, tol: float = 1e-12, max_iter: int = 10) -> PathResult:
         """The inverse kinematics along a path of task values (n x task value size, laid out as
-        :meth:`pkm.core.task.TaskMap.value`), warm-started, as :func:`pkm.solve_ik` per sample."""
-        from pkm.core.solve import solve_ik
+        :meth:`pkm.core.kinematics.task.TaskMap.value`), warm-started, as :func:`pkm.solve_ik` per sample."""
+        from pkm.core.kinematics.solve import solve_ik
 
         return self._path("ik_newton", targets, q0, tol, max_iter, lambda q, t: solve_ik(self.mech, t, q, tol=tol))
 

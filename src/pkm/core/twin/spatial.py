@@ -103,7 +103,7 @@ def log6(M: SE3):
 
 
 def zyx_angles(R):
-    """``(roll, pitch, yaw)`` with ``R = Rz(yaw) Ry(pitch) Rx(roll)`` (as :func:`pkm.core.task.zyx_angles`)."""
+    """``(roll, pitch, yaw)`` with ``R = Rz(yaw) Ry(pitch) Rx(roll)`` (as :func:`pkm.core.kinematics.task.zyx_angles`)."""
     return cs.vertcat(cs.atan2(R[2, 1], R[2, 2]), cs.atan2(-R[2, 0], cs.sqrt(R[0, 0] ** 2 + R[1, 0] ** 2)),
                       cs.atan2(R[1, 0], R[0, 0]))
 

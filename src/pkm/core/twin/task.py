@@ -1,5 +1,5 @@
 """The task of a mechanism's twin: its error and Jacobian, the forward and inverse Jacobians, and the Newton
-iterations of the inverse kinematics and of the maps (:mod:`pkm.core.maps`), as SX expressions of the twin's
+iterations of the inverse kinematics and of the maps (:mod:`pkm.core.analysis.maps`), as SX expressions of the twin's
 symbols (:class:`~pkm.core.twin.tree.Twin`, whose :attr:`~pkm.core.twin.tree.Twin.task` this is)."""
 
 from __future__ import annotations
@@ -34,14 +34,14 @@ class TaskTwin:
 
     @functools.cached_property
     def task_target(self):
-        """The symbol of a task target, laid out as :meth:`pkm.core.task.TaskMap.value` gives values."""
-        from pkm.core.task import TaskMap
+        """The symbol of a task target, laid out as :meth:`pkm.core.kinematics.task.TaskMap.value` gives values."""
+        from pkm.core.kinematics.task import TaskMap
 
         return cs.SX.sym("y", TaskMap(self.tw.mech).value_size)
 
     @functools.cached_property
     def task_error(self):
-        """``target - task(q)`` on the task's tangent space, as :meth:`pkm.core.task.TaskMap.error` (angles wrapped to
+        """``target - task(q)`` on the task's tangent space, as :meth:`pkm.core.kinematics.task.TaskMap.error` (angles wrapped to
         ``(-pi, pi]``, a pose's orientation as ``log3(R_target R^T)``)."""
         y, out, at = self.task_target, [], 0
         for fid, comps in self._task_groups():
@@ -65,7 +65,7 @@ class TaskTwin:
 
     @functools.cached_property
     def task_jacobian(self):
-        """``d(task)/dq`` on the tangent space (task size x nv), as :meth:`pkm.core.task.TaskMap.jacobian`."""
+        """``d(task)/dq`` on the tangent space (task size x nv), as :meth:`pkm.core.kinematics.task.TaskMap.jacobian`."""
         rows = []
         for fid, comps in self._task_groups():
             J6 = self.tw.frame_jacobian(fid)
@@ -116,7 +116,7 @@ class TaskTwin:
 
     @functools.cached_property
     def map_newton(self) -> dict:
-        """The Newton iteration of the maps (:mod:`pkm.core.maps`): ``q_next`` as :attr:`ik_newton`, ``step`` the
+        """The Newton iteration of the maps (:mod:`pkm.core.analysis.maps`): ``q_next`` as :attr:`ik_newton`, ``step`` the
         largest entry of the step (no residual at the new iterate: convergence is tested on the step, then on
         :attr:`map_indices`' residual), ``pivot`` as in :attr:`ik_newton` (at ``q``)."""
         rhs = cs.vertcat(-self.tw.rotate_rows(self.tw.closure_residual), self.task_error)

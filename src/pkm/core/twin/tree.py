@@ -4,7 +4,7 @@ For any :class:`~pkm.core.Mechanism` (loaded from any file pkm reads), :class:`T
 symbols ``q`` (nq), ``v`` (nv) and ``a`` (nv):
 
 * joint and frame placements, world-aligned frame Jacobians (``LOCAL_WORLD_ALIGNED``, as Pinocchio's);
-* the closure residual (the conventions of :mod:`pkm.core.constraints`), its Jacobian and drift
+* the closure residual (the conventions of :mod:`pkm.core.kinematics.constraints`), its Jacobian and drift
   ``gamma = dJ/dt v``;
 * RNEA (joint torques for ``q, v, a`` under ``model.gravity``), kinetic and potential energy;
 * for mechanisms without idle motions: the passive map ``G``, the joint rates and accelerations from the
@@ -40,7 +40,7 @@ import functools
 import casadi as cs
 import numpy as np
 
-from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.joint import Joint
 from pkm.core.twin.linear import PivotedLU
 from pkm.core.twin.spatial import (
@@ -121,7 +121,7 @@ class Twin:
     # ---------------------------------------------------------------- closures
     @functools.cached_property
     def closure_residual(self):
-        """The closure residual (n_constraints) in :mod:`pkm.core.constraints`' conventions."""
+        """The closure residual (n_constraints) in :mod:`pkm.core.kinematics.constraints`' conventions."""
         out = []
         for c, (fa, fb) in zip(self.mech.spec.closures, self.mech.closure_frames):
             A, B = self.frame_placement(fa), self.frame_placement(fb)
@@ -130,7 +130,7 @@ class Twin:
 
     @functools.cached_property
     def closure_jacobian(self):
-        """``d(residual)/dq`` on the tangent space (n_constraints x nv), as :func:`pkm.core.constraints.jacobian`."""
+        """``d(residual)/dq`` on the tangent space (n_constraints x nv), as :func:`pkm.core.kinematics.constraints.jacobian`."""
         rows = []
         for c, (fa, fb) in zip(self.mech.spec.closures, self.mech.closure_frames):
             Ja, Jb = self.frame_jacobian(fa), self.frame_jacobian(fb)
@@ -149,7 +149,7 @@ class Twin:
     @functools.cached_property
     def closure_drift(self):
         """``gamma = dJ/dt(q, v) v`` (n_constraints): the closure acceleration of ``v`` alone, as
-        :func:`pkm.core.constraints.drift`."""
+        :func:`pkm.core.kinematics.constraints.drift`."""
         out = []
         for c, (fa, fb) in zip(self.mech.spec.closures, self.mech.closure_frames):
             if c.type == "point":
@@ -266,7 +266,7 @@ class Twin:
         return out
 
     def _no_idle(self) -> None:
-        from pkm.core.differential import idle_motions
+        from pkm.core.differential.velocity import idle_motions
 
         if idle_motions(self.mech, self.mech.q_reference).shape[1]:
             raise SpecError(self.mech.source, "the twin's rate maps and efforts need a mechanism without idle motions; "
@@ -325,7 +325,7 @@ class Twin:
     @functools.cached_property
     def actuated_efforts(self):
         """Actuator efforts (na) at a consistent state ``(q, v, a)``: ``G^T rnea``
-        (:func:`pkm.core.dynamics.virtual_work_dynamics`), computed as ``tau_a - J_a^T lambda`` with
+        (:func:`pkm.core.dynamics.projection.virtual_work_dynamics`), computed as ``tau_a - J_a^T lambda`` with
         ``J_p^T lambda = tau_p`` (one transposed solve instead of the matrix ``G``).
 
         Raises:

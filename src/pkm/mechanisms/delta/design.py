@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from pkm.core.indices import KINDS
+from pkm.core.differential.indices import KINDS
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms._common import check_params, real
 from pkm.mechanisms.delta import PHI, DeltaParams, arm_angles

@@ -7,8 +7,8 @@ import math
 
 import numpy as np
 
-from pkm.core.indices import inverse_condition
-from pkm.core.mechanism import Mechanism, check_mechanism
+from pkm.core.differential.indices import inverse_condition
+from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import AssemblyError, InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
 from pkm.mechanisms._common import (
     best_reference,

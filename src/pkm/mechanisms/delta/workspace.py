@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.indices import KINDS, condition_number
+from pkm.core.differential.indices import KINDS, condition_number
 from pkm.errors import InvalidInputError
 from pkm.mechanisms._common import check_params, circle_sphere, real
 from pkm.mechanisms.delta import PHI, DeltaParams, jacobian_factors
@@ -73,7 +73,7 @@ def condition_numbers(params: DeltaParams, points, branch="knee_out", kinds=KIND
     """Condition numbers of ``J = dX/dth`` at many platform centres.
 
     They are computed on ``J^-1 = diag(d)^-1 A`` (no inversion needed; every kind of
-    :func:`pkm.core.indices.condition_number` takes the same value on a matrix and its inverse).
+    :func:`pkm.core.differential.indices.condition_number` takes the same value on a matrix and its inverse).
 
     Args:
         params: The design.

@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.mechanism import Mechanism, check_mechanism
-from pkm.core.task import zyx_matrix
+from pkm.core.kinematics.task import zyx_matrix
+from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms._common import check_params
 from pkm.mechanisms.gough_stewart.params import GoughStewartParams

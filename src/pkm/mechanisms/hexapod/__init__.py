@@ -100,7 +100,7 @@ at ``beta = 85 deg``, from pose T, it lands on another assembly about 35 mm away
 and checks each with the generic core's closure residual; at pose T it finds a second mode about
 3 mm from the first (pose T lies near a direct singularity).
 
-Platform rotations given by the user are checked by :func:`pkm.core.task.as_rotation`: a defect
+Platform rotations given by the user are checked by :func:`pkm.core.kinematics.task.as_rotation`: a defect
 ``max|R^T R - I|`` up to :data:`ROTATION_TOL` (matrices printed with 4 digits) is projected away,
 a larger one is refused with its size.
 
@@ -118,7 +118,7 @@ Masses are not given by the paper; the defaults are illustrative and only matter
 
 from __future__ import annotations
 
-from pkm.core.task import ROTATION_TOL
+from pkm.core.kinematics.task import ROTATION_TOL
 from pkm.mechanisms.hexapod.kinematics import (
     AssemblyMode,
     actuated_from_paper,

@@ -11,7 +11,7 @@ convention: ``v`` is the velocity of the platform point passing through O), and 
 ``w_tras`` by default (``point="O"``); ``point="P"`` uses the velocity of the platform centre P,
 ``v_P = v_O + w x P``. ``w_rot`` does not depend on the point.
 
-Condition numbers (:mod:`pkm.core.indices`, spectral): ``kappa_rot`` of ``J_rot`` and
+Condition numbers (:mod:`pkm.core.differential.indices`, spectral): ``kappa_rot`` of ``J_rot`` and
 ``kappa_tras`` of ``J_tras`` (each homogeneous in units), and ``kappa`` of the whole ``J`` with
 its rotation rows multiplied by a characteristic length (default: the arm length ``LA``, so that
 ``w LA`` compares with the speed ``alpha_dot LA`` of the elbows).
@@ -29,9 +29,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core import indices as core_indices
-from pkm.core import screws
-from pkm.core.task import as_rotation
+from pkm.core.differential import indices as core_indices
+from pkm.core.differential import screws
+from pkm.core.kinematics.task import as_rotation
 from pkm.errors import InvalidInputError
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms._common import check_params

@@ -9,11 +9,11 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from pkm.core import constraints
-from pkm.core.indices import inverse_condition
-from pkm.core.mechanism import Mechanism, check_mechanism
-from pkm.core.newton import gauss_newton
-from pkm.core.task import as_rotation
+from pkm.core.differential.indices import inverse_condition
+from pkm.core.kinematics import constraints
+from pkm.core.kinematics.newton import gauss_newton
+from pkm.core.kinematics.task import as_rotation
+from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, InvalidParameterError, UnreachableError
 from pkm.mechanisms._common import (
     best_reference,
@@ -241,7 +241,7 @@ class AssemblyMode:
         P: Platform position [m] (eq. 8).
         q: The full configuration of the tree (closed-form joint values of this assembly).
         core_residual: Largest closure residual of the generic core at ``q`` [m]
-            (:func:`pkm.core.constraints.residual`): the independent check of the solution.
+            (:func:`pkm.core.kinematics.constraints.residual`): the independent check of the solution.
     """
 
     C: np.ndarray

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.task import ROTATION_TOL, as_rotation  # noqa: F401 (ROTATION_TOL: part of this module's API)
+from pkm.core.kinematics.task import ROTATION_TOL, as_rotation  # noqa: F401 (ROTATION_TOL: part of this module's API)
 from pkm.errors import InvalidInputError, InvalidParameterError
 from pkm.mechanisms._common import (
     check_finite,

@@ -11,11 +11,11 @@ Here:
   ``[|LA - s|, LA + s]``, ``s = sqrt(LB^2 - c_u^2)`` (``c_u`` the offset of ``C_i`` from the leg
   plane, which ``beta`` does not change); and ``rho^2 = a - b cos(beta - phi)`` as ``A_i`` turns
   on its circle about ``F_i``, so each bound is an arc of ``beta``.
-* :func:`optimal_beta`: ``beta*`` of one pose, by :func:`pkm.core.redundant_parameter.maximise`
+* :func:`optimal_beta`: ``beta*`` of one pose, by :func:`pkm.core.analysis.redundant_parameter.maximise`
   (a grid start then a trust-region SQP on proxqp QPs) on the reachable interval that holds the
   best grid node.
 * :func:`beta_profile`: the whole profile along a path, by
-  :func:`pkm.core.redundant_parameter.optimise_profile`: maximise ``sum_k f_k(beta_k) / s - (mu/2)
+  :func:`pkm.core.analysis.redundant_parameter.optimise_profile`: maximise ``sum_k f_k(beta_k) / s - (mu/2)
   sum_k (beta_{k+1} - beta_k)^2`` with ``|beta_{k+1} - beta_k| <= delta`` and each ``beta_k`` in
   its reachable interval. The *base model* is the robot without reconfiguration: ``beta = 0`` at
   every pose (Fig. 1 of the paper; the gain is ``f(beta_k) / f(0) - 1``).
@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core import redundant_parameter
+from pkm.core.analysis import redundant_parameter
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi
@@ -55,7 +55,7 @@ class BetaChoice:
         index: Its name.
         interval: The reachable interval searched ``(lo, hi)`` [rad].
         intervals: Every reachable interval within the limits [rad].
-        optimum: The solver's record (:class:`pkm.core.redundant_parameter.PointOptimum`).
+        optimum: The solver's record (:class:`pkm.core.analysis.redundant_parameter.PointOptimum`).
     """
 
     beta: float
@@ -85,7 +85,7 @@ class BetaProfile:
         relative_gain: ``value / base_value - 1`` (``nan`` where the base model cannot reach).
         lower, upper: The reachable interval used at each pose [rad].
         rate_limit: ``delta`` [rad per pose]; smoothness: ``mu`` [1/rad^2].
-        result: The solver's record (:class:`pkm.core.redundant_parameter.ProfileOptimum`): objective,
+        result: The solver's record (:class:`pkm.core.analysis.redundant_parameter.ProfileOptimum`): objective,
             iterations, QP statuses, ...
     """
 

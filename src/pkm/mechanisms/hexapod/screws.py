@@ -1,6 +1,6 @@
 """Velocity and acceleration of the reconfigurable hexapod by screw theory (paper eqs. 18-33).
 
-Screws (Plücker, pole O, conventions of :mod:`pkm.core.screws`), per leg ``i`` in chain order:
+Screws (Plücker, pole O, conventions of :mod:`pkm.core.differential.screws`), per leg ``i`` in chain order:
 ``$r = [u; F x u]`` (reconfiguration joint, legs 1-3 only), ``$1 = [u; A x u]`` (actuated),
 ``$2 = [u; B x u]``, ``$3 = [v; B x v]`` (universal joint), ``$4, $5, $6 = [u|v|w; C x (u|v|w)]``
 (spherical joint), ``$f = [0; w]`` (the paper's virtual prismatic joint along the rod, rate 0);
@@ -21,7 +21,7 @@ The rod screw ``$6`` is reciprocal to every joint screw of its leg but ``$r``, `
   ``qd_beta = beta_dot (1, 1, 1, 0, 0, 0)``;
 * acceleration: ``J_x^T DELTA A = J'_q qdd_beta + J_q qdd_alpha + C`` with ``A`` the reduced
   acceleration ``[w_dot; a_O - w x v_O]`` (eq. 26) and ``C_i = {L_i; $6_i}``, ``L_i`` the Lie
-  screw of acceleration of leg i (eqs. 29-30, :func:`pkm.core.screws.chain_lie_term`), which
+  screw of acceleration of leg i (eqs. 29-30, :func:`pkm.core.differential.screws.chain_lie_term`), which
   needs every joint rate of the leg (:func:`leg_rates`).
 
 Departures from the printed text: eq. (22)-(25) say ``{$r_i; $6_i} = 1`` "because the screws are
@@ -42,8 +42,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core import screws
-from pkm.core.task import as_rotation
+from pkm.core.differential import screws
+from pkm.core.kinematics.task import as_rotation
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms._common import circle_sphere_cs

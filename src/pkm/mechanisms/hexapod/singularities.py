@@ -34,8 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core import screws
-from pkm.core.indices import singularity_class
+from pkm.core.differential import screws
+from pkm.core.differential.indices import singularity_class
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms._common import check_params
 from pkm.mechanisms.hexapod import screws as hs

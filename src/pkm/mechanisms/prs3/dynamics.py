@@ -8,7 +8,7 @@ One algorithm, written once over a small set of operations, runs on three backen
   (:func:`generate_c`); its numeric ``Function`` serves single calls (:meth:`Prs3Dynamics.forces`);
 * the reference route is not this code: :meth:`Prs3Dynamics.pinocchio` builds the state with the
   closed-form IK and the generic core, and projects Pinocchio's RNEA with
-  :class:`pkm.core.dynamics.KhalilProjection`. Tests hold the two together to 1e-9.
+  :class:`pkm.core.dynamics.projection.KhalilProjection`. Tests hold the two together to 1e-9.
 
 The pipeline, from the independent coordinates ``y = (z_p, beta, phi)`` and their first and second
 time derivatives to the three actuator efforts (the boundary of the operation count):
@@ -61,8 +61,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from pkm.core.differential import inverse_accelerations, inverse_velocities
-from pkm.core.dynamics import KhalilProjection
+from pkm.core.differential.velocity import inverse_accelerations, inverse_velocities
+from pkm.core.dynamics.projection import KhalilProjection
 from pkm.errors import InvalidInputError, NonFiniteError, SingularityError, UnreachableError
 from pkm.mechanisms.prs3 import BRANCHES, PHI, Prs3Params, as_task, branch_names, build, configuration
 from pkm.validation import as_array, as_count
@@ -606,7 +606,7 @@ class Prs3Dynamics:
 
     def pinocchio(self, y, yd, ydd, wrench=None) -> np.ndarray:
         """The reference route: closed-form IK, the generic core's velocities and accelerations,
-        Pinocchio's RNEA and :class:`~pkm.core.dynamics.KhalilProjection` on the URDF model."""
+        Pinocchio's RNEA and :class:`~pkm.core.dynamics.projection.KhalilProjection` on the URDF model."""
         q, v, a = self.state(y, yd, ydd)
         return self._projection.inverse_dynamics(q, v, a, wrench)
 

@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.indices import inverse_condition
-from pkm.core.mechanism import Mechanism, check_mechanism
-from pkm.core.task import zyx_matrix
+from pkm.core.differential.indices import inverse_condition
+from pkm.core.kinematics.task import zyx_matrix
+from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidParameterError, UnreachableError
 from pkm.mechanisms._common import (
     best_reference,

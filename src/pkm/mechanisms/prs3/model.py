@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from pkm.core.mechanism import Mechanism
-from pkm.core.spec import Branch, Closure, ClosureSpec, TaskSpec
-from pkm.core.urdf import UrdfBuilder
+from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
+from pkm.core.model.urdf import UrdfBuilder
 from pkm.mechanisms._common import (
     check_params,
     make_mechanism,

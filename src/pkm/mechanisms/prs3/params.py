@@ -11,7 +11,7 @@ from typing import cast
 
 import numpy as np
 
-from pkm.core.spec import parse_toml, read_text_file
+from pkm.core.model.spec import parse_toml, read_text_file
 from pkm.data import dynamics_path
 from pkm.errors import InvalidInputError, InvalidParameterError, SpecError
 from pkm.mechanisms._common import (

@@ -8,9 +8,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.indices import inverse_condition, singularity_class
-from pkm.core.mechanism import Mechanism, check_mechanism
-from pkm.core.newton import gauss_newton
+from pkm.core.differential.indices import inverse_condition, singularity_class
+from pkm.core.kinematics.newton import gauss_newton
+from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import (
     AssemblyError,
     BranchError,

@@ -11,7 +11,7 @@ open is an explicit argument:
 * **L and moment point** — :class:`CiSettings` ``length`` (default the platform circumradius
   ``h / sqrt 3``) and ``reference`` (default the centroid ``G``, whose velocity is the task rate).
 * **Norm** — ``"2"`` (spectral, ``sigma_min / sigma_max``) or ``"fro_normalized"``
-  (``n / (||J||_F ||J^-1||_F)``), the names of :mod:`pkm.core.indices`.
+  (``n / (||J||_F ||J^-1||_F)``), the names of :mod:`pkm.core.differential.indices`.
 * **Orientation and working mode** — ``phi`` (rad) and ``mode`` of :class:`CiSettings`.
 * **Grid** — :class:`Grid`: a square of nodes ``centre + step * (i, j)``, ``|i|, |j| <= n``,
   positions of the centroid ``G``.
@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from pkm.core.indices import inverse_condition
+from pkm.core.differential.indices import inverse_condition
 from pkm.errors import InvalidInputError, SingularityError, UnreachableError
 from pkm.mechanisms import rrr3
 from pkm.mechanisms._common import check_positive, real

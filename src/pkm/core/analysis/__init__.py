@@ -1,0 +1,2 @@
+"""Analyses over many configurations: workspace and index maps, reconfiguration through redundant
+parameters, the redundant-parameter optimiser."""

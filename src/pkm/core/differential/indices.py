@@ -1,0 +1,135 @@
+"""Kinematic performance indices of a Jacobian, vectorised over stacks ``(..., m, n)``.
+
+Condition numbers come in several conventions in the literature; each has its own name
+here, so a study says which one it uses:
+
+* ``"2"``: spectral, ``kappa_2 = sigma_max / sigma_min`` (>= 1);
+* ``"fro"``: raw Frobenius product ``||J||_F ||J^-1||_F`` (>= n, square J only);
+* ``"fro_normalized"``: ``(1/n) ||J||_F ||J^-1||_F`` (>= 1, square J only) — the
+  convention of Gosselin & Angeles for the condition index ``CI = 1/kappa``.
+
+A Jacobian mixing translations and rotations must be made dimensionally homogeneous
+first (:func:`homogenize`), otherwise every one of these depends on the unit of length.
+
+Condition numbers are computed on each matrix divided by its largest entry (they do not change),
+so that matrices with huge or tiny entries neither overflow nor underflow; ``inf`` marks a
+singular matrix (or a condition number beyond the float range), never NaN.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pkm.errors import InvalidInputError
+from pkm.validation import as_array, as_scalar, finite_result
+
+KINDS = ("2", "fro", "fro_normalized")
+
+
+#: The classes of singularity (Gosselin and Angeles): the inverse kinematics degenerates (``J_q``
+#: singular: a leg at a reach limit), the direct kinematics does (``J_x`` singular: the platform moves
+#: with the actuators locked), or both.
+SINGULARITY_CLASSES = ("regular", "inverse", "direct", "combined")
+
+
+def singularity_class(inverse: bool, direct: bool) -> str:
+    """The class of a configuration from its two singular flags (one of :data:`SINGULARITY_CLASSES`)."""
+    return SINGULARITY_CLASSES[int(bool(inverse)) + 2 * int(bool(direct))]
+
+
+def _stack(J) -> np.ndarray:
+    J = as_array(J, "J", "a matrix (m, n) or a stack (..., m, n) of numbers")
+    if J.ndim < 2:
+        raise InvalidInputError("J", f"a Jacobian needs at least 2 dimensions, got shape {J.shape}")
+    if 0 in J.shape:
+        raise InvalidInputError("J", f"the Jacobian is empty (shape {J.shape})")
+    if not np.all(np.isfinite(J)):
+        raise InvalidInputError("J", "the Jacobian has non-finite entries")
+    return J
+
+
+def _normalized(J: np.ndarray) -> np.ndarray:
+    """Each matrix of the stack divided by its largest |entry| (zero matrices left as they are)."""
+    scale = np.max(np.abs(J), axis=(-2, -1), keepdims=True)
+    return J / np.where(scale > 0.0, scale, 1.0)
+
+
+def singular_values(J) -> np.ndarray:
+    """Singular values, largest first, over the last two axes.
+
+    Raises:
+        NonFiniteError: a singular value overflows the float range.
+    """
+    J = _stack(J)
+    scale = np.max(np.abs(J), axis=(-2, -1))
+    s = np.linalg.svd(_normalized(J), compute_uv=False)
+    with np.errstate(over="ignore"):
+        return finite_result(s * np.where(scale > 0.0, scale, 1.0)[..., None], "singular values")
+
+
+def condition_number(J, kind: str = "2") -> np.ndarray | float:
+    """Condition number of ``J`` (or of every matrix of a stack); ``inf`` where singular.
+
+    Args:
+        J: One matrix ``(m, n)`` or a stack ``(..., m, n)``.
+        kind: ``"2"``, ``"fro"`` or ``"fro_normalized"`` (see the module docstring).
+
+    Returns:
+        A float for one matrix, an array of shape ``J.shape[:-2]`` for a stack.
+    """
+    J = _normalized(_stack(J))
+    if not isinstance(kind, str) or kind not in KINDS:
+        raise InvalidInputError("kind", f"unknown condition number kind {kind!r}; known: {', '.join(KINDS)}", kind)
+    s = np.linalg.svd(J, compute_uv=False)
+    smax, smin = s[..., 0], s[..., -1]
+    if kind == "2":
+        with np.errstate(divide="ignore"):
+            k = np.where(smin > 0.0, smax / np.where(smin > 0.0, smin, 1.0), np.inf)
+    else:
+        m, n = J.shape[-2:]
+        if m != n:
+            raise InvalidInputError("J", f"the Frobenius condition number needs a square matrix, got {m}x{n}")
+        # ||J||_F ||J^-1||_F = sqrt(sum s^2) sqrt(sum 1/s^2)
+        ok = smin > 0.0
+        inv2 = np.sum(1.0 / np.where(ok[..., None], s, 1.0) ** 2, axis=-1)
+        k = np.where(ok, np.sqrt(np.sum(s**2, axis=-1) * inv2), np.inf)
+        if kind == "fro_normalized":
+            k = k / n
+    return float(k) if np.ndim(k) == 0 else k
+
+
+def inverse_condition(J, kind: str = "2") -> np.ndarray | float:
+    """``1 / condition_number(J, kind)`` in [0, 1]: 0 at a singularity, 1 when isotropic."""
+    k = condition_number(J, kind)
+    return 1.0 / k if np.ndim(k) == 0 else 1.0 / np.asarray(k)
+
+
+def manipulability(J) -> np.ndarray | float:
+    """Yoshikawa's ``sqrt(det(J J^T))`` (= product of the singular values)."""
+    with np.errstate(over="ignore"):
+        w = np.prod(singular_values(J), axis=-1)
+    w = finite_result(w, "manipulability",
+                      "the product of the singular values overflows: express J in other units")
+    return float(w) if np.ndim(w) == 0 else w
+
+
+def homogenize(J, rotation_rows, length: float) -> np.ndarray:
+    """Scale the angular output rows of ``J`` by a characteristic length.
+
+    For a Jacobian ``xd = J qd`` whose output mixes linear (m/s) and angular (rad/s)
+    rates, multiplying the *angular* rows by ``length`` (``omega * L``, in m/s) makes
+    every output a speed. ``rotation_rows`` selects those rows (an index, slice or
+    mask over the second-to-last axis); ``length`` in [m] must be finite and > 0.
+    """
+    J = _stack(J).copy()
+    length = as_scalar(length, "length", low=0.0, strict_low=True, unit="m")
+    try:
+        J[..., rotation_rows, :] *= length
+    except (IndexError, TypeError, ValueError) as exc:
+        raise InvalidInputError("rotation_rows", f"cannot select rows of a {J.shape[-2]}-row Jacobian with "
+                                                 f"{rotation_rows!r} ({exc}); pass an index, slice or mask",
+                                rotation_rows) from None
+    return finite_result(J, "homogenized Jacobian", "the rows scaled by length overflow")
+
+
+__all__ = ["KINDS", "condition_number", "homogenize", "inverse_condition", "manipulability", "singular_values"]

@@ -1,0 +1,448 @@
+"""Velocity and acceleration kinematics of closed-loop mechanisms; singularity diagnostics.
+
+With ``J_c`` the constraint Jacobian (:mod:`pkm.core.kinematics.constraints`), split into
+actuated columns ``J_a`` and passive columns ``J_p``, and ``J_t`` the task Jacobian
+(:mod:`pkm.core.kinematics.task`):
+
+* *idle motions*: passive motions that move neither the closures (``J_p x = 0``) nor the task
+  (``J_t x = 0``): a rod spinning about its own axis between two ball joints, two coaxial
+  revolutes. They are not singularities; every map below leaves them out (minimum-norm
+  solutions) and :func:`diagnose` reports them;
+* passive rates: ``v_p = -J_p^+ J_a qd_a`` (``G = dq/dq_a``, :func:`passive_map`); undefined when,
+  off the idle motions, ``J_p`` loses column rank: a *direct* (type 2) singularity, the actuators
+  locked yet the task movable;
+* forward Jacobian ``J_fwd = J_t G`` (task rates from actuated rates);
+* inverse Jacobian: ``[J_c; J_t] v = [0; yd]``, read on the actuated rows; undefined when, off the
+  idle motions, ``[J_c; J_t]`` loses column rank: an *inverse* (type 1) singularity, the task
+  frozen yet the actuators movable;
+* accelerations: ``J_c a + gamma_c = 0`` with the drift ``gamma_c = dJ_c/dt v``, and
+  task accelerations ``J_t a + gamma_t``.
+
+Rank decisions compare singular values with ``rtol`` times the largest one (relative: a mechanism
+of micrometres is judged as one of metres); idle motions are those that move the task by at most
+``rtol`` times the largest singular value of ``J_t``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pkm.core.differential.indices import singularity_class
+from pkm.core.kinematics import constraints
+from pkm.core.kinematics.configuration import Configuration
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.errors import SingularityError
+from pkm.validation import as_tolerance, as_vector, finite_result
+
+RTOL = 1e-9
+
+
+def _check(mech, q) -> tuple[Mechanism, np.ndarray]:
+    """The mechanism and ``q`` checked (type, shape, finiteness, unit quaternions)."""
+    mech = check_mechanism(mech)
+    return mech, mech.check_q(q)
+
+
+def _svd(A: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Full SVD of ``A`` (m x n): ``U, s, Vt`` with ``s`` padded with zeros to ``n`` values."""
+    finite_result(A, "Jacobian")
+    try:
+        U, s, Vt = np.linalg.svd(A, full_matrices=True)
+    except np.linalg.LinAlgError as exc:
+        finite_result(np.nan, "singular values", f"numpy: {exc}")
+        raise
+    return U, np.concatenate([s, np.zeros(A.shape[1] - len(s))]), Vt
+
+
+def _complement(B: np.ndarray, n: int) -> np.ndarray:
+    """An orthonormal basis (n x (n - k)) of the orthogonal complement of the orthonormal columns of ``B`` (n x k)."""
+    if B.shape[1] == 0:
+        return np.eye(n)
+    return np.linalg.svd(B.T, full_matrices=True)[2][B.shape[1]:].T
+
+
+@dataclass(frozen=True)
+class _Split:
+    """The motions at one configuration, split: idle, closure-keeping, singular (see the module doc).
+
+    ``Jp = Up diag(sp) Vpt`` (passive columns of ``J_c``, rank ``rp``); ``AC = Ua diag(sa) Vat`` with
+    ``A = [J_c; J_t]`` restricted to the complement ``C`` of the idle motions.
+    """
+
+    mech: Mechanism
+    idle: np.ndarray  # (nv, k) orthonormal, zero on the actuated rows
+    Up: np.ndarray
+    sp: np.ndarray
+    Vpt: np.ndarray
+    rp: int
+    sigma_direct: float  # smallest singular value of J_p off the idle motions
+    smax_direct: float
+    direct_direction: np.ndarray  # the task motion of the weakest passive motion (unit), n_task
+    C: np.ndarray
+    Ua: np.ndarray
+    sa: np.ndarray
+    Vat: np.ndarray
+    sigma_inverse: float
+    smax_inverse: float
+    inverse_direction: np.ndarray  # the actuated rates of the weakest frozen-task motion (unit), na
+
+    @classmethod
+    def of(cls, mech: Mechanism, Jc: np.ndarray, Jt: np.ndarray, rtol: float) -> _Split:
+        pv, nv = mech.passive_v, mech.nv
+        Jp, Jtp = Jc[:, pv], Jt[:, pv]
+        Up, sp, Vpt = _svd(Jp)
+        smax_d = float(sp[0]) if len(sp) else 0.0
+        null = sp <= rtol * smax_d
+        N = Vpt[null].T  # passive motions the closures allow with the actuators locked
+        t_ref = float(np.linalg.norm(Jt, 2)) if Jt.size else 0.0
+        if N.shape[1]:
+            _, t, Wt = _svd(Jtp @ N)
+            idle_p = N @ Wt[t <= rtol * t_ref].T  # ... of those, the ones the task does not see
+        else:
+            idle_p = np.zeros((len(pv), 0))
+        Cp = _complement(idle_p, len(pv))
+        if Cp.shape[1]:
+            _, sc, Wct = _svd(Jp @ Cp)
+            sigma_d, weakest = float(sc[-1]), Cp @ Wct[-1]
+        else:
+            sigma_d, weakest = np.inf, np.zeros(len(pv))
+        move = Jtp @ weakest
+        idle = np.zeros((nv, idle_p.shape[1]))
+        idle[pv] = idle_p
+        base = np.zeros((nv, len(mech.base_v)))
+        base[mech.base_v, np.arange(len(mech.base_v))] = 1.0  # a floating base is an input: it does not move here
+        C = _complement(np.hstack([idle, base]), nv)
+        A = np.vstack([Jc, Jt])
+        Ua, sa, Vat = _svd(A @ C)
+        w = C @ Vat[-1] if C.shape[1] else np.zeros(nv)
+        act = w[mech.act_v]
+        return cls(mech, idle, Up, sp, Vpt, int(np.sum(~null)), sigma_d, smax_d,
+                   move / max(float(np.linalg.norm(move)), 1e-300), C, Ua, sa, Vat,
+                   float(sa[-1]) if len(sa) else np.inf, float(sa[0]) if len(sa) else 0.0,
+                   act / max(float(np.linalg.norm(act)), 1e-300))
+
+    def direct_singular(self, rtol: float) -> bool:
+        return self.sigma_direct <= rtol * self.smax_direct
+
+    def inverse_singular(self, rtol: float) -> bool:
+        return self.sigma_inverse <= rtol * self.smax_inverse
+
+    def passive_solve(self, rhs: np.ndarray) -> np.ndarray:
+        """The minimum-norm passive rates ``x`` with ``J_p x = rhs`` (no idle motion in them)."""
+        r = self.rp
+        return self.Vpt[:r].T @ ((self.Up[:, :r].T @ rhs) / self.sp[:r].reshape((r,) + (1,) * (rhs.ndim - 1)))
+
+    def joint_solve(self, rhs: np.ndarray) -> np.ndarray:
+        """The joint rates ``v`` off the idle motions with ``[J_c; J_t] v = rhs`` (least squares)."""
+        n = self.C.shape[1]
+        keep = self.sa[:n] > np.finfo(float).eps * max(self.Ua.shape[0], n) * self.smax_inverse  # as lstsq's rcond
+        y = (self.Ua[:, :n][:, keep].T @ rhs) / self.sa[:n][keep].reshape((-1,) + (1,) * (rhs.ndim - 1))
+        return self.C @ (self.Vat[:n][keep].T @ y)
+
+
+def _split(mech: Mechanism, c: Configuration, rtol: float) -> _Split:
+    return _Split.of(mech, c.constraint_jacobian, c.task_jacobian, rtol)
+
+
+def _direct_check(sp: _Split, rtol: float) -> None:
+    if sp.direct_singular(rtol):
+        raise SingularityError("direct", sp.sigma_direct, "actuators locked, the task can still move")
+
+
+def _inverse_check(sp: _Split, rtol: float) -> None:
+    if sp.inverse_singular(rtol):
+        raise SingularityError("inverse", sp.sigma_inverse, "the task frozen, the actuators can still move")
+
+
+def _passive_map(mech: Mechanism, sp: _Split, Jc: np.ndarray) -> np.ndarray:
+    G = np.zeros((mech.nv, mech.na))
+    G[mech.act_v, np.arange(mech.na)] = 1.0
+    G[mech.passive_v] = -sp.passive_solve(Jc[:, mech.act_v])
+    return G
+
+
+def idle_motions(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+    """An orthonormal basis (nv x k) of the idle motions at ``q``: joint rates that the closures allow with the
+    actuators locked and that the task does not see (a rod spinning about its axis between two ball joints);
+    k = 0 for most mechanisms. Their rates and accelerations are not fixed by the kinematics."""
+    mech, q = _check(mech, q)
+    return _split(mech, Configuration.compute(mech, q), as_tolerance(rtol, "rtol")).idle
+
+
+def passive_map(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+    """``G = dq/dq_a`` (nv x na): all joint rates from the actuated rates, without idle motion.
+
+    Raises:
+        SingularityError: ``kind="direct"``: with the actuators locked, a passive motion that moves
+            the task is allowed to first order (the smallest singular value of ``J_p`` off the idle
+            motions is at most ``rtol`` times the largest).
+    """
+    mech, q = _check(mech, q)
+    rtol = as_tolerance(rtol, "rtol")
+    c = Configuration.compute(mech, q)
+    sp = _split(mech, c, rtol)
+    _direct_check(sp, rtol)
+    return finite_result(_passive_map(mech, sp, c.constraint_jacobian), "passive map G")
+
+
+def forward_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+    """Task rates from actuated rates, ``yd = J qd_a`` (n_task x na); raises as :func:`passive_map`."""
+    return _forward(mech, q, rtol, "forward")
+
+
+def twist_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+    """End-effector twist ``[v; w]`` (origin velocity, world axes) from actuated rates (6 x na)."""
+    return _forward(mech, q, rtol, "twist")
+
+
+def _forward(mech, q, rtol, which: str) -> np.ndarray:
+    mech, q = _check(mech, q)
+    rtol = as_tolerance(rtol, "rtol")
+    c = Configuration.compute(mech, q)
+    sp = _split(mech, c, rtol)
+    _direct_check(sp, rtol)
+    J = c.task_jacobian if which == "forward" else c.ee_jacobian
+    return finite_result(J @ _passive_map(mech, sp, c.constraint_jacobian), f"{which} Jacobian")
+
+
+def inverse_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+    """Actuated rates from task rates, ``qd_a = J yd`` (na x n_task).
+
+    Raises:
+        SingularityError: ``kind="inverse"``: with the task frozen, a motion of the actuators is
+            allowed to first order (``[J_c; J_t]`` off the idle motions loses column rank, relative
+            to ``rtol``).
+    """
+    mech, q = _check(mech, q)
+    rtol = as_tolerance(rtol, "rtol")
+    sp = _split(mech, Configuration.compute(mech, q), rtol)
+    _inverse_check(sp, rtol)
+    rhs = np.zeros((mech.n_constraints + mech.n_task, mech.n_task))
+    rhs[mech.n_constraints:] = np.eye(mech.n_task)
+    return finite_result(sp.joint_solve(rhs)[mech.act_v], "inverse Jacobian")
+
+
+def velocities(mech: Mechanism, q, qd_actuated) -> np.ndarray:
+    """All joint rates ``v`` (nv,) from the actuated rates."""
+    G = passive_map(mech, q)
+    return finite_result(G @ mech.check_actuated(qd_actuated, "qd_actuated"), "joint velocities")
+
+
+def accelerations(mech: Mechanism, q, v, qdd_actuated) -> np.ndarray:
+    """All joint accelerations ``a`` (nv,) from the actuated ones, the drift included (no idle acceleration).
+
+    Raises:
+        SingularityError: as :func:`passive_map`.
+    """
+    mech, q = _check(mech, q)
+    v = mech.check_v(v)
+    qdd = mech.check_actuated(qdd_actuated, "qdd_actuated")
+    gamma = constraints.drift(mech, q, v)
+    c = Configuration.compute(mech, q)
+    sp = _split(mech, c, RTOL)
+    _direct_check(sp, RTOL)
+    a = np.zeros(mech.nv)
+    a[mech.act_v] = qdd
+    a[mech.passive_v] = -sp.passive_solve(c.constraint_jacobian[:, mech.act_v] @ qdd + gamma)
+    return finite_result(a, "joint accelerations")
+
+
+def task_velocity(mech: Mechanism, q, v) -> np.ndarray:
+    """Task rates for joint rates ``v``."""
+    mech, q = _check(mech, q)
+    v = mech.check_v(v)
+    return finite_result(mech.task_map.jacobian(q) @ v, "task velocity")
+
+
+def task_acceleration(mech: Mechanism, q, v, a) -> np.ndarray:
+    """Task accelerations ``J_t a + dJ_t/dt v``."""
+    mech, q = _check(mech, q)
+    v, a = mech.check_v(v), mech.check_v(a, "a")
+    task = mech.task_map
+    return finite_result(task.jacobian(q) @ a + task.bias(q, v), "task acceleration")
+
+
+def inverse_velocities(mech: Mechanism, q, yd) -> np.ndarray:
+    """All joint rates ``v`` for task rates ``yd`` (nv,)."""
+    mech, q = _check(mech, q)
+    yd = as_vector(yd, mech.n_task, "yd")
+    sp = _split(mech, Configuration.compute(mech, q), RTOL)
+    return finite_result(sp.joint_solve(np.concatenate([np.zeros(mech.n_constraints), yd])), "joint velocities")
+
+
+def inverse_accelerations(mech: Mechanism, q, v, ydd) -> np.ndarray:
+    """All joint accelerations ``a`` for task accelerations ``ydd`` at state ``(q, v)``."""
+    mech, q = _check(mech, q)
+    v = mech.check_v(v)
+    ydd = as_vector(ydd, mech.n_task, "ydd")
+    task = mech.task_map
+    gamma_c = constraints.drift(mech, q, v)
+    gamma_t = task.bias(q, v)
+    sp = _split(mech, Configuration.compute(mech, q), RTOL)
+    return finite_result(sp.joint_solve(np.concatenate([-gamma_c, ydd - gamma_t])), "joint accelerations")
+
+
+@dataclass(frozen=True)
+class Diagnostics:
+    """Rank and singularity measures at a configuration.
+
+    Attributes:
+        constraint_rank: Rank of the constraint Jacobian (relative to its largest singular value).
+        redundant_constraints: Equations that are linearly dependent on others (planar loops
+            closed with 3-D points have some).
+        mobility: Instantaneous degrees of freedom, ``nv - constraint_rank`` (idle motions included).
+        sigma_direct: Smallest singular value of the passive columns ``J_p`` off the idle motions
+            (type 2 measure, in the Jacobian's units).
+        sigma_inverse: Smallest singular value of ``[J_c; J_t]`` off the idle motions (type 1 measure).
+        classification: ``"regular"``, ``"inverse"``, ``"direct"`` or ``"combined"``.
+        idle_motions: Passive motions that move neither the closures, nor the task, nor the actuators
+            (a rod spinning about its axis between two ball joints; coaxial revolutes): not singularities.
+        idle_joints: The joints those motions turn.
+        direct_distance: ``sigma_direct`` over the largest singular value of ``J_p``, in [0, 1].
+        inverse_distance: ``sigma_inverse`` over the largest singular value of ``[J_c; J_t]``.
+        near: The kinds (``"direct"``, ``"inverse"``) whose distance is below ``near`` but above
+            ``rtol``: regular, but the Jacobians are large there.
+        direct_direction: The task motion (unit, task tangent coordinates) of the weakest passive
+            motion with the actuators locked: where the platform gives way near a direct singularity.
+        inverse_direction: The actuated rates (unit) of the weakest motion with the task frozen.
+        dependent_actuators: Actuators whose rates the others fix here (:class:`Actuation`).
+        unactuated: Degrees of freedom that move the task with every actuator locked (:class:`Actuation`).
+        near_threshold: The ``near`` argument: the distance below which :attr:`near` lists a kind.
+    """
+
+    constraint_rank: int
+    redundant_constraints: int
+    mobility: int
+    sigma_direct: float
+    sigma_inverse: float
+    classification: str
+    idle_motions: int = 0
+    idle_joints: tuple[str, ...] = ()
+    direct_distance: float = 1.0
+    inverse_distance: float = 1.0
+    near: tuple[str, ...] = ()
+    direct_direction: np.ndarray | None = None
+    inverse_direction: np.ndarray | None = None
+    dependent_actuators: tuple[str, ...] = ()
+    unactuated: int = 0
+    near_threshold: float = 1e-3
+
+    @property
+    def summary(self) -> str:
+        """One sentence: the class, how near a singularity a regular configuration is, the actuators that do not
+        fit the mobility (``str(diagnostics)``)."""
+        out = self.classification
+        if self.near:
+            dist = {"direct": self.direct_distance, "inverse": self.inverse_distance}
+            out += ", but near " + " and ".join(f"{'an' if k == 'inverse' else 'a'} {k} singularity (distance "
+                                                 f"{dist[k]:.2g} < {self.near_threshold:g})" for k in self.near)
+        if self.dependent_actuators:
+            out += f"; actuators {list(self.dependent_actuators)} depend on the others"
+        if self.unactuated:
+            out += f"; {self.unactuated} degree(s) of freedom move the task with every actuator locked"
+        return out
+
+    def __str__(self) -> str:
+        return self.summary
+
+
+@dataclass(frozen=True)
+class Actuation:
+    """How the actuators match the mechanism's mobility at a configuration (:func:`actuation`).
+
+    Attributes:
+        mobility: Degrees of freedom the closures leave (idle motions included, a floating base's six not).
+        independent: How many actuators move independently: the rank of the actuated rates over the motions the
+            closures allow.
+        dependent: Actuators whose rates the others' fix (redundant actuation, or a joint held that leaves an
+            actuator no freedom), in spec order: each one's value must agree with the others'.
+        unactuated: Degrees of freedom left with every actuator locked that are not idle motions (they move the
+            task): the actuators fall short of the mobility by this.
+        idle_motions: Motions left with every actuator locked that the task does not see.
+    """
+
+    mobility: int
+    independent: int
+    dependent: tuple[str, ...]
+    unactuated: int
+    idle_motions: int
+
+    @property
+    def problem(self) -> str:
+        """A sentence naming the dependent or missing actuators, or ``""`` when the actuators fit the mobility."""
+        out = []
+        if self.dependent:
+            out.append(f"actuator(s) {list(self.dependent)} depend on the others (mobility {self.mobility}, "
+                       f"{self.independent} independent actuators): their values must agree with the others'")
+        if self.unactuated:
+            out.append(f"{self.unactuated} degree(s) of freedom move the task with every actuator locked: the "
+                       f"actuators fall short of the mobility ({self.mobility}, of which {self.idle_motions} idle)")
+        return "; ".join(out)
+
+
+def actuation(mech: Mechanism, q=None, *, rtol: float = 1e-7) -> Actuation:
+    """The actuators against the mobility at ``q`` (default: the reference configuration): which actuators depend
+    on the others, and how many degrees of freedom no actuator drives (:class:`Actuation`).
+
+    With ``N`` a basis of the motions the closures allow (the null space of ``J_c``, the floating base held), the
+    actuators are independent as far as the rows ``N[act]`` are (their rank, judged against ``rtol`` times the
+    largest singular value of ``J_c`` and 1e-6 for the unit-free rows), taken greedily in spec order: an actuator
+    whose row adds no rank depends on those before it. Judged at one configuration: at a singular one more
+    actuators look dependent than elsewhere.
+    """
+    mech = check_mechanism(mech)
+    q = mech.q_reference if q is None else mech.check_q(q)
+    rtol = as_tolerance(rtol, "rtol")
+    c = Configuration.compute(mech, q)
+    return _actuation(mech, c, _split(mech, c, rtol), rtol)
+
+
+def _actuation(mech: Mechanism, c: Configuration, sp: _Split, rtol: float) -> Actuation:
+    Jc = finite_result(c.constraint_jacobian, "constraint Jacobian")
+    keep = np.setdiff1d(np.arange(mech.nv), mech.base_v)
+    _, s, Vt = _svd(Jc[:, keep])
+    rank = int(np.sum(s > rtol * s[0])) if len(s) and s[0] > 0.0 else 0
+    N = Vt[rank:].T
+    rows = N[np.searchsorted(keep, mech.act_v)]
+    dependent, basis = [], np.zeros((0, N.shape[1]))
+    for name, row in zip(mech.actuated_names, rows):
+        trial = np.vstack([basis, row])
+        if len(trial) <= N.shape[1] and np.linalg.svd(trial, compute_uv=False)[-1] > 1e-6:
+            basis = trial
+        else:
+            dependent.append(name)
+    idle = sp.idle.shape[1]
+    mobility = N.shape[1]
+    return Actuation(mobility, len(basis), tuple(dependent), max(mobility - len(basis) - idle, 0), idle)
+
+
+def diagnose(mech: Mechanism, q, *, rtol: float = 1e-7, near: float = 1e-3) -> Diagnostics:
+    """Rank, mobility, idle motions, graded singularity measures and the actuators against the mobility at ``q``
+    (which should be assembled). ``str()`` of the result is one sentence (:attr:`Diagnostics.summary`): a regular
+    configuration inside the ``near`` band says how near it is.
+
+    Args:
+        rtol: Relative rank tolerance: a kind is singular where its distance is at most ``rtol``.
+        near: Distances below this (and above ``rtol``) are reported in :attr:`Diagnostics.near`.
+    """
+    mech, q = _check(mech, q)
+    rtol = as_tolerance(rtol, "rtol")
+    near = max(as_tolerance(near, "near"), rtol)
+    c = Configuration.compute(mech, q)
+    Jc = finite_result(c.constraint_jacobian, "constraint Jacobian")
+    s = np.linalg.svd(Jc, compute_uv=False)
+    rank = int(np.sum(s > rtol * s[0])) if len(s) and s[0] > 0.0 else 0
+    sp = _split(mech, c, rtol)
+    dd = sp.sigma_direct / sp.smax_direct if sp.smax_direct > 0.0 else 0.0
+    di = sp.sigma_inverse / sp.smax_inverse if sp.smax_inverse > 0.0 else 0.0
+    dd, di = min(dd, 1.0), min(di, 1.0)
+    direct, inverse = dd <= rtol, di <= rtol
+    moved = np.abs(sp.idle).max(axis=1) > 1e-6 if sp.idle.shape[1] else np.zeros(mech.nv, dtype=bool)
+    idle_joints = tuple(j.name for j in mech.joints.values() if moved[j.idx_v:j.idx_v + j.nv].any())
+    fit = _actuation(mech, c, sp, rtol)
+    return Diagnostics(rank, mech.n_constraints - rank, mech.nv - rank, sp.sigma_direct, sp.sigma_inverse,
+                       singularity_class(inverse, direct), sp.idle.shape[1], idle_joints, dd, di,
+                       tuple(k for k, d in (("direct", dd), ("inverse", di)) if rtol < d < near),
+                       sp.direct_direction, sp.inverse_direction, fit.dependent, fit.unactuated, near)

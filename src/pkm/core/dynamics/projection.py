@@ -1,0 +1,405 @@
+"""Inverse dynamics of closed-loop mechanisms by Khalil's projection, and its independent checks.
+
+The mechanism is cut at its closures into *legs* and a *platform* (Khalil & Ibrahim 2007):
+
+* the **platform** is the subtree of the Pinocchio model that carries the end-effector
+  frame (a free joint, or the massless guide joints of a Delta); its joint velocity
+  ``v_p`` (``n_p`` coordinates) is the platform's motion;
+* a **leg** is a subtree hanging from the base whose tip frames meet platform frames
+  through closures; legs that share a joint are merged into one.
+
+With the constraint Jacobian rows of leg ``k`` written ``J_k qd_k = P_k v_p`` (leg tip
+velocity = velocity of the platform point it meets), an SVD of the leg's own Jacobian
+``J_k = U S V^T`` splits them into
+
+* the leg's inverse kinematics of velocity, ``qd_k = L_k v_p``, ``L_k = V S^-1 U_r^T P_k``
+  (undefined when the leg loses rank: an inverse singularity of that leg);
+* the motions of the platform the leg forbids, ``K_k v_p = 0``, ``K_k = U_n^T P_k``
+  (the leg's constraint wrenches).
+
+Stacking the actuated rows of the ``L_k`` (``A``) and the ``K_k`` gives the square
+``M = [A; K]``; ``J_k = M^-1 [I; 0]`` maps actuated rates to the platform motion
+(undefined where ``M`` loses rank: a direct singularity). Then
+
+    ``tau = h_a + J_k^T (f_p + sum_k L_{k,p}^T h_{k,p} - P_e^T w)``        (paper eq. 38)
+
+where ``h`` is the tree's inverse dynamics (``pin.rnea``: each leg is its own serial chain,
+so this is the recursive Newton-Euler of every leg, and the platform's free joint gives its
+Newton-Euler wrench ``f_p``), ``h_a``/``h_{k,p}`` its actuated/passive leg entries, ``L_{k,p}``
+the passive rows of ``L_k`` (the paper's ``G_2``) and ``w`` an external wrench on the
+platform (world-aligned, at the end-effector frame: force then moment) of Jacobian ``P_e``.
+
+Independent routes, used by the tests: :func:`virtual_work_dynamics` (``G^T h`` with the
+core's passive map ``G = dq/dq_a``), :func:`forward_dynamics` (Pinocchio's
+``constraintDynamics``: the forces must give back the accelerations) and :func:`energy`
+(power balance).
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core.differential.velocity import idle_motions, passive_map
+from pkm.core.kinematics import constraints
+from pkm.core.kinematics.configuration import Configuration
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.errors import InvalidInputError, PkmError, SingularityError, SpecError
+from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
+
+RTOL = 1e-9
+
+
+@dataclass(frozen=True)
+class Leg:
+    """One leg of the cut mechanism.
+
+    Attributes:
+        closures: Names of the closures at the leg's tips.
+        rows: Their rows in the constraint Jacobian.
+        v: Velocity indices of the leg's joints (tree order).
+        actuated: Positions in ``v`` of the actuated joints.
+        actuated_index: Their positions in ``mech.actuated`` (the order of ``tau``).
+        passive: Positions in ``v`` of the passive joints.
+    """
+
+    closures: tuple[str, ...]
+    rows: np.ndarray
+    v: np.ndarray
+    actuated: np.ndarray
+    actuated_index: np.ndarray
+    passive: np.ndarray
+
+
+@dataclass(frozen=True)
+class Partition:
+    """The platform's velocity indices and the legs."""
+
+    platform_v: np.ndarray
+    legs: tuple[Leg, ...]
+
+
+def _support_v(model: pin.Model, joint_id: int) -> set[int]:
+    out: set[int] = set()
+    for j in model.supports[joint_id]:
+        if j > 0:
+            jm = model.joints[j]
+            out.update(range(jm.idx_v, jm.idx_v + jm.nv))
+    return out
+
+
+def partition(mech: Mechanism) -> Partition:
+    """Cut ``mech`` into platform and legs (see the module doc).
+
+    Raises:
+        SpecError: The structure does not fit the projection: a closure that does not join a
+            leg to the platform, an actuated joint on the platform side, a joint that belongs to
+            no leg, or mimic joints (not supported).
+    """
+    mech = check_mechanism(mech)
+    model = mech.model
+    src = mech.source
+    if _has_mimic(model):
+        raise SpecError(src, "the Khalil projection does not support mimic joints yet")
+    if mech.base is not None:
+        raise SpecError(src, "the Khalil projection cuts a fixed base; a floating base takes the virtual-work route")
+    plat = _support_v(model, model.frames[mech.ee_frame].parentJoint)
+    if not plat:
+        raise SpecError(src, f"end effector {mech.spec.end_effector!r} is fixed to the base: no platform to cut")
+    act = {int(v): k for k, v in enumerate(mech.act_v)}
+    if plat & set(act):
+        raise SpecError(src, "an actuated joint drives the platform directly: the projection expects actuated "
+                             "joints in the legs")
+    groups: list[tuple[list[str], list[int], set[int]]] = []
+    row = 0
+    for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
+        n = 3 if c.type == "point" else 6
+        sa, sb = (_support_v(model, model.frames[f].parentJoint) for f in (fa, fb))
+        leg = sa - plat if sb <= plat and not sa <= plat else sb - plat if sa <= plat and not sb <= plat else None
+        if not leg or (sa & sb) - plat:
+            raise SpecError(src, f"closure {c.name!r} does not join a leg to the platform: the projection needs "
+                                 "every closure between a leg tip and the platform")
+        rows = list(range(row, row + n))
+        row += n
+        merged = [g for g in groups if g[2] & leg]
+        for g in merged:
+            groups.remove(g)
+            rows = g[1] + rows
+            leg = leg | g[2]
+        groups.append(([n for g in merged for n in g[0]] + [c.name], rows, leg))
+    covered = plat.union(*(g[2] for g in groups))
+    if len(covered) != model.nv:
+        raise SpecError(src, f"joints with velocity indices {sorted(set(range(model.nv)) - covered)} belong to "
+                             "neither the platform nor a leg")
+    legs = []
+    for names, rows, vs in groups:
+        v = np.array(sorted(vs))
+        a = [i for i, vi in enumerate(v) if int(vi) in act]
+        legs.append(Leg(tuple(names), np.array(sorted(rows)), v, np.array(a, dtype=int),
+                        np.array([act[int(v[i])] for i in a], dtype=int),
+                        np.array([i for i in range(len(v)) if i not in a], dtype=int)))
+    return Partition(np.array(sorted(plat)), tuple(legs))
+
+
+@dataclass(frozen=True)
+class Projection:
+    """The projection matrices at one configuration.
+
+    Attributes:
+        Jk: Platform joint velocity from actuated rates (``n_p x n_a``).
+        L: Per leg, its joint rates from the platform velocity (``n_k x n_p``).
+        sigma_leg: Per leg, the smallest singular value of its Jacobian (inverse singularity measure).
+        sigma_direct: Smallest singular value of ``M = [A; K]`` (direct singularity measure).
+    """
+
+    Jk: np.ndarray
+    L: tuple[np.ndarray, ...]
+    sigma_leg: tuple[float, ...]
+    sigma_direct: float
+
+
+class KhalilProjection:
+    """Actuator efforts of a closed-loop mechanism by Khalil's projection (module doc).
+
+    Args:
+        mech: The mechanism; its platform and legs are found by :func:`partition`.
+        rtol: Relative singular-value threshold for the rank decisions.
+    """
+
+    def __init__(self, mech: Mechanism, *, rtol: float = RTOL):
+        self.mech = check_mechanism(mech)
+        self.partition = partition(mech)
+        self.rtol = as_tolerance(rtol, "rtol")
+
+    def projection(self, q) -> Projection:
+        """``J_k`` and the legs' velocity maps at ``q`` (assembled).
+
+        Raises:
+            SingularityError: ``"inverse"`` where a leg's Jacobian loses rank (leg named in the
+                message), ``"direct"`` where ``M`` does.
+        """
+        return self._projection(constraints.jacobian(self.mech, self.mech.check_q(q)))
+
+    def _projection(self, Jc: np.ndarray) -> Projection:
+        mech, part = self.mech, self.partition
+        Jc = finite_result(Jc, "constraint Jacobian")
+        na, n_p = mech.na, len(part.platform_v)
+        A = np.zeros((na, n_p))
+        K, Ls, sig = [], [], []
+        for leg in part.legs:
+            Jl = Jc[np.ix_(leg.rows, leg.v)]
+            P = -Jc[np.ix_(leg.rows, part.platform_v)]
+            U, s, Vt = np.linalg.svd(Jl)
+            r = len(leg.v)
+            sig.append(float(s[r - 1]) if len(s) >= r else 0.0)
+            if len(s) < r or s[r - 1] <= self.rtol * float(s[0]):
+                raise SingularityError("inverse", sig[-1], f"leg of closures {', '.join(leg.closures)} loses rank: "
+                                                           "its joint rates are not fixed by the platform motion")
+            L = Vt.T @ ((U[:, :r].T @ P) / s[:r, None])
+            Ls.append(L)
+            K.append(U[:, r:].T @ P)
+            A[leg.actuated_index] = L[leg.actuated]
+        M = np.vstack([A, *K])
+        sv = np.linalg.svd(M, compute_uv=False)
+        smin = float(sv[n_p - 1]) if len(sv) >= n_p else 0.0
+        if smin <= self.rtol * float(sv[0]):
+            raise SingularityError("direct", smin, "the actuated legs do not fix the platform motion")
+        rhs = np.zeros((M.shape[0], na))
+        rhs[:na] = np.eye(na)
+        Jk = np.linalg.lstsq(M, rhs, rcond=None)[0]
+        return Projection(Jk, tuple(Ls), tuple(sig), smin)
+
+    def inverse_dynamics(self, q, v, a, wrench=None, *, wrenches=None) -> np.ndarray:
+        """Actuator efforts (N or N m, in ``mech.actuated`` order) for a consistent state.
+
+        Args:
+            q: Assembled configuration (nq,).
+            v: Joint velocities satisfying the closures (nv,).
+            a: Joint accelerations satisfying the closures (nv,).
+            wrench: Optional external wrench on the platform at the end-effector frame,
+                world-aligned ``(f [N], m [N m])``, shape (6,).
+            wrenches: Optional external wrenches on any frames, ``{frame name: (f, m)}``, each
+                world-aligned at the frame's origin.
+        """
+        mech, part = self.mech, self.partition
+        q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
+        c = Configuration.compute(mech, q)
+        proj = self._projection(c.constraint_jacobian)
+        h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches, c)
+        f = h[part.platform_v].copy()
+        tau = np.zeros(mech.na)
+        for leg, L in zip(part.legs, proj.L):
+            hk = h[leg.v]
+            tau[leg.actuated_index] = hk[leg.actuated]
+            p = leg.passive
+            f += L[p].T @ hk[p]
+        return finite_result(tau + proj.Jk.T @ f, "actuator efforts", "the state is too large for the inertias "
+                                                                      "(overflow); check the units")
+
+
+def _external(mech: Mechanism, q: np.ndarray, h: np.ndarray, wrench, wrenches,
+              c: Configuration | None = None) -> np.ndarray:
+    """``h - sum_f J_f^T w_f``: the tree's joint forces less those of the external wrenches (world-aligned at
+    each frame's origin, force then moment); ``wrench`` acts at the end-effector frame. ``c``: the
+    configuration's kinematics when the caller has them (computed here only when a wrench needs them)."""
+    if wrenches is not None and not (isinstance(wrenches, Mapping) and all(isinstance(k, str) for k in wrenches)):
+        raise InvalidInputError("wrenches", "expected {frame name: (fx, fy, fz, mx, my, mz)}", wrenches)
+    loads = dict(wrenches or {})
+    out = h.copy()
+    if wrench is not None:
+        c = Configuration.compute(mech, q) if c is None else c
+        out -= c.ee_jacobian.T @ as_vector(wrench, 6, "wrench")
+    m = mech.model
+    if loads:
+        pin.computeJointJacobians(m, mech.data, q)
+        pin.updateFramePlacements(m, mech.data)
+    for name, w in loads.items():
+        J = pin.getFrameJacobian(m, mech.data, mech.frame_id(name), pin.LOCAL_WORLD_ALIGNED)
+        out -= J.T @ as_vector(w, 6, f"wrenches[{name!r}]")
+    return out
+
+
+_KHALIL: weakref.WeakKeyDictionary[Mechanism, KhalilProjection | SpecError] = weakref.WeakKeyDictionary()
+
+
+def _khalil(mech: Mechanism) -> KhalilProjection | SpecError:
+    """The mechanism's Khalil projection, or the SpecError saying why its structure does not allow one (cached)."""
+    if mech not in _KHALIL:
+        try:
+            _KHALIL[mech] = KhalilProjection(mech)
+        except SpecError as exc:
+            _KHALIL[mech] = exc
+    return _KHALIL[mech]
+
+
+def _has_mimic(model: pin.Model) -> bool:
+    return any(jm.shortname() == "JointModelMimic" for jm in model.joints)
+
+
+METHODS = ("auto", "khalil", "virtual_work")
+_IDLE: weakref.WeakKeyDictionary[Mechanism, bool] = weakref.WeakKeyDictionary()
+
+
+def _settle_idle(mech: Mechanism, q, v, a, wrench, wrenches) -> np.ndarray:
+    """``a`` with its idle-motion part set by the dynamics, ``a + N alpha`` with ``N^T (M a' + h - J^T w) = 0``.
+
+    The kinematics fixes no idle acceleration (:func:`~pkm.core.differential.velocity.idle_motions` ``N``: a rod spinning
+    between two ball joints), and the one in ``a`` (the minimum-norm one of :func:`pkm.accelerations`) is in general
+    not the one the efforts produce: nothing drives an idle motion, so its generalised force must vanish. Without
+    this, ``G^T`` of the tree's forces depends on how ``G`` splits the idle motion (by up to 1e-4 of the efforts on
+    the RSSR four-bar). Mechanisms with no idle motion at their reference skip it (cached per mechanism);
+    massless idle motions (no inertia about the rod's axis) keep the acceleration given.
+    """
+    if mech not in _IDLE:
+        _IDLE[mech] = idle_motions(mech, mech.q_reference).shape[1] > 0
+    if not _IDLE[mech]:
+        return a
+    q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
+    N = idle_motions(mech, q)
+    if not N.shape[1]:
+        return a
+    m, d = mech.model, mech.data
+    h = _external(mech, q, pin.rnea(m, d, q, v, a), wrench, wrenches)
+    M = pin.crba(m, d, q)
+    M = np.triu(M) + np.triu(M, 1).T
+    alpha = np.linalg.lstsq(N.T @ M @ N, -(N.T @ h), rcond=1e-12)[0]
+    return a + N @ alpha
+
+
+def inverse_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=None, method: str = "auto") -> np.ndarray:
+    """Actuator efforts (N or N m, in ``mech.actuated`` order) of any mechanism at a consistent state.
+
+    Args:
+        mech: The mechanism.
+        q, v, a: Assembled configuration, joint velocities and accelerations satisfying the closures
+            (:func:`pkm.velocities`, :func:`pkm.accelerations` or their inverse-kinematics twins).
+        wrench: External wrench at the end-effector frame, world-aligned ``(f [N], m [N m])``.
+        wrenches: External wrenches on any frames, ``{frame name: (f, m)}``, world-aligned at each origin.
+        method: ``"khalil"`` (:class:`KhalilProjection`: legs cut from the platform; refuses the
+            structures it cannot cut, such as actuators on the platform chain or mimic joints),
+            ``"virtual_work"`` (:func:`virtual_work_dynamics`: ``G^T`` of the tree's forces, any
+            structure: mimic couplings, idle motions, redundant planar closures), or ``"auto"``: Khalil's
+            where the structure allows it, virtual work otherwise. Both give the same efforts to 1e-10
+            where both apply (tests).
+
+    Raises:
+        SingularityError: at a direct singularity (and, for ``"khalil"``, where a leg loses rank).
+        SpecError: ``"khalil"`` on a structure it cannot cut (says why).
+    """
+    mech = check_mechanism(mech)
+    if method not in METHODS:
+        raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
+    if method == "virtual_work":
+        return virtual_work_dynamics(mech, q, v, a, wrench, wrenches=wrenches)
+    k = _khalil(mech)
+    if isinstance(k, SpecError):
+        if method == "khalil":
+            raise k
+        return virtual_work_dynamics(mech, q, v, a, wrench, wrenches=wrenches)
+    return k.inverse_dynamics(q, v, _settle_idle(mech, q, v, a, wrench, wrenches), wrench, wrenches=wrenches)
+
+
+def virtual_work_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=None) -> np.ndarray:
+    """Actuator efforts as ``G^T (rnea(q, v, a) - sum J_f^T w_f)``, ``G = dq/dq_a`` without idle motions: the
+    whole-tree virtual-work route (external wrenches as in :func:`inverse_dynamics`; idle accelerations set by the
+    dynamics, see :func:`_settle_idle`)."""
+    mech = check_mechanism(mech)
+    q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
+    a = _settle_idle(mech, q, v, a, wrench, wrenches)
+    G = passive_map(mech, q)
+    h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches)
+    return finite_result(G.T @ h, "actuator efforts")
+
+
+def forward_dynamics(mech: Mechanism, q, v, tau_actuated, *, mu: float = 0.0) -> np.ndarray:
+    """Joint accelerations under actuator efforts, by Pinocchio's ``constraintDynamics``.
+
+    The closures are enforced at the acceleration level with no Baumgarte correction
+    (the state must be assembled and consistent).
+
+    Raises:
+        PkmError: The model has mimic joints (Pinocchio 4.1's ``constraintDynamics`` does not
+            handle them).
+    """
+    mech = check_mechanism(mech)
+    q, v = mech.check_q(q), mech.check_v(v)
+    tau_a = mech.check_actuated(tau_actuated, "tau_actuated")
+    mu = as_scalar(mu, "mu", low=0.0)
+    if _has_mimic(mech.model):
+        raise PkmError("constraintDynamics does not support mimic joints on Pinocchio 4.1")
+    tau = np.zeros(mech.nv)
+    tau[mech.act_v] = tau_a
+    pin.initConstraintDynamics(mech.model, mech.data, mech.constraint_models, mech.constraint_datas)
+    settings = pin.ProximalSettings(1e-14, mu, 10)
+    a = pin.constraintDynamics(mech.model, mech.data, q, v, tau, mech.constraint_models, mech.constraint_datas,
+                               settings).copy()
+    if not np.all(np.isfinite(a)):
+        s = np.linalg.svd(finite_result(constraints.jacobian(mech, q), "constraint Jacobian"), compute_uv=False)
+        if mu == 0.0 and s[-1] <= 1e-9 * max(s[0], 1.0):
+            raise SingularityError("constraint", float(s[-1]), "the closure equations are redundant (a planar "
+                                   "mechanism closed with 3-D points?): pass mu > 0, e.g. mu=1e-8")
+        finite_result(a, "joint accelerations", "constraintDynamics failed (a singular configuration?)")
+    return a
+
+
+def energy(mech: Mechanism, q, v) -> tuple[float, float]:
+    """Kinetic [J] and potential [J] energy of every body (gravity ``mech.model.gravity``)."""
+    mech = check_mechanism(mech)
+    q, v = mech.check_q(q), mech.check_v(v)
+    m, d = mech.model, mech.data
+    if not _has_mimic(m):
+        return float(pin.computeKineticEnergy(m, d, q, v)), float(pin.computePotentialEnergy(m, d, q))
+    # Pinocchio 4.1's energy routines refuse mimic joints (the hexapod): sum over the bodies instead
+    pin.forwardKinematics(m, d, q, v)
+    bodies = range(1, m.njoints)
+    kinetic = sum(0.5 * m.inertias[i].vtiv(d.v[i]) for i in bodies)
+    potential = -sum(m.inertias[i].mass * float(m.gravity.linear @ d.oMi[i].act(m.inertias[i].lever)) for i in bodies)
+    return float(kinetic), float(potential)
+
+
+__all__ = ["METHODS", "KhalilProjection", "Leg", "Partition", "Projection", "energy", "forward_dynamics", "inverse_dynamics",
+           "partition", "virtual_work_dynamics"]

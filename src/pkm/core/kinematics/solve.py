@@ -1,0 +1,457 @@
+"""Position problems of closed-loop mechanisms, solved on the Pinocchio tree.
+
+* :func:`close_loops` (forward kinematics): given the actuated coordinates, find
+  the passive ones so that every loop closes.
+* :func:`solve_ik` (inverse kinematics): given the task coordinates (end-effector
+  pose or components, plus any joint outputs), find every joint coordinate.
+
+Both are Gauss-Newton iterations on the tangent space (``pin.integrate``) with
+rank-revealing least-squares steps (a planar mechanism closed with 3-D point
+constraints has zero rows), a step-length cap and a backtracking line search.
+Far from the seed they follow a continuation path (actuated coordinates or task
+coordinates moved in steps of at most ``max_step``), each step corrected by
+Newton, so that the solution stays on the seed's assembly mode and working mode
+unless the path crosses a singularity. A straight path in actuated coordinates can
+leave the workspace through a fold near a direct singularity: loop closure then
+raises :class:`~pkm.errors.ConvergenceError` rather than jump to another assembly
+mode; follow a path inside the workspace instead (seed each solve with the last).
+Every solver stops after a bounded number of iterations and raises
+:class:`~pkm.errors.ConvergenceError` with its residual: at most ``max_iter`` Newton iterations
+per continuation step, at most :data:`MAX_STEPS` steps planned (a farther target takes longer
+steps, which fail early when it is out of reach), and at most :data:`MAX_TOTAL_ITER` Newton
+iterations for a whole solve. No solver returns a non-finite configuration.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core.kinematics import constraints
+from pkm.core.kinematics.configuration import Configuration
+from pkm.core.kinematics.newton import gauss_newton
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.errors import AssemblyError, BranchError, ConvergenceError, InvalidInputError, UnreachableError
+from pkm.validation import as_count, as_scalar, as_tolerance
+
+DEFAULT_TOL = 1e-12
+MAX_STEPS = 1000  #: continuation steps planned at most (a farther target gets longer steps)
+MAX_TOTAL_ITER = 5_000  #: Newton iterations at most for one solve, every continuation step included
+
+
+@dataclass(frozen=True)
+class SolveResult:
+    """Outcome of a position solver.
+
+    Attributes:
+        q: The configuration found (nq,).
+        converged: Whether the residual reached the tolerance.
+        residual: Infinity norm of the equations at ``q`` (m for points, rad for angles).
+        iterations: Newton iterations, all continuation steps included.
+        steps: Continuation steps taken (1 when solved directly).
+        branch_signs: Signs of the default-branch joints at ``q`` (empty without branches).
+        outside_limits: The joints whose coordinate at ``q`` lies outside the position limits their URDF
+            states (:meth:`pkm.core.Mechanism.outside_limits`); pkm's solvers do not enforce limits.
+    """
+
+    q: np.ndarray
+    converged: bool
+    residual: float
+    iterations: int
+    steps: int = 1
+    branch_signs: dict[str, int] = field(default_factory=dict)
+    outside_limits: tuple[str, ...] = ()
+
+
+def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray,
+            cols: np.ndarray | None, tol: float, max_iter: int, max_dq: float) -> tuple[np.ndarray, float, int]:
+    """:func:`pkm.core.kinematics.newton.gauss_newton` on the configuration manifold (``pin.integrate``), moving only the
+    velocity columns ``cols`` (all when None); returns (q, residual inf-norm, iterations)."""
+    m = mech.model
+    if cols is None:
+        return gauss_newton(fun, q, tol=tol, max_iter=max_iter, max_step=max_dq,
+                            retract=lambda x, dx: pin.integrate(m, x, dx))
+
+    def restricted(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        r, J = fun(x)
+        return r, J[:, cols]
+
+    def retract(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
+        full = np.zeros(m.nv)
+        full[cols] = dx
+        return pin.integrate(m, x, full)
+
+    return gauss_newton(restricted, q, tol=tol, max_iter=max_iter, max_step=max_dq, retract=retract)
+
+
+def _result(mech: Mechanism, q: np.ndarray, converged: bool, residual: float, iterations: int,
+            steps: int) -> SolveResult:
+    return SolveResult(q, converged, residual, iterations, steps, _signs(mech, q), mech.outside_limits(q))
+
+
+def _follow(mech: Mechanism, what: str, solve_at, q: np.ndarray, n_steps: int, tol: float,
+            raise_on_failure: bool) -> SolveResult:
+    """Continuation from ``s = 0`` (the seed ``q``) to ``s = 1`` (the target).
+
+    ``solve_at(q, s, tol) -> (q, residual, iterations)`` corrects at path parameter ``s`` from ``q``.
+    Steps start at ``1 / n_steps``, halve on failure, grow again on success; intermediate points
+    are solved to 1e-9, the target to ``tol``. When the step falls below 1e-3 of its initial length
+    the path has left the workspace: a last correction at the target gives the residual reported.
+    """
+    total, steps = 0, 0
+    s, ds = 0.0, 1.0 / n_steps
+    while True:
+        if total >= MAX_TOTAL_ITER:
+            q_new, res, it = solve_at(q, 1.0, tol)
+            result = _result(mech, q_new, False, res, total + it, steps)
+            if raise_on_failure:
+                err = _failure(mech, what, result, tol)
+                raise ConvergenceError(what, err.residual, err.iterations, tol, result,
+                                       f"gave up after {MAX_TOTAL_ITER} Newton iterations at {s:.0%} of the path; "
+                                       "seed nearer the target (q0) or split the path")
+            return result
+        s_next = min(1.0, s + ds)
+        t = tol if s_next >= 1.0 else max(tol, 1e-9)
+        q_new, res, it = solve_at(q, s_next, t)
+        total += it
+        if res <= t:
+            q, s, steps = q_new, s_next, steps + 1
+            if s >= 1.0:
+                q = mech.wrap(q)
+                return _result(mech, q, True, res, total, steps)
+            ds = min(ds * 1.5, 1.0 / n_steps)
+        else:
+            ds *= 0.5
+            if ds < 1e-3 / n_steps:
+                res_path = res
+                q_new, res, it = solve_at(q, 1.0, tol)
+                result = _result(mech, q_new, False, res, total + it, steps)
+                if raise_on_failure and res <= tol:  # the target closes, but not by following the seed's branch
+                    raise ConvergenceError(f"{what} along the path from the seed", res_path, result.iterations,
+                                           tol, result,
+                                           f"the path left the workspace at {s:.0%} of the way; "
+                                           "a direct correction at the target closes, possibly in "
+                                           "another assembly mode: seed nearer the target (q0)")
+                if raise_on_failure:
+                    raise _failure(mech, what, result, tol)
+                return result
+
+
+def close_loops(mech: Mechanism, q_actuated, q0=None, *, tol: float = DEFAULT_TOL, max_iter: int = 30,
+                max_step: float = 0.1, raise_on_failure: bool = True) -> SolveResult:
+    """Forward position problem: passive coordinates for given actuated ones.
+
+    Args:
+        mech: The mechanism.
+        q_actuated: Actuated coordinates in spec order (rad or m), shape (na,).
+        q0: Seed configuration (nq,); its assembly mode is kept. Default: the reference configuration.
+        tol: Tolerance on the infinity norm of the closure residual [m, rad].
+        max_iter: Newton iterations allowed per continuation step.
+        max_step: Largest change of an actuated coordinate per continuation step [rad or m].
+        raise_on_failure: Raise :class:`ConvergenceError` (default) instead of returning ``converged=False``.
+
+    Returns:
+        A :class:`SolveResult` whose ``q`` has the requested actuated coordinates.
+    """
+    mech = check_mechanism(mech)
+    qa1 = mech.check_actuated(q_actuated, positions=True)
+    q = mech.q_reference.copy() if q0 is None else mech.check_q(q0, "q0")
+    tol, max_iter, max_step = _settings(tol, max_iter, max_step)
+    qa0 = mech.actuated_q(q)
+    rev = np.array([j.revolute for j in mech.actuated], dtype=bool)  # angles go the short way round (+-pi)
+    qa1 = np.where(rev, qa0 + (qa1 - qa0 + np.pi) % (2.0 * np.pi) - np.pi, qa1)
+    n_steps = _n_steps(np.max(np.abs(qa1 - qa0)), max_step)
+
+    def fun(qq):
+        return constraints.residual_and_jacobian(mech, qq)
+
+    def solve_at(q, s, t):
+        return _newton(mech, fun, mech.with_actuated(q, qa0 + s * (qa1 - qa0)), mech.passive_v, t, max_iter, 0.5)
+
+    return _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure)
+
+
+def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol: float = DEFAULT_TOL,
+             max_iter: int = 30, max_step: float = 0.05, raise_on_failure: bool = True) -> SolveResult:
+    """Inverse position problem: every joint coordinate for given task coordinates.
+
+    Args:
+        mech: The mechanism.
+        target: Task coordinates (see :meth:`pkm.core.kinematics.task.TaskMap.parse`): a vector, or a mapping by name of
+            some of them (``{"z": "-36cm"}``), the others those of the reference; values may carry units.
+        q0: Seed configuration; default: the reference configuration (or, with ``branch``,
+            the reference with that branch's joint signs imposed and the loops re-closed).
+        branch: Working mode the solution must lie on; checked at the end (:class:`BranchError`).
+        tol: Tolerance on the infinity norm of closure residual and task error [m, rad].
+        max_iter: Newton iterations allowed per continuation step.
+        max_step: Largest task change per continuation step [m or rad].
+        raise_on_failure: Raise :class:`ConvergenceError` instead of returning ``converged=False``.
+    """
+    mech = check_mechanism(mech)
+    task = mech.task_map
+    y1 = task.parse(target)
+    tol, max_iter, max_step = _settings(tol, max_iter, max_step)
+    if branch is not None:
+        mech.branch(branch)  # an unknown branch is refused before any work
+    if q0 is None:
+        q = branch_seed(mech, branch) if branch is not None else mech.q_reference.copy()
+    else:
+        q = mech.check_q(q0, "q0")
+    y0 = task.value(q)
+    dist = np.max(np.abs(task.error(y1, y0)))
+    n_steps = _n_steps(dist, max_step)
+
+    def make_fun(y_goal):
+        def fun(qq):
+            c = Configuration.compute(mech, qq)
+            return np.concatenate([c.residual, -task.error(y_goal, c.task_value)]), c.closure_and_task_jacobian
+        return fun
+
+    def solve_at(q, s, t):
+        return _newton(mech, make_fun(y1 if s >= 1.0 else task.interpolate(y0, y1, s)), q, mech.free_v, t, max_iter,
+                       0.5)
+
+    try:
+        result = _follow(mech, "inverse kinematics", solve_at, q, n_steps, tol, raise_on_failure)
+    except ConvergenceError as exc:
+        if isinstance(exc.result, SolveResult):
+            _raise_if_out_of_reach(mech, make_fun(y1), exc.result.q, tol)
+        raise
+    q = result.q
+    if result.converged and branch is not None and not mech.on_branch(q, branch):
+        raise BranchError(branch, dict(mech.branch(branch).signs), mech.branch_signs(q, branch))
+    return result
+
+
+def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_iter: int = 50) -> np.ndarray:
+    """An assembled configuration on ``branch`` at the reference task coordinates.
+
+    Two phases: Gauss-Newton on the closures, the reference task and the branch joints pinned
+    to their mirrored values (sign imposed, magnitude kept), which moves every leg to the
+    requested side with the platform held; then the generic inverse kinematics removes what
+    the least-squares compromise left. Raises :class:`BranchError` if the result is on
+    another branch.
+    """
+    mech = check_mechanism(mech)
+    b = mech.branch(branch)
+    tol, max_iter, _ = _settings(tol, max_iter, 1.0)
+    q = mech.q_reference.copy()
+    if mech.on_branch(q, branch):
+        return q
+    task = mech.task_map
+    y_ref = task.value(q)
+    wrapped = mech.wrap(q)
+    pins = np.array([mech.joints[n].idx_v for n in b.signs])
+    values = np.array([sign * max(abs(wrapped[mech.joints[n].idx_q]), 0.3) for n, sign in b.signs.items()])
+    pin_q = np.array([mech.joints[n].idx_q for n in b.signs])
+    q[pin_q] = values
+    S = np.zeros((len(pins), mech.nv))
+    S[np.arange(len(pins)), pins] = 1.0
+
+    def fun(qq):
+        c = Configuration.compute(mech, qq)
+        return (np.concatenate([c.residual, -task.error(y_ref, c.task_value), qq[pin_q] - values]),
+                np.vstack([c.closure_and_task_jacobian, S]))
+
+    # over-determined when a pinned magnitude is not the mirrored leg's: Gauss-Newton lands close
+    q, _, _ = _newton(mech, fun, q, mech.free_v, tol, max_iter, 0.5)
+    out = solve_ik(mech, y_ref, q, tol=tol).q
+    if not mech.on_branch(out, branch):
+        raise BranchError(branch, dict(b.signs), mech.branch_signs(out, branch))
+    return out
+
+
+def assemble(mech: Mechanism, q0=None, *, hold=(), tol: float = 1e-10, restarts: int = 16, seed: int = 0,
+             max_iter: int = 200) -> SolveResult:
+    """A configuration that closes every loop, from any seed (the mechanism's own files need not be closed).
+
+    Levenberg-Marquardt on the closure residual over every joint, on the configuration manifold, from
+    ``q0`` (default: the reference); when it stalls above ``tol``, restarts from ``q0`` perturbed by
+    normal draws of growing size (0.1, 0.3, 1 rad or m), ``restarts`` times at most (seeded: the same
+    answer every run). Every joint moves but those named in ``hold``, which keep their values in ``q0``
+    (a spec's partial ``[reference]`` holds the joints it states): with no ``hold`` this finds *an*
+    assembly, not the one for given actuators (that is :func:`close_loops`).
+
+    Raises:
+        AssemblyError: no start closes: the best residual, and the closure that stays most open and by how much.
+    """
+    mech = check_mechanism(mech)
+    q_seed = mech.q_reference.copy() if q0 is None else mech.check_q(q0, "q0")
+    tol = as_tolerance(tol, "tol")
+    restarts = as_count(restarts, "restarts", low=0, high=10_000)
+    max_iter = as_count(max_iter, "max_iter", low=1, high=100_000)
+    rng = np.random.default_rng(as_count(seed, "seed", low=0, high=2**63 - 1))
+    if isinstance(hold, str) or not all(isinstance(n, str) for n in hold):
+        raise InvalidInputError("hold", "expected a sequence of joint names", hold)
+    held = np.zeros(mech.nv, dtype=bool)
+    held[mech.base_v] = True  # (a floating base is an input)
+    for name in hold:
+        j = mech.joint(name)
+        held[j.idx_v:j.idx_v + j.nv] = True
+
+    def closure(qq):
+        F, J = constraints.residual_and_jacobian(mech, qq)
+        J[:, held] = 0.0  # (Levenberg-Marquardt's damping then leaves the held coordinates where they are)
+        return F, J
+
+    m = mech.model
+    best: tuple[float, np.ndarray] = (np.inf, q_seed)
+    total = 0
+    for k in range(restarts + 1):
+        scale = (0.0, 0.1, 0.3, 1.0)[min(k, 3)]
+        q = pin.integrate(m, q_seed, np.where(held, 0.0, scale * rng.standard_normal(m.nv))) if k else q_seed.copy()
+        q, r, it = _levenberg_marquardt(mech, closure, q, tol, max_iter)
+        total += it
+        res = float(np.abs(r).max())
+        if res < best[0]:
+            best = (res, q)
+        if res <= tol:
+            q = mech.wrap(q)
+            return _result(mech, q, True, res, total, k + 1)
+    result = _result(mech, best[1], False, best[0], total, restarts + 1)
+    err = _failure(mech, "assembly", result, tol)
+    alone, detail = _open_alone(mech, q_seed, held, tol, max_iter, rng)
+    detail = detail or (f"{restarts + 1} starts of Levenberg-Marquardt: each closure closes alone, not all of them "
+                        f"together; at the best start closure {err.worst_closure!r} "
+                        f"({_frames(mech, err.worst_closure)}) stays open by {err.worst_gap:.3g}")
+    raise AssemblyError(best[0], "m or rad", detail, subject="this mechanism",
+                        closures=alone or ((str(err.worst_closure), err.worst_gap),))
+
+
+def _frames(mech: Mechanism, closure: str | None) -> str:
+    """``"frames 'A' and 'B'"`` of the named closure, as its file names them."""
+    c = next((c for c in mech.spec.closures if c.name == closure), None)
+    return f"frames {c.frame_a!r} and {c.frame_b!r}" if c is not None else "no closure"
+
+
+def _open_alone(mech: Mechanism, q_seed: np.ndarray, held: np.ndarray, tol: float, max_iter: int, rng
+                ) -> tuple[list[tuple[str, float]], str]:
+    """Why no assembly was found: the closures that do not close even alone (each tried with the others cut, from
+    the seed and three perturbed starts) with their gaps, worst first, and a sentence saying so and what would close
+    them: a frame closure whose origins can meet but whose frames stay turned apart closes as a point closure.
+    ``([], "")`` when every closure closes alone (then they fail only together)."""
+    sizes = [cm.residualSize() for cm in mech.constraint_models]
+    starts = np.cumsum([0, *sizes])
+
+    def gap(rows: np.ndarray) -> tuple[float, np.ndarray]:
+        def fun(qq):
+            F, J = constraints.residual_and_jacobian(mech, qq)
+            J[:, held] = 0.0
+            return F[rows], J[rows]
+
+        best = (np.inf, q_seed)
+        for k in range(4):
+            q = pin.integrate(mech.model, q_seed, np.where(held, 0.0, 0.3 * k * rng.standard_normal(mech.nv)))
+            q, r, _ = _levenberg_marquardt(mech, fun, q, tol, max_iter)
+            if np.abs(r).max() < best[0]:
+                best = (float(np.abs(r).max()), q)
+            if best[0] <= tol:
+                break
+        return best
+
+    open_: list[tuple[str, float, str]] = []
+    as_points = 0
+    for c, a, n in zip(mech.spec.closures, starts, sizes):
+        g, q = gap(np.arange(a, a + n))
+        if g <= tol:
+            continue
+        r = constraints.residual(mech, q)[a:a + n]
+        apart, turned = (float(np.linalg.norm(part)) if part.size and np.abs(part).max() > tol else 0.0
+                         for part in (r[:3], r[3:]))
+        what = f"{c.name!r} ({c.frame_a!r}/{c.frame_b!r}) open by {apart:.3g} m"
+        if c.type == "frame":
+            what += f" and {turned:.3g} rad at best"
+            if gap(np.arange(a, a + 3))[0] <= tol:
+                as_points += 1
+                what += " (its origins can meet)"
+        open_.append((c.name, g, what))
+    if not open_:
+        return [], ""
+    open_.sort(key=lambda t: -t[1])
+    fix = (f"; {'each' if as_points == len(open_) else f'{as_points} of them'} closes alone as a point closure (the "
+           "frames' origins meet: type 'point' in a closure spec, '3d' in a robot.yaml)" if as_points else "")
+    return ([(name, g) for name, g, _ in open_],
+            f"{len(open_)} closure(s) cannot close even alone: " + "; ".join(w for _, _, w in open_) + fix)
+
+
+def _levenberg_marquardt(mech: Mechanism, fun, q: np.ndarray, tol: float, max_iter: int
+                         ) -> tuple[np.ndarray, np.ndarray, int]:
+    """Levenberg-Marquardt on ``|F(q)|^2`` over every joint (``fun(q) -> (F, J)``, J on the tangent space), on the
+    configuration manifold; stops at ``|F|_inf <= tol``, at a stationary point (no decrease for any damping) or
+    after ``max_iter`` iterations. Returns ``(q, F, iterations)``."""
+    m = mech.model
+    F, J = fun(q)
+    cost, lam, it = float(F @ F), 1e-3, 0
+    while it < max_iter and np.abs(F).max() > tol:
+        it += 1
+        JtJ, g = J.T @ J, J.T @ F
+        dq = -np.linalg.solve(JtJ + lam * (np.diag(np.diag(JtJ)) + 1e-12 * np.eye(m.nv)), g)
+        q_try = pin.integrate(m, q, dq)
+        F_try, J_try = fun(q_try)
+        cost_try = float(F_try @ F_try)
+        if np.isfinite(cost_try) and cost_try < cost:
+            q, F, J, cost, lam = q_try, F_try, J_try, cost_try, max(lam / 3.0, 1e-12)
+        else:
+            lam *= 5.0
+            if lam > 1e12:
+                break
+    return q, F, it
+
+
+def _raise_if_out_of_reach(mech: Mechanism, fun, q: np.ndarray, tol: float) -> None:
+    """:class:`UnreachableError` when the IK equations ``fun`` have a least-squares minimum that is not a solution
+    near ``q`` (Levenberg-Marquardt from ``q`` stalls with ``|F|_inf > max(tol, 1e-9)``): the target lies outside
+    the workspace. It names the closure left most open there, or the task when the loops close there (to a
+    thousandth of the task's miss: the least-squares minimum trades a little closure for a far target)."""
+    def held(qq):  # (a floating base stays where it is)
+        F, J = fun(qq)
+        J[:, mech.base_v] = 0.0
+        return F, J
+
+    with np.errstate(over="ignore", invalid="ignore"):
+        q, F, _ = _levenberg_marquardt(mech, held, q, tol, 500)
+        gap, index, name = constraints.worst_closure(mech, F)
+        task_gap = float(np.linalg.norm(F[mech.n_constraints:]))
+    if not (np.isfinite(gap) and np.isfinite(task_gap) and np.abs(F).max() > max(tol, 1e-9)):
+        return  # solved after all, or beyond the float range: the ConvergenceError stands
+    if gap > tol and gap > 1e-3 * task_gap:  # a loop that cannot close, not a trade-off with a task far away
+        raise UnreachableError(index, gap, "m or rad",
+                               f"the target is out of the workspace: at the nearest configuration (a least-squares "
+                               f"minimum) closure {name!r} stays open by {gap:.3g} and the task misses by "
+                               f"{task_gap:.3g}")
+    raise UnreachableError(0, task_gap, "m or rad", "the target is out of the workspace: the loops close (to "
+                                                    f"{gap:.1e}) at the nearest configuration, where the task misses "
+                                                    f"by {task_gap:.3g}")
+
+
+def _failure(mech: Mechanism, what: str, result: SolveResult, tol: float) -> ConvergenceError:
+    """A ConvergenceError naming the loop that stays most open and by how much."""
+    gap, _, name = constraints.worst_closure(mech, constraints.residual(mech, result.q))
+    detail = (f"closure {name!r} stays open by {gap:.3g} (m or rad) at the last iterate"
+              if name is not None and gap > tol else "the task target is not met")
+    if what == "loop closure" and mech.dependent_actuators:
+        detail += (f"; actuators {list(mech.dependent_actuators)} depend on the others (see mech.notes): values "
+                   "that do not agree with the others' admit no assembly")
+    err = ConvergenceError(what, result.residual, result.iterations, tol, result, detail)
+    err.worst_closure, err.worst_gap = name, gap
+    return err
+
+
+def _settings(tol, max_iter, max_step) -> tuple[float, int, float]:
+    """The solver settings checked: ``tol`` in (0, 1], ``max_iter`` in [1, 10^4], ``max_step`` > 0."""
+    return (as_tolerance(tol, "tol"), as_count(max_iter, "max_iter", low=1, high=10_000),
+            as_scalar(max_step, "max_step", low=0.0, strict_low=True))
+
+
+def _n_steps(dist: float, max_step: float) -> int:
+    """Continuation steps for a path of length ``dist`` in steps of at most ``max_step``, capped at MAX_STEPS."""
+    if not np.isfinite(dist):
+        raise InvalidInputError("target", f"the distance to the target is not finite ({dist!r})", dist)
+    return int(min(MAX_STEPS, max(1, np.ceil(dist / max_step))))
+
+
+def _signs(mech: Mechanism, q: np.ndarray) -> dict[str, int]:
+    return mech.branch_signs(q) if mech.spec.default_branch is not None else {}

@@ -1,0 +1,111 @@
+"""Joints the URDF cannot state: spherical and universal joints as Pinocchio's own joint models, and locked joints.
+
+URDF has no spherical or universal joint; CAD exporters (onshape-to-robot) write a revolute in their place
+and a side file says what it is (Gepetto's toolbox-parallel-robots: ``joint_name`` / ``joint_type`` in
+``robot.yaml``). A closure spec says it in its ``[joint_types]`` table, ``name = "spherical"``:
+
+* ``"spherical"``: :class:`pinocchio.JointModelSpherical` at the joint's placement (a unit quaternion,
+  three velocity coordinates: no gimbal lock, unlike three revolutes);
+* ``"universal_ab"``, ``a`` and ``b`` two distinct axes among ``x``, ``y``, ``z`` (``"universal_zy"``...):
+  :class:`pinocchio.JointModelUniversal` about the joint frame's axis ``a``, then about axis ``b`` of the frame
+  that first rotation moved, ``R(q) = exp(q_1 [a]) exp(q_2 [b])``, two coordinates ``(q_1, q_2)`` [rad] (the
+  toolbox's ``UJOINT_AB``); ``"universal"`` is ``"universal_xy"`` (the toolbox's ``CARDAN``);
+* ``"fixed"``: the joint locked at its neutral value (its child body welded to its parent).
+
+The other joints, the bodies' inertias and every frame are kept, with their names. Mimic joints are kept too:
+Pinocchio 4.1 neither exposes a mimic joint's own joint model nor reduces a model that has mimic joints
+(``buildReducedModel`` fails), so they are rebuilt as plain joints about their axes, the model retyped and
+reduced, and each turned back into a mimic (``transformJointIntoMimic``); a mimic joint, or one that a mimic
+joint follows, cannot be retyped.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.errors import SpecError, SpecNameError, closest
+
+_AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+#: The universal joint types and their ``(first, second)`` axes, names of the joint frame's axes.
+UNIVERSAL_AXES: dict[str, tuple[str, str]] = {"universal": ("x", "y"),
+                                              **{f"universal_{a}{b}": (a, b) for a in "xyz" for b in "xyz" if a != b}}
+#: Every value ``[joint_types]`` accepts.
+JOINT_TYPES = ("spherical", *UNIVERSAL_AXES, "fixed")
+
+
+def universal_joint(kind: str) -> pin.JointModelUniversal:
+    """The :class:`pinocchio.JointModelUniversal` of a universal joint type (a key of :data:`UNIVERSAL_AXES`)."""
+    a, b = UNIVERSAL_AXES[kind]
+    return pin.JointModelUniversal(np.array(_AXES[a]), np.array(_AXES[b]))
+
+
+def retype_joints(model: pin.Model, types: Mapping[str, str], source: str = "<model>") -> pin.Model:
+    """``model`` with the joints named in ``types`` replaced (see the module doc); ``model`` itself when empty.
+
+    Raises:
+        SpecError: an unknown type, a joint that is not in the model, a mimic joint or one it follows.
+    """
+    if not types:
+        return model
+    names = list(model.names)
+    for name, kind in types.items():
+        if name not in names[1:]:
+            raise SpecNameError(source, "joint", name, names[1:], "[joint_types]")
+        if kind not in JOINT_TYPES:
+            hint = closest(kind, JOINT_TYPES)
+            raise SpecError(source, f"joint_types.{name} = {kind!r}: "
+                                    + (f"did you mean {hint[0]!r}? " if hint else "") + f"use one of {list(JOINT_TYPES)}")
+    mimics = _mimics(model)
+    for name, (leader, *_) in mimics.items():
+        for n in (name, leader):
+            if n in types:
+                raise SpecError(source, f"joint_types.{n} = {types[n]!r}: joint {name!r} mimics {leader!r}; "
+                                        "neither can be retyped")
+    new = pin.Model()
+    new.name = model.name
+    new.gravity = model.gravity
+    ids = {0: 0}
+    for jid in range(1, model.njoints):
+        name = names[jid]
+        retype = types.get(name)
+        jm = (pin.JointModelSpherical() if retype == "spherical"
+              else universal_joint(retype) if retype in UNIVERSAL_AXES
+              else mimics[name][3] if name in mimics else model.joints[jid])
+        ids[jid] = new.addJoint(ids[model.parents[jid]], jm, model.jointPlacements[jid], name)
+        new.appendBodyToJoint(ids[jid], model.inertias[jid], pin.SE3.Identity())
+    for k, f in enumerate(model.frames):
+        if k == 0:
+            continue  # the universe frame, which every model has
+        new.addFrame(pin.Frame(f.name, ids[f.parentJoint], f.parentFrame, f.placement, f.type, f.inertia), False)
+    locked = [new.getJointId(n) for n, kind in types.items() if kind == "fixed"]
+    new = pin.buildReducedModel(new, locked, pin.neutral(new)) if locked else new
+    for name, (leader, scaling, offset, _) in mimics.items():
+        new = pin.transformJointIntoMimic(new, new.getJointId(leader), new.getJointId(name), scaling, offset)
+    return new
+
+
+def _mimics(model: pin.Model) -> dict[str, tuple[str, float, float, pin.JointModel]]:
+    """``{mimic joint: (the joint it follows, scaling, offset, a plain joint about its axis)}`` (revolute or
+    prismatic: the axis is its motion subspace over its scaling)."""
+    out: dict[str, tuple[str, float, float, pin.JointModel]] = {}
+    if all(jm.shortname() != "JointModelMimic" for jm in model.joints):
+        return out
+    data = model.createData()
+    pin.forwardKinematics(model, data, pin.neutral(model))
+    for jid in range(1, model.njoints):
+        if model.joints[jid].shortname() != "JointModelMimic":
+            continue
+        jm = model.joints[jid].extract()
+        leader = next(k for k in range(1, model.njoints) if model.joints[k].shortname() != "JointModelMimic"
+                      and model.joints[k].nq and model.joints[k].idx_q == jm.idx_q)
+        S = np.asarray(data.joints[jid].S).reshape(6) / jm.scaling
+        plain = (pin.JointModelRevoluteUnaligned(S[3:]) if np.linalg.norm(S[3:]) > 0
+                 else pin.JointModelPrismaticUnaligned(S[:3]))
+        out[model.names[jid]] = (model.names[leader], float(jm.scaling), float(jm.offset), plain)
+    return out
+
+
+__all__ = ["JOINT_TYPES", "UNIVERSAL_AXES", "retype_joints", "universal_joint"]

@@ -1,0 +1,474 @@
+"""A closed-loop mechanism: a Pinocchio tree, its loop closures, actuation and task.
+
+:class:`Mechanism` holds no algorithm of its own beyond bookkeeping (names,
+indices, validated configuration vectors); the algorithms live in
+:mod:`pkm.core.kinematics.solve` and :mod:`pkm.core.differential.velocity` and take a mechanism.
+
+Joint coordinates follow Pinocchio: ``q`` has ``model.nq`` entries (a free-flyer
+takes 7: position and quaternion x y z w), velocities ``v`` have ``model.nv``.
+Joints are indexed by name through ``idx_q``/``idx_v`` (Pinocchio orders them
+by tree traversal, not by file order). Mimic joints take no coordinate.
+"""
+
+from __future__ import annotations
+
+import functools
+import threading
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core.model.joints import retype_joints
+from pkm.core.model.spec import ClosureSpec, as_path
+from pkm.core.model.urdf import load_model, position_limits
+from pkm.errors import AssemblyError, InvalidInputError, PkmWarning, SpecError, SpecNameError, UnknownNameError
+from pkm.units import quantities
+from pkm.validation import as_array, as_vector, wrap_angle
+
+#: A spec's [reference] must close every loop to this (m or rad); one that lacks joints is assembled.
+REFERENCE_TOL = 1e-9
+
+if TYPE_CHECKING:
+    from pkm.core.kinematics.task import TaskMap
+
+
+@dataclass(frozen=True)
+class JointInfo:
+    """Where a named joint sits in ``q`` and ``v``."""
+
+    name: str
+    id: int
+    idx_q: int
+    nq: int
+    idx_v: int
+    nv: int
+    kind: str
+
+    @property
+    def revolute(self) -> bool:
+        """A bounded revolute joint (its coordinate is an angle defined modulo 2 pi)."""
+        return self.nq == 1 and self.kind.startswith("JointModelR")
+
+
+class Mechanism:
+    """A parallel mechanism on Pinocchio.
+
+    The model, the spec and every index are fixed once built; the Pinocchio data the algorithms
+    write into are per thread (:attr:`data`, :attr:`constraint_datas`), so that one mechanism can be
+    used from several threads at once. A mechanism pickles (it is rebuilt from its URDF and spec),
+    so it can travel to worker processes.
+
+    Attributes:
+        model: The Pinocchio model of the tree (loops open).
+        data: This thread's Pinocchio data of the model (algorithms write into it).
+        spec: The closure spec.
+        params: The parameter object that generated it (None when loaded from files).
+        urdf: The URDF text, when known.
+        base: The floating base's joint (``spec.floating_base``: a free-flyer on the world carrying the whole
+            tree), or None. Its pose is an input like the actuators' values: the solvers hold it where ``q``
+            puts it, the rate maps give it no velocity, the efforts are those with the base held (its
+            reaction is not computed); Pinocchio's ``constraintDynamics`` lets it float.
+        constraint_models: One ``pin.RigidConstraintModel`` per closure, in spec order.
+            Point closures are ``CONTACT_3D`` in ``LOCAL_WORLD_ALIGNED``: their Jacobian is
+            exactly d(p_A - p_B)/dq. Frame closures are ``CONTACT_6D`` in ``LOCAL`` (frame A):
+            their Jacobian maps v to the twist of B relative to A, expressed in A, with a sign
+            such that it is the derivative of ``-log6(A^-1 B)`` at closure.
+    """
+
+    def __init__(self, model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | None = None,
+                 source: str = "<model>", notes: tuple[str, ...] = ()):
+        if not isinstance(model, pin.Model):
+            raise InvalidInputError("model", f"expected a pinocchio.Model, got {type(model).__name__}", model)
+        if not isinstance(spec, ClosureSpec):
+            raise InvalidInputError("spec", f"expected a ClosureSpec, got {type(spec).__name__}", spec)
+        self.model = model
+        self._local = threading.local()
+        self.spec = spec
+        self.params = params
+        self.urdf = urdf
+        self.source = source
+        #: What the file's reader interpreted or ignored (:attr:`pkm.core.formats.imported.Imported.notes`), and
+        #: actuators that do not fit the mobility (:func:`pkm.core.differential.velocity.actuation`).
+        self.notes: tuple[str, ...] = tuple(notes)
+        #: ``{joint: (lower, upper)}`` position limits stated by the URDF (none when built from a model).
+        self.limits: dict[str, tuple[float, float]] = position_limits(urdf, source) if urdf is not None else {}
+        self.joints: dict[str, JointInfo] = {}
+        for jid in range(1, model.njoints):
+            jm = model.joints[jid]
+            self.joints[model.names[jid]] = JointInfo(model.names[jid], jid, jm.idx_q, jm.nq, jm.idx_v, jm.nv,
+                                                      jm.shortname())
+        frame_names = [f.name for f in model.frames]
+
+        def frame(name: str, what: str) -> int:
+            fid = _frame_id(model, name, source)
+            if fid is None:
+                raise SpecNameError(source, "frame", name, frame_names, what)
+            return fid
+
+        def scalar_joint(name: str, what: str) -> JointInfo:
+            if name not in self.joints:
+                raise SpecNameError(source, "joint", name, self.scalar_joint_names(), what)
+            info = self.joints[name]
+            if info.nq != 1 or info.nv != 1:
+                raise SpecError(source, f"{what}: joint {name!r} ({info.kind}) must have one coordinate")
+            return info
+
+        #: The end-effector frame's id; 0 (the world frame, fixed) for a mechanism without one.
+        if not spec.closures:
+            raise SpecError(source, "no loop closure: give [[closure]] tables (or a model file with loops); pkm "
+                                    "models closed-loop mechanisms, a tree alone needs none of it")
+        self.ee_frame = frame(spec.end_effector, "end_effector") if spec.end_effector is not None else 0
+        #: The ids of the task's other frames (``[task.frames]``), in spec order.
+        self.task_frames = [frame(f, "task.frames") for f in spec.task.frames]
+        self.closure_frames = [(frame(c.frame_a, f"closure {c.name!r}"), frame(c.frame_b, f"closure {c.name!r}"))
+                               for c in spec.closures]
+        if not spec.actuated:
+            raise SpecError(source, "no actuated joint: name the driven joints (actuated = [...] in a closure spec)")
+        self.actuated = tuple(scalar_joint(n, "actuated") for n in spec.actuated)
+        self.task_joints = tuple(scalar_joint(n, "task.joints") for n in spec.task.joints)
+        if spec.task.size > len(self.actuated):
+            raise SpecError(source, f"the task has {spec.task.size} coordinates but only {len(self.actuated)} joints are "
+                                    "actuated: give as many task coordinates as degrees of freedom, or fewer")
+        for b in spec.branches.values():
+            for n in b.signs:
+                scalar_joint(n, f"branch {b.name!r}")
+        self.act_q = np.array([j.idx_q for j in self.actuated])
+        self.act_v = np.array([j.idx_v for j in self.actuated])
+        self._revolute_q = np.array([j.idx_q for j in self.joints.values() if j.revolute], dtype=int)
+        self._revolute_v = np.array([j.idx_v for j in self.joints.values() if j.revolute], dtype=int)
+        self.base: JointInfo | None = None
+        if spec.floating_base is not None:
+            if spec.floating_base not in self.joints:
+                raise SpecNameError(source, "joint", spec.floating_base, list(self.joints), "floating_base")
+            self.base = self.joints[spec.floating_base]
+            if self.base.kind != "JointModelFreeFlyer" or model.parents[self.base.id] != 0:
+                raise SpecError(source, f"floating_base {spec.floating_base!r} is a {self.base.kind} on "
+                                        f"{model.names[model.parents[self.base.id]]!r}: it must be a free-flyer "
+                                        "joint on the world")
+        self.base_v = np.arange(self.base.idx_v, self.base.idx_v + 6) if self.base else np.zeros(0, dtype=int)
+        inputs = set(self.act_v) | set(self.base_v)
+        self.passive_v = np.array([i for i in range(model.nv) if i not in inputs], dtype=int)
+        #: The velocity columns the solvers move (all but the floating base's); None: all of them.
+        self.free_v = np.array([i for i in range(model.nv) if i not in set(self.base_v)]) if self.base else None
+
+        self.constraint_models = []
+        for c, (fa, fb) in zip(spec.closures, self.closure_frames):
+            A, B = model.frames[fa], model.frames[fb]
+            if c.type == "point":
+                cm = pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, model, A.parentJoint, A.placement,
+                                              B.parentJoint, B.placement, pin.LOCAL_WORLD_ALIGNED)
+            else:
+                cm = pin.RigidConstraintModel(pin.ContactType.CONTACT_6D, model, A.parentJoint, A.placement,
+                                              B.parentJoint, B.placement, pin.LOCAL)
+            cm.name = c.name
+            self.constraint_models.append(cm)
+        self.n_constraints = sum(cm.residualSize() for cm in self.constraint_models)
+
+        missing = [n for n, j in self.joints.items() if j.nq > 0 and n not in spec.reference]
+        unknown = [n for n in spec.reference if n not in self.joints]
+        if unknown:
+            raise SpecNameError(source, "joint", unknown[0], list(self.joints), "[reference]")
+        degrees = [n for n, v in spec.reference.items()
+                   if self.joints[n].revolute and len(v) == 1 and abs(v[0]) > 2.0 * np.pi]
+        if degrees:
+            raise SpecError(source, f"[reference] gives {degrees[0]} = {spec.reference[degrees[0]][0]:g}, beyond "
+                                    "2 pi: angles are in rad (degrees?)")
+        try:
+            self.q_reference = self.check_q(self.q_from_dict(spec.reference, base=pin.neutral(model)), "[reference]")
+        except InvalidInputError as exc:
+            raise SpecError(source, f"{exc}; fix the [reference] table of the closure spec") from None
+        if missing:  # a partial (or no) reference: assembled from it, the other joints from the neutral configuration
+            from pkm.core.kinematics.solve import assemble  # (solve imports this module)
+
+            try:
+                self.q_reference = assemble(self, self.q_reference, hold=tuple(spec.reference), tol=1e-12).q
+            except AssemblyError as exc:
+                if not spec.reference:  # (the file states no configuration: the loops themselves do not close)
+                    raise SpecError(source, f"the loops cannot be closed: {exc}") from exc  # (its closures, gaps)
+                raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found that keeps the "
+                                        f"joints it states, the others starting from the neutral configuration "
+                                        f"({exc}); give an assembled [reference]") from None
+        elif (worst := self._worst_closure(self.q_reference))[0] > REFERENCE_TOL:
+            gap, closure = worst
+            raise SpecError(source, f"the [reference] configuration leaves closure {closure!r} open by {gap:.3g} "
+                                    f"(m or rad; closed means <= {REFERENCE_TOL:g}): fix it, or leave joints out of "
+                                    "[reference] to have pkm assemble the mechanism (pkm.assemble)")
+        from pkm.core.differential.velocity import actuation  # (differential imports this module)
+
+        fit = actuation(self)
+        #: Actuators whose values the others fix at the reference (redundant actuation): see ``notes``.
+        self.dependent_actuators: tuple[str, ...] = fit.dependent
+        if fit.problem:
+            self.notes += (f"at the reference configuration, {fit.problem}",)
+            warnings.warn(f"{source}: at the reference configuration, {fit.problem}", PkmWarning, stacklevel=2)
+
+    def outside_limits(self, q, *, tol: float = 1e-9) -> tuple[str, ...]:
+        """The joints whose coordinate in ``q`` lies outside their stated position limits by more than ``tol``
+        (m or rad), in model order. pkm's solvers do not enforce limits; their results report these."""
+        q = np.asarray(q, dtype=float)
+        return tuple(n for n, (lo, hi) in self.limits.items()
+                     if n in self.joints and not lo - tol <= q[self.joints[n].idx_q] <= hi + tol)
+
+    def _worst_closure(self, q: np.ndarray) -> tuple[float, str | None]:
+        """The largest closure gap at ``q`` (m or rad) and the closure's name (:func:`pkm.core.kinematics.constraints.worst_closure`)."""
+        from pkm.core.kinematics import constraints  # (constraints imports this module)
+
+        gap, _, name = constraints.worst_closure(self, constraints.residual(self, q))
+        return gap, name
+
+    # ------------------------------------------------------------------ per-thread data, pickling
+    @property
+    def data(self) -> pin.Data:
+        """This thread's ``pin.Data`` (made on first use in each thread)."""
+        try:
+            return self._local.data
+        except AttributeError:
+            self._local.data = self.model.createData()
+            return self._local.data
+
+    @property
+    def constraint_datas(self) -> list[pin.RigidConstraintData]:
+        """This thread's data of :attr:`constraint_models`."""
+        try:
+            return self._local.constraint_datas
+        except AttributeError:
+            self._local.constraint_datas = [cm.createData() for cm in self.constraint_models]
+            return self._local.constraint_datas
+
+    @functools.cached_property
+    def task_map(self) -> TaskMap:
+        """The mechanism's :class:`~pkm.core.kinematics.task.TaskMap` (made once; it holds no per-call state)."""
+        from pkm.core.kinematics.task import TaskMap  # (pkm.core.kinematics.task imports this module)
+
+        return TaskMap(self)
+
+    def __reduce__(self):
+        if self.urdf is None:
+            raise InvalidInputError("mech", "a Mechanism built from a pinocchio.Model (no URDF text) cannot be "
+                                            "pickled; build it with Mechanism.from_strings or from_files", self)
+        return (_rebuild, (self.urdf, self.spec.to_toml(), self.params, self.source))
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_strings(cls, urdf: str, spec: ClosureSpec | str, params: Any = None,
+                     source: str = "<string>", notes: tuple[str, ...] = ()) -> Mechanism:
+        """Build from URDF text and a spec (object or TOML text); ``notes``: what the reader of its files interpreted
+        or ignored (:attr:`notes`).
+
+        Raises:
+            SpecError: The URDF or the spec is malformed, or they do not fit together (see
+                :mod:`pkm.core.model.urdf` and :mod:`pkm.core.model.spec` for what the loaders refuse).
+            InvalidInputError: ``urdf`` is not a string, ``spec`` neither a string nor a ClosureSpec.
+        """
+        if not isinstance(urdf, str):
+            raise InvalidInputError("urdf", f"expected the URDF text as a str, got {type(urdf).__name__}", urdf)
+        if not isinstance(spec, (str, ClosureSpec)):
+            raise InvalidInputError("spec", f"expected a ClosureSpec or its TOML text, got {type(spec).__name__}",
+                                    spec)
+        if isinstance(spec, str):
+            spec = ClosureSpec.from_toml(spec, source + " (closures)")
+        return cls(retype_joints(load_model(urdf, source), spec.joint_types, source), spec, params, urdf, source,
+                   notes)
+
+    @classmethod
+    def from_files(cls, spec_path: str | Path) -> Mechanism:
+        """Load ``<name>.closures.toml`` and the model file it names (path relative to the spec): a URDF, or an
+        MJCF or SDF file whose own loops and joint types are added to the spec's (:mod:`pkm.core.formats`).
+
+        The spec's ``urdf`` must stay inside the spec's folder once symbolic links are resolved;
+        nothing else is read (see :mod:`pkm.core.model.spec`).
+
+        Raises:
+            SpecError: A file is missing, too large, malformed, or the URDF path leaves the folder.
+        """
+        spec_path = as_path(spec_path, "spec_path")
+        spec = ClosureSpec.load(spec_path)
+        try:
+            folder = spec_path.parent.resolve()
+            urdf_path = (folder / spec.urdf).resolve()
+        except (OSError, RuntimeError) as exc:  # a loop of symbolic links
+            raise SpecError(str(spec_path), f"cannot resolve urdf = {spec.urdf!r}: {exc}") from None
+        if not urdf_path.is_relative_to(folder):
+            raise SpecError(str(spec_path), f"urdf = {spec.urdf!r} resolves to {urdf_path}, outside the spec's folder "
+                                            f"{folder}; copy the URDF next to the spec")
+        from pkm.core.formats.imported import import_model, with_file  # (formats import this module)
+
+        imported = import_model(urdf_path)
+        spec = with_file(spec, imported, str(spec_path))
+        model = retype_joints(load_model(imported.urdf, str(urdf_path)), spec.joint_types, str(spec_path))
+        return cls(model, spec, None, imported.urdf, str(spec_path), imported.notes)
+
+    # ------------------------------------------------------------------ sizes and names
+    @property
+    def name(self) -> str:
+        return self.spec.mechanism
+
+    @property
+    def nq(self) -> int:
+        return self.model.nq
+
+    @property
+    def nv(self) -> int:
+        return self.model.nv
+
+    @property
+    def na(self) -> int:
+        """Number of actuated coordinates."""
+        return len(self.actuated)
+
+    @property
+    def n_task(self) -> int:
+        """Number of output (task) coordinates."""
+        return self.spec.task.size
+
+    @property
+    def actuated_names(self) -> tuple[str, ...]:
+        return self.spec.actuated
+
+    def scalar_joint_names(self) -> list[str]:
+        return [n for n, j in self.joints.items() if j.nq == 1 and j.nv == 1]
+
+    def frame_id(self, name: str) -> int:
+        """Frame index by name; raises :class:`UnknownNameError` listing the valid names."""
+        fid = _frame_id(self.model, name, self.source)
+        if fid is None:
+            raise UnknownNameError("frame", name, [f.name for f in self.model.frames], self.name)
+        return fid
+
+    def joint(self, name: str) -> JointInfo:
+        if not isinstance(name, str) or name not in self.joints:
+            raise UnknownNameError("joint", name, list(self.joints), self.name)
+        return self.joints[name]
+
+    # ------------------------------------------------------------------ vectors
+    def check_q(self, q, name: str = "q") -> np.ndarray:
+        """``q`` as a float array of shape (nq,), finite, with unit quaternions; else raise."""
+        q = as_vector(q, self.nq, name)
+        for j in self.joints.values():
+            if j.kind == "JointModelFreeFlyer":
+                quat = q[j.idx_q + 3:j.idx_q + 7]
+            elif j.kind == "JointModelSpherical":
+                quat = q[j.idx_q:j.idx_q + 4]
+            else:
+                continue
+            if abs(np.linalg.norm(quat) - 1.0) > 1e-6:
+                raise InvalidInputError(name, f"quaternion of joint {j.name!r} has norm {np.linalg.norm(quat):.6g}, "
+                                              "expected 1", quat)
+        return q
+
+    def check_v(self, v, name: str = "v") -> np.ndarray:
+        return as_vector(v, self.nv, name)
+
+    def check_actuated(self, qa, name: str = "q_actuated", *, positions: bool = False) -> np.ndarray:
+        """Actuated values as a vector (``na``, SI). With ``positions``, entries may be strings with units
+        (``"5deg"``, ``"20mm"``); rates and efforts take numbers only (SI: m/s, rad/s, N, N m)."""
+        if positions:
+            qa = quantities(qa, ["angle" if j.revolute else "length" for j in self.actuated], name)
+        return as_vector(qa, self.na, name)
+
+    def actuated_q(self, q) -> np.ndarray:
+        """The actuated coordinates of a configuration, in spec order."""
+        return np.asarray(q, dtype=float)[self.act_q].copy()
+
+    def with_actuated(self, q, qa) -> np.ndarray:
+        q = np.array(q, dtype=float)
+        q[self.act_q] = qa
+        return q
+
+    def difference(self, q0, q1) -> np.ndarray:
+        """The tangent step from ``q0`` to ``q1`` (``pin.difference``), revolute angles taken the short way round
+        (a crank passing pi moves by a little, not by 2 pi)."""
+        dq = pin.difference(self.model, np.asarray(q0, dtype=float), np.asarray(q1, dtype=float))
+        dq[self._revolute_v] = wrap_angle(dq[self._revolute_v])
+        return dq
+
+    def wrap(self, q) -> np.ndarray:
+        """``q`` with every revolute coordinate brought into (-pi, pi]."""
+        q = np.array(q, dtype=float)
+        q[self._revolute_q] = wrap_angle(q[self._revolute_q])
+        return q
+
+    def q_from_dict(self, values: Mapping[str, Any], base=None) -> np.ndarray:
+        """A configuration from ``{joint name: value or vector}``; other joints from ``base``."""
+        if not isinstance(values, Mapping):
+            raise InvalidInputError("values", f"expected a mapping {{joint name: value}}, got {type(values).__name__}",
+                                    values)
+        q = np.array(self.q_reference if base is None else base, dtype=float)
+        for name, val in values.items():
+            j = self.joint(name)
+            arr = np.atleast_1d(as_array(val, name, f"{j.nq} coordinate(s) of joint {name!r}"))
+            if arr.shape != (j.nq,):
+                raise InvalidInputError(name, f"joint {name!r} takes {j.nq} coordinate(s), got {arr.shape}", val)
+            if not np.all(np.isfinite(arr)):
+                raise InvalidInputError(name, "value is not finite", val)
+            q[j.idx_q:j.idx_q + j.nq] = arr
+        return q
+
+    def q_to_dict(self, q) -> dict[str, np.ndarray | float]:
+        """``{joint name: coordinate}`` (scalars for 1-DOF joints); mimic joints are left out."""
+        q = np.asarray(q, dtype=float)
+        out: dict[str, np.ndarray | float] = {}
+        for name, j in self.joints.items():
+            if j.nq == 1:
+                out[name] = float(q[j.idx_q])
+            elif j.nq > 1:
+                out[name] = q[j.idx_q:j.idx_q + j.nq].copy()
+        return out
+
+    def branch_signs(self, q, branch: str | None = None) -> dict[str, int]:
+        """Signs of the joints that define ``branch`` (default branch when None).
+
+        Angles are taken modulo 2 pi in (-pi, pi]: the sign of a revolute coordinate is that of its sine.
+        """
+        b = self.branch(branch)
+        q = self.wrap(q)
+        return {n: (1 if q[self.joints[n].idx_q] >= 0 else -1) for n in b.signs}
+
+    def on_branch(self, q, branch: str | None = None) -> bool:
+        b = self.branch(branch)
+        return self.branch_signs(q, b.name) == dict(b.signs)
+
+    def branch(self, name: str | None = None):
+        """The named branch (the spec's default when None)."""
+        key = self.spec.default_branch if name is None else name
+        if not isinstance(key, str) or key not in self.spec.branches:
+            raise UnknownNameError("branch", str(name), list(self.spec.branches), self.name)
+        return self.spec.branches[key]
+
+    def __repr__(self) -> str:
+        return (f"Mechanism({self.name!r}: nq={self.nq}, nv={self.nv}, actuated={list(self.actuated_names)}, "
+                f"closures={len(self.spec.closures)} ({self.n_constraints} equations), "
+                f"task={list(self.spec.task.components) + list(self.spec.task.joints)})")
+
+
+def _rebuild(urdf: str, spec: str, params: Any, source: str) -> Mechanism:
+    """Unpickling: the mechanism again from its URDF and spec texts."""
+    return Mechanism.from_strings(urdf, spec, params, source=source)
+
+
+def _frame_id(model: pin.Model, name, source: str) -> int | None:
+    """The frame called ``name`` (a link's frame when a joint shares its name); None if there is none."""
+    if not isinstance(name, str) or not model.existFrame(name):
+        return None
+    try:
+        return model.getFrameId(name)
+    except ValueError:  # several frames of that name: a link and a joint named alike
+        if model.existFrame(name, pin.FrameType.BODY):
+            return model.getFrameId(name, pin.FrameType.BODY)
+        raise SpecError(source, f"several frames are named {name!r}; give the links and joints distinct names") \
+            from None
+
+
+def check_mechanism(mech, name: str = "mech") -> Mechanism:
+    """``mech`` itself if it is a :class:`Mechanism`, else :class:`InvalidInputError` saying how to get one."""
+    if not isinstance(mech, Mechanism):
+        raise InvalidInputError(name, f"expected a pkm.Mechanism (from pkm.load(name) or pkm.build(name, ...)), "
+                                      f"got {type(mech).__name__}", mech)
+    return mech
+
+

@@ -1,0 +1,523 @@
+"""Building, validating and loading the URDF trees of mechanisms.
+
+The generators build each tree with :class:`UrdfBuilder` (yourdfpy objects,
+validated by yourdfpy), and :func:`load_model` turns URDF text into a Pinocchio
+model after pkm's own checks, so that a malformed file yields a
+:class:`~pkm.errors.SpecError` that says what is wrong instead of Pinocchio's
+bare ``ValueError``.
+
+What the loaders refuse
+-----------------------
+
+:func:`check_urdf` (run by :func:`load_model`, hence by every ``Mechanism`` constructor)
+raises :class:`~pkm.errors.SpecError` for:
+
+* text that is not a ``str``/``bytes``, that cannot be encoded as UTF-8, or that is larger
+  than 16 MiB; a document that is not well-formed XML (truncated files included) or nests
+  deeper than libxml2's default limit (256);
+* any ``DOCTYPE``, hence any entity declaration: internal entity expansion ("billion
+  laughs") and external entities (``<!ENTITY x SYSTEM "file:///etc/passwd">``) are refused
+  by a scan of the text before the parser runs, so nothing is expanded or opened. The parser
+  runs with entity resolution, DTD loading and network access off; XInclude elements are
+  refused too; nothing but the given text is ever read (meshes are not loaded);
+* a root element other than ``<robot>``; more than 10,000 links or joints;
+* links or joints without a name or with a duplicate name, a joint whose parent or child is
+  not a link, a link with two parents, a tree with several roots (or none), an unknown joint
+  type;
+* a zero axis; a revolute or prismatic joint without ``<limit>`` (URDF requires one), or whose
+  ``<limit>`` states only one of ``lower`` and ``upper``, or ``lower > upper`` (position limits are optional: without them a joint has none;
+  with them :meth:`pkm.core.Mechanism.outside_limits` and every solver result report violations);
+* a number that is not finite or absurd (``|x| > 1e6`` in SI units, taken for a unit error):
+  origins, axes, masses, inertias, mimic coefficients; a non-finite limit. A joint limit of magnitude
+  ``>= 1e6`` (:data:`UNLIMITED`: exporters write ``velocity="1e8"`` or ``effort="1e30"`` for "unlimited") is
+  read as no limit: an effort or velocity limit of any sign, a lower limit ``<= -1e6``, an upper limit
+  ``>= 1e6`` (:func:`position_limits` gives that side as infinite); :func:`limit_notes` says which were read so;
+  a lower limit ``>= 1e6`` or an upper one ``<= -1e6`` is refused;
+* a negative mass, an inertia tensor that is not positive semi-definite (beyond round-off);
+* a ``<mimic>`` naming an unknown joint.
+
+Whatever Pinocchio or yourdfpy still reject after these checks is reported as a
+:class:`~pkm.errors.SpecError` too, never as their own exception types.
+yourdfpy drops ``<mimic>`` when it writes, so the builder puts those elements back itself.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pinocchio as pin
+import yourdfpy
+from lxml import etree
+
+from pkm.errors import InvalidInputError, SpecError
+from pkm.validation import ABSURD
+
+_JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
+_MAX_BYTES = 16 * 1024 * 1024
+_MAX_ELEMENTS = 10_000  # links + joints
+
+
+def _origin(xyz=(0.0, 0.0, 0.0), rotation=None) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, 3] = xyz
+    if rotation is not None:
+        T[:3, :3] = rotation
+    return T
+
+
+class UrdfBuilder:
+    """Collects links and joints, then writes a validated URDF string.
+
+    Lengths in m, masses in kg, inertias in kg m^2 about the centre of mass,
+    angles in rad. Rotations are given as 3x3 matrices.
+    """
+
+    def __init__(self, name: str):
+        self.name = name
+        self._links: list[yourdfpy.Link] = []
+        self._joints: list[yourdfpy.Joint] = []
+        self._mimic: dict[str, tuple[str, float, float]] = {}
+
+    def link(self, name: str, mass: float = 0.0, com=(0.0, 0.0, 0.0), inertia=None) -> str:
+        """Add a link; a massless link gets no ``<inertial>``."""
+        inertial = None
+        if mass > 0.0:
+            I = np.zeros((3, 3)) if inertia is None else np.asarray(inertia, dtype=float)
+            inertial = yourdfpy.Inertial(origin=_origin(com), mass=float(mass), inertia=I)
+        self._links.append(yourdfpy.Link(name=name, inertial=inertial))
+        return name
+
+    def joint(self, name: str, type: str, parent: str, child: str, xyz=(0.0, 0.0, 0.0), rotation=None,
+              axis=(0.0, 0.0, 1.0), limits: tuple[float, float] | None = None, effort: float = 1e3,
+              velocity: float = 1e2, mimic: tuple[str, float, float] | None = None) -> str:
+        """Add a joint. ``mimic = (leader, multiplier, offset)`` makes it follow ``leader``."""
+        limit = None
+        if type in ("revolute", "prismatic"):
+            lo, hi = limits if limits is not None else (-math.pi, math.pi)
+            limit = yourdfpy.Limit(effort=float(effort), velocity=float(velocity), lower=float(lo), upper=float(hi))
+        ax = None if type in ("fixed", "floating") else np.asarray(axis, dtype=float)
+        self._joints.append(yourdfpy.Joint(name=name, type=type, parent=parent, child=child,
+                                           origin=_origin(xyz, rotation), axis=ax, limit=limit))
+        if mimic is not None:
+            self._mimic[name] = (mimic[0], float(mimic[1]), float(mimic[2]))
+        return name
+
+    def frame(self, name: str, parent: str, xyz=(0.0, 0.0, 0.0), rotation=None) -> str:
+        """Add a massless link ``name`` fixed to ``parent`` (a named frame for closures)."""
+        self.link(name)
+        self.joint(f"{name}_fixed", "fixed", parent, name, xyz, rotation)
+        return name
+
+    def to_xml(self) -> str:
+        """The URDF text: yourdfpy-validated, ``<mimic>`` restored, pretty-printed."""
+        robot = yourdfpy.Robot(name=self.name, links=self._links, joints=self._joints)
+        urdf = yourdfpy.URDF(robot=robot, build_scene_graph=False, load_meshes=False)
+        if not urdf.validate():
+            raise SpecError(f"<generated {self.name}>", "yourdfpy rejects the generated tree")
+        root = etree.fromstring(urdf.write_xml_string())
+        for jel in root.iter("joint"):
+            if jel.get("name") in self._mimic:
+                leader, mult, off = self._mimic[jel.get("name")]
+                etree.SubElement(jel, "mimic", joint=leader, multiplier=repr(mult), offset=repr(off))
+        etree.indent(root, space="  ")
+        text = etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True).decode()
+        check_urdf(text, f"<generated {self.name}>")
+        return text
+
+
+#: A joint limit of at least this magnitude (SI: m, rad, m/s, rad/s, N, N m) is read as no limit.
+UNLIMITED = 1e6
+_LIMIT_SIGN = {"lower": -1.0, "upper": 1.0, "effort": 0.0, "velocity": 0.0}  # the side a limit opens (0: either)
+
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(nan|inf|infinity)", re.IGNORECASE)
+
+
+def floats(text: str | None, n: int, what: str, source: str, bound: float = ABSURD) -> list[float]:
+    """``n`` finite numbers of magnitude <= ``bound`` from whitespace-separated text (the model formats share it)."""
+    words = (text or "").split()
+    if not all(_NUMBER.fullmatch(w) for w in words):  # float() would also take "1_000" and non-ASCII digits
+        raise SpecError(source, f"{what}: {text!r} is not a list of numbers")
+    vals = [float(v) for v in words]
+    if len(vals) != n:
+        raise SpecError(source, f"{what}: expected {n} numbers, got {text!r}")
+    for v in vals:
+        if not math.isfinite(v) or abs(v) > bound:
+            raise SpecError(source, f"{what}: value {v!r} is not finite or absurdly large (SI units expected)")
+    return vals
+
+
+def limit_value(text: str | None, key: str, what: str, source: str) -> float | None:
+    """A joint ``<limit>`` attribute (``key``: ``lower``, ``upper``, ``effort`` or ``velocity``) as a number, or
+    None when it states no limit: magnitude ``>= UNLIMITED`` (a lower limit ``<= -1e6``, an upper ``>= 1e6``, an
+    effort or velocity of either sign).
+
+    Raises:
+        SpecError: not a finite number; a lower limit ``>= 1e6`` or an upper one ``<= -1e6`` (no joint moves
+            there: a unit error).
+    """
+    v = floats(text, 1, what, source, bound=math.inf)[0]
+    if abs(v) < UNLIMITED:
+        return v
+    side = _LIMIT_SIGN[key]
+    if side and v * side < 0:
+        raise SpecError(source, f"{what}: value {v!r} is absurd for a {key} limit (SI units expected)")
+    return None
+
+
+def limit_notes(root: etree._Element) -> tuple[str, ...]:
+    """One sentence per limit value a checked URDF states that :func:`limit_value` reads as none, the joints
+    that state it named: ``"joint 'j': velocity limit 1e8 read as none"``."""
+    found: dict[tuple[str, str], list[str]] = {}
+    for el in root.findall("joint"):
+        lim = el.find("limit")
+        if lim is None:
+            continue
+        keys = tuple(_LIMIT_SIGN) if el.get("type") in ("revolute", "prismatic") else ("effort", "velocity")
+        for key in keys:  # (the position limits of other joints are neither checked nor read)
+            text = lim.get(key)
+            if text is not None and abs(float(text)) >= UNLIMITED:
+                found.setdefault((key, text.strip()), []).append(str(el.get("name")))
+    out = []
+    for (key, text), joints in found.items():
+        shown = ", ".join(repr(j) for j in joints[:6]) + (f", ... ({len(joints)} joints)" if len(joints) > 6 else "")
+        out.append(f"joint{'s' if len(joints) > 1 else ''} {shown}: {key} limit {text} read as none "
+                   f"(|x| >= {UNLIMITED:g})")
+    return tuple(out)
+
+
+def parse_xml(text: str | bytes, source: str = "<string>", root_tag: str = "robot", what: str = "URDF") \
+        -> etree._Element:
+    """Parse XML text safely (no DOCTYPE, entities, DTD, network or XInclude; at most 16 MiB) and check that its
+    root element is ``<root_tag>``; the model formats (URDF, MJCF, SDF) share it.
+
+    Raises:
+        SpecError: the text is not UTF-8, too large, not well-formed, or refused as above.
+    """
+    if not isinstance(text, (str, bytes)):
+        raise InvalidInputError("text", f"expected the {what} text as a str, got {type(text).__name__}", text)
+    if len(text) > _MAX_BYTES:
+        raise SpecError(source, f"{what} larger than {_MAX_BYTES} bytes")
+    try:
+        data = text.encode() if isinstance(text, str) else text.decode("utf-8").encode()
+    except UnicodeEncodeError as exc:
+        raise SpecError(source, f"{what} text cannot be encoded as UTF-8 (character {exc.start})") from None
+    except UnicodeDecodeError as exc:
+        raise SpecError(source, f"{what} bytes are not UTF-8 (byte {exc.start})") from None
+    if b"<!DOCTYPE" in data or b"<!ENTITY" in data:  # refused before the parser sees (and expands) anything
+        raise SpecError(source, f"{what} with a DOCTYPE (entity declarations) is refused; remove the <!DOCTYPE ...> "
+                                f"block ({what} needs none)")
+    if len(data) > _MAX_BYTES:
+        raise SpecError(source, f"{what} larger than {_MAX_BYTES} bytes")
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False,
+                             dtd_validation=False)
+    try:
+        root = etree.fromstring(data, parser)
+    except etree.XMLSyntaxError as exc:
+        raise SpecError(source, f"not well-formed XML: {exc}") from None
+    if root.getroottree().docinfo.doctype:
+        raise SpecError(source, f"{what} with a DOCTYPE (entity declarations) is refused")
+    if root.tag != root_tag:
+        raise SpecError(source, f"root element is <{root.tag}>, expected <{root_tag}>")
+    if any(isinstance(el.tag, str) and el.tag.startswith("{http://www.w3.org/2001/XInclude}") for el in root.iter()):
+        raise SpecError(source, f"XInclude elements are refused (pkm reads one self-contained {what}; expand it first)")
+    return root
+
+
+def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
+    """Parse and check URDF text (see the module docstring); returns the root element."""
+    root = parse_xml(text, source)
+    if len(root) > _MAX_ELEMENTS:
+        raise SpecError(source, f"more than {_MAX_ELEMENTS} elements under <robot>")
+    links = [el.get("name") for el in root.findall("link")]
+    if any(not n for n in links):
+        raise SpecError(source, "a <link> has no name")
+    if len(set(links)) != len(links):
+        raise SpecError(source, "two links share a name")
+    joints = root.findall("joint")
+    jnames = [el.get("name") for el in joints]
+    if any(not n for n in jnames) or len(set(jnames)) != len(jnames):
+        raise SpecError(source, "a <joint> has no name or two joints share a name")
+    parent_of: dict[str, str] = {}
+    for el in joints:
+        name, typ = el.get("name"), el.get("type")
+        if typ not in _JOINT_TYPES:
+            raise SpecError(source, f"joint {name!r}: unknown type {typ!r}; URDF types are {sorted(_JOINT_TYPES)}")
+        par, chi = el.find("parent"), el.find("child")
+        if par is None or chi is None:
+            raise SpecError(source, f"joint {name!r} lacks <parent> or <child>")
+        for role, link in (("parent", par.get("link")), ("child", chi.get("link"))):
+            if link not in links:
+                raise SpecError(source, f"joint {name!r}: {role} link {link!r} does not exist")
+        if chi.get("link") in parent_of:
+            raise SpecError(source, f"link {chi.get('link')!r} has two parents (URDF is a tree; "
+                                    "put loops in the closure spec)")
+        parent_of[chi.get("link")] = par.get("link")
+        org = el.find("origin")
+        if org is not None:
+            floats(org.get("xyz", "0 0 0"), 3, f"joint {name!r} origin xyz", source)
+            floats(org.get("rpy", "0 0 0"), 3, f"joint {name!r} origin rpy", source)
+        if typ in ("revolute", "continuous", "prismatic"):
+            ax = el.find("axis")
+            axis = floats(ax.get("xyz") if ax is not None else "1 0 0", 3, f"joint {name!r} axis", source)
+            if np.linalg.norm(axis) < 1e-9:
+                raise SpecError(source, f"joint {name!r} has a zero axis")
+        if typ in ("revolute", "prismatic"):
+            lim = el.find("limit")  # position limits are optional (onshape-to-robot writes effort and velocity only)
+            if lim is None:
+                raise SpecError(source, f"joint {name!r} ({typ}) needs a <limit> element (URDF requires one; "
+                                        "effort and velocity suffice, lower and upper are optional)")
+            stated = [] if lim is None else [k for k in ("lower", "upper") if lim.get(k) is not None]
+            if len(stated) == 1:
+                raise SpecError(source, f"joint {name!r} ({typ}) states only its {stated[0]} limit; give both "
+                                        "lower and upper, or neither (no position limits)")
+            if stated:
+                lo, hi = (limit_value(lim.get(k), k, f"joint {name!r} {k} limit", source) for k in ("lower", "upper"))
+                if lo is not None and hi is not None and lo > hi:
+                    raise SpecError(source, f"joint {name!r}: lower limit {lo} > upper limit {hi}")
+        lim = el.find("limit")
+        if lim is not None:
+            for key in ("effort", "velocity"):
+                if lim.get(key) is not None:
+                    limit_value(lim.get(key), key, f"joint {name!r} limit {key}", source)
+        mim = el.find("mimic")
+        if mim is not None and mim.get("joint") not in jnames:
+            raise SpecError(source, f"joint {name!r} mimics unknown joint {mim.get('joint')!r}")
+        if mim is not None:
+            for key in ("multiplier", "offset"):
+                if mim.get(key) is not None:
+                    floats(mim.get(key), 1, f"joint {name!r} mimic {key}", source)
+    roots = [n for n in links if n not in parent_of]
+    if len(roots) != 1:
+        raise SpecError(source, f"a URDF tree has one root link; found {roots}")
+    for lel in root.findall("link"):
+        inertial = lel.find("inertial")
+        if inertial is None:
+            continue
+        mass = inertial.find("mass")
+        lname = lel.get("name")
+        m = floats(mass.get("value") if mass is not None else None, 1, f"link {lname!r} mass", source)[0]
+        if m < 0:
+            raise SpecError(source, f"link {lname!r} has negative mass {m}")
+        org = inertial.find("origin")
+        if org is not None:
+            floats(org.get("xyz", "0 0 0"), 3, f"link {lname!r} inertial origin xyz", source)
+            floats(org.get("rpy", "0 0 0"), 3, f"link {lname!r} inertial origin rpy", source)
+        iel = inertial.find("inertia")
+        if iel is None:
+            raise SpecError(source, f"link {lname!r}: <inertial> needs <inertia ixx=... ixy=... ixz=... iyy=... "
+                                    "iyz=... izz=...>")
+        if iel is not None:
+            keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+            ixx, ixy, ixz, iyy, iyz, izz = floats(" ".join(iel.get(k, "0") for k in keys), 6,
+                                                   f"link {lname!r} inertia {'/'.join(keys)}", source)
+            ev = np.linalg.eigvalsh(np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]))
+            if ev[0] < -1e-9 * max(1.0, float(np.abs(ev).max())):
+                raise SpecError(source, f"link {lname!r}: inertia tensor has a negative principal moment "
+                                        f"{ev[0]:.6g} kg m^2 (not physical); check ixx..izz")
+    return root
+
+
+def position_limits(text: str | bytes, source: str = "<string>") -> dict[str, tuple[float, float]]:
+    """``{joint: (lower, upper)}`` [m or rad] for the revolute and prismatic joints whose ``<limit>`` states both
+    (checked URDF text; the others have none: Pinocchio's parser gives them ``[0, 0]``, which pkm does not read).
+    A side stated beyond :data:`UNLIMITED` is infinite (``-inf`` or ``inf``); a joint with neither side bounded
+    has no entry."""
+    out: dict[str, tuple[float, float]] = {}
+    for el in check_urdf(text, source).findall("joint"):
+        lim = el.find("limit")
+        if el.get("type") in ("revolute", "prismatic") and lim is not None and lim.get("lower") is not None \
+                and lim.get("upper") is not None:
+            lo, hi = (limit_value(lim.get(k), k, f"joint {el.get('name')!r} {k} limit", source)
+                      for k in ("lower", "upper"))
+            if lo is not None or hi is not None:
+                out[str(el.get("name"))] = (-math.inf if lo is None else lo, math.inf if hi is None else hi)
+    return out
+
+
+def load_model(text: str, source: str = "<string>") -> pin.Model:
+    """Check URDF text and build the Pinocchio model (mimic joints honoured).
+
+    Raises:
+        SpecError: see the module docstring for what is refused.
+    """
+    check_urdf(text, source)
+    if isinstance(text, bytes):
+        text = text.decode("utf-8", errors="replace")
+    try:
+        yourdfpy.URDF.load(io.BytesIO(text.encode()), build_scene_graph=False, load_meshes=False)
+    except Exception as exc:  # yourdfpy raises a variety of types
+        raise SpecError(source, f"yourdfpy rejects the URDF: {exc}") from None
+    try:
+        return pin.buildModelFromXML(text, mimic=True)
+    except Exception as exc:  # Pinocchio's own exception types must not leak
+        hint = (" (a mimic joint must come after the joint it mimics in Pinocchio's traversal, "
+                "which visits sibling joints in name order)") if "mimic" in str(exc) else ""
+        raise SpecError(source, f"Pinocchio rejects the URDF: {exc}{hint}") from None
+
+
+_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+
+
+def num(x) -> str:
+    """Numbers as URDF attribute text, each written exactly (``repr``)."""
+    return " ".join(repr(float(v)) for v in np.ravel(x))
+
+
+def origin(el: etree._Element, M: pin.SE3) -> None:
+    """An ``<origin xyz rpy>`` child of ``el`` for the placement ``M``."""
+    etree.SubElement(el, "origin", xyz=num(M.translation), rpy=num(pin.rpy.matrixToRpy(M.rotation)))
+
+
+def _urdf_joint_kind(jm, where: str, source: str) -> tuple[str, np.ndarray | None, str | None]:
+    """``(URDF type, axis, pkm joint type or None)`` of one (non-composite) Pinocchio joint model."""
+    kind = jm.shortname().removeprefix("JointModel")
+    if kind in ("RX", "RY", "RZ", "PX", "PY", "PZ"):
+        return ("revolute" if kind[0] == "R" else "prismatic"), np.array(_AXES[kind[1]]), None
+    if kind in ("RevoluteUnaligned", "PrismaticUnaligned"):
+        return ("revolute" if kind[0] == "R" else "prismatic"), np.asarray(jm.extract().axis, dtype=float), None
+    if kind in ("RUBX", "RUBY", "RUBZ"):
+        return "continuous", np.array(_AXES[kind[3]]), None
+    if kind == "Spherical":  # URDF has none: a revolute placeholder that [joint_types] makes spherical
+        return "revolute", np.array(_AXES["Z"]), "spherical"
+    if kind == "FreeFlyer":
+        return "floating", None, None
+    if kind == "Universal":
+        uj = jm.extract()
+        if np.allclose(uj.axis1, _AXES["X"], atol=1e-12) and np.allclose(uj.axis2, _AXES["Y"], atol=1e-12):
+            return "revolute", np.array(_AXES["Z"]), "universal"
+    raise SpecError(source, f"{where}: a Pinocchio {jm.shortname()} cannot be written as URDF (pkm writes revolute, "
+                            "prismatic, continuous, spherical, universal about x then y, and free-flyer joints)")
+
+
+def _joint_motion(jm, value: float, where: str, source: str) -> pin.SE3:
+    """The placement a revolute or prismatic joint model gives its child at ``q = value`` (rad or m)."""
+    kind, axis, pkm_type = _urdf_joint_kind(jm, where, source)
+    if kind not in ("revolute", "prismatic") or pkm_type is not None or axis is None:
+        raise SpecError(source, f"{where}: only a revolute or prismatic joint can be locked at a value")
+    if kind == "revolute":
+        return pin.SE3(pin.AngleAxis(float(value), axis / np.linalg.norm(axis)).matrix(), np.zeros(3))
+    return pin.SE3(np.eye(3), float(value) * axis / np.linalg.norm(axis))
+
+
+def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: dict[str, list[str]] | None = None,
+                    limits: dict[str, tuple[float, float]] | None = None,
+                    frames: Sequence[tuple[str, int, pin.SE3]] = (), skip_frames: tuple[str, ...] = (),
+                    mimic: Mapping[str, tuple[str, float, float]] | None = None,
+                    locked: Mapping[str, float] | None = None,
+                    source: str = "<model>") -> tuple[str, dict[str, str]]:
+    """The URDF text of a Pinocchio tree, and the ``[joint_types]`` that URDF cannot state.
+
+    The other formats (MJCF, SDF) reach pkm through this: one representation downstream. Each joint
+    becomes a URDF joint of its name, its child link carrying the joint's inertia and named after the body
+    frame at the joint's origin (``<joint>_link`` when there is none); a composite joint (a MuJoCo body
+    with several joints) becomes a chain through massless links, its parts named by ``joint_names``;
+    every other body and operational frame, and each of ``frames`` (``(name, parent joint id,
+    placement in that joint's frame)``), becomes a massless link on a fixed joint ``<frame>_fixed``.
+    ``limits`` gives the position limits ``{joint: (lower, upper)}`` to state; the other revolute and
+    prismatic joints get a ``<limit>`` without bounds. ``mimic`` makes joints followers,
+    ``{joint: (leader, multiplier, offset)}``: a URDF ``<mimic>``, ``q_joint = multiplier q_leader + offset``
+    (:func:`load_model` builds Pinocchio's mimic joints; the leader must come first in its traversal).
+    ``locked`` welds one-coordinate joints at a value, ``{joint: q [rad or m]}``: a fixed joint at the
+    placement the joint has there. :func:`load_model` and :func:`pkm.core.model.joints.retype_joints` give the
+    same tree back (same ``q`` layout but for the mimic and locked joints, frames, inertias).
+
+    Raises:
+        SpecError: a joint kind URDF and ``[joint_types]`` cannot express (planar, helical...), mimic joints
+            in ``model``, a locked joint with more than one coordinate.
+    """
+    joint_names = joint_names or {}
+    limits = limits or {}
+    mimic = mimic or {}
+    locked = locked or {}
+    fnames = {f.name for f in model.frames}
+    taken: set[str] = set()
+
+    def unique(base: str) -> str:
+        out, k = base, 1
+        while out in taken or (out != base and out in fnames):
+            out, k = f"{base}_{k}", k + 1
+        taken.add(out)
+        return out
+
+    robot = etree.Element("robot", name=name or model.name or "robot")
+
+    def link(lname: str, inertia: pin.Inertia | None = None) -> None:
+        lel = etree.SubElement(robot, "link", name=lname)
+        if inertia is not None and inertia.mass > 0.0:
+            iel = etree.SubElement(lel, "inertial")
+            origin(iel, pin.SE3(np.eye(3), inertia.lever))
+            etree.SubElement(iel, "mass", value=repr(float(inertia.mass)))
+            I = inertia.inertia
+            etree.SubElement(iel, "inertia", ixx=num(I[0, 0]), ixy=num(I[0, 1]), ixz=num(I[0, 2]),
+                             iyy=num(I[1, 1]), iyz=num(I[1, 2]), izz=num(I[2, 2]))
+
+    def joint(jname: str, kind: str, parent: str, child: str, M: pin.SE3, axis=None) -> None:
+        jel = etree.SubElement(robot, "joint", name=jname, type=kind)
+        origin(jel, M)
+        etree.SubElement(jel, "parent", link=parent)
+        etree.SubElement(jel, "child", link=child)
+        if axis is not None:
+            etree.SubElement(jel, "axis", xyz=num(axis))
+        if kind in ("revolute", "prismatic"):
+            bounds = {"lower": repr(float(limits[jname][0])), "upper": repr(float(limits[jname][1]))} \
+                if jname in limits else {}
+            etree.SubElement(jel, "limit", effort="0", velocity="0", **bounds)
+
+    root = unique("world")
+    taken.update(skip_frames)
+    link(root)
+    link_of = {0: root}
+    primary = set()
+    types: dict[str, str] = {}
+    for jid in range(1, model.njoints):
+        jm, jname = model.joints[jid], model.names[jid]
+        if jm.shortname() == "JointModelMimic":
+            raise SpecError(source, f"joint {jname!r}: mimic joints cannot be written as URDF by pkm yet")
+        if jm.shortname() == "JointModelComposite":
+            comp = jm.extract()
+            parts = list(zip(comp.joints, comp.jointPlacements))
+            names = joint_names.get(jname) or [f"{jname}_{k}" for k in range(len(parts))]
+            if len(names) != len(parts):
+                raise SpecError(source, f"joint {jname!r} has {len(parts)} parts but {len(names)} names")
+        else:
+            parts, names = [(jm, pin.SE3.Identity())], [jname]
+        body = next((f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == jid
+                     and f.placement.isIdentity(1e-12) and f.name not in taken), None)
+        parent = link_of[model.parents[jid]]
+        for k, ((part, placement), pname) in enumerate(zip(parts, names)):
+            kind, axis, pkm_type = _urdf_joint_kind(part, f"joint {pname!r}", source)
+            last = k == len(parts) - 1
+            child = (unique(body) if body is not None else unique(f"{pname}_link")) if last else unique(f"{pname}_link")
+            link(child, model.inertias[jid] if last else None)
+            M = model.jointPlacements[jid] * placement if k == 0 else placement
+            if pname in locked:
+                M, kind, axis, pkm_type = M * _joint_motion(part, locked[pname], f"joint {pname!r}", source), \
+                    "fixed", None, None
+            joint(pname, kind, parent, child, M, axis)
+            if pname in mimic:
+                leader, mult, off = mimic[pname]
+                etree.SubElement(robot[-1], "mimic", joint=leader, multiplier=repr(float(mult)), offset=repr(float(off)))
+            if pkm_type:
+                types[pname] = pkm_type
+            parent = child
+        link_of[jid] = parent
+        if body is not None:
+            primary.add(body)
+    extra = [(f.name, f.parentJoint, f.placement) for f in model.frames[1:]
+             if f.type in (pin.FrameType.BODY, pin.FrameType.OP_FRAME) and f.name not in primary
+             and f.name not in skip_frames]
+    for fname, _, _ in frames:
+        if fname in taken or fname in fnames:
+            raise SpecError(source, f"frame {fname!r} to add is already a name of the model")
+    for fname, jid, M in extra + list(frames):
+        child = unique(fname)
+        link(child)
+        joint(unique(f"{child}_fixed"), "fixed", link_of[jid], child, M)
+    etree.indent(robot, space="  ")
+    text = etree.tostring(robot, xml_declaration=True, encoding="utf-8", pretty_print=True).decode()
+    check_urdf(text, source)
+    return text, types

@@ -1,0 +1,133 @@
+"""pkm.core.analysis.maps: generic maps through the twin equal the papers' closed-form maps (the 3-RRR's eight GCIs and
+their CI maps, the Delta's K(R) and workspace volumes) and work on a user's mechanism."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm.core.analysis.maps import task_map
+from pkm.core.differential import indices
+from pkm.errors import InvalidInputError
+from pkm.mechanisms.delta import DeltaParams
+from pkm.mechanisms.delta.workspace import workspace
+from pkm.mechanisms.rrr3 import workspace as W
+from pkm.papers import delta as delta_study
+from pkm.papers import rrr3 as rrr3_study
+
+
+def _rrr3_map(figure: str):
+    d = rrr3_study.figure_design(figure)
+    mech = pkm.build("rrr3", a=d.a, b=d.b, h=d.h, H=d.H)
+    g = rrr3_study.paper_grid(d)
+    return d, g, task_map(mech, {"x": g.xs, "y": g.ys}, {"yaw": 0.0}, length=d.h / math.sqrt(3))
+
+
+@pytest.mark.parametrize("figure", sorted(rrr3_study.PUBLISHED))
+def test_the_3rrr_gcis_through_the_generic_route_equal_the_closed_form(figure):
+    """On the paper's 801 x 801 grid: the same reachable nodes; each node's CI within 1e-10 of LAPACK's SVD of the
+    closed form's matrix (1e-8 at the few nodes exactly on an inverse singularity, CI < 1e-8, where Newton locates
+    the double root to 1e-7) and within 1e-9 of the closed form's CI wherever that is itself within 1e-10 of LAPACK
+    (it is not where two singular values coincide: 8e-9 off); the overall and area GCI (the paper's two numbers per
+    figure) within 1e-9."""
+    d, g, m = _rrr3_map(figure)
+    hand = rrr3_study.figure_map(figure)
+    assert np.array_equal(m.reachable, hand.reachable)
+    ci = m.condition_index("2")
+    r = hand.reachable
+    K, _ = W.inverse_jacobian_stack(d, *np.meshgrid(g.xs, g.ys), W.CiSettings())
+    s = np.linalg.svd(K[r], compute_uv=False)
+    lapack = s[:, -1] / s[:, 0]
+    closed_ok = (np.abs(hand.ci[r] - lapack) <= 1e-10) & (lapack >= 1e-8)
+    on_singularity = lapack < 1e-8
+    assert np.abs(ci[r] - lapack)[~on_singularity].max() <= 1e-10
+    assert np.abs(ci[r] - lapack)[on_singularity].max(initial=0.0) <= 1e-8
+    assert np.abs(ci[r][closed_ok] - hand.ci[r][closed_ok]).max() <= 1e-9
+    assert abs(m.gci() - hand.gci().value) <= 1e-9
+    area = g.square_mask(W.AREA_SIDE, d.base_centroid)
+    assert abs(m.gci(region=area) - hand.area_gci().value) <= 1e-9
+
+
+def test_the_delta_condition_numbers_through_the_generic_route_equal_the_closed_form():
+    """K(R) of Fig. 5 in the three conventions at the study pose: the generic IK, then the twin's inverse Jacobian
+    (compiled) and pkm.core.differential.indices, equal the closed form to 1e-9 relative."""
+    for R in (0.100, 0.120, 0.150, 0.200):
+        p = delta_study.PAPER
+        mech = pkm.build("delta", La=p.La, Lb=p.Lb, r=p.r, R=R, home=tuple(p.home))
+        q = pkm.solve_ik(mech, delta_study.POSE).q
+        K = pkm.Kernels(mech).inverse_jacobian(q)
+        closed = delta_study._at(R)
+        for kind in delta_study.KINDS:
+            assert math.isclose(indices.condition_number(K, kind), closed[kind], rel_tol=1e-9), (R, kind)
+
+
+def test_the_delta_workspace_volumes_through_the_generic_route_equal_the_closed_form():
+    """The 8 mm grid of the radius study (110 x 110 x 55 = 665,500 nodes) at R = 120 mm: the same reachable nodes,
+    volume and volume where K_2 <= 3 as the closed form's."""
+    p = delta_study.PAPER
+    mech = pkm.build("delta", La=p.La, Lb=p.Lb, r=p.r, R=0.120, home=tuple(p.home))
+    hand = workspace(DeltaParams(La=p.La, Lb=p.Lb, r=p.r, R=0.120, home=tuple(p.home)), delta_study.SPACING,
+                     kinds=("2",))
+    xy, _, z = hand.axes
+    m = task_map(mech, {"x": xy, "y": xy, "z": z})
+    reach = np.transpose(m.reachable, (2, 1, 0))  # (z, y, x) -> (x, y, z), the closed form's layout
+    assert np.array_equal(reach, hand.reachable)
+    assert math.isclose(m.size, hand.volume, rel_tol=1e-12)
+    K2 = np.transpose(1.0 / m.condition_index("2"), (2, 1, 0))
+    assert np.count_nonzero(K2 <= delta_study.K_MAX) == np.count_nonzero(hand.K["2"] <= delta_study.K_MAX)
+    both = hand.reachable & np.isfinite(hand.K["2"])
+    assert np.abs(K2[both] / hand.K["2"][both] - 1.0).max() <= 1e-9
+
+
+def test_a_users_mechanism_gets_its_map():
+    """The Gough-Stewart of examples/ (a user's files, a pose task): a 121 x 121 map of the platform's x, y at the
+    reference height and orientation, L = 0.1 m. At random reachable nodes pkm.solve_ik and the kernels' inverse
+    Jacobian give the same CI (1e-8); the manipulability and the smallest singular value are positive inside."""
+    from tests.core.twin.test_tree import FILES
+
+    mech = pkm.load(FILES["gough_stewart"])
+    y0 = pkm.TaskMap(mech).named(mech.q_reference)
+    xs, ys = y0["x"] + np.linspace(-0.06, 0.06, 121), y0["y"] + np.linspace(-0.06, 0.06, 121)
+    m = task_map(mech, {"x": xs, "y": ys}, length=0.1)
+    assert m.nodes > 1000 and m.reachable[60, 60]
+    ci = m.condition_index("2")
+    K = pkm.Kernels(mech)
+    rng = np.random.default_rng(0)
+    for k in rng.choice(np.flatnonzero(m.reachable.ravel()), 5, replace=False):
+        iy, ix = np.unravel_index(k, m.reachable.shape)
+        q = pkm.solve_ik(mech, {"x": xs[ix], "y": ys[iy]}).q
+        J = K.inverse_jacobian(q) @ np.diag(m.scale)
+        assert math.isclose(1.0 / indices.condition_number(J, "2"), ci[iy, ix], rel_tol=1e-8)
+    inside = m.reachable
+    assert np.all(m.manipulability()[inside] > 0) and np.all(m.sigma_min()[inside] > 0)
+    assert math.isclose(m.size, m.nodes * 0.001 ** 2, rel_tol=1e-9)
+
+
+def test_the_workspace_over_orientations():
+    """A 3-D map (x, y, yaw) of the 3-RRR: its maximal and total-orientation workspaces equal the closed form's
+    reachability over the same orientations, any and all."""
+    mech = pkm.load("rrr3")
+    d = W.Design.of(mech.params)
+    xs, phis = np.linspace(0.0, d.H, 41), np.radians(np.arange(-30.0, 31.0, 10.0))
+    m = task_map(mech, {"x": xs, "y": xs, "yaw": phis}, length=d.h / math.sqrt(3))
+    X, Y, P = np.meshgrid(xs, xs, phis)  # (y, x, phi)
+    _, reach = W.condition_index_phi(d, X, Y, P, W.CiSettings())
+    assert np.array_equal(m.reachable_over("yaw", "any"), reach.any(axis=-1))
+    assert np.array_equal(m.reachable_over("yaw", "all"), reach.all(axis=-1))
+    with pytest.raises(InvalidInputError, match="mode"):
+        m.reachable_over("yaw", "some")
+
+
+def test_bad_maps_are_refused():
+    mech = pkm.load("rrr3")
+    with pytest.raises(InvalidInputError, match="not a task coordinate"):
+        task_map(mech, {"q": [0.0]})
+    with pytest.raises(InvalidInputError, match="characteristic length"):
+        task_map(mech, {"x": [0.5], "y": [0.3]})
+    with pytest.raises(InvalidInputError, match="1 to 3"):
+        task_map(mech, {})
+    with pytest.raises(InvalidInputError, match="finite"):
+        task_map(mech, {"x": [np.nan]}, length=0.05)

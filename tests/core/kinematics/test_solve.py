@@ -1,0 +1,260 @@
+"""Position solvers and differential kinematics of the core: results, bounds, and errors on bad input."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm.core import Mechanism, close_loops, diagnose, solve_ik
+from pkm.core.kinematics import constraints
+from pkm.errors import (
+    AssemblyError,
+    ConvergenceError,
+    InvalidInputError,
+    SingularityError,
+    SpecError,
+    UnknownNameError,
+)
+from pkm.mechanisms import delta as D
+from pkm.mechanisms import names, rrr3
+
+
+@pytest.fixture(scope="module")
+def delta(built):
+    return built("delta")
+
+
+def test_solve_result_reports_convergence_residual_and_iterations(delta):
+    """A loop closure from a neighbouring configuration converges in a few iterations to 1e-12."""
+    qa = delta.actuated_q(delta.q_reference) + 0.01
+    res = close_loops(delta, qa, delta.q_reference)
+    assert res.converged and res.residual <= 1e-12 and 1 <= res.iterations <= 10 and res.steps == 1
+    assert res.branch_signs == {"knee_1": -1, "knee_2": -1, "knee_3": -1}
+
+
+@pytest.mark.parametrize("bad", [[0.1, 0.2], [0.1, math.nan, 0.2], [[0.1, 0.2, 0.3]], "abc", None])
+def test_bad_actuated_input_is_refused(delta, bad):
+    """Wrong shapes, NaN and non-numbers are InvalidInputErrors naming the argument."""
+    with pytest.raises(InvalidInputError, match="q_actuated"):
+        close_loops(delta, bad)
+
+
+def test_bad_configuration_and_target_are_refused(delta):
+    """A configuration of the wrong size or with inf, and a target of the wrong size, are refused."""
+    with pytest.raises(InvalidInputError, match="q0"):
+        close_loops(delta, [0.0, 0.0, 0.0], np.zeros(5))
+    with pytest.raises(InvalidInputError, match="target"):
+        solve_ik(delta, [0.0, 0.0])
+    with pytest.raises(InvalidInputError, match="target"):
+        solve_ik(delta, [0.0, math.inf, -0.3])
+    q = delta.q_reference.copy()
+    q[0] = math.inf
+    with pytest.raises(InvalidInputError):
+        pkm.forward_jacobian(delta, q)
+
+
+def test_unassemblable_motor_angles_raise_convergence_error_with_the_open_loop():
+    """Motor angles with no assembly: the solver stops, bounded, and says which loop stays open."""
+    short = D.build(D.DeltaParams(Lb=0.2, home=(0.0, 0.0, -0.2)))
+    theta = [-0.7, -0.4, 0.2]
+    with pytest.raises(AssemblyError):  # the paper's sphere intersection agrees: no assembly
+        D.forward_kinematics(short.params, theta)
+    with pytest.raises(ConvergenceError) as info:
+        close_loops(short, theta, max_iter=15)
+    err = info.value
+    assert err.residual > 1e-3 and err.worst_closure in {"ball_1", "ball_2", "ball_3"} and err.worst_gap > 1e-3
+    assert "stays open" in str(err)
+
+
+def test_a_target_outside_the_workspace_is_unreachable_not_a_convergence_failure(delta, built):
+    """A platform position far outside the workspace, and the five-bar's tip beyond its reach (0.7 m up, links
+    0.55 m), give UnreachableError naming the closure left open at the least-squares minimum, never NaN nor
+    "did not converge"."""
+    from pkm.errors import UnreachableError
+
+    with pytest.raises(UnreachableError, match=r"out of the workspace.*closure 'ball_\d' stays open"):
+        solve_ik(delta, [0.0, 0.0, -2.0], max_iter=10)
+    with pytest.raises(UnreachableError, match=r"closure 'tip' stays open by .* the task misses by 0\.1"):
+        solve_ik(built("fivebar"), [0.0, 0.7])
+    import dataclasses
+    from pathlib import Path
+
+    from pkm.core.model.spec import TaskSpec
+
+    files = pkm.load(Path(__file__).resolve().parents[3] / "examples" / "gepetto_fivebar")
+    gepetto = Mechanism.from_strings(files.urdf, dataclasses.replace(files.spec, end_effector="closedloop1_A",
+                                                                     task=TaskSpec(("x", "y"))))
+    with pytest.raises(UnreachableError, match=r"the task misses by 4\.\d+ m or rad .*the loops close") as exc:
+        solve_ik(gepetto, {"x": 5.0})  # so far that the least-squares minimum has the loop (all but) closed
+    assert exc.value.leg == 0
+
+
+def test_a_reachable_target_the_solver_cannot_reach_is_a_convergence_failure(delta):
+    """One Newton iteration per step to a reachable target: "did not converge", with the residual."""
+    with pytest.raises(ConvergenceError) as exc:
+        solve_ik(delta, [0.05, 0.0, -0.3], max_iter=1, max_step=1.0)
+    assert not isinstance(exc.value, UnknownNameError) and exc.value.residual > 1e-12
+
+
+def test_unknown_branch_and_frame_names_list_the_valid_ones(delta):
+    """Unknown names raise UnknownNameError with the valid names in the message."""
+    with pytest.raises(UnknownNameError, match="knee_out"):
+        solve_ik(delta, [0.0, 0.0, -0.35], branch="knees_out")
+    with pytest.raises(UnknownNameError, match="platform_ball_1"):
+        delta.frame_id("platform_bal_1")
+
+
+def test_other_branch_is_reached_from_a_branch_seed(delta):
+    """The generic IK on 'knee_in' equals the closed form on that branch."""
+    y = [0.01, 0.02, -0.36]
+    res = solve_ik(delta, y, branch="knee_in")
+    assert delta.on_branch(res.q, "knee_in")
+    assert np.abs(delta.actuated_q(res.q) - D.inverse_kinematics(delta.params, y, "knee_in")).max() < 1e-9
+
+
+def test_diagnose_classifies_a_folded_leg_as_inverse_singularity(delta):
+    """With forearm 1 folded back onto arm 1's plane direction (double root of its IK), the configuration
+    is an inverse singularity, and the inverse measure falls to zero on the way there."""
+    p = delta.params
+    th, eta = -3.1, -0.8
+    B1 = np.array([0.0, p.R - p.r + p.La * math.cos(th), p.La * math.sin(th)])
+    f = np.array([math.sin(eta), math.cos(eta) * math.cos(th), math.cos(eta) * math.sin(th)])
+    E = B1 - p.Lb * f  # forearm 1's projection on arm 1's plane lies along the arm
+    d = diagnose(delta, D.configuration(delta, E))
+    assert d.classification == "inverse" and d.sigma_inverse < 1e-7
+    with pytest.raises(SingularityError) as info:
+        pkm.inverse_jacobian(delta, D.configuration(delta, E))
+    assert info.value.kind == "inverse"
+    sig = [diagnose(delta, D.configuration(delta, B1 - (p.Lb + s) * f)).sigma_inverse for s in (1e-4, 1e-5, 1e-6)]
+    assert sig[0] > sig[1] > sig[2] > 0
+
+
+def test_a_path_that_leaves_the_workspace_is_reported_as_such_when_the_target_itself_closes():
+    """When continuation from the seed fails but a direct correction at the target closes, the error says the path
+    left the workspace and asks for a nearer seed, instead of reporting a tiny residual as too large."""
+    m = rrr3.build()
+    qa = rrr3.closed_form_ik(m.params, [0.501, 0.025, 0.750])
+    seed = rrr3.closed_form_configuration(m, [0.716, 0.203, 0.793])
+    with pytest.raises(ConvergenceError, match="left the workspace") as info:
+        close_loops(m, qa, seed)
+    assert info.value.residual > info.value.tolerance
+    assert info.value.result.residual <= info.value.tolerance
+
+
+# ---------------------------------------------------------------------- assembly and the reference
+def _without_reference(mech):
+    import dataclasses
+
+    return dataclasses.replace(mech.spec, reference={})
+
+
+@pytest.mark.parametrize("name", names())
+def test_a_spec_without_reference_is_assembled(name, built):
+    """With no [reference], every registered mechanism is assembled from its neutral configuration (Levenberg-
+    Marquardt with restarts) to 1e-10, and that configuration is accepted as its reference."""
+    mech = built(name)
+    again = Mechanism.from_strings(mech.urdf, _without_reference(mech))
+    assert np.abs(constraints.residual(again, again.q_reference)).max() <= 1e-10
+
+
+def test_assemble_closes_from_far_seeds_and_says_which_closure_stays_open_when_nothing_can():
+    """pkm.assemble closes the Delta from seeds 1 rad away; a five-bar whose motors are 2 m apart (links 1.1 m
+    in all) cannot close: the SpecError names the closure and its gap (about 0.9 m)."""
+    import pinocchio as pin
+
+    import pkm
+    from tests import fivebar
+
+    delta = pkm.load("delta")
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        q0 = pin.integrate(delta.model, delta.q_reference, rng.uniform(-1, 1, delta.nv))
+        res = pkm.assemble(delta, q0)
+        assert res.converged and np.abs(constraints.residual(delta, res.q)).max() <= 1e-10
+    plain = fivebar.build()
+    with pytest.raises(SpecError, match=r"loops cannot be closed: .*'tip' \('tip_1'/'tip_2'\) open by 0\.[89]"):
+        Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params(d=2.0)), _without_reference(plain))
+
+
+def test_a_frame_closure_that_cannot_close_is_named_with_its_gap_and_what_would_close_it():
+    """Issue 27 (Gepetto's kangaroo_like: 6-D loops whose frames no joint can align): a planar five-bar closed by a
+    frame closure whose second frame is tilted 0.3 rad about x cannot close, even alone; the error names the
+    closure, its frames, the gap left at best (0 m, 0.3 rad: the tilt no joint can take) and that a point closure
+    closes it, and carries the closures with their gaps (its cause, an AssemblyError). As a point closure it
+    assembles, its frames then 0.3 rad apart about x at least."""
+    import dataclasses
+
+    import pinocchio as pin
+
+    from pkm.core.model.spec import Closure
+    from tests import fivebar
+
+    tilted = ('<link name="tilted"/><joint name="tilted_fixed" type="fixed"><parent link="distal_2"/>'
+              '<child link="tilted"/><origin xyz="0.3 0 0" rpy="0.3 0 0"/></joint></robot>')
+    urdf = fivebar.urdf_xml(fivebar.Params()).replace("</robot>", tilted)
+    spec = dataclasses.replace(fivebar.build().spec, reference={},
+                               closures=(Closure("tips", "frame", "tip_1", "tilted"),))
+    with pytest.raises(SpecError, match=r"cannot be closed: .*'tips' \('tip_1'/'tilted'\) open by 0 m and 0\.3 rad "
+                                        r"at best \(its origins can meet\); each closes alone as a point closure") as info:
+        Mechanism.from_strings(urdf, spec)
+    (name, gap), = info.value.__cause__.closures
+    assert name == "tips" and gap > 0.01
+    mech = Mechanism.from_strings(urdf, dataclasses.replace(spec, closures=(Closure("tips", "point", "tip_1",
+                                                                                      "tilted"),)))
+    assert np.abs(constraints.residual(mech, mech.q_reference)).max() <= 1e-10
+    pin.framesForwardKinematics(mech.model, mech.data, mech.q_reference)
+    tilt = mech.data.oMf[mech.frame_id("tilted")].rotation.T @ mech.data.oMf[mech.frame_id("tip_1")].rotation
+    assert np.linalg.norm(pin.log3(tilt)) >= 0.3 - 1e-9  # (no joint turns about x)
+
+
+def test_assemble_holds_the_joints_it_is_told_to_and_a_partial_reference_holds_what_it_states(built):
+    """pkm.assemble(hold=...) keeps the held coordinates exactly; a [reference] that states only the actuators is
+    assembled at those actuators (the 3-RPR of the acceptance set: its leg lengths)."""
+    import pinocchio as pin
+
+    delta = built("delta")
+    rng = np.random.default_rng(2)
+    q0 = pin.integrate(delta.model, delta.q_reference, 0.2 * rng.uniform(-1, 1, delta.nv))
+    res = pkm.assemble(delta, q0, hold=delta.actuated_names)
+    assert np.abs(delta.actuated_q(res.q) - delta.actuated_q(q0)).max() <= 1e-15
+    assert np.abs(constraints.residual(delta, res.q)).max() <= 1e-10
+    with pytest.raises(InvalidInputError, match="joint names"):
+        pkm.assemble(delta, q0, hold="motor_1")
+    from pathlib import Path
+
+    rpr = pkm.load(Path(__file__).resolve().parents[3] / "examples" / "rpr3" / "rpr3.closures.toml")
+    assert np.abs(rpr.actuated_q(rpr.q_reference) - 0.45).max() <= 1e-15
+
+
+def test_a_spec_without_any_loop_is_refused(built):
+    import dataclasses
+
+    mech = built("delta")
+    with pytest.raises(SpecError, match="no loop closure"):
+        Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, closures=()))
+
+
+def test_an_open_reference_is_refused_with_the_closure_and_the_gap(built):
+    """A [reference] 8 cm off its closure (the Delta's platform moved down) is refused, naming the open closure."""
+    import dataclasses
+
+    mech = built("delta")
+    ref = dict(mech.spec.reference)
+    ref["platform_z"] = (ref["platform_z"][0] - 0.08,)
+    with pytest.raises(SpecError, match=r"leaves closure 'ball_\d' open by 0\.0[78]"):
+        Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))
+
+
+def test_a_reference_in_degrees_or_without_values_is_refused(built):
+    import dataclasses
+
+    mech = built("delta")
+    ref = {**mech.spec.reference, "motor_1": (45.0,)}
+    with pytest.raises(SpecError, match=r"motor_1 = 45, beyond 2 pi: angles are in rad"):
+        Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))
+    ref = {**mech.spec.reference, "motor_1": ()}  # (found by the fuzzing: an IndexError before)
+    with pytest.raises(SpecError, match=r"joint 'motor_1' takes 1 coordinate\(s\), got \(0,\)"):
+        Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))

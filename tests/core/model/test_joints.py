@@ -1,0 +1,69 @@
+"""pkm.core.model.joints: the joints a URDF writes as revolutes that ``[joint_types]`` retypes, above all the universal
+joints about any two distinct axes of the joint frame (``universal_ab``, the toolbox's ``UJOINT_AB``), checked against
+the product of the two rotations and carried through a spec's TOML and ``pkm.save``."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from pkm.core import ClosureSpec
+from pkm.core.model.joints import JOINT_TYPES, UNIVERSAL_AXES, retype_joints
+from pkm.core.model.urdf import load_model
+from pkm.errors import SpecError
+
+#: A revolute placeholder ``u`` at a turned, offset placement, between two bodies, and a joint after it.
+URDF = """<robot name="u"><link name="base"/>
+<link name="a"><inertial><mass value="0.3"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="2e-3" iyz="0" izz="3e-3"/>
+</inertial></link><link name="b"/>
+<joint name="u" type="revolute"><origin xyz="0.1 -0.2 0.3" rpy="0.4 -0.5 0.6"/><parent link="base"/>
+<child link="a"/><axis xyz="0 0 1"/><limit effort="1" velocity="20"/></joint>
+<joint name="after" type="revolute"><origin xyz="0.2 0 0"/><parent link="a"/><child link="b"/><axis xyz="0 1 0"/>
+<limit effort="1" velocity="20"/></joint></robot>"""
+AXES = {"x": np.array([1.0, 0.0, 0.0]), "y": np.array([0.0, 1.0, 0.0]), "z": np.array([0.0, 0.0, 1.0])}
+
+
+def test_the_universal_types_are_the_six_ordered_pairs_of_distinct_axes_and_universal_is_xy():
+    assert sorted(k for k in UNIVERSAL_AXES if k != "universal") == sorted(
+        f"universal_{a}{b}" for a in "xyz" for b in "xyz" if a != b)
+    assert UNIVERSAL_AXES["universal"] == ("x", "y")
+    assert set(JOINT_TYPES) == {"spherical", "fixed", *UNIVERSAL_AXES}
+
+
+@pytest.mark.parametrize("kind", sorted(UNIVERSAL_AXES))
+def test_a_retyped_universal_joint_turns_about_its_first_axis_then_its_second(kind):
+    """The child's placement is ``placement * exp(q1 [a]) exp(q2 [b])`` (1e-14) at random coordinates, and its
+    Jacobian columns are axis ``a`` turned back by the second rotation, then axis ``b`` (joint frame, 1e-14)."""
+    model = retype_joints(load_model(URDF), {"u": kind})
+    assert model.joints[1].shortname() == "JointModelUniversal" and (model.nq, model.nv) == (3, 3)
+    assert model.names[2] == "after" and model.inertias[1].mass == pytest.approx(0.3, abs=0.0)
+    a, b = (AXES[c] for c in UNIVERSAL_AXES[kind])
+    data = model.createData()
+    for q in np.random.default_rng(7).uniform(-2.0, 2.0, (4, 3)):
+        pin.forwardKinematics(model, data, q)
+        expected = model.jointPlacements[1] * pin.SE3(pin.exp3(q[0] * a) @ pin.exp3(q[1] * b), np.zeros(3))
+        assert np.abs(data.oMi[1].homogeneous - expected.homogeneous).max() <= 1e-14
+        J = pin.computeJointJacobian(model, data, q, 1)[:, :2]  # in the joint's frame
+        assert np.abs(J[3:, 0] - pin.exp3(q[1] * b).T @ a).max() <= 1e-14
+        assert np.abs(J[3:, 1] - b).max() <= 1e-14 and np.abs(J[:3]).max() <= 1e-14
+
+
+def test_an_unknown_type_is_refused_naming_the_closest():
+    model = load_model(URDF)
+    with pytest.raises(SpecError, match=r"joint_types.u = 'universal_ZY': did you mean 'universal_zy'\? use one of"):
+        retype_joints(model, {"u": "universal_ZY"})
+    with pytest.raises(SpecError, match="use one of"):
+        retype_joints(model, {"u": "universal_zz"})  # four types are as close: none is named
+
+
+def test_the_new_types_go_through_a_spec_s_toml_and_back():
+    spec = ClosureSpec.from_toml('format = "pkm.closures/1"\nmechanism = "u"\nurdf = "u.urdf"\nactuated = ["after"]\n'
+                                 '[task]\ncomponents = []\njoints = ["after"]\n'
+                                 '[joint_types]\nu = "universal_zy"\n')
+    assert spec.joint_types == {"u": "universal_zy"}
+    again = ClosureSpec.from_toml(spec.to_toml())
+    assert again == spec and '[joint_types]\nu = "universal_zy"' in spec.to_toml()
+    assert dataclasses.replace(spec, joint_types={"u": "universal_xz"}).to_toml().count("universal_xz") == 1
