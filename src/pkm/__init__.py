@@ -92,7 +92,7 @@ def load(name) -> Mechanism:
     Raises:
         UnknownNameError: ``name`` is neither registered (:data:`MECHANISMS`) nor an existing file.
         SpecError: the files are missing, damaged or do not fit together; no reader takes the path (the
-            message says why each declined: :func:`pkm.core.formats.imported.load_path`).
+            message says why each declined: :func:`pkm.core.formats.load.load_path`).
     """
     import os
     from pathlib import Path
@@ -104,7 +104,8 @@ def load(name) -> Mechanism:
             return False
 
     if isinstance(name, str) and ":" in name and not exists(name):  # "example-robot-data:cassie"
-        from pkm.core.formats.packages import PACKAGES, load_package_model
+        from pkm.core.formats.load import load_package_model
+        from pkm.core.formats.packages import PACKAGES
 
         if name.partition(":")[0] in PACKAGES:
             return load_package_model(name)
@@ -112,7 +113,7 @@ def load(name) -> Mechanism:
                                          and (name.endswith((".toml", ".yaml", ".yml", ".xml", ".mjcf", ".sdf",
                                                              ".urdf"))
                                               or exists(name))):
-        from pkm.core.formats.imported import load_path
+        from pkm.core.formats.load import load_path
 
         return load_path(Path(name))  # by content: Gepetto URDF + YAML, closure spec, MJCF or SDF
     if isinstance(name, str) and name not in MECHANISMS:

@@ -1,17 +1,36 @@
 """The closed-loop model formats pkm reads besides its own closure spec, each turned into one
-representation (:class:`~pkm.core.formats.imported.Imported`: URDF text, loops, joint types, actuators):
+representation (:class:`~pkm.core.formats.base.Imported`: URDF text, loops, joint types, actuators):
 
-* :mod:`~pkm.core.formats.gepetto`: URDF + ``robot.yaml`` in the convention of Gepetto's
-  toolbox-parallel-robots;
+* :mod:`~pkm.core.formats.gepetto`: URDF + YAML in the convention of Gepetto's toolbox-parallel-robots;
 * :mod:`~pkm.core.formats.mjcf`: MuJoCo's MJCF, loops as ``<equality>`` connect/weld;
-* :mod:`~pkm.core.formats.sdf`: SDFormat, loops as links with several parent joints.
+* :mod:`~pkm.core.formats.sdf`: SDFormat, loops as links with several parent joints;
+* :mod:`~pkm.core.formats.packages`: models an installed package ships, by name.
 
 A closure spec's ``urdf`` key may name an MJCF or SDF file as well as a URDF: the file's loops and
 joint types are added to the spec's (:func:`~pkm.core.formats.imported.import_model`).
+:mod:`~pkm.core.formats.load` makes mechanisms of them (through :mod:`pkm.core.model.builder`);
 :mod:`~pkm.core.formats.to_mjcf` writes any mechanism as MJCF (for MuJoCo, and back).
+
+The names below are imported on first use, so that importing one format module does not import the others.
 """
 
-from pkm.core.formats.gepetto import gepetto_files, load_gepetto, spec_from_gepetto
-from pkm.core.formats.imported import SUFFIXES, Imported, import_model
+from __future__ import annotations
 
-__all__ = ["SUFFIXES", "Imported", "gepetto_files", "import_model", "load_gepetto", "spec_from_gepetto"]
+from typing import TYPE_CHECKING
+
+from pkm._lazy import lazy
+
+_WHERE = {"SUFFIXES": "pkm.core.formats.base", "Imported": "pkm.core.formats.base",
+          "import_model": "pkm.core.formats.imported", "gepetto_files": "pkm.core.formats.gepetto",
+          "spec_from_gepetto": "pkm.core.formats.gepetto", "load_gepetto": "pkm.core.formats.load",
+          "load_path": "pkm.core.formats.load"}
+
+if TYPE_CHECKING:
+    from pkm.core.formats.base import SUFFIXES, Imported
+    from pkm.core.formats.gepetto import gepetto_files, spec_from_gepetto
+    from pkm.core.formats.imported import import_model
+    from pkm.core.formats.load import load_gepetto, load_path
+
+__getattr__, __dir__ = lazy("pkm.core.formats", globals(), _WHERE)
+
+__all__ = ["SUFFIXES", "Imported", "gepetto_files", "import_model", "load_gepetto", "load_path", "spec_from_gepetto"]

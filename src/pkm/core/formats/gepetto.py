@@ -35,7 +35,7 @@ from pkm.core.model.spec import MAX_FILE_BYTES, Closure, ClosureSpec, TaskSpec, 
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, closest, did_you_mean
 
 if TYPE_CHECKING:
-    from pkm.core.model.mechanism import Mechanism
+    pass
 
 _YAML_TYPES = {"3d": "point", "6d": "frame"}
 #: The toolbox's ``joint_type`` values and pkm's ``[joint_types]`` for them.
@@ -254,30 +254,11 @@ def spec_from_gepetto(yaml_text: str, urdf_name: str, joint_names: list[str], me
     return read_gepetto(yaml_text, urdf_name, joint_names, mechanism, source)[0]
 
 
-def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = ()) -> Mechanism:
-    """The :class:`~pkm.core.Mechanism` of a Gepetto-convention URDF + YAML pair (see the module doc); its
-    :attr:`~pkm.core.Mechanism.notes` say what was interpreted (``notes`` first: how the files were paired)."""
-    from pkm.core.formats.imported import import_model
-    from pkm.core.model.mechanism import Mechanism
-
-    urdf_path, yaml_path = Path(urdf_path), Path(yaml_path)
-    imported = import_model(urdf_path)
-    if imported.format != "urdf":
-        raise SpecError(str(urdf_path), f"the model beside {yaml_path.name} is {imported.format.upper()}, not URDF: "
-                                        "Gepetto's convention pairs a YAML with a URDF")
-    joints = [str(j.get("name")) for j in _joints(imported.urdf, str(urdf_path))]
-    name = urdf_path.parent.name if urdf_path.stem == "robot" else urdf_path.stem
-    spec, read = read_gepetto(read_text_file(yaml_path, "YAML"), urdf_path.name, joints, name or "robot",
-                              str(yaml_path))
-    return Mechanism.from_strings(imported.urdf, spec, source=str(yaml_path),
-                                  notes=tuple(notes) + imported.notes + read)
-
-
 def _joints(urdf: str, source: str) -> list:
     from pkm.core.model.urdf import check_urdf
 
     return check_urdf(urdf, source).findall("joint")
 
 
-__all__ = ["JOINT_TYPES", "KEYS", "MARKERS", "find_gepetto", "gepetto_files", "gepetto_yaml", "load_gepetto",
+__all__ = ["JOINT_TYPES", "KEYS", "MARKERS", "find_gepetto", "gepetto_files", "gepetto_yaml",
            "parse_yaml", "read_gepetto", "spec_from_gepetto"]

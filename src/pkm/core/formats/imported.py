@@ -1,52 +1,18 @@
-"""A model file in any format pkm reads, turned into its one representation: URDF text plus what a
-closure spec adds (loops, joint types, actuators)."""
+"""A model file in any format pkm reads, turned into its one representation (:class:`~pkm.core.formats.base.Imported`:
+URDF text plus what a closure spec adds: loops, joint types, actuators): :func:`import_model` dispatches on the
+file's root element and suffix; :func:`with_file` adds what the file states to a closure spec;
+:func:`spec_skeleton` writes a spec to fill in. Making mechanisms of them is :mod:`pkm.core.formats.load`'s."""
 
 from __future__ import annotations
 
 import dataclasses
 import re
-from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-from pkm.core.model.spec import Closure, ClosureSpec, TaskSpec, read_text_file
+from pkm.core.formats.base import SUFFIXES, Imported
+from pkm.core.model.spec import ClosureSpec, read_text_file
 from pkm.core.model.urdf import check_urdf, limit_notes
 from pkm.errors import SpecError
-
-if TYPE_CHECKING:
-    from pkm.core.model.mechanism import Mechanism
-
-#: File suffixes and the format they are read as.
-SUFFIXES = {".urdf": "urdf", ".xml": "mjcf", ".mjcf": "mjcf", ".sdf": "sdf"}
-
-
-@dataclass(frozen=True)
-class Imported:
-    """A model file read into pkm's one representation.
-
-    Attributes:
-        urdf: The tree as URDF text (frames for the closures' anchors included).
-        closures: The loops the file closes (none for a URDF).
-        joint_types: Joints URDF cannot state (``spherical``, ``universal``), for ``[joint_types]``.
-        actuated: The actuated joints the file names (empty when it names none).
-        name: The model's name.
-        format: ``"urdf"``, ``"mjcf"`` or ``"sdf"``.
-        floating_base: The free-flyer joint that carries the whole tree (an MJCF root ``<freejoint>``), or None.
-        reference: Joint values the file states (an MJCF free body's pose), for ``[reference]``.
-        notes: What the reader interpreted or ignored, one sentence each (a tendon actuator read as its joint, a
-            velocity limit read as none...): :attr:`pkm.core.Mechanism.notes` after loading.
-    """
-
-    urdf: str
-    closures: tuple[Closure, ...]
-    joint_types: dict[str, str]
-    actuated: tuple[str, ...]
-    name: str
-    format: str
-    floating_base: str | None = None
-    reference: dict[str, tuple[float, ...]] = dataclasses.field(default_factory=dict)
-    notes: tuple[str, ...] = ()
 
 
 def _root_tag(text: str) -> str | None:
@@ -93,122 +59,6 @@ def with_file(spec: ClosureSpec, imp: Imported, source: str) -> ClosureSpec:
                                joint_types={**imp.joint_types, **spec.joint_types},
                                floating_base=spec.floating_base or imp.floating_base,
                                reference={**imp.reference, **spec.reference})
-
-
-def load_model_file(path: Path):
-    """The :class:`~pkm.core.Mechanism` of an MJCF or SDF file alone: its loops, its actuators, the actuated
-    joints as the task, no end effector, assembled (:func:`pkm.assemble`).
-
-    Raises:
-        SpecError: as :func:`import_model`, or a file that names no actuated joint (SDF never does):
-            then a closure spec must say which joints are driven.
-    """
-    from pkm.core.model.mechanism import Mechanism
-
-    imp = import_model(path)
-    if not imp.actuated:
-        raise SpecError(str(path), f"the {imp.format.upper()} file names no actuated joint; write a closure spec with "
-                                   f"urdf = {path.name!r} and actuated = [...] beside it (`pkm spec init {path}` "
-                                   "writes one to fill in), and load the spec")
-    spec = ClosureSpec(mechanism=imp.name, urdf=path.name, end_effector=None, actuated=imp.actuated,
-                       closures=imp.closures, task=TaskSpec((), imp.actuated), reference=dict(imp.reference),
-                       description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types,
-                       floating_base=imp.floating_base)
-    return Mechanism.from_strings(imp.urdf, spec, source=str(path), notes=imp.notes)
-
-
-@dataclass(frozen=True)
-class Reader:
-    """One way :func:`load_path` may read a path.
-
-    Attributes:
-        name: What it reads, for the messages.
-        claim: ``claim(path)``: a function that loads the mechanism when the reader takes ``path``, else why it
-            does not (one line). It raises :class:`~pkm.errors.SpecError` when it takes ``path`` but cannot
-            tell which files go together.
-    """
-
-    name: str
-    claim: Callable[[Path], Callable[[], Mechanism] | str]
-
-
-def _gepetto(path: Path) -> Callable[[], Mechanism] | str:
-    from pkm.core.formats.gepetto import find_gepetto, load_gepetto
-
-    found = find_gepetto(path)
-    return found if isinstance(found, str) else (lambda: load_gepetto(*found))
-
-
-def _head(path: Path) -> str | None:
-    """The file's text, or None when it cannot be read as text (the readers that take it say why)."""
-    try:
-        return read_text_file(path, "file")
-    except SpecError:
-        return None
-
-
-def _closure_spec(path: Path) -> Callable[[], Mechanism] | str:
-    import tomllib
-
-    from pkm.core.model.mechanism import Mechanism
-
-    if path.is_dir():
-        specs = sorted(p.name for p in path.glob("*.toml"))
-        return "a folder: give the spec file (" + (f"it holds {', '.join(specs[:4])}" if specs else "NAME.closures.toml") + ")"
-    if path.suffix.lower() == ".toml":
-        return lambda: Mechanism.from_files(path)
-    if path.suffix.lower() in (".yaml", ".yml"):
-        return "a YAML file: a pkm closure spec is TOML (NAME.closures.toml)"
-    if path.suffix.lower() in SUFFIXES:
-        return f"a {path.suffix} file: a pkm closure spec is TOML (NAME.closures.toml)"
-    text = _head(path)
-    if text is None:
-        return "not a readable text file"
-    try:
-        raw = tomllib.loads(text)
-    except (tomllib.TOMLDecodeError, RecursionError) as exc:
-        return f"not TOML ({' '.join(str(exc).split())})"
-    if "format" not in raw:
-        return "TOML without the key format = \"pkm.closures/1\""
-    return lambda: Mechanism.from_files(path)
-
-
-def _model_file(path: Path) -> Callable[[], Mechanism] | str:
-    if path.is_dir():
-        return "a folder (give the model file)"
-    kind = SUFFIXES.get(path.suffix.lower())
-    text = _head(path)
-    root = _root_tag(text) if text is not None else None
-    if kind is None and root not in ("robot", "mujoco", "sdf"):
-        return ("not XML with a <robot>, <mujoco> or <sdf> root element" if root is None
-                else f"XML whose root element is <{root}>, not <robot>, <mujoco> or <sdf>")
-    return lambda: load_model_file(path)
-
-
-#: The readers :func:`load_path` tries, in this order; the first that takes a path reads it.
-READERS = (Reader("Gepetto URDF + YAML", _gepetto), Reader("pkm closure spec", _closure_spec),
-           Reader("model file (URDF, MJCF, SDF)", _model_file))
-
-
-def load_path(path: Path) -> Mechanism:
-    """The mechanism of a file or folder, read by the first of :data:`READERS` that takes it, by content: a folder
-    or YAML in Gepetto's convention (:mod:`pkm.core.formats.gepetto`), a closure spec (``.toml``, or TOML text
-    with a ``format`` key), an MJCF or SDF file (or a URDF alone, which then asks for a spec).
-
-    Raises:
-        SpecError: nothing at ``path``; no reader takes it (the message says, one line each, why each declined);
-            what the reader that takes it refuses.
-    """
-    path = Path(path)
-    if not path.exists():
-        raise SpecError(str(path), "no such file or folder")
-    reasons = []
-    for reader in READERS:
-        claim = reader.claim(path)
-        if not isinstance(claim, str):
-            return claim()
-        reasons.append(f"  {reader.name}: {claim}")
-    raise SpecError(str(path), "no reader takes it:\n" + "\n".join(reasons))
 
 
 def spec_skeleton(path: Path) -> tuple[str, bool]:
@@ -274,5 +124,5 @@ def spec_skeleton(path: Path) -> tuple[str, bool]:
     return "\n".join(lines), bool(imp.actuated and imp.closures)
 
 
-__all__ = ["READERS", "SUFFIXES", "Imported", "Reader", "import_model", "load_model_file", "load_path", "spec_skeleton",
+__all__ = ["SUFFIXES", "Imported", "import_model", "spec_skeleton",
            "with_file"]

@@ -63,7 +63,7 @@ import numpy as np
 import pinocchio as pin
 from lxml import etree
 
-from pkm.core.formats.imported import Imported
+from pkm.core.formats.base import Imported
 from pkm.core.model.spec import Closure
 from pkm.core.model.urdf import floats, num, parse_xml, urdf_from_model
 from pkm.errors import SpecError, SpecNameError

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING
 from pkm.errors import SpecError, UnknownNameError
 
 if TYPE_CHECKING:
-    from pkm.core.model.mechanism import Mechanism
+    pass
 
 #: The packages pkm reads models from: distribution name -> its model folder, relative to the distribution's
 #: install location (:meth:`importlib.metadata.Distribution.locate_file`).
@@ -110,23 +110,4 @@ def model_file(name: str) -> tuple[Path, Path]:
     return spec_path, path
 
 
-def load_package_model(name: str) -> Mechanism:
-    """The :class:`~pkm.core.Mechanism` of model ``name`` (``<package>:<model>``): the package's file, read where
-    it is installed, with the loops and joint types it states and the spec pkm ships (actuated joints, more joint
-    types); assembled (:func:`pkm.assemble`).
-
-    Raises:
-        UnknownNameError: no such model (the valid names listed).
-        SpecError: the package is not installed, or its file is missing or refused by its reader.
-    """
-    from pkm.core.formats.imported import import_model, with_file
-    from pkm.core.model.mechanism import Mechanism
-    from pkm.core.model.spec import ClosureSpec
-
-    spec_path, path = model_file(name)
-    imported = import_model(path)
-    spec = with_file(ClosureSpec.load(spec_path), imported, str(spec_path))
-    return Mechanism.from_strings(imported.urdf, spec, source=f"{name} ({path})", notes=imported.notes)
-
-
-__all__ = ["PACKAGES", "PACKAGE_MODELS", "PackageModel", "load_package_model", "model_file", "package_dir"]
+__all__ = ["PACKAGES", "PACKAGE_MODELS", "PackageModel", "model_file", "package_dir"]

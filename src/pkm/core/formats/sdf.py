@@ -46,7 +46,7 @@ massless link ``<gearbox>__rotor_mount``, fixed to the reference body by a joint
 which sorts after the output's (a workaround of that Pinocchio 4.1 restriction, pinned by a test). The rotor's
 SDF position limits, if any, are dropped: its coordinate is the output's. Each gearbox so read, and the joints
 whose ``<spring_stiffness>`` is left unread, are listed in :attr:`Imported.notes
-<pkm.core.formats.imported.Imported.notes>`. SDFormat booleans (``use_parent_model_frame``) are ``true`` or ``1``.
+<pkm.core.formats.base.Imported.notes>`. SDFormat booleans (``use_parent_model_frame``) are ``true`` or ``1``.
 
 Refused with a :class:`~pkm.errors.SpecError`: nested models, ``<include>``, universal and screw joints, a
 gearbox whose links do not hang on revolutes about its axes from its reference body (or with a zero or
@@ -60,7 +60,7 @@ import numpy as np
 import pinocchio as pin
 from lxml import etree
 
-from pkm.core.formats.imported import Imported
+from pkm.core.formats.base import Imported
 from pkm.core.model.spec import Closure
 from pkm.core.model.urdf import check_urdf, floats, num, origin, parse_xml
 from pkm.errors import SpecError

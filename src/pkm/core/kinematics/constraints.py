@@ -16,10 +16,14 @@ when ``J a + gamma = 0``.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.model.mechanism import Mechanism
+if TYPE_CHECKING:  # (annotations only: the mechanism module imports this one)
+    from pkm.core.model.mechanism import Mechanism
+
 
 
 def residual(mech: Mechanism, q: np.ndarray) -> np.ndarray:

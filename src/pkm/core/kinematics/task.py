@@ -14,14 +14,17 @@ world axes (``LOCAL_WORLD_ALIGNED``). Joint outputs follow in both.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.units import quantities, quantity
 from pkm.validation import ABSURD, as_array, as_vector
+
+if TYPE_CHECKING:  # (annotations only: the mechanism module imports this one)
+    from pkm.core.model.mechanism import Mechanism
 
 _ANGLES = ("roll", "pitch", "yaw")
 _POS = {"x": 0, "y": 1, "z": 2}

@@ -3,6 +3,11 @@
 :class:`Mechanism` holds no algorithm of its own beyond bookkeeping (names,
 indices, validated configuration vectors); the algorithms live in
 :mod:`pkm.core.kinematics.solve` and :mod:`pkm.core.differential.velocity` and take a mechanism.
+It is made by :mod:`pkm.core.model.builder` (:func:`~pkm.core.model.builder.build`,
+:func:`~pkm.core.model.builder.from_strings`, :func:`~pkm.core.model.builder.from_files`, also reached as
+``Mechanism.from_strings`` / ``Mechanism.from_files``), which assembles and checks its reference configuration;
+``Mechanism(model, spec)`` alone takes the spec's ``[reference]`` over the neutral configuration as it is.
+The builder is reached through :func:`importlib.import_module` (it imports this module: no import cycle).
 
 Joint coordinates follow Pinocchio: ``q`` has ``model.nq`` entries (a free-flyer
 takes 7: position and quaternion x y z w), velocities ``v`` have ``model.nv``.
@@ -13,8 +18,8 @@ by tree traversal, not by file order). Mimic joints take no coordinate.
 from __future__ import annotations
 
 import functools
+import importlib
 import threading
-import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,15 +28,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.model.joints import retype_joints
-from pkm.core.model.spec import ClosureSpec, as_path
-from pkm.core.model.urdf import load_model, position_limits
-from pkm.errors import AssemblyError, InvalidInputError, PkmWarning, SpecError, SpecNameError, UnknownNameError
+from pkm.core.model.spec import ClosureSpec
+from pkm.core.model.urdf import position_limits
+from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
 from pkm.units import quantities
 from pkm.validation import as_array, as_vector, wrap_angle
-
-#: A spec's [reference] must close every loop to this (m or rad); one that lacks joints is assembled.
-REFERENCE_TOL = 1e-9
 
 if TYPE_CHECKING:
     from pkm.core.kinematics.task import TaskMap
@@ -92,7 +93,7 @@ class Mechanism:
         self.params = params
         self.urdf = urdf
         self.source = source
-        #: What the file's reader interpreted or ignored (:attr:`pkm.core.formats.imported.Imported.notes`), and
+        #: What the file's reader interpreted or ignored (:attr:`pkm.core.formats.base.Imported.notes`), and
         #: actuators that do not fit the mobility (:func:`pkm.core.differential.velocity.actuation`).
         self.notes: tuple[str, ...] = tuple(notes)
         #: ``{joint: (lower, upper)}`` position limits stated by the URDF (none when built from a model).
@@ -169,7 +170,6 @@ class Mechanism:
             self.constraint_models.append(cm)
         self.n_constraints = sum(cm.residualSize() for cm in self.constraint_models)
 
-        missing = [n for n, j in self.joints.items() if j.nq > 0 and n not in spec.reference]
         unknown = [n for n in spec.reference if n not in self.joints]
         if unknown:
             raise SpecNameError(source, "joint", unknown[0], list(self.joints), "[reference]")
@@ -182,30 +182,8 @@ class Mechanism:
             self.q_reference = self.check_q(self.q_from_dict(spec.reference, base=pin.neutral(model)), "[reference]")
         except InvalidInputError as exc:
             raise SpecError(source, f"{exc}; fix the [reference] table of the closure spec") from None
-        if missing:  # a partial (or no) reference: assembled from it, the other joints from the neutral configuration
-            from pkm.core.kinematics.solve import assemble  # (solve imports this module)
-
-            try:
-                self.q_reference = assemble(self, self.q_reference, hold=tuple(spec.reference), tol=1e-12).q
-            except AssemblyError as exc:
-                if not spec.reference:  # (the file states no configuration: the loops themselves do not close)
-                    raise SpecError(source, f"the loops cannot be closed: {exc}") from exc  # (its closures, gaps)
-                raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found that keeps the "
-                                        f"joints it states, the others starting from the neutral configuration "
-                                        f"({exc}); give an assembled [reference]") from None
-        elif (worst := self._worst_closure(self.q_reference))[0] > REFERENCE_TOL:
-            gap, closure = worst
-            raise SpecError(source, f"the [reference] configuration leaves closure {closure!r} open by {gap:.3g} "
-                                    f"(m or rad; closed means <= {REFERENCE_TOL:g}): fix it, or leave joints out of "
-                                    "[reference] to have pkm assemble the mechanism (pkm.assemble)")
-        from pkm.core.differential.velocity import actuation  # (differential imports this module)
-
-        fit = actuation(self)
-        #: Actuators whose values the others fix at the reference (redundant actuation): see ``notes``.
-        self.dependent_actuators: tuple[str, ...] = fit.dependent
-        if fit.problem:
-            self.notes += (f"at the reference configuration, {fit.problem}",)
-            warnings.warn(f"{source}: at the reference configuration, {fit.problem}", PkmWarning, stacklevel=2)
+        #: Actuators whose values the others fix at the reference (redundant actuation), set by the builder.
+        self.dependent_actuators: tuple[str, ...] = ()
 
     def outside_limits(self, q, *, tol: float = 1e-9) -> tuple[str, ...]:
         """The joints whose coordinate in ``q`` lies outside their stated position limits by more than ``tol``
@@ -213,13 +191,6 @@ class Mechanism:
         q = np.asarray(q, dtype=float)
         return tuple(n for n, (lo, hi) in self.limits.items()
                      if n in self.joints and not lo - tol <= q[self.joints[n].idx_q] <= hi + tol)
-
-    def _worst_closure(self, q: np.ndarray) -> tuple[float, str | None]:
-        """The largest closure gap at ``q`` (m or rad) and the closure's name (:func:`pkm.core.kinematics.constraints.worst_closure`)."""
-        from pkm.core.kinematics import constraints  # (constraints imports this module)
-
-        gap, _, name = constraints.worst_closure(self, constraints.residual(self, q))
-        return gap, name
 
     # ------------------------------------------------------------------ per-thread data, pickling
     @property
@@ -251,57 +222,20 @@ class Mechanism:
         if self.urdf is None:
             raise InvalidInputError("mech", "a Mechanism built from a pinocchio.Model (no URDF text) cannot be "
                                             "pickled; build it with Mechanism.from_strings or from_files", self)
-        return (_rebuild, (self.urdf, self.spec.to_toml(), self.params, self.source))
+        return (importlib.import_module("pkm.core.model.builder").rebuild,
+                (self.urdf, self.spec.to_toml(), self.params, self.source))
 
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_strings(cls, urdf: str, spec: ClosureSpec | str, params: Any = None,
                      source: str = "<string>", notes: tuple[str, ...] = ()) -> Mechanism:
-        """Build from URDF text and a spec (object or TOML text); ``notes``: what the reader of its files interpreted
-        or ignored (:attr:`notes`).
-
-        Raises:
-            SpecError: The URDF or the spec is malformed, or they do not fit together (see
-                :mod:`pkm.core.model.urdf` and :mod:`pkm.core.model.spec` for what the loaders refuse).
-            InvalidInputError: ``urdf`` is not a string, ``spec`` neither a string nor a ClosureSpec.
-        """
-        if not isinstance(urdf, str):
-            raise InvalidInputError("urdf", f"expected the URDF text as a str, got {type(urdf).__name__}", urdf)
-        if not isinstance(spec, (str, ClosureSpec)):
-            raise InvalidInputError("spec", f"expected a ClosureSpec or its TOML text, got {type(spec).__name__}",
-                                    spec)
-        if isinstance(spec, str):
-            spec = ClosureSpec.from_toml(spec, source + " (closures)")
-        return cls(retype_joints(load_model(urdf, source), spec.joint_types, source), spec, params, urdf, source,
-                   notes)
+        """:func:`pkm.core.model.builder.from_strings`: built from URDF text and a spec, assembled and checked."""
+        return importlib.import_module("pkm.core.model.builder").from_strings(urdf, spec, params, source, notes)
 
     @classmethod
     def from_files(cls, spec_path: str | Path) -> Mechanism:
-        """Load ``<name>.closures.toml`` and the model file it names (path relative to the spec): a URDF, or an
-        MJCF or SDF file whose own loops and joint types are added to the spec's (:mod:`pkm.core.formats`).
-
-        The spec's ``urdf`` must stay inside the spec's folder once symbolic links are resolved;
-        nothing else is read (see :mod:`pkm.core.model.spec`).
-
-        Raises:
-            SpecError: A file is missing, too large, malformed, or the URDF path leaves the folder.
-        """
-        spec_path = as_path(spec_path, "spec_path")
-        spec = ClosureSpec.load(spec_path)
-        try:
-            folder = spec_path.parent.resolve()
-            urdf_path = (folder / spec.urdf).resolve()
-        except (OSError, RuntimeError) as exc:  # a loop of symbolic links
-            raise SpecError(str(spec_path), f"cannot resolve urdf = {spec.urdf!r}: {exc}") from None
-        if not urdf_path.is_relative_to(folder):
-            raise SpecError(str(spec_path), f"urdf = {spec.urdf!r} resolves to {urdf_path}, outside the spec's folder "
-                                            f"{folder}; copy the URDF next to the spec")
-        from pkm.core.formats.imported import import_model, with_file  # (formats import this module)
-
-        imported = import_model(urdf_path)
-        spec = with_file(spec, imported, str(spec_path))
-        model = retype_joints(load_model(imported.urdf, str(urdf_path)), spec.joint_types, str(spec_path))
-        return cls(model, spec, None, imported.urdf, str(spec_path), imported.notes)
+        """:func:`pkm.core.model.builder.from_files`: a closure spec and the model file it names."""
+        return importlib.import_module("pkm.core.model.builder").from_files(spec_path)
 
     # ------------------------------------------------------------------ sizes and names
     @property
@@ -444,11 +378,6 @@ class Mechanism:
         return (f"Mechanism({self.name!r}: nq={self.nq}, nv={self.nv}, actuated={list(self.actuated_names)}, "
                 f"closures={len(self.spec.closures)} ({self.n_constraints} equations), "
                 f"task={list(self.spec.task.components) + list(self.spec.task.joints)})")
-
-
-def _rebuild(urdf: str, spec: str, params: Any, source: str) -> Mechanism:
-    """Unpickling: the mechanism again from its URDF and spec texts."""
-    return Mechanism.from_strings(urdf, spec, params, source=source)
 
 
 def _frame_id(model: pin.Model, name, source: str) -> int | None:

@@ -119,23 +119,25 @@ Masses are not given by the paper; the defaults are illustrative and only matter
 from __future__ import annotations
 
 from pkm.core.kinematics.task import ROTATION_TOL
-from pkm.mechanisms.hexapod.kinematics import (
-    AssemblyMode,
+from pkm.mechanisms.hexapod.geometry import (
     actuated_from_paper,
-    assembly_modes,
     base_points,
     branch_names,
+    elbow_points,
+    inverse_kinematics,
+    paper_alphas,
+    platform_local_points,
+    platform_points,
+)
+from pkm.mechanisms.hexapod.kinematics import (
+    AssemblyMode,
+    assembly_modes,
     closed_form_configuration,
     closed_form_fk,
     closed_form_ik,
     configuration,
-    elbow_points,
     forward_kinematics,
-    inverse_kinematics,
     joint_values,
-    paper_alphas,
-    platform_local_points,
-    platform_points,
     pose_from_points,
     reference_pose,
     task_vector,

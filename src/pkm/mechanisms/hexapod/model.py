@@ -15,7 +15,8 @@ from pkm.mechanisms._common import (
     rod_inertia,
     spec_parameters,
 )
-from pkm.mechanisms.hexapod.kinematics import base_points, joint_values, platform_local_points, reference_pose
+from pkm.mechanisms.hexapod.geometry import base_points, platform_local_points
+from pkm.mechanisms.hexapod.kinematics import joint_values, reference_pose
 from pkm.mechanisms.hexapod.params import (
     ACTUATED,
     BRANCHES,

@@ -45,8 +45,9 @@ import numpy as np
 from pkm.core.differential import screws
 from pkm.core.kinematics.task import as_rotation
 from pkm.errors import InvalidInputError, SingularityError
-from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms._common import circle_sphere_cs
+from pkm.mechanisms.hexapod import geometry as hx
+from pkm.mechanisms.hexapod import params as hp
 from pkm.validation import as_vector
 
 #: Chain order of the screws of a leg (rows of :func:`leg_screws`).
@@ -54,13 +55,13 @@ CHAIN = ("r", "1", "2", "3", "4", "5", "6", "f")
 
 
 @functools.lru_cache(maxsize=32)
-def leg_axes(params: hx.HexapodParams) -> np.ndarray:
+def leg_axes(params: hp.HexapodParams) -> np.ndarray:
     """Leg frames ``(e_r, e_y, u_i)`` as columns, stacked ``(6, 3, 3)``."""
-    return np.stack([hx.leg_frame(th) for th in params.theta])
+    return np.stack([hp.leg_frame(th) for th in params.theta])
 
 
 @functools.lru_cache(maxsize=32)
-def _trig(params: hx.HexapodParams) -> tuple[np.ndarray, np.ndarray]:
+def _trig(params: hp.HexapodParams) -> tuple[np.ndarray, np.ndarray]:
     th = np.asarray(params.theta)
     return np.cos(th), np.sin(th)
 
@@ -115,7 +116,7 @@ class LegBatch:
         return np.arctan2(self.sin_a, self.cos_a)
 
 
-def leg_batch(params: hx.HexapodParams, C: np.ndarray, beta, signs: np.ndarray) -> LegBatch:
+def leg_batch(params: hp.HexapodParams, C: np.ndarray, beta, signs: np.ndarray) -> LegBatch:
     """Closed-form inverse kinematics of the six legs, vectorised over a batch.
 
     In leg frame ``(e_r, e_y, u)`` with ``d = C - A``: ``(cos alpha, sin alpha)`` of
@@ -204,7 +205,7 @@ class ScrewJacobians:
         return _refer(J, point, self.P)
 
 
-def jacobians(params: hx.HexapodParams, R, P, beta: float, branch=hx.DEFAULT_BRANCH) -> ScrewJacobians:
+def jacobians(params: hp.HexapodParams, R, P, beta: float, branch=hp.DEFAULT_BRANCH) -> ScrewJacobians:
     """``J_x``, ``J_q``, ``J'_q`` of eqs. (23)-(25) for a platform pose and ``beta`` [rad].
 
     Raises:
@@ -215,13 +216,13 @@ def jacobians(params: hx.HexapodParams, R, P, beta: float, branch=hx.DEFAULT_BRA
     return ScrewJacobians(screws.DELTA @ M.T, np.diag(jq), np.diag(jqp), np.asarray(P, dtype=float))
 
 
-def leg_screws(params: hx.HexapodParams, R, P, beta: float, branch=hx.DEFAULT_BRANCH) -> np.ndarray:
+def leg_screws(params: hp.HexapodParams, R, P, beta: float, branch=hp.DEFAULT_BRANCH) -> np.ndarray:
     """The joint screws of every leg in chain order :data:`CHAIN`, shape (6, 8, 6) (pole O)."""
     legs, _ = _legs(params, R, P, beta, branch)
     return _chain_screws(params, legs)
 
 
-def _chain_screws(params: hx.HexapodParams, legs: LegBatch) -> np.ndarray:
+def _chain_screws(params: hp.HexapodParams, legs: LegBatch) -> np.ndarray:
     u = leg_axes(params)[:, :, 2]
     v = screws.cross(legs.w, u)
     v /= np.linalg.norm(v, axis=-1, keepdims=True)
@@ -234,7 +235,7 @@ def _chain_screws(params: hx.HexapodParams, legs: LegBatch) -> np.ndarray:
     return S
 
 
-def twist(params: hx.HexapodParams, R, P, beta: float, qd, branch=hx.DEFAULT_BRANCH,
+def twist(params: hp.HexapodParams, R, P, beta: float, qd, branch=hp.DEFAULT_BRANCH,
           point: str = "O") -> np.ndarray:
     """Platform twist ``[w; v]`` [rad/s, m/s] for actuated rates ``qd`` (eq. 22); ``point`` as in
     :meth:`ScrewJacobians.twist_jacobian`."""
@@ -242,7 +243,7 @@ def twist(params: hx.HexapodParams, R, P, beta: float, qd, branch=hx.DEFAULT_BRA
     return jacobians(params, R, P, beta, branch).twist_jacobian(point) @ qd
 
 
-def leg_rates(params: hx.HexapodParams, R, P, beta: float, qd, branch=hx.DEFAULT_BRANCH) -> np.ndarray:
+def leg_rates(params: hp.HexapodParams, R, P, beta: float, qd, branch=hp.DEFAULT_BRANCH) -> np.ndarray:
     """Every joint rate of every leg, in chain order :data:`CHAIN`, shape (6, 8) [rad/s, m/s].
 
     The passive rates solve eq. (18)/(19), ``V - beta_dot $r - alpha_dot $1 = [$2..$6 $f] w``,
@@ -273,8 +274,8 @@ def _rates(params, legs: LegBatch, beta: float, S: np.ndarray, qd: np.ndarray) -
     return known
 
 
-def complementary_acceleration(params: hx.HexapodParams, R, P, beta: float, qd,
-                               branch=hx.DEFAULT_BRANCH) -> np.ndarray:
+def complementary_acceleration(params: hp.HexapodParams, R, P, beta: float, qd,
+                               branch=hp.DEFAULT_BRANCH) -> np.ndarray:
     """The complementary acceleration ``C = [{L_i; $6_i}]`` of eq. (33), shape (6,) [m/s^2]."""
     qd = as_vector(qd, 7, "qd")
     legs, beta = _legs(params, R, P, beta, branch)
@@ -283,7 +284,7 @@ def complementary_acceleration(params: hx.HexapodParams, R, P, beta: float, qd,
     return np.asarray(screws.klein(L, S[:, 6]))
 
 
-def acceleration(params: hx.HexapodParams, R, P, beta: float, qd, qdd, branch=hx.DEFAULT_BRANCH) -> np.ndarray:
+def acceleration(params: hp.HexapodParams, R, P, beta: float, qd, qdd, branch=hp.DEFAULT_BRANCH) -> np.ndarray:
     """Reduced acceleration ``A = [w_dot; a_O - w x v_O]`` of the platform (eqs. 26, 33).
 
     Args:
@@ -309,7 +310,7 @@ def _legs(params, R, P, beta, branch) -> tuple[LegBatch, float]:
     R = as_rotation(R)
     P = as_vector(P, 3, "P")
     hx.inverse_kinematics(params, R, P, beta, branch)  # validates, raises UnreachableError with the leg
-    signs = np.array([-hx.BRANCHES[b] for b in hx.branch_names(branch)], dtype=float)
+    signs = np.array([-hp.BRANCHES[b] for b in hx.branch_names(branch)], dtype=float)
     return leg_batch(params, hx.platform_points(params, R, P), beta, signs), beta
 
 

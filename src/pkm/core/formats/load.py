@@ -1,0 +1,171 @@
+"""Loading a mechanism from files: every reader's result put through the builder
+(:mod:`pkm.core.model.builder`). :func:`load_path` (behind :func:`pkm.load`) tries :data:`READERS` in order on a
+file or folder, by content; :func:`load_model_file` reads an MJCF or SDF file alone; :func:`load_gepetto` a
+Gepetto URDF + YAML pair; :func:`load_package_model` a model an installed package ships, by name.
+
+The readers themselves (:mod:`~pkm.core.formats.imported`, :mod:`~pkm.core.formats.gepetto`,
+:mod:`~pkm.core.formats.packages`) only read files; this module, above the builder, makes mechanisms of them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from pkm.core.formats.base import SUFFIXES
+from pkm.core.formats.gepetto import _joints, find_gepetto, read_gepetto
+from pkm.core.formats.imported import _root_tag, import_model, with_file
+from pkm.core.formats.packages import model_file
+from pkm.core.model.builder import from_files, from_strings
+from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.spec import ClosureSpec, TaskSpec, read_text_file
+from pkm.errors import SpecError
+
+
+def load_model_file(path: Path):
+    """The :class:`~pkm.core.Mechanism` of an MJCF or SDF file alone: its loops, its actuators, the actuated
+    joints as the task, no end effector, assembled (:func:`pkm.assemble`).
+
+    Raises:
+        SpecError: as :func:`import_model`, or a file that names no actuated joint (SDF never does):
+            then a closure spec must say which joints are driven.
+    """
+
+    imp = import_model(path)
+    if not imp.actuated:
+        raise SpecError(str(path), f"the {imp.format.upper()} file names no actuated joint; write a closure spec with "
+                                   f"urdf = {path.name!r} and actuated = [...] beside it (`pkm spec init {path}` "
+                                   "writes one to fill in), and load the spec")
+    spec = ClosureSpec(mechanism=imp.name, urdf=path.name, end_effector=None, actuated=imp.actuated,
+                       closures=imp.closures, task=TaskSpec((), imp.actuated), reference=dict(imp.reference),
+                       description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types,
+                       floating_base=imp.floating_base)
+    return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes)
+
+
+@dataclass(frozen=True)
+class Reader:
+    """One way :func:`load_path` may read a path.
+
+    Attributes:
+        name: What it reads, for the messages.
+        claim: ``claim(path)``: a function that loads the mechanism when the reader takes ``path``, else why it
+            does not (one line). It raises :class:`~pkm.errors.SpecError` when it takes ``path`` but cannot
+            tell which files go together.
+    """
+
+    name: str
+    claim: Callable[[Path], Callable[[], Mechanism] | str]
+
+
+def _gepetto(path: Path) -> Callable[[], Mechanism] | str:
+    found = find_gepetto(path)
+    return found if isinstance(found, str) else (lambda: load_gepetto(*found))
+
+
+def _head(path: Path) -> str | None:
+    """The file's text, or None when it cannot be read as text (the readers that take it say why)."""
+    try:
+        return read_text_file(path, "file")
+    except SpecError:
+        return None
+
+
+def _closure_spec(path: Path) -> Callable[[], Mechanism] | str:
+    import tomllib
+
+
+    if path.is_dir():
+        specs = sorted(p.name for p in path.glob("*.toml"))
+        return "a folder: give the spec file (" + (f"it holds {', '.join(specs[:4])}" if specs else "NAME.closures.toml") + ")"
+    if path.suffix.lower() == ".toml":
+        return lambda: from_files(path)
+    if path.suffix.lower() in (".yaml", ".yml"):
+        return "a YAML file: a pkm closure spec is TOML (NAME.closures.toml)"
+    if path.suffix.lower() in SUFFIXES:
+        return f"a {path.suffix} file: a pkm closure spec is TOML (NAME.closures.toml)"
+    text = _head(path)
+    if text is None:
+        return "not a readable text file"
+    try:
+        raw = tomllib.loads(text)
+    except (tomllib.TOMLDecodeError, RecursionError) as exc:
+        return f"not TOML ({' '.join(str(exc).split())})"
+    if "format" not in raw:
+        return "TOML without the key format = \"pkm.closures/1\""
+    return lambda: from_files(path)
+
+
+def _model_file(path: Path) -> Callable[[], Mechanism] | str:
+    if path.is_dir():
+        return "a folder (give the model file)"
+    kind = SUFFIXES.get(path.suffix.lower())
+    text = _head(path)
+    root = _root_tag(text) if text is not None else None
+    if kind is None and root not in ("robot", "mujoco", "sdf"):
+        return ("not XML with a <robot>, <mujoco> or <sdf> root element" if root is None
+                else f"XML whose root element is <{root}>, not <robot>, <mujoco> or <sdf>")
+    return lambda: load_model_file(path)
+
+
+#: The readers :func:`load_path` tries, in this order; the first that takes a path reads it.
+READERS = (Reader("Gepetto URDF + YAML", _gepetto), Reader("pkm closure spec", _closure_spec),
+           Reader("model file (URDF, MJCF, SDF)", _model_file))
+
+
+def load_path(path: Path) -> Mechanism:
+    """The mechanism of a file or folder, read by the first of :data:`READERS` that takes it, by content: a folder
+    or YAML in Gepetto's convention (:mod:`pkm.core.formats.gepetto`), a closure spec (``.toml``, or TOML text
+    with a ``format`` key), an MJCF or SDF file (or a URDF alone, which then asks for a spec).
+
+    Raises:
+        SpecError: nothing at ``path``; no reader takes it (the message says, one line each, why each declined);
+            what the reader that takes it refuses.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise SpecError(str(path), "no such file or folder")
+    reasons = []
+    for reader in READERS:
+        claim = reader.claim(path)
+        if not isinstance(claim, str):
+            return claim()
+        reasons.append(f"  {reader.name}: {claim}")
+    raise SpecError(str(path), "no reader takes it:\n" + "\n".join(reasons))
+
+
+def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = ()) -> Mechanism:
+    """The :class:`~pkm.core.Mechanism` of a Gepetto-convention URDF + YAML pair (see the module doc); its
+    :attr:`~pkm.core.Mechanism.notes` say what was interpreted (``notes`` first: how the files were paired)."""
+
+    urdf_path, yaml_path = Path(urdf_path), Path(yaml_path)
+    imported = import_model(urdf_path)
+    if imported.format != "urdf":
+        raise SpecError(str(urdf_path), f"the model beside {yaml_path.name} is {imported.format.upper()}, not URDF: "
+                                        "Gepetto's convention pairs a YAML with a URDF")
+    joints = [str(j.get("name")) for j in _joints(imported.urdf, str(urdf_path))]
+    name = urdf_path.parent.name if urdf_path.stem == "robot" else urdf_path.stem
+    spec, read = read_gepetto(read_text_file(yaml_path, "YAML"), urdf_path.name, joints, name or "robot",
+                              str(yaml_path))
+    return from_strings(imported.urdf, spec, source=str(yaml_path),
+                                  notes=tuple(notes) + imported.notes + read)
+
+
+def load_package_model(name: str) -> Mechanism:
+    """The :class:`~pkm.core.Mechanism` of model ``name`` (``<package>:<model>``): the package's file, read where
+    it is installed, with the loops and joint types it states and the spec pkm ships (actuated joints, more joint
+    types); assembled (:func:`pkm.assemble`).
+
+    Raises:
+        UnknownNameError: no such model (the valid names listed).
+        SpecError: the package is not installed, or its file is missing or refused by its reader.
+    """
+
+    spec_path, path = model_file(name)
+    imported = import_model(path)
+    spec = with_file(ClosureSpec.load(spec_path), imported, str(spec_path))
+    return from_strings(imported.urdf, spec, source=f"{name} ({path})", notes=imported.notes)
+
+
+__all__ = ["READERS", "Reader", "load_gepetto", "load_model_file", "load_package_model", "load_path"]

@@ -1,0 +1,125 @@
+"""Building a :class:`~pkm.core.model.mechanism.Mechanism`: the tree and spec put together, the reference
+configuration assembled where the spec leaves joints out and checked where it states them all, the actuators
+weighed against the mobility.
+
+* :func:`build`: a Pinocchio model and a spec;
+* :func:`from_strings`: URDF text and a spec (object or TOML text);
+* :func:`from_files`: a closure spec and the model file it names (URDF, MJCF, SDF: :mod:`pkm.core.formats`);
+* :func:`rebuild`: unpickling (a mechanism pickles as its URDF and spec texts).
+
+A reference that lacks joints is assembled from the joints it states (held) and the neutral configuration
+(:func:`pkm.core.kinematics.solve.assemble`); a complete one must close every loop to :data:`REFERENCE_TOL`.
+Actuators that depend on the others, or freedom no actuator drives (:func:`pkm.core.differential.velocity.actuation`),
+are reported by a :class:`~pkm.errors.PkmWarning` and in :attr:`Mechanism.notes`.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from typing import Any
+
+import pinocchio as pin
+
+from pkm.core.differential.velocity import actuation
+from pkm.core.formats.imported import import_model, with_file
+from pkm.core.kinematics import constraints
+from pkm.core.kinematics.solve import assemble
+from pkm.core.model.joints import retype_joints
+from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.spec import ClosureSpec, as_path
+from pkm.core.model.urdf import load_model
+from pkm.errors import AssemblyError, InvalidInputError, PkmWarning, SpecError
+
+#: A spec's [reference] must close every loop to this (m or rad); one that lacks joints is assembled.
+REFERENCE_TOL = 1e-9
+
+
+def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | None = None,
+          source: str = "<model>", notes: tuple[str, ...] = ()) -> Mechanism:
+    """The mechanism of ``model`` and ``spec``, its reference assembled or checked (module doc).
+
+    Raises:
+        SpecError: the spec does not fit the model; no assembly keeps the joints a partial ``[reference]`` states
+            (or, with none stated, the loops cannot close: each open loop named with its gap, the
+            :class:`~pkm.errors.AssemblyError` as the cause); a complete ``[reference]`` leaves a loop open.
+    """
+    mech = Mechanism(model, spec, params, urdf, source, notes)
+    missing = [n for n, j in mech.joints.items() if j.nq > 0 and n not in spec.reference]
+    if missing:  # a partial (or no) reference: assembled from it, the other joints from the neutral configuration
+        try:
+            mech.q_reference = assemble(mech, mech.q_reference, hold=tuple(spec.reference), tol=1e-12).q
+        except AssemblyError as exc:
+            if not spec.reference:  # (the file states no configuration: the loops themselves do not close)
+                raise SpecError(source, f"the loops cannot be closed: {exc}") from exc  # (its closures, gaps)
+            raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found that keeps the "
+                                    f"joints it states, the others starting from the neutral configuration "
+                                    f"({exc}); give an assembled [reference]") from None
+    else:
+        gap, _, closure = constraints.worst_closure(mech, constraints.residual(mech, mech.q_reference))
+        if gap > REFERENCE_TOL:
+            raise SpecError(source, f"the [reference] configuration leaves closure {closure!r} open by {gap:.3g} "
+                                    f"(m or rad; closed means <= {REFERENCE_TOL:g}): fix it, or leave joints out of "
+                                    "[reference] to have pkm assemble the mechanism (pkm.assemble)")
+    fit = actuation(mech)
+    mech.dependent_actuators = fit.dependent
+    if fit.problem:
+        mech.notes += (f"at the reference configuration, {fit.problem}",)
+        warnings.warn(f"{source}: at the reference configuration, {fit.problem}", PkmWarning, stacklevel=3)
+    return mech
+
+
+def from_strings(urdf: str, spec: ClosureSpec | str, params: Any = None, source: str = "<string>",
+                 notes: tuple[str, ...] = ()) -> Mechanism:
+    """Build from URDF text and a spec (object or TOML text); ``notes``: what the reader of its files interpreted
+    or ignored (:attr:`Mechanism.notes`).
+
+    Raises:
+        SpecError: The URDF or the spec is malformed, or they do not fit together (see
+            :mod:`pkm.core.model.urdf` and :mod:`pkm.core.model.spec` for what the loaders refuse), or as
+            :func:`build`.
+        InvalidInputError: ``urdf`` is not a string, ``spec`` neither a string nor a ClosureSpec.
+    """
+    if not isinstance(urdf, str):
+        raise InvalidInputError("urdf", f"expected the URDF text as a str, got {type(urdf).__name__}", urdf)
+    if not isinstance(spec, (str, ClosureSpec)):
+        raise InvalidInputError("spec", f"expected a ClosureSpec or its TOML text, got {type(spec).__name__}",
+                                spec)
+    if isinstance(spec, str):
+        spec = ClosureSpec.from_toml(spec, source + " (closures)")
+    return build(retype_joints(load_model(urdf, source), spec.joint_types, source), spec, params, urdf, source,
+                 notes)
+
+
+def from_files(spec_path: str | Path) -> Mechanism:
+    """Load ``<name>.closures.toml`` and the model file it names (path relative to the spec): a URDF, or an
+    MJCF or SDF file whose own loops and joint types are added to the spec's (:mod:`pkm.core.formats`).
+
+    The spec's ``urdf`` must stay inside the spec's folder once symbolic links are resolved;
+    nothing else is read (see :mod:`pkm.core.model.spec`).
+
+    Raises:
+        SpecError: A file is missing, too large, malformed, or the URDF path leaves the folder; or as :func:`build`.
+    """
+    spec_path = as_path(spec_path, "spec_path")
+    spec = ClosureSpec.load(spec_path)
+    try:
+        folder = spec_path.parent.resolve()
+        urdf_path = (folder / spec.urdf).resolve()
+    except (OSError, RuntimeError) as exc:  # a loop of symbolic links
+        raise SpecError(str(spec_path), f"cannot resolve urdf = {spec.urdf!r}: {exc}") from None
+    if not urdf_path.is_relative_to(folder):
+        raise SpecError(str(spec_path), f"urdf = {spec.urdf!r} resolves to {urdf_path}, outside the spec's folder "
+                                        f"{folder}; copy the URDF next to the spec")
+    imported = import_model(urdf_path)
+    spec = with_file(spec, imported, str(spec_path))
+    model = retype_joints(load_model(imported.urdf, str(urdf_path)), spec.joint_types, str(spec_path))
+    return build(model, spec, None, imported.urdf, str(spec_path), imported.notes)
+
+
+def rebuild(urdf: str, spec: str, params: Any, source: str) -> Mechanism:
+    """Unpickling: the mechanism again from its URDF and spec texts."""
+    return from_strings(urdf, spec, params, source=source)
+
+
+__all__ = ["REFERENCE_TOL", "build", "from_files", "from_strings", "rebuild"]
