@@ -109,10 +109,10 @@ def load(name) -> Mechanism:
 
         if name.partition(":")[0] in PACKAGES:
             return load_package_model(name)
+    from pkm.core.formats.base import suffixes
+
     if isinstance(name, os.PathLike) or (isinstance(name, str) and name not in MECHANISMS
-                                         and (name.endswith((".toml", ".yaml", ".yml", ".xml", ".mjcf", ".sdf",
-                                                             ".urdf"))
-                                              or exists(name))):
+                                         and (name.endswith((".toml", ".yaml", ".yml", *suffixes())) or exists(name))):
         from pkm.core.formats.load import load_path
 
         return load_path(Path(name))  # by content: Gepetto URDF + YAML, closure spec, MJCF or SDF

@@ -20,17 +20,18 @@ from typing import TYPE_CHECKING
 
 from pkm._lazy import lazy
 
-_WHERE = {"SUFFIXES": "pkm.core.formats.base", "Imported": "pkm.core.formats.base",
+_WHERE = {"FORMATS": "pkm.core.formats.base", "Format": "pkm.core.formats.base", "register_format": "pkm.core.formats.base",
+          "SUFFIXES": "pkm.core.formats.base", "Imported": "pkm.core.formats.base",
           "import_model": "pkm.core.formats.imported", "gepetto_files": "pkm.core.formats.gepetto",
           "spec_from_gepetto": "pkm.core.formats.gepetto", "load_gepetto": "pkm.core.formats.load",
           "load_path": "pkm.core.formats.load"}
 
 if TYPE_CHECKING:
-    from pkm.core.formats.base import SUFFIXES, Imported
+    from pkm.core.formats.base import FORMATS, SUFFIXES, Format, Imported, register_format
     from pkm.core.formats.gepetto import gepetto_files, spec_from_gepetto
     from pkm.core.formats.imported import import_model
     from pkm.core.formats.load import load_gepetto, load_path
 
 __getattr__, __dir__ = lazy("pkm.core.formats", globals(), _WHERE)
 
-__all__ = ["SUFFIXES", "Imported", "gepetto_files", "import_model", "load_gepetto", "load_path", "spec_from_gepetto"]
+__all__ = ["FORMATS", "SUFFIXES", "Format", "Imported", "gepetto_files", "import_model", "load_gepetto", "load_path", "register_format", "spec_from_gepetto"]

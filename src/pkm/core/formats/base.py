@@ -1,17 +1,21 @@
-"""What every model-file reader gives: :class:`Imported`, pkm's one representation of a model file (URDF text plus
-what a closure spec adds: loops, joint types, actuators), and the file suffixes the readers take. The readers
-(:mod:`~pkm.core.formats.mjcf`, :mod:`~pkm.core.formats.sdf`) import this module, the dispatcher
-(:mod:`~pkm.core.formats.imported`) imports them: no import cycle."""
+"""What every model-file reader gives and where the readers are registered.
+
+:class:`Imported` is pkm's one representation of a model file (URDF text plus what a closure spec adds: loops,
+joint types, actuators). :data:`FORMATS` is the one table of model-file formats: each :class:`Format` names its
+suffixes, its XML root element and its reader (a function ``read(text, source) -> Imported``, named as
+``"module:function"`` and imported on first use). :func:`pkm.load`, ``pkm spec init`` and the command line go
+through it (:func:`~pkm.core.formats.imported.import_model`), so adding a format is one reader module and one
+:func:`register_format` call (or one line of :data:`FORMATS`). The readers import this module, the dispatcher
+imports them on use: no import cycle."""
 
 from __future__ import annotations
 
 import dataclasses
+import importlib
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from pkm.core.model.spec import Closure
-
-#: File suffixes and the format they are read as.
-SUFFIXES = {".urdf": "urdf", ".xml": "mjcf", ".mjcf": "mjcf", ".sdf": "sdf"}
 
 
 @dataclass(frozen=True)
@@ -42,4 +46,63 @@ class Imported:
     notes: tuple[str, ...] = ()
 
 
-__all__ = ["SUFFIXES", "Imported"]
+@dataclass(frozen=True)
+class Format:
+    """A model-file format pkm reads.
+
+    Attributes:
+        name: Its name (``"mjcf"``), as :attr:`Imported.format` gives it.
+        suffixes: The file suffixes read as this format when the root element says nothing (lower case, with the dot).
+        root: The XML root element that identifies it (``"mujoco"``), whatever the suffix.
+        reader: ``read(text, source) -> Imported``, or its ``"module:function"`` name (imported on first use).
+    """
+
+    name: str
+    suffixes: tuple[str, ...]
+    root: str
+    reader: str | Callable[[str, str], Imported]
+
+    def read(self, text: str, source: str) -> Imported:
+        """The file's text read by this format's reader."""
+        reader = self.reader
+        if isinstance(reader, str):
+            module, _, function = reader.partition(":")
+            reader = getattr(importlib.import_module(module), function)
+        return reader(text, source)
+
+
+#: The model-file formats, by name (:func:`register_format` adds one); the first is the default of a file whose
+#: suffix and root element say nothing.
+FORMATS: dict[str, Format] = {
+    "urdf": Format("urdf", (".urdf",), "robot", "pkm.core.formats.imported:read_urdf"),
+    "mjcf": Format("mjcf", (".xml", ".mjcf"), "mujoco", "pkm.core.formats.mjcf:read_mjcf"),
+    "sdf": Format("sdf", (".sdf",), "sdf", "pkm.core.formats.sdf:read_sdf"),
+}
+
+
+def register_format(fmt: Format) -> None:
+    """Add ``fmt`` to :data:`FORMATS` (replacing one of the same name)."""
+    if not isinstance(fmt, Format):
+        from pkm.errors import InvalidInputError
+
+        raise InvalidInputError("fmt", f"expected a pkm.core.formats.base.Format, got {type(fmt).__name__}", fmt)
+    FORMATS[fmt.name] = fmt
+
+
+def suffixes() -> dict[str, str]:
+    """``{suffix: format name}`` of every registered format."""
+    return {suffix: f.name for f in FORMATS.values() for suffix in f.suffixes}
+
+
+def by_root(root: str | None) -> Format | None:
+    """The registered format whose root element is ``root``, or None."""
+    return next((f for f in FORMATS.values() if f.root == root), None)
+
+
+def __getattr__(name: str) -> object:
+    if name == "SUFFIXES":  # (the old constant: {suffix: format name}, now read from FORMATS)
+        return suffixes()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+__all__ = ["FORMATS", "Format", "Imported", "by_root", "register_format", "suffixes"]

@@ -31,6 +31,7 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from pkm.core.formats.base import suffixes
 from pkm.core.model.spec import MAX_FILE_BYTES, Closure, ClosureSpec, TaskSpec, read_text_file
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, closest, did_you_mean
 
@@ -140,7 +141,7 @@ def find_gepetto(path: Path) -> tuple[Path, Path, tuple[str, ...]] | str:
         urdf, note = _urdf_for(yml)
         return urdf, yml, (note,) if note else ()
     suffix = path.suffix.lower()
-    if suffix in _YAML_SUFFIXES or (path.is_file() and suffix not in (".urdf", ".toml", ".xml", ".mjcf", ".sdf")):
+    if suffix in _YAML_SUFFIXES or (path.is_file() and suffix not in (".toml", *suffixes())):
         reason = gepetto_yaml(path)  # (a YAML of another suffix is taken by content too)
         if reason is not None:
             return reason

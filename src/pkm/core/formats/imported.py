@@ -9,7 +9,7 @@ import dataclasses
 import re
 from pathlib import Path
 
-from pkm.core.formats.base import SUFFIXES, Imported
+from pkm.core.formats.base import FORMATS, Imported, by_root, suffixes
 from pkm.core.model.spec import ClosureSpec, read_text_file
 from pkm.core.model.urdf import check_urdf, limit_notes
 from pkm.errors import SpecError
@@ -23,25 +23,22 @@ def _root_tag(text: str) -> str | None:
 
 
 def import_model(path: Path) -> Imported:
-    """Read the model file at ``path``, by its root element (``robot``, ``mujoco``, ``sdf``), else by its suffix
-    (:data:`SUFFIXES`; another suffix is read as URDF).
+    """Read the model file at ``path`` with the registered format (:data:`~pkm.core.formats.base.FORMATS`) whose
+    root element it has (a URDF named ``.xml`` is a URDF), else the one of its suffix; another is read as URDF.
 
     Raises:
         SpecError: the file is missing, too large, malformed, or uses what its reader refuses.
     """
-    kind = SUFFIXES.get(path.suffix.lower(), "urdf")
-    text = read_text_file(path, kind.upper())
-    kind = {"robot": "urdf", "mujoco": "mjcf", "sdf": "sdf"}.get(_root_tag(text) or "", kind)  # (a URDF named .xml)
-    if kind == "mjcf":
-        from pkm.core.formats.mjcf import read_mjcf
+    fmt = FORMATS.get(suffixes().get(path.suffix.lower(), ""), FORMATS["urdf"])
+    text = read_text_file(path, fmt.name.upper())
+    fmt = by_root(_root_tag(text)) or fmt
+    return fmt.read(text, str(path))
 
-        return read_mjcf(text, str(path))
-    if kind == "sdf":
-        from pkm.core.formats.sdf import read_sdf
 
-        return read_sdf(text, str(path))
-    root = check_urdf(text, str(path))
-    return Imported(text, (), {}, (), str(root.get("name") or path.stem), "urdf", notes=limit_notes(root))
+def read_urdf(text: str, source: str = "<urdf>") -> Imported:
+    """A URDF file (its loops come from a closure spec); exporters' "unlimited" limits noted."""
+    root = check_urdf(text, source)
+    return Imported(text, (), {}, (), str(root.get("name") or Path(source).stem), "urdf", notes=limit_notes(root))
 
 
 def with_file(spec: ClosureSpec, imp: Imported, source: str) -> ClosureSpec:
@@ -124,5 +121,5 @@ def spec_skeleton(path: Path) -> tuple[str, bool]:
     return "\n".join(lines), bool(imp.actuated and imp.closures)
 
 
-__all__ = ["SUFFIXES", "Imported", "import_model", "spec_skeleton",
+__all__ = ["import_model", "read_urdf", "spec_skeleton",
            "with_file"]

@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from pkm.core.formats.base import SUFFIXES
+from pkm.core.formats.base import FORMATS, suffixes
 from pkm.core.formats.gepetto import _joints, find_gepetto, read_gepetto
 from pkm.core.formats.imported import _root_tag, import_model, with_file
 from pkm.core.formats.packages import model_file
@@ -83,7 +83,7 @@ def _closure_spec(path: Path) -> Callable[[], Mechanism] | str:
         return lambda: from_files(path)
     if path.suffix.lower() in (".yaml", ".yml"):
         return "a YAML file: a pkm closure spec is TOML (NAME.closures.toml)"
-    if path.suffix.lower() in SUFFIXES:
+    if path.suffix.lower() in suffixes():
         return f"a {path.suffix} file: a pkm closure spec is TOML (NAME.closures.toml)"
     text = _head(path)
     if text is None:
@@ -100,12 +100,14 @@ def _closure_spec(path: Path) -> Callable[[], Mechanism] | str:
 def _model_file(path: Path) -> Callable[[], Mechanism] | str:
     if path.is_dir():
         return "a folder (give the model file)"
-    kind = SUFFIXES.get(path.suffix.lower())
+    kind = suffixes().get(path.suffix.lower())
     text = _head(path)
     root = _root_tag(text) if text is not None else None
-    if kind is None and root not in ("robot", "mujoco", "sdf"):
-        return ("not XML with a <robot>, <mujoco> or <sdf> root element" if root is None
-                else f"XML whose root element is <{root}>, not <robot>, <mujoco> or <sdf>")
+    roots = [f.root for f in FORMATS.values()]
+    if kind is None and root not in roots:
+        known = ", ".join(f"<{r}>" for r in roots)
+        return (f"not XML with a root element {known}" if root is None
+                else f"XML whose root element is <{root}>, not one of {known}")
     return lambda: load_model_file(path)
 
 
