@@ -24,6 +24,25 @@ def test_the_lazy_names_resolve():
 
     assert pkm.solve_ik is solve.solve_ik and pkm.core.TaskMap is task.TaskMap
     assert "close_loops" in dir(pkm) and "zyx_matrix" in dir(pkm.core)
-    assert sorted(pkm.core.__all__) == sorted(pkm.core._WHERE)  # the literal list names every lazy export
+    assert set(pkm.core.__all__) == set(pkm.core._WHERE)  # (derived from the one declaration)
     with pytest.raises(AttributeError, match="no attribute 'nothing'"):
         pkm.nothing  # noqa: B018
+
+
+@pytest.mark.parametrize("package", ["pkm", "pkm.core", "pkm.core.formats"])
+def test_the_static_view_of_the_lazy_names_is_the_declaration(package):
+    """Each lazy package declares its public names once (``_WHERE``: name -> module); its ``TYPE_CHECKING`` block,
+    which type checkers read, imports exactly those names from exactly those modules."""
+    import ast
+    import importlib
+
+    mod = importlib.import_module(package)
+    tree = ast.parse(open(mod.__file__).read())
+    block = next(n for n in tree.body if isinstance(n, ast.If) and getattr(n.test, "id", "") == "TYPE_CHECKING")
+    static = {a.asname or a.name: node.module for node in block.body if isinstance(node, ast.ImportFrom)
+              and node.module.startswith("pkm") for a in node.names}
+    where = dict(mod._WHERE)
+    if package == "pkm":  # (the core's names reach pkm through pkm.core's own table)
+        static = {n: where[n] if m == "pkm.core" else m for n, m in static.items()}
+    assert static == where
+    assert set(where) <= set(mod.__all__)

@@ -17,21 +17,32 @@ from typing import TYPE_CHECKING
 
 from pkm import errors
 from pkm._lazy import lazy
+from pkm.core import _EXPORTS as _CORE_EXPORTS
 from pkm.errors import PkmError, UnknownNameError
 from pkm.mechanisms import REGISTRY as MECHANISMS
 from pkm.mechanisms import definition as mechanism_definition
 from pkm.mechanisms import module as mechanism_module
 
-#: Names of the generic core, imported on first use (``import pkm`` stays cheap: no Pinocchio until needed).
-_CORE = ("ClosureSpec", "Configuration", "Diagnostics", "Jump", "Mechanism", "SolveResult", "TaskMap", "Trajectory",
-         "accelerations", "assemble", "close_loops", "diagnose", "follow_actuators", "follow_task", "forward_jacobian",
-         "idle_motions", "inverse_accelerations", "inverse_dynamics", "inverse_jacobian", "inverse_velocities",
-         "passive_map", "solve_ik", "task_acceleration", "task_values", "task_velocity", "twist_jacobian", "velocities")
+#: The public names imported on first use (``import pkm`` stays cheap: no Pinocchio until needed), by module: the
+#: one declaration that the lazy lookup and ``__all__`` are derived from (the ``TYPE_CHECKING`` block below is its
+#: static view for type checkers; a test checks that the two agree).
+_EXPORTS: dict[str, tuple[str, ...]] = {
+    **_CORE_EXPORTS,
+    "pkm.core.analysis.maps": ("task_map",),
+    "pkm.core.analysis.reconfiguration": ("reconfigure",),
+    "pkm.core.modes": ("assembly_modes", "track_assembly_mode", "track_working_mode", "working_modes"),
+    "pkm.core.twin": ("Kernels", "Twin"),
+    "pkm.sweeps": ("sweep",),
+    "pkm.units": ("quantity",),
+}
+_WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
 if TYPE_CHECKING:  # the static view of the lazy names
     from pathlib import Path
 
     from pkm.core import (
+        Branch,
+        Closure,
         ClosureSpec,
         Configuration,
         Diagnostics,
@@ -39,9 +50,11 @@ if TYPE_CHECKING:  # the static view of the lazy names
         Mechanism,
         SolveResult,
         TaskMap,
+        TaskSpec,
         Trajectory,
         accelerations,
         assemble,
+        branch_seed,
         close_loops,
         diagnose,
         follow_actuators,
@@ -59,6 +72,8 @@ if TYPE_CHECKING:  # the static view of the lazy names
         task_velocity,
         twist_jacobian,
         velocities,
+        zyx_angles,
+        zyx_matrix,
     )
     from pkm.core.analysis.maps import task_map
     from pkm.core.analysis.reconfiguration import reconfigure
@@ -68,12 +83,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.units import quantity
 
 
-__getattr__, __dir__ = lazy("pkm", globals(), {**dict.fromkeys(_CORE, "pkm.core"), "quantity": "pkm.units",
-                                                "Kernels": "pkm.core.twin", "Twin": "pkm.core.twin",
-                                                "task_map": "pkm.core.analysis.maps", "reconfigure": "pkm.core.analysis.reconfiguration",
-                                                "sweep": "pkm.sweeps",
-                                                **dict.fromkeys(("assembly_modes", "working_modes", "track_assembly_mode",
-                                                                 "track_working_mode"), "pkm.core.modes")})
+__getattr__, __dir__ = lazy("pkm", globals(), _WHERE)
 
 __version__ = "0.1.0"
 
@@ -213,51 +223,5 @@ def build(name: str, **params) -> Mechanism:
     return mechanism_module(name).build(design_params(name, **params))
 
 
-__all__ = [
-    "MECHANISMS",
-    "ClosureSpec",
-    "Configuration",
-    "Diagnostics",
-    "Jump",
-    "Kernels",
-    "Mechanism",
-    "PkmError",
-    "SolveResult",
-    "TaskMap",
-    "Trajectory",
-    "Twin",
-    "accelerations",
-    "assemble",
-    "assembly_modes",
-    "build",
-    "close_loops",
-    "design_params",
-    "diagnose",
-    "errors",
-    "follow_actuators",
-    "follow_task",
-    "forward_jacobian",
-    "idle_motions",
-    "inverse_accelerations",
-    "inverse_dynamics",
-    "inverse_jacobian",
-    "inverse_velocities",
-    "load",
-    "mechanism_definition",
-    "mechanism_module",
-    "passive_map",
-    "quantity",
-    "reconfigure",
-    "save",
-    "solve_ik",
-    "sweep",
-    "task_acceleration",
-    "task_map",
-    "task_values",
-    "task_velocity",
-    "track_assembly_mode",
-    "track_working_mode",
-    "twist_jacobian",
-    "velocities",
-    "working_modes",
-]
+__all__ = sorted(["MECHANISMS", "PkmError", "build", "design_params", "errors", "load", "mechanism_definition",
+                  "mechanism_module", "save", *_WHERE])

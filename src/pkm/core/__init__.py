@@ -10,7 +10,9 @@ from typing import TYPE_CHECKING
 
 from pkm._lazy import lazy
 
-_EXPORTS = {
+#: The public names, by module: the one declaration the lazy lookup and ``__all__`` are derived from (the
+#: ``TYPE_CHECKING`` block is its static view for type checkers; a test checks that the two agree).
+_EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.kinematics.configuration": ("Configuration",),
     "pkm.core.differential.velocity": ("Diagnostics", "accelerations", "diagnose", "forward_jacobian", "idle_motions",
                               "inverse_accelerations", "inverse_jacobian", "inverse_velocities", "passive_map",
@@ -51,10 +53,4 @@ if TYPE_CHECKING:  # the static view of the lazy names
 
 __getattr__, __dir__ = lazy("pkm.core", globals(), _WHERE)
 
-__all__ = [
-    "Branch", "Closure", "ClosureSpec", "Configuration", "Diagnostics", "Jump", "Mechanism", "SolveResult", "TaskMap",
-    "TaskSpec", "Trajectory", "accelerations", "assemble", "branch_seed", "close_loops", "diagnose", "follow_actuators",
-    "follow_task", "forward_jacobian", "idle_motions", "inverse_accelerations", "inverse_dynamics", "inverse_jacobian",
-    "inverse_velocities", "passive_map", "solve_ik", "task_acceleration", "task_values", "task_velocity",
-    "twist_jacobian", "velocities", "zyx_angles", "zyx_matrix",
-]
+__all__ = sorted(_WHERE)
