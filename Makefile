@@ -8,12 +8,12 @@ STAMP := $(VENV)/.pkm-installed
 
 venv: $(STAMP)
 
-# (Re)create the virtual environment and install pkm (editable) with its test tools and the benchmarks'
-# baseline (MuJoCo) whenever pyproject.toml changes.
+# (Re)create the virtual environment and install pkm (editable) with its test tools and every extra (sweeps,
+# figures, homotopy, the benchmarks' baseline MuJoCo: `all`) whenever pyproject.toml changes.
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[dev,bench,homotopy]"
+	$(PY) -m pip install --quiet -e ".[dev,all]"
 	touch $(STAMP)
 
 demo: $(STAMP)

@@ -606,7 +606,7 @@ def _kernels_path(g, adv):
 
 @entry("maps.task_map")
 def _task_map(g, adv):
-    from pkm.core.analysis.maps import task_map
+    from pkm.core.analysis.maps import workspace_map
 
     c = ctx()
     n = g.pick(c.names)
@@ -622,7 +622,7 @@ def _task_map(g, adv):
             kw[g.pick(("length", "tol", "max_iter", "branch", "seed"))] = g.hostile()
 
     def run(a, **kwargs):
-        m = task_map(c.mech[n], a, kernels=_kernels(n), **kwargs)
+        m = workspace_map(c.mech[n], a, kernels=_kernels(n), **kwargs)
         return m.condition_index("2")[m.reachable], m.size
     return run, (axes,), kw
 

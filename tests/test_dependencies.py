@@ -1,9 +1,11 @@
-"""Every third-party module that ``src/pkm`` imports is declared in ``pyproject.toml``.
+"""Every third-party module that ``src/pkm`` imports is declared in ``pyproject.toml``: in the core
+(``[project] dependencies``, what ``pip install pkm`` gives) or in one extra (``pkm[sweeps]``, ``pkm[figures]``, ...).
 
 A module that arrives only as another package's dependency (scipy through proxsuite, umsgpack
 through meshcat) works until that package drops it; so every import must name its own distribution.
-A benchmark baseline (the ``bench`` extra, MuJoCo) may be imported by ``pkm/bench`` alone, and the optional
-homotopy solver (the ``homotopy`` extra, Bertini 2, GPL-3) by ``pkm/core/modes/continuation.py`` alone.
+A module of an extra is imported inside functions only (never at a module's top level: ``import pkm`` and every
+module of it import without the extras), by modules that check the extra first (:mod:`pkm._optional`, whose table
+of extras is the one in ``pyproject.toml``); ``tests/test_extras.py`` runs the library with the extras blocked.
 """
 
 from __future__ import annotations
@@ -79,29 +81,96 @@ def declared() -> set[str]:
 
 
 def extra(name: str) -> set[str]:
-    """An optional extra's distributions (``bench``: baselines only ``pkm/bench`` may import)."""
+    """An optional extra's distributions (those of ``dask[distributed]`` included: dask and distributed)."""
     project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
-    return _names(project["optional-dependencies"][name])
+    reqs = project["optional-dependencies"][name]
+    inner = {_canonical(x) for r in reqs if "[" in r for x in r.split("[", 1)[1].split("]", 1)[0].split(",")}
+    return _names(reqs) | inner
+
+
+#: Extras of tools, not of the library (no module of pkm imports them), and the one that installs all of them.
+TOOLING = ("dev", "all")
+#: Modules of pkm that import an extra's module without checking it themselves, each with its reason.
+UNGUARDED = {
+    "pkm/sweeps/store.py": "internal: its callers (pkm.sweep, SweepResult.read) check pkm[sweeps] first",
+}
+
+
+def top_level_imports(path: Path) -> set[str]:
+    """Top-level names imported by the statements of ``path`` that run when it is imported (module body, its
+    ``if``/``try`` blocks; ``if TYPE_CHECKING:`` blocks excepted), not inside functions or classes."""
+    found: set[str] = set()
+
+    def visit(body):
+        for node in body:
+            if isinstance(node, ast.Import):
+                found.update(a.name.split(".")[0] for a in node.names)
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                found.add(node.module.split(".")[0])
+            elif isinstance(node, ast.If) and "TYPE_CHECKING" not in ast.unparse(node.test):
+                visit(node.body)
+                visit(node.orelse)
+            elif isinstance(node, ast.Try):
+                visit(node.body)
+                for h in node.handlers:
+                    visit(h.body)
+                visit(node.orelse)
+                visit(node.finalbody)
+
+    visit(ast.parse(path.read_text(encoding="utf-8")).body)
+    return found
 
 
 def test_every_third_party_import_is_a_declared_dependency():
     third_party = {m: files for m, files in imported_modules(ROOT / "src" / "pkm").items()
                    if m not in sys.stdlib_module_names and m not in ("pkm", "__future__")}
     assert {"numpy", "pinocchio", "casadi"} <= set(third_party)  # the scan sees the imports
-    deps, bench, homotopy = declared(), extra("bench"), extra("homotopy")
-    missing = {}
+    deps = declared()
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    extras = {name: extra(name) for name in project["optional-dependencies"] if name not in TOOLING}
+    missing, optional = {}, {}
     for mod, files in sorted(third_party.items()):
-        if _canonical(mod) in bench:
-            assert all(f.startswith("pkm/bench/") for f in files), (mod, sorted(files))
+        dists = owners(mod) or {_canonical(mod)}  # (an extra's module may not be installed here: its own name)
+        if dists & deps:
             continue
-        if owners(mod) & homotopy:
-            assert sorted(files) == ["pkm/core/modes/continuation.py"], (mod, sorted(files))
+        holders = [name for name, d in extras.items() if dists & d]
+        if holders:
+            assert len(holders) == 1, f"{mod!r} is in several extras: {holders}"
+            optional[mod] = (holders[0], files)
             continue
-        dists = owners(mod)
-        assert dists, f"{mod!r} (imported by {sorted(files)}) belongs to no installed distribution"
-        if not dists & deps:
-            missing[mod] = (sorted(dists), sorted(files))
-    assert not missing, f"imported but not declared in pyproject.toml [project] dependencies: {missing}"
+        assert owners(mod), f"{mod!r} (imported by {sorted(files)}) belongs to no installed distribution"
+        missing[mod] = (sorted(dists), sorted(files))
+    assert not missing, f"imported but not declared in pyproject.toml (core or an extra): {missing}"
+    assert {"dask", "pyarrow", "matplotlib", "mujoco", "bertini"} <= set(optional), sorted(optional)
+    src = ROOT / "src"
+    for mod, (name, files) in sorted(optional.items()):
+        for f in sorted(files):
+            text = (src / f).read_text(encoding="utf-8")
+            assert mod not in top_level_imports(src / f), f"{f} imports {mod} (pkm[{name}]) when it is imported"
+            guarded = "pkm._optional" in text or "MissingDependencyError" in text or "unavailable" in text
+            assert guarded or f in UNGUARDED, \
+                f"{f} imports {mod} (pkm[{name}]) without checking the extra first (pkm._optional.require)"
+
+
+def test_the_extras_table_is_pyprojects():
+    """:data:`pkm._optional.EXTRAS` names the extras of ``pyproject.toml`` (tooling aside) and their distributions;
+    ``all`` installs every one of them; the core declares none of them."""
+    from pkm._optional import EXTRAS
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    named = [n for n in project["optional-dependencies"] if n not in TOOLING]
+    assert named == list(EXTRAS)
+    for name, modules in EXTRAS.items():
+        assert {_canonical(d) for d in modules.values()} == extra(name), name
+        assert not extra(name) & declared(), name
+    (everything,) = project["optional-dependencies"]["all"]
+    assert everything == f"pkm[{','.join(EXTRAS)}]"
+
+
+def test_the_top_level_scan_skips_function_bodies(tmp_path):
+    (tmp_path / "m.py").write_text("import numpy\ntry:\n    import yaml\nexcept ImportError:\n    pass\n"
+                                   "if TYPE_CHECKING:\n    import dask\ndef f():\n    import matplotlib\n")
+    assert top_level_imports(tmp_path / "m.py") == {"numpy", "yaml"}
 
 
 def test_the_scan_catches_an_undeclared_import(tmp_path):

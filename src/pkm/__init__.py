@@ -28,7 +28,7 @@ from pkm.mechanisms import module as mechanism_module
 #: static view for type checkers; a test checks that the two agree).
 _EXPORTS: dict[str, tuple[str, ...]] = {
     **_CORE_EXPORTS,
-    "pkm.core.analysis.maps": ("task_map",),
+    "pkm.core.analysis.maps": ("workspace_map", "task_map"),  # (task_map: the deprecated name)
     "pkm.core.analysis.reconfiguration": ("reconfigure",),
     "pkm.core.modes": ("assembly_modes", "track_assembly_mode", "track_working_mode", "working_modes"),
     "pkm.core.twin": ("Kernels", "Twin"),
@@ -75,7 +75,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         zyx_angles,
         zyx_matrix,
     )
-    from pkm.core.analysis.maps import task_map
+    from pkm.core.analysis.maps import task_map, workspace_map
     from pkm.core.analysis.reconfiguration import reconfigure
     from pkm.core.modes import assembly_modes, track_assembly_mode, track_working_mode, working_modes
     from pkm.core.twin import Kernels, Twin

@@ -291,8 +291,22 @@ class SweepError(PkmError):
         super().__init__(message)
 
 
+class CompilerError(PkmError, RuntimeError):
+    """A capability that runs only compiled found no C compiler, or its compiled code failed (a ``RuntimeError`` too,
+    as it was before 0.2.0).
+
+    Attributes:
+        how: What the compiler search or the compiled code said.
+    """
+
+    def __init__(self, what: str, how: str):
+        self.how = how
+        super().__init__(f"{what}: {how}")
+
+
 class MissingDependencyError(PkmError, ImportError):
-    """An optional dependency that a capability needs is not installed.
+    """An optional dependency that a capability needs is not installed (raised where it is used, never at
+    ``import pkm``; :mod:`pkm._optional` lists the extras).
 
     Attributes:
         package: The PyPI package to install.
@@ -302,7 +316,7 @@ class MissingDependencyError(PkmError, ImportError):
     def __init__(self, package: str, extra: str, what: str):
         self.package = package
         self.extra = extra
-        super().__init__(f"{what} needs {package}: pip install {package} (or pip install \"pkm[{extra}]\")")
+        super().__init__(f"{what} needs {package}, which pkm's {extra!r} extra installs: pip install \"pkm[{extra}]\"")
 
 
 class StructureError(PkmError):

@@ -26,6 +26,7 @@ import numpy as np
 
 import pkm
 from pkm import papers as _papers
+from pkm._optional import require
 from pkm.errors import InvalidInputError
 from pkm.papers import Row
 
@@ -154,6 +155,8 @@ def run(out_dir, papers: Sequence[str] | None = None, *, figures: bool = True, s
     Raises:
         UnknownNameError: A name is not a paper (listing the valid ones), before anything runs.
         InvalidInputError: No paper, or one named twice.
+        MissingDependencyError: ``figures`` without matplotlib (``pip install "pkm[figures]"``), before anything
+            runs; a step that needs another extra (a series through :func:`pkm.sweep`) raises it when it runs.
     """
     names = _papers.names() if papers is None else tuple(papers)
     if not names:
@@ -161,6 +164,8 @@ def run(out_dir, papers: Sequence[str] | None = None, *, figures: bool = True, s
     if len(set(names)) != len(names):
         raise InvalidInputError("papers", f"each paper once, got {list(names)}", papers)
     modules = {n: _papers.module(n) for n in names}
+    if figures:
+        require("figures", "pkm report's figures (--no-figures leaves them out)")
     out = Path(out_dir).resolve()
     out.mkdir(parents=True, exist_ok=True)
 

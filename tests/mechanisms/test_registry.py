@@ -45,7 +45,26 @@ def test_register_refuses_a_taken_name_an_incomplete_package_and_other_objects()
         register(MechanismDefinition("half", "a package without the closed forms", "pkm.mechanisms.delta.workspace"))
     with pytest.raises(InvalidInputError):
         register("delta")
-    assert "half" not in REGISTRY
+    with pytest.raises(InvalidInputError, match="declares no CLOSED_FORMS"):
+        register(MechanismDefinition("fast", "a sweeps module that is not one", "tests.fivebar", sweeps="pkm.errors"))
+    assert "half" not in REGISTRY and "fast" not in REGISTRY
+
+
+@pytest.mark.parametrize("name", [n for n in names() if REGISTRY[n].sweeps is not None])
+def test_every_sweeps_module_declares_closed_forms_of_library_objectives(name):
+    """An entry's ``sweeps`` is a module of its own package mapping objectives of :mod:`pkm.sweeps` to closed forms,
+    whose options do not redefine the objectives' own."""
+    import importlib
+
+    from pkm.sweeps.objectives import OBJECTIVES, ClosedForm
+
+    entry = REGISTRY[name]
+    assert entry.sweeps.startswith(entry.package + ".")
+    forms = importlib.import_module(entry.sweeps).CLOSED_FORMS
+    assert forms and set(forms) <= set(OBJECTIVES), sorted(set(forms) - set(OBJECTIVES))
+    for objective, closed in forms.items():
+        assert isinstance(closed, ClosedForm) and callable(closed.function)
+        assert not set(closed.options) & set(OBJECTIVES[objective].generic_options), (objective, closed.options)
 
 
 def test_register_and_unregister_round_trip():

@@ -1,9 +1,14 @@
 """Objectives (pkm.sweeps.objectives): the papers' studies through pkm.sweep equal the serial ones; the generic
-routes agree with the closed forms; loaded mechanisms vary their joint origins; user callables; bad specs."""
+routes agree with the closed forms; loaded mechanisms vary their joint origins; user callables; bad specs; the closed
+forms are the mechanisms' own, found through the registry."""
 
 from __future__ import annotations
 
+import ast
+import dataclasses
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,10 +16,12 @@ import pytest
 import pkm
 from pkm import sweeps
 from pkm.errors import InvalidInputError, UnknownNameError
+from pkm.mechanisms import REGISTRY, register
 from pkm.mechanisms.delta import design
 from pkm.mechanisms.rrr3 import workspace as maps
 from pkm.papers import delta as delta_paper
 from pkm.papers import rrr3 as rrr3_paper
+from pkm.sweeps.objectives import OBJECTIVES, ClosedForm, closed_forms
 
 
 def test_the_delta_radius_study_through_the_sweep_equals_the_serial_study():
@@ -134,3 +141,78 @@ def test_the_3rrr_closed_form_maps_the_designs_working_mode():
 def test_conflicting_arguments_are_refused(call, match):
     with pytest.raises(InvalidInputError, match=match):
         call()
+
+
+# ---------------------------------------------------------------------- the fast paths belong to the mechanisms
+def _code_names(path: Path) -> set[str]:
+    """Identifiers, imported modules and string constants of a module's code (docstrings and comments left out:
+    a usage example may name a mechanism)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    docs = {id(n.body[0].value) for n in ast.walk(tree)
+            if isinstance(n, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and n.body
+            and isinstance(n.body[0], ast.Expr) and isinstance(n.body[0].value, ast.Constant)}
+    out: set[str] = set()
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Name):
+            out.add(n.id)
+        elif isinstance(n, ast.Attribute):
+            out.add(n.attr)
+        elif isinstance(n, (ast.FunctionDef, ast.ClassDef, ast.AsyncFunctionDef)):
+            out.add(n.name)
+        elif isinstance(n, ast.alias):
+            out.update((n.name, n.asname or ""))
+        elif isinstance(n, ast.ImportFrom) and n.module:
+            out.add(n.module)
+        elif isinstance(n, ast.Constant) and isinstance(n.value, str) and id(n) not in docs:
+            out.add(n.value)
+    return out
+
+
+def test_the_sweeps_package_names_no_mechanism():
+    """The closed forms are found through the registry (each entry's ``sweeps``): no code of ``pkm/sweeps`` names a
+    registered mechanism (in a name, an import or a string), so that adding one touches no other package."""
+    folder = Path(sweeps.__file__).parent
+    hits = {}
+    for path in sorted(folder.glob("*.py")):
+        words = {w for text in _code_names(path) for w in re.findall(r"[A-Za-z0-9]+", text.lower())}
+        named = sorted(n for n in REGISTRY if set(n.lower().split("_")) <= words and (n.lower() in words or "_" in n))
+        if named:
+            hits[path.name] = named
+    assert len(list(folder.glob("*.py"))) >= 7 and not hits, hits
+
+
+def test_the_scan_sees_a_mechanism_named_in_code(tmp_path):
+    (tmp_path / "m.py").write_text('"""rrr3 in a docstring"""\nfrom pkm.mechanisms.delta import design\n'
+                                   'def f():\n    """hexapod"""\n    return OBJ.get("prs3")\n')
+    words = {w for text in _code_names(tmp_path / "m.py") for w in re.findall(r"[A-Za-z0-9]+", text.lower())}
+    assert {"delta", "prs3"} <= words and not {"rrr3", "hexapod"} & words
+
+
+def _toy_gci(c, o):
+    """The toy's closed form of gci: its link length d times an option of its own."""
+    return o["toy_scale"] * c.params.d
+
+
+#: A closed form of the tests' five-bar (this module is its ``sweeps`` module while the test runs).
+CLOSED_FORMS = {"gci": ClosedForm(_toy_gci, {"toy_scale": ("float", 2.0, "toy: the factor")}, "m")}
+
+
+def test_a_registered_mechanism_brings_its_own_fast_path():
+    """The five-bar registered again with this module as its ``sweeps``: gci takes its closed form (and its option,
+    and its unit), the other objectives and mechanisms do not see it; unregistered, the generic route is back."""
+    plain = REGISTRY["fivebar"]
+    register(dataclasses.replace(plain, sweeps=__name__), replace=True)
+    try:
+        assert set(closed_forms("gci")) == {"rrr3", "fivebar"} and "toy_scale" in OBJECTIVES["gci"].options
+        assert "toy_scale" not in OBJECTIVES["gci_area"].options
+        res = pkm.sweep("fivebar", sweeps.table({"d": [0.2, 0.25]}), ["gci", "g3=gci:toy_scale=3"], scheduler="serial")
+        np.testing.assert_allclose(res.column("gci"), [0.4, 0.5], rtol=1e-15)
+        np.testing.assert_allclose(res.column("g3"), [0.6, 0.75], rtol=1e-15)
+        assert res.objectives["gci"]["unit"] == "m"
+        with pytest.raises(InvalidInputError, match="no closed form for fivebar"):
+            pkm.sweep("fivebar", sweeps.table({"d": [0.2]}), ["gci_area:route=closed_form"], scheduler="serial")
+    finally:
+        register(plain, replace=True)
+    assert set(closed_forms("gci")) == {"rrr3"} and "toy_scale" not in OBJECTIVES["gci"].options
+    with pytest.raises(UnknownNameError, match="toy_scale"):
+        sweeps.objective("gci:toy_scale=3")

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from pkm.bench import best_time, main, median_us
-from pkm.core.dynamics import forward_dynamics
+from pkm.core.dynamics.projection import forward_dynamics
 from pkm.mechanisms.prs3.dynamics import Prs3Dynamics, generate_c
 
 QUICK = {"n": 2000, "repeat": 40, "c_evaluations": 20000}

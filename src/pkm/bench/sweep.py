@@ -22,6 +22,7 @@ from __future__ import annotations
 import resource
 import time
 
+from pkm._optional import require
 from pkm.bench import main
 
 QUICK = {"designs": 64, "step": 0.04}
@@ -45,6 +46,7 @@ def _space(n: int):
 
 
 def run(args) -> dict:
+    require("sweeps", "the sweep benchmark")
     from dask.distributed import Client
 
     import pkm

@@ -3,7 +3,7 @@
 Two cases, each timed vectorised (best of ``--repeat``), as a naive Python loop over a
 random sample of its nodes (closed-form IK + per-pose Jacobians + SVD per node, from
 ``pkm.mechanisms.rrr3.workspace.naive_condition_index``), extrapolated to all nodes, and through the generic
-route of any mechanism (:func:`pkm.core.maps.task_map`: the compiled twin's IK warm-started across the grid, its
+route of any mechanism (:func:`pkm.core.analysis.maps.task_map`: the compiled twin's IK warm-started across the grid, its
 inverse Jacobian, singular values; compilation not timed); the ratios are measured in the same run, and the CIs
 compared between the routes:
 
@@ -43,16 +43,16 @@ def _naive(design, nodes: np.ndarray, settings: maps.CiSettings) -> tuple[float,
 
 
 def _generic(design, axes: dict, fixed: dict, repeat: int):
-    """The generic route (:func:`pkm.core.maps.task_map` through the compiled twin) on the same grid: best time
+    """The generic route (:func:`pkm.core.analysis.maps.task_map` through the compiled twin) on the same grid: best time
     [s] (the compilation done beforehand, on a 2-node grid) and the map."""
     import pkm
-    from pkm.core.maps import task_map
+    from pkm.core.analysis.maps import workspace_map
 
     mech = pkm.build("rrr3", a=design.a, b=design.b, h=design.h, H=design.H)
     length = design.h / rrr3.SQRT3
     kernels = pkm.Kernels(mech)
-    task_map(mech, {k: v[:2] for k, v in axes.items()}, fixed, length=length, kernels=kernels)
-    return best_time(lambda: task_map(mech, axes, fixed, length=length, kernels=kernels), repeat)
+    workspace_map(mech, {k: v[:2] for k, v in axes.items()}, fixed, length=length, kernels=kernels)
+    return best_time(lambda: workspace_map(mech, axes, fixed, length=length, kernels=kernels), repeat)
 
 
 def bench_3d(sample: int, repeat: int, rng: np.random.Generator) -> dict:

@@ -9,6 +9,10 @@ no closed-form forward kinematics). :data:`REGISTRY` maps each name to its
 :class:`MechanismDefinition`; the command line, the report, the papers, the benchmarks, the
 generic and property tests and the fuzzing iterate it.
 
+Optional capabilities are fields of the entry that may be None: its paper study (``paper``), its reference files
+(``reference``), its closed-form sweep objectives (``sweeps``, a module of its package; :mod:`pkm.sweeps` finds
+them here and names no mechanism).
+
 Adding a mechanism: one package implementing the protocol, and one :data:`REGISTRY` entry (or
 :func:`register` at run time, as the tests do for their toy five-bar). See the README's
 contributor section.
@@ -63,6 +67,9 @@ class MechanismDefinition:
             folder (shipped in the wheel; ``pkm.load`` reads it and its URDF), or None: ``pkm.load``
             builds the default ``Params()``.
         origin: Where the task coordinates are measured from, and along which axes (``pkm list`` says it).
+        sweeps: Import path of the module of its package declaring its closed-form sweep objectives (the fast
+            paths :func:`pkm.sweep` takes: ``CLOSED_FORMS``, objective name -> :class:`pkm.sweeps.objectives.ClosedForm`),
+            or None: the generic routes only.
     """
 
     name: str
@@ -72,6 +79,7 @@ class MechanismDefinition:
     task_scale: tuple[float, float, float] = (0.05, 0.1, 0.1)
     reference: str | None = None
     origin: str = "the world frame of the URDF"
+    sweeps: str | None = None
 
     def tangent_scale(self, coordinates: Sequence[str]) -> list[float]:
         """:attr:`task_scale` spread over task coordinates (``x y z`` positions, ``roll pitch yaw wx wy wz``
@@ -91,15 +99,18 @@ REGISTRY: dict[str, MechanismDefinition] = {
         MechanismDefinition("hexapod", "reconfigurable hexapod of two 3-RUS sub-manipulators (Sanchez-Alonso et al. "
                                        "2016)", "pkm.mechanisms.hexapod", "hexapod", (0.03, 0.08, 0.3),
                             "hexapod.closures.toml", "O, the centre of the reconfiguration pivots F1 F2 F3 (the "
-                            "paper's frame: Y the hexapod's axis); position of P, the centre of C4 C5 C6"),
+                            "paper's frame: Y the hexapod's axis); position of P, the centre of C4 C5 C6",
+                            "pkm.mechanisms.hexapod.sweeps"),
         MechanismDefinition("rrr3", "planar 3-RRR (singularities and global condition index)", "pkm.mechanisms.rrr3",
                             "rrr3", (0.12, 0.3, 0.0), "rrr3.closures.toml",
                             "the base joint A1 of leg 1, x along A1 A2 (the paper's frame): the base centroid is at "
-                            "x = H/2, y = H/(2 sqrt 3); position of the platform centroid G"),
+                            "x = H/2, y = H/(2 sqrt 3); position of the platform centroid G",
+                            "pkm.mechanisms.rrr3.sweeps"),
         MechanismDefinition("delta", "Delta robot with reconfigurable base radius R (Hernandez Reyna & "
                                      "Sandoval-Castro 2018)", "pkm.mechanisms.delta", "delta", (0.06, 0.0, 0.0),
                             "delta.closures.toml", "the centre of the base, in the plane of the motor axes (the "
-                            "paper's frame 0), z up; position of the end-effector centre"),
+                            "paper's frame 0), z up; position of the end-effector centre",
+                            "pkm.mechanisms.delta.sweeps"),
         MechanismDefinition("prs3", "3-PRS (Diaz-Rodriguez et al. 2016: kinematics and inverse dynamics)",
                             "pkm.mechanisms.prs3", "prs3", (0.06, 0.15, 0.0), "prs3.closures.toml",
                             "the base centre {O}, z along the sliders' axis of symmetry; height and tilts of the "
@@ -137,7 +148,8 @@ def register(entry: MechanismDefinition, *, replace: bool = False) -> MechanismD
 
     Raises:
         InvalidInputError: not a :class:`MechanismDefinition`, the name is taken (unless
-            ``replace``), or the package lacks part of the protocol.
+            ``replace``), the package lacks part of the protocol, or its ``sweeps`` module declares no
+            ``CLOSED_FORMS``.
     """
     if not isinstance(entry, MechanismDefinition):
         raise InvalidInputError("entry", f"expected a MechanismDefinition, got {type(entry).__name__}", entry)
@@ -149,6 +161,10 @@ def register(entry: MechanismDefinition, *, replace: bool = False) -> MechanismD
     if missing:
         raise InvalidInputError("entry", f"{entry.package} does not implement MechanismModule: no {missing}",
                                 entry.package)
+    if entry.sweeps is not None and not isinstance(getattr(importlib.import_module(entry.sweeps), "CLOSED_FORMS",
+                                                           None), dict):
+        raise InvalidInputError("entry", f"{entry.sweeps} declares no CLOSED_FORMS (objective name -> "
+                                         "pkm.sweeps.objectives.ClosedForm)", entry.sweeps)
     REGISTRY[entry.name] = entry
     return entry
 

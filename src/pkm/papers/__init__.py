@@ -129,7 +129,8 @@ def modes_row(mechanism: str, row_id: str, compare: Callable[[Any, Any], str] | 
     except importlib.metadata.PackageNotFoundError:
         bertini = None
     key = [row_id, mech.urdf, mech.spec.to_toml(), qa.tolist(), bertini]
-    code = ["pkm.core.modes", "pkm.core.solve", "pkm.papers", *([compare.__module__] if compare is not None else [])]
+    code = ["pkm.core.modes", "pkm.core.kinematics.solve", "pkm.papers",
+            *([compare.__module__] if compare is not None else [])]
     row = cached("rows", key, lambda: _modes_row(mech, qa, row_id, compare).to_dict(), code=code)
     row.pop("matches", None)
     return Row(**row)

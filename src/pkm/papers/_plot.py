@@ -1,20 +1,33 @@
 """Figure helpers shared by the paper studies: headless matplotlib, one style, and the check a published figure
 must pass (:func:`problems`: a caption line naming the paper's figure, units on every axis, a legend entry for every
-line, a colour bar for every image, no text cut off by the figure's edge)."""
+line, a colour bar for every image, no text cut off by the figure's edge). matplotlib is the ``figures`` extra,
+imported on the first figure (:func:`pyplot`), so that the studies' numbers need none."""
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
-import matplotlib
+from pkm._optional import module
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
+#: What needs the ``figures`` extra, as :class:`~pkm.errors.MissingDependencyError` says it.
+WHAT = "pkm's figures (the papers', sweep plots)"
+
+
+@functools.cache
+def pyplot():
+    """``matplotlib.pyplot`` on the Agg backend (no display needed), imported once.
+
+    Raises:
+        MissingDependencyError: matplotlib is not installed (``pip install "pkm[figures]"``).
+    """
+    module("matplotlib", extra="figures", what=WHAT).use("Agg")
+    return module("matplotlib.pyplot", extra="figures", what=WHAT)
 
 
 def figure(*, ncols: int = 1, nrows: int = 1, size: tuple[float, float] = (6.4, 4.0)):
     """A new figure and its axes (Agg backend, no display needed)."""
-    fig, axes = plt.subplots(nrows, ncols, figsize=(size[0] * ncols, size[1] * nrows), squeeze=False)
+    fig, axes = pyplot().subplots(nrows, ncols, figsize=(size[0] * ncols, size[1] * nrows), squeeze=False)
     return fig, axes if axes.size > 1 else axes[0, 0]
 
 
@@ -27,7 +40,7 @@ def save(fig, out_dir: Path | str, name: str, *, layout: bool = True) -> Path:
     if layout:
         fig.tight_layout()
     fig.savefig(path, dpi=150)
-    plt.close(fig)
+    pyplot().close(fig)
     return path
 
 
@@ -45,6 +58,7 @@ def problems(fig, *, paper: bool = True) -> list[str]:
     legend text runs past the figure's edge (judged as the figure stands: check it after its layout, as it is
     saved).
     """
+    pyplot()
     import matplotlib.collections as mcoll
     import matplotlib.contour as mcontour
     import matplotlib.image as mimage

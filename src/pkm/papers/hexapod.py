@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pkm.core.task import as_rotation
+from pkm.core.kinematics.task import as_rotation
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi
 from pkm.mechanisms.hexapod import reconfiguration as hr

@@ -37,12 +37,13 @@ from pathlib import Path
 
 import numpy as np
 
+from pkm._optional import module
 from pkm.errors import InvalidInputError, PkmError
 from pkm.mechanisms import rrr3
 from pkm.mechanisms.rrr3 import workspace as maps
 from pkm.mechanisms.rrr3.workspace import CiSettings, Design
 from pkm.papers import Row, modes_row
-from pkm.papers._plot import figure, save
+from pkm.papers._plot import WHAT, figure, save
 
 TITLE = ("Singularity analysis and global condition index of the planar 3-RRR parallel robot "
          "(IEEE Latin America Transactions 13(2), 2015)")
@@ -252,8 +253,7 @@ def _against_polynomial(mech, modes) -> str:
 
 # ---------------------------------------------------------------------- figures and series
 def _unreachable_patch():
-    from matplotlib.patches import Patch
-
+    Patch = module("matplotlib.patches", extra="figures", what=WHAT).Patch
     return Patch(facecolor="white", edgecolor="0.5", label="unreachable (outside the workspace)")
 
 
@@ -387,8 +387,8 @@ def _fig3_boundaries() -> tuple[tuple[int, float, tuple[np.ndarray, ...]], ...]:
     """Per orientation of :data:`FIG3_PHIS_DEG`: ``(deg, area [cm^2], boundary polylines)``, each polyline ``(n, 2)``
     positions of G from the base centroid [cm]: the zero contour of
     :func:`pkm.mechanisms.rrr3.workspace.reach_margin`; the area is that of the reachable nodes."""
-    from matplotlib.figure import Figure
-
+    Figure = module("matplotlib.figure", extra="figures", what="the 3-RRR's Fig. 3 boundaries (matplotlib's "
+                                                               "contour tracer)").Figure
     base = rrr3.Rrr3Params()
     centre = maps.Design.of(base).base_centroid
     fine = maps.Grid.square(centre, maps.AREA_SIDE * 3.0, FIG3_STEP)

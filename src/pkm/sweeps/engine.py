@@ -49,10 +49,10 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-import cloudpickle
 import numpy as np
 
-from pkm.core.spec import as_path
+from pkm._optional import require
+from pkm.core.model.spec import as_path
 from pkm.errors import InvalidInputError, PkmError, SweepError
 from pkm.sweeps.family import Family, family_of
 from pkm.sweeps.objectives import Objective, objective
@@ -126,6 +126,8 @@ def _as_value(v, column: str) -> float | None:
 
 
 def _unpickle(blob: bytes) -> _Context:
+    import cloudpickle
+
     return cloudpickle.loads(blob)
 
 
@@ -180,7 +182,9 @@ def local_cluster(workers: int | None = None):
 
     Raises:
         SweepError: the workers could not start.
+        MissingDependencyError: the ``sweeps`` extra is not installed (``pip install "pkm[sweeps]"``).
     """
+    require("sweeps", "a local Dask cluster")
     import dask
     from dask.distributed import LocalCluster
 
@@ -283,7 +287,10 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
         InvalidInputError: a malformed space, objective or option.
         SweepError: ``out`` holds another sweep; the scheduler cannot be reached or has no workers; designs were
             lost to the cluster (the finished chunks kept: a rerun resumes).
+        MissingDependencyError: the ``sweeps`` extra (Dask, pyarrow, cloudpickle) is not installed: ``pip install
+            "pkm[sweeps]"``.
     """
+    require("sweeps", "pkm.sweep (design sweeps on Dask, results in Parquet)")
     if scheduler is not None and not isinstance(scheduler, str):
         raise InvalidInputError("scheduler", f"'serial' or an address such as tcp://host:8786, got {scheduler!r}",
                                 scheduler)
@@ -351,6 +358,8 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
                                  f"{_message(exc)})", scheduler) from None
             # a task, not scattered data: a worker that dies takes its copy with it, and Dask recomputes a task's
             # result where scattered data would be lost (with every chunk waiting on it)
+            import cloudpickle
+
             shared = cl.submit(_unpickle, cloudpickle.dumps(context), pure=False)
         startup = time.perf_counter() - t_start
         t0 = time.perf_counter()

@@ -139,7 +139,7 @@ class ModelFamily(Family):
     """Designs of a loaded mechanism: its URDF joints' origins set to the values (see the module doc)."""
 
     def __init__(self, mech):
-        from pkm.core.mechanism import check_mechanism
+        from pkm.core.model.mechanism import check_mechanism
 
         mech = check_mechanism(mech)
         if mech.urdf is None:
@@ -167,7 +167,7 @@ class ModelFamily(Family):
         return ({"angle"}, "rad") if ORIGIN[name.rsplit(".", 1)[1]][0] == "rpy" else ({"length"}, "m")
 
     def mechanism(self, values: Mapping[str, float]):
-        from pkm.core.mechanism import Mechanism
+        from pkm.core.model.mechanism import Mechanism
 
         if not values and self._base is not None:
             return self._base
@@ -196,8 +196,8 @@ def family_of(mechanism, fixed: Mapping[str, Any] | None = None) -> Family:
 
 
 def _joints(urdf: str):
-    """The URDF's root and its joints by name (pkm's hardened parser, :func:`pkm.core.urdf.parse_xml`)."""
-    from pkm.core.urdf import parse_xml
+    """The URDF's root and its joints by name (pkm's hardened parser, :func:`pkm.core.model.urdf.parse_xml`)."""
+    from pkm.core.model.urdf import parse_xml
 
     root = parse_xml(urdf)
     return root, {j.get("name"): j for j in root.iter("joint") if j.get("name") and j.getparent() is root}

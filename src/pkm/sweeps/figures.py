@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pkm._optional import require
 from pkm.errors import InvalidInputError, SweepError
 from pkm.sweeps.family import from_description
 from pkm.sweeps.results import SweepResult
@@ -40,7 +41,12 @@ def plot(result, out_dir, pareto: Sequence[str] | None = None) -> list[Path]:
 
     Returns:
         The paths written.
+
+    Raises:
+        MissingDependencyError: matplotlib (``pip install "pkm[figures]"``), or pyarrow to read a file
+            (``pkm[sweeps]``), is not installed.
     """
+    require("figures", "pkm.sweeps.plot")
     from pkm.papers._plot import figure, save
 
     res = _result(result)

@@ -6,7 +6,12 @@ An objective is named by a spec ``NAME`` or ``NAME:OPTION=VALUE,...`` (``gci:ste
 maps of :func:`pkm.task_map`, the inverse Jacobian at a pose, the trajectory follower, the symbolic twin), and,
 for some registered mechanisms, a closed-form fast path that is also the papers' route (the 3-RRR's vectorised CI
 maps, the Delta's workspace grid and K(R), the hexapod's reachable beta intervals); ``route=generic`` or
-``route=closed_form`` forces one (the default, ``auto``, takes the closed form where there is one). A region is
+``route=closed_form`` forces one (the default, ``auto``, takes the closed form where there is one).
+
+The fast paths belong to the mechanisms: a registry entry's ``sweeps`` (:class:`pkm.mechanisms.MechanismDefinition`)
+names the module of its package whose ``CLOSED_FORMS`` maps objective names to closed forms (:class:`ClosedForm`:
+the function, the options it reads, the unit of its value); this module names no mechanism and finds them through
+:data:`pkm.mechanisms.REGISTRY`, so that a mechanism registered at run time brings its own. A region is
 ``region=x=-5cm:5cm:11/y=-5cm:5cm:11`` (1 to 3 task coordinates, ``START:STOP:COUNT``), a pose
 ``pose=x=2cm/y=0/z=-36cm`` (the other coordinates from the reference).
 
@@ -39,6 +44,38 @@ ROUTES = ("auto", "closed_form", "generic")
 
 
 @dataclass(frozen=True)
+class ClosedForm:
+    """A registered mechanism's closed-form route of one objective (declared in the module its registry entry's
+    ``sweeps`` names, under ``CLOSED_FORMS[objective name]``).
+
+    Attributes:
+        function: ``(design, options) -> value`` (None where the design has no value).
+        options: The options it reads beyond the objective's own: ``{option: (kind, default, doc[, check])}`` (as
+            :attr:`Definition.options`); an objective takes those of every registered mechanism's closed form.
+        unit: Of its value, where not the objective's (a planar closed form's area is ``m^2``); ``""``: the
+            objective's.
+    """
+
+    function: Callable[[Candidate, Mapping[str, Any]], float | None]
+    options: Mapping[str, tuple[Any, ...]] = field(default_factory=dict)
+    unit: str = ""
+
+
+def closed_forms(objective_name: str) -> dict[str, ClosedForm]:
+    """``{registered mechanism: its closed form of objective_name}``, in registry order (each mechanism's ``sweeps``
+    module imported on first use)."""
+    from pkm.mechanisms import REGISTRY
+
+    out = {}
+    for name, entry in list(REGISTRY.items()):
+        if entry.sweeps is not None:
+            found = getattr(importlib.import_module(entry.sweeps), "CLOSED_FORMS", {}).get(objective_name)
+            if found is not None:
+                out[name] = found
+    return out
+
+
+@dataclass(frozen=True)
 class Definition:
     """One objective of :data:`OBJECTIVES`.
 
@@ -47,32 +84,50 @@ class Definition:
         sense: ``"max"`` or ``"min"``: which way is better (Pareto fronts, best designs).
         unit: Of its value (SI).
         doc: One line.
-        options: ``{option: (kind, default, doc[, check])}``; kinds ``length`` (> 0), ``angle``, ``float``, ``int``
-            (``check``: a lower bound), ``text`` (``check``: the choices), ``range`` (``START:STOP:COUNT``), and
-            ``pose`` / ``region`` (read against the mechanism's task).
+        generic_options: ``{option: (kind, default, doc[, check])}`` of the objective itself; kinds ``length``
+            (> 0), ``angle``, ``float``, ``int`` (``check``: a lower bound), ``text`` (``check``: the choices),
+            ``range`` (``START:STOP:COUNT``), and ``pose`` / ``region`` (read against the mechanism's task).
         generic: ``(design, options) -> value`` on any mechanism, or None.
-        closed_forms: ``{registered mechanism: (design, options) -> value}``.
     """
 
     name: str
     sense: str
     unit: str
     doc: str
-    options: Mapping[str, tuple[Any, ...]]
+    generic_options: Mapping[str, tuple[Any, ...]]
     generic: Callable[[Candidate, Mapping[str, Any]], float | None] | None
-    closed_forms: Mapping[str, Callable[[Candidate, Mapping[str, Any]], float | None]] = field(default_factory=dict)
-    units: Mapping[str, str] = field(default_factory=dict)  # {registered mechanism: unit of its closed form}
+
+    @property
+    def closed_forms(self) -> dict[str, ClosedForm]:
+        """``{registered mechanism: closed form}`` (:func:`closed_forms`)."""
+        return closed_forms(self.name)
+
+    @property
+    def options(self) -> dict[str, tuple[Any, ...]]:
+        """Every option a spec may give: the objective's own, then those of the registered mechanisms' closed
+        forms (registry order; an option two of them declare is the first's)."""
+        out = dict(self.generic_options)
+        for closed in self.closed_forms.values():
+            for key, spec in closed.options.items():
+                out.setdefault(key, spec)
+        return out
 
     def route(self, family, route: str) -> Callable[[Candidate, Mapping[str, Any]], float | None]:
-        closed = self.closed_forms.get(family.registered or "")
+        forms = self.closed_forms
+        closed = forms.get(family.registered or "")
         if route in ("auto", "closed_form") and closed is not None:
-            return closed
+            return closed.function
         if route in ("auto", "generic") and self.generic is not None:
             return self.generic
         which = "closed form" if route == "closed_form" else "route"
-        has = sorted(self.closed_forms) + (["any mechanism (generic)"] if self.generic else [])
+        has = sorted(forms) + (["any mechanism (generic)"] if self.generic else [])
         raise InvalidInputError("objective", f"{self.name} has no {which} for {family.registered or 'this mechanism'}"
                                              f" (it has: {', '.join(has) or 'none'})", self.name)
+
+    def unit_of(self, registered: str | None) -> str:
+        """The unit of the route ``auto`` takes for a registered mechanism (its closed form's, else :attr:`unit`)."""
+        closed = self.closed_forms.get(registered or "")
+        return closed.unit or self.unit if closed is not None else self.unit
 
 
 @dataclass(frozen=True)
@@ -109,7 +164,7 @@ class Objective:
         """JSON-able, with the unit this family's route gives (a volume is m^2 for a planar closed form)."""
         unit = self.unit
         if self.definition is not None and self.options.get("route") != "generic":
-            unit = self.definition.units.get(family.registered or "", unit)
+            unit = self.definition.unit_of(family.registered)
         out = {"column": self.column, "spec": self.spec, "sense": self.sense, "unit": unit}
         if self.options.get("motions"):  # (what the file said: a resumed sweep must read the same cases)
             out["motions"] = repr(sorted(self.options["motions"].items()))
@@ -196,6 +251,7 @@ def _sense(sense: str) -> str:
 
 def _options(d: Definition, text: str) -> dict[str, Any]:
     out: dict[str, Any] = {"route": "auto"}
+    valid = d.options  # (the objective's own and its closed forms')
     for item in filter(None, (s.strip() for s in text.split(","))):
         key, eq, value = item.partition("=")
         key = key.strip()
@@ -204,10 +260,10 @@ def _options(d: Definition, text: str) -> dict[str, Any]:
                 raise InvalidInputError("route", f"one of {', '.join(ROUTES)}, got {value!r}", value)
             out["route"] = value
             continue
-        if not eq or key not in d.options:
-            raise UnknownNameError("option", key, list(d.options) + ["route"], f"objective {d.name}")
-        out[key] = _option(key, d.options[key], value.strip())
-    for key, spec in d.options.items():
+        if not eq or key not in valid:
+            raise UnknownNameError("option", key, list(valid) + ["route"], f"objective {d.name}")
+        out[key] = _option(key, valid[key], value.strip())
+    for key, spec in valid.items():
         out.setdefault(key, spec[1])
     if out.get("file"):  # a motion file: read here, where its path means something (the workers may not share it)
         from pkm.motion import load_motions
@@ -274,13 +330,13 @@ def _generic_map(c: Candidate, o: Mapping[str, Any]):
         raise InvalidInputError("region", "the generic route maps a region: give region=x=START:STOP:COUNT/...")
 
     def make():
-        from pkm.core.maps import task_map
+        from pkm.core.analysis.maps import workspace_map
 
         mech = c.mechanism
         axes = {n: np.linspace(_task_value(mech, n, a), _task_value(mech, n, b), k)
                 for n, (a, b, k) in o["region"].items()}
         fixed = {n: _task_value(mech, n, v) for n, v in (o.get("pose") or {}).items()}
-        return task_map(mech, axes, fixed, length=o.get("length"), branch=o.get("branch") or None)
+        return workspace_map(mech, axes, fixed, length=o.get("length"), branch=o.get("branch") or None)
 
     key = ("task_map", tuple(o["region"].items()), tuple((o.get("pose") or {}).items()), o.get("length"),
            o.get("branch"))
@@ -319,7 +375,7 @@ def _generic_weighted_volume(c, o):
 def _generic_condition(c, o):
     """``kappa`` of the inverse Jacobian at the pose, the angular rates divided by ``length`` (as the maps do)."""
     import pkm
-    from pkm.core.indices import condition_number
+    from pkm.core.differential.indices import condition_number
     from pkm.errors import SingularityError
 
     mech = c.mechanism
@@ -392,158 +448,39 @@ def _generic_interval(c, o):
     return float(np.count_nonzero(m.reachable) * step)
 
 
-# ---------------------------------------------------------------------- closed forms (the papers' routes)
-def _rrr3_map(c: Candidate, o):
-    from pkm.mechanisms.rrr3 import workspace as ws
-
-    d = ws.Design.of(c.params)
-    mode = o.get("branch") or c.params.mode  # the option's working mode, else the design's
-    return c.cached(("rrr3_map", o["step"], o["kind"], mode), lambda: ws.ci_map(
-        d, ws.workspace_grid(d, o["step"]), ws.CiSettings(mode=mode, norm=o["kind"])))
-
-
-def _rrr3_gci(c, o):
-    g = _rrr3_map(c, o).gci()
-    return None if g.empty else g.value
-
-
-def _rrr3_area(c, o):
-    g = _rrr3_map(c, o).area_gci(o["side"])
-    return None if g.empty else g.value
-
-
-def _centroid(c):
-    from pkm.mechanisms.rrr3 import workspace as ws
-
-    return ws.Design.of(c.params).base_centroid
-
-
-def _rrr3_coverage(c, o):
-    g = _rrr3_map(c, o).area_gci(o["side"])
-    return g.reachable / g.nodes
-
-
-def _rrr3_min_area_ci(c, o):
-    m = _rrr3_map(c, o)
-    region = m.grid.square_mask(o["side"], _centroid(c)) & m.reachable
-    return float(np.min(m.ci[region])) if region.any() else None
-
-
-def _rrr3_volume(c, o):
-    m = _rrr3_map(c, o)
-    return float(np.count_nonzero(m.reachable) * m.grid.step**2)
-
-
-def _delta_grid(c, o):
-    from pkm.mechanisms.delta.workspace import workspace
-
-    kind = o["kind"]
-    return c.cached(("delta_grid", o["spacing"], kind, o["branch"]),
-                    lambda: workspace(c.params, o["spacing"], o["branch"] or "knee_out", (kind,)))
-
-
-def _delta_volume(c, o):
-    return float(_delta_grid(c, o).volume)
-
-
-def _delta_K(c, o):
-    g = _delta_grid(c, o)
-    return g.K[o["kind"]][g.reachable]
-
-
-def _delta_conditioned_volume(c, o):
-    return float(np.count_nonzero(_delta_K(c, o) <= o["k_max"]) * o["spacing"] ** 3)
-
-
-def _delta_weighted_volume(c, o):  # (summed in ascending K, as the serial study's sorted nodes: the same float)
-    return float(np.sum(1.0 / np.sort(_delta_K(c, o))) * o["spacing"] ** 3)
-
-
-def _delta_condition(c, o):
-    from pkm.mechanisms.delta import reference_pose
-    from pkm.mechanisms.delta.design import condition_vs_radius
-
-    p = np.array(reference_pose(c.params), dtype=float)
-    for n, v in (o.get("pose") or {}).items():
-        if n not in ("x", "y", "z"):
-            raise UnknownNameError("task coordinate", n, ("x", "y", "z"), "delta")
-        p["xyz".index(n)] = parse_quantity(v, {"length"}, n, "m")
-    kind = o["kind"]
-    return float(condition_vs_radius(c.params, p, [c.params.R], o["branch"] or "knee_out", (kind,))[kind][0])
-
-
-def _hexapod_pose(c, o):
-    from pkm.mechanisms.hexapod import kinematics as hk
-
-    if o.get("pose"):
-        raise InvalidInputError("pose", "the hexapod's closed form scores its reference pose; use route=generic "
-                                        "for another pose")
-    R, P, _ = hk.reference_pose(c.params)
-    return R, P
-
-
-def _hexapod_interval(c, o):
-    from pkm.errors import UnreachableError
-    from pkm.mechanisms.hexapod.reconfiguration import reachable_intervals
-
-    R, P = _hexapod_pose(c, o)
-    try:
-        spans = reachable_intervals(c.params, R, P)
-    except UnreachableError:
-        return 0.0
-    return float(sum(hi - lo for lo, hi in spans))
-
-
-def _hexapod_gain(c, o):
-    from pkm.mechanisms.hexapod import indices as hi
-    from pkm.mechanisms.hexapod.reconfiguration import optimal_beta
-
-    R, P = _hexapod_pose(c, o)
-    best = optimal_beta(c.params, R, P, o["index"])
-    nominal = hi.PoseIndex(c.params, [(R, P)], o["index"])([0], [c.params.home_beta])
-    return float(best.value / float(np.ravel(nominal)[0]) - 1.0)
-
-
 _REGION_UNIT = "m^i rad^j"  # (the product of the region's axes' units)
 _MAP = {"region": ("region", None, "task coordinates mapped (generic): x=START:STOP:COUNT/y=..."),
         "pose": ("pose", None, "the other task coordinates (generic): x=2cm/z=-36cm"),
         "length": ("length", None, "characteristic length dividing angular rates (generic), e.g. 5cm"),
-        "branch": ("text", "", "working mode (default: the spec's; the 3-RRR's closed form: mode1..mode8)"),
+        "branch": ("text", "", "working mode (default: the spec's; a closed form may name its own modes)"),
         "kind": ("text", "2", "condition-index convention: 2 or fro_normalized", ("2", "fro_normalized"))}
-_RRR3 = {"step": ("length", 0.01, "3-RRR closed form: grid step"),
-         "side": ("length", 0.30, "3-RRR closed form: side of the square area of interest")}
-_DELTA = {"spacing": ("length", 0.008, "Delta closed form: workspace grid step")}
 
-#: name -> :class:`Definition`: every library objective.
+#: name -> :class:`Definition`: every library objective (the registered mechanisms' closed forms found through
+#: the registry: :func:`closed_forms`).
 OBJECTIVES: dict[str, Definition] = {d.name: d for d in (
-    Definition("gci", "max", "-", "global condition index: mean 1/kappa over the reachable nodes",
-               {**_MAP, **_RRR3}, _generic_gci, {"rrr3": _rrr3_gci}),
-    Definition("gci_area", "max", "-", "GCI over the area of interest (generic: the region)",
-               {**_MAP, **_RRR3}, _generic_gci, {"rrr3": _rrr3_area}),
-    Definition("coverage", "max", "-", "reachable fraction of the area of interest (generic: the region)",
-               {**_MAP, **_RRR3}, _generic_coverage, {"rrr3": _rrr3_coverage}),
+    Definition("gci", "max", "-", "global condition index: mean 1/kappa over the reachable nodes", _MAP,
+               _generic_gci),
+    Definition("gci_area", "max", "-", "GCI over the area of interest (generic: the region)", _MAP, _generic_gci),
+    Definition("coverage", "max", "-", "reachable fraction of the area of interest (generic: the region)", _MAP,
+               _generic_coverage),
     Definition("min_area_ci", "max", "-", "smallest 1/kappa over the reachable nodes of the area (generic: region)",
-               {**_MAP, **_RRR3}, _generic_min_ci, {"rrr3": _rrr3_min_area_ci}),
+               _MAP, _generic_min_ci),
     Definition("workspace_volume", "max", _REGION_UNIT, "reachable length, area or volume (generic: of the region)",
-               {**_MAP, **_RRR3, **_DELTA}, _generic_volume, {"rrr3": _rrr3_volume, "delta": _delta_volume},
-               {"rrr3": "m^2", "delta": "m^3"}),
+               _MAP, _generic_volume),
     Definition("conditioned_volume", "max", _REGION_UNIT, "volume of the reachable nodes with kappa <= k_max",
-               {**_MAP, **_DELTA, "k_max": ("float", 3.0, "bound on kappa", 1.0)}, _generic_conditioned_volume,
-               {"delta": _delta_conditioned_volume}, {"delta": "m^3"}),
+               {**_MAP, "k_max": ("float", 3.0, "bound on kappa", 1.0)}, _generic_conditioned_volume),
     Definition("weighted_volume", "max", _REGION_UNIT, "integral of 1/kappa over the workspace (volume x GCI)",
-               {**_MAP, **_DELTA}, _generic_weighted_volume, {"delta": _delta_weighted_volume}, {"delta": "m^3"}),
+               _MAP, _generic_weighted_volume),
     Definition("condition", "min", "-", "condition number kappa at a pose (default: the reference)",
                {**{k: _MAP[k] for k in ("pose", "length", "branch")},
-                "kind": ("text", "2", "2, fro or fro_normalized", ("2", "fro", "fro_normalized"))}, _generic_condition,
-               {"delta": _delta_condition}),
+                "kind": ("text", "2", "2, fro or fro_normalized", ("2", "fro", "fro_normalized"))}, _generic_condition),
     Definition("reachable_interval", "max", "m or rad", "reachable length of a task joint's range at a pose "
-               "(generic: parameter=beta_1,range=-90deg:90deg:181; hexapod closed form: beta's intervals)",
+               "(generic: parameter=beta_1,range=-90deg:90deg:181; a closed form: its exact intervals)",
                {**_MAP, "parameter": ("text", "", "the task joint (generic)"),
-                "range": ("range", None, "its range START:STOP:COUNT (generic)")}, _generic_interval,
-               {"hexapod": _hexapod_interval}, {"hexapod": "rad"}),
-    Definition("beta_gain", "max", "-", "hexapod: index at beta* over the index at the reference beta, minus 1",
-               {"pose": _MAP["pose"], "index": ("text", "w_rot", "w_rot or w_tras", ("w_rot", "w_tras"))}, None,
-               {"hexapod": _hexapod_gain}),
+                "range": ("range", None, "its range START:STOP:COUNT (generic)")}, _generic_interval),
+    Definition("beta_gain", "max", "-", "index at the best reconfiguration beta* over the index at the reference "
+               "beta, minus 1 (closed forms only)",
+               {"pose": _MAP["pose"], "index": ("text", "w_rot", "w_rot or w_tras", ("w_rot", "w_tras"))}, None),
     Definition("peak_effort", "min", "N or N m", "largest |actuator effort| along a motion case",
                {"motion": ("text", "1", "the case's name"), "file": ("text", "", "motion file (default: "
                 "<mechanism>_motions.toml)"), "coordinates": ("text", "", "the motion's coordinates as task "
@@ -561,4 +498,5 @@ OBJECTIVES: dict[str, Definition] = {d.name: d for d in (
 
 RESERVED = frozenset({"design", "status", "error", "message"})
 
-__all__ = ["OBJECTIVES", "ROUTES", "SENSES", "Definition", "Objective", "load_callable", "objective"]
+__all__ = ["OBJECTIVES", "ROUTES", "SENSES", "ClosedForm", "Definition", "Objective", "closed_forms", "load_callable",
+           "objective"]

@@ -9,7 +9,8 @@ from typing import Any
 
 import numpy as np
 
-from pkm.core.spec import as_path
+from pkm._optional import module, require
+from pkm.core.model.spec import as_path
 from pkm.errors import InvalidInputError, SweepError, UnknownNameError
 from pkm.sweeps.store import count_failed, read_manifest
 
@@ -60,7 +61,7 @@ class SweepResult:
     """
 
     def __init__(self, table, manifest: Mapping[str, Any], stats: Stats | None = None):
-        import pyarrow as pa
+        pa = module("pyarrow", extra="sweeps", what="pkm.sweeps.SweepResult (a pyarrow table)")
 
         if not isinstance(table, pa.Table) or not {"design", "status", "error", "message"} <= set(table.column_names):
             raise InvalidInputError("table", "a sweep's pyarrow.Table (columns design, the parameters, the "
@@ -197,7 +198,12 @@ class SweepResult:
 
     @classmethod
     def read(cls, path) -> SweepResult:
-        """The results file a sweep wrote."""
+        """The results file a sweep wrote.
+
+        Raises:
+            MissingDependencyError: pyarrow is not installed (``pip install "pkm[sweeps]"``).
+        """
+        require("sweeps", "reading a sweep's Parquet results", ("pyarrow",))
         import pyarrow as pa
         import pyarrow.parquet as pq
 

@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from pkm._optional import require
 from pkm.errors import InvalidInputError
 from pkm.units import parse_quantity, split_range
 from pkm.validation import as_scalar
@@ -238,6 +239,7 @@ def _read_table(path: Path) -> dict[str, list]:
     if not path.is_file():
         raise InvalidInputError("designs", f"no such file: {path}", str(path))
     if path.suffix.lower() == ".parquet":
+        require("sweeps", "a design table in Parquet (a .csv needs nothing)", ("pyarrow",))
         import pyarrow as pa
         import pyarrow.parquet as pq
 

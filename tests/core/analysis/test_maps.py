@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import pkm
-from pkm.core.analysis.maps import task_map
+from pkm.core.analysis.maps import workspace_map
 from pkm.core.differential import indices
 from pkm.errors import InvalidInputError
 from pkm.mechanisms.delta import DeltaParams
@@ -23,7 +23,7 @@ def _rrr3_map(figure: str):
     d = rrr3_study.figure_design(figure)
     mech = pkm.build("rrr3", a=d.a, b=d.b, h=d.h, H=d.H)
     g = rrr3_study.paper_grid(d)
-    return d, g, task_map(mech, {"x": g.xs, "y": g.ys}, {"yaw": 0.0}, length=d.h / math.sqrt(3))
+    return d, g, workspace_map(mech, {"x": g.xs, "y": g.ys}, {"yaw": 0.0}, length=d.h / math.sqrt(3))
 
 
 @pytest.mark.parametrize("figure", sorted(rrr3_study.PUBLISHED))
@@ -72,7 +72,7 @@ def test_the_delta_workspace_volumes_through_the_generic_route_equal_the_closed_
     hand = workspace(DeltaParams(La=p.La, Lb=p.Lb, r=p.r, R=0.120, home=tuple(p.home)), delta_study.SPACING,
                      kinds=("2",))
     xy, _, z = hand.axes
-    m = task_map(mech, {"x": xy, "y": xy, "z": z})
+    m = workspace_map(mech, {"x": xy, "y": xy, "z": z})
     reach = np.transpose(m.reachable, (2, 1, 0))  # (z, y, x) -> (x, y, z), the closed form's layout
     assert np.array_equal(reach, hand.reachable)
     assert math.isclose(m.size, hand.volume, rel_tol=1e-12)
@@ -91,7 +91,7 @@ def test_a_users_mechanism_gets_its_map():
     mech = pkm.load(FILES["gough_stewart"])
     y0 = pkm.TaskMap(mech).named(mech.q_reference)
     xs, ys = y0["x"] + np.linspace(-0.06, 0.06, 121), y0["y"] + np.linspace(-0.06, 0.06, 121)
-    m = task_map(mech, {"x": xs, "y": ys}, length=0.1)
+    m = workspace_map(mech, {"x": xs, "y": ys}, length=0.1)
     assert m.nodes > 1000 and m.reachable[60, 60]
     ci = m.condition_index("2")
     K = pkm.Kernels(mech)
@@ -112,7 +112,7 @@ def test_the_workspace_over_orientations():
     mech = pkm.load("rrr3")
     d = W.Design.of(mech.params)
     xs, phis = np.linspace(0.0, d.H, 41), np.radians(np.arange(-30.0, 31.0, 10.0))
-    m = task_map(mech, {"x": xs, "y": xs, "yaw": phis}, length=d.h / math.sqrt(3))
+    m = workspace_map(mech, {"x": xs, "y": xs, "yaw": phis}, length=d.h / math.sqrt(3))
     X, Y, P = np.meshgrid(xs, xs, phis)  # (y, x, phi)
     _, reach = W.condition_index_phi(d, X, Y, P, W.CiSettings())
     assert np.array_equal(m.reachable_over("yaw", "any"), reach.any(axis=-1))
@@ -124,10 +124,29 @@ def test_the_workspace_over_orientations():
 def test_bad_maps_are_refused():
     mech = pkm.load("rrr3")
     with pytest.raises(InvalidInputError, match="not a task coordinate"):
-        task_map(mech, {"q": [0.0]})
+        workspace_map(mech, {"q": [0.0]})
     with pytest.raises(InvalidInputError, match="characteristic length"):
-        task_map(mech, {"x": [0.5], "y": [0.3]})
+        workspace_map(mech, {"x": [0.5], "y": [0.3]})
     with pytest.raises(InvalidInputError, match="1 to 3"):
-        task_map(mech, {})
+        workspace_map(mech, {})
     with pytest.raises(InvalidInputError, match="finite"):
-        task_map(mech, {"x": [np.nan]}, length=0.05)
+        workspace_map(mech, {"x": [np.nan]}, length=0.05)
+
+
+def test_the_old_name_warns_and_without_a_compiler_the_error_is_pkms(monkeypatch):
+    """``pkm.task_map`` (0.1) is ``pkm.workspace_map`` with a DeprecationWarning; without a C compiler the map
+    raises pkm's CompilerError (still a RuntimeError, as before) saying why."""
+    import pkm
+    from pkm.core.analysis import maps
+    from pkm.core.twin import codegen
+    from pkm.errors import CompilerError, PkmError
+
+    assert maps.TaskGridMap is maps.WorkspaceMap
+    mech = pkm.load("delta")
+    with pytest.warns(DeprecationWarning, match="workspace_map"):
+        m = pkm.task_map(mech, {"x": [0.0, 0.01]}, kernels=None)
+    assert isinstance(m, maps.WorkspaceMap) and m.reachable.all()
+    monkeypatch.setattr(codegen, "compile_library", lambda *a, **k: (None, "no cc on PATH"))
+    with pytest.raises(CompilerError, match="maps need a C compiler: no cc on PATH") as info:
+        pkm.workspace_map(mech, {"x": [0.0]})
+    assert isinstance(info.value, PkmError) and isinstance(info.value, RuntimeError)

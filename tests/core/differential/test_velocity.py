@@ -270,3 +270,25 @@ def test_actuators_short_of_the_mobility_are_reported():
 
     with pytest.raises(SpecError, match="no actuated joint"):  # (an IndexError before)
         _fivebar_driven_by((), ())
+
+
+def test_a_configuration_is_accepted_wherever_q_is_and_computed_once(monkeypatch):
+    """forward_jacobian, inverse_jacobian, diagnose... at one Configuration: equal results, one kinematics pass
+    (Configuration.compute is not called again); a Configuration of another mechanism is refused."""
+    from pkm.core.kinematics.configuration import Configuration
+
+    delta = pkm.load("delta")
+    q = _near_reference(delta, 4)
+    c = Configuration.at(delta, q)
+    expected = (pkm.forward_jacobian(delta, q), pkm.inverse_jacobian(delta, q), pkm.diagnose(delta, q).sigma_direct)
+    calls = []
+    real = Configuration.compute.__func__
+    monkeypatch.setattr(Configuration, "compute", classmethod(lambda cls, m, qq: calls.append(1) or real(cls, m, qq)))
+    got = (pkm.forward_jacobian(delta, c), pkm.inverse_jacobian(delta, c), pkm.diagnose(delta, c).sigma_direct)
+    assert not calls
+    np.testing.assert_array_equal(got[0], expected[0])
+    np.testing.assert_array_equal(got[1], expected[1])
+    assert got[2] == expected[2]
+    np.testing.assert_array_equal(pkm.velocities(delta, c, [0.1, 0.2, 0.3]), pkm.velocities(delta, q, [0.1, 0.2, 0.3]))
+    with pytest.raises(InvalidInputError, match="Configuration of 'delta'"):
+        pkm.forward_jacobian(pkm.load("rrr3"), c)

@@ -258,3 +258,26 @@ def test_a_reference_in_degrees_or_without_values_is_refused(built):
     ref = {**mech.spec.reference, "motor_1": ()}  # (found by the fuzzing: an IndexError before)
     with pytest.raises(SpecError, match=r"joint 'motor_1' takes 1 coordinate\(s\), got \(0,\)"):
         Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))
+
+
+def test_a_result_checks_itself_again_and_assemble_follows_the_solvers_failure_rule(delta):
+    """SolveResult.check(mech) re-verifies a result from its q alone (qpsolvers' Solution.is_optimal): true for
+    what a solver returned, false once q is moved off the loops, for another mechanism, or for a NaN; assemble, like
+    close_loops and solve_ik, returns a failed result instead of raising with raise_on_failure=False."""
+    import dataclasses
+
+    res = close_loops(delta, [-0.9, -0.85, -1.0])
+    assert res.check(delta)
+    moved = dataclasses.replace(res, q=res.q + 1e-3)
+    assert not moved.check(delta)
+    assert not dataclasses.replace(res, q=np.full_like(res.q, np.nan)).check(delta)
+    assert not res.check(pkm.load("rrr3"))
+    from tests import fivebar
+
+    far = Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params()), fivebar.build().spec)
+    plain = dataclasses.replace(far.spec, reference={})
+    tight = Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params()), plain)
+    q_open = tight.q_reference.copy()
+    q_open[tight.joint("elbow_1").idx_q] += 2.0
+    failed = pkm.assemble(tight, q_open, hold=("motor_1", "motor_2", "elbow_1"), restarts=0, raise_on_failure=False)
+    assert not failed.converged and failed.residual > 1e-3 and failed.check(tight)

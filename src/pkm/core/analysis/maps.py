@@ -1,7 +1,8 @@
 """Maps of any mechanism over a grid of task coordinates: the reachable workspace in one working mode and the
 velocity map's indices at every reachable node, through the twin's compiled kernels.
 
-:func:`task_map` solves the inverse kinematics at every node of a grid of one, two or three task coordinates (the
+:func:`workspace_map` (formerly ``task_map``, a name kept as a deprecated alias: the task coordinates are
+:class:`~pkm.core.kinematics.task.TaskMap`) solves the inverse kinematics at every node of a grid of one, two or three task coordinates (the
 others fixed), breadth first from the node nearest the seed configuration: each node's Newton iteration starts from
 the solution of the neighbour that reached it, so that the whole reachable region connected to the seed is covered
 in the seed's working mode; a node whose solution leaves that mode (the default branch's signs) counts as not
@@ -11,7 +12,7 @@ the seed's Newton iteration does not reach in its mode, is missed.
 
 At a reachable node the map keeps the singular values of ``K diag(s)``: ``K`` the inverse Jacobian (actuated
 rates per task rate), ``s`` the task rates' scales (1 for lengths, ``1/L`` for angles: the homogenisation by a
-characteristic length ``L``). The indices follow from them (:class:`TaskGridMap`): the condition index
+characteristic length ``L``). The indices follow from them (:class:`WorkspaceMap`, formerly ``TaskGridMap``): the condition index
 ``1/kappa`` in the conventions of :mod:`pkm.core.differential.indices` (``"2"``: ``sigma_min / sigma_max``;
 ``"fro_normalized"``: ``n / (||K||_F ||K^-1||_F)``), the global condition index over a region, Yoshikawa's
 manipulability of the forward Jacobian ``J = K^-1`` and its smallest singular value (both 0 at an inverse
@@ -24,9 +25,11 @@ equation (closure and task, ``<= tol``).
 from __future__ import annotations
 
 import ctypes
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -34,7 +37,7 @@ from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.codegen import C_INT as _I
 from pkm.core.twin.codegen import C_REAL_P as _P
-from pkm.errors import InvalidInputError
+from pkm.errors import CompilerError, InvalidInputError
 from pkm.validation import as_array, as_count, as_scalar, as_tolerance
 
 #: Spacing of the root nodes that start a new search where the first did not reach.
@@ -48,7 +51,7 @@ KINDS = ("2", "fro_normalized")
 
 
 @dataclass(frozen=True, eq=False)
-class TaskGridMap:
+class WorkspaceMap:
     """A map over a grid of task coordinates (see the module doc).
 
     Attributes:
@@ -131,6 +134,9 @@ class TaskGridMap:
         """Draw the condition index (``kind``) over the map as a PNG at ``path``: a colour map with its colour bar
         (2-D), a curve (1-D); unreachable nodes white (said in a legend). Axes in mm or deg; the caption (``title``
         by default) names the mechanism, the reachable nodes and the GCI."""
+        from pkm._optional import require
+
+        require("figures", "WorkspaceMap.figure")
         import matplotlib
 
         matplotlib.use("Agg")
@@ -208,7 +214,7 @@ def _library(kernels):
     lib, how = compile_library([step, qr_step, index], directory=kernels.directory,
                                text=map_source(step, qr_step, index, PIVOT_FLOOR))
     if lib is None:
-        raise RuntimeError(f"maps need a C compiler ({how})")
+        raise CompilerError("maps need a C compiler", how)
     grid = getattr(lib, f"{step.name()}_grid")
     grid.argtypes = [ctypes.POINTER(_I), _I, _P, _P, _P, _P, ctypes.POINTER(_I), _I, _I, ctypes.c_double,
                      ctypes.c_double, ctypes.POINTER(ctypes.c_byte), _P, ctypes.POINTER(_I)]
@@ -216,9 +222,9 @@ def _library(kernels):
     return grid, index.size_out(0), how
 
 
-def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, object] | None = None, *,
-             branch: str | None = None, length: float | None = None, seed=None, tol: float = 1e-10,
-             step_tol: float = 1e-8, max_iter: int = 40, kernels=None) -> TaskGridMap:
+def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, object] | None = None, *,
+                  branch: str | None = None, length: float | None = None, seed=None, tol: float = 1e-10,
+                  step_tol: float = 1e-8, max_iter: int = 40, kernels=None) -> WorkspaceMap:
     """The map of ``mech`` over the grid ``axes`` (see the module doc).
 
     Args:
@@ -240,8 +246,8 @@ def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, ob
 
     Raises:
         InvalidInputError: bad axes, a missing ``length``, or a grid beyond :data:`MAX_NODES`.
-        RuntimeError: no C compiler on the machine (the maps run only compiled: a grid of 10^6 nodes through the
-            virtual machine would take an hour).
+        CompilerError: no C compiler on the machine (the maps run only compiled: a grid of 10^6 nodes through the
+            virtual machine would take an hour), or the compiled driver failed (out of memory).
     """
     from pkm.core.twin import Kernels
 
@@ -308,10 +314,21 @@ def task_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, ob
                 state.ctypes.data_as(ctypes.POINTER(ctypes.c_byte)), sv.ctypes.data_as(_P),
                 its.ctypes.data_as(ctypes.POINTER(_I)))
     if flag:
-        raise RuntimeError(f"the map driver failed (code {flag})")
+        raise CompilerError("the compiled map driver failed", "out of memory" if flag == 2 else f"code {flag}")
     shape = tuple(reversed(dims))
-    return TaskGridMap(tuple(grid_axes), base, scale, (state == 1).reshape(shape), sv.reshape(shape + (nsv,)),
+    return WorkspaceMap(tuple(grid_axes), base, scale, (state == 1).reshape(shape), sv.reshape(shape + (nsv,)),
                        its.reshape(shape), how, tuple(task.kinds[name] for name, _ in grid_axes), mech.name)
 
 
-__all__ = ["KINDS", "MAX_NODES", "PIVOT_FLOOR", "ROOT_STRIDE", "TaskGridMap", "task_map"]
+#: The former name of :class:`WorkspaceMap` (deprecated since 0.2.0).
+TaskGridMap = WorkspaceMap
+
+
+def task_map(*args: Any, **kwargs: Any) -> WorkspaceMap:
+    """Deprecated alias of :func:`workspace_map` (0.2.0: "task map" is the task coordinates, :class:`TaskMap`)."""
+    warnings.warn("pkm.task_map is now pkm.workspace_map (pkm 0.2.0)", DeprecationWarning, stacklevel=2)
+    return workspace_map(*args, **kwargs)
+
+
+__all__ = ["KINDS", "MAX_NODES", "PIVOT_FLOOR", "ROOT_STRIDE", "TaskGridMap", "WorkspaceMap", "task_map",
+           "workspace_map"]

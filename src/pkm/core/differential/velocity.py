@@ -18,6 +18,9 @@ actuated columns ``J_a`` and passive columns ``J_p``, and ``J_t`` the task Jacob
 * accelerations: ``J_c a + gamma_c = 0`` with the drift ``gamma_c = dJ_c/dt v``, and
   task accelerations ``J_t a + gamma_t``.
 
+Every function taking ``(mech, q)`` also takes a :class:`~pkm.core.kinematics.configuration.Configuration` of the
+mechanism for ``q`` (``Configuration.at(mech, q)``): the kinematics is then computed once for all of them.
+
 Rank decisions compare singular values with ``rtol`` times the largest one (relative: a mechanism
 of micrometres is judged as one of metres); idle motions are those that move the task by at most
 ``rtol`` times the largest singular value of ``J_t``.
@@ -28,21 +31,28 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pkm.core.differential.indices import singularity_class
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.errors import SingularityError
+from pkm.errors import InvalidInputError, SingularityError
 from pkm.validation import as_tolerance, as_vector, finite_result
 
 RTOL = 1e-9
 
 
-def _check(mech, q) -> tuple[Mechanism, np.ndarray]:
-    """The mechanism and ``q`` checked (type, shape, finiteness, unit quaternions)."""
+def _at(mech: Mechanism, q: ArrayLike | Configuration) -> tuple[Mechanism, Configuration]:
+    """The mechanism and its kinematics at ``q``: a :class:`Configuration` of that mechanism is used as it is (the
+    kinematics computed once for every analysis at one configuration), anything else is checked (type, shape,
+    finiteness, unit quaternions) and computed."""
     mech = check_mechanism(mech)
-    return mech, mech.check_q(q)
+    if isinstance(q, Configuration):
+        if q.mech is not mech:
+            raise InvalidInputError("q", f"a Configuration of {q.mech.name!r}, not of {mech.name!r}", q.mech.name)
+        return mech, q
+    return mech, Configuration.compute(mech, mech.check_q(q))
 
 
 def _svd(A: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -163,15 +173,15 @@ def _passive_map(mech: Mechanism, sp: _Split, Jc: np.ndarray) -> np.ndarray:
     return G
 
 
-def idle_motions(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+def idle_motions(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
     """An orthonormal basis (nv x k) of the idle motions at ``q``: joint rates that the closures allow with the
     actuators locked and that the task does not see (a rod spinning about its axis between two ball joints);
     k = 0 for most mechanisms. Their rates and accelerations are not fixed by the kinematics."""
-    mech, q = _check(mech, q)
-    return _split(mech, Configuration.compute(mech, q), as_tolerance(rtol, "rtol")).idle
+    mech, c = _at(mech, q)
+    return _split(mech, c, as_tolerance(rtol, "rtol")).idle
 
 
-def passive_map(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+def passive_map(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
     """``G = dq/dq_a`` (nv x na): all joint rates from the actuated rates, without idle motion.
 
     Raises:
@@ -179,35 +189,33 @@ def passive_map(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
             the task is allowed to first order (the smallest singular value of ``J_p`` off the idle
             motions is at most ``rtol`` times the largest).
     """
-    mech, q = _check(mech, q)
+    mech, c = _at(mech, q)
     rtol = as_tolerance(rtol, "rtol")
-    c = Configuration.compute(mech, q)
     sp = _split(mech, c, rtol)
     _direct_check(sp, rtol)
     return finite_result(_passive_map(mech, sp, c.constraint_jacobian), "passive map G")
 
 
-def forward_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+def forward_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
     """Task rates from actuated rates, ``yd = J qd_a`` (n_task x na); raises as :func:`passive_map`."""
     return _forward(mech, q, rtol, "forward")
 
 
-def twist_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+def twist_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
     """End-effector twist ``[v; w]`` (origin velocity, world axes) from actuated rates (6 x na)."""
     return _forward(mech, q, rtol, "twist")
 
 
-def _forward(mech, q, rtol, which: str) -> np.ndarray:
-    mech, q = _check(mech, q)
+def _forward(mech: Mechanism, q: ArrayLike | Configuration, rtol: float, which: str) -> np.ndarray:
+    mech, c = _at(mech, q)
     rtol = as_tolerance(rtol, "rtol")
-    c = Configuration.compute(mech, q)
     sp = _split(mech, c, rtol)
     _direct_check(sp, rtol)
     J = c.task_jacobian if which == "forward" else c.ee_jacobian
     return finite_result(J @ _passive_map(mech, sp, c.constraint_jacobian), f"{which} Jacobian")
 
 
-def inverse_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
+def inverse_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
     """Actuated rates from task rates, ``qd_a = J yd`` (na x n_task).
 
     Raises:
@@ -215,32 +223,31 @@ def inverse_jacobian(mech: Mechanism, q, *, rtol: float = RTOL) -> np.ndarray:
             allowed to first order (``[J_c; J_t]`` off the idle motions loses column rank, relative
             to ``rtol``).
     """
-    mech, q = _check(mech, q)
+    mech, c = _at(mech, q)
     rtol = as_tolerance(rtol, "rtol")
-    sp = _split(mech, Configuration.compute(mech, q), rtol)
+    sp = _split(mech, c, rtol)
     _inverse_check(sp, rtol)
     rhs = np.zeros((mech.n_constraints + mech.n_task, mech.n_task))
     rhs[mech.n_constraints:] = np.eye(mech.n_task)
     return finite_result(sp.joint_solve(rhs)[mech.act_v], "inverse Jacobian")
 
 
-def velocities(mech: Mechanism, q, qd_actuated) -> np.ndarray:
+def velocities(mech: Mechanism, q: ArrayLike | Configuration, qd_actuated: ArrayLike) -> np.ndarray:
     """All joint rates ``v`` (nv,) from the actuated rates."""
     G = passive_map(mech, q)
     return finite_result(G @ mech.check_actuated(qd_actuated, "qd_actuated"), "joint velocities")
 
 
-def accelerations(mech: Mechanism, q, v, qdd_actuated) -> np.ndarray:
+def accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, qdd_actuated: ArrayLike) -> np.ndarray:
     """All joint accelerations ``a`` (nv,) from the actuated ones, the drift included (no idle acceleration).
 
     Raises:
         SingularityError: as :func:`passive_map`.
     """
-    mech, q = _check(mech, q)
+    mech, c = _at(mech, q)
     v = mech.check_v(v)
     qdd = mech.check_actuated(qdd_actuated, "qdd_actuated")
-    gamma = constraints.drift(mech, q, v)
-    c = Configuration.compute(mech, q)
+    gamma = constraints.drift(mech, c.q, v)
     sp = _split(mech, c, RTOL)
     _direct_check(sp, RTOL)
     a = np.zeros(mech.nv)
@@ -249,38 +256,36 @@ def accelerations(mech: Mechanism, q, v, qdd_actuated) -> np.ndarray:
     return finite_result(a, "joint accelerations")
 
 
-def task_velocity(mech: Mechanism, q, v) -> np.ndarray:
+def task_velocity(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike) -> np.ndarray:
     """Task rates for joint rates ``v``."""
-    mech, q = _check(mech, q)
+    mech, c = _at(mech, q)
     v = mech.check_v(v)
-    return finite_result(mech.task_map.jacobian(q) @ v, "task velocity")
+    return finite_result(c.task_jacobian @ v, "task velocity")
 
 
-def task_acceleration(mech: Mechanism, q, v, a) -> np.ndarray:
+def task_acceleration(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, a: ArrayLike) -> np.ndarray:
     """Task accelerations ``J_t a + dJ_t/dt v``."""
-    mech, q = _check(mech, q)
+    mech, c = _at(mech, q)
     v, a = mech.check_v(v), mech.check_v(a, "a")
-    task = mech.task_map
-    return finite_result(task.jacobian(q) @ a + task.bias(q, v), "task acceleration")
+    return finite_result(c.task_jacobian @ a + mech.task_map.bias(c.q, v), "task acceleration")
 
 
-def inverse_velocities(mech: Mechanism, q, yd) -> np.ndarray:
+def inverse_velocities(mech: Mechanism, q: ArrayLike | Configuration, yd: ArrayLike) -> np.ndarray:
     """All joint rates ``v`` for task rates ``yd`` (nv,)."""
-    mech, q = _check(mech, q)
+    mech, c = _at(mech, q)
     yd = as_vector(yd, mech.n_task, "yd")
-    sp = _split(mech, Configuration.compute(mech, q), RTOL)
+    sp = _split(mech, c, RTOL)
     return finite_result(sp.joint_solve(np.concatenate([np.zeros(mech.n_constraints), yd])), "joint velocities")
 
 
-def inverse_accelerations(mech: Mechanism, q, v, ydd) -> np.ndarray:
+def inverse_accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, ydd: ArrayLike) -> np.ndarray:
     """All joint accelerations ``a`` for task accelerations ``ydd`` at state ``(q, v)``."""
-    mech, q = _check(mech, q)
+    mech, c = _at(mech, q)
     v = mech.check_v(v)
     ydd = as_vector(ydd, mech.n_task, "ydd")
-    task = mech.task_map
-    gamma_c = constraints.drift(mech, q, v)
-    gamma_t = task.bias(q, v)
-    sp = _split(mech, Configuration.compute(mech, q), RTOL)
+    gamma_c = constraints.drift(mech, c.q, v)
+    gamma_t = mech.task_map.bias(c.q, v)
+    sp = _split(mech, c, RTOL)
     return finite_result(sp.joint_solve(np.concatenate([-gamma_c, ydd - gamma_t])), "joint accelerations")
 
 
@@ -382,7 +387,7 @@ class Actuation:
         return "; ".join(out)
 
 
-def actuation(mech: Mechanism, q=None, *, rtol: float = 1e-7) -> Actuation:
+def actuation(mech: Mechanism, q: ArrayLike | Configuration | None = None, *, rtol: float = 1e-7) -> Actuation:
     """The actuators against the mobility at ``q`` (default: the reference configuration): which actuators depend
     on the others, and how many degrees of freedom no actuator drives (:class:`Actuation`).
 
@@ -393,9 +398,8 @@ def actuation(mech: Mechanism, q=None, *, rtol: float = 1e-7) -> Actuation:
     actuators look dependent than elsewhere.
     """
     mech = check_mechanism(mech)
-    q = mech.q_reference if q is None else mech.check_q(q)
+    mech, c = _at(mech, mech.q_reference if q is None else q)
     rtol = as_tolerance(rtol, "rtol")
-    c = Configuration.compute(mech, q)
     return _actuation(mech, c, _split(mech, c, rtol), rtol)
 
 
@@ -418,7 +422,7 @@ def _actuation(mech: Mechanism, c: Configuration, sp: _Split, rtol: float) -> Ac
     return Actuation(mobility, len(basis), tuple(dependent), max(mobility - len(basis) - idle, 0), idle)
 
 
-def diagnose(mech: Mechanism, q, *, rtol: float = 1e-7, near: float = 1e-3) -> Diagnostics:
+def diagnose(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 1e-7, near: float = 1e-3) -> Diagnostics:
     """Rank, mobility, idle motions, graded singularity measures and the actuators against the mobility at ``q``
     (which should be assembled). ``str()`` of the result is one sentence (:attr:`Diagnostics.summary`): a regular
     configuration inside the ``near`` band says how near it is.
@@ -427,10 +431,9 @@ def diagnose(mech: Mechanism, q, *, rtol: float = 1e-7, near: float = 1e-3) -> D
         rtol: Relative rank tolerance: a kind is singular where its distance is at most ``rtol``.
         near: Distances below this (and above ``rtol``) are reported in :attr:`Diagnostics.near`.
     """
-    mech, q = _check(mech, q)
+    mech, c = _at(mech, q)
     rtol = as_tolerance(rtol, "rtol")
     near = max(as_tolerance(near, "near"), rtol)
-    c = Configuration.compute(mech, q)
     Jc = finite_result(c.constraint_jacobian, "constraint Jacobian")
     s = np.linalg.svd(Jc, compute_uv=False)
     rank = int(np.sum(s > rtol * s[0])) if len(s) and s[0] > 0.0 else 0

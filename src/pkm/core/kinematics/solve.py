@@ -24,11 +24,12 @@ iterations for a whole solve. No solver returns a non-finite configuration.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
@@ -64,6 +65,21 @@ class SolveResult:
     steps: int = 1
     branch_signs: dict[str, int] = field(default_factory=dict)
     outside_limits: tuple[str, ...] = ()
+
+    def check(self, mech: Mechanism, *, tol: float = 1e-9) -> bool:
+        """Whether this result still holds on ``mech``, checked again from ``q`` alone (as qpsolvers'
+        ``Solution.is_optimal``): ``q`` a valid configuration of ``mech``; when converged, its loops closed to
+        ``max(tol, residual)`` (m or rad); the branch signs and the joints outside their limits as recorded.
+        A result of another mechanism, or one edited since, does not hold."""
+        mech = check_mechanism(mech)
+        tol = as_tolerance(tol, "tol")
+        try:
+            q = mech.check_q(self.q)
+        except InvalidInputError:
+            return False
+        gap = constraints.worst_closure(mech, constraints.residual(mech, q))[0]
+        return bool((not self.converged or gap <= max(tol, self.residual))
+                    and self.branch_signs == _signs(mech, q) and self.outside_limits == mech.outside_limits(q))
 
 
 def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray,
@@ -140,8 +156,8 @@ def _follow(mech: Mechanism, what: str, solve_at, q: np.ndarray, n_steps: int, t
                 return result
 
 
-def close_loops(mech: Mechanism, q_actuated, q0=None, *, tol: float = DEFAULT_TOL, max_iter: int = 30,
-                max_step: float = 0.1, raise_on_failure: bool = True) -> SolveResult:
+def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = None, *, tol: float = DEFAULT_TOL,
+                max_iter: int = 30, max_step: float = 0.1, raise_on_failure: bool = True) -> SolveResult:
     """Forward position problem: passive coordinates for given actuated ones.
 
     Args:
@@ -174,8 +190,9 @@ def close_loops(mech: Mechanism, q_actuated, q0=None, *, tol: float = DEFAULT_TO
     return _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure)
 
 
-def solve_ik(mech: Mechanism, target, q0=None, *, branch: str | None = None, tol: float = DEFAULT_TOL,
-             max_iter: int = 30, max_step: float = 0.05, raise_on_failure: bool = True) -> SolveResult:
+def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: ArrayLike | None = None, *,
+             branch: str | None = None, tol: float = DEFAULT_TOL, max_iter: int = 30, max_step: float = 0.05,
+             raise_on_failure: bool = True) -> SolveResult:
     """Inverse position problem: every joint coordinate for given task coordinates.
 
     Args:
@@ -264,8 +281,8 @@ def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_i
     return out
 
 
-def assemble(mech: Mechanism, q0=None, *, hold=(), tol: float = 1e-10, restarts: int = 16, seed: int = 0,
-             max_iter: int = 200) -> SolveResult:
+def assemble(mech: Mechanism, q0: ArrayLike | None = None, *, hold: Sequence[str] = (), tol: float = DEFAULT_TOL,
+             restarts: int = 16, seed: int = 0, max_iter: int = 200, raise_on_failure: bool = True) -> SolveResult:
     """A configuration that closes every loop, from any seed (the mechanism's own files need not be closed).
 
     Levenberg-Marquardt on the closure residual over every joint, on the configuration manifold, from
@@ -274,6 +291,9 @@ def assemble(mech: Mechanism, q0=None, *, hold=(), tol: float = 1e-10, restarts:
     answer every run). Every joint moves but those named in ``hold``, which keep their values in ``q0``
     (a spec's partial ``[reference]`` holds the joints it states): with no ``hold`` this finds *an*
     assembly, not the one for given actuators (that is :func:`close_loops`).
+
+    With ``raise_on_failure=False`` the best start's result is returned (``converged`` False) instead of raising,
+    as :func:`close_loops` and :func:`solve_ik` do.
 
     Raises:
         AssemblyError: no start closes: the best residual, and the closure that stays most open and by how much.
@@ -312,6 +332,8 @@ def assemble(mech: Mechanism, q0=None, *, hold=(), tol: float = 1e-10, restarts:
             q = mech.wrap(q)
             return _result(mech, q, True, res, total, k + 1)
     result = _result(mech, best[1], False, best[0], total, restarts + 1)
+    if not raise_on_failure:
+        return result
     err = _failure(mech, "assembly", result, tol)
     alone, detail = _open_alone(mech, q_seed, held, tol, max_iter, rng)
     detail = detail or (f"{restarts + 1} starts of Levenberg-Marquardt: each closure closes alone, not all of them "

@@ -1,0 +1,62 @@
+"""The Delta's closed-form sweep objectives (its registry entry's ``sweeps``): the workspace grid of
+:mod:`pkm.mechanisms.delta.workspace` behind ``workspace_volume``, ``conditioned_volume`` and ``weighted_volume``
+(m^3), and the paper's eq. 12 Jacobians (:func:`pkm.mechanisms.delta.design.condition_vs_radius`) behind
+``condition``. :func:`pkm.sweep` takes them by default (``route=auto``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pkm.errors import UnknownNameError
+from pkm.sweeps.objectives import ClosedForm
+from pkm.units import parse_quantity
+
+#: The option the workspace grid reads (beyond the objectives' own).
+OPTIONS = {"spacing": ("length", 0.008, "Delta closed form: workspace grid step")}
+
+
+def _grid(c, o):
+    from pkm.mechanisms.delta.workspace import workspace
+
+    kind = o["kind"]
+    return c.cached(("delta_grid", o["spacing"], kind, o["branch"]),
+                    lambda: workspace(c.params, o["spacing"], o["branch"] or "knee_out", (kind,)))
+
+
+def _K(c, o):
+    g = _grid(c, o)
+    return g.K[o["kind"]][g.reachable]
+
+
+def workspace_volume(c, o):
+    return float(_grid(c, o).volume)
+
+
+def conditioned_volume(c, o):
+    return float(np.count_nonzero(_K(c, o) <= o["k_max"]) * o["spacing"] ** 3)
+
+
+def weighted_volume(c, o):  # (summed in ascending K, as the serial study's sorted nodes: the same float)
+    return float(np.sum(1.0 / np.sort(_K(c, o))) * o["spacing"] ** 3)
+
+
+def condition(c, o):
+    from pkm.mechanisms.delta import reference_pose
+    from pkm.mechanisms.delta.design import condition_vs_radius
+
+    p = np.array(reference_pose(c.params), dtype=float)
+    for n, v in (o.get("pose") or {}).items():
+        if n not in ("x", "y", "z"):
+            raise UnknownNameError("task coordinate", n, ("x", "y", "z"), "delta")
+        p["xyz".index(n)] = parse_quantity(v, {"length"}, n, "m")
+    kind = o["kind"]
+    return float(condition_vs_radius(c.params, p, [c.params.R], o["branch"] or "knee_out", (kind,))[kind][0])
+
+
+#: objective name -> its closed form.
+CLOSED_FORMS = {"workspace_volume": ClosedForm(workspace_volume, OPTIONS, "m^3"),
+                "conditioned_volume": ClosedForm(conditioned_volume, OPTIONS, "m^3"),
+                "weighted_volume": ClosedForm(weighted_volume, OPTIONS, "m^3"),
+                "condition": ClosedForm(condition)}
+
+__all__ = ["CLOSED_FORMS", "OPTIONS"]
