@@ -49,15 +49,6 @@ def near_pose_t(params, rng, n, pos=0.02, ang=0.05):
     return [(pin.exp3(ang * rng.uniform(-1, 1, 3)) @ R0, P0 + pos * rng.uniform(-1, 1, 3)) for _ in range(n)]
 
 
-def core_handles_mimic(mech) -> bool:
-    """Whether the generic core computes the constraint Jacobian of a model with mimic joints."""
-    try:
-        constraints.jacobian(mech, mech.q_reference)
-    except RuntimeError:  # Pinocchio 4.1: getConstraintsJacobian refuses JointModelMimic
-        return False
-    return True
-
-
 def leg_geometry(params, R, P, beta, branch="elbow_out"):
     """Paper points A, B, C (rows) and axes u of the six legs at a pose."""
     alphas = hx.inverse_kinematics(params, R, P, beta, branch)
@@ -432,9 +423,7 @@ def test_default_layout_and_branch_reproduce_the_manipulability_optimum(params):
 
 def test_paper_jacobian_equals_the_generic_twist_jacobian(mech, params):
     """Eq. (37) with beta fixed equals the generic core's twist Jacobian referred to O (alpha columns)."""
-    if not core_handles_mimic(mech):
-        pytest.skip("the core's constraint Jacobian (pin.getConstraintsJacobian) refuses mimic joints")
-    from pkm.core import twist_jacobian
+    from pkm.core import twist_jacobian  # (the core builds its Jacobians from frame Jacobians: mimic joints too)
 
     R, P = pose_t(params)
     for beta in (-30 * DEG, 0.0, 50 * DEG):
@@ -448,8 +437,6 @@ def test_paper_jacobian_equals_the_generic_twist_jacobian(mech, params):
 
 def test_generic_inverse_kinematics_matches_the_closed_form_on_both_branches(mech, params):
     """The generic solver, seeded on a branch, lands on the closed-form solution of that branch."""
-    if not core_handles_mimic(mech):
-        pytest.skip("the core's constraint Jacobian (pin.getConstraintsJacobian) refuses mimic joints")
     rng = np.random.default_rng(4)
     for branch in hx.BRANCHES:
         for R, P in near_pose_t(params, rng, 2, pos=0.01, ang=0.03):
