@@ -23,3 +23,15 @@ def lazy(package: str, namespace: dict[str, Any], where: Mapping[str, str]) -> t
         return sorted(set(namespace) | set(where))
 
     return getattr_, dir_
+
+
+def delegate(module: str) -> Callable[[str], Any]:
+    """``__getattr__`` for a package whose names (private ones included) are those of its main ``module``, imported
+    on first use (so that importing one of the package's other modules does not import it)."""
+
+    def getattr_(name: str) -> Any:
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return getattr(importlib.import_module(module), name)
+
+    return getattr_

@@ -2,17 +2,11 @@
 (:mod:`~pkm.core.differential.velocity`), screws (:mod:`~pkm.core.differential.screws`) and condition indices
 (:mod:`~pkm.core.differential.indices`).
 
-The names of :mod:`~pkm.core.differential.velocity` are importable from here too (``pkm.core.differential.velocity.X``), imported on first
-use, so that ``import pkm.core.differential.velocity.<module>`` stays as cheap as that module.
+The names of :mod:`~pkm.core.differential.velocity` are importable from here too (``pkm.core.differential.X``, as before 0.2.0, when
+this package was one module), imported on first use, so that importing another module of the package stays as
+cheap as that module.
 """
 
-from __future__ import annotations
+from pkm._lazy import delegate
 
-import importlib
-from typing import Any
-
-
-def __getattr__(name: str) -> Any:
-    if name.startswith("__"):
-        raise AttributeError(name)
-    return getattr(importlib.import_module("pkm.core.differential.velocity"), name)
+__getattr__ = delegate("pkm.core.differential.velocity")

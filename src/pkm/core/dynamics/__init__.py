@@ -1,17 +1,11 @@
 """Dynamics: Khalil's projection of Pinocchio's RNEA onto the actuated joints, the virtual-work route, the
 forward dynamics through ``constraintDynamics`` (:mod:`~pkm.core.dynamics.projection`).
 
-The names of :mod:`~pkm.core.dynamics.projection` are importable from here too (``pkm.core.dynamics.projection.X``), imported on first
-use, so that ``import pkm.core.dynamics.projection.<module>`` stays as cheap as that module.
+The names of :mod:`~pkm.core.dynamics.projection` are importable from here too (``pkm.core.dynamics.X``, as before 0.2.0, when
+this package was one module), imported on first use, so that importing another module of the package stays as
+cheap as that module.
 """
 
-from __future__ import annotations
+from pkm._lazy import delegate
 
-import importlib
-from typing import Any
-
-
-def __getattr__(name: str) -> Any:
-    if name.startswith("__"):
-        raise AttributeError(name)
-    return getattr(importlib.import_module("pkm.core.dynamics.projection"), name)
+__getattr__ = delegate("pkm.core.dynamics.projection")
