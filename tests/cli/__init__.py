@@ -1,0 +1,1 @@
+"""Tests of pkm.cli, one module per module or command of the package."""

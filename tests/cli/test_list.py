@@ -1,0 +1,40 @@
+"""``pkm list``, as JSON through the installed console script and as text."""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+from pkm import cli
+from pkm.mechanisms import names
+from tests.cli.helpers import one_error_line, run
+
+
+def test_console_script_lists_every_mechanism_as_json():
+    """The installed ``pkm`` script prints every mechanism's parameters with defaults and units, SI."""
+    script = Path(sys.executable).with_name("pkm")
+    proc = subprocess.run([str(script), "list", "--json"], check=False, capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(proc.stdout)["mechanisms"]
+    assert list(data) == list(names(with_files=True))  # a subprocess: the shipped registry
+    assert data["delta"]["parameters"]["R"] == {**data["delta"]["parameters"]["R"], "default": 0.15, "unit": "m"}
+    assert data["delta"]["actuated"] == {"motor_1": "rad", "motor_2": "rad", "motor_3": "rad"}
+    assert data["prs3"]["actuated"]["slider_1"] == "m" and data["hexapod"]["task"]["beta_1"] == "rad"
+
+
+def test_list_as_text_and_a_bad_option(capsys):
+    """``pkm list`` names each mechanism, its task origin, a reachable pose (which ``pkm ik`` takes back as it is
+    printed) and its parameters; an unknown option exits 2 with one line."""
+    ok = run("list")
+    assert ok.returncode == 0
+    assert all(f"{m}: " in ok.stdout for m in names(with_files=True)) and "task (--pose): x [m], y [m], z [m]" in ok.stdout
+    rrr3 = ok.stdout[ok.stdout.index("rrr3: "):]
+    assert "task origin: the base joint A1" in rrr3
+    pose = re.search(r"reference pose \(reachable\): (.*)", rrr3).group(1).split()
+    assert pose == ["x=50cm", "y=28.87cm", "yaw=5deg"]
+    assert cli.main(["ik", "rrr3", "--pose", *pose]) == 0 and json.loads(capsys.readouterr().out)["converged"]
+    bad = run("list", "--bad")
+    assert bad.returncode == 2 and "unrecognized arguments: --bad" in one_error_line(bad)

@@ -1,0 +1,34 @@
+"""``pkm map``: the summary, the CSV and the figure of a workspace map."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+
+from pkm import cli
+from tests.cli.helpers import run
+from tests.papers.figures import inspected
+
+
+def test_map_prints_a_summary_and_writes_the_figure_and_the_numbers(tmp_path):
+    """``pkm map`` with units on the axes: the summary's GCI is the mean of the CSV's CIs; the PNG exists."""
+    proc = run("map", "rrr3", "--axis", "x=30cm:70cm:41", "--axis", "y=10cm:50cm:41", "--pose", "yaw=0deg",
+               "--length", "5.7735cm", "--png", str(tmp_path / "m.png"), "--csv", str(tmp_path / "m.csv"))
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    assert out["nodes"] == 41 * 41 and 0 < out["reachable"] <= out["nodes"]
+    rows = list(csv.DictReader((tmp_path / "m.csv").open()))
+    assert len(rows) == 41 * 41 and sum(int(r["reachable"]) for r in rows) == out["reachable"]
+    ci = [float(r["ci_2"]) for r in rows if r["reachable"] == "1"]
+    assert math.isclose(sum(ci) / len(ci), out["gci_2"], rel_tol=1e-12)
+    assert (tmp_path / "m.png").stat().st_size > 10_000
+
+
+def test_the_map_figure_passes_the_figure_check(tmp_path, capsys):
+    """The PNG of ``pkm map`` (in process, coarse): a caption naming the mechanism, units on both axes, a colour bar,
+    the white of unreachable nodes in a legend."""
+    with inspected(paper=False) as found:
+        assert cli.main(["map", "rrr3", "--axis", "x=0cm:100cm:21", "--axis", "y=-10cm:90cm:21", "--pose", "yaw=0deg",
+                         "--length", "5.7735cm", "--png", str(tmp_path / "m.png")]) == 0
+    assert found == {"m": []}

@@ -1,0 +1,1 @@
+"""Tests of pkm.viz, one module per module of the package."""
