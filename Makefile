@@ -4,7 +4,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.pkm-installed
 
-.PHONY: demo test bench venv clean
+.PHONY: demo test bench venv clean docs
 
 venv: $(STAMP)
 
@@ -29,3 +29,11 @@ bench: $(STAMP)
 
 clean:
 	rm -rf $(VENV) build dist .pytest_cache
+
+# The documentation site, built from the docstrings into site/ (MkDocs, Material, mkdocstrings; warnings are errors):
+# installs the `docs` extra into the venv when it is missing. (The two variables silence the banners Material and
+# properdocs print about MkDocs 2; they are not build warnings.)
+docs: $(STAMP)
+	$(PY) -c "import mkdocs, material, mkdocstrings_handlers.python, mkdocs_gen_files, mkdocs_literate_nav" 2>/dev/null \
+		|| $(PY) -m pip install --quiet -e ".[docs]"
+	NO_MKDOCS_2_WARNING=1 DISABLE_MKDOCS_2_WARNING=true $(PY) -m mkdocs build --strict -d site

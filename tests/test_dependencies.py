@@ -89,7 +89,7 @@ def extra(name: str) -> set[str]:
 
 
 #: Extras of tools, not of the library (no module of pkm imports them), and the one that installs all of them.
-TOOLING = ("dev", "all")
+TOOLING = ("dev", "all", "docs")
 #: Modules of pkm that import an extra's module without checking it themselves, each with its reason.
 UNGUARDED = {
     "pkm/sweeps/store.py": "internal: its callers (pkm.sweep, SweepResult.read) check pkm[sweeps] first",

@@ -106,7 +106,7 @@ def write_best(result, by: str, out_dir, *, n: int = 3, mechanism=None) -> list[
     Raises:
         SweepError: no design has a value of ``by`` (:meth:`~pkm.sweeps.SweepResult.best`).
         InvalidInputError: a loaded mechanism's files not given or not the same.
-        Whatever building the design raises (it could not assemble at its reference pose).
+        Exception: whatever building the design raises (it could not assemble at its reference pose).
     """
     import pkm
 
