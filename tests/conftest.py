@@ -1,6 +1,7 @@
 """Shared fixtures: mechanisms built once per session; the test-only toy mechanism registered; one folder of
-compiled twin kernels for the whole session (``PKM_CACHE_DIR``, inherited by the subprocesses the tests start), so
-that a kernel is compiled once and nothing is written to the user's cache.
+pkm's cache for the whole run, shared by the workers and the subprocesses the tests start (``PKM_CACHE_DIR``:
+:func:`pytest_configure`), so that a kernel is compiled once, each paper's rows are computed once, and nothing is
+written to the user's cache.
 
 ``tests/fivebar`` is a mechanism that exists only here: registering it (one line) puts it
 through every test that iterates the registry (generic core, property tests, fuzzing, scenes),
@@ -10,6 +11,8 @@ which proves that a mechanism is one folder plus one registry entry.
 from __future__ import annotations
 
 import os
+import shutil
+import tempfile
 
 import pytest
 
@@ -31,12 +34,22 @@ def built():
     return get
 
 
-@pytest.fixture(scope="session", autouse=True)
-def _twin_cache(tmp_path_factory):
-    previous = os.environ.get("PKM_CACHE_DIR")
-    os.environ["PKM_CACHE_DIR"] = str(tmp_path_factory.mktemp("twin-cache"))
-    yield
-    if previous is None:
-        os.environ.pop("PKM_CACHE_DIR", None)
-    else:
-        os.environ["PKM_CACHE_DIR"] = previous
+def pytest_configure(config):
+    """One cache folder for the whole run (``PKM_CACHE_DIR``: compiled twins, the papers' rows), made by the
+    controlling process before pytest-xdist starts its workers, which inherit it with the subprocesses they start:
+    each kernel is compiled and each paper's rows computed once per run, and nothing is written to the user's
+    cache. A fresh folder every run: nothing computed by an earlier run (or another version) is reused."""
+    if os.environ.get("PYTEST_XDIST_WORKER") is None:
+        folder = tempfile.mkdtemp(prefix="pkm-test-cache-")
+        config._pkm_cache = (folder, os.environ.get("PKM_CACHE_DIR"))
+        os.environ["PKM_CACHE_DIR"] = folder
+
+
+def pytest_unconfigure(config):
+    if hasattr(config, "_pkm_cache"):
+        folder, previous = config._pkm_cache
+        shutil.rmtree(folder, ignore_errors=True)
+        if previous is None:
+            os.environ.pop("PKM_CACHE_DIR", None)
+        else:
+            os.environ["PKM_CACHE_DIR"] = previous

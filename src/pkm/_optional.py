@@ -38,6 +38,10 @@ def missing(extra: str, modules: Iterable[str] | None = None) -> list[str]:
     blocked in ``sys.modules`` as None counts as missing)."""
     if extra not in EXTRAS:
         raise InvalidInputError("extra", f"one of {', '.join(EXTRAS)}, got {extra!r}", extra)
+    outside = [m for m in modules or () if m not in EXTRAS[extra]]
+    if outside:
+        raise InvalidInputError("modules", f"{outside} are not modules of the {extra!r} extra "
+                                           f"({', '.join(EXTRAS[extra])})", outside)
     wanted = EXTRAS[extra] if modules is None else {m: EXTRAS[extra][m] for m in modules}
     out = []
     for top, dist in wanted.items():

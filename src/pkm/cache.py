@@ -50,6 +50,18 @@ def code_digest(modules: Iterable[ModuleType | str]) -> str:
     return h.hexdigest()
 
 
+def file_digest(paths: Iterable[Path]) -> str:
+    """The SHA-256 of the files under ``paths`` (folders walked, in name order): names and contents."""
+    h = hashlib.sha256()
+    for root in paths:
+        root = Path(root)
+        for f in sorted(root.rglob("*")) if root.is_dir() else [root]:
+            if f.is_file():
+                h.update(str(f.relative_to(root.parent)).encode())
+                h.update(f.read_bytes())
+    return h.hexdigest()
+
+
 def cached(kind: str, key: Any, compute: Callable[[], Any], *, code: Iterable[ModuleType | str] = ()) -> Any:
     """``compute()``, or its JSON-able result stored earlier under the same ``kind``, ``key`` and ``code``.
 
@@ -81,4 +93,4 @@ def cached(kind: str, key: Any, compute: Callable[[], Any], *, code: Iterable[Mo
     return value
 
 
-__all__ = ["cache_dir", "cached", "code_digest"]
+__all__ = ["cache_dir", "cached", "code_digest", "file_digest"]

@@ -16,7 +16,9 @@ _PKG = Path(__file__).resolve().parent
 def data_dir(kind: str) -> Path:
     """The folder ``urdf`` or ``dynamics``."""
     if kind not in ("urdf", "dynamics"):
-        raise ValueError(f"unknown data kind {kind!r}")
+        from pkm.errors import InvalidInputError
+
+        raise InvalidInputError("kind", f"unknown data kind {kind!r}: pkm ships 'urdf' and 'dynamics'", kind)
     for cand in (_PKG / "_data" / kind, _PKG.parents[1] / kind):
         if cand.is_dir():
             return cand

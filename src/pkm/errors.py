@@ -73,7 +73,19 @@ def did_you_mean(names: tuple[str, ...]) -> str:
 
 
 class PkmError(Exception):
-    """Base class of every error raised by pkm."""
+    """Base class of every error raised by pkm. Every one pickles with its message and its data (so that it comes
+    back whole from a worker process: Dask, multiprocessing)."""
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (_restore, (type(self), self.args, self.__dict__))
+
+
+def _restore(cls: type[PkmError], args: tuple[object, ...], state: dict[str, object]) -> PkmError:
+    """Unpickling: the error with its message and data, without calling its constructor again."""
+    err = cls.__new__(cls)
+    Exception.__init__(err, *args)
+    err.__dict__.update(state)
+    return err
 
 
 class PkmWarning(UserWarning):

@@ -16,7 +16,9 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Collection
+from collections.abc import Collection, Sequence
+
+from numpy.typing import ArrayLike
 
 from pkm.errors import InvalidInputError, UnitError
 from pkm.validation import as_scalar
@@ -85,7 +87,7 @@ def split_range(text: str, what: str, max_count: int = 10**7) -> tuple[str, str,
     return parts[0], parts[1], int(count)
 
 
-def quantity(value, kind: str | None = None, what: str = "value") -> float:
+def quantity(value: object, kind: str | None = None, what: str = "value") -> float:
     """``value`` in SI: a number as it is, a string parsed with its unit (:func:`parse_quantity`).
 
     Args:
@@ -105,7 +107,7 @@ def quantity(value, kind: str | None = None, what: str = "value") -> float:
     return as_scalar(value, what)
 
 
-def quantities(values, kinds, what: str):
+def quantities(values: ArrayLike, kinds: Sequence[str | None], what: str) -> ArrayLike:
     """``values`` (a sequence) with every string entry converted by the kind at its position; other entries as
     they are (the numeric checks follow in :func:`pkm.validation.as_vector`)."""
     if isinstance(values, (str, bytes)) or not isinstance(values, (list, tuple)):

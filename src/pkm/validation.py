@@ -1,7 +1,7 @@
 """Validation of inputs at pkm's public entry points: numpy only, so that pure-numpy modules import cheaply.
 
-Each helper turns what a user may pass (lists, tuples, numpy arrays, numbers) into a validated
-float or array, and anything else (strings, booleans, None, complex numbers, ragged lists,
+Each helper turns what a user may pass (lists, tuples, numpy arrays, numbers; hence ``x: object``) into a
+validated float or array, and anything else (strings, booleans, None, complex numbers, ragged lists,
 overflowing ints, non-finite values) into an :class:`~pkm.errors.InvalidInputError` naming the
 argument; :func:`finite_result` turns a NaN or infinity that arose inside into a
 :class:`~pkm.errors.NonFiniteError` instead of returning it.
@@ -10,22 +10,26 @@ argument; :func:`finite_result` turns a NaN or infinity that arose inside into a
 from __future__ import annotations
 
 import math
+from typing import TypeVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pkm.errors import InvalidInputError, NonFiniteError
 
 
-def wrap_angle(angle):
+def wrap_angle(angle: ArrayLike) -> np.ndarray:
     """Angle(s) brought into (-pi, pi] [rad]."""
     return np.pi - np.mod(np.pi - np.asarray(angle, dtype=float), 2.0 * np.pi)
 
+
+_T = TypeVar("_T")
 
 #: |value| above this, in SI units (m, rad, kg, s...), is taken for a unit error or garbage (inputs and files).
 ABSURD = 1e6
 
 
-def as_array(x, name: str, what: str = "numbers") -> np.ndarray:
+def as_array(x: object, name: str, what: str = "numbers") -> np.ndarray:
     """``x`` as a float array of any shape, refusing what is not numbers.
 
     Strings, booleans, ``None``, complex numbers, ragged nestings and objects are refused with an
@@ -52,7 +56,7 @@ def as_array(x, name: str, what: str = "numbers") -> np.ndarray:
     return arr
 
 
-def as_vector(x, n: int, name: str) -> np.ndarray:
+def as_vector(x: object, n: int, name: str) -> np.ndarray:
     """``x`` as a finite float vector of shape (n,), or :class:`InvalidInputError` naming ``name``."""
     arr = as_array(x, name, f"{n} numbers")
     if arr.shape != (n,):
@@ -63,7 +67,7 @@ def as_vector(x, n: int, name: str) -> np.ndarray:
     return arr.copy()
 
 
-def as_scalar(x, name: str, *, low: float | None = None, high: float | None = None, strict_low: bool = False,
+def as_scalar(x: object, name: str, *, low: float | None = None, high: float | None = None, strict_low: bool = False,
               unit: str = "") -> float:
     """``x`` as one finite float (a number or a one-element array), optionally within bounds.
 
@@ -90,7 +94,7 @@ def as_scalar(x, name: str, *, low: float | None = None, high: float | None = No
     return v
 
 
-def as_count(x, name: str, *, low: int = 1, high: int = 10**7) -> int:
+def as_count(x: object, name: str, *, low: int = 1, high: int = 10**7) -> int:
     """``x`` as an integer in ``[low, high]`` (iteration limits, numbers of seeds or nodes)."""
     if isinstance(x, bool) or not isinstance(x, (int, np.integer)):
         raise InvalidInputError(name, f"expected an integer in [{low}, {high}], got {type(x).__name__} {x!r}", x)
@@ -99,19 +103,22 @@ def as_count(x, name: str, *, low: int = 1, high: int = 10**7) -> int:
     return int(x)
 
 
-def as_tolerance(x, name: str = "tol", *, high: float = 1.0) -> float:
+def as_tolerance(x: object, name: str = "tol", *, high: float = 1.0) -> float:
     """``x`` as a tolerance: a finite number in ``(0, high]``."""
     return as_scalar(x, name, low=0.0, high=high, strict_low=True)
 
 
-def finite_result(x, what: str, detail: str = ""):
+def finite_result(x: _T, what: str, detail: str = "") -> _T:
     """``x`` unchanged if every number in it is finite, else :class:`~pkm.errors.NonFiniteError`.
 
     The last guard of a public routine: a NaN or an infinity that slipped past the input checks
     (an overflow, a vanishing divisor) becomes an error instead of a silent result.
     """
-    arr = np.asarray(x, dtype=float)
-    if not np.all(np.isfinite(arr)):
+    try:
+        finite = bool(np.all(np.isfinite(np.asarray(x, dtype=float))))
+    except (ValueError, TypeError):  # (a result of parts of different shapes: each part checked)
+        finite = all(bool(np.all(np.isfinite(np.asarray(part, dtype=float)))) for part in x)  # type: ignore[attr-defined]
+    if not finite:
         raise NonFiniteError(what, x, detail or "the inputs are probably too large or the configuration is "
                                                "degenerate; check the units (SI) and the magnitudes")
     return x

@@ -79,6 +79,7 @@ def test_a_loaded_mechanism_sweeps_its_joint_origins():
     assert res.manifest["family"]["source"] == mech.source and res.manifest["units"] == {"motor_1.y": "m"}
     K = res.column("condition")
     unchanged = pkm.sweep(mech, sweeps.table({"motor_1.y": [0.15]}), ["condition"], scheduler="serial")
+    assert np.all(np.isfinite(K)) and res.stats.failed == 0  # (every design builds: its loops re-assembled)
     assert K[2] == unchanged.column("condition")[0] and len(set(K)) == 3
     closed = pkm.sweep("delta", sweeps.table({"R": [0.15]}), ["condition"], scheduler="serial")
     np.testing.assert_allclose(K[2], closed.column("condition")[0], rtol=1e-9)

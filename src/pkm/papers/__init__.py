@@ -152,6 +152,34 @@ def _modes_row(mech, qa, row_id: str, compare: Callable[[Any, Any], str] | None)
     return Row(row_id, None, len(modes), "", None, "reference configuration (no published count)", text)
 
 
+def cached_rows(paper: str) -> Callable[[Callable[[], list[Row]]], Callable[[], list[Row]]]:
+    """Decorator of a study's ``reproduce()``: its rows kept on disk (:mod:`pkm.cache`) under the source of the whole
+    ``pkm`` package and its shipped data (``urdf/``, ``dynamics/``), Bertini's version and the paper's name, so that
+    ``pkm report``, ``make demo`` and the tests, each a process of its own, compute a paper's rows once for a given
+    code and data (the 3-RRR's and the Delta's take seconds, the hexapod's homotopy as many). Any change of code or
+    data computes them anew; ``PKM_CACHE=0`` always does."""
+
+    def wrap(reproduce: Callable[[], list[Row]]) -> Callable[[], list[Row]]:
+        @functools.wraps(reproduce)
+        def rows() -> list[Row]:
+            import importlib.metadata
+
+            from pkm.cache import cached, file_digest
+            from pkm.data import data_dir
+
+            try:
+                bertini: str | None = importlib.metadata.version("bertini2")
+            except importlib.metadata.PackageNotFoundError:
+                bertini = None
+            key = [paper, bertini, file_digest([data_dir("urdf"), data_dir("dynamics")])]
+            out = cached("papers", key, lambda: [r.to_dict() for r in reproduce()], code=["pkm"])
+            return [Row(**{k: v for k, v in d.items() if k != "matches"}) for d in out]
+
+        return rows
+
+    return wrap
+
+
 def names() -> tuple[str, ...]:
     """The paper studies, in registry order: the ``paper`` of every registered mechanism that has one."""
     return tuple(d.paper for d in REGISTRY.values() if d.paper is not None)
@@ -164,4 +192,4 @@ def module(name: str) -> ModuleType:
     return importlib.import_module(f"pkm.papers.{name}")
 
 
-__all__ = ["Row", "generic_count", "modes_row", "module", "names", "opcount_rows"]
+__all__ = ["Row", "cached_rows", "generic_count", "modes_row", "module", "names", "opcount_rows"]

@@ -42,7 +42,7 @@ import numpy as np
 
 from pkm.mechanisms.delta import DeltaParams
 from pkm.mechanisms.delta import design as design
-from pkm.papers import Row, opcount_rows
+from pkm.papers import Row, cached_rows, opcount_rows
 from pkm.papers._plot import figure, save
 
 TITLE = "Hernández Reyna & Sandoval-Castro (2018): kinematics and base-radius reconfiguration of a Delta robot"
@@ -124,6 +124,7 @@ def _at(R: float) -> dict[str, float]:
     return {k: float(v[0]) for k, v in design.condition_vs_radius(PAPER, POSE, [R], "knee_out", KINDS).items()}
 
 
+@cached_rows("delta")
 def reproduce() -> list[Row]:
     R, K = fig5_sweep("knee_out")
     in_range = R <= R_RANGE[1] + 1e-12

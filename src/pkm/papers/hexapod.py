@@ -24,7 +24,7 @@ from pkm.core.kinematics.task import as_rotation
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi
 from pkm.mechanisms.hexapod import reconfiguration as hr
-from pkm.papers import Row, modes_row, opcount_rows
+from pkm.papers import Row, cached_rows, modes_row, opcount_rows
 from pkm.papers._plot import figure, save
 
 TITLE = "Sanchez-Alonso et al. (2016), Kinematic analysis of a novel reconfigurable parallel robot, RIAI 13:247-257"
@@ -74,6 +74,7 @@ def spiral() -> dict:
     return {"profiles": prof, "w_tras_P": at_p}
 
 
+@cached_rows("hexapod")
 def reproduce() -> list[Row]:
     """The published numbers of sec. 4 next to ours."""
     t = pose_t()

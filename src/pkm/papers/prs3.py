@@ -17,7 +17,7 @@ import numpy as np
 from pkm.mechanisms.prs3 import Prs3Params
 from pkm.mechanisms.prs3.dynamics import BOUNDARY, G, Prs3Dynamics, operation_count
 from pkm.motion import load_motions
-from pkm.papers import Row, generic_count, modes_row, opcount_rows
+from pkm.papers import Row, cached_rows, generic_count, modes_row, opcount_rows
 from pkm.papers._plot import figure, save
 
 TITLE = "Díaz-Rodríguez, Carretero, Bautista-Quintero & Chacón (2016): 3-PRS kinematics and inverse dynamics"
@@ -64,6 +64,7 @@ def _working_modes_too(mech, modes) -> str:
             "slider positions of eq. (10)). The paper gives no forward kinematics.")
 
 
+@cached_rows("prs3")
 def reproduce() -> list[Row]:
     """The paper's numbers and claims next to ours."""
     c = counts()

@@ -42,7 +42,7 @@ from pkm.errors import InvalidInputError, PkmError
 from pkm.mechanisms import rrr3
 from pkm.mechanisms.rrr3 import workspace as maps
 from pkm.mechanisms.rrr3.workspace import CiSettings, Design
-from pkm.papers import Row, modes_row
+from pkm.papers import Row, cached_rows, modes_row
 from pkm.papers._plot import WHAT, figure, save
 
 TITLE = ("Singularity analysis and global condition index of the planar 3-RRR parallel robot "
@@ -207,6 +207,7 @@ WHY_NOT = {
 }
 
 
+@cached_rows("rrr3")
 def reproduce() -> list[Row]:
     """The GCIs of Figs. 5, 6, 7, 9 and the working-mode verdict of Fig. 8."""
     reading = ("CI = 1/kappa_2 of J_x^-1 J_q, moment column / L, L = h/sqrt3, moments about G; Phi = 0, mode 1; "

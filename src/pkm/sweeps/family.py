@@ -167,11 +167,19 @@ class ModelFamily(Family):
         return ({"angle"}, "rad") if ORIGIN[name.rsplit(".", 1)[1]][0] == "rpy" else ({"length"}, "m")
 
     def mechanism(self, values: Mapping[str, float]):
-        from pkm.core.model.mechanism import Mechanism
+        import dataclasses
+
+        from pkm.core.model.builder import from_strings
+        from pkm.core.model.spec import ClosureSpec
 
         if not values and self._base is not None:
             return self._base
-        return Mechanism.from_strings(origins_set(self.urdf, values), self.spec, source=self.source)
+        # the moved origins no longer close the file's reference: the actuators are held, the other joints assembled
+        # from their former values (the same assembly mode)
+        spec = ClosureSpec.from_toml(self.spec, self.source)
+        held = {n: v for n, v in spec.reference.items() if n in spec.actuated}
+        return from_strings(origins_set(self.urdf, values), dataclasses.replace(spec, reference=held),
+                            source=self.source, seed=spec.reference)
 
     def describe(self) -> dict[str, Any]:
         return {"source": self.source, "urdf_sha256": hashlib.sha256(self.urdf.encode()).hexdigest(),

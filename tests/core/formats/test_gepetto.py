@@ -92,7 +92,7 @@ def test_saved_as_a_pkm_spec_it_loads_back_with_its_ball_joint(tmp_path):
 
 
 def test_the_cli_takes_the_folder():
-    from tests.test_cli import run
+    from tests.cli.helpers import run
 
     proc = run("fk", str(MODELS["gepetto_fivebar"]), "--joints", "mot1=100deg")
     assert proc.returncode == 0, proc.stderr

@@ -48,7 +48,7 @@ def test_a_yaml_that_is_not_the_convention_is_refused_about_yaml_naming_each_rea
     assert lines[1:] == ["  Gepetto URDF + YAML: a YAML mapping without the keys closed_loop or name_mot (its keys: "
                          "solver)",
                          "  pkm closure spec: a YAML file: a pkm closure spec is TOML (NAME.closures.toml)",
-                         "  model file (URDF, MJCF, SDF): not XML with a <robot>, <mujoco> or <sdf> root element"]
+                         "  model file (URDF, MJCF, SDF): not XML with a root element <robot>, <mujoco>, <sdf>"]
     with pytest.raises(SpecError, match=r"Gepetto URDF \+ YAML: not valid YAML: .*\n  pkm closure spec: a YAML file"):
         pkm.load(write(tmp_path / "n", broken__yaml="closed_loop: [[a, b]\n") / "broken.yaml")
     with pytest.raises(SpecError, match=r"a folder with no YAML file in Gepetto's convention \(config.yaml: a YAML "

@@ -29,9 +29,10 @@ import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
@@ -39,6 +40,9 @@ from pkm.core.twin.codegen import C_INT as _I
 from pkm.core.twin.codegen import C_REAL_P as _P
 from pkm.errors import CompilerError, InvalidInputError
 from pkm.validation import as_array, as_count, as_scalar, as_tolerance
+
+if TYPE_CHECKING:
+    from pkm.core.twin import Kernels
 
 #: Spacing of the root nodes that start a new search where the first did not reach.
 ROOT_STRIDE = 16
@@ -121,7 +125,7 @@ class WorkspaceMap:
         """The smallest singular value of ``J = (K diag(scale))^-1``: ``1 / sigma_max(K diag(scale))``."""
         return np.where(self.reachable, 1.0 / self.singular_values[..., 0], np.nan)
 
-    def _plane(self, slab: int | None):
+    def _plane(self, slab: int | None) -> tuple[tuple[tuple[str, np.ndarray], ...], Any]:
         """The 2-D (or 1-D) part of the map to draw: the whole map, or one slab of a 3-D map."""
         if len(self.axes) < 3:
             return self.axes, slice(None)
@@ -130,7 +134,7 @@ class WorkspaceMap:
                                             f"{self.axes[2][0]!r} in [0, {len(self.axes[2][1])})", slab)
         return self.axes[:2], slab
 
-    def figure(self, path, kind: str = "2", *, slab: int | None = None, title: str = "") -> Path:
+    def figure(self, path: str | Path, kind: str = "2", *, slab: int | None = None, title: str = "") -> Path:
         """Draw the condition index (``kind``) over the map as a PNG at ``path``: a colour map with its colour bar
         (2-D), a curve (1-D); unreachable nodes white (said in a legend). Axes in mm or deg; the caption (``title``
         by default) names the mechanism, the reachable nodes and the GCI."""
@@ -177,7 +181,7 @@ class WorkspaceMap:
         plt.close(fig)
         return out
 
-    def write_csv(self, path) -> Path:
+    def write_csv(self, path: str | Path) -> Path:
         """The numbers behind the map: one row per node, the axes' coordinates (SI), ``reachable``, the condition
         indices, the manipulability and the smallest singular value (empty where unreachable)."""
         import csv
@@ -199,7 +203,7 @@ class WorkspaceMap:
                            + [repr(float(flat[k][i])) if reach[i] else "" for k in values])
         return out
 
-    def gci(self, kind: str = "2", region=None) -> float | None:
+    def gci(self, kind: str = "2", region: ArrayLike | None = None) -> float | None:
         """The mean condition index over the reachable nodes of ``region`` (a boolean mask; default all): the
         global condition index as a node average. None when no node of the region is reachable."""
         ci = self.condition_index(kind)
@@ -207,7 +211,7 @@ class WorkspaceMap:
         return float(ci[mask].mean()) if mask.any() else None
 
 
-def _library(kernels):
+def _library(kernels: Kernels) -> tuple[Any, tuple[int, int], str]:
     from pkm.core.twin.codegen import compile_library, map_source
 
     step, qr_step, index = (kernels.function(k) for k in ("map_newton", "map_newton_qr", "map_indices"))
@@ -223,8 +227,9 @@ def _library(kernels):
 
 
 def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, object] | None = None, *,
-                  branch: str | None = None, length: float | None = None, seed=None, tol: float = 1e-10,
-                  step_tol: float = 1e-8, max_iter: int = 40, kernels=None) -> WorkspaceMap:
+                  branch: str | None = None, length: float | None = None, seed: ArrayLike | None = None,
+                  tol: float = 1e-10,
+                  step_tol: float = 1e-8, max_iter: int = 40, kernels: Kernels | None = None) -> WorkspaceMap:
     """The map of ``mech`` over the grid ``axes`` (see the module doc).
 
     Args:

@@ -20,10 +20,12 @@ A pose is solved in the default working mode (or ``branch``).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pkm.core.analysis import redundant_parameter
 from pkm.core.differential import indices
@@ -31,6 +33,9 @@ from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, UnreachableError
 from pkm.validation import ABSURD, as_array, as_count, as_scalar, as_tolerance
+
+if TYPE_CHECKING:
+    from pkm.core.twin import Kernels
 
 INDICES = ("ci_2", "ci_fro", "manipulability")
 #: A scanned reachable interval's ends are located to this fraction of its limits' width.
@@ -66,7 +71,7 @@ class _Index:
     """``index(k, x)`` of a mechanism (see the module doc), vectorised over ``(k, x)`` pairs."""
 
     def __init__(self, mech: Mechanism, poses: np.ndarray, params: list[str], kind: str, length: float | None,
-                 branch: str | None, kernels):
+                 branch: str | None, kernels: Kernels):
         task = TaskMap(mech)
         self.mech, self.poses, self.kind, self.kernels, self.branch = mech, poses, kind, kernels, branch
         self.parameter_names = params
@@ -132,7 +137,7 @@ class _Index:
             return 1.0 / np.asarray(indices.manipulability(K))
         return np.asarray(indices.inverse_condition(K, "2" if self.kind == "ci_2" else "fro_normalized"))
 
-    def __call__(self, k, x) -> np.ndarray:
+    def __call__(self, k: ArrayLike, x: ArrayLike) -> np.ndarray:
         k = np.asarray(k, dtype=int)
         x = np.asarray(x, dtype=float).reshape(len(k), -1)
         Q, solved = self.configurations(k, x)
@@ -150,8 +155,9 @@ def _unreached(f: _Index, k: int, x: np.ndarray, i: int, advice: str) -> Unreach
     return UnreachableError(0, miss, "m or rad", f"pose {k} with {where}{mode}: {advice}")
 
 
-def reconfigure(mech: Mechanism, poses, parameters: Sequence[str], limits, *, index: str = "ci_2",
-                length: float | None = None, rate_limit=None, smoothness: float = 1.0, baseline=None,
+def reconfigure(mech: Mechanism, poses: np.ndarray | Sequence[ArrayLike | Mapping[str, Any]],
+                parameters: Sequence[str], limits: ArrayLike, *, index: str = "ci_2", length: float | None = None,
+                rate_limit: ArrayLike | None = None, smoothness: float = 1.0, baseline: ArrayLike | None = None,
                 branch: str | None = None, grid: int = 31, tol: float = 1e-9) -> Reconfiguration:
     """The redundant ``parameters`` of ``mech`` chosen for each of ``poses`` (see the module doc).
 

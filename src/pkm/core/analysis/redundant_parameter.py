@@ -51,6 +51,7 @@ from typing import Any
 
 import numpy as np
 import proxsuite
+from numpy.typing import ArrayLike
 
 from pkm.errors import ConvergenceError, InvalidInputError, PkmError
 from pkm.validation import as_array, as_count, as_scalar, as_tolerance, finite_result
@@ -75,7 +76,8 @@ class WarmQP:
         cold_restarts: warm solves that had to be redone cold; statuses: status of every solve.
     """
 
-    def __init__(self, n: int, C: np.ndarray | None = None, l=None, u=None, *, eps: float = QP_EPS,
+    def __init__(self, n: int, C: np.ndarray | None = None, l: ArrayLike | None = None,
+                 u: ArrayLike | None = None, *, eps: float = QP_EPS,
                  max_iter: int = 1000):
         self.n = n
         self._C = np.zeros((0, n)) if C is None else np.asarray(C, dtype=float)
@@ -86,7 +88,7 @@ class WarmQP:
         self.solves = self.iterations = self.cold_restarts = 0
         self.statuses: list[str] = []
 
-    def _cold(self, H, g, l_box, u_box, *, careful: bool = False) -> None:
+    def _cold(self, H: np.ndarray, g: np.ndarray, l_box: np.ndarray, u_box: np.ndarray, *, careful: bool = False) -> None:
         qp = proxsuite.proxqp.dense.QP(self.n, 0, self._C.shape[0], True)
         s = qp.settings
         # the QPs here are feasible and bounded by construction (feasible_bounds, boxes): with proxqp's default
@@ -107,7 +109,7 @@ class WarmQP:
         s.initial_guess = proxsuite.proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT
         self._qp = qp
 
-    def solve(self, H, g, l_box, u_box) -> np.ndarray:
+    def solve(self, H: np.ndarray, g: np.ndarray, l_box: np.ndarray, u_box: np.ndarray) -> np.ndarray:
         """The minimiser ``y`` (see the class doc).
 
         Raises:
@@ -289,7 +291,7 @@ def _call(index: IndexFn, k: np.ndarray, x: np.ndarray, vector: bool) -> np.ndar
     return f
 
 
-def _check_index(index) -> None:
+def _check_index(index: object) -> None:
     if not callable(index):
         raise InvalidInputError("index", f"expected a callable index(k, x) -> values, got {type(index).__name__}",
                                 index)
@@ -303,7 +305,7 @@ def _check_finite(f: np.ndarray, k: np.ndarray, x: np.ndarray) -> None:
                                          "it must be finite on the whole interval given", f[i])
 
 
-def _intervals(lower, upper) -> tuple[np.ndarray, np.ndarray, bool]:
+def _intervals(lower: ArrayLike, upper: ArrayLike) -> tuple[np.ndarray, np.ndarray, bool]:
     """``(lo, hi, vector)``: the boxes as (n x p) arrays; ``vector`` when given as (n, p) (several parameters),
     not as (n,) or a scalar (one parameter)."""
     lo, hi = as_array(lower, "lower", "interval ends (n,) or (n, p)"), as_array(upper, "upper", "interval ends")
@@ -349,7 +351,7 @@ def _out(x: np.ndarray, vector: bool) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------- pointwise
-def maximise(index: IndexFn, lower, upper, *, grid: int = 31, tol: float = 1e-9, fd_step: float = 1e-5,
+def maximise(index: IndexFn, lower: ArrayLike, upper: ArrayLike, *, grid: int = 31, tol: float = 1e-9, fd_step: float = 1e-5,
              max_iter: int = 50, eta: float = 1e-6) -> PointOptimum:
     """Maximise ``f_k`` on the box ``[lower_k, upper_k]`` for every pose ``k`` at once.
 
@@ -416,7 +418,7 @@ def maximise(index: IndexFn, lower, upper, *, grid: int = 31, tol: float = 1e-9,
 
 
 # ---------------------------------------------------------------------- path
-def _rates(rate_limit, p: int) -> np.ndarray:
+def _rates(rate_limit: ArrayLike, p: int) -> np.ndarray:
     r = as_array(rate_limit, "rate_limit", "a rate limit (one, or one per parameter)")
     r = np.full(p, float(r)) if r.ndim == 0 else r.ravel()
     if r.shape != (p,) or not np.all(np.isfinite(r)) or np.any(r <= 0):
@@ -439,7 +441,7 @@ def _feasible(lo: np.ndarray, hi: np.ndarray, rate: np.ndarray, vector: bool) ->
     return L, U
 
 
-def feasible_bounds(lower, upper, rate_limit) -> tuple[np.ndarray, np.ndarray]:
+def feasible_bounds(lower: ArrayLike, upper: ArrayLike, rate_limit: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """The tightest intervals that admit a profile within ``[lower_k, upper_k]`` and the rate limit.
 
     Forward then backward propagation of the intervals by ``+- rate_limit``, per parameter (``rate_limit`` one
@@ -461,7 +463,7 @@ def _clip(x: np.ndarray, L: np.ndarray, U: np.ndarray, rate: np.ndarray) -> np.n
     return y
 
 
-def clip_to_rate(x, lower, upper, rate_limit) -> np.ndarray:
+def clip_to_rate(x: ArrayLike, lower: ArrayLike, upper: ArrayLike, rate_limit: ArrayLike) -> np.ndarray:
     """``x`` clipped pose by pose, from the first, into the feasible bounds and the rate limit.
 
     ``y_0 = clip(x_0, L_0, U_0)``, ``y_k = clip(x_k, max(L_k, y_{k-1} - delta), min(U_k, y_{k-1} + delta))``
@@ -478,8 +480,9 @@ def clip_to_rate(x, lower, upper, rate_limit) -> np.ndarray:
     return _out(_clip(x, L, U, rate), vector)
 
 
-def optimise_profile(index: IndexFn, lower, upper, *, rate_limit, smoothness: float = 1.0,
-                     baseline=0.0, tol: float = 1e-9, fd_step: float = 1e-5, max_iter: int = 100,
+def optimise_profile(index: IndexFn, lower: ArrayLike, upper: ArrayLike, *, rate_limit: ArrayLike,
+                     smoothness: float = 1.0, baseline: ArrayLike | None = 0.0, tol: float = 1e-9,
+                     fd_step: float = 1e-5, max_iter: int = 100,
                      eta: float = 1e-6, pointwise: PointOptimum | None = None) -> ProfileOptimum:
     """The profile maximising the summed index minus a smoothness penalty (see the module doc).
 
@@ -526,7 +529,7 @@ def optimise_profile(index: IndexFn, lower, upper, *, rate_limit, smoothness: fl
     D = np.kron(np.diff(np.eye(n), axis=0), np.eye(p))  # ((n-1) p, n p): x_{k+1} - x_k, per parameter
     DtD = D.T @ D
 
-    def objective(x, f):
+    def objective(x: np.ndarray, f: np.ndarray) -> float:
         return float(np.sum(f) / scale - 0.5 * smoothness * np.sum(np.diff(x, axis=0) ** 2))
 
     x = _clip(np.asarray(pw.x, dtype=float).reshape(n, p), Lb, Ub, rate)

@@ -18,7 +18,10 @@ singular matrix (or a condition number beyond the float range), never NaN.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pkm.errors import InvalidInputError
 from pkm.validation import as_array, as_scalar, finite_result
@@ -37,7 +40,7 @@ def singularity_class(inverse: bool, direct: bool) -> str:
     return SINGULARITY_CLASSES[int(bool(inverse)) + 2 * int(bool(direct))]
 
 
-def _stack(J) -> np.ndarray:
+def _stack(J: ArrayLike) -> np.ndarray:
     J = as_array(J, "J", "a matrix (m, n) or a stack (..., m, n) of numbers")
     if J.ndim < 2:
         raise InvalidInputError("J", f"a Jacobian needs at least 2 dimensions, got shape {J.shape}")
@@ -54,7 +57,7 @@ def _normalized(J: np.ndarray) -> np.ndarray:
     return J / np.where(scale > 0.0, scale, 1.0)
 
 
-def singular_values(J) -> np.ndarray:
+def singular_values(J: ArrayLike) -> np.ndarray:
     """Singular values, largest first, over the last two axes.
 
     Raises:
@@ -67,7 +70,7 @@ def singular_values(J) -> np.ndarray:
         return finite_result(s * np.where(scale > 0.0, scale, 1.0)[..., None], "singular values")
 
 
-def condition_number(J, kind: str = "2") -> np.ndarray | float:
+def condition_number(J: ArrayLike, kind: str = "2") -> np.ndarray | float:
     """Condition number of ``J`` (or of every matrix of a stack); ``inf`` where singular.
 
     Args:
@@ -98,13 +101,13 @@ def condition_number(J, kind: str = "2") -> np.ndarray | float:
     return float(k) if np.ndim(k) == 0 else k
 
 
-def inverse_condition(J, kind: str = "2") -> np.ndarray | float:
+def inverse_condition(J: ArrayLike, kind: str = "2") -> np.ndarray | float:
     """``1 / condition_number(J, kind)`` in [0, 1]: 0 at a singularity, 1 when isotropic."""
     k = condition_number(J, kind)
     return 1.0 / k if np.ndim(k) == 0 else 1.0 / np.asarray(k)
 
 
-def manipulability(J) -> np.ndarray | float:
+def manipulability(J: ArrayLike) -> np.ndarray | float:
     """Yoshikawa's ``sqrt(det(J J^T))`` (= product of the singular values)."""
     with np.errstate(over="ignore"):
         w = np.prod(singular_values(J), axis=-1)
@@ -113,7 +116,8 @@ def manipulability(J) -> np.ndarray | float:
     return float(w) if np.ndim(w) == 0 else w
 
 
-def homogenize(J, rotation_rows, length: float) -> np.ndarray:
+def homogenize(J: ArrayLike, rotation_rows: int | slice | Sequence[int] | Sequence[bool] | np.ndarray,
+               length: float) -> np.ndarray:
     """Scale the angular output rows of ``J`` by a characteristic length.
 
     For a Jacobian ``xd = J qd`` whose output mixes linear (m/s) and angular (rad/s)

@@ -29,6 +29,7 @@ Nothing here knows about a mechanism.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pkm.errors import InvalidInputError
 from pkm.validation import as_array, as_scalar, finite_result
@@ -46,21 +47,21 @@ def _compatible(a: np.ndarray, b: np.ndarray, names: str, tail_a: int = 1, tail_
                                        "pass one of each or stacks of one length") from None
 
 
-def _vec3(x, name: str) -> np.ndarray:
+def _vec3(x: ArrayLike, name: str) -> np.ndarray:
     x = as_array(x, name, "3-vectors (..., 3)")
     if x.shape[-1:] != (3,) or not np.all(np.isfinite(x)):
         raise InvalidInputError(name, f"expected finite 3-vectors (..., 3), got shape {x.shape}", x)
     return x
 
 
-def _screw(x, name: str = "screw") -> np.ndarray:
+def _screw(x: ArrayLike, name: str = "screw") -> np.ndarray:
     x = as_array(x, name, "screws (..., 6)")
     if x.shape[-1:] != (6,) or not np.all(np.isfinite(x)):
         raise InvalidInputError(name, f"expected finite screws (..., 6) = [primal; dual], got shape {x.shape}", x)
     return x
 
 
-def cross(a, b) -> np.ndarray:
+def cross(a: ArrayLike, b: ArrayLike) -> np.ndarray:
     """``a x b`` over the last axis of stacks of 3-vectors (broadcast; faster than ``np.cross`` on small stacks)."""
     a, b = np.asarray(a), np.asarray(b)
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
@@ -68,7 +69,7 @@ def cross(a, b) -> np.ndarray:
     return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
-def screw(direction, point, pitch: float = 0.0) -> np.ndarray:
+def screw(direction: ArrayLike, point: ArrayLike, pitch: float = 0.0) -> np.ndarray:
     """The screw of given unit ``direction`` through ``point`` [m] with ``pitch`` [m/rad].
 
     ``[s; r x s + h s]``. ``direction`` is normalised; it must not be zero.
@@ -83,12 +84,12 @@ def screw(direction, point, pitch: float = 0.0) -> np.ndarray:
     return finite_result(np.concatenate(np.broadcast_arrays(s, cross(r, s) + pitch * s), axis=-1), "screw")
 
 
-def line(direction, point) -> np.ndarray:
+def line(direction: ArrayLike, point: ArrayLike) -> np.ndarray:
     """The zero-pitch screw (a line; a revolute joint, a pure force) along ``direction`` through ``point``."""
     return screw(direction, point, 0.0)
 
 
-def prismatic(direction) -> np.ndarray:
+def prismatic(direction: ArrayLike) -> np.ndarray:
     """The screw ``[0; s]`` of a prismatic joint (a pure translation, a pure couple) along ``direction``."""
     s = _vec3(direction, "direction")
     n = np.linalg.norm(s, axis=-1, keepdims=True)
@@ -97,7 +98,7 @@ def prismatic(direction) -> np.ndarray:
     return np.concatenate([np.zeros_like(s), s / n], axis=-1)
 
 
-def klein(a, b) -> np.ndarray | float:
+def klein(a: ArrayLike, b: ArrayLike) -> np.ndarray | float:
     """Klein form (reciprocal product) ``{a; b} = a_primal . b_dual + a_dual . b_primal``."""
     a, b = _screw(a, "a"), _screw(b, "b")
     _compatible(a, b, "a, b")
@@ -105,7 +106,7 @@ def klein(a, b) -> np.ndarray | float:
     return float(k) if np.ndim(k) == 0 else k
 
 
-def lie(a, b) -> np.ndarray:
+def lie(a: ArrayLike, b: ArrayLike) -> np.ndarray:
     """Lie product ``[a, b] = [a_p x b_p; a_p x b_d - b_p x a_d]`` (antisymmetric)."""
     a, b = _screw(a, "a"), _screw(b, "b")
     _compatible(a, b, "a, b")
@@ -113,7 +114,7 @@ def lie(a, b) -> np.ndarray:
     return finite_result(np.concatenate([cross(ap, bp), cross(ap, bd) - cross(bp, ad)], axis=-1), "Lie product")
 
 
-def shift(s, point) -> np.ndarray:
+def shift(s: ArrayLike, point: ArrayLike) -> np.ndarray:
     """The same screw with its dual part referred to the pole ``point`` instead of O.
 
     ``s_Q = s_O - Q x s`` (for a twist: ``v_Q = v_O + w x Q``).
@@ -124,7 +125,7 @@ def shift(s, point) -> np.ndarray:
                          "shifted screw")
 
 
-def transform(s, rotation, translation) -> np.ndarray:
+def transform(s: ArrayLike, rotation: ArrayLike, translation: ArrayLike) -> np.ndarray:
     """The screw moved by the rigid displacement ``x -> R x + p``: ``[R s; R s_O + p x R s]``.
 
     Also the change of coordinates from a frame with orientation ``R`` and origin ``p`` to the
@@ -144,7 +145,7 @@ def transform(s, rotation, translation) -> np.ndarray:
                          "transformed screw")
 
 
-def pitch(s) -> np.ndarray | float:
+def pitch(s: ArrayLike) -> np.ndarray | float:
     """Pitch ``s . s_O / s . s`` [m/rad] (``inf`` for a pure translation or couple)."""
     s = _screw(s, "s")
     ss = np.sum(s[..., :3] ** 2, axis=-1)
@@ -153,7 +154,7 @@ def pitch(s) -> np.ndarray | float:
     return float(h) if np.ndim(h) == 0 else h
 
 
-def axis_point(s) -> np.ndarray:
+def axis_point(s: ArrayLike) -> np.ndarray:
     """The point of the screw axis closest to the pole: ``s x s_O / s . s`` [m] (non-zero primal only)."""
     s = _screw(s, "s")
     ss = np.sum(s[..., :3] ** 2, axis=-1, keepdims=True)
@@ -162,13 +163,13 @@ def axis_point(s) -> np.ndarray:
     return finite_result(cross(s[..., :3], s[..., 3:]) / ss, "axis point")
 
 
-def chain_twist(screws, rates) -> np.ndarray:
+def chain_twist(screws: ArrayLike, rates: ArrayLike) -> np.ndarray:
     """Twist ``sum_j w_j $_j`` of the last body of a serial chain (screws ``(..., n, 6)``, rates ``(..., n)``)."""
     S, w = _chain(screws, rates)
     return finite_result(np.einsum("...j,...jk->...k", w, S), "chain twist")
 
 
-def chain_lie_term(screws, rates) -> np.ndarray:
+def chain_lie_term(screws: ArrayLike, rates: ArrayLike) -> np.ndarray:
     """Lie screw of acceleration of a serial chain: ``sum_{j<k} [w_j $_j, w_k $_k]``.
 
     With the joint screws of the current configuration and the joint rates, the reduced
@@ -187,7 +188,7 @@ def chain_lie_term(screws, rates) -> np.ndarray:
     return finite_result(np.sum(lie(before, ws), axis=-2), "chain Lie term")
 
 
-def _chain(screws, rates) -> tuple[np.ndarray, np.ndarray]:
+def _chain(screws: ArrayLike, rates: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     S = _screw(screws, "screws")
     w = as_array(rates, "rates", "joint rates (..., n)")
     if S.ndim < 2 or w.ndim < 1 or w.shape[-1] != S.shape[-2] or not np.all(np.isfinite(w)):

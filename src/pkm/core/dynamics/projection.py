@@ -43,6 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from pkm.core.differential.velocity import idle_motions, passive_map
 from pkm.core.kinematics import constraints
@@ -175,7 +176,7 @@ class KhalilProjection:
         self.partition = partition(mech)
         self.rtol = as_tolerance(rtol, "rtol")
 
-    def projection(self, q) -> Projection:
+    def projection(self, q: ArrayLike) -> Projection:
         """``J_k`` and the legs' velocity maps at ``q`` (assembled).
 
         Raises:
@@ -213,7 +214,8 @@ class KhalilProjection:
         Jk = np.linalg.lstsq(M, rhs, rcond=None)[0]
         return Projection(Jk, tuple(Ls), tuple(sig), smin)
 
-    def inverse_dynamics(self, q, v, a, wrench=None, *, wrenches=None) -> np.ndarray:
+    def inverse_dynamics(self, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None = None, *, wrenches: Mapping[str, ArrayLike] | None = None) \
+            -> np.ndarray:
         """Actuator efforts (N or N m, in ``mech.actuated`` order) for a consistent state.
 
         Args:
@@ -241,7 +243,8 @@ class KhalilProjection:
                                                                       "(overflow); check the units")
 
 
-def _external(mech: Mechanism, q: np.ndarray, h: np.ndarray, wrench, wrenches,
+def _external(mech: Mechanism, q: np.ndarray, h: np.ndarray, wrench: ArrayLike | None,
+              wrenches: Mapping[str, ArrayLike] | None,
               c: Configuration | None = None) -> np.ndarray:
     """``h - sum_f J_f^T w_f``: the tree's joint forces less those of the external wrenches (world-aligned at
     each frame's origin, force then moment); ``wrench`` acts at the end-effector frame. ``c``: the
@@ -284,7 +287,8 @@ METHODS = ("auto", "khalil", "virtual_work")
 _IDLE: weakref.WeakKeyDictionary[Mechanism, bool] = weakref.WeakKeyDictionary()
 
 
-def _settle_idle(mech: Mechanism, q, v, a, wrench, wrenches) -> np.ndarray:
+def _settle_idle(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None,
+                 wrenches: Mapping[str, ArrayLike] | None) -> ArrayLike:
     """``a`` with its idle-motion part set by the dynamics, ``a + N alpha`` with ``N^T (M a' + h - J^T w) = 0``.
 
     The kinematics fixes no idle acceleration (:func:`~pkm.core.differential.velocity.idle_motions` ``N``: a rod spinning
@@ -310,7 +314,8 @@ def _settle_idle(mech: Mechanism, q, v, a, wrench, wrenches) -> np.ndarray:
     return a + N @ alpha
 
 
-def inverse_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=None, method: str = "auto") -> np.ndarray:
+def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None = None, *,
+                     wrenches: Mapping[str, ArrayLike] | None = None, method: str = "auto") -> np.ndarray:
     """Actuator efforts (N or N m, in ``mech.actuated`` order) of any mechanism at a consistent state.
 
     Args:
@@ -343,7 +348,8 @@ def inverse_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=None, me
     return k.inverse_dynamics(q, v, _settle_idle(mech, q, v, a, wrench, wrenches), wrench, wrenches=wrenches)
 
 
-def virtual_work_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=None) -> np.ndarray:
+def virtual_work_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None = None, *, wrenches: Mapping[str, ArrayLike] | None = None) \
+        -> np.ndarray:
     """Actuator efforts as ``G^T (rnea(q, v, a) - sum J_f^T w_f)``, ``G = dq/dq_a`` without idle motions: the
     whole-tree virtual-work route (external wrenches as in :func:`inverse_dynamics`; idle accelerations set by the
     dynamics, see :func:`_settle_idle`)."""
@@ -355,7 +361,7 @@ def virtual_work_dynamics(mech: Mechanism, q, v, a, wrench=None, *, wrenches=Non
     return finite_result(G.T @ h, "actuator efforts")
 
 
-def forward_dynamics(mech: Mechanism, q, v, tau_actuated, *, mu: float = 0.0) -> np.ndarray:
+def forward_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: ArrayLike, *, mu: float = 0.0) -> np.ndarray:
     """Joint accelerations under actuator efforts, by Pinocchio's ``constraintDynamics``.
 
     The closures are enforced at the acceleration level with no Baumgarte correction
@@ -386,7 +392,7 @@ def forward_dynamics(mech: Mechanism, q, v, tau_actuated, *, mu: float = 0.0) ->
     return a
 
 
-def energy(mech: Mechanism, q, v) -> tuple[float, float]:
+def energy(mech: Mechanism, q: ArrayLike, v: ArrayLike) -> tuple[float, float]:
     """Kinetic [J] and potential [J] energy of every body (gravity ``mech.model.gravity``)."""
     mech = check_mechanism(mech)
     q, v = mech.check_q(q), mech.check_v(v)

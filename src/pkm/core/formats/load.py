@@ -23,7 +23,7 @@ from pkm.core.model.spec import ClosureSpec, TaskSpec, read_text_file
 from pkm.errors import SpecError
 
 
-def load_model_file(path: Path):
+def load_model_file(path: Path) -> Mechanism:
     """The :class:`~pkm.core.Mechanism` of an MJCF or SDF file alone: its loops, its actuators, the actuated
     joints as the task, no end effector, assembled (:func:`pkm.assemble`).
 

@@ -57,6 +57,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Iterable
 from typing import NamedTuple
 
 import numpy as np
@@ -138,7 +139,7 @@ def _unit(x: np.ndarray, what: str, source: str) -> np.ndarray:
     return x / n
 
 
-def euler_matrix(angles, seq: str = "xyz") -> np.ndarray:
+def euler_matrix(angles: Iterable[float], seq: str = "xyz") -> np.ndarray:
     """The rotation of MuJoCo's ``euler`` attribute, ``angles`` [rad] in the sequence ``seq`` (``<compiler
     eulerseq>``): one rotation per letter, about the moving axes for a lower-case letter (``R = R R_i``), about
     the fixed (parent) axes for an upper-case one (``R = R_i R``), as MuJoCo composes them."""
@@ -616,7 +617,8 @@ def _free_bodies(model: pin.Model, world: etree._Element, degrees: bool, source:
     return out
 
 
-def _anchored(model: pin.Model, free: dict[int, pin.SE3], constraints):
+def _anchored(model: pin.Model, free: dict[int, pin.SE3], constraints: Iterable[pin.RigidConstraintModel]) \
+        -> list[_Anchors]:
     """The constraints with their second end re-anchored where the first is at qpos0 (free bodies at their poses)."""
     q0 = pin.neutral(model)
     for jid, X in free.items():

@@ -56,6 +56,8 @@ a cycle of parents.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pinocchio as pin
 from lxml import etree
@@ -95,7 +97,8 @@ def _end(joint: etree._Element, role: str) -> str:
     return _text(joint, role) or ""
 
 
-def _gears(gearboxes: list[etree._Element], parent_joint: dict[str, etree._Element], joint_frame, axis,
+def _gears(gearboxes: list[etree._Element], parent_joint: dict[str, etree._Element],
+           joint_frame: Callable[[etree._Element], pin.SE3], axis: Callable[..., np.ndarray],
            source: str) -> dict[str, tuple[str, float, str]]:
     """The mimic couplings of the ``gearbox`` joints (see the module doc): ``{rotor joint: (output joint,
     multiplier, gearbox)}``.
@@ -261,7 +264,8 @@ def _read_sdf(text: str, source: str) -> Imported:
         etree.SubElement(iel, "inertia", {k: repr(float(_numbers(_text(inertial, f"inertia/{k}", "0"), 1,
                                                                    f"link {name!r} {k}", source)[0])) for k in keys})
 
-    def add_joint(name: str, kind: str, parent: str, child: str, X: pin.SE3, j: etree._Element | None = None):
+    def add_joint(name: str, kind: str, parent: str, child: str, X: pin.SE3, j: etree._Element | None = None) \
+            -> None:
         jel = etree.SubElement(robot, "joint", name=name, type=kind)
         origin(jel, urdf_frame[parent].inverse() * X)
         etree.SubElement(jel, "parent", link=ulink.get(parent, parent))

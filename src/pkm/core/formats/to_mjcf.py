@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 from lxml import etree
+from numpy.typing import ArrayLike
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import SpecError
@@ -30,7 +31,7 @@ _PRISMATIC = {"PX", "PY", "PZ"}
 MIN_MASS, MIN_INERTIA = 1e-9, 1e-12
 
 
-def _num(x) -> str:
+def _num(x: ArrayLike) -> str:
     return " ".join(repr(float(v)) for v in np.atleast_1d(x))
 
 
@@ -45,7 +46,7 @@ def body_names(mech: Mechanism) -> list[str]:
     return ["world"] + [f"{mech.model.names[j]}_body" for j in range(1, mech.model.njoints)]
 
 
-def _joints(el: etree._Element, jm, name: str, source: str) -> list[str]:
+def _joints(el: etree._Element, jm: pin.JointModel, name: str, source: str) -> list[str]:
     """The MJCF joint elements of one Pinocchio joint; returns their names."""
     kind = jm.shortname().removeprefix("JointModel")
     if kind == "Mimic" or kind in _REVOLUTE or kind in _PRISMATIC or kind.endswith("Unaligned"):

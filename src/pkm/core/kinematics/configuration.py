@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from pkm.core.kinematics import constraints
 from pkm.core.model.mechanism import Mechanism, check_mechanism
@@ -41,8 +42,13 @@ class Configuration:
     task_jacobian: np.ndarray
     ee_jacobian: np.ndarray
 
+    def __post_init__(self) -> None:
+        for value in vars(self).values():  # (an immutable snapshot: its arrays cannot be written to either)
+            if isinstance(value, np.ndarray):
+                value.setflags(write=False)
+
     @classmethod
-    def at(cls, mech: Mechanism, q) -> Configuration:
+    def at(cls, mech: Mechanism, q: ArrayLike) -> Configuration:
         """The kinematics of ``mech`` at ``q`` (checked: size, finiteness, unit quaternions)."""
         mech = check_mechanism(mech)
         return cls.compute(mech, mech.check_q(q))

@@ -43,6 +43,10 @@ MAX_STEPS = 1000  #: continuation steps planned at most (a farther target gets l
 MAX_TOTAL_ITER = 5_000  #: Newton iterations at most for one solve, every continuation step included
 
 
+#: ``solve_at(q, s, tol) -> (q, residual, iterations)``: a continuation step's correction (:func:`_follow`).
+_StepSolver = Callable[[np.ndarray, float, float], tuple[np.ndarray, float, int]]
+
+
 @dataclass(frozen=True)
 class SolveResult:
     """Outcome of a position solver.
@@ -108,7 +112,7 @@ def _result(mech: Mechanism, q: np.ndarray, converged: bool, residual: float, it
     return SolveResult(q, converged, residual, iterations, steps, _signs(mech, q), mech.outside_limits(q))
 
 
-def _follow(mech: Mechanism, what: str, solve_at, q: np.ndarray, n_steps: int, tol: float,
+def _follow(mech: Mechanism, what: str, solve_at: _StepSolver, q: np.ndarray, n_steps: int, tol: float,
             raise_on_failure: bool) -> SolveResult:
     """Continuation from ``s = 0`` (the seed ``q``) to ``s = 1`` (the target).
 
@@ -181,10 +185,10 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
     qa1 = np.where(rev, qa0 + (qa1 - qa0 + np.pi) % (2.0 * np.pi) - np.pi, qa1)
     n_steps = _n_steps(np.max(np.abs(qa1 - qa0)), max_step)
 
-    def fun(qq):
+    def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return constraints.residual_and_jacobian(mech, qq)
 
-    def solve_at(q, s, t):
+    def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int]:
         return _newton(mech, fun, mech.with_actuated(q, qa0 + s * (qa1 - qa0)), mech.passive_v, t, max_iter, 0.5)
 
     return _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure)
@@ -221,13 +225,13 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
     dist = np.max(np.abs(task.error(y1, y0)))
     n_steps = _n_steps(dist, max_step)
 
-    def make_fun(y_goal):
-        def fun(qq):
+    def make_fun(y_goal: np.ndarray) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+        def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             c = Configuration.compute(mech, qq)
             return np.concatenate([c.residual, -task.error(y_goal, c.task_value)]), c.closure_and_task_jacobian
         return fun
 
-    def solve_at(q, s, t):
+    def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int]:
         return _newton(mech, make_fun(y1 if s >= 1.0 else task.interpolate(y0, y1, s)), q, mech.free_v, t, max_iter,
                        0.5)
 
@@ -268,7 +272,7 @@ def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_i
     S = np.zeros((len(pins), mech.nv))
     S[np.arange(len(pins)), pins] = 1.0
 
-    def fun(qq):
+    def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         c = Configuration.compute(mech, qq)
         return (np.concatenate([c.residual, -task.error(y_ref, c.task_value), qq[pin_q] - values]),
                 np.vstack([c.closure_and_task_jacobian, S]))
@@ -312,7 +316,7 @@ def assemble(mech: Mechanism, q0: ArrayLike | None = None, *, hold: Sequence[str
         j = mech.joint(name)
         held[j.idx_v:j.idx_v + j.nv] = True
 
-    def closure(qq):
+    def closure(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         F, J = constraints.residual_and_jacobian(mech, qq)
         J[:, held] = 0.0  # (Levenberg-Marquardt's damping then leaves the held coordinates where they are)
         return F, J
@@ -349,8 +353,8 @@ def _frames(mech: Mechanism, closure: str | None) -> str:
     return f"frames {c.frame_a!r} and {c.frame_b!r}" if c is not None else "no closure"
 
 
-def _open_alone(mech: Mechanism, q_seed: np.ndarray, held: np.ndarray, tol: float, max_iter: int, rng
-                ) -> tuple[list[tuple[str, float]], str]:
+def _open_alone(mech: Mechanism, q_seed: np.ndarray, held: np.ndarray, tol: float, max_iter: int,
+                rng: np.random.Generator                ) -> tuple[list[tuple[str, float]], str]:
     """Why no assembly was found: the closures that do not close even alone (each tried with the others cut, from
     the seed and three perturbed starts) with their gaps, worst first, and a sentence saying so and what would close
     them: a frame closure whose origins can meet but whose frames stay turned apart closes as a point closure.
@@ -359,7 +363,7 @@ def _open_alone(mech: Mechanism, q_seed: np.ndarray, held: np.ndarray, tol: floa
     starts = np.cumsum([0, *sizes])
 
     def gap(rows: np.ndarray) -> tuple[float, np.ndarray]:
-        def fun(qq):
+        def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             F, J = constraints.residual_and_jacobian(mech, qq)
             J[:, held] = 0.0
             return F[rows], J[rows]
@@ -399,7 +403,7 @@ def _open_alone(mech: Mechanism, q_seed: np.ndarray, held: np.ndarray, tol: floa
             f"{len(open_)} closure(s) cannot close even alone: " + "; ".join(w for _, _, w in open_) + fix)
 
 
-def _levenberg_marquardt(mech: Mechanism, fun, q: np.ndarray, tol: float, max_iter: int
+def _levenberg_marquardt(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray, tol: float, max_iter: int
                          ) -> tuple[np.ndarray, np.ndarray, int]:
     """Levenberg-Marquardt on ``|F(q)|^2`` over every joint (``fun(q) -> (F, J)``, J on the tangent space), on the
     configuration manifold; stops at ``|F|_inf <= tol``, at a stationary point (no decrease for any damping) or
@@ -423,12 +427,12 @@ def _levenberg_marquardt(mech: Mechanism, fun, q: np.ndarray, tol: float, max_it
     return q, F, it
 
 
-def _raise_if_out_of_reach(mech: Mechanism, fun, q: np.ndarray, tol: float) -> None:
+def _raise_if_out_of_reach(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray, tol: float) -> None:
     """:class:`UnreachableError` when the IK equations ``fun`` have a least-squares minimum that is not a solution
     near ``q`` (Levenberg-Marquardt from ``q`` stalls with ``|F|_inf > max(tol, 1e-9)``): the target lies outside
     the workspace. It names the closure left most open there, or the task when the loops close there (to a
     thousandth of the task's miss: the least-squares minimum trades a little closure for a far target)."""
-    def held(qq):  # (a floating base stays where it is)
+    def held(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # (a floating base stays where it is)
         F, J = fun(qq)
         J[:, mech.base_v] = 0.0
         return F, J
@@ -462,7 +466,7 @@ def _failure(mech: Mechanism, what: str, result: SolveResult, tol: float) -> Con
     return err
 
 
-def _settings(tol, max_iter, max_step) -> tuple[float, int, float]:
+def _settings(tol: object, max_iter: object, max_step: object) -> tuple[float, int, float]:
     """The solver settings checked: ``tol`` in (0, 1], ``max_iter`` in [1, 10^4], ``max_step`` > 0."""
     return (as_tolerance(tol, "tol"), as_count(max_iter, "max_iter", low=1, high=10_000),
             as_scalar(max_step, "max_step", low=0.0, strict_low=True))

@@ -13,11 +13,12 @@ world axes (``LOCAL_WORLD_ALIGNED``). Joint outputs follow in both.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import TYPE_CHECKING
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.units import quantities, quantity
@@ -168,7 +169,7 @@ class TaskMap:
         self.kinds = {k: v for g in groups for k, v in g.kinds.items()}
         self.kinds.update({j: "angle" if mech.joints[j].revolute else "length" for j in self.spec.joints})
 
-    def rate_scale(self, length: float | None, keys=None) -> np.ndarray:
+    def rate_scale(self, length: float | None, keys: Sequence[str] | None = None) -> np.ndarray:
         """The scales of the task rates ``keys`` (default: all, in :attr:`keys` order): 1 for a length, ``1/length``
         for an angle, the homogenisation by a characteristic length ``L`` [m] that makes every rate a speed.
 
@@ -181,7 +182,7 @@ class TaskMap:
                                               "[m] that homogenises the angular rates")
         return np.array([1.0 if k == "length" else 1.0 / (length or 1.0) for k in kinds])
 
-    def _parts(self, y: np.ndarray, tangent: bool = False):
+    def _parts(self, y: np.ndarray, tangent: bool = False) -> tuple[list[np.ndarray], np.ndarray]:
         at = self._tangent_at if tangent else self._value_at
         return [y[at[i]:at[i + 1]] for i in range(len(self._groups))], y[at[-1]:]
 
@@ -201,7 +202,7 @@ class TaskMap:
         values = [v for g, y in zip(self._groups, heads) for v in g.named(y)] + [float(v) for v in tail]
         return dict(zip(self.keys, values))
 
-    def parse(self, target, base: np.ndarray | None = None) -> np.ndarray:
+    def parse(self, target: Mapping[str, Any] | pin.SE3 | ArrayLike, base: np.ndarray | None = None) -> np.ndarray:
         """A target value from user input.
 
         Accepted: a flat vector of the task coordinates; a mapping ``{name: value}`` over some of
@@ -284,7 +285,7 @@ class TaskMap:
         return np.concatenate([g.bias(d) for g in self._groups] + [np.zeros(len(self._jv))])
 
 
-def _shape(x) -> tuple[int, ...] | None:
+def _shape(x: Any) -> tuple[int, ...] | None:
     """``np.shape(x)``, or None for what numpy cannot shape (ragged nestings)."""
     try:
         return np.shape(x)
@@ -299,7 +300,7 @@ def _wxyz(xyzw: np.ndarray) -> tuple[float, float, float, float]:
 ROTATION_TOL = 2e-3  # max|R^T R - I| projected away: matrices printed to 4 digits, as in the papers
 
 
-def as_rotation(R, name: str = "R", tol: float = ROTATION_TOL) -> np.ndarray:
+def as_rotation(R: ArrayLike, name: str = "R", tol: float = ROTATION_TOL) -> np.ndarray:
     """``R`` checked to be a rotation matrix and projected on SO(3) (SVD).
 
     Matrices printed with a few digits (the papers' poses carry 4) are accepted: the defect
@@ -319,7 +320,7 @@ def as_rotation(R, name: str = "R", tol: float = ROTATION_TOL) -> np.ndarray:
     return U @ Vt
 
 
-def _as_se3(T) -> pin.SE3:
+def _as_se3(T: pin.SE3 | ArrayLike) -> pin.SE3:
     if isinstance(T, pin.SE3):
         if not (np.all(np.isfinite(T.translation)) and np.all(np.isfinite(T.rotation))):
             raise InvalidInputError("pose", "the pin.SE3 holds non-finite values", T)

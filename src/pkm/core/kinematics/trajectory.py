@@ -15,9 +15,11 @@ efforts and a Jump.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pkm.core.differential.velocity import (
     accelerations,
@@ -28,7 +30,7 @@ from pkm.core.differential.velocity import (
     velocities,
 )
 from pkm.core.dynamics.projection import inverse_dynamics
-from pkm.core.kinematics.solve import close_loops, solve_ik
+from pkm.core.kinematics.solve import SolveResult, close_loops, solve_ik
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.validation import ABSURD, as_array, as_tolerance
@@ -89,7 +91,7 @@ class Trajectory:
         return len(self.q)
 
 
-def _samples(x, n: int | None, size: int, what: str) -> np.ndarray:
+def _samples(x: ArrayLike | None, n: int | None, size: int, what: str) -> np.ndarray:
     """``x`` as N x size (a 1-D ``x`` for size 1 is N samples); zeros when None (with n)."""
     if x is None:
         if n is None:
@@ -114,7 +116,10 @@ def _units(mech: Mechanism) -> dict[str, dict[str, str]]:
             "task": {k: unit[kind] for k, kind in mech.task_map.kinds.items()}}
 
 
-def _follow(mech: Mechanism, n: int, q0, solve, predict, rates, efforts: bool, wrench, tol: float) -> Trajectory:
+def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int, np.ndarray], SolveResult],
+            predict: Callable[[int, np.ndarray], np.ndarray],
+            rates: Callable[[int, np.ndarray], tuple[np.ndarray, np.ndarray]], efforts: bool, wrench: ArrayLike | None,
+            tol: float) -> Trajectory:
     """The samples one by one: ``solve(k, q_from)`` from the previous sample (``q0`` for the first),
     ``predict(k, q_prev)`` the first-order step, ``rates(k, q) -> (v, a)``."""
     start = mech.q_reference if q0 is None else mech.check_q(q0, "q0")
@@ -172,8 +177,8 @@ def _follow(mech: Mechanism, n: int, q0, solve, predict, rates, efforts: bool, w
                       tuple(jumps), _units(mech))
 
 
-def follow_task(mech: Mechanism, y, yd=None, ydd=None, *, q0=None, efforts: bool = True, wrench=None,
-                tol: float = 1e-10) -> Trajectory:
+def follow_task(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None = None, ydd: ArrayLike | None = None, *,
+                q0: ArrayLike | None = None, efforts: bool = True, wrench: ArrayLike | None = None, tol: float = 1e-10) -> Trajectory:
     """Inverse kinematics, rates and efforts along task samples, tracking one working mode.
 
     Args:
@@ -195,21 +200,21 @@ def follow_task(mech: Mechanism, y, yd=None, ydd=None, *, q0=None, efforts: bool
     n = len(Y)
     Yd, Ydd = _samples(yd, n, task.size, "yd"), _samples(ydd, n, task.size, "ydd")
 
-    def solve(k, q_from):
+    def solve(k: int, q_from: np.ndarray) -> SolveResult:
         return solve_ik(mech, Y[k], q_from, tol=tol, raise_on_failure=False)
 
-    def predict(k, prev):
+    def predict(k: int, prev: np.ndarray) -> np.ndarray:
         return inverse_velocities(mech, prev, task.error(Y[k], Y[k - 1]))
 
-    def rates(k, qk):
+    def rates(k: int, qk: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         vk = inverse_velocities(mech, qk, Yd[k])
         return vk, inverse_accelerations(mech, qk, vk, Ydd[k])
 
     return _follow(mech, n, q0, solve, predict, rates, efforts, wrench, tol)
 
 
-def follow_actuators(mech: Mechanism, qa, qd=None, qdd=None, *, q0=None, efforts: bool = True, wrench=None,
-                     tol: float = 1e-10) -> Trajectory:
+def follow_actuators(mech: Mechanism, qa: ArrayLike, qd: ArrayLike | None = None, qdd: ArrayLike | None = None, *,
+                     q0: ArrayLike | None = None, efforts: bool = True, wrench: ArrayLike | None = None, tol: float = 1e-10) -> Trajectory:
     """Forward kinematics, rates and efforts along actuator samples, tracking one assembly mode.
 
     Args:
@@ -227,20 +232,20 @@ def follow_actuators(mech: Mechanism, qa, qd=None, qdd=None, *, q0=None, efforts
     n = len(A)
     Ad, Add = _samples(qd, n, mech.na, "qd"), _samples(qdd, n, mech.na, "qdd")
 
-    def solve(k, q_from):
+    def solve(k: int, q_from: np.ndarray) -> SolveResult:
         return close_loops(mech, A[k], q_from, tol=tol, raise_on_failure=False)
 
-    def predict(k, prev):
+    def predict(k: int, prev: np.ndarray) -> np.ndarray:
         return velocities(mech, prev, A[k] - A[k - 1])
 
-    def rates(k, qk):
+    def rates(k: int, qk: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         vk = velocities(mech, qk, Ad[k])
         return vk, accelerations(mech, qk, vk, Add[k])
 
     return _follow(mech, n, q0, solve, predict, rates, efforts, wrench, tol)
 
 
-def task_values(mech: Mechanism, q) -> dict[str, float]:
+def task_values(mech: Mechanism, q: ArrayLike) -> dict[str, float]:
     """The task coordinates at ``q`` by name (a pose as x y z and Z-Y-X Euler roll pitch yaw) [m, rad]."""
     mech = check_mechanism(mech)
     return mech.task_map.named(mech.check_q(q))

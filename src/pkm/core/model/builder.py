@@ -16,6 +16,7 @@ are reported by a :class:`~pkm.errors.PkmWarning` and in :attr:`Mechanism.notes`
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -36,8 +37,12 @@ REFERENCE_TOL = 1e-9
 
 
 def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | None = None,
-          source: str = "<model>", notes: tuple[str, ...] = ()) -> Mechanism:
+          source: str = "<model>", notes: tuple[str, ...] = (), *,
+          seed: Mapping[str, Any] | None = None) -> Mechanism:
     """The mechanism of ``model`` and ``spec``, its reference assembled or checked (module doc).
+
+    ``seed``: values of joints the ``[reference]`` leaves out, where the assembly starts instead of the neutral
+    configuration (a design whose geometry moved, started from its former reference: the same assembly mode).
 
     Raises:
         SpecError: the spec does not fit the model; no assembly keeps the joints a partial ``[reference]`` states
@@ -45,6 +50,8 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
             :class:`~pkm.errors.AssemblyError` as the cause); a complete ``[reference]`` leaves a loop open.
     """
     mech = Mechanism(model, spec, params, urdf, source, notes)
+    if seed:
+        mech.q_reference = mech.q_from_dict({n: v for n, v in seed.items() if n not in spec.reference})
     missing = [n for n, j in mech.joints.items() if j.nq > 0 and n not in spec.reference]
     if missing:  # a partial (or no) reference: assembled from it, the other joints from the neutral configuration
         try:
@@ -70,7 +77,7 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
 
 
 def from_strings(urdf: str, spec: ClosureSpec | str, params: Any = None, source: str = "<string>",
-                 notes: tuple[str, ...] = ()) -> Mechanism:
+                 notes: tuple[str, ...] = (), *, seed: Mapping[str, Any] | None = None) -> Mechanism:
     """Build from URDF text and a spec (object or TOML text); ``notes``: what the reader of its files interpreted
     or ignored (:attr:`Mechanism.notes`).
 
@@ -88,7 +95,7 @@ def from_strings(urdf: str, spec: ClosureSpec | str, params: Any = None, source:
     if isinstance(spec, str):
         spec = ClosureSpec.from_toml(spec, source + " (closures)")
     return build(retype_joints(load_model(urdf, source), spec.joint_types, source), spec, params, urdf, source,
-                 notes)
+                 notes, seed=seed)
 
 
 def from_files(spec_path: str | Path) -> Mechanism:

@@ -22,12 +22,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pkm.core.model.spec import parse_toml
 from pkm.errors import InvalidInputError
+
+if TYPE_CHECKING:
+    from pkm.core.model.mechanism import Mechanism
 
 RTOL = 1e-12
 ATOL = 1e-15
@@ -45,7 +49,7 @@ def _numbers(text: str) -> tuple[float, ...] | None:
         return None
 
 
-def _xml_root(text: str):
+def _xml_root(text: str) -> Any:  # an lxml element (lxml is untyped)
     from lxml import etree
 
     parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False)
@@ -61,7 +65,7 @@ def _value_diff(where: str, a: Any, b: Any, out: list[str], rtol: float, atol: f
         out.append(f"{where}: {a!r} vs {b!r} (differ by {abs(a - b):.3g}; allowed {rtol:g} relative + {atol:g})")
 
 
-def _xml_diff(a, b, where: str, out: list[str], rtol: float, atol: float) -> None:
+def _xml_diff(a: Any, b: Any, where: str, out: list[str], rtol: float, atol: float) -> None:
     label = f"{where}/{a.tag}" + (f"[{a.get('name')!r}]" if a.get("name") is not None else "")
     if a.tag != b.tag or a.get("name") != b.get("name"):
         out.append(f"{label}: element <{a.tag} name={a.get('name')!r}> != <{b.tag} name={b.get('name')!r}>")
@@ -117,7 +121,7 @@ def document_differences(a: str, b: str, kind: str, *, rtol: float = RTOL, atol:
     return out
 
 
-def _array_diff(where: str, a, b, out: list[str], rtol: float, atol: float) -> None:
+def _array_diff(where: str, a: ArrayLike, b: ArrayLike, out: list[str], rtol: float, atol: float) -> None:
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     if a.shape != b.shape:
         out.append(f"{where}: shape {a.shape} vs {b.shape}")
@@ -131,7 +135,7 @@ def _array_diff(where: str, a, b, out: list[str], rtol: float, atol: float) -> N
                    f"{float(a.flat[k])!r} vs {float(b.flat[k])!r} (by {abs(a.flat[k] - b.flat[k]):.3g})")
 
 
-def mechanism_differences(a, b, *, rtol: float = RTOL, atol: float = ATOL) -> list[str]:
+def mechanism_differences(a: Mechanism, b: Mechanism, *, rtol: float = RTOL, atol: float = ATOL) -> list[str]:
     """Where two mechanisms differ as models: joints (names, types, placements, limits), bodies
     (inertias), frames, closures, actuation, task and the reference configuration.
     """

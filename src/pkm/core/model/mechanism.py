@@ -20,15 +20,16 @@ from __future__ import annotations
 import functools
 import importlib
 import threading
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
-from pkm.core.model.spec import ClosureSpec
+from pkm.core.model.spec import Branch, ClosureSpec
 from pkm.core.model.urdf import position_limits
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
 from pkm.units import quantities
@@ -185,7 +186,7 @@ class Mechanism:
         #: Actuators whose values the others fix at the reference (redundant actuation), set by the builder.
         self.dependent_actuators: tuple[str, ...] = ()
 
-    def outside_limits(self, q, *, tol: float = 1e-9) -> tuple[str, ...]:
+    def outside_limits(self, q: ArrayLike, *, tol: float = 1e-9) -> tuple[str, ...]:
         """The joints whose coordinate in ``q`` lies outside their stated position limits by more than ``tol``
         (m or rad), in model order. pkm's solvers do not enforce limits; their results report these."""
         q = np.asarray(q, dtype=float)
@@ -218,7 +219,7 @@ class Mechanism:
 
         return TaskMap(self)
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[Callable[..., Mechanism], tuple[Any, ...]]:
         if self.urdf is None:
             raise InvalidInputError("mech", "a Mechanism built from a pinocchio.Model (no URDF text) cannot be "
                                             "pickled; build it with Mechanism.from_strings or from_files", self)
@@ -280,7 +281,7 @@ class Mechanism:
         return self.joints[name]
 
     # ------------------------------------------------------------------ vectors
-    def check_q(self, q, name: str = "q") -> np.ndarray:
+    def check_q(self, q: ArrayLike, name: str = "q") -> np.ndarray:
         """``q`` as a float array of shape (nq,), finite, with unit quaternions; else raise."""
         q = as_vector(q, self.nq, name)
         for j in self.joints.values():
@@ -295,39 +296,39 @@ class Mechanism:
                                               "expected 1", quat)
         return q
 
-    def check_v(self, v, name: str = "v") -> np.ndarray:
+    def check_v(self, v: ArrayLike, name: str = "v") -> np.ndarray:
         return as_vector(v, self.nv, name)
 
-    def check_actuated(self, qa, name: str = "q_actuated", *, positions: bool = False) -> np.ndarray:
+    def check_actuated(self, qa: ArrayLike, name: str = "q_actuated", *, positions: bool = False) -> np.ndarray:
         """Actuated values as a vector (``na``, SI). With ``positions``, entries may be strings with units
         (``"5deg"``, ``"20mm"``); rates and efforts take numbers only (SI: m/s, rad/s, N, N m)."""
         if positions:
             qa = quantities(qa, ["angle" if j.revolute else "length" for j in self.actuated], name)
         return as_vector(qa, self.na, name)
 
-    def actuated_q(self, q) -> np.ndarray:
+    def actuated_q(self, q: ArrayLike) -> np.ndarray:
         """The actuated coordinates of a configuration, in spec order."""
         return np.asarray(q, dtype=float)[self.act_q].copy()
 
-    def with_actuated(self, q, qa) -> np.ndarray:
+    def with_actuated(self, q: ArrayLike, qa: ArrayLike) -> np.ndarray:
         q = np.array(q, dtype=float)
         q[self.act_q] = qa
         return q
 
-    def difference(self, q0, q1) -> np.ndarray:
+    def difference(self, q0: ArrayLike, q1: ArrayLike) -> np.ndarray:
         """The tangent step from ``q0`` to ``q1`` (``pin.difference``), revolute angles taken the short way round
         (a crank passing pi moves by a little, not by 2 pi)."""
         dq = pin.difference(self.model, np.asarray(q0, dtype=float), np.asarray(q1, dtype=float))
         dq[self._revolute_v] = wrap_angle(dq[self._revolute_v])
         return dq
 
-    def wrap(self, q) -> np.ndarray:
+    def wrap(self, q: ArrayLike) -> np.ndarray:
         """``q`` with every revolute coordinate brought into (-pi, pi]."""
         q = np.array(q, dtype=float)
         q[self._revolute_q] = wrap_angle(q[self._revolute_q])
         return q
 
-    def q_from_dict(self, values: Mapping[str, Any], base=None) -> np.ndarray:
+    def q_from_dict(self, values: Mapping[str, Any], base: ArrayLike | None = None) -> np.ndarray:
         """A configuration from ``{joint name: value or vector}``; other joints from ``base``."""
         if not isinstance(values, Mapping):
             raise InvalidInputError("values", f"expected a mapping {{joint name: value}}, got {type(values).__name__}",
@@ -343,7 +344,7 @@ class Mechanism:
             q[j.idx_q:j.idx_q + j.nq] = arr
         return q
 
-    def q_to_dict(self, q) -> dict[str, np.ndarray | float]:
+    def q_to_dict(self, q: ArrayLike) -> dict[str, np.ndarray | float]:
         """``{joint name: coordinate}`` (scalars for 1-DOF joints); mimic joints are left out."""
         q = np.asarray(q, dtype=float)
         out: dict[str, np.ndarray | float] = {}
@@ -354,7 +355,7 @@ class Mechanism:
                 out[name] = q[j.idx_q:j.idx_q + j.nq].copy()
         return out
 
-    def branch_signs(self, q, branch: str | None = None) -> dict[str, int]:
+    def branch_signs(self, q: ArrayLike, branch: str | None = None) -> dict[str, int]:
         """Signs of the joints that define ``branch`` (default branch when None).
 
         Angles are taken modulo 2 pi in (-pi, pi]: the sign of a revolute coordinate is that of its sine.
@@ -363,11 +364,11 @@ class Mechanism:
         q = self.wrap(q)
         return {n: (1 if q[self.joints[n].idx_q] >= 0 else -1) for n in b.signs}
 
-    def on_branch(self, q, branch: str | None = None) -> bool:
+    def on_branch(self, q: ArrayLike, branch: str | None = None) -> bool:
         b = self.branch(branch)
         return self.branch_signs(q, b.name) == dict(b.signs)
 
-    def branch(self, name: str | None = None):
+    def branch(self, name: str | None = None) -> Branch:
         """The named branch (the spec's default when None)."""
         key = self.spec.default_branch if name is None else name
         if not isinstance(key, str) or key not in self.spec.branches:
@@ -380,7 +381,7 @@ class Mechanism:
                 f"task={list(self.spec.task.components) + list(self.spec.task.joints)})")
 
 
-def _frame_id(model: pin.Model, name, source: str) -> int | None:
+def _frame_id(model: pin.Model, name: object, source: str) -> int | None:
     """The frame called ``name`` (a link's frame when a joint shares its name); None if there is none."""
     if not isinstance(name, str) or not model.existFrame(name):
         return None
@@ -393,7 +394,7 @@ def _frame_id(model: pin.Model, name, source: str) -> int | None:
             from None
 
 
-def check_mechanism(mech, name: str = "mech") -> Mechanism:
+def check_mechanism(mech: object, name: str = "mech") -> Mechanism:
     """``mech`` itself if it is a :class:`Mechanism`, else :class:`InvalidInputError` saying how to get one."""
     if not isinstance(mech, Mechanism):
         raise InvalidInputError(name, f"expected a pkm.Mechanism (from pkm.load(name) or pkm.build(name, ...)), "

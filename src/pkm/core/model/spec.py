@@ -96,6 +96,7 @@ import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
+from typing import Any
 
 from pkm.errors import InvalidInputError, SpecError
 from pkm.validation import ABSURD
@@ -202,7 +203,7 @@ class ClosureSpec:
 
     @classmethod
     def from_dict(cls, raw: Mapping, source: str = "<dict>") -> ClosureSpec:
-        def need(table: Mapping, key: str, typ: type | tuple[type, ...], where: str = ""):
+        def need(table: Mapping, key: str, typ: type | tuple[type, ...], where: str = "") -> Any:
             if key not in table:
                 raise SpecError(source, f"missing key {where}{key!r}")
             val = table[key]
@@ -398,7 +399,7 @@ class ClosureSpec:
         Path(path).write_text(self.to_toml(), encoding="utf-8")
 
 
-def as_path(path, name: str = "path") -> Path:
+def as_path(path: object, name: str = "path") -> Path:
     """``path`` (str or path-like) as a :class:`~pathlib.Path`, or :class:`InvalidInputError`."""
     if isinstance(path, (str, os.PathLike)) and not isinstance(path, bytes):
         text = os.fspath(path)
@@ -473,7 +474,7 @@ def _key(name: str) -> str:
     return name if _BARE_KEY.fullmatch(name) else _tv(name)
 
 
-def _tv(value) -> str:
+def _tv(value: object) -> str:
     """A TOML literal for the few value types the spec uses (strings with every control character escaped)."""
     if isinstance(value, bool):
         return "true" if value else "false"

@@ -52,6 +52,7 @@ import numpy as np
 import pinocchio as pin
 import yourdfpy
 from lxml import etree
+from numpy.typing import ArrayLike
 
 from pkm.errors import InvalidInputError, SpecError
 from pkm.validation import ABSURD
@@ -61,7 +62,7 @@ _MAX_BYTES = 16 * 1024 * 1024
 _MAX_ELEMENTS = 10_000  # links + joints
 
 
-def _origin(xyz=(0.0, 0.0, 0.0), rotation=None) -> np.ndarray:
+def _origin(xyz: ArrayLike = (0.0, 0.0, 0.0), rotation: ArrayLike | None = None) -> np.ndarray:
     T = np.eye(4)
     T[:3, 3] = xyz
     if rotation is not None:
@@ -82,7 +83,8 @@ class UrdfBuilder:
         self._joints: list[yourdfpy.Joint] = []
         self._mimic: dict[str, tuple[str, float, float]] = {}
 
-    def link(self, name: str, mass: float = 0.0, com=(0.0, 0.0, 0.0), inertia=None) -> str:
+    def link(self, name: str, mass: float = 0.0, com: ArrayLike = (0.0, 0.0, 0.0),
+             inertia: ArrayLike | None = None) -> str:
         """Add a link; a massless link gets no ``<inertial>``."""
         inertial = None
         if mass > 0.0:
@@ -91,8 +93,8 @@ class UrdfBuilder:
         self._links.append(yourdfpy.Link(name=name, inertial=inertial))
         return name
 
-    def joint(self, name: str, type: str, parent: str, child: str, xyz=(0.0, 0.0, 0.0), rotation=None,
-              axis=(0.0, 0.0, 1.0), limits: tuple[float, float] | None = None, effort: float = 1e3,
+    def joint(self, name: str, type: str, parent: str, child: str, xyz: ArrayLike = (0.0, 0.0, 0.0),
+              rotation: ArrayLike | None = None, axis: ArrayLike = (0.0, 0.0, 1.0), limits: tuple[float, float] | None = None, effort: float = 1e3,
               velocity: float = 1e2, mimic: tuple[str, float, float] | None = None) -> str:
         """Add a joint. ``mimic = (leader, multiplier, offset)`` makes it follow ``leader``."""
         limit = None
@@ -106,7 +108,7 @@ class UrdfBuilder:
             self._mimic[name] = (mimic[0], float(mimic[1]), float(mimic[2]))
         return name
 
-    def frame(self, name: str, parent: str, xyz=(0.0, 0.0, 0.0), rotation=None) -> str:
+    def frame(self, name: str, parent: str, xyz: ArrayLike = (0.0, 0.0, 0.0), rotation: ArrayLike | None = None) -> str:
         """Add a massless link ``name`` fixed to ``parent`` (a named frame for closures)."""
         self.link(name)
         self.joint(f"{name}_fixed", "fixed", parent, name, xyz, rotation)
@@ -362,7 +364,7 @@ def load_model(text: str, source: str = "<string>") -> pin.Model:
 _AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
 
 
-def num(x) -> str:
+def num(x: ArrayLike) -> str:
     """Numbers as URDF attribute text, each written exactly (``repr``)."""
     return " ".join(repr(float(v)) for v in np.ravel(x))
 
@@ -372,7 +374,7 @@ def origin(el: etree._Element, M: pin.SE3) -> None:
     etree.SubElement(el, "origin", xyz=num(M.translation), rpy=num(pin.rpy.matrixToRpy(M.rotation)))
 
 
-def _urdf_joint_kind(jm, where: str, source: str) -> tuple[str, np.ndarray | None, str | None]:
+def _urdf_joint_kind(jm: pin.JointModel, where: str, source: str) -> tuple[str, np.ndarray | None, str | None]:
     """``(URDF type, axis, pkm joint type or None)`` of one (non-composite) Pinocchio joint model."""
     kind = jm.shortname().removeprefix("JointModel")
     if kind in ("RX", "RY", "RZ", "PX", "PY", "PZ"):
@@ -393,7 +395,7 @@ def _urdf_joint_kind(jm, where: str, source: str) -> tuple[str, np.ndarray | Non
                             "prismatic, continuous, spherical, universal about x then y, and free-flyer joints)")
 
 
-def _joint_motion(jm, value: float, where: str, source: str) -> pin.SE3:
+def _joint_motion(jm: pin.JointModel, value: float, where: str, source: str) -> pin.SE3:
     """The placement a revolute or prismatic joint model gives its child at ``q = value`` (rad or m)."""
     kind, axis, pkm_type = _urdf_joint_kind(jm, where, source)
     if kind not in ("revolute", "prismatic") or pkm_type is not None or axis is None:
@@ -455,7 +457,7 @@ def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: d
             etree.SubElement(iel, "inertia", ixx=num(I[0, 0]), ixy=num(I[0, 1]), ixz=num(I[0, 2]),
                              iyy=num(I[1, 1]), iyz=num(I[1, 2]), izz=num(I[2, 2]))
 
-    def joint(jname: str, kind: str, parent: str, child: str, M: pin.SE3, axis=None) -> None:
+    def joint(jname: str, kind: str, parent: str, child: str, M: pin.SE3, axis: ArrayLike | None = None) -> None:
         jel = etree.SubElement(robot, "joint", name=jname, type=kind)
         origin(jel, M)
         etree.SubElement(jel, "parent", link=parent)

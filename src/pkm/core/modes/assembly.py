@@ -13,10 +13,12 @@ at infinity, on the exceptional set and complex, and every failed path; one fail
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import _levenberg_marquardt, assemble
@@ -94,7 +96,7 @@ class ModeSet:
     def __len__(self) -> int:
         return len(self.modes)
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[Mode]:
         return iter(self.modes)
 
     def __getitem__(self, k: int) -> Mode:
@@ -106,7 +108,8 @@ class ModeSet:
                 f"{self.n_infinite} at infinity) from {self.n_paths} paths of {self.method}; {state}")
 
 
-def _place_platform(mech: Mechanism, red: Reduction, q: np.ndarray, T: pin.SE3, rng) -> np.ndarray:
+def _place_platform(mech: Mechanism, red: Reduction, q: np.ndarray, T: pin.SE3, rng: np.random.Generator) \
+        -> np.ndarray:
     """``q`` with the joints that carry the platform moved so that it sits at ``T`` (a free-flyer is set; a chain is
     solved by Levenberg-Marquardt from a few starts)."""
     m = mech.model
@@ -122,7 +125,7 @@ def _place_platform(mech: Mechanism, red: Reduction, q: np.ndarray, T: pin.SE3, 
         cols[j.idx_v:j.idx_v + j.nv] = True
     d = m.createData()
 
-    def fun(qq):
+    def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         pin.forwardKinematics(m, d, qq)
         err = pin.log6(T.actInv(d.oMi[jp])).vector
         J = pin.Jlog6(T.actInv(d.oMi[jp])) @ pin.computeJointJacobian(m, d, qq, jp)
@@ -142,7 +145,8 @@ def _place_platform(mech: Mechanism, red: Reduction, q: np.ndarray, T: pin.SE3, 
     return best[1]
 
 
-def recover(mech: Mechanism, red: Reduction, q_actuated, R: np.ndarray, t: np.ndarray, *, seed: int = 0) -> np.ndarray:
+def recover(mech: Mechanism, red: Reduction, q_actuated: ArrayLike, R: np.ndarray, t: np.ndarray, *,
+            seed: int = 0) -> np.ndarray:
     """The full configuration of a platform displacement ``(R, t)`` (world, from the reference pose) at the given
     actuator values: the platform placed, every leg closed by :func:`pkm.core.kinematics.solve.assemble` (the actuators
     and the platform held). Raises :class:`~pkm.errors.ConvergenceError` when a leg does not close to
@@ -167,7 +171,8 @@ def _check(mech: Mechanism, q: np.ndarray) -> float:
     return res
 
 
-def real_solutions(cont: Continuation, sys_: FKSystem, distinct: float = 1e-7):
+def real_solutions(cont: Continuation, sys_: FKSystem, distinct: float = 1e-7) \
+        -> tuple[list[tuple[np.ndarray, Certificate, list[int]]], int, int]:
     """The finite real solutions of a continuation, polished and certified, merged when closer than ``distinct``;
     returns ``(solutions, n_complex, n_exceptional)`` with solutions ``[(point, certificate, paths)]``."""
     found: list[tuple[np.ndarray, Certificate, list[int]]] = []
@@ -209,7 +214,7 @@ def parameter_homotopy(system: FKSystem, *, precision: str = "adaptive", threads
     return cont
 
 
-def assembly_modes(mech: Mechanism, q_actuated, *, method: str = "auto", precision: str = "adaptive",
+def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "auto", precision: str = "adaptive",
                    threads: int = 2, continuation: Continuation | None = None) -> ModeSet:
     """Every real assembly mode of ``mech`` at the actuator values ``q_actuated`` (module doc).
 

@@ -25,6 +25,8 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
+from types import ModuleType
+from typing import Any
 
 import numpy as np
 
@@ -102,7 +104,7 @@ class Continuation:
         return Continuation(paths, self.bound, self.start, self.seconds, self.settings)
 
 
-def _bertini():
+def _bertini() -> ModuleType:
     try:
         import bertini
     except ImportError as exc:  # pragma: no cover - the dev install has it
@@ -112,7 +114,7 @@ def _bertini():
     return bertini
 
 
-def _coefficient(b, c: complex):
+def _coefficient(b: ModuleType, c: complex) -> Any:  # (bertini is untyped: its expressions are Any)
     """An exact Bertini coefficient from a double (its binary value, as a fraction: no digits invented)."""
     re, im = Fraction(float(c.real)), Fraction(float(c.imag))
     out = b.coefficient(re) if re else None
@@ -121,7 +123,7 @@ def _coefficient(b, c: complex):
     return b.coefficient(0) if out is None else out
 
 
-def _expression(b, p: Poly, xs):
+def _expression(b: ModuleType, p: Poly, xs: Sequence[Any]) -> Any:
     out = None
     for e, c in p.terms.items():
         term = _coefficient(b, c)
@@ -228,7 +230,7 @@ def track(homotopy: Sequence[Poly], target: Sequence[Poly], start_points: Sequen
     return _collect(solver, start, len(points), time.perf_counter() - t0, settings)
 
 
-def _collect(solver, start: str, bound: int, seconds: float, settings: dict) -> Continuation:
+def _collect(solver: Any, start: str, bound: int, seconds: float, settings: dict) -> Continuation:
     paths = []
     for k, (pt, md) in enumerate(zip(solver.all_solutions(), solver.solution_metadata())):
         code = str(md.endgame_success_code).rsplit(".", 1)[-1]

@@ -21,6 +21,9 @@ and a circle's plane ``n . (R~b + 2 vec(g e*) - D A) - (n . r) D = 0``: seven qu
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any
+
 import numpy as np
 import pinocchio as pin
 
@@ -29,7 +32,7 @@ from pkm.core.modes.reduce import Reduction
 
 
 # ---------------------------------------------------------------------- quaternions (w, x, y, z) of polynomials
-def qmul(p, q):
+def qmul(p: Sequence[Any], q: Sequence[Any]) -> list[Any]:  # entries: numbers or Polys
     a0, a1, a2, a3 = p
     b0, b1, b2, b3 = q
     return [a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
@@ -38,7 +41,7 @@ def qmul(p, q):
             a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0]
 
 
-def qconj(p):
+def qconj(p: Sequence[Any]) -> list[Any]:
     return [p[0], -p[1], -p[2], -p[3]]
 
 
@@ -93,7 +96,7 @@ def plane_axes(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return u, np.cross(normal, u)
 
 
-def equations(group: str, params, x) -> list[Poly]:
+def equations(group: str, params: Sequence[np.ndarray | Sequence[Any]], x: Sequence[Poly]) -> list[Poly]:
     """The reduced equations in the unknowns ``x`` (polynomials) for leg parameters ``params`` (numbers, or
     polynomials in the same variables: a parameter homotopy's path)."""
     if group == "SE3":

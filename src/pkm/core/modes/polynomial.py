@@ -11,8 +11,10 @@ Jacobians and the constant second derivatives of a quadratic system (Smale's alp
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 _TOL = 0.0  # coefficients are kept exactly as computed (cancellation to 0.0 drops a term)
 
@@ -37,10 +39,10 @@ class Poly:
         e[i] = 1
         return cls(n, {tuple(e): 1.0})
 
-    def _coerce(self, other) -> Poly:
+    def _coerce(self, other: Poly | complex) -> Poly:
         return other if isinstance(other, Poly) else Poly.const(self.n, other)
 
-    def __add__(self, other) -> Poly:
+    def __add__(self, other: Poly | complex) -> Poly:
         other = self._coerce(other)
         out = dict(self.terms)
         for e, c in other.terms.items():
@@ -52,13 +54,13 @@ class Poly:
     def __neg__(self) -> Poly:
         return Poly(self.n, {e: -c for e, c in self.terms.items()})
 
-    def __sub__(self, other) -> Poly:
+    def __sub__(self, other: Poly | complex) -> Poly:
         return self + (-self._coerce(other))
 
-    def __rsub__(self, other) -> Poly:
+    def __rsub__(self, other: Poly | complex) -> Poly:
         return self._coerce(other) - self
 
-    def __mul__(self, other) -> Poly:
+    def __mul__(self, other: Poly | complex) -> Poly:
         if not isinstance(other, Poly):
             return Poly(self.n, {e: c * other for e, c in self.terms.items()})
         out: dict[tuple[int, ...], complex] = {}
@@ -83,7 +85,7 @@ class Poly:
         """Every term of the same degree (a polynomial on a projective space)."""
         return len({sum(e) for e in self.terms}) <= 1
 
-    def __call__(self, x) -> complex:
+    def __call__(self, x: ArrayLike) -> complex:
         return System([self])(np.asarray(x))[0]
 
     def __repr__(self) -> str:
@@ -95,7 +97,7 @@ def variables(n: int) -> list[Poly]:
     return [Poly.var(n, i) for i in range(n)]
 
 
-def dot(a: Iterable, b: Iterable):
+def dot(a: Iterable, b: Iterable) -> Any:  # a Poly or a number, as the entries
     out = 0.0
     for x, y in zip(a, b):
         out = x * y + out
@@ -126,11 +128,11 @@ class System:
     def _monomials(x: np.ndarray, E: np.ndarray) -> np.ndarray:
         return np.prod(x[..., None, :] ** E, axis=-1)  # (..., terms)
 
-    def __call__(self, x) -> np.ndarray:
+    def __call__(self, x: ArrayLike) -> np.ndarray:
         x = np.asarray(x, dtype=complex)
         return np.stack([self._monomials(x, E) @ c for E, c in zip(self._E, self._c)], axis=-1)
 
-    def jacobian(self, x) -> np.ndarray:
+    def jacobian(self, x: ArrayLike) -> np.ndarray:
         x = np.asarray(x, dtype=complex)
         rows = []
         for E, c in zip(self._E, self._c):

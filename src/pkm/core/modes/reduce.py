@@ -30,6 +30,7 @@ degrees of freedom.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -106,7 +107,12 @@ class Reduction:
         return f"platform in {self.group}; legs {kinds}"
 
 
-def _elements(mech: Mechanism, d: pin.Data, jid: int) -> tuple[str, np.ndarray, np.ndarray | None]:
+#: A passive joint as a rotation element: ``("point", o, None)`` or ``("line", o, axis)`` (the axis typed Any: the
+#: kind, not the type, says whether it is None).
+_RotationElement = tuple[str, np.ndarray, Any]
+
+
+def _elements(mech: Mechanism, d: pin.Data, jid: int) -> _RotationElement:
     """A passive joint as a rotation element at the reference: ``("point", o, None)`` for a spherical or universal
     joint (its axes meet at its origin), ``("line", o, axis)`` for a revolute."""
     m = mech.model
@@ -123,13 +129,13 @@ def _elements(mech: Mechanism, d: pin.Data, jid: int) -> tuple[str, np.ndarray, 
                                                    "passive revolute, universal and spherical joints only")
 
 
-def _through(el, p: np.ndarray, tol: float) -> bool:
+def _through(el: _RotationElement, p: np.ndarray, tol: float) -> bool:
     kind, o, w = el
     r = p - o
     return bool(np.linalg.norm(r if kind == "point" else r - (r @ w) * w) <= tol)
 
 
-def _concurrent(els, tol: float, what: str) -> np.ndarray:
+def _concurrent(els: list[_RotationElement], tol: float, what: str) -> np.ndarray:
     """The common point of rotation elements (points and lines), or a StructureError."""
     pts = [o for k, o, _ in els if k == "point"]
     if pts:
@@ -148,14 +154,15 @@ def _concurrent(els, tol: float, what: str) -> np.ndarray:
     return c
 
 
-def _rank(els) -> int:
+def _rank(els: list[_RotationElement]) -> int:
     if any(k == "point" for k, _, _ in els):
         return 3
     return int(np.linalg.matrix_rank(np.array([w for _, _, w in els]), tol=1e-9))
 
 
 def _analyse(mech: Mechanism, d: pin.Data, chain: list[int], B: np.ndarray, name: str, tol: float,
-             platform_end: bool):
+             platform_end: bool) -> tuple[np.ndarray, tuple[int, np.ndarray], np.ndarray | None, int,
+                                         list[_RotationElement], list[str], tuple[str, ...]]:
     """Split a leg's chain (joint ids, root to tip) into the rotation groups about ``A`` and about ``B``."""
     m = mech.model
     actuated = {j.id for j in mech.actuated}

@@ -13,14 +13,16 @@ from __future__ import annotations
 
 import functools
 import json
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pkm.core.modes.continuation import solve
 from pkm.core.modes.equations import N_UNKNOWNS, equations
-from pkm.core.modes.polynomial import variables
+from pkm.core.modes.polynomial import Poly, variables
 
 _DIR = Path(__file__).resolve().parent / "starts"
 #: Parameters per leg kind and group (:func:`pkm.core.modes.equations.leg_parameters`).
@@ -53,7 +55,7 @@ class GenericStart:
         return self.n_failed == 0
 
     def to_json(self) -> str:
-        def cplx(a):
+        def cplx(a: ArrayLike) -> list[list[float]]:
             return [[float(z.real), float(z.imag)] for z in np.asarray(a, dtype=complex)]
 
         return json.dumps({"format": "pkm.generic_start/1", "signature": self.signature, "seed": self.seed,
@@ -65,7 +67,7 @@ class GenericStart:
     def from_json(cls, text: str) -> GenericStart:
         raw = json.loads(text)
 
-        def cplx(rows):
+        def cplx(rows: Iterable[Sequence[float]]) -> np.ndarray:
             return np.array([complex(a, b) for a, b in rows])
 
         return cls(raw["signature"], tuple(cplx(p) for p in raw["params"]), tuple(cplx(p) for p in raw["points"]),
@@ -99,6 +101,7 @@ def generic_start(signature: str) -> GenericStart:
     return compute(signature)
 
 
-def path_parameters(target, start: GenericStart, t) -> list[list]:
+def path_parameters(target: Sequence[np.ndarray | Sequence[float]], start: GenericStart, t: Poly) \
+        -> list[list[Poly]]:
     """The parameters along the straight path ``(1 - t) target + t generic`` (``t`` a polynomial variable)."""
     return [[(1.0 - t) * float(a) + t * complex(g) for a, g in zip(P, G)] for P, G in zip(target, start.params)]

@@ -14,14 +14,16 @@ the modes meet: the closure Jacobian in the passive joints (forward), closure an
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
-from pkm.core.kinematics.solve import close_loops, solve_ik
-from pkm.core.kinematics.trajectory import follow_actuators, follow_task
+from pkm.core.kinematics.solve import SolveResult, close_loops, solve_ik
+from pkm.core.kinematics.trajectory import Trajectory, follow_actuators, follow_task
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.modes.assembly import Mode
 
@@ -72,7 +74,9 @@ def _sigma(J: np.ndarray) -> float:
     return float(sv[-1] / sv[0]) if sv.size and sv[0] > 0 else 0.0
 
 
-def _track(mech: Mechanism, mode: Mode, traj, reasons: set[str], solve_between, jacobian) -> ModeTrack:
+def _track(mech: Mechanism, mode: Mode, traj: Trajectory, reasons: set[str],
+           solve_between: Callable[[int, float, np.ndarray], SolveResult],
+           jacobian: Callable[[np.ndarray], np.ndarray]) -> ModeTrack:
     q = traj.q.copy()
     stop = next((j for j in traj.jumps if j.reason in reasons), None)
     if stop is None:
@@ -90,21 +94,21 @@ def _track(mech: Mechanism, mode: Mode, traj, reasons: set[str], solve_between, 
     return ModeTrack(mode.label, q, k, Meeting(k, stop.reason, stop.detail, lo, q_lo, _sigma(jacobian(q_lo))))
 
 
-def track_assembly_mode(mech: Mechanism, mode: Mode, q_actuated) -> ModeTrack:
+def track_assembly_mode(mech: Mechanism, mode: Mode, q_actuated: ArrayLike) -> ModeTrack:
     """The assembly mode ``mode`` (of :func:`pkm.assembly_modes` at the first sample) along actuator samples
     ``q_actuated`` (N x na) [rad or m]."""
     mech = check_mechanism(mech)
     traj = follow_actuators(mech, q_actuated, q0=mode.q, efforts=False)
     A = np.asarray(q_actuated, dtype=float).reshape(len(traj.q), -1)  # the samples asked for (checked by the core)
 
-    def between(k, s, q_from):
+    def between(k: int, s: float, q_from: np.ndarray) -> SolveResult:
         return close_loops(mech, A[k - 1] + s * (A[k] - A[k - 1]), q_from, raise_on_failure=False)
 
     return _track(mech, mode, traj, _FK_MEETING, between,
                   lambda qq: constraints.jacobian(mech, qq)[:, mech.passive_v])
 
 
-def track_working_mode(mech: Mechanism, mode: Mode, task) -> ModeTrack:
+def track_working_mode(mech: Mechanism, mode: Mode, task: ArrayLike) -> ModeTrack:
     """The working mode ``mode`` (of :func:`pkm.working_modes` at the first sample) along task samples ``task``
     (N x the task's value size, as :meth:`pkm.core.TaskMap.value`)."""
     mech = check_mechanism(mech)
@@ -112,10 +116,10 @@ def track_working_mode(mech: Mechanism, mode: Mode, task) -> ModeTrack:
     Y = np.asarray(task, dtype=float).reshape(len(traj.q), -1)
     tm = mech.task_map
 
-    def between(k, s, q_from):
+    def between(k: int, s: float, q_from: np.ndarray) -> SolveResult:
         return solve_ik(mech, tm.interpolate(Y[k - 1], Y[k], s), q_from, raise_on_failure=False)
 
-    def jac(qq):
+    def jac(qq: np.ndarray) -> np.ndarray:
         J = Configuration.compute(mech, qq).closure_and_task_jacobian
         return J if mech.free_v is None else J[:, mech.free_v]
 

@@ -18,9 +18,12 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from pkm.core.kinematics.solve import solve_ik
 from pkm.core.model.mechanism import Mechanism, check_mechanism
@@ -78,7 +81,7 @@ class _LegSystem:
             raise StructureError(leg.name, f"{len(self.polys)} equations in {n} unknowns of its actuated joints: the "
                                            "working modes of this leg are not isolated")
 
-    def _motion(self, j: int, p, point: bool):
+    def _motion(self, j: int, p: Sequence[Any], point: bool) -> list[Any]:  # entries: numbers or Polys
         m = self.mech.model
         kind, w = self.kinds[self.unknown.index(j)]
         sl = self.slots[j]
@@ -94,7 +97,7 @@ class _LegSystem:
         out = matvec(M.rotation, p)
         return [out[i] + float(M.translation[i]) for i in range(3)] if point else out
 
-    def _up(self, j: int, p, stop: int, point: bool):
+    def _up(self, j: int, p: Iterable[float], stop: int, point: bool) -> list[Any]:
         """A point (or direction) fixed in joint ``j``'s frame, in the frame of ancestor ``stop`` (0: world)."""
         m, d = self.mech.model, self._d
         p = [float(v) for v in p]
@@ -116,7 +119,7 @@ class _LegSystem:
         return out
 
 
-def working_modes(mech: Mechanism, task, *, precision: str = "adaptive") -> ModeSet:
+def working_modes(mech: Mechanism, task: ArrayLike | Mapping[str, Any], *, precision: str = "adaptive") -> ModeSet:
     """Every real working mode of ``mech`` at the task coordinates ``task`` (module doc).
 
     Args:

@@ -24,9 +24,14 @@ import os
 import shutil
 import subprocess
 import tempfile
+from collections.abc import Callable, Iterable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import casadi as cs
+
+if TYPE_CHECKING:
+    import numpy as np
 
 _FLAGS = ("-shared", "-fPIC")
 #: ctypes types of the generated code's ``casadi_real*`` and ``casadi_int`` (``long long``).
@@ -222,7 +227,7 @@ def cache_dir() -> Path:
     return root() / "twin"
 
 
-def source(funs, *, follow: bool = False) -> str:
+def source(funs: cs.Function | Iterable[cs.Function], *, follow: bool = False) -> str:
     """The C source of one CasADi function or a list (CasADi's code generator, one preamble), each with its batch
     driver, and the path driver if ``follow``."""
     funs = [funs] if isinstance(funs, cs.Function) else list(funs)
@@ -249,7 +254,8 @@ def map_source(step: cs.Function, qr_step: cs.Function, index: cs.Function, pivo
     return source([step, qr_step, index]) + grid
 
 
-def compile_library(fun, *, follow: bool = False, directory=None, text: str | None = None
+def compile_library(fun: cs.Function | Iterable[cs.Function], *, follow: bool = False,
+                    directory: str | os.PathLike[str] | None = None, text: str | None = None
                     ) -> tuple[ctypes.CDLL | None, str]:
     """``fun`` (one CasADi function or a list) and its drivers compiled and loaded. Returns ``(library, how)``;
     ``library`` is None, and ``how`` says why, when there is no C compiler on the PATH (``cc``, ``gcc`` or
@@ -344,7 +350,7 @@ def numpy_source(fun: cs.Function) -> str:
     return "\n".join(lines) + "\n"
 
 
-def numpy_function(fun: cs.Function):
+def numpy_function(fun: cs.Function) -> Callable[..., list[np.ndarray]]:
     """``fun`` vectorised over samples with numpy (see :func:`numpy_source`): ``g(*inputs) -> outputs``, each an
     ``(n, nnz)`` array."""
     import numpy as np
@@ -355,7 +361,7 @@ def numpy_function(fun: cs.Function):
     return lambda *arrays: f(np, arrays[0].shape[0], *arrays)
 
 
-def compile_function(fun: cs.Function, directory=None) -> tuple[cs.Function, str]:
+def compile_function(fun: cs.Function, directory: str | os.PathLike[str] | None = None) -> tuple[cs.Function, str]:
     """``fun`` as compiled C loaded back as a ``casadi.Function`` (``casadi.external``) when a C compiler is present;
     else ``fun`` itself, run by CasADi's virtual machine. Returns ``(function, how)``."""
     lib, how = compile_library(fun, directory=directory)

@@ -6,7 +6,7 @@ import casadi as cs
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.twin.spatial import SE3, cross, quat_matrix, rodrigues
+from pkm.core.twin.spatial import SE3, Expr, cross, quat_matrix, rodrigues
 from pkm.errors import SpecError
 
 _ONE_DOF = {"RX", "RY", "RZ", "RevoluteUnaligned", "PX", "PY", "PZ", "PrismaticUnaligned"}
@@ -46,7 +46,7 @@ class Joint:
             raise SpecError(source, f"joint {model.names[jid]!r}: the symbolic twin does not handle a Pinocchio "
                                     f"{jm.shortname()}")
 
-    def motion(self, q) -> SE3:
+    def motion(self, q: Expr) -> SE3:
         """``M(q)``: the joint's transform (after its placement)."""
         k = self.kind
         if k in _ONE_DOF or k == "mimic":
@@ -73,7 +73,7 @@ class Joint:
         R2 = rodrigues(self.axes[1], cs.cos(q[i + 1]), cs.sin(q[i + 1]))
         return SE3(R1 @ R2, cs.DM.zeros(3))
 
-    def subspace(self, q):
+    def subspace(self, q: Expr) -> Expr:
         """``S`` (6 x k) in the joint's frame; constant except a universal joint's first column."""
         if self.kind != "Universal":
             return cs.DM(self.S)
@@ -82,11 +82,11 @@ class Joint:
         return cs.horzcat(cs.vertcat(cs.DM.zeros(3), R2.T @ cs.DM(self.axes[0])),
                           cs.vertcat(cs.DM.zeros(3), cs.DM(self.axes[1])))
 
-    def velocity(self, q, v):
+    def velocity(self, q: Expr, v: Expr) -> Expr:
         """The joint's twist in its frame, ``S v_j``."""
         return self.subspace(q) @ cs.vertcat(*[v[c] for c in self.cols])
 
-    def bias(self, q, v):
+    def bias(self, q: Expr, v: Expr) -> Expr:
         """``dS/dt v_j`` (only the universal joint's first axis turns with the second coordinate)."""
         if self.kind != "Universal":
             return cs.DM.zeros(6)
@@ -96,7 +96,7 @@ class Joint:
         w1 = R2.T @ cs.DM(self.axes[0])
         return cs.vertcat(cs.DM.zeros(3), -cross(cs.DM(self.axes[1]) * q2d, w1) * q1d)
 
-    def tangent(self, q):
+    def tangent(self, q: Expr) -> Expr | None:
         """``d(q + T dq)/d(dq)``: the joint's own coordinates' derivative along its velocity coordinates, the block
         ``(nq_j x nv_j)`` of Pinocchio's ``integrate(q, dq)`` at ``dq = 0`` (None for a mimic joint: no coordinates
         of its own)."""
@@ -115,7 +115,7 @@ class Joint:
             return cs.vertcat(cs.horzcat(c, -s, 0), cs.horzcat(s, c, 0), cs.horzcat(0, 0, -s), cs.horzcat(0, 0, c))
         return cs.DM.eye(len(self.cols))  # one-coordinate joints, universal
 
-    def retract(self, q, dq):
+    def retract(self, q: Expr, dq: Expr) -> list[tuple[int, Expr]]:
         """The joint's coordinates moved by its velocity coordinates ``dq`` (``(index, value)`` pairs): ``q + T dq``,
         unit blocks (quaternions, ``cos, sin`` pairs) renormalised. A retraction: it agrees with Pinocchio's
         ``integrate`` to first order, which keeps Newton's quadratic convergence."""
@@ -133,7 +133,7 @@ class Joint:
         return [(self.idx_q + r, new[r]) for r in range(nq)]
 
 
-def _quat_tangent(quat):
+def _quat_tangent(quat: Expr) -> Expr:
     """``d(quat * (dw/2, 1))/d(dw)`` for a unit quaternion ``(x, y, z, w)``: right multiplication by the rotation
     ``exp(dw)`` to first order (4 x 3)."""
     x, y, z, w = quat[0], quat[1], quat[2], quat[3]

@@ -16,10 +16,14 @@ result's ``fallback``; a path sample that does not converge in the kernel is han
 from __future__ import annotations
 
 import ctypes
+import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import casadi as cs
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.codegen import C_INT as _I
@@ -28,6 +32,9 @@ from pkm.core.twin.codegen import compile_library, numpy_function
 from pkm.core.twin.tree import Twin
 from pkm.errors import InvalidInputError, NonFiniteError
 from pkm.validation import as_array, as_count, as_tolerance
+
+if TYPE_CHECKING:
+    from pkm.core.kinematics.solve import SolveResult
 
 #: Smallest relative pivot (:meth:`PivotedLU.smallest_relative_pivot`) at which a kernel's solve is trusted.
 PIVOT_FLOOR = 1e-6
@@ -94,7 +101,7 @@ class _Kernel:
     of sample-major outputs: the C batch driver when compiled, else numpy vectorised over the samples
     (:func:`~pkm.core.twin.codegen.numpy_function`; CasADi's virtual machine for one sample)."""
 
-    def __init__(self, fun: cs.Function, follow: bool, compiled: bool, directory):
+    def __init__(self, fun: cs.Function, follow: bool, compiled: bool, directory: str | os.PathLike[str] | None):
         self.fun = fun
         self.lib, self.how = compile_library(fun, follow=follow, directory=directory) if compiled else (
             None, "compiled=False")
@@ -139,7 +146,8 @@ class _Kernel:
             raise RuntimeError(f"the compiled kernel {self.fun.name()} failed")
         return outs
 
-    def follow(self, q0: np.ndarray, targets: np.ndarray, max_iter: int, tol: float):
+    def follow(self, q0: np.ndarray, targets: np.ndarray, max_iter: int, tol: float) \
+            -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         n, nq = targets.shape[0], q0.shape[0]
         if self.lib is None:
             q, out = q0.copy(), (np.empty((n, nq)), np.empty(n), np.empty(n), np.zeros(n, dtype=np.int64))
@@ -177,7 +185,7 @@ class Kernels:
         SpecError: ``mech`` has idle motions (on the first kernel that needs the passive solve).
     """
 
-    def __init__(self, mech: Mechanism, *, compiled: bool = True, directory=None):
+    def __init__(self, mech: Mechanism, *, compiled: bool = True, directory: str | os.PathLike[str] | None = None):
         self.mech = check_mechanism(mech)
         self.twin = Twin(self.mech)
         self.compiled, self.directory = compiled, directory
@@ -237,7 +245,7 @@ class Kernels:
         return OperationCount(name, mul, add, counts, BOUNDARIES[name])
 
     # ---------------------------------------------------------------- evaluation
-    def _run(self, name: str, *args, pivoted: bool = False) -> tuple[list[np.ndarray], bool]:
+    def _run(self, name: str, *args: ArrayLike, pivoted: bool = False) -> tuple[list[np.ndarray], bool]:
         """The kernel on one sample (each input 1-D) or a batch (each 2-D, the same length); a non-finite output
         is diagnosed: non-finite input (:class:`InvalidInputError`) or a failed evaluation (:class:`NonFiniteError`;
         with ``pivoted``, only at samples whose pivot, the last output, is above the floor: the others are the
@@ -275,7 +283,7 @@ class Kernels:
             shaped.append(x[0] if single else x)
         return shaped
 
-    def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
+    def inverse_dynamics(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """Actuator efforts (na, or n x na) at closed configurations ``q`` (nq or n x nq) for actuated rates and
         accelerations ``qd, qdd`` (na or n x na) [N, N m]: :attr:`Twin.inverse_dynamics`, samples under the pivot
         floor recomputed by :func:`pkm.inverse_dynamics`."""
@@ -291,35 +299,35 @@ class Kernels:
                 tau[k] = inverse_dynamics(self.mech, Q[k], v, accelerations(self.mech, Q[k], v, QDD[k]))
         return tau[0] if single else tau
 
-    def inverse_dynamics_derivatives(self, q, qd, qdd) -> dict[str, np.ndarray]:
+    def inverse_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> dict[str, np.ndarray]:
         """``tau`` and its derivatives ``dtau_dqa`` (along the closure), ``dtau_dqd``, ``dtau_dqdd`` (na x na each, or
         n x na x na) at closed configurations (see :attr:`Twin.inverse_dynamics_derivatives`)."""
         outs, single = self._run("inverse_dynamics_derivatives", q, qd, qdd)
         return dict(zip(KERNELS["inverse_dynamics_derivatives"][1], self._shaped("inverse_dynamics_derivatives",
                                                                                  outs, single)))
 
-    def velocities(self, q, qd) -> np.ndarray:
+    def velocities(self, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
         """All joint rates (nv) for actuated rates ``qd`` at closed configurations ``q``."""
         outs, single = self._run("velocities", q, qd)
         return outs[0][0] if single else outs[0]
 
-    def accelerations(self, q, v, qdd) -> np.ndarray:
+    def accelerations(self, q: ArrayLike, v: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """All joint accelerations (nv) at ``(q, v)`` for actuated accelerations ``qdd``."""
         outs, single = self._run("accelerations", q, v, qdd)
         return outs[0][0] if single else outs[0]
 
-    def forward_jacobian(self, q) -> np.ndarray:
+    def forward_jacobian(self, q: ArrayLike) -> np.ndarray:
         """Task rates per actuated rate (task size x na) at closed configurations."""
         outs, single = self._run("forward_jacobian", q)
         return self._shaped("forward_jacobian", outs, single)[0]
 
-    def inverse_jacobian(self, q) -> np.ndarray:
+    def inverse_jacobian(self, q: ArrayLike) -> np.ndarray:
         """Actuated rates per task rate (na x task size) at closed configurations."""
         outs, single = self._run("inverse_jacobian", q)
         return self._shaped("inverse_jacobian", outs, single)[0]
 
     # ---------------------------------------------------------------- paths
-    def close_loops_path(self, q_actuated, q0=None, *, tol: float = 1e-12, max_iter: int = 10) -> PathResult:
+    def close_loops_path(self, q_actuated: ArrayLike, q0: ArrayLike | None = None, *, tol: float = 1e-12, max_iter: int = 10) -> PathResult:
         """The loop closure along a path of actuated coordinates (n x na), each solve warm-started from the previous
         solution (the first from ``q0``, default the reference), as :func:`pkm.close_loops` per sample."""
         from pkm.core.kinematics.solve import close_loops
@@ -327,14 +335,15 @@ class Kernels:
         return self._path("closure_newton", q_actuated, q0, tol, max_iter,
                           lambda q, t: close_loops(self.mech, t, q, tol=tol))
 
-    def ik_path(self, targets, q0=None, *, tol: float = 1e-12, max_iter: int = 10) -> PathResult:
+    def ik_path(self, targets: ArrayLike, q0: ArrayLike | None = None, *, tol: float = 1e-12, max_iter: int = 10) -> PathResult:
         """The inverse kinematics along a path of task values (n x task value size, laid out as
         :meth:`pkm.core.kinematics.task.TaskMap.value`), warm-started, as :func:`pkm.solve_ik` per sample."""
         from pkm.core.kinematics.solve import solve_ik
 
         return self._path("ik_newton", targets, q0, tol, max_iter, lambda q, t: solve_ik(self.mech, t, q, tol=tol))
 
-    def _path(self, name: str, targets, q0, tol: float, max_iter: int, core) -> PathResult:
+    def _path(self, name: str, targets: ArrayLike, q0: ArrayLike | None, tol: float, max_iter: int,
+              core: Callable[[np.ndarray, np.ndarray], SolveResult]) -> PathResult:
         tol, max_iter = as_tolerance(tol, "tol"), as_count(max_iter, "max_iter", high=1000)
         kernel = self.kernel(name)
         t = np.atleast_2d(as_array(targets, "targets"))

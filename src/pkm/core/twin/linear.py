@@ -21,6 +21,8 @@ from __future__ import annotations
 import casadi as cs
 import numpy as np
 
+from pkm.core.twin.spatial import Expr
+
 #: A pivot is taken only where it is at least this fraction of its column's largest remaining entry (at the reference).
 THRESHOLD = 0.1
 
@@ -37,7 +39,7 @@ class PivotedLU:
         ValueError: ``A_ref`` has rank below n (no pivot left for a column).
     """
 
-    def __init__(self, A, A_ref: np.ndarray, rank_tol: float = 1e-9):
+    def __init__(self, A: Expr, A_ref: np.ndarray, rank_tol: float = 1e-9):
         m, n = A.shape
         if m < n:
             raise ValueError(f"a {m} x {n} matrix: PivotedLU needs at least as many rows as columns")
@@ -90,11 +92,11 @@ class PivotedLU:
         #: The pivots' values at the reference (for :meth:`smallest_relative_pivot`).
         self.reference_pivots = np.array([num[p][c] for p, c in self.order])
 
-    def smallest_relative_pivot(self):
+    def smallest_relative_pivot(self) -> Expr:
         """``min_k |pivot_k| / |pivot_k(reference)|`` (SX): near 0, the fixed pivot order fails here."""
         return cs.mmin(cs.vertcat(*[cs.fabs(u) / abs(r) for u, r in zip(self.pivots, self.reference_pivots)]))
 
-    def solve(self, b):
+    def solve(self, b: Expr) -> Expr:
         """``x`` (n) with ``A x = b`` (b: m rows of SX; rows without a pivot are ignored)."""
         w = [b[i] for i in range(self.shape[0])]
         for (p, _), step in zip(self.order, self._factors):  # the elimination's row operations
@@ -109,7 +111,7 @@ class PivotedLU:
             x[c] = s / self._u[p][c]
         return cs.vertcat(*x)
 
-    def solve_transposed(self, b):
+    def solve_transposed(self, b: Expr) -> Expr:
         """``y`` (m) with ``A^T y = b`` (b: n rows of SX), zero on the rows without a pivot."""
         z: list = [0] * self.shape[0]
         for k, (p, c) in enumerate(self.order):  # U^T z = b, in pivot order

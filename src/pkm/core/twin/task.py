@@ -11,7 +11,7 @@ import casadi as cs
 import numpy as np
 
 from pkm.core.twin.linear import PivotedLU
-from pkm.core.twin.spatial import euler_rates, log3, quat_matrix, zyx_angles
+from pkm.core.twin.spatial import Expr, euler_rates, log3, quat_matrix, zyx_angles
 from pkm.errors import SpecError
 
 if TYPE_CHECKING:
@@ -33,14 +33,14 @@ class TaskTwin:
         return groups + list(zip(self.tw.mech.task_frames, spec.frames.values()))
 
     @functools.cached_property
-    def task_target(self):
+    def task_target(self) -> Expr:
         """The symbol of a task target, laid out as :meth:`pkm.core.kinematics.task.TaskMap.value` gives values."""
         from pkm.core.kinematics.task import TaskMap
 
         return cs.SX.sym("y", TaskMap(self.tw.mech).value_size)
 
     @functools.cached_property
-    def task_error(self):
+    def task_error(self) -> Expr:
         """``target - task(q)`` on the task's tangent space, as :meth:`pkm.core.kinematics.task.TaskMap.error` (angles wrapped to
         ``(-pi, pi]``, a pose's orientation as ``log3(R_target R^T)``)."""
         y, out, at = self.task_target, [], 0
@@ -64,7 +64,7 @@ class TaskTwin:
         return cs.vertcat(*out)
 
     @functools.cached_property
-    def task_jacobian(self):
+    def task_jacobian(self) -> Expr:
         """``d(task)/dq`` on the tangent space (task size x nv), as :meth:`pkm.core.kinematics.task.TaskMap.jacobian`."""
         rows = []
         for fid, comps in self._task_groups():
@@ -97,7 +97,7 @@ class TaskTwin:
         base = set(self.tw.mech.base_v.tolist())
         return [i for i in range(self.tw.mech.nv) if i not in base]
 
-    def _on_free(self, values) -> cs.SX:
+    def _on_free(self, values: Expr) -> cs.SX:
         out = cs.SX.zeros(self.tw.mech.nv)
         for r, col in enumerate(self._free_cols):
             out[col] = values[r]
@@ -135,7 +135,7 @@ class TaskTwin:
         return {"q_next": self.tw.retract(step), "step": cs.mmax(cs.fabs(step))}
 
     @functools.cached_property
-    def scale(self):
+    def scale(self) -> Expr:
         """The symbol of the task rates' scales (task size): :attr:`map_indices` homogenises with ``K diag(scale)``."""
         return cs.SX.sym("scale", self.task_jacobian.shape[0])
 
@@ -156,12 +156,12 @@ class TaskTwin:
                 "branch": cs.vertcat(*branch) if branch else cs.SX(0, 1)}
 
     @functools.cached_property
-    def forward_jacobian(self):
+    def forward_jacobian(self) -> Expr:
         """Task rates per actuated rate (task size x na): ``J_task G``."""
         return self.task_jacobian @ self.tw.passive_map
 
     @functools.cached_property
-    def inverse_jacobian(self):
+    def inverse_jacobian(self) -> Expr:
         """Actuated rates per task rate (na x task size): the actuated rows of ``[W J; J_task]^-1 [0; I]``."""
         n_closure = self.tw.closure_rows["jacobian"].shape[0]
         at = {c: r for r, c in enumerate(self._free_cols)}

@@ -36,6 +36,7 @@ free-flyer's velocity is its body twist, a spherical joint's its body angular ve
 from __future__ import annotations
 
 import functools
+from typing import TYPE_CHECKING
 
 import casadi as cs
 import numpy as np
@@ -45,12 +46,16 @@ from pkm.core.twin.joint import Joint
 from pkm.core.twin.linear import PivotedLU
 from pkm.core.twin.spatial import (
     SE3,
+    Expr,
     cross,
     force_cross,
     log6,
     motion_cross,
 )
 from pkm.errors import SpecError
+
+if TYPE_CHECKING:
+    from pkm.core.twin.task import TaskTwin
 
 
 # ---------------------------------------------------------------------- the twin
@@ -94,7 +99,7 @@ class Twin:
         f = self.mech.model.frames[fid]
         return self.oMi[f.parentJoint] * SE3.of(f.placement)
 
-    def frame_jacobian(self, fid: int):
+    def frame_jacobian(self, fid: int) -> Expr:
         """The frame's Jacobian in ``LOCAL_WORLD_ALIGNED`` (6 x nv): ``[v of its origin; w]`` in world axes."""
         model = self.mech.model
         f = model.frames[fid]
@@ -109,7 +114,7 @@ class Twin:
             j = Jt.parent
         return J
 
-    def frame_classical_acceleration(self, fid: int):
+    def frame_classical_acceleration(self, fid: int) -> Expr:
         """The frame origin's acceleration ``[a; alpha]`` in world axes with ``a = 0`` (classical: ``a + w x v``)."""
         f = self.mech.model.frames[fid]
         X = SE3.of(f.placement)
@@ -120,7 +125,7 @@ class Twin:
 
     # ---------------------------------------------------------------- closures
     @functools.cached_property
-    def closure_residual(self):
+    def closure_residual(self) -> Expr:
         """The closure residual (n_constraints) in :mod:`pkm.core.kinematics.constraints`' conventions."""
         out = []
         for c, (fa, fb) in zip(self.mech.spec.closures, self.mech.closure_frames):
@@ -129,7 +134,7 @@ class Twin:
         return cs.vertcat(*out)
 
     @functools.cached_property
-    def closure_jacobian(self):
+    def closure_jacobian(self) -> Expr:
         """``d(residual)/dq`` on the tangent space (n_constraints x nv), as :func:`pkm.core.kinematics.constraints.jacobian`."""
         rows = []
         for c, (fa, fb) in zip(self.mech.spec.closures, self.mech.closure_frames):
@@ -142,12 +147,12 @@ class Twin:
         return cs.vertcat(*rows)
 
     @staticmethod
-    def _local(M: SE3, J_lwa):
+    def _local(M: SE3, J_lwa: Expr) -> Expr:
         """A ``LOCAL_WORLD_ALIGNED`` Jacobian in the frame's own axes (``LOCAL``)."""
         return cs.vertcat(M.R.T @ J_lwa[:3, :], M.R.T @ J_lwa[3:, :])
 
     @functools.cached_property
-    def closure_drift(self):
+    def closure_drift(self) -> Expr:
         """``gamma = dJ/dt(q, v) v`` (n_constraints): the closure acceleration of ``v`` alone, as
         :func:`pkm.core.kinematics.constraints.drift`."""
         out = []
@@ -163,7 +168,7 @@ class Twin:
                 out.append(aa - ab - motion_cross(va, vb))
         return cs.vertcat(*out)
 
-    def frame_jacobian_local(self, fid: int):
+    def frame_jacobian_local(self, fid: int) -> Expr:
         """The frame's Jacobian in ``LOCAL`` axes (6 x nv), by a backward pass from the frame: a joint right above
         it (a free-flyer platform's) costs nothing."""
         model = self.mech.model
@@ -216,7 +221,7 @@ class Twin:
             at += 3
         return {"jacobian": cs.vertcat(*rows), "drift": cs.vertcat(*drift), "rotations": rotations}
 
-    def rotate_rows(self, residual):
+    def rotate_rows(self, residual: Expr) -> Expr:
         """``W residual`` for the rows of :attr:`closure_rows`."""
         out, at = [], 0
         for R in self.closure_rows["rotations"]:
@@ -226,14 +231,14 @@ class Twin:
         return cs.vertcat(*out)
 
     # ---------------------------------------------------------------- dynamics
-    def _inertia_times(self, j: int, m):
+    def _inertia_times(self, j: int, m: Expr) -> Expr:
         I = self._inertia[j]
         mass, c, Ic = I.mass, cs.DM(I.lever), cs.DM(I.inertia)
         lin = mass * (m[:3] - cross(c, m[3:]))
         return cs.vertcat(lin, Ic @ m[3:] + cross(c, lin))
 
     @functools.cached_property
-    def rnea(self):
+    def rnea(self) -> Expr:
         """Joint torques (nv) for ``q, v, a`` under ``model.gravity`` (Pinocchio's ``rnea``)."""
         model = self.mech.model
         n = len(self.joints)
@@ -252,11 +257,11 @@ class Twin:
         return tau
 
     @functools.cached_property
-    def kinetic_energy(self):
+    def kinetic_energy(self) -> Expr:
         return sum(0.5 * cs.dot(self.vel[j], self._inertia_times(j, self.vel[j])) for j in range(1, len(self.joints)))
 
     @functools.cached_property
-    def potential_energy(self):
+    def potential_energy(self) -> Expr:
         g = cs.DM(self.mech.model.gravity.linear)
         out = 0
         for j in range(1, len(self.joints)):
@@ -272,7 +277,7 @@ class Twin:
             raise SpecError(self.mech.source, "the twin's rate maps and efforts need a mechanism without idle motions; "
                                               "pkm.passive_map and pkm.inverse_dynamics handle them")
 
-    def at_reference(self, expr) -> np.ndarray:
+    def at_reference(self, expr: Expr) -> np.ndarray:
         """The value of an expression of ``q`` at the mechanism's reference configuration."""
         return np.array(cs.Function("at_reference", [self.q], [expr])(self.mech.q_reference))
 
@@ -283,47 +288,47 @@ class Twin:
         Jp = self.closure_rows["jacobian"][:, self.mech.passive_v.tolist()]
         return PivotedLU(Jp, self.at_reference(Jp))
 
-    def _passive(self, values) -> cs.SX:
+    def _passive(self, values: Expr) -> cs.SX:
         """An nv vector: ``values`` (passive) on the passive rows, zero elsewhere."""
         out = cs.SX.zeros(self.mech.nv)
         for r, row in enumerate(self.mech.passive_v):
             out[int(row)] = values[r]
         return out
 
-    def _actuated(self, values) -> cs.SX:
+    def _actuated(self, values: Expr) -> cs.SX:
         out = cs.SX.zeros(self.mech.nv)
         for k, col in enumerate(self.mech.act_v):
             out[int(col)] = values[k]
         return out
 
     @functools.cached_property
-    def passive_map(self):
+    def passive_map(self) -> Expr:
         """``G = dq/dq_a`` (nv x na), as :func:`pkm.passive_map` (mechanisms without idle motions)."""
         Ja = self.closure_rows["jacobian"][:, self.mech.act_v.tolist()]
         return cs.horzcat(*[self._actuated(np.eye(self.mech.na)[k]) - self._passive(self.passive_lu.solve(Ja[:, k]))
                             for k in range(self.mech.na)])
 
     @functools.cached_property
-    def velocities(self):
+    def velocities(self) -> Expr:
         """All joint rates for the actuated rates :attr:`qd` (symbol, na), as :func:`pkm.velocities`."""
         Ja = self.closure_rows["jacobian"][:, self.mech.act_v.tolist()]
         return self._actuated(self.qd) - self._passive(self.passive_lu.solve(Ja @ self.qd))
 
     @functools.cached_property
-    def accelerations(self):
+    def accelerations(self) -> Expr:
         """All joint accelerations at ``(q, v)`` for the actuated accelerations :attr:`qdd` (symbol, na), as
         :func:`pkm.accelerations`: the passive ones close the loops at the acceleration level (drift included)."""
         Ja = self.closure_rows["jacobian"][:, self.mech.act_v.tolist()]
         return self._actuated(self.qdd) - self._passive(self.passive_lu.solve(Ja @ self.qdd + self.closure_rows["drift"]))
 
     @functools.cached_property
-    def closure_step(self):
+    def closure_step(self) -> Expr:
         """The Newton step of the loop closure at ``q`` (actuators held): the passive rates ``dq`` (nv, zero on the
         actuated and base rows) with ``J_p dq_p = -residual``; ``pin.integrate(q, dq)`` applies it."""
         return -self._passive(self.passive_lu.solve(self.rotate_rows(self.closure_residual)))
 
     @functools.cached_property
-    def actuated_efforts(self):
+    def actuated_efforts(self) -> Expr:
         """Actuator efforts (na) at a consistent state ``(q, v, a)``: ``G^T rnea``
         (:func:`pkm.core.dynamics.projection.virtual_work_dynamics`), computed as ``tau_a - J_a^T lambda`` with
         ``J_p^T lambda = tau_p`` (one transposed solve instead of the matrix ``G``).
@@ -338,7 +343,7 @@ class Twin:
         return cs.vertcat(*[tau[int(c)] for c in mech.act_v]) - Ja.T @ lam
 
     @functools.cached_property
-    def inverse_dynamics(self):
+    def inverse_dynamics(self) -> Expr:
         """Actuator efforts (na) from the closed configuration :attr:`q` and the actuated rates and accelerations
         :attr:`qd`, :attr:`qdd`: joint rates, accelerations (drift included), RNEA under gravity, projection. A
         floating base is held still (its pose in ``q``)."""
@@ -356,7 +361,7 @@ class Twin:
                 "dtau_dqd": cs.jacobian(tau, self.qd), "dtau_dqdd": cs.jacobian(tau, self.qdd)}
 
     @functools.cached_property
-    def task(self):
+    def task(self) -> TaskTwin:
         """The task's expressions and the Newton iterations of the IK and the maps (:class:`TaskTwin`)."""
         from pkm.core.twin.task import TaskTwin
 
@@ -364,7 +369,7 @@ class Twin:
 
     # ---------------------------------------------------------------- configuration space
     @functools.cached_property
-    def tangent(self):
+    def tangent(self) -> Expr:
         """``T(q)`` (nq x nv), ``dq/d(dq)`` of Pinocchio's ``integrate(q, dq)`` at ``dq = 0``."""
         T = cs.SX.zeros(self.mech.model.nq, self.mech.nv)
         for J in self.joints[1:]:
@@ -373,7 +378,7 @@ class Twin:
                 T[J.idx_q:J.idx_q + block.shape[0], J.cols[0]:J.cols[-1] + 1] = block
         return T
 
-    def retract(self, dq):
+    def retract(self, dq: Expr) -> Expr:
         """:attr:`q` moved by the tangent vector ``dq`` (nv): ``q + T dq`` with unit blocks renormalised, which
         agrees with ``pin.integrate`` to first order (see :meth:`Joint.retract`)."""
         out = [self.q[i] for i in range(self.mech.model.nq)]
@@ -383,11 +388,11 @@ class Twin:
         return cs.vertcat(*out)
 
     @functools.cached_property
-    def target(self):
+    def target(self) -> Expr:
         """The symbol of a Newton iteration's target: the actuated coordinates (na) for :attr:`closure_newton`."""
         return cs.SX.sym("qa", self.mech.na)
 
-    def with_actuated(self, expr):
+    def with_actuated(self, expr: Expr) -> Expr:
         """``expr`` at :attr:`q` with its actuated coordinates replaced by :attr:`target`."""
         q = [self.q[i] for i in range(self.mech.model.nq)]
         for k, i in enumerate(self.mech.act_q):
@@ -403,7 +408,7 @@ class Twin:
         return {"q_next": q_next, "residual": self.largest_at(self.closure_residual, q_next),
                 "pivot": self.with_actuated(self.passive_lu.smallest_relative_pivot())}
 
-    def largest_at(self, residual, q):
+    def largest_at(self, residual: Expr, q: Expr) -> Expr:
         """The largest entry of ``residual`` (an expression of :attr:`q`) at the configuration ``q``."""
         return cs.mmax(cs.fabs(cs.substitute(residual, self.q, q)))
 
