@@ -12,7 +12,7 @@ import pytest
 import pkm
 from pkm.core.kinematics import constraints
 from pkm.core.model.urdf import parse_xml
-from pkm.errors import InvalidInputError, InvalidParameterError, SpecError, UnknownNameError
+from pkm.errors import InvalidInputError, InvalidParameterError, UnknownNameError
 from pkm.mechanisms.rrr3 import Rrr3Params
 from pkm.sweeps.family import Candidate, ModelFamily, RegisteredFamily, family_of, from_description, origins_set
 
