@@ -43,9 +43,11 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core import (
         Branch,
         Closure,
+        ClosureProblem,
         ClosureSpec,
         Configuration,
         Diagnostics,
+        IKProblem,
         Jump,
         Mechanism,
         SolveResult,

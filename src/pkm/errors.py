@@ -240,6 +240,9 @@ class ConvergenceError(PkmError):
         worst_gap: Its gap (norm of its residual block, m or rad).
         tolerance: Tolerance that was asked for.
         result: The solver's last result object, for inspection (may be None).
+        problem: The problem it was solving, with ``residual(q)`` and ``jacobian(q)``
+            (:class:`~pkm.core.kinematics.solve.ClosureProblem`, :class:`~pkm.core.kinematics.solve.IKProblem`), or
+            None.
     """
 
     def __init__(self, what: str, residual: float, iterations: int, tolerance: float, result: object = None,
@@ -251,6 +254,7 @@ class ConvergenceError(PkmError):
         self.result = result
         self.worst_closure: str | None = None
         self.worst_gap: float = 0.0
+        self.problem: object = None
         extra = f"; {detail}" if detail else ""
         super().__init__(
             f"{what} did not converge: residual {self.residual:.3e} > tolerance {self.tolerance:.1e} "

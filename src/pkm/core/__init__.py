@@ -19,7 +19,8 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
                               "task_acceleration", "task_velocity", "twist_jacobian", "velocities"),
     "pkm.core.dynamics.projection": ("inverse_dynamics",),
     "pkm.core.model.mechanism": ("Mechanism",),
-    "pkm.core.kinematics.solve": ("SolveResult", "assemble", "branch_seed", "close_loops", "solve_ik"),
+    "pkm.core.kinematics.solve": ("ClosureProblem", "IKProblem", "SolveResult", "assemble", "branch_seed",
+                                  "close_loops", "solve_ik"),
     "pkm.core.model.spec": ("Branch", "Closure", "ClosureSpec", "TaskSpec"),
     "pkm.core.kinematics.task": ("TaskMap", "zyx_angles", "zyx_matrix"),
     "pkm.core.kinematics.trajectory": ("Jump", "Trajectory", "follow_actuators", "follow_task", "task_values"),
@@ -44,7 +45,15 @@ if TYPE_CHECKING:  # the static view of the lazy names
     )
     from pkm.core.dynamics.projection import inverse_dynamics
     from pkm.core.kinematics.configuration import Configuration
-    from pkm.core.kinematics.solve import SolveResult, assemble, branch_seed, close_loops, solve_ik
+    from pkm.core.kinematics.solve import (
+        ClosureProblem,
+        IKProblem,
+        SolveResult,
+        assemble,
+        branch_seed,
+        close_loops,
+        solve_ik,
+    )
     from pkm.core.kinematics.task import TaskMap, zyx_angles, zyx_matrix
     from pkm.core.kinematics.trajectory import Jump, Trajectory, follow_actuators, follow_task, task_values
     from pkm.core.model.mechanism import Mechanism

@@ -281,3 +281,34 @@ def test_a_result_checks_itself_again_and_assemble_follows_the_solvers_failure_r
     q_open[tight.joint("elbow_1").idx_q] += 2.0
     failed = pkm.assemble(tight, q_open, hold=("motor_1", "motor_2", "elbow_1"), restarts=0, raise_on_failure=False)
     assert not failed.converged and failed.residual > 1e-3 and failed.check(tight)
+
+
+def test_a_failure_carries_its_problem_whose_jacobian_is_the_derivative_of_its_residual(delta):
+    """ConvergenceError.problem (ClosureProblem, IKProblem): residual(q) is zero at a solution and equals the
+    failure's residual at its last iterate; jacobian(q) equals central differences of residual along random
+    tangent directions (1e-6 relative)."""
+    import pinocchio as pin
+
+    from pkm.core import ClosureProblem, IKProblem
+
+    sol = close_loops(delta, [-0.9, -0.85, -1.0])
+    closure = ClosureProblem(delta, delta.actuated_q(sol.q))
+    ik = IKProblem(delta, delta.task_map.value(sol.q))
+    rng = np.random.default_rng(0)
+    for problem in (closure, ik):
+        assert np.abs(problem.residual(sol.q)).max() <= 1e-10
+        q = pin.integrate(delta.model, sol.q, 0.05 * rng.standard_normal(delta.nv))
+        J = problem.jacobian(q)
+        for _ in range(3):
+            d = rng.standard_normal(delta.nv)
+            h = 1e-6
+            fd = (problem.residual(pin.integrate(delta.model, q, h * d))
+                  - problem.residual(pin.integrate(delta.model, q, -h * d))) / (2 * h)
+            assert np.abs(J @ d - fd).max() <= 1e-6 * max(1.0, np.abs(fd).max())
+    short = D.build(D.DeltaParams(Lb=0.2, home=(0.0, 0.0, -0.2)))  # (these motor angles admit no assembly)
+    with pytest.raises(ConvergenceError) as info:
+        close_loops(short, [-0.7, -0.4, 0.2], max_iter=15)
+    err = info.value
+    assert isinstance(err.problem, ClosureProblem) and np.allclose(err.problem.q_actuated, [-0.7, -0.4, 0.2])
+    closure_part = err.problem.residual(err.result.q)[:short.n_constraints]
+    assert np.abs(closure_part).max() == pytest.approx(err.result.residual, rel=1e-9)

@@ -86,6 +86,63 @@ class SolveResult:
                     and self.branch_signs == _signs(mech, q) and self.outside_limits == mech.outside_limits(q))
 
 
+@dataclass(frozen=True)
+class ClosureProblem:
+    """The loop-closure problem of :func:`close_loops` as equations ``F(q) = 0`` on the whole configuration: every
+    closure residual, then the actuated coordinates less their targets (qpsolvers' ``Problem``, pink's
+    ``build_ik``: inspect it, evaluate it, check a solution). A :class:`~pkm.errors.ConvergenceError` of
+    :func:`close_loops` carries it (``problem``).
+
+    Attributes:
+        mech: The mechanism.
+        q_actuated: The actuated coordinates asked for (spec order) [rad or m].
+    """
+
+    mech: Mechanism
+    q_actuated: np.ndarray
+
+    def residual(self, q: ArrayLike) -> np.ndarray:
+        """``F(q)``: closure residuals [m, rad], then ``q_a - q_actuated`` [rad or m]."""
+        q = self.mech.check_q(q)
+        return np.concatenate([constraints.residual(self.mech, q), self.mech.actuated_q(q) - self.q_actuated])
+
+    def jacobian(self, q: ArrayLike) -> np.ndarray:
+        """``dF/dq`` on the tangent space (rows of :meth:`residual`, ``nv`` columns)."""
+        q = self.mech.check_q(q)
+        select = np.zeros((self.mech.na, self.mech.nv))
+        select[np.arange(self.mech.na), self.mech.act_v] = 1.0
+        return np.vstack([constraints.jacobian(self.mech, q), select])
+
+
+@dataclass(frozen=True)
+class IKProblem:
+    """The inverse-kinematics problem of :func:`solve_ik` as equations ``F(q) = 0``: every closure residual, then
+    the task error ``-(target - task(q))`` (as :class:`ClosureProblem`; a :class:`~pkm.errors.ConvergenceError` of
+    :func:`solve_ik` carries it).
+
+    Attributes:
+        mech: The mechanism.
+        target: The task coordinates asked for (:meth:`~pkm.core.kinematics.task.TaskMap.parse`'s vector).
+    """
+
+    mech: Mechanism
+    target: np.ndarray
+
+    def evaluate(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(F(q), dF/dq)`` from one kinematics pass (``q`` unchecked: the solvers' iterations)."""
+        c = Configuration.compute(self.mech, q)
+        return (np.concatenate([c.residual, -self.mech.task_map.error(self.target, c.task_value)]),
+                np.array(c.closure_and_task_jacobian))
+
+    def residual(self, q: ArrayLike) -> np.ndarray:
+        """``F(q)``: closure residuals [m, rad], then the task error [m, rad]."""
+        return self.evaluate(self.mech.check_q(q))[0]
+
+    def jacobian(self, q: ArrayLike) -> np.ndarray:
+        """``dF/dq`` on the tangent space."""
+        return self.evaluate(self.mech.check_q(q))[1]
+
+
 def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray,
             cols: np.ndarray | None, tol: float, max_iter: int, max_dq: float) -> tuple[np.ndarray, float, int]:
     """:func:`pkm.core.kinematics.newton.gauss_newton` on the configuration manifold (``pin.integrate``), moving only the
@@ -191,7 +248,11 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
     def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int]:
         return _newton(mech, fun, mech.with_actuated(q, qa0 + s * (qa1 - qa0)), mech.passive_v, t, max_iter, 0.5)
 
-    return _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure)
+    try:
+        return _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure)
+    except ConvergenceError as exc:
+        exc.problem = ClosureProblem(mech, qa1)
+        raise
 
 
 def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: ArrayLike | None = None, *,
@@ -225,21 +286,17 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
     dist = np.max(np.abs(task.error(y1, y0)))
     n_steps = _n_steps(dist, max_step)
 
-    def make_fun(y_goal: np.ndarray) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
-        def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            c = Configuration.compute(mech, qq)
-            return np.concatenate([c.residual, -task.error(y_goal, c.task_value)]), c.closure_and_task_jacobian
-        return fun
-
     def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int]:
-        return _newton(mech, make_fun(y1 if s >= 1.0 else task.interpolate(y0, y1, s)), q, mech.free_v, t, max_iter,
-                       0.5)
+        goal = IKProblem(mech, y1 if s >= 1.0 else task.interpolate(y0, y1, s))
+        return _newton(mech, goal.evaluate, q, mech.free_v, t, max_iter, 0.5)
 
+    problem = IKProblem(mech, y1)
     try:
         result = _follow(mech, "inverse kinematics", solve_at, q, n_steps, tol, raise_on_failure)
     except ConvergenceError as exc:
         if isinstance(exc.result, SolveResult):
-            _raise_if_out_of_reach(mech, make_fun(y1), exc.result.q, tol)
+            _raise_if_out_of_reach(mech, problem.evaluate, exc.result.q, tol)
+        exc.problem = problem
         raise
     q = result.q
     if result.converged and branch is not None and not mech.on_branch(q, branch):
