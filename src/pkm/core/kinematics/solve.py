@@ -88,9 +88,10 @@ class SolveResult:
 
 @dataclass(frozen=True)
 class ClosureProblem:
-    """The loop-closure problem of :func:`close_loops` as equations ``F(q) = 0`` on the whole configuration: every
-    closure residual, then the actuated coordinates less their targets (qpsolvers' ``Problem``, pink's
-    ``build_ik``: inspect it, evaluate it, check a solution). A :class:`~pkm.errors.ConvergenceError` of
+    """The loop-closure problem of :func:`close_loops` as equations ``F(q) = 0``.
+
+    On the whole configuration: every closure residual, then the actuated coordinates less their targets
+    (qpsolvers' ``Problem``, pink's ``build_ik``: inspect it, evaluate it, check a solution). A :class:`~pkm.errors.ConvergenceError` of
     :func:`close_loops` carries it (``problem``).
 
     Attributes:
@@ -116,9 +117,10 @@ class ClosureProblem:
 
 @dataclass(frozen=True)
 class IKProblem:
-    """The inverse-kinematics problem of :func:`solve_ik` as equations ``F(q) = 0``: every closure residual, then
-    the task error ``-(target - task(q))`` (as :class:`ClosureProblem`; a :class:`~pkm.errors.ConvergenceError` of
-    :func:`solve_ik` carries it).
+    """The inverse-kinematics problem of :func:`solve_ik` as equations ``F(q) = 0``.
+
+    Every closure residual, then the task error ``-(target - task(q))`` (as :class:`ClosureProblem`; a
+    :class:`~pkm.errors.ConvergenceError` of :func:`solve_ik` carries it).
 
     Attributes:
         mech: The mechanism.
