@@ -255,11 +255,5 @@ def spec_from_gepetto(yaml_text: str, urdf_name: str, joint_names: list[str], me
     return read_gepetto(yaml_text, urdf_name, joint_names, mechanism, source)[0]
 
 
-def _joints(urdf: str, source: str) -> list:
-    from pkm.core.model.urdf import check_urdf
-
-    return check_urdf(urdf, source).findall("joint")
-
-
 __all__ = ["JOINT_TYPES", "KEYS", "MARKERS", "find_gepetto", "gepetto_files", "gepetto_yaml",
            "parse_yaml", "read_gepetto", "spec_from_gepetto"]

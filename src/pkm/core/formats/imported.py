@@ -15,7 +15,7 @@ from pkm.core.model.urdf import check_urdf, limit_notes
 from pkm.errors import SpecError
 
 
-def _root_tag(text: str) -> str | None:
+def root_tag(text: str) -> str | None:
     """The name of the document's first element (after the declaration and comments), or None."""
     body = re.sub(r"<\?.*?\?>|<!--.*?-->", "", text[:65536], flags=re.DOTALL)
     m = re.search(r"<\s*([A-Za-z_][\w.-]*)", body)
@@ -31,7 +31,7 @@ def import_model(path: Path) -> Imported:
     """
     fmt = FORMATS.get(suffixes().get(path.suffix.lower(), ""), FORMATS["urdf"])
     text = read_text_file(path, fmt.name.upper())
-    fmt = by_root(_root_tag(text)) or fmt
+    fmt = by_root(root_tag(text)) or fmt
     return fmt.read(text, str(path))
 
 
@@ -121,5 +121,5 @@ def spec_skeleton(path: Path) -> tuple[str, bool]:
     return "\n".join(lines), bool(imp.actuated and imp.closures)
 
 
-__all__ = ["import_model", "read_urdf", "spec_skeleton",
+__all__ = ["import_model", "read_urdf", "root_tag", "spec_skeleton",
            "with_file"]

@@ -14,12 +14,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pkm.core.formats.base import FORMATS, suffixes
-from pkm.core.formats.gepetto import _joints, find_gepetto, read_gepetto
-from pkm.core.formats.imported import _root_tag, import_model, with_file
+from pkm.core.formats.gepetto import find_gepetto, read_gepetto
+from pkm.core.formats.imported import import_model, root_tag, with_file
 from pkm.core.formats.packages import model_file
 from pkm.core.model.builder import from_files, from_strings
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.spec import ClosureSpec, TaskSpec, read_text_file
+from pkm.core.model.urdf import check_urdf
 from pkm.errors import SpecError
 
 
@@ -31,7 +32,6 @@ def load_model_file(path: Path) -> Mechanism:
         SpecError: as :func:`import_model`, or a file that names no actuated joint (SDF never does):
             then a closure spec must say which joints are driven.
     """
-
     imp = import_model(path)
     if not imp.actuated:
         raise SpecError(str(path), f"the {imp.format.upper()} file names no actuated joint; write a closure spec with "
@@ -102,7 +102,7 @@ def _model_file(path: Path) -> Callable[[], Mechanism] | str:
         return "a folder (give the model file)"
     kind = suffixes().get(path.suffix.lower())
     text = _head(path)
-    root = _root_tag(text) if text is not None else None
+    root = root_tag(text) if text is not None else None
     roots = [f.root for f in FORMATS.values()]
     if kind is None and root not in roots:
         known = ", ".join(f"<{r}>" for r in roots)
@@ -146,7 +146,7 @@ def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = ()) 
     if imported.format != "urdf":
         raise SpecError(str(urdf_path), f"the model beside {yaml_path.name} is {imported.format.upper()}, not URDF: "
                                         "Gepetto's convention pairs a YAML with a URDF")
-    joints = [str(j.get("name")) for j in _joints(imported.urdf, str(urdf_path))]
+    joints = [str(j.get("name")) for j in check_urdf(imported.urdf, str(urdf_path)).findall("joint")]
     name = urdf_path.parent.name if urdf_path.stem == "robot" else urdf_path.stem
     spec, read = read_gepetto(read_text_file(yaml_path, "YAML"), urdf_path.name, joints, name or "robot",
                               str(yaml_path))
