@@ -435,7 +435,9 @@ def _results(cl, shared, chunks, designs: Designs, objectives):
                          "the finished chunks are kept: run the same sweep again (same out) to resume")
 
 
-def _bar(progress, total: int, initial: int):
+def _bar(progress: bool | None, total: int, initial: int):
+    if progress is not None and not isinstance(progress, bool):
+        raise InvalidInputError("progress", f"expected True, False or None, got {type(progress).__name__}", progress)
     if progress is False:
         return None
     from tqdm import tqdm
