@@ -641,7 +641,7 @@ def _sweep_space(g, adv):
             spec = g.pick((g.hostile(), "5cm:20deg:3", "5cm:20cm:-1", "20cm:5cm", "::", "5cm:20cm:3:4", [g.hostile()]))
         elif what == "n":
             n = g.hostile()
-    name = g.pick(("h", "a", "R", "", "mode")) if adv and g.chance(0.3) else "h"
+    name = g.pick(("h", "a", "R", "", "branch")) if adv and g.chance(0.3) else "h"
 
     def run(kind, spec, n):
         space = {"grid": lambda: sweeps.grid(**{name: spec}), "table": lambda: sweeps.table({name: spec}),
@@ -986,7 +986,7 @@ def _rrr3_fk(g, adv):
 @entry("rrr3.jacobians")
 def _rrr3_jac(g, adv):
     from pkm.mechanisms import rrr3
-    kw = {"mode": g.pick((None, 1, 5, "mode3"))} if not adv else {"mode": g.pick((0, 9, "mode0", None, 2.5, True))}
+    kw = {"branch": g.pick((None, 1, 5, "mode3"))} if not adv else {"branch": g.pick((0, 9, "mode0", None, 2.5, True))}
     return rrr3.jacobians, (_params(g, "rrr3", adv), _target(g, "rrr3", adv)), kw
 
 
@@ -1250,8 +1250,8 @@ def _rrr3_ci(g, adv):
             gy = g.corrupt(gy)
     settings = {}
     if g.chance(0.3):
-        settings = {"phi": float(g.rng.normal()) if not adv else g.hostile(), "norm": g.pick(rm.NORMS),
-                    "mode": int(g.rng.integers(1, 9))}
+        settings = {"phi": float(g.rng.normal()) if not adv else g.hostile(), "kind": g.pick(rm.KINDS),
+                    "branch": int(g.rng.integers(1, 9))}
     design = _params(g, "rrr3", adv)
     if adv and g.chance(0.1):
         design = g.pick((rm.Design(0.4, 0.4, 0.1, 1.0), None, "x"))

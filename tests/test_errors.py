@@ -41,6 +41,8 @@ CASES = [
     (E.SweepError("out.parquet holds another sweep", "out.parquet"), {"path": "out.parquet"},
      ["out.parquet holds another sweep"]),
     (E.CompilerError("twin kernels", "no cc on PATH"), {"how": "no cc on PATH"}, ["twin kernels: no cc on PATH"]),
+    (E.ControllerError(0.25, "returned shape (2,)"), {"time": 0.25, "reason": "returned shape (2,)"},
+     ["t = 0.25 s", "returned shape (2,)"]),
     (E.MissingDependencyError("dask", "sweeps", "pkm.sweep"), {"package": "dask", "extra": "sweeps"},
      ["pkm.sweep needs dask", 'pip install "pkm[sweeps]"']),
     (E.StructureError("leg 3", "not an arm-and-rod leg"), {"part": "leg 3"}, ["leg 3: not an arm-and-rod leg"]),

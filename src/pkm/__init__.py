@@ -41,39 +41,54 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pathlib import Path
 
     from pkm.core import (
+        Actuator,
+        ActuatorSpaceModel,
         Branch,
         Closure,
         ClosureProblem,
         ClosureSpec,
         Configuration,
         Diagnostics,
+        Event,
         IKProblem,
         Jump,
         Mechanism,
+        OperationalSpace,
+        Simulation,
         SolveResult,
         TaskMap,
         TaskSpec,
         Trajectory,
         accelerations,
+        actuator_model,
         assemble,
+        bias_efforts,
         branch_seed,
         close_loops,
+        constraint_dynamics,
+        coriolis_matrix,
         diagnose,
         follow_actuators,
         follow_task,
+        forward_dynamics,
         forward_jacobian,
+        gravity_efforts,
         idle_motions,
         inverse_accelerations,
         inverse_dynamics,
         inverse_jacobian,
         inverse_velocities,
+        mass_matrix,
+        operational_space,
         passive_map,
+        simulate,
         solve_ik,
         task_acceleration,
         task_values,
         task_velocity,
         twist_jacobian,
         velocities,
+        with_actuators,
         zyx_angles,
         zyx_matrix,
     )
@@ -87,7 +102,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
 
 __getattr__, __dir__ = lazy("pkm", globals(), _WHERE)
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 
 def load(name) -> Mechanism:
@@ -185,10 +200,12 @@ def design_params(name: str, **params):
         UnknownNameError: an unknown mechanism or parameter name (the valid ones listed).
         InvalidParameterError: a parameter out of range or with a unit of another kind.
     """
+    from pkm._moved import renamed_keywords
     from pkm.units import KIND_OF_UNIT, parse_quantity
 
     mod = mechanism_module(name)
     fields = {f.name: f for f in dataclasses.fields(mod.Params)}
+    params = renamed_keywords(mod.Params.__name__, params, getattr(mod.Params, "RENAMED", {}))  # (deprecated names)
     for key in params:
         if key not in fields:
             raise UnknownNameError("parameter", key, fields, f"pkm.build({name!r})")

@@ -345,3 +345,17 @@ class StructureError(PkmError):
     def __init__(self, part: str, message: str):
         self.part = part
         super().__init__(f"{part}: {message}")
+
+
+class ControllerError(PkmError):
+    """A simulation's controller raised, or returned efforts of the wrong shape or not finite.
+
+    Attributes:
+        time: The simulated time of the call [s].
+        reason: What went wrong (the controller's own exception is the ``__cause__``).
+    """
+
+    def __init__(self, time: float, reason: str):
+        self.time = float(time)
+        self.reason = reason
+        super().__init__(f"the controller at t = {self.time:.6g} s: {reason}")

@@ -11,7 +11,7 @@ import pytest
 import pkm
 from pkm.core.analysis import redundant_parameter
 from pkm.core.differential import indices, screws
-from pkm.core.dynamics.projection import KhalilProjection, forward_dynamics
+from pkm.core.dynamics.projection import KhalilProjection, constraint_dynamics, forward_dynamics
 from pkm.core.kinematics.solve import MAX_TOTAL_ITER
 from pkm.errors import (
     ConvergenceError,
@@ -143,14 +143,17 @@ def test_far_actuated_coordinates_fail_fast():
 
 
 def test_forward_dynamics_with_redundant_closures_names_the_fix(rrr3):
-    """The planar 3-RRR's 3-D point closures are redundant: mu = 0 is a SingularityError saying to pass mu > 0,
-    and mu > 0 gives finite accelerations."""
+    """The planar 3-RRR's 3-D point closures are redundant: the default (model) route needs no mu and agrees with
+    Pinocchio's proximal constraintDynamics; that route with mu = 0 is a SingularityError saying to pass mu > 0."""
     q, v, tau = rrr3.q_reference, np.zeros(rrr3.nv), np.ones(3)
+    a = forward_dynamics(rrr3, q, v, tau)
+    assert np.abs(constraint_dynamics(rrr3, q, v, tau) - a).max() <= 1e-9 * np.abs(a).max()
     with pytest.raises(SingularityError, match="mu > 0"):
-        forward_dynamics(rrr3, q, v, tau)
-    assert np.all(np.isfinite(forward_dynamics(rrr3, q, v, tau, mu=1e-8)))
+        constraint_dynamics(rrr3, q, v, tau, mu=0.0)
     with pytest.raises(InvalidInputError):
-        forward_dynamics(rrr3, q, v, tau, mu=-1.0)
+        constraint_dynamics(rrr3, q, v, tau, mu=-1.0)
+    with pytest.raises(InvalidInputError, match="method='constraint_dynamics'"):
+        forward_dynamics(rrr3, q, v, tau, mu=1e-8)
 
 
 def test_khalil_projection_checks_its_mechanism_and_wrench(delta):

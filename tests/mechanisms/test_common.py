@@ -9,7 +9,7 @@ from pkm.mechanisms import delta, hexapod, prs3, rrr3
 from pkm.mechanisms._common import leg_branches, params_from_table, spec_parameters
 
 
-@pytest.mark.parametrize("params", [delta.DeltaParams(R=0.12, home=(0.01, 0.0, -0.38)), rrr3.Rrr3Params(mode=3),
+@pytest.mark.parametrize("params", [delta.DeltaParams(R=0.12, home=(0.01, 0.0, -0.38)), rrr3.Rrr3Params(branch=3),
                                     hexapod.HexapodParams(layout="literal"), prs3.Prs3Params(actuation="R", gamma=1.2)])
 def test_a_spec_parameter_table_gives_back_its_design(params):
     """spec_parameters then params_from_table is the identity (tuples, strings and integer fields included)."""

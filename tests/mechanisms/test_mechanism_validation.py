@@ -41,7 +41,7 @@ def test_build_refuses_unknown_parameters_with_the_valid_names():
 @pytest.mark.parametrize("name, kwargs", [
     ("delta", {"La": 10**400}), ("delta", {"La": "0.11deg"}), ("delta", {"La": True}), ("delta", {"La": 2e6}),
     ("delta", {"home": "abc"}), ("delta", {"home": (0.0, 0.0)}), ("delta", {"home": (0.0, None, -0.3)}),
-    ("rrr3", {"home": (0.0, 10**400, 0.0)}), ("rrr3", {"mode": 2.0}), ("rrr3", {"a": -0.4}),
+    ("rrr3", {"home": (0.0, 10**400, 0.0)}), ("rrr3", {"branch": 2.0}), ("rrr3", {"a": -0.4}),
     ("hexapod", {"layout": ["sector"]}), ("hexapod", {"theta": (1.0,) * 5}), ("hexapod", {"H0": np.nan}),
     ("prs3", {"actuation": ["P"]}), ("prs3", {"reference": {"z": 0.8}}), ("prs3", {"Ixz3": 10**400}),
 ])
@@ -89,11 +89,11 @@ def test_unhashable_or_unknown_branches_are_invalid_input(branch):
         delta.inverse_kinematics(delta.DeltaParams(), [0.0, 0.0, -0.36], branch)
 
 
-def test_mode_of_the_wrong_type_is_invalid_input():
+def test_branch_of_the_wrong_type_is_invalid_input():
     """A 3-RRR working mode given as a list or a float is refused with the valid forms."""
-    for mode in (["mode1"], 2.0, "mode9"):
-        with pytest.raises(InvalidInputError, match="mode"):
-            rrr3.mode_signs(mode)
+    for branch in (["mode1"], 2.0, "mode9"):
+        with pytest.raises(InvalidInputError, match="branch"):
+            rrr3.branch_signs(branch)
 
 
 def test_hexapod_forward_kinematics_settings_and_bounded_failure():

@@ -192,7 +192,7 @@ def rrr3_designs(draw, mode=None) -> rrr3.Rrr3Params:
     a, b, h = H * draw(floats(0.35, 0.6)), H * draw(floats(0.35, 0.6)), H * draw(floats(0.05, 0.25))
     mode = draw(st.integers(1, 8)) if mode is None else mode
     try:
-        p = rrr3.Rrr3Params(a=a, b=b, h=h, H=H, mode=mode, home=(0.0, 0.0, 0.0), m_proximal=draw(floats(0.01, 1.0)),
+        p = rrr3.Rrr3Params(a=a, b=b, h=h, H=H, branch=mode, home=(0.0, 0.0, 0.0), m_proximal=draw(floats(0.01, 1.0)),
                             m_distal=draw(floats(0.01, 1.0)), m_platform=draw(floats(0.01, 1.0)))
         rrr3.reference_pose(p)
     except InvalidParameterError:

@@ -71,8 +71,8 @@ def test_inverse_then_forward_kinematics_gives_the_pose_back(p, u, du, mode):
     err = [_task_error(s.y, y) for s in sols]
     k = int(np.argmin(err))
     assert record("rrr3 IK->FK (closed form, all modes)", err[k]) <= 1e-9
-    assert sols[k].mode == mode
-    if mode == f"mode{p.mode}":
+    assert sols[k].branch == mode
+    if mode == f"mode{p.branch}":
         assert _task_error(rrr3.closed_form_fk(p, th, seed=y), y) <= 1e-9
     offset = np.array([0.005 * p.H, 0.005 * p.H, 0.02]) * seed_fraction(mech, q, p.H) * du
     seed = reachable(rrr3.closed_form_configuration, mech, y + offset, mode)
@@ -181,7 +181,7 @@ def test_concurrent_distal_links_are_approached_as_a_direct_singularity(p, u, fr
     |det J_x| (closed form) and the core's sigma_direct fall monotonically and linearly to 1e-8 of their start,
     with the class regular at s_max and direct at s = 1e-8 s_max (closed form and core)."""
     mech = rrr3.build(p)
-    mode = f"mode{p.mode}"
+    mode = f"mode{p.branch}"
     xy = rrr3.reference_pose(p)[:2] + 0.03 * p.H * u
 
     def det(phi):

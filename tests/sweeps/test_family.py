@@ -18,27 +18,27 @@ from pkm.sweeps.family import Candidate, ModelFamily, RegisteredFamily, family_o
 
 
 def test_a_registered_family_s_parameters_are_the_scalar_fields_with_their_units():
-    """The 3-RRR's: its lengths [m], masses [kg] and mode (an integer, no unit); not home (a tuple); an unknown name
+    """The 3-RRR's: its lengths [m], masses [kg] and branch (an integer, no unit); not home (a tuple); an unknown name
     or a tuple field is refused listing the parameters."""
     fam = RegisteredFamily("rrr3")
-    assert fam.parameters() == ("a", "b", "h", "H", "mode", "m_proximal", "m_distal", "m_platform")
+    assert fam.parameters() == ("a", "b", "h", "H", "branch", "m_proximal", "m_distal", "m_platform")
     assert fam.units("a") == ({"length"}, "m") and fam.units("m_distal") == ({"mass"}, "kg")
-    assert fam.units("mode") == ({None}, "-") and fam.integer("mode") and not fam.integer("a")
+    assert fam.units("branch") == ({None}, "-") and fam.integer("branch") and not fam.integer("a")
     for bad in ("home", "c"):
-        with pytest.raises(UnknownNameError, match="'a', 'b', 'h', 'H', 'mode'") as info:
+        with pytest.raises(UnknownNameError, match="'a', 'b', 'h', 'H', 'branch'") as info:
             fam.units(bad)
         assert info.value.kind == "parameter"
 
 
 def test_designs_are_the_fixed_design_with_the_values_and_integers_are_checked():
-    """Fixed values (with units) are kept in every design; a swept value replaces its field; mode 3.0 is the
-    integer 3, mode 2.5 refused; a value the design refuses fails where the design is made."""
+    """Fixed values (with units) are kept in every design; a swept value replaces its field; branch 3.0 is the
+    integer 3, branch 2.5 refused; a value the design refuses fails where the design is made."""
     fam = RegisteredFamily("rrr3", {"H": "90cm", "home": (0.0, 0.0, 0.0)})
     assert fam.fixed == {"H": 0.9, "home": (0.0, 0.0, 0.0)} and fam.registered == "rrr3"
-    p = fam.params({"a": 0.5, "mode": 3.0})
-    assert p == Rrr3Params(a=0.5, H=0.9, mode=3, home=(0.0, 0.0, 0.0)) and type(p.mode) is int
-    with pytest.raises(InvalidInputError, match="mode takes integers"):
-        fam.params({"mode": 2.5})
+    p = fam.params({"a": 0.5, "branch": 3.0})
+    assert p == Rrr3Params(a=0.5, H=0.9, branch=3, home=(0.0, 0.0, 0.0)) and type(p.branch) is int
+    with pytest.raises(InvalidInputError, match="branch takes integers"):
+        fam.params({"branch": 2.5})
     with pytest.raises(InvalidParameterError, match=r"^a: "):
         fam.params({"a": -0.1})
 

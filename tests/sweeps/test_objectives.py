@@ -123,18 +123,18 @@ def test_bad_objectives_are_refused_before_any_design_is_evaluated(objectives, e
 
 
 def test_the_3rrr_closed_form_maps_the_designs_working_mode():
-    """mode is a design field: each design's map is of its own working mode (or of the option's)."""
-    res = pkm.sweep("rrr3", sweeps.grid(mode=[1, 2]), ["gci:step=4cm", "m3=gci:step=4cm,branch=mode3"],
+    """branch is a design field: each design's map is of its own working mode (or of the option's)."""
+    res = pkm.sweep("rrr3", sweeps.grid(branch=[1, 2]), ["gci:step=4cm", "m3=gci:step=4cm,branch=mode3"],
                     scheduler="serial")
     d = maps.Design.of(pkm.design_params("rrr3"))
-    direct = [maps.ci_map(d, maps.workspace_grid(d, 0.04), maps.CiSettings(mode=m)).gci().value for m in (1, 2, 3)]
+    direct = [maps.ci_map(d, maps.workspace_grid(d, 0.04), maps.CiSettings(branch=m)).gci().value for m in (1, 2, 3)]
     np.testing.assert_array_equal(res.column("gci:step=4cm"), direct[:2])
     np.testing.assert_array_equal(res.column("m3"), [direct[2]] * 2)
     assert direct[0] != direct[1]
 
 
 @pytest.mark.parametrize("call,match", [
-    (lambda: pkm.sweep("rrr3", sweeps.sobol(4, mode="1:8"), ["gci"], scheduler="serial"), "integers"),
+    (lambda: pkm.sweep("rrr3", sweeps.sobol(4, branch="1:8"), ["gci"], scheduler="serial"), "integers"),
     (lambda: pkm.sweep("rrr3", sweeps.grid(a=[0.4]), ["gci"], fixed={"a": 0.5}, scheduler="serial"), "swept and"),
     (lambda: pkm.sweep("rrr3", sweeps.grid(a=[0.4]), ["gci"], workers=2, scheduler="serial"), "workers"),
     (lambda: pkm.sweep("rrr3", sweeps.grid(a=[0.4]), ["gci"], chunk_size=0, scheduler="serial"), "chunk_size"),

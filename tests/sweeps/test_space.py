@@ -62,4 +62,4 @@ def test_malformed_spaces_are_refused_with_the_parameter_named(space, error, mat
 def test_unknown_parameters_list_the_valid_ones():
     with pytest.raises(UnknownNameError, match="H") as exc:
         UNITS("R")
-    assert "a" in exc.value.valid and "mode" in exc.value.valid and "home" not in exc.value.valid
+    assert "a" in exc.value.valid and "branch" in exc.value.valid and "home" not in exc.value.valid

@@ -37,7 +37,7 @@ def _best(fn, repeat: int) -> float:
 def _naive(design, nodes: np.ndarray, settings: maps.CiSettings) -> tuple[float, np.ndarray]:
     """Seconds per node and the CIs of the per-node loop over ``nodes`` (rows ``x, y, phi``)."""
     t0 = time.perf_counter()
-    out = np.array([maps.naive_condition_index(design, node, maps.CiSettings(float(node[2]), settings.mode))
+    out = np.array([maps.naive_condition_index(design, node, maps.CiSettings(float(node[2]), settings.branch))
                     for node in nodes])
     return (time.perf_counter() - t0) / len(nodes), out
 

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 import pkm
+from pkm._moved import current_name
 from pkm.cli.usage import UsageError
 from pkm.errors import InvalidInputError, UnknownNameError
 from pkm.units import KIND_OF_UNIT, SI_UNITS, parse_quantity, split_range
@@ -135,6 +136,7 @@ def parse_params(mechanism: str, items: Sequence[str]) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for item in items:
         name, text = split_item(item, "--param")
+        name = current_name(pkm.mechanism_module(mechanism).Params, name)  # a deprecated former name: warned
         if name not in info:
             raise UnknownNameError("parameter", name, list(info), mechanism)
         p = info[name]

@@ -17,7 +17,12 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.differential.velocity": ("Diagnostics", "accelerations", "diagnose", "forward_jacobian", "idle_motions",
                               "inverse_accelerations", "inverse_jacobian", "inverse_velocities", "passive_map",
                               "task_acceleration", "task_velocity", "twist_jacobian", "velocities"),
-    "pkm.core.dynamics.projection": ("inverse_dynamics",),
+    "pkm.core.dynamics.projection": ("constraint_dynamics", "forward_dynamics", "inverse_dynamics"),
+    "pkm.core.dynamics.model": ("ActuatorSpaceModel", "OperationalSpace", "actuator_model", "bias_efforts",
+                                "coriolis_matrix", "gravity_efforts", "mass_matrix", "operational_space"),
+    "pkm.core.dynamics.simulate": ("Event", "Simulation", "simulate"),
+    "pkm.core.model.actuators": ("Actuator",),
+    "pkm.core.model.builder": ("with_actuators",),
     "pkm.core.model.mechanism": ("Mechanism",),
     "pkm.core.kinematics.solve": ("ClosureProblem", "IKProblem", "SolveResult", "assemble", "branch_seed",
                                   "close_loops", "solve_ik"),
@@ -43,7 +48,18 @@ if TYPE_CHECKING:  # the static view of the lazy names
         twist_jacobian,
         velocities,
     )
-    from pkm.core.dynamics.projection import inverse_dynamics
+    from pkm.core.dynamics.model import (
+        ActuatorSpaceModel,
+        OperationalSpace,
+        actuator_model,
+        bias_efforts,
+        coriolis_matrix,
+        gravity_efforts,
+        mass_matrix,
+        operational_space,
+    )
+    from pkm.core.dynamics.projection import constraint_dynamics, forward_dynamics, inverse_dynamics
+    from pkm.core.dynamics.simulate import Event, Simulation, simulate
     from pkm.core.kinematics.configuration import Configuration
     from pkm.core.kinematics.solve import (
         ClosureProblem,
@@ -56,6 +72,8 @@ if TYPE_CHECKING:  # the static view of the lazy names
     )
     from pkm.core.kinematics.task import TaskMap, zyx_angles, zyx_matrix
     from pkm.core.kinematics.trajectory import Jump, Trajectory, follow_actuators, follow_task, task_values
+    from pkm.core.model.actuators import Actuator
+    from pkm.core.model.builder import with_actuators
     from pkm.core.model.mechanism import Mechanism
     from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 

@@ -37,6 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pkm._moved import renamed_keyword
 from pkm._optional import module
 from pkm.errors import InvalidInputError, PkmError
 from pkm.mechanisms import rrr3
@@ -140,10 +141,12 @@ def figure_design(name: str) -> Design:
     return fig7_design() if name == "fig7" else _design_cm(*CAPTIONS[name])
 
 
+@renamed_keyword(mode="branch")
 @functools.cache
-def figure_map(name: str, mode: int = 1) -> maps.CiMap:
-    """The CI map of a figure (``"fig5"``, ``"fig6"``, ``"fig7"``, ``"fig9"``) on the paper grid."""
-    return maps.ci_map(figure_design(name), paper_grid(figure_design(name)), CiSettings(mode=mode))
+def figure_map(name: str, branch: int = 1) -> maps.CiMap:
+    """The CI map of a figure (``"fig5"``, ``"fig6"``, ``"fig7"``, ``"fig9"``) on the paper grid, in working mode
+    ``branch`` (1..8; ``mode=``: its deprecated former name)."""
+    return maps.ci_map(figure_design(name), paper_grid(figure_design(name)), CiSettings(branch=branch))
 
 
 @functools.cache
@@ -159,7 +162,7 @@ def mode_study() -> tuple[tuple[int, float | None, float | None, int], ...]:
     grid = paper_grid(d)
     out = []
     for mode in range(1, 9):
-        st = CiSettings(mode=mode)
+        st = CiSettings(branch=mode)
         m = figure_map("fig9", mode)
         out.append((mode, m.gci().value, m.area_gci().value, maps.direct_singularity_crossings(d, grid, st)))
     return tuple(out)

@@ -51,6 +51,7 @@ from typing import Any
 
 import numpy as np
 
+from pkm._moved import renamed_keywords
 from pkm._optional import require
 from pkm.core.model.spec import as_path
 from pkm.errors import InvalidInputError, PkmError, SweepError
@@ -306,6 +307,10 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
     if not isinstance(space, Space):
         raise InvalidInputError("space", "give pkm.sweeps.grid(...), sobol(...), latin_hypercube(...) or "
                                          f"table(...), got {type(space).__name__}", space)
+    if family.renamed:  # deprecated former parameter names: warned, swept under the new ones
+        specs = renamed_keywords(f"pkm.sweep({family.registered!r})", dict(space.specs), family.renamed)
+        space = dataclasses.replace(space, specs=tuple(specs.items()))
+        fixed = {family.renamed.get(k, k): v for k, v in fixed.items()} if fixed else fixed
     for name in space.names:
         family.units(name)  # UnknownNameError listing the parameters
         if family.integer(name) and space.kind in ("sobol", "latin_hypercube"):

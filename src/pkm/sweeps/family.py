@@ -21,6 +21,7 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from pkm._moved import renamed_keywords
 from pkm.errors import InvalidInputError, UnknownNameError
 
 ORIGIN = {"x": ("xyz", 0), "y": ("xyz", 1), "z": ("xyz", 2), "roll": ("rpy", 0), "pitch": ("rpy", 1), "yaw": ("rpy", 2)}
@@ -62,6 +63,8 @@ class Family:
 
     #: The mechanism's registered name, or None for a loaded mechanism (objectives' closed forms key on it).
     registered: str | None = None
+    #: Deprecated former parameter names -> the new ones (a registered design's ``Params.RENAMED``).
+    renamed: Mapping[str, str] = {}
 
     def units(self, name: str) -> tuple[set[str | None], str]:
         """``(unit kinds, unit)`` of parameter ``name``; UnknownNameError listing the parameters otherwise."""
@@ -97,6 +100,8 @@ class RegisteredFamily(Family):
         self.registered = name
         self.module = pkm.mechanism_module(name)  # UnknownNameError listing the mechanisms
         self.fields = {f.name: f for f in dataclasses.fields(self.module.Params)}
+        self.renamed = dict(getattr(self.module.Params, "RENAMED", {}))
+        fixed = renamed_keywords(f"pkm.sweep({name!r})", fixed, self.renamed) if isinstance(fixed, Mapping) else fixed
         self.base = pkm.design_params(name, **dict(fixed or {}))  # units converted, validated
         self.fixed = {k: getattr(self.base, k) for k in (fixed or {})}
 

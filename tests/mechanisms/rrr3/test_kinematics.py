@@ -69,7 +69,7 @@ def _random_poses(n, seed, radius=0.12, dphi=0.3):
 def test_reference_design_is_the_papers_workspace_study():
     """The default design is sec. III's (links 40 cm, platform 10 cm, actuators 100 cm apart); its reference pose is
     found: centred, at the orientation of largest condition index on the 2.5 deg grid (5 deg; 0.93 at Phi = 0)."""
-    assert (P.a, P.b, P.h, P.H, P.mode, P.home) == (0.40, 0.40, 0.10, 1.00, 1, None)
+    assert (P.a, P.b, P.h, P.H, P.branch, P.home) == (0.40, 0.40, 0.10, 1.00, 1, None)
     np.testing.assert_allclose(Y_REF[:2], [0.5, 0.5 / math.sqrt(3.0)], atol=1e-15)
     grid = np.linspace(-math.pi / 3, math.pi / 3, rrr3.kinematics.REFERENCE_ORIENTATIONS)
     ci = [rrr3.kinematics.condition_index(P, [Y_REF[0], Y_REF[1], phi]) for phi in grid]
@@ -99,11 +99,12 @@ def test_non_positive_or_non_finite_lengths_and_masses_are_refused(field, value)
     assert exc.value.name == field
 
 
-@pytest.mark.parametrize("mode", [0, 9, True, "mode1", 1.0])
-def test_mode_must_be_an_integer_from_1_to_8(mode):
-    """A working mode outside 1..8 (or not an integer) raises InvalidParameterError."""
-    with pytest.raises(InvalidParameterError, match="mode"):
-        rrr3.Rrr3Params(mode=mode)
+@pytest.mark.parametrize("branch", [0, 9, True, "mode1", 1.0])
+def test_branch_must_be_an_integer_from_1_to_8(branch):
+    """A working mode outside 1..8 (or not an integer) raises InvalidParameterError naming branch."""
+    with pytest.raises(InvalidParameterError, match="branch") as exc:
+        rrr3.Rrr3Params(branch=branch)
+    assert exc.value.name == "branch"
 
 
 @pytest.mark.parametrize("home", [(0.0, 0.0), (0.0, float("nan"), 0.0), "centre"])
@@ -144,10 +145,10 @@ def test_mode_names_follow_the_bits_of_k_minus_1():
     assert rrr3.MODES["mode3"] == (1, -1, 1)
     assert rrr3.MODES["mode5"] == (-1, 1, 1)
     assert rrr3.MODES["mode8"] == (-1, -1, -1)
-    assert rrr3.mode_signs(3) == rrr3.mode_signs("mode3") == rrr3.mode_signs(np.int64(3))
+    assert rrr3.branch_signs(3) == rrr3.branch_signs("mode3") == rrr3.branch_signs(np.int64(3))
     for bad in (0, "mode9", "knee_out", None):
         with pytest.raises(InvalidInputError):
-            rrr3.mode_signs(bad)
+            rrr3.branch_signs(bad)
 
 
 def test_spec_lists_the_eight_modes_on_the_elbows(mech):
@@ -479,9 +480,9 @@ def test_every_forward_solution_closes_the_loops_in_the_generic_core():
             sols = rrr3.forward_kinematics(P, theta)
             assert any(np.max(np.abs(np.r_[s.y[:2] - y[:2], _wrap(s.y[2] - y[2])])) < 1e-10 for s in sols)
             for s in sols:
-                assert s.residual <= 1e-10 and s.mode is not None
-                mech = built.setdefault(s.mode, rrr3.build(rrr3.Rrr3Params()))
-                q = rrr3.closed_form_configuration(mech, s.y, s.mode)
+                assert s.residual <= 1e-10 and s.branch is not None
+                mech = built.setdefault(s.branch, rrr3.build(rrr3.Rrr3Params()))
+                q = rrr3.closed_form_configuration(mech, s.y, s.branch)
                 assert np.abs(_wrap(mech.actuated_q(q) - theta)).max() <= 1e-10
                 assert np.abs(constraints.residual(mech, q)).max() <= 1e-10
                 res = close_loops(mech, theta, q)
@@ -501,3 +502,52 @@ def test_bad_motor_angles_are_refused(theta):
     """Wrongly shaped or non-finite motor angles raise InvalidInputError."""
     with pytest.raises(InvalidInputError):
         rrr3.forward_kinematics(P, theta)
+
+
+# ---------------------------------------------------------------------- the former names (deprecated in 0.2.0)
+KEYWORD_FUNCTIONS = {
+    "inverse_kinematics": lambda **kw: rrr3.inverse_kinematics(P, rrr3.a_from_centroid(P, Y_REF[:2], Y_REF[2]),
+                                                               Y_REF[2], **kw),
+    "joint_values": lambda **kw: rrr3.joint_values(P, Y_REF, **kw),
+    "jacobians": lambda **kw: rrr3.jacobians(P, Y_REF, **kw),
+    "homogenized_jacobians": lambda **kw: rrr3.homogenized_jacobians(P, Y_REF, **kw, reference="A"),
+    "singularity_measures": lambda **kw: rrr3.singularity_measures(P, Y_REF, **kw),
+    "classify_singularity": lambda **kw: rrr3.classify_singularity(P, Y_REF, **kw),
+}
+
+
+@pytest.mark.parametrize("name", sorted(KEYWORD_FUNCTIONS))
+def test_the_former_mode_keyword_warns_and_gives_the_same_result(name):
+    """Each function's mode= is its branch= with a DeprecationWarning naming branch; a bad value raises the same
+    InvalidInputError."""
+    f = KEYWORD_FUNCTIONS[name]
+    for value in (3, "mode6"):
+        with pytest.warns(DeprecationWarning, match=f"{name}: 'mode' is now 'branch'"):
+            old = f(mode=value)
+        new = f(branch=value)
+        if isinstance(new, dict):
+            assert old == new
+        else:
+            np.testing.assert_array_equal(np.asarray(old, dtype=object if isinstance(new, str) else float),
+                                          np.asarray(new, dtype=object if isinstance(new, str) else float))
+    with pytest.raises(InvalidInputError) as exc_new:
+        f(branch="mode9")
+    with pytest.warns(DeprecationWarning), pytest.raises(InvalidInputError) as exc_old:
+        f(mode="mode9")
+    assert str(exc_old.value) == str(exc_new.value) and exc_old.value.name == "branch"
+
+
+def test_configuration_takes_the_former_keyword(mech):
+    with pytest.warns(DeprecationWarning, match="'mode' is now 'branch'"):
+        q = rrr3.configuration(mech, Y_REF, mode=2)
+    np.testing.assert_array_equal(q, rrr3.configuration(mech, Y_REF, branch=2))
+
+
+def test_an_fk_solution_names_its_working_mode_branch():
+    """FkSolution.branch is the working-mode name; .mode (and FkSolution(mode=...)) warn and give the same."""
+    th = rrr3.inverse_kinematics(P, rrr3.a_from_centroid(P, Y_REF[:2], Y_REF[2]), Y_REF[2])
+    s = next(s for s in rrr3.forward_kinematics(P, th) if s.branch == "mode1")
+    with pytest.warns(DeprecationWarning, match="FkSolution: 'mode' is now 'branch'"):
+        assert s.mode == s.branch == "mode1"
+    with pytest.warns(DeprecationWarning, match="'mode' is now 'branch'"):
+        assert rrr3.FkSolution(s.y, s.a_point, s.psi, mode="mode1", residual=s.residual).branch == "mode1"

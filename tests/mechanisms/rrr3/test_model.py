@@ -17,7 +17,7 @@ from tests.mechanisms.model_contract import (
     joint_offset,
 )
 
-DESIGN = rrr3.Rrr3Params(a=0.45, b=0.35, h=0.12, H=0.9, mode=3)
+DESIGN = rrr3.Rrr3Params(a=0.45, b=0.35, h=0.12, H=0.9, branch=3)
 
 
 @pytest.mark.parametrize("params", [rrr3.Rrr3Params(), DESIGN])
@@ -29,7 +29,7 @@ def test_urdf_and_spec_agree_and_the_spec_survives_toml(params):
 
 def test_a_design_builds_with_its_lengths_in_the_tree():
     """Motors on the base vertices, elbows at a, leg tips at b, platform vertices B and C at h from A (1e-15 m);
-    two point closures (leg 1 carries the platform); the default branch is the design's mode."""
+    two point closures (leg 1 carries the platform); the default branch is the design's branch."""
     mech = check_build_of_a_design(rrr3, DESIGN)
     for n, vertex in enumerate(base_vertices(DESIGN), 1):
         np.testing.assert_allclose(joint_offset(mech, f"motor_{n}"), [*vertex, 0.0], atol=1e-15)

@@ -56,3 +56,23 @@ def test_a_design_twice_as_large_has_four_times_the_area_and_the_same_indices():
     assert double["workspace_volume"] == pytest.approx(4 * paper["workspace_volume"], rel=1e-12)
     for name in ("gci", "gci_area", "coverage", "min_area_ci"):
         assert double[name] == pytest.approx(paper[name], rel=1e-12), name
+
+
+def test_a_sweep_of_the_former_mode_is_a_sweep_of_branch():
+    """sweeps.grid(mode=...) and fixed={"mode": ...} warn naming branch and sweep branch: the same values, under
+    the new name."""
+    import numpy as np
+
+    import pkm
+
+    new = pkm.sweep("rrr3", sweeps.grid(branch=[1, 2]), ["gci:step=8cm"], fixed={"a": 0.45}, scheduler="serial",
+                    progress=False)
+    with pytest.warns(DeprecationWarning, match="'mode' is now 'branch'"):
+        old = pkm.sweep("rrr3", sweeps.grid(mode=[1, 2]), ["gci:step=8cm"], fixed={"a": 0.45}, scheduler="serial",
+                        progress=False)
+    np.testing.assert_array_equal(old.column("gci:step=8cm"), new.column("gci:step=8cm"))
+    np.testing.assert_array_equal(old.column("branch"), [1, 2])
+    with pytest.warns(DeprecationWarning, match="'mode' is now 'branch'"):
+        fixed = pkm.sweep("rrr3", sweeps.grid(a=[0.45]), ["gci:step=8cm"], fixed={"mode": 2}, scheduler="serial",
+                          progress=False)
+    assert fixed.column("gci:step=8cm")[0] == new.column("gci:step=8cm")[1]

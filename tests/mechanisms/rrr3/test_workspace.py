@@ -23,9 +23,10 @@ def _nodes(design, n, seed, spread=0.35):
 
 
 @pytest.mark.parametrize("design", [FIG6, FIG5], ids=["fig6", "fig5"])
-@pytest.mark.parametrize("settings", [CiSettings(), CiSettings(phi=0.4, mode=3), CiSettings(mode=8, norm="fro_normalized"),
+@pytest.mark.parametrize("settings", [CiSettings(), CiSettings(phi=0.4, branch=3),
+                                      CiSettings(branch=8, kind="fro_normalized"),
                                       CiSettings(phi=-0.2, reference="A", length=0.07),
-                                      CiSettings(mode=6, reference="origin", norm="fro_normalized")],
+                                      CiSettings(branch=6, reference="origin", kind="fro_normalized")],
                          ids=["default", "phi-mode3", "mode8-fro", "A-L", "origin-fro"])
 def test_vectorised_ci_equals_the_svd_of_the_per_pose_jacobians(design, settings):
     """On 150 random nodes the closed-form eigenvalue CI equals pkm.core.differential.indices on rrr3.homogenized_jacobians (1e-9 rel),
@@ -43,7 +44,7 @@ def test_inverse_jacobian_stack_equals_the_per_pose_matrices():
     pts = _nodes(FIG6, 40, seed=2, spread=0.2)
     params = rrr3.Rrr3Params(a=0.6, b=0.6, h=0.1, H=1.0)
     for mode in (1, 5):
-        st = CiSettings(phi=0.25, mode=mode)
+        st = CiSettings(phi=0.25, branch=mode)
         K, ok = maps.inverse_jacobian_stack(FIG6, pts[:, 0], pts[:, 1], st)
         for k in np.flatnonzero(ok):
             Jx, Jq = rrr3.homogenized_jacobians(params, [*pts[k], 0.25], mode)
@@ -65,8 +66,8 @@ def test_ci_is_zero_on_singularities_and_one_when_isotropic():
 def test_modes_1_and_8_are_mirror_images():
     """At Phi = 0 the map of mode 8 is the map of mode 1 mirrored about the vertical through the base centroid (1e-12)."""
     grid = Grid.square(FIG6.base_centroid, 0.7, 0.02)
-    m1 = maps.ci_map(FIG6, grid, CiSettings(mode=1))
-    m8 = maps.ci_map(FIG6, grid, CiSettings(mode=8))
+    m1 = maps.ci_map(FIG6, grid, CiSettings(branch=1))
+    m8 = maps.ci_map(FIG6, grid, CiSettings(branch=8))
     np.testing.assert_array_equal(m1.reachable, m8.reachable[:, ::-1])
     np.testing.assert_allclose(m1.ci[m1.reachable], m8.ci[:, ::-1][m1.reachable], atol=1e-12)
 
@@ -150,8 +151,8 @@ def test_direct_singularity_crossings_separate_the_working_modes():
     """On Fig. 9's design no det J_x sign change lies inside the workspace in mode 1; mode 2 has a singularity curve."""
     d = Design.similarity_law(2.0)
     grid = Grid.square(d.base_centroid, 0.8, 0.02)
-    assert maps.direct_singularity_crossings(d, grid, CiSettings(mode=1)) == 0
-    assert maps.direct_singularity_crossings(d, grid, CiSettings(mode=2)) > 10
+    assert maps.direct_singularity_crossings(d, grid, CiSettings(branch=1)) == 0
+    assert maps.direct_singularity_crossings(d, grid, CiSettings(branch=2)) > 10
 
 
 def test_sweep_is_the_per_design_maps_with_masked_empties():
@@ -168,10 +169,11 @@ def test_sweep_is_the_per_design_maps_with_masked_empties():
     assert best is not None and res.area_gci[best] == res.area_gci.max()
 
 
-@pytest.mark.parametrize("kwargs", [{"norm": "inf"}, {"mode": 9}, {"length": -1.0}, {"reference": "B"},
+@pytest.mark.parametrize("kwargs", [{"kind": "inf"}, {"kind": "fro"}, {"branch": 9}, {"length": -1.0}, {"reference": "B"},
                                     {"phi": float("nan")}])
 def test_bad_settings_are_refused(kwargs):
-    """Unknown norms, modes, references and non-positive L or non-finite Phi raise InvalidInputError."""
+    """Unknown kinds (the core's unnormalised "fro" has no closed form here), branches, references and non-positive
+    L or non-finite Phi raise InvalidInputError."""
     with pytest.raises(InvalidInputError):
         CiSettings(**kwargs)
 
@@ -189,3 +191,41 @@ def test_bad_designs_grids_and_nodes_are_refused():
         maps.ci_map(FIG6, Grid.square(FIG6.base_centroid, 0.1, 0.01)).gci(np.ones((3, 3), bool))
     with pytest.raises(InvalidInputError):
         Design.of("fig6")
+
+
+# ---------------------------------------------------------------------- the former names (deprecated in 0.2.0)
+def test_the_kinds_are_the_cores():
+    """The maps' kinds are condition-index kinds of pkm.core.differential.indices (those with a closed form here)."""
+    from pkm.core.differential import indices
+
+    assert maps.KINDS == ("2", "fro_normalized") and set(maps.KINDS) <= set(indices.KINDS)
+
+
+def test_ci_settings_former_mode_and_norm_warn_and_give_the_same_settings():
+    """CiSettings(mode=, norm=) are CiSettings(branch=, kind=) with a DeprecationWarning each; .mode, .norm and the
+    module's NORMS (now KINDS) warn too; the same map comes out."""
+    new = CiSettings(phi=0.1, branch=3, kind="fro_normalized")
+    with pytest.warns(DeprecationWarning) as record:
+        old = CiSettings(phi=0.1, mode=3, norm="fro_normalized")
+    assert old == new
+    assert [str(w.message).split(" (")[0] for w in record] == ["CiSettings: 'mode' is now 'branch'",
+                                                               "CiSettings: 'norm' is now 'kind'"]
+    with pytest.warns(DeprecationWarning, match="'mode' is now 'branch'"):
+        assert new.mode == 3
+    with pytest.warns(DeprecationWarning, match="'norm' is now 'kind'"):
+        assert new.norm == "fro_normalized"
+    with pytest.warns(DeprecationWarning, match="'NORMS' is now 'KINDS'"):
+        from pkm.mechanisms.rrr3.workspace import NORMS
+    assert NORMS == maps.KINDS and "NORMS" not in maps.__all__
+    grid = maps.workspace_grid(FIG6, 0.05)
+    np.testing.assert_array_equal(maps.ci_map(FIG6, grid, old).ci, maps.ci_map(FIG6, grid, new).ci)
+
+
+@pytest.mark.parametrize("old, new", [({"norm": "inf"}, {"kind": "inf"}), ({"mode": 9}, {"branch": 9})])
+def test_bad_settings_under_the_former_names_are_refused_as_before(old, new):
+    with pytest.raises(InvalidInputError) as exc_new:
+        CiSettings(**new)
+    with pytest.warns(DeprecationWarning), pytest.raises(InvalidInputError) as exc_old:
+        CiSettings(**old)
+    assert (exc_old.value.name, str(exc_old.value)) == (exc_new.value.name, str(exc_new.value))
+    assert exc_old.value.name in ("kind", "branch")

@@ -30,7 +30,7 @@ the passive rows of ``L_k`` (the paper's ``G_2``) and ``w`` an external wrench o
 platform (world-aligned, at the end-effector frame: force then moment) of Jacobian ``P_e``.
 
 Independent routes, used by the tests: :func:`virtual_work_dynamics` (``G^T h`` with the
-core's passive map ``G = dq/dq_a``), :func:`forward_dynamics` (Pinocchio's
+core's passive map ``G = dq/dq_a``), :func:`constraint_dynamics` (Pinocchio's
 ``constraintDynamics``: the forces must give back the accelerations) and :func:`energy`
 (power balance).
 """
@@ -46,6 +46,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from pkm.core.differential.velocity import idle_motions, passive_map
+from pkm.core.dynamics import model as actuator_space
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.model.mechanism import Mechanism, check_mechanism
@@ -361,35 +362,68 @@ def virtual_work_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayL
     return finite_result(G.T @ h, "actuator efforts")
 
 
-def forward_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: ArrayLike, *, mu: float = 0.0) -> np.ndarray:
-    """Joint accelerations under actuator efforts, by Pinocchio's ``constraintDynamics``.
+FORWARD_METHODS = ("model", "constraint_dynamics")
 
-    The closures are enforced at the acceleration level with no Baumgarte correction
-    (the state must be assembled and consistent).
+
+def forward_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: ArrayLike, *, method: str = "model",
+                     mu: float | None = None) -> np.ndarray:
+    """Joint accelerations (nv,) under actuator efforts.
+
+    Args:
+        mech: The mechanism.
+        q, v: An assembled configuration and consistent joint rates (nv,) (or, for ``"model"``, the actuated rates).
+        tau_actuated: Efforts in ``mech.actuated`` order [N m, N].
+        method: ``"model"`` (default): the actuated-coordinate model
+            (:func:`pkm.core.dynamics.model.forward_dynamics`), exact by rank on redundant closures;
+            ``"constraint_dynamics"``: Pinocchio's, :func:`constraint_dynamics` (the independent check).
+        mu: For ``"constraint_dynamics"`` only (see there).
+    """
+    if method not in FORWARD_METHODS:
+        raise InvalidInputError("method", f"use one of {list(FORWARD_METHODS)}, got {method!r}", method)
+    if method == "constraint_dynamics":
+        return constraint_dynamics(mech, q, v, tau_actuated, mu=mu)
+    if mu is not None:
+        raise InvalidInputError("mu", "the model route needs no regularisation; mu is for "
+                                      "method='constraint_dynamics'", mu)
+    return actuator_space.forward_dynamics(mech, q, v, tau_actuated)
+
+
+def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: ArrayLike, *,
+                        mu: float | None = None, max_iter: int = 1000) -> np.ndarray:
+    """Joint accelerations by Pinocchio's ``constraintDynamics``: the closures enforced at the acceleration level
+    with no Baumgarte correction (the state must be assembled and consistent).
+
+    Args:
+        mu: The proximal regularisation. Default: 0 where the closure equations are independent, else 1e-9 with
+            up to ``max_iter`` proximal iterations (which converge to the exact accelerations; with ``mu=0`` a
+            redundant closure, such as a planar loop closed with a 6-D frame, gives wrong accelerations or NaN).
+        max_iter: Proximal iterations allowed.
 
     Raises:
-        PkmError: The model has mimic joints (Pinocchio 4.1's ``constraintDynamics`` does not
-            handle them).
+        SingularityError: ``mu=0`` on redundant closures.
+        PkmError: The model has mimic joints (Pinocchio 4.1's ``constraintDynamics`` does not handle them).
     """
     mech = check_mechanism(mech)
     q, v = mech.check_q(q), mech.check_v(v)
     tau_a = mech.check_actuated(tau_actuated, "tau_actuated")
-    mu = as_scalar(mu, "mu", low=0.0)
     if _has_mimic(mech.model):
         raise PkmError("constraintDynamics does not support mimic joints on Pinocchio 4.1")
+    s = np.linalg.svd(finite_result(constraints.jacobian(mech, q), "constraint Jacobian"), compute_uv=False)
+    redundant = bool(s.size) and (s.size < mech.n_constraints or s[-1] <= RTOL * max(float(s[0]), 1.0))
+    if mu is None:
+        mu = 1e-9 if redundant else 0.0
+    mu = as_scalar(mu, "mu", low=0.0)
+    if mu == 0.0 and redundant:
+        raise SingularityError("constraint", float(s[-1]), "the closure equations are redundant (a planar "
+                                                           "mechanism closed with 3-D points?): pass mu > 0, e.g. "
+                                                           "mu=1e-9, or use method='model'")
     tau = np.zeros(mech.nv)
     tau[mech.act_v] = tau_a
     pin.initConstraintDynamics(mech.model, mech.data, mech.constraint_models, mech.constraint_datas)
-    settings = pin.ProximalSettings(1e-14, mu, 10)
+    settings = pin.ProximalSettings(1e-14, mu, max_iter if mu > 0.0 else 1)
     a = pin.constraintDynamics(mech.model, mech.data, q, v, tau, mech.constraint_models, mech.constraint_datas,
                                settings).copy()
-    if not np.all(np.isfinite(a)):
-        s = np.linalg.svd(finite_result(constraints.jacobian(mech, q), "constraint Jacobian"), compute_uv=False)
-        if mu == 0.0 and s[-1] <= 1e-9 * max(s[0], 1.0):
-            raise SingularityError("constraint", float(s[-1]), "the closure equations are redundant (a planar "
-                                   "mechanism closed with 3-D points?): pass mu > 0, e.g. mu=1e-8")
-        finite_result(a, "joint accelerations", "constraintDynamics failed (a singular configuration?)")
-    return a
+    return finite_result(a, "joint accelerations", "constraintDynamics failed (a singular configuration?)")
 
 
 def energy(mech: Mechanism, q: ArrayLike, v: ArrayLike) -> tuple[float, float]:
@@ -407,5 +441,6 @@ def energy(mech: Mechanism, q: ArrayLike, v: ArrayLike) -> tuple[float, float]:
     return float(kinetic), float(potential)
 
 
-__all__ = ["METHODS", "KhalilProjection", "Leg", "Partition", "Projection", "energy", "forward_dynamics", "inverse_dynamics",
+__all__ = ["FORWARD_METHODS", "METHODS", "KhalilProjection", "Leg", "Partition", "Projection", "constraint_dynamics", "energy",
+           "forward_dynamics", "inverse_dynamics",
            "partition", "virtual_work_dynamics"]

@@ -5,6 +5,7 @@ weighed against the mobility.
 * :func:`build`: a Pinocchio model and a spec;
 * :func:`from_strings`: URDF text and a spec (object or TOML text);
 * :func:`from_files`: a closure spec and the model file it names (URDF, MJCF, SDF: :mod:`pkm.core.formats`);
+* :func:`with_actuators`: a copy with other drives (:mod:`pkm.core.model.actuators`);
 * :func:`rebuild`: unpickling (a mechanism pickles as its URDF and spec texts).
 
 A reference that lacks joints is assembled from the joints it states (held) and the neutral configuration
@@ -15,6 +16,7 @@ are reported by a :class:`~pkm.errors.PkmWarning` and in :attr:`Mechanism.notes`
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from collections.abc import Mapping
 from pathlib import Path
@@ -26,6 +28,7 @@ from pkm.core.differential.velocity import actuation
 from pkm.core.formats.imported import import_model, with_file
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import assemble
+from pkm.core.model.actuators import NUMBERS, Actuator, as_actuators
 from pkm.core.model.joints import retype_joints
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.spec import ClosureSpec, as_path
@@ -124,9 +127,33 @@ def from_files(spec_path: str | Path) -> Mechanism:
     return build(model, spec, None, imported.urdf, str(spec_path), imported.notes)
 
 
+def with_actuators(mech: Mechanism, actuators: Mapping[str, Any]) -> Mechanism:
+    """A copy of ``mech`` whose drives are changed: ``{joint: Actuator}`` replaces a drive, ``{joint: {field:
+    value}}`` changes those fields (:mod:`pkm.core.model.actuators`). The values go into the spec's
+    ``[actuators]`` tables, so that :func:`pkm.save` writes them and the copy pickles with them.
+
+    Raises:
+        InvalidInputError: a joint that is not actuated, an unknown field, a negative or non-finite value.
+    """
+    if not isinstance(mech, Mechanism):
+        raise InvalidInputError("mech", f"expected a pkm Mechanism, got {type(mech).__name__}", mech)
+    given = as_actuators(actuators, mech.actuated_names)
+    tables = {j: dict(t) for j, t in mech.spec.actuators.items()}
+    for joint, act in given.items():
+        if isinstance(actuators[joint], Actuator):
+            tables[joint] = {f: getattr(act, f) for f in NUMBERS}
+        else:
+            tables[joint] = {**tables.get(joint, {}), **{str(k): float(v) for k, v in actuators[joint].items()}}
+    spec = dataclasses.replace(mech.spec, actuators=tables)
+    seed = mech.q_to_dict(mech.q_reference)
+    if mech.urdf is not None:
+        return from_strings(mech.urdf, spec, mech.params, mech.source, mech.notes, seed=seed)
+    return build(pin.Model(mech.model), spec, mech.params, None, mech.source, mech.notes, seed=seed)
+
+
 def rebuild(urdf: str, spec: str, params: Any, source: str) -> Mechanism:
     """Unpickling: the mechanism again from its URDF and spec texts."""
     return from_strings(urdf, spec, params, source=source)
 
 
-__all__ = ["REFERENCE_TOL", "build", "from_files", "from_strings", "rebuild"]
+__all__ = ["REFERENCE_TOL", "build", "from_files", "from_strings", "rebuild", "with_actuators"]

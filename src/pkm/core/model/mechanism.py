@@ -29,6 +29,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from pkm.core.model.actuators import Actuator, from_model, write_model
 from pkm.core.model.spec import Branch, ClosureSpec
 from pkm.core.model.urdf import position_limits
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
@@ -139,6 +140,16 @@ class Mechanism:
         for b in spec.branches.values():
             for n in b.signs:
                 scalar_joint(n, f"branch {b.name!r}")
+        #: The drive of each actuated joint, in ``actuated`` order: the model file's values, then the spec's
+        #: ``[actuators.<joint>]`` tables (:mod:`pkm.core.model.actuators`); written into the model's fields.
+        self.actuators: tuple[Actuator, ...] = ()
+        try:
+            self.actuators = tuple(from_model(model, j.name, j.idx_v, spec.actuators.get(j.name))
+                                   for j in self.actuated)
+        except InvalidInputError as exc:
+            raise SpecError(source, f"an actuator of the model file: {exc}") from None
+        for a, j in zip(self.actuators, self.actuated):
+            write_model(model, a, j.idx_v)
         self.act_q = np.array([j.idx_q for j in self.actuated])
         self.act_v = np.array([j.idx_v for j in self.actuated])
         self._revolute_q = np.array([j.idx_q for j in self.joints.values() if j.revolute], dtype=int)

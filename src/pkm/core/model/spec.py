@@ -46,6 +46,10 @@ Format ``pkm.closures/1`` (all values SI: m, rad)::
     cardan_1 = "universal_zy"        # a universal joint: about the joint frame's z, then its (turned) y
     lock_1 = "fixed"                 # welded at its neutral value
 
+    [actuators.motor_1]              # optional: the drive of an actuated joint (pkm.core.model.actuators)
+    rotor_inertia = 3.3e-5           # kg m^2; also gear_ratio, armature, viscous, coulomb,
+    gear_ratio = 50.0                # effort_limit, peak_effort, velocity_limit (inf: none)
+
 ``[joint_types]`` values (:mod:`pkm.core.model.joints`): ``"spherical"``; ``"universal_ab"`` with ``a``, ``b`` two
 distinct axes of ``x``, ``y``, ``z`` (``R = exp(q1 [a]) exp(q2 [b])``, Gepetto's ``UJOINT_AB``), ``"universal"``
 being ``"universal_xy"``; ``"fixed"``.
@@ -98,6 +102,7 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Any
 
+from pkm.core.model.actuators import parse_table
 from pkm.errors import InvalidInputError, SpecError
 from pkm.validation import ABSURD
 
@@ -180,6 +185,9 @@ class ClosureSpec:
     #: A free-flyer joint on the world that carries the whole mechanism (a legged robot's pelvis): its pose is an
     #: input, held by the solvers where ``q`` puts it (see :class:`pkm.core.Mechanism`).
     floating_base: str | None = None
+    #: ``{actuated joint: {field: value}}``: the drives' values the spec states (``[actuators.<joint>]``, see
+    #: :mod:`pkm.core.model.actuators`), over those of the model file.
+    actuators: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ reading
     @classmethod
@@ -225,7 +233,8 @@ class ClosureSpec:
         if fmt != FORMAT:
             raise SpecError(source, f"unsupported format {fmt!r}; this pkm reads {FORMAT!r}")
         known = {"format", "mechanism", "urdf", "end_effector", "actuated", "default_branch", "task",
-                 "closure", "branch", "reference", "parameters", "description", "joint_types", "floating_base"}
+                 "closure", "branch", "reference", "parameters", "description", "joint_types", "floating_base",
+                 "actuators"}
         unknown = sorted(set(raw) - known)
         if unknown:
             raise SpecError(source, f"unknown keys {unknown}; known keys: {sorted(known)}")
@@ -336,6 +345,12 @@ class ClosureSpec:
             raise SpecError(source, f"urdf = {raw['urdf']!r}: the URDF path must be relative to the spec's folder "
                                     "and stay inside it (no absolute path, no '..'); copy the URDF next to the spec")
 
+        actuators = parse_table(raw.get("actuators", {}), source)
+        stray = [j for j in actuators if j not in actuated]
+        if stray:
+            raise SpecError(source, f"[actuators.{stray[0]}]: {stray[0]!r} is not an actuated joint; actuated: "
+                                    f"{list(actuated)}")
+
         return cls(
             mechanism=need(raw, "mechanism", str),
             urdf=need(raw, "urdf", str),
@@ -350,6 +365,7 @@ class ClosureSpec:
             description=str(raw.get("description", "")),
             joint_types=dict(joint_types),
             floating_base=floating_base,
+            actuators=actuators,
         )
 
     # ------------------------------------------------------------------ writing
@@ -388,6 +404,9 @@ class ClosureSpec:
             out.append("signs = { " + ", ".join(f"{_key(k)} = {v:d}" for k, v in b.signs.items()) + " }")
         if self.joint_types:
             out += ["", "[joint_types]"] + [f"{_key(k)} = {_tv(v)}" for k, v in self.joint_types.items()]
+        for joint, values in self.actuators.items():
+            if values:
+                out += ["", f"[actuators.{_key(joint)}]"] + [f"{_key(k)} = {_tv(float(v))}" for k, v in values.items()]
         out += ["", "[reference]"]
         out += [f"{_key(k)} = {_tv(list(v))}" for k, v in self.reference.items()]
         if self.parameters:

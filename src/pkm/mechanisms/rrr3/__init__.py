@@ -46,7 +46,10 @@ significant; bit 0 -> ``psi_i > 0`` (``-`` root), bit 1 -> ``psi_i < 0`` (``+`` 
 for example ``mode3`` = bits ``010`` = ``(+, -, +)``. Modes 1 and 8 are the two that
 keep the three legs alike, which agrees with the paper's finding (sec. VIII, Fig. 8)
 that only the first and last modes are suitable; the paper does not print the
-sign convention behind its numbering, so this correspondence is ours.
+sign convention behind its numbering, so this correspondence is ours. As everywhere in
+pkm, a working mode is a ``branch``: the functions take ``branch=`` (``k`` or ``"modek"``;
+default the design's ``Rrr3Params.branch``), the spec names ``[branch.mode1]`` ..
+``[branch.mode8]`` (``mode=`` and :func:`mode_signs` are the deprecated former names).
 
 Departures from the paper:
 
@@ -124,6 +127,7 @@ from pkm.mechanisms.rrr3.params import (
     Rrr3Params,
     base_centroid,
     base_vertices,
+    branch_signs,
     mode_signs,
 )
 
@@ -139,6 +143,7 @@ __all__ = [
     "a_from_centroid",
     "base_centroid",
     "base_vertices",
+    "branch_signs",
     "build",
     "centroid_from_a",
     "characteristic_length",

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pkm._moved import renamed, renamed_fields, renamed_keyword
 from pkm.core.differential.indices import inverse_condition, singularity_class
 from pkm.core.kinematics.newton import gauss_newton
 from pkm.core.model.mechanism import Mechanism, check_mechanism
@@ -23,7 +24,7 @@ from pkm.mechanisms._common import (
     best_reference,
     check_params,
 )
-from pkm.mechanisms.rrr3.params import MODES, REACH_TOL, SQRT3, Rrr3Params, base_centroid, base_vertices, mode_signs
+from pkm.mechanisms.rrr3.params import MODES, REACH_TOL, SQRT3, Rrr3Params, base_centroid, base_vertices, branch_signs
 from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result, wrap_angle
 
 
@@ -80,12 +81,13 @@ def leg_elbows(a: float, b: float, tx, ty, sign) -> tuple[np.ndarray, np.ndarray
         return along * ex + sign * off * ey, along * ey - sign * off * ex, dist, reachable
 
 
-def _solve(params: Rrr3Params, a_point: np.ndarray, phi: float, mode: int | str) -> tuple[np.ndarray, np.ndarray]:
-    """``(theta, psi)`` [rad] of the three legs for the paper's ``(A, Phi)`` in ``mode`` (eqs. 6-9)."""
+def _solve(params: Rrr3Params, a_point: np.ndarray, phi: float, branch: int | str | None) -> tuple[np.ndarray, np.ndarray]:
+    """``(theta, psi)`` [rad] of the three legs for the paper's ``(A, Phi)`` in working mode ``branch`` (None:
+    ``params.branch``) (eqs. 6-9)."""
     params = check_params(params, Rrr3Params)
     a, b = params.a, params.b
     T = platform_vertices(params, a_point, phi) - base_vertices(params)
-    Dx, Dy, dist, reachable = leg_elbows(a, b, T[:, 0], T[:, 1], np.array(mode_signs(mode), dtype=float))
+    Dx, Dy, dist, reachable = leg_elbows(a, b, T[:, 0], T[:, 1], np.array(branch_signs(params.branch if branch is None else branch), dtype=float))
     for i in np.flatnonzero(~reachable):
         d, lo, hi = float(dist[i]), abs(a - b), a + b
         if not math.isfinite(d):
@@ -101,28 +103,32 @@ def _solve(params: Rrr3Params, a_point: np.ndarray, phi: float, mode: int | str)
     return wrap_angle(np.arctan2(Dy, Dx)), np.arctan2(Dx * uy - Dy * ux, Dx * ux + Dy * uy)
 
 
-def inverse_kinematics(params: Rrr3Params, a_point, phi: float, mode: int | str | None = None) -> np.ndarray:
+@renamed_keyword(mode="branch")
+def inverse_kinematics(params: Rrr3Params, a_point, phi: float, branch: int | str | None = None) -> np.ndarray:
     """Motor angles ``(theta_1, theta_2, theta_3)`` [rad] in (-pi, pi], in the paper's terms (eq. 9).
 
     Args:
         params: The design.
         a_point: Platform vertex ``A`` [m], shape (2,).
         phi: Platform orientation ``Phi`` [rad].
-        mode: Working mode (1..8 or ``"mode1"``..``"mode8"``); default ``params.mode``.
+        branch: Working mode (1..8 or ``"mode1"``..``"mode8"``); default ``params.branch``. (``mode=``: its
+            deprecated former name.)
 
     Raises:
         UnreachableError: with the first leg whose base-vertex-to-platform-vertex distance is
             outside ``[|a - b|, a + b]``, and by how much [m].
         SingularityError: a platform vertex on its base vertex (only when ``a = b``).
     """
-    return _solve(params, a_point, phi, params.mode if mode is None else mode)[0]
+    return _solve(params, a_point, phi, branch)[0]
 
 
-def joint_values(params: Rrr3Params, y, mode: int | str | None = None) -> dict[str, list[float]]:
-    """Every joint coordinate of the tree (closed form) for the task vector ``y = (x_G, y_G, Phi)``."""
+@renamed_keyword(mode="branch")
+def joint_values(params: Rrr3Params, y, branch: int | str | None = None) -> dict[str, list[float]]:
+    """Every joint coordinate of the tree (closed form) for the task vector ``y = (x_G, y_G, Phi)`` in working mode
+    ``branch`` (default ``params.branch``)."""
     params = check_params(params, Rrr3Params)
     y = as_vector(y, 3, "y")
-    theta, psi = _solve(params, a_from_centroid(params, y[:2], y[2]), y[2], params.mode if mode is None else mode)
+    theta, psi = _solve(params, a_from_centroid(params, y[:2], y[2]), y[2], branch)
     out: dict[str, list[float]] = {}
     for i in range(3):
         out[f"motor_{i + 1}"] = [float(theta[i])]
@@ -131,14 +137,18 @@ def joint_values(params: Rrr3Params, y, mode: int | str | None = None) -> dict[s
     return out
 
 
-def configuration(mech: Mechanism, y, mode: int | str | None = None) -> np.ndarray:
-    """Full configuration vector ``q`` of ``mech`` for the task vector ``y`` (closed form)."""
+@renamed_keyword(mode="branch")
+def configuration(mech: Mechanism, y, branch: int | str | None = None) -> np.ndarray:
+    """Full configuration vector ``q`` of ``mech`` for the task vector ``y`` (closed form) in working mode ``branch``
+    (default ``mech.params.branch``)."""
     mech = check_mechanism(mech)
-    return mech.q_from_dict(joint_values(mech.params, y, mode))
+    return mech.q_from_dict(joint_values(mech.params, y, branch))
 
 
-def jacobians(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """The paper's ``J_x``, ``J_q`` (eqs. 16-20, rebuilt) with ``J_x yd = J_q theta_dot``.
+@renamed_keyword(mode="branch")
+def jacobians(params: Rrr3Params, y, branch: int | str | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The paper's ``J_x``, ``J_q`` (eqs. 16-20, rebuilt) with ``J_x yd = J_q theta_dot`` in working mode ``branch``
+    (default ``params.branch``).
 
     Row ``i`` is the reciprocal product of leg ``i``'s wrench (a unit force ``u_i`` along its
     distal link, through its platform vertex) with the platform twist and with the motor's
@@ -154,7 +164,7 @@ def jacobians(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[np.
     params = check_params(params, Rrr3Params)
     y = as_vector(y, 3, "y")
     A = a_from_centroid(params, y[:2], y[2])
-    theta, psi = _solve(params, A, y[2], params.mode if mode is None else mode)
+    theta, psi = _solve(params, A, y[2], branch)
     V = platform_vertices(params, A, y[2])
     Jx, Jq = np.empty((3, 3)), np.zeros((3, 3))
     for i in range(3):
@@ -189,7 +199,8 @@ def reference_point(params: Rrr3Params, y, reference: str = "centroid") -> np.nd
     raise InvalidInputError("reference", f"use one of {REFERENCES}, got {reference!r}", reference)
 
 
-def homogenized_jacobians(params: Rrr3Params, y, mode: int | str | None = None, *, length: float | None = None,
+@renamed_keyword(mode="branch")
+def homogenized_jacobians(params: Rrr3Params, y, branch: int | str | None = None, *, length: float | None = None,
                           reference: str = "centroid") -> tuple[np.ndarray, np.ndarray]:
     """Eq. (25), read consistently: ``J_x`` with its moment column divided by ``L``, and ``J_q``.
 
@@ -202,7 +213,7 @@ def homogenized_jacobians(params: Rrr3Params, y, mode: int | str | None = None, 
     Args:
         params: The design.
         y: Task vector ``(x_G, y_G, Phi)`` [m, m, rad].
-        mode: Working mode; default ``params.mode``.
+        branch: Working mode; default ``params.branch``.
         length: Characteristic length ``L`` [m], finite and > 0; default :func:`characteristic_length`.
         reference: Moment reference point, one of :data:`REFERENCES`.
 
@@ -211,7 +222,7 @@ def homogenized_jacobians(params: Rrr3Params, y, mode: int | str | None = None, 
     """
     params = check_params(params, Rrr3Params)
     L = characteristic_length(params) if length is None else _length(length)
-    Jx, Jq = jacobians(params, y, mode)
+    Jx, Jq = jacobians(params, y, branch)
     d = as_vector(y, 3, "y")[:2] - reference_point(params, y, reference)  # G - P
     Jx[:, 2] += d[0] * Jx[:, 1] - d[1] * Jx[:, 0]  # (V - P) x u = (V - G) x u + (G - P) x u
     with np.errstate(over="ignore"):  # a tiny L overflows: reported below
@@ -219,8 +230,10 @@ def homogenized_jacobians(params: Rrr3Params, y, mode: int | str | None = None, 
     return finite_result(Jx, "homogenized J_x", f"length = {L!r} m is too small (the moment column overflows)"), Jq
 
 
-def singularity_measures(params: Rrr3Params, y, mode: int | str | None = None) -> tuple[float, float]:
-    """Dimensionless distances to the two kinds of singularity at task vector ``y``.
+@renamed_keyword(mode="branch")
+def singularity_measures(params: Rrr3Params, y, branch: int | str | None = None) -> tuple[float, float]:
+    """Dimensionless distances to the two kinds of singularity at task vector ``y`` in working mode ``branch``
+    (default ``params.branch``).
 
     Returns:
         ``(inverse, direct)``: ``min_i |sin psi_i|`` (0 when a leg is stretched or folded, eq. 20)
@@ -229,26 +242,28 @@ def singularity_measures(params: Rrr3Params, y, mode: int | str | None = None) -
         unchanged by a uniform scaling of the design.
     """
     params = check_params(params, Rrr3Params)
-    Jx, Jq = homogenized_jacobians(params, y, mode)
+    Jx, Jq = homogenized_jacobians(params, y, branch)
     return float(np.min(np.abs(np.diag(Jq)))) / params.a, abs(float(np.linalg.det(Jx)))
 
 
-def classify_singularity(params: Rrr3Params, y, mode: int | str | None = None, *, tol: float = 1e-8) -> str:
+@renamed_keyword(mode="branch")
+def classify_singularity(params: Rrr3Params, y, branch: int | str | None = None, *, tol: float = 1e-8) -> str:
     """``"regular"``, ``"inverse"`` (``J_q`` singular), ``"direct"`` (``J_x`` singular) or ``"combined"`` (both).
 
     Args:
         params: The design.
         y: Task vector ``(x_G, y_G, Phi)`` [m, m, rad].
-        mode: Working mode; default ``params.mode``.
+        branch: Working mode; default ``params.branch``.
         tol: A measure of :func:`singularity_measures` at or below ``tol`` counts as singular.
     """
     params = check_params(params, Rrr3Params)
     tol = as_scalar(tol, "tol", low=0.0)
-    inv, direct = singularity_measures(params, y, mode)
+    inv, direct = singularity_measures(params, y, branch)
     return singularity_class(inv <= tol, direct <= tol)
 
 
 # ---------------------------------------------------------------------- forward kinematics
+@renamed_fields(mode="branch")
 @dataclass(frozen=True)
 class FkSolution:
     """One assembly mode of the forward kinematics.
@@ -257,16 +272,22 @@ class FkSolution:
         y: Task vector ``(x_G, y_G, Phi)`` [m, m, rad], ``Phi`` in (-pi, pi].
         a_point: The paper's platform vertex ``A`` [m].
         psi: Elbow angles ``(psi_1, psi_2, psi_3)`` [rad] (see the module doc).
-        mode: Working mode name of the solution (signs of ``psi``), ``None`` if a leg is exactly stretched
-            or folded.
+        branch: Working mode name of the solution (``"mode1"``..``"mode8"``: signs of ``psi``), ``None`` if a
+            leg is exactly stretched or folded. (``mode``: its deprecated former name.)
         residual: Largest ``| |V_i - D_i| - b |`` over the legs [m].
     """
 
     y: np.ndarray
     a_point: np.ndarray
     psi: np.ndarray
-    mode: str | None
+    branch: str | None
     residual: float
+
+    @property
+    def mode(self) -> str | None:
+        """Deprecated former name of :attr:`branch` (a :class:`DeprecationWarning`)."""
+        renamed("FkSolution", "mode", "branch")
+        return self.branch
 
 
 _FK_SAMPLES = 16  # FFT samples of the degree-4 trigonometric polynomial (>= 9 makes the coefficients exact)
@@ -385,16 +406,16 @@ def _fk_polish(params: Rrr3Params, D: np.ndarray, x: np.ndarray, theta: np.ndarr
     u = e / b  # distal directions D -> V
     psi = np.arctan2(link_a[:, 0] * u[:, 1] - link_a[:, 1] * u[:, 0], np.sum(link_a * u, axis=1))
     signs = tuple(int(np.sign(p)) for p in psi)
-    mode = next((name for name, s in MODES.items() if s == signs), None)
+    branch = next((name for name, s in MODES.items() if s == signs), None)
     y = np.concatenate([centroid_from_a(params, A, phi), [phi]])
-    return FkSolution(y, A, psi, mode, residual)
+    return FkSolution(y, A, psi, branch, residual)
 
 
 # ---------------------------------------------------------------------- uniform interface
 # Every mechanism module offers these, over the task vector ``y`` laid out as
 # :class:`pkm.core.TaskMap` does (here: centroid x, y and yaw Phi).
 def closed_form_fk(params: Rrr3Params, q_actuated, seed=None) -> np.ndarray:
-    """One assembly mode of :func:`forward_kinematics`: on ``params.mode``, nearest to ``seed``.
+    """One assembly mode of :func:`forward_kinematics`: on working mode ``params.branch``, nearest to ``seed``.
 
     Args:
         params: The design.
@@ -402,14 +423,14 @@ def closed_form_fk(params: Rrr3Params, q_actuated, seed=None) -> np.ndarray:
         seed: Task vector the solution should be nearest to (default :func:`reference_pose`).
 
     Raises:
-        AssemblyError: no assembly at all; BranchError: none on ``params.mode``.
+        AssemblyError: no assembly at all; BranchError: none on ``params.branch``.
     """
     params = check_params(params, Rrr3Params)
     target = reference_pose(params) if seed is None else as_vector(seed, 3, "seed")
-    sols = [s for s in forward_kinematics(params, q_actuated) if s.mode == f"mode{params.mode}"]
+    sols = [s for s in forward_kinematics(params, q_actuated) if s.branch == f"mode{params.branch}"]
     if not sols:
-        expected = dict(zip(("elbow_1", "elbow_2", "elbow_3"), MODES[f"mode{params.mode}"]))
-        raise BranchError(f"mode{params.mode}", expected, {})
+        expected = dict(zip(("elbow_1", "elbow_2", "elbow_3"), MODES[f"mode{params.branch}"]))
+        raise BranchError(f"mode{params.branch}", expected, {})
     return min(sols, key=lambda s: float(np.max(np.abs(np.r_[s.y[:2] - target[:2],
                                                               wrap_angle(s.y[2] - target[2])])))).y.copy()
 
@@ -432,7 +453,7 @@ SINGULAR_TOL = 1e-6  # a given reference pose must be at least this far (dimensi
 
 
 def reference_pose(params: Rrr3Params) -> np.ndarray:
-    """The design's reference task vector ``(x_G, y_G, Phi)`` [m, m, rad] in working mode ``params.mode``.
+    """The design's reference task vector ``(x_G, y_G, Phi)`` [m, m, rad] in working mode ``params.branch``.
 
     ``params.home`` (offset from the base centroid, orientation) when given; otherwise the centred
     platform at the orientation of largest condition index (the inverse condition number of
@@ -457,7 +478,7 @@ def _reference(params: Rrr3Params) -> tuple[float, float, float]:
     y = (float(G[0] + params.home[0]), float(G[1] + params.home[1]), params.home[2])
     home = tuple(params.home)
     try:
-        margin_inv, margin_dir = singularity_measures(params, y, params.mode)
+        margin_inv, margin_dir = singularity_measures(params, y, params.branch)
     except UnreachableError as exc:
         raise InvalidParameterError(
             "home", f"reference pose {home} is unreachable with this design (leg {exc.leg} misses by "
@@ -469,19 +490,19 @@ def _reference(params: Rrr3Params) -> tuple[float, float, float]:
     if margin_inv < SINGULAR_TOL or margin_dir < SINGULAR_TOL:
         kind = "inverse (a leg stretched or folded)" if margin_inv < SINGULAR_TOL else "direct"
         raise InvalidParameterError(
-            "home", f"reference pose {home} is {kind}-singular in mode{params.mode}; choose another home or mode",
+            "home", f"reference pose {home} is {kind}-singular in mode{params.branch}; choose another home or branch",
             params.home)
     return y
 
 
 def condition_index(params: Rrr3Params, y) -> float:
     """The inverse condition number of ``J_q^-1 J_x`` (:func:`homogenized_jacobians`, centroid, default
-    length) at ``y`` in ``params.mode``: in [0, 1], 0 at a singularity.
+    length) at ``y`` in working mode ``params.branch``: in [0, 1], 0 at a singularity.
 
     Raises:
         UnreachableError, SingularityError: as :func:`homogenized_jacobians`.
     """
-    Jx, Jq = homogenized_jacobians(params, y, params.mode)
+    Jx, Jq = homogenized_jacobians(params, y, params.branch)
     q = np.diag(Jq)
     if np.min(np.abs(q)) == 0.0:
         raise SingularityError("inverse", 0.0, "a leg stretched or folded")

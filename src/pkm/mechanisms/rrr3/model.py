@@ -64,7 +64,7 @@ def closure_spec(params: Rrr3Params) -> ClosureSpec:
         task=TaskSpec(("x", "y", "yaw")),
         reference=reference,
         branches=branches,
-        default_branch=f"mode{params.mode}",
+        default_branch=f"mode{params.branch}",
         parameters=spec_parameters(params),
     )
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pkm._moved import renamed, renamed_fields
 from pkm.errors import InvalidInputError, InvalidParameterError
 from pkm.mechanisms._common import (
     check_numbers,
@@ -24,12 +25,13 @@ SQRT3 = math.sqrt(3.0)
 MODES: dict[str, tuple[int, int, int]] = {
     f"mode{k + 1}": (-1 if k & 4 else 1, -1 if k & 2 else 1, -1 if k & 1 else 1) for k in range(8)
 }
-"""Working mode name -> signs of ``(psi_1, psi_2, psi_3)`` (see the module doc)."""
+"""Working mode (branch) name -> signs of ``(psi_1, psi_2, psi_3)`` (see the module doc)."""
 
 
 REACH_TOL = 1e-12  # relative to a + b: a distance this close to the reach limits counts as on them
 
 
+@renamed_fields(mode="branch")
 @dataclass(frozen=True)
 class Rrr3Params:
     """Planar 3-RRR design (paper sec. III workspace study by default).
@@ -39,11 +41,12 @@ class Rrr3Params:
         b: Distal link length [m] (40 cm).
         h: Platform side ``AB = BC = CA`` [m] (10 cm).
         H: Base side, the actuator separation ``PQ = QR = RP`` [m] (100 cm).
-        mode: Working mode 1..8 of the reference configuration (see the module doc).
+        branch: Working mode 1..8 of the reference configuration (the spec's default branch
+            ``"mode<branch>"``, see the module doc); ``mode=`` is its deprecated former name.
         home: Reference placement ``(dx, dy, Phi)``: the platform centroid's offset from the
             base centroid [m] and the orientation [rad]; ``(0, 0, 0)``: centred, ``Phi = 0``; None
             (default): found for the design (``reference_pose``: centred, the orientation of
-            largest condition index in ``mode``).
+            largest condition index in ``branch``).
         m_proximal: Mass of a proximal link [kg] (illustrative; not in the paper).
         m_distal: Mass of a distal link [kg] (illustrative).
         m_platform: Platform mass [kg] (illustrative).
@@ -53,7 +56,7 @@ class Rrr3Params:
     b: float = param(0.40, "m")
     h: float = param(0.10, "m")
     H: float = param(1.00, "m")
-    mode: int = param(1)
+    branch: int = param(1)
     home: tuple[float, float, float] | None = param(None, "m", "rad", length=3)
     m_proximal: float = param(0.20, "kg")
     m_distal: float = param(0.15, "kg")
@@ -61,20 +64,32 @@ class Rrr3Params:
 
     def __post_init__(self):
         check_positive(self, "a", "b", "h", "H", "m_proximal", "m_distal", "m_platform")
-        if isinstance(self.mode, bool) or not isinstance(self.mode, int) or not 1 <= self.mode <= 8:
-            raise InvalidParameterError("mode", f"must be an integer 1..8 (working mode), got {self.mode!r}",
-                                        self.mode)
+        if isinstance(self.branch, bool) or not isinstance(self.branch, int) or not 1 <= self.branch <= 8:
+            raise InvalidParameterError("branch", f"must be an integer 1..8 (working mode 'mode1'..'mode8'), got "
+                                                  f"{self.branch!r}", self.branch)
         if self.home is not None:
             check_numbers(self, "home", 3, "(dx, dy, Phi) in m, m, rad")
 
+    @property
+    def mode(self) -> int:
+        """Deprecated former name of :attr:`branch` (a :class:`DeprecationWarning`)."""
+        renamed("Rrr3Params", "mode", "branch")
+        return self.branch
+
 
 # ---------------------------------------------------------------------- geometry
-def mode_signs(mode: int | str) -> tuple[int, int, int]:
-    """Signs of ``(psi_1, psi_2, psi_3)`` of a working mode given as ``k`` or ``"modek"`` (k = 1..8)."""
-    key = f"mode{mode}" if isinstance(mode, (int, np.integer)) and not isinstance(mode, bool) else mode
+def branch_signs(branch: int | str) -> tuple[int, int, int]:
+    """Signs of ``(psi_1, psi_2, psi_3)`` of a working mode (branch) given as ``k`` or ``"modek"`` (k = 1..8)."""
+    key = f"mode{branch}" if isinstance(branch, (int, np.integer)) and not isinstance(branch, bool) else branch
     if not isinstance(key, str) or key not in MODES:
-        raise InvalidInputError("mode", f"use 1..8 or 'mode1'..'mode8', got {mode!r}", mode)
+        raise InvalidInputError("branch", f"use 1..8 or 'mode1'..'mode8', got {branch!r}", branch)
     return MODES[key]
+
+
+def mode_signs(mode: int | str) -> tuple[int, int, int]:
+    """Deprecated former name of :func:`branch_signs` (a :class:`DeprecationWarning`)."""
+    renamed("pkm.mechanisms.rrr3", "mode_signs", "branch_signs")
+    return branch_signs(mode)
 
 
 def base_vertices(params: Rrr3Params) -> np.ndarray:

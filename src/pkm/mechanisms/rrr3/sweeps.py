@@ -17,9 +17,9 @@ def _map(c, o):
     from pkm.mechanisms.rrr3 import workspace as ws
 
     d = ws.Design.of(c.params)
-    mode = o.get("branch") or c.params.mode  # the option's working mode, else the design's
-    return c.cached(("rrr3_map", o["step"], o["kind"], mode), lambda: ws.ci_map(
-        d, ws.workspace_grid(d, o["step"]), ws.CiSettings(mode=mode, norm=o["kind"])))
+    branch = o.get("branch") or c.params.branch  # the option's working mode, else the design's
+    return c.cached(("rrr3_map", o["step"], o["kind"], branch), lambda: ws.ci_map(
+        d, ws.workspace_grid(d, o["step"]), ws.CiSettings(branch=branch, kind=o["kind"])))
 
 
 def _centroid(c):

@@ -10,9 +10,11 @@ open is an explicit argument:
   :func:`pkm.mechanisms.rrr3.homogenized_jacobians`: moment column divided by ``L``.
 * **L and moment point** — :class:`CiSettings` ``length`` (default the platform circumradius
   ``h / sqrt 3``) and ``reference`` (default the centroid ``G``, whose velocity is the task rate).
-* **Norm** — ``"2"`` (spectral, ``sigma_min / sigma_max``) or ``"fro_normalized"``
-  (``n / (||J||_F ||J^-1||_F)``), the names of :mod:`pkm.core.differential.indices`.
-* **Orientation and working mode** — ``phi`` (rad) and ``mode`` of :class:`CiSettings`.
+* **Kind** — :class:`CiSettings` ``kind``: ``"2"`` (spectral, ``sigma_min / sigma_max``) or ``"fro_normalized"``
+  (``n / (||J||_F ||J^-1||_F)``), the names of :data:`pkm.core.differential.indices.KINDS` (:data:`KINDS`: those
+  these maps compute).
+* **Orientation and working mode** — ``phi`` (rad) and ``branch`` (1..8 or ``"mode1"``..``"mode8"``) of
+  :class:`CiSettings`.
 * **Grid** — :class:`Grid`: a square of nodes ``centre + step * (i, j)``, ``|i|, |j| <= n``,
   positions of the centroid ``G``.
 * **Unreachable nodes** — they carry ``NaN`` in a map and are excluded from every mean
@@ -40,13 +42,16 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pkm._moved import renamed, renamed_fields
 from pkm.core.differential.indices import inverse_condition
 from pkm.errors import InvalidInputError, SingularityError, UnreachableError
 from pkm.mechanisms import rrr3
 from pkm.mechanisms._common import check_positive, real
 from pkm.validation import as_array, as_scalar, as_vector
 
-NORMS = ("2", "fro_normalized")
+#: The condition-index kinds these maps compute in closed form: a subset of
+#: :data:`pkm.core.differential.indices.KINDS` (not its unnormalised ``"fro"``).
+KINDS = ("2", "fro_normalized")
 MAX_NODES_PER_AXIS = 20001  # a grid larger than this per axis is refused (memory)
 MAX_NODES = 4001 ** 2  # a grid of more nodes in all is refused (memory: several float arrays of this size)
 _CHUNK = 1 << 15  # nodes evaluated at once (fits the cache: faster than larger blocks)
@@ -93,30 +98,32 @@ class Design:
         return np.array([self.H / 2.0, self.H / (2.0 * rrr3.SQRT3)])
 
 
+@renamed_fields(mode="branch", norm="kind")
 @dataclass(frozen=True)
 class CiSettings:
     """The choices behind a condition index (see the module doc).
 
     Attributes:
         phi: Platform orientation ``Phi`` [rad].
-        mode: Working mode 1..8 (or ``"modeK"``).
-        norm: ``"2"`` or ``"fro_normalized"``.
+        branch: Working mode 1..8 (or ``"modeK"``); ``mode=`` is its deprecated former name.
+        kind: Condition-index kind, one of :data:`KINDS`: ``"2"`` or ``"fro_normalized"``; ``norm=`` is its
+            deprecated former name.
         length: Characteristic length ``L`` [m]; ``None``: the platform circumradius ``h / sqrt 3``.
         reference: Moment reference point, one of :data:`pkm.mechanisms.rrr3.REFERENCES`.
     """
 
     phi: float = 0.0
-    mode: int | str = 1
-    norm: str = "2"
+    branch: int | str = 1
+    kind: str = "2"
     length: float | None = None
     reference: str = "centroid"
 
     def __post_init__(self):
         if real(self.phi) is None:
             raise InvalidInputError("phi", f"must be a finite angle in rad, got {self.phi!r}", self.phi)
-        rrr3.mode_signs(self.mode)
-        if not isinstance(self.norm, str) or self.norm not in NORMS:
-            raise InvalidInputError("norm", f"use one of {NORMS}, got {self.norm!r}", self.norm)
+        rrr3.branch_signs(self.branch)
+        if not isinstance(self.kind, str) or self.kind not in KINDS:
+            raise InvalidInputError("kind", f"use one of {KINDS}, got {self.kind!r}", self.kind)
         if self.length is not None and not (real(self.length) is not None and self.length > 0.0):
             raise InvalidInputError("length", f"must be finite and > 0 m (or None), got {self.length!r}", self.length)
         if not isinstance(self.reference, str) or self.reference not in rrr3.REFERENCES:
@@ -126,6 +133,18 @@ class CiSettings:
     def length_for(self, design: Design) -> float:
         """``L`` [m] for ``design``."""
         return design.h / rrr3.SQRT3 if self.length is None else float(self.length)
+
+    @property
+    def mode(self) -> int | str:
+        """Deprecated former name of :attr:`branch` (a :class:`DeprecationWarning`)."""
+        renamed("CiSettings", "mode", "branch")
+        return self.branch
+
+    @property
+    def norm(self) -> str:
+        """Deprecated former name of :attr:`kind` (a :class:`DeprecationWarning`)."""
+        renamed("CiSettings", "norm", "kind")
+        return self.kind
 
 
 @dataclass(frozen=True)
@@ -262,7 +281,7 @@ def inverse_jacobian_stack(design, gx, gy, settings: CiSettings = CiSettings()) 
     Args:
         design: Anything with ``a, b, h, H`` [m].
         gx, gy: Centroid coordinates [m], same shape ``S``.
-        settings: Orientation, mode, ``L`` and moment point (``norm`` unused).
+        settings: Orientation, working mode, ``L`` and moment point (``kind`` unused).
 
     Returns:
         ``(K, reachable)``: ``K`` of shape ``S + (3, 3)`` [1/m] (``inf``/``nan`` rows where a leg is
@@ -270,7 +289,7 @@ def inverse_jacobian_stack(design, gx, gy, settings: CiSettings = CiSettings()) 
     """
     d = Design.of(design)
     gx, gy = np.asarray(gx, dtype=float), np.asarray(gy, dtype=float)
-    reach, legs = _legs(d, gx, gy, settings.phi, rrr3.mode_signs(settings.mode))
+    reach, legs = _legs(d, gx, gy, settings.phi, rrr3.branch_signs(settings.branch))
     L = settings.length_for(d)
     px, py = _moment_point(d, gx, gy, settings.phi, settings.reference)
     K = np.empty(gx.shape + (3, 3))
@@ -282,7 +301,7 @@ def inverse_jacobian_stack(design, gx, gy, settings: CiSettings = CiSettings()) 
     return K, reach
 
 
-def _condition_index(rows, s, norm: str) -> np.ndarray:
+def _condition_index(rows, s, kind: str) -> np.ndarray:
     """``1 / kappa`` of ``K = diag(1/s) R`` (``R`` rows ``rows[i] = (r_x, r_y, r_m)``), by the eigenvalues of ``K' K'^T``."""
     w = (s[1] * s[2], s[0] * s[2], s[0] * s[1])  # K' = (s1 s2 s3) K = diag(w) R
     kr = [[w[i] * rows[i][j] for j in range(3)] for i in range(3)]
@@ -298,7 +317,7 @@ def _condition_index(rows, s, norm: str) -> np.ndarray:
     tr = m00 + m11 + m22
     p2 = m00 * m11 - m01 * m01 + m00 * m22 - m02 * m02 + m11 * m22 - m12 * m12
     with np.errstate(divide="ignore", invalid="ignore"):
-        if norm == "fro_normalized":  # kappa_F / 3 = sqrt(tr M tr M^-1) / 3, tr M^-1 = p2 / p3
+        if kind == "fro_normalized":  # kappa_F / 3 = sqrt(tr M tr M^-1) / 3, tr M^-1 = p2 / p3
             ci = np.where(p3 > 0.0, 3.0 * np.sqrt(p3 / (tr * p2)), 0.0)
         else:
             q = tr / 3.0
@@ -350,7 +369,7 @@ def condition_index_phi(design, gx, gy, phi, settings: CiSettings = CiSettings()
     constant = phi.size > 0 and bool(np.all(phi == phi[0]))
     ci = np.full(gx.size, np.nan)
     reach = np.zeros(gx.size, dtype=bool)
-    signs = rrr3.mode_signs(settings.mode)
+    signs = rrr3.branch_signs(settings.branch)
     L = settings.length_for(d)
     for start in range(0, gx.size, _CHUNK):
         sl = slice(start, start + _CHUNK)
@@ -363,7 +382,7 @@ def condition_index_phi(design, gx, gy, phi, settings: CiSettings = CiSettings()
         px, py = _moment_point(d, x, y, p, settings.reference)
         rows = [(ux, uy, ((vx - px) * uy - (vy - py) * ux) / L) for vx, vy, ux, uy, _ in legs]
         idx = np.flatnonzero(ok) + start
-        ci[idx] = _condition_index(rows, [leg[4] for leg in legs], settings.norm)
+        ci[idx] = _condition_index(rows, [leg[4] for leg in legs], settings.kind)
         reach[idx] = True
     return ci.reshape(shape), reach.reshape(shape)
 
@@ -552,7 +571,7 @@ def direct_singularity_crossings(design, grid: Grid, settings: CiSettings = CiSe
     """
     d = Design.of(design)
     X, Y = grid.xs[None, :], grid.ys[:, None]
-    reach, legs = _legs(d, X, Y, settings.phi, rrr3.mode_signs(settings.mode))
+    reach, legs = _legs(d, X, Y, settings.phi, rrr3.branch_signs(settings.branch))
     (ax, ay), (bx, by), (cx, cy) = [(ux, uy) for _, _, ux, uy, _ in legs]
     mx = [((vx - X) * uy - (vy - Y) * ux) for vx, vy, ux, uy, _ in legs]
     det = ax * (by * mx[2] - mx[1] * cy) - ay * (bx * mx[2] - mx[1] * cx) + mx[0] * (bx * cy - by * cx)
@@ -614,7 +633,7 @@ def naive_condition_index(design, y, settings: CiSettings = CiSettings()) -> flo
     d = Design.of(design)
     params = _LooseParams(d.a, d.b, d.h, d.H)
     try:
-        Jx, Jq = rrr3.homogenized_jacobians(params, y, settings.mode, length=settings.length_for(d),
+        Jx, Jq = rrr3.homogenized_jacobians(params, y, settings.branch, length=settings.length_for(d),
                                             reference=settings.reference)
     except UnreachableError:
         return float("nan")
@@ -622,8 +641,7 @@ def naive_condition_index(design, y, settings: CiSettings = CiSettings()) -> flo
         return 0.0
     if np.min(np.abs(np.diag(Jq))) == 0.0:
         return 0.0
-    kind = "2" if settings.norm == "2" else "fro_normalized"
-    return float(inverse_condition(Jx / np.diag(Jq)[:, None], kind))
+    return float(inverse_condition(Jx / np.diag(Jq)[:, None], settings.kind))
 
 
 def _broadcast(*named) -> tuple[np.ndarray, ...]:
@@ -657,9 +675,16 @@ class _LooseParams(rrr3.Rrr3Params):
         check_positive(self, "a", "b", "h", "H")
 
 
+def __getattr__(name: str) -> tuple[str, ...]:
+    if name == "NORMS":  # (deprecated since 0.2.0)
+        renamed("pkm.mechanisms.rrr3.workspace", "NORMS", "KINDS")
+        return KINDS
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 __all__ = [
     "AREA_SIDE",
-    "NORMS",
+    "KINDS",
     "CiMap",
     "CiSettings",
     "Design",

@@ -1,0 +1,210 @@
+"""Actuators: the motor and transmission behind each actuated joint.
+
+An :class:`Actuator` holds what the dynamics needs of a drive, in the joint's own units (a revolute joint's
+[N m], [rad/s]; a prismatic joint's [N], [m/s]):
+
+* the **reflected inertia** added to the joint's diagonal of the mass matrix: ``rotor_inertia * gear_ratio**2 +
+  armature`` (MuJoCo's and Pinocchio's ``armature`` is that sum for a rotor of inertia ``rotor_inertia`` [kg m^2]
+  turning ``gear_ratio`` times faster than the joint);
+* **friction**: ``viscous`` [N m s/rad] and ``coulomb`` [N m] (MuJoCo's ``damping`` and ``frictionloss``, URDF's
+  ``<dynamics damping friction>``), opposing the joint's rate;
+* **limits**: ``effort_limit`` (continuous) and ``peak_effort`` [N m], ``velocity_limit`` [rad/s]; ``inf`` for
+  none. The peak bounds what a simulation applies (:func:`pkm.simulate` saturates there), the continuous limit is
+  the one a capability analysis holds for ever.
+
+Where the values come from, later sources overriding earlier ones per field:
+
+1. the model file, through Pinocchio's own fields of the model (``armature``, ``rotorInertia``,
+   ``rotorGearRatio``, ``damping``, ``friction``, ``effortLimit``, ``velocityLimit``): URDF ``<limit effort
+   velocity>`` and ``<dynamics damping friction>``, MJCF ``armature``, ``damping``, ``frictionloss``; the MJCF
+   reader also passes ``gear`` and ``forcerange``/``ctrlrange`` of the joint's motor (see
+   :mod:`pkm.core.formats.mjcf`). A limit of 0 or of at least 1e6 in a file means "not given" (exporters write
+   ``effort="0"`` on passive joints and ``1e30`` for "unlimited"); it reads as ``inf``;
+2. the closure spec's ``[actuators.<joint>]`` tables (:mod:`pkm.core.model.spec`), keys as the attributes below::
+
+       [actuators.motor_1]
+       rotor_inertia = 3.3e-5       # kg m^2
+       gear_ratio = 50.0
+       viscous = 0.02               # N m s/rad
+       coulomb = 0.1                # N m
+       effort_limit = 20.0          # N m, continuous
+       peak_effort = 60.0           # N m
+       velocity_limit = 6.0         # rad/s
+
+The mechanism writes the merged values back into its Pinocchio model (``armature`` = the reflected inertia, so
+that ``crba``, ``rnea`` and the kinetic energy include it; ``damping``, ``friction``, the limits), so every
+algorithm of pkm and of Pinocchio sees the same drives.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from pkm.errors import InvalidInputError, SpecError
+
+UNLIMITED = 1e6  # a file's limit at least this large (or 0) means "none": it reads as inf
+
+
+@dataclass(frozen=True)
+class Actuator:
+    """The drive of one actuated joint (SI, the joint's units; see the module doc).
+
+    Attributes:
+        joint: The actuated joint's name.
+        rotor_inertia: The rotor's inertia about its axis [kg m^2] (a linear motor's moving mass [kg]).
+        gear_ratio: Rotor turns per joint turn (> 0).
+        armature: Reflected inertia added to ``rotor_inertia * gear_ratio**2`` [kg m^2 or kg] (MuJoCo's
+            ``armature``: a file that gives the reflected inertia directly puts it here).
+        viscous: Viscous friction [N m s/rad or N s/m].
+        coulomb: Coulomb (dry) friction [N m or N].
+        effort_limit: Continuous effort limit [N m or N]; ``inf``: none.
+        peak_effort: Peak effort limit [N m or N]; ``inf``: the continuous limit.
+        velocity_limit: Joint speed limit [rad/s or m/s]; ``inf``: none.
+    """
+
+    joint: str
+    rotor_inertia: float = 0.0
+    gear_ratio: float = 1.0
+    armature: float = 0.0
+    viscous: float = 0.0
+    coulomb: float = 0.0
+    effort_limit: float = math.inf
+    peak_effort: float = math.inf
+    velocity_limit: float = math.inf
+
+    def __post_init__(self) -> None:
+        for f in NUMBERS:
+            value = getattr(self, f)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+                raise InvalidInputError(f, f"actuator {self.joint!r}: expected a number, got {value!r}", value)
+            value = float(value)
+            if math.isnan(value) or value < 0.0 or (math.isinf(value) and f not in LIMITS):
+                raise InvalidInputError(f, f"actuator {self.joint!r}: {f} must be a finite number >= 0"
+                                           f"{' (or inf: none)' if f in LIMITS else ''}, got {value!r}", value)
+            object.__setattr__(self, f, value)
+        if self.gear_ratio == 0.0 or self.effort_limit == 0.0 or self.peak_effort == 0.0 \
+                or self.velocity_limit == 0.0:
+            zero = next(f for f in ("gear_ratio", "effort_limit", "peak_effort", "velocity_limit")
+                        if getattr(self, f) == 0.0)
+            raise InvalidInputError(zero, f"actuator {self.joint!r}: {zero} must be > 0", 0.0)
+        if self.peak_effort < self.effort_limit and math.isfinite(self.peak_effort):
+            raise InvalidInputError("peak_effort", f"actuator {self.joint!r}: the peak effort {self.peak_effort:g} is "
+                                                   f"below the continuous limit {self.effort_limit:g}", self.peak_effort)
+
+    @property
+    def reflected_inertia(self) -> float:
+        """``rotor_inertia * gear_ratio**2 + armature`` [kg m^2 or kg]: the inertia the joint feels."""
+        return self.rotor_inertia * self.gear_ratio ** 2 + self.armature
+
+    @property
+    def max_effort(self) -> float:
+        """The largest effort the drive applies: the peak limit, else the continuous one [N m or N]."""
+        return self.peak_effort if math.isfinite(self.peak_effort) else self.effort_limit
+
+
+NUMBERS = tuple(f.name for f in fields(Actuator) if f.name != "joint")
+LIMITS = ("effort_limit", "peak_effort", "velocity_limit")
+UNITS = {"rotor_inertia": "kg m^2", "gear_ratio": "1", "armature": "kg m^2", "viscous": "N m s/rad",
+         "coulomb": "N m", "effort_limit": "N m", "peak_effort": "N m", "velocity_limit": "rad/s"}
+"""The unit of each field for a revolute joint (a prismatic joint's: kg, N s/m, N, m/s)."""
+
+
+def parse_table(raw: object, source: str) -> dict[str, dict[str, float]]:
+    """The ``[actuators]`` table of a closure spec: ``{joint: {field: value}}``, checked.
+
+    Raises:
+        SpecError: not a table of tables, an unknown key, a value that is not a number, negative or NaN.
+    """
+    if not isinstance(raw, Mapping):
+        raise SpecError(source, "[actuators] must be a table of [actuators.<joint>] tables")
+    out: dict[str, dict[str, float]] = {}
+    for joint, table in raw.items():
+        if not isinstance(table, Mapping):
+            raise SpecError(source, f"actuators.{joint} must be a table (keys: {', '.join(NUMBERS)})")
+        unknown = sorted(set(table) - set(NUMBERS))
+        if unknown:
+            raise SpecError(source, f"actuators.{joint}: unknown keys {unknown}; known: {list(NUMBERS)}")
+        values = {}
+        for key, value in table.items():
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise SpecError(source, f"actuators.{joint}.{key} must be a number, got {type(value).__name__}")
+            values[key] = float(value)
+        try:
+            Actuator(str(joint), **values)
+        except InvalidInputError as exc:
+            raise SpecError(source, f"actuators.{joint}: {exc}") from None
+        out[str(joint)] = values
+    return out
+
+
+def _limit(value: float) -> float:
+    value = abs(float(value))
+    return math.inf if value == 0.0 or value >= UNLIMITED or not math.isfinite(value) else value
+
+
+def from_model(model: pin.Model, joint: str, idx_v: int, overrides: Mapping[str, float] | None = None) -> Actuator:
+    """The actuator of ``joint`` (velocity index ``idx_v``) from Pinocchio's fields of ``model``, then
+    ``overrides`` (a spec's table)."""
+    ratio = float(model.rotorGearRatio[idx_v])
+    base = Actuator(joint,
+                    rotor_inertia=max(float(model.rotorInertia[idx_v]), 0.0),
+                    gear_ratio=ratio if ratio > 0.0 and math.isfinite(ratio) else 1.0,
+                    armature=max(float(model.armature[idx_v]), 0.0),
+                    viscous=max(float(model.damping[idx_v]), 0.0),
+                    coulomb=max(float(model.friction[idx_v]), 0.0),
+                    effort_limit=_limit(model.effortLimit[idx_v]),
+                    velocity_limit=_limit(model.velocityLimit[idx_v]))
+    return replace(base, **dict(overrides or {}))  # type: ignore[arg-type]  # (field names checked by parse_table)
+
+
+def write_model(model: pin.Model, actuator: Actuator, idx_v: int) -> None:
+    """Write ``actuator`` into Pinocchio's fields of ``model`` at velocity index ``idx_v`` (``armature`` = the
+    reflected inertia; limits ``inf`` as Pinocchio's ``inf``)."""
+    for name, value in (("armature", actuator.reflected_inertia), ("rotorInertia", actuator.rotor_inertia),
+                        ("rotorGearRatio", actuator.gear_ratio), ("damping", actuator.viscous),
+                        ("friction", actuator.coulomb), ("effortLimit", actuator.effort_limit),
+                        ("velocityLimit", actuator.velocity_limit)):
+        vec = np.array(getattr(model, name), dtype=float)
+        vec[idx_v] = value
+        setattr(model, name, vec)
+    # rotorInertia * ratio^2 is already in armature: keep Pinocchio from adding it again if a version ever does
+    # (4.1 reads only armature)
+
+
+def as_actuators(values: ArrayLike | Mapping[str, object], names: tuple[str, ...]) -> dict[str, Actuator]:
+    """Checked ``{joint: Actuator}`` from ``{joint: Actuator | {field: value}}`` (joints among ``names``)."""
+    if not isinstance(values, Mapping):
+        raise InvalidInputError("actuators", "expected {joint: Actuator or {field: value}}", values)
+    out = {}
+    for joint, value in values.items():
+        if joint not in names:
+            raise InvalidInputError("actuators", f"{joint!r} is not an actuated joint; actuated: {list(names)}", joint)
+        if isinstance(value, Actuator):
+            out[joint] = replace(value, joint=joint)
+        elif isinstance(value, Mapping):
+            unknown = sorted(set(value) - set(NUMBERS))
+            if unknown:
+                raise InvalidInputError("actuators", f"{joint}: unknown fields {unknown}; known: {list(NUMBERS)}",
+                                        unknown)
+            out[joint] = Actuator(joint, **{str(k): v for k, v in value.items()})  # type: ignore[arg-type]
+        else:
+            raise InvalidInputError("actuators", f"{joint}: expected an Actuator or a table, got {value!r}", value)
+    return out
+
+
+__all__ = [
+    "LIMITS",
+    "NUMBERS",
+    "UNITS",
+    "Actuator",
+    "as_actuators",
+    "from_model",
+    "parse_table",
+    "write_model",
+]
