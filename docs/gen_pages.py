@@ -28,7 +28,7 @@ SRC = ROOT / "src"
 TOUR = (
     ("Looking at a mechanism", "tour/looking.md", "Looking at a mechanism"),
     ("Tour", "tour/index.md", "Tour"),
-    ("Inverse dynamics", "tour/dynamics.md", "Inverse dynamics"),
+    ("Dynamics", "tour/dynamics.md", "Dynamics"),
     ("The model", "tour/model.md", "The model and your own mechanism"),
     ("Design sweeps", "tour/sweeps.md", "Design sweeps"),
     ("The papers", "tour/papers.md", "The papers"),

@@ -1415,6 +1415,344 @@ def _fwd_dyn(g, adv):
                               g.value(np.zeros(mm.na), adv and g.chance(0.3), 1.0)), {}
 
 
+# the dynamic model, actuators, simulation (issue 29) -----------------------
+def _drives(acts) -> list:
+    """The numbers of drives (:class:`pkm.Actuator`), the reflected inertia and max effort with them; an ``inf``
+    limit (documented: none) read as 0, every other number must be finite."""
+    from pkm.core.model.actuators import LIMITS, NUMBERS
+
+    return [[0.0 if v == math.inf and f in (*LIMITS, "max_effort") else v
+             for f, v in ((f, getattr(a, f)) for f in (*NUMBERS, "reflected_inertia", "max_effort"))] for a in acts]
+
+
+def _drive_values(g: Gen, adversarial: bool, unknown: bool = True) -> dict:
+    """Some fields of an actuator: plausible, or (adversarial) one of them hostile, an unknown one (if ``unknown``:
+    not for a constructor, where Python refuses it), or a set that contradicts itself (peak below continuous), or
+    overflows (huge rotor inertia and ratio)."""
+    kw: dict = {}
+    for f in g.rng.permutation(("rotor_inertia", "gear_ratio", "armature", "viscous", "coulomb", "effort_limit",
+                                "peak_effort", "velocity_limit"))[:int(g.rng.integers(0, 5))]:
+        kw[str(f)] = {"rotor_inertia": 1e-5, "gear_ratio": 50.0, "armature": 1e-3, "viscous": 0.02, "coulomb": 0.1,
+                      "effort_limit": 20.0, "peak_effort": 60.0, "velocity_limit": 8.0}[str(f)] * \
+            float(g.rng.uniform(0.1, 3.0))
+    if "peak_effort" in kw and "effort_limit" in kw:
+        kw["peak_effort"] = max(kw["peak_effort"], kw["effort_limit"])
+    if adversarial:
+        r = int(g.rng.integers(5))
+        f = g.pick(("rotor_inertia", "gear_ratio", "armature", "viscous", "coulomb", "effort_limit", "peak_effort",
+                    "velocity_limit"))
+        if r <= 1:
+            kw[f] = g.pick(ADV_NUMBERS + ADV_OBJECTS[:12] + (np.float64(-2.0), np.int64(0), 10**400))
+        elif r == 2 and unknown:
+            kw[g.pick(("inertia", "damping", "", "joint", "gear"))] = 1.0
+        elif r <= 3:
+            kw.update(effort_limit=10.0, peak_effort=g.pick((5.0, 0.0, NAN, -10.0)))
+        else:
+            kw.update(rotor_inertia=g.pick((1e300, 1e200, 1e10)), gear_ratio=g.pick((1e300, 1e200, 1e10)),
+                      armature=g.pick((0.0, 1e308)))
+    return kw
+
+
+def _passive_name(mech) -> str:
+    """A joint of ``mech`` that is not actuated."""
+    return next(j for j in mech.joints if j not in mech.actuated_names)
+
+
+@entry("Actuator")
+def _actuator(g, adv):
+    from pkm import Actuator
+
+    joint = g.pick(("motor_1", "slider_2")) if not (adv and g.chance(0.1)) else g.hostile()
+    kw = _drive_values(g, adv, unknown=False)
+
+    def make(joint, **kw):
+        return _drives([Actuator(joint, **kw)])
+    return make, (joint,), kw
+
+
+@entry("pkm.with_actuators")
+def _with_actuators(g, adv):
+    from pkm import Actuator
+
+    c = ctx()
+    n, m = _mech(g, adv, ("rrr3", "delta", "prs3", "gough_stewart"))
+    mm = c.mech[n]
+    joint = g.pick(mm.actuated_names)
+    if g.chance(0.3):
+        try:
+            value: object = Actuator(joint, **_drive_values(g, False))
+        except c.pkm.PkmError:
+            value = {}
+    else:
+        value = _drive_values(g, adv)
+    drives: object = {joint: value}
+    if adv and g.chance(0.3):
+        drives = g.pick(({"no_such_joint": {}}, {_passive_name(mm): {}}, [joint],
+                         {joint: g.hostile()}, g.hostile(), {3: {}}, {joint: {"gear_ratio": "50"}}))
+
+    def run(mech, drives):
+        new = c.pkm.with_actuators(mech, drives)
+        return _drives(new.actuators), c.pkm.mass_matrix(new, new.q_reference)
+    return run, (m, drives), {}
+
+
+@entry("spec.actuators")
+def _spec_actuators(g, adv):
+    """The spec's ``[actuators.<joint>]`` tables, written into the spec's text, parsed and built into the model."""
+    c = ctx()
+    n = g.pick(("rrr3", "delta", "prs3"))
+    mm = c.mech[n]
+    joint = g.pick(mm.actuated_names)
+    lines = [f"{k} = {float(v)!r}" for k, v in _drive_values(g, False).items()]
+    table = f"\n[actuators.{joint}]\n" + "\n".join(lines) + "\n"
+    if adv:
+        r = int(g.rng.integers(8))
+        key = g.pick(("rotor_inertia", "gear_ratio", "viscous", "effort_limit", "peak_effort", "velocity_limit"))
+        if r == 0:
+            table += f"{key} = {g.pick(('nan', 'inf', '-inf', '-1.0', '0', '1e308', '-0.0', '1e-320'))}\n"
+        elif r == 1:
+            bad = g.pick(('"50"', "true", "[1.0]", "{ a = 1 }", "1979-05-27", "0x10"))
+            table += f"{key} = {bad}\n"
+        elif r == 2:
+            table += f"{g.pick(('inertia', 'joint', 'gear', 'damping'))} = 1.0\n"
+        elif r == 3:
+            table = f"\n[actuators.{g.pick(('no_such_joint', _passive_name(mm)))}]\n" \
+                "gear_ratio = 2.0\n"
+        elif r == 4:
+            table = g.pick(("\nactuators = 3\n", "\nactuators = [1, 2]\n", f"\n[actuators]\n{joint} = 5.0\n",
+                            "\n[[actuators]]\ngear_ratio = 1.0\n", f"\n[actuators.{joint}.sub]\na = 1.0\n"))
+        elif r == 5:
+            table += table  # the same table twice
+        elif r == 6:
+            table = f"\n[actuators.{joint}]\neffort_limit = 10.0\npeak_effort = 5.0\n"
+        else:
+            table = f"\n[actuators.{joint}]\nrotor_inertia = 1e300\ngear_ratio = 1e300\n"
+
+    def parse_and_build(spec_text):
+        from pkm.core.model.spec import ClosureSpec
+        spec = ClosureSpec.from_toml(spec_text)
+        mech = c.pkm.Mechanism.from_strings(c.urdf[n], spec)
+        return _drives(mech.actuators), sorted(spec.actuators)  # (the tables' inf limits: documented, none)
+    return parse_and_build, (c.spec[n] + table,), {}
+
+
+def _dyn_state(g: Gen, adversarial: bool, names=None):
+    """(name, mechanism or hostile, q, actuated rates) for the dynamic model."""
+    n, m = _mech(g, adversarial, names)
+    mm = ctx().mech[n]
+    q = _q(g, n, adversarial and g.chance(0.4))
+    qd = g.value(np.zeros(mm.na if g.chance(0.85) else mm.nv), adversarial and g.chance(0.4), 1.0)
+    return n, m, q, qd
+
+
+def _rtol_kwargs(g: Gen, adversarial: bool, names=("rtol",)) -> dict:
+    kw: dict = {}
+    if g.chance(0.25):
+        k = g.pick(names)
+        kw[k] = {"rtol": 1e-9, "coulomb_velocity": 1e-3, "mu": 1e-9, "max_iter": 100}[k] if not adversarial else \
+            g.pick(ADV_NUMBERS + (None, "1e-9", 0, 1.5, -3, 2.5))
+    return kw
+
+
+@entry("pkm.actuator_model")
+def _actuator_model(g, adv):
+    _, m, q, qd = _dyn_state(g, adv)
+    return ctx().pkm.actuator_model, (m, q, qd), _rtol_kwargs(g, adv, ("rtol", "coulomb_velocity"))
+
+
+@entry("ActuatorSpaceModel")
+def _actuator_model_methods(g, adv):
+    """The model's methods (efforts, accelerations, joint accelerations, energy) at a valid state, their
+    argument valid or hostile."""
+    c = ctx()
+    n, _, q, qd = _dyn_state(g, False)
+    na = c.mech[n].na
+    method = g.pick(("efforts", "accelerations", "joint_accelerations", "kinetic_energy"))
+    arg = g.value(np.zeros(na), adv, g.pick((0.1, 1.0, 100.0)))
+    kw = {"friction": g.chance(0.5)} if method == "accelerations" else {}
+
+    def run(mech, q, qd, arg, **kw):
+        model = c.pkm.actuator_model(mech, q, qd)
+        return model.kinetic_energy if method == "kinetic_energy" else getattr(model, method)(arg, **kw)
+    return run, (c.mech[n], q, qd, arg), kw
+
+
+@entry("pkm.mass_matrix")
+def _mass_matrix(g, adv):
+    _, m, q, _ = _dyn_state(g, adv)
+    return ctx().pkm.mass_matrix, (m, q), {}
+
+
+@entry("pkm.gravity_efforts")
+def _gravity_efforts(g, adv):
+    _, m, q, _ = _dyn_state(g, adv)
+    return ctx().pkm.gravity_efforts, (m, q), {}
+
+
+@entry("pkm.bias_efforts")
+def _bias_efforts(g, adv):
+    _, m, q, qd = _dyn_state(g, adv)
+    return ctx().pkm.bias_efforts, (m, q, qd), {}
+
+
+@entry("pkm.coriolis_matrix")
+def _coriolis(g, adv):
+    _, m, q, qd = _dyn_state(g, adv, ("rrr3", "delta", "prs3"))
+    return ctx().pkm.coriolis_matrix, (m, q, qd), _rtol_kwargs(g, adv)
+
+
+@entry("pkm.operational_space")
+def _operational_space(g, adv):
+    _, m, q, qd = _dyn_state(g, adv)
+    return ctx().pkm.operational_space, (m, q, qd), _rtol_kwargs(g, adv)
+
+
+def _forward_args(g: Gen, adversarial: bool, names=None):
+    """(mechanism, q, v, tau): ``v`` consistent with ``q`` where it is assembled (or zero), or hostile."""
+    c = ctx()
+    n, m, q, qd = _dyn_state(g, adversarial, names)
+    mm = c.mech[n]
+    v = np.zeros(mm.nv)
+    if not adversarial:
+        try:
+            v = c.pkm.passive_map(mm, q) @ qd[mm.act_v] if qd.shape == (mm.nv,) else c.pkm.passive_map(mm, q) @ qd
+        except (c.pkm.PkmError, ValueError):
+            pass
+    elif g.chance(0.5):
+        v = g.corrupt(v) if g.chance(0.5) else qd
+    tau = g.value(np.zeros(mm.na), adversarial and g.chance(0.4), g.pick((0.1, 10.0, 1e3)))
+    return m, q, v, tau
+
+
+@entry("pkm.forward_dynamics")
+def _forward_dynamics(g, adv):
+    m, q, v, tau = _forward_args(g, adv)
+    kw: dict = {"method": g.pick(("model", "constraint_dynamics") + (("khalil", None, 3, "") if adv else ()))}
+    if kw["method"] == "constraint_dynamics" or (adv and g.chance(0.2)):
+        kw.update(_rtol_kwargs(g, adv, ("mu",)))
+    return ctx().pkm.forward_dynamics, (m, q, v, tau), kw
+
+
+@entry("pkm.constraint_dynamics")
+def _constraint_dynamics(g, adv):
+    m, q, v, tau = _forward_args(g, adv, ("rrr3", "delta", "prs3", "gough_stewart", "hexapod"))
+    return ctx().pkm.constraint_dynamics, (m, q, v, tau), _rtol_kwargs(g, adv, ("mu", "max_iter"))
+
+
+def _driven(n: str):
+    """``n`` with drives that bind: rotor inertia, friction, peak effort and speed limits (made once)."""
+    c = ctx()
+
+    def make():
+        mech = c.mech[n]
+        drives = {j: {"rotor_inertia": 1e-5, "gear_ratio": 20.0, "viscous": 0.05, "coulomb": 0.05,
+                      "effort_limit": 2.0, "peak_effort": 5.0, "velocity_limit": 3.0} for j in mech.actuated_names}
+        return c.pkm.with_actuators(mech, drives)
+    return c.lazy(f"driven:{n}", make)
+
+
+def _controller(g: Gen, adversarial: bool, na: int):
+    """A controller ``(t, q, v) -> efforts``: a PD-like law, or (adversarial) one that raises, returns the wrong
+    shape or type, NaN, or efforts of absurd size."""
+    gain = float(g.pick((0.1, 1.0, 50.0)))
+    ref = None
+
+    def pd(t, q, v):
+        nonlocal ref
+        ref = q.copy() if ref is None else ref
+        return -gain * v[:na] - gain * (q[:na] - ref[:na])
+
+    if not adversarial:
+        return g.pick((pd, lambda t, q, v: np.full(na, 0.1 * math.sin(50 * t)), lambda t, q, v: [0.0] * na))
+    return g.pick((lambda t, q, v: 1 / 0, lambda t, q, v: np.zeros(na + 1), lambda t, q, v: np.zeros((na, 1)),
+                   lambda t, q, v: np.full(na, np.nan), lambda t, q, v: "efforts", lambda t, q, v: None,
+                   lambda t, q, v: np.full(na, 1e300), lambda t, q, v: np.full(na, 1e12), lambda t, q, v: [None] * na,
+                   lambda t, q, v: np.full(na, np.inf) if t > 0 else np.zeros(na), lambda t, q, v: 1.0,
+                   lambda t, q, v: q.__setitem__(0, np.nan), lambda: 0.0, lambda t, q, v: {"tau": 0},
+                   lambda t, q, v: np.zeros(na, dtype=complex) + 1j, pd, 3, "pd"))
+
+
+def _torques(g: Gen, adversarial: bool, na: int):
+    k = int(g.rng.integers(1, 5))
+    times = np.sort(g.rng.uniform(0.0, 0.005, k))
+    times += np.arange(k) * 1e-4  # strictly increasing
+    table = g.rng.normal(0.0, g.pick((0.1, 1.0)), (k, na))
+    if not adversarial:
+        return times, table
+    r = int(g.rng.integers(6))
+    if r == 0:
+        return times[::-1].copy() if k > 1 else np.array([0.0, 0.0]), table
+    if r == 1:
+        return g.corrupt(times), table
+    if r == 2:
+        return times, g.corrupt(table)
+    if r == 3:
+        return np.array([0.0, 0.001, 0.001]), np.zeros((3, na))
+    if r == 4:
+        return g.pick(((times,), (times, table, table), times, None, "t", [[0.0, [0.0] * na]]))
+    return g.pick(((np.zeros(0), np.zeros((0, na))), (times, table.T), (np.array([0.0, np.inf]), np.zeros((2, na)))))
+
+
+@entry("pkm.simulate")
+def _simulate(g, adv):
+    c = ctx()
+    n, m = _mech(g, adv, ("rrr3", "delta", "prs3", "delta", "rrr3", "gough_stewart", "hexapod"))
+    mm = c.mech[n]
+    if g.chance(0.3) and n != "hexapod" and m is mm:
+        m = mm = _driven(n)
+    kw: dict = {"duration": float(g.pick((1e-3, 2e-3, 3e-3))), "dt": 1e-3, "max_steps": 1000}  # (no long runs)
+    if g.chance(0.5):
+        kw["q0"] = g.pick((_q(g, n, False), mm.actuated_q(g.pick(c.assembled[n])), mm.q_reference))
+    if g.chance(0.4):
+        kw["v0"] = g.near(np.zeros(mm.na if g.chance(0.8) else mm.nv), g.pick((0.01, 0.5)))
+        if g.chance(0.2) and "q0" in kw and kw["q0"].shape == (mm.nq,):  # rates consistent with q0, all joints
+            try:
+                kw["v0"] = c.pkm.passive_map(mm, kw["q0"]) @ g.near(np.zeros(mm.na), 0.5)
+            except c.pkm.PkmError:
+                pass
+    if g.chance(0.4):
+        kw["controller"] = _controller(g, False, mm.na)
+    elif g.chance(0.3):
+        kw["torques"] = _torques(g, False, mm.na)
+    if g.chance(0.3) and n not in ("hexapod", "gough_stewart"):  # (Radau: the cheaper mechanisms)
+        kw["method"] = "radau"
+    for flag in ("friction", "saturate", "limits"):
+        if g.chance(0.15):
+            kw[flag] = g.chance(0.5)
+    if adv:
+        what = g.pick(("q0", "v0", "duration", "dt", "controller", "controller", "torques", "torques", "both",
+                       "method", "tols", "max_steps", "steps_beyond"))
+        if what == "q0":
+            kw["q0"] = g.corrupt(g.pick((mm.q_reference, mm.actuated_q(mm.q_reference))))
+        elif what == "v0":
+            kw["v0"] = g.corrupt(np.zeros(mm.na))
+        elif what in ("duration", "dt"):
+            kw[what] = g.pick(ADV_NUMBERS + ADV_OBJECTS[:10] + (1e-9, 1e-12, 10.0, np.array([1e-3])))
+        elif what == "controller":
+            kw.pop("torques", None)
+            kw["controller"] = _controller(g, True, mm.na)
+        elif what == "torques":
+            kw.pop("controller", None)
+            kw["torques"] = _torques(g, True, mm.na)
+        elif what == "both":
+            kw["controller"], kw["torques"] = _controller(g, False, mm.na), _torques(g, False, mm.na)
+        elif what == "method":
+            kw["method"] = g.pick(("RK4", "euler", "", None, 3, ["rk4"]))
+        elif what == "tols":
+            kw[g.pick(("singular_tol", "coulomb_velocity", "step_tol"))] = g.pick(ADV_NUMBERS + (None, "1e-3", 1.0))
+        elif what == "max_steps":
+            kw["max_steps"] = g.pick((0, -1, 2.5, True, None, "10", 10**400, np.int64(5), 1))
+        else:  # a run beyond max_steps (given, or the default)
+            kw.update(duration=g.pick((1e6, 1e300, 1e-2)), dt=g.pick((1e-3, 1e-9, 5e-324)), max_steps=g.pick((2, 5)))
+            if kw["duration"] > 1.0 and g.chance(0.5):
+                del kw["max_steps"]
+
+    def run(mech, **kw):
+        sim = c.pkm.simulate(mech, **kw)
+        return sim, sim.energy
+    return run, (m,), kw
+
+
 @entry("screws.transform")
 def _screw_transform(g, adv):
     from pkm.core.differential import screws

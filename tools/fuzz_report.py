@@ -27,7 +27,7 @@ Time bounds: every entry point may spend ``--entry-seconds`` (its calls' wall ti
 default: its fair share of the total, ``--total-seconds x --jobs / entries``), the whole run ``--total-seconds``
 (default 2700: 45 minutes) plus at most one call's bound. An entry point stopped by either before its ``--n`` calls
 is reported with the calls it got (``tried``) and why (``cut``: ``entry`` or ``total``); the table marks it ``*``.
-The full default run (86 entry points x 10,000 inputs on 2 cores) ends within the hour: the entry points that are
+The full default run (102 entry points x 10,000 inputs on 2 cores) ends within the hour: the entry points that are
 cheap get all 10,000, the slow ones their share of the time.
 
 Usage::

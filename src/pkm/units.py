@@ -3,8 +3,9 @@ command line.
 
 pkm computes in SI (m, rad, kg). Wherever the API takes a joint value, a task coordinate or a design
 parameter, it also takes a string with a unit suffix, converted here: lengths ``m cm mm``, angles
-``rad deg``, masses ``kg g``. A plain number (or a string without suffix) is SI. A suffix of another kind
-than the value's is refused (``"3deg"`` for a length), never silently converted::
+``rad deg``, masses ``kg g``, times ``s ms us`` (a simulation's duration and step). A plain number (or a string
+without suffix) is SI. A suffix of another kind than the value's is refused (``"3deg"`` for a length), never
+silently converted::
 
     pkm.quantity("20mm")             # 0.02
     pkm.quantity("5deg", "angle")    # 0.0873
@@ -28,9 +29,10 @@ SUFFIXES: dict[str, tuple[str, float]] = {
     "m": ("length", 1.0), "cm": ("length", 1e-2), "mm": ("length", 1e-3),
     "rad": ("angle", 1.0), "deg": ("angle", math.pi / 180.0),
     "kg": ("mass", 1.0), "g": ("mass", 1e-3),
+    "s": ("time", 1.0), "ms": ("time", 1e-3), "us": ("time", 1e-6),
 }
 #: The SI unit of each kind a suffix can convert to.
-SI_UNITS = {"length": "m", "angle": "rad", "mass": "kg"}
+SI_UNITS = {"length": "m", "angle": "rad", "mass": "kg", "time": "s"}
 #: The kind of each SI unit (``"m" -> "length"``).
 KIND_OF_UNIT = {v: k for k, v in SI_UNITS.items()}
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z]*)\s*$")
@@ -41,7 +43,7 @@ def parse_quantity(text: str, kinds: Collection[str | None], what: str = "value"
 
     Args:
         text: ``"120mm"``, ``"-11deg"``, ``"0.81"``.
-        kinds: Kinds the quantity may have (``"length"``, ``"angle"``, ``"mass"``; ``None``: a unit
+        kinds: Kinds the quantity may have (``"length"``, ``"angle"``, ``"mass"``, ``"time"``; ``None``: a unit
             without suffixes, e.g. ``kg m^2``); a plain number is always accepted (SI).
         what: Name of the quantity, for messages.
         unit: Its unit(s) as documented, for messages.
@@ -53,8 +55,8 @@ def parse_quantity(text: str, kinds: Collection[str | None], what: str = "value"
         raise UnitError(what, f"expected a number or a string such as '20mm', got {type(text).__name__}", text)
     m = _NUMBER.match(text)
     if not m:
-        raise UnitError(what, f"{what}={text!r} is not a number (with an optional unit: m, cm, mm, rad, deg, kg, g)",
-                        text)
+        raise UnitError(what, f"{what}={text!r} is not a number (with an optional unit: m, cm, mm, rad, deg, kg, g, "
+                              "s, ms, us)", text)
     value, suffix = float(m.group(1)), m.group(2)
     if not math.isfinite(value):
         raise UnitError(what, f"{what}={text!r} is not finite", text)
@@ -62,7 +64,7 @@ def parse_quantity(text: str, kinds: Collection[str | None], what: str = "value"
         return value
     if suffix not in SUFFIXES:
         raise UnitError(what, f"{what}={text}: unknown unit {suffix!r}; use m, cm, mm (lengths), rad, deg (angles), "
-                              f"kg, g (masses), or no unit for SI", text)
+                              f"kg, g (masses), s, ms, us (times), or no unit for SI", text)
     kind, factor = SUFFIXES[suffix]
     if kind not in kinds:
         accepted = [s for s, (k, _) in SUFFIXES.items() if k in kinds]
@@ -92,7 +94,7 @@ def quantity(value: object, kind: str | None = None, what: str = "value") -> flo
 
     Args:
         value: ``0.02``, ``"20mm"``, ``"5deg"``.
-        kind: ``"length"``, ``"angle"`` or ``"mass"`` to accept only that kind's units; None: any.
+        kind: ``"length"``, ``"angle"``, ``"mass"`` or ``"time"`` to accept only that kind's units; None: any.
         what: Its name, for messages.
 
     Raises:

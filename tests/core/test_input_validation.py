@@ -154,6 +154,9 @@ def test_forward_dynamics_with_redundant_closures_names_the_fix(rrr3):
         constraint_dynamics(rrr3, q, v, tau, mu=-1.0)
     with pytest.raises(InvalidInputError, match="method='constraint_dynamics'"):
         forward_dynamics(rrr3, q, v, tau, mu=1e-8)
+    for max_iter in (-1.0, 2.5, 0, "10", None, 10**400):  # (a fuzz finding: Boost.Python's ArgumentError)
+        with pytest.raises(InvalidInputError, match="max_iter"):
+            constraint_dynamics(rrr3, q, v, tau, max_iter=max_iter)
 
 
 def test_khalil_projection_checks_its_mechanism_and_wrench(delta):

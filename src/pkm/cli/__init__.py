@@ -6,6 +6,8 @@ Usage::
     pkm preview MECH [--param K=V ...] [--pose K=V ... | --joints NAME=V ...] [--html FILE] [--no-wait]
     pkm ik MECH --pose K=V ... [--param K=V ...] [--branch NAME]
     pkm fk MECH --joints NAME=V ... [--param K=V ...]
+    pkm dynamics MECH [--joints NAME=V ...] [--rates NAME=V ...] [--json]
+    pkm simulate MECH [--torques FILE.csv | --controller FILE.py:FN] [--duration 2s] [--dt 1ms] --out FILE
     pkm spec init MODEL [--out FILE] [--force]
     pkm report [--out DIR] [--paper NAME ...] [--no-figures] [--no-series]
     pkm bench [NAME ...] [--json] [--quick] [-- ARGS passed to each benchmark]

@@ -7,7 +7,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -187,22 +187,41 @@ def parse_pose(mech: pkm.Mechanism, items: Sequence[str]) -> tuple[dict[str, flo
     return values, values
 
 
-def parse_joints(mech: pkm.Mechanism, items: Sequence[str]) -> np.ndarray:
+def parse_joints(mech: pkm.Mechanism, items: Sequence[str], option: str = "--joints") -> np.ndarray:
     """``--joints`` items ``NAME=VALUE`` as actuated coordinates; actuated joints not named keep the reference.
 
     Raises:
         UsageError: Missing ``=`` or a bad number or unit.
         UnknownNameError: A name that is not an actuated joint.
     """
-    qa = mech.actuated_q(mech.q_reference)
+    return _actuated_items(mech, items, option, mech.actuated_q(mech.q_reference),
+                           lambda name, text: parse_quantity(text, {joint_kind(mech, name)}, name,
+                                                             SI_UNITS[joint_kind(mech, name)]))
+
+
+def parse_rates(mech: pkm.Mechanism, items: Sequence[str], option: str = "--rates") -> np.ndarray:
+    """Items ``NAME=VALUE`` as actuated rates, SI numbers [rad/s or m/s] (a unit suffix is refused: rad/s is not
+    rad); actuated joints not named: zero.
+
+    Raises:
+        UsageError: Missing ``=``; UnitError: not a number, or a unit suffix.
+        UnknownNameError: A name that is not an actuated joint.
+    """
+    return _actuated_items(mech, items, option, np.zeros(mech.na),
+                           lambda name, text: parse_quantity(text, {None}, name,
+                                                             "rad/s" if mech.joints[name].revolute else "m/s"))
+
+
+def _actuated_items(mech: pkm.Mechanism, items: Sequence[str], option: str, values: np.ndarray,
+                    parse: Callable[[str, str], float]) -> np.ndarray:
+    """``values`` (na,) with the actuated joints named by ``NAME=VALUE`` items set to ``parse(name, text)``."""
     names = list(mech.actuated_names)
     for item in items:
-        name, text = split_item(item, "--joints")
+        name, text = split_item(item, option)
         if name not in names:
             raise UnknownNameError("actuated joint", name, names, mech.name)
-        kind = joint_kind(mech, name)
-        qa[names.index(name)] = parse_quantity(text, {kind}, name, SI_UNITS[kind])
-    return qa
+        values[names.index(name)] = parse(name, text)
+    return values
 
 
 

@@ -43,7 +43,8 @@ Modules: :mod:`~pkm.viz.colors` (the palette), :mod:`~pkm.viz.body` (one drawn p
 :mod:`~pkm.viz.hull` (convex hulls), :mod:`~pkm.viz.bodies` (the bodies of a mechanism),
 :mod:`~pkm.viz.scene` (:class:`Scene`), :mod:`~pkm.viz.encode` (meshcat commands),
 :mod:`~pkm.viz.page` (the HTML page), :mod:`~pkm.viz.viewer` (the live viewer),
-:mod:`~pkm.viz.backend` (meshcat, imported on first use).
+:mod:`~pkm.viz.backend` (meshcat, imported on first use), :mod:`~pkm.viz.simulation` (the figure of a
+simulation: positions, speeds, efforts, energy).
 """
 
 from __future__ import annotations

@@ -26,7 +26,7 @@ import pytest
 import pkm
 from pkm.core.dynamics import model as dm
 from pkm.core.dynamics.projection import constraint_dynamics, energy
-from pkm.errors import InvalidInputError, SingularityError
+from pkm.errors import InvalidInputError, NonFiniteError, SingularityError
 from tests.fd import richardson
 from tests.test_acceptance import ACCEPTANCE
 from tests.test_gepetto_robots import ROOT
@@ -162,6 +162,21 @@ def test_bad_states_are_refused():
         pkm.operational_space(pkm.Mechanism.from_strings(mech.urdf, planar_task), q)
     with pytest.raises(InvalidInputError):
         pkm.actuator_model(mech, q, coulomb_velocity=0.0)
+
+
+def test_rates_that_are_not_numbers_and_efforts_that_overflow_are_refused():
+    """Fuzz findings: rates numpy cannot read as floats (a dict, a ragged list, an int beyond the floats, strings)
+    raise InvalidInputError naming ``qd`` (they raised TypeError, ValueError, OverflowError); efforts whose
+    accelerations overflow raise NonFiniteError (they gave NaN)."""
+    mech = mechanism("delta")
+    q = mech.q_reference
+    for qd in ({"value": np.zeros(3)}, [0.0, [1.0], 0.0], 10**400, np.array(["a", "b"])):
+        with pytest.raises(InvalidInputError, match="qd"):
+            pkm.actuator_model(mech, q, qd)
+    with pytest.raises(NonFiniteError):
+        pkm.actuator_model(mech, q).accelerations([0.0, -1e308, 1e308])
+    with pytest.raises(NonFiniteError):
+        pkm.forward_dynamics(mech, q, np.zeros(3), [0.0, -1e308, 1e308])
 
 
 def test_an_actuated_motion_without_mass_is_refused():

@@ -12,6 +12,7 @@ import pinocchio as pin
 import pytest
 
 import pkm
+import pkm.core.dynamics.simulate as simulate_module
 from pkm.errors import ControllerError, InvalidInputError, SingularityError
 from tests.core.dynamics.test_model import mechanism
 
@@ -153,6 +154,35 @@ def test_bad_input_is_refused():
         with pytest.raises(ControllerError, match=match) as info:
             pkm.simulate(mech, duration=0.01, controller=ctrl)
         assert info.value.time == 0.0
+
+
+def test_absurd_runs_and_unreadable_states_are_refused_by_name():
+    """Fuzz findings: ``duration / dt`` beyond the floats is a run beyond ``max_steps`` (math.ceil raised
+    OverflowError); rates and configurations numpy cannot read as floats are refused by name (TypeError,
+    ValueError)."""
+    mech = mechanism("delta")
+    for kwargs, name in (({"duration": 1e308}, "dt"), ({"duration": 1.0, "dt": 5e-324}, "dt"),
+                         ({"v0": {"value": [0.0, 0.0, 0.0]}}, "v0"), ({"v0": 10**400}, "v0"),
+                         ({"q0": [0.0] * 11 + [[1.0]]}, "q0"), ({"q0": [0.0, 0.0, [1.0]]}, "q0")):
+        with pytest.raises(InvalidInputError, match=name):
+            pkm.simulate(mech, **{"duration": 0.01, **kwargs})
+
+
+def test_radau_bounds_its_work_and_keeps_the_samples_before_a_stop(monkeypatch):
+    """A run shorter than a step is its initial sample (Radau was asked to integrate over nothing); past
+    ``RADAU_EVALUATIONS`` evaluations a sample (or ``RADAU_RATE`` a simulated second) the run stops with a ``"singularity"`` event and keeps the samples
+    reached (a state far too fast made Radau's steps shrink for ever; a stop inside the solver lost every sample
+    and raised IndexError). The bound is lowered here to keep the test quick."""
+    delta = mechanism("delta")
+    short = pkm.simulate(delta, duration=1e-12, method="radau")
+    assert len(short) == 1 and short.event is None and short.method == "radau"
+    monkeypatch.setattr(simulate_module, "RADAU_EVALUATIONS", 20)
+    monkeypatch.setattr(simulate_module, "RADAU_RATE", 0.0)
+    fast = pkm.simulate(delta, v0=[0.0, 1e30, 0.0], duration=2e-3, method="radau", limits=False)
+    assert len(fast) == 1 and fast.event.kind == "singularity" and "evaluations" in fast.event.detail
+    run = pkm.simulate(delta, v0=[0.0, 1.0, 0.0], duration=1e-2, method="radau")
+    assert 1 < len(run) < 11 and run.event.time == run.time[-1] and run.residual.max() <= 1e-12
+    assert np.allclose(run.time, np.arange(len(run)) * 1e-3, rtol=0, atol=1e-15)
 
 
 def test_a_run_cannot_start_at_a_singularity():

@@ -187,3 +187,109 @@ def test_a_urdf_named_xml_is_read_as_a_urdf(tmp_path):
     (tmp_path / "knee.closures.toml").write_text((knee / "knee.closures.toml").read_text().replace("knee.urdf",
                                                                                                      "knee.xml"))
     assert pkm.load(tmp_path / "knee.closures.toml").actuated_names == ("knee_front",)
+
+
+#: The drives' values in every form the reader takes: a default class's (joint and actuator), a motor's ctrlrange
+#: times gear under a joint's actuatorfrcrange, an asymmetric forcerange of a position servo, a fixed tendon's
+#: coefficient, a passive joint's damping (not read).
+DRIVES = """<mujoco model="drives">
+  <default>
+    <geom type="sphere" size="0.05" mass="1"/>
+    <default class="geared"><joint armature="0.02" damping="0.5" frictionloss="0.3"/><motor gear="20"/>
+      <position forcerange="-1.5 1.5"/></default>
+  </default>
+  <worldbody>
+    <body name="a"><joint name="ja" class="geared" axis="0 0 1"/><geom/>
+      <body name="b" pos="0.3 0 0"><joint name="jb" axis="0 0 1" damping="0.1" actuatorfrcrange="-4 4"/><geom/>
+        <body name="c" pos="0.3 0 0"><joint name="jc" type="slide" axis="1 0 0" armature="1.5"/><geom/>
+          <body name="d" pos="0.3 0 0"><joint name="jd" axis="0 0 1" damping="7"/><geom/></body>
+        </body>
+      </body>
+    </body>
+    <body name="e" pos="1 0 0"><joint name="je" axis="0 0 1"/><geom/></body>
+  </worldbody>
+  <tendon><fixed name="t"><joint joint="je" coef="0.5"/></fixed></tendon>
+  <actuator>
+    <motor name="ma" joint="ja" class="geared"/>
+    <motor name="mb" joint="jb" ctrlrange="-10 10" gear="2"/>
+    <position name="pc" joint="jc" kp="100" forcerange="-30 50"/>
+    <motor name="me" tendon="t" forcerange="-8 8" gear="3"/>
+  </actuator>
+</mujoco>"""
+
+
+def test_the_drives_are_read_in_joint_units_as_mujoco_applies_them():
+    """armature, damping, frictionloss as stated (classes included); the effort limit is the force MuJoCo's
+    actuators apply at full control, in the joint's units (gear, tendon coefficient, ctrlrange of a motor,
+    actuatorfrcrange), the smaller of the two directions; checked against MuJoCo's qfrc_actuator when installed."""
+    imp = read_mjcf(DRIVES, "drives.xml")
+    assert imp.actuators == {
+        "ja": {"armature": 0.02, "viscous": 0.5, "coulomb": 0.3, "effort_limit": 30.0},  # class: 1.5 x gear 20
+        "jb": {"viscous": 0.1, "effort_limit": 4.0},  # ctrlrange 10 x gear 2, held to actuatorfrcrange 4
+        "jc": {"armature": 1.5, "effort_limit": 30.0},  # [-30, 50]: the smaller magnitude
+        "je": {"effort_limit": 12.0}}  # 8 x gear 3 x coef 0.5
+    assert any("'pc'" in n and "[-30, 50] is not symmetric" in n for n in imp.notes)
+    assert any("'mb'" in n and "ctrlrange bounds joint jb" in n for n in imp.notes)
+    assert any("gains of <position name='pc'>" in n for n in imp.notes)
+    assert any("no actuator drives are not read: jd" in n for n in imp.notes)
+    try:
+        import mujoco
+    except ImportError:
+        return
+    m = mujoco.MjModel.from_xml_string(DRIVES)
+    d = mujoco.MjData(m)
+    reach = {}
+    for sign in (1.0, -1.0):
+        d.ctrl[:] = sign * 1e3
+        mujoco.mj_forward(m, d)
+        for joint in imp.actuators:
+            dof = m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, joint)]
+            reach[joint] = min(reach.get(joint, np.inf), abs(d.qfrc_actuator[dof]))
+    for joint, values in imp.actuators.items():
+        dof = m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, joint)]
+        assert reach[joint] == pytest.approx(values["effort_limit"], rel=1e-12), joint
+        assert (m.dof_armature[dof], m.dof_damping[dof], m.dof_frictionloss[dof]) == \
+            (values.get("armature", 0.0), values.get("viscous", 0.0), values.get("coulomb", 0.0))
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda s: s.replace('damping="0.1"', 'damping="-0.1"'), r"joint 'jb': viscous: .*-0\.1"),
+    (lambda s: s.replace('armature="1.5"', 'armature="heavy"'), r"joint 'jc' armature: 'heavy' is not"),
+    (lambda s: s.replace('gear="3"', 'gear="0"'), r"<motor name='me'> on joint 'je': gear 0"),
+    (lambda s: s.replace('forcerange="-8 8"', 'forcelimited="true"'), r"<motor name='me'> forcerange not given: "
+                                                                       r"a limited range needs lower < upper"),
+    (lambda s: s.replace('forcerange="-8 8"', 'forcerange="-8 nan"'), r"'me'> forcerange: .*not finite"),
+])
+def test_a_bad_drive_value_is_a_spec_error_naming_it(edit, message):
+    with pytest.raises(SpecError, match=message):
+        read_mjcf(edit(DRIVES), "drives.xml")
+
+
+def test_a_drive_one_way_or_unlimited_reads_as_the_range_allows():
+    """A one-sided range is read as its magnitude (a note says so); forcelimited="false", a range MuJoCo does not
+    apply (lower >= upper under "auto") and 1e6 or more read as no limit."""
+    one_sided = read_mjcf(DRIVES.replace('forcerange="-8 8"', 'forcerange="0 8"'), "d.xml")
+    assert one_sided.actuators["je"] == {"effort_limit": 12.0}
+    assert any("[0, 8] is one-sided" in n for n in one_sided.notes)
+    for edit in ('forcerange="-8 8" forcelimited="false"', 'forcerange="8 8"', 'forcerange="-1e30 1e30"'):
+        assert "je" not in read_mjcf(DRIVES.replace('forcerange="-8 8"', edit), "d.xml").actuators, edit
+
+
+def test_the_fourbars_drive_loads_saves_and_pickles(tmp_path):
+    """An MJCF file's drive values reach mech.actuators and the model's fields, and ride in the saved spec's
+    [actuators] tables (the URDF cannot carry an armature); a spec naming the file overrides them field by field."""
+    text = FOURBAR.read_text().replace('<joint name="crank_joint" range="-180 180"/>',
+                                       '<joint name="crank_joint" range="-180 180" armature="0.003" damping="0.05" '
+                                       'frictionloss="0.1"/>').replace('gear="1"/>', 'gear="2" forcerange="-1.5 1.5"/>')
+    (tmp_path / "fourbar.xml").write_text(text)
+    mech = pkm.load(tmp_path / "fourbar.xml")
+    assert mech.actuators == (pkm.Actuator("crank_joint", armature=0.003, viscous=0.05, coulomb=0.1, effort_limit=3.0),)
+    iv = mech.act_v[0]
+    assert (mech.model.armature[iv], mech.model.damping[iv], mech.model.effortLimit[iv]) == (0.003, 0.05, 3.0)
+    assert pkm.load(pkm.save(mech, tmp_path / "saved.closures.toml")).actuators == mech.actuators
+    assert pickle.loads(pickle.dumps(mech)).actuators == mech.actuators
+    spec = tmp_path / "fb.closures.toml"
+    spec.write_text('format = "pkm.closures/1"\nmechanism = "fb"\nurdf = "fourbar.xml"\nactuated = ["crank_joint"]\n'
+                    '[actuators.crank_joint]\nviscous = 0.2\n')
+    assert pkm.load(spec).actuators[0] == pkm.Actuator("crank_joint", armature=0.003, viscous=0.2, coulomb=0.1,
+                                                       effort_limit=3.0)

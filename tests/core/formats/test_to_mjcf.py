@@ -78,3 +78,60 @@ def test_mujoco_computes_the_same_efforts(name):
         q, v, a = _state(mech, seed)
         tau = pkm.inverse_dynamics(mech, q, v, a)
         assert np.abs(rigid.efforts(q, v, a) - tau).max() <= 1e-8 * max(1.0, np.abs(tau).max())
+
+
+def _drive_fields(a: pkm.Actuator) -> tuple[float, ...]:
+    return (a.reflected_inertia, a.viscous, a.coulomb, a.effort_limit)
+
+
+def test_the_drives_are_written_and_read_back(tmp_path):
+    """An MJCF file's armature, damping, frictionloss and force range (x gear) load into mech.actuators; written by
+    to_mjcf (gear 1, the effort as forcerange) and loaded again they are the same actuators (1e-12), and MuJoCo's
+    compiled model of the written file has them as dof_armature, dof_damping, dof_frictionloss, actuator_forcerange."""
+    text = FOURBAR.read_text().replace('<joint name="crank_joint" range="-180 180"/>',
+                                       '<joint name="crank_joint" range="-180 180" armature="0.003" damping="0.05" '
+                                       'frictionloss="0.1"/>').replace('gear="1"/>', 'gear="2" forcerange="-1.5 1.5"/>')
+    (tmp_path / "fourbar.xml").write_text(text)
+    mech = pkm.load(tmp_path / "fourbar.xml")
+    assert _drive_fields(mech.actuators[0]) == (0.003, 0.05, 0.1, 3.0)
+    written = mjcf_from_mechanism(mech)
+    (tmp_path / "again.xml").write_text(written)
+    back = pkm.load(tmp_path / "again.xml")
+    for a, b in zip(back.actuators, mech.actuators, strict=True):
+        assert a.joint == b.joint and a.velocity_limit == b.velocity_limit
+        np.testing.assert_allclose(_drive_fields(a), _drive_fields(b), rtol=1e-12, atol=0)
+    if unavailable() is None:
+        import mujoco
+
+        m = mujoco.MjModel.from_xml_string(written)
+        dof = m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "crank_joint")]
+        assert (m.dof_armature[dof], m.dof_damping[dof], m.dof_frictionloss[dof]) == (0.003, 0.05, 0.1)
+        assert m.actuator_forcerange.tolist() == [[-3.0, 3.0]] and m.actuator_gear[0, 0] == 1.0
+        assert m.actuator_forcelimited.tolist() == [1]
+
+
+def test_a_geared_drive_is_written_as_its_reflected_inertia_and_peak(tmp_path):
+    """armature = rotor_inertia gear_ratio^2 + armature; forcerange the peak when finite, else the continuous limit,
+    else none; no friction attribute when it is 0."""
+    from lxml import etree
+
+    mech = pkm.load(FOURBAR)
+    cases = [({"rotor_inertia": 1e-5, "gear_ratio": 30.0, "armature": 1e-3, "viscous": 0.2, "effort_limit": 4.0,
+               "peak_effort": 9.0}, 1e-5 * 900 + 1e-3, 9.0),
+             ({"effort_limit": 4.0}, None, 4.0),
+             ({}, None, None)]
+    for values, armature, force in cases:
+        drive = pkm.with_actuators(mech, {"crank_joint": values})
+        root = etree.fromstring(mjcf_from_mechanism(drive).encode())
+        joint = root.find(".//joint[@name='crank_joint']")
+        motor = root.find("actuator/motor")
+        assert joint.get("frictionloss") is None and motor.get("gear") == "1"
+        if armature is None:
+            assert joint.get("armature") is None
+        else:
+            assert float(joint.get("armature")) == pytest.approx(armature, rel=1e-15)
+        if force is None:
+            assert motor.get("forcerange") is None and motor.get("forcelimited") is None
+        else:
+            assert motor.get("forcelimited") == "true" and [float(x) for x in motor.get("forcerange").split()] == \
+                [-force, force]

@@ -8,7 +8,7 @@ what its command needs inside its functions, so that ``pkm --help`` stays fast.
 from __future__ import annotations
 
 from pkm.cli.command import Command
-from pkm.cli.commands import bench, fk, ik, preview, report, spec, sweep
+from pkm.cli.commands import bench, dynamics, fk, ik, preview, report, simulate, spec, sweep
 from pkm.cli.commands import list as list_
 from pkm.cli.commands import map as map_
 
@@ -18,6 +18,8 @@ COMMANDS: dict[str, Command] = {
     "ik": ik.COMMAND,
     "fk": fk.COMMAND,
     "map": map_.COMMAND,
+    "dynamics": dynamics.COMMAND,
+    "simulate": simulate.COMMAND,
     "spec": spec.COMMAND,
     "report": report.COMMAND,
     "bench": bench.COMMAND,

@@ -155,7 +155,8 @@ class ActuatorSpaceModel:
             SingularityError: ``kind="inertia"``: an actuated motion moves no mass (``M_a`` singular).
         """
         tau = self.mech.check_actuated(tau, "tau")
-        return _solve_inertia(self.M, tau + (self.friction if friction else 0.0) - self.h)
+        return finite_result(_solve_inertia(self.M, tau + (self.friction if friction else 0.0) - self.h),
+                             "actuated accelerations")
 
     def joint_accelerations(self, qdd: ArrayLike) -> np.ndarray:
         """All joint accelerations (nv,) for actuated ones: ``Ĝ qdd + a_b`` plus the idle accelerations that the
@@ -189,7 +190,10 @@ def _check_state(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None) -> tuple[M
     q = mech.check_q(q)
     if qd is None:
         return mech, q, np.zeros(mech.na)
-    arr = np.asarray(qd, dtype=float) if not isinstance(qd, str) else None
+    try:
+        arr = np.asarray(qd, dtype=float) if not isinstance(qd, str) else None
+    except (TypeError, ValueError, OverflowError):  # (check_actuated says what is wrong)
+        arr = None
     if arr is not None and arr.shape == (mech.nv,) and mech.nv != mech.na:
         return mech, q, mech.check_actuated(mech.check_v(arr, "qd")[mech.act_v], "qd")
     return mech, q, mech.check_actuated(qd, "qd")

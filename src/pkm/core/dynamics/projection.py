@@ -51,7 +51,7 @@ from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PkmError, SingularityError, SpecError
-from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
+from pkm.validation import as_count, as_scalar, as_tolerance, as_vector, finite_result
 
 RTOL = 1e-9
 
@@ -413,6 +413,7 @@ def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuate
     if mu is None:
         mu = 1e-9 if redundant else 0.0
     mu = as_scalar(mu, "mu", low=0.0)
+    max_iter = as_count(max_iter, "max_iter")
     if mu == 0.0 and redundant:
         raise SingularityError("constraint", float(s[-1]), "the closure equations are redundant (a planar "
                                                            "mechanism closed with 3-D points?): pass mu > 0, e.g. "

@@ -16,7 +16,9 @@ Integrators:
 * ``"radau"``: SciPy's Radau IIA (implicit, order 5, L-stable, adaptive step, output on the ``dt`` grid), for stiff
   cases: heavy viscous friction, a Coulomb friction's steep smoothed sign, high controller gains, where an explicit
   step must be tiny to stay stable. Each of its steps solves the implicit stages by Newton with a finite-difference
-  Jacobian of the closed-loop dynamics.
+  Jacobian of the closed-loop dynamics. Its work is bounded, as RK4's is: past :data:`RADAU_EVALUATIONS`
+  evaluations a sample or :data:`RADAU_RATE` a simulated second (whichever allows more), the run stops (a
+  ``"singularity"`` event: the motion is too fast to follow).
 
 The run stops with an :class:`Event`, keeping the samples up to it, where the motion
 
@@ -28,6 +30,17 @@ The run stops with an :class:`Event`, keeping the samples up to it, where the mo
 A controller is a callable ``(t, q, v) -> τ_a`` (``q`` the whole configuration, nq; ``v`` the joint rates, nv; the
 actuated ones are ``q[mech.act_q]`` and ``v[mech.act_v]``), or a sampled table ``(times, efforts)`` interpolated
 linearly (held outside its span).
+
+Backends (``backend=``): ``"python"`` runs every stage in Python as above; ``"c"`` runs the same ``"rk4"`` in
+generated C (:mod:`pkm.core.twin.simulation`: the closure's Newton, the actuator-space model, the efforts of a
+torque table or of no effort, the events' checks; a Python controller is called back once per stage, the rest in
+C). A step that the C route cannot settle as the Python route would (one to halve, one near an event, a fixed LU
+pivot that fails, a closure that does not converge) is taken by Python, then the run goes back to C: the two
+routes give the same samples (to about 1e-12) and the same events. ``"auto"`` (default) runs C where a C compiler
+exists, the method is ``"rk4"``, the mechanism has no idle motions and either this mechanism's simulation is
+already compiled or the run has at least :data:`AUTO_STEPS` steps (building costs about as much as that many
+Python steps); else Python. The C route's samples are assembled by one compiled batch (accelerations, task
+values, rates and accelerations, potential energy, residual).
 """
 
 from __future__ import annotations
@@ -35,6 +48,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
@@ -47,13 +61,20 @@ from pkm.core.kinematics.newton import least_squares
 from pkm.core.kinematics.solve import close_loops
 from pkm.core.kinematics.trajectory import Trajectory, _units
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.errors import ControllerError, InvalidInputError, PkmError, SingularityError
+from pkm.errors import CompilerError, ControllerError, InvalidInputError, PkmError, SingularityError, SpecError
 from pkm.validation import as_array, as_scalar
 
+if TYPE_CHECKING:
+    from pkm.core.twin.simulation import Simulator
+
 METHODS = ("rk4", "radau")
+BACKENDS = ("auto", "python", "c")
+AUTO_STEPS = 2000  # "auto" builds a mechanism's compiled simulation for runs of at least this many steps
 MAX_STEPS = 10_000_000  # a run of more steps than this is refused (its arrays alone would be gigabytes)
 CLOSURE_TOL = 1e-12
 MAX_HALVINGS = 8  # an RK4 step is halved at most this many times (a 1-ms step down to 4 us)
+RADAU_EVALUATIONS = 10 * 2 ** MAX_HALVINGS  # "radau" stops past this many evaluations a sample (RK4's worst case)
+RADAU_RATE = 1e6  # ... or a simulated second, whichever allows more (a stiff run with Coulomb friction takes 2e5)
 Controller = Callable[[float, np.ndarray, np.ndarray], ArrayLike]
 
 
@@ -207,14 +228,24 @@ def _controller(mech: Mechanism, controller: object, torques: object) -> Callabl
         raise InvalidInputError("torques", "the table holds non-finite values", torques)
     if np.any(np.diff(times) <= 0.0):
         raise InvalidInputError("torques", "the times must increase strictly", times)
-    return lambda t, q, v: np.array([np.interp(t, times, table[:, j]) for j in range(mech.na)])
+    return _Table(times, table)
+
+
+class _Table:
+    """A sampled torque table, interpolated linearly per actuator (held outside its span); the C route reads it."""
+
+    def __init__(self, times: np.ndarray, values: np.ndarray):
+        self.times, self.values = times, values
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return np.array([np.interp(t, self.times, self.values[:, j]) for j in range(self.values.shape[1])])
 
 
 def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None = None, duration: float = 1.0,
              dt: float = 1e-3, controller: Controller | None = None, *,
              torques: tuple[ArrayLike, ArrayLike] | None = None, method: str = "rk4", friction: bool = True,
              saturate: bool = True, limits: bool = True, singular_tol: float = 1e-3, coulomb_velocity: float = COULOMB_VELOCITY,
-             step_tol: float = 1e-9, max_steps: int = MAX_STEPS) -> Simulation:
+             step_tol: float = 1e-9, max_steps: int = MAX_STEPS, backend: str = "auto") -> Simulation:
     """Simulate ``mech`` from ``(q0, v0)`` for ``duration`` seconds (module doc).
 
     Args:
@@ -238,6 +269,7 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
             further than this from the stages' prediction [rad or m]: near a singularity the passive joints move
             fast and a fixed step would lose accuracy, or the assembly mode.
         max_steps: Refuse runs of more samples than this.
+        backend: ``"auto"``, ``"python"`` or ``"c"`` (module doc): where the ``"rk4"`` steps run.
 
     Returns:
         A :class:`Simulation` (with its :class:`Event` if it stopped early).
@@ -247,10 +279,13 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
             shape...).
         ControllerError: the controller raised or returned efforts of the wrong shape, or not finite.
         SingularityError: the initial state is singular.
+        CompilerError: ``backend="c"`` without a C compiler.
     """
     mech = check_mechanism(mech)
     if method not in METHODS:
         raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
+    if not isinstance(backend, str) or backend not in BACKENDS:
+        raise InvalidInputError("backend", f"use one of {list(BACKENDS)}, got {backend!r}", backend)
     duration = as_scalar(duration, "duration", low=0.0, strict_low=True)
     dt = as_scalar(dt, "dt", low=0.0, strict_low=True)
     singular_tol = as_scalar(singular_tol, "singular_tol", low=0.0)
@@ -258,14 +293,14 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
     step_tol = as_scalar(step_tol, "step_tol", low=0.0, strict_low=True)
     if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
         raise InvalidInputError("max_steps", "expected a positive integer", max_steps)
+    if duration / dt - 1e-9 > max_steps:  # (duration / dt may overflow to inf)
+        raise InvalidInputError("dt", f"{duration:g} s at dt = {dt:g} s is {duration / dt:.6g} steps, more than "
+                                      f"max_steps = {max_steps}: raise dt or max_steps, or shorten the run", dt)
     n_steps = math.ceil(duration / dt - 1e-9)
-    if n_steps > max_steps:
-        raise InvalidInputError("dt", f"{duration:g} s at dt = {dt:g} s is {n_steps} steps, more than max_steps = "
-                                      f"{max_steps}: raise dt or max_steps, or shorten the run", dt)
     ctrl = _controller(mech, controller, torques)
     if q0 is None:
         q = mech.q_reference.copy()
-    elif np.size(q0) == mech.na and mech.na != mech.nq:
+    elif np.size(np.asarray(q0, dtype=object)) == mech.na and mech.na != mech.nq:  # (object: ragged input counts)
         q = close_loops(mech, mech.check_actuated(q0, "q0", positions=True)).q
     else:
         q = mech.check_q(q0, "q0")
@@ -276,12 +311,20 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
     if v0 is None:
         qd = np.zeros(mech.na)
     else:
-        arr = np.asarray(v0, dtype=float) if not isinstance(v0, str) else np.zeros(0)
+        try:
+            arr = np.asarray(v0, dtype=float) if not isinstance(v0, str) else np.zeros(0)
+        except (TypeError, ValueError, OverflowError):  # (check_actuated says what is wrong)
+            arr = np.zeros(0)
         qd = mech.check_v(arr, "v0")[mech.act_v] if arr.shape == (mech.nv,) and mech.nv != mech.na \
             else mech.check_actuated(v0, "v0")
     dyn = _Dynamics(mech, ctrl, friction, saturate, bool(limits), singular_tol, coulomb_velocity, step_tol, q)
     x = np.concatenate([mech.actuated_q(q), qd])
-    run = _rk4 if method == "rk4" else _radau
+    sim = _compiled(mech, method, backend, n_steps)
+    if sim is not None:
+        table = ctrl if isinstance(ctrl, _Table) else _Table(np.zeros(1), np.zeros((1, mech.na))) \
+            if controller is None else None
+        return _rk4_c(dyn, sim, x, q, dt, n_steps, table)
+    run = _rk4 if method == "rk4" or n_steps == 0 else _radau  # (no step: the initial sample alone)
     return run(dyn, x, q, dt, n_steps, method)
 
 
@@ -336,18 +379,26 @@ class _Recorder:
         task_a = np.array([tm.jacobian(qq) @ aa + tm.bias(qq, vv) for qq, vv, aa in zip(q, v, a)])
         kinetic = np.array([m.kinetic_energy for m in self.models])
         potential = np.array([energy(mech, qq, np.zeros(mech.nv))[1] for qq in q])
-        t = np.array(self.t)
-        power = np.einsum("ij,ij->i", tau, qd)
         loss = -np.array([m.friction @ m.qd for m in self.models]) if self.dyn.friction else np.zeros(n)
-        steps = np.diff(t)
-        work = np.concatenate([[0.0], np.cumsum(0.5 * steps * (power[1:] + power[:-1]))])
-        dissipated = np.concatenate([[0.0], np.cumsum(0.5 * steps * (loss[1:] + loss[:-1]))])
-        units = _units(mech)
-        units["efforts"] = {j.name: "N m" if j.revolute else "N" for j in mech.actuated}
-        units["time"], units["energy"] = {"time": "s"}, {"energy": "J"}
         residual = np.array([np.max(np.abs(constraints.residual(mech, qq)), initial=0.0) for qq in q])
-        return Simulation(q, v, a, q[:, mech.act_q], qd, np.array(self.qdd), task, task_v, task_a, tau, residual,
-                          (), units, t, kinetic, potential, work, dissipated, event, method)
+        return _simulation(mech, np.array(self.t), q, v, a, qd, np.array(self.qdd), task, task_v, task_a, tau,
+                           residual, kinetic, potential, loss, event, method)
+
+
+def _simulation(mech: Mechanism, t: np.ndarray, q: np.ndarray, v: np.ndarray, a: np.ndarray, qd: np.ndarray,
+                qdd: np.ndarray, task: np.ndarray, task_v: np.ndarray, task_a: np.ndarray, tau: np.ndarray,
+                residual: np.ndarray, kinetic: np.ndarray, potential: np.ndarray, loss: np.ndarray, event: Event | None,
+                method: str) -> Simulation:
+    """The :class:`Simulation` of the samples' arrays (the work and the dissipated energy by the trapezoidal rule)."""
+    power = np.einsum("ij,ij->i", tau, qd)
+    steps = np.diff(t)
+    work = np.concatenate([[0.0], np.cumsum(0.5 * steps * (power[1:] + power[:-1]))])
+    dissipated = np.concatenate([[0.0], np.cumsum(0.5 * steps * (loss[1:] + loss[:-1]))])
+    units = _units(mech)
+    units["efforts"] = {j.name: "N m" if j.revolute else "N" for j in mech.actuated}
+    units["time"], units["energy"] = {"time": "s"}, {"energy": "J"}
+    return Simulation(q, v, a, q[:, mech.act_q], qd, qdd, task, task_v, task_a, tau, residual,
+                      (), units, t, kinetic, potential, work, dissipated, event, method)
 
 
 def _start(dyn: _Dynamics, x: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, ActuatorSpaceModel,
@@ -405,7 +456,7 @@ def _rk4(dyn: _Dynamics, x: np.ndarray, q: np.ndarray, dt: float, n_steps: int, 
 
 
 def _radau(dyn: _Dynamics, x0: np.ndarray, q: np.ndarray, dt: float, n_steps: int, method: str) -> Simulation:
-    from scipy.integrate import solve_ivp
+    from scipy.integrate import Radau
 
     mech = dyn.mech
     na = mech.na
@@ -420,13 +471,25 @@ def _radau(dyn: _Dynamics, x0: np.ndarray, q: np.ndarray, dt: float, n_steps: in
     _start(dyn, x0, q)
     rec = _Recorder(dyn)
     event = None
+    ts, xs = [0.0], [x0]  # (the samples reached, kept when the run stops)
+    budget = max(RADAU_EVALUATIONS * (n_steps + 1), RADAU_RATE * float(grid[-1]))
     try:
-        sol = solve_ivp(f, (0.0, grid[-1]), x0, method="Radau", t_eval=grid, rtol=1e-10, atol=1e-12,
-                        max_step=max(10.0 * dt, grid[-1] / 10.0))
-        xs, ts = sol.y.T, sol.t
+        solver = Radau(f, 0.0, x0, grid[-1], rtol=1e-10, atol=1e-12, max_step=max(10.0 * dt, grid[-1] / 10.0))
+        while len(ts) < len(grid):
+            message = solver.step()
+            if solver.status == "failed":
+                raise _Stop(Event("singularity", solver.t, f"Radau failed: {message}"))
+            interp = solver.dense_output()
+            while len(ts) < len(grid) and grid[len(ts)] <= solver.t:
+                ts.append(float(grid[len(ts)]))
+                xs.append(interp(ts[-1]))
+            if len(ts) < len(grid) and solver.nfev > budget:
+                raise _Stop(Event("singularity", solver.t, f"Radau's steps took more than {budget:.0f} evaluations "
+                                                           f"({RADAU_EVALUATIONS} a sample or {RADAU_RATE:g} a "
+                                                           "simulated second): the motion is too fast here (near a "
+                                                           "singularity, or a state far too fast)"))
     except _Stop as stop:
         event = stop.event
-        xs, ts = np.zeros((0, 2 * na)), np.zeros(0)
     seed[0] = q
     for t, x in zip(ts, xs):
         try:
@@ -442,4 +505,110 @@ def _radau(dyn: _Dynamics, x0: np.ndarray, q: np.ndarray, dt: float, n_steps: in
     return rec.result(event, method)
 
 
-__all__ = ["MAX_STEPS", "METHODS", "Controller", "Event", "Simulation", "simulate"]
+# ---------------------------------------------------------------------- the C route
+def _compiled(mech: Mechanism, method: str, backend: str, n_steps: int) -> Simulator | None:
+    """The compiled simulation where the backend and the run ask for it (module doc), else None."""
+    from pkm.core.twin import simulation
+
+    if backend == "python" or (backend == "auto" and n_steps < AUTO_STEPS and mech not in simulation._SIMULATORS):
+        return None
+    if method != "rk4":
+        if backend == "c":
+            raise InvalidInputError("backend", f"the C route runs method='rk4', not {method!r}", backend)
+        return None
+    try:
+        sim = simulation.simulator(mech)
+    except (SpecError, ValueError) as exc:  # (idle motions: the closure has no unique solution to step along)
+        if backend == "c":
+            raise InvalidInputError("backend", f"the C route does not run this mechanism: {exc}", backend) from None
+        return None
+    if sim.lib is None:
+        if backend == "c":
+            raise CompilerError("the compiled simulation (backend='c')", sim.how)
+        return None
+    return sim
+
+
+def _rk4_c(dyn: _Dynamics, sim: Simulator, x: np.ndarray, q: np.ndarray, dt: float, n_steps: int,
+           table: _Table | None) -> Simulation:
+    """``"rk4"`` in C (:mod:`pkm.core.twin.simulation`), a step the C route hands back taken by :func:`_rk4_step`."""
+    mech = dyn.mech
+    na, nq, nv = mech.na, mech.model.nq, mech.nv
+    n = n_steps + 1
+    rows = {"X": np.empty((n, 2 * na)), "Q": np.empty((n, nq)), "QDD": np.empty((n, na)), "V": np.empty((n, nv)),
+            "TAU": np.empty((n, na)), "KIN": np.empty(n), "FQD": np.empty(n)}
+
+    def put(i: int, x: np.ndarray, q: np.ndarray, model: ActuatorSpaceModel, tau: np.ndarray, k: np.ndarray) -> None:
+        rows["X"][i], rows["Q"][i], rows["QDD"][i], rows["V"][i], rows["TAU"][i] = x, q, k[na:], model.v, tau
+        rows["KIN"][i], rows["FQD"][i] = model.kinetic_energy, model.friction @ model.qd
+
+    k1, q, model, tau = _start(dyn, x, q)
+    put(0, x, q, model, tau, k1)
+    settings = np.array([1.0 if dyn.friction else 0.0, dyn.coulomb_velocity, 1.0 if dyn.saturate else 0.0,
+                         1.0 if dyn.limits else 0.0, dyn.singular_tol, dyn.step_tol, dt])
+    named = [(mech.joints[name].idx_q, lo, hi) for name, (lo, hi) in mech.limits.items() if name in mech.joints]
+    limits = (np.array([i for i, _, _ in named], dtype=np.int64), np.array([lo for _, lo, _ in named], dtype=float),
+              np.array([hi for _, _, hi in named], dtype=float))
+    speed = np.array([a.velocity_limit for a in mech.actuators], dtype=float)
+    effort = np.ascontiguousarray(dyn.limit, dtype=float)
+    failure: list[BaseException] = []
+
+    def call(t: float, qp: object, vp: object, taup: object) -> int:  # (the controller, called back from C)
+        try:
+            tau = dyn.efforts(t, np.ctypeslib.as_array(qp, (nq,)).copy(), np.ctypeslib.as_array(vp, (nv,)).copy())
+            np.ctypeslib.as_array(taup, (na,))[:] = tau
+        except BaseException as exc:  # (raised again below, out of C)
+            failure.append(exc)
+            return 1
+        return 0
+
+    tables = None if table is None else (np.ascontiguousarray(table.times, dtype=float),
+                                         np.ascontiguousarray(table.values, dtype=float))
+    done, event = 0, None
+    while done < n_steps:
+        done, code = sim.run(settings, effort, speed, limits, tables, call if table is None else None, done, n_steps,
+                             rows)
+        if code == 0:
+            break
+        if failure:
+            raise failure[0]
+        if code == 1:
+            raise CompilerError("the compiled simulation", "a generated function failed")
+        x, q, qdd = rows["X"][done].copy(), rows["Q"][done].copy(), rows["QDD"][done]
+        try:  # (the step the C route handed back: Python halves it, or stops, as the Python route)
+            x, q, model, tau, k = _rk4_step(dyn, done * dt, dt, x, np.concatenate([x[na:], qdd]), q,
+                                            rows["V"][done].copy(), 0)
+            _Recorder(dyn).check((done + 1) * dt, model)
+        except _Stop as stop:
+            event = Event(stop.event.kind, done * dt, stop.event.detail)
+            break
+        done += 1
+        put(done, x, q, model, tau, k)
+    return _c_result(dyn, sim, {key: value[:done + 1].copy() if done < n_steps else value
+                                for key, value in rows.items()}, dt, event)
+
+
+def _c_result(dyn: _Dynamics, sim: Simulator, rows: dict[str, np.ndarray], dt: float, event: Event | None) \
+        -> Simulation:
+    """The :class:`Simulation` of the C route's samples (one compiled batch; a sample whose LU pivot fails, by the
+    core, as :meth:`_Recorder.result`)."""
+    from pkm.core.twin.kernels import PIVOT_FLOOR
+
+    mech = dyn.mech
+    na = mech.na
+    Q, V, QDD, X = rows["Q"], rows["V"], rows["QDD"], rows["X"]
+    a, task, task_v, task_a, potential, residual, pivot = sim.samples(Q, V, QDD)
+    tm = mech.task_map
+    for k in np.flatnonzero(~(pivot[:, 0] >= PIVOT_FLOOR)):
+        model = _evaluate(mech, Q[k], X[k, na:], RTOL, dyn.coulomb_velocity)
+        a[k] = model.joint_accelerations(QDD[k])
+        task[k], task_v[k] = tm.value(Q[k]), tm.jacobian(Q[k]) @ V[k]
+        task_a[k] = tm.jacobian(Q[k]) @ a[k] + tm.bias(Q[k], V[k])
+        potential[k] = energy(mech, Q[k], np.zeros(mech.nv))[1]
+        residual[k] = np.max(np.abs(constraints.residual(mech, Q[k])), initial=0.0)
+    loss = -rows["FQD"] if dyn.friction else np.zeros(len(Q))
+    return _simulation(mech, np.arange(len(Q)) * dt, Q, V, a, X[:, na:], QDD, task, task_v, task_a, rows["TAU"],
+                       residual[:, 0], rows["KIN"], potential[:, 0], loss, event, "rk4")
+
+
+__all__ = ["AUTO_STEPS", "BACKENDS", "MAX_STEPS", "METHODS", "Controller", "Event", "Simulation", "simulate"]

@@ -33,6 +33,9 @@ class Imported:
         reference: Joint values the file states (an MJCF free body's pose), for ``[reference]``.
         notes: What the reader interpreted or ignored, one sentence each (a tendon actuator read as its joint, a
             velocity limit read as none...): :attr:`pkm.core.Mechanism.notes` after loading.
+        actuators: The drives' values the file states that its URDF text cannot carry, ``{actuated joint: {field:
+            value}}`` as a spec's ``[actuators.<joint>]`` tables (:mod:`pkm.core.model.actuators`; an MJCF
+            joint's ``armature``, its actuators' force limits...), under the spec's own.
     """
 
     urdf: str
@@ -44,6 +47,7 @@ class Imported:
     floating_base: str | None = None
     reference: dict[str, tuple[float, ...]] = dataclasses.field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    actuators: dict[str, dict[str, float]] = dataclasses.field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -42,12 +42,14 @@ def read_urdf(text: str, source: str = "<urdf>") -> Imported:
 
 
 def with_file(spec: ClosureSpec, imp: Imported, source: str) -> ClosureSpec:
-    """``spec`` with the loops, joint types and floating base of the model file it names added (the spec's win).
+    """``spec`` with the loops, joint types, floating base and the spec's actuated joints' drive values of the model
+    file it names added (the spec's win, a drive's field by field).
 
     Raises:
         SpecError: a closure named both in the spec and in the file.
     """
-    if not imp.closures and not imp.joint_types and imp.floating_base is None and not imp.reference:
+    if not imp.closures and not imp.joint_types and imp.floating_base is None and not imp.reference \
+            and not imp.actuators:
         return spec
     clash = sorted({c.name for c in spec.closures} & {c.name for c in imp.closures})
     if clash:
@@ -55,7 +57,9 @@ def with_file(spec: ClosureSpec, imp: Imported, source: str) -> ClosureSpec:
     return dataclasses.replace(spec, closures=imp.closures + spec.closures,
                                joint_types={**imp.joint_types, **spec.joint_types},
                                floating_base=spec.floating_base or imp.floating_base,
-                               reference={**imp.reference, **spec.reference})
+                               reference={**imp.reference, **spec.reference},
+                               actuators={j: {**imp.actuators.get(j, {}), **spec.actuators.get(j, {})}
+                                          for j in spec.actuated if j in imp.actuators or j in spec.actuators})
 
 
 def spec_skeleton(path: Path) -> tuple[str, bool]:

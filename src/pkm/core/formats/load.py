@@ -40,7 +40,7 @@ def load_model_file(path: Path) -> Mechanism:
     spec = ClosureSpec(mechanism=imp.name, urdf=path.name, end_effector=None, actuated=imp.actuated,
                        closures=imp.closures, task=TaskSpec((), imp.actuated), reference=dict(imp.reference),
                        description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types,
-                       floating_base=imp.floating_base)
+                       floating_base=imp.floating_base, actuators=imp.actuators)
     return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes)
 
 

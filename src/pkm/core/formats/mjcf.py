@@ -21,6 +21,16 @@ does not keep, from the file itself:
   the mimic couplings are substituted (Robotiq's ``0.5 right + 0.5 left`` with ``right = left`` drives
   ``left`` with factor 1). A tendon of several independent joints (a differential) or a ``<spatial>``
   tendon is refused; actuators on sites or bodies (forces, not joint inputs) are left out with a note;
+* the drive of each actuated joint (:attr:`Imported.actuators`, a spec's ``[actuators.<joint>]`` tables: the URDF
+  text cannot carry them; :mod:`pkm.core.model.actuators`), class defaults included (MuJoCo's actuator elements
+  share one default per class): the joint's ``armature`` (MuJoCo's is the reflected inertia) -> ``armature``,
+  ``damping`` -> ``viscous``, ``frictionloss`` -> ``coulomb``; ``effort_limit``, in the joint's units, is what the
+  actuators apply at full control: each one's ``forcerange`` when it limits (``forcelimited="true"``, or ``auto`` with
+  lower < upper), for a ``<motor>`` its ``ctrlrange`` too (a motor's force is its control), times the first
+  ``gear`` and the tendon's coefficient or the mimic scale; several actuators on one joint add; the joint's
+  ``actuatorfrcrange`` caps the sum. An asymmetric range reads as its smaller magnitude, a one-sided one as its
+  larger (a note says so), ``1e6`` or more as none. What is not stated stays at the defaults (no friction, no
+  limit); the servo gains (``kp``, ``kv``) and the drives of joints no actuator moves are not read (notes);
 * joint names and position limits (``range``, in degrees unless ``<compiler angle="radian">``, for
   hinges only; a slide's range is a length), with ``<default>`` classes and ``childclass``; a body with
   several joints keeps each one's name (Pinocchio joins them into one composite joint). ``q`` is MuJoCo's
@@ -48,7 +58,8 @@ a name (pkm names them in file order in its copy); it drops the
 ``pos`` a default class gives a joint (Robotiq 2F-85's followers), a geom or a site (pkm writes every class
 attribute on the joints, geoms and sites of its copy). Refused with a
 :class:`~pkm.errors.SpecError`: ``<include>`` (pkm reads one self-contained file), equalities other than
-``connect``/``weld``/``joint``, joint types other than hinge, slide, ball, free. What the reader interprets
+``connect``/``weld``/``joint``, joint types other than hinge, slide, ball, free, a drive's negative or non-numeric
+value, a limited range whose lower bound is not below its upper, a gear of 0. What the reader interprets
 or leaves out (tendons read as joints, contacts, sensors...) is listed in :attr:`Imported.notes`. Meshes are
 not read (kinematics and dynamics need none).
 """
@@ -65,9 +76,10 @@ import pinocchio as pin
 from lxml import etree
 
 from pkm.core.formats.base import Imported
+from pkm.core.model.actuators import UNLIMITED, Actuator
 from pkm.core.model.spec import Closure
 from pkm.core.model.urdf import floats, num, parse_xml, urdf_from_model
-from pkm.errors import SpecError, SpecNameError
+from pkm.errors import InvalidInputError, SpecError, SpecNameError
 
 _ACTUATORS = ("motor", "position", "velocity", "general", "intvelocity", "damper", "cylinder", "muscle",
               "adhesion")
@@ -101,9 +113,14 @@ class _Defaults:
                 self._walk(child, name)
             elif isinstance(child.tag, str):
                 self.attrs.setdefault((name, child.tag), {}).update(child.attrib)
+                if child.tag in _ACTUATORS:  # MuJoCo's actuator shortcuts share one default per class
+                    self.attrs.setdefault((name, "<actuator>"), {}).update(child.attrib)
 
     def chain(self, el: etree._Element) -> list[dict[str, str]]:
-        """The attributes the classes give ``el``, its own class (or the nearest ``childclass``) first."""
+        """The attributes the classes give ``el``, its own class (or the nearest ``childclass``) first (an
+        actuator: those any actuator element of the class gives, as MuJoCo shares them)."""
+        tag = "<actuator>" if el.tag in _ACTUATORS and el.getparent() is not None \
+            and el.getparent().tag == "actuator" else el.tag
         cls = el.get("class")
         node = el.getparent()
         while cls is None and node is not None:
@@ -111,7 +128,7 @@ class _Defaults:
             node = node.getparent()
         out, at = [], cls or "main"
         while at is not None:
-            out.append(self.attrs.get((at, el.tag), {}))
+            out.append(self.attrs.get((at, tag), {}))
             at = self.parent.get(at)
         return out
 
@@ -477,7 +494,9 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
         plain, _ = urdf_from_model(model, limits=limits, **kwargs)
         order = {n: k for k, n in enumerate(pin.buildModelFromXML(plain).names)}
         couplings.lead(order)
-    actuated = _actuated(root, kinds, couplings, notes, source)
+    drives = _actuated(root, kinds, couplings, notes, source)
+    actuated = [d.joint for d in drives]
+    actuators = _drives(drives, defaults, world, notes, source)
     mimic = couplings.followers()
     for j, (lead, m, c) in mimic.items():  # a follower's range bounds its leader; Pinocchio gives a mimic none
         if j in limits:
@@ -492,7 +511,7 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
     if len(set(actuated)) < len(actuated):
         notes.append("several actuators drive the same joint: it is one input")
     return Imported(urdf, tuple(closures), types, tuple(dict.fromkeys(actuated)), name, "mjcf", _floating_base(model), reference,
-                    tuple(notes))
+                    tuple(notes), actuators)
 
 
 def _joint_equalities(els: list[etree._Element], kinds: dict[str, str], refs: dict[str, float], notes: list[str],
@@ -539,14 +558,23 @@ def _tendons(root: etree._Element, source: str) -> dict[str, list[tuple[str, flo
     return out
 
 
+class _Drive(NamedTuple):
+    """An ``<actuator>`` element on an independent joint."""
+
+    joint: str  # the independent joint it drives
+    factor: float  # the effort on ``joint`` per unit of the transmission's effort (a mimic's scale, a tendon's coef)
+    el: etree._Element
+    label: str
+
+
 def _actuated(root: etree._Element, kinds: dict[str, str], couplings: _Couplings, notes: list[str],
-              source: str) -> list[str]:
-    """The independent joints the ``<actuator>`` elements drive, in file order (see the module doc)."""
+              source: str) -> list[_Drive]:
+    """The ``<actuator>`` elements that drive independent joints, in file order (see the module doc)."""
     tendons = _tendons(root, source)
     driven = {el.get("tendon") for el in root.findall("actuator/*") if isinstance(el.tag, str)}
     if set(tendons) - driven:
         notes.append(f"tendons no actuator drives ({', '.join(sorted(set(tendons) - driven))}) not read")
-    out: list[str] = []
+    out: list[_Drive] = []
     for k, el in enumerate(root.findall("actuator/*"), 1):
         if not isinstance(el.tag, str):
             continue
@@ -564,9 +592,9 @@ def _actuated(root: etree._Element, kinds: dict[str, str], couplings: _Couplings
             if a.root != joint:
                 notes.append(f"{label} drives {joint} = {a.scale:.6g} {a.root} + {a.offset:.6g}: read as actuated "
                              f"joint {a.root}")
-            out.append(a.root)
+            out.append(_Drive(a.root, a.scale, el, label))
         elif tendon:
-            out.append(_tendon_joint(label, tendon, tendons, kinds, couplings, notes, source))
+            out.append(_Drive(*_tendon_joint(label, tendon, tendons, kinds, couplings, notes, source), el, label))
         else:
             target = next((f"{key} {el.get(key)!r}" for key in ("site", "body", "refsite") if el.get(key)), "nothing")
             notes.append(f"{label} acts on {target}, not on a joint coordinate: left out")
@@ -574,8 +602,9 @@ def _actuated(root: etree._Element, kinds: dict[str, str], couplings: _Couplings
 
 
 def _tendon_joint(label: str, tendon: str, tendons: dict[str, list[tuple[str, float]] | None],
-                  kinds: dict[str, str], couplings: _Couplings, notes: list[str], source: str) -> str:
-    """The one independent joint a fixed tendon's length is an affine function of, with the mimic couplings."""
+                  kinds: dict[str, str], couplings: _Couplings, notes: list[str], source: str) -> tuple[str, float]:
+    """The one independent joint a fixed tendon's length is an affine function of, with the mimic couplings, and
+    the length's rate per unit of that joint's."""
     if tendon not in tendons:
         raise SpecNameError(source, "tendon", tendon, list(tendons), label)
     parts = tendons[tendon]
@@ -598,7 +627,96 @@ def _tendon_joint(label: str, tendon: str, tendons: dict[str, list[tuple[str, fl
     (joint, factor), = moving.items()
     notes.append(f"tendon {tendon!r} ({text}) of {label} read as actuated joint {joint} (length = {factor:.6g} "
                  f"{joint} + constant)")
-    return joint
+    return joint, factor
+
+
+_DRIVE_KEYS = (("armature", "armature"), ("damping", "viscous"), ("frictionloss", "coulomb"))  # MJCF -> Actuator
+_SERVOS = ("position", "velocity", "intvelocity", "damper")  # actuators whose gains make the force of a target
+
+
+def _range(el: etree._Element, defaults: _Defaults, key: str, what: str, source: str) -> tuple[float, float] | None:
+    """A ``forcerange``, ``ctrlrange`` or ``actuatorfrcrange`` when it limits (MuJoCo: ``<...>limited="true"``, or
+    ``"auto"`` and the range's lower bound below its upper), else None."""
+    text = defaults.get(el, key)
+    limited = defaults.get(el, key.replace("range", "limited"), "auto")
+    lo, hi = floats(text, 2, what, source, bound=np.inf) if text is not None else (0.0, 0.0)
+    if limited == "true" and not lo < hi:
+        stated = repr(text) if text is not None else "not given"
+        raise SpecError(source, f"{what} {stated}: a limited range needs lower < upper (MuJoCo refuses it)")
+    return (lo, hi) if limited != "false" and lo < hi else None
+
+
+def _magnitude(bounds: tuple[float, float], what: str, notes: list[str]) -> float:
+    """The symmetric limit pkm reads from ``(lower, upper)``: the smaller magnitude (a one-sided range: the larger),
+    ``inf`` from ``UNLIMITED`` on; a note says when the range is not symmetric."""
+    lo, hi = bounds
+    small, large = sorted((abs(lo), abs(hi)))
+    if small == 0.0:
+        notes.append(f"{what} [{lo:g}, {hi:g}] is one-sided: read as the symmetric limit {large:g}")
+        small = large
+    elif lo != -hi:
+        notes.append(f"{what} [{lo:g}, {hi:g}] is not symmetric: read as the smaller magnitude, {small:g}")
+    return np.inf if small >= UNLIMITED else small
+
+
+def _drives(drives: list[_Drive], defaults: _Defaults, world: etree._Element, notes: list[str],
+            source: str) -> dict[str, dict[str, float]]:
+    """``{joint: {field: value}}`` (:mod:`pkm.core.model.actuators`) of the driven joints, the values the file
+    states only: the joint's ``armature``, ``damping``, ``frictionloss``, and the effort limit of its actuators
+    (see the module doc).
+
+    Raises:
+        SpecError: a value that is not a number, a negative one, a limited range with lower >= upper, a gear of 0.
+    """
+    elements = {str(j.get("name")): j for j in world.iter("joint", "freejoint")}
+    efforts: dict[str, float] = {}
+    for d in drives:
+        gear = floats(((defaults.get(d.el, "gear") or "").split() or ["1"])[0], 1, f"{d.label} gear", source,
+                      np.inf)[0]
+        scale = abs(gear * d.factor)
+        if scale == 0.0:
+            raise SpecError(source, f"{d.label} on joint {d.joint!r}: gear 0 transmits no effort")
+        limit = np.inf
+        force = _range(d.el, defaults, "forcerange", f"{d.label} forcerange", source)
+        if force is not None:
+            limit = _magnitude(force, f"{d.label} forcerange", notes)
+        ctrl = _range(d.el, defaults, "ctrlrange", f"{d.label} ctrlrange", source) if d.el.tag == "motor" else None
+        if ctrl is not None and (m := _magnitude(ctrl, f"{d.label} ctrlrange", notes)) < limit:
+            limit = m
+            notes.append(f"{d.label}: a motor's force is its control: its ctrlrange bounds joint {d.joint}'s effort")
+        if scale != 1.0 and np.isfinite(limit):
+            by = f"gear {gear:g}" + (f" x coupling {d.factor:g}" if d.factor != 1.0 else "")
+            notes.append(f"{d.label}: force limit {limit:g} x {by} read as joint {d.joint}'s effort limit "
+                         f"{limit * scale:g}")
+        efforts[d.joint] = efforts.get(d.joint, 0.0) + limit * scale  # several actuators on one joint: they add
+    servos = [d.label for d in drives if d.el.tag in _SERVOS]
+    if servos:
+        notes.append(f"the gains of {', '.join(servos)} are not read: pkm's input is the joint effort (their force "
+                     "range bounds it)")
+    out: dict[str, dict[str, float]] = {}
+    for joint, effort in efforts.items():
+        el, values = elements[joint], {}
+        for key, field in _DRIVE_KEYS:
+            value = floats(defaults.get(el, key, "0"), 1, f"joint {joint!r} {key}", source, np.inf)[0]
+            if value != 0.0:
+                values[field] = value
+        own = _range(el, defaults, "actuatorfrcrange", f"joint {joint!r} actuatorfrcrange", source)
+        if own is not None:
+            effort = min(effort, _magnitude(own, f"joint {joint!r} actuatorfrcrange", notes))
+        if np.isfinite(effort):
+            values["effort_limit"] = float(effort)
+        try:
+            Actuator(joint, **values)
+        except InvalidInputError as exc:
+            raise SpecError(source, f"joint {joint!r}: {exc}") from None
+        if values:
+            out[joint] = values
+    passive = [n for n, el in elements.items() if n not in efforts
+               and any((defaults.get(el, key) or "0").strip() not in ("0", "0.0") for key, _ in _DRIVE_KEYS)]
+    if passive:
+        notes.append(f"armature, damping and frictionloss of joints no actuator drives are not read: "
+                     f"{', '.join(passive)}")
+    return out
 
 
 def _free_bodies(model: pin.Model, world: etree._Element, degrees: bool, source: str) -> dict[int, pin.SE3]:

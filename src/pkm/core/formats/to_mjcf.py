@@ -7,6 +7,15 @@ leader by a ``<joint>`` equality ``q = offset + scale q_leader``), a site at eac
 (point closure) or ``<weld>`` (frame closure) between the two sites, a ``<motor>`` on each actuated joint.
 Gravity is the model's, contacts are disabled, no joint is limited (MuJoCo would add limit rows).
 
+Each actuated joint's drive (:attr:`~pkm.core.Mechanism.actuators`, :mod:`pkm.core.model.actuators`) is written in
+the joint's units: the joint's ``armature`` is :attr:`~pkm.core.model.actuators.Actuator.reflected_inertia`
+(``rotor_inertia * gear_ratio**2 + armature``), its ``damping`` the viscous friction, its ``frictionloss`` the
+Coulomb friction (each left out when 0); its ``<motor>`` has ``gear="1"`` and, when the drive's effort is bounded,
+``forcelimited="true" forcerange="-F F"`` with ``F`` the peak effort if finite, else the continuous limit (what a
+simulation may apply, as :func:`pkm.simulate` saturates). MJCF has no joint speed limit and one force range: the
+velocity limit is not written, and a drive read back has ``F`` as its (continuous) ``effort_limit``, the rotor's
+inertia and ratio folded into ``armature``.
+
 pkm's own MJCF reader loads the file back (:mod:`pkm.core.formats.mjcf`), which tests the writer; MuJoCo reads it
 for the benchmark baseline (:mod:`pkm.bench.mujoco_baseline`). Not written: planar and other composite joints, a
 free-flyer below the root (MuJoCo allows free joints only on top-level bodies), geometry; each refusal is a
@@ -119,8 +128,17 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None) -> str:
                          site2=sites[1])
     root.append(equality)
     actuator = etree.SubElement(root, "actuator")
-    for joint in mech.actuated:
-        etree.SubElement(actuator, "motor", name=f"{model.names[joint.id]}_motor", joint=model.names[joint.id])
+    for joint, drive in zip(mech.actuated, mech.actuators):
+        name = model.names[joint.id]
+        el = next(e for e in world.iter("joint") if e.get("name") == name)
+        for key, value in (("armature", drive.reflected_inertia), ("damping", drive.viscous),
+                           ("frictionloss", drive.coulomb)):
+            if value != 0.0:
+                el.set(key, repr(value))
+        motor = etree.SubElement(actuator, "motor", name=f"{name}_motor", joint=name, gear="1")
+        if np.isfinite(drive.max_effort):  # the peak limit when there is one, else the continuous one
+            motor.set("forcelimited", "true")
+            motor.set("forcerange", _num([-drive.max_effort, drive.max_effort]))
     return etree.tostring(root, pretty_print=True, encoding="unicode")
 
 

@@ -14,12 +14,13 @@ An :class:`Actuator` holds what the dynamics needs of a drive, in the joint's ow
 
 Where the values come from, later sources overriding earlier ones per field:
 
-1. the model file, through Pinocchio's own fields of the model (``armature``, ``rotorInertia``,
-   ``rotorGearRatio``, ``damping``, ``friction``, ``effortLimit``, ``velocityLimit``): URDF ``<limit effort
-   velocity>`` and ``<dynamics damping friction>``, MJCF ``armature``, ``damping``, ``frictionloss``; the MJCF
-   reader also passes ``gear`` and ``forcerange``/``ctrlrange`` of the joint's motor (see
-   :mod:`pkm.core.formats.mjcf`). A limit of 0 or of at least 1e6 in a file means "not given" (exporters write
-   ``effort="0"`` on passive joints and ``1e30`` for "unlimited"); it reads as ``inf``;
+1. the model file: a URDF through Pinocchio's own fields of the model (``armature``, ``rotorInertia``,
+   ``rotorGearRatio``, ``damping``, ``friction``, ``effortLimit``, ``velocityLimit``: ``<limit effort
+   velocity>`` and ``<dynamics damping friction>``); an MJCF through the reader's table
+   (:attr:`pkm.core.formats.base.Imported.actuators`: joint ``armature``, ``damping``, ``frictionloss``, the
+   motor's ``gear`` times its ``forcerange``/``ctrlrange``; see :mod:`pkm.core.formats.mjcf`). A limit of 0 or of
+   at least 1e6 in a file means "not given" (exporters write ``effort="0"`` on passive joints and ``1e30`` for
+   "unlimited"); it reads as ``inf``;
 2. the closure spec's ``[actuators.<joint>]`` tables (:mod:`pkm.core.model.spec`), keys as the attributes below::
 
        [actuators.motor_1]
@@ -79,11 +80,16 @@ class Actuator:
     velocity_limit: float = math.inf
 
     def __post_init__(self) -> None:
+        if not isinstance(self.joint, str):
+            raise InvalidInputError("joint", f"expected the actuated joint's name, got {self.joint!r}", self.joint)
         for f in NUMBERS:
             value = getattr(self, f)
             if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
                 raise InvalidInputError(f, f"actuator {self.joint!r}: expected a number, got {value!r}", value)
-            value = float(value)
+            try:
+                value = float(value)
+            except OverflowError:  # (an int beyond the floats)
+                value = math.inf if value > 0 else -math.inf
             if math.isnan(value) or value < 0.0 or (math.isinf(value) and f not in LIMITS):
                 raise InvalidInputError(f, f"actuator {self.joint!r}: {f} must be a finite number >= 0"
                                            f"{' (or inf: none)' if f in LIMITS else ''}, got {value!r}", value)
@@ -93,14 +99,17 @@ class Actuator:
             zero = next(f for f in ("gear_ratio", "effort_limit", "peak_effort", "velocity_limit")
                         if getattr(self, f) == 0.0)
             raise InvalidInputError(zero, f"actuator {self.joint!r}: {zero} must be > 0", 0.0)
-        if self.peak_effort < self.effort_limit and math.isfinite(self.peak_effort):
+        if math.isfinite(self.peak_effort) and math.isfinite(self.effort_limit) and self.peak_effort < self.effort_limit:
             raise InvalidInputError("peak_effort", f"actuator {self.joint!r}: the peak effort {self.peak_effort:g} is "
                                                    f"below the continuous limit {self.effort_limit:g}", self.peak_effort)
+        if not math.isfinite(self.reflected_inertia):
+            raise InvalidInputError("rotor_inertia", f"actuator {self.joint!r}: the reflected inertia rotor_inertia * "
+                                                     "gear_ratio**2 + armature overflows", self.rotor_inertia)
 
     @property
     def reflected_inertia(self) -> float:
         """``rotor_inertia * gear_ratio**2 + armature`` [kg m^2 or kg]: the inertia the joint feels."""
-        return self.rotor_inertia * self.gear_ratio ** 2 + self.armature
+        return self.rotor_inertia * self.gear_ratio * self.gear_ratio + self.armature  # (no pow: it raises on overflow)
 
     @property
     def max_effort(self) -> float:
@@ -150,12 +159,18 @@ def _limit(value: float) -> float:
 
 def from_model(model: pin.Model, joint: str, idx_v: int, overrides: Mapping[str, float] | None = None) -> Actuator:
     """The actuator of ``joint`` (velocity index ``idx_v``) from Pinocchio's fields of ``model``, then
-    ``overrides`` (a spec's table)."""
+    ``overrides`` (a spec's table).
+
+    Pinocchio's ``armature`` is read as the whole reflected inertia (what its algorithms use), so the actuator's
+    own ``armature`` is what it holds beyond ``rotorInertia * rotorGearRatio**2`` (none if it holds less): a model
+    written by :func:`write_model` reads back the same actuator."""
     ratio = float(model.rotorGearRatio[idx_v])
+    ratio = ratio if ratio > 0.0 and math.isfinite(ratio) else 1.0
+    rotor = max(float(model.rotorInertia[idx_v]), 0.0)
     base = Actuator(joint,
-                    rotor_inertia=max(float(model.rotorInertia[idx_v]), 0.0),
-                    gear_ratio=ratio if ratio > 0.0 and math.isfinite(ratio) else 1.0,
-                    armature=max(float(model.armature[idx_v]), 0.0),
+                    rotor_inertia=rotor,
+                    gear_ratio=ratio,
+                    armature=max(float(model.armature[idx_v]) - rotor * ratio * ratio, 0.0),
                     viscous=max(float(model.damping[idx_v]), 0.0),
                     coulomb=max(float(model.friction[idx_v]), 0.0),
                     effort_limit=_limit(model.effortLimit[idx_v]),

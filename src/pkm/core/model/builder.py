@@ -134,6 +134,7 @@ def with_actuators(mech: Mechanism, actuators: Mapping[str, Any]) -> Mechanism:
 
     Raises:
         InvalidInputError: a joint that is not actuated, an unknown field, a negative or non-finite value.
+        SpecError: the values contradict the model file's drives (a peak effort below the file's continuous limit).
     """
     if not isinstance(mech, Mechanism):
         raise InvalidInputError("mech", f"expected a pkm Mechanism, got {type(mech).__name__}", mech)
@@ -143,7 +144,7 @@ def with_actuators(mech: Mechanism, actuators: Mapping[str, Any]) -> Mechanism:
         if isinstance(actuators[joint], Actuator):
             tables[joint] = {f: getattr(act, f) for f in NUMBERS}
         else:
-            tables[joint] = {**tables.get(joint, {}), **{str(k): float(v) for k, v in actuators[joint].items()}}
+            tables[joint] = {**tables.get(joint, {}), **{str(k): getattr(act, str(k)) for k in actuators[joint]}}
     spec = dataclasses.replace(mech.spec, actuators=tables)
     seed = mech.q_to_dict(mech.q_reference)
     if mech.urdf is not None:

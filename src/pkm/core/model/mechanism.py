@@ -147,7 +147,7 @@ class Mechanism:
             self.actuators = tuple(from_model(model, j.name, j.idx_v, spec.actuators.get(j.name))
                                    for j in self.actuated)
         except InvalidInputError as exc:
-            raise SpecError(source, f"an actuator of the model file: {exc}") from None
+            raise SpecError(source, f"the drives of the model file with the spec's [actuators] tables: {exc}") from None
         for a, j in zip(self.actuators, self.actuated):
             write_model(model, a, j.idx_v)
         self.act_q = np.array([j.idx_q for j in self.actuated])

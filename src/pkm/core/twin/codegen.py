@@ -101,19 +101,15 @@ int NAME_follow(casadi_int n, const casadi_real* q0, const casadi_real* targets,
 """
 
 
-_GRID = r"""
-/* pkm map driver: STEP (q, y -> q_next, step, pivot), its fallback QRSTEP (q, y -> q_next, step: taken where
-   STEP's smallest relative pivot is under PIVOT_FLOOR) and INDEX (q, y, scale -> K, residual, branch) over a grid of
-   task targets (dims[0] fastest), breadth first from root nodes: a node is solved from the neighbour that reached
-   it (one seed), each root from q0; its neighbours are queued with its solution. */
-static void STEP_pkm_sv(casadi_int m, casadi_int n, casadi_real* A, casadi_real* s) {
+_JACOBI_SV = r"""
+static void SV_NAME(casadi_int m, casadi_int n, casadi_real* A, casadi_real* s) {
   /* singular values (descending) of the column-major m x n matrix A (m >= n), one-sided Jacobi; A is destroyed */
   for (int sweep = 0; sweep < 60; ++sweep) {
     casadi_real off = 0.0;
     for (casadi_int p = 0; p < n; ++p) for (casadi_int r = p + 1; r < n; ++r) {
       casadi_real a = 0.0, b = 0.0, g = 0.0;
       for (casadi_int i = 0; i < m; ++i) { a += A[p*m+i]*A[p*m+i]; b += A[r*m+i]*A[r*m+i]; g += A[p*m+i]*A[r*m+i]; }
-      if (a == 0.0 || b == 0.0 || fabs(g) <= 1e-17 * sqrt(a * b)) continue;
+      if (a == 0.0 || b == 0.0 || fabs(g) <= SKIP_TOL * sqrt(a * b)) continue;
       if (fabs(g) / sqrt(a * b) > off) off = fabs(g) / sqrt(a * b);
       casadi_real z = (b - a) / (2.0 * g), t = (z >= 0 ? 1.0 : -1.0) / (fabs(z) + sqrt(1.0 + z * z));
       casadi_real c = 1.0 / sqrt(1.0 + t * t), sn = c * t;
@@ -121,11 +117,27 @@ static void STEP_pkm_sv(casadi_int m, casadi_int n, casadi_real* A, casadi_real*
         casadi_real x = A[p*m+i], y = A[r*m+i]; A[p*m+i] = c * x - sn * y; A[r*m+i] = sn * x + c * y;
       }
     }
-    if (off <= 1e-16) break;
+    if (off <= STOP_TOL) break;
   }
   for (casadi_int j = 0; j < n; ++j) { casadi_real a = 0.0; for (casadi_int i = 0; i < m; ++i) a += A[j*m+i]*A[j*m+i]; s[j] = sqrt(a); }
   for (casadi_int j = 1; j < n; ++j) for (casadi_int k = j; k > 0 && s[k] > s[k-1]; --k) { casadi_real t = s[k]; s[k] = s[k-1]; s[k-1] = t; }
 }
+"""
+
+
+def jacobi_sv(name: str, skip: float, stop: float) -> str:
+    """The C source of ``static void <name>(m, n, A, s)``: the singular values (descending) of the column-major
+    ``m x n`` matrix ``A`` (``m >= n``) by one-sided Jacobi, ``A`` destroyed; a pair of columns whose cosine is under
+    ``skip`` is left as it is, the sweeps stop when every cosine is under ``stop``."""
+    return _JACOBI_SV.replace("SV_NAME", name).replace("SKIP_TOL", repr(skip)).replace("STOP_TOL", repr(stop))
+
+
+_GRID = r"""
+/* pkm map driver: STEP (q, y -> q_next, step, pivot), its fallback QRSTEP (q, y -> q_next, step: taken where
+   STEP's smallest relative pivot is under PIVOT_FLOOR) and INDEX (q, y, scale -> K, residual, branch) over a grid of
+   task targets (dims[0] fastest), breadth first from root nodes: a node is solved from the neighbour that reached
+   it (one seed), each root from q0; its neighbours are queued with its solution. */
+JACOBI_SV
 
 int STEP_grid(const casadi_int* dims, casadi_int ndim, const casadi_real* targets, const casadi_real* q0,
               const casadi_real* scale, const casadi_real* signs, const casadi_int* roots, casadi_int nroots,
@@ -248,7 +260,8 @@ def map_source(step: cs.Function, qr_step: cs.Function, index: cs.Function, pivo
     drivers and the grid driver ``<step>_grid``."""
     nq, nt = step.nnz_in(0), step.nnz_in(1)
     m, n = index.size_out(0)
-    grid = (_GRID.replace("QRSTEP", qr_step.name()).replace("STEP", step.name()).replace("INDEX", index.name())
+    grid = (_GRID.replace("JACOBI_SV\n", jacobi_sv("STEP_pkm_sv", 1e-17, 1e-16))
+            .replace("QRSTEP", qr_step.name()).replace("STEP", step.name()).replace("INDEX", index.name())
             .replace("PIVOT_FLOOR", repr(float(pivot_floor))).replace("BRANCH_TOL", repr(BRANCH_TOL)).replace("NQ", str(nq)).replace("NT", str(nt))
             .replace("KROWS", str(m)).replace("KCOLS", str(n)).replace("NB", str(index.nnz_out(2))))
     return source([step, qr_step, index]) + grid

@@ -239,7 +239,8 @@ class Twin:
 
     @functools.cached_property
     def rnea(self) -> Expr:
-        """Joint torques (nv) for ``q, v, a`` under ``model.gravity`` (Pinocchio's ``rnea``)."""
+        """Joint torques (nv) for ``q, v, a`` under ``model.gravity`` (Pinocchio's ``rnea``, the model's ``armature``,
+        the actuators' reflected inertia, included: ``armature * a`` on each joint's diagonal)."""
         model = self.mech.model
         n = len(self.joints)
         g = cs.DM(model.gravity.vector)
@@ -254,6 +255,9 @@ class Twin:
             for k, col in enumerate(J.cols):
                 tau[col] = tau[col] + t[k]
             f[J.parent] = f[J.parent] + self.liMi[j].act_force(f[j])
+        armature = np.asarray(model.armature, dtype=float)  # the actuators' reflected inertia, as Pinocchio's rnea
+        for i in np.flatnonzero(armature):
+            tau[int(i)] = tau[int(i)] + float(armature[i]) * self.a[int(i)]
         return tau
 
     @functools.cached_property

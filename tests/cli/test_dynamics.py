@@ -1,0 +1,108 @@
+"""``pkm dynamics``: the actuator-space model at one state, equal to :func:`pkm.actuator_model`'s, each entry with its
+unit, by actuator name; bad input as one error line."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm import cli
+from pkm.cli.commands.dynamics import _mass_unit
+from tests.cli.helpers import one_error_line, run
+
+ROOT = Path(__file__).resolve().parents[2]
+ANKLE = ROOT / "examples" / "ankle" / "ankle.closures.toml"
+RTOL = 1e-12  # the command and the library take the same route (the JSON floats are exact): only the last bits
+
+
+def _json(capsys, *argv: str) -> dict:
+    assert cli.main(["dynamics", *argv, "--json"]) == 0, capsys.readouterr().err
+    return json.loads(capsys.readouterr().out)
+
+
+def _matrix(out: dict, key: str) -> np.ndarray:
+    names = list(out["actuated"])
+    return np.array([[out[key][a][b] for b in names] for a in names])
+
+
+def _vector(out: dict, key: str) -> np.ndarray:
+    return np.array([out[key][n] for n in out["actuated"]])
+
+
+def test_delta_json_equals_the_library_at_the_state_given(capsys):
+    """``pkm dynamics delta --joints motor_1=-30deg --rates ...``: M_a, h_a, g_a equal pkm.actuator_model at the
+    configuration closed from those values (to 1e-12 relative); units kg m^2 and N m; no friction, no idle motion."""
+    out = _json(capsys, "delta", "--joints", "motor_1=-30deg", "motor_2=-0.4", "--rates", "motor_1=0.5",
+                "motor_3=-1.5")
+    mech = pkm.load("delta")
+    qa = mech.actuated_q(mech.q_reference)
+    qa[:2] = math.radians(-30), -0.4
+    model = pkm.actuator_model(mech, pkm.close_loops(mech, qa).q, [0.5, 0.0, -1.5])
+    assert np.allclose(_vector(out, "actuated"), qa, rtol=RTOL, atol=0)
+    assert np.allclose(_matrix(out, "M"), model.M, rtol=RTOL, atol=0)
+    for key, ours in (("h", model.h), ("g", model.g)):
+        assert np.allclose(_vector(out, key), ours, rtol=RTOL, atol=1e-15)
+    assert not np.allclose(model.h, model.g)  # (the rates count)
+    assert out["units"]["M"]["motor_1"]["motor_2"] == "kg m^2" and out["units"]["h"]["motor_3"] == "N m"
+    assert out["units"]["rates"]["motor_1"] == "rad/s" and out["friction"] is None and out["idle_motions"] == 0
+
+
+def test_a_spec_file_prints_its_idle_motions_and_the_model_at_the_reference(capsys):
+    """The ankle from its file (two rods spinning idle): the text names every actuator with units and the idle
+    motions; the JSON at the reference equals the library's."""
+    assert cli.main(["dynamics", str(ANKLE)]) == 0
+    text = capsys.readouterr().out
+    assert "M_a (mass matrix)" in text and "kg m^2" in text and "N m" in text and "motor_left" in text
+    assert "idle motions: 2" in text and "friction" not in text
+    out = _json(capsys, str(ANKLE))
+    mech = pkm.load(ANKLE)
+    model = pkm.actuator_model(mech, mech.q_reference)
+    assert out["idle_motions"] == 2 and list(out["actuated"]) == list(mech.actuated_names)
+    assert np.allclose(_matrix(out, "M"), model.M, rtol=RTOL, atol=0)
+    assert np.allclose(_vector(out, "g"), model.g, rtol=RTOL, atol=1e-15)
+
+
+def test_prismatic_actuators_take_kg_and_newtons(capsys):
+    out = _json(capsys, "prs3", "--rates", "slider_2=0.1")
+    assert {u for row in out["units"]["M"].values() for u in row.values()} == {"kg"}
+    assert set(out["units"]["h"].values()) == {"N"} and out["units"]["rates"]["slider_2"] == "m/s"
+    assert (_mass_unit(True, True), _mass_unit(True, False), _mass_unit(False, True), _mass_unit(False, False)) == \
+        ("kg m^2", "kg m", "kg m", "kg")
+
+
+def test_friction_is_printed_where_the_actuators_have_some(tmp_path, capsys):
+    """A Delta whose first motor has viscous and Coulomb friction, saved as a spec: the friction efforts at the rates
+    given equal the library's and oppose the motion."""
+    mech = pkm.with_actuators(pkm.load("delta"), {"motor_1": {"viscous": 0.5, "coulomb": 0.1}})
+    path = tmp_path / "delta_friction.closures.toml"
+    pkm.save(mech, path)
+    out = _json(capsys, str(path), "--rates", "motor_1=2", "motor_2=-1")
+    mech = pkm.load(path)
+    model = pkm.actuator_model(mech, mech.q_reference, [2.0, -1.0, 0.0])
+    assert np.allclose(_vector(out, "friction"), model.friction, rtol=RTOL, atol=1e-15)
+    assert out["friction"]["motor_1"] < 0 and out["units"]["friction"]["motor_1"] == "N m"
+    assert cli.main(["dynamics", str(path), "--rates", "motor_1=2"]) == 0
+    assert "friction efforts:" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv,status,message", [
+    (["delta", "--rates", "motor_1=5deg"], 2, "'deg' is an angle unit but motor_1 is in [rad/s]"),
+    (["delta", "--joints", "motor_9=1"], 2, "actuated joint 'motor_9' does not exist"),
+    (["delta", "--rates", "motor_1"], 2, "must read NAME=VALUE"),
+    (["nowhere.closures.toml"], 1, "nowhere.closures.toml"),
+])
+def test_bad_input_is_one_error_line(argv, status, message, capsys):
+    assert cli.main(["dynamics", *argv]) == status
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("pkm: error: ") and message in err, err
+
+
+def test_the_command_runs_as_a_process():
+    """``python -m pkm dynamics delta --json --rates motor_1=fast``: one error line, exit status 2."""
+    bad = run("dynamics", "delta", "--json", "--rates", "motor_1=fast")
+    assert bad.returncode == 2 and "is not a number" in one_error_line(bad)
