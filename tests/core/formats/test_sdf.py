@@ -165,3 +165,22 @@ def test_links_that_are_each_others_parents_are_refused():
       <joint name="ca" type="fixed"><parent>a</parent><child>c</child></joint></model>""")
     with pytest.raises(SpecError, match=r"links \['a', 'b', 'c'\] are each other's parents"):
         read_sdf(text, "fb.sdf")
+
+
+def test_the_drive_of_an_actuated_joint_is_read_and_sdf_defaults_mean_none():
+    """SDFormat's ``<limit><effort>``, ``<velocity>`` and ``<dynamics><damping>``, ``<friction>`` become the
+    actuator's continuous effort and speed limits and its viscous and Coulomb friction; SDFormat's default -1 (no
+    limit) reads as none, and a negative damping is refused with the joint named."""
+    drive = ("<axis><xyz>0 1 0</xyz><limit><lower>-2</lower><upper>2</upper><effort>12.5</effort>"
+             "<velocity>4</velocity></limit><dynamics><damping>0.03</damping><friction>0.2</friction></dynamics>"
+             "</axis></joint>")
+    text = fourbar().replace("<axis><xyz>0 1 0</xyz><limit><lower>-2</lower><upper>2</upper></limit></axis></joint>",
+                             drive, 1)
+    (act,) = mechanism(text).actuators
+    assert (act.effort_limit, act.velocity_limit, act.viscous, act.coulomb) == (12.5, 4.0, 0.03, 0.2)
+    (free,) = mechanism(text.replace("<effort>12.5</effort>", "<effort>-1</effort>")).actuators
+    assert free.effort_limit == np.inf and free.velocity_limit == 4.0
+    (bare,) = mechanism(fourbar()).actuators
+    assert (bare.effort_limit, bare.velocity_limit, bare.viscous) == (np.inf, np.inf, 0.0)
+    with pytest.raises(SpecError, match="joint 'crank_joint': a negative dynamics value"):
+        read_sdf(text.replace("<damping>0.03</damping>", "<damping>-0.03</damping>"), "fb.sdf")

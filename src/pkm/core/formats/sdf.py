@@ -10,7 +10,9 @@ SDFormat's pose semantics (1.6 to 1.11):
 * ``<joint>`` of type ``revolute``, ``continuous``, ``prismatic``, ``ball`` or ``fixed``: ``<parent>``,
   ``<child>`` (``world`` for the ground), ``<pose>`` in the child link's frame (or ``relative_to``),
   ``<axis><xyz>`` in the joint frame (or ``expressed_in``; SDFormat 1.6's ``use_parent_model_frame``),
-  ``<limit><lower><upper>`` (SDFormat's default ±1e16 means none);
+  ``<limit><lower><upper>`` (SDFormat's default ±1e16 means none); an actuated joint's drive
+  (:class:`~pkm.core.model.actuators.Actuator`) from ``<limit><effort><velocity>`` (SDFormat's default -1: none)
+  and ``<dynamics><damping><friction>``;
 * ``<frame name attached_to>`` with a ``<pose>``: named frames (an end effector, a tool point);
 * ``<pose degrees="true">`` (SDFormat 1.9);
 * ``<joint type="gearbox">`` (below).
@@ -283,7 +285,19 @@ def _read_sdf(text: str, source: str) -> Imported:
                 b = _numbers(f"{lo} {hi}", 2, f"joint {name!r} limits", source)
                 if np.abs(b).max() < _NO_LIMIT:
                     bounds = {"lower": repr(float(b[0])), "upper": repr(float(b[1]))}
-            etree.SubElement(jel, "limit", effort="0", velocity="0", **bounds)
+            drive = {}
+            for key in ("effort", "velocity"):  # (SDF's default -1: no limit, read as none)
+                text = _text(j, f"axis/limit/{key}")
+                value = float(_numbers(text, 1, f"joint {name!r} {key} limit", source)[0]) if text else -1.0
+                drive[key] = repr(value) if value > 0.0 and name not in mimic else "0"
+            etree.SubElement(jel, "limit", **drive, **bounds)
+            damping, friction = _text(j, "axis/dynamics/damping"), _text(j, "axis/dynamics/friction")
+            if (damping or friction) and name not in mimic:
+                values = {k: float(_numbers(t, 1, f"joint {name!r} {k}", source)[0])
+                          for k, t in (("damping", damping), ("friction", friction)) if t}
+                if any(v < 0.0 for v in values.values()):
+                    raise SpecError(source, f"joint {name!r}: a negative dynamics value {values}")
+                etree.SubElement(jel, "dynamics", {k: repr(v) for k, v in values.items()})
 
     def fixed_frame(name: str, parent: str, X: pin.SE3, joint: str | None = None) -> None:
         for n in (name, joint or f"{name}_fixed"):
