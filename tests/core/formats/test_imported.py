@@ -128,3 +128,23 @@ def test_the_skeleton_of_an_sdf_file_needs_only_its_actuators(tmp_path):
                               for line in text.splitlines()))
     mech = pkm.load(spec)
     assert mech.actuated_names == ("crank_joint",) and [c.name for c in mech.spec.closures] == ["wrist", "wrist_axis"]
+
+
+def test_the_skeleton_lists_the_files_drives_and_an_example_that_loads_uncommented(tmp_path):
+    """``spec_skeleton`` writes each actuated joint's drive as the file states it (commented: the file's values
+    count without it), else a commented example, which loads once uncommented."""
+    example = Path(__file__).resolve().parents[3] / "examples" / "mjcf_fourbar" / "fourbar.xml"
+    text = example.read_text().replace('<joint name="crank_joint" ', '<joint name="crank_joint" armature="0.004" ')
+    (tmp_path / "geared").mkdir()
+    (tmp_path / "geared" / "fourbar.xml").write_text(text)
+    skeleton, _ = spec_skeleton(tmp_path / "geared" / "fourbar.xml")
+    assert "# [actuators.crank_joint]\n# armature = 0.004  # (from the file)" in skeleton
+    bare, complete = spec_skeleton(example)
+    assert complete and "# [actuators.crank_joint]  # for example:" in bare
+    head, rest = bare.split("# [actuators.crank_joint]  # for example:\n")
+    block, tail = rest.split("\n\n", 1)
+    filled = head + "[actuators.crank_joint]\n" + "\n".join(ln[2:] for ln in block.splitlines()) + "\n\n" + tail
+    (tmp_path / "fourbar.xml").write_text(example.read_text())
+    (tmp_path / "fourbar.closures.toml").write_text(filled)
+    (drive,) = pkm.load(tmp_path / "fourbar.closures.toml").actuators
+    assert (drive.gear_ratio, drive.peak_effort, drive.velocity_limit) == (50.0, 60.0, 6.0)

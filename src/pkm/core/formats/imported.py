@@ -119,6 +119,15 @@ def spec_skeleton(path: Path) -> tuple[str, bool]:
               "# [joint_types]  # joints the file writes as revolutes that are \"spherical\", \"universal_ab\" "
               "(about axis a then b: \"universal_zy\"...) or \"fixed\""]
     lines += [f"# {k} = {q(v)}  # (from the file)" for k, v in imp.joint_types.items()]
+    lines += ["", "# Drives (optional; pkm.core.model.actuators): per actuated joint, over what the file states:"]
+    for joint in imp.actuated or scalar[:1]:
+        stated = imp.actuators.get(joint, {})
+        lines.append(f"# [actuators.{joint}]" + ("" if stated else "  # for example:"))
+        lines += [f"# {k} = {v!r}  # (from the file)" for k, v in stated.items()] or \
+            ["# rotor_inertia = 3.3e-5  # kg m^2 (kg: a linear motor's moving mass)", "# gear_ratio = 50.0",
+             "# viscous = 0.02  # N m s/rad", "# coulomb = 0.1  # N m",
+             "# effort_limit = 20.0  # N m, continuous", "# peak_effort = 60.0  # N m",
+             "# velocity_limit = 6.0  # rad/s"]
     lines += ["",
               "# [reference]  # optional: pkm assembles the mechanism (pkm.assemble); the joints stated here are held",
               f"# {scalar[0] if scalar else 'joint'} = [0.0]", ""]
