@@ -190,3 +190,13 @@ def test_a_run_cannot_start_at_a_singularity():
     fall = pkm.simulate(delta, duration=1.0, dt=1e-3, friction=False)
     with pytest.raises(SingularityError):
         pkm.simulate(delta, fall.q[-1], duration=0.01, singular_tol=1e-2)
+
+
+def test_a_closure_that_fails_next_to_a_singularity_is_that_singularity():
+    """The ankle released from rest reaches a direct singularity where the closure's Newton fails a step before the
+    singular-value test would fire: the event is the singularity (within SINGULAR_CLOSURE * singular_tol), not a
+    lost assembly mode (test_simulate_c: away from a singularity a failed closure is a lost assembly mode)."""
+    ankle = mechanism("acceptance/ankle")
+    run = pkm.simulate(ankle, duration=0.5, friction=False, limits=False, backend="python")
+    assert run.event.kind == "singularity" and "do not close" in run.event.detail
+    assert 0.2 < run.event.time < 0.35

@@ -24,7 +24,8 @@ The run stops with an :class:`Event`, keeping the samples up to it, where the mo
 
 * comes within ``singular_tol`` of a direct singularity (the passive joints' Jacobian's smallest singular value
   relative to its largest), where the actuators lose control and the model its meaning;
-* leaves its assembly mode (the loops do not close from the previous configuration);
+* leaves its assembly mode (the loops do not close from the previous configuration; where they fail within
+  :data:`SINGULAR_CLOSURE` ``* singular_tol`` of a direct singularity, the event is that singularity);
 * crosses a position limit stated by the model file, or exceeds an actuator's speed limit.
 
 A controller is a callable ``(t, q, v) -> τ_a`` (``q`` the whole configuration, nq; ``v`` the joint rates, nv; the
@@ -72,6 +73,7 @@ BACKENDS = ("auto", "python", "c")
 AUTO_STEPS = 2000  # "auto" builds a mechanism's compiled simulation for runs of at least this many steps
 MAX_STEPS = 10_000_000  # a run of more steps than this is refused (its arrays alone would be gigabytes)
 CLOSURE_TOL = 1e-12
+SINGULAR_CLOSURE = 10.0  # a closure that fails within this many singular_tol of a direct singularity: "singularity"
 MAX_HALVINGS = 8  # an RK4 step is halved at most this many times (a 1-ms step down to 4 us)
 RADAU_EVALUATIONS = 10 * 2 ** MAX_HALVINGS  # "radau" stops past this many evaluations a sample (RK4's worst case)
 RADAU_RATE = 1e6  # ... or a simulated second, whichever allows more (a stiff run with Coulomb friction takes 2e5)
@@ -157,6 +159,12 @@ class _Dynamics:
             dv[pv] = -least_squares(J[:, pv], r)
             q = pin.integrate(mech.model, q, dv)
         gap, _, closure = constraints.worst_closure(mech, constraints.residual(mech, q))
+        s = np.linalg.svd(constraints.jacobian(mech, seed)[:, pv], compute_uv=False)
+        nonzero = s[s > RTOL * s[0]] if s.size and s[0] > 0.0 else s
+        near = nonzero[-1] / nonzero[0] if nonzero.size else 0.0
+        if near < SINGULAR_CLOSURE * self.singular_tol:  # (the closure fails because a singularity is near)
+            raise _Stop(Event("singularity", t, f"the loops do not close (closure {closure!r} open by {gap:.3g}) "
+                                                f"within {near:.3g} (relative) of a direct singularity"))
         raise _Stop(Event("assembly_mode", t, f"the loops do not close from the previous configuration (closure "
                                               f"{closure!r} open by {gap:.3g}): the motion left its assembly mode"))
 
