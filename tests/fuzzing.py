@@ -1607,6 +1607,20 @@ def _operational_space(g, adv):
     return ctx().pkm.operational_space, (m, q, qd), _rtol_kwargs(g, adv)
 
 
+@entry("pkm.regressor")
+def _regressor(g, adv):
+    n, m, q, qd = _dyn_state(g, adv)
+    qdd = g.value(np.zeros(ctx().mech[n].na), adv and g.chance(0.4), 1.0)
+    return ctx().pkm.regressor, (m, q, qd, qdd), {}
+
+
+@entry("pkm.base_parameters")
+def _base_parameters(g, adv):
+    _, m = _mech(g, adv, ("rrr3",))  # (the cheapest: 82 parameters; its least sample count 28)
+    samples = g.pick((28, 40, 5)) if not adv or g.chance(0.5) else g.pick(ADV_NUMBERS + (0, -3, 2.5, "7", True))
+    return ctx().pkm.base_parameters, (m, samples), {"seed": int(g.rng.integers(0, 100))}
+
+
 def _forward_args(g: Gen, adversarial: bool, names=None):
     """(mechanism, q, v, tau): ``v`` consistent with ``q`` where it is assembled (or zero), or hostile."""
     c = ctx()

@@ -1,0 +1,178 @@
+"""Base parameters: the combinations of the dynamic parameters that the efforts can identify.
+
+Many parameters never reach the actuators (a body's inertia about an axis it cannot turn about) or only in fixed
+combinations (the masses of bodies that move together); the **base parameters** ``β = P θ`` are the largest set of
+independent combinations, ``Y_a θ = Y_β β`` for every motion. Numerical route (Gautier's): the regressor stacked at
+random regular states, its columns scaled to unit norm, a QR decomposition with column pivoting (``scipy.linalg.qr``);
+the rank is where ``|R_kk| / |R_00|`` drops by the largest factor (the **gap**, stated in the result with the values
+either side) among the values under ``1e-6``, the last one kept above ``1e-10`` (below, the regressor's own rounding:
+the 3-RRR has 7 pivots between 1e-15 and 1e-17, then exact zeros, and its rank is 22, not 29); a gap under :data:`CLEAR_GAP` is reported as ``ambiguous``: the
+decision is then not to be trusted in double precision (Iriarte et al., arXiv 1706.09153). The independent columns
+``θ_1`` give ``β = θ_1 + K θ_2`` with ``K = R_11⁻¹ R_12`` (on unit-norm columns, entries under 1e-6 dropped as
+rounding; then scaled back to the parameters' units).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import ArrayLike
+
+from pkm.core.identification.regressor import Parameters, parameters, regressor
+from pkm.core.kinematics.solve import close_loops
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.errors import ConvergenceError, InvalidInputError, SingularityError
+
+CLEAR_GAP = 1e6  # a rank decision whose gap is smaller than this is reported as ambiguous
+SMALL = 1e-6  # the rank is decided among relative |R_kk| under this
+FLOOR = 1e-10  # relative |R_kk| under this are the double-precision regressor's rounding: never kept
+MAX_SAMPLES = 10_000  # states stacked at most (each costs about a millisecond)
+COEFFICIENT_TOL = 1e-6  # coefficients of K on unit-norm columns under this are dropped (rounding of R_11^-1 R_12)
+
+
+@dataclass(frozen=True)
+class RankDecision:
+    """Where the relative pivots ``|R_kk| / |R_00|`` of the scaled regressor drop: ``rank`` of them are kept.
+
+    Attributes:
+        rank: The number of identifiable combinations.
+        pivots: The relative pivots, descending.
+        gap: ``pivots[rank - 1] / pivots[rank]`` (inf when every pivot is kept or the next is exactly zero).
+        ambiguous: The gap is under :data:`CLEAR_GAP`.
+    """
+
+    rank: int
+    pivots: np.ndarray
+    gap: float
+    ambiguous: bool
+
+
+def decide_rank(pivots: ArrayLike) -> RankDecision:
+    """The rank from relative pivots (descending, the first 1): at the largest drop among those under ``SMALL``."""
+    d = np.abs(np.asarray(pivots, dtype=float))
+    if d.ndim != 1 or d.size == 0 or not np.all(np.isfinite(d)):
+        raise InvalidInputError("pivots", "expected a non-empty vector of finite pivots", pivots)
+    d = d / d[0] if d[0] > 0.0 else d
+    small = np.flatnonzero(d < SMALL)
+    if small.size == 0:
+        return RankDecision(int(d.size), d, np.inf, False)
+    ks = small[(small > 0) & (d[np.maximum(small - 1, 0)] > FLOOR)]
+    if ks.size == 0:
+        return RankDecision(0, d, np.inf, False)
+    ratios = np.array([d[k - 1] / d[k] if d[k] > 0.0 else np.inf for k in ks])
+    r = int(ks[int(np.argmax(ratios))])
+    gap = float(ratios.max())
+    return RankDecision(r, d, gap, gap < CLEAR_GAP)
+
+
+@dataclass(frozen=True)
+class BaseParameters:
+    """The base parameters of a mechanism (module doc).
+
+    Attributes:
+        names: Each combination, readable: ``"platform.m + 3 rod.m"``.
+        map: ``P`` (n_base x p): ``β = P θ`` for the standard parameters ``θ`` of :func:`parameters`.
+        values: ``P θ`` for the mechanism's own parameters.
+        independent: The indices (into ``θ``) of the parameter each combination is named after.
+        decision: The rank decision (its gap, and whether it is ambiguous).
+        parameters: The standard parameters.
+        samples: The number of random states stacked.
+    """
+
+    names: tuple[str, ...]
+    map: np.ndarray
+    values: np.ndarray
+    independent: tuple[int, ...]
+    decision: RankDecision
+    parameters: Parameters
+    samples: int
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def regressor(self, Y: ArrayLike) -> np.ndarray:
+        """The base regressor ``Y_β`` of a standard one ``Y`` (its independent columns: ``Y θ = Y_β β``)."""
+        return np.asarray(Y, dtype=float)[:, list(self.independent)]
+
+
+def _coefficient(c: float) -> str:
+    f = Fraction(c).limit_denominator(12)
+    if abs(float(f) - c) <= 1e-9 * max(abs(c), 1.0):
+        return str(f) if f.denominator != 1 else str(f.numerator)
+    return f"{c:.6g}"
+
+
+def _name(names: tuple[str, ...], lead: int, terms: list[tuple[int, float]]) -> str:
+    out = names[lead]
+    for j, c in terms:
+        text = _coefficient(abs(c))
+        out += (" - " if c < 0 else " + ") + ("" if text == "1" else text + " ") + names[j]
+    return out
+
+
+def random_states(mech: Mechanism, n: int, seed: int = 0, spread: float = 0.1) -> list[tuple[np.ndarray, np.ndarray,
+                                                                                              np.ndarray]]:
+    """``n`` random regular states ``(q, qd, qdd)``: each actuated coordinate moved by up to ``spread`` [rad or m]
+    from the reference and closed from it (states that do not close or are singular are drawn again), rates and
+    accelerations standard normal."""
+    mech = check_mechanism(mech)
+    rng = np.random.default_rng(seed)
+    qa0 = mech.actuated_q(mech.q_reference)
+    out: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    for _ in range(20 * n):
+        if len(out) == n:
+            break
+        try:
+            q = close_loops(mech, qa0 + rng.uniform(-spread, spread, mech.na), mech.q_reference).q
+        except (ConvergenceError, SingularityError):
+            continue
+        if mech.outside_limits(q):
+            continue
+        out.append((q, rng.standard_normal(mech.na), rng.standard_normal(mech.na)))
+    if len(out) < n:
+        raise InvalidInputError("spread", f"only {len(out)} of {n} random states closed within the limits", spread)
+    return out
+
+
+def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int = 0) -> BaseParameters:
+    """The base parameters of ``mech`` by the numerical route (module doc), from ``n_samples`` random states
+    (default: enough for three times as many rows as parameters).
+
+    Raises:
+        InvalidInputError: fewer states than needed for as many rows as parameters, or more than ``MAX_SAMPLES``.
+    """
+    mech = check_mechanism(mech)
+    P = parameters(mech)
+    p = len(P)
+    n = n_samples if n_samples is not None else max(10, -(-3 * p // mech.na))
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise InvalidInputError("n_samples", "expected a positive integer", n_samples)
+    least = -(-p // mech.na)
+    if not least <= n <= MAX_SAMPLES:
+        raise InvalidInputError("n_samples", f"{n} states stack {n * mech.na} rows for {p} parameters: give from "
+                                             f"{least} (as many rows as parameters) to {MAX_SAMPLES}", n_samples)
+    W = np.vstack([regressor(mech, *state) for state in random_states(mech, n, seed)])
+    scale = np.linalg.norm(W, axis=0)
+    live = np.flatnonzero(scale > 1e-12 * scale.max())
+    Ws = W[:, live] / scale[live]
+    _, R, perm = scipy.linalg.qr(Ws, mode="economic", pivoting=True)
+    decision = decide_rank(np.abs(np.diag(R)))
+    r = decision.rank
+    K = scipy.linalg.solve_triangular(R[:r, :r], R[:r, r:]) if r < len(live) else np.zeros((r, 0))
+    ind, dep = live[perm[:r]], live[perm[r:]]
+    K[np.abs(K) < COEFFICIENT_TOL] = 0.0
+    K = K * scale[dep][None, :] / scale[ind][:, None]  # (back to unscaled columns)
+    order = np.argsort(ind)
+    Pmap = np.zeros((r, p))
+    names: list[str] = []
+    for row in order:
+        Pmap[len(names), ind[row]] = 1.0
+        Pmap[len(names), dep] = K[row]
+        names.append(_name(P.names, int(ind[row]), [(int(j), float(c)) for j, c in zip(dep, K[row]) if c != 0.0]))
+    return BaseParameters(tuple(names), Pmap, Pmap @ P.values, tuple(int(ind[row]) for row in order), decision, P, n)
+
+
+__all__ = ["CLEAR_GAP", "BaseParameters", "RankDecision", "base_parameters", "decide_rank", "random_states"]

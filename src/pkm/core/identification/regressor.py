@@ -1,0 +1,156 @@
+"""The regressor of any mechanism: ``τ_a = Y_a θ``, the efforts linear in the dynamic parameters.
+
+The tree's joint efforts are linear in every body's standard parameters, ``rnea(q, v, a) = Y(q, v, a) θ_b +
+armature · a`` (Pinocchio's ``computeJointTorqueRegressor`` gives ``Y``); the actuator efforts are their projection
+``G^T`` onto the actuated joints (``G = dq/dq_a``, :func:`~pkm.core.differential.velocity.passive_map`), the way
+:func:`pkm.inverse_dynamics` projects them, plus the drives' terms, which act on the actuated joints only (``G``'s
+actuated rows are the identity): ``armature_j q̈_j + viscous_j q̇_j + coulomb_j tanh(q̇_j / COULOMB_VELOCITY) +
+offset_j`` (the efforts the actuator supplies: friction opposes the motion, so it enters with the rates' sign).
+
+Mimic joints (the hexapod's β coupling): Pinocchio 4.1's regressor refuses them, so the columns are taken from the
+linearity of ``rnea`` in the parameters itself: column ``k`` is ``rnea(θ₀ + e_k) - rnea(θ₀)`` on a copy of the model
+(``θ₀`` a unit mass at each joint's origin with a unit inertia), exact up to rounding since ``rnea`` is linear in
+``θ`` (not a finite difference: no step, no truncation). The tests check both routes against each other where both
+run, and each against :func:`pkm.inverse_dynamics`.
+
+Idle motions (a rod spinning between two balls) carry no generalised force, so any ``G`` whose columns differ by
+idle motions projects the same efforts; the regressor uses the kinematic ``G`` (which does not depend on the
+parameters) and the joint rates of :func:`~pkm.core.dynamics.model.actuator_model` (``v = Ĝ q̇_a``, the
+accelerations with their idle part settled by the dynamics: that part uses the model's own parameters, and is zero
+when a rod's inertia is symmetric about its axis). Passive joints' armature and friction are not parameters (none
+of pkm's mechanisms has any). With that, ``Y_a θ_true`` equals :func:`pkm.inverse_dynamics` plus the drives'
+friction (tests: 1e-10 relative, every shipped mechanism and the acceptance set).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from pkm.core.differential.velocity import passive_map
+from pkm.core.dynamics.model import COULOMB_VELOCITY, actuator_model
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.errors import InvalidInputError
+from pkm.validation import finite_result
+
+BODY_FIELDS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
+"""The ten standard parameters of a body, Pinocchio's order (``Inertia.toDynamicParameters``)."""
+BODY_UNITS = ("kg", "kg m", "kg m", "kg m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2")
+DRIVE_FIELDS = ("armature", "viscous", "coulomb", "offset")
+"""Per actuator: the reflected inertia, viscous and Coulomb friction, an effort offset."""
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """The dynamic parameters of a mechanism, in the regressor's column order.
+
+    Attributes:
+        names: ``"<body>.<field>"`` for every body (:data:`BODY_FIELDS`), then ``"<joint>.<field>"`` for every
+            actuator (:data:`DRIVE_FIELDS`).
+        values: The mechanism's own values (its model file's and spec's).
+        units: Each one's unit for a revolute actuator (a prismatic one's drive terms: kg, N s/m, N, N).
+        bodies: The bodies' names, one per Pinocchio joint (the link the joint moves, fixed links merged in).
+        n_body: ``10 * len(bodies)``: the body columns come first.
+    """
+
+    names: tuple[str, ...]
+    values: np.ndarray
+    units: tuple[str, ...]
+    bodies: tuple[str, ...]
+
+    @property
+    def n_body(self) -> int:
+        return 10 * len(self.bodies)
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+
+def _body_names(model: pin.Model) -> tuple[str, ...]:
+    names = []
+    for j in range(1, model.njoints):
+        link = next((f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == j),
+                    model.names[j])
+        names.append(link)
+    return tuple(names)
+
+
+def parameters(mech: Mechanism) -> Parameters:
+    """The dynamic parameters of ``mech`` (module doc): names, values and units in the regressor's column order."""
+    mech = check_mechanism(mech)
+    model = mech.model
+    bodies = _body_names(model)
+    names = [f"{b}.{f}" for b in bodies for f in BODY_FIELDS]
+    values = [model.inertias[j].toDynamicParameters() for j in range(1, model.njoints)]
+    drives = []
+    for a in mech.actuators:
+        names += [f"{a.joint}.{f}" for f in DRIVE_FIELDS]
+        drives += [a.reflected_inertia, a.viscous, a.coulomb, 0.0]
+    units = BODY_UNITS * len(bodies) + ("kg m^2", "N m s/rad", "N m", "N m") * mech.na
+    return Parameters(tuple(names), np.concatenate([*values, np.array(drives)]), units, bodies)
+
+
+def _has_mimic(model: pin.Model) -> bool:
+    return any("Mimic" in model.joints[j].shortname() for j in range(1, model.njoints))
+
+
+def tree_regressor(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike) -> np.ndarray:
+    """``Y`` (nv x 10 n_bodies): the tree's joint efforts ``rnea(q, v, a)`` (armature left out) as ``Y θ_b``;
+    Pinocchio's regressor, or the linearity route where the model has mimic joints (module doc)."""
+    mech = check_mechanism(mech)
+    q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
+    model = mech.model
+    if not _has_mimic(model):
+        return pin.computeJointTorqueRegressor(model, mech.data, q, v, a).copy()
+    return _linear_columns(mech, q, v, a)
+
+
+def _linear_columns(mech: Mechanism, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+    model = pin.Model(mech.model)
+    model.armature = np.zeros(model.nv)
+    data = model.createData()
+    nb = model.njoints - 1
+    base = pin.Inertia(1.0, np.zeros(3), np.eye(3)).toDynamicParameters()
+    for j in range(1, model.njoints):
+        model.inertias[j] = pin.Inertia.FromDynamicParameters(base)
+    tau0 = pin.rnea(model, data, q, v, a).copy()
+    Y = np.empty((model.nv, 10 * nb))
+    for j in range(1, model.njoints):
+        for k in range(10):
+            theta = base.copy()
+            theta[k] += 1.0
+            model.inertias[j] = pin.Inertia.FromDynamicParameters(theta)
+            Y[:, 10 * (j - 1) + k] = pin.rnea(model, data, q, v, a) - tau0
+        model.inertias[j] = pin.Inertia.FromDynamicParameters(base)
+    return Y
+
+
+def regressor(mech: Mechanism, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
+    """``Y_a`` (na x p, p = ``len(parameters(mech))``) at a closed ``q`` with actuated rates ``qd`` and
+    accelerations ``qdd``: ``Y_a θ`` are the actuator efforts [N m, N] (module doc)."""
+    model = actuator_model(mech, q, qd)
+    mech = model.mech
+    qdd = mech.check_actuated(qdd, "qdd")
+    a = model.joint_accelerations(qdd)
+    Yb = passive_map(mech, model.q).T @ tree_regressor(mech, model.q, model.v, a)
+    drives = np.zeros((mech.na, 4 * mech.na))
+    for i, (rate, acc) in enumerate(zip(model.qd, qdd)):
+        drives[i, 4 * i:4 * i + 4] = (acc, rate, np.tanh(rate / COULOMB_VELOCITY), 1.0)
+    return finite_result(np.hstack([Yb, drives]), "regressor")
+
+
+def regressor_batch(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike) -> np.ndarray:
+    """``Y_a`` stacked over N samples ((N na) x p): closed configurations ``Q`` (N, nq), actuated rates and
+    accelerations (N, na)."""
+    mech = check_mechanism(mech)
+    Q, QD, QDD = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (Q, QD, QDD))
+    if not (len(Q) == len(QD) == len(QDD)):
+        raise InvalidInputError("Q", f"expected as many samples of each: {len(Q)}, {len(QD)}, {len(QDD)}", len(Q))
+    return np.vstack([regressor(mech, q, qd, qdd) for q, qd, qdd in zip(Q, QD, QDD)])
+
+
+__all__ = ["BODY_FIELDS", "DRIVE_FIELDS", "Parameters", "parameters", "regressor", "regressor_batch",
+           "tree_regressor"]
