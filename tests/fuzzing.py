@@ -1614,6 +1614,25 @@ def _regressor(g, adv):
     return ctx().pkm.regressor, (m, q, qd, qdd), {}
 
 
+_BASES: dict = {}
+
+
+@entry("pkm.estimate")
+def _estimate(g, adv):
+    c = ctx()
+    _, m = _mech(g, adv, ("rrr3",))
+    mm = c.mech["rrr3"]
+    n = 30
+    Q = np.repeat(mm.q_reference[None, :], n, axis=0)
+    arrays = [Q, g.rng.standard_normal((n, 3)), g.rng.standard_normal((n, 3)), g.rng.standard_normal((n, 3))]
+    if adv:
+        k = int(g.rng.integers(0, 4))
+        arrays[k] = g.value(arrays[k], True, 1.0)
+    if "rrr3" not in _BASES:  # (computed once: the estimate, not the base parameters, is what this entry tries)
+        _BASES["rrr3"] = c.pkm.base_parameters(mm)
+    return c.pkm.estimate, (m, *arrays), {"weighted": g.chance(0.5), "base": _BASES["rrr3"]}
+
+
 @entry("pkm.base_parameters")
 def _base_parameters(g, adv):
     _, m = _mech(g, adv, ("rrr3",))  # (the cheapest: 82 parameters; its least sample count 28)

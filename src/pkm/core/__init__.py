@@ -22,6 +22,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
                                 "coriolis_matrix", "gravity_efforts", "mass_matrix", "operational_space"),
     "pkm.core.dynamics.simulate": ("Event", "Simulation", "simulate"),
     "pkm.core.identification.base": ("BaseParameters", "base_parameters"),
+    "pkm.core.identification.estimate": ("Estimate", "estimate"),
     "pkm.core.identification.regressor": ("Parameters", "parameters", "regressor"),
     "pkm.core.model.actuators": ("Actuator",),
     "pkm.core.model.builder": ("with_actuators",),
@@ -63,6 +64,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.dynamics.projection import constraint_dynamics, forward_dynamics, inverse_dynamics
     from pkm.core.dynamics.simulate import Event, Simulation, simulate
     from pkm.core.identification.base import BaseParameters, base_parameters
+    from pkm.core.identification.estimate import Estimate, estimate
     from pkm.core.identification.regressor import Parameters, parameters, regressor
     from pkm.core.kinematics.configuration import Configuration
     from pkm.core.kinematics.solve import (

@@ -1,0 +1,111 @@
+"""Least-squares estimates of the base parameters from measured states and efforts.
+
+``τ = W_β β + ε`` stacked over the samples (:mod:`pkm.core.identification.base`): ordinary least squares, or
+Gautier's weighted least squares (each actuator's rows divided by the standard deviation of its own residual from a
+first ordinary fit, so that an actuator measured with more noise counts less). The standard deviation of each
+estimate is ``s_i = sqrt(s² [(W_βᵀ W_β)⁻¹]_ii)`` with ``s² = |r|² / (rows - n_base)`` on the (weighted) rows, its
+relative standard deviation ``100 s_i / |β_i|`` [%], the usual measure of how well a parameter is identified (above
+about 10 %: poorly).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from pkm.core.identification.base import BaseParameters, base_parameters
+from pkm.core.identification.regressor import regressor
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.errors import InvalidInputError, SingularityError
+from pkm.validation import as_array
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """Estimated base parameters.
+
+    Attributes:
+        base: The base parameters estimated (their names, their map from the standard ones).
+        values: ``β̂`` (n_base,).
+        std: Their standard deviations (n_base,).
+        relative_std: ``100 std / |values|`` [%] (inf where a value is zero).
+        residual_rms: Each actuator's residual RMS [N m, N] (unweighted).
+        weights: Each actuator's weight (1 for ordinary least squares).
+        method: ``"ols"`` or ``"wls"``.
+        rows: The number of equations.
+    """
+
+    base: BaseParameters
+    values: np.ndarray
+    std: np.ndarray
+    relative_std: np.ndarray
+    residual_rms: np.ndarray
+    weights: np.ndarray
+    method: str
+    rows: int
+
+    def predict(self, Y: ArrayLike) -> np.ndarray:
+        """The efforts ``Y_β β̂`` of a standard regressor ``Y`` (rows as stacked by :func:`regressor`)."""
+        return self.base.regressor(Y) @ self.values
+
+
+def _solve(W: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    Q, R = np.linalg.qr(W)
+    d = np.abs(np.diag(R))
+    if d.min() <= 1e-12 * d.max():
+        raise SingularityError("regressor", float(d.min() / d.max()), "the samples do not excite every base parameter: "
+                                                                      "give more, or more varied, motion")
+    beta = np.linalg.solve(R, Q.T @ y)
+    Rinv = np.linalg.inv(R)
+    return beta, np.einsum("ij,ij->i", Rinv, Rinv)  # (diag of (W^T W)^-1)
+
+
+def estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, TAU: ArrayLike, *,
+             base: BaseParameters | None = None, weighted: bool = True) -> Estimate:
+    """Estimate the base parameters from N samples: closed configurations ``Q`` (N, nq), actuated rates and
+    accelerations ``QD``, ``QDD`` (N, na) and the measured efforts ``TAU`` (N, na) [N m, N] (module doc).
+
+    Raises:
+        InvalidInputError: arrays of the wrong shape, non-finite values (the row named), fewer rows than parameters.
+        SingularityError: the motion does not excite every base parameter.
+    """
+    mech = check_mechanism(mech)
+    base = base if base is not None else base_parameters(mech)
+    arrays = []
+    for name, x, cols in (("Q", Q, mech.nq), ("QD", QD, mech.na), ("QDD", QDD, mech.na), ("TAU", TAU, mech.na)):
+        arr = as_array(x, name, f"N x {cols}")
+        if arr.ndim != 2 or arr.shape[1] != cols:
+            raise InvalidInputError(name, f"expected N x {cols}, got shape {arr.shape}", arr.shape)
+        bad = np.flatnonzero(~np.all(np.isfinite(arr), axis=1))
+        if bad.size:
+            raise InvalidInputError(name, f"row {int(bad[0])} is not finite", arr[bad[0]])
+        arrays.append(arr)
+    Q_, QD_, QDD_, TAU_ = arrays
+    n = len(Q_)
+    if not all(len(a) == n for a in arrays):
+        raise InvalidInputError("TAU", f"expected as many samples of each: {[len(a) for a in arrays]}", n)
+    if n * mech.na < len(base):
+        raise InvalidInputError("Q", f"{n * mech.na} equations for {len(base)} base parameters: give more samples", n)
+    W = base.regressor(np.vstack([regressor(mech, q, qd, qdd) for q, qd, qdd in zip(Q_, QD_, QDD_)]))
+    y = TAU_.reshape(-1)
+    beta, diag = _solve(W, y)
+    weights = np.ones(mech.na)
+    if weighted:
+        r = (y - W @ beta).reshape(n, mech.na)
+        sd = np.sqrt(np.sum(r * r, axis=0) / max(n - len(base) / mech.na, 1.0))
+        weights = 1.0 / np.maximum(sd, 1e-300)
+        w = np.tile(weights, n)
+        beta, diag = _solve(W * w[:, None], y * w)
+    w = np.tile(weights, n)
+    r = (y - W @ beta) * w
+    sigma2 = float(r @ r) / max(len(y) - len(base), 1)
+    std = np.sqrt(sigma2 * diag)
+    with np.errstate(divide="ignore"):
+        rel = np.where(beta != 0.0, 100.0 * std / np.abs(beta), np.inf)
+    rms = np.sqrt(np.mean(((y - W @ beta).reshape(n, mech.na)) ** 2, axis=0))
+    return Estimate(base, beta, std, rel, rms, weights, "wls" if weighted else "ols", len(y))
+
+
+__all__ = ["Estimate", "estimate"]

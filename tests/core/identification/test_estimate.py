@@ -1,0 +1,54 @@
+"""pkm.core.identification.estimate: exact efforts give back the base parameters; efforts with noise (1 % of each
+actuator's range) give estimates within their stated standard deviations; bad data is refused by row."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pkm.core.identification.base import base_parameters, random_states
+from pkm.core.identification.estimate import estimate
+from pkm.core.identification.regressor import regressor
+from pkm.errors import InvalidInputError, SingularityError
+from tests.core.dynamics.test_model import mechanism
+
+
+def _data(name: str, n: int):
+    mech = mechanism(name)
+    base = base_parameters(mech)
+    states = random_states(mech, n, seed=11)
+    Q, QD, QDD = (np.array([s[i] for s in states]) for i in range(3))
+    TAU = np.array([regressor(mech, *s) @ base.parameters.values for s in states])
+    return mech, base, Q, QD, QDD, TAU
+
+
+@pytest.mark.parametrize("name", ["delta", "prs3"])
+def test_noisy_efforts_give_estimates_within_their_standard_deviations(name):
+    """Weighted least squares on 300 random states: the errors over the stated deviations behave as a standard
+    normal sample (at least 95 % within 3, none beyond 4); without noise the estimate is exact (1e-8 relative)."""
+    mech, base, Q, QD, QDD, TAU = _data(name, 300)
+    exact = estimate(mech, Q, QD, QDD, TAU, base=base, weighted=False)
+    assert np.abs(exact.values - base.values).max() <= 1e-8 * np.abs(base.values).max()
+    rng = np.random.default_rng(5)
+    noisy = TAU + 0.01 * np.ptp(TAU, axis=0) * rng.standard_normal(TAU.shape)
+    est = estimate(mech, Q, QD, QDD, noisy, base=base)
+    z = (est.values - base.values) / est.std
+    assert est.method == "wls" and np.mean(np.abs(z) <= 3.0) >= 0.95 and np.abs(z).max() <= 4.0
+    assert np.allclose(est.residual_rms, 0.01 * np.ptp(TAU, axis=0), rtol=0.15)  # (the noise, found again)
+    Y = regressor(mech, Q[0], QD[0], QDD[0])
+    assert np.abs(est.predict(Y) - TAU[0]).max() <= 5.0 * est.residual_rms.max()
+
+
+def test_bad_data_is_refused_by_row_and_too_little_motion_says_so():
+    mech, base, Q, QD, QDD, TAU = _data("delta", 20)
+    bad = TAU.copy()
+    bad[7, 1] = np.nan
+    with pytest.raises(InvalidInputError, match="row 7 is not finite"):
+        estimate(mech, Q, QD, QDD, bad, base=base)
+    with pytest.raises(InvalidInputError, match="N x 3"):
+        estimate(mech, Q, QD, QDD, TAU[:, :2], base=base)
+    with pytest.raises(InvalidInputError, match="give more samples"):
+        estimate(mech, Q[:5], QD[:5], QDD[:5], TAU[:5], base=base)
+    still = np.repeat(Q[:1], 20, axis=0), np.zeros((20, 3)), np.zeros((20, 3))
+    with pytest.raises(SingularityError, match="do not excite"):
+        estimate(mech, *still, np.zeros((20, 3)), base=base)
