@@ -14,6 +14,7 @@ rounding; then scaled back to the parameters' units).
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -80,6 +81,8 @@ class BaseParameters:
         decision: The rank decision (its gap, and whether it is ambiguous).
         parameters: The standard parameters.
         samples: The number of random states stacked.
+        tie: With tied legs, ``T`` (p x p_tied): the standard columns summed into each tied one (``Y T``), else None.
+        tied_names: The tied parameters' names (``"arm_*.m"``), empty without ties.
     """
 
     names: tuple[str, ...]
@@ -89,13 +92,16 @@ class BaseParameters:
     decision: RankDecision
     parameters: Parameters
     samples: int
+    tie: np.ndarray | None = None
+    tied_names: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return len(self.names)
 
     def regressor(self, Y: ArrayLike) -> np.ndarray:
         """The base regressor ``Y_β`` of a standard one ``Y`` (its independent columns: ``Y θ = Y_β β``)."""
-        return np.asarray(Y, dtype=float)[:, list(self.independent)]
+        Y = np.asarray(Y, dtype=float)
+        return (Y if self.tie is None else Y @ self.tie)[:, list(self.independent)]
 
 
 def _coefficient(c: float) -> str:
@@ -137,9 +143,32 @@ def random_states(mech: Mechanism, n: int, seed: int = 0, spread: float = 0.1) -
     return out
 
 
-def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int = 0) -> BaseParameters:
+def leg_ties(names: tuple[str, ...]) -> tuple[np.ndarray, tuple[str, ...]]:
+    """``T`` (p x p_tied) and the tied names: parameters whose body or joint names differ only by a trailing leg
+    number (``arm_1.m``, ``arm_2.m``, ``arm_3.m`` -> ``arm_*.m``; ``motor_1.viscous`` ... -> ``motor_*.viscous``)
+    share one column, the others keep theirs. The rule assumes the legs are built alike, each in its own frames
+    (as every mechanism pkm generates is, and as the tests check on the shipped ones)."""
+    keys = []
+    for name in names:
+        owner, field = name.rsplit(".", 1)
+        stem = re.sub(r"_\d+$", "_*", owner)
+        keys.append(f"{stem}.{field}")
+    counts: dict[str, int] = {}
+    for k in keys:
+        counts[k] = counts.get(k, 0) + 1
+    labels = [k if counts[k] > 1 and "*" in k else n for k, n in zip(keys, names)]
+    tied = tuple(dict.fromkeys(labels))
+    T = np.zeros((len(names), len(tied)))
+    for i, label in enumerate(labels):
+        T[i, tied.index(label)] = 1.0
+    return T, tied
+
+
+def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int = 0,
+                    tie_legs: bool = False) -> BaseParameters:
     """The base parameters of ``mech`` by the numerical route (module doc), from ``n_samples`` random states
-    (default: enough for three times as many rows as parameters).
+    (default: enough for three times as many rows as parameters); ``tie_legs``: one parameter set per kind of leg
+    (:func:`leg_ties`), which lowers the count.
 
     Raises:
         InvalidInputError: fewer states than needed for as many rows as parameters, or more than ``MAX_SAMPLES``.
@@ -155,6 +184,10 @@ def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int 
         raise InvalidInputError("n_samples", f"{n} states stack {n * mech.na} rows for {p} parameters: give from "
                                              f"{least} (as many rows as parameters) to {MAX_SAMPLES}", n_samples)
     W = np.vstack([regressor(mech, *state) for state in random_states(mech, n, seed)])
+    names, theta, T = P.names, P.values, None
+    if tie_legs:
+        T, names = leg_ties(P.names)
+        W, theta = W @ T, np.linalg.pinv(T) @ P.values  # (a tied value: its legs' mean)
     scale = np.linalg.norm(W, axis=0)
     live = np.flatnonzero(scale > 1e-12 * scale.max())
     Ws = W[:, live] / scale[live]
@@ -166,13 +199,16 @@ def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int 
     K[np.abs(K) < COEFFICIENT_TOL] = 0.0
     K = K * scale[dep][None, :] / scale[ind][:, None]  # (back to unscaled columns)
     order = np.argsort(ind)
-    Pmap = np.zeros((r, p))
-    names: list[str] = []
+    Pmap = np.zeros((r, len(names)))
+    combos: list[str] = []
     for row in order:
-        Pmap[len(names), ind[row]] = 1.0
-        Pmap[len(names), dep] = K[row]
-        names.append(_name(P.names, int(ind[row]), [(int(j), float(c)) for j, c in zip(dep, K[row]) if c != 0.0]))
-    return BaseParameters(tuple(names), Pmap, Pmap @ P.values, tuple(int(ind[row]) for row in order), decision, P, n)
+        Pmap[len(combos), ind[row]] = 1.0
+        Pmap[len(combos), dep] = K[row]
+        combos.append(_name(names, int(ind[row]), [(int(j), float(c)) for j, c in zip(dep, K[row]) if c != 0.0]))
+    full = Pmap if T is None else Pmap @ np.linalg.pinv(T)
+    return BaseParameters(tuple(combos), full, Pmap @ theta, tuple(int(ind[row]) for row in order), decision, P, n,
+                          T, names if T is not None else ())
 
 
-__all__ = ["CLEAR_GAP", "BaseParameters", "RankDecision", "base_parameters", "decide_rank", "random_states"]
+__all__ = ["CLEAR_GAP", "BaseParameters", "RankDecision", "base_parameters", "decide_rank", "leg_ties",
+           "random_states"]
