@@ -33,7 +33,9 @@ CORRECTED = {"rrr3.fig5.gci": 1e-5, "rrr3.fig5.gci_area": 1e-4}
 #: Rows added since, by the issue that names them (each paper's rows before them keep their order).
 ADDED = {"prs3.opcount.generic_mul", "prs3.opcount.generic_add", "delta.opcount.mul", "delta.opcount.add",
          "hexapod.opcount.mul", "hexapod.opcount.add",  # issue 15
-         "hexapod.fk.modes_reference", "rrr3.fk.modes_reference", "prs3.fk.modes_reference"}  # issue 17
+         "hexapod.fk.modes_reference", "rrr3.fk.modes_reference", "prs3.fk.modes_reference",  # issue 17
+         *(f"{paper}.ident.{row}" for paper in ("rrr3", "delta", "prs3", "hexapod")
+           for row in ("n_base", "n_base_tied", "routes_agree"))}  # issue 30
 
 BEFORE = json.loads((Path(__file__).parent / "data" / "report_rows_before_issue13.json").read_text())["papers"]
 

@@ -8,6 +8,7 @@ kernels, previews); the rest is behind extras, named in ``pyproject.toml``'s ``[
     pip install "pkm[figures]"   # the papers' figures, sweep plots, CiMap.figure: matplotlib
     pip install "pkm[homotopy]"  # every assembly mode (pkm.assembly_modes): Bertini 2 (GPL-3)
     pip install "pkm[bench]"     # the benchmarks' baseline: MuJoCo
+    pip install "pkm[identify]"  # identification's physically consistent estimate: cvxpy with Clarabel
     pip install "pkm[all]"       # all of them
 
 An extra is checked at the point of use, never at ``import pkm``: :func:`require` raises
@@ -30,6 +31,7 @@ EXTRAS: dict[str, dict[str, str]] = {
     "figures": {"matplotlib": "matplotlib"},
     "homotopy": {"bertini": "bertini2"},
     "bench": {"mujoco": "mujoco"},
+    "identify": {"cvxpy": "cvxpy", "clarabel": "clarabel"},
 }
 
 

@@ -14,7 +14,8 @@ from pkm.papers import delta as S
 from tests.papers.figures import draw_checked, uncovered
 
 IDS = ["delta.fig5.K_F_R100", "delta.fig5.K_F_R200", "delta.fig5.K_2_R120", "delta.fig5.monotone_100_200",
-       "delta.fig5.R_min_K2_mm", "delta.choice.R_mm", "delta.opcount.mul", "delta.opcount.add"]  # the last two: issue 15
+       "delta.fig5.R_min_K2_mm", "delta.choice.R_mm", "delta.opcount.mul", "delta.opcount.add",  # the last two: issue 15
+       "delta.ident.n_base", "delta.ident.n_base_tied", "delta.ident.routes_agree"]  # issue 30
 
 
 @pytest.fixture(scope="module")

@@ -15,7 +15,8 @@ from tests.papers.figures import draw_checked, uncovered
 IDS = ("hexapod.poseT.beta_min_reachable_deg", "hexapod.poseT.beta_opt_wrot_deg", "hexapod.poseT.beta_opt_wtras_deg",
        "hexapod.spiral.max_gap_rot_tras_deg", "hexapod.spiral.gain_after_40_wrot",
        "hexapod.opcount.mul", "hexapod.opcount.add",  # issue 15
-       "hexapod.fk.modes_reference")  # issue 17
+       "hexapod.fk.modes_reference",  # issue 17
+       "hexapod.ident.n_base", "hexapod.ident.n_base_tied", "hexapod.ident.routes_agree")  # issue 30
 
 
 @pytest.fixture(scope="module")

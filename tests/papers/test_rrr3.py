@@ -10,7 +10,8 @@ from tests.papers.figures import draw_checked, uncovered
 
 IDS = ["rrr3.fig5.gci", "rrr3.fig5.gci_area", "rrr3.fig6.gci", "rrr3.fig6.gci_area", "rrr3.fig7.gci",
        "rrr3.fig7.gci_area", "rrr3.fig9.gci", "rrr3.fig9.gci_area", "rrr3.modes.suitable",
-       "rrr3.fk.modes_reference"]  # the last: issue 17
+       "rrr3.fk.modes_reference",  # issue 17
+       "rrr3.ident.n_base", "rrr3.ident.n_base_tied", "rrr3.ident.routes_agree"]  # issue 30
 GCI = IDS[:8]
 
 

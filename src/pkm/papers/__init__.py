@@ -109,6 +109,32 @@ def opcount_rows(mechanism: str, prefix: str, note: str = "") -> list[Row]:
             Row(f"{prefix}add", None, c.add, "", None, "generic route (no published count)", text)]
 
 
+def ident_rows(mechanism: str, prefix: str) -> list[Row]:
+    """Rows ``<prefix>n_base`` and ``<prefix>n_base_tied``: the number of base parameters of a shipped mechanism
+    (:func:`pkm.base_parameters`; the papers publish none), its legs' parameters free and tied (one set per kind of
+    leg), each decided by both routes (double precision, and 50 digits on the same samples) and the row saying
+    whether they agree; and ``<prefix>routes_agree``: both counts found by both routes."""
+    import pkm
+
+    mech = pkm.load(mechanism)
+    rows, agree = [], True
+    for tie, suffix in ((False, "n_base"), (True, "n_base_tied")):
+        b = pkm.base_parameters(mech, tie_legs=tie)
+        assert b.precise is not None
+        agree = agree and bool(b.routes_agree)
+        text = (f"pkm.base_parameters({mechanism!r}{', tie_legs=True' if tie else ''}): {len(b)} of "
+                f"{len(b.tied_names or b.parameters.names)} parameters ({b.samples} random states; pivoted QR, gap "
+                f"{b.decision.gap:.1e} in double precision). In {50} digits on the same samples: "
+                f"{b.precise.decision.rank} (gap {b.precise.decision.gap:.1e}, {b.precise.unrecognised} of "
+                f"{b.precise.constants} model constants not recognised, floor {b.precise.floor:.0e}): the routes "
+                f"{'agree' if b.routes_agree else 'DISAGREE'}.")
+        rows.append(Row(f"{prefix}{suffix}", None, len(b), "", None, "identification (no published count)", text))
+    rows.append(Row(f"{prefix}routes_agree", None, agree, "", None, "identification (no published count)",
+                    "Both counts above found alike in double precision and in 50-digit arithmetic "
+                    "(pkm.core.identification.precise)."))
+    return rows
+
+
 @functools.cache
 def modes_row(mechanism: str, row_id: str, compare: Callable[[Any, Any], str] | None = None) -> Row:
     """Row ``row_id``: the number of real assembly modes at the reference design's reference actuators
@@ -192,4 +218,4 @@ def module(name: str) -> ModuleType:
     return importlib.import_module(f"pkm.papers.{name}")
 
 
-__all__ = ["Row", "cached_rows", "generic_count", "modes_row", "module", "names", "opcount_rows"]
+__all__ = ["Row", "cached_rows", "generic_count", "ident_rows", "modes_row", "module", "names", "opcount_rows"]

@@ -42,7 +42,7 @@ import numpy as np
 
 from pkm.mechanisms.delta import DeltaParams
 from pkm.mechanisms.delta import design as design
-from pkm.papers import Row, cached_rows, opcount_rows
+from pkm.papers import Row, cached_rows, ident_rows, opcount_rows
 from pkm.papers._plot import figure, save
 
 TITLE = "Hernández Reyna & Sandoval-Castro (2018): kinematics and base-radius reconfiguration of a Delta robot"
@@ -176,7 +176,7 @@ def reproduce() -> list[Row]:
             "it shrinks as R grows over the paper's range, as the paper says",
             why=f"the choice moves with the unstated bound on K_2 ({sens}); 120 mm is the paper's guideline, "
                 "not an optimum of a stated criterion"),
-    ] + opcount_rows("delta", "delta.opcount.")
+    ] + opcount_rows("delta", "delta.opcount.") + ident_rows("delta", "delta.ident.")
 
 
 K_BOUNDS = (2.5, 3.0, 4.0, 5.0)  # the bounds on K_2 whose conditioned volumes the R study draws

@@ -24,7 +24,7 @@ from pkm.core.kinematics.task import as_rotation
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi
 from pkm.mechanisms.hexapod import reconfiguration as hr
-from pkm.papers import Row, cached_rows, modes_row, opcount_rows
+from pkm.papers import Row, cached_rows, ident_rows, modes_row, opcount_rows
 from pkm.papers._plot import figure, save
 
 TITLE = "Sanchez-Alonso et al. (2016), Kinematic analysis of a novel reconfigurable parallel robot, RIAI 13:247-257"
@@ -119,7 +119,7 @@ def reproduce() -> list[Row]:
             f"approaches 0 along the spiral ({math.degrees(pr.pointwise[-1]):.2f} deg at the end). The rate-limited "
             f"QP profile gives {100 * pr.mean_gain(GAIN_FROM):.2f} %."),
     ] + opcount_rows("hexapod", "hexapod.opcount.") + [
-        modes_row("hexapod", "hexapod.fk.modes_reference", _against_multistart)]
+        modes_row("hexapod", "hexapod.fk.modes_reference", _against_multistart)] + ident_rows("hexapod", "hexapod.ident.")
 
 
 def _against_multistart(mech, modes) -> str:

@@ -17,7 +17,7 @@ import numpy as np
 from pkm.mechanisms.prs3 import Prs3Params
 from pkm.mechanisms.prs3.dynamics import BOUNDARY, G, Prs3Dynamics, operation_count
 from pkm.motion import load_motions
-from pkm.papers import Row, cached_rows, generic_count, modes_row, opcount_rows
+from pkm.papers import Row, cached_rows, generic_count, ident_rows, modes_row, opcount_rows
 from pkm.papers._plot import figure, save
 
 TITLE = "Díaz-Rodríguez, Carretero, Bautista-Quintero & Chacón (2016): 3-PRS kinematics and inverse dynamics"
@@ -110,7 +110,7 @@ def reproduce() -> list[Row]:
                 rows.append(Row(f"prs3.case{case}.F{i + 1}_{key}_N", None, float(r.tau[k, i]), "N", None,
                                 f"sec. 5, case {case}", f"slider force at t = {time} s; the paper prints no "
                                                         f"force values{extra}"))
-    return rows
+    return rows + ident_rows("prs3", "prs3.ident.")
 
 
 def series(out_dir) -> list[Path]:

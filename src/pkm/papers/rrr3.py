@@ -43,7 +43,7 @@ from pkm.errors import InvalidInputError, PkmError
 from pkm.mechanisms import rrr3
 from pkm.mechanisms.rrr3 import workspace as maps
 from pkm.mechanisms.rrr3.workspace import CiSettings, Design
-from pkm.papers import Row, cached_rows, modes_row
+from pkm.papers import Row, cached_rows, ident_rows, modes_row
 from pkm.papers._plot import WHAT, figure, save
 
 TITLE = ("Singularity analysis and global condition index of the planar 3-RRR parallel robot "
@@ -242,7 +242,7 @@ def reproduce() -> list[Row]:
                     "suitable = no direct singularity (sign change of det J_x between neighbouring reachable "
                     f"nodes) inside the workspace, Fig. 9's design, Phi = 0, paper grid. {detail}"))
     rows.append(modes_row("rrr3", "rrr3.fk.modes_reference", _against_polynomial))
-    return rows
+    return rows + ident_rows("rrr3", "rrr3.ident.")
 
 
 def _against_polynomial(mech, modes) -> str:

@@ -15,7 +15,7 @@ from tests.core.dynamics.test_model import mechanism
 
 def _data(name: str, n: int):
     mech = mechanism(name)
-    base = base_parameters(mech)
+    base = base_parameters(mech, precise=False)
     states = random_states(mech, n, seed=11)
     Q, QD, QDD = (np.array([s[i] for s in states]) for i in range(3))
     TAU = np.array([regressor(mech, *s) @ base.parameters.values for s in states])

@@ -75,7 +75,7 @@ def test_a_batch_stacks_the_samples_and_bad_input_is_refused():
     mech = mechanism("delta")
     states = list(_states(mech, 2))
     Q, QD, QDD = (np.array([s[i] for s in states]) for i in range(3))
-    W = regressor_batch(mech, Q, QD, QDD)
+    W = regressor_batch(mech, Q, QD, QDD, backend="python")
     assert np.array_equal(W[3:], regressor(mech, *states[1]))
     with pytest.raises(InvalidInputError, match="as many samples"):
         regressor_batch(mech, Q, QD[:1], QDD)

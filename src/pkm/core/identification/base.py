@@ -17,56 +17,23 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike
 
+from pkm.core.identification.rank import CLEAR_GAP, RankDecision, decide_rank
 from pkm.core.identification.regressor import Parameters, parameters, regressor
+
+if TYPE_CHECKING:
+    from pkm.core.identification.precise import PreciseRank
 from pkm.core.kinematics.solve import close_loops
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import ConvergenceError, InvalidInputError, SingularityError
 
-CLEAR_GAP = 1e6  # a rank decision whose gap is smaller than this is reported as ambiguous
-SMALL = 1e-6  # the rank is decided among relative |R_kk| under this
-FLOOR = 1e-10  # relative |R_kk| under this are the double-precision regressor's rounding: never kept
 MAX_SAMPLES = 10_000  # states stacked at most (each costs about a millisecond)
 COEFFICIENT_TOL = 1e-6  # coefficients of K on unit-norm columns under this are dropped (rounding of R_11^-1 R_12)
-
-
-@dataclass(frozen=True)
-class RankDecision:
-    """Where the relative pivots ``|R_kk| / |R_00|`` of the scaled regressor drop: ``rank`` of them are kept.
-
-    Attributes:
-        rank: The number of identifiable combinations.
-        pivots: The relative pivots, descending.
-        gap: ``pivots[rank - 1] / pivots[rank]`` (inf when every pivot is kept or the next is exactly zero).
-        ambiguous: The gap is under :data:`CLEAR_GAP`.
-    """
-
-    rank: int
-    pivots: np.ndarray
-    gap: float
-    ambiguous: bool
-
-
-def decide_rank(pivots: ArrayLike) -> RankDecision:
-    """The rank from relative pivots (descending, the first 1): at the largest drop among those under ``SMALL``."""
-    d = np.abs(np.asarray(pivots, dtype=float))
-    if d.ndim != 1 or d.size == 0 or not np.all(np.isfinite(d)):
-        raise InvalidInputError("pivots", "expected a non-empty vector of finite pivots", pivots)
-    d = d / d[0] if d[0] > 0.0 else d
-    small = np.flatnonzero(d < SMALL)
-    if small.size == 0:
-        return RankDecision(int(d.size), d, np.inf, False)
-    ks = small[(small > 0) & (d[np.maximum(small - 1, 0)] > FLOOR)]
-    if ks.size == 0:
-        return RankDecision(0, d, np.inf, False)
-    ratios = np.array([d[k - 1] / d[k] if d[k] > 0.0 else np.inf for k in ks])
-    r = int(ks[int(np.argmax(ratios))])
-    gap = float(ratios.max())
-    return RankDecision(r, d, gap, gap < CLEAR_GAP)
 
 
 @dataclass(frozen=True)
@@ -83,6 +50,8 @@ class BaseParameters:
         samples: The number of random states stacked.
         tie: With tied legs, ``T`` (p x p_tied): the standard columns summed into each tied one (``Y T``), else None.
         tied_names: The tied parameters' names (``"arm_*.m"``), empty without ties.
+        precise: The rank decided again in 50-digit arithmetic on the same samples (``precise=True``), else None;
+            :attr:`routes_agree` compares the counts.
     """
 
     names: tuple[str, ...]
@@ -94,6 +63,13 @@ class BaseParameters:
     samples: int
     tie: np.ndarray | None = None
     tied_names: tuple[str, ...] = ()
+    precise: PreciseRank | None = None
+
+    @property
+    def routes_agree(self) -> bool | None:
+        """Whether the second route (:mod:`~pkm.core.identification.precise`, 50 digits) finds the same count; None
+        when it was not run."""
+        return None if self.precise is None else self.precise.decision.rank == len(self.names)
 
     def __len__(self) -> int:
         return len(self.names)
@@ -165,13 +141,19 @@ def leg_ties(names: tuple[str, ...]) -> tuple[np.ndarray, tuple[str, ...]]:
 
 
 def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int = 0,
-                    tie_legs: bool = False) -> BaseParameters:
+                    tie_legs: bool = False, precise: bool = True) -> BaseParameters:
     """The base parameters of ``mech`` by the numerical route (module doc), from ``n_samples`` random states
     (default: enough for three times as many rows as parameters); ``tie_legs``: one parameter set per kind of leg
-    (:func:`leg_ties`), which lowers the count.
+    (:func:`leg_ties`), which lowers the count; ``precise``: decide the rank a second time in 50-digit arithmetic
+    on the same samples (:mod:`~pkm.core.identification.precise`: about a second for the Delta, ten for the
+    hexapod's 248 parameters), the result saying whether the two routes agree (:attr:`BaseParameters.routes_agree`).
+    The numerical route's base parameters are returned either way: where the routes disagree, the caller decides
+    (the precise rank says which combinations double precision could not see).
 
     Raises:
         InvalidInputError: fewer states than needed for as many rows as parameters, or more than ``MAX_SAMPLES``.
+        SpecError: ``precise`` on a mechanism whose twin cannot build the regressor (idle motions): pass
+            ``precise=False``.
     """
     mech = check_mechanism(mech)
     P = parameters(mech)
@@ -183,7 +165,8 @@ def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int 
     if not least <= n <= MAX_SAMPLES:
         raise InvalidInputError("n_samples", f"{n} states stack {n * mech.na} rows for {p} parameters: give from "
                                              f"{least} (as many rows as parameters) to {MAX_SAMPLES}", n_samples)
-    W = np.vstack([regressor(mech, *state) for state in random_states(mech, n, seed)])
+    states = random_states(mech, n, seed)
+    W = np.vstack([regressor(mech, *state) for state in states])
     names, theta, T = P.names, P.values, None
     if tie_legs:
         T, names = leg_ties(P.names)
@@ -206,8 +189,13 @@ def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int 
         Pmap[len(combos), dep] = K[row]
         combos.append(_name(names, int(ind[row]), [(int(j), float(c)) for j, c in zip(dep, K[row]) if c != 0.0]))
     full = Pmap if T is None else Pmap @ np.linalg.pinv(T)
+    second = None
+    if precise:
+        from pkm.core.identification.precise import precise_rank
+
+        second = precise_rank(mech, states[:-(-(p + 2 * mech.na) // mech.na)], T)  # (as many rows as it needs)
     return BaseParameters(tuple(combos), full, Pmap @ theta, tuple(int(ind[row]) for row in order), decision, P, n,
-                          T, names if T is not None else ())
+                          T, names if T is not None else (), second)
 
 
 __all__ = ["CLEAR_GAP", "BaseParameters", "RankDecision", "base_parameters", "decide_rank", "leg_ties",

@@ -50,6 +50,8 @@ if TYPE_CHECKING:
 
 #: Smallest relative pivot (:meth:`PivotedLU.smallest_relative_pivot`) at which a kernel's solve is trusted.
 PIVOT_FLOOR = 1e-6
+#: A compiled batch of at least twice this many samples runs on every core, in chunks (threads; the C is re-entrant).
+THREAD_SAMPLES = 2048
 
 
 
@@ -152,9 +154,22 @@ class _Kernel:
             return [o[None].copy() for o in self._one_out]
         ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
         outs = [np.empty((n, s)) for s in self.out_size]
-        in_p = (_P * len(ins))(*[a.ctypes.data_as(_P) for a in ins])
-        out_p = (_P * len(outs))(*[o.ctypes.data_as(_P) for o in outs])
-        if self._batch(n, in_p, out_p):
+        workers = min(os.cpu_count() or 1, n // THREAD_SAMPLES)
+        bounds = np.linspace(0, n, max(workers, 1) + 1).astype(int)
+
+        def part(lo: int, hi: int) -> int:  # (ctypes releases the GIL: the chunks run on as many cores)
+            in_p = (_P * len(ins))(*[a[lo:].ctypes.data_as(_P) for a in ins])
+            out_p = (_P * len(outs))(*[o[lo:].ctypes.data_as(_P) for o in outs])
+            return int(self._batch(hi - lo, in_p, out_p))
+
+        if workers > 1:
+            from concurrent.futures import ThreadPoolExecutor
+
+            with ThreadPoolExecutor(workers) as pool:
+                failed = any(pool.map(part, bounds[:-1], bounds[1:]))
+        else:
+            failed = bool(part(0, n))
+        if failed:
             raise RuntimeError(f"the compiled kernel {self.fun.name()} failed")
         return outs
 
@@ -209,6 +224,10 @@ class Kernels:
         tw, tk = self.twin, self.twin.task
         if name not in KERNELS:
             raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", name)
+        if name == "regressor":  # (a twin of its own: the bodies' parameters as symbols)
+            from pkm.core.twin.regressor import regressor_function
+
+            return regressor_function(self.mech)
         inputs, outputs = KERNELS[name]
         exprs = {"inverse_dynamics": lambda: {"tau": tw.inverse_dynamics,
                                               "pivot": tw.passive_lu.smallest_relative_pivot()},
@@ -324,6 +343,22 @@ class Kernels:
                 v = velocities(self.mech, Q[k], QD[k])
                 tau[k] = inverse_dynamics(self.mech, Q[k], v, accelerations(self.mech, Q[k], v, QDD[k]))
         return tau[0] if single else tau
+
+    def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike,
+                  fallback: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None) -> np.ndarray:
+        """The regressor ``Y_a`` (na x p, or n x na x p) at closed configurations ``q`` for actuated rates and
+        accelerations (:mod:`pkm.core.twin.regressor`; columns as :func:`pkm.regressor`'s); samples under the pivot
+        floor are recomputed by ``fallback(q, qd, qdd)`` (:func:`pkm.regressor`, as :func:`pkm.regressor_batch`
+        passes it), or are NaN without one."""
+        (Yt, pivot), single = self._run("regressor", q, qd, qdd, pivoted=True)
+        Y = Yt.reshape(len(Yt), self.mech.na, -1)  # (Yt's column-major nonzeros: Y row-major, no copy)
+        Y = Y[0] if single else Y
+        if not pivot.min() >= PIVOT_FLOOR:
+            Q, QD, QDD = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, qd, qdd))
+            Yb = Y[None] if single else Y
+            for k in np.flatnonzero(~(pivot[:, 0] >= PIVOT_FLOOR)):
+                Yb[k] = np.nan if fallback is None else fallback(Q[k], QD[k], QDD[k])
+        return Y
 
     def inverse_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> dict[str, np.ndarray]:
         """``tau`` and its derivatives ``dtau_dqa`` (along the closure), ``dtau_dqd``, ``dtau_dqdd`` (na x na each, or
@@ -479,6 +514,7 @@ KERNELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "gravity": (("q",), ("g", "pivot")),
     "mass_and_bias": (("q", "qd"), ("M", "h", "pivot")),
     "forward_dynamics": (("q", "qd", "tau", "friction"), ("qdd", "pivot")),
+    "regressor": (("q", "qd", "qdd"), ("Yt", "pivot")),
 }
 
 __all__ = ["KERNELS", "PIVOT_FLOOR", "Kernels", "PathResult"]

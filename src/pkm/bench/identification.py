@@ -1,0 +1,93 @@
+"""Identification's costs: the regressor of long trajectories in C against Python, and the second rank route.
+
+* **Regressor**: ``pkm.regressor_batch`` over ``--samples`` states (default 10⁵, the hexapod: 7 x 248 columns, 1.4
+  GB) through the compiled twin (``backend="c"``: every core), timed twice: the first call, which pays for its
+  output's pages, and a second, warm one; against the Python route (:func:`pkm.regressor` per sample) timed on
+  ``--python-samples`` of the same states and scaled to the batch (the ratio says how many times faster C is).
+  The two agree to the stated relative difference on those samples.
+* **Base parameters**: :func:`pkm.base_parameters` of the same mechanism with the 50-digit second route and
+  without it (the route's own cost).
+
+Compiling the kernel is timed apart (once per mechanism and machine: cached on disk).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from typing import Any
+
+import numpy as np
+
+import pkm
+from pkm.bench import best_time
+
+QUICK = {"mechanism": "delta", "samples": 4000, "python_samples": 20, "no_base": True}
+
+
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    ap.add_argument("--mechanism", default="hexapod", help="a registered mechanism (default hexapod)")
+    ap.add_argument("--samples", type=int, default=100_000, help="states of the C batch (default 10^5)")
+    ap.add_argument("--python-samples", type=int, default=200, help="states timed in Python (default 200)")
+    ap.add_argument("--no-base", action="store_true", help="skip the base parameters' timing")
+
+
+def run(args: argparse.Namespace) -> dict[str, Any]:
+    from pkm.core.identification.base import random_states
+    from pkm.core.identification.regressor import _kernels, regressor, regressor_batch
+
+    mech = pkm.load(args.mechanism)
+    t0 = time.perf_counter()
+    kernels = _kernels(mech)
+    compile_s = time.perf_counter() - t0
+    states = random_states(mech, 50, seed=0)
+    idx = np.arange(args.samples) % len(states)
+    Q, QD, QDD = (np.array([s[i] for s in states])[idx] for i in range(3))
+    out: dict[str, Any] = {"mechanism": args.mechanism, "samples": args.samples, "na": mech.na,
+                           "parameters": len(pkm.parameters(mech)), "compile_s": compile_s,
+                           "c": kernels.how if kernels is not None else None}
+    if kernels is not None:
+        t0 = time.perf_counter()
+        Y = regressor_batch(mech, Q, QD, QDD, backend="c")
+        out["c_first_s"] = time.perf_counter() - t0
+        del Y
+        out["c_warm_s"], Y = best_time(lambda: regressor_batch(mech, Q, QD, QDD, backend="c"), 1)
+        out["output_gb"] = Y.nbytes / 1e9
+        m = args.python_samples
+        python_s, Yp = best_time(lambda: np.vstack([regressor(mech, *s) for s in zip(Q[:m], QD[:m], QDD[:m])]), 1)
+        out["python_per_sample_us"] = 1e6 * python_s / m
+        out["python_batch_s"] = python_s / m * args.samples
+        out["ratio_python_over_c_warm"] = out["python_batch_s"] / out["c_warm_s"]
+        out["max_relative_difference"] = float(np.abs(Y[:m * mech.na] - Yp).max() / np.abs(Yp).max())
+        del Y
+    if not args.no_base:
+        out["base_double_s"], b = best_time(lambda: pkm.base_parameters(mech, precise=False), 1)
+        out["base_both_routes_s"], b = best_time(lambda: pkm.base_parameters(mech), 1)
+        out["n_base"], out["routes_agree"] = len(b), b.routes_agree
+    return out
+
+
+def table(r: dict[str, Any]) -> str:
+    lines = [f"identification: {r['mechanism']}, {r['na']} actuators, {r['parameters']} parameters"]
+    if r.get("c") is None:
+        lines.append("  no compiled regressor (no C compiler, or a mechanism the twin cannot build)")
+    else:
+        lines += [f"  compile (or load from the cache)  {r['compile_s']:8.2f} s",
+                  f"  regressor, {r['samples']} samples ({r['output_gb']:.2f} GB)",
+                  f"    C, first call                  {r['c_first_s']:8.3f} s",
+                  f"    C, warm                        {r['c_warm_s']:8.3f} s",
+                  f"    Python (scaled from a subset)  {r['python_batch_s']:8.3f} s "
+                  f"({r['python_per_sample_us']:.0f} us a sample)",
+                  f"    ratio Python / C warm          {r['ratio_python_over_c_warm']:8.1f}",
+                  f"    largest relative difference    {r['max_relative_difference']:8.1e}"]
+    if "n_base" in r:
+        lines += [f"  base parameters: {r['n_base']} (routes agree: {r['routes_agree']})",
+                  f"    double precision only          {r['base_double_s']:8.2f} s",
+                  f"    with the 50-digit route        {r['base_both_routes_s']:8.2f} s"]
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    from pkm.bench import main
+
+    raise SystemExit(main("identification"))
