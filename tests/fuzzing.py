@@ -1629,7 +1629,7 @@ def _estimate(g, adv):
         k = int(g.rng.integers(0, 4))
         arrays[k] = g.value(arrays[k], True, 1.0)
     if "rrr3" not in _BASES:  # (computed once: the estimate, not the base parameters, is what this entry tries)
-        _BASES["rrr3"] = c.pkm.base_parameters(mm)
+        _BASES["rrr3"] = c.pkm.base_parameters(mm, precise=False)
     return c.pkm.estimate, (m, *arrays), {"weighted": g.chance(0.5), "base": _BASES["rrr3"]}
 
 
@@ -1637,7 +1637,47 @@ def _estimate(g, adv):
 def _base_parameters(g, adv):
     _, m = _mech(g, adv, ("rrr3",))  # (the cheapest: 82 parameters; its least sample count 28)
     samples = g.pick((28, 40, 5)) if not adv or g.chance(0.5) else g.pick(ADV_NUMBERS + (0, -3, 2.5, "7", True))
-    return ctx().pkm.base_parameters, (m, samples), {"seed": int(g.rng.integers(0, 100))}
+    return ctx().pkm.base_parameters, (m, samples), {"seed": int(g.rng.integers(0, 100)),
+                                                     "precise": g.chance(0.3)}  # (the 50-digit route: 0.3 s)
+
+
+@entry("pkm.regressor_batch")
+def _regressor_batch(g, adv):
+    n, m, q, qd = _dyn_state(g, adv, ("delta", "prs3"))
+    mm = ctx().mech[n]
+    k = int(g.rng.integers(1, 4))
+    Q, QD, QDD = [q] * k, [qd] * k, g.rng.standard_normal((k, mm.na))  # (lists: q, qd may be hostile objects)
+    if adv and g.chance(0.5):
+        QDD = g.value(QDD, True, 1.0)
+    backend = g.pick(("auto", "python", "c")) if not adv or g.chance(0.5) else g.pick(("fortran", 3, None))
+    return ctx().pkm.regressor_batch, (m, Q, QD, QDD), {"backend": backend}
+
+
+@entry("pkm.measurements")
+def _measurements(g, adv):
+    """A table of the Delta's: time, q.<joint>, tau.<joint> (a slow sine), with hostile cells, columns, times."""
+    c = ctx()
+    _, m = _mech(g, adv, ("delta",))
+    mm = c.mech["delta"]
+    n = int(g.pick((400, 60, 3))) if adv else 400
+    t = np.arange(n) * 0.002
+    cols = {"time": t}
+    for k, j in enumerate(mm.actuated_names):
+        cols[f"q.{j}"] = mm.actuated_q(mm.q_reference)[k] + 0.05 * np.sin(3 * t + k)
+        cols[f"tau.{j}"] = np.cos(3 * t)
+    if adv:
+        key = g.pick(list(cols))
+        what = int(g.rng.integers(0, 4))
+        if what == 0:
+            cols.pop(key)
+        elif what == 1:
+            cols[key] = g.value(cols[key], True, 1.0)
+        elif what == 2:
+            cols[key] = cols[key][::-1].copy()
+        else:
+            cols[key] = cols[key] * 57.3
+    cutoff = g.pick((None, 5.0, 20.0)) if not adv or g.chance(0.5) else g.pick(ADV_NUMBERS + (0.0, 1e9))
+    return c.pkm.measurements, (m, cols), {"cutoff": cutoff}
 
 
 def _forward_args(g: Gen, adversarial: bool, names=None):

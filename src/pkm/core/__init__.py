@@ -22,8 +22,12 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
                                 "coriolis_matrix", "gravity_efforts", "mass_matrix", "operational_space"),
     "pkm.core.dynamics.simulate": ("Event", "Simulation", "simulate"),
     "pkm.core.identification.base": ("BaseParameters", "base_parameters"),
+    "pkm.core.identification.consistent": ("ConsistentEstimate", "consistent_estimate"),
     "pkm.core.identification.estimate": ("Estimate", "estimate"),
-    "pkm.core.identification.regressor": ("Parameters", "parameters", "regressor"),
+    "pkm.core.identification.excitation": ("Excitation", "excite"),
+    "pkm.core.identification.export": ("Validation", "validate", "write_identified"),
+    "pkm.core.identification.measurements": ("Measurements", "measurements"),
+    "pkm.core.identification.regressor": ("Parameters", "parameters", "regressor", "regressor_batch"),
     "pkm.core.model.actuators": ("Actuator",),
     "pkm.core.model.builder": ("with_actuators",),
     "pkm.core.model.mechanism": ("Mechanism",),
@@ -64,8 +68,12 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.dynamics.projection import constraint_dynamics, forward_dynamics, inverse_dynamics
     from pkm.core.dynamics.simulate import Event, Simulation, simulate
     from pkm.core.identification.base import BaseParameters, base_parameters
+    from pkm.core.identification.consistent import ConsistentEstimate, consistent_estimate
     from pkm.core.identification.estimate import Estimate, estimate
-    from pkm.core.identification.regressor import Parameters, parameters, regressor
+    from pkm.core.identification.excitation import Excitation, excite
+    from pkm.core.identification.export import Validation, validate, write_identified
+    from pkm.core.identification.measurements import Measurements, measurements
+    from pkm.core.identification.regressor import Parameters, parameters, regressor, regressor_batch
     from pkm.core.kinematics.configuration import Configuration
     from pkm.core.kinematics.solve import (
         ClosureProblem,

@@ -2,7 +2,10 @@
 written as a table (pkm's own inverse dynamics along it, two periods at 500 Hz), noise added as the issue states
 (1e-4 rad or m on every position, 1 % of each actuator's effort range on its efforts), the table read back through
 the zero-phase filter (cutoff 2 Hz, four times the excitation's highest harmonic), the base parameters estimated by
-Gautier's weighted least squares: every one within three of its stated standard deviations.
+Gautier's weighted least squares: every one within three of its stated standard deviations, but for what chance
+allows: with honest deviations a parameter lies beyond three with probability 0.27 %, so one of the Gough-Stewart's
+106 does in a quarter of noise draws (1 - 0.9973^106); the test allows one beyond three (seen: the Gough-Stewart's
+`leg4.offset` at 3.1 with this seed) and none beyond four (probability 6e-5 each).
 
 Why three and not fewer: the deviations are those of the efforts' noise; the positions' noise reaches the regressor
 through the filtered rates and accelerations (errors in the variables, which least squares does not model). The
@@ -38,4 +41,5 @@ def test_every_base_parameter_within_three_standard_deviations(name, tmp_path):
     base = base_parameters(mech, precise=False)
     est = estimate(mech, data.Q, data.QD, data.QDD, data.TAU, base=base)
     z = (est.values - base.values) / est.std
-    assert np.abs(z).max() <= 3.0, [(base.names[i], z[i]) for i in np.argsort(-np.abs(z))[:3]]
+    worst = [(base.names[i], round(float(z[i]), 2)) for i in np.argsort(-np.abs(z))[:3]]
+    assert np.sum(np.abs(z) > 3.0) <= 1 and np.abs(z).max() <= 4.0, worst

@@ -61,6 +61,6 @@ def test_bad_files_and_too_few_rows(tmp_path):
     with pytest.raises(InvalidInputError, match="no such file"):
         measurements(mech, tmp_path / "none.csv")
     with pytest.raises(InvalidInputError, match="rows; the filter"):
-        measurements(mech, _sine(mech, n=60), cutoff=5.0)
+        measurements(mech, _sine(mech, n=60), cutoff=20.0)
     with pytest.raises(InvalidInputError, match="cutoff"):
         measurements(mech, _sine(mech), cutoff=400.0)

@@ -8,7 +8,7 @@ what its command needs inside its functions, so that ``pkm --help`` stays fast.
 from __future__ import annotations
 
 from pkm.cli.command import Command
-from pkm.cli.commands import bench, dynamics, fk, ik, preview, report, simulate, spec, sweep
+from pkm.cli.commands import bench, dynamics, excite, fk, identify, ik, preview, report, simulate, spec, sweep
 from pkm.cli.commands import list as list_
 from pkm.cli.commands import map as map_
 
@@ -20,6 +20,8 @@ COMMANDS: dict[str, Command] = {
     "map": map_.COMMAND,
     "dynamics": dynamics.COMMAND,
     "simulate": simulate.COMMAND,
+    "excite": excite.COMMAND,
+    "identify": identify.COMMAND,
     "spec": spec.COMMAND,
     "report": report.COMMAND,
     "bench": bench.COMMAND,

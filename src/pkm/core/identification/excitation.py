@@ -247,11 +247,24 @@ def excite(mech: Mechanism, *, period: float = 10.0, harmonics: int = 5, samples
             break
         x0[na:] *= SHRINK
     start = float(np.exp(log_condition(x0)))
-    res = scipy.optimize.minimize(log_condition, x0, method="SLSQP",
+    best_f, best_x = [log_condition(x0)], [x0.copy()]
+
+    def keep(xk: np.ndarray) -> None:  # (the best feasible iterate: SLSQP stopped early may end infeasible)
+        f = log_condition(xk)
+        if f < best_f[0] and evaluated(xk) is not None and margins(xk).min() >= -1e-9:
+            best_f[0], best_x[0] = f, xk.copy()
+
+    res = scipy.optimize.minimize(log_condition, x0, method="SLSQP", callback=keep,
                                   constraints=[{"type": "ineq", "fun": margins}],
                                   bounds=[(-0.9, 0.9)] * na + [(None, None)] * (2 * na * L),
                                   options={"maxiter": max_iter, "ftol": 1e-6})
-    x = res.x if evaluated(res.x) is not None and margins(res.x).min() >= -1e-9 else x0
+    candidate = res.x.copy()
+    for _ in range(MAX_SHRINK):  # (SLSQP stopped early may end outside the limits: shrink its result until inside)
+        if evaluated(candidate) is not None and margins(candidate).min() >= -1e-9:
+            keep(candidate)
+            break
+        candidate *= SHRINK
+    x = best_x[0]
     dense = np.arange(DENSE * M) * period / (DENSE * M)
     shrunk = 0
     while shrunk <= MAX_SHRINK:

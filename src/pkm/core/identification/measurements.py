@@ -32,6 +32,7 @@ import scipy.signal
 from pkm._optional import module
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PkmError
+from pkm.validation import as_array, as_count, as_scalar
 
 ORDER = 4  # the Butterworth filter's order (run twice: 8 in magnitude)
 EDGE = 3.0  # cutoff periods left out at each end (the filter's transients)
@@ -126,8 +127,14 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
     """
     mech = check_mechanism(mech)
     source = str(data) if isinstance(data, (str, Path)) else "columns"
-    cols = read_table(data) if isinstance(data, (str, Path)) else {k: np.asarray(v, dtype=float)
-                                                                    for k, v in data.items()}
+    if isinstance(data, (str, Path)):
+        cols = read_table(data)
+    elif isinstance(data, dict):
+        cols = {}
+        for k, v in data.items():
+            cols[k] = as_array(v, str(k))
+    else:
+        raise InvalidInputError("data", "expected a path or a dict of columns", type(data).__name__)
     names = mech.actuated_names
     wanted = ["time", *(f"q.{j}" for j in names), *(f"tau.{j}" for j in names)]
     missing = [c for c in wanted if c not in cols]
@@ -135,6 +142,12 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
         raise InvalidInputError(missing[0], f"{source}: missing column{'s' * (len(missing) > 1)} "
                                             f"{', '.join(missing)} (expected time, q.<joint> and tau.<joint> for "
                                             f"{', '.join(names)})", missing)
+    lengths = {c: cols[c].shape for c in wanted}
+    n0 = lengths["time"]
+    for c, shape in lengths.items():
+        if len(shape) != 1 or shape != n0:
+            raise InvalidInputError(c, f"{source}: column {c!r} has shape {shape}, time {n0}: expected one value per "
+                                       f"row, as many as the times", shape)
     table = np.column_stack([cols[c] for c in wanted])
     bad = ~np.isfinite(table)
     if bad.any():
@@ -171,10 +184,11 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
                                                      f"{min(hi[j], cap):.6g}] (SI units: is the table in {unit}?)",
                                     QA[r, j])
     rate = 1.0 / dt
-    fc = 0.1 * rate if cutoff is None else float(cutoff)
-    if not 0.0 < fc < 0.5 * rate:
-        raise InvalidInputError("cutoff", f"the cutoff must lie in (0, {0.5 * rate:.6g}) Hz (half the sampling "
-                                          f"rate), got {fc}", cutoff)
+    fc = 0.1 * rate if cutoff is None else as_scalar(cutoff, "cutoff")
+    if not 2.0 * rate / n < fc < 0.5 * rate:
+        raise InvalidInputError("cutoff", f"the cutoff must lie in ({2.0 * rate / n:.6g}, {0.5 * rate:.6g}) Hz (two "
+                                          f"cutoff periods in the record, under half the sampling rate), got {fc}",
+                                cutoff)
     sos = scipy.signal.butter(ORDER, fc, fs=rate, output="sos")
     edge = int(np.ceil(EDGE * rate / fc))
     if n <= 2 * edge + 3 * (2 * ORDER + 1):
@@ -184,10 +198,10 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
     qd = _lowpass(np.gradient(q, dt, axis=0), sos, edge)
     qdd = _lowpass(np.gradient(qd, dt, axis=0), sos, edge)
     tau = _lowpass(TAU, sos, edge)
-    k = max(1, int(rate / (2.0 * fc))) if decimate is None else int(decimate)
-    if k < 1:
+    every = max(1, int(rate / (2.0 * fc))) if decimate is None else as_count(decimate, "decimate")
+    if every < 1:
         raise InvalidInputError("decimate", f"expected a positive integer, got {decimate}", decimate)
-    keep = np.arange(edge, n - edge, k)
+    keep = np.arange(edge, n - edge, every)
     from pkm.core.identification.excitation import _Path
 
     try:
@@ -195,7 +209,7 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
     except PkmError as exc:
         raise InvalidInputError("q", f"{source}: the loops do not close along the measured positions ({exc})",
                                 None) from None
-    return Measurements(t[keep], Q, qd[keep], qdd[keep], tau[keep], fc, rate, k, source)
+    return Measurements(t[keep], Q, qd[keep], qdd[keep], tau[keep], fc, rate, every, source)
 
 
 __all__ = ["Measurements", "measurements", "read_table"]

@@ -36,7 +36,7 @@ from pkm.core.differential.velocity import passive_map
 from pkm.core.dynamics.model import COULOMB_VELOCITY, actuator_model
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import CompilerError, InvalidInputError, SpecError
-from pkm.validation import finite_result
+from pkm.validation import as_array, finite_result
 
 if TYPE_CHECKING:
     from pkm.core.twin.kernels import Kernels
@@ -188,7 +188,7 @@ def regressor_batch(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike
     mech = check_mechanism(mech)
     if not isinstance(backend, str) or backend not in BACKENDS:
         raise InvalidInputError("backend", f"use one of {list(BACKENDS)}, got {backend!r}", backend)
-    Q, QD, QDD = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (Q, QD, QDD))
+    Q, QD, QDD = (np.atleast_2d(as_array(x, name)) for x, name in ((Q, "Q"), (QD, "QD"), (QDD, "QDD")))
     if not (len(Q) == len(QD) == len(QDD)):
         raise InvalidInputError("Q", f"expected as many samples of each: {len(Q)}, {len(QD)}, {len(QDD)}", len(Q))
     if backend == "c" or (backend == "auto" and (len(Q) >= AUTO_SAMPLES or _KERNELS.get(mech) is not None)):

@@ -1,0 +1,76 @@
+"""``pkm excite`` and ``pkm identify``: the Delta identified end to end from the command line (an optimal excitation
+written as a table, noise added as a robot's encoders and drives would, the physically consistent estimate written as
+a spec that pkm loads back and that predicts a second table), with figures; bad input as one error line."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm import cli
+from pkm.core.identification.regressor import parameters
+from tests.cli.helpers import one_error_line, run
+
+
+def _noisy(src, dst, seed):
+    rows = list(csv.reader(src.open()))
+    header, data = rows[0], np.array(rows[1:], dtype=float)
+    rng = np.random.default_rng(seed)
+    for i, name in enumerate(header):
+        if name.startswith("q."):
+            data[:, i] += 1e-4 * rng.standard_normal(len(data))
+        if name.startswith("tau."):
+            data[:, i] += 0.01 * np.ptp(data[:, i]) * rng.standard_normal(len(data))
+    with dst.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        w.writerows(data.tolist())
+    return dst
+
+
+@pytest.fixture(scope="module")
+def excited(tmp_path_factory):
+    pytest.importorskip("matplotlib")
+    folder = tmp_path_factory.mktemp("identify")
+    argv = ["excite", "delta", "--duration", "10s", "--periods", "2", "--out", str(folder / "exc.csv"),
+            "--plot", str(folder / "exc.png"), "--iterations", "15", "--json"]
+    return folder, argv
+
+
+def test_excite_then_identify_the_delta(excited, capsys):
+    pytest.importorskip("cvxpy")
+    folder, argv = excited
+    assert cli.main(argv) == 0, capsys.readouterr().err
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["condition"] < summary["condition_start"] and (folder / "exc.png").stat().st_size > 1000
+    train = _noisy(folder / "exc.csv", folder / "train.csv", 1)
+    check = _noisy(folder / "exc.csv", folder / "check.csv", 2)
+    out = folder / "ident" / "delta.closures.toml"
+    assert cli.main(["identify", "delta", str(train), "--out", str(out), "--consistent", "--cutoff", "2",
+                     "--validate", str(check), "--plot", str(folder / "fit.png"), "--json"]) == 0, \
+        capsys.readouterr().err
+    result = json.loads(capsys.readouterr().out)
+    assert result["routes_agree"] is True and len(result["base"]) == 48
+    assert result["smallest_pseudo_inertia_eigenvalue"] >= -1e-9
+    assert max(result["validation"]["relative_percent"].values()) <= 0.1  # (measured 0.02-0.03 %)
+    identified = pkm.load(out)
+    assert len(parameters(identified)) == len(parameters(pkm.load("delta")))
+    delta = pkm.load("delta")
+    q = delta.q_reference
+    tau_true = pkm.actuator_model(delta, q, [0.3, -0.2, 0.1]).efforts([1.0, 0.5, -0.7])
+    tau_identified = pkm.actuator_model(identified, q, [0.3, -0.2, 0.1]).efforts([1.0, 0.5, -0.7])
+    assert np.allclose(tau_identified, tau_true, rtol=0.02, atol=1e-3 * np.abs(tau_true).max())
+
+
+def test_bad_input_is_one_error_line(tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("time,q.motor_1,q.motor_2,q.motor_3,tau.motor_1,tau.motor_2\n0,0,0,0,0,0\n")
+    line = one_error_line(run("identify", "delta", str(bad), "--out", str(tmp_path / "x.closures.toml")))
+    assert "tau.motor_3" in line
+    line = one_error_line(run("excite", "delta", "--harmonics", "5", "--samples", "4", "--out",
+                              str(tmp_path / "e.csv")))
+    assert "samples" in line
