@@ -16,8 +16,13 @@ sampling step and one law per coordinate::
     beta = { law = "constant", value = 0.0 }
     phi = { law = "constant", value = 0.0 }
 
-Laws, with ``t`` in seconds: ``constant`` (``value``), ``linear`` (``start + rate t``) and
-``cosine`` (``offset + amplitude (1 - cos(omega t))``). Their derivatives are exact.
+Laws, with ``t`` in seconds: ``constant`` (``value``), ``linear`` (``start + rate t``),
+``cosine`` (``offset + amplitude (1 - cos(omega t))``) and ``fourier`` (Swevers' finite Fourier series
+``offset + Σ_l a_l / (omega l) sin(omega l t) - b_l / (omega l) cos(omega l t)``, ``a`` and ``b`` lists of as many
+harmonics: identification's excitations, :mod:`pkm.core.identification.excitation`). Their derivatives are exact.
+
+``space = "actuated"`` (top level; default ``"task"``) says the coordinates are actuated joints, by name, rather
+than task coordinates: an excitation trajectory is one.
 
 What the loader refuses (:class:`~pkm.errors.SpecError`): a path that is not a regular file
 (FIFOs and devices are not opened for reading), a file over 16 MiB or not UTF-8, TOML that does
@@ -42,7 +47,11 @@ from pkm.validation import ABSURD, as_array, finite_result
 FORMAT = "pkm.motion/1"
 MAX_SAMPLES = 10_000_000  #: samples of one case at most (memory)
 MAX_TIME = 1e9  #: |t| [s] accepted by :meth:`Motion.sample`
-LAWS = {"constant": ("value",), "linear": ("start", "rate"), "cosine": ("offset", "amplitude", "omega")}
+LAWS = {"constant": ("value",), "linear": ("start", "rate"), "cosine": ("offset", "amplitude", "omega"),
+        "fourier": ("offset", "omega", "a", "b")}
+LISTS = {"a", "b"}  #: keys holding one number per harmonic
+SPACES = ("task", "actuated")
+MAX_HARMONICS = 1000
 
 
 @dataclass(frozen=True)
@@ -61,6 +70,13 @@ class Law:
         if self.kind == "linear":
             start, rate = self.coef
             return start + rate * t, z + rate, z
+        if self.kind == "fourier":
+            off, om, *ab = self.coef
+            L = len(ab) // 2
+            a, b = np.array(ab[:L]), np.array(ab[L:])
+            wl = om * np.arange(1, L + 1)
+            s, c = np.sin(np.multiply.outer(t, wl)), np.cos(np.multiply.outer(t, wl))
+            return off + (s * (a / wl) - c * (b / wl)).sum(-1), (c * a + s * b).sum(-1), (c * b * wl - s * a * wl).sum(-1)
         off, amp, om = self.coef
         c, s = np.cos(om * t), np.sin(om * t)
         return off + amp * (1.0 - c), amp * om * s, amp * om * om * c
@@ -87,6 +103,7 @@ class Motion:
     dt: float
     description: str = ""
     source: str = ""
+    space: str = "task"
 
     def times(self) -> np.ndarray:
         """Sample times ``0, dt, ..., duration`` [s]."""
@@ -124,7 +141,10 @@ def load_motions(file: str | Path) -> dict[str, Motion]:
     cases = raw.get("case")
     if not isinstance(cases, dict) or not cases:
         raise SpecError(src, "no [case.NAME] tables")
-    return {name: _motion(src, name, body, tuple(coords)) for name, body in cases.items()}
+    space = raw.get("space", "task")
+    if space not in SPACES:
+        raise SpecError(src, f"'space' must be one of {list(SPACES)}, got {space!r}")
+    return {name: _motion(src, name, body, tuple(coords), space) for name, body in cases.items()}
 
 
 def _number(src: str, where: str, v) -> float:
@@ -133,7 +153,24 @@ def _number(src: str, where: str, v) -> float:
     return float(v)
 
 
-def _motion(src: str, name: str, body, coords: tuple[str, ...]) -> Motion:
+def _coefficients(src: str, where: str, spec: dict, keys: tuple[str, ...]) -> tuple[float, ...]:
+    out: list[float] = []
+    for k in keys:
+        v = spec.get(k)
+        if k in LISTS:
+            if not isinstance(v, list) or not 1 <= len(v) <= MAX_HARMONICS:
+                raise SpecError(src, f"{where}.{k} must be a list of 1 to {MAX_HARMONICS} numbers")
+            out += [_number(src, f"{where}.{k}", x) for x in v]
+        else:
+            out.append(_number(src, f"{where}.{k}", v))
+    if len(keys) == 4 and keys[2:] == ("a", "b") and len(spec["a"]) != len(spec["b"]):
+        raise SpecError(src, f"{where}: a and b must have as many harmonics ({len(spec['a'])} and {len(spec['b'])})")
+    if keys == LAWS["fourier"] and not out[1] > 0.0:
+        raise SpecError(src, f"{where}.omega must be positive, got {out[1]}")
+    return tuple(out)
+
+
+def _motion(src: str, name: str, body, coords: tuple[str, ...], space: str = "task") -> Motion:
     if not isinstance(body, dict):
         raise SpecError(src, f"case {name!r} must be a table")
     duration = _number(src, f"case {name!r} duration", body.get("duration"))
@@ -152,9 +189,9 @@ def _motion(src: str, name: str, body, coords: tuple[str, ...]) -> Motion:
         extra = set(spec) - {"law", *keys}
         if extra:
             raise SpecError(src, f"case {name!r}: coordinate {c!r} ({spec['law']}) has unknown keys {sorted(extra)}")
-        laws.append(Law(spec["law"], tuple(_number(src, f"case {name!r} {c}.{k}", spec.get(k)) for k in keys)))
+        laws.append(Law(spec["law"], _coefficients(src, f"case {name!r} {c}", spec, keys)))
     return Motion(name, coords, tuple(laws), duration, dt, str(body.get("description", "")),
-                  str(body.get("source", "")))
+                  str(body.get("source", "")), space)
 
 
-__all__ = ["FORMAT", "LAWS", "Law", "Motion", "load_motions"]
+__all__ = ["FORMAT", "LAWS", "SPACES", "Law", "Motion", "load_motions"]

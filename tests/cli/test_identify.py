@@ -37,7 +37,7 @@ def excited(tmp_path_factory):
     pytest.importorskip("matplotlib")
     folder = tmp_path_factory.mktemp("identify")
     argv = ["excite", "delta", "--duration", "10s", "--periods", "2", "--out", str(folder / "exc.csv"),
-            "--plot", str(folder / "exc.png"), "--iterations", "15", "--json"]
+            "--plot", str(folder / "exc.png"), "--iterations", "15", "--motion", str(folder / "exc.toml"), "--json"]
     return folder, argv
 
 
@@ -47,6 +47,9 @@ def test_excite_then_identify_the_delta(excited, capsys):
     assert cli.main(argv) == 0, capsys.readouterr().err
     summary = json.loads(capsys.readouterr().out)
     assert summary["condition"] < summary["condition_start"] and (folder / "exc.png").stat().st_size > 1000
+    from pkm.motion import load_motions
+
+    assert load_motions(summary["motion"])["excitation"].space == "actuated"
     train = _noisy(folder / "exc.csv", folder / "train.csv", 1)
     check = _noisy(folder / "exc.csv", folder / "check.csv", 2)
     out = folder / "ident" / "delta.closures.toml"

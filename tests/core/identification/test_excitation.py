@@ -71,6 +71,21 @@ def test_the_samples_table_holds_the_motion(tmp_path):
     assert np.allclose([cols[f"tau.{j}"][k] for j in mech.actuated_names], tau, rtol=1e-9, atol=1e-12)
 
 
+def test_the_motion_file_reads_back(tmp_path):
+    """Written as a pkm.motion/1 file (space "actuated", one fourier law per motor), loaded by pkm.motion: the same
+    positions, rates and accelerations to 1e-12."""
+    from pkm.core.identification.excitation import write_motion
+    from pkm.motion import load_motions
+
+    mech = mechanism("delta")
+    e = excitation("delta")
+    (motion,) = load_motions(write_motion(mech, e, tmp_path / "excitation.toml", dt=0.05)).values()
+    assert motion.space == "actuated" and motion.coordinates == tuple(mech.actuated_names)
+    t, Y, Yd, Ydd = motion.sample()
+    for got, want in zip((Y, Yd, Ydd), e(t)):
+        assert np.abs(got - want).max() <= 1e-12 * max(1.0, np.abs(want).max())
+
+
 def test_an_excitation_that_cannot_meet_its_limits_is_refused_naming_the_limit():
     """Gravity alone needs 0.18 N m at each Delta motor: a 0.1 N m limit is refused before any optimisation."""
     mech = pkm.load("delta")

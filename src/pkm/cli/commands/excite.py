@@ -26,6 +26,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--amplitude", type=float, help="largest excursion from the reference [rad or m, SI]")
     p.add_argument("--tie-legs", action="store_true", help="condition the tied base parameters (legs alike)")
     p.add_argument("--out", metavar="FILE.csv", required=True, help="the samples table")
+    p.add_argument("--motion", metavar="FILE.toml", help="also write the series as a motion file (pkm.motion)")
     p.add_argument("--plot", metavar="FILE.png", help="draw positions, rates and efforts (pkm[figures])")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
@@ -46,6 +47,10 @@ def run(args: argparse.Namespace) -> int:
     out = {"mechanism": mech.name, "period_s": e.period, "harmonics": int(e.a.shape[1]),
            "condition_start": e.condition_start, "condition": e.condition, "margins": e.margins,
            "shrunk": e.shrunk, "out": write_csv(mech, e, args.out, periods=args.periods, dt=dt)}
+    if args.motion:
+        from pkm.core.identification.excitation import write_motion
+
+        out["motion"] = write_motion(mech, e, args.motion, periods=args.periods, dt=dt)
     if args.plot:
         from pkm.viz.identification import excitation_figure
 
@@ -56,7 +61,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"{mech.name}: excitation of period {e.period:g} s, {out['harmonics']} harmonics; condition number "
               f"{e.condition_start:.4g} -> {e.condition:.4g}")
         print("margins (fraction of each limit left): " + ", ".join(f"{k} {v:.3g}" for k, v in e.margins.items()))
-        print(f"out: {out['out']}" + (f"\nplot: {out['plot']}" if args.plot else ""))
+        for key in ("out", "motion", "plot"):
+            if key in out:
+                print(f"{key}: {out[key]}")
     return 0
 
 

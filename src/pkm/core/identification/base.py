@@ -15,6 +15,7 @@ rounding; then scaled back to the parameters' units).
 from __future__ import annotations
 
 import re
+import weakref
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import TYPE_CHECKING
@@ -32,6 +33,7 @@ from pkm.core.kinematics.solve import close_loops
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import ConvergenceError, InvalidInputError, SingularityError
 
+_STATES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # mechanism -> {(n, seed, spread): states}
 MAX_SAMPLES = 10_000  # states stacked at most (each costs about a millisecond)
 COEFFICIENT_TOL = 1e-6  # coefficients of K on unit-norm columns under this are dropped (rounding of R_11^-1 R_12)
 
@@ -99,8 +101,13 @@ def random_states(mech: Mechanism, n: int, seed: int = 0, spread: float = 0.1) -
                                                                                               np.ndarray]]:
     """``n`` random regular states ``(q, qd, qdd)``: each actuated coordinate moved by up to ``spread`` [rad or m]
     from the reference and closed from it (states that do not close or are singular are drawn again), rates and
-    accelerations standard normal."""
+    accelerations standard normal. The last few draws are kept per mechanism (the tied and untied base parameters
+    share theirs: the hexapod's 107 states cost 8 s)."""
     mech = check_mechanism(mech)
+    key = (n, seed, spread)
+    kept = _STATES.setdefault(mech, {})
+    if key in kept:
+        return [(q.copy(), qd.copy(), qdd.copy()) for q, qd, qdd in kept[key]]
     rng = np.random.default_rng(seed)
     qa0 = mech.actuated_q(mech.q_reference)
     out: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
@@ -116,6 +123,9 @@ def random_states(mech: Mechanism, n: int, seed: int = 0, spread: float = 0.1) -
         out.append((q, rng.standard_normal(mech.na), rng.standard_normal(mech.na)))
     if len(out) < n:
         raise InvalidInputError("spread", f"only {len(out)} of {n} random states closed within the limits", spread)
+    if len(kept) >= 4:
+        kept.pop(next(iter(kept)))
+    kept[key] = tuple((q.copy(), qd.copy(), qdd.copy()) for q, qd, qdd in out)
     return out
 
 

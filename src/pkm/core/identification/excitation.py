@@ -337,4 +337,33 @@ def write_csv(mech: Mechanism, excitation: Excitation, path: str, *, periods: in
     return str(out)
 
 
-__all__ = ["AMPLITUDE", "SINGULARITY", "Excitation", "excite", "fourier", "write_csv"]
+def write_motion(mech: Mechanism, excitation: Excitation, path: str, *, periods: int = 1, dt: float | None = None,
+                 case: str = "excitation") -> str:
+    """The excitation as a motion file (:mod:`pkm.motion`, ``space = "actuated"``, one ``fourier`` law per actuated
+    joint, the coefficients exact: ``repr`` of each float), ``periods`` periods sampled every ``dt`` [s]."""
+    from pathlib import Path
+
+    from pkm.motion import FORMAT
+
+    mech = check_mechanism(mech)
+    step = excitation.t[1] - excitation.t[0] if dt is None else as_scalar(dt, "dt")
+    names = excitation.joints
+
+    def floats(x: np.ndarray) -> str:
+        return "[" + ", ".join(repr(float(v)) for v in x) + "]"
+
+    lines = [f'format = "{FORMAT}"', f'mechanism = "{mech.name}"', 'space = "actuated"',
+             "coordinates = [" + ", ".join(f'"{n}"' for n in names) + "]", "", f"[case.{case}]",
+             f'description = "optimal excitation: condition number {excitation.condition:.4g} (from '
+             f'{excitation.condition_start:.4g})"', 'source = "pkm.excite"',
+             f"duration = {as_count(periods, 'periods') * excitation.period!r}", f"dt = {float(step)!r}"]
+    for k, n in enumerate(names):
+        lines.append(f'{n} = {{ law = "fourier", offset = {float(excitation.offset[k])!r}, omega = '
+                     f'{excitation.omega!r}, a = {floats(excitation.a[k])}, b = {floats(excitation.b[k])} }}')
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return str(out)
+
+
+__all__ = ["AMPLITUDE", "SINGULARITY", "Excitation", "excite", "fourier", "write_csv", "write_motion"]
