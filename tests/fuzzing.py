@@ -1653,6 +1653,13 @@ def _regressor_batch(g, adv):
     return ctx().pkm.regressor_batch, (m, Q, QD, QDD), {"backend": backend}
 
 
+@entry("pkm.capability")
+def _capability(g, adv):
+    _, m, q, _ = _dyn_state(g, adv, ("delta", "prs3", "rrr3", "gough_stewart"))
+    kind = g.pick(("wrench", "twist", "acceleration")) if not adv or g.chance(0.5) else g.pick(("power", 3, None))
+    return ctx().pkm.capability, (m, q, kind), {"gravity": g.chance(0.7)}
+
+
 @entry("pkm.measurements")
 def _measurements(g, adv):
     """A table of the Delta's: time, q.<joint>, tau.<joint> (a slow sine), with hostile cells, columns, times."""

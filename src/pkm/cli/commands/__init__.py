@@ -8,7 +8,20 @@ what its command needs inside its functions, so that ``pkm --help`` stays fast.
 from __future__ import annotations
 
 from pkm.cli.command import Command
-from pkm.cli.commands import bench, dynamics, excite, fk, identify, ik, preview, report, simulate, spec, sweep
+from pkm.cli.commands import (
+    bench,
+    capability,
+    dynamics,
+    excite,
+    fk,
+    identify,
+    ik,
+    preview,
+    report,
+    simulate,
+    spec,
+    sweep,
+)
 from pkm.cli.commands import list as list_
 from pkm.cli.commands import map as map_
 
@@ -22,6 +35,7 @@ COMMANDS: dict[str, Command] = {
     "simulate": simulate.COMMAND,
     "excite": excite.COMMAND,
     "identify": identify.COMMAND,
+    "capability": capability.COMMAND,
     "spec": spec.COMMAND,
     "report": report.COMMAND,
     "bench": bench.COMMAND,

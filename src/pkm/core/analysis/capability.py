@@ -1,0 +1,189 @@
+"""Capability under actuator limits: the task wrenches, twists and accelerations the actuators can produce at a pose.
+
+Everything here is in the mechanism's **task coordinates** ``y`` (:attr:`pkm.Mechanism.task_map`), with the forward
+Jacobian ``J`` (``ẏ = J q̇_a``, :func:`pkm.forward_jacobian`); the efforts ``w`` conjugate to them are those whose
+power is the actuators' (``wᵀ ẏ = τ_aᵀ q̇_a``, so ``τ_a = Jᵀ w``): forces [N] on length coordinates, moments [N m]
+about an angle coordinate's own axis on angles (at zero angles, the platform frame's axes).
+
+* **Wrenches** (static): ``{w : τ_min ≤ Jᵀ w + g_a ≤ τ_max}``: what the platform can hold, the actuators also
+  holding the mechanism's own weight ``g_a`` (:func:`pkm.gravity_efforts`; ``gravity=False`` leaves it out).
+* **Twists**: ``{J q̇_a : |q̇_a| ≤ q̇_max}``, from the actuators' speed limits.
+* **Accelerations** (from rest): ``{J M_a⁻¹ (τ - h_a) : τ_min ≤ τ ≤ τ_max}`` (``M_a``, ``h_a``:
+  :func:`pkm.actuator_model`; at rest ``h_a`` is the gravity's and the ``J̇ q̇`` term vanishes).
+
+Each is a :class:`Polytope` (vertices and half-spaces ``A x ≤ b``), the affine image or preimage of the limits' box,
+exact: with ``J`` square and regular the map is one-to-one, so the vertices are the box's ``2^na`` corners mapped
+and the half-spaces its faces pulled back (no vertex enumeration, no hull). Indices (:class:`Capability`): the
+largest value along each task axis in each direction (the polytope's extent through the origin), the largest
+isotropic value of each unit group (the radius of the largest ball about the origin inside the polytope, in the
+axes of one unit: forces alone, moments alone), and, for comparison, the Yoshikawa-type ellipsoid (the image of the
+limits' inscribed ellipsoid: its semi-axes and their directions), which under-states the box (by up to
+``sqrt(na)`` along a corner).
+
+Why not ``pycapacity`` (evaluated, version 2.1.9: its ``force_polytope(J, t_max, t_min)`` takes this ``J``
+directly, as a serial arm's): it requires ``cvxopt`` (GPL-3, compiled) and ``matplotlib`` on install, and for the
+square Jacobians of non-redundant parallel mechanisms its vertex search (hyper-plane shifting) is not needed: the
+polytope is a linear image of a box, exact in closed form. Redundantly actuated mechanisms (more actuators than
+task coordinates) would need it, or a hull: refused here with the reason.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.errors import InvalidInputError, SingularityError
+
+KINDS = ("wrench", "twist", "acceleration")
+_UNITS = {"wrench": {"length": "N", "angle": "N m"}, "twist": {"length": "m/s", "angle": "rad/s"},
+          "acceleration": {"length": "m/s^2", "angle": "rad/s^2"}}
+
+
+@dataclass(frozen=True)
+class Polytope:
+    """A convex polytope in task coordinates: ``vertices`` (k x n) and half-spaces ``A x ≤ b``.
+
+    Attributes:
+        vertices: Its corners (the limits' box corners mapped).
+        A: Half-space normals (m x n); ``b``: their offsets (m,).
+        axes: The task coordinates, in order; ``units``: each one's unit.
+    """
+
+    vertices: np.ndarray
+    A: np.ndarray
+    b: np.ndarray
+    axes: tuple[str, ...]
+    units: tuple[str, ...]
+
+    def contains(self, x: ArrayLike, tol: float = 1e-9) -> bool:
+        """Whether ``x`` satisfies every half-space (to ``tol`` relative to each row's offset scale)."""
+        x = np.asarray(x, dtype=float)
+        scale = np.maximum(np.abs(self.b), np.linalg.norm(self.A, axis=1) * np.abs(x).max(initial=0.0))
+        return bool(np.all(self.A @ x - self.b <= tol * np.maximum(scale, 1e-300)))
+
+    def reach(self, direction: ArrayLike) -> float:
+        """The largest ``t ≥ 0`` with ``t d`` inside (``d`` normalised; the origin inside): ``min b_i / (A_i d)``
+        over the rows that ``d`` approaches."""
+        d = np.asarray(direction, dtype=float)
+        d = d / np.linalg.norm(d)
+        rate = self.A @ d
+        ahead = rate > 1e-300
+        return float(np.min(self.b[ahead] / rate[ahead])) if ahead.any() else float("inf")
+
+    def inscribed_radius(self, axes: ArrayLike | None = None) -> float:
+        """The radius of the largest ball about the origin inside, in the coordinates ``axes`` (indices; the others
+        held at zero; default all): ``min b_i / |A_i|`` over those columns."""
+        cols = np.arange(self.A.shape[1]) if axes is None else np.asarray(axes, dtype=int)
+        norms = np.linalg.norm(self.A[:, cols], axis=1)
+        live = norms > 1e-300
+        return float(np.min(self.b[live] / norms[live])) if live.any() else float("inf")
+
+
+@dataclass(frozen=True)
+class Capability:
+    """One kind of capability at a pose, with its indices (module doc).
+
+    Attributes:
+        kind: ``"wrench"``, ``"twist"`` or ``"acceleration"``.
+        polytope: The set (:class:`Polytope`).
+        along: ``{axis: (largest positive, largest negative magnitude)}`` through the origin, in the axis' unit.
+        isotropic: ``{unit: radius}``: the largest value reachable in every direction of that unit's axes.
+        ellipsoid_axes: The Yoshikawa-type ellipsoid's semi-axes (descending) and ``ellipsoid_directions`` their
+            directions (columns), in the task axes' units (mixed where the task mixes them), about
+            ``ellipsoid_center`` (the image of zero efforts or rates: the weight's share, for wrenches).
+        origin_inside: Whether the origin is inside (a wrench set that excludes it: the actuators cannot even hold
+            the weight; its indices are then 0).
+    """
+
+    kind: str
+    polytope: Polytope
+    along: dict[str, tuple[float, float]]
+    isotropic: dict[str, float]
+    ellipsoid_axes: np.ndarray
+    ellipsoid_directions: np.ndarray
+    ellipsoid_center: np.ndarray
+    origin_inside: bool
+
+
+def _limits(mech: Mechanism, kind: str) -> tuple[np.ndarray, np.ndarray]:
+    if kind == "twist":
+        hi = np.array([a.velocity_limit for a in mech.actuators], dtype=float)
+        what = "velocity_limit"
+    else:
+        hi = np.array([a.effort_limit for a in mech.actuators], dtype=float)
+        what = "effort_limit"
+    bad = np.flatnonzero(~np.isfinite(hi) | ~(hi > 0.0))
+    if bad.size:
+        j = int(bad[0])
+        raise InvalidInputError(f"{mech.actuated_names[j]}.{what}", f"the {kind} capability needs a finite positive "
+                                                                   f"{what.replace('_', ' ')} on every actuator; "
+                                                                   f"{mech.actuated_names[j]} has {hi[j]}", hi[j])
+    return -hi, hi
+
+
+def _box_map(L: np.ndarray, c: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray,
+                                                                                    np.ndarray]:
+    """``{L u + c : lo ≤ u ≤ hi}`` for square regular ``L``: vertices, and ``A x ≤ b`` from ``u = L⁻¹ (x - c)``."""
+    Li = np.linalg.inv(L)
+    corners = np.array(list(itertools.product(*zip(lo, hi))))
+    V = corners @ L.T + c
+    A = np.vstack([Li, -Li])
+    b = np.concatenate([hi + Li @ c, -lo - Li @ c])
+    return V, A, b
+
+
+def capability(mech: Mechanism, q: ArrayLike, kind: str = "wrench", *, gravity: bool = True) -> Capability:
+    """The ``kind`` capability of ``mech`` at the closed configuration ``q`` (module doc).
+
+    Raises:
+        InvalidInputError: an unknown kind, an actuator without a finite positive limit of that kind (named), a
+            mechanism with more actuators than task coordinates.
+        SingularityError: ``J`` (or ``M_a``) singular at ``q``: no finite polytope.
+    """
+    from pkm.core.differential.velocity import forward_jacobian
+
+    mech = check_mechanism(mech)
+    if kind not in KINDS:
+        raise InvalidInputError("kind", f"use one of {list(KINDS)}, got {kind!r}", kind)
+    q = mech.check_q(q)
+    J = forward_jacobian(mech, q)
+    if J.shape[0] != J.shape[1]:
+        raise InvalidInputError("mech", f"{J.shape[1]} actuators for {J.shape[0]} task coordinates: the capability of "
+                                        "redundant actuation needs a hull (pycapacity's force_polytope)", J.shape)
+    s = np.linalg.svd(J, compute_uv=False)
+    if not s[-1] > 1e-12 * s[0]:
+        raise SingularityError("inverse" if s[-1] == 0.0 else "direct", float(s[-1] / s[0]),
+                               "the forward Jacobian is singular here: the capability is unbounded or flat")
+    lo, hi = _limits(mech, kind)
+    n = J.shape[0]
+    if kind == "twist":
+        L, c = J, np.zeros(n)
+    else:
+        from pkm.core.dynamics.model import actuator_model, gravity_efforts
+
+        if kind == "wrench":  # (τ = Jᵀ w + g: w = J⁻ᵀ (τ - g))
+            g = gravity_efforts(mech, q) if gravity else np.zeros(mech.na)
+            L, c = np.linalg.inv(J.T), -np.linalg.solve(J.T, g)
+        else:  # (ÿ = J M⁻¹ (τ - h) at rest)
+            model = actuator_model(mech, q, np.zeros(mech.na))
+            L = J @ np.linalg.inv(model.M)
+            c = -L @ (model.h if gravity else model.h - model.g)
+    V, A, b = _box_map(L, c, lo, hi)
+    kinds = mech.task_map.kinds
+    axes = tuple(kinds)
+    units = tuple(_UNITS[kind][kinds[a]] for a in axes)
+    poly = Polytope(V, A, b, axes, units)
+    inside = bool(np.all(b > 0.0))
+    along = {a: (poly.reach(np.eye(n)[i]) if inside else 0.0, poly.reach(-np.eye(n)[i]) if inside else 0.0)
+             for i, a in enumerate(axes)}
+    iso = {u: (poly.inscribed_radius([i for i, x in enumerate(units) if x == u]) if inside else 0.0)
+           for u in dict.fromkeys(units)}
+    U, S, _ = np.linalg.svd(L @ np.diag(0.5 * (hi - lo)))
+    return Capability(kind, poly, along, iso, S, U, c, inside)
+
+
+__all__ = ["KINDS", "Capability", "Polytope", "capability"]

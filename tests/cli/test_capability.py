@@ -1,0 +1,31 @@
+"""``pkm capability``: the library's capability at the pose asked, as JSON and as text; bad input as one line."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+import pkm
+from pkm import cli
+from tests.cli.helpers import one_error_line, run
+
+
+def test_json_is_the_librarys(capsys):
+    assert cli.main(["capability", "prs3", "--pose", "z=0.8", "pitch=2deg", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    mech = pkm.load("prs3")
+    q = pkm.solve_ik(mech, {"z": 0.8, "pitch": np.radians(2.0)}).q
+    for kind in ("wrench", "twist", "acceleration"):
+        c = pkm.capability(mech, q, kind)
+        assert out[kind]["along"]["pitch"] == [c.along["pitch"][0], c.along["pitch"][1]]
+        assert out[kind]["units"]["z"] == c.polytope.units[0]
+        assert np.allclose(out[kind]["vertices"], c.polytope.vertices, rtol=1e-12, atol=0)
+    assert cli.main(["capability", "delta", "--kind", "twist"]) == 0
+    text = capsys.readouterr().out
+    assert "twist:" in text and "m/s" in text and "wrench:" not in text
+
+
+def test_a_mechanism_without_limits_is_one_error_line():
+    line = one_error_line(run("capability", "gough_stewart", "--kind", "wrench"))
+    assert "effort limit" in line and "leg1" in line

@@ -1,0 +1,78 @@
+"""pkm.core.analysis.capability: the polytopes are what their definitions say (each vertex a box corner mapped: the
+statics ``τ = Jᵀ w + g``, the forward dynamics from rest, ``J q̇``), their extents equal linear programs
+(``scipy.optimize.linprog``, 1e-9), the ellipsoid lies inside the polytope, and a mechanism without limits is
+refused naming the actuator."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+import scipy.optimize
+
+import pkm
+from pkm.core.analysis.capability import capability
+from pkm.errors import InvalidInputError
+from tests.core.dynamics.test_model import mechanism
+
+NAMES = ["delta", "prs3", "rrr3"]
+
+
+def _state(name):
+    mech = mechanism(name)
+    qa = mech.actuated_q(mech.q_reference) + 0.03 * np.array([1.0, -0.5, 0.7])[:mech.na]
+    return mech, pkm.close_loops(mech, qa, mech.q_reference).q
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("kind", ["wrench", "twist", "acceleration"])
+def test_the_extents_are_linear_programs(name, kind):
+    mech, q = _state(name)
+    c = capability(mech, q, kind)
+    P = c.polytope
+    n = len(P.axes)
+    assert c.origin_inside
+    for i, axis in enumerate(P.axes):
+        for sign, value in zip((1.0, -1.0), c.along[axis]):
+            cost = np.zeros(n)
+            cost[i] = -sign
+            others = np.delete(np.eye(n), i, axis=0)
+            lp = scipy.optimize.linprog(cost, A_ub=P.A, b_ub=P.b, A_eq=others, b_eq=np.zeros(n - 1),
+                                        bounds=[(None, None)] * n, method="highs")
+            assert lp.status == 0 and abs(-lp.fun - value) <= 1e-9 * abs(value)
+    for unit, r in c.isotropic.items():  # (the ball of that radius touches the boundary: a LP along its normal)
+        cols = [k for k, u in enumerate(P.units) if u == unit]
+        assert r > 0 and min(P.reach(np.eye(n)[k]) for k in cols) >= r * (1 - 1e-12)
+    # every vertex is inside and on the boundary; the ellipsoid's semi-axes end inside
+    assert all(P.contains(v) for v in P.vertices)
+    ends = [c.ellipsoid_center + sign * 0.999 * s * u for s, u in zip(c.ellipsoid_axes, c.ellipsoid_directions.T)
+            for sign in (1.0, -1.0)]
+    assert all(P.contains(x) for x in ends)
+    assert not P.contains(c.ellipsoid_center + 1.5 * np.sqrt(n) * c.ellipsoid_axes[0] * c.ellipsoid_directions[:, 0])
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_vertices_are_what_the_limits_give(name):
+    """Each box corner of efforts: the wrench vertex satisfies ``τ = Jᵀ w + g_a``; the acceleration vertex is
+    ``J q̈_a`` of the forward dynamics from rest (:meth:`ActuatorSpaceModel.accelerations`, no friction)."""
+    mech, q = _state(name)
+    J = pkm.forward_jacobian(mech, q)
+    g = pkm.gravity_efforts(mech, q)
+    model = pkm.actuator_model(mech, q, np.zeros(mech.na))
+    limit = np.array([a.effort_limit for a in mech.actuators])
+    corners = [np.array(c) * limit for c in itertools.product((-1.0, 1.0), repeat=mech.na)]
+    W = capability(mech, q, "wrench").polytope.vertices
+    Acc = capability(mech, q, "acceleration").polytope.vertices
+    for k, tau in enumerate(corners):
+        assert np.allclose(J.T @ W[k] + g, tau, rtol=1e-10, atol=1e-9 * limit.max())
+        assert np.allclose(Acc[k], J @ model.accelerations(tau, friction=False), rtol=1e-9, atol=1e-9)
+
+
+def test_refusals_name_what_is_missing():
+    gs = pkm.load("gough_stewart")  # (its legs carry no effort limit)
+    with pytest.raises(InvalidInputError, match=r"leg1\.effort_limit"):
+        capability(gs, gs.q_reference, "wrench")
+    delta = mechanism("delta")
+    with pytest.raises(InvalidInputError, match="kind"):
+        capability(delta, delta.q_reference, "power")
