@@ -29,3 +29,21 @@ def test_json_is_the_librarys(capsys):
 def test_a_mechanism_without_limits_is_one_error_line():
     line = one_error_line(run("capability", "gough_stewart", "--kind", "wrench"))
     assert "effort limit" in line and "leg1" in line
+
+
+def test_a_map_over_two_axes(tmp_path, capsys):
+    """``--axis`` twice with ``--pose`` fixing the third: the summary, its CSV rows (one per node) and the PNG."""
+    png, table = tmp_path / "map.png", tmp_path / "map.csv"
+    argv = ["capability", "delta", "--axis", "x=-10cm:10cm:3", "--axis", "y=-5cm:5cm:2", "--pose", "z=-35cm",
+            "--csv", str(table), "--json"]
+    assert cli.main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["nodes"] == out["reachable"] == 6 and list(out["fixed"]) == ["z"]
+    assert abs(out["fixed"]["z"] + 0.35) <= 1e-15  # (35 cm in metres: 0.35000000000000003)
+    lines = table.read_text().splitlines()
+    assert len(lines) == 7 and "isotropic [N]" in lines[0]
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        return
+    assert cli.main([*argv[:-1], "--png", str(png)]) == 0 and png.stat().st_size > 1000

@@ -76,3 +76,23 @@ def test_refusals_name_what_is_missing():
     delta = mechanism("delta")
     with pytest.raises(InvalidInputError, match="kind"):
         capability(delta, delta.q_reference, "power")
+
+
+def test_the_map_is_the_pointwise_capability(tmp_path):
+    """A 5 x 4 map of the Delta's wrench capability: each reachable node's isotropic value is that of
+    :func:`pkm.capability` at the node's own inverse kinematics (1e-9), the figure is drawn; unknown axes refused."""
+    from pkm.core.analysis.capability import capability_map
+
+    mech = mechanism("delta")
+    xs, ys = np.linspace(-0.1, 0.1, 5), np.linspace(-0.05, 0.05, 4)
+    cm = capability_map(mech, {"x": xs, "y": ys}, {"z": -0.35})
+    assert cm.reachable.shape == (4, 5) and cm.reachable.all()
+    q = pkm.solve_ik(mech, {"x": xs[3], "y": ys[1], "z": -0.35}).q
+    assert cm.isotropic["N"][1, 3] == pytest.approx(capability(mech, q).isotropic["N"], rel=1e-9)
+    assert cm.along["z"][0][1, 3] == pytest.approx(capability(mech, q).along["z"][0], rel=1e-9)
+    pytest.importorskip("matplotlib")
+    from pathlib import Path
+
+    assert Path(cm.figure(str(tmp_path / "map.png"))).stat().st_size > 1000
+    with pytest.raises(InvalidInputError, match="not a task coordinate"):
+        capability_map(mech, {"w": xs})

@@ -1,7 +1,11 @@
 """``pkm capability MECH [--pose K=V ... | --joints NAME=V ...] [--kind wrench|twist|acceleration|all]
 [--no-gravity] [--json]``: what the actuators can produce at a pose under their limits
 (:func:`pkm.capability`): per task axis the largest value each way, the largest isotropic value per unit, the
-ellipsoid's semi-axes; with ``--json`` the polytopes' vertices and half-spaces too."""
+ellipsoid's semi-axes; with ``--json`` the polytopes' vertices and half-spaces too.
+
+``--axis NAME=START:STOP:COUNT`` (once or twice; ``--pose`` then fixes the other task coordinates) maps one kind's
+indices over the grid instead (:func:`pkm.core.analysis.capability.capability_map`): the summary, ``--png`` the
+largest isotropic value's map, ``--csv`` every node."""
 
 from __future__ import annotations
 
@@ -18,6 +22,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--kind", choices=("wrench", "twist", "acceleration", "all"), default="all",
                    help="which capability (default all)")
     p.add_argument("--no-gravity", action="store_true", help="leave the mechanism's weight out")
+    p.add_argument("--axis", metavar="NAME=START:STOP:COUNT", action="append", default=[],
+                   help="map the capability over this task coordinate (once or twice)")
+    p.add_argument("--png", metavar="FILE", help="with --axis: draw the largest isotropic value (pkm[figures])")
+    p.add_argument("--csv", metavar="FILE", help="with --axis: every node's indices")
     p.add_argument("--json", action="store_true", help="print JSON (SI, units per axis, the polytopes)")
 
 
@@ -26,6 +34,8 @@ def run(args: argparse.Namespace) -> int:
     from pkm.report import jsonable
 
     mech = load_mechanism(args)
+    if args.axis:
+        return _map(mech, args)
     q = configuration(mech, args)
     out: dict[str, Any] = {"mechanism": mech.name, "task": mech.task_map.named(q)}
     for kind in KINDS if args.kind == "all" else (args.kind,):
@@ -47,6 +57,47 @@ def run(args: argparse.Namespace) -> int:
         for axis, (plus, minus) in r["along"].items():
             print(f"  {axis:>8}  +{plus:.6g} / -{minus:.6g} {r['units'][axis]}")
         print("  isotropic: " + ", ".join(f"{v:.6g} {u}" for u, v in r["isotropic"].items()))
+    return 0
+
+
+def _map(mech, args: argparse.Namespace) -> int:
+    import csv
+
+    import numpy as np
+
+    from pkm.cli.parsing import parse_axis, parse_pose
+    from pkm.core.analysis.capability import capability_map
+    from pkm.errors import InvalidInputError
+    from pkm.report import jsonable
+
+    kind = "wrench" if args.kind == "all" else args.kind
+    axes = dict(parse_axis(mech, item) for item in args.axis)
+    fixed = {k: v for k, v in parse_pose(mech, args.pose)[0].items() if k not in axes} if args.pose else None
+    if args.joints:
+        raise InvalidInputError("--joints", "a map fixes task coordinates: give --pose for those off the axes")
+    cm = capability_map(mech, axes, fixed, kind, gravity=not args.no_gravity)
+    out: dict[str, Any] = {"mechanism": mech.name, "kind": kind, "nodes": int(cm.reachable.size),
+                           "reachable": int(cm.reachable.sum()), "fixed": cm.fixed,
+                           "isotropic": {u: {"min": float(np.nanmin(v)), "max": float(np.nanmax(v))}
+                                         for u, v in cm.isotropic.items()} if cm.reachable.any() else {}}
+    if args.png:
+        out["png"] = cm.figure(args.png)
+    if args.csv:
+        mesh = np.meshgrid(*[v for _, v in reversed(cm.axes)], indexing="ij")
+        cols = {name: m.ravel() for (name, _), m in zip(reversed(cm.axes), mesh)}
+        cols["reachable"] = cm.reachable.ravel().astype(float)
+        for a, (plus, minus) in cm.along.items():
+            cols[f"{a}_plus"], cols[f"{a}_minus"] = plus.ravel(), minus.ravel()
+        for u, v in cm.isotropic.items():
+            cols[f"isotropic [{u}]"] = v.ravel()
+        with open(args.csv, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(list(cols))
+            w.writerows(zip(*[c.tolist() for c in cols.values()]))
+        out["csv"] = args.csv
+    print(json.dumps(jsonable(out), indent=2) if args.json else
+          f"{mech.name}: {kind} capability over {out['nodes']} nodes, {out['reachable']} reachable; isotropic "
+          + ", ".join(f"{v['min']:.6g} to {v['max']:.6g} {u}" for u, v in out["isotropic"].items()))
     return 0
 
 

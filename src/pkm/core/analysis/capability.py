@@ -30,6 +30,7 @@ task coordinates) would need it, or a hull: refused here with the reason.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -186,4 +187,152 @@ def capability(mech: Mechanism, q: ArrayLike, kind: str = "wrench", *, gravity: 
     return Capability(kind, poly, along, iso, S, U, c, inside)
 
 
-__all__ = ["KINDS", "Capability", "Polytope", "capability"]
+MAX_MAP_NODES = 250_000  # nodes of a capability map at most (each an IK solve and a capability: about 2 ms)
+
+
+@dataclass(frozen=True)
+class CapabilityMap:
+    """A capability index over a grid of task coordinates (:func:`capability_map`).
+
+    Attributes:
+        kind: ``"wrench"``, ``"twist"`` or ``"acceleration"``.
+        axes: ``(name, values)`` per grid axis (1 or 2), the first the fastest; arrays are shaped
+            ``(n_last, ..., n_first)``.
+        fixed: The other task coordinates by name.
+        reachable: Nodes solved (inverse kinematics converged, regular, the origin inside the set).
+        along: ``{axis: (plus, minus)}`` arrays: the largest value along each task axis each way (NaN where
+            unreachable).
+        isotropic: ``{unit: array}``: the largest isotropic value of each unit group.
+        units: Each task axis' unit (of the capability); ``kinds``: each task coordinate's kind (``"length"``,
+            ``"angle"``).
+        mechanism: The mechanism's name.
+    """
+
+    kind: str
+    axes: tuple[tuple[str, np.ndarray], ...]
+    fixed: dict[str, float]
+    reachable: np.ndarray
+    along: dict[str, tuple[np.ndarray, np.ndarray]]
+    isotropic: dict[str, np.ndarray]
+    units: dict[str, str]
+    kinds: dict[str, str]
+    mechanism: str = ""
+
+    def figure(self, path: str, unit: str | None = None) -> str:
+        """Draw the largest isotropic value of ``unit`` (default the first) over the map as a PNG at ``path``
+        (1 axis: a curve; 2 axes: a colour map with its colour bar; unreachable nodes blank).
+
+        Raises:
+            MissingDependencyError: matplotlib is not installed (``pip install "pkm[figures]"``).
+            InvalidInputError: an unknown unit.
+        """
+        from pathlib import Path
+
+        from pkm._optional import require
+
+        require("figures", "the figure of a capability map")
+        from pkm.papers._plot import figure, pyplot
+
+        unit = next(iter(self.isotropic)) if unit is None else unit
+        if unit not in self.isotropic:
+            raise InvalidInputError("unit", f"one of {list(self.isotropic)}, got {unit!r}", unit)
+        values = self.isotropic[unit]
+        fig, ax = figure()
+        (n1, v1) = self.axes[0]
+        label = f"largest isotropic {self.kind} [{unit}]"
+        def axis_label(name: str) -> str:
+            return f"{name} [{'m' if self.kinds[name] == 'length' else 'rad'}]"
+
+        if len(self.axes) == 1:
+            ax.plot(v1, values, label=label)
+            ax.set_xlabel(axis_label(n1))
+            ax.set_ylabel(label)
+            ax.legend()
+        else:
+            (n2, v2) = self.axes[1]
+            mesh = ax.pcolormesh(v1, v2, np.ma.masked_invalid(values), shading="nearest")
+            fig.colorbar(mesh, ax=ax, label=label)
+            ax.set_xlabel(axis_label(n1))
+            ax.set_ylabel(axis_label(n2))
+        fixed = ", ".join(f"{k} = {v:.4g}" for k, v in self.fixed.items())
+        ax.set_title(f"{self.mechanism}: {label}{' at ' + fixed if fixed else ''}\nno figure (capability map)",
+                     fontsize=9)
+        out = Path(path)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        fig.tight_layout()
+        fig.savefig(out, dpi=150)
+        pyplot().close(fig)
+        return str(out)
+
+
+def capability_map(mech: Mechanism, axes: Mapping[str, ArrayLike], fixed: Mapping[str, float] | None = None,
+                   kind: str = "wrench", *, gravity: bool = True) -> CapabilityMap:
+    """The ``kind`` capability's indices over a grid of task coordinates: ``axes`` (1 or 2 of them, values SI, the
+    first the fastest), ``fixed`` the other task coordinates (default the reference's). Each node's inverse
+    kinematics is warm-started from its neighbour's solution (so the map stays in the reference's working mode);
+    a node that does not solve or is singular is left unreachable.
+
+    Raises:
+        InvalidInputError: unknown or repeated axes, empty or more than two axes, more than :data:`MAX_MAP_NODES`
+            nodes; the capability's own refusals (a missing limit).
+    """
+    from pkm.core.kinematics.solve import solve_ik
+    from pkm.errors import PkmError
+    from pkm.validation import as_array, as_scalar
+
+    mech = check_mechanism(mech)
+    if kind not in KINDS:
+        raise InvalidInputError("kind", f"use one of {list(KINDS)}, got {kind!r}", kind)
+    names = list(mech.task_map.kinds)
+    if not isinstance(axes, Mapping) or not 1 <= len(axes) <= 2:
+        raise InvalidInputError("axes", "expected one or two task coordinates by name", axes)
+    grid = []
+    for name, values in axes.items():
+        if name not in names:
+            raise InvalidInputError("axes", f"{name!r} is not a task coordinate; they are {names}", name)
+        v = np.atleast_1d(as_array(values, f"axes[{name}]"))
+        if v.ndim != 1 or v.size == 0 or not np.all(np.isfinite(v)):
+            raise InvalidInputError(f"axes[{name}]", "expected a non-empty vector of finite values", values)
+        grid.append((name, v))
+    if np.prod([len(v) for _, v in grid]) > MAX_MAP_NODES:
+        raise InvalidInputError("axes", f"more than {MAX_MAP_NODES} nodes", [len(v) for _, v in grid])
+    reference = mech.task_map.named(mech.q_reference)
+    rest = {k: float(x) for k, x in reference.items() if k not in axes}
+    for k, x in (fixed or {}).items():
+        if k not in rest:
+            raise InvalidInputError("fixed", f"{k!r} is not a task coordinate off the axes; those are {list(rest)}", k)
+        rest[k] = as_scalar(x, f"fixed[{k}]")
+    _limits(mech, kind)  # (the refusal before any solve)
+    shape = tuple(len(v) for _, v in reversed(grid))
+    reachable = np.zeros(shape, dtype=bool)
+    along = {a: (np.full(shape, np.nan), np.full(shape, np.nan)) for a in names}
+    iso: dict[str, np.ndarray] = {}
+    units: dict[str, str] = {}
+    q_row = mech.q_reference
+    second = grid[1][1] if len(grid) == 2 else np.array([0.0])
+    for j, y2 in enumerate(second):
+        q = q_row
+        for i, y1 in enumerate(grid[0][1]):
+            target = dict(rest, **{grid[0][0]: float(y1)})
+            if len(grid) == 2:
+                target[grid[1][0]] = float(y2)
+            idx = (j, i) if len(grid) == 2 else (i,)
+            try:
+                q = solve_ik(mech, target, q).q
+                c = capability(mech, q, kind, gravity=gravity)
+            except PkmError:
+                continue
+            if i == 0:
+                q_row = q
+            if not c.origin_inside:
+                continue
+            reachable[idx] = True
+            for a in names:
+                along[a][0][idx], along[a][1][idx] = c.along[a]
+            units = dict(zip(c.polytope.axes, c.polytope.units))
+            for u, r in c.isotropic.items():
+                iso.setdefault(u, np.full(shape, np.nan))[idx] = r
+    return CapabilityMap(kind, tuple(grid), rest, reachable, along, iso, units, dict(mech.task_map.kinds), mech.name)
+
+
+__all__ = ["KINDS", "MAX_MAP_NODES", "Capability", "CapabilityMap", "Polytope", "capability", "capability_map"]
