@@ -10,7 +10,9 @@ derivatives filtered without end effects.
 
 **Criterion**: the **condition number** of the base regressor ``W_β`` stacked at ``M`` samples of one period, its
 columns first scaled to unit norm (so that the parameters' units do not decide which are "small"), is minimised
-(``log κ``, SLSQP, finite-difference gradients) over the offsets and coefficients; the log-determinant is the
+(``log κ``, SLSQP, finite-difference gradients, at most ``max_iter`` iterations: the best iterate within the
+limits is kept, and a last iterate outside them is shrunk toward its offsets until inside) over the offsets and
+coefficients; the log-determinant is the
 other usual choice, not taken: it rewards large motions as much as well-spread ones, which the limits then have to
 stop. Every objective evaluation closes the loops along the samples warm-started (the compiled twin's path when it
 builds: :meth:`pkm.Kernels.close_loops_path`) and stacks the compiled regressor.

@@ -20,19 +20,22 @@ and 1e-16, and no threshold tells them apart. This route removes the rounding in
 3. **The regressor evaluated exactly as built.** The twin's regressor expression (``∂τ_a/∂θ``,
    :mod:`pkm.core.twin.regressor`) evaluated instruction by instruction (:class:`Program`: CasADi's own
    instruction list, each operation in ``mpmath``), vectorised over the samples.
-4. **The rank.** The columns scaled to unit norm, a Householder QR with column pivoting in the same arithmetic,
-   and the rank decided by the same largest-drop rule as the numerical route among pivots under ``1e-6``, with the
+4. **The rank.** The columns scaled to unit norm, a Householder QR with column pivoting in 224-bit fixed point
+   (:func:`pivoted_qr`: Python integers, exact to ``4e-68`` on entries of at most 1), and the rank decided by the same largest-drop rule as the numerical route among pivots under ``1e-6``, with the
    rounding floor at ``10^(-DIGITS + 10)`` (every constant recognised) or :data:`MODEL_FLOOR` instead of ``1e-10``:
    a rounding pivot now sits near ``1e-50``. What the route catches that the first cannot: a combination that the
    efforts carry between ``1e-15`` and ``1e-10`` of the largest, which double precision drops as its own rounding
    (the test plants one: gravity tilted by ``1e-12`` rad makes the 3-RRR's proximal first moments identifiable at
    that level).
 
-The two routes then agree (same rank, same independent set) or :class:`~pkm.core.identification.base.BaseParameters`
-says they do not (:attr:`~pkm.core.identification.base.BaseParameters.routes_agree`).
+The two routes then find the same count or :class:`~pkm.core.identification.base.BaseParameters` says they do not
+(:attr:`~pkm.core.identification.base.BaseParameters.routes_agree`; the independent columns each route names may
+differ where columns tie, and need not: any independent set spans the same combinations).
 
 Cost: each sample's regressor costs ``n_instructions`` operations at about a microsecond each, the QR about
-``2 m n²`` of them (``m`` rows, ``n`` live columns): a second or two for the Delta, tens for the Gough-Stewart.
+``2 m n r`` integer operations (``m`` rows, ``n`` live columns, ``r`` the rank: the elimination stops where every
+remaining column is rounding): 0.3 s for the 3-RRR, 0.4 s for the Delta, 1.3 s for the Gough-Stewart, 2 s for
+the hexapod (``pkm bench identification``).
 """
 
 from __future__ import annotations
