@@ -1,0 +1,45 @@
+"""A humanoid's parallel ankle under its motors' limits: the joint torques it can hold, pose by pose.
+
+Two motors on the shank push rods down to the foot (``examples/ankle``). Hand-written ankle code caps pitch and
+roll with a box (``MAX_PITCH_DEG 35``) and assumes the torques a box too; the torque set is a polygon that turns and
+stretches with the pose. This script gives each motor a continuous limit of 30 N m and 12 rad/s (a typical
+humanoid ankle drive: the values are this example's, not the file's), then asks pkm for the ankle's capability:
+
+* at the neutral pose: the largest pitch and roll torque each way, the largest torque in every direction, the joint
+  speeds and accelerations from rest;
+* over a pitch-roll grid: the largest pure-pitch and pure-roll torques, which a box would hold constant.
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+import pkm
+from pkm.core.analysis.capability import capability_map
+
+ANKLE = Path(__file__).resolve().parent / "ankle" / "ankle.closures.toml"
+
+ankle = pkm.load(ANKLE)
+ankle = pkm.with_actuators(ankle, {name: {"effort_limit": 30.0, "velocity_limit": 12.0}
+                                   for name in ankle.actuated_names})
+
+print("at the neutral pose:")
+for kind in ("wrench", "twist", "acceleration"):
+    c = pkm.capability(ankle, ankle.q_reference, kind)
+    units = dict(zip(c.polytope.axes, c.polytope.units))
+    along = ", ".join(f"{axis} +{plus:.4g}/-{minus:.4g} {units[axis]}" for axis, (plus, minus) in c.along.items())
+    iso = ", ".join(f"{v:.4g} {u}" for u, v in c.isotropic.items())
+    print(f"  {kind:12s} {along}; every direction: {iso}")
+
+pitch = np.radians(np.linspace(-30.0, 30.0, 7))
+roll = np.radians(np.linspace(-15.0, 15.0, 5))
+cm = capability_map(ankle, {"ankle_pitch": pitch, "ankle_roll": roll})
+plus_pitch, _ = cm.along["ankle_pitch"]
+plus_roll, _ = cm.along["ankle_roll"]
+print(f"over pitch -30..30 deg x roll -15..15 deg ({int(cm.reachable.sum())} of {cm.reachable.size} poses "
+      "solved):")
+print(f"  largest pure-pitch torque: {np.nanmin(plus_pitch):.4g} to {np.nanmax(plus_pitch):.4g} N m")
+print(f"  largest pure-roll torque:  {np.nanmin(plus_roll):.4g} to {np.nanmax(plus_roll):.4g} N m")
+print("  pitch [deg] ->  " + "  ".join(f"{np.degrees(p):6.1f}" for p in pitch))
+for j, r in enumerate(roll):
+    print(f"  roll {np.degrees(r):5.1f}:  +pitch " + "  ".join(f"{v:6.1f}" for v in plus_pitch[j]))
