@@ -7,7 +7,9 @@ humanoid ankle drive: the values are this example's, not the file's), then asks 
 
 * at the neutral pose: the largest pitch and roll torque each way, the largest torque in every direction, the joint
   speeds and accelerations from rest;
-* over a pitch-roll grid: the largest pure-pitch and pure-roll torques, which a box would hold constant.
+* over a pitch-roll grid: the largest pure-pitch and pure-roll torques, which a box would hold constant;
+* the rotors' inertia as the ankle joints feel it, ``J⁻ᵀ diag(I_r k²) J⁻¹`` (rotor 3.3e-5 kg m^2 geared 50:1),
+  against the constant "armature" that hand-written controllers put on the joints' diagonal.
 """
 
 from pathlib import Path
@@ -20,8 +22,9 @@ from pkm.core.analysis.capability import capability_map
 ANKLE = Path(__file__).resolve().parent / "ankle" / "ankle.closures.toml"
 
 ankle = pkm.load(ANKLE)
-ankle = pkm.with_actuators(ankle, {name: {"effort_limit": 30.0, "velocity_limit": 12.0}
-                                   for name in ankle.actuated_names})
+ankle = pkm.with_actuators(ankle, {name: {"effort_limit": 30.0, "velocity_limit": 12.0, "rotor_inertia": 3.3e-5,
+                                          "gear_ratio": 50.0} for name in ankle.actuated_names})
+reflected = 3.3e-5 * 50.0**2  # [kg m^2] on each motor's axis
 
 print("at the neutral pose:")
 for kind in ("wrench", "twist", "acceleration"):
@@ -43,3 +46,14 @@ print(f"  largest pure-roll torque:  {np.nanmin(plus_roll):.4g} to {np.nanmax(pl
 print("  pitch [deg] ->  " + "  ".join(f"{np.degrees(p):6.1f}" for p in pitch))
 for j, r in enumerate(roll):
     print(f"  roll {np.degrees(r):5.1f}:  +pitch " + "  ".join(f"{v:6.1f}" for v in plus_pitch[j]))
+
+print(f"the rotors' inertia at the ankle joints (each motor {reflected:.4g} kg m^2 on its own axis):")
+neutral = None
+for p_deg, r_deg in ((0.0, 0.0), (30.0, 0.0), (-30.0, 0.0), (0.0, 15.0), (30.0, 15.0)):
+    q = pkm.solve_ik(ankle, {"ankle_pitch": np.radians(p_deg), "ankle_roll": np.radians(r_deg)}).q
+    J = pkm.forward_jacobian(ankle, q)  # (joint rates from motor rates)
+    Jinv = np.linalg.inv(J)
+    rotors = Jinv.T @ (reflected * np.eye(ankle.na)) @ Jinv
+    neutral = rotors if neutral is None else neutral
+    print(f"  pitch {p_deg:5.1f} deg, roll {r_deg:5.1f} deg: pitch {rotors[0, 0]:.4g}, roll {rotors[1, 1]:.4g}, "
+          f"coupling {rotors[0, 1]:.3g} kg m^2 ({100 * (rotors[0, 0] / neutral[0, 0] - 1):+.0f} % on pitch)")
