@@ -8,6 +8,8 @@ humanoid ankle drive: the values are this example's, not the file's), then asks 
 * at the neutral pose: the largest pitch and roll torque each way, the largest torque in every direction, the joint
   speeds and accelerations from rest;
 * over a pitch-roll grid: the largest pure-pitch and pure-roll torques, which a box would hold constant;
+* the feasible pitch-roll region with the motors' travel at ±0.7 rad: a polygon, each vertex with the limit that
+  stops it, against the largest box inside it;
 * the rotors' inertia as the ankle joints feel it, ``J⁻ᵀ diag(I_r k²) J⁻¹`` (rotor 3.3e-5 kg m^2 geared 50:1),
   against the constant "armature" that hand-written controllers put on the joints' diagonal.
 """
@@ -57,3 +59,11 @@ for p_deg, r_deg in ((0.0, 0.0), (30.0, 0.0), (-30.0, 0.0), (0.0, 15.0), (30.0, 
     neutral = rotors if neutral is None else neutral
     print(f"  pitch {p_deg:5.1f} deg, roll {r_deg:5.1f} deg: pitch {rotors[0, 0]:.4g}, roll {rotors[1, 1]:.4g}, "
           f"coupling {rotors[0, 1]:.3g} kg m^2 ({100 * (rotors[0, 0] / neutral[0, 0] - 1):+.0f} % on pitch)")
+
+region = pkm.feasible_region(ankle, ("ankle_pitch", "ankle_roll"), directions=16,
+                             limits={name: (-0.7, 0.7) for name in ankle.actuated_names})
+half = np.degrees(region.box())
+print(f"the feasible pitch-roll region (motors within ±0.7 rad, singularity distance >= {region.singularity:g}): "
+      f"{region.area:.3g} rad^2, the largest box inside it ±{half[0]:.1f} deg pitch x ±{half[1]:.1f} deg roll")
+for (p_, r_), why in zip(np.degrees(region.vertices), region.binding):
+    print(f"  pitch {p_:6.1f} deg, roll {r_:6.1f} deg: {why}")

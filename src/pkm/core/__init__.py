@@ -22,6 +22,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
                                 "coriolis_matrix", "gravity_efforts", "mass_matrix", "operational_space"),
     "pkm.core.dynamics.simulate": ("Event", "Simulation", "simulate"),
     "pkm.core.analysis.capability": ("Capability", "Polytope", "capability"),
+    "pkm.core.analysis.region": ("Region", "feasible_region"),
     "pkm.core.identification.base": ("BaseParameters", "base_parameters"),
     "pkm.core.identification.consistent": ("ConsistentEstimate", "consistent_estimate"),
     "pkm.core.identification.estimate": ("Estimate", "estimate"),
@@ -42,6 +43,7 @@ _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
 if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.analysis.capability import Capability, Polytope, capability
+    from pkm.core.analysis.region import Region, feasible_region
     from pkm.core.differential.velocity import (
         Diagnostics,
         accelerations,

@@ -1,0 +1,207 @@
+"""The feasible region of two task coordinates: a polygon, each vertex with the limit that stops it.
+
+Where may a parallel ankle point? Hand-written code answers with a box (``MAX_PITCH_DEG 35``, ``MAX_ROLL_DEG 20``);
+the set of poses where every leg closes within its joints' limits, away from every singularity, is not a box.
+:func:`feasible_region` traces it in the plane of two task coordinates (the others fixed) as the polygon of its
+boundary points along ``directions`` rays from the reference pose: along each ray the inverse kinematics is
+followed outward (warm-started, so one working mode), ``steps`` steps up to ``reach``, then the first step out is
+bisected to ``tol``. A pose is **feasible** where
+
+* the inverse kinematics converges (every leg closes);
+* every joint lies within its limits: the model's, and ``limits`` (``{joint: (low, high)}`` [rad or m], e.g. the
+  motors' travel, which URDFs often leave out);
+* the distance to a direct and to an inverse singularity (:func:`pkm.diagnose`'s ``direct_distance``,
+  ``inverse_distance``) is at least ``singularity``.
+
+Each vertex carries what stops it (:attr:`Region.binding`): ``"joint <name> at its low|high limit"``,
+``"direct singularity"``, ``"inverse singularity"``, ``"closure"`` (the legs no longer close: the workspace's own
+edge), or ``"reach"`` (nothing stopped it within ``reach``). The region is star-shaped about the reference by
+construction (a ray's first exit); a region with holes or a second component beyond a first exit is not traced.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.errors import InvalidInputError, PkmError
+from pkm.validation import as_count, as_scalar
+
+SINGULARITY = 1e-2  # default smallest relative distance to a singularity inside the region
+
+
+@dataclass(frozen=True)
+class Region:
+    """A feasible region (module doc).
+
+    Attributes:
+        axes: The two task coordinates, in order; ``fixed``: the others.
+        center: The reference pose in the plane (the rays' origin).
+        vertices: The boundary points (directions x 2), counter-clockwise from the first axis.
+        binding: What stops each vertex (module doc).
+        angles: The rays' angles in the plane [rad, of the plane's own coordinates].
+        singularity: The distance bound used.
+    """
+
+    axes: tuple[str, str]
+    fixed: dict[str, float]
+    center: np.ndarray
+    vertices: np.ndarray
+    binding: tuple[str, ...]
+    angles: np.ndarray
+    singularity: float
+
+    @property
+    def area(self) -> float:
+        """The polygon's area (shoelace) [in the axes' units squared]."""
+        x, y = self.vertices[:, 0], self.vertices[:, 1]
+        return float(0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+
+    def contains(self, point: ArrayLike) -> bool:
+        """Whether ``point`` (in the plane) lies inside the polygon (even-odd ray casting)."""
+        x, y = np.asarray(point, dtype=float)
+        xs, ys = self.vertices[:, 0], self.vertices[:, 1]
+        inside = False
+        for i in range(len(xs)):
+            x1, y1, x2, y2 = xs[i - 1], ys[i - 1], xs[i], ys[i]
+            if (y1 > y) != (y2 > y) and x < x1 + (y - y1) * (x2 - x1) / (y2 - y1):
+                inside = not inside
+        return inside
+
+    def box(self) -> np.ndarray:
+        """The half-sides of the largest box about the center, in the proportions of the polygon's extents along
+        the two axes, whose corners and edge midpoints lie inside the polygon (bisection to 1e-9): what a box
+        limit ("MAX_PITCH_DEG") can claim of this region."""
+        d = self.vertices - self.center
+        shape = np.abs(d).max(axis=0)
+        signs = [np.array(s) for s in ((1, 1), (1, -1), (-1, 1), (-1, -1), (1, 0), (-1, 0), (0, 1), (0, -1))]
+
+        def fits(t: float) -> bool:
+            return all(self.contains(self.center + t * shape * s) for s in signs)
+
+        lo, hi = 0.0, 1.0
+        while hi - lo > 1e-9:
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if fits(mid) else (lo, mid)
+        return lo * shape
+
+
+def _feasible(mech: Mechanism, target: dict[str, float], q0: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+              singularity: float) -> tuple[np.ndarray | None, str]:
+    """The closed configuration at ``target`` (warm-started from ``q0``) if feasible, else None and why."""
+    from pkm.core.differential.velocity import diagnose
+    from pkm.core.kinematics.solve import solve_ik
+
+    try:
+        q = solve_ik(mech, target, q0).q
+    except PkmError:
+        return None, "closure"
+    low, high = np.flatnonzero(q < lo), np.flatnonzero(q > hi)
+    if low.size or high.size:
+        i, side = (int(low[0]), "low") if low.size else (int(high[0]), "high")
+        return None, f"joint {_joint_of(mech, i)} at its {side} limit"
+    try:
+        d = diagnose(mech, q)
+    except PkmError:
+        return None, "direct singularity"
+    if d.direct_distance < singularity:
+        return None, "direct singularity"
+    if d.inverse_distance < singularity:
+        return None, "inverse singularity"
+    return q, ""
+
+
+def _joint_of(mech: Mechanism, iq: int) -> str:
+    model = mech.model
+    for j in range(1, model.njoints):
+        if model.joints[j].idx_q <= iq < model.joints[j].idx_q + model.joints[j].nq:
+            return str(model.names[j])
+    return f"q[{iq}]"
+
+
+def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[str, float] | None = None,
+                    limits: Mapping[str, tuple[float, float]] | None = None, singularity: float = SINGULARITY,
+                    reach: float = 1.0, directions: int = 36, steps: int = 20, tol: float = 1e-8) -> Region:
+    """The feasible region of ``mech`` in the plane of the task coordinates ``axes`` (module doc): ``reach`` [their
+    unit] the largest radius searched, ``directions`` rays, ``steps`` steps out along each, the boundary bisected
+    to ``tol``.
+
+    Raises:
+        InvalidInputError: axes that are not two distinct task coordinates, a limit for an unknown joint or with
+            ``low >= high``, the reference pose itself not feasible (what stops it named).
+    """
+    mech = check_mechanism(mech)
+    names = list(mech.task_map.kinds)
+    if not isinstance(axes, (tuple, list)) or len(axes) != 2 or axes[0] == axes[1] or any(a not in names
+                                                                                        for a in axes):
+        raise InvalidInputError("axes", f"expected two distinct task coordinates among {names}", axes)
+    singularity = as_scalar(singularity, "singularity")
+    reach = as_scalar(reach, "reach")
+    n_dir, n_steps = as_count(directions, "directions"), as_count(steps, "steps")
+    tol = as_scalar(tol, "tol")
+    if not (reach > 0 and n_dir >= 3 and n_steps >= 1 and tol > 0):
+        raise InvalidInputError("reach", "expected reach > 0, directions >= 3, steps >= 1, tol > 0",
+                                (reach, n_dir, n_steps, tol))
+    lo = np.array(mech.model.lowerPositionLimit, dtype=float)
+    hi = np.array(mech.model.upperPositionLimit, dtype=float)
+    if limits is not None and not isinstance(limits, Mapping):
+        raise InvalidInputError("limits", "expected {joint: (low, high)}", limits)
+    if fixed is not None and not isinstance(fixed, Mapping):
+        raise InvalidInputError("fixed", "expected {task coordinate: value}", fixed)
+    for joint, bounds in (limits or {}).items():
+        if not isinstance(joint, str) or not mech.model.existJointName(joint):
+            raise InvalidInputError("limits", f"{joint!r} is not a joint of {mech.name}", joint)
+        if not isinstance(bounds, (tuple, list)) or len(bounds) != 2:
+            raise InvalidInputError("limits", f"{joint}: expected (low, high)", bounds)
+        low, high = (as_scalar(x, f"limits[{joint}]") for x in bounds)
+        if not low < high:
+            raise InvalidInputError("limits", f"{joint}: low {low} is not below high {high}", bounds)
+        jm = mech.model.joints[mech.model.getJointId(joint)]
+        lo[jm.idx_q:jm.idx_q + jm.nq] = low
+        hi[jm.idx_q:jm.idx_q + jm.nq] = high
+    reference = mech.task_map.named(mech.q_reference)
+    rest = {k: float(v) for k, v in reference.items() if k not in axes}
+    for k, v in (fixed or {}).items():
+        if k not in rest:
+            raise InvalidInputError("fixed", f"{k!r} is not a task coordinate off the axes; those are {list(rest)}", k)
+        rest[k] = as_scalar(v, f"fixed[{k}]")
+    center = np.array([reference[axes[0]], reference[axes[1]]], dtype=float)
+
+    def at(point: np.ndarray, q0: np.ndarray) -> tuple[np.ndarray | None, str]:
+        return _feasible(mech, dict(rest, **{axes[0]: float(point[0]), axes[1]: float(point[1])}), q0, lo, hi,
+                         singularity)
+
+    q_center, why = at(center, mech.q_reference)
+    if q_center is None:
+        raise InvalidInputError("mech", f"the reference pose is not feasible: {why}", why)
+    angles = np.arange(n_dir) * 2.0 * np.pi / n_dir
+    vertices, binding = [], []
+    for a in angles:
+        u = np.array([np.cos(a), np.sin(a)])
+        r_in, q_in, why = 0.0, q_center, "reach"
+        r_out = None
+        for step in range(1, n_steps + 1):
+            r = reach * step / n_steps
+            q, reason = at(center + r * u, q_in)
+            if q is None:
+                r_out, why = r, reason
+                break
+            r_in, q_in = r, q
+        if r_out is not None:
+            while r_out - r_in > tol:
+                r = 0.5 * (r_in + r_out)
+                q, reason = at(center + r * u, q_in)
+                if q is None:
+                    r_out, why = r, reason
+                else:
+                    r_in, q_in = r, q
+        vertices.append(center + r_in * u)
+        binding.append(why)
+    return Region((axes[0], axes[1]), rest, center, np.array(vertices), tuple(binding), angles, singularity)
+
+
+__all__ = ["SINGULARITY", "Region", "feasible_region"]

@@ -1,0 +1,66 @@
+"""pkm.core.analysis.region: the feasible pitch-roll polygon of the parallel ankle: every vertex is stopped by what it
+says (a motor at its limit to 1e-6 rad, or the singularity distance at its bound to 1e-6), inside it every pose is
+feasible, and it is not the box a hand-written limit claims."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm.core.analysis.region import feasible_region
+from pkm.errors import InvalidInputError
+
+ANKLE = Path(__file__).resolve().parents[3] / "examples" / "ankle" / "ankle.closures.toml"
+AXES = ("ankle_pitch", "ankle_roll")
+MOTORS = {"motor_left": (-0.7, 0.7), "motor_right": (-0.7, 0.7)}
+
+
+@pytest.fixture(scope="module")
+def ankle():
+    return pkm.load(ANKLE)
+
+
+def _q(mech, point, q0=None):
+    return pkm.solve_ik(mech, {AXES[0]: float(point[0]), AXES[1]: float(point[1])}, q0).q
+
+
+def test_each_vertex_is_stopped_by_what_it_names(ankle):
+    region = feasible_region(ankle, AXES, limits=MOTORS, directions=12)
+    assert {b.split(" at ")[0] for b in region.binding} <= {"joint motor_left", "joint motor_right", "reach"}
+    for vertex, why in zip(region.vertices, region.binding):
+        if why == "reach":
+            continue
+        joint, side = why.split()[1], why.split()[4]
+        value = float(np.atleast_1d(ankle.q_to_dict(_q(ankle, vertex))[joint])[0])
+        assert abs(value - MOTORS[joint][0 if side == "low" else 1]) <= 1e-6
+    # a box limit: the largest box the polygon holds is much smaller than its extent along pitch
+    half = region.box()
+    assert half[0] < 0.5 * np.abs(region.vertices[:, 0]).max() and region.area > 4 * half[0] * half[1]
+    corners = [region.center + half * np.array(s) for s in ((1, 1), (1, -1), (-1, 1), (-1, -1))]
+    assert all(region.contains(c) for c in corners) and not region.contains(region.center + 1.01 * half * 3)
+    # inside (shrunk toward the centre), every pose solves within the motors' travel
+    for vertex in region.vertices[::3]:
+        q = ankle.q_to_dict(_q(ankle, 0.9 * vertex))
+        assert all(MOTORS[m][0] <= float(np.atleast_1d(q[m])[0]) <= MOTORS[m][1] for m in MOTORS)
+
+
+def test_a_singularity_bound_stops_the_vertices_at_it(ankle):
+    bound = 0.02  # (the reference's own distances: 0.20 direct, 0.035 inverse)
+    region = feasible_region(ankle, AXES, singularity=bound, directions=8, reach=1.5)
+    stopped = [(v, b) for v, b in zip(region.vertices, region.binding) if "singularity" in b]
+    assert stopped
+    for vertex, why in stopped:
+        d = pkm.diagnose(ankle, _q(ankle, vertex))
+        assert abs(min(d.direct_distance, d.inverse_distance) - bound) <= 1e-6, why
+
+
+def test_bad_arguments_are_refused(ankle):
+    with pytest.raises(InvalidInputError, match="two distinct"):
+        feasible_region(ankle, ("ankle_pitch", "ankle_pitch"))
+    with pytest.raises(InvalidInputError, match="not a joint"):
+        feasible_region(ankle, AXES, limits={"elbow": (-1.0, 1.0)})
+    with pytest.raises(InvalidInputError, match="not feasible"):
+        feasible_region(ankle, AXES, limits={"motor_left": (0.5, 0.7)})
