@@ -276,9 +276,10 @@ def capability_map(mech: Mechanism, axes: Mapping[str, ArrayLike], fixed: Mappin
         InvalidInputError: unknown or repeated axes, empty or more than two axes, more than :data:`MAX_MAP_NODES`
             nodes; the capability's own refusals (a missing limit).
     """
+    from pkm.core.analysis.region import other_coordinates
     from pkm.core.kinematics.solve import solve_ik
     from pkm.errors import PkmError
-    from pkm.validation import as_array, as_scalar
+    from pkm.validation import as_array
 
     mech = check_mechanism(mech)
     if kind not in KINDS:
@@ -296,12 +297,7 @@ def capability_map(mech: Mechanism, axes: Mapping[str, ArrayLike], fixed: Mappin
         grid.append((name, v))
     if np.prod([len(v) for _, v in grid]) > MAX_MAP_NODES:
         raise InvalidInputError("axes", f"more than {MAX_MAP_NODES} nodes", [len(v) for _, v in grid])
-    reference = mech.task_map.named(mech.q_reference)
-    rest = {k: float(x) for k, x in reference.items() if k not in axes}
-    for k, x in (fixed or {}).items():
-        if k not in rest:
-            raise InvalidInputError("fixed", f"{k!r} is not a task coordinate off the axes; those are {list(rest)}", k)
-        rest[k] = as_scalar(x, f"fixed[{k}]")
+    rest = other_coordinates(mech, axes, fixed)
     _limits(mech, kind)  # (the refusal before any solve)
     shape = tuple(len(v) for _, v in reversed(grid))
     reachable = np.zeros(shape, dtype=bool)

@@ -115,6 +115,23 @@ def _feasible(mech: Mechanism, target: dict[str, float], q0: np.ndarray, lo: np.
     return q, ""
 
 
+def other_coordinates(mech: Mechanism, axes: object, fixed: Mapping[str, float] | None) -> dict[str, float]:
+    """The task coordinates off ``axes`` by name: the reference's, those in ``fixed`` replaced (SI).
+
+    Raises:
+        InvalidInputError: a name in ``fixed`` that is not a task coordinate off the axes, or not a number.
+    """
+    if fixed is not None and not isinstance(fixed, Mapping):
+        raise InvalidInputError("fixed", "expected {task coordinate: value}", fixed)
+    reference = mech.task_map.named(mech.q_reference)
+    rest = {k: float(x) for k, x in reference.items() if k not in axes}  # type: ignore[operator]
+    for k, x in (fixed or {}).items():
+        if k not in rest:
+            raise InvalidInputError("fixed", f"{k!r} is not a task coordinate off the axes; those are {list(rest)}", k)
+        rest[k] = as_scalar(x, f"fixed[{k}]")
+    return rest
+
+
 def _joint_of(mech: Mechanism, iq: int) -> str:
     model = mech.model
     for j in range(1, model.njoints):
@@ -150,8 +167,6 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
     hi = np.array(mech.model.upperPositionLimit, dtype=float)
     if limits is not None and not isinstance(limits, Mapping):
         raise InvalidInputError("limits", "expected {joint: (low, high)}", limits)
-    if fixed is not None and not isinstance(fixed, Mapping):
-        raise InvalidInputError("fixed", "expected {task coordinate: value}", fixed)
     for joint, bounds in (limits or {}).items():
         if not isinstance(joint, str) or not mech.model.existJointName(joint):
             raise InvalidInputError("limits", f"{joint!r} is not a joint of {mech.name}", joint)
@@ -163,12 +178,8 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
         jm = mech.model.joints[mech.model.getJointId(joint)]
         lo[jm.idx_q:jm.idx_q + jm.nq] = low
         hi[jm.idx_q:jm.idx_q + jm.nq] = high
+    rest = other_coordinates(mech, axes, fixed)
     reference = mech.task_map.named(mech.q_reference)
-    rest = {k: float(v) for k, v in reference.items() if k not in axes}
-    for k, v in (fixed or {}).items():
-        if k not in rest:
-            raise InvalidInputError("fixed", f"{k!r} is not a task coordinate off the axes; those are {list(rest)}", k)
-        rest[k] = as_scalar(v, f"fixed[{k}]")
     center = np.array([reference[axes[0]], reference[axes[1]]], dtype=float)
 
     def at(point: np.ndarray, q0: np.ndarray) -> tuple[np.ndarray | None, str]:
@@ -204,4 +215,4 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
     return Region((axes[0], axes[1]), rest, center, np.array(vertices), tuple(binding), angles, singularity)
 
 
-__all__ = ["SINGULARITY", "Region", "feasible_region"]
+__all__ = ["SINGULARITY", "Region", "feasible_region", "other_coordinates"]
