@@ -48,6 +48,13 @@ print(f"  largest pure-roll torque:  {np.nanmin(plus_roll):.4g} to {np.nanmax(pl
 print("  pitch [deg] ->  " + "  ".join(f"{np.degrees(p):6.1f}" for p in pitch))
 for j, r in enumerate(roll):
     print(f"  roll {np.degrees(r):5.1f}:  +pitch " + "  ".join(f"{v:6.1f}" for v in plus_pitch[j]))
+try:  # (the figures: pip install "pkm[figures]")
+    import matplotlib  # noqa: F401
+except ImportError:
+    pass
+else:
+    for axis in ("ankle_pitch", "ankle_roll"):
+        print("  figure:", cm.figure(f"ankle_{axis.split('_')[1]}_torque.png", along=axis))
 
 print(f"the rotors' inertia at the ankle joints (each motor {reflected:.4g} kg m^2 on its own axis):")
 neutral = None

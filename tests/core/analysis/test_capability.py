@@ -94,5 +94,8 @@ def test_the_map_is_the_pointwise_capability(tmp_path):
     from pathlib import Path
 
     assert Path(cm.figure(str(tmp_path / "map.png"))).stat().st_size > 1000
+    assert Path(cm.figure(str(tmp_path / "z.png"), along="z", negative=True)).stat().st_size > 1000
+    with pytest.raises(InvalidInputError, match="along"):
+        cm.figure(str(tmp_path / "w.png"), along="w")
     with pytest.raises(InvalidInputError, match="not a task coordinate"):
         capability_map(mech, {"w": xs})

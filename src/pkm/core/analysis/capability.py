@@ -218,13 +218,15 @@ class CapabilityMap:
     kinds: dict[str, str]
     mechanism: str = ""
 
-    def figure(self, path: str, unit: str | None = None) -> str:
-        """Draw the largest isotropic value of ``unit`` (default the first) over the map as a PNG at ``path``
-        (1 axis: a curve; 2 axes: a colour map with its colour bar; unreachable nodes blank).
+    def figure(self, path: str, unit: str | None = None, *, along: str | None = None, negative: bool = False) \
+            -> str:
+        """Draw the largest isotropic value of ``unit`` (default the first) over the map as a PNG at ``path``, or
+        with ``along`` the largest value along that task axis (its positive direction, or ``negative``: a pure-pitch
+        torque map) (1 axis: a curve; 2 axes: a colour map with its colour bar; unreachable nodes blank).
 
         Raises:
             MissingDependencyError: matplotlib is not installed (``pip install "pkm[figures]"``).
-            InvalidInputError: an unknown unit.
+            InvalidInputError: an unknown unit or axis.
         """
         from pathlib import Path
 
@@ -233,13 +235,20 @@ class CapabilityMap:
         require("figures", "the figure of a capability map")
         from pkm.papers._plot import figure, pyplot
 
-        unit = next(iter(self.isotropic)) if unit is None else unit
-        if unit not in self.isotropic:
-            raise InvalidInputError("unit", f"one of {list(self.isotropic)}, got {unit!r}", unit)
-        values = self.isotropic[unit]
+        if along is not None:
+            if along not in self.along:
+                raise InvalidInputError("along", f"one of {list(self.along)}, got {along!r}", along)
+            values = self.along[along][1 if negative else 0]
+            label = f"largest {'-' if negative else '+'}{along} {self.kind} [{self.units.get(along, '')}]"
+        else:
+            unit = next(iter(self.isotropic)) if unit is None else unit
+            if unit not in self.isotropic:
+                raise InvalidInputError("unit", f"one of {list(self.isotropic)}, got {unit!r}", unit)
+            values = self.isotropic[unit]
+            label = f"largest isotropic {self.kind} [{unit}]"
         fig, ax = figure()
         (n1, v1) = self.axes[0]
-        label = f"largest isotropic {self.kind} [{unit}]"
+
         def axis_label(name: str) -> str:
             return f"{name} [{'m' if self.kinds[name] == 'length' else 'rad'}]"
 
