@@ -99,6 +99,20 @@ def metadata(mech: Mechanism, sim: Simulation) -> dict[str, object]:
             "actuated": list(mech.actuated_names), "units": column_units(mech, sim)}
 
 
+def write_csv(cols: dict[str, np.ndarray], path: str | Path) -> Path:
+    """Columns of equal length as CSV: a header of their names, then the numbers as ``repr`` of floats (exact);
+    the folder created. The one CSV layout of pkm's samples tables (simulations, excitations), which
+    :func:`pkm.measurements` reads."""
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with out.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(list(cols))
+        for row in zip(*cols.values()):
+            w.writerow([repr(float(v)) for v in row])
+    return out
+
+
 def write(mech: Mechanism, sim: Simulation, path: str | Path) -> Path:
     """Write the table of :func:`columns`: CSV when ``path`` ends in ``.csv`` (a header of the column names, numbers
     as ``repr`` of floats, the units in :func:`column_units`), otherwise Parquet with the units in each field's
@@ -114,13 +128,7 @@ def write(mech: Mechanism, sim: Simulation, path: str | Path) -> Path:
     cols = columns(mech, sim)
     out = Path(path)
     if out.suffix.lower() == ".csv":
-        out.parent.mkdir(parents=True, exist_ok=True)
-        with out.open("w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(list(cols))
-            for row in zip(*cols.values()):
-                w.writerow([repr(float(v)) for v in row])
-        return out
+        return write_csv(cols, out)
     what = "writing a simulation as Parquet (or give a .csv path)"
     pa = module("pyarrow", extra="sweeps", what=what)
     pq = module("pyarrow.parquet", extra="sweeps", what=what)
@@ -133,4 +141,4 @@ def write(mech: Mechanism, sim: Simulation, path: str | Path) -> Path:
     return out
 
 
-__all__ = ["ENERGIES", "column_units", "columns", "energy_balance", "metadata", "write"]
+__all__ = ["ENERGIES", "column_units", "columns", "energy_balance", "metadata", "write", "write_csv"]

@@ -26,12 +26,12 @@ from numpy.typing import ArrayLike
 
 from pkm.core.identification.rank import CLEAR_GAP, RankDecision, decide_rank
 from pkm.core.identification.regressor import Parameters, parameters, regressor
-
-if TYPE_CHECKING:
-    from pkm.core.identification.precise import PreciseRank
 from pkm.core.kinematics.solve import close_loops
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import ConvergenceError, InvalidInputError, SingularityError
+
+if TYPE_CHECKING:
+    from pkm.core.identification.precise import PreciseRank
 
 _STATES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # mechanism -> {(n, seed, spread): states}
 MAX_SAMPLES = 10_000  # states stacked at most (each costs about a millisecond)
@@ -155,8 +155,8 @@ def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int 
     """The base parameters of ``mech`` by the numerical route (module doc), from ``n_samples`` random states
     (default: enough for three times as many rows as parameters); ``tie_legs``: one parameter set per kind of leg
     (:func:`leg_ties`), which lowers the count; ``precise``: decide the rank a second time in 50-digit arithmetic
-    on the same samples (:mod:`~pkm.core.identification.precise`: about a second for the Delta, ten for the
-    hexapod's 248 parameters), the result saying whether the two routes agree (:attr:`BaseParameters.routes_agree`).
+    on the same samples (:mod:`~pkm.core.identification.precise`: 0.4 s for the Delta, 2 s for the hexapod's 248
+    parameters), the result saying whether the two routes agree (:attr:`BaseParameters.routes_agree`).
     The numerical route's base parameters are returned either way: where the routes disagree, the caller decides
     (the precise rank says which combinations double precision could not see).
 

@@ -40,7 +40,7 @@ import numpy as np
 import scipy.optimize
 
 from pkm.core.identification.base import BaseParameters, base_parameters
-from pkm.core.identification.regressor import parameters, regressor_batch
+from pkm.core.identification.regressor import close_along, parameters, regressor_batch
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PkmError
 from pkm.validation import as_count, as_scalar
@@ -111,35 +111,11 @@ class Excitation:
         return fourier(np.atleast_1d(t), self.offset, self.a, self.b, self.omega)
 
 
-class _Path:
-    """The loops closed along actuated samples, warm-started (compiled where the twin builds, else Python)."""
-
-    def __init__(self, mech: Mechanism):
-        from pkm.core.identification.regressor import _kernels
-
-        self.mech = mech
-        self.kernels = _kernels(mech)
-
-    def close(self, QA: np.ndarray) -> np.ndarray:
-        from pkm.core.kinematics.solve import close_loops
-
-        q0 = self.mech.q_reference
-        if self.kernels is not None:
-            path = self.kernels.close_loops_path(QA, q0)
-            return np.asarray(path.q)
-        out, q = [], q0
-        for qa in QA:
-            q = close_loops(self.mech, qa, q).q
-            out.append(q)
-        return np.array(out)
-
-
 def _limits(mech: Mechanism, amplitude: float | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     lo = mech.model.lowerPositionLimit[mech.act_q].astype(float)
     hi = mech.model.upperPositionLimit[mech.act_q].astype(float)
     ref = mech.actuated_q(mech.q_reference)
-    kinds = ["m" if "P" in mech.model.joints[j.id].shortname().removeprefix("JointModel")[:2] else "rad"
-             for j in mech.actuated]
+    kinds = ["rad" if mech.joints[name].revolute else "m" for name in mech.actuated_names]
     amp = np.array([AMPLITUDE[k] if amplitude is None else amplitude for k in kinds])
     lo, hi = np.maximum(lo, ref - amp), np.minimum(hi, ref + amp)
     bad = np.flatnonzero(~(lo < ref) | ~(ref < hi))
@@ -180,7 +156,6 @@ def excite(mech: Mechanism, *, period: float = 10.0, harmonics: int = 5, samples
     na, omega = mech.na, 2.0 * np.pi / period
     lo, hi, speed, effort = _limits(mech, amplitude)
     theta = parameters(mech).values
-    path = _Path(mech)
     t = np.arange(M) * period / M
     half = 0.5 * (hi - lo)
     ref = mech.actuated_q(mech.q_reference)
@@ -190,7 +165,7 @@ def excite(mech: Mechanism, *, period: float = 10.0, harmonics: int = 5, samples
 
     def state(x: np.ndarray, times: np.ndarray) -> tuple[np.ndarray, ...]:
         qa, qd, qdd = fourier(times, *unpack(x), omega)
-        Q = path.close(qa)
+        Q = close_along(mech, qa)
         W = regressor_batch(mech, Q, qd, qdd)
         return qa, qd, qdd, Q, W
 
@@ -315,28 +290,21 @@ def write_csv(mech: Mechanism, excitation: Excitation, path: str, *, periods: in
         -> str:
     """The excitation as a samples table (the columns of :mod:`pkm.core.dynamics.samples`: ``time``,
     ``q.<joint>``, ``qd.<joint>``, ``qdd.<joint>``, ``tau.<joint>``; the efforts the model's own), ``periods``
-    periods at ``dt`` [s] (default: the dense samples' step)."""
-    import csv
-    from pathlib import Path
+    periods at ``dt`` [s] (default: the dense samples' step), written by
+    :func:`pkm.core.dynamics.samples.write_csv`."""
+    from pkm.core.dynamics import samples
 
     mech = check_mechanism(mech)
     step = excitation.t[1] - excitation.t[0] if dt is None else as_scalar(dt, "dt")
     n = round(as_count(periods, "periods") * excitation.period / step)
     t = np.arange(n + 1) * step
     qa, qd, qdd = excitation(t)
-    Q = _Path(mech).close(qa)
-    tau = regressor_batch(mech, Q, qd, qdd) @ parameters(mech).values
-    tau = tau.reshape(len(t), mech.na)
-    names = mech.actuated_names
-    header = ["time", *(f"{k}.{j}" for k in ("q", "qd", "qdd", "tau") for j in names)]
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with out.open("w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        for row in np.column_stack([t, qa, qd, qdd, tau]):
-            w.writerow([repr(float(v)) for v in row])
-    return str(out)
+    Q = close_along(mech, qa)
+    tau = (regressor_batch(mech, Q, qd, qdd) @ parameters(mech).values).reshape(len(t), mech.na)
+    cols = {"time": t}
+    for prefix, values in (("q", qa), ("qd", qd), ("qdd", qdd), ("tau", tau)):
+        cols.update({f"{prefix}.{j}": values[:, k] for k, j in enumerate(mech.actuated_names)})
+    return str(samples.write_csv(cols, path))
 
 
 def write_motion(mech: Mechanism, excitation: Excitation, path: str, *, periods: int = 1, dt: float | None = None,

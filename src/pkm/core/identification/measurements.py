@@ -172,14 +172,14 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
     QA, TAU = table[:, 1:1 + mech.na], table[:, 1 + mech.na:]
     lo = mech.model.lowerPositionLimit[mech.act_q]
     hi = mech.model.upperPositionLimit[mech.act_q]
-    for j, joint in enumerate(mech.actuated):
-        prismatic = "P" in mech.model.joints[joint.id].shortname().removeprefix("JointModel")[:2]
+    for j, name in enumerate(names):
+        prismatic = not mech.joints[name].revolute
         cap = MAX_PRISMATIC if prismatic else MAX_REVOLUTE
         out = np.flatnonzero((QA[:, j] < max(lo[j], -cap) - 1e-9) | (QA[:, j] > min(hi[j], cap) + 1e-9))
         if out.size:
             r = int(out[0])
             unit = "mm" if prismatic else "degrees"
-            raise InvalidInputError(f"q.{names[j]}", f"{source}, row {r + 1}, column 'q.{names[j]}': {QA[r, j]:.6g} "
+            raise InvalidInputError(f"q.{name}", f"{source}, row {r + 1}, column 'q.{name}': {QA[r, j]:.6g} "
                                                      f"is outside the joint's range [{max(lo[j], -cap):.6g}, "
                                                      f"{min(hi[j], cap):.6g}] (SI units: is the table in {unit}?)",
                                     QA[r, j])
@@ -202,10 +202,10 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
     if every < 1:
         raise InvalidInputError("decimate", f"expected a positive integer, got {decimate}", decimate)
     keep = np.arange(edge, n - edge, every)
-    from pkm.core.identification.excitation import _Path
+    from pkm.core.identification.regressor import close_along
 
     try:
-        Q = _Path(mech).close(q[keep])
+        Q = close_along(mech, q[keep])
     except PkmError as exc:
         raise InvalidInputError("q", f"{source}: the loops do not close along the measured positions ({exc})",
                                 None) from None

@@ -43,6 +43,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import math
+import weakref
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
@@ -107,8 +108,8 @@ _BINARY: dict[int, Callable[[Any, Any], Any]] = {
     cs.OP_EQ: lambda x, y: mpmath.mpf(x == y), cs.OP_NE: lambda x, y: mpmath.mpf(x != y),
     cs.OP_AND: lambda x, y: mpmath.mpf(x != 0 and y != 0), cs.OP_OR: lambda x, y: mpmath.mpf(x != 0 or y != 0),
 }
-_FAST_UNARY = {cs.OP_ASSIGN, cs.OP_NEG, cs.OP_SQ, cs.OP_TWICE}
-_FAST_BINARY = {cs.OP_ADD, cs.OP_SUB, cs.OP_MUL, cs.OP_DIV}
+#: The operations numpy's object arrays run themselves (their operators call mpmath's): no per-element wrapper.
+_ARRAY_OPS = {cs.OP_ASSIGN, cs.OP_NEG, cs.OP_SQ, cs.OP_TWICE, cs.OP_INV, cs.OP_ADD, cs.OP_SUB, cs.OP_MUL, cs.OP_DIV}
 
 
 class Program:
@@ -139,12 +140,12 @@ class Program:
                 ops.append(("in", out[0], args[0], args[1]))
             elif op == cs.OP_OUTPUT:
                 ops.append(("out", args[0], out[0], out[1]))
-            elif op in _FAST_UNARY or op in _FAST_BINARY:
-                ops.append(("fast", out[0], op, tuple(args)))
             elif op in _UNARY:
-                ops.append(("map", out[0], np.frompyfunc(_UNARY[op], 1, 1), (args[0],)))
+                f = _UNARY[op] if op in _ARRAY_OPS else np.frompyfunc(_UNARY[op], 1, 1)
+                ops.append(("call", out[0], f, (args[0],)))
             elif op in _BINARY:
-                ops.append(("map", out[0], np.frompyfunc(_BINARY[op], 2, 1), tuple(args[:2])))
+                f = _BINARY[op] if op in _ARRAY_OPS else np.frompyfunc(_BINARY[op], 2, 1)
+                ops.append(("call", out[0], f, tuple(args[:2])))
             else:
                 raise SpecError(fun.name(), f"the high-precision evaluator does not run CasADi operation {op}")
         self.ops = ops
@@ -159,26 +160,7 @@ class Program:
         outs = [np.full((fun.nnz_out(i), S), mpmath.mpf(0), dtype=object) for i in range(fun.n_out())]
         for op in self.ops:
             kind = op[0]
-            if kind == "fast":
-                _, o, code, args = op
-                x = w[args[0]]
-                if code == cs.OP_ADD:
-                    w[o] = x + w[args[1]]
-                elif code == cs.OP_SUB:
-                    w[o] = x - w[args[1]]
-                elif code == cs.OP_MUL:
-                    w[o] = x * w[args[1]]
-                elif code == cs.OP_DIV:
-                    w[o] = x / w[args[1]]
-                elif code == cs.OP_NEG:
-                    w[o] = -x
-                elif code == cs.OP_SQ:
-                    w[o] = x * x
-                elif code == cs.OP_TWICE:
-                    w[o] = x + x
-                else:  # OP_ASSIGN
-                    w[o] = x
-            elif kind == "map":
+            if kind == "call":
                 _, o, f, args = op
                 w[o] = f(*(w[a] for a in args))
             elif kind == "const":
@@ -294,11 +276,13 @@ def pivoted_qr(A: np.ndarray, stop: float = 0.0) -> tuple[np.ndarray, np.ndarray
     return np.array([p / top for p in pivots], dtype=float), perm
 
 
-def _key(mech: Mechanism, states: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> tuple:
-    return id(mech), hashlib.sha256(b"".join(np.ascontiguousarray(x).tobytes() for s in states for x in s)).hexdigest()
+def _key(states: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> str:
+    return hashlib.sha256(b"".join(np.ascontiguousarray(x).tobytes() for s in states for x in s)).hexdigest()
 
 
-_REGRESSORS: dict[tuple, tuple[np.ndarray, int, int]] = {}
+#: mechanism -> {the states' digest: (W, constants, unrecognised)} (weakly: a mechanism made anew, a model changed
+#: in between, is computed anew, as :func:`~pkm.core.identification.base.random_states` keeps its draws)
+_REGRESSORS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def precise_regressor(mech: Mechanism, states: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]]) \
@@ -312,8 +296,9 @@ def precise_regressor(mech: Mechanism, states: Sequence[tuple[np.ndarray, np.nda
         ConvergenceError: a sample does not close in high precision.
     """
     mech = check_mechanism(mech)
-    key = _key(mech, states)
-    if key not in _REGRESSORS:
+    key = _key(states)
+    kept = _REGRESSORS.setdefault(mech, {})
+    if key not in kept:
         with mpmath.workdps(DIGITS):
             step, program = _programs(mech)
             q = close_precisely(mech, np.array([s[0] for s in states]), step)
@@ -324,10 +309,10 @@ def precise_regressor(mech: Mechanism, states: Sequence[tuple[np.ndarray, np.nda
         W = np.empty((S * na, p), dtype=object)
         for k in range(S):  # (the function gives Y transposed, column-major: Y row after row)
             W[k * na:(k + 1) * na] = flat[:, k].reshape(na, p)
-        if len(_REGRESSORS) >= 4:
-            _REGRESSORS.pop(next(iter(_REGRESSORS)))
-        _REGRESSORS[key] = (W, step.constants + program.constants, step.unrecognised + program.unrecognised)
-    return _REGRESSORS[key]
+        if len(kept) >= 4:
+            kept.pop(next(iter(kept)))
+        kept[key] = (W, step.constants + program.constants, step.unrecognised + program.unrecognised)
+    return kept[key]
 
 
 def precise_rank(mech: Mechanism, states: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]],

@@ -149,24 +149,49 @@ def regressor(mech: Mechanism, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> n
 
 AUTO_SAMPLES = 2000  # "auto" compiles a mechanism's regressor for batches of at least this many samples
 BACKENDS = ("auto", "python", "c")
-_KERNELS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_KERNELS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # mechanism -> (Kernels or None, why not)
 
 
-def _kernels(mech: Mechanism) -> Kernels | None:
-    """The mechanism's compiled regressor kernel (built once per mechanism), or None where the twin cannot build
-    it (idle motions, a joint kind it lacks) or no C compiler runs."""
+def _compiled(mech: Mechanism) -> tuple[Kernels | None, str]:
+    """The mechanism's kernels with the regressor compiled (built once per mechanism), or None and why not: the
+    twin cannot build it (idle motions, a joint kind it lacks: ``"spec: ..."``) or no C compiler runs (what the
+    compiler search said)."""
     from pkm.core.twin.kernels import Kernels
 
     if mech not in _KERNELS:
-        k: Kernels | None = Kernels(mech)
+        kernels = Kernels(mech)
         try:
-            assert k is not None
-            if k.kernel("regressor").lib is None:
-                k = None
-        except SpecError:
-            k = None
-        _KERNELS[mech] = k
+            kernel = kernels.kernel("regressor")
+            _KERNELS[mech] = (kernels, "") if kernel.lib is not None else (None, kernel.how)
+        except SpecError as exc:
+            _KERNELS[mech] = (None, f"spec: {exc}")
     return _KERNELS[mech]
+
+
+def _kernels(mech: Mechanism) -> Kernels | None:
+    """The mechanism's compiled kernels, or None (:func:`_compiled`)."""
+    return _compiled(mech)[0]
+
+
+def close_along(mech: Mechanism, QA: np.ndarray, q0: np.ndarray | None = None) -> np.ndarray:
+    """Closed configurations (N x nq) along actuated samples ``QA`` (N x na), each solve warm-started from the last
+    (one assembly mode): the compiled closure path (:meth:`pkm.Kernels.close_loops_path`) where the regressor's
+    kernels build, else :func:`pkm.close_loops` sample after sample.
+
+    Raises:
+        ConvergenceError: a sample does not close (from the previous one).
+    """
+    from pkm.core.kinematics.solve import close_loops
+
+    q = mech.q_reference if q0 is None else q0
+    kernels = _kernels(mech)
+    if kernels is not None:
+        return np.asarray(kernels.close_loops_path(QA, q).q)
+    out = []
+    for qa in QA:
+        q = close_loops(mech, qa, q).q
+        out.append(q)
+    return np.array(out)
 
 
 def regressor_batch(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, *,
@@ -176,7 +201,7 @@ def regressor_batch(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike
 
     ``backend``: ``"python"`` calls :func:`regressor` per sample (0.4 to 2 ms each); ``"c"`` runs the twin's
     compiled regressor (:mod:`pkm.core.twin.regressor`: the exact ``∂τ_a/∂θ``, on every core; the hexapod's 10⁵
-    samples in 0.23 s once its 1.4 GB are allocated, ``pkm bench identification``), samples under the pivot floor
+    samples in 0.34 s once its 1.4 GB are allocated, ``pkm bench identification``), samples under the pivot floor
     redone in Python; ``"auto"``: C for batches of :data:`AUTO_SAMPLES` or more (or when already built) where
     the twin builds the mechanism (no idle motions) and a C compiler runs, else Python.
 
@@ -192,21 +217,16 @@ def regressor_batch(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike
     if not (len(Q) == len(QD) == len(QDD)):
         raise InvalidInputError("Q", f"expected as many samples of each: {len(Q)}, {len(QD)}, {len(QDD)}", len(Q))
     if backend == "c" or (backend == "auto" and (len(Q) >= AUTO_SAMPLES or _KERNELS.get(mech) is not None)):
-        kernels = _kernels(mech)
+        kernels, why = _compiled(mech)
         if kernels is not None:
             Y = kernels.regressor(Q, QD, QDD, lambda q, qd, qdd: regressor(mech, q, qd, qdd))
-            return Y.reshape(-1, len(parameters(mech)))
+            return Y.reshape(-1, Y.shape[-1])
+        if backend == "c" and why.startswith("spec: "):
+            raise InvalidInputError("backend", f"the C route does not build this mechanism: {why[6:]}", backend)
         if backend == "c":
-            from pkm.core.twin.kernels import Kernels
-
-            try:
-                how = Kernels(mech).kernel("regressor").how
-            except SpecError as exc:
-                raise InvalidInputError("backend", f"the C route does not build this mechanism: {exc}",
-                                        backend) from None
-            raise CompilerError("the compiled regressor (backend='c')", how)
+            raise CompilerError("the compiled regressor (backend='c')", why)
     return np.vstack([regressor(mech, q, qd, qdd) for q, qd, qdd in zip(Q, QD, QDD)])
 
 
-__all__ = ["AUTO_SAMPLES", "BACKENDS", "BODY_FIELDS", "DRIVE_FIELDS", "Parameters", "parameters", "regressor",
-           "regressor_batch", "tree_regressor"]
+__all__ = ["AUTO_SAMPLES", "BACKENDS", "BODY_FIELDS", "DRIVE_FIELDS", "Parameters", "close_along", "parameters",
+           "regressor", "regressor_batch", "tree_regressor"]
