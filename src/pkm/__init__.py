@@ -30,6 +30,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     **_CORE_EXPORTS,
     "pkm.core.analysis.maps": ("workspace_map", "task_map"),  # (task_map: the deprecated name)
     "pkm.core.analysis.reconfiguration": ("reconfigure",),
+    "pkm.core.export": ("CLibrary", "export_c"),
     "pkm.core.modes": ("assembly_modes", "track_assembly_mode", "track_working_mode", "working_modes"),
     "pkm.core.twin": ("Kernels", "Twin"),
     "pkm.sweeps": ("sweep",),
@@ -116,6 +117,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
     )
     from pkm.core.analysis.maps import task_map, workspace_map
     from pkm.core.analysis.reconfiguration import reconfigure
+    from pkm.core.export import CLibrary, export_c
     from pkm.core.modes import assembly_modes, track_assembly_mode, track_working_mode, working_modes
     from pkm.core.twin import Kernels, Twin
     from pkm.sweeps import sweep

@@ -24,7 +24,7 @@ import os
 import shutil
 import subprocess
 import tempfile
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -315,6 +315,18 @@ def count_operations(fun: cs.Function) -> dict[str, int]:
     return counts
 
 
+def paper_counts(fun: cs.Function) -> tuple[int, int, dict[str, int]]:
+    """``(mul, add, functions)`` of ``fun`` counted as the papers and SYMORO count (:func:`count_operations`):
+    ``*``, ``/``, squares and doublings as multiplications, ``+ -`` as additions, negations, inputs, outputs and
+    constants free, every other operation apart by name."""
+    counts = count_operations(fun)
+    mul = sum(counts.pop(k, 0) for k in ("mul", "div", "sq", "twice"))
+    add = sum(counts.pop(k, 0) for k in ("add", "sub"))
+    for k in ("neg", "input", "output", "const"):
+        counts.pop(k, None)
+    return mul, add, counts
+
+
 #: numpy expressions of CasADi's scalar operations (``a``, ``b``: the operands).
 _NUMPY = {
     "ADD": "{a} + {b}", "SUB": "{a} - {b}", "MUL": "{a} * {b}", "DIV": "{a} / {b}", "NEG": "-{a}", "SQ": "{a} * {a}",
@@ -331,6 +343,34 @@ _NUMPY = {
 }
 
 
+def instructions(fun: cs.Function, table: dict[str, str], language: str
+                 ) -> Iterator[tuple[str, object, list[int], list[int]]]:
+    """The instructions of the SX function ``fun`` as ``(kind, value, inputs, outputs)``: ``kind`` is ``"input"``
+    (``inputs``: which input and entry), ``"output"`` (``outputs``: which output and entry), ``"const"`` (``value``
+    the constant) or ``"op"`` (``value`` the expression, ``table``'s template for the operation filled with the work
+    variables ``w<k>``); ``outputs[0]`` (``inputs[0]`` of an output) is the work variable written (read).
+
+    Raises:
+        ValueError: an operation ``table`` (whose keys are CasADi's ``OP_`` names) has no form for, in ``language``.
+    """
+    names = {getattr(cs, f"OP_{k}"): k for k in table}
+    for k in range(fun.n_instructions()):
+        op = fun.instruction_id(k)
+        i: list[int] = list(fun.instruction_input(k))
+        o: list[int] = list(fun.instruction_output(k))
+        if op == cs.OP_INPUT:
+            yield "input", None, i, o
+        elif op == cs.OP_OUTPUT:
+            yield "output", None, i, o
+        elif op == cs.OP_CONST:
+            yield "const", float(fun.instruction_constant(k)), i, o
+        elif op in names:
+            yield "op", table[names[op]].format(a=f"w{i[0]}", b=f"w{i[1]}" if len(i) > 1 else ""), i, o
+        else:
+            op_name = next((n[3:] for n in dir(cs) if n.startswith("OP_") and getattr(cs, n) == op), op)
+            raise ValueError(f"{fun.name()}: the operation {op_name} has no {language} form here")
+
+
 def numpy_source(fun: cs.Function) -> str:
     """Python source of ``fun`` vectorised over samples: ``def f(np, n, in0, in1, ...)`` with each input an
     ``(n, nnz)`` array, returning the outputs as ``(n, nnz)`` arrays, one numpy statement per instruction of the
@@ -341,24 +381,18 @@ def numpy_source(fun: cs.Function) -> str:
     """
     if not fun.is_a("SXFunction"):
         raise ValueError(f"{fun.name()}: numpy_source needs an SX function")
-    names = {getattr(cs, f"OP_{k}"): k for k in _NUMPY}
     ins = ", ".join(f"in{i}" for i in range(fun.n_in()))
     lines = [f"def f(np, n, {ins}):"]
     lines += [f"    out{i} = np.zeros((n, {fun.nnz_out(i)}))" for i in range(fun.n_out())]
-    for k in range(fun.n_instructions()):
-        op, i, o = fun.instruction_id(k), fun.instruction_input(k), fun.instruction_output(k)
-        if op == cs.OP_INPUT:
+    for kind, value, i, o in instructions(fun, _NUMPY, "numpy"):
+        if kind == "input":
             lines.append(f"    w{o[0]} = in{i[0]}[:, {i[1]}]")
-        elif op == cs.OP_OUTPUT:
+        elif kind == "output":
             lines.append(f"    out{o[0]}[:, {o[1]}] = w{i[0]}")
-        elif op == cs.OP_CONST:
-            lines.append(f"    w{o[0]} = {float(fun.instruction_constant(k))!r}")
-        elif op in names:
-            expr = _NUMPY[names[op]].format(a=f"w{i[0]}", b=f"w{i[1]}" if len(i) > 1 else "")
-            lines.append(f"    w{o[0]} = {expr}")
+        elif kind == "const":
+            lines.append(f"    w{o[0]} = {value!r}")
         else:
-            op_name = next((n[3:] for n in dir(cs) if n.startswith("OP_") and getattr(cs, n) == op), op)
-            raise ValueError(f"{fun.name()}: the operation {op_name} has no numpy form here")
+            lines.append(f"    w{o[0]} = {value}")
     lines.append(f"    return [{', '.join(f'out{i}' for i in range(fun.n_out()))}]")
     return "\n".join(lines) + "\n"
 
@@ -383,5 +417,6 @@ def compile_function(fun: cs.Function, directory: str | os.PathLike[str] | None 
     return cs.external(fun.name(), lib._name), how
 
 
-__all__ = ["C_INT", "C_REAL_P", "cache_dir", "compile_function", "compile_library", "count_operations", "map_source", "numpy_function",
-           "numpy_source", "source"]
+__all__ = ["C_INT", "C_REAL_P", "cache_dir", "compile_function", "compile_library", "count_operations", "instructions",
+           "map_source",
+           "numpy_function", "numpy_source", "paper_counts", "source"]

@@ -275,18 +275,13 @@ class Kernels:
 
     def operation_count(self, name: str = "inverse_dynamics") -> OperationCount:
         """The operations of the kernel's main output (``tau``, ``q_next``) after CSE: see :class:`OperationCount`."""
-        from pkm.core.twin.codegen import count_operations
+        from pkm.core.twin.codegen import paper_counts
 
         if name not in BOUNDARIES:
             raise InvalidInputError("kernel", f"operation counts are stated for {sorted(BOUNDARIES)}", name)
         fun = self.function(name)
         args = fun.sx_in()
-        counted = cs.Function("count", args, cs.cse([fun.call(args)[0]]))
-        counts = count_operations(counted)
-        mul = sum(counts.pop(k, 0) for k in ("mul", "div", "sq", "twice"))
-        add = sum(counts.pop(k, 0) for k in ("add", "sub"))
-        for k in ("neg", "input", "output", "const"):
-            counts.pop(k, None)
+        mul, add, counts = paper_counts(cs.Function("count", args, cs.cse([fun.call(args)[0]])))
         return OperationCount(name, mul, add, counts, BOUNDARIES[name])
 
     # ---------------------------------------------------------------- evaluation

@@ -1,0 +1,359 @@
+"""``pkm export c``: a mechanism's kinematics and dynamics as a self-contained C99 library a controller can link.
+
+:func:`export_c` writes into a folder ``<name>.h``, ``<name>.c``, a ``Makefile``, a ``CMakeLists.txt`` and an
+example ``main.c``. The library's functions (declared and documented in the header): forward kinematics (Newton,
+warm-started from the caller's previous solution, a fixed iteration bound), inverse kinematics (Newton), the
+assembly and working mode ids of a configuration, the task value, the forward and inverse Jacobians, the rate and
+effort maps between actuators and task, ``J̇ q̇``, inverse dynamics, ``M_a`` and the gravity efforts.
+
+Every function is re-entrant (constant tables only, the caller owns every buffer), allocates nothing, prints
+nothing, needs only ``<math.h>``, and returns a status:
+
+* ``OK``; ``NOT_CONVERGED`` (``info.residual``: the largest residual at the last iterate);
+* ``SINGULAR`` (``info.sigma_min``: the Newton or closure matrix's smallest singular value, under ``SINGULAR_TOL``
+  times its largest);
+* ``OUTSIDE_LIMITS`` (``info.joint``: which limited joint, an index into ``<name>_limit_names``);
+* ``LEFT_MODE`` (``info.mode``: the mode id found, not the one asked for: see :mod:`pkm.core.export.model`);
+* ``INVALID_INPUT`` (a NaN or an infinity in an input);
+* ``PIVOT_ORDER``: the fixed elimination order of a kernel fails at this state although the matrix is regular
+  (``info.pivot``); the kinematics fall back to a dense solve, the maps and the dynamics report it.
+
+The kernels are the twin's expressions (:mod:`pkm.core.export.model`) written as C by :mod:`pkm.core.export.emit`;
+the hand-written parts (the Newton driver, the dense fallbacks) are :mod:`pkm.core.export.runtime`. Operation
+counts and the worst-case iteration count are in the header comment.
+"""
+
+from __future__ import annotations
+
+import datetime
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import casadi as cs
+import numpy as np
+
+from pkm.core.export import runtime
+from pkm.core.export.emit import c_constant, c_function
+from pkm.core.export.model import Block, ExportError, ExportModel, c_name
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.twin.codegen import jacobi_sv, paper_counts
+
+#: Newton iterations at most (each one evaluation of the step), the convergence tolerance on the largest closure
+#: residual or task error [m, rad], the relative pivot under which a solve goes dense, the relative smallest
+#: singular value under which a matrix counts as singular, the slack on joint limits [rad, m].
+MAX_ITER = 20
+TOL = 1e-12
+PIVOT_FLOOR = 1e-6
+SINGULAR_TOL = 1e-9
+LIMIT_TOL = 1e-9
+#: The status codes, in order from 0.
+STATUS = ("OK", "NOT_CONVERGED", "SINGULAR", "OUTSIDE_LIMITS", "LEFT_MODE", "INVALID_INPUT", "PIVOT_ORDER")
+
+
+@dataclass(frozen=True)
+class CLibrary:
+    """An exported library (:func:`export_c`).
+
+    Attributes:
+        name: The C prefix (``<name>_fk``...).
+        directory: Where the files are.
+        files: The files written.
+        sizes: ``NQ, NV, NA, NY, NX`` (configuration, velocity, actuated, task value and task rate sizes).
+        operations: Per kernel, ``(mul, add, other functions)`` after CSE (counted as the papers count).
+        blocks: ``{"fk": [...], "ik": [...]}``: each mode bit's joints (velocity coordinates named).
+        limits: The joints whose limits are checked, in ``info.joint``'s order.
+        idle: The velocity coordinates held at the caller's previous solution (one per idle motion).
+    """
+
+    name: str
+    directory: Path
+    files: tuple[Path, ...]
+    sizes: dict[str, int]
+    operations: dict[str, tuple[int, int, int]]
+    blocks: dict[str, list[list[str]]] = field(default_factory=dict)
+    limits: tuple[str, ...] = ()
+    idle: tuple[str, ...] = ()
+
+    @property
+    def header(self) -> Path:
+        return self.directory / f"{self.name}.h"
+
+    @property
+    def source(self) -> Path:
+        return self.directory / f"{self.name}.c"
+
+
+def _array(ctype: str, name: str, values: list, fmt: object = str, public: bool = False) -> str:
+    values = list(values) or [0]  # (C has no empty arrays: a placeholder the loops never read)
+    body = ", ".join(fmt(v) for v in values)  # type: ignore[operator]
+    return f"{'' if public else 'static '}const {ctype} {name}[{len(values)}] = {{{body}}};\n"
+
+
+def _blocks(kind: str, blocks: tuple[Block, ...]) -> str:
+    start = np.cumsum([0] + [len(b.rows) for b in blocks]).tolist()
+    return (f"#define {kind.upper()}_NBLOCKS {len(blocks)}\n"
+            + _array("int", f"p_{kind}_block_start", start)
+            + _array("int", f"p_{kind}_block_rows", [r for b in blocks for r in b.rows])
+            + _array("int", f"p_{kind}_block_cols", [c for b in blocks for c in b.cols])
+            + _array("int", f"p_{kind}_block_sign", [b.sign for b in blocks]))
+
+
+def _velocity_names(mech: Mechanism) -> list[str]:
+    """A name per velocity coordinate: the joint's, suffixed by the coordinate for multi-DOF joints."""
+    names = [""] * mech.nv
+    for name, j in mech.joints.items():
+        for k in range(j.nv):
+            names[j.idx_v + k] = name if j.nv == 1 else f"{name}[{k}]"
+    return names
+
+
+def _limits(mech: Mechanism) -> list[tuple[str, int, float, float]]:
+    """``(joint, q index, low, high)`` of the one-coordinate joints with finite limits."""
+    lo, hi = mech.model.lowerPositionLimit, mech.model.upperPositionLimit
+    out = []
+    for name, j in mech.joints.items():
+        if j.nq != 1:
+            continue
+        a, b = float(lo[j.idx_q]), float(hi[j.idx_q])
+        if np.isfinite(a) and np.isfinite(b) and a < b and max(abs(a), abs(b)) < 1e10:
+            out.append((name, j.idx_q, a, b))
+    return out
+
+
+def _quote(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | None = None) -> CLibrary:
+    """Write ``mech``'s C library into ``directory`` (created): see the module doc.
+
+    Args:
+        mech: Any mechanism pkm loads (without a ``[task]``, its task is its actuated joints).
+        directory: The output folder.
+        name: The C prefix (default: the mechanism's name as a C identifier).
+
+    Raises:
+        ExportError: the mechanism cannot be exported, and why: a joint kind the twin does not write; the closures (or closures and task) do not fix the joints at the reference; a Newton solve that does not
+            converge at the reference; a non-finite kernel value at the reference.
+    """
+    from pkm import __version__
+
+    mech = check_mechanism(mech)
+    prefix = c_name(name or mech.name)
+    model = ExportModel(mech)
+    fk, ik = model.fk, model.ik
+    kernels = [fk.step, fk.system, fk.retract, ik.step, ik.system, ik.retract, model.task_value(), model.jacobians(), model.jdot_qdot(),
+               model.inverse_dynamics(), model.mass_matrix(), model.gravity()]
+    _check_at_reference(mech, model, kernels)
+    sizes = {"NQ": mech.nq, "NV": mech.nv, "NA": mech.na, "NY": mech.task_map.value_size, "NX": mech.task_map.size}
+    ops = {}
+    for fun in kernels:
+        mul, add, other = paper_counts(fun)
+        ops[fun.name()] = (mul, add, sum(other.values()))
+    vnames = _velocity_names(mech)
+    blocks = {kind: [[vnames[newton.columns[c]] for c in b.cols] for b in newton.blocks]
+              for kind, newton in (("fk", fk), ("ik", ik))}
+    limits = _limits(mech)
+    out = Path(directory)
+    out.mkdir(parents=True, exist_ok=True)
+    nfk, nik = len(fk.columns), len(ik.columns)
+    fill = {"FKN": str(nfk), "IKN": str(nik), "FKB": str(max(len(fk.blocks), 1)), "IKB": str(max(len(ik.blocks), 1))}
+
+    def prefixed(text: str) -> str:
+        for key, value in fill.items():
+            text = text.replace(key, value)
+        return text.replace("p_", f"{prefix}_").replace("P_", f"{prefix.upper()}_")
+
+    stamp = datetime.date.today().isoformat()
+    header = _header(mech, prefix, sizes, ops, blocks, limits, fk, ik, __version__, stamp)
+    tables = (_array("int", "p_actuated_q", [int(i) for i in mech.act_q], public=True)
+              + f"#define P_NLIMITS {len(limits)}\n"
+              + _array("int", "p_limit_q", [q for _, q, _, _ in limits])
+              + _array("double", "p_limit_low", [lo for _, _, lo, _ in limits], c_constant)
+              + _array("double", "p_limit_high", [hi for _, _, _, hi in limits], c_constant)
+              + _blocks("fk", fk.blocks) + _blocks("ik", ik.blocks)
+              + f"#define P_NMAX {max(nfk, nik)}\n"
+              + f"#define P_BMAX {max([len(b.rows) for b in fk.blocks + ik.blocks] + [1])}\n")
+    limit_names = [n for n, *_ in limits] or [""]
+    constants = ("const char* const p_limit_names[P_NLIMITS_OR_1] = {"
+                 + ", ".join(_quote(n) for n in limit_names) + "};\n"
+                 + "const char* const p_task_names[P_NY] = {"
+                 + ", ".join(_quote(n) for n in mech.task_map.value_names) + "};\n"
+                 + _array("double", "p_q_reference", [float(x) for x in mech.q_reference], c_constant, public=True))
+    constants = constants.replace("P_NLIMITS_OR_1", str(len(limit_names)))
+    functions = "".join(c_function(fun, f"p_k_{fun.name()}") for fun in kernels)
+    newton = "".join(runtime.NEWTON.replace("$KNBLOCKS", f"{k.upper()}_NBLOCKS").replace("$kind", k)
+                     .replace("$NX", str(n)).replace("$NB", str(max(len(b), 1)))
+                     for k, n, b in (("fk", nfk, fk.blocks), ("ik", nik, ik.blocks)))
+    sv = jacobi_sv("p_sv", 1e-17, 1e-16).replace("casadi_real", "double").replace("casadi_int", "int")
+    source = (f"/* {prefix}: generated by pkm {__version__} on {stamp}; see {prefix}.h. */\n"
+              f'#include "{prefix}.h"\n#include <math.h>\n\n'
+              + prefixed(tables) + prefixed(constants) + "\n/* ---------------------------------------------------------------- kernels (the twin's expressions) */\n"
+              + prefixed(functions) + prefixed(runtime.HELPERS.replace("JACOBI_SV", sv)) + prefixed(newton)
+              + prefixed(runtime.PUBLIC))
+    files = {f"{prefix}.h": header, f"{prefix}.c": source, "Makefile": _MAKEFILE.replace("NAME", prefix),
+             "CMakeLists.txt": _CMAKE.replace("NAME", prefix), "main.c": _main(prefix, mech)}
+    written = []
+    for fname, text in files.items():
+        path = out / fname
+        path.write_text(text)
+        written.append(path)
+    return CLibrary(prefix, out, tuple(written), sizes, ops, blocks, tuple(n for n, *_ in limits),
+                    tuple(vnames[c] for c in model.idle))
+
+
+def _check_at_reference(mech: Mechanism, model: ExportModel, kernels: list[cs.Function]) -> None:
+    """Each kernel finite at the reference and both Newton solves converged there (the reference is closed: its
+    step is a zero step)."""
+    q = mech.q_reference
+    qa, y = mech.actuated_q(q), mech.task_map.value(q)
+    zeros = np.zeros(mech.na)
+    for newton, target, what in ((model.fk, qa, "forward"), (model.ik, y, "inverse")):
+        q_next, r, pivot, *_ = (np.array(x).ravel() for x in newton.step(q, target))
+        if not (np.isfinite(q_next).all() and r[0] <= 1e-9 and pivot[0] >= PIVOT_FLOOR):
+            raise ExportError(mech.name, f"the {what} kinematics' Newton step does not converge at the reference "
+                                         f"(residual {r[0]:.3g}, smallest relative pivot {pivot[0]:.3g})")
+    args = {"task_value": (q,), "jacobians": (q,), "jdot_qdot": (q, zeros + 0.1), "inverse_dynamics": (q, zeros, zeros),
+            "mass_matrix": (q,), "gravity": (q,)}
+    for fun in kernels:
+        if fun.name() not in args:
+            continue
+        values = [np.array(x) for x in fun.call([cs.DM(a) for a in args[fun.name()]])]
+        if not all(np.isfinite(v).all() for v in values):
+            raise ExportError(mech.name, f"{fun.name()} is not finite at the reference")
+        if fun.name_out(fun.n_out() - 1) == "pivot" and not values[-1].ravel()[0] >= PIVOT_FLOOR:
+            raise ExportError(mech.name, f"{fun.name()}'s factorisation fails at the reference (an idle motion "
+                                         "without inertia of its own?)")
+
+
+def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, tuple[int, int, int]],
+            blocks: dict[str, list[list[str]]], limits: list, fk: object, ik: object, version: str, stamp: str) -> str:
+    U = prefix.upper()
+    step = lambda k: ops[k][0] + ops[k][1] + ops[k][2]
+    lines = [
+        f"{prefix}: the kinematics and dynamics of the mechanism {mech.name!r} as C99, generated by pkm {version}",
+        f"on {stamp} from {mech.source}.",
+        "",
+        f"Sizes: configuration q {sizes['NQ']} (Pinocchio's layout: a ball joint's quaternion x y z w), velocity "
+        f"{sizes['NV']}, actuated {sizes['NA']} ({', '.join(mech.actuated_names)}), task value {sizes['NY']} "
+        f"({', '.join(mech.task_map.value_names)}), task rate {sizes['NX']}. SI units: m, rad, N, N m, kg.",
+        "",
+        "Operations after common-subexpression elimination (multiplications, additions, other functions):",
+    ]
+    for k, (mul, add, other) in ops.items():
+        lines.append(f"  {k:18s} {mul:6d} mul {add:6d} add {other:5d} functions")
+    lines += [
+        "",
+        f"Forward kinematics: at most {U}_MAX_ITER = {MAX_ITER} evaluations of fk_step ({step('fk_step')} operations "
+        f"each), so at most {MAX_ITER * step('fk_step')} operations and a dense {len(fk.columns)} x {len(fk.columns)}"  # type: ignore[attr-defined]
+        " solve per iteration where the fixed pivots fail.",
+        f"Inverse kinematics: at most {MAX_ITER} evaluations of ik_step ({step('ik_step')} operations each), at "
+        f"most {MAX_ITER * step('ik_step')} operations.",
+        f"Converged when the largest closure residual (and task error) is at most {U}_TOL = {TOL:g} [m, rad].",
+        "",
+        "Mode ids: bit k set when the k-th diagonal block of the Newton matrix has the determinant sign opposite to",
+        "the reference configuration's; 0 is the reference's mode. Blocks (their coordinates):",
+    ]
+    for kind in ("fk", "ik"):
+        for bit, cols in enumerate(blocks[kind]):
+            lines.append(f"  {kind} bit {bit}: {', '.join(cols)}")
+        if not blocks[kind]:
+            lines.append(f"  {kind}: none (one mode)")
+    lines += ["", "Joint limits checked: " + (", ".join(f"{n} [{lo:.6g}, {hi:.6g}]" for n, _, lo, hi in limits)
+                                              or "none")]
+    comment = "/*\n" + "".join(f" * {line}".rstrip() + "\n" for line in lines) + " */\n"
+    guard = f"{U}_H"
+    defs = [f"#define {U}_{k} {v}" for k, v in sizes.items()]
+    defs += [f"#ifndef {U}_MAX_ITER\n#define {U}_MAX_ITER {MAX_ITER}\n#endif",
+             f"#ifndef {U}_TOL\n#define {U}_TOL {TOL!r}\n#endif",
+             f"#ifndef {U}_PIVOT_FLOOR\n#define {U}_PIVOT_FLOOR {PIVOT_FLOOR!r}\n#endif",
+             f"#ifndef {U}_SINGULAR_TOL\n#define {U}_SINGULAR_TOL {SINGULAR_TOL!r}\n#endif",
+             f"#ifndef {U}_LIMIT_TOL\n#define {U}_LIMIT_TOL {LIMIT_TOL!r}\n#endif"]
+    status = "\n".join(f"  {U}_{s} = {i}," for i, s in enumerate(STATUS))
+    info = (f"typedef struct {{\n  int status;        /* the status returned */\n"
+            "  int iterations;    /* Newton step evaluations */\n"
+            "  double residual;   /* the largest closure residual or task error at the last iterate [m, rad] */\n"
+            "  double sigma_min;  /* SINGULAR, PIVOT_ORDER: the smallest singular value of the matrix */\n"
+            "  double pivot;      /* the smallest relative pivot of the fixed elimination order */\n"
+            "  int joint;         /* OUTSIDE_LIMITS: the joint (index into limit_names), else -1 */\n"
+            "  long mode;         /* the mode id of the solution */\n"
+            f"}} {prefix}_info;\n")
+    decls = (f"extern const char* const {prefix}_limit_names[{max(len(limits), 1)}];\n"
+             f"extern const char* const {prefix}_task_names[{U}_NY];\n"
+             f"extern const double {prefix}_q_reference[{U}_NQ];  /* the reference configuration (mode 0) */\n"
+             f"extern const int {prefix}_actuated_q[{U}_NA];  /* where the actuated coordinates are in q */\n")
+    body = runtime.HEADER_FUNCTIONS.replace("p_", f"{prefix}_").replace("P_", f"{U}_")
+    return (comment + f"#ifndef {guard}\n#define {guard}\n\n#ifdef __cplusplus\nextern \"C\" {{\n#endif\n\n"
+            + "\n".join(defs) + f"\n\nenum {{\n{status}\n}};\n\n" + info + "\n" + decls + body
+            + "\n#ifdef __cplusplus\n}\n#endif\n\n#endif\n")
+
+
+_MAKEFILE = """# Builds libNAME.a and the example. Override CC or CFLAGS as you like.
+CC ?= cc
+CFLAGS ?= -std=c99 -O2 -Wall -Wextra -pedantic
+
+all: libNAME.a example
+
+NAME.o: NAME.c NAME.h
+\t$(CC) $(CFLAGS) -c NAME.c -o NAME.o
+
+libNAME.a: NAME.o
+\tar rcs libNAME.a NAME.o
+
+example: main.c libNAME.a
+\t$(CC) $(CFLAGS) main.c libNAME.a -lm -o example
+
+clean:
+\trm -f NAME.o libNAME.a example
+
+.PHONY: all clean
+"""
+
+_CMAKE = """cmake_minimum_required(VERSION 3.10)
+project(NAME C)
+set(CMAKE_C_STANDARD 99)
+set(CMAKE_C_STANDARD_REQUIRED ON)
+add_library(NAME NAME.c)
+target_include_directories(NAME PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
+find_library(MATH_LIBRARY m)
+if(MATH_LIBRARY)
+  target_link_libraries(NAME PUBLIC ${MATH_LIBRARY})
+endif()
+add_executable(NAME_example main.c)
+target_link_libraries(NAME_example NAME)
+"""
+
+
+def _main(prefix: str, mech: Mechanism) -> str:
+    U = prefix.upper()
+    return f"""/* An example: the forward kinematics along a short motion of the actuators, warm-started from the previous
+   solution, then the inverse kinematics and the inverse dynamics at the last pose. Build: make; run: ./example */
+#include <stdio.h>
+#include "{prefix}.h"
+
+int main(void) {{
+  double q_prev[{U}_NQ], q[{U}_NQ], y[{U}_NY], qa[{U}_NA], qa_ik[{U}_NA], qd[{U}_NA], qdd[{U}_NA], tau[{U}_NA];
+  {prefix}_info info;
+  int k, i, status = {U}_OK;
+  for (i = 0; i < {U}_NQ; ++i) q_prev[i] = {prefix}_q_reference[i];
+  for (k = 1; k <= 10; ++k) {{
+    for (i = 0; i < {U}_NA; ++i) qa[i] = q_prev[{prefix}_actuated_q[i]] + 0.002 * (i % 2 ? -1.0 : 1.0);
+    status = {prefix}_fk(qa, q_prev, 0, q, y, &info);
+    if (status != {U}_OK) {{ printf("fk: status %d (residual %g)\\n", status, info.residual); return 1; }}
+    for (i = 0; i < {U}_NQ; ++i) q_prev[i] = q[i];
+  }}
+  printf("fk after 10 steps (%d iterations at the last):", info.iterations);
+  for (i = 0; i < {U}_NY; ++i) printf(" %s=%.9g", {prefix}_task_names[i], y[i]);
+  printf("\\n");
+  status = {prefix}_ik(y, q, 0, q_prev, qa_ik, &info);
+  printf("ik: status %d, actuated error %.3g\\n", status, qa_ik[0] - qa[0]);
+  for (i = 0; i < {U}_NA; ++i) {{ qd[i] = 0.1; qdd[i] = 1.0; }}
+  status = {prefix}_inverse_dynamics(q, qd, qdd, tau, &info);
+  printf("inverse dynamics: status %d, tau[0] = %.9g\\n", status, tau[0]);
+  return status;
+}}
+"""
+
+
+__all__ = ["MAX_ITER", "STATUS", "TOL", "CLibrary", "ExportError", "export_c"]

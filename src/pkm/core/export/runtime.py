@@ -1,0 +1,325 @@
+"""The hand-written C of an exported library: the dense fallbacks, the Newton driver and the public functions'
+bodies, as templates (``p_`` the library's prefix in lower case, ``P_`` in upper case; other upper-case words are
+filled in by :mod:`pkm.core.export.library`). Strict C99, ``<math.h>`` only, no allocation, no state."""
+
+HELPERS = r"""
+/* ---------------------------------------------------------------- helpers */
+static int p_finite(const double* x, int n) {
+  int i;
+  for (i = 0; i < n; ++i) if (!isfinite(x[i])) return 0;
+  return 1;
+}
+
+static void p_copy(double* to, const double* from, int n) {
+  int i;
+  for (i = 0; i < n; ++i) to[i] = from[i];
+}
+
+static p_info* p_start(p_info* info, p_info* local) {
+  p_info* out = info ? info : local;
+  out->status = P_OK; out->iterations = 0; out->residual = 0.0; out->sigma_min = 0.0; out->pivot = 1.0;
+  out->joint = -1; out->mode = 0;
+  return out;
+}
+
+static int p_end(p_info* info, int status) {
+  info->status = status;
+  return status;
+}
+
+/* LU with partial pivoting of the column-major n x n A (destroyed); solves A x = b in place of b when b is not
+   NULL. Returns the sign of det(A) (+1 or -1), 0 when a pivot is exactly zero. */
+static int p_lu(int n, double* A, double* b) {
+  int i, j, k, sign = 1;
+  for (k = 0; k < n; ++k) {
+    int r = k;
+    double best = fabs(A[k * n + k]);
+    for (i = k + 1; i < n; ++i) if (fabs(A[k * n + i]) > best) { best = fabs(A[k * n + i]); r = i; }
+    if (best == 0.0) return 0;
+    if (r != k) {
+      for (j = 0; j < n; ++j) { double t = A[j * n + k]; A[j * n + k] = A[j * n + r]; A[j * n + r] = t; }
+      if (b) { double t = b[k]; b[k] = b[r]; b[r] = t; }
+      sign = -sign;
+    }
+    if (A[k * n + k] < 0.0) sign = -sign;
+    for (i = k + 1; i < n; ++i) {
+      double f = A[k * n + i] / A[k * n + k];
+      A[k * n + i] = f;
+      for (j = k + 1; j < n; ++j) A[j * n + i] -= f * A[j * n + k];
+      if (b) b[i] -= f * b[k];
+    }
+  }
+  if (b) for (i = n - 1; i >= 0; --i) {
+    double s = b[i];
+    for (j = i + 1; j < n; ++j) s -= A[j * n + i] * b[j];
+    b[i] = s / A[i * n + i];
+  }
+  return sign;
+}
+
+JACOBI_SV
+/* the smallest and largest singular values of the column-major n x n A (kept) */
+static void p_extreme_sv(int n, const double* A, double* smin, double* smax) {
+  double W[P_NMAX * P_NMAX], s[P_NMAX];
+  p_copy(W, A, n * n);
+  p_sv(n, n, W, s);
+  *smax = s[0]; *smin = s[n - 1];
+}
+
+/* the mode id from the blocks' determinants relative to the reference's: bit k set unless the k-th is positive */
+static long p_mode(int nblocks, const double* det) {
+  long mode = 0;
+  int k;
+  for (k = 0; k < nblocks; ++k) if (!(det[k] > 0.0)) mode |= 1L << k;
+  return mode;
+}
+
+/* the first joint (index into p_limit_joint) outside its limits by more than P_LIMIT_TOL, or -1 */
+static int p_outside(const double* q) {
+  int k;
+  for (k = 0; k < P_NLIMITS; ++k) {
+    double x = q[p_limit_q[k]];
+    if (x < p_limit_low[k] - P_LIMIT_TOL || x > p_limit_high[k] + P_LIMIT_TOL) return k;
+  }
+  return -1;
+}
+"""
+
+#: The Newton driver of one solve (``$kind``: ``fk`` or ``ik``; ``$NX`` the unknowns, ``$NB`` the mode's blocks).
+NEWTON = r"""
+static int p_newton_$kind(const double* target, const double* q_prev, long mode, double* q, p_info* info) {
+  double cur[P_NQ], next[P_NQ], det[$NB], r = 0.0, pv = 0.0;
+  int it;
+  p_copy(cur, q_prev, P_NQ);
+  for (it = 1; it <= P_MAX_ITER; ++it) {
+    p_k_$kind_step(cur, target, next, &r, &pv, det);
+    info->iterations = it; info->residual = r; info->pivot = pv;
+    if (!(pv >= P_PIVOT_FLOOR)) {  /* the fixed pivots fail: the same system, densely */
+      double A[$NX * $NX], b[$NX], smin, smax;
+      p_k_$kind_system(cur, target, A, b);
+      p_extreme_sv($NX, A, &smin, &smax);
+      info->sigma_min = smin;
+      if (!(smin > P_SINGULAR_TOL * smax)) { p_copy(q, q_prev, P_NQ); return p_end(info, P_SINGULAR); }
+      p_lu($NX, A, b);
+      p_k_$kind_retract(cur, b, target, next);
+      if (r <= P_TOL) {  /* the mode from the dense blocks */
+        int k, i, j;
+        p_k_$kind_system(cur, target, A, b);
+        for (k = 0; k < $KNBLOCKS; ++k) {
+          double B[P_BMAX * P_BMAX];
+          int m = p_$kind_block_start[k + 1] - p_$kind_block_start[k];
+          const int* rows = p_$kind_block_rows + p_$kind_block_start[k];
+          const int* cols = p_$kind_block_cols + p_$kind_block_start[k];
+          for (j = 0; j < m; ++j) for (i = 0; i < m; ++i) B[j * m + i] = A[cols[j] * $NX + rows[i]];
+          det[k] = p_lu(m, B, 0) * p_$kind_block_sign[k];
+        }
+      }
+    }
+    if (!p_finite(next, P_NQ) || !(r < INFINITY)) break;
+    if (r <= P_TOL) {  /* converged at cur; next is one step further */
+      long found = p_mode($KNBLOCKS, det);
+      int joint;
+      p_copy(q, next, P_NQ);
+      info->mode = found;
+      if (mode >= 0 && found != mode) return p_end(info, P_LEFT_MODE);
+      joint = p_outside(q);
+      info->joint = joint;
+      return p_end(info, joint >= 0 ? P_OUTSIDE_LIMITS : P_OK);
+    }
+    p_copy(cur, next, P_NQ);
+  }
+  p_copy(q, q_prev, P_NQ);
+  return p_end(info, P_NOT_CONVERGED);
+}
+"""
+
+#: The public functions (``p_`` prefix); declarations in :data:`HEADER_FUNCTIONS`.
+PUBLIC = r"""
+/* ---------------------------------------------------------------- public functions */
+int p_fk(const double qa[P_NA], const double q_prev[P_NQ], long mode, double q[P_NQ], double y[P_NY], p_info* info) {
+  p_info local;
+  int status;
+  info = p_start(info, &local);
+  if (!p_finite(qa, P_NA) || !p_finite(q_prev, P_NQ)) return p_end(info, P_INVALID_INPUT);
+  status = p_newton_fk(qa, q_prev, mode, q, info);
+  p_k_task_value(q, y);
+  return status;
+}
+
+int p_ik(const double y[P_NY], const double q_prev[P_NQ], long mode, double q[P_NQ], double qa[P_NA], p_info* info) {
+  p_info local;
+  int status, k;
+  info = p_start(info, &local);
+  if (!p_finite(y, P_NY) || !p_finite(q_prev, P_NQ)) return p_end(info, P_INVALID_INPUT);
+  status = p_newton_ik(y, q_prev, mode, q, info);
+  for (k = 0; k < P_NA; ++k) qa[k] = q[p_actuated_q[k]];
+  return status;
+}
+
+int p_fk_mode(const double q[P_NQ], long* mode) {
+  double qa[P_NA], next[P_NQ], det[FKB], r, pv;
+  int k;
+  if (!p_finite(q, P_NQ)) return P_INVALID_INPUT;
+  for (k = 0; k < P_NA; ++k) qa[k] = q[p_actuated_q[k]];
+  p_k_fk_step(q, qa, next, &r, &pv, det);
+  *mode = p_mode(FK_NBLOCKS, det);
+  return P_OK;
+}
+
+int p_ik_mode(const double q[P_NQ], long* mode) {
+  double y[P_NY], next[P_NQ], det[IKB], r, pv;
+  if (!p_finite(q, P_NQ)) return P_INVALID_INPUT;
+  p_k_task_value(q, y);
+  p_k_ik_step(q, y, next, &r, &pv, det);
+  *mode = p_mode(IK_NBLOCKS, det);
+  return P_OK;
+}
+
+int p_task_value(const double q[P_NQ], double y[P_NY]) {
+  if (!p_finite(q, P_NQ)) return P_INVALID_INPUT;
+  p_k_task_value(q, y);
+  return P_OK;
+}
+
+/* a kernel's pivot under the floor: singular (the passive closure Jacobian's smallest singular value) or not */
+static int p_pivot_failed(const double* q, p_info* info) {
+  double qa[P_NA], A[FKN * FKN], b[FKN], smin, smax;
+  int k;
+  for (k = 0; k < P_NA; ++k) qa[k] = q[p_actuated_q[k]];
+  p_k_fk_system(q, qa, A, b);
+  p_extreme_sv(FKN, A, &smin, &smax);
+  info->sigma_min = smin;
+  return p_end(info, smin > P_SINGULAR_TOL * smax ? P_PIVOT_ORDER : P_SINGULAR);
+}
+
+int p_jacobians(const double q[P_NQ], double J[P_NX * P_NA], double K[P_NA * P_NX], p_info* info) {
+  p_info local;
+  info = p_start(info, &local);
+  if (!p_finite(q, P_NQ)) return p_end(info, P_INVALID_INPUT);
+  p_k_jacobians(q, J, K, &info->pivot);
+  if (!(info->pivot >= P_PIVOT_FLOOR)) return p_pivot_failed(q, info);
+  return P_OK;
+}
+
+int p_task_velocity(const double q[P_NQ], const double qd[P_NA], double xd[P_NX], p_info* info) {
+  double J[P_NX * P_NA], K[P_NA * P_NX];
+  int i, k, status;
+  if (!p_finite(qd, P_NA)) { p_info local; return p_end(p_start(info, &local), P_INVALID_INPUT); }
+  status = p_jacobians(q, J, K, info);
+  if (status != P_OK) return status;
+  for (i = 0; i < P_NX; ++i) { xd[i] = 0.0; for (k = 0; k < P_NA; ++k) xd[i] += J[k * P_NX + i] * qd[k]; }
+  return P_OK;
+}
+
+int p_actuator_velocity(const double q[P_NQ], const double xd[P_NX], double qd[P_NA], p_info* info) {
+  double J[P_NX * P_NA], K[P_NA * P_NX];
+  int i, k, status;
+  if (!p_finite(xd, P_NX)) { p_info local; return p_end(p_start(info, &local), P_INVALID_INPUT); }
+  status = p_jacobians(q, J, K, info);
+  if (status != P_OK) return status;
+  for (k = 0; k < P_NA; ++k) { qd[k] = 0.0; for (i = 0; i < P_NX; ++i) qd[k] += K[i * P_NA + k] * xd[i]; }
+  return P_OK;
+}
+
+int p_task_effort(const double q[P_NQ], const double tau[P_NA], double w[P_NX], p_info* info) {
+  double J[P_NX * P_NA], K[P_NA * P_NX];
+  int i, k, status;
+  if (!p_finite(tau, P_NA)) { p_info local; return p_end(p_start(info, &local), P_INVALID_INPUT); }
+  status = p_jacobians(q, J, K, info);
+  if (status != P_OK) return status;
+  for (i = 0; i < P_NX; ++i) { w[i] = 0.0; for (k = 0; k < P_NA; ++k) w[i] += K[i * P_NA + k] * tau[k]; }
+  return P_OK;
+}
+
+int p_actuator_effort(const double q[P_NQ], const double w[P_NX], double tau[P_NA], p_info* info) {
+  double J[P_NX * P_NA], K[P_NA * P_NX];
+  int i, k, status;
+  if (!p_finite(w, P_NX)) { p_info local; return p_end(p_start(info, &local), P_INVALID_INPUT); }
+  status = p_jacobians(q, J, K, info);
+  if (status != P_OK) return status;
+  for (k = 0; k < P_NA; ++k) { tau[k] = 0.0; for (i = 0; i < P_NX; ++i) tau[k] += J[k * P_NX + i] * w[i]; }
+  return P_OK;
+}
+
+int p_jdot_qdot(const double q[P_NQ], const double qd[P_NA], double c[P_NX], p_info* info) {
+  p_info local;
+  info = p_start(info, &local);
+  if (!p_finite(q, P_NQ) || !p_finite(qd, P_NA)) return p_end(info, P_INVALID_INPUT);
+  p_k_jdot_qdot(q, qd, c, &info->pivot);
+  if (!(info->pivot >= P_PIVOT_FLOOR)) return p_pivot_failed(q, info);
+  return P_OK;
+}
+
+int p_inverse_dynamics(const double q[P_NQ], const double qd[P_NA], const double qdd[P_NA], double tau[P_NA],
+                       p_info* info) {
+  p_info local;
+  info = p_start(info, &local);
+  if (!p_finite(q, P_NQ) || !p_finite(qd, P_NA) || !p_finite(qdd, P_NA)) return p_end(info, P_INVALID_INPUT);
+  p_k_inverse_dynamics(q, qd, qdd, tau, &info->pivot);
+  if (!(info->pivot >= P_PIVOT_FLOOR)) return p_pivot_failed(q, info);
+  return P_OK;
+}
+
+int p_mass_matrix(const double q[P_NQ], double M[P_NA * P_NA], p_info* info) {
+  p_info local;
+  info = p_start(info, &local);
+  if (!p_finite(q, P_NQ)) return p_end(info, P_INVALID_INPUT);
+  p_k_mass_matrix(q, M, &info->pivot);
+  if (!(info->pivot >= P_PIVOT_FLOOR)) return p_pivot_failed(q, info);
+  return P_OK;
+}
+
+int p_gravity(const double q[P_NQ], double g[P_NA], p_info* info) {
+  p_info local;
+  info = p_start(info, &local);
+  if (!p_finite(q, P_NQ)) return p_end(info, P_INVALID_INPUT);
+  p_k_gravity(q, g, &info->pivot);
+  if (!(info->pivot >= P_PIVOT_FLOOR)) return p_pivot_failed(q, info);
+  return P_OK;
+}
+"""
+
+HEADER_FUNCTIONS = r"""
+/* Every function returns a status (P_OK or one of the codes above) and fills *info when info is not NULL. None
+   allocates, prints or keeps state: any number of threads may call them at once. Arrays are column-major. */
+
+/* Forward kinematics: the configuration q (P_NQ) and task value y (P_NY) for the actuated coordinates qa (P_NA),
+   by Newton from the caller's previous solution q_prev (P_MAX_ITER iterations at most). mode: the assembly mode
+   the solution must be in (a P_FK_MODE_* id; negative: any). q and y hold the solution for P_OK, P_LEFT_MODE
+   and P_OUTSIDE_LIMITS, else q_prev (nothing is written for P_INVALID_INPUT). */
+int p_fk(const double qa[P_NA], const double q_prev[P_NQ], long mode, double q[P_NQ], double y[P_NY], p_info* info);
+
+/* Inverse kinematics: q (P_NQ) and the actuated coordinates qa (P_NA) for the task value y (P_NY), by Newton
+   from q_prev; mode: the working mode (a P_IK_MODE_* id; negative: any). Outputs as p_fk's. */
+int p_ik(const double y[P_NY], const double q_prev[P_NQ], long mode, double q[P_NQ], double qa[P_NA], p_info* info);
+
+/* The assembly (forward kinematics) and working (inverse kinematics) mode ids of a closed configuration. */
+int p_fk_mode(const double q[P_NQ], long* mode);
+int p_ik_mode(const double q[P_NQ], long* mode);
+
+/* The task value of a configuration (P_NY: see p_task_names). */
+int p_task_value(const double q[P_NQ], double y[P_NY]);
+
+/* At a closed configuration q: the forward Jacobian J (task rates per actuated rate, P_NX x P_NA) and the
+   inverse K (P_NA x P_NX). */
+int p_jacobians(const double q[P_NQ], double J[P_NX * P_NA], double K[P_NA * P_NX], p_info* info);
+
+/* Rate and effort maps at a closed configuration: xd = J qd, qd = K xd, w = K^T tau (the task effort the
+   actuator efforts balance), tau = J^T w (the actuator efforts that balance the task effort w). */
+int p_task_velocity(const double q[P_NQ], const double qd[P_NA], double xd[P_NX], p_info* info);
+int p_actuator_velocity(const double q[P_NQ], const double xd[P_NX], double qd[P_NA], p_info* info);
+int p_task_effort(const double q[P_NQ], const double tau[P_NA], double w[P_NX], p_info* info);
+int p_actuator_effort(const double q[P_NQ], const double w[P_NX], double tau[P_NA], p_info* info);
+
+/* dJ/dt qd: the task acceleration at zero actuated acceleration (P_NX). */
+int p_jdot_qdot(const double q[P_NQ], const double qd[P_NA], double c[P_NX], p_info* info);
+
+/* Inverse dynamics: the actuator efforts tau (P_NA) [N m, N] at a closed configuration for the actuated rates qd
+   and accelerations qdd, under gravity (reflected rotor inertias included). */
+int p_inverse_dynamics(const double q[P_NQ], const double qd[P_NA], const double qdd[P_NA], double tau[P_NA],
+                       p_info* info);
+
+/* The actuator-space mass matrix M_a (P_NA x P_NA) and the gravity efforts g_a (P_NA). */
+int p_mass_matrix(const double q[P_NQ], double M[P_NA * P_NA], p_info* info);
+int p_gravity(const double q[P_NQ], double g[P_NA], p_info* info);
+"""

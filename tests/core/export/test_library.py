@@ -1,0 +1,115 @@
+"""The exported C library (``pkm.export_c``), built strictly and run from Python: the ankle's and the knee's
+functions against pkm's generic core to 1e-12 (relative to max(1, the largest value)), no allocation or I/O in the
+object file, a status (never a NaN) for NaN, infinite and unreachable inputs, the mode and limit codes, the files a
+user builds with ``make``, and the mechanisms it refuses. Every shipped and acceptance-set mechanism is run by
+``tools/export_harness.py`` in CI (gcc, and clang where present)."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm.core.export import ExportError, export_c
+from pkm.core.export.harness import FORBIDDEN, build, compare, domain
+from pkm.core.export.library import STATUS
+from pkm.errors import PkmError, SpecError
+from tests.test_acceptance import ACCEPTANCE
+
+pytestmark = pytest.mark.skipif(shutil.which("cc") is None, reason="needs a C compiler (cc)")
+TOL = 1e-12
+MATH = {"sin", "cos", "sincos", "tan", "asin", "acos", "atan", "atan2", "sqrt", "exp", "log", "pow", "fabs", "fmin",
+        "fmax", "floor", "ceil", "fmod", "copysign", "hypot", "sinh", "cosh", "tanh"}
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    """The ankle's and the knee's libraries, exported and built once (-O2, strict)."""
+    out = {}
+    for name in ("ankle", "knee"):
+        mech = pkm.load(ACCEPTANCE[name][0])
+        lib = export_c(mech, tmp_path_factory.mktemp(name))
+        out[name] = (mech, build(lib))
+    return out
+
+
+@pytest.mark.parametrize("name", ["ankle", "knee"])
+def test_every_function_matches_pkm(built, name):
+    mech, h = built[name]
+    errors = compare(mech, h)
+    assert errors.pop("status") == 0
+    assert set(errors) >= {"fk", "ik", "jacobians", "maps", "jdot_qdot", "inverse_dynamics", "mass_matrix", "gravity"}
+    assert max(errors.values()) <= TOL, errors
+
+
+def test_the_object_file_allocates_and_prints_nothing(built):
+    for _, h in built.values():
+        assert h.symbols, "nm listed no undefined symbol: the check did not run"
+        assert not h.symbols & FORBIDDEN
+        assert h.symbols <= MATH, sorted(h.symbols - MATH)
+
+
+@pytest.mark.parametrize("name", ["ankle", "knee"])
+def test_outside_the_domain_a_status_never_a_nan(built, name):
+    mech, h = built[name]
+    problems, statuses = domain(mech, h)
+    assert problems == []
+    # driven 3 rad along a line, each mechanism leaves its workspace: the ankle its mode, the knee its limits
+    assert set(statuses) - {"OK"} == ({"NOT_CONVERGED", "LEFT_MODE"} if name == "ankle" else {"OUTSIDE_LIMITS"})
+
+
+def test_the_mode_asked_for_and_the_limits(built):
+    mech, h = built["ankle"]
+    ref = mech.q_reference
+    qa = mech.actuated_q(ref)
+    row = np.hstack([qa + 0.01, ref, [1.0]])  # the reference is mode 0: asking for mode 1 fails
+    got = h.run("fk", row[None])[0]
+    assert STATUS[int(got[0])] == "LEFT_MODE" and got[3] == 0
+    solved = pkm.close_loops(mech, qa + 0.01, ref, tol=1e-14)
+    assert np.abs(mech.task_map.error(mech.task_map.value(solved.q), got[4 + mech.nq:])).max() <= TOL
+    got = h.run("fk", np.hstack([qa + 0.01, ref, [0.0]])[None])[0]
+    assert STATUS[int(got[0])] == "OK" and 1 <= got[1] <= 6
+    knee, hk = built["knee"]
+    assert hk.lib.limits
+    y = knee.task_map.value(knee.q_reference)
+    far = hk.run("ik", np.hstack([y + 2.5, knee.q_reference, [-1.0]])[None])[0]
+    assert STATUS[int(far[0])] in ("OUTSIDE_LIMITS", "NOT_CONVERGED", "SINGULAR") and np.isfinite(far).all()
+
+
+def test_the_folder_builds_with_make_and_runs(built, tmp_path):
+    if shutil.which("make") is None:
+        pytest.skip("no make")
+    lib = built["ankle"][1].lib
+    folder = tmp_path / "ankle"
+    shutil.copytree(lib.directory, folder, ignore=shutil.ignore_patterns("*.o", "harness*"))
+    assert subprocess.run(["make", "-s", "CFLAGS=-std=c99 -O2 -Wall -Wextra -Werror -pedantic"], cwd=folder,
+                          capture_output=True, check=False).returncode == 0
+    run = subprocess.run(["./example"], cwd=folder, capture_output=True, text=True, check=False)
+    assert run.returncode == 0 and "inverse dynamics: status 0" in run.stdout
+    header = (folder / "ankle.h").read_text()
+    assert "ANKLE_MAX_ITER" in header and "fk_step" in header and " mul " in header and "ik bit 1" in header
+
+
+def test_what_cannot_be_exported_is_refused(tmp_path, monkeypatch):
+    """A task that does not fix the joints, and a joint kind the twin does not write (the twin's refusal, forced
+    here: no shipped file has a helical joint), are refused with the mechanism and the reason."""
+    spec = Path(ACCEPTANCE["ankle"][0])
+    shutil.copy(spec.parent / "ankle.urdf", tmp_path)
+    (tmp_path / spec.name).write_text(spec.read_text().replace('joints = ["ankle_pitch", "ankle_roll"]',
+                                                                'joints = ["ankle_pitch"]'))
+    mech = pkm.load(tmp_path / spec.name)
+    with pytest.raises(ExportError, match="do not fix every joint") as e:
+        export_c(mech, tmp_path / "out")
+    assert e.value.mechanism == mech.name and isinstance(e.value, PkmError)
+    assert not (tmp_path / "out").exists()
+
+    def helical(mech):
+        raise SpecError(mech.source, "joint 'screw': the symbolic twin does not handle a JointModelHelical")
+
+    monkeypatch.setattr("pkm.core.export.model.Twin", helical)
+    with pytest.raises(ExportError, match="JointModelHelical"):
+        export_c(pkm.load(ACCEPTANCE["knee"][0]), tmp_path / "knee")
