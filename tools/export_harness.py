@@ -1,4 +1,4 @@
-"""The exported C of every shipped mechanism and of the acceptance set, proven in C (run by ``.ci/run``).
+"""The exported C of every shipped mechanism, the acceptance set and the humanoid ankle and knee, proven in C (run by ``.ci/run``).
 
 For each mechanism: :func:`pkm.core.export.export_c`, then with every compiler present (``gcc``; ``clang`` where
 installed) a strict C99 build (``-std=c99 -Wall -Wextra -Werror -pedantic -O2``; a warning fails it), the object
@@ -27,6 +27,8 @@ MECHANISMS = {
     "rpr3": ROOT / "examples/rpr3/rpr3.closures.toml", "ankle": ROOT / "examples/ankle/ankle.closures.toml",
     "knee": ROOT / "examples/knee/knee.closures.toml", "mjcf_fourbar": ROOT / "examples/mjcf_fourbar/fourbar.xml",
     "slider_crank": ROOT / "examples/sdf_slider_crank/slider_crank.closures.toml",
+    "humanoid_ankle": ROOT / "examples/humanoid_ankle/ankle.closures.toml",
+    "humanoid_knee": ROOT / "examples/humanoid_knee/knee.closures.toml",
 }
 
 

@@ -293,10 +293,11 @@ def sensitivity(mech: Mechanism, q: np.ndarray, law: ChirpLaw) -> float:
     return float(max(gains))
 
 
-def pkm_run(mech: Mechanism, q0: np.ndarray, law: ChirpLaw, duration: float, dt: float) -> pkm.Simulation:
+def pkm_run(mech: Mechanism, q0: np.ndarray, law: ChirpLaw, duration: float, dt: float,
+            friction: bool = False) -> pkm.Simulation:
     act_q, act_v = mech.act_q, mech.act_v
     return pkm.simulate(mech, q0, None, duration, dt, lambda t, q, v: law.efforts(t, q[act_q], v[act_v]),
-                        friction=False, limits=False)
+                        friction=friction, limits=False)
 
 
 def baumgarte_run(mech: Mechanism, q0: np.ndarray, law: ChirpLaw, duration: float, dt: float,
@@ -348,17 +349,26 @@ def baumgarte_run(mech: Mechanism, q0: np.ndarray, law: ChirpLaw, duration: floa
 
 
 def mujoco_run(mech: Mechanism, q0: np.ndarray, law: ChirpLaw, duration: float, dt: float,
-               softness: tuple[list[float], list[float]] | None = None) \
+               softness: tuple[list[float], list[float]] | None = None, path: str | Path | None = None) \
         -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
     """MuJoCo's RK4 on the mechanism's MJCF from rest at ``q0`` (module doc, 2.ii); ``softness``: the equality
     constraints' ``(solref, solimp)`` instead of the MJCF's (MuJoCo's defaults). Returns the times, the actuated
-    coordinates, the largest equality violation at each sample and MuJoCo's settings as read from its model."""
+    coordinates, the largest equality violation at each sample and MuJoCo's settings as read from its model.
+
+    ``path``: the user's own MJCF file (the one ``mech`` was read from) instead of pkm's
+    (:func:`~pkm.core.formats.to_mjcf.mjcf_from_mechanism`): MuJoCo starts at its ``qpos0``, which must be ``q0``'s
+    actuated coordinates (:class:`ValueError` otherwise), with the file's joint damping, armature and equality
+    softness."""
     import mujoco
 
     from pkm.bench.mujoco_baseline import MujocoRigid
 
-    rigid = MujocoRigid(mech)
-    mm, md = rigid.model, rigid.data
+    if path is None:
+        rigid = MujocoRigid(mech)
+        mm, md = rigid.model, rigid.data
+    else:
+        mm = mujoco.MjModel.from_xml_path(str(path))
+        md = mujoco.MjData(mm)
     mm.opt.timestep = dt
     mm.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if softness is not None:
@@ -372,7 +382,10 @@ def mujoco_run(mech: Mechanism, q0: np.ndarray, law: ChirpLaw, duration: float, 
     qpos = [int(mm.jnt_qposadr[mujoco.mj_name2id(mm, mujoco.mjtObj.mjOBJ_JOINT, pm.names[j.id])])
             for j in mech.actuated]
     zero = np.zeros(mech.nv)
-    rigid._state(q0, zero, zero)
+    if path is None:
+        rigid._state(q0, zero, zero)
+    elif not np.allclose(mm.qpos0[qpos], mech.actuated_q(q0), rtol=0.0, atol=1e-12):
+        raise ValueError(f"{path}: MuJoCo's qpos0 {mm.qpos0[qpos]} is not q0's actuated coordinates")
     md.qvel[:], md.qacc_warmstart[:] = 0.0, 0.0
     equality = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
 

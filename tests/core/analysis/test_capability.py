@@ -70,7 +70,7 @@ def test_the_vertices_are_what_the_limits_give(name):
 
 
 def test_refusals_name_what_is_missing():
-    gs = pkm.load("gough_stewart")  # (its legs carry no effort limit)
+    gs = pkm.with_actuators(pkm.load("gough_stewart"), {"leg1": {"effort_limit": np.inf}})  # (no limit on leg 1)
     with pytest.raises(InvalidInputError, match=r"leg1\.effort_limit"):
         capability(gs, gs.q_reference, "wrench")
     delta = mechanism("delta")

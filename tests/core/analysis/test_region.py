@@ -29,16 +29,22 @@ def _q(mech, point, q0=None):
 
 def test_each_vertex_is_stopped_by_what_it_names(ankle):
     region = feasible_region(ankle, AXES, limits=MOTORS, directions=12)
-    assert {b.split(" at ")[0] for b in region.binding} <= {"joint motor_left", "joint motor_right", "reach"}
+    limits = {**ankle.limits, **MOTORS}  # (the file's pitch and roll limits, the motors' travel given here)
+    assert {b.split(" at ")[0] for b in region.binding} <= {f"joint {j}" for j in limits} | {"reach"}
+    assert {"joint motor_left", "joint motor_right"} <= {b.split(" at ")[0] for b in region.binding}
     for vertex, why in zip(region.vertices, region.binding):
         if why == "reach":
             continue
         joint, side = why.split()[1], why.split()[4]
         value = float(np.atleast_1d(ankle.q_to_dict(_q(ankle, vertex))[joint])[0])
-        assert abs(value - MOTORS[joint][0 if side == "low" else 1]) <= 1e-6
-    # a box limit: the largest box the polygon holds is much smaller than its extent along pitch
+        assert abs(value - limits[joint][0 if side == "low" else 1]) <= 1e-6
+    # a box limit: the joints' own box (pitch ±0.6, roll ±0.4) is not feasible, and the largest box the polygon holds
+    # leaves a third of it out (0.43 of 0.78 rad² when written)
     half = region.box()
-    assert half[0] < 0.5 * np.abs(region.vertices[:, 0]).max() and region.area > 4 * half[0] * half[1]
+    own = np.array([ankle.limits["ankle_pitch"][1], ankle.limits["ankle_roll"][1]])
+    assert not all(region.contains(region.center + 0.99 * own * np.array(s)) for s in ((1, 1), (1, -1), (-1, 1),
+                                                                                         (-1, -1)))
+    assert region.area > 1.5 * 4 * half[0] * half[1]
     corners = [region.center + half * np.array(s) for s in ((1, 1), (1, -1), (-1, 1), (-1, -1))]
     assert all(region.contains(c) for c in corners) and not region.contains(region.center + 1.01 * half * 3)
     # inside (shrunk toward the centre), every pose solves within the motors' travel
@@ -49,7 +55,8 @@ def test_each_vertex_is_stopped_by_what_it_names(ankle):
 
 def test_a_singularity_bound_stops_the_vertices_at_it(ankle):
     bound = 0.02  # (the reference's own distances: 0.20 direct, 0.035 inverse)
-    region = feasible_region(ankle, AXES, singularity=bound, directions=8, reach=1.5)
+    free = {j: (-3.0, 3.0) for j in ankle.limits}  # (no joint limit: the bound alone stops the rays)
+    region = feasible_region(ankle, AXES, limits=free, singularity=bound, directions=8, reach=1.5)
     stopped = [(v, b) for v, b in zip(region.vertices, region.binding) if "singularity" in b]
     assert stopped
     for vertex, why in stopped:

@@ -76,6 +76,7 @@ def retype_joints(model: pin.Model, types: Mapping[str, str], source: str = "<mo
               else mimics[name][3] if name in mimics else model.joints[jid])
         ids[jid] = new.addJoint(ids[model.parents[jid]], jm, model.jointPlacements[jid], name)
         new.appendBodyToJoint(ids[jid], model.inertias[jid], pin.SE3.Identity())
+    _keep_limits(model, new, names, types, mimics)
     for k, f in enumerate(model.frames):
         if k == 0:
             continue  # the universe frame, which every model has
@@ -85,6 +86,28 @@ def retype_joints(model: pin.Model, types: Mapping[str, str], source: str = "<mo
     for name, (leader, scaling, offset, _) in mimics.items():
         new = pin.transformJointIntoMimic(new, new.getJointId(leader), new.getJointId(name), scaling, offset)
     return new
+
+
+def _keep_limits(model: pin.Model, new: pin.Model, names: list[str], types: Mapping[str, str],
+                 mimics: Mapping[str, object]) -> None:
+    """The joints kept as they were keep the file's limits and drives (``addJoint`` without them leaves
+    Pinocchio's defaults: unbounded positions, no effort or speed limit, no friction, damping or armature)."""
+    per_q = tuple(k for k in ("lowerPositionLimit", "upperPositionLimit", "positionLimitMargin") if hasattr(new, k))
+    per_v = tuple(k for k in ("lowerEffortLimit", "upperEffortLimit", "lowerVelocityLimit", "upperVelocityLimit",
+                              "lowerDryFrictionLimit", "upperDryFrictionLimit", "effortLimit", "velocityLimit",
+                              "damping", "friction", "armature") if hasattr(new, k))
+    values = {k: np.array(getattr(new, k), dtype=float) for k in per_q + per_v}
+    for jid in range(1, model.njoints):
+        name = names[jid]
+        if name in types or name in mimics:
+            continue
+        old, kept = model.joints[jid], new.joints[new.getJointId(name)]
+        for k in per_q:
+            values[k][kept.idx_q:kept.idx_q + kept.nq] = getattr(model, k)[old.idx_q:old.idx_q + old.nq]
+        for k in per_v:
+            values[k][kept.idx_v:kept.idx_v + kept.nv] = getattr(model, k)[old.idx_v:old.idx_v + old.nv]
+    for k, v in values.items():
+        setattr(new, k, v)
 
 
 def _mimics(model: pin.Model) -> dict[str, tuple[str, float, float, pin.JointModel]]:
