@@ -32,3 +32,18 @@ def test_the_map_figure_passes_the_figure_check(tmp_path, capsys):
         assert cli.main(["map", "rrr3", "--axis", "x=0cm:100cm:21", "--axis", "y=-10cm:90cm:21", "--pose", "yaw=0deg",
                          "--length", "5.7735cm", "--png", str(tmp_path / "m.png")]) == 0
     assert found == {"m": []}
+
+
+def test_map_index_adds_the_capability(tmp_path):
+    """``pkm map --index wrench``: the capability's ranges in the summary, its CSV (one row per node, the isotropic
+    value's range the summary's) and its figure."""
+    proc = run("map", "delta", "--axis", "x=-10cm:10cm:11", "--axis", "y=-5cm:5cm:6", "--pose", "z=-35cm",
+               "--index", "wrench", "--csv", str(tmp_path / "w.csv"), "--png", str(tmp_path / "w.png"))
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    cap = out["capability"]
+    assert cap["kind"] == "wrench" and cap["regular"] == out["reachable"] == 66 and cap["units"]["x"] == "N"
+    rows = list(csv.DictReader((tmp_path / "w.csv").open()))
+    iso = [float(r["isotropic [N]"]) for r in rows if r["reachable"] == "1.0"]
+    assert len(rows) == 66 and [min(iso), max(iso)] == cap["isotropic"]["N"]
+    assert (tmp_path / "w.png").stat().st_size > 10_000

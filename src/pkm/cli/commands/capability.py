@@ -61,8 +61,6 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _map(mech, args: argparse.Namespace) -> int:
-    import csv
-
     import numpy as np
 
     from pkm.cli.parsing import parse_axis, parse_pose
@@ -83,18 +81,7 @@ def _map(mech, args: argparse.Namespace) -> int:
     if args.png:
         out["png"] = cm.figure(args.png)
     if args.csv:
-        mesh = np.meshgrid(*[v for _, v in reversed(cm.axes)], indexing="ij")
-        cols = {name: m.ravel() for (name, _), m in zip(reversed(cm.axes), mesh)}
-        cols["reachable"] = cm.reachable.ravel().astype(float)
-        for a, (plus, minus) in cm.along.items():
-            cols[f"{a}_plus"], cols[f"{a}_minus"] = plus.ravel(), minus.ravel()
-        for u, v in cm.isotropic.items():
-            cols[f"isotropic [{u}]"] = v.ravel()
-        with open(args.csv, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(list(cols))
-            w.writerows(zip(*[c.tolist() for c in cols.values()]))
-        out["csv"] = args.csv
+        out["csv"] = cm.write_csv(args.csv)
     print(json.dumps(jsonable(out), indent=2) if args.json else
           f"{mech.name}: {kind} capability over {out['nodes']} nodes, {out['reachable']} reachable; isotropic "
           + ", ".join(f"{v['min']:.6g} to {v['max']:.6g} {u}" for u, v in out["isotropic"].items()))

@@ -1,10 +1,14 @@
-"""``pkm map MECH --axis NAME=START:STOP:COUNT ... [--png FILE] [--csv FILE]``: a workspace and condition-index
-map over one to three task coordinates (JSON summary, PNG, CSV)."""
+"""``pkm map MECH --axis NAME=START:STOP:COUNT ... [--index wrench|twist|acceleration [--no-gravity]] [--png FILE]
+[--csv FILE]``: a workspace and condition-index map over one to three task coordinates (JSON summary, PNG, CSV);
+with ``--index``, the capability under actuator limits at every reachable node as well
+(:func:`pkm.core.analysis.capability.map_capability`: the largest value along each task axis each way and the
+largest isotropic value per unit; the PNG and CSV are then the capability's)."""
 
 from __future__ import annotations
 
 import argparse
 import json
+from typing import Any
 
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, load_mechanism
@@ -23,7 +27,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--length", metavar="L", help="characteristic length dividing the angular rates, e.g. 5cm "
                                                  "(needed when the task mixes lengths and angles)")
     p.add_argument("--branch", metavar="NAME", help="working mode of the map (see 'pkm list')")
-    p.add_argument("--png", metavar="FILE", help="draw the condition index (a 3-D map: its middle slab)")
+    p.add_argument("--index", choices=("wrench", "twist", "acceleration"),
+                   help="the capability under the actuators' limits at every reachable node (pkm capability's)")
+    p.add_argument("--no-gravity", action="store_true", help="with --index: leave the mechanism's weight out")
+    p.add_argument("--png", metavar="FILE", help="draw the condition index (a 3-D map: its middle slab); with "
+                                                 "--index, the largest isotropic value (1 or 2 axes)")
     p.add_argument("--csv", metavar="FILE", help="write one row per node")
 
 
@@ -41,17 +49,26 @@ def run(args: argparse.Namespace) -> int:
             raise UnknownNameError("task coordinate", name, list(mech.task_map.keys), mech.name)
         fixed[name] = parse_quantity(text, {mech.task_map.kinds[name]}, name, SI_UNITS[mech.task_map.kinds[name]])
     length = None if args.length is None else parse_quantity(args.length, {"length"}, "--length", "m")
-    m = workspace_map(mech, axes, fixed, branch=args.branch, length=length)
-    out = {"mechanism": mech.name, "axes": {n: [float(v[0]), float(v[-1]), len(v)] for n, v in m.axes},
-           "nodes": int(m.reachable.size), "reachable": m.nodes, "size_SI": m.size,
-           "gci_2": m.gci("2"), "gci_fro_normalized": m.gci("fro_normalized"), "how": m.how}
+    if args.index and args.png and len(axes) > 2:
+        raise UsageError("--index draws one or two axes: leave --png out of a 3-D map (its CSV has every node)")
+    m = workspace_map(mech, axes, fixed, branch=args.branch, length=length, configurations=bool(args.index))
+    out: dict[str, Any] = {"mechanism": mech.name, "axes": {n: [float(v[0]), float(v[-1]), len(v)] for n, v in m.axes},
+                           "nodes": int(m.reachable.size), "reachable": m.nodes, "size_SI": m.size,
+                           "gci_2": m.gci("2"), "gci_fro_normalized": m.gci("fro_normalized"), "how": m.how}
+    figures: Any = m
+    if args.index:
+        from pkm.core.analysis.capability import map_capability
+
+        figures = map_capability(mech, m, args.index, gravity=not args.no_gravity)
+        out["capability"] = {"kind": args.index, "regular": int(figures.reachable.sum()), **figures.summary()}
     if args.csv:
-        out["csv"] = str(m.write_csv(args.csv))
+        out["csv"] = str(figures.write_csv(args.csv))
     if args.png:
-        out["png"] = str(m.figure(args.png, slab=None if len(m.axes) < 3 else len(m.axes[2][1]) // 2))
+        out["png"] = str(figures.figure(args.png) if args.index else
+                         m.figure(args.png, slab=None if len(m.axes) < 3 else len(m.axes[2][1]) // 2))
     print(json.dumps(out, indent=2))
     return 0
 
 
-COMMAND = Command("a workspace and condition-index map over 1-3 task coordinates (JSON summary, PNG, CSV)", add_arguments,
-                  run)
+COMMAND = Command("a workspace, condition-index and capability map over 1-3 task coordinates (JSON, PNG, CSV)",
+                  add_arguments, run)

@@ -32,12 +32,17 @@ from __future__ import annotations
 import itertools
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, SingularityError
+
+if TYPE_CHECKING:
+    from pkm.core.analysis.maps import WorkspaceMap
+    from pkm.core.twin import Kernels
 
 KINDS = ("wrench", "twist", "acceleration")
 _UNITS = {"wrench": {"length": "N", "angle": "N m"}, "twist": {"length": "m/s", "angle": "rad/s"},
@@ -187,6 +192,104 @@ def capability(mech: Mechanism, q: ArrayLike, kind: str = "wrench", *, gravity: 
     return Capability(kind, poly, along, iso, S, U, c, inside)
 
 
+def capability_indices(mech: Mechanism, Q: ArrayLike, kind: str = "wrench", *, gravity: bool = True,
+                       kernels: Kernels | None = None) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]],
+                                                                dict[str, np.ndarray], np.ndarray]:
+    """The indices of :func:`capability` at many closed configurations ``Q`` (n x nq) at once, from the compiled
+    kernels (:class:`pkm.Kernels`: ``J``, ``g_a``, ``M_a`` in batches) and the half-spaces in closed form: the set
+    is ``{x : A x ≤ b}``, ``A = [P; -P]``, ``b = [hi - s; s - lo]``, with ``P = Jᵀ, s = g_a`` (wrenches),
+    ``P = J⁻¹, s = 0`` (twists), ``P = M_a J⁻¹, s = g_a`` (accelerations from rest); along a unit direction ``d``
+    the extent is ``min b_r / (A d)_r`` over the rows ``d`` approaches, and the isotropic value of a unit group
+    ``min b_r / |A_r|`` on that group's columns, as :class:`Polytope` computes them one pose at a time. Returns ``(along, isotropic, regular)``: ``{axis: (plus, minus)}`` and ``{unit: values}`` (n each; 0 where
+    the origin is outside, NaN where ``J`` is singular, as :func:`capability` refuses) and the mask of the regular
+    samples.
+
+    Raises:
+        InvalidInputError: as :func:`capability` (kind, limits, redundant actuation).
+    """
+    from pkm.core.twin import Kernels
+
+    mech = check_mechanism(mech)
+    if kind not in KINDS:
+        raise InvalidInputError("kind", f"use one of {list(KINDS)}, got {kind!r}", kind)
+    kernels = Kernels(mech) if kernels is None else kernels
+    Q = np.atleast_2d(np.asarray(Q, dtype=float))
+    lo, hi = _limits(mech, kind)
+    J = kernels.forward_jacobian(Q)
+    if J.shape[1] != J.shape[2]:
+        raise InvalidInputError("mech", f"{J.shape[2]} actuators for {J.shape[1]} task coordinates: the capability "
+                                        "of redundant actuation needs a hull", J.shape[1:])
+    s = np.linalg.svd(J, compute_uv=False)
+    regular = s[:, -1] > 1e-12 * s[:, 0]
+    J = np.where(regular[:, None, None], J, np.eye(J.shape[1]))  # (singular samples: NaN below)
+    shift = kernels.gravity(Q) if gravity and kind != "twist" else np.zeros((len(Q), mech.na))
+    if kind == "wrench":
+        P = np.transpose(J, (0, 2, 1))
+    elif kind == "twist":
+        P = np.linalg.inv(J)
+    else:
+        P = kernels.mass_matrix(Q) @ np.linalg.inv(J)
+    A = np.concatenate([P, -P], axis=1)  # (n, 2 na, t): A x <= b
+    b = np.concatenate([hi - shift, -lo + shift], axis=1)
+    inside = np.all(b > 0.0, axis=1)
+    kinds = mech.task_map.kinds
+    axes = tuple(kinds)
+    units = tuple(_UNITS[kind][kinds[a]] for a in axes)
+    tiny = 1e-300
+
+    def reach(rate: np.ndarray) -> np.ndarray:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.min(np.where(rate > tiny, b / np.where(rate > tiny, rate, 1.0), np.inf), axis=1)
+
+    def finish(x: np.ndarray) -> np.ndarray:
+        return np.where(regular, np.where(inside, x, 0.0), np.nan)
+
+    along = {a: (finish(reach(A[:, :, i])), finish(reach(-A[:, :, i]))) for i, a in enumerate(axes)}
+    iso = {}
+    for u in dict.fromkeys(units):
+        cols = [i for i, x in enumerate(units) if x == u]
+        norms = np.linalg.norm(A[:, :, cols], axis=2)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = np.min(np.where(norms > tiny, b / np.where(norms > tiny, norms, 1.0), np.inf), axis=1)
+        iso[u] = finish(r)
+    return along, iso, regular
+
+
+def map_capability(mech: Mechanism, wmap: WorkspaceMap, kind: str = "wrench", *, gravity: bool = True,
+                   kernels: Kernels | None = None) -> CapabilityMap:
+    """The ``kind`` capability's indices over a compiled workspace map (:func:`pkm.workspace_map` with
+    ``configurations=True``: every node solved in C, breadth first, in one working mode), computed at all its
+    reachable nodes at once (:func:`capability_indices`): the route for large grids (10⁶ nodes) where
+    :func:`capability_map` solves each node's inverse kinematics in Python.
+
+    Raises:
+        InvalidInputError: ``wmap`` kept no configurations, or is not ``mech``'s; as :func:`capability_indices`.
+    """
+    mech = check_mechanism(mech)
+    if wmap.q is None or wmap.q.shape[-1] != mech.nq or wmap.mechanism != mech.name:
+        raise InvalidInputError("wmap", "give a map of this mechanism made with workspace_map(..., "
+                                        "configurations=True)", wmap)
+    shape = wmap.reachable.shape
+    nodes = np.flatnonzero(wmap.reachable.ravel())
+    along_n, iso_n, regular = capability_indices(mech, wmap.q.reshape(-1, mech.nq)[nodes], kind, gravity=gravity,
+                                                 kernels=kernels)
+
+    def spread(values: np.ndarray) -> np.ndarray:
+        out = np.full(int(np.prod(shape)), np.nan)
+        out[nodes] = values
+        return out.reshape(shape)
+
+    reachable = np.zeros(int(np.prod(shape)), dtype=bool)
+    reachable[nodes[regular]] = True
+    kinds = mech.task_map.kinds
+    names = {n for n, _ in wmap.axes}
+    fixed = {k: float(v) for k, v in zip(mech.task_map.value_names, wmap.fixed) if k not in names}
+    return CapabilityMap(kind, wmap.axes, fixed, reachable.reshape(shape),
+                         {a: (spread(p), spread(m)) for a, (p, m) in along_n.items()},
+                         {u: spread(v) for u, v in iso_n.items()},
+                         {a: _UNITS[kind][kinds[a]] for a in kinds}, dict(kinds), mech.name)
+
+
 MAX_MAP_NODES = 250_000  # nodes of a capability map at most (each an IK solve and a capability: about 2 ms)
 
 
@@ -272,6 +375,38 @@ class CapabilityMap:
         fig.savefig(out, dpi=150)
         pyplot().close(fig)
         return str(out)
+
+
+    def write_csv(self, path: str) -> str:
+        """One row per node: the axes' coordinates (SI), ``reachable``, the largest value along each task axis each
+        way (``<axis>_plus``, ``<axis>_minus``) and the isotropic values (``isotropic [<unit>]``; NaN where
+        unreachable)."""
+        import csv
+        from pathlib import Path
+
+        mesh = np.meshgrid(*[v for _, v in reversed(self.axes)], indexing="ij")
+        cols = {name: m.ravel() for (name, _), m in zip(reversed(self.axes), mesh)}
+        cols["reachable"] = self.reachable.ravel().astype(float)
+        for a, (plus, minus) in self.along.items():
+            cols[f"{a}_plus"], cols[f"{a}_minus"] = plus.ravel(), minus.ravel()
+        for u, v in self.isotropic.items():
+            cols[f"isotropic [{u}]"] = v.ravel()
+        out = Path(path)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        with out.open("w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(list(cols))
+            w.writerows(zip(*[c.tolist() for c in cols.values()]))
+        return str(out)
+
+    def summary(self) -> dict:
+        """The indices' ranges over the reachable nodes: ``{"along": {axis: {"plus": [min, max], "minus": [...]}},
+        "isotropic": {unit: [min, max]}, "units": ...}`` (empty where no node is reachable)."""
+        if not self.reachable.any():
+            return {"along": {}, "isotropic": {}, "units": self.units}
+        span = lambda v: [float(np.nanmin(v[self.reachable])), float(np.nanmax(v[self.reachable]))]
+        return {"along": {a: {"plus": span(p), "minus": span(m)} for a, (p, m) in self.along.items()},
+                "isotropic": {u: span(v) for u, v in self.isotropic.items()}, "units": self.units}
 
 
 def capability_map(mech: Mechanism, axes: Mapping[str, ArrayLike], fixed: Mapping[str, float] | None = None,

@@ -69,6 +69,8 @@ class WorkspaceMap:
         how: What ran the kernels.
         kinds: Each axis's kind, ``"length"`` or ``"angle"``.
         mechanism: The mechanism's name (the figure's caption).
+        q: The configuration solved at each node (shaped as the arrays, then nq; NaN where unreachable), when
+            :func:`workspace_map` was asked to keep them (``configurations=True``), else None.
     """
 
     axes: tuple[tuple[str, np.ndarray], ...]
@@ -80,6 +82,7 @@ class WorkspaceMap:
     how: str = ""
     kinds: tuple[str, ...] = ()
     mechanism: str = ""
+    q: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def nodes(self) -> int:
@@ -221,7 +224,7 @@ def _library(kernels: Kernels) -> tuple[Any, tuple[int, int], str]:
         raise CompilerError("maps need a C compiler", how)
     grid = getattr(lib, f"{step.name()}_grid")
     grid.argtypes = [ctypes.POINTER(_I), _I, _P, _P, _P, _P, ctypes.POINTER(_I), _I, _I, ctypes.c_double,
-                     ctypes.c_double, ctypes.POINTER(ctypes.c_byte), _P, ctypes.POINTER(_I)]
+                     ctypes.c_double, ctypes.POINTER(ctypes.c_byte), _P, ctypes.POINTER(_I), _P]
     grid.restype = ctypes.c_int
     return grid, index.size_out(0), how
 
@@ -229,7 +232,8 @@ def _library(kernels: Kernels) -> tuple[Any, tuple[int, int], str]:
 def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[str, object] | None = None, *,
                   branch: str | None = None, length: float | None = None, seed: ArrayLike | None = None,
                   tol: float = 1e-10,
-                  step_tol: float = 1e-8, max_iter: int = 40, kernels: Kernels | None = None) -> WorkspaceMap:
+                  step_tol: float = 1e-8, max_iter: int = 40, kernels: Kernels | None = None,
+                  configurations: bool = False) -> WorkspaceMap:
     """The map of ``mech`` over the grid ``axes`` (see the module doc).
 
     Args:
@@ -248,6 +252,8 @@ def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[st
             from the third) is given up earlier. Near an inverse singularity the root is (nearly) double and the
             step only halves: those nodes take tens of iterations.
         kernels: A :class:`pkm.Kernels` of ``mech`` to reuse.
+        configurations: Keep each node's configuration (:attr:`WorkspaceMap.q`: nq numbers a node), for indices
+            computed afterwards (:func:`pkm.core.analysis.capability.map_capability`).
 
     Raises:
         InvalidInputError: bad axes, a missing ``length``, or a grid beyond :data:`MAX_NODES`.
@@ -312,17 +318,19 @@ def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[st
     state = np.zeros(total, dtype=np.int8)
     sv = np.empty((total, nsv))
     its = np.zeros(total, dtype=np.int64)
+    q_out = np.full((total, mech.nq), np.nan) if configurations else None
     c_dims = np.array(dims, dtype=np.int64)
     arrays = [np.ascontiguousarray(a, dtype=float) for a in (targets, q0, scale, signs if signs.size else np.zeros(1))]
     flag = grid(c_dims.ctypes.data_as(ctypes.POINTER(_I)), len(dims), *[a.ctypes.data_as(_P) for a in arrays],
                 roots.ctypes.data_as(ctypes.POINTER(_I)), len(roots), max_iter, step_tol, tol,
                 state.ctypes.data_as(ctypes.POINTER(ctypes.c_byte)), sv.ctypes.data_as(_P),
-                its.ctypes.data_as(ctypes.POINTER(_I)))
+                its.ctypes.data_as(ctypes.POINTER(_I)), None if q_out is None else q_out.ctypes.data_as(_P))
     if flag:
         raise CompilerError("the compiled map driver failed", "out of memory" if flag == 2 else f"code {flag}")
     shape = tuple(reversed(dims))
     return WorkspaceMap(tuple(grid_axes), base, scale, (state == 1).reshape(shape), sv.reshape(shape + (nsv,)),
-                       its.reshape(shape), how, tuple(task.kinds[name] for name, _ in grid_axes), mech.name)
+                        its.reshape(shape), how, tuple(task.kinds[name] for name, _ in grid_axes), mech.name,
+                        None if q_out is None else q_out.reshape(shape + (mech.nq,)))
 
 
 #: The former name of :class:`WorkspaceMap` (deprecated since 0.2.0).

@@ -142,9 +142,9 @@ JACOBI_SV
 int STEP_grid(const casadi_int* dims, casadi_int ndim, const casadi_real* targets, const casadi_real* q0,
               const casadi_real* scale, const casadi_real* signs, const casadi_int* roots, casadi_int nroots,
               casadi_int max_iter, casadi_real step_tol, casadi_real tol,
-              signed char* state, casadi_real* sv, casadi_int* iterations) {
+              signed char* state, casadi_real* sv, casadi_int* iterations, casadi_real* q_out) {
   /* state: 0 not reached, 1 solved, -3 failed (not converged, or in another mode), -2 queued; a node is queued
-     by each solved neighbour (2 ndim tries at most) until one solves it */
+     by each solved neighbour (2 ndim tries at most) until one solves it; q_out (NULL: not kept) the solutions */
   const casadi_int nq = NQ, nt = NT, m = KROWS, n = KCOLS, nb = NB, nsv = (m < n ? m : n);
   casadi_int total = 1, stride[3] = {1, 1, 1};
   for (casadi_int d = 0; d < ndim; ++d) { stride[d] = total; total *= dims[d]; }
@@ -196,6 +196,7 @@ int STEP_grid(const casadi_int* dims, casadi_int ndim, const casadi_real* target
       for (casadi_int b = 0; b < nb; ++b) if (signs[b] != 0.0 && !(signs[b] * branch[b] > -BRANCH_TOL)) same = 0;
       if (!same) continue;  /* solved in another mode */
       state[k] = 1;
+      if (q_out) memcpy(q_out + k * nq, cur, sizeof(casadi_real) * nq);
       if (m >= n) { memcpy(Kt, K, sizeof(casadi_real) * m * n); STEP_pkm_sv(m, n, Kt, sv + k * nsv); }
       else {  /* K^T, column-major n x m */
         for (casadi_int i = 0; i < m; ++i) for (casadi_int j = 0; j < n; ++j) Kt[i * n + j] = K[j * m + i];
