@@ -120,6 +120,10 @@ if shutil.which("cc"):
         for target, row in zip(y, out):
             print(f"  pitch {target[0]:+.2f}, roll {target[1]:+.2f} rad -> motors {row[4 + ankle.nq:]} rad, status "
                   f"{int(row[0])}, {int(row[1])} Newton evaluations, mode id {int(row[3])}")
+        for mode in (0, 1, 2, 3):  # the closed form, each leg on either branch (bit k: actuator k's other branch)
+            row = h.run("ik_actuators", np.array([[0.3, 0.1, mode]]))[0]
+            print(f"  closed form, mode {mode}: motors {row[3:]} rad, status {int(row[0])} (3: outside the motors' "
+                  f"travel), smallest leg margin {row[2]:.3f}")
 else:
     print("no C compiler: the exported C is skipped")
 

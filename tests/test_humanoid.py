@@ -1,8 +1,8 @@
 """The humanoid ankle (``examples/humanoid_ankle``: MJCF with ``<connect>`` loops and motors, its outputs in a
 four-line spec) and knee (``examples/humanoid_knee``: URDF + spec, a four-bar) against routes that are not pkm's:
 
-* the ankle's inverse kinematics (pkm's generic Newton, and the exported C) equals each leg's circle-sphere
-  intersection, written here from the file's geometry, to 1e-10 over the feasible pitch-roll region; the knee's
+* the ankle's inverse kinematics (pkm's generic Newton, the exported C's Newton and its closed form, both
+  branches) equals each leg's circle-sphere intersection, written here from the file's geometry, to 1e-10 over the feasible pitch-roll region; the knee's
   equals the four-bar's circle-circle intersection;
 * the largest pure-pitch and pure-roll torques (:func:`pkm.capability`) equal linear programs over the motor torques
   (``scipy.optimize.linprog``: the statics ``τ_m = Jᵀ w + g_a`` with the motors' box) to 1e-9;
@@ -46,14 +46,15 @@ def rot_x(a: float) -> np.ndarray:
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
-def ankle_closed_form(pitch: float, roll: float) -> np.ndarray:
+def ankle_closed_form(pitch: float, roll: float, other: tuple[bool, bool] = (False, False)) -> np.ndarray:
     """Each motor's angle: its crank tip ``M + R_y(a) (-R, 0, 0)`` on the sphere of radius L about the heel ball
-    ``R_y(pitch) R_x(roll) B``: ``A cos a + B sin a = C``, the root of the reference's branch (a = 0 at neutral)."""
+    ``R_y(pitch) R_x(roll) B``: ``A cos a + B sin a = C``, the root of the reference's branch (a = 0 at neutral), or
+    the other root for the legs ``other`` names."""
     out = []
-    for side in ("left", "right"):
+    for side, flip in zip(("left", "right"), other):
         d = rot_y(pitch) @ rot_x(roll) @ B[side] - M[side]
         a_, b_, c_ = 2.0 * R * d[0], -2.0 * R * d[2], L[side] ** 2 - R ** 2 - d @ d
-        out.append(math.atan2(b_, a_) - math.acos(c_ / math.hypot(a_, b_)))
+        out.append(math.atan2(b_, a_) + (1.0 if flip else -1.0) * math.acos(c_ / math.hypot(a_, b_)))
     return np.array(out)
 
 
@@ -99,6 +100,15 @@ def test_the_ankle_map_is_the_circle_sphere_intersection(ankle, region, tmp_path
     assert (out[:, 0] == 0).all() and (out[:, 3] == 0).all()
     closed = np.array([ankle_closed_form(p, r) for p, r in points])
     assert np.abs(out[:, 4 + ankle.nq:] - closed).max() <= 1e-10
+    # the library's own closed form (no iteration), in mode 0 and with the left leg on its other branch (mode 1:
+    # the crank up, outside the motor's travel)
+    assert not h.lib.closed_form
+    direct = h.run("ik_actuators", np.hstack([np.array(points), np.zeros((len(points), 1))]))
+    assert (direct[:, 0] == 0).all() and np.abs(direct[:, 3:] - closed).max() <= 1e-10
+    flipped = h.run("ik_actuators", np.hstack([np.array(points), np.ones((len(points), 1))]))
+    other = np.array([ankle_closed_form(p, r, (True, False)) for p, r in points])
+    gap = (flipped[:, 3:] - other + np.pi) % (2 * np.pi) - np.pi  # (the library's angle within pi of the reference's)
+    assert np.abs(gap).max() <= 1e-10 and np.abs(flipped[:, 3:]).max() <= np.pi and (flipped[:, 0] == 3).all()
 
 
 def test_the_torque_extremes_are_linear_programs(ankle, region):

@@ -1,18 +1,21 @@
 """The exported C library (``pkm export c``) per call, next to pkm's Python routes timed in the same run.
 
-For each mechanism (default: the humanoid ankle of ``examples/ankle``, the knee and the Delta) the library is
+For each mechanism (default: the humanoid ankle and knee of ``examples/humanoid_ankle`` and ``humanoid_knee``, and
+the Delta) the library is
 exported, built ``-O2`` (:func:`pkm.core.export.harness.build`: the strict C99 build) and timed in C over ``-n``
 calls (default 10⁵), in blocks of 100, the median block's time per call:
 
 * ``fk``: the forward kinematics along a 1 kHz motion of the actuators (0.2 rad sines at 0.5 and 0.7 Hz, or 0.2 of
   the mechanism's size for prismatic ones), each call warm-started from the previous call's solution;
 * ``ik``: the inverse kinematics of the same path's task values, each from the previous sample's configuration;
+* ``ik_actuators``: the closed-form inverse kinematics of the actuators, where the mechanism has one (crank legs:
+  the ankle, the knee), of the same task values;
 * ``jacobians`` (both), ``inverse_dynamics`` (unit rates and accelerations), ``mass_matrix`` at its configurations.
 
 The Python routes, per call (median of ``--calls``): :func:`pkm.close_loops` from the previous sample,
 :func:`pkm.solve_ik` from the previous sample, :func:`pkm.forward_jacobian` with :func:`pkm.inverse_jacobian`,
 :func:`pkm.actuator_model` (``M_a qdd + h_a``), :func:`pkm.mass_matrix`. The targets of issue 31 on this machine are
-for the ankle: FK ≤ 1 µs, IK ≤ 0.3 µs, inverse dynamics ≤ 1 µs.
+for the ankle: FK ≤ 1 µs, IK ≤ 0.3 µs (the closed form's), inverse dynamics ≤ 1 µs.
 
 Usage: ``python -m pkm.bench.export [--json] [--quick] [-n 100000] [--calls 300] [--mechanism NAME ...]``.
 """
@@ -27,11 +30,11 @@ import numpy as np
 
 from pkm.bench import median_us
 
-QUICK = {"n": 2000, "calls": 20, "mechanism": ["ankle", "delta"]}
+QUICK = {"n": 2000, "calls": 20, "mechanism": ["humanoid_ankle", "delta"]}
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
-MECHANISMS = ("ankle", "knee", "delta")
+MECHANISMS = ("humanoid_ankle", "humanoid_knee", "delta")
 #: What each C function is timed against.
-PYTHON = {"fk": "close_loops", "ik": "solve_ik", "jacobians": "forward_jacobian + inverse_jacobian",
+PYTHON = {"fk": "close_loops", "ik": "solve_ik", "ik_actuators": "solve_ik", "jacobians": "forward_jacobian + inverse_jacobian",
           "inverse_dynamics": "actuator_model", "mass_matrix": "mass_matrix"}
 
 
@@ -39,7 +42,7 @@ def add_arguments(ap) -> None:
     ap.add_argument("-n", type=int, default=100_000, help="calls timed in C per function (default 10^5)")
     ap.add_argument("--calls", type=int, default=300, help="calls timed in Python per function (default 300)")
     ap.add_argument("--mechanism", nargs="*", default=list(MECHANISMS),
-                    help="shipped names or files (default: the ankle, the knee and the Delta)")
+                    help="shipped names or folders of examples/ (default: the humanoid ankle and knee, the Delta)")
 
 
 def _load(name: str):
@@ -48,9 +51,9 @@ def _load(name: str):
     import pkm
     from pkm.mechanisms import REGISTRY
 
-    local = EXAMPLES / name / f"{name}.closures.toml"
-    if local.exists():
-        return pkm.load(local)
+    local = sorted((EXAMPLES / name).glob("*.closures.toml")) if (EXAMPLES / name).is_dir() else []
+    if local:
+        return pkm.load(local[0])
     return pkm.load(name) if name in REGISTRY or Path(name).exists() else None
 
 
@@ -80,6 +83,8 @@ def _one(name: str, args, folder: Path) -> dict[str, Any]:
          "jacobians": h.bench("jacobians", Q),
          "inverse_dynamics": h.bench("inverse_dynamics", np.hstack([Q, ones, ones])),
          "mass_matrix": h.bench("mass_matrix", Q)}
+    if not lib.closed_form:
+        c["ik_actuators"] = h.bench("ik_actuators", np.hstack([Y, zeros]))
     idx = np.linspace(1, n - 1, min(args.calls, n - 1)).astype(int)
     calls = [(int(k),) for k in idx]
     m = len(calls)
@@ -94,6 +99,8 @@ def _one(name: str, args, folder: Path) -> dict[str, Any]:
                                  calls, m),
           "inverse_dynamics": median_us(model, calls, m),
           "mass_matrix": median_us(lambda k: pkm.mass_matrix(mech, Q[k]), calls, m)}
+    if "ik_actuators" in c:
+        py["ik_actuators"] = py["ik"]
     fk_path = h.run("fk", np.hstack([QA[:2000], previous[:2000], zeros[:2000]]))
     return {"mechanism": mech.name, "calls": n, "path_solved": int(ok.sum()),
             "fk_iterations_warm": float(fk_path[1:, 1].mean()),

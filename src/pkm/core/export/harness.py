@@ -7,11 +7,13 @@ a generated ``harness.c`` that reads samples on standard input and writes every 
 output, as doubles. :meth:`Harness.run` feeds a table of inputs (one row per call) and returns a table of outputs;
 :meth:`Harness.bench` times the functions in C (``clock_gettime``, the median of blocks of calls).
 
-Row layouts (:data:`LAYOUTS`): ``fk`` in ``qa, q_prev, mode`` out ``status, iterations, residual, mode, q, y``;
+Row layouts (:func:`layouts`): ``fk`` in ``qa, q_prev, mode`` out ``status, iterations, residual, mode, q, y``;
 ``ik`` in ``y, q_prev, mode`` out ``status, iterations, residual, mode, q, qa``; ``jacobians`` in ``q`` out
 ``status, J, K``; ``maps`` in ``q, qd, xd, tau, w`` out four statuses, ``xd = J qd, qd = K xd, w = Kᵀ tau,
 tau = Jᵀ w``; ``jdot_qdot`` in ``q, qd`` out ``status, c``; ``inverse_dynamics`` in ``q, qd, qdd`` out
-``status, tau``; ``mass_matrix`` in ``q`` out ``status, M``; ``gravity`` in ``q`` out ``status, g``.
+``status, tau``; ``mass_matrix`` in ``q`` out ``status, M``; ``gravity`` in ``q`` out ``status, g``;
+``ik_actuators`` (the closed form, where the library has it; status -1 otherwise) in ``y, mode`` out
+``status, residual, smallest margin, qa``.
 """
 
 from __future__ import annotations
@@ -34,7 +36,7 @@ STRICT = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic")
 FORBIDDEN = frozenset({"malloc", "calloc", "realloc", "free", "printf", "fprintf", "sprintf", "snprintf", "puts",
                        "putchar", "fputs", "fwrite", "perror", "abort", "exit", "__printf_chk", "__fprintf_chk",
                        "__sprintf_chk", "__snprintf_chk"})
-KINDS = ("fk", "ik", "jacobians", "maps", "jdot_qdot", "inverse_dynamics", "mass_matrix", "gravity")
+KINDS = ("fk", "ik", "jacobians", "maps", "jdot_qdot", "inverse_dynamics", "mass_matrix", "gravity", "ik_actuators")
 
 
 def layouts(lib: CLibrary) -> dict[str, tuple[int, int]]:
@@ -42,7 +44,8 @@ def layouts(lib: CLibrary) -> dict[str, tuple[int, int]]:
     nq, na, ny, nx = (lib.sizes[k] for k in ("NQ", "NA", "NY", "NX"))
     return {"fk": (na + nq + 1, 4 + nq + ny), "ik": (ny + nq + 1, 4 + nq + na), "jacobians": (nq, 1 + 2 * nx * na),
             "maps": (nq + 2 * na + 2 * nx, 4 + 2 * nx + 2 * na), "jdot_qdot": (nq + na, 1 + nx),
-            "inverse_dynamics": (nq + 2 * na, 1 + na), "mass_matrix": (nq, 1 + na * na), "gravity": (nq, 1 + na)}
+            "inverse_dynamics": (nq + 2 * na, 1 + na), "mass_matrix": (nq, 1 + na * na), "gravity": (nq, 1 + na),
+            "ik_actuators": (ny + 1, 3 + na)}
 
 
 _HARNESS = r"""
@@ -98,15 +101,24 @@ static void one(int kind, const double* in, double* out) {
   case 6:
     out[0] = NAME_mass_matrix(in, out + 1, &info);
     break;
-  default:
+  case 7:
     out[0] = NAME_gravity(in, out + 1, &info);
+    break;
+  default:
+#if U_HAS_CLOSED_FORM
+    out[0] = NAME_ik_actuators(in, (long) in[NY], out + 3, &info);
+    out[1] = info.residual; out[2] = info.sigma_min;
+#else
+    out[0] = -1;
+#endif
+    break;
   }
 }
 
 /* stdin: kind, n, then n rows; kind + 100: time the function over the n rows (fk warm-started along them), in
    blocks of 100 calls, and write the median time per call [s]. */
 int main(void) {
-  static const int in_w[8] = {IN_WIDTHS}, out_w[8] = {OUT_WIDTHS};
+  static const int in_w[9] = {IN_WIDTHS}, out_w[9] = {OUT_WIDTHS};
   double head[2], *in, *out;
   long n, k;
   int kind, bench;
@@ -275,6 +287,10 @@ def compare(mech: Mechanism, harness: Harness, samples: int = 4, step: float = 0
     ik = harness.run("ik", np.hstack([Y, np.tile(ref, (samples, 1)), mode]))
     statuses(ik[:, 0])
     out["ik"] = _difference(ik[:, 4 + nq:], QA)
+    if not lib.closed_form:  # (the closed form, from the same task values)
+        direct = harness.run("ik_actuators", np.hstack([Y, np.zeros((samples, 1))]))
+        statuses(direct[:, 0])
+        out["ik_actuators"] = _difference(direct[:, 3:], QA)
     jac = harness.run("jacobians", Q)
     statuses(jac[:, 0])
     nx = lib.sizes["NX"]
@@ -329,6 +345,8 @@ def domain(mech: Mechanism, harness: Harness, steps: int = 60) -> tuple[list[str
                 "jacobians": np.full(nq, bad), "jdot_qdot": np.hstack([ref, np.full(na, bad)]),
                 "inverse_dynamics": np.hstack([ref, np.zeros(na), np.full(na, bad)]), "mass_matrix": np.full(nq, bad),
                 "gravity": np.full(nq, bad), "maps": np.hstack([ref, np.full(2 * na + 2 * lib.sizes["NX"], bad)])}
+        if not lib.closed_form:
+            rows["ik_actuators"] = np.hstack([np.full(ny, bad), [0.0]])
         for kind, row in rows.items():
             got = harness.run(kind, row[None])[0]
             statuses = got[:4] if kind == "maps" else got[:1]
@@ -358,6 +376,10 @@ def domain(mech: Mechanism, harness: Harness, steps: int = 60) -> tuple[list[str
         got = harness.run("ik", row[None])[0]
         if not np.isfinite(got).all():
             problems.append(f"ik of a target 10 away: non-finite output (status {got[0]:g})")
+        if not lib.closed_form:
+            got = harness.run("ik_actuators", np.hstack([row[:ny], [0.0]])[None])[0]
+            if not (np.isfinite(got).all() and STATUS[int(got[0])] in ("NOT_CONVERGED", "OUTSIDE_LIMITS")):
+                problems.append(f"ik_actuators of a target 10 away: status {got[0]:g}, outputs {got.tolist()}")
     return problems, {k: seen.count(k) for k in STATUS if k in seen}
 
 

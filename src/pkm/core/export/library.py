@@ -2,8 +2,9 @@
 
 :func:`export_c` writes into a folder ``<name>.h``, ``<name>.c``, a ``Makefile``, a ``CMakeLists.txt`` and an
 example ``main.c``. The library's functions (declared and documented in the header): forward kinematics (Newton,
-warm-started from the caller's previous solution, a fixed iteration bound), inverse kinematics (Newton), the
-assembly and working mode ids of a configuration, the task value, the forward and inverse Jacobians, the rate and
+warm-started from the caller's previous solution, a fixed iteration bound), inverse kinematics (Newton, and in
+closed form, ``<name>_ik_actuators``, where the mechanism is made of crank legs on a body the task places:
+:attr:`~pkm.core.export.model.ExportModel.closed_form`), the assembly and working mode ids of a configuration, the task value, the forward and inverse Jacobians, the rate and
 effort maps between actuators and task, ``J̇ q̇``, inverse dynamics, ``M_a`` and the gravity efforts.
 
 Every function is re-entrant (constant tables only, the caller owns every buffer), allocates nothing, prints
@@ -64,6 +65,7 @@ class CLibrary:
         blocks: ``{"fk": [...], "ik": [...]}``: each mode bit's joints (velocity coordinates named).
         limits: The joints whose limits are checked, in ``info.joint``'s order.
         idle: The velocity coordinates held at the caller's previous solution (one per idle motion).
+        closed_form: Why there is no closed-form inverse kinematics (``<name>_ik_actuators``); empty when there is.
     """
 
     name: str
@@ -74,6 +76,7 @@ class CLibrary:
     blocks: dict[str, list[list[str]]] = field(default_factory=dict)
     limits: tuple[str, ...] = ()
     idle: tuple[str, ...] = ()
+    closed_form: str = ""
 
     @property
     def header(self) -> Path:
@@ -145,6 +148,9 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
     fk, ik = model.fk, model.ik
     kernels = [fk.step, fk.system, fk.retract, ik.step, ik.system, ik.retract, model.task_value(), model.jacobians(), model.jdot_qdot(),
                model.inverse_dynamics(), model.mass_matrix(), model.gravity()]
+    closed, closed_signs, no_closed_form = model.closed_form
+    if closed is not None:
+        kernels.append(closed)
     _check_at_reference(mech, model, kernels)
     sizes = {"NQ": mech.nq, "NV": mech.nv, "NA": mech.na, "NY": mech.task_map.value_size, "NX": mech.task_map.size}
     ops = {}
@@ -166,13 +172,18 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
         return text.replace("p_", f"{prefix}_").replace("P_", f"{prefix.upper()}_")
 
     stamp = datetime.date.today().isoformat()
-    header = _header(mech, prefix, sizes, ops, blocks, limits, fk, ik, __version__, stamp)
+    header = _header(mech, prefix, sizes, ops, blocks, limits, fk, ik, __version__, stamp, no_closed_form)
     tables = (_array("int", "p_actuated_q", [int(i) for i in mech.act_q], public=True)
               + f"#define P_NLIMITS {len(limits)}\n"
               + _array("int", "p_limit_q", [q for _, q, _, _ in limits])
               + _array("double", "p_limit_low", [lo for _, _, lo, _ in limits], c_constant)
               + _array("double", "p_limit_high", [hi for _, _, _, hi in limits], c_constant)
               + _blocks("fk", fk.blocks) + _blocks("ik", ik.blocks)
+              + (_array("int", "p_actuated_limit", [next((k for k, (_, qi, _, _) in enumerate(limits)
+                                                           if qi == int(i)), -1) for i in mech.act_q])
+                 + _array("int", "p_task_limit", [next((k for k, (name, *_) in enumerate(limits) if name == j.name), -1)
+                                                   for j in mech.task_joints])
+                 + _array("double", "p_closed_sign", list(closed_signs), c_constant) if closed else "")
               + f"#define P_NMAX {max(nfk, nik)}\n"
               + f"#define P_BMAX {max([len(b.rows) for b in fk.blocks + ik.blocks] + [1])}\n")
     limit_names = [n for n, *_ in limits] or [""]
@@ -191,7 +202,7 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
               f'#include "{prefix}.h"\n#include <math.h>\n\n'
               + prefixed(tables) + prefixed(constants) + "\n/* ---------------------------------------------------------------- kernels (the twin's expressions) */\n"
               + prefixed(functions) + prefixed(runtime.HELPERS.replace("JACOBI_SV", sv)) + prefixed(newton)
-              + prefixed(runtime.PUBLIC))
+              + prefixed(runtime.PUBLIC) + (prefixed(runtime.CLOSED_FORM) if closed else ""))
     files = {f"{prefix}.h": header, f"{prefix}.c": source, "Makefile": _MAKEFILE.replace("NAME", prefix),
              "CMakeLists.txt": _CMAKE.replace("NAME", prefix), "main.c": _main(prefix, mech)}
     written = []
@@ -200,7 +211,7 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
         path.write_text(text)
         written.append(path)
     return CLibrary(prefix, out, tuple(written), sizes, ops, blocks, tuple(n for n, *_ in limits),
-                    tuple(vnames[c] for c in model.idle))
+                    tuple(vnames[c] for c in model.idle), no_closed_form)
 
 
 def _check_at_reference(mech: Mechanism, model: ExportModel, kernels: list[cs.Function]) -> None:
@@ -214,7 +225,8 @@ def _check_at_reference(mech: Mechanism, model: ExportModel, kernels: list[cs.Fu
         if not (np.isfinite(q_next).all() and r[0] <= 1e-9 and pivot[0] >= PIVOT_FLOOR):
             raise ExportError(mech.name, f"the {what} kinematics' Newton step does not converge at the reference "
                                          f"(residual {r[0]:.3g}, smallest relative pivot {pivot[0]:.3g})")
-    args = {"task_value": (q,), "jacobians": (q,), "jdot_qdot": (q, zeros + 0.1), "inverse_dynamics": (q, zeros, zeros),
+    args = {"task_value": (q,), "jacobians": (q,), "ik_closed": (y, model.closed_form[1]),
+            "jdot_qdot": (q, zeros + 0.1), "inverse_dynamics": (q, zeros, zeros),
             "mass_matrix": (q,), "gravity": (q,)}
     for fun in kernels:
         if fun.name() not in args:
@@ -228,7 +240,8 @@ def _check_at_reference(mech: Mechanism, model: ExportModel, kernels: list[cs.Fu
 
 
 def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, tuple[int, int, int]],
-            blocks: dict[str, list[list[str]]], limits: list, fk: object, ik: object, version: str, stamp: str) -> str:
+            blocks: dict[str, list[list[str]]], limits: list, fk: object, ik: object, version: str, stamp: str,
+            no_closed_form: str) -> str:
     U = prefix.upper()
     step = lambda k: ops[k][0] + ops[k][1] + ops[k][2]
     lines = [
@@ -251,6 +264,8 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
         f"Inverse kinematics: at most {MAX_ITER} evaluations of ik_step ({step('ik_step')} operations each), at "
         f"most {MAX_ITER * step('ik_step')} operations.",
         f"Converged when the largest closure residual (and task error) is at most {U}_TOL = {TOL:g} [m, rad].",
+        (f"Closed-form inverse kinematics of the actuators ({prefix}_ik_actuators): {step('ik_closed')} operations, "
+         "no iteration." if not no_closed_form else f"No closed-form inverse kinematics: {no_closed_form}."),
         "",
         "Mode ids: bit k set when the k-th diagonal block of the Newton matrix has the determinant sign opposite to",
         "the reference configuration's; 0 is the reference's mode. Blocks (their coordinates):",
@@ -265,6 +280,7 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
     comment = "/*\n" + "".join(f" * {line}".rstrip() + "\n" for line in lines) + " */\n"
     guard = f"{U}_H"
     defs = [f"#define {U}_{k} {v}" for k, v in sizes.items()]
+    defs.append(f"#define {U}_HAS_CLOSED_FORM {0 if no_closed_form else 1}")
     defs += [f"#ifndef {U}_MAX_ITER\n#define {U}_MAX_ITER {MAX_ITER}\n#endif",
              f"#ifndef {U}_TOL\n#define {U}_TOL {TOL!r}\n#endif",
              f"#ifndef {U}_PIVOT_FLOOR\n#define {U}_PIVOT_FLOOR {PIVOT_FLOOR!r}\n#endif",
@@ -283,7 +299,8 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
              f"extern const char* const {prefix}_task_names[{U}_NY];\n"
              f"extern const double {prefix}_q_reference[{U}_NQ];  /* the reference configuration (mode 0) */\n"
              f"extern const int {prefix}_actuated_q[{U}_NA];  /* where the actuated coordinates are in q */\n")
-    body = runtime.HEADER_FUNCTIONS.replace("p_", f"{prefix}_").replace("P_", f"{U}_")
+    body = (runtime.HEADER_FUNCTIONS + ("" if no_closed_form else runtime.HEADER_CLOSED_FORM)) \
+        .replace("p_", f"{prefix}_").replace("P_", f"{U}_")
     return (comment + f"#ifndef {guard}\n#define {guard}\n\n#ifdef __cplusplus\nextern \"C\" {{\n#endif\n\n"
             + "\n".join(defs) + f"\n\nenum {{\n{status}\n}};\n\n" + info + "\n" + decls + body
             + "\n#ifdef __cplusplus\n}\n#endif\n\n#endif\n")

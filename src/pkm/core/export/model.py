@@ -28,9 +28,11 @@ import functools
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import casadi as cs
 import numpy as np
+import pinocchio as pin
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.dynamics import ActuatorTwin
@@ -268,6 +270,90 @@ class ExportModel:
         c = cs.jtimes(J @ tw.qd, tw.q, tw.tangent @ self._rates)
         return _function("jdot_qdot", [("q", tw.q), ("qd", tw.qd)], [("c", c), ("pivot", self.fk_pivot)])
 
+    @functools.cached_property
+    def closed_form(self) -> tuple[cs.Function | None, np.ndarray, str]:
+        """The inverse kinematics of the actuated coordinates in closed form, where the mechanism is made of crank
+        legs on a task-placed body: ``(function, signs, why)``, the function ``(y, signs) -> (qa, margin)`` and the
+        reference's signs, or ``(None, [], why not)``.
+
+        The pattern (a humanoid ankle's, a four-bar knee's, any RSS or RRR leg): every closure is a point closure
+        between a frame on a body placed by the task alone (the task's joints, every joint on its way to the root
+        a task joint) and the end of a two-joint leg: an actuated one-coordinate revolute on the fixed base, then
+        any joint (a ball, a universal, a revolute), then the frame at a fixed distance ``L`` from that joint's
+        centre. The centre runs on a circle as the crank turns, ``c(a) = m + cos(a) u + sin(a) v`` (read off the
+        model at a = 0, pi/2, pi), so ``|c(a) - p| = L`` with ``p`` the body's point is ``A cos(a) + B sin(a) = C``:
+        ``a = atan2(B, A) + s acos(C / rho)``, ``rho = sqrt(A^2 + B^2)``, ``s = ±1`` the leg's branch (``signs``; the
+        reference's gives its own angle there), ``a`` then taken within pi of the reference's. ``margin`` per leg is
+        ``1 - |C| / rho``: negative where the leg cannot reach, zero at its inverse singularity (the rod along the
+        crank's tangent)."""
+        mech, tw = self.mech, self.twin
+        model = mech.model
+        if mech.spec.task.components or mech.spec.task.frames:
+            return None, np.zeros(0), "the task is not joint outputs alone"
+        task_ids = {j.id for j in mech.task_joints}
+        y_of = {j.idx_q: self.y[k] for k, j in enumerate(mech.task_joints)}
+        q_task = cs.vertcat(*[y_of.get(i, tw.q[i]) for i in range(model.nq)])
+        act = {int(j.id): k for k, j in enumerate(mech.actuated)}
+        legs: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, float, Expr]] = {}
+        for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
+            if c.type != "point":
+                return None, np.zeros(0), f"closure {c.name!r} is not a point closure"
+            leg = None
+            for f_leg, f_body in ((fa, fb), (fb, fa)):
+                j = model.frames[f_body].parentJoint
+                while j > 0 and j in task_ids:
+                    j = model.parents[j]
+                j2 = model.frames[f_leg].parentJoint
+                j1 = model.parents[j2] if j2 > 0 else 0
+                if j == 0 and j1 in act and model.parents[j1] == 0 and model.joints[j1].nq == 1 \
+                        and mech.joints[model.names[j1]].revolute and j1 not in legs:
+                    leg = (j1, j2, f_leg, f_body)
+                    break
+            if leg is None:
+                return None, np.zeros(0), f"closure {c.name!r} does not join a crank leg to a body the task places"
+            j1, j2, f_leg, f_body = leg
+            centres = [_centre(model, j1, j2, angle) for angle in (0.0, np.pi / 2, np.pi)]
+            m = 0.5 * (centres[0] + centres[2])
+            u, v = centres[0] - m, centres[1] - m
+            if not (abs(u @ v) <= 1e-12 * (u @ u) and abs(u @ u - v @ v) <= 1e-12 * (u @ u) and u @ u > 0):
+                return None, np.zeros(0), f"joint {model.names[j1]!r}: its leg's centre does not turn on a circle"
+            L = float(np.linalg.norm(model.frames[f_leg].placement.translation))
+            p = cs.substitute(tw.frame_placement(f_body).p, tw.q, q_task)
+            legs[j1] = (m, u, v, L, p)
+        if sorted(act[j] for j in legs) != list(range(mech.na)):
+            return None, np.zeros(0), "not every actuator drives a crank leg"
+        signs = cs.SX.sym("signs", mech.na)
+        qa: list[Any] = [None] * mech.na
+        margin: list[Any] = [None] * mech.na
+        ref = mech.q_reference
+        qa_ref = mech.actuated_q(ref)
+        for j1, (m, u, v, L, p) in legs.items():
+            k = act[j1]
+            d = cs.DM(m) - p
+            A, B = 2 * cs.dot(d, cs.DM(u)), 2 * cs.dot(d, cs.DM(v))
+            C = L * L - cs.dot(d, d) - float(u @ u)
+            rho = cs.sqrt(A * A + B * B)
+            ratio = C / rho
+            a = cs.atan2(B, A) + signs[k] * cs.acos(cs.fmin(cs.fmax(ratio, -1.0), 1.0))
+            qa[k] = a - 2 * np.pi * cs.floor((a - float(qa_ref[k]) + np.pi) / (2 * np.pi))  # (near the reference's)
+            margin[k] = 1 - cs.fabs(ratio)
+        fun = _function("ik_closed", [("y", self.y), ("signs", signs)],
+                        [("qa", cs.vertcat(*qa)), ("margin", cs.vertcat(*margin))])
+        y_ref = mech.task_map.value(ref)
+        chosen = []
+        for k in range(mech.na):  # the reference's branch of each leg
+            gaps = {}
+            for s_k in (1.0, -1.0):
+                trial = np.ones(mech.na)
+                trial[k] = s_k
+                gaps[s_k] = abs(float(np.array(fun(y_ref, trial)[0])[k, 0]) - qa_ref[k])
+            best = min(gaps, key=lambda x: gaps[x])
+            if gaps[best] > 1e-8:
+                return None, np.zeros(0), (f"the closed form misses the reference of {mech.actuated_names[k]} by "
+                                           f"{gaps[best]:.3g}")
+            chosen.append(best)
+        return fun, np.array(chosen), ""
+
     # ---------------------------------------------------------------- dynamics
     def inverse_dynamics(self) -> cs.Function:
         """``(q, qd, qdd) -> (tau, pivot)``: the actuator efforts (:func:`pkm.inverse_dynamics`'s, projected; with
@@ -287,6 +373,15 @@ class ExportModel:
     def gravity(self) -> cs.Function:
         """``q -> (g, pivot)``: the efforts that hold the mechanism still, as :func:`pkm.gravity_efforts`."""
         return _function("gravity", [("q", self.twin.q)], [("g", self.dyn.gravity), ("pivot", self.dyn.pivot)])
+
+
+def _centre(model: pin.Model, j1: int, j2: int, angle: float) -> np.ndarray:
+    """The origin of joint ``j2`` (child of ``j1``, whose parent is the base) with ``j1`` at ``angle``, the others at 0."""
+    q = pin.neutral(model)
+    q[model.joints[j1].idx_q] = angle
+    data = model.createData()
+    pin.forwardKinematics(model, data, q)
+    return np.array(data.oMi[j2].translation)
 
 
 def _function(name: str, inputs: list[tuple[str, Expr]], outputs: list[tuple[str, Expr]]) -> cs.Function:

@@ -279,6 +279,52 @@ int p_gravity(const double q[P_NQ], double g[P_NA], p_info* info) {
 }
 """
 
+#: The closed-form inverse kinematics of the actuated coordinates (mechanisms of crank legs: see
+#: :attr:`pkm.core.export.model.ExportModel.closed_form`).
+CLOSED_FORM = r"""
+int p_ik_actuators(const double y[P_NY], long mode, double qa[P_NA], p_info* info) {
+  p_info local;
+  double signs[P_NA], margin[P_NA];
+  int k;
+  info = p_start(info, &local);
+  if (!p_finite(y, P_NY)) return p_end(info, P_INVALID_INPUT);
+  if (mode < 0) mode = 0;
+  for (k = 0; k < P_NA; ++k) signs[k] = ((mode >> k) & 1L) ? -p_closed_sign[k] : p_closed_sign[k];
+  p_k_ik_closed(y, signs, qa, margin);
+  info->mode = mode; info->iterations = 0; info->sigma_min = margin[0];
+  for (k = 0; k < P_NA; ++k) {
+    if (margin[k] < info->sigma_min) info->sigma_min = margin[k];
+    if (!(margin[k] >= 0.0) && -margin[k] > info->residual) info->residual = -margin[k];
+  }
+  if (!p_finite(qa, P_NA)) return p_end(info, P_SINGULAR);
+  if (info->residual > 0.0) return p_end(info, P_NOT_CONVERGED);
+  for (k = 0; k < P_NY; ++k) {  /* (the task's joints: y is their values) */
+    int l = p_task_limit[k];
+    if (l >= 0 && (y[k] < p_limit_low[l] - P_LIMIT_TOL || y[k] > p_limit_high[l] + P_LIMIT_TOL)) {
+      info->joint = l;
+      return p_end(info, P_OUTSIDE_LIMITS);
+    }
+  }
+  for (k = 0; k < P_NA; ++k) {
+    int l = p_actuated_limit[k];
+    if (l >= 0 && (qa[k] < p_limit_low[l] - P_LIMIT_TOL || qa[k] > p_limit_high[l] + P_LIMIT_TOL)) {
+      info->joint = l;
+      return p_end(info, P_OUTSIDE_LIMITS);
+    }
+  }
+  return P_OK;
+}
+"""
+
+HEADER_CLOSED_FORM = r"""
+/* The actuated coordinates qa (P_NA) for the task value y (P_NY) in closed form, no iteration: each crank leg's
+   circle-sphere intersection. mode: bit k set puts actuator k's leg on the branch opposite to the reference's
+   (negative: 0). NOT_CONVERGED: a leg cannot reach (info->residual: by how much, as 1 - |C| / rho); info->sigma_min:
+   the smallest leg margin 1 - |C| / rho (0 at a leg's inverse singularity); OUTSIDE_LIMITS: a task joint's or an
+   actuator's limit (info->joint). */
+int p_ik_actuators(const double y[P_NY], long mode, double qa[P_NA], p_info* info);
+"""
+
 HEADER_FUNCTIONS = r"""
 /* Every function returns a status (P_OK or one of the codes above) and fills *info when info is not NULL. None
    allocates, prints or keeps state: any number of threads may call them at once. Arrays are column-major. */
