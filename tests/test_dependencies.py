@@ -93,6 +93,7 @@ TOOLING = ("dev", "all", "docs")
 #: Modules of pkm that import an extra's module without checking it themselves, each with its reason.
 UNGUARDED = {
     "pkm/sweeps/store.py": "internal: its callers (pkm.sweep, SweepResult.read) check pkm[sweeps] first",
+    "pkm/serve/wire.py": "internal: its callers (create_app, pkm.client.Client) check pkm[serve] first",
 }
 
 

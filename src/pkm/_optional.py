@@ -9,6 +9,7 @@ kernels, previews); the rest is behind extras, named in ``pyproject.toml``'s ``[
     pip install "pkm[homotopy]"  # every assembly mode (pkm.assembly_modes): Bertini 2 (GPL-3)
     pip install "pkm[bench]"     # the benchmarks' baseline: MuJoCo
     pip install "pkm[identify]"  # identification's physically consistent estimate: cvxpy with Clarabel
+    pip install "pkm[serve]"     # the service (pkm serve) and its client: FastAPI, uvicorn, msgpack, httpx
     pip install "pkm[all]"       # all of them
 
 An extra is checked at the point of use, never at ``import pkm``: :func:`require` raises
@@ -32,6 +33,8 @@ EXTRAS: dict[str, dict[str, str]] = {
     "homotopy": {"bertini": "bertini2"},
     "bench": {"mujoco": "mujoco"},
     "identify": {"cvxpy": "cvxpy", "clarabel": "clarabel"},
+    "serve": {"fastapi": "fastapi", "uvicorn": "uvicorn", "multipart": "python-multipart", "msgpack": "msgpack",
+              "httpx": "httpx", "websockets": "websockets"},
 }
 
 

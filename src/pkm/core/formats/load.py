@@ -1,7 +1,8 @@
 """Loading a mechanism from files: every reader's result put through the builder
 (:mod:`pkm.core.model.builder`). :func:`load_path` (behind :func:`pkm.load`) tries :data:`READERS` in order on a
 file or folder, by content; :func:`load_model_file` reads an MJCF or SDF file alone; :func:`load_gepetto` a
-Gepetto URDF + YAML pair; :func:`load_package_model` a model an installed package ships, by name.
+Gepetto URDF + YAML pair; :func:`load_package_model` a model an installed package ships, by name;
+:func:`load_texts` the same kinds of files given as texts (an upload: no file name reaches the file system).
 
 The readers themselves (:mod:`~pkm.core.formats.imported`, :mod:`~pkm.core.formats.gepetto`,
 :mod:`~pkm.core.formats.packages`) only read files; this module, above the builder, makes mechanisms of them.
@@ -9,15 +10,15 @@ The readers themselves (:mod:`~pkm.core.formats.imported`, :mod:`~pkm.core.forma
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from pkm.core.formats.base import FORMATS, suffixes
+from pkm.core.formats.base import FORMATS, Imported, by_root, suffixes
 from pkm.core.formats.gepetto import find_gepetto, read_gepetto
 from pkm.core.formats.imported import import_model, root_tag, with_file
 from pkm.core.formats.packages import model_file
-from pkm.core.model.builder import from_files, from_strings
+from pkm.core.model.builder import from_files, from_imported, from_strings
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.spec import ClosureSpec, TaskSpec, read_text_file
 from pkm.core.model.urdf import check_urdf
@@ -135,6 +136,57 @@ def load_path(path: Path) -> Mechanism:
             return claim()
         reasons.append(f"  {reader.name}: {claim}")
     raise SpecError(str(path), "no reader takes it:\n" + "\n".join(reasons))
+
+
+def _read_text(name: str, text: str) -> Imported:
+    """A model file given as text: read by the format of its root element, else of its name's suffix."""
+    fmt = FORMATS.get(suffixes().get(Path(name).suffix.lower(), ""), FORMATS["urdf"])
+    fmt = by_root(root_tag(text)) or fmt
+    return fmt.read(text, name)
+
+
+def load_texts(files: Mapping[str, str], source: str = "<upload>") -> Mechanism:
+    """The mechanism of files given as ``{name: text}`` (an upload), read as :func:`load_path` reads them from a
+    folder, without touching the file system (the names are labels: a spec's ``urdf`` must name one of them):
+
+    * a closure spec (``.toml``) and the model file it names (URDF, MJCF or SDF);
+    * a Gepetto pair: a YAML and the URDF beside it (the only ``.urdf``);
+    * an MJCF or SDF file alone (its loops and actuators from the file).
+
+    Raises:
+        SpecError: none of these, or several; a spec naming a file that is not there; what the readers refuse.
+    """
+    names = sorted(files)
+    kind = {n: Path(n).suffix.lower() for n in names}
+    specs = [n for n in names if kind[n] == ".toml"]
+    yamls = [n for n in names if kind[n] in (".yaml", ".yml")]
+    if len(specs) > 1 or len(yamls) > 1 or (specs and yamls):
+        raise SpecError(source, f"give one closure spec (.toml) or one Gepetto YAML, not {specs + yamls}")
+    if specs:
+        spec = ClosureSpec.from_toml(files[specs[0]], f"{source}:{specs[0]}")
+        if spec.urdf not in files:
+            raise SpecError(f"{source}:{specs[0]}", f"urdf = {spec.urdf!r}: not among the files given ({names})")
+        return from_imported(spec, _read_text(spec.urdf, files[spec.urdf]), f"{source}:{specs[0]}")
+    if yamls:
+        urdfs = [n for n in names if kind[n] == ".urdf"]
+        if len(urdfs) != 1:
+            raise SpecError(source, f"a Gepetto YAML goes with one URDF; given {urdfs or 'none'}")
+        imported = _read_text(urdfs[0], files[urdfs[0]])
+        joints = [str(j.get("name")) for j in check_urdf(imported.urdf, urdfs[0]).findall("joint")]
+        spec, read = read_gepetto(files[yamls[0]], urdfs[0], joints, Path(urdfs[0]).stem, f"{source}:{yamls[0]}")
+        return from_strings(imported.urdf, spec, source=f"{source}:{yamls[0]}", notes=imported.notes + read)
+    models = [n for n in names if kind[n] != ".urdf"]
+    if len(names) != 1 or not models:
+        raise SpecError(source, f"give a closure spec with its model file, a Gepetto YAML with its URDF, or an MJCF "
+                                f"or SDF file alone (a URDF alone needs a spec: it cannot hold loops); given {names}")
+    imported = _read_text(names[0], files[names[0]])
+    if imported.format == "urdf" or not imported.actuated:
+        raise SpecError(f"{source}:{names[0]}", "the file names no loop or no actuated joint: send a closure spec "
+                                                "with it")
+    spec = ClosureSpec(mechanism=imported.name, urdf=names[0], end_effector=None, actuated=imported.actuated,
+                       closures=(), task=TaskSpec((), imported.actuated), reference={},
+                       description=f"read from {names[0]} ({imported.format.upper()})")
+    return from_imported(spec, imported, f"{source}:{names[0]}")
 
 
 def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = ()) -> Mechanism:

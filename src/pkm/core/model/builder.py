@@ -25,6 +25,7 @@ from typing import Any
 import pinocchio as pin
 
 from pkm.core.differential.velocity import actuation
+from pkm.core.formats.base import Imported
 from pkm.core.formats.imported import import_model, with_file
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import assemble
@@ -121,10 +122,15 @@ def from_files(spec_path: str | Path) -> Mechanism:
     if not urdf_path.is_relative_to(folder):
         raise SpecError(str(spec_path), f"urdf = {spec.urdf!r} resolves to {urdf_path}, outside the spec's folder "
                                         f"{folder}; copy the URDF next to the spec")
-    imported = import_model(urdf_path)
-    spec = with_file(spec, imported, str(spec_path))
-    model = retype_joints(load_model(imported.urdf, str(urdf_path)), spec.joint_types, str(spec_path))
-    return build(model, spec, None, imported.urdf, str(spec_path), imported.notes)
+    return from_imported(spec, import_model(urdf_path), str(spec_path))
+
+
+def from_imported(spec: ClosureSpec, imported: Imported, source: str) -> Mechanism:
+    """A closure spec and the model file it names, read (:class:`~pkm.core.formats.base.Imported`): what the file
+    states added to the spec, then built (as :func:`from_files` does once it has read both)."""
+    spec = with_file(spec, imported, source)
+    model = retype_joints(load_model(imported.urdf, source), spec.joint_types, source)
+    return build(model, spec, None, imported.urdf, source, imported.notes)
 
 
 def with_actuators(mech: Mechanism, actuators: Mapping[str, Any]) -> Mechanism:

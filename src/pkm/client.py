@@ -1,0 +1,145 @@
+"""A Python client of ``pkm serve``: the library's questions asked of a service (the ``serve`` extra).
+
+``Client(url)`` speaks msgpack (numpy arrays travel as raw bytes) and raises the service's errors as
+:class:`ServiceError` carrying the status, the error's name, its message and data::
+
+    from pkm.client import Client
+    c = Client("http://127.0.0.1:8000")
+    c.models()                                   # registered and uploaded
+    model = c.upload(["ankle.xml", "ankle.closures.toml"])["id"]
+    r = c.fk(model, qa=[[0.1, -0.1], [0.12, -0.1]])  # a batch: q, y, residual, status per sample
+    with c.stream("delta") as s:                 # forward kinematics, rates, efforts per sample
+        s.send(qa=[0.1, 0.2, 0.3], qd=[0, 0, 0], qdd=[1, 0, 0])
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+from pkm.errors import PkmError
+
+
+class ServiceError(PkmError):
+    """An answer of the service that is not a success: ``status`` (HTTP), ``kind`` (the error's name), ``message``,
+    ``data``."""
+
+    def __init__(self, status: int, kind: str, message: str, data: Any = None):
+        self.status, self.kind, self.message, self.data = status, kind, message, data
+        super().__init__(f"{status} {kind}: {message}")
+
+
+class Client:
+    """The service at ``url`` (see the module doc); ``token``: its bearer token, if it asks one."""
+
+    def __init__(self, url: str = "http://127.0.0.1:8000", *, token: str | None = None, timeout: float = 120.0):
+        import httpx
+
+        from pkm._optional import require
+
+        require("serve", "pkm.client", ["httpx", "msgpack"])
+        self.url = url.rstrip("/")
+        self.token = token
+        headers = {"accept": "application/msgpack"}
+        if token:
+            headers["authorization"] = f"Bearer {token}"
+        self._http = httpx.Client(base_url=self.url, headers=headers, timeout=timeout)
+
+    def close(self) -> None:
+        self._http.close()
+
+    def __enter__(self) -> Client:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def _answer(self, response: Any) -> Any:
+        from pkm.serve.wire import MSGPACK, unpack
+
+        body = unpack(response.content) if response.headers.get("content-type", "").startswith(MSGPACK) \
+            else (response.json() if response.content else None)
+        if response.status_code >= 400:
+            body = body if isinstance(body, dict) else {}
+            raise ServiceError(response.status_code, str(body.get("error", "Error")), str(body.get("message", "")),
+                               body.get("data"))
+        return body
+
+    def health(self) -> dict:
+        return self._answer(self._http.get("/health"))
+
+    def models(self) -> list[dict]:
+        """Every model: ``id``, ``kind`` (registered, uploaded), ``name``, ``files``."""
+        return self._answer(self._http.get("/models"))["models"]
+
+    def upload(self, files: Iterable[str | Path] | Mapping[str, bytes]) -> dict:
+        """Upload a model's files (paths, or ``{name: bytes}``); returns its entry (``id``...)."""
+        items = files.items() if isinstance(files, Mapping) else ((Path(p).name, Path(p).read_bytes()) for p in files)
+        return self._answer(self._http.post("/models", files=[("files", (n, d)) for n, d in items]))
+
+    def model(self, model: str) -> dict:
+        """Sizes, names and units of ``model``."""
+        return self._answer(self._http.get(f"/models/{model}"))
+
+    def delete(self, model: str) -> None:
+        self._answer(self._http.delete(f"/models/{model}"))
+
+    def query(self, model: str, query: str, **body: Any) -> dict:
+        """``POST /models/{model}/{query}`` with ``body`` (arrays as numpy arrays or lists)."""
+        from pkm.serve.wire import MSGPACK, pack
+
+        response = self._http.post(f"/models/{model}/{query}", content=pack(body),
+                                   headers={"content-type": MSGPACK})
+        return self._answer(response)
+
+    def fk(self, model: str, qa: Any, seed: Any = None) -> dict:
+        return self.query(model, "fk", qa=qa, seed=seed)
+
+    def ik(self, model: str, y: Any, seed: Any = None, branch: str | None = None) -> dict:
+        return self.query(model, "ik", y=y, seed=seed, branch=branch)
+
+    def jacobians(self, model: str, q: Any) -> dict:
+        return self.query(model, "jacobians", q=q)
+
+    def diagnose(self, model: str, q: Any) -> dict:
+        return self.query(model, "diagnose", q=q)
+
+    def velocities(self, model: str, q: Any, qd: Any) -> dict:
+        return self.query(model, "velocities", q=q, qd=qd)
+
+    def dynamics(self, model: str, q: Any, qd: Any = None, qdd: Any = None) -> dict:
+        return self.query(model, "dynamics", q=q, qd=qd, qdd=qdd)
+
+    def capability(self, model: str, q: Any, kind: str = "wrench") -> dict:
+        return self.query(model, "capability", q=q, kind=kind)
+
+    @contextmanager
+    def stream(self, model: str) -> Iterator[Stream]:
+        """A WebSocket stream over ``model`` (:class:`Stream`)."""
+        from websockets.sync.client import connect
+
+        ws_url = "ws" + self.url[4:] + f"/models/{model}/stream"
+        headers = {"authorization": f"Bearer {self.token}"} if self.token else None
+        with connect(ws_url, additional_headers=headers, max_size=2**24) as ws:
+            yield Stream(ws)
+
+
+class Stream:
+    """An open stream: :meth:`send` one sample and get its answer (``q``, ``y``, ``yd``, ``tau``...)."""
+
+    def __init__(self, ws: Any):
+        self.ws = ws
+
+    def send(self, **sample: Any) -> dict:
+        from pkm.serve.wire import pack, unpack
+
+        self.ws.send(pack(sample))
+        out = unpack(self.ws.recv())
+        if isinstance(out, dict) and "error" in out:
+            raise ServiceError(422, str(out["error"]), str(out.get("message", "")))
+        return out
+
+
+__all__ = ["Client", "ServiceError", "Stream"]

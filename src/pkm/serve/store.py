@@ -1,0 +1,196 @@
+"""The models a service answers about: the registered mechanisms by name, and uploaded ones in a content-addressed
+store.
+
+An upload is a set of files ``{name: bytes}`` (a closure spec and its model file, a Gepetto URDF + YAML pair, an
+MJCF or SDF file alone) read in memory by pkm's loaders (:func:`pkm.core.formats.load.load_texts`): no uploaded name
+reaches the file system. Its id is a hash of the names and contents (the same files give the same id); with a
+folder (``pkm serve --store DIR``) each upload is kept as its blobs (named by their own hashes) and a manifest, and
+read back when the service starts again. Mechanisms are built once and kept in memory.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from pkm.core.model.mechanism import Mechanism
+from pkm.errors import InvalidInputError, SpecError, UnknownNameError
+
+#: Limits of an upload: files, bytes per file, bytes in all.
+MAX_FILES = 8
+MAX_FILE_BYTES = 8 * 2**20
+MAX_UPLOAD_BYTES = 16 * 2**20
+
+
+@dataclass(frozen=True)
+class Entry:
+    """A model the service knows: ``id`` (a registered name, or an upload's hash), ``kind`` (``"registered"`` or
+    ``"uploaded"``), ``files`` (an upload's file names and sizes)."""
+
+    id: str
+    kind: str
+    name: str
+    files: dict[str, int]
+
+
+def upload_id(files: dict[str, bytes]) -> str:
+    """The id of an upload: the first 20 hex digits of SHA-256 over its names and contents, in name order."""
+    h = hashlib.sha256()
+    for name in sorted(files):
+        h.update(name.encode() + b"\0" + hashlib.sha256(files[name]).digest())
+    return h.hexdigest()[:20]
+
+
+class Store:
+    """The registered mechanisms and the uploads (see the module doc); thread-safe.
+
+    Args:
+        folder: Where uploads are kept across restarts (None: in memory only).
+    """
+
+    def __init__(self, folder: str | Path | None = None):
+        from pkm.mechanisms import REGISTRY
+
+        self.folder = None if folder is None else Path(folder)
+        self._lock = threading.Lock()
+        self._mechanisms: dict[str, Mechanism] = {}
+        self._uploads: dict[str, Entry] = {}
+        self._files: dict[str, dict[str, bytes]] = {}
+        self._kernels: dict[str, Any] = {}
+        self.registered = sorted(REGISTRY)
+        if self.folder is not None:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            for manifest in sorted(self.folder.glob("*/manifest.json")):
+                try:
+                    names = json.loads(manifest.read_text())["files"]
+                    files = {n: (manifest.parent / f"{h}.blob").read_bytes() for n, h in names.items()}
+                    self.add(files, persist=False)
+                except (OSError, ValueError, KeyError, SpecError, InvalidInputError):
+                    continue  # (a damaged entry is skipped, never served)
+
+    def entries(self) -> list[Entry]:
+        """Every model: the registered ones, then the uploads."""
+        with self._lock:
+            uploads = list(self._uploads.values())
+        return [Entry(n, "registered", n, {}) for n in self.registered] + uploads
+
+    def add(self, files: dict[str, bytes], *, persist: bool = True) -> Entry:
+        """Read an upload, keep it, return its entry (the same files: the same entry).
+
+        Raises:
+            InvalidInputError: too many or too large files, a name that is not a plain file name, a file that is
+                not UTF-8 text.
+            SpecError: what pkm's loaders refuse.
+        """
+        from pkm.core.formats.load import load_texts
+
+        if not files or len(files) > MAX_FILES:
+            raise InvalidInputError("files", f"send 1 to {MAX_FILES} files", len(files))
+        total = 0
+        texts = {}
+        for name, data in files.items():
+            if not isinstance(name, str) or not name or len(name) > 200 or any(c in name for c in "/\\\0") \
+                    or name in (".", ".."):
+                raise InvalidInputError("files", "a file name must be a plain name (no folder)", name)
+            if len(data) > MAX_FILE_BYTES:
+                raise InvalidInputError(name, f"larger than {MAX_FILE_BYTES} bytes", len(data))
+            total += len(data)
+            try:
+                texts[name] = data.decode("utf-8")
+            except UnicodeDecodeError as e:
+                raise InvalidInputError(name, f"not UTF-8 text (byte {e.start})") from None
+        if total > MAX_UPLOAD_BYTES:
+            raise InvalidInputError("files", f"larger than {MAX_UPLOAD_BYTES} bytes in all", total)
+        key = upload_id(files)
+        with self._lock:
+            if key in self._uploads:
+                return self._uploads[key]
+        mech = load_texts(texts, source=f"upload {key}")
+        entry = Entry(key, "uploaded", mech.name, {n: len(d) for n, d in files.items()})
+        with self._lock:
+            self._uploads[key] = entry
+            self._mechanisms[key] = mech
+            self._files[key] = dict(files)
+        if persist and self.folder is not None:
+            place = self.folder / key
+            place.mkdir(exist_ok=True)
+            hashes = {}
+            for name, data in files.items():
+                h = hashlib.sha256(data).hexdigest()
+                (place / f"{h}.blob").write_bytes(data)
+                hashes[name] = h
+            (place / "manifest.json").write_text(json.dumps({"files": hashes}))
+        return entry
+
+    def entry(self, model: str) -> Entry:
+        """The entry of ``model``.
+
+        Raises:
+            UnknownNameError: no such model.
+        """
+        if model in self.registered:
+            return Entry(model, "registered", model, {})
+        with self._lock:
+            if model in self._uploads:
+                return self._uploads[model]
+        raise UnknownNameError("model", str(model), [e.id for e in self.entries()])
+
+    def files(self, model: str) -> dict[str, bytes]:
+        """An upload's files (``{}`` for a registered mechanism)."""
+        self.entry(model)
+        with self._lock:
+            return dict(self._files.get(model, {}))
+
+    def mechanism(self, model: str) -> Mechanism:
+        """The mechanism of ``model`` (built once)."""
+        import pkm
+
+        self.entry(model)
+        with self._lock:
+            if model in self._mechanisms:
+                return self._mechanisms[model]
+        mech = pkm.load(model)
+        with self._lock:
+            return self._mechanisms.setdefault(model, mech)
+
+    def kernels(self, model: str) -> Any:
+        """The compiled kernels of ``model`` for streams (:func:`pkm.serve.stream.kernels_for`), built once; None
+        where they do not build."""
+        from pkm.serve.stream import kernels_for
+
+        mech = self.mechanism(model)
+        with self._lock:
+            if model in self._kernels:
+                return self._kernels[model]
+        K = kernels_for(mech)
+        with self._lock:
+            return self._kernels.setdefault(model, K)
+
+    def delete(self, model: str) -> None:
+        """Forget an upload (and its kept files).
+
+        Raises:
+            UnknownNameError: no such upload.
+            InvalidInputError: a registered mechanism (they cannot be deleted).
+        """
+        if model in self.registered:
+            raise InvalidInputError("model", "a registered mechanism cannot be deleted", model)
+        self.entry(model)
+        with self._lock:
+            self._uploads.pop(model, None)
+            self._mechanisms.pop(model, None)
+            self._files.pop(model, None)
+            self._kernels.pop(model, None)
+        if self.folder is not None:
+            place = self.folder / model
+            for f in place.glob("*"):
+                f.unlink()
+            if place.exists():
+                place.rmdir()
+
+
+__all__ = ["MAX_FILES", "MAX_FILE_BYTES", "MAX_UPLOAD_BYTES", "Entry", "Store", "upload_id"]

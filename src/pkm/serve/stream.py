@@ -1,0 +1,100 @@
+"""The state of one WebSocket stream: actuator samples in, forward kinematics, task rates and efforts out.
+
+Each message is a map with ``qa`` (the actuated coordinates) and optionally ``qd`` (their rates) and ``qdd`` (their
+accelerations); the answer has ``q`` and ``y`` (the configuration and the task value, the loops closed from the
+previous sample's configuration: a stream stays on its assembly mode), the closure ``residual``, with ``qd`` the task
+rates ``yd``, with ``qd`` and ``qdd`` the actuator efforts ``tau`` (``M_a qdd + h_a``), and ``compute_s``.
+
+Where the mechanism's compiled kernels build (:class:`pkm.Kernels`: a C compiler, no idle motion), a sample is the
+kernels' (the closure's Newton warm-started in C, the Jacobian and ``M_a``, ``h_a`` from their generated C), each
+checked as the library checks it (a sample the kernels hand back goes to :func:`pkm.close_loops`); otherwise the
+library's Python routes.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from pkm.core.model.mechanism import Mechanism
+from pkm.errors import InvalidInputError
+
+
+class Stream:
+    """One stream over ``mech``, warm-started from ``seed`` (default the reference configuration)."""
+
+    def __init__(self, mech: Mechanism, seed: np.ndarray | None = None, kernels: Any = None):
+        self.mech = mech
+        self.q = mech.q_reference.copy() if seed is None else np.asarray(seed, dtype=float)
+        self.kernels = kernels
+
+    def _vector(self, sample: Mapping[str, Any], key: str) -> np.ndarray | None:
+        if key not in sample or sample[key] is None:
+            return None
+        try:
+            v = np.asarray(sample[key], dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise InvalidInputError(key, f"expected {self.mech.na} numbers", str(sample[key])[:100]) from None
+        if v.shape != (self.mech.na,) or not np.all(np.isfinite(v)):
+            raise InvalidInputError(key, f"expected {self.mech.na} finite numbers", v.tolist()[:20])
+        return v
+
+    def step(self, sample: Any) -> dict[str, Any]:
+        """The answer to one message (see the module doc).
+
+        Raises:
+            InvalidInputError: a malformed message; ConvergenceError and the other solve errors of
+                :func:`pkm.close_loops` (the stream keeps its last configuration).
+        """
+        from pkm.core.differential.velocity import forward_jacobian
+        from pkm.core.dynamics.model import actuator_model
+        from pkm.core.kinematics.solve import close_loops
+
+        if not isinstance(sample, Mapping):
+            raise InvalidInputError("message", "a map with qa (and qd, qdd)", str(sample)[:100])
+        t0 = time.perf_counter()
+        qa = self._vector(sample, "qa")
+        if qa is None:
+            raise InvalidInputError("qa", f"missing: give {self.mech.na} numbers")
+        qd, qdd = self._vector(sample, "qd"), self._vector(sample, "qdd")
+        K = self.kernels
+        if K is not None:
+            path = K.close_loops_path(qa[None], self.q)
+            q, residual = path.q[0], float(path.residual[0])
+        else:
+            r = close_loops(self.mech, qa, self.q)
+            q, residual = r.q, r.residual
+        self.q = q
+        out: dict[str, Any] = {"q": q, "y": self.mech.task_map.value(q), "residual": residual}
+        if qd is not None:
+            out["yd"] = (K.forward_jacobian(q) if K is not None else forward_jacobian(self.mech, q)) @ qd
+            if qdd is not None:
+                if K is not None:
+                    out["tau"] = K.inverse_dynamics(q, qd, qdd)
+                else:
+                    m = actuator_model(self.mech, q, qd)
+                    out["tau"] = m.M @ qdd + m.h
+        out["compute_s"] = time.perf_counter() - t0
+        return out
+
+
+def kernels_for(mech: Mechanism) -> Any:
+    """The compiled kernels a stream over ``mech`` uses, built and compiled now (None where they do not build: no
+    C compiler, idle motions)."""
+    from pkm.core.twin import Kernels
+    from pkm.errors import PkmError
+
+    try:
+        K = Kernels(mech)
+        for name in ("closure_newton", "forward_jacobian", "inverse_dynamics"):
+            if K.kernel(name).lib is None:
+                return None
+        return K
+    except PkmError:
+        return None
+
+
+__all__ = ["Stream", "kernels_for"]

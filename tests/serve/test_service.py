@@ -1,0 +1,179 @@
+"""``pkm serve`` through a real uvicorn on a free local port (tests/serve/conftest.py): every endpoint through the
+client (msgpack) and over raw HTTP (JSON) and WebSocket, answers equal to the library's in-process calls, and bad
+requests answered 4xx with their message (never a 500, never a traceback)."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+from pathlib import Path
+
+import httpx
+import numpy as np
+import pytest
+
+import pkm
+from tests.serve.conftest import TOKEN
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+AUTH = {"authorization": f"Bearer {TOKEN}"}
+
+
+@pytest.fixture(scope="module")
+def delta():
+    return pkm.load("delta")
+
+
+def _path(mech, n=5):
+    return mech.actuated_q(mech.q_reference) + 0.02 * np.arange(1, n + 1)[:, None] * np.array([1.0, -0.5, 0.3])
+
+
+def test_health_is_open_and_everything_else_needs_the_token(service):
+    assert httpx.get(service.url + "/health").json()["status"] == "ok"
+    for path in ("/models", "/models/delta", "/openapi.json"):
+        r = httpx.get(service.url + path)
+        assert r.status_code == 401 and r.json()["error"] == "Unauthorized"
+    assert httpx.get(service.url + "/models", headers={"authorization": "Bearer wrong"}).status_code == 401
+    schema = httpx.get(service.url + "/openapi.json", headers=AUTH).json()
+    assert {"/models", "/models/{model}/{query}", "/models/{model}/preview"} <= set(schema["paths"])
+
+
+def test_the_queries_answer_what_the_library_does(client, delta):
+    models = {m["id"]: m for m in client.models()}
+    assert {"delta", "rrr3", "prs3", "hexapod", "gough_stewart"} <= set(models)
+    about = client.model("delta")
+    assert about["na"] == 3 and about["task_units"] == {"x": "m", "y": "m", "z": "m"}
+    qa = _path(delta)
+    fk = client.fk("delta", qa)
+    q, previous = [], delta.q_reference
+    for a in qa:  # each sample from the previous solution, as the service solves a batch
+        previous = pkm.close_loops(delta, a, previous).q
+        q.append(previous)
+    assert fk["status"] == ["ok"] * 5 and np.abs(fk["q"] - np.array(q)).max() <= 1e-12
+    assert fk["residual"].max() <= 1e-10 and fk["compute_s"] > 0 and fk["units"]["y"] == ["m", "m", "m"]
+    ik = client.ik("delta", fk["y"])
+    assert np.abs(ik["qa"] - qa).max() <= 1e-9
+    jac = client.jacobians("delta", fk["q"][:2])
+    assert np.abs(jac["J"][1] - pkm.forward_jacobian(delta, fk["q"][1])).max() <= 1e-12
+    assert np.abs(jac["K"][0] - pkm.inverse_jacobian(delta, fk["q"][0])).max() <= 1e-12
+    diag = client.diagnose("delta", fk["q"][0])
+    assert diag["direct_distance"][0] == pytest.approx(pkm.diagnose(delta, fk["q"][0]).direct_distance, rel=1e-12)
+    qd, qdd = np.array([0.1, -0.2, 0.3]), np.array([1.0, 0.5, -0.5])
+    vel = client.velocities("delta", fk["q"], qd)  # (one qd for every sample)
+    assert np.abs(vel["v"][2] - pkm.velocities(delta, fk["q"][2], qd)).max() <= 1e-12
+    dyn = client.dynamics("delta", fk["q"][:2], qd, qdd)
+    model = pkm.actuator_model(delta, fk["q"][1], qd)
+    assert np.abs(dyn["tau"][1] - (model.M @ qdd + model.h)).max() <= 1e-12 and dyn["units"]["tau"] == ["N m"] * 3
+    cap = client.capability("delta", fk["q"][0], "twist")
+    c = pkm.capability(delta, fk["q"][0], "twist")
+    assert np.allclose(cap["along"][0], np.array(list(c.along.values())), rtol=1e-12) and cap["axes"] == ["x", "y", "z"]
+    raw = httpx.post(client.url + "/models/delta/fk", json={"qa": qa.tolist()}, headers=AUTH).json()  # JSON
+    assert np.abs(np.array(raw["q"]) - fk["q"]).max() == 0.0
+
+
+def test_a_failing_sample_does_not_fail_the_batch(client, delta):
+    y = [[0.0, 0.0, -0.35], [0.0, 0.0, -3.0]]  # (the second 3 m down: out of reach)
+    out = client.ik("delta", y)
+    assert out["status"] == ["ok", "failed"] and [f["sample"] for f in out["failures"]] == [1]
+    assert out["failures"][0]["error"] in ("ConvergenceError", "UnreachableError")
+    assert np.isnan(out["q"][1]).all() and np.isfinite(out["q"][0]).all()
+
+
+def test_uploads_are_content_addressed_kept_and_deleted(client, service, tmp_path):
+    from pkm.client import ServiceError
+    from pkm.serve.store import Store
+
+    files = [EXAMPLES / "humanoid_ankle" / "ankle.xml", EXAMPLES / "humanoid_ankle" / "ankle.closures.toml"]
+    entry = client.upload(files)
+    assert client.upload(files)["id"] == entry["id"] and entry["name"] == "humanoid_ankle"
+    assert entry["id"] in {m["id"] for m in client.models()}
+    assert set(client._answer(client._http.get(f"/models/{entry['id']}/files"))["files"]) == {f.name for f in files}
+    out = client.fk(entry["id"], [0.1, -0.1])
+    mech = pkm.load(files[1])
+    assert np.abs(out["y"][0] - mech.task_map.value(pkm.close_loops(mech, [0.1, -0.1]).q)).max() <= 1e-12
+    page = httpx.get(f"{client.url}/models/{entry['id']}/preview", headers=AUTH)
+    assert page.status_code == 200 and "<html" in page.text.lower()
+    again = Store(service_store(service))  # (a new service on the same folder serves it again)
+    assert entry["id"] in {e.id for e in again.entries()}
+    client.delete(entry["id"])
+    with pytest.raises(ServiceError) as e:
+        client.fk(entry["id"], [0.1, -0.1])
+    assert e.value.status == 404
+
+
+def service_store(service) -> Path:
+    return service.store_folder
+
+
+@pytest.mark.parametrize(("files", "status", "says"), [
+    ({"../../evil.urdf": b"<robot name='x'/>"}, 422, "plain name"),
+    ({"a.urdf": b"\xff\xfe\x00"}, 422, "UTF-8"),
+    ({"robot.xml": b"<?xml version='1.0'?><!DOCTYPE lolz [<!ENTITY lol 'lol'><!ENTITY lol2 '&lol;&lol;&lol;'>]>"
+                   b"<mujoco><worldbody/></mujoco>"}, 422, ""),
+    ({"x.closures.toml": b'format = "pkm.closures/1"\nurdf = "../../etc/passwd"\n'}, 422, ""),
+    ({"only.urdf": b"<robot name='r'><link name='a'/></robot>"}, 422, "spec"),
+])
+def test_bad_uploads_are_refused(service, files, status, says, tmp_path):
+    r = httpx.post(service.url + "/models", files=[("files", (n, d)) for n, d in files.items()], headers=AUTH)
+    assert r.status_code == status, r.text
+    assert says in r.json()["message"] and "Traceback" not in r.text
+    assert not (tmp_path.parent / "evil.urdf").exists()
+
+
+@pytest.mark.parametrize(("path", "body", "headers", "status"), [
+    ("/models/delta/fk", b"{bad json", {}, 400),
+    ("/models/delta/fk", b"\xc1\xc1", {"content-type": "application/msgpack"}, 400),
+    ("/models/delta/fk", json.dumps({"qa": [1, 2]}).encode(), {}, 422),
+    ("/models/delta/fk", json.dumps({"qa": [[1, 2, "x"]]}).encode(), {}, 422),
+    ("/models/delta/fk", json.dumps({"qa": [1, 2, float("nan")]}).encode().replace(b"NaN", b"1e999"), {}, 422),
+    ("/models/delta/fk", json.dumps([1, 2, 3]).encode(), {}, 400),
+    ("/models/delta/teleport", b"{}", {}, 404),
+    ("/models/nope/fk", json.dumps({"qa": [1, 2, 3]}).encode(), {}, 404),
+    ("/models/delta/capability", json.dumps({"q": [0.0] * 15, "kind": "power"}).encode(), {}, 422),
+    ("/models/delta/fk", b"x" * (2**20 + 10), {}, 413),
+])
+def test_bad_requests_are_4xx_with_their_message(service, path, body, headers, status):
+    r = httpx.post(service.url + path, content=body, headers={**AUTH, **headers})
+    assert r.status_code == status, r.text
+    answer = r.json()
+    assert answer["message"] and "Traceback" not in r.text
+    assert httpx.get(service.url + "/health").status_code == 200  # (still answering)
+
+
+def test_the_stream_warm_starts_and_answers_bad_messages(client, service, delta):
+    from websockets.sync.client import connect
+
+    qa = _path(delta, 3)
+    with client.stream("delta") as s:
+        answers = [s.send(qa=a, qd=[0.1, 0.0, 0.0], qdd=[1.0, 0.0, 0.0]) for a in qa]
+    q = pkm.close_loops(delta, qa[0], delta.q_reference).q
+    assert np.abs(answers[0]["q"] - q).max() <= 1e-10 and answers[0]["residual"] <= 1e-10
+    model = pkm.actuator_model(delta, answers[2]["q"], np.array([0.1, 0.0, 0.0]))
+    assert np.abs(answers[2]["tau"] - (model.M @ np.array([1.0, 0.0, 0.0]) + model.h)).max() <= 1e-12
+    url = "ws" + service.url[4:] + "/models/delta/stream"
+    with connect(url, additional_headers=AUTH) as ws:  # JSON text, a bad message, then a good one
+        ws.send(json.dumps({"qa": [1, 2]}))
+        assert json.loads(ws.recv())["error"] == "InvalidInputError"
+        ws.send("not json")
+        assert json.loads(ws.recv())["error"] == "BadMessage"
+        ws.send(json.dumps({"qa": qa[0].tolist()}))
+        assert np.abs(np.array(json.loads(ws.recv())["q"]) - q).max() <= 1e-10
+    from websockets.exceptions import InvalidStatus
+
+    with pytest.raises(InvalidStatus) as refused, connect(url):  # (no token: refused before the handshake ends)
+        pass
+    assert refused.value.response.status_code == 403
+
+
+def test_the_limiter_answers_busy_when_the_queue_is_full():
+    from pkm.serve.app import Limiter, _Busy
+
+    async def main() -> list:
+        import time
+
+        limiter = Limiter(workers=1, queue=1)
+        slow = lambda: time.sleep(0.2)
+        return await asyncio.gather(limiter.run(slow), limiter.run(slow), limiter.run(slow), return_exceptions=True)
+
+    results = asyncio.run(main())
+    assert sum(isinstance(r, _Busy) for r in results) == 1 and results.count(None) == 2
