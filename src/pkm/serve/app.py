@@ -6,7 +6,8 @@ is its maintained server (graceful shutdown on SIGTERM: in-flight requests finis
 
 Endpoints (see ``/docs``): ``GET /health``; ``GET /models``; ``POST /models`` (an upload: multipart files);
 ``GET /models/{model}`` (sizes, names, units); ``GET /models/{model}/files``; ``DELETE /models/{model}``;
-``GET /models/{model}/preview`` (the self-contained 3-D page); ``POST /models/{model}/{query}`` for every query of
+``GET /models/{model}/preview`` (the self-contained 3-D page); ``GET /`` (the design page,
+:mod:`pkm.serve.page`); ``POST /models/{model}/{query}`` for every query of
 :data:`pkm.serve.queries.QUERIES` (one sample or a batch); ``WS /models/{model}/stream`` (actuator samples in, the
 forward kinematics, task rates and efforts out, warm-started along the stream).
 
@@ -172,10 +173,17 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
 
     @app.middleware("http")
     async def auth(request: Request, call_next: Callable) -> Any:
-        if token is not None and request.url.path != "/health" \
-                and request.headers.get("authorization") != f"Bearer {token}":
+        given = request.headers.get("authorization") == f"Bearer {token}" \
+            or (request.method == "GET" and request.query_params.get("token") == token)  # (a page's iframe)
+        if token is not None and request.url.path not in ("/", "/health") and not given:
             return _error(401, "Unauthorized", "give the service's token: Authorization: Bearer <token>")
         return await call_next(request)
+
+    @app.get("/", response_class=HTMLResponse)
+    async def design_page() -> Response:
+        from pkm.serve.page import PAGE
+
+        return HTMLResponse(PAGE)
 
     @app.get("/health")
     async def health() -> dict:

@@ -9,6 +9,7 @@ bad one is a :class:`~pkm.errors.PkmError` naming the field, which the service a
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -237,10 +238,31 @@ def capability(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+_SCENES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def scene(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
+    """At configurations ``q``: the world placement of every body of the model's 3-D scene (the preview page's,
+    :class:`pkm.viz.scene.Scene`), as ``paths`` (meshcat paths) and ``matrices`` (per sample and body, 16 numbers
+    column-major, as meshcat's ``set_transform`` takes them)."""
+    from pkm.viz.scene import Scene
+
+    q = _array(body, "q", mech.nq)
+    if mech not in _SCENES:
+        _SCENES[mech] = Scene.from_mechanism(mech)
+    sc = _SCENES[mech]
+    paths = [b.path for b in sc.bodies]
+    matrices = []
+    for k in range(len(q)):
+        placed = sc.transforms(mech.check_q(q[k]))
+        matrices.append([np.asarray(placed[p]).T.ravel() for p in paths])
+    return {"paths": paths, "matrices": np.array(matrices)}
+
+
 #: The queries by name (the endpoints ``POST /models/{model}/{name}``).
 QUERIES: dict[str, Callable[[Mechanism, Mapping[str, Any]], dict[str, Any]]] = {
     "fk": fk, "ik": ik, "jacobians": jacobians, "diagnose": diagnose, "velocities": velocities,
-    "dynamics": dynamics, "capability": capability}
+    "dynamics": dynamics, "capability": capability, "scene": scene}
 
 
 def describe(mech: Mechanism) -> dict[str, Any]:
@@ -248,6 +270,7 @@ def describe(mech: Mechanism) -> dict[str, Any]:
     reference configuration, the branches."""
     return {"name": mech.name, "nq": mech.nq, "nv": mech.nv, "na": mech.na,
             "joints": list(mech.joints), "actuated": list(mech.actuated_names),
+            "actuated_q": [int(i) for i in mech.act_q],
             "actuated_units": [_unit(mech, j) for j in mech.actuated_names],
             "task": list(mech.task_map.keys), "task_units": _task_units(mech),
             "task_value_names": list(mech.task_map.value_names), "q_reference": mech.q_reference,

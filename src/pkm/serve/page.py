@@ -1,0 +1,177 @@
+"""The design page the service serves at ``/``: choose a model (or upload one), move its actuators with sliders, and
+see the mechanism follow in the 3-D view, with its task coordinates and its distances to the singularities.
+
+The page is static HTML and JavaScript, no build step, no third-party code besides what the service already ships:
+the 3-D view is the model's own preview page (``/models/{model}/preview``: meshcat's viewer with the scene, in an
+``iframe`` of the same origin), whose bodies the page moves with ``set_transform`` commands from the service's
+``scene`` query. Each slider move asks ``fk`` (warm-started from the last configuration, so the mechanism stays on
+its assembly mode), then ``scene`` and ``diagnose``; moves made while a request is in flight are coalesced into the
+next one. A token, when the service asks one, is given in the page's address: ``/?token=...``.
+
+``window.pkmState`` exposes the page's state to tests (a real browser drives it in ``tests/serve/test_page.py``):
+the model, the configuration shown, the number of updates, and the errors met.
+"""
+
+PAGE = r"""<!DOCTYPE html>
+<html>
+<head>
+<meta charset="utf-8">
+<title>pkm: design</title>
+<link rel="icon" href="data:,">
+<style>
+body { margin: 0; font: 13px sans-serif; color: #222; display: flex; height: 100vh; }
+#side { width: 300px; padding: 10px 12px; overflow-y: auto; background: #f4f4f4; border-right: 1px solid #ccc; }
+#side h1 { font-size: 16px; margin: 0 0 8px; }
+#side label { display: block; margin: 6px 0 2px; }
+#side input[type=range] { width: 100%; }
+#side table { border-collapse: collapse; margin-top: 6px; }
+#side td { padding: 1px 6px 1px 0; }
+#status { margin-top: 8px; color: #555; min-height: 1.2em; }
+#status.error { color: #b00; }
+#view { flex: 1; border: 0; height: 100vh; }
+</style>
+</head>
+<body>
+<div id="side">
+  <h1>pkm: design</h1>
+  <label>model <select id="model"></select></label>
+  <form id="upload"><label>upload (spec + model file, Gepetto pair, MJCF, SDF)</label>
+    <input type="file" id="files" multiple> <button type="submit">upload</button></form>
+  <div id="sliders"></div>
+  <table id="readout"></table>
+  <div id="status"></div>
+</div>
+<iframe id="view" title="3-D view"></iframe>
+<script>
+"use strict";
+const token = new URLSearchParams(location.search).get("token");
+const auth = token ? {"authorization": "Bearer " + token} : {};
+const state = window.pkmState = {model: null, about: null, q: null, updates: 0, errors: [], busy: false,
+                                 pending: false, paths: null};
+
+function say(text, error) {
+  const s = document.getElementById("status");
+  s.textContent = text;
+  s.className = error ? "error" : "";
+  if (error) state.errors.push(text);
+}
+
+async function api(method, path, body) {
+  const options = {method: method, headers: Object.assign({}, auth)};
+  if (body !== undefined) {
+    options.headers["content-type"] = "application/json";
+    options.body = JSON.stringify(body);
+  }
+  const r = await fetch(path, options);
+  const answer = await r.json();
+  if (!r.ok) throw new Error(answer.message || r.statusText);
+  return answer;
+}
+
+function fmt(x) { return typeof x === "number" ? x.toPrecision(5) : String(x); }
+
+async function loadModels(select) {
+  const list = (await api("GET", "/models")).models;
+  const box = document.getElementById("model");
+  box.innerHTML = "";
+  for (const m of list) {
+    const o = document.createElement("option");
+    o.value = m.id;
+    o.textContent = m.kind === "uploaded" ? m.name + " (" + m.id.slice(0, 8) + ")" : m.id;
+    box.appendChild(o);
+  }
+  box.value = select || list[0].id;
+  await selectModel(box.value);
+}
+
+async function selectModel(id) {
+  const about = await api("GET", "/models/" + id);
+  state.model = id; state.about = about; state.q = about.q_reference; state.paths = null;
+  const sliders = document.getElementById("sliders");
+  sliders.innerHTML = "";
+  about.actuated.forEach(function (name, k) {
+    const value = qaOf(about, about.q_reference)[k];
+    const unit = about.actuated_units[k];
+    const limits = about.limits[name];
+    const span = unit === "rad" ? 1.0 : 0.1;
+    const lo = limits ? Math.max(limits[0], value - span) : value - span;
+    const hi = limits ? Math.min(limits[1], value + span) : value + span;
+    const label = document.createElement("label");
+    label.textContent = name + " [" + unit + "]";
+    const input = document.createElement("input");
+    Object.assign(input, {type: "range", min: lo, max: hi, step: (hi - lo) / 1000, value: value, id: "qa-" + k});
+    input.addEventListener("input", schedule);
+    sliders.appendChild(label);
+    sliders.appendChild(input);
+  });
+  const view = document.getElementById("view");
+  const loaded = new Promise(function (resolve) { view.onload = resolve; });
+  view.src = "/models/" + id + "/preview" + (token ? "?token=" + encodeURIComponent(token) : "");
+  await loaded;
+  await update();
+}
+
+function qaOf(about, q) {
+  return about.actuated_q.map(function (i) { return q[i]; });
+}
+
+function schedule() {
+  if (state.busy) { state.pending = true; return; }
+  update();
+}
+
+async function update() {
+  state.busy = true;
+  try {
+    const about = state.about;
+    const qa = about.actuated.map(function (_, k) { return parseFloat(document.getElementById("qa-" + k).value); });
+    const fk = await api("POST", "/models/" + state.model + "/fk", {qa: qa, seed: state.q});
+    if (fk.status[0] !== "ok") {
+      say(fk.failures[0].message, false);
+      return;
+    }
+    state.q = fk.q[0];
+    const scene = await api("POST", "/models/" + state.model + "/scene", {q: state.q});
+    const viewer = document.getElementById("view").contentWindow.viewer;
+    scene.paths.forEach(function (path, b) {
+      viewer.handle_command({type: "set_transform", path: path, matrix: scene.matrices[0][b]});
+    });
+    const diag = await api("POST", "/models/" + state.model + "/diagnose", {q: state.q});
+    const rows = about.task.map(function (name, k) {
+      return "<tr><td>" + name + "</td><td>" + fmt(fk.y[0][k]) + " " + about.task_units[name] + "</td></tr>";
+    });
+    rows.push("<tr><td>direct singularity</td><td>" + fmt(diag.direct_distance[0]) + "</td></tr>");
+    rows.push("<tr><td>inverse singularity</td><td>" + fmt(diag.inverse_distance[0]) + "</td></tr>");
+    rows.push("<tr><td>closure residual</td><td>" + fmt(fk.residual[0]) + " m or rad</td></tr>");
+    document.getElementById("readout").innerHTML = rows.join("");
+    state.updates += 1;
+    say("fk " + (fk.compute_s * 1e3).toFixed(2) + " ms", false);
+  } catch (e) {
+    say(e.message, true);
+  } finally {
+    state.busy = false;
+    if (state.pending) { state.pending = false; update(); }
+  }
+}
+
+document.getElementById("model").addEventListener("change", function (e) {
+  selectModel(e.target.value).catch(function (err) { say(err.message, true); });
+});
+document.getElementById("upload").addEventListener("submit", async function (e) {
+  e.preventDefault();
+  const form = new FormData();
+  for (const f of document.getElementById("files").files) form.append("files", f);
+  try {
+    const r = await fetch("/models", {method: "POST", headers: auth, body: form});
+    const answer = await r.json();
+    if (!r.ok) throw new Error(answer.message);
+    await loadModels(answer.id);
+  } catch (err) { say(err.message, true); }
+});
+loadModels(new URLSearchParams(location.search).get("model")).catch(function (e) { say(e.message, true); });
+</script>
+</body>
+</html>
+"""
+
+__all__ = ["PAGE"]
