@@ -33,8 +33,8 @@ EXTRAS: dict[str, dict[str, str]] = {
     "homotopy": {"bertini": "bertini2"},
     "bench": {"mujoco": "mujoco"},
     "identify": {"cvxpy": "cvxpy", "clarabel": "clarabel"},
-    "serve": {"fastapi": "fastapi", "uvicorn": "uvicorn", "multipart": "python-multipart", "msgpack": "msgpack",
-              "httpx": "httpx", "websockets": "websockets"},
+    "serve": {"fastapi": "fastapi", "starlette": "starlette", "uvicorn": "uvicorn", "multipart": "python-multipart",
+              "msgpack": "msgpack", "httpx": "httpx", "websockets": "websockets"},
 }
 
 

@@ -177,3 +177,13 @@ def test_the_limiter_answers_busy_when_the_queue_is_full():
 
     results = asyncio.run(main())
     assert sum(isinstance(r, _Busy) for r in results) == 1 and results.count(None) == 2
+
+
+def test_a_short_fuzz_gets_no_500_and_the_service_goes_on(service):
+    """300 malformed requests (:mod:`pkm.serve.fuzz`; CI sends 10,000 to a service of its own): none answered 500,
+    every error JSON with a message, the service answering afterwards."""
+    from pkm.serve.fuzz import fuzz
+
+    out = fuzz(service.url, 300, token=TOKEN, seed=1)
+    assert out["failures"] == [] and out["alive"]
+    assert {400, 401, 404, 413, 422} <= set(out["statuses"])

@@ -30,7 +30,7 @@ import numpy as np
 
 from pkm.bench import median_us
 
-QUICK = {"n": 2000, "calls": 20, "mechanism": ["humanoid_ankle", "delta"]}
+QUICK = {"n": 1000, "calls": 10, "mechanism": ["delta"]}
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 MECHANISMS = ("humanoid_ankle", "humanoid_knee", "delta")
 #: What each C function is timed against.

@@ -24,6 +24,7 @@ never a traceback; a body over ``max_body`` bytes is 413; a bearer token, when s
 # inside create_app, when pkm[serve] is known to be installed)
 import asyncio
 import json
+import signal
 import time
 from collections.abc import Callable
 from typing import Any
@@ -123,6 +124,7 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
     from fastapi import FastAPI, Request, WebSocket, WebSocketDisconnect
     from fastapi.exceptions import RequestValidationError
     from fastapi.responses import HTMLResponse, JSONResponse, Response
+    from starlette.exceptions import HTTPException as StarletteHTTPException
 
     from pkm import __version__
     from pkm.serve.queries import QUERIES, describe
@@ -131,7 +133,6 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
     limiter = Limiter(workers, queue)
     app = FastAPI(title="pkm", version=__version__,
                   description="Kinematics and dynamics of closed-loop mechanisms: models, queries, streams.")
-    app.add_middleware(SizeLimit, max_body=max_body)
 
     def answer(request: Request, payload: Any, status: int = 200) -> Response:
         if MSGPACK in request.headers.get("accept", ""):
@@ -178,6 +179,13 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
         if token is not None and request.url.path not in ("/", "/health") and not given:
             return _error(401, "Unauthorized", "give the service's token: Authorization: Bearer <token>")
         return await call_next(request)
+
+    app.add_middleware(SizeLimit, max_body=max_body)  # (added last: the outermost, before any other reads)
+
+    @app.exception_handler(StarletteHTTPException)
+    async def http_errors(request: Request, e: StarletteHTTPException) -> Any:  # (no such route, method)
+        return _error(e.status_code, "NotFound" if e.status_code == 404 else "HTTPError",
+                      f"{request.method} {request.url.path}: {e.detail}")
 
     @app.get("/", response_class=HTMLResponse)
     async def design_page() -> Response:
@@ -292,6 +300,9 @@ def serve(host: str = "127.0.0.1", port: int = 8000, *, store: str | None = None
     import uvicorn
 
     app = create_app(Store(store), token=token, workers=workers, queue=queue, max_body=max_body)
+    # uvicorn drains on SIGTERM, then raises the signal again with the handler it found: a quiet one here, so that a
+    # drained stop exits 0
+    signal.signal(signal.SIGTERM, lambda signum, frame: None)
     uvicorn.run(app, host=host, port=port, log_level="warning", timeout_graceful_shutdown=30)
 
 

@@ -26,11 +26,11 @@ def run(args: argparse.Namespace) -> int:
     if not 1 <= args.workers <= 64 or not 0 <= args.queue <= 10_000 or not 0 < args.port < 65536:
         raise InvalidInputError("--workers", "workers 1..64, queue 0..10000, port 1..65535",
                                 (args.workers, args.queue, args.port))
-    print(f"pkm serve on http://{args.host}:{args.port} (docs: /docs; Ctrl-C stops it)", flush=True)
-    try:
+    try:  # (Ctrl-C from the first line on: a stop like any other)
+        print(f"pkm serve on http://{args.host}:{args.port} (docs: /docs; Ctrl-C stops it)", flush=True)
         serve(args.host, args.port, store=args.store, workers=args.workers, queue=args.queue,
               token=args.token or os.environ.get("PKM_SERVE_TOKEN"))
-    except KeyboardInterrupt:  # (Ctrl-C while starting: a stop like any other)
+    except KeyboardInterrupt:
         pass
     return 0
 

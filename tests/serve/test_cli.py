@@ -1,0 +1,47 @@
+"""``pkm serve`` as a process: it binds to 127.0.0.1, answers, and on SIGTERM finishes the request in flight before
+it exits (status 0)."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import httpx
+import numpy as np
+
+import pkm
+from tests.serve.conftest import free_port
+
+
+def test_sigterm_drains_the_request_in_flight():
+    port = free_port()
+    proc = subprocess.Popen([sys.executable, "-m", "pkm", "serve", "--port", str(port)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        assert f"http://127.0.0.1:{port}" in proc.stdout.readline()
+        url = f"http://127.0.0.1:{port}"
+        for _ in range(200):
+            try:
+                if httpx.get(url + "/health").status_code == 200:
+                    break
+            except httpx.TransportError:
+                time.sleep(0.05)
+        delta = pkm.load("delta")
+        qa = delta.actuated_q(delta.q_reference) + 0.1 * np.sin(np.linspace(0, 6, 4000))[:, None]
+        answer = {}
+
+        def slow() -> None:  # (4,000 samples: about a second of work)
+            answer["r"] = httpx.post(url + "/models/delta/fk", json={"qa": qa.tolist()}, timeout=120)
+
+        t = threading.Thread(target=slow)
+        t.start()
+        time.sleep(0.3)
+        proc.send_signal(signal.SIGTERM)
+        t.join(timeout=120)
+        assert answer["r"].status_code == 200 and answer["r"].json()["status"] == ["ok"] * 4000
+        assert proc.wait(timeout=60) == 0
+    finally:
+        proc.kill()
