@@ -3,7 +3,6 @@ token, stopped at the end (its graceful shutdown)."""
 
 from __future__ import annotations
 
-import socket
 import threading
 import time
 
@@ -15,15 +14,11 @@ pytest.importorskip("uvicorn")
 TOKEN = "test-token"
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 class Server:
     def __init__(self, app):
         import uvicorn
+
+        from pkm.serve.process import free_port
 
         self.port = free_port()
         self.url = f"http://127.0.0.1:{self.port}"

@@ -4,8 +4,6 @@ it exits (status 0)."""
 from __future__ import annotations
 
 import signal
-import subprocess
-import sys
 import threading
 import time
 
@@ -13,22 +11,13 @@ import httpx
 import numpy as np
 
 import pkm
-from tests.serve.conftest import free_port
+from pkm.serve.process import start
 
 
 def test_sigterm_drains_the_request_in_flight():
-    port = free_port()
-    proc = subprocess.Popen([sys.executable, "-m", "pkm", "serve", "--port", str(port)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    proc, url = start()
     try:
-        assert f"http://127.0.0.1:{port}" in proc.stdout.readline()
-        url = f"http://127.0.0.1:{port}"
-        for _ in range(200):
-            try:
-                if httpx.get(url + "/health").status_code == 200:
-                    break
-            except httpx.TransportError:
-                time.sleep(0.05)
+        assert url in proc.stdout.readline()
         delta = pkm.load("delta")
         qa = delta.actuated_q(delta.q_reference) + 0.1 * np.sin(np.linspace(0, 6, 4000))[:, None]
         answer = {}

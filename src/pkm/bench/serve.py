@@ -17,9 +17,6 @@ Usage: ``python -m pkm.bench.serve [--json] [--quick] [--clients 32] [--duration
 from __future__ import annotations
 
 import asyncio
-import socket
-import subprocess
-import sys
 import time
 from typing import Any
 
@@ -45,26 +42,6 @@ def _rss_mb(pid: int) -> float:
     except OSError:
         pass
     return float("nan")
-
-
-def _start() -> tuple[subprocess.Popen, str]:
-    import httpx
-
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-    proc = subprocess.Popen([sys.executable, "-m", "pkm", "serve", "--port", str(port), "--queue", "1024"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    url = f"http://127.0.0.1:{port}"
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:
-        try:
-            if httpx.get(url + "/health").status_code == 200:
-                return proc, url
-        except httpx.TransportError:
-            time.sleep(0.05)
-    proc.kill()
-    raise RuntimeError("the service did not start")
 
 
 async def _load(url: str, clients: int, duration: float, bodies: list[tuple[str, dict]]) -> dict[str, Any]:
@@ -101,6 +78,7 @@ def run(args) -> dict[str, Any]:
         return {"skipped": f"pip install \"pkm[serve]\" (missing: {', '.join(missing('serve'))})"}
     import pkm
     from pkm.client import Client
+    from pkm.serve.process import start
 
     mech = pkm.load(MECHANISM)
     qa0 = mech.actuated_q(mech.q_reference)
@@ -109,7 +87,7 @@ def run(args) -> dict[str, Any]:
     bodies = [(f"/models/{MECHANISM}/fk", {"qa": (qa0 + 0.05).tolist()}),
               (f"/models/{MECHANISM}/ik", {"y": y}),
               (f"/models/{MECHANISM}/dynamics", {"q": q.tolist(), "qd": [0.1, 0.0, 0.0], "qdd": [1.0, 0.0, 0.0]})]
-    proc, url = _start()
+    proc, url = start("--queue", "1024")
     try:
         with Client(url) as c:  # (warm: the model built, the stream's kernels compiled)
             for path, body in bodies:

@@ -157,32 +157,17 @@ def fuzz(url: str, n: int, *, token: str | None = None, seed: int = 0) -> dict[s
 
 def main(argv: list[str] | None = None) -> int:
     import argparse
-    import socket
-    import subprocess
-    import sys
-
-    import httpx
 
     from pkm.bench.serve import _rss_mb
+    from pkm.serve.process import start
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--requests", type=int, default=10_000)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
     token = "fuzz-token"
-    proc = subprocess.Popen([sys.executable, "-m", "pkm", "serve", "--port", str(port), "--token", token],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    url = f"http://127.0.0.1:{port}"
+    proc, url = start("--token", token)
     try:
-        for _ in range(1200):
-            try:
-                if httpx.get(url + "/health").status_code == 200:
-                    break
-            except httpx.TransportError:
-                time.sleep(0.05)
         rss0 = _rss_mb(proc.pid)
         t0 = time.perf_counter()
         out = fuzz(url, args.requests, token=token, seed=args.seed)
