@@ -115,6 +115,35 @@ class Client:
     def capability(self, model: str, q: Any, kind: str = "wrench") -> dict:
         return self.query(model, "capability", q=q, kind=kind)
 
+    def job(self, model: str, kind: str, **body: Any) -> dict:
+        """Start a job (``assembly_modes`` with ``qa``, ``working_modes`` with ``y``, ``map`` with ``axes``...);
+        returns its state (``id``...)."""
+        from pkm.serve.wire import MSGPACK, pack
+
+        return self._answer(self._http.post(f"/models/{model}/jobs/{kind}", content=pack(body),
+                                            headers={"content-type": MSGPACK}))
+
+    def job_state(self, job_id: str) -> dict:
+        return self._answer(self._http.get(f"/jobs/{job_id}"))
+
+    def result(self, job_id: str, *, wait: float = 600.0) -> dict:
+        """A job's result, waiting up to ``wait`` seconds for it to finish (:class:`ServiceError` if it failed)."""
+        import time
+
+        deadline = time.monotonic() + wait
+        while True:
+            state = self.job_state(job_id)
+            if state["state"] == "done":
+                return self._answer(self._http.get(f"/jobs/{job_id}/result"))["result"]
+            if state["state"] in ("failed", "cancelled") or time.monotonic() > deadline:
+                error = state.get("error") or {}
+                raise ServiceError(409, str(error.get("error", state["state"])), str(error.get("message", "")),
+                                   state)
+            time.sleep(0.05)
+
+    def cancel(self, job_id: str) -> dict:
+        return self._answer(self._http.delete(f"/jobs/{job_id}"))
+
     @contextmanager
     def stream(self, model: str) -> Iterator[Stream]:
         """A WebSocket stream over ``model`` (:class:`Stream`)."""

@@ -187,3 +187,35 @@ def test_a_short_fuzz_gets_no_500_and_the_service_goes_on(service):
     out = fuzz(service.url, 300, token=TOKEN, seed=1)
     assert out["failures"] == [] and out["alive"]
     assert {400, 401, 404, 413, 422} <= set(out["statuses"])
+
+
+def test_jobs_run_apart_and_give_json_and_parquet(client, service, delta):
+    """A map job with the capability index, every assembly mode of the 3-RRR, a failing job and a cancelled one."""
+    import io
+
+    import pyarrow.parquet as pq
+
+    job = client.job("delta", "map", axes={"x": [-0.1, 0.1, 7], "y": [-0.05, 0.05, 5]}, fixed={"z": -0.35},
+                     index="wrench")
+    assert job["state"] in ("queued", "running", "done")
+    result = client.result(job["id"])
+    wmap = pkm.workspace_map(delta, {"x": np.linspace(-0.1, 0.1, 7), "y": np.linspace(-0.05, 0.05, 5)}, {"z": -0.35})
+    assert np.array_equal(result["reachable"], wmap.reachable) and result["nodes"] == wmap.nodes
+    assert result["capability"]["units"]["x"] == "N" and result["capability"]["isotropic"]["N"].shape == (5, 7)
+    table = pq.read_table(io.BytesIO(httpx.get(f"{client.url}/jobs/{job['id']}/result", params={"format": "parquet"},
+                                               headers=AUTH).content))
+    assert table.num_rows == 35 and {"x", "y", "reachable", "ci_2", "isotropic [N]"} <= set(table.column_names)
+    rrr3 = pkm.load("rrr3")
+    modes = client.result(client.job("rrr3", "assembly_modes", qa=rrr3.actuated_q(rrr3.q_reference))["id"])
+    direct = pkm.assembly_modes(rrr3, rrr3.actuated_q(rrr3.q_reference))
+    assert modes["count"] == len(direct.modes) >= 2 and np.abs(modes["q"] - np.array([m.q for m in direct.modes])).max() < 1e-9
+    from pkm.client import ServiceError
+
+    bad = client.job("delta", "working_modes", y=[1.0, 2.0])  # (a wrong size: the job fails, with the message)
+    with pytest.raises(ServiceError) as e:
+        client.result(bad["id"])
+    assert e.value.kind == "InvalidInputError" and "y" in e.value.message
+    assert client.cancel(bad["id"])["state"] == "failed"  # (a finished job: forgotten)
+    with pytest.raises(ServiceError) as e:
+        client.job("delta", "teleport")
+    assert e.value.status == 404 and {j["id"] for j in client._answer(client._http.get("/jobs"))["jobs"]} >= {job["id"]}

@@ -8,7 +8,9 @@ Endpoints (see ``/docs``): ``GET /health``; ``GET /models``; ``POST /models`` (a
 ``GET /models/{model}`` (sizes, names, units); ``GET /models/{model}/files``; ``DELETE /models/{model}``;
 ``GET /models/{model}/preview`` (the self-contained 3-D page); ``GET /`` (the design page,
 :mod:`pkm.serve.page`); ``POST /models/{model}/{query}`` for every query of
-:data:`pkm.serve.queries.QUERIES` (one sample or a batch); ``WS /models/{model}/stream`` (actuator samples in, the
+:data:`pkm.serve.queries.QUERIES` (one sample or a batch); jobs (every assembly or working mode, a workspace map:
+:mod:`pkm.serve.jobs`) at ``POST /models/{model}/jobs/{kind}``, ``GET /jobs/{id}`` and its ``/result``,
+``DELETE /jobs/{id}``; ``WS /models/{model}/stream`` (actuator samples in, the
 forward kinematics, task rates and efforts out, warm-started along the stream).
 
 Bodies are JSON, or msgpack (``Content-Type: application/msgpack``; numpy arrays as msgpack extension 1: dtype,
@@ -108,7 +110,7 @@ class Limiter:
 
 
 def create_app(store: Store | None = None, *, token: str | None = None, workers: int = 2, queue: int = 64,
-               max_body: int = 32 * 2**20) -> Any:
+               max_body: int = 32 * 2**20, job_workers: int = 1) -> Any:
     """The service's ASGI application (see the module doc).
 
     Args:
@@ -117,6 +119,7 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
         workers: Queries computed at once (threads).
         queue: Queries waiting at most; the next is answered 429.
         max_body: Largest request body [bytes]; larger is 413.
+        job_workers: Jobs run at once (:mod:`pkm.serve.jobs`), on threads apart from the queries'.
     """
     from pkm._optional import require
 
@@ -127,10 +130,12 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
     from starlette.exceptions import HTTPException as StarletteHTTPException
 
     from pkm import __version__
+    from pkm.serve.jobs import JobManager
     from pkm.serve.queries import QUERIES, describe
 
     store = Store() if store is None else store
     limiter = Limiter(workers, queue)
+    jobs = JobManager(job_workers)
     app = FastAPI(title="pkm", version=__version__,
                   description="Kinematics and dynamics of closed-loop mechanisms: models, queries, streams.")
 
@@ -181,6 +186,7 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
         return await call_next(request)
 
     app.add_middleware(SizeLimit, max_body=max_body)  # (added last: the outermost, before any other reads)
+    app.router.on_shutdown.append(jobs.shutdown)  # (queued jobs dropped; a running one finishes in its thread)
 
     @app.exception_handler(StarletteHTTPException)
     async def http_errors(request: Request, e: StarletteHTTPException) -> Any:  # (no such route, method)
@@ -247,6 +253,38 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
             return out
 
         return answer(request, await limiter.run(compute))
+
+    @app.post("/models/{model}/jobs/{kind}", status_code=202)
+    async def start_job(request: Request, model: str, kind: str) -> Response:
+        body = await body_of(request)
+        mech = await limiter.run(lambda: store.mechanism(model))
+        return answer(request, jobs.submit(kind, model, mech, body).summary(), 202)
+
+    @app.get("/jobs")
+    async def list_jobs(request: Request) -> Response:
+        return answer(request, {"jobs": [j.summary() for j in jobs.list()]})
+
+    @app.get("/jobs/{job_id}")
+    async def job_state(request: Request, job_id: str) -> Response:
+        return answer(request, jobs.get(job_id).summary())
+
+    @app.get("/jobs/{job_id}/result")
+    async def job_result(request: Request, job_id: str, format: str = "json") -> Response:
+        from pkm.serve.jobs import parquet
+
+        job = jobs.get(job_id)
+        if job.state != "done" or job.result is None or job.rows is None:
+            return _error(409, "NotReady", f"job {job_id} is {job.state}", job.summary())
+        if format == "parquet":
+            rows = job.rows
+            return Response(await limiter.run(lambda: parquet(rows)), media_type="application/vnd.apache.parquet")
+        if format != "json":
+            return _error(422, "InvalidInputError", "format: json or parquet", format)
+        return answer(request, {**job.summary(), "result": job.result})
+
+    @app.delete("/jobs/{job_id}")
+    async def cancel_job(request: Request, job_id: str) -> Response:
+        return answer(request, jobs.cancel(job_id).summary())
 
     @app.websocket("/models/{model}/stream")
     async def stream(ws: WebSocket, model: str) -> None:

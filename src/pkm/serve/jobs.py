@@ -1,0 +1,221 @@
+"""Long computations as jobs: every assembly mode, every working mode, a workspace map (with capability indices).
+
+``POST /models/{model}/jobs/{kind}`` starts one and answers its id at once (202); ``GET /jobs/{id}`` gives its state
+(``queued``, ``running``, ``done``, ``failed``, ``cancelled``), its progress (0 to 1) and its error;
+``GET /jobs/{id}/result`` its result as JSON (or msgpack), ``?format=parquet`` as a Parquet table (one row per mode
+or per map node, the ``sweeps`` extra's pyarrow); ``DELETE /jobs/{id}`` cancels it (a queued job never starts; a
+running one is told to stop and its result dropped: pkm's solvers run to their end in their thread). Jobs run on
+their own worker threads, apart from the queries' (:class:`JobManager`); finished jobs are kept for
+:data:`KEEP_SECONDS`.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+import uuid
+from collections.abc import Callable, Mapping
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from pkm.core.model.mechanism import Mechanism
+from pkm.errors import InvalidInputError, PkmError, UnknownNameError
+
+#: How long a finished job's result is kept [s]; jobs kept at most.
+KEEP_SECONDS = 3600.0
+MAX_JOBS = 256
+
+
+@dataclass
+class Job:
+    """One job (see the module doc)."""
+
+    id: str
+    kind: str
+    model: str
+    state: str = "queued"
+    progress: float = 0.0
+    error: dict[str, str] | None = None
+    result: dict[str, Any] | None = field(default=None, repr=False)
+    rows: dict[str, np.ndarray] | None = field(default=None, repr=False)
+    created: float = field(default_factory=time.time)
+    finished: float | None = None
+    cancel: threading.Event = field(default_factory=threading.Event, repr=False)
+    future: Future | None = field(default=None, repr=False)
+
+    def summary(self) -> dict[str, Any]:
+        return {"id": self.id, "kind": self.kind, "model": self.model, "state": self.state,
+                "progress": self.progress, "error": self.error, "created": self.created, "finished": self.finished}
+
+
+def _modes(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """Every assembly mode at ``qa`` (:func:`pkm.assembly_modes`)."""
+    from pkm.core.modes import assembly_modes
+    from pkm.serve.queries import _array
+
+    qa = _array(body, "qa", mech.na)[0]
+    s = assembly_modes(mech, qa)
+    Q = np.array([m.q for m in s.modes]) if s.modes else np.zeros((0, mech.nq))
+    Y = np.array([mech.task_map.value(q) for q in Q]) if len(Q) else np.zeros((0, mech.task_map.value_size))
+    residual = np.array([m.residual for m in s.modes])
+    out = {"count": len(s.modes), "complete": bool(s.complete), "q": Q, "y": Y, "residual": residual,
+           "labels": [str(m.label) for m in s.modes], "seconds": s.seconds}
+    return out, {"mode": np.arange(len(Q)), **{f"q{i}": Q[:, i] for i in range(Q.shape[1])},
+                 **{f"y{i}": Y[:, i] for i in range(Y.shape[1])}, "residual": residual}
+
+
+def _working(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """Every working mode at the task value ``y`` (:func:`pkm.working_modes`)."""
+    from pkm.core.modes import working_modes
+    from pkm.serve.queries import _array
+
+    y = _array(body, "y", mech.task_map.value_size)[0]
+    s = working_modes(mech, y)
+    Q = np.array([m.q for m in s.modes]) if s.modes else np.zeros((0, mech.nq))
+    QA = Q[:, mech.act_q] if len(Q) else np.zeros((0, mech.na))
+    out = {"count": len(s.modes), "complete": bool(s.complete), "q": Q, "qa": QA,
+           "labels": [str(m.label) for m in s.modes], "seconds": s.seconds}
+    return out, {"mode": np.arange(len(Q)), **{f"qa{i}": QA[:, i] for i in range(QA.shape[1])}}
+
+
+def _map(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """A workspace map (:func:`pkm.workspace_map`): ``axes`` ``{name: [start, stop, count]}`` (SI), ``fixed``,
+    ``length``; with ``index`` (``wrench``, ``twist``, ``acceleration``) the capability at every node."""
+    from pkm.core.analysis.maps import MAX_NODES, workspace_map
+
+    axes_in = body.get("axes")
+    if not isinstance(axes_in, Mapping) or not 1 <= len(axes_in) <= 3:
+        raise InvalidInputError("axes", "give {name: [start, stop, count]} for 1 to 3 task coordinates", axes_in)
+    axes = {}
+    for name, spec in axes_in.items():
+        if not (isinstance(spec, (list, tuple)) and len(spec) == 3 and all(isinstance(x, (int, float)) for x in spec)
+                and float(spec[2]).is_integer() and 1 <= spec[2] <= MAX_NODES):
+            raise InvalidInputError(f"axes.{name}", "[start, stop, count] (SI, count a positive integer)", spec)
+        axes[str(name)] = np.linspace(float(spec[0]), float(spec[1]), int(spec[2]))
+    fixed = body.get("fixed")
+    if fixed is not None and not isinstance(fixed, Mapping):
+        raise InvalidInputError("fixed", "{task coordinate: value}", fixed)
+    length = body.get("length")
+    index = body.get("index")
+    m = workspace_map(mech, axes, fixed, length=None if length is None else float(length),
+                      configurations=index is not None)
+    job.progress = 0.7
+    grids = np.meshgrid(*[v for _, v in reversed(m.axes)], indexing="ij")
+    rows: dict[str, np.ndarray] = {name: g.ravel() for (name, _), g in zip(reversed(m.axes), grids)}
+    rows["reachable"] = m.reachable.ravel()
+    rows["ci_2"] = m.condition_index("2").ravel()
+    out: dict[str, Any] = {"axes": {n: v for n, v in m.axes}, "reachable": m.reachable,
+                           "condition_index": m.condition_index("2"), "nodes": m.nodes, "size": m.size,
+                           "gci": m.gci("2"), "how": m.how}
+    if index is not None:
+        from pkm.core.analysis.capability import map_capability
+
+        cm = map_capability(mech, m, str(index))
+        out["capability"] = {"kind": cm.kind, "units": cm.units, "isotropic": cm.isotropic,
+                             "along": {a: {"plus": p, "minus": n} for a, (p, n) in cm.along.items()}}
+        for u, v in cm.isotropic.items():
+            rows[f"isotropic [{u}]"] = v.ravel()
+    return out, rows
+
+
+#: The job kinds (``POST /models/{model}/jobs/{kind}``).
+KINDS: dict[str, Callable[[Mechanism, Mapping[str, Any], Job], tuple[dict[str, Any], dict[str, np.ndarray]]]] = {
+    "assembly_modes": _modes, "working_modes": _working, "map": _map}
+
+
+class JobManager:
+    """Jobs on ``workers`` threads of their own (see the module doc)."""
+
+    def __init__(self, workers: int = 1):
+        self._pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="pkm-job")
+        self._jobs: dict[str, Job] = {}
+        self._lock = threading.Lock()
+
+    def submit(self, kind: str, model: str, mech: Mechanism, body: Mapping[str, Any]) -> Job:
+        """Start a job (see :data:`KINDS`).
+
+        Raises:
+            UnknownNameError: an unknown kind.
+            InvalidInputError: too many jobs kept.
+        """
+        if kind not in KINDS:
+            raise UnknownNameError("job kind", kind, sorted(KINDS))
+        self._forget_old()
+        with self._lock:
+            if len(self._jobs) >= MAX_JOBS:
+                raise InvalidInputError("jobs", f"{MAX_JOBS} jobs are kept: delete finished ones first")
+            job = Job(uuid.uuid4().hex[:16], kind, model)
+            self._jobs[job.id] = job
+
+        def run() -> None:
+            if job.cancel.is_set():
+                return
+            job.state = "running"
+            try:
+                result, rows = KINDS[kind](mech, body, job)
+            except PkmError as e:
+                job.state, job.error = "failed", {"error": type(e).__name__, "message": str(e)}
+            except Exception as e:  # (a defect: reported on the job, the service goes on)
+                job.state, job.error = "failed", {"error": type(e).__name__, "message": f"unexpected: {e}"}
+            else:
+                if job.cancel.is_set():
+                    job.state = "cancelled"
+                else:
+                    job.result, job.rows, job.state, job.progress = result, rows, "done", 1.0
+            job.finished = time.time()
+
+        job.future = self._pool.submit(run)
+        return job
+
+    def get(self, job_id: str) -> Job:
+        with self._lock:
+            if job_id in self._jobs:
+                return self._jobs[job_id]
+            known = list(self._jobs)
+        raise UnknownNameError("job", job_id, known)
+
+    def list(self) -> list[Job]:
+        with self._lock:
+            return list(self._jobs.values())
+
+    def cancel(self, job_id: str) -> Job:
+        """Cancel a job: a queued one never starts, a running one's result is dropped; a finished one is forgotten."""
+        job = self.get(job_id)
+        job.cancel.set()
+        if job.state in ("done", "failed", "cancelled"):
+            with self._lock:
+                self._jobs.pop(job_id, None)
+            return job
+        if job.future is not None and job.future.cancel():
+            job.state, job.finished = "cancelled", time.time()
+        return job
+
+    def _forget_old(self) -> None:
+        now = time.time()
+        with self._lock:
+            for k in [k for k, j in self._jobs.items() if j.finished is not None and now - j.finished > KEEP_SECONDS]:
+                del self._jobs[k]
+
+    def shutdown(self) -> None:
+        self._pool.shutdown(wait=False, cancel_futures=True)
+
+
+def parquet(rows: Mapping[str, np.ndarray]) -> bytes:
+    """A job's rows as a Parquet table (pyarrow, the ``sweeps`` extra)."""
+    import io
+
+    from pkm._optional import require
+
+    require("sweeps", "a job's result as Parquet", ["pyarrow"])
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    buf = io.BytesIO()
+    pq.write_table(pa.table({k: np.asarray(v) for k, v in rows.items()}), buf)
+    return buf.getvalue()
+
+
+__all__ = ["KEEP_SECONDS", "KINDS", "MAX_JOBS", "Job", "JobManager", "parquet"]
