@@ -1,7 +1,8 @@
 """The design page in a real browser: headless Chromium (Debian's ``chromium``), driven over the DevTools protocol,
 loads ``/`` from the suite's service, moves an actuator's slider, and the test checks that the configuration shown
-is the library's forward kinematics at the new actuator value, that the 3-D view's pixels changed, and that no
-console error or exception occurred (skipped without Chromium, a failure when ``PKM_REQUIRE_BROWSER`` is set, as
+is the library's forward kinematics at the new actuator value and that the 3-D view's pixels changed; then the page's
+two jobs run (every assembly mode there: as many as :func:`pkm.assembly_modes` finds; a workspace map); no console
+error or exception occurs (skipped without Chromium, a failure when ``PKM_REQUIRE_BROWSER`` is set, as
 ``tests/test_viz_browser.py``)."""
 
 from __future__ import annotations
@@ -108,6 +109,10 @@ def test_moving_a_slider_moves_the_mechanism(service, tmp_path):
 
         mimage.imsave(tmp_path / "page.png", after)
         q1 = np.array(browser.evaluate("pkmState.q"))
+        browser.evaluate("document.getElementById('modes-button').click()")  # (the assembly modes job)
+        modes = browser.wait("pkmState.modes && pkmState.modes.length")
+        browser.evaluate("document.getElementById('map-button').click()")  # (the map job)
+        nodes = browser.wait("pkmState.map && pkmState.map.nodes")
         assert browser.evaluate("pkmState.errors") == [] and browser.errors == []
     finally:
         browser.close()
@@ -115,6 +120,7 @@ def test_moving_a_slider_moves_the_mechanism(service, tmp_path):
     qa = delta.actuated_q(q0)
     qa[0] = target
     assert np.abs(q1 - pkm.close_loops(delta, qa, q0).q).max() <= 1e-9 and np.abs(q1 - q0).max() > 0.05
+    assert modes == len(pkm.assembly_modes(delta, qa).modes) and nodes > 0
     view = slice(None), slice(320, None)  # (the 3-D view, right of the side panel)
     changed = np.abs(after[view] - before[view]).max(axis=-1) > 0.1
     assert changed.mean() > 0.002, changed.mean()

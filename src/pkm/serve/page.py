@@ -1,7 +1,9 @@
 """The design page the service serves at ``/``: choose a model (or upload one), move its actuators with sliders, and
 see the mechanism follow in the 3-D view, with its task coordinates and its distances to the singularities.
 
-The page is static HTML and JavaScript, no build step, no third-party code besides what the service already ships:
+Two buttons start jobs (:mod:`pkm.serve.jobs`) at the current actuator values: every assembly mode (each listed with
+its task values; a click shows it) and a workspace map of two task coordinates around the current pose (drawn as the
+condition index, blue to red). The page is static HTML and JavaScript, no build step, no third-party code besides what the service already ships:
 the 3-D view is the model's own preview page (``/models/{model}/preview``: meshcat's viewer with the scene, in an
 ``iframe`` of the same origin), whose bodies the page moves with ``set_transform`` commands from the service's
 ``scene`` query. Each slider move asks ``fk`` (warm-started from the last configuration, so the mechanism stays on
@@ -29,6 +31,10 @@ body { margin: 0; font: 13px sans-serif; color: #222; display: flex; height: 100
 #status { margin-top: 8px; color: #555; min-height: 1.2em; }
 #status.error { color: #b00; }
 #view { flex: 1; border: 0; height: 100vh; }
+#tools { margin-top: 10px; }
+#tools button { margin: 4px 0; }
+#modes a { display: block; cursor: pointer; color: #0645ad; }
+#map { display: block; margin-top: 4px; border: 1px solid #ccc; }
 </style>
 </head>
 <body>
@@ -39,6 +45,12 @@ body { margin: 0; font: 13px sans-serif; color: #222; display: flex; height: 100
     <input type="file" id="files" multiple> <button type="submit">upload</button></form>
   <div id="sliders"></div>
   <table id="readout"></table>
+  <div id="tools">
+    <button type="button" id="modes-button">every assembly mode here</button>
+    <div id="modes"></div>
+    <button type="button" id="map-button">workspace map around here</button>
+    <canvas id="map" width="240" height="180"></canvas>
+  </div>
   <div id="status"></div>
 </div>
 <iframe id="view" title="3-D view"></iframe>
@@ -154,6 +166,66 @@ async function update() {
   }
 }
 
+async function job(kind, body) {
+  const started = await api("POST", "/models/" + state.model + "/jobs/" + kind, body);
+  for (;;) {
+    const s = await api("GET", "/jobs/" + started.id);
+    if (s.state === "done") return (await api("GET", "/jobs/" + started.id + "/result")).result;
+    if (s.state === "failed" || s.state === "cancelled") throw new Error(s.error ? s.error.message : s.state);
+    await new Promise(function (r) { setTimeout(r, 100); });
+  }
+}
+
+async function showModes() {
+  const about = state.about;
+  const qa = about.actuated.map(function (_, k) { return parseFloat(document.getElementById("qa-" + k).value); });
+  say("solving every assembly mode...", false);
+  const r = await job("assembly_modes", {qa: qa});
+  const box = document.getElementById("modes");
+  box.innerHTML = "";
+  state.modes = r.q;
+  r.q.forEach(function (q, k) {
+    const a = document.createElement("a");
+    a.textContent = "mode " + k + ": " + about.task.map(function (n, i) { return n + " " + fmt(r.y[k][i]); }).join(", ");
+    a.addEventListener("click", function () { state.q = q; update(); });
+    box.appendChild(a);
+  });
+  say(r.count + " assembly modes (" + (r.complete ? "complete" : "incomplete") + ")", false);
+}
+
+async function showMap() {
+  const about = state.about;
+  const names = about.task.filter(function (n) { return about.task_units[n] === "m"; }).slice(0, 2);
+  const axes = names.length === 2 ? names : about.task.slice(0, 2);
+  const y = (await api("POST", "/models/" + state.model + "/fk", {qa: qaOf(about, state.q), seed: state.q})).y[0];
+  const body = {axes: {}, fixed: {}};
+  axes.forEach(function (n) {
+    const i = about.task.indexOf(n), span = about.task_units[n] === "m" ? 0.1 : 0.5;
+    body.axes[n] = [y[i] - span, y[i] + span, 41];
+  });
+  about.task.forEach(function (n, i) { if (axes.indexOf(n) < 0) body.fixed[n] = y[i]; });
+  if (axes.length < 2) throw new Error("a map needs two task coordinates");
+  say("mapping...", false);
+  const r = await job("map", body);
+  const ci = r.condition_index, canvas = document.getElementById("map"), g = canvas.getContext("2d");
+  const rows = ci.length, cols = ci[0].length, w = canvas.width / cols, h = canvas.height / rows;
+  g.clearRect(0, 0, canvas.width, canvas.height);
+  for (let j = 0; j < rows; j++) for (let i = 0; i < cols; i++) {
+    const v = ci[j][i];
+    if (typeof v !== "number") continue;
+    g.fillStyle = "hsl(" + Math.round(240 * (1 - v)) + ", 80%, 50%)";
+    g.fillRect(i * w, (rows - 1 - j) * h, w + 1, h + 1);
+  }
+  state.map = r;
+  say("workspace: " + r.nodes + " reachable nodes of " + rows * cols + "; colour: the condition index", false);
+}
+
+document.getElementById("modes-button").addEventListener("click", function () {
+  showModes().catch(function (e) { say(e.message, true); });
+});
+document.getElementById("map-button").addEventListener("click", function () {
+  showMap().catch(function (e) { say(e.message, true); });
+});
 document.getElementById("model").addEventListener("change", function (e) {
   selectModel(e.target.value).catch(function (err) { say(err.message, true); });
 });
