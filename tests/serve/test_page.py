@@ -1,8 +1,8 @@
 """The design page in a real browser: headless Chromium (Debian's ``chromium``), driven over the DevTools protocol,
 loads ``/`` from the suite's service, moves an actuator's slider, and the test checks that the configuration shown
 is the library's forward kinematics at the new actuator value and that the 3-D view's pixels changed; then the page's
-two jobs run (every assembly mode there: as many as :func:`pkm.assembly_modes` finds; a workspace map); no console
-error or exception occurs (skipped without Chromium, a failure when ``PKM_REQUIRE_BROWSER`` is set, as
+two jobs run (every assembly mode there: as many as :func:`pkm.assembly_modes` finds; a workspace map) and another
+design is built from the parameters panel; no console error or exception occurs (skipped without Chromium, a failure when ``PKM_REQUIRE_BROWSER`` is set, as
 ``tests/test_viz_browser.py``)."""
 
 from __future__ import annotations
@@ -113,6 +113,10 @@ def test_moving_a_slider_moves_the_mechanism(service, tmp_path):
         modes = browser.wait("pkmState.modes && pkmState.modes.length")
         browser.evaluate("document.getElementById('map-button').click()")  # (the map job)
         nodes = browser.wait("pkmState.map && pkmState.map.nodes")
+        updates = browser.evaluate("pkmState.updates")
+        browser.evaluate("document.getElementById('param-R').value = 0.16;"  # (another design, built and shown)
+                         " document.getElementById('params-button').click()")
+        variant = browser.wait(f"pkmState.model.startsWith('delta@') && pkmState.updates > {updates} && pkmState.model")
         assert browser.evaluate("pkmState.errors") == [] and browser.errors == []
     finally:
         browser.close()
@@ -121,6 +125,8 @@ def test_moving_a_slider_moves_the_mechanism(service, tmp_path):
     qa[0] = target
     assert np.abs(q1 - pkm.close_loops(delta, qa, q0).q).max() <= 1e-9 and np.abs(q1 - q0).max() > 0.05
     assert modes == len(pkm.assembly_modes(delta, qa).modes) and nodes > 0
+    assert httpx.get(f"{service.url}/models/{variant}", headers={"authorization": f"Bearer {TOKEN}"}).json()["kind"] \
+        == "variant"
     view = slice(None), slice(320, None)  # (the 3-D view, right of the side panel)
     changed = np.abs(after[view] - before[view]).max(axis=-1) > 0.1
     assert changed.mean() > 0.002, changed.mean()

@@ -179,6 +179,26 @@ def test_the_limiter_answers_busy_when_the_queue_is_full():
     assert sum(isinstance(r, _Busy) for r in results) == 1 and results.count(None) == 2
 
 
+def test_the_compute_limit_answers_while_the_slot_stays_held():
+    from pkm.serve.app import Limiter, _TooSlow
+
+    async def main() -> tuple:
+        import time
+
+        limiter = Limiter(workers=1, queue=4)
+        slow = asyncio.ensure_future(limiter.run(lambda: time.sleep(0.3), timeout=0.05))
+        try:
+            await slow
+        except _TooSlow as e:
+            first = e
+        t0 = time.perf_counter()
+        await limiter.run(lambda: None)  # (waits for the slow one's thread to end: the slot was held)
+        return first, time.perf_counter() - t0
+
+    err, waited = asyncio.run(main())
+    assert "compute-time limit" in str(err) and waited > 0.15
+
+
 def test_a_short_fuzz_gets_no_500_and_the_service_goes_on(service):
     """300 malformed requests (:mod:`pkm.serve.fuzz`; CI sends 10,000 to a service of its own): none answered 500,
     every error JSON with a message, the service answering afterwards."""
@@ -219,3 +239,40 @@ def test_jobs_run_apart_and_give_json_and_parquet(client, service, delta):
     with pytest.raises(ServiceError) as e:
         client.job("delta", "teleport")
     assert e.value.status == 404 and {j["id"] for j in client._answer(client._http.get("/jobs"))["jobs"]} >= {job["id"]}
+
+
+def test_a_registered_mechanism_with_other_parameters(client, service):
+    """``GET /models/delta/parameters`` lists the design parameters; ``POST /models/delta/variants`` builds one (the
+    same as ``pkm.build``), listed, queried; a parameter pkm refuses is 422 naming it."""
+    from pkm.client import ServiceError
+
+    info = client._answer(client._http.get("/models/delta/parameters"))
+    names = {p["name"]: p for p in info["parameters"]}
+    assert info["registered"] == "delta" and "R" in names and names["R"]["units"] == ["m"]
+    entry = client._answer(client._http.post("/models/delta/variants", json={"params": {"R": 0.16}}))
+    assert entry["kind"] == "variant" and entry["id"].startswith("delta@")
+    built = pkm.build("delta", R=0.16)
+    out = client.fk(entry["id"], built.actuated_q(built.q_reference))
+    assert np.abs(out["q"][0] - pkm.close_loops(built, built.actuated_q(built.q_reference)).q).max() <= 1e-12
+    with pytest.raises(ServiceError) as e:
+        client._answer(client._http.post("/models/delta/variants", json={"params": {"R": -1.0}}))
+    assert e.value.status == 422 and "R" in e.value.message
+
+
+def test_a_sweep_job_is_pkm_sweep(client):
+    """A design sweep as a job (serial here: CI's two cores; a local Dask cluster by default) equals
+    :func:`pkm.sweep` of the same grid, and its rows come as Parquet too."""
+    import io
+
+    import pyarrow.parquet as pq
+
+    from pkm import sweeps
+
+    job = client.job("delta", "sweep", grid={"R": "10cm:20cm:3"}, objectives=["condition"], scheduler="serial")
+    result = client.result(job["id"])
+    direct = sweeps.sweep("delta", sweeps.grid(R="10cm:20cm:3"), ["condition"], scheduler="serial", progress=False)
+    assert result["designs"] == 3 and result["failed"] == 0
+    assert np.allclose(result["rows"]["condition"], direct.table.column("condition").to_pylist(), rtol=1e-12)
+    table = pq.read_table(io.BytesIO(httpx.get(f"{client.url}/jobs/{job['id']}/result", params={"format": "parquet"},
+                                               headers=AUTH).content))
+    assert table.num_rows == 3 and "condition" in table.column_names

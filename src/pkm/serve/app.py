@@ -5,7 +5,8 @@ Why FastAPI: it is Starlette (the ASGI toolkit: routing, WebSockets, multipart) 
 is its maintained server (graceful shutdown on SIGTERM: in-flight requests finish, new ones are refused).
 
 Endpoints (see ``/docs``): ``GET /health``; ``GET /models``; ``POST /models`` (an upload: multipart files);
-``GET /models/{model}`` (sizes, names, units); ``GET /models/{model}/files``; ``DELETE /models/{model}``;
+``GET /models/{model}`` (sizes, names, units); ``GET /models/{model}/files``; ``DELETE /models/{model}``; ``GET /models/{model}/parameters`` and
+``POST /models/{model}/variants`` (a registered mechanism with other design parameters);
 ``GET /models/{model}/preview`` (the self-contained 3-D page); ``GET /`` (the design page,
 :mod:`pkm.serve.page`); ``POST /models/{model}/{query}`` for every query of
 :data:`pkm.serve.queries.QUERIES` (one sample or a batch); jobs (every assembly or working mode, a workspace map:
@@ -19,7 +20,7 @@ query carries ``compute_s``, the server's time for it.
 
 Reliability: pkm's errors are 4xx answers with their message and data (422; 404 for an unknown model or query),
 never a traceback; a body over ``max_body`` bytes is 413; a bearer token, when set, is required on everything but
-``/health`` (401); at most ``workers`` queries compute at once and ``queue`` wait, the next is 429.
+``/health`` (401); at most ``workers`` queries compute at once and ``queue`` wait, the next is 429; a query computing longer than ``compute_limit`` seconds is answered 503.
 """
 
 # (no ``from __future__ import annotations`` here: FastAPI reads the routes' annotations, whose types are imported
@@ -87,6 +88,10 @@ class _Busy(Exception):
     pass
 
 
+class _TooSlow(Exception):
+    pass
+
+
 class Limiter:
     """At most ``workers`` computations at once (threads) and ``queue`` waiting; over that, :meth:`run` raises
     :class:`_Busy` (answered 429)."""
@@ -95,7 +100,9 @@ class Limiter:
         self.slots = asyncio.Semaphore(workers)
         self.queue, self.waiting = queue, 0
 
-    async def run(self, fn: Callable[[], Any]) -> Any:
+    async def run(self, fn: Callable[[], Any], timeout: float | None = None) -> Any:
+        """``fn()`` on a thread, once a slot is free; past ``timeout`` seconds :class:`_TooSlow` is raised while the
+        computation goes on, holding its slot until it ends (Python cannot stop a thread)."""
         if self.waiting >= self.queue:
             raise _Busy(f"{self.waiting} requests are waiting; try again shortly")
         self.waiting += 1
@@ -103,14 +110,22 @@ class Limiter:
             await self.slots.acquire()
         finally:
             self.waiting -= 1
+        task = asyncio.ensure_future(asyncio.to_thread(fn))
         try:
-            return await asyncio.to_thread(fn)
-        finally:
-            self.slots.release()
+            done, _ = await asyncio.wait({task}, timeout=timeout)
+        except BaseException:  # (the request cancelled: the slot is freed when the thread ends)
+            task.add_done_callback(lambda _: self.slots.release())
+            raise
+        if not done:
+            task.add_done_callback(lambda _: self.slots.release())
+            raise _TooSlow(f"the computation takes more than {timeout:g} s (the service's compute-time limit); "
+                           "send fewer samples, or start a job")
+        self.slots.release()
+        return task.result()
 
 
 def create_app(store: Store | None = None, *, token: str | None = None, workers: int = 2, queue: int = 64,
-               max_body: int = 32 * 2**20, job_workers: int = 1) -> Any:
+               max_body: int = 32 * 2**20, job_workers: int = 1, compute_limit: float = 60.0) -> Any:
     """The service's ASGI application (see the module doc).
 
     Args:
@@ -120,6 +135,8 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
         queue: Queries waiting at most; the next is answered 429.
         max_body: Largest request body [bytes]; larger is 413.
         job_workers: Jobs run at once (:mod:`pkm.serve.jobs`), on threads apart from the queries'.
+        compute_limit: A query computing longer is answered 503 [s] (it finishes in its thread, holding its slot);
+            jobs have no such limit.
     """
     from pkm._optional import require
 
@@ -164,6 +181,10 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
     @app.exception_handler(_Busy)
     async def busy(request: Request, e: _Busy) -> Any:
         return _error(429, "Busy", str(e))
+
+    @app.exception_handler(_TooSlow)
+    async def too_slow(request: Request, e: _TooSlow) -> Any:
+        return _error(503, "ComputeTimeLimit", str(e))
 
     @app.exception_handler(_BadBody)
     async def bad_body(request: Request, e: _BadBody) -> Any:
@@ -223,6 +244,23 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
         mech = await limiter.run(lambda: store.mechanism(model))
         return answer(request, {**vars(entry), **describe(mech)})
 
+    @app.get("/models/{model}/parameters")
+    async def parameters(request: Request, model: str) -> Response:
+        from pkm.cli.parsing import param_info
+
+        entry = store.entry(model)
+        name = model if entry.kind == "registered" else model.split("@")[0] if entry.kind == "variant" else None
+        infos = [] if name is None else [
+            {"name": p.name, "default": p.default, "units": list(p.units), "description": p.description}
+            for p in param_info(name).values()]
+        return answer(request, {"model": model, "registered": name, "parameters": infos})
+
+    @app.post("/models/{model}/variants", status_code=201)
+    async def variant(request: Request, model: str) -> Response:
+        body = await body_of(request)
+        entry = await limiter.run(lambda: store.variant(model, body.get("params", {})))
+        return answer(request, vars(entry), 201)
+
     @app.get("/models/{model}/files")
     async def files(request: Request, model: str) -> Response:
         return answer(request, {"files": {n: d.decode() for n, d in store.files(model).items()}})
@@ -247,12 +285,13 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
         mech = store.mechanism(model)
 
         def compute() -> dict:
+            kernels = store.kernels(model)
             t0 = time.perf_counter()
-            out = QUERIES[query](mech, body)
+            out = QUERIES[query](mech, body, kernels)
             out["compute_s"] = time.perf_counter() - t0
             return out
 
-        return answer(request, await limiter.run(compute))
+        return answer(request, await limiter.run(compute, compute_limit))
 
     @app.post("/models/{model}/jobs/{kind}", status_code=202)
     async def start_job(request: Request, model: str, kind: str) -> Response:
@@ -330,14 +369,15 @@ class _BadBody(Exception):
 
 
 def serve(host: str = "127.0.0.1", port: int = 8000, *, store: str | None = None, workers: int = 2,
-          token: str | None = None, queue: int = 64, max_body: int = 32 * 2**20) -> None:
+          token: str | None = None, queue: int = 64, max_body: int = 32 * 2**20, compute_limit: float = 60.0) -> None:
     """Run the service until SIGINT or SIGTERM (in-flight requests finish first)."""
     from pkm._optional import require
 
     require("serve", "pkm serve")
     import uvicorn
 
-    app = create_app(Store(store), token=token, workers=workers, queue=queue, max_body=max_body)
+    app = create_app(Store(store), token=token, workers=workers, queue=queue, max_body=max_body,
+                     compute_limit=compute_limit)
     # uvicorn drains on SIGTERM, then raises the signal again with the handler it found: a quiet one here, so that a
     # drained stop exits 0
     signal.signal(signal.SIGTERM, lambda signum, frame: None)

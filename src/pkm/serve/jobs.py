@@ -1,4 +1,5 @@
-"""Long computations as jobs: every assembly mode, every working mode, a workspace map (with capability indices).
+"""Long computations as jobs: every assembly mode, every working mode, a workspace map (with capability indices), a
+design sweep (pkm's Dask engine).
 
 ``POST /models/{model}/jobs/{kind}`` starts one and answers its id at once (202); ``GET /jobs/{id}`` gives its state
 (``queued``, ``running``, ``done``, ``failed``, ``cancelled``), its progress (0 to 1) and its error;
@@ -121,9 +122,34 @@ def _map(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, 
     return out, rows
 
 
+def _sweep(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """A design sweep of a registered mechanism on pkm's Dask engine (:func:`pkm.sweep`): ``grid`` ``{parameter:
+    "START:STOP:COUNT"}`` (units as ``pkm sweep`` reads them), ``objectives`` (names or specs), ``fixed`` (other
+    parameters), ``scheduler`` (None: a local cluster of ``workers``; ``"serial"``; a scheduler's address)."""
+    from pkm import sweeps
+
+    grid, objectives = body.get("grid"), body.get("objectives")
+    if not isinstance(grid, Mapping) or not grid or not all(isinstance(v, str) for v in grid.values()):
+        raise InvalidInputError("grid", "{parameter: \"START:STOP:COUNT\"}, e.g. {\"R\": \"10cm:20cm:5\"}", grid)
+    if not isinstance(objectives, list) or not objectives or not all(isinstance(o, str) for o in objectives):
+        raise InvalidInputError("objectives", "a list of objective names or specs", objectives)
+    scheduler, workers = body.get("scheduler"), body.get("workers")
+    if workers is not None and not (isinstance(workers, int) and 1 <= workers <= 8):
+        raise InvalidInputError("workers", "1 to 8 local workers", workers)
+    name = job.model.split("@")[0]
+    res = sweeps.sweep(name, sweeps.grid(**grid), objectives, fixed=body.get("fixed"), scheduler=scheduler,
+                       workers=workers, progress=False)
+    table = res.table
+    rows = {c: np.asarray(table.column(c).to_pylist(), dtype=object if table.schema.field(c).type == "string"
+                          else None) for c in table.column_names}
+    out = {"columns": table.column_names, "rows": {c: v.tolist() for c, v in rows.items()},
+           "designs": len(res), "failed": int(sum(1 for s in rows.get("status", []) if s != "ok"))}
+    return out, rows
+
+
 #: The job kinds (``POST /models/{model}/jobs/{kind}``).
 KINDS: dict[str, Callable[[Mechanism, Mapping[str, Any], Job], tuple[dict[str, Any], dict[str, np.ndarray]]]] = {
-    "assembly_modes": _modes, "working_modes": _working, "map": _map}
+    "assembly_modes": _modes, "working_modes": _working, "map": _map, "sweep": _sweep}
 
 
 class JobManager:

@@ -1,7 +1,8 @@
 """The design page the service serves at ``/``: choose a model (or upload one), move its actuators with sliders, and
 see the mechanism follow in the 3-D view, with its task coordinates and its distances to the singularities.
 
-Two buttons start jobs (:mod:`pkm.serve.jobs`) at the current actuator values: every assembly mode (each listed with
+A registered mechanism's numeric design parameters can be changed and built (``POST /models/{name}/variants``: a
+new model, listed with the others). Two buttons start jobs (:mod:`pkm.serve.jobs`) at the current actuator values: every assembly mode (each listed with
 its task values; a click shows it) and a workspace map of two task coordinates around the current pose (drawn as the
 condition index, blue to red). The page is static HTML and JavaScript, no build step, no third-party code besides what the service already ships:
 the 3-D view is the model's own preview page (``/models/{model}/preview``: meshcat's viewer with the scene, in an
@@ -44,6 +45,8 @@ body { margin: 0; font: 13px sans-serif; color: #222; display: flex; height: 100
   <form id="upload"><label>upload (spec + model file, Gepetto pair, MJCF, SDF)</label>
     <input type="file" id="files" multiple> <button type="submit">upload</button></form>
   <div id="sliders"></div>
+  <details id="design"><summary>design parameters</summary><div id="params"></div>
+    <button type="button" id="params-button">build this design</button></details>
   <table id="readout"></table>
   <div id="tools">
     <button type="button" id="modes-button">every assembly mode here</button>
@@ -99,6 +102,7 @@ async function loadModels(select) {
 async function selectModel(id) {
   const about = await api("GET", "/models/" + id);
   state.model = id; state.about = about; state.q = about.q_reference; state.paths = null;
+  await showParameters(id);
   const sliders = document.getElementById("sliders");
   sliders.innerHTML = "";
   about.actuated.forEach(function (name, k) {
@@ -166,6 +170,34 @@ async function update() {
   }
 }
 
+async function showParameters(id) {
+  const info = await api("GET", "/models/" + id + "/parameters");
+  const box = document.getElementById("params");
+  box.innerHTML = "";
+  document.getElementById("design").style.display = info.registered ? "" : "none";
+  state.parameters = info.parameters.filter(function (p) { return typeof p.default === "number"; });
+  state.parameters.forEach(function (p) {
+    const label = document.createElement("label");
+    label.textContent = p.name + (p.units.length ? " [" + p.units[0] + "]" : "");
+    label.title = p.description;
+    const input = document.createElement("input");
+    Object.assign(input, {type: "number", value: p.default, step: "any", id: "param-" + p.name});
+    box.appendChild(label);
+    box.appendChild(input);
+  });
+}
+
+async function buildDesign() {
+  const params = {};
+  state.parameters.forEach(function (p) {
+    const v = parseFloat(document.getElementById("param-" + p.name).value);
+    if (v !== p.default) params[p.name] = v;
+  });
+  const base = state.model.split("@")[0];
+  const entry = await api("POST", "/models/" + base + "/variants", {params: params});
+  await loadModels(entry.id);
+}
+
 async function job(kind, body) {
   const started = await api("POST", "/models/" + state.model + "/jobs/" + kind, body);
   for (;;) {
@@ -220,6 +252,9 @@ async function showMap() {
   say("workspace: " + r.nodes + " reachable nodes of " + rows * cols + "; colour: the condition index", false);
 }
 
+document.getElementById("params-button").addEventListener("click", function () {
+  buildDesign().catch(function (e) { say(e.message, true); });
+});
 document.getElementById("modes-button").addEventListener("click", function () {
   showModes().catch(function (e) { say(e.message, true); });
 });

@@ -1,5 +1,8 @@
-"""The questions the service answers about a model: each a function ``(mech, body) -> answer`` over one sample or a
-batch (every array input given as one sample, or as a list of samples of the same length).
+"""The questions the service answers about a model: each a function ``(mech, body, kernels) -> answer`` over one sample
+or a batch (every array input given as one sample, or as a list of samples of the same length). Batches of the
+forward kinematics, the Jacobians and the dynamic model run through the model's compiled kernels (``kernels``, a
+:class:`pkm.Kernels`, where they build; the same answers to 1e-12) and fall back to the library's Python route, sample
+by sample, where the kernels refuse a sample.
 
 Every answer carries its units (SI: ``m``, ``rad``, ``N``, ``N m``, per coordinate) and what certifies it: the
 residuals of the closures, the status of each sample (``"ok"`` or the error that sample raised, with its data: a
@@ -104,7 +107,7 @@ def _columns(rows: list[dict[str, Any]], keys: tuple[str, ...]) -> dict[str, Any
     return out
 
 
-def fk(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
+def fk(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """Forward kinematics (the loop closure): ``qa`` (na per sample) -> ``q`` (nq), ``y`` (task value), the closure
     ``residual`` [m, rad]. Samples are solved in order, each from the previous one's solution (the first from
     ``seed``, default the reference): a stream of actuator values stays on one assembly mode."""
@@ -113,19 +116,28 @@ def fk(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
     qa = _array(body, "qa", mech.na)
     seed = _optional(body, "seed", mech.nq)
     q = [mech.q_reference if seed is None else seed[0]]
+    out: dict[str, Any] | None = None
+    if kernels is not None and len(qa) > 1:
+        try:  # (the compiled path, warm-started in C; any sample it cannot solve: the per-sample route below)
+            path = kernels.close_loops_path(qa, q[0])
+            out = {"status": ["ok"] * len(qa), "q": path.q,
+                   "y": np.array([mech.task_map.value(x) for x in path.q]), "residual": path.residual,
+                   "iterations": path.iterations.astype(float)}
+        except PkmError:
+            out = None
+    if out is None:
+        def one(k: int) -> dict[str, Any]:
+            r = close_loops(mech, qa[k], q[0])
+            q[0] = r.q
+            return {"q": r.q, "y": mech.task_map.value(r.q), "residual": r.residual, "iterations": r.iterations}
 
-    def one(k: int) -> dict[str, Any]:
-        r = close_loops(mech, qa[k], q[0])
-        q[0] = r.q
-        return {"q": r.q, "y": mech.task_map.value(r.q), "residual": r.residual, "iterations": r.iterations}
-
-    out = _columns(_each(len(qa), one), ("q", "y", "residual", "iterations"))
+        out = _columns(_each(len(qa), one), ("q", "y", "residual", "iterations"))
     out["units"] = {"y": list(_task_units(mech).values()), "residual": "m or rad",
                     "qa": [_unit(mech, j) for j in mech.actuated_names]}
     return out
 
 
-def ik(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
+def ik(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """Inverse kinematics: ``y`` (task values, laid out as ``task_value_names``) -> ``q``, ``qa``, ``residual``;
     each sample from the previous one's solution (the first from ``seed``), in the working mode ``branch`` (a
     named branch of the spec) when given."""
@@ -148,20 +160,27 @@ def ik(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
-def jacobians(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
+def jacobians(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations ``q``: the forward Jacobian ``J`` (task rates per actuated rate) and the inverse
     ``K`` (actuated rates per task rate)."""
     from pkm.core.differential.velocity import forward_jacobian, inverse_jacobian
 
     q = _array(body, "q", mech.nq)
-    out = _columns(_each(len(q), lambda k: {"J": forward_jacobian(mech, q[k]), "K": inverse_jacobian(mech, q[k])}),
-                   ("J", "K"))
+    out: dict[str, Any] | None = None
+    if kernels is not None and len(q) > 1:
+        try:
+            out = {"status": ["ok"] * len(q), "J": kernels.forward_jacobian(q), "K": kernels.inverse_jacobian(q)}
+        except PkmError:
+            out = None
+    if out is None:
+        out = _columns(_each(len(q), lambda k: {"J": forward_jacobian(mech, q[k]),
+                                                "K": inverse_jacobian(mech, q[k])}), ("J", "K"))
     out["units"] = {"rows": list(_task_units(mech).values()),
                     "columns": [_unit(mech, j) for j in mech.actuated_names]}
     return out
 
 
-def diagnose(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
+def diagnose(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations ``q``: the distances to the direct and inverse singularities and the closure
     residual (:func:`pkm.diagnose`)."""
     from pkm.core.differential.velocity import diagnose as run
@@ -175,7 +194,7 @@ def diagnose(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
     return _columns(_each(len(q), one), ("direct_distance", "inverse_distance"))
 
 
-def velocities(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
+def velocities(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations ``q`` and actuated rates ``qd``: every joint's rate ``v`` and the task rates
     ``yd``."""
     from pkm.core.differential.velocity import forward_jacobian
@@ -191,7 +210,7 @@ def velocities(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
     return _columns(_each(n, one), ("v", "yd"))
 
 
-def dynamics(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
+def dynamics(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """The actuator-space model at closed states ``(q, qd)``: ``M`` (``M_a``), ``h`` (``h_a``), ``g`` (``g_a``), and
     with ``qdd`` the inverse dynamics ``tau = M_a qdd + h_a`` [N m, N]."""
     from pkm.core.dynamics.model import actuator_model
@@ -208,12 +227,24 @@ def dynamics(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
             out["tau"] = m.M @ _row(qdd, k) + m.h
         return out
 
-    out = _columns(_each(n, one), ("M", "h", "g") + (("tau",) if qdd is not None else ()))
+    out: dict[str, Any] | None = None
+    if kernels is not None and n > 1:
+        try:  # (the compiled model in batches)
+            Q = np.broadcast_to(q, (n, mech.nq)) if len(q) == 1 else q
+            QD = np.zeros((n, mech.na)) if qd is None else np.broadcast_to(qd, (n, mech.na))
+            M, h = kernels.mass_and_bias(np.ascontiguousarray(Q), np.ascontiguousarray(QD))
+            out = {"status": ["ok"] * n, "M": M, "h": h, "g": kernels.gravity(np.ascontiguousarray(Q))}
+            if qdd is not None:
+                out["tau"] = np.einsum("kij,kj->ki", M, np.broadcast_to(qdd, (n, mech.na))) + h
+        except PkmError:
+            out = None
+    if out is None:
+        out = _columns(_each(n, one), ("M", "h", "g") + (("tau",) if qdd is not None else ()))
     out["units"] = {"tau": [_unit(mech, j, "effort") for j in mech.actuated_names]}
     return out
 
 
-def capability(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
+def capability(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations ``q``, the ``kind`` capability (``wrench``, ``twist``, ``acceleration``) under the
     actuators' limits: the largest value along each task axis each way, the largest isotropic value per unit, the
     polytope's vertices (:func:`pkm.capability`)."""
@@ -241,7 +272,7 @@ def capability(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
 _SCENES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def scene(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
+def scene(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At configurations ``q``: the world placement of every body of the model's 3-D scene (the preview page's,
     :class:`pkm.viz.scene.Scene`), as ``paths`` (meshcat paths) and ``matrices`` (per sample and body, 16 numbers
     column-major, as meshcat's ``set_transform`` takes them)."""
@@ -260,7 +291,7 @@ def scene(mech: Mechanism, body: Mapping[str, Any]) -> dict[str, Any]:
 
 
 #: The queries by name (the endpoints ``POST /models/{model}/{name}``).
-QUERIES: dict[str, Callable[[Mechanism, Mapping[str, Any]], dict[str, Any]]] = {
+QUERIES: dict[str, Callable[[Mechanism, Mapping[str, Any], Any], dict[str, Any]]] = {
     "fk": fk, "ik": ik, "jacobians": jacobians, "diagnose": diagnose, "velocities": velocities,
     "dynamics": dynamics, "capability": capability, "scene": scene}
 

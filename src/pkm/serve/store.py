@@ -126,6 +126,30 @@ class Store:
             (place / "manifest.json").write_text(json.dumps({"files": hashes}))
         return entry
 
+    def variant(self, model: str, params: dict[str, Any]) -> Entry:
+        """A registered mechanism built with other design parameters (:func:`pkm.build`): its entry, id
+        ``<name>@<hash of the parameters>`` (the same parameters: the same entry).
+
+        Raises:
+            InvalidInputError: ``model`` is not a registered mechanism; the parameters pkm refuses (named).
+        """
+        import pkm
+
+        if model not in self.registered:
+            raise InvalidInputError("model", "variants are of registered mechanisms", model)
+        if not isinstance(params, dict) or not all(isinstance(k, str) for k in params):
+            raise InvalidInputError("params", "{parameter name: value}", params)
+        key = f"{model}@{hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()[:12]}"
+        with self._lock:
+            if key in self._uploads:
+                return self._uploads[key]
+        mech = pkm.build(model, **params)
+        entry = Entry(key, "variant", mech.name, {})
+        with self._lock:
+            self._uploads[key] = entry
+            self._mechanisms[key] = mech
+        return entry
+
     def entry(self, model: str) -> Entry:
         """The entry of ``model``.
 

@@ -52,6 +52,7 @@ class Stream:
         from pkm.core.differential.velocity import forward_jacobian
         from pkm.core.dynamics.model import actuator_model
         from pkm.core.kinematics.solve import close_loops
+        from pkm.core.twin.kernels import PIVOT_FLOOR
 
         if not isinstance(sample, Mapping):
             raise InvalidInputError("message", "a map with qa (and qd, qdd)", str(sample)[:100])
@@ -61,22 +62,31 @@ class Stream:
             raise InvalidInputError("qa", f"missing: give {self.mech.na} numbers")
         qd, qdd = self._vector(sample, "qd"), self._vector(sample, "qdd")
         K = self.kernels
-        if K is not None:
-            path = K.close_loops_path(qa[None], self.q)
-            q, residual = path.q[0], float(path.residual[0])
-        else:
+        q = residual = None
+        if K is not None:  # (the kernels called directly: a stream's samples are checked here, one at a time)
+            q_k, r_k, p_k, _ = K.kernel("closure_newton").follow(self.q, qa[None], 10, 1e-12)
+            if r_k[0] <= 1e-12 and p_k[0] >= PIVOT_FLOOR and np.all(np.isfinite(q_k[0])):
+                q, residual = q_k[0], float(r_k[0])
+        if q is None:
             r = close_loops(self.mech, qa, self.q)
             q, residual = r.q, r.residual
         self.q = q
         out: dict[str, Any] = {"q": q, "y": self.mech.task_map.value(q), "residual": residual}
         if qd is not None:
-            out["yd"] = (K.forward_jacobian(q) if K is not None else forward_jacobian(self.mech, q)) @ qd
+            if K is not None:
+                J = K.kernel("forward_jacobian")(q[None])[0].reshape(-1, self.mech.na, order="F")
+            else:
+                J = forward_jacobian(self.mech, q)
+            out["yd"] = J @ qd
             if qdd is not None:
+                tau = None
                 if K is not None:
-                    out["tau"] = K.inverse_dynamics(q, qd, qdd)
-                else:
+                    t_k, p_k = K.kernel("inverse_dynamics")(q[None], qd[None], qdd[None])
+                    tau = t_k[0] if p_k[0, 0] >= PIVOT_FLOOR and np.all(np.isfinite(t_k[0])) else None
+                if tau is None:
                     m = actuator_model(self.mech, q, qd)
-                    out["tau"] = m.M @ qdd + m.h
+                    tau = m.M @ qdd + m.h
+                out["tau"] = tau
         out["compute_s"] = time.perf_counter() - t0
         return out
 
