@@ -109,6 +109,12 @@ def test_moving_a_slider_moves_the_mechanism(service, tmp_path):
 
         mimage.imsave(tmp_path / "page.png", after)
         q1 = np.array(browser.evaluate("pkmState.q"))
+        updates = browser.evaluate("pkmState.updates")
+        z = browser.evaluate("(function () { const s = document.getElementById('y-2');"  # (a task slider: the IK)
+                             " s.value = parseFloat(s.value) - 0.02; s.dispatchEvent(new Event('input'));"
+                             " return parseFloat(s.value); })()")
+        browser.wait(f"pkmState.updates > {updates} && !pkmState.busy")
+        y2 = browser.evaluate("pkmState.y")
         browser.evaluate("document.getElementById('modes-button').click()")  # (the assembly modes job)
         modes = browser.wait("pkmState.modes && pkmState.modes.length")
         browser.evaluate("document.getElementById('map-button').click()")  # (the map job)
@@ -125,6 +131,7 @@ def test_moving_a_slider_moves_the_mechanism(service, tmp_path):
     qa[0] = target
     assert np.abs(q1 - pkm.close_loops(delta, qa, q0).q).max() <= 1e-9 and np.abs(q1 - q0).max() > 0.05
     assert modes == len(pkm.assembly_modes(delta, qa).modes) and nodes > 0
+    assert abs(y2[2] - z) <= 1e-9  # (the pose shown reaches the task slider's z)
     assert httpx.get(f"{service.url}/models/{variant}", headers={"authorization": f"Bearer {TOKEN}"}).json()["kind"] \
         == "variant"
     view = slice(None), slice(320, None)  # (the 3-D view, right of the side panel)

@@ -59,8 +59,11 @@ def test_the_queries_answer_what_the_library_does(client, delta):
     diag = client.diagnose("delta", fk["q"][0])
     assert diag["direct_distance"][0] == pytest.approx(pkm.diagnose(delta, fk["q"][0]).direct_distance, rel=1e-12)
     qd, qdd = np.array([0.1, -0.2, 0.3]), np.array([1.0, 0.5, -0.5])
-    vel = client.velocities("delta", fk["q"], qd)  # (one qd for every sample)
-    assert np.abs(vel["v"][2] - pkm.velocities(delta, fk["q"][2], qd)).max() <= 1e-12
+    vel = client.query("delta", "velocities", q=fk["q"], qd=qd, qdd=qdd)  # (one qd, qdd for every sample)
+    v2 = pkm.velocities(delta, fk["q"][2], qd)
+    a2 = pkm.accelerations(delta, fk["q"][2], v2, qdd)
+    assert np.abs(vel["v"][2] - v2).max() <= 1e-12 and np.abs(vel["a"][2] - a2).max() <= 1e-12
+    assert np.abs(vel["ydd"][2] - pkm.task_acceleration(delta, fk["q"][2], v2, a2)).max() <= 1e-12
     dyn = client.dynamics("delta", fk["q"][:2], qd, qdd)
     model = pkm.actuator_model(delta, fk["q"][1], qd)
     assert np.abs(dyn["tau"][1] - (model.M @ qdd + model.h)).max() <= 1e-12 and dyn["units"]["tau"] == ["N m"] * 3
@@ -99,6 +102,29 @@ def test_uploads_are_content_addressed_kept_and_deleted(client, service, tmp_pat
     with pytest.raises(ServiceError) as e:
         client.fk(entry["id"], [0.1, -0.1])
     assert e.value.status == 404
+
+
+def test_an_archive_is_its_files(client, service):
+    """A zip (or tar) of a model's files is the same upload as the files (the same id); folders in it are dropped,
+    a link refused."""
+    import io
+    import tarfile
+    import zipfile
+
+    files = [EXAMPLES / "humanoid_ankle" / "ankle.xml", EXAMPLES / "humanoid_ankle" / "ankle.closures.toml"]
+    plain = client.upload(files)
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as z:
+        for f in files:
+            z.writestr(f"../../deep/{f.name}", f.read_bytes())  # (a zip-slip path: only the base name is kept)
+    assert client.upload({"ankle.zip": buf.getvalue()})["id"] == plain["id"]
+    tar = io.BytesIO()
+    with tarfile.open(fileobj=tar, mode="w:gz") as t:
+        link = tarfile.TarInfo("ankle.xml")
+        link.type, link.linkname = tarfile.SYMTYPE, "/etc/passwd"
+        t.addfile(link)
+    r = httpx.post(service.url + "/models", files=[("files", ("m.tgz", tar.getvalue()))], headers=AUTH)
+    assert r.status_code == 422 and "link" in r.json()["message"]
 
 
 def service_store(service) -> Path:

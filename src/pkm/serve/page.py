@@ -1,5 +1,6 @@
-"""The design page the service serves at ``/``: choose a model (or upload one), move its actuators with sliders, and
-see the mechanism follow in the 3-D view, with its task coordinates and its distances to the singularities.
+"""The design page the service serves at ``/``: choose a model (or upload one), move its actuators (or its task
+coordinates: the inverse kinematics then moves the actuators) with sliders, and see the mechanism follow in the 3-D
+view, with its task coordinates and its distances to the singularities.
 
 A registered mechanism's numeric design parameters can be changed and built (``POST /models/{name}/variants``: a
 new model, listed with the others). Two buttons start jobs (:mod:`pkm.serve.jobs`) at the current actuator values: every assembly mode (each listed with
@@ -45,6 +46,7 @@ body { margin: 0; font: 13px sans-serif; color: #222; display: flex; height: 100
   <form id="upload"><label>upload (spec + model file, Gepetto pair, MJCF, SDF)</label>
     <input type="file" id="files" multiple> <button type="submit">upload</button></form>
   <div id="sliders"></div>
+  <div id="task-sliders"></div>
   <details id="design"><summary>design parameters</summary><div id="params"></div>
     <button type="button" id="params-button">build this design</button></details>
   <table id="readout"></table>
@@ -115,11 +117,27 @@ async function selectModel(id) {
     const label = document.createElement("label");
     label.textContent = name + " [" + unit + "]";
     const input = document.createElement("input");
-    Object.assign(input, {type: "range", min: lo, max: hi, step: (hi - lo) / 1000, value: value, id: "qa-" + k});
+    Object.assign(input, {type: "range", min: lo, max: hi, step: "any", value: value, id: "qa-" + k});
     input.addEventListener("input", schedule);
     sliders.appendChild(label);
     sliders.appendChild(input);
   });
+  const tasks = document.getElementById("task-sliders");
+  tasks.innerHTML = "";
+  const y0 = (await api("POST", "/models/" + id + "/fk", {qa: qaOf(about, about.q_reference)})).y[0];
+  about.task_value_names.forEach(function (name, k) {
+    if (!(name in about.task_units)) return;  // (a pose's quaternion entries: no slider)
+    const unit = about.task_units[name], span = unit === "m" ? 0.05 : 0.3;
+    const label = document.createElement("label");
+    label.textContent = "task " + name + " [" + unit + "]";
+    const input = document.createElement("input");
+    Object.assign(input, {type: "range", min: y0[k] - span, max: y0[k] + span, step: "any", value: y0[k],
+                          id: "y-" + k});
+    input.addEventListener("input", function () { scheduleTask(k); });
+    tasks.appendChild(label);
+    tasks.appendChild(input);
+  });
+  state.y = y0;
   const view = document.getElementById("view");
   const loaded = new Promise(function (resolve) { view.onload = resolve; });
   view.src = "/models/" + id + "/preview" + (token ? "?token=" + encodeURIComponent(token) : "");
@@ -129,6 +147,25 @@ async function selectModel(id) {
 
 function qaOf(about, q) {
   return about.actuated_q.map(function (i) { return q[i]; });
+}
+
+async function scheduleTask(k) {
+  // a task slider: the inverse kinematics from the pose shown, then the actuator sliders follow
+  if (state.busy) { return; }
+  state.busy = true;
+  try {
+    const y = state.y.slice();
+    y[k] = parseFloat(document.getElementById("y-" + k).value);
+    const ik = await api("POST", "/models/" + state.model + "/ik", {y: y, seed: state.q});
+    if (ik.status[0] !== "ok") { say(ik.failures[0].message, false); return; }
+    state.y = y;
+    ik.qa[0].forEach(function (v, i) { document.getElementById("qa-" + i).value = v; });
+  } catch (e) {
+    say(e.message, true);
+  } finally {
+    state.busy = false;
+  }
+  update();
 }
 
 function schedule() {
@@ -147,6 +184,8 @@ async function update() {
       return;
     }
     state.q = fk.q[0];
+    state.y = fk.y[0];
+    fk.y[0].forEach(function (v, k) { const el = document.getElementById("y-" + k); if (el) el.value = v; });
     const scene = await api("POST", "/models/" + state.model + "/scene", {q: state.q});
     const viewer = document.getElementById("view").contentWindow.viewer;
     scene.paths.forEach(function (path, b) {

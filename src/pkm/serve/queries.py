@@ -195,19 +195,26 @@ def diagnose(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> d
 
 
 def velocities(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
-    """At closed configurations ``q`` and actuated rates ``qd``: every joint's rate ``v`` and the task rates
-    ``yd``."""
-    from pkm.core.differential.velocity import forward_jacobian
+    """At closed configurations ``q`` and actuated rates ``qd``: every joint's rate ``v`` and the task rates ``yd``;
+    with the actuated accelerations ``qdd`` too, every joint's acceleration ``a`` (the loops closed at the
+    acceleration level) and the task accelerations ``ydd``."""
+    from pkm.core.differential.velocity import accelerations, forward_jacobian, task_acceleration
     from pkm.core.differential.velocity import velocities as joint_rates
 
     q, qd = _array(body, "q", mech.nq), _array(body, "qd", mech.na)
-    n = _same_length(q=q, qd=qd)
+    qdd = _optional(body, "qdd", mech.na)
+    n = _same_length(q=q, qd=qd, qdd=qdd)
 
     def one(k: int) -> dict[str, Any]:
         qk, qdk = _row(q, k), _row(qd, k)
-        return {"v": joint_rates(mech, qk, qdk), "yd": forward_jacobian(mech, qk) @ qdk}
+        v = joint_rates(mech, qk, qdk)
+        out = {"v": v, "yd": forward_jacobian(mech, qk) @ qdk}
+        if qdd is not None:
+            a = accelerations(mech, qk, v, _row(qdd, k))
+            out.update(a=a, ydd=task_acceleration(mech, qk, v, a))
+        return out
 
-    return _columns(_each(n, one), ("v", "yd"))
+    return _columns(_each(n, one), ("v", "yd") + (("a", "ydd") if qdd is not None else ()))
 
 
 def dynamics(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:

@@ -2,7 +2,7 @@
 store.
 
 An upload is a set of files ``{name: bytes}`` (a closure spec and its model file, a Gepetto URDF + YAML pair, an
-MJCF or SDF file alone) read in memory by pkm's loaders (:func:`pkm.core.formats.load.load_texts`): no uploaded name
+MJCF or SDF file alone), or one archive of them (zip, tar: :meth:`Store.unpack`), read in memory by pkm's loaders (:func:`pkm.core.formats.load.load_texts`): no uploaded name
 reaches the file system. Its id is a hash of the names and contents (the same files give the same id); with a
 folder (``pkm serve --store DIR``) each upload is kept as its blobs (named by their own hashes) and a manifest, and
 read back when the service starts again. Mechanisms are built once and kept in memory.
@@ -78,6 +78,58 @@ class Store:
             uploads = list(self._uploads.values())
         return [Entry(n, "registered", n, {}) for n in self.registered] + uploads
 
+    @staticmethod
+    def unpack(files: dict[str, bytes]) -> dict[str, bytes]:
+        """An upload of one archive (``.zip``, ``.tar``, ``.tar.gz``, ``.tgz``) as its files, read in memory: each
+        member by its base name (folders dropped), at most :data:`MAX_FILES` regular files of at most
+        :data:`MAX_FILE_BYTES` (links and devices refused); any other upload as it is.
+
+        Raises:
+            InvalidInputError: a broken archive, too many or too large members, two members of one name.
+        """
+        import io
+        import tarfile
+        import zipfile
+
+        if len(files) != 1:
+            return files
+        (name, data), = files.items()
+        lower = name.lower()
+        members: dict[str, bytes] = {}
+
+        def take(member: str, content: bytes) -> None:
+            base = member.replace("\\", "/").rsplit("/", 1)[-1]
+            if not base:
+                return
+            if base in members or len(members) >= MAX_FILES or len(content) > MAX_FILE_BYTES:
+                raise InvalidInputError(name, f"member {member!r}: a repeated name, more than {MAX_FILES} files or "
+                                              f"over {MAX_FILE_BYTES} bytes")
+            members[base] = content
+
+        try:  # (each member read to one byte past the limit at most: a bomb stops there)
+            if lower.endswith(".zip"):
+                with zipfile.ZipFile(io.BytesIO(data)) as z:
+                    for info in z.infolist():
+                        if not info.is_dir():
+                            with z.open(info) as fh:
+                                take(info.filename, fh.read(MAX_FILE_BYTES + 1))
+            elif lower.endswith((".tar", ".tar.gz", ".tgz")):
+                with tarfile.open(fileobj=io.BytesIO(data)) as t:
+                    for m in t.getmembers():
+                        if m.isdir():
+                            continue
+                        member = t.extractfile(m) if m.isfile() else None
+                        if member is None:
+                            raise InvalidInputError(name, f"member {m.name!r} is a link or a device")
+                        take(m.name, member.read(MAX_FILE_BYTES + 1))
+            else:
+                return files
+        except (zipfile.BadZipFile, tarfile.TarError, EOFError, OSError) as e:
+            raise InvalidInputError(name, f"not a readable archive: {e}") from None
+        if not members:
+            raise InvalidInputError(name, "the archive holds no file")
+        return members
+
     def add(self, files: dict[str, bytes], *, persist: bool = True) -> Entry:
         """Read an upload, keep it, return its entry (the same files: the same entry).
 
@@ -88,6 +140,7 @@ class Store:
         """
         from pkm.core.formats.load import load_texts
 
+        files = self.unpack(files)
         if not files or len(files) > MAX_FILES:
             raise InvalidInputError("files", f"send 1 to {MAX_FILES} files", len(files))
         total = 0
