@@ -137,8 +137,9 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
         name: The C prefix (default: the mechanism's name as a C identifier).
 
     Raises:
-        ExportError: the mechanism cannot be exported, and why: a joint kind the twin does not write; the closures (or closures and task) do not fix the joints at the reference; a Newton solve that does not
-            converge at the reference; a non-finite kernel value at the reference.
+        ExportError: the mechanism cannot be exported, and why: a joint kind the twin does not write; the closures
+            (or closures and task) do not fix the joints at the reference; a Newton solve that does not converge at
+            the reference; a non-finite kernel value at the reference.
     """
     from pkm import __version__
 
