@@ -95,16 +95,16 @@ static int p_newton_$kind(const double* target, const double* q_prev, long mode,
     p_k_$kind_step(cur, target, next, &r, &pv, det);
     info->iterations = it; info->residual = r; info->pivot = pv;
     if (!(pv >= P_PIVOT_FLOOR)) {  /* the fixed pivots fail: the same system, densely */
-      double A[$NX * $NX], b[$NX], smin, smax;
+      double A[$NX * $NX], W[$NX * $NX], b[$NX], smin, smax;
       p_k_$kind_system(cur, target, A, b);
       p_extreme_sv($NX, A, &smin, &smax);
       info->sigma_min = smin;
       if (!(smin > P_SINGULAR_TOL * smax)) { p_copy(q, q_prev, P_NQ); return p_end(info, P_SINGULAR); }
-      p_lu($NX, A, b);
+      p_copy(W, A, $NX * $NX);  /* (A kept for the mode's blocks) */
+      p_lu($NX, W, b);
       p_k_$kind_retract(cur, b, target, next);
       if (r <= P_TOL) {  /* the mode from the dense blocks */
         int k, i, j;
-        p_k_$kind_system(cur, target, A, b);
         for (k = 0; k < $KNBLOCKS; ++k) {
           double B[P_BMAX * P_BMAX];
           int m = p_$kind_block_start[k + 1] - p_$kind_block_start[k];
@@ -201,44 +201,37 @@ int p_jacobians(const double q[P_NQ], double J[P_NX * P_NA], double K[P_NA * P_N
   return P_OK;
 }
 
-int p_task_velocity(const double q[P_NQ], const double qd[P_NA], double xd[P_NX], p_info* info) {
+/* out = M x (transpose: M^T x), M the forward Jacobian J (which 0: P_NX x P_NA) or the inverse K (which 1:
+   P_NA x P_NX) at q, column-major */
+static int p_map(const double* q, const double* x, int which, int transpose, double* out, p_info* info) {
   double J[P_NX * P_NA], K[P_NA * P_NX];
-  int i, k, status;
-  if (!p_finite(qd, P_NA)) { p_info local; return p_end(p_start(info, &local), P_INVALID_INPUT); }
+  const double* M = which ? K : J;
+  int rows = which ? P_NA : P_NX, cols = which ? P_NX : P_NA, a, b, status;
+  if (!p_finite(x, transpose ? rows : cols)) { p_info local; return p_end(p_start(info, &local), P_INVALID_INPUT); }
   status = p_jacobians(q, J, K, info);
   if (status != P_OK) return status;
-  for (i = 0; i < P_NX; ++i) { xd[i] = 0.0; for (k = 0; k < P_NA; ++k) xd[i] += J[k * P_NX + i] * qd[k]; }
+  if (!transpose) {
+    for (a = 0; a < rows; ++a) { out[a] = 0.0; for (b = 0; b < cols; ++b) out[a] += M[b * rows + a] * x[b]; }
+  } else {
+    for (b = 0; b < cols; ++b) { out[b] = 0.0; for (a = 0; a < rows; ++a) out[b] += M[b * rows + a] * x[a]; }
+  }
   return P_OK;
+}
+
+int p_task_velocity(const double q[P_NQ], const double qd[P_NA], double xd[P_NX], p_info* info) {
+  return p_map(q, qd, 0, 0, xd, info);  /* xd = J qd */
 }
 
 int p_actuator_velocity(const double q[P_NQ], const double xd[P_NX], double qd[P_NA], p_info* info) {
-  double J[P_NX * P_NA], K[P_NA * P_NX];
-  int i, k, status;
-  if (!p_finite(xd, P_NX)) { p_info local; return p_end(p_start(info, &local), P_INVALID_INPUT); }
-  status = p_jacobians(q, J, K, info);
-  if (status != P_OK) return status;
-  for (k = 0; k < P_NA; ++k) { qd[k] = 0.0; for (i = 0; i < P_NX; ++i) qd[k] += K[i * P_NA + k] * xd[i]; }
-  return P_OK;
+  return p_map(q, xd, 1, 0, qd, info);  /* qd = K xd */
 }
 
 int p_task_effort(const double q[P_NQ], const double tau[P_NA], double w[P_NX], p_info* info) {
-  double J[P_NX * P_NA], K[P_NA * P_NX];
-  int i, k, status;
-  if (!p_finite(tau, P_NA)) { p_info local; return p_end(p_start(info, &local), P_INVALID_INPUT); }
-  status = p_jacobians(q, J, K, info);
-  if (status != P_OK) return status;
-  for (i = 0; i < P_NX; ++i) { w[i] = 0.0; for (k = 0; k < P_NA; ++k) w[i] += K[i * P_NA + k] * tau[k]; }
-  return P_OK;
+  return p_map(q, tau, 1, 1, w, info);  /* w = K^T tau */
 }
 
 int p_actuator_effort(const double q[P_NQ], const double w[P_NX], double tau[P_NA], p_info* info) {
-  double J[P_NX * P_NA], K[P_NA * P_NX];
-  int i, k, status;
-  if (!p_finite(w, P_NX)) { p_info local; return p_end(p_start(info, &local), P_INVALID_INPUT); }
-  status = p_jacobians(q, J, K, info);
-  if (status != P_OK) return status;
-  for (k = 0; k < P_NA; ++k) { tau[k] = 0.0; for (i = 0; i < P_NX; ++i) tau[k] += J[k * P_NX + i] * w[i]; }
-  return P_OK;
+  return p_map(q, w, 0, 1, tau, info);  /* tau = J^T w */
 }
 
 int p_jdot_qdot(const double q[P_NQ], const double qd[P_NA], double c[P_NX], p_info* info) {
