@@ -75,18 +75,22 @@ class Polytope:
         """The largest ``t ≥ 0`` with ``t d`` inside (``d`` normalised; the origin inside): ``min b_i / (A_i d)``
         over the rows that ``d`` approaches."""
         d = np.asarray(direction, dtype=float)
-        d = d / np.linalg.norm(d)
-        rate = self.A @ d
-        ahead = rate > 1e-300
-        return float(np.min(self.b[ahead] / rate[ahead])) if ahead.any() else float("inf")
+        return float(_reach(self.b, self.A @ (d / np.linalg.norm(d))))
 
     def inscribed_radius(self, axes: ArrayLike | None = None) -> float:
         """The radius of the largest ball about the origin inside, in the coordinates ``axes`` (indices; the others
         held at zero; default all): ``min b_i / |A_i|`` over those columns."""
         cols = np.arange(self.A.shape[1]) if axes is None else np.asarray(axes, dtype=int)
-        norms = np.linalg.norm(self.A[:, cols], axis=1)
-        live = norms > 1e-300
-        return float(np.min(self.b[live] / norms[live])) if live.any() else float("inf")
+        return float(_reach(self.b, np.linalg.norm(self.A[:, cols], axis=1)))
+
+
+def _reach(b: np.ndarray, rate: np.ndarray) -> np.ndarray:
+    """``min b_i / rate_i`` over the rows whose rate is positive (the last axis), ``inf`` where none is: how far a
+    direction (``rate = A d``) or a ball (``rate = |A_i|``) goes inside ``A x ≤ b`` from the origin; one polytope or
+    a stack of them (``(n, m)`` arrays)."""
+    ahead = rate > 1e-300
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.min(np.where(ahead, b / np.where(ahead, rate, 1.0), np.inf), axis=-1)
 
 
 @dataclass(frozen=True)
@@ -235,23 +239,13 @@ def capability_indices(mech: Mechanism, Q: ArrayLike, kind: str = "wrench", *, g
     kinds = mech.task_map.kinds
     axes = tuple(kinds)
     units = tuple(_UNITS[kind][kinds[a]] for a in axes)
-    tiny = 1e-300
-
-    def reach(rate: np.ndarray) -> np.ndarray:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.min(np.where(rate > tiny, b / np.where(rate > tiny, rate, 1.0), np.inf), axis=1)
 
     def finish(x: np.ndarray) -> np.ndarray:
         return np.where(regular, np.where(inside, x, 0.0), np.nan)
 
-    along = {a: (finish(reach(A[:, :, i])), finish(reach(-A[:, :, i]))) for i, a in enumerate(axes)}
-    iso = {}
-    for u in dict.fromkeys(units):
-        cols = [i for i, x in enumerate(units) if x == u]
-        norms = np.linalg.norm(A[:, :, cols], axis=2)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            r = np.min(np.where(norms > tiny, b / np.where(norms > tiny, norms, 1.0), np.inf), axis=1)
-        iso[u] = finish(r)
+    along = {a: (finish(_reach(b, A[:, :, i])), finish(_reach(b, -A[:, :, i]))) for i, a in enumerate(axes)}
+    iso = {u: finish(_reach(b, np.linalg.norm(A[:, :, [i for i, x in enumerate(units) if x == u]], axis=2)))
+           for u in dict.fromkeys(units)}
     return along, iso, regular
 
 
