@@ -20,6 +20,7 @@ import numpy as np
 
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, PkmError
+from pkm.validation import as_array
 
 #: Samples in one request at most.
 MAX_SAMPLES = 100_000
@@ -49,10 +50,7 @@ def _array(body: Mapping[str, Any], key: str, size: int) -> np.ndarray:
     """``body[key]`` as :func:`_optional` gives it, required."""
     if key not in body or body[key] is None:
         raise InvalidInputError(key, f"missing: give {size} numbers, or a list of such samples")
-    try:
-        a = np.asarray(body[key], dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidInputError(key, f"expected numbers ({size} a sample)", str(body[key])[:200]) from None
+    a = as_array(body[key], key, f"numbers ({size} a sample)")  # (strings, booleans, ragged lists refused)
     if a.ndim == 1:
         a = a[None]
     if a.ndim != 2 or a.shape[1] != size:

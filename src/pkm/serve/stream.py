@@ -21,6 +21,7 @@ import numpy as np
 
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError
+from pkm.validation import as_array
 
 
 class Stream:
@@ -34,10 +35,7 @@ class Stream:
     def _vector(self, sample: Mapping[str, Any], key: str) -> np.ndarray | None:
         if key not in sample or sample[key] is None:
             return None
-        try:
-            v = np.asarray(sample[key], dtype=float).ravel()
-        except (TypeError, ValueError):
-            raise InvalidInputError(key, f"expected {self.mech.na} numbers", str(sample[key])[:100]) from None
+        v = as_array(sample[key], key, f"{self.mech.na} numbers").ravel()
         if v.shape != (self.mech.na,) or not np.all(np.isfinite(v)):
             raise InvalidInputError(key, f"expected {self.mech.na} finite numbers", v.tolist()[:20])
         return v
