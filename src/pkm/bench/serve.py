@@ -33,17 +33,6 @@ def add_arguments(ap) -> None:
     ap.add_argument("--stream", type=int, default=2000, help="samples through the WebSocket (default 2000)")
 
 
-def _rss_mb(pid: int) -> float:
-    try:
-        with open(f"/proc/{pid}/status") as fh:
-            for line in fh:
-                if line.startswith("VmRSS:"):
-                    return int(line.split()[1]) / 1024.0
-    except OSError:
-        pass
-    return float("nan")
-
-
 async def _load(url: str, clients: int, duration: float, bodies: list[tuple[str, dict]]) -> dict[str, Any]:
     import httpx
 
@@ -78,7 +67,7 @@ def run(args) -> dict[str, Any]:
         return {"skipped": f"pip install \"pkm[serve]\" (missing: {', '.join(missing('serve'))})"}
     import pkm
     from pkm.client import Client
-    from pkm.serve.process import start
+    from pkm.serve.process import rss_mb, start
 
     mech = pkm.load(MECHANISM)
     qa0 = mech.actuated_q(mech.q_reference)
@@ -94,9 +83,9 @@ def run(args) -> dict[str, Any]:
                 c._answer(c._http.post(path, json=body))
             with c.stream(MECHANISM) as s:
                 s.send(qa=qa0)
-        rss0 = _rss_mb(proc.pid)
+        rss0 = rss_mb(proc.pid)
         load = asyncio.run(_load(url, args.clients, args.duration, bodies))
-        rss1 = _rss_mb(proc.pid)
+        rss1 = rss_mb(proc.pid)
         n = max(1, args.batch)
         path_qa = qa0 + 0.1 * np.sin(np.linspace(0.0, 6.0, n))[:, None] * np.array([1.0, -0.5, 0.3])
         with Client(url) as c:

@@ -158,8 +158,7 @@ def fuzz(url: str, n: int, *, token: str | None = None, seed: int = 0) -> dict[s
 def main(argv: list[str] | None = None) -> int:
     import argparse
 
-    from pkm.bench.serve import _rss_mb
-    from pkm.serve.process import start
+    from pkm.serve.process import rss_mb, start
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--requests", type=int, default=10_000)
@@ -168,11 +167,11 @@ def main(argv: list[str] | None = None) -> int:
     token = "fuzz-token"
     proc, url = start("--token", token)
     try:
-        rss0 = _rss_mb(proc.pid)
+        rss0 = rss_mb(proc.pid)
         t0 = time.perf_counter()
         out = fuzz(url, args.requests, token=token, seed=args.seed)
         wall = time.perf_counter() - t0
-        rss1 = _rss_mb(proc.pid)
+        rss1 = rss_mb(proc.pid)
     finally:
         proc.terminate()
         code = proc.wait(timeout=60)

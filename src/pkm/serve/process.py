@@ -44,4 +44,16 @@ def start(*options: str, timeout: float = 60.0) -> tuple[subprocess.Popen, str]:
     raise RuntimeError(f"pkm serve did not answer on {url} within {timeout} s")
 
 
-__all__ = ["free_port", "start"]
+def rss_mb(pid: int) -> float:
+    """The resident memory of process ``pid`` [MB] (Linux's ``/proc/<pid>/status``; NaN elsewhere)."""
+    try:
+        with open(f"/proc/{pid}/status") as fh:
+            for line in fh:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
+    return float("nan")
+
+
+__all__ = ["free_port", "rss_mb", "start"]

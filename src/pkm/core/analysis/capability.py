@@ -204,9 +204,10 @@ def capability_indices(mech: Mechanism, Q: ArrayLike, kind: str = "wrench", *, g
     is ``{x : A x ≤ b}``, ``A = [P; -P]``, ``b = [hi - s; s - lo]``, with ``P = Jᵀ, s = g_a`` (wrenches),
     ``P = J⁻¹, s = 0`` (twists), ``P = M_a J⁻¹, s = g_a`` (accelerations from rest); along a unit direction ``d``
     the extent is ``min b_r / (A d)_r`` over the rows ``d`` approaches, and the isotropic value of a unit group
-    ``min b_r / |A_r|`` on that group's columns, as :class:`Polytope` computes them one pose at a time. Returns ``(along, isotropic, regular)``: ``{axis: (plus, minus)}`` and ``{unit: values}`` (n each; 0 where
-    the origin is outside, NaN where ``J`` is singular, as :func:`capability` refuses) and the mask of the regular
-    samples.
+    ``min b_r / |A_r|`` on that group's columns, as :class:`Polytope` computes them one pose at a time (one rule,
+    ``_reach``). Returns ``(along, isotropic, regular)``: ``{axis: (plus, minus)}`` and ``{unit: values}`` (n each;
+    0 where the origin is outside, NaN where ``J`` is singular, as :func:`capability` refuses) and the mask of the
+    regular samples.
 
     Raises:
         InvalidInputError: as :func:`capability` (kind, limits, redundant actuation).
