@@ -136,8 +136,10 @@ def _sweep(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str
     scheduler, workers = body.get("scheduler"), body.get("workers")
     if workers is not None and not (isinstance(workers, int) and 1 <= workers <= 8):
         raise InvalidInputError("workers", "1 to 8 local workers", workers)
-    name = job.model.split("@")[0]
-    res = sweeps.sweep(name, sweeps.grid(**grid), objectives, fixed=body.get("fixed"), scheduler=scheduler,
+    if "@" in job.model:  # (a variant's design would be dropped: its base's sweep with these values in fixed)
+        raise InvalidInputError("model", "sweep the registered mechanism and give the variant's parameters in fixed",
+                                job.model)
+    res = sweeps.sweep(job.model, sweeps.grid(**grid), objectives, fixed=body.get("fixed"), scheduler=scheduler,
                        workers=workers, progress=False)
     table = res.table
     rows = {c: np.asarray(table.column(c).to_pylist(), dtype=object if table.schema.field(c).type == "string"
