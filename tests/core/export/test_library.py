@@ -115,3 +115,19 @@ def test_what_cannot_be_exported_is_refused(tmp_path, monkeypatch):
     monkeypatch.setattr("pkm.core.export.model.Twin", helical)
     with pytest.raises(ExportError, match="JointModelHelical"):
         export_c(pkm.load(ACCEPTANCE["knee"][0]), tmp_path / "knee")
+
+
+def test_the_files_names_reach_the_c_unchanged(tmp_path):
+    """A joint whose name holds the template's own "p_" (``grip_pin``) keeps it in the library's name tables."""
+    from pkm.core.formats.load import load_texts
+
+    folder = Path(ACCEPTANCE["knee"][0]).parent
+    files = {f.name: f.read_text() for f in folder.iterdir() if f.suffix in (".urdf", ".toml")}
+    urdf = next(n for n in files if n.endswith(".urdf"))
+    files[urdf] = files[urdf].replace('"knee_front"', '"grip_pin"')
+    spec = next(n for n in files if n.endswith(".toml"))
+    files[spec] = files[spec].replace('"knee_front"', '"grip_pin"')
+    mech = load_texts(files)
+    assert "grip_pin" in mech.limits
+    source = export_c(mech, tmp_path / "knee").source.read_text()
+    assert '"grip_pin"' in source
