@@ -7,9 +7,11 @@ from __future__ import annotations
 
 import pickle
 
+import numpy as np
 import pytest
 
 import pkm
+from pkm import sweeps
 from pkm.core.kinematics import constraints
 from pkm.core.model.urdf import parse_xml
 from pkm.errors import InvalidInputError, InvalidParameterError, UnknownNameError
@@ -94,12 +96,15 @@ def test_origins_set_writes_the_named_components_and_refuses_unknown_joints():
 
 
 def test_a_model_family_varies_joint_origins_and_pickles_without_its_mechanism(built):
-    """Six parameters a URDF joint ([m] for x y z, [rad] for roll pitch yaw); no values: the loaded mechanism
-    itself; pickled: the texts only, rebuilt from them; its description fingerprints the files."""
+    """Six parameters a URDF joint ([m] for x y z, [rad] for roll pitch yaw) and ten a body (its inertial
+    parameters: kg, kg m, kg m^2); no values: the loaded mechanism itself; pickled: the texts only, rebuilt from
+    them; its description fingerprints the files."""
     mech = pkm.load("rrr3")
     fam = ModelFamily(mech)
-    assert len(fam.parameters()) == 6 * len(fam.joint_names) and "motor_1.x" in fam.parameters()
+    assert len(fam.parameters()) == 6 * len(fam.joint_names) + 10 * (mech.model.njoints - 1)
+    assert {"motor_1.x", "platform.m", "platform.Izz"} <= set(fam.parameters())
     assert fam.units("motor_1.z") == ({"length"}, "m") and fam.units("motor_1.roll") == ({"angle"}, "rad")
+    assert fam.units("platform.m") == ({"mass"}, "kg") and fam.units("platform.Ixy")[1] == "kg m^2"
     with pytest.raises(UnknownNameError):
         fam.units("motor_1.w")
     assert fam.mechanism({}) is mech and fam.params({}) is None and fam.registered is None
@@ -119,3 +124,21 @@ def test_a_moved_joint_origin_gives_a_closed_mechanism():
     mech = fam.mechanism({"motor_1.y": 0.14})
     assert mech.model.jointPlacements[mech.model.getJointId("motor_1")].translation[1] == pytest.approx(0.14, abs=1e-15)
     assert abs(constraints.residual(mech, mech.q_reference)).max() < 1e-9
+
+
+def test_designs_share_one_twin_with_design_inputs_and_score_as_their_own_twins():
+    """The 3-RRR's a, b, h move elbow, tip and platform-vertex origins and the links' inertias: the family's kernels
+    take those as inputs (found by moving each field), and two designs' generic GCI maps through them equal the maps
+    through each design's own compiled twin (``parametric=False``) to 1e-12."""
+    fam = RegisteredFamily("rrr3")
+    varied = fam.varied(("a", "b", "h"))
+    assert {"elbow_1.x", "leg2_tip_fixed.x", "platform_C_fixed.y", "proximal_1.mx"} <= set(varied)
+    assert "motor_2.x" not in varied  # (the base triangle is H's)
+    spec = "gci:route=generic,region=x=0.3:0.7:9/y=0.1:0.5:9,pose=yaw=0,length=0.1"
+    space = sweeps.table([{"a": 0.35, "b": 0.45, "h": 0.12}, {"a": 0.5, "b": 0.3, "h": 0.2}])
+    shared = pkm.sweep(fam, space, [spec], scheduler="serial").table.column(spec).to_pylist()
+    own = pkm.sweep(RegisteredFamily("rrr3", parametric=False), space, [spec], scheduler="serial")
+    assert None not in shared
+    assert np.allclose(shared, own.table.column(spec).to_pylist(), rtol=1e-12, atol=0)
+    candidate = fam.candidate({"a": 0.35, "b": 0.45, "h": 0.12})
+    assert candidate.kernels.design_values.size == len(varied)

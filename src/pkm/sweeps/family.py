@@ -5,8 +5,12 @@
   given (the paper's by default). A design is ``Params(**fixed, **values)``; its mechanism ``module.build``.
 * :class:`ModelFamily`: a mechanism loaded from one's own files. Its parameters are the origins of its URDF
   joints, ``JOINT.x``, ``JOINT.y``, ``JOINT.z`` [m] and ``JOINT.roll``, ``JOINT.pitch``, ``JOINT.yaw`` [rad]
-  (the joint's placement in its parent link, which is where a link's length lives), set to the values given; the
-  closure spec is kept as it is. Tuple fields of registered designs are not swept (name them fixed).
+  (the joint's placement in its parent link, which is where a link's length lives), and its bodies' inertial
+  parameters ``BODY.m`` [kg], ``BODY.mx`` ... [kg m], ``BODY.Ixx`` ... [kg m^2] (the regressor's names), set to the
+  values given (:func:`pkm.core.twin.design.design_mechanism`); the closure spec is kept as it is. Its compiled
+  kernels take the swept parameters as inputs (:meth:`ModelFamily.kernels`: designs as kernel inputs), so the
+  maps of a thousand designs share one compiled library. Tuple fields of registered designs are not swept (name
+  them fixed).
 
 A candidate builds what objectives need on first use and keeps it (:meth:`Candidate.cached`), so that several
 objectives of one design share one map or one mechanism. Families pickle small: the mechanism's name and the
@@ -22,10 +26,15 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from pkm._moved import renamed_keywords
+from pkm.core.identification.regressor import BODY_FIELDS
+from pkm.core.twin.design import ORIGIN, origins_set, urdf_joints
 from pkm.errors import InvalidInputError, UnknownNameError
 
-ORIGIN = {"x": ("xyz", 0), "y": ("xyz", 1), "z": ("xyz", 2), "roll": ("rpy", 0), "pitch": ("rpy", 1), "yaw": ("rpy", 2)}
 _SCALAR_TYPES = ("float", "int")
+#: Units of the inertial parameters, by field.
+_INERTIAL_UNITS = {"m": "kg", "mx": "kg m", "my": "kg m", "mz": "kg m", **dict.fromkeys(BODY_FIELDS[4:], "kg m^2")}
+#: Each process's kernels with design inputs, by family and design inputs (:meth:`Family.kernels`).
+_KERNELS: dict[tuple[str, tuple[str, ...]], Any] = {}
 
 
 class Candidate:
@@ -57,6 +66,12 @@ class Candidate:
         """The :class:`pkm.Mechanism` of this design (built on first use)."""
         return self.cached("mechanism", lambda: self.family.mechanism(self.values))
 
+    @property
+    def kernels(self):
+        """The :class:`pkm.Kernels` of this design: the family's kernels with design inputs bound to it where the
+        family has them (:meth:`ModelFamily.kernels`), else the design's own (compiled per design)."""
+        return self.cached("kernels", lambda: self.family.design_kernels(self))
+
 
 class Family:
     """A family of designs (see the module doc)."""
@@ -87,6 +102,50 @@ class Family:
         """JSON-able, enough to rebuild the family (:func:`from_description`)."""
         raise NotImplementedError
 
+    #: Whether designs share one compiled twin with design inputs (:meth:`design_kernels`); False compiles each
+    #: design's own (the route the shared one is checked against).
+    parametric: bool = True
+
+    def design_kernels(self, candidate: Candidate):
+        """The kernels of one design (:attr:`Candidate.kernels`): the family's twin with the parameters that
+        differ from the base design as inputs (:mod:`pkm.core.twin.design`), bound to this design; the design's own
+        when the family is not :attr:`parametric`, the design is the base, or it changes more than origins and
+        inertias (joint kinds, limits, the spec)."""
+        from pkm.core.twin import Kernels
+        from pkm.core.twin.design import read_design, structure
+
+        mech = candidate.mechanism
+        names = self.varied(tuple(candidate.values)) if self.parametric and candidate.values else ()
+        if not names or structure(mech) != self.cached_structure():
+            return Kernels(mech)
+        return self.kernels(names).at(read_design(mech, names), mech)
+
+    def varied(self, parameters: tuple[str, ...]) -> tuple[str, ...]:
+        """The design inputs (:func:`pkm.core.twin.design.read_design`'s names) that ``parameters`` move."""
+        raise NotImplementedError
+
+    def base_mechanism(self):
+        """The mechanism of the base design."""
+        raise NotImplementedError
+
+    def cached_structure(self) -> str:
+        if "_structure" not in self.__dict__:
+            from pkm.core.twin.design import structure
+
+            self._structure = structure(self.base_mechanism())
+        return self._structure
+
+    def kernels(self, names: tuple[str, ...]):
+        """The :class:`pkm.Kernels` of the base design with ``names`` as design inputs, built once per process
+        (their compiled libraries once per machine: :mod:`pkm.core.twin.codegen` caches them by source); bind a
+        design with :meth:`pkm.Kernels.at`."""
+        from pkm.core.twin import Kernels
+
+        key = (repr(sorted(self.describe().items())), tuple(names))
+        if key not in _KERNELS:
+            _KERNELS[key] = Kernels(self.base_mechanism(), design=names)
+        return _KERNELS[key]
+
     def candidate(self, values: Mapping[str, float]) -> Candidate:
         return Candidate(self, values)
 
@@ -94,9 +153,10 @@ class Family:
 class RegisteredFamily(Family):
     """The designs of registered mechanism ``name``, the fields not swept at ``fixed`` (SI or with units)."""
 
-    def __init__(self, name: str, fixed: Mapping[str, Any] | None = None):
+    def __init__(self, name: str, fixed: Mapping[str, Any] | None = None, *, parametric: bool = True):
         import pkm
 
+        self.parametric = bool(parametric)
         self.registered = name
         self.module = pkm.mechanism_module(name)  # UnknownNameError listing the mechanisms
         self.fields = {f.name: f for f in dataclasses.fields(self.module.Params)}
@@ -106,7 +166,7 @@ class RegisteredFamily(Family):
         self.fixed = {k: getattr(self.base, k) for k in (fixed or {})}
 
     def __reduce__(self):  # (the module does not pickle): rebuilt from the name and the fixed values
-        return (RegisteredFamily, (self.registered, self.fixed))
+        return (_registered, (self.registered, self.fixed, self.parametric))
 
     def parameters(self) -> tuple[str, ...]:
         return tuple(n for n, f in self.fields.items() if f.type in _SCALAR_TYPES)
@@ -136,59 +196,110 @@ class RegisteredFamily(Family):
     def mechanism(self, values: Mapping[str, float]):
         return self.module.build(self.params(values))
 
+    def base_mechanism(self):
+        if "_base_mech" not in self.__dict__:
+            self._base_mech = self.module.build(self.base)
+        return self._base_mech
+
+    def varied(self, parameters: tuple[str, ...]) -> tuple[str, ...]:
+        """The origins and inertias that move when each of ``parameters`` moves from the base design (a scalar
+        field moved by 1 %, and by 1e-3 where it is 0); none when an integer field (a working mode) is swept."""
+        from pkm.core.twin.design import read_design
+
+        from pkm.errors import PkmError
+
+        cache: dict[tuple[str, ...], tuple[str, ...]] = self.__dict__.setdefault("_varied", {})
+        if parameters not in cache:
+            base = read_design(self.base_mechanism())
+            names: set[str] = set()
+            for p in parameters:
+                v = float(getattr(self.base, p))
+                try:
+                    if self.integer(p):
+                        raise InvalidInputError(p, "a working mode changes the spec, not the geometry")
+                    moved = read_design(self.mechanism({p: v * 1.01 if v else 1e-3}))
+                except PkmError:  # (or the moved design does not build): no shared twin, each design its own
+                    names = set()
+                    break
+                names |= {n for n, x in moved.items() if n in base and x != base[n]}
+            cache[parameters] = tuple(n for n in base if n in names)
+        return cache[parameters]
+
     def describe(self) -> dict[str, Any]:
         return {"registered": self.registered, "fixed": {k: _jsonable(v) for k, v in self.fixed.items()}}
 
 
 class ModelFamily(Family):
-    """Designs of a loaded mechanism: its URDF joints' origins set to the values (see the module doc)."""
+    """Designs of a loaded mechanism: its URDF joints' origins and its bodies' inertial parameters set to the values
+    (see the module doc). ``parametric=False`` compiles each design's kernels apart (:attr:`Family.parametric`)."""
 
-    def __init__(self, mech):
+    def __init__(self, mech, *, parametric: bool = True):
         from pkm.core.model.mechanism import check_mechanism
 
         mech = check_mechanism(mech)
         if mech.urdf is None:
             raise InvalidInputError("mechanism", "built from a Pinocchio model without URDF text: nothing to vary "
                                                  "(load it from files)", mech.source)
+        from pkm.core.identification.regressor import parameters
+
         self.urdf, self.spec, self.source = mech.urdf, mech.spec.to_toml(), mech.source
         self._base = mech
-        self.joint_names = tuple(_joints(self.urdf)[1])
+        self.joint_names = urdf_joints(self.urdf)
+        self.body_names = parameters(mech).bodies
+        self.parametric = bool(parametric)
 
     def __getstate__(self):
-        return {"urdf": self.urdf, "spec": self.spec, "source": self.source, "joint_names": self.joint_names}
+        return {"urdf": self.urdf, "spec": self.spec, "source": self.source, "joint_names": self.joint_names,
+                "body_names": self.body_names, "parametric": self.parametric}
 
     def __setstate__(self, state):
         self.__dict__.update(state)
         self._base = None
 
+    @property
+    def base(self):
+        """The mechanism as its files state it (rebuilt once after pickling)."""
+        if self._base is None:
+            from pkm.core.model.builder import from_strings
+
+            self._base = from_strings(self.urdf, self.spec, source=self.source)
+        return self._base
+
     def parameters(self) -> tuple[str, ...]:
-        return tuple(f"{j}.{c}" for j in self.joint_names for c in ORIGIN)
+        return (tuple(f"{j}.{c}" for j in self.joint_names for c in ORIGIN)
+                + tuple(f"{b}.{f}" for b in self.body_names for f in BODY_FIELDS))
 
     def units(self, name: str) -> tuple[set[str | None], str]:
         if name not in self.parameters():
             raise UnknownNameError("parameter", name, self.parameters(),
                                    f"a sweep of {self.source} (URDF joint origins JOINT.x/y/z [m], "
-                                   f"JOINT.roll/pitch/yaw [rad])")
-        return ({"angle"}, "rad") if ORIGIN[name.rsplit(".", 1)[1]][0] == "rpy" else ({"length"}, "m")
+                                   f"JOINT.roll/pitch/yaw [rad]; inertial parameters BODY.m [kg], BODY.mx/my/mz "
+                                   f"[kg m], BODY.Ixx... [kg m^2])")
+        comp = name.rsplit(".", 1)[1]
+        if comp in ORIGIN:
+            return ({"angle"}, "rad") if ORIGIN[comp][0] == "rpy" else ({"length"}, "m")
+        return ({"mass"}, "kg") if comp == "m" else ({None}, _INERTIAL_UNITS[comp])
 
     def mechanism(self, values: Mapping[str, float]):
-        import dataclasses
+        from pkm.core.twin.design import design_mechanism
 
-        from pkm.core.model.builder import from_strings
-        from pkm.core.model.spec import ClosureSpec
+        if not values:
+            return self.base
+        return design_mechanism(self.base, values)
 
-        if not values and self._base is not None:
-            return self._base
-        # the moved origins no longer close the file's reference: the actuators are held, the other joints assembled
-        # from their former values (the same assembly mode)
-        spec = ClosureSpec.from_toml(self.spec, self.source)
-        held = {n: v for n, v in spec.reference.items() if n in spec.actuated}
-        return from_strings(origins_set(self.urdf, values), dataclasses.replace(spec, reference=held),
-                            source=self.source, seed=spec.reference)
+    def base_mechanism(self):
+        return self.base
+
+    def varied(self, parameters: tuple[str, ...]) -> tuple[str, ...]:
+        return parameters
 
     def describe(self) -> dict[str, Any]:
         return {"source": self.source, "urdf_sha256": hashlib.sha256(self.urdf.encode()).hexdigest(),
                 "spec_sha256": hashlib.sha256(self.spec.encode()).hexdigest()}
+
+
+def _registered(name: str, fixed: Mapping[str, Any], parametric: bool) -> RegisteredFamily:
+    return RegisteredFamily(name, fixed, parametric=parametric)
 
 
 def family_of(mechanism, fixed: Mapping[str, Any] | None = None) -> Family:
@@ -206,33 +317,6 @@ def family_of(mechanism, fixed: Mapping[str, Any] | None = None) -> Family:
         raise InvalidInputError("fixed", "fixed parameters are for registered mechanisms; a loaded one sweeps its "
                                          "joint origins and keeps the others as its files state them", fixed)
     return ModelFamily(mechanism if isinstance(mechanism, pkm.Mechanism) else pkm.load(mechanism))
-
-
-def _joints(urdf: str):
-    """The URDF's root and its joints by name (pkm's hardened parser, :func:`pkm.core.model.urdf.parse_xml`)."""
-    from pkm.core.model.urdf import parse_xml
-
-    root = parse_xml(urdf)
-    return root, {j.get("name"): j for j in root.iter("joint") if j.get("name") and j.getparent() is root}
-
-
-def origins_set(urdf: str, values: Mapping[str, float]) -> str:
-    """The URDF text with the joint origins named by ``values`` (``JOINT.x`` ... ``JOINT.yaw``, SI) set."""
-    from lxml import etree
-
-    root, joints = _joints(urdf)
-    for name, value in values.items():
-        joint, _, comp = name.rpartition(".")
-        if joint not in joints or comp not in ORIGIN:
-            raise UnknownNameError("parameter", name, [f"{j}.{c}" for j in joints for c in ORIGIN], "the URDF")
-        origin = joints[joint].find("origin")
-        if origin is None:
-            origin = etree.SubElement(joints[joint], "origin")
-        attr, k = ORIGIN[comp]
-        parts = (origin.get(attr) or "0 0 0").split()
-        parts[k] = repr(float(value))
-        origin.set(attr, " ".join(parts))
-    return etree.tostring(root, encoding="unicode")
 
 
 def from_description(desc: Mapping[str, Any], mechanism=None) -> Family:

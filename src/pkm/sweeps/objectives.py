@@ -336,7 +336,8 @@ def _generic_map(c: Candidate, o: Mapping[str, Any]):
         axes = {n: np.linspace(_task_value(mech, n, a), _task_value(mech, n, b), k)
                 for n, (a, b, k) in o["region"].items()}
         fixed = {n: _task_value(mech, n, v) for n, v in (o.get("pose") or {}).items()}
-        return workspace_map(mech, axes, fixed, length=o.get("length"), branch=o.get("branch") or None)
+        return workspace_map(mech, axes, fixed, length=o.get("length"), branch=o.get("branch") or None,
+                             kernels=c.kernels)
 
     key = ("task_map", tuple(o["region"].items()), tuple((o.get("pose") or {}).items()), o.get("length"),
            o.get("branch"))

@@ -215,6 +215,10 @@ class WorkspaceMap:
 
 
 def _library(kernels: Kernels) -> tuple[Any, tuple[int, int], str]:
+    return kernels.cached("map", lambda: _compile(kernels))  # type: ignore[return-value]
+
+
+def _compile(kernels: Kernels) -> tuple[Any, tuple[int, int], str]:
     from pkm.core.twin.codegen import compile_library, map_source
 
     step, qr_step, index = (kernels.function(k) for k in ("map_newton", "map_newton_qr", "map_indices"))
@@ -224,7 +228,7 @@ def _library(kernels: Kernels) -> tuple[Any, tuple[int, int], str]:
         raise CompilerError("maps need a C compiler", how)
     grid = getattr(lib, f"{step.name()}_grid")
     grid.argtypes = [ctypes.POINTER(_I), _I, _P, _P, _P, _P, ctypes.POINTER(_I), _I, _I, ctypes.c_double,
-                     ctypes.c_double, ctypes.POINTER(ctypes.c_byte), _P, ctypes.POINTER(_I), _P]
+                     ctypes.c_double, ctypes.POINTER(ctypes.c_byte), _P, ctypes.POINTER(_I), _P, _P]
     grid.restype = ctypes.c_int
     return grid, index.size_out(0), how
 
@@ -251,7 +255,8 @@ def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[st
         max_iter: Newton iterations allowed per node; a node whose step stops shrinking (by 10 % an iteration
             from the third) is given up earlier. Near an inverse singularity the root is (nearly) double and the
             step only halves: those nodes take tens of iterations.
-        kernels: A :class:`pkm.Kernels` of ``mech`` to reuse.
+        kernels: A :class:`pkm.Kernels` of ``mech`` to reuse; or kernels with design inputs bound to ``mech``'s design
+            (``Kernels(family_mech, design=names).at(values, mech)``): one compiled library for every design.
         configurations: Keep each node's configuration (:attr:`WorkspaceMap.q`: nq numbers a node), for indices
             computed afterwards (:func:`pkm.core.analysis.capability.map_capability`).
 
@@ -270,7 +275,8 @@ def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[st
     task = TaskMap(mech)
     kernels = Kernels(mech) if kernels is None else kernels
     if not isinstance(kernels, Kernels) or kernels.mech is not mech:
-        raise InvalidInputError("kernels", "give the pkm.Kernels of this mechanism", kernels)
+        raise InvalidInputError("kernels", "give the pkm.Kernels of this mechanism (or kernels with design inputs "
+                                           "bound to it: Kernels.at(values, mech))", kernels)
     if not isinstance(axes, Mapping) or not 1 <= len(axes) <= 3:
         raise InvalidInputError("axes", "give 1 to 3 task coordinates as {name: values}", axes)
     names = list(task.value_names)
@@ -314,6 +320,7 @@ def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[st
     roots = np.concatenate([[first], sum(c.ravel() * s for c, s in zip(coarse, strides))]).astype(np.int64)
 
     grid, (m, n), how = _library(kernels)
+    design = np.ascontiguousarray(kernels.design_values, dtype=float)
     nsv = min(m, n)
     state = np.zeros(total, dtype=np.int8)
     sv = np.empty((total, nsv))
@@ -324,7 +331,8 @@ def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[st
     flag = grid(c_dims.ctypes.data_as(ctypes.POINTER(_I)), len(dims), *[a.ctypes.data_as(_P) for a in arrays],
                 roots.ctypes.data_as(ctypes.POINTER(_I)), len(roots), max_iter, step_tol, tol,
                 state.ctypes.data_as(ctypes.POINTER(ctypes.c_byte)), sv.ctypes.data_as(_P),
-                its.ctypes.data_as(ctypes.POINTER(_I)), None if q_out is None else q_out.ctypes.data_as(_P))
+                its.ctypes.data_as(ctypes.POINTER(_I)), None if q_out is None else q_out.ctypes.data_as(_P),
+                design.ctypes.data_as(_P) if design.size else None)
     if flag:
         raise CompilerError("the compiled map driver failed", "out of memory" if flag == 2 else f"code {flag}")
     shape = tuple(reversed(dims))

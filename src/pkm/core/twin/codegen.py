@@ -5,9 +5,10 @@ the whole with the system's C compiler (``cc -O2 -shared``; ``-O0`` above :data:
 with :mod:`ctypes`:
 
 * ``NAME_batch(n, in, out)``: the function on ``n`` samples, each input and output a sample-major array;
-* ``NAME_follow(n, q0, targets, q_out, residual, pivot, iterations, max_iter, tol)``, for a Newton iteration
-  (inputs ``q, target``; outputs ``q_next, residual, pivot``): per target, iterate from the previous solution
-  (the first from ``q0``) until the residual is at most ``tol`` or ``max_iter`` iterations were made;
+* ``NAME_follow(n, q0, targets, q_out, residual, pivot, iterations, max_iter, tol, design)``, for a Newton
+  iteration (inputs ``q, target`` and, for a twin with design inputs, ``design``; outputs ``q_next, residual,
+  pivot``): per target, iterate from the previous solution (the first from ``q0``) until the residual is at most
+  ``tol`` or ``max_iter`` iterations were made;
 * ``NAME_grid(...)`` (:func:`map_source`): the maps' breadth-first solve over a grid (:mod:`pkm.core.analysis.maps`).
 
 :func:`numpy_function` runs a function vectorised over samples with numpy instead (one statement per instruction),
@@ -77,7 +78,7 @@ int NAME_batch(casadi_int n, const casadi_real** in, casadi_real** out) {
 _FOLLOW = r"""
 int NAME_follow(casadi_int n, const casadi_real* q0, const casadi_real* targets, casadi_real* q_out,
                 casadi_real* residual, casadi_real* pivot, casadi_int* iterations, casadi_int max_iter,
-                casadi_real tol) {
+                casadi_real tol, const casadi_real* design) {
   const casadi_real** arg; casadi_real** res; casadi_int* iw; casadi_real* w;
   const casadi_int nq = NAME_isz[0], nt = NAME_isz[1];
   casadi_real* cur = malloc(sizeof(casadi_real) * nq); casadi_real* next = malloc(sizeof(casadi_real) * nq);
@@ -85,7 +86,7 @@ int NAME_follow(casadi_int n, const casadi_real* q0, const casadi_real* targets,
   memcpy(cur, q0, sizeof(casadi_real) * nq);
   for (casadi_int k = 0; k < n; ++k) {
     casadi_real r = 0.0, p = 0.0; casadi_int it = 0;
-    arg[1] = targets + k * nt; res[0] = next; res[1] = &r; res[2] = &p;
+    arg[1] = targets + k * nt; res[0] = next; res[1] = &r; res[2] = &p; DESIGN_FOLLOW
     do {
       arg[0] = cur;
       if (NAME(arg, res, iw, w, 0)) { NAME_pkm_free(arg, res, iw, w); free(cur); free(next); return 1; }
@@ -142,7 +143,8 @@ JACOBI_SV
 int STEP_grid(const casadi_int* dims, casadi_int ndim, const casadi_real* targets, const casadi_real* q0,
               const casadi_real* scale, const casadi_real* signs, const casadi_int* roots, casadi_int nroots,
               casadi_int max_iter, casadi_real step_tol, casadi_real tol,
-              signed char* state, casadi_real* sv, casadi_int* iterations, casadi_real* q_out) {
+              signed char* state, casadi_real* sv, casadi_int* iterations, casadi_real* q_out,
+              const casadi_real* design) {
   /* state: 0 not reached, 1 solved, -3 failed (not converged, or in another mode), -2 queued; a node is queued
      by each solved neighbour (2 ndim tries at most) until one solves it; q_out (NULL: not kept) the solutions */
   const casadi_int nq = NQ, nt = NT, m = KROWS, n = KCOLS, nb = NB, nsv = (m < n ? m : n);
@@ -161,6 +163,7 @@ int STEP_grid(const casadi_int* dims, casadi_int ndim, const casadi_real* target
       || INDEX_pkm_alloc(&ia, &ir, &iiw, &iw_) || QRSTEP_pkm_alloc(&qa, &qr, &qiw, &qw)) return 2;
   unsigned char* tries = calloc((size_t) total, 1);
   if (!tries) return 2;
+  DESIGN_GRID
   for (casadi_int k = 0; k < total; ++k) { state[k] = 0; iterations[k] = 0; for (casadi_int j = 0; j < nsv; ++j) sv[k * nsv + j] = NAN; }
   for (casadi_int r = 0; r < nroots; ++r) {  /* each root not reached from an earlier one starts a search */
     if (state[roots[r]] != 0) continue;
@@ -251,6 +254,7 @@ def source(funs: cs.Function | Iterable[cs.Function], *, follow: bool = False) -
     text = gen.dump() + "#include <math.h>\n#include <stdlib.h>\n#include <string.h>\n"
     for fun in funs:
         drivers = (_BATCH + (_FOLLOW if follow else "")).replace("NIN", str(fun.n_in())).replace("NOUT", str(fun.n_out()))
+        drivers = drivers.replace("DESIGN_FOLLOW", "arg[2] = design;" if fun.n_in() > 2 else "(void) design;")
         drivers = drivers.replace("ISZ", sizes(fun.n_in(), fun.nnz_in)).replace("OSZ", sizes(fun.n_out(), fun.nnz_out))
         text += drivers.replace("NAME", fun.name())
     return text
@@ -261,7 +265,9 @@ def map_source(step: cs.Function, qr_step: cs.Function, index: cs.Function, pivo
     drivers and the grid driver ``<step>_grid``."""
     nq, nt = step.nnz_in(0), step.nnz_in(1)
     m, n = index.size_out(0)
-    grid = (_GRID.replace("JACOBI_SV\n", jacobi_sv("STEP_pkm_sv", 1e-17, 1e-16))
+    design = ("sa[2] = design; qa[2] = design; ia[3] = design;  /* the design: one for every node */"
+              if step.n_in() > 2 else "(void) design;")
+    grid = (_GRID.replace("JACOBI_SV\n", jacobi_sv("STEP_pkm_sv", 1e-17, 1e-16)).replace("DESIGN_GRID", design)
             .replace("QRSTEP", qr_step.name()).replace("STEP", step.name()).replace("INDEX", index.name())
             .replace("PIVOT_FLOOR", repr(float(pivot_floor))).replace("BRANCH_TOL", repr(BRANCH_TOL)).replace("NQ", str(nq)).replace("NT", str(nt))
             .replace("KROWS", str(m)).replace("KCOLS", str(n)).replace("NB", str(index.nnz_out(2))))
@@ -269,8 +275,8 @@ def map_source(step: cs.Function, qr_step: cs.Function, index: cs.Function, pivo
 
 
 def compile_library(fun: cs.Function | Iterable[cs.Function], *, follow: bool = False,
-                    directory: str | os.PathLike[str] | None = None, text: str | None = None
-                    ) -> tuple[ctypes.CDLL | None, str]:
+                    directory: str | os.PathLike[str] | None = None, text: str | None = None,
+                    flags: tuple[str, ...] | None = None) -> tuple[ctypes.CDLL | None, str]:
     """``fun`` (one CasADi function or a list) and its drivers compiled and loaded. Returns ``(library, how)``;
     ``library`` is None, and ``how`` says why, when there is no C compiler on the PATH (``cc``, ``gcc`` or
     ``clang``) or it failed.
@@ -280,6 +286,8 @@ def compile_library(fun: cs.Function | Iterable[cs.Function], *, follow: bool = 
         follow: Add the path driver (``fun`` is a Newton iteration: see the module doc).
         directory: Where the source and library go (default :func:`cache_dir`).
         text: The C source, when not :func:`source` of ``fun`` (:func:`map_source`).
+        flags: The compiler's optimisation flags, in place of ``-O2`` (``-O0`` above :data:`LARGE` instructions);
+            ``-shared -fPIC`` are added (:mod:`pkm.core.twin.simd`).
     """
     funs = [fun] if isinstance(fun, cs.Function) else list(fun)
     cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
@@ -288,7 +296,8 @@ def compile_library(fun: cs.Function | Iterable[cs.Function], *, follow: bool = 
     text = source(funs, follow=follow) if text is None else text
     folder = Path(directory) if directory is not None else cache_dir()
     folder.mkdir(parents=True, exist_ok=True)
-    flags = ("-O2" if sum(f.n_instructions() for f in funs) <= LARGE else "-O0", *_FLAGS)
+    flags = (*(flags if flags is not None else ("-O2" if sum(f.n_instructions() for f in funs) <= LARGE else "-O0",)),
+             *_FLAGS)
     digest = hashlib.sha256((text + " ".join(flags)).encode()).hexdigest()[:20]
     name = funs[0].name()
     library = folder / f"{name}-{digest}.so"

@@ -24,10 +24,11 @@ reflected rotor inertias (Pinocchio's ``armature``) are in the twin's RNEA, and 
 
 from __future__ import annotations
 
+import copy
 import ctypes
 import functools
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -130,7 +131,7 @@ class _Kernel:
         self._batch.restype = ctypes.c_int
         if follow:
             self._follow = getattr(self.lib, f"{fun.name()}_follow")
-            self._follow.argtypes = [_I, _P, _P, _P, _P, _P, ctypes.POINTER(_I), _I, ctypes.c_double]
+            self._follow.argtypes = [_I, _P, _P, _P, _P, _P, ctypes.POINTER(_I), _I, ctypes.c_double, _P]
             self._follow.restype = ctypes.c_int
         # one sample: fixed buffers and pointer arrays, so that a call costs a copy in and out
         self._one_in = [np.zeros(n) for n in self.in_size]
@@ -173,15 +174,16 @@ class _Kernel:
             raise RuntimeError(f"the compiled kernel {self.fun.name()} failed")
         return outs
 
-    def follow(self, q0: np.ndarray, targets: np.ndarray, max_iter: int, tol: float) \
-            -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def follow(self, q0: np.ndarray, targets: np.ndarray, max_iter: int, tol: float,
+               design: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         n, nq = targets.shape[0], q0.shape[0]
+        extra = () if design is None else (design,)
         if self.lib is None:
             q, out = q0.copy(), (np.empty((n, nq)), np.empty(n), np.empty(n), np.zeros(n, dtype=np.int64))
             for k in range(n):
                 it = 0
                 while True:
-                    nxt, r, p = self.fun(q, targets[k])
+                    nxt, r, p = self.fun(q, targets[k], *extra)
                     q, it = np.array(nxt).ravel(), it + 1
                     if float(r) <= tol or it >= max_iter or not np.isfinite(float(r)):
                         break
@@ -193,7 +195,8 @@ class _Kernel:
         q0 = np.ascontiguousarray(q0, dtype=float)
         flag = self._follow(n, q0.ctypes.data_as(_P), t.ctypes.data_as(_P), q_out.ctypes.data_as(_P),
                             res.ctypes.data_as(_P), piv.ctypes.data_as(_P), its.ctypes.data_as(ctypes.POINTER(_I)),
-                            max_iter, tol)
+                            max_iter, tol, None if design is None else np.ascontiguousarray(design, dtype=float
+                                                                                            ).ctypes.data_as(_P))
         if flag:
             raise RuntimeError(f"the compiled kernel {self.fun.name()} failed")
         return q_out, res, piv, its
@@ -204,19 +207,54 @@ class Kernels:
 
     Args:
         mech: Any mechanism pkm loads, without idle motions (the actuator-space model's kernels take them too).
+        design: Design parameters taken as kernel inputs (:mod:`~pkm.core.twin.design`: ``JOINT.x`` ...
+            ``JOINT.yaw``, ``BODY.m`` ... ``BODY.Izz``): every kernel takes a last input ``design`` and one compiled
+            library serves every design; :meth:`at` binds a design. Default none: the file's numbers are constants.
         compiled: Compile to C when a C compiler is present (default); False runs numpy (batches) and CasADi's
             virtual machine (one sample).
         directory: Where compiled libraries go (default :func:`pkm.core.twin.codegen.cache_dir`).
 
     Raises:
         SpecError: ``mech`` has idle motions (on the first kernel that needs the passive solve, but the model's).
+        UnknownNameError: a design parameter ``mech`` does not have (the error lists those it has).
     """
 
-    def __init__(self, mech: Mechanism, *, compiled: bool = True, directory: str | os.PathLike[str] | None = None):
+    def __init__(self, mech: Mechanism, *, design: Sequence[str] | None = None, compiled: bool = True,
+                 directory: str | os.PathLike[str] | None = None):
         self.mech = check_mechanism(mech)
-        self.twin = Twin(self.mech)
+        self.twin = Twin(self.mech, design)
+        #: The design parameters (:class:`~pkm.core.twin.design.Design`; empty: none).
+        self.design = self.twin.design
         self.compiled, self.directory = compiled, directory
         self._kernels: dict[str, _Kernel] = {}
+        self._shared: dict[object, object] = {}
+        self._p = self.design.base
+
+    def at(self, design: Mapping[str, float] | ArrayLike, mech: Mechanism | None = None) -> Kernels:
+        """These kernels (the same compiled libraries) evaluated at one design: ``design`` by name (the others at
+        the file's values) or as the whole vector of :attr:`design`'s parameters. ``mech`` is that design's
+        mechanism, which the fallbacks (samples under the pivot floor) and the paths' default start use; default
+        :func:`~pkm.core.twin.design.design_mechanism` (built here: a few milliseconds)."""
+        if not len(self.design):
+            raise InvalidInputError("design", "these kernels take no design inputs: build them with "
+                                              "Kernels(mech, design=[names])", design)
+        view = copy.copy(self)
+        view._p = self.design.vector(design)
+        if mech is None:
+            from pkm.core.twin.design import design_mechanism
+
+            mech = design_mechanism(self.mech, dict(zip(self.design.names, view._p)))
+        view.mech = check_mechanism(mech)
+        return view
+
+    @property
+    def design_values(self) -> np.ndarray:
+        """The design the kernels are evaluated at (:meth:`at`; the file's by default)."""
+        return self._p.copy()
+
+    def inputs(self, name: str) -> tuple[str, ...]:
+        """The inputs of kernel ``name`` (:data:`KERNELS`, then ``design`` when the kernels take one)."""
+        return KERNELS[name][0] + (("design",) if len(self.design) else ())
 
     # ---------------------------------------------------------------- kernels
     def function(self, name: str) -> cs.Function:
@@ -227,6 +265,9 @@ class Kernels:
         if name == "regressor":  # (a twin of its own: the bodies' parameters as symbols)
             from pkm.core.twin.regressor import regressor_function
 
+            if len(self.design):
+                raise InvalidInputError("kernel", "the regressor is linear in the inertial parameters already; "
+                                                  "take it from Kernels(mech) of each design", name)
             return regressor_function(self.mech)
         inputs, outputs = KERNELS[name]
         exprs = {"inverse_dynamics": lambda: {"tau": tw.inverse_dynamics,
@@ -249,11 +290,13 @@ class Kernels:
                  }[name]()
         assert tuple(exprs) == outputs
         sym = {"q": tw.q, "v": tw.v, "qd": tw.qd, "qdd": tw.qdd, "target": tw.target, "y": tk.task_target,
-               "scale": tk.scale}
+               "scale": tk.scale, "design": tw.p}
+        inputs = self.inputs(name)
         if name in _DYNAMICS:
             sym.update(tau=self.dynamics.tau, friction=self.dynamics.friction)
         values = cs.cse([cs.densify(cs.SX(e)) for e in exprs.values()])
-        return cs.Function(f"pkm_{name}", [sym[i] for i in inputs], values, list(inputs), list(outputs))
+        fun_name = f"pkm_{name}" + ("_design" if len(self.design) else "")
+        return cs.Function(fun_name, [sym[i] for i in inputs], values, list(inputs), list(outputs))
 
     @functools.cached_property
     def dynamics(self) -> ActuatorTwin:
@@ -267,6 +310,13 @@ class Kernels:
             self._kernels[name] = _Kernel(self.function(name), name in _PATHS, self.compiled,
                                           self.directory)
         return self._kernels[name]
+
+    def cached(self, key: object, make: Callable[[], object]) -> object:
+        """``make()`` once for these kernels and every design bound to them (:meth:`at`): a compiled library of
+        several kernels (the maps' grid driver)."""
+        if key not in self._shared:
+            self._shared[key] = make()
+        return self._shared[key]
 
     @property
     def how(self) -> dict[str, str]:
@@ -304,6 +354,8 @@ class Kernels:
             arrays = [a[None] for a in arrays]
         elif len({a.shape[0] for a in arrays}) > 1:
             raise InvalidInputError(name, f"batches of different lengths {[a.shape[0] for a in arrays]}")
+        if len(self.design):
+            arrays.append(np.broadcast_to(self._p, (arrays[0].shape[0], len(self._p))))
         outs = kernel(*arrays)
         if not np.isfinite(outs[0]).all():
             for what, a in zip(KERNELS[name][0], arrays):
@@ -475,7 +527,7 @@ class Kernels:
         Q, res, its = np.empty((n, len(prev))), np.empty(n), np.zeros(n, dtype=np.int64)
         fallback, start = [], 0
         while start < n:
-            q_k, r_k, p_k, i_k = kernel.follow(prev, t[start:], max_iter, tol)
+            q_k, r_k, p_k, i_k = kernel.follow(prev, t[start:], max_iter, tol, self._p if len(self.design) else None)
             bad = np.flatnonzero(~((r_k <= tol) & (p_k >= PIVOT_FLOOR)))
             end = start + (int(bad[0]) if bad.size else len(q_k))
             Q[start:end], res[start:end], its[start:end] = q_k[:end - start], r_k[:end - start], i_k[:end - start]

@@ -23,8 +23,8 @@ import casadi as cs
 
 from pkm.core.dynamics.model import COULOMB_VELOCITY
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.core.twin.spatial import Expr, cross
-from pkm.core.twin.tree import Twin
+from pkm.core.twin.spatial import Expr
+from pkm.core.twin.tree import Twin, theta_times
 
 
 class ParametricTwin(Twin):
@@ -36,12 +36,7 @@ class ParametricTwin(Twin):
         self.theta = cs.SX.sym("theta", 10 * (len(self.joints) - 1))
 
     def _inertia_times(self, j: int, m: Expr) -> Expr:
-        th = self.theta[10 * (j - 1):10 * j]
-        mass, h = th[0], th[1:4]
-        inertia = cs.vertcat(cs.horzcat(th[4], th[5], th[7]), cs.horzcat(th[5], th[6], th[8]),
-                             cs.horzcat(th[7], th[8], th[9]))
-        lin = mass * m[:3] - cross(h, m[3:])
-        return cs.vertcat(lin, inertia @ m[3:] + cross(h, m[:3]))
+        return theta_times(self.theta[10 * (j - 1):10 * j], m)
 
 
 def regressor_expression(twin: ParametricTwin) -> cs.SX:

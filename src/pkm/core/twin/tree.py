@@ -36,12 +36,15 @@ free-flyer's velocity is its body twist, a spherical joint's its body angular ve
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import casadi as cs
 import numpy as np
+import pinocchio as pin
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.twin.design import design_of
 from pkm.core.twin.joint import Joint
 from pkm.core.twin.linear import PivotedLU
 from pkm.core.twin.spatial import (
@@ -58,18 +61,36 @@ if TYPE_CHECKING:
     from pkm.core.twin.task import TaskTwin
 
 
+def theta_times(th: Expr, m: Expr) -> Expr:
+    """A body's spatial force for the spatial motion ``m = [v; w]`` from its ten standard parameters ``th``
+    (Pinocchio's ``toDynamicParameters``: ``m``, ``h = m c``, the inertia about the frame's origin):
+    ``f = m v - h x w``, ``n = I_o w + h x v`` (Featherstone's)."""
+    mass, h = th[0], th[1:4]
+    inertia = cs.vertcat(cs.horzcat(th[4], th[5], th[7]), cs.horzcat(th[5], th[6], th[8]),
+                         cs.horzcat(th[7], th[8], th[9]))
+    lin = mass * m[:3] - cross(h, m[3:])
+    return cs.vertcat(lin, inertia @ m[3:] + cross(h, m[:3]))
+
+
 # ---------------------------------------------------------------------- the twin
 class Twin:
     """The symbolic twin of ``mech`` (see the module doc). Its expressions are built once, in terms of the
     symbols :attr:`q`, :attr:`v`, :attr:`a`; :meth:`function` wraps any of them as a ``casadi.Function``."""
 
-    def __init__(self, mech: Mechanism):
+    def __init__(self, mech: Mechanism, design: Sequence[str] | None = None):
         self.mech = mech = check_mechanism(mech)
         model = mech.model
+        #: The design parameters taken as symbols (:mod:`~pkm.core.twin.design`; none by default) and the symbols.
+        self.design = design_of(mech, design)
+        self.p = cs.SX.sym("design", len(self.design))
         self.q, self.v, self.a = cs.SX.sym("q", model.nq), cs.SX.sym("v", model.nv), cs.SX.sym("a", model.nv)
         #: The actuated rates and accelerations (symbols, na), inputs of :attr:`velocities` and :attr:`accelerations`.
         self.qd, self.qdd = cs.SX.sym("qd", mech.na), cs.SX.sym("qdd", mech.na)
         self.joints: list = [None] + [Joint(model, j, mech.source) for j in range(1, model.njoints)]
+        self._frames: dict[int, SE3] = {}
+        self._moved = self._moved_frames()
+        for j in range(1, model.njoints) if self.design.joints else ():
+            self._design_placement(j)
         self._inertia = [model.inertias[j] for j in range(model.njoints)]
         self._forward()
 
@@ -94,10 +115,55 @@ class Twin:
             self.acc[j] = M.inv_act_motion(self.acc[J.parent]) + J.velocity(q, a) + c
             self.acc0[j] = M.inv_act_motion(self.acc0[J.parent]) + c
 
+    # ---------------------------------------------------------------- the design's geometry
+    def _moved_frames(self) -> set[int]:
+        """The frames whose placement in their joint a varied fixed-joint origin moves (parents come first)."""
+        model, moved = self.mech.model, set()
+        for fid, f in enumerate(model.frames) if self.design.joints else ():
+            parent = model.frames[f.parentFrame]
+            if f.type == pin.FrameType.FIXED_JOINT and f.name in self.design.joints:
+                moved.add(fid)
+            elif fid and f.type != pin.FrameType.JOINT and parent.parentJoint == f.parentJoint and f.parentFrame in moved:
+                moved.add(fid)
+        return moved
+
+    def frame_local(self, fid: int) -> SE3:
+        """Frame ``fid``'s placement in its joint: the model's, or with the design's varied fixed-joint origins as
+        symbols (:mod:`~pkm.core.twin.design`)."""
+        f = self.mech.model.frames[fid]
+        if fid not in self._moved:
+            return SE3.of(f.placement)
+        if fid not in self._frames:
+            parent = self.mech.model.frames[f.parentFrame]
+            own = (self.design.origin(f.name, self.p) if f.type == pin.FrameType.FIXED_JOINT
+                   and f.name in self.design.joints else SE3.of(parent.placement.inverse() * f.placement))
+            self._frames[fid] = self.frame_local(f.parentFrame) * own
+        return self._frames[fid]
+
+    def _design_placement(self, j: int) -> None:
+        """Joint ``j``'s placement from the design: its parent link's frame, then its URDF origin (either varied)."""
+        model = self.mech.model
+        name = model.names[j]
+        if name not in self.design.urdf:
+            return
+        link = self.design.urdf[name][2]
+        parent = model.getFrameId(link, pin.FrameType.BODY) if model.existFrame(link, pin.FrameType.BODY) else None
+        if name not in self.design.joints and parent not in self._moved:
+            return
+        if parent is None or model.frames[parent].parentJoint != model.parents[j]:
+            raise SpecError(self.mech.source, f"joint {name!r}: its URDF parent link {link!r} is not a body of its "
+                                              f"parent joint in the model: its origin cannot be a design input")
+        xyz, rpy, _ = self.design.urdf[name]
+        if not (model.frames[parent].placement * pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)).isApprox(
+                model.jointPlacements[j], 1e-10):
+            raise SpecError(self.mech.source, f"joint {name!r}: the model's placement is not its URDF origin in its "
+                                              f"parent link: its origin cannot be a design input")
+        self.joints[j].placement = self.frame_local(parent) * self.design.origin(name, self.p)
+
     # ---------------------------------------------------------------- kinematics
     def frame_placement(self, fid: int) -> SE3:
         f = self.mech.model.frames[fid]
-        return self.oMi[f.parentJoint] * SE3.of(f.placement)
+        return self.oMi[f.parentJoint] * self.frame_local(fid)
 
     def frame_jacobian(self, fid: int) -> Expr:
         """The frame's Jacobian in ``LOCAL_WORLD_ALIGNED`` (6 x nv): ``[v of its origin; w]`` in world axes."""
@@ -117,7 +183,7 @@ class Twin:
     def frame_classical_acceleration(self, fid: int) -> Expr:
         """The frame origin's acceleration ``[a; alpha]`` in world axes with ``a = 0`` (classical: ``a + w x v``)."""
         f = self.mech.model.frames[fid]
-        X = SE3.of(f.placement)
+        X = self.frame_local(fid)
         vf = X.inv_act_motion(self.vel[f.parentJoint])
         af = X.inv_act_motion(self.acc0[f.parentJoint])
         R = self.frame_placement(fid).R
@@ -160,7 +226,7 @@ class Twin:
             if c.type == "point":
                 out.append(self.frame_classical_acceleration(fa)[:3] - self.frame_classical_acceleration(fb)[:3])
             else:  # relative acceleration of A w.r.t. B in A: a_A - X a_B - v_A x (X v_B), X = Ad(A^-1 B)
-                Xa, Xb = (SE3.of(self.mech.model.frames[f].placement) for f in (fa, fb))
+                Xa, Xb = (self.frame_local(f) for f in (fa, fb))
                 ja, jb = (self.mech.model.frames[f].parentJoint for f in (fa, fb))
                 aMb = self.frame_placement(fa).inverse() * self.frame_placement(fb)
                 va, vb = Xa.inv_act_motion(self.vel[ja]), aMb.act_motion(Xb.inv_act_motion(self.vel[jb]))
@@ -174,7 +240,7 @@ class Twin:
         model = self.mech.model
         f = model.frames[fid]
         J = cs.SX.zeros(6, model.nv)
-        M = SE3.of(f.placement).inverse()  # the frame from joint j
+        M = self.frame_local(fid).inverse()  # the frame from joint j
         j = f.parentJoint
         while j > 0:
             Jt = self.joints[j]
@@ -210,7 +276,7 @@ class Twin:
             F, G, sign = (fa, fb, 1) if nv_of(fa) >= nv_of(fb) else (fb, fa, -1)
             R = self.frame_placement(F).R
             J = self.frame_jacobian_local(F)[:3, :] - R.T @ self.frame_jacobian(G)[:3, :]
-            X = SE3.of(model.frames[F].placement)
+            X = self.frame_local(F)
             vf = X.inv_act_motion(self.vel[model.frames[F].parentJoint])
             af = X.inv_act_motion(self.acc0[model.frames[F].parentJoint])
             gF = af[:3] + cross(vf[3:], vf[:3])
@@ -232,6 +298,8 @@ class Twin:
 
     # ---------------------------------------------------------------- dynamics
     def _inertia_times(self, j: int, m: Expr) -> Expr:
+        if j in self.design.bodies:
+            return theta_times(self._theta(j), m)
         I = self._inertia[j]
         mass, c, Ic = I.mass, cs.DM(I.lever), cs.DM(I.inertia)
         lin = mass * (m[:3] - cross(c, m[3:]))
@@ -269,10 +337,13 @@ class Twin:
         g = cs.DM(self.mech.model.gravity.linear)
         out = 0
         for j in range(1, len(self.joints)):
-            I = self._inertia[j]
-            com = self.oMi[j].p + self.oMi[j].R @ cs.DM(I.lever)
-            out = out - I.mass * cs.dot(g, com)
+            th = self._theta(j) if j in self.design.bodies else cs.DM(self._inertia[j].toDynamicParameters())
+            out = out - cs.dot(g, th[0] * self.oMi[j].p + self.oMi[j].R @ th[1:4])  # (m times the centre of mass)
         return out
+
+    def _theta(self, j: int) -> Expr:
+        """Body ``j``'s ten inertial parameters, the design's as symbols."""
+        return self.design.theta(j, np.asarray(self._inertia[j].toDynamicParameters()), self.p)
 
     def _no_idle(self) -> None:
         from pkm.core.differential.velocity import idle_motions
@@ -282,8 +353,10 @@ class Twin:
                                               "pkm.passive_map and pkm.inverse_dynamics handle them")
 
     def at_reference(self, expr: Expr) -> np.ndarray:
-        """The value of an expression of ``q`` at the mechanism's reference configuration."""
-        return np.array(cs.Function("at_reference", [self.q], [expr])(self.mech.q_reference))
+        """The value of an expression of ``q`` (and the design) at the mechanism's reference configuration (and
+        its own design)."""
+        return np.array(cs.Function("at_reference", [self.q, self.p], [expr])(self.mech.q_reference,
+                                                                                 self.design.base))
 
     @functools.cached_property
     def passive_lu(self) -> PivotedLU:

@@ -1,0 +1,308 @@
+"""Designs as kernel inputs: which of a mechanism's numbers a twin takes as symbols, so that one compiled library
+serves every design of a family.
+
+A design parameter is named as the sweeps name it (:mod:`pkm.sweeps.family`):
+
+* ``JOINT.x``, ``JOINT.y``, ``JOINT.z`` [m], ``JOINT.roll``, ``JOINT.pitch``, ``JOINT.yaw`` [rad]: the origin of a
+  moving URDF joint in its parent link (where a link's length and a base joint's position live). The twin's
+  placement of that joint becomes ``prefix * origin(p)``, ``prefix`` the fixed links merged between the parent
+  joint and the joint (constant: ``placement * origin⁻¹`` at the file's values); only the varied components are
+  symbols (an origin whose angles stay fixed keeps a constant rotation: no trigonometry is added).
+* ``BODY.m``, ``BODY.mx`` ... ``BODY.Izz`` (:data:`~pkm.core.identification.regressor.BODY_FIELDS`, the
+  regressor's names and Pinocchio's ``toDynamicParameters`` order: the mass, its first moments, the inertia about
+  the joint frame's origin) [kg, kg m, kg m^2]: a body's inertial parameters.
+
+What stays structural (fixed by the file the twin was built from): the joints' kinds, axes and limits, the tree,
+the closures, the task, the fixed joints' origins (they move frames and merged inertias: refused here), and the
+choices a twin makes numerically at its reference: the linear solves' pivot orders
+(:mod:`~pkm.core.twin.linear`), the idle motions' coordinates. A design far from the file's may therefore hit the
+pivot floor sooner; the kernels report the pivot and the callers fall back as for any state.
+
+:func:`design_mechanism` builds the :class:`~pkm.core.Mechanism` of one design (the URDF with its origins set, the
+inertias set, the actuators held at the file's reference and the other joints assembled from it): the generic core's
+route, against which the parametric kernels are checked, and what their fallbacks use.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as cs
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from pkm.core.model.mechanism import Mechanism
+from pkm.core.twin.spatial import SE3, Expr
+from pkm.errors import InvalidInputError, UnknownNameError
+
+#: Origin components: name -> (URDF attribute, index).
+ORIGIN = {"x": ("xyz", 0), "y": ("xyz", 1), "z": ("xyz", 2), "roll": ("rpy", 0), "pitch": ("rpy", 1), "yaw": ("rpy", 2)}
+
+
+@dataclass(frozen=True)
+class Design:
+    """The design parameters of a twin (see the module doc).
+
+    Attributes:
+        names: The parameters, in the order of the kernels' ``design`` input.
+        base: Their values in the mechanism the twin was built from (SI).
+        joints: URDF joint name -> ``(component, index in names)`` of its varied origin components.
+        bodies: Pinocchio joint id -> ``(field, index in names)`` of its body's varied inertial parameters.
+        urdf: URDF joint name -> ``(xyz, rpy, parent link)`` of every URDF joint (geometry varied), else empty.
+    """
+
+    names: tuple[str, ...]
+    base: np.ndarray
+    joints: Mapping[str, tuple[tuple[int, int], ...]]
+    bodies: Mapping[int, tuple[tuple[int, int], ...]]
+    urdf: Mapping[str, tuple[np.ndarray, np.ndarray, str]]
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def vector(self, values: Mapping[str, float] | ArrayLike | None = None) -> np.ndarray:
+        """The ``design`` input of the kernels: ``values`` by name (the others at :attr:`base`) or a whole vector."""
+        from pkm.validation import as_array
+
+        if values is None:
+            return self.base.copy()
+        if isinstance(values, Mapping):
+            out = self.base.copy()
+            for name, value in values.items():
+                if name not in self.names:
+                    raise UnknownNameError("design parameter", name, self.names, "the twin's design inputs")
+                out[self.names.index(name)] = value
+            if not np.all(np.isfinite(out)):
+                raise InvalidInputError("design", "holds non-finite values", dict(values))
+            return out
+        out = as_array(values, "design", f"{len(self.names)} values (SI): {', '.join(self.names)}")
+        if out.shape != (len(self.names),) or not np.all(np.isfinite(out)):
+            raise InvalidInputError("design", f"expected {len(self.names)} finite values ({', '.join(self.names)})",
+                                    values)
+        return out
+
+    def origin(self, joint: str, p: Expr) -> SE3:
+        """URDF joint ``joint``'s origin (its placement in its parent link) with its varied components the symbols
+        ``p``: a constant rotation where no angle varies (no trigonometry added)."""
+        xyz0, rpy0, _ = self.urdf[joint]
+        xyz, rpy = [cs.SX(float(v)) for v in xyz0], [cs.SX(float(v)) for v in rpy0]
+        turned = False
+        for comp, k in self.joints.get(joint, ()):
+            attr, i = ORIGIN[list(ORIGIN)[comp]]
+            (xyz if attr == "xyz" else rpy)[i] = p[k]
+            turned = turned or attr == "rpy"
+        R = _rpy_matrix(*rpy) if turned else cs.DM(pin.rpy.rpyToMatrix(*rpy0))
+        return SE3(R, cs.vertcat(*xyz))
+
+    def theta(self, jid: int, values: np.ndarray, p: Expr) -> Expr:
+        """Body ``jid``'s ten inertial parameters (``values``: the model's) with its varied ones the symbols ``p``."""
+        out = [cs.SX(float(v)) for v in values]
+        for field, k in self.bodies[jid]:
+            out[field] = p[k]
+        return cs.vertcat(*out)
+
+
+def design_of(mech: Mechanism, names: Sequence[str] | None) -> Design:
+    """The :class:`Design` of ``mech`` whose parameters are ``names`` (none: a twin of constants).
+
+    Raises:
+        UnknownNameError: a name is neither a URDF joint's origin component nor a body's inertial parameter (the
+            error lists them).
+        InvalidInputError: ``mech`` was not built from URDF text (origins need it), a name repeats, or a fixed
+            joint's origin varies with mass below it and none of the body it merges into's inertial parameters
+            varies (the merged inertia would stay the file's).
+    """
+    from pkm.core.identification.regressor import BODY_FIELDS, parameters
+
+    names = tuple(names or ())
+    if len(set(names)) != len(names):
+        raise InvalidInputError("design", "a parameter is named twice", names)
+    model = mech.model
+    bodies = parameters(mech).bodies if names else ()
+    urdf = _urdf_joints(mech) if any(n.rpartition(".")[2] in ORIGIN for n in names) else {}
+    base: list[float] = []
+    joints: dict[str, list[tuple[int, int]]] = {}
+    body_fields: dict[int, list[tuple[int, int]]] = {}
+    for k, name in enumerate(names):
+        owner, _, comp = name.rpartition(".")
+        if comp in ORIGIN and owner in urdf:
+            joints.setdefault(owner, []).append((list(ORIGIN).index(comp), k))
+            attr, i = ORIGIN[comp]
+            base.append(float(urdf[owner][0 if attr == "xyz" else 1][i]))
+        elif comp in BODY_FIELDS and owner in bodies:
+            jid = bodies.index(owner) + 1
+            body_fields.setdefault(jid, []).append((BODY_FIELDS.index(comp), k))
+            base.append(float(model.inertias[jid].toDynamicParameters()[BODY_FIELDS.index(comp)]))
+        else:
+            choices = [f"{j}.{c}" for j in urdf or _urdf_joints(mech) for c in ORIGIN]
+            choices += [f"{b}.{f}" for b in bodies or parameters(mech).bodies for f in BODY_FIELDS]
+            raise UnknownNameError("design parameter", name, choices,
+                                   f"{mech.name}: URDF joints' origins and bodies' inertial parameters")
+    for joint in joints:  # a fixed joint moves what it carries: its links' mass merged into the body above
+        if not model.existJointName(joint):
+            fid = model.getFrameId(joint, pin.FrameType.FIXED_JOINT)
+            carried = _carried_mass(mech.urdf or "", joint)
+            if carried > 0.0 and model.frames[fid].parentJoint not in body_fields:
+                body = bodies[model.frames[fid].parentJoint - 1] if model.frames[fid].parentJoint else "the world"
+                raise InvalidInputError("design", f"the fixed joint {joint!r} carries {carried:g} kg merged into "
+                                                  f"body {body!r}: vary that body's inertial parameters with it "
+                                                  f"({body}.m ...) or keep its origin fixed", names)
+    return Design(names, np.array(base, dtype=float), {j: tuple(v) for j, v in joints.items()},
+                  {j: tuple(v) for j, v in body_fields.items()}, urdf)
+
+
+def design_mechanism(mech: Mechanism, values: Mapping[str, float]) -> Mechanism:
+    """The mechanism of one design of ``mech``: its URDF's joint origins and its bodies' inertial parameters set to
+    ``values`` (names as in the module doc); the actuators held at the file's reference, the other joints assembled
+    from their former values (the same assembly mode). The inertias live in the model only: pickled (to a Dask
+    worker), the mechanism is rebuilt from its files with the file's inertias; send the values instead.
+
+    Raises:
+        InvalidInputError: ``mech`` was not built from URDF text.
+        UnknownNameError: as :func:`design_of`.
+        AssemblyError: the design does not close at the held actuators.
+    """
+    from pkm.core.identification.regressor import BODY_FIELDS, parameters
+    from pkm.core.model.builder import from_strings
+    from pkm.core.model.spec import ClosureSpec
+
+    design_of(mech, tuple(values))  # (the names checked, with the choices listed)
+    inertial = {k: v for k, v in values.items() if k.rpartition(".")[2] in BODY_FIELDS}
+    origins = {k: v for k, v in values.items() if k not in inertial}
+    spec = ClosureSpec.from_toml(mech.spec.to_toml(), mech.source)
+    held = {n: v for n, v in spec.reference.items() if n in spec.actuated}
+    out = from_strings(origins_set(_urdf(mech), origins), dataclasses.replace(spec, reference=held),
+                       source=mech.source, seed=spec.reference)
+    bodies = parameters(mech).bodies if inertial else ()
+    for name, value in inertial.items():  # (the mechanism's own model, fresh: set in place)
+        body, _, field = name.rpartition(".")
+        jid = bodies.index(body) + 1
+        theta = np.array(out.model.inertias[jid].toDynamicParameters())
+        theta[BODY_FIELDS.index(field)] = value
+        out.model.inertias[jid] = pin.Inertia.FromDynamicParameters(theta)
+    return out
+
+
+def read_design(mech: Mechanism, names: Sequence[str] | None = None) -> dict[str, float]:
+    """The design values of ``mech`` by name: ``names``, or every URDF joint's origin components and every body's
+    inertial parameters (what :func:`design_of` can take). The design of a mechanism built by other means (a
+    registered mechanism's ``build``) read back, so that one twin with design inputs serves its family."""
+    from pkm.core.identification.regressor import BODY_FIELDS, parameters
+
+    out: dict[str, float] = {}
+    if mech.urdf is not None:
+        for joint, (xyz, rpy, _) in _urdf_joints(mech).items():
+            for comp, (attr, i) in ORIGIN.items():
+                out[f"{joint}.{comp}"] = float((xyz if attr == "xyz" else rpy)[i])
+    for j, body in enumerate(parameters(mech).bodies, start=1):
+        theta = mech.model.inertias[j].toDynamicParameters()
+        for k, field in enumerate(BODY_FIELDS):
+            out[f"{body}.{field}"] = float(theta[k])
+    if names is None:
+        return out
+    missing = [n for n in names if n not in out]
+    if missing:
+        raise UnknownNameError("design parameter", missing[0], list(out), mech.name)
+    return {n: out[n] for n in names}
+
+
+def structure(mech: Mechanism) -> str:
+    """What a twin with design inputs fixes of ``mech`` (its URDF without origins and inertials, its spec without
+    reference, parameters and description, its model's joint kinds and limits), as text: designs of one family share it or cannot share a
+    twin."""
+    from lxml import etree
+
+    model = mech.model
+    parts = [dataclasses.replace(mech.spec, reference={}, parameters={}, description="").to_toml(), " ".join(j.shortname() for j in model.joints),
+             repr(np.round(np.concatenate([model.lowerPositionLimit, model.upperPositionLimit]), 12).tolist())]
+    if mech.urdf is not None:
+        root, _ = _joints(mech.urdf)
+        for el in list(root.iter("origin", "inertial")):
+            if el.getparent() is not None:
+                el.getparent().remove(el)
+        parts.append(etree.tostring(root, encoding="unicode"))
+    return "\n".join(parts)
+
+
+def origins_set(urdf: str, values: Mapping[str, float]) -> str:
+    """The URDF text with the joint origins named by ``values`` (``JOINT.x`` ... ``JOINT.yaw``, SI) set."""
+    from lxml import etree
+
+    root, joints = _joints(urdf)
+    for name, value in values.items():
+        joint, _, comp = name.rpartition(".")
+        if joint not in joints or comp not in ORIGIN:
+            raise UnknownNameError("parameter", name, [f"{j}.{c}" for j in joints for c in ORIGIN], "the URDF")
+        origin = joints[joint].find("origin")
+        if origin is None:
+            origin = etree.SubElement(joints[joint], "origin")
+        attr, k = ORIGIN[comp]
+        parts = (origin.get(attr) or "0 0 0").split()
+        parts[k] = repr(float(value))
+        origin.set(attr, " ".join(parts))
+    return etree.tostring(root, encoding="unicode")
+
+
+def urdf_joints(urdf: str) -> tuple[str, ...]:
+    """The URDF's joint names, in file order."""
+    return tuple(_joints(urdf)[1])
+
+
+def _joints(urdf: str) -> tuple[Any, dict[str, Any]]:
+    """The URDF's root and its joints by name (pkm's hardened parser, :func:`pkm.core.model.urdf.parse_xml`)."""
+    from pkm.core.model.urdf import parse_xml
+
+    root = parse_xml(urdf)
+    return root, {j.get("name"): j for j in root.iter("joint") if j.get("name") and j.getparent() is root}
+
+
+def _urdf(mech: Mechanism) -> str:
+    if mech.urdf is None:
+        raise InvalidInputError("mechanism", "built from a Pinocchio model without URDF text: its joint origins "
+                                             "cannot vary (load it from files)", mech.source)
+    return mech.urdf
+
+
+def _urdf_joints(mech: Mechanism) -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
+    """``{joint: (xyz, rpy, parent link)}`` of every URDF joint of ``mech``'s file."""
+    out = {}
+    for name, j in _joints(_urdf(mech))[1].items():
+        origin, parent = j.find("origin"), j.find("parent")
+        xyz, rpy = ((np.array([float(v) for v in ((origin.get(a) if origin is not None else None) or "0 0 0").split()]))
+                    for a in ("xyz", "rpy"))
+        out[name] = (xyz, rpy, parent.get("link") if parent is not None else "")
+    return out
+
+
+def _carried_mass(urdf: str, joint: str) -> float:
+    """The mass of the links URDF joint ``joint`` carries through fixed joints (what merges into one body)."""
+    root, joints = _joints(urdf)
+    masses = {}
+    for link in root.iter("link"):
+        m = link.find("inertial/mass")
+        masses[link.get("name")] = float(m.get("value", 0.0)) if m is not None else 0.0
+    children: dict[str, list] = {}
+    for j in joints.values():
+        children.setdefault(j.find("parent").get("link"), []).append(j)
+    total, todo = 0.0, [joints[joint].find("child").get("link")]
+    while todo:
+        link = todo.pop()
+        total += masses.get(link, 0.0)
+        todo += [j.find("child").get("link") for j in children.get(link, []) if j.get("type") == "fixed"]
+    return total
+
+
+def _rpy_matrix(roll: Expr, pitch: Expr, yaw: Expr) -> Expr:
+    """URDF's ``Rz(yaw) Ry(pitch) Rx(roll)`` of symbols."""
+    cr, sr, cp, sp, cy, sy = cs.cos(roll), cs.sin(roll), cs.cos(pitch), cs.sin(pitch), cs.cos(yaw), cs.sin(yaw)
+    return cs.vertcat(cs.horzcat(cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr),
+                      cs.horzcat(sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr),
+                      cs.horzcat(-sp, cp * sr, cp * cr))
+
+
+__all__ = ["ORIGIN", "Design", "design_mechanism", "design_of", "origins_set", "read_design", "structure",
+           "urdf_joints"]
