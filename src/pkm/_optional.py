@@ -10,6 +10,7 @@ kernels, previews); the rest is behind extras, named in ``pyproject.toml``'s ``[
     pip install "pkm[bench]"     # the benchmarks' baseline: MuJoCo
     pip install "pkm[identify]"  # identification's physically consistent estimate: cvxpy with Clarabel
     pip install "pkm[serve]"     # the service (pkm serve) and its client: FastAPI, uvicorn, msgpack, httpx
+    pip install "pkm[jax]"       # the twin's kernels as JAX functions (jit, vmap, grad; GPU): JAX
     pip install "pkm[all]"       # all of them
 
 An extra is checked at the point of use, never at ``import pkm``: :func:`require` raises
@@ -35,6 +36,7 @@ EXTRAS: dict[str, dict[str, str]] = {
     "identify": {"cvxpy": "cvxpy", "clarabel": "clarabel"},
     "serve": {"fastapi": "fastapi", "starlette": "starlette", "uvicorn": "uvicorn", "multipart": "python-multipart",
               "msgpack": "msgpack", "httpx": "httpx", "websockets": "websockets"},
+    "jax": {"jax": "jax"},
 }
 
 

@@ -26,13 +26,13 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from pkm._moved import renamed_keywords
-from pkm.core.identification.regressor import BODY_FIELDS
+from pkm.core.model.bodies import BODY_FIELDS, BODY_UNITS, body_names
 from pkm.core.twin.design import ORIGIN, origins_set, urdf_joints
 from pkm.errors import InvalidInputError, UnknownNameError
 
 _SCALAR_TYPES = ("float", "int")
 #: Units of the inertial parameters, by field.
-_INERTIAL_UNITS = {"m": "kg", "mx": "kg m", "my": "kg m", "mz": "kg m", **dict.fromkeys(BODY_FIELDS[4:], "kg m^2")}
+_INERTIAL_UNITS = dict(zip(BODY_FIELDS, BODY_UNITS))
 #: Each process's kernels with design inputs, by family and design inputs (:meth:`Family.kernels`).
 _KERNELS: dict[tuple[str, tuple[str, ...]], Any] = {}
 
@@ -240,12 +240,10 @@ class ModelFamily(Family):
         if mech.urdf is None:
             raise InvalidInputError("mechanism", "built from a Pinocchio model without URDF text: nothing to vary "
                                                  "(load it from files)", mech.source)
-        from pkm.core.identification.regressor import parameters
-
         self.urdf, self.spec, self.source = mech.urdf, mech.spec.to_toml(), mech.source
         self._base = mech
         self.joint_names = urdf_joints(self.urdf)
-        self.body_names = parameters(mech).bodies
+        self.body_names = body_names(mech.model)
         self.parametric = bool(parametric)
 
     def __getstate__(self):

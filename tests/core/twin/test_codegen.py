@@ -136,3 +136,16 @@ def test_operations_are_counted_by_kind():
     x, y = cs.SX.sym("x"), cs.SX.sym("y")
     counts = codegen.count_operations(cs.Function("c", [x, y], [x * y + cs.sin(x)]))
     assert counts == {"input": 2, "mul": 1, "sin": 1, "add": 1, "output": 1}
+
+
+def test_the_numpy_route_writes_infinite_and_nan_constants():
+    """Constants inf, -inf and NaN (a kernel's guard values) were written as bare names the generated Python did not
+    know; they are numpy's now."""
+    import casadi as cs
+
+    from pkm.core.twin.codegen import numpy_function
+
+    x = cs.SX.sym("x")
+    f = cs.Function("f", [x], [cs.vertcat(x + 1.5, cs.SX(cs.inf) * x, cs.SX(float("nan")), -cs.inf)])
+    out = codegen.numpy_function(f)(np.ones((2, 1)))[0]
+    assert np.array_equal(out, np.tile([2.5, np.inf, np.nan, -np.inf], (2, 1)), equal_nan=True)

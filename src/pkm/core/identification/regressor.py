@@ -34,6 +34,7 @@ from numpy.typing import ArrayLike
 
 from pkm.core.differential.velocity import passive_map
 from pkm.core.dynamics.model import COULOMB_VELOCITY, actuator_model
+from pkm.core.model.bodies import BODY_FIELDS, BODY_UNITS, body_names
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import CompilerError, InvalidInputError, SpecError
 from pkm.validation import as_array, finite_result
@@ -41,9 +42,6 @@ from pkm.validation import as_array, finite_result
 if TYPE_CHECKING:
     from pkm.core.twin.kernels import Kernels
 
-BODY_FIELDS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
-"""The ten standard parameters of a body, Pinocchio's order (``Inertia.toDynamicParameters``)."""
-BODY_UNITS = ("kg", "kg m", "kg m", "kg m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2")
 DRIVE_FIELDS = ("armature", "viscous", "coulomb", "offset")
 """Per actuator: the reflected inertia, viscous and Coulomb friction, an effort offset."""
 
@@ -74,20 +72,11 @@ class Parameters:
         return len(self.names)
 
 
-def _body_names(model: pin.Model) -> tuple[str, ...]:
-    names = []
-    for j in range(1, model.njoints):
-        link = next((f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == j),
-                    model.names[j])
-        names.append(link)
-    return tuple(names)
-
-
 def parameters(mech: Mechanism) -> Parameters:
     """The dynamic parameters of ``mech`` (module doc): names, values and units in the regressor's column order."""
     mech = check_mechanism(mech)
     model = mech.model
-    bodies = _body_names(model)
+    bodies = body_names(model)
     names = [f"{b}.{f}" for b in bodies for f in BODY_FIELDS]
     values = [model.inertias[j].toDynamicParameters() for j in range(1, model.njoints)]
     drives = []

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import ctypes
 import hashlib
+import math
 import os
 import shutil
 import subprocess
@@ -337,16 +338,19 @@ def paper_counts(fun: cs.Function) -> tuple[int, int, dict[str, int]]:
     return mul, add, counts
 
 
-#: numpy expressions of CasADi's scalar operations (``a``, ``b``: the operands).
-_NUMPY = {
+#: numpy expressions of CasADi's scalar operations (``a``, ``b``: the operands); ``fmin``/``fmax`` ignore a NaN
+#: operand as C's do, comparisons and logic give 1.0 or 0.0. The JAX translation takes them with ``jnp`` for ``np``
+#: (:mod:`pkm.core.twin.jaxgen`).
+NUMPY_FORMS = {
     "ADD": "{a} + {b}", "SUB": "{a} - {b}", "MUL": "{a} * {b}", "DIV": "{a} / {b}", "NEG": "-{a}", "SQ": "{a} * {a}",
     "TWICE": "2.0 * {a}", "INV": "1.0 / {a}", "ASSIGN": "{a}", "POW": "{a} ** {b}", "CONSTPOW": "{a} ** {b}",
     "SIN": "np.sin({a})", "COS": "np.cos({a})", "TAN": "np.tan({a})", "ASIN": "np.arcsin({a})",
     "ACOS": "np.arccos({a})", "ATAN": "np.arctan({a})", "ATAN2": "np.arctan2({a}, {b})", "SQRT": "np.sqrt({a})",
-    "EXP": "np.exp({a})", "LOG": "np.log({a})", "FABS": "np.abs({a})", "FMIN": "np.minimum({a}, {b})",
-    "FMAX": "np.maximum({a}, {b})", "FLOOR": "np.floor({a})", "CEIL": "np.ceil({a})", "FMOD": "np.fmod({a}, {b})",
+    "EXP": "np.exp({a})", "LOG": "np.log({a})", "FABS": "np.abs({a})", "FMIN": "np.fmin({a}, {b})",
+    "FMAX": "np.fmax({a}, {b})", "FLOOR": "np.floor({a})", "CEIL": "np.ceil({a})", "FMOD": "np.fmod({a}, {b})",
     "SIGN": "np.sign({a})", "COPYSIGN": "np.copysign({a}, {b})", "HYPOT": "np.hypot({a}, {b})",
-    "SINH": "np.sinh({a})", "COSH": "np.cosh({a})", "TANH": "np.tanh({a})",
+    "SINH": "np.sinh({a})", "COSH": "np.cosh({a})", "TANH": "np.tanh({a})", "ASINH": "np.arcsinh({a})",
+    "ACOSH": "np.arccosh({a})", "ATANH": "np.arctanh({a})", "EXPM1": "np.expm1({a})", "LOG1P": "np.log1p({a})",
     "IF_ELSE_ZERO": "np.where({a} != 0, {b}, 0.0)", "LT": "1.0 * ({a} < {b})", "LE": "1.0 * ({a} <= {b})",
     "EQ": "1.0 * ({a} == {b})", "NE": "1.0 * ({a} != {b})", "NOT": "1.0 * ({a} == 0)",
     "AND": "1.0 * (({a} != 0) & ({b} != 0))", "OR": "1.0 * (({a} != 0) | ({b} != 0))",
@@ -381,26 +385,35 @@ def instructions(fun: cs.Function, table: dict[str, str], language: str
             raise ValueError(f"{fun.name()}: the operation {op_name} has no {language} form here")
 
 
+def python_constant(x: float, module: str = "np") -> str:
+    """``x`` as a Python expression that reads back to the same double (``np.inf``, ``np.nan``: ``module``'s)."""
+    if math.isnan(x):
+        return f"{module}.nan"
+    if math.isinf(x):
+        return f"{module}.inf" if x > 0 else f"(-{module}.inf)"
+    return repr(float(x))
+
+
 def numpy_source(fun: cs.Function) -> str:
     """Python source of ``fun`` vectorised over samples: ``def f(np, n, in0, in1, ...)`` with each input an
     ``(n, nnz)`` array, returning the outputs as ``(n, nnz)`` arrays, one numpy statement per instruction of the
     SX function (its work vector reused as the variables ``w0, w1, ...``).
 
     Raises:
-        ValueError: ``fun`` is not an SX function, or uses an operation :data:`_NUMPY` lacks.
+        ValueError: ``fun`` is not an SX function, or uses an operation :data:`NUMPY_FORMS` lacks.
     """
     if not fun.is_a("SXFunction"):
         raise ValueError(f"{fun.name()}: numpy_source needs an SX function")
     ins = ", ".join(f"in{i}" for i in range(fun.n_in()))
     lines = [f"def f(np, n, {ins}):"]
     lines += [f"    out{i} = np.zeros((n, {fun.nnz_out(i)}))" for i in range(fun.n_out())]
-    for kind, value, i, o in instructions(fun, _NUMPY, "numpy"):
+    for kind, value, i, o in instructions(fun, NUMPY_FORMS, "numpy"):
         if kind == "input":
             lines.append(f"    w{o[0]} = in{i[0]}[:, {i[1]}]")
         elif kind == "output":
             lines.append(f"    out{o[0]}[:, {o[1]}] = w{i[0]}")
         elif kind == "const":
-            lines.append(f"    w{o[0]} = {value!r}")
+            lines.append(f"    w{o[0]} = {python_constant(float(value))}")  # type: ignore[arg-type]
         else:
             lines.append(f"    w{o[0]} = {value}")
     lines.append(f"    return [{', '.join(f'out{i}' for i in range(fun.n_out()))}]")
@@ -427,6 +440,6 @@ def compile_function(fun: cs.Function, directory: str | os.PathLike[str] | None 
     return cs.external(fun.name(), lib._name), how
 
 
-__all__ = ["C_INT", "C_REAL_P", "cache_dir", "compile_function", "compile_library", "count_operations", "instructions",
+__all__ = ["C_INT", "C_REAL_P", "NUMPY_FORMS", "cache_dir", "compile_function", "compile_library", "count_operations", "instructions",
            "map_source",
-           "numpy_function", "numpy_source", "paper_counts", "source"]
+           "numpy_function", "numpy_source", "paper_counts", "python_constant", "source"]

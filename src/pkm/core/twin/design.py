@@ -8,7 +8,7 @@ A design parameter is named as the sweeps name it (:mod:`pkm.sweeps.family`):
   placement of that joint becomes ``prefix * origin(p)``, ``prefix`` the fixed links merged between the parent
   joint and the joint (constant: ``placement * origin⁻¹`` at the file's values); only the varied components are
   symbols (an origin whose angles stay fixed keeps a constant rotation: no trigonometry is added).
-* ``BODY.m``, ``BODY.mx`` ... ``BODY.Izz`` (:data:`~pkm.core.identification.regressor.BODY_FIELDS`, the
+* ``BODY.m``, ``BODY.mx`` ... ``BODY.Izz`` (:data:`~pkm.core.model.bodies.BODY_FIELDS`, the
   regressor's names and Pinocchio's ``toDynamicParameters`` order: the mass, its first moments, the inertia about
   the joint frame's origin) [kg, kg m, kg m^2]: a body's inertial parameters.
 
@@ -35,6 +35,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from pkm.core.model.bodies import BODY_FIELDS, body_names
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.twin.spatial import SE3, Expr
 from pkm.errors import InvalidInputError, UnknownNameError
@@ -116,13 +117,11 @@ def design_of(mech: Mechanism, names: Sequence[str] | None) -> Design:
             joint's origin varies with mass below it and none of the body it merges into's inertial parameters
             varies (the merged inertia would stay the file's).
     """
-    from pkm.core.identification.regressor import BODY_FIELDS, parameters
-
     names = tuple(names or ())
     if len(set(names)) != len(names):
         raise InvalidInputError("design", "a parameter is named twice", names)
     model = mech.model
-    bodies = parameters(mech).bodies if names else ()
+    bodies = body_names(model) if names else ()
     urdf = _urdf_joints(mech) if any(n.rpartition(".")[2] in ORIGIN for n in names) else {}
     base: list[float] = []
     joints: dict[str, list[tuple[int, int]]] = {}
@@ -139,7 +138,7 @@ def design_of(mech: Mechanism, names: Sequence[str] | None) -> Design:
             base.append(float(model.inertias[jid].toDynamicParameters()[BODY_FIELDS.index(comp)]))
         else:
             choices = [f"{j}.{c}" for j in urdf or _urdf_joints(mech) for c in ORIGIN]
-            choices += [f"{b}.{f}" for b in bodies or parameters(mech).bodies for f in BODY_FIELDS]
+            choices += [f"{b}.{f}" for b in bodies or body_names(model) for f in BODY_FIELDS]
             raise UnknownNameError("design parameter", name, choices,
                                    f"{mech.name}: URDF joints' origins and bodies' inertial parameters")
     for joint in joints:  # a fixed joint moves what it carries: its links' mass merged into the body above
@@ -166,7 +165,6 @@ def design_mechanism(mech: Mechanism, values: Mapping[str, float]) -> Mechanism:
         UnknownNameError: as :func:`design_of`.
         AssemblyError: the design does not close at the held actuators.
     """
-    from pkm.core.identification.regressor import BODY_FIELDS, parameters
     from pkm.core.model.builder import from_strings
     from pkm.core.model.spec import ClosureSpec
 
@@ -177,7 +175,7 @@ def design_mechanism(mech: Mechanism, values: Mapping[str, float]) -> Mechanism:
     held = {n: v for n, v in spec.reference.items() if n in spec.actuated}
     out = from_strings(origins_set(_urdf(mech), origins), dataclasses.replace(spec, reference=held),
                        source=mech.source, seed=spec.reference)
-    bodies = parameters(mech).bodies if inertial else ()
+    bodies = body_names(mech.model) if inertial else ()
     for name, value in inertial.items():  # (the mechanism's own model, fresh: set in place)
         body, _, field = name.rpartition(".")
         jid = bodies.index(body) + 1
@@ -191,14 +189,12 @@ def read_design(mech: Mechanism, names: Sequence[str] | None = None) -> dict[str
     """The design values of ``mech`` by name: ``names``, or every URDF joint's origin components and every body's
     inertial parameters (what :func:`design_of` can take). The design of a mechanism built by other means (a
     registered mechanism's ``build``) read back, so that one twin with design inputs serves its family."""
-    from pkm.core.identification.regressor import BODY_FIELDS, parameters
-
     out: dict[str, float] = {}
     if mech.urdf is not None:
         for joint, (xyz, rpy, _) in _urdf_joints(mech).items():
             for comp, (attr, i) in ORIGIN.items():
                 out[f"{joint}.{comp}"] = float((xyz if attr == "xyz" else rpy)[i])
-    for j, body in enumerate(parameters(mech).bodies, start=1):
+    for j, body in enumerate(body_names(mech.model), start=1):
         theta = mech.model.inertias[j].toDynamicParameters()
         for k, field in enumerate(BODY_FIELDS):
             out[f"{body}.{field}"] = float(theta[k])

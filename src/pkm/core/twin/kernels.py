@@ -298,6 +298,24 @@ class Kernels:
         fun_name = f"pkm_{name}" + ("_design" if len(self.design) else "")
         return cs.Function(fun_name, [sym[i] for i in inputs], values, list(inputs), list(outputs))
 
+    def jax(self, name: str, *, x64: bool = True) -> Callable[..., tuple]:
+        """Kernel ``name`` as a jitted JAX function of one sample (:mod:`pkm.core.twin.jaxgen`, pkm's own
+        translation of the twin): inputs as :meth:`inputs` names them (the design last, where the kernels take
+        one), each a 1-D array of nonzeros, outputs likewise (column-major); ``jax.vmap`` maps it over a batch,
+        ``jax.grad`` and ``jax.jacfwd`` differentiate it, on whatever device JAX runs (a GPU where it has one).
+        Equal to the compiled C to 1e-12 in double precision (``x64``: JAX's 64-bit mode turned on, process-wide).
+        The samples under the pivot floor are not redone here: the kernels that solve return the pivot (the last
+        output); mask on it.
+
+        Raises:
+            MissingDependencyError: JAX is not installed (``pip install "pkm[jax]"``).
+        """
+        from pkm.core.twin.jaxgen import jax_function
+
+        if name not in KERNELS:
+            raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", name)
+        return jax_function(self.function(name), x64=x64)
+
     @functools.cached_property
     def dynamics(self) -> ActuatorTwin:
         """The actuator-space model's expressions (:class:`~pkm.core.twin.dynamics.ActuatorTwin`; idle motions

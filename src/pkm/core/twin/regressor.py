@@ -2,7 +2,7 @@
 
 The twin's inverse dynamics (:attr:`~pkm.core.twin.tree.Twin.inverse_dynamics`: joint rates and accelerations from
 the actuated ones, RNEA under gravity, the projection by one transposed solve) is built once more with every body's
-ten standard parameters as symbols ``θ`` (Pinocchio's order, :data:`~pkm.core.identification.regressor.BODY_FIELDS`:
+ten standard parameters as symbols ``θ`` (Pinocchio's order, :data:`~pkm.core.model.bodies.BODY_FIELDS`:
 ``m``, the first moments ``h = m c``, the inertia about the joint frame's origin), and differentiated by CasADi:
 the efforts are linear in ``θ``, so the Jacobian holds no ``θ`` and is the regressor itself, not an approximation.
 The drives' columns follow (reflected inertia ``q̈_j``, viscous ``q̇_j``, Coulomb ``tanh(q̇_j / COULOMB_VELOCITY)``,
