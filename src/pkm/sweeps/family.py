@@ -205,7 +205,6 @@ class RegisteredFamily(Family):
         """The origins and inertias that move when each of ``parameters`` moves from the base design (a scalar
         field moved by 1 %, and by 1e-3 where it is 0); none when an integer field (a working mode) is swept."""
         from pkm.core.twin.design import read_design
-
         from pkm.errors import PkmError
 
         cache: dict[tuple[str, ...], tuple[str, ...]] = self.__dict__.setdefault("_varied", {})

@@ -141,10 +141,6 @@ def test_operations_are_counted_by_kind():
 def test_the_numpy_route_writes_infinite_and_nan_constants():
     """Constants inf, -inf and NaN (a kernel's guard values) were written as bare names the generated Python did not
     know; they are numpy's now."""
-    import casadi as cs
-
-    from pkm.core.twin.codegen import numpy_function
-
     x = cs.SX.sym("x")
     f = cs.Function("f", [x], [cs.vertcat(x + 1.5, cs.SX(cs.inf) * x, cs.SX(float("nan")), -cs.inf)])
     out = codegen.numpy_function(f)(np.ones((2, 1)))[0]

@@ -27,8 +27,10 @@ from __future__ import annotations
 import copy
 import ctypes
 import functools
+import itertools
 import os
 from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -53,6 +55,10 @@ if TYPE_CHECKING:
 PIVOT_FLOOR = 1e-6
 #: A compiled batch of at least twice this many samples runs on every core, in chunks (threads; the C is re-entrant).
 THREAD_SAMPLES = 2048
+#: A compiled batch of at least this many samples runs the kernel's vector driver (:mod:`~pkm.core.twin.simd`:
+#: several samples a vector instruction, bit for bit the scalar driver's), compiled on the first such batch; a
+#: smaller one the scalar driver (the vector library's compile, 0.2 s to 7 s, is not worth it for a few samples).
+VECTOR_SAMPLES = 256
 
 
 
@@ -111,13 +117,24 @@ class PathResult:
     how: str = ""
 
 
+@functools.lru_cache(maxsize=1)
+def _pool() -> ThreadPoolExecutor:
+    """The threads compiled batches are split over (one a core, started once: starting them per call costs a
+    millisecond, a third of a 100,000-sample batch of the 3-PRS on two cores)."""
+    return ThreadPoolExecutor(os.cpu_count() or 1, thread_name_prefix="pkm-kernels")
+
+
 class _Kernel:
     """One function, compiled (``lib``) or not; ``__call__`` takes sample-major arrays (n x size) and returns a list
-    of sample-major outputs: the C batch driver when compiled, else numpy vectorised over the samples
-    (:func:`~pkm.core.twin.codegen.numpy_function`; CasADi's virtual machine for one sample)."""
+    of sample-major outputs: the C batch driver when compiled (the vector driver from :data:`VECTOR_SAMPLES`
+    samples when ``vector``; split over ``threads`` cores, default all, from ``2 THREAD_SAMPLES``), else numpy
+    vectorised over the samples (:func:`~pkm.core.twin.codegen.numpy_function`; CasADi's virtual machine for one
+    sample)."""
 
-    def __init__(self, fun: cs.Function, follow: bool, compiled: bool, directory: str | os.PathLike[str] | None):
-        self.fun = fun
+    def __init__(self, fun: cs.Function, follow: bool, compiled: bool, directory: str | os.PathLike[str] | None,
+                 vector: bool = True, threads: int | None = None):
+        self.fun, self.directory, self.vector, self.threads = fun, directory, vector, threads
+        self._simd: Callable[..., int] | None = None
         self.lib, self.how = compile_library(fun, follow=follow, directory=directory) if compiled else (
             None, "compiled=False")
         self.in_size = [fun.nnz_in(i) for i in range(fun.n_in())]
@@ -155,24 +172,40 @@ class _Kernel:
             return [o[None].copy() for o in self._one_out]
         ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
         outs = [np.empty((n, s)) for s in self.out_size]
-        workers = min(os.cpu_count() or 1, n // THREAD_SAMPLES)
+        workers = min(self.threads or os.cpu_count() or 1, n // THREAD_SAMPLES)
         bounds = np.linspace(0, n, max(workers, 1) + 1).astype(int)
+        driver = self._vector_driver() if self.vector and n >= VECTOR_SAMPLES else self._batch
 
         def part(lo: int, hi: int) -> int:  # (ctypes releases the GIL: the chunks run on as many cores)
             in_p = (_P * len(ins))(*[a[lo:].ctypes.data_as(_P) for a in ins])
             out_p = (_P * len(outs))(*[o[lo:].ctypes.data_as(_P) for o in outs])
-            return int(self._batch(hi - lo, in_p, out_p))
+            return int(driver(hi - lo, in_p, out_p))
 
-        if workers > 1:
-            from concurrent.futures import ThreadPoolExecutor
-
-            with ThreadPoolExecutor(workers) as pool:
-                failed = any(pool.map(part, bounds[:-1], bounds[1:]))
+        if workers > 1:  # (the last chunk on this thread)
+            others = [_pool().submit(part, lo, hi) for lo, hi in itertools.pairwise(bounds[:-1])]
+            failed = bool(part(bounds[-2], bounds[-1])) | any(f.result() for f in others)
         else:
             failed = bool(part(0, n))
         if failed:
             raise RuntimeError(f"the compiled kernel {self.fun.name()} failed")
         return outs
+
+    def _vector_driver(self) -> Callable[..., int]:
+        """The vector driver (:func:`~pkm.core.twin.simd.simd_library`, compiled on first use), or the scalar one
+        where it does not compile (:attr:`how` says why)."""
+        if self._simd is None:
+            from pkm.core.twin.simd import simd_library
+
+            lib, how = simd_library(self.fun, self.directory)
+            self._simd = self._batch
+            if lib is not None:
+                driver = getattr(lib, f"{self.fun.name()}_simd")
+                driver.argtypes = [_I, ctypes.POINTER(_P), ctypes.POINTER(_P)]
+                driver.restype = ctypes.c_int
+                self._simd = driver
+            self.how += f"; batches of {VECTOR_SAMPLES} or more: " + (
+                f"the vector driver ({how})" if lib is not None else f"scalar (no vector driver: {how})")
+        return self._simd
 
     def follow(self, q0: np.ndarray, targets: np.ndarray, max_iter: int, tol: float,
                design: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -213,6 +246,9 @@ class Kernels:
         compiled: Compile to C when a C compiler is present (default); False runs numpy (batches) and CasADi's
             virtual machine (one sample).
         directory: Where compiled libraries go (default :func:`pkm.core.twin.codegen.cache_dir`).
+        vector: Run compiled batches of :data:`VECTOR_SAMPLES` or more on the vector units
+            (:mod:`~pkm.core.twin.simd`; bit for bit the scalar driver's); False: the scalar driver always.
+        threads: Cores a compiled batch of ``2 THREAD_SAMPLES`` or more is split over (default: every core).
 
     Raises:
         SpecError: ``mech`` has idle motions (on the first kernel that needs the passive solve, but the model's).
@@ -220,12 +256,15 @@ class Kernels:
     """
 
     def __init__(self, mech: Mechanism, *, design: Sequence[str] | None = None, compiled: bool = True,
-                 directory: str | os.PathLike[str] | None = None):
+                 directory: str | os.PathLike[str] | None = None, vector: bool = True, threads: int | None = None):
         self.mech = check_mechanism(mech)
         self.twin = Twin(self.mech, design)
         #: The design parameters (:class:`~pkm.core.twin.design.Design`; empty: none).
         self.design = self.twin.design
         self.compiled, self.directory = compiled, directory
+        if not isinstance(vector, (bool, np.bool_)):
+            raise InvalidInputError("vector", "expected True or False", vector)
+        self.vector, self.threads = bool(vector), None if threads is None else as_count(threads, "threads", high=1024)
         self._kernels: dict[str, _Kernel] = {}
         self._shared: dict[object, object] = {}
         self._p = self.design.base
@@ -326,7 +365,7 @@ class Kernels:
         """The kernel ``name`` (built, and compiled, on first use)."""
         if name not in self._kernels:
             self._kernels[name] = _Kernel(self.function(name), name in _PATHS, self.compiled,
-                                          self.directory)
+                                          self.directory, self.vector, self.threads)
         return self._kernels[name]
 
     def cached(self, key: object, make: Callable[[], object]) -> object:
