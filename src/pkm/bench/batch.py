@@ -20,7 +20,7 @@ measured by :func:`pkm.core.twin.simd.peak_gflops` (independent multiply-then-ad
 run; the FMA peak is stated too). Goals (the issue's): 3-PRS <= 0.06 µs, hexapod <= 0.3 µs a sample on one core;
 the vector driver on 2 threads >= 1.8x one.
 
-Usage: ``python -m pkm.bench.batch [--json] [--quick] [-n 100000] [--repeat 9]``.
+Usage: ``python -m pkm.bench.batch [--json] [--quick] [-n 100000] [--repeat 9] [--mechanisms prs3,delta,hexapod]``.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ import numpy as np
 from pkm.bench import main
 from pkm.bench.twin import _path
 
-QUICK = {"n": 4096, "repeat": 3}
+QUICK = {"n": 4096, "repeat": 3, "mechanisms": "prs3"}
 MECHANISMS = ("prs3", "delta", "hexapod")
 GOALS_US = {"prs3": 0.06, "hexapod": 0.3}
 GOAL_SCALING = 1.8
@@ -42,6 +42,7 @@ GOAL_SCALING = 1.8
 def add_arguments(ap) -> None:
     ap.add_argument("-n", type=int, default=100_000, help="samples (default 100,000)")
     ap.add_argument("--repeat", type=int, default=9, help="timed repeats of each route (median kept)")
+    ap.add_argument("--mechanisms", default=",".join(MECHANISMS), help="which, comma-separated (default all three)")
 
 
 def _median(fn, repeat: int) -> float:
@@ -55,10 +56,12 @@ def _median(fn, repeat: int) -> float:
 
 
 def _jax(K, args, repeat: int, reference: np.ndarray) -> dict:
-    try:
-        import jax
-    except ImportError:
+    from pkm._optional import missing
+
+    if missing("jax"):
         return {"skipped": 'JAX is not installed (pip install "pkm[jax]")'}
+    import jax
+
     f = jax.jit(jax.vmap(K.jax("inverse_dynamics")))
     arrays = [jax.device_put(a) for a in args]
     t0 = time.perf_counter()
@@ -98,7 +101,7 @@ def run(args) -> dict:
 
     peak = peak_gflops()
     out: dict = {"n": args.n, "peak_gflops": peak, "mechanisms": {}}
-    for name in MECHANISMS:
+    for name in args.mechanisms.split(","):
         mech = pkm.load(name)
         qa, qd, qdd = _path(mech, args.n)
         Q = pkm.Kernels(mech).close_loops_path(qa).q

@@ -27,7 +27,7 @@ from typing import Any
 
 from pkm._moved import renamed_keywords
 from pkm.core.model.bodies import BODY_FIELDS, BODY_UNITS, body_names
-from pkm.core.twin.design import ORIGIN, origins_set, urdf_joints
+from pkm.core.model.origins import ORIGIN, origins_set, urdf_joints
 from pkm.errors import InvalidInputError, UnknownNameError
 
 _SCALAR_TYPES = ("float", "int")

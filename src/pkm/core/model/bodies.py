@@ -6,7 +6,10 @@ A body is what one Pinocchio joint moves (its link, with the links fixed to it m
 
 from __future__ import annotations
 
-import pinocchio as pin
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import pinocchio as pin
 
 BODY_FIELDS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
 """The ten standard parameters of a body, Pinocchio's order (``Inertia.toDynamicParameters``): the mass, its first
@@ -17,6 +20,8 @@ BODY_UNITS = ("kg", "kg m", "kg m", "kg m", "kg m^2", "kg m^2", "kg m^2", "kg m^
 def body_names(model: pin.Model) -> tuple[str, ...]:
     """One name per Pinocchio joint (1 to ``njoints - 1``): the first link it moves (its body frame), else the
     joint's name."""
+    import pinocchio as pin  # (here: the names above are read by the command line, which does not load Pinocchio)
+
     names = []
     for j in range(1, model.njoints):
         link = next((f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == j),

@@ -28,7 +28,6 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import casadi as cs
 import numpy as np
@@ -37,11 +36,9 @@ from numpy.typing import ArrayLike
 
 from pkm.core.model.bodies import BODY_FIELDS, body_names
 from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.origins import ORIGIN, joint_elements, origins_set
 from pkm.core.twin.spatial import SE3, Expr
 from pkm.errors import InvalidInputError, UnknownNameError
-
-#: Origin components: name -> (URDF attribute, index).
-ORIGIN = {"x": ("xyz", 0), "y": ("xyz", 1), "z": ("xyz", 2), "roll": ("rpy", 0), "pitch": ("rpy", 1), "yaw": ("rpy", 2)}
 
 
 @dataclass(frozen=True)
@@ -214,46 +211,14 @@ def structure(mech: Mechanism) -> str:
 
     model = mech.model
     parts = [dataclasses.replace(mech.spec, reference={}, parameters={}, description="").to_toml(), " ".join(j.shortname() for j in model.joints),
-             repr(np.round(np.concatenate([model.lowerPositionLimit, model.upperPositionLimit]), 12).tolist())]
+             repr(np.concatenate([model.lowerPositionLimit, model.upperPositionLimit]).tolist())]
     if mech.urdf is not None:
-        root, _ = _joints(mech.urdf)
+        root, _ = joint_elements(mech.urdf)
         for el in list(root.iter("origin", "inertial")):
             if el.getparent() is not None:
                 el.getparent().remove(el)
         parts.append(etree.tostring(root, encoding="unicode"))
     return "\n".join(parts)
-
-
-def origins_set(urdf: str, values: Mapping[str, float]) -> str:
-    """The URDF text with the joint origins named by ``values`` (``JOINT.x`` ... ``JOINT.yaw``, SI) set."""
-    from lxml import etree
-
-    root, joints = _joints(urdf)
-    for name, value in values.items():
-        joint, _, comp = name.rpartition(".")
-        if joint not in joints or comp not in ORIGIN:
-            raise UnknownNameError("parameter", name, [f"{j}.{c}" for j in joints for c in ORIGIN], "the URDF")
-        origin = joints[joint].find("origin")
-        if origin is None:
-            origin = etree.SubElement(joints[joint], "origin")
-        attr, k = ORIGIN[comp]
-        parts = (origin.get(attr) or "0 0 0").split()
-        parts[k] = repr(float(value))
-        origin.set(attr, " ".join(parts))
-    return etree.tostring(root, encoding="unicode")
-
-
-def urdf_joints(urdf: str) -> tuple[str, ...]:
-    """The URDF's joint names, in file order."""
-    return tuple(_joints(urdf)[1])
-
-
-def _joints(urdf: str) -> tuple[Any, dict[str, Any]]:
-    """The URDF's root and its joints by name (pkm's hardened parser, :func:`pkm.core.model.urdf.parse_xml`)."""
-    from pkm.core.model.urdf import parse_xml
-
-    root = parse_xml(urdf)
-    return root, {j.get("name"): j for j in root.iter("joint") if j.get("name") and j.getparent() is root}
 
 
 def _urdf(mech: Mechanism) -> str:
@@ -266,7 +231,7 @@ def _urdf(mech: Mechanism) -> str:
 def _urdf_joints(mech: Mechanism) -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
     """``{joint: (xyz, rpy, parent link)}`` of every URDF joint of ``mech``'s file."""
     out = {}
-    for name, j in _joints(_urdf(mech))[1].items():
+    for name, j in joint_elements(_urdf(mech))[1].items():
         origin, parent = j.find("origin"), j.find("parent")
         xyz, rpy = ((np.array([float(v) for v in ((origin.get(a) if origin is not None else None) or "0 0 0").split()]))
                     for a in ("xyz", "rpy"))
@@ -276,7 +241,7 @@ def _urdf_joints(mech: Mechanism) -> dict[str, tuple[np.ndarray, np.ndarray, str
 
 def _carried_mass(urdf: str, joint: str) -> float:
     """The mass of the links URDF joint ``joint`` carries through fixed joints (what merges into one body)."""
-    root, joints = _joints(urdf)
+    root, joints = joint_elements(urdf)
     masses = {}
     for link in root.iter("link"):
         m = link.find("inertial/mass")
@@ -300,5 +265,4 @@ def _rpy_matrix(roll: Expr, pitch: Expr, yaw: Expr) -> Expr:
                       cs.horzcat(-sp, cp * sr, cp * cr))
 
 
-__all__ = ["ORIGIN", "Design", "design_mechanism", "design_of", "origins_set", "read_design", "structure",
-           "urdf_joints"]
+__all__ = ["Design", "design_mechanism", "design_of", "read_design", "structure"]

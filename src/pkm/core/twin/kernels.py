@@ -57,8 +57,13 @@ PIVOT_FLOOR = 1e-6
 THREAD_SAMPLES = 2048
 #: A compiled batch of at least this many samples runs the kernel's vector driver (:mod:`~pkm.core.twin.simd`:
 #: several samples a vector instruction, bit for bit the scalar driver's), compiled on the first such batch; a
-#: smaller one the scalar driver (the vector library's compile, 0.2 s to 7 s, is not worth it for a few samples).
+#: smaller one the scalar driver (the vector library's compile is not worth it for a few samples).
 VECTOR_SAMPLES = 256
+#: By default (``vector=None``) only kernels of at most this many instructions take the vector driver: their vector
+#: library compiles in under a second (the hexapod's efforts, 3,478: 0.6 s); a larger one's takes seconds to tens of
+#: seconds (the Gough-Stewart's regressor, 9,322: 11 s), repaid only by batches of millions of samples (about 0.1 ns
+#: saved an instruction a sample): ``vector=True`` asks for it.
+VECTOR_INSTRUCTIONS = 4000
 
 
 
@@ -132,8 +137,9 @@ class _Kernel:
     sample)."""
 
     def __init__(self, fun: cs.Function, follow: bool, compiled: bool, directory: str | os.PathLike[str] | None,
-                 vector: bool = True, threads: int | None = None):
-        self.fun, self.directory, self.vector, self.threads = fun, directory, vector, threads
+                 vector: bool | None = None, threads: int | None = None):
+        self.fun, self.directory, self.threads = fun, directory, threads
+        self.vector = vector if vector is not None else fun.n_instructions() <= VECTOR_INSTRUCTIONS
         self._simd: Callable[..., int] | None = None
         self.lib, self.how = compile_library(fun, follow=follow, directory=directory) if compiled else (
             None, "compiled=False")
@@ -247,7 +253,8 @@ class Kernels:
             virtual machine (one sample).
         directory: Where compiled libraries go (default :func:`pkm.core.twin.codegen.cache_dir`).
         vector: Run compiled batches of :data:`VECTOR_SAMPLES` or more on the vector units
-            (:mod:`~pkm.core.twin.simd`; bit for bit the scalar driver's); False: the scalar driver always.
+            (:mod:`~pkm.core.twin.simd`; bit for bit the scalar driver's): True for every kernel, None (default)
+            for kernels of at most :data:`VECTOR_INSTRUCTIONS` instructions, False never.
         threads: Cores a compiled batch of ``2 THREAD_SAMPLES`` or more is split over (default: every core).
 
     Raises:
@@ -256,15 +263,17 @@ class Kernels:
     """
 
     def __init__(self, mech: Mechanism, *, design: Sequence[str] | None = None, compiled: bool = True,
-                 directory: str | os.PathLike[str] | None = None, vector: bool = True, threads: int | None = None):
+                 directory: str | os.PathLike[str] | None = None, vector: bool | None = None,
+                 threads: int | None = None):
         self.mech = check_mechanism(mech)
         self.twin = Twin(self.mech, design)
         #: The design parameters (:class:`~pkm.core.twin.design.Design`; empty: none).
         self.design = self.twin.design
         self.compiled, self.directory = compiled, directory
-        if not isinstance(vector, (bool, np.bool_)):
-            raise InvalidInputError("vector", "expected True or False", vector)
-        self.vector, self.threads = bool(vector), None if threads is None else as_count(threads, "threads", high=1024)
+        if vector is not None and not isinstance(vector, (bool, np.bool_)):
+            raise InvalidInputError("vector", "expected True, False or None", vector)
+        self.vector = None if vector is None else bool(vector)
+        self.threads = None if threads is None else as_count(threads, "threads", high=1024)
         self._kernels: dict[str, _Kernel] = {}
         self._shared: dict[object, object] = {}
         self._p = self.design.base

@@ -75,7 +75,9 @@ def theta_times(th: Expr, m: Expr) -> Expr:
 # ---------------------------------------------------------------------- the twin
 class Twin:
     """The symbolic twin of ``mech`` (see the module doc). Its expressions are built once, in terms of the
-    symbols :attr:`q`, :attr:`v`, :attr:`a`; :meth:`function` wraps any of them as a ``casadi.Function``."""
+    symbols :attr:`q`, :attr:`v`, :attr:`a`, and :attr:`p` for the ``design`` parameters taken as symbols (URDF
+    joint origins, bodies' inertial parameters: :mod:`~pkm.core.twin.design`; none by default); :meth:`function`
+    wraps any of them as a ``casadi.Function``."""
 
     def __init__(self, mech: Mechanism, design: Sequence[str] | None = None):
         self.mech = mech = check_mechanism(mech)
