@@ -87,6 +87,30 @@ def test_a_loaded_mechanism_sweeps_its_joint_origins():
         pkm.sweep(mech, sweeps.grid(**{"motor_1.w": [0.1]}), ["condition"], scheduler="serial")
 
 
+def test_the_capability_of_a_loaded_mechanism_s_designs_through_the_shared_twin():
+    """The acceptance-set Gough-Stewart with two base joints moved: the capability objective (the smallest
+    isotropic force and the mean isotropic moment its 1000 N legs give over a 6 x 6 map) through the family's shared
+    twin equals :func:`map_capability` on the design's own mechanism and kernels to 1e-12; a unit group the task
+    has not is refused, naming those it has."""
+    from pkm.core.analysis.capability import map_capability
+    from tests.core.twin.test_tree import FILES
+
+    mech = pkm.load(FILES["gough_stewart"])
+    region = "region=x=-0.1:0.1:6/y=-0.1:0.1:6,length=0.5"
+    values = {"u1.x": 0.49, "u2.y": 0.14}
+    res = pkm.sweep(mech, sweeps.table([values]), [f"f=capability:{region}",
+                                                   f"m=capability:{region},unit=N m,stat=mean"], scheduler="serial")
+    design = sweeps.family_of(mech).mechanism(values)
+    wmap = pkm.workspace_map(design, {"x": np.linspace(-0.1, 0.1, 6), "y": np.linspace(-0.1, 0.1, 6)},
+                             length=0.5, configurations=True)
+    cap = map_capability(design, wmap)
+    assert cap.reachable.sum() == 36
+    np.testing.assert_allclose(res.column("f")[0], cap.isotropic["N"][cap.reachable].min(), rtol=1e-12)
+    np.testing.assert_allclose(res.column("m")[0], cap.isotropic["N m"][cap.reachable].mean(), rtol=1e-12)
+    bad = pkm.sweep(mech, sweeps.table([values]), [f"capability:{region},unit=kg"], scheduler="serial")
+    assert bad.stats.failed == 1 and "N m" in bad.table.column("message")[0].as_py()
+
+
 def test_user_callables_their_nulls_and_their_failures():
     def triangle(design):
         h = design.values["h"]

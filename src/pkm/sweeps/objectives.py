@@ -324,10 +324,17 @@ def _task_value(mech, name: str, text: str) -> float:
     return parse_quantity(text, {kind}, name, SI_UNITS[kind])
 
 
-def _generic_map(c: Candidate, o: Mapping[str, Any]):
-    """The :func:`pkm.task_map` of the design over ``region`` (cached per design and region)."""
+#: A sweep's map of at most this many nodes keeps its nodes' configurations (nq numbers a node), so that a capability
+#: objective reads the same map as the others; a larger one keeps them only for a capability objective.
+KEEP_CONFIGURATIONS = 100_000
+
+
+def _generic_map(c: Candidate, o: Mapping[str, Any], configurations: bool = False):
+    """The :func:`pkm.workspace_map` of the design over ``region`` (cached per design and region), through the
+    design's kernels (:attr:`Candidate.kernels`: one compiled twin for every design of a family that has one)."""
     if not o.get("region"):
         raise InvalidInputError("region", "the generic route maps a region: give region=x=START:STOP:COUNT/...")
+    nodes = int(np.prod([k for _, _, k in o["region"].values()]))
 
     def make():
         from pkm.core.analysis.maps import workspace_map
@@ -337,11 +344,35 @@ def _generic_map(c: Candidate, o: Mapping[str, Any]):
                 for n, (a, b, k) in o["region"].items()}
         fixed = {n: _task_value(mech, n, v) for n, v in (o.get("pose") or {}).items()}
         return workspace_map(mech, axes, fixed, length=o.get("length"), branch=o.get("branch") or None,
-                             kernels=c.kernels)
+                             kernels=c.kernels, configurations=configurations or nodes <= KEEP_CONFIGURATIONS)
 
     key = ("task_map", tuple(o["region"].items()), tuple((o.get("pose") or {}).items()), o.get("length"),
            o.get("branch"))
-    return c.cached(key, make)
+    found = c.cached(key, make)
+    if configurations and found.q is None:  # (a large map made without them for another objective)
+        c._cache.pop(key)
+        found = c.cached(key, make)
+    return found
+
+
+def _capability(c: Candidate, o: Mapping[str, Any]) -> float | None:
+    """The smallest (or mean) isotropic capability of one unit group over the regular reachable nodes of the map
+    (:func:`pkm.core.analysis.capability.map_capability`, through the design's kernels); None where no node is."""
+    from pkm.core.analysis.capability import UNITS, map_capability
+
+    m = _generic_map(c, o, configurations=True)
+    kind = o["kind"]
+    cap = c.cached(("capability", id(m), kind, o["gravity"]),
+                   lambda: map_capability(c.mechanism, m, kind, gravity=o["gravity"] == "on", kernels=c.kernels))
+    groups = list(cap.isotropic)
+    unit = o.get("unit") or groups[0]
+    if unit not in groups:
+        raise InvalidInputError("unit", f"this task's {kind} capability has the unit groups {groups} "
+                                        f"({UNITS[kind]})", unit)
+    values = cap.isotropic[unit][cap.reachable]
+    if not values.size:
+        return None
+    return float(values.min() if o["stat"] == "min" else values.mean())
 
 
 def _generic_gci(c, o):
@@ -491,6 +522,14 @@ OBJECTIVES: dict[str, Definition] = {d.name: d for d in (
                {"motion": ("text", "1", "the case's name"), "file": ("text", "", "motion file"),
                 "coordinates": ("text", "", "as peak_effort"), "samples": ("int", 0, "as peak_effort", 0)},
                _peak_power),
+    Definition("capability", "max", "N, N m, m/s, rad/s, m/s^2 or rad/s^2", "smallest (stat=mean: mean) isotropic "
+               "wrench, twist or acceleration capability under the actuators' limits over the map's regular nodes",
+               {**_MAP, "kind": ("text", "wrench", "wrench, twist or acceleration", ("wrench", "twist", "acceleration")),
+                "unit": ("text", "", "the unit group of a mixed task (N or N m ...; default the first)"),
+                "stat": ("text", "min", "min or mean over the nodes", ("min", "mean")),
+                "gravity": ("text", "on", "wrenches and accelerations against gravity (on) or not (off)",
+                            ("on", "off"))},
+               _capability),
     Definition("operation_count", "min", "operations", "operations of a generated kernel after CSE",
                {"kernel": ("text", "inverse_dynamics", "the kernel"),
                 "count": ("text", "total", "total, mul, add", ("total", "mul", "add"))},

@@ -45,8 +45,8 @@ if TYPE_CHECKING:
     from pkm.core.twin import Kernels
 
 KINDS = ("wrench", "twist", "acceleration")
-_UNITS = {"wrench": {"length": "N", "angle": "N m"}, "twist": {"length": "m/s", "angle": "rad/s"},
-          "acceleration": {"length": "m/s^2", "angle": "rad/s^2"}}
+UNITS = {"wrench": {"length": "N", "angle": "N m"}, "twist": {"length": "m/s", "angle": "rad/s"},
+         "acceleration": {"length": "m/s^2", "angle": "rad/s^2"}}
 
 
 @dataclass(frozen=True)
@@ -185,7 +185,7 @@ def capability(mech: Mechanism, q: ArrayLike, kind: str = "wrench", *, gravity: 
     V, A, b = _box_map(L, c, lo, hi)
     kinds = mech.task_map.kinds
     axes = tuple(kinds)
-    units = tuple(_UNITS[kind][kinds[a]] for a in axes)
+    units = tuple(UNITS[kind][kinds[a]] for a in axes)
     poly = Polytope(V, A, b, axes, units)
     inside = bool(np.all(b > 0.0))
     along = {a: (poly.reach(np.eye(n)[i]) if inside else 0.0, poly.reach(-np.eye(n)[i]) if inside else 0.0)
@@ -239,7 +239,7 @@ def capability_indices(mech: Mechanism, Q: ArrayLike, kind: str = "wrench", *, g
     inside = np.all(b > 0.0, axis=1)
     kinds = mech.task_map.kinds
     axes = tuple(kinds)
-    units = tuple(_UNITS[kind][kinds[a]] for a in axes)
+    units = tuple(UNITS[kind][kinds[a]] for a in axes)
 
     def finish(x: np.ndarray) -> np.ndarray:
         return np.where(regular, np.where(inside, x, 0.0), np.nan)
@@ -282,7 +282,7 @@ def map_capability(mech: Mechanism, wmap: WorkspaceMap, kind: str = "wrench", *,
     return CapabilityMap(kind, wmap.axes, fixed, reachable.reshape(shape),
                          {a: (spread(p), spread(m)) for a, (p, m) in along_n.items()},
                          {u: spread(v) for u, v in iso_n.items()},
-                         {a: _UNITS[kind][kinds[a]] for a in kinds}, dict(kinds), mech.name)
+                         {a: UNITS[kind][kinds[a]] for a in kinds}, dict(kinds), mech.name)
 
 
 MAX_MAP_NODES = 250_000  # nodes of a capability map at most (each an IK solve and a capability: about 2 ms)
@@ -470,4 +470,4 @@ def capability_map(mech: Mechanism, axes: Mapping[str, ArrayLike], fixed: Mappin
     return CapabilityMap(kind, tuple(grid), rest, reachable, along, iso, units, dict(mech.task_map.kinds), mech.name)
 
 
-__all__ = ["KINDS", "MAX_MAP_NODES", "Capability", "CapabilityMap", "Polytope", "capability", "capability_map"]
+__all__ = ["KINDS", "MAX_MAP_NODES", "UNITS", "Capability", "CapabilityMap", "Polytope", "capability", "capability_map"]
