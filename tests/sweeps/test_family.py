@@ -142,3 +142,18 @@ def test_designs_share_one_twin_with_design_inputs_and_score_as_their_own_twins(
     assert np.allclose(shared, own.table.column(spec).to_pylist(), rtol=1e-12, atol=0)
     candidate = fam.candidate({"a": 0.35, "b": 0.45, "h": 0.12})
     assert candidate.kernels.design_values.size == len(varied)
+
+
+def test_a_loaded_mechanism_changed_in_memory_is_refused_and_the_shared_twin_is_the_files():
+    """A sweep builds its designs from the files: a model whose inertias were set in memory is refused (naming
+    them); the family kernels of the files are not another family's of the same texts."""
+    import pinocchio as pin
+
+    mech = pkm.load("rrr3")
+    changed = pkm.load("rrr3")
+    changed.model.inertias[1] = pin.Inertia.FromDynamicParameters(
+        changed.model.inertias[1].toDynamicParameters() * 2.0)
+    with pytest.raises(InvalidInputError, match=r"proximal_1\.I"):
+        ModelFamily(changed)
+    fam = ModelFamily(mech)
+    assert fam.kernels(("platform.m",)).design.base[0] == pytest.approx(0.1)

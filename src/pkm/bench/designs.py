@@ -109,6 +109,9 @@ def _gs_case(args) -> dict:
     for j, k in enumerate(sorted(pick)):
         for o in ("coverage", "gci"):
             a, b = rows[o][int(k)], own_rows[o][j]
+            if a is None or b is None:  # (no value, or a failed design: equal only if both)
+                worst = max(worst, 0.0 if a is b else float("inf"))
+                continue
             worst = max(worst, 0.0 if a == b else abs(a - b) / max(1.0, abs(b)))
     return {"designs": args.designs, "nodes": args.nodes ** 2, "parameters": list(params), "spread_m": args.spread,
             "objectives": objectives, "failed": st.failed, "workers": st.workers,

@@ -33,8 +33,10 @@ from pkm.errors import InvalidInputError, UnknownNameError
 _SCALAR_TYPES = ("float", "int")
 #: Units of the inertial parameters, by field.
 _INERTIAL_UNITS = dict(zip(BODY_FIELDS, BODY_UNITS))
-#: Each process's kernels with design inputs, by family and design inputs (:meth:`Family.kernels`).
+#: Each process's kernels with design inputs, by family and design inputs (:meth:`Family.kernels`): the
+#: :data:`KEEP_KERNELS` latest.
 _KERNELS: dict[tuple[str, tuple[str, ...]], Any] = {}
+KEEP_KERNELS = 8
 
 
 class Candidate:
@@ -110,15 +112,23 @@ class Family:
         """The kernels of one design (:attr:`Candidate.kernels`): the family's twin with the parameters that
         differ from the base design as inputs (:mod:`pkm.core.twin.design`), bound to this design; the design's own
         when the family is not :attr:`parametric`, the design is the base, or it changes more than origins and
-        inertias (joint kinds, limits, the spec)."""
+        inertias (joint kinds, the spec: :func:`~pkm.core.twin.design.structure`). A fixed joint carrying mass
+        brings the ten inertial parameters of the body it merges into (:func:`~pkm.core.twin.design.with_merged_bodies`:
+        the design mechanism's, as Pinocchio merges them)."""
         from pkm.core.twin import Kernels
-        from pkm.core.twin.design import read_design, structure
+        from pkm.core.twin.design import read_design, structure, with_merged_bodies
+        from pkm.errors import PkmError
 
         mech = candidate.mechanism
         names = self.varied(tuple(candidate.values)) if self.parametric and candidate.values else ()
         if not names or structure(mech) != self.cached_structure():
             return Kernels(mech)
-        return self.kernels(names).at(read_design(mech, names), mech)
+        names = with_merged_bodies(mech, names)
+        try:
+            shared = self.kernels(names)
+        except PkmError:  # (names the shared twin cannot take: the design's own kernels)
+            return Kernels(mech)
+        return shared.at(read_design(mech, names), mech)
 
     def varied(self, parameters: tuple[str, ...]) -> tuple[str, ...]:
         """The design inputs (:func:`pkm.core.twin.design.read_design`'s names) that ``parameters`` move."""
@@ -140,9 +150,14 @@ class Family:
         (their compiled libraries once per machine: :mod:`pkm.core.twin.codegen` caches them by source); bind a
         design with :meth:`pkm.Kernels.at`."""
         from pkm.core.twin import Kernels
+        from pkm.core.twin.design import read_design
 
-        key = (repr(sorted(self.describe().items())), tuple(names))
+        if "_fingerprint" not in self.__dict__:  # (the files, and the base's numbers: a model changed in memory)
+            self._fingerprint = repr((sorted(self.describe().items()), sorted(read_design(self.base_mechanism()).items())))
+        key = (self._fingerprint, tuple(names))
         if key not in _KERNELS:
+            while len(_KERNELS) >= KEEP_KERNELS:  # (the oldest first: a long-lived process sweeps many families)
+                _KERNELS.pop(next(iter(_KERNELS)))
             _KERNELS[key] = Kernels(self.base_mechanism(), design=names)
         return _KERNELS[key]
 
@@ -240,6 +255,17 @@ class ModelFamily(Family):
             raise InvalidInputError("mechanism", "built from a Pinocchio model without URDF text: nothing to vary "
                                                  "(load it from files)", mech.source)
         self.urdf, self.spec, self.source = mech.urdf, mech.spec.to_toml(), mech.source
+        self._base = None
+        files = self.base  # (what every design is built from: the texts)
+        from pkm.core.twin.design import read_design
+
+        ours, theirs = read_design(mech), read_design(files)
+        changed = sorted(k for k in ours if ours[k] != theirs.get(k))
+        if changed:
+            raise InvalidInputError("mechanism", f"its model differs from its files ({', '.join(changed[:3])}"
+                                                 f"{' ...' if len(changed) > 3 else ''} set in memory): a sweep builds "
+                                                 "its designs from the files; write them, or sweep those parameters",
+                                    mech.source)
         self._base = mech
         self.joint_names = urdf_joints(self.urdf)
         self.body_names = body_names(mech.model)

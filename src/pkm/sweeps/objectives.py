@@ -346,13 +346,18 @@ def _generic_map(c: Candidate, o: Mapping[str, Any], configurations: bool = Fals
         return workspace_map(mech, axes, fixed, length=o.get("length"), branch=o.get("branch") or None,
                              kernels=c.kernels, configurations=configurations or nodes <= KEEP_CONFIGURATIONS)
 
-    key = ("task_map", tuple(o["region"].items()), tuple((o.get("pose") or {}).items()), o.get("length"),
-           o.get("branch"))
+    key = _map_key(o)
     found = c.cached(key, make)
     if configurations and found.q is None:  # (a large map made without them for another objective)
         c._cache.pop(key)
         found = c.cached(key, make)
     return found
+
+
+def _map_key(o: Mapping[str, Any]) -> tuple:
+    """A design's map, as the options name it (the key it is cached under)."""
+    return ("task_map", tuple(o["region"].items()), tuple((o.get("pose") or {}).items()), o.get("length"),
+            o.get("branch"))
 
 
 def _capability(c: Candidate, o: Mapping[str, Any]) -> float | None:
@@ -362,7 +367,7 @@ def _capability(c: Candidate, o: Mapping[str, Any]) -> float | None:
 
     m = _generic_map(c, o, configurations=True)
     kind = o["kind"]
-    cap = c.cached(("capability", id(m), kind, o["gravity"]),
+    cap = c.cached(("capability", _map_key(o), kind, o["gravity"]),
                    lambda: map_capability(c.mechanism, m, kind, gravity=o["gravity"] == "on", kernels=c.kernels))
     groups = list(cap.isotropic)
     unit = o.get("unit") or groups[0]

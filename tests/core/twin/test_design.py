@@ -102,8 +102,6 @@ def test_fixed_joint_origins_move_the_frames_they_carry():
     names = ("platform_B_fixed.x", "platform_C_fixed.x", "platform_C_fixed.y")
     K = Kernels(mech, design=names)
     values = dict(zip(names, np.array(list(read_design(mech, names).values())) * 1.2))
-    d = pkm.design_params("rrr3")  # (the file's design, for its reference)
-    assert d.h > 0
     own = design_mechanism(mech, values)
     Kd = K.at(values, own)
     q = own.q_reference
@@ -131,17 +129,29 @@ def test_bad_designs_are_refused_with_the_choices_named(gough_stewart):
 
 
 def test_a_fixed_joint_carrying_mass_varies_only_with_the_body_it_merges_into(gough_stewart):
-    """A 2 kg weight bolted to the platform by a fixed joint: its origin alone is refused (the platform's merged
-    inertia would stay the file's); with the platform's inertial parameters as inputs too it is accepted."""
+    """A 2 kg weight bolted to the platform by a fixed joint: its origin moves mass within the platform's body, so
+    it is refused without the platform's ten inertial parameters (one of them is not enough: the others would stay
+    the file's); with them (``with_merged_bodies``, their values the design's as Pinocchio merges them) the efforts
+    at a moved weight are that design's, to 1e-12."""
+    from pkm.core.twin.design import with_merged_bodies
+
     mech, _ = gough_stewart
     weight = ('<link name="weight"><inertial><mass value="2.0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" '
               'iyz="0" izz="0.01"/></inertial></link><joint name="weight_fixed" type="fixed"><parent link="platform"/>'
               '<child link="weight"/><origin xyz="0 0 0.1" rpy="0 0 0"/></joint></robot>')
     heavy = pkm.Mechanism.from_strings(mech.urdf.replace("</robot>", weight), mech.spec.to_toml(), source="heavy")
-    with pytest.raises(InvalidInputError, match="carries 2 kg"):
-        Kernels(heavy, design=("weight_fixed.z",))
-    K = Kernels(heavy, design=("weight_fixed.z", "platform.mz"))
-    assert K.design.names == ("weight_fixed.z", "platform.mz")
+    for names in (("weight_fixed.z",), ("weight_fixed.z", "platform.mz")):
+        with pytest.raises(InvalidInputError, match="carries 2 kg"):
+            Kernels(heavy, design=names)
+    names = with_merged_bodies(heavy, ("weight_fixed.z",))
+    assert len(names) == 11 and "platform.Izz" in names
+    K = Kernels(heavy, design=names)
+    d = design_mechanism(heavy, {"weight_fixed.z": 0.4})
+    rng = np.random.default_rng(4)
+    q, qd, qdd = d.q_reference, rng.standard_normal(6), rng.standard_normal(6)
+    v = pkm.velocities(d, q, qd)
+    tau = pkm.inverse_dynamics(d, q, v, pkm.accelerations(d, q, v, qdd))
+    assert _rel(K.at(read_design(d, names), d).inverse_dynamics(q, qd, qdd), tau) <= 1e-12
 
 
 def test_the_structure_ignores_origins_inertias_and_the_reference_but_not_the_spec():
@@ -149,3 +159,30 @@ def test_the_structure_ignores_origins_inertias_and_the_reference_but_not_the_sp
     moved = pkm.build("rrr3", a=0.5, h=0.2)
     assert structure(moved) == structure(mech)
     assert structure(pkm.build("rrr3", branch=2)) != structure(mech)
+
+
+def test_views_of_two_designs_answer_from_two_threads_each_its_own(gough_stewart):
+    """Two threads calling one sample at a time, each on its own design's view (the views share the compiled
+    kernels): every answer is its own design's (the single-sample buffers are each thread's)."""
+    import threading
+
+    mech, K = gough_stewart
+    views = []
+    for values in _designs(K, 2, 0.03, seed=7):
+        d = design_mechanism(mech, values)
+        views.append((K.at(values, d), d.q_reference))
+    qd, qdd = np.full(6, 0.3), np.full(6, -0.2)
+    expected = [view.inverse_dynamics(q, qd, qdd) for view, q in views]
+    wrong = [0, 0]
+
+    def run(k: int) -> None:
+        view, q = views[k]
+        for _ in range(3000):
+            wrong[k] += not np.array_equal(view.inverse_dynamics(q, qd, qdd), expected[k])
+
+    threads = [threading.Thread(target=run, args=(k,)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert wrong == [0, 0]

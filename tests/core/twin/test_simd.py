@@ -169,3 +169,31 @@ def test_kernels_run_large_batches_on_the_vector_driver_bit_for_bit_on_any_threa
     assert _same(Kernels(mech, threads=2).inverse_dynamics(Q, QD, QDD), scalar)
     with pytest.raises(pkm.errors.InvalidInputError, match="threads"):
         Kernels(mech, threads=0)
+
+
+def _child_batch(queue) -> None:  # (module level: the fork runs it)
+    mech = pkm.load("prs3")
+    Q, QD, QDD = (np.repeat(a, 400, axis=0) for a in _states(mech, 12, seed=5))
+    queue.put(Kernels(mech).inverse_dynamics(Q, QD, QDD).shape)
+
+
+def test_a_forked_child_splits_its_batches_over_threads_of_its_own(monkeypatch):
+    """After the parent split a batch over its thread pool, a child forked from it (multiprocessing's default on
+    Linux) splits its own batch: it has a pool of its own (the parent's threads do not exist in the child)."""
+    import multiprocessing
+
+    from pkm.core.twin import kernels as kmod
+
+    monkeypatch.setattr(kmod, "THREAD_SAMPLES", 1000)
+    mech = pkm.load("prs3")
+    Q, QD, QDD = (np.repeat(a, 400, axis=0) for a in _states(mech, 12, seed=5))
+    Kernels(mech, threads=2).inverse_dynamics(Q, QD, QDD)  # (the parent's pool started)
+    context = multiprocessing.get_context("fork")
+    queue = context.Queue()
+    child = context.Process(target=_child_batch, args=(queue,))
+    child.start()
+    child.join(60)
+    hung = child.is_alive()
+    if hung:
+        child.kill()
+    assert not hung and child.exitcode == 0 and queue.get(timeout=5) == (4800, 3)

@@ -217,5 +217,5 @@ def regressor_batch(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike
     return np.vstack([regressor(mech, q, qd, qdd) for q, qd, qdd in zip(Q, QD, QDD)])
 
 
-__all__ = ["AUTO_SAMPLES", "BACKENDS", "BODY_FIELDS", "DRIVE_FIELDS", "Parameters", "close_along", "parameters",
+__all__ = ["AUTO_SAMPLES", "BACKENDS", "BODY_FIELDS", "BODY_UNITS", "DRIVE_FIELDS", "Parameters", "close_along", "parameters",
            "regressor", "regressor_batch", "tree_regressor"]

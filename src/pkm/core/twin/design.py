@@ -4,17 +4,19 @@ serves every design of a family.
 A design parameter is named as the sweeps name it (:mod:`pkm.sweeps.family`):
 
 * ``JOINT.x``, ``JOINT.y``, ``JOINT.z`` [m], ``JOINT.roll``, ``JOINT.pitch``, ``JOINT.yaw`` [rad]: the origin of a
-  moving URDF joint in its parent link (where a link's length and a base joint's position live). The twin's
-  placement of that joint becomes ``prefix * origin(p)``, ``prefix`` the fixed links merged between the parent
-  joint and the joint (constant: ``placement * origin⁻¹`` at the file's values); only the varied components are
-  symbols (an origin whose angles stay fixed keeps a constant rotation: no trigonometry is added).
+  URDF joint in its parent link (where a link's length and a base joint's position live). A moving joint's placement
+  in the twin becomes ``F * origin(p)``, ``F`` its parent link's frame in the parent joint (the fixed links merged
+  between them); a fixed joint's origin moves the frames it carries (:meth:`Twin.frame_local
+  <pkm.core.twin.tree.Twin.frame_local>`), and the moving joints hanging from them. Only the varied components are
+  symbols (an origin whose angles stay fixed keeps a constant rotation: no trigonometry is added). A fixed joint
+  that carries mass moves it within the body it merges into: that body's ten inertial parameters must be inputs
+  too (:func:`with_merged_bodies` adds them), or the twin would keep the file's.
 * ``BODY.m``, ``BODY.mx`` ... ``BODY.Izz`` (:data:`~pkm.core.model.bodies.BODY_FIELDS`, the
   regressor's names and Pinocchio's ``toDynamicParameters`` order: the mass, its first moments, the inertia about
   the joint frame's origin) [kg, kg m, kg m^2]: a body's inertial parameters.
 
-What stays structural (fixed by the file the twin was built from): the joints' kinds, axes and limits, the tree,
-the closures, the task, the fixed joints' origins (they move frames and merged inertias: refused here), and the
-choices a twin makes numerically at its reference: the linear solves' pivot orders
+What stays structural (fixed by the file the twin was built from: :func:`structure`): the joints' kinds and axes,
+the tree, the closures, the task, and the choices a twin makes numerically at its reference: the linear solves' pivot orders
 (:mod:`~pkm.core.twin.linear`), the idle motions' coordinates. A design far from the file's may therefore hit the
 pivot floor sooner; the kernels report the pivot and the callers fall back as for any state.
 
@@ -26,7 +28,7 @@ route, against which the parametric kernels are checked, and what their fallback
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 import casadi as cs
@@ -64,7 +66,7 @@ class Design:
 
     def vector(self, values: Mapping[str, float] | ArrayLike | None = None) -> np.ndarray:
         """The ``design`` input of the kernels: ``values`` by name (the others at :attr:`base`) or a whole vector."""
-        from pkm.validation import as_array
+        from pkm.validation import as_array, as_scalar
 
         if values is None:
             return self.base.copy()
@@ -73,14 +75,16 @@ class Design:
             for name, value in values.items():
                 if name not in self.names:
                     raise UnknownNameError("design parameter", name, self.names, "the twin's design inputs")
-                out[self.names.index(name)] = value
-            if not np.all(np.isfinite(out)):
-                raise InvalidInputError("design", "holds non-finite values", dict(values))
-            return out
-        out = as_array(values, "design", f"{len(self.names)} values (SI): {', '.join(self.names)}")
-        if out.shape != (len(self.names),) or not np.all(np.isfinite(out)):
-            raise InvalidInputError("design", f"expected {len(self.names)} finite values ({', '.join(self.names)})",
-                                    values)
+                out[self.names.index(name)] = as_scalar(value, name)
+        else:
+            out = as_array(values, "design", f"{len(self.names)} values (SI): {', '.join(self.names)}")
+            if out.shape != (len(self.names),) or not np.all(np.isfinite(out)):
+                raise InvalidInputError("design", f"expected {len(self.names)} finite values "
+                                                  f"({', '.join(self.names)})", values)
+        for k, name in enumerate(self.names):
+            if name.endswith(".m") and k in {i for fields in self.bodies.values() for f, i in fields if f == 0} \
+                    and not out[k] > 0.0:
+                raise InvalidInputError(name, "a body's mass must be positive", float(out[k]))
         return out
 
     def origin(self, joint: str, p: Expr) -> SE3:
@@ -114,6 +118,8 @@ def design_of(mech: Mechanism, names: Sequence[str] | None) -> Design:
             joint's origin varies with mass below it and none of the body it merges into's inertial parameters
             varies (the merged inertia would stay the file's).
     """
+    if isinstance(names, str) or not all(isinstance(n, str) for n in names or ()):
+        raise InvalidInputError("design", "expected a list of parameter names (JOINT.x, BODY.m, ...)", names)
     names = tuple(names or ())
     if len(set(names)) != len(names):
         raise InvalidInputError("design", "a parameter is named twice", names)
@@ -138,17 +144,37 @@ def design_of(mech: Mechanism, names: Sequence[str] | None) -> Design:
             choices += [f"{b}.{f}" for b in bodies or body_names(model) for f in BODY_FIELDS]
             raise UnknownNameError("design parameter", name, choices,
                                    f"{mech.name}: URDF joints' origins and bodies' inertial parameters")
-    for joint in joints:  # a fixed joint moves what it carries: its links' mass merged into the body above
-        if not model.existJointName(joint):
-            fid = model.getFrameId(joint, pin.FrameType.FIXED_JOINT)
-            carried = _carried_mass(mech.urdf or "", joint)
-            if carried > 0.0 and model.frames[fid].parentJoint not in body_fields:
-                body = bodies[model.frames[fid].parentJoint - 1] if model.frames[fid].parentJoint else "the world"
-                raise InvalidInputError("design", f"the fixed joint {joint!r} carries {carried:g} kg merged into "
-                                                  f"body {body!r}: vary that body's inertial parameters with it "
-                                                  f"({body}.m ...) or keep its origin fixed", names)
+    for joint, body in _merged(mech, joints).items():  # (a fixed joint carrying mass moves it in its body)
+        jid = bodies.index(body) + 1
+        if len(body_fields.get(jid, ())) != len(BODY_FIELDS):
+            raise InvalidInputError("design", f"the fixed joint {joint!r} carries {_carried_mass(mech.urdf or '', joint):g}"
+                                              f" kg merged into body {body!r}: its ten inertial parameters vary with it "
+                                              f"({body}.m ... {body}.Izz; with_merged_bodies adds them), or keep the "
+                                              f"origin fixed", names)
     return Design(names, np.array(base, dtype=float), {j: tuple(v) for j, v in joints.items()},
                   {j: tuple(v) for j, v in body_fields.items()}, urdf)
+
+
+def with_merged_bodies(mech: Mechanism, names: Sequence[str]) -> tuple[str, ...]:
+    """``names`` and, for each varied fixed-joint origin that carries mass, the ten inertial parameters of the body
+    it merges into (what :func:`design_of` requires; their values are the design mechanism's, which Pinocchio merges
+    from its files: :func:`read_design`)."""
+    joints = {n.rpartition(".")[0] for n in names if n.rpartition(".")[2] in ORIGIN}
+    extra = [f"{b}.{f}" for b in dict.fromkeys(_merged(mech, joints).values()) for f in BODY_FIELDS]
+    return tuple(names) + tuple(n for n in extra if n not in names)
+
+
+def _merged(mech: Mechanism, joints: Iterable[str]) -> dict[str, str]:
+    """``{fixed joint: body}`` of the URDF fixed joints among ``joints`` that carry mass into a moving body (mass
+    welded to the world moves nothing)."""
+    model, out = mech.model, {}
+    for joint in joints:
+        if model.existJointName(joint) or not model.existFrame(joint, pin.FrameType.FIXED_JOINT):
+            continue
+        jid = model.frames[model.getFrameId(joint, pin.FrameType.FIXED_JOINT)].parentJoint
+        if jid and _carried_mass(mech.urdf or "", joint) > 0.0:
+            out[joint] = body_names(model)[jid - 1]
+    return out
 
 
 def design_mechanism(mech: Mechanism, values: Mapping[str, float]) -> Mechanism:
@@ -160,12 +186,12 @@ def design_mechanism(mech: Mechanism, values: Mapping[str, float]) -> Mechanism:
     Raises:
         InvalidInputError: ``mech`` was not built from URDF text.
         UnknownNameError: as :func:`design_of`.
-        AssemblyError: the design does not close at the held actuators.
+        SpecError: the design does not assemble at the held actuators.
     """
     from pkm.core.model.builder import from_strings
     from pkm.core.model.spec import ClosureSpec
 
-    design_of(mech, tuple(values))  # (the names checked, with the choices listed)
+    design_of(mech, with_merged_bodies(mech, tuple(values)))  # (the names checked, with the choices listed)
     inertial = {k: v for k, v in values.items() if k.rpartition(".")[2] in BODY_FIELDS}
     origins = {k: v for k, v in values.items() if k not in inertial}
     spec = ClosureSpec.from_toml(mech.spec.to_toml(), mech.source)
@@ -204,17 +230,17 @@ def read_design(mech: Mechanism, names: Sequence[str] | None = None) -> dict[str
 
 
 def structure(mech: Mechanism) -> str:
-    """What a twin with design inputs fixes of ``mech`` (its URDF without origins and inertials, its spec without
-    reference, parameters and description, its model's joint kinds and limits), as text: designs of one family share it or cannot share a
-    twin."""
+    """What a twin with design inputs fixes of ``mech``, as text: its URDF without origins, inertials and limits, its
+    spec without reference, parameters and description, its model's joint kinds. Designs of one family that share it
+    can share a twin (the kernels read no position, effort or speed limit: a design whose limits move with its
+    lengths shares it too)."""
     from lxml import etree
 
-    model = mech.model
-    parts = [dataclasses.replace(mech.spec, reference={}, parameters={}, description="").to_toml(), " ".join(j.shortname() for j in model.joints),
-             repr(np.concatenate([model.lowerPositionLimit, model.upperPositionLimit]).tolist())]
+    parts = [dataclasses.replace(mech.spec, reference={}, parameters={}, description="").to_toml(),
+             " ".join(j.shortname() for j in mech.model.joints)]
     if mech.urdf is not None:
         root, _ = joint_elements(mech.urdf)
-        for el in list(root.iter("origin", "inertial")):
+        for el in list(root.iter("origin", "inertial", "limit", "safety_controller")):
             if el.getparent() is not None:
                 el.getparent().remove(el)
         parts.append(etree.tostring(root, encoding="unicode"))
@@ -265,4 +291,4 @@ def _rpy_matrix(roll: Expr, pitch: Expr, yaw: Expr) -> Expr:
                       cs.horzcat(-sp, cp * sr, cp * cr))
 
 
-__all__ = ["Design", "design_mechanism", "design_of", "read_design", "structure"]
+__all__ = ["Design", "design_mechanism", "design_of", "read_design", "structure", "with_merged_bodies"]

@@ -29,6 +29,7 @@ import ctypes
 import functools
 import itertools
 import os
+import threading
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -125,8 +126,17 @@ class PathResult:
 @functools.lru_cache(maxsize=1)
 def _pool() -> ThreadPoolExecutor:
     """The threads compiled batches are split over (one a core, started once: starting them per call costs a
-    millisecond, a third of a 100,000-sample batch of the 3-PRS on two cores)."""
-    return ThreadPoolExecutor(os.cpu_count() or 1, thread_name_prefix="pkm-kernels")
+    millisecond, a third of a 100,000-sample batch of the 3-PRS on two cores); a forked child starts its own."""
+    return ThreadPoolExecutor(_cores(), thread_name_prefix="pkm-kernels")
+
+
+def _cores() -> int:
+    """The cores this process may run on (its affinity, where the system tells it)."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+if hasattr(os, "register_at_fork"):  # (a fork's child has none of the parent's threads: its pool would hang)
+    os.register_at_fork(after_in_child=_pool.cache_clear)
 
 
 class _Kernel:
@@ -156,11 +166,16 @@ class _Kernel:
             self._follow = getattr(self.lib, f"{fun.name()}_follow")
             self._follow.argtypes = [_I, _P, _P, _P, _P, _P, ctypes.POINTER(_I), _I, ctypes.c_double, _P]
             self._follow.restype = ctypes.c_int
-        # one sample: fixed buffers and pointer arrays, so that a call costs a copy in and out
-        self._one_in = [np.zeros(n) for n in self.in_size]
-        self._one_out = [np.zeros(n) for n in self.out_size]
-        self._one_in_p = (_P * len(self._one_in))(*[a.ctypes.data_as(_P) for a in self._one_in])
-        self._one_out_p = (_P * len(self._one_out))(*[o.ctypes.data_as(_P) for o in self._one_out])
+        self._one = threading.local()  # (one sample: each thread's buffers, the C call releasing the GIL)
+
+    def _buffers(self) -> tuple[list[np.ndarray], list[np.ndarray], object, object]:
+        """This thread's fixed buffers and pointer arrays for one sample, so that a call costs a copy in and out."""
+        one = self._one
+        if not hasattr(one, "bufs"):
+            ins, outs = [np.zeros(n) for n in self.in_size], [np.zeros(n) for n in self.out_size]
+            one.bufs = (ins, outs, (_P * len(ins))(*[a.ctypes.data_as(_P) for a in ins]),
+                        (_P * len(outs))(*[o.ctypes.data_as(_P) for o in outs]))
+        return one.bufs
 
     def __call__(self, *arrays: np.ndarray) -> list[np.ndarray]:
         n = arrays[0].shape[0]
@@ -171,14 +186,15 @@ class _Kernel:
                 return [np.array(o).reshape(1, -1, order="F") for o in outs]
             return self._numpy(*arrays)
         if n == 1:
-            for buf, a in zip(self._one_in, arrays):
+            ins1, outs1, in_p1, out_p1 = self._buffers()
+            for buf, a in zip(ins1, arrays):
                 buf[:] = a[0]
-            if self._batch(1, self._one_in_p, self._one_out_p):
+            if self._batch(1, in_p1, out_p1):
                 raise RuntimeError(f"the compiled kernel {self.fun.name()} failed")
-            return [o[None].copy() for o in self._one_out]
+            return [o[None].copy() for o in outs1]
         ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
         outs = [np.empty((n, s)) for s in self.out_size]
-        workers = min(self.threads or os.cpu_count() or 1, n // THREAD_SAMPLES)
+        workers = min(self.threads or _cores(), n // THREAD_SAMPLES)
         bounds = np.linspace(0, n, max(workers, 1) + 1).astype(int)
         driver = self._vector_driver() if self.vector and n >= VECTOR_SAMPLES else self._batch
 
@@ -282,7 +298,8 @@ class Kernels:
         """These kernels (the same compiled libraries) evaluated at one design: ``design`` by name (the others at
         the file's values) or as the whole vector of :attr:`design`'s parameters. ``mech`` is that design's
         mechanism, which the fallbacks (samples under the pivot floor) and the paths' default start use; default
-        :func:`~pkm.core.twin.design.design_mechanism` (built here: a few milliseconds)."""
+        :func:`~pkm.core.twin.design.design_mechanism` (built here: a URDF read and an assembly). The view shares
+        the compiled kernels: each thread may call its own views."""
         if not len(self.design):
             raise InvalidInputError("design", "these kernels take no design inputs: build them with "
                                               "Kernels(mech, design=[names])", design)
@@ -301,8 +318,9 @@ class Kernels:
         return self._p.copy()
 
     def inputs(self, name: str) -> tuple[str, ...]:
-        """The inputs of kernel ``name`` (:data:`KERNELS`, then ``design`` when the kernels take one)."""
-        return KERNELS[name][0] + (("design",) if len(self.design) else ())
+        """The inputs of kernel ``name`` (:data:`KERNELS`, then ``design`` when the kernels take one: all but the
+        regressor's)."""
+        return KERNELS[name][0] + (("design",) if len(self.design) and name != "regressor" else ())
 
     # ---------------------------------------------------------------- kernels
     def function(self, name: str) -> cs.Function:
@@ -348,8 +366,9 @@ class Kernels:
 
     def jax(self, name: str, *, x64: bool = True) -> Callable[..., tuple]:
         """Kernel ``name`` as a jitted JAX function of one sample (:mod:`pkm.core.twin.jaxgen`, pkm's own
-        translation of the twin): inputs as :meth:`inputs` names them (the design last, where the kernels take
-        one), each a 1-D array of nonzeros, outputs likewise (column-major); ``jax.vmap`` maps it over a batch,
+        translation of the twin; built once per kernel): inputs as :meth:`inputs` names them (the design last,
+        where the kernels take one: pass :attr:`design_values` or any design, a JAX array like the others), each a
+        1-D array of nonzeros, outputs likewise (column-major); ``jax.vmap`` maps it over a batch,
         ``jax.grad`` and ``jax.jacfwd`` differentiate it, on whatever device JAX runs (a GPU where it has one).
         Equal to the compiled C to 1e-12 in double precision (``x64``: JAX's 64-bit mode turned on, process-wide).
         The samples under the pivot floor are not redone here: the kernels that solve return the pivot (the last
@@ -362,7 +381,7 @@ class Kernels:
 
         if name not in KERNELS:
             raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", name)
-        return jax_function(self.function(name), x64=x64)
+        return self.cached(("jax", name, x64), lambda: jax_function(self.function(name), x64=x64))  # type: ignore
 
     @functools.cached_property
     def dynamics(self) -> ActuatorTwin:

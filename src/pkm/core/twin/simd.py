@@ -383,8 +383,7 @@ def lanes(lib: ctypes.CDLL | None = None, name: str | None = None, *, maths: str
     or 4 (libm), with AVX 4, else 2."""
     if lib is not None and name is not None:
         return int(getattr(lib, f"{name}_simd_lanes")())
-    target = _target().split()
-    return _widest(maths) if "AVX512F" in target else 4 if "AVX" in target else 2
+    return min(widest(), _widest(maths))
 
 
 def widest() -> int:

@@ -495,7 +495,7 @@ class Twin:
     def function(self, name: str, outputs: dict, inputs: tuple[str, ...] = ("q", "v", "a")) -> cs.Function:
         """``casadi.Function(name, inputs, outputs)`` over the twin's symbols."""
         sym = {"q": self.q, "v": self.v, "a": self.a, "qd": self.qd, "qdd": self.qdd, "target": self.target,
-               "y": self.task.task_target, "scale": self.task.scale}
+               "y": self.task.task_target, "scale": self.task.scale, "design": self.p}
         return cs.Function(name, [sym[i] for i in inputs], list(outputs.values()), list(inputs), list(outputs))
 
 
