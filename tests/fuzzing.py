@@ -587,6 +587,24 @@ def _kernels_inverse_dynamics(g, adv):
     return run, tuple(args), {}
 
 
+@entry("Kernels.at")
+def _kernels_at(g, adv):
+    """The 3-PRS's kernels with a coupler joint's origin and the platform's mass as design inputs, bound to a
+    design near the file's (adversarial: corrupt or hostile values, unknown names), then one sample's efforts."""
+    c = ctx()
+    m = c.mech["prs3"]
+    K = c.lazy("kernels:prs3:design", lambda: c.pkm.Kernels(m, design=("coupler_1_tip_fixed.z", "platform_link.m")))
+    values: object = dict(zip(K.design.names, K.design.base * (1.0 + g.near(np.zeros(2), 0.05))))
+    if adv:
+        values = (g.pick(({"platform_link.m": g.hostile()}, {"nowhere.x": 0.1}, {"platform_link.m": -1.0},
+                          g.corrupt(K.design.base), g.hostile())))
+    q, qd, qdd = m.q_reference, g.near(np.zeros(m.na), 1.0), g.near(np.zeros(m.na), 1.0)
+
+    def run(v):
+        return K.at(v).inverse_dynamics(q, qd, qdd)
+    return run, (values,), {}
+
+
 @entry("Kernels.close_loops_path")
 def _kernels_path(g, adv):
     c = ctx()
