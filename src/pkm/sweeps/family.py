@@ -8,7 +8,7 @@
   (the joint's placement in its parent link, which is where a link's length lives), and its bodies' inertial
   parameters ``BODY.m`` [kg], ``BODY.mx`` ... [kg m], ``BODY.Ixx`` ... [kg m^2] (the regressor's names), set to the
   values given (:func:`pkm.core.twin.design.design_mechanism`); the closure spec is kept as it is. Its compiled
-  kernels take the swept parameters as inputs (:meth:`ModelFamily.kernels`: designs as kernel inputs), so the
+  kernels take the swept parameters as inputs (:meth:`Family.kernels`: designs as kernel inputs), so the
   maps of a thousand designs share one compiled library. Tuple fields of registered designs are not swept (name
   them fixed).
 
@@ -71,7 +71,7 @@ class Candidate:
     @property
     def kernels(self):
         """The :class:`pkm.Kernels` of this design: the family's kernels with design inputs bound to it where the
-        family has them (:meth:`ModelFamily.kernels`), else the design's own (compiled per design)."""
+        family has them (:meth:`Family.design_kernels`), else the design's own (compiled per design)."""
         return self.cached("kernels", lambda: self.family.design_kernels(self))
 
 

@@ -440,6 +440,5 @@ def compile_function(fun: cs.Function, directory: str | os.PathLike[str] | None 
     return cs.external(fun.name(), lib._name), how
 
 
-__all__ = ["C_INT", "C_REAL_P", "NUMPY_FORMS", "cache_dir", "compile_function", "compile_library", "count_operations", "instructions",
-           "map_source",
-           "numpy_function", "numpy_source", "paper_counts", "python_constant", "source"]
+__all__ = ["C_INT", "C_REAL_P", "NUMPY_FORMS", "cache_dir", "compile_function", "compile_library", "count_operations",
+           "instructions", "map_source", "numpy_function", "numpy_source", "paper_counts", "python_constant", "source"]

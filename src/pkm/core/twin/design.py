@@ -28,6 +28,7 @@ route, against which the parametric kernels are checked, and what their fallback
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
@@ -81,10 +82,9 @@ class Design:
             if out.shape != (len(self.names),) or not np.all(np.isfinite(out)):
                 raise InvalidInputError("design", f"expected {len(self.names)} finite values "
                                                   f"({', '.join(self.names)})", values)
-        for k, name in enumerate(self.names):
-            if name.endswith(".m") and k in {i for fields in self.bodies.values() for f, i in fields if f == 0} \
-                    and not out[k] > 0.0:
-                raise InvalidInputError(name, "a body's mass must be positive", float(out[k]))
+        for k in (i for fields in self.bodies.values() for f, i in fields if f == 0):  # (the masses)
+            if not out[k] > 0.0:
+                raise InvalidInputError(self.names[k], "a body's mass must be positive", float(out[k]))
         return out
 
     def origin(self, joint: str, p: Expr) -> SE3:
@@ -115,8 +115,8 @@ def design_of(mech: Mechanism, names: Sequence[str] | None) -> Design:
         UnknownNameError: a name is neither a URDF joint's origin component nor a body's inertial parameter (the
             error lists them).
         InvalidInputError: ``mech`` was not built from URDF text (origins need it), a name repeats, or a fixed
-            joint's origin varies with mass below it and none of the body it merges into's inertial parameters
-            varies (the merged inertia would stay the file's).
+            joint's origin varies with mass below it without the ten inertial parameters of the body it merges
+            into (:func:`with_merged_bodies`; else the merged inertia would stay the file's).
     """
     if isinstance(names, str) or not all(isinstance(n, str) for n in names or ()):
         raise InvalidInputError("design", "expected a list of parameter names (JOINT.x, BODY.m, ...)", names)
@@ -147,10 +147,11 @@ def design_of(mech: Mechanism, names: Sequence[str] | None) -> Design:
     for joint, body in _merged(mech, joints).items():  # (a fixed joint carrying mass moves it in its body)
         jid = bodies.index(body) + 1
         if len(body_fields.get(jid, ())) != len(BODY_FIELDS):
-            raise InvalidInputError("design", f"the fixed joint {joint!r} carries {_carried_mass(mech.urdf or '', joint):g}"
-                                              f" kg merged into body {body!r}: its ten inertial parameters vary with it "
-                                              f"({body}.m ... {body}.Izz; with_merged_bodies adds them), or keep the "
-                                              f"origin fixed", names)
+            carried = _carried_mass(mech.urdf or "", joint)
+            raise InvalidInputError("design", f"the fixed joint {joint!r} carries {carried:g} kg merged into body "
+                                              f"{body!r}: its ten inertial parameters vary with it ({body}.m ... "
+                                              f"{body}.Izz; with_merged_bodies adds them), or keep the origin fixed",
+                                    names)
     return Design(names, np.array(base, dtype=float), {j: tuple(v) for j, v in joints.items()},
                   {j: tuple(v) for j, v in body_fields.items()}, urdf)
 
@@ -267,6 +268,12 @@ def _urdf_joints(mech: Mechanism) -> dict[str, tuple[np.ndarray, np.ndarray, str
 
 def _carried_mass(urdf: str, joint: str) -> float:
     """The mass of the links URDF joint ``joint`` carries through fixed joints (what merges into one body)."""
+    return _carried(urdf).get(joint, 0.0)
+
+
+@functools.lru_cache(maxsize=16)
+def _carried(urdf: str) -> dict[str, float]:
+    """:func:`_carried_mass` of every joint of the URDF text (read once per text: a sweep asks at every design)."""
     root, joints = joint_elements(urdf)
     masses = {}
     for link in root.iter("link"):
@@ -275,12 +282,15 @@ def _carried_mass(urdf: str, joint: str) -> float:
     children: dict[str, list] = {}
     for j in joints.values():
         children.setdefault(j.find("parent").get("link"), []).append(j)
-    total, todo = 0.0, [joints[joint].find("child").get("link")]
-    while todo:
-        link = todo.pop()
-        total += masses.get(link, 0.0)
-        todo += [j.find("child").get("link") for j in children.get(link, []) if j.get("type") == "fixed"]
-    return total
+    out = {}
+    for name, j in joints.items():
+        total, todo = 0.0, [j.find("child").get("link")]
+        while todo:
+            link = todo.pop()
+            total += masses.get(link, 0.0)
+            todo += [c.find("child").get("link") for c in children.get(link, []) if c.get("type") == "fixed"]
+        out[name] = total
+    return out
 
 
 def _rpy_matrix(roll: Expr, pitch: Expr, yaw: Expr) -> Expr:

@@ -20,6 +20,12 @@ a sample for the 3-PRS and 0.32 µs for the Delta in a C batch, ``pkm bench simu
 smoothed as ``tanh(v / COULOMB_VELOCITY)``); idle motions are handled as :func:`pkm.actuator_model` handles them,
 reflected rotor inertias (Pinocchio's ``armature``) are in the twin's RNEA, and a sample under the pivot floor is
 :func:`pkm.actuator_model`'s. The compiled simulation built on them is :mod:`~pkm.core.twin.simulation`.
+
+Speed (issue 33): ``Kernels(mech, design=[...])`` takes joint origins and inertial parameters as every kernel's
+last input (:mod:`~pkm.core.twin.design`; :meth:`Kernels.at` binds a design), so that one compiled library serves a
+whole family of designs; compiled batches of :data:`VECTOR_SAMPLES` samples or more run on the vector units
+(:mod:`~pkm.core.twin.simd`, bit for bit the scalar driver) and are split over ``threads`` cores;
+:meth:`Kernels.jax` gives any kernel as a JAX function (:mod:`~pkm.core.twin.jaxgen`).
 """
 
 from __future__ import annotations
