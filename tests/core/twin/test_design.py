@@ -186,3 +186,25 @@ def test_views_of_two_designs_answer_from_two_threads_each_its_own(gough_stewart
     for t in threads:
         t.join()
     assert wrong == [0, 0]
+
+
+def test_a_batch_reads_the_design_once_and_equals_one_sample_at_a_time(gough_stewart, monkeypatch):
+    """300 states of one design (the design a single row, read in place by every sample: the vector driver's and
+    the scalar driver's stride 0, on two threads) give each sample's efforts bit for bit; numpy's route (no
+    compiler) broadcasts it, to 1e-12."""
+    from pkm.core.twin import kernels as kmod
+
+    mech, K = gough_stewart
+    values, = _designs(K, 1, 0.02, seed=9)
+    d = design_mechanism(mech, values)
+    view = K.at(values, d)
+    rng = np.random.default_rng(9)
+    qa = d.actuated_q(d.q_reference)
+    Q = view.close_loops_path(qa + 0.01 * np.sin(np.linspace(0, 3, 300))[:, None] * rng.standard_normal(6)).q
+    QD, QDD = rng.standard_normal((300, 6)), rng.standard_normal((300, 6))
+    monkeypatch.setattr(kmod, "THREAD_SAMPLES", 100)
+    batch = view.inverse_dynamics(Q, QD, QDD)
+    one = np.array([view.inverse_dynamics(q, qd, qdd) for q, qd, qdd in zip(Q, QD, QDD)])
+    assert np.array_equal(batch, one)
+    numpy = Kernels(mech, design=GS_NAMES, compiled=False).at(values, d).inverse_dynamics(Q[:5], QD[:5], QDD[:5])
+    assert _rel(numpy, one[:5]) <= 1e-12

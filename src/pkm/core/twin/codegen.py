@@ -5,6 +5,7 @@ the whole with the system's C compiler (``cc -O2 -shared``; ``-O0`` above :data:
 with :mod:`ctypes`:
 
 * ``NAME_batch(n, in, out)``: the function on ``n`` samples, each input and output a sample-major array;
+  ``NAME_batch_steps(n, in, out, steps)`` with each input's stride (0: one value for every sample, a design);
 * ``NAME_follow(n, q0, targets, q_out, residual, pivot, iterations, max_iter, tol, design)``, for a Newton
   iteration (inputs ``q, target`` and, for a twin with design inputs, ``design``; outputs ``q_next, residual,
   pivot``): per target, iterate from the previous solution (the first from ``q0``) until the residual is at most
@@ -63,17 +64,20 @@ static void NAME_pkm_free(const casadi_real** arg, casadi_real** res, casadi_int
   free((void*) arg); free(res); free(iw); free(w);
 }
 
-int NAME_batch(casadi_int n, const casadi_real** in, casadi_real** out) {
+int NAME_batch_steps(casadi_int n, const casadi_real** in, casadi_real** out, const casadi_int* steps) {
+  /* steps[i]: input i's stride (NULL: every input its size; 0: one value for every sample) */
   const casadi_real** arg; casadi_real** res; casadi_int* iw; casadi_real* w; int flag = 0;
   if (NAME_pkm_alloc(&arg, &res, &iw, &w)) return 2;
   for (casadi_int k = 0; k < n && !flag; ++k) {
-    for (int i = 0; i < NIN; ++i) arg[i] = in[i] + k * NAME_isz[i];
+    for (int i = 0; i < NIN; ++i) arg[i] = in[i] + k * (steps ? steps[i] : NAME_isz[i]);
     for (int i = 0; i < NOUT; ++i) res[i] = out[i] + k * NAME_osz[i];
     flag = NAME(arg, res, iw, w, 0);
   }
   NAME_pkm_free(arg, res, iw, w);
   return flag;
 }
+
+int NAME_batch(casadi_int n, const casadi_real** in, casadi_real** out) { return NAME_batch_steps(n, in, out, 0); }
 """
 
 _FOLLOW = r"""

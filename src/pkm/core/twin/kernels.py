@@ -145,6 +145,14 @@ if hasattr(os, "register_at_fork"):  # (a fork's child has none of the parent's 
     os.register_at_fork(after_in_child=_pool.cache_clear)
 
 
+def _steps_driver(lib: ctypes.CDLL, name: str) -> Callable[..., int]:
+    """A driver ``(n, in, out, steps)`` of ``lib`` (:mod:`~pkm.core.twin.codegen`, :mod:`~pkm.core.twin.simd`)."""
+    driver = getattr(lib, name)
+    driver.argtypes = [_I, ctypes.POINTER(_P), ctypes.POINTER(_P), ctypes.POINTER(_I)]
+    driver.restype = ctypes.c_int
+    return driver
+
+
 class _Kernel:
     """One function, compiled (``lib``) or not; ``__call__`` takes sample-major arrays (n x size) and returns a list
     of sample-major outputs: the C batch driver when compiled (the vector driver from :data:`VECTOR_SAMPLES`
@@ -168,6 +176,7 @@ class _Kernel:
         self._batch = getattr(self.lib, f"{fun.name()}_batch")
         self._batch.argtypes = [_I, ctypes.POINTER(_P), ctypes.POINTER(_P)]
         self._batch.restype = ctypes.c_int
+        self._batch_steps = _steps_driver(self.lib, f"{fun.name()}_batch_steps")
         if follow:
             self._follow = getattr(self.lib, f"{fun.name()}_follow")
             self._follow.argtypes = [_I, _P, _P, _P, _P, _P, ctypes.POINTER(_I), _I, ctypes.c_double, _P]
@@ -184,8 +193,12 @@ class _Kernel:
         return one.bufs
 
     def __call__(self, *arrays: np.ndarray) -> list[np.ndarray]:
-        n = arrays[0].shape[0]
+        """The kernel on ``n`` samples; an input of one row among inputs of ``n`` is the same for every sample (a
+        design: read in place, not copied ``n`` times)."""
+        n = max(a.shape[0] for a in arrays)
         if self.lib is None:
+            if n > 1:
+                arrays = tuple(np.broadcast_to(a, (n, a.shape[1])) for a in arrays)
             if n == 1:
                 outs = self.fun(*[a[0] for a in arrays])
                 outs = outs if isinstance(outs, tuple) else (outs,)
@@ -199,15 +212,18 @@ class _Kernel:
                 raise RuntimeError(f"the compiled kernel {self.fun.name()} failed")
             return [o[None].copy() for o in outs1]
         ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
+        constant = [a.shape[0] == 1 for a in ins]
+        steps = np.array([0 if c else size for c, size in zip(constant, self.in_size)], dtype=np.int64)
+        steps_p = steps.ctypes.data_as(ctypes.POINTER(_I))
         outs = [np.empty((n, s)) for s in self.out_size]
         workers = min(self.threads or _cores(), n // THREAD_SAMPLES)
         bounds = np.linspace(0, n, max(workers, 1) + 1).astype(int)
-        driver = self._vector_driver() if self.vector and n >= VECTOR_SAMPLES else self._batch
+        driver = self._vector_driver() if self.vector and n >= VECTOR_SAMPLES else self._batch_steps
 
         def part(lo: int, hi: int) -> int:  # (ctypes releases the GIL: the chunks run on as many cores)
-            in_p = (_P * len(ins))(*[a[lo:].ctypes.data_as(_P) for a in ins])
+            in_p = (_P * len(ins))(*[(a if c else a[lo:]).ctypes.data_as(_P) for a, c in zip(ins, constant)])
             out_p = (_P * len(outs))(*[o[lo:].ctypes.data_as(_P) for o in outs])
-            return int(driver(hi - lo, in_p, out_p))
+            return int(driver(hi - lo, in_p, out_p, steps_p))
 
         if workers > 1:  # (the last chunk on this thread)
             others = [_pool().submit(part, lo, hi) for lo, hi in itertools.pairwise(bounds[:-1])]
@@ -225,12 +241,7 @@ class _Kernel:
             from pkm.core.twin.simd import simd_library
 
             lib, how = simd_library(self.fun, self.directory)
-            self._simd = self._batch
-            if lib is not None:
-                driver = getattr(lib, f"{self.fun.name()}_simd")
-                driver.argtypes = [_I, ctypes.POINTER(_P), ctypes.POINTER(_P)]
-                driver.restype = ctypes.c_int
-                self._simd = driver
+            self._simd = self._batch_steps if lib is None else _steps_driver(lib, f"{self.fun.name()}_simd_steps")
             self.how += f"; batches of {VECTOR_SAMPLES} or more: " + (
                 f"the vector driver ({how})" if lib is not None else f"scalar (no vector driver: {how})")
         return self._simd
@@ -446,7 +457,7 @@ class Kernels:
         elif len({a.shape[0] for a in arrays}) > 1:
             raise InvalidInputError(name, f"batches of different lengths {[a.shape[0] for a in arrays]}")
         if len(self.design):
-            arrays.append(np.broadcast_to(self._p, (arrays[0].shape[0], len(self._p))))
+            arrays.append(self._p[None])  # (one row: the same design for every sample, read in place)
         outs = kernel(*arrays)
         if not np.isfinite(outs[0]).all():
             for what, a in zip(KERNELS[name][0], arrays):

@@ -258,7 +258,8 @@ _DRIVER = r"""
 #define PKM_GATHER(p, s, nz, i) (pkm_v) { p[s[0] * nz + i], p[s[1] * nz + i] }
 #endif
 
-int NAME_simd(long long n, const double** in, double** out) {
+int NAME_simd_steps(long long n, const double** in, double** out, const long long* steps) {
+  /* steps[j]: input j's stride (NULL: every input its size; 0: one value for every sample, a design) */
   pkm_v x[@NX@], y[@NY@];
   for (long long k = 0; k < n; k += PKM_LANES) {
     const int m = n - k < PKM_LANES ? (int) (n - k) : PKM_LANES;
@@ -272,6 +273,8 @@ int NAME_simd(long long n, const double** in, double** out) {
   return 0;
 }
 
+int NAME_simd(long long n, const double** in, double** out) { return NAME_simd_steps(n, in, out, 0); }
+
 int NAME_simd_lanes(void) { return PKM_LANES; }
 int NAME_simd_vector_math(void) { return PKM_VECTOR_MATH; }
 """
@@ -280,7 +283,8 @@ int NAME_simd_vector_math(void) { return PKM_VECTOR_MATH; }
 def simd_source(fun: cs.Function, name: str | None = None, *, maths: str = "libm", lanes: int | None = None,
                 chunk: int | None = None) -> str:
     """The C source of ``fun``'s vector batch driver ``int NAME_simd(long long n, const double** in, double**
-    out)`` (``NAME`` default ``fun.name()``; the calling convention of ``NAME_batch``, returns 0), with
+    out)`` (``NAME`` default ``fun.name()``; the calling convention of ``NAME_batch``, returns 0) and
+    ``NAME_simd_steps(n, in, out, steps)`` (each input's stride, as ``NAME_batch_steps``: 0 for a design), with
     ``int NAME_simd_lanes(void)`` (the lanes compiled in) and ``int NAME_simd_vector_math(void)`` (1 when libmvec's
     functions are in). See the module doc.
 
@@ -314,7 +318,8 @@ def simd_source(fun: cs.Function, name: str | None = None, *, maths: str = "libm
         nz = fun.nnz_in(j)
         if nz:
             gather += (f"    if (in[{j}]) {{\n      const double* p = in[{j}];\n"
-                       + "".join(f"      x[{at + i}] = PKM_GATHER(p, s, {nz}, {i});\n" for i in range(nz))
+                       f"      const long long st = steps ? steps[{j}] : {nz};\n"
+                       + "".join(f"      x[{at + i}] = PKM_GATHER(p, s, st, {i});\n" for i in range(nz))
                        + f"    }} else for (int i = 0; i < {nz}; ++i) x[{at} + i] = pkm_splat(0.0);\n")
         at += nz
     nx, at = at, 0
