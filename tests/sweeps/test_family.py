@@ -157,3 +157,15 @@ def test_a_loaded_mechanism_changed_in_memory_is_refused_and_the_shared_twin_is_
         ModelFamily(changed)
     fam = ModelFamily(mech)
     assert fam.kernels(("platform.m",)).design.base[0] == pytest.approx(0.1)
+
+
+def test_a_design_that_moves_a_number_the_inputs_do_not_hold_gets_its_own_kernels(monkeypatch):
+    """Were the varied inputs to miss one number a design moves (an elbow origin, here taken out of them), the
+    shared twin would keep the base's: that design gets its own kernels instead; with every moved number it gets
+    the shared twin, bound to its values."""
+    fam = RegisteredFamily("rrr3")
+    full = fam.varied(("a",))
+    design = fam.candidate({"a": 0.45})
+    assert design.kernels.design.names == full and design.kernels.design_values[full.index("elbow_1.x")] == 0.45
+    monkeypatch.setattr(fam, "varied", lambda parameters: tuple(n for n in full if n != "elbow_1.x"))
+    assert len(fam.candidate({"a": 0.45}).kernels.design) == 0

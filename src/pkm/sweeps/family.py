@@ -25,6 +25,8 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any
 
+import numpy as np
+
 from pkm._moved import renamed_keywords
 from pkm.core.model.bodies import BODY_FIELDS, BODY_UNITS, body_names
 from pkm.core.model.origins import ORIGIN, origins_set, urdf_joints
@@ -112,7 +114,8 @@ class Family:
         """The kernels of one design (:attr:`Candidate.kernels`): the family's twin with the parameters that
         differ from the base design as inputs (:mod:`pkm.core.twin.design`), bound to this design; the design's own
         when the family is not :attr:`parametric`, the design is the base, or it changes more than origins and
-        inertias (joint kinds, the spec: :func:`~pkm.core.twin.design.structure`). A fixed joint carrying mass
+        inertias (joint kinds, the spec: :func:`~pkm.core.twin.design.structure`) or moves a number the inputs do not
+        hold (checked at every design: the shared twin would keep the base's). A fixed joint carrying mass
         brings the ten inertial parameters of the body it merges into (:func:`~pkm.core.twin.design.with_merged_bodies`:
         the design mechanism's, as Pinocchio merges them)."""
         from pkm.core.twin import Kernels
@@ -124,11 +127,17 @@ class Family:
         if not names or structure(mech) != self.cached_structure():
             return Kernels(mech)
         names = with_merged_bodies(mech, names)
+        ours = read_design(mech)
+        if "_base_design" not in self.__dict__:
+            self._base_design = read_design(self.base_mechanism())
+        inputs = set(names)
+        if any(ours.get(k) != v for k, v in self._base_design.items() if k not in inputs):
+            return Kernels(mech)  # (it moved a number the inputs do not hold: the shared twin would keep the base's)
         try:
             shared = self.kernels(names)
         except PkmError:  # (names the shared twin cannot take: the design's own kernels)
             return Kernels(mech)
-        return shared.at(read_design(mech, names), mech)
+        return shared.at(np.array([ours[n] for n in names]), mech)
 
     def varied(self, parameters: tuple[str, ...]) -> tuple[str, ...]:
         """The design inputs (:func:`pkm.core.twin.design.read_design`'s names) that ``parameters`` move."""
