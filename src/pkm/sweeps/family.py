@@ -60,6 +60,10 @@ class Candidate:
             self._cache[key] = make()
         return self._cache[key]
 
+    def forget(self, key) -> None:
+        """Drop what :meth:`cached` keeps under ``key`` (to make it again otherwise)."""
+        self._cache.pop(key, None)
+
     @property
     def params(self):
         """The design dataclass (a registered family), or None (a loaded one)."""

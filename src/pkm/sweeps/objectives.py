@@ -349,7 +349,7 @@ def _generic_map(c: Candidate, o: Mapping[str, Any], configurations: bool = Fals
     key = _map_key(o)
     found = c.cached(key, make)
     if configurations and found.q is None:  # (a large map made without them for another objective)
-        c._cache.pop(key)
+        c.forget(key)
         found = c.cached(key, make)
     return found
 
