@@ -165,6 +165,7 @@ class _Kernel:
         self.fun, self.directory, self.threads = fun, directory, threads
         self.vector = vector if vector is not None else fun.n_instructions() <= VECTOR_INSTRUCTIONS
         self._simd: Callable[..., int] | None = None
+        self._simd_lock = threading.Lock()
         self.lib, self.how = compile_library(fun, follow=follow, directory=directory) if compiled else (
             None, "compiled=False")
         self.in_size = [fun.nnz_in(i) for i in range(fun.n_in())]
@@ -237,14 +238,17 @@ class _Kernel:
     def _vector_driver(self) -> Callable[..., int]:
         """The vector driver (:func:`~pkm.core.twin.simd.simd_library`, compiled on first use), or the scalar one
         where it does not compile (:attr:`how` says why)."""
-        if self._simd is None:
-            from pkm.core.twin.simd import simd_library
+        if self._simd is not None:
+            return self._simd
+        with self._simd_lock:  # (compiled once, whichever thread asks first)
+            if self._simd is None:
+                from pkm.core.twin.simd import simd_library
 
-            lib, how = simd_library(self.fun, self.directory)
-            self._simd = self._batch_steps if lib is None else _steps_driver(lib, f"{self.fun.name()}_simd_steps")
-            self.how += f"; batches of {VECTOR_SAMPLES} or more: " + (
-                f"the vector driver ({how})" if lib is not None else f"scalar (no vector driver: {how})")
-        return self._simd
+                lib, how = simd_library(self.fun, self.directory)
+                self.how += f"; batches of {VECTOR_SAMPLES} or more: " + (
+                    f"the vector driver ({how})" if lib is not None else f"scalar (no vector driver: {how})")
+                self._simd = self._batch_steps if lib is None else _steps_driver(lib, f"{self.fun.name()}_simd_steps")
+            return self._simd
 
     def follow(self, q0: np.ndarray, targets: np.ndarray, max_iter: int, tol: float,
                design: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -309,6 +313,7 @@ class Kernels:
         self.threads = None if threads is None else as_count(threads, "threads", high=1024)
         self._kernels: dict[str, _Kernel] = {}
         self._shared: dict[object, object] = {}
+        self._lock = threading.RLock()  # (the kernels and what they share, built once whichever thread asks first)
         self._p = self.design.base
 
     def at(self, design: Mapping[str, float] | ArrayLike, mech: Mechanism | None = None) -> Kernels:
@@ -409,15 +414,19 @@ class Kernels:
     def kernel(self, name: str) -> _Kernel:
         """The kernel ``name`` (built, and compiled, on first use)."""
         if name not in self._kernels:
-            self._kernels[name] = _Kernel(self.function(name), name in _PATHS, self.compiled,
-                                          self.directory, self.vector, self.threads)
+            with self._lock:
+                if name not in self._kernels:
+                    self._kernels[name] = _Kernel(self.function(name), name in _PATHS, self.compiled,
+                                                  self.directory, self.vector, self.threads)
         return self._kernels[name]
 
     def cached(self, key: object, make: Callable[[], object]) -> object:
         """``make()`` once for these kernels and every design bound to them (:meth:`at`): a compiled library of
         several kernels (the maps' grid driver)."""
         if key not in self._shared:
-            self._shared[key] = make()
+            with self._lock:
+                if key not in self._shared:
+                    self._shared[key] = make()
         return self._shared[key]
 
     @property
