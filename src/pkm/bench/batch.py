@@ -74,12 +74,11 @@ def _jax(K, args, repeat: int, reference: np.ndarray) -> dict:
 
 def _scalar(kernel, arrays: list[np.ndarray]) -> list[np.ndarray]:
     """The scalar driver (``NAME_batch``) on the whole batch, one thread."""
-    from pkm.core.twin.codegen import C_REAL_P as P
+    from pkm.core.twin.codegen import pointers
 
     n = len(arrays[0])
     outs = [np.empty((n, s)) for s in kernel.out_size]
-    kernel._batch(n, (P * len(arrays))(*[a.ctypes.data_as(P) for a in arrays]),
-                  (P * len(outs))(*[o.ctypes.data_as(P) for o in outs]))
+    kernel._batch(n, pointers(arrays), pointers(outs))
     return outs
 
 
@@ -87,14 +86,13 @@ def _halves(driver, arrays: list[np.ndarray], out_size: list[int]):
     """A call of ``driver`` on each half of the batch at once, on two threads (ctypes releases the GIL)."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from pkm.core.twin.codegen import C_REAL_P as P
+    from pkm.core.twin.codegen import pointers
 
     n = len(arrays[0])
     outs = [np.empty((n, s)) for s in out_size]
 
     def part(lo: int, hi: int) -> int:
-        return int(driver(hi - lo, (P * len(arrays))(*[a[lo:].ctypes.data_as(P) for a in arrays]),
-                          (P * len(outs))(*[o[lo:].ctypes.data_as(P) for o in outs])))
+        return int(driver(hi - lo, pointers(a[lo:] for a in arrays), pointers(o[lo:] for o in outs)))
 
     pool = ThreadPoolExecutor(1)
 

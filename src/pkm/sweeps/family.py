@@ -132,10 +132,8 @@ class Family:
             return Kernels(mech)
         names = with_merged_bodies(mech, names)
         ours = read_design(mech)
-        if "_base_design" not in self.__dict__:
-            self._base_design = read_design(self.base_mechanism())
         inputs = set(names)
-        if any(ours.get(k) != v for k, v in self._base_design.items() if k not in inputs):
+        if any(ours.get(k) != v for k, v in self.base_design().items() if k not in inputs):
             return Kernels(mech)  # (it moved a number the inputs do not hold: the shared twin would keep the base's)
         try:
             shared = self.kernels(names)
@@ -151,6 +149,14 @@ class Family:
         """The mechanism of the base design."""
         raise NotImplementedError
 
+    def base_design(self) -> dict[str, float]:
+        """The base design's numbers (:func:`pkm.core.twin.design.read_design`), read once."""
+        if "_base_design" not in self.__dict__:
+            from pkm.core.twin.design import read_design
+
+            self._base_design = read_design(self.base_mechanism())
+        return self._base_design
+
     def cached_structure(self) -> str:
         if "_structure" not in self.__dict__:
             from pkm.core.twin.design import structure
@@ -163,10 +169,9 @@ class Family:
         (their compiled libraries once per machine: :mod:`pkm.core.twin.codegen` caches them by source); bind a
         design with :meth:`pkm.Kernels.at`."""
         from pkm.core.twin import Kernels
-        from pkm.core.twin.design import read_design
 
         if "_fingerprint" not in self.__dict__:  # (the files, and the base's numbers: a model changed in memory)
-            self._fingerprint = repr((sorted(self.describe().items()), sorted(read_design(self.base_mechanism()).items())))
+            self._fingerprint = repr((sorted(self.describe().items()), sorted(self.base_design().items())))
         key = (self._fingerprint, tuple(names))
         if key not in _KERNELS:
             while len(_KERNELS) >= KEEP_KERNELS:  # (the oldest first: a long-lived process sweeps many families)
@@ -237,7 +242,7 @@ class RegisteredFamily(Family):
 
         cache: dict[tuple[str, ...], tuple[str, ...]] = self.__dict__.setdefault("_varied", {})
         if parameters not in cache:
-            base = read_design(self.base_mechanism())
+            base = self.base_design()
             names: set[str] = set()
             for p in parameters:
                 v = float(getattr(self.base, p))

@@ -43,9 +43,7 @@ def _scalar(driver, out_size: list[int], args: tuple[np.ndarray, ...]) -> list[n
     """A scalar batch driver (``NAME_batch``) on one thread."""
     ins = [np.ascontiguousarray(a, dtype=float) for a in args]
     outs = [np.empty((len(ins[0]), s)) for s in out_size]
-    P = codegen.C_REAL_P
-    assert driver(codegen.C_INT(len(ins[0])), (P * len(ins))(*[a.ctypes.data_as(P) for a in ins]),
-                  (P * len(outs))(*[o.ctypes.data_as(P) for o in outs])) == 0
+    assert driver(codegen.C_INT(len(ins[0])), codegen.pointers(ins), codegen.pointers(outs)) == 0
     return outs
 
 

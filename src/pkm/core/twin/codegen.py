@@ -319,6 +319,13 @@ def compile_library(fun: cs.Function | Iterable[cs.Function], *, follow: bool = 
     return ctypes.CDLL(str(library)), f"C ({Path(cc).name} {flags[0]}, {library})"
 
 
+def pointers(arrays: Iterable[np.ndarray]) -> ctypes.Array:
+    """The ``double*`` array of ``arrays``' data (C-contiguous float64 arrays): how the drivers take their inputs
+    and outputs."""
+    arrays = list(arrays)
+    return (C_REAL_P * len(arrays))(*[a.ctypes.data_as(C_REAL_P) for a in arrays])
+
+
 def count_operations(fun: cs.Function) -> dict[str, int]:
     """The instructions of ``fun`` by CasADi operation (``mul``, ``add``, ``sin``...; inputs, outputs and constants
     included), counted on its virtual machine's instruction list (after whatever CSE built it)."""
@@ -445,4 +452,5 @@ def compile_function(fun: cs.Function, directory: str | os.PathLike[str] | None 
 
 
 __all__ = ["C_INT", "C_REAL_P", "NUMPY_FORMS", "cache_dir", "compile_function", "compile_library", "count_operations",
-           "instructions", "map_source", "numpy_function", "numpy_source", "paper_counts", "python_constant", "source"]
+           "instructions", "map_source", "numpy_function", "numpy_source", "paper_counts", "pointers", "python_constant",
+           "source"]

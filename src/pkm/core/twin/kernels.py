@@ -49,7 +49,7 @@ from pkm.core.dynamics.model import COULOMB_VELOCITY
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.codegen import C_INT as _I
 from pkm.core.twin.codegen import C_REAL_P as _P
-from pkm.core.twin.codegen import compile_library, numpy_function
+from pkm.core.twin.codegen import compile_library, numpy_function, pointers
 from pkm.core.twin.dynamics import ActuatorTwin
 from pkm.core.twin.tree import Twin
 from pkm.errors import InvalidInputError, NonFiniteError
@@ -189,8 +189,7 @@ class _Kernel:
         one = self._one
         if not hasattr(one, "bufs"):
             ins, outs = [np.zeros(n) for n in self.in_size], [np.zeros(n) for n in self.out_size]
-            one.bufs = (ins, outs, (_P * len(ins))(*[a.ctypes.data_as(_P) for a in ins]),
-                        (_P * len(outs))(*[o.ctypes.data_as(_P) for o in outs]))
+            one.bufs = (ins, outs, pointers(ins), pointers(outs))
         return one.bufs
 
     def __call__(self, *arrays: np.ndarray) -> list[np.ndarray]:
@@ -222,9 +221,8 @@ class _Kernel:
         driver = self._vector_driver() if self.vector and n >= VECTOR_SAMPLES else self._batch_steps
 
         def part(lo: int, hi: int) -> int:  # (ctypes releases the GIL: the chunks run on as many cores)
-            in_p = (_P * len(ins))(*[(a if c else a[lo:]).ctypes.data_as(_P) for a, c in zip(ins, constant)])
-            out_p = (_P * len(outs))(*[o[lo:].ctypes.data_as(_P) for o in outs])
-            return int(driver(hi - lo, in_p, out_p, steps_p))
+            in_p = pointers(a if c else a[lo:] for a, c in zip(ins, constant))
+            return int(driver(hi - lo, in_p, pointers(o[lo:] for o in outs), steps_p))
 
         if workers > 1:  # (the last chunk on this thread)
             others = [_pool().submit(part, lo, hi) for lo, hi in itertools.pairwise(bounds[:-1])]

@@ -67,7 +67,7 @@ import casadi as cs
 import numpy as np
 
 from pkm.core.export.emit import c_constant
-from pkm.core.twin.codegen import C_INT, C_REAL_P, compile_library, instructions
+from pkm.core.twin.codegen import C_INT, C_REAL_P, compile_library, instructions, pointers
 
 #: A function of more instructions is cut into parts of this many, each its own C function (:func:`_body`): gcc's
 #: register allocation on one basic block grows faster than the block (``-O1`` on the hexapod's 52,000-instruction
@@ -425,9 +425,7 @@ class SimdKernel:
         ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
         n = ins[0].shape[0]
         outs = [np.empty((n, s)) for s in self.out_size]
-        in_p = (C_REAL_P * len(ins))(*[a.ctypes.data_as(C_REAL_P) for a in ins])
-        out_p = (C_REAL_P * len(outs))(*[o.ctypes.data_as(C_REAL_P) for o in outs])
-        if self.driver(n, in_p, out_p):
+        if self.driver(n, pointers(ins), pointers(outs)):
             raise RuntimeError(f"the vector driver of {self.fun.name()} failed")
         return outs
 
@@ -493,8 +491,7 @@ def time_per_sample(driver: Callable[..., object], arrays: list[np.ndarray], out
     ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
     n = ins[0].shape[0]
     outs = [np.empty((n, s)) for s in out_size]
-    in_p = (C_REAL_P * len(ins))(*[a.ctypes.data_as(C_REAL_P) for a in ins])
-    out_p = (C_REAL_P * len(outs))(*[o.ctypes.data_as(C_REAL_P) for o in outs])
+    in_p, out_p = pointers(ins), pointers(outs)
     driver(n, in_p, out_p)  # (warm: pages touched)
     return statistics.median(_timed(driver, n, in_p, out_p) for _ in range(repeat)) / n
 

@@ -40,7 +40,7 @@ import casadi as cs
 import numpy as np
 
 from pkm.core.model.mechanism import Mechanism
-from pkm.core.twin.codegen import C_INT, C_REAL_P, compile_library, jacobi_sv, source
+from pkm.core.twin.codegen import C_INT, C_REAL_P, compile_library, jacobi_sv, pointers, source
 from pkm.core.twin.joint import _ONE_DOF
 from pkm.core.twin.spatial import SE3, Expr, log3, log6, quat_matrix, rodrigues, zyx_angles
 
@@ -497,9 +497,7 @@ class Simulator:
         n = Q.shape[0]
         ins = [np.ascontiguousarray(a, dtype=float) for a in (Q, V, QDD)]
         outs = [np.empty((n, s)) for s in self.out_sizes]
-        in_p = (C_REAL_P * 3)(*[a.ctypes.data_as(C_REAL_P) for a in ins])
-        out_p = (C_REAL_P * len(outs))(*[o.ctypes.data_as(C_REAL_P) for o in outs])
-        if self._samples(n, in_p, out_p):
+        if self._samples(n, pointers(ins), pointers(outs)):
             from pkm.errors import CompilerError
 
             raise CompilerError("the compiled simulation's samples", "the generated code failed")
