@@ -1,6 +1,6 @@
-"""The ten robots of Gepetto's example-parallel-robots (URDF + robot.yaml, exported from Onshape), loaded with no edits
-from ``../shared/robots/gepetto-example-parallel-robots/`` beside the clone (their licence stays with them: pkm ships
-none of them; ``SOURCE.txt`` there names the commit).
+"""The ten robots of Gepetto's example-parallel-robots (URDF + robot.yaml, exported from Onshape), shipped unmodified
+in ``urdf/gepetto/`` with their licence and loaded by name from pkm's catalogue (``pkm.load("gepetto:<robot>")``:
+:mod:`pkm.core.formats.catalogue`), so that a clone with nothing beside it runs these tests.
 
 Nine load and are given every generic answer: assembled (closure residual <= 1e-10); their loops closed again from
 a perturbed seed (every joint moved by up to 0.05 rad or m) with the actuators held; the forward Jacobian equal to
@@ -8,26 +8,21 @@ Richardson-extrapolated finite differences of the loop closure (<= 1e-6 relative
 Pinocchio's ``constraintDynamics`` giving back the actuated and task accelerations (<= 1e-8 relative), as in
 ``tests/test_acceptance.py``. ``kangaroo_like`` cannot be assembled as a whole (its 6-D loops do not close): it must be
 refused with a message that names a closure.
-
-Without the shared folder these tests fail saying where they looked; ``PKM_NO_SHARED=1`` skips them instead.
 """
 
 from __future__ import annotations
-
-import os
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
 import pkm
+from pkm.core.formats.catalogue import CATALOGUE, catalogue_path
 from pkm.core.kinematics import constraints
 from pkm.errors import PkmError
 from tests.fd import forward_jacobian_error
 from tests.test_acceptance import check_efforts_give_back_accelerations, moved
 
-ROOT = Path(__file__).resolve().parents[2] / "shared" / "robots" / "gepetto-example-parallel-robots"
 #: The robots that load and answer, and the one that must be refused.
 ROBOTS = ("5bar_linkage", "5bar_linkage_iso3d", "battobot_6d", "cassie_like", "digit_like", "disney_like",
           "robot_delta", "talos_like", "wl16_like")
@@ -35,39 +30,34 @@ UNCLOSABLE = "kangaroo_like"
 _CACHE: dict[str, pkm.Mechanism] = {}
 
 
-@pytest.fixture(scope="module")
-def root() -> Path:
-    if not (ROOT / UNCLOSABLE / "robot.yaml").is_file():
-        if os.environ.get("PKM_NO_SHARED") == "1":
-            pytest.skip(f"PKM_NO_SHARED=1 and no Gepetto robots at {ROOT}")
-        pytest.fail(f"the Gepetto robots are not at {ROOT} (shared/ beside the clone, "
-                    "robots/gepetto-example-parallel-robots/<name>/robot.urdf + robot.yaml); set PKM_NO_SHARED=1 to "
-                    "skip these tests on a clone without shared/")
-    return ROOT
-
-
-def load(root: Path, name: str) -> pkm.Mechanism:
+def gepetto(name: str) -> pkm.Mechanism:
+    """Gepetto's robot ``name``, loaded once per test process."""
     if name not in _CACHE:
-        _CACHE[name] = pkm.load(root / name)
+        _CACHE[name] = pkm.load(f"gepetto:{name}")
     return _CACHE[name]
 
 
-
-
-def test_the_folder_holds_the_ten_robots(root):
-    assert sorted(p.name for p in root.iterdir() if p.is_dir()) == sorted((*ROBOTS, UNCLOSABLE))
+def test_the_catalogue_is_sorted_and_ships_the_ten_robots_with_their_licence():
+    assert list(CATALOGUE) == sorted(CATALOGUE)
+    assert sorted(CATALOGUE) == sorted(f"gepetto:{n}" for n in (*ROBOTS, UNCLOSABLE))
+    for name in CATALOGUE:
+        folder = catalogue_path(name)
+        assert (folder / "robot.urdf").is_file() and (folder / "robot.yaml").is_file()
+    root = catalogue_path("gepetto:robot_delta").parent
+    assert "BSD 3-Clause License" in (root / "LICENSE").read_text()
+    assert "52e64b3" in (root / "SOURCE.txt").read_text()
 
 
 @pytest.mark.parametrize("name", ROBOTS)
-def test_it_loads_assembled(root, name):
-    mech = load(root, name)
+def test_it_loads_assembled(name):
+    mech = gepetto(name)
     assert mech.na >= 2 and len(mech.spec.closures) >= 1
     assert constraints.worst_closure(mech, constraints.residual(mech, mech.q_reference))[0] <= 1e-10
 
 
 @pytest.mark.parametrize("name", ROBOTS)
-def test_its_loops_close_again_from_a_perturbed_seed(root, name):
-    mech = load(root, name)
+def test_its_loops_close_again_from_a_perturbed_seed(name):
+    mech = gepetto(name)
     qa = mech.actuated_q(mech.q_reference)
     step = 0.05 * np.random.default_rng(0).uniform(-1.0, 1.0, mech.nv)
     step[mech.act_v] = 0.0
@@ -76,33 +66,33 @@ def test_its_loops_close_again_from_a_perturbed_seed(root, name):
 
 
 @pytest.mark.parametrize("name", ROBOTS)
-def test_the_forward_jacobian_matches_finite_differences(root, name):
-    mech = load(root, name)
+def test_the_forward_jacobian_matches_finite_differences(name):
+    mech = gepetto(name)
     assert forward_jacobian_error(mech, moved(mech)) <= 1e-6
 
 
 @pytest.mark.parametrize("name", ROBOTS)
-def test_constraint_dynamics_gives_back_the_accelerations_the_efforts_were_computed_for(root, name):
-    mech = load(root, name)
+def test_constraint_dynamics_gives_back_the_accelerations_the_efforts_were_computed_for(name):
+    mech = gepetto(name)
     check_efforts_give_back_accelerations(mech, moved(mech))
 
 
-def test_battobot_saved_as_a_pkm_spec_loads_back_the_same(root, tmp_path):
+def test_battobot_saved_as_a_pkm_spec_loads_back_the_same(tmp_path):
     """Its universal joints (UJOINT_ZY, UJOINT_YZ) written as [joint_types] and read back: the same model."""
     from pkm.core.model.compare import mechanism_differences
 
-    mech = load(root, "battobot_6d")
+    mech = gepetto("battobot_6d")
     text = pkm.save(mech, tmp_path / "battobot.closures.toml").read_text()
     assert 'left_spherical_ankle_1 = "universal_zy"' in text and 'free_knee_left = "universal_yz"' in text
     assert mechanism_differences(pkm.load(tmp_path / "battobot.closures.toml"), mech) == []
 
 
-def test_kangaroo_is_refused_naming_the_closures_their_gaps_and_the_fix(root):
+def test_kangaroo_is_refused_naming_the_closures_their_gaps_and_the_fix():
     """Five of its eleven 6-D loops cannot close even alone (their frames' axes cannot be aligned; each closes as a
     point closure, the toolbox's '3d'): a PkmError (not a traceback) naming them in the user's terms (the YAML's
     frame pairs), with their gaps, and what would close each one."""
     with pytest.raises(PkmError) as info:
-        pkm.load(root / UNCLOSABLE)
+        pkm.load(f"gepetto:{UNCLOSABLE}")
     text = str(info.value)
     assert "the loops cannot be closed" in text and "[reference]" not in text  # (the user wrote none)
     assert "5 closure(s) cannot close even alone" in text and "each closes alone as a point closure" in text

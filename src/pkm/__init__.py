@@ -138,7 +138,8 @@ def load(name) -> Mechanism:
     (``.xml``, loops as ``<equality>`` connect/weld, actuators from ``<actuator>``) or an SDF file (loops
     as links with several parents; it names no actuators, so it comes through a spec): see
     :mod:`pkm.core.formats`. Or a model an installed package ships, by name ``"<package>:<model>"``
-    (``"example-robot-data:cassie"``: :mod:`pkm.core.formats.packages`).
+    (``"example-robot-data:cassie"``: :mod:`pkm.core.formats.packages`), or a third-party robot pkm ships, by name
+    ``"<source>:<robot>"`` (``"gepetto:robot_delta"``: :mod:`pkm.core.formats.catalogue`).
 
     Raises:
         UnknownNameError: ``name`` is neither registered (:data:`MECHANISMS`) nor an existing file.
@@ -154,12 +155,15 @@ def load(name) -> Mechanism:
         except (OSError, ValueError):  # (a name too long for a path, a NUL in it)
             return False
 
-    if isinstance(name, str) and ":" in name and not exists(name):  # "example-robot-data:cassie"
-        from pkm.core.formats.load import load_package_model
+    if isinstance(name, str) and ":" in name and not exists(name):  # "example-robot-data:cassie", "gepetto:..."
+        from pkm.core.formats.catalogue import CATALOGUE, catalogue_path
+        from pkm.core.formats.load import load_package_model, load_path
         from pkm.core.formats.packages import PACKAGES
 
         if name.partition(":")[0] in PACKAGES:
             return load_package_model(name)
+        if name.partition(":")[0] in {n.partition(":")[0] for n in CATALOGUE}:
+            return load_path(catalogue_path(name))
     from pkm.core.formats.base import suffixes
 
     if isinstance(name, os.PathLike) or (isinstance(name, str) and name not in MECHANISMS

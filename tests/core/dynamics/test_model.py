@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -29,19 +28,16 @@ from pkm.core.dynamics.projection import constraint_dynamics, energy
 from pkm.errors import InvalidInputError, NonFiniteError, SingularityError
 from tests.fd import richardson
 from tests.test_acceptance import ACCEPTANCE
-from tests.test_gepetto_robots import ROOT
 
 SHIPPED = ("delta", "prs3", "rrr3", "hexapod", "gough_stewart")
 SETS = {**{n: n for n in SHIPPED}, **{f"acceptance/{n}": p for n, (p, _) in ACCEPTANCE.items()},
-        "gepetto/5bar_linkage": ROOT / "5bar_linkage", "gepetto/robot_delta": ROOT / "robot_delta"}
+        "gepetto/5bar_linkage": "gepetto:5bar_linkage", "gepetto/robot_delta": "gepetto:robot_delta"}
 _CACHE: dict[str, pkm.Mechanism] = {}
 
 
 def mechanism(name: str) -> pkm.Mechanism:
     if name not in _CACHE:
         where = SETS[name]
-        if isinstance(where, Path) and not where.exists():
-            pytest.skip(f"no Gepetto robots at {ROOT} (checked by tests/test_gepetto_robots.py)")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             _CACHE[name] = pkm.load(where)

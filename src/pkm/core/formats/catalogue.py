@@ -1,0 +1,76 @@
+"""Third-party robot files that pkm ships, loaded by name: ``pkm.load("gepetto:robot_delta")``.
+
+Gepetto's example-parallel-robots (LAAS-CNRS, INRIA; BSD-3-Clause: ``urdf/gepetto/LICENSE``, the commit in
+``urdf/gepetto/SOURCE.txt``) are ten robots exported from Onshape, a URDF and a ``robot.yaml`` each in the
+convention of the toolbox-parallel-robots (:func:`pkm.core.formats.load.load_gepetto`), shipped unmodified in
+``urdf/gepetto/<robot>/`` (``pkm/_data/urdf/gepetto/`` in a wheel). They are what pkm's tests and benchmarks meet
+as a user's own files would be: nothing in them was written for pkm. A name is ``gepetto:<robot>``, a key of
+:data:`CATALOGUE`; ``pkm list`` lists them.
+
+``gepetto:kangaroo_like`` is shipped as a robot pkm must refuse: its 6-D loops do not close at any pose the file
+allows, and :func:`pkm.load` says which closure.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from pkm.errors import SpecError, UnknownNameError
+
+
+@dataclass(frozen=True)
+class CatalogueModel:
+    """A robot pkm ships from a third party, with where it came from.
+
+    Attributes:
+        folder: Its folder, relative to pkm's ``urdf/`` data folder.
+        source: The project and licence it comes under (the licence file beside it).
+        description: One line: what the robot is.
+    """
+
+    folder: str
+    source: str
+    description: str
+
+
+_GEPETTO = "Gepetto/example-parallel-robots, BSD-3-Clause (urdf/gepetto/LICENSE)"
+
+
+def _gepetto(robot: str, description: str) -> tuple[str, CatalogueModel]:
+    return f"gepetto:{robot}", CatalogueModel(f"gepetto/{robot}", _GEPETTO, description)
+
+
+#: Every shipped third-party robot by name ``<source>:<robot>``, sorted.
+CATALOGUE: dict[str, CatalogueModel] = dict([
+    _gepetto("5bar_linkage", "a planar five-bar, one 6-D loop, two motors"),
+    _gepetto("5bar_linkage_iso3d", "a five-bar closed by a 3-D point, two motors"),
+    _gepetto("battobot_6d", "a biped: parallel knees and ankles, six 6-D loops, twelve motors"),
+    _gepetto("cassie_like", "a Cassie-like leg: two 6-D loops, five motors"),
+    _gepetto("digit_like", "a Digit-like leg: three 6-D loops, six motors"),
+    _gepetto("disney_like", "a Disney-like leg: three four-bars, six motors"),
+    _gepetto("kangaroo_like", "a Kangaroo-like leg whose 6-D loops do not close (refused on load)"),
+    _gepetto("robot_delta", "a small Delta-like arm (links of about 5 cm): three 6-D loops, two motors"),
+    _gepetto("talos_like", "a TALOS-like leg: one 6-D loop, six motors"),
+    _gepetto("wl16_like", "a WL-16-like leg: five 6-D loops, six motors"),
+])
+
+
+def catalogue_path(name: str) -> Path:
+    """The folder of shipped robot ``name`` (``<source>:<robot>``).
+
+    Raises:
+        UnknownNameError: no such robot (the valid names listed).
+        SpecError: its folder is missing from this installation.
+    """
+    from pkm.data import data_dir
+
+    if name not in CATALOGUE:
+        raise UnknownNameError("shipped robot", name, CATALOGUE, "pkm's catalogue of third-party robots")
+    folder = data_dir("urdf") / CATALOGUE[name].folder
+    if not folder.is_dir():
+        raise SpecError(name, f"the shipped robot's folder {folder} is missing from this installation")
+    return folder
+
+
+__all__ = ["CATALOGUE", "CatalogueModel", "catalogue_path"]
