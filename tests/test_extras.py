@@ -51,7 +51,7 @@ def test_the_core_works_and_each_extra_is_named_where_it_is_used(tmp_path):
 
         raises("sweeps", lambda: pkm.sweep("rrr3", space, ["gci:step=4cm"], scheduler="serial"))
         raises("sweeps", lambda: sweeps.read({str(tmp_path / "x.parquet")!r}))
-        raises("figures", lambda: __import__("pkm.papers._plot", fromlist=["figure"]).figure())
+        raises("figures", lambda: __import__("pkm._plot", fromlist=["figure"]).figure())
         raises("figures", lambda: sweeps.plot({str(tmp_path / "x.parquet")!r}, {str(tmp_path)!r}))
         from pkm import report
         raises("figures", lambda: report.run({str(tmp_path / "report")!r}, ["delta"], series=False))

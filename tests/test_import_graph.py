@@ -126,3 +126,16 @@ def test_there_is_no_import_cycle():
 
 def test_a_planted_cycle_is_found():
     assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+
+
+#: What the core may not import: the faces (command line, service, previews, report, benchmarks, sweeps) and the
+#: paper studies. The core is what they are built on.
+ABOVE_THE_CORE = ("pkm.papers", "pkm.cli", "pkm.serve", "pkm.viz", "pkm.report", "pkm.bench", "pkm.sweeps",
+                  "pkm.mechanisms")
+
+
+def test_the_core_imports_no_face_and_no_paper():
+    graph = import_graph()
+    found = sorted(f"{m} -> {t}" for m, targets in graph.items() if m.startswith("pkm.core")
+                   for t in targets if t.startswith(ABOVE_THE_CORE))
+    assert found == []

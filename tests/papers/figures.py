@@ -1,4 +1,4 @@
-"""Drawing figures with every one inspected (pkm.papers._plot.problems) as it is saved."""
+"""Drawing figures with every one inspected (pkm._plot.problems) as it is saved."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from unittest import mock
 
 from matplotlib.figure import Figure
 
-from pkm.papers import _plot
+from pkm import _plot
 
 
 @contextlib.contextmanager

@@ -516,8 +516,8 @@ def tracking_runs(mech: Mechanism, duration: float, dt: float) -> tuple[dict, di
 
 def figure(series: dict[str, dict], out_dir: str | Path) -> Path:
     """Both tracking errors over time, one panel per mechanism (log scale), as ``simulation_tracking.png``."""
-    from pkm.papers._plot import figure as new_figure
-    from pkm.papers._plot import save
+    from pkm._plot import figure as new_figure
+    from pkm._plot import save
 
     fig, axes = new_figure(ncols=len(series), size=(5.0, 3.6))
     axes = np.asarray(axes).ravel()

@@ -43,7 +43,7 @@ import numpy as np
 from pkm.mechanisms.delta import DeltaParams
 from pkm.mechanisms.delta import design as design
 from pkm.papers import Row, cached_rows, ident_rows, opcount_rows
-from pkm.papers._plot import figure, save
+from pkm._plot import figure, save
 
 TITLE = "Hernández Reyna & Sandoval-Castro (2018): kinematics and base-radius reconfiguration of a Delta robot"
 

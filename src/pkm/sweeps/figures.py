@@ -47,7 +47,7 @@ def plot(result, out_dir, pareto: Sequence[str] | None = None) -> list[Path]:
             (``pkm[sweeps]``), is not installed.
     """
     require("figures", "pkm.sweeps.plot")
-    from pkm.papers._plot import figure, save
+    from pkm._plot import figure, save
 
     res = _result(result)
     params, objs = list(res.parameters), list(res.objectives)

@@ -22,7 +22,7 @@ def _units(mech: Mechanism) -> tuple[str, str, str]:
 
 
 def _save(fig: object, path: str | Path) -> Path:
-    from pkm.papers._plot import pyplot
+    from pkm._plot import pyplot
 
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -40,7 +40,7 @@ def excitation_figure(mech: Mechanism, excitation: Excitation, path: str | Path)
         MissingDependencyError: matplotlib is not installed (``pip install "pkm[figures]"``).
     """
     require("figures", "the figure of an excitation (pkm.viz.identification)")
-    from pkm.papers._plot import figure
+    from pkm._plot import figure
 
     pos, rate, effort = _units(mech)
     fig, axes = figure(nrows=3, size=(7.0, 2.2))
@@ -79,7 +79,7 @@ def fit_figure(mech: Mechanism, validation: Validation, path: str | Path, *, tit
         MissingDependencyError: matplotlib is not installed (``pip install "pkm[figures]"``).
     """
     require("figures", "the figure of an identified model (pkm.viz.identification)")
-    from pkm.papers._plot import figure
+    from pkm._plot import figure
 
     fig, axes = figure(nrows=mech.na, size=(7.0, 2.0))
     axes = np.atleast_1d(np.asarray(axes)).ravel()

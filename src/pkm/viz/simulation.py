@@ -42,7 +42,7 @@ def plot(mech: Mechanism, sim: Simulation, path: str | Path, *, title: str | Non
         InvalidInputError: ``sim`` is not a simulation of ``mech``.
     """
     require("figures", WHAT)
-    from pkm.papers._plot import figure, pyplot
+    from pkm._plot import figure, pyplot
 
     cols = columns(mech, sim)
     units = column_units(mech, sim)

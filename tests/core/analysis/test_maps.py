@@ -133,6 +133,22 @@ def test_bad_maps_are_refused():
         workspace_map(mech, {"x": [np.nan]}, length=0.05)
 
 
+def test_coordinates_beyond_the_float_spacing_of_tol_are_refused():
+    """Issue 47's repro: the 3-PRS's map over ``pitch`` = [1e308, 1e-2] rad (``length=1e7``) called 1e308 rad
+    reachable and returned a size of inf. A coordinate beyond ``tol / eps`` (4.5e5 at tol = 1e-10) cannot be solved
+    to ``tol`` (its float spacing is larger): refused, naming the axis; the bound is met just inside."""
+    from pkm.core.analysis.maps import EPS
+
+    mech = pkm.load("prs3")
+    with pytest.raises(InvalidInputError, match="'pitch': 1e\\+308 is beyond 450360 .*tol = 1e-10"):
+        workspace_map(mech, {"z": [0.99], "pitch": [1e308, 1e-2]}, length=1e7)
+    with pytest.raises(InvalidInputError, match="beyond") as info:
+        workspace_map(mech, {"z": [0.99]}, {"pitch": 1e6}, length=1e7)
+    assert info.value.name == "fixed"
+    m = workspace_map(mech, {"pitch": [1e-10 / EPS * (1 - 1e-12)]}, length=0.1)
+    assert np.isfinite(m.size)
+
+
 def test_the_old_name_warns_and_without_a_compiler_the_error_is_pkms(monkeypatch):
     """``pkm.task_map`` (0.1) is ``pkm.workspace_map`` with a DeprecationWarning; without a C compiler the map
     raises pkm's CompilerError (still a RuntimeError, as before) saying why."""

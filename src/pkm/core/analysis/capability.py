@@ -331,7 +331,7 @@ class CapabilityMap:
         from pkm._optional import require
 
         require("figures", "the figure of a capability map")
-        from pkm.papers._plot import figure, pyplot
+        from pkm._plot import figure, pyplot
 
         if along is not None:
             if along not in self.along:

@@ -50,6 +50,9 @@ ROOT_STRIDE = 16
 PIVOT_FLOOR = 1e-3
 #: Grids larger than this are refused (memory: the singular values and states of every node).
 MAX_NODES = 50_000_000
+#: Machine epsilon: a task coordinate beyond ``tol / EPS`` (4.5e5 m or rad at the default ``tol``) has a float spacing
+#: larger than ``tol``, so no node there can be solved to ``tol``: such grids are refused.
+EPS = float(np.finfo(float).eps)
 KINDS = ("2", "fro_normalized")
 
 
@@ -288,6 +291,10 @@ def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[st
         v = as_array(values, "axes", f"values of {name!r} (SI)").ravel()
         if v.size == 0 or not np.all(np.isfinite(v)):
             raise InvalidInputError("axes", f"{name!r}: give finite values (SI)", values)
+        if np.abs(v).max() > tol / EPS:
+            raise InvalidInputError("axes", f"{name!r}: {np.abs(v).max():.6g} is beyond {tol / EPS:.6g} (SI), where "
+                                            f"the spacing of floating-point numbers exceeds tol = {tol:g}: no node "
+                                            "there could be solved to tol", values)
         grid_axes.append((name, v))
     dims = [len(v) for _, v in grid_axes]
     total = int(np.prod(dims))
@@ -295,6 +302,9 @@ def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[st
         raise InvalidInputError("axes", f"{total} nodes exceed {MAX_NODES}; map in parts", dims)
     q0 = mech.q_reference.copy() if seed is None else mech.check_q(seed, "seed")
     base = task.parse(dict(fixed or {}), base=q0)
+    if np.abs(base).max(initial=0.0) > tol / EPS:
+        raise InvalidInputError("fixed", f"a task coordinate of {np.abs(base).max():.6g} (SI) is beyond {tol / EPS:.6g}, "
+                                         f"where the spacing of floating-point numbers exceeds tol = {tol:g}", fixed)
     scale = task.rate_scale(length)  # (a pose's tangent: x y z then three angles, in the order of its keys)
 
     targets = np.empty((total, len(base)))

@@ -1,4 +1,5 @@
-"""Figure helpers shared by the paper studies: headless matplotlib, one style, and the check a published figure
+"""Figure helpers shared by pkm's figures (the paper studies, capability maps, sweeps, simulations, identification
+runs, benchmarks): headless matplotlib, one style, and the check a published figure
 must pass (:func:`problems`: a caption line naming the paper's figure, units on every axis, a legend entry for every
 line, a colour bar for every image, no text cut off by the figure's edge). matplotlib is the ``figures`` extra,
 imported on the first figure (:func:`pyplot`), so that the studies' numbers need none."""
