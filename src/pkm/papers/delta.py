@@ -40,10 +40,10 @@ from pathlib import Path
 
 import numpy as np
 
+from pkm._plot import figure, save
 from pkm.mechanisms.delta import DeltaParams
 from pkm.mechanisms.delta import design as design
 from pkm.papers import Row, cached_rows, ident_rows, opcount_rows
-from pkm._plot import figure, save
 
 TITLE = "Hernández Reyna & Sandoval-Castro (2018): kinematics and base-radius reconfiguration of a Delta robot"
 

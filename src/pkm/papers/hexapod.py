@@ -20,12 +20,12 @@ from pathlib import Path
 
 import numpy as np
 
+from pkm._plot import figure, save
 from pkm.core.kinematics.task import as_rotation
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi
 from pkm.mechanisms.hexapod import reconfiguration as hr
 from pkm.papers import Row, cached_rows, ident_rows, modes_row, opcount_rows
-from pkm._plot import figure, save
 
 TITLE = "Sanchez-Alonso et al. (2016), Kinematic analysis of a novel reconfigurable parallel robot, RIAI 13:247-257"
 

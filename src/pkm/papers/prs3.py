@@ -14,11 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
+from pkm._plot import figure, save
 from pkm.mechanisms.prs3 import Prs3Params
 from pkm.mechanisms.prs3.dynamics import BOUNDARY, G, Prs3Dynamics, operation_count
 from pkm.motion import load_motions
 from pkm.papers import Row, cached_rows, generic_count, ident_rows, modes_row, opcount_rows
-from pkm._plot import figure, save
 
 TITLE = "Díaz-Rodríguez, Carretero, Bautista-Quintero & Chacón (2016): 3-PRS kinematics and inverse dynamics"
 PUBLISHED_COUNTS = {"this paper": (860, 680), "Díaz-Rodríguez et al. 2013": (1163, 735),

@@ -39,12 +39,12 @@ import numpy as np
 
 from pkm._moved import renamed_keyword
 from pkm._optional import module
+from pkm._plot import WHAT, figure, save
 from pkm.errors import InvalidInputError, PkmError
 from pkm.mechanisms import rrr3
 from pkm.mechanisms.rrr3 import workspace as maps
 from pkm.mechanisms.rrr3.workspace import CiSettings, Design
 from pkm.papers import Row, cached_rows, ident_rows, modes_row
-from pkm._plot import WHAT, figure, save
 
 TITLE = ("Singularity analysis and global condition index of the planar 3-RRR parallel robot "
          "(IEEE Latin America Transactions 13(2), 2015)")

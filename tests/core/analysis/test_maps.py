@@ -140,7 +140,7 @@ def test_coordinates_beyond_the_float_spacing_of_tol_are_refused():
     from pkm.core.analysis.maps import EPS
 
     mech = pkm.load("prs3")
-    with pytest.raises(InvalidInputError, match="'pitch': 1e\\+308 is beyond 450360 .*tol = 1e-10"):
+    with pytest.raises(InvalidInputError, match=r"'pitch': 1e\+308 is beyond 450360 .*tol = 1e-10"):
         workspace_map(mech, {"z": [0.99], "pitch": [1e308, 1e-2]}, length=1e7)
     with pytest.raises(InvalidInputError, match="beyond") as info:
         workspace_map(mech, {"z": [0.99]}, {"pitch": 1e6}, length=1e7)
