@@ -32,3 +32,31 @@ def test_ik_of_an_unreachable_pose_names_the_leg():
     debug = run("--debug", "ik", "delta", "--pose", "z=-1")
     assert debug.returncode == 1 and debug.stderr.startswith("Traceback")
     assert "UnreachableError" in debug.stderr and debug.stderr.strip().splitlines()[-1].startswith("pkm: error: pose")
+
+
+def test_the_seed_the_solvers_suggest_is_an_option(capsys):
+    """The solvers' messages suggest a seed nearer the target (``q0``): ``--q0 NAME=V`` sets any joint of the
+    seed, passive ones included (units allowed), in ``pkm ik`` and ``pkm fk``; the answer is the library's from
+    that seed (here the 3-RRR's leg 2 in its other elbow), and a joint that is not one is named."""
+    import math
+
+    import pkm
+    from pkm import cli
+
+    mech = pkm.load("rrr3")
+    elbow = mech.joints["elbow_2"].idx_q
+    q0 = mech.q_reference.copy()
+    q0[elbow] = -q0[elbow]
+    pose = ["x=50cm", "y=28.87cm", "yaw=5deg"]
+    assert cli.main(["ik", "rrr3", "--pose", *pose, "--q0", f"elbow_2={math.degrees(q0[elbow])!r}deg"]) == 0
+    got = json.loads(capsys.readouterr().out)
+    want = pkm.solve_ik(mech, {"x": 0.5, "y": 0.2887, "yaw": math.radians(5.0)}, q0)
+    assert np.allclose([got["joints"][n] for n in mech.joints], want.q, rtol=0, atol=1e-9)
+    assert abs(got["joints"]["elbow_2"] - mech.q_reference[elbow]) > 1.0  # (the seed's elbow, not the reference's)
+    qa = [f"{n}={float(v)!r}" for n, v in zip(mech.actuated_names, want.q[mech.act_q])]
+    seed = [f"{n}={round(float(want.q[j.idx_q]), 2)!r}" for n, j in mech.joints.items()]  # (near, not on it)
+    assert cli.main(["fk", "rrr3", "--joints", *qa, "--q0", *seed]) == 0
+    fk = json.loads(capsys.readouterr().out)
+    assert abs(fk["joints"]["elbow_2"] - want.q[elbow]) < 1e-9
+    bad = run("fk", "rrr3", "--joints", *qa, "--q0", "elbow_9=1")
+    assert bad.returncode != 0 and "'elbow_9'" in one_error_line(bad)

@@ -38,3 +38,21 @@ def test_list_as_text_and_a_bad_option(capsys):
     assert cli.main(["ik", "rrr3", "--pose", *pose]) == 0 and json.loads(capsys.readouterr().out)["converged"]
     bad = run("list", "--bad")
     assert bad.returncode == 2 and "unrecognized arguments: --bad" in one_error_line(bad)
+
+
+def test_list_describes_any_mech_and_names_the_robots_loaded_by_name(capsys):
+    """``pkm list MECH`` takes what every other command's MECH takes (a shipped robot by name, one's own spec), as
+    the ``--joints`` and ``--pose`` helps' "see 'pkm list MECH'" promise; bare ``pkm list`` ends with the names of
+    the robots pkm ships and of installed packages' models; an unknown name is one error line."""
+    from pkm.core.formats.catalogue import CATALOGUE
+
+    ankle = str(Path(__file__).resolve().parents[2] / "examples" / "humanoid_ankle" / "ankle.closures.toml")
+    assert cli.main(["list", "gepetto:robot_delta", ankle, "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)["mechanisms"]
+    assert data["gepetto:robot_delta"]["actuated"] == {"mot1_rod1": "rad", "mot1_rod2": "rad"}
+    assert data[ankle]["task"] == {"ankle_pitch": "rad", "ankle_roll": "rad"} and "parameters" not in data[ankle]
+    assert cli.main(["list"]) == 0
+    tail = capsys.readouterr().out.split("Also loaded by name")[1]
+    assert all(name in tail for name in (*CATALOGUE, "example-robot-data:cassie"))
+    bad = run("list", "gepetto:nope")
+    assert bad.returncode != 0 and "'gepetto:nope'" in one_error_line(bad)

@@ -2,7 +2,7 @@
 
 Usage::
 
-    pkm list [--json]
+    pkm list [MECH ...] [--json]
     pkm preview MECH [--param K=V ...] [--pose K=V ... | --joints NAME=V ...] [--html FILE] [--no-wait]
     pkm ik MECH --pose K=V ... [--param K=V ...] [--branch NAME]
     pkm fk MECH --joints NAME=V ... [--param K=V ...]

@@ -9,7 +9,7 @@ import argparse
 import numpy as np
 
 import pkm
-from pkm.cli.parsing import parse_joints, parse_params, parse_pose
+from pkm.cli.parsing import parse_joints, parse_params, parse_pose, parse_seed
 from pkm.cli.usage import UsageError
 from pkm.errors import ConvergenceError, PkmError
 
@@ -19,21 +19,31 @@ def shipped() -> str:
     return ", ".join(pkm.MECHANISMS)
 
 
+def mech_help() -> str:
+    """What ``MECH`` takes: every input :func:`pkm.load` reads."""
+    return (f"a shipped mechanism ({shipped()}), a robot pkm ships or an installed package's model by name "
+            "(gepetto:robot_delta, example-robot-data:cassie: 'pkm list' names them), or one's own files: a closure "
+            "spec (path/to/my.closures.toml, naming its URDF, MJCF or SDF file), a URDF + YAML in Gepetto's "
+            "convention (the folder or either file), or an MJCF file (.xml)")
+
+
 def add_mechanism_arguments(p: argparse.ArgumentParser, pose: str | None, joints: str | None) -> None:
     """``MECH``, ``--param`` and, if asked (``"required"`` or ``"optional"``), ``--pose`` and ``--joints`` (exclusive
     when both are taken)."""
-    mechs = shipped()
-    p.add_argument("mechanism", metavar="MECH", help=f"one of {mechs}, or a closure spec file "
-                                                     "(path/to/my.closures.toml, naming its URDF)")
+    p.add_argument("mechanism", metavar="MECH", help=mech_help())
     p.add_argument("--param", metavar="K=V", action="extend", nargs="+", default=[],
                    help="a design parameter (see 'pkm list'); default: the paper's design")
     g = p.add_mutually_exclusive_group() if pose and joints else p
     if pose:
         g.add_argument("--pose", metavar="K=V", action="extend", nargs="+", required=pose == "required",
-                       help="task coordinates (others keep the reference; see 'pkm list')")
+                       help="task coordinates (others keep the reference; see 'pkm list MECH')")
     if joints:
         g.add_argument("--joints", metavar="NAME=V", action="extend", nargs="+", required=joints == "required",
-                       help="actuated joint values (others keep the reference; see 'pkm list')")
+                       help="actuated joint values (others keep the reference; see 'pkm list MECH')")
+    if pose or joints:
+        p.add_argument("--q0", metavar="NAME=V", action="extend", nargs="+", default=[],
+                       help="the solver's seed: values of any joints, passive ones included (others keep the "
+                            "reference); its assembly mode is kept")
 
 
 def load_mechanism(args) -> pkm.Mechanism:
@@ -48,11 +58,12 @@ def load_mechanism(args) -> pkm.Mechanism:
 
 def configuration(mech: pkm.Mechanism, args) -> np.ndarray:
     """The configuration that ``--pose`` (solved on ``--branch``) or ``--joints`` give, else the reference."""
-    if args.pose:
+    q0 = parse_seed(mech, getattr(args, "q0", None))
+    if getattr(args, "pose", None):
         _, target = parse_pose(mech, args.pose)
-        return solve_ik(mech, target, getattr(args, "branch", None)).q
-    if args.joints:
-        return close_loops(mech, parse_joints(mech, args.joints)).q
+        return solve_ik(mech, target, getattr(args, "branch", None), q0).q
+    if getattr(args, "joints", None):
+        return close_loops(mech, parse_joints(mech, args.joints), q0).q
     return mech.q_reference
 
 
@@ -61,12 +72,13 @@ def has_closed_forms(mech: pkm.Mechanism) -> bool:
     return mech.name in pkm.MECHANISMS and isinstance(mech.params, pkm.mechanism_module(mech.name).Params)
 
 
-def solve_ik(mech: pkm.Mechanism, target, branch: str | None) -> pkm.SolveResult:
-    """The generic IK; when it fails, a shipped mechanism's closed form says which leg cannot reach, if one cannot."""
+def solve_ik(mech: pkm.Mechanism, target, branch: str | None, q0: np.ndarray | None = None) -> pkm.SolveResult:
+    """The generic IK (from the seed ``q0``, default the reference); when it fails, a shipped mechanism's closed
+    form says which leg cannot reach, if one cannot."""
     from pkm.errors import UnreachableError
 
     try:
-        return pkm.solve_ik(mech, target, branch=branch)
+        return pkm.solve_ik(mech, target, q0, branch=branch)
     except (ConvergenceError, UnreachableError) as exc:
         if not has_closed_forms(mech):
             raise
@@ -80,12 +92,13 @@ def solve_ik(mech: pkm.Mechanism, target, branch: str | None) -> pkm.SolveResult
         raise
 
 
-def close_loops(mech: pkm.Mechanism, qa) -> pkm.SolveResult:
-    """Generic loop closure; when it fails, the paper's forward kinematics says if no assembly exists."""
+def close_loops(mech: pkm.Mechanism, qa, q0: np.ndarray | None = None) -> pkm.SolveResult:
+    """Generic loop closure (from the seed ``q0``, default the reference); when it fails, the paper's forward
+    kinematics says if no assembly exists."""
     from pkm.errors import AssemblyError
 
     try:
-        return pkm.close_loops(mech, qa)
+        return pkm.close_loops(mech, qa, q0)
     except ConvergenceError as exc:
         if not has_closed_forms(mech):
             raise

@@ -199,6 +199,27 @@ def parse_joints(mech: pkm.Mechanism, items: Sequence[str], option: str = "--joi
                                                              SI_UNITS[joint_kind(mech, name)]))
 
 
+def parse_seed(mech: pkm.Mechanism, items: Sequence[str] | None, option: str = "--q0") -> np.ndarray | None:
+    """``--q0`` items ``NAME=VALUE`` (any one-coordinate joint: revolute or prismatic, actuated or passive; units
+    allowed) as a seed configuration (nq,): the joints not named keep the reference. None without items.
+
+    Raises:
+        UsageError: Missing ``=``; UnitError: a bad number or unit.
+        UnknownNameError: A name that is not a joint of one coordinate.
+    """
+    if not items:
+        return None
+    q = mech.q_reference.copy()
+    names = [n for n, j in mech.joints.items() if j.nq == 1]
+    for item in items:
+        name, text = split_item(item, option)
+        if name not in names:
+            raise UnknownNameError("joint of one coordinate", name, names, mech.name)
+        q[mech.joints[name].idx_q] = parse_quantity(text, {joint_kind(mech, name)}, name,
+                                                    SI_UNITS[joint_kind(mech, name)])
+    return q
+
+
 def parse_rates(mech: pkm.Mechanism, items: Sequence[str], option: str = "--rates") -> np.ndarray:
     """Items ``NAME=VALUE`` as actuated rates, SI numbers [rad/s or m/s] (a unit suffix is refused: rad/s is not
     rad); actuated joints not named: zero.

@@ -12,8 +12,8 @@ import numpy as np
 
 import pkm
 from pkm.cli.command import Command
-from pkm.cli.mechanism import add_mechanism_arguments, close_loops, load_mechanism
-from pkm.cli.parsing import parse_joints, parse_rates
+from pkm.cli.mechanism import add_mechanism_arguments, configuration, load_mechanism
+from pkm.cli.parsing import parse_rates
 from pkm.report import jsonable
 
 if TYPE_CHECKING:
@@ -91,7 +91,7 @@ def text(out: dict[str, Any]) -> str:
 
 def run(args: argparse.Namespace) -> int:
     mech = load_mechanism(args)
-    q = close_loops(mech, parse_joints(mech, args.joints)).q if args.joints else mech.q_reference
+    q = configuration(mech, args)
     qd = parse_rates(mech, args.rates, "--rates")
     out = model_dict(mech, pkm.actuator_model(mech, q, qd))
     print(json.dumps(out, indent=2) if args.json else text(out))

@@ -9,7 +9,7 @@ import pkm
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, close_loops, load_mechanism
 from pkm.cli.output import modes_dict, solution_dict
-from pkm.cli.parsing import parse_joints
+from pkm.cli.parsing import parse_joints, parse_seed
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -23,7 +23,7 @@ def run(args: argparse.Namespace) -> int:
     if args.all:
         print(json.dumps(modes_dict(mech, pkm.assembly_modes(mech, qa)), indent=2))
         return 0
-    res = close_loops(mech, qa)
+    res = close_loops(mech, qa, parse_seed(mech, args.q0))
     print(json.dumps(solution_dict(mech, res), indent=2))
     return 0
 

@@ -9,12 +9,12 @@ import pkm
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, load_mechanism, solve_ik
 from pkm.cli.output import modes_dict, solution_dict
-from pkm.cli.parsing import parse_pose
+from pkm.cli.parsing import parse_pose, parse_seed
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_mechanism_arguments(p, "required", None)
-    p.add_argument("--branch", metavar="NAME", help="working mode the solution must lie on (see 'pkm list')")
+    p.add_argument("--branch", metavar="NAME", help="working mode the solution must lie on (see 'pkm list MECH')")
     p.add_argument("--all", action="store_true", help="every working mode (homotopy continuation, pkm[homotopy])")
 
 
@@ -26,7 +26,7 @@ def run(args: argparse.Namespace) -> int:
     if args.all:
         print(json.dumps(modes_dict(mech, pkm.working_modes(mech, target), target=values), indent=2))
         return 0
-    res = solve_ik(mech, target, args.branch)
+    res = solve_ik(mech, target, args.branch, parse_seed(mech, args.q0))
     print(json.dumps(solution_dict(mech, res, target=values), indent=2))
     return 0
 
