@@ -373,7 +373,7 @@ def _mutated_spec(g: Gen, n: str, adversarial: bool) -> str:
     return g.text_mutation(c.spec[n]) if adversarial or g.chance(0.7) else c.spec[n]
 
 
-@entry("Mechanism.from_strings")
+@entry("pkm.from_strings")
 def _from_strings(g, adv):
     c = ctx()
     n = g.pick(("rrr3", "delta", "prs3", "rrr3", "delta", "prs3", "hexapod"))
@@ -386,7 +386,7 @@ def _from_strings(g, adv):
     if adv and g.chance(0.05):
         urdf, spec = g.pick(((None, spec), (urdf, None), (urdf.encode("utf-8", "surrogatepass"), spec), (urdf, 3),
                              ([urdf], spec)))
-    return c.pkm.Mechanism.from_strings, (urdf, spec), {}
+    return c.pkm.from_strings, (urdf, spec), {}
 
 
 @entry("ClosureSpec.from_toml")
@@ -430,7 +430,7 @@ def _load_model(g, adv):
     return load_model, (text,), {}
 
 
-@entry("Mechanism.from_files")
+@entry("builder.from_files")
 def _from_files(g, adv):
     c = ctx()
     n = g.pick(("rrr3", "delta", "prs3"))
@@ -457,7 +457,9 @@ def _from_files(g, adv):
             path = d / "spec.toml"
         else:
             path.write_text(c.spec[n].replace(f'urdf = "{n}.urdf"', f'urdf = "{d.name}/../{n}.urdf"'))
-    return c.pkm.Mechanism.from_files, (path,), {}
+    from pkm.core.model.builder import from_files
+
+    return from_files, (path,), {}
 
 
 _EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -1549,7 +1551,7 @@ def _spec_actuators(g, adv):
     def parse_and_build(spec_text):
         from pkm.core.model.spec import ClosureSpec
         spec = ClosureSpec.from_toml(spec_text)
-        mech = c.pkm.Mechanism.from_strings(c.urdf[n], spec)
+        mech = c.pkm.from_strings(c.urdf[n], spec)
         return _drives(mech.actuators), sorted(spec.actuators)  # (the tables' inf limits: documented, none)
     return parse_and_build, (c.spec[n] + table,), {}
 

@@ -34,7 +34,7 @@ def report(fuzz):
 def test_harness_covers_the_public_entry_points(fuzz):
     """The registry names the loaders, the generic core, every mechanism's closed forms, indices and dynamics."""
     entries = {e.name for e in fuzz.ENTRIES}
-    expected = {"pkm.load", "Mechanism.from_strings", "Mechanism.from_files", "ClosureSpec.from_toml",
+    expected = {"pkm.load", "pkm.from_strings", "builder.from_files", "ClosureSpec.from_toml",
                 "motion.load_motions", "pkm.solve_ik", "pkm.close_loops", "pkm.forward_jacobian",
                 "pkm.inverse_jacobian", "pkm.velocities", "pkm.accelerations", "pkm.inverse_velocities",
                 "pkm.inverse_accelerations", "pkm.diagnose", "indices.condition_number",

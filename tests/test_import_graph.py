@@ -1,7 +1,8 @@
 """pkm's import graph has no cycle (issue "architecture, round two", item 2).
 
 The graph is read from the source (``ast``), every ``import`` and ``from ... import`` counted wherever it stands,
-deferred imports inside functions included; only imports under ``if TYPE_CHECKING:`` (annotations, never run) are
+deferred imports inside functions included, and ``importlib.import_module("pkm....")`` of a literal name too (a
+builder reached that way is still imported); only imports under ``if TYPE_CHECKING:`` (annotations, never run) are
 left out. An edge goes from a module to each pkm module it names: ``from pkm.a import b`` is an edge to
 ``pkm.a.b`` when that is a module, else to ``pkm.a``. A package's ``__init__`` is the module of the package's name;
 importing a submodule is not counted as importing its parents (their ``__init__`` files import nothing at import
@@ -32,6 +33,15 @@ def _type_checking(node: ast.If) -> bool:
         (isinstance(t, ast.Attribute) and t.attr == "TYPE_CHECKING")
 
 
+def _import_module(node: ast.Call) -> bool:
+    """Whether ``node`` is ``importlib.import_module("<literal>")`` (or ``import_module("<literal>")``)."""
+    f = node.func
+    named = (isinstance(f, ast.Attribute) and f.attr == "import_module") or \
+        (isinstance(f, ast.Name) and f.id == "import_module")
+    return named and len(node.args) >= 1 and isinstance(node.args[0], ast.Constant) and \
+        isinstance(node.args[0].value, str)
+
+
 def _imports(tree: ast.AST, package: str) -> list[tuple[str, list[str]]]:
     """``(module, names)`` of every import outside ``if TYPE_CHECKING:`` blocks (relative ones resolved)."""
     found: list[tuple[str, list[str]]] = []
@@ -43,6 +53,8 @@ def _imports(tree: ast.AST, package: str) -> list[tuple[str, list[str]]]:
             return
         if isinstance(node, ast.Import):
             found.extend((a.name, []) for a in node.names)
+        elif isinstance(node, ast.Call) and _import_module(node):  # importlib.import_module("pkm.x"): an import too
+            found.append((node.args[0].value, []))  # type: ignore[attr-defined]
         elif isinstance(node, ast.ImportFrom):
             base = node.module or ""
             if node.level:
@@ -122,6 +134,11 @@ def test_the_graph_is_read():
 def test_there_is_no_import_cycle():
     found = cycles(import_graph())
     assert not found, "import cycles (deferred imports count):\n" + "\n".join(" <-> ".join(c) for c in found)
+
+
+def test_a_literal_import_module_is_an_edge():
+    tree = ast.parse('import importlib\ndef f():\n    return importlib.import_module("pkm.core.model.builder")\n')
+    assert ("pkm.core.model.builder", []) in _imports(tree, "pkm.core.model")
 
 
 def test_a_planted_cycle_is_found():

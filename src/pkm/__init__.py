@@ -89,6 +89,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         follow_task,
         forward_dynamics,
         forward_jacobian,
+        from_strings,
         gravity_efforts,
         idle_motions,
         inverse_accelerations,
@@ -178,11 +179,11 @@ def load(name) -> Mechanism:
     mod = entry.module()
     if entry.reference is None:
         return mod.build(mod.Params())
-    from pkm.core.model.mechanism import Mechanism
+    from pkm.core.model.builder import from_files
     from pkm.data import data_dir
     from pkm.mechanisms._common import params_from_table
 
-    mech = Mechanism.from_files(data_dir("urdf") / entry.reference)
+    mech = from_files(data_dir("urdf") / entry.reference)
     mech.params = params_from_table(mod.Params, mech.spec.parameters)  # the design the files state
     return mech
 

@@ -244,7 +244,7 @@ def test_errors_carry_the_data_a_caller_needs(delta):
     keeps the solver's name; every one is a PkmError with a one-line message."""
     spec = delta.spec.to_toml().replace('end_effector = "platform"', 'end_effector = "platfrom"')
     with pytest.raises(SpecNameError) as info:
-        pkm.Mechanism.from_strings(delta.urdf, spec, source="mine.toml")
+        pkm.from_strings(delta.urdf, spec, source="mine.toml")
     err = info.value
     assert isinstance(err, SpecError) and isinstance(err, UnknownNameError) and isinstance(err, PkmError)
     assert err.source == "mine.toml" and err.kind == "frame" and err.name == "platfrom" and "platform" in err.valid

@@ -254,4 +254,6 @@ def params_from_table(cls: type, table: Mapping[str, float | str]):
 
 
 def make_mechanism(urdf: str, spec: ClosureSpec, params) -> Mechanism:
-    return Mechanism.from_strings(urdf, spec, params, source=f"<{spec.mechanism} generator>")
+    from pkm.core.model.builder import from_strings
+
+    return from_strings(urdf, spec, params, source=f"<{spec.mechanism} generator>")

@@ -16,6 +16,7 @@ import pytest
 import pkm
 from pkm.core import Configuration
 from pkm.core.kinematics import constraints
+from pkm.core.model.builder import from_strings
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.mechanisms import names
 from tests.fivebar import inverse_kinematics as fivebar_ik
@@ -151,13 +152,12 @@ def _fivebar_with_spinning_rod():
     point nor the tip, an idle motion, as a rod between two ball joints. Returns it and the plain five-bar."""
     import dataclasses
 
-    from pkm.core import Mechanism
     from tests import fivebar
 
     p = fivebar.Params()
     spec = fivebar.closure_spec(p)
     spec = dataclasses.replace(spec, reference={**spec.reference, "spin_1": (0.0,)})
-    return Mechanism.from_strings(fivebar.urdf_xml(p, spinning_rod=True), spec), fivebar.build(p)
+    return from_strings(fivebar.urdf_xml(p, spinning_rod=True), spec), fivebar.build(p)
 
 
 def test_an_idle_rod_spin_is_reported_and_is_not_a_singularity():
@@ -224,13 +224,12 @@ def test_diagnose_grades_the_approach_to_a_direct_singularity(built):
 def _fivebar_driven_by(actuated, task):
     import dataclasses
 
-    from pkm.core.model.mechanism import Mechanism
     from pkm.core.model.spec import TaskSpec
     from tests import fivebar
 
     plain = fivebar.build()
     spec = dataclasses.replace(plain.spec, actuated=actuated, task=TaskSpec(task), branches={}, default_branch=None)
-    return Mechanism.from_strings(plain.urdf, spec)
+    return from_strings(plain.urdf, spec)
 
 
 def test_actuators_beyond_the_mobility_are_named_when_the_model_loads_and_by_diagnose():

@@ -155,7 +155,7 @@ def test_bad_states_are_refused():
         pkm.actuator_model(mech, q[:-1])
     planar_task = dataclasses.replace(mech.spec, task=pkm.TaskSpec(("x", "y"), (), {}))
     with pytest.raises(InvalidInputError, match="as many"):
-        pkm.operational_space(pkm.Mechanism.from_strings(mech.urdf, planar_task), q)
+        pkm.operational_space(pkm.from_strings(mech.urdf, planar_task), q)
     with pytest.raises(InvalidInputError):
         pkm.actuator_model(mech, q, coulomb_velocity=0.0)
 

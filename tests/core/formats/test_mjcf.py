@@ -87,7 +87,7 @@ def test_what_pinocchio_drops_is_read_from_the_file(probe):
     assert probe.actuated == ("ja", "jc")
     assert probe.joint_types == {"jball": "spherical"}
     assert [(c.name, c.type) for c in probe.closures] == [("tie", "point"), ("weld1", "frame")]
-    mech = pkm.Mechanism.from_strings(probe.urdf, pkm.ClosureSpec(
+    mech = pkm.from_strings(probe.urdf, pkm.ClosureSpec(
         mechanism="probe", urdf="probe.urdf", end_effector=None, actuated=probe.actuated, closures=probe.closures,
         task=pkm.core.model.spec.TaskSpec((), probe.actuated), reference={}, joint_types=probe.joint_types))
     assert mech.limits["ja"] == pytest.approx((-np.pi / 2, np.pi / 4), abs=1e-15)

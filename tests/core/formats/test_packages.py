@@ -105,7 +105,7 @@ def test_cassie_v2_with_both_springs_rigid_reports_its_knees_dependent():
              for joint in ("knee-shin-joint", "tarsus-spring-joint")}
     spec = with_file(dataclasses.replace(ClosureSpec.load(spec_path), joint_types=rigid), imported, str(spec_path))
     with pytest.warns(PkmWarning, match=r"\['left-knee-op', 'right-knee-op'\] depend on the others \(mobility 8"):
-        mech = pkm.Mechanism.from_strings(imported.urdf, spec, source="cassie_v2, springs rigid")
+        mech = pkm.from_strings(imported.urdf, spec, source="cassie_v2, springs rigid")
     diag = pkm.diagnose(mech, mech.q_reference)
     assert (diag.mobility, diag.dependent_actuators) == (8, ("left-knee-op", "right-knee-op"))
     qa = mech.actuated_q(mech.q_reference) + np.array([0, 0, 0, -0.05, 0] * 2)

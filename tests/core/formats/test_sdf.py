@@ -43,7 +43,7 @@ def mechanism(text: str, actuated=("crank_joint",)) -> pkm.Mechanism:
     spec = pkm.ClosureSpec(mechanism="fb", urdf="fb.sdf", end_effector=None, actuated=tuple(actuated),
                            closures=imp.closures, task=TaskSpec((), tuple(actuated)), reference={},
                            joint_types=imp.joint_types)
-    return pkm.Mechanism.from_strings(imp.urdf, spec, source="fb.sdf")
+    return pkm.from_strings(imp.urdf, spec, source="fb.sdf")
 
 
 def placements(mech, q, *names):

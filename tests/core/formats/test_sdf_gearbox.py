@@ -135,7 +135,7 @@ def fourbar_geared(types=None, gear: bool = True) -> pkm.Mechanism:
     spec = pkm.ClosureSpec(mechanism="fb", urdf="fb.sdf", end_effector=None, actuated=("crank_joint",),
                            closures=imp.closures, task=TaskSpec((), ("crank_joint",)), reference={},
                            joint_types={**imp.joint_types, **(types or {})})
-    return pkm.Mechanism.from_strings(imp.urdf, spec, source="fb.sdf")
+    return pkm.from_strings(imp.urdf, spec, source="fb.sdf")
 
 
 def test_a_geared_crank_drives_a_loop_and_joints_can_be_retyped_beside_it():

@@ -19,6 +19,7 @@ from lxml import etree
 import pkm
 from pkm.core import ClosureSpec, Mechanism, TaskMap, close_loops, diagnose, solve_ik
 from pkm.core.kinematics import constraints
+from pkm.core.model.builder import from_strings
 from pkm.core.model.spec import Closure, TaskSpec
 from tests import fd
 
@@ -61,7 +62,7 @@ def _gantry_ur5() -> Mechanism:
                        actuated=("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"),
                        closures=(Closure("weld", "frame", "tool0", "gantry_tool"),),
                        task=TaskSpec(("x", "y", "z")), reference=reference)
-    return Mechanism.from_strings(urdf, spec, source="ur5+gantry")
+    return from_strings(urdf, spec, source="ur5+gantry")
 
 
 @pytest.fixture(scope="module")

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 import pkm
-from pkm.core import Mechanism, close_loops, diagnose, solve_ik
+from pkm.core import close_loops, diagnose, solve_ik
 from pkm.core.kinematics import constraints
+from pkm.core.model.builder import from_strings
 from pkm.errors import (
     AssemblyError,
     ConvergenceError,
@@ -85,7 +86,7 @@ def test_a_target_outside_the_workspace_is_unreachable_not_a_convergence_failure
     from pkm.core.model.spec import TaskSpec
 
     files = pkm.load(Path(__file__).resolve().parents[3] / "examples" / "gepetto_fivebar")
-    gepetto = Mechanism.from_strings(files.urdf, dataclasses.replace(files.spec, end_effector="closedloop1_A",
+    gepetto = from_strings(files.urdf, dataclasses.replace(files.spec, end_effector="closedloop1_A",
                                                                      task=TaskSpec(("x", "y"))))
     with pytest.raises(UnreachableError, match=r"the task misses by 4\.\d+ m or rad .*the loops close") as exc:
         solve_ik(gepetto, {"x": 5.0})  # so far that the least-squares minimum has the loop (all but) closed
@@ -156,7 +157,7 @@ def test_a_spec_without_reference_is_assembled(name, built):
     """With no [reference], every registered mechanism is assembled from its neutral configuration (Levenberg-
     Marquardt with restarts) to 1e-10, and that configuration is accepted as its reference."""
     mech = built(name)
-    again = Mechanism.from_strings(mech.urdf, _without_reference(mech))
+    again = from_strings(mech.urdf, _without_reference(mech))
     assert np.abs(constraints.residual(again, again.q_reference)).max() <= 1e-10
 
 
@@ -176,7 +177,7 @@ def test_assemble_closes_from_far_seeds_and_says_which_closure_stays_open_when_n
         assert res.converged and np.abs(constraints.residual(delta, res.q)).max() <= 1e-10
     plain = fivebar.build()
     with pytest.raises(SpecError, match=r"loops cannot be closed: .*'tip' \('tip_1'/'tip_2'\) open by 0\.[89]"):
-        Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params(d=2.0)), _without_reference(plain))
+        from_strings(fivebar.urdf_xml(fivebar.Params(d=2.0)), _without_reference(plain))
 
 
 def test_a_frame_closure_that_cannot_close_is_named_with_its_gap_and_what_would_close_it():
@@ -199,10 +200,10 @@ def test_a_frame_closure_that_cannot_close_is_named_with_its_gap_and_what_would_
                                closures=(Closure("tips", "frame", "tip_1", "tilted"),))
     with pytest.raises(SpecError, match=r"cannot be closed: .*'tips' \('tip_1'/'tilted'\) open by 0 m and 0\.3 rad "
                                         r"at best \(its origins can meet\); each closes alone as a point closure") as info:
-        Mechanism.from_strings(urdf, spec)
+        from_strings(urdf, spec)
     (name, gap), = info.value.__cause__.closures
     assert name == "tips" and gap > 0.01
-    mech = Mechanism.from_strings(urdf, dataclasses.replace(spec, closures=(Closure("tips", "point", "tip_1",
+    mech = from_strings(urdf, dataclasses.replace(spec, closures=(Closure("tips", "point", "tip_1",
                                                                                       "tilted"),)))
     assert np.abs(constraints.residual(mech, mech.q_reference)).max() <= 1e-10
     pin.framesForwardKinematics(mech.model, mech.data, mech.q_reference)
@@ -234,7 +235,7 @@ def test_a_spec_without_any_loop_is_refused(built):
 
     mech = built("delta")
     with pytest.raises(SpecError, match="no loop closure"):
-        Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, closures=()))
+        from_strings(mech.urdf, dataclasses.replace(mech.spec, closures=()))
 
 
 def test_an_open_reference_is_refused_with_the_closure_and_the_gap(built):
@@ -245,7 +246,7 @@ def test_an_open_reference_is_refused_with_the_closure_and_the_gap(built):
     ref = dict(mech.spec.reference)
     ref["platform_z"] = (ref["platform_z"][0] - 0.08,)
     with pytest.raises(SpecError, match=r"leaves closure 'ball_\d' open by 0\.0[78]"):
-        Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))
+        from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))
 
 
 def test_a_reference_in_degrees_or_without_values_is_refused(built):
@@ -254,10 +255,10 @@ def test_a_reference_in_degrees_or_without_values_is_refused(built):
     mech = built("delta")
     ref = {**mech.spec.reference, "motor_1": (45.0,)}
     with pytest.raises(SpecError, match=r"motor_1 = 45, beyond 2 pi: angles are in rad"):
-        Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))
+        from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))
     ref = {**mech.spec.reference, "motor_1": ()}  # (found by the fuzzing: an IndexError before)
     with pytest.raises(SpecError, match=r"joint 'motor_1' takes 1 coordinate\(s\), got \(0,\)"):
-        Mechanism.from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))
+        from_strings(mech.urdf, dataclasses.replace(mech.spec, reference=ref))
 
 
 def test_a_result_checks_itself_again_and_assemble_follows_the_solvers_failure_rule(delta):
@@ -274,9 +275,9 @@ def test_a_result_checks_itself_again_and_assemble_follows_the_solvers_failure_r
     assert not res.check(pkm.load("rrr3"))
     from tests import fivebar
 
-    far = Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params()), fivebar.build().spec)
+    far = from_strings(fivebar.urdf_xml(fivebar.Params()), fivebar.build().spec)
     plain = dataclasses.replace(far.spec, reference={})
-    tight = Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params()), plain)
+    tight = from_strings(fivebar.urdf_xml(fivebar.Params()), plain)
     q_open = tight.q_reference.copy()
     q_open[tight.joint("elbow_1").idx_q] += 2.0
     failed = pkm.assemble(tight, q_open, hold=("motor_1", "motor_2", "elbow_1"), restarts=0, raise_on_failure=False)

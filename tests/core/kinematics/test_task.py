@@ -55,7 +55,7 @@ def test_a_task_of_several_frames(tmp_path):
     stewart = pkm.load(Path(__file__).resolve().parents[3] / "examples" / "gough_stewart" / "gough_stewart.closures.toml")
     spec = dataclasses.replace(stewart.spec, end_effector=None, task=TaskSpec(
         (), (), {"socket1": ("x", "y", "z"), "socket3": ("x", "z"), "socket5": ("z",)}), reference={})
-    mech = pkm.Mechanism.from_strings(stewart.urdf, spec)
+    mech = pkm.from_strings(stewart.urdf, spec)
     assert mech.task_map.keys == ("socket1.x", "socket1.y", "socket1.z", "socket3.x", "socket3.z", "socket5.z")
     assert pkm.diagnose(mech, mech.q_reference).classification == "regular"
     assert mech.n_task == 6 and mech.task_map.kinds["socket5.z"] == "length"

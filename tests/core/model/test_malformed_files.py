@@ -20,6 +20,7 @@ import pytest
 
 import pkm
 from pkm.core import ClosureSpec, Mechanism
+from pkm.core.model.builder import from_files, from_strings
 from pkm.core.model.spec import MAX_FILE_BYTES
 from pkm.core.model.urdf import check_urdf, load_model
 from pkm.data import spec_path, urdf_path
@@ -244,13 +245,13 @@ def test_spec_naming_missing_frames_and_joints_is_a_spec_error(delta_urdf, delta
                      ('frame_a = "forearm_2_tip"', 'frame_a = "forearm_9_tip"'),
                      ('"motor_3"]', '"motor_33"]'),
                      ("knee_1 = [", "knee_99 = [")):
-        exc = refused(Mechanism.from_strings, delta_urdf, delta_spec.replace(old, new, 1), error=SpecNameError)
+        exc = refused(from_strings, delta_urdf, delta_spec.replace(old, new, 1), error=SpecNameError)
         assert isinstance(exc, UnknownNameError) and exc.valid and exc.source == "<string>"
 
 
 def test_spec_reference_of_the_wrong_length_is_a_spec_error(delta_urdf, delta_spec):
     """A [reference] entry with the wrong number of coordinates is reported as a defect of the spec."""
-    refused(Mechanism.from_strings, delta_urdf, re.sub(r"platform_z = \[[^\]]*\]", "platform_z = [1, 2]", delta_spec),
+    refused(from_strings, delta_urdf, re.sub(r"platform_z = \[[^\]]*\]", "platform_z = [1, 2]", delta_spec),
             match=r"\[reference\]")
 
 
@@ -265,7 +266,7 @@ def _write(folder: Path, spec: str, urdf: str | None) -> Path:
 def test_files_load_and_only_the_two_files_are_opened(tmp_path, delta_urdf, delta_spec):
     """A valid spec and URDF in one folder load; the only files opened are those two."""
     path = _write(tmp_path / "ok", delta_spec, delta_urdf)
-    mech, _, opened = outcome(Mechanism.from_files, path)
+    mech, _, opened = outcome(from_files, path)
     assert isinstance(mech, Mechanism)
     assert {Path(p).resolve() for p in opened} == {path.resolve(), (tmp_path / "ok" / "delta.urdf").resolve()}
 
@@ -278,7 +279,7 @@ def test_urdf_path_escaping_the_folder_is_refused_without_opening(tmp_path, delt
     folder.mkdir()
     os.symlink(outside, folder / "link.urdf")
     path = _write(folder, delta_spec.replace('urdf = "delta.urdf"', 'urdf = "link.urdf"'), None)
-    exc, _, opened = outcome(Mechanism.from_files, path)
+    exc, _, opened = outcome(from_files, path)
     assert isinstance(exc, SpecError) and "outside the spec's folder" in str(exc)
     assert str(outside) not in opened and all(Path(p).resolve() != outside.resolve() for p in opened)
 
@@ -287,7 +288,7 @@ def test_spec_pointing_at_etc_passwd_never_opens_it(tmp_path, delta_spec):
     """urdf = "../../etc/passwd" (relative escape) and "/etc/passwd" (absolute) are refused before any read."""
     for target in ("../../../../../../etc/passwd", "/etc/passwd"):
         path = _write(tmp_path / "p", delta_spec.replace('urdf = "delta.urdf"', f'urdf = "{target}"'), None)
-        exc, _, opened = outcome(Mechanism.from_files, path)
+        exc, _, opened = outcome(from_files, path)
         assert isinstance(exc, SpecError) and "root:" not in str(exc)
         assert not any("passwd" in p for p in opened)
 
@@ -320,7 +321,7 @@ def test_fifo_urdf_next_to_the_spec_is_not_read(tmp_path, delta_spec):
     folder = tmp_path / "f"
     folder.mkdir()
     os.mkfifo(folder / "delta.urdf")
-    exc, _, _ = outcome(Mechanism.from_files, _write(folder, delta_spec, None))
+    exc, _, _ = outcome(from_files, _write(folder, delta_spec, None))
     assert isinstance(exc, SpecError) and "not a regular file" in str(exc)
     assert _nobody_reads(folder / "delta.urdf")
 
@@ -328,7 +329,7 @@ def test_fifo_urdf_next_to_the_spec_is_not_read(tmp_path, delta_spec):
 @pytest.mark.parametrize("path", [None, 3, b"/tmp/x", "", "a\0b"])
 def test_spec_paths_of_the_wrong_type_are_invalid_input(path):
     """None, numbers, bytes, empty strings and NUL characters are refused as InvalidInputError."""
-    exc, _, _ = outcome(Mechanism.from_files, path)
+    exc, _, _ = outcome(from_files, path)
     assert isinstance(exc, InvalidInputError), repr(exc)
 
 
@@ -373,5 +374,5 @@ def test_shipped_files_still_load():
 
 def test_spec_text_with_a_lone_surrogate_is_a_spec_error(delta_urdf, delta_spec):
     """A spec whose names cannot be encoded as UTF-8 (they go to Pinocchio) is refused as a SpecError."""
-    refused(Mechanism.from_strings, delta_urdf, delta_spec.replace('end_effector = "platform"',
+    refused(from_strings, delta_urdf, delta_spec.replace('end_effector = "platform"',
                                                                     'end_effector = "\ud800"'), match="UTF-8")

@@ -8,8 +8,9 @@ import re
 import numpy as np
 import pytest
 
-from pkm.core import ClosureSpec, Mechanism
+from pkm.core import ClosureSpec
 from pkm.core.kinematics import constraints
+from pkm.core.model.builder import from_strings
 from pkm.data import spec_path
 from pkm.errors import SpecError, UnknownNameError
 from pkm.mechanisms import names
@@ -58,16 +59,16 @@ def test_spec_names_are_checked_against_the_urdf(built):
     spec = mech.spec
     bad_frame = dataclasses.replace(spec, end_effector="platfrom")
     with pytest.raises(UnknownNameError, match=r"frame 'platfrom' does not exist.*'platform'"):
-        Mechanism.from_strings(mech.urdf, bad_frame)
+        from_strings(mech.urdf, bad_frame)
     bad_joint = dataclasses.replace(spec, actuated=("motor_1", "motor_2", "motr_3"))
     with pytest.raises(UnknownNameError, match=r"joint 'motr_3'.*'motor_3'"):
-        Mechanism.from_strings(mech.urdf, bad_joint)
+        from_strings(mech.urdf, bad_joint)
     partial = dataclasses.replace(spec, reference={k: v for k, v in spec.reference.items() if k != "knee_2"})
-    assembled = Mechanism.from_strings(mech.urdf, partial)  # the missing joint is found by assembly
+    assembled = from_strings(mech.urdf, partial)  # the missing joint is found by assembly
     assert np.abs(constraints.residual(assembled, assembled.q_reference)).max() <= 1e-10
     bad_closure = dataclasses.replace(spec, closures=(dataclasses.replace(spec.closures[0], frame_b="nowhere"),))
     with pytest.raises(UnknownNameError, match="closure 'ball_1'"):
-        Mechanism.from_strings(mech.urdf, bad_closure)
+        from_strings(mech.urdf, bad_closure)
 
 
 @pytest.mark.parametrize("odd", ["a/b", "knee 1", 'say "hi"', "dot.ted", "élan", "tab\there", "new\nline", "back\\slash"])
@@ -102,7 +103,7 @@ def test_a_minimal_spec_names_only_closures_and_actuators():
     import pkm
     from tests import fivebar
 
-    mech = Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params()), MINIMAL)
+    mech = from_strings(fivebar.urdf_xml(fivebar.Params()), MINIMAL)
     assert mech.spec.end_effector is None and mech.spec.task.joints == ("motor_1", "motor_2")
     q = mech.q_reference
     assert np.abs(constraints.residual(mech, q)).max() <= 1e-10
@@ -131,4 +132,4 @@ def test_more_task_coordinates_than_actuators_are_refused():
 
     text = MINIMAL.replace('actuated =', 'end_effector = "tip_1"\nactuated =') + '\n[task]\ncomponents = ["x", "y", "z"]\n'
     with pytest.raises(SpecError, match=r"the task has 3 coordinates but only 2 joints are actuated"):
-        Mechanism.from_strings(fivebar.urdf_xml(fivebar.Params()), text)
+        from_strings(fivebar.urdf_xml(fivebar.Params()), text)

@@ -139,7 +139,7 @@ def test_a_fixed_joint_carrying_mass_varies_only_with_the_body_it_merges_into(go
     weight = ('<link name="weight"><inertial><mass value="2.0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" '
               'iyz="0" izz="0.01"/></inertial></link><joint name="weight_fixed" type="fixed"><parent link="platform"/>'
               '<child link="weight"/><origin xyz="0 0 0.1" rpy="0 0 0"/></joint></robot>')
-    heavy = pkm.Mechanism.from_strings(mech.urdf.replace("</robot>", weight), mech.spec.to_toml(), source="heavy")
+    heavy = pkm.from_strings(mech.urdf.replace("</robot>", weight), mech.spec.to_toml(), source="heavy")
     for names in (("weight_fixed.z",), ("weight_fixed.z", "platform.mz")):
         with pytest.raises(InvalidInputError, match="carries 2 kg"):
             Kernels(heavy, design=names)

@@ -29,6 +29,7 @@ from pkm.core.formats.base import Imported
 from pkm.core.formats.imported import import_model, with_file
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import assemble
+from pkm.core.model import mechanism as _mechanism
 from pkm.core.model.actuators import NUMBERS, Actuator, as_actuators
 from pkm.core.model.joints import retype_joints
 from pkm.core.model.mechanism import Mechanism
@@ -161,6 +162,14 @@ def with_actuators(mech: Mechanism, actuators: Mapping[str, Any]) -> Mechanism:
 def rebuild(urdf: str, spec: str, params: Any, source: str) -> Mechanism:
     """Unpickling: the mechanism again from its URDF and spec texts."""
     return from_strings(urdf, spec, params, source=source)
+
+
+def _reduce(mech: Mechanism) -> tuple[Any, tuple[Any, ...]]:
+    """Pickling (:data:`pkm.core.model.mechanism.REDUCE`): the URDF and spec texts, rebuilt by :func:`rebuild`."""
+    return rebuild, (mech.urdf, mech.spec.to_toml(), mech.params, mech.source)
+
+
+_mechanism.REDUCE = _reduce
 
 
 __all__ = ["REFERENCE_TOL", "build", "from_files", "from_strings", "rebuild", "with_actuators"]

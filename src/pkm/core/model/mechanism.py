@@ -4,10 +4,10 @@
 indices, validated configuration vectors); the algorithms live in
 :mod:`pkm.core.kinematics.solve` and :mod:`pkm.core.differential.velocity` and take a mechanism.
 It is made by :mod:`pkm.core.model.builder` (:func:`~pkm.core.model.builder.build`,
-:func:`~pkm.core.model.builder.from_strings`, :func:`~pkm.core.model.builder.from_files`, also reached as
-``Mechanism.from_strings`` / ``Mechanism.from_files``), which assembles and checks its reference configuration;
-``Mechanism(model, spec)`` alone takes the spec's ``[reference]`` over the neutral configuration as it is.
-The builder is reached through :func:`importlib.import_module` (it imports this module: no import cycle).
+:func:`~pkm.core.model.builder.from_strings`, also :func:`pkm.from_strings`, and
+:func:`~pkm.core.model.builder.from_files`, which :func:`pkm.load` reaches), which assembles and checks its reference
+configuration; ``Mechanism(model, spec)`` alone takes the spec's ``[reference]`` over the neutral configuration as it
+is. The model never imports its builder: the builder registers how a mechanism it made pickles (:data:`REDUCE`).
 
 Joint coordinates follow Pinocchio: ``q`` has ``model.nq`` entries (a free-flyer
 takes 7: position and quaternion x y z w), velocities ``v`` have ``model.nv``.
@@ -18,11 +18,9 @@ by tree traversal, not by file order). Mimic joints take no coordinate.
 from __future__ import annotations
 
 import functools
-import importlib
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -56,6 +54,11 @@ class JointInfo:
     def revolute(self) -> bool:
         """A bounded revolute joint (its coordinate is an angle defined modulo 2 pi)."""
         return self.nq == 1 and self.kind.startswith("JointModelR")
+
+
+#: How a mechanism that :mod:`pkm.core.model.builder` made pickles, ``mech -> (rebuild, (urdf, spec, ...))``: set by
+#: the builder when it is imported (the model does not import its builder). None until then.
+REDUCE: Callable[[Mechanism], tuple[Callable[..., Mechanism], tuple[Any, ...]]] | None = None
 
 
 class Mechanism:
@@ -231,23 +234,23 @@ class Mechanism:
         return TaskMap(self)
 
     def __reduce__(self) -> tuple[Callable[..., Mechanism], tuple[Any, ...]]:
-        if self.urdf is None:
-            raise InvalidInputError("mech", "a Mechanism built from a pinocchio.Model (no URDF text) cannot be "
-                                            "pickled; build it with Mechanism.from_strings or from_files", self)
-        return (importlib.import_module("pkm.core.model.builder").rebuild,
-                (self.urdf, self.spec.to_toml(), self.params, self.source))
+        if self.urdf is None or REDUCE is None:
+            raise InvalidInputError("mech", "a Mechanism built from a pinocchio.Model (no URDF text, or not by pkm's "
+                                            "builder) cannot be pickled; build it with pkm.from_strings or pkm.load",
+                                    self)
+        return REDUCE(self)
 
-    # ------------------------------------------------------------------ construction
+    # ------------------------------------------------------------------ construction (moved)
     @classmethod
-    def from_strings(cls, urdf: str, spec: ClosureSpec | str, params: Any = None,
-                     source: str = "<string>", notes: tuple[str, ...] = ()) -> Mechanism:
-        """:func:`pkm.core.model.builder.from_strings`: built from URDF text and a spec, assembled and checked."""
-        return importlib.import_module("pkm.core.model.builder").from_strings(urdf, spec, params, source, notes)
+    def from_strings(cls, *args: Any, **kwargs: Any) -> Mechanism:
+        """Moved: :func:`pkm.from_strings` (construction lives in the builder, above the model)."""
+        raise AttributeError("Mechanism.from_strings moved to pkm.from_strings (the same arguments): construction lives in the builder")
 
     @classmethod
-    def from_files(cls, spec_path: str | Path) -> Mechanism:
-        """:func:`pkm.core.model.builder.from_files`: a closure spec and the model file it names."""
-        return importlib.import_module("pkm.core.model.builder").from_files(spec_path)
+    def from_files(cls, *args: Any, **kwargs: Any) -> Mechanism:
+        """Moved: :func:`pkm.load` (any model file or closure spec by path)."""
+        raise AttributeError("Mechanism.from_files moved to pkm.load: pkm.load(path) reads a closure spec "
+                             "and the model file it names, or any other model file pkm reads")
 
     # ------------------------------------------------------------------ sizes and names
     @property

@@ -65,8 +65,7 @@ separates working modes (for example the relative elbow angle of a leg).
 What the loaders refuse
 -----------------------
 
-:meth:`ClosureSpec.load`, :meth:`ClosureSpec.from_toml` and :meth:`Mechanism.from_files
-<pkm.core.model.mechanism.Mechanism.from_files>` raise :class:`~pkm.errors.SpecError` for:
+:meth:`ClosureSpec.load`, :meth:`ClosureSpec.from_toml` and :func:`pkm.load` (:func:`~pkm.core.model.builder.from_files`) raise :class:`~pkm.errors.SpecError` for:
 
 * a path that is not a regular file: FIFOs, devices (``/dev/zero``) and directories are refused
   from ``fstat`` before anything is read, so a load never blocks; a file larger than 16 MiB
@@ -80,7 +79,7 @@ What the loaders refuse
 * ``[reference]`` values that are not lists of finite numbers of magnitude <= 1e6 (SI);
   ``[parameters]`` values that are not finite numbers or strings;
 * a ``urdf`` path that is absolute, contains ``..`` or would leave the spec's folder once
-  symbolic links are resolved (:meth:`~pkm.core.model.mechanism.Mechanism.from_files` opens the
+  symbolic links are resolved (:func:`~pkm.core.model.builder.from_files` opens the
   spec and that URDF, nothing else);
 * once the URDF is loaded (see :mod:`pkm.core.model.urdf` for what it refuses): a frame or joint
   named by the spec that the URDF lacks (:class:`~pkm.errors.SpecNameError`, also an
