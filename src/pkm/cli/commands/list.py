@@ -47,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
     from pkm.core.formats.packages import PACKAGE_MODELS
 
     data = {name: describe(name) for name in (args.mechanisms or pkm.MECHANISMS)}
-    others = {} if args.mechanisms else {**{n: e.description for n, e in CATALOGUE.items()},
+    others: dict[str, str] = {} if args.mechanisms else {**{n: e.description for n, e in CATALOGUE.items()},
                                          **{n: e.description for n, e in PACKAGE_MODELS.items()}}
     if args.json:
         print(json.dumps(jsonable({"units": "SI (m, rad, kg) unless a parameter says otherwise",
@@ -76,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
         print()
     if others:
         print("Also loaded by name (pkm list NAME describes one):")
-        w = max(map(len, others))
+        w = max(len(name) for name in others)
         for name, what in others.items():
             print(f"  {name.ljust(w)}  {what}")
     return 0
