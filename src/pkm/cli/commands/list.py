@@ -76,9 +76,9 @@ def run(args: argparse.Namespace) -> int:
         print()
     if others:
         print("Also loaded by name (pkm list NAME describes one):")
-        w = max(len(name) for name in others)
+        width = max(len(name) for name in others)
         for name, what in others.items():
-            print(f"  {name.ljust(w)}  {what}")
+            print(f"  {name.ljust(width)}  {what}")
     return 0
 
 
