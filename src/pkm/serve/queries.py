@@ -33,9 +33,17 @@ def _unit(mech: Mechanism, joint: str, kind: str = "position") -> str:
 
 
 def _task_units(mech: Mechanism) -> dict[str, str]:
+    """The units of the task's tangent coordinates (:attr:`TaskMap.keys`: a pose's x y z roll pitch yaw)."""
     kinds = mech.task_map.kinds
     out = {k: ("m" if kinds.get(k) == "length" else "rad") for k in mech.task_map.keys}
     return out
+
+
+def _value_units(mech: Mechanism) -> list[str]:
+    """The units of the task value's entries (:attr:`TaskMap.value_names`: a pose's x y z qx qy qz qw, whose
+    quaternion is unitless, ``"1"``)."""
+    kinds = mech.task_map.kinds
+    return [("m" if kinds[k] == "length" else "rad") if k in kinds else "1" for k in mech.task_map.value_names]
 
 
 def _optional(body: Mapping[str, Any], key: str, size: int) -> np.ndarray | None:
@@ -130,7 +138,7 @@ def fk(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[st
             return {"q": r.q, "y": mech.task_map.value(r.q), "residual": r.residual, "iterations": r.iterations}
 
         out = _columns(_each(len(qa), one), ("q", "y", "residual", "iterations"))
-    out["units"] = {"y": list(_task_units(mech).values()), "residual": "m or rad",
+    out["units"] = {"y": _value_units(mech), "residual": "m or rad",
                     "qa": [_unit(mech, j) for j in mech.actuated_names]}
     return out
 
@@ -309,7 +317,8 @@ def describe(mech: Mechanism) -> dict[str, Any]:
             "actuated_q": [int(i) for i in mech.act_q],
             "actuated_units": [_unit(mech, j) for j in mech.actuated_names],
             "task": list(mech.task_map.keys), "task_units": _task_units(mech),
-            "task_value_names": list(mech.task_map.value_names), "q_reference": mech.q_reference,
+            "task_value_names": list(mech.task_map.value_names), "task_value_units": _value_units(mech),
+            "q_reference": mech.q_reference,
             "branches": list(mech.spec.branches), "limits": mech.limits}
 
 
