@@ -95,3 +95,21 @@ def test_an_excitation_that_cannot_meet_its_limits_is_refused_naming_the_limit()
     assert "motor_1" in str(info.value) and "0.1" in str(info.value)
     with pytest.raises(InvalidInputError, match="samples"):
         excite(mech, harmonics=5, samples=8)
+
+
+def test_a_finite_speed_limit_beside_an_infinite_one_is_checked():
+    """The dense check skipped every speed (and effort) margin as soon as one actuator's limit was infinite, and
+    reported 1.0 ("unused") though a finite limit bound the motion: each finite limit counts, an infinite one gives
+    a margin of 1 (the 3-RRR at rest at its reference, one actuator turning at 0.1 rad/s against 0.2 rad/s)."""
+    from pkm.core.identification.excitation import _check, _limits
+
+    mech = pkm.load("rrr3")
+    lo, hi, _, _ = _limits(mech, None)
+    q = np.repeat(mech.q_reference[None], 3, axis=0)
+    qa, qd = q[:, mech.act_q], np.zeros((3, mech.na))
+    qd[:, 0] = 0.1
+    W, theta = np.zeros((3 * mech.na, 1)), np.zeros(1)
+    for speed, margin in (([0.2, np.inf, 100.0], 0.5), ([np.inf, np.inf, np.inf], 1.0)):
+        out = _check(mech, (qa, qd, None, q, W), lo, hi, (hi - lo) / 2, np.array(speed),
+                     np.full(mech.na, np.inf), theta, 1e-9)
+        assert out is not None and out["speed"] == pytest.approx(margin, rel=1e-12) and out["effort"] == 1.0

@@ -272,8 +272,8 @@ def _check(mech: Mechanism, s: tuple[np.ndarray, ...], lo: np.ndarray, hi: np.nd
     na = mech.na
     tau = (W @ theta).reshape(len(qa), na)
     out = {"joint": float(min(((qa - lo) / half).min(), ((hi - qa) / half).min()))}
-    out["speed"] = float((1.0 - np.abs(qd) / speed).min()) if np.isfinite(speed).all() else 1.0
-    out["effort"] = float((1.0 - np.abs(tau) / effort).min()) if np.isfinite(effort).all() else 1.0
+    out["speed"] = float((1.0 - np.abs(qd) / speed).min())  # (an infinite limit: a margin of 1, unused)
+    out["effort"] = float((1.0 - np.abs(tau) / effort).min())
     if min(out.values()) < 0.0 or any(mech.outside_limits(q) for q in Q):
         return None
     worst = np.inf
