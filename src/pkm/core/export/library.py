@@ -4,7 +4,8 @@
 example ``main.c``. The library's functions (declared and documented in the header): forward kinematics (Newton,
 warm-started from the caller's previous solution, a fixed iteration bound), inverse kinematics (Newton, and in
 closed form, ``<name>_ik_actuators``, where the mechanism is made of crank legs on a body the task places:
-:attr:`~pkm.core.export.model.ExportModel.closed_form`), the assembly and working mode ids of a configuration, the task value, the forward and inverse Jacobians, the rate and
+:attr:`~pkm.core.export.model.ExportModel.closed_form`), the assembly and working mode ids of a configuration (the
+header names the spec's branches' ids: :func:`mode_constants`), the task value, the forward and inverse Jacobians, the rate and
 effort maps between actuators and task, ``J̇ q̇``, inverse dynamics, ``M_a`` and the gravity efforts.
 
 Every function is re-entrant (constant tables only, the caller owns every buffer), allocates nothing, prints
@@ -142,14 +143,16 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
 
     Raises:
         ExportError: the mechanism cannot be exported, and why: a joint kind the twin does not write; the closures
-            (or closures and task) do not fix the joints at the reference; a Newton solve that does not converge at
-            the reference; a non-finite kernel value at the reference.
+            (or closures and task) do not fix the joints at the reference; two branches that make one C name (or a
+            branch named ``reference`` in another mode, :func:`mode_constants`); a Newton solve that does not converge
+            at the reference; a non-finite kernel value at the reference.
     """
     from pkm import __version__
 
     mech = check_mechanism(mech)
     prefix = c_name(name or mech.name)
     model = ExportModel(mech)
+    modes, mode_lines = mode_constants(mech, model)
     fk, ik = model.fk, model.ik
     kernels = [fk.step, fk.system, fk.retract, ik.step, ik.system, ik.retract, model.task_value(), model.jacobians(), model.jdot_qdot(),
                model.inverse_dynamics(), model.mass_matrix(), model.gravity()]
@@ -166,7 +169,6 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
     blocks = {kind: [[vnames[newton.columns[c]] for c in b.cols] for b in newton.blocks]
               for kind, newton in (("fk", fk), ("ik", ik))}
     limits = _limits(mech)
-    modes, mode_lines = mode_constants(mech, model)
     out = Path(directory)
     out.mkdir(parents=True, exist_ok=True)
     nfk, nik = len(fk.columns), len(ik.columns)
@@ -264,11 +266,13 @@ def mode_constants(mech: Mechanism, model: ExportModel) -> tuple[dict[str, dict[
              + (f" (on branch {', '.join(on)})." if on else
                 (" (on none of the spec's branches)." if mech.spec.branches else "; the spec names no branch."))]
     owner: dict[str, str] = {}
-    for name, branch in mech.spec.branches.items():
+    for name in mech.spec.branches:
         key = c_name(name).upper()
         if key in owner:
             raise ExportError(mech.name, f"branches {owner[key]!r} and {name!r} make the same C name {key}")
         owner[key] = name
+    for key, name in owner.items():
+        branch = mech.spec.branches[name]
         signs = ", ".join(f"{j} {'>' if s > 0 else '<'} 0" for j, s in branch.signs.items())
         try:
             q = branch_seed(mech, name)
