@@ -16,7 +16,7 @@ tau = Jᵀ w``; ``jdot_qdot`` in ``q, qd`` out ``status, c``; ``inverse_dynamics
 ``status, residual, smallest margin, qa``; ``modes`` in ``q`` out ``fk_mode``'s status and id, ``ik_mode``'s status
 and id; ``mode_ids`` in nothing out the header's named mode ids as the C compiler reads them (``<NAME>_FK_MODE_*``
 then ``<NAME>_IK_MODE_*``, in :attr:`CLibrary.modes <pkm.core.export.library.CLibrary.modes>`' order).
-:func:`mode_constants` proves each named id on a configuration in its mode.
+:func:`check_modes` proves each named id on a configuration in its mode.
 """
 
 from __future__ import annotations

@@ -37,7 +37,7 @@ import numpy as np
 
 from pkm.core.export import runtime
 from pkm.core.export.emit import c_constant, c_function
-from pkm.core.export.model import Block, ExportError, ExportModel, c_name
+from pkm.core.export.model import Block, ExportError, ExportModel, Newton, c_name
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.codegen import jacobi_sv, paper_counts
 
@@ -225,13 +225,13 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
                     tuple(vnames[c] for c in model.idle), no_closed_form, modes)
 
 
-def mode_id(newton: object, q: np.ndarray, target: np.ndarray) -> tuple[int, float]:
+def mode_id(newton: Newton, q: np.ndarray, target: np.ndarray) -> tuple[int, float]:
     """The mode id of ``q`` for the Newton system ``newton`` (``ExportModel.fk`` or ``.ik``) and its target, from
     the dense determinants of the diagonal blocks (numpy's, not the kernel's fixed pivots: a second route to the
     C's ids), and the square matrix's smallest singular value relative to its largest."""
-    A = np.array(newton.system(q, target)[0])  # type: ignore[attr-defined]
+    A = np.array(newton.system(q, target)[0])
     ident = 0
-    for k, b in enumerate(newton.blocks):  # type: ignore[attr-defined]
+    for k, b in enumerate(newton.blocks):
         if not np.linalg.det(A[np.ix_(b.rows, b.cols)]) * b.sign > 0:
             ident |= 1 << k
     s = np.linalg.svd(A, compute_uv=False) if A.size else np.ones(1)
@@ -277,7 +277,8 @@ def mode_constants(mech: Mechanism, model: ExportModel) -> tuple[dict[str, dict[
         try:
             q = branch_seed(mech, name)
         except PkmError as e:
-            why = f"branch {name!r} ({signs}): no constant, pkm finds no configuration on it at the reference task value ({e})"
+            why = (f"branch {name!r} ({signs}): no constant, pkm finds no configuration on it at the reference task "
+                   f"value ({e})")
             warnings.warn(why, PkmWarning, stacklevel=3)
             lines.append(why + ".")
             continue
@@ -304,7 +305,7 @@ def mode_constants(mech: Mechanism, model: ExportModel) -> tuple[dict[str, dict[
             why = (f"branches {', '.join(keys)} share the id {ident}: the blocks' determinants do not tell them apart, "
                    "and asking ik for that mode does not keep a solution on one of them")
             warnings.warn(why, PkmWarning, stacklevel=3)
-            lines.append(why.capitalize() + ".")
+            lines.append(why[0].upper() + why[1:] + ".")
     return modes, lines
 
 
