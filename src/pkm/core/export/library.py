@@ -354,11 +354,13 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
     lines += [
         "",
         f"Forward kinematics: at most {U}_MAX_ITER = {MAX_ITER} evaluations of fk_step ({step('fk_step')} operations "
-        f"each), so at most {MAX_ITER * step('fk_step')} operations and a dense {len(fk.columns)} x {len(fk.columns)}"  # type: ignore[attr-defined]
-        " solve per iteration where the fixed pivots fail.",
+        f"each), so at most {MAX_ITER * step('fk_step')} operations where the fixed pivots hold; an iteration where "
+        f"they fail also evaluates fk_system ({step('fk_system')} operations), a Jacobi SVD and a dense "
+        f"{len(fk.columns)} x {len(fk.columns)} solve.",  # type: ignore[attr-defined]
         f"Inverse kinematics: at most {MAX_ITER} evaluations of ik_step ({step('ik_step')} operations each), at "
-        f"most {MAX_ITER * step('ik_step')} operations and a dense {len(ik.columns)} x {len(ik.columns)} solve per "  # type: ignore[attr-defined]
-        "iteration where the fixed pivots fail.",
+        f"most {MAX_ITER * step('ik_step')} operations where the fixed pivots hold; an iteration where they fail also "
+        f"evaluates ik_system ({step('ik_system')} operations), a Jacobi SVD and a dense {len(ik.columns)} x "  # type: ignore[attr-defined]
+        f"{len(ik.columns)} solve.",  # type: ignore[attr-defined]
         f"Converged when the largest closure residual (and task error) is at most {U}_TOL = {TOL:g} [m, rad].",
         (f"Closed-form inverse kinematics of the actuators ({prefix}_ik_actuators): {step('ik_closed')} operations, "
          "no iteration." if not no_closed_form else f"No closed-form inverse kinematics: {no_closed_form}."),
