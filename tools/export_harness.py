@@ -4,7 +4,8 @@ For each mechanism: :func:`pkm.core.export.export_c`, then with every compiler p
 installed) a strict C99 build (``-std=c99 -Wall -Wextra -Werror -pedantic -O2``; a warning fails it), the object
 file's undefined symbols checked (no ``malloc``, ``free``, ``printf``...), and every function compared with pkm's
 generic core at four closed configurations (:func:`pkm.core.export.harness.compare`) to :data:`TOL`; then the
-bad-input calls (:func:`pkm.core.export.harness.domain`). Exit status 1 on any failure.
+bad-input calls (:func:`pkm.core.export.harness.domain`) and the header's named mode ids, each on a configuration in
+its mode (:func:`pkm.core.export.harness.check_modes`). Exit status 1 on any failure.
 
 Usage: ``python tools/export_harness.py [--out DIR] [--only NAME ...]``.
 """
@@ -35,7 +36,7 @@ MECHANISMS = {
 def main(argv: list[str] | None = None) -> int:
     import pkm
     from pkm.core.export import export_c
-    from pkm.core.export.harness import build, compare, compiler, domain
+    from pkm.core.export.harness import build, check_modes, compare, compiler, domain
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=None, help="where the libraries go (default: a temporary folder)")
@@ -60,12 +61,14 @@ def main(argv: list[str] | None = None) -> int:
                 t2 = time.perf_counter()
                 errors = compare(mech, h)
                 bad_input, statuses = domain(mech, h)
+                modes = check_modes(mech, h)
                 worst = max(v for k, v in errors.items() if k != "status")
-                ok = worst <= TOL and errors["status"] == 0 and not bad_input
+                ok = worst <= TOL and errors["status"] == 0 and not bad_input and not modes
                 print(f"{name:14s} {cc:5s} export {t1 - t0:6.1f} s, build {t2 - t1:6.1f} s: largest difference "
                       f"{worst:.2e} ({max((k for k in errors if k != 'status'), key=errors.get)}), "
                       f"{int(errors['status'])} calls not OK; bad input {'ok' if not bad_input else bad_input}, fk beyond "
-                      f"the workspace {statuses}"
+                      f"the workspace {statuses}; named modes ({sum(map(len, lib.modes.values()))}) "
+                      f"{'ok' if not modes else modes}"
                       f"{'' if ok else '  FAILED'}", flush=True)
                 if not ok:
                     failed.append(f"{name} ({cc})")

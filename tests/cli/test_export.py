@@ -23,9 +23,11 @@ def test_export_and_check(tmp_path, capsys):
     worst = {k: v for k, v in out["check"]["largest_difference"].items() if k != "status"}
     assert max(worst.values()) <= 1e-12 and out["check"]["largest_difference"]["status"] == 0
     assert "malloc" not in out["check"]["undefined_symbols"]
+    assert out["mode_ids"] == {"fk": {"REFERENCE": 0}, "ik": {"REFERENCE": 0}} and out["check"]["mode_ids"] == []
     assert cli.main(["export", "c", "rrr3", "--out", str(tmp_path / "r")]) == 0
     text = capsys.readouterr().out
     assert "C library rrr3" in text and "fk_step" in text and (tmp_path / "r" / "rrr3.h").exists()
+    assert "RRR3_FK_MODE_REFERENCE = 0, RRR3_IK_MODE_REFERENCE = 0, RRR3_IK_MODE_MODE1 = 0" in text
 
 
 def test_a_mechanism_it_cannot_export_is_one_error_line(tmp_path):

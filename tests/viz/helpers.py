@@ -12,6 +12,7 @@ import pinocchio as pin
 import umsgpack
 
 import pkm
+from pkm.viz.bodies import CENTRE_OF_MASS
 
 TOL = 1e-9  # m, on placements sent as float64
 TOL_F32 = 1e-6  # m, on mesh vertices (meshcat sends geometry as float32)
@@ -57,8 +58,12 @@ def frame_placement(mech, data, name: str) -> np.ndarray:
 
 
 def point(mech, data, name: str, host: str) -> np.ndarray:
-    """World position of joint or frame ``name``; a joint as the point where body ``host`` carries it."""
+    """World position of joint or frame ``name``; a joint as the point where body ``host`` carries it; ``host``'s
+    centre of mass for :data:`~pkm.viz.bodies.CENTRE_OF_MASS`."""
     model = mech.model
+    if name == CENTRE_OF_MASS:
+        j = model.getJointId(host)
+        return data.oMi[j].act(model.inertias[j].lever)
     if model.existJointName(name) and name != host:
         j = model.getJointId(name)
         return (data.oMi[model.parents[j]] * model.jointPlacements[j]).translation

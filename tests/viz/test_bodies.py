@@ -60,17 +60,25 @@ def test_every_joint_has_a_sphere_at_its_origin_coloured_by_actuation(case, whic
 def test_links_join_the_points_they_name(case):
     """Each link cylinder runs from its joint's origin to the child joint or frame it names (1e-9)."""
     mech, scene, qs = case
+    assert [b for b in scene.bodies if b.role == "link"]
     for q in qs:
-        data = fk(mech, q)
-        tr = scene.transforms(q)
-        links = [b for b in scene.bodies if b.role == "link"]
-        assert links
-        for b in links:
-            half = np.array([[0.0, b.size[0] / 2, 0.0, 1.0], [0.0, -b.size[0] / 2, 0.0, 1.0]])
-            ends = (tr[b.path] @ half.T).T[:, :3]
-            a, c = point(mech, data, b.ends[0], b.joint), point(mech, data, b.ends[1], b.joint)
-            assert min(np.linalg.norm(ends[1] - a) + np.linalg.norm(ends[0] - c),
-                       np.linalg.norm(ends[0] - a) + np.linalg.norm(ends[1] - c)) <= TOL
+        assert _link_error(mech, scene, q) <= TOL
+
+
+def _link_error(mech: pkm.Mechanism, scene: viz.Scene, q: np.ndarray) -> float:
+    """The largest distance [m] at ``q`` between a link cylinder's ends and the joints or frames it names."""
+    data = fk(mech, q)
+    tr = scene.transforms(q)
+    worst = 0.0
+    for b in scene.bodies:
+        if b.role != "link":
+            continue
+        half = np.array([[0.0, b.size[0] / 2, 0.0, 1.0], [0.0, -b.size[0] / 2, 0.0, 1.0]])
+        ends = (tr[b.path] @ half.T).T[:, :3]
+        a, c = point(mech, data, b.ends[0], b.joint), point(mech, data, b.ends[1], b.joint)
+        worst = max(worst, min(np.linalg.norm(ends[1] - a) + np.linalg.norm(ends[0] - c),
+                               np.linalg.norm(ends[0] - a) + np.linalg.norm(ends[1] - c)))
+    return worst
 
 
 @pytest.mark.parametrize("which", [0, 1], ids=["reference", "assembled"])
@@ -205,3 +213,44 @@ def test_a_joint_on_its_parents_origin_is_a_ring_around_its_sphere():
     delta = viz.Scene.from_mechanism(pkm.load("delta"))
     guide = [delta.body(f"{viz.ROOT}/joints/platform_{a}") for a in "xyz"]
     assert len({b.size[0] for b in guide}) == 1 and not any(b.halo for b in guide)
+
+
+def _undrawn(mech: pkm.Mechanism, scene: viz.Scene) -> list[str]:
+    """The bodies of ``mech``'s tree (one per joint) that ``scene`` does not draw: a body reaching off its joint's
+    origin (a child joint, a frame it carries (a task, closure or link frame), the centre of mass of a body with mass,
+    farther than 1e-9 of the mechanism's size) needs a link or the platform on it; every body its joint's sphere."""
+    model = mech.model
+    eps = 1e-9 * scene.length
+    links = {b.joint for b in scene.bodies if b.role in ("link", "platform")}
+    spheres = {b.joint for b in scene.bodies if b.role == "joint"}
+    missing = []
+    for j in range(1, model.njoints):
+        name = model.names[j]
+        points = [model.jointPlacements[c].translation for c in range(1, model.njoints) if model.parents[c] == j]
+        points += [f.placement.translation for f in model.frames if f.parentJoint == j]
+        if model.inertias[j].mass > 0:
+            points.append(model.inertias[j].lever)
+        if name not in spheres or (any(np.linalg.norm(p) > eps for p in points) and name not in links):
+            missing.append(name)
+    return missing
+
+
+def test_every_body_of_every_mechanism_is_drawn():
+    """Every body of the shipped mechanisms (the test-only five-bar included), the acceptance set and Gepetto's nine
+    robots that load: a link (or the platform) on each body that reaches off its joint, a sphere on each joint. The
+    five-bar's distal link 1 carries the end effector on a platform of one point (no polygon): it was left out, leg 1
+    drawn broken; the knee's thigh likewise; a body whose only extent is its centre of mass (the Gough-Stewart
+    example's cylinders, the 3-RPR's rockers) is a link to it. Each link joins the points it names (1e-9 m)."""
+    from tests.test_acceptance import ACCEPTANCE
+    from tests.test_acceptance import load as acceptance
+    from tests.test_gepetto_robots import ROBOTS, gepetto
+
+    mechanisms = [pkm.load(n) for n in pkm.MECHANISMS] + [acceptance(n) for n in ACCEPTANCE]
+    mechanisms += [gepetto(n) for n in ROBOTS]
+    assert "fivebar" in pkm.MECHANISMS and len(mechanisms) == len(pkm.MECHANISMS) + len(ACCEPTANCE) + 9
+    scenes = [(m, viz.Scene.from_mechanism(m)) for m in mechanisms]
+    assert {m.name: u for m, s in scenes if (u := _undrawn(m, s))} == {}
+    assert max(_link_error(m, s, m.q_reference) for m, s in scenes) <= TOL  # (the new links too)
+    fivebar = next(s for m, s in scenes if m.name == "fivebar")
+    distal = [b for b in fivebar.bodies if b.joint == "elbow_1" and b.role == "link"]
+    assert [(b.ends, b.leg) for b in distal] == [(("elbow_1", "tip_1"), "motor_1")]  # (in leg 1's colour)

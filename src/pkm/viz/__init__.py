@@ -9,11 +9,15 @@ closure spec say:
   joint's second axis, a knee on a slider) is a larger sphere around its parent's, drawn by its
   back faces only, so that it shows as a ring around it;
 * every body as cylinders from its joint's origin to the origins of its child joints and to
-  the frames it carries (leg tips, closure frames), each leg in a colour of its own
-  (:data:`LEG_COLORS`; a leg: the joints hung on the world, or on the platform, with their
-  descendants up to the platform), named after its actuated joints;
+  the frames it carries (leg tips, closure frames), or, when all of them sit on its origin,
+  to its centre of mass if it has mass (a Gough-Stewart leg's cylinder under its piston);
+  each leg in a colour of its own (:data:`LEG_COLORS`; a leg: the joints hung on the world,
+  or on the platform, with their descendants up to the platform), named after its actuated
+  joints; a body with nothing off its origin is its joint's sphere;
 * the platform (the body holding the end-effector frame) as the convex hull of the closure
   frames it carries: a triangle for the 3-RRR, Delta and 3-PRS, a prism for the hexapod;
+  where they make no polygon (the five-bar's tip on its distal link), that body is drawn as
+  the others, in its leg's colour;
 * the base, translucent, through the anchor points of the joints hung on the world
   (free-flyers excepted) and the closure frames fixed to it: their polygon when they are
   coplanar, one polygon per layer when they lie in parallel planes (the hexapod's two

@@ -31,6 +31,8 @@ _PLATFORM_FRACTION = 0.15  # largest joint radius, of the platform's diameter
 _NESTED_SCALE = 1.35  # radius of a joint's ring around its parent's sphere
 _TRIAD_LENGTH = 0.12
 _TRIAD_RADIUS = 0.2 * JOINT_RADIUS
+CENTRE_OF_MASS = "centre of mass"
+"""The name of a link's far end when the link runs to its body's centre of mass (:attr:`Body.ends`)."""
 
 
 def build_bodies(mech: Mechanism, root: str) -> tuple[list[Body], float, str | None]:
@@ -96,24 +98,31 @@ def build_bodies(mech: Mechanism, root: str) -> tuple[list[Body], float, str | N
         bodies.append(Body(f"{root}/base", "cylinder", "base", joint_frame(0), _segment(ends[a], ends[b]),
                            BASE_COLOR, (float(far[a, b]), _BASE_BAR * r_joint), joint=model.names[0]))
 
-    # links: cylinders from each joint's origin to its children and to the frames it carries, coloured by leg
-    legs = _legs(mech, pj)
+    # links: cylinders from each joint's origin to its children and to the frames it carries (the platform's body:
+    # the polygon draws them, unless its frames make no polygon, as the five-bar's tip), coloured by leg (the tree cut
+    # at the platform where there is one drawn); a body with mass that reaches nowhere else: a link to its centre of
+    # mass (the cylinder of a Gough-Stewart leg, its piston on a prismatic joint at the same origin)
+    platform_drawn = any(b.role == "platform" for b in bodies)
+    legs = _legs(mech, pj if platform_drawn else 0)
     rank = {pin.FrameType.BODY: 1, pin.FrameType.OP_FRAME: 2, pin.FrameType.FIXED_JOINT: 3}
     for j in range(1, model.njoints):
         targets = [(model.names[c], np.array(model.jointPlacements[c].translation))
                    for c in range(1, model.njoints) if model.parents[c] == j]
-        if j != pj:
+        if j != pj or not platform_drawn:
             frames = [f for f in range(model.nframes) if model.frames[f].parentJoint == j
                       and model.frames[f].type in rank]
             frames.sort(key=lambda f: (rank[model.frames[f].type], f))
             targets += [(model.frames[f].name, local(f)) for f in frames]
+            if all(np.linalg.norm(p) <= eps for _, p in targets) and model.inertias[j].mass > 0:
+                targets.append((CENTRE_OF_MASS, np.array(model.inertias[j].lever)))
         seen: list[np.ndarray] = []
         for name, p in targets:
             if np.linalg.norm(p) <= eps or any(np.linalg.norm(p - s) <= eps for s in seen):
                 continue
             seen.append(p)
             leg, color = legs.get(j, (None, LINK_COLOR))
-            bodies.append(Body(f"{root}/links/{_clean(model.names[j])}-{_clean(name)}", "cylinder", "link",
+            end = "centre_of_mass" if name == CENTRE_OF_MASS else _clean(name)
+            bodies.append(Body(f"{root}/links/{_clean(model.names[j])}-{end}", "cylinder", "link",
                                joint_frame(j), _segment(np.zeros(3), p), color,
                                (float(np.linalg.norm(p)), _LINK_RADIUS * r_joint), joint=model.names[j],
                                ends=(model.names[j], name), leg=leg))

@@ -24,7 +24,8 @@ class Body:
         faces: Mesh triangles, (m, 3) indices into ``vertices``; empty otherwise.
         joint: For a joint sphere, the joint's name; for a link, the joint whose body it belongs to.
         actuation: For a joint sphere: ``"actuated"``, ``"passive"`` or ``"mimic"``.
-        ends: For a link: the names of the joint or frame at each end; for a closure marker,
+        ends: For a link: the names of the joint or frame at each end (the far one
+            :data:`~pkm.viz.bodies.CENTRE_OF_MASS` for a link to its body's centre of mass); for a closure marker,
             the closure's name and the frame it marks.
         halo: Drawn by its back faces only: a sphere around another shows as a ring around it.
         leg: For a link of a leg, the leg's name (see :meth:`Scene.legend`).

@@ -1,7 +1,8 @@
 """The exported C library (``pkm.export_c``), built strictly and run from Python: the ankle's and the knee's
 functions against pkm's generic core to 1e-12 (relative to max(1, the largest value)), no allocation or I/O in the
-object file, a status (never a NaN) for NaN, infinite and unreachable inputs, the mode and limit codes, the files a
-user builds with ``make``, and the mechanisms it refuses. Every shipped and acceptance-set mechanism is run by
+object file, a status (never a NaN) for NaN, infinite and unreachable inputs, the mode and limit codes, the named
+mode ids of the header proven in C (the 3-RRR's eight branches), the files a user builds with ``make``, and the
+mechanisms it refuses. Every shipped and acceptance-set mechanism is run by
 ``tools/export_harness.py`` in CI (gcc, and clang where present)."""
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import pytest
 
 import pkm
 from pkm.core.export import ExportError, export_c
-from pkm.core.export.harness import FORBIDDEN, build, compare, domain
+from pkm.core.export.harness import FORBIDDEN, build, check_modes, compare, domain
 from pkm.core.export.library import STATUS
 from pkm.errors import PkmError, SpecError
 from tests.test_acceptance import ACCEPTANCE
@@ -82,6 +83,25 @@ def test_the_mode_asked_for_and_the_limits(built):
     assert STATUS[int(far[0])] in ("OUTSIDE_LIMITS", "NOT_CONVERGED", "SINGULAR") and np.isfinite(far).all()
 
 
+def test_the_named_mode_ids_are_the_ids_the_c_returns_in_those_modes(built, tmp_path):
+    """``<NAME>_IK_MODE_<BRANCH>`` for each branch of the spec (the 3-RRR's eight working modes: eight distinct ids),
+    ``_FK_MODE_REFERENCE`` and ``_IK_MODE_REFERENCE``: compiled in C, each equal to what ``ik_mode`` returns at the
+    branch's configuration pkm computes, and ``ik`` asked for it from there stays on the branch
+    (:func:`check_modes`). A spec without branches (the ankle's) gets the reference's ids, and the header says why."""
+    mech = pkm.load("rrr3")
+    h = build(export_c(mech, tmp_path / "rrr3"), optimise="-O0")
+    assert check_modes(mech, h) == []
+    ik = h.lib.modes["ik"]
+    assert set(ik) == {"REFERENCE"} | {f"MODE{k}" for k in range(1, 9)} and ik["MODE1"] == ik["REFERENCE"] == 0
+    assert len({ik[f"MODE{k}"] for k in range(1, 9)}) == 8 and h.lib.modes["fk"] == {"REFERENCE": 0}
+    header = h.lib.header.read_text()
+    assert f"#define RRR3_IK_MODE_MODE8 {ik['MODE8']}\n" in header and "(on branch mode1)" in header
+    ankle, ha = built["ankle"]
+    assert check_modes(ankle, ha) == [] and ha.lib.modes == {"fk": {"REFERENCE": 0}, "ik": {"REFERENCE": 0}}
+    text = ha.lib.header.read_text()
+    assert "the spec names no branch" in text and "ANKLE_FK_MODE_REFERENCE 0" in text
+
+
 def test_the_folder_builds_with_make_and_runs(built, tmp_path):
     if shutil.which("make") is None:
         pytest.skip("no make")
@@ -92,6 +112,7 @@ def test_the_folder_builds_with_make_and_runs(built, tmp_path):
                           capture_output=True, check=False).returncode == 0
     run = subprocess.run(["./example"], cwd=folder, capture_output=True, text=True, check=False)
     assert run.returncode == 0 and "inverse dynamics: status 0" in run.stdout
+    assert "ik: status 0, mode 0" in run.stdout and "working mode id 0 (the reference's)" in run.stdout
     header = (folder / "ankle.h").read_text()
     assert "ANKLE_MAX_ITER" in header and "fk_step" in header and " mul " in header and "ik bit 1" in header
 
@@ -131,3 +152,29 @@ def test_the_files_names_reach_the_c_unchanged(tmp_path):
     assert "grip_pin" in mech.limits
     source = export_c(mech, tmp_path / "knee").source.read_text()
     assert '"grip_pin"' in source
+
+
+def test_a_branch_without_a_constant_is_said_so_and_names_that_clash_are_refused(tmp_path):
+    """A branch pkm cannot reach at the reference task value (the Delta's platform_x < 0, the reference's x being 0)
+    gets no constant: a PkmWarning and the header's line (:func:`mode_constants`) say why. Two branches whose names make one C identifier are refused
+    before anything is written."""
+    from pkm.core.export.library import mode_constants
+    from pkm.core.export.model import ExportModel
+    from pkm.core.formats.load import load_texts
+    from pkm.data import data_dir
+    from pkm.errors import PkmWarning
+
+    folder = data_dir("urdf")
+    spec = (folder / "delta.closures.toml").read_text()
+    extra = '\n[branch.left]\nsigns = { platform_x = -1 }\n'
+    files = {"delta.urdf": (folder / "delta.urdf").read_text(), "delta.closures.toml": spec + extra}
+    mech = load_texts(files)
+    with pytest.warns(PkmWarning, match="branch 'left'.*no constant"):
+        modes, lines = mode_constants(mech, ExportModel(mech))
+    assert set(modes["ik"]) == {"REFERENCE", "KNEE_OUT", "KNEE_IN"}
+    assert any(line.startswith("branch 'left' (platform_x < 0): no constant, pkm finds no configuration")
+               for line in lines)
+    files["delta.closures.toml"] = spec + '\n[branch.Knee-In]\nsigns = { knee_1 = 1 }\n'
+    with pytest.raises(ExportError, match="'knee_in' and 'Knee-In' make the same C name KNEE_IN"):
+        export_c(load_texts(files), tmp_path / "clash")
+    assert not (tmp_path / "clash").exists()

@@ -13,7 +13,10 @@ Row layouts (:func:`layouts`): ``fk`` in ``qa, q_prev, mode`` out ``status, iter
 tau = Jᵀ w``; ``jdot_qdot`` in ``q, qd`` out ``status, c``; ``inverse_dynamics`` in ``q, qd, qdd`` out
 ``status, tau``; ``mass_matrix`` in ``q`` out ``status, M``; ``gravity`` in ``q`` out ``status, g``;
 ``ik_actuators`` (the closed form, where the library has it; status -1 otherwise) in ``y, mode`` out
-``status, residual, smallest margin, qa``.
+``status, residual, smallest margin, qa``; ``modes`` in ``q`` out ``fk_mode``'s status and id, ``ik_mode``'s status
+and id; ``mode_ids`` in nothing out the header's named mode ids as the C compiler reads them (``<NAME>_FK_MODE_*``
+then ``<NAME>_IK_MODE_*``, in :attr:`CLibrary.modes <pkm.core.export.library.CLibrary.modes>`' order).
+:func:`check_modes` proves each named id on a configuration in its mode.
 """
 
 from __future__ import annotations
@@ -36,7 +39,8 @@ STRICT = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic")
 FORBIDDEN = frozenset({"malloc", "calloc", "realloc", "free", "printf", "fprintf", "sprintf", "snprintf", "puts",
                        "putchar", "fputs", "fwrite", "perror", "abort", "exit", "__printf_chk", "__fprintf_chk",
                        "__sprintf_chk", "__snprintf_chk"})
-KINDS = ("fk", "ik", "jacobians", "maps", "jdot_qdot", "inverse_dynamics", "mass_matrix", "gravity", "ik_actuators")
+KINDS = ("fk", "ik", "jacobians", "maps", "jdot_qdot", "inverse_dynamics", "mass_matrix", "gravity", "ik_actuators",
+         "modes", "mode_ids")
 
 
 def layouts(lib: CLibrary) -> dict[str, tuple[int, int]]:
@@ -45,7 +49,8 @@ def layouts(lib: CLibrary) -> dict[str, tuple[int, int]]:
     return {"fk": (na + nq + 1, 4 + nq + ny), "ik": (ny + nq + 1, 4 + nq + na), "jacobians": (nq, 1 + 2 * nx * na),
             "maps": (nq + 2 * na + 2 * nx, 4 + 2 * nx + 2 * na), "jdot_qdot": (nq + na, 1 + nx),
             "inverse_dynamics": (nq + 2 * na, 1 + na), "mass_matrix": (nq, 1 + na * na), "gravity": (nq, 1 + na),
-            "ik_actuators": (ny + 1, 3 + na)}
+            "ik_actuators": (ny + 1, 3 + na), "modes": (nq, 4),
+            "mode_ids": (0, sum(len(lib.modes.get(k, {})) for k in ("fk", "ik")))}
 
 
 _HARNESS = r"""
@@ -104,6 +109,19 @@ static void one(int kind, const double* in, double* out) {
   case 7:
     out[0] = NAME_gravity(in, out + 1, &info);
     break;
+  case 9: {
+    long mode = -1;
+    out[0] = NAME_fk_mode(in, &mode); out[1] = (double) mode;
+    mode = -1;
+    out[2] = NAME_ik_mode(in, &mode); out[3] = (double) mode;
+    break;
+  }
+  case 10: {
+    static const long ids[] = {MODE_IDS};
+    unsigned i;
+    for (i = 0; i < sizeof ids / sizeof ids[0]; ++i) out[i] = (double) ids[i];
+    break;
+  }
   default:
 #if U_HAS_CLOSED_FORM
     out[0] = NAME_ik_actuators(in, (long) in[NY], out + 3, &info);
@@ -118,7 +136,7 @@ static void one(int kind, const double* in, double* out) {
 /* stdin: kind, n, then n rows; kind + 100: time the function over the n rows (fk warm-started along them), in
    blocks of 100 calls, and write the median time per call [s]. */
 int main(void) {
-  static const int in_w[9] = {IN_WIDTHS}, out_w[9] = {OUT_WIDTHS};
+  static const int in_w[] = {IN_WIDTHS}, out_w[] = {OUT_WIDTHS};
   double head[2], *in, *out;
   long n, k;
   int kind, bench;
@@ -223,7 +241,9 @@ def build(lib: CLibrary, cc: str = "cc", *, optimise: str = "-O2", directory: Pa
     widths = layouts(lib)
     text = (_HARNESS.replace("NAME", lib.name).replace("U_", f"{lib.name.upper()}_")
             .replace("IN_WIDTHS", ", ".join(str(widths[k][0]) for k in KINDS))
-            .replace("OUT_WIDTHS", ", ".join(str(widths[k][1]) for k in KINDS)))
+            .replace("OUT_WIDTHS", ", ".join(str(widths[k][1]) for k in KINDS))
+            .replace("MODE_IDS", ", ".join(f"{lib.name.upper()}_{kind.upper()}_MODE_{key}" for kind in ("fk", "ik")
+                                           for key in lib.modes.get(kind, {})) or "0"))
     source = out / f"harness-{lib.name}.c"
     source.write_text(text)
     exe = out / f"harness-{lib.name}-{Path(cc).name}{optimise}"
@@ -325,6 +345,55 @@ def compare(mech: Mechanism, harness: Harness, samples: int = 4, step: float = 0
     return out
 
 
+def check_modes(mech: Mechanism, harness: Harness, step: float = 0.01) -> list[str]:
+    """The header's named mode ids proven in C: the ids as the compiler reads them are :attr:`CLibrary.modes
+    <pkm.core.export.library.CLibrary.modes>`; ``fk_mode`` and ``ik_mode`` of the reference configuration return
+    the ``REFERENCE`` ids; for each branch of the spec, at its configuration at the reference task value (pkm's
+    :func:`~pkm.core.kinematics.solve.branch_seed`, computed here again), ``ik_mode`` returns the branch's constant,
+    and ``ik`` asked for that mode from there to the task value of a configuration pkm closes with the actuators
+    moved by ``step`` (rad or m) returns OK at a configuration on the branch, in that mode. Returns what went wrong
+    (empty when nothing did)."""
+    import pkm
+    from pkm.core.export.model import c_name
+    from pkm.core.kinematics.solve import branch_seed
+
+    lib = harness.lib
+    problems = []
+    names = [(kind, key) for kind in ("fk", "ik") for key in lib.modes[kind]]
+    compiled = harness.run("mode_ids", np.zeros((1, 0)))[0]
+    values = {}
+    for (kind, key), value in zip(names, compiled):
+        values[kind, key] = int(value)
+        if value != lib.modes[kind][key]:
+            problems.append(f"{lib.name.upper()}_{kind.upper()}_MODE_{key} is {value:g} in C, {lib.modes[kind][key]} "
+                            "in pkm")
+    ref = harness.run("modes", mech.q_reference[None])[0]
+    if not (ref[0] == 0 and ref[2] == 0 and ref[1] == values["fk", "REFERENCE"] and ref[3] == values["ik", "REFERENCE"]):
+        problems.append(f"at the reference fk_mode and ik_mode return (status, id) {ref.tolist()}")
+    for name in mech.spec.branches:
+        key = c_name(name).upper()
+        if key not in lib.modes["ik"]:
+            continue  # (the header says why it has no constant)
+        q = branch_seed(mech, name)
+        got = harness.run("modes", q[None])[0]
+        if not (got[2] == 0 and got[3] == values["ik", key]):
+            problems.append(f"branch {name!r}: ik_mode returns (status, id) {got[2:].tolist()}, the constant is "
+                            f"{values['ik', key]}")
+            continue
+        qa = mech.actuated_q(q) + step * (-1.0) ** np.arange(mech.na)
+        moved = pkm.close_loops(mech, qa, q, tol=1e-14, raise_on_failure=False)
+        if not (moved.converged and mech.on_branch(moved.q, name)):
+            problems.append(f"branch {name!r}: pkm cannot move its configuration by {step} along it")
+            continue
+        row = np.hstack([mech.task_map.value(moved.q), q, [values["ik", key]]])
+        got = harness.run("ik", row[None])[0]
+        q_c = got[4:4 + mech.nq]
+        if not (got[0] == 0 and got[3] == values["ik", key] and mech.on_branch(q_c, name)):
+            problems.append(f"branch {name!r}: ik in its mode returns status {got[0]:g}, mode {got[3]:g}, "
+                            f"{'on' if mech.on_branch(q_c, name) else 'off'} the branch")
+    return problems
+
+
 def domain(mech: Mechanism, harness: Harness, steps: int = 60) -> tuple[list[str], dict[str, int]]:
     """Calls outside the domain, each of which must return a status, never a NaN: NaN and infinite inputs to every
     function (``INVALID_INPUT``); the forward kinematics warm-started along a straight motion of the actuators from
@@ -383,4 +452,5 @@ def domain(mech: Mechanism, harness: Harness, steps: int = 60) -> tuple[list[str
     return problems, {k: seen.count(k) for k in STATUS if k in seen}
 
 
-__all__ = ["FORBIDDEN", "KINDS", "STRICT", "Harness", "build", "compare", "compiler", "domain", "layouts"]
+__all__ = ["FORBIDDEN", "KINDS", "STRICT", "Harness", "build", "check_modes", "compare", "compiler", "domain",
+           "layouts"]

@@ -4,7 +4,8 @@
 example ``main.c``. The library's functions (declared and documented in the header): forward kinematics (Newton,
 warm-started from the caller's previous solution, a fixed iteration bound), inverse kinematics (Newton, and in
 closed form, ``<name>_ik_actuators``, where the mechanism is made of crank legs on a body the task places:
-:attr:`~pkm.core.export.model.ExportModel.closed_form`), the assembly and working mode ids of a configuration, the task value, the forward and inverse Jacobians, the rate and
+:attr:`~pkm.core.export.model.ExportModel.closed_form`), the assembly and working mode ids of a configuration (the
+header names the spec's branches' ids: :func:`mode_constants`), the task value, the forward and inverse Jacobians, the rate and
 effort maps between actuators and task, ``J̇ q̇``, inverse dynamics, ``M_a`` and the gravity efforts.
 
 Every function is re-entrant (constant tables only, the caller owns every buffer), allocates nothing, prints
@@ -36,7 +37,7 @@ import numpy as np
 
 from pkm.core.export import runtime
 from pkm.core.export.emit import c_constant, c_function
-from pkm.core.export.model import Block, ExportError, ExportModel, c_name
+from pkm.core.export.model import Block, ExportError, ExportModel, Newton, c_name
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.codegen import jacobi_sv, paper_counts
 
@@ -66,6 +67,9 @@ class CLibrary:
         limits: The joints whose limits are checked, in ``info.joint``'s order.
         idle: The velocity coordinates held at the caller's previous solution (one per idle motion).
         closed_form: Why there is no closed-form inverse kinematics (``<name>_ik_actuators``); empty when there is.
+        modes: ``{"fk": {...}, "ik": {...}}``: the named mode ids the header defines (``<NAME>_FK_MODE_<KEY>``,
+            ``<NAME>_IK_MODE_<KEY>``): ``REFERENCE`` (0) in both, and in ``ik`` one per branch of the spec
+            (:func:`mode_constants`).
     """
 
     name: str
@@ -77,6 +81,7 @@ class CLibrary:
     limits: tuple[str, ...] = ()
     idle: tuple[str, ...] = ()
     closed_form: str = ""
+    modes: dict[str, dict[str, int]] = field(default_factory=dict)
 
     @property
     def header(self) -> Path:
@@ -138,14 +143,16 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
 
     Raises:
         ExportError: the mechanism cannot be exported, and why: a joint kind the twin does not write; the closures
-            (or closures and task) do not fix the joints at the reference; a Newton solve that does not converge at
-            the reference; a non-finite kernel value at the reference.
+            (or closures and task) do not fix the joints at the reference; two branches that make one C name (or a
+            branch named ``reference`` in another mode, :func:`mode_constants`); a Newton solve that does not converge
+            at the reference; a non-finite kernel value at the reference.
     """
     from pkm import __version__
 
     mech = check_mechanism(mech)
     prefix = c_name(name or mech.name)
     model = ExportModel(mech)
+    modes, mode_lines = mode_constants(mech, model)
     fk, ik = model.fk, model.ik
     kernels = [fk.step, fk.system, fk.retract, ik.step, ik.system, ik.retract, model.task_value(), model.jacobians(), model.jdot_qdot(),
                model.inverse_dynamics(), model.mass_matrix(), model.gravity()]
@@ -173,7 +180,8 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
         return text.replace("p_", f"{prefix}_").replace("P_", f"{prefix.upper()}_")
 
     stamp = datetime.date.today().isoformat()
-    header = _header(mech, prefix, sizes, ops, blocks, limits, fk, ik, __version__, stamp, no_closed_form)
+    header = _header(mech, prefix, sizes, ops, blocks, limits, fk, ik, __version__, stamp, no_closed_form, modes,
+                     mode_lines)
     tables = (_array("int", "p_actuated_q", [int(i) for i in mech.act_q], public=True)
               + f"#define P_NLIMITS {len(limits)}\n"
               + _array("int", "p_limit_q", [q for _, q, _, _ in limits])
@@ -214,7 +222,91 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
         path.write_text(text)
         written.append(path)
     return CLibrary(prefix, out, tuple(written), sizes, ops, blocks, tuple(n for n, *_ in limits),
-                    tuple(vnames[c] for c in model.idle), no_closed_form)
+                    tuple(vnames[c] for c in model.idle), no_closed_form, modes)
+
+
+def mode_id(newton: Newton, q: np.ndarray, target: np.ndarray) -> tuple[int, float]:
+    """The mode id of ``q`` for the Newton system ``newton`` (``ExportModel.fk`` or ``.ik``) and its target, from
+    the dense determinants of the diagonal blocks (numpy's, not the kernel's fixed pivots: a second route to the
+    C's ids), and the square matrix's smallest singular value relative to its largest."""
+    A = np.array(newton.system(q, target)[0])
+    ident = 0
+    for k, b in enumerate(newton.blocks):
+        if not np.linalg.det(A[np.ix_(b.rows, b.cols)]) * b.sign > 0:
+            ident |= 1 << k
+    s = np.linalg.svd(A, compute_uv=False) if A.size else np.ones(1)
+    return ident, float(s[-1] / s[0])
+
+
+def mode_constants(mech: Mechanism, model: ExportModel) -> tuple[dict[str, dict[str, int]], list[str]]:
+    """The mode ids the header names, and the header's lines about them.
+
+    ``REFERENCE``: the reference configuration's id, 0 for both kinematics. The spec's branches (working modes,
+    ``[branch.<name>]``: signs of joint coordinates) are the inverse kinematics' named modes: each one's id is the
+    working-mode id of its configuration at the reference task value (:func:`pkm.core.kinematics.solve.branch_seed`).
+    A spec names no assembly mode: the forward kinematics has ``REFERENCE`` only. A branch pkm cannot reach at the
+    reference task value, or reaches at a singular configuration, gets no constant (a line and a
+    :class:`~pkm.errors.PkmWarning` say so); two branches with one id (the blocks' determinants do not tell them
+    apart) are said so too.
+
+    Raises:
+        ExportError: two branches' names make the same C identifier, or a branch called ``reference`` is not the
+            reference's mode.
+    """
+    import warnings
+
+    from pkm.core.kinematics.solve import branch_seed
+    from pkm.errors import PkmError, PkmWarning
+
+    modes: dict[str, dict[str, int]] = {"fk": {"REFERENCE": 0}, "ik": {"REFERENCE": 0}}
+    on = [b for b in mech.spec.branches if mech.on_branch(mech.q_reference, b)]
+    lines = ["FK_MODE_REFERENCE = 0: the reference configuration's assembly mode. The spec names no assembly mode; "
+             "fk_mode gives any closed configuration's id.",
+             "IK_MODE_REFERENCE = 0: the reference configuration's working mode"
+             + (f" (on branch {', '.join(on)})." if on else
+                (" (on none of the spec's branches)." if mech.spec.branches else "; the spec names no branch."))]
+    owner: dict[str, str] = {}
+    for name in mech.spec.branches:
+        key = c_name(name).upper()
+        if key in owner:
+            raise ExportError(mech.name, f"branches {owner[key]!r} and {name!r} make the same C name {key}")
+        owner[key] = name
+    for key, name in owner.items():
+        branch = mech.spec.branches[name]
+        signs = ", ".join(f"{j} {'>' if s > 0 else '<'} 0" for j, s in branch.signs.items())
+        try:
+            q = branch_seed(mech, name)
+        except PkmError as e:
+            why = (f"branch {name!r} ({signs}): no constant, pkm finds no configuration on it at the reference task "
+                   f"value ({e})")
+            warnings.warn(why, PkmWarning, stacklevel=3)
+            lines.append(why + ".")
+            continue
+        ident, sigma = mode_id(model.ik, q, mech.task_map.value(q))
+        if not sigma > SINGULAR_TOL:
+            why = (f"branch {name!r} ({signs}): no constant, its configuration at the reference task value is singular "
+                   f"(relative smallest singular value {sigma:.3g})")
+            warnings.warn(why, PkmWarning, stacklevel=3)
+            lines.append(why + ".")
+            continue
+        if key == "REFERENCE" and ident != 0:
+            raise ExportError(mech.name, f"branch {name!r} is not the reference's working mode (id {ident}) but its C "
+                                         "name is REFERENCE's")
+        modes["ik"][key] = ident
+        lines.append(f"IK_MODE_{key} = {ident}: branch {name!r} ({signs}"
+                     + (f"; {branch.description}" if branch.description else "")
+                     + "): the working-mode id of its configuration at the reference task value.")
+    seen: dict[int, list[str]] = {}
+    for key, ident in modes["ik"].items():
+        if key != "REFERENCE":
+            seen.setdefault(ident, []).append(key)
+    for ident, keys in seen.items():
+        if len(keys) > 1:
+            why = (f"branches {', '.join(keys)} share the id {ident}: the blocks' determinants do not tell them apart, "
+                   "and asking ik for that mode does not keep a solution on one of them")
+            warnings.warn(why, PkmWarning, stacklevel=3)
+            lines.append(why[0].upper() + why[1:] + ".")
+    return modes, lines
 
 
 def _check_at_reference(mech: Mechanism, model: ExportModel, kernels: list[cs.Function]) -> None:
@@ -244,7 +336,7 @@ def _check_at_reference(mech: Mechanism, model: ExportModel, kernels: list[cs.Fu
 
 def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, tuple[int, int, int]],
             blocks: dict[str, list[list[str]]], limits: list, fk: object, ik: object, version: str, stamp: str,
-            no_closed_form: str) -> str:
+            no_closed_form: str, modes: dict[str, dict[str, int]], mode_lines: list[str]) -> str:
     U = prefix.upper()
     step = lambda k: ops[k][0] + ops[k][1] + ops[k][2]
     lines = [
@@ -262,10 +354,13 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
     lines += [
         "",
         f"Forward kinematics: at most {U}_MAX_ITER = {MAX_ITER} evaluations of fk_step ({step('fk_step')} operations "
-        f"each), so at most {MAX_ITER * step('fk_step')} operations and a dense {len(fk.columns)} x {len(fk.columns)}"  # type: ignore[attr-defined]
-        " solve per iteration where the fixed pivots fail.",
+        f"each), so at most {MAX_ITER * step('fk_step')} operations where the fixed pivots hold; an iteration where "
+        f"they fail also evaluates fk_system ({step('fk_system')} operations), a Jacobi SVD and a dense "
+        f"{len(fk.columns)} x {len(fk.columns)} solve.",  # type: ignore[attr-defined]
         f"Inverse kinematics: at most {MAX_ITER} evaluations of ik_step ({step('ik_step')} operations each), at "
-        f"most {MAX_ITER * step('ik_step')} operations.",
+        f"most {MAX_ITER * step('ik_step')} operations where the fixed pivots hold; an iteration where they fail also "
+        f"evaluates ik_system ({step('ik_system')} operations), a Jacobi SVD and a dense {len(ik.columns)} x "  # type: ignore[attr-defined]
+        f"{len(ik.columns)} solve.",  # type: ignore[attr-defined]
         f"Converged when the largest closure residual (and task error) is at most {U}_TOL = {TOL:g} [m, rad].",
         (f"Closed-form inverse kinematics of the actuators ({prefix}_ik_actuators): {step('ik_closed')} operations, "
          "no iteration." if not no_closed_form else f"No closed-form inverse kinematics: {no_closed_form}."),
@@ -278,12 +373,18 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
             lines.append(f"  {kind} bit {bit}: {', '.join(cols)}")
         if not blocks[kind]:
             lines.append(f"  {kind}: none (one mode)")
+    lines += ["", f"Named mode ids ({U}_FK_MODE_*, {U}_IK_MODE_*, defined below; {prefix}_fk and {prefix}_ik take "
+              "them as mode):"]
+    lines += [f"  {U}_" + line.replace("fk_mode", f"{prefix}_fk_mode") if line.startswith(("FK_", "IK_"))
+              else f"  {line}" for line in mode_lines]
     lines += ["", "Joint limits checked: " + (", ".join(f"{n} [{lo:.6g}, {hi:.6g}]" for n, _, lo, hi in limits)
                                               or "none")]
     comment = "/*\n" + "".join(f" * {line}".rstrip() + "\n" for line in lines) + " */\n"
     guard = f"{U}_H"
     defs = [f"#define {U}_{k} {v}" for k, v in sizes.items()]
     defs.append(f"#define {U}_HAS_CLOSED_FORM {0 if no_closed_form else 1}")
+    defs += [f"#define {U}_{kind.upper()}_MODE_{key} {ident}" for kind in ("fk", "ik")
+             for key, ident in modes[kind].items()]
     defs += [f"#ifndef {U}_MAX_ITER\n#define {U}_MAX_ITER {MAX_ITER}\n#endif",
              f"#ifndef {U}_TOL\n#define {U}_TOL {TOL!r}\n#endif",
              f"#ifndef {U}_PIVOT_FLOOR\n#define {U}_PIVOT_FLOOR {PIVOT_FLOOR!r}\n#endif",
@@ -356,18 +457,21 @@ int main(void) {{
   double q_prev[{U}_NQ], q[{U}_NQ], y[{U}_NY], qa[{U}_NA], qa_ik[{U}_NA], qd[{U}_NA], qdd[{U}_NA], tau[{U}_NA];
   {prefix}_info info;
   int k, i, status = {U}_OK;
+  long mode;
   for (i = 0; i < {U}_NQ; ++i) q_prev[i] = {prefix}_q_reference[i];
   for (k = 1; k <= 10; ++k) {{
     for (i = 0; i < {U}_NA; ++i) qa[i] = q_prev[{prefix}_actuated_q[i]] + 0.002 * (i % 2 ? -1.0 : 1.0);
-    status = {prefix}_fk(qa, q_prev, 0, q, y, &info);
+    status = {prefix}_fk(qa, q_prev, {U}_FK_MODE_REFERENCE, q, y, &info);  /* (stay in the reference's assembly mode) */
     if (status != {U}_OK) {{ printf("fk: status %d (residual %g)\\n", status, info.residual); return 1; }}
     for (i = 0; i < {U}_NQ; ++i) q_prev[i] = q[i];
   }}
   printf("fk after 10 steps (%d iterations at the last):", info.iterations);
   for (i = 0; i < {U}_NY; ++i) printf(" %s=%.9g", {prefix}_task_names[i], y[i]);
   printf("\\n");
-  status = {prefix}_ik(y, q, 0, q_prev, qa_ik, &info);
-  printf("ik: status %d, actuated error %.3g\\n", status, qa_ik[0] - qa[0]);
+  status = {prefix}_ik(y, q, {U}_IK_MODE_REFERENCE, q_prev, qa_ik, &info);  /* (in the reference's working mode) */
+  printf("ik: status %d, mode %ld, actuated error %.3g\\n", status, info.mode, qa_ik[0] - qa[0]);
+  if ({prefix}_ik_mode(q, &mode) == {U}_OK)
+    printf("working mode id %ld%s\\n", mode, mode == {U}_IK_MODE_REFERENCE ? " (the reference's)" : "");
   for (i = 0; i < {U}_NA; ++i) {{ qd[i] = 0.1; qdd[i] = 1.0; }}
   status = {prefix}_inverse_dynamics(q, qd, qdd, tau, &info);
   printf("inverse dynamics: status %d, tau[0] = %.9g\\n", status, tau[0]);
@@ -376,4 +480,4 @@ int main(void) {{
 """
 
 
-__all__ = ["MAX_ITER", "STATUS", "TOL", "CLibrary", "ExportError", "export_c"]
+__all__ = ["MAX_ITER", "STATUS", "TOL", "CLibrary", "ExportError", "export_c", "mode_constants", "mode_id"]

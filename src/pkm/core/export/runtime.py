@@ -312,9 +312,10 @@ int p_ik_actuators(const double y[P_NY], long mode, double qa[P_NA], p_info* inf
 HEADER_CLOSED_FORM = r"""
 /* The actuated coordinates qa (P_NA) for the task value y (P_NY) in closed form, no iteration: each crank leg's
    circle-sphere intersection. mode: bit k set puts actuator k's leg on the branch opposite to the reference's
-   (negative: 0). NOT_CONVERGED: a leg cannot reach (info->residual: by how much, as 1 - |C| / rho); info->sigma_min:
-   the smallest leg margin 1 - |C| / rho (0 at a leg's inverse singularity); OUTSIDE_LIMITS: a task joint's or an
-   actuator's limit (info->joint). */
+   (negative: 0; its own numbering, per actuator: not a P_IK_MODE_* id, which numbers p_ik's blocks).
+   NOT_CONVERGED: a leg cannot reach (info->residual: by how much, as 1 - |C| / rho); info->sigma_min: the smallest
+   leg margin 1 - |C| / rho (0 at a leg's inverse singularity); OUTSIDE_LIMITS: a task joint's or an actuator's limit
+   (info->joint). */
 int p_ik_actuators(const double y[P_NY], long mode, double qa[P_NA], p_info* info);
 """
 
