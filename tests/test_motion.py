@@ -46,3 +46,15 @@ def test_malformed_motion_files_are_refused(tmp_path, text):
     path.write_text(text)
     with pytest.raises(SpecError):
         load_motions(path)
+
+
+@pytest.mark.parametrize(("dt", "times"), [(0.25, [0.0, 0.25, 0.5, 0.75, 1.0]), (0.6, [0.0, 0.6, 1.0]),
+                                            (0.4, [0.0, 0.4, 0.8, 1.0]), (0.1, [round(0.1 * k, 12) for k in range(11)])])
+def test_the_samples_span_the_case_whatever_its_step(dt, times):
+    """``round(duration / dt)`` steps ran past the case (dt = 0.6 over 1 s: a sample at 1.2 s) or stopped short of
+    it (dt = 0.4: the last at 0.8 s); the samples now end at the duration, with a shorter last step where dt does not
+    divide it."""
+    import dataclasses
+
+    case = dataclasses.replace(load_motions("prs3_motions.toml")["2"], duration=1.0, dt=dt)
+    assert np.allclose(case.times(), times, rtol=0, atol=1e-12)

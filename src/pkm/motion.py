@@ -106,9 +106,11 @@ class Motion:
     space: str = "task"
 
     def times(self) -> np.ndarray:
-        """Sample times ``0, dt, ..., duration`` [s]."""
-        n = round(self.duration / self.dt)
-        return np.arange(n + 1) * self.dt
+        """Sample times ``0, dt, 2 dt, ...`` up to ``duration`` [s], and ``duration`` itself where ``dt`` does not
+        divide it (a last, shorter step): the samples never stop short of the case nor run past it."""
+        n = math.floor(self.duration / self.dt + 1e-9)
+        t = np.arange(n + 1) * self.dt
+        return t if t[-1] >= self.duration * (1.0 - 1e-12) else np.append(t, self.duration)
 
     def sample(self, t=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(t, Y, Yd, Ydd)``: times (N,) and positions, velocities, accelerations (N, n)."""
