@@ -241,3 +241,15 @@ def test_a_registered_mechanism_brings_its_own_fast_path():
     assert set(closed_forms("gci")) == {"rrr3"} and "toy_scale" not in OBJECTIVES["gci"].options
     with pytest.raises(UnknownNameError, match="toy_scale"):
         sweeps.objective("gci:toy_scale=3")
+
+
+def test_a_design_that_does_not_follow_the_motion_fails_saying_where(tmp_path):
+    """The 3-PRS tilting at 3 rad/s for 1 s leaves its workspace at sample 9 of 21: its peak effort and power were
+    blank (NaN efforts read as None) with the status "ok"; the design now fails, naming the first jump."""
+    motion = tmp_path / "tilt.toml"
+    motion.write_text('format = "pkm.motion/1"\nmechanism = "prs3"\ncoordinates = ["z", "pitch", "roll"]\n'
+                      '[case.up]\nduration = 1.0\ndt = 0.05\nz = { law = "constant", value = 0.81 }\n'
+                      'pitch = { law = "linear", start = 0.0, rate = 3.0 }\nroll = { law = "constant", value = 0.0 }\n')
+    res = pkm.sweep("prs3", sweeps.grid(l=[1.0]), [f"peak_effort:file={motion},motion=up"], scheduler="serial")
+    (failure,) = res.failures()
+    assert not res.ok.any() and "does not follow motion 'up': at sample 9 of 21, did not converge" in failure["message"]

@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from pkm.errors import InvalidInputError, UnknownNameError
+from pkm.errors import InvalidInputError, PkmError, UnknownNameError
 from pkm.sweeps.family import Candidate
 from pkm.units import SI_UNITS, parse_quantity, split_range
 
@@ -453,7 +453,13 @@ def _motion(c: Candidate, o: Mapping[str, Any]):
         _, Y, Yd, Ydd = motion.sample(None if not o.get("samples") else np.linspace(0.0, motion.duration,
                                                                                    int(o["samples"])))
         order = [coords.index(k) for k in task.keys]
-        return pkm.follow_task(mech, Y[:, order], Yd[:, order], Ydd[:, order], efforts=True)
+        traj = pkm.follow_task(mech, Y[:, order], Yd[:, order], Ydd[:, order], efforts=True)
+        if traj.jumps:  # (NaN efforts, or a motion on another branch: no peak of this design's)
+            j = traj.jumps[0]
+            raise PkmError(f"the design does not follow motion {o['motion']!r}: at sample {j.index} of {len(traj)}, "
+                           f"{j.reason} ({j.detail})" + (f"; {len(traj.jumps) - 1} more jump(s)"
+                                                         if len(traj.jumps) > 1 else ""))
+        return traj
 
     return c.cached(("motion", o.get("file"), o["motion"], o.get("coordinates"), o.get("samples")), make)
 
