@@ -400,13 +400,13 @@ def _generic_volume(c, o):
 
 def _generic_conditioned_volume(c, o):
     m = _generic_map(c, o)
-    ci = m.condition_index(o["kind"])[m.reachable]
-    return float(np.count_nonzero(ci >= 1.0 / o["k_max"]) * m.cell)
+    return float(m.measure(m.reachable & (m.condition_index(o["kind"]) >= 1.0 / o["k_max"])))
 
 
 def _generic_weighted_volume(c, o):
     m = _generic_map(c, o)
-    return float(np.sum(m.condition_index(o["kind"])[m.reachable]) * m.cell)
+    ci = m.condition_index(o["kind"])[m.reachable]
+    return float(np.sum(ci) * m.cell if m.uniform else np.sum(ci * m.cells[m.reachable]))
 
 
 def _generic_condition(c, o):

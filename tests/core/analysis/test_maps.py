@@ -166,3 +166,19 @@ def test_the_old_name_warns_and_without_a_compiler_the_error_is_pkms(monkeypatch
     with pytest.raises(CompilerError, match="maps need a C compiler: no cc on PATH") as info:
         pkm.workspace_map(mech, {"x": [0.0]})
     assert isinstance(info.value, PkmError) and isinstance(info.value, RuntimeError)
+
+
+def test_an_unevenly_spaced_axis_measures_each_node_s_own_cell():
+    """The cell was the first two nodes' gap on every node: x = [0.45, 0.46, 0.50, 0.60] measured 0.04 m where the
+    span is 0.15 m. Each node now counts half the way to each neighbour (an end node its gap), an evenly spaced
+    grid as before (count x cell, bit for bit), and the size says its unit (an axis of one node has no extent)."""
+    mech = pkm.load("rrr3")
+    uneven = workspace_map(mech, {"x": [0.45, 0.46, 0.50, 0.60]}, length=0.1)
+    assert uneven.reachable.all() and not uneven.uniform
+    assert np.allclose(uneven.cells, [0.01, 0.025, 0.07, 0.1], rtol=1e-12)
+    assert uneven.size == pytest.approx(0.205, rel=1e-12) and uneven.size_unit == "m"
+    with pytest.raises(InvalidInputError, match="unevenly spaced"):
+        uneven.cell  # noqa: B018
+    even = workspace_map(mech, {"x": np.linspace(0.45, 0.5, 6), "yaw": [0.0, 0.05], "y": [0.29]}, length=0.1)
+    assert even.uniform and even.size == even.nodes * even.cell and even.size_unit == "m rad"
+    assert np.allclose(even.cells, even.cell, rtol=1e-12)

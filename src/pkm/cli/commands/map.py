@@ -53,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("--index draws one or two axes: leave --png out of a 3-D map (its CSV has every node)")
     m = workspace_map(mech, axes, fixed, branch=args.branch, length=length, configurations=bool(args.index))
     out: dict[str, Any] = {"mechanism": mech.name, "axes": {n: [float(v[0]), float(v[-1]), len(v)] for n, v in m.axes},
-                           "nodes": int(m.reachable.size), "reachable": m.nodes, "size_SI": m.size,
+                           "nodes": int(m.reachable.size), "reachable": m.nodes, "size_SI": m.size, "size_unit": m.size_unit,
                            "gci_2": m.gci("2"), "gci_fro_normalized": m.gci("fro_normalized"), "how": m.how}
     figures: Any = m
     if args.index:

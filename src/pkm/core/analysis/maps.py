@@ -92,14 +92,56 @@ class WorkspaceMap:
         return int(self.reachable.sum())
 
     @property
+    def uniform(self) -> bool:
+        """Whether every axis of more than one node is evenly spaced (relative 1e-9): then every node's cell is
+        :attr:`cell`."""
+        return all(len(v) < 3 or np.ptp(np.diff(v)) <= 1e-9 * np.abs(np.diff(v)).max() for _, v in self.axes)
+
+    @property
     def cell(self) -> float:
-        """The size of one grid cell: the product of the axes' steps (m, m^2, m^3 or with rad)."""
+        """The size of one grid cell: the product of the axes' steps (in :attr:`size_unit`; an axis of one node
+        counts 1, no extent).
+
+        Raises:
+            InvalidInputError: an axis is unevenly spaced: its nodes' cells differ (:attr:`cells`).
+        """
+        if not self.uniform:
+            raise InvalidInputError("axes", "an axis is unevenly spaced, so the nodes' cells differ: use cells "
+                                            "or measure()", [n for n, _ in self.axes])
         return float(np.prod([abs(v[1] - v[0]) if len(v) > 1 else 1.0 for _, v in self.axes]))
 
     @property
+    def cells(self) -> np.ndarray:
+        """Each node's cell, shaped as the arrays: the product over the axes of the node's width, half the way to
+        each neighbour (an end node's: its gap to its neighbour; an axis of one node: 1). On an evenly spaced grid
+        every one is :attr:`cell`."""
+        widths = []
+        for _, v in self.axes:
+            d = np.abs(np.diff(v))
+            widths.append(np.ones(1) if len(v) == 1 else np.concatenate([d[:1], (d[:-1] + d[1:]) / 2.0, d[-1:]]))
+        out = np.ones(())
+        for w in reversed(widths):  # (arrays run from the last axis to the first)
+            out = np.multiply.outer(out, w)
+        return out
+
+    def measure(self, mask: np.ndarray | None = None) -> float:
+        """The size of the nodes of ``mask`` (default: the reachable ones), in :attr:`size_unit`: their count times
+        :attr:`cell` on an evenly spaced grid, else the sum of their :attr:`cells`."""
+        mask = self.reachable if mask is None else np.asarray(mask, dtype=bool)
+        return int(mask.sum()) * self.cell if self.uniform else float(self.cells[mask].sum())
+
+    @property
     def size(self) -> float:
-        """The reachable region's length, area or volume: reachable nodes times :attr:`cell`."""
-        return self.nodes * self.cell
+        """The reachable region's length, area or volume (:meth:`measure`; in :attr:`size_unit`)."""
+        return self.measure()
+
+    @property
+    def size_unit(self) -> str:
+        """The unit of :attr:`size` and :attr:`cell`: the product of the units of the axes of more than one node
+        (``"m^2"``, ``"m rad"``; ``"1"`` when no axis has two nodes)."""
+        units = [("m" if kind == "length" else "rad") for (_, v), kind in zip(self.axes, self.kinds) if len(v) > 1]
+        out = [f"{u}^{units.count(u)}" if units.count(u) > 1 else u for u in dict.fromkeys(units)]
+        return " ".join(out) or "1"
 
     def reachable_over(self, axis: str, mode: str = "any") -> np.ndarray:
         """The workspace over one axis (an orientation, say): nodes of the other axes reachable at some value of
