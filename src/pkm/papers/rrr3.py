@@ -189,25 +189,34 @@ def _value(g: maps.Gci) -> float | None:
     return None if g.empty else g.value
 
 
-#: The one-line reason of each row that misses (Row.why; the report's summary quotes it).
+#: The one-line reason of each row that misses (Row.why; the report's summary quotes it): ``{miss}`` is the row's
+#: difference to print and ``{ours}`` its value, written from the row (:func:`_why`).
 WHY_SHORT = {
-    "fig5.gci": "1.2e-4 off under the reading that matches Figs. 6, 7, 9; not the grid (the overall GCI hardly moves "
+    "fig5.gci": "{miss} off under the reading that matches Figs. 6, 7, 9; not the grid (the overall GCI hardly moves "
                 "with it)",
     "fig5.gci_area": "the area GCI moves by +-5e-3 with the unprinted node spacing; 2 mm, which matches Figs. 6, 7 "
-                     "and 9, misses this one by 7e-4",
+                     "and 9, misses this one by {miss}",
     "fig7.gci": "the similarity law makes Fig. 7's overall GCI equal Fig. 9's, printed 0.4214 and 0.4215: both "
                 "cannot match",
 }
 
 #: Why a row may miss its published value by more than the last printed digit (read in the report).
 WHY_NOT = {
-    "fig5.gci": "Where it misses: by ~1.3e-4, under the reading that matches Figs. 6, 7 and 9; the overall "
+    "fig5.gci": "Where it misses: by {miss}, under the reading that matches Figs. 6, 7 and 9; the overall "
                 "GCI hardly moves with the unprinted node spacing (10..1 mm), so the cause is not the grid. ",
     "fig5.gci_area": "Where it misses: the area GCI depends on the unprinted node spacing (+-5e-3 over "
-                     "10..1 mm); 2 mm matches Figs. 6, 7, 9 and misses this one by ~8e-4. ",
-    "fig7.gci": "Where it misses: under the similarity law Fig. 7's overall GCI equals Fig. 9's (ours 0.42153 "
+                     "10..1 mm); 2 mm matches Figs. 6, 7, 9 and misses this one by {miss}. ",
+    "fig7.gci": "Where it misses: under the similarity law Fig. 7's overall GCI equals Fig. 9's (ours {ours} "
                 "for both); the paper prints 0.4214 here and 0.4215 for Fig. 9, so both cannot match. ",
 }
+
+
+def _why(texts: dict[str, str], key: str, computed: float | None, published: float) -> str:
+    """``texts[key]`` (or nothing) with the row's own numbers written in: its difference to print and its value."""
+    text = texts.get(key, "")
+    if not text or computed is None:
+        return text
+    return text.format(miss=f"{abs(computed - published):.1e}", ours=f"{computed:.5f}")
 
 
 @cached_rows("rrr3")
@@ -230,12 +239,14 @@ def reproduce() -> list[Row]:
     for name, source in (("fig5", "Fig. 5"), ("fig6", "Fig. 6"), ("fig7", "Fig. 7"), ("fig9", "Fig. 9")):
         m = figure_map(name)
         p_all, p_area = PUBLISHED[name]
-        rows.append(Row(f"rrr3.{name}.gci", p_all, _value(m.gci()), "", TOLERANCE, source,
-                        notes[name] + WHY_NOT.get(f"{name}.gci", "") + reading, why=WHY_SHORT.get(f"{name}.gci", "")))
-        rows.append(Row(f"rrr3.{name}.gci_area", p_area, _value(m.area_gci()), "", TOLERANCE, source,
-                        notes[name] + WHY_NOT.get(f"{name}.gci_area", "") + "30 x 30 cm square centred on the "
-                        "base centroid, edges included, reachable nodes only. " + reading,
-                        why=WHY_SHORT.get(f"{name}.gci_area", "")))
+        g, g_area = _value(m.gci()), _value(m.area_gci())
+        rows.append(Row(f"rrr3.{name}.gci", p_all, g, "", TOLERANCE, source,
+                        notes[name] + _why(WHY_NOT, f"{name}.gci", g, p_all) + reading,
+                        why=_why(WHY_SHORT, f"{name}.gci", g, p_all)))
+        rows.append(Row(f"rrr3.{name}.gci_area", p_area, g_area, "", TOLERANCE, source,
+                        notes[name] + _why(WHY_NOT, f"{name}.gci_area", g_area, p_area) + "30 x 30 cm square centred "
+                        "on the base centroid, edges included, reachable nodes only. " + reading,
+                        why=_why(WHY_SHORT, f"{name}.gci_area", g_area, p_area)))
     study = mode_study()
     detail = "; ".join(f"mode{m}: GCI {g:.4f}, {c} sign changes of det J_x" for m, g, _, c in study)
     rows.append(Row("rrr3.modes.suitable", SUITABLE_MODES, suitable_modes(), "", None, "sec. VIII, Fig. 8",
