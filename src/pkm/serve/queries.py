@@ -260,7 +260,8 @@ def dynamics(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> d
 def capability(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations ``q``, the ``kind`` capability (``wrench``, ``twist``, ``acceleration``) under the
     actuators' limits: the largest value along each task axis each way, the largest isotropic value per unit, the
-    polytope's vertices (:func:`pkm.capability`)."""
+    polytope's vertices (:func:`pkm.capability`), ``origin_inside`` (1, or 0 where the actuators cannot hold the
+    weight: the indices are then 0)."""
     from pkm.core.analysis.capability import KINDS
     from pkm.core.analysis.capability import capability as run
 
@@ -272,9 +273,9 @@ def capability(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) ->
     def one(k: int) -> dict[str, Any]:
         c = run(mech, q[k], kind)
         return {"along": np.array(list(c.along.values())), "vertices": c.polytope.vertices,
-                "isotropic": np.array(list(c.isotropic.values()))}
+                "isotropic": np.array(list(c.isotropic.values())), "origin_inside": float(c.origin_inside)}
 
-    out = _columns(_each(len(q), one), ("along", "vertices", "isotropic"))
+    out = _columns(_each(len(q), one), ("along", "vertices", "isotropic", "origin_inside"))
     c0 = run(mech, mech.q_reference, kind) if len(q) else None
     if c0 is not None:
         out["axes"] = list(c0.polytope.axes)

@@ -128,3 +128,27 @@ def test_the_compiled_map_gives_the_pointwise_capability(name):
     assert np.array_equal(python.reachable, cm.reachable)
     with pytest.raises(InvalidInputError, match="configurations=True"):
         map_capability(mech, workspace_map(mech, axes, fixed, length=length), "wrench")
+
+
+def test_both_map_routes_count_the_nodes_where_the_weight_cannot_be_held():
+    """A Delta whose motors give 0.1834 N m holds its weight only at the centre of x in [-15, 15] cm: the compiled
+    route kept the other nodes (indices 0) and the Python route dropped them, so ``pkm map --index`` and ``pkm
+    capability --axis`` disagreed on the same map. Both now keep them, with their indices 0, and say how many
+    (``below_weight``, ``inside``); the pointwise capability says so too (``origin_inside``)."""
+    import dataclasses
+
+    from pkm.core.analysis.capability import capability_map, map_capability
+    from pkm.core.analysis.maps import workspace_map
+
+    weak = pkm.load("delta")
+    weak.actuators = tuple(dataclasses.replace(a, effort_limit=0.1834) for a in weak.actuators)
+    xs = np.linspace(-0.15, 0.15, 7)
+    python = capability_map(weak, {"x": xs})
+    compiled = map_capability(weak, workspace_map(weak, {"x": xs}, configurations=True))
+    for cm in (python, compiled):
+        assert cm.reachable.all() and cm.inside.tolist() == [False] * 3 + [True] + [False] * 3
+        assert cm.below_weight == 6 and cm.summary()["below_weight"] == 6
+        assert (cm.isotropic["N"][~cm.inside] == 0.0).all() and cm.isotropic["N"][3] > 0.0
+    assert np.allclose(python.isotropic["N"], compiled.isotropic["N"], rtol=1e-9, atol=0)
+    assert not capability(weak, pkm.solve_ik(weak, {"x": xs[0], "y": 0.0, "z": weak.task_map.named(
+        weak.q_reference)["z"]}).q).origin_inside

@@ -57,6 +57,9 @@ def run(args: argparse.Namespace) -> int:
         for axis, (plus, minus) in r["along"].items():
             print(f"  {axis:>8}  +{plus:.6g} / -{minus:.6g} {r['units'][axis]}")
         print("  isotropic: " + ", ".join(f"{v:.6g} {u}" for u, v in r["isotropic"].items()))
+        if not r["origin_inside"]:
+            print("  the actuators cannot hold the mechanism's weight here (the set excludes the origin): every "
+                  "index is 0")
     return 0
 
 
@@ -75,7 +78,7 @@ def _map(mech, args: argparse.Namespace) -> int:
         raise InvalidInputError("--joints", "a map fixes task coordinates: give --pose for those off the axes")
     cm = capability_map(mech, axes, fixed, kind, gravity=not args.no_gravity)
     out: dict[str, Any] = {"mechanism": mech.name, "kind": kind, "nodes": int(cm.reachable.size),
-                           "reachable": int(cm.reachable.sum()), "fixed": cm.fixed,
+                           "reachable": int(cm.reachable.sum()), "below_weight": cm.below_weight, "fixed": cm.fixed,
                            "isotropic": {u: {"min": float(np.nanmin(v)), "max": float(np.nanmax(v))}
                                          for u, v in cm.isotropic.items()} if cm.reachable.any() else {}}
     if args.png:
@@ -83,7 +86,9 @@ def _map(mech, args: argparse.Namespace) -> int:
     if args.csv:
         out["csv"] = cm.write_csv(args.csv)
     print(json.dumps(jsonable(out), indent=2) if args.json else
-          f"{mech.name}: {kind} capability over {out['nodes']} nodes, {out['reachable']} reachable; isotropic "
+          f"{mech.name}: {kind} capability over {out['nodes']} nodes, {out['reachable']} reachable"
+          + (f" ({cm.below_weight} where the actuators cannot hold the weight: indices 0)" if cm.below_weight else "")
+          + "; isotropic "
           + ", ".join(f"{v['min']:.6g} to {v['max']:.6g} {u}" for u, v in out["isotropic"].items()))
     return 0
 

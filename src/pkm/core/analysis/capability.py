@@ -198,16 +198,16 @@ def capability(mech: Mechanism, q: ArrayLike, kind: str = "wrench", *, gravity: 
 
 def capability_indices(mech: Mechanism, Q: ArrayLike, kind: str = "wrench", *, gravity: bool = True,
                        kernels: Kernels | None = None) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]],
-                                                                dict[str, np.ndarray], np.ndarray]:
+                                                                dict[str, np.ndarray], np.ndarray, np.ndarray]:
     """The indices of :func:`capability` at many closed configurations ``Q`` (n x nq) at once, from the compiled
     kernels (:class:`pkm.Kernels`: ``J``, ``g_a``, ``M_a`` in batches) and the half-spaces in closed form: the set
     is ``{x : A x ≤ b}``, ``A = [P; -P]``, ``b = [hi - s; s - lo]``, with ``P = Jᵀ, s = g_a`` (wrenches),
     ``P = J⁻¹, s = 0`` (twists), ``P = M_a J⁻¹, s = g_a`` (accelerations from rest); along a unit direction ``d``
     the extent is ``min b_r / (A d)_r`` over the rows ``d`` approaches, and the isotropic value of a unit group
     ``min b_r / |A_r|`` on that group's columns, as :class:`Polytope` computes them one pose at a time (one rule,
-    ``_reach``). Returns ``(along, isotropic, regular)``: ``{axis: (plus, minus)}`` and ``{unit: values}`` (n each;
-    0 where the origin is outside, NaN where ``J`` is singular, as :func:`capability` refuses) and the mask of the
-    regular samples.
+    ``_reach``). Returns ``(along, isotropic, regular, inside)``: ``{axis: (plus, minus)}`` and ``{unit: values}`` (n
+    each; 0 where the origin is outside, NaN where ``J`` is singular, as :func:`capability` refuses), the mask of
+    the regular samples and that of the samples whose set holds the origin (the actuators hold the weight there).
 
     Raises:
         InvalidInputError: as :func:`capability` (kind, limits, redundant actuation).
@@ -247,7 +247,7 @@ def capability_indices(mech: Mechanism, Q: ArrayLike, kind: str = "wrench", *, g
     along = {a: (finish(_reach(b, A[:, :, i])), finish(_reach(b, -A[:, :, i]))) for i, a in enumerate(axes)}
     iso = {u: finish(_reach(b, np.linalg.norm(A[:, :, [i for i, x in enumerate(units) if x == u]], axis=2)))
            for u in dict.fromkeys(units)}
-    return along, iso, regular
+    return along, iso, regular, inside & regular
 
 
 def map_capability(mech: Mechanism, wmap: WorkspaceMap, kind: str = "wrench", *, gravity: bool = True,
@@ -266,8 +266,8 @@ def map_capability(mech: Mechanism, wmap: WorkspaceMap, kind: str = "wrench", *,
                                         "configurations=True)", wmap)
     shape = wmap.reachable.shape
     nodes = np.flatnonzero(wmap.reachable.ravel())
-    along_n, iso_n, regular = capability_indices(mech, wmap.q.reshape(-1, mech.nq)[nodes], kind, gravity=gravity,
-                                                 kernels=kernels)
+    along_n, iso_n, regular, inside_n = capability_indices(mech, wmap.q.reshape(-1, mech.nq)[nodes], kind,
+                                                           gravity=gravity, kernels=kernels)
 
     def spread(values: np.ndarray) -> np.ndarray:
         out = np.full(int(np.prod(shape)), np.nan)
@@ -276,13 +276,15 @@ def map_capability(mech: Mechanism, wmap: WorkspaceMap, kind: str = "wrench", *,
 
     reachable = np.zeros(int(np.prod(shape)), dtype=bool)
     reachable[nodes[regular]] = True
+    inside = np.zeros(int(np.prod(shape)), dtype=bool)
+    inside[nodes[inside_n]] = True
     kinds = mech.task_map.kinds
     names = {n for n, _ in wmap.axes}
     fixed = {k: float(v) for k, v in zip(mech.task_map.value_names, wmap.fixed) if k not in names}
     return CapabilityMap(kind, wmap.axes, fixed, reachable.reshape(shape),
                          {a: (spread(p), spread(m)) for a, (p, m) in along_n.items()},
                          {u: spread(v) for u, v in iso_n.items()},
-                         {a: UNITS[kind][kinds[a]] for a in kinds}, dict(kinds), mech.name)
+                         {a: UNITS[kind][kinds[a]] for a in kinds}, dict(kinds), mech.name, inside.reshape(shape))
 
 
 MAX_MAP_NODES = 250_000  # nodes of a capability map at most (each an IK solve and a capability: about 2 ms)
@@ -297,13 +299,16 @@ class CapabilityMap:
         axes: ``(name, values)`` per grid axis (1 or 2), the first the fastest; arrays are shaped
             ``(n_last, ..., n_first)``.
         fixed: The other task coordinates by name.
-        reachable: Nodes solved (inverse kinematics converged, regular, the origin inside the set).
+        reachable: Nodes solved (inverse kinematics converged, the Jacobian regular); where the set does not hold
+            the origin (the actuators cannot hold the weight there) the node counts, its indices 0 (:attr:`inside`).
         along: ``{axis: (plus, minus)}`` arrays: the largest value along each task axis each way (NaN where
             unreachable).
         isotropic: ``{unit: array}``: the largest isotropic value of each unit group.
         units: Each task axis' unit (of the capability); ``kinds``: each task coordinate's kind (``"length"``,
             ``"angle"``).
         mechanism: The mechanism's name.
+        inside: The reachable nodes whose set holds the origin (elsewhere the indices are 0: the actuators cannot
+            hold the weight there); None: every reachable node's does.
     """
 
     kind: str
@@ -315,6 +320,13 @@ class CapabilityMap:
     units: dict[str, str]
     kinds: dict[str, str]
     mechanism: str = ""
+    inside: np.ndarray | None = None
+
+    @property
+    def below_weight(self) -> int:
+        """How many reachable nodes' sets exclude the origin: the actuators cannot hold the weight there (their
+        indices are 0)."""
+        return 0 if self.inside is None else int(np.count_nonzero(self.reachable & ~self.inside))
 
     def figure(self, path: str, unit: str | None = None, *, along: str | None = None, negative: bool = False) \
             -> str:
@@ -373,7 +385,8 @@ class CapabilityMap:
 
 
     def write_csv(self, path: str) -> str:
-        """One row per node: the axes' coordinates (SI), ``reachable``, the largest value along each task axis each
+        """One row per node: the axes' coordinates (SI), ``reachable``, ``origin_inside`` (0: the actuators cannot
+        hold the weight there, the indices are 0), the largest value along each task axis each
         way (``<axis>_plus``, ``<axis>_minus``) and the isotropic values (``isotropic [<unit>]``; NaN where
         unreachable)."""
         import csv
@@ -382,6 +395,8 @@ class CapabilityMap:
         mesh = np.meshgrid(*[v for _, v in reversed(self.axes)], indexing="ij")
         cols = {name: m.ravel() for (name, _), m in zip(reversed(self.axes), mesh)}
         cols["reachable"] = self.reachable.ravel().astype(float)
+        if self.inside is not None:
+            cols["origin_inside"] = self.inside.ravel().astype(float)
         for a, (plus, minus) in self.along.items():
             cols[f"{a}_plus"], cols[f"{a}_minus"] = plus.ravel(), minus.ravel()
         for u, v in self.isotropic.items():
@@ -396,12 +411,14 @@ class CapabilityMap:
 
     def summary(self) -> dict:
         """The indices' ranges over the reachable nodes: ``{"along": {axis: {"plus": [min, max], "minus": [...]}},
-        "isotropic": {unit: [min, max]}, "units": ...}`` (empty where no node is reachable)."""
+        "isotropic": {unit: [min, max]}, "units": ..., "below_weight": n}`` (empty where no node is reachable;
+        ``below_weight``: the nodes where the actuators cannot hold the weight, whose indices are 0)."""
         if not self.reachable.any():
-            return {"along": {}, "isotropic": {}, "units": self.units}
+            return {"along": {}, "isotropic": {}, "units": self.units, "below_weight": 0}
         span = lambda v: [float(np.nanmin(v[self.reachable])), float(np.nanmax(v[self.reachable]))]
         return {"along": {a: {"plus": span(p), "minus": span(m)} for a, (p, m) in self.along.items()},
-                "isotropic": {u: span(v) for u, v in self.isotropic.items()}, "units": self.units}
+                "isotropic": {u: span(v) for u, v in self.isotropic.items()}, "units": self.units,
+                "below_weight": self.below_weight}
 
 
 def capability_map(mech: Mechanism, axes: Mapping[str, ArrayLike], fixed: Mapping[str, float] | None = None,
@@ -440,6 +457,7 @@ def capability_map(mech: Mechanism, axes: Mapping[str, ArrayLike], fixed: Mappin
     _limits(mech, kind)  # (the refusal before any solve)
     shape = tuple(len(v) for _, v in reversed(grid))
     reachable = np.zeros(shape, dtype=bool)
+    inside = np.zeros(shape, dtype=bool)
     along = {a: (np.full(shape, np.nan), np.full(shape, np.nan)) for a in names}
     iso: dict[str, np.ndarray] = {}
     units: dict[str, str] = {}
@@ -459,15 +477,14 @@ def capability_map(mech: Mechanism, axes: Mapping[str, ArrayLike], fixed: Mappin
                 continue
             if i == 0:
                 q_row = q
-            if not c.origin_inside:
-                continue
-            reachable[idx] = True
+            reachable[idx], inside[idx] = True, c.origin_inside  # (outside: indices 0, the node counts)
             for a in names:
                 along[a][0][idx], along[a][1][idx] = c.along[a]
             units = dict(zip(c.polytope.axes, c.polytope.units))
             for u, r in c.isotropic.items():
                 iso.setdefault(u, np.full(shape, np.nan))[idx] = r
-    return CapabilityMap(kind, tuple(grid), rest, reachable, along, iso, units, dict(mech.task_map.kinds), mech.name)
+    return CapabilityMap(kind, tuple(grid), rest, reachable, along, iso, units, dict(mech.task_map.kinds), mech.name,
+                         inside)
 
 
 __all__ = ["KINDS", "MAX_MAP_NODES", "UNITS", "Capability", "CapabilityMap", "Polytope", "capability", "capability_map"]
