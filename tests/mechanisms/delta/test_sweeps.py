@@ -21,11 +21,19 @@ def value(spec: str, candidate):
 
 
 def test_declared_forms_and_units():
-    """Four closed forms; the volumes are in m^3 and read the grid spacing (8 mm by default); condition is unitless."""
+    """Four closed forms; the volumes are in m^3 and read the grid spacing (by default (La + Lb) / 55: 8 mm at the
+    paper's design, twice that at a design twice as large, where a fixed 8 mm made a small design's volume 6 %
+    off); condition is unitless."""
+    from pkm.mechanisms.delta.sweeps import _spacing
+
     assert set(CLOSED_FORMS) == {"workspace_volume", "conditioned_volume", "weighted_volume", "condition"}
     assert {k: f.unit for k, f in CLOSED_FORMS.items()} == {"workspace_volume": "m^3", "conditioned_volume": "m^3",
                                                            "weighted_volume": "m^3", "condition": ""}
-    assert OPTIONS["spacing"][:2] == ("length", 0.008)
+    assert OPTIONS["spacing"][:2] == ("length", None)
+    default = sweeps.objective("workspace_volume").options
+    paper, double = RegisteredFamily("delta").candidate({}), RegisteredFamily("delta").candidate(DOUBLE)
+    assert _spacing(paper, default) == pytest.approx(0.008, rel=1e-12)
+    assert _spacing(double, default) == pytest.approx(0.016, rel=1e-12)
     family = RegisteredFamily("delta")
     assert sweeps.objective("workspace_volume").describe(family)["unit"] == "m^3"
 

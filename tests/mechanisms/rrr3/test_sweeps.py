@@ -23,11 +23,18 @@ def values(candidate, step: str = "4cm", side: str = "30cm") -> dict:
 
 
 def test_declared_forms_units_and_options():
-    """Five closed forms; workspace_volume is an area (m^2); they read the grid step (1 cm) and the side of the
-    area of interest (30 cm)."""
+    """Five closed forms; workspace_volume is an area (m^2); they read the grid step (by default the library's,
+    relative to the design's size: a fixed 1 cm made a 5 % design's GCI 0.370 from 10 nodes against 0.421) and the
+    side of the area of interest (30 cm)."""
+    from pkm.mechanisms.rrr3 import workspace as ws
+
     assert set(CLOSED_FORMS) == set(NAMES)
     assert {k: f.unit for k, f in CLOSED_FORMS.items()} == {**dict.fromkeys(NAMES, ""), "workspace_volume": "m^2"}
-    assert (OPTIONS["step"][:2], OPTIONS["side"][:2]) == (("length", 0.01), ("length", 0.30))
+    assert (OPTIONS["step"][:2], OPTIONS["side"][:2]) == (("length", None), ("length", 0.30))
+    c = RegisteredFamily("rrr3").candidate({})
+    d = ws.Design.of(c.params)
+    expected = ws.ci_map(d, ws.workspace_grid(d), ws.CiSettings(branch=c.params.branch)).gci().value
+    assert CLOSED_FORMS["gci"].function(c, sweeps.objective("gci").options) == expected
 
 
 def test_the_paper_design_shares_one_map_and_its_values_are_consistent():

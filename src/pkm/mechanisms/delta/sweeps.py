@@ -11,16 +11,24 @@ from pkm.errors import UnknownNameError
 from pkm.sweeps.objectives import ClosedForm
 from pkm.units import parse_quantity
 
+#: Cells across the grid's half side ``La + Lb`` by default (8 mm at the paper's design), so that every design's
+#: grid is as fine relative to its size: a fixed step made a small design's volume 6 % off (15 %: 13 cells).
+CELLS = 55
+
 #: The option the workspace grid reads (beyond the objectives' own).
-OPTIONS = {"spacing": ("length", 0.008, "Delta closed form: workspace grid step")}
+OPTIONS = {"spacing": ("length", None, f"Delta closed form: workspace grid step (default (La + Lb) / {CELLS})")}
+
+
+def _spacing(c, o) -> float:
+    return o["spacing"] if o["spacing"] is not None else (c.params.La + c.params.Lb) / CELLS
 
 
 def _grid(c, o):
     from pkm.mechanisms.delta.workspace import workspace
 
-    kind = o["kind"]
-    return c.cached(("delta_grid", o["spacing"], kind, o["branch"]),
-                    lambda: workspace(c.params, o["spacing"], o["branch"] or "knee_out", (kind,)))
+    kind, spacing = o["kind"], _spacing(c, o)
+    return c.cached(("delta_grid", spacing, kind, o["branch"]),
+                    lambda: workspace(c.params, spacing, o["branch"] or "knee_out", (kind,)))
 
 
 def _K(c, o):
@@ -33,11 +41,11 @@ def workspace_volume(c, o):
 
 
 def conditioned_volume(c, o):
-    return float(np.count_nonzero(_K(c, o) <= o["k_max"]) * o["spacing"] ** 3)
+    return float(np.count_nonzero(_K(c, o) <= o["k_max"]) * _spacing(c, o) ** 3)
 
 
 def weighted_volume(c, o):  # (summed in ascending K, as the serial study's sorted nodes: the same float)
-    return float(np.sum(1.0 / np.sort(_K(c, o))) * o["spacing"] ** 3)
+    return float(np.sum(1.0 / np.sort(_K(c, o))) * _spacing(c, o) ** 3)
 
 
 def condition(c, o):

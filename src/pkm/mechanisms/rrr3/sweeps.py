@@ -9,7 +9,8 @@ import numpy as np
 from pkm.sweeps.objectives import ClosedForm
 
 #: The options the maps read (beyond the objectives' own).
-OPTIONS = {"step": ("length", 0.01, "3-RRR closed form: grid step"),
+OPTIONS = {"step": ("length", None, "3-RRR closed form: grid step (default the library's: 1/100 of the grid's half "
+                                   "side a + b + H/sqrt3, as fine relative to every design)"),
            "side": ("length", 0.30, "3-RRR closed form: side of the square area of interest")}
 
 
