@@ -54,6 +54,10 @@ def test_the_delta_excitation_is_better_conditioned_and_keeps_its_limits():
     hi = mech.model.upperPositionLimit[mech.act_q]
     assert np.all(qa >= lo) and np.all(qa <= hi)
     assert np.abs(qa - mech.actuated_q(mech.q_reference)).max() <= 0.3 + 1e-9  # (the default amplitude)
+    ref = mech.actuated_q(mech.q_reference)  # the bounds used, stated: the tighter of the limits and ref +- 0.3
+    assert np.allclose(e.bounds, np.column_stack([np.maximum(lo, ref - 0.3), np.minimum(hi, ref + 0.3)]), rtol=0,
+                       atol=1e-15)
+    assert np.all(qa >= e.bounds[:, 0] - 1e-12) and np.all(qa <= e.bounds[:, 1] + 1e-12)
 
 
 def test_the_samples_table_holds_the_motion(tmp_path):

@@ -18,8 +18,9 @@ stop. Every objective evaluation closes the loops along the samples warm-started
 builds: :meth:`pkm.Kernels.close_loops_path`) and stacks the compiled regressor.
 
 **Constraints**, at the ``M`` samples: each actuated coordinate within its joint limits and within ``amplitude``
-of its reference (``amplitude`` [rad or m] bounds the motion where the model's limits do not, as on most shipped
-mechanisms), each rate within its actuator's speed limit, each effort (the model's own parameters: ``Y θ``)
+of its reference, whichever is tighter (``amplitude`` [rad or m], default :data:`AMPLITUDE`: the bound where the
+model states no limit, as on most shipped mechanisms, and the tighter one where its limits are wider;
+:attr:`Excitation.bounds` holds the bounds used), each rate within its actuator's speed limit, each effort (the model's own parameters: ``Y θ``)
 within its actuator's continuous limit. After the optimisation, on a resampling ``DENSE`` times finer, every
 constraint is checked again, the passive joints' limits too, and the distance to every singularity
 (:func:`pkm.diagnose`'s ``direct_distance`` and ``inverse_distance``) must stay above ``singularity`` (default
@@ -84,6 +85,8 @@ class Excitation:
             ``"singularity"``: the smallest distance over the bound).
         shrunk: How many times the motion was shrunk after the optimisation (module doc).
         iterations: SLSQP's iterations.
+        bounds: Each actuated coordinate's position bounds used (na x 2) [rad or m]: the tighter of its joint limits
+            and ``amplitude`` about its reference.
     """
 
     joints: tuple[str, ...]
@@ -101,6 +104,7 @@ class Excitation:
     margins: dict[str, float] = field(default_factory=dict)
     shrunk: int = 0
     iterations: int = 0
+    bounds: np.ndarray | None = None
 
     @property
     def omega(self) -> float:
@@ -260,7 +264,8 @@ def excite(mech: Mechanism, *, period: float = 10.0, harmonics: int = 5, samples
     _, qd, qdd, Q, W = state(x, dense)
     offset, a, b = unpack(x)
     return Excitation(tuple(mech.actuated_names), period, offset, a, b, float(np.exp(log_condition(x))), start,
-                      dense, Q, qd, qdd, (W @ theta).reshape(len(dense), na), checked, shrunk, int(res.nit))
+                      dense, Q, qd, qdd, (W @ theta).reshape(len(dense), na), checked, shrunk, int(res.nit),
+                      np.column_stack([lo, hi]))
 
 
 def _check(mech: Mechanism, s: tuple[np.ndarray, ...], lo: np.ndarray, hi: np.ndarray, half: np.ndarray,
