@@ -61,13 +61,14 @@ def test_the_generic_condition_number_agrees_with_the_delta_closed_form():
 
 def test_the_generic_reachable_interval_agrees_with_the_hexapod_closed_form():
     """beta's reachable length at the reference pose: a 1-degree scan of the compiled map against the exact
-    intervals (within two scan steps)."""
+    intervals (within half a scan step: each gap between two reachable nodes counts; nodes times the step overstated
+    each reachable run by a step, 2.3737 against 2.3575 rad at the paper's design)."""
     res = pkm.sweep("hexapod", sweeps.table({"h": [0.034]}),
                     ["reachable_interval", "scan=reachable_interval:route=generic,parameter=beta_1,"
                                            "range=-90deg:90deg:181", "beta_gain"], scheduler="serial")
     assert res.ok.all(), res.failures()
     exact, scan = res.column("reachable_interval")[0], res.column("scan")[0]
-    assert 1.0 < exact <= math.pi and abs(scan - exact) <= 2 * math.radians(1.0)
+    assert 1.0 < exact <= math.pi and abs(scan - exact) <= 0.5 * math.radians(1.0)
     assert res.column("beta_gain")[0] > 0.0  # beta* beats the reference beta (0)
 
 

@@ -481,14 +481,15 @@ def _operation_count(c, o):
 
 
 def _generic_interval(c, o):
-    """Length of the reachable part of ``parameter`` (a task joint) over ``range`` at the pose: a 1-D map."""
+    """Length of the reachable part of ``parameter`` (a task joint) over ``range`` at the pose: a 1-D map, each gap
+    between two neighbouring reachable nodes counted (nodes times the step overstated each reachable run by a step)."""
     name = o.get("parameter")
     if not name or not o.get("range"):
         raise InvalidInputError("parameter", "give parameter=TASK_JOINT and range=START:STOP:COUNT")
     m = _generic_map(c, {**o, "region": {name: o["range"]}, "length": o.get("length") or 1.0})  # (reach only)
     (_, values), = m.axes
-    step = float(values[1] - values[0]) if len(values) > 1 else 0.0
-    return float(np.count_nonzero(m.reachable) * step)
+    reach = m.reachable.ravel()
+    return float(np.sum(np.abs(np.diff(values))[reach[1:] & reach[:-1]]))
 
 
 _REGION_UNIT = "m^i rad^j"  # (the product of the region's axes' units)
