@@ -11,7 +11,7 @@ import pytest
 
 import pkm
 from pkm.core.analysis.region import feasible_region
-from pkm.errors import InvalidInputError
+from pkm.errors import InvalidInputError, PkmWarning
 
 ANKLE = Path(__file__).resolve().parents[3] / "examples" / "ankle" / "ankle.closures.toml"
 AXES = ("ankle_pitch", "ankle_roll")
@@ -71,3 +71,11 @@ def test_bad_arguments_are_refused(ankle):
         feasible_region(ankle, AXES, limits={"elbow": (-1.0, 1.0)})
     with pytest.raises(InvalidInputError, match="not feasible"):
         feasible_region(ankle, AXES, limits={"motor_left": (0.5, 0.7)})
+
+
+def test_rays_cut_by_the_reach_are_said_so(ankle):
+    """A ray that meets no limit within ``reach`` stops there: the region's edge is then the search's, not the
+    mechanism's (a robot five times larger than the default reach of 1 m or rad was cut silently)."""
+    with pytest.warns(PkmWarning, match="8 of 8 rays found no limit within reach = 0.01"):
+        region = feasible_region(ankle, AXES, directions=8, steps=1, reach=0.01)
+    assert set(region.binding) == {"reach"}

@@ -15,12 +15,14 @@ bisected to ``tol``. A pose is **feasible** where
 
 Each vertex carries what stops it (:attr:`Region.binding`): ``"joint <name> at its low|high limit"``,
 ``"direct singularity"``, ``"inverse singularity"``, ``"closure"`` (the legs no longer close: the workspace's own
-edge), or ``"reach"`` (nothing stopped it within ``reach``). The region is star-shaped about the reference by
+edge), or ``"reach"`` (nothing stopped it within ``reach``: a :class:`~pkm.errors.PkmWarning` says how many rays
+were cut so). The region is star-shaped about the reference by
 construction (a ray's first exit); a region with holes or a second component beyond a first exit is not traced.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -28,7 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.errors import InvalidInputError, PkmError
+from pkm.errors import InvalidInputError, PkmError, PkmWarning
 from pkm.validation import as_count, as_scalar
 
 SINGULARITY = 1e-2  # default smallest relative distance to a singularity inside the region
@@ -212,6 +214,10 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
                     r_in, q_in = r, q
         vertices.append(center + r_in * u)
         binding.append(why)
+    cut = binding.count("reach")
+    if cut:
+        warnings.warn(PkmWarning(f"{cut} of {n_dir} rays found no limit within reach = {reach:g} (in the axes' "
+                                 f"units): the region is cut there, not bounded; raise reach"), stacklevel=2)
     return Region((axes[0], axes[1]), rest, center, np.array(vertices), tuple(binding), angles, singularity)
 
 
