@@ -331,7 +331,7 @@ def operational_space(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None
     Jt = tm.jacobian(q)
     J = Jt @ model.G
     scales = mech.jacobian_scales  # (homogenised: judged as for the mechanism scaled in size)
-    s = np.linalg.svd(scales.task_rows[:, None] * J * scales.columns[mech.act_v], compute_uv=False)
+    s = np.linalg.svd(scales.forward(J), compute_uv=False)
     if s[-1] <= rtol * max(float(s[0]), 1e-300):
         raise SingularityError("inverse", float(s[-1]), "the task Jacobian J = dy/dq_a loses rank",
                                distance=float(s[-1]) / max(float(s[0]), 1e-300))

@@ -70,12 +70,14 @@ class JacobianScales:
         task_rows: Per task coordinate (n_task,): ``L`` for an angle, 1 for a length.
         columns: Per joint velocity (nv,): ``L`` for a length (prismatic, a floating base's translation), 1 for an
             angle.
+        actuated: ``columns`` on the actuated joints (na,).
     """
 
     length: float
     constraint_rows: np.ndarray
     task_rows: np.ndarray
     columns: np.ndarray
+    actuated: np.ndarray
 
     @functools.cached_property
     def trivial(self) -> bool:
@@ -91,6 +93,10 @@ class JacobianScales:
         """The task Jacobian (n_task x nv) homogenised."""
         return Jt if self.trivial else self.task_rows[:, None] * Jt * self.columns
 
+    def forward(self, J: np.ndarray) -> np.ndarray:
+        """A forward Jacobian (task rates from actuated rates, ``(..., n_task, na)``) homogenised."""
+        return J if self.trivial else self.task_rows[:, None] * J * self.actuated
+
 
 def jacobian_scales(mech: Mechanism) -> JacobianScales:
     """The homogenising factors of ``mech``'s Jacobians (:class:`JacobianScales`, cached on the mechanism)."""
@@ -103,11 +109,10 @@ def _jacobian_scales(mech: Mechanism) -> JacobianScales:
     for c in mech.spec.closures:
         rows += [1.0] * 3 + ([L] * 3 if c.type == "frame" else [])
     task = [L if mech.task_map.kinds[k] == "angle" else 1.0 for k in mech.task_map.keys]
-    data = mech.model.createData()
-    pin.computeJointJacobians(mech.model, data, mech.q_reference)
-    # a column that turns no frame is a translation (prismatic, a free-flyer's first three): its rate is a length
-    columns = np.where(np.all(data.J[3:] == 0.0, axis=0) & np.any(data.J[:3] != 0.0, axis=0), L, 1.0)
-    return JacobianScales(L, np.array(rows, dtype=float), np.array(task, dtype=float), columns.astype(float))
+    columns = np.ones(mech.nv)
+    for j in mech.joints.values():  # a translation's rate (prismatic, a free-flyer's first three) is a length
+        columns[j.idx_v:j.idx_v + min(_length_entries(j.kind), j.nv)] = L
+    return JacobianScales(L, np.array(rows, dtype=float), np.array(task, dtype=float), columns, columns[mech.act_v])
 
 
 # ---------------------------------------------------------------------- a mechanism scaled in size
