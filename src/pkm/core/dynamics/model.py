@@ -163,7 +163,8 @@ class ActuatorSpaceModel:
             SingularityError: ``kind="inertia"``: an actuated motion moves no mass (``M_a`` singular).
         """
         tau = self.mech.check_actuated(tau, "tau")
-        return finite_result(_solve_inertia(self.M, tau + (self.friction if friction else 0.0) - self.h),
+        return finite_result(_solve_inertia(self.M, tau + (self.friction if friction else 0.0) - self.h,
+                                            self.mech.jacobian_scales.actuated),
                              "actuated accelerations")
 
     def joint_accelerations(self, qdd: ArrayLike) -> np.ndarray:
@@ -178,13 +179,16 @@ class ActuatorSpaceModel:
         return finite_result(a, "joint accelerations")
 
 
-def _solve_inertia(M: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+def _solve_inertia(M: np.ndarray, rhs: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """``M^-1 rhs`` by Cholesky, refused where the factor's diagonal, homogenised by ``scale`` (the actuated columns'
+    factors of :class:`~pkm.core.model.scale.JacobianScales`: ``L`` for a prismatic actuator, so that every entry of
+    ``D M D`` is in kg m^2), spans more than ``1 / sqrt(RTOL)``: the same test for the mechanism scaled in size."""
     try:
         L = np.linalg.cholesky(M)
     except np.linalg.LinAlgError:
         L = None
     if L is not None:
-        d = np.diag(L)
+        d = np.diag(L) * scale
         if d.min() > np.sqrt(RTOL) * d.max():
             return np.linalg.solve(L.T, np.linalg.solve(L, rhs))
     w = np.linalg.eigvalsh(M)

@@ -222,7 +222,7 @@ class _Dynamics:
         model, tau = self.state(t, x[:na], x[na:], seed)
         rhs = tau + (model.friction if self.friction else 0.0) - model.h
         try:
-            qdd = _solve_inertia(model.M, rhs)
+            qdd = _solve_inertia(model.M, rhs, self.mech.jacobian_scales.actuated)
         except SingularityError as exc:
             raise _Stop(Event("singularity", t, str(exc)), exc.sigma_min, exc.distance) from None
         return np.concatenate([x[na:], qdd]), model.q, model, tau

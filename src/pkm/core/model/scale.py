@@ -194,6 +194,18 @@ def scaled_mechanism(mech: Mechanism, factor: float) -> Mechanism:
                         seed=seed)
 
 
+def scale_configuration(mech: Mechanism, q: ArrayLike, factor: float) -> np.ndarray:
+    """The configuration ``q`` of ``mech`` on its copy scaled by ``factor`` (:func:`scaled_mechanism`): prismatic
+    joints' values and a floating base's position times ``factor``, angles unchanged (nq,)."""
+    q = mech.check_q(q)
+    s = as_scalar(factor, "factor", low=0.0, strict_low=True)
+    out = q.copy()
+    for j in mech.joints.values():
+        k = min(_length_entries(j.kind), j.nq)
+        out[j.idx_q:j.idx_q + k] *= s
+    return out
+
+
 def _length_entries(kind: str) -> int:
     """How many leading configuration entries of a joint of Pinocchio kind ``kind`` are lengths."""
     if kind in ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned"):
@@ -201,4 +213,5 @@ def _length_entries(kind: str) -> int:
     return {"JointModelFreeFlyer": 3, "JointModelTranslation": 3, "JointModelPlanar": 2}.get(kind, 0)
 
 
-__all__ = ["JacobianScales", "characteristic_length", "jacobian_scales", "scale_urdf", "scaled_mechanism"]
+__all__ = ["JacobianScales", "characteristic_length", "jacobian_scales", "scale_configuration", "scale_urdf",
+           "scaled_mechanism"]

@@ -130,15 +130,16 @@ static int pkm_sim_eval(pkm_sim* s, casadi_real t, const casadi_real* x, const c
     }
   }
   for (int i = 0; i < NA_; ++i) rhs[i] = (tau[i] + (s->set[0] != 0.0 ? f[i] : 0.0)) - h[i];
-  /* Cholesky of M (symmetric, column-major), the test of _solve_inertia */
+  /* Cholesky of M (symmetric, column-major), the test of _solve_inertia (the diagonal homogenised) */
+  static const casadi_real act_scale[NA_] = ACT_SCALE_;
   casadi_real dmin = INFINITY, dmax = 0.0;
   for (int j = 0; j < NA_; ++j) {
     casadi_real d = M[j * NA_ + j];
     for (int c = 0; c < j; ++c) d -= L[j * NA_ + c] * L[j * NA_ + c];
     if (!(d > 0.0)) return 6;
     d = sqrt(d); L[j * NA_ + j] = d;
-    if (d < dmin) dmin = d;
-    if (d > dmax) dmax = d;
+    if (d * act_scale[j] < dmin) dmin = d * act_scale[j];
+    if (d * act_scale[j] > dmax) dmax = d * act_scale[j];
     for (int i = j + 1; i < NA_; ++i) {
       casadi_real e = M[j * NA_ + i];
       for (int c = 0; c < j; ++c) e -= L[i * NA_ + c] * L[j * NA_ + c];
@@ -462,7 +463,8 @@ class Simulator:
         for key, value in sizes.items():
             driver = driver.replace(f" {key}\n", f" {value}\n")
         driver = (driver.replace("JACOBI_SV\n", jacobi_sv("pkm_sim_sv", 1e-15, 1e-15)).replace("CLOSURE_TOL_", repr(CLOSURE_TOL)).replace("PIVOT_FLOOR_", repr(float(PIVOT_FLOOR)))
-                  .replace("NEWTON_MAX_", str(NEWTON_MAX)).replace("INERTIA_FLOOR_", repr(INERTIA_FLOOR)))
+                  .replace("NEWTON_MAX_", str(NEWTON_MAX)).replace("INERTIA_FLOOR_", repr(INERTIA_FLOOR))
+                  .replace("ACT_SCALE_", "{" + ", ".join(repr(float(x)) for x in mech.jacobian_scales.actuated) + "}"))
         self.lib, self.how = compile_library(self.functions, directory=kernels.directory,
                                              text=source(self.functions) + driver)
         if self.lib is None:
