@@ -33,6 +33,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.model.actuators": ("Actuator",),
     "pkm.core.model.builder": ("with_actuators",),
     "pkm.core.model.mechanism": ("Mechanism",),
+    "pkm.core.model.scale": ("scale_configuration", "scaled_mechanism"),
     "pkm.core.kinematics.solve": ("ClosureProblem", "IKProblem", "SolveResult", "assemble", "branch_seed",
                                   "close_loops", "solve_ik"),
     "pkm.core.model.spec": ("Branch", "Closure", "ClosureSpec", "TaskSpec"),
@@ -93,6 +94,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.model.actuators import Actuator
     from pkm.core.model.builder import with_actuators
     from pkm.core.model.mechanism import Mechanism
+    from pkm.core.model.scale import scale_configuration, scaled_mechanism
     from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 
 
