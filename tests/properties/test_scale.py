@@ -17,7 +17,8 @@ import pytest
 
 import pkm
 from pkm.core.kinematics import constraints
-from pkm.core.model.scale import scale_configuration, scaled_mechanism
+from pkm.core.model.builder import scaled_mechanism
+from pkm.core.model.scale import scale_configuration
 from tests.test_acceptance import ACCEPTANCE
 from tests.test_acceptance import load as acceptance
 from tests.test_gepetto_robots import ROBOTS, gepetto

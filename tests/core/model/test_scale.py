@@ -9,7 +9,8 @@ import pytest
 
 import pkm
 from pkm.core.kinematics import constraints
-from pkm.core.model.scale import scale_configuration, scaled_mechanism
+from pkm.core.model.builder import scaled_mechanism
+from pkm.core.model.scale import scale_configuration
 from pkm.errors import InvalidInputError
 from tests.test_gepetto_robots import gepetto
 

@@ -14,12 +14,12 @@ A mechanism made only of revolute (and ball) joints closed by point closures, wh
 exactly as it is. Scaling every length of a mechanism by ``s`` then scales every homogenised entry by ``s``: every
 ratio of singular values (a distance to a singularity, a condition index) is unchanged.
 
-``L`` (:func:`characteristic_length`) is the root-mean-square distance of the joints' origins from their centroid at
+``L`` (:attr:`Mechanism.characteristic_length <pkm.core.model.mechanism.Mechanism.characteristic_length>`) is the root-mean-square distance of the joints' origins from their centroid at
 the reference configuration (``mech.q_reference``), in [m]: a length of the mechanism itself, which scales exactly
 with it. Where every joint origin coincides, the frames' origins are used instead, and 1 m where they coincide too
 (nothing in the mechanism has a length).
 
-:func:`scaled_mechanism` builds the copy of a mechanism with every length multiplied by a factor: the URDF's origins,
+:func:`~pkm.core.model.builder.scaled_mechanism` builds the copy of a mechanism with every length multiplied by a factor: the URDF's origins,
 prismatic limits and speed limits, geometry, the inertias' centres of mass and tensors (times ``s^2``, the masses
 unchanged), and the spec's reference values of prismatic joints and of a floating base's position.
 """
@@ -34,18 +34,10 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from pkm.errors import InvalidInputError
 from pkm.validation import as_scalar
 
 if TYPE_CHECKING:
     from pkm.core.model.mechanism import Mechanism
-
-
-def characteristic_length(mech: Mechanism) -> float:
-    """The mechanism's characteristic length ``L`` [m] (module doc): the root-mean-square distance of its joints'
-    origins from their centroid at the reference configuration. Cached on the mechanism
-    (:attr:`Mechanism.characteristic_length`)."""
-    return mech.characteristic_length
 
 
 def _characteristic_length(model: pin.Model, q: np.ndarray) -> float:
@@ -98,11 +90,6 @@ class JacobianScales:
         return J if self.trivial else self.task_rows[:, None] * J * self.actuated
 
 
-def jacobian_scales(mech: Mechanism) -> JacobianScales:
-    """The homogenising factors of ``mech``'s Jacobians (:class:`JacobianScales`, cached on the mechanism)."""
-    return mech.jacobian_scales
-
-
 def _jacobian_scales(mech: Mechanism) -> JacobianScales:
     L = mech.characteristic_length
     rows = []
@@ -111,7 +98,7 @@ def _jacobian_scales(mech: Mechanism) -> JacobianScales:
     task = [L if mech.task_map.kinds[k] == "angle" else 1.0 for k in mech.task_map.keys]
     columns = np.ones(mech.nv)
     for j in mech.joints.values():  # a translation's rate (prismatic, a free-flyer's first three) is a length
-        columns[j.idx_v:j.idx_v + min(_length_entries(j.kind), j.nv)] = L
+        columns[j.idx_v:j.idx_v + min(length_entries(j.kind), j.nv)] = L
     return JacobianScales(L, np.array(rows, dtype=float), np.array(task, dtype=float), columns, columns[mech.act_v])
 
 
@@ -163,55 +150,24 @@ def scale_urdf(urdf: str, factor: float) -> str:
     return etree.tostring(root, encoding="unicode")
 
 
-def scaled_mechanism(mech: Mechanism, factor: float) -> Mechanism:
-    """A copy of ``mech`` with every length multiplied by ``factor`` (> 0): its URDF (:func:`scale_urdf`) and the
-    spec's reference values of prismatic joints and of a floating base's position, assembled from the scaled
-    reference configuration. Masses, angles and the actuators' efforts are unchanged; the copy has no ``params``
-    (a mechanism's own parameters describe the original).
-
-    Raises:
-        InvalidInputError: ``factor`` is not a finite number > 0; ``mech`` has no URDF text (built from a
-            ``pinocchio.Model``).
-    """
-    import dataclasses
-
-    from pkm.core.model.builder import from_strings
-    from pkm.core.model.mechanism import check_mechanism
-
-    mech = check_mechanism(mech)
-    s = as_scalar(factor, "factor", low=0.0, strict_low=True)
-    if mech.urdf is None:
-        raise InvalidInputError("mech", "a mechanism built from a pinocchio.Model (no URDF text) cannot be scaled",
-                                mech.name)
-
-    def lengths(name: str, values: ArrayLike) -> tuple[float, ...]:
-        k = _length_entries(mech.joints[name].kind)
-        return tuple(float(v) * s if i < k else float(v) for i, v in enumerate(np.atleast_1d(values)))
-
-    spec = dataclasses.replace(mech.spec, reference={n: lengths(n, v) for n, v in mech.spec.reference.items()})
-    seed = {n: np.array(lengths(n, v)) for n, v in mech.q_to_dict(mech.q_reference).items()}
-    return from_strings(scale_urdf(mech.urdf, s), spec, None, f"{mech.source} (scaled by {s:g})", mech.notes,
-                        seed=seed)
-
-
 def scale_configuration(mech: Mechanism, q: ArrayLike, factor: float) -> np.ndarray:
-    """The configuration ``q`` of ``mech`` on its copy scaled by ``factor`` (:func:`scaled_mechanism`): prismatic
+    """The configuration ``q`` of ``mech`` on its copy scaled by ``factor``
+    (:func:`~pkm.core.model.builder.scaled_mechanism`): prismatic
     joints' values and a floating base's position times ``factor``, angles unchanged (nq,)."""
     q = mech.check_q(q)
     s = as_scalar(factor, "factor", low=0.0, strict_low=True)
     out = q.copy()
     for j in mech.joints.values():
-        k = min(_length_entries(j.kind), j.nq)
+        k = min(length_entries(j.kind), j.nq)
         out[j.idx_q:j.idx_q + k] *= s
     return out
 
 
-def _length_entries(kind: str) -> int:
+def length_entries(kind: str) -> int:
     """How many leading configuration entries of a joint of Pinocchio kind ``kind`` are lengths."""
     if kind in ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned"):
         return 1
     return {"JointModelFreeFlyer": 3, "JointModelTranslation": 3, "JointModelPlanar": 2}.get(kind, 0)
 
 
-__all__ = ["JacobianScales", "characteristic_length", "jacobian_scales", "scale_configuration", "scale_urdf",
-           "scaled_mechanism"]
+__all__ = ["JacobianScales", "length_entries", "scale_configuration", "scale_urdf"]
