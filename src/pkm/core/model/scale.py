@@ -14,14 +14,17 @@ A mechanism made only of revolute (and ball) joints closed by point closures, wh
 exactly as it is. Scaling every length of a mechanism by ``s`` then scales every homogenised entry by ``s``: every
 ratio of singular values (a distance to a singularity, a condition index) is unchanged.
 
-``L`` (:attr:`Mechanism.characteristic_length <pkm.core.model.mechanism.Mechanism.characteristic_length>`) is the root-mean-square distance of the joints' origins from their centroid at
-the reference configuration (``mech.q_reference``), in [m]: a length of the mechanism itself, which scales exactly
-with it. Where every joint origin coincides, the frames' origins are used instead, and 1 m where they coincide too
-(nothing in the mechanism has a length).
+``L`` (:attr:`Mechanism.characteristic_length <pkm.core.model.mechanism.Mechanism.characteristic_length>`) is the
+root-mean-square distance of the joints' origins from their centroid at the reference configuration
+(``mech.q_reference``), in [m]: a length of the mechanism itself, which scales exactly with it. Where every joint
+origin coincides, the frames' origins are used instead, and 1 m where they coincide too (nothing in the mechanism has
+a length). :attr:`Mechanism.jacobian_scales <pkm.core.model.mechanism.Mechanism.jacobian_scales>` holds the factors
+(:class:`JacobianScales`).
 
-:func:`~pkm.core.model.builder.scaled_mechanism` builds the copy of a mechanism with every length multiplied by a factor: the URDF's origins,
-prismatic limits and speed limits, geometry, the inertias' centres of mass and tensors (times ``s^2``, the masses
-unchanged), and the spec's reference values of prismatic joints and of a floating base's position.
+:func:`~pkm.core.model.builder.scaled_mechanism` builds the copy of a mechanism with every length multiplied by a
+factor (:func:`scale_urdf`: the URDF's origins, prismatic limits and speed limits, geometry, the inertias' centres of
+mass and tensors, times ``s^2``, the masses unchanged; the spec's reference values of prismatic joints and of a
+floating base's position); :func:`scale_configuration` maps a configuration onto it.
 """
 
 from __future__ import annotations
@@ -152,8 +155,8 @@ def scale_urdf(urdf: str, factor: float) -> str:
 
 def scale_configuration(mech: Mechanism, q: ArrayLike, factor: float) -> np.ndarray:
     """The configuration ``q`` of ``mech`` on its copy scaled by ``factor``
-    (:func:`~pkm.core.model.builder.scaled_mechanism`): prismatic
-    joints' values and a floating base's position times ``factor``, angles unchanged (nq,)."""
+    (:func:`~pkm.core.model.builder.scaled_mechanism`): prismatic joints' values and a floating base's position times
+    ``factor``, angles unchanged (nq,)."""
     q = mech.check_q(q)
     s = as_scalar(factor, "factor", low=0.0, strict_low=True)
     out = q.copy()
@@ -164,7 +167,8 @@ def scale_configuration(mech: Mechanism, q: ArrayLike, factor: float) -> np.ndar
 
 
 def length_entries(kind: str) -> int:
-    """How many leading configuration entries of a joint of Pinocchio kind ``kind`` are lengths."""
+    """How many leading configuration entries (and velocity entries) of a joint of Pinocchio kind ``kind`` are
+    lengths: a prismatic joint's one, a free flyer's or a translation's three, a planar joint's two."""
     if kind in ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned"):
         return 1
     return {"JointModelFreeFlyer": 3, "JointModelTranslation": 3, "JointModelPlanar": 2}.get(kind, 0)
