@@ -113,9 +113,10 @@ def test_a_leg_at_its_rank_loss_is_reported_as_an_inverse_singularity():
 
 
 def test_the_projection_s_measures_scale_with_the_mechanism_and_its_maps_are_joint_rates():
-    """Gough-Stewart (prismatic legs, a free-flying platform) scaled by 10: its legs' homogenised singular values are
-    10 times larger and those of M the same (1e-9 relative: the rank decisions are the same at any size), and at both sizes the projection's
-    efforts (at rest, gravity) equal the virtual-work route's (1e-9): its maps are given back in joint rates."""
+    """Gough-Stewart (prismatic legs, a free-flying platform) scaled by 10: its legs' homogenised singular values
+    are 10 times larger and those of M the same (1e-9 relative: the rank decisions are the same at any size), and at
+    both sizes the projection's efforts (at rest, gravity) equal the virtual-work route's (1e-9): its maps are given
+    back in joint rates."""
     from pkm.core.model.builder import scaled_mechanism
     from pkm.core.model.scale import scale_configuration
 

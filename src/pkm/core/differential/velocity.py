@@ -23,9 +23,9 @@ mechanism for ``q`` (``Configuration.at(mech, q)``): the kinematics is then comp
 
 Rank decisions compare singular values with ``rtol`` times the largest one; idle motions are those that move the
 task by at most ``rtol`` times the largest singular value of ``J_t``. Both are taken of the Jacobians made
-homogeneous by the mechanism's characteristic length ``L`` (:attr:`~pkm.core.model.mechanism.Mechanism.characteristic_length`,
-:mod:`pkm.core.model.scale`: rotation rows of 6-D closures and angular task coordinates times ``L``, prismatic
-columns times ``L``; every entry a length): a ratio of their singular values does not change when the mechanism is
+homogeneous by the mechanism's characteristic length ``L``
+(:attr:`~pkm.core.model.mechanism.Mechanism.characteristic_length`, :mod:`pkm.core.model.scale`: rotation rows of
+6-D closures and angular task coordinates times ``L``, prismatic columns times ``L``; every entry a length): a ratio of their singular values does not change when the mechanism is
 scaled in size, so that every threshold (``rtol``, ``near``) judges a robot of 5 cm as the same robot of 5 m. A
 mechanism of revolute and ball joints closed by points, whose task is a position, is left as it is.
 """
@@ -428,8 +428,8 @@ def actuation(mech: Mechanism, q: ArrayLike | Configuration | None = None, *, rt
 
     With ``N`` a basis of the motions the closures allow (the null space of ``J_c``, the floating base held), the
     actuators are independent as far as the rows ``N[act]`` are (their rank, judged against ``rtol`` times the
-    largest singular value of the homogenised ``J_c`` and 1e-6 for the unit-free rows), taken greedily in spec order: an actuator
-    whose row adds no rank depends on those before it. Judged at one configuration: at a singular one more
+    largest singular value of the homogenised ``J_c`` and 1e-6 for the unit-free rows), taken greedily in spec
+    order: an actuator whose row adds no rank depends on those before it. Judged at one configuration: at a singular one more
     actuators look dependent than elsewhere.
     """
     mech = check_mechanism(mech)
