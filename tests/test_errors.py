@@ -30,6 +30,9 @@ CASES = [
      {"deficit": 0.5, "unit": "rad", "closures": (("ball_1", 0.5),)}, ["short by 0.5 rad", "(knee)"]),
     (E.SingularityError("direct", 1.5e-13, "platform gains a freedom"), {"kind": "direct", "sigma_min": 1.5e-13},
      ["direct singularity", "1.500e-13", "platform gains a freedom"]),
+    (E.SingularityError("direct", 1.5e-13, "platform", distance=2e-14), {"kind": "direct", "sigma_min": 1.5e-13,
+                                                                         "distance": 2e-14},
+     ["(smallest singular value 1.500e-13, 2e-14 of the largest)"]),
     (E.ConvergenceError("loop closure", 2e-3, 50, 1e-10, result="r", detail="stalled"),
      {"what": "loop closure", "residual": 2e-3, "iterations": 50, "tolerance": 1e-10, "result": "r",
       "worst_closure": None, "worst_gap": 0.0},
@@ -112,7 +115,8 @@ def test_unreachable_without_a_leg_blames_the_task_and_magnitudes_are_floats():
     """leg 0 means no single leg is to blame: the message says the task misses; integer excesses become floats."""
     err = E.UnreachableError(0, 3)
     assert str(err) == "pose unreachable: the task misses by 3 m" and err.excess == 3.0 and type(err.excess) is float
-    assert E.SingularityError("inverse", 0).sigma_min == 0.0 and E.AssemblyError(1).closures == ()
+    assert E.SingularityError("inverse", 0).sigma_min == 0.0 and E.SingularityError("inverse", 0).distance is None
+    assert E.AssemblyError(1).closures == ()
 
 
 def test_did_you_mean_phrasing():

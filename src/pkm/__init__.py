@@ -103,6 +103,8 @@ if TYPE_CHECKING:  # the static view of the lazy names
         passive_map,
         regressor,
         regressor_batch,
+        scale_configuration,
+        scaled_mechanism,
         simulate,
         solve_ik,
         task_acceleration,

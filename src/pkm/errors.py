@@ -219,14 +219,19 @@ class SingularityError(PkmError):
 
     Attributes:
         kind: "inverse" (type 1), "direct" (type 2) or another descriptive kind.
-        sigma_min: Smallest singular value of the matrix that lost rank.
+        sigma_min: Smallest singular value of the matrix that lost rank (the Jacobians homogenised by the
+            mechanism's characteristic length: [m]).
+        distance: ``sigma_min`` over that matrix's largest singular value (dimensionless, the number the
+            thresholds ``rtol``, ``singular_tol`` are compared with), or None where not measured.
     """
 
-    def __init__(self, kind: str, sigma_min: float, detail: str = ""):
+    def __init__(self, kind: str, sigma_min: float, detail: str = "", *, distance: float | None = None):
         self.kind = kind
         self.sigma_min = float(sigma_min)
+        self.distance = None if distance is None else float(distance)
         extra = f": {detail}" if detail else ""
-        super().__init__(f"{kind} singularity (smallest singular value {self.sigma_min:.3e}){extra}")
+        rel = "" if self.distance is None else f", {self.distance:.3g} of the largest"
+        super().__init__(f"{kind} singularity (smallest singular value {self.sigma_min:.3e}{rel}){extra}")
 
 
 class ConvergenceError(PkmError):

@@ -31,8 +31,9 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.identification.measurements": ("Measurements", "measurements"),
     "pkm.core.identification.regressor": ("Parameters", "parameters", "regressor", "regressor_batch"),
     "pkm.core.model.actuators": ("Actuator",),
-    "pkm.core.model.builder": ("from_strings", "with_actuators"),
+    "pkm.core.model.builder": ("from_strings", "scaled_mechanism", "with_actuators"),
     "pkm.core.model.mechanism": ("Mechanism",),
+    "pkm.core.model.scale": ("scale_configuration",),
     "pkm.core.kinematics.solve": ("ClosureProblem", "IKProblem", "SolveResult", "assemble", "branch_seed",
                                   "close_loops", "solve_ik"),
     "pkm.core.model.spec": ("Branch", "Closure", "ClosureSpec", "TaskSpec"),
@@ -91,8 +92,9 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.kinematics.task import TaskMap, zyx_angles, zyx_matrix
     from pkm.core.kinematics.trajectory import Jump, Trajectory, follow_actuators, follow_task, task_values
     from pkm.core.model.actuators import Actuator
-    from pkm.core.model.builder import from_strings, with_actuators
+    from pkm.core.model.builder import from_strings, scaled_mechanism, with_actuators
     from pkm.core.model.mechanism import Mechanism
+    from pkm.core.model.scale import scale_configuration
     from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 
 

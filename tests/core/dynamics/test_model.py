@@ -177,4 +177,15 @@ def test_rates_that_are_not_numbers_and_efforts_that_overflow_are_refused():
 
 def test_an_actuated_motion_without_mass_is_refused():
     with pytest.raises(SingularityError, match="moves no mass"):
-        dm._solve_inertia(np.diag([1.0, 0.0]), np.ones(2))
+        dm._solve_inertia(np.diag([1.0, 0.0]), np.ones(2), np.ones(2))
+
+
+def test_the_inertia_test_does_not_depend_on_the_size():
+    """A revolute and a prismatic actuator moving 1 kg at arm L (``M_a = diag(L^2, 1)``, kg m^2 and kg): the raw
+    Cholesky diagonal spans L, which a robot of 10 um put under sqrt(RTOL) = 3.2e-5; homogenised by L (the prismatic
+    column times L, :class:`~pkm.core.model.scale.JacobianScales`) it spans 1 at every size."""
+    for L in (1e-5, 1.0, 1e3):
+        qdd = dm._solve_inertia(np.diag([L * L, 1.0]), np.array([L * L, 1.0]), np.array([1.0, L]))
+        assert np.allclose(qdd, 1.0, rtol=1e-14)
+    with pytest.raises(SingularityError):
+        dm._solve_inertia(np.diag([1e-10, 1.0]), np.ones(2), np.ones(2))

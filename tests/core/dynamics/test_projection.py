@@ -112,6 +112,28 @@ def test_a_leg_at_its_rank_loss_is_reported_as_an_inverse_singularity():
     assert err.value.kind == "inverse" and "ball_1" in str(err.value)
 
 
+def test_the_projection_s_measures_scale_with_the_mechanism_and_its_maps_are_joint_rates():
+    """Gough-Stewart (prismatic legs, a free-flying platform) scaled by 10: its legs' homogenised singular values
+    are 10 times larger and those of M the same (1e-9 relative: the rank decisions are the same at any size), and at
+    both sizes the projection's efforts (at rest, gravity) equal the virtual-work route's (1e-9): its maps are given
+    back in joint rates."""
+    from pkm.core.model.builder import scaled_mechanism
+    from pkm.core.model.scale import scale_configuration
+
+    mech = pkm.load("gough_stewart")
+    big = scaled_mechanism(mech, 10.0)
+    q = mech.q_reference
+    p, pb = dynamics.KhalilProjection(mech).projection(q), dynamics.KhalilProjection(big).projection(
+        scale_configuration(mech, q, 10.0))
+    assert np.isclose(pb.sigma_direct, p.sigma_direct, rtol=1e-9)  # (M = [A; K] homogenised is unit-free)
+    assert np.allclose(pb.sigma_leg, 10.0 * np.array(p.sigma_leg), rtol=1e-9)
+    zero = np.zeros(mech.nv)
+    for m in (mech, big):
+        qm = m.q_reference
+        assert np.allclose(dynamics.inverse_dynamics(m, qm, zero, zero, method="khalil"),
+                           dynamics.inverse_dynamics(m, qm, zero, zero, method="virtual_work"), rtol=1e-9, atol=1e-9)
+
+
 def test_knee_actuation_with_vertical_rails_is_a_direct_singularity():
     """With vertical rails and the knees driven, the platform rises with every knee locked: M loses rank (the load
     warns that the knees fall short of the mobility)."""

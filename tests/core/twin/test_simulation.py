@@ -58,3 +58,21 @@ def test_the_task_values_are_task_map_values(name):
     qa = mech.actuated_q(mech.q_reference) + 0.02
     q = pkm.close_loops(mech, qa).q
     assert np.abs(np.array(f(q)).ravel() - mech.task_map.value(q)).max() <= 1e-14
+
+
+def test_the_compiled_singularity_check_reads_the_homogenised_passive_jacobian():
+    """The C route's ``J_p`` (the singular values it compares with ``singular_tol``) is the passive columns of the
+    constraint Jacobian homogenised by the characteristic length, as the Python route's check (issue 41: the raw one
+    made the event depend on the mechanism's size); the PRS's prismatic sliders and free-flying platform make the
+    homogenisation more than the identity. 1e-12."""
+    from pkm.core.kinematics import constraints
+    from pkm.core.twin import Kernels
+    from pkm.core.twin.simulation import Simulator
+
+    mech = _mechanism("prs3")
+    assert not mech.jacobian_scales.trivial
+    rates = Simulator(Kernels(mech, compiled=False)).functions[1]
+    q = pkm.close_loops(mech, mech.actuated_q(mech.q_reference) + 0.02).q
+    got = np.array(rates(q, np.zeros(mech.na), [1.0, 1e-3])[5])
+    want = mech.jacobian_scales.constraint(constraints.jacobian(mech, q))[:, mech.passive_v]
+    assert np.abs(got - want).max() <= 1e-12 * np.abs(want).max()

@@ -164,10 +164,11 @@ def capability(mech: Mechanism, q: ArrayLike, kind: str = "wrench", *, gravity: 
     if J.shape[0] != J.shape[1]:
         raise InvalidInputError("mech", f"{J.shape[1]} actuators for {J.shape[0]} task coordinates: the capability of "
                                         "redundant actuation needs a hull (pycapacity's force_polytope)", J.shape)
-    s = np.linalg.svd(J, compute_uv=False)
+    s = np.linalg.svd(mech.jacobian_scales.forward(J), compute_uv=False)  # (homogenised: the same at any size)
     if not s[-1] > 1e-12 * s[0]:
-        raise SingularityError("inverse" if s[-1] == 0.0 else "direct", float(s[-1] / s[0]),
-                               "the forward Jacobian is singular here: the capability is unbounded or flat")
+        raise SingularityError("inverse" if s[-1] == 0.0 else "direct", float(s[-1]),
+                               "the forward Jacobian is singular here: the capability is unbounded or flat",
+                               distance=float(s[-1] / s[0]) if s[0] > 0.0 else 0.0)
     lo, hi = _limits(mech, kind)
     n = J.shape[0]
     if kind == "twist":
@@ -224,7 +225,7 @@ def capability_indices(mech: Mechanism, Q: ArrayLike, kind: str = "wrench", *, g
     if J.shape[1] != J.shape[2]:
         raise InvalidInputError("mech", f"{J.shape[2]} actuators for {J.shape[1]} task coordinates: the capability "
                                         "of redundant actuation needs a hull", J.shape[1:])
-    s = np.linalg.svd(J, compute_uv=False)
+    s = np.linalg.svd(mech.jacobian_scales.forward(J), compute_uv=False)
     regular = s[:, -1] > 1e-12 * s[:, 0]
     J = np.where(regular[:, None, None], J, np.eye(J.shape[1]))  # (singular samples: NaN below)
     shift = kernels.gravity(Q) if gravity and kind != "twist" else np.zeros((len(Q), mech.na))

@@ -21,9 +21,13 @@ actuated columns ``J_a`` and passive columns ``J_p``, and ``J_t`` the task Jacob
 Every function taking ``(mech, q)`` also takes a :class:`~pkm.core.kinematics.configuration.Configuration` of the
 mechanism for ``q`` (``Configuration.at(mech, q)``): the kinematics is then computed once for all of them.
 
-Rank decisions compare singular values with ``rtol`` times the largest one (relative: a mechanism
-of micrometres is judged as one of metres); idle motions are those that move the task by at most
-``rtol`` times the largest singular value of ``J_t``.
+Rank decisions compare singular values with ``rtol`` times the largest one; idle motions are those that move the
+task by at most ``rtol`` times the largest singular value of ``J_t``. Both are taken of the Jacobians made
+homogeneous by the mechanism's characteristic length ``L``
+(:attr:`~pkm.core.model.mechanism.Mechanism.characteristic_length`, :mod:`pkm.core.model.scale`: rotation rows of
+6-D closures and angular task coordinates times ``L``, prismatic columns times ``L``; every entry a length): a ratio of their singular values does not change when the mechanism is
+scaled in size, so that every threshold (``rtol``, ``near``) judges a robot of 5 cm as the same robot of 5 m. A
+mechanism of revolute and ball joints closed by points, whose task is a position, is left as it is.
 """
 
 from __future__ import annotations
@@ -77,17 +81,20 @@ def _complement(B: np.ndarray, n: int) -> np.ndarray:
 class _Split:
     """The motions at one configuration, split: idle, closure-keeping, singular (see the module doc).
 
-    ``Jp = Up diag(sp) Vpt`` (passive columns of ``J_c``, rank ``rp``); ``AC = Ua diag(sa) Vat`` with
-    ``A = [J_c; J_t]`` restricted to the complement ``C`` of the idle motions.
+    Every decomposition is of the Jacobians homogenised by the mechanism's characteristic length
+    (:class:`~pkm.core.model.scale.JacobianScales`: rows ``r``, columns ``c``, ``Ĵ = r J c``), so that every rank
+    decision and distance is the same for the mechanism scaled in size; the solutions are given back in joint rates.
+    ``Ĵp = Up diag(sp) Vpt`` (passive columns of ``Ĵ_c``, rank ``rp``); ``ÂC = Ua diag(sa) Vat`` with
+    ``Â = [Ĵ_c; Ĵ_t]`` restricted to the complement ``C`` of the idle motions (in the homogenised rates).
     """
 
     mech: Mechanism
-    idle: np.ndarray  # (nv, k) orthonormal, zero on the actuated rows
+    idle: np.ndarray  # (nv, k) orthonormal, zero on the actuated rows (joint rates)
     Up: np.ndarray
     sp: np.ndarray
     Vpt: np.ndarray
     rp: int
-    sigma_direct: float  # smallest singular value of J_p off the idle motions
+    sigma_direct: float  # smallest singular value of Ĵ_p off the idle motions [m]
     smax_direct: float
     direct_direction: np.ndarray  # the task motion of the weakest passive motion (unit), n_task
     C: np.ndarray
@@ -97,9 +104,13 @@ class _Split:
     sigma_inverse: float
     smax_inverse: float
     inverse_direction: np.ndarray  # the actuated rates of the weakest frozen-task motion (unit), na
+    rows: np.ndarray  # (n_constraints + n_task,) the row factors r of [J_c; J_t]
+    columns: np.ndarray  # (nv,) the column factors c
 
     @classmethod
     def of(cls, mech: Mechanism, Jc: np.ndarray, Jt: np.ndarray, rtol: float) -> _Split:
+        scales = mech.jacobian_scales
+        Jc, Jt, col = scales.constraint(Jc), scales.task(Jt), scales.columns
         pv, nv = mech.passive_v, mech.nv
         Jp, Jtp = Jc[:, pv], Jt[:, pv]
         Up, sp, Vpt = _svd(Jp)
@@ -118,7 +129,7 @@ class _Split:
             sigma_d, weakest = float(sc[-1]), Cp @ Wct[-1]
         else:
             sigma_d, weakest = np.inf, np.zeros(len(pv))
-        move = Jtp @ weakest
+        move = (Jtp @ weakest) / scales.task_rows  # (in the task's own coordinates)
         idle = np.zeros((nv, idle_p.shape[1]))
         idle[pv] = idle_p
         base = np.zeros((nv, len(mech.base_v)))
@@ -126,12 +137,25 @@ class _Split:
         C = _complement(np.hstack([idle, base]), nv)
         A = np.vstack([Jc, Jt])
         Ua, sa, Vat = _svd(A @ C)
-        w = C @ Vat[-1] if C.shape[1] else np.zeros(nv)
+        w = col * (C @ Vat[-1]) if C.shape[1] else np.zeros(nv)
         act = w[mech.act_v]
+        if idle.shape[1] and not scales.trivial:  # (the idle motions in joint rates, orthonormal)
+            idle = np.linalg.qr(col[:, None] * idle)[0]
         return cls(mech, idle, Up, sp, Vpt, int(np.sum(~null)), sigma_d, smax_d,
                    move / max(float(np.linalg.norm(move)), 1e-300), C, Ua, sa, Vat,
                    float(sa[-1]) if len(sa) else np.inf, float(sa[0]) if len(sa) else 0.0,
-                   act / max(float(np.linalg.norm(act)), 1e-300))
+                   act / max(float(np.linalg.norm(act)), 1e-300),
+                   np.concatenate([scales.constraint_rows, scales.task_rows]), col)
+
+    @property
+    def direct_distance(self) -> float:
+        """``sigma_direct`` over the largest singular value of ``Ĵ_p``, in [0, 1] (0 where ``Ĵ_p`` is zero)."""
+        return min(self.sigma_direct / self.smax_direct, 1.0) if self.smax_direct > 0.0 else 0.0
+
+    @property
+    def inverse_distance(self) -> float:
+        """``sigma_inverse`` over the largest singular value of ``[Ĵ_c; Ĵ_t]``, in [0, 1]."""
+        return min(self.sigma_inverse / self.smax_inverse, 1.0) if self.smax_inverse > 0.0 else 0.0
 
     def direct_singular(self, rtol: float) -> bool:
         return self.sigma_direct <= rtol * self.smax_direct
@@ -140,16 +164,23 @@ class _Split:
         return self.sigma_inverse <= rtol * self.smax_inverse
 
     def passive_solve(self, rhs: np.ndarray) -> np.ndarray:
-        """The minimum-norm passive rates ``x`` with ``J_p x = rhs`` (no idle motion in them)."""
+        """The minimum-norm passive rates ``x`` with ``J_p x = rhs`` (no idle motion in them; the norm of the
+        homogenised rates)."""
         r = self.rp
-        return self.Vpt[:r].T @ ((self.Up[:, :r].T @ rhs) / self.sp[:r].reshape((r,) + (1,) * (rhs.ndim - 1)))
+        nc = self.Up.shape[0]
+        rhs = self.rows[:nc].reshape((nc,) + (1,) * (rhs.ndim - 1)) * rhs
+        x = self.Vpt[:r].T @ ((self.Up[:, :r].T @ rhs) / self.sp[:r].reshape((r,) + (1,) * (rhs.ndim - 1)))
+        cp = self.columns[self.mech.passive_v]
+        return cp.reshape((len(cp),) + (1,) * (rhs.ndim - 1)) * x
 
     def joint_solve(self, rhs: np.ndarray) -> np.ndarray:
         """The joint rates ``v`` off the idle motions with ``[J_c; J_t] v = rhs`` (least squares)."""
         n = self.C.shape[1]
+        extra = (1,) * (rhs.ndim - 1)
+        rhs = self.rows.reshape((len(self.rows),) + extra) * rhs
         keep = self.sa[:n] > np.finfo(float).eps * max(self.Ua.shape[0], n) * self.smax_inverse  # as lstsq's rcond
-        y = (self.Ua[:, :n][:, keep].T @ rhs) / self.sa[:n][keep].reshape((-1,) + (1,) * (rhs.ndim - 1))
-        return self.C @ (self.Vat[:n][keep].T @ y)
+        y = (self.Ua[:, :n][:, keep].T @ rhs) / self.sa[:n][keep].reshape((-1,) + extra)
+        return self.columns.reshape((len(self.columns),) + extra) * (self.C @ (self.Vat[:n][keep].T @ y))
 
 
 def _split(mech: Mechanism, c: Configuration, rtol: float) -> _Split:
@@ -158,12 +189,14 @@ def _split(mech: Mechanism, c: Configuration, rtol: float) -> _Split:
 
 def _direct_check(sp: _Split, rtol: float) -> None:
     if sp.direct_singular(rtol):
-        raise SingularityError("direct", sp.sigma_direct, "actuators locked, the task can still move")
+        raise SingularityError("direct", sp.sigma_direct, "actuators locked, the task can still move",
+                               distance=sp.direct_distance)
 
 
 def _inverse_check(sp: _Split, rtol: float) -> None:
     if sp.inverse_singular(rtol):
-        raise SingularityError("inverse", sp.sigma_inverse, "the task frozen, the actuators can still move")
+        raise SingularityError("inverse", sp.sigma_inverse, "the task frozen, the actuators can still move",
+                               distance=sp.inverse_distance)
 
 
 def _passive_map(mech: Mechanism, sp: _Split, Jc: np.ndarray) -> np.ndarray:
@@ -294,19 +327,21 @@ class Diagnostics:
     """Rank and singularity measures at a configuration.
 
     Attributes:
-        constraint_rank: Rank of the constraint Jacobian (relative to its largest singular value).
+        constraint_rank: Rank of the homogenised constraint Jacobian (relative to its largest singular value).
         redundant_constraints: Equations that are linearly dependent on others (planar loops
             closed with 3-D points have some).
         mobility: Instantaneous degrees of freedom, ``nv - constraint_rank`` (idle motions included).
-        sigma_direct: Smallest singular value of the passive columns ``J_p`` off the idle motions
-            (type 2 measure, in the Jacobian's units).
-        sigma_inverse: Smallest singular value of ``[J_c; J_t]`` off the idle motions (type 1 measure).
+        sigma_direct: Smallest singular value of the passive columns ``J_p`` off the idle motions, the Jacobian
+            homogenised by the characteristic length (module doc; type 2 measure) [m]: it scales with the mechanism.
+        sigma_inverse: Smallest singular value of ``[J_c; J_t]`` off the idle motions, homogenised (type 1
+            measure) [m].
         classification: ``"regular"``, ``"inverse"``, ``"direct"`` or ``"combined"``.
         idle_motions: Passive motions that move neither the closures, nor the task, nor the actuators
             (a rod spinning about its axis between two ball joints; coaxial revolutes): not singularities.
         idle_joints: The joints those motions turn.
-        direct_distance: ``sigma_direct`` over the largest singular value of ``J_p``, in [0, 1].
-        inverse_distance: ``sigma_inverse`` over the largest singular value of ``[J_c; J_t]``.
+        direct_distance: ``sigma_direct`` over the largest singular value of the homogenised ``J_p``, in [0, 1]:
+            dimensionless, the same for the mechanism scaled in size.
+        inverse_distance: ``sigma_inverse`` over the largest singular value of the homogenised ``[J_c; J_t]``.
         near: The kinds (``"direct"``, ``"inverse"``) whose distance is below ``near`` but above
             ``rtol``: regular, but the Jacobians are large there.
         direct_direction: The task motion (unit, task tangent coordinates) of the weakest passive
@@ -393,8 +428,8 @@ def actuation(mech: Mechanism, q: ArrayLike | Configuration | None = None, *, rt
 
     With ``N`` a basis of the motions the closures allow (the null space of ``J_c``, the floating base held), the
     actuators are independent as far as the rows ``N[act]`` are (their rank, judged against ``rtol`` times the
-    largest singular value of ``J_c`` and 1e-6 for the unit-free rows), taken greedily in spec order: an actuator
-    whose row adds no rank depends on those before it. Judged at one configuration: at a singular one more
+    largest singular value of the homogenised ``J_c`` and 1e-6 for the unit-free rows), taken greedily in spec
+    order: an actuator whose row adds no rank depends on those before it. Judged at one configuration: at a singular one more
     actuators look dependent than elsewhere.
     """
     mech = check_mechanism(mech)
@@ -404,7 +439,7 @@ def actuation(mech: Mechanism, q: ArrayLike | Configuration | None = None, *, rt
 
 
 def _actuation(mech: Mechanism, c: Configuration, sp: _Split, rtol: float) -> Actuation:
-    Jc = finite_result(c.constraint_jacobian, "constraint Jacobian")
+    Jc = mech.jacobian_scales.constraint(finite_result(c.constraint_jacobian, "constraint Jacobian"))
     keep = np.setdiff1d(np.arange(mech.nv), mech.base_v)
     _, s, Vt = _svd(Jc[:, keep])
     rank = int(np.sum(s > rtol * s[0])) if len(s) and s[0] > 0.0 else 0
@@ -434,13 +469,11 @@ def diagnose(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 1e-
     mech, c = _at(mech, q)
     rtol = as_tolerance(rtol, "rtol")
     near = max(as_tolerance(near, "near"), rtol)
-    Jc = finite_result(c.constraint_jacobian, "constraint Jacobian")
+    Jc = mech.jacobian_scales.constraint(finite_result(c.constraint_jacobian, "constraint Jacobian"))
     s = np.linalg.svd(Jc, compute_uv=False)
     rank = int(np.sum(s > rtol * s[0])) if len(s) and s[0] > 0.0 else 0
     sp = _split(mech, c, rtol)
-    dd = sp.sigma_direct / sp.smax_direct if sp.smax_direct > 0.0 else 0.0
-    di = sp.sigma_inverse / sp.smax_inverse if sp.smax_inverse > 0.0 else 0.0
-    dd, di = min(dd, 1.0), min(di, 1.0)
+    dd, di = sp.direct_distance, sp.inverse_distance
     direct, inverse = dd <= rtol, di <= rtol
     moved = np.abs(sp.idle).max(axis=1) > 1e-6 if sp.idle.shape[1] else np.zeros(mech.nv, dtype=bool)
     idle_joints = tuple(j.name for j in mech.joints.values() if moved[j.idx_v:j.idx_v + j.nv].any())

@@ -71,14 +71,18 @@ class _Reduction:
 
 
 def _reduce(mech: Mechanism, q: np.ndarray, rtol: float) -> _Reduction:
+    """The rank of ``J_p`` and the idle motions are judged on the Jacobians homogenised by the mechanism's
+    characteristic length (:mod:`pkm.core.model.scale`), as :func:`pkm.diagnose` judges them: the same for the
+    mechanism scaled in size."""
     m, d = mech.model, mech.data
+    scales = mech.jacobian_scales
     Jc = constraints.jacobian(mech, q)
     pv, av = mech.passive_v, mech.act_v
-    Jp = Jc[:, pv]
-    U, s, Vt = np.linalg.svd(Jp, full_matrices=True)
+    cp = scales.columns[pv]
+    U, s, Vt = np.linalg.svd(scales.constraint(Jc)[:, pv], full_matrices=True)
     smax = float(s[0]) if s.size else 0.0
     r = int(np.sum(s > rtol * smax)) if smax > 0.0 else 0
-    Jp_pinv = (Vt[:r].T / s[:r]) @ U[:, :r].T
+    Jp_pinv = cp[:, None] * ((Vt[:r].T / s[:r]) @ U[:, :r].T) * scales.constraint_rows
     G = np.zeros((mech.nv, mech.na))
     G[av, np.arange(mech.na)] = 1.0
     G[pv] = -Jp_pinv @ Jc[:, av]
@@ -86,13 +90,17 @@ def _reduce(mech: Mechanism, q: np.ndarray, rtol: float) -> _Reduction:
     idle = np.zeros((mech.nv, null.shape[1]))
     if null.shape[1]:  # passive motions with the actuators locked: idle (the task does not see them) or singular
         idle[pv] = null
-        Jt = mech.task_map.jacobian(q)
+        Jt = scales.task(mech.task_map.jacobian(q))
         seen = np.linalg.svd(Jt @ idle, compute_uv=False)
         t_ref = max(float(np.linalg.norm(Jt, 2)), 1e-300)
         if seen.size and seen[0] > rtol * t_ref:
-            raise SingularityError("direct", float(s[r]) if r < s.size else 0.0,
+            sigma = float(s[r]) if r < s.size else 0.0
+            raise SingularityError("direct", sigma,
                                    "with the actuators locked a passive motion moves the task: the actuators do "
-                                   "not hold the mechanism here, its dynamics in actuated coordinates is undefined")
+                                   "not hold the mechanism here, its dynamics in actuated coordinates is undefined",
+                                   distance=sigma / smax if smax > 0.0 else 0.0)
+        if not scales.trivial:  # (in joint rates, orthonormal)
+            idle = np.linalg.qr(scales.columns[:, None] * idle)[0]
     M = pin.crba(m, d, q)
     M = np.triu(M) + np.triu(M, 1).T
     if idle.shape[1]:
@@ -155,7 +163,8 @@ class ActuatorSpaceModel:
             SingularityError: ``kind="inertia"``: an actuated motion moves no mass (``M_a`` singular).
         """
         tau = self.mech.check_actuated(tau, "tau")
-        return finite_result(_solve_inertia(self.M, tau + (self.friction if friction else 0.0) - self.h),
+        return finite_result(_solve_inertia(self.M, tau + (self.friction if friction else 0.0) - self.h,
+                                            self.mech.jacobian_scales.actuated),
                              "actuated accelerations")
 
     def joint_accelerations(self, qdd: ArrayLike) -> np.ndarray:
@@ -170,13 +179,16 @@ class ActuatorSpaceModel:
         return finite_result(a, "joint accelerations")
 
 
-def _solve_inertia(M: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+def _solve_inertia(M: np.ndarray, rhs: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """``M^-1 rhs`` by Cholesky, refused where the factor's diagonal, homogenised by ``scale`` (the actuated columns'
+    factors of :class:`~pkm.core.model.scale.JacobianScales`: ``L`` for a prismatic actuator, so that every entry of
+    ``D M D`` is in kg m^2), spans more than ``1 / sqrt(RTOL)``: the same test for the mechanism scaled in size."""
     try:
         L = np.linalg.cholesky(M)
     except np.linalg.LinAlgError:
         L = None
     if L is not None:
-        d = np.diag(L)
+        d = np.diag(L) * scale
         if d.min() > np.sqrt(RTOL) * d.max():
             return np.linalg.solve(L.T, np.linalg.solve(L, rhs))
     w = np.linalg.eigvalsh(M)
@@ -322,9 +334,11 @@ def operational_space(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None
     tm = mech.task_map
     Jt = tm.jacobian(q)
     J = Jt @ model.G
-    s = np.linalg.svd(J, compute_uv=False)
+    scales = mech.jacobian_scales  # (homogenised: judged as for the mechanism scaled in size)
+    s = np.linalg.svd(scales.forward(J), compute_uv=False)
     if s[-1] <= rtol * max(float(s[0]), 1e-300):
-        raise SingularityError("inverse", float(s[-1]), "the task Jacobian J = dy/dq_a loses rank")
+        raise SingularityError("inverse", float(s[-1]), "the task Jacobian J = dy/dq_a loses rank",
+                               distance=float(s[-1]) / max(float(s[0]), 1e-300))
     drift = Jt @ model.drift_acceleration + tm.bias(q, model.v)
     Jinv = np.linalg.inv(J)
     Lam = Jinv.T @ model.M @ Jinv

@@ -154,8 +154,9 @@ class Projection:
     Attributes:
         Jk: Platform joint velocity from actuated rates (``n_p x n_a``).
         L: Per leg, its joint rates from the platform velocity (``n_k x n_p``).
-        sigma_leg: Per leg, the smallest singular value of its Jacobian (inverse singularity measure).
-        sigma_direct: Smallest singular value of ``M = [A; K]`` (direct singularity measure).
+        sigma_leg: Per leg, the smallest singular value of its Jacobian (inverse singularity measure), homogenised by
+            the characteristic length (:mod:`pkm.core.model.scale`).
+        sigma_direct: Smallest singular value of ``M = [A; K]`` (direct singularity measure), homogenised.
     """
 
     Jk: np.ndarray
@@ -187,8 +188,11 @@ class KhalilProjection:
         return self._projection(constraints.jacobian(self.mech, self.mech.check_q(q)))
 
     def _projection(self, Jc: np.ndarray) -> Projection:
+        # (computed on the Jacobian homogenised by the characteristic length, so that every rank decision is the same
+        # for the mechanism scaled in size; the maps are given back in joint rates at the end)
         mech, part = self.mech, self.partition
-        Jc = finite_result(Jc, "constraint Jacobian")
+        scales = mech.jacobian_scales
+        Jc = scales.constraint(finite_result(Jc, "constraint Jacobian"))
         na, n_p = mech.na, len(part.platform_v)
         A = np.zeros((na, n_p))
         K, Ls, sig = [], [], []
@@ -200,7 +204,8 @@ class KhalilProjection:
             sig.append(float(s[r - 1]) if len(s) >= r else 0.0)
             if len(s) < r or s[r - 1] <= self.rtol * float(s[0]):
                 raise SingularityError("inverse", sig[-1], f"leg of closures {', '.join(leg.closures)} loses rank: "
-                                                           "its joint rates are not fixed by the platform motion")
+                                                           "its joint rates are not fixed by the platform motion",
+                                       distance=sig[-1] / float(s[0]) if len(s) and s[0] > 0.0 else 0.0)
             L = Vt.T @ ((U[:, :r].T @ P) / s[:r, None])
             Ls.append(L)
             K.append(U[:, r:].T @ P)
@@ -209,10 +214,15 @@ class KhalilProjection:
         sv = np.linalg.svd(M, compute_uv=False)
         smin = float(sv[n_p - 1]) if len(sv) >= n_p else 0.0
         if smin <= self.rtol * float(sv[0]):
-            raise SingularityError("direct", smin, "the actuated legs do not fix the platform motion")
+            raise SingularityError("direct", smin, "the actuated legs do not fix the platform motion",
+                                   distance=smin / float(sv[0]) if sv[0] > 0.0 else 0.0)
         rhs = np.zeros((M.shape[0], na))
         rhs[:na] = np.eye(na)
         Jk = np.linalg.lstsq(M, rhs, rcond=None)[0]
+        if not scales.trivial:
+            c, cp = scales.columns, scales.columns[part.platform_v]
+            Jk = cp[:, None] * Jk / scales.actuated
+            Ls = [c[leg.v][:, None] * L / cp for leg, L in zip(part.legs, Ls)]
         return Projection(Jk, tuple(Ls), tuple(sig), smin)
 
     def inverse_dynamics(self, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None = None, *, wrenches: Mapping[str, ArrayLike] | None = None) \
@@ -408,8 +418,9 @@ def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuate
     tau_a = mech.check_actuated(tau_actuated, "tau_actuated")
     if _has_mimic(mech.model):
         raise PkmError("constraintDynamics does not support mimic joints on Pinocchio 4.1")
-    s = np.linalg.svd(finite_result(constraints.jacobian(mech, q), "constraint Jacobian"), compute_uv=False)
-    redundant = bool(s.size) and (s.size < mech.n_constraints or s[-1] <= RTOL * max(float(s[0]), 1.0))
+    s = np.linalg.svd(mech.jacobian_scales.constraint(finite_result(constraints.jacobian(mech, q),
+                                                                     "constraint Jacobian")), compute_uv=False)
+    redundant = bool(s.size) and (s.size < mech.n_constraints or s[-1] <= RTOL * float(s[0]))
     if mu is None:
         mu = 1e-9 if redundant else 0.0
     mu = as_scalar(mu, "mu", low=0.0)

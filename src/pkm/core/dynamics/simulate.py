@@ -23,7 +23,9 @@ Integrators:
 The run stops with an :class:`Event`, keeping the samples up to it, where the motion
 
 * comes within ``singular_tol`` of a direct singularity (the passive joints' Jacobian's smallest singular value
-  relative to its largest), where the actuators lose control and the model its meaning;
+  relative to its largest, the Jacobian homogenised by the mechanism's characteristic length as in
+  :func:`pkm.diagnose`: the same for the mechanism scaled in size), where the actuators lose control and the model
+  its meaning;
 * leaves its assembly mode (the loops do not close from the previous configuration; where they fail within
   :data:`SINGULAR_CLOSURE` ``* singular_tol`` of a direct singularity, the event is that singularity);
 * crosses a position limit stated by the model file, or exceeds an actuator's speed limit.
@@ -125,8 +127,24 @@ class Simulation(Trajectory):
 
 
 class _Stop(Exception):
-    def __init__(self, event: Event):
-        self.event = event
+    """A run stops with ``event``; ``sigma`` and ``distance``: the singular value and its ratio to the largest that
+    stopped it, where one did (a start there raises a SingularityError carrying them)."""
+
+    def __init__(self, event: Event, sigma: float | None = None, distance: float | None = None):
+        self.event, self.sigma, self.distance = event, sigma, distance
+
+
+def _passive_distance(mech: Mechanism, q: np.ndarray) -> tuple[float, float, int]:
+    """The smallest singular value of the passive columns of the homogenised constraint Jacobian at ``q``
+    (:mod:`pkm.core.model.scale`) above ``RTOL`` times the largest, its ratio to the largest (the distance to a
+    direct singularity that ``singular_tol`` is compared with: the same for the mechanism scaled in size), and how
+    many there are: ``(sigma [m], distance, rank)``."""
+    s = np.linalg.svd(mech.jacobian_scales.constraint(constraints.jacobian(mech, q))[:, mech.passive_v],
+                      compute_uv=False)
+    nonzero = s[s > RTOL * s[0]] if s.size and s[0] > 0.0 else s[:0]
+    if not nonzero.size:
+        return 0.0, 0.0, 0
+    return float(nonzero[-1]), float(nonzero[-1] / nonzero[0]), int(nonzero.size)
 
 
 @dataclass
@@ -159,12 +177,10 @@ class _Dynamics:
             dv[pv] = -least_squares(J[:, pv], r)
             q = pin.integrate(mech.model, q, dv)
         gap, _, closure = constraints.worst_closure(mech, constraints.residual(mech, q))
-        s = np.linalg.svd(constraints.jacobian(mech, seed)[:, pv], compute_uv=False)
-        nonzero = s[s > RTOL * s[0]] if s.size and s[0] > 0.0 else s
-        near = nonzero[-1] / nonzero[0] if nonzero.size else 0.0
+        sigma, near, _ = _passive_distance(mech, seed)
         if near < SINGULAR_CLOSURE * self.singular_tol:  # (the closure fails because a singularity is near)
             raise _Stop(Event("singularity", t, f"the loops do not close (closure {closure!r} open by {gap:.3g}) "
-                                                f"within {near:.3g} (relative) of a direct singularity"))
+                                                f"within {near:.3g} (relative) of a direct singularity"), sigma, near)
         raise _Stop(Event("assembly_mode", t, f"the loops do not close from the previous configuration (closure "
                                               f"{closure!r} open by {gap:.3g}): the motion left its assembly mode"))
 
@@ -177,7 +193,7 @@ class _Dynamics:
         try:
             model = _evaluate(self.mech, q, qd, RTOL, self.coulomb_velocity)
         except SingularityError as exc:
-            raise _Stop(Event("singularity", t, str(exc))) from None
+            raise _Stop(Event("singularity", t, str(exc)), exc.sigma_min, exc.distance) from None
         tau = self.efforts(t, q, model.v)
         return model, tau
 
@@ -206,9 +222,9 @@ class _Dynamics:
         model, tau = self.state(t, x[:na], x[na:], seed)
         rhs = tau + (model.friction if self.friction else 0.0) - model.h
         try:
-            qdd = _solve_inertia(model.M, rhs)
+            qdd = _solve_inertia(model.M, rhs, self.mech.jacobian_scales.actuated)
         except SingularityError as exc:
-            raise _Stop(Event("singularity", t, str(exc))) from None
+            raise _Stop(Event("singularity", t, str(exc)), exc.sigma_min, exc.distance) from None
         return np.concatenate([x[na:], qdd]), model.q, model, tau
 
 
@@ -271,7 +287,8 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
         saturate: Clip each effort to its actuator's peak (else continuous) limit.
         limits: Stop where a joint leaves its position limits or an actuator exceeds its speed limit (else those
             limits are not watched: the model's free motion, as in an energy check).
-        singular_tol: Stop this close to a direct singularity (relative singular value).
+        singular_tol: Stop this close to a direct singularity (relative singular value of the homogenised passive
+            Jacobian, dimensionless: :attr:`pkm.Diagnostics.direct_distance` where there are no idle motions).
         coulomb_velocity: The speed over which the Coulomb friction's sign is smoothed [rad/s or m/s].
         step_tol: ``"rk4"``: a step is halved (up to 8 times) where the closed configuration at its end lies
             further than this from the stages' prediction [rad or m]: near a singularity the passive joints move
@@ -286,7 +303,8 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
         InvalidInputError: a bad argument (``dt <= 0``, a run beyond ``max_steps``, a torque table of the wrong
             shape...).
         ControllerError: the controller raised or returned efforts of the wrong shape, or not finite.
-        SingularityError: the initial state is singular.
+        SingularityError: the initial state is singular (``kind="start"``; its ``sigma_min`` and ``distance`` are
+            those the detail states, or measured at the initial configuration).
         CompilerError: ``backend="c"`` without a C compiler.
     """
     mech = check_mechanism(mech)
@@ -366,12 +384,10 @@ class _Recorder:
                 raise _Stop(Event("velocity_limit", t, f"actuator {a.joint!r} at {rate:.6g} beyond its speed limit "
                                                        f"{a.velocity_limit:.6g}"))
         if self.dyn.singular_tol > 0.0 and mech.n_constraints:
-            s = np.linalg.svd(constraints.jacobian(mech, model.q)[:, mech.passive_v], compute_uv=False)
-            nonzero = s[s > RTOL * s[0]] if s.size and s[0] > 0.0 else s
-            if nonzero.size and nonzero[-1] < self.dyn.singular_tol * nonzero[0] \
-                    and nonzero.size == len(mech.passive_v) - model.idle.shape[1]:
-                raise _Stop(Event("singularity", t, f"within {nonzero[-1] / nonzero[0]:.3g} (relative) of a direct "
-                                                    f"singularity (singular_tol = {self.dyn.singular_tol:g})"))
+            sigma, distance, rank = _passive_distance(mech, model.q)
+            if rank and distance < self.dyn.singular_tol and rank == len(mech.passive_v) - model.idle.shape[1]:
+                raise _Stop(Event("singularity", t, f"within {distance:.3g} (relative) of a direct singularity "
+                                                    f"(singular_tol = {self.dyn.singular_tol:g})"), sigma, distance)
 
     def result(self, event: Event | None, method: str) -> Simulation:
         mech = self.dyn.mech
@@ -419,7 +435,9 @@ def _start(dyn: _Dynamics, x: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np
         if stop.event.kind in ("joint_limit", "velocity_limit"):
             raise InvalidInputError("q0" if stop.event.kind == "joint_limit" else "v0",
                                     f"the initial state is beyond a limit: {stop.event.detail}") from None
-        raise SingularityError("start", 0.0, f"the simulation cannot start: {stop.event.detail}") from None
+        sigma, distance = (stop.sigma, stop.distance) if stop.sigma is not None else _passive_distance(dyn.mech, q)[:2]
+        raise SingularityError("start", sigma, f"the simulation cannot start: {stop.event.detail}",
+                               distance=distance) from None
     return k, q1, model, tau
 
 

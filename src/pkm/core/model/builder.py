@@ -6,6 +6,7 @@ weighed against the mobility.
 * :func:`from_strings`: URDF text and a spec (object or TOML text);
 * :func:`from_files`: a closure spec and the model file it names (URDF, MJCF, SDF: :mod:`pkm.core.formats`);
 * :func:`with_actuators`: a copy with other drives (:mod:`pkm.core.model.actuators`);
+* :func:`scaled_mechanism`: a copy with every length scaled (:mod:`pkm.core.model.scale`);
 * :func:`rebuild`: unpickling (a mechanism pickles as its URDF and spec texts).
 
 A reference that lacks joints is assembled from the joints it states (held) and the neutral configuration
@@ -22,7 +23,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from pkm.core.differential.velocity import actuation
 from pkm.core.formats.base import Imported
@@ -32,10 +35,12 @@ from pkm.core.kinematics.solve import assemble
 from pkm.core.model import mechanism as _mechanism
 from pkm.core.model.actuators import NUMBERS, Actuator, as_actuators
 from pkm.core.model.joints import retype_joints
-from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import length_entries, scale_urdf
 from pkm.core.model.spec import ClosureSpec, as_path
 from pkm.core.model.urdf import load_model
 from pkm.errors import AssemblyError, InvalidInputError, PkmWarning, SpecError
+from pkm.validation import as_scalar
 
 #: A spec's [reference] must close every loop to this (m or rad); one that lacks joints is assembled.
 REFERENCE_TOL = 1e-9
@@ -159,6 +164,35 @@ def with_actuators(mech: Mechanism, actuators: Mapping[str, Any]) -> Mechanism:
     return build(pin.Model(mech.model), spec, mech.params, None, mech.source, mech.notes, seed=seed)
 
 
+def scaled_mechanism(mech: Mechanism, factor: float) -> Mechanism:
+    """A copy of ``mech`` with every length multiplied by ``factor`` (> 0): its URDF
+    (:func:`~pkm.core.model.scale.scale_urdf`: origins, prismatic limits, geometry, centres of mass, inertias times
+    ``factor^2``) and the spec's reference values of prismatic joints and of a floating base's position, assembled
+    from the scaled reference configuration (:func:`~pkm.core.model.scale.scale_configuration` maps any
+    configuration onto the copy). Masses, angles and the actuators' efforts are unchanged; the copy has no
+    ``params`` (a mechanism's own parameters describe the original). Every singularity measure of the copy equals
+    the original's (:mod:`pkm.core.model.scale`).
+
+    Raises:
+        InvalidInputError: ``factor`` is not a finite number > 0; ``mech`` has no URDF text (built from a
+            ``pinocchio.Model``).
+    """
+    mech = check_mechanism(mech)
+    s = as_scalar(factor, "factor", low=0.0, strict_low=True)
+    if mech.urdf is None:
+        raise InvalidInputError("mech", "a mechanism built from a pinocchio.Model (no URDF text) cannot be scaled",
+                                mech.name)
+
+    def lengths(name: str, values: ArrayLike) -> tuple[float, ...]:
+        k = length_entries(mech.joints[name].kind)
+        return tuple(float(v) * s if i < k else float(v) for i, v in enumerate(np.atleast_1d(values)))
+
+    spec = dataclasses.replace(mech.spec, reference={n: lengths(n, v) for n, v in mech.spec.reference.items()})
+    seed = {n: np.array(lengths(n, v)) for n, v in mech.q_to_dict(mech.q_reference).items()}
+    return from_strings(scale_urdf(mech.urdf, s), spec, None, f"{mech.source} (scaled by {s:g})", mech.notes,
+                        seed=seed)
+
+
 def rebuild(urdf: str, spec: str, params: Any, source: str) -> Mechanism:
     """Unpickling: the mechanism again from its URDF and spec texts."""
     return from_strings(urdf, spec, params, source=source)
@@ -172,4 +206,4 @@ def _reduce(mech: Mechanism) -> tuple[Any, tuple[Any, ...]]:
 _mechanism.REDUCE = _reduce
 
 
-__all__ = ["REFERENCE_TOL", "build", "from_files", "from_strings", "rebuild", "with_actuators"]
+__all__ = ["REFERENCE_TOL", "build", "from_files", "from_strings", "rebuild", "scaled_mechanism", "with_actuators"]

@@ -36,6 +36,7 @@ from pkm.validation import as_array, as_vector, wrap_angle
 
 if TYPE_CHECKING:
     from pkm.core.kinematics.task import TaskMap
+    from pkm.core.model.scale import JacobianScales
 
 
 @dataclass(frozen=True)
@@ -232,6 +233,34 @@ class Mechanism:
         from pkm.core.kinematics.task import TaskMap  # (pkm.core.kinematics.task imports this module)
 
         return TaskMap(self)
+
+    @property
+    def q_reference(self) -> np.ndarray:
+        """The reference configuration (nq,): the spec's ``[reference]``, assembled by the builder."""
+        return self._q_reference
+
+    @q_reference.setter
+    def q_reference(self, q: np.ndarray) -> None:
+        self._q_reference = q
+        for cached in ("characteristic_length", "jacobian_scales"):  # (measured at the reference)
+            self.__dict__.pop(cached, None)
+
+    @functools.cached_property
+    def characteristic_length(self) -> float:
+        """The mechanism's characteristic length ``L`` [m]: the root-mean-square distance of its joints' origins from
+        their centroid at :attr:`q_reference` (:mod:`pkm.core.model.scale`). The singularity measures homogenise
+        their Jacobians by it, so that they judge a mechanism of 5 cm as the same one of 5 m."""
+        from pkm.core.model.scale import _characteristic_length
+
+        return _characteristic_length(self.model, self.q_reference)
+
+    @functools.cached_property
+    def jacobian_scales(self) -> JacobianScales:
+        """The factors that homogenise the Jacobians by :attr:`characteristic_length`
+        (:class:`~pkm.core.model.scale.JacobianScales`)."""
+        from pkm.core.model.scale import _jacobian_scales
+
+        return _jacobian_scales(self)
 
     def __reduce__(self) -> tuple[Callable[..., Mechanism], tuple[Any, ...]]:
         if self.urdf is None or REDUCE is None:

@@ -42,6 +42,11 @@ class Meeting:
         index: The first sample not reached on the mode (the meeting lies between it and the one before).
         reason: The core's verdict (``"fold"``, ``"singular"``, ``"branch"``, ...).
         detail: What was measured.
+        s: Where between the two samples the mode was last reached (0 to 1).
+        q: The configuration there.
+        sigma_min: The distance to a singularity there: the smallest over the largest singular value of the
+            passive Jacobian (actuated motion) or of ``[J_c; J_t]`` (task motion), homogenised by the characteristic
+            length (:mod:`pkm.core.model.scale`: the same for the mechanism scaled in size).
     """
 
     index: int
@@ -105,7 +110,7 @@ def track_assembly_mode(mech: Mechanism, mode: Mode, q_actuated: ArrayLike) -> M
         return close_loops(mech, A[k - 1] + s * (A[k] - A[k - 1]), q_from, raise_on_failure=False)
 
     return _track(mech, mode, traj, _FK_MEETING, between,
-                  lambda qq: constraints.jacobian(mech, qq)[:, mech.passive_v])
+                  lambda qq: mech.jacobian_scales.constraint(constraints.jacobian(mech, qq))[:, mech.passive_v])
 
 
 def track_working_mode(mech: Mechanism, mode: Mode, task: ArrayLike) -> ModeTrack:
@@ -120,7 +125,8 @@ def track_working_mode(mech: Mechanism, mode: Mode, task: ArrayLike) -> ModeTrac
         return solve_ik(mech, tm.interpolate(Y[k - 1], Y[k], s), q_from, raise_on_failure=False)
 
     def jac(qq: np.ndarray) -> np.ndarray:
-        J = Configuration.compute(mech, qq).closure_and_task_jacobian
+        c, sc = Configuration.compute(mech, qq), mech.jacobian_scales
+        J = np.vstack([sc.constraint(c.constraint_jacobian), sc.task(c.task_jacobian)])
         return J if mech.free_v is None else J[:, mech.free_v]
 
     return _track(mech, mode, traj, _IK_MEETING, between, jac)

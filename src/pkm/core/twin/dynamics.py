@@ -40,7 +40,8 @@ from pkm.core.twin.tree import Twin
 from pkm.errors import SpecError
 
 #: ``M_a`` is refused (the forward dynamics' pivot is 0) where its Cholesky factor's smallest diagonal entry is at
-#: most this times its largest: :func:`pkm.core.dynamics.model._solve_inertia`'s test (``sqrt(RTOL)``).
+#: most this times its largest, the entries homogenised by the characteristic length (a prismatic actuator's times
+#: ``L``): :func:`pkm.core.dynamics.model._solve_inertia`'s test (``sqrt(RTOL)``).
 INERTIA_FLOOR = float(np.sqrt(1e-9))
 
 
@@ -228,7 +229,7 @@ class ActuatorTwin:
         fails :data:`INERTIA_FLOOR`."""
         L, diag = cholesky(self.mass_matrix)
         rhs = self.tau + self.friction[0] * self.friction_efforts - self.bias
-        d = cs.vertcat(*diag)
+        d = cs.vertcat(*diag) * cs.DM(self.tw.mech.jacobian_scales.actuated)  # (homogenised, as _solve_inertia)
         ok = cs.if_else(cs.mmin(d) > INERTIA_FLOOR * cs.mmax(d), 1.0, 0.0)
         return {"qdd": cholesky_solve(L, rhs), "pivot": cs.fmin(self.pivot, ok)}
 

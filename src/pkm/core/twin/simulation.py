@@ -7,7 +7,7 @@ the driver ``pkm_sim_run``:
 * ``pkm_sim_close (q, q_a) -> q_next, residual, pivot, residual_0``: the loop closure's Newton iteration
   (:attr:`Twin.closure_newton`) with the residual at its starting point;
 * ``pkm_sim_rates (q, qd, friction) -> M_a, h_a, f_a, v, pivot, J_p``: the actuator-space model
-  (:class:`~pkm.core.twin.dynamics.ActuatorTwin`) and the passive columns of the closure rows;
+  (:class:`~pkm.core.twin.dynamics.ActuatorTwin`) and the passive columns of the closure rows (homogenised);
 * ``pkm_sim_integrate (q, dv)``, ``pkm_sim_difference (q0, q1)``: Pinocchio's ``integrate`` (exact exponentials:
   the stages' seeds and the step's prediction are Pinocchio's) and ``difference`` on the configuration space;
 * ``pkm_sim_samples (q, v, qdd) -> a, task, task velocity, task acceleration, potential energy, residual, pivot``:
@@ -19,7 +19,8 @@ table interpolated as ``numpy.interp`` does and clipped to the actuators' peak e
 called back through :mod:`ctypes` once per stage), ``M_a``'s Cholesky factorisation with
 :func:`pkm.core.dynamics.model._solve_inertia`'s test. After each step the end is checked as
 :class:`~pkm.core.dynamics.simulate.Simulation`'s events are (position and speed limits, the distance to a direct
-singularity from ``J_p``'s singular values by one-sided Jacobi).
+singularity from the singular values of ``J_p``, homogenised by the mechanism's characteristic length as the Python
+route's (:mod:`pkm.core.model.scale`), by one-sided Jacobi).
 
 The driver hands a step back to Python (the return code says why) where the Python route could decide otherwise:
 a step to be halved (the closed end more than half ``step_tol`` from the prediction), an end near an event
@@ -129,15 +130,16 @@ static int pkm_sim_eval(pkm_sim* s, casadi_real t, const casadi_real* x, const c
     }
   }
   for (int i = 0; i < NA_; ++i) rhs[i] = (tau[i] + (s->set[0] != 0.0 ? f[i] : 0.0)) - h[i];
-  /* Cholesky of M (symmetric, column-major), the test of _solve_inertia */
+  /* Cholesky of M (symmetric, column-major), the test of _solve_inertia (the diagonal homogenised) */
+  static const casadi_real act_scale[NA_] = ACT_SCALE_;
   casadi_real dmin = INFINITY, dmax = 0.0;
   for (int j = 0; j < NA_; ++j) {
     casadi_real d = M[j * NA_ + j];
     for (int c = 0; c < j; ++c) d -= L[j * NA_ + c] * L[j * NA_ + c];
     if (!(d > 0.0)) return 6;
     d = sqrt(d); L[j * NA_ + j] = d;
-    if (d < dmin) dmin = d;
-    if (d > dmax) dmax = d;
+    if (d * act_scale[j] < dmin) dmin = d * act_scale[j];
+    if (d * act_scale[j] > dmax) dmax = d * act_scale[j];
     for (int i = j + 1; i < NA_; ++i) {
       casadi_real e = M[j * NA_ + i];
       for (int c = 0; c < j; ++c) e -= L[i * NA_ + c] * L[j * NA_ + c];
@@ -424,7 +426,9 @@ class Simulator:
         close = tw.closure_newton
         r0 = tw.with_actuated(cs.mmax(cs.fabs(tw.closure_residual))) if mech.n_constraints else cs.SX(0.0)
         passive = [int(c) for c in mech.passive_v]
-        Jp = tw.closure_rows["jacobian"][:, passive] if mech.n_constraints else cs.SX(0, len(passive))
+        scales = mech.jacobian_scales  # (J_p homogenised, as the Python route's check: the same for any size)
+        Jp = cs.diag(cs.DM(scales.constraint_rows)) @ tw.closure_rows["jacobian"][:, passive] \
+            @ cs.diag(cs.DM(scales.columns[passive])) if mech.n_constraints else cs.SX(0, len(passive))
         self.shape_jp = Jp.shape
         dq = cs.SX.sym("dv", mech.nv)
         q1 = cs.SX.sym("q1", mech.model.nq)
@@ -459,7 +463,8 @@ class Simulator:
         for key, value in sizes.items():
             driver = driver.replace(f" {key}\n", f" {value}\n")
         driver = (driver.replace("JACOBI_SV\n", jacobi_sv("pkm_sim_sv", 1e-15, 1e-15)).replace("CLOSURE_TOL_", repr(CLOSURE_TOL)).replace("PIVOT_FLOOR_", repr(float(PIVOT_FLOOR)))
-                  .replace("NEWTON_MAX_", str(NEWTON_MAX)).replace("INERTIA_FLOOR_", repr(INERTIA_FLOOR)))
+                  .replace("NEWTON_MAX_", str(NEWTON_MAX)).replace("INERTIA_FLOOR_", repr(INERTIA_FLOOR))
+                  .replace("ACT_SCALE_", "{" + ", ".join(repr(float(x)) for x in mech.jacobian_scales.actuated) + "}"))
         self.lib, self.how = compile_library(self.functions, directory=kernels.directory,
                                              text=source(self.functions) + driver)
         if self.lib is None:
