@@ -152,3 +152,15 @@ def test_both_map_routes_count_the_nodes_where_the_weight_cannot_be_held():
     assert np.allclose(python.isotropic["N"], compiled.isotropic["N"], rtol=1e-9, atol=0)
     assert not capability(weak, pkm.solve_ik(weak, {"x": xs[0], "y": 0.0, "z": weak.task_map.named(
         weak.q_reference)["z"]}).q).origin_inside
+
+
+def test_a_configuration_whose_loops_are_open_is_refused():
+    """The 3-RRR's reference with one motor turned 0.3 rad (the loops open by 0.15 m) was given a capability of
+    3769 N with no word: a polytope of no assembly. Refused, naming the closure and the gap relative to the size;
+    a configuration closed to 1e-10 passes."""
+    mech = mechanism("rrr3")
+    q = mech.q_reference.copy()
+    q[mech.act_q[0]] += 0.3
+    with pytest.raises(InvalidInputError, match="the loops are not closed: closure .* open by 0.1"):
+        capability(mech, q)
+    capability(mech, mech.q_reference)

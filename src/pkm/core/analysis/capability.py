@@ -151,15 +151,18 @@ def capability(mech: Mechanism, q: ArrayLike, kind: str = "wrench", *, gravity: 
 
     Raises:
         InvalidInputError: an unknown kind, an actuator without a finite positive limit of that kind (named), a
-            mechanism with more actuators than task coordinates.
+            mechanism with more actuators than task coordinates, a ``q`` whose loops are not closed
+            (:func:`~pkm.core.kinematics.constraints.check_closed`).
         SingularityError: ``J`` (or ``M_a``) singular at ``q``: no finite polytope.
     """
     from pkm.core.differential.velocity import forward_jacobian
+    from pkm.core.kinematics.constraints import check_closed
 
     mech = check_mechanism(mech)
     if kind not in KINDS:
         raise InvalidInputError("kind", f"use one of {list(KINDS)}, got {kind!r}", kind)
     q = mech.check_q(q)
+    check_closed(mech, q)
     J = forward_jacobian(mech, q)
     if J.shape[0] != J.shape[1]:
         raise InvalidInputError("mech", f"{J.shape[1]} actuators for {J.shape[0]} task coordinates: the capability of "

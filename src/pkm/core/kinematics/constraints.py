@@ -97,6 +97,30 @@ def worst_closure(mech: Mechanism, r: np.ndarray) -> tuple[float, int, str | Non
     return worst
 
 
+#: A configuration counts as assembled where no closure is open by more than this, relative to the mechanism's
+#: characteristic length (:attr:`~pkm.core.model.mechanism.Mechanism.characteristic_length`; a rotation's gap in rad).
+CLOSED_RTOL = 1e-6
+
+
+def check_closed(mech: Mechanism, q: np.ndarray, what: str = "q") -> None:
+    """Refuse a configuration whose loops are not closed (by :data:`CLOSED_RTOL`, relative to the mechanism's size):
+    an answer computed there (a Jacobian, a capability) would be of no assembly of the mechanism.
+
+    Raises:
+        InvalidInputError: naming the closure most open, by how much [m or rad] and relative to the size.
+    """
+    from pkm.errors import InvalidInputError
+
+    L = mech.characteristic_length
+    r = residual(mech, q)[:mech.n_constraints] * mech.jacobian_scales.constraint_rows / L  # (dimensionless)
+    gap, _, name = worst_closure(mech, r)
+    if gap > CLOSED_RTOL:
+        raw = worst_closure(mech, residual(mech, q))[0]
+        raise InvalidInputError(what, f"the loops are not closed: closure {name!r} is open by {raw:.3g} (m or rad), "
+                                      f"{gap:.3g} of the mechanism's size {L:.3g} m (at most {CLOSED_RTOL:g}); close "
+                                      "them first (pkm.close_loops, pkm.solve_ik)", name)
+
+
 def residual_and_jacobian(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Both at once, with one kinematics pass (the loop closure's Newton step)."""
     pin.computeJointJacobians(mech.model, mech.data, q)
