@@ -161,6 +161,6 @@ def test_a_configuration_whose_loops_are_open_is_refused():
     mech = mechanism("rrr3")
     q = mech.q_reference.copy()
     q[mech.act_q[0]] += 0.3
-    with pytest.raises(InvalidInputError, match="the loops are not closed: closure .* open by 0.1"):
+    with pytest.raises(InvalidInputError, match=r"the loops are not closed: closure .* open by 0\.1"):
         capability(mech, q)
     capability(mech, mech.q_reference)
