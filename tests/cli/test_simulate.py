@@ -95,7 +95,7 @@ def test_a_csv_torque_table_round_trip_on_delta(tmp_path, capsys):
     assert math.isclose(out["energy_balance"], samples.energy_balance(sim), rel_tol=1e-9, abs_tol=1e-15)
     # (the balance is the trapezoidal rule's on the work, O(dt^2): 3.3e-3 of the work here, 8.3e-4 at dt = 0.5 ms)
     assert 0.0 < abs(out["energy_balance"]) < 1e-2 * abs(out["work"])
-    assert out["units"]["energy_balance"] == "J"
+    assert out["units"]["energy_balance"] == "J" and out["saturated"] == {}  # (0.3 N m: within every limit)
 
 
 def test_a_controller_file_on_a_spec_file_writes_parquet_and_a_figure(tmp_path, capsys):

@@ -135,6 +135,9 @@ def test_saturation_clips_to_the_peak_effort():
     free = pkm.simulate(mech, duration=0.01, dt=1e-3, controller=lambda t, q, v: np.array([50.0, 0.0, 0.0]),
                         saturate=False)
     assert np.all(free.efforts[:, 0] == 50.0)
+    # the clipping is counted, not silent (motor_2 and motor_3 keep their own limits, unreached)
+    assert run.saturated == {"motor_1": len(run), "motor_2": 0, "motor_3": 0}
+    assert free.saturated == {"motor_1": len(free), "motor_2": 0, "motor_3": 0} and len(run) == 11
 
 
 def test_bad_input_is_refused():

@@ -47,6 +47,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="initial actuated rates [rad/s or m/s, numbers, no unit] (others zero)")
     p.add_argument("--no-friction", action="store_true", help="leave the joints' friction out")
     p.add_argument("--no-limits", action="store_true", help="do not stop at position or speed limits")
+    p.add_argument("--no-saturate", action="store_true", help="apply the efforts asked for beyond the actuators' "
+                                                              "limits (default: clip them; the summary counts them)")
     p.add_argument("--out", metavar="FILE", required=True, help="the samples: Parquet (pkm[sweeps]), or CSV when FILE "
                                                                 "ends in .csv")
     p.add_argument("--plot", metavar="FILE.png", help="draw positions, speeds, efforts and energies (pkm[figures])")
@@ -120,7 +122,8 @@ def load_controller(spec: str) -> Any:
 
 
 def summary(mech: Mechanism, sim: Simulation, written: dict[str, str]) -> dict[str, Any]:
-    """What ``pkm simulate`` prints: samples, final time, the event, the energies and their balance [J]."""
+    """What ``pkm simulate`` prints: samples, final time, the event, the energies and their balance [J], the samples
+    whose efforts are at the actuators' limits (``saturated``, the actuators with any)."""
     from pkm.core.dynamics.samples import energy_balance
     from pkm.report import jsonable
 
@@ -130,7 +133,7 @@ def summary(mech: Mechanism, sim: Simulation, written: dict[str, str]) -> dict[s
         "mechanism": mech.name, "method": sim.method, "samples": len(sim), "final_time": float(sim.time[-1]),
         "event": event, "energy_start": float(energy[0]), "energy_end": float(energy[-1]),
         "work": float(sim.work[-1]), "dissipated": float(sim.dissipated[-1]), "energy_balance": energy_balance(sim),
-        **written,
+        "saturated": {k: n for k, n in sim.saturated.items() if n}, **written,
         "units": {"final_time": "s", "energy_start": "J", "energy_end": "J", "work": "J", "dissipated": "J",
                   "energy_balance": "J", "note": "energy_balance = E(end) - E(0) - work + dissipated: the "
                                                 "integration's error, and the trapezoidal rule's of work and "
@@ -147,6 +150,9 @@ def text(out: dict[str, Any]) -> str:
     lines.append(f"energy: E(0) {out['energy_start']:.6g} J, E(end) {out['energy_end']:.6g} J, work "
                  f"{out['work']:.6g} J, dissipated {out['dissipated'] + 0.0:.6g} J")
     lines.append(f"energy balance E(end) - E(0) - work + dissipated: {out['energy_balance']:.3g} J")
+    if out["saturated"]:
+        lines.append(f"efforts at the actuators' limits (samples of {out['samples']}): "
+                     + ", ".join(f"{k} {n}" for k, n in out["saturated"].items()))
     lines += [f"{key}: {out[key]}" for key in ("out", "plot") if key in out]
     return "\n".join(lines)
 
@@ -171,7 +177,7 @@ def run(args: argparse.Namespace) -> int:
     elif args.controller is not None:
         drive["controller"] = load_controller(args.controller)
     sim = pkm.simulate(mech, q0, v0, duration, dt, method=args.method, friction=not args.no_friction,
-                       limits=not args.no_limits, **drive)
+                       limits=not args.no_limits, saturate=not args.no_saturate, **drive)
     written = {"out": str(samples.write(mech, sim, args.out))}
     if args.plot:
         from pkm.viz.simulation import plot

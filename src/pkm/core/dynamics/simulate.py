@@ -110,6 +110,8 @@ class Simulation(Trajectory):
         dissipated: The energy friction has taken since the start (N,) [J] (trapezoidal rule; >= 0).
         event: Why the run stopped early, or None.
         method: The integrator.
+        saturated: Per actuator, the samples whose effort is at or beyond its limit (peak, else continuous): clipped
+            there when the run saturates (the default), exceeded when it does not.
     """
 
     time: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -119,6 +121,7 @@ class Simulation(Trajectory):
     dissipated: np.ndarray = field(default_factory=lambda: np.zeros(0))
     event: Event | None = None
     method: str = "rk4"
+    saturated: dict[str, int] = field(default_factory=dict)
 
     @property
     def energy(self) -> np.ndarray:
@@ -421,8 +424,11 @@ def _simulation(mech: Mechanism, t: np.ndarray, q: np.ndarray, v: np.ndarray, a:
     units = _units(mech)
     units["efforts"] = {j.name: "N m" if j.revolute else "N" for j in mech.actuated}
     units["time"], units["energy"] = {"time": "s"}, {"energy": "J"}
+    limit = np.array([a.max_effort for a in mech.actuators], dtype=float)
+    at = np.abs(tau) >= limit * (1.0 - 1e-12) if len(tau) else np.zeros((0, mech.na), dtype=bool)
+    saturated = {name: int(n) for name, n in zip(mech.actuated_names, at.sum(axis=0))}
     return Simulation(q, v, a, q[:, mech.act_q], qd, qdd, task, task_v, task_a, tau, residual,
-                      (), units, t, kinetic, potential, work, dissipated, event, method)
+                      (), units, t, kinetic, potential, work, dissipated, event, method, saturated)
 
 
 def _start(dyn: _Dynamics, x: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, ActuatorSpaceModel,
