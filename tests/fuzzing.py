@@ -755,7 +755,7 @@ def _reconfigure(g, adv):
     m = c.mech["hexapod"]
     y = c.task["hexapod"].retract(c.y_ref["hexapod"], g.near(np.zeros(c.task["hexapod"].size), 0.01))
     limits = [(-0.5, 0.5)]
-    kw: dict = {"length": 0.1, "grid": 7}
+    kw: dict = {"length": 0.1, "grid": 7, "kernels": _kernels("hexapod")}  # (the twin, built once)
     if g.chance(0.3):
         kw["rate_limit"] = 0.05
     poses, params = [y, y], ["beta_1"]
@@ -768,7 +768,7 @@ def _reconfigure(g, adv):
         elif what == "limits":
             limits = g.pick(([(0.5, -0.5)], [(np.nan, 1.0)], [(-1e9, 1e9)], [], g.hostile()))
         else:
-            kw[g.pick(("length", "index", "rate_limit", "grid", "tol", "branch"))] = g.hostile()
+            kw[g.pick(("length", "index", "rate_limit", "grid", "tol", "branch", "kernels"))] = g.hostile()
 
     def run(*a, **k):
         return c.pkm.reconfigure(*a, **k).x
