@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import json
 import os
 import signal
 import sys
@@ -137,3 +138,28 @@ def test_the_time_bounds_cut_an_entry_and_say_so(fuzz, monkeypatch):
     rep = fuzz.run(["planted.slow"], 1000, jobs=1, total_seconds=0.2)
     assert 3 <= rep["entries"]["planted.slow"]["tried"] <= 8 and rep["entries"]["planted.slow"]["cut"] == "total"
     assert "1 entry point(s) stopped by a time bound" in fuzz.table(rep)
+
+
+def test_the_time_a_cheap_entry_leaves_goes_to_a_slow_one(fuzz, monkeypatch, capsys):
+    """By default (no --entry-seconds) an entry point's share of the run's bound is re-divided as others finish: a
+    slow entry needing more than half the bound (2 s of 3), stopped at its first share (1.5 s), gets all its calls
+    once a cheap one is done, where equal fixed shares would have cut it; and the output of the calls on the
+    process's stderr (descriptor 2, as C++ libraries print) is counted, not shown."""
+    def cheap(g, adversarial):
+        return (lambda: os.write(2, b"chatter from a C library\n")), (), {}
+
+    def slow(g, adversarial):
+        return (lambda: time.sleep(0.05)), (), {}
+
+    fuzz.ctx()  # (built here, the forked worker has it: no build within the bound)
+    monkeypatch.setattr(fuzz, "ENTRIES", fuzz.ENTRIES + [fuzz.Entry("planted.slow", slow),
+                                                        fuzz.Entry("planted.cheap", cheap)])
+    assert fuzz.main(["--only", "planted.", "--n", "40", "--jobs", "1", "--total-seconds", "3", "--json",
+                      "--no-progress"]) == 0
+    out, err = capsys.readouterr()
+    rep = json.loads(out)
+    s, c = rep["entries"]["planted.slow"], rep["entries"]["planted.cheap"]
+    assert (s["tried"], s["ok"], s["cut"]) == (40, 40, None) and s["seconds"] > 1.5, s
+    assert (c["tried"], c["output_calls"], c["output_lines"]) == (40, 40, 40), c
+    assert c["output_example"].startswith("chatter from a C library") and s["output_lines"] == 0
+    assert "chatter" not in err and "40 line(s) printed by libraries in 40 call(s)" in fuzz.table(rep)

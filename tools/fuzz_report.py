@@ -23,12 +23,19 @@ is classified:
 A PkmError whose numeric attributes (residual, excess, sigma_min, deficit) are NaN is counted
 in ``error_nan``.
 
-Time bounds: every entry point may spend ``--entry-seconds`` (its calls' wall time, summed over its chunks;
-default: its fair share of the total, ``--total-seconds x --jobs / entries``), the whole run ``--total-seconds``
-(default 2700: 45 minutes) plus at most one call's bound. An entry point stopped by either before its ``--n`` calls
-is reported with the calls it got (``tried``) and why (``cut``: ``entry`` or ``total``); the table marks it ``*``.
-The full default run (102 entry points x 10,000 inputs on 2 cores) ends within the hour: the entry points that are
-cheap get all 10,000, the slow ones their share of the time.
+What the libraries print on a worker's stdout and stderr (urdfdom's parser messages through Pinocchio's C++,
+LAPACK's, loggers') goes to a temporary file, not to the run's stderr: each entry point reports how many of its
+calls printed (``output_calls``), how many lines (``output_lines``) and the start of the first (``output_example``).
+
+Time bounds: the whole run may take ``--total-seconds`` (default 2700: 45 minutes) plus at most one call's bound.
+Every entry point may spend (its calls' wall time, summed over its chunks) ``--entry-seconds`` if given, else its
+share of the total, re-divided whenever a chunk is handed out: the time left (``x --jobs``) plus what the entry
+points not finished have spent, divided equally among them. So the time a cheap entry point leaves unused goes to
+those still running, and a slow one waits (its chunks stay queued) until the share grows past what it spent.
+An entry point stopped before its ``--n`` calls is reported with the calls it got (``tried``) and why (``cut``:
+``entry``, its ``--entry-seconds`` spent, or ``total``, the run's); the table marks it ``*``. The full default run
+(109 entry points x 10,000 inputs on 2 cores) is sized to give every entry point its 10,000 within the 45 minutes:
+its calls need about 2,500 of the 5,400 worker-seconds (issue 47: the slowest entry points, 5 to 25 ms a call).
 
 Usage::
 
@@ -51,6 +58,7 @@ import multiprocessing
 import os
 import signal
 import sys
+import tempfile
 import time
 import traceback
 import warnings
@@ -121,6 +129,7 @@ def run_chunk(task: tuple, send) -> None:
             continue
         send(("start", k))
         out = {"verdict": "", "error": None, "documented": False, "error_nan": False, "example": None}
+        mark = _capture_mark()
         signal.setitimer(signal.ITIMER_REAL, timeout)
         try:
             try:
@@ -146,6 +155,7 @@ def run_chunk(task: tuple, send) -> None:
                        example={"type": type(exc).__name__, "message": str(exc)[:500],
                                 "repro": _repro(name, fn, args, kwargs),
                                 "traceback": "".join(traceback.format_exception(exc)[-3:])[-1500:]})
+        out["output"] = _captured_since(mark)
         seconds = time.perf_counter() - t0
         spent += seconds
         send(("done", k, out, seconds))
@@ -159,9 +169,49 @@ def _safe(check, res) -> bool:
         return False
 
 
+_CAPTURE: int | None = None  # (in a worker: the descriptor of the file its stdout and stderr go to)
+CAPTURE_BYTES = 1 << 20  # the capture file is emptied past this size
+
+
+def _capture() -> None:
+    """This process's stdout and stderr (the descriptors 1 and 2, which C and C++ libraries write to: urdfdom's
+    parser messages through Pinocchio, LAPACK's, loggers') to an unlinked temporary file, read after each call."""
+    global _CAPTURE
+    f = tempfile.TemporaryFile()
+    _CAPTURE = os.dup(f.fileno())
+    f.close()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os.dup2(_CAPTURE, 1)
+    os.dup2(_CAPTURE, 2)
+
+
+def _captured_since(mark: int) -> tuple[int, str]:
+    """(lines, their text's start) written to the capture since offset ``mark`` (nothing where none is made)."""
+    if _CAPTURE is None:
+        return 0, ""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    end = os.lseek(_CAPTURE, 0, os.SEEK_END)
+    if end <= mark:
+        return 0, ""
+    text = os.pread(_CAPTURE, min(end - mark, 1 << 16), mark)
+    lines = text.count(b"\n") + (not text.endswith(b"\n"))
+    if end > CAPTURE_BYTES:
+        os.ftruncate(_CAPTURE, 0)
+        os.lseek(_CAPTURE, 0, os.SEEK_SET)
+    return lines, text[:300].decode("utf-8", "replace")
+
+
+def _capture_mark() -> int:
+    return 0 if _CAPTURE is None else os.lseek(_CAPTURE, 0, os.SEEK_END)
+
+
 def _serve(conn) -> None:
-    """A worker process: runs the chunks it is sent until it is sent None."""
+    """A worker process (its output captured: :func:`_capture`): runs the chunks it is sent until it is sent
+    None."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # (Ctrl-C is the parent's to handle)
+    _capture()
     while True:
         task = conn.recv()
         if task is None:
@@ -173,12 +223,18 @@ def _serve(conn) -> None:
 def _tally() -> dict:
     return {"tried": 0, **dict.fromkeys(OUTCOMES, 0), "documented": 0, "error_nan": 0, "seconds": 0.0,
             "by_kind": {"random": Counter(), "adversarial": Counter()}, "errors": Counter(),
-            "examples_other": [], "examples_nonfinite": [], "examples_hang": [], "cut": None}
+            "examples_other": [], "examples_nonfinite": [], "examples_hang": [], "cut": None,
+            "output_calls": 0, "output_lines": 0, "output_example": None}
 
 
 def _count(t: dict, chunk_index: int, k: int, verdict: str, seconds: float, *, error: str | None = None,
-           example: dict | None = None, documented: bool = False, error_nan: bool = False) -> None:
+           example: dict | None = None, documented: bool = False, error_nan: bool = False,
+           output: tuple[int, str] = (0, "")) -> None:
     kind = "adversarial" if (chunk_index * CHUNK + k) % 2 == 1 else "random"
+    if output[0]:
+        t["output_calls"] += 1
+        t["output_lines"] += output[0]
+        t["output_example"] = t["output_example"] or output[1]
     t["tried"] += 1
     t[verdict] += 1
     t["by_kind"][kind][verdict] += 1
@@ -266,7 +322,42 @@ def _run_tasks(tasks: deque, totals: dict, jobs: int, progress: bool, calls: int
             bar = None
     mp = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
     workers = [_Worker(mp) for _ in range(min(jobs, len(tasks)) or 1)]
-    reason: dict[str, str] = {}  # (the bound a chunk was given: entry or total)
+    open_chunks = Counter(t[0] for t in tasks)  # an entry's chunks not finished (queued, waiting or running)
+
+    def bounds(now: float) -> dict[str, tuple[float, str]]:
+        """For each entry not finished, (seconds it may still spend, the bound that says so): its
+        ``entry_seconds``, or (none given) its share of the time left: ``(deadline - now) x jobs`` plus what the
+        entries not finished have spent, divided equally among them, less what it has spent. The time the cheap
+        entries leave unused goes to those still running."""
+        unfinished = [nm for nm, k in open_chunks.items() if k]
+        if entry_seconds is not None:
+            return {nm: (entry_seconds - totals[nm]["seconds"], "entry") for nm in unfinished}
+        if deadline is None:
+            return dict.fromkeys(unfinished, (math.inf, ""))
+        share = (max(0.0, deadline - now) * jobs + sum(totals[nm]["seconds"] for nm in unfinished)) / len(unfinished)
+        return {nm: (share - totals[nm]["seconds"], "total") for nm in unfinished}
+
+    def take(left: dict, now: float) -> tuple | None:
+        """The first queued chunk whose entry has time left (its budget: that time, within the deadline); the
+        chunks of an entry out of time are dropped (cut) when no more time can come to it (its ``entry_seconds``
+        spent, or the deadline past), else left queued."""
+        over = deadline is not None and now >= deadline
+        i = 0
+        while i < len(tasks):
+            nm, seed, chunk_index, count, timeout, start, hung = tasks[i]
+            room, why = (0.0, "total") if over else left[nm]
+            if deadline is not None:
+                room = min(room, deadline - now)
+            if room > 0 or hung >= 0:  # (a hung call's repro is sent even by an entry out of time)
+                del tasks[i]
+                return nm, seed, chunk_index, count, timeout, start, hung, max(0.0, room) if why else None
+            if over or why == "entry":
+                del tasks[i]
+                totals[nm]["cut"] = totals[nm]["cut"] or why
+                open_chunks[nm] -= 1
+            else:
+                i += 1
+        return None
 
     def replace(w: _Worker, verdict: str, example: dict) -> None:
         """``w``'s call in progress ended as ``verdict``: counted, ``w`` replaced, the rest of its chunk queued."""
@@ -284,24 +375,18 @@ def _run_tasks(tasks: deque, totals: dict, jobs: int, progress: bool, calls: int
     try:
         while True:
             now = time.monotonic()
-            for w in workers:  # hand out chunks
-                while w.task is None and tasks:
-                    nm, seed, chunk_index, count, timeout, start, hung = tasks.popleft()
-                    t = totals[nm]
-                    left = {}
-                    if entry_seconds is not None:
-                        left["entry"] = entry_seconds - t["seconds"]
-                    if deadline is not None:
-                        left["total"] = deadline - now
-                    why = min(left, key=left.__getitem__) if left else None
-                    if why is not None and left[why] <= 0 and start < count:
-                        t["cut"] = t["cut"] or why
-                        if hung < 0:
-                            continue  # (else given no time: to send the repro of its hung call)
-                    reason[nm] = why or ""
-                    w.give((nm, seed, chunk_index, count, timeout, start, hung, max(0.0, left[why]) if why else None))
+            if any(w.task is None for w in workers) and tasks:
+                left = bounds(now)
+                for w in workers:  # hand out chunks
+                    if w.task is None:
+                        task = take(left, now)
+                        if task is not None:
+                            w.give(task)
             busy = [w for w in workers if w.task is not None]
             if not busy:
+                if tasks:  # (none could be given: only past the deadline, where take dropped them)
+                    for nm in {t[0] for t in tasks}:
+                        totals[nm]["cut"] = totals[nm]["cut"] or "total"
                 break
             for conn in wait([w.conn for w in busy], timeout=0.25):
                 w = next(w for w in busy if w.conn is conn)
@@ -320,7 +405,8 @@ def _run_tasks(tasks: deque, totals: dict, jobs: int, progress: bool, calls: int
                 elif msg[0] == "done":
                     _, k, out, seconds = msg
                     _count(totals[nm], chunk_index, k, out["verdict"], seconds, error=out["error"],
-                           example=out["example"], documented=out["documented"], error_nan=out["error_nan"])
+                           example=out["example"], documented=out["documented"], error_nan=out["error_nan"],
+                           output=out["output"])
                     w.call, w.last, w.since = None, k, time.monotonic()
                     if bar:
                         bar.update(1)
@@ -330,8 +416,10 @@ def _run_tasks(tasks: deque, totals: dict, jobs: int, progress: bool, calls: int
                         if ex.get("k") == (chunk_index, k):
                             ex["repro"] = repro
                 elif msg[0] == "end":
-                    if msg[1]:
-                        totals[nm]["cut"] = totals[nm]["cut"] or reason.get(nm) or "entry"
+                    if msg[1]:  # (its budget spent: the rest waits for time to be given, or is cut)
+                        tasks.appendleft((nm, w.task[1], chunk_index, w.task[3], w.task[4], w.last + 1, -1))
+                    else:
+                        open_chunks[nm] -= 1
                     w.task, w.call = None, None
                 elif msg[0] == "fail":
                     raise RuntimeError(msg[1])
@@ -361,13 +449,15 @@ def _report_entries(report: dict, names: list[str], totals: dict) -> dict:
         report["entries"][nm] = {
             "tried": t["tried"], **{k: t[k] for k in OUTCOMES}, "documented": t["documented"],
             "error_nan": t["error_nan"], "seconds": round(t["seconds"], 2), "cut": t["cut"],
+            "output_calls": t["output_calls"], "output_lines": t["output_lines"],
+            "output_example": t["output_example"],
             "random": dict(t["by_kind"]["random"]), "adversarial": dict(t["by_kind"]["adversarial"]),
             "errors": dict(t["errors"].most_common()),
             "examples_other": [_public(ex) for ex in t["examples_other"]],
             "examples_nonfinite": t["examples_nonfinite"],
             "examples_hang": [_public(ex) for ex in t["examples_hang"]]}
     report["total"] = {k: sum(e[k] for e in report["entries"].values())
-                       for k in ("tried", *OUTCOMES, "documented", "error_nan")}
+                       for k in ("tried", *OUTCOMES, "documented", "error_nan", "output_calls", "output_lines")}
     report["total"]["cut"] = sum(1 for e in report["entries"].values() if e["cut"])
     return report
 
@@ -391,6 +481,11 @@ def table(report: dict) -> str:
     lines.append(f"{'total':{w}}  {tot['tried']:7d}  {tot['ok']:7d} {tot['pkm_error']:8d} {tot['other']:6d} "
                  f"{tot['nonfinite']:6d} {tot['hang']:5d}   wall {report['wall_seconds']:.0f} s on "
                  f"{report['jobs']} worker(s)")
+    if tot["output_lines"]:
+        noisy = sorted(((e["output_lines"], nm) for nm, e in report["entries"].items() if e["output_lines"]),
+                       reverse=True)
+        lines.append(f"{tot['output_lines']} line(s) printed by libraries in {tot['output_calls']} call(s), captured "
+                     f"(not shown; --json: output_example): " + ", ".join(f"{nm} {k}" for k, nm in noisy[:8]))
     if tot["cut"]:
         lines.append(f"* {tot['cut']} entry point(s) stopped by a time bound before their {report['n']} calls "
                      f"(--entry-seconds {report['entry_seconds']}, --total-seconds {report['total_seconds']})")
@@ -413,7 +508,7 @@ def main(argv=None) -> int:
     ap.add_argument("--grace", type=float, default=5.0, help="seconds more before the worker of a call that does "
                                                              "not give control back is killed (default 5)")
     ap.add_argument("--entry-seconds", type=float, help="seconds of calls each entry point may spend (default: "
-                                                        "its share, total-seconds x jobs / entry points)")
+                                                        "its share of the total, re-divided as entries finish)")
     ap.add_argument("--total-seconds", type=float, default=TOTAL_SECONDS,
                     help=f"seconds the whole run may take (default {TOTAL_SECONDS:g}; 0: no bound)")
     ap.add_argument("--list", action="store_true", help="list the entry points and exit")
@@ -427,11 +522,9 @@ def main(argv=None) -> int:
         print(f"nothing to run (--only {args.only}, --n {args.n}, --jobs {args.jobs}, --timeout {args.timeout}, "
               f"--grace {args.grace})", file=sys.stderr)
         return 2
-    total = args.total_seconds or None
-    entry = args.entry_seconds if args.entry_seconds is not None else \
-        (None if total is None else total * args.jobs / len(names))
     report = run(names, args.n, seed=args.seed, jobs=args.jobs, timeout=args.timeout, grace=args.grace,
-                 entry_seconds=entry, total_seconds=total, progress=not args.no_progress)
+                 entry_seconds=args.entry_seconds, total_seconds=args.total_seconds or None,
+                 progress=not args.no_progress)
     if args.json:
         json.dump(report, sys.stdout, indent=1)
         print()

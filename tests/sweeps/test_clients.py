@@ -86,3 +86,16 @@ def test_no_client_or_cluster_outlives_a_sweep(monkeypatch):
         assert sum(t.name == "IO loop" for t in threading.enumerate()) == loops_before
     finally:
         gc.enable()
+
+
+def test_a_daemonic_process_is_told_at_once_it_cannot_start_local_workers(monkeypatch):
+    """In a daemonic process (a multiprocessing pool's worker, the fuzz harness's), which may not have children,
+    a sweep without a scheduler refuses the local cluster before starting it: a SweepError saying why and what
+    to pass, not dask's nannies failing after seconds of tracebacks."""
+    import multiprocessing
+    import types
+
+    monkeypatch.setattr(multiprocessing, "current_process", lambda: types.SimpleNamespace(daemon=True))
+    with pytest.raises(SweepError, match=r"could not start 2 local Dask workers \(daemonic processes are not allowed"
+                                         r" to have children.*scheduler='serial'"):
+        pkm.sweep("rrr3", TINY, ["gci:step=5cm"], workers=2, progress=False)

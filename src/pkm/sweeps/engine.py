@@ -41,6 +41,7 @@ import dataclasses
 import json
 import logging
 import math
+import multiprocessing
 import os
 import shutil
 import time
@@ -192,6 +193,11 @@ def local_cluster(workers: int | None = None):
     n = _local_workers() if workers is None else workers
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise InvalidInputError("workers", f"a positive integer, got {workers!r}", workers)
+    if multiprocessing.current_process().daemon:  # (dask's nannies would fail, after seconds and tracebacks)
+        raise SweepError(f"could not start {n} local Dask workers (daemonic processes are not allowed to have "
+                         "children: this is one, a multiprocessing pool's worker or the like): run the sweep from a "
+                         "script (with an `if __name__ == '__main__':` guard), a notebook or `pkm sweep`, or pass "
+                         "scheduler='serial'")
     environ = {**(dask.config.get("distributed.nanny.pre-spawn-environ", None) or {}), **WORKER_MALLOC}
     try:
         with dask.config.set({"distributed.nanny.pre-spawn-environ": environ,

@@ -52,6 +52,9 @@ def test_one_parameter_the_hexapods_beta_at_pose_t(hexapod_pose_t):
                           options={"xatol": 1e-9})
     assert abs(r.x[0] - ref.x) <= 1e-5 and math.isclose(r.value[0], -ref.fun, rel_tol=1e-8)
     assert np.abs(pkm.TaskMap(mech).value(r.q[0])[-1] - r.x[0]) <= 1e-10  # the configuration at the choice
+    again = reconfigure(mech, [target], ["beta_1"], [(-math.pi / 2, math.pi / 2)], length=0.1,
+                        kernels=pkm.Kernels(mech))  # (kernels given: the same choice, to 1e-12)
+    assert np.allclose(again.x, r.x, rtol=0, atol=1e-12) and np.allclose(again.value, r.value, rtol=1e-12)
 
 
 def test_one_parameter_along_a_path_keeps_the_rate_limit(hexapod_pose_t):
@@ -97,6 +100,9 @@ def test_bad_requests_are_refused(hexapod_pose_t):
         reconfigure(mech, [target], ["beta_1"], [(-1.0, 1.0)])
     with pytest.raises(InvalidInputError, match="index"):
         reconfigure(mech, [target], ["beta_1"], [(-1.0, 1.0)], length=0.1, index="dexterity")
+    for other in (pkm.Kernels(pkm.load("rrr3")), "kernels"):
+        with pytest.raises(InvalidInputError, match="Kernels of this mechanism"):
+            reconfigure(mech, [target], ["beta_1"], [(-1.0, 1.0)], length=0.1, kernels=other)
     far = {"pose": pin.SE3(np.eye(3), np.array([0.0, -2.0, 0.0])), "beta_1": 0.0}
     with pytest.raises((UnreachableError, pkm.errors.ConvergenceError)):
         reconfigure(mech, [far], ["beta_1"], [(-1.0, 1.0)], length=0.1)

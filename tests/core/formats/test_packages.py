@@ -110,3 +110,17 @@ def test_cassie_v2_with_both_springs_rigid_reports_its_knees_dependent():
     assert (diag.mobility, diag.dependent_actuators) == (8, ("left-knee-op", "right-knee-op"))
     qa = mech.actuated_q(mech.q_reference) + np.array([0, 0, 0, -0.05, 0] * 2)
     assert not pkm.close_loops(mech, qa, max_iter=10, raise_on_failure=False).converged
+
+
+def test_a_package_file_is_read_once_per_process_while_unchanged(monkeypatch):
+    """Two loads of Cassie read its SDF once (half a load's time) and give the same mechanism; the cache is keyed
+    by the file's path, modification time and size."""
+    from pkm.core.formats import load
+
+    reads = []
+    monkeypatch.setattr(load, "_PACKAGE_FILES", {})
+    monkeypatch.setattr(load, "import_model", lambda path: reads.append(path) or import_model(path))
+    a, b = pkm.load("example-robot-data:cassie"), pkm.load("example-robot-data:cassie")
+    assert len(reads) == 1 and a is not b and a.urdf == b.urdf and np.array_equal(a.q_reference, b.q_reference)
+    ((path, mtime, size),) = load._PACKAGE_FILES
+    assert path == str(reads[0]) and (mtime, size) == (reads[0].stat().st_mtime_ns, reads[0].stat().st_size)

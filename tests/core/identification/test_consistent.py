@@ -87,3 +87,17 @@ def test_least_squares_alone_writes_only_a_body_that_can_exist(fitted):
     bad[10] = -0.01  # (the second body's mass)
     with pytest.raises(InvalidInputError, match="mass"):
         identified_mechanism(mech, bad)
+
+
+def test_efforts_of_order_1e300_give_a_finite_residual_rms():
+    """The residuals' squares of efforts of order 1e300 overflowed: the consistent estimate's residual RMS was inf
+    (issue 47's pattern, after pkm.estimate's). It is now the residuals' RMS, computed divided by a power of two
+    (checked against the RMS of the residuals divided by 1e300 first, to 1e-12)."""
+    from tests.core.identification.test_estimate import _data
+
+    mech, base, Q, QD, QDD, TAU = _data("rrr3", 82)
+    tau = 1e300 * (TAU + 0.01 * np.random.default_rng(2).standard_normal(TAU.shape))
+    est = consistent_estimate(mech, Q, QD, QDD, tau, base=base)
+    res = (tau - (pkm.regressor_batch(mech, Q, QD, QDD) @ est.theta).reshape(tau.shape)) / 1e300
+    assert np.all(np.isfinite(est.residual_rms))
+    assert np.allclose(est.residual_rms / 1e300, np.sqrt(np.mean(res**2, axis=0)), rtol=1e-12, atol=0)

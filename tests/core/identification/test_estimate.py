@@ -52,3 +52,36 @@ def test_bad_data_is_refused_by_row_and_too_little_motion_says_so():
     still = np.repeat(Q[:1], 20, axis=0), np.zeros((20, 3)), np.zeros((20, 3))
     with pytest.raises(SingularityError, match="do not excite"):
         estimate(mech, *still, np.zeros((20, 3)), base=base)
+
+
+def test_efforts_near_the_ends_of_the_float_range_scale_exactly_or_are_refused():
+    """Issue 47's repro (the 3-RRR, 82 states, efforts of order 1e300): their squares overflowed, giving infinite
+    deviations and residuals (ordinary least squares) and a NaN 'singularity' (weighted); validating such an
+    estimate gave infinite errors and NaN ratios. The fit and the validation now run on the efforts divided by a
+    power of two: every result is the one of the same efforts at order 1, scaled (linearity, to 1e-9), at 1e300
+    and at 1e-300; efforts whose estimate itself overflows are refused, named."""
+    from pkm.core.identification.export import validate
+    from pkm.core.identification.measurements import Measurements
+
+    mech, base, Q, QD, QDD, TAU = _data("rrr3", 82)
+    tau = np.random.default_rng(3).standard_normal(TAU.shape)  # (not a fit: residuals and deviations not zero)
+    t, refs = np.arange(82.0), {}
+    for weighted in (False, True):
+        ref = estimate(mech, Q, QD, QDD, tau, base=base, weighted=weighted)
+        for k in (1e300, 1e-300):
+            est = estimate(mech, Q, QD, QDD, tau * k, base=base, weighted=weighted)
+            for got, want in ((est.values, ref.values * k), (est.std, ref.std * k),
+                              (est.residual_rms, ref.residual_rms * k),
+                              (est.weights, ref.weights / (k if weighted else 1)),
+                              (est.relative_std, ref.relative_std)):
+                assert np.all(np.isfinite(got)) and np.allclose(got, want, rtol=1e-9, atol=0), (weighted, k)
+        val, val_ref = (validate(mech, e, Measurements(t, Q, QD, QDD, tau * k, 1.0, 1.0, 1))
+                        for e, k in ((est, 1e-300), (ref, 1.0)))
+        assert np.allclose(val.rms, val_ref.rms * 1e-300, rtol=1e-9, atol=0)
+        assert np.allclose(val.relative, val_ref.relative, rtol=1e-9, atol=0)
+        refs[weighted] = val_ref
+    val = validate(mech, estimate(mech, Q, QD, QDD, tau * 1e300, base=base, weighted=False),
+                   Measurements(t, Q, QD, QDD, tau * 1e300, 1.0, 1.0, 1))
+    assert np.all(np.isfinite(val.relative)) and np.allclose(val.relative, refs[False].relative, rtol=1e-9, atol=0)
+    with pytest.raises(InvalidInputError, match=r"efforts up to 1\.7e\+308 \[N m, N\] overflow the estimate"):
+        estimate(mech, Q, QD, QDD, 1.7e308 * np.sign(tau), base=base, weighted=False)

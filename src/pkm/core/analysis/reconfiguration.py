@@ -158,7 +158,8 @@ def _unreached(f: _Index, k: int, x: np.ndarray, i: int, advice: str) -> Unreach
 def reconfigure(mech: Mechanism, poses: np.ndarray | Sequence[ArrayLike | Mapping[str, Any]],
                 parameters: Sequence[str], limits: ArrayLike, *, index: str = "ci_2", length: float | None = None,
                 rate_limit: ArrayLike | None = None, smoothness: float = 1.0, baseline: ArrayLike | None = None,
-                branch: str | None = None, grid: int = 31, tol: float = 1e-9) -> Reconfiguration:
+                branch: str | None = None, grid: int = 31, tol: float = 1e-9,
+                kernels: Kernels | None = None) -> Reconfiguration:
     """The redundant ``parameters`` of ``mech`` chosen for each of ``poses`` (see the module doc).
 
     Args:
@@ -177,6 +178,7 @@ def reconfigure(mech: Mechanism, poses: np.ndarray | Sequence[ArrayLike | Mappin
         branch: The working mode (default: the spec's).
         grid: Nodes of the scan per parameter (the optimiser's start and the reachability scan).
         tol: The optimiser's tolerance on the parameters.
+        kernels: The :class:`pkm.Kernels` of ``mech`` to reuse (default: made here, their twin built each call).
 
     Raises:
         InvalidInputError: unknown parameters or index, bad limits, a missing ``length``.
@@ -186,6 +188,8 @@ def reconfigure(mech: Mechanism, poses: np.ndarray | Sequence[ArrayLike | Mappin
     from pkm.core.twin import Kernels
 
     mech = check_mechanism(mech)
+    if kernels is not None and (not isinstance(kernels, Kernels) or kernels.mech is not mech):
+        raise InvalidInputError("kernels", "give the pkm.Kernels of this mechanism", kernels)
     task = TaskMap(mech)
     if index not in INDICES:
         raise InvalidInputError("index", f"use one of {INDICES}", index)
@@ -208,7 +212,7 @@ def reconfigure(mech: Mechanism, poses: np.ndarray | Sequence[ArrayLike | Mappin
     Y = np.array([task.parse(t) for t in targets]) if len(targets) else np.zeros((0, task.value_size))
     if len(Y) == 0:
         raise InvalidInputError("poses", "give at least one pose", poses)
-    f = _Index(mech, Y, params, index, length, branch, Kernels(mech))
+    f = _Index(mech, Y, params, index, length, branch, Kernels(mech) if kernels is None else kernels)
     n, p = len(Y), len(params)
     mid = lim.mean(axis=1)
     for k in range(n):  # (the generic IK's own error, UnreachableError or ConvergenceError, when one fails)

@@ -206,6 +206,24 @@ def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = ()) 
                                   notes=tuple(notes) + imported.notes + read)
 
 
+_PACKAGE_FILES: dict[tuple[str, int, int], Imported] = {}  # (path, mtime [ns], size): the file read
+
+
+def _package_file(path: Path) -> Imported:
+    """:func:`import_model` of an installed package's file, read once per process while the file is unchanged
+    (Cassie's SDF: half the time of a load); a file that cannot be read raises each time."""
+    try:
+        st = path.stat()
+    except OSError:
+        return import_model(path)  # (its SpecError)
+    key = (str(path), st.st_mtime_ns, st.st_size)
+    if key not in _PACKAGE_FILES:
+        if len(_PACKAGE_FILES) >= 8:
+            _PACKAGE_FILES.pop(next(iter(_PACKAGE_FILES)))
+        _PACKAGE_FILES[key] = import_model(path)
+    return _PACKAGE_FILES[key]
+
+
 def load_package_model(name: str) -> Mechanism:
     """The :class:`~pkm.core.Mechanism` of model ``name`` (``<package>:<model>``): the package's file, read where
     it is installed, with the loops and joint types it states and the spec pkm ships (actuated joints, more joint
@@ -217,7 +235,7 @@ def load_package_model(name: str) -> Mechanism:
     """
 
     spec_path, path = model_file(name)
-    imported = import_model(path)
+    imported = _package_file(path)
     spec = with_file(ClosureSpec.load(spec_path), imported, str(spec_path))
     return from_strings(imported.urdf, spec, source=f"{name} ({path})", notes=imported.notes)
 

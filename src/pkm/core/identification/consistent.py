@@ -28,10 +28,10 @@ from numpy.typing import ArrayLike
 
 from pkm._optional import module
 from pkm.core.identification.base import BaseParameters, base_parameters
-from pkm.core.identification.estimate import Estimate, estimate
+from pkm.core.identification.estimate import Estimate, _scale, estimate
 from pkm.core.identification.regressor import parameters, regressor_batch
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.errors import ConvergenceError
+from pkm.errors import ConvergenceError, InvalidInputError
 
 REGULARISATION = 1e-6  # ε, relative to the weighted regressor's mean squared column norm
 
@@ -121,7 +121,12 @@ def consistent_estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: Array
     th = np.asarray(theta.value, dtype=float)
     smallest = min(float(np.linalg.eigvalsh(pseudo_inertia(th[10 * b:10 * b + 10])).min())
                    for b in range(len(P.bodies)))
-    rms = np.sqrt(np.mean((TAU_ - (Y @ th).reshape(TAU_.shape)) ** 2, axis=0))
+    s = _scale(float(np.abs(TAU_).max()))  # (the residuals' squares overflow beyond 1e154: taken divided by s)
+    with np.errstate(over="ignore"):
+        rms = s * np.sqrt(np.mean(((TAU_ - (Y @ th).reshape(TAU_.shape)) / s) ** 2, axis=0))
+    if not np.all(np.isfinite(rms)):
+        raise InvalidInputError("TAU", f"efforts up to {np.abs(TAU_).max():.3g} [N m, N]: the residuals of "
+                                       f"{what} overflow", float(np.abs(TAU_).max()))
     return ConsistentEstimate(th, base.map @ th, smallest, rms, ls, str(problem.status))
 
 

@@ -10,6 +10,7 @@ about 10 %: poorly).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -89,7 +90,9 @@ def estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, TAU: 
     if n * mech.na < len(base):
         raise InvalidInputError("Q", f"{n * mech.na} equations for {len(base)} base parameters: give more samples", n)
     W = base.regressor(np.vstack([regressor(mech, q, qd, qdd) for q, qd, qdd in zip(Q_, QD_, QDD_)]))
-    y = TAU_.reshape(-1)
+    peak = float(np.abs(TAU_).max())
+    s = _scale(peak)  # (the efforts' sums of squares overflow beyond 1e154: the fit runs on TAU / s, exactly)
+    y = TAU_.reshape(-1) / s
     beta, diag = _solve(W, y)
     weights = np.ones(mech.na)
     if weighted:
@@ -105,7 +108,19 @@ def estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, TAU: 
     with np.errstate(divide="ignore"):
         rel = np.where(beta != 0.0, 100.0 * std / np.abs(beta), np.inf)
     rms = np.sqrt(np.mean(((y - W @ beta).reshape(n, mech.na)) ** 2, axis=0))
+    with np.errstate(over="ignore"):
+        beta, std, rms, weights = beta * s, std * s, rms * s, weights / s if weighted else weights
+    if not all(np.all(np.isfinite(a)) for a in (beta, std, rms, weights)):
+        raise InvalidInputError("TAU", f"efforts up to {peak:.3g} [N m, N] overflow the estimate (its values, "
+                                       "standard deviations or residuals beyond 1.8e308)", peak)
     return Estimate(base, beta, std, rel, rms, weights, "wls" if weighted else "ols", len(y))
+
+
+def _scale(peak: float) -> float:
+    """1, or for efforts whose squares overflow or underflow (``peak`` beyond ``2^±500``) the power of two
+    at or below ``peak``, by which the fit divides them: exact, and every result is scaled back (the
+    standard deviations and residuals with the values, a weighted fit's weights inversely)."""
+    return 1.0 if 2.0**-500 <= peak <= 2.0**500 or peak == 0.0 else math.ldexp(1.0, math.frexp(peak)[1] - 1)
 
 
 __all__ = ["Estimate", "estimate"]

@@ -30,7 +30,7 @@ from lxml import etree
 from numpy.typing import ArrayLike
 
 from pkm.core.identification.base import BaseParameters
-from pkm.core.identification.estimate import Estimate
+from pkm.core.identification.estimate import Estimate, _scale
 from pkm.core.identification.measurements import Measurements
 from pkm.core.identification.regressor import parameters, regressor_batch
 from pkm.core.model.mechanism import Mechanism, check_mechanism
@@ -138,9 +138,17 @@ def validate(mech: Mechanism, predict: Estimate | ConsistentEstimate, data: Meas
     mech = check_mechanism(mech)
     Y = regressor_batch(mech, data.Q, data.QD, data.QDD)
     pred = np.asarray(predict.predict(Y), dtype=float).reshape(data.TAU.shape)
-    rms = np.sqrt(np.mean((pred - data.TAU) ** 2, axis=0))
-    scale = np.sqrt(np.mean(data.TAU ** 2, axis=0))
-    return Validation(rms, 100.0 * rms / np.maximum(scale, 1e-300), pred, data.TAU, data.t)
+    if not np.all(np.isfinite(pred)):
+        raise InvalidInputError("predict", "its predicted efforts overflow on these samples", predict)
+    s = _scale(max(float(np.abs(pred).max(initial=0.0)), float(np.abs(data.TAU).max(initial=0.0))))
+    rms = np.sqrt(np.mean((pred / s - data.TAU / s) ** 2, axis=0))  # (squares beyond 1e154 overflow: divided by s)
+    relative = 100.0 * rms / np.maximum(np.sqrt(np.mean((data.TAU / s) ** 2, axis=0)), 1e-300)
+    with np.errstate(over="ignore"):
+        rms = rms * s
+    if not np.all(np.isfinite(rms)):
+        raise InvalidInputError("data", "the efforts' errors overflow (beyond 1.8e308 [N m, N])",
+                                float(np.abs(data.TAU).max()))
+    return Validation(rms, relative, pred, data.TAU, data.t)
 
 
 __all__ = ["Validation", "identified_mechanism", "standard_from_base", "validate", "write_identified"]

@@ -26,6 +26,14 @@ ROOT_TOL = 1e-12  # radicands of eq. (10) above -ROOT_TOL l^2 count as the doubl
 # ---------------------------------------------------------------------- closed forms
 def leg_geometry(params: Prs3Params) -> tuple[np.ndarray, ...]:
     """Per-leg vectors (rows i = 1..3, world axes): a_i, u_1,i, w_i, e_t,i, and b_i (platform axes)."""
+    try:
+        return tuple(v.copy() for v in _leg_geometry(params))  # (a design's reference search: 400 IK calls)
+    except TypeError:  # (unhashable parameters)
+        return _leg_geometry.__wrapped__(params)
+
+
+@functools.lru_cache(maxsize=256)
+def _leg_geometry(params: Prs3Params) -> tuple[np.ndarray, ...]:
     cg, sg = math.cos(params.gamma), math.sin(params.gamma)
     er = np.array([[math.cos(f), math.sin(f), 0.0] for f in PHI])
     ez = np.array([0.0, 0.0, 1.0])
