@@ -24,6 +24,7 @@ iterations for a whole solve. No solver returns a non-finite configuration.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -33,9 +34,17 @@ from numpy.typing import ArrayLike
 
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
+from pkm.core.kinematics.labels import ModeLabel, mode_label
 from pkm.core.kinematics.newton import gauss_newton
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.errors import AssemblyError, BranchError, ConvergenceError, InvalidInputError, UnreachableError
+from pkm.errors import (
+    AssemblyError,
+    BranchError,
+    ConvergenceError,
+    InvalidInputError,
+    ModeChangeWarning,
+    UnreachableError,
+)
 from pkm.validation import as_count, as_scalar, as_tolerance
 
 DEFAULT_TOL = 1e-12
@@ -58,6 +67,9 @@ class SolveResult:
         iterations: Newton iterations, all continuation steps included.
         steps: Continuation steps taken (1 when solved directly).
         branch_signs: Signs of the default-branch joints at ``q`` (empty without branches).
+        mode: The assembly and working mode labels at ``q`` (:class:`~pkm.core.kinematics.labels.ModeLabel`: the
+            signs of the solvers' Newton blocks relative to the reference's; a solve that ends in another mode than
+            its seed's warns, :class:`~pkm.errors.ModeChangeWarning`).
         outside_limits: The joints whose coordinate at ``q`` lies outside the position limits their URDF
             states (:meth:`pkm.core.Mechanism.outside_limits`); pkm's solvers do not enforce limits.
     """
@@ -69,6 +81,7 @@ class SolveResult:
     steps: int = 1
     branch_signs: dict[str, int] = field(default_factory=dict)
     outside_limits: tuple[str, ...] = ()
+    mode: ModeLabel = field(default_factory=ModeLabel)
 
     def check(self, mech: Mechanism, *, tol: float = 1e-9) -> bool:
         """Whether this result still holds on ``mech``, checked again from ``q`` alone (as qpsolvers'
@@ -168,7 +181,16 @@ def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.nd
 
 def _result(mech: Mechanism, q: np.ndarray, converged: bool, residual: float, iterations: int,
             steps: int) -> SolveResult:
-    return SolveResult(q, converged, residual, iterations, steps, _signs(mech, q), mech.outside_limits(q))
+    return SolveResult(q, converged, residual, iterations, steps, _signs(mech, q), mech.outside_limits(q),
+                       mode_label(mech, q))
+
+
+def _warn_mode_change(what: str, seed: ModeLabel, result: SolveResult) -> None:
+    """A :class:`~pkm.errors.ModeChangeWarning` when a converged ``result`` lies in another assembly or working
+    mode than its seed (a block's determinant changed sign on the way: the path crossed a singularity)."""
+    changed = seed.differs(result.mode) if result.converged else ()
+    if changed:
+        warnings.warn(ModeChangeWarning(what, changed, seed, result.mode), stacklevel=3)
 
 
 def _follow(mech: Mechanism, what: str, solve_at: _StepSolver, q: np.ndarray, n_steps: int, tol: float,
@@ -226,7 +248,9 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
     Args:
         mech: The mechanism.
         q_actuated: Actuated coordinates in spec order (rad or m), shape (na,).
-        q0: Seed configuration (nq,); its assembly mode is kept. Default: the reference configuration.
+        q0: Seed configuration (nq,); its assembly mode is kept (a result in another assembly or working mode, the
+            path having crossed a singularity, warns: :class:`~pkm.errors.ModeChangeWarning`). Default: the
+            reference configuration.
         tol: Tolerance on the infinity norm of the closure residual [m, rad].
         max_iter: Newton iterations allowed per continuation step.
         max_step: Largest change of an actuated coordinate per continuation step [rad or m].
@@ -250,11 +274,14 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
     def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int]:
         return _newton(mech, fun, mech.with_actuated(q, qa0 + s * (qa1 - qa0)), mech.passive_v, t, max_iter, 0.5)
 
+    seed = mode_label(mech, q)
     try:
-        return _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure)
+        result = _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure)
     except ConvergenceError as exc:
         exc.problem = ClosureProblem(mech, qa1)
         raise
+    _warn_mode_change("loop closure", seed, result)
+    return result
 
 
 def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: ArrayLike | None = None, *,
@@ -267,7 +294,8 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
         target: Task coordinates (see :meth:`pkm.core.kinematics.task.TaskMap.parse`): a vector, or a mapping by name of
             some of them (``{"z": "-36cm"}``), the others those of the reference; values may carry units.
         q0: Seed configuration; default: the reference configuration (or, with ``branch``,
-            the reference with that branch's joint signs imposed and the loops re-closed).
+            the reference with that branch's joint signs imposed and the loops re-closed). A result in another
+            working or assembly mode than the seed's warns (:class:`~pkm.errors.ModeChangeWarning`).
         branch: Working mode the solution must lie on; checked at the end (:class:`BranchError`).
         tol: Tolerance on the infinity norm of closure residual and task error [m, rad].
         max_iter: Newton iterations allowed per continuation step.
@@ -293,6 +321,7 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
         return _newton(mech, goal.evaluate, q, mech.free_v, t, max_iter, 0.5)
 
     problem = IKProblem(mech, y1)
+    seed = mode_label(mech, q)
     try:
         result = _follow(mech, "inverse kinematics", solve_at, q, n_steps, tol, raise_on_failure)
     except ConvergenceError as exc:
@@ -303,6 +332,7 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
     q = result.q
     if result.converged and branch is not None and not mech.on_branch(q, branch):
         raise BranchError(branch, dict(mech.branch(branch).signs), mech.branch_signs(q, branch))
+    _warn_mode_change("inverse kinematics", seed, result)
     return result
 
 

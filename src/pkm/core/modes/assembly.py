@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -29,7 +30,7 @@ from pkm.core.modes.equations import FKSystem, equations
 from pkm.core.modes.polynomial import System, variables
 from pkm.core.modes.reduce import Reduction, reduce_mechanism
 from pkm.core.modes.starts import generic_start, path_parameters
-from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError
+from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, StructureError
 
 #: A solution is real when its imaginary part is below this, relative to its size.
 REAL_TOL = 1e-8
@@ -214,17 +215,35 @@ def parameter_homotopy(system: FKSystem, *, precision: str = "adaptive", threads
     return cont
 
 
+def _generic(mech: Mechanism, refused: StructureError, precision: str, *, qa: np.ndarray | None = None,
+             task: Any = None) -> ModeSet:
+    """The generic route (:mod:`pkm.core.modes.generic`) where the reduction refused ``mech``: the assembly modes at
+    the actuator values ``qa``, else the working modes at ``task``. A refusal names both reasons."""
+    from pkm.core.modes import generic
+
+    try:
+        if qa is not None:
+            return generic.assembly_modes_generic(mech, qa, precision=precision)
+        return generic.working_modes_generic(mech, task, precision=precision)
+    except StructureError as exc:
+        raise StructureError(exc.part, f"{str(exc).removeprefix(exc.part + ': ')}; the platform reduction refuses "
+                                       f"it too ({refused})") from None
+
+
 def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "auto", precision: str = "adaptive",
                    threads: int = 2, continuation: Continuation | None = None) -> ModeSet:
     """Every real assembly mode of ``mech`` at the actuator values ``q_actuated`` (module doc).
 
     Args:
-        mech: Any mechanism the reduction covers (:mod:`pkm.core.modes.reduce`; others are refused with a
-            :class:`~pkm.errors.StructureError`).
+        mech: Any mechanism the reduction covers (:mod:`pkm.core.modes.reduce`) or, failing that, the generic route
+            (:mod:`pkm.core.modes.generic`: revolute and prismatic joints, point closures); others are refused with
+            a :class:`~pkm.errors.StructureError` naming both reasons.
         q_actuated: The actuated coordinates in spec order [rad or m].
         method: ``"total-degree"`` (Bertini's total-degree start), ``"parameter"`` (a parameter homotopy from the
-            family's generic solutions, :mod:`pkm.core.modes.starts`) or ``"auto"`` (parameter for a spatial
-            platform, total degree for the small planar and translational systems).
+            family's generic solutions, :mod:`pkm.core.modes.starts`), ``"generic"`` (no reduction: the closures in
+            every passive joint, :mod:`pkm.core.modes.generic`) or ``"auto"`` (parameter for a spatial platform,
+            total degree for the small planar and translational systems, generic where the reduction finds no
+            platform: a task point on a leg).
         precision: Bertini's precision mode (``"adaptive"``: the safe default).
         threads: Bertini's tracking threads.
         continuation: A finished :class:`~pkm.core.modes.continuation.Continuation` of this very system to use
@@ -234,14 +253,25 @@ def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "aut
         A :class:`ModeSet`; its modes sorted by distance from the reference configuration.
 
     Raises:
-        StructureError: the mechanism's structure is outside the reduction.
+        StructureError: the mechanism's structure is outside the reduction and the generic route.
         MissingDependencyError: bertini2 is not installed.
         ConvergenceError: a real solution whose legs the core cannot close (a defect: the reduction and the tree
             disagree).
     """
     mech = check_mechanism(mech)
     qa = mech.check_actuated(q_actuated, positions=True)
-    red = reduce_mechanism(mech)
+    if method not in ("auto", "parameter", "total-degree", "generic"):
+        raise InvalidInputError("method", "expected 'auto', 'parameter', 'total-degree' or 'generic'", method)
+    if method == "generic":
+        from pkm.core.modes.generic import assembly_modes_generic
+
+        return assembly_modes_generic(mech, qa, precision=precision)
+    try:
+        red = reduce_mechanism(mech)
+    except StructureError as exc:
+        if method != "auto" or continuation is not None:
+            raise
+        return _generic(mech, exc, precision, qa=qa)
     d = mech.model.createData()
     pin.forwardKinematics(mech.model, d, mech.with_actuated(mech.q_reference, qa))
     system = FKSystem(red, d)
@@ -249,11 +279,9 @@ def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "aut
         cont = continuation
     elif method == "parameter" or (method == "auto" and red.group == "SE3"):
         cont = parameter_homotopy(system, precision=precision, threads=threads)
-    elif method in ("auto", "total-degree"):
+    else:
         cont = solve(system.polys, system.groups, projective=system.projective, precision=precision,
                      threads=threads)
-    else:
-        raise InvalidInputError("method", "expected 'auto', 'parameter' or 'total-degree'", method)
     found, n_complex, n_exc = real_solutions(cont, system)
     modes = []
     for x, cert, paths in found:
