@@ -436,6 +436,87 @@ def assemble(mech: Mechanism, q0: ArrayLike | None = None, *, hold: Sequence[str
                         closures=alone or ((str(err.worst_closure), err.worst_gap),))
 
 
+#: Seeded starts of :func:`nearest_assembly` besides ``q0`` itself (normal draws of 0.3, 1 and 2 rad or m).
+NEAREST_STARTS = 12
+
+
+def nearest_assembly(mech: Mechanism, q0: ArrayLike | None = None, *, tol: float = DEFAULT_TOL,
+                     seed: int = 0) -> SolveResult:
+    """The closed configuration nearest ``q0`` (default: the zero pose, Pinocchio's neutral configuration): the
+    rule by which a mechanism whose files state no configuration gets its reference (:mod:`pkm.core.model.builder`).
+
+    Distance: the norm of :meth:`~pkm.core.Mechanism.difference` (every joint coordinate alike, rad and m). Each of
+    ``q0`` and :data:`NEAREST_STARTS` seeded perturbations of it is closed by Levenberg-Marquardt, then slid along
+    the closed configurations to a local minimum of the distance (the distance's gradient projected on the closures'
+    null space, the loops closed again by minimum-norm Newton steps). The nearest wins; among those as near to
+    ``1e-9`` (a mechanism symmetric about ``q0``, such as a five-bar mirrored by ``q -> -q``, has its nearest
+    configurations in mirrored pairs) the first in the lexicographic order of ``q`` from the largest. Because
+    each step is equivariant, a symmetry of the mechanism that fixes ``q0`` (legs alike, permuted) fixes a unique
+    nearest configuration: a symmetric mechanism gets a symmetric reference. A local minimum from a finite set of
+    starts, not a certified global one; the same every run.
+
+    Raises:
+        AssemblyError: no start closes the loops (as :func:`assemble`).
+    """
+    mech = check_mechanism(mech)
+    q_zero = pin.neutral(mech.model) if q0 is None else mech.check_q(q0, "q0")
+    tol = as_tolerance(tol, "tol")
+    rng = np.random.default_rng(as_count(seed, "seed", low=0, high=2**63 - 1))
+    held = np.zeros(mech.nv, dtype=bool)
+    held[mech.base_v] = True
+    cols = ~held
+
+    def closure(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        F, J = constraints.residual_and_jacobian(mech, qq)
+        J[:, held] = 0.0
+        return F, J
+
+    found: list[tuple[float, np.ndarray]] = []
+    for k in range(NEAREST_STARTS + 1):
+        scale = (0.0, 0.3, 1.0, 2.0)[min(k, 3) if k < 4 else 1 + k % 3]
+        q = pin.integrate(mech.model, q_zero, np.where(held, 0.0, scale * rng.standard_normal(mech.nv)))
+        q, F, _ = _levenberg_marquardt(mech, closure, q, tol, 200)
+        if np.abs(F).max() > tol:
+            continue
+        q = _slide_nearest(mech, q, q_zero, cols, tol)
+        if q is not None:
+            found.append((float(np.linalg.norm(mech.difference(q_zero, q))), mech.wrap(q)))
+    if not found:
+        return assemble(mech, q_zero, tol=tol, seed=seed)  # (its AssemblyError says which closure stays open)
+    best = min(d for d, _ in found)
+    near = [q for d, q in found if d <= best + 1e-9 * max(1.0, best)]
+    q = max(near, key=lambda x: tuple(np.round(x, 9)))
+    res = float(np.abs(constraints.residual(mech, q)).max())
+    return _result(mech, q, True, res, 0, len(found))
+
+
+def _slide_nearest(mech: Mechanism, q: np.ndarray, q_zero: np.ndarray, cols: np.ndarray, tol: float) \
+        -> np.ndarray | None:
+    """From the closed ``q``, a closed configuration where the distance to ``q_zero`` is locally least (its gradient
+    normal to the closures' tangent space to 1e-10), or None when the loops do not close again."""
+    m = mech.model
+
+    def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return constraints.residual_and_jacobian(mech, qq)
+
+    for _ in range(200):
+        g = np.where(cols, mech.difference(q_zero, q), 0.0)
+        J = constraints.jacobian(mech, q)[:, cols]
+        step = np.zeros(mech.nv)
+        step[cols] = -(g[cols] - np.linalg.pinv(J, rcond=1e-10) @ (J @ g[cols]))
+        if np.abs(step).max() <= 1e-10:
+            return q
+        d0 = float(np.linalg.norm(mech.difference(q_zero, q)))
+        for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625):
+            q_try, res, _ = _newton(mech, fun, pin.integrate(m, q, alpha * step), np.flatnonzero(cols), tol, 30, 0.5)
+            if res <= tol and float(np.linalg.norm(mech.difference(q_zero, q_try))) < d0:
+                q = q_try
+                break
+        else:
+            return q  # no shorter closed configuration along the projected gradient: a minimum to the step size
+    return q
+
+
 def _frames(mech: Mechanism, closure: str | None) -> str:
     """``"frames 'A' and 'B'"`` of the named closure, as its file names them."""
     c = next((c for c in mech.spec.closures if c.name == closure), None)
