@@ -442,8 +442,9 @@ NEAREST_STARTS = 12
 
 def nearest_assembly(mech: Mechanism, q0: ArrayLike | None = None, *, tol: float = DEFAULT_TOL,
                      seed: int = 0) -> SolveResult:
-    """The closed configuration nearest ``q0`` (default: the zero pose, Pinocchio's neutral configuration): the
-    rule by which a mechanism whose files state no configuration gets its reference (:mod:`pkm.core.model.builder`).
+    """The closed configuration nearest ``q0`` (default: the zero pose, Pinocchio's neutral configuration): a
+    reference chosen by a rule, for a mechanism whose files state none (not the builder's default, which is the
+    first assembly :func:`assemble` reaches: see :mod:`pkm.core.model.builder` for why).
 
     Distance: the norm of :meth:`~pkm.core.Mechanism.difference` (every joint coordinate alike, rad and m). Each of
     ``q0`` and :data:`NEAREST_STARTS` seeded perturbations of it is closed by Levenberg-Marquardt, then slid along

@@ -9,11 +9,14 @@ weighed against the mobility.
 * :func:`rebuild`: unpickling (a mechanism pickles as its URDF and spec texts).
 
 The reference configuration, by a stated rule: the files' own where they state one (the spec's ``[reference]``, a
-robot.yaml's or MJCF's keyframe read into it), which must close every loop to :data:`REFERENCE_TOL`; one that lacks
-joints is assembled from the joints it states (held) and the neutral configuration
-(:func:`pkm.core.kinematics.solve.assemble`); with no configuration stated at all, the closed configuration nearest
-the zero pose (:func:`pkm.core.kinematics.solve.nearest_assembly`: a symmetric mechanism whose symmetry fixes the
-zero pose gets a symmetric reference; of a mirrored pair, the first in the order of ``q`` from the largest).
+robot.yaml's or MJCF's keyframe read into it), which must close every loop to :data:`REFERENCE_TOL`; else the
+assembly :func:`pkm.core.kinematics.solve.assemble` reaches from the joints the files state (held) and the zero pose
+(Pinocchio's neutral configuration) for the others: Levenberg-Marquardt from there, then seeded restarts, the first
+that closes (the same every run; a closed configuration near the zero pose, not the nearest, and not chosen for
+symmetry). :func:`pkm.core.kinematics.solve.nearest_assembly` gives the nearest (a symmetric one where a symmetry
+of the mechanism fixes the zero pose); it is not the default because the nearest is often near a singularity (a
+URDF's zero pose with aligned links): Gepetto's disney_like and wl16_like would get references 3 and 2 mrad from one.
+Write a ``[reference]`` (or ``pkm.save`` a mechanism whose ``q_reference`` was set) to choose.
 Actuators that depend on the others, or freedom no actuator drives (:func:`pkm.core.differential.velocity.actuation`),
 are reported by a :class:`~pkm.errors.PkmWarning` and in :attr:`Mechanism.notes`.
 """
@@ -32,7 +35,7 @@ from pkm.core.differential.velocity import actuation
 from pkm.core.formats.base import Imported
 from pkm.core.formats.imported import import_model, with_file
 from pkm.core.kinematics import constraints
-from pkm.core.kinematics.solve import assemble, nearest_assembly
+from pkm.core.kinematics.solve import assemble
 from pkm.core.model.actuators import NUMBERS, Actuator, as_actuators
 from pkm.core.model.joints import retype_joints
 from pkm.core.model.mechanism import Mechanism
@@ -63,10 +66,7 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
     missing = [n for n, j in mech.joints.items() if j.nq > 0 and n not in spec.reference]
     if missing:  # a partial (or no) reference: assembled from it, the other joints from the neutral configuration
         try:
-            if spec.reference or seed:
-                mech.q_reference = assemble(mech, mech.q_reference, hold=tuple(spec.reference), tol=1e-12).q
-            else:  # no configuration stated: the closed one nearest the zero pose
-                mech.q_reference = nearest_assembly(mech, tol=1e-12).q
+            mech.q_reference = assemble(mech, mech.q_reference, hold=tuple(spec.reference), tol=1e-12).q
         except AssemblyError as exc:
             if not spec.reference:  # (the file states no configuration: the loops themselves do not close)
                 raise SpecError(source, f"the loops cannot be closed: {exc}") from exc  # (its closures, gaps)

@@ -36,9 +36,9 @@ from numpy.typing import ArrayLike
 
 from pkm.core.kinematics.blocks import block_triangular
 from pkm.core.model.mechanism import Mechanism
-from pkm.core.modes.assembly import REAL_TOL, Mode, ModeSet, _check
 from pkm.core.modes.certify import Certificate, alpha_test, polish
 from pkm.core.modes.continuation import Continuation, solve
+from pkm.core.modes.modeset import REAL_TOL, Mode, ModeSet, _check
 from pkm.core.modes.polynomial import Poly, System, fix
 from pkm.core.modes.tree import REVOLUTE, PolyTree, joint_axis
 from pkm.errors import StructureError
