@@ -129,5 +129,7 @@ def mode_label(mech: Mechanism, q: np.ndarray) -> ModeLabel:
     fk, ik = _structures(mech)
     if fk is None and ik is None:
         return ModeLabel()
+    if np.array_equal(q, mech.q_reference):  # (the reference's own signs, by construction: no kinematics pass)
+        return ModeLabel(() if fk is None else (1,) * len(fk.blocks), () if ik is None else (1,) * len(ik.blocks))
     fk_m, ik_m = _mats(mech, q)
     return ModeLabel(() if fk is None else fk.signs(fk_m), () if ik is None else ik.signs(ik_m))

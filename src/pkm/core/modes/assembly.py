@@ -24,6 +24,7 @@ from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.modes.certify import Certificate, alpha_test, polish
 from pkm.core.modes.continuation import Continuation, solve, track
 from pkm.core.modes.equations import FKSystem, equations
+from pkm.core.modes.generic import assembly_modes_generic, working_modes_generic
 from pkm.core.modes.modeset import REAL_TOL, VERIFY_TOL, Mode, ModeSet, _check
 from pkm.core.modes.polynomial import System, variables
 from pkm.core.modes.reduce import Reduction, reduce_mechanism
@@ -134,12 +135,10 @@ def _generic(mech: Mechanism, refused: StructureError, precision: str, *, qa: np
              task: Any = None) -> ModeSet:
     """The generic route (:mod:`pkm.core.modes.generic`) where the reduction refused ``mech``: the assembly modes at
     the actuator values ``qa``, else the working modes at ``task``. A refusal names both reasons."""
-    from pkm.core.modes import generic
-
     try:
         if qa is not None:
-            return generic.assembly_modes_generic(mech, qa, precision=precision)
-        return generic.working_modes_generic(mech, task, precision=precision)
+            return assembly_modes_generic(mech, qa, precision=precision)
+        return working_modes_generic(mech, task, precision=precision)
     except StructureError as exc:
         raise StructureError(exc.part, f"{str(exc).removeprefix(exc.part + ': ')}; the platform reduction refuses "
                                        f"it too ({refused})") from None
@@ -178,8 +177,6 @@ def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "aut
     if method not in ("auto", "parameter", "total-degree", "generic"):
         raise InvalidInputError("method", "expected 'auto', 'parameter', 'total-degree' or 'generic'", method)
     if method == "generic":
-        from pkm.core.modes.generic import assembly_modes_generic
-
         return assembly_modes_generic(mech, qa, precision=precision)
     try:
         red = reduce_mechanism(mech)

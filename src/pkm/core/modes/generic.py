@@ -98,8 +98,11 @@ def _unknowns(mech: Mechanism, joints: list[int]) -> None:
                                                          "writes revolute and prismatic joints only" + _ALTERNATIVE)
 
 
-def _square(polys: list[Poly], n: int, what: str) -> list[Poly]:
-    polys = [p for p in polys if p.degree > 0]
+def _square(polys: list[Poly], n: int, what: str, d: pin.Data) -> list[Poly]:
+    """The equations that are not constants (rounding below 1e-12 of the mechanism's size dropped), as many as the
+    unknowns, else a StructureError."""
+    size = max(1.0, max(float(np.linalg.norm(M.translation)) for M in d.oMi))
+    polys = [q for q in (p.cleaned(size) for p in polys) if q.degree > 0]
     if len(polys) != n:
         raise StructureError(what, f"{len(polys)} independent equations in {n} unknowns: the solutions are not "
                                    "isolated points (a freedom no input fixes, or redundant closures)" + _ALTERNATIVE)
@@ -137,7 +140,7 @@ def _solutions(polys: list[Poly], groups: list[list[int]], precision: str) \
                 for i in sorted(range(n), reverse=True):
                     if i not in cols:
                         p = fix(p, i, known.get(i, 0.0))
-                sub.append(p)
+                sub.append(p.cleaned(max((abs(c) for c in p.terms.values()), default=1.0)))  # (what the known values cancel)
             cont = solve(sub, sub_groups, precision=precision)
             conts.append(cont)
             S = System(sub)
@@ -186,7 +189,7 @@ def assembly_modes_generic(mech: Mechanism, qa: np.ndarray, *, precision: str = 
     _unknowns(mech, unknown)
     tree = PolyTree(mech, d, unknown)
     rows = _closure_rows(mech, tree, _plane(mech, d))
-    polys = _square([*tree.circles, *(p for p in rows if isinstance(p, Poly))], tree.n, mech.name)
+    polys = _square([*tree.circles, *(p for p in rows if isinstance(p, Poly))], tree.n, mech.name, d)
     conts, found, n_complex = _solutions(polys, tree.groups, precision)
     modes = []
     for x, cert, paths in found:
@@ -227,7 +230,7 @@ def working_modes_generic(mech: Mechanism, task: ArrayLike | Mapping[str, Any], 
             rows.append(math.sin(named[c]) * ex[0] - math.cos(named[c]) * ex[1])
         else:
             rows.append(p["xyz".index(c)] - named[c])
-    polys = _square([*tree.circles, *(r for r in rows if isinstance(r, Poly))], tree.n, mech.name)
+    polys = _square([*tree.circles, *(r for r in rows if isinstance(r, Poly))], tree.n, mech.name, d)
     conts, found, n_complex = _solutions(polys, tree.groups, precision)
     modes = []
     for x, cert, paths in found:

@@ -29,7 +29,8 @@ class Mode:
         label: Its number in the set (0, 1, ...), sorted by distance from the reference configuration.
         q: The full configuration (every joint), recovered by the core.
         residual: Its closure residual (infinity norm) [m or rad], <= :data:`VERIFY_TOL`.
-        point: The polynomial system's solution (real; the unknowns of the reduced equations).
+        point: The polynomial system's solution (real; the unknowns of the reduced equations, or of the generic route's:
+            each unknown joint's ``(cos, sin)`` or coordinate).
         certificate: Smale's alpha test on the polished point.
         path: The index of the Bertini path that ended there (several when a mode is reached twice; one per leg for
             a working mode).

@@ -87,8 +87,7 @@ class PolyTree:
     def up(self, j: int, p: Iterable[float], stop: int = 0, *, point: bool = True) -> list[Any]:
         """A point (or direction) fixed in joint ``j``'s frame, in the frame of its ancestor ``stop`` (0: world)."""
         m, d = self.mech.model, self.d
-        q = [float(v) for v in p]
-        out: list[Any] = q
+        out: list[Any] = [float(v) for v in p]
         while j != stop:
             if j in self.slots:
                 out = self._motion(j, out, point)

@@ -26,9 +26,10 @@ from numpy.typing import ArrayLike
 
 from pkm.core.kinematics.solve import solve_ik
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.core.modes.assembly import REAL_TOL, Mode, ModeSet, _check, _generic, recover
+from pkm.core.modes.assembly import _generic, recover
 from pkm.core.modes.certify import Certificate, alpha_test, polish
 from pkm.core.modes.continuation import Path, solve
+from pkm.core.modes.modeset import REAL_TOL, Mode, ModeSet, _check
 from pkm.core.modes.polynomial import Poly, System, dot
 from pkm.core.modes.reduce import Leg, reduce_mechanism
 from pkm.core.modes.tree import PolyTree
