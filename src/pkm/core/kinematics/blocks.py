@@ -37,7 +37,7 @@ def block_triangular(nz: np.ndarray, *, ordered: bool = False) -> list[tuple[tup
         for j in np.flatnonzero(nz[i]):
             G[i, col_row[j]] = True
     count, label = connected_components(csr_matrix(G.astype(float)), directed=True, connection="strong")
-    after = [set() for _ in range(count)]  # the blocks each block needs first
+    after: list[set[int]] = [set() for _ in range(count)]  # the blocks each block needs first
     for i, r in zip(*np.nonzero(G)):
         if label[i] != label[r]:
             after[label[i]].add(int(label[r]))

@@ -74,7 +74,19 @@ class _Blocks:
 
     def signs(self, A: np.ndarray) -> tuple[int, ...]:
         S = A[np.ix_(self.rows, self.cols)]
-        return tuple(int(np.sign(np.linalg.det(S[np.ix_(r, c)]))) * s for r, c, s in self.blocks)
+        return tuple(_sign(S[np.ix_(r, c)]) * s for r, c, s in self.blocks)
+
+
+#: A block whose smallest singular value is below this, relative to its largest, is singular: sign 0.
+SINGULAR = 1e-8
+
+
+def _sign(B: np.ndarray) -> int:
+    """The sign of ``det(B)``, 0 where ``B`` is singular to :data:`SINGULAR` (there the sign is rounding)."""
+    sv = np.linalg.svd(B, compute_uv=False)
+    if not sv[-1] > SINGULAR * sv[0]:
+        return 0
+    return 1 if np.linalg.det(B) > 0 else -1
 
 
 def _structure(mats: list[np.ndarray], cols: np.ndarray) -> _Blocks | None:
@@ -98,8 +110,8 @@ def _structure(mats: list[np.ndarray], cols: np.ndarray) -> _Blocks | None:
         found = block_triangular(pattern)
     except ValueError:
         return None
-    blocks = tuple((r, c, 1 if np.linalg.det(ref[np.ix_(r, c)]) > 0 else -1) for r, c in found
-                   if not constant[np.ix_(r, c)].all())
+    signs = [(r, c, _sign(ref[np.ix_(r, c)])) for r, c in found if not constant[np.ix_(r, c)].all()]
+    blocks = tuple(b for b in signs if b[2] != 0)  # (a block singular at the reference labels nothing)
     return _Blocks(rows, cols, blocks)
 
 

@@ -486,7 +486,7 @@ def nearest_assembly(mech: Mechanism, q0: ArrayLike | None = None, *, tol: float
         return assemble(mech, q_zero, tol=tol, seed=seed)  # (its AssemblyError says which closure stays open)
     best = min(d for d, _ in found)
     near = [q for d, q in found if d <= best + 1e-9 * max(1.0, best)]
-    q = max(near, key=lambda x: tuple(np.round(x, 9)))
+    q = max(near, key=lambda x: tuple(np.round(np.asarray(x, dtype=float), 9).tolist()))
     res = float(np.abs(constraints.residual(mech, q)).max())
     return _result(mech, q, True, res, 0, len(found))
 

@@ -51,7 +51,8 @@ def _plane(mech: Mechanism, d: pin.Data) -> np.ndarray | None:
     """The normal of a planar mechanism (every revolute axis parallel, every prismatic one normal to it), else
     None."""
     m = mech.model
-    axes, slides = [], []
+    axes: list[np.ndarray] = []
+    slides: list[np.ndarray] = []
     for j in range(1, m.njoints):
         if m.joints[j].nv == 0:
             continue
@@ -128,8 +129,8 @@ def _solutions(polys: list[Poly], groups: list[list[int]], precision: str) \
     conts: list[Continuation] = []
     n_complex = 0
     partial: list[tuple[dict[int, float], list[int]]] = [({}, [])]
-    for rows, cols in blocks:
-        cols = sorted(cols)
+    for rows, block_cols in blocks:
+        cols = sorted(block_cols)
         sub_groups = [[cols.index(v) for v in g if v in cols] for g in groups]
         sub_groups = [g for g in sub_groups if g]
         grown = []
