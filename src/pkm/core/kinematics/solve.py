@@ -451,10 +451,10 @@ def nearest_assembly(mech: Mechanism, q0: ArrayLike | None = None, *, tol: float
     the closed configurations to a local minimum of the distance (the distance's gradient projected on the closures'
     null space, the loops closed again by minimum-norm Newton steps). The nearest wins; among those as near to
     ``1e-9`` (a mechanism symmetric about ``q0``, such as a five-bar mirrored by ``q -> -q``, has its nearest
-    configurations in mirrored pairs) the first in the lexicographic order of ``q`` from the largest. Because
-    each step is equivariant, a symmetry of the mechanism that fixes ``q0`` (legs alike, permuted) fixes a unique
-    nearest configuration: a symmetric mechanism gets a symmetric reference. A local minimum from a finite set of
-    starts, not a certified global one; the same every run.
+    configurations in mirrored pairs) the first in the lexicographic order of ``q`` from the largest. A symmetry
+    of the mechanism that fixes ``q0`` and the distance (legs alike, permuted) maps the nearest configuration to one
+    as near: where the nearest is unique, it is symmetric. A local minimum from a finite set of starts, not a
+    certified global one; the same every run.
 
     Raises:
         AssemblyError: no start closes the loops (as :func:`assemble`).

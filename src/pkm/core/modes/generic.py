@@ -170,8 +170,8 @@ def _mode_set(mech: Mechanism, conts: list[Continuation], modes: list[tuple], n_
     ref = mech.q_reference
     modes.sort(key=lambda m: float(np.linalg.norm(mech.difference(ref, m[0]))))
     out = tuple(Mode(k, *m) for k, m in enumerate(modes))
-    how = (f"{len(conts)} multihomogeneous homotopies, block by block, on the loop closures in {what} (Bertini 2, "
-           f"{conts[0].settings.get('mptype')} precision)")
+    how = (f"{len(conts)} multihomogeneous homotop{'y' if len(conts) == 1 else 'ies'}, block by block, on the loop "
+           f"closures in {what} (Bertini 2, {conts[0].settings.get('mptype')} precision)")
     return ModeSet(out, all(c.complete for c in conts), how, sum(len(c.paths) for c in conts),
                    sum(c.bound for c in conts), n_complex, sum(c.count("infinite") for c in conts), 0,
                    tuple(p for c in conts for p in c.failed),
