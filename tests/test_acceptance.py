@@ -12,6 +12,7 @@ power ``tau . qd_a = dE/dt`` (<= 1e-7 relative, the energy's rate from finite di
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +22,7 @@ import pkm
 from pkm import cli
 from pkm.core import dynamics
 from pkm.core.kinematics import constraints
+from pkm.errors import ModeChangeWarning
 from tests.fd import forward_jacobian_error, richardson
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -151,10 +153,18 @@ def test_the_mjcf_four_bar_keeps_its_link_lengths():
 
 
 def test_the_sdf_slider_crank_follows_its_closed_form():
-    """x = r cos(theta) + sqrt(l^2 - r^2 sin^2(theta)), the slider's travel from its pose at theta = 0."""
+    """x = r cos(theta) + sqrt(l^2 - r^2 sin^2(theta)), the slider's travel from its pose at theta = 0. From the
+    reference (theta = 0.5) the crank crosses the dead centre (theta = 0, where dx/dtheta = -r sin(theta)(1 + ...)
+    vanishes: the slider's two working modes meet) to reach theta < 0: those loop closures warn, the others not."""
     mech = load("slider_crank")
     r, l = 0.08, 0.25
+    theta_ref = mech.actuated_q(mech.q_reference)[0]
     for theta in np.linspace(-1.0, 1.0, 9):
-        q = pkm.close_loops(mech, [theta], mech.q_reference).q
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ModeChangeWarning)
+            q = pkm.close_loops(mech, [theta], mech.q_reference).q
         x = r * np.cos(theta) + np.sqrt(l**2 - (r * np.sin(theta)) ** 2)
         assert abs(q[mech.joint("rail").idx_q] - (x - (r + l))) <= 1e-10
+        crossed = theta != 0.0 and np.sign(np.sin(theta)) != np.sign(np.sin(theta_ref))
+        assert [w.message.changed for w in caught if w.category is ModeChangeWarning] == \
+            ([("working",)] if crossed else [])

@@ -93,6 +93,24 @@ class PkmWarning(UserWarning):
     as something else. The same sentence is kept in :attr:`pkm.core.Mechanism.notes`."""
 
 
+class ModeChangeWarning(PkmWarning):
+    """A solve ended in another assembly or working mode than its seed: the path from the seed crossed a
+    singularity (a Newton block's determinant changed sign, :mod:`pkm.core.kinematics.labels`).
+
+    Attributes:
+        solve: ``"loop closure"`` or ``"inverse kinematics"``.
+        changed: ``("assembly",)``, ``("working",)`` or both.
+        seed: The seed's :class:`~pkm.core.kinematics.labels.ModeLabel`.
+        result: The result's.
+    """
+
+    def __init__(self, solve: str, changed: tuple[str, ...], seed: object, result: object):
+        self.solve, self.changed, self.seed, self.result = solve, changed, seed, result
+        super().__init__(f"{solve} ended in another {' and '.join(changed)} mode than its seed's (the path crossed "
+                         f"a singularity): seed {seed}, result {result}; seed nearer the target (q0) to stay, or "
+                         "pass this mode's configuration as q0 to continue in it")
+
+
 class InvalidInputError(PkmError, ValueError):
     """An argument has the wrong shape, is not finite, or is out of range.
 

@@ -38,6 +38,7 @@ def solution_dict(mech: pkm.Mechanism, res: pkm.SolveResult, **extra) -> dict[st
         "iterations": res.iterations,
         "converged": res.converged,
         "branch": _branch_of(mech, res.q) if mech.spec.branches else None,
+        "mode": res.mode.as_dict(),
     })
 
 
@@ -53,7 +54,8 @@ def modes_dict(mech: pkm.Mechanism, modes, **extra) -> dict[str, Any]:
                    "task": task_values(mech, m.q), "residual": m.residual, "alpha": m.certificate.alpha,
                    "certified_within": m.certificate.radius if m.certificate.certified else None,
                    "outside_limits": list(m.outside_limits),
-                   "branch": _branch_of(mech, m.q) if mech.spec.branches else None} for m in modes],
+                   "branch": _branch_of(mech, m.q) if mech.spec.branches else None,
+                   "mode": pkm.mode_label(mech, m.q).as_dict()} for m in modes],
     })
 
 

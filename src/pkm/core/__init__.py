@@ -34,8 +34,9 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.model.builder": ("from_strings", "scaled_mechanism", "with_actuators"),
     "pkm.core.model.mechanism": ("Mechanism",),
     "pkm.core.model.scale": ("scale_configuration",),
+    "pkm.core.kinematics.labels": ("ModeLabel", "mode_label"),
     "pkm.core.kinematics.solve": ("ClosureProblem", "IKProblem", "SolveResult", "assemble", "branch_seed",
-                                  "close_loops", "solve_ik"),
+                                  "close_loops", "nearest_assembly", "solve_ik"),
     "pkm.core.model.spec": ("Branch", "Closure", "ClosureSpec", "TaskSpec"),
     "pkm.core.kinematics.task": ("TaskMap", "zyx_angles", "zyx_matrix"),
     "pkm.core.kinematics.trajectory": ("Jump", "Trajectory", "follow_actuators", "follow_task", "task_values"),
@@ -80,6 +81,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.identification.measurements import Measurements, measurements
     from pkm.core.identification.regressor import Parameters, parameters, regressor, regressor_batch
     from pkm.core.kinematics.configuration import Configuration
+    from pkm.core.kinematics.labels import ModeLabel, mode_label
     from pkm.core.kinematics.solve import (
         ClosureProblem,
         IKProblem,
@@ -87,6 +89,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         assemble,
         branch_seed,
         close_loops,
+        nearest_assembly,
         solve_ik,
     )
     from pkm.core.kinematics.task import TaskMap, zyx_angles, zyx_matrix

@@ -13,7 +13,6 @@ from pkm.core.modes.assembly import VERIFY_TOL
 from pkm.core.modes.continuation import solve
 from pkm.core.modes.equations import FKSystem
 from pkm.core.modes.reduce import reduce_mechanism
-from pkm.errors import StructureError
 from pkm.mechanisms.rrr3 import kinematics as rrr3_kinematics
 
 pytest.importorskip("bertini")
@@ -93,9 +92,3 @@ def test_prs3_has_eight_real_modes_at_its_reference():
     assert modes.complete and modes.n_paths == 16 and len(modes) == 8
     assert all(m.certificate.certified and m.residual <= VERIFY_TOL for m in modes)
     assert np.abs(prs3.difference(modes[0].q, prs3.q_reference)).max() < 1e-8  # mode 0: the reference itself
-
-
-def test_structures_outside_the_reduction_are_refused(built):
-    """The toy five-bar (a point on two RR legs, no platform) is refused with a StructureError naming why."""
-    with pytest.raises(StructureError):
-        assembly_modes(built("fivebar"), built("fivebar").actuated_q(built("fivebar").q_reference))

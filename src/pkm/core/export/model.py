@@ -34,6 +34,7 @@ import casadi as cs
 import numpy as np
 import pinocchio as pin
 
+from pkm.core.kinematics.blocks import block_triangular
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.dynamics import ActuatorTwin
 from pkm.core.twin.linear import PivotedLU
@@ -74,26 +75,10 @@ def diagonal_blocks(A: Expr, A_ref: np.ndarray) -> list[Block]:
     """The irreducible diagonal blocks of the square ``A``'s block triangular form, from its sparsity (a maximum
     matching puts a nonzero on every diagonal entry; the strongly connected components of the rows' graph are the
     blocks), without the blocks whose entries are all constants."""
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import connected_components, maximum_bipartite_matching
-
     n = A.shape[0]
     nz = np.array([[not A[i, j].is_zero() for j in range(n)] for i in range(n)])
-    S = csr_matrix(nz.astype(float))
-    match = maximum_bipartite_matching(S, perm_type="column")  # row i -> its column
-    if (match < 0).any():
-        raise ValueError("structurally singular")
-    col_row = np.empty(n, dtype=int)
-    col_row[match] = np.arange(n)
-    G = np.zeros((n, n), dtype=bool)  # row i -> row r when A[i, match[r]] != 0
-    for i in range(n):
-        for j in np.flatnonzero(nz[i]):
-            G[i, col_row[j]] = True
-    count, label = connected_components(csr_matrix(G.astype(float)), directed=True, connection="strong")
     blocks = []
-    for k in range(count):
-        rows = tuple(int(r) for r in np.flatnonzero(label == k))
-        cols = tuple(int(match[r]) for r in rows)
+    for rows, cols in block_triangular(nz):
         if all(A[r, c].is_constant() for r in rows for c in cols):
             continue
         det = float(np.linalg.det(A_ref[np.ix_(rows, cols)]))

@@ -24,6 +24,7 @@ iterations for a whole solve. No solver returns a non-finite configuration.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -33,9 +34,17 @@ from numpy.typing import ArrayLike
 
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
+from pkm.core.kinematics.labels import ModeLabel, mode_label
 from pkm.core.kinematics.newton import gauss_newton
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.errors import AssemblyError, BranchError, ConvergenceError, InvalidInputError, UnreachableError
+from pkm.errors import (
+    AssemblyError,
+    BranchError,
+    ConvergenceError,
+    InvalidInputError,
+    ModeChangeWarning,
+    UnreachableError,
+)
 from pkm.validation import as_count, as_scalar, as_tolerance
 
 DEFAULT_TOL = 1e-12
@@ -58,6 +67,9 @@ class SolveResult:
         iterations: Newton iterations, all continuation steps included.
         steps: Continuation steps taken (1 when solved directly).
         branch_signs: Signs of the default-branch joints at ``q`` (empty without branches).
+        mode: The assembly and working mode labels at ``q`` (:class:`~pkm.core.kinematics.labels.ModeLabel`: the
+            signs of the solvers' Newton blocks relative to the reference's; a solve that ends in another mode than
+            its seed's warns, :class:`~pkm.errors.ModeChangeWarning`).
         outside_limits: The joints whose coordinate at ``q`` lies outside the position limits their URDF
             states (:meth:`pkm.core.Mechanism.outside_limits`); pkm's solvers do not enforce limits.
     """
@@ -69,6 +81,7 @@ class SolveResult:
     steps: int = 1
     branch_signs: dict[str, int] = field(default_factory=dict)
     outside_limits: tuple[str, ...] = ()
+    mode: ModeLabel = field(default_factory=ModeLabel)
 
     def check(self, mech: Mechanism, *, tol: float = 1e-9) -> bool:
         """Whether this result still holds on ``mech``, checked again from ``q`` alone (as qpsolvers'
@@ -168,7 +181,16 @@ def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.nd
 
 def _result(mech: Mechanism, q: np.ndarray, converged: bool, residual: float, iterations: int,
             steps: int) -> SolveResult:
-    return SolveResult(q, converged, residual, iterations, steps, _signs(mech, q), mech.outside_limits(q))
+    return SolveResult(q, converged, residual, iterations, steps, _signs(mech, q), mech.outside_limits(q),
+                       mode_label(mech, q))
+
+
+def _warn_mode_change(what: str, seed: ModeLabel, result: SolveResult) -> None:
+    """A :class:`~pkm.errors.ModeChangeWarning` when a converged ``result`` lies in another assembly or working
+    mode than its seed (a block's determinant changed sign on the way: the path crossed a singularity)."""
+    changed = seed.differs(result.mode) if result.converged else ()
+    if changed:
+        warnings.warn(ModeChangeWarning(what, changed, seed, result.mode), stacklevel=3)
 
 
 def _follow(mech: Mechanism, what: str, solve_at: _StepSolver, q: np.ndarray, n_steps: int, tol: float,
@@ -226,7 +248,9 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
     Args:
         mech: The mechanism.
         q_actuated: Actuated coordinates in spec order (rad or m), shape (na,).
-        q0: Seed configuration (nq,); its assembly mode is kept. Default: the reference configuration.
+        q0: Seed configuration (nq,); its assembly mode is kept (a result in another assembly or working mode, the
+            path having crossed a singularity, warns: :class:`~pkm.errors.ModeChangeWarning`). Default: the
+            reference configuration.
         tol: Tolerance on the infinity norm of the closure residual [m, rad].
         max_iter: Newton iterations allowed per continuation step.
         max_step: Largest change of an actuated coordinate per continuation step [rad or m].
@@ -250,11 +274,14 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
     def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int]:
         return _newton(mech, fun, mech.with_actuated(q, qa0 + s * (qa1 - qa0)), mech.passive_v, t, max_iter, 0.5)
 
+    seed = mode_label(mech, q)
     try:
-        return _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure)
+        result = _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure)
     except ConvergenceError as exc:
         exc.problem = ClosureProblem(mech, qa1)
         raise
+    _warn_mode_change("loop closure", seed, result)
+    return result
 
 
 def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: ArrayLike | None = None, *,
@@ -267,7 +294,8 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
         target: Task coordinates (see :meth:`pkm.core.kinematics.task.TaskMap.parse`): a vector, or a mapping by name of
             some of them (``{"z": "-36cm"}``), the others those of the reference; values may carry units.
         q0: Seed configuration; default: the reference configuration (or, with ``branch``,
-            the reference with that branch's joint signs imposed and the loops re-closed).
+            the reference with that branch's joint signs imposed and the loops re-closed). A result in another
+            working or assembly mode than the seed's warns (:class:`~pkm.errors.ModeChangeWarning`).
         branch: Working mode the solution must lie on; checked at the end (:class:`BranchError`).
         tol: Tolerance on the infinity norm of closure residual and task error [m, rad].
         max_iter: Newton iterations allowed per continuation step.
@@ -293,6 +321,7 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
         return _newton(mech, goal.evaluate, q, mech.free_v, t, max_iter, 0.5)
 
     problem = IKProblem(mech, y1)
+    seed = mode_label(mech, q)
     try:
         result = _follow(mech, "inverse kinematics", solve_at, q, n_steps, tol, raise_on_failure)
     except ConvergenceError as exc:
@@ -303,6 +332,7 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
     q = result.q
     if result.converged and branch is not None and not mech.on_branch(q, branch):
         raise BranchError(branch, dict(mech.branch(branch).signs), mech.branch_signs(q, branch))
+    _warn_mode_change("inverse kinematics", seed, result)
     return result
 
 
@@ -404,6 +434,88 @@ def assemble(mech: Mechanism, q0: ArrayLike | None = None, *, hold: Sequence[str
                         f"({_frames(mech, err.worst_closure)}) stays open by {err.worst_gap:.3g}")
     raise AssemblyError(best[0], "m or rad", detail, subject="this mechanism",
                         closures=alone or ((str(err.worst_closure), err.worst_gap),))
+
+
+#: Seeded starts of :func:`nearest_assembly` besides ``q0`` itself (normal draws of 0.3, 1 and 2 rad or m).
+NEAREST_STARTS = 12
+
+
+def nearest_assembly(mech: Mechanism, q0: ArrayLike | None = None, *, tol: float = DEFAULT_TOL,
+                     seed: int = 0) -> SolveResult:
+    """The closed configuration nearest ``q0`` (default: the zero pose, Pinocchio's neutral configuration): a
+    reference chosen by a rule, for a mechanism whose files state none (not the builder's default, which is the
+    first assembly :func:`assemble` reaches: see :mod:`pkm.core.model.builder` for why).
+
+    Distance: the norm of :meth:`~pkm.core.Mechanism.difference` (every joint coordinate alike, rad and m). Each of
+    ``q0`` and :data:`NEAREST_STARTS` seeded perturbations of it is closed by Levenberg-Marquardt, then slid along
+    the closed configurations to a local minimum of the distance (the distance's gradient projected on the closures'
+    null space, the loops closed again by minimum-norm Newton steps). The nearest wins; among those as near to
+    ``1e-9`` (a mechanism symmetric about ``q0``, such as a five-bar mirrored by ``q -> -q``, has its nearest
+    configurations in mirrored pairs) the first in the lexicographic order of ``q`` from the largest. A symmetry
+    of the mechanism that fixes ``q0`` and the distance (legs alike, permuted) maps the nearest configuration to one
+    as near: where the nearest is unique, it is symmetric. A local minimum from a finite set of starts, not a
+    certified global one; the same every run.
+
+    Raises:
+        AssemblyError: no start closes the loops (as :func:`assemble`).
+    """
+    mech = check_mechanism(mech)
+    q_zero = pin.neutral(mech.model) if q0 is None else mech.check_q(q0, "q0")
+    tol = as_tolerance(tol, "tol")
+    rng = np.random.default_rng(as_count(seed, "seed", low=0, high=2**63 - 1))
+    held = np.zeros(mech.nv, dtype=bool)
+    held[mech.base_v] = True
+    cols = ~held
+
+    def closure(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        F, J = constraints.residual_and_jacobian(mech, qq)
+        J[:, held] = 0.0
+        return F, J
+
+    found: list[tuple[float, np.ndarray]] = []
+    for k in range(NEAREST_STARTS + 1):
+        scale = (0.0, 0.3, 1.0, 2.0)[min(k, 3) if k < 4 else 1 + k % 3]
+        q = pin.integrate(mech.model, q_zero, np.where(held, 0.0, scale * rng.standard_normal(mech.nv)))
+        q, F, _ = _levenberg_marquardt(mech, closure, q, tol, 200)
+        if np.abs(F).max() > tol:
+            continue
+        q = _slide_nearest(mech, q, q_zero, cols, tol)
+        if q is not None:
+            found.append((float(np.linalg.norm(mech.difference(q_zero, q))), mech.wrap(q)))
+    if not found:
+        return assemble(mech, q_zero, tol=tol, seed=seed)  # (its AssemblyError says which closure stays open)
+    best = min(d for d, _ in found)
+    near = [q for d, q in found if d <= best + 1e-9 * max(1.0, best)]
+    q = max(near, key=lambda x: tuple(np.round(np.asarray(x, dtype=float), 9).tolist()))
+    res = float(np.abs(constraints.residual(mech, q)).max())
+    return _result(mech, q, True, res, 0, len(found))
+
+
+def _slide_nearest(mech: Mechanism, q: np.ndarray, q_zero: np.ndarray, cols: np.ndarray, tol: float) \
+        -> np.ndarray | None:
+    """From the closed ``q``, a closed configuration where the distance to ``q_zero`` is locally least (its gradient
+    normal to the closures' tangent space to 1e-10), or None when the loops do not close again."""
+    m = mech.model
+
+    def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return constraints.residual_and_jacobian(mech, qq)
+
+    for _ in range(200):
+        g = np.where(cols, mech.difference(q_zero, q), 0.0)
+        J = constraints.jacobian(mech, q)[:, cols]
+        step = np.zeros(mech.nv)
+        step[cols] = -(g[cols] - np.linalg.pinv(J, rcond=1e-10) @ (J @ g[cols]))
+        if np.abs(step).max() <= 1e-10:
+            return q
+        d0 = float(np.linalg.norm(mech.difference(q_zero, q)))
+        for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625):
+            q_try, res, _ = _newton(mech, fun, pin.integrate(m, q, alpha * step), np.flatnonzero(cols), tol, 30, 0.5)
+            if res <= tol and float(np.linalg.norm(mech.difference(q_zero, q_try))) < d0:
+                q = q_try
+                break
+        else:
+            return q  # no shorter closed configuration along the projected gradient: a minimum to the step size
+    return q
 
 
 def _frames(mech: Mechanism, closure: str | None) -> str:

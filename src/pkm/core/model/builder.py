@@ -9,8 +9,15 @@ weighed against the mobility.
 * :func:`scaled_mechanism`: a copy with every length scaled (:mod:`pkm.core.model.scale`);
 * :func:`rebuild`: unpickling (a mechanism pickles as its URDF and spec texts).
 
-A reference that lacks joints is assembled from the joints it states (held) and the neutral configuration
-(:func:`pkm.core.kinematics.solve.assemble`); a complete one must close every loop to :data:`REFERENCE_TOL`.
+The reference configuration, by a stated rule: the files' own where they state one (the spec's ``[reference]``, a
+robot.yaml's or MJCF's keyframe read into it), which must close every loop to :data:`REFERENCE_TOL`; else the
+assembly :func:`pkm.core.kinematics.solve.assemble` reaches from the joints the files state (held) and the zero pose
+(Pinocchio's neutral configuration) for the others: Levenberg-Marquardt from there, then seeded restarts, the first
+that closes (the same every run; a closed configuration near the zero pose, not the nearest, and not chosen for
+symmetry). :func:`pkm.core.kinematics.solve.nearest_assembly` gives the nearest (a symmetric one where a symmetry
+of the mechanism fixes the zero pose); it is not the default because the nearest is often near a singularity (a
+URDF's zero pose with aligned links): Gepetto's disney_like and wl16_like would get references 3 and 2 mrad from one.
+Write a ``[reference]`` (or ``pkm.save`` a mechanism whose ``q_reference`` was set) to choose.
 Actuators that depend on the others, or freedom no actuator drives (:func:`pkm.core.differential.velocity.actuation`),
 are reported by a :class:`~pkm.errors.PkmWarning` and in :attr:`Mechanism.notes`.
 """

@@ -13,99 +13,23 @@ at infinity, on the exceptional set and complex, and every failed path; one fail
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
-from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import _levenberg_marquardt, assemble
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.modes.certify import Certificate, alpha_test, polish
-from pkm.core.modes.continuation import Continuation, Path, solve, track
+from pkm.core.modes.continuation import Continuation, solve, track
 from pkm.core.modes.equations import FKSystem, equations
+from pkm.core.modes.generic import assembly_modes_generic, working_modes_generic
+from pkm.core.modes.modeset import REAL_TOL, VERIFY_TOL, Mode, ModeSet, _check
 from pkm.core.modes.polynomial import System, variables
 from pkm.core.modes.reduce import Reduction, reduce_mechanism
 from pkm.core.modes.starts import generic_start, path_parameters
-from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError
-
-#: A solution is real when its imaginary part is below this, relative to its size.
-REAL_TOL = 1e-8
-#: Every recovered configuration closes its loops to this [m or rad].
-VERIFY_TOL = 1e-10
-
-
-@dataclass(frozen=True)
-class Mode:
-    """One real solution: an assembly mode (or, from :func:`~pkm.core.modes.working.working_modes`, a working mode).
-
-    Attributes:
-        label: Its number in the set (0, 1, ...), sorted by distance from the reference configuration.
-        q: The full configuration (every joint), recovered by the core.
-        residual: Its closure residual (infinity norm) [m or rad], <= :data:`VERIFY_TOL`.
-        point: The polynomial system's solution (real; the unknowns of the reduced equations).
-        certificate: Smale's alpha test on the polished point.
-        path: The index of the Bertini path that ended there (several when a mode is reached twice; one per leg for
-            a working mode).
-        outside_limits: The joints outside the position limits the files state (kept: a mode is geometry; whether
-            the machine can reach it is the limits' business).
-    """
-
-    label: int
-    q: np.ndarray
-    residual: float
-    point: np.ndarray
-    certificate: Certificate
-    path: tuple[int, ...]
-    outside_limits: tuple[str, ...] = ()
-
-
-@dataclass(frozen=True)
-class ModeSet:
-    """Every real solution found, and the account of how it was found.
-
-    Attributes:
-        modes: The real solutions as :class:`Mode` (configurations verified by the core).
-        complete: Every path ended (finite or at infinity), so the set holds every isolated real solution
-            (with probability one); False as soon as one path failed.
-        method: How the set was found (the homotopy, its start system and bound).
-        n_paths: Paths tracked.
-        bound: The Bezout number the start system has (total degree or multihomogeneous).
-        n_complex: Finite solutions that are not real.
-        n_infinite: Paths that went to infinity.
-        n_exceptional: Finite real solutions that are not poses (Study's exceptional set ``e = 0``).
-        failed: The paths that failed, with Bertini's code.
-        reduction: The reduced structure (:meth:`pkm.core.modes.reduce.Reduction.describe`).
-        seconds: Wall time of the homotopy [s].
-    """
-
-    modes: tuple[Mode, ...]
-    complete: bool
-    method: str
-    n_paths: int
-    bound: int
-    n_complex: int
-    n_infinite: int
-    n_exceptional: int
-    failed: tuple[Path, ...]
-    reduction: str
-    seconds: float
-
-    def __len__(self) -> int:
-        return len(self.modes)
-
-    def __iter__(self) -> Iterator[Mode]:
-        return iter(self.modes)
-
-    def __getitem__(self, k: int) -> Mode:
-        return self.modes[k]
-
-    def summary(self) -> str:
-        state = "complete" if self.complete else f"NOT complete: {len(self.failed)} path(s) failed"
-        return (f"{len(self.modes)} real solutions ({self.n_complex} complex, {self.n_exceptional} exceptional, "
-                f"{self.n_infinite} at infinity) from {self.n_paths} paths of {self.method}; {state}")
+from pkm.errors import AssemblyError, ConvergenceError, InvalidInputError, StructureError
 
 
 def _place_platform(mech: Mechanism, red: Reduction, q: np.ndarray, T: pin.SE3, rng: np.random.Generator) \
@@ -164,13 +88,6 @@ def recover(mech: Mechanism, red: Reduction, q_actuated: ArrayLike, R: np.ndarra
     return q
 
 
-def _check(mech: Mechanism, q: np.ndarray) -> float:
-    res = float(np.abs(constraints.residual(mech, q)).max())
-    if not res <= VERIFY_TOL:
-        raise ConvergenceError("the core's check of a recovered mode", res, 0, VERIFY_TOL)
-    return res
-
-
 def real_solutions(cont: Continuation, sys_: FKSystem, distinct: float = 1e-7) \
         -> tuple[list[tuple[np.ndarray, Certificate, list[int]]], int, int]:
     """The finite real solutions of a continuation, polished and certified, merged when closer than ``distinct``;
@@ -214,17 +131,33 @@ def parameter_homotopy(system: FKSystem, *, precision: str = "adaptive", threads
     return cont
 
 
+def _generic(mech: Mechanism, refused: StructureError, precision: str, *, qa: np.ndarray | None = None,
+             task: Any = None) -> ModeSet:
+    """The generic route (:mod:`pkm.core.modes.generic`) where the reduction refused ``mech``: the assembly modes at
+    the actuator values ``qa``, else the working modes at ``task``. A refusal names both reasons."""
+    try:
+        if qa is not None:
+            return assembly_modes_generic(mech, qa, precision=precision)
+        return working_modes_generic(mech, task, precision=precision)
+    except StructureError as exc:
+        raise StructureError(exc.part, f"{str(exc).removeprefix(exc.part + ': ')}; the platform reduction refuses "
+                                       f"it too ({refused})") from None
+
+
 def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "auto", precision: str = "adaptive",
                    threads: int = 2, continuation: Continuation | None = None) -> ModeSet:
     """Every real assembly mode of ``mech`` at the actuator values ``q_actuated`` (module doc).
 
     Args:
-        mech: Any mechanism the reduction covers (:mod:`pkm.core.modes.reduce`; others are refused with a
-            :class:`~pkm.errors.StructureError`).
+        mech: Any mechanism the reduction covers (:mod:`pkm.core.modes.reduce`) or, failing that, the generic route
+            (:mod:`pkm.core.modes.generic`: revolute and prismatic joints, point closures); others are refused with
+            a :class:`~pkm.errors.StructureError` naming both reasons.
         q_actuated: The actuated coordinates in spec order [rad or m].
         method: ``"total-degree"`` (Bertini's total-degree start), ``"parameter"`` (a parameter homotopy from the
-            family's generic solutions, :mod:`pkm.core.modes.starts`) or ``"auto"`` (parameter for a spatial
-            platform, total degree for the small planar and translational systems).
+            family's generic solutions, :mod:`pkm.core.modes.starts`), ``"generic"`` (no reduction: the closures in
+            every passive joint, :mod:`pkm.core.modes.generic`) or ``"auto"`` (parameter for a spatial platform,
+            total degree for the small planar and translational systems, generic where the reduction finds no
+            platform: a task point on a leg).
         precision: Bertini's precision mode (``"adaptive"``: the safe default).
         threads: Bertini's tracking threads.
         continuation: A finished :class:`~pkm.core.modes.continuation.Continuation` of this very system to use
@@ -234,14 +167,23 @@ def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "aut
         A :class:`ModeSet`; its modes sorted by distance from the reference configuration.
 
     Raises:
-        StructureError: the mechanism's structure is outside the reduction.
+        StructureError: the mechanism's structure is outside the reduction and the generic route.
         MissingDependencyError: bertini2 is not installed.
         ConvergenceError: a real solution whose legs the core cannot close (a defect: the reduction and the tree
             disagree).
     """
     mech = check_mechanism(mech)
     qa = mech.check_actuated(q_actuated, positions=True)
-    red = reduce_mechanism(mech)
+    if method not in ("auto", "parameter", "total-degree", "generic"):
+        raise InvalidInputError("method", "expected 'auto', 'parameter', 'total-degree' or 'generic'", method)
+    if method == "generic":
+        return assembly_modes_generic(mech, qa, precision=precision)
+    try:
+        red = reduce_mechanism(mech)
+    except StructureError as exc:
+        if method != "auto" or continuation is not None:
+            raise
+        return _generic(mech, exc, precision, qa=qa)
     d = mech.model.createData()
     pin.forwardKinematics(mech.model, d, mech.with_actuated(mech.q_reference, qa))
     system = FKSystem(red, d)
@@ -249,11 +191,9 @@ def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "aut
         cont = continuation
     elif method == "parameter" or (method == "auto" and red.group == "SE3"):
         cont = parameter_homotopy(system, precision=precision, threads=threads)
-    elif method in ("auto", "total-degree"):
+    else:
         cont = solve(system.polys, system.groups, projective=system.projective, precision=precision,
                      threads=threads)
-    else:
-        raise InvalidInputError("method", "expected 'auto', 'parameter' or 'total-degree'", method)
     found, n_complex, n_exc = real_solutions(cont, system)
     modes = []
     for x, cert, paths in found:

@@ -17,8 +17,7 @@ the sliders do, so this is not a restriction there; it would be for a mechanism 
 from __future__ import annotations
 
 import itertools
-import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -27,103 +26,46 @@ from numpy.typing import ArrayLike
 
 from pkm.core.kinematics.solve import solve_ik
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.core.modes.assembly import REAL_TOL, Mode, ModeSet, _check, recover
+from pkm.core.modes.assembly import _generic, recover
 from pkm.core.modes.certify import Certificate, alpha_test, polish
 from pkm.core.modes.continuation import Path, solve
-from pkm.core.modes.polynomial import Poly, System, dot, matvec, variables
+from pkm.core.modes.modeset import REAL_TOL, Mode, ModeSet, _check
+from pkm.core.modes.polynomial import Poly, System, dot
 from pkm.core.modes.reduce import Leg, reduce_mechanism
+from pkm.core.modes.tree import PolyTree
 from pkm.errors import StructureError, UnreachableError
-
-_REVOLUTE = {"RX", "RY", "RZ", "RevoluteUnaligned"}
-_PRISMATIC = {"PX", "PY", "PZ", "PrismaticUnaligned"}
-
-
-def _axis(model: pin.Model, jid: int) -> tuple[str, np.ndarray]:
-    jm = model.joints[jid]
-    jd = jm.createData()
-    jm.calc(jd, np.zeros(jm.nq))
-    S = np.asarray(jd.S, dtype=float).reshape(6, -1)[:, 0]
-    kind = jm.shortname().removeprefix("JointModel")
-    return ("R", S[3:] / np.linalg.norm(S[3:])) if kind in _REVOLUTE else ("P", S[:3] / np.linalg.norm(S[:3]))
 
 
 class _LegSystem:
     """One leg's equations in its unknown actuated joints (see the module doc)."""
 
     def __init__(self, mech: Mechanism, leg: Leg, d: pin.Data, B: np.ndarray, unknown: list[int]):
-        m = mech.model
-        self.mech, self.leg, self.unknown = mech, leg, unknown
-        self.kinds = [_axis(m, j) for j in unknown]
-        n = sum(2 if k == "R" else 1 for k, _ in self.kinds)
-        x = variables(n)
-        self.slots: dict[int, tuple[int, ...]] = {}
-        k = 0
-        polys: list[Poly] = []
-        for j, (kind, _) in zip(unknown, self.kinds):
-            self.slots[j] = (k, k + 1) if kind == "R" else (k,)
-            if kind == "R":
-                polys.append(x[k] * x[k] + x[k + 1] * x[k + 1] - 1.0)
-            k += len(self.slots[j])
-        self._x, self._d = x, d
+        self.tree = tree = PolyTree(mech, d, unknown)
+        self.leg, self.unknown = leg, unknown
+        polys: list[Poly] = list(tree.circles)
         jc, a = leg.center
         jt, tip = leg.tip
-        A = self._up(jc, a, 0, point=True)
-        r = [p - float(c) for p, c in zip(self._up(jt, tip, jc, point=True), a)]
+        A = tree.up(jc, a)
+        r = [p - float(c) for p, c in zip(tree.up(jt, tip, jc), a)]
         polys.append(dot([B[i] - A[i] for i in range(3)], [B[i] - A[i] for i in range(3)]) - dot(r, r))
         if leg.axis is not None:
-            nvec = self._up(jc, leg.axis, 0, point=False)
+            nvec = tree.up(jc, leg.axis, point=False)
             polys.append(dot(nvec, [B[i] - A[i] for i in range(3)]) - dot(leg.axis, r))
         size = max(1.0, float(np.abs(B).max()), float(np.abs(np.asarray(a, dtype=float)).max()))
         polys = [p.cleaned(size ** 2) for p in polys]
         self.constants = [p for p in polys if p.degree == 0]
         self.polys = [p for p in polys if p.degree > 0]
-        if len(self.polys) != n:
-            raise StructureError(leg.name, f"{len(self.polys)} equations in {n} unknowns of its actuated joints: the "
-                                           "working modes of this leg are not isolated")
-
-    def _motion(self, j: int, p: Sequence[Any], point: bool) -> list[Any]:  # entries: numbers or Polys
-        m = self.mech.model
-        kind, w = self.kinds[self.unknown.index(j)]
-        sl = self.slots[j]
-        if kind == "R":
-            c, s = self._x[sl[0]], self._x[sl[1]]
-            W = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
-            ww = np.outer(w, w)
-            R = [[c * (float(i == k) - ww[i, k]) + s * W[i, k] + ww[i, k] for k in range(3)] for i in range(3)]
-            p = matvec(R, p)
-        elif point:
-            p = [p[i] + self._x[sl[0]] * float(w[i]) for i in range(3)]
-        M = m.jointPlacements[j]
-        out = matvec(M.rotation, p)
-        return [out[i] + float(M.translation[i]) for i in range(3)] if point else out
-
-    def _up(self, j: int, p: Iterable[float], stop: int, point: bool) -> list[Any]:
-        """A point (or direction) fixed in joint ``j``'s frame, in the frame of ancestor ``stop`` (0: world)."""
-        m, d = self.mech.model, self._d
-        p = [float(v) for v in p]
-        while j != stop:
-            if j in self.slots:
-                p = self._motion(j, p, point)
-            else:
-                M = d.liMi[j]
-                out = matvec(M.rotation, p)
-                p = [out[i] + float(M.translation[i]) for i in range(3)] if point else out
-            j = int(m.parents[j])
-        return p
-
-    def values(self, x: np.ndarray) -> dict[int, float]:
-        out = {}
-        for j, (kind, _) in zip(self.unknown, self.kinds):
-            sl = self.slots[j]
-            out[j] = float(math.atan2(x[sl[1]], x[sl[0]])) if kind == "R" else float(x[sl[0]])
-        return out
+        if len(self.polys) != tree.n:
+            raise StructureError(leg.name, f"{len(self.polys)} equations in {tree.n} unknowns of its actuated joints: "
+                                           "the working modes of this leg are not isolated")
 
 
 def working_modes(mech: Mechanism, task: ArrayLike | Mapping[str, Any], *, precision: str = "adaptive") -> ModeSet:
     """Every real working mode of ``mech`` at the task coordinates ``task`` (module doc).
 
     Args:
-        mech: Any mechanism the reduction covers (:mod:`pkm.core.modes.reduce`).
+        mech: Any mechanism the reduction covers (:mod:`pkm.core.modes.reduce`) or, where it finds no platform
+            (a task point on a leg), the generic route covers (:mod:`pkm.core.modes.generic`).
         task: Task coordinates (:meth:`pkm.core.kinematics.task.TaskMap.parse`: a vector or a mapping by name, with units).
         precision: Bertini's precision mode.
 
@@ -134,10 +76,13 @@ def working_modes(mech: Mechanism, task: ArrayLike | Mapping[str, Any], *, preci
 
     Raises:
         UnreachableError: the task is out of reach, or a leg has no real solution (which leg).
-        StructureError: the structure is outside the reduction.
+        StructureError: the structure is outside the reduction and the generic route.
     """
     mech = check_mechanism(mech)
-    red = reduce_mechanism(mech)
+    try:
+        red = reduce_mechanism(mech)
+    except StructureError as exc:
+        return _generic(mech, exc, precision, task=task)
     q0 = solve_ik(mech, task).q  # the platform's pose (and the task joints)
     d = mech.model.createData()
     pin.forwardKinematics(mech.model, d, q0)
@@ -179,11 +124,7 @@ def working_modes(mech: Mechanism, task: ArrayLike | Mapping[str, Any], *, preci
     for combo in itertools.product(*[sols for _, sols in legs]):
         qa_q = q0.copy()
         for (ls, _), (x, _, _) in zip(legs, combo):
-            for j, v in ls.values(x).items():
-                info = mech.model.joints[j]
-                if (ls.kinds[ls.unknown.index(j)][0]) == "R":  # the turn nearest the reference's
-                    v = ref[info.idx_q] + (v - ref[info.idx_q] + math.pi) % (2.0 * math.pi) - math.pi
-                qa_q[info.idx_q] = v
+            qa_q = ls.tree.configuration(qa_q, x, ref)  # (an angle on the turn nearest the reference's)
         R, t = G.rotation, G.translation
         q = recover(mech, red, mech.actuated_q(qa_q), R, t)
         for tj in mech.task_joints:

@@ -1,0 +1,60 @@
+"""Mode labels on every solve result, the warning when a solve ends in another mode than its seed, and the
+nearest assembly to the zero pose."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize
+
+import pkm
+from pkm.core.kinematics import constraints
+from pkm.errors import ModeChangeWarning
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def test_an_ik_across_a_direct_singularity_warns_and_fk_confirms_the_other_assembly_mode(built):
+    """The toy five-bar's tip moved down past the aligned distal links: the inverse kinematics follows the path
+    (well posed there) into the other assembly mode and says so; the loop closure from the reference at the same
+    actuators (an independent route) lands elsewhere, in the reference's assembly mode. A short move stays silent."""
+    mech = built("fivebar")
+    y0 = mech.task_map.value(mech.q_reference)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ModeChangeWarning)
+        near = pkm.solve_ik(mech, y0 + [0.0, -0.1])
+    assert near.mode == pkm.solve_ik(mech, y0).mode == pkm.ModeLabel((1,), (1, 1))
+    with pytest.warns(ModeChangeWarning) as record:
+        far = pkm.solve_ik(mech, y0 + [0.0, -0.3])
+    w = record[0].message
+    assert w.changed == ("assembly",) and w.seed.assembly == (1,) and w.result == far.mode
+    assert far.mode.assembly == (-1,) and far.mode.assembly_id == 1 and far.mode.working == (1, 1)
+    fk = pkm.close_loops(mech, mech.actuated_q(far.q))  # from the reference, which it keeps
+    assert fk.mode.assembly == (1,) and np.abs(mech.difference(fk.q, far.q)).max() > 0.1
+    assert np.abs(mech.actuated_q(fk.q) - mech.actuated_q(far.q)).max() < 1e-12
+
+
+def test_nearest_assembly_is_the_closed_configuration_nearest_the_zero_pose(tmp_path):
+    """The five-bar of examples/your_own_fivebar.py states no [reference]: pkm.nearest_assembly gives the closed
+    configuration nearest q = 0 (SLSQP from 12 starts, an independent route, finds no nearer one; the default
+    assembly is 2.7 times as far), of the mirrored pair q, -q the one with the larger first coordinate."""
+    spec = (ROOT / "examples" / "your_own_fivebar.py").read_text().split('SPEC = """\\\n')[1].split('"""')[0]
+    (tmp_path / "fivebar.urdf").write_text((ROOT / "examples" / "gepetto_fivebar" / "robot.urdf").read_text())
+    (tmp_path / "fivebar.closures.toml").write_text(spec)
+    mech = pkm.load(tmp_path / "fivebar.closures.toml")
+    res = pkm.nearest_assembly(mech)
+    q = res.q
+    assert res.converged and np.abs(constraints.residual(mech, q)).max() < 1e-12
+    rng = np.random.default_rng(1)
+    best = np.inf
+    for _ in range(12):
+        r = minimize(lambda x: x @ x, rng.uniform(-np.pi, np.pi, 4), jac=lambda x: 2 * x, method="SLSQP",
+                     constraints=[{"type": "eq", "fun": lambda x: constraints.residual(mech, x)[:2]}],
+                     options={"ftol": 1e-14, "maxiter": 500})
+        if np.abs(constraints.residual(mech, r.x)).max() < 1e-9:
+            best = min(best, float(np.linalg.norm(r.x)))
+    assert np.linalg.norm(q) <= best + 1e-7 and np.linalg.norm(q) < 0.5 * np.linalg.norm(mech.q_reference)
+    assert np.abs(constraints.residual(mech, -q)).max() < 1e-12 and q[0] > 0  # the mirrored one: not chosen
