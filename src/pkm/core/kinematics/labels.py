@@ -116,9 +116,14 @@ def _structure(mats: list[np.ndarray], cols: np.ndarray) -> _Blocks | None:
 
 
 def _mats(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The closure and the closure-and-task Jacobians at ``q``, homogenised (:mod:`pkm.core.model.scale`: positive
+    row and column factors, so the determinants' signs are the raw matrices' and the singularity thresholds mean the
+    same at any size)."""
     c = Configuration.compute(mech, q)
     J = np.array(c.closure_and_task_jacobian)
-    return J[:mech.n_constraints], J
+    scales = mech.jacobian_scales
+    Jc = scales.constraint(J[:mech.n_constraints])
+    return Jc, np.vstack([Jc, scales.task(J[mech.n_constraints:])])
 
 
 def _structures(mech: Mechanism) -> tuple[_Blocks | None, _Blocks | None]:
