@@ -6,18 +6,17 @@ actuated and passive columns (:mod:`pkm.core.kinematics.constraints`), ``M`` Pin
 (``crba``, the actuators' reflected inertia on its diagonal, :mod:`pkm.core.model.actuators`) and ``b`` its
 non-linear effects (``rnea``):
 
-* ``G``: joint rates from actuated rates (:func:`~pkm.core.differential.velocity.passive_map`), ``v = G qd``;
+* ``Ĝ``: joint rates from actuated rates, ``v = Ĝ qd`` (:func:`~pkm.core.differential.velocity.passive_map`,
+  :func:`pkm.velocities`);
 * the **idle motions** ``N`` (a rod spinning between two balls: passive motions the closures and the task leave
   free with the actuators locked) are **kept out of the state** by pkm's one idle-motion convention
-  (:mod:`pkm.core.differential.idle`): rates and accelerations carry none in the mass metric. ``G`` is
-  :func:`~pkm.core.differential.velocity.passive_map`'s, ``Ĝ = G_0 - N (Nᵀ M N)⁺ Nᵀ M G_0`` (``G_0`` the
-  minimum-norm map), mass-orthogonal to the idle motions (``Nᵀ M Ĝ = 0``), so that ``v = Ĝ qd`` is
-  :func:`pkm.velocities`' and the spin carries no momentum of its own. For a rod whose inertia is symmetric about
-  the line of its two balls (any cylinder, any point mass) the spin decouples exactly and a spin started at zero
-  stays zero; otherwise the spin is slaved to carry no momentum (exact for a spin-free start to first order). No
-  idle acceleration changes an effort (``Ĝᵀ M N = 0``);
-* ``a = Ĝ qdd + a_b``, ``a_b`` the closure's drift compensation (``J_c a_b + gamma = 0``, no actuated acceleration,
-  no idle acceleration in the mass metric): :func:`pkm.accelerations`'.
+  (:mod:`pkm.core.differential.idle`): rates and accelerations carry none in the mass metric, ``Ĝ = G - N (Nᵀ M
+  N)⁺ Nᵀ M G`` (``G`` the minimum-norm map), so that ``Nᵀ M Ĝ = 0`` and the spin carries no momentum of its own.
+  For a rod whose inertia is symmetric about the line of its two balls (any cylinder, any point mass) ``Ĝ = G``: the
+  spin decouples exactly and a spin started at zero stays zero; otherwise the spin is slaved to carry no momentum
+  (exact for a spin-free start to first order). No idle acceleration changes an effort (``Ĝᵀ M N = 0``);
+* ``a = Ĝ qdd + a_b`` (:func:`pkm.accelerations`), ``a_b`` the closure's drift compensation (``J_c a_b + gamma =
+  0``, no actuated acceleration, no idle acceleration in the mass metric).
 
 Then, with ``τ_a`` the actuator efforts,
 

@@ -295,9 +295,9 @@ def _settle_idle(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wren
     for Khalil's projection, whose implicit passive map need not be mass-orthogonal to the idle motions.
 
     The kinematics fixes no idle acceleration (:func:`~pkm.core.differential.velocity.idle_motions` ``N``: a rod spinning
-    between two ball joints); the efforts do not depend on it through a map ``Ĝ`` with ``Nᵀ M Ĝ = 0``
-    (:func:`pkm.passive_map`, the virtual-work route), but through another map only where the idle motions' generalised
-    force vanishes, as nothing drives them. Mechanisms with no idle motion at their reference skip it (cached per
+    between two ball joints). Efforts projected by a map ``Ĝ`` with ``Nᵀ M Ĝ = 0`` (:func:`pkm.passive_map`: the
+    virtual-work route) do not depend on it; those of another map only once the idle motions' generalised force
+    vanishes, as nothing drives them. Mechanisms with no idle motion at their reference skip it (cached per
     mechanism); massless idle directions (:mod:`pkm.core.differential.idle`) keep the acceleration given.
     """
     if mech not in _IDLE:
