@@ -107,11 +107,11 @@ def test_a_massless_idle_direction_keeps_the_minimum_norm():
 @pytest.mark.parametrize("method", ["rk4", "radau"])
 def test_a_simulation_keeps_the_energy_of_a_spin_that_moves_mass(method):
     """``talos_like``'s idle rod is not symmetric about its axis (its energy depends on its spin angle), released
-    with a push, no friction, no effort: the total energy stays within 1e-8 of the largest kinetic energy over 20 ms,
+    with a push, no friction, no effort: the total energy stays within 1e-8 of the largest kinetic energy over 10 ms,
     with either integrator (Radau closed every evaluation from the last one's configuration, so that the spin angle
     stayed put: 1e-4 off, and a hundred times slower)."""
     mech = mechanism("gepetto/talos_like")
-    run = pkm.simulate(mech, moved(mech), np.full(mech.na, 0.5), duration=0.02, dt=1e-3, method=method,
+    run = pkm.simulate(mech, moved(mech), np.full(mech.na, 0.5), duration=0.01, dt=1e-3, method=method,
                        friction=False, limits=False, singular_tol=0.0, backend="python")
-    assert run.event is None and len(run) == 21
+    assert run.event is None and len(run) == 11
     assert np.abs(run.energy - run.energy[0]).max() <= 1e-8 * run.kinetic.max()
