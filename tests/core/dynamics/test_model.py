@@ -6,8 +6,8 @@ set (and two Gepetto robots whose closures are redundant).
   inverse then forward dynamics, every route, gives ``qdd`` back (1e-10 relative);
 * ``½ qdᵀ M_a qd`` against the bodies' kinetic energy (Pinocchio): 1e-12 relative;
 * the forward dynamics against Pinocchio's ``constraintDynamics`` (proximal where closures are redundant): 1e-9,
-  idle accelerations left out (only the dynamics fixes them, ill-conditioned where the idle body is nearly
-  massless);
+  idle accelerations left out (the model reports the convention's, no idle acceleration in the mass metric;
+  ``constraintDynamics`` the unforced spin's);
 * ``Ṁ_a - 2 C_a`` skew-symmetric, ``Ṁ_a`` from Richardson differences of ``M_a`` along the closed motion: 1e-8
   relative to ``|G|² |M| |qd|`` (the scale of the joint-space terms that ``Gᵀ M G`` cancels, whose rounding the
   differences amplify; ``C_a`` itself holds central differences);
@@ -84,7 +84,7 @@ def test_forward_dynamics_equals_constraint_dynamics(state):
     if any(j.shortname() == "JointModelMimic" for j in mech.model.joints):
         return  # (constraintDynamics refuses mimic joints on Pinocchio 4.1)
     a_cd = constraint_dynamics(mech, q, model.v, tau)
-    N = model.idle  # (a nearly massless idle motion's acceleration is ill-conditioned in both routes: left out)
+    N = model.idle  # (the idle accelerations: the convention's here, the unforced spin's there)
     assert rel(a - N @ (N.T @ a), a_cd - N @ (N.T @ a_cd)) <= 1e-9
 
 
