@@ -85,7 +85,7 @@ def text(out: dict[str, Any]) -> str:
         lines.append(f"{label}:")
         lines += [f"  {n.ljust(width)}{_value(out[key][n], units[key][n]).rjust(col)}" for n in names]
     if out["idle_motions"]:
-        lines.append(f"idle motions: {out['idle_motions']} (left out of the state, zero generalised force)")
+        lines.append(f"idle motions: {out['idle_motions']} (left out of the state: their rates are those of least kinetic energy)")
     return "\n".join(lines)
 
 

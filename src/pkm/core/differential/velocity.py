@@ -6,8 +6,9 @@ actuated columns ``J_a`` and passive columns ``J_p``, and ``J_t`` the task Jacob
 
 * *idle motions*: passive motions that move neither the closures (``J_p x = 0``) nor the task
   (``J_t x = 0``): a rod spinning about its own axis between two ball joints, two coaxial
-  revolutes. They are not singularities; every map below leaves them out (minimum-norm
-  solutions) and :func:`diagnose` reports them;
+  revolutes. They are not singularities; :func:`diagnose` reports them, and every rate and acceleration below carries
+  none of them in the mass metric (``Nᵀ M v = 0``, the rates of least kinetic energy: the convention of
+  :mod:`pkm.core.differential.idle`, shared with the dynamic model);
 * passive rates: ``v_p = -J_p^+ J_a qd_a`` (``G = dq/dq_a``, :func:`passive_map`); undefined when,
   off the idle motions, ``J_p`` loses column rank: a *direct* (type 2) singularity, the actuators
   locked yet the task movable;
@@ -37,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pkm.core.differential.idle import joint_inertia, without_idle
 from pkm.core.differential.indices import singularity_class
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
@@ -199,23 +201,34 @@ def _inverse_check(sp: _Split, rtol: float) -> None:
                                distance=sp.inverse_distance)
 
 
-def _passive_map(mech: Mechanism, sp: _Split, Jc: np.ndarray) -> np.ndarray:
+def _convention(sp: _Split, c: Configuration, X: np.ndarray) -> np.ndarray:
+    """Joint rates or accelerations ``X`` (no idle part in the Euclidean metric) with none in the mass metric
+    (:func:`pkm.core.differential.idle.without_idle`); unchanged without idle motions."""
+    if not sp.idle.shape[1]:
+        return X
+    return without_idle(joint_inertia(sp.mech, c.q), sp.idle, X)
+
+
+def _passive_map(mech: Mechanism, sp: _Split, c: Configuration) -> np.ndarray:
     G = np.zeros((mech.nv, mech.na))
     G[mech.act_v, np.arange(mech.na)] = 1.0
-    G[mech.passive_v] = -sp.passive_solve(Jc[:, mech.act_v])
-    return G
+    G[mech.passive_v] = -sp.passive_solve(c.constraint_jacobian[:, mech.act_v])
+    return _convention(sp, c, G)
 
 
 def idle_motions(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
     """An orthonormal basis (nv x k) of the idle motions at ``q``: joint rates that the closures allow with the
     actuators locked and that the task does not see (a rod spinning about its axis between two ball joints);
-    k = 0 for most mechanisms. Their rates and accelerations are not fixed by the kinematics."""
+    k = 0 for most mechanisms. The kinematics does not fix their rates and accelerations; pkm's rates and
+    accelerations carry none of them in the mass metric (:mod:`pkm.core.differential.idle`)."""
     mech, c = _at(mech, q)
     return _split(mech, c, as_tolerance(rtol, "rtol")).idle
 
 
 def passive_map(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
-    """``G = dq/dq_a`` (nv x na): all joint rates from the actuated rates, without idle motion.
+    """``G = dq/dq_a`` (nv x na): all joint rates from the actuated rates, the idle motions' rates those of least
+    kinetic energy (``Nᵀ M G = 0``, :mod:`pkm.core.differential.idle`; the mass matrix is computed only where there
+    are idle motions).
 
     Raises:
         SingularityError: ``kind="direct"``: with the actuators locked, a passive motion that moves
@@ -226,7 +239,7 @@ def passive_map(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 
     rtol = as_tolerance(rtol, "rtol")
     sp = _split(mech, c, rtol)
     _direct_check(sp, rtol)
-    return finite_result(_passive_map(mech, sp, c.constraint_jacobian), "passive map G")
+    return finite_result(_passive_map(mech, sp, c), "passive map G")
 
 
 def forward_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
@@ -245,7 +258,7 @@ def _forward(mech: Mechanism, q: ArrayLike | Configuration, rtol: float, which: 
     sp = _split(mech, c, rtol)
     _direct_check(sp, rtol)
     J = c.task_jacobian if which == "forward" else c.ee_jacobian
-    return finite_result(J @ _passive_map(mech, sp, c.constraint_jacobian), f"{which} Jacobian")
+    return finite_result(J @ _passive_map(mech, sp, c), f"{which} Jacobian")
 
 
 def inverse_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
@@ -266,13 +279,15 @@ def inverse_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: flo
 
 
 def velocities(mech: Mechanism, q: ArrayLike | Configuration, qd_actuated: ArrayLike) -> np.ndarray:
-    """All joint rates ``v`` (nv,) from the actuated rates."""
+    """All joint rates ``v = G qd`` (nv,) from the actuated rates (:func:`passive_map`: no idle motion in the mass
+    metric)."""
     G = passive_map(mech, q)
     return finite_result(G @ mech.check_actuated(qd_actuated, "qd_actuated"), "joint velocities")
 
 
 def accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, qdd_actuated: ArrayLike) -> np.ndarray:
-    """All joint accelerations ``a`` (nv,) from the actuated ones, the drift included (no idle acceleration).
+    """All joint accelerations ``a`` (nv,) from the actuated ones, the drift included, with no idle acceleration in
+    the mass metric (``Nᵀ M a = 0``, :mod:`pkm.core.differential.idle`).
 
     Raises:
         SingularityError: as :func:`passive_map`.
@@ -286,7 +301,7 @@ def accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, q
     a = np.zeros(mech.nv)
     a[mech.act_v] = qdd
     a[mech.passive_v] = -sp.passive_solve(c.constraint_jacobian[:, mech.act_v] @ qdd + gamma)
-    return finite_result(a, "joint accelerations")
+    return finite_result(_convention(sp, c, a), "joint accelerations")
 
 
 def task_velocity(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike) -> np.ndarray:
@@ -304,22 +319,25 @@ def task_acceleration(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLik
 
 
 def inverse_velocities(mech: Mechanism, q: ArrayLike | Configuration, yd: ArrayLike) -> np.ndarray:
-    """All joint rates ``v`` for task rates ``yd`` (nv,)."""
+    """All joint rates ``v`` for task rates ``yd`` (nv,), no idle motion in the mass metric (as :func:`velocities`)."""
     mech, c = _at(mech, q)
     yd = as_vector(yd, mech.n_task, "yd")
     sp = _split(mech, c, RTOL)
-    return finite_result(sp.joint_solve(np.concatenate([np.zeros(mech.n_constraints), yd])), "joint velocities")
+    v = sp.joint_solve(np.concatenate([np.zeros(mech.n_constraints), yd]))
+    return finite_result(_convention(sp, c, v), "joint velocities")
 
 
 def inverse_accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, ydd: ArrayLike) -> np.ndarray:
-    """All joint accelerations ``a`` for task accelerations ``ydd`` at state ``(q, v)``."""
+    """All joint accelerations ``a`` for task accelerations ``ydd`` at state ``(q, v)``, no idle acceleration in the
+    mass metric (as :func:`accelerations`)."""
     mech, c = _at(mech, q)
     v = mech.check_v(v)
     ydd = as_vector(ydd, mech.n_task, "ydd")
     gamma_c = constraints.drift(mech, c.q, v)
     gamma_t = mech.task_map.bias(c.q, v)
     sp = _split(mech, c, RTOL)
-    return finite_result(sp.joint_solve(np.concatenate([-gamma_c, ydd - gamma_t])), "joint accelerations")
+    a = sp.joint_solve(np.concatenate([-gamma_c, ydd - gamma_t]))
+    return finite_result(_convention(sp, c, a), "joint accelerations")
 
 
 @dataclass(frozen=True)

@@ -6,16 +6,17 @@ actuated and passive columns (:mod:`pkm.core.kinematics.constraints`), ``M`` Pin
 (``crba``, the actuators' reflected inertia on its diagonal, :mod:`pkm.core.model.actuators`) and ``b`` its
 non-linear effects (``rnea``):
 
-* ``G``: joint rates from actuated rates (:func:`~pkm.core.differential.velocity.passive_map`), ``v = G qd``;
+* ``Ĝ``: joint rates from actuated rates, ``v = Ĝ qd`` (:func:`~pkm.core.differential.velocity.passive_map`,
+  :func:`pkm.velocities`);
 * the **idle motions** ``N`` (a rod spinning between two balls: passive motions the closures and the task leave
-  free with the actuators locked) are **kept out of the state and given zero generalised force**: the model uses
-  the dynamically consistent map ``Ĝ = G - N (Nᵀ M N)⁺ Nᵀ M G``, which differs from ``G`` only by idle motion and
-  is mass-orthogonal to it (``Nᵀ M Ĝ = 0``). For a rod whose inertia is symmetric about the line of its two balls
-  (any cylinder, any point mass), ``Nᵀ M G = 0`` and ``Ĝ = G``: the spin decouples exactly, and a spin started at
-  zero stays zero. Otherwise the spin is slaved to carry no momentum of its own (exact for a spin-free start to
-  first order); the efforts are those of :func:`pkm.inverse_dynamics`, which settles idle accelerations the same
-  way;
-* ``a = Ĝ qdd + a_b``, ``a_b`` the closure's drift compensation (``J_c a_b + gamma = 0``, no actuated acceleration).
+  free with the actuators locked) are **kept out of the state** by pkm's one idle-motion convention
+  (:mod:`pkm.core.differential.idle`): rates and accelerations carry none in the mass metric, ``Ĝ = G - N (Nᵀ M
+  N)⁺ Nᵀ M G`` (``G`` the minimum-norm map), so that ``Nᵀ M Ĝ = 0`` and the spin carries no momentum of its own.
+  For a rod whose inertia is symmetric about the line of its two balls (any cylinder, any point mass) ``Ĝ = G``: the
+  spin decouples exactly and a spin started at zero stays zero; otherwise the spin is slaved to carry no momentum
+  (exact for a spin-free start to first order). No idle acceleration changes an effort (``Ĝᵀ M N = 0``);
+* ``a = Ĝ qdd + a_b`` (:func:`pkm.accelerations`), ``a_b`` the closure's drift compensation (``J_c a_b + gamma =
+  0``, no actuated acceleration, no idle acceleration in the mass metric).
 
 Then, with ``τ_a`` the actuator efforts,
 
@@ -49,6 +50,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from pkm.core.differential.idle import joint_inertia, without_idle
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import close_loops
 from pkm.core.model.mechanism import Mechanism, check_mechanism
@@ -74,7 +76,6 @@ def _reduce(mech: Mechanism, q: np.ndarray, rtol: float) -> _Reduction:
     """The rank of ``J_p`` and the idle motions are judged on the Jacobians homogenised by the mechanism's
     characteristic length (:mod:`pkm.core.model.scale`), as :func:`pkm.diagnose` judges them: the same for the
     mechanism scaled in size."""
-    m, d = mech.model, mech.data
     scales = mech.jacobian_scales
     Jc = constraints.jacobian(mech, q)
     pv, av = mech.passive_v, mech.act_v
@@ -101,12 +102,8 @@ def _reduce(mech: Mechanism, q: np.ndarray, rtol: float) -> _Reduction:
                                    distance=sigma / smax if smax > 0.0 else 0.0)
         if not scales.trivial:  # (in joint rates, orthonormal)
             idle = np.linalg.qr(scales.columns[:, None] * idle)[0]
-    M = pin.crba(m, d, q)
-    M = np.triu(M) + np.triu(M, 1).T
-    if idle.shape[1]:
-        MN = M @ idle
-        G = G - idle @ np.linalg.pinv(idle.T @ MN, rcond=1e-12, hermitian=True) @ (MN.T @ G)
-    return _Reduction(G, Jp_pinv, idle, M)
+    M = joint_inertia(mech, q)
+    return _Reduction(without_idle(M, idle, G), Jp_pinv, idle, M)
 
 
 @dataclass(frozen=True)
@@ -119,12 +116,13 @@ class ActuatorSpaceModel:
         qd: The actuated rates (na,) [rad/s or m/s].
         v: The joint rates ``Ĝ qd`` (nv,).
         G: ``Ĝ`` (nv x na): joint rates from actuated rates, mass-orthogonal to the idle motions.
-        drift_acceleration: ``a_b`` (nv,): the joint accelerations at ``qdd = 0`` (closure drift compensated).
+        drift_acceleration: ``a_b`` (nv,): the joint accelerations at ``qdd = 0`` (closure drift compensated, no idle
+            acceleration in the mass metric).
         M: ``M_a`` (na x na) [kg m^2, kg]: symmetric, positive definite away from singularities.
         h: ``h_a`` (na,) [N m, N]: Coriolis, centrifugal, gravity and closure-drift efforts.
         g: ``g_a`` (na,): the gravity part of ``h_a`` (the efforts that hold the mechanism still).
         friction: ``f_a`` (na,): the joints' viscous and Coulomb friction at ``v`` (opposes the motion).
-        idle: The idle motions (nv x k, orthonormal), zero generalised force.
+        idle: The idle motions (nv x k, orthonormal), carried by no rate in the mass metric.
     """
 
     mech: Mechanism
@@ -139,7 +137,6 @@ class ActuatorSpaceModel:
     friction: np.ndarray
     idle: np.ndarray
     _M_joint: np.ndarray
-    _nle: np.ndarray  # rnea(q, v, a_b) - joint friction (the idle motions' settling uses it)
 
     def __post_init__(self) -> None:
         for value in vars(self).values():
@@ -168,15 +165,10 @@ class ActuatorSpaceModel:
                              "actuated accelerations")
 
     def joint_accelerations(self, qdd: ArrayLike) -> np.ndarray:
-        """All joint accelerations (nv,) for actuated ones: ``Ĝ qdd + a_b`` plus the idle accelerations that the
-        dynamics give (zero generalised force on the idle motions)."""
+        """All joint accelerations (nv,) for actuated ones: ``Ĝ qdd + a_b``, as :func:`pkm.accelerations` gives them
+        (no idle acceleration in the mass metric)."""
         qdd = self.mech.check_actuated(qdd, "qdd")
-        a = self.G @ qdd + self.drift_acceleration
-        if self.idle.shape[1]:
-            N = self.idle
-            f = N.T @ (self._M_joint @ (self.G @ qdd) + self._nle)
-            a = a - N @ np.linalg.pinv(N.T @ self._M_joint @ N, rcond=1e-12, hermitian=True) @ f
-        return finite_result(a, "joint accelerations")
+        return finite_result(self.G @ qdd + self.drift_acceleration, "joint accelerations")
 
 
 def _solve_inertia(M: np.ndarray, rhs: np.ndarray, scale: np.ndarray) -> np.ndarray:
@@ -219,6 +211,7 @@ def _evaluate(mech: Mechanism, q: np.ndarray, qd: np.ndarray, rtol: float,
     a_b = np.zeros(mech.nv)
     if mech.n_constraints:
         a_b[mech.passive_v] = -red.Jp_pinv @ constraints.drift(mech, q, v)
+        a_b = without_idle(red.M, red.idle, a_b)
     b = pin.rnea(m, d, q, v, a_b).copy()
     g = pin.computeGeneralizedGravity(m, d, q)
     f_joint = -np.asarray(m.damping) * v - np.asarray(m.friction) * np.tanh(v / coulomb_velocity)
@@ -227,7 +220,7 @@ def _evaluate(mech: Mechanism, q: np.ndarray, qd: np.ndarray, rtol: float,
     M_a = 0.5 * (M_a + M_a.T)
     return ActuatorSpaceModel(mech, q, qd.copy(), v, red.G, a_b, finite_result(M_a, "actuator-space mass matrix"),
                               finite_result(Gt @ b, "actuator-space bias"), Gt @ g, Gt @ f_joint, red.idle,
-                              red.M, b - f_joint)
+                              red.M)
 
 
 def actuator_model(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None, *, rtol: float = RTOL,

@@ -45,6 +45,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from pkm.core.differential.idle import idle_inertia_inverse, joint_inertia
 from pkm.core.differential.velocity import idle_motions, passive_map
 from pkm.core.dynamics import model as actuator_space
 from pkm.core.kinematics import constraints
@@ -300,14 +301,14 @@ _IDLE: weakref.WeakKeyDictionary[Mechanism, bool] = weakref.WeakKeyDictionary()
 
 def _settle_idle(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None,
                  wrenches: Mapping[str, ArrayLike] | None) -> ArrayLike:
-    """``a`` with its idle-motion part set by the dynamics, ``a + N alpha`` with ``N^T (M a' + h - J^T w) = 0``.
+    """``a`` with its idle-motion part set by the dynamics, ``a + N alpha`` with ``N^T (rnea(q, v, a') - J^T w) = 0``:
+    for Khalil's projection, whose implicit passive map need not be mass-orthogonal to the idle motions.
 
     The kinematics fixes no idle acceleration (:func:`~pkm.core.differential.velocity.idle_motions` ``N``: a rod spinning
-    between two ball joints), and the one in ``a`` (the minimum-norm one of :func:`pkm.accelerations`) is in general
-    not the one the efforts produce: nothing drives an idle motion, so its generalised force must vanish. Without
-    this, ``G^T`` of the tree's forces depends on how ``G`` splits the idle motion (by up to 1e-4 of the efforts on
-    the RSSR four-bar). Mechanisms with no idle motion at their reference skip it (cached per mechanism);
-    massless idle motions (no inertia about the rod's axis) keep the acceleration given.
+    between two ball joints). Efforts projected by a map ``Ĝ`` with ``Nᵀ M Ĝ = 0`` (:func:`pkm.passive_map`: the
+    virtual-work route) do not depend on it; those of another map only once the idle motions' generalised force
+    vanishes, as nothing drives them. Mechanisms with no idle motion at their reference skip it (cached per
+    mechanism); massless idle directions (:mod:`pkm.core.differential.idle`) keep the acceleration given.
     """
     if mech not in _IDLE:
         _IDLE[mech] = idle_motions(mech, mech.q_reference).shape[1] > 0
@@ -317,12 +318,8 @@ def _settle_idle(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wren
     N = idle_motions(mech, q)
     if not N.shape[1]:
         return a
-    m, d = mech.model, mech.data
-    h = _external(mech, q, pin.rnea(m, d, q, v, a), wrench, wrenches)
-    M = pin.crba(m, d, q)
-    M = np.triu(M) + np.triu(M, 1).T
-    alpha = np.linalg.lstsq(N.T @ M @ N, -(N.T @ h), rcond=1e-12)[0]
-    return a + N @ alpha
+    h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches)
+    return a - N @ (idle_inertia_inverse(joint_inertia(mech, q), N) @ (N.T @ h))
 
 
 def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None = None, *,
@@ -361,12 +358,11 @@ def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, 
 
 def virtual_work_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None = None, *, wrenches: Mapping[str, ArrayLike] | None = None) \
         -> np.ndarray:
-    """Actuator efforts as ``G^T (rnea(q, v, a) - sum J_f^T w_f)``, ``G = dq/dq_a`` without idle motions: the
-    whole-tree virtual-work route (external wrenches as in :func:`inverse_dynamics`; idle accelerations set by the
-    dynamics, see :func:`_settle_idle`)."""
+    """Actuator efforts as ``G^T (rnea(q, v, a) - sum J_f^T w_f)``, ``G = dq/dq_a`` (:func:`pkm.passive_map`, idle
+    motions mass-orthogonal: ``G^T M N = 0``, so that no idle acceleration in ``a`` changes the efforts): the
+    whole-tree virtual-work route (external wrenches as in :func:`inverse_dynamics`)."""
     mech = check_mechanism(mech)
     q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
-    a = _settle_idle(mech, q, v, a, wrench, wrenches)
     G = passive_map(mech, q)
     h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches)
     return finite_result(G.T @ h, "actuator efforts")

@@ -16,7 +16,10 @@ Integrators:
 * ``"radau"``: SciPy's Radau IIA (implicit, order 5, L-stable, adaptive step, output on the ``dt`` grid), for stiff
   cases: heavy viscous friction, a Coulomb friction's steep smoothed sign, high controller gains, where an explicit
   step must be tiny to stay stable. Each of its steps solves the implicit stages by Newton with a finite-difference
-  Jacobian of the closed-loop dynamics. Its work is bounded, as RK4's is: past :data:`RADAU_EVALUATIONS`
+  Jacobian of the closed-loop dynamics; each evaluation closes the loops from the last step's configuration moved
+  by the joint rates, so that the right-hand side is a function of the state and an idle motion's coordinate, which
+  the closure does not fix, follows its rate (:mod:`pkm.core.differential.idle`; the trapezoidal rule). Its work is
+  bounded, as RK4's is: past :data:`RADAU_EVALUATIONS`
   evaluations a sample or :data:`RADAU_RATE` a simulated second (whichever allows more), the run stops (a
   ``"singularity"`` event: the motion is too fast to follow).
 
@@ -487,20 +490,54 @@ def _rk4(dyn: _Dynamics, x: np.ndarray, q: np.ndarray, dt: float, n_steps: int, 
     return rec.result(event, method)
 
 
+@dataclass(frozen=True)
+class _Base:
+    """A closed state ``x = (qa, qd)``, its configuration and its map ``Ĝ``: the seed of the loop closure at a nearby
+    state is ``q`` moved by ``Ĝ`` times the change of ``qa``, so that an idle motion's coordinate (which the closure
+    does not fix) follows its rate (:mod:`pkm.core.differential.idle`) instead of staying where the last closure
+    left it."""
+
+    x: np.ndarray
+    q: np.ndarray
+    G: np.ndarray
+
+    def rates(self, dyn: _Dynamics, t: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, ActuatorSpaceModel,
+                                                                        np.ndarray]:
+        """:meth:`_Dynamics.rates` at ``x``, closed from here moved by ``Ĝ (qa - qa_here)``; with idle motions, again
+        by the mean of both ends' ``Ĝ`` (the trapezoidal rule for the idle coordinates)."""
+        mech = dyn.mech
+        step = x[:mech.na] - self.x[:mech.na]
+        out = dyn.rates(t, x, pin.integrate(mech.model, self.q, self.G @ step))
+        if out[2].idle.shape[1]:
+            out = dyn.rates(t, x, pin.integrate(mech.model, self.q, 0.5 * (self.G + out[2].G) @ step))
+        return out
+
+    def next(self, dyn: _Dynamics, t: float, x: np.ndarray,
+             last: tuple[float, np.ndarray, ActuatorSpaceModel] | None = None) -> _Base:
+        """The base at ``x``, closed from here (``last``: the evaluation at ``(t, x)`` from here, if it was made)."""
+        if last is not None and last[0] == t and np.array_equal(last[1], x):
+            return _Base(x.copy(), last[2].q, last[2].G)
+        _, q, model, _ = self.rates(dyn, t, x)
+        return _Base(x.copy(), q, model.G)
+
+
 def _radau(dyn: _Dynamics, x0: np.ndarray, q: np.ndarray, dt: float, n_steps: int, method: str) -> Simulation:
     from scipy.integrate import Radau
 
     mech = dyn.mech
     na = mech.na
-    seed = [q]
+    # every evaluation closes the loops from the last accepted step's configuration moved by the rates (_Base), so
+    # that the right-hand side is a function of the state and an idle motion's coordinate follows its rate
+    _, q, model, _ = _start(dyn, x0, q)
+    start = base = _Base(x0.copy(), q, model.G)
+    last: list[tuple[float, np.ndarray, ActuatorSpaceModel]] = []  # (Radau evaluates the end of each step it takes)
 
     def f(t: float, x: np.ndarray) -> np.ndarray:
-        dx, qq, _, _ = dyn.rates(t, x, seed[0])
-        seed[0] = qq
+        dx, _, model, _ = base.rates(dyn, t, x)
+        last[:] = [(t, x.copy(), model)]
         return dx
 
     grid = np.arange(n_steps + 1) * dt
-    _start(dyn, x0, q)
     rec = _Recorder(dyn)
     event = None
     ts, xs = [0.0], [x0]  # (the samples reached, kept when the run stops)
@@ -511,6 +548,7 @@ def _radau(dyn: _Dynamics, x0: np.ndarray, q: np.ndarray, dt: float, n_steps: in
             message = solver.step()
             if solver.status == "failed":
                 raise _Stop(Event("singularity", solver.t, f"Radau failed: {message}"))
+            base = base.next(dyn, solver.t, solver.y, last[0] if last else None)
             interp = solver.dense_output()
             while len(ts) < len(grid) and grid[len(ts)] <= solver.t:
                 ts.append(float(grid[len(ts)]))
@@ -522,11 +560,11 @@ def _radau(dyn: _Dynamics, x0: np.ndarray, q: np.ndarray, dt: float, n_steps: in
                                                            "singularity, or a state far too fast)"))
     except _Stop as stop:
         event = stop.event
-    seed[0] = q
+    base = start
     for t, x in zip(ts, xs):
         try:
-            dx, qq, model, tau = dyn.rates(float(t), x, seed[0])
-            seed[0] = qq
+            dx, qq, model, tau = base.rates(dyn, float(t), x)
+            base = _Base(x.copy(), qq, model.G)
             rec.check(float(t), model)
         except _Stop as stop:
             event = stop.event

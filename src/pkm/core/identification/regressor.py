@@ -13,11 +13,11 @@ linearity of ``rnea`` in the parameters itself: column ``k`` is ``rnea(θ₀ + e
 ``θ`` (not a finite difference: no step, no truncation). The tests check both routes against each other where both
 run, and each against :func:`pkm.inverse_dynamics`.
 
-Idle motions (a rod spinning between two balls) carry no generalised force, so any ``G`` whose columns differ by
-idle motions projects the same efforts; the regressor uses the kinematic ``G`` (which does not depend on the
-parameters) and the joint rates of :func:`~pkm.core.dynamics.model.actuator_model` (``v = Ĝ q̇_a``, the
-accelerations with their idle part settled by the dynamics: that part uses the model's own parameters, and is zero
-when a rod's inertia is symmetric about its axis). Passive joints' armature and friction are not parameters (none
+Idle motions (a rod spinning between two balls) follow pkm's convention (:mod:`pkm.core.differential.idle`): the
+regressor takes :func:`~pkm.core.dynamics.model.actuator_model`'s map ``Ĝ`` (mass-orthogonal to the idle motions,
+so that no idle acceleration changes the projected efforts), rates ``v = Ĝ q̇_a`` and accelerations. ``Ĝ`` depends on
+the model's own parameters where a rod's inertia is not symmetric about its axis (elsewhere it is the kinematic map):
+``Y_a`` is then the regressor at those parameters. Passive joints' armature and friction are not parameters (none
 of pkm's mechanisms has any). With that, ``Y_a θ_true`` equals :func:`pkm.inverse_dynamics` plus the drives'
 friction (tests: 1e-10 relative, every shipped mechanism and the acceptance set).
 """
@@ -32,7 +32,6 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from pkm.core.differential.velocity import passive_map
 from pkm.core.dynamics.model import COULOMB_VELOCITY, actuator_model
 from pkm.core.model.bodies import BODY_FIELDS, BODY_UNITS, body_names
 from pkm.core.model.mechanism import Mechanism, check_mechanism
@@ -129,7 +128,7 @@ def regressor(mech: Mechanism, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> n
     mech = model.mech
     qdd = mech.check_actuated(qdd, "qdd")
     a = model.joint_accelerations(qdd)
-    Yb = passive_map(mech, model.q).T @ tree_regressor(mech, model.q, model.v, a)
+    Yb = model.G.T @ tree_regressor(mech, model.q, model.v, a)
     drives = np.zeros((mech.na, 4 * mech.na))
     for i, (rate, acc) in enumerate(zip(model.qd, qdd)):
         drives[i, 4 * i:4 * i + 4] = (acc, rate, np.tanh(rate / COULOMB_VELOCITY), 1.0)
