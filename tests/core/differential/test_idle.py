@@ -79,7 +79,9 @@ def test_one_convention_from_the_rates_to_the_efforts(name):
     assert energy_rel(M, a, least_inertia(mech, q, M, -drift, qdd)) <= 1e-10
 
     model = pkm.actuator_model(mech, q, qd)
-    assert rel(model.v, v) <= 1e-12 and rel(model.joint_accelerations(qdd), a) <= 1e-12
+    # (two routes through a J_p made rank deficient by the idle motions, each with its own pseudo-inverse: they agree
+    # to round-off, 3e-12 on robot_delta's near-zero components; the identities below hold to 1e-12)
+    assert rel(model.v, v) <= 1e-11 and rel(model.joint_accelerations(qdd), a) <= 1e-11
     tau = pkm.inverse_dynamics(mech, q, v, a)
     assert rel(model.efforts(qdd), tau) <= 1e-12
     kinetic, _ = projection.energy(mech, q, v)
