@@ -141,8 +141,7 @@ class _Split:
         Ua, sa, Vat = _svd(A @ C)
         w = col * (C @ Vat[-1]) if C.shape[1] else np.zeros(nv)
         act = w[mech.act_v]
-        if idle.shape[1] and not scales.trivial:  # (the idle motions in joint rates, orthonormal)
-            idle = np.linalg.qr(col[:, None] * idle)[0]
+        idle = scales.joint_motions(idle)  # (the idle motions in joint rates, orthonormal)
         return cls(mech, idle, Up, sp, Vpt, int(np.sum(~null)), sigma_d, smax_d,
                    move / max(float(np.linalg.norm(move)), 1e-300), C, Ua, sa, Vat,
                    float(sa[-1]) if len(sa) else np.inf, float(sa[0]) if len(sa) else 0.0,

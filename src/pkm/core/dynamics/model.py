@@ -100,8 +100,7 @@ def _reduce(mech: Mechanism, q: np.ndarray, rtol: float) -> _Reduction:
                                    "with the actuators locked a passive motion moves the task: the actuators do "
                                    "not hold the mechanism here, its dynamics in actuated coordinates is undefined",
                                    distance=sigma / smax if smax > 0.0 else 0.0)
-        if not scales.trivial:  # (in joint rates, orthonormal)
-            idle = np.linalg.qr(scales.columns[:, None] * idle)[0]
+        idle = scales.joint_motions(idle)  # (in joint rates, orthonormal)
     M = joint_inertia(mech, q)
     return _Reduction(without_idle(M, idle, G), Jp_pinv, idle, M)
 

@@ -88,6 +88,16 @@ class JacobianScales:
         """The task Jacobian (n_task x nv) homogenised."""
         return Jt if self.trivial else self.task_rows[:, None] * Jt * self.columns
 
+    def joint_motions(self, basis: np.ndarray) -> np.ndarray:
+        """A basis of motions found on the homogenised columns (nv x k), back in joint rates and orthonormal; a joint
+        the basis does not move stays exactly unmoved (a floating base's rows stay 0, not QR's round-off)."""
+        if self.trivial or not basis.shape[1]:
+            return basis
+        out = np.zeros(basis.shape)
+        rows = np.flatnonzero(np.any(basis != 0.0, axis=1))
+        out[rows] = np.linalg.qr(self.columns[rows, None] * basis[rows])[0]
+        return out
+
     def forward(self, J: np.ndarray) -> np.ndarray:
         """A forward Jacobian (task rates from actuated rates, ``(..., n_task, na)``) homogenised."""
         return J if self.trivial else self.task_rows[:, None] * J * self.actuated
