@@ -120,8 +120,10 @@ class ImplausibleModelWarning(PkmWarning):
         kind: ``"mass"``, ``"inertia"``, ``"triangle"`` or ``"limits"``.
         names: The bodies (or, for ``"limits"``, the joints) concerned.
         values: Each one's offending value (the mass [kg], the largest principal inertia [kg m^2], the triangle
-            inequality's excess [kg m^2], the limit [N m, N or rad/s, m/s]).
-        bound: The value the rule allows (for ``"limits"``: the placeholder value repeated).
+            inequality's excess [kg m^2]); for ``"limits"`` the effort and the velocity limit every joint shares
+            [N m or N, rad/s or m/s].
+        bound: The value the rule allows (the mass bound [kg], the largest of the inertia bounds [kg m^2], 0 for the
+            triangle); for ``"limits"`` the effort limit shared.
     """
 
     def __init__(self, message: str, kind: str, names: Iterable[str], values: Iterable[float], bound: float):
