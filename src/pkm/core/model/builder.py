@@ -31,8 +31,8 @@ from pkm.core.formats.base import Imported
 from pkm.core.formats.imported import import_model, with_file
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import assemble
-from pkm.core.model.actuators import NUMBERS, Actuator, as_actuators
 from pkm.core.model import plausibility
+from pkm.core.model.actuators import NUMBERS, Actuator, as_actuators
 from pkm.core.model.joints import retype_joints
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.spec import ClosureSpec, as_path
