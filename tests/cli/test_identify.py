@@ -77,6 +77,10 @@ def test_excite_then_identify_the_delta(excited, capsys):
     poor = [r["name"] for r in result["base"] if r["relative_std_percent"] > 100.0]
     assert poor and any(f"{len(poor)} of 48 base parameters" in w for w in result["warnings"])
     assert result["smallest_pseudo_inertia_eigenvalue"] >= -1e-9
+    # least squares alone, on so few samples, is no real mechanism: the error says so and names --consistent
+    assert cli.main(["identify", "delta", str(train), "--out", str(folder / "ls" / "d.closures.toml"),
+                     "--cutoff", "2"]) != 0
+    assert "--consistent writes the physically consistent estimate" in capsys.readouterr().err
     assert max(result["validation"]["relative_percent"].values()) <= 0.1  # (measured 0.02-0.03 %)
     identified = pkm.load(out)
     assert len(parameters(identified)) == len(parameters(delta))

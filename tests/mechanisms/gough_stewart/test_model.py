@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from pkm.core.model.urdf import parse_xml
-from pkm.errors import ImplausibleModelWarning
 from pkm.mechanisms import delta, gough_stewart
 from tests.mechanisms.model_contract import (
     check_build_of_a_design,
@@ -37,8 +36,6 @@ def test_a_design_builds_with_its_points_and_stroke():
     the spec (two coordinates each), the URDF's leg limits the stroke; regular at the reference (no warning)."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        # (but its drives' limits are still placeholders, said by an ImplausibleModelWarning: issue 41)
-        warnings.filterwarnings("ignore", category=ImplausibleModelWarning)
         mech = check_build_of_a_design(gough_stewart, DESIGN)
     model = mech.model
     limits = {j.get("name"): j.find("limit").attrib for j in parse_xml(gough_stewart.urdf_xml(DESIGN)).iter("joint")

@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
     from pkm.core.identification.export import identified_mechanism, standard_from_base, validate
     from pkm.core.identification.measurements import measurements
     from pkm.core.identification.regressor import parameters
-    from pkm.errors import PoorIdentificationWarning
+    from pkm.errors import InvalidInputError, PoorIdentificationWarning, SpecError
     from pkm.report import jsonable
 
     mech = load_mechanism(args)
@@ -66,7 +66,14 @@ def run(args: argparse.Namespace) -> int:
         theta = model.theta
     else:
         theta = standard_from_base(mech, base, ls.values)
-    identified = identified_mechanism(mech, theta)
+    try:
+        identified = identified_mechanism(mech, theta)
+    except (SpecError, InvalidInputError) as exc:
+        if args.consistent:
+            raise
+        raise InvalidInputError("--consistent", f"the least-squares estimate is no real mechanism and cannot be "
+                                                f"written ({exc}); --consistent writes the physically consistent "
+                                                f"estimate", None) from None
     written = base.map @ parameters(identified).values  # the model written, as written (no offset, friction >= 0)
     out: dict[str, Any] = {
         "mechanism": mech.name, "samples": len(data), "table_rows": data.table_rows, "decimate": data.decimate,
