@@ -6,6 +6,7 @@ from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.model.urdf import UrdfBuilder
 from pkm.mechanisms._common import (
+    PH54_200,
     SA2_PD,
     check_params,
     make_mechanism,
@@ -33,7 +34,8 @@ def urdf_xml(params: Prs3Params) -> str:
         b.joint(f"slider_{n}", "prismatic", "base", f"slider_link_{n}", a[i], rot_z(PHI[i]) @ rot_y(-params.gamma),
                 axis=(1.0, 0.0, 0.0), limits=(-reach, reach), **SA2_PD.limits)  # (Linearmech SA 2 PD: 310 N, 0.5 m/s)
         b.link(f"coupler_{n}", params.m_coupler, (0.0, 0.0, params.l / 2), rod_inertia(params.m_coupler, params.l, 2))
-        b.joint(f"knee_{n}", "revolute", f"slider_link_{n}", f"coupler_{n}", axis=(0.0, 1.0, 0.0))
+        b.joint(f"knee_{n}", "revolute", f"slider_link_{n}", f"coupler_{n}", axis=(0.0, 1.0, 0.0),
+                **(PH54_200.limits if params.actuation == "R" else {}))  # (actuated: a ROBOTIS PH54-200-S500-R)
         b.frame(f"coupler_{n}_tip", f"coupler_{n}", (0.0, 0.0, params.l))
     # link "platform_link": Pinocchio 4.1 refuses a name shared by a body frame and a joint frame
     b.link("platform_link", params.m_platform, inertia=params.platform_inertia)
