@@ -19,7 +19,7 @@ def urdf_xml(p: FiveBarParams, *, spinning_rod: bool = False) -> str:
     for i, x in enumerate((-p.d / 2.0, p.d / 2.0)):
         n = i + 1
         b.link(f"proximal_{n}", p.m_link, (p.l1 / 2.0, 0.0, 0.0), rod_inertia(p.m_link, p.l1, 0))
-        b.joint(f"motor_{n}", "revolute", "base", f"proximal_{n}", (x, 0.0, 0.0), **PM54_040.limits)
+        b.joint(f"motor_{n}", "revolute", "base", f"proximal_{n}", (x, 0.0, 0.0), effort=PM54_040.effort, velocity=PM54_040.speed)
         b.link(f"distal_{n}", p.m_link, (p.l2 / 2.0, 0.0, 0.0), rod_inertia(p.m_link, p.l2, 0))
         if spinning_rod and n == 1:
             b.link("hub_1")

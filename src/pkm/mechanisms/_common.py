@@ -37,10 +37,6 @@ class Drive:
     speed: float
     source: str
 
-    @property
-    def limits(self) -> dict[str, float]:
-        """``{"effort": effort, "velocity": speed}``: the keyword arguments of ``UrdfBuilder.joint``."""
-        return {"effort": self.effort, "velocity": self.speed}
 
 
 #: ROBOTIS DYNAMIXEL-P PM54-040-S250-R (BLDC, 251.417:1), 24 V: continuous torque 3.9 N m, no-load speed 28.4 rev/min

@@ -121,8 +121,8 @@ def estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, TAU: 
         rel = np.where(beta != 0.0, 100.0 * std / np.abs(beta), np.inf)
     rms = np.sqrt(np.mean(((y - W @ beta).reshape(n, mech.na)) ** 2, axis=0))
     found = _warnings(base, n, len(y), rel)
-    for w in found:
-        warnings.warn(w, stacklevel=2)
+    for warning in found:
+        warnings.warn(warning, stacklevel=2)
     return Estimate(base, beta, std, rel, rms, weights, "wls" if weighted else "ols", len(y),
                     tuple(str(w) for w in found))
 

@@ -103,13 +103,13 @@ def findings(mech: Mechanism) -> list[ImplausibleModelWarning]:
     effort = {a.effort_limit for a in acts}
     speed = {a.velocity_limit for a in acts}
     if acts and len(effort) == 1 and len(speed) == 1 and _power_of_ten(*effort) and _power_of_ten(*speed):
-        e, s = effort.pop(), speed.pop()
+        tau, vel = effort.pop(), speed.pop()
         joints = tuple(a.joint for a in acts)
         out.append(ImplausibleModelWarning(
-            f"{where}: every actuator's limits are {e:g} (N m or N) and {s:g} (rad/s or m/s), round powers of ten "
+            f"{where}: every actuator's limits are {tau:g} (N m or N) and {vel:g} (rad/s or m/s), round powers of ten "
             f"alike on all of {', '.join(joints)}: placeholders, not a drive's; give the motors' values "
             f"([actuators.<joint>] effort_limit, peak_effort, velocity_limit in the closure spec, or "
-            f"pkm.with_actuators)", "limits", joints, (e, s), e))
+            f"pkm.with_actuators)", "limits", joints, (tau, vel), tau))
     return out
 
 

@@ -33,7 +33,7 @@ def urdf_xml(params: DeltaParams) -> str:
         Rz = rot_z(PHI[i])
         b.link(f"arm_{n}", params.m_arm, (0.0, params.La / 2, 0.0), rod_inertia(params.m_arm, params.La, 1))
         b.joint(f"motor_{n}", "revolute", "base", f"arm_{n}", Rz @ np.array([0.0, params.R, 0.0]), Rz,
-                axis=(1.0, 0.0, 0.0), **PM54_040.limits)
+                axis=(1.0, 0.0, 0.0), effort=PM54_040.effort, velocity=PM54_040.speed)
         b.link(f"knee_cross_{n}")
         b.joint(f"knee_{n}", "revolute", f"arm_{n}", f"knee_cross_{n}", (0.0, params.La, 0.0), axis=(1.0, 0.0, 0.0))
         b.link(f"forearm_{n}", params.m_forearm, (0.0, params.Lb / 2, 0.0),

@@ -29,7 +29,7 @@ def urdf_xml(params: Rrr3Params) -> str:
         b.link(f"proximal_{n}", params.m_proximal, (params.a / 2.0, 0.0, 0.0),
                rod_inertia(params.m_proximal, params.a, 0))
         b.joint(f"motor_{n}", "revolute", "base", f"proximal_{n}", (vertex[0], vertex[1], 0.0),
-                **PM54_040.limits)  # (a ROBOTIS PM54-040-S250-R: 3.9 N m, 28.4 rev/min, its datasheet)
+                effort=PM54_040.effort, velocity=PM54_040.speed)  # (a ROBOTIS PM54-040-S250-R: 3.9 N m, 28.4 rev/min, its datasheet)
         b.link(f"distal_{n}", params.m_distal, (params.b / 2.0, 0.0, 0.0), rod_inertia(params.m_distal, params.b, 0))
         b.joint(f"elbow_{n}", "revolute", f"proximal_{n}", f"distal_{n}", (params.a, 0.0, 0.0))
         if n > 1:
