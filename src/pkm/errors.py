@@ -111,6 +111,47 @@ class ModeChangeWarning(PkmWarning):
                          "pass this mode's configuration as q0 to continue in it")
 
 
+class PoorIdentificationWarning(PkmWarning):
+    """An identification whose data cannot carry its parameters (:func:`pkm.estimate`): fewer equations than three
+    per base parameter, or base parameters whose relative standard deviation exceeds 100 % (their estimate cannot
+    be told from zero). The same sentence is kept in ``Estimate.warnings``.
+
+    Attributes:
+        equations: The rows the estimate stacked (samples times actuators).
+        n_base: The number of base parameters.
+        poor: ``((name, relative standard deviation [%]), ...)`` of each base parameter above 100 % (may be empty).
+    """
+
+    def __init__(self, message: str, equations: int, n_base: int, poor: Iterable[tuple[str, float]] = ()):
+        self.equations = int(equations)
+        self.n_base = int(n_base)
+        self.poor = tuple((str(n), float(r)) for n, r in poor)
+        super().__init__(message)
+
+
+class ImplausibleModelWarning(PkmWarning):
+    """A model that loads but whose numbers no real mechanism has (:mod:`pkm.core.model.plausibility`: the rules):
+    a body far heavier than a steel block enclosing the whole mechanism, an inertia that breaks the triangle
+    inequality, drive limits that look like an exporter's placeholders.
+
+    Attributes:
+        kind: ``"mass"``, ``"inertia"``, ``"triangle"`` or ``"limits"``.
+        names: The bodies (or, for ``"limits"``, the joints) concerned.
+        values: Each one's offending value (the mass [kg], the largest principal inertia [kg m^2], the triangle
+            inequality's excess [kg m^2]); for ``"limits"`` the effort and the velocity limit every joint shares
+            [N m or N, rad/s or m/s].
+        bound: The value the rule allows (the mass bound [kg], the largest of the inertia bounds [kg m^2], 0 for the
+            triangle); for ``"limits"`` the effort limit shared.
+    """
+
+    def __init__(self, message: str, kind: str, names: Iterable[str], values: Iterable[float], bound: float):
+        self.kind = kind
+        self.names = tuple(names)
+        self.values = tuple(float(v) for v in values)
+        self.bound = float(bound)
+        super().__init__(message)
+
+
 class InvalidInputError(PkmError, ValueError):
     """An argument has the wrong shape, is not finite, or is out of range.
 

@@ -58,11 +58,32 @@ def test_excite_then_identify_the_delta(excited, capsys):
         capsys.readouterr().err
     result = json.loads(capsys.readouterr().out)
     assert result["routes_agree"] is True and len(result["base"]) == 48
+    # the base parameters reported are the model written's (issue 41: the consistent estimate's, not least
+    # squares'), read back from the URDF written, to the digits of the file (repr: exact; 1e-12 for the inertia's
+    # change of point)
+    from pkm.core.identification.base import base_parameters
+
+    delta = pkm.load("delta")
+    written = base_parameters(delta, precise=False).map @ parameters(pkm.load(out)).values
+    reported = np.array([row["value"] for row in result["base"]])
+    assert np.allclose(reported, written, rtol=1e-9, atol=1e-12 * np.abs(written).max())
+    # least squares gives a negative mass where the consistent estimate cannot
+    i = [row["name"] for row in result["base"]].index("guide_y.m")
+    assert result["base"][i]["value"] >= 0.0 and result["base"][i]["least_squares"] != result["base"][i]["value"]
+    # the rows used and why so few: two periods of 10 s at 500 Hz, one row in int(rate / (2 cutoff)) kept (124: the
+    # rate read from the times' steps is a hair under 500 Hz)
+    assert result["table_rows"] == 10001 and result["decimate"] == 124
+    assert result["equations"] == 3 * result["samples"] and result["cutoff_hz"] == 2.0
+    poor = [r["name"] for r in result["base"] if r["relative_std_percent"] > 100.0]
+    assert poor and any(f"{len(poor)} of 48 base parameters" in w for w in result["warnings"])
     assert result["smallest_pseudo_inertia_eigenvalue"] >= -1e-9
+    # least squares alone, on so few samples, is no real mechanism: the error says so and names --consistent
+    assert cli.main(["identify", "delta", str(train), "--out", str(folder / "ls" / "d.closures.toml"),
+                     "--cutoff", "2"]) != 0
+    assert "--consistent writes the physically consistent estimate" in capsys.readouterr().err
     assert max(result["validation"]["relative_percent"].values()) <= 0.1  # (measured 0.02-0.03 %)
     identified = pkm.load(out)
-    assert len(parameters(identified)) == len(parameters(pkm.load("delta")))
-    delta = pkm.load("delta")
+    assert len(parameters(identified)) == len(parameters(delta))
     q = delta.q_reference
     tau_true = pkm.actuator_model(delta, q, [0.3, -0.2, 0.1]).efforts([1.0, 0.5, -0.7])
     tau_identified = pkm.actuator_model(identified, q, [0.3, -0.2, 0.1]).efforts([1.0, 0.5, -0.7])

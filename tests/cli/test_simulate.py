@@ -131,11 +131,16 @@ def test_a_controller_file_on_a_spec_file_writes_parquet_and_a_figure(tmp_path, 
 
 
 def test_a_run_stopped_early_reports_its_event(tmp_path, capsys):
-    """The Delta let fall (no effort, a coarse step) reaches a direct singularity: the summary names the event,
-    and the text says it stopped early."""
+    """The Delta let fall (no effort, a coarse step) outruns its servos (2.97 rad/s) within 0.05 s and, with the
+    limits unwatched (--no-limits), reaches a direct singularity: the summary names the event, and the text says it
+    stopped early."""
     (tmp_path / "zero.py").write_text("def zero(t, q, v):\n    return [0.0, 0.0, 0.0]\n")
     out = _summary(capsys, "delta", "--controller", f"{tmp_path / 'zero.py'}:zero", "--duration", "1s", "--dt",
-                   "5ms", "--out", str(tmp_path / "fall.csv"))
+                   "5ms", "--out", str(tmp_path / "fast.csv"))
+    assert out["event"]["kind"] == "velocity_limit" and out["final_time"] < 0.05
+    assert "speed limit 2.97404" in out["event"]["detail"]
+    out = _summary(capsys, "delta", "--controller", f"{tmp_path / 'zero.py'}:zero", "--duration", "1s", "--dt",
+                   "5ms", "--no-limits", "--out", str(tmp_path / "fall.csv"))
     assert out["event"]["kind"] == "singularity" and out["final_time"] < 1.0
     assert math.isclose(out["event"]["time"], out["final_time"], rel_tol=1e-12)
     assert out["samples"] == len(_read_csv(tmp_path / "fall.csv")["time"])
@@ -209,9 +214,9 @@ def test_the_command_runs_as_a_process(tmp_path):
 
 def test_without_a_drive_the_mechanism_is_released(tmp_path, capsys):
     """Neither ``--torques`` nor ``--controller``: no effort, as ``pkm.simulate`` without a controller; the Delta
-    falls to its direct singularity and the summary says so."""
-    out = _summary(capsys, "delta", "--duration", "0.3s", "--out", str(tmp_path / "free.csv"))
-    sim = pkm.simulate(pkm.load("delta"), duration=0.3)
+    falls to its direct singularity (its limits unwatched: it outruns its servos first) and the summary says so."""
+    out = _summary(capsys, "delta", "--duration", "0.3s", "--no-limits", "--out", str(tmp_path / "free.csv"))
+    sim = pkm.simulate(pkm.load("delta"), duration=0.3, limits=False)
     assert out["samples"] == len(sim.time) and out["event"]["kind"] == sim.event.kind == "singularity"
     assert math.isclose(out["final_time"], sim.time[-1], rel_tol=1e-12)
     assert out["work"] == 0.0

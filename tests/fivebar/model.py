@@ -6,7 +6,7 @@ import math
 
 from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.model.urdf import UrdfBuilder
-from pkm.mechanisms._common import make_mechanism, rod_inertia, spec_parameters
+from pkm.mechanisms._common import PM54_040, make_mechanism, rod_inertia, spec_parameters
 from tests.fivebar.kinematics import inverse_kinematics, reference_pose
 from tests.fivebar.params import BRANCHES, NAME, FiveBarParams
 
@@ -19,7 +19,7 @@ def urdf_xml(p: FiveBarParams, *, spinning_rod: bool = False) -> str:
     for i, x in enumerate((-p.d / 2.0, p.d / 2.0)):
         n = i + 1
         b.link(f"proximal_{n}", p.m_link, (p.l1 / 2.0, 0.0, 0.0), rod_inertia(p.m_link, p.l1, 0))
-        b.joint(f"motor_{n}", "revolute", "base", f"proximal_{n}", (x, 0.0, 0.0))
+        b.joint(f"motor_{n}", "revolute", "base", f"proximal_{n}", (x, 0.0, 0.0), effort=PM54_040.effort, velocity=PM54_040.speed)
         b.link(f"distal_{n}", p.m_link, (p.l2 / 2.0, 0.0, 0.0), rod_inertia(p.m_link, p.l2, 0))
         if spinning_rod and n == 1:
             b.link("hub_1")

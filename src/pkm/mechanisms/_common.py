@@ -19,6 +19,41 @@ from pkm.validation import ABSURD, wrap_angle
 T = TypeVar("T")
 
 
+@dataclasses.dataclass(frozen=True)
+class Drive:
+    """A real drive whose limits a shipped mechanism's actuated joints carry (issue 41: they carried 1000 N m and
+    100 rad/s, or 1000 N and 100 m/s, placeholders that made ``pkm capability delta`` report 8.7 kN).
+
+    Attributes:
+        name: The product.
+        effort: Its continuous torque [N m] or force [N] at the output (the URDF's ``effort``, what a capability
+            holds).
+        speed: Its no-load (rotary) or largest (linear) speed at the output [rad/s or m/s] (the URDF's ``velocity``).
+        source: Its public datasheet.
+    """
+
+    name: str
+    effort: float
+    speed: float
+    source: str
+
+
+
+#: ROBOTIS DYNAMIXEL-P PM54-040-S250-R (BLDC, 251.417:1), 24 V: continuous torque 3.9 N m, no-load speed 28.4 rev/min
+#: (the Delta's, the 3-RRR's and the five-bar's motors).
+PM54_040 = Drive("ROBOTIS DYNAMIXEL-P PM54-040-S250-R", 3.9, 28.4 * 2.0 * math.pi / 60.0,
+                 "https://emanual.robotis.com/docs/en/dxl/p/pm54-040-s250-r/")
+#: ROBOTIS DYNAMIXEL-P PH54-200-S500-R (BLDC, 501.923:1), 24 V: continuous torque 44.7 N m, no-load speed
+#: 33.1 rev/min (the hexapod's motors).
+PH54_200 = Drive("ROBOTIS DYNAMIXEL-P PH54-200-S500-R", 44.7, 33.1 * 2.0 * math.pi / 60.0,
+                 "https://emanual.robotis.com/docs/en/dxl/p/ph54-200-s500-r/")
+#: Linearmech (Servomech) SA 2 PD servo-actuator, ball screw BS2 (16 x 10 mm), brushless BM 63 S motor: continuous
+#: load at non-zero speed 310 N, largest linear speed 500 mm/s (peak load 1095 N), its catalogue's table 5.1
+#: "Technical Data" (the 3-PRS's sliders and the Gough-Stewart platform's legs).
+SA2_PD = Drive("Linearmech SA 2 PD servo-actuator (ball screw 16 x 10)", 310.0, 0.5,
+               "Linearmech 'Servoactuators SA-PD series' catalogue, 5.1 Technical Data")
+
+
 def param(default: T, *units: str, length: int | None = None) -> T:
     """A design field: its default, its units (SI: ``"m"``, ``"rad"``, ``"kg"``, ``"kg m^2"``, ``"-"``;
     several for a tuple of mixed quantities, none for text and integers) and, for a tuple, its length

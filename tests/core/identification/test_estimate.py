@@ -1,15 +1,18 @@
 """pkm.core.identification.estimate: exact efforts give back the base parameters; efforts with noise (1 % of each
-actuator's range) give estimates within their stated standard deviations; bad data is refused by row."""
+actuator's range) give estimates within their stated standard deviations; bad data is refused by row; too few
+equations, and parameters that cannot be told from zero, are warned of (PoorIdentificationWarning)."""
 
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 import pytest
 
 from pkm.core.identification.base import base_parameters, random_states
-from pkm.core.identification.estimate import estimate
+from pkm.core.identification.estimate import POOR_RELATIVE_STD, estimate
 from pkm.core.identification.regressor import regressor
-from pkm.errors import InvalidInputError, SingularityError
+from pkm.errors import InvalidInputError, PoorIdentificationWarning, SingularityError
 from tests.core.dynamics.test_model import mechanism
 
 
@@ -27,11 +30,21 @@ def test_noisy_efforts_give_estimates_within_their_standard_deviations(name):
     """Weighted least squares on 300 random states: the errors over the stated deviations behave as a standard
     normal sample (at least 95 % within 3, none beyond 4); without noise the estimate is exact (1e-8 relative)."""
     mech, base, Q, QD, QDD, TAU = _data(name, 300)
-    exact = estimate(mech, Q, QD, QDD, TAU, base=base, weighted=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PoorIdentificationWarning)  # (exact: the zero parameters' deviations are 0/0)
+        exact = estimate(mech, Q, QD, QDD, TAU, base=base, weighted=False)
     assert np.abs(exact.values - base.values).max() <= 1e-8 * np.abs(base.values).max()
     rng = np.random.default_rng(5)
     noisy = TAU + 0.01 * np.ptp(TAU, axis=0) * rng.standard_normal(TAU.shape)
-    est = estimate(mech, Q, QD, QDD, noisy, base=base)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        est = estimate(mech, Q, QD, QDD, noisy, base=base)
+    # 900 equations or more: no warning of too few; one naming exactly the parameters above 100 % (those whose true
+    # value is zero, a drive's friction and offset among them), its sentence kept in est.warnings
+    poor = [n for n, r in zip(base.names, est.relative_std) if r > POOR_RELATIVE_STD]
+    found = [w.message for w in caught if isinstance(w.message, PoorIdentificationWarning)]
+    assert poor and len(found) == 1 and [n for n, _ in found[0].poor] == poor
+    assert est.warnings == (str(found[0]),) and f"{len(poor)} of {len(base)} base parameters" in est.warnings[0]
     z = (est.values - base.values) / est.std
     assert est.method == "wls" and np.mean(np.abs(z) <= 3.0) >= 0.95 and np.abs(z).max() <= 4.0
     assert np.allclose(est.residual_rms, 0.01 * np.ptp(TAU, axis=0), rtol=0.15)  # (the noise, found again)
@@ -41,6 +54,12 @@ def test_noisy_efforts_give_estimates_within_their_standard_deviations(name):
 
 def test_bad_data_is_refused_by_row_and_too_little_motion_says_so():
     mech, base, Q, QD, QDD, TAU = _data("delta", 20)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        est = estimate(mech, Q, QD, QDD, TAU, base=base)
+    w = caught[0].message
+    assert isinstance(w, PoorIdentificationWarning) and w.equations == est.rows == 60 and w.n_base == 48
+    assert "20 samples (60 equations) for 48 base parameters" in est.warnings[0] and "--tie-legs" in est.warnings[0]
     bad = TAU.copy()
     bad[7, 1] = np.nan
     with pytest.raises(InvalidInputError, match="row 7 is not finite"):

@@ -153,10 +153,10 @@ def test_a_spec_table_on_a_joint_that_is_not_actuated_is_refused(five):
 
 
 def test_a_peak_alone_is_checked_against_the_drives_continuous_limit(five):
-    assert five.actuators[0].effort_limit == 1000.0
-    assert pkm.with_actuators(five, {"motor_1": {"peak_effort": 2000.0}}).actuators[0].peak_effort == 2000.0
-    with pytest.raises(SpecError, match="peak effort 500 is below the continuous limit 1000"):
-        pkm.with_actuators(five, {"motor_1": {"peak_effort": 500.0}})
+    assert five.actuators[0].effort_limit == 3.9  # (a PM54-040-S250-R's continuous torque)
+    assert pkm.with_actuators(five, {"motor_1": {"peak_effort": 8.0}}).actuators[0].peak_effort == 8.0
+    with pytest.raises(SpecError, match=r"peak effort 2 is below the continuous limit 3\.9"):
+        pkm.with_actuators(five, {"motor_1": {"peak_effort": 2.0}})
 
 
 def test_the_reflected_inertia_is_not_counted_twice_without_urdf_text(five):

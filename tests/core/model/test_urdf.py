@@ -89,13 +89,14 @@ def test_external_entity_is_not_read(tmp_path):
 
 # ---------------------------------------------------------------------- optional position limits
 def _fivebar_urdf(limit_attrs: str) -> str:
-    """The toy five-bar's URDF with each ``<limit>`` rewritten as ``<limit effort="1000.0" velocity="100.0" ...>``."""
+    """The toy five-bar's URDF with each ``<limit>`` rewritten as ``<limit effort="..." velocity="..." ...>`` (its
+    effort and velocity kept)."""
     import re
 
     from tests import fivebar
 
-    return re.sub(r'<limit effort="1000.0" velocity="100.0" lower="[^"]*" upper="[^"]*"/>',
-                  f'<limit effort="1000.0" velocity="100.0"{limit_attrs}/>', fivebar.urdf_xml(fivebar.Params()))
+    return re.sub(r'<limit effort="([^"]*)" velocity="([^"]*)" lower="[^"]*" upper="[^"]*"/>',
+                  lambda m: f'<limit effort="{m[1]}" velocity="{m[2]}"{limit_attrs}/>', fivebar.urdf_xml(fivebar.Params()))
 
 
 def test_joints_without_position_limits_load_and_have_none():

@@ -1,7 +1,10 @@
 """``pkm capability MECH [--pose K=V ... | --joints NAME=V ...] [--kind wrench|twist|acceleration|all]
 [--no-gravity] [--json]``: what the actuators can produce at a pose under their limits
 (:func:`pkm.capability`): per task axis the largest value each way, the largest isotropic value per unit, the
-ellipsoid's semi-axes; with ``--json`` the polytopes' vertices and half-spaces too.
+ellipsoid's semi-axes; with ``--json`` the polytopes' vertices and half-spaces too. It prints first the limits it
+holds each actuator to (the continuous effort limit for wrenches and accelerations, the velocity limit for twists)
+and where each comes from (the model file, the closure spec's ``[actuators]``: ``limits`` in ``--json``), and says
+so when they look like placeholders (:mod:`pkm.core.model.plausibility`).
 
 ``--axis NAME=START:STOP:COUNT`` (once or twice; ``--pose`` then fixes the other task coordinates) maps one kind's
 indices over the grid instead (:func:`pkm.core.analysis.capability.capability_map`): the summary, ``--png`` the
@@ -31,13 +34,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from pkm.core.analysis.capability import KINDS, capability
+    from pkm.core.model.actuators import limit_sources
+    from pkm.core.model.plausibility import findings
     from pkm.report import jsonable
 
     mech = load_mechanism(args)
     if args.axis:
         return _map(mech, args)
     q = configuration(mech, args)
-    out: dict[str, Any] = {"mechanism": mech.name, "task": mech.task_map.named(q)}
+    limits = limit_sources(mech)
+    out: dict[str, Any] = {"mechanism": mech.name, "task": mech.task_map.named(q),
+                           "limits": {j: {f: {"value": v, "source": src} for f, (v, src) in row.items()
+                                          if f != "peak_effort"} for j, row in limits.items()},
+                           "placeholder_limits": any(w.kind == "limits" for w in findings(mech))}
     for kind in KINDS if args.kind == "all" else (args.kind,):
         c = capability(mech, q, kind, gravity=not args.no_gravity)
         P = c.polytope
@@ -49,6 +58,17 @@ def run(args: argparse.Namespace) -> int:
         return 0
     pose = ", ".join(f"{k}={v:.6g}" for k, v in out["task"].items())
     print(f"{mech.name} at {pose}")
+    texts: dict[str, list[str]] = {}  # (actuators with the same limits from the same places: one line)
+    for j, row in limits.items():
+        unit = ("N m", "rad/s") if mech.joints[j].revolute else ("N", "m/s")
+        text = (f"effort {row['effort_limit'][0]:.4g} {unit[0]} ({row['effort_limit'][1]}), velocity "
+                f"{row['velocity_limit'][0]:.4g} {unit[1]} ({row['velocity_limit'][1]})")
+        texts.setdefault(text, []).append(j)
+    for text, joints in texts.items():
+        print(f"limits held ({', '.join(joints)}): {text}")
+    if out["placeholder_limits"]:
+        print("warning: these limits look like placeholders (every actuator's alike, powers of ten): the capability "
+              "below is theirs, not a real drive's")
     for kind in KINDS:
         if kind not in out:
             continue

@@ -3,7 +3,15 @@
 ``time``, ``q.<joint>``, ``tau.<joint>``: :mod:`pkm.core.identification.measurements`): the base parameters by
 Gautier's weighted least squares with each one's relative standard deviation, with ``--consistent`` the physically
 consistent estimate (cvxpy and Clarabel: ``pkm[identify]``), written as a spec and URDF that ``pkm.load`` reads; with
-``--validate`` the identified model's efforts against a second table."""
+``--validate`` the identified model's efforts against a second table.
+
+The table printed (and ``base`` in ``--json``) holds, per base parameter, its value in the model written (``value``:
+``P θ`` of the spec and URDF saved, so the consistent estimate's with ``--consistent``; an effort offset is not
+written, a drive's negative friction is written as 0), then the least-squares estimate, its standard deviation and
+relative standard deviation; the fit (or ``--validate``'s prediction) is the estimate's, its effort offsets
+included; the samples used, the decimation and the filter's cutoff are printed, and the
+estimate's warnings (:class:`~pkm.errors.PoorIdentificationWarning`: too few equations, parameters that cannot be
+told from zero)."""
 
 from __future__ import annotations
 
@@ -28,11 +36,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import warnings
+
+    import pkm
     from pkm._optional import require
     from pkm.core.identification.base import base_parameters
-    from pkm.core.identification.estimate import estimate
-    from pkm.core.identification.export import standard_from_base, validate, write_identified
+    from pkm.core.identification.estimate import POOR_RELATIVE_STD, estimate
+    from pkm.core.identification.export import identified_mechanism, standard_from_base, validate
     from pkm.core.identification.measurements import measurements
+    from pkm.core.identification.regressor import parameters
+    from pkm.errors import InvalidInputError, PoorIdentificationWarning, SpecError
     from pkm.report import jsonable
 
     mech = load_mechanism(args)
@@ -42,7 +55,9 @@ def run(args: argparse.Namespace) -> int:
         require("figures", "the figure of an identified model (pkm.viz.identification)")
     data = measurements(mech, args.data, cutoff=args.cutoff)
     base = base_parameters(mech, tie_legs=args.tie_legs)
-    ls = estimate(mech, data.Q, data.QD, data.QDD, data.TAU, base=base)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PoorIdentificationWarning)  # (printed below, from ls.warnings)
+        ls = estimate(mech, data.Q, data.QD, data.QDD, data.TAU, base=base)
     model: Any = ls
     if args.consistent:
         from pkm.core.identification.consistent import consistent_estimate
@@ -51,13 +66,25 @@ def run(args: argparse.Namespace) -> int:
         theta = model.theta
     else:
         theta = standard_from_base(mech, base, ls.values)
+    try:
+        identified = identified_mechanism(mech, theta)
+    except (SpecError, InvalidInputError) as exc:
+        if args.consistent:
+            raise
+        raise InvalidInputError("--consistent", f"the least-squares estimate is no real mechanism and cannot be "
+                                                f"written ({exc}); --consistent writes the physically consistent "
+                                                f"estimate", None) from None
+    written = base.map @ parameters(identified).values  # the model written, as written (no offset, friction >= 0)
     out: dict[str, Any] = {
-        "mechanism": mech.name, "samples": len(data), "cutoff_hz": data.cutoff, "method": ls.method,
+        "mechanism": mech.name, "samples": len(data), "table_rows": data.table_rows, "decimate": data.decimate,
+        "equations": ls.rows, "cutoff_hz": data.cutoff, "method": ls.method,
         "consistent": bool(args.consistent), "routes_agree": base.routes_agree,
-        "base": [{"name": n, "value": float(v), "std": float(s), "relative_std_percent": float(r)}
-                 for n, v, s, r in zip(base.names, ls.values, ls.std, ls.relative_std)],
+        "base": [{"name": n, "value": float(w), "least_squares": float(v), "std": float(s),
+                  "relative_std_percent": float(r)}
+                 for n, w, v, s, r in zip(base.names, written, ls.values, ls.std, ls.relative_std)],
         "residual_rms": dict(zip(mech.actuated_names, ls.residual_rms.tolist())),
-        "out": str(write_identified(mech, theta, args.out)),
+        "warnings": list(ls.warnings),
+        "out": str(pkm.save(identified, args.out)),
     }
     if args.consistent:
         out["smallest_pseudo_inertia_eigenvalue"] = model.smallest_eigenvalue
@@ -75,15 +102,21 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(jsonable(out), indent=2))
         return 0
-    print(f"{mech.name}: {len(base)} base parameters from {len(data)} samples ({ls.method}"
-          f"{', physically consistent' if args.consistent else ''}); the two rank routes "
-          f"{'agree' if base.routes_agree else 'DISAGREE'}")
+    print(f"{mech.name}: {len(base)} base parameters from {len(data)} samples ({ls.rows} equations): one row in "
+          f"{data.decimate} of {data.table_rows} kept, filtered at {data.cutoff:.4g} Hz (its transients left out at "
+          f"each end); the two rank routes {'agree' if base.routes_agree else 'DISAGREE'}")
+    estimate_name = "physically consistent estimate" if args.consistent else f"least squares ({ls.method})"
+    print(f"the model written ({estimate_name}); least squares ({ls.method}) ± standard deviation (relative), "
+          f"'!' above {POOR_RELATIVE_STD:g} %:")
     width = max(len(n) for n in base.names)
     for row in out["base"]:
-        print(f"  {row['name'].ljust(width)}  {row['value']: .6g}  ± {row['std']:.2g} "
-              f"({row['relative_std_percent']:.3g} %)")
+        flag = "!" if not row["relative_std_percent"] <= POOR_RELATIVE_STD else " "
+        print(f"  {row['name'].ljust(width)}  {row['value']: .6g}  ({row['least_squares']: .6g} ± {row['std']:.2g}, "
+              f"{row['relative_std_percent']:.3g} %){flag}")
     key = "validation" if args.validate else "fit"
-    print(f"{key}: relative RMS " + ", ".join(f"{n} {r:.3g} %" for n, r in out[key]["relative_percent"].items()))
+    print(f"{key} of the {estimate_name} (its effort offsets included: the model written has none): relative RMS " + ", ".join(f"{n} {r:.3g} %" for n, r in out[key]["relative_percent"].items()))
+    for w in ls.warnings:
+        print(f"warning: {w}")
     print(f"out: {out['out']}" + (f"\nplot: {out['plot']}" if args.plot else ""))
     return 0
 

@@ -6,11 +6,20 @@ first ordinary fit, so that an actuator measured with more noise counts less). T
 estimate is ``s_i = sqrt(s² [(W_βᵀ W_β)⁻¹]_ii)`` with ``s² = |r|² / (rows - n_base)`` on the (weighted) rows, its
 relative standard deviation ``100 s_i / |β_i|`` [%], the usual measure of how well a parameter is identified (above
 about 10 %: poorly).
+
+**Warnings** (:class:`~pkm.errors.PoorIdentificationWarning`, the same sentences in :attr:`Estimate.warnings`):
+fewer than :data:`EQUATIONS_PER_PARAMETER` equations (samples times actuators) per base parameter (the
+standard deviations themselves are then poorly known), and every base parameter whose relative standard deviation
+exceeds :data:`POOR_RELATIVE_STD` (its estimate cannot be told from zero: its true value may be zero, a drive
+without friction, or the motion does not excite it). Remedies: a longer or better-excited run (:func:`pkm.excite`),
+a higher filter cutoff (fewer samples decimated away, :func:`pkm.core.identification.measurements.measurements`),
+fewer parameters (legs tied: ``tie_legs=True``, ``pkm identify --tie-legs``).
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,8 +28,12 @@ from numpy.typing import ArrayLike
 from pkm.core.identification.base import BaseParameters, base_parameters
 from pkm.core.identification.regressor import regressor
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.errors import InvalidInputError, SingularityError
+from pkm.errors import InvalidInputError, PoorIdentificationWarning, SingularityError
 from pkm.validation import as_array
+
+EQUATIONS_PER_PARAMETER = 3  # fewer equations than this per base parameter: a warning
+POOR_RELATIVE_STD = 100.0  # [%] a base parameter's relative standard deviation above this: a warning
+SHOWN = 6  # a warning's message names this many poorly identified parameters (its ``poor`` attribute holds all)
 
 
 @dataclass(frozen=True)
@@ -36,6 +49,7 @@ class Estimate:
         weights: Each actuator's weight (1 for ordinary least squares).
         method: ``"ols"`` or ``"wls"``.
         rows: The number of equations.
+        warnings: What the data cannot carry (module doc), one sentence each; empty when nothing.
     """
 
     base: BaseParameters
@@ -46,6 +60,7 @@ class Estimate:
     weights: np.ndarray
     method: str
     rows: int
+    warnings: tuple[str, ...] = ()
 
     def predict(self, Y: ArrayLike) -> np.ndarray:
         """The efforts ``Y_β β̂`` of a standard regressor ``Y`` (rows as stacked by :func:`regressor`)."""
@@ -113,7 +128,11 @@ def estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, TAU: 
     if not all(np.all(np.isfinite(a)) for a in (beta, std, rms, weights)):
         raise InvalidInputError("TAU", f"efforts up to {peak:.3g} [N m, N] overflow the estimate (its values, "
                                        "standard deviations or residuals beyond 1.8e308)", peak)
-    return Estimate(base, beta, std, rel, rms, weights, "wls" if weighted else "ols", len(y))
+    found = _warnings(base, n, len(y), rel)
+    for warning in found:
+        warnings.warn(warning, stacklevel=2)
+    return Estimate(base, beta, std, rel, rms, weights, "wls" if weighted else "ols", len(y),
+                    tuple(str(w) for w in found))
 
 
 def _scale(peak: float) -> float:
@@ -123,4 +142,26 @@ def _scale(peak: float) -> float:
     return 1.0 if 2.0**-500 <= peak <= 2.0**500 or peak == 0.0 else math.ldexp(1.0, math.frexp(peak)[1] - 1)
 
 
-__all__ = ["Estimate", "estimate"]
+def _warnings(base: BaseParameters, samples: int, equations: int,
+              relative_std: np.ndarray) -> list[PoorIdentificationWarning]:
+    """The module doc's warnings of an estimate from ``samples`` samples (``equations`` rows)."""
+    nb = len(base)
+    poor = [(name, float(r)) for name, r in zip(base.names, relative_std) if not r <= POOR_RELATIVE_STD]
+    remedy = "a longer or better-excited run (pkm excite), a higher filter cutoff, or legs tied (--tie-legs)"
+    out = []
+    if equations < EQUATIONS_PER_PARAMETER * nb:
+        out.append(PoorIdentificationWarning(
+            f"{samples} samples ({equations} equations) for {nb} base parameters: fewer than "
+            f"{EQUATIONS_PER_PARAMETER} equations per parameter, the estimate and its deviations are poorly "
+            f"determined; give more samples: {remedy}", equations, nb, poor))
+    if poor:
+        shown = "; ".join(f"{name} ({r:.3g} %)" for name, r in poor[:SHOWN])
+        more = f"; and {len(poor) - SHOWN} more" if len(poor) > SHOWN else ""
+        out.append(PoorIdentificationWarning(
+            f"{len(poor)} of {nb} base parameters have a relative standard deviation above {POOR_RELATIVE_STD:g} % "
+            f"(cannot be told from zero: zero in truth, or not excited): {shown}{more}; for a better estimate: "
+            f"{remedy}", equations, nb, poor))
+    return out
+
+
+__all__ = ["EQUATIONS_PER_PARAMETER", "POOR_RELATIVE_STD", "Estimate", "estimate"]

@@ -53,6 +53,8 @@ class Measurements:
         cutoff: The filter's cutoff [Hz]; ``rate``: the table's sampling rate [Hz]; ``decimate``: one row in this
             many kept.
         source: Where the table came from.
+        table_rows: The table's rows (the samples kept are ``len(self)``: one in ``decimate``, less the filter's
+            transients at each end).
     """
 
     t: np.ndarray
@@ -64,6 +66,7 @@ class Measurements:
     rate: float
     decimate: int
     source: str = ""
+    table_rows: int = 0
 
     def __len__(self) -> int:
         return len(self.t)
@@ -209,7 +212,7 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
     except PkmError as exc:
         raise InvalidInputError("q", f"{source}: the loops do not close along the measured positions ({exc})",
                                 None) from None
-    return Measurements(t[keep], Q, qd[keep], qdd[keep], tau[keep], fc, rate, every, source)
+    return Measurements(t[keep], Q, qd[keep], qdd[keep], tau[keep], fc, rate, every, source, n)
 
 
 __all__ = ["Measurements", "measurements", "read_table"]

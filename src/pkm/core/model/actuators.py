@@ -192,6 +192,24 @@ def write_model(model: pin.Model, actuator: Actuator, idx_v: int) -> None:
     # (4.1 reads only armature)
 
 
+def limit_sources(mech: object) -> dict[str, dict[str, tuple[float, str]]]:
+    """Each actuated joint's limits and where each comes from: ``{joint: {field: (value, source)}}`` for the
+    fields of :data:`LIMITS`, the source ``"spec"`` (the closure spec's ``[actuators.<joint>]`` table, where
+    :func:`pkm.with_actuators` writes too), ``"file <source>"`` (the model file's ``<limit>``) or ``"none"`` (no limit:
+    ``inf``). ``mech``: a :class:`~pkm.core.model.mechanism.Mechanism`."""
+    spec_tables = mech.spec.actuators  # type: ignore[attr-defined]
+    source = mech.spec.urdf or mech.source  # type: ignore[attr-defined]
+    out: dict[str, dict[str, tuple[float, str]]] = {}
+    for a in mech.actuators:  # type: ignore[attr-defined]
+        stated = spec_tables.get(a.joint, {})
+        row = {}
+        for f in LIMITS:
+            value = float(getattr(a, f))
+            row[f] = (value, "spec" if f in stated else "none" if not math.isfinite(value) else f"file {source}")
+        out[a.joint] = row
+    return out
+
+
 def as_actuators(values: ArrayLike | Mapping[str, object], names: tuple[str, ...]) -> dict[str, Actuator]:
     """Checked ``{joint: Actuator}`` from ``{joint: Actuator | {field: value}}`` (joints among ``names``)."""
     if not isinstance(values, Mapping):
@@ -220,6 +238,7 @@ __all__ = [
     "Actuator",
     "as_actuators",
     "from_model",
+    "limit_sources",
     "parse_table",
     "write_model",
 ]

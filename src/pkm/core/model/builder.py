@@ -19,7 +19,9 @@ of the mechanism fixes the zero pose); it is not the default because the nearest
 URDF's zero pose with aligned links): Gepetto's disney_like and wl16_like would get references 3 and 2 mrad from one.
 Write a ``[reference]`` (or ``pkm.save`` a mechanism whose ``q_reference`` was set) to choose.
 Actuators that depend on the others, or freedom no actuator drives (:func:`pkm.core.differential.velocity.actuation`),
-are reported by a :class:`~pkm.errors.PkmWarning` and in :attr:`Mechanism.notes`.
+are reported by a :class:`~pkm.errors.PkmWarning` and in :attr:`Mechanism.notes`; so are masses, inertias and
+drive limits no real mechanism has (:mod:`pkm.core.model.plausibility`: an
+:class:`~pkm.errors.ImplausibleModelWarning`).
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ from pkm.core.formats.imported import import_model, with_file
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import assemble
 from pkm.core.model import mechanism as _mechanism
+from pkm.core.model import plausibility
 from pkm.core.model.actuators import NUMBERS, Actuator, as_actuators
 from pkm.core.model.joints import retype_joints
 from pkm.core.model.mechanism import Mechanism, check_mechanism
@@ -90,6 +93,9 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
     if fit.problem:
         mech.notes += (f"at the reference configuration, {fit.problem}",)
         warnings.warn(f"{source}: at the reference configuration, {fit.problem}", PkmWarning, stacklevel=3)
+    for finding in plausibility.findings(mech):  # (masses, inertias, limits no real mechanism has)
+        mech.notes += (str(finding),)
+        warnings.warn(finding, stacklevel=3)
     return mech
 
 

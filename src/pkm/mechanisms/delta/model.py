@@ -8,6 +8,7 @@ from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.model.urdf import UrdfBuilder
 from pkm.mechanisms._common import (
+    PM54_040,
     check_params,
     make_mechanism,
     rod_inertia,
@@ -20,7 +21,9 @@ from pkm.mechanisms.delta.params import BRANCHES, NAME, PHI, DeltaParams
 
 # ---------------------------------------------------------------------- tree and spec
 def urdf_xml(params: DeltaParams) -> str:
-    """The URDF tree (see the module doc for the modelling of the parallelograms)."""
+    """The URDF tree (see the module doc for the modelling of the parallelograms); the motors' limits a ROBOTIS
+    PM54-040-S250-R servo's (:data:`pkm.mechanisms._common.PM54_040`: 3.9 N m continuous, 28.4 rev/min = 2.974
+    rad/s no-load, from its public datasheet https://emanual.robotis.com/docs/en/dxl/p/pm54-040-s250-r/)."""
     params = check_params(params, DeltaParams)
     b = UrdfBuilder(NAME)
     b.link("base")
@@ -30,7 +33,7 @@ def urdf_xml(params: DeltaParams) -> str:
         Rz = rot_z(PHI[i])
         b.link(f"arm_{n}", params.m_arm, (0.0, params.La / 2, 0.0), rod_inertia(params.m_arm, params.La, 1))
         b.joint(f"motor_{n}", "revolute", "base", f"arm_{n}", Rz @ np.array([0.0, params.R, 0.0]), Rz,
-                axis=(1.0, 0.0, 0.0))
+                axis=(1.0, 0.0, 0.0), effort=PM54_040.effort, velocity=PM54_040.speed)
         b.link(f"knee_cross_{n}")
         b.joint(f"knee_{n}", "revolute", f"arm_{n}", f"knee_cross_{n}", (0.0, params.La, 0.0), axis=(1.0, 0.0, 0.0))
         b.link(f"forearm_{n}", params.m_forearm, (0.0, params.Lb / 2, 0.0),

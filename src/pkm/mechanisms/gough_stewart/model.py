@@ -7,7 +7,7 @@ import numpy as np
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.model.urdf import UrdfBuilder
-from pkm.mechanisms._common import check_params, make_mechanism, rod_inertia, spec_parameters
+from pkm.mechanisms._common import SA2_PD, check_params, make_mechanism, rod_inertia, spec_parameters
 from pkm.mechanisms.gough_stewart.kinematics import joint_values, reference_pose
 from pkm.mechanisms.gough_stewart.params import NAME, GoughStewartParams
 
@@ -31,7 +31,7 @@ def urdf_xml(params: GoughStewartParams) -> str:
         b.joint(f"u{n}", "revolute", "base", f"cylinder_{n}", params.base[i], axis=(1.0, 0.0, 0.0))
         b.link(f"rod_{n}", half, (0.0, 0.0, -mid / 4), rod_inertia(half, mid / 2, 2))
         b.joint(f"leg{n}", "prismatic", f"cylinder_{n}", f"rod_{n}", axis=(0.0, 0.0, 1.0),
-                limits=(params.leg_min, params.leg_max))
+                limits=(params.leg_min, params.leg_max), effort=SA2_PD.effort, velocity=SA2_PD.speed)  # (a Linearmech SA 2 PD: 310 N, 0.5 m/s)
         b.frame(f"ball_{n}", f"rod_{n}")
         b.frame(f"cylinder_{n}_end", f"cylinder_{n}", (0.0, 0.0, params.leg_min / 2))  # (drawn: the cylinder, the rod)
         b.frame(f"rod_{n}_end", f"rod_{n}", (0.0, 0.0, -params.leg_min / 2))

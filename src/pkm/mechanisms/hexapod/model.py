@@ -10,6 +10,7 @@ from pkm.core.model.mechanism import (
 from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.model.urdf import UrdfBuilder
 from pkm.mechanisms._common import (
+    PH54_200,
     check_params,
     make_mechanism,
     rod_inertia,
@@ -39,12 +40,12 @@ def urdf_xml(params: HexapodParams) -> str:
         if i < 3:
             b.link(f"recon_{n}", params.m_recon, (params.Rr / 2, 0.0, 0.0), rod_inertia(params.m_recon, params.Rr, 0))
             b.joint(f"beta_{n}", "revolute", "base", f"recon_{n}", params.Rf * L[:, 0], L,
-                    mimic=None if n == 1 else ("beta_1", 1.0, 0.0))
+                    mimic=None if n == 1 else ("beta_1", 1.0, 0.0), effort=PH54_200.effort, velocity=PH54_200.speed)
             b.link(f"arm_{n}", params.m_arm, (params.LA / 2, 0.0, 0.0), rod_inertia(params.m_arm, params.LA, 0))
-            b.joint(f"alpha_{n}", "revolute", f"recon_{n}", f"arm_{n}", (params.Rr, 0.0, 0.0))
+            b.joint(f"alpha_{n}", "revolute", f"recon_{n}", f"arm_{n}", (params.Rr, 0.0, 0.0), effort=PH54_200.effort, velocity=PH54_200.speed)
         else:
             b.link(f"arm_{n}", params.m_arm, (params.LA / 2, 0.0, 0.0), rod_inertia(params.m_arm, params.LA, 0))
-            b.joint(f"alpha_{n}", "revolute", "base", f"arm_{n}", base_points(params, 0.0)[i], L)
+            b.joint(f"alpha_{n}", "revolute", "base", f"arm_{n}", base_points(params, 0.0)[i], L, effort=PH54_200.effort, velocity=PH54_200.speed)
         b.link(f"knee_cross_{n}")
         b.joint(f"knee_{n}", "revolute", f"arm_{n}", f"knee_cross_{n}", (params.LA, 0.0, 0.0))
         b.link(f"rod_{n}", params.m_rod, (params.LB / 2, 0.0, 0.0), rod_inertia(params.m_rod, params.LB, 0))

@@ -6,6 +6,8 @@ from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.model.urdf import UrdfBuilder
 from pkm.mechanisms._common import (
+    PH54_200,
+    SA2_PD,
     check_params,
     make_mechanism,
     rod_inertia,
@@ -30,9 +32,11 @@ def urdf_xml(params: Prs3Params) -> str:
         # slider frame: x along the rail u_1, y along e_t (knee axis), z along w (coupler at theta = 0)
         b.link(f"slider_link_{n}", params.m_slider)
         b.joint(f"slider_{n}", "prismatic", "base", f"slider_link_{n}", a[i], rot_z(PHI[i]) @ rot_y(-params.gamma),
-                axis=(1.0, 0.0, 0.0), limits=(-reach, reach))
+                axis=(1.0, 0.0, 0.0), limits=(-reach, reach), effort=SA2_PD.effort, velocity=SA2_PD.speed)  # (Linearmech SA 2 PD: 310 N, 0.5 m/s)
         b.link(f"coupler_{n}", params.m_coupler, (0.0, 0.0, params.l / 2), rod_inertia(params.m_coupler, params.l, 2))
-        b.joint(f"knee_{n}", "revolute", f"slider_link_{n}", f"coupler_{n}", axis=(0.0, 1.0, 0.0))
+        knee = params.actuation == "R"  # (the knees actuated: a ROBOTIS PH54-200-S500-R drives each)
+        b.joint(f"knee_{n}", "revolute", f"slider_link_{n}", f"coupler_{n}", axis=(0.0, 1.0, 0.0),
+                effort=PH54_200.effort if knee else 1e3, velocity=PH54_200.speed if knee else 1e2)
         b.frame(f"coupler_{n}_tip", f"coupler_{n}", (0.0, 0.0, params.l))
     # link "platform_link": Pinocchio 4.1 refuses a name shared by a body frame and a joint frame
     b.link("platform_link", params.m_platform, inertia=params.platform_inertia)

@@ -8,6 +8,7 @@ from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 from pkm.core.model.urdf import UrdfBuilder
 from pkm.mechanisms._common import (
+    PM54_040,
     check_params,
     make_mechanism,
     rod_inertia,
@@ -27,7 +28,8 @@ def urdf_xml(params: Rrr3Params) -> str:
         n = i + 1
         b.link(f"proximal_{n}", params.m_proximal, (params.a / 2.0, 0.0, 0.0),
                rod_inertia(params.m_proximal, params.a, 0))
-        b.joint(f"motor_{n}", "revolute", "base", f"proximal_{n}", (vertex[0], vertex[1], 0.0))
+        b.joint(f"motor_{n}", "revolute", "base", f"proximal_{n}", (vertex[0], vertex[1], 0.0),
+                effort=PM54_040.effort, velocity=PM54_040.speed)  # (a ROBOTIS PM54-040-S250-R: 3.9 N m, 28.4 rev/min, its datasheet)
         b.link(f"distal_{n}", params.m_distal, (params.b / 2.0, 0.0, 0.0), rod_inertia(params.m_distal, params.b, 0))
         b.joint(f"elbow_{n}", "revolute", f"proximal_{n}", f"distal_{n}", (params.a, 0.0, 0.0))
         if n > 1:

@@ -1,0 +1,123 @@
+"""Plausibility of a model's numbers: what loads but no real mechanism has (issue 41).
+
+Checked on every mechanism built (:func:`pkm.core.model.builder.build`), each finding a
+:class:`~pkm.errors.ImplausibleModelWarning` (its bodies or joints and values as attributes) and a line of
+:attr:`~pkm.core.Mechanism.notes`. The rules, all scale-aware (a mechanism of 5 cm and one of 5 m are judged alike):
+
+* **size** ``L`` [m]: the largest extent, along x, y or z, of the joint origins, the frames' origins and the bodies'
+  centres of mass at the reference configuration (no rule of size below applies when ``L`` is 0);
+* **mass** (``kind="mass"``): a body heavier than a solid steel cube of side ``L`` (:data:`DENSITY` ``L³``), the
+  heaviest solid that fits in a cube enclosing the whole mechanism;
+* **inertia** (``kind="inertia"``): a body whose largest principal moment about its centre of mass exceeds
+  ``m L²`` (its radius of gyration beyond the whole mechanism's extent);
+* **triangle** (``kind="triangle"``): principal moments ``I1 <= I2 <= I3`` about the centre of mass with
+  ``I3 > I1 + I2`` by more than :data:`TRIANGLE_TOL` ``I3`` (no distribution of mass has them);
+* **limits** (``kind="limits"``): every actuated joint with the same effort limit and the same velocity limit,
+  each a power of ten (``10^k``, ``k`` an integer: 1000 N m and 100 rad/s, an exporter's or a template's
+  placeholders). A limit of 0 or of at least 1e6 in a file already reads as none (:mod:`pkm.core.model.actuators`).
+
+Measured on pkm's shipped mechanisms, the acceptance set and Gepetto's examples: the heaviest body weighs at most
+1.2 % of the mass bound (Gepetto's ``5bar_linkage_iso3d``) and a radius of gyration at most 0.53 ``L`` (the knee
+example), except Gepetto's ``5bar_linkage``, whose links of 654,498 kg weigh 91 times the bound.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core.model.mechanism import Mechanism
+from pkm.errors import ImplausibleModelWarning
+
+DENSITY = 8000.0  # [kg/m^3] steel: the mass bound is a steel cube of side L
+TRIANGLE_TOL = 1e-4  # relative slack of the triangle inequality (a file's rounding of a flat body's moments)
+
+
+def size(mech: Mechanism) -> float:
+    """The mechanism's size ``L`` [m] (module doc)."""
+    model = mech.model
+    data = model.createData()
+    pin.forwardKinematics(model, data, mech.q_reference)
+    pin.updateFramePlacements(model, data)
+    points = [data.oMi[j].translation for j in range(1, model.njoints)]
+    points += [data.oMf[k].translation for k in range(model.nframes)]
+    points += [data.oMi[j].act(model.inertias[j].lever) for j in range(1, model.njoints)
+               if model.inertias[j].mass > 0.0]
+    return float(np.ptp(np.array(points), axis=0).max()) if len(points) > 1 else 0.0
+
+
+def _body_names(model: pin.Model) -> list[str]:
+    """Each joint's body by the name of its first link (the joint's name where it has none)."""
+    names = [model.names[j] for j in range(model.njoints)]
+    for f in reversed(list(model.frames)):
+        if f.type == pin.FrameType.BODY and f.parentJoint > 0:
+            names[f.parentJoint] = f.name
+    return names
+
+
+def _fmt(names: tuple[str, ...], values: tuple[float, ...], unit: str) -> str:
+    return ", ".join(f"{n!r} {v:.6g} {unit}" for n, v in zip(names, values))
+
+
+def findings(mech: Mechanism) -> list[ImplausibleModelWarning]:
+    """Every rule's finding on ``mech`` (module doc), one warning per rule that fires, in the module doc's order."""
+    model = mech.model
+    names = _body_names(model)
+    L = size(mech)
+    heavy, spread, skew = [], [], []
+    for j in range(1, model.njoints):
+        inertia = model.inertias[j]
+        m = float(inertia.mass)
+        if m <= 0.0:
+            continue
+        e = np.linalg.eigvalsh(np.asarray(inertia.inertia, dtype=float))
+        if L > 0.0 and m > DENSITY * L ** 3:
+            heavy.append((names[j], m))
+        if L > 0.0 and e[2] > m * L * L:
+            spread.append((names[j], float(e[2]), m * L * L))
+        if e[2] - e[0] - e[1] > TRIANGLE_TOL * e[2]:
+            skew.append((names[j], float(e[2] - e[0] - e[1])))
+    out = []
+    where = mech.source
+    if heavy:
+        n, v = zip(*heavy)
+        bound = DENSITY * L ** 3
+        out.append(ImplausibleModelWarning(
+            f"{where}: bodies heavier than a solid steel cube enclosing the whole mechanism ({bound:.4g} kg: "
+            f"{DENSITY:g} kg/m^3 times its extent {L:.4g} m cubed): {_fmt(n, v, 'kg')}; check the masses (units: "
+            f"kg, not g)", "mass", n, v, bound))
+    if spread:
+        n, v, b = zip(*spread)
+        out.append(ImplausibleModelWarning(
+            f"{where}: bodies whose largest principal moment of inertia exceeds their mass times the mechanism's "
+            f"extent squared ({L:.4g} m): {_fmt(n, v, 'kg m^2')} (above {', '.join(f'{x:.4g}' for x in b)}); check "
+            f"the inertias (units: kg m^2; about the centre of mass)", "inertia", n, v, float(max(b))))
+    if skew:
+        n, v = zip(*skew)
+        out.append(ImplausibleModelWarning(
+            f"{where}: inertias that break the triangle inequality (the largest principal moment exceeds the sum of "
+            f"the two others by): {_fmt(n, v, 'kg m^2')}; no distribution of mass has them", "triangle", n, v, 0.0))
+    acts = mech.actuators
+    effort = {a.effort_limit for a in acts}
+    speed = {a.velocity_limit for a in acts}
+    if acts and len(effort) == 1 and len(speed) == 1 and _power_of_ten(*effort) and _power_of_ten(*speed):
+        tau, vel = effort.pop(), speed.pop()
+        joints = tuple(a.joint for a in acts)
+        out.append(ImplausibleModelWarning(
+            f"{where}: every actuator's limits are {tau:g} (N m or N) and {vel:g} (rad/s or m/s), round powers of ten "
+            f"alike on all of {', '.join(joints)}: placeholders, not a drive's; give the motors' values "
+            f"([actuators.<joint>] effort_limit, peak_effort, velocity_limit in the closure spec, or "
+            f"pkm.with_actuators)", "limits", joints, (tau, vel), tau))
+    return out
+
+
+def _power_of_ten(x: float) -> bool:
+    if not (math.isfinite(x) and x > 0.0):
+        return False
+    k = round(math.log10(x))
+    return x == float(10.0 ** k) or math.isclose(x, 10.0 ** k, rel_tol=1e-12)
+
+
+__all__ = ["DENSITY", "TRIANGLE_TOL", "findings", "size"]
