@@ -142,7 +142,7 @@ def test_events_stop_the_run():
 
 
 def test_saturation_clips_to_the_peak_effort():
-    mech = pkm.with_actuators(mechanism("delta"), {"motor_1": {"effort_limit": 1.0, "peak_effort": 2.0}})
+    mech = pkm.with_actuators(released("delta"), {"motor_1": {"effort_limit": 1.0, "peak_effort": 2.0}})
     run = pkm.simulate(mech, duration=0.01, dt=1e-3, controller=lambda t, q, v: np.array([50.0, 0.0, 0.0]))
     assert np.all(run.efforts[:, 0] == 2.0)
     free = pkm.simulate(mech, duration=0.01, dt=1e-3, controller=lambda t, q, v: np.array([50.0, 0.0, 0.0]),

@@ -62,7 +62,7 @@ def test_triangle_inequality_and_placeholder_limits(built):
     urdf = re.sub(r'(<link name="platform">.*?<inertia )[^/]*/>',
                   r'\1ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.003"/>', delta.urdf, flags=re.S)
     with pytest.warns(ImplausibleModelWarning, match="triangle inequality") as w:
-        pkm.Mechanism.from_strings(urdf, delta.spec)
+        pkm.from_strings(urdf, delta.spec)
     assert w[0].message.kind == "triangle" and w[0].message.names == ("platform",)
     assert w[0].message.values[0] == pytest.approx(0.001, rel=1e-9)
     same = {j: {"effort_limit": 1000.0, "velocity_limit": 100.0} for j in delta.actuated_names}
