@@ -44,9 +44,9 @@ def run(args: argparse.Namespace) -> int:
         require("figures", "the figure of an excitation (pkm.viz.identification)")
     e = excite(mech, period=period, harmonics=args.harmonics, samples=args.samples, tie_legs=args.tie_legs,
                amplitude=args.amplitude, max_iter=args.iterations)
+    bounds = {j: (float(lo), float(hi)) for j, (lo, hi) in zip(e.joints, () if e.bounds is None else e.bounds)}
     out = {"mechanism": mech.name, "period_s": e.period, "harmonics": int(e.a.shape[1]),
-           "condition_start": e.condition_start, "condition": e.condition, "margins": e.margins,
-           "bounds": {j: [float(lo), float(hi)] for j, (lo, hi) in zip(e.joints, e.bounds)},
+           "condition_start": e.condition_start, "condition": e.condition, "margins": e.margins, "bounds": bounds,
            "shrunk": e.shrunk, "out": write_csv(mech, e, args.out, periods=args.periods, dt=dt)}
     if args.motion:
         from pkm.core.identification.excitation import write_motion
@@ -63,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
               f"{e.condition_start:.4g} -> {e.condition:.4g}")
         units = {j: "rad" if mech.joints[j].revolute else "m" for j in e.joints}
         print("position bounds (the tighter of the joint limits and the amplitude about the reference): "
-              + ", ".join(f"{j} [{lo:.4g}, {hi:.4g}] {units[j]}" for j, (lo, hi) in out["bounds"].items()))
+              + ", ".join(f"{j} [{lo:.4g}, {hi:.4g}] {units[j]}" for j, (lo, hi) in bounds.items()))
         print("margins (joint, speed, effort: fraction of each bound left; singularity: the smallest distance over "
               "its bound): " + ", ".join(f"{k} {v:.3g}" for k, v in e.margins.items()))
         for key in ("out", "motion", "plot"):
