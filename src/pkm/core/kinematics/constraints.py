@@ -112,11 +112,12 @@ def check_closed(mech: Mechanism, q: np.ndarray, what: str = "q") -> None:
     from pkm.errors import InvalidInputError
 
     L = mech.characteristic_length
-    r = residual(mech, q)[:mech.n_constraints] * mech.jacobian_scales.constraint_rows / L  # (dimensionless)
-    gap, _, name = worst_closure(mech, r)
+    raw = residual(mech, q)
+    gap, index, name = worst_closure(mech, raw[:mech.n_constraints] * mech.jacobian_scales.constraint_rows / L)
     if gap > CLOSED_RTOL:
-        raw = worst_closure(mech, residual(mech, q))[0]
-        raise InvalidInputError(what, f"the loops are not closed: closure {name!r} is open by {raw:.3g} (m or rad), "
+        start = sum(cm.residualSize() for cm in mech.constraint_models[:index - 1])
+        open_by = float(np.linalg.norm(raw[start:start + mech.constraint_models[index - 1].residualSize()]))
+        raise InvalidInputError(what, f"the loops are not closed: closure {name!r} is open by {open_by:.3g} (m or rad), "
                                       f"{gap:.3g} of the mechanism's size {L:.3g} m (at most {CLOSED_RTOL:g}); close "
                                       "them first (pkm.close_loops, pkm.solve_ik)", name)
 
