@@ -106,3 +106,11 @@ def test_bad_requests_are_refused(hexapod_pose_t):
     far = {"pose": pin.SE3(np.eye(3), np.array([0.0, -2.0, 0.0])), "beta_1": 0.0}
     with pytest.raises((UnreachableError, pkm.errors.ConvergenceError)):
         reconfigure(mech, [far], ["beta_1"], [(-1.0, 1.0)], length=0.1)
+
+
+def test_an_index_that_is_no_name_is_refused_by_pkm():
+    """The fuzz's repro (issue 47): ``index=`` an array raised numpy's "truth value of an array is ambiguous"."""
+    mech = pkm.load("hexapod")
+    with pytest.raises(InvalidInputError, match="index"):
+        reconfigure(mech, [mech.task_map.value(mech.q_reference)], ["beta_1"], [(-0.5, 0.5)], length=0.1,
+                    index=np.array(["a", "b"]))

@@ -117,3 +117,16 @@ def test_a_simulation_keeps_the_energy_of_a_spin_that_moves_mass(method):
                        friction=False, limits=False, singular_tol=0.0, backend="python")
     assert run.event is None and len(run) == 11
     assert np.abs(run.energy - run.energy[0]).max() <= 1e-8 * run.kinetic.max()
+
+
+def test_a_configuration_whose_inertia_overflows_is_refused_by_pkm():
+    """The fuzz's repro (issue 47): the Gough-Stewart (idle rod spins) at a configuration with a coordinate of
+    -1e308 gave numpy's LinAlgError ("Eigenvalues did not converge") from the idle motions' inertia: the mass matrix
+    there is not finite, which pkm now says."""
+    from pkm.errors import PkmError
+
+    mech = pkm.load("gough_stewart")
+    q = mech.q_reference.copy()
+    q[-4] = -1e308
+    with pytest.raises(PkmError):
+        pkm.inverse_velocities(mech, q, np.ones(mech.n_task))

@@ -71,6 +71,9 @@ def test_bad_data_is_refused_by_row_and_too_little_motion_says_so():
     still = np.repeat(Q[:1], 20, axis=0), np.zeros((20, 3)), np.zeros((20, 3))
     with pytest.raises(SingularityError, match="do not excite"):
         estimate(mech, *still, np.zeros((20, 3)), base=base)
+    # (the fuzz's repro, issue 47: efforts all zero gave every relative deviation 0/0, inf; refused)
+    with pytest.raises(InvalidInputError, match="every effort is zero"):
+        estimate(mech, Q, QD, QDD, np.zeros_like(TAU), base=base)
 
 
 def test_efforts_near_the_ends_of_the_float_range_scale_exactly_or_are_refused():

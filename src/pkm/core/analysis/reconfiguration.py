@@ -191,7 +191,7 @@ def reconfigure(mech: Mechanism, poses: np.ndarray | Sequence[ArrayLike | Mappin
     if kernels is not None and (not isinstance(kernels, Kernels) or kernels.mech is not mech):
         raise InvalidInputError("kernels", "give the pkm.Kernels of this mechanism", kernels)
     task = TaskMap(mech)
-    if index not in INDICES:
+    if not isinstance(index, str) or index not in INDICES:
         raise InvalidInputError("index", f"use one of {INDICES}", index)
     params = [parameters] if isinstance(parameters, str) else list(parameters) \
         if isinstance(parameters, (list, tuple)) else []

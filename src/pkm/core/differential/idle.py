@@ -30,6 +30,7 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core.model.mechanism import Mechanism
+from pkm.validation import finite_result
 
 #: An idle direction whose inertia is at most this times the largest diagonal entry of ``M`` is massless.
 MASSLESS = 1e-12
@@ -39,7 +40,7 @@ def joint_inertia(mech: Mechanism, q: np.ndarray) -> np.ndarray:
     """Pinocchio's joint-space mass matrix ``M(q)`` (nv x nv, ``crba``, symmetric; the actuators' reflected inertia,
     Pinocchio's ``armature``, on its diagonal) [kg m^2, kg m, kg]."""
     M = pin.crba(mech.model, mech.data, q)
-    return np.triu(M) + np.triu(M, 1).T
+    return finite_result(np.triu(M) + np.triu(M, 1).T, "joint-space mass matrix")
 
 
 def idle_inertia_inverse(M: np.ndarray, N: np.ndarray) -> np.ndarray:

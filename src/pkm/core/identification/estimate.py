@@ -108,7 +108,10 @@ def estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, TAU: 
     peak = float(np.abs(TAU_).max())
     s = _scale(peak)  # (the efforts' sums of squares overflow beyond 1e154: the fit runs on TAU / s, exactly)
     y = TAU_.reshape(-1) / s
-    beta, diag = _solve(W, y)
+    beta, diag = _solve(W, y)  # (a regressor that the samples do not excite: SingularityError)
+    if peak == 0.0:
+        raise InvalidInputError("TAU", "every effort is zero: the data carry no parameter (each relative deviation "
+                                       "would be 0/0)", peak)
     weights = np.ones(mech.na)
     if weighted:
         r = (y - W @ beta).reshape(n, mech.na)
