@@ -10,7 +10,7 @@ from collections.abc import Sequence
 
 import pkm
 from pkm.cli.commands import COMMANDS
-from pkm.cli.output import print_error
+from pkm.cli.output import print_error, seed_hints
 from pkm.cli.usage import PROG, Parser, UsageError, debug_option
 from pkm.errors import PkmError
 
@@ -48,6 +48,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if " " in two and two in COMMANDS:  # 'pkm sweep plot' is the parser's sweep-plot
         argv = [_parser_name(two)] + argv[2:]
     debug = "--debug" in argv
+    seed = False  # (whether the command takes --q0)
     try:
         try:
             args = build_parser().parse_args(argv)
@@ -58,9 +59,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             takers = " or ".join(repr(f"{PROG} {n}") for n, c in COMMANDS.items() if c.passthrough)
             raise UsageError(f"arguments after '--' are only for {takers}, got {extra}")
         args.extra = extra
-        return args.func(args)
+        seed = hasattr(args, "q0")
+        if not seed:
+            return args.func(args)
+        with seed_hints():
+            return args.func(args)
     except PkmError as exc:
-        return print_error(exc, debug)
+        return print_error(exc, debug, seed)
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130

@@ -5,32 +5,48 @@ fail, a shipped mechanism's closed forms say why."""
 from __future__ import annotations
 
 import argparse
+import functools
 
 import numpy as np
 
 import pkm
 from pkm.cli.parsing import parse_joints, parse_params, parse_pose, parse_seed
-from pkm.cli.usage import UsageError
+from pkm.cli.usage import UsageError, late_help
 from pkm.errors import ConvergenceError, PkmError
 
 
-def shipped() -> str:
-    """The shipped mechanisms' names, for the help of ``MECH``."""
-    return ", ".join(pkm.MECHANISMS)
-
-
+@functools.cache
 def mech_help() -> str:
-    """What ``MECH`` takes: every input :func:`pkm.load` reads."""
-    return (f"a shipped mechanism ({shipped()}), a robot pkm ships or an installed package's model by name "
-            "(gepetto:robot_delta, example-robot-data:cassie: 'pkm list' names them), or one's own files: a closure "
-            "spec (path/to/my.closures.toml, naming its URDF, MJCF or SDF file), a URDF + YAML in Gepetto's "
-            "convention (the folder or either file), or an MJCF file (.xml)")
+    """What ``MECH`` takes: every input :func:`pkm.load` reads, from the tables that say so (the registry, the robots
+    pkm ships, the installed packages' models, the model-file formats), so that it cannot drift from them."""
+    from pkm.core.formats.base import FORMATS
+    from pkm.core.formats.catalogue import CATALOGUE
+    from pkm.core.formats.packages import PACKAGE_MODELS
+
+    def by_source(names: list[str], what: str) -> str:
+        sources = dict.fromkeys(n.partition(":")[0] for n in names)
+        return ", ".join(f"{s}:<{what}> (e.g. {next(n for n in names if n.startswith(s + ':'))})" for s in sources)
+
+    formats = ", ".join(f"{f.name.upper()} ({' '.join(f.suffixes)})" for f in FORMATS.values())
+    return (f"a shipped mechanism ({', '.join(pkm.MECHANISMS)}); a robot pkm ships, {by_source(list(CATALOGUE), 'robot')}; an "
+            f"installed package's model, {by_source(list(PACKAGE_MODELS), 'model')} ('pkm list' names them all); "
+            "or a path: a closure spec (NAME.closures.toml, naming its model file), a URDF + YAML in Gepetto's "
+            "convention (their folder, or either file), or a model file read by its content, " + formats
+            + ": alone when it names its loops and actuated joints, else through a closure spec ('pkm spec init FILE' "
+            "writes one)")
+
+
+def add_mechanism_help(action: argparse.Action, before: str = "", after: str = "") -> argparse.Action:
+    """Give the ``MECH`` argument ``action`` the help ``before + mech_help() + after``, computed when a help is
+    printed (it reads the formats' tables: imports that ``pkm --help`` and every other run need not make)."""
+    action.help = "what pkm.load takes (see the help)"
+    return late_help(action, lambda: before + mech_help() + after)
 
 
 def add_mechanism_arguments(p: argparse.ArgumentParser, pose: str | None, joints: str | None) -> None:
-    """``MECH``, ``--param`` and, if asked (``"required"`` or ``"optional"``), ``--pose`` and ``--joints`` (exclusive
-    when both are taken)."""
-    p.add_argument("mechanism", metavar="MECH", help=mech_help())
+    """``MECH``, ``--param``, ``--q0`` and, if asked (``"required"`` or ``"optional"``), ``--pose`` and ``--joints``
+    (exclusive when both are taken)."""
+    add_mechanism_help(p.add_argument("mechanism", metavar="MECH"))
     p.add_argument("--param", metavar="K=V", action="extend", nargs="+", default=[],
                    help="a design parameter (see 'pkm list'); default: the paper's design")
     g = p.add_mutually_exclusive_group() if pose and joints else p
@@ -41,9 +57,15 @@ def add_mechanism_arguments(p: argparse.ArgumentParser, pose: str | None, joints
         g.add_argument("--joints", metavar="NAME=V", action="extend", nargs="+", required=joints == "required",
                        help="actuated joint values (others keep the reference; see 'pkm list MECH')")
     if pose or joints:
-        p.add_argument("--q0", metavar="NAME=V", action="extend", nargs="+", default=[],
-                       help="the solver's seed: values of any joints, passive ones included (others keep the "
-                            "reference); its assembly mode is kept")
+        add_seed_argument(p, "the solver's seed")
+
+
+def add_seed_argument(p: argparse.ArgumentParser, what: str) -> None:
+    """``--q0 NAME=V ...``: the seed configuration (:func:`~pkm.cli.parsing.parse_seed`), the option the messages
+    of the solvers point to when they ask for a seed nearer the target."""
+    p.add_argument("--q0", metavar="NAME=V", action="extend", nargs="+", default=[],
+                   help=f"{what}: values of any joints, passive ones included (others keep the reference); its "
+                        "assembly mode is kept")
 
 
 def load_mechanism(args) -> pkm.Mechanism:

@@ -3,13 +3,17 @@ refusal with its exit status."""
 
 from __future__ import annotations
 
+import contextlib
+import re
 import sys
 import traceback
+import warnings
+from collections.abc import Iterator
 from typing import Any
 
 import pkm
 from pkm.cli.usage import PROG, UsageError
-from pkm.errors import PkmError, SpecError, UnitError, UnknownNameError
+from pkm.errors import PkmError, PkmWarning, SpecError, UnitError, UnknownNameError
 from pkm.report import jsonable
 
 
@@ -60,14 +64,44 @@ def modes_dict(mech: pkm.Mechanism, modes, **extra) -> dict[str, Any]:
 
 
 
-def print_error(exc: PkmError, debug: bool = False) -> int:
+SEED_HINT = "on the command line the seed is --q0 NAME=V ..., any joints by name (see 'pkm list MECH')"
+"""What a message of the library that asks for a seed (``q0``) gets added in a command that takes ``--q0``."""
+
+
+def seed_hint(text: str) -> str:
+    """``text`` with :data:`SEED_HINT` added when it asks for the library's seed ``q0`` (the solvers' failures and
+    :class:`~pkm.errors.ModeChangeWarning` say "seed nearer the target (q0)")."""
+    return f"{text} [{SEED_HINT}]" if re.search(r"\(q0\)|\bas q0\b", text) else text
+
+
+@contextlib.contextmanager
+def seed_hints() -> Iterator[None]:
+    """While it is open, a :class:`~pkm.errors.PkmWarning` shown that asks for a seed carries :data:`SEED_HINT`."""
+    shown = warnings.showwarning
+
+    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int, file: Any = None,
+             line: str | None = None) -> None:
+        if isinstance(message, PkmWarning) and message.args and isinstance(message.args[0], str):
+            message.args = (seed_hint(message.args[0]), *message.args[1:])
+        shown(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
+    try:
+        yield
+    finally:
+        warnings.showwarning = shown
+
+
+def print_error(exc: PkmError, debug: bool = False, seed: bool = False) -> int:
     """Print ``pkm: error: ...`` on stderr (after the traceback with ``--debug``); return the exit status.
+    ``seed``: the command takes ``--q0`` (a message asking for a seed says so, :func:`seed_hint`).
 
     The status is 2 when the command line is wrong (syntax, unknown names, units), 1 when pkm refuses or fails
     (invalid parameter, unreachable pose, no convergence, a broken file).
     """
     if debug:
         traceback.print_exc()
-    print(f"{PROG}: error: {exc}", file=sys.stderr)
+    text = seed_hint(str(exc)) if seed else str(exc)
+    print(f"{PROG}: error: {text}", file=sys.stderr)
     named_wrong = isinstance(exc, UnknownNameError) and not isinstance(exc, SpecError)  # not a broken file
     return 2 if isinstance(exc, (UsageError, UnitError)) or named_wrong else 1

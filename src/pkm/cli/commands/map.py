@@ -11,8 +11,8 @@ import json
 from typing import Any
 
 from pkm.cli.command import Command
-from pkm.cli.mechanism import add_mechanism_arguments, load_mechanism
-from pkm.cli.parsing import parse_axis, split_item
+from pkm.cli.mechanism import add_mechanism_arguments, add_seed_argument, load_mechanism
+from pkm.cli.parsing import parse_axis, parse_seed, split_item
 from pkm.cli.usage import UsageError
 from pkm.errors import UnknownNameError
 from pkm.units import SI_UNITS, parse_quantity
@@ -27,6 +27,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--length", metavar="L", help="characteristic length dividing the angular rates, e.g. 5cm "
                                                  "(needed when the task mixes lengths and angles)")
     p.add_argument("--branch", metavar="NAME", help="working mode of the map (see 'pkm list')")
+    add_seed_argument(p, "the configuration the map starts from (its working mode is the map's; default: the "
+                         "reference, or the branch's)")
     p.add_argument("--index", choices=("wrench", "twist", "acceleration"),
                    help="the capability under the actuators' limits at every reachable node (pkm capability's)")
     p.add_argument("--no-gravity", action="store_true", help="with --index: leave the mechanism's weight out")
@@ -51,7 +53,8 @@ def run(args: argparse.Namespace) -> int:
     length = None if args.length is None else parse_quantity(args.length, {"length"}, "--length", "m")
     if args.index and args.png and len(axes) > 2:
         raise UsageError("--index draws one or two axes: leave --png out of a 3-D map (its CSV has every node)")
-    m = workspace_map(mech, axes, fixed, branch=args.branch, length=length, configurations=bool(args.index))
+    m = workspace_map(mech, axes, fixed, branch=args.branch, length=length, seed=parse_seed(mech, args.q0),
+                      configurations=bool(args.index))
     out: dict[str, Any] = {"mechanism": mech.name, "axes": {n: [float(v[0]), float(v[-1]), len(v)] for n, v in m.axes},
                            "nodes": int(m.reachable.size), "reachable": m.nodes, "size_SI": m.size, "size_unit": m.size_unit,
                            "gci_2": m.gci("2"), "gci_fro_normalized": m.gci("fro_normalized"), "how": m.how}

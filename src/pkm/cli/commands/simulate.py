@@ -22,7 +22,7 @@ import numpy as np
 
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, close_loops, load_mechanism
-from pkm.cli.parsing import parse_joints, parse_rates
+from pkm.cli.parsing import parse_rates, parse_seed
 from pkm.errors import InvalidInputError, UnknownNameError
 from pkm.units import parse_quantity
 
@@ -42,7 +42,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--dt", metavar="DT", default="1ms", help="sample period, the RK4 step (default 1ms)")
     p.add_argument("--method", choices=("rk4", "radau"), default="rk4", help="integrator (default rk4)")
     p.add_argument("--q0", metavar="NAME=V", action="extend", nargs="+", default=[],
-                   help="initial actuated joint values (others keep the reference)")
+                   help="the initial configuration: actuated joint values (others keep the reference), and passive "
+                        "ones as the loop closure's seed (its assembly mode is kept)")
     p.add_argument("--v0", metavar="NAME=V", action="extend", nargs="+", default=[],
                    help="initial actuated rates [rad/s or m/s, numbers, no unit] (others zero)")
     p.add_argument("--no-friction", action="store_true", help="leave the joints' friction out")
@@ -169,7 +170,12 @@ def run(args: argparse.Namespace) -> int:
     mech = load_mechanism(args)
     duration = parse_quantity(args.duration, {"time"}, "--duration", "s")
     dt = parse_quantity(args.dt, {"time"}, "--dt", "s")
-    q0 = close_loops(mech, parse_joints(mech, args.q0, "--q0")).q if args.q0 else None
+    q0 = None
+    seed = parse_seed(mech, args.q0)
+    if seed is not None:  # the actuators named set the state; the passive joints named, the closure's seed
+        qa = mech.actuated_q(seed)
+        seed[mech.act_q] = mech.q_reference[mech.act_q]
+        q0 = close_loops(mech, qa, seed).q
     v0 = parse_rates(mech, args.v0, "--v0")
     drive: dict[str, Any] = {}
     if args.torques is not None:

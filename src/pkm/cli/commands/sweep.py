@@ -10,7 +10,7 @@ import numpy as np
 
 import pkm
 from pkm.cli.command import Command
-from pkm.cli.mechanism import shipped
+from pkm.cli.mechanism import add_mechanism_help
 from pkm.cli.parsing import parse_params, split_item
 from pkm.cli.usage import UsageError
 from pkm.report import jsonable
@@ -23,11 +23,10 @@ def _objective_names() -> list[str]:
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    mechs = shipped()
     p.epilog = ("Objectives: " + ", ".join(_objective_names()) + "; options as gci:step=1cm, a column name as "
                 "label=SPEC, or path/to/file.py:function. A killed sweep run again with the same --out resumes.")
-    p.add_argument("mechanism", metavar="MECH", help=f"one of {mechs}, or a closure spec file (its URDF joint "
-                                                     "origins JOINT.x ... JOINT.yaw are the parameters)")
+    add_mechanism_help(p.add_argument("mechanism", metavar="MECH"), after=" (a model read from files: its joint "
+                       "origins JOINT.x ... JOINT.yaw are the parameters)")
     p.add_argument("parameters", metavar="NAME=RANGE", nargs="*",
                    help="grid: a=30cm:80cm:11 (START:STOP:COUNT) or a=0.3; sampled: a=30cm:80cm (LOW:HIGH)")
     p.add_argument("--objective", metavar="SPEC", action="append", required=True, help="an objective (repeat)")
