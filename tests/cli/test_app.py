@@ -58,3 +58,58 @@ def test_every_subcommand_takes_a_closure_spec_file(tmp_path):
     assert refused.returncode == 2 and "states its own" in refused.stderr
     unknown = run("ik", "nosuch", "--pose", "x=0")
     assert unknown.returncode != 0 and "closure spec's path" in unknown.stderr
+
+
+def _subparsers():
+    """``{name: parser}`` of every subcommand of :func:`pkm.cli.build_parser`."""
+    import argparse
+
+    from pkm.cli import build_parser
+
+    ap = build_parser()
+    return next(a for a in ap._actions if isinstance(a, argparse._SubParsersAction)).choices
+
+
+def test_every_mech_help_names_every_input_from_the_formats_tables(monkeypatch):
+    """Every subcommand taking MECH gives it the one help, read when printed from the tables: the registry, each
+    source of shipped robots and installed packages' models, each registered model-file format with its suffixes;
+    a format registered later is named too (no drift)."""
+    import re
+
+    from pkm.cli.mechanism import mech_help
+    from pkm.core.formats.base import FORMATS, Format
+    from pkm.core.formats.catalogue import CATALOGUE
+    from pkm.core.formats.packages import PACKAGE_MODELS
+
+    monkeypatch.setitem(FORMATS, "step", Format("step", (".stp", ".step"), "step", "nowhere:read"))
+    text = " ".join(mech_help().split())
+    for needed in [*pkm.MECHANISMS, "STEP (.stp .step)", "MJCF (.xml .mjcf)", "closure spec", "Gepetto",
+                   *{n.partition(":")[0] + ":<" for n in [*CATALOGUE, *PACKAGE_MODELS]}]:
+        assert needed in text, needed
+    takers = 0
+    for name, parser in _subparsers().items():
+        helped = " ".join(re.sub(r"-\n\s*", "-", parser.format_help()).split())
+        if " MECH " in helped:
+            takers += 1
+            assert text in helped, name
+    assert takers >= 12  # (list, preview, ik, fk, map, dynamics, simulate, excite, identify, capability, export, sweep)
+
+
+def test_each_command_that_solves_takes_the_seed_and_a_warning_asking_for_one_names_it(tmp_path, capsys, built):
+    """The solvers' messages ask for a seed nearer the target (q0): every command that closes the loops or solves
+    the IK from a seed takes ``--q0``; the toy five-bar's IK across its direct singularity (which the library warns
+    of, ModeChangeWarning) says, on the command line, that the seed is ``--q0``."""
+    from pkm import cli
+    from pkm.errors import ModeChangeWarning
+
+    parsers = _subparsers()
+    for name in ("ik", "fk", "preview", "dynamics", "capability", "map", "simulate"):
+        assert "--q0" in parsers[name].format_help(), name
+    mech = built("fivebar")
+    spec = pkm.save(mech, tmp_path / "five.closures.toml")
+    y = mech.task_map.named(mech.q_reference)["y"] - 0.3
+    with pytest.warns(ModeChangeWarning) as record:
+        assert cli.main(["ik", str(spec), "--pose", f"y={y!r}"]) == 0
+    assert "seed nearer the target (q0)" in str(record[0].message) and "the seed is --q0 NAME=V" in \
+        str(record[0].message)
+    capsys.readouterr()

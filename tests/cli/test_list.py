@@ -8,6 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pkm
 from pkm import cli
 from pkm.mechanisms import names
 from tests.cli.helpers import one_error_line, run
@@ -56,3 +57,39 @@ def test_list_describes_any_mech_and_names_the_robots_loaded_by_name(capsys):
     assert all(name in tail for name in (*CATALOGUE, "example-robot-data:cassie"))
     bad = run("list", "gepetto:nope")
     assert bad.returncode != 0 and "'gepetto:nope'" in one_error_line(bad)
+
+
+def test_list_a_folder_names_what_loads_there_and_why_the_rest_does_not(tmp_path, capsys, built):
+    """``pkm list FOLDER`` searches it: a closure spec (its URDF among its files, not listed apart) and an MJCF file
+    two levels down are described with their format, name, joints and task, as ``pkm.load`` reads them; a URDF
+    alone is named with load's error; a TOML that is no spec is left out. A single file is described alone; a
+    folder with nothing pkm loads is one error line (status 1) saying what it searched for."""
+    import shutil
+
+    root = Path(__file__).resolve().parents[2]
+    spec = pkm.save(built("fivebar"), tmp_path / "five" / "five.closures.toml")
+    (tmp_path / "deep" / "er").mkdir(parents=True)
+    mjcf = Path(shutil.copy(root / "examples" / "mjcf_fourbar" / "fourbar.xml", tmp_path / "deep" / "er"))
+    lone = Path(shutil.copy(spec.parent / "five.urdf", tmp_path / "lone.urdf"))
+    (tmp_path / "pyproject.toml").write_text('[project]\nname = "x"\n')
+    assert cli.main(["list", str(tmp_path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    data = out["mechanisms"]
+    assert sorted(data) == sorted([str(spec), str(mjcf)])
+    five, four = data[str(spec)], data[str(mjcf)]
+    assert five["format"] == "pkm closure spec + URDF" and five["files"] == [str(spec), str(spec.parent / "five.urdf")]
+    assert (five["name"], five["loops"], five["joints"]) == ("fivebar", 1, 4)
+    assert five["actuated"] == {"motor_1": "rad", "motor_2": "rad"} and five["task"] == {"x": "m", "y": "m"}
+    mech = pkm.load(mjcf)
+    assert four["format"] == "MJCF file" and four["name"] == mech.name
+    assert list(four["actuated"]) == list(mech.actuated_names) and four["loops"] == len(mech.spec.closures)
+    assert list(out["not_loaded"]) == [str(lone)] and "pkm spec init" in out["not_loaded"][str(lone)]
+    assert cli.main(["list", str(mjcf)]) == 0
+    text = capsys.readouterr().out
+    assert f"{mjcf}: " in text and "read from: MJCF file" in text and "not loaded" not in text.lower()
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "empty" / "notes.toml").write_text("x = 1\n")
+    assert cli.main(["list", str(tmp_path / "empty")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "pkm loads nothing here: no closure spec, Gepetto YAML or model file" in err[0]
+    assert "MJCF (.xml .mjcf)" in err[0] and "notes.toml" in err[0]

@@ -47,3 +47,26 @@ def test_map_index_adds_the_capability(tmp_path):
     iso = [float(r["isotropic [N]"]) for r in rows if r["reachable"] == "1.0"]
     assert len(rows) == 66 and [min(iso), max(iso)] == cap["isotropic"]["N"]
     assert (tmp_path / "w.png").stat().st_size > 10_000
+
+
+def test_the_map_starts_from_the_seed_given(monkeypatch):
+    """``pkm map --q0 NAME=V``: the map's seed configuration (its working mode), as :func:`workspace_map` takes it."""
+    import numpy as np
+    import pytest
+
+    import pkm
+    from pkm.core.analysis import maps
+
+    class Seen(Exception):
+        pass
+
+    def seen(mech, axes, fixed, **kw):
+        raise Seen(kw["seed"])
+
+    monkeypatch.setattr(maps, "workspace_map", seen)
+    with pytest.raises(Seen) as got:
+        cli.main(["map", "rrr3", "--axis", "x=30cm:70cm:3", "--q0", "elbow_2=-40deg"])
+    mech = pkm.load("rrr3")
+    want = mech.q_reference.copy()
+    want[mech.joints["elbow_2"].idx_q] = np.radians(-40.0)
+    assert np.array_equal(got.value.args[0], want)

@@ -220,3 +220,26 @@ def test_without_a_drive_the_mechanism_is_released(tmp_path, capsys):
     assert out["samples"] == len(sim.time) and out["event"]["kind"] == sim.event.kind == "singularity"
     assert math.isclose(out["final_time"], sim.time[-1], rel_tol=1e-12)
     assert out["work"] == 0.0
+
+
+def test_the_initial_configuration_takes_passive_joints_as_the_closure_s_seed(tmp_path, capsys, built):
+    """``--q0`` names actuated joints (the initial state) and passive ones (the loop closure's seed): the toy
+    five-bar at the actuator values of its other assembly mode starts there when its elbows are given, and in the
+    reference's mode (pkm.close_loops from the reference, the command's default) when they are not."""
+    import warnings
+
+    mech = built("fivebar")
+    spec = pkm.save(mech, tmp_path / "five.closures.toml")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pkm.errors.ModeChangeWarning)
+        far = pkm.solve_ik(mech, mech.task_map.value(mech.q_reference) + [0.0, -0.3])  # (the other assembly mode)
+    near = pkm.close_loops(mech, mech.actuated_q(far.q))
+    start = {}
+    for label, names in (("far", list(mech.joints)), ("near", list(mech.actuated_names))):
+        q0 = [f"{n}={float(far.q[mech.joints[n].idx_q])!r}" for n in names]
+        _summary(capsys, str(spec), "--q0", *q0, "--duration", "1ms", "--out", str(tmp_path / f"{label}.csv"))
+        table = _read_csv(tmp_path / f"{label}.csv")
+        start[label] = np.array([table[f"task.{k}"][0] for k in mech.task_map.keys])
+    assert np.allclose(start["far"], mech.task_map.value(far.q), rtol=0, atol=1e-9)
+    assert np.allclose(start["near"], mech.task_map.value(near.q), rtol=0, atol=1e-9)
+    assert np.abs(start["far"] - start["near"]).max() > 0.1

@@ -5,7 +5,6 @@ fail, a shipped mechanism's closed forms say why."""
 from __future__ import annotations
 
 import argparse
-import functools
 
 import numpy as np
 
@@ -15,7 +14,6 @@ from pkm.cli.usage import UsageError, late_help
 from pkm.errors import ConvergenceError, PkmError
 
 
-@functools.cache
 def mech_help() -> str:
     """What ``MECH`` takes: every input :func:`pkm.load` reads, from the tables that say so (the registry, the robots
     pkm ships, the installed packages' models, the model-file formats), so that it cannot drift from them."""
