@@ -2,7 +2,7 @@
 
 Usage::
 
-    pkm list [MECH ...] [--json]
+    pkm list [MECH | FOLDER ...] [--json]
     pkm preview MECH [--param K=V ...] [--pose K=V ... | --joints NAME=V ...] [--html FILE] [--no-wait]
     pkm ik MECH --pose K=V ... [--param K=V ...] [--branch NAME]
     pkm fk MECH --joints NAME=V ... [--param K=V ...]
@@ -14,6 +14,10 @@ Usage::
     pkm sweep MECH NAME=START:STOP:COUNT ... --objective SPEC ... [--out FILE.parquet] [--scheduler ADDR]
     pkm sweep plot FILE.parquet [--out DIR] [--pareto A,B]
     pkm sweep best FILE.parquet --by OBJECTIVE [--n N] [--out DIR]
+
+MECH is anything :func:`pkm.load` takes (``pkm ik --help`` says what, from the formats' tables); a folder given to
+``pkm list`` is searched for it. Where a solver asks for a seed nearer the target (``q0``), the commands that solve
+take it as ``--q0 NAME=V ...`` (any joints by name).
 
 Values are SI (m, rad, kg) unless they carry a unit: ``R=120mm``, ``beta=-11deg``, ``z=81cm``
 (lengths m, cm, mm; angles rad, deg; masses kg, g). A parameter's units are those of its field's

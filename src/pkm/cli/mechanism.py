@@ -26,12 +26,12 @@ def mech_help() -> str:
         return ", ".join(f"{s}:<{what}> (e.g. {next(n for n in names if n.startswith(s + ':'))})" for s in sources)
 
     formats = ", ".join(f"{f.name.upper()} ({' '.join(f.suffixes)})" for f in FORMATS.values())
-    return (f"a shipped mechanism ({', '.join(pkm.MECHANISMS)}); a robot pkm ships, {by_source(list(CATALOGUE), 'robot')}; an "
-            f"installed package's model, {by_source(list(PACKAGE_MODELS), 'model')} ('pkm list' names them all); "
-            "or a path: a closure spec (NAME.closures.toml, naming its model file), a URDF + YAML in Gepetto's "
-            "convention (their folder, or either file), or a model file read by its content, " + formats
-            + ": alone when it names its loops and actuated joints, else through a closure spec ('pkm spec init FILE' "
-            "writes one)")
+    return (f"a shipped mechanism ({', '.join(pkm.MECHANISMS)}); a robot pkm ships, "
+            f"{by_source(list(CATALOGUE), 'robot')}; an installed package's model, "
+            f"{by_source(list(PACKAGE_MODELS), 'model')} ('pkm list' names them all); or a path: a closure spec "
+            "(NAME.closures.toml, naming its model file), a URDF + YAML in Gepetto's convention (their folder, or "
+            f"either file), or a model file read by its content, {formats}: alone when it names its loops and "
+            "actuated joints, else through a closure spec ('pkm spec init FILE' writes one)")
 
 
 def add_mechanism_help(action: argparse.Action, before: str = "", after: str = "") -> argparse.Action:

@@ -60,15 +60,15 @@ def _reader(path: Path) -> tuple[str, Callable[[], pkm.Mechanism]] | None:
 def source(arg: str, mech: pkm.Mechanism) -> dict[str, Any]:
     """What ``mech`` (loaded from ``arg``, a name or a path) is read from: its format and its files."""
     from pkm.core.formats.catalogue import CATALOGUE, catalogue_path
-    from pkm.core.formats.packages import PACKAGE_MODELS
+    from pkm.core.formats.packages import PACKAGE_MODELS, model_file
 
     if arg in pkm.MECHANISMS:
         return {"format": "shipped mechanism (pkm closure spec + URDF)" if pkm.MECHANISMS[arg].reference else
                 "shipped mechanism (built from its parameters)", "files": []}
     if arg in PACKAGE_MODELS:
-        where = mech.source.partition(" (")[2].rstrip(")")
-        return {"format": f"model of the installed package {PACKAGE_MODELS[arg].package} ({_model_format(Path(where))}"
-                          " + the closure spec pkm ships)", "files": [where]}
+        spec, model = model_file(arg)
+        return {"format": f"model of the installed package {PACKAGE_MODELS[arg].package} ({_model_format(model)} + "
+                          "the closure spec pkm ships)", "files": [str(spec), str(model)]}
     path = catalogue_path(arg) if arg in CATALOGUE else Path(arg)
     try:
         reader = _reader(path)
@@ -119,7 +119,11 @@ def _candidates(folder: Path, depth: int) -> list[Path]:
 
     wanted = {".toml", ".yaml", ".yml", *suffixes()}
     out: list[Path] = []
-    for child in sorted(folder.iterdir()):
+    try:
+        children = sorted(folder.iterdir())
+    except OSError:  # (a folder one may not read: nothing found there)
+        return out
+    for child in children:
         if child.name.startswith((".", "__")):
             continue
         if child.is_dir():

@@ -1,5 +1,5 @@
-"""``pkm map MECH --axis NAME=START:STOP:COUNT ... [--index wrench|twist|acceleration [--no-gravity]] [--png FILE]
-[--csv FILE]``: a workspace and condition-index map over one to three task coordinates (JSON summary, PNG, CSV);
+"""``pkm map MECH --axis NAME=START:STOP:COUNT ... [--q0 NAME=V ...] [--index wrench|twist|acceleration
+[--no-gravity]] [--png FILE] [--csv FILE]``: a workspace and condition-index map over one to three task coordinates (JSON summary, PNG, CSV);
 with ``--index``, the capability under actuator limits at every reachable node as well
 (:func:`pkm.core.analysis.capability.map_capability`: the largest value along each task axis each way and the
 largest isotropic value per unit; the PNG and CSV are then the capability's)."""
