@@ -151,6 +151,17 @@ def load(name) -> Mechanism:
         UnknownNameError: ``name`` is neither registered (:data:`MECHANISMS`) nor an existing file.
         SpecError: the files are missing, damaged or do not fit together; no reader takes the path (the
             message says why each declined: :func:`pkm.core.formats.load.load_path`).
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> delta
+        Mechanism('delta': nq=12, nv=12, actuated=['motor_1', 'motor_2', 'motor_3'], closures=3 (9 equations), task=['x', 'y', 'z'])
+        >>> delta.actuated_names
+        ('motor_1', 'motor_2', 'motor_3')
+        >>> gepetto = pkm.load("gepetto:robot_delta")
+        >>> gepetto.na, gepetto.nq
+        (2, 14)
     """
     import os
     from pathlib import Path
@@ -203,6 +214,19 @@ def save(mech: Mechanism, spec_path) -> Path:
     Raises:
         InvalidInputError: not a Mechanism, a bad path, or a mechanism built from a Pinocchio model
             without URDF text (nothing to write).
+
+    Examples:
+        >>> import tempfile
+        >>> from pathlib import Path
+        >>> import numpy as np
+        >>> import pkm
+        >>> small = pkm.build("delta", R="100mm")
+        >>> path = pkm.save(small, Path(tempfile.mkdtemp()) / "my_delta.closures.toml")
+        >>> sorted(p.name for p in path.parent.iterdir())
+        ['my_delta.closures.toml', 'my_delta.urdf']
+        >>> back = pkm.load(path)
+        >>> np.allclose(back.q_reference, small.q_reference)
+        True
     """
     import dataclasses as dc
 
@@ -233,6 +257,12 @@ def design_params(name: str, **params):
     Raises:
         UnknownNameError: an unknown mechanism or parameter name (the valid ones listed).
         InvalidParameterError: a parameter out of range or with a unit of another kind.
+
+    Examples:
+        >>> import pkm
+        >>> p = pkm.design_params("delta", R="120mm")
+        >>> type(p).__name__, p.R
+        ('DeltaParams', 0.12)
     """
     from pkm._moved import renamed_keywords
     from pkm.units import KIND_OF_UNIT, parse_quantity
@@ -272,6 +302,14 @@ def build(name: str, **params) -> Mechanism:
         UnknownNameError: an unknown mechanism or parameter name (the valid ones listed).
         InvalidParameterError: a parameter out of range, or a design that cannot assemble at its
             reference pose (see the mechanism's ``Params``).
+
+    Examples:
+        >>> import pkm
+        >>> small = pkm.build("delta", R="100mm")
+        >>> small.params.R
+        0.1
+        >>> round(pkm.task_values(small, small.q_reference)["z"], 4)
+        -0.2888
     """
     return mechanism_module(name).build(design_params(name, **params))
 

@@ -296,6 +296,17 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
             lost to the cluster (the finished chunks kept: a rerun resumes).
         MissingDependencyError: the ``sweeps`` extra (Dask, pyarrow, cloudpickle) is not installed: ``pip install
             "pkm[sweeps]"``.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> from pkm import sweeps
+        >>> space = sweeps.grid(a="30cm:60cm:3", b="40cm", h="10cm")
+        >>> res = pkm.sweep("rrr3", space, ["gci:step=4cm"], scheduler="serial", progress=False)
+        >>> res
+        SweepResult(3 designs of {'registered': 'rrr3', 'fixed': {}}, 0 failed; objectives ['gci:step=4cm'])
+        >>> np.round(res.column("gci:step=4cm"), 4)
+        array([0.4576, 0.3477, 0.2184])
     """
     require("sweeps", "pkm.sweep (design sweeps on Dask, results in Parquet)")
     if scheduler is not None and not isinstance(scheduler, str):

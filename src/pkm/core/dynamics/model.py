@@ -236,6 +236,24 @@ def actuator_model(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None, *
 
     Raises:
         SingularityError: ``kind="direct"`` at a direct singularity.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> model = pkm.actuator_model(delta, delta.q_reference, [1.0, 0.0, 0.0])
+        >>> np.round(model.M, 5)
+        array([[ 0.00298, -0.00058, -0.00058],
+               [-0.00058,  0.00298, -0.00058],
+               [-0.00058, -0.00058,  0.00298]])
+        >>> np.round(model.h, 4)
+        array([0.1784, 0.1805, 0.1805])
+        >>> np.round(model.efforts([10.0, 0.0, 0.0]), 4)
+        array([0.2082, 0.1747, 0.1747])
+        >>> np.allclose(model.efforts([10.0, 0.0, 0.0]), model.M @ [10.0, 0.0, 0.0] + model.h)
+        True
+        >>> round(model.kinetic_energy, 6)
+        0.001489
     """
     mech, q, qd = _check_state(mech, q, qd)
     rtol = as_tolerance(rtol, "rtol")
@@ -244,17 +262,49 @@ def actuator_model(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None, *
 
 
 def mass_matrix(mech: Mechanism, q: ArrayLike) -> np.ndarray:
-    """``M_a(q)`` (na x na) [kg m^2, kg]: the mass matrix in the actuated coordinates (reflected inertias in)."""
+    """``M_a(q)`` (na x na) [kg m^2, kg]: the mass matrix in the actuated coordinates (reflected inertias in).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> M = pkm.mass_matrix(delta, delta.q_reference)
+        >>> np.round(M, 5)
+        array([[ 0.00298, -0.00058, -0.00058],
+               [-0.00058,  0.00298, -0.00058],
+               [-0.00058, -0.00058,  0.00298]])
+        >>> bool(np.all(np.linalg.eigvalsh(M) > 0))
+        True
+    """
     return actuator_model(mech, q).M.copy()
 
 
 def bias_efforts(mech: Mechanism, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
-    """``h_a(q, qd)`` (na,): Coriolis, centrifugal, gravity and closure-drift efforts (the efforts at ``qdd = 0``)."""
+    """``h_a(q, qd)`` (na,): Coriolis, centrifugal, gravity and closure-drift efforts (the efforts at ``qdd = 0``).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q = delta.q_reference
+        >>> np.round(pkm.bias_efforts(delta, q, [1.0, 0.0, 0.0]), 4)
+        array([0.1784, 0.1805, 0.1805])
+        >>> np.allclose(pkm.bias_efforts(delta, q, np.zeros(3)), pkm.gravity_efforts(delta, q))
+        True
+    """
     return actuator_model(mech, q, qd).h.copy()
 
 
 def gravity_efforts(mech: Mechanism, q: ArrayLike) -> np.ndarray:
-    """``g_a(q)`` (na,): the actuator efforts that hold the mechanism still against gravity."""
+    """``g_a(q)`` (na,): the actuator efforts that hold the mechanism still against gravity.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> np.round(pkm.gravity_efforts(delta, delta.q_reference), 4)
+        array([0.1797, 0.1797, 0.1797])
+    """
     return actuator_model(mech, q).g.copy()
 
 
@@ -286,7 +336,19 @@ def coriolis_matrix(mech: Mechanism, q: ArrayLike, qd: ArrayLike, *, rtol: float
     ``C_a qd = h_a - g_a`` (the derivatives by :func:`mass_matrix_derivatives`).
 
     Pinocchio's own ``computeCoriolisMatrix`` is not used: on Pinocchio 4.1 it is wrong for universal joints (NaN)
-    and mimic joints (tested)."""
+    and mimic joints (tested).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q, qd = delta.q_reference, np.array([1.0, -0.5, 0.2])
+        >>> C = pkm.coriolis_matrix(delta, q, qd)
+        >>> np.round(C @ qd, 4)
+        array([-0.0009,  0.001 ,  0.0008])
+        >>> np.allclose(C @ qd, pkm.bias_efforts(delta, q, qd) - pkm.gravity_efforts(delta, q))
+        True
+    """
     mech, q, qd = _check_state(mech, q, qd)
     dM = mass_matrix_derivatives(mech, q, rtol=rtol)  # dM[k, i, j] = d M_ij / d q_k
     gamma = 0.5 * (dM + np.transpose(dM, (2, 1, 0)) - np.transpose(dM, (2, 0, 1)))  # gamma[k, i, j]
@@ -317,6 +379,16 @@ def operational_space(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None
     Raises:
         InvalidInputError: the task does not have ``na`` coordinates.
         SingularityError: ``kind="inverse"`` where ``J`` loses rank.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> osp = pkm.operational_space(delta, delta.q_reference)
+        >>> np.round(np.diag(osp.inertia), 4)
+        array([0.3011, 0.3011, 0.4505])
+        >>> round(float(osp.bias[2]), 4)
+        4.908
     """
     mech, q, qd = _check_state(mech, q, qd)
     if mech.n_task != mech.na:

@@ -142,7 +142,17 @@ def _structures(mech: Mechanism) -> tuple[_Blocks | None, _Blocks | None]:
 
 def mode_label(mech: Mechanism, q: np.ndarray) -> ModeLabel:
     """The assembly and working mode labels of the configuration ``q`` (module doc); one kinematics pass (the
-    blocks are found once per mechanism)."""
+    blocks are found once per mechanism).
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> pkm.mode_label(delta, delta.q_reference)
+        ModeLabel(assembly=(1,), working=(1, 1, 1, 1))
+        >>> q = pkm.branch_seed(delta, "knee_in")
+        >>> pkm.mode_label(delta, q).working
+        (1, -1, -1, -1)
+    """
     fk, ik = _structures(mech)
     if fk is None and ik is None:
         return ModeLabel()
