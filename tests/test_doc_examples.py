@@ -1,5 +1,6 @@
 """Every public function's docs page teaches by an example that runs: each function of ``pkm.__all__`` (and the
-classes users construct or receive most: :class:`pkm.Mechanism`, :class:`pkm.Kernels`, :class:`pkm.Simulation`)
+classes users construct or receive most: :class:`pkm.Mechanism`, :class:`pkm.Kernels`, :class:`pkm.Simulation`;
+the package's own quick start)
 has a Google ``Examples:`` section in its docstring whose ``>>>`` lines pass under :mod:`doctest` (ELLIPSIS,
 NORMALIZE_WHITESPACE; fresh globals: each example imports what it uses, as a reader copying it would), and each
 function is fully annotated (what its page's signature shows). One item per name, so that pytest-xdist spreads
@@ -18,6 +19,7 @@ import pkm
 
 FUNCTIONS = sorted(n for n in pkm.__all__ if inspect.isfunction(getattr(pkm, n)))
 CLASSES = ["Kernels", "Mechanism", "Simulation"]
+PACKAGE = ["pkm"]  # the package page's quick start
 FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
 
 
@@ -27,7 +29,7 @@ def test_the_public_functions_are_all_found() -> None:
 
 
 def _examples(name: str) -> list[doctest.Example]:
-    doc = inspect.getdoc(getattr(pkm, name)) or ""
+    doc = inspect.getdoc(pkm if name == "pkm" else getattr(pkm, name)) or ""
     assert re.search(r"^Examples:\n", doc, re.MULTILINE), f"pkm.{name}'s docstring has no 'Examples:' section"
     section = doc.split("\nExamples:\n", 1)[1]
     examples = doctest.DocTestParser().get_examples(section)
@@ -35,7 +37,7 @@ def _examples(name: str) -> list[doctest.Example]:
     return examples
 
 
-@pytest.mark.parametrize("name", FUNCTIONS + CLASSES)
+@pytest.mark.parametrize("name", FUNCTIONS + CLASSES + PACKAGE)
 def test_the_example_runs(name: str) -> None:
     """The section's examples give the output they show; a failing example fails naming the function."""
     test = doctest.DocTest(_examples(name), {}, f"pkm.{name}", None, None, None)

@@ -48,7 +48,7 @@ import time
 import traceback
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -70,6 +70,9 @@ from pkm.sweeps.store import (
     resume,
     write_atomic,
 )
+
+if TYPE_CHECKING:
+    from pkm.core.model.mechanism import Mechanism
 
 MAX_CHUNK = 500
 #: glibc's allocator settings of the local workers (see :func:`local_cluster`) [bytes].
@@ -269,20 +272,23 @@ def _client(scheduler, client, workers: int | None, stack: contextlib.ExitStack)
     return c, max(1, len(c.scheduler_info().get("workers", {})))
 
 
-def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, Any] | None = None,
-          scheduler: str | None = None, client=None, workers: int | None = None, chunk_size: int | None = None,
-          progress: bool | None = None, overwrite: bool = False) -> SweepResult:
+def sweep(mechanism: str | os.PathLike[str] | Mechanism | Family, space: Space,
+          objectives: str | Objective | Callable[..., Any] | Sequence[str | Objective | Callable[..., Any]], *,
+          out: str | os.PathLike[str] | None = None, fixed: Mapping[str, Any] | None = None,
+          scheduler: str | None = None, client: Any = None, workers: int | None = None,
+          chunk_size: int | None = None, progress: bool | None = None, overwrite: bool = False) -> SweepResult:
     """Evaluate ``objectives`` on every design of ``space`` (see the module doc).
 
     Args:
-        mechanism: A registered name (``"rrr3"``), a :class:`pkm.Mechanism`, or a closure spec's path.
+        mechanism: A registered name (``"rrr3"``), a :class:`pkm.Mechanism`, or a closure spec's path (or a
+            :class:`~pkm.sweeps.family.Family`).
         space: :func:`~pkm.sweeps.grid`, :func:`~pkm.sweeps.sobol`, :func:`~pkm.sweeps.latin_hypercube` or
             :func:`~pkm.sweeps.table`.
         objectives: Specs (``"gci:step=1cm"``), callables or :class:`~pkm.sweeps.objectives.Objective`\\ s.
         out: A ``.parquet`` path to write (and resume from), or None: results in memory only.
         fixed: A registered mechanism's parameters not swept (SI or with units; the paper's by default).
         scheduler: None: a local cluster; ``"serial"``: this process; else a Dask scheduler's address.
-        client: A ``dask.distributed.Client`` to use instead.
+        client: A ``dask.distributed.Client`` to use instead (typed ``Any``: Dask is an optional extra).
         workers: Worker processes of the local cluster (default: one per core); with a scheduler, how many to
             wait for.
         chunk_size: Designs per chunk (default: about 32 chunks per worker, at most :data:`MAX_CHUNK`).
