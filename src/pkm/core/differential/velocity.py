@@ -239,9 +239,9 @@ def idle_motions(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float =
 
 
 def passive_map(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
-    """``G = dq/dq_a`` (nv x na): all joint rates from the actuated rates, the idle motions' rates those of least
-    kinetic energy (``Nᵀ M G = 0``, :mod:`pkm.core.differential.idle`; the mass matrix is computed only where there
-    are idle motions).
+    r"""The passive map :math:`G = \partial q / \partial q_a` (nv x na): all joint rates from the actuated rates, the
+    idle motions' rates those of least kinetic energy (:math:`N^\top M G = 0`, :mod:`pkm.core.differential.idle`;
+    the mass matrix is computed only where there are idle motions).
 
     Raises:
         SingularityError: ``kind="direct"``: with the actuators locked, a passive motion that moves
@@ -267,7 +267,8 @@ def passive_map(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 
 
 
 def forward_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
-    """Task rates from actuated rates, ``yd = J qd_a`` (n_task x na); raises as :func:`passive_map`.
+    r"""The forward Jacobian :math:`J = J_t G`: task rates from actuated rates, :math:`\dot y = J \dot q_a`
+    (n_task x na); raises as :func:`passive_map`.
 
     Examples:
         >>> import numpy as np
@@ -284,7 +285,8 @@ def forward_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: flo
 
 
 def twist_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
-    """End-effector twist ``[v; w]`` (origin velocity, world axes) from actuated rates (6 x na).
+    r"""The twist Jacobian: the end-effector twist :math:`[v; \omega]` (origin velocity, world axes) from actuated
+    rates (6 x na).
 
     Examples:
         >>> import numpy as np
@@ -310,7 +312,8 @@ def _forward(mech: Mechanism, q: ArrayLike | Configuration, rtol: float, which: 
 
 
 def inverse_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
-    """Actuated rates from task rates, ``qd_a = J yd`` (na x n_task).
+    r"""The inverse Jacobian :math:`J_{\mathrm{inv}}`: actuated rates from task rates,
+    :math:`\dot q_a = J_{\mathrm{inv}} \dot y` (na x n_task), from :math:`[J_c; J_t]\, v = [0; \dot y]` read on the actuated rows.
 
     Raises:
         SingularityError: ``kind="inverse"``: with the task frozen, a motion of the actuators is
@@ -338,8 +341,8 @@ def inverse_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: flo
 
 
 def velocities(mech: Mechanism, q: ArrayLike | Configuration, qd_actuated: ArrayLike) -> np.ndarray:
-    """All joint rates ``v = G qd`` (nv,) from the actuated rates (:func:`passive_map`: no idle motion in the mass
-    metric).
+    r"""All joint rates :math:`v = G \dot q_a` (nv,) from the actuated rates (:func:`passive_map`: no idle motion in
+    the mass metric).
 
     Examples:
         >>> import numpy as np
@@ -359,8 +362,8 @@ def velocities(mech: Mechanism, q: ArrayLike | Configuration, qd_actuated: Array
 
 
 def accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, qdd_actuated: ArrayLike) -> np.ndarray:
-    """All joint accelerations ``a`` (nv,) from the actuated ones, the drift included, with no idle acceleration in
-    the mass metric (``Nᵀ M a = 0``, :mod:`pkm.core.differential.idle`).
+    r"""All joint accelerations ``a`` (nv,) from the actuated ones, the drift included (:math:`J_c a + \dot J_c v = 0`),
+    with no idle acceleration in the mass metric (:math:`N^\top M a = 0`, :mod:`pkm.core.differential.idle`).
 
     Raises:
         SingularityError: as :func:`passive_map`.
@@ -409,7 +412,7 @@ def task_velocity(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike) -
 
 
 def task_acceleration(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, a: ArrayLike) -> np.ndarray:
-    """Task accelerations ``J_t a + dJ_t/dt v``.
+    r"""Task accelerations :math:`\ddot y = J_t a + \dot J_t v`.
 
     Examples:
         >>> import numpy as np
