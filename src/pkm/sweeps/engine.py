@@ -346,19 +346,18 @@ def sweep(mechanism: str | os.PathLike[str] | Mechanism | Family, space: Space,
     if out_path is not None and space.seed is None and space.kind in ("sobol", "latin_hypercube") and not overwrite:
         space = dataclasses.replace(space, seed=recorded_seed(out_path))  # resuming: the samples drawn before
     designs = space.designs(family.units)
-    if isinstance(objectives, (str, Objective)) or callable(objectives):
-        objectives = [objectives]
-    objectives = [objective(o) for o in objectives]
-    if not objectives:
+    given = [objectives] if isinstance(objectives, (str, Objective)) or callable(objectives) else objectives
+    chosen: list[Objective] = [objective(o) for o in given]
+    if not chosen:
         raise InvalidInputError("objectives", "name at least one objective (see pkm.sweeps.OBJECTIVES)")
-    columns = [o.column for o in objectives]
+    columns = [o.column for o in chosen]
     clash = sorted({c for c in columns if columns.count(c) > 1} | (set(columns) & set(designs.names)))
     if clash:
         raise InvalidInputError("objectives", f"columns named twice: {clash} (name them: 'label=spec')", clash)
-    context = _Context(family, designs.names, objectives)
-    for o in objectives:
+    context = _Context(family, designs.names, chosen)
+    for o in chosen:
         o.bind(family)  # a route that does not exist fails here, not in every design
-    manifest = manifest_of(family, designs, objectives)
+    manifest = manifest_of(family, designs, chosen)
     done_tables: list = []
     if out_path is not None:
         if out_path.suffix != ".parquet" or (out_path.exists() and not out_path.is_file()):
@@ -394,8 +393,8 @@ def sweep(mechanism: str | os.PathLike[str] | Mechanism | Family, space: Space,
         new_tables, work = [], 0.0
         bar = _bar(progress, len(designs), int(done.sum()))
         try:
-            for ids, cols, seconds in _results(cl, shared, chunks, designs, objectives):
-                table = chunk_table(designs, objectives, cols)
+            for ids, cols, seconds in _results(cl, shared, chunks, designs, chosen):
+                table = chunk_table(designs, chosen, cols)
                 if out_path is not None:
                     write_atomic(table, parts_folder(out_path) / f"part-{ids[0]:09d}-{ids[-1]:09d}.parquet")
                 new_tables.append(table)
@@ -406,7 +405,7 @@ def sweep(mechanism: str | os.PathLike[str] | Mechanism | Family, space: Space,
             if bar is not None:
                 bar.close()
         wall = time.perf_counter() - t0
-    table = combine(done_tables + new_tables, designs, objectives)
+    table = combine(done_tables + new_tables, designs, chosen)
     if out_path is not None:
         write_atomic(table, out_path, {"pkm.sweep": json.dumps(manifest)})
         shutil.rmtree(parts_folder(out_path), ignore_errors=True)
