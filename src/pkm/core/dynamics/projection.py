@@ -352,7 +352,8 @@ def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, 
         >>> a = pkm.inverse_accelerations(delta, q, v, [0.0, 0.0, 1.0])
         >>> np.round(pkm.inverse_dynamics(delta, q, v, a), 4)
         array([0.1839, 0.157 , 0.2098])
-        >>> np.round(pkm.inverse_dynamics(delta, q, v, a, wrench=[0.0, 0.0, -10.0, 0.0, 0.0, 0.0]), 4)
+        >>> push = [0.0, 0.0, -10.0, 0.0, 0.0, 0.0]  # 10 N downwards on the end effector
+        >>> np.round(pkm.inverse_dynamics(delta, q, v, a, wrench=push), 4)
         array([0.6013, 0.5016, 0.6976])
     """
     mech = check_mechanism(mech)

@@ -94,7 +94,7 @@ def consistent_estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: Array
         >>> TAU = np.array([pkm.actuator_model(delta, q, qd).efforts(qdd)
         ...                 for q, qd, qdd in zip(Q, QD, QDD)])
         >>> base = pkm.base_parameters(delta, 50, precise=False)
-        >>> TAU += 1e-3 * rng.standard_normal(TAU.shape)
+        >>> TAU += 1e-3 * rng.standard_normal(TAU.shape)  # measurement noise [N m]
         >>> sdp = pkm.consistent_estimate(delta, Q, QD, QDD, TAU, base=base)
         >>> sdp.status, bool(sdp.smallest_eigenvalue >= -1e-9)
         ('optimal', True)

@@ -193,7 +193,7 @@ def with_actuators(mech: Mechanism, actuators: Mapping[str, Any]) -> Mechanism:
         >>> geared.actuators[0].gear_ratio, geared.actuators[0].rotor_inertia
         (10.0, 1e-05)
         >>> M0, M1 = pkm.mass_matrix(delta, delta.q_reference), pkm.mass_matrix(geared, geared.q_reference)
-        >>> round(float(M1[0, 0] - M0[0, 0]), 9)
+        >>> round(float(M1[0, 0] - M0[0, 0]), 9)  # the reflected inertia 1e-5 kg m^2 x 10^2
         0.001
     """
     if not isinstance(mech, Mechanism):
@@ -229,7 +229,7 @@ def scaled_mechanism(mech: Mechanism, factor: float) -> Mechanism:
         >>> import numpy as np
         >>> import pkm
         >>> delta = pkm.load("delta")
-        >>> big = pkm.scaled_mechanism(delta, 2.0)
+        >>> big = pkm.scaled_mechanism(delta, 2.0)  # every length doubled
         >>> z0, z1 = pkm.task_values(delta, delta.q_reference)["z"], pkm.task_values(big, big.q_reference)["z"]
         >>> round(z1 / z0, 9)
         2.0
