@@ -1,13 +1,21 @@
 """pkm: parallel kinematic machines on Pinocchio.
 
-Quick start::
+Examples:
+    A quick start: a shipped mechanism (the paper's reference design, from ``urdf/``) or one built from your
+    own parameters (SI units, or strings with units), its forward and inverse kinematics and Jacobian.
 
-    import pkm
-    delta = pkm.load("delta")                       # the paper's reference design (urdf/)
-    delta = pkm.build("delta", R=0.12)              # or your own parameters (SI units)
-    res = pkm.close_loops(delta, [-0.9, -0.8, -1.0])  # forward kinematics, generic core
-    ik = pkm.solve_ik(delta, [0.02, 0.0, -0.36])      # inverse kinematics
-    J = pkm.forward_jacobian(delta, ik.q)
+    >>> import numpy as np
+    >>> import pkm
+    >>> delta = pkm.load("delta")
+    >>> mine = pkm.build("delta", R="120mm")
+    >>> fk = pkm.close_loops(delta, [-0.9, -0.8, -1.0])
+    >>> {k: round(v, 4) for k, v in pkm.task_values(delta, fk.q).items()}
+    {'x': -0.0232, 'y': 0.0002, 'z': -0.3691}
+    >>> ik = pkm.solve_ik(delta, [0.02, 0.0, -0.36])
+    >>> np.round(delta.actuated_q(ik.q), 4)
+    array([-0.8243, -0.9097, -0.7367])
+    >>> np.round(pkm.forward_jacobian(delta, ik.q) @ [0.1, 0.2, 0.3], 4)
+    array([ 0.0108, -0.0198,  0.0257])
 """
 
 from __future__ import annotations
@@ -39,7 +47,9 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
 _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
 if TYPE_CHECKING:  # the static view of the lazy names
+    import os
     from pathlib import Path
+    from typing import Any
 
     from pkm.core import (
         Actuator,
@@ -135,7 +145,7 @@ __getattr__, __dir__ = lazy("pkm", globals(), _WHERE)
 __version__ = "0.2.0"
 
 
-def load(name) -> Mechanism:
+def load(name: str | os.PathLike[str]) -> Mechanism:
     """A mechanism: a registered name's reference design (from its shipped ``urdf/`` files, or built from
     its default parameters when it ships none), or one's own files: a closure spec
     (``path/to/my.closures.toml``, naming its URDF; see :mod:`pkm.core.model.spec`), or a URDF + YAML
@@ -151,6 +161,17 @@ def load(name) -> Mechanism:
         UnknownNameError: ``name`` is neither registered (:data:`MECHANISMS`) nor an existing file.
         SpecError: the files are missing, damaged or do not fit together; no reader takes the path (the
             message says why each declined: :func:`pkm.core.formats.load.load_path`).
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> delta
+        Mechanism('delta': nq=12, nv=12, actuated=['motor_1', 'motor_2', 'motor_3'], closures=3 (9 equations), task=['x', 'y', 'z'])
+        >>> delta.actuated_names
+        ('motor_1', 'motor_2', 'motor_3')
+        >>> gepetto = pkm.load("gepetto:robot_delta")
+        >>> gepetto.na, gepetto.nq
+        (2, 14)
     """
     import os
     from pathlib import Path
@@ -193,7 +214,7 @@ def load(name) -> Mechanism:
     return mech
 
 
-def save(mech: Mechanism, spec_path) -> Path:
+def save(mech: Mechanism, spec_path: str | os.PathLike[str]) -> Path:
     """Write ``mech`` as a closure spec at ``spec_path`` and its URDF beside it (``<stem>.urdf``, the
     spec's ``urdf`` key set to it), so that :func:`load` gives the same model back; any joint names.
 
@@ -203,6 +224,19 @@ def save(mech: Mechanism, spec_path) -> Path:
     Raises:
         InvalidInputError: not a Mechanism, a bad path, or a mechanism built from a Pinocchio model
             without URDF text (nothing to write).
+
+    Examples:
+        >>> import tempfile
+        >>> from pathlib import Path
+        >>> import numpy as np
+        >>> import pkm
+        >>> small = pkm.build("delta", R="100mm")
+        >>> path = pkm.save(small, Path(tempfile.mkdtemp()) / "my_delta.closures.toml")
+        >>> sorted(p.name for p in path.parent.iterdir())
+        ['my_delta.closures.toml', 'my_delta.urdf']
+        >>> back = pkm.load(path)
+        >>> np.allclose(back.q_reference, small.q_reference)
+        True
     """
     import dataclasses as dc
 
@@ -226,13 +260,23 @@ def save(mech: Mechanism, spec_path) -> Path:
     return path
 
 
-def design_params(name: str, **params):
+def design_params(name: str, **params: Any) -> Any:
     """The design dataclass (``Params``) of mechanism ``name`` from parameters (SI units, or strings with units:
     ``R="120mm"``; unspecified ones keep the paper's values), validated as :func:`build` does, without building.
+
+    Returns:
+        An instance of the mechanism's own ``Params`` dataclass (``DeltaParams``, ``Rrr3Params``, ...: one class per
+        mechanism, hence typed ``Any``).
 
     Raises:
         UnknownNameError: an unknown mechanism or parameter name (the valid ones listed).
         InvalidParameterError: a parameter out of range or with a unit of another kind.
+
+    Examples:
+        >>> import pkm
+        >>> p = pkm.design_params("delta", R="120mm")
+        >>> type(p).__name__, p.R
+        ('DeltaParams', 0.12)
     """
     from pkm._moved import renamed_keywords
     from pkm.units import KIND_OF_UNIT, parse_quantity
@@ -264,7 +308,7 @@ def design_params(name: str, **params):
     return mod.Params(**params)
 
 
-def build(name: str, **params) -> Mechanism:
+def build(name: str, **params: Any) -> Mechanism:
     """Mechanism ``name`` generated from parameters (SI units, or strings with units: ``R="120mm"``;
     unspecified ones keep the paper's values).
 
@@ -272,6 +316,14 @@ def build(name: str, **params) -> Mechanism:
         UnknownNameError: an unknown mechanism or parameter name (the valid ones listed).
         InvalidParameterError: a parameter out of range, or a design that cannot assemble at its
             reference pose (see the mechanism's ``Params``).
+
+    Examples:
+        >>> import pkm
+        >>> small = pkm.build("delta", R="100mm")
+        >>> small.params.R
+        0.1
+        >>> round(pkm.task_values(small, small.q_reference)["z"], 4)
+        -0.2888
     """
     return mechanism_module(name).build(design_params(name, **params))
 

@@ -100,6 +100,15 @@ def quantity(value: object, kind: str | None = None, what: str = "value") -> flo
     Raises:
         UnitError: a bad string (see :func:`parse_quantity`); InvalidInputError: neither a number nor a string,
             or not finite.
+
+    Examples:
+        >>> import pkm
+        >>> pkm.quantity("20mm")
+        0.02
+        >>> round(pkm.quantity("90deg", "angle"), 6)
+        1.570796
+        >>> pkm.quantity(0.5)
+        0.5
     """
     if kind is not None and kind not in SI_UNITS:
         raise InvalidInputError("kind", f"use one of {list(SI_UNITS)} or None", kind)

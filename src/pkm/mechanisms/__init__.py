@@ -130,14 +130,30 @@ def names(*, with_files: bool = False) -> tuple[str, ...]:
 
 
 def definition(name: str) -> MechanismDefinition:
-    """The registry entry of ``name``; :class:`UnknownNameError` listing the registered ones otherwise."""
+    """The registry entry of ``name``; :class:`UnknownNameError` listing the registered ones otherwise.
+
+    Examples:
+        >>> import pkm
+        >>> entry = pkm.mechanism_definition("delta")
+        >>> entry.name, entry.reference
+        ('delta', 'delta.closures.toml')
+        >>> entry.title
+        'Delta robot with reconfigurable base radius R (Hernandez Reyna & Sandoval-Castro 2018)'
+    """
     if not isinstance(name, str) or name not in REGISTRY:
         raise UnknownNameError("mechanism", repr(name) if not isinstance(name, str) else name, names())
     return REGISTRY[name]
 
 
 def module(name: str) -> ModuleType:
-    """The package of mechanism ``name``."""
+    """The package of mechanism ``name``.
+
+    Examples:
+        >>> import pkm
+        >>> mod = pkm.mechanism_module("rrr3")
+        >>> mod.__name__, type(mod.Params()).__name__
+        ('pkm.mechanisms.rrr3', 'Rrr3Params')
+    """
     return cast(ModuleType, definition(name).module())
 
 

@@ -48,7 +48,7 @@ import time
 import traceback
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -70,6 +70,9 @@ from pkm.sweeps.store import (
     resume,
     write_atomic,
 )
+
+if TYPE_CHECKING:
+    from pkm.core.model.mechanism import Mechanism
 
 MAX_CHUNK = 500
 #: glibc's allocator settings of the local workers (see :func:`local_cluster`) [bytes].
@@ -269,20 +272,23 @@ def _client(scheduler, client, workers: int | None, stack: contextlib.ExitStack)
     return c, max(1, len(c.scheduler_info().get("workers", {})))
 
 
-def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, Any] | None = None,
-          scheduler: str | None = None, client=None, workers: int | None = None, chunk_size: int | None = None,
-          progress: bool | None = None, overwrite: bool = False) -> SweepResult:
+def sweep(mechanism: str | os.PathLike[str] | Mechanism | Family, space: Space,
+          objectives: str | Objective | Callable[..., Any] | Sequence[str | Objective | Callable[..., Any]], *,
+          out: str | os.PathLike[str] | None = None, fixed: Mapping[str, Any] | None = None,
+          scheduler: str | None = None, client: Any = None, workers: int | None = None,
+          chunk_size: int | None = None, progress: bool | None = None, overwrite: bool = False) -> SweepResult:
     """Evaluate ``objectives`` on every design of ``space`` (see the module doc).
 
     Args:
-        mechanism: A registered name (``"rrr3"``), a :class:`pkm.Mechanism`, or a closure spec's path.
+        mechanism: A registered name (``"rrr3"``), a :class:`pkm.Mechanism`, or a closure spec's path (or a
+            :class:`~pkm.sweeps.family.Family`).
         space: :func:`~pkm.sweeps.grid`, :func:`~pkm.sweeps.sobol`, :func:`~pkm.sweeps.latin_hypercube` or
             :func:`~pkm.sweeps.table`.
         objectives: Specs (``"gci:step=1cm"``), callables or :class:`~pkm.sweeps.objectives.Objective`\\ s.
         out: A ``.parquet`` path to write (and resume from), or None: results in memory only.
         fixed: A registered mechanism's parameters not swept (SI or with units; the paper's by default).
         scheduler: None: a local cluster; ``"serial"``: this process; else a Dask scheduler's address.
-        client: A ``dask.distributed.Client`` to use instead.
+        client: A ``dask.distributed.Client`` to use instead (typed ``Any``: Dask is an optional extra).
         workers: Worker processes of the local cluster (default: one per core); with a scheduler, how many to
             wait for.
         chunk_size: Designs per chunk (default: about 32 chunks per worker, at most :data:`MAX_CHUNK`).
@@ -296,6 +302,17 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
             lost to the cluster (the finished chunks kept: a rerun resumes).
         MissingDependencyError: the ``sweeps`` extra (Dask, pyarrow, cloudpickle) is not installed: ``pip install
             "pkm[sweeps]"``.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> from pkm import sweeps
+        >>> space = sweeps.grid(a="30cm:60cm:3", b="40cm", h="10cm")
+        >>> res = pkm.sweep("rrr3", space, ["gci:step=4cm"], scheduler="serial", progress=False)
+        >>> res
+        SweepResult(3 designs of {'registered': 'rrr3', 'fixed': {}}, 0 failed; objectives ['gci:step=4cm'])
+        >>> np.round(res.column("gci:step=4cm"), 4)
+        array([0.4576, 0.3477, 0.2184])
     """
     require("sweeps", "pkm.sweep (design sweeps on Dask, results in Parquet)")
     if scheduler is not None and not isinstance(scheduler, str):
@@ -329,19 +346,18 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
     if out_path is not None and space.seed is None and space.kind in ("sobol", "latin_hypercube") and not overwrite:
         space = dataclasses.replace(space, seed=recorded_seed(out_path))  # resuming: the samples drawn before
     designs = space.designs(family.units)
-    if isinstance(objectives, (str, Objective)) or callable(objectives):
-        objectives = [objectives]
-    objectives = [objective(o) for o in objectives]
-    if not objectives:
+    given = [objectives] if isinstance(objectives, (str, Objective)) or callable(objectives) else objectives
+    chosen: list[Objective] = [objective(o) for o in given]
+    if not chosen:
         raise InvalidInputError("objectives", "name at least one objective (see pkm.sweeps.OBJECTIVES)")
-    columns = [o.column for o in objectives]
+    columns = [o.column for o in chosen]
     clash = sorted({c for c in columns if columns.count(c) > 1} | (set(columns) & set(designs.names)))
     if clash:
         raise InvalidInputError("objectives", f"columns named twice: {clash} (name them: 'label=spec')", clash)
-    context = _Context(family, designs.names, objectives)
-    for o in objectives:
+    context = _Context(family, designs.names, chosen)
+    for o in chosen:
         o.bind(family)  # a route that does not exist fails here, not in every design
-    manifest = manifest_of(family, designs, objectives)
+    manifest = manifest_of(family, designs, chosen)
     done_tables: list = []
     if out_path is not None:
         if out_path.suffix != ".parquet" or (out_path.exists() and not out_path.is_file()):
@@ -377,8 +393,8 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
         new_tables, work = [], 0.0
         bar = _bar(progress, len(designs), int(done.sum()))
         try:
-            for ids, cols, seconds in _results(cl, shared, chunks, designs, objectives):
-                table = chunk_table(designs, objectives, cols)
+            for ids, cols, seconds in _results(cl, shared, chunks, designs, chosen):
+                table = chunk_table(designs, chosen, cols)
                 if out_path is not None:
                     write_atomic(table, parts_folder(out_path) / f"part-{ids[0]:09d}-{ids[-1]:09d}.parquet")
                 new_tables.append(table)
@@ -389,7 +405,7 @@ def sweep(mechanism, space: Space, objectives, *, out=None, fixed: Mapping[str, 
             if bar is not None:
                 bar.close()
         wall = time.perf_counter() - t0
-    table = combine(done_tables + new_tables, designs, objectives)
+    table = combine(done_tables + new_tables, designs, chosen)
     if out_path is not None:
         write_atomic(table, out_path, {"pkm.sweep": json.dumps(manifest)})
         shutil.rmtree(parts_folder(out_path), ignore_errors=True)

@@ -58,3 +58,12 @@ def test_nearest_assembly_is_the_closed_configuration_nearest_the_zero_pose(tmp_
             best = min(best, float(np.linalg.norm(r.x)))
     assert np.linalg.norm(q) <= best + 1e-7 and np.linalg.norm(q) < 0.5 * np.linalg.norm(mech.q_reference)
     assert np.abs(constraints.residual(mech, -q)).max() < 1e-12 and q[0] > 0  # the mirrored one: not chosen
+
+
+def test_mode_label_takes_any_array_like_and_refuses_a_bad_configuration():
+    """``q`` as a list labels as the array does (it raised Pinocchio's TypeError); a wrong length is pkm's error."""
+    delta = pkm.load("delta")
+    q = pkm.branch_seed(delta, "knee_in")
+    assert pkm.mode_label(delta, list(q)) == pkm.mode_label(delta, q)
+    with pytest.raises(pkm.errors.InvalidInputError):
+        pkm.mode_label(delta, q[:-1])

@@ -154,6 +154,17 @@ def capability(mech: Mechanism, q: ArrayLike, kind: str = "wrench", *, gravity: 
             mechanism with more actuators than task coordinates, a ``q`` whose loops are not closed
             (:func:`~pkm.core.kinematics.constraints.check_closed`).
         SingularityError: ``J`` (or ``M_a``) singular at ``q``: no finite polytope.
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> cap = pkm.capability(delta, delta.q_reference)
+        >>> cap.polytope.units
+        ('N', 'N', 'N')
+        >>> {k: tuple(round(x, 2) for x in v) for k, v in cap.along.items()}
+        {'x': (48.39, 48.39), 'y': (41.91, 45.96), 'z': (101.6, 111.42)}
+        >>> round(cap.isotropic["N"], 2)
+        38.74
     """
     from pkm.core.differential.velocity import forward_jacobian
     from pkm.core.kinematics.constraints import check_closed

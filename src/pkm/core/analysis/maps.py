@@ -309,6 +309,17 @@ def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[st
         InvalidInputError: bad axes, a missing ``length``, or a grid beyond :data:`MAX_NODES`.
         CompilerError: no C compiler on the machine (the maps run only compiled: a grid of 10^6 nodes through the
             virtual machine would take an hour), or the compiled driver failed (out of memory).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> grid = {"x": np.linspace(-0.1, 0.1, 5), "y": np.linspace(-0.1, 0.1, 5)}
+        >>> wmap = pkm.workspace_map(delta, grid, {"z": -0.35})
+        >>> wmap.reachable.shape, int(wmap.reachable.sum())
+        ((5, 5), 25)
+        >>> round(float(wmap.gci()), 4)
+        0.3788
     """
     from pkm.core.twin import Kernels
 
@@ -398,7 +409,19 @@ TaskGridMap = WorkspaceMap
 
 
 def task_map(*args: Any, **kwargs: Any) -> WorkspaceMap:
-    """Deprecated alias of :func:`workspace_map` (0.2.0: "task map" is the task coordinates, :class:`TaskMap`)."""
+    """Deprecated alias of :func:`workspace_map` (0.2.0: "task map" is the task coordinates, :class:`TaskMap`).
+
+    Examples:
+        >>> import warnings
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> with warnings.catch_warnings(record=True) as caught:
+        ...     warnings.simplefilter("always")
+        ...     wmap = pkm.task_map(delta, {"x": [-0.05, 0.0, 0.05]}, {"y": 0.0, "z": -0.35})
+        ...
+        >>> caught[0].category.__name__, type(wmap).__name__
+        ('DeprecationWarning', 'WorkspaceMap')
+    """
     warnings.warn("pkm.task_map is now pkm.workspace_map (pkm 0.2.0)", DeprecationWarning, stacklevel=2)
     return workspace_map(*args, **kwargs)
 

@@ -184,6 +184,17 @@ def reconfigure(mech: Mechanism, poses: np.ndarray | Sequence[ArrayLike | Mappin
         InvalidInputError: unknown parameters or index, bad limits, a missing ``length``.
         UnreachableError: a pose no parameter value within the limits reaches (one parameter), or a box not
             reached everywhere (several).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> hexapod = pkm.load("hexapod")
+        >>> pose = pkm.task_values(hexapod, hexapod.q_reference)
+        >>> r = pkm.reconfigure(hexapod, [pose], ["beta_1"], [(-1.5, 1.5)], length=0.1)
+        >>> np.round(r.x, 4), np.round(r.value, 4)
+        (array([-1.5]), array([0.1469]))
+        >>> np.round(r.lower, 4), np.round(r.upper, 4)
+        (array([-1.5]), array([0.7867]))
     """
     from pkm.core.twin import Kernels
 

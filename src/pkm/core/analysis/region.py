@@ -152,6 +152,15 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
     Raises:
         InvalidInputError: axes that are not two distinct task coordinates, a limit for an unknown joint or with
             ``low >= high``, the reference pose itself not feasible (what stops it named).
+
+    Examples:
+        >>> import pkm
+        >>> prs3 = pkm.load("prs3")
+        >>> region = pkm.feasible_region(prs3, ("pitch", "roll"), singularity=0.05, reach=2.0, directions=8)
+        >>> region.binding[:2]
+        ('direct singularity', 'direct singularity')
+        >>> round(region.area, 3), region.contains([0.1, -0.1])
+        (1.762, True)
     """
     mech = check_mechanism(mech)
     names = list(mech.task_map.kinds)

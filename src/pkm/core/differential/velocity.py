@@ -219,20 +219,45 @@ def idle_motions(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float =
     """An orthonormal basis (nv x k) of the idle motions at ``q``: joint rates that the closures allow with the
     actuators locked and that the task does not see (a rod spinning about its axis between two ball joints);
     k = 0 for most mechanisms. The kinematics does not fix their rates and accelerations; pkm's rates and
-    accelerations carry none of them in the mass metric (:mod:`pkm.core.differential.idle`)."""
+    accelerations carry none of them in the mass metric (:mod:`pkm.core.differential.idle`).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> pkm.idle_motions(delta, delta.q_reference).shape
+        (12, 0)
+        >>> robot = pkm.load("gepetto:robot_delta")
+        >>> N = pkm.idle_motions(robot, robot.q_reference)
+        >>> N.shape
+        (14, 3)
+        >>> np.allclose(N.T @ N, np.eye(3))
+        True
+    """
     mech, c = _at(mech, q)
     return _split(mech, c, as_tolerance(rtol, "rtol")).idle
 
 
 def passive_map(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
-    """``G = dq/dq_a`` (nv x na): all joint rates from the actuated rates, the idle motions' rates those of least
-    kinetic energy (``Nᵀ M G = 0``, :mod:`pkm.core.differential.idle`; the mass matrix is computed only where there
-    are idle motions).
+    r"""The passive map :math:`G = \partial q / \partial q_a` (nv x na): all joint rates from the actuated rates, the
+    idle motions' rates those of least kinetic energy (:math:`N^\top M G = 0`, :mod:`pkm.core.differential.idle`;
+    the mass matrix is computed only where there are idle motions).
 
     Raises:
         SingularityError: ``kind="direct"``: with the actuators locked, a passive motion that moves
             the task is allowed to first order (the smallest singular value of ``J_p`` off the idle
             motions is at most ``rtol`` times the largest).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q = pkm.solve_ik(delta, [0.02, 0.0, -0.36]).q
+        >>> G = pkm.passive_map(delta, q)
+        >>> G.shape
+        (12, 3)
+        >>> np.allclose(G @ [0.1, 0.2, 0.3], pkm.velocities(delta, q, [0.1, 0.2, 0.3]))
+        True
     """
     mech, c = _at(mech, q)
     rtol = as_tolerance(rtol, "rtol")
@@ -242,12 +267,38 @@ def passive_map(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 
 
 
 def forward_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
-    """Task rates from actuated rates, ``yd = J qd_a`` (n_task x na); raises as :func:`passive_map`."""
+    r"""The forward Jacobian :math:`J = J_t G`: task rates from actuated rates, :math:`\dot y = J \dot q_a`
+    (n_task x na); raises as :func:`passive_map`.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q = pkm.solve_ik(delta, [0.02, 0.0, -0.36]).q
+        >>> J = pkm.forward_jacobian(delta, q)
+        >>> J.shape
+        (3, 3)
+        >>> np.round(J @ [0.1, 0.2, 0.3], 4)
+        array([ 0.0108, -0.0198,  0.0257])
+    """
     return _forward(mech, q, rtol, "forward")
 
 
 def twist_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
-    """End-effector twist ``[v; w]`` (origin velocity, world axes) from actuated rates (6 x na)."""
+    r"""The twist Jacobian: the end-effector twist :math:`[v; \omega]` (origin velocity, world axes) from actuated
+    rates (6 x na).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> gs = pkm.load("gough_stewart")
+        >>> Jt = pkm.twist_jacobian(gs, gs.q_reference)
+        >>> Jt.shape
+        (6, 6)
+        >>> twist = Jt @ np.full(6, 0.01)  # every leg extending at 1 cm/s: the platform rises
+        >>> round(float(twist[2]), 4), np.allclose(np.delete(twist, 2), 0.0)
+        (0.0107, True)
+    """
     return _forward(mech, q, rtol, "twist")
 
 
@@ -261,12 +312,24 @@ def _forward(mech: Mechanism, q: ArrayLike | Configuration, rtol: float, which: 
 
 
 def inverse_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
-    """Actuated rates from task rates, ``qd_a = J yd`` (na x n_task).
+    r"""The inverse Jacobian :math:`J_{\mathrm{inv}}`: actuated rates from task rates,
+    :math:`\dot q_a = J_{\mathrm{inv}} \dot y` (na x n_task), from :math:`[J_c; J_t]\, v = [0; \dot y]` read on the actuated rows.
 
     Raises:
         SingularityError: ``kind="inverse"``: with the task frozen, a motion of the actuators is
             allowed to first order (``[J_c; J_t]`` off the idle motions loses column rank, relative
             to ``rtol``).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q = pkm.solve_ik(delta, [0.02, 0.0, -0.36]).q
+        >>> K = pkm.inverse_jacobian(delta, q)
+        >>> np.round(K @ [0.0, 0.0, 0.1], 4)
+        array([0.7986, 0.7918, 0.8072])
+        >>> np.allclose(K @ pkm.forward_jacobian(delta, q), np.eye(3))
+        True
     """
     mech, c = _at(mech, q)
     rtol = as_tolerance(rtol, "rtol")
@@ -278,18 +341,44 @@ def inverse_jacobian(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: flo
 
 
 def velocities(mech: Mechanism, q: ArrayLike | Configuration, qd_actuated: ArrayLike) -> np.ndarray:
-    """All joint rates ``v = G qd`` (nv,) from the actuated rates (:func:`passive_map`: no idle motion in the mass
-    metric)."""
+    r"""All joint rates :math:`v = G \dot q_a` (nv,) from the actuated rates (:func:`passive_map`: no idle motion in
+    the mass metric).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q = pkm.solve_ik(delta, [0.02, 0.0, -0.36]).q
+        >>> v = pkm.velocities(delta, q, [0.1, 0.2, 0.3])
+        >>> v.shape
+        (12,)
+        >>> np.round(delta.actuated_q(v), 3)
+        array([0.1, 0.2, 0.3])
+        >>> np.round(pkm.task_velocity(delta, q, v), 4)
+        array([ 0.0108, -0.0198,  0.0257])
+    """
     G = passive_map(mech, q)
     return finite_result(G @ mech.check_actuated(qd_actuated, "qd_actuated"), "joint velocities")
 
 
 def accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, qdd_actuated: ArrayLike) -> np.ndarray:
-    """All joint accelerations ``a`` (nv,) from the actuated ones, the drift included, with no idle acceleration in
-    the mass metric (``Nᵀ M a = 0``, :mod:`pkm.core.differential.idle`).
+    r"""All joint accelerations ``a`` (nv,) from the actuated ones, the drift included (:math:`J_c a + \dot J_c v = 0`),
+    with no idle acceleration in the mass metric (:math:`N^\top M a = 0`, :mod:`pkm.core.differential.idle`).
 
     Raises:
         SingularityError: as :func:`passive_map`.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q = pkm.solve_ik(delta, [0.02, 0.0, -0.36]).q
+        >>> v = pkm.velocities(delta, q, [0.1, 0.2, 0.3])
+        >>> a = pkm.accelerations(delta, q, v, [1.0, 0.0, -1.0])
+        >>> np.round(delta.actuated_q(a), 3)
+        array([ 1.,  0., -1.])
+        >>> np.round(pkm.task_acceleration(delta, q, v, a), 4)
+        array([-0.1143,  0.1993, -0.0029])
     """
     mech, c = _at(mech, q)
     v = mech.check_v(v)
@@ -304,21 +393,56 @@ def accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, q
 
 
 def task_velocity(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike) -> np.ndarray:
-    """Task rates for joint rates ``v``."""
+    """Task rates for joint rates ``v``.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q = pkm.solve_ik(delta, [0.02, 0.0, -0.36]).q
+        >>> v = pkm.velocities(delta, q, [0.1, 0.2, 0.3])
+        >>> np.round(pkm.task_velocity(delta, q, v), 4)
+        array([ 0.0108, -0.0198,  0.0257])
+        >>> np.allclose(pkm.task_velocity(delta, q, v), pkm.forward_jacobian(delta, q) @ [0.1, 0.2, 0.3])
+        True
+    """
     mech, c = _at(mech, q)
     v = mech.check_v(v)
     return finite_result(c.task_jacobian @ v, "task velocity")
 
 
 def task_acceleration(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, a: ArrayLike) -> np.ndarray:
-    """Task accelerations ``J_t a + dJ_t/dt v``."""
+    r"""Task accelerations :math:`\ddot y = J_t a + \dot J_t v`.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q = pkm.solve_ik(delta, [0.02, 0.0, -0.36]).q
+        >>> v = pkm.velocities(delta, q, [0.1, 0.2, 0.3])
+        >>> a = pkm.accelerations(delta, q, v, [0.0, 0.0, 0.0])
+        >>> np.round(pkm.task_acceleration(delta, q, v, a), 4)
+        array([-0.002 ,  0.0007,  0.0041])
+    """
     mech, c = _at(mech, q)
     v, a = mech.check_v(v), mech.check_v(a, "a")
     return finite_result(c.task_jacobian @ a + mech.task_map.bias(c.q, v), "task acceleration")
 
 
 def inverse_velocities(mech: Mechanism, q: ArrayLike | Configuration, yd: ArrayLike) -> np.ndarray:
-    """All joint rates ``v`` for task rates ``yd`` (nv,), no idle motion in the mass metric (as :func:`velocities`)."""
+    """All joint rates ``v`` for task rates ``yd`` (nv,), no idle motion in the mass metric (as :func:`velocities`).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q = pkm.solve_ik(delta, [0.02, 0.0, -0.36]).q
+        >>> v = pkm.inverse_velocities(delta, q, [0.1, 0.0, 0.1])
+        >>> np.allclose(pkm.task_velocity(delta, q, v), [0.1, 0.0, 0.1])
+        True
+        >>> np.round(delta.actuated_q(v), 4)
+        array([0.7414, 0.3133, 1.1942])
+    """
     mech, c = _at(mech, q)
     yd = as_vector(yd, mech.n_task, "yd")
     sp = _split(mech, c, RTOL)
@@ -328,7 +452,18 @@ def inverse_velocities(mech: Mechanism, q: ArrayLike | Configuration, yd: ArrayL
 
 def inverse_accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, ydd: ArrayLike) -> np.ndarray:
     """All joint accelerations ``a`` for task accelerations ``ydd`` at state ``(q, v)``, no idle acceleration in the
-    mass metric (as :func:`accelerations`)."""
+    mass metric (as :func:`accelerations`).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q = pkm.solve_ik(delta, [0.02, 0.0, -0.36]).q
+        >>> v = pkm.inverse_velocities(delta, q, [0.1, 0.1, 0.0])
+        >>> a = pkm.inverse_accelerations(delta, q, v, [1.0, 1.0, 2.0])
+        >>> np.round(pkm.task_acceleration(delta, q, v, a), 6)
+        array([1., 1., 2.])
+    """
     mech, c = _at(mech, q)
     v = mech.check_v(v)
     ydd = as_vector(ydd, mech.n_task, "ydd")
@@ -482,6 +617,15 @@ def diagnose(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 1e-
     Args:
         rtol: Relative rank tolerance: a kind is singular where its distance is at most ``rtol``.
         near: Distances below this (and above ``rtol``) are reported in :attr:`Diagnostics.near`.
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> d = pkm.diagnose(delta, delta.q_reference)
+        >>> print(d)
+        regular
+        >>> d.mobility, round(d.direct_distance, 3), round(d.inverse_distance, 3)
+        (3, 0.236, 0.068)
     """
     mech, c = _at(mech, q)
     rtol = as_tolerance(rtol, "rtol")

@@ -1,4 +1,4 @@
-"""The dynamic model of any closed-loop mechanism in its actuated coordinates.
+r"""The dynamic model of any closed-loop mechanism in its actuated coordinates.
 
 The closures leave ``na`` degrees of freedom, driven by the actuated joints: the state is the configuration ``q``
 (assembled) and the actuated rates ``qd`` (``q̇_a``). With ``J_c = [J_a J_p]`` the closure Jacobian split into
@@ -18,20 +18,26 @@ non-linear effects (``rnea``):
 * ``a = Ĝ qdd + a_b`` (:func:`pkm.accelerations`), ``a_b`` the closure's drift compensation (``J_c a_b + gamma =
   0``, no actuated acceleration, no idle acceleration in the mass metric).
 
-Then, with ``τ_a`` the actuator efforts,
+Then, with :math:`\tau_a` the actuator efforts,
 
-    ``M_a(q) qdd + h_a(q, qd) = τ_a + f_a(q, qd)``,   ``M_a = Ĝᵀ M Ĝ``,   ``h_a = Ĝᵀ rnea(q, Ĝ qd, a_b)``
+$$
+M_a(q)\,\ddot q_a + h_a(q, \dot q_a) = \tau_a + f_a(q, \dot q_a), \qquad
+M_a = \hat G^\top M \hat G, \qquad h_a = \hat G^\top \mathrm{rnea}(q, \hat G \dot q_a, a_b)
+$$
 
-where ``h_a`` holds the Coriolis, centrifugal and gravity terms and the drift of the closures, ``g_a = Ĝᵀ g(q)``
-is gravity alone, and ``f_a = Ĝᵀ (-D v - F sgn(v))`` the joints' friction (Pinocchio's ``damping`` ``D`` and
-``friction`` ``F``, the actuators' viscous and Coulomb friction among them; ``sgn`` a sign smoothed over
-``coulomb_velocity``). ``½ qdᵀ M_a qd`` is the kinetic energy. The Coriolis matrix ``C_a`` is built from the Christoffel
-symbols of ``M_a`` (:func:`coriolis_matrix`), so that ``Ṁ_a - 2 C_a`` is skew-symmetric; the derivatives of ``M_a``
+where :math:`h_a` holds the Coriolis, centrifugal and gravity terms and the drift of the closures,
+:math:`g_a = \hat G^\top g(q)` is gravity alone, and :math:`f_a = \hat G^\top (-D v - F \operatorname{sgn}(v))` the joints' friction (Pinocchio's
+``damping`` ``D`` and ``friction`` ``F``, the actuators' viscous and Coulomb friction among them; ``sgn`` a sign
+smoothed over ``coulomb_velocity``). :math:`\tfrac{1}{2} \dot q_a^\top M_a \dot q_a` is the kinetic energy. The
+Coriolis matrix :math:`C_a` is built from the Christoffel symbols of :math:`M_a` (:func:`coriolis_matrix`), so that
+:math:`\dot M_a - 2 C_a` is skew-symmetric; the derivatives of ``M_a``
 are Richardson-extrapolated central differences on the closed mechanism (steps of 2e-5 and 1e-5 in the actuated
 coordinates).
 
-In task coordinates (a task of ``na`` coordinates, ``yd = J qd``), ``Λ = J⁻ᵀ M_a J⁻¹`` (Khatib's operational-space
-inertia) and ``μ = J⁻ᵀ h_a - Λ ÿ_b`` (``ÿ_b`` the task acceleration at ``qdd = 0``): ``J⁻ᵀ τ_a = Λ ÿ + μ``.
+In task coordinates (a task of ``na`` coordinates, :math:`\dot y = J \dot q_a`),
+:math:`\Lambda = J^{-\top} M_a J^{-1}` (Khatib's operational-space inertia) and
+:math:`\mu = J^{-\top} h_a - \Lambda \ddot y_b` (:math:`\ddot y_b` the task acceleration at :math:`\ddot q_a = 0`):
+:math:`J^{-\top} \tau_a = \Lambda \ddot y + \mu`.
 
 Redundant closures (a planar loop closed with a 6-D frame) are handled by rank: ``J_p``'s pseudo-inverse drops the
 dependent rows; no regularisation is involved. A direct singularity (a passive motion the actuators do not hold)
@@ -144,16 +150,17 @@ class ActuatorSpaceModel:
 
     @property
     def kinetic_energy(self) -> float:
-        """``½ qdᵀ M_a qd`` [J]."""
+        r"""The kinetic energy :math:`\tfrac{1}{2} \dot q_a^\top M_a \dot q_a` [J]."""
         return float(0.5 * self.qd @ self.M @ self.qd)
 
     def efforts(self, qdd: ArrayLike) -> np.ndarray:
-        """``M_a qdd + h_a`` (na,): the efforts for actuated accelerations ``qdd`` (no friction)."""
+        r""":math:`M_a \ddot q_a + h_a` (na,) [N m, N]: the efforts for actuated accelerations ``qdd`` (no friction)."""
         qdd = self.mech.check_actuated(qdd, "qdd")
         return finite_result(self.M @ qdd + self.h, "actuator efforts")
 
     def accelerations(self, tau: ArrayLike, *, friction: bool = True) -> np.ndarray:
-        """``qdd = M_a⁻¹ (τ_a + f_a - h_a)`` (na,) for actuator efforts ``tau`` (with the friction, by default).
+        r""":math:`\ddot q_a = M_a^{-1} (\tau_a + f_a - h_a)` (na,) for actuator efforts ``tau`` (with the friction,
+        by default).
 
         Raises:
             SingularityError: ``kind="inertia"``: an actuated motion moves no mass (``M_a`` singular).
@@ -224,7 +231,8 @@ def _evaluate(mech: Mechanism, q: np.ndarray, qd: np.ndarray, rtol: float,
 
 def actuator_model(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None, *, rtol: float = RTOL,
                    coulomb_velocity: float = COULOMB_VELOCITY) -> ActuatorSpaceModel:
-    """The dynamic model of ``mech`` in its actuated coordinates at the state ``(q, qd)`` (module doc).
+    r"""The dynamic model of ``mech`` in its actuated coordinates at the state ``(q, qd)``:
+    :math:`M_a(q)\,\ddot q_a + h_a(q, \dot q_a) = \tau_a + f_a(q, \dot q_a)` (module doc).
 
     Args:
         mech: The mechanism.
@@ -236,6 +244,24 @@ def actuator_model(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None, *
 
     Raises:
         SingularityError: ``kind="direct"`` at a direct singularity.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> model = pkm.actuator_model(delta, delta.q_reference, [1.0, 0.0, 0.0])
+        >>> np.round(model.M, 5)
+        array([[ 0.00298, -0.00058, -0.00058],
+               [-0.00058,  0.00298, -0.00058],
+               [-0.00058, -0.00058,  0.00298]])
+        >>> np.round(model.h, 4)
+        array([0.1784, 0.1805, 0.1805])
+        >>> np.round(model.efforts([10.0, 0.0, 0.0]), 4)
+        array([0.2082, 0.1747, 0.1747])
+        >>> np.allclose(model.efforts([10.0, 0.0, 0.0]), model.M @ [10.0, 0.0, 0.0] + model.h)
+        True
+        >>> round(model.kinetic_energy, 6)
+        0.001489
     """
     mech, q, qd = _check_state(mech, q, qd)
     rtol = as_tolerance(rtol, "rtol")
@@ -244,17 +270,52 @@ def actuator_model(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None, *
 
 
 def mass_matrix(mech: Mechanism, q: ArrayLike) -> np.ndarray:
-    """``M_a(q)`` (na x na) [kg m^2, kg]: the mass matrix in the actuated coordinates (reflected inertias in)."""
+    r"""The mass matrix in the actuated coordinates :math:`M_a(q) = \hat G^\top M(q) \hat G` (na x na)
+    [kg m^2, kg]: the reflected inertias in (module doc: :math:`\hat G` the passive map, :math:`M` Pinocchio's).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> M = pkm.mass_matrix(delta, delta.q_reference)
+        >>> np.round(M, 5)
+        array([[ 0.00298, -0.00058, -0.00058],
+               [-0.00058,  0.00298, -0.00058],
+               [-0.00058, -0.00058,  0.00298]])
+        >>> bool(np.all(np.linalg.eigvalsh(M) > 0))
+        True
+    """
     return actuator_model(mech, q).M.copy()
 
 
 def bias_efforts(mech: Mechanism, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
-    """``h_a(q, qd)`` (na,): Coriolis, centrifugal, gravity and closure-drift efforts (the efforts at ``qdd = 0``)."""
+    r"""The bias efforts :math:`h_a(q, \dot q_a)` (na,) [N m, N]: Coriolis, centrifugal, gravity and closure-drift
+    efforts, the efforts at :math:`\ddot q_a = 0` in :math:`M_a \ddot q_a + h_a = \tau_a + f_a` (module doc).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q = delta.q_reference
+        >>> np.round(pkm.bias_efforts(delta, q, [1.0, 0.0, 0.0]), 4)
+        array([0.1784, 0.1805, 0.1805])
+        >>> np.allclose(pkm.bias_efforts(delta, q, np.zeros(3)), pkm.gravity_efforts(delta, q))
+        True
+    """
     return actuator_model(mech, q, qd).h.copy()
 
 
 def gravity_efforts(mech: Mechanism, q: ArrayLike) -> np.ndarray:
-    """``g_a(q)`` (na,): the actuator efforts that hold the mechanism still against gravity."""
+    r"""The gravity efforts :math:`g_a(q) = \hat G^\top g(q)` (na,) [N m, N]: the actuator efforts that hold the
+    mechanism still against gravity.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> np.round(pkm.gravity_efforts(delta, delta.q_reference), 4)
+        array([0.1797, 0.1797, 0.1797])
+    """
     return actuator_model(mech, q).g.copy()
 
 
@@ -281,12 +342,29 @@ def mass_matrix_derivatives(mech: Mechanism, q: ArrayLike, *, rtol: float = RTOL
 
 
 def coriolis_matrix(mech: Mechanism, q: ArrayLike, qd: ArrayLike, *, rtol: float = RTOL) -> np.ndarray:
-    """``C_a(q, qd)`` (na x na) from the Christoffel symbols of ``M_a``:
-    ``C_ij = Σ_k ½ (∂_k M_ij + ∂_j M_ik - ∂_i M_jk) qd_k``, so that ``Ṁ_a - 2 C_a`` is skew-symmetric and
-    ``C_a qd = h_a - g_a`` (the derivatives by :func:`mass_matrix_derivatives`).
+    r"""The Coriolis matrix :math:`C_a(q, \dot q_a)` (na x na) from the Christoffel symbols of :math:`M_a`:
+
+    $$
+    C_{ij} = \sum_k \tfrac{1}{2} \left( \partial_k M_{ij} + \partial_j M_{ik} - \partial_i M_{jk} \right) \dot q_k,
+    $$
+
+    so that :math:`\dot M_a - 2 C_a` is skew-symmetric and :math:`C_a \dot q_a = h_a - g_a` (the derivatives by
+    :func:`mass_matrix_derivatives`).
 
     Pinocchio's own ``computeCoriolisMatrix`` is not used: on Pinocchio 4.1 it is wrong for universal joints (NaN)
-    and mimic joints (tested)."""
+    and mimic joints (tested).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q, qd = delta.q_reference, np.array([1.0, -0.5, 0.2])
+        >>> C = pkm.coriolis_matrix(delta, q, qd)
+        >>> np.round(C @ qd, 4)
+        array([-0.0009,  0.001 ,  0.0008])
+        >>> np.allclose(C @ qd, pkm.bias_efforts(delta, q, qd) - pkm.gravity_efforts(delta, q))
+        True
+    """
     mech, q, qd = _check_state(mech, q, qd)
     dM = mass_matrix_derivatives(mech, q, rtol=rtol)  # dM[k, i, j] = d M_ij / d q_k
     gamma = 0.5 * (dM + np.transpose(dM, (2, 1, 0)) - np.transpose(dM, (2, 0, 1)))  # gamma[k, i, j]
@@ -312,11 +390,22 @@ class OperationalSpace:
 
 def operational_space(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None, *,
                       rtol: float = RTOL) -> OperationalSpace:
-    """The operational-space inertia and bias in the task coordinates (needs as many as actuators).
+    r"""The operational-space inertia :math:`\Lambda = J^{-\top} M_a J^{-1}` and bias :math:`\mu`, such that
+    :math:`J^{-\top} \tau_a = \Lambda \ddot y + \mu`, in the task coordinates (needs as many as actuators).
 
     Raises:
         InvalidInputError: the task does not have ``na`` coordinates.
         SingularityError: ``kind="inverse"`` where ``J`` loses rank.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> osp = pkm.operational_space(delta, delta.q_reference)
+        >>> np.round(np.diag(osp.inertia), 4)
+        array([0.3011, 0.3011, 0.4505])
+        >>> round(float(osp.bias[2]), 4)
+        4.908
     """
     mech, q, qd = _check_state(mech, q, qd)
     if mech.n_task != mech.na:

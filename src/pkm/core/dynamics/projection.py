@@ -342,6 +342,19 @@ def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, 
     Raises:
         SingularityError: at a direct singularity (and, for ``"khalil"``, where a leg loses rank).
         SpecError: ``"khalil"`` on a structure it cannot cut (says why).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q = pkm.solve_ik(delta, [0.02, 0.0, -0.36]).q
+        >>> v = pkm.inverse_velocities(delta, q, [0.0, 0.0, 0.1])
+        >>> a = pkm.inverse_accelerations(delta, q, v, [0.0, 0.0, 1.0])
+        >>> np.round(pkm.inverse_dynamics(delta, q, v, a), 4)
+        array([0.1839, 0.157 , 0.2098])
+        >>> push = [0.0, 0.0, -10.0, 0.0, 0.0, 0.0]  # 10 N downwards on the end effector
+        >>> np.round(pkm.inverse_dynamics(delta, q, v, a, wrench=push), 4)
+        array([0.6013, 0.5016, 0.6976])
     """
     mech = check_mechanism(mech)
     if method not in METHODS:
@@ -383,6 +396,17 @@ def forward_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: 
             (:func:`pkm.core.dynamics.model.forward_dynamics`), exact by rank on redundant closures;
             ``"constraint_dynamics"``: Pinocchio's, :func:`constraint_dynamics` (the independent check).
         mu: For ``"constraint_dynamics"`` only (see there).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q, v = delta.q_reference, np.zeros(delta.nv)
+        >>> a = pkm.forward_dynamics(delta, q, v, [0.5, 0.5, 0.5])
+        >>> np.round(delta.actuated_q(a), 2)
+        array([176.76, 176.76, 176.76])
+        >>> np.allclose(pkm.inverse_dynamics(delta, q, v, a), [0.5, 0.5, 0.5])
+        True
     """
     if method not in FORWARD_METHODS:
         raise InvalidInputError("method", f"use one of {list(FORWARD_METHODS)}, got {method!r}", method)
@@ -408,6 +432,17 @@ def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuate
     Raises:
         SingularityError: ``mu=0`` on redundant closures.
         PkmError: The model has mimic joints (Pinocchio 4.1's ``constraintDynamics`` does not handle them).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q, v = delta.q_reference, np.zeros(delta.nv)
+        >>> a = pkm.constraint_dynamics(delta, q, v, [0.5, 0.5, 0.5])
+        >>> np.round(delta.actuated_q(a), 2)
+        array([176.76, 176.76, 176.76])
+        >>> np.allclose(a, pkm.forward_dynamics(delta, q, v, [0.5, 0.5, 0.5]))
+        True
     """
     mech = check_mechanism(mech)
     q, v = mech.check_q(q), mech.check_v(v)

@@ -115,6 +115,14 @@ class Simulation(Trajectory):
         method: The integrator.
         saturated: Per actuator, the samples whose effort is at or beyond its limit (peak, else continuous): clipped
             there when the run saturates (the default), exceeded when it does not.
+
+    Examples:
+        >>> import pkm
+        >>> sim = pkm.simulate(pkm.load("delta"), duration=0.01, dt=0.005)
+        >>> sim.units["task"]
+        {'x': 'm', 'y': 'm', 'z': 'm'}
+        >>> sim.actuated.shape, sim.efforts.shape
+        ((3, 3), (3, 3))
     """
 
     time: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -312,6 +320,20 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
         SingularityError: the initial state is singular (``kind="start"``; its ``sigma_min`` and ``distance`` are
             those the detail states, or measured at the initial configuration).
         CompilerError: ``backend="c"`` without a C compiler.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> sim = pkm.simulate(delta, duration=0.02, dt=0.005)  # no effort: the platform falls
+        >>> sim.time
+        array([0.   , 0.005, 0.01 , 0.015, 0.02 ])
+        >>> np.round(sim.task[:, 2], 5)
+        array([-0.25438, -0.25451, -0.25492, -0.2556 , -0.25656])
+        >>> hold = pkm.gravity_efforts(delta, delta.q_reference)
+        >>> still = pkm.simulate(delta, duration=0.02, dt=0.005, controller=lambda t, q, v: hold)  # held still
+        >>> np.round(still.task[:, 2], 6)
+        array([-0.254375, -0.254375, -0.254375, -0.254375, -0.254375])
     """
     mech = check_mechanism(mech)
     if method not in METHODS:

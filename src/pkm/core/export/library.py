@@ -146,6 +146,16 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
             (or closures and task) do not fix the joints at the reference; two branches that make one C name (or a
             branch named ``reference`` in another mode, :func:`mode_constants`); a Newton solve that does not converge
             at the reference; a non-finite kernel value at the reference.
+
+    Examples:
+        >>> import tempfile
+        >>> import pkm
+        >>> rrr3 = pkm.load("rrr3")
+        >>> lib = pkm.export_c(rrr3, tempfile.mkdtemp())
+        >>> lib.name, sorted(f.name for f in lib.files)
+        ('rrr3', ['CMakeLists.txt', 'Makefile', 'main.c', 'rrr3.c', 'rrr3.h'])
+        >>> lib.sizes
+        {'NQ': 7, 'NV': 7, 'NA': 3, 'NY': 3, 'NX': 3}
     """
     from pkm import __version__
 

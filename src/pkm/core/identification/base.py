@@ -164,6 +164,15 @@ def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int 
         InvalidInputError: fewer states than needed for as many rows as parameters, or more than ``MAX_SAMPLES``.
         SpecError: ``precise`` on a mechanism whose twin cannot build the regressor (idle motions): pass
             ``precise=False``.
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> base = pkm.base_parameters(delta, 50, precise=False)
+        >>> len(base.names), len(pkm.parameters(delta).names)
+        (48, 132)
+        >>> base.names[0]
+        'arm_1.mz'
     """
     mech = check_mechanism(mech)
     P = parameters(mech)

@@ -83,6 +83,23 @@ def consistent_estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: Array
         MissingDependencyError: cvxpy or Clarabel missing (``pip install "pkm[identify]"``).
         ConvergenceError: the solver did not reach an optimal solution (its status in the message).
         InvalidInputError, SingularityError: as :func:`pkm.estimate`.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> rng = np.random.default_rng(0)
+        >>> Q = np.array([pkm.solve_ik(delta, [x, y, -0.36]).q for x, y in 0.05 * rng.standard_normal((50, 2))])
+        >>> QD, QDD = rng.standard_normal((50, 3)), 10 * rng.standard_normal((50, 3))
+        >>> TAU = np.array([pkm.actuator_model(delta, q, qd).efforts(qdd)
+        ...                 for q, qd, qdd in zip(Q, QD, QDD)])
+        >>> base = pkm.base_parameters(delta, 50, precise=False)
+        >>> TAU += 1e-3 * rng.standard_normal(TAU.shape)  # measurement noise [N m]
+        >>> sdp = pkm.consistent_estimate(delta, Q, QD, QDD, TAU, base=base)
+        >>> sdp.status, bool(sdp.smallest_eigenvalue >= -1e-9)
+        ('optimal', True)
+        >>> sdp.theta.shape
+        (132,)
     """
     what = "the physically consistent estimate"
     cp = module("cvxpy", extra="identify", what=what)

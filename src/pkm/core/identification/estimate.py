@@ -86,6 +86,22 @@ def estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, TAU: 
     Raises:
         InvalidInputError: arrays of the wrong shape, non-finite values (the row named), fewer rows than parameters.
         SingularityError: the motion does not excite every base parameter.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> rng = np.random.default_rng(0)
+        >>> Q = np.array([pkm.solve_ik(delta, [x, y, -0.36]).q for x, y in 0.05 * rng.standard_normal((50, 2))])
+        >>> QD, QDD = rng.standard_normal((50, 3)), 10 * rng.standard_normal((50, 3))
+        >>> TAU = np.array([pkm.actuator_model(delta, q, qd).efforts(qdd)
+        ...                 for q, qd, qdd in zip(Q, QD, QDD)])
+        >>> base = pkm.base_parameters(delta, 50, precise=False)
+        >>> est = pkm.estimate(delta, Q, QD, QDD, TAU, base=base)
+        >>> len(est.values), bool(est.residual_rms.max() < 1e-9)
+        (48, True)
+        >>> np.allclose(est.predict(pkm.regressor(delta, Q[0], QD[0], QDD[0])), TAU[0])
+        True
     """
     mech = check_mechanism(mech)
     base = base if base is not None else base_parameters(mech)

@@ -144,6 +144,16 @@ def excite(mech: Mechanism, *, period: float = 10.0, harmonics: int = 5, samples
     Raises:
         InvalidInputError: bad arguments, or an excitation that cannot meet its limits (the limit named, and by
             how much).
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> base = pkm.base_parameters(delta, 50, precise=False)
+        >>> ex = pkm.excite(delta, harmonics=2, samples=20, base=base, max_iter=3)
+        >>> ex.Q.shape, ex.TAU.shape
+        ((80, 12), (80, 3))
+        >>> bool(ex.condition < ex.condition_start)
+        True
     """
     mech = check_mechanism(mech)
     period = as_scalar(period, "period")

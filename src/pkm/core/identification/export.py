@@ -108,7 +108,23 @@ def identified_mechanism(mech: Mechanism, theta: ArrayLike) -> Mechanism:
 
 
 def write_identified(mech: Mechanism, theta: ArrayLike, spec_path: str | Path) -> Path:
-    """Write :func:`identified_mechanism` as a spec at ``spec_path`` and its URDF beside it (:func:`pkm.save`)."""
+    """Write :func:`identified_mechanism` as a spec at ``spec_path`` and its URDF beside it (:func:`pkm.save`).
+
+    Examples:
+        >>> import tempfile
+        >>> from pathlib import Path
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> P = pkm.parameters(delta)
+        >>> theta = P.values.copy()
+        >>> theta[P.names.index("arm_1.m")] *= 1.1
+        >>> path = pkm.write_identified(delta, theta, Path(tempfile.mkdtemp()) / "identified.closures.toml")
+        >>> back = pkm.parameters(pkm.load(path))
+        >>> k = P.names.index("arm_1.m")
+        >>> round(float(back.values[k] / P.values[k]), 9)
+        1.1
+    """
     import pkm
 
     return pkm.save(identified_mechanism(mech, theta), spec_path)
@@ -134,7 +150,25 @@ class Validation:
 
 def validate(mech: Mechanism, predict: Estimate | ConsistentEstimate, data: Measurements) -> Validation:
     """Compare the efforts ``predict(Y)`` (an :class:`~pkm.core.identification.estimate.Estimate` or a
-    :class:`~pkm.core.identification.consistent.ConsistentEstimate`) with ``data``'s."""
+    :class:`~pkm.core.identification.consistent.ConsistentEstimate`) with ``data``'s.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> rng = np.random.default_rng(0)
+        >>> Q = np.array([pkm.solve_ik(delta, [x, y, -0.36]).q for x, y in 0.05 * rng.standard_normal((60, 2))])
+        >>> QD, QDD = rng.standard_normal((60, 3)), 10 * rng.standard_normal((60, 3))
+        >>> TAU = np.array([pkm.actuator_model(delta, q, qd).efforts(qdd)
+        ...                 for q, qd, qdd in zip(Q, QD, QDD)])
+        >>> base = pkm.base_parameters(delta, 50, precise=False)
+        >>> est = pkm.estimate(delta, Q[:50], QD[:50], QDD[:50], TAU[:50], base=base)
+        >>> check = pkm.Measurements(t=np.arange(10) * 0.01, Q=Q[50:], QD=QD[50:], QDD=QDD[50:], TAU=TAU[50:],
+        ...                          cutoff=10.0, rate=100.0, decimate=1)
+        >>> val = pkm.validate(delta, est, check)
+        >>> val.rms.shape, bool(val.rms.max() < 1e-9)
+        ((3,), True)
+    """
     mech = check_mechanism(mech)
     Y = regressor_batch(mech, data.Q, data.QD, data.QDD)
     pred = np.asarray(predict.predict(Y), dtype=float).reshape(data.TAU.shape)

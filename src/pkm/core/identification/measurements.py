@@ -127,6 +127,20 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
 
     Raises:
         InvalidInputError: the cases of the module doc, naming the column or row.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> t = np.arange(1000) * 0.002
+        >>> cols = {"time": t}
+        >>> for k, joint in enumerate(delta.actuated_names):
+        ...     cols[f"q.{joint}"] = -0.9 + 0.05 * np.sin(np.pi * t + k)
+        ...     cols[f"tau.{joint}"] = 0.2 + 0.01 * np.cos(np.pi * t)
+        ...
+        >>> data = pkm.measurements(delta, cols, cutoff=25.0)
+        >>> data.Q.shape, data.QD.shape, round(data.rate, 6), data.decimate
+        ((98, 12), (98, 3), 500.0, 9)
     """
     mech = check_mechanism(mech)
     source = str(data) if isinstance(data, (str, Path)) else "columns"

@@ -72,7 +72,14 @@ class Parameters:
 
 
 def parameters(mech: Mechanism) -> Parameters:
-    """The dynamic parameters of ``mech`` (module doc): names, values and units in the regressor's column order."""
+    """The dynamic parameters of ``mech`` (module doc): names, values and units in the regressor's column order.
+
+    Examples:
+        >>> import pkm
+        >>> theta = pkm.parameters(pkm.load("delta"))
+        >>> len(theta.names), theta.names[:4], theta.units[:4]
+        (132, ('arm_1.m', 'arm_1.mx', 'arm_1.my', 'arm_1.mz'), ('kg', 'kg m', 'kg m', 'kg m'))
+    """
     mech = check_mechanism(mech)
     model = mech.model
     bodies = body_names(model)
@@ -123,7 +130,22 @@ def _linear_columns(mech: Mechanism, q: np.ndarray, v: np.ndarray, a: np.ndarray
 
 def regressor(mech: Mechanism, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
     """``Y_a`` (na x p, p = ``len(parameters(mech))``) at a closed ``q`` with actuated rates ``qd`` and
-    accelerations ``qdd``: ``Y_a θ`` are the actuator efforts [N m, N] (module doc)."""
+    accelerations ``qdd``: ``Y_a θ`` are the actuator efforts [N m, N] (module doc).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> q, qd, qdd = delta.q_reference, np.array([0.5, -0.2, 0.1]), np.array([1.0, 2.0, -1.0])
+        >>> Y = pkm.regressor(delta, q, qd, qdd)
+        >>> Y.shape
+        (3, 132)
+        >>> theta = pkm.parameters(delta).values
+        >>> np.round(Y @ theta, 4)
+        array([0.1819, 0.1859, 0.1752])
+        >>> np.allclose(Y @ theta, pkm.actuator_model(delta, q, qd).efforts(qdd))
+        True
+    """
     model = actuator_model(mech, q, qd)
     mech = model.mech
     qdd = mech.check_actuated(qdd, "qdd")
@@ -197,6 +219,18 @@ def regressor_batch(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike
         InvalidInputError: arrays of different lengths or shapes, non-finite values, an unknown backend, or
             ``backend="c"`` for a mechanism the twin cannot build.
         CompilerError: ``backend="c"`` without a C compiler.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> Q = np.array([pkm.solve_ik(delta, [x, 0.0, -0.36]).q for x in (0.0, 0.02, 0.04)])
+        >>> QD, QDD = np.full((3, 3), 0.5), np.ones((3, 3))
+        >>> Y = pkm.regressor_batch(delta, Q, QD, QDD, backend="python")
+        >>> Y.shape
+        (9, 132)
+        >>> np.allclose(Y[3:6], pkm.regressor(delta, Q[1], QD[1], QDD[1]))
+        True
     """
     mech = check_mechanism(mech)
     if not isinstance(backend, str) or backend not in BACKENDS:

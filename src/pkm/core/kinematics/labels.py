@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 import scipy.linalg
+from numpy.typing import ArrayLike
 
 from pkm.core.kinematics.blocks import block_triangular
 from pkm.core.kinematics.configuration import Configuration
@@ -140,10 +141,21 @@ def _structures(mech: Mechanism) -> tuple[_Blocks | None, _Blocks | None]:
     return cached[1], cached[2]
 
 
-def mode_label(mech: Mechanism, q: np.ndarray) -> ModeLabel:
+def mode_label(mech: Mechanism, q: ArrayLike) -> ModeLabel:
     """The assembly and working mode labels of the configuration ``q`` (module doc); one kinematics pass (the
-    blocks are found once per mechanism)."""
+    blocks are found once per mechanism).
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> pkm.mode_label(delta, delta.q_reference)
+        ModeLabel(assembly=(1,), working=(1, 1, 1, 1))
+        >>> q = pkm.branch_seed(delta, "knee_in")
+        >>> pkm.mode_label(delta, q).working
+        (1, -1, -1, -1)
+    """
     fk, ik = _structures(mech)
+    q = mech.check_q(q)
     if fk is None and ik is None:
         return ModeLabel()
     if np.array_equal(q, mech.q_reference):  # (the reference's own signs, by construction: no kinematics pass)

@@ -258,6 +258,18 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
 
     Returns:
         A :class:`SolveResult` whose ``q`` has the requested actuated coordinates.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> res = pkm.close_loops(delta, [-0.9, -0.8, -1.0])
+        >>> res.converged, bool(res.residual < 1e-12)
+        (True, True)
+        >>> np.round(delta.actuated_q(res.q), 3)
+        array([-0.9, -0.8, -1. ])
+        >>> {k: round(v, 4) for k, v in pkm.task_values(delta, res.q).items()}
+        {'x': -0.0232, 'y': 0.0002, 'z': -0.3691}
     """
     mech = check_mechanism(mech)
     qa1 = mech.check_actuated(q_actuated, positions=True)
@@ -301,6 +313,19 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
         max_iter: Newton iterations allowed per continuation step.
         max_step: Largest task change per continuation step [m or rad].
         raise_on_failure: Raise :class:`ConvergenceError` instead of returning ``converged=False``.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> ik = pkm.solve_ik(delta, [0.02, 0.0, -0.36])
+        >>> ik.converged
+        True
+        >>> np.round(delta.actuated_q(ik.q), 4)
+        array([-0.8243, -0.9097, -0.7367])
+        >>> ik = pkm.solve_ik(delta, {"z": "-34cm"})
+        >>> {k: round(v, 6) for k, v in pkm.task_values(delta, ik.q).items()}
+        {'x': 0.0, 'y': 0.0, 'z': -0.34}
     """
     mech = check_mechanism(mech)
     task = mech.task_map
@@ -344,6 +369,15 @@ def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_i
     requested side with the platform held; then the generic inverse kinematics removes what
     the least-squares compromise left. Raises :class:`BranchError` if the result is on
     another branch.
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> list(delta.spec.branches)
+        ['knee_out', 'knee_in']
+        >>> q = pkm.branch_seed(delta, "knee_in")
+        >>> delta.on_branch(q, "knee_in"), round(pkm.task_values(delta, q)["z"], 6)
+        (True, -0.254375)
     """
     mech = check_mechanism(mech)
     b = mech.branch(branch)
@@ -390,6 +424,14 @@ def assemble(mech: Mechanism, q0: ArrayLike | None = None, *, hold: Sequence[str
 
     Raises:
         AssemblyError: no start closes: the best residual, and the closure that stays most open and by how much.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> rrr3 = pkm.load("rrr3")
+        >>> res = pkm.assemble(rrr3, np.zeros(rrr3.nq))
+        >>> res.converged, bool(res.residual < 1e-12)
+        (True, True)
     """
     mech = check_mechanism(mech)
     q_seed = mech.q_reference.copy() if q0 is None else mech.check_q(q0, "q0")
@@ -458,6 +500,16 @@ def nearest_assembly(mech: Mechanism, q0: ArrayLike | None = None, *, tol: float
 
     Raises:
         AssemblyError: no start closes the loops (as :func:`assemble`).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> rrr3 = pkm.load("rrr3")
+        >>> res = pkm.nearest_assembly(rrr3)
+        >>> res.converged
+        True
+        >>> round(float(np.linalg.norm(rrr3.difference(np.zeros(rrr3.nq), res.q))), 4)
+        2.9202
     """
     mech = check_mechanism(mech)
     q_zero = pin.neutral(mech.model) if q0 is None else mech.check_q(q0, "q0")

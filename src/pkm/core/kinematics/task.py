@@ -31,13 +31,37 @@ _ANGLES = ("roll", "pitch", "yaw")
 _POS = {"x": 0, "y": 1, "z": 2}
 
 
-def zyx_angles(R: np.ndarray) -> np.ndarray:
-    """``(roll, pitch, yaw)`` with ``R = Rz(yaw) Ry(pitch) Rx(roll)``."""
+def zyx_angles(R: ArrayLike) -> np.ndarray:
+    r"""``(roll, pitch, yaw)`` [rad] with :math:`R = R_z(\psi)\, R_y(\theta)\, R_x(\phi)` (roll :math:`\phi`,
+    pitch :math:`\theta`, yaw :math:`\psi`; the pitch in :math:`[-\pi/2, \pi/2]`): the inverse of :func:`zyx_matrix`.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> np.round(pkm.zyx_angles(pkm.zyx_matrix(0.1, 0.2, 0.3)), 12)
+        array([0.1, 0.2, 0.3])
+    """
+    R = np.asarray(R, dtype=float)
     pitch = np.arctan2(-R[2, 0], np.hypot(R[0, 0], R[1, 0]))
     return np.array([np.arctan2(R[2, 1], R[2, 2]), pitch, np.arctan2(R[1, 0], R[0, 0])])
 
 
 def zyx_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    r"""The rotation (3 x 3) :math:`R = R_z(\psi)\, R_y(\theta)\, R_x(\phi)` of the Z-Y-X Euler angles roll
+    :math:`\phi`, pitch :math:`\theta` and yaw :math:`\psi` [rad] (rotations about the fixed x, y and z axes, in that
+    order): the convention of a pose task's ``roll pitch yaw`` (:func:`pkm.task_values`).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> R = pkm.zyx_matrix(0.1, 0.2, 0.3)
+        >>> np.round(R, 3)
+        array([[ 0.936, -0.275,  0.218],
+               [ 0.29 ,  0.956, -0.037],
+               [-0.199,  0.098,  0.975]])
+        >>> np.allclose(R.T @ R, np.eye(3))
+        True
+    """
     cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
     return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
                      [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],

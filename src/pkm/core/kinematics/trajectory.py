@@ -193,6 +193,18 @@ def follow_task(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None = None, ydd:
 
     Raises:
         InvalidInputError: samples of the wrong shape or not finite.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> y = np.array([[x, 0.0, -0.36] for x in np.linspace(0.0, 0.05, 6)])
+        >>> yd = np.tile([0.05, 0.0, 0.0], (6, 1))
+        >>> traj = pkm.follow_task(delta, y, yd)
+        >>> traj.actuated.shape, traj.efforts.shape
+        ((6, 3), (6, 3))
+        >>> np.round(traj.efforts[-1], 4)
+        array([0.1647, 0.1005, 0.2231])
     """
     mech = check_mechanism(mech)
     task = mech.task_map
@@ -226,6 +238,17 @@ def follow_actuators(mech: Mechanism, qa: ArrayLike, qd: ArrayLike | None = None
 
     Raises:
         InvalidInputError: samples of the wrong shape or not finite.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> qa = np.linspace([-0.9, -0.9, -0.9], [-0.8, -0.9, -1.0], 5)
+        >>> traj = pkm.follow_actuators(delta, qa)
+        >>> np.round(traj.task[-1], 4)
+        array([-0.0118,  0.02  , -0.3691])
+        >>> bool(traj.residual.max() < 1e-10)
+        True
     """
     mech = check_mechanism(mech)
     A = _samples(qa, None, mech.na, "qa")
@@ -246,7 +269,17 @@ def follow_actuators(mech: Mechanism, qa: ArrayLike, qd: ArrayLike | None = None
 
 
 def task_values(mech: Mechanism, q: ArrayLike) -> dict[str, float]:
-    """The task coordinates at ``q`` by name (a pose as x y z and Z-Y-X Euler roll pitch yaw) [m, rad]."""
+    """The task coordinates at ``q`` by name (a pose as x y z and Z-Y-X Euler roll pitch yaw) [m, rad].
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> pkm.task_values(delta, delta.q_reference)
+        {'x': 0.0, 'y': 0.0, 'z': -0.254375}
+        >>> hexapod = pkm.load("hexapod")
+        >>> list(pkm.task_values(hexapod, hexapod.q_reference))
+        ['x', 'y', 'z', 'roll', 'pitch', 'yaw', 'beta_1']
+    """
     mech = check_mechanism(mech)
     return mech.task_map.named(mech.check_q(q))
 

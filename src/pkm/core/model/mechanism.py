@@ -85,6 +85,16 @@ class Mechanism:
             exactly d(p_A - p_B)/dq. Frame closures are ``CONTACT_6D`` in ``LOCAL`` (frame A):
             their Jacobian maps v to the twist of B relative to A, expressed in A, with a sign
             such that it is the derivative of ``-log6(A^-1 B)`` at closure.
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> delta.na, delta.nq, delta.nv, delta.actuated_names
+        (3, 12, 12, ('motor_1', 'motor_2', 'motor_3'))
+        >>> delta.task_map.keys
+        ('x', 'y', 'z')
+        >>> {k: round(v, 4) for k, v in delta.q_to_dict(delta.q_reference).items() if k.startswith("motor")}
+        {'motor_1': 0.0017, 'motor_2': 0.0017, 'motor_3': 0.0017}
     """
 
     def __init__(self, model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | None = None,

@@ -166,7 +166,19 @@ def scale_urdf(urdf: str, factor: float) -> str:
 def scale_configuration(mech: Mechanism, q: ArrayLike, factor: float) -> np.ndarray:
     """The configuration ``q`` of ``mech`` on its copy scaled by ``factor``
     (:func:`~pkm.core.model.builder.scaled_mechanism`): prismatic joints' values and a floating base's position times
-    ``factor``, angles unchanged (nq,)."""
+    ``factor``, angles unchanged (nq,).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> prs3 = pkm.load("prs3")
+        >>> big = pkm.scaled_mechanism(prs3, 10.0)
+        >>> q = pkm.scale_configuration(prs3, prs3.q_reference, 10.0)
+        >>> np.allclose(q, big.q_reference)
+        True
+        >>> np.round(prs3.actuated_q(prs3.q_reference), 4), np.round(big.actuated_q(q), 4)
+        (array([0.134, 0.134, 0.134]), array([1.3397, 1.3397, 1.3397]))
+    """
     q = mech.check_q(q)
     s = as_scalar(factor, "factor", low=0.0, strict_low=True)
     out = q.copy()

@@ -171,6 +171,15 @@ def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "aut
         MissingDependencyError: bertini2 is not installed.
         ConvergenceError: a real solution whose legs the core cannot close (a defect: the reduction and the tree
             disagree).
+
+    Examples:
+        >>> import pkm
+        >>> rrr3 = pkm.load("rrr3")
+        >>> modes = pkm.assembly_modes(rrr3, rrr3.actuated_q(rrr3.q_reference))
+        >>> len(modes.modes), modes.complete, modes.n_paths
+        (2, True, 16)
+        >>> [m.certificate.certified for m in modes.modes]
+        [True, True]
     """
     mech = check_mechanism(mech)
     qa = mech.check_actuated(q_actuated, positions=True)

@@ -101,7 +101,19 @@ def _track(mech: Mechanism, mode: Mode, traj: Trajectory, reasons: set[str],
 
 def track_assembly_mode(mech: Mechanism, mode: Mode, q_actuated: ArrayLike) -> ModeTrack:
     """The assembly mode ``mode`` (of :func:`pkm.assembly_modes` at the first sample) along actuator samples
-    ``q_actuated`` (N x na) [rad or m]."""
+    ``q_actuated`` (N x na) [rad or m].
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> rrr3 = pkm.load("rrr3")
+        >>> qa0 = rrr3.actuated_q(rrr3.q_reference)
+        >>> modes = pkm.assembly_modes(rrr3, qa0)
+        >>> path = qa0 + np.linspace(0.0, 0.2, 5)[:, None] * [1.0, -1.0, 0.5]
+        >>> track = pkm.track_assembly_mode(rrr3, modes.modes[0], path)
+        >>> track.reached, track.q.shape, track.meeting
+        (5, (5, 7), None)
+    """
     mech = check_mechanism(mech)
     traj = follow_actuators(mech, q_actuated, q0=mode.q, efforts=False)
     A = np.asarray(q_actuated, dtype=float).reshape(len(traj.q), -1)  # the samples asked for (checked by the core)
@@ -115,7 +127,18 @@ def track_assembly_mode(mech: Mechanism, mode: Mode, q_actuated: ArrayLike) -> M
 
 def track_working_mode(mech: Mechanism, mode: Mode, task: ArrayLike) -> ModeTrack:
     """The working mode ``mode`` (of :func:`pkm.working_modes` at the first sample) along task samples ``task``
-    (N x the task's value size, as :meth:`pkm.core.TaskMap.value`)."""
+    (N x the task's value size, as :meth:`pkm.core.TaskMap.value`).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> modes = pkm.working_modes(delta, [0.0, 0.0, -0.36])
+        >>> ys = np.array([[x, 0.0, -0.36] for x in np.linspace(0.0, 0.05, 4)])
+        >>> track = pkm.track_working_mode(delta, modes.modes[0], ys)
+        >>> track.reached, track.q.shape, track.meeting
+        (4, (4, 12), None)
+    """
     mech = check_mechanism(mech)
     traj = follow_task(mech, task, q0=mode.q, efforts=False)
     Y = np.asarray(task, dtype=float).reshape(len(traj.q), -1)

@@ -77,6 +77,15 @@ def working_modes(mech: Mechanism, task: ArrayLike | Mapping[str, Any], *, preci
     Raises:
         UnreachableError: the task is out of reach, or a leg has no real solution (which leg).
         StructureError: the structure is outside the reduction and the generic route.
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> modes = pkm.working_modes(delta, [0.02, 0.0, -0.36])
+        >>> len(modes.modes), modes.complete
+        (8, True)
+        >>> sorted({pkm.mode_label(delta, m.q).working for m in modes.modes})[:3]
+        [(1, -1, -1, -1), (1, -1, -1, 1), (1, -1, 1, -1)]
     """
     mech = check_mechanism(mech)
     try:

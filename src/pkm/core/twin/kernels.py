@@ -295,6 +295,15 @@ class Kernels:
     Raises:
         SpecError: ``mech`` has idle motions (on the first kernel that needs the passive solve, but the model's).
         UnknownNameError: a design parameter ``mech`` does not have (the error lists those it has).
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> K = pkm.Kernels(delta)
+        >>> q = pkm.solve_ik(delta, [0.02, 0.0, -0.36]).q
+        >>> np.allclose(K.forward_jacobian(q), pkm.forward_jacobian(delta, q))
+        True
     """
 
     def __init__(self, mech: Mechanism, *, design: Sequence[str] | None = None, compiled: bool = True,
