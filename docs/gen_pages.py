@@ -5,7 +5,6 @@
   section's navigation. A package page renders the package's docstring and its own definitions, then a table of
   the names it re-exports, each linked to the page of the module that defines it (where it is documented once).
   The package ``pkm`` re-exports every name of ``pkm.__all__``: ``tests/test_docs.py`` checks the table covers it.
-* ``tour/``: the README's tour, cut at its headings (so that the site and the README never disagree).
 * ``gallery.md``: the report's figures when ``make demo`` has made them (``out/figures/<paper>/*.png``, copied into
   the site), otherwise a page saying how to make them. The build never runs the report.
 
@@ -23,19 +22,6 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 SRC = ROOT / "src"
-
-#: The README's sections that make the tour, in order: (heading in README.md, page path, page title).
-TOUR = (
-    ("Looking at a mechanism", "tour/looking.md", "Looking at a mechanism"),
-    ("Tour", "tour/index.md", "Tour"),
-    ("Dynamics", "tour/dynamics.md", "Dynamics"),
-    ("The model", "tour/model.md", "The model and your own mechanism"),
-    ("Design sweeps", "tour/sweeps.md", "Design sweeps"),
-    ("The papers", "tour/papers.md", "The papers"),
-    ("The command line", "tour/cli.md", "The command line"),
-    ("Adding a mechanism (contributors)", "tour/adding.md", "Adding a mechanism"),
-)
-
 
 # ---------------------------------------------------------------------------------------------------- API pages
 
@@ -94,10 +80,27 @@ def reexports(module: str, griffe_module) -> dict[str, str]:
     return out
 
 
+def _defined_in(name: str, target: str, is_module: bool) -> str:
+    """The re-exports table's "defined in" cell: the defining module (``pkm.core.kinematics.solve`` for ``solve_ik``),
+    the full path where the object has another name there or is itself a module. (The name links to the object; the
+    cell stays short so that the table leaves its summary room.)"""
+    module, _, leaf = target.rpartition(".")
+    return target if is_module or leaf != name or not module else module
+
+
+def _role_text(role: str, target: str) -> str:
+    """A reST role in a table cell: ``:math:`x``` as maths, ``:class:`~pkm.a.B``` as code ``B`` (the last name, as
+    Sphinx shows it), ``:func:`pkm.a.b``` as code of its whole target."""
+    if role.startswith(":math:"):
+        return f"\\({target}\\)"
+    return f"`{target.rpartition('.')[2] if '`~' in role else target}`"
+
+
 def _summary(obj) -> str:
     doc = obj.docstring.value if obj.docstring else ""
     first = doc.strip().split("\n\n")[0].replace("\n", " ").strip()
-    first = re.sub(r":[a-z]+:`([^`]*)`", r"\1", first)  # (a table cell: the role's target as text)
+    # (no ``~pkm.a.b.C`` path left whole: a word that long keeps the summary column from narrowing)
+    first = re.sub(r":[a-z]+:`~?([^`]*)`", lambda m: _role_text(m.group(0), m.group(1)), first)
     return first.replace("|", r"\|")
 
 
@@ -121,55 +124,13 @@ def api_pages() -> dict[str, str]:
         text += f"      members: {own!r}\n" if own else "      members: false\n"
         exported = reexports(module, gmod)
         if exported:
-            text += (f"\n## Names re-exported by `{module}`\n\nEach is documented in the module that defines it.\n\n"
-                     "| name | defined as | summary |\n|---|---|---|\n")
+            text += (f"\n## Names re-exported by `{module}`\n\nEach is documented in the module that defines it "
+                     "(the name links there).\n\n| name | defined in | summary |\n|---|---|---|\n")
             for name, target in exported.items():
                 obj = pkg[target.removeprefix("pkm.")] if target != "pkm" else pkg
-                text += f"| `{name}` | [`{target}`][{target}] | {_summary(obj)} |\n"
+                text += f"| [`{name}`][{target}] | `{_defined_in(name, target, obj.is_module)}` | {_summary(obj)} |\n"
         pages[path] = text
     pages["reference/SUMMARY.md"] = "\n".join(nav) + "\n"
-    return pages
-
-
-# --------------------------------------------------------------------------------------------------------- tour
-
-
-def readme_sections() -> dict[str, str]:
-    """The README's sections by heading (``##`` and ``###``), each its text up to the next heading."""
-    text = ROOT.joinpath("README.md").read_text(encoding="utf-8")
-    sections: dict[str, str] = {}
-    current, lines, fence = None, [], False
-    for line in text.splitlines():
-        if line.startswith("```"):
-            fence = not fence
-        m = None if fence else re.match(r"^(##|###) (.+)$", line)
-        if m:
-            if current is not None:
-                sections[current] = "\n".join(lines).strip() + "\n"
-            current, lines = m.group(2).strip(), []
-        else:
-            lines.append(line)
-    if current is not None:
-        sections[current] = "\n".join(lines).strip() + "\n"
-    return sections
-
-
-def _plain_relative_links(markdown: str) -> str:
-    """A README link to a file of the checkout (not part of the site) as its text; web links stay."""
-    return re.sub(r"\[([^\]]+)\]\((?!https?://|#)[^)]+\)", r"\1", markdown)
-
-
-def tour_pages() -> dict[str, str]:
-    """``{path: markdown}`` of the tour, cut from README.md at the headings of :data:`TOUR`."""
-    sections = readme_sections()
-    pages = {}
-    for heading, path, title in TOUR:
-        body = sections.get(heading)
-        if body is None:  # (the README changed its headings: say so on the page rather than break the build)
-            body = f"*This page is cut from the README's section \"{heading}\", which the README no longer has.*\n"
-        pages[path] = f"# {title}\n\n*From the README.*\n\n{_plain_relative_links(body)}"
-    pages["tour/SUMMARY.md"] = "".join(f"* [{title}]({path.removeprefix('tour/')})\n" for _, path, title in
-                                       [TOUR[1], TOUR[0], *TOUR[2:]])
     return pages
 
 
@@ -211,7 +172,7 @@ def write() -> None:
     import mkdocs_gen_files
 
     gallery, images = gallery_pages()
-    for path, text in {**api_pages(), **tour_pages(), **gallery}.items():
+    for path, text in {**api_pages(), **gallery}.items():
         with mkdocs_gen_files.open(path, "w") as f:
             f.write(text)
     for path, source in images.items():

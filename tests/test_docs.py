@@ -11,11 +11,13 @@ from __future__ import annotations
 import ast
 import importlib.util
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+import yaml
 
 import pkm
 
@@ -28,6 +30,18 @@ def _gen_pages():
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+class _ConfigLoader(yaml.SafeLoader):
+    """mkdocs.yml's YAML: MkDocs' own tags (``!ENV``, ``!!python/name:``) read as None."""
+
+
+_ConfigLoader.add_multi_constructor("!", lambda loader, suffix, node: None)
+_ConfigLoader.add_multi_constructor("tag:yaml.org,2002:python/", lambda loader, suffix, node: None)
+
+
+def _mkdocs_config() -> dict:
+    return yaml.load((ROOT / "mkdocs.yml").read_text(encoding="utf-8"), Loader=_ConfigLoader)
 
 
 def _source(module: str) -> Path | None:
@@ -107,10 +121,35 @@ def test_the_pkm_page_lists_every_public_name():
         module, obj = resolve("pkm", name)
         target = module if obj is None else f"{module}.{obj}"
         own = f"'{name}'" in text.split("members:")[1].split("\n")[0]
-        assert own or f"| `{name}` | [`{target}`][{target}] |" in text, f"pkm.{name} is not listed on pkm's page"
+        assert own or f"| [`{name}`][{target}] |" in text, f"pkm.{name} is not listed on pkm's page"
     summary = pages["reference/SUMMARY.md"]
     for module in gen.public_modules():
         assert f"[{module}](" in summary
+
+
+def test_the_reexports_table_keeps_names_whole():
+    """The re-exports table: each name linked to its definition, its module in the "defined in" cell (not the full
+    path again), the summaries' roles as Sphinx shows them (``:class:`~pkm.a.B``` as ``B``), and inline code in tables
+    that breaks at no letter (Material's ``word-break: break-word`` let the
+    table squeeze its name columns to a few characters: ``task_accel|eration``)."""
+    pytest.importorskip("griffe")
+    text = _gen_pages().api_pages()["reference/pkm/index.md"]
+    assert "| [`solve_ik`][pkm.core.kinematics.solve.solve_ik] | `pkm.core.kinematics.solve` |" in text
+    assert "| [`errors`][pkm.errors] | `pkm.errors` |" in text  # (a module: its own path)
+    assert "~pkm." not in text and "(an `Estimate` or a `ConsistentEstimate`)" in text  # (roles as Sphinx shows them)
+    config = _mkdocs_config()
+    assert "stylesheets/pkm.css" in config["extra_css"]
+    css = (ROOT / "docs" / "stylesheets" / "pkm.css").read_text(encoding="utf-8")
+    assert re.search(r"table:not\(\[class\]\) code \{\s*word-break: normal;", css)
+
+
+def test_the_tour_is_in_the_nav():
+    """Every page of ``docs/tour/`` is in ``mkdocs.yml``'s nav, and every page the nav names exists."""
+    nav = _mkdocs_config()["nav"]
+    tour = next(entry["Tour"] for entry in nav if "Tour" in entry)
+    listed = {item if isinstance(item, str) else next(iter(item.values())) for item in tour}
+    files = {f"tour/{p.name}" for p in (ROOT / "docs" / "tour").glob("*.md")}
+    assert listed == files and "tour/index.md" in files
 
 
 def test_gallery_without_figures_says_how_to_make_them(tmp_path):

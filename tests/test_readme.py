@@ -1,9 +1,11 @@
-"""Every Python block and every shell command line of the README runs, exactly as printed.
+"""Every Python block and every shell command line of the README and of the tour (``docs/tour/*.md``) runs, exactly
+as printed.
 
 Python blocks run one by one in a fresh interpreter, in a scratch directory. Shell lines run in
 bash, ``make`` lines in the checkout and ``pkm`` lines in the scratch directory, with the
 installed ``pkm`` first on ``PATH``. A line whose comment says ``Ctrl-C`` starts something that
 runs until stopped (the live viewer): it must print, then stop cleanly on Ctrl-C (SIGINT).
+A block or command printed on several pages (the README's command lines are the tour's too) runs once.
 One line is not run: ``make test``, the command that runs this test (CI runs it).
 """
 
@@ -14,6 +16,7 @@ import re
 import signal
 import subprocess
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -21,12 +24,42 @@ import pytest
 from tests.cli.helpers import default_sigint
 
 ROOT = Path(__file__).resolve().parents[1]
-README = (ROOT / "README.md").read_text(encoding="utf-8")
-BLOCKS = re.findall(r"^```(\w*)\n(.*?)^```", README, flags=re.S | re.M)
-PYTHON = [code for lang, code in BLOCKS if lang == "python"]
-SHELL = [line for lang, code in BLOCKS if lang in ("sh", "bash", "console") for line in code.splitlines()
-         if line.split("#")[0].strip()]
+#: The pages whose blocks run: the README, then the tour of the documentation site.
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs" / "tour").glob("*.md"))]
+FENCE = re.compile(r"^```(\w*)\n(.*?)^```", flags=re.S | re.M)
 SELF = "make test"
+#: The README's size limit [bytes] (issue 42: what pkm is, the two commands, one example, links; the tour in docs/).
+README_MAX_BYTES = 12 * 1024
+
+
+def _collect() -> tuple[dict[str, str], dict[str, tuple[str, str]]]:
+    """``{code: page}`` of the Python blocks and ``{command: (page, line)}`` of the shell lines, each the first time
+    it is printed, in page order."""
+    python: dict[str, str] = {}
+    shell: dict[str, tuple[str, str]] = {}
+    for page in PAGES:
+        where = page.relative_to(ROOT).as_posix()
+        for lang, code in FENCE.findall(page.read_text(encoding="utf-8")):
+            if lang == "python":
+                python.setdefault(code, where)
+            elif lang in ("sh", "bash", "console"):
+                for line in code.splitlines():
+                    if line.split("#")[0].strip():
+                        shell.setdefault(line.split("#")[0].strip(), (where, line))
+    return python, shell
+
+
+_PYTHON, _SHELL = _collect()
+PYTHON = list(_PYTHON)
+SHELL = [line for _, line in _SHELL.values()]
+
+
+def _python_ids() -> Iterator[str]:
+    """``README.md:python1``, ``docs/tour/dynamics.md:python2``: each block by its page and its rank there."""
+    seen: dict[str, int] = {}
+    for where in _PYTHON.values():
+        seen[where] = seen.get(where, 0) + 1
+        yield f"{where}:python{seen[where]}"
 
 
 def _env() -> dict[str, str]:
@@ -35,15 +68,30 @@ def _env() -> dict[str, str]:
     return env
 
 
-def test_the_readme_has_python_blocks_and_shell_lines():
-    assert len(PYTHON) >= 3 and len(SHELL) >= 8 and SELF in [ln.split("#")[0].strip() for ln in SHELL]
+def test_the_pages_have_python_blocks_and_shell_lines():
+    """The README shows one example and the two commands; the tour the rest (10 Python blocks and 21 commands when
+    the tour moved out of the README: none lost)."""
+    readme = [where for where in _PYTHON.values() if where == "README.md"]
+    readme_commands = {cmd for cmd, (where, _) in _SHELL.items() if where == "README.md"}
+    assert len(readme) == 1 and {"make demo", SELF} <= readme_commands
+    assert len(PYTHON) >= 10 and len(SHELL) >= 21
 
 
-@pytest.mark.parametrize("code", PYTHON, ids=[f"python{k + 1}" for k in range(len(PYTHON))])
+def test_the_readme_is_short_and_its_links_resolve():
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    size = len(text.encode("utf-8"))
+    assert size <= README_MAX_BYTES, f"README.md is {size} bytes, over {README_MAX_BYTES}: the tour lives in docs/tour/"
+    targets = re.findall(r"\]\((?!https?://|#)([^)#]+)", text)
+    assert targets, "the README links to the documentation"
+    missing = [t for t in targets if not (ROOT / t).exists()]
+    assert not missing, f"README links to files that are not in the checkout: {missing}"
+
+
+@pytest.mark.parametrize("code", PYTHON, ids=list(_python_ids()))
 def test_python_block_runs(code, tmp_path):
     proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=_env(), capture_output=True, text=True,
                           timeout=300)
-    assert proc.returncode == 0, f"README block failed:\n{code}\n--- stderr:\n{proc.stderr[-3000:]}"
+    assert proc.returncode == 0, f"block failed ({_PYTHON[code]}):\n{code}\n--- stderr:\n{proc.stderr[-3000:]}"
 
 
 @pytest.mark.parametrize("line", SHELL, ids=[ln.split("#")[0].strip()[:60] for ln in SHELL])
@@ -65,4 +113,4 @@ def test_shell_line_runs(line, tmp_path):
         return
     proc = subprocess.run(["bash", "-c", command], cwd=cwd, env=_env(), capture_output=True, text=True,
                           timeout=600)
-    assert proc.returncode == 0, f"{command!r} exited {proc.returncode}:\n{proc.stderr[-3000:]}"
+    assert proc.returncode == 0, f"{command!r} ({_SHELL[command][0]}) exited {proc.returncode}:\n{proc.stderr[-3000:]}"
