@@ -14,8 +14,8 @@ Optional capabilities are fields of the entry that may be None: its paper study 
 them here and names no mechanism).
 
 Adding a mechanism: one package implementing the protocol, and one :data:`REGISTRY` entry (or
-:func:`register` at run time, as the tests do for their toy five-bar). See the README's
-contributor section.
+:func:`register` at run time, as the tests do for their toy five-bar). See the docs' contributing page
+(docs/tour/contributing.md).
 """
 
 from __future__ import annotations

@@ -183,7 +183,7 @@ def local_cluster(workers: int | None = None):
     statistical profiler is off (it samples the running thread every 10 ms: 25 % slower). Its scheduler gives a
     worker one chunk at a time (``worker-saturation`` 1.0, dask's default 1.1 queues two on a single thread): a
     design that kills its worker then takes no other chunk's retries with it. The workers of an existing cluster
-    keep their own configuration (the README says how to set the same).
+    keep their own configuration (docs/tour/sweeps.md, "On a cluster", says how to set the same).
 
     Raises:
         SweepError: the workers could not start.
