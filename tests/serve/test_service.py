@@ -35,7 +35,7 @@ def test_health_is_open_and_everything_else_needs_the_token(service):
         assert r.status_code == 401 and r.json()["error"] == "Unauthorized"
     assert httpx.get(service.url + "/models", headers={"authorization": "Bearer wrong"}).status_code == 401
     schema = httpx.get(service.url + "/openapi.json", headers=AUTH).json()
-    assert {"/models", "/models/{model}/{query}", "/models/{model}/preview"} <= set(schema["paths"])
+    assert {"/models", "/models/{model}/fk", "/models/{model}/preview"} <= set(schema["paths"])
 
 
 def test_the_queries_answer_what_the_library_does(client, delta):
@@ -74,12 +74,25 @@ def test_the_queries_answer_what_the_library_does(client, delta):
     assert np.abs(np.array(raw["q"]) - fk["q"]).max() == 0.0
 
 
-def test_a_failing_sample_does_not_fail_the_batch(client, delta):
+def test_a_failing_sample_does_not_fail_the_batch_but_fails_alone(client, service, delta):
+    """A batch keeps its shape: null (None) for the failed sample's values, its status and error; the same sample
+    given alone is a 422 with pkm's error JSON (never a 200 with a failure inside)."""
+    from pkm.client import ServiceError
+
     y = [[0.0, 0.0, -0.35], [0.0, 0.0, -3.0]]  # (the second 3 m down: out of reach)
     out = client.ik("delta", y)
     assert out["status"] == ["ok", "failed"] and [f["sample"] for f in out["failures"]] == [1]
     assert out["failures"][0]["error"] in ("ConvergenceError", "UnreachableError")
-    assert np.isnan(out["q"][1]).all() and np.isfinite(out["q"][0]).all()
+    assert out["q"][1] is None and out["iterations"][1] is None and np.isfinite(out["q"][0]).all()
+    assert isinstance(out["iterations"][0], int)
+    raw = httpx.post(service.url + "/models/delta/ik", json={"y": y}, headers=AUTH)
+    assert raw.status_code == 200 and raw.json()["q"][1] is None and "nan" not in raw.text.lower()
+    with pytest.raises(ServiceError) as e:
+        client.ik("delta", y[1])
+    assert e.value.status == 422 and e.value.kind == out["failures"][0]["error"] and e.value.data["leg"] >= 1
+    with pytest.raises(ServiceError) as e:  # (a configuration asked by qa whose loops do not close: that sample's)
+        client.dynamics("prs3", qa=[0.6, -0.4, 0.6], qdd=[1.0, 0.0, 0.0])
+    assert e.value.status == 422
 
 
 def test_uploads_are_content_addressed_kept_and_deleted(client, service, tmp_path):
@@ -156,13 +169,20 @@ def test_bad_uploads_are_refused(service, files, status, says, tmp_path):
     ("/models/delta/teleport", b"{}", {}, 404),
     ("/models/nope/fk", json.dumps({"qa": [1, 2, 3]}).encode(), {}, 404),
     ("/models/delta/capability", json.dumps({"q": [0.0] * 15, "kind": "power"}).encode(), {}, 422),
+    ("/models/delta/fk", json.dumps({"qa": [1, 2, 3], "foo": 1}).encode(), {}, 422),
+    ("/models/delta/dynamics", json.dumps({"qa": [1, 2, 3], "q": [0.0] * 12}).encode(), {}, 422),
+    ("/models/delta/dynamics", json.dumps({"qd": [1, 2, 3]}).encode(), {}, 422),
+    ("/models/delta/fk", json.dumps({"qa": ["10deg", "1mm", 0.0]}).encode(), {}, 422),
+    ("/models/delta/ik", json.dumps({"y": [0, 0, -0.35], "branch": 3}).encode(), {}, 422),
+    ("/models/delta/jobs/map", json.dumps({"axes": {"x": [0, 1, 3]}, "what": 1}).encode(), {}, 422),
+    ("/models/delta/variants", json.dumps({"params": {"R": 0.16}, "x": 1}).encode(), {}, 422),
     ("/models/delta/fk", b"x" * (2**20 + 10), {}, 413),
 ])
 def test_bad_requests_are_4xx_with_their_message(service, path, body, headers, status):
     r = httpx.post(service.url + path, content=body, headers={**AUTH, **headers})
     assert r.status_code == status, r.text
     answer = r.json()
-    assert answer["message"] and "Traceback" not in r.text
+    assert answer["message"] and set(answer) == {"error", "message", "data"} and "Traceback" not in r.text
     assert httpx.get(service.url + "/health").status_code == 200  # (still answering)
 
 
