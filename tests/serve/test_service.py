@@ -307,18 +307,44 @@ def test_a_registered_mechanism_with_other_parameters(client, service):
 
 def test_a_sweep_job_is_pkm_sweep(client):
     """A design sweep as a job (serial here: CI's two cores; a local Dask cluster by default) equals
-    :func:`pkm.sweep` of the same grid, and its rows come as Parquet too."""
+    :func:`pkm.sweep` of the same grid, and its rows come as Parquet too; its JSON answer matches its schema."""
     import io
 
     import pyarrow.parquet as pq
 
     from pkm import sweeps
+    from tests.serve.test_schemas import Checker
 
     job = client.job("delta", "sweep", grid={"R": "10cm:20cm:3"}, objectives=["condition"], scheduler="serial")
     result = client.result(job["id"])
+    answer = httpx.get(f"{client.url}/jobs/{job['id']}/result", headers=AUTH)
+    Checker(httpx.get(client.url + "/openapi.json", headers=AUTH).json())("job_result", answer)  # (its schema)
     direct = sweeps.sweep("delta", sweeps.grid(R="10cm:20cm:3"), ["condition"], scheduler="serial", progress=False)
     assert result["designs"] == 3 and result["failed"] == 0
     assert np.allclose(result["rows"]["condition"], direct.table.column("condition").to_pylist(), rtol=1e-12)
     table = pq.read_table(io.BytesIO(httpx.get(f"{client.url}/jobs/{job['id']}/result", params={"format": "parquet"},
                                                headers=AUTH).content))
     assert table.num_rows == 3 and "condition" in table.column_names
+
+
+def test_the_compiled_batches_answer_as_the_python_route(client, delta):
+    """A batch's FK, Jacobians and dynamics run on the compiled kernels in the service: the same answers as the
+    Python route (queries called without kernels) to 1e-10, iterations integers both ways; a batch with a sample the
+    loops cannot close (the 3-PRS's sliders 1 m apart) gives the same statuses and nulls both ways."""
+    from pkm.serve import queries
+
+    qa = _path(delta, 4)
+    for name, body in (("fk", {"qa": qa}), ("jacobians", {"qa": qa}),
+                       ("dynamics", {"qa": qa, "qd": [0.1, 0.0, 0.0], "qdd": [1.0, 0.0, 0.0]})):
+        served, local = client.query("delta", name, **body), queries.QUERIES[name](delta, body, None)
+        assert served["status"] == local["status"] == ["ok"] * 4
+        for key in set(local) - {"status", "units"}:
+            assert np.abs(np.asarray(served[key], dtype=float) - local[key]).max() <= 1e-10, (name, key)
+    assert served["units"] == local["units"] and served["units"]["M"][0][0] == "N m/(rad/s^2)"
+    assert client.fk("delta", qa)["iterations"].dtype.kind == "i"
+    prs3 = pkm.load("prs3")
+    qa = [prs3.actuated_q(prs3.q_reference).tolist(), [0.6, -0.4, 0.6]] * 2
+    served, local = client.fk("prs3", qa), queries.fk(prs3, {"qa": qa})
+    assert served["status"] == local["status"] == ["ok", "failed"] * 2 and served["q"][1] is local["q"][1] is None
+    assert [f["error"] for f in served["failures"]] == [f["error"] for f in local["failures"]] == ["ConvergenceError"] * 2
+    assert np.abs(served["q"][2] - local["q"][2]).max() <= 1e-12 and isinstance(served["iterations"][0], int)

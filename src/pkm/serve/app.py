@@ -4,23 +4,31 @@ Why FastAPI: it is Starlette (the ASGI toolkit: routing, WebSockets, multipart) 
 (``/openapi.json``) and its browsable docs (``/docs``) generated from the routes, which the issue asks for; uvicorn
 is its maintained server (graceful shutdown on SIGTERM: in-flight requests finish, new ones are refused).
 
-Endpoints (see ``/docs``): ``GET /health``; ``GET /models``; ``POST /models`` (an upload: multipart files);
-``GET /models/{model}`` (sizes, names, units); ``GET /models/{model}/files``; ``DELETE /models/{model}``; ``GET /models/{model}/parameters`` and
-``POST /models/{model}/variants`` (a registered mechanism with other design parameters);
-``GET /models/{model}/preview`` (the self-contained 3-D page); ``GET /`` (the design page,
-:mod:`pkm.serve.page`); ``POST /models/{model}/{query}`` for every query of
-:data:`pkm.serve.queries.QUERIES` (one sample or a batch); jobs (every assembly or working mode, a workspace map:
-:mod:`pkm.serve.jobs`) at ``POST /models/{model}/jobs/{kind}``, ``GET /jobs/{id}`` and its ``/result``,
-``DELETE /jobs/{id}``; ``WS /models/{model}/stream`` (actuator samples in, the
-forward kinematics, task rates and efforts out, warm-started along the stream).
+The schema is a contract (:mod:`pkm.serve.schemas`): every operation has an ``operationId``, a request model and an
+answer model whose fields carry their units and an example, so that a client can be generated from it (CI does:
+``tools/generated_client.py``). Endpoints (see ``/docs``): ``GET /health``; ``GET /models``; ``POST /models`` (an
+upload: multipart files); ``GET /models/{model}`` (sizes, names, units); ``GET /models/{model}/files``;
+``DELETE /models/{model}``; ``GET /models/{model}/parameters`` and ``POST /models/{model}/variants`` (a registered
+mechanism with other design parameters); ``GET /models/{model}/preview`` (the self-contained 3-D page); ``GET /``
+(the design page, :mod:`pkm.serve.page`); one operation per query of :data:`pkm.serve.queries.QUERIES`:
+``POST /models/{model}/fk``, ``/ik``, ``/jacobians``, ``/diagnose``, ``/velocities``, ``/dynamics``, ``/capability``,
+``/scene`` (one sample or a batch; an unknown query is 404 listing them); one per job kind (every assembly or working
+mode, a workspace map, a design sweep: :mod:`pkm.serve.jobs`) at ``POST /models/{model}/jobs/{kind}``,
+``GET /jobs/{id}`` and its ``/result``, ``DELETE /jobs/{id}``; ``WS /models/{model}/stream`` (actuator samples in,
+the forward kinematics, task rates and efforts out, warm-started along the stream).
 
 Bodies are JSON, or msgpack (``Content-Type: application/msgpack``; numpy arrays as msgpack extension 1: dtype,
-shape and raw bytes, no text round trip); answers are JSON unless ``Accept`` asks for msgpack. Every answer of a
-query carries ``compute_s``, the server's time for it.
+shape and raw bytes, no text round trip), decoded by the routes themselves and then checked by their request model
+(unknown fields refused; arrays left to pkm's own parsing, so that large batches cost no pydantic walk); answers are
+JSON unless ``Accept`` asks for msgpack, a non-finite number ``null`` in JSON. Every answer of a query carries
+``compute_s``, the server's time for it.
 
-Reliability: pkm's errors are 4xx answers with their message and data (422; 404 for an unknown model or query),
-never a traceback; a body over ``max_body`` bytes is 413; a bearer token, when set, is required on everything but
-``/health`` (401); at most ``workers`` queries compute at once and ``queue`` wait, the next is 429; a query computing longer than ``compute_limit`` seconds is answered 503.
+Reliability: pkm's errors are 4xx answers with their ``error``, ``message`` and ``data`` (422; 404 for an unknown
+model, query or job), never a traceback: one sample that fails (unreachable, singular, not converged) is its
+error's 422, a batch answers 200 with each sample's status and ``null`` values for the failed ones; a body over
+``max_body`` bytes is 413; a bearer token, when set, is required on everything but ``/health`` (401); at most
+``workers`` queries compute at once and ``queue`` wait, the next is 429; a query computing longer than
+``compute_limit`` seconds is answered 503.
 """
 
 # (no ``from __future__ import annotations`` here: FastAPI reads the routes' annotations, whose types are imported
