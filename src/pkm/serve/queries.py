@@ -19,9 +19,10 @@ batch keeps its length; a query given ONE sample (not a list of samples) whose s
 
 from __future__ import annotations
 
+import functools
 import weakref
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -33,6 +34,22 @@ from pkm.validation import as_array
 #: Samples in one request at most.
 MAX_SAMPLES = 100_000
 
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def _per_mechanism(fn: _F) -> _F:
+    """``fn(mech, *args)`` computed once per mechanism and arguments (units and names: asked on every request)."""
+    cache: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+    @functools.wraps(fn)
+    def cached(mech: Mechanism, *args: Any) -> Any:
+        per = cache.setdefault(mech, {})
+        if args not in per:
+            per[args] = fn(mech, *args)
+        return per[args]
+
+    return cached  # type: ignore[return-value]
+
 
 def _unit(mech: Mechanism, joint: str, kind: str = "position") -> str:
     revolute = mech.joints[joint].revolute
@@ -40,6 +57,7 @@ def _unit(mech: Mechanism, joint: str, kind: str = "position") -> str:
             "acceleration": "rad/s^2" if revolute else "m/s^2", "effort": "N m" if revolute else "N"}[kind]
 
 
+@_per_mechanism
 def _task_units(mech: Mechanism) -> dict[str, str]:
     """The units of the task's tangent coordinates (:attr:`TaskMap.keys`: a pose's x y z roll pitch yaw)."""
     kinds = mech.task_map.kinds
@@ -47,6 +65,7 @@ def _task_units(mech: Mechanism) -> dict[str, str]:
     return out
 
 
+@_per_mechanism
 def _value_units(mech: Mechanism) -> list[str]:
     """The units of the task value's entries (:attr:`TaskMap.value_names`: a pose's x y z qx qy qz qw, whose
     quaternion is unitless, ``"1"``)."""
@@ -76,12 +95,14 @@ def _joint_units(mech: Mechanism, which: int) -> list[str]:
     return out
 
 
+@_per_mechanism
 def _q_units(mech: Mechanism) -> list[str]:
     """The unit of every coordinate of ``q``: ``rad`` (a revolute joint), ``m`` (a prismatic one, a free-flyer's
     position), ``1`` (a quaternion's entries, an unbounded revolute's cosine and sine)."""
     return [{"m": "m", "r": "rad"}.get(u, "1") for u in _joint_units(mech, 0)]
 
 
+@_per_mechanism
 def _v_units(mech: Mechanism, order: int = 1) -> list[str]:
     """The unit of every coordinate of the velocity ``v`` (``order`` 1) or acceleration (2)."""
     per = "/s" if order == 1 else "/s^2"
@@ -102,6 +123,13 @@ def _matrix_units(rows: Sequence[str], columns: Sequence[str]) -> list[list[str]
 
 def _rates(units: Sequence[str], per: str = "/s") -> list[str]:
     return [u + per for u in units]
+
+
+@_per_mechanism
+def _position_kinds(mech: Mechanism, what: str) -> list[str | None]:
+    """The :mod:`pkm.units` kinds of the entries of ``q``, ``qa`` or ``y`` (``what``)."""
+    units = {"q": _q_units, "qa": _actuated_units, "y": _value_units}[what](mech)
+    return _kinds(units)
 
 
 def _kinds(units: Sequence[str]) -> list[str | None]:
@@ -182,7 +210,7 @@ def _is_single(body: Mapping[str, Any], *keys: str) -> bool:
 
 def _seed(mech: Mechanism, body: Mapping[str, Any]) -> np.ndarray:
     """The configuration the first sample is solved from: ``seed`` (nq, one sample), default the reference."""
-    seed = _optional(body, "seed", mech.nq, _kinds(_q_units(mech)))
+    seed = _optional(body, "seed", mech.nq, _position_kinds(mech, "q"))
     if seed is not None and len(seed) != 1:
         raise InvalidInputError("seed", f"one configuration ({mech.nq} numbers), not {len(seed)}")
     return mech.q_reference if seed is None else seed[0]
@@ -292,13 +320,14 @@ def _configurations(mech: Mechanism, body: Mapping[str, Any], kernels: Any, *oth
                                          "closed from seed, default the reference)")
     single = _is_single(body, "q" if has_q else "qa", *others)
     if has_q:
-        q = _array(body, "q", mech.nq, _kinds(_q_units(mech)))
+        q = _array(body, "q", mech.nq, _position_kinds(mech, "q"))
         return q, _Samples(len(q), single)
-    qa = _array(body, "qa", mech.na, _kinds(_actuated_units(mech)))
+    qa = _array(body, "qa", mech.na, _position_kinds(mech, "qa"))
     q, _, _, errors = _close(mech, qa, _seed(mech, body), kernels)
     return q, _Samples(len(q), single, errors)
 
 
+@_per_mechanism
 def _actuated_units(mech: Mechanism, kind: str = "position") -> list[str]:
     return [_unit(mech, j, kind) for j in mech.actuated_names]
 
@@ -308,7 +337,7 @@ def fk(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[st
     ``residual`` [m, rad], the Newton ``iterations``. Samples are solved in order, each from the previous one's
     solution (the first from ``seed``, default the reference): a stream of actuator values stays on one assembly
     mode."""
-    qa = _array(body, "qa", mech.na, _kinds(_actuated_units(mech)))
+    qa = _array(body, "qa", mech.na, _position_kinds(mech, "qa"))
     Q, residual, iterations, errors = _close(mech, qa, _seed(mech, body), kernels)
     samples = _Samples(len(qa), _is_single(body, "qa"), errors)
     Y = [None if e is not None else mech.task_map.value(Q[k]) for k, e in enumerate(errors)]
@@ -324,7 +353,7 @@ def ik(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[st
     ``branch`` (a named branch of the spec) when given."""
     from pkm.core.kinematics.solve import solve_ik
 
-    y = _array(body, "y", mech.task_map.value_size, _kinds(_value_units(mech)))
+    y = _array(body, "y", mech.task_map.value_size, _position_kinds(mech, "y"))
     seed = _seed(mech, body)
     branch = body.get("branch")
     if branch is not None and not isinstance(branch, str):
@@ -342,6 +371,7 @@ def ik(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[st
     return out
 
 
+@_per_mechanism
 def _jacobian_units(mech: Mechanism) -> dict[str, Any]:
     task, act = list(_task_units(mech).values()), _actuated_units(mech)
     return {"J": _matrix_units(task, act), "K": _matrix_units(act, task), "q": _q_units(mech)}
