@@ -37,6 +37,8 @@ def test_positions_take_units_and_a_configuration_q_or_qa():
     assert np.abs(ik["q"] - queries.ik(mech, {"y": [0.0, 0.0, -0.35]})["q"]).max() <= 1e-12
     with pytest.raises(UnitError, match=r"qa\[1\]"):
         queries.fk(mech, {"qa": [0.0, "3mm", 0.0]})
+    with pytest.raises(InvalidInputError, match="positions"):  # (no unit suffix for a rate: said, not numpy's words)
+        queries.velocities(mech, {"qa": qa, "qd": ["1deg", 0.0, 0.0]})
     at_qa = queries.jacobians(mech, {"qa": [qa, qa + 0.01]})
     at_q = queries.jacobians(mech, {"q": queries.fk(mech, {"qa": [qa, qa + 0.01]})["q"]})
     assert np.abs(at_qa["J"] - at_q["J"]).max() <= 1e-12 and at_qa["units"]["J"][0][0] == "m/rad"

@@ -252,7 +252,8 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
     Model = Annotated[str, Path(description="The model's id: a registered mechanism (" + ", ".join(registered)
                                 + "), an upload's id or a variant's; GET /models lists them all.",
                                 examples=registered)]
-    errors = {status: {"model": schemas.ErrorAnswer, "description": what} for status, what in (
+    errors: dict[int | str, dict[str, Any]] = {
+        status: {"model": schemas.ErrorAnswer, "description": what} for status, what in (
         (404, "No such model (or job)"),
         (422, "Refused input (unknown field, wrong type or shape, bad unit), or one sample that failed: pkm's error"),
         (429, "Too many requests waiting"), (503, "The computation ran past the service's compute-time limit"))}
@@ -451,7 +452,7 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
             components["Upload"] = {"type": "object", "required": ["files"], "properties": {"files": {
                 "type": "array", "items": {"type": "string", "format": "binary"},
                 "description": "A model's files (URDF, MJCF, SDF, YAML, a closures TOML...) or one zip or tar of them"}}}
-        return app.openapi_schema
+        return app.openapi_schema or {}
 
     app.openapi = openapi  # type: ignore[method-assign]
     return app
@@ -490,9 +491,11 @@ def _plain(x: Any) -> Any:
     if isinstance(x, dict):
         return {k: _plain(v) for k, v in x.items()}
     if isinstance(x, np.ndarray):
-        if x.dtype.kind == "f" and not np.isfinite(x).all():
-            return np.where(np.isfinite(x), x, None).tolist()
-        return x.tolist() if x.dtype.kind in "biuf" else [_plain(v) for v in x]
+        if x.ndim == 0:
+            return _plain(x.item())
+        if x.dtype.kind in "biu" or (x.dtype.kind == "f" and np.isfinite(x).all()):
+            return x.tolist()
+        return [_plain(v) for v in x]
     if isinstance(x, (list, tuple)):
         return [_plain(v) for v in x]
     if isinstance(x, np.generic):

@@ -181,7 +181,13 @@ def _array(body: Mapping[str, Any], key: str, size: int, kinds: Sequence[str | N
     raw = body[key]
     if kinds is not None and not isinstance(raw, np.ndarray) and _has_string(raw):
         raw = _with_units(raw, key, kinds)  # (a unit string: pkm.units; the plain numeric path stays numpy's)
-    a = as_array(raw, key, f"numbers ({size} a sample)")  # (strings, booleans, ragged lists refused)
+    try:
+        a = as_array(raw, key, f"numbers ({size} a sample)")  # (strings, booleans, ragged lists refused)
+    except InvalidInputError:
+        if kinds is None and _has_string(raw):
+            raise InvalidInputError(key, "numbers in SI (rad/s, m/s, rad/s^2...): unit strings such as '10deg' are "
+                                         "taken for positions (qa, q, y, seed) only", raw) from None
+        raise
     if a.ndim == 1:
         a = a[None]
     if a.ndim != 2 or a.shape[1] != size:
