@@ -42,8 +42,10 @@ class Checker:
         response = op["responses"][str(r.status_code)]
         schema = response["content"]["application/json"]["schema"]
         body = r.json()
-        jsonschema.validate(body, {**schema, "components": self.openapi["components"]},
-                            cls=jsonschema.Draft202012Validator)
+        error = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(
+            {**schema, "components": self.openapi["components"]}).iter_errors(body))
+        if error is not None:
+            raise error
         assert "NaN" not in r.text and '"nan"' not in r.text
         self.seen.add((operation, r.status_code))
         return body
