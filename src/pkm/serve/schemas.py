@@ -410,6 +410,8 @@ class AssemblyModesResult(_Answer):
     residual: list[float] = _field("Each mode's closure residual [m or rad].", [1e-15])
     labels: list[str] = _field("Each mode's label.", ["(1,)"])
     seconds: float = _field("The search's time [s].", 0.5)
+    units: Units = _field(UNITS, {"q": ["rad"] * 9 + ["m"] * 3, "y": ["m", "m", "m"], "residual": "m or rad",
+                                  "seconds": "s"})
 
 
 class WorkingModesResult(_Answer):
@@ -419,6 +421,7 @@ class WorkingModesResult(_Answer):
     qa: list[list[float]] = _field("Each mode's actuated values [rad, m].", [_QA_EXAMPLE])
     labels: list[str] = _field("Each mode's label.", ["(1, 1, 1)"])
     seconds: float = _field("The search's time [s].", 0.5)
+    units: Units = _field(UNITS, {"q": ["rad"] * 9 + ["m"] * 3, "qa": ["rad"] * 3, "seconds": "s"})
 
 
 class MapCapability(_Answer):
@@ -434,10 +437,12 @@ class MapResult(_Answer):
                             [[True]])
     condition_index: Any = _field("The condition index at each node, in [0, 1] (null: unreachable) [1].", [[0.5]])
     nodes: int = _field("Reachable nodes.", 1)
-    size: float = _field("The reachable part's size (length, area, volume in m^k, rad^k).", 0.01)
+    size: float = _field("The reachable region's length, area or volume (in units.size: m^2, m rad...).", 0.01)
     gci: float | None = _field("The global condition index (its mean over the reachable nodes) [1].", 0.5)
     how: str = _field("How the map was computed.", "ik")
     capability: MapCapability | None = _field("With index: the capability at every node.", None, None)
+    units: dict[str, Any] = _field("The units: of each axis (m, rad), of size, of the condition index (1).",
+                                   {"axes": {"x": "m", "y": "m"}, "size": "m^2", "condition_index": "1", "gci": "1"})
 
 
 class SweepResult(_Answer):
