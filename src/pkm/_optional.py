@@ -35,7 +35,7 @@ EXTRAS: dict[str, dict[str, str]] = {
     "bench": {"mujoco": "mujoco"},
     "identify": {"cvxpy": "cvxpy", "clarabel": "clarabel"},
     "serve": {"fastapi": "fastapi", "starlette": "starlette", "uvicorn": "uvicorn", "multipart": "python-multipart",
-              "msgpack": "msgpack", "httpx": "httpx", "websockets": "websockets"},
+              "msgpack": "msgpack", "httpx": "httpx", "websockets": "websockets", "pydantic": "pydantic"},
     "jax": {"jax": "jax"},
 }
 

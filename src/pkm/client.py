@@ -87,33 +87,43 @@ class Client:
         self._answer(self._http.delete(f"/models/{model}"))
 
     def query(self, model: str, query: str, **body: Any) -> dict:
-        """``POST /models/{model}/{query}`` with ``body`` (arrays as numpy arrays or lists)."""
+        """``POST /models/{model}/{query}`` with ``body`` (arrays as numpy arrays or lists; None values left out).
+
+        A batch (every array a list of samples) answers per sample: ``status``, ``failures``, None for a failed
+        sample's values; one sample that fails raises :class:`ServiceError` (422, pkm's error's name and data)."""
         from pkm.serve.wire import MSGPACK, pack
 
+        body = {k: v for k, v in body.items() if v is not None}
         response = self._http.post(f"/models/{model}/{query}", content=pack(body),
                                    headers={"content-type": MSGPACK})
         return self._answer(response)
 
     def fk(self, model: str, qa: Any, seed: Any = None) -> dict:
+        """The forward kinematics at actuated values ``qa`` (``q``, ``y``, ``residual``, ``iterations``)."""
         return self.query(model, "fk", qa=qa, seed=seed)
 
     def ik(self, model: str, y: Any, seed: Any = None, branch: str | None = None) -> dict:
+        """The inverse kinematics at task values ``y`` (``q``, ``qa``, ``residual``, ``iterations``)."""
         return self.query(model, "ik", y=y, seed=seed, branch=branch)
 
-    def jacobians(self, model: str, q: Any) -> dict:
-        return self.query(model, "jacobians", q=q)
+    def jacobians(self, model: str, q: Any = None, *, qa: Any = None, seed: Any = None) -> dict:
+        """``J`` and ``K`` at configurations ``q``, or at actuated values ``qa`` (the loops closed from ``seed``)."""
+        return self.query(model, "jacobians", q=q, qa=qa, seed=seed)
 
-    def diagnose(self, model: str, q: Any) -> dict:
-        return self.query(model, "diagnose", q=q)
+    def diagnose(self, model: str, q: Any = None, *, qa: Any = None, seed: Any = None) -> dict:
+        return self.query(model, "diagnose", q=q, qa=qa, seed=seed)
 
-    def velocities(self, model: str, q: Any, qd: Any) -> dict:
-        return self.query(model, "velocities", q=q, qd=qd)
+    def velocities(self, model: str, q: Any = None, qd: Any = None, qdd: Any = None, *, qa: Any = None,
+                   seed: Any = None) -> dict:
+        return self.query(model, "velocities", q=q, qa=qa, qd=qd, qdd=qdd, seed=seed)
 
-    def dynamics(self, model: str, q: Any, qd: Any = None, qdd: Any = None) -> dict:
-        return self.query(model, "dynamics", q=q, qd=qd, qdd=qdd)
+    def dynamics(self, model: str, q: Any = None, qd: Any = None, qdd: Any = None, *, qa: Any = None,
+                 seed: Any = None) -> dict:
+        """``M``, ``h``, ``g`` (and ``tau`` with ``qdd``) at ``q``, or at actuated values ``qa``."""
+        return self.query(model, "dynamics", q=q, qa=qa, qd=qd, qdd=qdd, seed=seed)
 
-    def capability(self, model: str, q: Any, kind: str = "wrench") -> dict:
-        return self.query(model, "capability", q=q, kind=kind)
+    def capability(self, model: str, q: Any = None, kind: str = "wrench", *, qa: Any = None, seed: Any = None) -> dict:
+        return self.query(model, "capability", q=q, qa=qa, kind=kind, seed=seed)
 
     def job(self, model: str, kind: str, **body: Any) -> dict:
         """Start a job (``assembly_modes`` with ``qa``, ``working_modes`` with ``y``, ``map`` with ``axes``...);

@@ -17,3 +17,31 @@ def test_every_entry_of_a_pose_task_value_has_its_unit():
     assert len(about["task_value_units"]) == len(about["task_value_names"]) == 7
     hexapod = queries.describe(pkm.load("hexapod"))
     assert dict(zip(hexapod["task_value_names"], hexapod["task_value_units"]))["beta_1"] == "rad"
+
+
+def test_positions_take_units_and_a_configuration_q_or_qa():
+    """``"10deg"`` and ``"-35cm"`` are the SI numbers (pkm.units); a unit of the wrong kind is refused naming the entry;
+    the Jacobians at ``qa`` are those at the configuration the FK closes; q and qa together, or neither, are refused
+    naming both."""
+    import numpy as np
+    import pytest
+
+    from pkm.errors import InvalidInputError, UnitError
+
+    mech = pkm.load("delta")
+    qa = mech.actuated_q(mech.q_reference)
+    plain = queries.fk(mech, {"qa": [np.deg2rad(-30.0), qa[1], qa[2]]})
+    with_unit = queries.fk(mech, {"qa": ["-30deg", qa[1], qa[2]]})
+    assert np.abs(with_unit["q"] - plain["q"]).max() <= 1e-14 and with_unit["iterations"].dtype.kind == "i"
+    ik = queries.ik(mech, {"y": [0.0, "0mm", "-35cm"]})
+    assert np.abs(ik["q"] - queries.ik(mech, {"y": [0.0, 0.0, -0.35]})["q"]).max() <= 1e-12
+    with pytest.raises(UnitError, match=r"qa\[1\]"):
+        queries.fk(mech, {"qa": [0.0, "3mm", 0.0]})
+    with pytest.raises(InvalidInputError, match="positions"):  # (no unit suffix for a rate: said, not numpy's words)
+        queries.velocities(mech, {"qa": qa, "qd": ["1deg", 0.0, 0.0]})
+    at_qa = queries.jacobians(mech, {"qa": [qa, qa + 0.01]})
+    at_q = queries.jacobians(mech, {"q": queries.fk(mech, {"qa": [qa, qa + 0.01]})["q"]})
+    assert np.abs(at_qa["J"] - at_q["J"]).max() <= 1e-12 and at_qa["units"]["J"][0][0] == "m/rad"
+    for body in ({"q": mech.q_reference, "qa": qa}, {}):
+        with pytest.raises(InvalidInputError, match="q, qa"):
+            queries.dynamics(mech, body)

@@ -35,7 +35,7 @@ def test_health_is_open_and_everything_else_needs_the_token(service):
         assert r.status_code == 401 and r.json()["error"] == "Unauthorized"
     assert httpx.get(service.url + "/models", headers={"authorization": "Bearer wrong"}).status_code == 401
     schema = httpx.get(service.url + "/openapi.json", headers=AUTH).json()
-    assert {"/models", "/models/{model}/{query}", "/models/{model}/preview"} <= set(schema["paths"])
+    assert {"/models", "/models/{model}/fk", "/models/{model}/preview"} <= set(schema["paths"])
 
 
 def test_the_queries_answer_what_the_library_does(client, delta):
@@ -74,12 +74,25 @@ def test_the_queries_answer_what_the_library_does(client, delta):
     assert np.abs(np.array(raw["q"]) - fk["q"]).max() == 0.0
 
 
-def test_a_failing_sample_does_not_fail_the_batch(client, delta):
+def test_a_failing_sample_does_not_fail_the_batch_but_fails_alone(client, service, delta):
+    """A batch keeps its shape: null (None) for the failed sample's values, its status and error; the same sample
+    given alone is a 422 with pkm's error JSON (never a 200 with a failure inside)."""
+    from pkm.client import ServiceError
+
     y = [[0.0, 0.0, -0.35], [0.0, 0.0, -3.0]]  # (the second 3 m down: out of reach)
     out = client.ik("delta", y)
     assert out["status"] == ["ok", "failed"] and [f["sample"] for f in out["failures"]] == [1]
     assert out["failures"][0]["error"] in ("ConvergenceError", "UnreachableError")
-    assert np.isnan(out["q"][1]).all() and np.isfinite(out["q"][0]).all()
+    assert out["q"][1] is None and out["iterations"][1] is None and np.isfinite(out["q"][0]).all()
+    assert isinstance(out["iterations"][0], int)
+    raw = httpx.post(service.url + "/models/delta/ik", json={"y": y}, headers=AUTH)
+    assert raw.status_code == 200 and raw.json()["q"][1] is None and "nan" not in raw.text.lower()
+    with pytest.raises(ServiceError) as e:
+        client.ik("delta", y[1])
+    assert e.value.status == 422 and e.value.kind == out["failures"][0]["error"] and e.value.data["leg"] >= 1
+    with pytest.raises(ServiceError) as e:  # (a configuration asked by qa whose loops do not close: that sample's)
+        client.dynamics("prs3", qa=[0.6, -0.4, 0.6], qdd=[1.0, 0.0, 0.0])
+    assert e.value.status == 422
 
 
 def test_uploads_are_content_addressed_kept_and_deleted(client, service, tmp_path):
@@ -156,13 +169,20 @@ def test_bad_uploads_are_refused(service, files, status, says, tmp_path):
     ("/models/delta/teleport", b"{}", {}, 404),
     ("/models/nope/fk", json.dumps({"qa": [1, 2, 3]}).encode(), {}, 404),
     ("/models/delta/capability", json.dumps({"q": [0.0] * 15, "kind": "power"}).encode(), {}, 422),
+    ("/models/delta/fk", json.dumps({"qa": [1, 2, 3], "foo": 1}).encode(), {}, 422),
+    ("/models/delta/dynamics", json.dumps({"qa": [1, 2, 3], "q": [0.0] * 12}).encode(), {}, 422),
+    ("/models/delta/dynamics", json.dumps({"qd": [1, 2, 3]}).encode(), {}, 422),
+    ("/models/delta/fk", json.dumps({"qa": ["10deg", "1mm", 0.0]}).encode(), {}, 422),
+    ("/models/delta/ik", json.dumps({"y": [0, 0, -0.35], "branch": 3}).encode(), {}, 422),
+    ("/models/delta/jobs/map", json.dumps({"axes": {"x": [0, 1, 3]}, "what": 1}).encode(), {}, 422),
+    ("/models/delta/variants", json.dumps({"params": {"R": 0.16}, "x": 1}).encode(), {}, 422),
     ("/models/delta/fk", b"x" * (2**20 + 10), {}, 413),
 ])
 def test_bad_requests_are_4xx_with_their_message(service, path, body, headers, status):
     r = httpx.post(service.url + path, content=body, headers={**AUTH, **headers})
     assert r.status_code == status, r.text
     answer = r.json()
-    assert answer["message"] and "Traceback" not in r.text
+    assert answer["message"] and set(answer) == {"error", "message", "data"} and "Traceback" not in r.text
     assert httpx.get(service.url + "/health").status_code == 200  # (still answering)
 
 
@@ -287,18 +307,44 @@ def test_a_registered_mechanism_with_other_parameters(client, service):
 
 def test_a_sweep_job_is_pkm_sweep(client):
     """A design sweep as a job (serial here: CI's two cores; a local Dask cluster by default) equals
-    :func:`pkm.sweep` of the same grid, and its rows come as Parquet too."""
+    :func:`pkm.sweep` of the same grid, and its rows come as Parquet too; its JSON answer matches its schema."""
     import io
 
     import pyarrow.parquet as pq
 
     from pkm import sweeps
+    from tests.serve.test_schemas import Checker
 
     job = client.job("delta", "sweep", grid={"R": "10cm:20cm:3"}, objectives=["condition"], scheduler="serial")
     result = client.result(job["id"])
+    answer = httpx.get(f"{client.url}/jobs/{job['id']}/result", headers=AUTH)
+    Checker(httpx.get(client.url + "/openapi.json", headers=AUTH).json())("job_result", answer)  # (its schema)
     direct = sweeps.sweep("delta", sweeps.grid(R="10cm:20cm:3"), ["condition"], scheduler="serial", progress=False)
     assert result["designs"] == 3 and result["failed"] == 0
     assert np.allclose(result["rows"]["condition"], direct.table.column("condition").to_pylist(), rtol=1e-12)
     table = pq.read_table(io.BytesIO(httpx.get(f"{client.url}/jobs/{job['id']}/result", params={"format": "parquet"},
                                                headers=AUTH).content))
     assert table.num_rows == 3 and "condition" in table.column_names
+
+
+def test_the_compiled_batches_answer_as_the_python_route(client, delta):
+    """A batch's FK, Jacobians and dynamics run on the compiled kernels in the service: the same answers as the
+    Python route (queries called without kernels) to 1e-10, iterations integers both ways; a batch with a sample the
+    loops cannot close (the 3-PRS's sliders 1 m apart) gives the same statuses and nulls both ways."""
+    from pkm.serve import queries
+
+    qa = _path(delta, 4)
+    for name, body in (("fk", {"qa": qa}), ("jacobians", {"qa": qa}),
+                       ("dynamics", {"qa": qa, "qd": [0.1, 0.0, 0.0], "qdd": [1.0, 0.0, 0.0]})):
+        served, local = client.query("delta", name, **body), queries.QUERIES[name](delta, body, None)
+        assert served["status"] == local["status"] == ["ok"] * 4
+        for key in set(local) - {"status", "units"}:
+            assert np.abs(np.asarray(served[key], dtype=float) - local[key]).max() <= 1e-10, (name, key)
+    assert served["units"] == local["units"] and served["units"]["M"][0][0] == "N m/(rad/s^2)"
+    assert client.fk("delta", qa)["iterations"].dtype.kind == "i"
+    prs3 = pkm.load("prs3")
+    qa = [prs3.actuated_q(prs3.q_reference).tolist(), [0.6, -0.4, 0.6]] * 2
+    served, local = client.fk("prs3", qa), queries.fk(prs3, {"qa": qa})
+    assert served["status"] == local["status"] == ["ok", "failed"] * 2 and served["q"][1] is local["q"][1] is None
+    assert [f["error"] for f in served["failures"]] == [f["error"] for f in local["failures"]] == ["ConvergenceError"] * 2
+    assert np.abs(served["q"][2] - local["q"][2]).max() <= 1e-12 and isinstance(served["iterations"][0], int)

@@ -18,19 +18,27 @@ from collections import Counter
 from typing import Any
 
 MODELS = ("delta", "rrr3", "prs3", "nope", "", "..", "%2e%2e", "a" * 300, "delta%00", "../../etc/passwd")
-QUERIES = ("fk", "ik", "jacobians", "diagnose", "velocities", "dynamics", "capability", "scene", "teleport", "")
-KEYS = ("qa", "q", "y", "qd", "qdd", "seed", "kind", "branch", "x", "")
+QUERIES = ("fk", "ik", "jacobians", "diagnose", "velocities", "dynamics", "capability", "scene", "teleport", "",
+           "jobs/map", "jobs/assembly_modes", "jobs/working_modes", "jobs/teleport", "variants")
+#: The typed operations' field names (pkm.serve.schemas), an unknown one and an empty one.
+KEYS = ("qa", "q", "y", "qd", "qdd", "seed", "kind", "branch", "axes", "fixed", "index", "length", "params", "x", "foo",
+        "")
 
 
 def _value(rng: random.Random, depth: int = 0) -> Any:
     """A random JSON-able value: numbers of every kind, strings, nested lists and maps, wrong shapes."""
-    pick = rng.randrange(12)
+    pick = rng.randrange(13)
     if pick == 0:
         return rng.choice([0, 1, -1, 10**30, -(10**30), 1e308, -1e308, 1e-308, 0.1])
     if pick == 1:
         return "".join(rng.choice(string.printable) for _ in range(rng.randrange(20)))
     if pick == 2:
-        return rng.choice(["NaN", "Infinity", "-Infinity", "1e999", "3 deg", "5cm", None, True, False])
+        return rng.choice(["NaN", "Infinity", "-Infinity", "1e999", "3 deg", "5cm", None, True, False, "wrench",
+                           "power", "10deg", "1e999deg", "5 kg"])
+    if pick == 11 and depth < 2:  # (one sample or a batch with unit strings, of every kind and none)
+        units = ["10deg", "-5mm", "0.3rad", "2cm", "1m", "3kg", "7", "deg", "1e400mm", "-0.1"]
+        row = [rng.choice(units) if rng.random() < 0.5 else rng.uniform(-1, 1) for _ in range(rng.choice([2, 3, 12]))]
+        return row if rng.random() < 0.5 else [row] * rng.choice([1, 2, 5])
     if pick in (3, 4, 5):
         return [rng.uniform(-3, 3) for _ in range(rng.choice([0, 1, 2, 3, 4, 15, 16, 100]))]
     if pick in (6, 7):

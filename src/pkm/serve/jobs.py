@@ -55,15 +55,16 @@ class Job:
 def _modes(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """Every assembly mode at ``qa`` (:func:`pkm.assembly_modes`)."""
     from pkm.core.modes import assembly_modes
-    from pkm.serve.queries import _array
+    from pkm.serve.queries import _array, _position_kinds, _q_units, _value_units
 
-    qa = _array(body, "qa", mech.na)[0]
+    qa = _array(body, "qa", mech.na, _position_kinds(mech, "qa"))[0]
     s = assembly_modes(mech, qa)
     Q = np.array([m.q for m in s.modes]) if s.modes else np.zeros((0, mech.nq))
     Y = np.array([mech.task_map.value(q) for q in Q]) if len(Q) else np.zeros((0, mech.task_map.value_size))
     residual = np.array([m.residual for m in s.modes])
     out = {"count": len(s.modes), "complete": bool(s.complete), "q": Q, "y": Y, "residual": residual,
-           "labels": [str(m.label) for m in s.modes], "seconds": s.seconds}
+           "labels": [str(m.label) for m in s.modes], "seconds": s.seconds,
+           "units": {"q": _q_units(mech), "y": _value_units(mech), "residual": "m or rad", "seconds": "s"}}
     return out, {"mode": np.arange(len(Q)), **{f"q{i}": Q[:, i] for i in range(Q.shape[1])},
                  **{f"y{i}": Y[:, i] for i in range(Y.shape[1])}, "residual": residual}
 
@@ -71,14 +72,15 @@ def _modes(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str
 def _working(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """Every working mode at the task value ``y`` (:func:`pkm.working_modes`)."""
     from pkm.core.modes import working_modes
-    from pkm.serve.queries import _array
+    from pkm.serve.queries import _actuated_units, _array, _position_kinds, _q_units
 
-    y = _array(body, "y", mech.task_map.value_size)[0]
+    y = _array(body, "y", mech.task_map.value_size, _position_kinds(mech, "y"))[0]
     s = working_modes(mech, y)
     Q = np.array([m.q for m in s.modes]) if s.modes else np.zeros((0, mech.nq))
     QA = Q[:, mech.act_q] if len(Q) else np.zeros((0, mech.na))
     out = {"count": len(s.modes), "complete": bool(s.complete), "q": Q, "qa": QA,
-           "labels": [str(m.label) for m in s.modes], "seconds": s.seconds}
+           "labels": [str(m.label) for m in s.modes], "seconds": s.seconds,
+           "units": {"q": _q_units(mech), "qa": _actuated_units(mech), "seconds": "s"}}
     return out, {"mode": np.arange(len(Q)), **{f"qa{i}": QA[:, i] for i in range(QA.shape[1])}}
 
 
@@ -110,7 +112,9 @@ def _map(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, 
     rows["ci_2"] = m.condition_index("2").ravel()
     out: dict[str, Any] = {"axes": {n: v for n, v in m.axes}, "reachable": m.reachable,
                            "condition_index": m.condition_index("2"), "nodes": m.nodes, "size": m.size,
-                           "gci": m.gci("2"), "how": m.how}
+                           "gci": m.gci("2"), "how": m.how,
+                           "units": {"axes": {n: ("m" if k == "length" else "rad") for (n, _), k in zip(m.axes, m.kinds)},
+                                     "size": m.size_unit, "condition_index": "1", "gci": "1"}}
     if index is not None:
         from pkm.core.analysis.capability import map_capability
 

@@ -81,7 +81,12 @@ async function api(method, path, body) {
   }
   const r = await fetch(path, options);
   const answer = await r.json();
-  if (!r.ok) throw new Error(answer.message || r.statusText);
+  if (!r.ok) {
+    const e = new Error(answer.message || r.statusText);
+    // one sample the library could not solve (unreachable, singular, not converged): said, not an error of the page
+    e.sample = r.status === 422 && ["InvalidRequest", "InvalidInputError", "UnitError"].indexOf(answer.error) < 0;
+    throw e;
+  }
   return answer;
 }
 
@@ -157,11 +162,10 @@ async function scheduleTask(k) {
     const y = state.y.slice();
     y[k] = parseFloat(document.getElementById("y-" + k).value);
     const ik = await api("POST", "/models/" + state.model + "/ik", {y: y, seed: state.q});
-    if (ik.status[0] !== "ok") { say(ik.failures[0].message, false); return; }
     state.y = y;
     ik.qa[0].forEach(function (v, i) { document.getElementById("qa-" + i).value = v; });
   } catch (e) {
-    say(e.message, true);
+    say(e.message, !e.sample);
   } finally {
     state.busy = false;
   }
@@ -179,10 +183,6 @@ async function update() {
     const about = state.about;
     const qa = about.actuated.map(function (_, k) { return parseFloat(document.getElementById("qa-" + k).value); });
     const fk = await api("POST", "/models/" + state.model + "/fk", {qa: qa, seed: state.q});
-    if (fk.status[0] !== "ok") {
-      say(fk.failures[0].message, false);
-      return;
-    }
     state.q = fk.q[0];
     state.y = fk.y[0];
     fk.y[0].forEach(function (v, k) { const el = document.getElementById("y-" + k); if (el) el.value = v; });
@@ -202,7 +202,7 @@ async function update() {
     state.updates += 1;
     say("fk " + (fk.compute_s * 1e3).toFixed(2) + " ms", false);
   } catch (e) {
-    say(e.message, true);
+    say(e.message, !e.sample);
   } finally {
     state.busy = false;
     if (state.pending) { state.pending = false; update(); }

@@ -4,34 +4,60 @@ forward kinematics, the Jacobians and the dynamic model run through the model's 
 :class:`pkm.Kernels`, where they build; the same answers to 1e-12) and fall back to the library's Python route, sample
 by sample, where the kernels refuse a sample.
 
-Every answer carries its units (SI: ``m``, ``rad``, ``N``, ``N m``, per coordinate) and what certifies it: the
-residuals of the closures, the status of each sample (``"ok"`` or the error that sample raised, with its data: a
-batch does not fail as a whole because one sample is unreachable). Inputs are checked by pkm's own validation: a
-bad one is a :class:`~pkm.errors.PkmError` naming the field, which the service answers with 422.
+Inputs follow the Python API's and the CLI's conventions: positions (``qa``, ``q``, ``y``, ``seed``) are numbers in SI
+or strings with a unit (``"10deg"``, ``"5mm"``, :mod:`pkm.units`); where a configuration is asked, either the full
+``q`` or the actuated ``qa`` (the loops then closed from ``seed``, default the reference, each sample from the
+previous one's solution), exactly one of the two. Inputs are checked by pkm's own validation: a bad one is a
+:class:`~pkm.errors.PkmError` naming the field, which the service answers with 422.
+
+Every answer carries ``units`` for every quantity it returns (SI: ``m``, ``rad``, ``N``, ``N m``, per coordinate;
+a matrix's per entry) and what certifies it: the status of each sample (``"ok"`` or ``"failed"``) and, where some
+failed, ``failures`` (each one's sample, error and message). A failed sample's values are ``None`` (JSON ``null``), the
+batch keeps its length; a query given ONE sample (not a list of samples) whose sample fails raises that sample's
+:class:`~pkm.errors.PkmError` instead (the service's 4xx). Counts (``iterations``) are integers.
 """
 
 from __future__ import annotations
 
+import functools
 import weakref
-from collections.abc import Callable, Mapping
-from typing import Any
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any, TypeVar
 
 import numpy as np
 
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, PkmError
+from pkm.units import KIND_OF_UNIT, parse_quantity
 from pkm.validation import as_array
 
 #: Samples in one request at most.
 MAX_SAMPLES = 100_000
 
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def _per_mechanism(fn: _F) -> _F:
+    """``fn(mech, *args)`` computed once per mechanism and arguments (units and names: asked on every request)."""
+    cache: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+    @functools.wraps(fn)
+    def cached(mech: Mechanism, *args: Any) -> Any:
+        per = cache.setdefault(mech, {})
+        if args not in per:
+            per[args] = fn(mech, *args)
+        return per[args]
+
+    return cached  # type: ignore[return-value]
+
 
 def _unit(mech: Mechanism, joint: str, kind: str = "position") -> str:
     revolute = mech.joints[joint].revolute
     return {"position": "rad" if revolute else "m", "rate": "rad/s" if revolute else "m/s",
-            "effort": "N m" if revolute else "N"}[kind]
+            "acceleration": "rad/s^2" if revolute else "m/s^2", "effort": "N m" if revolute else "N"}[kind]
 
 
+@_per_mechanism
 def _task_units(mech: Mechanism) -> dict[str, str]:
     """The units of the task's tangent coordinates (:attr:`TaskMap.keys`: a pose's x y z roll pitch yaw)."""
     kinds = mech.task_map.kinds
@@ -39,6 +65,7 @@ def _task_units(mech: Mechanism) -> dict[str, str]:
     return out
 
 
+@_per_mechanism
 def _value_units(mech: Mechanism) -> list[str]:
     """The units of the task value's entries (:attr:`TaskMap.value_names`: a pose's x y z qx qy qz qw, whose
     quaternion is unitless, ``"1"``)."""
@@ -46,29 +73,153 @@ def _value_units(mech: Mechanism) -> list[str]:
     return [("m" if kinds[k] == "length" else "rad") if k in kinds else "1" for k in mech.task_map.value_names]
 
 
-def _optional(body: Mapping[str, Any], key: str, size: int) -> np.ndarray | None:
+#: The units of the coordinates of the joints that are not scalar: (q's, v's), the letters m (a length) and r (an angle),
+#: 1 (unitless); a scalar joint's are by :attr:`JointInfo.revolute`, a prismatic one's in m.
+_JOINT_UNITS = {"JointModelFreeFlyer": ("mmm1111", "mmmrrr"), "JointModelSpherical": ("1111", "rrr"),
+                "JointModelPlanar": ("mm11", "mmr"), "JointModelTranslation": ("mmm", "mmm")}
+_PRISMATIC = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned")
+
+
+def _joint_units(mech: Mechanism, which: int) -> list[str]:
+    """The unit letters of every coordinate of ``q`` (``which`` 0) or ``v`` (1)."""
+    size = mech.nq if which == 0 else mech.nv
+    out = ["1" if which == 0 else "r"] * size
+    for j in mech.joints.values():
+        at, n = (j.idx_q, j.nq) if which == 0 else (j.idx_v, j.nv)
+        if j.kind in _JOINT_UNITS:
+            out[at:at + n] = list(_JOINT_UNITS[j.kind][which])
+        elif j.kind in _PRISMATIC:
+            out[at:at + n] = ["m"] * n
+        elif j.revolute or which == 1:
+            out[at:at + n] = ["r"] * n
+    return out
+
+
+@_per_mechanism
+def _q_units(mech: Mechanism) -> list[str]:
+    """The unit of every coordinate of ``q``: ``rad`` (a revolute joint), ``m`` (a prismatic one, a free-flyer's
+    position), ``1`` (a quaternion's entries, an unbounded revolute's cosine and sine)."""
+    return [{"m": "m", "r": "rad"}.get(u, "1") for u in _joint_units(mech, 0)]
+
+
+@_per_mechanism
+def _v_units(mech: Mechanism, order: int = 1) -> list[str]:
+    """The unit of every coordinate of the velocity ``v`` (``order`` 1) or acceleration (2)."""
+    per = "/s" if order == 1 else "/s^2"
+    return [("m" if u == "m" else "rad") + per for u in _joint_units(mech, 1)]
+
+
+def _per(a: str, b: str) -> str:
+    """The unit of a ratio: ``1`` where the two are the same, ``a/b`` else (``b`` in parentheses when composite)."""
+    if a == b:
+        return "1"
+    return f"{a}/({b})" if " " in b or "/" in b else f"{a}/{b}"
+
+
+def _matrix_units(rows: Sequence[str], columns: Sequence[str]) -> list[list[str]]:
+    """Every entry's unit of a matrix mapping ``columns`` quantities to ``rows`` ones."""
+    return [[_per(r, c) for c in columns] for r in rows]
+
+
+def _rates(units: Sequence[str], per: str = "/s") -> list[str]:
+    return [u + per for u in units]
+
+
+@_per_mechanism
+def _position_kinds(mech: Mechanism, what: str) -> list[str | None]:
+    """The :mod:`pkm.units` kinds of the entries of ``q``, ``qa`` or ``y`` (``what``)."""
+    units = {"q": _q_units, "qa": _actuated_units, "y": _value_units}[what](mech)
+    return _kinds(units)
+
+
+def _kinds(units: Sequence[str]) -> list[str | None]:
+    """The :mod:`pkm.units` kind of each unit (``m`` -> length, ``rad`` -> angle), None where a unit string cannot
+    be given (a unitless entry: a plain number only)."""
+    return [KIND_OF_UNIT.get(u) for u in units]
+
+
+def _with_units(raw: Any, key: str, kinds: Sequence[str | None]) -> Any:
+    """``raw`` (one sample or a list of samples) with every string entry converted to SI by its column's kind."""
+    def convert(sample: Any, where: str) -> Any:
+        if not isinstance(sample, (list, tuple)):
+            return sample
+        out = []
+        for i, v in enumerate(sample):
+            if isinstance(v, str):
+                kind = kinds[i] if i < len(kinds) else None
+                v = parse_quantity(v, set() if kind is None else {kind}, f"{where}[{i}]",
+                                   {"length": "m", "angle": "rad"}.get(kind or "", "a plain number"))
+            out.append(v)
+        return out
+
+    if isinstance(raw, (list, tuple)) and raw and isinstance(raw[0], (list, tuple)):
+        return [convert(s, f"{key}[{k}]") for k, s in enumerate(raw)]
+    return convert(raw, key)
+
+
+def _has_string(raw: Any) -> bool:
+    if isinstance(raw, str):
+        return True
+    if isinstance(raw, (list, tuple)):
+        return any(_has_string(v) for v in raw)
+    return False
+
+
+def _optional(body: Mapping[str, Any], key: str, size: int, kinds: Sequence[str | None] | None = None
+              ) -> np.ndarray | None:
     """``body[key]`` as an (n, size) array (a single sample as n = 1), finite, at most :data:`MAX_SAMPLES` rows;
-    None when absent."""
+    None when absent. With ``kinds`` (one per column), entries may be strings with units."""
     if key not in body or body[key] is None:
         return None
-    return _array(body, key, size)
+    return _array(body, key, size, kinds)
 
 
-def _array(body: Mapping[str, Any], key: str, size: int) -> np.ndarray:
+def _array(body: Mapping[str, Any], key: str, size: int, kinds: Sequence[str | None] | None = None) -> np.ndarray:
     """``body[key]`` as :func:`_optional` gives it, required."""
     if key not in body or body[key] is None:
         raise InvalidInputError(key, f"missing: give {size} numbers, or a list of such samples")
-    a = as_array(body[key], key, f"numbers ({size} a sample)")  # (strings, booleans, ragged lists refused)
+    raw = body[key]
+    if kinds is not None and not isinstance(raw, np.ndarray) and _has_string(raw):
+        raw = _with_units(raw, key, kinds)  # (a unit string: pkm.units; the plain numeric path stays numpy's)
+    try:
+        a = as_array(raw, key, f"numbers ({size} a sample)")  # (strings, booleans, ragged lists refused)
+    except InvalidInputError:
+        if kinds is None and _has_string(raw):
+            raise InvalidInputError(key, "numbers in SI (rad/s, m/s, rad/s^2...): unit strings such as '10deg' are "
+                                         "taken for positions (qa, q, y, seed) only", raw) from None
+        raise
     if a.ndim == 1:
         a = a[None]
     if a.ndim != 2 or a.shape[1] != size:
-        raise InvalidInputError(key, f"expected {size} numbers a sample, got shape {list(np.shape(body[key]))}")
+        raise InvalidInputError(key, f"expected {size} numbers a sample, got shape {list(np.shape(raw))}")
     if len(a) > MAX_SAMPLES:
         raise InvalidInputError(key, f"more than {MAX_SAMPLES} samples in one request: send them in parts", len(a))
     if not np.all(np.isfinite(a)):
         bad = np.argwhere(~np.isfinite(a))[0]
         raise InvalidInputError(key, f"sample {bad[0]}, entry {bad[1]} is not finite")
     return a
+
+
+def _is_single(body: Mapping[str, Any], *keys: str) -> bool:
+    """Whether every array input among ``keys`` that is given is ONE sample (a flat list), not a list of samples."""
+    for key in keys:
+        v = body.get(key)
+        if v is None:
+            continue
+        if isinstance(v, np.ndarray):
+            if v.ndim != 1:
+                return False
+        elif isinstance(v, (list, tuple)) and v and isinstance(v[0], (list, tuple, np.ndarray)):
+            return False
+    return True
+
+
+def _seed(mech: Mechanism, body: Mapping[str, Any]) -> np.ndarray:
+    """The configuration the first sample is solved from: ``seed`` (nq, one sample), default the reference."""
+    seed = _optional(body, "seed", mech.nq, _position_kinds(mech, "q"))
+    if seed is not None and len(seed) != 1:
+        raise InvalidInputError("seed", f"one configuration ({mech.nq} numbers), not {len(seed)}")
+    return mech.q_reference if seed is None else seed[0]
 
 
 def _same_length(**arrays: np.ndarray | None) -> int:
@@ -84,202 +235,282 @@ def _row(a: np.ndarray, k: int) -> np.ndarray:
     return a[0] if len(a) == 1 else a[k]
 
 
-def _error(e: PkmError) -> dict[str, Any]:
-    return {"error": type(e).__name__, "message": str(e)}
+class _Samples:
+    """A batch's per-sample outcome: ``errors[k]`` (None where sample k is fine), and the answer's columns."""
+
+    def __init__(self, n: int, single: bool, errors: list[PkmError | None] | None = None):
+        self.n, self.single = n, single
+        self.errors: list[PkmError | None] = [None] * n if errors is None else errors
+
+    def each(self, fn: Callable[[int], dict[str, Any]], keys: tuple[str, ...]) -> dict[str, Any]:
+        """``fn(k)`` for every sample not failed yet; a sample whose computation raises a PkmError is marked failed;
+        the answer's columns (see :meth:`columns`)."""
+        rows: list[dict[str, Any] | None] = []
+        for k in range(self.n):
+            if self.errors[k] is not None:
+                rows.append(None)
+                continue
+            try:
+                rows.append(fn(k))
+            except PkmError as e:
+                self.errors[k] = e
+                rows.append(None)
+        return self.columns({key: [None if r is None else r[key] for r in rows] for key in keys})
+
+    def columns(self, values: Mapping[str, Any]) -> dict[str, Any]:
+        """``values`` (each a full array, or a list per sample) with ``status`` and, where samples failed,
+        ``failures`` and ``None`` for their values; one sample given alone that failed raises its error."""
+        failed = [k for k, e in enumerate(self.errors) if e is not None]
+        if self.single and failed:
+            raise self.errors[failed[0]]  # type: ignore[misc]
+        out: dict[str, Any] = {"status": ["failed" if e is not None else "ok" for e in self.errors]}
+        if failed:
+            out["failures"] = [{"sample": k, "error": type(e).__name__, "message": str(e)}
+                               for k, e in enumerate(self.errors) if e is not None]
+        bad = set(failed)
+        for key, column in values.items():
+            if not bad and all(v is not None for v in column):
+                out[key] = np.asarray(column) if not isinstance(column, np.ndarray) else column
+            else:
+                out[key] = [None if k in bad else _value(column[k]) for k in range(self.n)]
+        return out
 
 
-def _each(n: int, fn: Callable[[int], dict[str, Any]]) -> list[dict[str, Any]]:
-    """``fn(k)`` for every sample; a sample whose computation raises a PkmError is reported, not fatal."""
-    out = []
+def _value(v: Any) -> Any:
+    """One sample's value: an array as a numpy array, a number as a plain Python one."""
+    if v is None or isinstance(v, (bool, int, float)):
+        return v
+    a = np.asarray(v)
+    return a.item() if a.ndim == 0 else a
+
+
+def _close(mech: Mechanism, qa: np.ndarray, q0: np.ndarray, kernels: Any
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[PkmError | None]]:
+    """The loops closed at every actuated sample ``qa``, each from the previous one's solution (the first from
+    ``q0``): ``q`` (NaN rows where a sample failed), ``residual`` [m, rad], ``iterations`` (integers) and the errors.
+    A batch runs through the compiled kernels first; any sample they cannot solve sends it to the Python route."""
+    from pkm.core.kinematics.solve import close_loops
+
+    n = len(qa)
+    if kernels is not None and n > 1:
+        try:  # (the compiled path, warm-started in C; any sample it cannot solve: the per-sample route below)
+            path = kernels.close_loops_path(qa, q0)
+            return (np.asarray(path.q), np.asarray(path.residual, dtype=float),
+                    np.asarray(path.iterations).astype(np.int64), [None] * n)
+        except PkmError:
+            pass
+    Q, residual = np.full((n, mech.nq), np.nan), np.full(n, np.nan)
+    iterations = np.zeros(n, dtype=np.int64)
+    errors: list[PkmError | None] = [None] * n
+    previous = q0
     for k in range(n):
         try:
-            out.append({"status": "ok", **fn(k)})
+            r = close_loops(mech, qa[k], previous)
         except PkmError as e:
-            out.append({"status": "failed", **_error(e)})
-    return out
+            errors[k] = e
+            continue
+        previous = Q[k] = r.q
+        residual[k], iterations[k] = r.residual, r.iterations
+    return Q, residual, iterations, errors
 
 
-def _columns(rows: list[dict[str, Any]], keys: tuple[str, ...]) -> dict[str, Any]:
-    """The per-sample dicts as columns (NaN where a sample failed)."""
-    out: dict[str, Any] = {"status": [r["status"] for r in rows]}
-    failures = [{"sample": k, "error": r["error"], "message": r["message"]} for k, r in enumerate(rows)
-                if r["status"] != "ok"]
-    if failures:
-        out["failures"] = failures
-    for key in keys:
-        values = [r.get(key) for r in rows]
-        shape = next((np.shape(v) for v in values if v is not None), ())
-        out[key] = np.array([np.full(shape, np.nan) if v is None else np.asarray(v, dtype=float) for v in values])
-    return out
+def _configurations(mech: Mechanism, body: Mapping[str, Any], kernels: Any, *others: str
+                    ) -> tuple[np.ndarray, _Samples]:
+    """The closed configurations asked: ``q`` as given, or ``qa`` with the loops closed (see the module doc); with
+    the samples' outcome (a sample whose loops do not close has failed). ``others``: the other array inputs, for
+    whether one sample was given."""
+    has_q, has_qa = body.get("q") is not None, body.get("qa") is not None
+    if has_q == has_qa:
+        raise InvalidInputError("q, qa", f"give exactly one of q (the {mech.nq} coordinates of a closed "
+                                         f"configuration) and qa (the {mech.na} actuated values: the loops are then "
+                                         "closed from seed, default the reference)")
+    single = _is_single(body, "q" if has_q else "qa", *others)
+    if has_q:
+        q = _array(body, "q", mech.nq, _position_kinds(mech, "q"))
+        return q, _Samples(len(q), single)
+    qa = _array(body, "qa", mech.na, _position_kinds(mech, "qa"))
+    q, _, _, errors = _close(mech, qa, _seed(mech, body), kernels)
+    return q, _Samples(len(q), single, errors)
+
+
+@_per_mechanism
+def _actuated_units(mech: Mechanism, kind: str = "position") -> list[str]:
+    return [_unit(mech, j, kind) for j in mech.actuated_names]
 
 
 def fk(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """Forward kinematics (the loop closure): ``qa`` (na per sample) -> ``q`` (nq), ``y`` (task value), the closure
-    ``residual`` [m, rad]. Samples are solved in order, each from the previous one's solution (the first from
-    ``seed``, default the reference): a stream of actuator values stays on one assembly mode."""
-    from pkm.core.kinematics.solve import close_loops
-
-    qa = _array(body, "qa", mech.na)
-    seed = _optional(body, "seed", mech.nq)
-    q = [mech.q_reference if seed is None else seed[0]]
-    out: dict[str, Any] | None = None
-    if kernels is not None and len(qa) > 1:
-        try:  # (the compiled path, warm-started in C; any sample it cannot solve: the per-sample route below)
-            path = kernels.close_loops_path(qa, q[0])
-            out = {"status": ["ok"] * len(qa), "q": path.q,
-                   "y": np.array([mech.task_map.value(x) for x in path.q]), "residual": path.residual,
-                   "iterations": path.iterations.astype(float)}
-        except PkmError:
-            out = None
-    if out is None:
-        def one(k: int) -> dict[str, Any]:
-            r = close_loops(mech, qa[k], q[0])
-            q[0] = r.q
-            return {"q": r.q, "y": mech.task_map.value(r.q), "residual": r.residual, "iterations": r.iterations}
-
-        out = _columns(_each(len(qa), one), ("q", "y", "residual", "iterations"))
-    out["units"] = {"y": _value_units(mech), "residual": "m or rad",
-                    "qa": [_unit(mech, j) for j in mech.actuated_names]}
+    ``residual`` [m, rad], the Newton ``iterations``. Samples are solved in order, each from the previous one's
+    solution (the first from ``seed``, default the reference): a stream of actuator values stays on one assembly
+    mode."""
+    qa = _array(body, "qa", mech.na, _position_kinds(mech, "qa"))
+    Q, residual, iterations, errors = _close(mech, qa, _seed(mech, body), kernels)
+    samples = _Samples(len(qa), _is_single(body, "qa"), errors)
+    Y = [None if e is not None else mech.task_map.value(Q[k]) for k, e in enumerate(errors)]
+    out = samples.columns({"q": Q, "y": Y, "residual": residual, "iterations": iterations})
+    out["units"] = {"q": _q_units(mech), "y": _value_units(mech), "residual": "m or rad", "iterations": "1",
+                    "qa": _actuated_units(mech)}
     return out
 
 
 def ik(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
-    """Inverse kinematics: ``y`` (task values, laid out as ``task_value_names``) -> ``q``, ``qa``, ``residual``;
-    each sample from the previous one's solution (the first from ``seed``), in the working mode ``branch`` (a
-    named branch of the spec) when given."""
+    """Inverse kinematics: ``y`` (task values, laid out as ``task_value_names``) -> ``q``, ``qa``, ``residual``,
+    ``iterations``; each sample from the previous one's solution (the first from ``seed``), in the working mode
+    ``branch`` (a named branch of the spec) when given."""
     from pkm.core.kinematics.solve import solve_ik
 
-    y = _array(body, "y", mech.task_map.value_size)
-    seed = _optional(body, "seed", mech.nq)
+    y = _array(body, "y", mech.task_map.value_size, _position_kinds(mech, "y"))
+    seed = _seed(mech, body)
     branch = body.get("branch")
     if branch is not None and not isinstance(branch, str):
         raise InvalidInputError("branch", "a branch name", branch)
-    q = [mech.q_reference if seed is None else seed[0]]
+    q = [seed]
 
     def one(k: int) -> dict[str, Any]:
         r = solve_ik(mech, y[k], q[0], branch=branch)
         q[0] = r.q
-        return {"q": r.q, "qa": mech.actuated_q(r.q), "residual": r.residual, "iterations": r.iterations}
+        return {"q": r.q, "qa": mech.actuated_q(r.q), "residual": r.residual, "iterations": int(r.iterations)}
 
-    out = _columns(_each(len(y), one), ("q", "qa", "residual", "iterations"))
-    out["units"] = {"qa": [_unit(mech, j) for j in mech.actuated_names], "residual": "m or rad"}
+    out = _Samples(len(y), _is_single(body, "y")).each(one, ("q", "qa", "residual", "iterations"))
+    out["units"] = {"q": _q_units(mech), "qa": _actuated_units(mech), "residual": "m or rad", "iterations": "1",
+                    "y": _value_units(mech)}
     return out
 
 
+@_per_mechanism
+def _jacobian_units(mech: Mechanism) -> dict[str, Any]:
+    task, act = list(_task_units(mech).values()), _actuated_units(mech)
+    return {"J": _matrix_units(task, act), "K": _matrix_units(act, task), "q": _q_units(mech)}
+
+
 def jacobians(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
-    """At closed configurations ``q``: the forward Jacobian ``J`` (task rates per actuated rate) and the inverse
-    ``K`` (actuated rates per task rate)."""
+    """At closed configurations (``q``, or ``qa`` closed): the forward Jacobian ``J`` (task rates per actuated rate)
+    and the inverse ``K`` (actuated rates per task rate), with ``q``."""
     from pkm.core.differential.velocity import forward_jacobian, inverse_jacobian
 
-    q = _array(body, "q", mech.nq)
+    q, samples = _configurations(mech, body, kernels)
     out: dict[str, Any] | None = None
-    if kernels is not None and len(q) > 1:
+    if kernels is not None and len(q) > 1 and not any(samples.errors):
         try:
-            out = {"status": ["ok"] * len(q), "J": kernels.forward_jacobian(q), "K": kernels.inverse_jacobian(q)}
+            out = samples.columns({"q": q, "J": kernels.forward_jacobian(q), "K": kernels.inverse_jacobian(q)})
         except PkmError:
             out = None
     if out is None:
-        out = _columns(_each(len(q), lambda k: {"J": forward_jacobian(mech, q[k]),
-                                                "K": inverse_jacobian(mech, q[k])}), ("J", "K"))
-    out["units"] = {"rows": list(_task_units(mech).values()),
-                    "columns": [_unit(mech, j) for j in mech.actuated_names]}
+        out = samples.each(lambda k: {"q": q[k], "J": forward_jacobian(mech, q[k]), "K": inverse_jacobian(mech, q[k])},
+                           ("q", "J", "K"))
+    out["units"] = _jacobian_units(mech)
     return out
 
 
 def diagnose(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
-    """At closed configurations ``q``: the distances to the direct and inverse singularities and the closure
-    residual (:func:`pkm.diagnose`)."""
+    """At closed configurations (``q``, or ``qa`` closed): the distances to the direct and inverse singularities
+    (:func:`pkm.diagnose`: smallest over largest singular value of the homogenised Jacobians, in [0, 1]), with
+    ``q``."""
     from pkm.core.differential.velocity import diagnose as run
 
-    q = _array(body, "q", mech.nq)
+    q, samples = _configurations(mech, body, kernels)
 
     def one(k: int) -> dict[str, Any]:
         d = run(mech, q[k])
-        return {"direct_distance": d.direct_distance, "inverse_distance": d.inverse_distance}
+        return {"q": q[k], "direct_distance": d.direct_distance, "inverse_distance": d.inverse_distance}
 
-    return _columns(_each(len(q), one), ("direct_distance", "inverse_distance"))
+    out = samples.each(one, ("q", "direct_distance", "inverse_distance"))
+    out["units"] = {"q": _q_units(mech), "direct_distance": "1", "inverse_distance": "1"}
+    return out
 
 
 def velocities(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
-    """At closed configurations ``q`` and actuated rates ``qd``: every joint's rate ``v`` and the task rates ``yd``;
-    with the actuated accelerations ``qdd`` too, every joint's acceleration ``a`` (the loops closed at the
-    acceleration level) and the task accelerations ``ydd``."""
+    """At closed configurations (``q``, or ``qa`` closed) and actuated rates ``qd``: every joint's rate ``v`` and the
+    task rates ``yd``; with the actuated accelerations ``qdd`` too, every joint's acceleration ``a`` (the loops closed
+    at the acceleration level) and the task accelerations ``ydd``."""
     from pkm.core.differential.velocity import accelerations, forward_jacobian, task_acceleration
     from pkm.core.differential.velocity import velocities as joint_rates
 
-    q, qd = _array(body, "q", mech.nq), _array(body, "qd", mech.na)
+    q, configured = _configurations(mech, body, kernels, "qd", "qdd")
+    qd = _array(body, "qd", mech.na)
     qdd = _optional(body, "qdd", mech.na)
     n = _same_length(q=q, qd=qd, qdd=qdd)
+    samples = _Samples(n, configured.single, [configured.errors[0 if len(q) == 1 else k] for k in range(n)])
 
     def one(k: int) -> dict[str, Any]:
         qk, qdk = _row(q, k), _row(qd, k)
         v = joint_rates(mech, qk, qdk)
-        out = {"v": v, "yd": forward_jacobian(mech, qk) @ qdk}
+        out = {"q": qk, "v": v, "yd": forward_jacobian(mech, qk) @ qdk}
         if qdd is not None:
             a = accelerations(mech, qk, v, _row(qdd, k))
             out.update(a=a, ydd=task_acceleration(mech, qk, v, a))
         return out
 
-    return _columns(_each(n, one), ("v", "yd") + (("a", "ydd") if qdd is not None else ()))
+    out = samples.each(one, ("q", "v", "yd") + (("a", "ydd") if qdd is not None else ()))
+    task = list(_task_units(mech).values())
+    out["units"] = {"q": _q_units(mech), "v": _v_units(mech), "yd": _rates(task), "qd": _actuated_units(mech, "rate"),
+                    "a": _v_units(mech, 2), "ydd": _rates(task, "/s^2"), "qdd": _actuated_units(mech, "acceleration")}
+    return out
 
 
 def dynamics(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
-    """The actuator-space model at closed states ``(q, qd)``: ``M`` (``M_a``), ``h`` (``h_a``), ``g`` (``g_a``), and
-    with ``qdd`` the inverse dynamics ``tau = M_a qdd + h_a`` [N m, N]."""
+    """The actuator-space model at closed states (``q``, or ``qa`` closed; ``qd``, default 0): ``M`` (``M_a``),
+    ``h`` (``h_a``), ``g`` (``g_a``), and with ``qdd`` the inverse dynamics ``tau = M_a qdd + h_a`` [N m, N]."""
     from pkm.core.dynamics.model import actuator_model
 
-    q = _array(body, "q", mech.nq)
+    q, configured = _configurations(mech, body, kernels, "qd", "qdd")
     qd = _optional(body, "qd", mech.na)
     qdd = _optional(body, "qdd", mech.na)
     n = _same_length(q=q, qd=qd, qdd=qdd)
+    samples = _Samples(n, configured.single, [configured.errors[0 if len(q) == 1 else k] for k in range(n)])
+    keys = ("q", "M", "h", "g") + (("tau",) if qdd is not None else ())
 
     def one(k: int) -> dict[str, Any]:
         m = actuator_model(mech, _row(q, k), None if qd is None else _row(qd, k))
-        out = {"M": m.M, "h": m.h, "g": m.g}
+        out = {"q": _row(q, k), "M": m.M, "h": m.h, "g": m.g}
         if qdd is not None:
             out["tau"] = m.M @ _row(qdd, k) + m.h
         return out
 
     out: dict[str, Any] | None = None
-    if kernels is not None and n > 1:
+    if kernels is not None and n > 1 and not any(samples.errors):
         try:  # (the compiled model in batches)
-            Q = np.broadcast_to(q, (n, mech.nq)) if len(q) == 1 else q
-            QD = np.zeros((n, mech.na)) if qd is None else np.broadcast_to(qd, (n, mech.na))
-            M, h = kernels.mass_and_bias(np.ascontiguousarray(Q), np.ascontiguousarray(QD))
-            out = {"status": ["ok"] * n, "M": M, "h": h, "g": kernels.gravity(np.ascontiguousarray(Q))}
+            Q = np.ascontiguousarray(np.broadcast_to(q, (n, mech.nq)))
+            QD = np.zeros((n, mech.na)) if qd is None else np.ascontiguousarray(np.broadcast_to(qd, (n, mech.na)))
+            M, h = kernels.mass_and_bias(Q, QD)
+            values = {"q": Q, "M": M, "h": h, "g": kernels.gravity(Q)}
             if qdd is not None:
-                out["tau"] = np.einsum("kij,kj->ki", M, np.broadcast_to(qdd, (n, mech.na))) + h
+                values["tau"] = np.einsum("kij,kj->ki", M, np.broadcast_to(qdd, (n, mech.na))) + h
+            out = samples.columns(values)
         except PkmError:
             out = None
     if out is None:
-        out = _columns(_each(n, one), ("M", "h", "g") + (("tau",) if qdd is not None else ()))
-    out["units"] = {"tau": [_unit(mech, j, "effort") for j in mech.actuated_names]}
+        out = samples.each(one, keys)
+    effort, acc = _actuated_units(mech, "effort"), _actuated_units(mech, "acceleration")
+    out["units"] = {"q": _q_units(mech), "M": _matrix_units(effort, acc), "h": effort, "g": effort, "tau": effort,
+                    "qd": _actuated_units(mech, "rate"), "qdd": acc}
     return out
 
 
 def capability(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
-    """At closed configurations ``q``, the ``kind`` capability (``wrench``, ``twist``, ``acceleration``) under the
-    actuators' limits: the largest value along each task axis each way, the largest isotropic value per unit, the
-    polytope's vertices (:func:`pkm.capability`), ``origin_inside`` (1, or 0 where the actuators cannot hold the
-    weight: the indices are then 0)."""
+    """At closed configurations (``q``, or ``qa`` closed), the ``kind`` capability (``wrench``, ``twist``,
+    ``acceleration``) under the actuators' limits: the largest value along each task axis each way, the largest
+    isotropic value per unit, the polytope's vertices (:func:`pkm.capability`), ``origin_inside`` (false where the
+    actuators cannot hold the weight: the indices are then 0)."""
     from pkm.core.analysis.capability import KINDS
     from pkm.core.analysis.capability import capability as run
 
-    q = _array(body, "q", mech.nq)
     kind = body.get("kind", "wrench")
     if kind not in KINDS:
         raise InvalidInputError("kind", f"one of {list(KINDS)}", kind)
+    q, samples = _configurations(mech, body, kernels)
 
     def one(k: int) -> dict[str, Any]:
         c = run(mech, q[k], kind)
-        return {"along": np.array(list(c.along.values())), "vertices": c.polytope.vertices,
-                "isotropic": np.array(list(c.isotropic.values())), "origin_inside": float(c.origin_inside)}
+        return {"q": q[k], "along": np.array(list(c.along.values())), "vertices": c.polytope.vertices,
+                "isotropic": np.array(list(c.isotropic.values())), "origin_inside": bool(c.origin_inside)}
 
-    out = _columns(_each(len(q), one), ("along", "vertices", "isotropic", "origin_inside"))
-    c0 = run(mech, mech.q_reference, kind) if len(q) else None
-    if c0 is not None:
-        out["axes"] = list(c0.polytope.axes)
-        out["units"] = {"along": list(c0.polytope.units), "isotropic": list(c0.isotropic)}
+    out = samples.each(one, ("q", "along", "vertices", "isotropic", "origin_inside"))
+    c0 = run(mech, mech.q_reference, kind)
+    out["kind"] = kind
+    out["axes"] = list(c0.polytope.axes)
+    out["units"] = {"q": _q_units(mech), "along": list(c0.polytope.units), "vertices": list(c0.polytope.units),
+                    "isotropic": list(c0.isotropic), "origin_inside": "1"}
     return out
 
 
@@ -287,21 +518,26 @@ _SCENES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def scene(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
-    """At configurations ``q``: the world placement of every body of the model's 3-D scene (the preview page's,
-    :class:`pkm.viz.scene.Scene`), as ``paths`` (meshcat paths) and ``matrices`` (per sample and body, 16 numbers
-    column-major, as meshcat's ``set_transform`` takes them)."""
+    """At configurations (``q``, or ``qa`` closed): the world placement of every body of the model's 3-D scene (the
+    preview page's, :class:`pkm.viz.scene.Scene`), as ``paths`` (meshcat paths) and ``matrices`` (per sample and
+    body, the 4 x 4 homogeneous transform's 16 numbers column-major, as meshcat's ``set_transform`` takes them: the
+    translation, entries 12 to 14, in m)."""
     from pkm.viz.scene import Scene
 
-    q = _array(body, "q", mech.nq)
+    q, samples = _configurations(mech, body, kernels)
     if mech not in _SCENES:
         _SCENES[mech] = Scene.from_mechanism(mech)
     sc = _SCENES[mech]
     paths = [b.path for b in sc.bodies]
-    matrices = []
-    for k in range(len(q)):
+
+    def one(k: int) -> dict[str, Any]:
         placed = sc.transforms(mech.check_q(q[k]))
-        matrices.append([np.asarray(placed[p]).T.ravel() for p in paths])
-    return {"paths": paths, "matrices": np.array(matrices)}
+        return {"q": q[k], "matrices": np.array([np.asarray(placed[p]).T.ravel() for p in paths])}
+
+    out = samples.each(one, ("q", "matrices"))
+    out["paths"] = paths
+    out["units"] = {"q": _q_units(mech), "matrices": ["1"] * 12 + ["m"] * 3 + ["1"]}
+    return out
 
 
 #: The queries by name (the endpoints ``POST /models/{model}/{name}``).
@@ -316,10 +552,10 @@ def describe(mech: Mechanism) -> dict[str, Any]:
     return {"name": mech.name, "nq": mech.nq, "nv": mech.nv, "na": mech.na,
             "joints": list(mech.joints), "actuated": list(mech.actuated_names),
             "actuated_q": [int(i) for i in mech.act_q],
-            "actuated_units": [_unit(mech, j) for j in mech.actuated_names],
+            "actuated_units": _actuated_units(mech),
             "task": list(mech.task_map.keys), "task_units": _task_units(mech),
             "task_value_names": list(mech.task_map.value_names), "task_value_units": _value_units(mech),
-            "q_reference": mech.q_reference,
+            "q_reference": mech.q_reference, "q_units": _q_units(mech),
             "branches": list(mech.spec.branches), "limits": mech.limits}
 
 
