@@ -5,7 +5,8 @@ site). Outside traffic is blocked twice: every host name but ``127.0.0.1`` resol
 (``--host-resolver-rules``), and every request that is not to the loopback goes to a proxy that is not there
 (``--proxy-server`` on a closed port of 127.0.0.1; Chromium sends loopback requests directly), so that an address
 written as a number fails too. The pages' requests are recorded (the Network domain), whether they succeeded or not,
-as are console errors, uncaught exceptions and failed loads.
+as are console errors, uncaught exceptions and failed loads; the pages' workers (attached as they start) are
+watched the same way.
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ class OfflineBrowser:
     uncaught exceptions and failed requests (with their URL and reason).
     """
 
-    def __init__(self, chromium: str, folder: Path, width: int = 1200, height: int = 900):
+    def __init__(self, chromium: str, folder: Path, width: int = 1200, height: int = 900, cache: bool = False):
         from websockets.sync.client import connect
 
         self.proc = subprocess.Popen(
@@ -67,15 +68,18 @@ class OfflineBrowser:
             self.proc.kill()
             self.proc.wait(timeout=30)
             raise
-        self.next_id = 0
+        self.next_id, self._sent = 0, 10**9  # (commands awaited; commands sent to workers, not awaited)
         self.requests: list[str] = []
         self._urls: dict[str, str] = {}
         self._pending: set[str] = set()
+        self._workers: set[str] = set()
         self.errors: list[str] = []
         self._loaded = False
         for domain in ("Runtime", "Log", "Page", "Network"):
             self.call(f"{domain}.enable")
-        self.call("Network.setCacheDisabled", cacheDisabled=True)  # (every page's requests seen, none from cache)
+        # (no cache: every page's requests go to the network, where they are seen; a cached file was seen once)
+        self.call("Network.setCacheDisabled", cacheDisabled=not cache)
+        self.call("Target.setAutoAttach", autoAttach=True, waitForDebuggerOnStart=False, flatten=True)
 
     def __enter__(self) -> OfflineBrowser:
         return self
@@ -97,12 +101,18 @@ class OfflineBrowser:
 
     def _event(self, message: dict) -> None:
         method, params = message.get("method"), message.get("params", {})
-        if method == "Network.requestWillBeSent":
+        if method == "Target.attachedToTarget":  # (a worker: its requests, console and exceptions recorded too)
+            self._workers.add(params["targetInfo"].get("url", ""))  # (started: its script came, said or not)
+            for domain in ("Network", "Runtime"):
+                self._sent += 1
+                self.ws.send(json.dumps({"id": self._sent, "method": f"{domain}.enable",
+                                         "sessionId": params["sessionId"]}))
+        elif method == "Network.requestWillBeSent":
             self.requests.append(params["request"]["url"])
             self._urls[params["requestId"]] = params["request"]["url"]
             if urlsplit(params["request"]["url"]).scheme not in LOCAL_SCHEMES:  # (data: and blob: never finish)
                 self._pending.add(params["requestId"])
-        elif method == "Network.loadingFinished":
+        elif method in ("Network.loadingFinished", "Network.responseReceived"):  # (a worker's script: no finish)
             self._pending.discard(params["requestId"])
         elif method == "Network.loadingFailed":
             self._pending.discard(params["requestId"])
@@ -148,16 +158,22 @@ class OfflineBrowser:
             time.sleep(0.05)
 
     def settle(self, quiet: float = 0.25, timeout: float = 10.0) -> None:
-        """Record events until no request is pending and none came for ``quiet`` seconds (at most ``timeout``)."""
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
+        """Record events until no request is pending and none was sent or answered for ``quiet`` seconds (at most
+        ``timeout``)."""
+        now = time.monotonic()
+        deadline, last = now + timeout, now
+        while now < deadline:
+            waiting = [i for i in self._pending if self._urls[i] not in self._workers]
+            if not waiting and now - last >= quiet:
+                return
             try:
-                message = self.ws.recv(timeout=quiet)
+                message = json.loads(self.ws.recv(timeout=quiet))
             except TimeoutError:
-                if not self._pending:
-                    return
-                continue
-            self._event(json.loads(message))
+                message = {}
+            self._event(message)
+            now = time.monotonic()
+            if message.get("method", "").startswith("Network."):
+                last = now
 
     def outside(self) -> list[str]:
         """The URLs of this page's requests that were to leave the machine."""
