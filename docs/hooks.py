@@ -58,7 +58,8 @@ def render_maths(content: str, where: str = "") -> str:
             return mathml(tex[2:-2], False, where)
         if tex.startswith("\\[") and tex.endswith("\\]"):
             tex = tex[2:-2]
-        return f'<div class="arithmatex">{mathml(tex, True, where)}</div>'  # (a block: Material's style, scrolling)
+        # (a block in Material's style, scrolling sideways if it is wide; no vertical scroll bar for a tall one)
+        return f'<div class="arithmatex" style="overflow-y: hidden">{mathml(tex, True, where)}</div>'
 
     return _ARITHMATEX.sub(formula, content)
 

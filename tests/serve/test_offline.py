@@ -7,6 +7,8 @@ blocked. Skipped without Chromium, a failure when ``PKM_REQUIRE_BROWSER`` is set
 
 from __future__ import annotations
 
+import re
+
 import httpx
 import pytest
 
@@ -62,3 +64,15 @@ def test_an_outside_request_is_seen_and_blocked(browser):
     browser.settle()
     assert browser.outside() == urls
     assert all(any(e.startswith("request failed") and e.endswith(u) for e in browser.errors) for u in urls)
+
+
+def test_the_docs_pages_stay_behind_the_token(service):
+    """Nothing is exempted from the token for the docs: without it the pages, their files and the schema are 401;
+    a page opened with ``?token=`` passes it on to everything it loads (and no CDN address is in it)."""
+    for path in ("/docs", "/redoc", "/openapi.json", "/docs-static/redoc.js", "/docs-static/swagger-ui.css"):
+        assert httpx.get(f"{service.url}{path}").status_code == 401, path
+    for path in ("/docs", "/redoc"):
+        page = httpx.get(f"{service.url}{path}?token={TOKEN}")
+        assert page.status_code == 200
+        urls = re.findall(r"""(?:src|href|url|spec-url)[=:]\s*["']([^"']+)["']""", page.text)
+        assert len(urls) >= 3 and all(u.startswith("/") and u.endswith(f"?token={TOKEN}") for u in urls), urls
