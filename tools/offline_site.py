@@ -83,25 +83,26 @@ def check(site: Path, chromium: str, timeout: float = 30.0) -> tuple[list[str], 
     try:
         with tempfile.TemporaryDirectory() as folder, OfflineBrowser(chromium, Path(folder), cache=True) as browser:
             for page in pages(site):
+                name = page or "/"
                 try:
                     browser.load(base + page, timeout)
                     browser.settle(quiet=0.1, timeout=timeout)
                     seen = browser.evaluate(PROBE % repr(list(RAW_TEX)).replace("'", '"'))
                 except (RuntimeError, TimeoutError) as e:
-                    findings.append(f"{page}: did not load: {e}")
+                    findings.append(f"{name}: did not load: {e}")
                     continue
                 counts["pages"] += 1
                 counts["maths"] += seen["maths"]
                 counts["requests"] += len(browser.requests)
-                findings += [f"{page}: a request leaves 127.0.0.1: {u}" for u in browser.outside()]
-                findings += [f"{page}: {e}" for e in browser.errors]
+                findings += [f"{name}: a request leaves 127.0.0.1: {u}" for u in browser.outside()]
+                findings += [f"{name}: {e}" for e in browser.errors]
                 if not seen["h1"]:
-                    findings.append(f"{page}: no h1 (the page did not render)")
-                findings += [f"{page}: raw TeX in the text: ...{r}..." for r in seen["raw"]]
-                findings += [f"{page}: a formula left as TeX: {t}" for t in seen["leftover"]]
-                findings += [f"{page}: a formula drawn with no size: {t}" for t in seen["empty"]]
+                    findings.append(f"{name}: no h1 (the page did not render)")
+                findings += [f"{name}: raw TeX in the text: ...{r}..." for r in seen["raw"]]
+                findings += [f"{name}: a formula left as TeX: {t}" for t in seen["leftover"]]
+                findings += [f"{name}: a formula drawn with no size: {t}" for t in seen["empty"]]
                 if seen["merror"]:
-                    findings.append(f"{page}: {seen['merror']} MathML error(s) (merror)")
+                    findings.append(f"{name}: {seen['merror']} MathML error(s) (merror)")
     finally:
         server.shutdown()
         server.server_close()
@@ -124,8 +125,13 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     t0 = time.perf_counter()
     findings, counts = check(args.site, args.chromium, args.timeout)
+    pages_of: dict[str, list[str]] = {}  # (a finding on every page, such as a CDN's script, printed once)
     for line in findings:
-        print(f"offline_site: {line}")
+        page, _, finding = line.partition(": ")
+        pages_of.setdefault(finding, []).append(page)
+    for finding, where in pages_of.items():
+        more = f" and {len(where) - 3} more pages" if len(where) > 3 else ""
+        print(f"offline_site: {', '.join(where[:3])}{more}: {finding}")
     print(f"offline_site: {counts['pages']} pages, {counts['maths']} formulas, {counts['requests']} requests, "
           f"{len(findings)} findings, {time.perf_counter() - t0:.1f} s")
     return 1 if findings else 0
