@@ -112,7 +112,7 @@ class OfflineBrowser:
             self._urls[params["requestId"]] = params["request"]["url"]
             if urlsplit(params["request"]["url"]).scheme not in LOCAL_SCHEMES:  # (data: and blob: never finish)
                 self._pending.add(params["requestId"])
-        elif method in ("Network.loadingFinished", "Network.responseReceived"):  # (a worker's script: no finish)
+        elif method in ("Network.loadingFinished", "Network.responseReceived"):  # (answered: no longer awaited)
             self._pending.discard(params["requestId"])
         elif method == "Network.loadingFailed":
             self._pending.discard(params["requestId"])

@@ -15,18 +15,21 @@ It serves ``site/`` (the default) on 127.0.0.1 and loads each of its pages (ever
   formula left without MathML, a MathML error (``merror``), or a formula drawn with no size.
 
 It prints the number of pages, of formulas and of requests, and its wall time. Chromium is required (Debian's
-``chromium``; ``--chromium`` to give another).
+``chromium``; ``--chromium`` to give another); ``--jobs`` browsers share the pages (default: half the CPUs, at most
+4).
 """
 
 from __future__ import annotations
 
 import argparse
 import functools
+import os
 import shutil
 import sys
 import tempfile
 import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 
@@ -73,39 +76,48 @@ class _Quiet(SimpleHTTPRequestHandler):
         pass
 
 
-def check(site: Path, chromium: str, timeout: float = 30.0) -> tuple[list[str], dict]:
-    """The findings (one line each; none: the site works offline) and the counts of the run."""
+def _visit(browser: OfflineBrowser, url: str, name: str, timeout: float) -> tuple[list[str], dict]:
+    """One page's findings and counts."""
+    try:
+        browser.load(url, timeout)
+        browser.settle(quiet=0.1, timeout=timeout)
+        seen = browser.evaluate(PROBE % repr(list(RAW_TEX)).replace("'", '"'))
+    except (RuntimeError, TimeoutError) as e:
+        return [f"{name}: did not load: {e}"], {"pages": 0, "maths": 0, "requests": 0}
+    findings = [f"{name}: a request leaves 127.0.0.1: {u}" for u in browser.outside()]
+    findings += [f"{name}: {e}" for e in browser.errors]
+    if not seen["h1"]:
+        findings.append(f"{name}: no h1 (the page did not render)")
+    findings += [f"{name}: raw TeX in the text: ...{r}..." for r in seen["raw"]]
+    findings += [f"{name}: a formula left as TeX: {t}" for t in seen["leftover"]]
+    findings += [f"{name}: a formula drawn with no size: {t}" for t in seen["empty"]]
+    if seen["merror"]:
+        findings.append(f"{name}: {seen['merror']} MathML error(s) (merror)")
+    return findings, {"pages": 1, "maths": seen["maths"], "requests": len(browser.requests)}
+
+
+def check(site: Path, chromium: str, timeout: float = 30.0, jobs: int = 1) -> tuple[list[str], dict]:
+    """The findings (one line each, in the pages' order; none: the site works offline) and the counts of the run;
+    ``jobs`` browsers load the pages side by side."""
     server = ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(_Quiet, directory=str(site)))
     threading.Thread(target=server.serve_forever, daemon=True).start()
     base = f"http://127.0.0.1:{server.server_address[1]}/"
-    findings: list[str] = []
-    counts = {"pages": 0, "maths": 0, "requests": 0}
-    try:
+    names = pages(site)
+    results: dict[str, tuple[list[str], dict]] = {}
+
+    def work(share: list[str]) -> None:
         with tempfile.TemporaryDirectory() as folder, OfflineBrowser(chromium, Path(folder), cache=True) as browser:
-            for page in pages(site):
-                name = page or "/"
-                try:
-                    browser.load(base + page, timeout)
-                    browser.settle(quiet=0.1, timeout=timeout)
-                    seen = browser.evaluate(PROBE % repr(list(RAW_TEX)).replace("'", '"'))
-                except (RuntimeError, TimeoutError) as e:
-                    findings.append(f"{name}: did not load: {e}")
-                    continue
-                counts["pages"] += 1
-                counts["maths"] += seen["maths"]
-                counts["requests"] += len(browser.requests)
-                findings += [f"{name}: a request leaves 127.0.0.1: {u}" for u in browser.outside()]
-                findings += [f"{name}: {e}" for e in browser.errors]
-                if not seen["h1"]:
-                    findings.append(f"{name}: no h1 (the page did not render)")
-                findings += [f"{name}: raw TeX in the text: ...{r}..." for r in seen["raw"]]
-                findings += [f"{name}: a formula left as TeX: {t}" for t in seen["leftover"]]
-                findings += [f"{name}: a formula drawn with no size: {t}" for t in seen["empty"]]
-                if seen["merror"]:
-                    findings.append(f"{name}: {seen['merror']} MathML error(s) (merror)")
+            for page in share:
+                results[page] = _visit(browser, base + page, page or "/", timeout)
+
+    try:
+        with ThreadPoolExecutor(max(1, jobs)) as pool:
+            list(pool.map(work, [names[i::max(1, jobs)] for i in range(max(1, jobs))]))
     finally:
         server.shutdown()
         server.server_close()
+    findings = [f for page in names for f in results[page][0]]
+    counts = {k: sum(results[page][1][k] for page in names) for k in ("pages", "maths", "requests")}
     return findings, counts
 
 
@@ -115,6 +127,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--chromium", default=shutil.which("chromium") or "/usr/bin/chromium",
                         help="the Chromium executable (default: chromium on the PATH)")
     parser.add_argument("--timeout", type=float, default=30.0, help="seconds a page may take to load [s]")
+    parser.add_argument("--jobs", type=int, default=max(1, min(4, (os.cpu_count() or 2) // 2)),
+                        help="browsers loading pages side by side (default: half the CPUs, at most 4)")
     args = parser.parse_args(argv)
     if not (args.site / "index.html").exists():
         print(f"offline_site: {args.site} holds no built site (index.html); run `make docs` first", file=sys.stderr)
@@ -124,7 +138,7 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)
         return 2
     t0 = time.perf_counter()
-    findings, counts = check(args.site, args.chromium, args.timeout)
+    findings, counts = check(args.site, args.chromium, args.timeout, args.jobs)
     pages_of: dict[str, list[str]] = {}  # (a finding on every page, such as a CDN's script, printed once)
     for line in findings:
         page, _, finding = line.partition(": ")
@@ -133,7 +147,7 @@ def main(argv: list[str] | None = None) -> int:
         more = f" and {len(where) - 3} more pages" if len(where) > 3 else ""
         print(f"offline_site: {', '.join(where[:3])}{more}: {finding}")
     print(f"offline_site: {counts['pages']} pages, {counts['maths']} formulas, {counts['requests']} requests, "
-          f"{len(findings)} findings, {time.perf_counter() - t0:.1f} s")
+          f"{len(findings)} findings, {time.perf_counter() - t0:.1f} s ({args.jobs} browsers)")
     return 1 if findings else 0
 
 

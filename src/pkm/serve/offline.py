@@ -12,9 +12,9 @@ blocked).
 
 With a token (``pkm serve --token``), the pages are behind it like every route but ``/`` and ``/health``: a browser
 opens ``/docs?token=<token>`` (the service takes ``?token=`` on a GET), and the page passes the token it was opened
-with on to what it loads (the static files and ``/openapi.json``), so that nothing has to be exempted from the
-token: the schema, which names the uploaded models, stays as private as they are. (Swagger UI's "Try it out" on a
-POST route still needs the ``Authorization: Bearer`` header, which a browser page does not add by itself.)
+with on to what it loads (the static files and ``/openapi.json``), so that no route has to be exempted from the
+token: the service shows nothing, not even its schema, to a client without it. (Swagger UI's "Try it out" on a POST
+route still needs the ``Authorization: Bearer`` header, which a browser page does not add by itself.)
 """
 
 # (no ``from __future__ import annotations``: FastAPI reads the routes' annotations)
