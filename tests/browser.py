@@ -12,7 +12,9 @@ watched the same way.
 from __future__ import annotations
 
 import json
+import os
 import re
+import signal
 import subprocess
 import threading
 import time
@@ -45,7 +47,7 @@ class OfflineBrowser:
              "--disable-background-networking", "--disable-component-update", "--no-first-run",
              "--host-resolver-rules=MAP * ~NOTFOUND , EXCLUDE 127.0.0.1", "--proxy-server=http://127.0.0.1:9",
              f"--window-size={width},{height}", "--remote-debugging-port=0", f"--user-data-dir={folder}",
-             "about:blank"], stderr=subprocess.PIPE, text=True)
+             "about:blank"], stderr=subprocess.PIPE, text=True, start_new_session=True)
         try:
             port = None
             deadline = time.monotonic() + 30
@@ -65,8 +67,7 @@ class OfflineBrowser:
             self._connection = connect(pages[0]["webSocketDebuggerUrl"], max_size=2**26, proxy=None)
             self.ws = self._connection.__enter__()
         except BaseException:
-            self.proc.kill()
-            self.proc.wait(timeout=30)
+            self._stop()
             raise
         self.next_id, self._sent = 0, 10**9  # (commands awaited; commands sent to workers, not awaited)
         self.requests: list[str] = []
@@ -180,8 +181,17 @@ class OfflineBrowser:
         return [u for u in self.requests if leaves_the_machine(u)]
 
     def close(self) -> None:
+        """Chromium stopped: asked (SIGTERM: it ends its renderers and lets go of its profile folder), killed with
+        the processes it started if it takes over 10 s."""
         try:
             self._connection.__exit__(None, None, None)
         finally:
-            self.proc.kill()
+            self._stop()
+
+    def _stop(self) -> None:
+        self.proc.terminate()
+        try:
+            self.proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            os.killpg(self.proc.pid, signal.SIGKILL)  # (its own process group: start_new_session)
             self.proc.wait(timeout=30)
