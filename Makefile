@@ -34,6 +34,6 @@ clean:
 # installs the `docs` extra into the venv when it is missing. (The two variables silence the banners Material and
 # properdocs print about MkDocs 2; they are not build warnings.)
 docs: $(STAMP)
-	$(PY) -c "import mkdocs, material, mkdocstrings_handlers.python, mkdocs_gen_files, mkdocs_literate_nav" 2>/dev/null \
+	$(PY) -c "import mkdocs, material, mkdocstrings_handlers.python, mkdocs_gen_files, mkdocs_literate_nav, latex2mathml" 2>/dev/null \
 		|| $(PY) -m pip install --quiet -e ".[docs]"
 	NO_MKDOCS_2_WARNING=1 DISABLE_MKDOCS_2_WARNING=true $(PY) -m mkdocs build --strict -d site

@@ -9,7 +9,7 @@ kernels, previews); the rest is behind extras, named in ``pyproject.toml``'s ``[
     pip install "pkm[homotopy]"  # every assembly mode (pkm.assembly_modes): Bertini 2 (GPL-3)
     pip install "pkm[bench]"     # the benchmarks' baseline: MuJoCo
     pip install "pkm[identify]"  # identification's physically consistent estimate: cvxpy with Clarabel
-    pip install "pkm[serve]"     # the service (pkm serve) and its client: FastAPI, uvicorn, msgpack, httpx
+    pip install "pkm[serve]"     # the service (pkm serve) and its client: FastAPI, uvicorn, msgpack, httpx, offline docs
     pip install "pkm[jax]"       # the twin's kernels as JAX functions (jit, vmap, grad; GPU): JAX
     pip install "pkm[all]"       # all of them
 
@@ -35,7 +35,8 @@ EXTRAS: dict[str, dict[str, str]] = {
     "bench": {"mujoco": "mujoco"},
     "identify": {"cvxpy": "cvxpy", "clarabel": "clarabel"},
     "serve": {"fastapi": "fastapi", "starlette": "starlette", "uvicorn": "uvicorn", "multipart": "python-multipart",
-              "msgpack": "msgpack", "httpx": "httpx", "websockets": "websockets", "pydantic": "pydantic"},
+              "msgpack": "msgpack", "httpx": "httpx", "websockets": "websockets", "pydantic": "pydantic",
+              "fastapi_offline": "fastapi-offline"},
     "jax": {"jax": "jax"},
 }
 

@@ -163,6 +163,7 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
     from pkm import MECHANISMS, __version__
     from pkm.serve import schemas
     from pkm.serve.jobs import KINDS, JobManager
+    from pkm.serve.offline import add_offline_docs
     from pkm.serve.queries import QUERIES, describe
 
     store = Store() if store is None else store
@@ -170,7 +171,9 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
     limiter = Limiter(workers, queue)
     jobs = JobManager(job_workers)
     app = FastAPI(title="pkm", version=__version__,
-                  description="Kinematics and dynamics of closed-loop mechanisms: models, queries, streams.")
+                  description="Kinematics and dynamics of closed-loop mechanisms: models, queries, streams.",
+                  docs_url=None, redoc_url=None)
+    add_offline_docs(app)  # (/docs and /redoc from local files, not FastAPI's CDN: pkm.serve.offline)
 
     def answer(request: Request, payload: Any, status: int = 200) -> Response:
         if MSGPACK in request.headers.get("accept", ""):

@@ -18,6 +18,7 @@ _PAGE = """<!DOCTYPE html>
 <head>
 <meta charset="utf-8">
 <title>{title}</title>
+<link rel="icon" href="data:,">
 <style>
 body {{ margin: 0; }}
 #meshcat-pane {{ width: 100vw; height: 100vh; overflow: hidden; }}

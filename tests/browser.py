@@ -1,0 +1,197 @@
+"""Headless Chromium with the outside network off, over the DevTools protocol: every request a page makes recorded.
+
+Used by ``tests/serve/test_offline.py`` (the service's pages) and ``tools/offline_site.py`` (every page of the docs
+site). Outside traffic is blocked twice: every host name but ``127.0.0.1`` resolves to nothing
+(``--host-resolver-rules``), and every request that is not to the loopback goes to a proxy that is not there
+(``--proxy-server`` on a closed port of 127.0.0.1; Chromium sends loopback requests directly), so that an address
+written as a number fails too. The pages' requests are recorded (the Network domain), whether they succeeded or not,
+as are console errors, uncaught exceptions and failed loads; the pages' workers (attached as they start) are
+watched the same way.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import threading
+import time
+from pathlib import Path
+from typing import Any
+from urllib.parse import urlsplit
+
+#: The schemes of URLs that stay inside the browser.
+LOCAL_SCHEMES = ("data", "blob", "about", "chrome", "devtools")
+
+
+def leaves_the_machine(url: str) -> bool:
+    """Whether a request for ``url`` goes anywhere but 127.0.0.1 (or stays inside the browser: ``data:`` ...)."""
+    parts = urlsplit(url)
+    return parts.scheme not in LOCAL_SCHEMES and parts.hostname != "127.0.0.1"
+
+
+class OfflineBrowser:
+    """One headless Chromium page with the outside network off (see the module doc).
+
+    :attr:`requests` holds the URL of every request since the last :meth:`load`, :attr:`errors` the console errors,
+    uncaught exceptions and failed requests (with their URL and reason).
+    """
+
+    def __init__(self, chromium: str, folder: Path, width: int = 1200, height: int = 900, cache: bool = False):
+        from websockets.sync.client import connect
+
+        self.proc = subprocess.Popen(
+            [chromium, "--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+             "--disable-background-networking", "--disable-component-update", "--no-first-run",
+             "--host-resolver-rules=MAP * ~NOTFOUND , EXCLUDE 127.0.0.1", "--proxy-server=http://127.0.0.1:9",
+             f"--window-size={width},{height}", "--remote-debugging-port=0", f"--user-data-dir={folder}",
+             "about:blank"], stderr=subprocess.PIPE, text=True, start_new_session=True)
+        try:
+            port = None
+            deadline = time.monotonic() + 30
+            while port is None and time.monotonic() < deadline:
+                line = self.proc.stderr.readline() if self.proc.stderr else ""
+                m = re.search(r"DevTools listening on ws://127\.0\.0\.1:(\d+)/", line)
+                port = int(m.group(1)) if m else None
+                if not line and self.proc.poll() is not None:
+                    break
+            if port is None:
+                raise RuntimeError("chromium printed no DevTools address")
+            threading.Thread(target=self.proc.stderr.read, daemon=True).start()  # (drained: never a full pipe)
+            import httpx
+
+            with httpx.Client(trust_env=False) as http:  # (no proxy from the environment for the loopback)
+                pages = [t for t in http.get(f"http://127.0.0.1:{port}/json/list").json() if t["type"] == "page"]
+            self._connection = connect(pages[0]["webSocketDebuggerUrl"], max_size=2**26, proxy=None)
+            self.ws = self._connection.__enter__()
+        except BaseException:
+            self._stop()
+            raise
+        self.next_id, self._sent = 0, 10**9  # (commands awaited; commands sent to workers, not awaited)
+        self.requests: list[str] = []
+        self._urls: dict[str, str] = {}
+        self._pending: set[str] = set()
+        self._workers: set[str] = set()
+        self.errors: list[str] = []
+        self._loaded = False
+        for domain in ("Runtime", "Log", "Page", "Network"):
+            self.call(f"{domain}.enable")
+        # (no cache: every page's requests go to the network, where they are seen; a cached file was seen once)
+        self.call("Network.setCacheDisabled", cacheDisabled=not cache)
+        self.call("Target.setAutoAttach", autoAttach=True, waitForDebuggerOnStart=False, flatten=True)
+
+    def __enter__(self) -> OfflineBrowser:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def call(self, method: str, **params: Any) -> dict:
+        """A DevTools command's result (events arriving meanwhile are recorded)."""
+        self.next_id += 1
+        self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
+        while True:
+            message = json.loads(self.ws.recv(timeout=60))
+            if message.get("id") == self.next_id:
+                if "error" in message:
+                    raise RuntimeError(f"{method}: {message['error']}")
+                return message.get("result", {})
+            self._event(message)
+
+    def _event(self, message: dict) -> None:
+        method, params = message.get("method"), message.get("params", {})
+        if method == "Target.attachedToTarget":  # (a worker: its requests, console and exceptions recorded too)
+            self._workers.add(params["targetInfo"].get("url", ""))  # (started: its script came, said or not)
+            for domain in ("Network", "Runtime"):
+                self._sent += 1
+                self.ws.send(json.dumps({"id": self._sent, "method": f"{domain}.enable",
+                                         "sessionId": params["sessionId"]}))
+        elif method == "Network.requestWillBeSent":
+            self.requests.append(params["request"]["url"])
+            self._urls[params["requestId"]] = params["request"]["url"]
+            if urlsplit(params["request"]["url"]).scheme not in LOCAL_SCHEMES:  # (data: and blob: never finish)
+                self._pending.add(params["requestId"])
+        elif method in ("Network.loadingFinished", "Network.responseReceived"):  # (answered: no longer awaited)
+            self._pending.discard(params["requestId"])
+        elif method == "Network.loadingFailed":
+            self._pending.discard(params["requestId"])
+            if not params.get("canceled"):
+                url = self._urls.get(params["requestId"], "?")
+                self.errors.append(f"request failed ({params.get('errorText')}): {url}")
+        elif method == "Runtime.consoleAPICalled" and params.get("type") == "error":
+            self.errors.append(" ".join(str(a.get("value", a.get("description"))) for a in params.get("args", [])))
+        elif method == "Runtime.exceptionThrown":
+            details = params["exceptionDetails"]
+            self.errors.append(details.get("exception", {}).get("description") or details.get("text", "exception"))
+        elif method == "Log.entryAdded" and params["entry"].get("level") == "error":
+            self.errors.append(f"{params['entry'].get('text', '')} {params['entry'].get('url', '')}".strip())
+        elif method == "Page.loadEventFired":
+            self._loaded = True
+
+    def load(self, url: str, timeout: float = 30.0) -> None:
+        """Navigate to ``url`` and wait for its load event; :attr:`requests` and :attr:`errors` start afresh."""
+        self.requests, self.errors, self._urls, self._pending, self._loaded = [], [], {}, set(), False
+        result = self.call("Page.navigate", url=url)
+        if result.get("errorText"):
+            raise RuntimeError(f"{url}: {result['errorText']}")
+        deadline = time.monotonic() + timeout
+        while not self._loaded:
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"{url}: no load event in {timeout} s")
+            self._event(json.loads(self.ws.recv(timeout=max(deadline - time.monotonic(), 0.01))))
+
+    def evaluate(self, expression: str) -> Any:
+        """The value of a JavaScript expression in the page (promises awaited)."""
+        result = self.call("Runtime.evaluate", expression=expression, returnByValue=True, awaitPromise=True)
+        if "exceptionDetails" in result:
+            raise RuntimeError(f"{expression}: {result['exceptionDetails'].get('text')}")
+        return result["result"].get("value")
+
+    def wait(self, expression: str, timeout: float = 30.0) -> Any:
+        """The first truthy value of ``expression``, polled every 50 ms for at most ``timeout`` seconds."""
+        deadline = time.monotonic() + timeout
+        while True:
+            value = self.evaluate(expression)
+            if value or time.monotonic() > deadline:
+                return value
+            time.sleep(0.05)
+
+    def settle(self, quiet: float = 0.25, timeout: float = 10.0) -> None:
+        """Record events until no request is pending and none was sent or answered for ``quiet`` seconds (at most
+        ``timeout``)."""
+        now = time.monotonic()
+        deadline, last = now + timeout, now
+        while now < deadline:
+            waiting = [i for i in self._pending if self._urls[i] not in self._workers]
+            if not waiting and now - last >= quiet:
+                return
+            try:
+                message = json.loads(self.ws.recv(timeout=quiet))
+            except TimeoutError:
+                message = {}
+            self._event(message)
+            now = time.monotonic()
+            if message.get("method", "").startswith("Network."):
+                last = now
+
+    def outside(self) -> list[str]:
+        """The URLs of this page's requests that were to leave the machine."""
+        return [u for u in self.requests if leaves_the_machine(u)]
+
+    def close(self) -> None:
+        """Chromium stopped: asked (SIGTERM: it ends its renderers and lets go of its profile folder), killed with
+        the processes it started if it takes over 10 s."""
+        try:
+            self._connection.__exit__(None, None, None)
+        finally:
+            self._stop()
+
+    def _stop(self) -> None:
+        self.proc.terminate()
+        try:
+            self.proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            os.killpg(self.proc.pid, signal.SIGKILL)  # (its own process group: start_new_session)
+            self.proc.wait(timeout=30)
