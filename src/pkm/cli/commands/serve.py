@@ -17,22 +17,30 @@ from pkm.cli.usage import late_epilog
 def routes() -> list[tuple[str, str, str]]:
     """``(methods, path, summary)`` of every route of the service's application (:func:`pkm.serve.app.create_app`),
     in its order: read from the application, so that the help cannot drift from the service. ``methods`` is ``"WS"``
-    for a WebSocket; the summary is the route's own, else its description's first line, else its name.
+    for a WebSocket; a mounted folder of static files is one line; the catch-alls that answer an unknown query or
+    job kind (404 naming the valid ones) are left out; the summary is the route's own, else its description's first line, else its name.
 
     Raises:
         MissingDependencyError: pkm[serve] is not installed.
     """
+    from starlette.routing import Mount, WebSocketRoute
+
     from pkm.serve.app import create_app
 
     out = []
     for route in create_app().routes:  # (no thread started: the job manager's start with a job)
+        if isinstance(route, Mount):  # (static files under a folder: the docs pages' scripts)
+            out.append(("GET", f"{route.path}/...", f"{route.name}: static files"))
+            continue
+        if route.name.startswith("unknown_"):  # (the catch-alls answering an unknown query or job kind with 404)
+            continue
         methods = sorted(getattr(route, "methods", None) or ())
         if "GET" in methods and "HEAD" in methods:
             methods.remove("HEAD")  # (starlette answers HEAD for every GET)
         description = (getattr(route, "description", "") or "").strip().splitlines()
         summary = getattr(route, "summary", None) or (description[0] if description else "") \
             or route.name.replace("_", " ")
-        out.append((",".join(methods) or "WS", route.path, summary))
+        out.append(("WS" if isinstance(route, WebSocketRoute) else ",".join(methods), route.path, summary))
     return out
 
 
