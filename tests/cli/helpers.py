@@ -9,10 +9,10 @@ import sys
 from pathlib import Path
 
 
-def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
-    """``python -m pkm ARGS`` in a subprocess (text output, no check)."""
+def run(*args: str, cwd: Path | None = None, timeout: float = 120) -> subprocess.CompletedProcess:
+    """``python -m pkm ARGS`` in a subprocess (text output, no check), ended past ``timeout`` seconds (a hang)."""
     return subprocess.run([sys.executable, "-m", "pkm", *args], check=False, capture_output=True, text=True,
-                          cwd=cwd, timeout=120)
+                          cwd=cwd, timeout=timeout)
 
 
 def one_error_line(proc: subprocess.CompletedProcess) -> str:
