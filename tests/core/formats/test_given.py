@@ -117,3 +117,27 @@ def test_the_command_line_takes_actuated_and_task(passive, capsys):
     out = json.loads(capsys.readouterr().out)
     mech = pkm.load(passive, actuated=["crank_joint"], task="coupler_tip:z")
     assert np.isclose(out["task"]["z"], mech.task_map.named(pkm.close_loops(mech, [0.2]).q)["z"], atol=1e-12)
+
+
+@pytest.mark.filterwarnings("ignore::pkm.errors.ImplausibleModelWarning")  # (the file's 654 t spheres)
+def test_a_gepetto_yaml_without_name_mot_takes_them_from_code(tmp_path):
+    """Gepetto's five-bar with ``name_mot: []``: refused alone, loaded with its motors given in code as its own
+    ``name_mot`` loads it (the same mechanism)."""
+    from pkm.core.formats.catalogue import catalogue_path
+    from pkm.core.model.compare import mechanism_differences
+
+    source = catalogue_path("gepetto:5bar_linkage")
+    (tmp_path / "robot.urdf").write_text((source / "robot.urdf").read_text())
+    (tmp_path / "robot.yaml").write_text((source / "robot.yaml").read_text().replace("['mot1', 'mot2']", "[]"))
+    with pytest.raises(SpecError):
+        pkm.load(tmp_path)
+    mech = pkm.load(tmp_path, actuated=["mot1", "mot2"])
+    assert mech.actuated_names == ("mot1", "mot2")
+    assert mechanism_differences(mech, pkm.load(source)) == []
+
+
+def test_pkm_list_says_to_give_actuated(passive, capsys):
+    from pkm.cli.app import main
+
+    assert main(["list", str(passive)]) != 0
+    assert "no actuators named: give actuated=[...]" in capsys.readouterr().err
