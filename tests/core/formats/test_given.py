@@ -94,6 +94,8 @@ def test_actuated_in_code_replaces_the_files_with_a_warning(tmp_path):
                                         r"the files name, \['crank_joint'\]"):
         mech = pkm.load(path, actuated=["rocker_joint"])
     assert mech.actuated_names == ("rocker_joint",) and mech.spec.task.joints == ("rocker_joint",)
+    assert "actuated=['rocker_joint'] given in code replaces the actuated joints the files name, ['crank_joint']" \
+        in mech.notes
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert pkm.load(path, actuated=["crank_joint"]).actuated_names == ("crank_joint",)  # the same: silent

@@ -119,25 +119,28 @@ def given_task(task: TaskGiven, actuated: tuple[str, ...] = ("_",)) -> tuple[str
     return spec.end_effector, spec.task
 
 
-def with_given(spec: ClosureSpec, g: Given, source: str) -> ClosureSpec:
-    """``spec`` with what the caller gave in code (:class:`Given`) in place of what its files state: the actuated
-    joints (a :class:`~pkm.errors.PkmWarning` when the files named others: the code wins), their drives' values
-    kept for those still actuated; the task (when none is given and the files' task was their actuated joints,
-    the new actuated joints)."""
+def with_given(spec: ClosureSpec, g: Given, source: str) -> tuple[ClosureSpec, tuple[str, ...]]:
+    """``spec`` with what the caller gave in code (:class:`Given`) in place of what its files state, and the notes
+    for :attr:`~pkm.core.Mechanism.notes`: the actuated joints (a :class:`~pkm.errors.PkmWarning`, and its
+    sentence as a note, when the files named others: the code wins), their drives' values kept for those still
+    actuated; the task (when none is given and the files' task was their actuated joints, the new actuated
+    joints)."""
     if g.empty:
-        return spec
+        return spec, ()
     actuated, end_effector, task = spec.actuated, spec.end_effector, spec.task
+    notes: tuple[str, ...] = ()
     if g.actuated is not None:
         if spec.actuated and set(spec.actuated) != set(g.actuated):
-            warnings.warn(f"{source}: actuated={list(g.actuated)} given in code replaces the actuated joints the "
-                          f"files name, {list(spec.actuated)}", PkmWarning, stacklevel=4)
+            notes = (f"actuated={list(g.actuated)} given in code replaces the actuated joints the files name, "
+                     f"{list(spec.actuated)}",)
+            warnings.warn(f"{source}: {notes[0]}", PkmWarning, stacklevel=4)
         actuated = g.actuated
         if g.task is None and not task.components and not task.frames and task.joints == spec.actuated:
             task = TaskSpec((), actuated)
     if g.task is not None:
         end_effector, task = g.end_effector, g.task
     return dataclasses.replace(spec, actuated=actuated, end_effector=end_effector, task=task,
-                               actuators={j: v for j, v in spec.actuators.items() if j in actuated})
+                               actuators={j: v for j, v in spec.actuators.items() if j in actuated}), notes
 
 
 def load_model_file(path: Path, given: Given = Given()) -> Mechanism:
@@ -159,7 +162,8 @@ def load_model_file(path: Path, given: Given = Given()) -> Mechanism:
                        closures=imp.closures, task=TaskSpec((), imp.actuated), reference=dict(imp.reference),
                        description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types,
                        floating_base=imp.floating_base, actuators=imp.actuators)
-    return from_strings(imp.urdf, with_given(spec, given, str(path)), source=str(path), notes=imp.notes)
+    spec, read = with_given(spec, given, str(path))
+    return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes + read)
 
 
 #: A reader's loader: the mechanism, given what the caller states in code (:class:`Given`, default nothing).
@@ -252,8 +256,10 @@ def load_spec_file(path: Path, given: Given = Given()) -> Mechanism:
     raw = parse_toml(read_text_file(path, "closure spec"), str(path))
     if isinstance(raw, dict) and given.actuated is not None and not raw.get("actuated"):
         raw["actuated"] = list(given.actuated)  # (the spec's parser asks for one; the code gives them)
-    spec = ClosureSpec.from_dict(raw, str(path))
-    return from_files(path, with_given(spec, given, str(path)))
+    spec, read = with_given(ClosureSpec.from_dict(raw, str(path)), given, str(path))
+    mech = from_files(path, spec)
+    mech.notes += read
+    return mech
 
 
 def load_path(path: Path, given: Given = Given()) -> Mechanism:
@@ -343,8 +349,9 @@ def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = (), 
     name = urdf_path.parent.name if urdf_path.stem == "robot" else urdf_path.stem
     spec, read = read_gepetto(read_text_file(yaml_path, "YAML"), urdf_path.name, joints, name or "robot",
                               str(yaml_path))
-    return from_strings(imported.urdf, with_given(spec, given, str(yaml_path)), source=str(yaml_path),
-                        notes=tuple(notes) + imported.notes + read)
+    spec, replaced = with_given(spec, given, str(yaml_path))
+    return from_strings(imported.urdf, spec, source=str(yaml_path), notes=tuple(notes) + imported.notes + read
+                        + replaced)
 
 
 _PACKAGE_FILES: dict[tuple[str, int, int], Imported] = {}  # (path, mtime [ns], size): the file read
@@ -377,8 +384,8 @@ def load_package_model(name: str, given: Given = Given()) -> Mechanism:
 
     spec_path, path = model_file(name)
     imported = _package_file(path)
-    spec = with_given(with_file(ClosureSpec.load(spec_path), imported, str(spec_path)), given, name)
-    return from_strings(imported.urdf, spec, source=f"{name} ({path})", notes=imported.notes)
+    spec, read = with_given(with_file(ClosureSpec.load(spec_path), imported, str(spec_path)), given, name)
+    return from_strings(imported.urdf, spec, source=f"{name} ({path})", notes=imported.notes + read)
 
 
 __all__ = ["READERS", "Given", "Loader", "Reader", "given", "given_task", "load_gepetto", "load_model_file",
