@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 from pkm import errors
 from pkm._lazy import lazy
 from pkm.core import _EXPORTS as _CORE_EXPORTS
-from pkm.errors import PkmError, UnknownNameError
+from pkm.errors import InvalidInputError, PkmError, UnknownNameError
 from pkm.mechanisms import REGISTRY as MECHANISMS
 from pkm.mechanisms import definition as mechanism_definition
 from pkm.mechanisms import module as mechanism_module
@@ -48,6 +48,7 @@ _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
 if TYPE_CHECKING:  # the static view of the lazy names
     import os
+    from collections.abc import Sequence
     from pathlib import Path
     from typing import Any
 
@@ -145,7 +146,8 @@ __getattr__, __dir__ = lazy("pkm", globals(), _WHERE)
 __version__ = "0.2.0"
 
 
-def load(name: str | os.PathLike[str]) -> Mechanism:
+def load(name: str | os.PathLike[str], *, actuated: Sequence[str] | str | None = None,
+         task: Any = None) -> Mechanism:
     """A mechanism: a registered name's reference design (from its shipped ``urdf/`` files, or built from
     its default parameters when it ships none), or one's own files: a closure spec
     (``path/to/my.closures.toml``, naming its URDF; see :mod:`pkm.core.model.spec`), or a URDF + YAML
@@ -157,10 +159,21 @@ def load(name: str | os.PathLike[str]) -> Mechanism:
     (``"example-robot-data:cassie"``: :mod:`pkm.core.formats.packages`), or a third-party robot pkm ships, by name
     ``"<source>:<robot>"`` (``"gepetto:robot_delta"``: :mod:`pkm.core.formats.catalogue`).
 
+    A file that names no actuators (an MJCF with loops and no ``<actuator>``, an SDF, a Gepetto YAML with no
+    ``name_mot``, a spec with ``actuated = []``) loads with them given in code: ``actuated`` (joint names, or
+    ``"j1,j2"``) and optionally ``task``, the task in the spec's terms: ``"FRAME"`` (its origin, ``x, y, z``),
+    ``"FRAME:KIND"`` or ``(frame, kind)`` with KIND ``"pose"`` or components (``"x,z"``, of ``x y z roll pitch
+    yaw``), or the spec's dict ``{"end_effector": ..., "components": [...], "joints": [...]}``
+    (:func:`pkm.core.formats.load.given_task`); without ``task``, the task is the actuated joints. Where the files
+    name actuators or a task, these replace them (a :class:`~pkm.errors.PkmWarning` when the actuated joints
+    differ). Files and installed packages' models only: a shipped mechanism's design states its own.
+
     Raises:
         UnknownNameError: ``name`` is neither registered (:data:`MECHANISMS`) nor an existing file.
+        InvalidInputError: ``actuated`` or ``task`` malformed, or given for a shipped mechanism.
         SpecError: the files are missing, damaged or do not fit together; no reader takes the path (the
-            message says why each declined: :func:`pkm.core.formats.load.load_path`).
+            message says why each declined: :func:`pkm.core.formats.load.load_path`); a joint of ``actuated``
+            or a frame of ``task`` the model lacks (:class:`~pkm.errors.SpecNameError`, listing the valid ones).
 
     Examples:
         >>> import pkm
@@ -176,11 +189,15 @@ def load(name: str | os.PathLike[str]) -> Mechanism:
     import os
     from pathlib import Path
 
+    from pkm.core.formats.load import given as read_given
+
     def exists(path: str) -> bool:
         try:
             return Path(path).exists()
         except (OSError, ValueError):  # (a name too long for a path, a NUL in it)
             return False
+
+    given = read_given(actuated, task)
 
     if isinstance(name, str) and ":" in name and not exists(name):  # "example-robot-data:cassie", "gepetto:..."
         from pkm.core.formats.catalogue import CATALOGUE, catalogue_path
@@ -188,19 +205,24 @@ def load(name: str | os.PathLike[str]) -> Mechanism:
         from pkm.core.formats.packages import PACKAGES
 
         if name.partition(":")[0] in PACKAGES:
-            return load_package_model(name)
+            return load_package_model(name, given)
         if name.partition(":")[0] in {n.partition(":")[0] for n in CATALOGUE}:
-            return load_path(catalogue_path(name))
+            return load_path(catalogue_path(name), given)
     from pkm.core.formats.base import suffixes
 
     if isinstance(name, os.PathLike) or (isinstance(name, str) and name not in MECHANISMS
                                          and (name.endswith((".toml", ".yaml", ".yml", *suffixes())) or exists(name))):
         from pkm.core.formats.load import load_path
 
-        return load_path(Path(name))  # by content: Gepetto URDF + YAML, closure spec, MJCF or SDF
+        return load_path(Path(name), given)  # by content: Gepetto URDF + YAML, closure spec, MJCF or SDF
     if isinstance(name, str) and name not in MECHANISMS:
         raise UnknownNameError("mechanism", name, MECHANISMS, "the registry, nor is it a file (give a closure spec's "
                                                               "path, such as path/to/my.closures.toml)")
+    if not given.empty:
+        raise InvalidInputError("actuated" if actuated is not None else "task",
+                                f"{name!r} is a shipped mechanism, its actuators and task stated by its design; "
+                                "actuated= and task= are for files (save it with pkm.save and load the files)",
+                                actuated if actuated is not None else task)
     entry = mechanism_definition(name)
     mod = entry.module()
     if entry.reference is None:

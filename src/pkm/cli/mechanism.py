@@ -42,11 +42,16 @@ def add_mechanism_help(action: argparse.Action, before: str = "", after: str = "
 
 
 def add_mechanism_arguments(p: argparse.ArgumentParser, pose: str | None, joints: str | None) -> None:
-    """``MECH``, ``--param``, ``--q0`` and, if asked (``"required"`` or ``"optional"``), ``--pose`` and ``--joints``
-    (exclusive when both are taken)."""
+    """``MECH``, ``--param``, ``--actuated``, ``--task``, ``--q0`` and, if asked (``"required"`` or
+    ``"optional"``), ``--pose`` and ``--joints`` (exclusive when both are taken)."""
     add_mechanism_help(p.add_argument("mechanism", metavar="MECH"))
     p.add_argument("--param", metavar="K=V", action="extend", nargs="+", default=[],
                    help="a design parameter (see 'pkm list'); default: the paper's design")
+    p.add_argument("--actuated", metavar="J1,J2",
+                   help="the driven joints of a model file (one that names none, or in place of those it names)")
+    p.add_argument("--task", metavar="FRAME[:KIND]",
+                   help="the task of a model file: a frame's origin (x, y, z), or KIND: pose, or components such "
+                        "as x,z (default: the actuated joints)")
     g = p.add_mutually_exclusive_group() if pose and joints else p
     if pose:
         g.add_argument("--pose", metavar="K=V", action="extend", nargs="+", required=pose == "required",
@@ -67,11 +72,15 @@ def add_seed_argument(p: argparse.ArgumentParser, what: str) -> None:
 
 
 def load_mechanism(args) -> pkm.Mechanism:
-    """A shipped mechanism (its design changed by ``--param``) or one's own closure spec file."""
+    """A shipped mechanism (its design changed by ``--param``) or one's own files (their actuated joints and task
+    given by ``--actuated`` and ``--task`` where stated: :func:`pkm.load`'s ``actuated=`` and ``task=``)."""
+    actuated, task = getattr(args, "actuated", None), getattr(args, "task", None)
     if args.mechanism not in pkm.MECHANISMS:
         if args.param:
             raise UsageError(f"--param sets the design of a shipped mechanism; {args.mechanism} states its own")
-        return pkm.load(args.mechanism)
+        return pkm.load(args.mechanism, actuated=actuated, task=task)
+    if actuated is not None or task is not None:
+        raise UsageError(f"--actuated and --task are for model files; {args.mechanism} states its own")
     params = parse_params(args.mechanism, args.param or [])
     return pkm.build(args.mechanism, **params) if params else pkm.load(args.mechanism)
 

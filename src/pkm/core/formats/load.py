@@ -10,9 +10,12 @@ The readers themselves (:mod:`~pkm.core.formats.imported`, :mod:`~pkm.core.forma
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+import dataclasses
+import warnings
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from pkm.core.formats.base import FORMATS, Imported, by_root, suffixes
 from pkm.core.formats.gepetto import find_gepetto, read_gepetto
@@ -20,29 +23,151 @@ from pkm.core.formats.imported import import_model, root_tag, with_file
 from pkm.core.formats.packages import model_file
 from pkm.core.model.builder import from_files, from_imported, from_strings
 from pkm.core.model.mechanism import Mechanism
-from pkm.core.model.spec import ClosureSpec, TaskSpec, read_text_file
+from pkm.core.model.spec import FORMAT, ClosureSpec, TaskSpec, parse_toml, read_text_file
 from pkm.core.model.urdf import check_urdf
-from pkm.errors import SpecError
+from pkm.errors import InvalidInputError, PkmWarning, SpecError
+
+#: What ``task=`` takes (:func:`given_task`): a frame name, ``"FRAME:KIND"``, ``(frame, kind)`` or the spec's dict.
+TaskGiven = str | Sequence[Any] | Mapping[str, Any] | None
 
 
-def load_model_file(path: Path) -> Mechanism:
-    """The :class:`~pkm.core.Mechanism` of an MJCF or SDF file alone: its loops, its actuators, the actuated
-    joints as the task, no end effector, assembled (:func:`pkm.assemble`).
+@dataclass(frozen=True)
+class Given:
+    """What the caller states in code over what the files state (``pkm.load(path, actuated=..., task=...)``).
+
+    Attributes:
+        actuated: The driven joints (one coordinate each), or None: the file's.
+        end_effector: The task's frame, or None (the task is then joint outputs).
+        task: The task, or None: the file's (or, when ``actuated`` is given and the file's task is its actuated
+            joints, the new actuated joints).
+    """
+
+    actuated: tuple[str, ...] | None = None
+    end_effector: str | None = None
+    task: TaskSpec | None = None
+
+    @property
+    def empty(self) -> bool:
+        return self.actuated is None and self.task is None
+
+
+def given(actuated: Sequence[str] | str | None = None, task: TaskGiven = None) -> Given:
+    """``actuated=`` and ``task=`` of :func:`pkm.load` checked and read (see :func:`given_task` for ``task``).
+
+    ``actuated``: joint names (a list, or one string of names separated by commas).
 
     Raises:
-        SpecError: as :func:`import_model`, or a file that names no actuated joint (SDF never does):
-            then a closure spec must say which joints are driven.
+        InvalidInputError: ``actuated`` empty, not names, or a name twice; ``task`` in none of the forms, or with
+            unknown components.
+    """
+    names: tuple[str, ...] | None = None
+    if actuated is not None:
+        listed = [n.strip() for n in actuated.split(",")] if isinstance(actuated, str) else actuated
+        if (isinstance(listed, Mapping) or not isinstance(listed, Sequence)
+                or not all(isinstance(n, str) and n for n in listed)):
+            raise InvalidInputError("actuated", "expected joint names (a list of strings, or 'j1,j2')", actuated)
+        names = tuple(listed)
+        if not names or len(set(names)) != len(names):
+            raise InvalidInputError("actuated", "name at least one joint, each once", actuated)
+    if task is None:
+        return Given(names)
+    frame, spec_task = given_task(task, names or ("_",))
+    return Given(names, frame, spec_task)
+
+
+def given_task(task: TaskGiven, actuated: tuple[str, ...] = ("_",)) -> tuple[str | None, TaskSpec]:
+    """The end effector and task that ``task=`` states, in the closure spec's terms (``end_effector`` and
+    ``[task]``, :mod:`pkm.core.model.spec`), checked by the spec's own parser:
+
+    * ``"FRAME"``: the frame's origin, components ``x, y, z`` [m] in the world frame;
+    * ``"FRAME:KIND"``: KIND ``pose`` (the full placement) or components separated by commas (``"tip:x,z"``,
+      of ``x y z roll pitch yaw``);
+    * ``(frame, kind)``: kind as above, or a list of components;
+    * the spec's dict: ``{"end_effector": frame, "components": [...], "joints": [...], "frames": {...}}``
+      (``end_effector`` left out: joint outputs only).
+
+    Raises:
+        InvalidInputError: none of these forms; what the spec's parser refuses (unknown components...).
+    """
+    def kind_of(kind: object) -> list[str]:
+        if isinstance(kind, str):
+            return [c.strip() for c in kind.split(",")]
+        if isinstance(kind, Sequence) and all(isinstance(c, str) for c in kind):
+            return list(kind)
+        raise InvalidInputError("task", f"a task's kind is 'pose' or components ('x,z', ['x', 'z']), got {kind!r}",
+                                task)
+
+    if isinstance(task, str):
+        frame, sep, kind = task.partition(":")
+        raw: dict[str, Any] = {"end_effector": frame, "task": {"components": kind_of(kind) if sep else
+                                                                ["x", "y", "z"]}}
+    elif isinstance(task, Mapping):
+        table = dict(task)
+        raw = {"task": table}
+        if "end_effector" in table:
+            raw["end_effector"] = table.pop("end_effector")
+    elif isinstance(task, Sequence) and len(task) == 2 and isinstance(task[0], str):
+        raw = {"end_effector": task[0], "task": {"components": kind_of(task[1])}}
+    else:
+        raise InvalidInputError("task", "expected 'FRAME', 'FRAME:KIND', (frame, kind) or the spec's dict "
+                                        "{'end_effector': ..., 'components': [...], 'joints': [...]}", task)
+    try:
+        spec = ClosureSpec.from_dict({"format": FORMAT, "mechanism": "_", "urdf": "_", "actuated": list(actuated),
+                                      **raw}, "task=")
+    except SpecError as exc:
+        raise InvalidInputError("task", str(exc).removeprefix("task=: "), task) from None
+    return spec.end_effector, spec.task
+
+
+def with_given(spec: ClosureSpec, g: Given, source: str) -> tuple[ClosureSpec, tuple[str, ...]]:
+    """``spec`` with what the caller gave in code (:class:`Given`) in place of what its files state, and the notes
+    for :attr:`~pkm.core.Mechanism.notes`: the actuated joints (a :class:`~pkm.errors.PkmWarning`, and its
+    sentence as a note, when the files named others: the code wins), their drives' values kept for those still
+    actuated; the task (when none is given and the files' task was their actuated joints, the new actuated
+    joints)."""
+    if g.empty:
+        return spec, ()
+    actuated, end_effector, task = spec.actuated, spec.end_effector, spec.task
+    notes: tuple[str, ...] = ()
+    if g.actuated is not None:
+        if spec.actuated and set(spec.actuated) != set(g.actuated):
+            notes = (f"actuated={list(g.actuated)} given in code replaces the actuated joints the files name, "
+                     f"{list(spec.actuated)}",)
+            warnings.warn(f"{source}: {notes[0]}", PkmWarning, stacklevel=4)
+        actuated = g.actuated
+        if g.task is None and not task.components and not task.frames and task.joints == spec.actuated:
+            task = TaskSpec((), actuated)
+    if g.task is not None:
+        end_effector, task = g.end_effector, g.task
+    return dataclasses.replace(spec, actuated=actuated, end_effector=end_effector, task=task,
+                               actuators={j: v for j, v in spec.actuators.items() if j in actuated}), notes
+
+
+def load_model_file(path: Path, given: Given = Given()) -> Mechanism:
+    """The :class:`~pkm.core.Mechanism` of an MJCF or SDF file alone (or a URDF alone, an open tree): its loops,
+    its actuators, the actuated joints as the task, no end effector, assembled (:func:`pkm.assemble`); ``given``:
+    the actuated joints and task stated in code instead (:func:`with_given`).
+
+    Raises:
+        SpecError: as :func:`import_model`, or a file that names no actuated joint (SDF never does) when
+            ``given`` names none: then ``actuated=`` in code, or a closure spec, must say which joints are driven.
     """
     imp = import_model(path)
-    if not imp.actuated:
-        raise SpecError(str(path), f"the {imp.format.upper()} file names no actuated joint; write a closure spec with "
-                                   f"urdf = {path.name!r} and actuated = [...] beside it (`pkm spec init {path}` "
-                                   "writes one to fill in), and load the spec")
+    if not imp.actuated and given.actuated is None:
+        raise SpecError(str(path), f"the {imp.format.upper()} file names no actuated joint: no actuators named: give "
+                                   f"actuated=[...] to pkm.load (--actuated j1,j2 on the command line), or write a "
+                                   f"closure spec with urdf = {path.name!r} and actuated = [...] beside it "
+                                   f"(`pkm spec init {path}` writes one to fill in), and load the spec")
     spec = ClosureSpec(mechanism=imp.name, urdf=path.name, end_effector=None, actuated=imp.actuated,
                        closures=imp.closures, task=TaskSpec((), imp.actuated), reference=dict(imp.reference),
                        description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types,
                        floating_base=imp.floating_base, actuators=imp.actuators)
-    return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes)
+    spec, read = with_given(spec, given, str(path))
+    return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes + read)
+
+
+#: A reader's loader: the mechanism, given what the caller states in code (:class:`Given`, default nothing).
+Loader = Callable[..., Mechanism]
 
 
 @dataclass(frozen=True)
@@ -51,18 +176,19 @@ class Reader:
 
     Attributes:
         name: What it reads, for the messages.
-        claim: ``claim(path)``: a function that loads the mechanism when the reader takes ``path``, else why it
-            does not (one line). It raises :class:`~pkm.errors.SpecError` when it takes ``path`` but cannot
+        claim: ``claim(path)``: a function that loads the mechanism when the reader takes ``path`` (called with
+            no argument, or with a :class:`Given`: what the caller states in code), else why it does not (one
+            line). It raises :class:`~pkm.errors.SpecError` when it takes ``path`` but cannot
             tell which files go together.
     """
 
     name: str
-    claim: Callable[[Path], Callable[[], Mechanism] | str]
+    claim: Callable[[Path], Loader | str]
 
 
-def _gepetto(path: Path) -> Callable[[], Mechanism] | str:
+def _gepetto(path: Path) -> Loader | str:
     found = find_gepetto(path)
-    return found if isinstance(found, str) else (lambda: load_gepetto(*found))
+    return found if isinstance(found, str) else (lambda given=Given(): load_gepetto(*found, given=given))
 
 
 def _head(path: Path) -> str | None:
@@ -73,7 +199,7 @@ def _head(path: Path) -> str | None:
         return None
 
 
-def _closure_spec(path: Path) -> Callable[[], Mechanism] | str:
+def _closure_spec(path: Path) -> Loader | str:
     import tomllib
 
 
@@ -81,7 +207,7 @@ def _closure_spec(path: Path) -> Callable[[], Mechanism] | str:
         specs = sorted(p.name for p in path.glob("*.toml"))
         return "a folder: give the spec file (" + (f"it holds {', '.join(specs[:4])}" if specs else "NAME.closures.toml") + ")"
     if path.suffix.lower() == ".toml":
-        return lambda: from_files(path)
+        return lambda given=Given(): load_spec_file(path, given)
     if path.suffix.lower() in (".yaml", ".yml"):
         return "a YAML file: a pkm closure spec is TOML (NAME.closures.toml)"
     if path.suffix.lower() in suffixes():
@@ -95,10 +221,10 @@ def _closure_spec(path: Path) -> Callable[[], Mechanism] | str:
         return f"not TOML ({' '.join(str(exc).split())})"
     if "format" not in raw:
         return "TOML without the key format = \"pkm.closures/1\""
-    return lambda: from_files(path)
+    return lambda given=Given(): load_spec_file(path, given)
 
 
-def _model_file(path: Path) -> Callable[[], Mechanism] | str:
+def _model_file(path: Path) -> Loader | str:
     if path.is_dir():
         return "a folder (give the model file)"
     kind = suffixes().get(path.suffix.lower())
@@ -109,7 +235,7 @@ def _model_file(path: Path) -> Callable[[], Mechanism] | str:
         known = ", ".join(f"<{r}>" for r in roots)
         return (f"not XML with a root element {known}" if root is None
                 else f"XML whose root element is <{root}>, not one of {known}")
-    return lambda: load_model_file(path)
+    return lambda given=Given(): load_model_file(path, given)
 
 
 #: The readers :func:`load_path` tries, in this order; the first that takes a path reads it.
@@ -117,10 +243,30 @@ READERS = (Reader("Gepetto URDF + YAML", _gepetto), Reader("pkm closure spec", _
            Reader("model file (URDF, MJCF, SDF)", _model_file))
 
 
-def load_path(path: Path) -> Mechanism:
+def load_spec_file(path: Path, given: Given = Given()) -> Mechanism:
+    """A closure spec file and the model file it names (:func:`~pkm.core.model.builder.from_files`), with what the
+    caller states in code (:class:`Given`) in place of the spec's actuated joints and task: then the spec may
+    leave ``actuated`` empty (a URDF and its closures, no drives named).
+
+    Raises:
+        SpecError: as :func:`~pkm.core.model.builder.from_files`.
+    """
+    if given.empty:
+        return from_files(path)
+    raw = parse_toml(read_text_file(path, "closure spec"), str(path))
+    if isinstance(raw, dict) and given.actuated is not None and not raw.get("actuated"):
+        raw["actuated"] = list(given.actuated)  # (the spec's parser asks for one; the code gives them)
+    spec, read = with_given(ClosureSpec.from_dict(raw, str(path)), given, str(path))
+    mech = from_files(path, spec)
+    mech.notes += read
+    return mech
+
+
+def load_path(path: Path, given: Given = Given()) -> Mechanism:
     """The mechanism of a file or folder, read by the first of :data:`READERS` that takes it, by content: a folder
     or YAML in Gepetto's convention (:mod:`pkm.core.formats.gepetto`), a closure spec (``.toml``, or TOML text
-    with a ``format`` key), an MJCF or SDF file (or a URDF alone, which then asks for a spec).
+    with a ``format`` key), an MJCF or SDF file (or a URDF alone, which then asks for a spec); ``given``: the
+    actuated joints and task stated in code, over the files' (:func:`with_given`).
 
     Raises:
         SpecError: nothing at ``path``; no reader takes it (the message says, one line each, why each declined);
@@ -133,7 +279,7 @@ def load_path(path: Path) -> Mechanism:
     for reader in READERS:
         claim = reader.claim(path)
         if not isinstance(claim, str):
-            return claim()
+            return claim(given)
         reasons.append(f"  {reader.name}: {claim}")
     raise SpecError(str(path), "no reader takes it:\n" + "\n".join(reasons))
 
@@ -189,9 +335,10 @@ def load_texts(files: Mapping[str, str], source: str = "<upload>") -> Mechanism:
     return from_imported(spec, imported, f"{source}:{names[0]}")
 
 
-def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = ()) -> Mechanism:
+def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = (), given: Given = Given()) -> Mechanism:
     """The :class:`~pkm.core.Mechanism` of a Gepetto-convention URDF + YAML pair (see the module doc); its
-    :attr:`~pkm.core.Mechanism.notes` say what was interpreted (``notes`` first: how the files were paired)."""
+    :attr:`~pkm.core.Mechanism.notes` say what was interpreted (``notes`` first: how the files were paired);
+    ``given``: the actuated joints and task stated in code (:func:`with_given`), over ``name_mot``."""
 
     urdf_path, yaml_path = Path(urdf_path), Path(yaml_path)
     imported = import_model(urdf_path)
@@ -202,8 +349,9 @@ def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = ()) 
     name = urdf_path.parent.name if urdf_path.stem == "robot" else urdf_path.stem
     spec, read = read_gepetto(read_text_file(yaml_path, "YAML"), urdf_path.name, joints, name or "robot",
                               str(yaml_path))
-    return from_strings(imported.urdf, spec, source=str(yaml_path),
-                                  notes=tuple(notes) + imported.notes + read)
+    spec, replaced = with_given(spec, given, str(yaml_path))
+    return from_strings(imported.urdf, spec, source=str(yaml_path), notes=tuple(notes) + imported.notes + read
+                        + replaced)
 
 
 _PACKAGE_FILES: dict[tuple[str, int, int], Imported] = {}  # (path, mtime [ns], size): the file read
@@ -224,7 +372,7 @@ def _package_file(path: Path) -> Imported:
     return _PACKAGE_FILES[key]
 
 
-def load_package_model(name: str) -> Mechanism:
+def load_package_model(name: str, given: Given = Given()) -> Mechanism:
     """The :class:`~pkm.core.Mechanism` of model ``name`` (``<package>:<model>``): the package's file, read where
     it is installed, with the loops and joint types it states and the spec pkm ships (actuated joints, more joint
     types); assembled (:func:`pkm.assemble`).
@@ -236,8 +384,9 @@ def load_package_model(name: str) -> Mechanism:
 
     spec_path, path = model_file(name)
     imported = _package_file(path)
-    spec = with_file(ClosureSpec.load(spec_path), imported, str(spec_path))
-    return from_strings(imported.urdf, spec, source=f"{name} ({path})", notes=imported.notes)
+    spec, read = with_given(with_file(ClosureSpec.load(spec_path), imported, str(spec_path)), given, name)
+    return from_strings(imported.urdf, spec, source=f"{name} ({path})", notes=imported.notes + read)
 
 
-__all__ = ["READERS", "Reader", "load_gepetto", "load_model_file", "load_package_model", "load_path"]
+__all__ = ["READERS", "Given", "Loader", "Reader", "given", "given_task", "load_gepetto", "load_model_file",
+           "load_package_model", "load_path", "load_spec_file", "with_given"]

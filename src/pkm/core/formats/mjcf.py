@@ -8,7 +8,10 @@ does not keep, from the file itself:
   ``name`` (else ``connect1``, ``weld2``...); their anchors become frames ``<name>_a`` (on ``body1``)
   and ``<name>_b`` (on ``body2``, the world when it is omitted); an equality between two sites
   (``site1``, ``site2``) closes those sites' frames (origins for a connect, frames for a weld);
-  an equality with ``active="false"`` is left out (a note says so);
+  an equality with ``active="false"`` is left out (a note says so); a weld is read as MuJoCo reads it,
+  ``X1 relpose = X2 T(anchor)``: ``relpose`` (body2's pose in body1's frame, position then quaternion ``w x y
+  z``; without it the pose at ``qpos0``), ``anchor`` (the point of body2 it holds), ``torquescale="0"`` (the
+  orientation free: a ``point`` closure); a free body it ties is moved where its ``relpose`` puts it;
 * ``<equality><joint joint1 joint2 polycoef="a0 a1 a2 a3 a4">`` (MuJoCo:
   ``q1 - q1_0 = a0 + a1 (q2 - q2_0) + a2 (q2 - q2_0)^2 + ...``, ``q_0`` the joint's ``ref``): a linear one
   (``a2 = a3 = a4 = 0``) is a mimic joint, ``q1 = a1 q2 + a0 + q1_0 - a1 q2_0`` (Pinocchio's
@@ -418,10 +421,17 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             el.getparent().remove(el)
     counts = {"connect": 0, "weld": 0}
     eq_names = []
+    bodies = [str(b.get("name")) for b in world.iter("body") if b.get("name")]
     for el in equalities:
         counts[el.tag] += 1
-        eq_names.append((el.tag, el.get("name") or f"{el.tag}{counts[el.tag]}",
-                         (el.get("site1"), el.get("site2")) if el in on_sites else None))
+        eq_name = el.get("name") or f"{el.tag}{counts[el.tag]}"
+        for key in ("body1", "body2"):
+            if el.get(key) not in (None, "world", *bodies):
+                raise SpecNameError(source, "body", str(el.get(key)), bodies,
+                                    f"<equality><{el.tag} name={eq_name!r}> (line {el.sourceline}) {key}")
+        point = el.tag == "connect" or _torquescale(el, eq_name, defaults, source) == 0.0
+        eq_names.append((el.tag, eq_name, (el.get("site1"), el.get("site2")) if el in on_sites else None,
+                         "point" if point else "frame"))
     body_based = {t: counts[t] - sum(1 for el in on_sites if el.tag == t) for t in counts}
     for k, el in enumerate(el for el in equalities if el not in on_sites):  # Pinocchio returns them by name
         el.set("name", f"pkm{k:06d}")
@@ -449,10 +459,9 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
 
     free = _free_bodies(model, world, degrees, source)
     if free:
-        if any(el.tag == "weld" and el.get("relpose") is not None for el in equalities):
-            raise SpecError(source, "a weld's relpose with free bodies is not read: leave relpose out (the bodies are "
-                                    "then welded as they are at qpos0)")
-        points, welds = _anchored(model, free, points), _anchored(model, free, welds)
+        points = _anchored(model, free, points)
+    welds = _welds(model, free, refs, [(el, eq[1]) for el, eq in zip(equalities, eq_names)
+                                       if el.tag == "weld" and el not in on_sites], defaults, source)
     taken = set(model.names) | {f.name for f in model.frames}
     extra: list[tuple[str, int, pin.SE3]] = []
     for site in world.iter("site"):  # the sites Pinocchio dropped (those of bodies without joints)
@@ -467,12 +476,12 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             taken.add(site.get("name"))
     closures = []
     iters = {"connect": iter(points), "weld": iter(welds)}
-    for tag, name, on in eq_names:
+    for tag, name, on, kind in eq_names:
         if on is not None:  # the two sites coincide (connect: their origins; weld: their frames)
             for site_name in on:
                 if site_name not in taken:
                     raise SpecError(source, f"<equality><{tag} name={name!r}>: no site {site_name!r} on a body")
-            closures.append(Closure(name, "point" if tag == "connect" else "frame", *on))
+            closures.append(Closure(name, kind, *on))
             continue
         cm = next(iters[tag])
         frames = []
@@ -483,7 +492,7 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             taken.add(fname)
             extra.append((fname, jid, M))
             frames.append(fname)
-        closures.append(Closure(name, "point" if tag == "connect" else "frame", *frames))
+        closures.append(Closure(name, kind, *frames))
 
     joint_names = {f"Composite_{first}": parts for first, parts in body_joints.items() if len(parts) > 1}
     name = root.get("model", "mjcf")
@@ -748,6 +757,71 @@ def _anchored(model: pin.Model, free: dict[int, pin.SE3], constraints: Iterable[
     for cm in constraints:
         world_a = d.oMi[cm.joint1_id] * cm.joint1_placement
         out.append(_Anchors(cm.joint1_id, cm.joint1_placement, cm.joint2_id, d.oMi[cm.joint2_id].actInv(world_a)))
+    return out
+
+
+def _torquescale(el: etree._Element, name: str, defaults: _Defaults, source: str) -> float:
+    """A weld's ``torquescale`` (MuJoCo's default 1); 0 makes it position-only."""
+    where = f"<equality><weld name={name!r}> (line {el.sourceline}) torquescale"
+    value = float(_floats(defaults.get(el, "torquescale", "1"), 1, where, source)[0])
+    if value < 0.0:
+        raise SpecError(source, f"{where} = {value:g}: MuJoCo's scale of the angular residual is >= 0")
+    return value
+
+
+def _welds(model: pin.Model, free: dict[int, pin.SE3], refs: dict[str, float],
+           welds: list[tuple[etree._Element, str]], defaults: _Defaults, source: str) -> list[_Anchors]:
+    """The two ends of the body-based ``<weld>`` elements (with their names), read from the file as MuJoCo reads
+    them (pkm does not rely on Pinocchio 4.1's parser for them: it misplaces free bodies).
+
+    MuJoCo's weld holds ``X1 relpose = X2 T(anchor)``: the frame ``relpose`` (position, then quaternion ``w x y
+    z``) of ``body1`` on the point ``anchor`` of ``body2`` (in its frame), their axes aligned with ``body2``'s.
+    Without ``relpose`` (its quaternion all zeros, MuJoCo's default) the relative pose is the one at ``qpos0``
+    (free bodies where the file puts them, hinges and slides at their ``ref``). With it, a free body at either end
+    (body2 first) is moved where the weld puts it (``free`` edited: the reference pkm assembles from holds it);
+    MuJoCo would pull it there. ``torquescale = 0`` leaves the
+    orientation free: a ``point`` closure (as ``<connect>``), else a ``frame`` one (another scale weights the
+    angular residual in MuJoCo's soft solver, the closed configuration is the same).
+    """
+    q0 = pin.neutral(model)
+    for jid, X in free.items():
+        q0[model.joints[jid].idx_q:model.joints[jid].idx_q + 7] = pin.SE3ToXYZQUAT(X)
+    for joint, value in refs.items():
+        if model.existJointName(joint) and model.joints[model.getJointId(joint)].nq == 1:
+            q0[model.joints[model.getJointId(joint)].idx_q] = value
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q0)
+    bodies = [f.name for f in model.frames if f.type == pin.FrameType.BODY and f.name != _WORLD]
+    out, moved = [], set()
+    for el, name in welds:
+        where = f"<equality><weld name={name!r}> (line {el.sourceline})"
+        ends = []
+        for key in ("body1", "body2"):
+            body = el.get(key)
+            if body in (None, "world", _WORLD):
+                ends.append((0, pin.SE3.Identity(), pin.SE3.Identity()))
+            elif model.existFrame(body, pin.FrameType.BODY):
+                fid = model.getFrameId(body, pin.FrameType.BODY)
+                ends.append((model.frames[fid].parentJoint, model.frames[fid].placement, data.oMf[fid]))
+            else:
+                raise SpecNameError(source, "body", str(body), bodies, f"{where} {key}")
+        (j1, P1, X1), (j2, P2, X2) = ends
+        anchor = pin.SE3(np.eye(3), _floats(defaults.get(el, "anchor", "0 0 0"), 3, f"{where} anchor", source))
+        relpose = _floats(defaults.get(el, "relpose", "0 1 0 0 0 0 0"), 7, f"{where} relpose", source)
+        if np.linalg.norm(relpose[3:]) < 1e-15:  # (MuJoCo's mjMINVAL: no relpose, the pose at qpos0)
+            rel = X1.actInv(X2 * anchor)
+        else:
+            w, x, y, z = relpose[3:] / np.linalg.norm(relpose[3:])
+            rel = pin.SE3(pin.Quaternion(w, x, y, z).matrix(), relpose[:3])
+            for jid, target in ((j2, X1 * rel * anchor.inverse() * P2.inverse()),
+                                (j1, X2 * anchor * rel.inverse() * P1.inverse())):
+                if jid in free and jid not in moved:  # a free body where the weld puts it (the reference holds it)
+                    free[jid] = target
+                    moved.add(jid)
+                    q0[model.joints[jid].idx_q:model.joints[jid].idx_q + 7] = pin.SE3ToXYZQUAT(target)
+                    pin.framesForwardKinematics(model, data, q0)
+                    break
+        out.append(_Anchors(j1, P1 * rel, j2, P2 * anchor))
     return out
 
 

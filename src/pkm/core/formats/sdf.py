@@ -35,7 +35,9 @@ links, :math:`\theta_2 = -r\,\theta_1` with :math:`r` its ``<gearbox_ratio>``, w
 angle of the parent link about ``<axis>`` and :math:`\theta_2` that of the child link about ``<axis2>``, both
 relative to its ``<gearbox_reference_body>`` (SDFormat's definition; Gazebo's gear joints, and Cassie's motor
 rotors). pkm requires each of the two links to hang on a revolute (or continuous) joint from the reference body
-about that axis (parallel, either sense; its angle zero at the model's pose, as SDFormat's are), and writes the
+about that axis (parallel, either sense; its angle zero at the model's pose, as SDFormat's are), with only fixed
+joints besides it between them (a rotor in a housing fixed to the reference body; the reference body anywhere in
+the tree: the angles are relative to it), and writes the
 coupling as a URDF ``<mimic>``, which Pinocchio models exactly: the slower link's joint (the output: the child
 when :math:`|r| \le 1`) keeps its coordinate, the faster one (the motor's rotor) follows it with multiplier
 :math:`-s_1 s_2 / r` (or :math:`-s_1 s_2 r` when the parent is the slower), :math:`s_i = \pm 1` the sense of
@@ -99,6 +101,25 @@ def _end(joint: etree._Element, role: str) -> str:
     return _text(joint, role) or ""
 
 
+def _turning_joint(link: str, ref: str, parent_joint: dict[str, etree._Element]) -> etree._Element | None:
+    """The one revolute (or continuous) joint on the path from ``ref`` down to ``link``, the others fixed, or None
+    (``ref`` is not above ``link``, or the path has no moving joint, or another)."""
+    moving: list[etree._Element] = []
+    node = link
+    while node != ref:
+        j = parent_joint.get(node)
+        if j is None:  # the base (fixed to the world) or the world itself
+            if ref != "world" or node == "world":
+                return None
+            break
+        if j.get("type") != "fixed":
+            moving.append(j)
+        node = _end(j, "parent")
+    if link == ref or len(moving) != 1 or moving[0].get("type") not in ("revolute", "continuous"):
+        return None
+    return moving[0]
+
+
 def _gears(gearboxes: list[etree._Element], parent_joint: dict[str, etree._Element],
            joint_frame: Callable[[etree._Element], pin.SE3], axis: Callable[..., np.ndarray],
            source: str) -> dict[str, tuple[str, float, str]]:
@@ -122,10 +143,10 @@ def _gears(gearboxes: list[etree._Element], parent_joint: dict[str, etree._Eleme
         ends = []
         for role, tag in (("parent", "axis"), ("child", "axis2")):
             link = _end(g, role)
-            j = parent_joint.get(link)
-            if link == "world" or j is None or j.get("type") not in ("revolute", "continuous") or _end(j, "parent") != ref:
+            j = _turning_joint(link, ref, parent_joint)
+            if j is None:
                 raise SpecError(source, f"gearbox {name!r}: its {role} link {link!r} must hang on a revolute joint from "
-                                        f"its gearbox_reference_body {ref!r}")
+                                        f"its gearbox_reference_body {ref!r} (with fixed joints only between them)")
             a = Xg.rotation @ axis(g, Xg, tag)
             Xj = joint_frame(j)
             b = Xj.rotation @ axis(j, Xj)

@@ -146,9 +146,10 @@ def from_strings(urdf: str, spec: ClosureSpec | str, params: Any = None, source:
                  notes, seed=seed)
 
 
-def from_files(spec_path: str | Path) -> Mechanism:
+def from_files(spec_path: str | Path, spec: ClosureSpec | None = None) -> Mechanism:
     """Load ``<name>.closures.toml`` and the model file it names (path relative to the spec): a URDF, or an
     MJCF or SDF file whose own loops and joint types are added to the spec's (:mod:`pkm.core.formats`).
+    ``spec``: the spec file already read (and changed: :func:`pkm.core.formats.load.load_spec_file`).
 
     The spec's ``urdf`` must stay inside the spec's folder once symbolic links are resolved;
     nothing else is read (see :mod:`pkm.core.model.spec`).
@@ -157,7 +158,7 @@ def from_files(spec_path: str | Path) -> Mechanism:
         SpecError: A file is missing, too large, malformed, or the URDF path leaves the folder; or as :func:`build`.
     """
     spec_path = as_path(spec_path, "spec_path")
-    spec = ClosureSpec.load(spec_path)
+    spec = ClosureSpec.load(spec_path) if spec is None else spec
     try:
         folder = spec_path.parent.resolve()
         urdf_path = (folder / spec.urdf).resolve()

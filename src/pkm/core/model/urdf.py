@@ -341,24 +341,107 @@ def position_limits(text: str | bytes, source: str = "<string>") -> dict[str, tu
 
 
 def load_model(text: str, source: str = "<string>") -> pin.Model:
-    """Check URDF text and build the Pinocchio model (mimic joints honoured).
+    """Check URDF text and build the Pinocchio model (mimic joints honoured, in whatever order the file gives
+    them: where Pinocchio's parser meets a mimic joint before its leader, :func:`mimics_first`).
 
     Raises:
         SpecError: see the module docstring for what is refused.
     """
-    check_urdf(text, source)
+    root = check_urdf(text, source)
     if isinstance(text, bytes):
         text = text.decode("utf-8", errors="replace")
     try:
         yourdfpy.URDF.load(io.BytesIO(text.encode()), build_scene_graph=False, load_meshes=False)
     except Exception as exc:  # yourdfpy raises a variety of types
         raise SpecError(source, f"yourdfpy rejects the URDF: {exc}") from None
+    mimics = {str(el.get("name")): (str(m.get("joint")), float(m.get("multiplier", 1.0)), float(m.get("offset", 0.0)))
+              for el in root.findall("joint") if el.get("type") != "fixed" for m in el.findall("mimic")[:1]}
     try:
-        return pin.buildModelFromXML(text, mimic=True)
+        return pin.buildModelFromXML(text, mimic=bool(mimics))
     except Exception as exc:  # Pinocchio's own exception types must not leak
-        hint = (" (a mimic joint must come after the joint it mimics in Pinocchio's traversal, "
-                "which visits sibling joints in name order)") if "mimic" in str(exc) else ""
-        raise SpecError(source, f"Pinocchio rejects the URDF: {exc}{hint}") from None
+        if not mimics:
+            raise SpecError(source, f"Pinocchio rejects the URDF: {exc}") from None
+    try:  # (a mimic met before its leader in Pinocchio's traversal: pkm orders the tree itself)
+        model = pin.buildModelFromXML(text)
+    except Exception as exc:
+        raise SpecError(source, f"Pinocchio rejects the URDF: {exc}") from None
+    return mimics_first(model, mimics, source)
+
+
+def mimics_first(model: pin.Model, mimics: Mapping[str, tuple[str, float, float]], source: str) -> pin.Model:
+    """``model`` (plain joints) with the joints ``mimics`` names made mimic joints, ``{joint: (leader, multiplier,
+    offset)}``: ``q_joint = multiplier q_leader + offset`` (URDF's ``<mimic>``).
+
+    Pinocchio's URDF parser visits the tree depth first, sibling joints in name order, and refuses a mimic joint
+    met before its leader ("The parent joint of the mimic joint is not in the kinematic tree") though the file is
+    valid URDF: here the tree is visited depth first with, under each body, the subtrees holding a leader before
+    those holding the joints that mimic it (else in the parser's order), and each mimic joint made so
+    (``transformJointIntoMimic``). Joint names, placements, inertias, limits and frames are kept.
+
+    Raises:
+        SpecError: a mimic joint's leader is not a 1-coordinate joint, is below it in the tree, or the leaders
+            cross between sibling subtrees (no depth-first order visits every leader first).
+    """
+    names = list(model.names)
+    for name, (leader, _, _) in mimics.items():
+        if leader not in names[1:] or model.joints[model.getJointId(leader)].nq != 1 \
+                or model.joints[model.getJointId(name)].nq != 1:
+            raise SpecError(source, f"joint {name!r}: <mimic joint={leader!r}> needs two joints of one coordinate "
+                                    "each")
+    children: dict[int, list[int]] = {j: [] for j in range(model.njoints)}
+    for j in range(1, model.njoints):
+        children[model.parents[j]].append(j)
+    subtree = {j: {j} for j in range(model.njoints)}
+    for j in range(model.njoints - 1, 0, -1):
+        subtree[model.parents[j]] |= subtree[j]
+    pairs = [(model.getJointId(leader), model.getJointId(name)) for name, (leader, _, _) in mimics.items()]
+    order: list[int] = []
+
+    def visit(j: int) -> None:
+        order.append(j)
+        kids, ordered = list(children[j]), []
+        while kids:  # the first sibling no other pending sibling must precede (a leader of a mimic in it)
+            ready = [k for k in kids if not any(lead in subtree[o] and mim in subtree[k]
+                                                for o in kids if o != k for lead, mim in pairs)]
+            if not ready:
+                raise SpecError(source, f"the mimic joints below {names[j]!r} follow leaders across sibling branches "
+                                        "both ways: no depth-first order visits each leader first")
+            ordered.append(ready[0])
+            kids.remove(ready[0])
+        for k in ordered:
+            visit(k)
+
+    visit(0)
+    rank = {j: n for n, j in enumerate(order)}
+    for lead, mim in pairs:
+        if rank[lead] > rank[mim]:
+            raise SpecError(source, f"joint {names[mim]!r} mimics {names[lead]!r}, a joint below it in the tree: "
+                                    "Pinocchio cannot model that coupling")
+    new = pin.Model()
+    new.name, new.gravity = model.name, model.gravity
+    ids = {0: 0}
+    for j in order[1:]:
+        ids[j] = new.addJoint(ids[model.parents[j]], model.joints[j], model.jointPlacements[j], names[j])
+        new.appendBodyToJoint(ids[j], model.inertias[j], pin.SE3.Identity())
+    per_q = [k for k in ("lowerPositionLimit", "upperPositionLimit", "positionLimitMargin") if hasattr(new, k)]
+    per_v = [k for k in ("lowerEffortLimit", "upperEffortLimit", "lowerVelocityLimit", "upperVelocityLimit",
+                         "lowerDryFrictionLimit", "upperDryFrictionLimit", "effortLimit", "velocityLimit",
+                         "damping", "friction", "armature", "rotorInertia", "rotorGearRatio") if hasattr(new, k)]
+    for key, per in [(k, "q") for k in per_q] + [(k, "v") for k in per_v]:
+        old_values, values = np.asarray(getattr(model, key), dtype=float), np.array(getattr(new, key), dtype=float)
+        if old_values.shape != values.shape:
+            continue
+        for j in order[1:]:
+            a, b = model.joints[j], new.joints[ids[j]]
+            i0, i1, n = (a.idx_q, b.idx_q, a.nq) if per == "q" else (a.idx_v, b.idx_v, a.nv)
+            values[i1:i1 + n] = old_values[i0:i0 + n]
+        setattr(new, key, values)
+    for k, f in enumerate(model.frames):
+        if k:  # (the universe frame: every model has it)
+            new.addFrame(pin.Frame(f.name, ids[f.parentJoint], f.parentFrame, f.placement, f.type, f.inertia), False)
+    for name, (leader, multiplier, offset) in sorted(mimics.items(), key=lambda item: rank[model.getJointId(item[0])]):
+        new = pin.transformJointIntoMimic(new, new.getJointId(leader), new.getJointId(name), multiplier, offset)
+    return new
 
 
 _AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
@@ -422,7 +505,7 @@ def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: d
     ``limits`` gives the position limits ``{joint: (lower, upper)}`` to state; the other revolute and
     prismatic joints get a ``<limit>`` without bounds. ``mimic`` makes joints followers,
     ``{joint: (leader, multiplier, offset)}``: a URDF ``<mimic>``, ``q_joint = multiplier q_leader + offset``
-    (:func:`load_model` builds Pinocchio's mimic joints; the leader must come first in its traversal).
+    (:func:`load_model` builds Pinocchio's mimic joints, in any order).
     ``locked`` welds one-coordinate joints at a value, ``{joint: q [rad or m]}``: a fixed joint at the
     placement the joint has there. :func:`load_model` and :func:`pkm.core.model.joints.retype_joints` give the
     same tree back (same ``q`` layout but for the mimic and locked joints, frames, inertias).
