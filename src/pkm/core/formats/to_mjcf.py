@@ -7,6 +7,18 @@ leader by a ``<joint>`` equality ``q = offset + scale q_leader``), a site at eac
 (point closure) or ``<weld>`` (frame closure) between the two sites, a ``<motor>`` on each actuated joint.
 Gravity is the model's, contacts are disabled, no joint is limited (MuJoCo would add limit rows).
 
+The loop closures (and mimic equalities) are written stiff, not with MuJoCo's default softness (``solref`` (0.02, 1),
+``solimp`` (0.9, 0.95, ...), under which a Delta held at rest opens its loops by 0.4 mm): each carries ``solref =
+(2 dt, 1)`` with ``dt`` the written ``<option timestep>`` (:data:`TIMESTEP`, 1 ms by default), the shortest time
+constant MuJoCo keeps stable (MuJoCo's documentation: at least twice the step; it clamps shorter ones), critically
+damped, and ``solimp`` = :data:`SOLIMP` (0.9999, 0.9999, ...: constant impedance at MuJoCo's largest,
+``mjMAXIMP``). At rest, a soft equality carrying a load sags by ``r = (1-d)/d * a0 * (d timeconst)^2`` (``a0``: the
+acceleration the load would give the loop without it), so this choice divides MuJoCo's default sag by about
+``(0.05/1e-4) * (0.02/0.002)^2`` = 5e4: held at rest under gravity for 1 s at 1 ms, the shipped Delta, 3-PRS and
+Gough-Stewart, the humanoid ankle and Gepetto's planar five-bar stay closed within 5e-8 m
+(``tests/core/formats/test_to_mjcf.py``); light links carrying a large load sag more (the hexapod 1.05e-6 m, Gepetto's
+battobot 1.8e-5 m): write a smaller ``timestep`` for them (the sag goes as its square).
+
 Each actuated joint's drive (:attr:`~pkm.core.Mechanism.actuators`, :mod:`pkm.core.model.actuators`) is written in
 the joint's units: the joint's ``armature`` is :attr:`~pkm.core.model.actuators.Actuator.reflected_inertia`
 (``rotor_inertia * gear_ratio**2 + armature``), its ``damping`` the viscous friction, its ``frictionloss`` the
@@ -30,7 +42,7 @@ from lxml import etree
 from numpy.typing import ArrayLike
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.errors import SpecError
+from pkm.errors import InvalidInputError, SpecError
 
 _REVOLUTE = {"RX", "RY", "RZ", "RUBX", "RUBY", "RUBZ"}
 _PRISMATIC = {"PX", "PY", "PZ"}
@@ -38,6 +50,11 @@ _PRISMATIC = {"PX", "PY", "PZ"}
 #: mass): the compiler raises them to these bounds (``boundmass``, ``boundinertia``), which changes efforts by
 #: about ``MIN_INERTIA`` times an angular acceleration.
 MIN_MASS, MIN_INERTIA = 1e-9, 1e-12
+#: The written ``<option timestep>`` [s] by default (MuJoCo's own default is 2 ms).
+TIMESTEP = 1e-3
+#: The loop closures' ``solimp`` (impedance ``d`` from ``dmin`` at no violation to ``dmax`` beyond ``width`` [m],
+#: ``midpoint``, ``power``): see the module doc.
+SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 
 
 def _num(x: ArrayLike) -> str:
@@ -83,17 +100,20 @@ def _joints(el: etree._Element, jm: pin.JointModel, name: str, source: str) -> l
                             "universal, spherical, free-flyer and mimic joints)")
 
 
-def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None) -> str:
-    """The MJCF text of ``mech`` (see the module doc).
+def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, timestep: float = TIMESTEP) -> str:
+    """The MJCF text of ``mech`` (see the module doc); ``timestep`` [s]: the written ``<option timestep>``, which
+    the loop closures' ``solref`` follows (:func:`closure_softness`).
 
     Raises:
         SpecError: A joint MJCF cannot express (see the module doc).
+        InvalidInputError: ``timestep`` not a positive finite number.
     """
     mech = check_mechanism(mech)
+    solref, solimp = closure_softness(timestep)
     model = mech.model
     root = etree.Element("mujoco", model=model_name or model.name or "pkm")
     etree.SubElement(root, "compiler", angle="radian", boundmass=repr(MIN_MASS), boundinertia=repr(MIN_INERTIA))
-    option = etree.SubElement(root, "option", gravity=_num(model.gravity.linear))
+    option = etree.SubElement(root, "option", timestep=repr(float(timestep)), gravity=_num(model.gravity.linear))
     etree.SubElement(option, "flag", contact="disable")
     world = etree.SubElement(root, "worldbody")
     bodies: list[etree._Element] = [world]
@@ -115,7 +135,8 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None) -> str:
             mimic = jm.extract()
             leader = model.names[_leader(model, j)]
             etree.SubElement(equality, "joint", joint1=model.names[j], joint2=leader,
-                             polycoef=_num([mimic.offset, mimic.scaling, 0, 0, 0]))
+                             polycoef=_num([mimic.offset, mimic.scaling, 0, 0, 0]), solref=_num(solref),
+                             solimp=_num(solimp))
         bodies.append(body)
     for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
         sites = []
@@ -125,7 +146,7 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None) -> str:
             _pose(site, frame.placement)
             sites.append(site.get("name"))
         etree.SubElement(equality, "connect" if c.type == "point" else "weld", name=c.name, site1=sites[0],
-                         site2=sites[1])
+                         site2=sites[1], solref=_num(solref), solimp=_num(solimp))
     root.append(equality)
     actuator = etree.SubElement(root, "actuator")
     for joint, drive in zip(mech.actuated, mech.actuators):
@@ -142,6 +163,20 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None) -> str:
     return etree.tostring(root, pretty_print=True, encoding="unicode")
 
 
+def closure_softness(timestep: float = TIMESTEP) -> tuple[tuple[float, float], tuple[float, ...]]:
+    """The ``(solref, solimp)`` written on each loop closure's ``<connect>``/``<weld>`` for a step of ``timestep``
+    [s]: ``solref = (2 timestep, 1)`` (a critically damped reference with the shortest time constant MuJoCo keeps
+    stable: it clamps shorter ones to ``2 timestep``) and ``solimp`` = :data:`SOLIMP` (see the module doc).
+
+    Raises:
+        InvalidInputError: ``timestep`` not a positive finite number.
+    """
+    dt = float(timestep) if isinstance(timestep, (int, float)) and not isinstance(timestep, bool) else float("nan")
+    if not (np.isfinite(dt) and dt > 0.0):
+        raise InvalidInputError("timestep", "must be a positive, finite number of seconds", timestep)
+    return (2.0 * dt, 1.0), SOLIMP
+
+
 def _leader(model: pin.Model, j: int) -> int:
     """The joint a mimic joint follows: the one whose coordinates it reads."""
     idx_q = model.joints[j].idx_q
@@ -151,4 +186,4 @@ def _leader(model: pin.Model, j: int) -> int:
     raise SpecError(model.name, f"mimic joint {model.names[j]!r}: no leader found")
 
 
-__all__ = ["MIN_INERTIA", "MIN_MASS", "body_names", "mjcf_from_mechanism"]
+__all__ = ["MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "body_names", "closure_softness", "mjcf_from_mechanism"]
