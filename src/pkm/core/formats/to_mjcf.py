@@ -5,7 +5,8 @@ fixed joints are merged), the joint itself (``hinge``, ``slide``, ``ball``, ``fr
 hinges of one body, about its first axis and then its second; a mimic joint as a joint of its own tied to its
 leader by a ``<joint>`` equality ``q = offset + scale q_leader``), a site at each closure frame, a ``<connect>``
 (point closure) or ``<weld>`` (frame closure) between the two sites, a ``<motor>`` on each actuated joint.
-Gravity is the model's, contacts are disabled, no joint is limited (MuJoCo would add limit rows).
+Gravity is the model's, contacts are disabled; a one-coordinate joint with position limits
+(:attr:`~pkm.core.Mechanism.limits`) has them as its ``range`` (radians or metres: ``<compiler angle="radian">``).
 
 The loop closures (and mimic equalities) are written stiff, not with MuJoCo's default softness (``solref`` (0.02, 1),
 ``solimp`` (0.9, 0.95, ...), under which a Delta held at rest opens its loops by 0.4 mm): each carries ``solref =
@@ -130,7 +131,9 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
         I = inertia.inertia
         etree.SubElement(body, "inertial", pos=_num(inertia.lever), mass=repr(max(float(inertia.mass), MIN_MASS)),
                          fullinertia=_num([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]))
-        _joints(body, jm, model.names[j], mech.source)
+        for name in _joints(body, jm, model.names[j], mech.source):
+            if name in mech.limits and jm.nq == 1:  # (MuJoCo adds a limit row only where a joint reaches it)
+                body.find(f"joint[@name='{name}']").set("range", _num(mech.limits[name]))
         if jm.shortname() == "JointModelMimic":
             mimic = jm.extract()
             leader = model.names[_leader(model, j)]
@@ -177,6 +180,41 @@ def closure_softness(timestep: float = TIMESTEP) -> tuple[tuple[float, float], t
     return (2.0 * dt, 1.0), SOLIMP
 
 
+def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
+    """What :func:`mjcf_from_mechanism` cannot write of ``mech``, one line each (pkm's MJCF reader gives a mechanism
+    without it): the task and end effector, the reference configuration, the spec's working modes and design
+    parameters, the drives' speed limits and continuous efforts (when a peak is written), the rotor inertia and
+    gear ratio (folded into ``armature``), and universal joints' kind (written as two hinges of one body)."""
+    import json
+
+    mech = check_mechanism(mech)
+    spec, out = mech.spec, []
+    actuated = tuple(mech.actuated_names)
+    if spec.end_effector is not None or spec.task.components or spec.task.frames or tuple(spec.task.joints) != actuated:
+        out.append(f"task: end effector {spec.end_effector!r}, components {' '.join(spec.task.components) or '-'} "
+                   "(read back, the task is the actuated joints)")
+    out.append("reference configuration (read back, the mechanism is assembled from MuJoCo's qpos0)")
+    if spec.branches:
+        out.append(f"working modes ([branches]): {sorted(spec.branches)}")
+    if spec.parameters:
+        out.append(f"design parameters ([parameters]): {json.dumps(dict(spec.parameters))}")
+    for a in mech.actuators:
+        lost = [f"{k} {v!r}" for k, v in (("velocity_limit", a.velocity_limit),
+                                          ("effort_limit", a.effort_limit if np.isfinite(a.peak_effort) else np.inf),
+                                          ("rotor_inertia", a.rotor_inertia),
+                                          ("gear_ratio", a.gear_ratio if a.gear_ratio != 1.0 else 0.0))
+                if np.isfinite(v) and v != 0.0]
+        if lost:
+            out.append(f"drive of {a.joint!r}: {', '.join(lost)} (MJCF has one force range, and armature for the "
+                       "rotor)")
+    universal = [mech.model.names[j] for j in range(1, mech.model.njoints)
+                 if mech.model.joints[j].shortname() == "JointModelUniversal"]
+    if universal:
+        out.append(f"universal joints {universal}: written as two hinges of one body each (read back as a composite "
+                   "joint)")
+    return tuple(out)
+
+
 def _leader(model: pin.Model, j: int) -> int:
     """The joint a mimic joint follows: the one whose coordinates it reads."""
     idx_q = model.joints[j].idx_q
@@ -186,4 +224,5 @@ def _leader(model: pin.Model, j: int) -> int:
     raise SpecError(model.name, f"mimic joint {model.names[j]!r}: no leader found")
 
 
-__all__ = ["MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "body_names", "closure_softness", "mjcf_from_mechanism"]
+__all__ = ["MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "body_names", "closure_softness", "mjcf_from_mechanism",
+           "mjcf_omissions"]
