@@ -132,19 +132,34 @@ def target(path: str | Path, to: str | None = None) -> tuple[Writer, Path | None
     return by_suffix, path
 
 
+def destination(mech: Mechanism, path: str | Path, to: str | None = None) -> tuple[Writer, tuple[Path, ...]]:
+    """The writer for ``path`` (:func:`target`) and the files it will write, the main one first (a folder's named
+    after the mechanism, or ``robot.yaml``; the URDF beside a spec or a Gepetto YAML).
+
+    Raises:
+        UnknownNameError, InvalidInputError: see :func:`target`.
+    """
+    writer, file = target(path, to)
+    if file is None:
+        file = Path(path) / ("robot.yaml" if writer.name == "gepetto" else
+                             f"{_safe(mech.spec.mechanism)}{writer.suffixes[0]}")
+    if writer.name == "pkm":
+        return writer, (file, file.with_name(f"{file.name.removesuffix('.toml').removesuffix('.closures')}.urdf"))
+    return writer, (file, file.with_suffix(".urdf")) if writer.name == "gepetto" else (file,)
+
+
 def write(mech: Mechanism, path: str | Path, to: str | None = None) -> Written:
-    """Write ``mech`` at ``path`` in the format its suffix names, or ``to`` (see the module doc).
+    """Write ``mech`` at ``path`` in the format its suffix names, or ``to`` (see the module doc); the files are
+    :func:`destination`'s.
 
     Raises:
         UnknownNameError, InvalidInputError: see :func:`target`; not a Mechanism.
         SpecError: the format cannot hold something the mechanism needs (a joint MJCF has no kind for, a floating
-            base in Gepetto's format): the message names it.
+            base in Gepetto's format): the message names it; a file that cannot be written.
     """
     mech = check_mechanism(mech)
-    writer, file = target(path, to)
-    if file is None:
-        base = Path(path)
-        file = base / ("robot.yaml" if writer.name == "gepetto" else f"{_safe(mech.spec.mechanism)}{writer.suffixes[0]}")
+    writer, files = destination(mech, path, to)
+    file = files[0]
     try:
         return writer.write(mech, file)
     except OSError as exc:
@@ -155,4 +170,4 @@ def _safe(name: str) -> str:
     return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "mechanism"
 
 
-__all__ = ["WRITERS", "Writer", "Written", "target", "write"]
+__all__ = ["WRITERS", "Writer", "Written", "destination", "target", "write"]
