@@ -112,7 +112,7 @@ def test_a_path_names_its_format_or_is_refused_listing_the_known_ones(tmp_path):
                             ("out", None, "needs to= .* known: "), ("a.xml", "pkm", "is mjcf's, not pkm's")):
         with pytest.raises(InvalidInputError, match=match):
             target(path, to)
-    with pytest.raises(UnknownNameError, match="format 'urdf' does not exist.*'gepetto'"):
+    with pytest.raises(UnknownNameError, match=r"format 'urdf' does not exist.*'gepetto'"):
         pkm.save(_mech("fivebar"), tmp_path / "a.urdf", to="urdf")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PkmWarning)

@@ -17,6 +17,7 @@ A path without a suffix, with ``to`` given, is a folder: the files go in it (``<
 from __future__ import annotations
 
 import dataclasses as dc
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -105,7 +106,7 @@ def _known() -> str:
     return "; ".join(f"{w.name} ({', '.join(w.suffixes)})" for w in WRITERS.values())
 
 
-def target(path: str | Path, to: str | None = None) -> tuple[Writer, Path | None]:
+def target(path: str | os.PathLike[str], to: str | None = None) -> tuple[Writer, Path | None]:
     """The writer for ``path`` (by its suffix, or ``to``) and, when ``path`` is a folder (no suffix, ``to`` given),
     None for the file (the caller names it); else ``path`` itself.
 
@@ -132,7 +133,7 @@ def target(path: str | Path, to: str | None = None) -> tuple[Writer, Path | None
     return by_suffix, path
 
 
-def destination(mech: Mechanism, path: str | Path, to: str | None = None) -> tuple[Writer, tuple[Path, ...]]:
+def destination(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) -> tuple[Writer, tuple[Path, ...]]:
     """The writer for ``path`` (:func:`target`) and the files it will write, the main one first (a folder's named
     after the mechanism, or ``robot.yaml``; the URDF beside a spec or a Gepetto YAML).
 
@@ -148,7 +149,7 @@ def destination(mech: Mechanism, path: str | Path, to: str | None = None) -> tup
     return writer, (file, file.with_suffix(".urdf")) if writer.name == "gepetto" else (file,)
 
 
-def write(mech: Mechanism, path: str | Path, to: str | None = None) -> Written:
+def write(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) -> Written:
     """Write ``mech`` at ``path`` in the format its suffix names, or ``to`` (see the module doc); the files are
     :func:`destination`'s.
 
