@@ -45,10 +45,11 @@ Every run is :func:`pkm.simulate` (RK4 in the actuated coordinates, the loops cl
       RK4 integrator at the same ``dt``; the PD evaluated natively at every stage (affine actuator bias
       ``-K_p q - K_d q̇``), the rest through ``ctrl`` held over each step at its midpoint value (an O(dt²) error).
       Its equality constraints are soft (``solref``, ``solimp``: MuJoCo's defaults, :data:`MUJOCO_SOFTNESS`, set
-      on the compiled model in place of the stiffer ones the MJCF carries): they open by the ``r`` the run reports, which moves the actuated coordinates
-      through the same ``T``: bound ``2 S max|r| + 2 ε_pkm`` (the factor 2: ``S`` is a gain in energy, not in peak,
-      and the model is linearised). Run again with stiffer equalities (``solref = (2 dt, 1)``, ``solimp = (0.99,
-      0.999, 0.001, 0.5, 2)``): the violation and the difference shrink together.
+      on the compiled model in place of the stiffer ones the MJCF carries): they open by the ``r`` the run reports,
+      which moves the actuated coordinates through the same ``T``: bound ``2 S max|r| + 2 ε_pkm`` (the factor 2:
+      ``S`` is a gain in energy, not in peak, and the model is linearised). Run again with stiffer equalities
+      (``solref = (2 dt, 1)``, ``solimp = (0.99, 0.999, 0.001, 0.5, 2)``): the violation and the difference shrink
+      together.
 
    The closure residual of each: pkm's <= 1e-12 by construction, Baumgarte's drift, MuJoCo's equality violation.
 

@@ -15,7 +15,7 @@ constant MuJoCo keeps stable (MuJoCo's documentation: at least twice the step; i
 damped, and ``solimp`` = :data:`SOLIMP` (0.9999, 0.9999, ...: constant impedance at MuJoCo's largest,
 ``mjMAXIMP``). At rest, a soft equality carrying a load sags by ``r = (1-d)/d * a0 * (d timeconst)^2`` (``a0``: the
 acceleration the load would give the loop without it), so this choice divides MuJoCo's default sag by about
-``(0.05/1e-4) * (0.02/0.002)^2`` = 5e4: held at rest under gravity for 1 s at 1 ms, the shipped Delta, 3-PRS and
+``(0.1/0.9 / 1e-4) * (0.95 * 0.02 / 0.002)^2`` = 1e5 (measured: 8e4 on the Delta): held at rest under gravity for 1 s at 1 ms, the shipped Delta, 3-PRS and
 Gough-Stewart, the humanoid ankle and Gepetto's planar five-bar stay closed within 5e-8 m
 (``tests/core/formats/test_to_mjcf.py``); light links carrying a large load sag more (the hexapod 1.05e-6 m, Gepetto's
 battobot 1.8e-5 m): write a smaller ``timestep`` for them (the sag goes as its square).
@@ -193,7 +193,8 @@ def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
     if spec.end_effector is not None or spec.task.components or spec.task.frames or tuple(spec.task.joints) != actuated:
         out.append(f"task: end effector {spec.end_effector!r}, components {' '.join(spec.task.components) or '-'} "
                    "(read back, the task is the actuated joints)")
-    out.append("reference configuration (read back, the mechanism is assembled from MuJoCo's qpos0)")
+    out.append("reference configuration (read back, the mechanism is assembled from the neutral configuration, "
+               "MuJoCo's qpos0)")
     if spec.branches:
         out.append(f"working modes ([branches]): {sorted(spec.branches)}")
     if spec.parameters:
