@@ -199,3 +199,27 @@ def test_mujoco_on_the_written_ankle_follows_pkm_simulate_under_a_chirp():
     sim = pkm_run(mech, mech.q_reference, law, 0.5, 1e-3)
     _, qa, residual, _ = mujoco_run(mech, mech.q_reference, law, 0.5, 1e-3)
     assert np.abs(qa - sim.actuated[:len(qa)]).max() <= 1e-5 and residual.max() <= 1e-6
+
+
+@pytest.mark.skipif(unavailable() is not None, reason="MuJoCo is a benchmark-only dependency")
+def test_the_reference_keyframe_is_closed_in_mujoco():
+    """<keyframe name="reference">: MuJoCo reset to it has every equality closed (1e-12) and the qpos the benchmark's
+    own conversion (MujocoRigid, joint by joint through MuJoCo's addresses) gives, on the Delta, the hexapod (free
+    flyer, mimic joints) and the Gough-Stewart (universal joints); a wrong q is refused."""
+    import mujoco
+
+    from pkm.core.formats.to_mjcf import mjcf_qpos
+
+    for name in ("delta", "hexapod", "gough_stewart"):
+        mech = pkm.load(name)
+        m = mujoco.MjModel.from_xml_string(mjcf_from_mechanism(mech))
+        d = mujoco.MjData(m)
+        mujoco.mj_resetDataKeyframe(m, d, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "reference"))
+        mujoco.mj_fwdPosition(m, d)
+        rows = d.efc_type[:d.nefc] == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        assert rows.any() and np.abs(d.efc_pos[:d.nefc][rows]).max() <= 1e-12, name
+        rigid = MujocoRigid(mech)
+        rigid._state(mech.q_reference, np.zeros(mech.nv), np.zeros(mech.nv))
+        np.testing.assert_array_equal(rigid.data.qpos, d.qpos)
+    with pytest.raises(InvalidInputError, match="q: must be"):
+        mjcf_qpos(pkm.load("delta"), np.zeros(3))

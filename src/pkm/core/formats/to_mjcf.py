@@ -4,7 +4,9 @@
 fixed joints are merged), the joint itself (``hinge``, ``slide``, ``ball``, ``free``; a universal joint as two
 hinges of one body, about its first axis and then its second; a mimic joint as a joint of its own tied to its
 leader by a ``<joint>`` equality ``q = offset + scale q_leader``), a site at each closure frame, a ``<connect>``
-(point closure) or ``<weld>`` (frame closure) between the two sites, a ``<motor>`` on each actuated joint.
+(point closure) or ``<weld>`` (frame closure) between the two sites, a ``<motor>`` on each actuated joint, and the
+reference configuration as ``<keyframe><key name="reference">`` (:func:`mjcf_qpos`; MuJoCo's
+``mj_resetDataKeyframe(model, data, 0)`` starts from it, closed).
 Gravity is the model's, contacts are disabled; a one-coordinate joint with position limits
 (:attr:`~pkm.core.Mechanism.limits`) has them as its ``range`` (radians or metres: ``<compiler angle="radian">``).
 
@@ -151,6 +153,8 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
         etree.SubElement(equality, "connect" if c.type == "point" else "weld", name=c.name, site1=sites[0],
                          site2=sites[1], solref=_num(solref), solimp=_num(solimp))
     root.append(equality)
+    keyframe = etree.SubElement(root, "keyframe")
+    etree.SubElement(keyframe, "key", name="reference", qpos=_num(mjcf_qpos(mech, mech.q_reference)))
     actuator = etree.SubElement(root, "actuator")
     for joint, drive in zip(mech.actuated, mech.actuators):
         name = model.names[joint.id]
@@ -164,6 +168,49 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
             motor.set("forcelimited", "true")
             motor.set("forcerange", _num([-drive.max_effort, drive.max_effort]))
     return etree.tostring(root, pretty_print=True, encoding="unicode")
+
+
+def mjcf_qpos(mech: Mechanism, q: ArrayLike) -> np.ndarray:
+    """Pinocchio's configuration ``q`` (nq,) as MuJoCo's ``qpos`` of the file :func:`mjcf_from_mechanism` writes:
+    its joints in the file's (depth-first) order; a free body's world position and quaternion ``w x y z``, a ball's
+    quaternion ``w x y z``, an unbounded revolute's angle, a mimic joint's own coordinate ``offset + scale
+    q_leader``, a universal joint's two angles.
+
+    Raises:
+        InvalidInputError: ``q`` not of shape (nq,) or not finite.
+    """
+    mech = check_mechanism(mech)
+    model = mech.model
+    q = np.asarray(q, dtype=float)
+    if q.shape != (model.nq,) or not np.all(np.isfinite(q)):
+        raise InvalidInputError("q", f"must be {model.nq} finite numbers (Pinocchio's configuration)", q)
+    children: list[list[int]] = [[] for _ in range(model.njoints)]
+    for j in range(1, model.njoints):
+        children[int(model.parents[j])].append(j)
+    order, stack = [], list(reversed(children[0]))
+    while stack:  # the bodies as the file nests them: MuJoCo's order
+        j = stack.pop()
+        order.append(j)
+        stack.extend(reversed(children[j]))
+    out: list[float] = []
+    for j in order:
+        jm = model.joints[j]
+        kind = jm.shortname().removeprefix("JointModel")
+        seg = q[jm.idx_q:jm.idx_q + jm.nq]
+        if kind == "FreeFlyer":
+            X = model.jointPlacements[j] * pin.XYZQUATToSE3(seg)
+            quat = pin.Quaternion(X.rotation)
+            out += [*X.translation, quat.w, quat.x, quat.y, quat.z]
+        elif kind == "Spherical":
+            out += [seg[3], seg[0], seg[1], seg[2]]
+        elif kind in ("RUBX", "RUBY", "RUBZ"):
+            out.append(float(np.arctan2(seg[1], seg[0])))
+        elif kind == "Mimic":
+            mimic = jm.extract()
+            out.append(float(mimic.offset + mimic.scaling * q[jm.idx_q]))
+        else:
+            out += list(seg)
+    return np.array(out)
 
 
 def closure_softness(timestep: float = TIMESTEP) -> tuple[tuple[float, float], tuple[float, ...]]:
@@ -184,7 +231,8 @@ def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
     """What :func:`mjcf_from_mechanism` cannot write of ``mech``, one line each (pkm's MJCF reader gives a mechanism
     without it): the task and end effector, the reference configuration, the spec's working modes and design
     parameters, the drives' speed limits and continuous efforts (when a peak is written), the rotor inertia and
-    gear ratio (folded into ``armature``), and universal joints' kind (written as two hinges of one body)."""
+    gear ratio (folded into ``armature``), and universal joints' kind (written as two hinges of one body, read back
+    as two revolute joints ``<name>__1``, ``<name>__2``)."""
     import json
 
     mech = check_mechanism(mech)
@@ -193,8 +241,8 @@ def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
     if spec.end_effector is not None or spec.task.components or spec.task.frames or tuple(spec.task.joints) != actuated:
         out.append(f"task: end effector {spec.end_effector!r}, components {' '.join(spec.task.components) or '-'} "
                    "(read back, the task is the actuated joints)")
-    out.append("reference configuration (read back, the mechanism is assembled from the neutral configuration, "
-               "MuJoCo's qpos0)")
+    out.append("reference configuration: written as MuJoCo's <keyframe> 'reference', which pkm's reader does not "
+               "read (it assembles the mechanism from the neutral configuration)")
     if spec.branches:
         out.append(f"working modes ([branches]): {sorted(spec.branches)}")
     if spec.parameters:
@@ -211,8 +259,8 @@ def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
     universal = [mech.model.names[j] for j in range(1, mech.model.njoints)
                  if mech.model.joints[j].shortname() == "JointModelUniversal"]
     if universal:
-        out.append(f"universal joints {universal}: written as two hinges of one body each (read back as a composite "
-                   "joint)")
+        out.append(f"universal joints {universal}: written as two hinges <name>__1, <name>__2 of one body each (read "
+                   "back as two revolute joints of those names)")
     return tuple(out)
 
 
@@ -226,4 +274,4 @@ def _leader(model: pin.Model, j: int) -> int:
 
 
 __all__ = ["MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "body_names", "closure_softness", "mjcf_from_mechanism",
-           "mjcf_omissions"]
+           "mjcf_omissions", "mjcf_qpos"]
