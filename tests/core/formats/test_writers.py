@@ -103,7 +103,7 @@ def test_the_gepetto_yaml_says_what_it_cannot_hold(tmp_path):
 def test_a_path_names_its_format_or_is_refused_listing_the_known_ones(tmp_path):
     """By suffix (.closures.toml, .toml, .xml, .mjcf, .yaml, .yml, any case), or to= for a folder; an unknown suffix,
     a folder without to=, a suffix of another format than to=, an unknown to=: each refused, the message listing the
-    formats and their suffixes."""
+    formats and their suffixes; a file that cannot be written is a SpecError naming it."""
     for path, name in (("a.closures.toml", "pkm"), ("a.TOML", "pkm"), ("a.xml", "mjcf"), ("a.mjcf", "mjcf"),
                        ("a.yaml", "gepetto"), ("a.yml", "gepetto")):
         assert target(path)[0].name == name
@@ -119,3 +119,6 @@ def test_a_path_names_its_format_or_is_refused_listing_the_known_ones(tmp_path):
         main = pkm.save(_mech("fivebar"), tmp_path / "folder", to="gepetto")
     assert main == tmp_path / "folder" / "robot.yaml" and (tmp_path / "folder" / "robot.urdf").is_file()
     assert pkm.load(tmp_path / "folder").actuated_names == _mech("fivebar").actuated_names
+    (tmp_path / "plain").write_text("")
+    with pytest.raises(SpecError, match=r"plain/x\.xml: cannot write"):
+        write(_mech("fivebar"), tmp_path / "plain" / "x.xml")

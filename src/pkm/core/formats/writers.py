@@ -46,12 +46,14 @@ class Written:
 
 @dataclass(frozen=True)
 class Writer:
-    """One output format: its name, its suffixes (the first for a folder's file), what it is, how it writes."""
+    """One output format: its name, its suffixes (the first for a folder's file), what it is, how it writes (to
+    :func:`destination`'s files), and the URDF it writes beside its main file, if any."""
 
     name: str
     suffixes: tuple[str, ...]
     description: str
-    write: Callable[[Mechanism, Path], Written]
+    write: Callable[[Mechanism, tuple[Path, ...]], Written]
+    urdf_beside: Callable[[Path], Path] | None = None
 
 
 def _urdf_text(mech: Mechanism, what: str) -> str:
@@ -61,10 +63,9 @@ def _urdf_text(mech: Mechanism, what: str) -> str:
     return mech.urdf
 
 
-def _write_pkm(mech: Mechanism, path: Path) -> Written:
+def _write_pkm(mech: Mechanism, files: tuple[Path, ...]) -> Written:
+    path, urdf_path = files
     urdf = _urdf_text(mech, "pkm's spec + URDF")
-    stem = path.name.removesuffix(".toml").removesuffix(".closures")
-    urdf_path = path.with_name(f"{stem}.urdf")
     reference = {k: tuple(float(x) for x in np.atleast_1d(v)) for k, v in mech.q_to_dict(mech.q_reference).items()}
     spec = dc.replace(mech.spec, urdf=urdf_path.name, reference=reference)
     text = spec.to_toml()
@@ -74,20 +75,21 @@ def _write_pkm(mech: Mechanism, path: Path) -> Written:
     return Written((path, urdf_path), (), "pkm")
 
 
-def _write_mjcf(mech: Mechanism, path: Path) -> Written:
+def _write_mjcf(mech: Mechanism, files: tuple[Path, ...]) -> Written:
     from pkm.core.formats.to_mjcf import mjcf_from_mechanism, mjcf_omissions
 
+    (path,) = files
     text = mjcf_from_mechanism(mech)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(text, encoding="utf-8")
     return Written((path,), mjcf_omissions(mech), "mjcf")
 
 
-def _write_gepetto(mech: Mechanism, path: Path) -> Written:
+def _write_gepetto(mech: Mechanism, files: tuple[Path, ...]) -> Written:
     from pkm.core.formats.to_gepetto import gepetto_from_mechanism
 
+    path, urdf_path = files
     text, dropped = gepetto_from_mechanism(mech)
-    urdf_path = path.with_suffix(".urdf")
     path.parent.mkdir(parents=True, exist_ok=True)
     urdf_path.write_text(_urdf_text(mech, "Gepetto's URDF + YAML"), encoding="utf-8")
     path.write_text(text, encoding="utf-8")
@@ -96,9 +98,11 @@ def _write_gepetto(mech: Mechanism, path: Path) -> Written:
 
 #: The writers by name (see the module doc).
 WRITERS: dict[str, Writer] = {w.name: w for w in (
-    Writer("pkm", (".closures.toml", ".toml"), "pkm's closure spec + URDF", _write_pkm),
+    Writer("pkm", (".closures.toml", ".toml"), "pkm's closure spec + URDF", _write_pkm,
+           lambda p: p.with_name(f"{p.name.removesuffix('.toml').removesuffix('.closures')}.urdf")),
     Writer("mjcf", (".xml", ".mjcf"), "MuJoCo's MJCF", _write_mjcf),
-    Writer("gepetto", (".yaml", ".yml"), "Gepetto's URDF + YAML (toolbox-parallel-robots)", _write_gepetto),
+    Writer("gepetto", (".yaml", ".yml"), "Gepetto's URDF + YAML (toolbox-parallel-robots)", _write_gepetto,
+           lambda p: p.with_suffix(".urdf")),
 )}
 
 
@@ -144,9 +148,7 @@ def destination(mech: Mechanism, path: str | os.PathLike[str], to: str | None = 
     if file is None:
         file = Path(path) / ("robot.yaml" if writer.name == "gepetto" else
                              f"{_safe(mech.spec.mechanism)}{writer.suffixes[0]}")
-    if writer.name == "pkm":
-        return writer, (file, file.with_name(f"{file.name.removesuffix('.toml').removesuffix('.closures')}.urdf"))
-    return writer, (file, file.with_suffix(".urdf")) if writer.name == "gepetto" else (file,)
+    return writer, (file,) if writer.urdf_beside is None else (file, writer.urdf_beside(file))
 
 
 def write(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) -> Written:
@@ -160,11 +162,10 @@ def write(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) 
     """
     mech = check_mechanism(mech)
     writer, files = destination(mech, path, to)
-    file = files[0]
     try:
-        return writer.write(mech, file)
+        return writer.write(mech, files)
     except OSError as exc:
-        raise SpecError(str(file), f"cannot write: {exc.strerror or exc}") from None
+        raise SpecError(str(files[0]), f"cannot write: {exc.strerror or exc}") from None
 
 
 def _safe(name: str) -> str:
