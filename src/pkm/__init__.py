@@ -236,16 +236,28 @@ def load(name: str | os.PathLike[str], *, actuated: Sequence[str] | str | None =
     return mech
 
 
-def save(mech: Mechanism, spec_path: str | os.PathLike[str]) -> Path:
-    """Write ``mech`` as a closure spec at ``spec_path`` and its URDF beside it (``<stem>.urdf``, the
-    spec's ``urdf`` key set to it), so that :func:`load` gives the same model back; any joint names.
+def save(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) -> Path:
+    """Write ``mech`` at ``path`` in the format its suffix names, or ``to``, so that :func:`load` reads it back:
+
+    * ``.closures.toml`` / ``.toml`` (``to="pkm"``): a closure spec and the URDF beside it (``<stem>.urdf``, the spec's
+      ``urdf`` key set to it): the same model back, reference configuration included;
+    * ``.xml`` / ``.mjcf`` (``to="mjcf"``): MuJoCo's MJCF, loops as stiff ``<connect>``/``<weld>`` equalities
+      (:mod:`pkm.core.formats.to_mjcf`);
+    * ``.yaml`` / ``.yml`` (``to="gepetto"``): URDF + YAML in the convention of Gepetto's toolbox-parallel-robots, the
+      URDF beside the YAML (:mod:`pkm.core.formats.to_gepetto`);
+    * a path without a suffix, with ``to``: a folder, the files in it (:mod:`pkm.core.formats.writers`).
+
+    What the chosen format cannot hold (the task in MJCF and Gepetto's format, the reference configuration...) is
+    left out with a :class:`~pkm.errors.PkmWarning` that lists it (and, in the YAML, written as comments).
 
     Returns:
-        The spec's path.
+        The path of the main file written (the one :func:`load` takes).
 
     Raises:
-        InvalidInputError: not a Mechanism, a bad path, or a mechanism built from a Pinocchio model
-            without URDF text (nothing to write).
+        InvalidInputError: not a Mechanism, a bad path, a suffix no writer takes (the message lists the formats and
+            their suffixes), or a mechanism built from a Pinocchio model without URDF text (nothing to write).
+        UnknownNameError: ``to`` is not one of ``"pkm"``, ``"mjcf"``, ``"gepetto"``.
+        SpecError: the format cannot hold something the mechanism needs (named in the message).
 
     Examples:
         >>> import tempfile
@@ -260,26 +272,15 @@ def save(mech: Mechanism, spec_path: str | os.PathLike[str]) -> Path:
         >>> np.allclose(back.q_reference, small.q_reference)
         True
     """
-    import dataclasses as dc
+    import warnings
 
-    import numpy as np
+    from pkm.core.formats.writers import write
 
-    from pkm.core.model.mechanism import check_mechanism
-    from pkm.core.model.spec import as_path
-
-    mech = check_mechanism(mech)
-    path = as_path(spec_path, "spec_path")
-    if mech.urdf is None:
-        raise errors.InvalidInputError("mech", "it was built from a Pinocchio model, not URDF text: no URDF to write",
-                                       mech.source)
-    stem = path.name.removesuffix(".toml").removesuffix(".closures")
-    urdf_path = path.with_name(f"{stem}.urdf")
-    reference = {k: tuple(float(x) for x in np.atleast_1d(v)) for k, v in mech.q_to_dict(mech.q_reference).items()}
-    spec = dc.replace(mech.spec, urdf=urdf_path.name, reference=reference)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    urdf_path.write_text(mech.urdf, encoding="utf-8")
-    spec.dump(path)
-    return path
+    written = write(mech, path, to)
+    if written.dropped:
+        warnings.warn(f"{written.files[0]}: the {written.format} format cannot hold, left out: "
+                      + "; ".join(written.dropped), errors.PkmWarning, stacklevel=2)
+    return written.files[0]
 
 
 def design_params(name: str, **params: Any) -> Any:

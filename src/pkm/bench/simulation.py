@@ -44,11 +44,12 @@ Every run is :func:`pkm.simulate` (RK4 in the actuated coordinates, the loops cl
    ii. *MuJoCo* (if ``import mujoco`` works) on :func:`~pkm.core.formats.to_mjcf.mjcf_from_mechanism`'s model, its
       RK4 integrator at the same ``dt``; the PD evaluated natively at every stage (affine actuator bias
       ``-K_p q - K_d q̇``), the rest through ``ctrl`` held over each step at its midpoint value (an O(dt²) error).
-      Its equality constraints are soft (``solref``, ``solimp`` as read from the compiled model: MuJoCo's
-      defaults, which the MJCF keeps): they open by the ``r`` the run reports, which moves the actuated coordinates
-      through the same ``T``: bound ``2 S max|r| + 2 ε_pkm`` (the factor 2: ``S`` is a gain in energy, not in peak,
-      and the model is linearised). Run again with stiffer equalities (``solref = (2 dt, 1)``, ``solimp = (0.99,
-      0.999, 0.001, 0.5, 2)``): the violation and the difference shrink together.
+      Its equality constraints are soft (``solref``, ``solimp``: MuJoCo's defaults, :data:`MUJOCO_SOFTNESS`, set
+      on the compiled model in place of the stiffer ones the MJCF carries): they open by the ``r`` the run reports,
+      which moves the actuated coordinates through the same ``T``: bound ``2 S max|r| + 2 ε_pkm`` (the factor 2:
+      ``S`` is a gain in energy, not in peak, and the model is linearised). Run again with stiffer equalities
+      (``solref = (2 dt, 1)``, ``solimp = (0.99, 0.999, 0.001, 0.5, 2)``): the violation and the difference shrink
+      together.
 
    The closure residual of each: pkm's <= 1e-12 by construction, Baumgarte's drift, MuJoCo's equality violation.
 
@@ -93,6 +94,8 @@ SPRING_HZ, DISPLACEMENT, ZETA = 2.0, (0.01, 0.001), 0.1  # [Hz], ([rad], [m]), [
 CHIRP_HZ, CHIRP_ZETA, CHIRP_BAND, CHIRP_DEFLECTION = 3.0, 0.5, (0.5, 5.0), (0.01, 0.001)
 BAUMGARTE_OMEGA = 100.0  # [rad/s]
 STIFF_SOLIMP = (0.99, 0.999, 0.001, 0.5, 2.0)  # MuJoCo's stiffer equality run: with solref (2 dt, 1)
+#: MuJoCo's default equality softness ``(solref, solimp)``: the first MuJoCo run's (the MJCF pkm writes is stiffer)
+MUJOCO_SOFTNESS = ([0.02, 1.0], [0.9, 0.95, 0.001, 0.5, 2.0])
 TRACKING_HZ, TRACKING_AMPLITUDE, MASS_ERROR = 5.0, (0.05, 0.005), 1.1
 
 QUICK = {"duration": 0.2, "chirp_duration": 0.2, "tracking_duration": 0.1, "mechanisms": ["delta", "ankle"]}
@@ -352,7 +355,7 @@ def mujoco_run(mech: Mechanism, q0: np.ndarray, law: ChirpLaw, duration: float, 
                softness: tuple[list[float], list[float]] | None = None, path: str | Path | None = None) \
         -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
     """MuJoCo's RK4 on the mechanism's MJCF from rest at ``q0`` (module doc, 2.ii); ``softness``: the equality
-    constraints' ``(solref, solimp)`` instead of the MJCF's (MuJoCo's defaults). Returns the times, the actuated
+    constraints' ``(solref, solimp)`` instead of the MJCF's. Returns the times, the actuated
     coordinates, the largest equality violation at each sample and MuJoCo's settings as read from its model.
 
     ``path``: the user's own MJCF file (the one ``mech`` was read from) instead of pkm's
@@ -442,7 +445,7 @@ def chirp_runs(mech: Mechanism, duration: float, dt: float) -> dict:
     if reason is not None:
         out["mujoco"] = out["mujoco_stiff"] = {"skipped": reason}
         return out
-    for key, softness in (("mujoco", None), ("mujoco_stiff", ([2.0 * dt, 1.0], list(STIFF_SOLIMP)))):
+    for key, softness in (("mujoco", MUJOCO_SOFTNESS), ("mujoco_stiff", ([2.0 * dt, 1.0], list(STIFF_SOLIMP)))):
         t0 = time.perf_counter()
         t_m, qa_m, r_m, settings = mujoco_run(mech, q0, law, duration, dt, softness)
         wall = time.perf_counter() - t0

@@ -11,7 +11,7 @@ import pytest
 import pkm
 from pkm.bench.mujoco_baseline import MujocoRigid, unavailable
 from pkm.core.formats.to_mjcf import mjcf_from_mechanism
-from pkm.errors import SpecError
+from pkm.errors import InvalidInputError, SpecError
 
 FOURBAR = Path(__file__).resolve().parents[3] / "examples" / "mjcf_fourbar" / "fourbar.xml"
 
@@ -135,3 +135,91 @@ def test_a_geared_drive_is_written_as_its_reflected_inertia_and_peak(tmp_path):
         else:
             assert motor.get("forcelimited") == "true" and [float(x) for x in motor.get("forcerange").split()] == \
                 [-force, force]
+
+
+def _held_at_rest(mech: pkm.Mechanism, duration: float = 1.0, softness=None) -> float:
+    """The largest equality violation (MuJoCo's ``efc_pos`` of its equality rows [m, rad]) over ``duration`` [s] of
+    MuJoCo stepping the written file from pkm's closed reference at rest under gravity, the actuators giving pkm's
+    gravity efforts plus a 10 Hz critically damped PD (``M_a``-scaled) on their coordinates; ``softness``: MuJoCo's
+    ``(solref, solimp)`` instead of the written ones."""
+    import mujoco
+
+    rigid = MujocoRigid(mech)
+    m, d = rigid.model, rigid.data
+    if softness is not None:
+        m.eq_solref[:], m.eq_solimp[:] = softness
+    zero = np.zeros(mech.nv)
+    rigid._state(mech.q_reference, zero, zero)
+    d.qvel[:] = 0.0
+    ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, mech.model.names[j.id]) for j in mech.actuated]
+    qpos, dof = m.jnt_qposadr[ids], m.jnt_dofadr[ids]
+    qa0, g = d.qpos[qpos].copy(), pkm.gravity_efforts(mech, mech.q_reference)
+    Ma, w = pkm.actuator_model(mech, mech.q_reference).M, 2 * np.pi * 10.0
+    m.actuator_forcelimited[:] = 0
+    equality, worst = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY), 0.0
+    for _ in range(round(duration / m.opt.timestep)):
+        d.ctrl[:] = g + Ma @ (w**2 * (qa0 - d.qpos[qpos]) - 2 * w * d.qvel[dof])
+        mujoco.mj_step(m, d)
+        rows = d.efc_type[:d.nefc] == equality
+        worst = max(worst, float(np.abs(d.efc_pos[:d.nefc][rows]).max(initial=0.0)))
+    return worst
+
+
+@pytest.mark.skipif(unavailable() is not None, reason="MuJoCo is a benchmark-only dependency")
+def test_written_loops_hold_at_rest_under_gravity():
+    """The written closures are stiff (solref (2 dt, 1) at the written dt = 1 ms, solimp 0.9999): held at rest for
+    1 s, every loop stays closed within 1e-6 m (measured 4e-9 to 5e-8 m); with MuJoCo's default softness (solref
+    (0.02, 1), solimp (0.9, 0.95, ...)) the Delta's opens by 3.8e-4 m."""
+    from pkm.core.formats.to_mjcf import SOLIMP, TIMESTEP
+
+    text = mjcf_from_mechanism(pkm.load("delta"))
+    assert f'timestep="{TIMESTEP!r}"' in text and f'solref="{2 * TIMESTEP!r} 1.0"' in text
+    assert text.count(f'solimp="{" ".join(map(repr, SOLIMP))}"') == 3
+    assert 'timestep="0.0005"' in (half := mjcf_from_mechanism(pkm.load("delta"), timestep=5e-4)) and \
+        'solref="0.001 1.0"' in half
+    for bad in (0.0, -1e-3, float("nan"), "1ms", True):
+        with pytest.raises(InvalidInputError, match="timestep: must be a positive"):
+            mjcf_from_mechanism(pkm.load("delta"), timestep=bad)
+    examples = Path(__file__).resolve().parents[3] / "examples"
+    for name in ("delta", "prs3", "gough_stewart", examples / "humanoid_ankle" / "ankle.closures.toml",
+                 "gepetto:5bar_linkage_iso3d"):
+        assert _held_at_rest(pkm.load(name)) <= 1e-6, name
+    assert _held_at_rest(pkm.load("delta"), 0.1, ([0.02, 1.0], [0.9, 0.95, 0.001, 0.5, 2.0])) > 1e-4
+
+
+@pytest.mark.skipif(unavailable() is not None, reason="MuJoCo is a benchmark-only dependency")
+def test_mujoco_on_the_written_ankle_follows_pkm_simulate_under_a_chirp():
+    """The acceptance set's ankle under the benchmark's chirp (:mod:`pkm.bench.simulation`, 0.5 s at 1 ms): MuJoCo's
+    RK4 on the written file (its own softness) follows pkm.simulate within 1e-5 rad (measured 4.8e-7 over 0.5 s and
+    4.8e-7 over 2 s; with MuJoCo's default softness 1.4e-2 over 2 s, more than the 1e-2 rad swing)."""
+    from pkm.bench.simulation import ChirpLaw, mujoco_run, pkm_run
+
+    mech = pkm.load(FOURBAR.parents[1] / "ankle" / "ankle.closures.toml")
+    law = ChirpLaw.at(mech, mech.q_reference, 0.5)
+    sim = pkm_run(mech, mech.q_reference, law, 0.5, 1e-3)
+    _, qa, residual, _ = mujoco_run(mech, mech.q_reference, law, 0.5, 1e-3)
+    assert np.abs(qa - sim.actuated[:len(qa)]).max() <= 1e-5 and residual.max() <= 1e-6
+
+
+@pytest.mark.skipif(unavailable() is not None, reason="MuJoCo is a benchmark-only dependency")
+def test_the_reference_keyframe_is_closed_in_mujoco():
+    """<keyframe name="reference">: MuJoCo reset to it has every equality closed (1e-12) and the qpos the benchmark's
+    own conversion (MujocoRigid, joint by joint through MuJoCo's addresses) gives, on the Delta, the hexapod (free
+    flyer, mimic joints) and the Gough-Stewart (universal joints); a wrong q is refused."""
+    import mujoco
+
+    from pkm.core.formats.to_mjcf import mjcf_qpos
+
+    for name in ("delta", "hexapod", "gough_stewart"):
+        mech = pkm.load(name)
+        m = mujoco.MjModel.from_xml_string(mjcf_from_mechanism(mech))
+        d = mujoco.MjData(m)
+        mujoco.mj_resetDataKeyframe(m, d, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "reference"))
+        mujoco.mj_fwdPosition(m, d)
+        rows = d.efc_type[:d.nefc] == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        assert rows.any() and np.abs(d.efc_pos[:d.nefc][rows]).max() <= 1e-12, name
+        rigid = MujocoRigid(mech)
+        rigid._state(mech.q_reference, np.zeros(mech.nv), np.zeros(mech.nv))
+        np.testing.assert_array_equal(rigid.data.qpos, d.qpos)
+    with pytest.raises(InvalidInputError, match="q: must be"):
+        mjcf_qpos(pkm.load("delta"), np.zeros(3))

@@ -11,6 +11,7 @@ from pkm.cli.command import Command
 from pkm.cli.commands import (
     bench,
     capability,
+    convert,
     dynamics,
     excite,
     export,
@@ -39,6 +40,7 @@ COMMANDS: dict[str, Command] = {
     "identify": identify.COMMAND,
     "capability": capability.COMMAND,
     "export": export.COMMAND,
+    "convert": convert.COMMAND,
     "spec": spec.COMMAND,
     "report": report.COMMAND,
     "serve": serve.COMMAND,

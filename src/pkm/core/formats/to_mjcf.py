@@ -4,8 +4,23 @@
 fixed joints are merged), the joint itself (``hinge``, ``slide``, ``ball``, ``free``; a universal joint as two
 hinges of one body, about its first axis and then its second; a mimic joint as a joint of its own tied to its
 leader by a ``<joint>`` equality ``q = offset + scale q_leader``), a site at each closure frame, a ``<connect>``
-(point closure) or ``<weld>`` (frame closure) between the two sites, a ``<motor>`` on each actuated joint.
-Gravity is the model's, contacts are disabled, no joint is limited (MuJoCo would add limit rows).
+(point closure) or ``<weld>`` (frame closure) between the two sites, a ``<motor>`` on each actuated joint, and the
+reference configuration as ``<keyframe><key name="reference">`` (:func:`mjcf_qpos`; MuJoCo's
+``mj_resetDataKeyframe(model, data, 0)`` starts from it, closed).
+Gravity is the model's, contacts are disabled; a one-coordinate joint with position limits
+(:attr:`~pkm.core.Mechanism.limits`) has them as its ``range`` (radians or metres: ``<compiler angle="radian">``).
+
+The loop closures (and mimic equalities) are written stiff, not with MuJoCo's default softness (``solref`` (0.02, 1),
+``solimp`` (0.9, 0.95, ...), under which a Delta held at rest opens its loops by 0.4 mm): each carries ``solref =
+(2 dt, 1)`` with ``dt`` the written ``<option timestep>`` (:data:`TIMESTEP`, 1 ms by default), the shortest time
+constant MuJoCo keeps stable (MuJoCo's documentation: at least twice the step; it clamps shorter ones), critically
+damped, and ``solimp`` = :data:`SOLIMP` (0.9999, 0.9999, ...: constant impedance at MuJoCo's largest,
+``mjMAXIMP``). At rest, a soft equality carrying a load sags by ``r = (1-d)/d * a0 * (d timeconst)^2`` (``a0``: the
+acceleration the load would give the loop without it), so this choice divides MuJoCo's default sag by about
+``(0.1/0.9 / 1e-4) * (0.95 * 0.02 / 0.002)^2`` = 1e5 (measured: 8e4 on the Delta): held at rest under gravity for 1 s at 1 ms, the shipped Delta, 3-PRS and
+Gough-Stewart, the humanoid ankle and Gepetto's planar five-bar stay closed within 5e-8 m
+(``tests/core/formats/test_to_mjcf.py``); light links carrying a large load sag more (the hexapod 1.05e-6 m, Gepetto's
+battobot 1.8e-5 m): write a smaller ``timestep`` for them (the sag goes as its square).
 
 Each actuated joint's drive (:attr:`~pkm.core.Mechanism.actuators`, :mod:`pkm.core.model.actuators`) is written in
 the joint's units: the joint's ``armature`` is :attr:`~pkm.core.model.actuators.Actuator.reflected_inertia`
@@ -30,7 +45,7 @@ from lxml import etree
 from numpy.typing import ArrayLike
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.errors import SpecError
+from pkm.errors import InvalidInputError, SpecError
 
 _REVOLUTE = {"RX", "RY", "RZ", "RUBX", "RUBY", "RUBZ"}
 _PRISMATIC = {"PX", "PY", "PZ"}
@@ -38,6 +53,11 @@ _PRISMATIC = {"PX", "PY", "PZ"}
 #: mass): the compiler raises them to these bounds (``boundmass``, ``boundinertia``), which changes efforts by
 #: about ``MIN_INERTIA`` times an angular acceleration.
 MIN_MASS, MIN_INERTIA = 1e-9, 1e-12
+#: The written ``<option timestep>`` [s] by default (MuJoCo's own default is 2 ms).
+TIMESTEP = 1e-3
+#: The loop closures' ``solimp`` (impedance ``d`` from ``dmin`` at no violation to ``dmax`` beyond ``width`` [m],
+#: ``midpoint``, ``power``): see the module doc.
+SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 
 
 def _num(x: ArrayLike) -> str:
@@ -83,17 +103,20 @@ def _joints(el: etree._Element, jm: pin.JointModel, name: str, source: str) -> l
                             "universal, spherical, free-flyer and mimic joints)")
 
 
-def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None) -> str:
-    """The MJCF text of ``mech`` (see the module doc).
+def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, timestep: float = TIMESTEP) -> str:
+    """The MJCF text of ``mech`` (see the module doc); ``timestep`` [s]: the written ``<option timestep>``, which
+    the loop closures' ``solref`` follows (:func:`closure_softness`).
 
     Raises:
         SpecError: A joint MJCF cannot express (see the module doc).
+        InvalidInputError: ``timestep`` not a positive finite number.
     """
     mech = check_mechanism(mech)
+    solref, solimp = closure_softness(timestep)
     model = mech.model
     root = etree.Element("mujoco", model=model_name or model.name or "pkm")
     etree.SubElement(root, "compiler", angle="radian", boundmass=repr(MIN_MASS), boundinertia=repr(MIN_INERTIA))
-    option = etree.SubElement(root, "option", gravity=_num(model.gravity.linear))
+    option = etree.SubElement(root, "option", timestep=repr(float(timestep)), gravity=_num(model.gravity.linear))
     etree.SubElement(option, "flag", contact="disable")
     world = etree.SubElement(root, "worldbody")
     bodies: list[etree._Element] = [world]
@@ -110,12 +133,15 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None) -> str:
         I = inertia.inertia
         etree.SubElement(body, "inertial", pos=_num(inertia.lever), mass=repr(max(float(inertia.mass), MIN_MASS)),
                          fullinertia=_num([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]))
-        _joints(body, jm, model.names[j], mech.source)
+        for name in _joints(body, jm, model.names[j], mech.source):
+            if name in mech.limits and jm.nq == 1:  # (MuJoCo adds a limit row only where a joint reaches it)
+                body.find(f"joint[@name='{name}']").set("range", _num(mech.limits[name]))
         if jm.shortname() == "JointModelMimic":
             mimic = jm.extract()
             leader = model.names[_leader(model, j)]
             etree.SubElement(equality, "joint", joint1=model.names[j], joint2=leader,
-                             polycoef=_num([mimic.offset, mimic.scaling, 0, 0, 0]))
+                             polycoef=_num([mimic.offset, mimic.scaling, 0, 0, 0]), solref=_num(solref),
+                             solimp=_num(solimp))
         bodies.append(body)
     for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
         sites = []
@@ -125,8 +151,10 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None) -> str:
             _pose(site, frame.placement)
             sites.append(site.get("name"))
         etree.SubElement(equality, "connect" if c.type == "point" else "weld", name=c.name, site1=sites[0],
-                         site2=sites[1])
+                         site2=sites[1], solref=_num(solref), solimp=_num(solimp))
     root.append(equality)
+    keyframe = etree.SubElement(root, "keyframe")
+    etree.SubElement(keyframe, "key", name="reference", qpos=_num(mjcf_qpos(mech, mech.q_reference)))
     actuator = etree.SubElement(root, "actuator")
     for joint, drive in zip(mech.actuated, mech.actuators):
         name = model.names[joint.id]
@@ -142,6 +170,100 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None) -> str:
     return etree.tostring(root, pretty_print=True, encoding="unicode")
 
 
+def mjcf_qpos(mech: Mechanism, q: ArrayLike) -> np.ndarray:
+    """Pinocchio's configuration ``q`` (nq,) as MuJoCo's ``qpos`` of the file :func:`mjcf_from_mechanism` writes:
+    its joints in the file's (depth-first) order; a free body's world position and quaternion ``w x y z``, a ball's
+    quaternion ``w x y z``, an unbounded revolute's angle, a mimic joint's own coordinate ``offset + scale
+    q_leader``, a universal joint's two angles.
+
+    Raises:
+        InvalidInputError: ``q`` not of shape (nq,) or not finite.
+    """
+    mech = check_mechanism(mech)
+    model = mech.model
+    q = np.asarray(q, dtype=float)
+    if q.shape != (model.nq,) or not np.all(np.isfinite(q)):
+        raise InvalidInputError("q", f"must be {model.nq} finite numbers (Pinocchio's configuration)", q)
+    children: list[list[int]] = [[] for _ in range(model.njoints)]
+    for j in range(1, model.njoints):
+        children[int(model.parents[j])].append(j)
+    order, stack = [], list(reversed(children[0]))
+    while stack:  # the bodies as the file nests them: MuJoCo's order
+        j = stack.pop()
+        order.append(j)
+        stack.extend(reversed(children[j]))
+    out: list[float] = []
+    for j in order:
+        jm = model.joints[j]
+        kind = jm.shortname().removeprefix("JointModel")
+        seg = q[jm.idx_q:jm.idx_q + jm.nq]
+        if kind == "FreeFlyer":
+            X = model.jointPlacements[j] * pin.XYZQUATToSE3(seg)
+            quat = pin.Quaternion(X.rotation)
+            out += [*X.translation, quat.w, quat.x, quat.y, quat.z]
+        elif kind == "Spherical":
+            out += [seg[3], seg[0], seg[1], seg[2]]
+        elif kind in ("RUBX", "RUBY", "RUBZ"):
+            out.append(float(np.arctan2(seg[1], seg[0])))
+        elif kind == "Mimic":
+            mimic = jm.extract()
+            out.append(float(mimic.offset + mimic.scaling * q[jm.idx_q]))
+        else:
+            out += list(seg)
+    return np.array(out)
+
+
+def closure_softness(timestep: float = TIMESTEP) -> tuple[tuple[float, float], tuple[float, ...]]:
+    """The ``(solref, solimp)`` written on each loop closure's ``<connect>``/``<weld>`` for a step of ``timestep``
+    [s]: ``solref = (2 timestep, 1)`` (a critically damped reference with the shortest time constant MuJoCo keeps
+    stable: it clamps shorter ones to ``2 timestep``) and ``solimp`` = :data:`SOLIMP` (see the module doc).
+
+    Raises:
+        InvalidInputError: ``timestep`` not a positive finite number.
+    """
+    dt = float(timestep) if isinstance(timestep, (int, float)) and not isinstance(timestep, bool) else float("nan")
+    if not (np.isfinite(dt) and dt > 0.0):
+        raise InvalidInputError("timestep", "must be a positive, finite number of seconds", timestep)
+    return (2.0 * dt, 1.0), SOLIMP
+
+
+def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
+    """What :func:`mjcf_from_mechanism` cannot write of ``mech``, one line each (pkm's MJCF reader gives a mechanism
+    without it): the task and end effector, the reference configuration, the spec's working modes and design
+    parameters, the drives' speed limits and continuous efforts (when a peak is written), the rotor inertia and
+    gear ratio (folded into ``armature``), and universal joints' kind (written as two hinges of one body, read back
+    as two revolute joints ``<name>__1``, ``<name>__2``)."""
+    import json
+
+    mech = check_mechanism(mech)
+    spec, out = mech.spec, []
+    actuated = tuple(mech.actuated_names)
+    if spec.end_effector is not None or spec.task.components or spec.task.frames or tuple(spec.task.joints) != actuated:
+        out.append(f"task: end effector {spec.end_effector!r}, components {' '.join(spec.task.components) or '-'} "
+                   "(read back, the task is the actuated joints)")
+    out.append("reference configuration: written as MuJoCo's <keyframe> 'reference', which pkm's reader does not "
+               "read (it assembles the mechanism from the neutral configuration)")
+    if spec.branches:
+        out.append(f"working modes ([branches]): {sorted(spec.branches)}")
+    if spec.parameters:
+        out.append(f"design parameters ([parameters]): {json.dumps(dict(spec.parameters))}")
+    for a in mech.actuators:
+        lost = [f"{k} {v!r}" for k, v in (("velocity_limit", a.velocity_limit),
+                                          ("effort_limit", a.effort_limit if np.isfinite(a.peak_effort) else np.inf),
+                                          ("rotor_inertia", a.rotor_inertia),
+                                          ("gear_ratio", a.gear_ratio if a.gear_ratio != 1.0 else 0.0))
+                if np.isfinite(v) and v != 0.0]
+        if lost:
+            out.append(f"drive of {a.joint!r}: {', '.join(lost)} (MJCF has one force range, and armature for the "
+                       "rotor)")
+    universal = [mech.model.names[j] for j in range(1, mech.model.njoints)
+                 if mech.model.joints[j].shortname() == "JointModelUniversal"]
+    if universal:
+        out.append(f"universal joints {universal}: written as two hinges <name>__1, <name>__2 of one body each (read "
+                   "back as two revolute joints of those names)")
+    return tuple(out)
+
+
 def _leader(model: pin.Model, j: int) -> int:
     """The joint a mimic joint follows: the one whose coordinates it reads."""
     idx_q = model.joints[j].idx_q
@@ -151,4 +273,5 @@ def _leader(model: pin.Model, j: int) -> int:
     raise SpecError(model.name, f"mimic joint {model.names[j]!r}: no leader found")
 
 
-__all__ = ["MIN_INERTIA", "MIN_MASS", "body_names", "mjcf_from_mechanism"]
+__all__ = ["MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "body_names", "closure_softness", "mjcf_from_mechanism",
+           "mjcf_omissions", "mjcf_qpos"]

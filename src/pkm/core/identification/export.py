@@ -127,7 +127,7 @@ def write_identified(mech: Mechanism, theta: ArrayLike, spec_path: str | Path) -
     """
     import pkm
 
-    return pkm.save(identified_mechanism(mech, theta), spec_path)
+    return pkm.save(identified_mechanism(mech, theta), spec_path, to="pkm")
 
 
 @dataclass(frozen=True)

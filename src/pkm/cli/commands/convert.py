@@ -1,0 +1,53 @@
+"""``pkm convert IN OUT [--to FORMAT] [--force] [--json]``: a mechanism read from anything ``pkm.load`` takes,
+written in the format OUT's suffix names (or ``--to``: ``pkm``, ``mjcf``, ``gepetto``; OUT without a suffix is then a
+folder): :mod:`pkm.core.formats.writers`. It prints every file written, what the reader noted while reading IN, and
+what the target format cannot hold (left out, or kept as comments); a mechanism the format cannot express is one
+error line naming what."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+from pkm.cli.command import Command
+from pkm.cli.mechanism import add_mechanism_arguments, load_mechanism
+from pkm.cli.usage import UsageError
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    add_mechanism_arguments(p, None, None)
+    p.add_argument("out", metavar="OUT", help="the file to write: .closures.toml/.toml (pkm's spec + URDF), .xml/.mjcf "
+                                              "(MJCF), .yaml/.yml (Gepetto's URDF + YAML); with --to, a folder too")
+    p.add_argument("--to", metavar="FORMAT", help="the format (pkm, mjcf, gepetto), when OUT's suffix does not say")
+    p.add_argument("--force", action="store_true", help="overwrite existing files")
+    p.add_argument("--json", action="store_true", help="print JSON")
+
+
+def run(args: argparse.Namespace) -> int:
+    from pkm.core.formats.writers import destination, write
+
+    mech = load_mechanism(args)
+    _, files = destination(mech, args.out, args.to)
+    existing = [str(f) for f in files if f.exists()]
+    if existing and not args.force:
+        raise UsageError(f"{', '.join(existing)} exist{'s' if len(existing) == 1 else ''}; pass --force to overwrite")
+    written = write(mech, args.out, args.to)
+    out: dict[str, Any] = {"mechanism": mech.name, "format": written.format,
+                           "files": [str(f) for f in written.files], "read_notes": list(mech.notes),
+                           "dropped": list(written.dropped)}
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return 0
+    print(f"{mech.name}: written as {written.format}")
+    for f in written.files:
+        print(f"  wrote {f}")
+    for note in mech.notes:
+        print(f"  read: {note}")
+    for d in written.dropped:
+        print(f"  not expressible in {written.format}, left out: {d}")
+    return 0
+
+
+COMMAND = Command("a mechanism written in another format: pkm's spec, MJCF, Gepetto's URDF + YAML", add_arguments,
+                  run)
