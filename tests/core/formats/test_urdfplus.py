@@ -12,7 +12,7 @@ import pytest
 
 import pkm
 from pkm.core.formats.urdfplus import read_urdf
-from pkm.errors import SpecError, SpecNameError
+from pkm.errors import PkmWarning, SpecError, SpecNameError
 
 INERTIA = ('<inertial><mass value="0.2"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/>'
            '</inertial>')
@@ -175,3 +175,25 @@ def test_bad_input_names_the_file_the_element_and_its_line():
             read_urdf(TREE.format(extra=bad), "f.urdf")
     with pytest.raises(SpecNameError, match="crank_tr"):
         read_urdf(TREE.format(extra=LOOP.replace('joint name="crank_joint"', 'joint name="nope"')), "f.urdf")
+
+
+def test_urdfplus_writer_round_trip(tmp_path):
+    """A URDF+ four-bar written back (pkm.save, by suffix) reads as the same mechanism: its revolute loop, actuator
+    and FK to 1e-12; a spherical cut (a lone point closure) is refused by name."""
+    mech = loaded("urdfplus")
+    with pytest.warns(PkmWarning, match="reference configuration"):
+        path = pkm.save(mech, tmp_path / "out.urdf")
+    text = path.read_text()
+    assert '<loop name="cut" type="revolute">' in text and "cut_predecessor" not in text
+    back = pkm.load(path)
+    assert [(c.name, c.type) for c in back.spec.closures] == [("cut", "point"), ("cut_axis", "point")]
+    assert back.spec.actuated == ("crank_joint",) and back.limits == mech.limits
+    for angle in ANGLES:
+        X = tip(mech, pkm.close_loops(mech, [angle], tol=1e-13).q)
+        Y = tip(back, pkm.close_loops(back, [angle], tol=1e-13).q)
+        assert np.linalg.norm(X.translation - Y.translation) < 1e-12
+        assert np.linalg.norm(X.rotation - Y.rotation) < 1e-12
+    sph = tmp_path / "sph.urdf"
+    sph.write_text(TREE.format(extra=CONSTRAINT.replace('name="cut" type="revolute"', 'name="ball" type="spherical"')))
+    with pytest.raises(SpecError, match="closure 'ball': a point closure"):
+        pkm.save(pkm.load(sph, actuated=["crank_joint"]), tmp_path / "sph_out.urdf")

@@ -170,6 +170,8 @@ def read_urdf(text: str, source: str = "<urdf>") -> Imported:
     """
     from pkm.core.formats.imported import read_urdf as read_plain
 
+    if not any(f"<{tag}" in text for tag in ELEMENTS):  # (a plain URDF, parsed once)
+        return read_plain(text, source)
     root = parse_xml(text, source)
     marked = [el for el in root if isinstance(el.tag, str) and el.tag in ELEMENTS]
     if not marked:
