@@ -4,6 +4,7 @@ mechanism; the same four-bar written as pkm's spec (cut elsewhere) gives the sam
 from __future__ import annotations
 
 import functools
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +13,7 @@ import pytest
 
 import pkm
 from pkm.core.formats.urdfplus import read_urdf
-from pkm.errors import PkmWarning, SpecError, SpecNameError
+from pkm.errors import ImplausibleModelWarning, PkmWarning, SpecError, SpecNameError
 
 INERTIA = ('<inertial><mass value="0.2"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/>'
            '</inertial>')
@@ -197,3 +198,29 @@ def test_urdfplus_writer_round_trip(tmp_path):
     sph.write_text(TREE.format(extra=CONSTRAINT.replace('name="cut" type="revolute"', 'name="ball" type="spherical"')))
     with pytest.raises(SpecError, match="closure 'ball': a point closure"):
         pkm.save(pkm.load(sph, actuated=["crank_joint"]), tmp_path / "sph_out.urdf")
+
+
+def test_gepetto_five_bar_written_as_urdfplus_keeps_its_frame_closure(tmp_path):
+    """Gepetto's 5-bar (a 6-D closure) written as URDF+ (a fixed <loop>) and read back: the same joints, and at the
+    original's closed reference the loop holds (1e-12) and every shared frame is in place (1e-12)."""
+    from pkm.core.kinematics.constraints import residual
+    from tests.test_gepetto_robots import gepetto
+
+    with warnings.catch_warnings():  # (the file's own masses, pinned below on the written file)
+        warnings.simplefilter("ignore", ImplausibleModelWarning)
+        mech = gepetto("5bar_linkage")
+    with pytest.warns(PkmWarning):
+        path = pkm.save(mech, tmp_path / "five.urdf", to="urdfplus")
+    assert 'type="fixed">' in path.read_text()
+    with pytest.warns(ImplausibleModelWarning, match="'sphere' 654498 kg"):  # (as the original: its masses kept)
+        back = pkm.load(path, actuated=list(mech.spec.actuated))
+    assert list(back.model.names) == list(mech.model.names) and [c.type for c in back.spec.closures] == ["frame"]
+    q = mech.q_reference
+    assert np.max(np.abs(residual(back, q))) < 1e-12
+    pin.framesForwardKinematics(mech.model, mech.data, q)
+    pin.framesForwardKinematics(back.model, back.data, q)
+    shared = {f.name for f in back.model.frames} & {f.name for f in mech.model.frames}
+    assert len(shared) > 5
+    for name in shared:
+        X, Y = mech.data.oMf[mech.frame_id(name)], back.data.oMf[back.frame_id(name)]
+        assert np.linalg.norm(X.homogeneous - Y.homogeneous) < 1e-12, name
