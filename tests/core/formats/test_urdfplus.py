@@ -180,7 +180,7 @@ def test_bad_input_names_the_file_the_element_and_its_line():
 
 def test_urdfplus_writer_round_trip(tmp_path):
     """A URDF+ four-bar written back (pkm.save, by suffix) reads as the same mechanism: its revolute loop, actuator
-    and FK to 1e-12; a spherical cut (a lone point closure) is refused by name."""
+    and FK to 1e-12; a spherical cut (a lone point closure) is written as a pkm extension, and said."""
     mech = loaded("urdfplus")
     with pytest.warns(PkmWarning, match="reference configuration"):
         path = pkm.save(mech, tmp_path / "out.urdf")
@@ -196,8 +196,10 @@ def test_urdfplus_writer_round_trip(tmp_path):
         assert np.linalg.norm(X.rotation - Y.rotation) < 1e-12
     sph = tmp_path / "sph.urdf"
     sph.write_text(TREE.format(extra=CONSTRAINT.replace('name="cut" type="revolute"', 'name="ball" type="spherical"')))
-    with pytest.raises(SpecError, match="closure 'ball': a point closure"):
-        pkm.save(pkm.load(sph, actuated=["crank_joint"]), tmp_path / "sph_out.urdf")
+    with pytest.warns(PkmWarning, match=r"point closures \['ball'\] are written as <loop type=\"spherical\">, a pkm ext"):
+        out = pkm.save(pkm.load(sph, actuated=["crank_joint"]), tmp_path / "sph_out.urdf")
+    assert '<loop name="ball" type="spherical">' in out.read_text()
+    assert [(c.name, c.type) for c in pkm.load(out).spec.closures] == [("ball", "point")]
 
 
 def test_gepetto_five_bar_written_as_urdfplus_keeps_its_frame_closure(tmp_path):

@@ -6,12 +6,15 @@
 * a ``point`` closure ``X`` with a ``point`` closure ``X_axis`` whose frames hang on the same two links at the
   same distance (> 0) from ``X``'s on each side: a ``<loop type="revolute">`` about that line, its ``<axis>`` z
   of the loop frame (pkm's reader makes of it the same two closures, so a URDF+ file comes back as it was read);
+* any other ``point`` closure: a ``<loop type="spherical">``. URDF+ has no spherical loop joint: this is a pkm
+  extension, which pkm's reader reads and other URDF+ readers refuse; the writer says so (:class:`Written`'s
+  ``dropped``, a :class:`~pkm.errors.PkmWarning` from :func:`pkm.save`);
 * the actuated joints: a ``<transmission>`` each (ROS's ``SimpleTransmission``);
 * the closures' frames that are massless leaf links fixed to their parent (and not the end effector or a task
   frame) are left out of the tree: the loop's origins place them, and the reader adds them back.
 
-URDF+ has no spherical loop joint: any other ``point`` closure is refused by name, as are ``[joint_types]``
-(URDF cannot state a spherical or universal joint) and a floating base. Left out, and said (:class:`Written`'s
+Refused by name: ``[joint_types]`` (URDF cannot state a spherical or universal joint in the tree) and a floating
+base. Left out, and said (:class:`Written`'s
 ``dropped``): the task and end effector, the reference configuration (the reader assembles), the spec's drives,
 working modes and parameters.
 """
@@ -46,7 +49,7 @@ def urdfplus_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
     """``mech`` as URDF+ text and what it leaves out (module doc).
 
     Raises:
-        SpecError: a point closure that is no revolute cut, ``[joint_types]``, a floating base; no URDF text.
+        SpecError: ``[joint_types]``, a floating base; no URDF text.
     """
     spec = mech.spec
     if mech.urdf is None:
@@ -74,30 +77,29 @@ def urdfplus_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
             cut.add(name)
     loops: list[etree._Element] = []
     used: set[str] = set()
+    balls: list[str] = []
     for c in spec.closures:
         if c.name in used:
             continue
         (la, Xa), (lb, Xb) = (_link_of(mech, i, cut) for i in ids[c.name])
         loop = etree.Element("loop", name=c.name, type="fixed")
-        if c.type == "point":
-            axis = spec.closures[[d.name for d in spec.closures].index(f"{c.name}_axis")] \
-                if f"{c.name}_axis" in ids else None
-            if axis is None or axis.type != "point":
-                raise SpecError(mech.source, f"closure {c.name!r}: a point closure (a spherical cut); URDF+ has no "
-                                             "spherical loop joint (it writes revolute pairs: {name}, {name}_axis); "
-                                             "write pkm's spec or MJCF")
+        axis = next((d for d in spec.closures if d.name == f"{c.name}_axis" and d.type == "point"
+                     and d.name not in used), None) if c.type == "point" else None
+        if axis is not None:  # a revolute cut if the two pairs of frames are on one line of the same two links
             (la2, Xa2), (lb2, Xb2) = (_link_of(mech, i, cut) for i in ids[axis.name])
             ua, ub = Xa2.translation - Xa.translation, Xb2.translation - Xb.translation
             na, nb = float(np.linalg.norm(ua)), float(np.linalg.norm(ub))
-            if (la2, lb2) != (la, lb) or na == 0.0 or abs(na - nb) > _TOL * na:
-                raise SpecError(mech.source, f"closures {c.name!r} and {axis.name!r}: not the two points of one "
-                                             "revolute cut (their frames on other links, or at other distances); "
-                                             "URDF+ has no spherical loop joint")
-            z = np.array([0.0, 0.0, 1.0])  # the loop frame's z along the axis on each side
-            Xa = pin.SE3(pin.Quaternion.FromTwoVectors(z, ua / na).matrix(), Xa.translation)
-            Xb = pin.SE3(pin.Quaternion.FromTwoVectors(z, ub / nb).matrix(), Xb.translation)
-            loop.set("type", "revolute")
-            used.add(axis.name)
+            if (la2, lb2) == (la, lb) and na > 0.0 and abs(na - nb) <= _TOL * na:
+                z = np.array([0.0, 0.0, 1.0])  # the loop frame's z along the axis on each side
+                Xa = pin.SE3(pin.Quaternion.FromTwoVectors(z, ua / na).matrix(), Xa.translation)
+                Xb = pin.SE3(pin.Quaternion.FromTwoVectors(z, ub / nb).matrix(), Xb.translation)
+                loop.set("type", "revolute")
+                used.add(axis.name)
+            else:
+                axis = None
+        if c.type == "point" and axis is None:
+            loop.set("type", "spherical")
+            balls.append(c.name)
         for role, link, X in (("predecessor", la, Xa), ("successor", lb, Xb)):
             _origin(etree.SubElement(loop, role, link=link), X)
         if loop.get("type") == "revolute":
@@ -115,6 +117,9 @@ def urdfplus_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
         etree.SubElement(etree.SubElement(tr, "actuator", name=f"{j}_actuator"), "mechanicalReduction").text = "1"
     etree.indent(root, space="  ")
     dropped = ["the reference configuration (the reader assembles)"]
+    if balls:
+        dropped.append(f"URDF+ has no spherical loop joint: the point closures {balls} are written as "
+                       '<loop type="spherical">, a pkm extension that other URDF+ readers refuse')
     if spec.end_effector or spec.task.components or spec.task.frames or spec.task.joints != spec.actuated:
         dropped.append("the task and end effector")
     if spec.actuators:

@@ -9,7 +9,7 @@ element and field names as in its reference parser's ``LoopConstraint``/``Coupli
 constraint.h`` of the authors' urdfdom fork used by ROAM-Lab-ND/generalized_rbda) and in ACDC4Robot's URDF+
 exporter)::
 
-    <loop name="L" type="revolute|continuous|fixed">
+    <loop name="L" type="revolute|continuous|fixed|spherical">
       <predecessor link="A"> <origin xyz="x y z" rpy="r p y"/> </predecessor>
       <successor link="B"> <origin xyz="x y z" rpy="r p y"/> </successor>
       <axis xyz="ax ay az"/>
@@ -18,7 +18,9 @@ exporter)::
 The loop frame is ``origin`` in link A's frame and ``origin`` in link B's frame (each defaults to the identity,
 as URDF's); ``axis`` (URDF's default ``1 0 0``) is in the loop frame; ``type`` is URDF's joint type of the cut.
 ``<coupling name ratio>`` (a gear relation between two links' velocities) is refused by name: pkm's closures
-are positions; its ``prismatic`` and ``planar`` loop types are refused too (below).
+are positions; its ``prismatic`` and ``planar`` loop types are refused too (below). URDF+ has no spherical loop
+joint: ``type="spherical"`` is a pkm extension (what :mod:`pkm.core.formats.to_urdfplus` writes for a ball cut,
+the Delta's), which other URDF+ readers refuse.
 
 **urdfdom ``<constraint>``** (ros/urdfdom_headers PR #108, "Add constraints to describe closed loops", and
 ros/urdfdom PR #264, both from 2026-06: the grammar of the PR's description)::
@@ -66,7 +68,7 @@ from pkm.errors import SpecError, SpecNameError
 #: The elements under ``<robot>`` that make a URDF closed, and the format each marks.
 ELEMENTS = {"loop": "urdfplus", "coupling": "urdfplus", "constraint": "urdfdom"}
 
-_TYPES = {"loop": ("revolute", "continuous", "fixed"), "constraint": ("revolute", "continuous", "fixed", "spherical")}
+_TYPES = {"loop": ("revolute", "continuous", "fixed", "spherical"), "constraint": ("revolute", "continuous", "fixed", "spherical")}
 _REFUSED = {"prismatic": "a cut prismatic joint", "planar": "a cut planar joint",
             "universal": "a universal cut (4 equations; pkm's closures state 3 or 6)",
             "floating": "a floating cut (no equation)"}
