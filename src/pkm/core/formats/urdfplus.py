@@ -68,7 +68,7 @@ from pkm.errors import SpecError, SpecNameError
 #: The elements under ``<robot>`` that make a URDF closed, and the format each marks.
 ELEMENTS = {"loop": "urdfplus", "coupling": "urdfplus", "constraint": "urdfdom"}
 
-_TYPES = {"loop": ("revolute", "continuous", "fixed", "spherical"), "constraint": ("revolute", "continuous", "fixed", "spherical")}
+_TYPES = ("revolute", "continuous", "fixed", "spherical")  # (spherical: a pkm extension in both, module doc)
 _REFUSED = {"prismatic": "a cut prismatic joint", "planar": "a cut planar joint",
             "universal": "a universal cut (4 equations; pkm's closures state 3 or 6)",
             "floating": "a floating cut (no equation)"}
@@ -134,8 +134,8 @@ def _cut(el: etree._Element, links: list[str], source: str) -> _Cut:
         raise SpecError(source, f"<{el.tag}> at line {el.sourceline}: no name")
     if typ in _REFUSED:
         raise SpecError(source, f"{where}: {_REFUSED[typ]} is not read")
-    if typ not in _TYPES[el.tag]:
-        raise SpecError(source, f"{where}: type {typ!r} unknown; pkm reads {list(_TYPES[el.tag])}")
+    if typ not in _TYPES:
+        raise SpecError(source, f"{where}: type {typ!r} unknown; pkm reads {list(_TYPES)}")
     if el.tag == "loop":
         pred, succ = el.find("predecessor"), el.find("successor")
         axis = _axis(el.find("axis"), source, where)
@@ -178,10 +178,11 @@ def read_urdf(text: str, source: str = "<urdf>") -> Imported:
     marked = [el for el in root if isinstance(el.tag, str) and el.tag in ELEMENTS]
     if not marked:
         return read_plain(text, source)
-    kinds = {ELEMENTS[el.tag] for el in marked}
-    if len(kinds) > 1:
-        raise SpecError(source, f"{_where(marked[0])} and {_where(next(e for e in marked if ELEMENTS[e.tag] != ELEMENTS[marked[0].tag]))}: "
-                                "URDF+ and urdfdom constraints in one file; write one kind")
+    kind = ELEMENTS[marked[0].tag]
+    other = next((el for el in marked if ELEMENTS[el.tag] != kind), None)
+    if other is not None:
+        raise SpecError(source, f"{_where(marked[0])} and {_where(other)}: URDF+ and urdfdom constraints in one "
+                                "file; write one kind")
     links = [str(el.get("name")) for el in root.findall("link")]
     cuts = [_cut(el, links, source) for el in marked]
     for el in marked:
@@ -217,7 +218,6 @@ def read_urdf(text: str, source: str = "<urdf>") -> Imported:
             a, b = (frame(f"{cut.name}_axis_{role}", link, X * pin.SE3(np.eye(3), _AXIS_POINT * axis), where)
                     for role, link, X, axis in zip(cut.roles, cut.links, cut.frames, cut.axes, strict=True))
             closures.append(Closure(f"{cut.name}_axis", "point", a, b))
-    kind = kinds.pop()
     return Imported(etree.tostring(tree, encoding="unicode"), tuple(closures), {}, _actuated(tree, joints, source),
                     str(root.get("name") or "robot"), kind, notes=limit_notes(tree))
 
