@@ -7,16 +7,16 @@
   same distance (> 0) from ``X``'s on each side: a ``<loop type="revolute">`` about that line, its ``<axis>`` z
   of the loop frame (pkm's reader makes of it the same two closures, so a URDF+ file comes back as it was read);
 * any other ``point`` closure: a ``<loop type="spherical">``. URDF+ has no spherical loop joint: this is a pkm
-  extension, which pkm's reader reads and other URDF+ readers refuse; the writer says so (:class:`Written`'s
+  extension, which pkm's reader reads and other URDF+ readers refuse; the writer says so (:class:`~pkm.core.formats.writers.Written`'s
   ``dropped``, a :class:`~pkm.errors.PkmWarning` from :func:`pkm.save`);
 * the actuated joints: a ``<transmission>`` each (ROS's ``SimpleTransmission``);
 * the closures' frames that are massless leaf links fixed to their parent (and not the end effector or a task
   frame) are left out of the tree: the loop's origins place them, and the reader adds them back.
 
 Refused by name: ``[joint_types]`` (URDF cannot state a spherical or universal joint in the tree) and a floating
-base. Left out, and said (:class:`Written`'s
-``dropped``): the task and end effector, the reference configuration (the reader assembles), the spec's drives,
-working modes and parameters.
+base. Left out, and said (:class:`~pkm.core.formats.writers.Written`'s ``dropped``): the closures' frame names
+(read back as ``<loop>_predecessor``, ``<loop>_successor``), the task and end effector, the reference
+configuration (the reader assembles), the spec's drives, working modes and parameters.
 """
 
 from __future__ import annotations
@@ -117,6 +117,8 @@ def urdfplus_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
         etree.SubElement(etree.SubElement(tr, "actuator", name=f"{j}_actuator"), "mechanicalReduction").text = "1"
     etree.indent(root, space="  ")
     dropped = ["the reference configuration (the reader assembles)"]
+    if spec.closures:
+        dropped.append("the closures' frame names (read back as <loop>_predecessor, <loop>_successor)")
     if balls:
         dropped.append(f"URDF+ has no spherical loop joint: the point closures {balls} are written as "
                        '<loop type="spherical">, a pkm extension that other URDF+ readers refuse')
