@@ -245,6 +245,7 @@ def save(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) -
       (:mod:`pkm.core.formats.to_mjcf`);
     * ``.yaml`` / ``.yml`` (``to="gepetto"``): URDF + YAML in the convention of Gepetto's toolbox-parallel-robots, the
       URDF beside the YAML (:mod:`pkm.core.formats.to_gepetto`);
+    * ``.urdf`` (``to="urdfplus"``): MIT's URDF+, loops as ``<loop>`` elements (:mod:`pkm.core.formats.to_urdfplus`);
     * a path without a suffix, with ``to``: a folder, the files in it (:mod:`pkm.core.formats.writers`).
 
     What the chosen format cannot hold (the task in MJCF and Gepetto's format, the reference configuration...) is
@@ -256,7 +257,7 @@ def save(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) -
     Raises:
         InvalidInputError: not a Mechanism, a bad path, a suffix no writer takes (the message lists the formats and
             their suffixes), or a mechanism built from a Pinocchio model without URDF text (nothing to write).
-        UnknownNameError: ``to`` is not one of ``"pkm"``, ``"mjcf"``, ``"gepetto"``.
+        UnknownNameError: ``to`` is not one of ``"pkm"``, ``"mjcf"``, ``"gepetto"``, ``"urdfplus"``.
         SpecError: the format cannot hold something the mechanism needs (named in the message).
 
     Examples:

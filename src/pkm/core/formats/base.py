@@ -78,7 +78,7 @@ class Format:
 #: The model-file formats, by name (:func:`register_format` adds one); the first is the default of a file whose
 #: suffix and root element say nothing.
 FORMATS: dict[str, Format] = {
-    "urdf": Format("urdf", (".urdf",), "robot", "pkm.core.formats.imported:read_urdf"),
+    "urdf": Format("urdf", (".urdf",), "robot", "pkm.core.formats.urdfplus:read_urdf"),  # (URDF+ and urdfdom loops too)
     "mjcf": Format("mjcf", (".xml", ".mjcf"), "mujoco", "pkm.core.formats.mjcf:read_mjcf"),
     "sdf": Format("sdf", (".sdf",), "sdf", "pkm.core.formats.sdf:read_sdf"),
 }

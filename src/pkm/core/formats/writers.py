@@ -6,7 +6,9 @@
 * ``"mjcf"`` (``.xml``, ``.mjcf``): MuJoCo's MJCF (:mod:`pkm.core.formats.to_mjcf`; loops as stiff ``<connect>`` /
   ``<weld>`` equalities, drives as armature, damping, friction and force ranges);
 * ``"gepetto"`` (``.yaml``, ``.yml``): URDF + YAML in the convention of Gepetto's toolbox-parallel-robots
-  (:mod:`pkm.core.formats.to_gepetto`), the URDF beside the YAML (``<stem>.urdf``).
+  (:mod:`pkm.core.formats.to_gepetto`), the URDF beside the YAML (``<stem>.urdf``);
+* ``"urdfplus"`` (``.urdf``): MIT's URDF+, loops as ``<loop>`` elements in the URDF
+  (:mod:`pkm.core.formats.to_urdfplus`).
 
 A path without a suffix, with ``to`` given, is a folder: the files go in it (``<mechanism>.closures.toml``,
 ``<mechanism>.xml``, ``robot.yaml``). Each writer returns what it wrote and what its format cannot hold
@@ -96,6 +98,16 @@ def _write_gepetto(mech: Mechanism, files: tuple[Path, ...]) -> Written:
     return Written((path, urdf_path), dropped, "gepetto")
 
 
+def _write_urdfplus(mech: Mechanism, files: tuple[Path, ...]) -> Written:
+    from pkm.core.formats.to_urdfplus import urdfplus_from_mechanism
+
+    (path,) = files
+    text, dropped = urdfplus_from_mechanism(mech)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text, encoding="utf-8")
+    return Written((path,), dropped, "urdfplus")
+
+
 #: The writers by name (see the module doc).
 WRITERS: dict[str, Writer] = {w.name: w for w in (
     Writer("pkm", (".closures.toml", ".toml"), "pkm's closure spec + URDF", _write_pkm,
@@ -103,6 +115,7 @@ WRITERS: dict[str, Writer] = {w.name: w for w in (
     Writer("mjcf", (".xml", ".mjcf"), "MuJoCo's MJCF", _write_mjcf),
     Writer("gepetto", (".yaml", ".yml"), "Gepetto's URDF + YAML (toolbox-parallel-robots)", _write_gepetto,
            lambda p: p.with_suffix(".urdf")),
+    Writer("urdfplus", (".urdf",), "MIT's URDF+ (loops as <loop> elements)", _write_urdfplus),
 )}
 
 
