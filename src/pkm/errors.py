@@ -175,6 +175,8 @@ class InvalidParameterError(InvalidInputError):
 
 
 def _plural(noun: str) -> str:
+    if noun.endswith("y") and noun[-2:-1] not in ("a", "e", "i", "o", "u", ""):
+        return noun[:-1] + "ies"  # (body: bodies; key: keys)
     return noun + ("es" if noun.endswith(("s", "sh", "ch", "x")) else "s")
 
 

@@ -113,7 +113,7 @@ def test_without_relpose_the_pose_at_qpos0_is_kept_with_the_anchor(tmp_path):
 def test_bad_welds_name_the_element_and_line(tmp_path):
     """A missing body, a negative torquescale, a relpose of 4 numbers: SpecErrors naming the file and element."""
     with pytest.raises(SpecNameError, match=r"body 'nobody' does not exist in bad.xml \(<equality><weld "
-                                            r"name='w'> \(line 13\) body2\); valid bodys: 'crank', 'lid'"):
+                                            r"name='w'> \(line 13\) body2\); valid bodies: 'crank', 'lid'"):
         read_mjcf(WELDED.replace("WELD", '\n<weld name="w" body1="crank" body2="nobody"/>'), "bad.xml")
     with pytest.raises(SpecError, match=r"bad.xml: <equality><weld name='w'> \(line 12\) torquescale = -1"):
         read_mjcf(WELDED.replace("WELD", '<weld name="w" body1="crank" body2="lid" torquescale="-1"/>'), "bad.xml")

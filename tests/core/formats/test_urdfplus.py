@@ -176,3 +176,17 @@ def test_bad_input_names_the_file_the_element_and_its_line():
     with pytest.raises(SpecNameError, match="crank_tr"):
         read_urdf(TREE.format(extra=LOOP.replace('joint name="crank_joint"', 'joint name="nope"')), "f.urdf")
 
+
+
+def test_a_urdf_plus_file_alone_uploads_and_a_plain_urdf_alone_is_refused():
+    """An upload (:func:`pkm.core.formats.load.load_texts`, the service's) of one URDF+ file is a mechanism, the
+    same as ``pkm.load`` of the file; a plain URDF alone still needs a spec, and the refusal says why."""
+    from pkm.core.formats.load import load_texts
+    from pkm.errors import SpecError
+
+    mech = load_texts({"fourbar.urdf": TREE.format(extra=LOOP)})
+    assert [c.name for c in mech.spec.closures] == ["cut", "cut_axis"] and mech.spec.actuated == ("crank_joint",)
+    q, q_file = (pkm.close_loops(m, [0.3], tol=1e-13).q for m in (mech, loaded("urdfplus")))
+    assert np.linalg.norm(q - q_file) < 1e-12
+    with pytest.raises(SpecError, match="a plain URDF cannot hold one"):
+        load_texts({"fourbar.urdf": TREE.format(extra="")})

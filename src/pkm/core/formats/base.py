@@ -24,11 +24,12 @@ class Imported:
 
     Attributes:
         urdf: The tree as URDF text (frames for the closures' anchors included).
-        closures: The loops the file closes (none for a URDF).
+        closures: The loops the file closes (none for a plain URDF).
         joint_types: Joints URDF cannot state (``spherical``, ``universal``), for ``[joint_types]``.
         actuated: The actuated joints the file names (empty when it names none).
         name: The model's name.
-        format: ``"urdf"``, ``"mjcf"`` or ``"sdf"``.
+        format: ``"urdf"``, ``"urdfplus"`` (URDF+ ``<loop>``), ``"urdfdom"`` (the proposed ``<constraint>``),
+            ``"mjcf"`` or ``"sdf"``.
         floating_base: The free-flyer joint that carries the whole tree (an MJCF root ``<freejoint>``), or None.
         reference: Joint values the file states (an MJCF free body's pose), for ``[reference]``.
         notes: What the reader interpreted or ignored, one sentence each (a tendon actuator read as its joint, a

@@ -321,14 +321,14 @@ def load_texts(files: Mapping[str, str], source: str = "<upload>") -> Mechanism:
         joints = [str(j.get("name")) for j in check_urdf(imported.urdf, urdfs[0]).findall("joint")]
         spec, read = read_gepetto(files[yamls[0]], urdfs[0], joints, Path(urdfs[0]).stem, f"{source}:{yamls[0]}")
         return from_strings(imported.urdf, spec, source=f"{source}:{yamls[0]}", notes=imported.notes + read)
-    models = [n for n in names if kind[n] != ".urdf"]
-    if len(names) != 1 or not models:
-        raise SpecError(source, f"give a closure spec with its model file, a Gepetto YAML with its URDF, or an MJCF "
-                                f"or SDF file alone (a URDF alone needs a spec: it cannot hold loops); given {names}")
+    if len(names) != 1:
+        raise SpecError(source, f"give a closure spec with its model file, a Gepetto YAML with its URDF, or one model "
+                                f"file alone (MJCF, SDF, or a URDF with URDF+ <loop> or urdfdom <constraint> "
+                                f"elements); given {names}")
     imported = _read_text(names[0], files[names[0]])
     if imported.format == "urdf" or not imported.actuated:
-        raise SpecError(f"{source}:{names[0]}", "the file names no loop or no actuated joint: send a closure spec "
-                                                "with it")
+        raise SpecError(f"{source}:{names[0]}", "the file names no loop (a plain URDF cannot hold one) or no "
+                                                "actuated joint: send a closure spec with it")
     spec = ClosureSpec(mechanism=imported.name, urdf=names[0], end_effector=None, actuated=imported.actuated,
                        closures=(), task=TaskSpec((), imported.actuated), reference={},
                        description=f"read from {names[0]} ({imported.format.upper()})")
