@@ -517,10 +517,53 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
         limits.pop(j, None)
     urdf, types = urdf_from_model(model, limits=limits, mimic=mimic, **kwargs)
     reference = {model.names[j]: tuple(map(float, pin.SE3ToXYZQUAT(X))) for j, X in free.items()}
+    keyed = _keyframe(root, world, kinds, set(mimic) | set(locked), urdf, source)
+    if keyed:
+        reference = keyed
+        notes.append(f"the reference configuration is the <keyframe><key name={_KEY!r}> (the one pkm writes)")
     if len(set(actuated)) < len(actuated):
         notes.append("several actuators drive the same joint: it is one input")
     return Imported(urdf, tuple(closures), types, tuple(dict.fromkeys(actuated)), name, "mjcf", _floating_base(model), reference,
                     tuple(notes), actuators)
+
+
+#: The ``<keyframe><key>`` read as the reference configuration (:func:`pkm.save` writes it).
+_KEY = "reference"
+_QPOS = {"free": 7, "ball": 4, "hinge": 1, "slide": 1}  # MuJoCo's qpos width of each joint type
+
+
+def _keyframe(root: etree._Element, world: etree._Element, kinds: dict[str, str], dependent: set[str], urdf: str,
+              source: str) -> dict[str, tuple[float, ...]]:
+    """``{joint: value}`` (``[reference]``, Pinocchio's coordinates) from the ``<key name="reference">``'s ``qpos``
+    (MuJoCo's order: the joints as the file nests them), the dependent (mimic, locked) joints left out; ``{}``
+    without that key.
+
+    Raises:
+        SpecError: a ``qpos`` of the wrong length, or not numbers.
+    """
+    key = next((k for k in root.findall("keyframe/key") if k.get("name") == _KEY), None)
+    if key is None or key.get("qpos") is None:
+        return {}
+    joints = [str(j.get("name")) for j in world.iter("joint", "freejoint")]
+    width = sum(_QPOS[kinds[j]] for j in joints)
+    qpos = _floats(key.get("qpos"), width, f"<keyframe><key name={_KEY!r}> (line {key.sourceline}) qpos", source)
+    continuous = {str(j.get("name")) for j in etree.fromstring(urdf.encode()).iter("joint")
+                  if j.get("type") == "continuous"}
+    out: dict[str, tuple[float, ...]] = {}
+    k = 0
+    for j in joints:
+        n = _QPOS[kinds[j]]
+        seg = [float(x) for x in qpos[k:k + n]]
+        k += n
+        if j in dependent:
+            continue
+        if kinds[j] == "free":  # position, quaternion w x y z -> Pinocchio's x y z, qx qy qz qw
+            out[j] = (*seg[:3], *seg[4:], seg[3])
+        elif kinds[j] == "ball":
+            out[j] = (*seg[1:], seg[0])
+        else:
+            out[j] = (float(np.cos(seg[0])), float(np.sin(seg[0]))) if j in continuous else (seg[0],)
+    return out
 
 
 def _joint_equalities(els: list[etree._Element], kinds: dict[str, str], refs: dict[str, float], notes: list[str],
