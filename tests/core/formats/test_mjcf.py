@@ -152,7 +152,8 @@ def test_equalities_on_sites_close_the_sites_frames():
         ("tie", "point", "tie_a", "tie_b"), ("w", "frame", "bs", "stand_tip")]
     with pytest.raises(SpecError, match="give both site1 and site2"):
         read_mjcf(PROBE.replace('<weld body1="a" body2="b"/>', '<weld site1="bs"/>'), "probe.xml")
-    with pytest.raises(SpecError, match="no site 'nope'"):
+    with pytest.raises(SpecError, match=r"site 'nope' does not exist in probe.xml \(<equality><connect "
+                                        r"name='connect2'> \(line \d+\) site2\)"):
         read_mjcf(PROBE.replace('<weld body1="a" body2="b"/>', '<connect site1="bs" site2="nope"/>'), "probe.xml")
     with pytest.raises(SpecError, match="no body1 and no sites"):
         read_mjcf(PROBE.replace('<weld body1="a" body2="b"/>', '<connect anchor="0 0 0"/>'), "probe.xml")

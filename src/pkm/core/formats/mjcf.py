@@ -431,7 +431,7 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
                                     f"<equality><{el.tag} name={eq_name!r}> (line {el.sourceline}) {key}")
         point = el.tag == "connect" or _torquescale(el, eq_name, defaults, source) == 0.0
         eq_names.append((el.tag, eq_name, (el.get("site1"), el.get("site2")) if el in on_sites else None,
-                         "point" if point else "frame"))
+                         "point" if point else "frame", el.sourceline))
     body_based = {t: counts[t] - sum(1 for el in on_sites if el.tag == t) for t in counts}
     for k, el in enumerate(el for el in equalities if el not in on_sites):  # Pinocchio returns them by name
         el.set("name", f"pkm{k:06d}")
@@ -476,11 +476,13 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             taken.add(site.get("name"))
     closures = []
     iters = {"connect": iter(points), "weld": iter(welds)}
-    for tag, name, on, kind in eq_names:
+    sites = sorted(str(site.get("name")) for site in world.iter("site") if site.get("name") in taken)
+    for tag, name, on, kind, line in eq_names:
         if on is not None:  # the two sites coincide (connect: their origins; weld: their frames)
-            for site_name in on:
+            for key, site_name in zip(("site1", "site2"), on):
                 if site_name not in taken:
-                    raise SpecError(source, f"<equality><{tag} name={name!r}>: no site {site_name!r} on a body")
+                    raise SpecNameError(source, "site", str(site_name), sites,
+                                        f"<equality><{tag} name={name!r}> (line {line}) {key}")
             closures.append(Closure(name, kind, *on))
             continue
         cm = next(iters[tag])
