@@ -163,7 +163,7 @@ def load_model_file(path: Path, given: Given = Given()) -> Mechanism:
                        description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types,
                        floating_base=imp.floating_base, actuators=imp.actuators)
     spec, read = with_given(spec, given, str(path))
-    return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes + read)
+    return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes + read, seed=imp.seed)
 
 
 #: A reader's loader: the mechanism, given what the caller states in code (:class:`Given`, default nothing).
