@@ -480,12 +480,12 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             taken.add(site.get("name"))
     closures = []
     iters = {"connect": iter(points), "weld": iter(welds)}
-    sites = sorted(str(site.get("name")) for site in world.iter("site") if site.get("name") in taken)
+    site_names = sorted(str(site.get("name")) for site in world.iter("site") if site.get("name") in taken)
     for tag, name, on, kind, line in eq_names:
         if on is not None:  # the two sites coincide (connect: their origins; weld: their frames)
             for key, site_name in zip(("site1", "site2"), on):
                 if site_name not in taken:
-                    raise SpecNameError(source, "site", str(site_name), sites,
+                    raise SpecNameError(source, "site", str(site_name), site_names,
                                         f"<equality><{tag} name={name!r}> (line {line}) {key}")
             closures.append(Closure(name, kind, *on))
             continue
