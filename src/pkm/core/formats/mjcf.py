@@ -41,6 +41,10 @@ does not keep, from the file itself:
   bodies without a name (MuJoCo's are optional) are named from their body: ``<body>_free``,
   ``<body>_hinge``, ``<body>_hinge_2`` (the second), ``<body>_slide``, ``<body>_ball``; a body
   ``<parent>_child`` (``_child_2``...); a derived name never takes one the file uses;
+* the reference configuration: the ``<keyframe><key name="reference">`` (the one :func:`pkm.save` writes), held
+  (a ``qpos`` of another length is refused naming its line); without it the mechanism is assembled starting from
+  MuJoCo's ``qpos0`` (hinges and slides at their ``ref``, free bodies where the file puts them), where a
+  ``<connect>``'s second anchor is taken (also for the connects pkm re-anchors: those to free bodies);
 * ``euler`` angles in any ``<compiler eulerseq>`` (three of ``xyzXYZ``: lower case about the moving axes,
   upper case about the fixed ones, mixed allowed): pkm writes each ``euler`` (bodies, geoms, sites,
   inertials, cameras, default classes...) as the ``quat`` MuJoCo computes, in the copy Pinocchio reads;
