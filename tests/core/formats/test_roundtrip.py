@@ -4,7 +4,7 @@ set (tests/test_acceptance.py) and the other examples under examples/.
 
 "The same": the joint names (MJCF writes a universal joint ``u`` as two hinges ``u__1``, ``u__2`` of one body: read
 back as two revolute joints, the stated mapping), the limits (a universal's on both hinges; MJCF folds a mimic
-joint's range into its leader's), the actuated joints (as a set: Gepetto's YAML reads them back in the model's order,
+joint's range into its leader's), the actuated joints (as a set: Gepetto's YAML reads them back in the URDF's order,
 permuted here) and their drives (reflected inertia, viscous and Coulomb friction), the closure types and names (Gepetto's
 format has no names), and at three random closed states the residual of the copy (<= 1e-12), every joint's placement,
 the passive map G (joint rates from actuated rates; with the placements it gives any task's forward Jacobian), the
@@ -28,6 +28,7 @@ import pinocchio as pin
 import pytest
 
 import pkm
+from pkm.core.formats.to_gepetto import gepetto_from_mechanism
 from pkm.core.formats.to_mjcf import MIN_MASS
 from pkm.core.formats.writers import WRITERS
 from pkm.core.kinematics import constraints
@@ -117,6 +118,8 @@ def compare(case: str, writer: str) -> dict[str, float]:
     assert dst.limits == limits, case
     assert sorted(dst.actuated_names) == sorted(src.actuated_names), case
     order = [dst.actuated_names.index(n) for n in src.actuated_names]  # dst's index of each of src's actuators
+    if writer == "gepetto" and dst.actuated_names != src.actuated_names:  # (the writer says the order it reads back)
+        assert f"read back in the URDF's order: {list(dst.actuated_names)}" in str(gepetto_from_mechanism(src)[1])
     drives = [(d.reflected_inertia, d.viscous, d.coulomb) for d in src.actuators]
     if writer == "gepetto":  # Gepetto's YAML holds no spec drives (the writer says so): the copy is given them back
         dst = pkm.with_actuators(dst, {d.joint: d for d in src.actuators})
