@@ -152,7 +152,8 @@ def test_equalities_on_sites_close_the_sites_frames():
         ("tie", "point", "tie_a", "tie_b"), ("w", "frame", "bs", "stand_tip")]
     with pytest.raises(SpecError, match="give both site1 and site2"):
         read_mjcf(PROBE.replace('<weld body1="a" body2="b"/>', '<weld site1="bs"/>'), "probe.xml")
-    with pytest.raises(SpecError, match="no site 'nope'"):
+    with pytest.raises(SpecError, match=r"site 'nope' does not exist in probe.xml \(<equality><connect "
+                                        r"name='connect2'> \(line \d+\) site2\)"):
         read_mjcf(PROBE.replace('<weld body1="a" body2="b"/>', '<connect site1="bs" site2="nope"/>'), "probe.xml")
     with pytest.raises(SpecError, match="no body1 and no sites"):
         read_mjcf(PROBE.replace('<weld body1="a" body2="b"/>', '<connect anchor="0 0 0"/>'), "probe.xml")
@@ -293,3 +294,46 @@ def test_the_fourbars_drive_loads_saves_and_pickles(tmp_path):
                     '[actuators.crank_joint]\nviscous = 0.2\n')
     assert pkm.load(spec).actuators[0] == pkm.Actuator("crank_joint", armature=0.003, viscous=0.2, coulomb=0.1,
                                                        effort_limit=3.0)
+
+
+_FOURBAR = Path(__file__).resolve().parents[3] / "examples" / "mjcf_fourbar" / "fourbar.xml"
+
+
+def test_the_reference_is_mujocos_qpos0_the_joints_at_their_ref(tmp_path):
+    """A hinge's ``ref`` is where its body has the file's pose (MuJoCo's ``qpos0``, where a connect's second anchor
+    is taken): the four-bar with the coupler's ``ref`` at 30 degrees is assembled there (it was assembled from 0
+    before), and with the rocker a free body (the connect re-anchored by pkm) it is closed there too (it was anchored
+    at the coupler's 0, which left MuJoCo's qpos0 open by 0.52 rad of coupler). MuJoCo's own qpos0 agrees
+    (test_mjcf_mujoco.py checks the written files in MuJoCo)."""
+    from pkm.core.kinematics import constraints
+
+    text = _FOURBAR.read_text().replace('<joint name="coupler_joint"/>', '<joint name="coupler_joint" ref="30"/>')
+    free = text.replace('<body name="rocker" pos="0.3 0 0">\n      <joint name="rocker_joint"/>',
+                        '<body name="rocker" pos="0.3 0 0">\n      <freejoint name="rocker_free"/>')
+    assert free != text
+    for name, body, expected in (("hinged.xml", text, [0.0, np.pi / 6, 0.0]),
+                                 ("free.xml", free, [0.0, np.pi / 6, 0.3, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0])):
+        (tmp_path / name).write_text(body)
+        mech = pkm.load(tmp_path / name)
+        assert np.abs(mech.q_reference - expected).max() <= 1e-12, name
+        assert np.abs(constraints.residual(mech, np.array(expected))).max() <= 1e-12, name
+        assert any("assembled from the joints' ref" in n for n in mech.notes), name
+
+
+def test_the_reference_keyframe_is_the_reference_and_a_wrong_one_is_refused_by_line(tmp_path):
+    """``<keyframe><key name="reference" qpos>`` (what pkm.save writes) is the reference, held (a note says so); a
+    qpos of the wrong length is a SpecError naming the file, the key and its line."""
+    q = [0.1, 0.2, 0.3]
+    key = f'<keyframe><key name="reference" qpos="{" ".join(map(str, q))}"/></keyframe>\n</mujoco>'
+    text = _FOURBAR.read_text()
+    (tmp_path / "keyed.xml").write_text(text.replace("</mujoco>", key))
+    with pytest.raises(SpecError, match="leaves closure 'pin_c' open"):  # (an arbitrary qpos is not closed: held)
+        pkm.load(tmp_path / "keyed.xml")
+    mech = pkm.load(_FOURBAR)
+    q = pkm.close_loops(mech, [0.2]).q
+    (tmp_path / "keyed.xml").write_text(text.replace("</mujoco>", key.replace("0.1 0.2 0.3", " ".join(repr(float(x)) for x in q))))
+    keyed = pkm.load(tmp_path / "keyed.xml")
+    assert np.abs(keyed.q_reference - q).max() == 0.0 and any("<keyframe>" in n for n in keyed.notes)
+    (tmp_path / "short.xml").write_text(text.replace("</mujoco>", key.replace("0.1 0.2 0.3", "0.1 0.2")))
+    with pytest.raises(SpecError, match=r"short\.xml: <keyframe><key name='reference'> \(line \d+\) qpos"):
+        pkm.load(tmp_path / "short.xml")

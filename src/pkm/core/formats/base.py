@@ -37,6 +37,8 @@ class Imported:
         actuators: The drives' values the file states that its URDF text cannot carry, ``{actuated joint: {field:
             value}}`` as a spec's ``[actuators.<joint>]`` tables (:mod:`pkm.core.model.actuators`; an MJCF
             joint's ``armature``, its actuators' force limits...), under the spec's own.
+        seed: Joint values where the assembly starts for the joints ``reference`` leaves out (an MJCF joint's
+            ``ref``: MuJoCo's ``qpos0``, where the file's poses hold), instead of the neutral configuration.
     """
 
     urdf: str
@@ -49,6 +51,7 @@ class Imported:
     reference: dict[str, tuple[float, ...]] = dataclasses.field(default_factory=dict)
     notes: tuple[str, ...] = ()
     actuators: dict[str, dict[str, float]] = dataclasses.field(default_factory=dict)
+    seed: dict[str, tuple[float, ...]] = dataclasses.field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import dataclasses
 import re
+import warnings
 from pathlib import Path
 
 from pkm.core.formats.base import FORMATS, Imported, by_root, suffixes
 from pkm.core.model.spec import ClosureSpec, read_text_file
 from pkm.core.model.urdf import check_urdf, limit_notes
-from pkm.errors import SpecError
+from pkm.errors import PkmWarning, SpecError
 
 
 def root_tag(text: str) -> str | None:
@@ -25,14 +26,32 @@ def root_tag(text: str) -> str | None:
 def import_model(path: Path) -> Imported:
     """Read the model file at ``path`` with the registered format (:data:`~pkm.core.formats.base.FORMATS`) whose
     root element it has (a URDF named ``.xml`` is a URDF), else the one of its suffix; another is read as URDF.
+    A suffix that names another format than the root element (``.urdf``, ``.sdf``, ``.mjcf``; ``.xml`` names any XML)
+    is said: a note (:attr:`Imported.notes`) and a :class:`~pkm.errors.PkmWarning` naming the file, the root element
+    and its line.
 
     Raises:
         SpecError: the file is missing, too large, malformed, or uses what its reader refuses.
     """
-    fmt = FORMATS.get(suffixes().get(path.suffix.lower(), ""), FORMATS["urdf"])
+    named = FORMATS.get(suffixes().get(path.suffix.lower(), ""))
+    fmt = named or FORMATS["urdf"]
     text = read_text_file(path, fmt.name.upper())
     fmt = by_root(root_tag(text)) or fmt
-    return fmt.read(text, str(path))
+    imp = fmt.read(text, str(path))
+    if named is not None and named is not fmt and path.suffix.lower() != ".xml":  # (.xml: any XML, URDF too)
+        line = _root_line(text)
+        said = (f"read as {fmt.name.upper()} by its root element <{fmt.root}>" + (f" (line {line})" if line else "")
+                + f", though its suffix {path.suffix!r} names {named.name.upper()}")
+        warnings.warn(f"{path}: {said}", PkmWarning, stacklevel=2)
+        imp = dataclasses.replace(imp, notes=(*imp.notes, said))
+    return imp
+
+
+def _root_line(text: str) -> int | None:
+    """The line of the document's first element (as :func:`root_tag` finds it), or None."""
+    body = re.sub(r"<\?.*?\?>|<!--.*?-->", lambda m: "\n" * m.group(0).count("\n"), text[:65536], flags=re.DOTALL)
+    m = re.search(r"<\s*[A-Za-z_]", body)
+    return body[:m.start()].count("\n") + 1 if m else None
 
 
 def read_urdf(text: str, source: str = "<urdf>") -> Imported:

@@ -163,7 +163,7 @@ def load_model_file(path: Path, given: Given = Given()) -> Mechanism:
                        description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types,
                        floating_base=imp.floating_base, actuators=imp.actuators)
     spec, read = with_given(spec, given, str(path))
-    return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes + read)
+    return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes + read, seed=imp.seed)
 
 
 #: A reader's loader: the mechanism, given what the caller states in code (:class:`Given`, default nothing).
@@ -207,6 +207,14 @@ def _closure_spec(path: Path) -> Loader | str:
         specs = sorted(p.name for p in path.glob("*.toml"))
         return "a folder: give the spec file (" + (f"it holds {', '.join(specs[:4])}" if specs else "NAME.closures.toml") + ")"
     if path.suffix.lower() == ".toml":
+        text = _head(path)
+        fmt = by_root(root_tag(text)) if text is not None and text.lstrip().startswith("<") else None
+        if fmt is not None:  # a model file named as a spec: said before TOML's parser says "line 1"
+            def refuse(given: Given = Given()) -> Mechanism:
+                raise SpecError(str(path), f"XML with the root element <{fmt.root}>, a {fmt.name.upper()} file, not a "
+                                           f"pkm closure spec (TOML): name it {fmt.suffixes[0]}, and write the spec "
+                                           f"beside it (`pkm spec init {path.with_suffix(fmt.suffixes[0])}`)")
+            return refuse
         return lambda given=Given(): load_spec_file(path, given)
     if path.suffix.lower() in (".yaml", ".yml"):
         return "a YAML file: a pkm closure spec is TOML (NAME.closures.toml)"

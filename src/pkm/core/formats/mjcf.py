@@ -41,6 +41,10 @@ does not keep, from the file itself:
   bodies without a name (MuJoCo's are optional) are named from their body: ``<body>_free``,
   ``<body>_hinge``, ``<body>_hinge_2`` (the second), ``<body>_slide``, ``<body>_ball``; a body
   ``<parent>_child`` (``_child_2``...); a derived name never takes one the file uses;
+* the reference configuration: the ``<keyframe><key name="reference">`` (the one :func:`pkm.save` writes), held
+  (a ``qpos`` of another length is refused naming its line); without it the mechanism is assembled starting from
+  MuJoCo's ``qpos0`` (hinges and slides at their ``ref``, free bodies where the file puts them), where a
+  ``<connect>``'s second anchor is taken (also for the connects pkm re-anchors: those to free bodies);
 * ``euler`` angles in any ``<compiler eulerseq>`` (three of ``xyzXYZ``: lower case about the moving axes,
   upper case about the fixed ones, mixed allowed): pkm writes each ``euler`` (bodies, geoms, sites,
   inertials, cameras, default classes...) as the ``quat`` MuJoCo computes, in the copy Pinocchio reads;
@@ -396,6 +400,7 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             body_joints[names[0]] = names
     if derived:
         notes.append(f"names derived for what the file leaves unnamed: {', '.join(derived)}")
+    key_qpos = _keyframe(root, world, kinds, source)
 
     equalities = []
     for el in [el for el in root.findall("equality/*") if isinstance(el.tag, str)]:
@@ -431,11 +436,14 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
                                     f"<equality><{el.tag} name={eq_name!r}> (line {el.sourceline}) {key}")
         point = el.tag == "connect" or _torquescale(el, eq_name, defaults, source) == 0.0
         eq_names.append((el.tag, eq_name, (el.get("site1"), el.get("site2")) if el in on_sites else None,
-                         "point" if point else "frame"))
+                         "point" if point else "frame", el.sourceline))
     body_based = {t: counts[t] - sum(1 for el in on_sites if el.tag == t) for t in counts}
     for k, el in enumerate(el for el in equalities if el not in on_sites):  # Pinocchio returns them by name
         el.set("name", f"pkm{k:06d}")
-    unread = [el.tag for el in root if isinstance(el.tag, str) and el.tag in _UNREAD]
+    unread = [el.tag for el in root if isinstance(el.tag, str) and el.tag in _UNREAD
+              and not (el.tag == "keyframe" and key_qpos and len(el) == 1)]
+    for el in root.findall("keyframe"):  # (Pinocchio checks their sizes; pkm reads the reference key itself)
+        root.remove(el)
     if unread:
         notes.append(f"{', '.join(f'<{t}>' for t in dict.fromkeys(unread))} not read (kinematics and dynamics need "
                      "none of it)")
@@ -459,7 +467,7 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
 
     free = _free_bodies(model, world, degrees, source)
     if free:
-        points = _anchored(model, free, points)
+        points = _anchored(model, free, refs, points)
     welds = _welds(model, free, refs, [(el, eq[1]) for el, eq in zip(equalities, eq_names)
                                        if el.tag == "weld" and el not in on_sites], defaults, source)
     taken = set(model.names) | {f.name for f in model.frames}
@@ -476,11 +484,13 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             taken.add(site.get("name"))
     closures = []
     iters = {"connect": iter(points), "weld": iter(welds)}
-    for tag, name, on, kind in eq_names:
+    site_names = sorted(str(site.get("name")) for site in world.iter("site") if site.get("name") in taken)
+    for tag, name, on, kind, line in eq_names:
         if on is not None:  # the two sites coincide (connect: their origins; weld: their frames)
-            for site_name in on:
+            for key, site_name in zip(("site1", "site2"), on):
                 if site_name not in taken:
-                    raise SpecError(source, f"<equality><{tag} name={name!r}>: no site {site_name!r} on a body")
+                    raise SpecNameError(source, "site", str(site_name), site_names,
+                                        f"<equality><{tag} name={name!r}> (line {line}) {key}")
             closures.append(Closure(name, kind, *on))
             continue
         cm = next(iters[tag])
@@ -517,10 +527,70 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
         limits.pop(j, None)
     urdf, types = urdf_from_model(model, limits=limits, mimic=mimic, **kwargs)
     reference = {model.names[j]: tuple(map(float, pin.SE3ToXYZQUAT(X))) for j, X in free.items()}
+    dependent = set(mimic) | set(locked)
+    continuous = {str(j.get("name")) for j in etree.fromstring(urdf.encode()).iter("joint")
+                  if j.get("type") == "continuous"}
+    keyed = _pinocchio_values(key_qpos, kinds, dependent, continuous)
+    seed = {} if keyed else {j: _value(v, j in continuous) for j, v in refs.items() if v != 0.0 and j not in dependent}
+    if keyed:
+        reference = keyed
+        notes.append(f"the reference configuration is the <keyframe><key name={_KEY!r}> (the one pkm writes)")
+    elif seed:
+        notes.append(f"assembled from the joints' ref (MuJoCo's qpos0, where the file's poses hold): "
+                     f"{', '.join(seed)}")
     if len(set(actuated)) < len(actuated):
         notes.append("several actuators drive the same joint: it is one input")
-    return Imported(urdf, tuple(closures), types, tuple(dict.fromkeys(actuated)), name, "mjcf", _floating_base(model), reference,
-                    tuple(notes), actuators)
+    return Imported(urdf, tuple(closures), types, tuple(dict.fromkeys(actuated)), name, "mjcf", _floating_base(model),
+                    reference, tuple(notes), actuators, seed)
+
+
+#: The ``<keyframe><key>`` read as the reference configuration (:func:`pkm.save` writes it).
+_KEY = "reference"
+_QPOS = {"free": 7, "ball": 4, "hinge": 1, "slide": 1}  # MuJoCo's qpos width of each joint type
+
+
+def _value(angle: float, continuous: bool) -> tuple[float, ...]:
+    """A one-coordinate joint's value in Pinocchio's coordinates (an unbounded revolute's: cos, sin)."""
+    return (float(np.cos(angle)), float(np.sin(angle))) if continuous else (float(angle),)
+
+
+def _keyframe(root: etree._Element, world: etree._Element, kinds: dict[str, str],
+              source: str) -> dict[str, list[float]]:
+    """``{joint: its qpos}`` of the ``<key name="reference">`` (MuJoCo's order: the joints as the file nests them),
+    ``{}`` without that key.
+
+    Raises:
+        SpecError: a ``qpos`` of the wrong length, or not numbers (naming the key's line).
+    """
+    key = next((k for k in root.findall("keyframe/key") if k.get("name") == _KEY), None)
+    if key is None or key.get("qpos") is None:
+        return {}
+    joints = [str(j.get("name")) for j in world.iter("joint", "freejoint")]
+    width = sum(_QPOS[kinds[j]] for j in joints)
+    qpos = _floats(key.get("qpos"), width, f"<keyframe><key name={_KEY!r}> (line {key.sourceline}) qpos", source)
+    out, k = {}, 0
+    for j in joints:
+        out[j] = [float(x) for x in qpos[k:k + _QPOS[kinds[j]]]]
+        k += _QPOS[kinds[j]]
+    return out
+
+
+def _pinocchio_values(qpos: dict[str, list[float]], kinds: dict[str, str], dependent: set[str],
+                      continuous: set[str]) -> dict[str, tuple[float, ...]]:
+    """MuJoCo's ``{joint: qpos}`` in Pinocchio's coordinates (``[reference]``), the dependent (mimic, locked) joints
+    left out: a free body's position and quaternion ``w x y z`` as ``x y z qx qy qz qw``, a ball's quaternion as
+    ``qx qy qz qw``, an unbounded hinge's angle as its cosine and sine."""
+    out: dict[str, tuple[float, ...]] = {}
+    for j, seg in qpos.items():
+        if j in dependent:
+            continue
+        if kinds[j] == "free":
+            out[j] = (*seg[:3], *seg[4:], seg[3])
+        elif kinds[j] == "ball":
+            out[j] = (*seg[1:], seg[0])
+        else:
+            out[j] = _value(seg[0], j in continuous)
+    return out
 
 
 def _joint_equalities(els: list[etree._Element], kinds: dict[str, str], refs: dict[str, float], notes: list[str],
@@ -744,13 +814,21 @@ def _free_bodies(model: pin.Model, world: etree._Element, degrees: bool, source:
     return out
 
 
-def _anchored(model: pin.Model, free: dict[int, pin.SE3], constraints: Iterable[pin.RigidConstraintModel]) \
-        -> list[_Anchors]:
-    """The constraints with their second end re-anchored where the first is at qpos0 (free bodies at their poses)."""
+def _qpos0(model: pin.Model, free: dict[int, pin.SE3], refs: dict[str, float]) -> np.ndarray:
+    """MuJoCo's ``qpos0`` in Pinocchio's coordinates: free bodies at their poses, hinges and slides at their ``ref``."""
     q0 = pin.neutral(model)
     for jid, X in free.items():
-        jm = model.joints[jid]
-        q0[jm.idx_q:jm.idx_q + 7] = pin.SE3ToXYZQUAT(X)
+        q0[model.joints[jid].idx_q:model.joints[jid].idx_q + 7] = pin.SE3ToXYZQUAT(X)
+    for joint, value in refs.items():
+        if model.existJointName(joint) and model.joints[model.getJointId(joint)].nq == 1:
+            q0[model.joints[model.getJointId(joint)].idx_q] = value
+    return q0
+
+
+def _anchored(model: pin.Model, free: dict[int, pin.SE3], refs: dict[str, float],
+              constraints: Iterable[pin.RigidConstraintModel]) -> list[_Anchors]:
+    """The constraints with their second end re-anchored where the first is at qpos0 (:func:`_qpos0`)."""
+    q0 = _qpos0(model, free, refs)
     d = model.createData()
     pin.forwardKinematics(model, d, q0)
     out = []
@@ -783,12 +861,7 @@ def _welds(model: pin.Model, free: dict[int, pin.SE3], refs: dict[str, float],
     orientation free: a ``point`` closure (as ``<connect>``), else a ``frame`` one (another scale weights the
     angular residual in MuJoCo's soft solver, the closed configuration is the same).
     """
-    q0 = pin.neutral(model)
-    for jid, X in free.items():
-        q0[model.joints[jid].idx_q:model.joints[jid].idx_q + 7] = pin.SE3ToXYZQUAT(X)
-    for joint, value in refs.items():
-        if model.existJointName(joint) and model.joints[model.getJointId(joint)].nq == 1:
-            q0[model.joints[model.getJointId(joint)].idx_q] = value
+    q0 = _qpos0(model, free, refs)
     data = model.createData()
     pin.framesForwardKinematics(model, data, q0)
     bodies = [f.name for f in model.frames if f.type == pin.FrameType.BODY and f.name != _WORLD]

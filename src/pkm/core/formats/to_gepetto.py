@@ -19,7 +19,7 @@ so; read back, the mechanism lacks it:
 * the drives stated in the spec (``[actuators.<joint>]``: rotor inertia, gear ratio, friction...; the URDF keeps
   only each joint's effort and velocity limits);
 * the working modes (``[branches]``) and the design parameters (``[parameters]``);
-* the actuators' order when it is not the model's (the reader takes them in the model's order).
+* the actuators' order when it is not the URDF's (the reader takes them in the order of the URDF's ``<joint>`` elements).
 
 Refused (a :class:`~pkm.errors.SpecError` naming what): a mechanism built from a Pinocchio model without URDF text,
 and one with a floating base (a free-flyer the spec adds to the URDF's tree: the format has no place for it).
@@ -33,6 +33,7 @@ import numpy as np
 
 from pkm.core.formats.gepetto import JOINT_TYPES
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.urdf import check_urdf
 from pkm.errors import SpecError
 
 #: pkm's joint types and the toolbox's ``joint_type`` for them (the inverse of
@@ -79,9 +80,10 @@ def gepetto_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
         dropped.append(f"working modes ([branches]): {sorted(spec.branches)}, default {spec.default_branch!r}")
     if spec.parameters:
         dropped.append(f"design parameters ([parameters]): {json.dumps(dict(spec.parameters))}")
-    order = sorted(actuated, key=lambda n: mech.model.getJointId(n))
+    in_file = [str(j.get("name")) for j in check_urdf(mech.urdf, mech.source).findall("joint")]
+    order = sorted(actuated, key=in_file.index)  # (pkm's reader takes them in the URDF's order of <joint> elements)
     if order != actuated:
-        dropped.append(f"actuator order {actuated} (read back in the model's order: {order})")
+        dropped.append(f"actuator order {actuated} (read back in the URDF's order: {order})")
     lines = [f"# {spec.mechanism}: written by pkm in the convention of Gepetto's toolbox-parallel-robots"]
     if spec.description:
         lines.append("# " + " ".join(spec.description.split()))

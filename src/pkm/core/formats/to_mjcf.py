@@ -2,10 +2,10 @@
 
 :func:`mjcf_from_mechanism` writes one body per Pinocchio joint (placement and inertia as Pinocchio has them, after
 fixed joints are merged), the joint itself (``hinge``, ``slide``, ``ball``, ``free``; a universal joint as two
-hinges of one body, about its first axis and then its second; a mimic joint as a joint of its own tied to its
-leader by a ``<joint>`` equality ``q = offset + scale q_leader``), a site at each closure frame, a ``<connect>``
-(point closure) or ``<weld>`` (frame closure) between the two sites, a ``<motor>`` on each actuated joint, and the
-reference configuration as ``<keyframe><key name="reference">`` (:func:`mjcf_qpos`; MuJoCo's
+hinges of one body, about its first axis and then its second, each with the universal's range; a mimic joint as a
+joint of its own tied to its leader by a ``<joint>`` equality ``q = offset + scale q_leader``), a site at each closure
+frame, a ``<connect>`` (point closure) or ``<weld>`` (frame closure) between the two sites, a ``<motor>`` on each
+actuated joint, and the reference configuration as ``<keyframe><key name="reference">`` (:func:`mjcf_qpos`; MuJoCo's
 ``mj_resetDataKeyframe(model, data, 0)`` starts from it, closed).
 Gravity is the model's, contacts are disabled; a one-coordinate joint with position limits
 (:attr:`~pkm.core.Mechanism.limits`) has them as its ``range`` (radians or metres: ``<compiler angle="radian">``).
@@ -136,6 +136,8 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
         for name in _joints(body, jm, model.names[j], mech.source):
             if name in mech.limits and jm.nq == 1:  # (MuJoCo adds a limit row only where a joint reaches it)
                 body.find(f"joint[@name='{name}']").set("range", _num(mech.limits[name]))
+            elif model.names[j] in mech.limits and jm.shortname() == "JointModelUniversal":  # (both hinges)
+                body.find(f"joint[@name='{name}']").set("range", _num(mech.limits[model.names[j]]))
         if jm.shortname() == "JointModelMimic":
             mimic = jm.extract()
             leader = model.names[_leader(model, j)]
@@ -229,7 +231,7 @@ def closure_softness(timestep: float = TIMESTEP) -> tuple[tuple[float, float], t
 
 def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
     """What :func:`mjcf_from_mechanism` cannot write of ``mech``, one line each (pkm's MJCF reader gives a mechanism
-    without it): the task and end effector, the reference configuration, the spec's working modes and design
+    without it): the task and end effector, the spec's working modes and design
     parameters, the drives' speed limits and continuous efforts (when a peak is written), the rotor inertia and
     gear ratio (folded into ``armature``), and universal joints' kind (written as two hinges of one body, read back
     as two revolute joints ``<name>__1``, ``<name>__2``)."""
@@ -241,8 +243,6 @@ def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
     if spec.end_effector is not None or spec.task.components or spec.task.frames or tuple(spec.task.joints) != actuated:
         out.append(f"task: end effector {spec.end_effector!r}, components {' '.join(spec.task.components) or '-'} "
                    "(read back, the task is the actuated joints)")
-    out.append("reference configuration: written as MuJoCo's <keyframe> 'reference', which pkm's reader does not "
-               "read (it assembles the mechanism from the neutral configuration)")
     if spec.branches:
         out.append(f"working modes ([branches]): {sorted(spec.branches)}")
     if spec.parameters:

@@ -171,7 +171,7 @@ def write(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) 
     Raises:
         UnknownNameError, InvalidInputError: see :func:`target`; not a Mechanism.
         SpecError: the format cannot hold something the mechanism needs (a joint MJCF has no kind for, a floating
-            base in Gepetto's format): the message names it; a file that cannot be written.
+            base in Gepetto's format): the message names the file and the joint; a file that cannot be written.
     """
     mech = check_mechanism(mech)
     writer, files = destination(mech, path, to)
@@ -179,6 +179,11 @@ def write(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) 
         return writer.write(mech, files)
     except OSError as exc:
         raise SpecError(str(files[0]), f"cannot write: {exc.strerror or exc}") from None
+    except SpecError as exc:  # what the format cannot hold: said with the file it was to go in
+        if exc.source == str(files[0]):
+            raise
+        raise SpecError(str(files[0]), f"{writer.description} cannot hold mechanism {mech.spec.mechanism!r}, nothing "
+                                       f"written: {exc}") from None
 
 
 def _safe(name: str) -> str:

@@ -175,7 +175,7 @@ def from_imported(spec: ClosureSpec, imported: Imported, source: str) -> Mechani
     states added to the spec, then built (as :func:`from_files` does once it has read both)."""
     spec = with_file(spec, imported, source)
     model = retype_joints(load_model(imported.urdf, source), spec.joint_types, source)
-    return build(model, spec, None, imported.urdf, source, imported.notes)
+    return build(model, spec, None, imported.urdf, source, imported.notes, seed=imported.seed)
 
 
 def with_actuators(mech: Mechanism, actuators: Mapping[str, Any]) -> Mechanism:
