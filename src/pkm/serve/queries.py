@@ -179,15 +179,16 @@ def _array(body: Mapping[str, Any], key: str, size: int, kinds: Sequence[str | N
     if key not in body or body[key] is None:
         raise InvalidInputError(key, f"missing: give {size} numbers, or a list of such samples")
     raw = body[key]
-    if kinds is not None and not isinstance(raw, np.ndarray) and _has_string(raw):
-        raw = _with_units(raw, key, kinds)  # (a unit string: pkm.units; the plain numeric path stays numpy's)
-    try:
-        a = as_array(raw, key, f"numbers ({size} a sample)")  # (strings, booleans, ragged lists refused)
+    what = f"numbers ({size} a sample)"
+    try:  # (numbers first: a batch of plain numbers is not walked in Python for strings)
+        a = as_array(raw, key, what)  # (strings, booleans, ragged lists refused)
     except InvalidInputError:
-        if kinds is None and _has_string(raw):
+        if not _has_string(raw):
+            raise
+        if kinds is None:
             raise InvalidInputError(key, "numbers in SI (rad/s, m/s, rad/s^2...): unit strings such as '10deg' are "
                                          "taken for positions (qa, q, y, seed) only", raw) from None
-        raise
+        a = as_array(_with_units(raw, key, kinds), key, what)  # (a unit string: pkm.units)
     if a.ndim == 1:
         a = a[None]
     if a.ndim != 2 or a.shape[1] != size:
