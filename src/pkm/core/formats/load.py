@@ -48,6 +48,7 @@ class Given:
 
     @property
     def empty(self) -> bool:
+        """Whether nothing is given (the file's own actuators and task are used)."""
         return self.actuated is None and self.task is None
 
 

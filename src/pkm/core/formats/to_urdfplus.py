@@ -26,6 +26,7 @@ import pinocchio as pin
 from lxml import etree
 
 from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.urdf import origin
 from pkm.errors import SpecError
 
 _TOL = 1e-9  # relative tolerance on the two sides' axis lengths (they are written by a reader to 1e-16)
@@ -38,11 +39,6 @@ def _link_of(mech: Mechanism, frame_id: int, cut: set[str]) -> tuple[str, pin.SE
     link = next(g.name for g in mech.model.frames if g.type == pin.FrameType.BODY and g.parentJoint == f.parentJoint
                 and g.placement.isIdentity(1e-14) and g.name not in cut)
     return link, f.placement
-
-
-def _origin(el: etree._Element, X: pin.SE3) -> None:
-    etree.SubElement(el, "origin", xyz=" ".join(map(repr, X.translation.tolist())),
-                     rpy=" ".join(map(repr, pin.rpy.matrixToRpy(X.rotation).tolist())))
 
 
 def urdfplus_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
@@ -101,7 +97,7 @@ def urdfplus_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
             loop.set("type", "spherical")
             balls.append(c.name)
         for role, link, X in (("predecessor", la, Xa), ("successor", lb, Xb)):
-            _origin(etree.SubElement(loop, role, link=link), X)
+            origin(etree.SubElement(loop, role, link=link), X)
         if loop.get("type") == "revolute":
             etree.SubElement(loop, "axis", xyz="0 0 1")
         loops.append(loop)

@@ -62,7 +62,7 @@ from lxml import etree
 from pkm.core.formats.base import Imported
 from pkm.core.formats.sdf import _AXIS_POINT
 from pkm.core.model.spec import Closure
-from pkm.core.model.urdf import check_urdf, limit_notes, parse_xml
+from pkm.core.model.urdf import check_urdf, limit_notes, origin, parse_xml
 from pkm.errors import SpecError, SpecNameError
 
 #: The elements under ``<robot>`` that make a URDF closed, and the format each marks.
@@ -199,8 +199,7 @@ def read_urdf(text: str, source: str = "<urdf>") -> Imported:
             names.add(n)
         etree.SubElement(tree, "link", name=name)
         jel = etree.SubElement(tree, "joint", name=f"{name}_fixed", type="fixed")
-        etree.SubElement(jel, "origin", xyz=" ".join(map(repr, X.translation.tolist())),
-                         rpy=" ".join(map(repr, pin.rpy.matrixToRpy(X.rotation).tolist())))
+        origin(jel, X)
         etree.SubElement(jel, "parent", link=link)
         etree.SubElement(jel, "child", link=name)
         return name
