@@ -73,25 +73,17 @@ def _value_units(mech: Mechanism) -> list[str]:
     return [("m" if kinds[k] == "length" else "rad") if k in kinds else "1" for k in mech.task_map.value_names]
 
 
-#: The units of the coordinates of the joints that are not scalar: (q's, v's), the letters m (a length) and r (an angle),
-#: 1 (unitless); a scalar joint's are by :attr:`JointInfo.revolute`, a prismatic one's in m.
-_JOINT_UNITS = {"JointModelFreeFlyer": ("mmm1111", "mmmrrr"), "JointModelSpherical": ("1111", "rrr"),
-                "JointModelPlanar": ("mm11", "mmr"), "JointModelTranslation": ("mmm", "mmm")}
-_PRISMATIC = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned")
-
-
 def _joint_units(mech: Mechanism, which: int) -> list[str]:
-    """The unit letters of every coordinate of ``q`` (``which`` 0) or ``v`` (1)."""
-    size = mech.nq if which == 0 else mech.nv
-    out = ["1" if which == 0 else "r"] * size
+    """The unit letters of every coordinate of ``q`` (``which`` 0) or ``v`` (1): ``m`` (a length: the leading
+    entries :func:`~pkm.core.model.scale.length_entries` counts), ``r`` (an angle: a bounded revolute's coordinate,
+    every other velocity entry), ``1`` (unitless: a quaternion's entries, an unbounded revolute's cosine and sine)."""
+    from pkm.core.model.scale import length_entries
+
+    out = ["1" if which == 0 else "r"] * (mech.nq if which == 0 else mech.nv)
     for j in mech.joints.values():
         at, n = (j.idx_q, j.nq) if which == 0 else (j.idx_v, j.nv)
-        if j.kind in _JOINT_UNITS:
-            out[at:at + n] = list(_JOINT_UNITS[j.kind][which])
-        elif j.kind in _PRISMATIC:
-            out[at:at + n] = ["m"] * n
-        elif j.revolute or which == 1:
-            out[at:at + n] = ["r"] * n
+        lengths = min(length_entries(j.kind), n)
+        out[at:at + n] = ["m"] * lengths + ["r" if which == 1 or j.revolute else "1"] * (n - lengths)
     return out
 
 
@@ -270,7 +262,7 @@ class _Samples:
                                for k, e in enumerate(self.errors) if e is not None]
         bad = set(failed)
         for key, column in values.items():
-            if not bad and all(v is not None for v in column):
+            if not bad and (isinstance(column, np.ndarray) or all(v is not None for v in column)):
                 out[key] = np.asarray(column) if not isinstance(column, np.ndarray) else column
             else:
                 out[key] = [None if k in bad else _value(column[k]) for k in range(self.n)]
@@ -507,12 +499,22 @@ def capability(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) ->
                 "isotropic": np.array(list(c.isotropic.values())), "origin_inside": bool(c.origin_inside)}
 
     out = samples.each(one, ("q", "along", "vertices", "isotropic", "origin_inside"))
-    c0 = run(mech, mech.q_reference, kind)
+    axes, units, isotropic = _capability_labels(mech, kind)
     out["kind"] = kind
-    out["axes"] = list(c0.polytope.axes)
-    out["units"] = {"q": _q_units(mech), "along": list(c0.polytope.units), "vertices": list(c0.polytope.units),
-                    "isotropic": list(c0.isotropic), "origin_inside": "1"}
+    out["axes"] = list(axes)
+    out["units"] = {"q": _q_units(mech), "along": list(units), "vertices": list(units), "isotropic": list(isotropic),
+                    "origin_inside": "1"}
     return out
+
+
+@_per_mechanism
+def _capability_labels(mech: Mechanism, kind: str) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
+    """The ``kind`` capability's axes, their units and its isotropic values' units (the same at every
+    configuration: read once per mechanism, at the reference)."""
+    from pkm.core.analysis.capability import capability as run
+
+    c0 = run(mech, mech.q_reference, kind)
+    return tuple(c0.polytope.axes), tuple(c0.polytope.units), tuple(c0.isotropic)
 
 
 _SCENES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
