@@ -111,10 +111,13 @@ class Client:
         return self.query(model, "jacobians", q=q, qa=qa, seed=seed)
 
     def diagnose(self, model: str, q: Any = None, *, qa: Any = None, seed: Any = None) -> dict:
+        """The distances to the direct and inverse singularities at ``q``, or at actuated values ``qa``."""
         return self.query(model, "diagnose", q=q, qa=qa, seed=seed)
 
     def velocities(self, model: str, q: Any = None, qd: Any = None, qdd: Any = None, *, qa: Any = None,
                    seed: Any = None) -> dict:
+        """Joint and task rates ``v``, ``yd`` at actuated rates ``qd`` (with ``qdd``: ``a``, ``ydd``) at ``q``, or at
+        actuated values ``qa``."""
         return self.query(model, "velocities", q=q, qa=qa, qd=qd, qdd=qdd, seed=seed)
 
     def dynamics(self, model: str, q: Any = None, qd: Any = None, qdd: Any = None, *, qa: Any = None,
@@ -123,6 +126,7 @@ class Client:
         return self.query(model, "dynamics", q=q, qa=qa, qd=qd, qdd=qdd, seed=seed)
 
     def capability(self, model: str, q: Any = None, kind: str = "wrench", *, qa: Any = None, seed: Any = None) -> dict:
+        """The ``kind`` capability (``wrench``, ``twist``, ``acceleration``) at ``q``, or at actuated values ``qa``."""
         return self.query(model, "capability", q=q, qa=qa, kind=kind, seed=seed)
 
     def job(self, model: str, kind: str, **body: Any) -> dict:
