@@ -76,7 +76,9 @@ def retype_joints(model: pin.Model, types: Mapping[str, str], source: str = "<mo
               else mimics[name][3] if name in mimics else model.joints[jid])
         ids[jid] = new.addJoint(ids[model.parents[jid]], jm, model.jointPlacements[jid], name)
         new.appendBodyToJoint(ids[jid], model.inertias[jid], pin.SE3.Identity())
-    _keep_limits(model, new, names, types, mimics)
+    # the joints kept as they were keep the file's limits and drives (addJoint leaves Pinocchio's defaults)
+    copy_limits(model, new, [(jid, ids[jid]) for jid in range(1, model.njoints)
+                             if names[jid] not in types and names[jid] not in mimics])
     for k, f in enumerate(model.frames):
         if k == 0:
             continue  # the universe frame, which every model has
@@ -88,20 +90,24 @@ def retype_joints(model: pin.Model, types: Mapping[str, str], source: str = "<mo
     return new
 
 
-def _keep_limits(model: pin.Model, new: pin.Model, names: list[str], types: Mapping[str, str],
-                 mimics: Mapping[str, object]) -> None:
-    """The joints kept as they were keep the file's limits and drives (``addJoint`` without them leaves
-    Pinocchio's defaults: unbounded positions, no effort or speed limit, no friction, damping or armature)."""
-    per_q = tuple(k for k in ("lowerPositionLimit", "upperPositionLimit", "positionLimitMargin") if hasattr(new, k))
-    per_v = tuple(k for k in ("lowerEffortLimit", "upperEffortLimit", "lowerVelocityLimit", "upperVelocityLimit",
-                              "lowerDryFrictionLimit", "upperDryFrictionLimit", "effortLimit", "velocityLimit",
-                              "damping", "friction", "armature") if hasattr(new, k))
+#: A model's limits and drives per configuration entry (``q``) and per velocity entry (``v``), as Pinocchio names them;
+#: ``addJoint`` gives a new joint Pinocchio's defaults (unbounded positions, no effort or speed limit, no friction,
+#: damping or armature).
+LIMITS_Q = ("lowerPositionLimit", "upperPositionLimit", "positionLimitMargin")
+LIMITS_V = ("lowerEffortLimit", "upperEffortLimit", "lowerVelocityLimit", "upperVelocityLimit", "lowerDryFrictionLimit",
+            "upperDryFrictionLimit", "effortLimit", "velocityLimit", "damping", "friction", "armature")
+
+
+def copy_limits(model: pin.Model, new: pin.Model, joints: list[tuple[int, int]],
+                extra_v: tuple[str, ...] = ()) -> None:
+    """``model``'s limits and drives (:data:`LIMITS_Q`, :data:`LIMITS_V` and ``extra_v``, those this Pinocchio has)
+    onto the coordinates of ``new``'s joints: ``joints`` pairs each joint id of ``model`` with its id in ``new``, the
+    two of the same kind."""
+    per_q = tuple(k for k in LIMITS_Q if hasattr(new, k))
+    per_v = tuple(k for k in LIMITS_V + extra_v if hasattr(new, k))
     values = {k: np.array(getattr(new, k), dtype=float) for k in per_q + per_v}
-    for jid in range(1, model.njoints):
-        name = names[jid]
-        if name in types or name in mimics:
-            continue
-        old, kept = model.joints[jid], new.joints[new.getJointId(name)]
+    for old_id, new_id in joints:
+        old, kept = model.joints[old_id], new.joints[new_id]
         for k in per_q:
             values[k][kept.idx_q:kept.idx_q + kept.nq] = getattr(model, k)[old.idx_q:old.idx_q + old.nq]
         for k in per_v:
@@ -131,4 +137,4 @@ def _mimics(model: pin.Model) -> dict[str, tuple[str, float, float, pin.JointMod
     return out
 
 
-__all__ = ["JOINT_TYPES", "UNIVERSAL_AXES", "retype_joints", "universal_joint"]
+__all__ = ["JOINT_TYPES", "LIMITS_Q", "LIMITS_V", "UNIVERSAL_AXES", "copy_limits", "retype_joints", "universal_joint"]

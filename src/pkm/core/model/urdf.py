@@ -54,6 +54,7 @@ import yourdfpy
 from lxml import etree
 from numpy.typing import ArrayLike
 
+from pkm.core.model.joints import copy_limits
 from pkm.errors import InvalidInputError, SpecError
 from pkm.validation import ABSURD
 
@@ -423,19 +424,7 @@ def mimics_first(model: pin.Model, mimics: Mapping[str, tuple[str, float, float]
     for j in order[1:]:
         ids[j] = new.addJoint(ids[model.parents[j]], model.joints[j], model.jointPlacements[j], names[j])
         new.appendBodyToJoint(ids[j], model.inertias[j], pin.SE3.Identity())
-    per_q = [k for k in ("lowerPositionLimit", "upperPositionLimit", "positionLimitMargin") if hasattr(new, k)]
-    per_v = [k for k in ("lowerEffortLimit", "upperEffortLimit", "lowerVelocityLimit", "upperVelocityLimit",
-                         "lowerDryFrictionLimit", "upperDryFrictionLimit", "effortLimit", "velocityLimit",
-                         "damping", "friction", "armature", "rotorInertia", "rotorGearRatio") if hasattr(new, k)]
-    for key, per in [(k, "q") for k in per_q] + [(k, "v") for k in per_v]:
-        old_values, values = np.asarray(getattr(model, key), dtype=float), np.array(getattr(new, key), dtype=float)
-        if old_values.shape != values.shape:
-            continue
-        for j in order[1:]:
-            a, b = model.joints[j], new.joints[ids[j]]
-            i0, i1, n = (a.idx_q, b.idx_q, a.nq) if per == "q" else (a.idx_v, b.idx_v, a.nv)
-            values[i1:i1 + n] = old_values[i0:i0 + n]
-        setattr(new, key, values)
+    copy_limits(model, new, [(j, ids[j]) for j in order[1:]], extra_v=("rotorInertia", "rotorGearRatio"))
     for k, f in enumerate(model.frames):
         if k:  # (the universe frame: every model has it)
             new.addFrame(pin.Frame(f.name, ids[f.parentJoint], f.parentFrame, f.placement, f.type, f.inertia), False)
