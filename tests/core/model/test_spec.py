@@ -133,3 +133,15 @@ def test_more_task_coordinates_than_actuators_are_refused():
     text = MINIMAL.replace('actuated =', 'end_effector = "tip_1"\nactuated =') + '\n[task]\ncomponents = ["x", "y", "z"]\n'
     with pytest.raises(SpecError, match=r"the task has 3 coordinates but only 2 joints are actuated"):
         from_strings(fivebar.urdf_xml(fivebar.Params()), text)
+
+
+def test_task_is_actuated_says_whether_a_format_without_a_task_gives_it_back():
+    """A spec whose task is its actuated joints (no end effector, components or frames) is what Gepetto's, MJCF's and
+    URDF+'s readers give back; the Delta's (an end effector's x y z) is not, nor the same joints in another order."""
+    delta = ClosureSpec.load(spec_path("delta"))
+    assert not delta.task_is_actuated
+    joints = dataclasses.replace(delta, end_effector=None, task=dataclasses.replace(delta.task, components=(),
+                                                                                     frames={}, joints=delta.actuated))
+    assert joints.task_is_actuated
+    swapped = dataclasses.replace(joints, task=dataclasses.replace(joints.task, joints=delta.actuated[::-1]))
+    assert not swapped.task_is_actuated

@@ -62,8 +62,7 @@ def gepetto_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
                                      "(a free-flyer the spec adds to the URDF's tree); write a pkm spec or MJCF")
     dropped: list[str] = []
     actuated = list(mech.actuated_names)
-    if spec.end_effector is not None or spec.task.components or spec.task.frames or \
-            tuple(spec.task.joints) != tuple(actuated):
+    if not spec.task_is_actuated:
         task = " ".join(spec.task.components) or "-"
         dropped.append(f"task: end effector {spec.end_effector!r}, components {task}, frames "
                        f"{dict(spec.task.frames) or '-'}, joints {list(spec.task.joints) or '-'} (read back, the task is "

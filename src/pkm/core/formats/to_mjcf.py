@@ -239,8 +239,7 @@ def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
 
     mech = check_mechanism(mech)
     spec, out = mech.spec, []
-    actuated = tuple(mech.actuated_names)
-    if spec.end_effector is not None or spec.task.components or spec.task.frames or tuple(spec.task.joints) != actuated:
+    if not spec.task_is_actuated:
         out.append(f"task: end effector {spec.end_effector!r}, components {' '.join(spec.task.components) or '-'} "
                    "(read back, the task is the actuated joints)")
     if spec.branches:

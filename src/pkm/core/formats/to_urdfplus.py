@@ -118,7 +118,7 @@ def urdfplus_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
     if balls:
         dropped.append(f"URDF+ has no spherical loop joint: the point closures {balls} are written as "
                        '<loop type="spherical">, a pkm extension that other URDF+ readers refuse')
-    if spec.end_effector or spec.task.components or spec.task.frames or spec.task.joints != spec.actuated:
+    if not spec.task_is_actuated:
         dropped.append("the task and end effector")
     if spec.actuators:
         dropped.append(f"the drives of {sorted(spec.actuators)}")

@@ -189,6 +189,13 @@ class ClosureSpec:
     actuators: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ reading
+    @property
+    def task_is_actuated(self) -> bool:
+        """Whether the task is the actuated joints' values (no end effector, components or frames): the task a format
+        that cannot state one gives back on reading."""
+        return (self.end_effector is None and not self.task.components and not self.task.frames
+                and tuple(self.task.joints) == tuple(self.actuated))
+
     @classmethod
     def from_toml(cls, text: str, source: str = "<string>") -> ClosureSpec:
         """Parse a spec from TOML text. Raises :class:`SpecError` on any problem."""
