@@ -84,7 +84,9 @@ async function api(method, path, body) {
   if (!r.ok) {
     const e = new Error(answer.message || r.statusText);
     // one sample the library could not solve (unreachable, singular, not converged): said, not an error of the page
-    e.sample = r.status === 422 && ["InvalidRequest", "InvalidInputError", "UnitError"].indexOf(answer.error) < 0;
+    // (by name, the failures a sample can meet: any other 4xx, a bad input of any kind, is an error of the page)
+    e.sample = r.status === 422 && ["UnreachableError", "SingularityError", "ConvergenceError", "AssemblyError",
+                                    "NonFiniteError"].indexOf(answer.error) >= 0;
     throw e;
   }
   return answer;
