@@ -441,7 +441,7 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
                 if binary:
                     await ws.send_bytes(pack(out))
                 else:
-                    await ws.send_json(jsonable(out))
+                    await ws.send_json(_plain(out))  # (non-finite as null, as every answer)
         except WebSocketDisconnect:
             pass
 
