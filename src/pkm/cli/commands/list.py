@@ -35,14 +35,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def _model_format(path: Path) -> str:
     """The registered format of a model file: its root element's, else its suffix's (as the readers decide)."""
-    from pkm.core.formats.base import FORMATS, by_root, suffixes
-    from pkm.core.formats.imported import root_tag
+    from pkm.core.formats.imported import format_of
 
     try:
-        fmt = by_root(root_tag(path.read_text(errors="replace")[:65536]))
+        text = path.read_text(errors="replace")[:65536]
     except OSError:
-        fmt = None
-    return (fmt or FORMATS.get(suffixes().get(path.suffix.lower(), ""), FORMATS["urdf"])).name.upper()
+        text = ""
+    return format_of(path, text).name.upper()
 
 
 def _reader(path: Path) -> tuple[str, Callable[[], pkm.Mechanism]] | None:

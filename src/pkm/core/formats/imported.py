@@ -10,7 +10,7 @@ import re
 import warnings
 from pathlib import Path
 
-from pkm.core.formats.base import FORMATS, Imported, by_root, suffixes
+from pkm.core.formats.base import FORMATS, Format, Imported, by_root, suffixes
 from pkm.core.model.spec import ClosureSpec, read_text_file
 from pkm.core.model.urdf import check_urdf, limit_notes
 from pkm.errors import PkmWarning, SpecError
@@ -21,6 +21,11 @@ def root_tag(text: str) -> str | None:
     body = re.sub(r"<\?.*?\?>|<!--.*?-->", "", text[:65536], flags=re.DOTALL)
     m = re.search(r"<\s*([A-Za-z_][\w.-]*)", body)
     return m.group(1) if m else None
+
+
+def format_of(name: str | Path, text: str) -> Format:
+    """The format a model file is read as: its root element's (``text``), else its name's suffix's, else URDF's."""
+    return by_root(root_tag(text)) or FORMATS.get(suffixes().get(Path(name).suffix.lower(), ""), FORMATS["urdf"])
 
 
 def import_model(path: Path) -> Imported:
@@ -36,7 +41,7 @@ def import_model(path: Path) -> Imported:
     named = FORMATS.get(suffixes().get(path.suffix.lower(), ""))
     fmt = named or FORMATS["urdf"]
     text = read_text_file(path, fmt.name.upper())
-    fmt = by_root(root_tag(text)) or fmt
+    fmt = format_of(path, text)
     imp = fmt.read(text, str(path))
     if named is not None and named is not fmt and path.suffix.lower() != ".xml":  # (.xml: any XML, URDF too)
         line = _root_line(text)
@@ -153,5 +158,5 @@ def spec_skeleton(path: Path) -> tuple[str, bool]:
     return "\n".join(lines), bool(imp.actuated and imp.closures)
 
 
-__all__ = ["import_model", "read_urdf", "root_tag", "spec_skeleton",
+__all__ = ["format_of", "import_model", "read_urdf", "root_tag", "spec_skeleton",
            "with_file"]

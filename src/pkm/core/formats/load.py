@@ -19,7 +19,7 @@ from typing import Any
 
 from pkm.core.formats.base import FORMATS, Imported, by_root, suffixes
 from pkm.core.formats.gepetto import find_gepetto, read_gepetto
-from pkm.core.formats.imported import import_model, root_tag, with_file
+from pkm.core.formats.imported import format_of, import_model, root_tag, with_file
 from pkm.core.formats.packages import model_file
 from pkm.core.model.builder import from_files, from_imported, from_strings
 from pkm.core.model.mechanism import Mechanism
@@ -295,9 +295,7 @@ def load_path(path: Path, given: Given = Given()) -> Mechanism:
 
 def _read_text(name: str, text: str) -> Imported:
     """A model file given as text: read by the format of its root element, else of its name's suffix."""
-    fmt = FORMATS.get(suffixes().get(Path(name).suffix.lower(), ""), FORMATS["urdf"])
-    fmt = by_root(root_tag(text)) or fmt
-    return fmt.read(text, name)
+    return format_of(name, text).read(text, name)
 
 
 def load_texts(files: Mapping[str, str], source: str = "<upload>") -> Mechanism:
