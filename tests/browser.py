@@ -11,6 +11,8 @@ watched the same way.
 
 from __future__ import annotations
 
+import base64
+import io
 import json
 import os
 import re
@@ -21,6 +23,8 @@ import time
 from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
+
+import numpy as np
 
 #: The schemes of URLs that stay inside the browser.
 LOCAL_SCHEMES = ("data", "blob", "about", "chrome", "devtools")
@@ -157,6 +161,13 @@ class OfflineBrowser:
             if value or time.monotonic() > deadline:
                 return value
             time.sleep(0.05)
+
+    def screenshot(self) -> np.ndarray:
+        """The page as it shows now: an (height, width, 3) RGB array in [0, 1]."""
+        import matplotlib.image as mimage
+
+        png = base64.b64decode(self.call("Page.captureScreenshot", format="png")["data"])
+        return mimage.imread(io.BytesIO(png), format="png")[..., :3]
 
     def settle(self, quiet: float = 0.25, timeout: float = 10.0) -> None:
         """Record events until no request is pending and none was sent or answered for ``quiet`` seconds (at most
