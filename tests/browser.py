@@ -192,8 +192,8 @@ class OfflineBrowser:
         return [u for u in self.requests if leaves_the_machine(u)]
 
     def close(self) -> None:
-        """Chromium stopped: asked (SIGTERM: it ends its renderers and lets go of its profile folder), killed with
-        the processes it started if it takes over 10 s."""
+        """Chromium stopped: asked (SIGTERM: it ends its renderers and lets go of its profile folder), then killed
+        with every process it started that is left."""
         try:
             self._connection.__exit__(None, None, None)
         finally:
@@ -204,5 +204,16 @@ class OfflineBrowser:
         try:
             self.proc.wait(timeout=10)
         except subprocess.TimeoutExpired:
-            os.killpg(self.proc.pid, signal.SIGKILL)  # (its own process group: start_new_session)
-            self.proc.wait(timeout=30)
+            pass
+        # Its helpers (network service, renderers) can outlive it and still write its profile folder (a CI run's
+        # temporary folder failed to go: 'Cache_Data' not empty): the whole group (its own: start_new_session) is
+        # killed, and awaited until none is left (5 s at most: a zombie an unreaping init keeps stays in the group).
+        deadline = time.monotonic() + 5
+        while time.monotonic() < deadline:
+            try:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                break
+            if self.proc.poll() is None:
+                self.proc.wait(timeout=30)
+            time.sleep(0.05)

@@ -106,7 +106,8 @@ def check(site: Path, chromium: str, timeout: float = 30.0, jobs: int = 1) -> tu
     results: dict[str, tuple[list[str], dict]] = {}
 
     def work(share: list[str]) -> None:
-        with tempfile.TemporaryDirectory() as folder, OfflineBrowser(chromium, Path(folder), cache=True) as browser:
+        with (tempfile.TemporaryDirectory(ignore_cleanup_errors=True) as folder,
+              OfflineBrowser(chromium, Path(folder), cache=True) as browser):
             for page in share:
                 results[page] = _visit(browser, base + page, page or "/", timeout)
 
