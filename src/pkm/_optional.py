@@ -11,6 +11,8 @@ kernels, previews); the rest is behind extras, named in ``pyproject.toml``'s ``[
     pip install "pkm[identify]"  # identification's physically consistent estimate: cvxpy with Clarabel
     pip install "pkm[serve]"     # the service (pkm serve) and its client: FastAPI, uvicorn, msgpack, httpx, offline docs
     pip install "pkm[jax]"       # the twin's kernels as JAX functions (jit, vmap, grad; GPU): JAX
+    pip install "pkm[warp]"      # transmission kernels on NVIDIA Warp (CPU, or a GPU where there is one)
+    pip install "pkm[plan]"      # time-optimal motion (pkm.time_optimal, pkm plan): toppra
     pip install "pkm[all]"       # all of them
 
 An extra is checked at the point of use, never at ``import pkm``: :func:`require` raises
@@ -38,6 +40,8 @@ EXTRAS: dict[str, dict[str, str]] = {
               "msgpack": "msgpack", "httpx": "httpx", "websockets": "websockets", "pydantic": "pydantic",
               "fastapi_offline": "fastapi-offline"},
     "jax": {"jax": "jax"},
+    "warp": {"warp": "warp-lang"},
+    "plan": {"toppra": "toppra"},
 }
 
 
