@@ -154,3 +154,15 @@ def test_every_answer_matches_its_published_schema(service, openapi):
                               for code in ("200", "201", "202"))}
     # (every operation answering JSON checked, but the sweep: its answer is checked in test_a_sweep_job_is_pkm_sweep)
     assert json_operations - {op for op, _ in check.seen} == {"job_sweep"}
+
+
+def test_the_token_is_a_declared_bearer_scheme(openapi, service):
+    """A service with a token declares the bearer scheme on every operation but ``/`` and ``/health`` (Swagger UI's
+    Authorize then sends the header); the declared operations refuse a request without it, the exempt ones do not."""
+    assert openapi["components"]["securitySchemes"]["bearer"] == {
+        "type": "http", "scheme": "bearer", "description": "the token `pkm serve --token` was given"}
+    for path, item in openapi["paths"].items():
+        for op in item.values():
+            assert op["security"] == ([] if path in ("/", "/health") else [{"bearer": []}]), path
+    assert httpx.get(service.url + "/health").status_code == 200
+    assert httpx.get(service.url + "/models").status_code == 401

@@ -455,6 +455,12 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
             components["Upload"] = {"type": "object", "required": ["files"], "properties": {"files": {
                 "type": "array", "items": {"type": "string", "format": "binary"},
                 "description": "A model's files (URDF, MJCF, SDF, YAML, a closures TOML...) or one zip or tar of them"}}}
+            if token is not None:  # (the bearer scheme: Swagger UI's Authorize button then adds the header)
+                schema["components"]["securitySchemes"] = {"bearer": {
+                    "type": "http", "scheme": "bearer", "description": "the token `pkm serve --token` was given"}}
+                for route, operations in schema.get("paths", {}).items():
+                    for operation in operations.values():
+                        operation["security"] = [] if route in ("/", "/health") else [{"bearer": []}]
         return app.openapi_schema or {}
 
     app.openapi = openapi  # type: ignore[method-assign]

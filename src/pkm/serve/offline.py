@@ -13,8 +13,9 @@ blocked).
 With a token (``pkm serve --token``), the pages are behind it like every route but ``/`` and ``/health``: a browser
 opens ``/docs?token=<token>`` (the service takes ``?token=`` on a GET), and the page passes the token it was opened
 with on to what it loads (the static files and ``/openapi.json``), so that no route has to be exempted from the
-token: the service shows nothing, not even its schema, to a client without it. (Swagger UI's "Try it out" on a POST
-route still needs the ``Authorization: Bearer`` header, which a browser page does not add by itself.)
+token: the service shows nothing, not even its schema, to a client without it. Swagger UI's "Try it out" sends the
+``Authorization: Bearer`` header once the token is given to its Authorize button (the schema declares the bearer
+scheme on every operation but ``/`` and ``/health`` when the service has a token).
 """
 
 # (no ``from __future__ import annotations``: FastAPI reads the routes' annotations)
