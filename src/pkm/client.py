@@ -141,19 +141,14 @@ class Client:
         return self._answer(self._http.get(f"/jobs/{job_id}"))
 
     def result(self, job_id: str, *, wait: float = 600.0) -> dict:
-        """A job's result, waiting up to ``wait`` seconds for it to finish (:class:`ServiceError` if it failed)."""
+        """A job's result, waiting up to ``wait`` seconds for it to finish: the service's :class:`ServiceError` if
+        it failed (422 with the job's own error, 500 on a defect), was cancelled (410) or is still running (409)."""
         import time
 
         deadline = time.monotonic() + wait
-        while True:
-            state = self.job_state(job_id)
-            if state["state"] == "done":
-                return self._answer(self._http.get(f"/jobs/{job_id}/result"))["result"]
-            if state["state"] in ("failed", "cancelled") or time.monotonic() > deadline:
-                error = state.get("error") or {}
-                raise ServiceError(409, str(error.get("error", state["state"])), str(error.get("message", "")),
-                                   state)
+        while self.job_state(job_id)["state"] in ("queued", "running") and time.monotonic() < deadline:
             time.sleep(0.05)
+        return self._answer(self._http.get(f"/jobs/{job_id}/result"))["result"]
 
     def cancel(self, job_id: str) -> dict:
         return self._answer(self._http.delete(f"/jobs/{job_id}"))

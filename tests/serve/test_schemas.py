@@ -89,7 +89,7 @@ def test_the_check_sees_a_drift(openapi):
 
 def test_every_answer_matches_its_published_schema(service, openapi):
     """Every operation answering JSON, each query as one sample and as a batch with a failed sample, the errors (404,
-    409, 422): validated against /openapi.json."""
+    409, 422, a failed job's 422, a cancelled job's 410): validated against /openapi.json."""
     check = Checker(openapi)
     url = service.url
 
@@ -138,6 +138,9 @@ def test_every_answer_matches_its_published_schema(service, openapi):
     started["job_assembly_modes"] = call("job_assembly_modes", "/models/rrr3/jobs/assembly_modes", status=202,
                                          json={"qa": qa_rrr3})
     call("job_map", "/models/delta/jobs/map", status=422, json={"axes": {"x": [0, 1, 3]}, "what": 1})
+    late = call("job_working_modes", "/models/delta/jobs/working_modes", status=202, json={"y": [0.0, 0.0, -0.35]})
+    assert call("cancel_job", f"/jobs/{late['id']}", method="delete")["state"] == "cancelled"  # (queued: one worker)
+    call("job_result", f"/jobs/{late['id']}/result", method="get", status=410)
     for job in started.values():
         for _ in range(1200):
             state = call("job_state", f"/jobs/{job['id']}", method="get")
@@ -146,6 +149,11 @@ def test_every_answer_matches_its_published_schema(service, openapi):
             time.sleep(0.05)
         assert state["state"] == "done", state
         call("job_result", f"/jobs/{job['id']}/result", method="get")
+    bad = call("job_working_modes", "/models/delta/jobs/working_modes", status=202, json={"y": [1.0, 2.0]})
+    while call("job_state", f"/jobs/{bad['id']}", method="get")["state"] in ("queued", "running"):
+        time.sleep(0.05)
+    failed = call("job_result", f"/jobs/{bad['id']}/result", method="get", status=422)  # (the job's own error)
+    assert failed["error"] == "InvalidInputError" and failed["data"]["state"] == "failed"
     call("list_jobs", "/jobs", method="get")
     call("cancel_job", f"/jobs/{started['job_map']['id']}", method="delete")
     call("job_state", "/jobs/nope", method="get", status=404)

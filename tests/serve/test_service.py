@@ -280,7 +280,8 @@ def test_jobs_run_apart_and_give_json_and_parquet(client, service, delta):
     bad = client.job("delta", "working_modes", y=[1.0, 2.0])  # (a wrong size: the job fails, with the message)
     with pytest.raises(ServiceError) as e:
         client.result(bad["id"])
-    assert e.value.kind == "InvalidInputError" and "y" in e.value.message
+    assert e.value.status == 422 and e.value.kind == "InvalidInputError" and "y" in e.value.message
+    assert e.value.data["state"] == "failed"  # (the job's summary rides along)
     assert client.cancel(bad["id"])["state"] == "failed"  # (a finished job: forgotten)
     with pytest.raises(ServiceError) as e:
         client.job("delta", "teleport")

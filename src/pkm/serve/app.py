@@ -392,11 +392,17 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
 
     @app.get("/jobs/{job_id}/result", response_model=schemas.JobResult, tags=["jobs"], operation_id="job_result",
              responses={404: errors[404], 409: {"model": schemas.ErrorAnswer, "description": "Not finished yet"},
+                        410: {"model": schemas.ErrorAnswer, "description": "Cancelled: there will be no result"},
+                        422: {"model": schemas.ErrorAnswer, "description": "Failed: the job's own error"},
                         200: {"content": {"application/vnd.apache.parquet": {}}}})
     async def job_result(request: Request, job_id: str, format: Literal["json", "parquet"] = "json") -> Response:
         from pkm.serve.jobs import parquet
 
         job = jobs.get(job_id)
+        if job.state == "failed" and job.error is not None:  # (its own error, as the query would have answered it)
+            return _error(500 if job.defect else 422, job.error["error"], job.error["message"], job.summary())
+        if job.state == "cancelled":
+            return _error(410, "Cancelled", f"job {job_id} was cancelled: it has no result", job.summary())
         if job.state != "done" or job.result is None or job.rows is None:
             return _error(409, "NotReady", f"job {job_id} is {job.state}", job.summary())
         if format == "parquet":

@@ -46,6 +46,7 @@ class Job:
     finished: float | None = None
     cancel: threading.Event = field(default_factory=threading.Event, repr=False)
     future: Future | None = field(default=None, repr=False)
+    defect: bool = field(default=False, repr=False)  # (failed on an unexpected exception, not on a PkmError)
 
     def summary(self) -> dict[str, Any]:
         return {"id": self.id, "kind": self.kind, "model": self.model, "state": self.state,
@@ -192,6 +193,7 @@ class JobManager:
                 job.state, job.error = "failed", {"error": type(e).__name__, "message": str(e)}
             except Exception as e:  # (a defect: reported on the job, the service goes on)
                 job.state, job.error = "failed", {"error": type(e).__name__, "message": f"unexpected: {e}"}
+                job.defect = True
             else:
                 if job.cancel.is_set():
                     job.state = "cancelled"
