@@ -8,7 +8,10 @@
 * ``"gepetto"`` (``.yaml``, ``.yml``): URDF + YAML in the convention of Gepetto's toolbox-parallel-robots
   (:mod:`pkm.core.formats.to_gepetto`), the URDF beside the YAML (``<stem>.urdf``);
 * ``"urdfplus"`` (``.urdf``): MIT's URDF+, loops as ``<loop>`` elements in the URDF
-  (:mod:`pkm.core.formats.to_urdfplus`).
+  (:mod:`pkm.core.formats.to_urdfplus`);
+* ``"sdf"`` (``.sdf``): SDFormat 1.11, loops as cut joints, posed at the reference configuration
+  (:mod:`pkm.core.formats.to_sdf`), with a closure spec beside it (``<stem>.closures.toml``: the actuated joints,
+  the task, the drives, which SDFormat does not say): the spec is the main file, the one :func:`pkm.load` takes.
 
 A path without a suffix, with ``to`` given, is a folder: the files go in it (``<mechanism>.closures.toml``,
 ``<mechanism>.xml``, ``robot.yaml``). Each writer returns what it wrote and what its format cannot hold
@@ -98,6 +101,18 @@ def _write_gepetto(mech: Mechanism, files: tuple[Path, ...]) -> Written:
     return Written((path, urdf_path), dropped, "gepetto")
 
 
+def _write_sdf(mech: Mechanism, files: tuple[Path, ...]) -> Written:
+    from pkm.core.formats.to_sdf import sdf_from_mechanism, sdf_spec
+
+    path, spec_path = files
+    text, dropped = sdf_from_mechanism(mech)
+    spec = sdf_spec(mech, path.name).to_toml()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text, encoding="utf-8")
+    spec_path.write_text(spec, encoding="utf-8")
+    return Written((spec_path, path), dropped, "sdf")
+
+
 def _write_urdfplus(mech: Mechanism, files: tuple[Path, ...]) -> Written:
     from pkm.core.formats.to_urdfplus import urdfplus_from_mechanism
 
@@ -116,6 +131,8 @@ WRITERS: dict[str, Writer] = {w.name: w for w in (
     Writer("gepetto", (".yaml", ".yml"), "Gepetto's URDF + YAML (toolbox-parallel-robots)", _write_gepetto,
            lambda p: p.with_suffix(".urdf")),
     Writer("urdfplus", (".urdf",), "MIT's URDF+ (loops as <loop> elements)", _write_urdfplus),
+    Writer("sdf", (".sdf",), "SDFormat (loops as cut joints) + pkm's closure spec", _write_sdf,
+           lambda p: p.with_name(f"{p.name.removesuffix(p.suffix)}.closures.toml")),
 )}
 
 
