@@ -258,11 +258,10 @@ def save(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) -
 
     Raises:
         InvalidInputError: not a Mechanism, a bad path, a suffix no writer takes (the message lists the formats and
-            their suffixes), or, for pkm's spec, a mechanism built from a Pinocchio model without URDF text (nothing
-            to write).
+            their suffixes).
         UnknownNameError: ``to`` is not one of ``"pkm"``, ``"mjcf"``, ``"gepetto"``, ``"urdfplus"``, ``"sdf"``.
-        SpecError: the format cannot hold something the mechanism needs (named in the message; for Gepetto's and
-            URDF+'s, a mechanism without URDF text too).
+        SpecError: the format cannot hold something the mechanism needs (named in the message, with the file; for
+            pkm's spec, Gepetto's and URDF+, a mechanism without URDF text too).
 
     Examples:
         >>> import tempfile

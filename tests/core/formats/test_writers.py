@@ -124,3 +124,22 @@ def test_a_path_names_its_format_or_is_refused_listing_the_known_ones(tmp_path):
     (tmp_path / "plain").write_text("")
     with pytest.raises(SpecError, match=r"plain/x\.xml: cannot write"):
         write(_mech("fivebar"), tmp_path / "plain" / "x.xml")
+
+
+def test_a_mechanism_without_urdf_text_is_one_error_type_for_every_writer(tmp_path):
+    """A Mechanism built from a pinocchio.Model has no URDF text: pkm's spec, Gepetto's format and URDF+ (which carry
+    the URDF) refuse it with a SpecError naming the file (writers' module doc: one rule); MJCF and SDF write it from the
+    model, and it reads back closed at the original's states (1e-12)."""
+    mech = _mech("fivebar")
+    bare = pkm.Mechanism(mech.model, mech.spec, source="bare")
+    assert bare.urdf is None
+    for to in ("pkm", "gepetto", "urdfplus"):
+        path = tmp_path / f"bare{WRITERS[to].suffixes[0]}"
+        with pytest.raises(SpecError, match=rf"{path.name}: .*no URDF"):
+            write(bare, path)
+    q = pkm.close_loops(mech, mech.actuated_q(mech.q_reference) + 0.01).q
+    for to in ("mjcf", "sdf"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PkmWarning)
+            back = pkm.load(pkm.save(bare, tmp_path / to, to=to))
+        assert np.abs(constraints.residual(back, _moved(mech, back, q))).max() <= 1e-12, to

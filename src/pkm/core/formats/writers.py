@@ -14,7 +14,13 @@
   the task, the drives, which SDFormat does not say): the spec is the main file, the one :func:`pkm.load` takes.
 
 A path without a suffix, with ``to`` given, is a folder: the files go in it (``<mechanism>.closures.toml``,
-``<mechanism>.xml``, ``robot.yaml``). Each writer returns what it wrote and what its format cannot hold
+``<mechanism>.xml``, ``robot.yaml``).
+
+Errors follow one rule: what is wrong with the arguments (a path or ``to`` naming no format, not a
+:class:`~pkm.core.Mechanism`) is an :class:`~pkm.errors.InvalidInputError` (an :class:`~pkm.errors.UnknownNameError`
+for ``to``); what the mechanism cannot be written as (a joint or a floating base the format has no element for, no URDF
+text for a format that carries the URDF: pkm's spec, Gepetto's and URDF+) is a :class:`~pkm.errors.SpecError` naming
+the file it was to go in, whatever the writer; so is a file that cannot be written. Each writer returns what it wrote and what its format cannot hold
 (:class:`Written`); the latter is also written as comments where the format has them (YAML) and is never silent:
 :func:`pkm.save` warns with it, ``pkm convert`` prints it.
 """
@@ -62,9 +68,9 @@ class Writer:
 
 
 def _urdf_text(mech: Mechanism, what: str) -> str:
-    if mech.urdf is None:
-        raise InvalidInputError("mech", f"it was built from a Pinocchio model, not URDF text: no URDF to write ({what})",
-                                mech.source)
+    if mech.urdf is None:  # (what the mechanism lacks for this format: a SpecError, as every writer's, module doc)
+        raise SpecError(mech.source, f"built from a Pinocchio model, not URDF text: no URDF to write ({what}); "
+                                     "SDF and MJCF are written from the model")
     return mech.urdf
 
 
@@ -188,7 +194,8 @@ def write(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) 
     Raises:
         UnknownNameError, InvalidInputError: see :func:`target`; not a Mechanism.
         SpecError: the format cannot hold something the mechanism needs (a joint MJCF has no kind for, a floating
-            base in Gepetto's format): the message names the file and the joint; a file that cannot be written.
+            base in Gepetto's format, no URDF text for pkm's spec, Gepetto's or URDF+): the message names the file
+            and what; a file that cannot be written (module doc).
     """
     mech = check_mechanism(mech)
     writer, files = destination(mech, path, to)
