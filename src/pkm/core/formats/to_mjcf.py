@@ -101,18 +101,24 @@ def body_names(mech: Mechanism) -> list[str]:
     return ["world"] + [f"{mech.model.names[j]}_body" for j in range(1, mech.model.njoints)]
 
 
+def joint_axis(jm: pin.JointModel) -> tuple[bool, np.ndarray]:
+    """``(revolute, axis)`` of a one-coordinate Pinocchio joint (revolute or prismatic, aligned or not; a mimic
+    joint's own motion): its motion subspace's angular part, or its linear part, in the joint frame."""
+    jd = jm.createData()
+    jm.calc(jd, np.zeros(max(jm.idx_q + jm.nq, jm.idx_q + 1)))  # S does not depend on q for these
+    S = np.asarray(jd.S, dtype=float).reshape(6, -1)[:, 0]
+    if jm.shortname() == "JointModelMimic":
+        S = S / float(jm.extract().scaling)
+    revolute = bool(np.abs(S[3:]).max() > 0)
+    return revolute, S[3:] if revolute else S[:3]
+
+
 def _joints(el: etree._Element, jm: pin.JointModel, name: str, source: str) -> list[str]:
     """The MJCF joint elements of one Pinocchio joint; returns their names."""
     kind = jm.shortname().removeprefix("JointModel")
     if kind == "Mimic" or kind in _REVOLUTE or kind in _PRISMATIC or kind.endswith("Unaligned"):
-        jd = jm.createData()
-        jm.calc(jd, np.zeros(max(jm.idx_q + jm.nq, jm.idx_q + 1)))  # S does not depend on q for these
-        S = np.asarray(jd.S, dtype=float).reshape(6, -1)[:, 0]
-        if kind == "Mimic":
-            S = S / float(jm.extract().scaling)
-        revolute = np.abs(S[3:]).max() > 0
-        etree.SubElement(el, "joint", name=name, type="hinge" if revolute else "slide",
-                         axis=_num(S[3:] if revolute else S[:3]))
+        revolute, axis = joint_axis(jm)
+        etree.SubElement(el, "joint", name=name, type="hinge" if revolute else "slide", axis=_num(axis))
         return [name]
     if kind == "Universal":
         u = jm.extract()
@@ -166,7 +172,7 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
                 body.find(f"joint[@name='{name}']").set("range", _num(mech.limits[model.names[j]]))
         if jm.shortname() == "JointModelMimic":
             mimic = jm.extract()
-            leader = model.names[_leader(model, j)]
+            leader = model.names[mimic_leader(model, j)]
             etree.SubElement(equality, "joint", joint1=model.names[j], joint2=leader,
                              polycoef=_num([mimic.offset, mimic.scaling, 0, 0, 0]), solref=_num(solref),
                              solimp=_num(solimp))
@@ -292,8 +298,8 @@ def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
     return tuple(out)
 
 
-def _leader(model: pin.Model, j: int) -> int:
-    """The joint a mimic joint follows: the one whose coordinates it reads."""
+def mimic_leader(model: pin.Model, j: int) -> int:
+    """The joint a mimic joint ``j`` follows: the one whose coordinates it reads."""
     idx_q = model.joints[j].idx_q
     for k in range(1, model.njoints):
         if k != j and model.joints[k].shortname() != "JointModelMimic" and model.joints[k].idx_q == idx_q:
@@ -301,5 +307,5 @@ def _leader(model: pin.Model, j: int) -> int:
     raise SpecError(model.name, f"mimic joint {model.names[j]!r}: no leader found")
 
 
-__all__ = ["DAMPRATIO", "MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "TORQUESCALE", "body_names", "closure_softness", "mjcf_from_mechanism",
-           "mjcf_omissions", "mjcf_qpos"]
+__all__ = ["DAMPRATIO", "MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "TORQUESCALE", "body_names", "closure_softness",
+           "joint_axis", "mimic_leader", "mjcf_from_mechanism", "mjcf_omissions", "mjcf_qpos"]

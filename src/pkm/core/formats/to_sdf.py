@@ -43,6 +43,7 @@ import numpy as np
 import pinocchio as pin
 from lxml import etree
 
+from pkm.core.formats.to_mjcf import joint_axis, mimic_leader
 from pkm.core.model.actuators import NUMBERS
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.spec import ClosureSpec
@@ -67,19 +68,6 @@ def _pose(parent: etree._Element, M: pin.SE3) -> None:
     _text(parent, "pose", _num([*M.translation, *pin.rpy.matrixToRpy(M.rotation)]))
 
 
-def _axis(jm: pin.JointModel) -> tuple[bool, np.ndarray]:
-    """``(revolute, unit axis in the joint frame)`` of a one-coordinate joint (a mimic joint's own)."""
-    kind = jm.shortname().removeprefix("JointModel")
-    jd = jm.createData()
-    jm.calc(jd, np.zeros(max(jm.idx_q + jm.nq, jm.idx_q + 1)))  # S does not depend on q for these
-    S = np.asarray(jd.S, dtype=float).reshape(6, -1)[:, 0]
-    if kind == "Mimic":
-        S = S / float(jm.extract().scaling)
-    revolute = bool(np.abs(S[3:]).max() > 0)
-    a = S[3:] if revolute else S[:3]
-    return revolute, a / np.linalg.norm(a)
-
-
 def _closed(mech: Mechanism) -> np.ndarray:
     """The reference configuration, its loops closed to the last bit where the solver gets there (the file's poses
     place each cut joint's two frames at one point: the residual left in the reference, 1e-13 on some, would move
@@ -89,12 +77,6 @@ def _closed(mech: Mechanism) -> np.ndarray:
     polished = close_loops(mech, mech.actuated_q(mech.q_reference), mech.q_reference, tol=1e-15,
                            raise_on_failure=False)
     return polished.q if polished.converged else mech.q_reference
-
-
-def _leader(model: pin.Model, j: int) -> int:
-    idx_q = model.joints[j].idx_q
-    return next(k for k in range(1, model.njoints)
-                if k != j and model.joints[k].shortname() != "JointModelMimic" and model.joints[k].idx_q == idx_q)
 
 
 def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
@@ -183,7 +165,8 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
                         "PrismaticUnaligned", "RevoluteUnboundedUnaligned", "Mimic"):
             raise SpecError(source, f"joint {jname!r}: SDFormat has no {jm.shortname()} (pkm writes revolute, "
                                     "continuous, prismatic, ball, universal, free-flyer and mimic joints)")
-        revolute, axis = _axis(jm)
+        revolute, axis = joint_axis(jm)
+        axis = axis / np.linalg.norm(axis)
         if kind == "Mimic":
             mimic = jm.extract()
             value = float(mimic.offset + mimic.scaling * q[jm.idx_q])
@@ -196,7 +179,7 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
         jel = _joint(jname, sdf_kind, parent, lname, repr(value), axis,
                      mech.limits.get(jname) if sdf_kind != "continuous" else None, value)
         if kind == "Mimic":
-            m = etree.SubElement(jel.find("axis"), "mimic", joint=model.names[_leader(model, j)], axis="axis")
+            m = etree.SubElement(jel.find("axis"), "mimic", joint=model.names[mimic_leader(model, j)], axis="axis")
             _text(m, "multiplier", repr(float(jm.extract().scaling)))
             _text(m, "offset", "0.0")
             _text(m, "reference", "0.0")
@@ -204,8 +187,10 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
     for a in mech.actuators:  # SDFormat's own drive fields, for other readers (the spec beside has the whole drive)
         jel = next(el for el in joints if el.get("name") == a.joint)
         limit = jel.find("axis/limit")
-        if limit is None:
+        if limit is None:  # (SDFormat's own "no limit")
             limit = etree.SubElement(jel.find("axis"), "limit")
+            _text(limit, "lower", "-1e16")
+            _text(limit, "upper", "1e16")
         for key, value in (("effort", a.effort_limit), ("velocity", a.velocity_limit)):
             if np.isfinite(value):
                 _text(limit, key, repr(value))
