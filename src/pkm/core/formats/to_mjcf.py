@@ -39,7 +39,7 @@ its stability bounds ``k dt^2`` whatever the masses. So each of the four factors
   frames (the angular residual is zero exactly where it was); MuJoCo's ``efc_pos`` on those rows is 10 times the
   angle.
 
-Held at rest under gravity (0.5 s at 1 ms, ``tests/core/formats/test_to_mjcf.py``), every mechanism of the round-trip
+Held at rest under gravity (0.1 s or 0.5 s at 1 ms, ``tests/core/formats/test_to_mjcf.py``), every mechanism of the round-trip
 matrix stays closed within 2.7e-7 (the hexapod's mimic equalities on its massless knees [rad]; 1.2e-9 m for the
 Delta), Gepetto's battobot within 4.6e-8 (from 1.8e-5 with ``(2 dt, 1)`` and no torquescale). A heavier load on a
 lighter link still opens more: write a smaller ``timestep`` (the sag goes as its square).
