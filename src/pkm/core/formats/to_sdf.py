@@ -69,14 +69,16 @@ def _pose(parent: etree._Element, M: pin.SE3) -> None:
 
 
 def _closed(mech: Mechanism) -> np.ndarray:
-    """The reference configuration, its loops closed to the last bit where the solver gets there (the file's poses
-    place each cut joint's two frames at one point: the residual left in the reference, 1e-13 on some, would move
-    them apart by as much)."""
+    """The reference configuration, its loops closed to the last bit where the solver gets there from it within
+    1e-9 (the file's poses place each cut joint's two frames at one point: the residual left in the reference, 5e-13
+    on the acceptance set's 3-RPR, would move them apart by as much; the polish moves it by 2.5e-12 there), else the
+    reference itself."""
     from pkm.core.kinematics.solve import close_loops
 
-    polished = close_loops(mech, mech.actuated_q(mech.q_reference), mech.q_reference, tol=1e-15,
-                           raise_on_failure=False)
-    return polished.q if polished.converged else mech.q_reference
+    q = mech.q_reference
+    polished = close_loops(mech, mech.actuated_q(q), q, tol=1e-15, raise_on_failure=False)
+    near = polished.converged and float(np.abs(pin.difference(mech.model, q, polished.q)).max(initial=0.0)) <= 1e-9
+    return polished.q if near else q
 
 
 def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
