@@ -210,7 +210,13 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
         cut.find("pose").text = _num([*model.frames[fb].placement.translation,
                                       *pin.rpy.matrixToRpy(model.frames[fb].placement.rotation)])
         sdf_model.append(cut)
-    skip = primary | cut_frames | names | set(links)  # (the links' and joints' names, the cut joints' frames)
+    cuts = {c.name for c in spec.closures}
+    needed = {spec.end_effector, *spec.task.frames} - {None} - names
+    clash = sorted(needed & (cuts | cut_frames))
+    if clash:
+        raise SpecError(source, f"frame {clash[0]!r} (the task's) has the name of a closure, or of the frame pkm's "
+                                "reader makes for one: SDFormat's joints and frames share their names; rename it")
+    skip = primary | cut_frames | names | set(links) | cuts  # (SDFormat: one name per link, joint or frame)
     for f in model.frames[1:]:
         if f.type not in (pin.FrameType.BODY, pin.FrameType.OP_FRAME) or f.name in skip:
             continue
