@@ -25,14 +25,15 @@ zero back where it was and adds it to the limits, so the mechanism reads back wi
   link of its second (``<child>``), at the second frame; a ``frame`` closure: a cut ``fixed`` joint. pkm's reader
   makes of each the closure of that name and type between frames ``<closure>_parent`` and ``<closure>_child``;
 * every other body and operational frame of the model as a ``<frame attached_to>`` (the end effector, the task frames,
-  the closures' own frames), but those whose names the reader takes for the cut joints' frames;
+  the closures' own frames), but those named as a closure (SDFormat gives links, joints and frames one namespace)
+  or as the frames the reader makes for the cut joints;
 * inertias as ``<inertial>`` (a massless body with ``<mass>0</mass>``: SDFormat's default inertial is 1 kg);
   actuated joints' effort and speed limits and friction as ``<limit><effort><velocity>`` and ``<dynamics>`` (their
   whole drives are in the spec beside).
 
 Refused by name (:class:`~pkm.errors.SpecError`): planar and other composite joints, a floating base (the spec's
 ``floating_base``: pkm's SDF reader fixes the base), an actuated or task universal joint, a closure whose two
-frames are on one body.
+frames are on one body, a task frame named as a closure.
 """
 
 from __future__ import annotations
@@ -229,7 +230,8 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
     dropped = []
     if spec.closures:
         dropped.append("the closures' frames: read back as <closure>_parent, <closure>_child, at the same places (the "
-                       "original frames are kept as <frame>s)")
+                       "original frames are kept as <frame>s, but those named as a closure: SDFormat's joints and frames share "
+                       "names)")
     if universals:
         dropped.append(f"universal joints {universals}: written as two revolute joints <name>__1, <name>__2 through a "
                        "massless link <name>__cross (read back as two revolute joints of those names)")
