@@ -126,7 +126,8 @@ def compare(case: str, writer: str) -> dict[str, float]:
     mimic = {n for n, j in src.joints.items() if src.model.joints[j.id].shortname() == "JointModelMimic"}
     limits = {p: v for n, v in src.limits.items() for p in names.get(n, [n]) if writer != "mjcf" or n not in mimic}
     assert dst.limits.keys() == limits.keys(), case  # (SDF writes them from the reference: to 1 ulp)
-    assert all(np.abs(np.subtract(dst.limits[n], v)).max() <= TOL * max(1.0, np.abs(v).max()) for n, v in limits.items())
+    assert all(np.abs(np.subtract(dst.limits[n], v)).max() <= TOL * max(1.0, np.abs(v).max())
+               for n, v in limits.items()), case
     assert sorted(dst.actuated_names) == sorted(src.actuated_names), case
     order = [dst.actuated_names.index(n) for n in src.actuated_names]  # dst's index of each of src's actuators
     if writer == "gepetto" and dst.actuated_names != src.actuated_names:  # (the writer says the order it reads back)
@@ -190,6 +191,7 @@ def test_every_writer_then_load_gives_the_same_mechanism(writer):
         light = any(original(case).model.inertias[j].mass < MIN_MASS for j in range(1, original(case).model.njoints))
         dynamic = MASSLESS if writer == "mjcf" and light else TOL
         rates = ROUNDED if writer in REWRITTEN else TOL
-        assert err["residual"] <= TOL and err["placements"] <= TOL and err["G"] <= rates and err["J"] <= TOL, (case, err)
+        assert err["residual"] <= TOL and err["placements"] <= TOL and err["G"] <= rates and err["J"] <= TOL, \
+            (case, err)
         assert err["tau"] <= dynamic and err["M_a"] <= dynamic, (case, err)
     print(writer, {k: f"{v:.1e}" for k, v in worst.items()})

@@ -174,11 +174,11 @@ def _held_at_rest(mech: pkm.Mechanism, duration: float = 1.0, softness=None) -> 
 @pytest.mark.skipif(unavailable() is not None, reason="MuJoCo is a benchmark-only dependency")
 def test_written_loops_hold_at_rest_under_gravity():
     """The written closures are stiff (module doc of pkm.core.formats.to_mjcf: solref (2 dt, 0.5) at the written dt = 1
-    ms, solimp 0.9999, welds' torquescale 10): held at rest for 0.1 s (the same worst as over 0.5 s), every mechanism of the round-trip matrix and
-    Gepetto's battobot (welds on light links) stays closed within 1e-6 m and rad (measured: 2.7e-7 on the hexapod's
-    mimic equalities, 4.6e-8 on the battobot, 2e-8 or less elsewhere; with (2 dt, 1) and no torquescale, 1.05e-6 and
-    1.8e-5); with MuJoCo's default softness (solref (0.02, 1), solimp (0.9, 0.95, ...)) the Delta's opens by 3.8e-4
-    m."""
+    ms, solimp 0.9999, welds' torquescale 10): held at rest for 0.1 s (the same worst as over 0.5 s), every mechanism
+    of the round-trip matrix and Gepetto's battobot (welds on light links) stays closed within 1e-6 m and rad
+    (measured: 2.6e-7 on the hexapod's mimic equalities, 4.6e-8 on the battobot, 2e-8 or less elsewhere; with (2 dt, 1)
+    and no torquescale, 1.05e-6 and 1.8e-5); with MuJoCo's default softness (solref (0.02, 1), solimp (0.9, 0.95,
+    ...)) the Delta's opens by 3.8e-4 m."""
     from pkm.core.formats.to_mjcf import DAMPRATIO, SOLIMP, TIMESTEP, TORQUESCALE
     from tests.core.formats.test_roundtrip import CASES, original
 

@@ -287,8 +287,8 @@ def _read_sdf(text: str, source: str) -> Imported:
     tree = {j.get("name"): j for j in parent_joint.values()}
     for j in cuts:
         if j.find(f"{_PKM}position") is not None:
-            raise SpecError(source, f"joint {j.get('name')!r}: <pkm:position> on a joint that cuts a loop (pkm writes it "
-                                    "on tree joints only)")
+            raise SpecError(source, f"joint {j.get('name')!r}: <pkm:position> on a joint that cuts a loop (pkm "
+                                    "writes it on tree joints only)")
 
     def position(j: etree._Element) -> np.ndarray:
         """The joint's ``<pkm:position>`` (its coordinate at the model's pose: 1 number, a ball's quaternion ``x y z

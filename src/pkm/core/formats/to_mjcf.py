@@ -39,9 +39,9 @@ its stability bounds ``k dt^2`` whatever the masses. So each of the four factors
   frames (the angular residual is zero exactly where it was); MuJoCo's ``efc_pos`` on those rows is 10 times the
   angle.
 
-Held at rest under gravity (0.1 s or 0.5 s at 1 ms, ``tests/core/formats/test_to_mjcf.py``), every mechanism of the round-trip
-matrix stays closed within 2.7e-7 (the hexapod's mimic equalities on its massless knees [rad]; 1.2e-9 m for the
-Delta), Gepetto's battobot within 4.6e-8 (from 1.8e-5 with ``(2 dt, 1)`` and no torquescale). A heavier load on a
+Held at rest under gravity (0.1 s or 0.5 s at 1 ms, ``tests/core/formats/test_to_mjcf.py``), every mechanism of the
+round-trip matrix stays closed within 2.7e-7 (the hexapod's mimic equalities on its massless knees [rad]; 1.2e-9 m for
+the Delta), Gepetto's battobot within 4.6e-8 (from 1.8e-5 with ``(2 dt, 1)`` and no torquescale). A heavier load on a
 lighter link still opens more: write a smaller ``timestep`` (the sag goes as its square).
 
 Each actuated joint's drive (:attr:`~pkm.core.Mechanism.actuators`, :mod:`pkm.core.model.actuators`) is written in
@@ -307,5 +307,5 @@ def mimic_leader(model: pin.Model, j: int) -> int:
     raise SpecError(model.name, f"mimic joint {model.names[j]!r}: no leader found")
 
 
-__all__ = ["DAMPRATIO", "MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "TORQUESCALE", "body_names", "closure_softness",
-           "joint_axis", "mimic_leader", "mjcf_from_mechanism", "mjcf_omissions", "mjcf_qpos"]
+__all__ = ["DAMPRATIO", "MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "TORQUESCALE", "body_names",
+           "closure_softness", "joint_axis", "mimic_leader", "mjcf_from_mechanism", "mjcf_omissions", "mjcf_qpos"]

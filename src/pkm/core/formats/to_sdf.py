@@ -212,7 +212,7 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
                                       *pin.rpy.matrixToRpy(model.frames[fb].placement.rotation)])
         sdf_model.append(cut)
     cuts = {c.name for c in spec.closures}
-    needed = {spec.end_effector, *spec.task.frames} - {None} - names
+    needed = {f for f in (spec.end_effector, *spec.task.frames) if f is not None} - names
     clash = sorted(needed & (cuts | cut_frames))
     if clash:
         raise SpecError(source, f"frame {clash[0]!r} (the task's) has the name of a closure, or of the frame pkm's "
@@ -230,8 +230,8 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
     dropped = []
     if spec.closures:
         dropped.append("the closures' frames: read back as <closure>_parent, <closure>_child, at the same places (the "
-                       "original frames are kept as <frame>s, but those named as a closure: SDFormat's joints and frames share "
-                       "names)")
+                       "original frames are kept as <frame>s, but those named as a closure: SDFormat's joints and "
+                       "frames share names)")
     if universals:
         dropped.append(f"universal joints {universals}: written as two revolute joints <name>__1, <name>__2 through a "
                        "massless link <name>__cross (read back as two revolute joints of those names)")

@@ -20,9 +20,9 @@ Errors follow one rule: what is wrong with the arguments (a path or ``to`` namin
 :class:`~pkm.core.Mechanism`) is an :class:`~pkm.errors.InvalidInputError` (an :class:`~pkm.errors.UnknownNameError`
 for ``to``); what the mechanism cannot be written as (a joint or a floating base the format has no element for, no URDF
 text for a format that carries the URDF: pkm's spec, Gepetto's and URDF+) is a :class:`~pkm.errors.SpecError` naming
-the file it was to go in, whatever the writer; so is a file that cannot be written. Each writer returns what it wrote and what its format cannot hold
-(:class:`Written`); the latter is also written as comments where the format has them (YAML) and is never silent:
-:func:`pkm.save` warns with it, ``pkm convert`` prints it.
+the file it was to go in, whatever the writer; so is a file that cannot be written. Each writer returns what it wrote
+and what its format cannot hold (:class:`Written`); the latter is also written as comments where the format has them
+(YAML) and is never silent: :func:`pkm.save` warns with it, ``pkm convert`` prints it.
 """
 
 from __future__ import annotations
