@@ -246,6 +246,8 @@ def save(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) -
     * ``.yaml`` / ``.yml`` (``to="gepetto"``): URDF + YAML in the convention of Gepetto's toolbox-parallel-robots, the
       URDF beside the YAML (:mod:`pkm.core.formats.to_gepetto`);
     * ``.urdf`` (``to="urdfplus"``): MIT's URDF+, loops as ``<loop>`` elements (:mod:`pkm.core.formats.to_urdfplus`);
+    * ``.sdf`` (``to="sdf"``): SDFormat, loops as cut joints, with a closure spec beside it (``<stem>.closures.toml``,
+      the main file: the actuated joints, the task, the drives) (:mod:`pkm.core.formats.to_sdf`);
     * a path without a suffix, with ``to``: a folder, the files in it (:mod:`pkm.core.formats.writers`).
 
     What the chosen format cannot hold (the task in MJCF and Gepetto's format, the reference configuration...) is
@@ -256,11 +258,10 @@ def save(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) -
 
     Raises:
         InvalidInputError: not a Mechanism, a bad path, a suffix no writer takes (the message lists the formats and
-            their suffixes), or, for pkm's spec, a mechanism built from a Pinocchio model without URDF text (nothing
-            to write).
-        UnknownNameError: ``to`` is not one of ``"pkm"``, ``"mjcf"``, ``"gepetto"``, ``"urdfplus"``.
-        SpecError: the format cannot hold something the mechanism needs (named in the message; for Gepetto's and
-            URDF+'s, a mechanism without URDF text too).
+            their suffixes).
+        UnknownNameError: ``to`` is not one of ``"pkm"``, ``"mjcf"``, ``"gepetto"``, ``"urdfplus"``, ``"sdf"``.
+        SpecError: the format cannot hold something the mechanism needs (named in the message, with the file; for
+            pkm's spec, Gepetto's and URDF+, a mechanism without URDF text too).
 
     Examples:
         >>> import tempfile

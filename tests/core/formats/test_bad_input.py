@@ -55,7 +55,9 @@ def test_a_file_with_another_formats_suffix_is_read_by_content_and_said_or_refus
 
 def test_a_closure_naming_a_missing_frame_names_the_file_the_element_and_the_line(tmp_path):
     """MJCF: a connect's or weld's body (its line), a site equality's site (its line); pkm's spec and Gepetto's YAML:
-    the frame and the closure (TOML and YAML parsers give no lines); each a SpecNameError with the valid names."""
+    the frame, the closure and the line where the frame's name is written (YAML: PyYAML's composer's; TOML, whose
+    parser gives no positions: the one line where the name stands quoted; none when it stands on several), also in an
+    upload (load_texts); each a SpecNameError with the valid names."""
     cases = (("body2.xml", 'body2="rocker"', 'body2="rockr"', r"body 'rockr' does not exist in \S+body2\.xml "
               r"\(<equality><connect name='pin_c'> \(line 28\) body2\); did you mean 'rocker'"),
              ("weld.xml", CONNECT, '<weld name="w" body1="couplr" body2="rocker"/>',
@@ -70,14 +72,22 @@ def test_a_closure_naming_a_missing_frame_names_the_file_the_element_and_the_lin
     (tmp_path / "knee.closures.toml").write_text((EXAMPLES / "knee" / "knee.closures.toml").read_text()
                                                  .replace('frame_b = "thigh_pin"', 'frame_b = "thigh_pni"'))
     with pytest.raises(SpecNameError, match=r"frame 'thigh_pni' does not exist in \S+knee\.closures\.toml \(closure "
-                                            r"'back_pin'\); did you mean 'thigh_pin'"):
+                                            r"'back_pin', line 17\); did you mean 'thigh_pin'"):
         pkm.load(tmp_path / "knee.closures.toml")
+    from pkm.core.formats.load import load_texts
+
+    texts = {n: (tmp_path / n).read_text() for n in ("knee.urdf", "knee.closures.toml")}
+    with pytest.raises(SpecNameError, match=r"in up:knee\.closures\.toml \(closure 'back_pin', line 17\)"):
+        load_texts(texts, "up")
+    texts["knee.closures.toml"] += '# "thigh_pni" twice\n'
+    with pytest.raises(SpecNameError, match=r"in up:knee\.closures\.toml \(closure 'back_pin'\); did you mean"):
+        load_texts(texts, "up")
     (tmp_path / "g").mkdir()
     shutil.copy(EXAMPLES / "gepetto_fivebar" / "robot.urdf", tmp_path / "g" / "robot.urdf")
     (tmp_path / "g" / "robot.yaml").write_text((EXAMPLES / "gepetto_fivebar" / "robot.yaml").read_text()
                                                .replace("closedloop1_B", "closedloop1_X"))
     with pytest.raises(SpecNameError, match=r"frame 'closedloop1_X' does not exist in \S+robot\.yaml \(closure "
-                                            r"'loop1'\)"):
+                                            r"'loop1', line 2\)"):
         pkm.load(tmp_path / "g" / "robot.yaml")
 
 

@@ -95,7 +95,7 @@ def test_a_joint_one_letter_off_among_sixty_is_named_without_the_sixty(tmp_path)
     with pytest.raises(SpecNameError) as info:
         pkm.load(folder)
     assert str(info.value).endswith("joint 'ujöint_b' does not exist in " + str(folder / "robot.yaml")
-                                    + " (joint_name); did you mean 'ujoint_b'? (65 valid joints)")
+                                    + " (joint_name, line 4); did you mean 'ujoint_b'? (65 valid joints)")
     assert len(info.value.valid) == 65
 
 

@@ -143,3 +143,29 @@ def test_pkm_list_says_to_give_actuated(passive, capsys):
 
     assert main(["list", str(passive)]) != 0
     assert "no actuators named: give actuated=[...]" in capsys.readouterr().err
+
+
+def test_an_upload_takes_actuated_and_task_as_pkm_load_does(passive):
+    """load_texts (the service's uploads): the passive MJCF alone is refused without actuated=, loads with it as
+    pkm.load loads the file (same actuators, task and reference, 1e-12); a spec with ``actuated = []`` and a Gepetto
+    YAML with ``name_mot: []`` sent with their model files take them too; a bad form is an InvalidInputError."""
+    from pkm.core.formats.catalogue import catalogue_path
+    from pkm.core.formats.load import load_texts
+
+    files = {"fourbar.xml": passive.read_text()}
+    with pytest.raises(SpecError, match=r"names no actuated joint: give actuated=\[\.\.\.\]"):
+        load_texts(files)
+    mech = load_texts(files, actuated="crank_joint", task="coupler_tip:z")
+    ref = pkm.load(passive, actuated=["crank_joint"], task="coupler_tip:z")
+    assert mech.actuated_names == ref.actuated_names and mech.spec.end_effector == "coupler_tip"
+    assert mech.spec.task == ref.spec.task and np.abs(mech.q_reference - ref.q_reference).max() <= 1e-12
+    spec = 'format = "pkm.closures/1"\nmechanism = "fb"\nurdf = "fourbar.xml"\nactuated = []\n'
+    assert load_texts({**files, "fb.toml": spec}, actuated=["rocker_joint"]).actuated_names == ("rocker_joint",)
+    source = catalogue_path("gepetto:5bar_linkage")
+    pair = {"robot.urdf": (source / "robot.urdf").read_text(),
+            "robot.yaml": (source / "robot.yaml").read_text().replace("['mot1', 'mot2']", "[]")}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pkm.errors.ImplausibleModelWarning)  # (the file's 654 t spheres)
+        assert load_texts(pair, actuated=["mot1", "mot2"]).actuated_names == ("mot1", "mot2")
+    with pytest.raises(InvalidInputError, match="actuated"):
+        load_texts(files, actuated=[])

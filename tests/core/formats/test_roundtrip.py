@@ -1,18 +1,20 @@
-"""The round-trip matrix (issue 43): every writer (pkm.save: pkm's spec + URDF, MJCF, Gepetto's URDF + YAML, URDF+) followed
-by pkm.load gives the same mechanism, for every shipped mechanism (pkm.MECHANISMS), tests/fivebar, the acceptance
-set (tests/test_acceptance.py) and the other examples under examples/.
+"""The round-trip matrix (issue 43): every writer (pkm.save: pkm's spec + URDF, MJCF, Gepetto's URDF + YAML, URDF+,
+SDF + spec) followed by pkm.load gives the same mechanism, for every shipped mechanism (pkm.MECHANISMS), tests/fivebar,
+the acceptance set (tests/test_acceptance.py) and the other examples under examples/.
 
-"The same": the joint names (MJCF writes a universal joint ``u`` as two hinges ``u__1``, ``u__2`` of one body: read
+"The same": the joint names (MJCF and SDF write a universal joint ``u`` as two hinges ``u__1``, ``u__2``: read
 back as two revolute joints, the stated mapping), the limits (a universal's on both hinges; MJCF folds a mimic
-joint's range into its leader's), the actuated joints (as a set: Gepetto's YAML reads them back in the URDF's order,
-permuted here) and their drives (reflected inertia, viscous and Coulomb friction), the closure types and names (Gepetto's
-format has no names), and at three random closed states the residual of the copy (<= 1e-12), every joint's placement,
-the passive map G (joint rates from actuated rates; with the placements it gives any task's forward Jacobian), the
-forward Jacobian itself where the task survives (pkm's spec), the inverse dynamics and M_a (Gepetto's YAML and URDF+
-hold no spec drives: the copy is given the original's), all to 1e-12 (relative to the largest entry, or absolute below 1).
-One stated exception: MJCF raises a body's mass to MuJoCo's ``boundmass`` (1e-9 kg), so where the original has
-lighter (massless) bodies (the Delta, the hexapod) the efforts and M_a agree to MASSLESS (measured: 1e-9, 3e-10).
-URDF+ has no spherical or universal joint: a mechanism with ``[joint_types]`` is refused by name (:data:`REFUSED`).
+joint's range into its leader's; to 1e-12: SDF writes them from the reference), the actuated joints (as a set:
+Gepetto's YAML reads them back in the URDF's order, permuted here) and their drives (reflected inertia, viscous and
+Coulomb friction), the closure types and names (Gepetto's format has no names), and at three random closed states
+(the original's values computed once for every writer, :func:`states`) the residual of the copy (<= 1e-12), every
+joint's placement, the passive map G (joint rates from actuated rates; with the placements it gives any task's forward
+Jacobian), the forward Jacobian itself where the task survives (pkm's spec), the inverse dynamics and M_a (Gepetto's
+YAML and URDF+ hold no spec drives: the copy is given the original's), all to 1e-12 (relative to the largest entry, or
+absolute below 1). Two stated exceptions: MJCF raises a body's mass to MuJoCo's ``boundmass`` (1e-9 kg), so where the
+original has lighter (massless) bodies (the Delta, the hexapod) the efforts and M_a agree to MASSLESS (measured: 1e-9,
+3e-10); SDF's G to ROUNDED (:data:`REWRITTEN`). URDF+ has no spherical or universal joint: a mechanism with
+``[joint_types]`` is refused by name (:data:`REFUSED`).
 """
 
 from __future__ import annotations
@@ -49,6 +51,11 @@ TOL = 1e-12
 #: MJCF's massless bodies weigh 1e-9 kg (MuJoCo's boundmass): the efforts and M_a differ by about that mass times
 #: accelerations and squared lengths of a metre or so; bounded here by 1e-8 (relative).
 MASSLESS = 1e-8
+#: Writers whose files hold other numbers than the original's (SDFormat: world poses at the reference, rounded to an
+#: ulp, re-derived by the reader): there G is compared to ROUNDED. G's idle part is the least-kinetic-energy one
+#: (pkm.core.differential.idle), which a rounding of 1e-16 in the poses moves by up to 1.6e-12 on the acceptance
+#: set's RSSR (its ball joint spins idle); at most 2e-13 on every other case.
+REWRITTEN, ROUNDED = ("sdf",), 1e-11
 #: writer -> what makes it refuse a mechanism by name (a SpecError saying what), asserted for those cases.
 REFUSED = {"urdfplus": (lambda mech: bool(mech.spec.joint_types), "cannot state the joint types")}
 _TMP = Path(tempfile.mkdtemp(prefix="pkm-roundtrip-"))
@@ -118,7 +125,9 @@ def compare(case: str, writer: str) -> dict[str, float]:
     assert set(dst.joints) == expected, case
     mimic = {n for n, j in src.joints.items() if src.model.joints[j.id].shortname() == "JointModelMimic"}
     limits = {p: v for n, v in src.limits.items() for p in names.get(n, [n]) if writer != "mjcf" or n not in mimic}
-    assert dst.limits == limits, case
+    assert dst.limits.keys() == limits.keys(), case  # (SDF writes them from the reference: to 1 ulp)
+    assert all(np.abs(np.subtract(dst.limits[n], v)).max() <= TOL * max(1.0, np.abs(v).max())
+               for n, v in limits.items()), case
     assert sorted(dst.actuated_names) == sorted(src.actuated_names), case
     order = [dst.actuated_names.index(n) for n in src.actuated_names]  # dst's index of each of src's actuators
     if writer == "gepetto" and dst.actuated_names != src.actuated_names:  # (the writer says the order it reads back)
@@ -132,26 +141,34 @@ def compare(case: str, writer: str) -> dict[str, float]:
         assert [c.name for c in dst.spec.closures] == [c.name for c in src.spec.closures], case
     rows = np.concatenate([_rows(dst, p) for n in names for p in names[n]])  # the same joints' rates, in order
     src_rows = np.concatenate([_rows(src, n) for n in names])
-    rng = np.random.default_rng(43)
     err = dict.fromkeys(("residual", "placements", "G", "J", "tau", "M_a"), 0.0)
+    for q, v, a, pa, Ga, Ja, ta, Ma in states(case):
+        qb, vb, ab = _moved(src, dst, q, "q"), _moved(src, dst, v, "v"), _moved(src, dst, a, "v")
+        err["residual"] = max(err["residual"], float(np.abs(constraints.residual(dst, qb)).max(initial=0.0)))
+        pb = _placements(dst, qb)
+        ends = {n: names[n][-1] for n in names}  # a universal's frame: its second hinge's
+        err["placements"] = max(err["placements"], max(_err(pa[n], pb[ends[n]]) for n in ends))
+        err["G"] = max(err["G"], _err(Ga[src_rows], pkm.passive_map(dst, qb)[rows][:, order]))
+        if writer == "pkm":
+            err["J"] = max(err["J"], _err(Ja, pkm.forward_jacobian(dst, qb)))
+        err["tau"] = max(err["tau"], _err(ta, pkm.inverse_dynamics(dst, qb, vb, ab)[order]))
+        err["M_a"] = max(err["M_a"], _err(Ma, pkm.mass_matrix(dst, qb)[np.ix_(order, order)]))
+    return err
+
+
+@functools.cache
+def states(case: str) -> list[tuple]:
+    """The original's three random closed states and its values there, computed once for every writer's row:
+    ``(q, v, a, joint placements, G, forward Jacobian, inverse dynamics, M_a)``."""
+    src, rng, out = original(case), np.random.default_rng(43), []
     for _ in range(3):
         qa = src.actuated_q(src.q_reference) + 0.01 * rng.standard_normal(src.na)
         q = pkm.close_loops(src, qa).q
         v = pkm.velocities(src, q, rng.standard_normal(src.na))
         a = pkm.accelerations(src, q, v, rng.standard_normal(src.na))
-        qb, vb, ab = _moved(src, dst, q, "q"), _moved(src, dst, v, "v"), _moved(src, dst, a, "v")
-        err["residual"] = max(err["residual"], float(np.abs(constraints.residual(dst, qb)).max(initial=0.0)))
-        pa, pb = _placements(src, q), _placements(dst, qb)
-        ends = {n: names[n][-1] for n in names}  # a universal's frame: its second hinge's
-        err["placements"] = max(err["placements"], max(_err(pa[n], pb[ends[n]]) for n in ends))
-        Ga, Gb = pkm.passive_map(src, q), pkm.passive_map(dst, qb)
-        err["G"] = max(err["G"], _err(Ga[src_rows], Gb[rows][:, order]))
-        if writer == "pkm":
-            err["J"] = max(err["J"], _err(pkm.forward_jacobian(src, q), pkm.forward_jacobian(dst, qb)))
-        ta, tb = pkm.inverse_dynamics(src, q, v, a), pkm.inverse_dynamics(dst, qb, vb, ab)
-        err["tau"] = max(err["tau"], _err(ta, tb[order]))
-        err["M_a"] = max(err["M_a"], _err(pkm.mass_matrix(src, q), pkm.mass_matrix(dst, qb)[np.ix_(order, order)]))
-    return err
+        out.append((q, v, a, _placements(src, q), pkm.passive_map(src, q), pkm.forward_jacobian(src, q),
+                    pkm.inverse_dynamics(src, q, v, a), pkm.mass_matrix(src, q)))
+    return out
 
 
 @pytest.mark.parametrize("writer", list(WRITERS))
@@ -173,6 +190,8 @@ def test_every_writer_then_load_gives_the_same_mechanism(writer):
         worst = {k: max(worst.get(k, 0.0), v) for k, v in err.items()}
         light = any(original(case).model.inertias[j].mass < MIN_MASS for j in range(1, original(case).model.njoints))
         dynamic = MASSLESS if writer == "mjcf" and light else TOL
-        assert err["residual"] <= TOL and err["placements"] <= TOL and err["G"] <= TOL and err["J"] <= TOL, (case, err)
+        rates = ROUNDED if writer in REWRITTEN else TOL
+        assert err["residual"] <= TOL and err["placements"] <= TOL and err["G"] <= rates and err["J"] <= TOL, \
+            (case, err)
         assert err["tau"] <= dynamic and err["M_a"] <= dynamic, (case, err)
     print(writer, {k: f"{v:.1e}" for k, v in worst.items()})

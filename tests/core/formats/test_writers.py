@@ -50,8 +50,8 @@ def test_every_writer_reads_back_as_the_same_mechanism(to, tmp_path):
     (and names where the format has them: pkm, MJCF, URDF+; frames where it keeps them: pkm, Gepetto); at three random
     actuator values near the reference the original's closed configuration closes the copy (1e-12) and is the copy's
     FK from it (close_loops moves it by <= 1e-12); every joint's placement agrees to 1e-12; pkm's spec keeps the task
-    (the same task values). What MJCF and Gepetto's format cannot hold comes as a PkmWarning; pkm's spec loses
-    nothing."""
+    (the same task values). What the other formats cannot hold comes as a PkmWarning; pkm's spec loses nothing
+    (SDF's limits to 1 ulp: written from the reference)."""
     suffix = WRITERS[to].suffixes[0]
     for name in MECHANISMS:
         mech = _mech(name)
@@ -61,12 +61,14 @@ def test_every_writer_reads_back_as_the_same_mechanism(to, tmp_path):
         said = [w for w in caught if issubclass(w.category, PkmWarning)]
         assert (len(said) == 1 and "cannot hold" in str(said[0].message)) if to != "pkm" else not said, name
         back = pkm.load(path)
-        assert sorted(back.joints) == sorted(mech.joints) and back.limits == mech.limits, name
+        assert sorted(back.joints) == sorted(mech.joints) and back.limits.keys() == mech.limits.keys(), name
+        for joint, bounds in mech.limits.items():  # (SDF: from the reference and back, 1 ulp)
+            assert np.abs(np.subtract(back.limits[joint], bounds)).max() <= (1e-15 if to == "sdf" else 0.0), name
         assert back.actuated_names == mech.actuated_names, name
         assert [c.type for c in back.spec.closures] == [c.type for c in mech.spec.closures], name
         if to != "gepetto":
             assert [c.name for c in back.spec.closures] == [c.name for c in mech.spec.closures], name
-        if to not in ("mjcf", "urdfplus"):
+        if to not in ("mjcf", "urdfplus", "sdf"):
             assert [(c.frame_a, c.frame_b) for c in back.spec.closures] == \
                 [(c.frame_a, c.frame_b) for c in mech.spec.closures], name
         rng = np.random.default_rng(7)
@@ -122,3 +124,22 @@ def test_a_path_names_its_format_or_is_refused_listing_the_known_ones(tmp_path):
     (tmp_path / "plain").write_text("")
     with pytest.raises(SpecError, match=r"plain/x\.xml: cannot write"):
         write(_mech("fivebar"), tmp_path / "plain" / "x.xml")
+
+
+def test_a_mechanism_without_urdf_text_is_one_error_type_for_every_writer(tmp_path):
+    """A Mechanism built from a pinocchio.Model has no URDF text: pkm's spec, Gepetto's format and URDF+ (which carry
+    the URDF) refuse it with a SpecError naming the file (writers' module doc: one rule); MJCF and SDF write it from the
+    model, and it reads back closed at the original's states (1e-12)."""
+    mech = _mech("fivebar")
+    bare = pkm.Mechanism(mech.model, mech.spec, source="bare")
+    assert bare.urdf is None
+    for to in ("pkm", "gepetto", "urdfplus"):
+        path = tmp_path / f"bare{WRITERS[to].suffixes[0]}"
+        with pytest.raises(SpecError, match=rf"{path.name}: .*no URDF"):
+            write(bare, path)
+    q = pkm.close_loops(mech, mech.actuated_q(mech.q_reference) + 0.01).q
+    for to in ("mjcf", "sdf"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PkmWarning)
+            back = pkm.load(pkm.save(bare, tmp_path / to, to=to))
+        assert np.abs(constraints.residual(back, _moved(mech, back, q))).max() <= 1e-12, to

@@ -11,6 +11,7 @@ The readers themselves (:mod:`~pkm.core.formats.imported`, :mod:`~pkm.core.forma
 from __future__ import annotations
 
 import dataclasses
+import re
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -25,7 +26,7 @@ from pkm.core.model.builder import from_files, from_imported, from_strings
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.spec import FORMAT, ClosureSpec, TaskSpec, parse_toml, read_text_file
 from pkm.core.model.urdf import check_urdf
-from pkm.errors import InvalidInputError, PkmWarning, SpecError
+from pkm.errors import InvalidInputError, PkmWarning, SpecError, SpecNameError
 
 #: What ``task=`` takes (:func:`given_task`): a frame name, ``"FRAME:KIND"``, ``(frame, kind)`` or the spec's dict.
 TaskGiven = str | Sequence[Any] | Mapping[str, Any] | None
@@ -260,15 +261,52 @@ def load_spec_file(path: Path, given: Given = Given()) -> Mechanism:
     Raises:
         SpecError: as :func:`~pkm.core.model.builder.from_files`.
     """
-    if given.empty:
-        return from_files(path)
-    raw = parse_toml(read_text_file(path, "closure spec"), str(path))
-    if isinstance(raw, dict) and given.actuated is not None and not raw.get("actuated"):
-        raw["actuated"] = list(given.actuated)  # (the spec's parser asks for one; the code gives them)
-    spec, read = with_given(ClosureSpec.from_dict(raw, str(path)), given, str(path))
-    mech = from_files(path, spec)
+    try:
+        if given.empty:
+            return from_files(path)
+        raw = parse_toml(read_text_file(path, "closure spec"), str(path))
+        if isinstance(raw, dict) and given.actuated is not None and not raw.get("actuated"):
+            raw["actuated"] = list(given.actuated)  # (the spec's parser asks for one; the code gives them)
+        spec, read = with_given(ClosureSpec.from_dict(raw, str(path)), given, str(path))
+        mech = from_files(path, spec)
+    except SpecNameError as exc:
+        if exc.source != str(path):
+            raise
+        raise located(exc, read_text_file(path, "closure spec"), "toml") from None
     mech.notes += read
     return mech
+
+
+def located(exc: SpecNameError, text: str, kind: str) -> SpecNameError:
+    """``exc`` (a name a closure spec or Gepetto YAML gives that the model lacks) with the line of ``text`` where that
+    name is written, when it is written on one line only (else ``exc`` itself): for YAML (``kind="yaml"``) the lines
+    PyYAML's composer gives its scalars; for TOML (``"toml"``), whose parser gives no positions, the lines where
+    the name stands quoted."""
+    if kind == "yaml":
+        import yaml
+
+        lines: set[int] = set()
+        try:
+            stack = [yaml.compose(text, Loader=yaml.SafeLoader)]
+        except yaml.YAMLError:
+            return exc
+        while stack:
+            node = stack.pop()
+            if isinstance(node, yaml.ScalarNode):
+                if node.value == exc.name:
+                    lines.add(node.start_mark.line + 1)
+            elif isinstance(node, yaml.SequenceNode):
+                stack.extend(node.value)
+            elif isinstance(node, yaml.MappingNode):
+                stack.extend(n for pair in node.value for n in pair)
+    else:
+        quoted = (f'"{exc.name}"', f"'{exc.name}'")
+        lines = {k for k, line in enumerate(text.splitlines(), 1) if any(q in line for q in quoted)}
+    if len(lines) != 1:
+        return exc
+    what = re.search(rf" in {re.escape(exc.source)} \((.*?)\);", str(exc))
+    where = f"{what.group(1)}, line {lines.pop()}" if what else f"line {lines.pop()}"
+    return SpecNameError(exc.source, exc.kind, exc.name, exc.valid, where)
 
 
 def load_path(path: Path, given: Given = Given()) -> Mechanism:
@@ -298,17 +336,35 @@ def _read_text(name: str, text: str) -> Imported:
     return format_of(name, text).read(text, name)
 
 
-def load_texts(files: Mapping[str, str], source: str = "<upload>") -> Mechanism:
+def load_texts(files: Mapping[str, str], source: str = "<upload>", *, actuated: Sequence[str] | str | None = None,
+               task: TaskGiven = None) -> Mechanism:
     """The mechanism of files given as ``{name: text}`` (an upload), read as :func:`load_path` reads them from a
     folder, without touching the file system (the names are labels: a spec's ``urdf`` must name one of them):
 
     * a closure spec (``.toml``) and the model file it names (URDF, MJCF or SDF);
     * a Gepetto pair: a YAML and the URDF beside it (the only ``.urdf``);
-    * an MJCF or SDF file alone (its loops and actuators from the file).
+    * an MJCF or SDF file alone (its loops and actuators from the file), or a URDF with URDF+ ``<loop>`` or urdfdom
+      ``<constraint>`` elements.
+
+    ``actuated``, ``task``: as :func:`pkm.load`'s (:func:`given`), over what the files state (:func:`with_given`): a
+    file that names no actuated joint (SDF never does), or a spec or YAML that leaves them empty, loads with them.
 
     Raises:
-        SpecError: none of these, or several; a spec naming a file that is not there; what the readers refuse.
+        SpecError: none of these, or several; a spec naming a file that is not there; no actuated joint named by
+            the files nor given; what the readers refuse.
+        InvalidInputError: ``actuated`` or ``task`` in none of their forms (:func:`given`).
     """
+    g = given(actuated, task)
+    try:
+        return _load_texts(files, source, g)
+    except SpecNameError as exc:
+        label = exc.source.removeprefix(f"{source}:")
+        if label not in files or Path(label).suffix.lower() not in (".toml", ".yaml", ".yml"):
+            raise
+        raise located(exc, files[label], "toml" if label.lower().endswith(".toml") else "yaml") from None
+
+
+def _load_texts(files: Mapping[str, str], source: str, g: Given) -> Mechanism:
     names = sorted(files)
     kind = {n: Path(n).suffix.lower() for n in names}
     specs = [n for n in names if kind[n] == ".toml"]
@@ -316,30 +372,45 @@ def load_texts(files: Mapping[str, str], source: str = "<upload>") -> Mechanism:
     if len(specs) > 1 or len(yamls) > 1 or (specs and yamls):
         raise SpecError(source, f"give one closure spec (.toml) or one Gepetto YAML, not {specs + yamls}")
     if specs:
-        spec = ClosureSpec.from_toml(files[specs[0]], f"{source}:{specs[0]}")
+        where = f"{source}:{specs[0]}"
+        raw = parse_toml(files[specs[0]], where)
+        if isinstance(raw, dict) and g.actuated is not None and not raw.get("actuated"):
+            raw["actuated"] = list(g.actuated)  # (the spec's parser asks for one; the code gives them)
+        spec, read = with_given(ClosureSpec.from_dict(raw, where), g, where)
         if spec.urdf not in files:
-            raise SpecError(f"{source}:{specs[0]}", f"urdf = {spec.urdf!r}: not among the files given ({names})")
-        return from_imported(spec, _read_text(spec.urdf, files[spec.urdf]), f"{source}:{specs[0]}")
+            raise SpecError(where, f"urdf = {spec.urdf!r}: not among the files given ({names})")
+        mech = from_imported(spec, _read_text(spec.urdf, files[spec.urdf]), where)
+        mech.notes += read
+        return mech
     if yamls:
         urdfs = [n for n in names if kind[n] == ".urdf"]
         if len(urdfs) != 1:
             raise SpecError(source, f"a Gepetto YAML goes with one URDF; given {urdfs or 'none'}")
+        where = f"{source}:{yamls[0]}"
         imported = _read_text(urdfs[0], files[urdfs[0]])
         joints = [str(j.get("name")) for j in check_urdf(imported.urdf, urdfs[0]).findall("joint")]
-        spec, read = read_gepetto(files[yamls[0]], urdfs[0], joints, Path(urdfs[0]).stem, f"{source}:{yamls[0]}")
-        return from_strings(imported.urdf, spec, source=f"{source}:{yamls[0]}", notes=imported.notes + read)
+        spec, read = read_gepetto(files[yamls[0]], urdfs[0], joints, Path(urdfs[0]).stem, where)
+        spec, replaced = with_given(spec, g, where)
+        return from_strings(imported.urdf, spec, source=where, notes=imported.notes + read + replaced)
     if len(names) != 1:
         raise SpecError(source, f"give a closure spec with its model file, a Gepetto YAML with its URDF, or one model "
                                 f"file alone (MJCF, SDF, or a URDF with URDF+ <loop> or urdfdom <constraint> "
                                 f"elements); given {names}")
+    where = f"{source}:{names[0]}"
     imported = _read_text(names[0], files[names[0]])
-    if imported.format == "urdf" or not imported.actuated:
-        raise SpecError(f"{source}:{names[0]}", "the file names no loop (a plain URDF cannot hold one) or no "
-                                                "actuated joint: send a closure spec with it")
-    spec = ClosureSpec(mechanism=imported.name, urdf=names[0], end_effector=None, actuated=imported.actuated,
-                       closures=(), task=TaskSpec((), imported.actuated), reference={},
+    if imported.format == "urdf":
+        raise SpecError(where, "the file names no loop (a plain URDF cannot hold one): send a closure spec with it")
+    if not imported.actuated and g.actuated is None:
+        raise SpecError(where, f"the {imported.format.upper()} file names no actuated joint: give actuated=[...], or "
+                               "send a closure spec with it")
+    spec = ClosureSpec(mechanism=imported.name, urdf=names[0], end_effector=None,
+                       actuated=imported.actuated or g.actuated or (), closures=(),
+                       task=TaskSpec((), imported.actuated or g.actuated or ()), reference={},
                        description=f"read from {names[0]} ({imported.format.upper()})")
-    return from_imported(spec, imported, f"{source}:{names[0]}")
+    spec, read = with_given(spec, g, where)
+    mech = from_imported(spec, imported, where)
+    mech.notes += read
+    return mech
 
 
 def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = (), given: Given = Given()) -> Mechanism:
@@ -354,11 +425,16 @@ def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = (), 
                                         "Gepetto's convention pairs a YAML with a URDF")
     joints = [str(j.get("name")) for j in check_urdf(imported.urdf, str(urdf_path)).findall("joint")]
     name = urdf_path.parent.name if urdf_path.stem == "robot" else urdf_path.stem
-    spec, read = read_gepetto(read_text_file(yaml_path, "YAML"), urdf_path.name, joints, name or "robot",
-                              str(yaml_path))
-    spec, replaced = with_given(spec, given, str(yaml_path))
-    return from_strings(imported.urdf, spec, source=str(yaml_path), notes=tuple(notes) + imported.notes + read
-                        + replaced)
+    text = read_text_file(yaml_path, "YAML")
+    try:
+        spec, read = read_gepetto(text, urdf_path.name, joints, name or "robot", str(yaml_path))
+        spec, replaced = with_given(spec, given, str(yaml_path))
+        return from_strings(imported.urdf, spec, source=str(yaml_path), notes=tuple(notes) + imported.notes + read
+                            + replaced)
+    except SpecNameError as exc:
+        if exc.source != str(yaml_path):
+            raise
+        raise located(exc, text, "yaml") from None
 
 
 _PACKAGE_FILES: dict[tuple[str, int, int], Imported] = {}  # (path, mtime [ns], size): the file read

@@ -15,7 +15,16 @@ SDFormat's pose semantics (1.6 to 1.11):
   and ``<dynamics><damping><friction>``;
 * ``<frame name attached_to>`` with a ``<pose>``: named frames (an end effector, a tool point);
 * ``<pose degrees="true">`` (SDFormat 1.9);
-* ``<joint type="gearbox">`` (below).
+* ``<joint type="gearbox">`` (below);
+* SDFormat 1.11's ``<axis><mimic joint="LEADER" axis="axis">`` with ``<multiplier>`` (required), ``<offset>``,
+  ``<reference>``: ``follower = offset + multiplier (leader - reference)``, a URDF ``<mimic>`` (both joints
+  revolute, continuous or prismatic, in the tree);
+* pkm's own custom elements (namespace ``urn:pkm:sdf``, :mod:`pkm.core.formats.to_sdf` writes them; other SDFormat
+  readers ignore them): ``<pkm:position>`` in a tree joint, its coordinate at the model's pose (an angle, a length, a
+  ball's quaternion ``x y z w``): the joint's zero is put where that coordinate places the link, and its limits and a
+  mimic's offset (counted from the model's pose in SDFormat) are shifted by it; ``<pkm:free_joint>NAME`` in a link
+  without a parent joint: a free body (SDFormat's reading of such a link), on a free-flyer joint ``NAME`` (its
+  ``<pkm:position>``: ``x y z`` and the quaternion ``x y z w``), every joint whose child it is cutting a loop.
 
 The tree: each link's parent joint is the first joint in the file that has it as child; every other
 joint cuts a loop, between frames ``<joint>_parent`` and ``<joint>_child`` at the joint: a cut ``ball``
@@ -52,7 +61,8 @@ SDF position limits, if any, are dropped: its coordinate is the output's. Each g
 whose ``<spring_stiffness>`` is left unread, are listed in :attr:`Imported.notes
 <pkm.core.formats.base.Imported.notes>`. SDFormat booleans (``use_parent_model_frame``) are ``true`` or ``1``.
 
-Refused with a :class:`~pkm.errors.SpecError`: nested models, ``<include>``, universal and screw joints, a
+Refused with a :class:`~pkm.errors.SpecError`: nested models, ``<include>``, universal and screw joints, a mimic
+without a multiplier or not between two tree joints, ``<pkm:position>`` on a joint cutting a loop, a
 gearbox whose links do not hang on revolutes about its axes from its reference body (or with a zero or
 non-finite ratio, or a link geared twice), poses relative to what is not a link or frame, several base links,
 a cycle of parents.
@@ -75,6 +85,7 @@ _TYPES = ("revolute", "continuous", "prismatic", "ball", "fixed", "gearbox")
 _PARALLEL = 1e-6  # |sin| of the angle between a gearbox's axis and its joint's axis above which they differ
 _NO_LIMIT = 1e6  # |bound| above this (SDFormat writes 1e16) is no bound
 _AXIS_POINT = 0.1  # m: a cut revolute is two point closures, at the joint and this far along its axis
+_PKM = "{urn:pkm:sdf}"  # pkm's custom elements (pkm.core.formats.to_sdf.PKM_NS)
 
 
 def _numbers(text: str | None, n: int, what: str, source: str) -> np.ndarray:
@@ -226,15 +237,22 @@ def _read_sdf(text: str, source: str) -> Imported:
         placed[name] = pose_of(rel, stack + (name,)) * M if rel else M
         return placed[name]
 
+    free: dict[str, str] = {}  # a link marked free by pkm's writer -> its free-flyer joint's name
+    for name, el in links.items():
+        mark = el.find(f"{_PKM}free_joint")
+        if mark is not None:
+            if not (mark.text or "").strip():
+                raise SpecError(source, f"link {name!r}: <pkm:free_joint> needs the free-flyer joint's name")
+            free[name] = mark.text.strip()
     parent_joint: dict[str, etree._Element] = {}
     cuts = []
     for j in joints:
         child = _end(j, "child")
-        if child in parent_joint or child == "world":
+        if child in parent_joint or child == "world" or child in free:  # (a free link's joints all cut loops)
             cuts.append(j)
         else:
             parent_joint[child] = j
-    bases = [n for n in links if n not in parent_joint]
+    bases = [n for n in links if n not in parent_joint and n not in free]
     if len(bases) > 1:
         raise SpecError(source, f"links {bases} have no parent joint: a model for pkm has one base (join the others "
                                 "with joints)")
@@ -266,6 +284,59 @@ def _read_sdf(text: str, source: str) -> Imported:
         return a if frame is None else X.rotation.T @ pose_of(frame).rotation @ a
 
     mimic = _gears(gearboxes, parent_joint, joint_frame, axis, source)  # {rotor joint: (output joint, multiplier)}
+    tree = {j.get("name"): j for j in parent_joint.values()}
+    for j in cuts:
+        if j.find(f"{_PKM}position") is not None:
+            raise SpecError(source, f"joint {j.get('name')!r}: <pkm:position> on a joint that cuts a loop (pkm "
+                                    "writes it on tree joints only)")
+
+    def position(j: etree._Element) -> np.ndarray:
+        """The joint's ``<pkm:position>`` (its coordinate at the model's pose: 1 number, a ball's quaternion ``x y z
+        w``, 0 or the identity when absent)."""
+        n = 4 if j.get("type") == "ball" else 1
+        el = j.find(f"{_PKM}position")
+        if el is None:
+            return np.array([0.0, 0.0, 0.0, 1.0]) if n == 4 else np.zeros(1)
+        if j.get("type") not in ("revolute", "continuous", "prismatic", "ball"):
+            raise SpecError(source, f"joint {j.get('name')!r}: <pkm:position> on a {j.get('type')} joint")
+        p = _numbers(el.text, n, f"joint {j.get('name')!r} pkm:position", source)
+        if n == 4 and abs(np.linalg.norm(p) - 1.0) > 1e-9:
+            raise SpecError(source, f"joint {j.get('name')!r}: <pkm:position> {p.tolist()} is not a unit quaternion")
+        return p
+
+    def motion(j: etree._Element, X: pin.SE3) -> pin.SE3:
+        """The placement the joint gives its child at its ``<pkm:position>`` (module doc)."""
+        p = position(j)
+        if j.get("type") == "ball":
+            return pin.SE3(pin.Quaternion(p[3], p[0], p[1], p[2]).normalized().matrix(), np.zeros(3))
+        if not p[0]:
+            return pin.SE3.Identity()
+        a = axis(j, X)
+        a = a / np.linalg.norm(a)
+        if j.get("type") == "prismatic":
+            return pin.SE3(np.eye(3), float(p[0]) * a)
+        return pin.SE3(pin.AngleAxis(float(p[0]), a).matrix(), np.zeros(3))
+
+    follow: dict[str, tuple[str, float, float]] = {}  # SDFormat 1.11 <mimic>: {follower: (leader, mult, offset)}
+    for j in joints:
+        el = j.find("axis/mimic")
+        if el is None:
+            continue
+        name, leader = j.get("name"), el.get("joint")
+        where = f"joint {name!r} <mimic>"
+        if name not in tree or leader not in tree or name in mimic or leader == name:
+            raise SpecError(source, f"{where}: follower and leader {leader!r} must be two joints of the tree (not "
+                                    "cutting a loop, not geared by a gearbox)")
+        if el.get("axis", "axis") != "axis" or {j.get("type"), tree[leader].get("type")} - \
+                {"revolute", "continuous", "prismatic"}:
+            raise SpecError(source, f"{where}: pkm reads a mimic between the first axes of revolute, continuous or "
+                                    "prismatic joints")
+        if el.find("multiplier") is None:
+            raise SpecError(source, f"{where}: needs a <multiplier>")
+        m, off, ref = (float(_numbers(_text(el, key, "0"), 1, f"{where} {key}", source)[0])
+                       for key in ("multiplier", "offset", "reference"))
+        # SDFormat: follower = offset + m (leader - reference), both counted from the model's pose
+        follow[name] = (leader, m, off - m * ref + float(position(j)[0]) - m * float(position(tree[leader])[0]))
 
     names = set(links) | {j.get("name") for j in joints} | set(frames)
     robot = etree.Element("robot", name=model.get("name") or "sdf")
@@ -290,7 +361,8 @@ def _read_sdf(text: str, source: str) -> Imported:
     def add_joint(name: str, kind: str, parent: str, child: str, X: pin.SE3, j: etree._Element | None = None) \
             -> None:
         jel = etree.SubElement(robot, "joint", name=name, type=kind)
-        origin(jel, urdf_frame[parent].inverse() * X)
+        shift = motion(j, X) if j is not None and tree.get(name) is j else pin.SE3.Identity()
+        origin(jel, urdf_frame[parent].inverse() * X * shift.inverse())
         etree.SubElement(jel, "parent", link=ulink.get(parent, parent))
         etree.SubElement(jel, "child", link=ulink.get(child, child))
         if j is not None and j.get("type") == "ball":  # a placeholder that [joint_types] makes spherical
@@ -300,12 +372,19 @@ def _read_sdf(text: str, source: str) -> Imported:
             etree.SubElement(jel, "axis", xyz=num(axis(j, X)))
             lo, hi = _text(j, "axis/limit/lower"), _text(j, "axis/limit/upper")
             bounds = {}
+            at = float(position(j)[0]) if tree.get(name) is j else 0.0
             if name in mimic:  # a gearbox's rotor: no coordinate, no bounds of its own
-                etree.SubElement(jel, "mimic", joint=mimic[name][0], multiplier=repr(mimic[name][1]), offset="0")
-            elif lo is not None and hi is not None and j.get("type") != "continuous":
-                b = _numbers(f"{lo} {hi}", 2, f"joint {name!r} limits", source)
-                if np.abs(b).max() < _NO_LIMIT:
-                    bounds = {"lower": repr(float(b[0])), "upper": repr(float(b[1]))}
+                output, mult = mimic[name][0], mimic[name][1]
+                etree.SubElement(jel, "mimic", joint=output, multiplier=repr(mult),
+                                 offset=repr(at - mult * float(position(tree[output])[0])))
+            else:
+                if name in follow:
+                    etree.SubElement(jel, "mimic", joint=follow[name][0], multiplier=repr(follow[name][1]),
+                                     offset=repr(follow[name][2]))
+                if lo is not None and hi is not None and j.get("type") != "continuous":
+                    b = _numbers(f"{lo} {hi}", 2, f"joint {name!r} limits", source)
+                    if np.abs(b).max() < _NO_LIMIT:
+                        bounds = {"lower": repr(float(b[0]) + at), "upper": repr(float(b[1]) + at)}
             drive = {}
             for key in ("effort", "velocity"):  # (SDF's default -1: no limit, read as none)
                 text = _text(j, f"axis/limit/{key}")
@@ -361,6 +440,15 @@ def _read_sdf(text: str, source: str) -> Imported:
     for name in order:
         add_link(name, links[name])
         j = parent_joint.get(name)
+        if j is None and name in free:
+            if free[name] in names:
+                raise SpecError(source, f"link {name!r}: its <pkm:free_joint> {free[name]!r} names another element")
+            names.add(free[name])
+            el = links[name].find(f"{_PKM}position")
+            X = pin.XYZQUATToSE3(_numbers(el.text, 7, f"link {name!r} pkm:position", source)) if el is not None \
+                else pin.SE3.Identity()
+            add_joint(free[name], "floating", robot_root, name, urdf_frame[name] * X.inverse())
+            continue
         if j is None:
             add_joint(f"{name}_base", "fixed", robot_root, name, urdf_frame[name])
             continue

@@ -11,16 +11,38 @@ Gravity is the model's, contacts are disabled; a one-coordinate joint with posit
 (:attr:`~pkm.core.Mechanism.limits`) has them as its ``range`` (radians or metres: ``<compiler angle="radian">``).
 
 The loop closures (and mimic equalities) are written stiff, not with MuJoCo's default softness (``solref`` (0.02, 1),
-``solimp`` (0.9, 0.95, ...), under which a Delta held at rest opens its loops by 0.4 mm): each carries ``solref =
-(2 dt, 1)`` with ``dt`` the written ``<option timestep>`` (:data:`TIMESTEP`, 1 ms by default), the shortest time
-constant MuJoCo keeps stable (MuJoCo's documentation: at least twice the step; it clamps shorter ones), critically
-damped, and ``solimp`` = :data:`SOLIMP` (0.9999, 0.9999, ...: constant impedance at MuJoCo's largest,
-``mjMAXIMP``). At rest, a soft equality carrying a load sags by ``r = (1-d)/d * a0 * (d timeconst)^2`` (``a0``: the
-acceleration the load would give the loop without it), so this choice divides MuJoCo's default sag by about
-``(0.1/0.9 / 1e-4) * (0.95 * 0.02 / 0.002)^2`` = 1e5 (measured: 8e4 on the Delta): held at rest under gravity for 1 s at 1 ms, the shipped Delta, 3-PRS and
-Gough-Stewart, the humanoid ankle and Gepetto's planar five-bar stay closed within 5e-8 m
-(``tests/core/formats/test_to_mjcf.py``); light links carrying a large load sag more (the hexapod 1.05e-6 m, Gepetto's
-battobot 1.8e-5 m): write a smaller ``timestep`` for them (the sag goes as its square).
+``solimp`` (0.9, 0.95, ...), under which a Delta held at rest opens its loops by 0.4 mm). Why a loaded loop opens at
+all: MuJoCo solves each equality row for the acceleration ``a1 = d aref + (1 - d) a0`` (``a0`` the row's acceleration
+without the constraint, ``aref = -b v - k r`` its reference, ``d`` the impedance), by regularizing the row with ``R =
+(1 - d)/d diagApprox``, where ``diagApprox`` is the row's inverse inertia estimated once, at ``qpos0``, from the two
+bodies' ``body_invweight0`` (translational for a ``<connect>``, rotational for a weld's angular rows) or the joints'
+``dof_invweight0``. At rest the row carries the force ``f`` its load needs and stands open by ``r = R f / k = (1 - d)
+(d timeconst dampratio)^2 diagApprox f``: a light link (small mass, tiny rotational inertia, large inverse weight)
+carrying a large force or torque opens most. Neither the solver nor its iterations are the cause (the hexapod and
+Gepetto's battobot give the same sag with ``tolerance`` 1e-15 and 1000 iterations), and the sag cannot be bought
+back by the stiffness alone: MuJoCo's impedance makes a row's own dynamics mass-free, ``r'' = -d (b r' + k r)``, so
+its stability bounds ``k dt^2`` whatever the masses. So each of the four factors is taken at its limit:
+
+* ``d`` = 0.9999 (``solimp`` = :data:`SOLIMP`: constant impedance at MuJoCo's largest, ``mjMAXIMP``; MuJoCo clamps
+  larger values);
+* ``solref = (2 dt, 0.5)`` with ``dt`` the written ``<option timestep>`` (:data:`TIMESTEP`, 1 ms by default):
+  ``timeconst = 2 dt`` is the shortest MuJoCo keeps (its ``refsafe`` clamps shorter ones), and ``dampratio``
+  :data:`DAMPRATIO` = 0.5 makes ``b = 1/dt`` and ``k = 1/dt^2`` (times ``1/d``): under MuJoCo's semi-implicit Euler
+  step a violation is then removed in one step (both roots of the step's characteristic polynomial at 0, deadbeat),
+  and the sag is 4 times smaller than with the critically damped ``(2 dt, 1)`` (``k`` 4 times larger; ``k dt^2`` = 2
+  would be the stability limit). Under RK4 the row is a continuous oscillator of damping ratio 0.5 at ``1/dt``,
+  well inside RK4's stability region;
+* a ``<weld>``'s ``torquescale`` = :data:`TORQUESCALE` (10): MuJoCo multiplies the angular rows (residual and
+  Jacobian) by it but not their ``diagApprox``, so the angular rows' regularization is 100 times smaller relative
+  to their inertia and their sag 100 times smaller (a weld's rotational inverse weight on a light link is 1e3 to
+  1e5 times its translational one: Gepetto's battobot's angular rows opened by 1.8e-5 rad). The weld holds the same
+  frames (the angular residual is zero exactly where it was); MuJoCo's ``efc_pos`` on those rows is 10 times the
+  angle.
+
+Held at rest under gravity (0.1 s or 0.5 s at 1 ms, ``tests/core/formats/test_to_mjcf.py``), every mechanism of the
+round-trip matrix stays closed within 2.7e-7 (the hexapod's mimic equalities on its massless knees [rad]; 1.2e-9 m for
+the Delta), Gepetto's battobot within 4.6e-8 (from 1.8e-5 with ``(2 dt, 1)`` and no torquescale). A heavier load on a
+lighter link still opens more: write a smaller ``timestep`` (the sag goes as its square).
 
 Each actuated joint's drive (:attr:`~pkm.core.Mechanism.actuators`, :mod:`pkm.core.model.actuators`) is written in
 the joint's units: the joint's ``armature`` is :attr:`~pkm.core.model.actuators.Actuator.reflected_inertia`
@@ -58,6 +80,10 @@ TIMESTEP = 1e-3
 #: The loop closures' ``solimp`` (impedance ``d`` from ``dmin`` at no violation to ``dmax`` beyond ``width`` [m],
 #: ``midpoint``, ``power``): see the module doc.
 SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
+#: The loop closures' ``solref`` damping ratio (their time constant is twice the step): see the module doc.
+DAMPRATIO = 0.5
+#: A ``<weld>``'s ``torquescale``, the factor on its angular rows (see the module doc).
+TORQUESCALE = 10.0
 
 
 def _num(x: ArrayLike) -> str:
@@ -75,18 +101,24 @@ def body_names(mech: Mechanism) -> list[str]:
     return ["world"] + [f"{mech.model.names[j]}_body" for j in range(1, mech.model.njoints)]
 
 
+def joint_axis(jm: pin.JointModel) -> tuple[bool, np.ndarray]:
+    """``(revolute, axis)`` of a one-coordinate Pinocchio joint (revolute or prismatic, aligned or not; a mimic
+    joint's own motion): its motion subspace's angular part, or its linear part, in the joint frame."""
+    jd = jm.createData()
+    jm.calc(jd, np.zeros(max(jm.idx_q + jm.nq, jm.idx_q + 1)))  # S does not depend on q for these
+    S = np.asarray(jd.S, dtype=float).reshape(6, -1)[:, 0]
+    if jm.shortname() == "JointModelMimic":
+        S = S / float(jm.extract().scaling)
+    revolute = bool(np.abs(S[3:]).max() > 0)
+    return revolute, S[3:] if revolute else S[:3]
+
+
 def _joints(el: etree._Element, jm: pin.JointModel, name: str, source: str) -> list[str]:
     """The MJCF joint elements of one Pinocchio joint; returns their names."""
     kind = jm.shortname().removeprefix("JointModel")
     if kind == "Mimic" or kind in _REVOLUTE or kind in _PRISMATIC or kind.endswith("Unaligned"):
-        jd = jm.createData()
-        jm.calc(jd, np.zeros(max(jm.idx_q + jm.nq, jm.idx_q + 1)))  # S does not depend on q for these
-        S = np.asarray(jd.S, dtype=float).reshape(6, -1)[:, 0]
-        if kind == "Mimic":
-            S = S / float(jm.extract().scaling)
-        revolute = np.abs(S[3:]).max() > 0
-        etree.SubElement(el, "joint", name=name, type="hinge" if revolute else "slide",
-                         axis=_num(S[3:] if revolute else S[:3]))
+        revolute, axis = joint_axis(jm)
+        etree.SubElement(el, "joint", name=name, type="hinge" if revolute else "slide", axis=_num(axis))
         return [name]
     if kind == "Universal":
         u = jm.extract()
@@ -140,7 +172,7 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
                 body.find(f"joint[@name='{name}']").set("range", _num(mech.limits[model.names[j]]))
         if jm.shortname() == "JointModelMimic":
             mimic = jm.extract()
-            leader = model.names[_leader(model, j)]
+            leader = model.names[mimic_leader(model, j)]
             etree.SubElement(equality, "joint", joint1=model.names[j], joint2=leader,
                              polycoef=_num([mimic.offset, mimic.scaling, 0, 0, 0]), solref=_num(solref),
                              solimp=_num(solimp))
@@ -152,8 +184,10 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
             site = etree.SubElement(bodies[frame.parentJoint], "site", name=f"{c.name}_{side}")
             _pose(site, frame.placement)
             sites.append(site.get("name"))
-        etree.SubElement(equality, "connect" if c.type == "point" else "weld", name=c.name, site1=sites[0],
-                         site2=sites[1], solref=_num(solref), solimp=_num(solimp))
+        el = etree.SubElement(equality, "connect" if c.type == "point" else "weld", name=c.name, site1=sites[0],
+                              site2=sites[1], solref=_num(solref), solimp=_num(solimp))
+        if c.type != "point":
+            el.set("torquescale", repr(TORQUESCALE))
     root.append(equality)
     keyframe = etree.SubElement(root, "keyframe")
     etree.SubElement(keyframe, "key", name="reference", qpos=_num(mjcf_qpos(mech, mech.q_reference)))
@@ -217,8 +251,9 @@ def mjcf_qpos(mech: Mechanism, q: ArrayLike) -> np.ndarray:
 
 def closure_softness(timestep: float = TIMESTEP) -> tuple[tuple[float, float], tuple[float, ...]]:
     """The ``(solref, solimp)`` written on each loop closure's ``<connect>``/``<weld>`` for a step of ``timestep``
-    [s]: ``solref = (2 timestep, 1)`` (a critically damped reference with the shortest time constant MuJoCo keeps
-    stable: it clamps shorter ones to ``2 timestep``) and ``solimp`` = :data:`SOLIMP` (see the module doc).
+    [s]: ``solref = (2 timestep, DAMPRATIO)`` (the shortest time constant MuJoCo keeps: it clamps shorter ones to
+    ``2 timestep``; with :data:`DAMPRATIO` 0.5 a violation is removed in one semi-implicit Euler step) and ``solimp`` =
+    :data:`SOLIMP` (see the module doc).
 
     Raises:
         InvalidInputError: ``timestep`` not a positive finite number.
@@ -226,7 +261,7 @@ def closure_softness(timestep: float = TIMESTEP) -> tuple[tuple[float, float], t
     dt = float(timestep) if isinstance(timestep, (int, float)) and not isinstance(timestep, bool) else float("nan")
     if not (np.isfinite(dt) and dt > 0.0):
         raise InvalidInputError("timestep", "must be a positive, finite number of seconds", timestep)
-    return (2.0 * dt, 1.0), SOLIMP
+    return (2.0 * dt, DAMPRATIO), SOLIMP
 
 
 def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
@@ -263,8 +298,8 @@ def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
     return tuple(out)
 
 
-def _leader(model: pin.Model, j: int) -> int:
-    """The joint a mimic joint follows: the one whose coordinates it reads."""
+def mimic_leader(model: pin.Model, j: int) -> int:
+    """The joint a mimic joint ``j`` follows: the one whose coordinates it reads."""
     idx_q = model.joints[j].idx_q
     for k in range(1, model.njoints):
         if k != j and model.joints[k].shortname() != "JointModelMimic" and model.joints[k].idx_q == idx_q:
@@ -272,5 +307,5 @@ def _leader(model: pin.Model, j: int) -> int:
     raise SpecError(model.name, f"mimic joint {model.names[j]!r}: no leader found")
 
 
-__all__ = ["MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "body_names", "closure_softness", "mjcf_from_mechanism",
-           "mjcf_omissions", "mjcf_qpos"]
+__all__ = ["DAMPRATIO", "MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "TORQUESCALE", "body_names",
+           "closure_softness", "joint_axis", "mimic_leader", "mjcf_from_mechanism", "mjcf_omissions", "mjcf_qpos"]

@@ -8,12 +8,21 @@
 * ``"gepetto"`` (``.yaml``, ``.yml``): URDF + YAML in the convention of Gepetto's toolbox-parallel-robots
   (:mod:`pkm.core.formats.to_gepetto`), the URDF beside the YAML (``<stem>.urdf``);
 * ``"urdfplus"`` (``.urdf``): MIT's URDF+, loops as ``<loop>`` elements in the URDF
-  (:mod:`pkm.core.formats.to_urdfplus`).
+  (:mod:`pkm.core.formats.to_urdfplus`);
+* ``"sdf"`` (``.sdf``): SDFormat 1.11, loops as cut joints, posed at the reference configuration
+  (:mod:`pkm.core.formats.to_sdf`), with a closure spec beside it (``<stem>.closures.toml``: the actuated joints,
+  the task, the drives, which SDFormat does not say): the spec is the main file, the one :func:`pkm.load` takes.
 
 A path without a suffix, with ``to`` given, is a folder: the files go in it (``<mechanism>.closures.toml``,
-``<mechanism>.xml``, ``robot.yaml``). Each writer returns what it wrote and what its format cannot hold
-(:class:`Written`); the latter is also written as comments where the format has them (YAML) and is never silent:
-:func:`pkm.save` warns with it, ``pkm convert`` prints it.
+``<mechanism>.xml``, ``robot.yaml``).
+
+Errors follow one rule: what is wrong with the arguments (a path or ``to`` naming no format, not a
+:class:`~pkm.core.Mechanism`) is an :class:`~pkm.errors.InvalidInputError` (an :class:`~pkm.errors.UnknownNameError`
+for ``to``); what the mechanism cannot be written as (a joint or a floating base the format has no element for, no URDF
+text for a format that carries the URDF: pkm's spec, Gepetto's and URDF+) is a :class:`~pkm.errors.SpecError` naming
+the file it was to go in, whatever the writer; so is a file that cannot be written. Each writer returns what it wrote
+and what its format cannot hold (:class:`Written`); the latter is also written as comments where the format has them
+(YAML) and is never silent: :func:`pkm.save` warns with it, ``pkm convert`` prints it.
 """
 
 from __future__ import annotations
@@ -59,9 +68,9 @@ class Writer:
 
 
 def _urdf_text(mech: Mechanism, what: str) -> str:
-    if mech.urdf is None:
-        raise InvalidInputError("mech", f"it was built from a Pinocchio model, not URDF text: no URDF to write ({what})",
-                                mech.source)
+    if mech.urdf is None:  # (what the mechanism lacks for this format: a SpecError, as every writer's, module doc)
+        raise SpecError(mech.source, f"built from a Pinocchio model, not URDF text: no URDF to write ({what}); "
+                                     "SDF and MJCF are written from the model")
     return mech.urdf
 
 
@@ -98,6 +107,18 @@ def _write_gepetto(mech: Mechanism, files: tuple[Path, ...]) -> Written:
     return Written((path, urdf_path), dropped, "gepetto")
 
 
+def _write_sdf(mech: Mechanism, files: tuple[Path, ...]) -> Written:
+    from pkm.core.formats.to_sdf import sdf_from_mechanism, sdf_spec
+
+    path, spec_path = files
+    text, dropped = sdf_from_mechanism(mech)
+    spec = sdf_spec(mech, path.name).to_toml()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text, encoding="utf-8")
+    spec_path.write_text(spec, encoding="utf-8")
+    return Written((spec_path, path), dropped, "sdf")
+
+
 def _write_urdfplus(mech: Mechanism, files: tuple[Path, ...]) -> Written:
     from pkm.core.formats.to_urdfplus import urdfplus_from_mechanism
 
@@ -116,6 +137,8 @@ WRITERS: dict[str, Writer] = {w.name: w for w in (
     Writer("gepetto", (".yaml", ".yml"), "Gepetto's URDF + YAML (toolbox-parallel-robots)", _write_gepetto,
            lambda p: p.with_suffix(".urdf")),
     Writer("urdfplus", (".urdf",), "MIT's URDF+ (loops as <loop> elements)", _write_urdfplus),
+    Writer("sdf", (".sdf",), "SDFormat (loops as cut joints) + pkm's closure spec", _write_sdf,
+           lambda p: p.with_name(f"{p.name.removesuffix(p.suffix)}.closures.toml")),
 )}
 
 
@@ -171,7 +194,8 @@ def write(mech: Mechanism, path: str | os.PathLike[str], to: str | None = None) 
     Raises:
         UnknownNameError, InvalidInputError: see :func:`target`; not a Mechanism.
         SpecError: the format cannot hold something the mechanism needs (a joint MJCF has no kind for, a floating
-            base in Gepetto's format): the message names the file and the joint; a file that cannot be written.
+            base in Gepetto's format, no URDF text for pkm's spec, Gepetto's or URDF+): the message names the file
+            and what; a file that cannot be written (module doc).
     """
     mech = check_mechanism(mech)
     writer, files = destination(mech, path, to)
