@@ -36,3 +36,13 @@ def test_what_convert_refuses_is_one_error_line(tmp_path, capsys):
         assert len(err) == 1 and err[0].startswith("pkm: error: ") and message in err[0], err
     assert cli.main(["convert", "fivebar", str(tmp_path / "five.xml"), "--force"]) == 0
     assert "<connect" in (tmp_path / "five.xml").read_text()
+
+
+def test_the_help_names_every_writer_and_its_suffixes():
+    """``pkm convert --help``'s formats (a table kept apart, so that the help imports no model code) are the writers'."""
+    from pkm.cli.commands.convert import FORMATS
+    from pkm.core.formats.writers import WRITERS
+
+    assert list(FORMATS) == list(WRITERS)
+    for name, writer in WRITERS.items():
+        assert FORMATS[name].split(" ")[0] == "/".join(writer.suffixes), name

@@ -1,6 +1,6 @@
 """``pkm convert IN OUT [--to FORMAT] [--force] [--json]``: a mechanism read from anything ``pkm.load`` takes,
-written in the format OUT's suffix names (or ``--to``: ``pkm``, ``mjcf``, ``gepetto``; OUT without a suffix is then a
-folder): :mod:`pkm.core.formats.writers`. It prints every file written, what the reader noted while reading IN, and
+written in the format OUT's suffix names (or ``--to``: one of :data:`~pkm.core.formats.writers.WRITERS`, each
+listed with its suffixes in the help; OUT without a suffix is then a folder): :mod:`pkm.core.formats.writers`. It prints every file written, what the reader noted while reading IN, and
 what the target format cannot hold (left out, or kept as comments); a mechanism the format cannot express is one
 error line naming what."""
 
@@ -14,12 +14,18 @@ from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, load_mechanism
 from pkm.cli.usage import UsageError
 
+#: The formats and their suffixes as the help says them: :data:`pkm.core.formats.writers.WRITERS` (not imported here:
+#: ``pkm --help`` imports no model code; tests/cli/test_convert.py keeps the two the same).
+FORMATS = {"pkm": ".closures.toml/.toml (pkm's closure spec + URDF)", "mjcf": ".xml/.mjcf (MuJoCo's MJCF)",
+           "gepetto": ".yaml/.yml (Gepetto's URDF + YAML)", "urdfplus": ".urdf (MIT's URDF+)",
+           "sdf": ".sdf (SDFormat + pkm's closure spec)"}
+
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_mechanism_arguments(p, None, None)
-    p.add_argument("out", metavar="OUT", help="the file to write: .closures.toml/.toml (pkm's spec + URDF), .xml/.mjcf "
-                                              "(MJCF), .yaml/.yml (Gepetto's URDF + YAML); with --to, a folder too")
-    p.add_argument("--to", metavar="FORMAT", help="the format (pkm, mjcf, gepetto), when OUT's suffix does not say")
+    p.add_argument("out", metavar="OUT", help=f"the file to write: {'; '.join(FORMATS.values())}; with --to, a "
+                                              "folder too")
+    p.add_argument("--to", metavar="FORMAT", help=f"the format ({', '.join(FORMATS)}), when OUT's suffix does not say")
     p.add_argument("--force", action="store_true", help="overwrite existing files")
     p.add_argument("--json", action="store_true", help="print JSON")
 
