@@ -12,6 +12,8 @@ MuJoCo is a benchmark-only dependency (the ``bench`` extra: ``pip install "pkm[b
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pinocchio as pin
 
@@ -94,4 +96,20 @@ class MujocoRigid:
         return x[:len(self._act)]
 
 
-__all__ = ["MujocoRigid", "unavailable"]
+def equality_violation(m: Any, d: Any) -> float:
+    """The largest violation of MuJoCo's equality constraints in ``d`` (after its position stage) [m, rad]: the
+    equality rows' ``efc_pos``, a weld's three angular rows divided by its ``torquescale`` (``eq_data[10]``, which
+    MuJoCo multiplies them by: :mod:`pkm.core.formats.to_mjcf` writes 10) to give the angle."""
+    import mujoco
+
+    rows = np.flatnonzero(d.efc_type[:d.nefc] == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY))
+    if not len(rows):
+        return 0.0
+    ids = d.efc_id[rows]
+    first = {e: i for i, e in reversed(list(zip(rows, ids)))}  # (each equality's first row)
+    scale = np.array([m.eq_data[e, 10] if m.eq_type[e] == mujoco.mjtEq.mjEQ_WELD and i - first[e] >= 3 else 1.0
+                      for i, e in zip(rows, ids)])
+    return float(np.abs(d.efc_pos[rows] / scale).max())
+
+
+__all__ = ["MujocoRigid", "equality_violation", "unavailable"]

@@ -364,7 +364,7 @@ def mujoco_run(mech: Mechanism, q0: np.ndarray, law: ChirpLaw, duration: float, 
     softness."""
     import mujoco
 
-    from pkm.bench.mujoco_baseline import MujocoRigid
+    from pkm.bench.mujoco_baseline import MujocoRigid, equality_violation
 
     if path is None:
         rigid = MujocoRigid(mech)
@@ -390,12 +390,9 @@ def mujoco_run(mech: Mechanism, q0: np.ndarray, law: ChirpLaw, duration: float, 
     elif not np.allclose(mm.qpos0[qpos], mech.actuated_q(q0), rtol=0.0, atol=1e-12):
         raise ValueError(f"{path}: MuJoCo's qpos0 {mm.qpos0[qpos]} is not q0's actuated coordinates")
     md.qvel[:], md.qacc_warmstart[:] = 0.0, 0.0
-    equality = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
-
     def violation() -> float:
         mujoco.mj_fwdPosition(mm, md)
-        rows = md.efc_type[:md.nefc] == equality
-        return float(np.abs(md.efc_pos[:md.nefc][rows]).max(initial=0.0))
+        return equality_violation(mm, md)
 
     n = math.ceil(duration / dt - 1e-9)
     qa, res = [md.qpos[qpos].copy()], [violation()]

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import pkm
-from pkm.bench.mujoco_baseline import MujocoRigid, unavailable
+from pkm.bench.mujoco_baseline import MujocoRigid, equality_violation, unavailable
 from pkm.core.formats.to_mjcf import mjcf_from_mechanism
 from pkm.errors import InvalidInputError, SpecError
 
@@ -157,17 +157,11 @@ def _held_at_rest(mech: pkm.Mechanism, duration: float = 1.0, softness=None) -> 
     qa0, g = d.qpos[qpos].copy(), pkm.gravity_efforts(mech, mech.q_reference)
     Ma, w = pkm.actuator_model(mech, mech.q_reference).M, 2 * np.pi * 10.0
     m.actuator_forcelimited[:] = 0
-    equality, worst = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY), 0.0
+    worst = 0.0
     for _ in range(round(duration / m.opt.timestep)):
         d.ctrl[:] = g + Ma @ (w**2 * (qa0 - d.qpos[qpos]) - 2 * w * d.qvel[dof])
         mujoco.mj_step(m, d)
-        rows = np.flatnonzero(d.efc_type[:d.nefc] == equality)
-        scale = np.ones(len(rows))
-        for k, i in enumerate(rows):  # a weld's rows: 3 positions, then 3 angles times its torquescale
-            e = d.efc_id[i]
-            if m.eq_type[e] == mujoco.mjtEq.mjEQ_WELD and i - rows[np.argmax(d.efc_id[rows] == e)] >= 3:
-                scale[k] = m.eq_data[e, 10]
-        worst = max(worst, float(np.abs(d.efc_pos[rows] / scale).max(initial=0.0)))
+        worst = max(worst, equality_violation(m, d))
     return worst
 
 
