@@ -156,8 +156,10 @@ class CalibrationModel:
         x, m, g, y = self._expressions(self.parameters)
         T = tw.tangent
         Gq, Yq = cs.jacobian(g, tw.q) @ T, cs.jacobian(y, tw.q) @ T
-        self._close = cs.Function("close", [tw.q, m, x], [g, Gq])
-        self._full = cs.Function("full", [tw.q, m, x], [g, Gq, cs.jacobian(g, x), y, Yq, cs.jacobian(y, x)])
+        d = cs.densify  # (dense outputs: the exact route reads them entry by entry)
+        self._close = cs.Function("close", [tw.q, m, x], [d(g), d(Gq)])
+        self._full = cs.Function("full", [tw.q, m, x], [d(g), d(Gq), d(cs.jacobian(g, x)), d(y), d(Yq),
+                                                          d(cs.jacobian(y, x))])
         self._maps: dict[tuple[str, int], cs.Function] = {}
 
     def _admissible(self, P: CalibrationParameters) -> tuple[CalibrationParameters, tuple[str, ...]]:
