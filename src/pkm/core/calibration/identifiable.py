@@ -103,11 +103,12 @@ def base_geometry(model: CalibrationModel, readings: ArrayLike, *, precise: bool
     W = stacked_jacobian(model, M)
     names = model.names
     p = len(names)
-    if W.shape[0] < p:
-        raise InvalidInputError("readings", f"{len(M)} poses give {W.shape[0]} rows for {p} parameters: give at least "
-                                            f"{-(-p // len(model.rows.labels))} poses", len(M))
     scale = np.linalg.norm(W, axis=0)
     live = np.flatnonzero(scale > 1e-12 * scale.max())
+    if W.shape[0] < len(live):
+        raise InvalidInputError("readings", f"{len(M)} poses give {W.shape[0]} rows for {len(live)} parameters the "
+                                            f"measurements see: give at least "
+                                            f"{-(-len(live) // len(model.rows.labels))} poses", len(M))
     Ws = W[:, live] / scale[live]
     _, R, perm = scipy.linalg.qr(Ws, mode="economic", pivoting=True)
     decision = decide_rank(np.abs(np.diag(R)))
