@@ -96,12 +96,12 @@ def add_plan_arguments(p: argparse.ArgumentParser) -> None:
 def run_plan(args: argparse.Namespace) -> int:
     from pkm.core.calibration.estimate import perturbed, simulate
     from pkm.core.calibration.measurement import CalibrationModel
-    from pkm.core.calibration.poses import plan
+    from pkm.core.calibration.poses import calibration_poses
     from pkm.core.calibration.writeback import write_data
 
     mech = load_mechanism(args)
     model = CalibrationModel(mech, args.model)
-    chosen = plan(model, args.poses, spread=args.spread)
+    chosen = calibration_poses(model, args.poses, spread=args.spread)
     x = model.parameters.nominal if args.simulate is None else perturbed(model, args.simulate)
     y = simulate(model, x, chosen.readings, seed=args.simulate or 0,
                  sigma=None if args.simulate is not None else {"m": 0.0, "rad": 0.0})

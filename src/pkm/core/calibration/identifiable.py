@@ -182,7 +182,7 @@ def precise_rank(model: CalibrationModel, readings: ArrayLike) -> RankDecision:
 
     Raises:
         ConvergenceError: a pose does not close to :data:`~pkm.core.identification.precise.CLOSURE_TOL`.
-        InvalidInputError: a closure Jacobian is singular.
+        InvalidInputError: a closure Jacobian is singular, or the mechanism has idle motions.
     """
     import casadi as cs
     import mpmath
@@ -198,6 +198,9 @@ def precise_rank(model: CalibrationModel, readings: ArrayLike) -> RankDecision:
     )
     from pkm.errors import ConvergenceError
 
+    if model.idle:
+        raise InvalidInputError("precise", f"{model.mech.name} has {model.idle} idle motion(s): the exact route "
+                                           f"solves the closure as a square system; use precise=False", model.idle)
     M = np.atleast_2d(np.asarray(readings, dtype=float))
     Q = model.close(None, M)
     tw = model.twin

@@ -31,6 +31,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import casadi as cs
 import numpy as np
@@ -96,11 +97,17 @@ class CalibrationModel:
         if kind not in KINDS:
             raise UnknownNameError("measurement model", kind, KINDS)
         self.kind = kind
+        self.twin = tw = Twin(mech)  # (replaced below by the twin with design inputs)
+        idle = self._idle_joints()
         if kind == "passive":
-            one = [n for n, j in mech.joints.items() if j.nv == 1 and n not in mech.actuated_names]
+            one = [n for n, j in mech.joints.items() if j.nv == 1 and n not in mech.actuated_names and n not in idle]
             self.sensors = tuple(one if sensors is None else sensors)
             if not self.sensors:
                 raise InvalidInputError("sensors", "self-calibration needs encoders on passive joints", sensors)
+            moved = [s for s in self.sensors if s in idle]
+            if moved:
+                raise InvalidInputError("sensors", f"{moved[0]!r} moves in an idle motion (the actuators do not fix "
+                                                   f"it): its reading cannot be predicted", moved[0])
         else:
             self.sensors = ()
             if not mech.ee_frame:
@@ -123,10 +130,7 @@ class CalibrationModel:
         for i in P.origins:
             pd[self._tw_index[P.names[i]]] = x[i]
         value = dict(zip(P.names, [x[i] for i in range(len(P))]))
-        rows = []
-        for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
-            A, B = tw.frame_placement(fa), tw.frame_placement(fb)
-            rows.append(A.p - B.p if c.type == "point" else cs.vertcat(A.p - B.p, _vee_skew(A.R.T @ B.R)))
+        rows = [_closure(tw)]
         for k, a in enumerate(mech.actuated_names):
             qa = tw.q[int(mech.act_q[k])]
             rows.append(qa - value.get(f"{a}.gain", 1.0) * m[k] - value.get(f"{a}.offset", 0.0))
@@ -161,6 +165,20 @@ class CalibrationModel:
         self._full = cs.Function("full", [tw.q, m, x], [d(g), d(Gq), d(cs.jacobian(g, x)), d(y), d(Yq),
                                                           d(cs.jacobian(y, x))])
         self._maps: dict[tuple[str, int], cs.Function] = {}
+
+    def _idle_joints(self) -> tuple[str, ...]:
+        """The joints that move in the idle motions at the reference (motions the actuators do not fix: the
+        closure with actuated rows has a null space); :attr:`idle` counts those motions."""
+        mech, tw = self.mech, self.twin
+        rows = [_closure(tw), *(tw.q[int(i)] for i in mech.act_q)]
+        G = np.array(cs.Function("g", [tw.q], [cs.jacobian(cs.vertcat(*rows), tw.q) @ tw.tangent])(mech.q_reference))
+        _, s, Vt = np.linalg.svd(G)
+        rank = int(np.sum(s > 1e-10 * s[0])) if s.size else 0
+        null = Vt[rank:]
+        #: The number of idle motions at the reference.
+        self.idle = len(null)
+        return tuple(n for n, j in mech.joints.items()
+                     if len(null) and np.max(np.abs(null[:, j.idx_v:j.idx_v + j.nv])) > 1e-8)
 
     def _admissible(self, P: CalibrationParameters) -> tuple[CalibrationParameters, tuple[str, ...]]:
         """``P`` without the origin components that would open an overconstrained loop (module doc)."""
@@ -319,6 +337,15 @@ class CalibrationModel:
     def measure(self, x: ArrayLike | None, readings: ArrayLike) -> np.ndarray:
         """What the model measures at ``readings`` with parameters ``x`` (n x ny, :meth:`evaluate`'s layout)."""
         return self.evaluate(x, readings, jacobian=False)[0]
+
+
+def _closure(tw: Any) -> cs.SX:
+    """The closure rows of twin ``tw`` (module doc: smooth through a closed frame closure)."""
+    rows = []
+    for c, (fa, fb) in zip(tw.mech.spec.closures, tw.mech.closure_frames):
+        A, B = tw.frame_placement(fa), tw.frame_placement(fb)
+        rows.append(A.p - B.p if c.type == "point" else cs.vertcat(A.p - B.p, _vee_skew(A.R.T @ B.R)))
+    return cs.vertcat(*rows)
 
 
 def _vee(A: np.ndarray) -> np.ndarray:

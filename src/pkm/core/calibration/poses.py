@@ -46,13 +46,13 @@ class PosePlan:
 
 def conditioning(model: CalibrationModel, readings: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
     """The closure system's ``sigma_min / sigma_max`` at each pose (the twin's closure and actuated rows, along the
-    tangent space): 0 at a singularity."""
+    tangent space; the idle motions' zeros left out: :attr:`CalibrationModel.idle`): 0 at a singularity."""
     M = np.atleast_2d(readings)
     Q = model.close(x, M)
     _, Gq = model._map("close", len(M))(Q.T, M.T, model.vector(x))
     G = np.array(Gq).reshape(-1, len(M), model.mech.nv).transpose(1, 0, 2)
     s = np.linalg.svd(G, compute_uv=False)
-    return s[:, -1] / s[:, 0]
+    return s[:, -1 - model.idle] / s[:, 0]
 
 
 def candidates(model: CalibrationModel, n: int, *, spread: float = 0.1, margin: float = MARGIN,
@@ -94,7 +94,7 @@ def candidates(model: CalibrationModel, n: int, *, spread: float = 0.1, margin: 
     return np.array(out)
 
 
-def plan(model: CalibrationModel, n: int, *, pool: int | None = None, spread: float = 0.1, margin: float = MARGIN,
+def calibration_poses(model: CalibrationModel, n: int, *, pool: int | None = None, spread: float = 0.1, margin: float = MARGIN,
          seed: int = 0) -> PosePlan:
     """``n`` poses maximising O1 among ``pool`` candidates (default ``4 n``) (module doc).
 
@@ -126,4 +126,4 @@ def plan(model: CalibrationModel, n: int, *, pool: int | None = None, spread: fl
     return PosePlan(C[chosen], float(np.sum(np.log(s))), float(s[-1] ** 2 / s[0]), len(C), base)
 
 
-__all__ = ["MARGIN", "PosePlan", "candidates", "conditioning", "plan"]
+__all__ = ["MARGIN", "PosePlan", "calibration_poses", "candidates", "conditioning"]
