@@ -97,7 +97,17 @@ def base_geometry(model: CalibrationModel, readings: ArrayLike, *, precise: bool
     enough for as many rows as parameters, plus two poses) (module doc).
 
     Raises:
-        InvalidInputError: fewer rows than parameters.
+        InvalidInputError: fewer rows than the parameters the measurements see.
+
+    Examples:
+        >>> import pkm
+        >>> model = pkm.CalibrationModel(pkm.load("prs3"), "pose")
+        >>> poses = pkm.calibration_poses(model, 12, spread=0.2).readings
+        >>> base = pkm.base_geometry(model, poses, precise=False)
+        >>> len(base), base.unseen[:2]
+        (34, ('knee_1.pitch', 'coupler_1_tip_fixed.x'))
+        >>> base.absorbed["slider_1.offset"]
+        ('tracker.z', 'slider_1.pitch', 'tracker.pitch', 'slider_3.pitch', 'slider_2.pitch')
     """
     M = np.atleast_2d(np.asarray(readings, dtype=float))
     W = stacked_jacobian(model, M)

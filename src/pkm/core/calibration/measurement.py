@@ -41,7 +41,7 @@ from numpy.typing import ArrayLike
 from pkm.core.calibration.parameters import KINDS, CalibrationParameters, calibration_parameters
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.origins import ORIGIN
-from pkm.errors import ConvergenceError, InvalidInputError, UnknownNameError
+from pkm.errors import ConvergenceError, InvalidInputError, PkmError, UnknownNameError
 
 #: The closure is solved to this infinity norm, relative to the mechanism's characteristic length [m / m, rad].
 CLOSURE_TOL = 1e-13
@@ -260,7 +260,7 @@ class CalibrationModel:
         for k, qa in enumerate(M):
             try:
                 q = close_loops(self.mech, qa, q).q
-            except Exception as exc:  # noqa: BLE001 (any failure of the solver: said with the row)
+            except PkmError as exc:  # (any failure of the solver: said with the row)
                 raise InvalidInputError("readings", f"row {k + 1}: the nominal mechanism does not close at "
                                                     f"{np.round(qa, 6).tolist()} ({exc})", qa) from None
             out[k] = q
@@ -278,7 +278,7 @@ class CalibrationModel:
         model = self.mech.model
         tol = CLOSURE_TOL * max(1.0, self.mech.characteristic_length)
         f = self._map("close", len(M))
-        for it in range(MAX_NEWTON):
+        for _ in range(MAX_NEWTON):
             g, Gq = f(Q.T, M.T, x)
             g = np.array(g).T  # (n, rows)
             worst = np.max(np.abs(g), axis=1)
@@ -302,7 +302,7 @@ class CalibrationModel:
         if Q is None:
             Q = self.close(x, M)
         n = len(M)
-        g, Gq, Gx, y, Yq, Yx = (np.array(a) for a in self._map("full", n)(Q.T, M.T, x))
+        _, Gq, Gx, y, Yq, Yx = (np.array(a) for a in self._map("full", n)(Q.T, M.T, x))
         y = y.T
         if not jacobian:
             return y, None, Q

@@ -116,6 +116,12 @@ def calibration_parameters(mech: Mechanism, kind: str = "pose", *, joints: Seque
     Raises:
         InvalidInputError: an unknown ``kind`` or ``origins``, or a name clash with the frames' names.
         UnknownNameError: a joint or sensor the mechanism does not have.
+
+    Examples:
+        >>> import pkm
+        >>> P = pkm.calibration_parameters(pkm.load("prs3"), "position")
+        >>> len(P), P.names[:3], P.names[-3:]
+        (87, ('slider_1.x', 'slider_1.y', 'slider_1.z'), ('target.x', 'target.y', 'target.z'))
     """
     from pkm.core.twin.design import _urdf_joints
 

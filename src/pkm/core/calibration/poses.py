@@ -18,7 +18,7 @@ import numpy as np
 
 from pkm.core.calibration.identifiable import BaseGeometry, base_geometry, stacked_jacobian
 from pkm.core.calibration.measurement import CalibrationModel
-from pkm.errors import InvalidInputError
+from pkm.errors import InvalidInputError, PkmError
 from pkm.validation import as_count, as_scalar
 
 #: The closure system's default singularity margin (smallest over largest singular value).
@@ -78,14 +78,14 @@ def candidates(model: CalibrationModel, n: int, *, spread: float = 0.1, margin: 
         qa = qa0 + rng.uniform(-spread, spread, mech.na)
         try:
             q = close_loops(mech, qa, mech.q_reference).q
-        except Exception:  # noqa: BLE001 (outside the workspace: drawn again)
+        except PkmError:  # (outside the workspace: drawn again)
             continue
         if mech.outside_limits(q):
             continue
         try:
             if conditioning(model, qa[None])[0] < margin:
                 continue
-        except Exception:  # noqa: BLE001
+        except PkmError:  # (a singular pose: drawn again)
             continue
         out.append(qa)
     if len(out) < n:
@@ -100,6 +100,13 @@ def calibration_poses(model: CalibrationModel, n: int, *, pool: int | None = Non
 
     Raises:
         InvalidInputError: too few poses for the base parameters, or too few candidates.
+
+    Examples:
+        >>> import pkm
+        >>> model = pkm.CalibrationModel(pkm.load("prs3"), "pose")
+        >>> plan = pkm.calibration_poses(model, 12, spread=0.2)
+        >>> plan.readings.shape, plan.candidates, len(plan.base)
+        ((12, 3), 48, 34)
     """
     n = as_count(n, "n")
     C = candidates(model, pool or 4 * n, spread=spread, margin=margin, seed=seed)

@@ -41,6 +41,13 @@ def tolerance_table(model: CalibrationModel, readings: ArrayLike, delta: dict[st
 
     Raises:
         InvalidInputError: a ``planar`` or ``passive`` model.
+
+    Examples:
+        >>> import pkm
+        >>> model = pkm.CalibrationModel(pkm.load("prs3"), "pose")
+        >>> rows = pkm.tolerance_table(model, pkm.calibration_poses(model, 12, spread=0.2).readings)
+        >>> rows[0].name, round(rows[0].position[1] * 1e3, 2)  # (0.1 degree on the slider's pitch: mm at the tool)
+        ('slider_2.pitch', 2.26)
     """
     if model.kind not in ("pose", "position"):
         raise InvalidInputError("model", "a tolerance table needs a pose or position model", model.kind)

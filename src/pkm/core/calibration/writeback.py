@@ -139,7 +139,19 @@ def calibrated_mechanism(cal: Calibration) -> Mechanism:
 
 def write_calibrated(cal: Calibration, out: str | Path) -> tuple[Path, Path]:
     """Write the calibrated mechanism into folder ``out`` (module doc): the spec's path (what :func:`pkm.load`
-    takes) and ``calibration.toml``'s."""
+    takes) and ``calibration.toml``'s.
+
+    Examples:
+        >>> import tempfile
+        >>> import pkm
+        >>> from pkm.core.calibration.estimate import perturbed, simulate
+        >>> model = pkm.CalibrationModel(pkm.load("prs3"), "pose")
+        >>> poses = pkm.calibration_poses(model, 12, spread=0.2).readings
+        >>> cal = pkm.calibrate(model, poses, simulate(model, perturbed(model, seed=1), poses, seed=2))
+        >>> spec, toml = pkm.write_calibrated(cal, tempfile.mkdtemp())
+        >>> spec.name, toml.name, pkm.load(spec).name
+        ('prs3.closures.toml', 'calibration.toml', 'prs3')
+    """
     from pkm.core.formats.writers import write
 
     out = Path(out)
