@@ -104,9 +104,9 @@ def calibration_poses(model: CalibrationModel, n: int, *, pool: int | None = Non
     Examples:
         >>> import pkm
         >>> model = pkm.CalibrationModel(pkm.load("prs3"), "pose")
-        >>> plan = pkm.calibration_poses(model, 12, spread=0.2)
+        >>> plan = pkm.calibration_poses(model, 12, spread=0.2, pool=14)
         >>> plan.readings.shape, plan.candidates, len(plan.base)
-        ((12, 3), 48, 34)
+        ((12, 3), 14, 34)
     """
     n = as_count(n, "n")
     C = candidates(model, pool or 4 * n, spread=spread, margin=margin, seed=seed)

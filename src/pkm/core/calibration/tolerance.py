@@ -45,7 +45,7 @@ def tolerance_table(model: CalibrationModel, readings: ArrayLike, delta: dict[st
     Examples:
         >>> import pkm
         >>> model = pkm.CalibrationModel(pkm.load("prs3"), "pose")
-        >>> rows = pkm.tolerance_table(model, pkm.calibration_poses(model, 12, spread=0.2).readings)
+        >>> rows = pkm.tolerance_table(model, pkm.calibration_poses(model, 12, spread=0.2, pool=14).readings)
         >>> rows[0].name, round(rows[0].position[1] * 1e3, 2)  # (0.1 degree on the slider's pitch: mm at the tool)
         ('slider_2.pitch', 2.26)
     """

@@ -146,7 +146,7 @@ def write_calibrated(cal: Calibration, out: str | Path) -> tuple[Path, Path]:
         >>> import pkm
         >>> from pkm.core.calibration.estimate import perturbed, simulate
         >>> model = pkm.CalibrationModel(pkm.load("prs3"), "pose")
-        >>> poses = pkm.calibration_poses(model, 12, spread=0.2).readings
+        >>> poses = pkm.calibration_poses(model, 12, spread=0.2, pool=14).readings
         >>> cal = pkm.calibrate(model, poses, simulate(model, perturbed(model, seed=1), poses, seed=2))
         >>> spec, toml = pkm.write_calibrated(cal, tempfile.mkdtemp())
         >>> spec.name, toml.name, pkm.load(spec).name
