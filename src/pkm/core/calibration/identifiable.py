@@ -168,8 +168,9 @@ def _mp_solve(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 
 
 def _lstsq(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """The least-squares solution of ``A X = B`` (``A`` of full column rank, ``mpmath``): normal equations."""
-    return _mp_solve(A.T @ A, A.T @ B)
+    """The least-squares solution of ``A X = B`` (``A`` of full column rank, ``mpmath``): the solve itself for a
+    square ``A``, else the normal equations (a consistent tall system: its exact solution either way)."""
+    return _mp_solve(A, B) if A.shape[0] == A.shape[1] else _mp_solve(A.T @ A, A.T @ B)
 
 
 def _angle(c: float, recognise: Callable[[float], tuple[Any, bool]]) -> tuple[Any, bool]:
@@ -216,7 +217,8 @@ def precise_rank(model: CalibrationModel, readings: ArrayLike) -> RankDecision:
     tw = model.twin
     dq = cs.SX.sym("dq", model.mech.nv)
     with mpmath.workdps(DIGITS):
-        full, retract = Program(model._full), Program(cs.Function("retract", [tw.q, dq], [cs.densify(tw.retract(dq))]))
+        full, close = Program(model._full), Program(model._close)
+        retract = Program(cs.Function("retract", [tw.q, dq], [cs.densify(tw.retract(dq))]))
 
         values, known = [], 0
         for value, unit in zip(model.parameters.nominal, model.parameters.units):
@@ -228,11 +230,10 @@ def precise_rank(model: CalibrationModel, readings: ArrayLike) -> RankDecision:
         q = np.array([[mpmath.mpf(float(a)) for a in row] for row in Q.T], dtype=object)
         nv, p, S = model.mech.nv, len(model.names), len(M)
         for _ in range(MAX_NEWTON):
-            g = full(q, m, x)[0]
+            g, Gq = close(q, m, x)
             worst = max(abs(a) for a in g.ravel())
             if worst < CLOSURE_TOL:
                 break
-            Gq = full(q, m, x)[1]
             step = np.empty((nv, S), dtype=object)
             for k in range(S):
                 G = Gq[:, k].reshape(nv, -1).T  # (column-major nonzeros of a dense matrix)

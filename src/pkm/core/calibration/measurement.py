@@ -13,7 +13,7 @@ A **calibration model** (:class:`CalibrationModel`) is a mechanism, its calibrat
 
 The configuration ``q(x, m)`` solves the loop closure ``c(q, x) = 0`` with the actuated coordinates
 ``q_a = gain * m + offset`` (Newton's method on the tangent space, from the nominal mechanism's closed
-configuration), the closure rows ``A.p - B.p`` for a point closure and, for a frame closure,
+configuration, each step halved where it would raise the residual), the closure rows ``A.p - B.p`` for a point closure and, for a frame closure,
 ``[A.p - B.p; \tfrac12 \mathrm{vee}(A.R^T B.R - B.R^T A.R)]`` (the same zero set as the core's ``log6``, smooth
 through it). **The Jacobian** ``dy/dx`` follows from the implicit function theorem through the closure: with
 ``g(q, x, m) = [c; q_a - gain\, m - offset] = 0``, ``dq/dx = -G_q^+ G_x`` and ``dy/dx = Y_x + Y_q \, dq/dx``,
@@ -278,16 +278,23 @@ class CalibrationModel:
         model = self.mech.model
         tol = CLOSURE_TOL * max(1.0, self.mech.characteristic_length)
         f = self._map("close", len(M))
+        g, Gq = f(Q.T, M.T, x)
         for _ in range(MAX_NEWTON):
-            g, Gq = f(Q.T, M.T, x)
             g = np.array(g).T  # (n, rows)
             worst = np.max(np.abs(g), axis=1)
             if np.all(worst < tol):
                 return Q
             G = np.array(Gq).reshape(g.shape[1], len(M), -1).transpose(1, 0, 2)
             dq = -np.einsum("kij,kj->ki", np.linalg.pinv(G), g)
-            for k in range(len(M)):
-                Q[k] = pin.integrate(model, Q[k], dq[k])
+            step = np.ones(len(M))
+            for _ in range(8):  # (halved where the residual grows: a pose far from its seed)
+                new = np.array([pin.integrate(model, q, t * d) for q, d, t in zip(Q, dq, step)])
+                g_new, Gq_new = f(new.T, M.T, x)
+                grew = np.max(np.abs(np.array(g_new)), axis=0) > np.maximum(worst, tol)
+                if not grew.any():
+                    break
+                step[grew] *= 0.5
+            Q, g, Gq = new, g_new, Gq_new
         k = int(np.argmax(worst))
         raise ConvergenceError(f"loop closure of the calibration model at pose {k + 1}", float(worst[k]), MAX_NEWTON,
                                tol)
