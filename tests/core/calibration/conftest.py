@@ -48,7 +48,7 @@ class Simulated:
 def simulated(name: str) -> Simulated:
     """Every parameter perturbed (lengths 2 mm, angles 0.5 degree, gains 1e-3), measured with a laser tracker's
     noise at O1-chosen poses, calibrated; 10 held-out poses measured without noise."""
-    kind, n, spread = SETUPS[name]
+    _, n, spread = SETUPS[name]
     m = model(name)
     readings = calibration_poses(m, n, spread=spread, pool=3 * n).readings
     truth = perturbed(m, seed=3)

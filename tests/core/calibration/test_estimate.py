@@ -7,9 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pkm.errors import PkmWarning
-
 from pkm.core.calibration.estimate import accuracy, calibrate, simulate
+from pkm.errors import PkmWarning
 from tests.core.calibration.conftest import NOISE, simulated
 
 

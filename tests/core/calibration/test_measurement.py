@@ -24,7 +24,7 @@ def test_jacobian_matches_finite_differences(name: str, kind: str) -> None:
     rng = np.random.default_rng(0)
     readings = mech.actuated_q(mech.q_reference) + rng.uniform(-0.02, 0.02, (3, mech.na))
     x = m.parameters.nominal + rng.uniform(-1e-3, 1e-3, len(m.names))
-    y, J, _ = m.evaluate(x, readings)
+    _, J, _ = m.evaluate(x, readings)
     cols = rng.choice(len(x), 8, replace=False)
 
     def diff(h: float) -> np.ndarray:

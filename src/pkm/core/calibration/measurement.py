@@ -52,7 +52,7 @@ MAX_NEWTON = 30
 ADMISSIBLE = 1e-8
 
 
-def _rpy(r: cs.SX, p: cs.SX, y: cs.SX) -> cs.SX:
+def _rpy(r: Any, p: Any, y: Any) -> cs.SX:
     from pkm.core.twin.design import _rpy_matrix
 
     return _rpy_matrix(r, p, y)

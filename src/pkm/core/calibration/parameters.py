@@ -139,33 +139,37 @@ def calibration_parameters(mech: Mechanism, kind: str = "pose", *, joints: Seque
     names: list[str] = []
     values: list[float] = []
     units: list[str] = []
+
+    def add(name: str, value: float, unit: str) -> None:
+        names.append(name)
+        values.append(value)
+        units.append(unit)
+
     for j in chosen:
         extra = ("roll", "pitch") if (directions and j in mech.actuated_names and not mech.joints[j].revolute
                                       and not flat and origins == "position") else ()
         for c in comps + extra:
             attr, i = ORIGIN[c]
-            names.append(f"{j}.{c}")
-            values.append(float(urdf[j][0 if attr == "xyz" else 1][i]))
-            units.append("m" if attr == "xyz" else "rad")
+            add(f"{j}.{c}", float(urdf[j][0 if attr == "xyz" else 1][i]), "m" if attr == "xyz" else "rad")
     origin_idx = tuple(range(len(names)))
     for a in mech.actuated_names:
         unit = "rad" if mech.joints[a].revolute else "m"
         if offsets:
-            names.append(f"{a}.offset"), values.append(0.0), units.append(unit)
+            add(f"{a}.offset", 0.0, unit)
         if gains:
-            names.append(f"{a}.gain"), values.append(1.0), units.append("1")
+            add(f"{a}.gain", 1.0, "1")
     for s in sensors:
         if s not in mech.joints or mech.joints[s].nv != 1:
             raise UnknownNameError("passive joint with one coordinate", s,
                                    [n for n, j in mech.joints.items() if j.nv == 1 and n not in mech.actuated_names])
-        names.append(f"{s}.offset"), values.append(0.0), units.append("rad" if mech.joints[s].revolute else "m")
+        add(f"{s}.offset", 0.0, "rad" if mech.joints[s].revolute else "m")
     tracker, target = FRAMES[kind]
     for frame, comps_f in (("tracker", tracker), ("target", target)):
         if frame in urdf:
             raise InvalidInputError("mechanism", f"a URDF joint is named {frame!r}: the measurement frames' names "
                                                  f"would clash", frame)
         for c in comps_f:
-            names.append(f"{frame}.{c}"), values.append(0.0), units.append("m" if c in ("x", "y", "z") else "rad")
+            add(f"{frame}.{c}", 0.0, "m" if c in ("x", "y", "z") else "rad")
     if len(set(names)) != len(names):
         raise InvalidInputError("parameters", "a parameter is named twice (a joint listed twice?)", names)
     return CalibrationParameters(tuple(names), np.array(values, dtype=float), tuple(units), origin_idx)
