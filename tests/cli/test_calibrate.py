@@ -15,9 +15,9 @@ from pkm import cli
 def test_plan_simulate_calibrate_write_load(tmp_path, capsys) -> None:
     pytest.importorskip("matplotlib")
     data = tmp_path / "data.csv"
-    assert cli.main(["calibrate", "plan", "prs3", "--poses", "14", "--spread", "0.2", "--out", str(data),
+    assert cli.main(["calibrate", "plan", "prs3", "--poses", "12", "--spread", "0.2", "--out", str(data),
                      "--simulate", "3"]) == 0
-    assert "14 poses" in capsys.readouterr().out
+    assert "12 poses" in capsys.readouterr().out
     out = tmp_path / "out"
     assert cli.main(["calibrate", "prs3", str(data), "--out", str(out), "--plot", str(tmp_path / "r.png"),
                      "--json"]) == 0
