@@ -27,7 +27,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("data", metavar="DATA", help="CSV or Parquet: m.<joint> readings and the measured columns")
     p.add_argument("--out", metavar="DIR", required=True, help="folder for the calibrated spec, URDF and calibration.toml")
     p.add_argument("--model", default="pose", choices=("pose", "position", "planar", "passive"), help=KIND_HELP)
-    p.add_argument("--loss", default="linear", help="least-squares loss: linear (LM) or soft_l1, huber, cauchy")
+    p.add_argument("--loss", default="linear", choices=("linear", "soft_l1", "huber", "cauchy", "arctan"),
+                   help="least-squares loss: linear (Levenberg-Marquardt) or a robust one (trust-region)")
     p.add_argument("--plot", metavar="FILE.png", help="the residuals before and after, per pose (pkm[figures])")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
 

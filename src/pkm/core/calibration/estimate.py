@@ -70,7 +70,7 @@ class Calibration:
         std: Their standard deviations (SI).
         base: The base geometry at the nominal parameters.
         chi2: The reduced chi-square (module doc).
-        before: The residual accuracy of the nominal model at the calibration poses.
+        before: The accuracy of the starting parameters (``x0``, nominal by default) at the calibration poses.
         after: The residual accuracy of the calibrated model there.
         nfev: Residual evaluations.
         method: ``"lm"`` or ``"trf"``; ``loss`` the loss.
@@ -271,8 +271,12 @@ def perturbed(model: CalibrationModel, seed: int = 0, *, length: float = 2e-3, a
 def simulate(model: CalibrationModel, x_true: ArrayLike, readings: ArrayLike, *,
              sigma: Mapping[str, float] | None = None, seed: int = 0) -> np.ndarray:
     """What the instrument would read at ``readings`` on the mechanism of parameters ``x_true``, with Gaussian
-    noise of ``sigma`` (by unit, :data:`SIGMA`; ``{}``... zeros: ``{"m": 0, "rad": 0}``): a pose's position
-    noise per axis, its orientation noise a random rotation vector of ``sigma["rad"]`` per axis."""
+    noise of ``sigma`` by unit (default :data:`SIGMA`; ``{"m": 0, "rad": 0}`` for none): a pose's position noise
+    per axis, its orientation turned by a random rotation vector of ``sigma["rad"]`` per axis.
+
+    Raises:
+        ConvergenceError: the mechanism of ``x_true`` does not reach a pose (its loops do not close there).
+    """
     rng = np.random.default_rng(seed)
     sig = dict(SIGMA, **(sigma or {}))
     y = model.measure(x_true, readings)
