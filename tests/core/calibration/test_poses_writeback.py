@@ -87,3 +87,27 @@ def test_tolerance_table_matches_the_closed_mechanism() -> None:
             x[m.names.index(row.name)] += row.delta
             err = np.linalg.norm(m.measure(x, readings)[:, :3] - y0[:, :3], axis=1).max()
             assert err == pytest.approx(row.position[1], rel=tol)
+
+
+def test_an_mjcf_mechanism_self_calibrates_and_is_written_back_as_mjcf_too(tmp_path) -> None:
+    """The MJCF four-bar example, its passive joints read by encoders: calibrated, written as spec + URDF and as
+    MJCF, both loading to the same calibrated geometry (the coupler's reading predicted alike)."""
+    from pathlib import Path
+
+    from pkm.core.calibration.estimate import perturbed, simulate
+    from pkm.core.calibration.measurement import CalibrationModel
+
+    mech = pkm.load(str(Path(__file__).parents[3] / "examples" / "mjcf_fourbar" / "fourbar.xml"))
+    m = CalibrationModel(mech, "passive")
+    readings = calibration_poses(m, 12, spread=0.3, pool=14).readings
+    cal = calibrate(m, readings, simulate(m, perturbed(m, seed=1), readings, seed=2))
+    assert cal.after.position[1] < 3 * 20e-6 < 1e-3 < cal.before.position[1]
+    spec, _, mjcf = write_calibrated(cal, tmp_path)
+    v = cal.values()
+    qa = [v["crank_joint.gain"] * readings[0, 0] + v["crank_joint.offset"]]
+    angles = []
+    for other in (pkm.load(spec), pkm.load(mjcf)):
+        q = pkm.close_loops(other, qa, tol=1e-13).q
+        angles.append(q[other.joints["coupler_joint"].idx_q])
+    predicted = m.measure(cal.x, readings[:1])[0, m.sensors.index("coupler_joint")] - v["coupler_joint.offset"]
+    assert abs(angles[0] - predicted) < 1e-10 and abs(angles[1] - predicted) < 1e-6

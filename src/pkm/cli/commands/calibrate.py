@@ -44,11 +44,12 @@ def run(args: argparse.Namespace) -> int:
     model = CalibrationModel(mech, args.model)
     M, Y = read_data(model, args.data)
     cal = calibrate(model, M, Y, loss=args.loss)
-    spec, toml = write_calibrated(cal, args.out)
+    spec, toml, *mjcf = write_calibrated(cal, args.out)
     out: dict[str, Any] = {"mechanism": mech.name, "model": args.model, "poses": len(M), "base": len(cal.free),
                            "chi2": cal.chi2, "before": cal.before.as_dict(), "after": cal.after.as_dict(),
                            "estimated": {n: {"change": d, "std": s} for n, (d, s) in cal.changes().items()},
-                           "unseen": list(cal.base.unseen), "spec": str(spec), "calibration": str(toml)}
+                           "unseen": list(cal.base.unseen), "spec": str(spec), "calibration": str(toml),
+                           "mjcf": str(mjcf[0]) if mjcf else None}
     if args.plot:
         out["plot"] = str(_plot(cal, M, Y, Path(args.plot)))
     if args.json:
@@ -61,7 +62,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"{label}: {text} (m, rad)")
     for name, (d, s) in cal.changes().items():
         print(f"  {name:40s} {d:+.6g} +- {s:.3g}")
-    print(f"out: {spec}\ncalibration: {toml}" + (f"\nplot: {out['plot']}" if args.plot else ""))
+    print(f"out: {spec}\ncalibration: {toml}" + (f"\nmjcf: {mjcf[0]}" if mjcf else "")
+          + (f"\nplot: {out['plot']}" if args.plot else ""))
     return 0
 
 

@@ -14,7 +14,7 @@ mechanism does not close (outside the workspace).
 
 **Writing back** (:func:`write_calibrated`): the calibrated joint origins set in the URDF, the mechanism assembled
 again (:func:`~pkm.core.twin.design.design_mechanism`) and saved as a closure spec + URDF that :func:`pkm.load`
-reads (:func:`pkm.save`); the actuator offsets and gains and the measurement frames, which belong to the
+reads (:func:`pkm.save`), and as MJCF too where the mechanism was read from MJCF; the actuator offsets and gains and the measurement frames, which belong to the
 instrument and the drives' readings rather than to the geometry, go to ``calibration.toml`` beside them, with each
 estimated parameter's standard deviation and the accuracy before and after.
 """
@@ -137,9 +137,9 @@ def calibrated_mechanism(cal: Calibration) -> Mechanism:
     return design_mechanism(cal.model.mech, {P.names[k]: float(cal.x[k]) for k in P.origins})
 
 
-def write_calibrated(cal: Calibration, out: str | Path) -> tuple[Path, Path]:
+def write_calibrated(cal: Calibration, out: str | Path) -> tuple[Path, ...]:
     """Write the calibrated mechanism into folder ``out`` (module doc): the spec's path (what :func:`pkm.load`
-    takes) and ``calibration.toml``'s.
+    takes), ``calibration.toml``'s and, where the mechanism was read from MJCF, the calibrated MJCF's.
 
     Examples:
         >>> import tempfile
@@ -148,7 +148,7 @@ def write_calibrated(cal: Calibration, out: str | Path) -> tuple[Path, Path]:
         >>> model = pkm.CalibrationModel(pkm.load("prs3"), "pose")
         >>> poses = pkm.calibration_poses(model, 12, spread=0.2, pool=14).readings
         >>> cal = pkm.calibrate(model, poses, simulate(model, perturbed(model, seed=1), poses, seed=2))
-        >>> spec, toml = pkm.write_calibrated(cal, tempfile.mkdtemp())
+        >>> spec, toml = pkm.write_calibrated(cal, tempfile.mkdtemp())  # (and the MJCF, for a model read from one)
         >>> spec.name, toml.name, pkm.load(spec).name
         ('prs3.closures.toml', 'calibration.toml', 'prs3')
     """
@@ -166,7 +166,19 @@ def write_calibrated(cal: Calibration, out: str | Path) -> tuple[Path, Path]:
         lines += ["", f"[accuracy.{label}]"] + [f"{k} = {v!r}" for k, v in acc.as_dict().items()]
     path = out / "calibration.toml"
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    if _from_mjcf(cal.model.mech):
+        return spec, path, write(mech, out, "mjcf").files[0]
     return spec, path
+
+
+def _from_mjcf(mech: Mechanism) -> bool:
+    """Whether ``mech`` was read from an MJCF file."""
+    from pkm.core.formats.imported import format_of
+
+    source = Path(mech.source)
+    if source.suffix.lower() not in (".xml", ".mjcf") or not source.is_file():
+        return False
+    return format_of(source, source.read_text(encoding="utf-8", errors="replace")).name == "mjcf"
 
 
 __all__ = ["calibrated_mechanism", "columns", "from_layout", "read_data", "to_layout", "write_calibrated",
