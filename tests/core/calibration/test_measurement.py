@@ -11,7 +11,6 @@ import pytest
 import pkm
 from pkm.core.calibration.measurement import CalibrationModel
 from pkm.core.calibration.parameters import calibration_parameters
-from pkm.core.twin.design import design_mechanism
 from tests.core.calibration.conftest import mechanism, model
 from tests.fd import rel, richardson
 
@@ -40,7 +39,8 @@ def test_jacobian_matches_finite_differences(name: str, kind: str) -> None:
 
 def test_prediction_matches_pinocchio_on_the_written_mechanism() -> None:
     """Joint origins, actuator offsets and gains and the tracker's and target's frames all changed: the model's pose
-    equals ``T^-1 oMf E`` from Pinocchio on the mechanism :func:`design_mechanism` builds (1e-12 m)."""
+    equals ``T^-1 oMf E`` from Pinocchio on the mechanism :meth:`CalibrationModel.mechanism` builds (the URDF
+    written with the origins and read again), to 1e-12 m."""
     mech = mechanism("gough_stewart")
     m = CalibrationModel(mech, "pose")
     rng = np.random.default_rng(1)
@@ -48,7 +48,7 @@ def test_prediction_matches_pinocchio_on_the_written_mechanism() -> None:
     reading = mech.actuated_q(mech.q_reference) + 0.01
     y = m.measure(x, reading[None])[0]
     v = dict(zip(m.names, x))
-    other = design_mechanism(mech, {m.names[k]: x[k] for k in m.parameters.origins})
+    other = m.mechanism(x)
     qa = [v[f"{a}.gain"] * r + v[f"{a}.offset"] for a, r in zip(mech.actuated_names, reading)]
     q = pkm.close_loops(other, qa, tol=1e-13).q
     data = other.model.createData()

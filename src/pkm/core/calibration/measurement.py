@@ -341,6 +341,15 @@ class CalibrationModel:
             r[:, 2] = np.angle(np.exp(1j * r[:, 2]))
         return r, J
 
+    def mechanism(self, x: ArrayLike | None = None) -> Mechanism:
+        """The mechanism with the joint origins of ``x`` (its loops assembled again at the file's reference:
+        :func:`~pkm.core.twin.design.design_mechanism`); the actuators' offsets and gains and the frames stay
+        with the readings and the instrument."""
+        from pkm.core.twin.design import design_mechanism
+
+        x = self.vector(x)
+        return design_mechanism(self.mech, {self.names[k]: float(x[k]) for k in self.parameters.origins})
+
     def measure(self, x: ArrayLike | None, readings: ArrayLike) -> np.ndarray:
         """What the model measures at ``readings`` with parameters ``x`` (n x ny, :meth:`evaluate`'s layout)."""
         return self.evaluate(x, readings, jacobian=False)[0]

@@ -131,10 +131,7 @@ def write_data(model: CalibrationModel, path: str | Path, readings: np.ndarray, 
 
 def calibrated_mechanism(cal: Calibration) -> Mechanism:
     """The mechanism with the calibrated joint origins (module doc)."""
-    from pkm.core.twin.design import design_mechanism
-
-    P = cal.model.parameters
-    return design_mechanism(cal.model.mech, {P.names[k]: float(cal.x[k]) for k in P.origins})
+    return cal.model.mechanism(cal.x)
 
 
 def write_calibrated(cal: Calibration, out: str | Path) -> tuple[Path, ...]:
