@@ -261,7 +261,7 @@ def precise_rank(model: CalibrationModel, readings: ArrayLike) -> RankDecision:
                 J = np.vstack([J[:3], rot])
             blocks.append(J * np.array([mpmath.mpf(float(s)) for s in scale], dtype=object)[:, None])
         W = np.vstack(blocks)
-        unrecognised = full.unrecognised + retract.unrecognised + len(values) - known
+        unrecognised = full.unrecognised + close.unrecognised + retract.unrecognised + len(values) - known
         floor = MODEL_FLOOR if unrecognised else 10.0 ** (-DIGITS + 10)
         norms = np.array([mpmath.sqrt((W[:, j] * W[:, j]).sum()) for j in range(W.shape[1])], dtype=object)
         top = max(norms)
