@@ -23,6 +23,13 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.dynamics.simulate": ("Event", "Simulation", "simulate"),
     "pkm.core.analysis.capability": ("Capability", "Polytope", "capability"),
     "pkm.core.analysis.region": ("Region", "feasible_region"),
+    "pkm.core.calibration.estimate": ("Calibration", "calibrate"),
+    "pkm.core.calibration.identifiable": ("BaseGeometry", "base_geometry"),
+    "pkm.core.calibration.measurement": ("CalibrationModel",),
+    "pkm.core.calibration.parameters": ("CalibrationParameters", "calibration_parameters"),
+    "pkm.core.calibration.poses": ("PosePlan", "calibration_poses"),
+    "pkm.core.calibration.tolerance": ("ToleranceRow", "tolerance_table"),
+    "pkm.core.calibration.writeback": ("write_calibrated",),
     "pkm.core.identification.base": ("BaseParameters", "base_parameters"),
     "pkm.core.identification.consistent": ("ConsistentEstimate", "consistent_estimate"),
     "pkm.core.identification.estimate": ("Estimate", "estimate"),
@@ -46,6 +53,13 @@ _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.analysis.capability import Capability, Polytope, capability
     from pkm.core.analysis.region import Region, feasible_region
+    from pkm.core.calibration.estimate import Calibration, calibrate
+    from pkm.core.calibration.identifiable import BaseGeometry, base_geometry
+    from pkm.core.calibration.measurement import CalibrationModel
+    from pkm.core.calibration.parameters import CalibrationParameters, calibration_parameters
+    from pkm.core.calibration.poses import PosePlan, calibration_poses
+    from pkm.core.calibration.tolerance import ToleranceRow, tolerance_table
+    from pkm.core.calibration.writeback import write_calibrated
     from pkm.core.differential.velocity import (
         Diagnostics,
         accelerations,

@@ -10,6 +10,7 @@ from __future__ import annotations
 from pkm.cli.command import Command
 from pkm.cli.commands import (
     bench,
+    calibrate,
     capability,
     convert,
     dynamics,
@@ -38,6 +39,8 @@ COMMANDS: dict[str, Command] = {
     "simulate": simulate.COMMAND,
     "excite": excite.COMMAND,
     "identify": identify.COMMAND,
+    "calibrate": calibrate.COMMAND,
+    "calibrate plan": calibrate.PLAN,
     "capability": capability.COMMAND,
     "export": export.COMMAND,
     "convert": convert.COMMAND,

@@ -1,0 +1,295 @@
+"""The estimate: the base calibration parameters by weighted nonlinear least squares, their standard deviations,
+and the accuracy before and after on held-out poses.
+
+:func:`calibrate` frees the independent parameters of the base geometry (:func:`~pkm.core.calibration.identifiable.
+base_geometry`), holds the others at their nominal values (a dependent parameter's error is absorbed by those it
+combines with: :attr:`~pkm.core.calibration.identifiable.BaseGeometry.absorbed`), and minimises the residuals
+divided by the instrument's standard deviations (``sigma``: position [m], angle [rad], passive reading [rad or m])
+with ``scipy.optimize.least_squares``: Levenberg-Marquardt (``method="lm"``) without bounds and with the plain
+loss, else the trust-region reflective method (``"trf"``) with the bounds and a robust ``loss`` (``"soft_l1"``,
+``"huber"``, ``"cauchy"``; ``f_scale`` one standard deviation). The residual's Jacobian is the model's exact one
+(:mod:`~pkm.core.calibration.measurement`), the loops closed anew at every iterate from the last closed poses.
+
+**Standard deviations**: ``sqrt(diag(s^2 (J^T J)^{-1}))`` of the weighted Jacobian at the solution, ``s^2`` the
+reduced chi-square (the sum of squared weighted residuals over rows minus free parameters: 1 when ``sigma`` is the
+noise); :attr:`Calibration.std` per free parameter.
+
+**Accuracy** (:func:`accuracy`): per pose, the position error ``|p - p_m|`` [m] and the orientation error (the
+angle of ``R_m^T R`` [rad]; the planar yaw's difference), their mean, RMS and maximum.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from pkm.core.calibration.identifiable import BaseGeometry, base_geometry
+from pkm.core.calibration.measurement import CalibrationModel
+from pkm.errors import ConvergenceError, InvalidInputError, PkmWarning, UnknownNameError
+
+#: The least squares stop when the cost or the step changes by less than this, relative.
+TOL = 1e-10
+#: The same for the trust-region method (bounds, robust losses), whose last steps are slower.
+TRF_TOL = 1e-8
+LOSSES = ("linear", "soft_l1", "huber", "cauchy", "arctan")
+#: Default instrument standard deviations: a laser tracker's 10 µm and 20 µrad, an encoder's 20 µrad.
+SIGMA = {"m": 10e-6, "rad": 20e-6}
+
+
+@dataclass(frozen=True)
+class Accuracy:
+    """Pose errors over a set of poses (module doc): ``position`` and ``orientation`` each ``(mean, rms, max)``
+    [m] and [rad] (None where the model does not measure it); ``n`` poses."""
+
+    position: tuple[float, float, float] | None
+    orientation: tuple[float, float, float] | None
+    n: int
+
+    def as_dict(self) -> dict[str, float]:
+        """Flat ``{"position_rms": ..., ...}`` (SI)."""
+        out: dict[str, float] = {}
+        for what, stats in (("position", self.position), ("orientation", self.orientation)):
+            for label, v in zip(("mean", "rms", "max"), stats or ()):
+                out[f"{what}_{label}"] = v
+        return out
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """A calibration's result (module doc).
+
+    Attributes:
+        model: The calibration model.
+        x: Every parameter's value (the dependent ones at their nominal values).
+        free: The indices of the estimated parameters (the base geometry's independent ones).
+        std: Their standard deviations (SI).
+        base: The base geometry at the nominal parameters.
+        chi2: The reduced chi-square (module doc).
+        before: The accuracy of the starting parameters (``x0``, nominal by default) at the calibration poses.
+        after: The residual accuracy of the calibrated model there.
+        nfev: Residual evaluations.
+        method: ``"lm"`` or ``"trf"``; ``loss`` the loss.
+        loss: See ``method``.
+        sigma: The standard deviations the residuals were divided by (per unit).
+    """
+
+    model: CalibrationModel
+    x: np.ndarray
+    free: tuple[int, ...]
+    std: np.ndarray
+    base: BaseGeometry
+    chi2: float
+    before: Accuracy
+    after: Accuracy
+    nfev: int
+    method: str
+    loss: str
+    sigma: Mapping[str, float] = field(default_factory=dict)
+
+    def values(self) -> dict[str, float]:
+        """Every parameter by name (SI)."""
+        return dict(zip(self.model.names, map(float, self.x)))
+
+    def changes(self) -> dict[str, tuple[float, float]]:
+        """The estimated parameters: name -> (value - nominal, standard deviation) (SI)."""
+        nominal = self.model.parameters.nominal
+        return {self.model.names[k]: (float(self.x[k] - nominal[k]), float(s)) for k, s in zip(self.free, self.std)}
+
+
+def _angle_errors(R: np.ndarray, Rm: np.ndarray) -> np.ndarray:
+    return np.array([np.linalg.norm(pin.log3(a.T @ b)) for a, b in zip(Rm, R)])
+
+
+def _stats(e: np.ndarray) -> tuple[float, float, float]:
+    return float(np.mean(e)), float(np.sqrt(np.mean(e * e))), float(np.max(e))
+
+
+def pose_errors(model: CalibrationModel, y: np.ndarray, measured: ArrayLike) -> Accuracy:
+    """The :class:`Accuracy` of predictions ``y`` against ``measured`` (:meth:`CalibrationModel.evaluate`'s
+    layout); for ``passive``, ``position`` holds the readings' errors (in their joints' units)."""
+    Ym = np.asarray(measured, dtype=float)
+    if model.kind == "pose":
+        R, Rm = (a[:, 3:].reshape(-1, 3, 3).transpose(0, 2, 1) for a in (y, Ym))
+        return Accuracy(_stats(np.linalg.norm(y[:, :3] - Ym[:, :3], axis=1)), _stats(_angle_errors(R, Rm)), len(y))
+    if model.kind == "position":
+        return Accuracy(_stats(np.linalg.norm(y - Ym, axis=1)), None, len(y))
+    if model.kind == "planar":
+        yaw = np.abs(np.angle(np.exp(1j * (y[:, 2] - Ym[:, 2]))))
+        return Accuracy(_stats(np.linalg.norm(y[:, :2] - Ym[:, :2], axis=1)), _stats(yaw), len(y))
+    return Accuracy(_stats(np.abs(y - Ym).ravel()), None, len(y))
+
+
+def accuracy(model: CalibrationModel, x: ArrayLike | None, readings: ArrayLike, measured: ArrayLike) -> Accuracy:
+    """The pose errors of the model with parameters ``x`` (None: nominal) at ``readings`` against ``measured``."""
+    return pose_errors(model, model.measure(x, readings), measured)
+
+
+def _weights(model: CalibrationModel, sigma: Mapping[str, float]) -> np.ndarray:
+    out = []
+    for u in model.rows.units:
+        s = sigma.get(u, SIGMA.get(u))
+        if s is None or not s > 0.0:
+            raise InvalidInputError("sigma", f"expected a positive standard deviation for the {u} rows", sigma)
+        out.append(1.0 / s)
+    return np.array(out)
+
+
+def calibrate(model: CalibrationModel, readings: ArrayLike, measured: ArrayLike, *,
+              sigma: Mapping[str, float] | None = None, loss: str = "linear",
+              bounds: Mapping[str, tuple[float, float]] | None = None, base: BaseGeometry | None = None,
+              x0: ArrayLike | None = None, max_nfev: int = 200) -> Calibration:
+    """Estimate ``model``'s base parameters from the measurements ``measured`` (n x ny, :meth:`CalibrationModel.
+    evaluate`'s layout) at the actuators' ``readings`` (n x na) (module doc).
+
+    Args:
+        model: The calibration model.
+        readings: The actuators' readings [rad or m].
+        measured: What the instrument measured at each pose.
+        sigma: The instrument's standard deviations by unit (``{"m": 1e-5, "rad": 2e-5}``: :data:`SIGMA`).
+        loss: ``"linear"`` (least squares) or a robust loss (:data:`LOSSES`).
+        bounds: ``{name: (low, high)}`` on estimated parameters (SI; then ``trf``).
+        base: The base geometry (default: computed at the nominal parameters and these poses, double precision).
+        x0: The starting parameters (default nominal).
+        max_nfev: Residual evaluations at most.
+
+    Raises:
+        InvalidInputError: fewer residual rows than free parameters, shapes that do not match, an unknown loss.
+        UnknownNameError: a bound on a parameter that is not estimated.
+        ConvergenceError: the least squares did not converge.
+
+    Examples:
+        A simulated calibration: a perturbed 3-PRS measured with a laser tracker's noise.
+
+        >>> import pkm
+        >>> from pkm.core.calibration.estimate import perturbed, simulate
+        >>> model = pkm.CalibrationModel(pkm.load("prs3"), "pose")
+        >>> poses = pkm.calibration_poses(model, 12, spread=0.2, pool=14).readings
+        >>> measured = simulate(model, perturbed(model, seed=1), poses, seed=2)
+        >>> cal = pkm.calibrate(model, poses, measured)
+        >>> len(cal.free), cal.before.position[1] > 1e-3, cal.after.position[1] < 2e-5
+        (34, True, True)
+    """
+    import scipy.optimize
+
+    M = model._readings(readings)
+    Ym = np.asarray(measured, dtype=float)
+    ny = model.measure(None, M[:1]).shape[1]
+    if Ym.shape != (len(M), ny):
+        raise InvalidInputError("measured", f"expected {len(M)} x {ny} measurements ({model.kind})", Ym.shape)
+    if loss not in LOSSES:
+        raise UnknownNameError("loss", loss, LOSSES)
+    sig = dict(SIGMA, **(sigma or {}))
+    w = _weights(model, sig)
+    if base is None:
+        base = base_geometry(model, M, precise=False)
+    free = list(base.independent)
+    rows = len(M) * len(w)
+    if rows <= len(free):
+        raise InvalidInputError("readings", f"{len(M)} poses give {rows} residuals for {len(free)} base parameters: "
+                                            f"give more poses", len(M))
+    x = model.vector(x0).copy()
+    seeds = model.seeds(M)
+    state: dict[str, np.ndarray] = {"Q": seeds}
+
+    start = x[free].copy()
+
+    def parts(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        xx = x.copy()
+        xx[free] = start + z  # (the deviation from the start: MINPACK's first step is then bounded in J's scale)
+        try:
+            try:
+                Q = model.close(xx, M, state["Q"])
+            except ConvergenceError:
+                Q = model.close(xx, M, seeds)
+        except ConvergenceError:  # (a step too long for the loops to close: a large residual makes it shorter)
+            return np.full(rows, 1e6), np.zeros((rows, len(free)))
+        state["Q"] = Q
+        y, J, _ = model.evaluate(xx, M, Q)
+        r, Jr = model.residual(y, Ym, J)
+        assert Jr is not None
+        return (r * w).ravel(), (Jr[:, :, free] * w[None, :, None]).reshape(rows, len(free))
+
+    cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+
+    def cached(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        key = z.tobytes()
+        if key not in cache:
+            cache.clear()
+            cache[key] = parts(z)
+        return cache[key]
+
+    lo, hi = np.full(len(free), -np.inf), np.full(len(free), np.inf)
+    for name, (a, b) in (bounds or {}).items():
+        k = model.parameters.index(name)
+        if k not in free:
+            raise UnknownNameError("estimated parameter", name, [model.names[i] for i in free])
+        lo[free.index(k)], hi[free.index(k)] = a, b
+    method = "lm" if loss == "linear" and not bounds else "trf"
+    tol = TOL if method == "lm" else TRF_TOL
+    lo, hi = lo - start, hi - start
+    z0 = np.clip(np.zeros(len(free)), lo, hi)
+    r0 = cached(z0)[0]
+    before = accuracy(model, x, M, Ym)
+    sol = scipy.optimize.least_squares(lambda z: cached(z)[0], z0, jac=lambda z: cached(z)[1], method=method,
+                                       loss=loss, f_scale=1.0, bounds=(lo, hi) if method == "trf" else (-np.inf, np.inf),
+                                       x_scale="jac", max_nfev=max_nfev, **dict.fromkeys(("xtol", "ftol", "gtol"), tol))
+    if sol.status <= 0:
+        raise ConvergenceError("calibration least squares", float(np.max(np.abs(sol.fun))), int(sol.nfev), tol,
+                               sol)
+    x[free] = start + sol.x
+    r, J = cached(sol.x)
+    dof = rows - len(free)
+    chi2 = float(r @ r / dof)
+    try:
+        cov = np.linalg.inv(J.T @ J) * chi2
+    except np.linalg.LinAlgError:
+        cov = np.linalg.pinv(J.T @ J) * chi2
+    std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    if loss == "linear" and chi2 > 9.0 and float(r0 @ r0) > 0.0:  # (a robust loss expects its outliers)
+        warnings.warn(f"the calibrated model leaves residuals {np.sqrt(chi2):.3g} times the stated sigma (reduced "
+                      f"chi-square {chi2:.3g}): a sigma too small, a wrong measurement model or outliers (loss)",
+                      PkmWarning, stacklevel=2)
+    return Calibration(model, x, tuple(free), std, base, chi2, before, accuracy(model, x, M, Ym), int(sol.nfev),
+                       method, loss, sig)
+
+
+def perturbed(model: CalibrationModel, seed: int = 0, *, length: float = 2e-3, angle: float = np.deg2rad(0.5),
+              gain: float = 1e-3) -> np.ndarray:
+    """A random "true" parameter vector: every length within ``length`` [m] and every angle within ``angle`` [rad]
+    of its nominal value (uniform), gains within ``gain`` of 1 (simulated calibrations)."""
+    rng = np.random.default_rng(seed)
+    P = model.parameters
+    spread = np.array([length if u == "m" else angle if u == "rad" else gain for u in P.units])
+    return P.nominal + rng.uniform(-1.0, 1.0, len(P)) * spread
+
+
+def simulate(model: CalibrationModel, x_true: ArrayLike, readings: ArrayLike, *,
+             sigma: Mapping[str, float] | None = None, seed: int = 0) -> np.ndarray:
+    """What the instrument would read at ``readings`` on the mechanism of parameters ``x_true``, with Gaussian
+    noise of ``sigma`` by unit (default :data:`SIGMA`; ``{"m": 0, "rad": 0}`` for none): a pose's position noise
+    per axis, its orientation turned by a random rotation vector of ``sigma["rad"]`` per axis.
+
+    Raises:
+        ConvergenceError: the mechanism of ``x_true`` does not reach a pose (its loops do not close there).
+    """
+    rng = np.random.default_rng(seed)
+    sig = dict(SIGMA, **(sigma or {}))
+    y = model.measure(x_true, readings)
+    if model.kind == "pose":
+        y[:, :3] += rng.normal(0.0, sig["m"], (len(y), 3))
+        for k in range(len(y)):
+            R = y[k, 3:].reshape(3, 3).T @ pin.exp3(rng.normal(0.0, sig["rad"], 3))
+            y[k, 3:] = R.T.ravel()
+    else:
+        units = model.rows.units
+        y += rng.normal(0.0, 1.0, y.shape) * np.array([sig[u] for u in units])
+    return y
+
+
+__all__ = ["LOSSES", "SIGMA", "Accuracy", "Calibration", "accuracy", "calibrate", "perturbed", "pose_errors",
+           "simulate"]

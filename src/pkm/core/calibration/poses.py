@@ -1,0 +1,136 @@
+"""Pose selection: the calibration poses that make the base parameters best observed.
+
+Candidates are random actuator readings around the reference, within ``spread`` [rad or m] of it, kept where the
+nominal mechanism closes, within its joint limits (:meth:`~pkm.core.Mechanism.outside_limits`: the workspace) and
+away from singularities: the closure system's smallest singular value over its largest (:func:`conditioning`) at
+least ``margin``. Among them, ``n`` poses are chosen greedily to maximise the observability index **O1** (Borm and
+Menq: the product of the singular values of the base parameters' scaled Jacobian, that is ``sqrt(det(J^T J))``, the
+D-optimal criterion), each step adding the candidate that raises ``log det(J^T J + eps I)`` most (the matrix
+determinant lemma: ``log det(I + J_k A^{-1} J_k^T)``). O1 is the one optimised; O4 (the noise amplification
+``sigma_min^2 / sigma_max``) is reported for the choice (:attr:`PosePlan.o4`), not optimised.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pkm.core.calibration.identifiable import BaseGeometry, base_geometry, stacked_jacobian
+from pkm.core.calibration.measurement import CalibrationModel
+from pkm.errors import InvalidInputError, PkmError
+from pkm.validation import as_count, as_scalar
+
+#: The closure system's default singularity margin (smallest over largest singular value).
+MARGIN = 1e-3
+
+
+@dataclass(frozen=True)
+class PosePlan:
+    """Chosen calibration poses.
+
+    Attributes:
+        readings: The actuator readings (n x na) [rad or m].
+        o1: ``log`` of the O1 index (the product of the scaled base Jacobian's singular values).
+        o4: The O4 index (``sigma_min^2 / sigma_max``) of the same Jacobian.
+        candidates: The candidates drawn that closed within the limits and the margin.
+        base: The base geometry the index is computed for.
+    """
+
+    readings: np.ndarray
+    o1: float
+    o4: float
+    candidates: int
+    base: BaseGeometry
+
+
+def conditioning(model: CalibrationModel, readings: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
+    """The closure system's ``sigma_min / sigma_max`` at each pose (the twin's closure and actuated rows, along the
+    tangent space; the idle motions' zeros left out: :attr:`CalibrationModel.idle`): 0 at a singularity."""
+    M = np.atleast_2d(readings)
+    Q = model.close(x, M)
+    _, Gq = model._map("close", len(M))(Q.T, M.T, model.vector(x))
+    G = np.array(Gq).reshape(-1, len(M), model.mech.nv).transpose(1, 0, 2)
+    s = np.linalg.svd(G, compute_uv=False)
+    return s[:, -1 - model.idle] / s[:, 0]
+
+
+def candidates(model: CalibrationModel, n: int, *, spread: float = 0.1, margin: float = MARGIN,
+               seed: int = 0) -> np.ndarray:
+    """``n`` candidate readings (module doc). ``spread`` [rad or m]: the largest change of a reading from the
+    reference.
+
+    Raises:
+        InvalidInputError: fewer than ``n`` of ``20 n`` draws qualify (a smaller spread or margin may help).
+    """
+    from pkm.core.kinematics.solve import close_loops
+
+    n = as_count(n, "n")
+    spread = as_scalar(spread, "spread", low=0.0, strict_low=True)
+    margin = as_scalar(margin, "margin", low=0.0)
+    mech = model.mech
+    rng = np.random.default_rng(seed)
+    qa0 = mech.actuated_q(mech.q_reference)
+    out: list[np.ndarray] = []
+    for _ in range(20 * n):
+        if len(out) == n:
+            break
+        qa = qa0 + rng.uniform(-spread, spread, mech.na)
+        try:
+            q = close_loops(mech, qa, mech.q_reference).q
+        except PkmError:  # (outside the workspace: drawn again)
+            continue
+        if mech.outside_limits(q):
+            continue
+        try:
+            if conditioning(model, qa[None])[0] < margin:
+                continue
+        except PkmError:  # (a singular pose: drawn again)
+            continue
+        out.append(qa)
+    if len(out) < n:
+        raise InvalidInputError("spread", f"only {len(out)} of {n} candidate poses closed within the limits and the "
+                                          f"singularity margin {margin:g}", spread)
+    return np.array(out)
+
+
+def calibration_poses(model: CalibrationModel, n: int, *, pool: int | None = None, spread: float = 0.1, margin: float = MARGIN,
+         seed: int = 0) -> PosePlan:
+    """``n`` poses maximising O1 among ``pool`` candidates (default ``4 n``) (module doc).
+
+    Raises:
+        InvalidInputError: too few poses for the base parameters, or too few candidates.
+
+    Examples:
+        >>> import pkm
+        >>> model = pkm.CalibrationModel(pkm.load("prs3"), "pose")
+        >>> plan = pkm.calibration_poses(model, 12, spread=0.2, pool=14)
+        >>> plan.readings.shape, plan.candidates, len(plan.base)
+        ((12, 3), 14, 34)
+    """
+    n = as_count(n, "n")
+    C = candidates(model, pool or 4 * n, spread=spread, margin=margin, seed=seed)
+    base = base_geometry(model, C, precise=False)
+    rows = len(model.rows.labels)
+    if n * rows <= len(base):
+        raise InvalidInputError("n", f"{n} poses give {n * rows} residuals for {len(base)} base parameters: give at "
+                                     f"least {len(base) // rows + 1}", n)
+    W = stacked_jacobian(model, C)[:, list(base.independent)]
+    W = W / np.linalg.norm(W, axis=0)
+    blocks = W.reshape(len(C), rows, -1)
+    p = blocks.shape[2]
+    A = 1e-9 * np.eye(p)
+    chosen: list[int] = []
+    for _ in range(n):
+        Ainv = np.linalg.inv(A)
+        gain = [-np.inf if k in chosen else np.linalg.slogdet(np.eye(rows) + B @ Ainv @ B.T)[1]
+                for k, B in enumerate(blocks)]
+        k = int(np.argmax(gain))
+        chosen.append(k)
+        A = A + blocks[k].T @ blocks[k]
+    J = blocks[chosen].reshape(-1, p)
+    s = np.linalg.svd(J, compute_uv=False)
+    return PosePlan(C[chosen], float(np.sum(np.log(s))), float(s[-1] ** 2 / s[0]), len(C), base)
+
+
+__all__ = ["MARGIN", "PosePlan", "calibration_poses", "candidates", "conditioning"]

@@ -1,0 +1,39 @@
+"""``pkm calibrate plan`` and ``pkm calibrate``: the 3-PRS calibrated end to end from the command line (poses chosen,
+measurements simulated on a perturbed robot, the estimate, the calibrated spec written and loaded back, the residual
+figure), in process; bad input as one error line."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+import pkm
+from pkm import cli
+
+
+def test_plan_simulate_calibrate_write_load(tmp_path, capsys) -> None:
+    pytest.importorskip("matplotlib")
+    data = tmp_path / "data.csv"
+    assert cli.main(["calibrate", "plan", "prs3", "--poses", "12", "--spread", "0.2", "--out", str(data),
+                     "--simulate", "3"]) == 0
+    assert "12 poses" in capsys.readouterr().out
+    out = tmp_path / "out"
+    assert cli.main(["calibrate", "prs3", str(data), "--out", str(out), "--plot", str(tmp_path / "r.png"),
+                     "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["base"] == 34 and result["before"]["position_rms"] > 1e-3
+    assert result["after"]["position_rms"] < 3e-5 and 0.3 < result["chi2"] < 3.0
+    assert pkm.load(result["spec"]).name == "prs3" and (tmp_path / "r.png").stat().st_size > 1000
+    assert "knee_1.pitch" in result["unseen"]
+
+
+def test_bad_table_is_one_error_line(tmp_path, capsys) -> None:
+    table = tmp_path / "bad.csv"
+    rows = ["m.slider_1,m.slider_2,m.slider_3,x,y,z,roll,pitch,yaw"]
+    rows += [",".join(map(str, [0.13, 0.13, 0.13, 0.0, 0.0, 0.7, 0.0, 0.0, 0.0]))] * 3
+    rows.append(",".join(map(str, [0.13, 0.13, 0.13, 0.0, 0.0, 700.0, 0.0, 0.0, 0.0])))
+    table.write_text("\n".join(rows) + "\n")
+    assert cli.main(["calibrate", "prs3", str(table), "--out", str(tmp_path / "o")]) != 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("pkm: error: ") and "row 4, column 'z'" in err[0] and "mm" in err[0]

@@ -1,0 +1,113 @@
+"""Pose selection (O1) and the measurement table's refusals; the write-back read again by pkm.load."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm.core.calibration.estimate import calibrate
+from pkm.core.calibration.identifiable import stacked_jacobian
+from pkm.core.calibration.poses import calibration_poses, candidates
+from pkm.core.calibration.tolerance import tolerance_table
+from pkm.core.calibration.writeback import read_data, write_calibrated, write_data
+from tests.core.calibration.conftest import model, simulated
+
+
+def _log_o1(m, readings, cols) -> float:
+    W = stacked_jacobian(m, readings)[:, cols]
+    return float(np.sum(np.log(np.linalg.svd(W / np.linalg.norm(W, axis=0), compute_uv=False))))
+
+
+def test_chosen_poses_beat_random_ones_on_o1() -> None:
+    m = model("prs3")
+    plan = calibration_poses(m, 12, spread=0.2, pool=36)
+    cols = list(plan.base.independent)
+    random = candidates(m, 12, spread=0.2, seed=5)
+    assert _log_o1(m, plan.readings, cols) > _log_o1(m, random, cols)
+    assert not any(m.mech.outside_limits(q) for q in m.close(None, plan.readings))
+    with pytest.raises(pkm.errors.InvalidInputError, match="base parameters"):
+        calibration_poses(m, 4, spread=0.2, pool=12)
+
+
+def test_bad_tables_are_refused_naming_row_and_column(tmp_path) -> None:
+    s = simulated("prs3")
+    m = s.model
+    path = write_data(m, tmp_path / "data.csv", s.readings, s.measured)
+    M, Y = read_data(m, path)
+    assert np.allclose(M, s.readings) and np.allclose(Y, s.measured, atol=1e-15)
+    text = path.read_text().splitlines()
+    cases = {"x": ("millimetres", lambda c: c.__setitem__(3, str(float(c[3]) * 1000)), r"row 3, column 'x'.*mm"),
+             "roll": ("degrees", lambda c: c.__setitem__(6, "57.3"), r"row 3, column 'roll'.*degrees"),
+             "nan": ("NaN", lambda c: c.__setitem__(1, "nan"), r"row 3, column 'm.slider_2'.*not a finite"),
+             "out": ("workspace", lambda c: c.__setitem__(0, "6.5"), r"row 3, columns m.slider_1"),
+             }
+    for label, (_, change, message) in cases.items():
+        cells = text[3].split(",")
+        change(cells)
+        bad = tmp_path / f"{label}.csv"
+        bad.write_text("\n".join(text[:3] + [",".join(cells)] + text[4:]) + "\n")
+        with pytest.raises(pkm.errors.InvalidInputError, match=message):
+            read_data(m, bad)
+    with pytest.raises(pkm.errors.InvalidInputError, match="missing column"):
+        read_data(m, {"m.slider_1": [0.1]})
+    with pytest.raises(pkm.errors.InvalidInputError, match=r"30 residuals for 34 base parameters: give more poses"):
+        calibrate(m, s.readings[:5], s.measured[:5], base=s.cal.base)
+
+
+def test_written_back_mechanism_predicts_as_the_calibrated_model(tmp_path) -> None:
+    s = simulated("prs3")
+    spec, toml = write_calibrated(s.cal, tmp_path)
+    other = pkm.load(spec)
+    v = s.cal.values()
+    assert f"'slider_1.gain' = {v['slider_1.gain']!r}" in toml.read_text()
+    qa = [v[f"{a}.gain"] * r + v[f"{a}.offset"] for a, r in zip(other.actuated_names, s.readings[0])]
+    q = pkm.close_loops(other, qa, tol=1e-13).q
+    x = s.cal.x.copy()
+    for k, n in enumerate(s.model.names):
+        if n.startswith(("tracker.", "target.")):
+            x[k] = 0.0
+    import pinocchio as pin
+    data = other.model.createData()
+    pin.framesForwardKinematics(other.model, data, q)
+    assert np.max(np.abs(s.model.measure(x, s.readings[:1])[0, :3] - data.oMf[other.ee_frame].translation)) < 1e-11
+
+
+def test_tolerance_table_matches_the_closed_mechanism() -> None:
+    """The first-order pose errors against the loops closed again with the change: to 1e-4 for small changes; for
+    the default 0.1 mm / 0.1 degree, the first order is within 5 % (the slider's tilt moves the tool 2.3 mm)."""
+    m = model("prs3")
+    readings = simulated("prs3").readings[:4]
+    y0 = m.measure(None, readings)
+    for delta, tol in (({"m": 1e-7, "rad": 1e-6, "1": 1e-7}, 1e-4), (None, 5e-2)):
+        rows = tolerance_table(m, readings, delta)
+        assert rows[0].position[1] >= rows[-1].position[1] and not any(r.name.startswith("tracker") for r in rows)
+        for row in (rows[0], rows[len(rows) // 2]):
+            x = m.parameters.nominal.copy()
+            x[m.names.index(row.name)] += row.delta
+            err = np.linalg.norm(m.measure(x, readings)[:, :3] - y0[:, :3], axis=1).max()
+            assert err == pytest.approx(row.position[1], rel=tol)
+
+
+def test_an_mjcf_mechanism_self_calibrates_and_is_written_back_as_mjcf_too(tmp_path) -> None:
+    """The MJCF four-bar example, its passive joints read by encoders: calibrated, written as spec + URDF and as
+    MJCF, both loading to the same calibrated geometry (the coupler's reading predicted alike)."""
+    from pathlib import Path
+
+    from pkm.core.calibration.estimate import perturbed, simulate
+    from pkm.core.calibration.measurement import CalibrationModel
+
+    mech = pkm.load(str(Path(__file__).parents[3] / "examples" / "mjcf_fourbar" / "fourbar.xml"))
+    m = CalibrationModel(mech, "passive")
+    readings = calibration_poses(m, 12, spread=0.3, pool=14).readings
+    cal = calibrate(m, readings, simulate(m, perturbed(m, seed=1), readings, seed=2))
+    assert cal.after.position[1] < 3 * 20e-6 < 1e-3 < cal.before.position[1]
+    spec, _, mjcf = write_calibrated(cal, tmp_path)
+    v = cal.values()
+    qa = [v["crank_joint.gain"] * readings[0, 0] + v["crank_joint.offset"]]
+    angles = []
+    for other in (pkm.load(spec), pkm.load(mjcf)):
+        q = pkm.close_loops(other, qa, tol=1e-13).q
+        angles.append(q[other.joints["coupler_joint"].idx_q])
+    predicted = m.measure(cal.x, readings[:1])[0, m.sensors.index("coupler_joint")] - v["coupler_joint.offset"]
+    assert abs(angles[0] - predicted) < 1e-10 and abs(angles[1] - predicted) < 1e-6
