@@ -6,7 +6,7 @@ closure Jacobian split into the outputs' columns ``J_o`` and the others' ``J_d``
 * ``G = ∂q/∂o`` (nv x k): ``G_o = I``, ``G_d = -J_d⁺ J_o``; the idle motions ``N`` (a rod's spin between two
   balls: what ``J_d`` leaves free with the outputs held and no motor sees) are removed in the mass metric, as pkm's
   actuator-space model removes them (:mod:`pkm.core.differential.idle`): ``Ĝ = G - N (Nᵀ M N)⁺ Nᵀ M G``;
-* ``Ġ ȯ`` (nv): the joint accelerations at ``ö = 0``: ``J_d a_d = -γ`` (``γ = J̇_c v``, :func:`~pkm.core.kinematics.
+* ``Ġ ȯ`` (nv): the joint accelerations at ``ö = 0``: ``J_d a_d = -gamma`` (``gamma = J̇_c v``, :func:`~pkm.core.kinematics.
   constraints.drift`), ``a_o = 0``, the idle part removed in the mass metric;
 * the Khalil / constraint projection with the outputs as the independent coordinates:
 

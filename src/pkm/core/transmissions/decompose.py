@@ -54,8 +54,10 @@ def _groups(mech: Mechanism) -> list[tuple[list[int], set[int], int]]:
     """The sub-mechanisms: ``(closure indices, joint ids, root joint id)``, in the order of their first closure."""
     model = mech.model
     loops = []
-    for fa, fb in mech.closure_frames:
-        loops.append(_loop(model, model.frames[fa].parentJoint, model.frames[fb].parentJoint))
+    for c, (fa, fb) in enumerate(mech.closure_frames):
+        root, joints = _loop(model, model.frames[fa].parentJoint, model.frames[fb].parentJoint)
+        if joints:  # (a closure between two frames of one body closes no loop)
+            loops.append((c, root, joints))
     parent = list(range(len(loops)))
 
     def find(i: int) -> int:
@@ -66,15 +68,15 @@ def _groups(mech: Mechanism) -> list[tuple[list[int], set[int], int]]:
 
     for i in range(len(loops)):
         for k in range(i):
-            if loops[i][1] & loops[k][1]:
+            if loops[i][2] & loops[k][2]:
                 parent[find(i)] = find(k)
     out: dict[int, tuple[list[int], set[int], int]] = {}
-    for i, (root, joints) in enumerate(loops):
+    for i, (c, root, joints) in enumerate(loops):
         g = find(i)
         if g not in out:
             out[g] = ([], set(), root)
         members, js, r = out[g]
-        members.append(i)
+        members.append(c)
         js |= joints
         # the group's root: the deepest joint that supports both roots (one supports the other when loops share a
         # joint)
@@ -240,6 +242,10 @@ def _transmission(mech: Mechanism, name: str, closures: list[int], joints: set[i
         raise TransmissionError(name, "outputs", f"{[model.names[j] for j in carrying]} carry the rest of the robot "
                                 f"but are no outputs {list(outputs)}: a serial model cannot keep the rest of the robot "
                                 "on them", [model.names[j] for j in carrying])
+    if not outputs:
+        raise TransmissionError(name, "outputs", f"no one-coordinate serial joint hangs from its root through a "
+                                f"motor-free chain (a parallel mechanism whose output is a frame, not a joint): name "
+                                f"its {len(motors)} outputs (outputs={{{name!r}: [...]}})", motors)
     if len(outputs) != len(motors):
         raise TransmissionError(name, "outputs", f"{len(outputs)} outputs {list(outputs)} for {len(motors)} motors "
                                 f"{list(motors)}: give as many outputs as motors (outputs={{{name!r}: [...]}})",
