@@ -27,7 +27,8 @@ The rules, in order:
    the sub-mechanism locked at the robot's reference (``pinocchio.buildReducedModel``: the locked bodies welded to
    their parents, so that the root is fixed where the reference puts it, gravity as the whole robot's at its
    reference and a floating base held there), its closures, its motors as the actuated joints, its outputs as the
-   task (``TaskSpec(components=(), joints=outputs)``), the drives' values of the robot.
+   task (``TaskSpec(components=(), joints=outputs)``), the drives' values of the robot. A joint whose position limits
+   are an empty interval (``lower >= upper``: Pinocchio's placeholder where a file states none) is unlimited there.
 """
 
 from __future__ import annotations
@@ -140,6 +141,10 @@ def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[
     lock = [j for j in range(1, model.njoints) if model.names[j] not in keep]
     reduced = pin.buildReducedModel(model, lock, mech.q_reference) if lock else model.copy()
     reduced.name = name
+    lower, upper = np.array(reduced.lowerPositionLimit, dtype=float), np.array(reduced.upperPositionLimit, dtype=float)
+    empty = lower >= upper  # (a reader's placeholder for "no limit stated": URDF's revolute without <limit>, SDF)
+    lower[empty], upper[empty] = -np.inf, np.inf
+    reduced.lowerPositionLimit, reduced.upperPositionLimit = lower, upper
     q_ref = mech.q_to_dict(mech.q_reference)
     spec = ClosureSpec(
         mechanism=name, urdf=mech.spec.urdf, end_effector=None, actuated=motors,
