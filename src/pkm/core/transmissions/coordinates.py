@@ -27,6 +27,7 @@ acceleration at ``qÌˆ_m = 0``, :func:`pkm.accelerations`) to 1e-10 relative; ``Ä
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -109,4 +110,21 @@ def drift_acceleration(sub: Mechanism, q: np.ndarray, v: np.ndarray, sp: OutputS
     return without_idle(sp.M, sp.idle, a)
 
 
-__all__ = ["OutputSplit", "drift_acceleration", "output_model", "output_split"]
+def serial_tree(model: pin.Model, outputs: Sequence[str]) -> pin.Model:
+    """A copy of ``model`` (a sub-mechanism's) in which every joint but ``outputs`` is massless: its body's (and its
+    welded bodies') inertia zero, its armature zero. Since every output hangs from the root through outputs only,
+    the massless joints move nothing the outputs carry: the copy's mass matrix and bias, restricted to the outputs'
+    rows and columns, are the serial-equivalent model's."""
+    serial = model.copy()
+    keep = set(outputs)
+    armature = np.array(serial.armature, dtype=float)
+    for j in range(1, serial.njoints):
+        if serial.names[j] not in keep:
+            serial.inertias[j] = pin.Inertia.Zero()
+            jm = serial.joints[j]
+            armature[jm.idx_v:jm.idx_v + jm.nv] = 0.0
+    serial.armature = armature
+    return serial
+
+
+__all__ = ["OutputSplit", "drift_acceleration", "output_model", "output_split", "serial_tree"]

@@ -1,7 +1,7 @@
 r"""The serial-equivalent model: the tree with only the output joints and the bodies they carry.
 
 Rule: every joint of a sub-mechanism that is not an output (the motors, the rods' joints) is removed with the bodies
-it carries, and its reflected inertia (the rotors') with it: their mass and inertia are dropped from the serial model
+it carries, and its reflected inertia (the rotors') with it (:func:`~pkm.core.transmissions.coordinates.serial_tree`): their mass and inertia are dropped from the serial model
 and carried by ``ΔM`` and ``Δh`` (:class:`~pkm.core.transmissions.transmission.Transmission`). The outputs keep
 their own armature, if the file gives one, in both models.
 
@@ -35,25 +35,9 @@ from pkm.core.analysis.region import SINGULARITY
 from pkm.core.formats.to_mjcf import MIN_INERTIA, MIN_MASS, TIMESTEP, _joints, _num, _pose
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.urdf import urdf_from_model
+from pkm.core.transmissions.decompose import transmissions as find
 from pkm.core.transmissions.limits import OutputLimits, output_limits
 from pkm.core.transmissions.transmission import Transmission
-
-
-def serial_tree(model: pin.Model, outputs: Sequence[str]) -> pin.Model:
-    """A copy of ``model`` (a sub-mechanism's) in which every joint but ``outputs`` is massless: its body's (and its
-    welded bodies') inertia zero, its armature zero. Since every output hangs from the root through outputs only,
-    the massless joints move nothing the outputs carry: the copy's mass matrix and bias, restricted to the outputs'
-    rows and columns, are the serial-equivalent model's."""
-    serial = model.copy()
-    keep = set(outputs)
-    armature = np.array(serial.armature, dtype=float)
-    for j in range(1, serial.njoints):
-        if serial.names[j] not in keep:
-            serial.inertias[j] = pin.Inertia.Zero()
-            jm = serial.joints[j]
-            armature[jm.idx_v:jm.idx_v + jm.nv] = 0.0
-    serial.armature = armature
-    return serial
 
 
 @dataclass(frozen=True)
@@ -126,8 +110,6 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
     """The serial-equivalent model of ``robot`` (module doc); ``transmissions`` default ``pkm.transmissions(robot)``;
     ``directions`` and ``singularity``: the feasible regions' (:func:`~pkm.core.transmissions.limits.output_limits`).
     """
-    from pkm.core.transmissions.decompose import transmissions as find
-
     robot = check_mechanism(robot)
     found = tuple(find(robot) if transmissions is None else transmissions)
     model = robot.model.copy()
@@ -219,4 +201,4 @@ def write_serial_equivalent(se: SerialEquivalent, folder: str | os.PathLike[str]
     return urdf, mjcf, data
 
 
-__all__ = ["SerialEquivalent", "serial_equivalent", "serial_tree", "write_serial_equivalent"]
+__all__ = ["SerialEquivalent", "serial_equivalent", "write_serial_equivalent"]

@@ -12,7 +12,7 @@ simulator needs, in the sub-mechanism's configuration ``q_sub`` (its ``nq``, as 
 * the effort maps by the power balance ``τ_mᵀ ṁ = τ_oᵀ ȯ``: ``τ_m = Jᵀ τ_o`` and ``τ_o = J⁻ᵀ τ_m``, computed by the
   other route, the outputs independent (:mod:`pkm.core.transmissions.coordinates`), so that ``effort_map = Jᵀ`` is a
   check;
-* what the serial-equivalent model lacks (:mod:`pkm.core.transmissions.serial`: the tree with the outputs only and the
+* what the serial-equivalent model lacks (:func:`~pkm.core.transmissions.coordinates.serial_tree`: the tree with the outputs only and the
   bodies they carry), in output coordinates: ``ΔM = M_o - M_s`` and ``Δh = h_o - h_s``, so that serial model + ΔM +
   Δh is the closed-loop model exactly: ``(M_s + ΔM) ö + h_s + Δh = τ_o`` is the sub-mechanism's dynamics with the
   root held where the robot's reference puts it.
@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike
 from pkm.core.differential.velocity import forward_jacobian, inverse_jacobian
 from pkm.core.kinematics.solve import close_loops, solve_ik
 from pkm.core.model.mechanism import Mechanism
-from pkm.core.transmissions.coordinates import OutputSplit, output_model, output_split
+from pkm.core.transmissions.coordinates import OutputSplit, output_model, output_split, serial_tree
 from pkm.errors import SingularityError, TransmissionError
 from pkm.validation import as_vector
 
@@ -158,10 +158,8 @@ class Transmission:
 
     @functools.cached_property
     def serial(self) -> pin.Model:
-        """The serial-equivalent model of the sub-mechanism (:func:`pkm.core.transmissions.serial.serial_tree`): its
-        model with every joint but the outputs massless (their bodies, the motors' rotors removed)."""
-        from pkm.core.transmissions.serial import serial_tree
-
+        """The serial-equivalent model of the sub-mechanism (:func:`pkm.core.transmissions.coordinates.serial_tree`):
+        its model with every joint but the outputs massless (their bodies, the motors' rotors removed)."""
         return serial_tree(self.mechanism.model, self.outputs)
 
     def serial_model(self, q_sub: ArrayLike, qd_o: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
