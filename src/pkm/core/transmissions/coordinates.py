@@ -36,6 +36,7 @@ import pinocchio as pin
 from pkm.core.differential.idle import joint_inertia, without_idle
 from pkm.core.kinematics import constraints
 from pkm.core.model.mechanism import Mechanism
+from pkm.errors import ConvergenceError
 
 RTOL = 1e-9  #: relative singular value below which ``J_d`` loses rank (on the homogenised Jacobian)
 
@@ -108,6 +109,31 @@ def drift_acceleration(sub: Mechanism, q: np.ndarray, v: np.ndarray, sp: OutputS
     d_v = np.array([i for i in range(sub.nv) if i not in set(out_v)], dtype=int)
     a[d_v] = -sp.Jd_pinv @ constraints.drift(sub, q, v)
     return without_idle(sp.M, sp.idle, a)
+
+
+def close_at_outputs(sub: Mechanism, qo: np.ndarray, guess: np.ndarray, out_q: np.ndarray, out_v: np.ndarray, *,
+                     tol: float = 1e-13, max_iter: int = 20) -> np.ndarray:
+    """The closed configuration with the outputs at ``qo`` nearest ``guess``: Gauss-Newton on the closures with the
+    outputs held (minimum-norm steps in the other joints), for a warm start a small step away (a simulation's
+    next state); :func:`pkm.solve_ik` (continuation, mode checks) is the general route.
+
+    Raises:
+        ConvergenceError: the closures not within ``tol`` [m, rad] after ``max_iter`` iterations.
+    """
+    q = np.array(guess, dtype=float)
+    q[out_q] = qo
+    d_v = np.array([i for i in range(sub.nv) if i not in set(out_v)], dtype=int)
+    for it in range(max_iter + 1):
+        r, Jc = constraints.residual_and_jacobian(sub, q)
+        gap = float(np.abs(r).max(initial=0.0))
+        if gap <= tol:
+            return q
+        if it == max_iter:
+            break
+        dq = np.zeros(sub.nv)
+        dq[d_v] = -np.linalg.lstsq(Jc[:, d_v], r, rcond=None)[0]
+        q = pin.integrate(sub.model, q, dq)
+    raise ConvergenceError("loop closure at given outputs", gap, max_iter, tol, q)
 
 
 def serial_tree(model: pin.Model, outputs: Sequence[str]) -> pin.Model:

@@ -91,8 +91,9 @@ class SerialEquivalent:
         """The data file's content (JSON-ready): per transmission its names, motors, outputs, passive joints,
         closures, root, constant armature, box limits and feasible region, for the kernels."""
         out = []
+        none = OutputLimits((), None, None, None, (), 0)
         for t in self.transmissions:
-            reg = self.regions[t.name]
+            reg = self.regions.get(t.name, none)
             out.append({
                 "name": t.name, "root": t.root, "motors": list(t.motors), "outputs": list(t.outputs),
                 "passive": list(t.passive), "closures": [c.name for c in t.mechanism.spec.closures],
@@ -106,9 +107,11 @@ class SerialEquivalent:
 
 
 def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | None = None, *,
-                      directions: int = 24, singularity: float = SINGULARITY) -> SerialEquivalent:
+                      limits: bool = True, directions: int = 24, singularity: float = SINGULARITY) -> SerialEquivalent:
     """The serial-equivalent model of ``robot`` (module doc); ``transmissions`` default ``pkm.transmissions(robot)``;
-    ``directions`` and ``singularity``: the feasible regions' (:func:`~pkm.core.transmissions.limits.output_limits`).
+    ``directions`` and ``singularity``: the feasible regions' (:func:`~pkm.core.transmissions.limits.output_limits`);
+    ``limits=False``: no limits at all (no region traced, the robot's stated limits left out: a model for a free
+    motion, as :mod:`pkm.core.transmissions.fidelity` runs it).
     """
     robot = check_mechanism(robot)
     found = tuple(find(robot) if transmissions is None else transmissions)
@@ -120,24 +123,26 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
     serial.name = f"{robot.name}_serial"
     armature = np.array(serial.armature, dtype=float)
     constant: dict[str, float] = {}
-    limits = {n: lim for n, lim in robot.limits.items() if serial.existJointName(n)}
+    bounds = {n: lim for n, lim in robot.limits.items() if serial.existJointName(n)} if limits else {}
     regions = {}
     for t in found:
         dM = t.delta_mass(t.q_reference)
         for i, o in enumerate(t.outputs):
             constant[o] = float(dM[i, i])
             armature[serial.joints[serial.getJointId(o)].idx_v] += dM[i, i]
+        if not limits:
+            continue
         reg = output_limits(t, directions=directions, singularity=singularity)
         regions[t.name] = reg
         if reg.lower is not None and reg.upper is not None:
-            limits.update({o: (float(lo), float(hi)) for o, lo, hi in zip(t.outputs, reg.lower, reg.upper)})
+            bounds.update({o: (float(lo), float(hi)) for o, lo, hi in zip(t.outputs, reg.lower, reg.upper)})
     serial.armature = armature
     keep = [j for j in range(1, robot.model.njoints) if robot.model.names[j] not in
             {robot.model.names[g] for g in gone}]
     q_ref = np.concatenate([robot.q_reference[robot.model.joints[j].idx_q:
                                               robot.model.joints[j].idx_q + robot.model.joints[j].nq] for j in keep]) \
         if keep else np.zeros(0)
-    return SerialEquivalent(robot, found, serial, constant, limits, regions, q_ref)
+    return SerialEquivalent(robot, found, serial, constant, bounds, regions, q_ref)
 
 
 def _mjcf(se: SerialEquivalent, timestep: float) -> str:
