@@ -151,3 +151,16 @@ def test_a_sub_mechanism_whose_chain_outnumbers_its_motors_is_refused():
     cassie = pkm.load("gepetto:cassie_like")  # (the knee motor and the passive tarsus joint both carry the foot)
     with pytest.raises(TransmissionError, match=r"2 outputs \['motor_knee', 'free_knee'\] for 1 motors"):
         pkm.transmissions(cassie)
+
+
+def test_the_spec_names_a_transmission_and_its_outputs(tmp_path):
+    folder = FILES["humanoid_knee"].parent
+    (tmp_path / "knee.urdf").write_text((folder / "knee.urdf").read_text())
+    spec = FILES["humanoid_knee"].read_text() + '\n[transmission.left_knee]\noutputs = ["knee"]\n'
+    (tmp_path / "knee.closures.toml").write_text(spec)
+    knee = pkm.load(tmp_path / "knee.closures.toml")
+    assert knee.spec.transmissions == {"left_knee": ("knee",)}
+    assert pkm.ClosureSpec.from_toml(knee.spec.to_toml()).transmissions == {"left_knee": ("knee",)}
+    assert [(t.name, t.outputs) for t in pkm.transmissions(knee)] == [("left_knee", ("knee",))]
+    with pytest.raises(pkm.errors.SpecError, match=r"\[transmission.k\] must hold one key"):
+        pkm.ClosureSpec.from_toml(spec.replace("left_knee]\noutputs", "k]\nout"))

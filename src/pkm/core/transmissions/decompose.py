@@ -11,8 +11,8 @@ The rules, in order:
 2. **Motors**: the robot's actuated joints in the sub-mechanism. A sub-mechanism with none is refused.
 3. **Outputs** (the serial joints the serial-equivalent model keeps), by the first rule that applies:
 
-   * named: ``outputs={name: [joint, ...]}`` gives the transmission that contains those joints its name and its
-     outputs;
+   * named: ``outputs={name: [joint, ...]}``, else the spec's ``[transmission.<name>] outputs = [...]`` tables,
+     give the transmission that contains those joints its name and its outputs;
    * else the joints of the **chain**: for every closure, the side whose path from the root crosses no motor is the
      chain (the foot hanging from the shank by pitch and roll); the outputs are the joints on the chains' paths,
      in the model's order. Its name is the body the deepest chain ends on (the foot), made unique with ``_2``,
@@ -105,15 +105,14 @@ def _distal_body(model: pin.Model, joint: int) -> str:
     return model.names[joint]
 
 
-def _chain_outputs(mech: Mechanism, closures: list[int], joints: set[int], k: int) -> tuple[list[int], int | None, bool]:
-    """Rule 3's chain: ``(outputs, the joint whose body names the transmission, whether the chain carries the rest
-    of the robot)`` (module doc)."""
+def _chain_outputs(mech: Mechanism, closures: list[int], joints: set[int], k: int) -> tuple[list[int], int | None]:
+    """Rule 3's chain: ``(outputs, the joint whose body names the transmission)`` (module doc)."""
     model = mech.model
     motors = {mech.joints[n].id for n in mech.actuated_names}
     below = {j: {i for i in range(1, model.njoints) if j in model.supports[i]} for j in joints}
     carrying = sorted(j for j in joints if below[j] - joints)
     if carrying:  # (a): the joints that carry the rest of the robot, every one of them
-        return carrying, max(carrying, key=lambda j: len(model.supports[j])), True
+        return carrying, max(carrying, key=lambda j: len(model.supports[j]))
     sides: set[int] = set()
     for i in closures:
         for f in mech.closure_frames[i]:
@@ -121,7 +120,7 @@ def _chain_outputs(mech: Mechanism, closures: list[int], joints: set[int], k: in
             if path and not motors & set(path):
                 sides |= set(path)
     chain = sorted(sides)[:k]  # (b): the motor-free sides' first k joints (the rods' own joints come after)
-    return chain, (chain[-1] if chain else None), False
+    return chain, (chain[-1] if chain else None)
 
 
 def _unique(names: list[str]) -> list[str]:
@@ -164,7 +163,8 @@ def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None =
     Args:
         mech: The whole robot (fixed or floating base, any number of loops, serial joints between them).
         outputs: ``{transmission name: output joints}`` for the transmissions whose outputs the chain rule would not
-            choose (or to name them); a transmission not listed gets the chain rule and a generated name.
+            choose (or to name them); a transmission not listed gets the chain rule and a generated name. Default:
+            the spec's ``[transmission.<name>]`` tables (:attr:`pkm.ClosureSpec.transmissions`).
 
     Returns:
         The transmissions, in the order of their first closure in the spec.
@@ -184,15 +184,16 @@ def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None =
     mech = check_mechanism(mech)
     model = mech.model
     named: dict[str, tuple[str, ...]] = {}
-    if outputs is not None:
-        if not isinstance(outputs, Mapping):
-            raise InvalidInputError("outputs", "expected {transmission name: [output joint, ...]}", outputs)
-        for tname, joints in outputs.items():
-            if isinstance(joints, str) or not isinstance(joints, Sequence):
-                raise InvalidInputError("outputs", f"transmission {tname!r}: expected a list of joint names", joints)
-            for j in joints:
-                mech.joint(j)  # (UnknownNameError naming the valid joints)
-            named[str(tname)] = tuple(joints)
+    if outputs is None:
+        outputs = mech.spec.transmissions
+    if not isinstance(outputs, Mapping):
+        raise InvalidInputError("outputs", "expected {transmission name: [output joint, ...]}", outputs)
+    for tname, joints in outputs.items():
+        if isinstance(joints, str) or not isinstance(joints, Sequence):
+            raise InvalidInputError("outputs", f"transmission {tname!r}: expected a list of joint names", joints)
+        for j in joints:
+            mech.joint(j)  # (UnknownNameError naming the valid joints)
+        named[str(tname)] = tuple(joints)
     groups = _groups(mech)
     actuated = {mech.joints[n].id for n in mech.actuated_names}
     claimed: dict[str, int] = {}
@@ -207,22 +208,20 @@ def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None =
                                     joints)
         claimed[tname] = hits[0]
     by_group = {g: t for t, g in claimed.items()}
-    plans = []
-    for g, (closures, joints, root) in enumerate(groups):
-        motor_ids = actuated & joints
+    plans: list[tuple[str, list[int], set[int], int, set[int], list[int]]] = []
+    for g, (closures, members, root) in enumerate(groups):
+        motor_ids = actuated & members
         if g in by_group:
-            tname = by_group[g]
-            out_ids = [mech.joints[j].id for j in named[tname]]
-            plans.append((tname, False, closures, joints, root, motor_ids, out_ids))
+            out_ids = [mech.joints[j].id for j in named[by_group[g]]]
+            plans.append((by_group[g], closures, members, root, motor_ids, out_ids))
         else:
-            out_ids, deepest, carrying = _chain_outputs(mech, closures, joints, len(motor_ids))
-            label = _distal_body(model, deepest) if deepest is not None else model.names[min(joints)]
-            plans.append((label, carrying, closures, joints, root, motor_ids, out_ids))
+            out_ids, deepest = _chain_outputs(mech, closures, members, len(motor_ids))
+            label = _distal_body(model, deepest) if deepest is not None else model.names[min(members)]
+            plans.append((label, closures, members, root, motor_ids, out_ids))
     generated = _unique([p[0] for p in plans])
     result = []
     for g, p in enumerate(plans):
-        tname = by_group.get(g) or generated[g]
-        result.append(_transmission(mech, tname, *p[2:]))
+        result.append(_transmission(mech, by_group.get(g) or generated[g], *p[1:]))
     if not result:
         raise TransmissionError(mech.name, "no_loop", "the robot has no closure: no closed sub-mechanism")
     return result

@@ -26,7 +26,7 @@ from (a) over the run [rad or m]; each integrator's own error is estimated by th
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -133,6 +133,7 @@ class FidelityRow:
         exact: (c)'s error.
         mujoco_integrator: (c) at ``dt`` against (c) at ``dt / 2``: MuJoCo's RK4's own error.
         pkm_integrator: (a) at ``dt`` against (a) at ``dt / 2``: :func:`pkm.simulate`'s.
+        traces: The outputs of each run, ``{"a": ..., "b": ..., "c": ...}`` ((N+1) x k, at ``0, dt, ...``).
     """
 
     transmission: str
@@ -144,6 +145,7 @@ class FidelityRow:
     exact: float
     mujoco_integrator: float
     pkm_integrator: float
+    traces: dict[str, np.ndarray] = field(default_factory=dict, repr=False, compare=False)
 
 
 def fidelity(t: Transmission, duration: float = 2.0, dt: float = 1e-3, *, amplitude: float = 0.05,
@@ -162,7 +164,7 @@ def fidelity(t: Transmission, duration: float = 2.0, dt: float = 1e-3, *, amplit
         c2 = serial_run(t, torque, duration, dt / 2, exact=True)[::2] if integrators else nan
         rows.append(FidelityRow(t.name, name, duration, dt, float(np.abs(a - a[0]).max()), float(np.abs(b - a).max()),
                                 float(np.abs(c - a).max()), float(np.abs(c - c2).max()),
-                                float(np.abs(a - a2).max())))
+                                float(np.abs(a - a2).max()), {"a": a, "b": b, "c": c}))
     return rows
 
 
