@@ -164,3 +164,20 @@ def test_the_spec_names_a_transmission_and_its_outputs(tmp_path):
     assert [(t.name, t.outputs) for t in pkm.transmissions(knee)] == [("left_knee", ("knee",))]
     with pytest.raises(pkm.errors.SpecError, match=r"\[transmission.k\] must hold one key"):
         pkm.ClosureSpec.from_toml(spec.replace("left_knee]\noutputs", "k]\nout"))
+
+
+def test_a_floating_base_is_held_at_the_reference_in_the_sub_mechanism(tmp_path):
+    folder = FILES["humanoid_knee"].parent
+    tilt = [0.1, 0.2, 1.0, 0.0, float(np.sin(np.pi / 8)), 0.0, float(np.cos(np.pi / 8))]  # (pitched 45 degrees)
+    (tmp_path / "knee.urdf").write_text((folder / "knee.urdf").read_text().replace(
+        '<robot name="humanoid_knee">', '<robot name="humanoid_knee">\n  <link name="world"/>\n  <joint name="pelvis" '
+        'type="floating"><parent link="world"/><child link="thigh"/></joint>'))
+    (tmp_path / "knee.closures.toml").write_text(FILES["humanoid_knee"].read_text().replace(
+        'urdf = "knee.urdf"', 'urdf = "knee.urdf"\nfloating_base = "pelvis"').replace(
+        "knee = [0.8]", f"knee = [0.8]\npelvis = {tilt}"))
+    (t,) = pkm.transmissions(pkm.load(tmp_path / "knee.closures.toml"))
+    (fixed,) = transmissions("humanoid_knee")
+    assert (t.name, t.root, t.outputs) == (fixed.name, fixed.root, fixed.outputs) and "pelvis" not in t.mechanism.joints
+    np.testing.assert_allclose(t.delta_mass(t.q_reference), fixed.delta_mass(fixed.q_reference), rtol=1e-12)
+    g_tilted, g_upright = t.delta_bias(t.q_reference, [0.0]), fixed.delta_bias(fixed.q_reference, [0.0])
+    assert abs(g_tilted[0] - g_upright[0]) > 1e-3 * abs(g_upright[0])  # (gravity as the tilted pelvis sees it)

@@ -177,9 +177,9 @@ def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None =
 
     Examples:
         >>> import pkm
-        >>> ankle = pkm.load("examples/humanoid_ankle/ankle.closures.toml")  # doctest: +SKIP
-        >>> [(t.name, t.motors, t.outputs) for t in pkm.transmissions(ankle)]  # doctest: +SKIP
-        [('foot', ('motor_left', 'motor_right'), ('ankle_pitch', 'ankle_roll'))]
+        >>> talos = pkm.load("gepetto:talos_like")  # (a leg whose ankle a motor on the shin drives through rods)
+        >>> [(t.name, t.root, t.motors, t.outputs) for t in pkm.transmissions(talos)]
+        [('ankle', 'knee', ('motor_shin',), ('free_ankle',))]
     """
     mech = check_mechanism(mech)
     model = mech.model

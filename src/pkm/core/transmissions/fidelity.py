@@ -41,7 +41,7 @@ from pkm.errors import InvalidInputError
 Profile = Callable[[float], np.ndarray]
 
 
-def profiles(t: Transmission, duration: float = 2.0, *, amplitude: float = 0.05) -> dict[str, Profile]:
+def profiles(t: Transmission, duration: float = 2.0, *, amplitude: float = 0.02) -> dict[str, Profile]:
     """The two motor-torque profiles ``{"chirp": τ(t), "swing": τ(t)}`` [N m or N] about the torques that hold the
     sub-mechanism at its reference (:func:`pkm.gravity_efforts`): a chirp from 0.5 to 4 Hz over ``duration`` and a
     walking-like swing (1 Hz with its second harmonic), each motor's amplitude the torque that swings its own
@@ -148,7 +148,7 @@ class FidelityRow:
     traces: dict[str, np.ndarray] = field(default_factory=dict, repr=False, compare=False)
 
 
-def fidelity(t: Transmission, duration: float = 2.0, dt: float = 1e-3, *, amplitude: float = 0.05,
+def fidelity(t: Transmission, duration: float = 2.0, dt: float = 1e-3, *, amplitude: float = 0.02,
              which: tuple[str, ...] = ("chirp", "swing"), integrators: bool = True) -> list[FidelityRow]:
     """The fidelity table of ``t`` (module doc): one row per profile of :func:`profiles` named in ``which``;
     ``integrators=False`` skips the runs at ``dt / 2`` (the integrators' errors are then NaN)."""
