@@ -52,6 +52,7 @@ def test_the_rules_find_each_robots_transmissions(name):
     for t in found:  # motors, outputs and passive joints partition the sub-mechanism's joints
         assert set(t.mechanism.joints) == {*t.motors, *t.outputs, *t.passive}
         assert set(t.motors) <= set(mech.actuated_names)
+        assert list(t.mechanism.actuators) == [a for a in mech.actuators if a.joint in t.motors]  # (rotors kept)
         np.testing.assert_array_equal(  # the sub-mechanism sits where the robot's reference puts it
             [t.q_reference[t.mechanism.joints[n].idx_q] for n in t.outputs],
             [mech.q_reference[mech.joints[n].idx_q] for n in t.outputs])
