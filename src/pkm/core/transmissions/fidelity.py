@@ -15,7 +15,7 @@ reference at rest:
   acceleration is first solved exactly, ``ö = (M_s + ΔM)⁻¹ (τ_o - h_s - Δh)``, then ``qfrc_applied = τ_o - ΔM ö -
   Δh``, so that MuJoCo's own ``M_s ö + h_s = qfrc_applied`` gives that ``ö``: no lag, no iteration (a fixed point
   ``ö_{k+1} = M_s⁻¹(τ_o - ΔM ö_k - …)`` would diverge where ``ΔM`` outweighs ``M_s``, as on an ankle whose rods and
-  rotors weigh 25 times the foot).
+  rotors add 25 times the foot's own inertia about pitch).
 
 Both MuJoCo runs use MuJoCo's RK4 (``integrator="RK4"``) at ``dt``; each state's sub-mechanism configuration is the
 closure at its outputs, warm-started from the previous one
