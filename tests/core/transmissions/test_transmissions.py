@@ -8,7 +8,10 @@ moved from it:
   reference);
 * the velocity map against Richardson differences of the forward position map (1e-7 relative), and the effort map,
   computed with the outputs independent, equal to the velocity map's transpose, computed with the motors
-  independent (1e-12 relative);
+  independent (1e-12 relative; ``1e-14 ‖Ĝ‖`` where the joints move more than 100 times faster than the outputs,
+  the round-off of either route growing with ``‖Ĝ‖``: talos_like's rods, each three revolutes, sit 4e-4 rad from
+  their gimbal lock at its reference, ``‖Ĝ‖`` = 3890, the error 3.6e-12, as between pkm's own forward and inverse
+  Jacobians there, 2.6e-12);
 * serial model + ΔM + Δh = the closed-loop model in output coordinates, and that model, mapped by the velocity map,
   equal to pkm's actuator-space model (``pkm.mass_matrix = Jᵀ M_o J``, ``pkm.bias_efforts = Jᵀ (h_o + M_o J̇ ṁ)``):
   1e-10 relative;
@@ -18,6 +21,7 @@ moved from it:
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import pkm
@@ -53,6 +57,13 @@ def test_the_rules_find_each_robots_transmissions(name):
         assert set(t.mechanism.joints) == {*t.motors, *t.outputs, *t.passive}
         assert set(t.motors) <= set(mech.actuated_names)
         assert list(t.mechanism.actuators) == [a for a in mech.actuators if a.joint in t.motors]  # (rotors kept)
+        sub = t.mechanism  # (written as URDF and read back: every closure frame where the robot has it)
+        pin.framesForwardKinematics(mech.model, mech.data, mech.q_reference)
+        pin.framesForwardKinematics(sub.model, sub.data, t.q_reference)
+        for fa, fb in sub.closure_frames:
+            for f in (fa, fb):
+                here, there = sub.data.oMf[f], mech.data.oMf[mech.frame_id(sub.model.frames[f].name)]
+                assert np.abs(here.homogeneous - there.homogeneous).max() <= 1e-12
         np.testing.assert_array_equal(  # the sub-mechanism sits where the robot's reference puts it
             [t.q_reference[t.mechanism.joints[n].idx_q] for n in t.outputs],
             [mech.q_reference[mech.joints[n].idx_q] for n in t.outputs])
@@ -85,7 +96,8 @@ def test_the_maps_agree_with_independent_routes(name):
             qm_back, _ = t.motors_from_outputs(qo)
             assert np.abs(qm_back - qm).max() <= 1e-12, t.name
             J = t.velocity_map(q1)
-            assert rel(t.effort_map(q1), J.T) <= 1e-12, t.name
+            amplification = np.linalg.norm(output_split(sub, q1, t.out_v, sub.act_v).G, 2)  # (joint per output rate)
+            assert rel(t.effort_map(q1), J.T) <= max(1e-12, 1e-14 * amplification), t.name
             assert rel(t.inverse_effort_map(q1) @ t.effort_map(q1), np.eye(t.k)) <= 1e-12
             assert rel(J, _forward_differences(t, q1)) <= 1e-7, t.name
             qd_m = rng.normal(size=t.k)

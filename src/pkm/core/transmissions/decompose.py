@@ -26,22 +26,28 @@ The rules, in order:
 4. **The sub-mechanism alone** (:attr:`Transmission.mechanism`): the robot's Pinocchio model with every joint outside
    the sub-mechanism locked at the robot's reference (``pinocchio.buildReducedModel``: the locked bodies welded to
    their parents, so that the root is fixed where the reference puts it, gravity as the whole robot's at its
-   reference and a floating base held there), its closures, its motors as the actuated joints, its outputs as the
-   task (``TaskSpec(components=(), joints=outputs)``), the drives' values of the robot. A joint whose position limits
+   reference and a floating base held there), written as URDF (:func:`~pkm.core.model.urdf.urdf_from_model`) and
+   built from it with a spec of its own: its closures, its motors as the actuated joints with the robot's drives
+   (every field in ``[actuators.<motor>]``), its outputs as the task (``TaskSpec(components=(), joints=outputs)``),
+   the robot's reference. It has files and pickles. A joint whose position limits
    are an empty interval (``lower >= upper``: Pinocchio's placeholder where a file states none) is unlimited there.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pinocchio as pin
 
+from pkm.core.model.actuators import NUMBERS
+from pkm.core.model.builder import from_strings
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.spec import ClosureSpec, TaskSpec
+from pkm.core.model.urdf import urdf_from_model
 from pkm.core.transmissions.transmission import Transmission
-from pkm.errors import InvalidInputError, PkmError, TransmissionError, UnknownNameError
+from pkm.errors import InvalidInputError, PkmError, PkmWarning, TransmissionError, UnknownNameError
 
 
 def _loop(model: pin.Model, ja: int, jb: int) -> tuple[int, set[int]]:
@@ -134,26 +140,30 @@ def _unique(names: list[str]) -> list[str]:
 
 def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[int], motors: tuple[str, ...],
                    outputs: tuple[str, ...]) -> Mechanism:
-    """Rule 4: the sub-mechanism alone, rooted where the robot's reference puts its root."""
+    """Rule 4: the sub-mechanism alone, rooted where the robot's reference puts its root, built from its own URDF
+    (so that it has files, :func:`~pkm.core.transmissions.serial.write_serial_equivalent`, and pickles)."""
     model = mech.model
     keep = {model.names[j] for j in joints}
     lock = [j for j in range(1, model.njoints) if model.names[j] not in keep]
     reduced = pin.buildReducedModel(model, lock, mech.q_reference) if lock else model.copy()
-    reduced.name = name
-    lower, upper = np.array(reduced.lowerPositionLimit, dtype=float), np.array(reduced.upperPositionLimit, dtype=float)
-    empty = lower >= upper  # (a reader's placeholder for "no limit stated": URDF's revolute without <limit>, SDF)
-    lower[empty], upper[empty] = -np.inf, np.inf
-    reduced.lowerPositionLimit, reduced.upperPositionLimit = lower, upper
+    stated = {n: lim for n, lim in mech.limits.items() if n in keep}
+    urdf, types = urdf_from_model(reduced, name=name, limits=stated, source=mech.source)
     q_ref = mech.q_to_dict(mech.q_reference)
     spec = ClosureSpec(
-        mechanism=name, urdf=mech.spec.urdf, end_effector=None, actuated=motors,
+        mechanism=name, urdf=f"{name}.urdf", end_effector=None, actuated=motors,
         closures=tuple(mech.spec.closures[i] for i in closures), task=TaskSpec(components=(), joints=outputs),
-        reference={n: tuple(np.atleast_1d(q_ref[n]).tolist()) for n in keep if n in q_ref},
-        joint_types={n: t for n, t in mech.spec.joint_types.items() if n in keep},
-        actuators={n: v for n, v in mech.spec.actuators.items() if n in motors},
+        reference={n: tuple(np.atleast_1d(q_ref[n]).tolist()) for n in sorted(keep) if n in q_ref},
+        joint_types=types, actuators={a.joint: {f: float(getattr(a, f)) for f in NUMBERS}
+                                      for a in mech.actuators if a.joint in motors},
         description=f"the closed sub-mechanism {name!r} of {mech.name!r}")
-    sub = Mechanism(reduced, spec, source=f"{mech.source} [{name}]")
-    sub.limits = {n: lim for n, lim in mech.limits.items() if n in keep}
+    with warnings.catch_warnings():  # (what the robot's loading said already: kept in the notes, not said twice)
+        warnings.simplefilter("ignore", PkmWarning)
+        sub = from_strings(urdf, spec, source=f"{mech.source} [{name}]")
+    lower, upper = np.array(sub.model.lowerPositionLimit, dtype=float), np.array(sub.model.upperPositionLimit,
+                                                                                 dtype=float)
+    empty = lower >= upper  # (a reader's placeholder for "no limit stated": URDF's revolute without bounds, SDF)
+    lower[empty], upper[empty] = -np.inf, np.inf
+    sub.model.lowerPositionLimit, sub.model.upperPositionLimit = lower, upper
     return sub
 
 

@@ -22,8 +22,10 @@ sub-mechanism (so in its ``M_s``) but removed from the whole serial model (batto
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -193,19 +195,33 @@ def _mjcf(se: SerialEquivalent, timestep: float) -> str:
 
 
 def write_serial_equivalent(se: SerialEquivalent, folder: str | os.PathLike[str]) -> tuple[Path, ...]:
-    """Write ``se`` into ``folder`` (made if missing): ``<robot>_serial.urdf``, ``<robot>_serial.xml`` (MJCF) and
-    ``<robot>_transmissions.json`` (:meth:`SerialEquivalent.data`, with the two files' names); returns their
-    paths."""
+    """Write ``se`` into ``folder`` (made if missing): ``<robot>_serial.urdf``, ``<robot>_serial.xml`` (MJCF),
+    each transmission's sub-mechanism as ``<robot>_<transmission>.urdf`` and ``.closures.toml`` (``pkm.load`` reads
+    it back) and ``<robot>_transmissions.json`` (:meth:`SerialEquivalent.data`, with the files' names); returns
+    their paths, the data file last."""
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
-    stem = se.robot.name
+    stem = _safe(se.robot.name)
     urdf, mjcf, data = out / f"{stem}_serial.urdf", out / f"{stem}_serial.xml", out / f"{stem}_transmissions.json"
     urdf.write_text(se.urdf())
     mjcf.write_text(se.mjcf())
+    written = [urdf, mjcf]
     content = se.data()
     content["files"] = {"urdf": urdf.name, "mjcf": mjcf.name}
+    for t, entry in zip(se.transmissions, content["transmissions"]):
+        sub = t.mechanism
+        sub_urdf, sub_spec = out / f"{stem}_{_safe(t.name)}.urdf", out / f"{stem}_{_safe(t.name)}.closures.toml"
+        sub_urdf.write_text(sub.urdf or "")
+        sub_spec.write_text(dataclasses.replace(sub.spec, urdf=sub_urdf.name).to_toml())
+        entry["files"] = {"urdf": sub_urdf.name, "spec": sub_spec.name}
+        written += [sub_urdf, sub_spec]
     data.write_text(json.dumps(content, indent=1))
-    return urdf, mjcf, data
+    return (*written, data)
+
+
+def _safe(name: str) -> str:
+    """``name`` as a file name: every character but letters, digits, ``_``, ``-`` and ``.`` written ``_``."""
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", name)
 
 
 __all__ = ["SerialEquivalent", "serial_equivalent", "write_serial_equivalent"]
