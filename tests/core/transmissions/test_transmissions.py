@@ -26,6 +26,7 @@ import pytest
 
 import pkm
 from pkm.core.transmissions.coordinates import drift_acceleration, output_split
+from pkm.core.transmissions.serial import serial_equivalent
 from pkm.errors import TransmissionError, UnknownNameError
 from tests.core.transmissions.robots import FILES, ROBOTS, robot, transmissions
 from tests.fd import rel, richardson
@@ -160,10 +161,15 @@ def test_outputs_singular_at_the_reference_are_refused():
     assert err.value.value > 1e-3
 
 
-def test_a_sub_mechanism_whose_chain_outnumbers_its_motors_is_refused():
+def test_a_sub_mechanism_whose_chain_outnumbers_its_motors_is_refused_or_left_out():
     cassie = pkm.load("gepetto:cassie_like")  # (the knee motor and the passive tarsus joint both carry the foot)
     with pytest.raises(TransmissionError, match=r"2 outputs \['motor_knee', 'free_knee'\] for 1 motors"):
         pkm.transmissions(cassie)
+    with pytest.warns(pkm.errors.PkmWarning, match="'tarsus'.*left out"):
+        (ankle,) = pkm.transmissions(cassie, skip_unfit=True)
+    assert (ankle.name, ankle.motors, ankle.outputs) == ("foot_2", ("motor_ankle",), ("free_ankle",))
+    with pytest.raises(pkm.errors.InvalidInputError, match=r"closures \['loop2'\] belong to no transmission"):
+        serial_equivalent(cassie, [ankle], limits=False)
 
 
 def test_the_spec_names_a_transmission_and_its_outputs(tmp_path):

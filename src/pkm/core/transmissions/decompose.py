@@ -167,7 +167,8 @@ def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[
     return sub
 
 
-def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None = None) -> list[Transmission]:
+def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None = None, *,
+                  skip_unfit: bool = False) -> list[Transmission]:
     """The closed sub-mechanisms of a whole robot, each a :class:`Transmission` (the rules: module doc).
 
     Args:
@@ -175,6 +176,9 @@ def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None =
         outputs: ``{transmission name: output joints}`` for the transmissions whose outputs the chain rule would not
             choose (or to name them); a transmission not listed gets the chain rule and a generated name. Default:
             the spec's ``[transmission.<name>]`` tables (:attr:`pkm.ClosureSpec.transmissions`).
+        skip_unfit: Leave out a sub-mechanism that cannot be a transmission (its :class:`TransmissionError` said in a
+            :class:`~pkm.errors.PkmWarning`) instead of raising: the others of a robot one of whose loops is no
+            transmission (Gepetto's ``cassie_like``: its ankle, not its knee).
 
     Returns:
         The transmissions, in the order of their first closure in the spec.
@@ -231,9 +235,15 @@ def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None =
     generated = _unique([p[0] for p in plans])
     result = []
     for g, p in enumerate(plans):
-        result.append(_transmission(mech, by_group.get(g) or generated[g], *p[1:]))
+        try:
+            result.append(_transmission(mech, by_group.get(g) or generated[g], *p[1:]))
+        except TransmissionError as exc:
+            if not skip_unfit:
+                raise
+            warnings.warn(PkmWarning(f"{exc}: left out (skip_unfit)"), stacklevel=2)
     if not result:
-        raise TransmissionError(mech.name, "no_loop", "the robot has no closure: no closed sub-mechanism")
+        raise TransmissionError(mech.name, "no_loop", "the robot has no closed sub-mechanism that is a transmission"
+                                if plans else "the robot has no closure: no closed sub-mechanism")
     return result
 
 

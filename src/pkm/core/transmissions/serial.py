@@ -42,6 +42,7 @@ from pkm.core.model.urdf import urdf_from_model
 from pkm.core.transmissions.decompose import transmissions as find
 from pkm.core.transmissions.limits import OutputLimits, output_limits
 from pkm.core.transmissions.transmission import Transmission
+from pkm.errors import InvalidInputError
 
 
 @dataclass(frozen=True)
@@ -119,6 +120,11 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
     """
     robot = check_mechanism(robot)
     found = tuple(find(robot) if transmissions is None else transmissions)
+    covered = {c.name for t in found for c in t.mechanism.spec.closures}
+    open_loops = [c.name for c in robot.spec.closures if c.name not in covered]
+    if open_loops:
+        raise InvalidInputError("transmissions", f"closures {open_loops} belong to no transmission given: the serial "
+                                "model would keep their joints with the loops open", open_loops)
     model = robot.model.copy()
     gone = [robot.joints[n].id for t in found for n in (*t.motors, *t.passive)]
     for j in gone:
