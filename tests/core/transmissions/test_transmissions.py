@@ -46,6 +46,8 @@ EXPECTED = {
         ("foot_assembly_2", "shin_assembly_sym", ("motor_ankle1_left", "motor_ankle2_left"),
          ("ankley_left", "anklex_left"))],
     "talos_like": [("ankle", "knee", ("motor_shin",), ("free_ankle",))],
+    "cassie_like": [("foot_2", "tarsus", ("motor_ankle",), ("free_ankle",))],
+    "digit_like": [("foot_part", "tarsus", ("motor_shin1", "motor_shin2"), ("free_foot1", "free_foot2"))],
 }
 
 
@@ -162,7 +164,7 @@ def test_outputs_singular_at_the_reference_are_refused():
 
 
 def test_a_sub_mechanism_whose_chain_outnumbers_its_motors_is_refused_or_left_out():
-    cassie = pkm.load("gepetto:cassie_like")  # (the knee motor and the passive tarsus joint both carry the foot)
+    cassie = robot("cassie_like")  # (the knee motor and the passive tarsus joint both carry the foot)
     with pytest.raises(TransmissionError, match=r"2 outputs \['motor_knee', 'free_knee'\] for 1 motors"):
         pkm.transmissions(cassie)
     with pytest.warns(pkm.errors.PkmWarning, match="'tarsus'.*left out"):
