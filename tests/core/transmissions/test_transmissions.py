@@ -202,3 +202,11 @@ def test_a_floating_base_is_held_at_the_reference_in_the_sub_mechanism(tmp_path)
     np.testing.assert_allclose(t.delta_mass(t.q_reference), fixed.delta_mass(fixed.q_reference), rtol=1e-12)
     g_tilted, g_upright = t.delta_bias(t.q_reference, [0.0]), fixed.delta_bias(fixed.q_reference, [0.0])
     assert abs(g_tilted[0] - g_upright[0]) > 1e-3 * abs(g_upright[0])  # (gravity as the tilted pelvis sees it)
+
+
+def test_a_robot_with_no_transmission_is_refused():
+    disney = pkm.load("gepetto:disney_like")  # (one sub-mechanism of five motors, its outputs singular)
+    with pytest.warns(pkm.errors.PkmWarning, match="singular at the reference.*left out"):
+        with pytest.raises(TransmissionError, match="no closed sub-mechanism that is a transmission") as err:
+            pkm.transmissions(disney, skip_unfit=True)
+    assert (err.value.transmission, err.value.reason) == ("disney_like", "no_loop")
