@@ -10,6 +10,7 @@ import numpy as np
 from pkm._optional import require
 from pkm.core.identification.excitation import Excitation
 from pkm.core.identification.export import Validation
+from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism
 
 
@@ -45,8 +46,7 @@ def excitation_figure(mech: Mechanism, excitation: Excitation, path: str | Path)
     pos, rate, effort = _units(mech)
     fig, axes = figure(nrows=3, size=(7.0, 2.2))
     axes = np.asarray(axes).ravel()
-    lo = mech.model.lowerPositionLimit[mech.act_q]
-    hi = mech.model.upperPositionLimit[mech.act_q]
+    lo, hi = stated_limits(mech.model, mech.act_q)
     speed = [a.velocity_limit for a in mech.actuators]
     force = [a.effort_limit for a in mech.actuators]
     t = excitation.t

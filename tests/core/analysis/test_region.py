@@ -79,3 +79,20 @@ def test_rays_cut_by_the_reach_are_said_so(ankle):
     with pytest.warns(PkmWarning, match="8 of 8 rays found no limit within reach = 0.01"):
         region = feasible_region(ankle, AXES, directions=8, steps=1, reach=0.01)
     assert set(region.binding) == {"reach"}
+
+
+def test_a_limit_the_file_does_not_state_is_no_limit():
+    """Gepetto's five-bar states no joint limit (Pinocchio's placeholder 0/0 on every joint): its region is bounded
+    by its singularities and the reach, not by an empty interval (before: 'the reference pose is not feasible: joint
+    mot1 at its low limit'); the shared reading (pkm.core.model.joints.stated_limits) gives (-inf, inf) there."""
+    import warnings
+
+    from pkm.core.model.joints import stated_limits
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PkmWarning)
+        five = pkm.load("gepetto:5bar_linkage")
+        region = feasible_region(five, ("mot1", "mot2"), reach=1.0, directions=8)
+    assert np.all(five.model.lowerPositionLimit >= five.model.upperPositionLimit)  # (the file's placeholders)
+    assert np.all(np.isinf(stated_limits(five.model)[0])) and not any("limit" in b for b in region.binding)
+    assert np.ptp(region.vertices, axis=0).min() > 0.1  # (a region, not the reference point alone) [rad]

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PkmError, PkmWarning
 from pkm.validation import as_count, as_scalar
@@ -174,8 +175,7 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
     if not (reach > 0 and n_dir >= 3 and n_steps >= 1 and tol > 0):
         raise InvalidInputError("reach", "expected reach > 0, directions >= 3, steps >= 1, tol > 0",
                                 (reach, n_dir, n_steps, tol))
-    lo = np.array(mech.model.lowerPositionLimit, dtype=float)
-    hi = np.array(mech.model.upperPositionLimit, dtype=float)
+    lo, hi = stated_limits(mech.model)  # (a placeholder 0/0 is no limit)
     if limits is not None and not isinstance(limits, Mapping):
         raise InvalidInputError("limits", "expected {joint: (low, high)}", limits)
     for joint, bounds in (limits or {}).items():

@@ -38,6 +38,7 @@ import numpy as np
 from pkm.core.export import runtime
 from pkm.core.export.emit import c_constant, c_function
 from pkm.core.export.model import Block, ExportError, ExportModel, Newton, c_name
+from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.codegen import jacobi_sv, paper_counts
 
@@ -118,13 +119,13 @@ def _velocity_names(mech: Mechanism) -> list[str]:
 
 def _limits(mech: Mechanism) -> list[tuple[str, int, float, float]]:
     """``(joint, q index, low, high)`` of the one-coordinate joints with finite limits."""
-    lo, hi = mech.model.lowerPositionLimit, mech.model.upperPositionLimit
+    lo, hi = stated_limits(mech.model)
     out = []
     for name, j in mech.joints.items():
         if j.nq != 1:
             continue
         a, b = float(lo[j.idx_q]), float(hi[j.idx_q])
-        if np.isfinite(a) and np.isfinite(b) and a < b and max(abs(a), abs(b)) < 1e10:
+        if np.isfinite(a) and np.isfinite(b) and max(abs(a), abs(b)) < 1e10:
             out.append((name, j.idx_q, a, b))
     return out
 

@@ -42,6 +42,7 @@ import scipy.optimize
 
 from pkm.core.identification.base import BaseParameters, base_parameters
 from pkm.core.identification.regressor import close_along, parameters, regressor_batch
+from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PkmError
 from pkm.validation import as_count, as_scalar
@@ -116,8 +117,7 @@ class Excitation:
 
 
 def _limits(mech: Mechanism, amplitude: float | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    lo = mech.model.lowerPositionLimit[mech.act_q].astype(float)
-    hi = mech.model.upperPositionLimit[mech.act_q].astype(float)
+    lo, hi = stated_limits(mech.model, mech.act_q)
     ref = mech.actuated_q(mech.q_reference)
     kinds = ["rad" if mech.joints[name].revolute else "m" for name in mech.actuated_names]
     amp = np.array([AMPLITUDE[k] if amplitude is None else amplitude for k in kinds])

@@ -30,6 +30,7 @@ import numpy as np
 import scipy.signal
 
 from pkm._optional import module
+from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PkmError
 from pkm.validation import as_array, as_count, as_scalar
@@ -187,8 +188,7 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
         raise InvalidInputError("time", f"{source}, row {row}: step {step[row - 2]:.6g} s where the sampling is "
                                         f"{dt:.6g} s (uniform sampling expected, to 1 %)", step[row - 2])
     QA, TAU = table[:, 1:1 + mech.na], table[:, 1 + mech.na:]
-    lo = mech.model.lowerPositionLimit[mech.act_q]
-    hi = mech.model.upperPositionLimit[mech.act_q]
+    lo, hi = stated_limits(mech.model, mech.act_q)
     for j, name in enumerate(names):
         prismatic = not mech.joints[name].revolute
         cap = MAX_PRISMATIC if prismatic else MAX_REVOLUTE

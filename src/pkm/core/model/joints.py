@@ -98,6 +98,21 @@ LIMITS_V = ("lowerEffortLimit", "upperEffortLimit", "lowerVelocityLimit", "upper
             "upperDryFrictionLimit", "effortLimit", "velocityLimit", "damping", "friction", "armature")
 
 
+def stated_limits(model: pin.Model, idx: np.ndarray | slice | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The position limits a model's file states, per configuration entry (of ``idx`` only, if given) [rad, m]:
+    ``(-inf, inf)`` where the interval is empty or a point (``lower >= upper``), the placeholder Pinocchio's readers
+    leave where a file states no limit (URDF's ``lower``/``upper`` default to 0; SDF, Gepetto's robots), which MuJoCo
+    also reads as unlimited (``range="0 0"``). Every use of a model's limits reads them here: a placeholder taken as a
+    limit made every pose infeasible (:func:`pkm.feasible_region` on a Gepetto robot)."""
+    lo = np.array(model.lowerPositionLimit, dtype=float)
+    hi = np.array(model.upperPositionLimit, dtype=float)
+    if idx is not None:
+        lo, hi = lo[idx], hi[idx]
+    empty = ~(lo < hi)
+    lo[empty], hi[empty] = -np.inf, np.inf
+    return lo, hi
+
+
 def copy_limits(model: pin.Model, new: pin.Model, joints: list[tuple[int, int]],
                 extra_v: tuple[str, ...] = ()) -> None:
     """``model``'s limits and drives (:data:`LIMITS_Q`, :data:`LIMITS_V` and ``extra_v``, those this Pinocchio has)
@@ -137,4 +152,5 @@ def _mimics(model: pin.Model) -> dict[str, tuple[str, float, float, pin.JointMod
     return out
 
 
-__all__ = ["JOINT_TYPES", "LIMITS_Q", "LIMITS_V", "UNIVERSAL_AXES", "copy_limits", "retype_joints", "universal_joint"]
+__all__ = ["JOINT_TYPES", "LIMITS_Q", "LIMITS_V", "UNIVERSAL_AXES", "copy_limits", "retype_joints", "stated_limits",
+           "universal_joint"]

@@ -45,6 +45,7 @@ import pinocchio as pin
 
 from pkm.core.model.actuators import NUMBERS
 from pkm.core.model.builder import from_strings
+from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.spec import ClosureSpec, TaskSpec
 from pkm.core.model.urdf import urdf_from_model
@@ -161,11 +162,7 @@ def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[
     with warnings.catch_warnings():  # (what the robot's loading said already: kept in the notes, not said twice)
         warnings.simplefilter("ignore", PkmWarning)
         sub = from_strings(urdf, spec, source=f"{mech.source} [{name}]")
-    lower, upper = np.array(sub.model.lowerPositionLimit, dtype=float), np.array(sub.model.upperPositionLimit,
-                                                                                 dtype=float)
-    empty = lower >= upper  # (a reader's placeholder for "no limit stated": URDF's revolute without bounds, SDF)
-    lower[empty], upper[empty] = -np.inf, np.inf
-    sub.model.lowerPositionLimit, sub.model.upperPositionLimit = lower, upper
+    sub.model.lowerPositionLimit, sub.model.upperPositionLimit = stated_limits(sub.model)
     return sub
 
 
