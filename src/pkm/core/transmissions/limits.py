@@ -4,7 +4,7 @@ The feasible region of the outputs is where the sub-mechanism closes within its 
 singularity (:mod:`pkm.core.analysis.region`: the same rules, ``singularity`` the smallest relative distance):
 
 * two outputs: :func:`pkm.feasible_region` in their plane (a polygon, each vertex naming what stops it), and its
-  :attr:`~pkm.core.analysis.region.Region.box` (the largest box about the reference in the polygon's proportions);
+  :meth:`~pkm.core.analysis.region.Region.box` (the largest box about the reference in the polygon's proportions);
 * one output: the interval about the reference, followed out each way by ``steps`` steps up to ``reach`` and the
   first step out bisected to ``tol`` (the 1-D case of the same search), its ends the limits;
 * more outputs: not traced (:class:`OutputLimits` with no limits; the export says so).
