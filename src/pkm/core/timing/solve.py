@@ -113,7 +113,7 @@ def _rows(C: PathCoefficients, L: Limits, x0: np.ndarray | None) -> tuple[np.nda
     scale = 1.0 - L.margin
     Au, Ax, c0, g = [], [], [], []
     for sigma in (1.0, -1.0):
-        e = sigma * C.d[:, :, None] + beta[None] * np.abs(C.dqa)[:, :, None]  # (n x na x k)
+        e = sigma * C.d[:, :, None] + scale * beta[None] * np.abs(C.dqa)[:, :, None]  # (n x na x k)
         if x0 is None:  # (no speed-dependent term: e == 0)
             lin_x, lin_c = np.zeros_like(e), np.zeros_like(e)
         else:
