@@ -117,8 +117,14 @@ def _rows(C: PathCoefficients, L: Limits, x0: np.ndarray | None) -> tuple[np.nda
         if x0 is None:  # (no speed-dependent term: e == 0)
             lin_x, lin_c = np.zeros_like(e), np.zeros_like(e)
         else:
-            r0 = np.sqrt(np.maximum(x0, 1e-12))[:, None, None]
+            # (the tangent's point: the last law's x, but no further than where the row's constant e sqrt(x0) / 2
+            # would take 3/4 of its slack at rest; any x0 > 0 gives an upper bound)
             ep = np.where(e > 0.0, e, 0.0)
+            slack = np.maximum(scale * np.where(np.isfinite(alpha), alpha, 0.0)[None] - sigma * C.c[:, :, None],
+                               1e-12)
+            with np.errstate(divide="ignore"):
+                cap = np.where(ep > 0.0, (1.5 * slack / ep) ** 2, np.inf)
+            r0 = np.sqrt(np.maximum(np.minimum(x0[:, None, None], cap), 1e-9 * max(float(x0.max()), 1e-12)))
             lin_x, lin_c = ep / (2.0 * r0), ep * r0 / 2.0
         finite = np.isfinite(alpha)[None] & np.ones((n, 1, 1), dtype=bool)
         Au.append(np.where(finite, sigma * C.a[:, :, None], 0.0))
@@ -243,7 +249,12 @@ def solve(mech: Mechanism, path: GeometricPath, C: PathCoefficients, L: Limits, 
         sd, sdd = _toppra(C0, const, None)
         best, T, passes = None, math.inf, 1
         for _ in range(MAX_PASSES):
-            sd, sdd = _toppra(C, L, sd ** 2)
+            try:
+                sd, sdd = _toppra(C, L, sd ** 2)
+            except PkmError:
+                if best is None:
+                    raise
+                break  # (the last law found holds the limits: kept)
             passes += 1
             T_new = float(_times(C.s, sd)[-1])
             if best is None or T_new < T:
@@ -314,7 +325,7 @@ def time_optimal(mech: Mechanism, path: object, *, payload: float = 0.0, limits:
         >>> line = np.array([[-0.05, 0.0, -0.36], [0.05, 0.0, -0.36]])
         >>> plan = pkm.time_optimal(delta, line, points=50)
         >>> round(plan.cycle_time, 4)
-        0.1296
+        0.1729
     """
     from pkm.core.model.mechanism import check_mechanism
     from pkm.core.timing.coefficients import path_coefficients, with_payload
