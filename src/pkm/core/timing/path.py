@@ -210,4 +210,34 @@ def motion_path(mech: Mechanism, motion: object) -> GeometricPath:
     return path
 
 
-__all__ = ["MAX_TURN", "SPACES", "GeometricPath", "motion_path", "waypoint_path"]
+__all__ = ["MAX_TURN", "SPACES", "GeometricPath", "adept_waypoints", "motion_path", "waypoint_path"]
+
+
+def adept_waypoints(start: ArrayLike, *, across: float = 0.305, up: float = 0.025, points: int = 200,
+                    direction: ArrayLike = (1.0, 0.0, 0.0)) -> np.ndarray:
+    """Points (n x 3) [m] of the standard pick-and-place cycle ("Adept cycle": ``up`` 25 mm, ``across`` 305 mm,
+    down 25 mm) from ``start`` along ``direction`` (horizontal), its corners rounded with the radius ``up`` (a
+    quarter circle up, a straight line, a quarter circle down): geometry C¹, curvature 1/up on the arcs, sampled at
+    ``points`` points for :func:`waypoint_path`'s spline."""
+    p0 = as_array(start, "start", "x y z [m]")
+    e = as_array(direction, "direction", "a horizontal direction")
+    if p0.shape != (3,) or e.shape != (3,) or abs(e[2]) > 0.0 or not np.linalg.norm(e) > 0.0:
+        raise InvalidInputError("start", "expected a point (x, y, z) and a horizontal direction", (start, direction))
+    e = e / np.linalg.norm(e)
+    r = float(up)
+    if not (0.0 < 2.0 * r < across):
+        raise InvalidInputError("across", f"needs across > 2 up, got {across} and {up}", across)
+    lengths = np.array([0.5 * np.pi * r, across - 2.0 * r, 0.5 * np.pi * r])
+    u = np.linspace(0.0, lengths.sum(), points)
+    out = np.empty((points, 3))
+    for k, arc in enumerate(u):
+        if arc <= lengths[0]:
+            th = arc / r
+            h, z = r * (1.0 - np.cos(th)), r * np.sin(th)
+        elif arc <= lengths[:2].sum():
+            h, z = r + arc - lengths[0], r
+        else:
+            th = (arc - lengths[:2].sum()) / r
+            h, z = across - r + r * np.sin(th), r * np.cos(th)
+        out[k] = p0 + h * e + np.array([0.0, 0.0, z])
+    return out
