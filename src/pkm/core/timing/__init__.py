@@ -3,7 +3,7 @@
 * :mod:`~pkm.core.timing.path`: the path :math:`y(s)` (a C² cubic spline through waypoints, or a motion case);
 * :mod:`~pkm.core.timing.coefficients`: the efforts along it, :math:`a \\ddot s + b \\dot s^2 + c + d \\dot s`, from
   the actuator-space model (payload, friction);
-* :mod:`~pkm.core.timing.limits`: torque–speed curves, speed and acceleration limits;
+* :mod:`~pkm.core.timing.limits`: torque-speed curves, speed and acceleration limits;
 * :mod:`~pkm.core.timing.solve`: the time-optimal law (TOPP-RA, ``toppra``): :func:`time_optimal`;
 * :mod:`~pkm.core.timing.verify`: the law checked by :func:`pkm.inverse_dynamics` at 10x the resolution,
   Pontryagin's structure and a tracking simulation: :func:`verify_time_optimal`.

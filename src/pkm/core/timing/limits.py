@@ -1,4 +1,4 @@
-r"""The limits a time law must hold: each actuator's effort under its torque–speed curve, its speed and its
+r"""The limits a time law must hold: each actuator's effort under its torque-speed curve, its speed and its
 acceleration.
 
 **Effort**: :math:`|\tau_i| \le T_i(|\omega_i|)` with :math:`\omega_i = \dot q_{a,i}` the joint's speed and
@@ -107,7 +107,7 @@ def actuator_limits(mech: Mechanism, *, peak: ArrayLike | None = None, omega0: A
         mech: The mechanism.
         peak: The effort at rest [N m, N]; default each drive's :attr:`~pkm.Actuator.max_effort`.
         omega0: The no-load speed of a linear motor line [rad/s, m/s]; default none (a constant peak).
-        table: A torque–speed table, rows ``(speed, effort)`` (the same for every actuator) instead of
+        table: A torque-speed table, rows ``(speed, effort)`` (the same for every actuator) instead of
             ``peak``/``omega0``.
         speed: The speed limits; default the drives' ``velocity_limit``.
         acceleration: The acceleration limits; default none.

@@ -10,7 +10,7 @@ arrays), and times a 1,000-point Delta path in about 25 ms; writing another woul
 **interpolation** discretisation (the efforts at both ends of each segment held with the segment's
 :math:`\ddot s`: the efforts just before a grid point are checked too, not only those at it).
 
-**The torque–speed curve and viscous friction** depend on :math:`\dot s = \sqrt{x}`, which is not linear in
+**The torque-speed curve and viscous friction** depend on :math:`\dot s = \sqrt{x}`, which is not linear in
 :math:`x`: each effort row :math:`\sigma (a u + b x + c) + e \sqrt{x} \le \alpha` (:math:`e = \sigma d + \beta
 |q_a'|`) is linearised per grid point on the tangent of :math:`\sqrt{x}` at the previous solution's :math:`x_0`,
 :math:`\sqrt{x} \le \sqrt{x_0}/2 + x / (2 \sqrt{x_0})` (an upper bound for every :math:`x`: each iterate is
@@ -188,7 +188,7 @@ def _toppra(C: PathCoefficients, L: Limits, x0: np.ndarray | None) -> tuple[np.n
             return np.zeros((np.size(s), C.a.shape[1]))
 
     algo = TOPPRA([_Rows()], _Path(), gridpoints=C.s, solver_wrapper="seidel")
-    sdd, sd, _, K = algo.compute_parameterization(0.0, 0.0, return_data=True)
+    sdd, sd, _, _ = algo.compute_parameterization(0.0, 0.0, return_data=True)
     if sd is None or sdd is None:
         raise PkmError("toppra found no time law: the path is not controllable under these limits (at rest at "
                        "both ends)")
@@ -216,7 +216,7 @@ def check_static(C: PathCoefficients, L: Limits) -> None:
 
 def usage(C: PathCoefficients, L: Limits, sd: np.ndarray, sdd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per segment, the largest use of any limit at its two ends with its ``sdd`` against the margin-reduced
-    limits (the true torque–speed curve), and which (an index: ``k < na`` effort of actuator k, ``na + k`` speed,
+    limits (the true torque-speed curve), and which (an index: ``k < na`` effort of actuator k, ``na + k`` speed,
     ``2 na + k`` acceleration)."""
     na = C.a.shape[1]
     scale = 1.0 - L.margin
