@@ -3,18 +3,20 @@
 from __future__ import annotations
 
 import csv
+import json
 
-from tests.cli.helpers import one_error_line, run
+from pkm import cli
 
 
-def test_plan_writes_the_trajectory_and_prints_the_cycle_time(tmp_path):
+def test_plan_writes_the_trajectory_and_prints_the_cycle_time(tmp_path, capsys):
     out = tmp_path / "plan.csv"
-    proc = run("plan", "delta", "--path", "adept:-0.1525,0,-0.33", "--points", "30", "--out", str(out), "--json")
-    assert proc.returncode == 0, proc.stderr
-    import json
-
-    summary = json.loads(proc.stdout)
+    argv = ["plan", "delta", "--path", "adept:-0.1525,0,-0.33", "--points", "30", "--out", str(out)]
+    assert cli.main([*argv, "--json"]) == 0, capsys.readouterr().err
+    summary = json.loads(capsys.readouterr().out)
     rows = list(csv.DictReader(out.open()))
     assert len(rows) == 30 and float(rows[-1]["t"]) == summary["cycle_time_s"]
-    bad = run("plan", "delta", "--path", "adept:0,0,-0.5", "--points", "30", "--out", str(out))
-    assert "workspace" in one_error_line(bad) and "path point 0" in bad.stderr
+    assert sum(summary["active_segments"].values()) == 29
+    status = cli.main(["plan", "delta", "--path", "adept:0,0,-0.5", "--points", "30", "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert status != 0 and err.startswith("pkm: error: path point 0") and "workspace" in err
+    assert len(err.splitlines()) == 1

@@ -63,3 +63,37 @@ def test_refused_paths_name_the_point_and_the_limit(delta):
     assert err.value.limit.startswith("peak effort of motor_") and "cannot hold" in str(err.value)
     with pytest.raises(InvalidInputError):
         actuator_limits(delta, table=[[0.0, 1.0], [1.0, 0.9], [2.0, 0.1], [3.0, 0.05]])  # (convex: refused)
+
+
+def test_same_cycle_time_as_toppra_on_its_own_constraints(delta, arc):
+    """toppra assembling its own rows (SecondOrderConstraint from pkm.inverse_dynamics, JointVelocityConstraint) on
+    the actuated path equals the plan built from a, b, c, to 1e-6 s."""
+    import toppra
+    from toppra.constraint import DiscretizationType, JointVelocityConstraint, SecondOrderConstraint
+
+    path, C = arc
+    L = actuator_limits(delta, margin=0.0, speed=20.0)
+    plan = solve(delta, path, C, L, 0.0)
+    assert {a.split()[0] for a in plan.active} == {"effort", "speed"}  # (both kinds of rows at work)
+
+    class Actuated(toppra.interpolator.AbstractGeometricPath):  # (the grid's q_a, q_a', q_a'')
+        path_interval = np.array([0.0, 1.0])
+        dof = delta.na
+
+        def __call__(self, s, order=0):
+            k = np.searchsorted(C.s, np.atleast_1d(s) - 1e-12)
+            return (C.qa, C.dqa, C.ddqa)[order][k]
+
+    def inv_dyn(qa, qd, qdd):
+        k = int(np.argmin(np.abs(C.qa - qa).sum(axis=1)))
+        v = pkm.velocities(delta, C.q[k], qd)
+        return pkm.inverse_dynamics(delta, C.q[k], v, pkm.accelerations(delta, C.q[k], v, qdd))
+
+    F = np.vstack([np.eye(delta.na), -np.eye(delta.na)])
+    torque = SecondOrderConstraint(inv_dyn, lambda q: F, lambda q: np.full(2 * delta.na, 3.9), delta.na,
+                                   discretization_scheme=DiscretizationType.Interpolation)
+    speed = JointVelocityConstraint(np.tile([-20.0, 20.0], (delta.na, 1)))
+    algo = toppra.algorithm.TOPPRA([torque, speed], Actuated(), gridpoints=C.s, solver_wrapper="seidel")
+    _, sd, _ = algo.compute_parameterization(0.0, 0.0)
+    T = float(np.sum(2.0 * np.diff(C.s) / (sd[1:] + sd[:-1])))
+    assert abs(T - plan.cycle_time) <= 1e-6
