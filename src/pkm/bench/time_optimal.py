@@ -27,9 +27,8 @@ def run(args) -> dict:
     delta = pkm.load("delta")
     path = adept_waypoints([-0.1525, 0.0, -0.33])
     pkm.time_optimal(delta, path, points=args.n, kernels=True)  # (the kernels compiled and loaded)
-    compiled, plan = best_time(lambda: pkm.time_optimal(delta, path, points=args.n, kernels=True), args.repeat)
-    spent = []
     inner = solve_mod._toppra
+    spent: list[float] = []
 
     def timed(*a):
         t0 = time.perf_counter()
@@ -37,13 +36,19 @@ def run(args) -> dict:
         spent.append(time.perf_counter() - t0)
         return out
 
+    runs = []
     solve_mod._toppra = timed
     try:
-        pkm.time_optimal(delta, path, points=args.n, kernels=True)
+        for _ in range(max(1, args.repeat)):  # (the best run, with its toppra share)
+            spent.clear()
+            t0 = time.perf_counter()
+            plan = pkm.time_optimal(delta, path, points=args.n, kernels=True)
+            runs.append((time.perf_counter() - t0, sum(spent)))
     finally:
         solve_mod._toppra = inner
+    compiled, toppra_s = min(runs)
     core, plan_core = best_time(lambda: pkm.time_optimal(delta, path, points=args.n), 1)
-    return {"points": args.n, "compiled_s": compiled, "toppra_s": sum(spent), "core_s": core,
+    return {"points": args.n, "compiled_s": compiled, "toppra_s": toppra_s, "core_s": core,
             "cycle_time_s": plan.cycle_time, "cycle_time_core_s": plan_core.cycle_time,
             "target_s": 0.05, "within_target": compiled <= 0.05}
 

@@ -154,9 +154,10 @@ def _assemble(mech: Mechanism, s: np.ndarray, q: np.ndarray, y: np.ndarray, dy: 
     b = np.einsum("kij,kj->ki", M, ddqa) + h - g
     coulomb, viscous = (np.zeros_like(a), np.zeros_like(a)) if G is None else _friction(mech, G, dqa)
     out = PathCoefficients(s, q, y, dy, ddy, qa, dqa, ddqa, a, b, g + coulomb, viscous, g, route)
-    bad = [k for k in range(len(s)) if not (np.all(np.isfinite(a[k])) and np.all(np.isfinite(b[k])))]
-    if bad:
-        raise PathError(bad[0], s[bad[0]], "singularity", "non-finite effort coefficients (a singular state)")
+    bad = np.flatnonzero(~(np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)))
+    if bad.size:
+        k = int(bad[0])
+        raise PathError(k, s[k], "singularity", "non-finite effort coefficients (a singular state)")
     return out
 
 

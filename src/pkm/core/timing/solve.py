@@ -160,15 +160,17 @@ def _toppra(C: PathCoefficients, L: Limits, x0: np.ndarray | None) -> tuple[np.n
     from toppra.constraint.linear_constraint import LinearConstraint, canlinear_colloc_to_interpolate
 
     Au, Ax, c0, g = _rows(C, L, x0)
+    keep = np.flatnonzero(np.any(Au != 0.0, axis=0) | np.any(Ax != 0.0, axis=0))  # (rows of no limit left out)
+    Au, Ax, c0, g = Au[:, keep], Ax[:, keep], c0[:, keep], g[0, keep]  # (g is the same at every point)
     n, m = Au.shape
-    F = np.broadcast_to(np.eye(m), (n, m, m))
     xb = np.column_stack([np.zeros(n), _x_bound(C, L)])
-    params = canlinear_colloc_to_interpolate(Au, Ax, c0, F, g, xb, None, C.s)
+    params = canlinear_colloc_to_interpolate(Au, Ax, c0, np.eye(m), g, xb, None, C.s, identical=True)
 
     class _Rows(LinearConstraint):  # (the rows computed here, handed over as they are)
         def __init__(self) -> None:
             super().__init__()
             self.discretization_type = DiscretizationType.Interpolation
+            self.identical = True
 
         def compute_constraint_params(self, path: object, gridpoints: np.ndarray, *args: object,
                                       **kwargs: object) -> tuple:
