@@ -1,6 +1,7 @@
-"""``pkm plan MECH --path PATH [--payload KG] [--limits K=V,...] [--points N] --out FILE [--plot FILE.png]``: the
-time-optimal motion along a path (:func:`pkm.time_optimal`), written as a table (CSV, or Parquet), its speed profile
-drawn with the active limit marked, and the cycle time printed.
+"""``pkm plan MECH --path PATH [--payload KG] [--limits K=V,...] [--points N] --out FILE [--motion FILE.toml]
+[--plot FILE.png]``: the time-optimal motion along a path (:func:`pkm.time_optimal`), written as a table (CSV, or
+Parquet) and as a ``pkm.motion`` file (the actuated joints' ``hermite`` laws: positions and rates at the plan's
+times), its speed profile drawn with the active limit marked, and the cycle time printed.
 
 ``--path`` is a CSV of waypoints whose header names the task's values (``pkm list`` names them; or the actuated
 joints', for a path in actuator space) [m, rad], a ``pkm.motion`` case ``FILE.toml:CASE``, or
@@ -39,6 +40,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--points", metavar="N", type=int, default=1000, help="grid points along the path (default 1000)")
     p.add_argument("--out", metavar="FILE", required=True, help="the trajectory: CSV when FILE ends in .csv, else "
                                                                 "Parquet (pkm[sweeps])")
+    p.add_argument("--motion", metavar="FILE.toml", help="the motors' motion as a pkm.motion file (hermite laws of "
+                                                         "the actuated joints; default: FILE of --out with the "
+                                                         "suffix .motion.toml)")
     p.add_argument("--plot", metavar="FILE.png", help="the speed profile, the active limit marked (pkm[figures])")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
@@ -150,7 +154,14 @@ def run(args: argparse.Namespace) -> int:
 
     limits = parse_limits(with_payload(mech, args.payload), args.limits)
     plan = pkm.time_optimal(mech, path, payload=args.payload, limits=limits, points=args.points, space=space)
+    from pkm.motion import write_motion
+
     written = {"out": str(write(plan, args.out))}
+    motion = args.motion or str(Path(args.out).with_suffix(".motion.toml"))
+    written["motion"] = str(write_motion(motion, tuple(mech.actuated_names), "plan", plan.time, plan.qa,
+                                         plan.qa_rate, space="actuated", mechanism=mech.name,
+                                         description=f"time-optimal motion along {args.path} (pkm plan), payload "
+                                                     f"{plan.payload:g} kg, cycle {plan.cycle_time:.6g} s"))
     if args.plot:
         written["plot"] = str(plot(plan, args.plot))
     counts = {k: plan.active.count(k) for k in sorted(set(plan.active))}
