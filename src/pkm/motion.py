@@ -20,7 +20,7 @@ Laws, with ``t`` in seconds: ``constant`` (``value``), ``linear`` (``start + rat
 ``cosine`` (``offset + amplitude (1 - cos(omega t))``) and ``fourier`` (Swevers' finite Fourier series
 ``offset + Σ_l a_l / (omega l) sin(omega l t) - b_l / (omega l) cos(omega l t)``, ``a`` and ``b`` lists of as many
 harmonics: identification's excitations, :mod:`pkm.core.identification.excitation`) and ``hermite`` (a sampled
-motion, ``t`` [s] increasing, ``position`` and ``rate`` at each: the piecewise-cubic Hermite interpolant, exact at
+motion, ``t`` [s] increasing, ``position`` and ``velocity`` at each: the piecewise-cubic Hermite interpolant, exact at
 the knots, C¹; held at its end values with zero rate outside ``[t_0, t_n]``: what ``pkm plan`` writes). Their
 derivatives are exact.
 
@@ -52,8 +52,8 @@ FORMAT = "pkm.motion/1"
 MAX_SAMPLES = 10_000_000  #: samples of one case at most (memory)
 MAX_TIME = 1e9  #: |t| [s] accepted by :meth:`Motion.sample`
 LAWS = {"constant": ("value",), "linear": ("start", "rate"), "cosine": ("offset", "amplitude", "omega"),
-        "fourier": ("offset", "omega", "a", "b"), "hermite": ("t", "position", "rate")}
-LISTS = {"a", "b", "t", "position", "rate"}  #: keys holding a list (one number per harmonic, or per knot)
+        "fourier": ("offset", "omega", "a", "b"), "hermite": ("t", "position", "velocity")}
+LISTS = {"a", "b", "t", "position", "velocity"}  #: keys holding a list (one number per harmonic, or per knot)
 MAX_KNOTS = 1_000_000  #: knots of a ``hermite`` law at most
 SPACES = ("task", "actuated")
 MAX_HARMONICS = 1000
@@ -184,8 +184,8 @@ def _coefficients(src: str, where: str, spec: dict, keys: tuple[str, ...]) -> tu
         raise SpecError(src, f"{where}: a and b must have as many harmonics ({len(spec['a'])} and {len(spec['b'])})")
     if keys == LAWS["hermite"]:
         n = len(spec["t"])
-        if len(spec["position"]) != n or len(spec["rate"]) != n or n < 2 or not np.all(np.diff(out[:n]) > 0.0):
-            raise SpecError(src, f"{where}: t, position and rate must be lists of as many numbers (2 or more), t "
+        if len(spec["position"]) != n or len(spec["velocity"]) != n or n < 2 or not np.all(np.diff(out[:n]) > 0.0):
+            raise SpecError(src, f"{where}: t, position and velocity must be lists of as many numbers (2 or more), t "
                                  "increasing")
     if keys == LAWS["fourier"] and not out[1] > 0.0:
         raise SpecError(src, f"{where}.omega must be positive, got {out[1]}")
@@ -245,7 +245,7 @@ def write_motion(path: str | Path, coordinates: tuple[str, ...], name: str, t: n
              f"duration = {float(t[-1])!r}", f"dt = {float(np.min(np.diff(t)))!r}"]
     for j, c in enumerate(coordinates):
         lines.append(f'{q(c)} = {{ law = "hermite", t = {floats(t - t[0])}, position = {floats(P[:, j])}, '
-                     f"rate = {floats(R[:, j])} }}")
+                     f"velocity = {floats(R[:, j])} }}")
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text("\n".join(lines) + "\n", encoding="utf-8")
