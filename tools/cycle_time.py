@@ -1,137 +1,212 @@
 """Cycle-time studies (issue 46): the Delta's 25/305/25 mm cycle at 0, 1 and 3 kg against two baselines, a map of
-cycle time over the workspace, the 3-PRS and Gough-Stewart along their own paths; a table (stdout, JSON) and
+cycle time over the workspace, the 3-PRS and the Gough-Stewart along their own paths; a table (stdout and JSON) and
 figures.
 
-Baselines, computed in the same run on the same path and grid, each then checked against the true limits
-(:func:`pkm.core.timing.solve.usage` on the payload's coefficients: does it violate a peak effort somewhere, or
-leave time on the table?):
+Every law is checked by :func:`pkm.verify_time_optimal` (efforts by :func:`pkm.inverse_dynamics` at 10x the planning
+resolution against the TRUE limits; the optimal law's tracking simulated with a PD). Baselines, computed in the same
+run on the same path and grid:
 
-* **joint-space box**: each motor held to its speed limit and to an acceleration limit ``A`` taken as the
-  common practice does, the peak effort over the largest reflected inertia (``tau_peak / max diag M_a`` over the
-  path, payload included), the efforts not modelled: the time-optimal law under speed and acceleration boxes only;
-* **constant task-space acceleration**: the end effector's path speed ``v(s)`` under one acceleration ``a_max``
-  (and the motors' speed limits), ``a_max`` the largest that the efforts allow at the worst point of the path.
+* **joint-space box** (the common practice): each motor held to its speed limit and to one acceleration limit
+  ``A = tau_peak / max diag M_a`` (the peak effort over the largest inertia the motor sees on the path, payload
+  included; gravity and coupling not modelled): the fastest law under those boxes only. Does it violate the true
+  limits somewhere, or leave time on the table?
+* **constant task-space acceleration**: the end effector's speed along the path grows and falls at one acceleration
+  ``a_max`` [m/s^2] (capped by the motors' speed limits), ``a_max`` the largest for which the efforts hold at
+  every grid point (bisection): safe by construction, slower.
 
-Usage: ``python tools/cycle_time.py [--points 200] [--out out/cycle_time]``.
+Two drive settings: the Delta's own drives (3.9 N m, 2.97 rad/s: speed-bound) and faster ones (a motor line
+``omega0 = 15 rad/s``, speed limit 10 rad/s: effort-bound), to show both regimes.
+
+Usage: ``python tools/cycle_time.py [--points 200] [--out out/cycle_time] [--quick]``.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
+import time
 from pathlib import Path
 
 import numpy as np
 
 import pkm
-from pkm.core.timing import actuator_limits, path_coefficients, waypoint_path, with_payload
+from pkm.core.timing import actuator_limits, motion_path, path_coefficients, waypoint_path, with_payload
 from pkm.core.timing.path import adept_waypoints
-from pkm.core.timing.solve import solve, usage
+from pkm.core.timing.solve import TimeOptimal, _times, solve, usage
+from pkm.motion import load_motions
+
+SETTINGS = {"own drives": {}, "fast drives": {"omega0": 15.0, "speed": 10.0}}
+START = (-0.1525, 0.0, -0.33)  # [m]: the cycle from x = -152.5 mm to +152.5 mm at y = 0, z = -0.33 m
 
 
-def _box(delta_p, geo, C, L):
-    M = np.array([pkm.mass_matrix(delta_p, q) for q in C.q[:: max(1, len(C.q) // 20)]])
+def _law(plan: TimeOptimal, sd: np.ndarray, sdd: np.ndarray) -> TimeOptimal:
+    """``plan`` with another law on the same grid (its motors' motion and efforts recomputed from the
+    coefficients)."""
+    C = plan.coefficients
+    t = _times(C.s, sd)
+    u = np.append(sdd, sdd[-1])
+    return dataclasses.replace(plan, sd=sd, sdd=sdd, time=t, cycle_time=float(t[-1]), qa_rate=C.dqa * sd[:, None],
+                               qa_acceleration=C.dqa * u[:, None] + C.ddqa * (sd ** 2)[:, None],
+                               efforts=C.efforts(u, sd))
+
+
+def box_law(plan: TimeOptimal) -> tuple[TimeOptimal, float]:
+    """The joint-space box baseline (module doc) on ``plan``'s path: ``(law, A [rad/s^2])``."""
+    C, L = plan.coefficients, plan.limits
+    M = np.array([pkm.mass_matrix(plan.mech, q) for q in C.q[:: max(1, len(C.q) // 25)]])
     A = float(np.min(L.peak) / np.max(np.einsum("kii->ki", M)))
-    box = actuator_limits(delta_p, peak=1e9, speed=L.speed, acceleration=A, margin=L.margin)
-    return solve(delta_p, geo, C, box, 0.0), A
+    box = actuator_limits(plan.mech, peak=1e9, speed=L.speed, acceleration=A, margin=L.margin)
+    law = solve(plan.mech, plan.path, C, box, plan.payload)
+    return _law(plan, law.sd, law.sdd), A
 
 
-def _task_acceleration(C, L, a_max):
-    """The time law of a constant task-space acceleration ``a_max`` [m/s^2] along the path (trapezoid in path
-    length, capped by the motors' speed limits): ``(sd, sdd)`` on the grid."""
-    ds_len = np.linalg.norm(C.dy[:, :3], axis=1)  # [m per unit s]
-    x_acc = np.empty(len(C.s))
-    x_acc[0] = 0.0
-    for i in range(len(C.s) - 1):  # v^2 grows by 2 a ds in path length
-        ds = C.s[i + 1] - C.s[i]
-        v2 = x_acc[i] * ds_len[i] ** 2 + 2.0 * a_max * ds * 0.5 * (ds_len[i] + ds_len[i + 1])
-        x_acc[i + 1] = v2 / ds_len[i + 1] ** 2
-    x_dec = x_acc[::-1].copy()  # (symmetric in path length: the path's length element reversed)
-    lens = ds_len[::-1]
-    x_dec[0] = 0.0
-    for i in range(len(C.s) - 1):
-        ds = C.s[i + 1] - C.s[i]
-        v2 = x_dec[i] * lens[i] ** 2 + 2.0 * a_max * ds * 0.5 * (lens[i] + lens[i + 1])
-        x_dec[i + 1] = v2 / lens[i + 1] ** 2
-    x_dec = x_dec[::-1]
+def _task_speed(C, L, a_max: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(sd, sdd)`` of a constant task acceleration ``a_max`` along the path (module doc)."""
+    g = np.linalg.norm(C.dy[:, :3], axis=1)  # [m per unit s]
+    ds = np.diff(C.s)
+    length = np.concatenate([[0.0], np.cumsum(0.5 * (g[1:] + g[:-1]) * ds)])  # [m]
     with np.errstate(divide="ignore"):
         cap = np.min(np.where(np.abs(C.dqa) > 0, ((1 - L.margin) * L.speed / np.abs(C.dqa)) ** 2, np.inf), axis=1)
-    x = np.minimum(np.minimum(x_acc, x_dec), cap)
-    sd = np.sqrt(x)
-    sdd = np.diff(x) / (2.0 * np.diff(C.s))
-    return sd, sdd
+    w = np.minimum(cap * g ** 2, 1e12)  # (speed^2 [m^2/s^2]: the motors' caps, then a_max up and down)
+    w[0] = w[-1] = 0.0
+    dl = np.diff(length)
+    for i in range(len(w) - 1):
+        w[i + 1] = min(w[i + 1], w[i] + 2.0 * a_max * dl[i])
+    for i in range(len(w) - 1, 0, -1):
+        w[i - 1] = min(w[i - 1], w[i] + 2.0 * a_max * dl[i - 1])
+    x = w / g ** 2
+    sd = np.sqrt(np.maximum(x, 0.0))
+    return sd, np.diff(x) / (2.0 * ds)
 
 
-def _time(s, sd):
-    return float(np.sum(2.0 * np.diff(s) / (sd[1:] + sd[:-1])))
+def task_acceleration_law(plan: TimeOptimal) -> tuple[TimeOptimal, float]:
+    """The constant task-acceleration baseline: ``(law, a_max [m/s^2])``."""
+    C, L = plan.coefficients, plan.limits
+    lo, hi = 0.01, 1000.0
+    for _ in range(50):
+        mid = np.sqrt(lo * hi)
+        sd, sdd = _task_speed(C, L, mid)
+        lo, hi = (mid, hi) if usage(C, L, sd, sdd)[0].max() <= 1.0 + 1e-9 else (lo, mid)
+    sd, sdd = _task_speed(C, L, lo)
+    return _law(plan, sd, sdd), lo
 
 
-def delta_cycle(points: int) -> list[dict]:
+def delta_cycle(points: int, simulate: bool) -> list[dict]:
     delta = pkm.load("delta")
-    geo = waypoint_path(delta, adept_waypoints([-0.1525, 0.0, -0.33]))
+    geo = waypoint_path(delta, adept_waypoints(START))
     rows = []
-    for m in (0.0, 1.0, 3.0):
-        dp = with_payload(delta, m)
-        C = path_coefficients(dp, geo, np.linspace(0.0, 1.0, points))
-        L = actuator_limits(dp)
-        opt = solve(dp, geo, C, L, m)
-        box, A = _box(dp, geo, C, L)
-        box_use, _ = usage(C, L, box.sd, box.sdd)
-        lo, hi = 0.1, 500.0  # (the largest constant task acceleration the efforts allow: bisection)
-        for _ in range(40):
-            mid = 0.5 * (lo + hi)
-            sd, sdd = _task_acceleration(C, L, mid)
-            lo, hi = (mid, hi) if usage(C, L, sd, sdd)[0].max() <= 1.0 + 1e-9 else (lo, mid)
-        sd, sdd = _task_acceleration(C, L, lo)
-        rows.append({"payload_kg": m, "optimal_s": opt.cycle_time, "box_s": box.cycle_time,
-                     "box_acceleration_rad_s2": A, "box_max_effort_usage": float(box_use.max()),
-                     "task_acceleration_s": _time(C.s, sd), "task_acceleration_m_s2": lo,
-                     "optimal_active": {k: opt.active.count(k) for k in sorted(set(opt.active))}})
+    for setting, given in SETTINGS.items():
+        for m in (0.0, 1.0, 3.0):
+            dp = with_payload(delta, m)
+            C = path_coefficients(dp, geo, np.linspace(0.0, 1.0, points))
+            opt = solve(dp, geo, C, actuator_limits(dp, **given), m)
+            check = pkm.verify_time_optimal(opt, simulate=simulate)
+            box, A = box_law(opt)
+            box_check = pkm.verify_time_optimal(box, simulate=False)
+            task, a_max = task_acceleration_law(opt)
+            task_check = pkm.verify_time_optimal(task, simulate=False)
+            rows.append({
+                "drives": setting, "payload_kg": m, "optimal_s": opt.cycle_time,
+                "optimal_effort_usage": check.effort_usage, "optimal_speed_usage": check.speed_usage,
+                "optimal_holds": check.holds, "optimal_inactive_segments": len(check.inactive),
+                "optimal_tracking_error_mrad": None if check.tracking_error is None else
+                float(check.tracking_error.max() * 1e3),
+                "optimal_task_error_mm": None if check.task_error is None else check.task_error * 1e3,
+                "optimal_active": {k: opt.active.count(k) for k in sorted(set(opt.active))},
+                "box_s": box.cycle_time, "box_acceleration_rad_s2": A, "box_effort_usage": box_check.effort_usage,
+                "box_holds": box_check.holds,
+                "task_s": task.cycle_time, "task_acceleration_m_s2": a_max,
+                "task_effort_usage": task_check.effort_usage, "task_holds": task_check.holds,
+                "_laws": (opt, box, task)})
     return rows
 
 
-def workspace_map(points: int) -> dict:
+def workspace_map(points: int, n: int) -> dict:
     delta = pkm.load("delta")
-    out = {}
-    for y0 in (-0.05, 0.0, 0.05):
-        for z0 in (-0.30, -0.33, -0.36):
+    ys, zs = np.linspace(-0.06, 0.06, n), np.linspace(-0.38, -0.28, n)
+    grid = np.full((n, n), np.nan)
+    refused = {}
+    for i, z0 in enumerate(zs):
+        for j, y0 in enumerate(ys):
             try:
-                plan = pkm.time_optimal(delta, adept_waypoints([-0.1525, y0, z0]), points=points)
-                out[f"{y0:+.2f},{z0:+.2f}"] = plan.cycle_time
+                grid[i, j] = pkm.time_optimal(delta, adept_waypoints([START[0], y0, z0]), points=points,
+                                              kernels=True).cycle_time
             except pkm.errors.PathError as exc:
-                out[f"{y0:+.2f},{z0:+.2f}"] = f"refused: {exc.limit} at point {exc.index}"
-    return out
+                refused[f"y={y0:+.3f},z={z0:+.3f}"] = f"{exc.limit} at point {exc.index}"
+    return {"y_m": ys.tolist(), "z_m": zs.tolist(), "cycle_s": grid.tolist(), "refused": refused}
 
 
 def others(points: int) -> dict:
     out = {}
     prs3 = pkm.load("prs3")
-    from pkm.motion import load_motions
-
-    case = load_motions("prs3_motions.toml")["3"]
-    try:
-        out["prs3 case 3"] = pkm.time_optimal(prs3, case, points=points).cycle_time
-    except pkm.errors.PkmError as exc:
-        out["prs3 case 3"] = f"refused: {exc}"
+    cases = load_motions("prs3_motions.toml")
+    for case, T, what in (("1", 5.0, "10 mm rise"), ("2", 3.0, "10 mm harmonic rise (half period)"),
+                          ("3", 3.0, "0.175 rad roll (half period)"), ("4", 3.0, "0.175 rad pitch (half period)")):
+        geo = motion_path(prs3, dataclasses.replace(cases[case], duration=T), ("z", "pitch", "roll"))
+        plan = pkm.time_optimal(prs3, geo, points=points)
+        check = pkm.verify_time_optimal(plan, simulate=False)
+        out[f"prs3 case {case}: {what}"] = {"optimal_s": plan.cycle_time, "paper_s": T,
+                                            "effort_usage": check.effort_usage, "holds": check.holds,
+                                            "active": {k: plan.active.count(k) for k in sorted(set(plan.active))}}
     gs = pkm.load("gough_stewart")
     y0 = gs.task_map.value(gs.q_reference)
-    W = np.array([y0 + np.r_[dx, 0.0, dz, 0, 0, 0, 0] for dx, dz in ((-0.05, 0.0), (0.0, 0.03), (0.05, 0.0))])
-    try:
-        out["gough_stewart heave-surge arc"] = pkm.time_optimal(gs, W, points=points).cycle_time
-    except pkm.errors.PkmError as exc:
-        out["gough_stewart heave-surge arc"] = f"refused: {exc}"
+    th = np.linspace(0.0, np.pi, 25)
+    W = np.array([y0 + np.r_[-0.05 * np.cos(a), 0.0, 0.03 * np.sin(a), 0, 0, 0, 0] for a in th])
+    plan = pkm.time_optimal(gs, W, points=points)
+    check = pkm.verify_time_optimal(plan, simulate=False)
+    out["gough_stewart: 100 mm surge, 30 mm heave arc"] = {
+        "optimal_s": plan.cycle_time, "effort_usage": check.effort_usage, "holds": check.holds,
+        "active": {k: plan.active.count(k) for k in sorted(set(plan.active))}}
     return out
+
+
+def figures(rows: list[dict], grid: dict, out: Path) -> list[str]:
+    from pkm._plot import figure, save
+
+    written = []
+    for setting in SETTINGS:
+        fig, ax = figure(size=(7.0, 4.0))
+        row = next(r for r in rows if r["drives"] == setting and r["payload_kg"] == 1.0)
+        for law, name in zip(row["_laws"], ("time-optimal", "joint box", "constant task acceleration")):
+            ax.plot(law.time, law.sd * np.linalg.norm(law.coefficients.dy[:, :3], axis=1), label=
+                    f"{name}: {law.cycle_time * 1e3:.1f} ms")
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("end-effector speed [m/s]")
+        ax.set_title(f"Delta 25/305/25 mm cycle, 1 kg, {setting}")
+        ax.legend(fontsize=8)
+        written.append(str(save(fig, out, f"delta_speed_{setting.replace(' ', '_')}")))
+    fig, ax = figure(size=(5.5, 4.5))
+    c = np.array(grid["cycle_s"], dtype=float) * 1e3
+    im = ax.pcolormesh(np.array(grid["y_m"]) * 1e3, np.array(grid["z_m"]) * 1e3, c, shading="nearest")
+    fig.colorbar(im, ax=ax, label="cycle time [ms]")
+    ax.set_xlabel("path's y [mm]")
+    ax.set_ylabel("path's z [mm]")
+    ax.set_title("Delta cycle time over the workspace (own drives)")
+    written.append(str(save(fig, out, "delta_cycle_map")))
+    return written
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=200)
     ap.add_argument("--out", default="out/cycle_time")
+    ap.add_argument("--quick", action="store_true", help="coarser grids and map, no tracking simulation")
     args = ap.parse_args()
-    result = {"delta_adept": delta_cycle(args.points), "delta_map": workspace_map(max(50, args.points // 4)),
-              "others": others(args.points)}
-    Path(args.out).mkdir(parents=True, exist_ok=True)
-    (Path(args.out) / "cycle_time.json").write_text(json.dumps(result, indent=2))
+    t0 = time.perf_counter()
+    points = 60 if args.quick else args.points
+    rows = delta_cycle(points, simulate=not args.quick)
+    grid = workspace_map(max(50, points // 2), 3 if args.quick else 7)
+    result = {"delta_adept": [{k: v for k, v in r.items() if k != "_laws"} for r in rows], "delta_map": grid,
+              "others": others(points)}
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        result["figures"] = figures(rows, grid, out)
+    except pkm.errors.MissingDependencyError as exc:
+        result["figures"] = str(exc)
+    result["seconds"] = time.perf_counter() - t0
+    (out / "cycle_time.json").write_text(json.dumps(result, indent=2))
     print(json.dumps(result, indent=2))
 
 

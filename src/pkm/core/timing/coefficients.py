@@ -37,7 +37,7 @@ import pinocchio as pin
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.timing.path import GeometricPath
-from pkm.errors import InvalidInputError, PathError, SingularityError
+from pkm.errors import ConvergenceError, InvalidInputError, PathError, SingularityError, UnreachableError
 from pkm.validation import as_scalar
 
 _FD = 1e-3  # the Richardson step in s of the compiled route's q_a''
@@ -173,7 +173,10 @@ def _kernels(mech: Mechanism, kernels: object, path: GeometricPath, s: np.ndarra
     ss = (s[:, None] + offsets[None]).ravel()  # (interleaved: the warm start follows the path)
     ya, d1a, _ = path._raw(ss)  # (continued past the ends: the differences stay central)
     if path.space == "task":
-        res = kernels.ik_path(ya, q0, tol=1e-14)
+        try:
+            res = kernels.ik_path(ya, q0, tol=1e-14)
+        except (UnreachableError, ConvergenceError):  # (a point the kernels' core fallback cannot reach either:
+            return _core(mech, path, s, q0)  # the core names it)
         bad = np.flatnonzero(res.residual > 1e-9)
         if bad.size:
             k = int(bad[0]) // 5

@@ -175,10 +175,11 @@ def waypoint_path(mech: Mechanism, waypoints: ArrayLike, *, space: str = "task",
     return GeometricPath(space, size, rate, how, _Spline(u, W[:, cols]), tuple(cols), constant)
 
 
-def motion_path(mech: Mechanism, motion: object) -> GeometricPath:
+def motion_path(mech: Mechanism, motion: object, coordinates: tuple[str, ...] | None = None) -> GeometricPath:
     """The path of a ``pkm.motion`` case (:class:`pkm.motion.Motion`): :math:`y(s) = Y(s T)` with the laws' exact
-    derivatives; its coordinates must be the task's keys (a task without a quaternion) or, for ``space =
-    "actuated"``, the actuated joints' names.
+    derivatives; its coordinates (or ``coordinates``, the names they take, in the file's order: the 3-PRS's
+    ``("z", "pitch", "roll")`` for its paper's ``z, beta, phi``) must be the task's keys (a task without a quaternion)
+    or, for ``space = "actuated"``, the actuated joints' names.
 
     Raises:
         InvalidInputError: coordinates that are not the task's (or the actuated joints').
@@ -189,12 +190,13 @@ def motion_path(mech: Mechanism, motion: object) -> GeometricPath:
     mech = check_mechanism(mech)
     if not isinstance(motion, Motion):
         raise InvalidInputError("motion", "expected a pkm.motion.Motion", motion)
-    names = mech.actuated_names if motion.space == "actuated" else mech.task_map.value_names
-    if sorted(motion.coordinates) != sorted(names) or (motion.space == "task" and
-                                                       mech.task_map.value_size != mech.task_map.size):
-        raise InvalidInputError("motion", f"the motion's coordinates {motion.coordinates} must be {tuple(names)}",
-                                motion.coordinates)
-    order = [motion.coordinates.index(n) for n in names]
+    names = tuple(mech.actuated_names if motion.space == "actuated" else mech.task_map.value_names)
+    given = tuple(motion.coordinates if coordinates is None else coordinates)
+    if sorted(given) != sorted(names) or len(given) != len(motion.coordinates) or (
+            motion.space == "task" and mech.task_map.value_size != mech.task_map.size):
+        raise InvalidInputError("motion", f"the motion's coordinates {given} must be {names} (rename them: "
+                                          "coordinates=...)", given)
+    order = [given.index(n) for n in names]
     law = _MotionLaw(motion, order)
     path = GeometricPath(motion.space, len(names), len(names), f"pkm.motion case {motion.name!r} (exact laws)",
                          law, tuple(range(len(names))), None)

@@ -29,6 +29,7 @@ The law between grid points: :math:`\ddot s = u_i` constant, :math:`\dot s^2` li
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -44,6 +45,8 @@ from pkm.core.timing.path import GeometricPath
 from pkm.errors import InvalidInputError, PathError, PkmError
 
 MAX_PASSES = 12
+#: Rounds of tightening where the limits are used beyond 1 between the grid points (:func:`solve`).
+MAX_REFINE = 8
 PASS_RTOL = 1e-9
 #: A limit counts as active at a stage where used to within this fraction (:attr:`TimeOptimal.active`).
 ACTIVE_RTOL = 1e-6
@@ -70,7 +73,10 @@ class TimeOptimal:
         active: At each segment, the limit most used (``"effort motor_1"``, ``"speed motor_2"``,
             ``"acceleration motor_3"``).
         usage: At each segment, how much of that limit is used (1: at the margin-reduced limit).
-        passes: toppra solves made (more than one where a limit depends on the speed).
+        passes: toppra solves made (more than one where a limit depends on the speed, or where the limits were
+            tightened between the grid points).
+        tightened: Per grid point (n x 3), the factor (>= 1) the effort, speed and acceleration limits were
+            tightened by so that they hold between the grid points too (:func:`solve`).
         jerk_limited: False: jerk is not limited (module doc).
     """
 
@@ -91,6 +97,7 @@ class TimeOptimal:
     active: tuple[str, ...]
     usage: np.ndarray
     passes: int
+    tightened: np.ndarray | None = None
     jerk_limited: bool = False
 
     def state_at(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -105,9 +112,10 @@ class TimeOptimal:
         return t, sd, u
 
 
-def _rows(C: PathCoefficients, L: Limits, x0: np.ndarray | None) -> tuple[np.ndarray, ...]:
+def _rows(C: PathCoefficients, L: Limits, x0: np.ndarray | None, tight: np.ndarray) -> tuple[np.ndarray, ...]:
     """The stage constraints ``A_u u + A_x x + c <= g`` at every grid point (n x m each), the effort rows
-    linearised at ``x0`` (None: where no term depends on the speed)."""
+    linearised at ``x0`` (None: where no term depends on the speed), the effort and acceleration rows of point ``k``
+    tightened by ``tight[k, 0]`` and ``tight[k, 2]`` (>= 1: the row times it)."""
     n, na = C.a.shape
     alpha, beta = L.lines[..., 0], L.lines[..., 1]  # (na x k)
     scale = 1.0 - L.margin
@@ -127,14 +135,15 @@ def _rows(C: PathCoefficients, L: Limits, x0: np.ndarray | None) -> tuple[np.nda
             r0 = np.sqrt(np.maximum(np.minimum(x0[:, None, None], cap), 1e-9 * max(float(x0.max()), 1e-12)))
             lin_x, lin_c = ep / (2.0 * r0), ep * r0 / 2.0
         finite = np.isfinite(alpha)[None] & np.ones((n, 1, 1), dtype=bool)
-        Au.append(np.where(finite, sigma * C.a[:, :, None], 0.0))
-        Ax.append(np.where(finite, sigma * C.b[:, :, None] + lin_x, 0.0))
-        c0.append(np.where(finite, sigma * C.c[:, :, None] + lin_c, 0.0))
+        te = tight[:, 0, None, None]
+        Au.append(np.where(finite, te * sigma * C.a[:, :, None], 0.0))
+        Ax.append(np.where(finite, te * (sigma * C.b[:, :, None] + lin_x), 0.0))
+        c0.append(np.where(finite, te * (sigma * C.c[:, :, None] + lin_c), 0.0))
         g.append(np.where(finite, scale * np.where(np.isfinite(alpha), alpha, 1.0)[None], 1.0))
     for sigma in (1.0, -1.0):
         finite = np.isfinite(L.acceleration)[None] & np.ones((n, 1), dtype=bool)
-        Au.append(np.where(finite, sigma * C.dqa, 0.0)[..., None])
-        Ax.append(np.where(finite, sigma * C.ddqa, 0.0)[..., None])
+        Au.append(np.where(finite, tight[:, 2, None] * sigma * C.dqa, 0.0)[..., None])
+        Ax.append(np.where(finite, tight[:, 2, None] * sigma * C.ddqa, 0.0)[..., None])
         c0.append(np.zeros((n, na, 1)))
         g.append(np.where(finite, scale * np.where(np.isfinite(L.acceleration), L.acceleration, 1.0)[None],
                           1.0)[..., None])
@@ -142,15 +151,16 @@ def _rows(C: PathCoefficients, L: Limits, x0: np.ndarray | None) -> tuple[np.nda
     return tuple(flat)
 
 
-def _x_bound(C: PathCoefficients, L: Limits) -> np.ndarray:
-    """The speed limits' bound on :math:`\\dot s^2` at every grid point (n,)."""
+def _x_bound(C: PathCoefficients, L: Limits, tight: np.ndarray) -> np.ndarray:
+    """The speed limits' bound on :math:`\\dot s^2` at every grid point (n,), tightened by ``tight[:, 1]``."""
     V = (1.0 - L.margin) * L.speed
     with np.errstate(divide="ignore"):
         bound = np.where(np.abs(C.dqa) > 0.0, (V[None] / np.abs(C.dqa)) ** 2, np.inf)
-    return np.minimum(bound.min(axis=1), 1e12)
+    return np.minimum(bound.min(axis=1) / tight[:, 1] ** 2, 1e12)
 
 
-def _toppra(C: PathCoefficients, L: Limits, x0: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+def _toppra(C: PathCoefficients, L: Limits, x0: np.ndarray | None,
+            tight: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """One toppra solve: ``(sd (n,), sdd (n - 1,))``."""
     from pkm._optional import module
 
@@ -159,11 +169,12 @@ def _toppra(C: PathCoefficients, L: Limits, x0: np.ndarray | None) -> tuple[np.n
     from toppra.constraint import DiscretizationType
     from toppra.constraint.linear_constraint import LinearConstraint, canlinear_colloc_to_interpolate
 
-    Au, Ax, c0, g = _rows(C, L, x0)
+    tight = np.ones((len(C.s), 3)) if tight is None else tight
+    Au, Ax, c0, g = _rows(C, L, x0, tight)
     keep = np.flatnonzero(np.any(Au != 0.0, axis=0) | np.any(Ax != 0.0, axis=0))  # (rows of no limit left out)
     Au, Ax, c0, g = Au[:, keep], Ax[:, keep], c0[:, keep], g[0, keep]  # (g is the same at every point)
     n, m = Au.shape
-    xb = np.column_stack([np.zeros(n), _x_bound(C, L)])
+    xb = np.column_stack([np.zeros(n), _x_bound(C, L, tight)])
     params = canlinear_colloc_to_interpolate(Au, Ax, c0, np.eye(m), g, xb, None, C.s, identical=True)
 
     class _Rows(LinearConstraint):  # (the rows computed here, handed over as they are)
@@ -216,10 +227,11 @@ def check_static(C: PathCoefficients, L: Limits) -> None:
                         f"{L.peak[i]:.6g} (planned at {peak[i]:.6g}): the limit cannot hold the payload")
 
 
-def usage(C: PathCoefficients, L: Limits, sd: np.ndarray, sdd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def usage(C: PathCoefficients, L: Limits, sd: np.ndarray, sdd: np.ndarray,
+          tight: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Per segment, the largest use of any limit at its two ends with its ``sdd`` against the margin-reduced
-    limits (the true torque-speed curve), and which (an index: ``k < na`` effort of actuator k, ``na + k`` speed,
-    ``2 na + k`` acceleration)."""
+    limits (the true torque-speed curve; each grid point's tightened by ``tight``, as planned), and which (an index:
+    ``k < na`` effort of actuator k, ``na + k`` speed, ``2 na + k`` acceleration)."""
     na = C.a.shape[1]
     scale = 1.0 - L.margin
     out = []
@@ -232,6 +244,8 @@ def usage(C: PathCoefficients, L: Limits, sd: np.ndarray, sdd: np.ndarray) -> tu
         eff = np.abs(tau) / limit
         speed = np.abs(omega) / (scale * L.speed[None])
         acc = np.abs(C.dqa[idx] * sdd[:, None] + C.ddqa[idx] * x[:, None]) / (scale * L.acceleration[None])
+        if tight is not None:
+            eff, speed, acc = (x * tight[idx, j, None] for j, x in enumerate((eff, speed, acc)))
         out.append(np.concatenate([eff, speed, acc], axis=1))
     both = np.maximum(out[0], out[1])
     k = np.argmax(both, axis=1)
@@ -239,37 +253,72 @@ def usage(C: PathCoefficients, L: Limits, sd: np.ndarray, sdd: np.ndarray) -> tu
     return both[np.arange(len(k)), k], k
 
 
-def solve(mech: Mechanism, path: GeometricPath, C: PathCoefficients, L: Limits, payload: float) -> TimeOptimal:
-    """The time-optimal law on the coefficients ``C`` under ``L`` (module doc)."""
+def _law(C: PathCoefficients, L: Limits, tight: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """``(sd, sdd, toppra solves)``: one solve, or the passes of the linearised speed-dependent limits."""
+    if not (L.speed_dependent or bool(np.any(C.d != 0.0))):
+        sd, sdd = _toppra(C, L, None, tight)
+        return sd, sdd, 1
+    const = Limits(np.stack([L.lines[..., 0], np.zeros_like(L.lines[..., 1])], -1), L.speed, L.acceleration,
+                   L.margin, L.names)  # (the constant-peak law: the first linearisation point)
+    sd, sdd = _toppra(dataclasses.replace(C, d=np.zeros_like(C.d)), const, None, tight)
+    best: tuple[np.ndarray, np.ndarray] | None = None
+    T, passes = math.inf, 1
+    for _ in range(MAX_PASSES):
+        try:
+            sd, sdd = _toppra(C, L, sd ** 2, tight)
+        except PkmError:
+            if best is None:
+                raise
+            break  # (the last law found holds the limits: kept)
+        passes += 1
+        T_new = float(_times(C.s, sd)[-1])
+        if best is not None and T_new >= T:
+            break
+        converged = abs(T - T_new) <= PASS_RTOL * T_new
+        best, T = (sd, sdd), T_new
+        if converged:
+            break
+    assert best is not None
+    return best[0], best[1], passes
+
+
+def _between(M: PathCoefficients, C: PathCoefficients, L: Limits, sd: np.ndarray, sdd: np.ndarray) -> np.ndarray:
+    """Per segment (n - 1 x 3), the use of the margin-reduced effort, speed and acceleration limits at the
+    check points ``M`` (one inside each segment) under the segment's law."""
+    i = np.clip(np.searchsorted(C.s, M.s, side="right") - 1, 0, len(sdd) - 1)
+    u = sdd[i]
+    x = np.maximum(sd[i] ** 2 + 2.0 * u * (M.s - C.s[i]), 0.0)
+    rate = np.sqrt(x)
+    scale = 1.0 - L.margin
+    tau = M.a * u[:, None] + M.b * x[:, None] + M.c + M.d * rate[:, None]
+    omega = M.dqa * rate[:, None]
+    out = np.zeros((len(sdd), 3))
+    out[i, 0] = np.max(np.abs(tau) / (scale * L.effort_limit(omega)), axis=1)
+    out[i, 1] = np.max(np.abs(omega) / (scale * L.speed[None]), axis=1)
+    out[i, 2] = np.max(np.abs(M.dqa * u[:, None] + M.ddqa * x[:, None]) / (scale * L.acceleration[None]), axis=1)
+    return out
+
+
+def solve(mech: Mechanism, path: GeometricPath, C: PathCoefficients, L: Limits, payload: float,
+          between: PathCoefficients | None = None) -> TimeOptimal:
+    """The time-optimal law on the coefficients ``C`` under ``L`` (module doc); with ``between`` (the coefficients
+    at one point inside each segment), the limits are also checked there under each segment's law and, where used
+    beyond 1, tightened at the segment's two grid points by that ratio and the law solved again (up to
+    :data:`MAX_REFINE` rounds): what the grid does not see between its points is held too."""
     check_static(C, L)
-    speedy = L.speed_dependent or bool(np.any(C.d != 0.0))
-    if speedy:
-        const = Limits(np.stack([L.lines[..., 0], np.zeros_like(L.lines[..., 1])], -1), L.speed, L.acceleration,
-                       L.margin, L.names)  # (the constant-peak law: the first linearisation point)
-        C0 = PathCoefficients(*[getattr(C, f) for f in ("s", "q", "y", "dy", "ddy", "qa", "dqa", "ddqa", "a", "b",
-                                                        "c")], np.zeros_like(C.d), C.gravity, C.route)
-        sd, sdd = _toppra(C0, const, None)
-        best, T, passes = None, math.inf, 1
-        for _ in range(MAX_PASSES):
-            try:
-                sd, sdd = _toppra(C, L, sd ** 2)
-            except PkmError:
-                if best is None:
-                    raise
-                break  # (the last law found holds the limits: kept)
-            passes += 1
-            T_new = float(_times(C.s, sd)[-1])
-            if best is None or T_new < T:
-                converged = abs(T - T_new) <= PASS_RTOL * T_new
-                best, T = (sd, sdd), T_new
-                if converged:
-                    break
-            else:
-                break
-        sd, sdd = best
-    else:
-        sd, sdd = _toppra(C, L, None)
-        passes = 1
+    tight = np.ones((len(C.s), 3))
+    passes = 0
+    for _ in range(MAX_REFINE + 1):
+        sd, sdd, p = _law(C, L, tight)
+        passes += p
+        if between is None:
+            break
+        over = _between(between, C, L, sd, sdd)
+        if over.max() <= 1.0:
+            break
+        r = np.maximum(over, 1.0) * np.where(over > 1.0, 1.0 + 1e-9, 1.0)
+        tight[:-1] = np.maximum(tight[:-1], tight[:-1] * r)
+        tight[1:] = np.maximum(tight[1:], tight[1:] * r)
     t = _times(C.s, sd)
     if not np.isfinite(t[-1]):
         k = int(np.flatnonzero(~np.isfinite(t))[0])
@@ -279,12 +328,12 @@ def solve(mech: Mechanism, path: GeometricPath, C: PathCoefficients, L: Limits, 
     qa_rate = C.dqa * sd[:, None]
     qa_acc = C.dqa * u_pt[:, None] + C.ddqa * (sd ** 2)[:, None]
     efforts = C.efforts(u_pt, sd)
-    use, which = usage(C, L, sd, sdd)
+    use, which = usage(C, L, sd, sdd, tight)
     na = mech.na
     kinds = ("effort", "speed", "acceleration")
     active = tuple(f"{kinds[k // na]} {L.names[k % na]}" for k in which)
     return TimeOptimal(mech, path, L, C, payload, C.s, sd, sdd, t, float(t[-1]), C.qa, qa_rate, qa_acc, efforts,
-                       active, use, passes)
+                       active, use, passes, tight)
 
 
 _KERNELS: dict[int, object] = {}
@@ -361,9 +410,10 @@ def time_optimal(mech: Mechanism, path: object, *, payload: float = 0.0, limits:
             _KERNELS[id(timed)] = Kernels(timed)
         kernels = _KERNELS[id(timed)]
     s = np.linspace(0.0, 1.0, n)
-    C = path_coefficients(timed, geo, s, q0=None if q0 is None else timed.check_q(q0, "q0"),
-                          kernels=kernels or None)
-    return solve(timed, geo, C, lim, float(payload))
+    start = None if q0 is None else timed.check_q(q0, "q0")
+    C = path_coefficients(timed, geo, s, q0=start, kernels=kernels or None)
+    mid = path_coefficients(timed, geo, 0.5 * (s[1:] + s[:-1]), q0=C.q[0], kernels=kernels or None)
+    return solve(timed, geo, C, lim, float(payload), mid)
 
 
 __all__ = ["ACTIVE_RTOL", "TimeOptimal", "solve", "time_optimal", "usage"]
