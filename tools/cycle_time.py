@@ -51,13 +51,13 @@ def _law(plan: TimeOptimal, sd: np.ndarray, sdd: np.ndarray) -> TimeOptimal:
                                efforts=C.efforts(u, sd))
 
 
-def box_law(plan: TimeOptimal) -> tuple[TimeOptimal, float]:
+def box_law(plan: TimeOptimal, mid) -> tuple[TimeOptimal, float]:
     """The joint-space box baseline (module doc) on ``plan``'s path: ``(law, A [rad/s^2])``."""
     C, L = plan.coefficients, plan.limits
     M = np.array([pkm.mass_matrix(plan.mech, q) for q in C.q[:: max(1, len(C.q) // 25)]])
     A = float(np.min(L.peak) / np.max(np.einsum("kii->ki", M)))
     box = actuator_limits(plan.mech, peak=1e9, speed=L.speed, acceleration=A, margin=L.margin)
-    law = solve(plan.mech, plan.path, C, box, plan.payload)
+    law = solve(plan.mech, plan.path, C, box, plan.payload, mid)
     return _law(plan, law.sd, law.sdd), A
 
 
@@ -99,10 +99,12 @@ def delta_cycle(points: int, simulate: bool) -> list[dict]:
     for setting, given in SETTINGS.items():
         for m in (0.0, 1.0, 3.0):
             dp = with_payload(delta, m)
-            C = path_coefficients(dp, geo, np.linspace(0.0, 1.0, points))
-            opt = solve(dp, geo, C, actuator_limits(dp, **given), m)
+            s = np.linspace(0.0, 1.0, points)
+            C = path_coefficients(dp, geo, s)
+            mid = path_coefficients(dp, geo, 0.5 * (s[1:] + s[:-1]), q0=C.q[0])  # (the limits held between points)
+            opt = solve(dp, geo, C, actuator_limits(dp, **given), m, mid)
             check = pkm.verify_time_optimal(opt, simulate=simulate)
-            box, A = box_law(opt)
+            box, A = box_law(opt, mid)
             box_check = pkm.verify_time_optimal(box, simulate=False)
             task, a_max = task_acceleration_law(opt)
             task_check = pkm.verify_time_optimal(task, simulate=False)

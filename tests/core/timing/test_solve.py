@@ -97,3 +97,18 @@ def test_same_cycle_time_as_toppra_on_its_own_constraints(delta, arc):
     _, sd, _ = algo.compute_parameterization(0.0, 0.0)
     T = float(np.sum(2.0 * np.diff(C.s) / (sd[1:] + sd[:-1])))
     assert abs(T - plan.cycle_time) <= 1e-6
+
+
+def test_limits_are_held_between_the_grid_points(delta, arc):
+    """From rest, sqrt(x) grows fastest just after a grid point, where a torque-speed line falls fastest: the grid
+    alone lets the efforts cross the line inside the first segment; checked inside and tightened, they do not."""
+    from pkm.core.timing import path_coefficients
+    from pkm.core.timing.solve import _between
+
+    path, C = arc
+    mid = path_coefficients(delta, path, 0.5 * (C.s[1:] + C.s[:-1]), q0=C.q[0])
+    L = actuator_limits(delta, speed=20.0, omega0=8.0)
+    plain, held = solve(delta, path, C, L, 0.0), solve(delta, path, C, L, 0.0, mid)
+    assert _between(mid, C, L, plain.sd, plain.sdd).max() > 1.0 + L.margin
+    assert _between(mid, C, L, held.sd, held.sdd).max() <= 1.0 + 0.5 * L.margin
+    assert held.cycle_time > plain.cycle_time

@@ -24,7 +24,11 @@ with unbounded jerk at its switches; a jerk-limited law needs a third-order meth
 :attr:`TimeOptimal.jerk_limited`).
 
 The law between grid points: :math:`\ddot s = u_i` constant, :math:`\dot s^2` linear in :math:`s`, so that
-:math:`\Delta t_i = 2 \Delta s_i / (\dot s_i + \dot s_{i+1})`.
+:math:`\Delta t_i = 2 \Delta s_i / (\dot s_i + \dot s_{i+1})`. **Between the grid points** the coefficients
+change and :math:`\dot s = \sqrt{x}` is concave (steepest just after a start from rest, where a torque-speed
+line falls fastest): :func:`pkm.time_optimal` also computes the coefficients at each segment's midpoint, and
+:func:`solve` checks the limits inside every segment (the coefficients' quadratic through its ends and midpoint, at
+:data:`FRACTIONS` of it) and tightens them where the grid alone would let them be crossed.
 """
 
 from __future__ import annotations
@@ -46,7 +50,9 @@ from pkm.errors import InvalidInputError, PathError, PkmError
 
 MAX_PASSES = 12
 #: Rounds of tightening where the limits are used beyond 1 between the grid points (:func:`solve`).
-MAX_REFINE = 8
+MAX_REFINE = 12
+#: A limit counts as held inside a segment where used to 1 + this (rounding; the margin is far larger).
+REFINE_HOLD = 1e-9
 PASS_RTOL = 1e-9
 #: A limit counts as active at a stage where used to within this fraction (:attr:`TimeOptimal.active`).
 ACTIVE_RTOL = 1e-6
@@ -75,8 +81,9 @@ class TimeOptimal:
         usage: At each segment, how much of that limit is used (1: at the margin-reduced limit).
         passes: toppra solves made (more than one where a limit depends on the speed, or where the limits were
             tightened between the grid points).
-        tightened: Per grid point (n x 3), the factor (>= 1) the effort, speed and acceleration limits were
-            tightened by so that they hold between the grid points too (:func:`solve`).
+        tightened: The factors (>= 1, n x 3) the limits were tightened by so that they hold between the grid points
+            too (:func:`solve`): per segment (row ``i``: segment ``i``) for the effort and acceleration columns 0
+            and 2, per grid point for the speed column 1.
         jerk_limited: False: jerk is not limited (module doc).
     """
 
@@ -112,10 +119,10 @@ class TimeOptimal:
         return t, sd, u
 
 
-def _rows(C: PathCoefficients, L: Limits, x0: np.ndarray | None, tight: np.ndarray) -> tuple[np.ndarray, ...]:
+def _rows(C: PathCoefficients, L: Limits, x0: np.ndarray | None) -> tuple[np.ndarray, ...]:
     """The stage constraints ``A_u u + A_x x + c <= g`` at every grid point (n x m each), the effort rows
-    linearised at ``x0`` (None: where no term depends on the speed), the effort and acceleration rows of point ``k``
-    tightened by ``tight[k, 0]`` and ``tight[k, 2]`` (>= 1: the row times it)."""
+    linearised at ``x0`` (None: where no term depends on the speed), and each row's kind (m,: 0 effort, 2
+    acceleration)."""
     n, na = C.a.shape
     alpha, beta = L.lines[..., 0], L.lines[..., 1]  # (na x k)
     scale = 1.0 - L.margin
@@ -135,20 +142,20 @@ def _rows(C: PathCoefficients, L: Limits, x0: np.ndarray | None, tight: np.ndarr
             r0 = np.sqrt(np.maximum(np.minimum(x0[:, None, None], cap), 1e-9 * max(float(x0.max()), 1e-12)))
             lin_x, lin_c = ep / (2.0 * r0), ep * r0 / 2.0
         finite = np.isfinite(alpha)[None] & np.ones((n, 1, 1), dtype=bool)
-        te = tight[:, 0, None, None]
-        Au.append(np.where(finite, te * sigma * C.a[:, :, None], 0.0))
-        Ax.append(np.where(finite, te * (sigma * C.b[:, :, None] + lin_x), 0.0))
-        c0.append(np.where(finite, te * (sigma * C.c[:, :, None] + lin_c), 0.0))
+        Au.append(np.where(finite, sigma * C.a[:, :, None], 0.0))
+        Ax.append(np.where(finite, sigma * C.b[:, :, None] + lin_x, 0.0))
+        c0.append(np.where(finite, sigma * C.c[:, :, None] + lin_c, 0.0))
         g.append(np.where(finite, scale * np.where(np.isfinite(alpha), alpha, 1.0)[None], 1.0))
     for sigma in (1.0, -1.0):
         finite = np.isfinite(L.acceleration)[None] & np.ones((n, 1), dtype=bool)
-        Au.append(np.where(finite, tight[:, 2, None] * sigma * C.dqa, 0.0)[..., None])
-        Ax.append(np.where(finite, tight[:, 2, None] * sigma * C.ddqa, 0.0)[..., None])
+        Au.append(np.where(finite, sigma * C.dqa, 0.0)[..., None])
+        Ax.append(np.where(finite, sigma * C.ddqa, 0.0)[..., None])
         c0.append(np.zeros((n, na, 1)))
         g.append(np.where(finite, scale * np.where(np.isfinite(L.acceleration), L.acceleration, 1.0)[None],
                           1.0)[..., None])
     flat = [np.concatenate([x.reshape(n, -1) for x in part], axis=1) for part in (Au, Ax, c0, g)]
-    return tuple(flat)
+    kinds = np.concatenate([np.zeros(Au[0].size // n + Au[1].size // n), np.full(2 * na, 2)]).astype(int)
+    return (*flat, kinds)
 
 
 def _x_bound(C: PathCoefficients, L: Limits, tight: np.ndarray) -> np.ndarray:
@@ -170,12 +177,15 @@ def _toppra(C: PathCoefficients, L: Limits, x0: np.ndarray | None,
     from toppra.constraint.linear_constraint import LinearConstraint, canlinear_colloc_to_interpolate
 
     tight = np.ones((len(C.s), 3)) if tight is None else tight
-    Au, Ax, c0, g = _rows(C, L, x0, tight)
+    Au, Ax, c0, g, kinds = _rows(C, L, x0)
     keep = np.flatnonzero(np.any(Au != 0.0, axis=0) | np.any(Ax != 0.0, axis=0))  # (rows of no limit left out)
-    Au, Ax, c0, g = Au[:, keep], Ax[:, keep], c0[:, keep], g[0, keep]  # (g is the same at every point)
+    Au, Ax, c0, g, kinds = Au[:, keep], Ax[:, keep], c0[:, keep], g[0, keep], kinds[keep]  # (g: the same everywhere)
     n, m = Au.shape
     xb = np.column_stack([np.zeros(n), _x_bound(C, L, tight)])
-    params = canlinear_colloc_to_interpolate(Au, Ax, c0, np.eye(m), g, xb, None, C.s, identical=True)
+    params = list(canlinear_colloc_to_interpolate(Au, Ax, c0, np.eye(m), g, xb, None, C.s, identical=True))
+    if np.any(tight[:, [0, 2]] != 1.0):  # (a stage's rows, at both its ends, tightened: the row times the factor)
+        factor = np.tile(tight[:, kinds], 2)
+        params[:3] = [x * factor for x in params[:3]]
 
     class _Rows(LinearConstraint):  # (the rows computed here, handed over as they are)
         def __init__(self) -> None:
@@ -244,8 +254,8 @@ def usage(C: PathCoefficients, L: Limits, sd: np.ndarray, sdd: np.ndarray,
         eff = np.abs(tau) / limit
         speed = np.abs(omega) / (scale * L.speed[None])
         acc = np.abs(C.dqa[idx] * sdd[:, None] + C.ddqa[idx] * x[:, None]) / (scale * L.acceleration[None])
-        if tight is not None:
-            eff, speed, acc = (x * tight[idx, j, None] for j, x in enumerate((eff, speed, acc)))
+        if tight is not None:  # (effort and acceleration: the segment's factor; speed: the point's)
+            eff, speed, acc = eff * tight[:-1, 0, None], speed * tight[idx, 1, None], acc * tight[:-1, 2, None]
         out.append(np.concatenate([eff, speed, acc], axis=1))
     both = np.maximum(out[0], out[1])
     k = np.argmax(both, axis=1)
@@ -282,43 +292,66 @@ def _law(C: PathCoefficients, L: Limits, tight: np.ndarray) -> tuple[np.ndarray,
     return best[0], best[1], passes
 
 
+#: Where :func:`solve` checks the limits inside each segment (fractions of it): dense near the ends, where
+#: :math:`\\dot s = \\sqrt{x}` grows fastest from rest and a speed-dependent limit falls fastest.
+FRACTIONS = np.array([0.003, 0.01, 0.03, 0.1, 0.25, 0.5, 0.75, 0.9, 0.97, 0.99, 0.997])
+
+
 def _between(M: PathCoefficients, C: PathCoefficients, L: Limits, sd: np.ndarray, sdd: np.ndarray) -> np.ndarray:
-    """Per segment (n - 1 x 3), the use of the margin-reduced effort, speed and acceleration limits at the
-    check points ``M`` (one inside each segment) under the segment's law."""
-    i = np.clip(np.searchsorted(C.s, M.s, side="right") - 1, 0, len(sdd) - 1)
-    u = sdd[i]
-    x = np.maximum(sd[i] ** 2 + 2.0 * u * (M.s - C.s[i]), 0.0)
+    """Per segment (n - 1 x 3), the largest use of the margin-reduced effort, speed and acceleration limits inside
+    it under its law, at :data:`FRACTIONS` of it: the coefficients there the quadratic through the segment's ends
+    (``C``) and its midpoint (``M``), :math:`\\dot s^2 = \\dot s_i^2 + 2 u_i (s - s_i)`."""
+    f = FRACTIONS[:, None, None]
+    w0, wm, w1 = 2.0 * (f - 0.5) * (f - 1.0), -4.0 * f * (f - 1.0), 2.0 * f * (f - 0.5)
+
+    def at(name: str) -> np.ndarray:  # (fractions x segments x na)
+        x = getattr(C, name)
+        return w0 * x[None, :-1] + wm * getattr(M, name)[None] + w1 * x[None, 1:]
+
+    a, b, c, d, dqa, ddqa = (at(k) for k in ("a", "b", "c", "d", "dqa", "ddqa"))
+    u = sdd[None, :, None]
+    x = np.maximum(sd[None, :-1, None] ** 2 + 2.0 * u * f * np.diff(C.s)[None, :, None], 0.0)
     rate = np.sqrt(x)
     scale = 1.0 - L.margin
-    tau = M.a * u[:, None] + M.b * x[:, None] + M.c + M.d * rate[:, None]
-    omega = M.dqa * rate[:, None]
-    out = np.zeros((len(sdd), 3))
-    out[i, 0] = np.max(np.abs(tau) / (scale * L.effort_limit(omega)), axis=1)
-    out[i, 1] = np.max(np.abs(omega) / (scale * L.speed[None]), axis=1)
-    out[i, 2] = np.max(np.abs(M.dqa * u[:, None] + M.ddqa * x[:, None]) / (scale * L.acceleration[None]), axis=1)
+    tau = a * u + b * x + c + d * rate
+    omega = dqa * rate
+    limit = L.effort_limit(omega.reshape(-1, omega.shape[-1])).reshape(omega.shape) if L.speed_dependent else \
+        L.peak
+    out = np.empty((len(sdd), 3))
+    out[:, 0] = np.max(np.abs(tau) / (scale * limit), axis=(0, 2))
+    out[:, 1] = np.max(np.abs(omega) / (scale * L.speed), axis=(0, 2))
+    out[:, 2] = np.max(np.abs(dqa * u + ddqa * x) / (scale * L.acceleration), axis=(0, 2))
     return out
 
 
 def solve(mech: Mechanism, path: GeometricPath, C: PathCoefficients, L: Limits, payload: float,
           between: PathCoefficients | None = None) -> TimeOptimal:
     """The time-optimal law on the coefficients ``C`` under ``L`` (module doc); with ``between`` (the coefficients
-    at one point inside each segment), the limits are also checked there under each segment's law and, where used
-    beyond 1, tightened at the segment's two grid points by that ratio and the law solved again (up to
-    :data:`MAX_REFINE` rounds): what the grid does not see between its points is held too."""
+    at each segment's midpoint), the limits are also checked inside each segment under its law
+    (:func:`_between`); where used beyond ``1 + margin / 2`` on the first pass (beyond 1 on later ones) the limits
+    are tightened (the segment's effort and acceleration rows, the speed bound at its two grid points) by the
+    square of that use and the law solved again (up to :data:`MAX_REFINE` rounds): what the grid does not see
+    between its points is held too, at the price of a segment or two used slightly under 1 on a coarse grid."""
     check_static(C, L)
     tight = np.ones((len(C.s), 3))
-    passes = 0
+    passes, over = 0, None
     for _ in range(MAX_REFINE + 1):
         sd, sdd, p = _law(C, L, tight)
         passes += p
         if between is None:
             break
         over = _between(between, C, L, sd, sdd)
-        if over.max() <= 1.0:
-            break
-        r = np.maximum(over, 1.0) * np.where(over > 1.0, 1.0 + 1e-9, 1.0)
-        tight[:-1] = np.maximum(tight[:-1], tight[:-1] * r)
-        tight[1:] = np.maximum(tight[1:], tight[1:] * r)
+        if over.max() <= 1.0 + (0.5 * L.margin if passes == p else REFINE_HOLD):
+            break  # (first pass: inside the segments within half the margin, the true limits hold with the rest)
+        # (tightened, never relaxed: effort and acceleration per segment, speed per grid point (what its two
+        # segments need); squared: from rest the use inside falls slower than the factor rises)
+        step = np.maximum(over, 1.0) ** 2
+        tight[:-1, [0, 2]] *= step[:, [0, 2]]
+        tight[:-1, 1] *= step[:, 1]
+        tight[1:, 1] *= step[:, 1]
+    else:
+        raise PkmError(f"the limits do not hold between the grid points after {MAX_REFINE} rounds of tightening "
+                       f"(used {over.max():.6g} inside a segment): give more points")  # type: ignore[union-attr]
     t = _times(C.s, sd)
     if not np.isfinite(t[-1]):
         k = int(np.flatnonzero(~np.isfinite(t))[0])
@@ -329,6 +362,8 @@ def solve(mech: Mechanism, path: GeometricPath, C: PathCoefficients, L: Limits, 
     qa_acc = C.dqa * u_pt[:, None] + C.ddqa * (sd ** 2)[:, None]
     efforts = C.efforts(u_pt, sd)
     use, which = usage(C, L, sd, sdd, tight)
+    if over is not None:  # (a limit held inside a segment is the one active there)
+        use = np.maximum(use, np.max(over, axis=1))
     na = mech.na
     kinds = ("effort", "speed", "acceleration")
     active = tuple(f"{kinds[k // na]} {L.names[k % na]}" for k in which)
