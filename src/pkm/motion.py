@@ -79,8 +79,8 @@ class Law:
             from scipy.interpolate import CubicHermiteSpline
 
             n = len(self.coef) // 3
-            knots, pos, rate = (np.array(self.coef[i * n:(i + 1) * n]) for i in range(3))
-            spline = CubicHermiteSpline(knots, pos, rate)
+            knots, pos, vel = (np.array(self.coef[i * n:(i + 1) * n]) for i in range(3))
+            spline = CubicHermiteSpline(knots, pos, vel)
             tc = np.clip(t, knots[0], knots[-1])
             inside = (t >= knots[0]) & (t <= knots[-1])
             return spline(tc), np.where(inside, spline(tc, 1), 0.0), np.where(inside, spline(tc, 2), 0.0)

@@ -90,7 +90,7 @@ def _lines_of_table(table: ArrayLike, joint: str) -> list[tuple[float, float]]:
     return lines
 
 
-def _per_actuator(value: object, na: int, what: str) -> np.ndarray:
+def _per_actuator(value: ArrayLike, na: int, what: str) -> np.ndarray:
     arr = np.broadcast_to(np.asarray(value, dtype=float), (na,)).copy() if np.ndim(value) == 0 else \
         np.asarray(value, dtype=float)
     if arr.shape != (na,) or np.any(np.isnan(arr)) or np.any(arr <= 0.0):

@@ -171,10 +171,11 @@ def _toppra(C: PathCoefficients, L: Limits, x0: np.ndarray | None,
     """One toppra solve: ``(sd (n,), sdd (n - 1,))``."""
     from pkm._optional import module
 
-    ta = module("toppra", extra="plan", what="time-optimal motion (pkm.time_optimal)")
+    module("toppra", extra="plan", what="time-optimal motion (pkm.time_optimal)")
     from toppra.algorithm import TOPPRA
     from toppra.constraint import DiscretizationType
     from toppra.constraint.linear_constraint import LinearConstraint, canlinear_colloc_to_interpolate
+    from toppra.interpolator import AbstractGeometricPath
 
     tight = np.ones((len(C.s), 3)) if tight is None else tight
     Au, Ax, c0, g, kinds = _rows(C, L, x0)
@@ -198,7 +199,7 @@ def _toppra(C: PathCoefficients, L: Limits, x0: np.ndarray | None,
             a, b, c, FF, gg, xbound, ubound = params
             return a, b, c, FF, gg, ubound, xbound
 
-    class _Path(ta.interpolator.AbstractGeometricPath):  # (toppra reads only the interval and the dof)
+    class _Path(AbstractGeometricPath):  # (toppra reads only the interval and the dof)
         @property
         def path_interval(self) -> np.ndarray:
             return np.array([0.0, 1.0])
@@ -207,8 +208,8 @@ def _toppra(C: PathCoefficients, L: Limits, x0: np.ndarray | None,
         def dof(self) -> int:
             return C.a.shape[1]
 
-        def __call__(self, s: object, order: int = 0) -> np.ndarray:
-            return np.zeros((np.size(s), C.a.shape[1]))
+        def __call__(self, s: np.ndarray, order: int = 0) -> np.ndarray:
+            return np.zeros((int(np.size(s)), C.a.shape[1]))
 
     algo = TOPPRA([_Rows()], _Path(), gridpoints=C.s, solver_wrapper="seidel")
     sdd, sd, _, _ = algo.compute_parameterization(0.0, 0.0, return_data=True)

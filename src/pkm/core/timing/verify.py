@@ -90,6 +90,14 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
 
     Raises:
         InvalidInputError: ``plan`` is not a :class:`~pkm.core.timing.solve.TimeOptimal`.
+
+    Examples:
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> plan = pkm.time_optimal(delta, [[-0.05, 0.0, -0.36], [0.05, 0.0, -0.36]], points=20)
+        >>> check = pkm.verify_time_optimal(plan, simulate=False)
+        >>> check.holds, round(check.speed_usage, 3), check.inactive
+        (True, 0.999, ())
     """
     from pkm.core.dynamics.model import actuator_model
     from pkm.core.kinematics.trajectory import follow_actuators, follow_task
@@ -103,6 +111,7 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
     follow = follow_task if plan.path.space == "task" else follow_actuators
     traj = follow(mech, y, dy * sd[:, None], ddy * (sd * sd)[:, None] + dy * u[:, None], q0=plan.coefficients.q[0],
                   efforts=True, tol=1e-12)
+    assert traj.efforts is not None
     tau = traj.efforts.copy()
     if np.any(np.asarray(mech.model.damping) != 0.0) or np.any(np.asarray(mech.model.friction) != 0.0):
         for k in range(len(s)):  # (the model's friction, Coulomb's sign exact as planned)
