@@ -10,7 +10,7 @@ import pytest
 import pkm
 from pkm.core.timing import actuator_limits, waypoint_path
 from pkm.core.timing.solve import solve
-from pkm.errors import InvalidInputError, PathError
+from pkm.errors import InvalidInputError, ModeChangeWarning, PathError
 
 from .conftest import ARC
 
@@ -61,6 +61,10 @@ def test_refused_paths_name_the_point_and_the_limit(delta):
     with pytest.raises(PathError) as err:
         pkm.time_optimal(delta, ARC, points=5, payload=3.0, limits={"peak": 0.5})
     assert err.value.limit.startswith("peak effort of motor_") and "cannot hold" in str(err.value)
+    with pytest.raises(PathError) as err, pytest.warns(ModeChangeWarning):  # (the motors raised until the knees
+        # fold through: pkm's follow says so too)
+        pkm.time_optimal(delta, [[-0.9] * 3, [1.5] * 3], space="actuated", points=20)
+    assert err.value.limit == "singularity" and 0 < err.value.index < 19
     with pytest.raises(InvalidInputError):
         actuator_limits(delta, table=[[0.0, 1.0], [1.0, 0.9], [2.0, 0.1], [3.0, 0.05]])  # (convex: refused)
 
