@@ -14,7 +14,9 @@ arrays), and times a 1,000-point Delta path in about 25 ms; writing another woul
 :math:`x`: each effort row :math:`\sigma (a u + b x + c) + e \sqrt{x} \le \alpha` (:math:`e = \sigma d + \beta
 |q_a'|`) is linearised per grid point on the tangent of :math:`\sqrt{x}` at the previous solution's :math:`x_0`,
 :math:`\sqrt{x} \le \sqrt{x_0}/2 + x / (2 \sqrt{x_0})` (an upper bound for every :math:`x`: each iterate is
-feasible for the true curve when :math:`e \ge 0`; a row with :math:`e < 0` drops the term, conservatively), and
+feasible for the true curve when :math:`e \ge 0`; a row with :math:`e < 0` drops the term, conservatively; the
+tangent's point no further than where :math:`e \sqrt{x_0} / 2` would take 3/4 of the row's slack at rest, so that
+the linearised rows leave the path controllable), and
 solved again until the cycle time changes by less than 1e-9 relative (at most 12 passes; the first from the
 constant-peak solution). Where no limit depends on the speed, one pass: toppra's exact answer on these coefficients.
 
