@@ -33,6 +33,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--path", metavar="PATH", required=True,
                    help="waypoints (CSV, header: the task's value names or the actuated joints'), a motion case "
                         "FILE.toml:CASE, or adept:X,Y,Z")
+    p.add_argument("--coordinates", metavar="A,B,C", help="a motion case's coordinates as the task's names, in the "
+                                                          "file's order (the 3-PRS's z,beta,phi: z,pitch,roll)")
     p.add_argument("--payload", metavar="KG", type=float, default=0.0, help="a point mass at the end effector [kg]")
     p.add_argument("--limits", metavar="K=V,...", default="",
                    help="peak=N m, omega0=rad/s (a linear motor line), speed=rad/s, acceleration=rad/s^2 (default: "
@@ -47,8 +49,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
 
-def read_path(mech: Mechanism, text: str) -> tuple[object, str]:
-    """``(path, space)`` from ``--path`` (module doc).
+def read_path(mech: Mechanism, text: str, coordinates: str | None = None) -> tuple[object, str]:
+    """``(path, space)`` from ``--path`` (module doc); ``coordinates``: a motion case's coordinates renamed
+    (``--coordinates``).
 
     Raises:
         InvalidInputError: no such file, a header that names neither the task's values nor the actuated joints, a
@@ -64,14 +67,16 @@ def read_path(mech: Mechanism, text: str) -> tuple[object, str]:
         if mech.task_map.value_names != ("x", "y", "z"):
             raise InvalidInputError("--path", "the adept cycle is a path of a task x, y, z", mech.task_map.value_names)
         return adept_waypoints(start), "task"
-    file, _, case = text.partition(":") if text.endswith(".toml") is False and ".toml:" in text else (text, "", "")
+    file, case = text.rsplit(":", 1) if ".toml:" in text else (text, "")
     if file.endswith(".toml"):
+        from pkm.core.timing.path import motion_path
         from pkm.motion import load_motions
 
         motions = load_motions(file)
         if case not in motions:
             raise InvalidInputError("--path", f"name a case: FILE.toml:CASE, one of {sorted(motions)}", text)
-        return motions[case], "task"
+        names = tuple(coordinates.split(",")) if coordinates else None
+        return motion_path(mech, motions[case], names), motions[case].space
     path = Path(file)
     if not path.is_file():
         raise InvalidInputError("--path", f"{file}: no such file", file)
@@ -149,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         require("figures", "the figure of a plan")
     mech = load_mechanism(args)
-    path, space = read_path(mech, args.path)
+    path, space = read_path(mech, args.path, args.coordinates)
     from pkm.core.timing.coefficients import with_payload
 
     limits = parse_limits(with_payload(mech, args.payload), args.limits)
