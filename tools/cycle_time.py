@@ -33,7 +33,7 @@ import numpy as np
 import pkm
 from pkm.core.timing import actuator_limits, motion_path, path_coefficients, waypoint_path, with_payload
 from pkm.core.timing.path import adept_waypoints
-from pkm.core.timing.solve import TimeOptimal, _times, solve, usage
+from pkm.core.timing.solve import TimeOptimal, _between, _times, solve, usage
 from pkm.motion import load_motions
 
 SETTINGS = {"own drives": {}, "fast drives": {"omega0": 15.0, "speed": 10.0}}
@@ -61,13 +61,18 @@ def box_law(plan: TimeOptimal, mid) -> tuple[TimeOptimal, float]:
     return _law(plan, law.sd, law.sdd), A
 
 
-def _task_speed(C, L, a_max: float) -> tuple[np.ndarray, np.ndarray]:
-    """``(sd, sdd)`` of a constant task acceleration ``a_max`` along the path (module doc)."""
+def _task_speed(C, L, a_max: float, mid) -> tuple[np.ndarray, np.ndarray]:
+    """``(sd, sdd)`` of a constant task acceleration ``a_max`` along the path (module doc), the motors' speed caps
+    held at the grid points and at the midpoints ``mid`` of the two segments around each."""
     g = np.linalg.norm(C.dy[:, :3], axis=1)  # [m per unit s]
     ds = np.diff(C.s)
     length = np.concatenate([[0.0], np.cumsum(0.5 * (g[1:] + g[:-1]) * ds)])  # [m]
     with np.errstate(divide="ignore"):
         cap = np.min(np.where(np.abs(C.dqa) > 0, ((1 - L.margin) * L.speed / np.abs(C.dqa)) ** 2, np.inf), axis=1)
+        inner = np.min(np.where(np.abs(mid.dqa) > 0, ((1 - L.margin) * L.speed / np.abs(mid.dqa)) ** 2, np.inf),
+                       axis=1)
+    cap[:-1] = np.minimum(cap[:-1], inner)  # (x is linear in s on a segment: held at both its ends, held inside)
+    cap[1:] = np.minimum(cap[1:], inner)
     w = np.minimum(cap * g ** 2, 1e12)  # (speed^2 [m^2/s^2]: the motors' caps, then a_max up and down)
     w[0] = w[-1] = 0.0
     dl = np.diff(length)
@@ -80,15 +85,18 @@ def _task_speed(C, L, a_max: float) -> tuple[np.ndarray, np.ndarray]:
     return sd, np.diff(x) / (2.0 * ds)
 
 
-def task_acceleration_law(plan: TimeOptimal) -> tuple[TimeOptimal, float]:
-    """The constant task-acceleration baseline: ``(law, a_max [m/s^2])``."""
+def task_acceleration_law(plan: TimeOptimal, mid) -> tuple[TimeOptimal, float]:
+    """The constant task-acceleration baseline: ``(law, a_max [m/s^2])``, ``a_max`` the largest (bisection in
+    [0.01, 1000] m/s^2: 1000 means the motors' speed caps bind everywhere) whose efforts hold at the grid points
+    and inside every segment (:func:`pkm.core.timing.solve._between`)."""
     C, L = plan.coefficients, plan.limits
     lo, hi = 0.01, 1000.0
     for _ in range(50):
-        mid = np.sqrt(lo * hi)
-        sd, sdd = _task_speed(C, L, mid)
-        lo, hi = (mid, hi) if usage(C, L, sd, sdd)[0].max() <= 1.0 + 1e-9 else (lo, mid)
-    sd, sdd = _task_speed(C, L, lo)
+        a = np.sqrt(lo * hi)
+        sd, sdd = _task_speed(C, L, a, mid)
+        ok = usage(C, L, sd, sdd)[0].max() <= 1.0 + 1e-9 and _between(mid, C, L, sd, sdd).max() <= 1.0 + 1e-9
+        lo, hi = (a, hi) if ok else (lo, a)
+    sd, sdd = _task_speed(C, L, lo, mid)
     return _law(plan, sd, sdd), lo
 
 
@@ -106,7 +114,7 @@ def delta_cycle(points: int, simulate: bool) -> list[dict]:
             check = pkm.verify_time_optimal(opt, simulate=simulate)
             box, A = box_law(opt, mid)
             box_check = pkm.verify_time_optimal(box, simulate=False)
-            task, a_max = task_acceleration_law(opt)
+            task, a_max = task_acceleration_law(opt, mid)
             task_check = pkm.verify_time_optimal(task, simulate=False)
             rows.append({
                 "drives": setting, "payload_kg": m, "optimal_s": opt.cycle_time,
