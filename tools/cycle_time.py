@@ -88,13 +88,13 @@ def _task_speed(C, L, a_max: float, mid) -> tuple[np.ndarray, np.ndarray]:
 def task_acceleration_law(plan: TimeOptimal, mid) -> tuple[TimeOptimal, float]:
     """The constant task-acceleration baseline: ``(law, a_max [m/s^2])``, ``a_max`` the largest (bisection in
     [0.01, 1000] m/s^2: 1000 means the motors' speed caps bind everywhere) whose efforts hold at the grid points
-    and inside every segment (:func:`pkm.core.timing.solve._between`)."""
+    and inside every segment (:func:`pkm.core.timing.solve._between`; the speeds are capped by construction)."""
     C, L = plan.coefficients, plan.limits
     lo, hi = 0.01, 1000.0
     for _ in range(50):
         a = np.sqrt(lo * hi)
         sd, sdd = _task_speed(C, L, a, mid)
-        ok = usage(C, L, sd, sdd)[0].max() <= 1.0 + 1e-9 and _between(mid, C, L, sd, sdd).max() <= 1.0 + 1e-9
+        ok = usage(C, L, sd, sdd)[0].max() <= 1.0 + 1e-9 and _between(mid, C, L, sd, sdd)[:, 0].max() <= 1.0 + 1e-9
         lo, hi = (a, hi) if ok else (lo, a)
     sd, sdd = _task_speed(C, L, lo, mid)
     return _law(plan, sd, sdd), lo
