@@ -40,6 +40,10 @@ def test_velocities_and_accelerations_are_the_derivatives_of_the_positions(case)
     'format = "pkm.motion/1"\ncoordinates = ["z"]\n[case.a]\nduration = 1.0\ndt = 0.1\n'
     'z = { law = "constant", value = 0, extra = 1 }',
     "not = [toml",
+    'format = "pkm.motion/1"\ncoordinates = ["z"]\n[case.a]\nduration = 1.0\ndt = 0.1\n'
+    'z = { law = "hermite", t = [0.0, 1.0], position = [0.0], velocity = [0.0, 0.0] }',
+    'format = "pkm.motion/1"\ncoordinates = ["z"]\n[case.a]\nduration = 1.0\ndt = 0.1\n'
+    'z = { law = "hermite", t = [0.0, 0.0], position = [0.0, 1.0], velocity = [0.0, 0.0] }',
 ])
 def test_malformed_motion_files_are_refused(tmp_path, text):
     path = tmp_path / "m.toml"

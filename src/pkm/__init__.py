@@ -41,6 +41,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.export": ("CLibrary", "export_c"),
     "pkm.core.modes": ("assembly_modes", "track_assembly_mode", "track_working_mode", "working_modes"),
     "pkm.core.transmissions": ("Transmission", "transmissions"),
+    "pkm.core.timing": ("TimeOptimal", "time_optimal", "verify_time_optimal"),
     "pkm.core.twin": ("Kernels", "Twin"),
     "pkm.sweeps": ("sweep",),
     "pkm.units": ("quantity",),
@@ -149,6 +150,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.analysis.reconfiguration import reconfigure
     from pkm.core.export import CLibrary, export_c
     from pkm.core.modes import assembly_modes, track_assembly_mode, track_working_mode, working_modes
+    from pkm.core.timing import TimeOptimal, time_optimal, verify_time_optimal
     from pkm.core.transmissions import Transmission, transmissions
     from pkm.core.twin import Kernels, Twin
     from pkm.sweeps import sweep

@@ -448,3 +448,23 @@ class TransmissionError(PkmError):
         self.joints = tuple(joints)
         self.value = None if value is None else float(value)
         super().__init__(f"transmission {transmission!r}: {message}")
+
+
+class PathError(PkmError):
+    """A geometric path cannot be timed (:func:`pkm.time_optimal`): it leaves the workspace, crosses a singularity,
+    is not smooth, or a limit cannot hold the mechanism still on it.
+
+    Attributes:
+        index: The path point (0-based, in the planning grid or the waypoints, as ``what`` says) where it fails.
+        s: The path parameter there (in [0, 1]).
+        limit: What is violated: ``"workspace"``, ``"singularity"``, ``"smoothness"`` or the limit that cannot hold
+            (``"peak effort of motor_1"``).
+        detail: What was measured.
+    """
+
+    def __init__(self, index: int, s: float, limit: str, detail: str, what: str = "path point"):
+        self.index = int(index)
+        self.s = float(s)
+        self.limit = limit
+        self.detail = detail
+        super().__init__(f"{what} {self.index} (s = {self.s:.6g}): {limit}: {detail}")

@@ -19,7 +19,10 @@ sampling step and one law per coordinate::
 Laws, with ``t`` in seconds: ``constant`` (``value``), ``linear`` (``start + rate t``),
 ``cosine`` (``offset + amplitude (1 - cos(omega t))``) and ``fourier`` (Swevers' finite Fourier series
 ``offset + Σ_l a_l / (omega l) sin(omega l t) - b_l / (omega l) cos(omega l t)``, ``a`` and ``b`` lists of as many
-harmonics: identification's excitations, :mod:`pkm.core.identification.excitation`). Their derivatives are exact.
+harmonics: identification's excitations, :mod:`pkm.core.identification.excitation`) and ``hermite`` (a sampled
+motion, ``t`` [s] increasing, ``position`` and ``velocity`` at each: the piecewise-cubic Hermite interpolant, exact at
+the knots, C¹; held at its end values with zero rate outside ``[t_0, t_n]``: what ``pkm plan`` writes). Their
+derivatives are exact.
 
 ``space = "actuated"`` (top level; default ``"task"``) says the coordinates are actuated joints, by name, rather
 than task coordinates: an excitation trajectory is one.
@@ -33,6 +36,7 @@ unknown keys, numbers that are not finite or beyond 1e6 (SI), booleans or string
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -48,8 +52,9 @@ FORMAT = "pkm.motion/1"
 MAX_SAMPLES = 10_000_000  #: samples of one case at most (memory)
 MAX_TIME = 1e9  #: |t| [s] accepted by :meth:`Motion.sample`
 LAWS = {"constant": ("value",), "linear": ("start", "rate"), "cosine": ("offset", "amplitude", "omega"),
-        "fourier": ("offset", "omega", "a", "b")}
-LISTS = {"a", "b"}  #: keys holding one number per harmonic
+        "fourier": ("offset", "omega", "a", "b"), "hermite": ("t", "position", "velocity")}
+LISTS = {"a", "b", "t", "position", "velocity"}  #: keys holding a list (one number per harmonic, or per knot)
+MAX_KNOTS = 1_000_000  #: knots of a ``hermite`` law at most
 SPACES = ("task", "actuated")
 MAX_HARMONICS = 1000
 
@@ -70,6 +75,15 @@ class Law:
         if self.kind == "linear":
             start, rate = self.coef
             return start + rate * t, z + rate, z
+        if self.kind == "hermite":
+            from scipy.interpolate import CubicHermiteSpline
+
+            n = len(self.coef) // 3
+            knots, pos, vel = (np.array(self.coef[i * n:(i + 1) * n]) for i in range(3))
+            spline = CubicHermiteSpline(knots, pos, vel)
+            tc = np.clip(t, knots[0], knots[-1])
+            inside = (t >= knots[0]) & (t <= knots[-1])
+            return spline(tc), np.where(inside, spline(tc, 1), 0.0), np.where(inside, spline(tc, 2), 0.0)
         if self.kind == "fourier":
             off, om, *ab = self.coef
             L = len(ab) // 2
@@ -160,13 +174,19 @@ def _coefficients(src: str, where: str, spec: dict, keys: tuple[str, ...]) -> tu
     for k in keys:
         v = spec.get(k)
         if k in LISTS:
-            if not isinstance(v, list) or not 1 <= len(v) <= MAX_HARMONICS:
-                raise SpecError(src, f"{where}.{k} must be a list of 1 to {MAX_HARMONICS} numbers")
+            most = MAX_KNOTS if keys == LAWS["hermite"] else MAX_HARMONICS
+            if not isinstance(v, list) or not 1 <= len(v) <= most:
+                raise SpecError(src, f"{where}.{k} must be a list of 1 to {most} numbers")
             out += [_number(src, f"{where}.{k}", x) for x in v]
         else:
             out.append(_number(src, f"{where}.{k}", v))
     if len(keys) == 4 and keys[2:] == ("a", "b") and len(spec["a"]) != len(spec["b"]):
         raise SpecError(src, f"{where}: a and b must have as many harmonics ({len(spec['a'])} and {len(spec['b'])})")
+    if keys == LAWS["hermite"]:
+        n = len(spec["t"])
+        if len(spec["position"]) != n or len(spec["velocity"]) != n or n < 2 or not np.all(np.diff(out[:n]) > 0.0):
+            raise SpecError(src, f"{where}: t, position and velocity must be lists of as many numbers (2 or more), t "
+                                 "increasing")
     if keys == LAWS["fourier"] and not out[1] > 0.0:
         raise SpecError(src, f"{where}.omega must be positive, got {out[1]}")
     return tuple(out)
@@ -196,4 +216,40 @@ def _motion(src: str, name: str, body, coords: tuple[str, ...], space: str = "ta
                   str(body.get("source", "")), space)
 
 
-__all__ = ["FORMAT", "LAWS", "SPACES", "Law", "Motion", "load_motions"]
+def write_motion(path: str | Path, coordinates: tuple[str, ...], name: str, t: np.ndarray, position: np.ndarray,
+                 rate: np.ndarray, *, space: str = "task", mechanism: str = "", description: str = "",
+                 source: str = "") -> Path:
+    """A motion file of one case ``name`` whose laws are ``hermite`` (module doc): ``position`` and ``rate``
+    (N x len(coordinates)) at times ``t`` (N,) [s], numbers written as ``repr`` of floats (exact); read back by
+    :func:`load_motions`.
+
+    Raises:
+        InvalidInputError: arrays of mismatched shapes, times not increasing, not finite.
+    """
+    t = np.asarray(t, dtype=float)
+    P, R = np.atleast_2d(np.asarray(position, dtype=float)), np.atleast_2d(np.asarray(rate, dtype=float))
+    if t.ndim != 1 or len(t) < 2 or P.shape != (len(t), len(coordinates)) or R.shape != P.shape \
+            or not np.all(np.diff(t) > 0.0) or not (np.all(np.isfinite(P)) and np.all(np.isfinite(R))):
+        raise InvalidInputError("position", f"expected {len(t)} x {len(coordinates)} finite samples at increasing "
+                                            "times", P.shape)
+    if space not in SPACES:
+        raise InvalidInputError("space", f"use one of {list(SPACES)}", space)
+
+    def floats(x: np.ndarray) -> str:
+        return "[" + ", ".join(repr(float(v)) for v in x) + "]"
+
+    q = json.dumps  # (a JSON string is a TOML basic string)
+    lines = [f'format = "{FORMAT}"', f"mechanism = {q(mechanism)}", f"space = {q(space)}",
+             "coordinates = [" + ", ".join(q(c) for c in coordinates) + "]", "", f"[case.{q(name)}]",
+             f"description = {q(description)}", f"source = {q(source)}",
+             f"duration = {float(t[-1])!r}", f"dt = {float(np.min(np.diff(t)))!r}"]
+    for j, c in enumerate(coordinates):
+        lines.append(f'{q(c)} = {{ law = "hermite", t = {floats(t - t[0])}, position = {floats(P[:, j])}, '
+                     f"velocity = {floats(R[:, j])} }}")
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return out
+
+
+__all__ = ["FORMAT", "LAWS", "SPACES", "Law", "Motion", "load_motions", "write_motion"]

@@ -28,11 +28,12 @@ def test_bench_quick_runs_every_benchmark_and_refuses_bad_arguments(tmp_path):
     out = json.loads(proc.stdout)
     assert sorted(out) == sorted(BENCHMARKS) == ["assembly", "batch", "designs", "dynamics", "export", "hexapod",
                                                  "identification", "kinematics", "opcount", "serve", "simulation",
-                                                 "simulation_speed", "sweep", "twin", "workspace"]
+                                                 "simulation_speed", "sweep", "time_optimal", "twin", "workspace"]
     assert out["batch"]["mechanisms"]["prs3"]["bit_for_bit"]
     assert out["designs"]["gough_stewart"]["largest_difference"] <= 1e-12
     assert all(r["equals_serial"] for k, r in out["sweep"]["runs"].items() if k != "serial")
     assert [r["samples"] for r in out["kinematics"]] == [3] * 5  # one row per shipped mechanism
     assert out["dynamics"]["max_force_difference_to_baseline_N"]["pkm"] < 1e-9
+    assert abs(out["time_optimal"]["cycle_time_s"] - out["time_optimal"]["cycle_time_core_s"]) <= 1e-6
     bad = run("bench", "kinematics", "--", "--samples", "3")
     assert bad.returncode == 2 and "unrecognized arguments: --samples" in one_error_line(bad)
