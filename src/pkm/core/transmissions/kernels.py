@@ -1,0 +1,285 @@
+"""Transmission kernels: a closed sub-mechanism's maps between its motors and its output joints, from ONE generator
+(the twin's CasADi expressions, :mod:`pkm.core.twin`) to three targets: C99 (:func:`c_source`), JAX
+(:func:`pkm.core.twin.jaxgen.jax_source`) and NVIDIA Warp (:mod:`pkm.core.twin.warpgen`).
+
+A transmission here is a mechanism ``mech`` (the closed sub-mechanism alone, ``actuated`` = its motors ``m``) and
+``k = na`` output joints ``o`` (one-coordinate joints of the tree: revolute or prismatic). The kernels
+(:data:`KERNELS`), each an SX function of one sample after CSE:
+
+* ``fk`` ``(q, qm) -> (q_out, qo, status, residual)``: motors to outputs. Newton on the closure with the motors set
+  to ``qm``, warm-started from ``q`` (the previous solution), :data:`ITERATIONS` iterations unrolled (no branch: one
+  instruction list for every target and every GPU thread); the passive rates solved by the twin's sparse LU
+  (pivots fixed at the reference), the idle motions (a rod spinning between two balls) held at the guess's values
+  (:func:`pkm.core.twin.dynamics.idle_columns`). ``residual`` is the largest closure residual at ``q_out`` [m, rad];
+  ``status`` (:data:`STATUS`): 0 ``OK`` (``residual <= TOL``), 1 ``NOT_CONVERGED``, 2 ``SINGULAR`` (a pivot under
+  :data:`~pkm.core.twin.kernels.PIVOT_FLOOR` relative to the reference at some iteration);
+* ``ik`` ``(q, qo) -> (q_out, qm, status, residual)``: outputs to motors, the same Newton with the outputs held;
+* ``maps`` ``(q) -> (J, J_inv, pivot)``: the velocity map ``qdot_o = J qdot_m`` (k x k) and its inverse, each from
+  its own closure solve (motors driving, outputs driving); the effort maps are their transposes by power balance:
+  ``tau_m = Jᵀ tau_o`` and ``tau_o = J_invᵀ tau_m``;
+* ``delta`` ``(q, qdo) -> (dM, dh, pivot)``: what a serial-equivalent model lacks, in output coordinates: ``ΔM(q) =
+  M_o - M_s`` (k x k) [kg m², kg] and ``Δh(q, qdot_o) = h_o - h_s`` (k) [N m, N];
+* ``fk_j_dm`` ``(q, qm) -> (q_out, qo, J, dM, status)``: ``fk`` then ``J`` and ``ΔM`` at its solution, fused (what a
+  learning simulator's step needs; :mod:`pkm.bench.transmissions` times it).
+
+Definitions. ``M_o``, ``h_o`` are the closed-loop model in output coordinates: the actuator-space model
+(:class:`~pkm.core.twin.dynamics.ActuatorTwin`, as :func:`pkm.mass_matrix`, :func:`pkm.bias_efforts`) of the same
+mechanism with the outputs as its actuated joints: ``M_o = G_oᵀ M G_o``, ``h_o = G_oᵀ (h + M Ġ_o qdot_o)`` with
+``G_o = ∂q/∂o`` (rotor armature and gravity included, idle motions mass-orthogonal). ``M_s``, ``h_s`` are the
+serial-equivalent model's: the tree with only the output joints and the bodies every joint above which (from the
+sub-mechanism's root) is an output (the rods, the cranks and the rotors dropped): RNEA of those bodies with only the
+outputs moving. Hence ``M_s + ΔM = M_o`` and ``h_s + Δh = h_o`` exactly, and ``M_a = Jᵀ M_o J`` (tested against
+:func:`pkm.mass_matrix` and :func:`pkm.inverse_dynamics`).
+
+Every kernel takes and returns SI values in Pinocchio's conventions; arrays are the CasADi functions' nonzeros,
+matrices column-major. Equal across targets to 1e-12 in double precision (the tests).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import os
+from collections.abc import Callable, Sequence
+
+import casadi as cs
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.twin.dynamics import ActuatorTwin
+from pkm.core.twin.kernels import PIVOT_FLOOR
+from pkm.core.twin.spatial import Expr
+from pkm.core.twin.tree import Twin
+from pkm.errors import InvalidInputError, SpecError
+from pkm.validation import as_array, as_count
+
+#: Newton iterations unrolled in ``fk`` and ``ik`` (from a warm start a controller's previous solution, 2 to 3 reach
+#: 1e-12; from the reference across the whole workspace of the ankle, 6).
+ITERATIONS = 8
+#: The largest closure residual at which a solve counts as converged [m, rad].
+TOL = 1e-12
+#: The status codes, in order from 0 (``INVALID_INPUT``: the C target's own check of its inputs, before the kernel).
+STATUS = ("OK", "NOT_CONVERGED", "SINGULAR", "INVALID_INPUT")
+
+#: Each kernel's inputs and outputs.
+KERNELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    "fk": (("q", "qm"), ("q_out", "qo", "status", "residual")),
+    "ik": (("q", "qo"), ("q_out", "qm", "status", "residual")),
+    "maps": (("q",), ("J", "J_inv", "pivot")),
+    "delta": (("q", "qdo"), ("dM", "dh", "pivot")),
+    "fk_j_dm": (("q", "qm"), ("q_out", "qo", "J", "dM", "status")),
+}
+
+
+def _driven(mech: Mechanism, actuated: Sequence[str]) -> Mechanism:
+    """``mech`` with ``actuated`` as its actuated joints (the same Pinocchio model, closures and reference)."""
+    out = Mechanism(mech.model, dataclasses.replace(mech.spec, actuated=tuple(actuated)), urdf=mech.urdf,
+                    source=mech.source)
+    out.q_reference = mech.q_reference.copy()
+    return out
+
+
+class TransmissionKernels:
+    """The transmission kernels of a closed sub-mechanism (see the module doc).
+
+    Args:
+        mech: The closed sub-mechanism, its actuated joints the motors.
+        outputs: The output joints (as many as motors; one-coordinate joints of ``mech``).
+        name: The transmission's name (default the mechanism's): C names, files.
+        iterations: Newton iterations unrolled in ``fk`` and ``ik``.
+        tol: Convergence tolerance of ``fk`` and ``ik`` on the largest closure residual [m, rad].
+
+    Raises:
+        SpecError: the outputs are not one-coordinate joints of ``mech``, are motors, are not as many as the
+            motors, or do not determine the sub-mechanism at the reference (its closure with the outputs driving
+            is singular there); naming the transmission.
+    """
+
+    def __init__(self, mech: Mechanism, outputs: Sequence[str], *, name: str | None = None,
+                 iterations: int = ITERATIONS, tol: float = TOL):
+        self.mech = check_mechanism(mech)
+        self.name = name or mech.name
+        self.outputs = tuple(outputs)
+        self.motors = tuple(mech.actuated_names)
+        self.iterations = as_count(iterations, "iterations", high=100)
+        self.tol = float(tol)
+        where = f"transmission {self.name!r}"
+        for o in self.outputs:
+            j = mech.joints.get(o)
+            if j is None or j.nq != 1 or j.nv != 1:
+                raise SpecError(mech.source, f"{where}: output {o!r} is not a one-coordinate joint of the "
+                                             f"sub-mechanism (its joints: {sorted(mech.joints)})")
+            if o in self.motors:
+                raise SpecError(mech.source, f"{where}: output {o!r} is a motor")
+        if len(set(self.outputs)) != len(self.motors):
+            raise SpecError(mech.source, f"{where}: {len(set(self.outputs))} distinct outputs for "
+                                         f"{len(self.motors)} motors {list(self.motors)}")
+        try:
+            self.driven = _driven(mech, self.outputs)  # (the same mechanism, the outputs driving)
+            self._twin_m = ActuatorTwin(Twin(self.mech))
+            self._twin_o = ActuatorTwin(Twin(self.driven))
+            self._twin_o.pivot  # noqa: B018  (the LU with the outputs driving: refused here if singular)
+        except SpecError as e:
+            raise SpecError(mech.source, f"{where}: the outputs {list(self.outputs)} do not determine the "
+                                         f"sub-mechanism at the reference ({e.args[0] if e.args else e})") from None
+        self.q = self._twin_m.tw.q  # the one configuration symbol every kernel takes
+        self.qdo = self._twin_o.tw.qd  # the output rates' symbol
+        self.k = len(self.motors)
+        self.motor_q = [mech.joints[m].idx_q for m in self.motors]
+        self.output_q = [mech.joints[o].idx_q for o in self.outputs]
+        self.motor_v = [mech.joints[m].idx_v for m in self.motors]
+        self.output_v = [mech.joints[o].idx_v for o in self.outputs]
+
+    # ---------------------------------------------------------------- expressions
+    def _in_q(self, at: ActuatorTwin, expr: Expr) -> Expr:
+        """An expression of ``at``'s configuration symbol in terms of :attr:`q`."""
+        return cs.substitute(expr, at.tw.q, self.q) if at.tw.q is not self.q else expr
+
+    def _newton(self, at: ActuatorTwin) -> cs.Function:
+        """One closure Newton iteration of ``at``'s mechanism, its actuated joints held at ``target``:
+        ``(q, target) -> (q_next, pivot)``, the idle coordinates held."""
+        tw = at.tw
+        dq = cs.SX.zeros(tw.mech.nv)
+        if at.lu is not None:
+            step = at.lu.solve(tw.rotate_rows(tw.closure_residual))
+            for r, c in enumerate(at.passive):
+                dq[c] = -step[r]
+        q_next = tw.retract(dq)
+        q_next = cs.vertcat(*[tw.target[list(tw.mech.act_q).index(i)] if i in tw.mech.act_q else q_next[i]
+                              for i in range(tw.mech.nq)])
+        return cs.Function("newton", [tw.q, tw.target], [q_next, at.pivot])
+
+    def _solve(self, at: ActuatorTwin, target: Expr) -> tuple[Expr, Expr, Expr]:
+        """The unrolled Newton of ``at`` from :attr:`q` to ``target``: ``(q_out, status, residual)``."""
+        newton = self._newton(at)
+        tw = at.tw
+        act = list(tw.mech.act_q)
+        q = cs.vertcat(*[target[act.index(i)] if i in act else self.q[i] for i in range(tw.mech.nq)])
+        pivot = None
+        for _ in range(self.iterations):
+            q, p = newton(q, target)
+            pivot = p if pivot is None else cs.fmin(pivot, p)
+        residual = cs.mmax(cs.fabs(cs.substitute(tw.closure_residual, tw.q, q)))
+        status = cs.if_else(pivot < PIVOT_FLOOR, 2.0, cs.if_else(residual <= self.tol, 0.0, 1.0))
+        return q, status, residual
+
+    @functools.cached_property
+    def _maps(self) -> tuple[Expr, Expr, Expr]:
+        """``(J, J_inv, pivot)`` in :attr:`q`."""
+        am, ao = self._twin_m, self._twin_o
+        J = cs.jacobian(cs.vertcat(*[am.v[c] for c in self.output_v]), am.tw.qd)
+        J_inv = self._in_q(ao, cs.jacobian(cs.vertcat(*[ao.v[c] for c in self.motor_v]), ao.tw.qd))
+        return J, J_inv, cs.fmin(am.pivot, self._in_q(ao, ao.pivot))
+
+    def serial_joints(self) -> tuple[str, ...]:
+        """The joints whose bodies the serial-equivalent model keeps: those every joint above which (the joint
+        itself included, up to the sub-mechanism's root) is an output."""
+        model = self.mech.model
+        outs = {self.mech.joints[o].id for o in self.outputs}
+        return tuple(model.names[j] for j in range(1, model.njoints)
+                     if all(s in outs for s in list(model.supports[j])[1:]))
+
+    @functools.cached_property
+    def _delta(self) -> tuple[Expr, Expr, Expr]:
+        """``(ΔM, Δh, pivot)`` in :attr:`q` and the symbol :attr:`qdo`."""
+        ao = self._twin_o
+        M_o, h_o = self._in_q(ao, ao.mass_matrix), self._in_q(ao, ao.bias)
+        serial = Twin(self.mech)  # the serial-equivalent model: the other bodies' inertias zeroed
+        keep = {self.mech.joints[n].id for n in self.serial_joints()}
+        serial._inertia = [I if j in keep else pin.Inertia.Zero() for j, I in enumerate(serial._inertia)]
+        qdd_o = cs.SX.sym("qdd_o", self.k)
+        v, a = cs.SX.zeros(self.mech.nv), cs.SX.zeros(self.mech.nv)
+        for r, c in enumerate(self.output_v):
+            v[c], a[c] = self.qdo[r], qdd_o[r]
+        tau = cs.substitute(serial.rnea, cs.vertcat(serial.q, serial.v, serial.a), cs.vertcat(self.q, v, a))
+        tau = cs.vertcat(*[tau[c] for c in self.output_v])
+        M_s = cs.jacobian(tau, qdd_o)
+        M_s = cs.tril(M_s) + cs.tril(M_s, False).T  # (exactly symmetric, as the twin's M_a)
+        h_s = cs.substitute(tau, qdd_o, cs.DM.zeros(self.k))
+        return M_o - M_s, h_o - h_s, self._in_q(ao, ao.pivot)
+
+    @functools.cache  # noqa: B019  (one function per kernel for the life of the kernels)
+    def function(self, kernel: str) -> cs.Function:
+        """The CasADi SX function of ``kernel`` (:data:`KERNELS`), dense, after CSE: the one generator every target
+        is written from. Its name is ``<name>_<kernel>`` (C identifiers)."""
+        if kernel not in KERNELS:
+            raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", kernel)
+        qm, qo = cs.SX.sym("qm", self.k), cs.SX.sym("qo", self.k)
+        if kernel in ("fk", "fk_j_dm"):
+            q, status, residual = self._solve(self._twin_m, qm)
+            out_o = cs.vertcat(*[q[i] for i in self.output_q])
+            if kernel == "fk":
+                exprs = [q, out_o, status, residual]
+            else:
+                J, _, _ = self._maps
+                dM, _, _ = self._delta
+                at_q = lambda e: cs.substitute(e, self.q, q)  # noqa: E731
+                exprs = [q, out_o, at_q(J), at_q(dM), status]
+            sym: list[Expr] = [self.q, qm]
+        elif kernel == "ik":
+            q, status, residual = self._solve(self._twin_o, qo)
+            q = self._in_q(self._twin_o, q)
+            exprs = [q, cs.vertcat(*[q[i] for i in self.motor_q]), status, residual]
+            sym = [self.q, qo]
+        elif kernel == "maps":
+            exprs, sym = list(self._maps), [self.q]
+        else:
+            exprs, sym = list(self._delta), [self.q, self.qdo]
+        ins, outs = KERNELS[kernel]
+        values = cs.cse([cs.densify(cs.SX(e)) for e in exprs])
+        return cs.Function(f"{c_identifier(self.name)}_{kernel}", sym, values, list(ins), list(outs))
+
+    # ---------------------------------------------------------------- evaluation (the C batch, in process)
+    @functools.cache  # noqa: B019
+    def kernel(self, kernel: str) -> Callable[..., list[np.ndarray]]:
+        """``kernel`` compiled (the twin's C batch driver, its vector driver from 256 samples): ``f(*arrays) ->
+        outputs``, each an ``(n, nnz)`` array (numpy over samples without a C compiler)."""
+        from pkm.core.twin.kernels import _Kernel
+
+        return _Kernel(self.function(kernel), False, True, None, None)
+
+    def run(self, kernel: str, *args: ArrayLike) -> list[np.ndarray]:
+        """``kernel`` on a batch (each input ``(n, size)``) or one sample (each 1-D): its outputs, shaped alike."""
+        fun = self.function(kernel)
+        arrays = []
+        for i, x in enumerate(args):
+            a = as_array(x, fun.name_in(i))
+            if a.ndim not in (1, 2) or a.shape[-1] != fun.nnz_in(i):
+                raise InvalidInputError(fun.name_in(i), f"expected ({fun.nnz_in(i)},) or (n, {fun.nnz_in(i)})", x)
+            arrays.append(np.ascontiguousarray(np.atleast_2d(a)))
+        if len(arrays) != fun.n_in():
+            raise InvalidInputError(kernel, f"takes {fun.n_in()} inputs {fun.name_in()}, got {len(arrays)}")
+        outs = self.kernel(kernel)(*arrays)
+        return [o[0] for o in outs] if np.ndim(args[0]) == 1 else outs
+
+    def jax(self, kernel: str) -> Callable[..., tuple]:
+        """``kernel`` as a jitted JAX function of one sample (:func:`pkm.core.twin.jaxgen.jax_function`; ``jax.vmap``
+        for batches, ``jax.grad`` differentiates it).
+
+        Raises:
+            MissingDependencyError: JAX is not installed (``pip install "pkm[jax]"``).
+        """
+        from pkm.core.twin.jaxgen import jax_function
+
+        return jax_function(self.function(kernel))
+
+    def warp(self, kernel: str, directory: str | os.PathLike[str] | None = None) -> object:
+        """``kernel`` as a Warp kernel (:func:`pkm.core.twin.warpgen.warp_kernel`).
+
+        Raises:
+            MissingDependencyError: Warp is not installed (``pip install "pkm[warp]"``).
+        """
+        from pkm.core.twin.warpgen import warp_kernel
+
+        return warp_kernel(self.function(kernel), directory)
+
+
+def c_identifier(name: str) -> str:
+    """``name`` as a C identifier (other characters as ``_``, a leading digit prefixed)."""
+    out = "".join(c if c.isalnum() or c == "_" else "_" for c in name)
+    return out if out and not out[0].isdigit() else f"t_{out}"
+
+
+__all__ = ["ITERATIONS", "KERNELS", "STATUS", "TOL", "TransmissionKernels", "c_identifier"]
