@@ -9,9 +9,9 @@ of shape ``(nnz, n)`` (entry-major: thread ``t`` reads column ``t``, so that nei
 neighbouring addresses), the CasADi function's nonzeros column-major.
 
 Warp compiles a kernel from its Python source (``inspect``), so the source is written to a real file and imported
-(:func:`warp_kernel`: a file per function, named by the hash of its source, under :func:`pkm.cache.cache_dir`'s
-``warp`` folder); Warp then caches its own compiled module (``~/.cache/warp``). Warp (``pip install "pkm[warp]"``)
-is imported by :func:`warp_kernel` and :func:`launch` only.
+(:func:`warp_module`: a file named by the hash of its source, under :func:`pkm.cache.cache_dir`'s ``warp``
+folder); Warp then caches its own compiled module (``~/.cache/warp``). Warp (``pip install "pkm[warp]"``)
+is imported by :func:`warp_module` and :func:`launch` only.
 
 Rounding: ``+ - * /``, square roots, ``abs``, the comparisons are IEEE operations as in the C; sines, cosines,
 ``atan2`` are Warp's (the CPU's libm through its LLVM; CUDA's on a GPU): within a few ulp of glibc's, which the
@@ -98,39 +98,50 @@ def warp_source(funs: cs.Function | Sequence[cs.Function]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def warp_kernel(fun: cs.Function, directory: str | os.PathLike[str] | None = None) -> Any:
-    """``fun`` as a Warp kernel: :func:`warp_source` written to ``directory`` (default the ``warp`` folder of
-    :func:`pkm.cache.cache_dir`; the file named by the hash of its source) and imported (Warp reads a kernel's
-    source from its file: it refuses source that exists only in memory). Launch it with :func:`launch`.
+def warp_module(funs: cs.Function | Sequence[cs.Function], directory: str | os.PathLike[str] | None = None) -> Any:
+    """The Python module of :func:`warp_source` of ``funs``, written to ``directory`` (default the ``warp`` folder of
+    :func:`pkm.cache.cache_dir`; the file named by the hash of its source) and imported: Warp reads a kernel's
+    source from its file (it refuses source that exists only in memory) and compiles the module's kernels together,
+    on their first launch (or ``wp.load_module``). Its attributes are the kernels, by the functions' names.
 
     Raises:
         MissingDependencyError: Warp is not installed (``pip install "pkm[warp]"``).
     """
     from pkm._optional import require
 
-    require("warp", "pkm.core.twin.warpgen.warp_kernel (the twin's kernels on NVIDIA Warp)")
-    text = warp_source(fun)
+    require("warp", "pkm.core.twin.warpgen (the twin's kernels on NVIDIA Warp)")
+    funs = [funs] if isinstance(funs, cs.Function) else list(funs)
+    text = warp_source(funs)
+    digest = hashlib.sha256(text.encode()).hexdigest()[:16]
+    module_name = f"pkm_warp_{funs[0].name()}_{digest}"
+    if module_name in sys.modules:
+        return sys.modules[module_name]
     if directory is None:
         from pkm.cache import cache_dir
 
         directory = cache_dir() / "warp"
     folder = Path(directory)
     folder.mkdir(parents=True, exist_ok=True)
-    digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-    module_name = f"pkm_warp_{fun.name()}_{digest}"
-    if module_name in sys.modules:
-        return getattr(sys.modules[module_name], fun.name())
     path = folder / f"{module_name}.py"
     if not path.exists() or path.read_text() != text:
         tmp = path.with_suffix(f".{os.getpid()}.tmp")
         tmp.write_text(text)
-        os.replace(tmp, path)
+        os.replace(tmp, path)  # (whole, whichever process writes it)
     spec = importlib.util.spec_from_file_location(module_name, path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     sys.modules[module_name] = module
     spec.loader.exec_module(module)
-    return getattr(module, fun.name())
+    return module
+
+
+def warp_kernel(fun: cs.Function, directory: str | os.PathLike[str] | None = None) -> Any:
+    """``fun`` as a Warp kernel (:func:`warp_module` of ``fun`` alone); launch it with :func:`launch`.
+
+    Raises:
+        MissingDependencyError: Warp is not installed (``pip install "pkm[warp]"``).
+    """
+    return getattr(warp_module(fun, directory), fun.name())
 
 
 def launch(kernel: Any, fun: cs.Function, *arrays: np.ndarray, device: str = "cpu") -> list[np.ndarray]:
@@ -148,4 +159,4 @@ def launch(kernel: Any, fun: cs.Function, *arrays: np.ndarray, device: str = "cp
     return [o.numpy().T.copy() for o in outs]
 
 
-__all__ = ["WARP_FORMS", "launch", "warp_kernel", "warp_source"]
+__all__ = ["WARP_FORMS", "launch", "warp_kernel", "warp_module", "warp_source"]
