@@ -59,7 +59,7 @@ def test_fk_ik_round_trip_and_maps_match_pkm():
     for k in (0, 17, 39):
         closed = pkm.close_loops(mech, qm[k], mech.q_reference, tol=1e-13).q
         assert np.abs(closed[tk.output_q] - qo[k]).max() <= 1e-12
-    q_back, qm_back, status, residual = tk.run("ik", np.tile(mech.q_reference, (40, 1)), qo)
+    _, qm_back, status, residual = tk.run("ik", np.tile(mech.q_reference, (40, 1)), qo)
     assert (status == 0).all() and residual.max() <= 1e-12
     assert np.abs(qm_back - qm).max() <= 1e-12
     J, J_inv, pivot = tk.run("maps", q)
@@ -77,7 +77,7 @@ def test_serial_plus_delta_is_the_closed_loop_model():
     tk = ankle()
     mech = tk.mech
     assert tk.serial_joints() == ("ankle_pitch", "ankle_roll")
-    qm, q = states(tk, 6, seed=2)
+    _, q = states(tk, 6, seed=2)
     qdm = np.random.default_rng(3).uniform(-2.0, 2.0, (6, 2))
     J = tk.run("maps", q)[0].reshape(-1, 2, 2).transpose(0, 2, 1)
     qdo = np.einsum("nij,nj->ni", J, qdm)
@@ -115,9 +115,9 @@ def test_fk_reports_its_status_and_holds_the_warm_start():
 
 def test_bad_outputs_are_refused_naming_the_transmission():
     mech = pkm.load(KNEE)
-    with pytest.raises(SpecError, match="transmission 'left_knee'.*1 distinct outputs for 1 motors|is a motor"):
+    with pytest.raises(SpecError, match=r"transmission 'left_knee': output 'knee_motor' is a motor"):
         TransmissionKernels(mech, ("knee_motor",), name="left_knee")
-    with pytest.raises(SpecError, match="transmission 'left_knee'.*'nope' is not a one-coordinate joint"):
+    with pytest.raises(SpecError, match=r"transmission 'left_knee': output 'nope' is not a one-coordinate joint"):
         TransmissionKernels(mech, ("nope",), name="left_knee")
     with pytest.raises(SpecError, match="2 distinct outputs for 1 motors"):
         TransmissionKernels(mech, tuple(n for n in mech.joints if n != "knee_motor")[:2])

@@ -216,8 +216,7 @@ class TransmissionKernels:
             else:
                 J, _, _ = self._maps
                 dM, _, _ = self._delta
-                at_q = lambda e: cs.substitute(e, self.q, q)  # noqa: E731
-                exprs = [q, out_o, at_q(J), at_q(dM), status]
+                exprs = [q, out_o, cs.substitute(J, self.q, q), cs.substitute(dM, self.q, q), status]
             sym: list[Expr] = [self.q, qm]
         elif kernel == "ik":
             q, status, residual = self._solve(self._twin_o, qo)

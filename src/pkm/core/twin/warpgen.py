@@ -149,8 +149,9 @@ def launch(kernel: Any, fun: cs.Function, *arrays: np.ndarray, device: str = "cp
     ``device`` (``"cpu"``, ``"cuda"``); returns the outputs sample-major (``(n, nnz)`` each). Copies in and out:
     to keep data on a GPU, launch the kernel yourself on ``(nnz, n)`` Warp arrays (``wp.from_torch`` of a PyTorch
     tensor's transpose, made contiguous, needs no copy)."""
-    import warp as wp
+    from pkm._optional import module
 
+    wp = module("warp", extra="warp", what="pkm.core.twin.warpgen.launch")
     n = arrays[0].shape[0]
     ins = [wp.array(np.ascontiguousarray(np.asarray(a, dtype=np.float64).T), dtype=wp.float64, device=device)
            for a in arrays]
