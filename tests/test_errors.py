@@ -49,6 +49,9 @@ CASES = [
     (E.MissingDependencyError("dask", "sweeps", "pkm.sweep"), {"package": "dask", "extra": "sweeps"},
      ["pkm.sweep needs dask", 'pip install "pkm[sweeps]"']),
     (E.StructureError("leg 3", "not an arm-and-rod leg"), {"part": "leg 3"}, ["leg 3: not an arm-and-rod leg"]),
+    (E.TransmissionError("foot", "singular", "outputs singular", ("ankle_pitch",), 3e-9),
+     {"transmission": "foot", "reason": "singular", "joints": ("ankle_pitch",), "value": 3e-9},
+     ["transmission 'foot': outputs singular"]),
 ]
 
 #: The builtin exception each class is also, for callers that catch those.

@@ -40,6 +40,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.analysis.reconfiguration": ("reconfigure",),
     "pkm.core.export": ("CLibrary", "export_c"),
     "pkm.core.modes": ("assembly_modes", "track_assembly_mode", "track_working_mode", "working_modes"),
+    "pkm.core.transmissions": ("Transmission", "transmissions"),
     "pkm.core.twin": ("Kernels", "Twin"),
     "pkm.sweeps": ("sweep",),
     "pkm.units": ("quantity",),
@@ -136,6 +137,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.analysis.reconfiguration import reconfigure
     from pkm.core.export import CLibrary, export_c
     from pkm.core.modes import assembly_modes, track_assembly_mode, track_working_mode, working_modes
+    from pkm.core.transmissions import Transmission, transmissions
     from pkm.core.twin import Kernels, Twin
     from pkm.sweeps import sweep
     from pkm.units import quantity

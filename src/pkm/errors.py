@@ -425,3 +425,25 @@ class ControllerError(PkmError):
         self.time = float(time)
         self.reason = reason
         super().__init__(f"the controller at t = {self.time:.6g} s: {reason}")
+
+
+class TransmissionError(PkmError):
+    """A closed sub-mechanism that cannot be a transmission (:func:`pkm.transmissions`): the robot has no loop, the
+    output joints given or chosen do not determine it, or its outputs or motors are singular at the reference.
+
+    Attributes:
+        transmission: The transmission's name (its generated one when no name was given).
+        reason: ``"no_loop"``, ``"outputs"`` (wrong count, not in the loop, not scalar, not a serial chain) or
+            ``"singular"``.
+        joints: The joints concerned (the outputs given, the motors, the joints that do not fit).
+        value: The number behind the refusal where there is one (the smallest singular value of the Jacobian
+            concerned, relative to its largest), else None.
+    """
+
+    def __init__(self, transmission: str, reason: str, message: str, joints: Iterable[str] = (),
+                 value: float | None = None):
+        self.transmission = transmission
+        self.reason = reason
+        self.joints = tuple(joints)
+        self.value = None if value is None else float(value)
+        super().__init__(f"transmission {transmission!r}: {message}")

@@ -1,0 +1,156 @@
+r"""A closed sub-mechanism's model with its output joints as the independent coordinates.
+
+With the loops closed, the sub-mechanism's joints are (locally) functions of the outputs ``o``. With ``J_c`` the
+closure Jacobian split into the outputs' columns ``J_o`` and the others' ``J_d``:
+
+* ``G = ∂q/∂o`` (nv x k): ``G_o = I``, ``G_d = -J_d⁺ J_o``; the idle motions ``N`` (a rod's spin between two
+  balls: what ``J_d`` leaves free with the outputs held and no motor sees) are removed in the mass metric, as pkm's
+  actuator-space model removes them (:mod:`pkm.core.differential.idle`): ``Ĝ = G - N (Nᵀ M N)⁺ Nᵀ M G``;
+* ``Ġ ȯ`` (nv): the joint accelerations at ``ö = 0``: ``J_d a_d = -gamma`` (``gamma = J̇_c v``, :func:`~pkm.core.kinematics.
+  constraints.drift`), ``a_o = 0``, the idle part removed in the mass metric;
+* the Khalil / constraint projection with the outputs as the independent coordinates:
+
+$$
+M_o = \hat G^\top M \hat G, \qquad h_o = \hat G^\top \big(h(q, \hat G \dot o) + M \dot G \dot o\big)
+    = \hat G^\top \mathrm{rnea}(q, \hat G \dot o, \dot G \dot o)
+$$
+
+with ``M`` Pinocchio's mass matrix with the motors' reflected inertia on its diagonal (the rotors included) and
+``h`` the Coriolis, centrifugal and gravity efforts. The motors' rates are ``Ĝ_m ȯ`` (``Ĝ_m = ∂m/∂o``, the inverse of
+the velocity map ``J = ∂o/∂m``), so the effort maps are ``τ_m = Jᵀ τ_o = Ĝ_m⁻ᵀ τ_o`` and ``τ_o = Ĝ_mᵀ τ_m``.
+
+Checked (tests) against the independent route of pkm's actuator-space model (the motors independent):
+``pkm.mass_matrix = Jᵀ M_o J`` and ``pkm.bias_efforts = Jᵀ (h_o + M_o J̇ q̇_m)`` (``J̇ q̇_m`` the outputs'
+acceleration at ``q̈_m = 0``, :func:`pkm.accelerations`) to 1e-10 relative; ``Ġ ȯ`` against finite differences of
+``Ĝ`` along the motion.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core.differential.idle import joint_inertia, without_idle
+from pkm.core.kinematics import constraints
+from pkm.core.model.mechanism import Mechanism
+from pkm.errors import ConvergenceError
+
+RTOL = 1e-9  #: relative singular value below which ``J_d`` loses rank (on the homogenised Jacobian)
+
+
+@dataclass(frozen=True)
+class OutputSplit:
+    """The sub-mechanism's kinematics at ``q`` with the outputs independent (module doc).
+
+    Attributes:
+        G: ``Ĝ`` (nv x k): joint rates from output rates, mass-orthogonal to the idle motions.
+        Jd_pinv: ``J_d⁺`` (n_d x n_constraints), ``d`` the joints other than the outputs.
+        idle: The idle motions (nv x n_idle, orthonormal in joint rates).
+        M: Pinocchio's mass matrix (nv x nv), the reflected inertias on its diagonal [kg m^2, kg].
+        motor_leak: The largest motor component of an idle motion (0 when the outputs hold the motors; more: the
+            outputs are singular, the motors move with the outputs held).
+        dependence: ``‖J_c Ĝ‖ / ‖J_c‖`` (homogenised): 0 when the closures leave the outputs independent.
+        sigma: The smallest singular value of ``J_d`` kept, relative to its largest (homogenised).
+    """
+
+    G: np.ndarray
+    Jd_pinv: np.ndarray
+    idle: np.ndarray
+    M: np.ndarray
+    motor_leak: float
+    dependence: float
+    sigma: float
+
+
+def output_split(sub: Mechanism, q: np.ndarray, out_v: np.ndarray, motor_v: np.ndarray) -> OutputSplit:
+    """:class:`OutputSplit` of the sub-mechanism ``sub`` at ``q`` (closed), outputs at velocity indices ``out_v``."""
+    scales = sub.jacobian_scales
+    Jc = constraints.jacobian(sub, q)
+    d_v = np.array([i for i in range(sub.nv) if i not in set(out_v)], dtype=int)
+    Jh = scales.constraint(Jc)
+    U, s, Vt = np.linalg.svd(Jh[:, d_v], full_matrices=True)
+    smax = float(s[0]) if s.size else 0.0
+    r = int(np.sum(s > RTOL * smax)) if smax > 0.0 else 0
+    cd = scales.columns[d_v]
+    Jd_pinv = cd[:, None] * ((Vt[:r].T / s[:r]) @ U[:, :r].T) * scales.constraint_rows
+    k = len(out_v)
+    G = np.zeros((sub.nv, k))
+    G[out_v, np.arange(k)] = 1.0
+    G[d_v] = -Jd_pinv @ Jc[:, out_v]
+    null = np.zeros((sub.nv, Vt.shape[0] - r))
+    null[d_v] = Vt[r:].T
+    idle = scales.joint_motions(null)
+    leak = float(np.max(np.abs(null[motor_v]), initial=0.0))
+    dependence = float(np.linalg.norm(scales.constraint_rows[:, None] * (Jc @ G) * scales.columns[out_v], 2)
+                       / max(float(np.linalg.norm(Jh, 2)), 1e-300))
+    M = joint_inertia(sub, q)
+    return OutputSplit(without_idle(M, idle, G), Jd_pinv, idle, M, leak, dependence,
+                       float(s[r - 1]) / smax if r else 0.0)
+
+
+def output_model(sub: Mechanism, q: np.ndarray, qd_o: np.ndarray, out_v: np.ndarray,
+                 motor_v: np.ndarray) -> tuple[np.ndarray, np.ndarray, OutputSplit]:
+    """``(M_o, h_o, split)``: the closed-loop model in output coordinates at ``(q, ȯ)`` (module doc)
+    [kg m^2, N m; kg, N for prismatic outputs]."""
+    sp = output_split(sub, q, out_v, motor_v)
+    v = sp.G @ qd_o
+    tau = pin.rnea(sub.model, sub.data, q, v, drift_acceleration(sub, q, v, sp, out_v))
+    return sp.G.T @ sp.M @ sp.G, sp.G.T @ tau, sp
+
+
+def drift_acceleration(sub: Mechanism, q: np.ndarray, v: np.ndarray, sp: OutputSplit,
+                       out_v: np.ndarray) -> np.ndarray:
+    """``Ġ ȯ`` (nv): the joint accelerations at ``ö = 0`` with joint rates ``v = Ĝ ȯ`` (module doc)
+    [rad/s^2, m/s^2]."""
+    a = np.zeros(sub.nv)
+    d_v = np.array([i for i in range(sub.nv) if i not in set(out_v)], dtype=int)
+    a[d_v] = -sp.Jd_pinv @ constraints.drift(sub, q, v)
+    return without_idle(sp.M, sp.idle, a)
+
+
+def close_at_outputs(sub: Mechanism, qo: np.ndarray, guess: np.ndarray, out_q: np.ndarray, out_v: np.ndarray, *,
+                     tol: float = 1e-13, max_iter: int = 20) -> np.ndarray:
+    """The closed configuration with the outputs at ``qo`` nearest ``guess``: Gauss-Newton on the closures with the
+    outputs held (minimum-norm steps in the other joints), for a warm start a small step away (a simulation's
+    next state); :func:`pkm.solve_ik` (continuation, mode checks) is the general route.
+
+    Raises:
+        ConvergenceError: the closures not within ``tol`` [m, rad] after ``max_iter`` iterations.
+    """
+    q = np.array(guess, dtype=float)
+    q[out_q] = qo
+    d_v = np.array([i for i in range(sub.nv) if i not in set(out_v)], dtype=int)
+    for it in range(max_iter + 1):
+        r, Jc = constraints.residual_and_jacobian(sub, q)
+        gap = float(np.abs(r).max(initial=0.0))
+        if gap <= tol:
+            return q
+        if it == max_iter:
+            break
+        dq = np.zeros(sub.nv)
+        dq[d_v] = -np.linalg.lstsq(Jc[:, d_v], r, rcond=None)[0]
+        q = pin.integrate(sub.model, q, dq)
+    raise ConvergenceError("loop closure at given outputs", gap, max_iter, tol, q)
+
+
+def serial_tree(model: pin.Model, outputs: Sequence[str]) -> pin.Model:
+    """A copy of ``model`` (a sub-mechanism's) in which every joint but ``outputs`` is massless: its body's (and its
+    welded bodies') inertia zero, its armature zero. Since every output hangs from the root through outputs only,
+    the massless joints move nothing the outputs carry: the copy's mass matrix and bias, restricted to the outputs'
+    rows and columns, are the serial-equivalent model's."""
+    serial = model.copy()
+    keep = set(outputs)
+    armature = np.array(serial.armature, dtype=float)
+    for j in range(1, serial.njoints):
+        if serial.names[j] not in keep:
+            serial.inertias[j] = pin.Inertia.Zero()
+            jm = serial.joints[j]
+            armature[jm.idx_v:jm.idx_v + jm.nv] = 0.0
+    serial.armature = armature
+    return serial
+
+
+__all__ = ["OutputSplit", "drift_acceleration", "output_model", "output_split", "serial_tree"]

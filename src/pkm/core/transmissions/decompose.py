@@ -1,0 +1,277 @@
+r"""A whole robot split into its serial tree and its closed sub-mechanisms (:func:`transmissions`).
+
+The rules, in order:
+
+1. **Loops.** Each closure of the spec closes a loop: the joints on the two chains from its frames' joints up to
+   their deepest common ancestor (``model.supports``). Loops that share a joint are one **sub-mechanism** (a
+   union-find over the closures); its **root** is the deepest joint every one of its loops hangs from, and
+   :attr:`Transmission.root` names that joint's body (the body the sub-mechanism's first joints are attached to). Two
+   loops that meet only at a body (a knee four-bar carrying an ankle's loops) are two sub-mechanisms, the second
+   rooted at a body the first moves. The joints of no loop are the **serial tree**.
+2. **Motors**: the robot's actuated joints in the sub-mechanism. A sub-mechanism with none is refused.
+3. **Outputs** (the serial joints the serial-equivalent model keeps), by the first rule that applies:
+
+   * named: ``outputs={name: [joint, ...]}`` gives the transmission that contains those joints its name and its
+     outputs;
+   * else the joints of the **chain**: for every closure, the side whose path from the root crosses no motor is the
+     chain (the foot hanging from the shank by pitch and roll); the outputs are the joints on the chains' paths,
+     in the model's order. Its name is the body the deepest chain ends on (the foot), made unique with ``_2``,
+     ``_3``, ... in the model's order.
+
+   Every output is a one-coordinate joint of the sub-mechanism whose path to the root crosses outputs only (the
+   serial model keeps it with the bodies it carries), there are as many as motors, and at the reference the outputs
+   determine every joint of the sub-mechanism but the idle ones (a rod's spin between two balls) and the motors
+   determine the outputs: otherwise :class:`~pkm.errors.TransmissionError` (``reason`` ``"outputs"`` or
+   ``"singular"``, naming the transmission, its joints and the smallest relative singular value).
+4. **The sub-mechanism alone** (:attr:`Transmission.mechanism`): the robot's Pinocchio model with every joint outside
+   the sub-mechanism locked at the robot's reference (``pinocchio.buildReducedModel``: the locked bodies welded to
+   their parents, so that the root is fixed where the reference puts it, gravity as the whole robot's at its
+   reference and a floating base held there), its closures, its motors as the actuated joints, its outputs as the
+   task (``TaskSpec(components=(), joints=outputs)``), the drives' values of the robot. A joint whose position limits
+   are an empty interval (``lower >= upper``: Pinocchio's placeholder where a file states none) is unlimited there.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pinocchio as pin
+
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.spec import ClosureSpec, TaskSpec
+from pkm.core.transmissions.transmission import Transmission
+from pkm.errors import InvalidInputError, PkmError, TransmissionError, UnknownNameError
+
+
+def _loop(model: pin.Model, ja: int, jb: int) -> tuple[int, set[int]]:
+    """The deepest common ancestor of joints ``ja`` and ``jb`` and the joints of the loop they close."""
+    sa, sb = list(model.supports[ja]), list(model.supports[jb])
+    common = [j for j in sa if j in sb]
+    return common[-1], (set(sa) | set(sb)) - set(common)
+
+
+def _groups(mech: Mechanism) -> list[tuple[list[int], set[int], int]]:
+    """The sub-mechanisms: ``(closure indices, joint ids, root joint id)``, in the order of their first closure."""
+    model = mech.model
+    loops = []
+    for c, (fa, fb) in enumerate(mech.closure_frames):
+        root, joints = _loop(model, model.frames[fa].parentJoint, model.frames[fb].parentJoint)
+        if joints:  # (a closure between two frames of one body closes no loop)
+            loops.append((c, root, joints))
+    parent = list(range(len(loops)))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for i in range(len(loops)):
+        for k in range(i):
+            if loops[i][2] & loops[k][2]:
+                parent[find(i)] = find(k)
+    out: dict[int, tuple[list[int], set[int], int]] = {}
+    for i, (c, root, joints) in enumerate(loops):
+        g = find(i)
+        if g not in out:
+            out[g] = ([], set(), root)
+        members, js, r = out[g]
+        members.append(c)
+        js |= joints
+        # the group's root: the deepest joint that supports both roots (one supports the other when loops share a
+        # joint)
+        sr, sn = list(model.supports[r]), list(model.supports[root])
+        out[g] = (members, js, [j for j in sr if j in sn][-1])
+    return list(out.values())
+
+
+def _root_body(model: pin.Model, joints: set[int], root: int) -> str:
+    """The body the sub-mechanism's first joints hang from: the frame the first of them is attached to (Pinocchio's
+    readers attach a joint's frame to its parent link's frame)."""
+    first = min(j for j in joints if model.parents[j] == root)
+    fid = model.getFrameId(model.names[first], pin.FrameType.JOINT)
+    frame = model.frames[model.frames[fid].parentFrame]
+    if frame.parentJoint == root:
+        return frame.name
+    return model.names[root]  # (a model built by hand: the joint's name)
+
+
+def _distal_body(model: pin.Model, joint: int) -> str:
+    """The body a joint carries: the first BODY frame attached to it, else the joint's name."""
+    for f in model.frames:
+        if f.parentJoint == joint and f.type == pin.FrameType.BODY:
+            return f.name
+    return model.names[joint]
+
+
+def _chain_outputs(mech: Mechanism, closures: list[int], joints: set[int], k: int) -> tuple[list[int], int | None, bool]:
+    """Rule 3's chain: ``(outputs, the joint whose body names the transmission, whether the chain carries the rest
+    of the robot)`` (module doc)."""
+    model = mech.model
+    motors = {mech.joints[n].id for n in mech.actuated_names}
+    below = {j: {i for i in range(1, model.njoints) if j in model.supports[i]} for j in joints}
+    carrying = sorted(j for j in joints if below[j] - joints)
+    if carrying:  # (a): the joints that carry the rest of the robot, every one of them
+        return carrying, max(carrying, key=lambda j: len(model.supports[j])), True
+    sides: set[int] = set()
+    for i in closures:
+        for f in mech.closure_frames[i]:
+            path = [j for j in model.supports[model.frames[f].parentJoint] if j in joints]
+            if path and not motors & set(path):
+                sides |= set(path)
+    chain = sorted(sides)[:k]  # (b): the motor-free sides' first k joints (the rods' own joints come after)
+    return chain, (chain[-1] if chain else None), False
+
+
+def _unique(names: list[str]) -> list[str]:
+    seen: dict[str, int] = {}
+    out = []
+    for n in names:
+        seen[n] = seen.get(n, 0) + 1
+        out.append(n if seen[n] == 1 else f"{n}_{seen[n]}")
+    return out
+
+
+def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[int], motors: tuple[str, ...],
+                   outputs: tuple[str, ...]) -> Mechanism:
+    """Rule 4: the sub-mechanism alone, rooted where the robot's reference puts its root."""
+    model = mech.model
+    keep = {model.names[j] for j in joints}
+    lock = [j for j in range(1, model.njoints) if model.names[j] not in keep]
+    reduced = pin.buildReducedModel(model, lock, mech.q_reference) if lock else model.copy()
+    reduced.name = name
+    lower, upper = np.array(reduced.lowerPositionLimit, dtype=float), np.array(reduced.upperPositionLimit, dtype=float)
+    empty = lower >= upper  # (a reader's placeholder for "no limit stated": URDF's revolute without <limit>, SDF)
+    lower[empty], upper[empty] = -np.inf, np.inf
+    reduced.lowerPositionLimit, reduced.upperPositionLimit = lower, upper
+    q_ref = mech.q_to_dict(mech.q_reference)
+    spec = ClosureSpec(
+        mechanism=name, urdf=mech.spec.urdf, end_effector=None, actuated=motors,
+        closures=tuple(mech.spec.closures[i] for i in closures), task=TaskSpec(components=(), joints=outputs),
+        reference={n: tuple(np.atleast_1d(q_ref[n]).tolist()) for n in keep if n in q_ref},
+        joint_types={n: t for n, t in mech.spec.joint_types.items() if n in keep},
+        actuators={n: v for n, v in mech.spec.actuators.items() if n in motors},
+        description=f"the closed sub-mechanism {name!r} of {mech.name!r}")
+    sub = Mechanism(reduced, spec, source=f"{mech.source} [{name}]")
+    sub.limits = {n: lim for n, lim in mech.limits.items() if n in keep}
+    return sub
+
+
+def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None = None) -> list[Transmission]:
+    """The closed sub-mechanisms of a whole robot, each a :class:`Transmission` (the rules: module doc).
+
+    Args:
+        mech: The whole robot (fixed or floating base, any number of loops, serial joints between them).
+        outputs: ``{transmission name: output joints}`` for the transmissions whose outputs the chain rule would not
+            choose (or to name them); a transmission not listed gets the chain rule and a generated name.
+
+    Returns:
+        The transmissions, in the order of their first closure in the spec.
+
+    Raises:
+        TransmissionError: no closure; a sub-mechanism with no motor; outputs that do not determine their
+            sub-mechanism (count, not in a loop, not scalar, below a joint that is not an output), or singular at the
+            reference (``reason`` and the joints on the error).
+        UnknownNameError: an output joint the robot does not have.
+
+    Examples:
+        >>> import pkm
+        >>> ankle = pkm.load("examples/humanoid_ankle/ankle.closures.toml")  # doctest: +SKIP
+        >>> [(t.name, t.motors, t.outputs) for t in pkm.transmissions(ankle)]  # doctest: +SKIP
+        [('foot', ('motor_left', 'motor_right'), ('ankle_pitch', 'ankle_roll'))]
+    """
+    mech = check_mechanism(mech)
+    model = mech.model
+    named: dict[str, tuple[str, ...]] = {}
+    if outputs is not None:
+        if not isinstance(outputs, Mapping):
+            raise InvalidInputError("outputs", "expected {transmission name: [output joint, ...]}", outputs)
+        for tname, joints in outputs.items():
+            if isinstance(joints, str) or not isinstance(joints, Sequence):
+                raise InvalidInputError("outputs", f"transmission {tname!r}: expected a list of joint names", joints)
+            for j in joints:
+                mech.joint(j)  # (UnknownNameError naming the valid joints)
+            named[str(tname)] = tuple(joints)
+    groups = _groups(mech)
+    actuated = {mech.joints[n].id for n in mech.actuated_names}
+    claimed: dict[str, int] = {}
+    for tname, joints in named.items():
+        ids = {mech.joints[j].id for j in joints}
+        hits = [g for g, (_, js, _) in enumerate(groups) if ids & js]
+        if len(hits) != 1 or not ids <= groups[hits[0]][1]:
+            where = [sorted(model.names[j] for j in groups[g][1] & ids) for g in hits]
+            raise TransmissionError(tname, "outputs", f"the outputs {list(joints)} must all be joints of one closed "
+                                    f"sub-mechanism (loop joints found: {where}; joints outside every loop: "
+                                    f"{sorted(set(joints) - {model.names[j] for g in hits for j in groups[g][1]})})",
+                                    joints)
+        claimed[tname] = hits[0]
+    by_group = {g: t for t, g in claimed.items()}
+    plans = []
+    for g, (closures, joints, root) in enumerate(groups):
+        motor_ids = actuated & joints
+        if g in by_group:
+            tname = by_group[g]
+            out_ids = [mech.joints[j].id for j in named[tname]]
+            plans.append((tname, False, closures, joints, root, motor_ids, out_ids))
+        else:
+            out_ids, deepest, carrying = _chain_outputs(mech, closures, joints, len(motor_ids))
+            label = _distal_body(model, deepest) if deepest is not None else model.names[min(joints)]
+            plans.append((label, carrying, closures, joints, root, motor_ids, out_ids))
+    generated = _unique([p[0] for p in plans])
+    result = []
+    for g, p in enumerate(plans):
+        tname = by_group.get(g) or generated[g]
+        result.append(_transmission(mech, tname, *p[2:]))
+    if not result:
+        raise TransmissionError(mech.name, "no_loop", "the robot has no closure: no closed sub-mechanism")
+    return result
+
+
+def _transmission(mech: Mechanism, name: str, closures: list[int], joints: set[int], root: int,
+                  motor_ids: set[int], out_ids: list[int]) -> Transmission:
+    model = mech.model
+    order = sorted(joints)  # (the model's order)
+    motors = tuple(n for n in mech.actuated_names if mech.joints[n].id in motor_ids)
+    outputs = tuple(model.names[j] for j in out_ids)
+    if not motors:
+        raise TransmissionError(name, "outputs", f"its loops ({[mech.spec.closures[i].name for i in closures]}) hold "
+                                "no actuated joint: a passive closed chain is no transmission", outputs)
+    bad = [model.names[j] for j in out_ids if mech.joints[model.names[j]].nv != 1]
+    if bad:
+        raise TransmissionError(name, "outputs", f"outputs {bad} have more than one coordinate: outputs are "
+                                "one-coordinate serial joints", bad)
+    carrying = [j for j in joints if j not in out_ids
+                and {i for i in range(1, model.njoints) if j in model.supports[i]} - joints]
+    if carrying:
+        raise TransmissionError(name, "outputs", f"{[model.names[j] for j in carrying]} carry the rest of the robot "
+                                f"but are no outputs {list(outputs)}: a serial model cannot keep the rest of the robot "
+                                "on them", [model.names[j] for j in carrying])
+    if not outputs:
+        raise TransmissionError(name, "outputs", f"no one-coordinate serial joint hangs from its root through a "
+                                f"motor-free chain (a parallel mechanism whose output is a frame, not a joint): name "
+                                f"its {len(motors)} outputs (outputs={{{name!r}: [...]}})", motors)
+    if len(outputs) != len(motors):
+        raise TransmissionError(name, "outputs", f"{len(outputs)} outputs {list(outputs)} for {len(motors)} motors "
+                                f"{list(motors)}: give as many outputs as motors (outputs={{{name!r}: [...]}})",
+                                outputs)
+    for j in out_ids:
+        above = [k for k in model.supports[j] if k in joints and k not in out_ids]
+        if above:
+            raise TransmissionError(name, "outputs", f"output {model.names[j]!r} hangs below {model.names[above[0]]!r}, "
+                                    "which is no output: the serial model keeps only the outputs' chain",
+                                    (model.names[j], model.names[above[0]]))
+    passive = tuple(model.names[j] for j in order if j not in motor_ids and j not in out_ids)
+    try:
+        sub = _sub_mechanism(mech, name, closures, joints, motors, outputs)
+    except UnknownNameError:
+        raise
+    except PkmError as exc:
+        raise TransmissionError(name, "outputs", f"its sub-mechanism cannot be built: {exc}", outputs) from exc
+    t = Transmission(name=name, mechanism=sub, root=_root_body(model, joints, root), motors=motors, outputs=outputs,
+                     passive=passive)
+    t.check()  # (the rank conditions at the reference: TransmissionError "singular")
+    return t
+
+
+__all__ = ["transmissions"]

@@ -1,0 +1,209 @@
+r"""The serial-equivalent model: the tree with only the output joints and the bodies they carry.
+
+Rule: every joint of a sub-mechanism that is not an output (the motors, the rods' joints) is removed with the bodies
+it carries, and its reflected inertia (the rotors') with it (:func:`~pkm.core.transmissions.coordinates.serial_tree`): their mass and inertia are dropped from the serial model
+and carried by ``ΔM`` and ``Δh`` (:class:`~pkm.core.transmissions.transmission.Transmission`). The outputs keep
+their own armature, if the file gives one, in both models.
+
+For a whole robot, :func:`serial_equivalent` locks every transmission's motors and passive joints at the reference
+(Pinocchio's ``buildReducedModel``) after making their bodies massless: the serial tree keeps the robot's serial
+joints and the outputs. Each output gets a **constant armature**, ``ΔM``'s diagonal entry at the robot's reference
+(what a constant-armature model uses: exact at that pose for a diagonal ``ΔM``, neither its off-diagonal coupling nor
+its change with the pose nor ``Δh``), and **box limits** from its transmission's feasible region
+(:mod:`pkm.core.transmissions.limits`). :meth:`SerialEquivalent.urdf` and :meth:`SerialEquivalent.mjcf` write it;
+:func:`write_serial_equivalent` writes both and a JSON data file describing each transmission for the kernels.
+
+Each transmission's ``ΔM`` and ``Δh`` are exact for its sub-mechanism with its root held; on a whole robot whose
+root moves (a knee carrying an ankle, a floating base), the rods' coupling with the joints above the root is not in
+them (the rods' mass rides on the serial model only through the transmission's own outputs).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from lxml import etree
+
+from pkm.core.analysis.region import SINGULARITY
+from pkm.core.formats.to_mjcf import MIN_INERTIA, MIN_MASS, TIMESTEP, _joints, _num, _pose
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.urdf import urdf_from_model
+from pkm.core.transmissions.decompose import transmissions as find
+from pkm.core.transmissions.limits import OutputLimits, output_limits
+from pkm.core.transmissions.transmission import Transmission
+
+
+@dataclass(frozen=True)
+class SerialEquivalent:
+    """A whole robot's serial-equivalent model (module doc), what :func:`serial_equivalent` returns.
+
+    Attributes:
+        robot: The whole robot.
+        transmissions: Its transmissions.
+        model: The serial tree (Pinocchio): the robot's model with every transmission's motors and passive joints
+            locked at the reference and their bodies removed; each output's ``armature`` is its own plus the
+            constant armature.
+        armature: ``{output: ΔM's diagonal entry at the reference}`` [kg m^2 or kg]: the constant armature a
+            serial model uses in place of ``ΔM`` (today's practice; :func:`pkm.core.transmissions.fidelity` measures
+            what it misses).
+        limits: ``{joint: (lower, upper)}`` [rad or m]: each output's box limits
+            (:func:`~pkm.core.transmissions.limits.output_limits`), the serial joints' stated limits.
+        regions: ``{transmission: OutputLimits}``: the feasible regions the boxes come from.
+        q_reference: The serial model's reference configuration (the robot's).
+    """
+
+    robot: Mechanism
+    transmissions: tuple[Transmission, ...]
+    model: pin.Model
+    armature: dict[str, float]
+    limits: dict[str, tuple[float, float]]
+    regions: dict[str, OutputLimits]
+    q_reference: np.ndarray
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        """Every transmission's outputs, in transmission order."""
+        return tuple(o for t in self.transmissions for o in t.outputs)
+
+    def urdf(self) -> str:
+        """The serial model as URDF (Pinocchio loads it): the outputs' box limits; URDF has no armature (the data
+        file and the MJCF carry it)."""
+        text, types = urdf_from_model(self.model, name=f"{self.robot.name}_serial", limits=self.limits,
+                                      source=self.robot.source)
+        if types:
+            text = text.replace("<robot ", f"<!-- joint types URDF cannot state: {types} -->\n<robot ", 1)
+        return text
+
+    def mjcf(self, *, timestep: float = TIMESTEP) -> str:
+        """The serial model as MJCF (MuJoCo loads it): one body per joint, the outputs' box limits as ``range``
+        (``limited``), their constant armature, a ``<motor>`` on every output and on every serial joint the robot
+        actuates, the reference as ``<keyframe><key name="reference">``; contacts disabled, the robot's gravity."""
+        return _mjcf(self, timestep)
+
+    def data(self) -> dict[str, Any]:
+        """The data file's content (JSON-ready): per transmission its names, motors, outputs, passive joints,
+        closures, root, constant armature, box limits and feasible region, for the kernels."""
+        out = []
+        none = OutputLimits((), None, None, None, (), 0)
+        for t in self.transmissions:
+            reg = self.regions.get(t.name, none)
+            out.append({
+                "name": t.name, "root": t.root, "motors": list(t.motors), "outputs": list(t.outputs),
+                "passive": list(t.passive), "closures": [c.name for c in t.mechanism.spec.closures],
+                "armature": [self.armature[o] for o in t.outputs],
+                "lower": None if reg.lower is None else reg.lower.tolist(),
+                "upper": None if reg.upper is None else reg.upper.tolist(),
+                "region": None if reg.polygon is None else reg.polygon.tolist(), "binding": list(reg.binding),
+                "q_reference": t.q_reference.tolist()})
+        return {"format": "pkm.transmissions/1", "robot": self.robot.name, "source": str(self.robot.source),
+                "outputs": {t.name: list(t.outputs) for t in self.transmissions}, "transmissions": out}
+
+
+def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | None = None, *,
+                      limits: bool = True, directions: int = 24, singularity: float = SINGULARITY) -> SerialEquivalent:
+    """The serial-equivalent model of ``robot`` (module doc); ``transmissions`` default ``pkm.transmissions(robot)``;
+    ``directions`` and ``singularity``: the feasible regions' (:func:`~pkm.core.transmissions.limits.output_limits`);
+    ``limits=False``: no limits at all (no region traced, the robot's stated limits left out: a model for a free
+    motion, as :mod:`pkm.core.transmissions.fidelity` runs it).
+    """
+    robot = check_mechanism(robot)
+    found = tuple(find(robot) if transmissions is None else transmissions)
+    model = robot.model.copy()
+    gone = [robot.joints[n].id for t in found for n in (*t.motors, *t.passive)]
+    for j in gone:
+        model.inertias[j] = pin.Inertia.Zero()
+    serial = pin.buildReducedModel(model, sorted(gone), robot.q_reference)
+    serial.name = f"{robot.name}_serial"
+    armature = np.array(serial.armature, dtype=float)
+    constant: dict[str, float] = {}
+    bounds = {n: lim for n, lim in robot.limits.items() if serial.existJointName(n)} if limits else {}
+    regions = {}
+    for t in found:
+        dM = t.delta_mass(t.q_reference)
+        for i, o in enumerate(t.outputs):
+            constant[o] = float(dM[i, i])
+            armature[serial.joints[serial.getJointId(o)].idx_v] += dM[i, i]
+        if not limits:
+            continue
+        reg = output_limits(t, directions=directions, singularity=singularity)
+        regions[t.name] = reg
+        if reg.lower is not None and reg.upper is not None:
+            bounds.update({o: (float(lo), float(hi)) for o, lo, hi in zip(t.outputs, reg.lower, reg.upper)})
+    serial.armature = armature
+    keep = [j for j in range(1, robot.model.njoints) if robot.model.names[j] not in
+            {robot.model.names[g] for g in gone}]
+    q_ref = np.concatenate([robot.q_reference[robot.model.joints[j].idx_q:
+                                              robot.model.joints[j].idx_q + robot.model.joints[j].nq] for j in keep]) \
+        if keep else np.zeros(0)
+    return SerialEquivalent(robot, found, serial, constant, bounds, regions, q_ref)
+
+
+def _mjcf(se: SerialEquivalent, timestep: float) -> str:
+    model = se.model
+    root = etree.Element("mujoco", model=model.name)
+    etree.SubElement(root, "compiler", angle="radian", boundmass=repr(MIN_MASS), boundinertia=repr(MIN_INERTIA))
+    option = etree.SubElement(root, "option", timestep=repr(float(timestep)), gravity=_num(model.gravity.linear))
+    etree.SubElement(option, "flag", contact="disable")
+    bodies: list[etree._Element] = [etree.SubElement(root, "worldbody")]
+    qpos: list[float] = []
+    armature = np.array(model.armature, dtype=float)
+    for j in range(1, model.njoints):
+        jm, name = model.joints[j], model.names[j]
+        body = etree.SubElement(bodies[int(model.parents[j])], "body", name=f"{name}_body")
+        _pose(body, model.jointPlacements[j])
+        inertia = model.inertias[j]
+        I = inertia.inertia
+        etree.SubElement(body, "inertial", pos=_num(inertia.lever), mass=repr(max(float(inertia.mass), MIN_MASS)),
+                         fullinertia=_num([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]))
+        names = _joints(body, jm, name, se.robot.source)
+        seg = se.q_reference[jm.idx_q:jm.idx_q + jm.nq]
+        kind = jm.shortname().removeprefix("JointModel")
+        if kind == "FreeFlyer":
+            X = model.jointPlacements[j] * pin.XYZQUATToSE3(seg)
+            quat = pin.Quaternion(X.rotation)
+            qpos += [*X.translation, quat.w, quat.x, quat.y, quat.z]
+        elif kind == "Spherical":
+            qpos += [seg[3], seg[0], seg[1], seg[2]]
+        else:
+            qpos += list(seg)
+        if jm.nv == 1:
+            el = body.find(f"joint[@name='{names[0]}']")
+            if name in se.limits:
+                el.set("range", _num(se.limits[name]))
+                el.set("limited", "true")
+            if armature[jm.idx_v] != 0.0:
+                el.set("armature", repr(float(armature[jm.idx_v])))
+        bodies.append(body)
+    keyframe = etree.SubElement(root, "keyframe")
+    etree.SubElement(keyframe, "key", name="reference", qpos=_num(qpos))
+    actuator = etree.SubElement(root, "actuator")
+    driven = [*se.outputs, *(n for n in se.robot.actuated_names if model.existJointName(n))]
+    for name in dict.fromkeys(driven):
+        etree.SubElement(actuator, "motor", name=f"{name}_motor", joint=name, gear="1")
+    return etree.tostring(root, pretty_print=True, encoding="unicode")
+
+
+def write_serial_equivalent(se: SerialEquivalent, folder: str | os.PathLike[str]) -> tuple[Path, ...]:
+    """Write ``se`` into ``folder`` (made if missing): ``<robot>_serial.urdf``, ``<robot>_serial.xml`` (MJCF) and
+    ``<robot>_transmissions.json`` (:meth:`SerialEquivalent.data`, with the two files' names); returns their
+    paths."""
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    stem = se.robot.name
+    urdf, mjcf, data = out / f"{stem}_serial.urdf", out / f"{stem}_serial.xml", out / f"{stem}_transmissions.json"
+    urdf.write_text(se.urdf())
+    mjcf.write_text(se.mjcf())
+    content = se.data()
+    content["files"] = {"urdf": urdf.name, "mjcf": mjcf.name}
+    data.write_text(json.dumps(content, indent=1))
+    return urdf, mjcf, data
+
+
+__all__ = ["SerialEquivalent", "serial_equivalent", "write_serial_equivalent"]

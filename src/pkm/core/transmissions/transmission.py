@@ -1,0 +1,189 @@
+r"""A transmission: a closed sub-mechanism between its motors and the serial joints it drives (its outputs).
+
+:func:`pkm.transmissions` makes them from a whole robot (:mod:`pkm.core.transmissions.decompose`: the rules). Each
+holds its sub-mechanism alone (:attr:`Transmission.mechanism`, a :class:`pkm.Mechanism` rooted at
+:attr:`Transmission.root`, the motors actuated, the outputs its task) and answers the maps a serial controller or
+simulator needs, in the sub-mechanism's configuration ``q_sub`` (its ``nq``, as the solvers return it):
+
+* the position maps motors -> outputs (the sub-mechanism's loop closure, warm-started from ``guess``) and outputs ->
+  motors (its inverse kinematics), both pkm's bounded Newton solvers (:class:`~pkm.errors.ConvergenceError`);
+* the velocity map ``J = ∂o/∂m`` (``ȯ = J ṁ``, :func:`pkm.forward_jacobian` of the sub-mechanism) and its inverse
+  (:class:`~pkm.errors.SingularityError` where singular);
+* the effort maps by the power balance ``τ_mᵀ ṁ = τ_oᵀ ȯ``: ``τ_m = Jᵀ τ_o`` and ``τ_o = J⁻ᵀ τ_m``, computed by the
+  other route, the outputs independent (:mod:`pkm.core.transmissions.coordinates`), so that ``effort_map = Jᵀ`` is a
+  check;
+* what the serial-equivalent model lacks (:func:`~pkm.core.transmissions.coordinates.serial_tree`: the tree with the outputs only and the
+  bodies they carry), in output coordinates: ``ΔM = M_o - M_s`` and ``Δh = h_o - h_s``, so that serial model + ΔM +
+  Δh is the closed-loop model exactly: ``(M_s + ΔM) ö + h_s + Δh = τ_o`` is the sub-mechanism's dynamics with the
+  root held where the robot's reference puts it.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from pkm.core.differential.velocity import forward_jacobian, inverse_jacobian
+from pkm.core.kinematics.solve import close_loops, solve_ik
+from pkm.core.model.mechanism import Mechanism
+from pkm.core.transmissions.coordinates import OutputSplit, output_model, output_split, serial_tree
+from pkm.errors import SingularityError, TransmissionError
+from pkm.validation import as_vector
+
+#: The position solvers' tolerance on the closure residual and the task error [m, rad]: tight, so that a round trip
+#: motors -> outputs -> motors comes back to 1e-12.
+TOL = 1e-13
+#: Below this, an idle motion's motor component or the outputs' dependence (homogenised, relative) counts as zero.
+SINGULAR = 1e-7
+
+
+@dataclass(frozen=True)
+class Transmission:
+    """One closed sub-mechanism of a robot, between its motors and its output joints (module doc).
+
+    Attributes:
+        name: The transmission's name (given in ``outputs=``, else generated: :mod:`pkm.core.transmissions.decompose`).
+        mechanism: The closed sub-mechanism alone, rooted at ``root`` (held where the robot's reference puts it),
+            the motors actuated, the outputs its task (``TaskSpec(components=(), joints=outputs)``).
+        root: The robot's body the sub-mechanism hangs from.
+        motors: The actuated joints (names as in the whole robot).
+        outputs: The serial joints the serial-equivalent model keeps (as many as motors).
+        passive: The sub-mechanism's other joints (rods, cranks' balls), in the model's order.
+    """
+
+    name: str
+    mechanism: Mechanism = field(repr=False)
+    root: str
+    motors: tuple[str, ...]
+    outputs: tuple[str, ...]
+    passive: tuple[str, ...]
+
+    # ------------------------------------------------------------------ indices
+    @functools.cached_property
+    def out_q(self) -> np.ndarray:
+        """The outputs' indices in ``q_sub``."""
+        return np.array([self.mechanism.joints[n].idx_q for n in self.outputs], dtype=int)
+
+    @functools.cached_property
+    def out_v(self) -> np.ndarray:
+        """The outputs' indices in the sub-mechanism's velocities."""
+        return np.array([self.mechanism.joints[n].idx_v for n in self.outputs], dtype=int)
+
+    @property
+    def k(self) -> int:
+        """The number of motors (= of outputs)."""
+        return len(self.motors)
+
+    @property
+    def q_reference(self) -> np.ndarray:
+        """The sub-mechanism's reference configuration (the robot's reference)."""
+        return self.mechanism.q_reference
+
+    def check(self) -> None:
+        """Raise :class:`~pkm.errors.TransmissionError` (``reason="singular"``) where, at the reference, the outputs do
+        not hold the motors or are not independent, or the motors do not hold the outputs."""
+        sub = self.mechanism
+        sp = output_split(sub, sub.q_reference, self.out_v, sub.act_v)
+        if sp.motor_leak > SINGULAR or sp.dependence > SINGULAR:
+            why = ("with the outputs held the motors can move" if sp.motor_leak > SINGULAR
+                   else "the closures constrain the outputs among themselves")
+            raise TransmissionError(self.name, "singular", f"the outputs {list(self.outputs)} are singular at the "
+                                    f"reference: {why} (motor component of a free motion {sp.motor_leak:.3g}, "
+                                    f"dependence {sp.dependence:.3g}); choose other outputs (outputs={{...}})",
+                                    self.outputs, max(sp.motor_leak, sp.dependence))
+        try:
+            forward_jacobian(sub, sub.q_reference)
+        except SingularityError as exc:
+            raise TransmissionError(self.name, "singular", f"the motors {list(self.motors)} do not hold the outputs "
+                                    f"at the reference: {exc}", self.motors, exc.sigma_min) from exc
+
+    # ------------------------------------------------------------------ positions
+    def outputs_from_motors(self, qm: ArrayLike, guess: ArrayLike | None = None, *, tol: float = TOL,
+                            max_iter: int = 30) -> tuple[np.ndarray, np.ndarray]:
+        """Forward kinematics: ``(qo, q_sub)`` for the motors at ``qm`` [rad or m] (the sub-mechanism's loop closure,
+        seeded with the configuration ``guess``, default the reference). Raises
+        :class:`~pkm.errors.ConvergenceError` when the loops do not close within ``max_iter`` Newton iterations per
+        continuation step."""
+        q = close_loops(self.mechanism, qm, guess, tol=tol, max_iter=max_iter).q
+        return q[self.out_q].copy(), q
+
+    def motors_from_outputs(self, qo: ArrayLike, guess: ArrayLike | None = None, *, tol: float = TOL,
+                            max_iter: int = 30) -> tuple[np.ndarray, np.ndarray]:
+        """Inverse kinematics: ``(qm, q_sub)`` for the outputs at ``qo`` [rad or m] (the sub-mechanism's inverse
+        kinematics, seeded with ``guess``, default the reference)."""
+        q = solve_ik(self.mechanism, as_vector(qo, self.k, "qo"), guess, tol=tol, max_iter=max_iter).q
+        return self.mechanism.actuated_q(q), q
+
+    # ------------------------------------------------------------------ rates and efforts
+    def velocity_map(self, q_sub: ArrayLike) -> np.ndarray:
+        """``J = ∂o/∂m`` (k x k): ``ȯ = J ṁ`` at the closed configuration ``q_sub``."""
+        return forward_jacobian(self.mechanism, q_sub)
+
+    def inverse_velocity_map(self, q_sub: ArrayLike) -> np.ndarray:
+        """``J⁻¹ = ∂m/∂o`` (k x k): ``ṁ = J⁻¹ ȯ``; :class:`~pkm.errors.SingularityError` where the outputs do not hold
+        the motors."""
+        return inverse_jacobian(self.mechanism, q_sub)
+
+    def _split(self, q_sub: ArrayLike) -> OutputSplit:
+        return output_split(self.mechanism, self.mechanism.check_q(q_sub, "q_sub"), self.out_v,
+                            self.mechanism.act_v)
+
+    def effort_map(self, q_sub: ArrayLike) -> np.ndarray:
+        """``Jᵀ`` (k x k): the motor efforts ``τ_m = Jᵀ τ_o`` that hold the output efforts ``τ_o`` (the power balance)
+        [N m or N], computed with the outputs independent (``J⁻ᵀ = Ĝ_mᵀ``, inverted: a second route to ``J``);
+        :class:`~pkm.errors.SingularityError` where the motors do not hold the outputs."""
+        Gm = self._split(q_sub).G[self.mechanism.act_v]
+        s = np.linalg.svd(Gm, compute_uv=False)
+        if s[-1] <= 1e-12 * s[0]:
+            raise SingularityError("direct", float(s[-1] / s[0]), f"transmission {self.name!r}: the motors do not "
+                                   "hold the outputs here: no motor efforts balance an output effort")
+        return np.linalg.inv(Gm).T
+
+    def inverse_effort_map(self, q_sub: ArrayLike) -> np.ndarray:
+        """``J⁻ᵀ`` (k x k): the output efforts ``τ_o = J⁻ᵀ τ_m`` the motor efforts ``τ_m`` produce [N m or N]."""
+        return self._split(q_sub).G[self.mechanism.act_v].T
+
+    # ------------------------------------------------------------------ dynamics in output coordinates
+    def output_model(self, q_sub: ArrayLike, qd_o: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """``(M_o, h_o)``: the closed-loop model in output coordinates at ``q_sub`` and the output rates ``qd_o``
+        (:mod:`pkm.core.transmissions.coordinates`) [kg m^2, N m]."""
+        sub = self.mechanism
+        M, h, _ = output_model(sub, sub.check_q(q_sub, "q_sub"), as_vector(qd_o, self.k, "qd_o"), self.out_v,
+                               sub.act_v)
+        return M, h
+
+    @functools.cached_property
+    def serial(self) -> pin.Model:
+        """The serial-equivalent model of the sub-mechanism (:func:`pkm.core.transmissions.coordinates.serial_tree`):
+        its model with every joint but the outputs massless (their bodies, the motors' rotors removed)."""
+        return serial_tree(self.mechanism.model, self.outputs)
+
+    def serial_model(self, q_sub: ArrayLike, qd_o: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """``(M_s, h_s)``: the serial-equivalent model's mass matrix and bias (Coriolis, centrifugal, gravity) in the
+        outputs [kg m^2, N m]."""
+        q = self.mechanism.check_q(q_sub, "q_sub")
+        v = np.zeros(self.mechanism.nv)
+        v[self.out_v] = as_vector(qd_o, self.k, "qd_o")
+        data = self.serial.createData()
+        M = pin.crba(self.serial, data, q)
+        M = np.triu(M) + np.triu(M, 1).T
+        h = pin.rnea(self.serial, data, q, v, np.zeros(self.mechanism.nv))
+        return M[np.ix_(self.out_v, self.out_v)], h[self.out_v]
+
+    def delta_mass(self, q_sub: ArrayLike) -> np.ndarray:
+        """``ΔM = M_o - M_s`` (k x k) [kg m^2]: the mass matrix the serial-equivalent model lacks (rods, cranks,
+        rotors), in output coordinates."""
+        zero = np.zeros(self.k)
+        return self.output_model(q_sub, zero)[0] - self.serial_model(q_sub, zero)[0]
+
+    def delta_bias(self, q_sub: ArrayLike, qd_o: ArrayLike) -> np.ndarray:
+        """``Δh = h_o - h_s`` (k) [N m]: the Coriolis, centrifugal and gravity efforts (and the closures' drift) the
+        serial-equivalent model lacks, at the output rates ``qd_o`` [rad/s or m/s]."""
+        return self.output_model(q_sub, qd_o)[1] - self.serial_model(q_sub, qd_o)[1]
+
+
+__all__ = ["SINGULAR", "TOL", "Transmission"]

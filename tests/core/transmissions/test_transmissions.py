@@ -1,0 +1,153 @@
+"""pkm.transmissions: the decomposition's rules on whole robots of every format, the maps of each transmission
+against independent routes, and the refusals.
+
+Checked on every transmission of :data:`tests.core.transmissions.robots.ROBOTS`, at the reference and at a state
+moved from it:
+
+* motors -> outputs -> motors to 1e-12 [rad or m] (the loop closure, then the inverse kinematics seeded at the
+  reference);
+* the velocity map against Richardson differences of the forward position map (1e-7 relative), and the effort map,
+  computed with the outputs independent, equal to the velocity map's transpose, computed with the motors
+  independent (1e-12 relative);
+* serial model + ΔM + Δh = the closed-loop model in output coordinates, and that model, mapped by the velocity map,
+  equal to pkm's actuator-space model (``pkm.mass_matrix = Jᵀ M_o J``, ``pkm.bias_efforts = Jᵀ (h_o + M_o J̇ ṁ)``):
+  1e-10 relative;
+* ``Ġ ȯ`` against Richardson differences of ``Ĝ ȯ`` along the motion, on the mechanisms without idle motions.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm.core.transmissions.coordinates import drift_acceleration, output_split
+from pkm.errors import TransmissionError, UnknownNameError
+from tests.core.transmissions.robots import FILES, ROBOTS, robot, transmissions
+from tests.fd import rel, richardson
+
+#: What the rules choose, written from each file's structure: (name, root, motors, outputs) per transmission.
+EXPECTED = {
+    "humanoid_ankle": [("foot", "world", ("motor_left", "motor_right"), ("ankle_pitch", "ankle_roll"))],
+    "humanoid_knee": [("shank", "thigh", ("knee_motor",), ("knee",))],
+    "slider_crank": [("slider", "frame", ("crank_joint",), ("rail",))],
+    "ankle": [("foot", "shank", ("motor_left", "motor_right"), ("ankle_pitch", "ankle_roll"))],
+    "knee": [("back_link", "shank", ("knee_front",), ("knee_back",))],
+    "battobot_6d": [  # (two legs, each a knee four-bar and a two-motor ankle; the knee carries the rest of the leg)
+        ("shin_assembly_sym", "tigh_assembly_sym", ("motor_knee_left",), ("knee_left",)),
+        ("shin_assembly", "tigh_assembly", ("motor_knee_right",), ("knee_right",)),
+        ("foot_assembly", "shin_assembly", ("motor_ankle1_right", "motor_ankle2_right"),
+         ("ankley_right", "anklex_right")),
+        ("foot_assembly_2", "shin_assembly_sym", ("motor_ankle1_left", "motor_ankle2_left"),
+         ("ankley_left", "anklex_left"))],
+    "talos_like": [("ankle", "knee", ("motor_shin",), ("free_ankle",))],
+}
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_the_rules_find_each_robots_transmissions(name):
+    found = transmissions(name)
+    assert [(t.name, t.root, t.motors, t.outputs) for t in found] == EXPECTED[name]
+    mech = robot(name)
+    for t in found:  # motors, outputs and passive joints partition the sub-mechanism's joints
+        assert set(t.mechanism.joints) == {*t.motors, *t.outputs, *t.passive}
+        assert set(t.motors) <= set(mech.actuated_names)
+        np.testing.assert_array_equal(  # the sub-mechanism sits where the robot's reference puts it
+            [t.q_reference[t.mechanism.joints[n].idx_q] for n in t.outputs],
+            [mech.q_reference[mech.joints[n].idx_q] for n in t.outputs])
+
+
+def _moved(t: pkm.Transmission, rng: np.random.Generator) -> np.ndarray:
+    qm = t.mechanism.actuated_q(t.q_reference) + rng.uniform(-0.02, 0.02, t.k)
+    return t.outputs_from_motors(qm)[1]
+
+
+def _forward_differences(t: pkm.Transmission, q: np.ndarray) -> np.ndarray:
+    """``∂o/∂m`` by Richardson differences of the forward position map."""
+    qm = t.mechanism.actuated_q(q)
+
+    def column(e: np.ndarray) -> np.ndarray:
+        return richardson(lambda h: (t.outputs_from_motors(qm + h * e, q)[0]
+                                     - t.outputs_from_motors(qm - h * e, q)[0]) / (2 * h), 1e-5)
+
+    return np.column_stack([column(e) for e in np.eye(t.k)])
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_the_maps_agree_with_independent_routes(name):
+    rng = np.random.default_rng(7)
+    for t in transmissions(name):
+        sub = t.mechanism
+        for q in (t.q_reference, _moved(t, rng)):
+            qm = sub.actuated_q(q)
+            qo, q1 = t.outputs_from_motors(qm, q)
+            qm_back, _ = t.motors_from_outputs(qo)
+            assert np.abs(qm_back - qm).max() <= 1e-12, t.name
+            J = t.velocity_map(q1)
+            assert rel(t.effort_map(q1), J.T) <= 1e-12, t.name
+            assert rel(t.inverse_effort_map(q1) @ t.effort_map(q1), np.eye(t.k)) <= 1e-12
+            assert rel(J, _forward_differences(t, q1)) <= 1e-7, t.name
+            qd_m = rng.normal(size=t.k)
+            qd_o = J @ qd_m
+            M_o, h_o = t.output_model(q1, qd_o)
+            M_s, h_s = t.serial_model(q1, qd_o)
+            dM, dh = t.delta_mass(q1), t.delta_bias(q1, qd_o)
+            np.testing.assert_allclose(M_s + dM, M_o, rtol=0, atol=1e-14 * np.abs(M_o).max())
+            np.testing.assert_allclose(h_s + dh, h_o, rtol=0, atol=1e-14 * np.abs(h_o).max())
+            M_a = pkm.mass_matrix(sub, q1)
+            assert rel(J.T @ (M_s + dM) @ J, M_a) <= 1e-10, t.name
+            v = pkm.velocities(sub, q1, qd_m)
+            od_b = pkm.accelerations(sub, q1, v, np.zeros(t.k))[t.out_v]  # (J̇ ṁ: the outputs at no motor acceleration)
+            assert rel(J.T @ (h_s + dh + (M_s + dM) @ od_b), pkm.bias_efforts(sub, q1, qd_m)) <= 1e-10, t.name
+            assert np.all(np.linalg.eigvalsh(dM) > 0.0)  # (the rods and rotors add inertia)
+
+
+@pytest.mark.parametrize("name", ["humanoid_knee", "slider_crank"])
+def test_the_drift_acceleration_is_the_derivative_of_the_joint_rates_along_the_motion(name):
+    t = transmissions(name)[0]
+    sub = t.mechanism
+    q = _moved(t, np.random.default_rng(3))
+    qd_o = np.array([0.7])
+    qo = q[t.out_q]
+
+    def rates(s: float) -> np.ndarray:
+        qs = t.motors_from_outputs(qo + s * qd_o, q)[1]
+        return output_split(sub, qs, t.out_v, sub.act_v).G @ qd_o
+
+    fd = richardson(lambda h: (rates(h) - rates(-h)) / (2 * h), 1e-4)
+    sp = output_split(sub, q, t.out_v, sub.act_v)
+    assert sp.idle.shape[1] == 0
+    assert rel(drift_acceleration(sub, q, sp.G @ qd_o, sp, t.out_v), fd) <= 1e-7
+
+
+def test_named_outputs_name_the_transmission_and_bad_ones_are_refused():
+    knee = robot("humanoid_knee")
+    (t,) = pkm.transmissions(knee, {"left_knee": ["knee"]})
+    assert (t.name, t.outputs) == ("left_knee", ("knee",))
+    ankle = robot("humanoid_ankle")
+    with pytest.raises(TransmissionError, match="2 motors") as err:  # (wrong count)
+        pkm.transmissions(ankle, {"left_ankle": ["ankle_pitch"]})
+    assert (err.value.transmission, err.value.reason, err.value.joints) == ("left_ankle", "outputs", ("ankle_pitch",))
+    with pytest.raises(TransmissionError, match="hangs below 'knee_motor'"):  # (not a serial chain)
+        pkm.transmissions(knee, {"k": ["rod_top"]})
+    with pytest.raises(UnknownNameError, match="did you mean 'knee'"):
+        pkm.transmissions(knee, {"k": ["kne"]})
+    five = pkm.load(FILES["ankle"].parents[1] / "gepetto_fivebar")
+    with pytest.raises(TransmissionError, match="no one-coordinate serial joint") as err:  # (a frame's output)
+        pkm.transmissions(five)
+    assert err.value.reason == "outputs" and set(err.value.joints) == set(five.actuated_names)
+
+
+def test_outputs_singular_at_the_reference_are_refused():
+    crank = pkm.load(FILES["slider_crank"])
+    crank.q_reference = pkm.close_loops(crank, [0.0]).q  # (the dead centre: the slider's travel has zero slope)
+    with pytest.raises(TransmissionError, match="singular at the reference") as err:
+        pkm.transmissions(crank)
+    assert (err.value.transmission, err.value.reason, err.value.joints) == ("slider", "singular", ("rail",))
+    assert err.value.value > 1e-3
+
+
+def test_a_sub_mechanism_whose_chain_outnumbers_its_motors_is_refused():
+    cassie = pkm.load("gepetto:cassie_like")  # (the knee motor and the passive tarsus joint both carry the foot)
+    with pytest.raises(TransmissionError, match=r"2 outputs \['motor_knee', 'free_knee'\] for 1 motors"):
+        pkm.transmissions(cassie)
