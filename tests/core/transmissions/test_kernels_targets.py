@@ -61,12 +61,11 @@ def test_the_c_library_and_the_cpp_class_round_trip(tmp_path):
     (IK, J_inv, J^T) equal the in-process kernels' and come back to 1e-12."""
     tk = ankle()
     files = write_transmission(tk, tmp_path, ["c"])
-    assert {"humanoid_ankle.c", "humanoid_ankle.h", "humanoid_ankle_transmission.hpp", "example.cpp", "README.md",
-            "transmission.json"} <= set(files)
-    subprocess.run(["gcc", "-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", "-pedantic", "-c", "humanoid_ankle.c"],
+    assert set(files) == {"foot.c", "foot.h", "foot_transmission.hpp", "example.cpp", "README.md", "transmission.json"}
+    subprocess.run(["gcc", "-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", "-pedantic", "-c", "foot.c"],
                    cwd=tmp_path, check=True, capture_output=True)
     subprocess.run(["g++", "-std=c++17", "-O1", "-Wall", "-Wextra", "-Werror", "-o", "example", "example.cpp",
-                    "humanoid_ankle.o", "-lm"], cwd=tmp_path, check=True, capture_output=True)
+                    "foot.o", "-lm"], cwd=tmp_path, check=True, capture_output=True)
     qm = tk.mech.actuated_q(tk.mech.q_reference) + np.array([0.12, -0.07])
     qdm, tau_m = np.array([0.3, -1.1]), np.array([2.0, -5.0])
     run = subprocess.run([str(tmp_path / "example"), *(repr(float(x)) for x in (*qm, *qdm, *tau_m))],

@@ -26,9 +26,9 @@ Definitions. ``M_o``, ``h_o`` are the closed-loop model in output coordinates: t
 (:class:`~pkm.core.twin.dynamics.ActuatorTwin`, as :func:`pkm.mass_matrix`, :func:`pkm.bias_efforts`) of the same
 mechanism with the outputs as its actuated joints: ``M_o = G_oᵀ M G_o``, ``h_o = G_oᵀ (h + M Ġ_o qdot_o)`` with
 ``G_o = ∂q/∂o`` (rotor armature and gravity included, idle motions mass-orthogonal). ``M_s``, ``h_s`` are the
-serial-equivalent model's: the tree with only the output joints and the bodies every joint above which (from the
-sub-mechanism's root) is an output (the rods, the cranks and the rotors dropped): RNEA of those bodies with only the
-outputs moving. Hence ``M_s + ΔM = M_o`` and ``h_s + Δh = h_o`` exactly, and ``M_a = Jᵀ M_o J`` (tested against
+serial-equivalent model's (:func:`pkm.core.transmissions.coordinates.serial_tree`): the tree with every joint but the
+outputs massless (the rods, the cranks and the rotors dropped; each output hangs from the root through outputs only),
+as RNEA of the twin with only the outputs moving. Hence ``M_s + ΔM = M_o`` and ``h_s + Δh = h_o`` exactly, and ``M_a = Jᵀ M_o J`` (tested against
 :func:`pkm.mass_matrix` and :func:`pkm.inverse_dynamics`).
 
 Every kernel takes and returns SI values in Pinocchio's conventions; arrays are the CasADi functions' nonzeros,
@@ -48,11 +48,12 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.transmissions.transmission import Transmission
 from pkm.core.twin.dynamics import ActuatorTwin
 from pkm.core.twin.kernels import PIVOT_FLOOR
 from pkm.core.twin.spatial import Expr
 from pkm.core.twin.tree import Twin
-from pkm.errors import InvalidInputError, SpecError
+from pkm.errors import InvalidInputError, SpecError, TransmissionError
 from pkm.validation import as_array, as_count
 
 #: Newton iterations unrolled in ``fk`` and ``ik``: on the humanoid ankle, 3 reach 1e-12 from a warm start 0.01 rad
@@ -93,9 +94,9 @@ class TransmissionKernels:
         tol: Convergence tolerance of ``fk`` and ``ik`` on the largest closure residual [m, rad].
 
     Raises:
-        SpecError: the outputs are not one-coordinate joints of ``mech``, are motors, are not as many as the
-            motors, or do not determine the sub-mechanism at the reference (its closure with the outputs driving
-            is singular there); naming the transmission.
+        TransmissionError: the outputs are not one-coordinate joints of ``mech``, are motors, are not as many as
+            the motors (``reason="outputs"``), or the motors or the outputs do not determine the sub-mechanism at the
+            reference (a closure solve without a pivot there, ``reason="singular"``).
     """
 
     def __init__(self, mech: Mechanism, outputs: Sequence[str], *, name: str | None = None,
@@ -106,25 +107,24 @@ class TransmissionKernels:
         self.motors = tuple(mech.actuated_names)
         self.iterations = as_count(iterations, "iterations", high=100)
         self.tol = float(tol)
-        where = f"transmission {self.name!r}"
         for o in self.outputs:
             j = mech.joints.get(o)
             if j is None or j.nq != 1 or j.nv != 1:
-                raise SpecError(mech.source, f"{where}: output {o!r} is not a one-coordinate joint of the "
-                                             f"sub-mechanism (its joints: {sorted(mech.joints)})")
+                raise TransmissionError(self.name, "outputs", f"output {o!r} is not a one-coordinate joint of the "
+                                        f"sub-mechanism (its joints: {sorted(mech.joints)})", (o,))
             if o in self.motors:
-                raise SpecError(mech.source, f"{where}: output {o!r} is a motor")
+                raise TransmissionError(self.name, "outputs", f"output {o!r} is a motor", (o,))
         if len(set(self.outputs)) != len(self.motors):
-            raise SpecError(mech.source, f"{where}: {len(set(self.outputs))} distinct outputs for "
-                                         f"{len(self.motors)} motors {list(self.motors)}")
+            raise TransmissionError(self.name, "outputs", f"{len(set(self.outputs))} distinct outputs for "
+                                    f"{len(self.motors)} motors {list(self.motors)}", self.outputs)
         try:
             self.driven = _driven(mech, self.outputs)  # (the same mechanism, the outputs driving)
             self._twin_m = ActuatorTwin(Twin(self.mech))
             self._twin_o = ActuatorTwin(Twin(self.driven))
-            self._twin_o.pivot  # noqa: B018  (the LU with the outputs driving: refused here if singular)
-        except SpecError as e:
-            raise SpecError(mech.source, f"{where}: the outputs {list(self.outputs)} do not determine the "
-                                         f"sub-mechanism at the reference ({e.args[0] if e.args else e})") from None
+        except SpecError as e:  # (a closure LU without a pivot at the reference)
+            raise TransmissionError(self.name, "singular", f"the motors {list(self.motors)} or the outputs "
+                                    f"{list(self.outputs)} do not determine the sub-mechanism at the reference "
+                                    f"({e.args[0] if e.args else e})", self.outputs) from None
         self.q = self._twin_m.tw.q  # the one configuration symbol every kernel takes
         self.qdo = self._twin_o.tw.qd  # the output rates' symbol
         self.k = len(self.motors)
@@ -174,21 +174,19 @@ class TransmissionKernels:
         J_inv = self._in_q(ao, cs.jacobian(cs.vertcat(*[ao.v[c] for c in self.motor_v]), ao.tw.qd))
         return J, J_inv, cs.fmin(am.pivot, self._in_q(ao, ao.pivot))
 
-    def serial_joints(self) -> tuple[str, ...]:
-        """The joints whose bodies the serial-equivalent model keeps: those every joint above which (the joint
-        itself included, up to the sub-mechanism's root) is an output."""
-        model = self.mech.model
-        outs = {self.mech.joints[o].id for o in self.outputs}
-        return tuple(model.names[j] for j in range(1, model.njoints)
-                     if all(s in outs for s in list(model.supports[j])[1:]))
+    @classmethod
+    def of(cls, transmission: Transmission, **options: int | float) -> TransmissionKernels:
+        """The kernels of a :class:`~pkm.core.transmissions.transmission.Transmission` (:func:`pkm.transmissions`):
+        its sub-mechanism, outputs and name (``options``: ``iterations``, ``tol``)."""
+        return cls(transmission.mechanism, transmission.outputs, name=transmission.name, **options)  # type: ignore[arg-type]
 
     @functools.cached_property
     def _delta(self) -> tuple[Expr, Expr, Expr]:
         """``(ΔM, Δh, pivot)`` in :attr:`q` and the symbol :attr:`qdo`."""
         ao = self._twin_o
         M_o, h_o = self._in_q(ao, ao.mass_matrix), self._in_q(ao, ao.bias)
-        serial = Twin(self.mech)  # the serial-equivalent model: the other bodies' inertias zeroed
-        keep = {self.mech.joints[n].id for n in self.serial_joints()}
+        serial = Twin(self.mech)  # the serial-equivalent model: every joint but the outputs massless (serial_tree's)
+        keep = {self.mech.joints[n].id for n in self.outputs}
         serial._inertia = [I if j in keep else pin.Inertia.Zero() for j, I in enumerate(serial._inertia)]
         qdd_o = cs.SX.sym("qdd_o", self.k)
         v, a = cs.SX.zeros(self.mech.nv), cs.SX.zeros(self.mech.nv)

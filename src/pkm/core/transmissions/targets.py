@@ -495,7 +495,7 @@ def write_transmission(tk: TransmissionKernels, directory: str | os.PathLike[str
     description = {
         "format": "pkm.transmission/1", "name": tk.name, "prefix": p, "motors": list(tk.motors),
         "outputs": list(tk.outputs), "passive": [n for n in tk.mech.joints if n not in tk.motors + tk.outputs],
-        "serial_joints": list(tk.serial_joints()), "nq": tk.mech.nq, "q_names": _q_names(tk),
+        "nq": tk.mech.nq, "q_names": _q_names(tk),
         "q_reference": np.asarray(tk.mech.q_reference).tolist(), "iterations": tk.iterations, "tol": tk.tol,
         "status": list(STATUS), "source": str(tk.mech.source),
         "kernels": {k: {"inputs": {n: tk.function(k).nnz_in(i) for i, n in enumerate(KERNELS[k][0])},
