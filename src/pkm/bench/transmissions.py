@@ -84,18 +84,22 @@ def run(args) -> dict:
                  "instructions": fun.n_instructions(), "threads": args.threads, "cores": os.cpu_count(),
                  "us_per_sample": {}, "compile_s": {}, "largest_difference": {}, "skipped": {}}
     us, comp, diff = out["us_per_sample"], out["compile_s"], out["largest_difference"]
-    ref = None
+    ref: list[np.ndarray] = []
     for label, vector in (("c_vector", True), ("c_scalar", False)):
         t0 = time.perf_counter()
-        k = _Kernel(fun, False, True, None, vector, args.threads)
-        k(Q0[:300], QM[:300])
+        kernel = _Kernel(fun, False, True, None, vector, args.threads)
+        kernel(Q0[:300], QM[:300])
         comp[label] = time.perf_counter() - t0
-        wall, outs = best_time(lambda k=k: k(Q0, QM), args.repeat)
+
+        def batch(kernel: _Kernel = kernel) -> list[np.ndarray]:
+            return kernel(Q0, QM)
+
+        wall, outs = best_time(batch, args.repeat)
         us[label] = wall / n * 1e6
-        if ref is None:
+        if not ref:
             ref = outs
             out["status_counts"] = {int(s): int(c) for s, c in zip(*np.unique(outs[-1], return_counts=True))}
-            out["how"] = k.how
+            out["how"] = kernel.how
         else:
             diff[label] = max(float(np.abs(a - b).max()) for a, b in zip(outs, ref))
     try:
@@ -115,10 +119,10 @@ def run(args) -> dict:
 
         from pkm.core.twin.warpgen import warp_kernel
 
-        wp.config.quiet = True
+        wp.config.quiet = True  # type: ignore[attr-defined]
         t0 = time.perf_counter()
         kern = warp_kernel(fun)
-        ins = [wp.array(np.ascontiguousarray(a.T), dtype=wp.float64, device="cpu") for a in (Q0, QM)]
+        ins: list = [wp.array(np.ascontiguousarray(a.T), dtype=wp.float64, device="cpu") for a in (Q0, QM)]
         outs_w = [wp.zeros((fun.nnz_out(j), n), dtype=wp.float64, device="cpu") for j in range(fun.n_out())]
         wp.launch(kern, dim=n, inputs=ins, outputs=outs_w, device="cpu")
         wp.synchronize()

@@ -12,7 +12,7 @@ import pytest
 
 import pkm
 from pkm.core.transmissions.kernels import TransmissionKernels
-from pkm.errors import TransmissionError
+from pkm.errors import InvalidInputError, TransmissionError
 from tests.core.transmissions.robots import transmissions
 
 
@@ -129,6 +129,8 @@ def test_fk_reports_its_status_and_holds_the_warm_start():
     assert (status == 0).all() and residual.max() <= 1e-12
     _, _, status, residual = tk.run("fk", q[0], np.array([qm[0, 0] + 3.0]))
     assert status[0] in (1.0, 2.0) and not residual[0] <= 1e-12
+    with pytest.raises(InvalidInputError, match="qm.*non-finite"):
+        tk.run("fk", q[0], np.array([np.nan]))
 
 
 def test_bad_outputs_are_refused_naming_the_transmission():

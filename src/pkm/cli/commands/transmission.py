@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import Any
 
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, load_mechanism
@@ -49,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
     if not targets or any(t not in TARGETS for t in targets):
         raise InvalidInputError("--targets", f"choose among {', '.join(TARGETS)}", args.targets)
     mech = load_mechanism(args)
-    out = []
+    out: list[dict[str, Any]] = []
     for t in pkm.transmissions(mech, parse_outputs(args.outputs)):
         tk = TransmissionKernels.of(t)
         files = write_transmission(tk, Path(args.out) / t.name, targets)

@@ -158,10 +158,10 @@ class TransmissionKernels:
         tw = at.tw
         act = list(tw.mech.act_q)
         q = cs.vertcat(*[target[act.index(i)] if i in act else self.q[i] for i in range(tw.mech.nq)])
-        pivot = None
-        for _ in range(self.iterations):
+        q, pivot = newton(q, target)
+        for _ in range(self.iterations - 1):
             q, p = newton(q, target)
-            pivot = p if pivot is None else cs.fmin(pivot, p)
+            pivot = cs.fmin(pivot, p)
         residual = cs.mmax(cs.fabs(cs.substitute(tw.closure_residual, tw.q, q)))
         status = cs.if_else(pivot < PIVOT_FLOOR, 2.0, cs.if_else(residual <= self.tol, 0.0, 1.0))
         return q, status, residual
@@ -239,13 +239,20 @@ class TransmissionKernels:
         return _Kernel(self.function(kernel), False, True, None, None)
 
     def run(self, kernel: str, *args: ArrayLike) -> list[np.ndarray]:
-        """``kernel`` on a batch (each input ``(n, size)``) or one sample (each 1-D): its outputs, shaped alike."""
+        """``kernel`` on a batch (each input ``(n, size)``) or one sample (each 1-D): its outputs, shaped alike
+        (matrices as their column-major nonzeros; a solve's status per sample, :data:`STATUS`).
+
+        Raises:
+            InvalidInputError: an input of the wrong size, or holding a NaN or an infinity.
+        """
         fun = self.function(kernel)
         arrays = []
         for i, x in enumerate(args):
             a = as_array(x, fun.name_in(i))
             if a.ndim not in (1, 2) or a.shape[-1] != fun.nnz_in(i):
                 raise InvalidInputError(fun.name_in(i), f"expected ({fun.nnz_in(i)},) or (n, {fun.nnz_in(i)})", x)
+            if not np.isfinite(a).all():  # (the C target's INVALID_INPUT)
+                raise InvalidInputError(fun.name_in(i), "holds non-finite values", x)
             arrays.append(np.ascontiguousarray(np.atleast_2d(a)))
         if len(arrays) != fun.n_in():
             raise InvalidInputError(kernel, f"takes {fun.n_in()} inputs {fun.name_in()}, got {len(arrays)}")
