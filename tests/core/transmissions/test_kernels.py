@@ -129,7 +129,7 @@ def test_fk_reports_its_status_and_holds_the_warm_start():
     assert (status == 0).all() and residual.max() <= 1e-12
     _, _, status, residual = tk.run("fk", q[0], np.array([qm[0, 0] + 3.0]))
     assert status[0] in (1.0, 2.0) and not residual[0] <= 1e-12
-    with pytest.raises(InvalidInputError, match="qm.*non-finite"):
+    with pytest.raises(InvalidInputError, match=r"qm.*non-finite"):
         tk.run("fk", q[0], np.array([np.nan]))
 
 
