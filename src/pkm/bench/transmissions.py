@@ -45,7 +45,8 @@ def add_arguments(ap) -> None:
     ap.add_argument("--calls", type=int, default=200, help="samples of the Python baseline")
     ap.add_argument("--threads", type=int, default=1, help="cores of the C batches (default 1)")
     ap.add_argument("--iterations", type=int, default=3,
-                    help="Newton iterations unrolled (default 3: enough from a warm start a tick away; statuses counted)")
+                    help="Newton iterations unrolled (default 3: enough from a warm start a tick away; the statuses "
+                         "are counted)")
     ap.add_argument("--mechanism", choices=sorted(MECHANISMS), default="ankle",
                     help="the transmission (default the ankle; --quick: the knee)")
 

@@ -1,6 +1,8 @@
 """Transmission kernels: a closed sub-mechanism's maps between its motors and its output joints, from ONE generator
-(the twin's CasADi expressions, :mod:`pkm.core.twin`) to three targets: C99 (:func:`c_source`), JAX
-(:func:`pkm.core.twin.jaxgen.jax_source`) and NVIDIA Warp (:mod:`pkm.core.twin.warpgen`).
+(the twin's CasADi expressions, :mod:`pkm.core.twin`) to three targets: C99
+(:func:`pkm.core.export.emit.c_function`), JAX (:func:`pkm.core.twin.jaxgen.jax_source`) and NVIDIA Warp
+(:mod:`pkm.core.twin.warpgen`); written out for a robot's software by :mod:`pkm.core.transmissions.targets`
+(``pkm transmission``).
 
 A transmission here is a mechanism ``mech`` (the closed sub-mechanism alone, ``actuated`` = its motors ``m``) and
 ``k = na`` output joints ``o`` (one-coordinate joints of the tree: revolute or prismatic). The kernels
@@ -8,9 +10,10 @@ A transmission here is a mechanism ``mech`` (the closed sub-mechanism alone, ``a
 
 * ``fk`` ``(q, qm) -> (q_out, qo, status, residual)``: motors to outputs. Newton on the closure with the motors set
   to ``qm``, warm-started from ``q`` (the previous solution), :data:`ITERATIONS` iterations unrolled (no branch: one
-  instruction list for every target and every GPU thread); the passive rates solved by the twin's sparse LU
-  (pivots fixed at the reference), the idle motions (a rod spinning between two balls) held at the guess's values
-  (:func:`pkm.core.twin.dynamics.idle_columns`). ``residual`` is the largest closure residual at ``q_out`` [m, rad];
+  instruction list for every target and every GPU thread); each step the twin's sparse LU of the passive columns
+  (pivots fixed at the reference) or, with idle motions (a rod spinning between two balls), the least-norm step
+  (:meth:`TransmissionKernels._newton`), at most :data:`MAX_STEP` long. ``residual`` is the largest closure
+  residual at ``q_out`` [m, rad];
   ``status`` (:data:`STATUS`): 0 ``OK`` (``residual <= TOL``), 1 ``NOT_CONVERGED``, 2 ``SINGULAR`` (a pivot under
   :data:`~pkm.core.twin.kernels.PIVOT_FLOOR` relative to the reference at some iteration);
 * ``ik`` ``(q, qo) -> (q_out, qm, status, residual)``: outputs to motors, the same Newton with the outputs held;
@@ -28,8 +31,9 @@ mechanism with the outputs as its actuated joints: ``M_o = G_oᵀ M G_o``, ``h_o
 ``G_o = ∂q/∂o`` (rotor armature and gravity included, idle motions mass-orthogonal). ``M_s``, ``h_s`` are the
 serial-equivalent model's (:func:`pkm.core.transmissions.coordinates.serial_tree`): the tree with every joint but the
 outputs massless (the rods, the cranks and the rotors dropped; each output hangs from the root through outputs only),
-as RNEA of the twin with only the outputs moving. Hence ``M_s + ΔM = M_o`` and ``h_s + Δh = h_o`` exactly, and ``M_a = Jᵀ M_o J`` (tested against
-:func:`pkm.mass_matrix` and :func:`pkm.inverse_dynamics`).
+as RNEA of the twin with only the outputs moving. Hence ``M_s + ΔM = M_o`` and ``h_s + Δh = h_o`` exactly, and
+``M_a = Jᵀ M_o J`` (tested against :func:`pkm.mass_matrix`, :func:`pkm.bias_efforts` and
+:class:`~pkm.core.transmissions.transmission.Transmission`'s Python reference).
 
 Every kernel takes and returns SI values in Pinocchio's conventions; arrays are the CasADi functions' nonzeros,
 matrices column-major. Equal across targets to 1e-12 in double precision (the tests).
@@ -205,7 +209,8 @@ class TransmissionKernels:
     def of(cls, transmission: Transmission, **options: int | float) -> TransmissionKernels:
         """The kernels of a :class:`~pkm.core.transmissions.transmission.Transmission` (:func:`pkm.transmissions`):
         its sub-mechanism, outputs and name (``options``: ``iterations``, ``tol``)."""
-        return cls(transmission.mechanism, transmission.outputs, name=transmission.name, **options)  # type: ignore[arg-type]
+        return cls(transmission.mechanism, transmission.outputs, name=transmission.name,
+                   **options)  # type: ignore[arg-type]
 
     @functools.cached_property
     def _delta(self) -> tuple[Expr, Expr, Expr]:
