@@ -14,7 +14,7 @@ from tests.core.transmissions.robots import transmissions
 def test_serial_plus_delta_follows_the_closed_loop_and_constant_armature_does_not():
     pytest.importorskip("mujoco")  # the bench extra: MuJoCo runs the serial model, not a dependency
     (row,) = fidelity(transmissions("humanoid_ankle")[0], duration=0.2, dt=2e-3, which=("chirp",), integrators=False)
-    assert row.motion > 0.03  # (the foot moves: a few degrees)
+    assert row.motion > 0.01  # (the foot moves: a degree or more)
     assert row.exact <= 1e-9
     assert row.constant_armature > 1e-4  # (the constant armature misses ΔM's change and Δh: visible in 0.2 s)
     assert "| foot | chirp |" in table([row])

@@ -6,11 +6,13 @@ kinematics and the box lies inside the feasible region; the data file describes 
 from __future__ import annotations
 
 import json
+import pickle
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
+import pkm
 from pkm.core.analysis.region import Region, _feasible
 from pkm.core.transmissions.serial import serial_equivalent, write_serial_equivalent
 from tests.core.transmissions.robots import robot, transmissions
@@ -23,7 +25,7 @@ def ankle_files(tmp_path_factory):
 
 
 def test_the_urdf_loads_in_pinocchio_with_the_serial_models_inertia(ankle_files):
-    se, (urdf, _, _) = ankle_files
+    se, (urdf, *_) = ankle_files
     (t,) = se.transmissions
     model = pin.buildModelFromUrdf(str(urdf))
     assert [model.names[j] for j in range(1, model.njoints)] == list(t.outputs)  # (the rods are gone)
@@ -36,7 +38,7 @@ def test_the_urdf_loads_in_pinocchio_with_the_serial_models_inertia(ankle_files)
 
 def test_the_mjcf_loads_in_mujoco_with_the_constant_armature(ankle_files):
     mujoco = pytest.importorskip("mujoco")  # the bench extra: MuJoCo reads the file, not a dependency
-    se, (_, xml, _) = ankle_files
+    se, (_, xml, *_) = ankle_files
     (t,) = se.transmissions
     m = mujoco.MjModel.from_xml_path(str(xml))
     d = mujoco.MjData(m)
@@ -52,7 +54,7 @@ def test_the_mjcf_loads_in_mujoco_with_the_constant_armature(ankle_files):
 
 
 def test_the_box_lies_inside_the_feasible_region_every_corner_checked(ankle_files):
-    se, (_, _, data) = ankle_files
+    se, (*_, data) = ankle_files
     (t,) = se.transmissions
     region = se.regions[t.name]
     assert region.corners_checked == 4
@@ -67,3 +69,14 @@ def test_the_box_lies_inside_the_feasible_region_every_corner_checked(ankle_file
     assert content["transmissions"][0]["motors"] == ["motor_left", "motor_right"]
     assert content["transmissions"][0]["armature"] == pytest.approx(np.diag(t.delta_mass(t.q_reference)), abs=0)
     assert content["files"]["mjcf"].endswith("_serial.xml")
+
+
+def test_each_sub_mechanism_is_written_loads_back_the_same_and_pickles(ankle_files):
+    se, (*_, sub_urdf, sub_spec, data) = ankle_files
+    (t,) = se.transmissions
+    assert json.loads(data.read_text())["transmissions"][0]["files"] == {"urdf": sub_urdf.name, "spec": sub_spec.name}
+    (back,) = pkm.transmissions(pkm.load(sub_spec))
+    assert (back.motors, back.outputs) == (t.motors, t.outputs)
+    np.testing.assert_allclose(back.delta_mass(back.q_reference), t.delta_mass(t.q_reference), rtol=1e-12)
+    again = pickle.loads(pickle.dumps(t))
+    np.testing.assert_allclose(again.velocity_map(t.q_reference), t.velocity_map(t.q_reference), rtol=1e-14)

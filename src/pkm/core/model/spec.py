@@ -50,6 +50,9 @@ Format ``pkm.closures/1`` (all values SI: m, rad)::
     rotor_inertia = 3.3e-5           # kg m^2; also gear_ratio, armature, viscous, coulomb,
     gear_ratio = 50.0                # effort_limit, peak_effort, velocity_limit (inf: none)
 
+    [transmission.left_ankle]        # optional: a closed sub-mechanism's name and output joints
+    outputs = ["ankle_pitch", "ankle_roll"]   # (pkm.transmissions; pkm.core.transmissions.decompose)
+
 ``[joint_types]`` values (:mod:`pkm.core.model.joints`): ``"spherical"``; ``"universal_ab"`` with ``a``, ``b`` two
 distinct axes of ``x``, ``y``, ``z`` (``R = exp(q1 [a]) exp(q2 [b])``, Gepetto's ``UJOINT_AB``), ``"universal"``
 being ``"universal_xy"``; ``"fixed"``.
@@ -187,6 +190,9 @@ class ClosureSpec:
     #: ``{actuated joint: {field: value}}``: the drives' values the spec states (``[actuators.<joint>]``, see
     #: :mod:`pkm.core.model.actuators`), over those of the model file.
     actuators: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    #: ``{transmission name: output joints}``: the ``[transmission.<name>]`` tables, the outputs
+    #: :func:`pkm.transmissions` gives the closed sub-mechanism that holds them.
+    transmissions: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ reading
     @property
@@ -240,7 +246,7 @@ class ClosureSpec:
             raise SpecError(source, f"unsupported format {fmt!r}; this pkm reads {FORMAT!r}")
         known = {"format", "mechanism", "urdf", "end_effector", "actuated", "default_branch", "task",
                  "closure", "branch", "reference", "parameters", "description", "joint_types", "floating_base",
-                 "actuators"}
+                 "actuators", "transmission"}
         unknown = sorted(set(raw) - known)
         if unknown:
             raise SpecError(source, f"unknown keys {unknown}; known keys: {sorted(known)}")
@@ -357,6 +363,13 @@ class ClosureSpec:
             raise SpecError(source, f"[actuators.{stray[0]}]: {stray[0]!r} is not an actuated joint; actuated: "
                                     f"{list(actuated)}")
 
+        transmissions = {}
+        for tname, table in need(raw, "transmission", dict).items() if "transmission" in raw else ():
+            where = f"[transmission.{tname}] "
+            if not isinstance(table, dict) or set(table) != {"outputs"}:
+                raise SpecError(source, f"{where}must hold one key, outputs = [joint, ...]")
+            transmissions[str(tname)] = names(table, "outputs", where)
+
         return cls(
             mechanism=need(raw, "mechanism", str),
             urdf=need(raw, "urdf", str),
@@ -372,6 +385,7 @@ class ClosureSpec:
             joint_types=dict(joint_types),
             floating_base=floating_base,
             actuators=actuators,
+            transmissions=transmissions,
         )
 
     # ------------------------------------------------------------------ writing
@@ -413,6 +427,8 @@ class ClosureSpec:
         for joint, values in self.actuators.items():
             if values:
                 out += ["", f"[actuators.{_key(joint)}]"] + [f"{_key(k)} = {_tv(float(v))}" for k, v in values.items()]
+        for tname, outputs in self.transmissions.items():
+            out += ["", f"[transmission.{_key(tname)}]", f"outputs = {_tv(list(outputs))}"]
         out += ["", "[reference]"]
         out += [f"{_key(k)} = {_tv(list(v))}" for k, v in self.reference.items()]
         if self.parameters:

@@ -461,10 +461,14 @@ def _urdf_joint_kind(jm: pin.JointModel, where: str, source: str) -> tuple[str, 
         return "floating", None, None
     if kind == "Universal":
         uj = jm.extract()
-        if np.allclose(uj.axis1, _AXES["X"], atol=1e-12) and np.allclose(uj.axis2, _AXES["Y"], atol=1e-12):
+        names = [next((a for a in "XYZ" if np.allclose(axis, _AXES[a], atol=1e-12)), None)
+                 for axis in (uj.axis1, uj.axis2)]
+        if names == ["X", "Y"]:
             return "revolute", np.array(_AXES["Z"]), "universal"
+        if None not in names and names[0] != names[1]:  # (about two of the frame's axes: [joint_types] says which)
+            return "revolute", np.array(_AXES["Z"]), f"universal_{names[0]}{names[1]}".lower()
     raise SpecError(source, f"{where}: a Pinocchio {jm.shortname()} cannot be written as URDF (pkm writes revolute, "
-                            "prismatic, continuous, spherical, universal about x then y, and free-flyer joints)")
+                            "prismatic, continuous, spherical, universal about two of the joint frame's axes, and free-flyer joints)")
 
 
 def _joint_motion(jm: pin.JointModel, value: float, where: str, source: str) -> pin.SE3:

@@ -11,8 +11,8 @@ The rules, in order:
 2. **Motors**: the robot's actuated joints in the sub-mechanism. A sub-mechanism with none is refused.
 3. **Outputs** (the serial joints the serial-equivalent model keeps), by the first rule that applies:
 
-   * named: ``outputs={name: [joint, ...]}`` gives the transmission that contains those joints its name and its
-     outputs;
+   * named: ``outputs={name: [joint, ...]}``, else the spec's ``[transmission.<name>] outputs = [...]`` tables,
+     give the transmission that contains those joints its name and its outputs;
    * else the joints of the **chain**: for every closure, the side whose path from the root crosses no motor is the
      chain (the foot hanging from the shank by pitch and roll); the outputs are the joints on the chains' paths,
      in the model's order. Its name is the body the deepest chain ends on (the foot), made unique with ``_2``,
@@ -26,22 +26,28 @@ The rules, in order:
 4. **The sub-mechanism alone** (:attr:`Transmission.mechanism`): the robot's Pinocchio model with every joint outside
    the sub-mechanism locked at the robot's reference (``pinocchio.buildReducedModel``: the locked bodies welded to
    their parents, so that the root is fixed where the reference puts it, gravity as the whole robot's at its
-   reference and a floating base held there), its closures, its motors as the actuated joints, its outputs as the
-   task (``TaskSpec(components=(), joints=outputs)``), the drives' values of the robot. A joint whose position limits
+   reference and a floating base held there), written as URDF (:func:`~pkm.core.model.urdf.urdf_from_model`) and
+   built from it with a spec of its own: its closures, its motors as the actuated joints with the robot's drives
+   (every field in ``[actuators.<motor>]``), its outputs as the task (``TaskSpec(components=(), joints=outputs)``),
+   the robot's reference. It has files and pickles. A joint whose position limits
    are an empty interval (``lower >= upper``: Pinocchio's placeholder where a file states none) is unlimited there.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pinocchio as pin
 
+from pkm.core.model.actuators import NUMBERS
+from pkm.core.model.builder import from_strings
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.spec import ClosureSpec, TaskSpec
+from pkm.core.model.urdf import urdf_from_model
 from pkm.core.transmissions.transmission import Transmission
-from pkm.errors import InvalidInputError, PkmError, TransmissionError, UnknownNameError
+from pkm.errors import InvalidInputError, PkmError, PkmWarning, TransmissionError, UnknownNameError
 
 
 def _loop(model: pin.Model, ja: int, jb: int) -> tuple[int, set[int]]:
@@ -105,15 +111,14 @@ def _distal_body(model: pin.Model, joint: int) -> str:
     return model.names[joint]
 
 
-def _chain_outputs(mech: Mechanism, closures: list[int], joints: set[int], k: int) -> tuple[list[int], int | None, bool]:
-    """Rule 3's chain: ``(outputs, the joint whose body names the transmission, whether the chain carries the rest
-    of the robot)`` (module doc)."""
+def _chain_outputs(mech: Mechanism, closures: list[int], joints: set[int], k: int) -> tuple[list[int], int | None]:
+    """Rule 3's chain: ``(outputs, the joint whose body names the transmission)`` (module doc)."""
     model = mech.model
     motors = {mech.joints[n].id for n in mech.actuated_names}
     below = {j: {i for i in range(1, model.njoints) if j in model.supports[i]} for j in joints}
     carrying = sorted(j for j in joints if below[j] - joints)
     if carrying:  # (a): the joints that carry the rest of the robot, every one of them
-        return carrying, max(carrying, key=lambda j: len(model.supports[j])), True
+        return carrying, max(carrying, key=lambda j: len(model.supports[j]))
     sides: set[int] = set()
     for i in closures:
         for f in mech.closure_frames[i]:
@@ -121,7 +126,7 @@ def _chain_outputs(mech: Mechanism, closures: list[int], joints: set[int], k: in
             if path and not motors & set(path):
                 sides |= set(path)
     chain = sorted(sides)[:k]  # (b): the motor-free sides' first k joints (the rods' own joints come after)
-    return chain, (chain[-1] if chain else None), False
+    return chain, (chain[-1] if chain else None)
 
 
 def _unique(names: list[str]) -> list[str]:
@@ -135,36 +140,45 @@ def _unique(names: list[str]) -> list[str]:
 
 def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[int], motors: tuple[str, ...],
                    outputs: tuple[str, ...]) -> Mechanism:
-    """Rule 4: the sub-mechanism alone, rooted where the robot's reference puts its root."""
+    """Rule 4: the sub-mechanism alone, rooted where the robot's reference puts its root, built from its own URDF
+    (so that it has files, :func:`~pkm.core.transmissions.serial.write_serial_equivalent`, and pickles)."""
     model = mech.model
     keep = {model.names[j] for j in joints}
     lock = [j for j in range(1, model.njoints) if model.names[j] not in keep]
     reduced = pin.buildReducedModel(model, lock, mech.q_reference) if lock else model.copy()
-    reduced.name = name
-    lower, upper = np.array(reduced.lowerPositionLimit, dtype=float), np.array(reduced.upperPositionLimit, dtype=float)
-    empty = lower >= upper  # (a reader's placeholder for "no limit stated": URDF's revolute without <limit>, SDF)
-    lower[empty], upper[empty] = -np.inf, np.inf
-    reduced.lowerPositionLimit, reduced.upperPositionLimit = lower, upper
+    stated = {n: lim for n, lim in mech.limits.items() if n in keep}
+    urdf, types = urdf_from_model(reduced, name=name, limits=stated, source=mech.source)
     q_ref = mech.q_to_dict(mech.q_reference)
     spec = ClosureSpec(
-        mechanism=name, urdf=mech.spec.urdf, end_effector=None, actuated=motors,
+        mechanism=name, urdf=f"{name}.urdf", end_effector=None, actuated=motors,
         closures=tuple(mech.spec.closures[i] for i in closures), task=TaskSpec(components=(), joints=outputs),
-        reference={n: tuple(np.atleast_1d(q_ref[n]).tolist()) for n in keep if n in q_ref},
-        joint_types={n: t for n, t in mech.spec.joint_types.items() if n in keep},
-        actuators={n: v for n, v in mech.spec.actuators.items() if n in motors},
+        reference={n: tuple(np.atleast_1d(q_ref[n]).tolist()) for n in sorted(keep) if n in q_ref},
+        joint_types=types, actuators={a.joint: {f: float(getattr(a, f)) for f in NUMBERS}
+                                      for a in mech.actuators if a.joint in motors},
         description=f"the closed sub-mechanism {name!r} of {mech.name!r}")
-    sub = Mechanism(reduced, spec, source=f"{mech.source} [{name}]")
-    sub.limits = {n: lim for n, lim in mech.limits.items() if n in keep}
+    with warnings.catch_warnings():  # (what the robot's loading said already: kept in the notes, not said twice)
+        warnings.simplefilter("ignore", PkmWarning)
+        sub = from_strings(urdf, spec, source=f"{mech.source} [{name}]")
+    lower, upper = np.array(sub.model.lowerPositionLimit, dtype=float), np.array(sub.model.upperPositionLimit,
+                                                                                 dtype=float)
+    empty = lower >= upper  # (a reader's placeholder for "no limit stated": URDF's revolute without bounds, SDF)
+    lower[empty], upper[empty] = -np.inf, np.inf
+    sub.model.lowerPositionLimit, sub.model.upperPositionLimit = lower, upper
     return sub
 
 
-def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None = None) -> list[Transmission]:
+def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None = None, *,
+                  skip_unfit: bool = False) -> list[Transmission]:
     """The closed sub-mechanisms of a whole robot, each a :class:`Transmission` (the rules: module doc).
 
     Args:
         mech: The whole robot (fixed or floating base, any number of loops, serial joints between them).
         outputs: ``{transmission name: output joints}`` for the transmissions whose outputs the chain rule would not
-            choose (or to name them); a transmission not listed gets the chain rule and a generated name.
+            choose (or to name them); a transmission not listed gets the chain rule and a generated name. Default:
+            the spec's ``[transmission.<name>]`` tables (:attr:`pkm.ClosureSpec.transmissions`).
+        skip_unfit: Leave out a sub-mechanism that cannot be a transmission (its :class:`TransmissionError` said in a
+            :class:`~pkm.errors.PkmWarning`) instead of raising: the others of a robot one of whose loops is no
+            transmission (Gepetto's ``cassie_like``: its ankle, not its knee).
 
     Returns:
         The transmissions, in the order of their first closure in the spec.
@@ -177,22 +191,23 @@ def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None =
 
     Examples:
         >>> import pkm
-        >>> ankle = pkm.load("examples/humanoid_ankle/ankle.closures.toml")  # doctest: +SKIP
-        >>> [(t.name, t.motors, t.outputs) for t in pkm.transmissions(ankle)]  # doctest: +SKIP
-        [('foot', ('motor_left', 'motor_right'), ('ankle_pitch', 'ankle_roll'))]
+        >>> talos = pkm.load("gepetto:talos_like")  # (a leg whose ankle a motor on the shin drives through rods)
+        >>> [(t.name, t.root, t.motors, t.outputs) for t in pkm.transmissions(talos)]
+        [('ankle', 'knee', ('motor_shin',), ('free_ankle',))]
     """
     mech = check_mechanism(mech)
     model = mech.model
     named: dict[str, tuple[str, ...]] = {}
-    if outputs is not None:
-        if not isinstance(outputs, Mapping):
-            raise InvalidInputError("outputs", "expected {transmission name: [output joint, ...]}", outputs)
-        for tname, joints in outputs.items():
-            if isinstance(joints, str) or not isinstance(joints, Sequence):
-                raise InvalidInputError("outputs", f"transmission {tname!r}: expected a list of joint names", joints)
-            for j in joints:
-                mech.joint(j)  # (UnknownNameError naming the valid joints)
-            named[str(tname)] = tuple(joints)
+    if outputs is None:
+        outputs = mech.spec.transmissions
+    if not isinstance(outputs, Mapping):
+        raise InvalidInputError("outputs", "expected {transmission name: [output joint, ...]}", outputs)
+    for tname, joints in outputs.items():
+        if isinstance(joints, str) or not isinstance(joints, Sequence):
+            raise InvalidInputError("outputs", f"transmission {tname!r}: expected a list of joint names", joints)
+        for j in joints:
+            mech.joint(j)  # (UnknownNameError naming the valid joints)
+        named[str(tname)] = tuple(joints)
     groups = _groups(mech)
     actuated = {mech.joints[n].id for n in mech.actuated_names}
     claimed: dict[str, int] = {}
@@ -207,24 +222,28 @@ def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None =
                                     joints)
         claimed[tname] = hits[0]
     by_group = {g: t for t, g in claimed.items()}
-    plans = []
-    for g, (closures, joints, root) in enumerate(groups):
-        motor_ids = actuated & joints
+    plans: list[tuple[str, list[int], set[int], int, set[int], list[int]]] = []
+    for g, (closures, members, root) in enumerate(groups):
+        motor_ids = actuated & members
         if g in by_group:
-            tname = by_group[g]
-            out_ids = [mech.joints[j].id for j in named[tname]]
-            plans.append((tname, False, closures, joints, root, motor_ids, out_ids))
+            out_ids = [mech.joints[j].id for j in named[by_group[g]]]
+            plans.append((by_group[g], closures, members, root, motor_ids, out_ids))
         else:
-            out_ids, deepest, carrying = _chain_outputs(mech, closures, joints, len(motor_ids))
-            label = _distal_body(model, deepest) if deepest is not None else model.names[min(joints)]
-            plans.append((label, carrying, closures, joints, root, motor_ids, out_ids))
+            out_ids, deepest = _chain_outputs(mech, closures, members, len(motor_ids))
+            label = _distal_body(model, deepest) if deepest is not None else model.names[min(members)]
+            plans.append((label, closures, members, root, motor_ids, out_ids))
     generated = _unique([p[0] for p in plans])
     result = []
     for g, p in enumerate(plans):
-        tname = by_group.get(g) or generated[g]
-        result.append(_transmission(mech, tname, *p[2:]))
+        try:
+            result.append(_transmission(mech, by_group.get(g) or generated[g], *p[1:]))
+        except TransmissionError as exc:
+            if not skip_unfit:
+                raise
+            warnings.warn(PkmWarning(f"{exc}: left out (skip_unfit)"), stacklevel=2)
     if not result:
-        raise TransmissionError(mech.name, "no_loop", "the robot has no closure: no closed sub-mechanism")
+        raise TransmissionError(mech.name, "no_loop", "the robot has no closed sub-mechanism that is a transmission"
+                                if plans else "the robot has no closure: no closed sub-mechanism")
     return result
 
 

@@ -15,7 +15,7 @@ reference at rest:
   acceleration is first solved exactly, ``ö = (M_s + ΔM)⁻¹ (τ_o - h_s - Δh)``, then ``qfrc_applied = τ_o - ΔM ö -
   Δh``, so that MuJoCo's own ``M_s ö + h_s = qfrc_applied`` gives that ``ö``: no lag, no iteration (a fixed point
   ``ö_{k+1} = M_s⁻¹(τ_o - ΔM ö_k - …)`` would diverge where ``ΔM`` outweighs ``M_s``, as on an ankle whose rods and
-  rotors weigh 25 times the foot).
+  rotors add 25 times the foot's own inertia about pitch).
 
 Both MuJoCo runs use MuJoCo's RK4 (``integrator="RK4"``) at ``dt``; each state's sub-mechanism configuration is the
 closure at its outputs, warm-started from the previous one
@@ -26,7 +26,7 @@ from (a) over the run [rad or m]; each integrator's own error is estimated by th
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -36,12 +36,12 @@ from pkm.core.dynamics.simulate import simulate
 from pkm.core.transmissions.coordinates import close_at_outputs, output_model
 from pkm.core.transmissions.serial import serial_equivalent
 from pkm.core.transmissions.transmission import Transmission
-from pkm.errors import InvalidInputError
+from pkm.errors import ConvergenceError, InvalidInputError
 
 Profile = Callable[[float], np.ndarray]
 
 
-def profiles(t: Transmission, duration: float = 2.0, *, amplitude: float = 0.05) -> dict[str, Profile]:
+def profiles(t: Transmission, duration: float = 2.0, *, amplitude: float = 0.02) -> dict[str, Profile]:
     """The two motor-torque profiles ``{"chirp": τ(t), "swing": τ(t)}`` [N m or N] about the torques that hold the
     sub-mechanism at its reference (:func:`pkm.gravity_efforts`): a chirp from 0.5 to 4 Hz over ``duration`` and a
     walking-like swing (1 Hz with its second harmonic), each motor's amplitude the torque that swings its own
@@ -75,7 +75,8 @@ def closed_loop(t: Transmission, torque: Profile, duration: float, dt: float) ->
 
 def serial_run(t: Transmission, torque: Profile, duration: float, dt: float, *, exact: bool) -> np.ndarray:
     """(b) (``exact=False``) or (c) (``exact=True``): the outputs (N+1, k) [rad or m] of MuJoCo's serial model at
-    ``0, dt, ..., duration`` under ``torque`` (module doc)."""
+    ``0, dt, ..., duration`` under ``torque`` (module doc); NaN from the first step whose outputs no closed
+    configuration of the sub-mechanism reaches (the serial model went where the mechanism cannot)."""
     mujoco = module("mujoco", extra="bench", what="the serial-equivalent model's MuJoCo run")
     se = serial_equivalent(t.mechanism, [t], limits=False)
     m = mujoco.MjModel.from_xml_string(se.mjcf(timestep=dt))
@@ -108,12 +109,15 @@ def serial_run(t: Transmission, torque: Profile, duration: float, dt: float, *, 
         data.qfrc_applied[dadr] = tau_o - dM @ odd - dh  # type: ignore[attr-defined]
 
     n = round(duration / dt)
-    out = np.empty((n + 1, t.k))
+    out = np.full((n + 1, t.k), np.nan)
     out[0] = d.qpos[qadr]
     mujoco.set_mjcb_control(control)
     try:
         for i in range(n):
-            mujoco.mj_step(m, d)
+            try:
+                mujoco.mj_step(m, d)
+            except ConvergenceError:  # (the serial model's outputs left the sub-mechanism's workspace: NaN after)
+                break
             out[i + 1] = d.qpos[qadr]
     finally:
         mujoco.set_mjcb_control(None)
@@ -129,10 +133,12 @@ class FidelityRow:
         profile: ``"chirp"`` or ``"swing"``.
         duration: The run's length [s]; ``dt`` its step [s].
         motion: The largest output excursion of (a) from the reference [rad or m] (the scale of the errors).
-        constant_armature: (b)'s error.
-        exact: (c)'s error.
+        constant_armature: (b)'s error (over the time it stayed in the sub-mechanism's workspace).
+        exact: (c)'s error (inf if it left the workspace).
+        left_workspace: The time (b) reached outputs the sub-mechanism cannot [s], or None.
         mujoco_integrator: (c) at ``dt`` against (c) at ``dt / 2``: MuJoCo's RK4's own error.
         pkm_integrator: (a) at ``dt`` against (a) at ``dt / 2``: :func:`pkm.simulate`'s.
+        traces: The outputs of each run, ``{"a": ..., "b": ..., "c": ...}`` ((N+1) x k, at ``0, dt, ...``).
     """
 
     transmission: str
@@ -144,9 +150,11 @@ class FidelityRow:
     exact: float
     mujoco_integrator: float
     pkm_integrator: float
+    left_workspace: float | None = None
+    traces: dict[str, np.ndarray] = field(default_factory=dict, repr=False, compare=False)
 
 
-def fidelity(t: Transmission, duration: float = 2.0, dt: float = 1e-3, *, amplitude: float = 0.05,
+def fidelity(t: Transmission, duration: float = 2.0, dt: float = 1e-3, *, amplitude: float = 0.02,
              which: tuple[str, ...] = ("chirp", "swing"), integrators: bool = True) -> list[FidelityRow]:
     """The fidelity table of ``t`` (module doc): one row per profile of :func:`profiles` named in ``which``;
     ``integrators=False`` skips the runs at ``dt / 2`` (the integrators' errors are then NaN)."""
@@ -160,10 +168,18 @@ def fidelity(t: Transmission, duration: float = 2.0, dt: float = 1e-3, *, amplit
         nan = np.full_like(a, np.nan)
         a2 = closed_loop(t, torque, duration, dt / 2)[::2] if integrators else nan
         c2 = serial_run(t, torque, duration, dt / 2, exact=True)[::2] if integrators else nan
-        rows.append(FidelityRow(t.name, name, duration, dt, float(np.abs(a - a[0]).max()), float(np.abs(b - a).max()),
-                                float(np.abs(c - a).max()), float(np.abs(c - c2).max()),
-                                float(np.abs(a - a2).max())))
+        gone = np.flatnonzero(np.isnan(b[:, 0]))
+        rows.append(FidelityRow(t.name, name, duration, dt, float(np.abs(a - a[0]).max()),
+                                float(np.nanmax(np.abs(b - a))), _worst(c - a), _worst(c - c2), _worst(a - a2),
+                                float(gone[0] * dt) if gone.size else None, {"a": a, "b": b, "c": c}))
     return rows
+
+
+def _worst(x: np.ndarray) -> float:
+    """The largest deviation; inf where a run stopped early (NaN), NaN where it was not run."""
+    if np.all(np.isnan(x)):
+        return float("nan")
+    return float("inf") if np.any(np.isnan(x)) else float(np.abs(x).max())
 
 
 def table(rows: list[FidelityRow]) -> str:
@@ -171,7 +187,8 @@ def table(rows: list[FidelityRow]) -> str:
     lines = ["| transmission | profile | motion | (b) constant armature | (c) serial + ΔM + Δh | MuJoCo RK4 (dt vs dt/2) "
              "| pkm RK4 (dt vs dt/2) |", "|---|---|---|---|---|---|---|"]
     for r in rows:
-        lines.append(f"| {r.transmission} | {r.profile} | {r.motion:.3g} | {r.constant_armature:.2e} | {r.exact:.2e} "
+        left = f" (left the workspace at {r.left_workspace:.3g} s)" if r.left_workspace is not None else ""
+        lines.append(f"| {r.transmission} | {r.profile} | {r.motion:.3g} | {r.constant_armature:.2e}{left} | {r.exact:.2e} "
                      f"| {r.mujoco_integrator:.1e} | {r.pkm_integrator:.1e} |")
     return "\n".join(lines)
 

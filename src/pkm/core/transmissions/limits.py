@@ -87,6 +87,7 @@ def output_limits(t: Transmission, *, singularity: float = SINGULARITY, reach: f
     """The box limits of ``t``'s outputs and their feasible region (module doc); ``reach`` [rad or m] the largest
     distance searched from the reference, ``directions`` rays for two outputs."""
     sub = t.mechanism
+    binding: tuple[str, ...]
     if t.k == 1:
         ends, binding = _interval(t, singularity, reach, steps, tol)
         polygon: np.ndarray | None = ends[:, None]
