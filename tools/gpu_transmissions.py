@@ -164,8 +164,8 @@ def main() -> int:
     ap.add_argument("--device", default="cuda", help="Warp's device (default cuda; cpu to check the script)")
     ap.add_argument("--json", type=Path, help="write the results here too")
     args = ap.parse_args()
-    path, outputs = MECHANISMS["ankle"]
-    tk = TransmissionKernels(pkm.load(ROOT / path), outputs, iterations=args.iterations)
+    [t] = pkm.transmissions(pkm.load(ROOT / MECHANISMS["ankle"]))
+    tk = TransmissionKernels.of(t, iterations=args.iterations)
     fun = tk.function("fk_j_dm")
     Q0, QM = samples(tk, args.n)
     kernel = tk.kernel("fk_j_dm")

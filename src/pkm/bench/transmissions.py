@@ -12,7 +12,8 @@ the fused kernel ``fk_j_dm`` (:mod:`pkm.core.transmissions.kernels`, ``--iterati
 * ``jax``: ``jax.jit(jax.vmap(f))`` of the JAX translation (the ``jax`` extra; skipped without it), on JAX's CPU
   device (its threads);
 * ``warp_cpu``: the Warp kernel (the ``warp`` extra; skipped without it), one thread a sample on Warp's ``"cpu"``
-  device, structure-of-arrays (a GPU: ``tools/gpu_transmissions.py``);
+  device, structure-of-arrays (a GPU: ``tools/gpu_transmissions.py``); its compile time is the module's of every
+  kernel (as ``pkm transmission`` writes it);
 * ``python`` (the baseline, on ``--calls`` samples): :func:`pkm.close_loops` (warm-started the same way),
   :func:`pkm.forward_jacobian` and :func:`pkm.mass_matrix` per sample (the closed-loop ``M_a``, not ``ΔM``: the
   Python route to the same inputs of a simulator step).
@@ -32,9 +33,10 @@ import numpy as np
 
 from pkm.bench import best_time, main, median_us
 
-QUICK = {"n": 2000, "repeat": 1, "calls": 5, "mechanism": "knee"}
-MECHANISMS = {"ankle": ("examples/humanoid_ankle/ankle.closures.toml", ("ankle_pitch", "ankle_roll")),
-              "knee": ("examples/humanoid_knee/knee.closures.toml", ("knee",))}
+#: The quick run: the knee, the kernels' default iterations (the tests' kernels: their compiled C and Warp module are
+#: found in the caches).
+QUICK = {"n": 2000, "repeat": 1, "calls": 5, "mechanism": "knee", "iterations": 8}
+MECHANISMS = {"ankle": "examples/humanoid_ankle/ankle.closures.toml", "knee": "examples/humanoid_knee/knee.closures.toml"}
 SPREAD, TICK = 0.25, 0.01  # [rad]: the samples' spread around the reference, the warm start's distance
 GOAL_US = 0.3
 
@@ -63,9 +65,9 @@ def samples(tk, n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     qm_ref = tk.mech.actuated_q(tk.mech.q_reference)
     QM = qm_ref + rng.uniform(-SPREAD, SPREAD, (n, tk.k))
     before = QM - TICK * rng.choice([-1.0, 1.0], (n, tk.k))
-    from pkm.core.transmissions.kernels import TransmissionKernels
+    from pkm.core.transmissions.kernels import ITERATIONS, TransmissionKernels
 
-    cold = TransmissionKernels(tk.mech, tk.outputs, iterations=8)  # (from the reference: 5 needed)
+    cold = tk if tk.iterations >= ITERATIONS else TransmissionKernels(tk.mech, tk.outputs, name=tk.name)
     Q0 = cold.run("fk", np.tile(tk.mech.q_reference, (n, 1)), before)[0]
     return Q0, QM
 
@@ -75,9 +77,9 @@ def run(args) -> dict:
     from pkm.core.transmissions.kernels import TransmissionKernels
     from pkm.core.twin.kernels import _Kernel
 
-    path, outputs = MECHANISMS[args.mechanism]
-    mech = pkm.load(os.path.join(_root(), path))
-    tk = TransmissionKernels(mech, outputs, iterations=args.iterations)
+    mech = pkm.load(os.path.join(_root(), MECHANISMS[args.mechanism]))
+    [t] = pkm.transmissions(mech)
+    tk = TransmissionKernels.of(t, iterations=args.iterations)
     fun = tk.function("fk_j_dm")
     n = args.n
     Q0, QM = samples(tk, n)
@@ -118,11 +120,12 @@ def run(args) -> dict:
     try:
         import warp as wp
 
-        from pkm.core.twin.warpgen import warp_kernel
+        from pkm.core.transmissions.kernels import KERNELS
+        from pkm.core.twin.warpgen import warp_module
 
         wp.config.quiet = True  # type: ignore[attr-defined]
-        t0 = time.perf_counter()
-        kern = warp_kernel(fun)
+        t0 = time.perf_counter()  # (the module of every kernel, as pkm transmission writes it)
+        kern = getattr(warp_module([tk.function(k) for k in KERNELS]), fun.name())
         ins: list = [wp.array(np.ascontiguousarray(a.T), dtype=wp.float64, device="cpu") for a in (Q0, QM)]
         outs_w = [wp.zeros((fun.nnz_out(j), n), dtype=wp.float64, device="cpu") for j in range(fun.n_out())]
         wp.launch(kern, dim=n, inputs=ins, outputs=outs_w, device="cpu")
