@@ -52,6 +52,9 @@ def test_c_jax_and_warp_agree_on_every_kernel():
             assert np.abs(w[i] - ref).max() <= 1e-12 * scale, (name, fun.name_out(i), "warp")
         if name in ("fk", "ik", "fk_j_dm"):
             assert (c[KERNELS[name][1].index("status")] == 0).all()
+    q, qm = inputs["maps"][0][0], inputs["fk"][1][0]  # (JAX differentiates through the unrolled Newton: J)
+    dqo_dqm = jax.jacfwd(lambda x: tk.jax("fk")(q, x)[1])(qm)
+    assert abs(float(dqo_dqm[0, 0]) - float(tk.run("maps", q)[0][0])) <= 1e-10
 
 
 @pytest.mark.skipif(not (shutil.which("gcc") and shutil.which("g++")), reason="needs gcc and g++")
@@ -66,6 +69,8 @@ def test_the_c_library_and_the_cpp_class_round_trip(tmp_path):
                    cwd=tmp_path, check=True, capture_output=True)
     subprocess.run(["g++", "-std=c++17", "-O1", "-Wall", "-Wextra", "-Werror", "-o", "example", "example.cpp",
                     "foot.o", "-lm"], cwd=tmp_path, check=True, capture_output=True)
+    symbols = subprocess.run(["nm", "-u", "foot.o"], cwd=tmp_path, capture_output=True, text=True).stdout
+    assert not {"malloc", "calloc", "free", "printf", "fprintf"} & {line.split()[-1] for line in symbols.splitlines()}
     qm = tk.mech.actuated_q(tk.mech.q_reference) + np.array([0.12, -0.07])
     qdm, tau_m = np.array([0.3, -1.1]), np.array([2.0, -5.0])
     run = subprocess.run([str(tmp_path / "example"), *(repr(float(x)) for x in (*qm, *qdm, *tau_m))],
