@@ -58,7 +58,7 @@ from pkm.core.twin.kernels import PIVOT_FLOOR
 from pkm.core.twin.spatial import Expr
 from pkm.core.twin.tree import Twin
 from pkm.errors import InvalidInputError, SpecError, TransmissionError
-from pkm.validation import as_array, as_count
+from pkm.validation import as_array, as_count, as_tolerance
 
 #: Newton iterations unrolled in ``fk`` and ``ik``: on the humanoid ankle, 3 reach 1e-12 from a warm start 0.01 rad
 #: away (a controller's previous solution: 2 do not), 5 from the reference over ±0.25 rad of both motors (4 do not,
@@ -115,7 +115,7 @@ class TransmissionKernels:
         self.outputs = tuple(outputs)
         self.motors = tuple(mech.actuated_names)
         self.iterations = as_count(iterations, "iterations", high=100)
-        self.tol = float(tol)
+        self.tol = as_tolerance(tol, "tol")
         for o in self.outputs:
             j = mech.joints.get(o)
             if j is None or j.nq != 1 or j.nv != 1:
@@ -315,7 +315,7 @@ class TransmissionKernels:
 
 def _independent_rows(A: np.ndarray, rtol: float = 1e-9) -> list[int]:
     """Rows of ``A`` independent (a greedy Gram-Schmidt, the largest remaining row first), in order."""
-    rows, chosen = A.astype(float).copy(), []
+    rows, chosen = A.astype(float).copy(), list[int]()
     top = float(np.linalg.norm(A, axis=1).max(initial=0.0))
     for _ in range(min(A.shape)):
         norms = np.linalg.norm(rows, axis=1)
