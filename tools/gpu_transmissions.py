@@ -138,7 +138,7 @@ def warp_run(tk, fun, arrays: list[np.ndarray], repeat: int, device: str) -> tup
     """Warp on ``device``: ``(compile s, best ms, outputs sample-major)``."""
     import warp as wp
 
-    wp.config.quiet = True
+    wp.config.log_level = wp.LOG_WARNING
     t0 = time.perf_counter()
     kern = tk.warp("fk_j_dm")
     n = arrays[0].shape[0]

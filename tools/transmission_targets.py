@@ -70,7 +70,7 @@ def check(t, jax_on: bool, warp_on: bool) -> dict:
 
         from pkm.core.twin.warpgen import launch, warp_module
 
-        wp.config.quiet = True
+        wp.config.log_level = wp.LOG_WARNING
         t0 = time.perf_counter()
         module = warp_module([tk.function(n) for n in KERNELS])
         out["warp_vs_c"] = {n: max(float(np.abs(x - y).max()) for x, y in

@@ -123,7 +123,7 @@ def run(args) -> dict:
         from pkm.core.transmissions.kernels import KERNELS
         from pkm.core.twin.warpgen import warp_module
 
-        wp.config.quiet = True  # type: ignore[attr-defined]
+        wp.config.log_level = wp.LOG_WARNING  # (Warp prints its start to stdout: --json)
         t0 = time.perf_counter()  # (the module of every kernel, as pkm transmission writes it)
         kern = getattr(warp_module([tk.function(k) for k in KERNELS]), fun.name())
         ins: list = [wp.array(np.ascontiguousarray(a.T), dtype=wp.float64, device="cpu") for a in (Q0, QM)]
