@@ -127,6 +127,8 @@ def test_fk_reports_its_status_and_holds_the_warm_start():
     qm, q = states(tk, 3)
     _, _, status, residual = tk.run("fk", q, qm + 0.01)
     assert (status == 0).all() and residual.max() <= 1e-12
+    _, qo, status, _ = tk.run("fk", tk.mech.q_reference, qm)  # (one warm start for every sample)
+    assert qo.shape == (3, 1) and (status == 0).all()
     _, _, status, residual = tk.run("fk", q[0], np.array([qm[0, 0] + 3.0]))
     assert status[0] in (1.0, 2.0) and not residual[0] <= 1e-12
     with pytest.raises(InvalidInputError, match=r"qm.*non-finite"):

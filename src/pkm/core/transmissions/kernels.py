@@ -271,8 +271,9 @@ class TransmissionKernels:
         return _Kernel(self.function(kernel), False, True, None, None)
 
     def run(self, kernel: str, *args: ArrayLike) -> list[np.ndarray]:
-        """``kernel`` on a batch (each input ``(n, size)``) or one sample (each 1-D): its outputs, shaped alike
-        (matrices as their column-major nonzeros; a solve's status per sample, :data:`STATUS`).
+        """``kernel`` on a batch (each input ``(n, size)``, or 1-D: the same for every sample) or on one sample
+        (every input 1-D): its outputs, ``(n, size)`` each or 1-D (matrices as their column-major nonzeros; a solve's
+        status per sample, :data:`STATUS`).
 
         Raises:
             InvalidInputError: an input of the wrong size, or holding a NaN or an infinity.
@@ -288,8 +289,8 @@ class TransmissionKernels:
             arrays.append(np.ascontiguousarray(np.atleast_2d(a)))
         if len(arrays) != fun.n_in():
             raise InvalidInputError(kernel, f"takes {fun.n_in()} inputs {fun.name_in()}, got {len(arrays)}")
-        outs = self.kernel(kernel)(*arrays)
-        return [o[0] for o in outs] if np.ndim(args[0]) == 1 else outs
+        outs = self.kernel(kernel)(*arrays)  # (a one-sample input among batches: the same for every sample)
+        return [o[0] for o in outs] if all(np.ndim(x) == 1 for x in args) else outs
 
     def jax(self, kernel: str) -> Callable[..., tuple]:
         """``kernel`` as a jitted JAX function of one sample (:func:`pkm.core.twin.jaxgen.jax_function`; ``jax.vmap``
