@@ -73,7 +73,7 @@ column-major; statuses {', '.join(f'{i} `{s}`' for i, s in enumerate(STATUS))}.
 ## C and C++
 
 ```sh
-gcc -std=c99 -O2 -c {p}.c && g++ -std=c++17 -O2 -Wall -Werror example.cpp {p}.o -o example
+gcc -std=c99 -O2 -c {p}.c && g++ -std=c++17 -O2 -Wall -Werror example.cpp {p}.o -o example -lm
 ./example {example_args}    # the {tk.k} motors' positions [rad, m], then velocities, then efforts
 ```
 
@@ -97,18 +97,35 @@ class {cls}Plugin : public transmission_interface::Transmission {{
  public:
   void configure(const std::vector<transmission_interface::JointHandle>& joints,
                  const std::vector<transmission_interface::ActuatorHandle>& actuators) override {{
-    std::vector<pkm::Handle> j, a;  // the handles' names and interfaces, pointing at values this class owns
-    for (const auto& h : joints) {{ j_.push_back(h); j.push_back({{h.get_prefix_name(), h.get_interface_name(), &jv_[j.size()]}}); }}
-    for (const auto& h : actuators) {{ a_.push_back(h); a.push_back({{h.get_prefix_name(), h.get_interface_name(), &av_[a.size()]}}); }}
-    impl_.configure(j, a);
+    joints_ = joints;
+    actuators_ = actuators;
+    joint_values_.assign(joints.size(), 0.0);
+    actuator_values_.assign(actuators.size(), 0.0);
+    std::vector<pkm::Handle> j, a;  // the same names and interfaces, over values this class owns
+    for (std::size_t i = 0; i < joints.size(); ++i)
+      j.push_back({{joints[i].get_prefix_name(), joints[i].get_interface_name(), &joint_values_[i]}});
+    for (std::size_t i = 0; i < actuators.size(); ++i)
+      a.push_back({{actuators[i].get_prefix_name(), actuators[i].get_interface_name(), &actuator_values_[i]}});
+    impl_.configure(j, a);  // throws pkm::TransmissionError on handles that do not fit
   }}
-  void actuator_to_joint() override {{ copy_in(a_, av_); impl_.actuator_to_joint(); copy_out(j_, jv_); }}
-  void joint_to_actuator() override {{ copy_in(j_, jv_); impl_.joint_to_actuator(); copy_out(a_, av_); }}
+  void actuator_to_joint() override {{
+    for (std::size_t i = 0; i < actuators_.size(); ++i) actuator_values_[i] = actuators_[i].get_value();
+    impl_.actuator_to_joint();
+    for (std::size_t i = 0; i < joints_.size(); ++i) joints_[i].set_value(joint_values_[i]);
+  }}
+  void joint_to_actuator() override {{
+    for (std::size_t i = 0; i < joints_.size(); ++i) joint_values_[i] = joints_[i].get_value();
+    impl_.joint_to_actuator();
+    for (std::size_t i = 0; i < actuators_.size(); ++i) actuators_[i].set_value(actuator_values_[i]);
+  }}
   std::size_t num_actuators() const override {{ return impl_.num_actuators(); }}
   std::size_t num_joints() const override {{ return impl_.num_joints(); }}
+
  private:
-  // copy_in / copy_out: h.get_value() / h.set_value(x) for each handle (the handle API of your ros2_control
-  // release); jv_, av_: std::array<double, 3 * {tk.k}>; j_, a_: the handles.
+  // (get_value / set_value: the handle API of Humble and Iron; newer releases name them get_optional / set_value)
+  std::vector<transmission_interface::JointHandle> joints_;
+  std::vector<transmission_interface::ActuatorHandle> actuators_;
+  std::vector<double> joint_values_, actuator_values_;
   pkm::{cls} impl_;
 }};
 ```
