@@ -197,13 +197,31 @@ class TransmissionKernels:
         status = cs.if_else(pivot < PIVOT_FLOOR, 2.0, cs.if_else(residual <= self.tol, 0.0, 1.0))
         return q, status, residual
 
+    @staticmethod
+    def _rates(at: ActuatorTwin, rows: Sequence[int]) -> Expr:
+        """The joint rates ``rows`` per actuated rate of ``at``'s mechanism (its symbol ``qd``), the idle rates zero:
+        the closure's passive rates from the LU (rows that no idle motion moves: the outputs, the motors; the
+        mass-orthogonal idle rates of the model, :attr:`ActuatorTwin.v`, would bring its mass matrix in)."""
+        tw = at.tw
+        act = [int(c) for c in tw.mech.act_v]
+        v = cs.SX.zeros(tw.mech.nv)
+        for k, c in enumerate(act):
+            v[c] = tw.qd[k]
+        if at.lu is not None:
+            passive = -at.lu.solve(tw.closure_rows["jacobian"][:, act] @ tw.qd)
+            for k, c in enumerate(at.passive):
+                v[c] = passive[k]
+        return cs.jacobian(cs.vertcat(*[v[r] for r in rows]), tw.qd)
+
     @functools.cached_property
     def _maps(self) -> tuple[Expr, Expr, Expr]:
         """``(J, J_inv, pivot)`` in :attr:`q`."""
         am, ao = self._twin_m, self._twin_o
-        J = cs.jacobian(cs.vertcat(*[am.v[c] for c in self.output_v]), am.tw.qd)
-        J_inv = self._in_q(ao, cs.jacobian(cs.vertcat(*[ao.v[c] for c in self.motor_v]), ao.tw.qd))
-        return J, J_inv, cs.fmin(am.pivot, self._in_q(ao, ao.pivot))
+        J = self._rates(am, self.output_v)
+        J_inv = self._in_q(ao, self._rates(ao, self.motor_v))
+        pm = am.lu.smallest_relative_pivot() if am.lu is not None else cs.SX(1.0)
+        po = self._in_q(ao, ao.lu.smallest_relative_pivot()) if ao.lu is not None else cs.SX(1.0)
+        return J, J_inv, cs.fmin(pm, po)
 
     @classmethod
     def of(cls, transmission: Transmission, **options: int | float) -> TransmissionKernels:
