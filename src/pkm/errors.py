@@ -436,8 +436,9 @@ class TransmissionError(PkmError):
         reason: ``"no_loop"``, ``"outputs"`` (wrong count, not in the loop, not scalar, not a serial chain) or
             ``"singular"``.
         joints: The joints concerned (the outputs given, the motors, the joints that do not fit).
-        value: The number behind the refusal where there is one (the smallest singular value of the Jacobian
-            concerned, relative to its largest), else None.
+        value: The number behind a ``"singular"`` refusal: the largest motor component of a motion the outputs
+            leave free, or the closures' dependence among the outputs (relative, homogenised), or the motors'
+            :attr:`SingularityError.sigma_min`; None for the others.
     """
 
     def __init__(self, transmission: str, reason: str, message: str, joints: Iterable[str] = (),

@@ -46,6 +46,8 @@ EXPECTED = {
         ("foot_assembly_2", "shin_assembly_sym", ("motor_ankle1_left", "motor_ankle2_left"),
          ("ankley_left", "anklex_left"))],
     "talos_like": [("ankle", "knee", ("motor_shin",), ("free_ankle",))],
+    "cassie_like": [("foot_2", "tarsus", ("motor_ankle",), ("free_ankle",))],
+    "digit_like": [("foot_part", "tarsus", ("motor_shin1", "motor_shin2"), ("free_foot1", "free_foot2"))],
 }
 
 
@@ -162,7 +164,7 @@ def test_outputs_singular_at_the_reference_are_refused():
 
 
 def test_a_sub_mechanism_whose_chain_outnumbers_its_motors_is_refused_or_left_out():
-    cassie = pkm.load("gepetto:cassie_like")  # (the knee motor and the passive tarsus joint both carry the foot)
+    cassie = robot("cassie_like")  # (the knee motor and the passive tarsus joint both carry the foot)
     with pytest.raises(TransmissionError, match=r"2 outputs \['motor_knee', 'free_knee'\] for 1 motors"):
         pkm.transmissions(cassie)
     with pytest.warns(pkm.errors.PkmWarning, match="'tarsus'.*left out"):
@@ -200,3 +202,11 @@ def test_a_floating_base_is_held_at_the_reference_in_the_sub_mechanism(tmp_path)
     np.testing.assert_allclose(t.delta_mass(t.q_reference), fixed.delta_mass(fixed.q_reference), rtol=1e-12)
     g_tilted, g_upright = t.delta_bias(t.q_reference, [0.0]), fixed.delta_bias(fixed.q_reference, [0.0])
     assert abs(g_tilted[0] - g_upright[0]) > 1e-3 * abs(g_upright[0])  # (gravity as the tilted pelvis sees it)
+
+
+def test_a_robot_with_no_transmission_is_refused():
+    disney = pkm.load("gepetto:disney_like")  # (one sub-mechanism of five motors, its outputs singular)
+    with pytest.warns(pkm.errors.PkmWarning, match="singular at the reference.*left out"):
+        with pytest.raises(TransmissionError, match="no closed sub-mechanism that is a transmission") as err:
+            pkm.transmissions(disney, skip_unfit=True)
+    assert (err.value.transmission, err.value.reason) == ("disney_like", "no_loop")

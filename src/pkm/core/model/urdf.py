@@ -468,7 +468,8 @@ def _urdf_joint_kind(jm: pin.JointModel, where: str, source: str) -> tuple[str, 
         if None not in names and names[0] != names[1]:  # (about two of the frame's axes: [joint_types] says which)
             return "revolute", np.array(_AXES["Z"]), f"universal_{names[0]}{names[1]}".lower()
     raise SpecError(source, f"{where}: a Pinocchio {jm.shortname()} cannot be written as URDF (pkm writes revolute, "
-                            "prismatic, continuous, spherical, universal about two of the joint frame's axes, and free-flyer joints)")
+                            "prismatic, continuous, spherical, universal about two of the joint frame's axes, and "
+                            "free-flyer joints)")
 
 
 def _joint_motion(jm: pin.JointModel, value: float, where: str, source: str) -> pin.SE3:

@@ -13,10 +13,12 @@ The rules, in order:
 
    * named: ``outputs={name: [joint, ...]}``, else the spec's ``[transmission.<name>] outputs = [...]`` tables,
      give the transmission that contains those joints its name and its outputs;
-   * else the joints of the **chain**: for every closure, the side whose path from the root crosses no motor is the
-     chain (the foot hanging from the shank by pitch and roll); the outputs are the joints on the chains' paths,
-     in the model's order. Its name is the body the deepest chain ends on (the foot), made unique with ``_2``,
-     ``_3``, ... in the model's order.
+   * else the joints of the **chain**: (a) the sub-mechanism's joints that carry the rest of the robot (a joint
+     outside the sub-mechanism hangs below them: a knee four-bar's knee), every one of them; else (b) for every
+     closure, the side whose path from the root crosses no motor (the foot hanging from the shank by pitch and
+     roll), the first ``k`` joints of those paths in the model's order, ``k`` the number of motors (a rod's own
+     joints, modelled on the foot's side, come after). Its name is the body the chain ends on (the foot), made
+     unique with ``_2``, ``_3``, ... in the model's order.
 
    Every output is a one-coordinate joint of the sub-mechanism whose path to the root crosses outputs only (the
    serial model keeps it with the bodies it carries), there are as many as motors, and at the reference the outputs
@@ -29,8 +31,8 @@ The rules, in order:
    reference and a floating base held there), written as URDF (:func:`~pkm.core.model.urdf.urdf_from_model`) and
    built from it with a spec of its own: its closures, its motors as the actuated joints with the robot's drives
    (every field in ``[actuators.<motor>]``), its outputs as the task (``TaskSpec(components=(), joints=outputs)``),
-   the robot's reference. It has files and pickles. A joint whose position limits
-   are an empty interval (``lower >= upper``: Pinocchio's placeholder where a file states none) is unlimited there.
+   the robot's reference. It has files and pickles. A joint whose position limits are an empty interval (``lower >=
+   upper``: Pinocchio's placeholder where a file states none) is unlimited there.
 """
 
 from __future__ import annotations
