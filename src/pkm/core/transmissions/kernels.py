@@ -23,7 +23,8 @@ A transmission here is a mechanism ``mech`` (the closed sub-mechanism alone, ``a
 * ``delta`` ``(q, qdo) -> (dM, dh, pivot)``: what a serial-equivalent model lacks, in output coordinates: ``ΔM(q) =
   M_o - M_s`` (k x k) [kg m², kg] and ``Δh(q, qdot_o) = h_o - h_s`` (k) [N m, N];
 * ``fk_j_dm`` ``(q, qm) -> (q_out, qo, J, dM, status)``: ``fk`` then ``J`` and ``ΔM`` at its solution, fused (what a
-  learning simulator's step needs; :mod:`pkm.bench.transmissions` times it).
+  learning simulator's step needs; :mod:`pkm.bench.transmissions` times it); ``SINGULAR`` also where a solve of
+  ``J`` or ``ΔM`` has a pivot under the floor.
 
 Definitions. ``M_o``, ``h_o`` are the closed-loop model in output coordinates: the actuator-space model
 (:class:`~pkm.core.twin.dynamics.ActuatorTwin`, as :func:`pkm.mass_matrix`, :func:`pkm.bias_efforts`) of the same
@@ -261,10 +262,12 @@ class TransmissionKernels:
             out_o = cs.vertcat(*[q[i] for i in self.output_q])
             if kernel == "fk":
                 exprs = [q, out_o, status, residual]
-            else:
-                J, _, _ = self._maps
-                dM, _, _ = self._delta
-                exprs = [q, out_o, cs.substitute(J, self.q, q), cs.substitute(dM, self.q, q), status]
+            else:  # (J and ΔM at the solution; their solves' pivots under the floor make the status SINGULAR too)
+                J, _, p_maps = self._maps
+                dM, _, p_delta = self._delta
+                at_q = [cs.substitute(e, self.q, q) for e in (J, dM, cs.fmin(p_maps, p_delta))]
+                status = cs.if_else(at_q[2] < PIVOT_FLOOR, 2.0, status)
+                exprs = [q, out_o, at_q[0], at_q[1], status]
             sym: list[Expr] = [self.q, qm]
         elif kernel == "ik":
             q, status, residual = self._solve(self._twin_o, qo)
