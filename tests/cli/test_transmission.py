@@ -3,6 +3,7 @@ refuses as one error line."""
 
 from __future__ import annotations
 
+import importlib.util
 import json
 
 from pkm import cli
@@ -28,6 +29,12 @@ def test_transmission_writes_every_target(tmp_path, capsys):
     namespace: dict = {}
     exec(compile((folder / "left_knee_jax.py").read_text(), "left_knee_jax.py", "exec"), namespace)
     assert set(namespace) >= {"fk", "ik", "maps", "delta", "fk_j_dm", "functions"}
+    if importlib.util.find_spec("jax") is not None:  # (the written module runs: the velocity map at the reference)
+        from tests.core.transmissions.test_kernels import knee
+
+        tk = knee()
+        J = namespace["functions"]()["maps"](tk.mech.q_reference)[0]
+        assert abs(float(J[0]) - float(tk.run("maps", tk.mech.q_reference)[0][0])) <= 1e-12
 
 
 def test_what_it_refuses_is_one_error_line(tmp_path, capsys):
