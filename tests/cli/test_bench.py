@@ -28,7 +28,7 @@ def test_bench_quick_runs_every_benchmark_and_refuses_bad_arguments(tmp_path):
     out = json.loads(proc.stdout)
     assert sorted(out) == sorted(BENCHMARKS) == ["assembly", "batch", "designs", "dynamics", "export", "hexapod",
                                                  "identification", "kinematics", "opcount", "serve", "simulation",
-                                                 "simulation_speed", "sweep", "time_optimal", "twin", "workspace"]
+                                                 "simulation_speed", "sweep", "time_optimal", "transmissions", "twin", "workspace"]
     assert out["batch"]["mechanisms"]["prs3"]["bit_for_bit"]
     assert out["designs"]["gough_stewart"]["largest_difference"] <= 1e-12
     assert all(r["equals_serial"] for k, r in out["sweep"]["runs"].items() if k != "serial")

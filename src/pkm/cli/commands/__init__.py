@@ -26,6 +26,7 @@ from pkm.cli.commands import (
     simulate,
     spec,
     sweep,
+    transmission,
 )
 from pkm.cli.commands import list as list_
 from pkm.cli.commands import map as map_
@@ -49,6 +50,7 @@ COMMANDS: dict[str, Command] = {
     "spec": spec.COMMAND,
     "report": report.COMMAND,
     "serve": serve.COMMAND,
+    "transmission": transmission.COMMAND,
     "bench": bench.COMMAND,
     "sweep": sweep.COMMAND,
     "sweep plot": sweep.PLOT,

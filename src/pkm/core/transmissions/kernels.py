@@ -1,0 +1,360 @@
+"""Transmission kernels: a closed sub-mechanism's maps between its motors and its output joints, from ONE generator
+(the twin's CasADi expressions, :mod:`pkm.core.twin`) to three targets: C99
+(:func:`pkm.core.export.emit.c_function`), JAX (:func:`pkm.core.twin.jaxgen.jax_source`) and NVIDIA Warp
+(:mod:`pkm.core.twin.warpgen`); written out for a robot's software by :mod:`pkm.core.transmissions.targets`
+(``pkm transmission``).
+
+A transmission here is a mechanism ``mech`` (the closed sub-mechanism alone, ``actuated`` = its motors ``m``) and
+``k = na`` output joints ``o`` (one-coordinate joints of the tree: revolute or prismatic). The kernels
+(:data:`KERNELS`), each an SX function of one sample after CSE:
+
+* ``fk`` ``(q, qm) -> (q_out, qo, status, residual)``: motors to outputs. Newton on the closure with the motors set
+  to ``qm``, warm-started from ``q`` (the previous solution), :data:`ITERATIONS` iterations unrolled (no branch: one
+  instruction list for every target and every GPU thread); each step the twin's sparse LU of the passive columns
+  (pivots fixed at the reference) or, with idle motions (a rod spinning between two balls), the least-norm step
+  (:meth:`TransmissionKernels._newton`), at most :data:`MAX_STEP` long. ``residual`` is the largest closure
+  residual at ``q_out`` [m, rad];
+  ``status`` (:data:`STATUS`): 0 ``OK`` (``residual <= TOL``), 1 ``NOT_CONVERGED``, 2 ``SINGULAR`` (a pivot under
+  :data:`~pkm.core.twin.kernels.PIVOT_FLOOR` relative to the reference at some iteration);
+* ``ik`` ``(q, qo) -> (q_out, qm, status, residual)``: outputs to motors, the same Newton with the outputs held;
+* ``maps`` ``(q) -> (J, J_inv, pivot)``: the velocity map ``qdot_o = J qdot_m`` (k x k) and its inverse, each from
+  its own closure solve (motors driving, outputs driving); the effort maps are their transposes by power balance:
+  ``tau_m = Jᵀ tau_o`` and ``tau_o = J_invᵀ tau_m``;
+* ``delta`` ``(q, qdo) -> (dM, dh, pivot)``: what a serial-equivalent model lacks, in output coordinates: ``ΔM(q) =
+  M_o - M_s`` (k x k) [kg m², kg] and ``Δh(q, qdot_o) = h_o - h_s`` (k) [N m, N];
+* ``fk_j_dm`` ``(q, qm) -> (q_out, qo, J, dM, status)``: ``fk`` then ``J`` and ``ΔM`` at its solution, fused (what a
+  learning simulator's step needs; :mod:`pkm.bench.transmissions` times it); ``SINGULAR`` also where a solve of
+  ``J`` or ``ΔM`` has a pivot under the floor.
+
+Definitions. ``M_o``, ``h_o`` are the closed-loop model in output coordinates: the actuator-space model
+(:class:`~pkm.core.twin.dynamics.ActuatorTwin`, as :func:`pkm.mass_matrix`, :func:`pkm.bias_efforts`) of the same
+mechanism with the outputs as its actuated joints: ``M_o = G_oᵀ M G_o``, ``h_o = G_oᵀ (h + M Ġ_o qdot_o)`` with
+``G_o = ∂q/∂o`` (rotor armature and gravity included, idle motions mass-orthogonal). ``M_s``, ``h_s`` are the
+serial-equivalent model's (:func:`pkm.core.transmissions.coordinates.serial_tree`): the tree with every joint but the
+outputs massless (the rods, the cranks and the rotors dropped; each output hangs from the root through outputs only),
+as RNEA of the twin with only the outputs moving. Hence ``M_s + ΔM = M_o`` and ``h_s + Δh = h_o`` exactly, and
+``M_a = Jᵀ M_o J`` (tested against :func:`pkm.mass_matrix`, :func:`pkm.bias_efforts` and
+:class:`~pkm.core.transmissions.transmission.Transmission`'s Python reference).
+
+Every kernel takes and returns SI values in Pinocchio's conventions; arrays are the CasADi functions' nonzeros,
+matrices column-major. Equal across targets to 1e-12 in double precision (the tests).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import os
+from collections.abc import Callable, Sequence
+
+import casadi as cs
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.transmissions.transmission import Transmission
+from pkm.core.twin.dynamics import ActuatorTwin, cholesky, cholesky_solve
+from pkm.core.twin.kernels import PIVOT_FLOOR
+from pkm.core.twin.spatial import Expr
+from pkm.core.twin.tree import Twin
+from pkm.errors import InvalidInputError, SpecError, TransmissionError
+from pkm.validation import as_array, as_count, as_tolerance
+
+#: Newton iterations unrolled in ``fk`` and ``ik``: on the humanoid ankle, 3 reach 1e-12 from a warm start 0.01 rad
+#: away (a controller's previous solution: 2 do not), 5 from the reference over ±0.25 rad of both motors (4 do not,
+#: for 15% of the samples: ``NOT_CONVERGED``); 8 leave a margin.
+ITERATIONS = 8
+#: The largest Newton step [rad, characteristic lengths]: a longer one (from a guess near a singular configuration)
+#: is shortened to it; near the solution the step is Newton's. (From the reference, 8 iterations: the Talos-like
+#: ankle's FK converges for 200 of 200 motor positions within ±0.05 rad, its IK for 180 with this bound, 171 with
+#: 0.2 and 187 without; the humanoid ankle's and the battobot's every sample either way.)
+MAX_STEP = 0.5
+#: The largest closure residual at which a solve counts as converged [m, rad].
+TOL = 1e-12
+#: The status codes, in order from 0 (``INVALID_INPUT``: the C target's own check of its inputs, before the kernel).
+STATUS = ("OK", "NOT_CONVERGED", "SINGULAR", "INVALID_INPUT")
+
+#: Each kernel's inputs and outputs.
+KERNELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    "fk": (("q", "qm"), ("q_out", "qo", "status", "residual")),
+    "ik": (("q", "qo"), ("q_out", "qm", "status", "residual")),
+    "maps": (("q",), ("J", "J_inv", "pivot")),
+    "delta": (("q", "qdo"), ("dM", "dh", "pivot")),
+    "fk_j_dm": (("q", "qm"), ("q_out", "qo", "J", "dM", "status")),
+}
+
+
+def _driven(mech: Mechanism, actuated: Sequence[str]) -> Mechanism:
+    """``mech`` with ``actuated`` as its actuated joints (the same Pinocchio model, closures and reference)."""
+    out = Mechanism(mech.model, dataclasses.replace(mech.spec, actuated=tuple(actuated)), urdf=mech.urdf,
+                    source=mech.source)
+    out.q_reference = mech.q_reference.copy()
+    return out
+
+
+class TransmissionKernels:
+    """The transmission kernels of a closed sub-mechanism (see the module doc).
+
+    Args:
+        mech: The closed sub-mechanism, its actuated joints the motors.
+        outputs: The output joints (as many as motors; one-coordinate joints of ``mech``).
+        name: The transmission's name (default the mechanism's): C names, files.
+        iterations: Newton iterations unrolled in ``fk`` and ``ik``.
+        tol: Convergence tolerance of ``fk`` and ``ik`` on the largest closure residual [m, rad].
+
+    Raises:
+        TransmissionError: the outputs are not one-coordinate joints of ``mech``, are motors, are not as many as
+            the motors (``reason="outputs"``), or the motors or the outputs do not determine the sub-mechanism at the
+            reference (a closure solve without a pivot there, ``reason="singular"``).
+    """
+
+    def __init__(self, mech: Mechanism, outputs: Sequence[str], *, name: str | None = None,
+                 iterations: int = ITERATIONS, tol: float = TOL):
+        self.mech = check_mechanism(mech)
+        self.name = name or mech.name
+        self.outputs = tuple(outputs)
+        self.motors = tuple(mech.actuated_names)
+        self.iterations = as_count(iterations, "iterations", high=100)
+        self.tol = as_tolerance(tol, "tol")
+        for o in self.outputs:
+            j = mech.joints.get(o)
+            if j is None or j.nq != 1 or j.nv != 1:
+                raise TransmissionError(self.name, "outputs", f"output {o!r} is not a one-coordinate joint of the "
+                                        f"sub-mechanism (its joints: {sorted(mech.joints)})", (o,))
+            if o in self.motors:
+                raise TransmissionError(self.name, "outputs", f"output {o!r} is a motor", (o,))
+        if len(set(self.outputs)) != len(self.motors):
+            raise TransmissionError(self.name, "outputs", f"{len(set(self.outputs))} distinct outputs for "
+                                    f"{len(self.motors)} motors {list(self.motors)}", self.outputs)
+        try:
+            self.driven = _driven(mech, self.outputs)  # (the same mechanism, the outputs driving)
+            self._twin_m = ActuatorTwin(Twin(self.mech))
+            self._twin_o = ActuatorTwin(Twin(self.driven))
+        except SpecError as e:  # (a closure LU without a pivot at the reference)
+            raise TransmissionError(self.name, "singular", f"the motors {list(self.motors)} or the outputs "
+                                    f"{list(self.outputs)} do not determine the sub-mechanism at the reference "
+                                    f"({e.args[0] if e.args else e})", self.outputs) from None
+        self.q = self._twin_m.tw.q  # the one configuration symbol every kernel takes
+        self.qdo = self._twin_o.tw.qd  # the output rates' symbol
+        self.k = len(self.motors)
+        self.motor_q = [mech.joints[m].idx_q for m in self.motors]
+        self.output_q = [mech.joints[o].idx_q for o in self.outputs]
+        self.motor_v = [mech.joints[m].idx_v for m in self.motors]
+        self.output_v = [mech.joints[o].idx_v for o in self.outputs]
+
+    # ---------------------------------------------------------------- expressions
+    def _in_q(self, at: ActuatorTwin, expr: Expr) -> Expr:
+        """An expression of ``at``'s configuration symbol in terms of :attr:`q`."""
+        return cs.substitute(expr, at.tw.q, self.q) if at.tw.q is not self.q else expr
+
+    def _newton(self, at: ActuatorTwin) -> cs.Function:
+        """One closure Newton iteration of ``at``'s mechanism, its actuated joints held at ``target``:
+        ``(q, target) -> (q_next, pivot)``. Without idle motions the step solves the twin's sparse LU of the passive
+        columns (pivots fixed at the reference); with idle motions (a rod's spin) it is the least-norm step over
+        every passive coordinate (homogenised: lengths in characteristic lengths), ``A⁺ r = Aᵀ (A Aᵀ)⁻¹ r`` by a
+        Cholesky factorisation of ``A Aᵀ`` over the closure rows independent at the reference, as pkm's closure
+        solver steps: holding an idle coordinate instead fails where the idle motion turns away from it (the
+        Talos-like ankle's rods). A step longer than :data:`MAX_STEP` is shortened to it."""
+        tw = at.tw
+        mech = tw.mech
+        scale = mech.jacobian_scales.columns  # (a length in characteristic lengths)
+        r = tw.rotate_rows(tw.closure_residual)
+        if not at.idle:
+            cols = list(at.passive)
+            step = at.lu.solve(r) if at.lu is not None else cs.SX(0, 1)
+            pivot = at.pivot
+        else:
+            cols = sorted(at.passive + at.idle)
+            J = tw.closure_rows["jacobian"]
+            rows = _independent_rows(tw.at_reference(J[:, cols]) * scale[cols])
+            A = cs.horzcat(*[J[rows, c] * float(scale[c]) for c in cols])
+            L, diag = cholesky(A @ A.T)
+            step = cs.vertcat(*[float(scale[c]) for c in cols]) * (A.T @ cholesky_solve(L, r[rows]))
+            ref = tw.at_reference(cs.vertcat(*diag)).ravel()
+            pivot = cs.mmin(cs.vertcat(*[d * d / (x * x) for d, x in zip(diag, ref)]))
+        dq = cs.SX.zeros(mech.nv)
+        if cols:
+            size = cs.mmax(cs.vertcat(*[cs.fabs(step[k]) / float(scale[c]) for k, c in enumerate(cols)]))
+            factor = cs.fmin(1.0, MAX_STEP / size)  # (1 near the solution: the full Newton step)
+            for k, c in enumerate(cols):
+                dq[c] = -factor * step[k]
+        q_next = tw.retract(dq)
+        act = list(mech.act_q)
+        q_next = cs.vertcat(*[tw.target[act.index(i)] if i in act else q_next[i] for i in range(mech.nq)])
+        return cs.Function("newton", [tw.q, tw.target], [q_next, pivot])
+
+    def _solve(self, at: ActuatorTwin, target: Expr) -> tuple[Expr, Expr, Expr]:
+        """The unrolled Newton of ``at`` from :attr:`q` to ``target``: ``(q_out, status, residual)``."""
+        newton = self._newton(at)
+        tw = at.tw
+        act = list(tw.mech.act_q)
+        q = cs.vertcat(*[target[act.index(i)] if i in act else self.q[i] for i in range(tw.mech.nq)])
+        q, pivot = newton(q, target)
+        for _ in range(self.iterations - 1):
+            q, p = newton(q, target)
+            pivot = cs.fmin(pivot, p)
+        residual = cs.mmax(cs.fabs(cs.substitute(tw.closure_residual, tw.q, q)))
+        status = cs.if_else(pivot < PIVOT_FLOOR, 2.0, cs.if_else(residual <= self.tol, 0.0, 1.0))
+        return q, status, residual
+
+    @staticmethod
+    def _rates(at: ActuatorTwin, rows: Sequence[int]) -> Expr:
+        """The joint rates ``rows`` per actuated rate of ``at``'s mechanism (its symbol ``qd``), the idle rates zero:
+        the closure's passive rates from the LU (rows that no idle motion moves: the outputs, the motors; the
+        mass-orthogonal idle rates of the model, :attr:`ActuatorTwin.v`, would bring its mass matrix in)."""
+        tw = at.tw
+        act = [int(c) for c in tw.mech.act_v]
+        v = cs.SX.zeros(tw.mech.nv)
+        for k, c in enumerate(act):
+            v[c] = tw.qd[k]
+        if at.lu is not None:
+            passive = -at.lu.solve(tw.closure_rows["jacobian"][:, act] @ tw.qd)
+            for k, c in enumerate(at.passive):
+                v[c] = passive[k]
+        return cs.jacobian(cs.vertcat(*[v[r] for r in rows]), tw.qd)
+
+    @functools.cached_property
+    def _maps(self) -> tuple[Expr, Expr, Expr]:
+        """``(J, J_inv, pivot)`` in :attr:`q`."""
+        am, ao = self._twin_m, self._twin_o
+        J = self._rates(am, self.output_v)
+        J_inv = self._in_q(ao, self._rates(ao, self.motor_v))
+        pm = am.lu.smallest_relative_pivot() if am.lu is not None else cs.SX(1.0)
+        po = self._in_q(ao, ao.lu.smallest_relative_pivot()) if ao.lu is not None else cs.SX(1.0)
+        return J, J_inv, cs.fmin(pm, po)
+
+    @classmethod
+    def of(cls, transmission: Transmission, **options: int | float) -> TransmissionKernels:
+        """The kernels of a :class:`~pkm.core.transmissions.transmission.Transmission` (:func:`pkm.transmissions`):
+        its sub-mechanism, outputs and name (``options``: ``iterations``, ``tol``)."""
+        return cls(transmission.mechanism, transmission.outputs, name=transmission.name,
+                   **options)  # type: ignore[arg-type]
+
+    @functools.cached_property
+    def _delta(self) -> tuple[Expr, Expr, Expr]:
+        """``(ΔM, Δh, pivot)`` in :attr:`q` and the symbol :attr:`qdo`."""
+        ao = self._twin_o
+        M_o, h_o = self._in_q(ao, ao.mass_matrix), self._in_q(ao, ao.bias)
+        serial = Twin(self.mech)  # the serial-equivalent model: every joint but the outputs massless (serial_tree's)
+        keep = {self.mech.joints[n].id for n in self.outputs}
+        serial._inertia = [I if j in keep else pin.Inertia.Zero() for j, I in enumerate(serial._inertia)]
+        qdd_o = cs.SX.sym("qdd_o", self.k)
+        v, a = cs.SX.zeros(self.mech.nv), cs.SX.zeros(self.mech.nv)
+        for r, c in enumerate(self.output_v):
+            v[c], a[c] = self.qdo[r], qdd_o[r]
+        tau = cs.substitute(serial.rnea, cs.vertcat(serial.q, serial.v, serial.a), cs.vertcat(self.q, v, a))
+        tau = cs.vertcat(*[tau[c] for c in self.output_v])
+        M_s = cs.jacobian(tau, qdd_o)
+        M_s = cs.tril(M_s) + cs.tril(M_s, False).T  # (exactly symmetric, as the twin's M_a)
+        h_s = cs.substitute(tau, qdd_o, cs.DM.zeros(self.k))
+        return M_o - M_s, h_o - h_s, self._in_q(ao, ao.pivot)
+
+    @functools.cache  # noqa: B019  (one function per kernel for the life of the kernels)
+    def function(self, kernel: str) -> cs.Function:
+        """The CasADi SX function of ``kernel`` (:data:`KERNELS`), dense, after CSE: the one generator every target
+        is written from. Its name is ``<name>_<kernel>`` (C identifiers)."""
+        if kernel not in KERNELS:
+            raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", kernel)
+        qm, qo = cs.SX.sym("qm", self.k), cs.SX.sym("qo", self.k)
+        if kernel in ("fk", "fk_j_dm"):
+            q, status, residual = self._solve(self._twin_m, qm)
+            out_o = cs.vertcat(*[q[i] for i in self.output_q])
+            if kernel == "fk":
+                exprs = [q, out_o, status, residual]
+            else:  # (J and ΔM at the solution; their solves' pivots under the floor make the status SINGULAR too)
+                J, _, p_maps = self._maps
+                dM, _, p_delta = self._delta
+                at_q = [cs.substitute(e, self.q, q) for e in (J, dM, cs.fmin(p_maps, p_delta))]
+                status = cs.if_else(at_q[2] < PIVOT_FLOOR, 2.0, status)
+                exprs = [q, out_o, at_q[0], at_q[1], status]
+            sym: list[Expr] = [self.q, qm]
+        elif kernel == "ik":
+            q, status, residual = self._solve(self._twin_o, qo)
+            q = self._in_q(self._twin_o, q)
+            exprs = [q, cs.vertcat(*[q[i] for i in self.motor_q]), status, residual]
+            sym = [self.q, qo]
+        elif kernel == "maps":
+            exprs, sym = list(self._maps), [self.q]
+        else:
+            exprs, sym = list(self._delta), [self.q, self.qdo]
+        ins, outs = KERNELS[kernel]
+        values = cs.cse([cs.densify(cs.SX(e)) for e in exprs])
+        return cs.Function(f"{c_identifier(self.name)}_{kernel}", sym, values, list(ins), list(outs))
+
+    # ---------------------------------------------------------------- evaluation (the C batch, in process)
+    @functools.cache  # noqa: B019
+    def kernel(self, kernel: str) -> Callable[..., list[np.ndarray]]:
+        """``kernel`` compiled (the twin's C batch driver, its vector driver from 256 samples): ``f(*arrays) ->
+        outputs``, each an ``(n, nnz)`` array (numpy over samples without a C compiler)."""
+        from pkm.core.twin.kernels import _Kernel
+
+        return _Kernel(self.function(kernel), False, True, None, None)
+
+    def run(self, kernel: str, *args: ArrayLike) -> list[np.ndarray]:
+        """``kernel`` on a batch (each input ``(n, size)``, or 1-D: the same for every sample) or on one sample
+        (every input 1-D): its outputs, ``(n, size)`` each or 1-D (matrices as their column-major nonzeros; a solve's
+        status per sample, :data:`STATUS`).
+
+        Raises:
+            InvalidInputError: an input of the wrong size, or holding a NaN or an infinity.
+        """
+        fun = self.function(kernel)
+        arrays = []
+        for i, x in enumerate(args):
+            a = as_array(x, fun.name_in(i))
+            if a.ndim not in (1, 2) or a.shape[-1] != fun.nnz_in(i):
+                raise InvalidInputError(fun.name_in(i), f"expected ({fun.nnz_in(i)},) or (n, {fun.nnz_in(i)})", x)
+            if not np.isfinite(a).all():  # (the C target's INVALID_INPUT)
+                raise InvalidInputError(fun.name_in(i), "holds non-finite values", x)
+            arrays.append(np.ascontiguousarray(np.atleast_2d(a)))
+        if len(arrays) != fun.n_in():
+            raise InvalidInputError(kernel, f"takes {fun.n_in()} inputs {fun.name_in()}, got {len(arrays)}")
+        outs = self.kernel(kernel)(*arrays)  # (a one-sample input among batches: the same for every sample)
+        return [o[0] for o in outs] if all(np.ndim(x) == 1 for x in args) else outs
+
+    def jax(self, kernel: str) -> Callable[..., tuple]:
+        """``kernel`` as a jitted JAX function of one sample (:func:`pkm.core.twin.jaxgen.jax_function`; ``jax.vmap``
+        for batches, ``jax.grad`` differentiates it).
+
+        Raises:
+            MissingDependencyError: JAX is not installed (``pip install "pkm[jax]"``).
+        """
+        from pkm.core.twin.jaxgen import jax_function
+
+        return jax_function(self.function(kernel))
+
+    def warp(self, kernel: str, directory: str | os.PathLike[str] | None = None) -> object:
+        """``kernel`` as a Warp kernel (:func:`pkm.core.twin.warpgen.warp_kernel`).
+
+        Raises:
+            MissingDependencyError: Warp is not installed (``pip install "pkm[warp]"``).
+        """
+        from pkm.core.twin.warpgen import warp_kernel
+
+        return warp_kernel(self.function(kernel), directory)
+
+
+def _independent_rows(A: np.ndarray, rtol: float = 1e-9) -> list[int]:
+    """Rows of ``A`` independent (a greedy Gram-Schmidt, the largest remaining row first), in order."""
+    rows, chosen = A.astype(float).copy(), list[int]()
+    top = float(np.linalg.norm(A, axis=1).max(initial=0.0))
+    for _ in range(min(A.shape)):
+        norms = np.linalg.norm(rows, axis=1)
+        norms[chosen] = -1.0
+        i = int(np.argmax(norms))
+        if norms[i] <= rtol * top:
+            break
+        chosen.append(i)
+        u = rows[i] / norms[i]
+        rows = rows - np.outer(rows @ u, u)
+    return sorted(chosen)
+
+
+def c_identifier(name: str) -> str:
+    """``name`` as a C identifier (other characters as ``_``, a leading digit prefixed)."""
+    out = "".join(c if c.isalnum() or c == "_" else "_" for c in name)
+    return out if out and not out[0].isdigit() else f"t_{out}"
+
+
+__all__ = ["ITERATIONS", "KERNELS", "MAX_STEP", "STATUS", "TOL", "TransmissionKernels", "c_identifier"]

@@ -1,0 +1,50 @@
+"""``pkm transmission``: the folder a robot's software takes (C/C++, JAX, Warp), one a transmission, and what it
+refuses as one error line."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+
+from pkm import cli
+from tests.core.transmissions.robots import FILES
+
+KNEE = FILES["humanoid_knee"]
+
+
+def test_transmission_writes_every_target(tmp_path, capsys):
+    assert cli.main(["transmission", str(KNEE), "--out", str(tmp_path), "--outputs", "left_knee=knee",
+                     "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    [t] = out["transmissions"]
+    assert t["transmission"] == "left_knee" and t["motors"] == ["knee_motor"] and t["outputs"] == ["knee"]
+    assert t["files"] == sorted(["left_knee.h", "left_knee.c", "left_knee_transmission.hpp", "example.cpp",
+                                 "left_knee_jax.py", "left_knee_warp.py", "transmission.json", "README.md"])
+    folder = tmp_path / "left_knee"
+    described = json.loads((folder / "transmission.json").read_text())
+    assert described["motors"] == ["knee_motor"] and described["kernels"]["delta"]["outputs"] == {
+        "dM": 1, "dh": 1, "pivot": 1}
+    assert "class LeftKneeTransmission" in (folder / "left_knee_transmission.hpp").read_text()
+    assert "ros2_control is not installed" in (folder / "README.md").read_text()
+    namespace: dict = {}
+    exec(compile((folder / "left_knee_jax.py").read_text(), "left_knee_jax.py", "exec"), namespace)
+    assert set(namespace) >= {"fk", "ik", "maps", "delta", "fk_j_dm", "functions"}
+    if importlib.util.find_spec("jax") is not None:  # (the written module runs: the velocity map at the reference)
+        from tests.core.transmissions.test_kernels import knee
+
+        tk = knee()
+        J = namespace["functions"]()["maps"](tk.mech.q_reference)[0]
+        assert abs(float(J[0]) - float(tk.run("maps", tk.mech.q_reference)[0][0])) <= 1e-12
+
+
+def test_what_it_refuses_is_one_error_line(tmp_path, capsys):
+    assert cli.main(["transmission", "rrr3", "--out", str(tmp_path), "--outputs", "x=nope", "--targets", "c"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "joint 'nope' does not exist in rrr3" in err[0]
+    assert cli.main(["transmission", "rrr3", "--out", str(tmp_path), "--outputs", "x=elbow_1", "--targets", "c"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "transmission 'x'" in err[0], err
+    assert cli.main(["transmission", str(KNEE), "--out", str(tmp_path), "--targets", "c,fortran"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--targets: choose among c, jax, warp" in err[0]
+    assert not any(tmp_path.iterdir())

@@ -1,0 +1,90 @@
+"""The transmission kernels' three targets from one generator: compiled C, JAX (jit, vmap, jacfwd) and Warp (its
+CPU device) equal to 1e-12 on every kernel (the humanoid knee: small kernels, one Warp module compiled once; JAX's
+``fk`` checked within ``fk_j_dm``, and differentiated through); the C99 library and the C++17 class built strictly
+with gcc/g++ and run (the ankle's round trip); the extras named when missing. (Every test robot's transmissions:
+tools/transmission_targets.py; Warp on a GPU: tools/gpu_transmissions.py, not run here.)"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from pkm.core.transmissions.kernels import KERNELS
+from pkm.core.transmissions.targets import write_transmission
+from pkm.errors import MissingDependencyError
+from tests.core.transmissions.test_kernels import ankle, knee, states
+
+
+def _inputs(tk, n: int) -> dict[str, list[np.ndarray]]:
+    qm, q = states(tk, n, seed=4)
+    rng = np.random.default_rng(5)
+    warm = q + 1e-3 * rng.standard_normal(q.shape) * (np.arange(q.shape[1]) < 1)  # (a guess off the solution)
+    return {"fk": [warm, qm], "ik": [warm, q[:, tk.output_q]], "maps": [q],
+            "delta": [q, rng.uniform(-2, 2, (n, tk.k))], "fk_j_dm": [warm, qm]}
+
+
+def test_c_jax_and_warp_agree_on_every_kernel():
+    jax = pytest.importorskip("jax")
+    wp = pytest.importorskip("warp")
+    from pkm.core.twin.warpgen import warp_module
+
+    tk = knee()
+    inputs = _inputs(tk, 32)
+    module = warp_module([tk.function(k) for k in KERNELS])  # (as pkm transmission writes it: one compile)
+    for name, args in inputs.items():
+        fun = tk.function(name)
+        c = tk.run(name, *args)
+        j = c if name == "fk" else jax.vmap(tk.jax(name))(*args)  # (JAX's fk: within fk_j_dm, its compile saved)
+        ins = [wp.array(np.ascontiguousarray(a.T), dtype=wp.float64, device="cpu") for a in args]
+        outs = [wp.zeros((fun.nnz_out(i), len(args[0])), dtype=wp.float64, device="cpu") for i in range(fun.n_out())]
+        wp.launch(getattr(module, fun.name()), dim=len(args[0]), inputs=ins, outputs=outs, device="cpu")
+        w = [o.numpy().T for o in outs]
+        for i, ref in enumerate(c):
+            scale = max(1.0, float(np.abs(ref).max()))
+            assert np.abs(np.asarray(j[i]) - ref).max() <= 1e-12 * scale, (name, fun.name_out(i), "jax")
+            assert np.abs(w[i] - ref).max() <= 1e-12 * scale, (name, fun.name_out(i), "warp")
+        if name in ("fk", "ik", "fk_j_dm"):
+            assert (c[KERNELS[name][1].index("status")] == 0).all()
+    q, qm = inputs["maps"][0][0], inputs["fk"][1][0]  # (JAX differentiates through the unrolled Newton: J)
+    dqo_dqm = jax.jacfwd(lambda x: tk.jax("fk_j_dm")(q, x)[1])(qm)
+    assert abs(float(dqo_dqm[0, 0]) - float(tk.run("maps", q)[0][0])) <= 1e-10
+
+
+@pytest.mark.skipif(not (shutil.which("gcc") and shutil.which("g++")), reason="needs gcc and g++")
+def test_the_c_library_and_the_cpp_class_round_trip(tmp_path):
+    """``gcc -std=c99 -Wall -Wextra -Werror -pedantic`` and ``g++ -std=c++17 -Wall -Wextra -Werror`` build the
+    ankle's library and example; actuator positions, velocities and efforts -> joints (FK, J, J_inv^T) -> actuators
+    (IK, J_inv, J^T) equal the in-process kernels' and come back to 1e-12."""
+    tk = ankle()
+    files = write_transmission(tk, tmp_path, ["c"])
+    assert set(files) == {"foot.c", "foot.h", "foot_transmission.hpp", "example.cpp", "README.md", "transmission.json"}
+    subprocess.run(["gcc", "-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", "-pedantic", "-c", "foot.c"],
+                   cwd=tmp_path, check=True, capture_output=True)
+    subprocess.run(["g++", "-std=c++17", "-O1", "-Wall", "-Wextra", "-Werror", "-o", "example", "example.cpp",
+                    "foot.o", "-lm"], cwd=tmp_path, check=True, capture_output=True)
+    symbols = subprocess.run(["nm", "-u", "foot.o"], cwd=tmp_path, capture_output=True, text=True).stdout
+    assert not {"malloc", "calloc", "free", "printf", "fprintf"} & {line.split()[-1] for line in symbols.splitlines()}
+    qm = tk.mech.actuated_q(tk.mech.q_reference) + np.array([0.12, -0.07])
+    qdm, tau_m = np.array([0.3, -1.1]), np.array([2.0, -5.0])
+    run = subprocess.run([str(tmp_path / "example"), *(repr(float(x)) for x in (*qm, *qdm, *tau_m))],
+                         capture_output=True, text=True, check=True)
+    lines = dict(line.split(" ", 1) for line in run.stdout.strip().splitlines())
+    joint, back = (np.array(lines[k].split(), dtype=float) for k in ("joint", "actuator"))
+    q, qo, _, _ = tk.run("fk", tk.mech.q_reference, qm)
+    J, J_inv = (x.reshape(2, 2, order="F") for x in tk.run("maps", q)[:2])
+    assert np.abs(joint - np.concatenate([qo, J @ qdm, J_inv.T @ tau_m])).max() <= 1e-12
+    assert np.abs(back - np.concatenate([qm, qdm, tau_m])).max() <= 1e-12
+    bad = subprocess.run([str(tmp_path / "example"), "nan", *["0"] * 5], capture_output=True, text=True)
+    assert bad.returncode == 1 and "fk failed with status 3" in bad.stderr  # (INVALID_INPUT)
+
+
+@pytest.mark.parametrize("target, extra", [("jax", "jax"), ("warp", "warp")])
+def test_a_missing_extra_is_named(tmp_path, monkeypatch, target, extra):
+    monkeypatch.setitem(sys.modules, extra, None)
+    with pytest.raises(MissingDependencyError, match=rf'pkm\[{extra}\]'):
+        write_transmission(knee(), tmp_path, ["c", target])
+    assert not any(tmp_path.iterdir())  # (checked before anything is written)
