@@ -100,6 +100,7 @@ def test_shell_line_runs(line, tmp_path):
     if command == SELF:
         pytest.skip("the command that runs this test (CI runs it)")
     cwd = ROOT if command.startswith("make ") else tmp_path
+    (tmp_path / "examples").symlink_to(ROOT / "examples")  # (a reader in a clone: `examples/...` from its root)
     if "Ctrl-C" in line:
         proc = subprocess.Popen(["bash", "-c", f"exec {command}"], cwd=cwd, env=_env(), stdout=subprocess.PIPE,
                                 stderr=subprocess.PIPE, text=True, preexec_fn=default_sigint)
