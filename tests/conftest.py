@@ -16,15 +16,7 @@ import tempfile
 
 import pytest
 
-# Before numpy loads (pkm imports it below): one OpenBLAS thread per process, unless the caller chose otherwise.
-# The suite runs in two pytest-xdist workers on two cores; a multi-threaded OpenBLAS in each of them (two threads
-# each, which spin while they wait) made the identification's 360 x 248 SVDs 20 times dearer in CPU time than one
-# thread does (issue 44: the suite's time budget). The subprocesses the tests start inherit it. Results do not
-# depend on it beyond rounding (every check has its stated tolerance).
-for _variable in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(_variable, "1")
-
-from pkm.mechanisms import MechanismDefinition, module, register  # noqa: E402
+from pkm.mechanisms import MechanismDefinition, module, register
 
 register(MechanismDefinition("fivebar", "toy planar five-bar (tests only)", "tests.fivebar", task_scale=(0.03, 0.0, 0.0)))
 
