@@ -16,6 +16,14 @@ import tempfile
 
 import pytest
 
+# Before numpy loads (pkm imports it below), unless the caller set it: OpenBLAS's idle threads sleep at once instead of
+# spinning 2^28 cycles (its default) after each call. The suite runs two pytest-xdist workers on two cores, each with
+# OpenBLAS's threads (one a core): spinning threads took the CPU the other worker needed (tests/core/identification
+# with tests/cli/test_identify.py: 115 s of CPU -> 76 s alone, 136 s -> 75 s of wall). The thread count, hence every
+# result to the last bit, is unchanged (a thread count of 1 would change the SVDs' rounding, and the Delta's
+# identification acceptance row with it). The subprocesses the tests start inherit it.
+os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
+
 from pkm.mechanisms import MechanismDefinition, module, register
 
 register(MechanismDefinition("fivebar", "toy planar five-bar (tests only)", "tests.fivebar", task_scale=(0.03, 0.0, 0.0)))

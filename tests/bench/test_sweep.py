@@ -27,10 +27,10 @@ def test_the_peak_memory_is_in_megabytes():
 
 
 def test_options_and_quick_sizes():
-    """2048 designs at a 1 cm step by default; --quick 64 at 4 cm; the goals are 1.7 (speedup) and 5 % (overhead)."""
+    """2048 designs at a 1 cm step by default; --quick 16 at 4 cm; the goals are 1.7 (speedup) and 5 % (overhead)."""
     assert (arguments(bench_sweep, []).designs, arguments(bench_sweep, []).step) == (2048, 0.01)
     quick = arguments(bench_sweep, ["--quick"])
-    assert (quick.designs, quick.step) == (64, 0.04)
+    assert (quick.designs, quick.step) == (16, 0.04)
     assert (bench_sweep.GOAL_SPEEDUP, bench_sweep.GOAL_OVERHEAD) == (1.7, 0.05)
 
 

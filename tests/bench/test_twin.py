@@ -27,8 +27,8 @@ def test_the_path_is_smooth_and_consistent_around_the_reference(name, built):
 
 
 def test_quick_sizes_apply_to_the_options_not_given():
-    """--quick gives n 400, repeat 2, calls 200, except an option the command line sets."""
-    assert vars(arguments(twin, ["--quick"])) == {"json": False, "quick": True, "n": 400, "repeat": 2, "calls": 200}
+    """--quick gives n 100, repeat 1, calls 50, except an option the command line sets."""
+    assert vars(arguments(twin, ["--quick"])) == {"json": False, "quick": True, "n": 100, "repeat": 1, "calls": 50}
     assert arguments(twin, ["--quick", "-n", "50"]).n == 50
     assert arguments(twin, []).n == 20_000
 

@@ -33,7 +33,7 @@ import numpy as np
 from pkm.bench import main
 from pkm.bench.twin import _path
 
-QUICK = {"n": 4096, "repeat": 3, "mechanisms": "prs3"}
+QUICK = {"n": 1024, "repeat": 1, "mechanisms": "prs3"}
 MECHANISMS = ("prs3", "delta", "hexapod")
 GOALS_US = {"prs3": 0.06, "hexapod": 0.3}
 GOAL_SCALING = 1.8

@@ -30,7 +30,7 @@ import numpy as np
 from pkm._optional import require
 from pkm.bench import main
 
-QUICK = {"designs": 8, "nodes": 12, "check": 1, "rrr_designs": 8, "workers": 0}
+QUICK = {"designs": 2, "nodes": 8, "check": 1, "rrr_designs": 2, "workers": 0}
 GOAL_PER_DESIGN = 2.0
 GOAL_WALL_S = 600.0
 GOAL_RRR = 3.0

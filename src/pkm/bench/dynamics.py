@@ -29,7 +29,7 @@ from pkm.bench import best_time, main, median_us
 from pkm.core.dynamics.projection import forward_dynamics
 from pkm.mechanisms.prs3.dynamics import Prs3Dynamics, generate_c
 
-QUICK = {"n": 2000, "repeat": 40, "c_evaluations": 20000}
+QUICK = {"n": 500, "repeat": 10, "c_evaluations": 5000}
 
 HARNESS = r"""
 #include <stdio.h>

@@ -25,7 +25,7 @@ import numpy as np
 import pkm
 from pkm.bench import best_time
 
-QUICK = {"mechanism": "delta", "samples": 4000, "python_samples": 20, "no_base": True, "iterations": 3}
+QUICK = {"mechanism": "delta", "samples": 1000, "python_samples": 5, "no_base": True, "iterations": 1}
 
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:

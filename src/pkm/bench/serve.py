@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-QUICK = {"clients": 4, "duration": 0.5, "batch": 100, "stream": 100}
+QUICK = {"clients": 2, "duration": 0.2, "batch": 50, "stream": 50}
 MECHANISM = "delta"
 
 

@@ -25,7 +25,7 @@ import time
 from pkm._optional import require
 from pkm.bench import main
 
-QUICK = {"designs": 64, "step": 0.04}
+QUICK = {"designs": 16, "step": 0.04}
 GOAL_SPEEDUP = 1.7
 GOAL_OVERHEAD = 0.05
 

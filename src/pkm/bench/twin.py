@@ -26,7 +26,7 @@ import numpy as np
 
 from pkm.bench import best_time, main, median_us
 
-QUICK = {"n": 400, "repeat": 2, "calls": 200}
+QUICK = {"n": 100, "repeat": 1, "calls": 50}
 MECHANISMS = ("prs3", "delta", "hexapod")
 
 

@@ -27,7 +27,7 @@ from pkm.mechanisms import rrr3
 from pkm.mechanisms.rrr3 import workspace as maps
 from pkm.papers.rrr3 import paper_grid
 
-QUICK = {"sample": 50, "repeat": 1}
+QUICK = {"sample": 10, "repeat": 1}
 
 
 def _best(fn, repeat: int) -> float:
