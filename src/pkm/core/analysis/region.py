@@ -23,7 +23,7 @@ construction (a ray's first exit); a region with holes or a second component bey
 from __future__ import annotations
 
 import warnings
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -143,6 +143,32 @@ def _joint_of(mech: Mechanism, iq: int) -> str:
     return f"q[{iq}]"
 
 
+def march(at: Callable[[float, np.ndarray], tuple[np.ndarray | None, str]], q0: np.ndarray, reach: float,
+          steps: int, tol: float) -> tuple[float, str]:
+    """How far a ray stays feasible: ``at(r, q_seed)`` is the configuration at distance ``r`` (seeded with the last
+    feasible one) or None and what stops it; ``steps`` equal steps out to ``reach``, then a bisection to ``tol`` on
+    the first step that fails. Returns the last feasible distance and what stops the ray there (``"reach"``: nothing
+    within ``reach``). Shared by :func:`feasible_region` and the transmissions' output limits."""
+    r_in, q_in, why = 0.0, q0, "reach"
+    r_out = None
+    for step in range(1, steps + 1):
+        r = reach * step / steps
+        q, reason = at(r, q_in)
+        if q is None:
+            r_out, why = r, reason
+            break
+        r_in, q_in = r, q
+    if r_out is not None:
+        while r_out - r_in > tol:
+            r = 0.5 * (r_in + r_out)
+            q, reason = at(r, q_in)
+            if q is None:
+                r_out, why = r, reason
+            else:
+                r_in, q_in = r, q
+    return r_in, why
+
+
 def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[str, float] | None = None,
                     limits: Mapping[str, tuple[float, float]] | None = None, singularity: float = SINGULARITY,
                     reach: float = 1.0, directions: int = 36, steps: int = 20, tol: float = 1e-8) -> Region:
@@ -204,23 +230,10 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
     vertices, binding = [], []
     for a in angles:
         u = np.array([np.cos(a), np.sin(a)])
-        r_in, q_in, why = 0.0, q_center, "reach"
-        r_out = None
-        for step in range(1, n_steps + 1):
-            r = reach * step / n_steps
-            q, reason = at(center + r * u, q_in)
-            if q is None:
-                r_out, why = r, reason
-                break
-            r_in, q_in = r, q
-        if r_out is not None:
-            while r_out - r_in > tol:
-                r = 0.5 * (r_in + r_out)
-                q, reason = at(center + r * u, q_in)
-                if q is None:
-                    r_out, why = r, reason
-                else:
-                    r_in, q_in = r, q
+        def along(r: float, q0: np.ndarray, u: np.ndarray = u) -> tuple[np.ndarray | None, str]:
+            return at(center + r * u, q0)
+
+        r_in, why = march(along, q_center, reach, n_steps, tol)
         vertices.append(center + r_in * u)
         binding.append(why)
     cut = binding.count("reach")
@@ -230,4 +243,4 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
     return Region((axes[0], axes[1]), rest, center, np.array(vertices), tuple(binding), angles, singularity)
 
 
-__all__ = ["SINGULARITY", "Region", "feasible_region", "other_coordinates"]
+__all__ = ["SINGULARITY", "Region", "feasible_region", "march", "other_coordinates"]

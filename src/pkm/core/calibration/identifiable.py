@@ -28,14 +28,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike
 
 from pkm.core.calibration.measurement import CalibrationModel
+from pkm.core.identification.base import base_split
 from pkm.core.identification.rank import RankDecision, decide_rank
 from pkm.errors import InvalidInputError
-
-COEFFICIENT_TOL = 1e-6  # as the dynamic base parameters': coefficients of K under this on unit-norm columns dropped
 
 
 @dataclass(frozen=True)
@@ -119,23 +117,9 @@ def base_geometry(model: CalibrationModel, readings: ArrayLike, *, precise: bool
         raise InvalidInputError("readings", f"{len(M)} poses give {W.shape[0]} rows for {len(live)} parameters the "
                                             f"measurements see: give at least "
                                             f"{-(-len(live) // len(model.rows.labels))} poses", len(M))
-    Ws = W[:, live] / scale[live]
-    _, R, perm = scipy.linalg.qr(Ws, mode="economic", pivoting=True)
-    decision = decide_rank(np.abs(np.diag(R)))
-    r = decision.rank
-    K = scipy.linalg.solve_triangular(R[:r, :r], R[:r, r:]) if r < len(live) else np.zeros((r, 0))
-    ind, dep = live[perm[:r]], live[perm[r:]]
-    K[np.abs(K) < COEFFICIENT_TOL] = 0.0
-    K = K * scale[dep][None, :] / scale[ind][:, None]
-    order = np.argsort(ind)
-    from pkm.core.identification.base import _name
-
-    Pmap = np.zeros((r, p))
-    combos = []
-    for k, row in enumerate(order):
-        Pmap[k, ind[row]] = 1.0
-        Pmap[k, dep] = K[row]
-        combos.append(_name(names, int(ind[row]), [(int(j), float(c)) for j, c in zip(dep, K[row]) if c != 0.0]))
+    split = base_split(W, names)
+    decision, Pmap, combos, K = split.decision, split.P, split.names, split.K
+    ind, dep, order = split.independent, split.dependent, split.order
     unseen = tuple(names[k] for k in range(p) if k not in set(live))
     absorbed = {names[j]: tuple(names[int(ind[i])] for i in np.flatnonzero(K[:, c] != 0.0))
                 for c, j in enumerate(dep)}

@@ -89,6 +89,55 @@ def _coefficient(c: float) -> str:
     return f"{c:.6g}"
 
 
+@dataclass(frozen=True)
+class BaseSplit:
+    """The double-precision base decomposition of a regressor's columns (:func:`base_split`).
+
+    Attributes:
+        decision: The rank decision on the pivoted QR's diagonal.
+        live: The columns that are not zero (norm above 1e-12 times the largest).
+        independent: The independent columns, in pivot order; ``dependent``: the other live columns.
+        K: ``dependent = independent @ K`` (r x len(dependent)), coefficients under ``COEFFICIENT_TOL`` zeroed.
+        order: ``independent``'s rows in column order (the base parameters' order).
+        P: Each base combination's row over every column (r x n), in ``order``.
+        names: Each combination's readable name.
+    """
+
+    decision: RankDecision
+    live: np.ndarray
+    independent: np.ndarray
+    dependent: np.ndarray
+    K: np.ndarray
+    order: np.ndarray
+    P: np.ndarray
+    names: tuple[str, ...]
+
+
+def base_split(W: np.ndarray, names: tuple[str, ...]) -> BaseSplit:
+    """The base combinations of ``W``'s columns (named ``names``): a QR with column pivoting of the unit-norm live
+    columns, its rank decided by :func:`decide_rank`, the dependent columns as combinations of the independent ones
+    (back to unscaled columns). Shared by the dynamic base parameters and the geometric ones
+    (:mod:`pkm.core.calibration.identifiable`)."""
+    scale = np.linalg.norm(W, axis=0)
+    live = np.flatnonzero(scale > 1e-12 * scale.max())
+    Ws = W[:, live] / scale[live]
+    _, R, perm = scipy.linalg.qr(Ws, mode="economic", pivoting=True)
+    decision = decide_rank(np.abs(np.diag(R)))
+    r = decision.rank
+    K = scipy.linalg.solve_triangular(R[:r, :r], R[:r, r:]) if r < len(live) else np.zeros((r, 0))
+    ind, dep = live[perm[:r]], live[perm[r:]]
+    K[np.abs(K) < COEFFICIENT_TOL] = 0.0
+    K = K * scale[dep][None, :] / scale[ind][:, None]  # (back to unscaled columns)
+    order = np.argsort(ind)
+    Pmap = np.zeros((r, len(names)))
+    combos: list[str] = []
+    for row in order:
+        Pmap[len(combos), ind[row]] = 1.0
+        Pmap[len(combos), dep] = K[row]
+        combos.append(_name(names, int(ind[row]), [(int(j), float(c)) for j, c in zip(dep, K[row]) if c != 0.0]))
+    return BaseSplit(decision, live, ind, dep, K, order, Pmap, tuple(combos))
+
+
 def _name(names: tuple[str, ...], lead: int, terms: list[tuple[int, float]]) -> str:
     out = names[lead]
     for j, c in terms:
@@ -190,23 +239,9 @@ def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int 
     if tie_legs:
         T, names = leg_ties(P.names)
         W, theta = W @ T, np.linalg.pinv(T) @ P.values  # (a tied value: its legs' mean)
-    scale = np.linalg.norm(W, axis=0)
-    live = np.flatnonzero(scale > 1e-12 * scale.max())
-    Ws = W[:, live] / scale[live]
-    _, R, perm = scipy.linalg.qr(Ws, mode="economic", pivoting=True)
-    decision = decide_rank(np.abs(np.diag(R)))
-    r = decision.rank
-    K = scipy.linalg.solve_triangular(R[:r, :r], R[:r, r:]) if r < len(live) else np.zeros((r, 0))
-    ind, dep = live[perm[:r]], live[perm[r:]]
-    K[np.abs(K) < COEFFICIENT_TOL] = 0.0
-    K = K * scale[dep][None, :] / scale[ind][:, None]  # (back to unscaled columns)
-    order = np.argsort(ind)
-    Pmap = np.zeros((r, len(names)))
-    combos: list[str] = []
-    for row in order:
-        Pmap[len(combos), ind[row]] = 1.0
-        Pmap[len(combos), dep] = K[row]
-        combos.append(_name(names, int(ind[row]), [(int(j), float(c)) for j, c in zip(dep, K[row]) if c != 0.0]))
+    split = base_split(W, names)
+    decision, Pmap, combos = split.decision, split.P, split.names
+    ind, order = split.independent, split.order
     full = Pmap if T is None else Pmap @ np.linalg.pinv(T)
     second = None
     if precise:
@@ -217,5 +252,5 @@ def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int 
                           T, names if T is not None else (), second)
 
 
-__all__ = ["CLEAR_GAP", "BaseParameters", "RankDecision", "base_parameters", "decide_rank", "leg_ties",
-           "random_states"]
+__all__ = ["CLEAR_GAP", "BaseParameters", "BaseSplit", "RankDecision", "base_parameters", "base_split", "decide_rank",
+           "leg_ties", "random_states"]

@@ -22,7 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.analysis.region import SINGULARITY, _feasible, feasible_region
+from pkm.core.analysis.region import SINGULARITY, _feasible, feasible_region, march
+from pkm.core.model.joints import stated_limits
 from pkm.core.transmissions.transmission import Transmission
 from pkm.errors import PkmWarning
 
@@ -50,8 +51,7 @@ class OutputLimits:
 
 
 def _bounds(t: Transmission) -> tuple[np.ndarray, np.ndarray]:
-    model = t.mechanism.model
-    return np.array(model.lowerPositionLimit, dtype=float), np.array(model.upperPositionLimit, dtype=float)
+    return stated_limits(t.mechanism.model)
 
 
 def _interval(t: Transmission, singularity: float, reach: float, steps: int, tol: float) \
@@ -61,22 +61,10 @@ def _interval(t: Transmission, singularity: float, reach: float, steps: int, tol
     center = float(t.q_reference[t.out_q[0]])
     ends, why = [], []
     for sign in (-1.0, 1.0):
-        r_in, q_in, r_out, stop = 0.0, t.q_reference, None, "reach"
-        for step in range(1, steps + 1):
-            r = reach * step / steps
-            q, reason = _feasible(sub, {name: center + sign * r}, q_in, lo, hi, singularity)
-            if q is None:
-                r_out, stop = r, reason
-                break
-            r_in, q_in = r, q
-        if r_out is not None:
-            while r_out - r_in > tol:
-                r = 0.5 * (r_in + r_out)
-                q, reason = _feasible(sub, {name: center + sign * r}, q_in, lo, hi, singularity)
-                if q is None:
-                    r_out, stop = r, reason
-                else:
-                    r_in, q_in = r, q
+        def along(r: float, q0: np.ndarray, sign: float = sign) -> tuple[np.ndarray | None, str]:
+            return _feasible(sub, {name: center + sign * r}, q0, lo, hi, singularity)
+
+        r_in, stop = march(along, t.q_reference, reach, steps, tol)
         ends.append(center + sign * r_in)
         why.append(stop)
     return np.array(ends), (why[0], why[1])
