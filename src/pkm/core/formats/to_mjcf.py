@@ -228,25 +228,28 @@ def mjcf_qpos(mech: Mechanism, q: ArrayLike) -> np.ndarray:
         j = stack.pop()
         order.append(j)
         stack.extend(reversed(children[j]))
-    out: list[float] = []
-    for j in order:
-        jm = model.joints[j]
-        kind = jm.shortname().removeprefix("JointModel")
-        seg = q[jm.idx_q:jm.idx_q + jm.nq]
-        if kind == "FreeFlyer":
-            X = model.jointPlacements[j] * pin.XYZQUATToSE3(seg)
-            quat = pin.Quaternion(X.rotation)
-            out += [*X.translation, quat.w, quat.x, quat.y, quat.z]
-        elif kind == "Spherical":
-            out += [seg[3], seg[0], seg[1], seg[2]]
-        elif kind in ("RUBX", "RUBY", "RUBZ"):
-            out.append(float(np.arctan2(seg[1], seg[0])))
-        elif kind == "Mimic":
-            mimic = jm.extract()
-            out.append(float(mimic.offset + mimic.scaling * q[jm.idx_q]))
-        else:
-            out += list(seg)
-    return np.array(out)
+    return np.array([x for j in order for x in qpos_of(model, j, q)])
+
+
+def qpos_of(model: pin.Model, j: int, q: np.ndarray) -> list[float]:
+    """Joint ``j``'s entries of MuJoCo's ``qpos`` for Pinocchio's configuration ``q`` of ``model``: a free joint's
+    position and ``(w, x, y, z)`` quaternion in its parent's frame (its placement folded in), a ball's quaternion
+    reordered to ``(w, x, y, z)``, an unbounded revolute's angle, a mimic's value; the others as they are."""
+    jm = model.joints[j]
+    kind = jm.shortname().removeprefix("JointModel")
+    seg = q[jm.idx_q:jm.idx_q + jm.nq]
+    if kind == "FreeFlyer":
+        X = model.jointPlacements[j] * pin.XYZQUATToSE3(seg)
+        quat = pin.Quaternion(X.rotation)
+        return [*X.translation, quat.w, quat.x, quat.y, quat.z]
+    if kind == "Spherical":
+        return [seg[3], seg[0], seg[1], seg[2]]
+    if kind in ("RUBX", "RUBY", "RUBZ"):
+        return [float(np.arctan2(seg[1], seg[0]))]
+    if kind == "Mimic":
+        mimic = jm.extract()
+        return [float(mimic.offset + mimic.scaling * q[jm.idx_q])]
+    return list(seg)
 
 
 def closure_softness(timestep: float = TIMESTEP) -> tuple[tuple[float, float], tuple[float, ...]]:
@@ -308,4 +311,5 @@ def mimic_leader(model: pin.Model, j: int) -> int:
 
 
 __all__ = ["DAMPRATIO", "MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "TORQUESCALE", "body_names",
-           "closure_softness", "joint_axis", "mimic_leader", "mjcf_from_mechanism", "mjcf_omissions", "mjcf_qpos"]
+           "closure_softness", "joint_axis", "mimic_leader", "mjcf_from_mechanism", "mjcf_omissions", "mjcf_qpos",
+           "qpos_of"]

@@ -36,7 +36,7 @@ import pinocchio as pin
 from lxml import etree
 
 from pkm.core.analysis.region import SINGULARITY
-from pkm.core.formats.to_mjcf import MIN_INERTIA, MIN_MASS, TIMESTEP, _joints, _num, _pose
+from pkm.core.formats.to_mjcf import MIN_INERTIA, MIN_MASS, TIMESTEP, _joints, _num, _pose, qpos_of
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.urdf import urdf_from_model
 from pkm.core.transmissions.decompose import transmissions as find
@@ -173,16 +173,7 @@ def _mjcf(se: SerialEquivalent, timestep: float) -> str:
         etree.SubElement(body, "inertial", pos=_num(inertia.lever), mass=repr(max(float(inertia.mass), MIN_MASS)),
                          fullinertia=_num([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]))
         names = _joints(body, jm, name, se.robot.source)
-        seg = se.q_reference[jm.idx_q:jm.idx_q + jm.nq]
-        kind = jm.shortname().removeprefix("JointModel")
-        if kind == "FreeFlyer":
-            X = model.jointPlacements[j] * pin.XYZQUATToSE3(seg)
-            quat = pin.Quaternion(X.rotation)
-            qpos += [*X.translation, quat.w, quat.x, quat.y, quat.z]
-        elif kind == "Spherical":
-            qpos += [seg[3], seg[0], seg[1], seg[2]]
-        else:
-            qpos += list(seg)
+        qpos += qpos_of(model, j, se.q_reference)
         if jm.nv == 1:
             el = body.find(f"joint[@name='{names[0]}']")
             if name in se.limits:
