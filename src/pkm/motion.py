@@ -235,21 +235,32 @@ def write_motion(path: str | Path, coordinates: tuple[str, ...], name: str, t: n
     if space not in SPACES:
         raise InvalidInputError("space", f"use one of {list(SPACES)}", space)
 
-    def floats(x: np.ndarray) -> str:
-        return "[" + ", ".join(repr(float(v)) for v in x) + "]"
+    laws = {c: f'law = "hermite", t = {toml_floats(t - t[0])}, position = {toml_floats(P[:, j])}, '
+               f"velocity = {toml_floats(R[:, j])}" for j, c in enumerate(coordinates)}
+    return motion_file(path, name, laws, space=space, mechanism=mechanism, description=description, source=source,
+                       duration=float(t[-1]), dt=float(np.min(np.diff(t))))
 
+
+def toml_floats(x: np.ndarray) -> str:
+    """A TOML array of ``x``'s floats, each its ``repr`` (read back exactly)."""
+    return "[" + ", ".join(repr(float(v)) for v in np.ravel(x)) + "]"
+
+
+def motion_file(path: str | Path, case: str, laws: dict[str, str], *, space: str, mechanism: str, description: str,
+                source: str, duration: float, dt: float) -> Path:
+    """A motion file (module doc) of one case: ``laws`` maps each coordinate to its law's TOML fields (the text
+    inside its braces); the names and strings quoted as TOML basic strings. Shared by :func:`write_motion` and the
+    excitation's writer (:func:`pkm.core.identification.excitation.write_motion`)."""
     q = json.dumps  # (a JSON string is a TOML basic string)
     lines = [f'format = "{FORMAT}"', f"mechanism = {q(mechanism)}", f"space = {q(space)}",
-             "coordinates = [" + ", ".join(q(c) for c in coordinates) + "]", "", f"[case.{q(name)}]",
-             f"description = {q(description)}", f"source = {q(source)}",
-             f"duration = {float(t[-1])!r}", f"dt = {float(np.min(np.diff(t)))!r}"]
-    for j, c in enumerate(coordinates):
-        lines.append(f'{q(c)} = {{ law = "hermite", t = {floats(t - t[0])}, position = {floats(P[:, j])}, '
-                     f"velocity = {floats(R[:, j])} }}")
+             "coordinates = [" + ", ".join(q(c) for c in laws) + "]", "", f"[case.{q(case)}]",
+             f"description = {q(description)}", f"source = {q(source)}", f"duration = {float(duration)!r}",
+             f"dt = {float(dt)!r}"]
+    lines += [f"{q(c)} = {{ {law} }}" for c, law in laws.items()]
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return out
 
 
-__all__ = ["FORMAT", "LAWS", "SPACES", "Law", "Motion", "load_motions", "write_motion"]
+__all__ = ["FORMAT", "LAWS", "SPACES", "Law", "Motion", "load_motions", "motion_file", "toml_floats", "write_motion"]

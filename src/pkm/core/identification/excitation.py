@@ -326,28 +326,17 @@ def write_motion(mech: Mechanism, excitation: Excitation, path: str, *, periods:
                  case: str = "excitation") -> str:
     """The excitation as a motion file (:mod:`pkm.motion`, ``space = "actuated"``, one ``fourier`` law per actuated
     joint, the coefficients exact: ``repr`` of each float), ``periods`` periods sampled every ``dt`` [s]."""
-    from pathlib import Path
-
-    from pkm.motion import FORMAT
+    from pkm.motion import motion_file, toml_floats
 
     mech = check_mechanism(mech)
     step = excitation.t[1] - excitation.t[0] if dt is None else as_scalar(dt, "dt")
-    names = excitation.joints
-
-    def floats(x: np.ndarray) -> str:
-        return "[" + ", ".join(repr(float(v)) for v in x) + "]"
-
-    lines = [f'format = "{FORMAT}"', f'mechanism = "{mech.name}"', 'space = "actuated"',
-             "coordinates = [" + ", ".join(f'"{n}"' for n in names) + "]", "", f"[case.{case}]",
-             f'description = "optimal excitation: condition number {excitation.condition:.4g} (from '
-             f'{excitation.condition_start:.4g})"', 'source = "pkm.excite"',
-             f"duration = {as_count(periods, 'periods') * excitation.period!r}", f"dt = {float(step)!r}"]
-    for k, n in enumerate(names):
-        lines.append(f'{n} = {{ law = "fourier", offset = {float(excitation.offset[k])!r}, omega = '
-                     f'{excitation.omega!r}, a = {floats(excitation.a[k])}, b = {floats(excitation.b[k])} }}')
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    laws = {n: f'law = "fourier", offset = {float(excitation.offset[k])!r}, omega = {excitation.omega!r}, '
+               f"a = {toml_floats(excitation.a[k])}, b = {toml_floats(excitation.b[k])}"
+            for k, n in enumerate(excitation.joints)}
+    out = motion_file(path, case, laws, space="actuated", mechanism=mech.name,
+                      description=f"optimal excitation: condition number {excitation.condition:.4g} (from "
+                                  f"{excitation.condition_start:.4g})", source="pkm.excite",
+                      duration=as_count(periods, "periods") * excitation.period, dt=float(step))
     return str(out)
 
 
