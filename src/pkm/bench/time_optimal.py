@@ -20,6 +20,10 @@ def add_arguments(ap) -> None:
 
 
 def run(args) -> dict:
+    from pkm._optional import missing
+
+    if missing("plan"):  # (an installed wheel without the extra: said, as the other benchmarks say theirs)
+        return {"skipped": f"pip install \"pkm[plan]\" (missing: {', '.join(missing('plan'))})"}
     import pkm
     import pkm.core.timing.solve as solve_mod
     from pkm.core.timing.path import adept_waypoints
@@ -54,6 +58,8 @@ def run(args) -> dict:
 
 
 def table(r: dict) -> str:
+    if "skipped" in r:
+        return f"time-optimal planning: skipped ({r['skipped']})"
     return "\n".join([
         f"time-optimal planning, Delta 25/305/25 mm cycle, {r['points']} points",
         f"  compiled kernels : {r['compiled_s'] * 1e3:8.1f} ms  (toppra {r['toppra_s'] * 1e3:.1f} ms; target "
