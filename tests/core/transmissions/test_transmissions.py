@@ -210,3 +210,16 @@ def test_a_robot_with_no_transmission_is_refused():
         with pytest.raises(TransmissionError, match="no closed sub-mechanism that is a transmission") as err:
             pkm.transmissions(disney, skip_unfit=True)
     assert (err.value.transmission, err.value.reason) == ("disney_like", "no_loop")
+
+
+def test_maps_in_output_coordinates_refuse_a_state_where_the_outputs_are_singular():
+    """Away from the reference too: at the slider-crank's dead centre the slider held leaves the crank free, so no
+    map or model in output coordinates exists there; each raises (before: a least-squares answer, no word)."""
+    crank = pkm.load(FILES["slider_crank"])
+    (t,) = pkm.transmissions(crank)
+    dead = t.outputs_from_motors([0.0])[1]
+    for call in (t.inverse_effort_map, t.effort_map, t.delta_mass, lambda q: t.delta_bias(q, [0.1])):
+        with pytest.raises(pkm.errors.SingularityError, match="do not determine the sub-mechanism") as err:
+            call(dead)
+        assert err.value.kind == "outputs" and err.value.distance > 1e-3
+    t.inverse_effort_map(t.q_reference)  # (the same transmission at its reference: a map)

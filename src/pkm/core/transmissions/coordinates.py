@@ -34,11 +34,10 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core.differential.idle import joint_inertia, without_idle
+from pkm.core.differential.velocity import RTOL
 from pkm.core.kinematics import constraints
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import ConvergenceError
-
-RTOL = 1e-9  #: relative singular value below which ``J_d`` loses rank (on the homogenised Jacobian)
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from pkm.core.differential.velocity import forward_jacobian, inverse_jacobian
+from pkm.core.differential.velocity import RTOL, forward_jacobian, inverse_jacobian
 from pkm.core.kinematics.solve import close_loops, solve_ik
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.transmissions.coordinates import OutputSplit, output_model, output_split, serial_tree
@@ -128,23 +128,41 @@ class Transmission:
         the motors."""
         return inverse_jacobian(self.mechanism, q_sub)
 
+    def _held(self, sp: OutputSplit) -> OutputSplit:
+        """``sp``, or :class:`~pkm.errors.SingularityError` (kind ``"outputs"``) where the outputs do not determine
+        the sub-mechanism there (the test :meth:`check` makes at the reference, with the same bound
+        :data:`SINGULAR`): every map and model in output coordinates is undefined there, not a least-squares
+        answer."""
+        if sp.motor_leak > SINGULAR or sp.dependence > SINGULAR:
+            raise SingularityError("outputs", sp.sigma, f"transmission {self.name!r}: the outputs "
+                                   f"{list(self.outputs)} do not determine the sub-mechanism here (motor component of "
+                                   f"a free motion {sp.motor_leak:.3g}, dependence {sp.dependence:.3g})",
+                                   distance=max(sp.motor_leak, sp.dependence))
+        return sp
+
     def _split(self, q_sub: ArrayLike) -> OutputSplit:
-        return output_split(self.mechanism, self.mechanism.check_q(q_sub, "q_sub"), self.out_v,
-                            self.mechanism.act_v)
+        return self._held(output_split(self.mechanism, self.mechanism.check_q(q_sub, "q_sub"), self.out_v,
+                                       self.mechanism.act_v))
 
     def effort_map(self, q_sub: ArrayLike) -> np.ndarray:
         """``Jᵀ`` (k x k): the motor efforts ``τ_m = Jᵀ τ_o`` that hold the output efforts ``τ_o`` (the power balance)
         [N m or N], computed with the outputs independent (``J⁻ᵀ = Ĝ_mᵀ``, inverted: a second route to ``J``);
-        :class:`~pkm.errors.SingularityError` where the motors do not hold the outputs."""
-        Gm = self._split(q_sub).G[self.mechanism.act_v]
-        s = np.linalg.svd(Gm, compute_uv=False)
-        if s[-1] <= 1e-12 * s[0]:
-            raise SingularityError("direct", float(s[-1] / s[0]), f"transmission {self.name!r}: the motors do not "
-                                   "hold the outputs here: no motor efforts balance an output effort")
+        :class:`~pkm.errors.SingularityError` where the motors do not hold the outputs, decided as
+        :meth:`velocity_map` decides it (``Ĝ_m`` homogenised by the characteristic length, its relative smallest
+        singular value under :data:`pkm.core.differential.velocity.RTOL`)."""
+        sub = self.mechanism
+        Gm = self._split(q_sub).G[sub.act_v]
+        cols = sub.jacobian_scales.columns
+        s = np.linalg.svd(Gm * cols[self.out_v][None, :] / cols[sub.act_v][:, None], compute_uv=False)
+        if not s[-1] > RTOL * s[0]:
+            raise SingularityError("direct", float(s[-1]), f"transmission {self.name!r}: the motors do not hold the "
+                                   "outputs here: no motor efforts balance an output effort",
+                                   distance=float(s[-1] / s[0]) if s[0] > 0.0 else 0.0)
         return np.linalg.inv(Gm).T
 
     def inverse_effort_map(self, q_sub: ArrayLike) -> np.ndarray:
-        """``J⁻ᵀ`` (k x k): the output efforts ``τ_o = J⁻ᵀ τ_m`` the motor efforts ``τ_m`` produce [N m or N]."""
+        """``J⁻ᵀ`` (k x k): the output efforts ``τ_o = J⁻ᵀ τ_m`` the motor efforts ``τ_m`` produce [N m or N];
+        :class:`~pkm.errors.SingularityError` where the outputs do not determine the sub-mechanism."""
         return self._split(q_sub).G[self.mechanism.act_v].T
 
     # ------------------------------------------------------------------ dynamics in output coordinates
@@ -152,8 +170,9 @@ class Transmission:
         """``(M_o, h_o)``: the closed-loop model in output coordinates at ``q_sub`` and the output rates ``qd_o``
         (:mod:`pkm.core.transmissions.coordinates`) [kg m^2, N m]."""
         sub = self.mechanism
-        M, h, _ = output_model(sub, sub.check_q(q_sub, "q_sub"), as_vector(qd_o, self.k, "qd_o"), self.out_v,
-                               sub.act_v)
+        M, h, sp = output_model(sub, sub.check_q(q_sub, "q_sub"), as_vector(qd_o, self.k, "qd_o"), self.out_v,
+                                sub.act_v)
+        self._held(sp)
         return M, h
 
     @functools.cached_property
