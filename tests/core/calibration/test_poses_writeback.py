@@ -10,7 +10,7 @@ from pkm.core.calibration.estimate import calibrate
 from pkm.core.calibration.identifiable import stacked_jacobian
 from pkm.core.calibration.poses import calibration_poses, candidates
 from pkm.core.calibration.tolerance import tolerance_table
-from pkm.core.calibration.writeback import read_data, write_calibrated, write_data
+from pkm.core.calibration.writeback import SIZE_FACTOR, read_data, write_calibrated, write_data
 from tests.core.calibration.conftest import model, simulated
 
 
@@ -51,6 +51,12 @@ def test_bad_tables_are_refused_naming_row_and_column(tmp_path) -> None:
             read_data(m, bad)
     with pytest.raises(pkm.errors.InvalidInputError, match="missing column"):
         read_data(m, {"m.slider_1": [0.1]})
+    header = text[0].split(",")
+    away = 2.0 * SIZE_FACTOR * m.mech.characteristic_length  # (a tracker twice the size bound away from the base:
+    far = [",".join(str(float(v) + away) if header[k] in ("x", "y", "z") else v for k, v in enumerate(row.split(",")))
+           for row in text[1:]]  # its frame is estimated; before, every row was refused as a unit mistake)
+    (tmp_path / "far.csv").write_text("\n".join([text[0], *far]) + "\n")
+    assert np.allclose(read_data(m, tmp_path / "far.csv")[0], s.readings)
     with pytest.raises(pkm.errors.InvalidInputError, match=r"30 residuals for 34 base parameters: give more poses"):
         calibrate(m, s.readings[:5], s.measured[:5], base=s.cal.base)
 

@@ -104,10 +104,14 @@ def read_data(model: CalibrationModel, data: str | Path | dict[str, np.ndarray])
     for i, c in enumerate(meas):
         length = c in ("x", "y", "z") or (c.startswith("q.") and not mech.joints[c[2:]].revolute)
         cap = L if length else np.pi + 1e-9 if c in ("roll", "pitch", "yaw") else MAX_REVOLUTE
-        out = np.flatnonzero(np.abs(Y[:, i]) > cap)
+        # (a tracker's x, y, z are in its own frame, metres away from the base: their spread about the median is
+        # what the mechanism's size bounds, not their distance from the tracker)
+        about = float(np.median(Y[:, i])) if c in ("x", "y", "z") else 0.0
+        out = np.flatnonzero(np.abs(Y[:, i] - about) > cap)
         if out.size:
             r = int(out[0])
-            raise InvalidInputError(c, f"{source}, row {r + 1}, column {c!r}: {Y[r, i]:.6g} exceeds {cap:.6g} "
+            where = f" from the column's median {about:.6g}" if about else ""
+            raise InvalidInputError(c, f"{source}, row {r + 1}, column {c!r}: {Y[r, i]:.6g} is over {cap:.6g}{where} "
                                        f"{'m (ten times the mechanism' + chr(39) + 's size)' if length else 'rad'} (SI "
                                        f"units: is the table in {'mm' if length else 'degrees'}?)", Y[r, i])
     for k, qa in enumerate(M):  # (outside the workspace: the nominal mechanism does not close there)
