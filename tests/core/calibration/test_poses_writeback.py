@@ -117,3 +117,14 @@ def test_an_mjcf_mechanism_self_calibrates_and_is_written_back_as_mjcf_too(tmp_p
         angles.append(q[other.joints["coupler_joint"].idx_q])
     predicted = m.measure(cal.x, readings[:1])[0, m.sensors.index("coupler_joint")] - v["coupler_joint.offset"]
     assert abs(angles[0] - predicted) < 1e-10 and abs(angles[1] - predicted) < 1e-6
+
+
+def test_deviations_that_do_not_exist_are_refused() -> None:
+    """Enough rows but one pose repeated: the estimated parameters are not determined, and their deviations are
+    refused (before: a pseudo-inverse's finite, meaningless numbers, or an inverse of a singular matrix)."""
+    s = simulated("prs3")
+    n = len(s.cal.base) // 6 + 2  # (more rows than parameters, all from the first pose)
+    with pytest.raises(pkm.errors.SingularityError, match="not all determined by these poses") as err:
+        calibrate(s.model, np.repeat(s.readings[:1], n, axis=0), np.repeat(s.measured[:1], n, axis=0),
+                  base=s.cal.base)
+    assert err.value.kind == "calibration" and err.value.distance < 1e-10

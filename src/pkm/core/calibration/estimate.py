@@ -30,12 +30,15 @@ from numpy.typing import ArrayLike
 
 from pkm.core.calibration.identifiable import BaseGeometry, base_geometry
 from pkm.core.calibration.measurement import CalibrationModel
-from pkm.errors import ConvergenceError, InvalidInputError, PkmWarning, UnknownNameError
+from pkm.errors import ConvergenceError, InvalidInputError, PkmWarning, SingularityError, UnknownNameError
 
 #: The least squares stop when the cost or the step changes by less than this, relative.
 TOL = 1e-10
 #: The same for the trust-region method (bounds, robust losses), whose last steps are slower.
 TRF_TOL = 1e-8
+#: the relative smallest singular value of the Jacobian (unit columns) at the solution under which the estimated
+#: parameters' standard deviations are refused (SingularityError) rather than taken from a pseudo-inverse
+STD_RTOL = 1e-10
 LOSSES = ("linear", "soft_l1", "huber", "cauchy", "arctan")
 #: Default instrument standard deviations: a laser tracker's 10 µm and 20 µrad, an encoder's 20 µrad.
 SIGMA = {"m": 10e-6, "rad": 20e-6}
@@ -245,10 +248,15 @@ def calibrate(model: CalibrationModel, readings: ArrayLike, measured: ArrayLike,
     r, J = cached(sol.x)
     dof = rows - len(free)
     chi2 = float(r @ r / dof)
-    try:
-        cov = np.linalg.inv(J.T @ J) * chi2
-    except np.linalg.LinAlgError:
-        cov = np.linalg.pinv(J.T @ J) * chi2
+    scale = np.linalg.norm(J, axis=0)  # (unit columns: the conditioning of the parameters, not of their units)
+    _, sv, Vt = np.linalg.svd(J / np.where(scale > 0.0, scale, 1.0), full_matrices=False)
+    if not sv[-1] > STD_RTOL * sv[0]:  # (a pseudo-inverse would give finite, meaningless deviations: refused)
+        worst = free[int(np.argmax(np.abs(Vt[-1])))]
+        raise SingularityError("calibration", float(sv[-1]), f"the estimated parameters are not all determined by "
+                               f"these poses at the solution (most in the undetermined direction: "
+                               f"{model.names[worst]!r}): their deviations do not exist; give more or other poses",
+                               distance=float(sv[-1] / sv[0]))
+    cov = (Vt.T / sv**2) @ Vt / np.outer(scale, scale) * chi2
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     if loss == "linear" and chi2 > 9.0 and float(r0 @ r0) > 0.0:  # (a robust loss expects its outliers)
         warnings.warn(f"the calibrated model leaves residuals {np.sqrt(chi2):.3g} times the stated sigma (reduced "
