@@ -13,6 +13,7 @@ import pytest
 
 from pkm._optional import EXTRAS, missing, module, require
 from pkm.errors import InvalidInputError, MissingDependencyError, PkmError
+from tests import bounded
 
 #: Every module of every extra, blocked.
 BLOCKED = sorted({m for modules in EXTRAS.values() for m in modules} | {"dask.distributed"})
@@ -20,8 +21,7 @@ BLOCKED = sorted({m for modules in EXTRAS.values() for m in modules} | {"dask.di
 
 def _run(code: str, *args: str) -> subprocess.CompletedProcess:
     prelude = f"import sys\nfor _m in {BLOCKED!r}:\n    sys.modules[_m] = None\n"
-    return subprocess.run([sys.executable, "-c", prelude + textwrap.dedent(code), *args], capture_output=True,
-                          text=True, timeout=120)
+    return bounded.run([sys.executable, "-c", prelude + textwrap.dedent(code), *args], cpu=120)
 
 
 def test_the_core_works_and_each_extra_is_named_where_it_is_used(tmp_path):
