@@ -196,12 +196,12 @@ def test_a_controller_that_raises_or_is_missing(tmp_path, capsys):
 
 
 def test_parquet_without_pyarrow_names_the_extra(tmp_path, capsys, monkeypatch):
-    """Without pyarrow, a Parquet output is refused before the run, naming ``pip install "pkm[sweeps]"``; a CSV one
-    needs nothing."""
+    """Without pyarrow, a Parquet output is refused before the run, naming ``pip install "pkm-robotics[sweeps]"``; a
+    CSV one needs nothing."""
     monkeypatch.setitem(sys.modules, "pyarrow", None)
     (tmp_path / "T.csv").write_text("t,motor_1,motor_2,motor_3\n0,0,0,0\n")
     status, err = _error(capsys, "delta", "--torques", str(tmp_path / "T.csv"), "--out", str(tmp_path / "r.parquet"))
-    assert status == 1 and 'pip install "pkm[sweeps]"' in err and not (tmp_path / "r.parquet").exists()
+    assert status == 1 and 'pip install "pkm-robotics[sweeps]"' in err and not (tmp_path / "r.parquet").exists()
 
 
 def test_the_command_runs_as_a_process(tmp_path):

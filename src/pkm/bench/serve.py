@@ -64,7 +64,7 @@ def run(args) -> dict[str, Any]:
     from pkm._optional import missing
 
     if missing("serve"):
-        return {"skipped": f"pip install \"pkm[serve]\" (missing: {', '.join(missing('serve'))})"}
+        return {"skipped": f"pip install \"pkm-robotics[serve]\" (missing: {', '.join(missing('serve'))})"}
     import pkm
     from pkm.client import Client
     from pkm.serve.process import rss_mb, start

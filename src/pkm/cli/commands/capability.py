@@ -27,7 +27,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-gravity", action="store_true", help="leave the mechanism's weight out")
     p.add_argument("--axis", metavar="NAME=START:STOP:COUNT", action="append", default=[],
                    help="map the capability over this task coordinate (once or twice)")
-    p.add_argument("--png", metavar="FILE", help="with --axis: draw the largest isotropic value (pkm[figures])")
+    p.add_argument("--png", metavar="FILE",
+                   help="with --axis: draw the largest isotropic value (pkm-robotics[figures])")
     p.add_argument("--csv", metavar="FILE", help="with --axis: every node's indices")
     p.add_argument("--json", action="store_true", help="print JSON (SI, units per axis, the polytopes)")
 

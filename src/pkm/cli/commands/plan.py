@@ -41,11 +41,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "the drives' own peak efforts and speed limits)")
     p.add_argument("--points", metavar="N", type=int, default=1000, help="grid points along the path (default 1000)")
     p.add_argument("--out", metavar="FILE", required=True, help="the trajectory: CSV when FILE ends in .csv, else "
-                                                                "Parquet (pkm[sweeps])")
+                                                                "Parquet (pkm-robotics[sweeps])")
     p.add_argument("--motion", metavar="FILE.toml", help="the motors' motion as a pkm.motion file (hermite laws of "
                                                          "the actuated joints; default: FILE of --out with the "
                                                          "suffix .motion.toml)")
-    p.add_argument("--plot", metavar="FILE.png", help="the speed profile, the active limit marked (pkm[figures])")
+    p.add_argument("--plot", metavar="FILE.png",
+                   help="the speed profile, the active limit marked (pkm-robotics[figures])")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
 

@@ -350,7 +350,7 @@ class CapabilityMap:
         torque map) (1 axis: a curve; 2 axes: a colour map with its colour bar; unreachable nodes blank).
 
         Raises:
-            MissingDependencyError: matplotlib is not installed (``pip install "pkm[figures]"``).
+            MissingDependencyError: matplotlib is not installed (``pip install "pkm-robotics[figures]"``).
             InvalidInputError: an unknown unit or axis.
         """
         from pathlib import Path

@@ -122,7 +122,7 @@ def write(mech: Mechanism, sim: Simulation, path: str | Path) -> Path:
         The path written (its folder created).
 
     Raises:
-        MissingDependencyError: Parquet without pyarrow (``pip install "pkm[sweeps]"``).
+        MissingDependencyError: Parquet without pyarrow (``pip install "pkm-robotics[sweeps]"``).
         InvalidInputError: ``sim`` is not a simulation of ``mech``.
     """
     cols = columns(mech, sim)

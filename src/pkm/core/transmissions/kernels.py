@@ -318,7 +318,7 @@ class TransmissionKernels:
         for batches, ``jax.grad`` differentiates it).
 
         Raises:
-            MissingDependencyError: JAX is not installed (``pip install "pkm[jax]"``).
+            MissingDependencyError: JAX is not installed (``pip install "pkm-robotics[jax]"``).
         """
         from pkm.core.twin.jaxgen import jax_function
 
@@ -328,7 +328,7 @@ class TransmissionKernels:
         """``kernel`` as a Warp kernel (:func:`pkm.core.twin.warpgen.warp_kernel`).
 
         Raises:
-            MissingDependencyError: Warp is not installed (``pip install "pkm[warp]"``).
+            MissingDependencyError: Warp is not installed (``pip install "pkm-robotics[warp]"``).
         """
         from pkm.core.twin.warpgen import warp_kernel
 

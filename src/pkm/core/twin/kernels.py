@@ -404,7 +404,7 @@ class Kernels:
         output); mask on it.
 
         Raises:
-            MissingDependencyError: JAX is not installed (``pip install "pkm[jax]"``).
+            MissingDependencyError: JAX is not installed (``pip install "pkm-robotics[jax]"``).
         """
         from pkm.core.twin.jaxgen import jax_function
 
