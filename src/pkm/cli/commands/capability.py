@@ -16,6 +16,7 @@ import argparse
 import json
 from typing import Any
 
+import pkm
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, configuration, load_mechanism
 
@@ -44,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
         return _map(mech, args)
     q = configuration(mech, args)
     limits = limit_sources(mech)
-    out: dict[str, Any] = {"mechanism": mech.name, "task": mech.task_map.named(q),
+    out: dict[str, Any] = {"mechanism": mech.name, "task": pkm.TaskMap.of(mech).named(q),
                            "limits": {j: {f: {"value": v, "source": src} for f, (v, src) in row.items()
                                           if f != "peak_effort"} for j, row in limits.items()},
                            "placeholder_limits": any(w.kind == "limits" for w in findings(mech))}

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+import pkm
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, load_mechanism
 from pkm.errors import InvalidInputError
@@ -65,8 +66,9 @@ def read_path(mech: Mechanism, text: str, coordinates: str | None = None) -> tup
             start = [float(v) for v in text[6:].split(",")]
         except ValueError:
             raise InvalidInputError("--path", "adept:X,Y,Z: three numbers [m]", text) from None
-        if mech.task_map.value_names != ("x", "y", "z"):
-            raise InvalidInputError("--path", "the adept cycle is a path of a task x, y, z", mech.task_map.value_names)
+        task = pkm.TaskMap.of(mech).value_names
+        if task != ("x", "y", "z"):
+            raise InvalidInputError("--path", "the adept cycle is a path of a task x, y, z", task)
         return adept_waypoints(start), "task"
     file, case = text.rsplit(":", 1) if ".toml:" in text else (text, "")
     if file.endswith(".toml"):
@@ -84,9 +86,9 @@ def read_path(mech: Mechanism, text: str, coordinates: str | None = None) -> tup
     with path.open(newline="", encoding="utf-8") as fh:
         rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
     header = tuple(c.strip() for c in rows[0]) if rows else ()
-    spaces = {tuple(mech.task_map.value_names): "task", tuple(mech.actuated_names): "actuated"}
+    spaces = {tuple(pkm.TaskMap.of(mech).value_names): "task", tuple(mech.actuated_names): "actuated"}
     if header not in spaces:
-        raise InvalidInputError("--path", f"{file}: the header must read {','.join(mech.task_map.value_names)} "
+        raise InvalidInputError("--path", f"{file}: the header must read {','.join(pkm.TaskMap.of(mech).value_names)} "
                                           f"(task) or {','.join(mech.actuated_names)} (actuated)", header)
     try:
         values = np.array([[float(c) for c in r] for r in rows[1:]])
@@ -104,7 +106,7 @@ def columns(plan: TimeOptimal) -> dict[str, np.ndarray]:
         cols[f"{name}.rate"] = plan.qa_rate[:, i]
         cols[f"{name}.acceleration"] = plan.qa_acceleration[:, i]
         cols[f"{name}.effort"] = plan.efforts[:, i]
-    names = plan.mech.task_map.value_names if plan.path.space == "task" else ()
+    names = pkm.TaskMap.of(plan.mech).value_names if plan.path.space == "task" else ()
     for i, name in enumerate(names):
         cols[f"path.{name}"] = plan.coefficients.y[:, i]
     return cols
