@@ -104,10 +104,9 @@ def test_every_public_name_has_a_rendered_home():
         assert exported is None or obj in exported, f"pkm.{name}: {module}.{obj} is not in {module}.__all__"
 
 
-def test_deprecated_aliases_have_no_page():
+def test_private_modules_have_no_page():
     modules = _gen_pages().public_modules()
-    assert "pkm.core.kinematics.solve" in modules
-    assert "pkm.core.solve" not in modules  # (a deprecated alias of it)
+    assert "pkm.core.kinematics.solve" in modules and "pkm.core" in modules
     assert not any(part.startswith("_") for m in modules for part in m.split("."))
 
 

@@ -49,7 +49,7 @@ def test_wheel_ships_urdf_and_dynamics(tmp_path):
     """The wheel contains every reference design and the dynamics data under ``pkm/_data``."""
     subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps", "--no-build-isolation",
                     "-q", "-w", str(tmp_path)], check=True)
-    wheel = next(tmp_path.glob("pkm-*.whl"))
+    wheel = next(tmp_path.glob("pkm_robotics-*.whl"))
     shipped = set(zipfile.ZipFile(wheel).namelist())
     for name in names(with_files=True):
         assert f"pkm/_data/urdf/{name}.urdf" in shipped

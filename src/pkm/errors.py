@@ -386,19 +386,25 @@ class CompilerError(PkmError, RuntimeError):
         super().__init__(f"{what}: {how}")
 
 
+#: The distribution's name on PyPI (``pyproject.toml``'s ``[project] name``), in every ``pip install`` line pkm prints:
+#: ``pkm`` there is another project. It installs the ``pkm`` package (``import pkm``) and the ``pkm`` command.
+DISTRIBUTION = "pkm-robotics"
+
+
 class MissingDependencyError(PkmError, ImportError):
     """An optional dependency that a capability needs is not installed (raised where it is used, never at
     ``import pkm``; :mod:`pkm._optional` lists the extras).
 
     Attributes:
         package: The PyPI package to install.
-        extra: The pkm extra that installs it (``pip install "pkm[extra]"``).
+        extra: The pkm extra that installs it (``pip install "pkm-robotics[extra]"``).
     """
 
     def __init__(self, package: str, extra: str, what: str):
         self.package = package
         self.extra = extra
-        super().__init__(f"{what} needs {package}, which pkm's {extra!r} extra installs: pip install \"pkm[{extra}]\"")
+        super().__init__(f"{what} needs {package}, which pkm's {extra!r} extra installs: "
+                         f"pip install \"{DISTRIBUTION}[{extra}]\"")
 
 
 class StructureError(PkmError):

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+import pkm
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError
 from pkm.validation import as_array
@@ -69,7 +70,7 @@ class Stream:
             r = close_loops(self.mech, qa, self.q)
             q, residual = r.q, r.residual
         self.q = q
-        out: dict[str, Any] = {"q": q, "y": self.mech.task_map.value(q), "residual": residual}
+        out: dict[str, Any] = {"q": q, "y": pkm.TaskMap.of(self.mech).value(q), "residual": residual}
         if qd is not None:
             if K is not None:
                 J = K.kernel("forward_jacobian")(q[None])[0].reshape(-1, self.mech.na, order="F")

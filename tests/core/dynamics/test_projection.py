@@ -215,7 +215,7 @@ def test_an_idle_motion_changes_no_effort():
     from tests.fivebar import inverse_kinematics
 
     spin, plain = _fivebar_with_spinning_rod()
-    y = plain.task_map.value(plain.q_reference) + np.array([0.01, -0.02])
+    y = pkm.TaskMap.of(plain).value(plain.q_reference) + np.array([0.01, -0.02])
     q0 = plain.q_from_dict(inverse_kinematics(plain.params, y))
     q1 = spin.q_from_dict({**inverse_kinematics(plain.params, y), "spin_1": [0.7]})
     qd, qdd = np.array([0.3, -0.2]), np.array([1.0, 0.5])

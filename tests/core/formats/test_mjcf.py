@@ -113,7 +113,7 @@ def test_a_spec_may_name_an_mjcf_file_and_add_a_task(tmp_path):
     spec.write_text('format = "pkm.closures/1"\nmechanism = "fb"\nurdf = "fourbar.xml"\nend_effector = "coupler_point"\n'
                     'actuated = ["crank_joint"]\n[task]\ncomponents = ["x"]\n')
     mech = pkm.load(spec)
-    assert [c.name for c in mech.spec.closures] == ["pin_c"] and mech.task_map.names == ("x",)
+    assert [c.name for c in mech.spec.closures] == ["pin_c"] and pkm.TaskMap.of(mech).names == ("x",)
     clash = spec.read_text() + '[[closure]]\nname = "pin_c"\ntype = "point"\nframe_a = "crank"\nframe_b = "rocker"\n'
     spec.write_text(clash)
     with pytest.raises(SpecError, match="'pin_c' is both in the spec"):

@@ -85,6 +85,6 @@ def test_the_c_library_and_the_cpp_class_round_trip(tmp_path):
 @pytest.mark.parametrize("target, extra", [("jax", "jax"), ("warp", "warp")])
 def test_a_missing_extra_is_named(tmp_path, monkeypatch, target, extra):
     monkeypatch.setitem(sys.modules, extra, None)
-    with pytest.raises(MissingDependencyError, match=rf'pkm\[{extra}\]'):
+    with pytest.raises(MissingDependencyError, match=rf'pkm-robotics\[{extra}\]'):
         write_transmission(knee(), tmp_path, ["c", target])
     assert not any(tmp_path.iterdir())  # (checked before anything is written)

@@ -29,7 +29,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--model", default="pose", choices=("pose", "position", "planar", "passive"), help=KIND_HELP)
     p.add_argument("--loss", default="linear", choices=("linear", "soft_l1", "huber", "cauchy", "arctan"),
                    help="least-squares loss: linear (Levenberg-Marquardt) or a robust one (trust-region)")
-    p.add_argument("--plot", metavar="FILE.png", help="the residuals before and after, per pose (pkm[figures])")
+    p.add_argument("--plot", metavar="FILE.png",
+                   help="the residuals before and after, per pose (pkm-robotics[figures])")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
 
 

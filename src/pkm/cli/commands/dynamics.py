@@ -42,7 +42,7 @@ def model_dict(mech: pkm.Mechanism, model: ActuatorSpaceModel) -> dict[str, Any]
         "mechanism": mech.name,
         "actuated": dict(zip(names, mech.actuated_q(model.q))),
         "rates": dict(zip(names, model.qd)),
-        "task": mech.task_map.named(model.q),
+        "task": pkm.TaskMap.of(mech).named(model.q),
         "M": {a: dict(zip(names, row)) for a, row in zip(names, model.M)},
         "h": dict(zip(names, model.h)),
         "g": dict(zip(names, model.g)),
@@ -51,7 +51,7 @@ def model_dict(mech: pkm.Mechanism, model: ActuatorSpaceModel) -> dict[str, Any]
         "units": {
             "actuated": {n: "rad" if r else "m" for n, r in zip(names, revolute)},
             "rates": {n: "rad/s" if r else "m/s" for n, r in zip(names, revolute)},
-            "task": {k: "rad" if kind == "angle" else "m" for k, kind in mech.task_map.kinds.items()},
+            "task": {k: "rad" if kind == "angle" else "m" for k, kind in pkm.TaskMap.of(mech).kinds.items()},
             "M": {a: {b: _mass_unit(ra, rb) for b, rb in zip(names, revolute)} for a, ra in zip(names, revolute)},
             "h": effort, "g": effort, "friction": effort,
             "note": "M_a qdd + h_a = tau_a + friction; h_a: Coriolis, centrifugal, gravity and closure-drift efforts, "

@@ -2,8 +2,8 @@
 [--cutoff HZ] [--plot FILE.png] [--json]``: the dynamic parameters of a mechanism from its measurements (a table of
 ``time``, ``q.<joint>``, ``tau.<joint>``: :mod:`pkm.core.identification.measurements`): the base parameters by
 Gautier's weighted least squares with each one's relative standard deviation, with ``--consistent`` the physically
-consistent estimate (cvxpy and Clarabel: ``pkm[identify]``), written as a spec and URDF that ``pkm.load`` reads; with
-``--validate`` the identified model's efforts against a second table.
+consistent estimate (cvxpy and Clarabel: ``pkm-robotics[identify]``), written as a spec and URDF that ``pkm.load``
+reads; with ``--validate`` the identified model's efforts against a second table.
 
 The table printed (and ``base`` in ``--json``) holds, per base parameter, its value in the model written (``value``:
 ``P θ`` of the spec and URDF saved, so the consistent estimate's with ``--consistent``; an effort offset is not
@@ -28,10 +28,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("data", metavar="DATA", help="measurements: CSV or Parquet with time, q.<joint>, tau.<joint>")
     p.add_argument("--out", metavar="FILE.closures.toml", required=True, help="the identified spec (URDF beside it)")
     p.add_argument("--tie-legs", action="store_true", help="one parameter set per kind of leg")
-    p.add_argument("--consistent", action="store_true", help="physically consistent estimate (pkm[identify])")
+    p.add_argument("--consistent", action="store_true", help="physically consistent estimate (pkm-robotics[identify])")
     p.add_argument("--validate", metavar="OTHER", help="a second table to predict")
     p.add_argument("--cutoff", type=float, help="the zero-phase filter's cutoff [Hz] (default: a tenth of the rate)")
-    p.add_argument("--plot", metavar="FILE.png", help="measured against predicted efforts (pkm[figures])")
+    p.add_argument("--plot", metavar="FILE.png", help="measured against predicted efforts (pkm-robotics[figures])")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
 
 

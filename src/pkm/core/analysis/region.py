@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PkmError, PkmWarning
@@ -126,7 +127,7 @@ def other_coordinates(mech: Mechanism, axes: object, fixed: Mapping[str, float] 
     """
     if fixed is not None and not isinstance(fixed, Mapping):
         raise InvalidInputError("fixed", "expected {task coordinate: value}", fixed)
-    reference = mech.task_map.named(mech.q_reference)
+    reference = TaskMap.of(mech).named(mech.q_reference)
     rest = {k: float(x) for k, x in reference.items() if k not in axes}  # type: ignore[operator]
     for k, x in (fixed or {}).items():
         if k not in rest:
@@ -190,7 +191,7 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
         (1.762, True)
     """
     mech = check_mechanism(mech)
-    names = list(mech.task_map.kinds)
+    names = list(TaskMap.of(mech).kinds)
     if not isinstance(axes, (tuple, list)) or len(axes) != 2 or axes[0] == axes[1] or any(a not in names
                                                                                         for a in axes):
         raise InvalidInputError("axes", f"expected two distinct task coordinates among {names}", axes)
@@ -216,7 +217,7 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
         lo[jm.idx_q:jm.idx_q + jm.nq] = low
         hi[jm.idx_q:jm.idx_q + jm.nq] = high
     rest = other_coordinates(mech, axes, fixed)
-    reference = mech.task_map.named(mech.q_reference)
+    reference = TaskMap.of(mech).named(mech.q_reference)
     center = np.array([reference[axes[0]], reference[axes[1]]], dtype=float)
 
     def at(point: np.ndarray, q0: np.ndarray) -> tuple[np.ndarray | None, str]:

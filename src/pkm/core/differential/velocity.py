@@ -42,7 +42,9 @@ from pkm.core.differential.idle import joint_inertia, without_idle
 from pkm.core.differential.indices import singularity_class
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.validation import as_tolerance, as_vector, finite_result
 
@@ -111,7 +113,7 @@ class _Split:
 
     @classmethod
     def of(cls, mech: Mechanism, Jc: np.ndarray, Jt: np.ndarray, rtol: float) -> _Split:
-        scales = mech.jacobian_scales
+        scales = JacobianScales.of(mech)
         Jc, Jt, col = scales.constraint(Jc), scales.task(Jt), scales.columns
         pv, nv = mech.passive_v, mech.nv
         Jp, Jtp = Jc[:, pv], Jt[:, pv]
@@ -426,7 +428,7 @@ def task_acceleration(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLik
     """
     mech, c = _at(mech, q)
     v, a = mech.check_v(v), mech.check_v(a, "a")
-    return finite_result(c.task_jacobian @ a + mech.task_map.bias(c.q, v), "task acceleration")
+    return finite_result(c.task_jacobian @ a + TaskMap.of(mech).bias(c.q, v), "task acceleration")
 
 
 def inverse_velocities(mech: Mechanism, q: ArrayLike | Configuration, yd: ArrayLike) -> np.ndarray:
@@ -468,7 +470,7 @@ def inverse_accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: Arra
     v = mech.check_v(v)
     ydd = as_vector(ydd, mech.n_task, "ydd")
     gamma_c = constraints.drift(mech, c.q, v)
-    gamma_t = mech.task_map.bias(c.q, v)
+    gamma_t = TaskMap.of(mech).bias(c.q, v)
     sp = _split(mech, c, RTOL)
     a = sp.joint_solve(np.concatenate([-gamma_c, ydd - gamma_t]))
     return finite_result(_convention(sp, c, a), "joint accelerations")
@@ -591,7 +593,7 @@ def actuation(mech: Mechanism, q: ArrayLike | Configuration | None = None, *, rt
 
 
 def _actuation(mech: Mechanism, c: Configuration, sp: _Split, rtol: float) -> Actuation:
-    Jc = mech.jacobian_scales.constraint(finite_result(c.constraint_jacobian, "constraint Jacobian"))
+    Jc = JacobianScales.of(mech).constraint(finite_result(c.constraint_jacobian, "constraint Jacobian"))
     keep = np.setdiff1d(np.arange(mech.nv), mech.base_v)
     _, s, Vt = _svd(Jc[:, keep])
     rank = int(np.sum(s > rtol * s[0])) if len(s) and s[0] > 0.0 else 0
@@ -630,7 +632,7 @@ def diagnose(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 1e-
     mech, c = _at(mech, q)
     rtol = as_tolerance(rtol, "rtol")
     near = max(as_tolerance(near, "near"), rtol)
-    Jc = mech.jacobian_scales.constraint(finite_result(c.constraint_jacobian, "constraint Jacobian"))
+    Jc = JacobianScales.of(mech).constraint(finite_result(c.constraint_jacobian, "constraint Jacobian"))
     s = np.linalg.svd(Jc, compute_uv=False)
     rank = int(np.sum(s > rtol * s[0])) if len(s) and s[0] > 0.0 else 0
     sp = _split(mech, c, rtol)

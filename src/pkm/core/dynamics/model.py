@@ -59,7 +59,9 @@ from numpy.typing import ArrayLike
 from pkm.core.differential.idle import joint_inertia, without_idle
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import close_loops
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.validation import as_scalar, as_tolerance, finite_result
 
@@ -82,7 +84,7 @@ def _reduce(mech: Mechanism, q: np.ndarray, rtol: float) -> _Reduction:
     """The rank of ``J_p`` and the idle motions are judged on the Jacobians homogenised by the mechanism's
     characteristic length (:mod:`pkm.core.model.scale`), as :func:`pkm.diagnose` judges them: the same for the
     mechanism scaled in size."""
-    scales = mech.jacobian_scales
+    scales = JacobianScales.of(mech)
     Jc = constraints.jacobian(mech, q)
     pv, av = mech.passive_v, mech.act_v
     cp = scales.columns[pv]
@@ -97,7 +99,7 @@ def _reduce(mech: Mechanism, q: np.ndarray, rtol: float) -> _Reduction:
     idle = np.zeros((mech.nv, null.shape[1]))
     if null.shape[1]:  # passive motions with the actuators locked: idle (the task does not see them) or singular
         idle[pv] = null
-        Jt = scales.task(mech.task_map.jacobian(q))
+        Jt = scales.task(TaskMap.of(mech).jacobian(q))
         seen = np.linalg.svd(Jt @ idle, compute_uv=False)
         t_ref = max(float(np.linalg.norm(Jt, 2)), 1e-300)
         if seen.size and seen[0] > rtol * t_ref:
@@ -167,7 +169,7 @@ class ActuatorSpaceModel:
         """
         tau = self.mech.check_actuated(tau, "tau")
         return finite_result(_solve_inertia(self.M, tau + (self.friction if friction else 0.0) - self.h,
-                                            self.mech.jacobian_scales.actuated),
+                                            JacobianScales.of(self.mech).actuated),
                              "actuated accelerations")
 
     def joint_accelerations(self, qdd: ArrayLike) -> np.ndarray:
@@ -412,10 +414,10 @@ def operational_space(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None
         raise InvalidInputError("mech", f"the task has {mech.n_task} coordinates for {mech.na} actuators: the "
                                         "operational space needs as many", mech.n_task)
     model = _evaluate(mech, q, qd, as_tolerance(rtol, "rtol"))
-    tm = mech.task_map
+    tm = TaskMap.of(mech)
     Jt = tm.jacobian(q)
     J = Jt @ model.G
-    scales = mech.jacobian_scales  # (homogenised: judged as for the mechanism scaled in size)
+    scales = JacobianScales.of(mech)  # (homogenised: judged as for the mechanism scaled in size)
     s = np.linalg.svd(scales.forward(J), compute_uv=False)
     if s[-1] <= rtol * max(float(s[0]), 1e-300):
         raise SingularityError("inverse", float(s[-1]), "the task Jacobian J = dy/dq_a loses rank",

@@ -51,6 +51,7 @@ from pkm.core.dynamics import model as actuator_space
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, PkmError, SingularityError, SpecError
 from pkm.validation import as_count, as_scalar, as_tolerance, as_vector, finite_result
 
@@ -192,7 +193,7 @@ class KhalilProjection:
         # (computed on the Jacobian homogenised by the characteristic length, so that every rank decision is the same
         # for the mechanism scaled in size; the maps are given back in joint rates at the end)
         mech, part = self.mech, self.partition
-        scales = mech.jacobian_scales
+        scales = JacobianScales.of(mech)
         Jc = scales.constraint(finite_result(Jc, "constraint Jacobian"))
         na, n_p = mech.na, len(part.platform_v)
         A = np.zeros((na, n_p))
@@ -449,7 +450,7 @@ def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuate
     tau_a = mech.check_actuated(tau_actuated, "tau_actuated")
     if _has_mimic(mech.model):
         raise PkmError("constraintDynamics does not support mimic joints on Pinocchio 4.1")
-    s = np.linalg.svd(mech.jacobian_scales.constraint(finite_result(constraints.jacobian(mech, q),
+    s = np.linalg.svd(JacobianScales.of(mech).constraint(finite_result(constraints.jacobian(mech, q),
                                                                      "constraint Jacobian")), compute_uv=False)
     redundant = bool(s.size) and (s.size < mech.n_constraints or s[-1] <= RTOL * float(s[0]))
     if mu is None:

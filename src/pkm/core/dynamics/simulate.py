@@ -65,8 +65,10 @@ from pkm.core.dynamics.projection import energy
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.newton import least_squares
 from pkm.core.kinematics.solve import close_loops
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.kinematics.trajectory import Trajectory, _units
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.errors import CompilerError, ControllerError, InvalidInputError, PkmError, SingularityError, SpecError
 from pkm.validation import as_array, as_scalar
 
@@ -153,7 +155,7 @@ def _passive_distance(mech: Mechanism, q: np.ndarray) -> tuple[float, float, int
     (:mod:`pkm.core.model.scale`) above ``RTOL`` times the largest, its ratio to the largest (the distance to a
     direct singularity that ``singular_tol`` is compared with: the same for the mechanism scaled in size), and how
     many there are: ``(sigma [m], distance, rank)``."""
-    s = np.linalg.svd(mech.jacobian_scales.constraint(constraints.jacobian(mech, q))[:, mech.passive_v],
+    s = np.linalg.svd(JacobianScales.of(mech).constraint(constraints.jacobian(mech, q))[:, mech.passive_v],
                       compute_uv=False)
     nonzero = s[s > RTOL * s[0]] if s.size and s[0] > 0.0 else s[:0]
     if not nonzero.size:
@@ -236,7 +238,7 @@ class _Dynamics:
         model, tau = self.state(t, x[:na], x[na:], seed)
         rhs = tau + (model.friction if self.friction else 0.0) - model.h
         try:
-            qdd = _solve_inertia(model.M, rhs, self.mech.jacobian_scales.actuated)
+            qdd = _solve_inertia(model.M, rhs, JacobianScales.of(self.mech).actuated)
         except SingularityError as exc:
             raise _Stop(Event("singularity", t, str(exc)), exc.sigma_min, exc.distance) from None
         return np.concatenate([x[na:], qdd]), model.q, model, tau
@@ -425,7 +427,7 @@ class _Recorder:
         a = np.array([m.joint_accelerations(qdd) for m, qdd in zip(self.models, self.qdd)])
         qd = np.array([m.qd for m in self.models])
         tau = np.array(self.tau)
-        tm = mech.task_map
+        tm = TaskMap.of(mech)
         task = np.array([tm.value(qq) for qq in q])
         task_v = np.array([tm.jacobian(qq) @ vv for qq, vv in zip(q, v)])
         task_a = np.array([tm.jacobian(qq) @ aa + tm.bias(qq, vv) for qq, vv, aa in zip(q, v, a)])
@@ -690,7 +692,7 @@ def _c_result(dyn: _Dynamics, sim: Simulator, rows: dict[str, np.ndarray], dt: f
     na = mech.na
     Q, V, QDD, X = rows["Q"], rows["V"], rows["QDD"], rows["X"]
     a, task, task_v, task_a, potential, residual, pivot = sim.samples(Q, V, QDD)
-    tm = mech.task_map
+    tm = TaskMap.of(mech)
     for k in np.flatnonzero(~(pivot[:, 0] >= PIVOT_FLOOR)):
         model = _evaluate(mech, Q[k], X[k, na:], RTOL, dyn.coulomb_velocity)
         a[k] = model.joint_accelerations(QDD[k])

@@ -36,6 +36,7 @@ from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.kinematics.labels import ModeLabel, mode_label
 from pkm.core.kinematics.newton import gauss_newton
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import (
     AssemblyError,
@@ -146,7 +147,7 @@ class IKProblem:
     def evaluate(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(F(q), dF/dq)`` from one kinematics pass (``q`` unchecked: the solvers' iterations)."""
         c = Configuration.compute(self.mech, q)
-        return (np.concatenate([c.residual, -self.mech.task_map.error(self.target, c.task_value)]),
+        return (np.concatenate([c.residual, -TaskMap.of(self.mech).error(self.target, c.task_value)]),
                 np.array(c.closure_and_task_jacobian))
 
     def residual(self, q: ArrayLike) -> np.ndarray:
@@ -328,7 +329,7 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
         {'x': 0.0, 'y': 0.0, 'z': -0.34}
     """
     mech = check_mechanism(mech)
-    task = mech.task_map
+    task = TaskMap.of(mech)
     y1 = task.parse(target)
     tol, max_iter, max_step = _settings(tol, max_iter, max_step)
     if branch is not None:
@@ -385,7 +386,7 @@ def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_i
     q = mech.q_reference.copy()
     if mech.on_branch(q, branch):
         return q
-    task = mech.task_map
+    task = TaskMap.of(mech)
     y_ref = task.value(q)
     wrapped = mech.wrap(q)
     pins = np.array([mech.joints[n].idx_v for n in b.signs])

@@ -128,7 +128,7 @@ def from_strings(urdf: str, spec: ClosureSpec | str, params: Any = None, source:
         ... frame_b = "closedloop3D_1B"
         ... '''
         >>> mech = pkm.from_strings(five.urdf, spec)
-        >>> mech.name, mech.na, mech.task_map.keys
+        >>> mech.name, mech.na, pkm.TaskMap.of(mech).keys
         ('my_fivebar', 2, ('x', 'z'))
         >>> {k: round(v, 4) for k, v in pkm.task_values(mech, mech.q_reference).items()}
         {'x': 0.1371, 'z': -0.6192}

@@ -8,6 +8,9 @@ It is made by :mod:`pkm.core.model.builder` (:func:`~pkm.core.model.builder.buil
 :func:`~pkm.core.model.builder.from_files`, which :func:`pkm.load` reaches), which assembles and checks its reference
 configuration; ``Mechanism(model, spec)`` alone takes the spec's ``[reference]`` over the neutral configuration as it
 is. The model never imports its builder: the builder registers how a mechanism it made pickles (:data:`REDUCE`).
+Nor does it import what is built on it: its task map is :meth:`TaskMap.of(mech) <pkm.core.kinematics.task.TaskMap.of>`,
+the factors that homogenise its Jacobians :meth:`JacobianScales.of(mech) <pkm.core.model.scale.JacobianScales.of>`,
+each made once and kept with the mechanism (:func:`pkm._derived.derived`).
 
 Joint coordinates follow Pinocchio: ``q`` has ``model.nq`` entries (a free-flyer
 takes 7: position and quaternion x y z w), velocities ``v`` have ``model.nv``.
@@ -21,22 +24,19 @@ import functools
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from pkm._derived import SLOT
 from pkm.core.model.actuators import Actuator, from_model, write_model
 from pkm.core.model.spec import Branch, ClosureSpec
 from pkm.core.model.urdf import position_limits
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
 from pkm.units import quantities
 from pkm.validation import as_array, as_vector, wrap_angle
-
-if TYPE_CHECKING:
-    from pkm.core.kinematics.task import TaskMap
-    from pkm.core.model.scale import JacobianScales
 
 
 @dataclass(frozen=True)
@@ -91,7 +91,7 @@ class Mechanism:
         >>> delta = pkm.load("delta")
         >>> delta.na, delta.nq, delta.nv, delta.actuated_names
         (3, 12, 12, ('motor_1', 'motor_2', 'motor_3'))
-        >>> delta.task_map.keys
+        >>> pkm.TaskMap.of(delta).keys
         ('x', 'y', 'z')
         >>> {k: round(v, 4) for k, v in delta.q_to_dict(delta.q_reference).items() if k.startswith("motor")}
         {'motor_1': 0.0017, 'motor_2': 0.0017, 'motor_3': 0.0017}
@@ -237,12 +237,12 @@ class Mechanism:
             self._local.constraint_datas = [cm.createData() for cm in self.constraint_models]
             return self._local.constraint_datas
 
-    @functools.cached_property
-    def task_map(self) -> TaskMap:
-        """The mechanism's :class:`~pkm.core.kinematics.task.TaskMap` (made once; it holds no per-call state)."""
-        from pkm.core.kinematics.task import TaskMap  # (pkm.core.kinematics.task imports this module)
-
-        return TaskMap(self)
+    @property
+    def task_map(self) -> Any:
+        """Moved: :meth:`pkm.TaskMap.of(mech) <pkm.core.kinematics.task.TaskMap.of>` (the task map is built on the
+        mechanism, whose module does not import it)."""
+        raise AttributeError("Mechanism.task_map moved to pkm.TaskMap.of(mech) (the same map, made once per "
+                             "mechanism): the task map is built on the mechanism, above it")
 
     @property
     def q_reference(self) -> np.ndarray:
@@ -252,25 +252,31 @@ class Mechanism:
     @q_reference.setter
     def q_reference(self, q: np.ndarray) -> None:
         self._q_reference = q
-        for cached in ("characteristic_length", "jacobian_scales"):  # (measured at the reference)
+        for cached in ("characteristic_length", SLOT):  # (measured at the reference; what was derived from it)
             self.__dict__.pop(cached, None)
 
     @functools.cached_property
     def characteristic_length(self) -> float:
         """The mechanism's characteristic length ``L`` [m]: the root-mean-square distance of its joints' origins from
         their centroid at :attr:`q_reference` (:mod:`pkm.core.model.scale`). The singularity measures homogenise
-        their Jacobians by it, so that they judge a mechanism of 5 cm as the same one of 5 m."""
-        from pkm.core.model.scale import _characteristic_length
+        their Jacobians by it (:meth:`JacobianScales.of(mech) <pkm.core.model.scale.JacobianScales.of>`), so that
+        they judge a mechanism of 5 cm as the same one of 5 m. Where every joint origin coincides, the frames'
+        origins are used instead, and 1 m where they coincide too (nothing in the mechanism has a length)."""
+        data = self.model.createData()
+        pin.framesForwardKinematics(self.model, data, self.q_reference)
+        for points in (np.array([data.oMi[j].translation for j in range(1, self.model.njoints)]),
+                       np.array([f.translation for f in data.oMf])):
+            if len(points):
+                length = float(np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=1))))
+                if length > 0.0:
+                    return length
+        return 1.0
 
-        return _characteristic_length(self.model, self.q_reference)
-
-    @functools.cached_property
-    def jacobian_scales(self) -> JacobianScales:
-        """The factors that homogenise the Jacobians by :attr:`characteristic_length`
-        (:class:`~pkm.core.model.scale.JacobianScales`)."""
-        from pkm.core.model.scale import _jacobian_scales
-
-        return _jacobian_scales(self)
+    @property
+    def jacobian_scales(self) -> Any:
+        """Moved: :meth:`pkm.core.model.scale.JacobianScales.of(mech) <pkm.core.model.scale.JacobianScales.of>`."""
+        raise AttributeError("Mechanism.jacobian_scales moved to pkm.core.model.scale.JacobianScales.of(mech): the "
+                             "scales are built on the mechanism, above it")
 
     def __reduce__(self) -> tuple[Callable[..., Mechanism], tuple[Any, ...]]:
         if self.urdf is None or REDUCE is None:

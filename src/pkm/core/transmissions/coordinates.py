@@ -37,6 +37,7 @@ from pkm.core.differential.idle import joint_inertia, without_idle
 from pkm.core.differential.velocity import RTOL
 from pkm.core.kinematics import constraints
 from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.errors import ConvergenceError
 
 
@@ -66,7 +67,7 @@ class OutputSplit:
 
 def output_split(sub: Mechanism, q: np.ndarray, out_v: np.ndarray, motor_v: np.ndarray) -> OutputSplit:
     """:class:`OutputSplit` of the sub-mechanism ``sub`` at ``q`` (closed), outputs at velocity indices ``out_v``."""
-    scales = sub.jacobian_scales
+    scales = JacobianScales.of(sub)
     Jc = constraints.jacobian(sub, q)
     d_v = np.array([i for i in range(sub.nv) if i not in set(out_v)], dtype=int)
     Jh = scales.constraint(Jc)

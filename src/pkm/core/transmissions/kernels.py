@@ -53,6 +53,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.core.transmissions.transmission import Transmission
 from pkm.core.twin.dynamics import ActuatorTwin, cholesky, cholesky_solve
 from pkm.core.twin.kernels import PIVOT_FLOOR
@@ -158,7 +159,7 @@ class TransmissionKernels:
         Talos-like ankle's rods). A step longer than :data:`MAX_STEP` is shortened to it."""
         tw = at.tw
         mech = tw.mech
-        scale = mech.jacobian_scales.columns  # (a length in characteristic lengths)
+        scale = JacobianScales.of(mech).columns  # (a length in characteristic lengths)
         r = tw.rotate_rows(tw.closure_residual)
         if not at.idle:
             cols = list(at.passive)
@@ -318,7 +319,7 @@ class TransmissionKernels:
         for batches, ``jax.grad`` differentiates it).
 
         Raises:
-            MissingDependencyError: JAX is not installed (``pip install "pkm[jax]"``).
+            MissingDependencyError: JAX is not installed (``pip install "pkm-robotics[jax]"``).
         """
         from pkm.core.twin.jaxgen import jax_function
 
@@ -328,7 +329,7 @@ class TransmissionKernels:
         """``kernel`` as a Warp kernel (:func:`pkm.core.twin.warpgen.warp_kernel`).
 
         Raises:
-            MissingDependencyError: Warp is not installed (``pip install "pkm[warp]"``).
+            MissingDependencyError: Warp is not installed (``pip install "pkm-robotics[warp]"``).
         """
         from pkm.core.twin.warpgen import warp_kernel
 

@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike
 from pkm.core.differential.velocity import RTOL, forward_jacobian, inverse_jacobian
 from pkm.core.kinematics.solve import close_loops, solve_ik
 from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.core.transmissions.coordinates import OutputSplit, output_model, output_split, serial_tree
 from pkm.errors import SingularityError, TransmissionError
 from pkm.validation import as_vector
@@ -152,7 +153,7 @@ class Transmission:
         singular value under :data:`pkm.core.differential.velocity.RTOL`)."""
         sub = self.mechanism
         Gm = self._split(q_sub).G[sub.act_v]
-        cols = sub.jacobian_scales.columns
+        cols = JacobianScales.of(sub).columns
         s = np.linalg.svd(Gm * cols[self.out_v][None, :] / cols[sub.act_v][:, None], compute_uv=False)
         if not s[-1] > RTOL * s[0]:
             raise SingularityError("direct", float(s[-1]), f"transmission {self.name!r}: the motors do not hold the "
