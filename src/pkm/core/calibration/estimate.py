@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike
 from pkm.core.calibration.identifiable import BaseGeometry, base_geometry
 from pkm.core.calibration.measurement import CalibrationModel
 from pkm.errors import ConvergenceError, InvalidInputError, PkmWarning, SingularityError, UnknownNameError
+from pkm.validation import wrap_angle
 
 #: The least squares stop when the cost or the step changes by less than this, relative.
 TOL = 1e-10
@@ -122,7 +123,7 @@ def pose_errors(model: CalibrationModel, y: np.ndarray, measured: ArrayLike) -> 
     if model.kind == "position":
         return Accuracy(_stats(np.linalg.norm(y - Ym, axis=1)), None, len(y))
     if model.kind == "planar":
-        yaw = np.abs(np.angle(np.exp(1j * (y[:, 2] - Ym[:, 2]))))
+        yaw = np.abs(wrap_angle(y[:, 2] - Ym[:, 2]))
         return Accuracy(_stats(np.linalg.norm(y[:, :2] - Ym[:, :2], axis=1)), _stats(yaw), len(y))
     return Accuracy(_stats(np.abs(y - Ym).ravel()), None, len(y))
 

@@ -124,13 +124,13 @@ def read_data(model: CalibrationModel, data: str | Path | dict[str, np.ndarray])
 
 
 def write_data(model: CalibrationModel, path: str | Path, readings: np.ndarray, measured: np.ndarray) -> Path:
-    """Write readings and measurements (:meth:`CalibrationModel.evaluate`'s layout) as a CSV table (module doc)."""
+    """Write readings and measurements (:meth:`CalibrationModel.evaluate`'s layout) as a CSV table (module doc), by
+    :func:`pkm.core.dynamics.samples.write_csv` (pkm's one CSV layout: numbers as ``repr`` of floats, exact)."""
+    from pkm.core.dynamics.samples import write_csv
+
     reads, meas = columns(model)
     table = np.hstack([readings, from_layout(model, measured)])
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    np.savetxt(path, table, delimiter=",", header=",".join(reads + meas), comments="", fmt="%.17g")
-    return path
+    return write_csv({name: table[:, k] for k, name in enumerate(reads + meas)}, path)
 
 
 def calibrated_mechanism(cal: Calibration) -> Mechanism:

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.units import quantities, quantity
-from pkm.validation import ABSURD, as_array, as_vector
+from pkm.validation import ABSURD, as_array, as_vector, wrap_angle
 
 if TYPE_CHECKING:  # (annotations only: the mechanism module imports this one)
     from pkm.core.model.mechanism import Mechanism
@@ -119,7 +119,7 @@ class _FrameTask:
         out = y_target - y
         for i, c in enumerate(self.comp):
             if c in _ANGLES:
-                out[i] = (out[i] + np.pi) % (2 * np.pi) - np.pi
+                out[i] = wrap_angle(out[i])
         return out
 
     def retract(self, y: np.ndarray, dy: np.ndarray) -> np.ndarray:
