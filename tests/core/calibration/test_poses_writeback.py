@@ -128,3 +128,15 @@ def test_deviations_that_do_not_exist_are_refused() -> None:
         calibrate(s.model, np.repeat(s.readings[:1], n, axis=0), np.repeat(s.measured[:1], n, axis=0),
                   base=s.cal.base)
     assert err.value.kind == "calibration" and err.value.distance < 1e-10
+
+
+def test_candidates_spread_per_unit_by_default() -> None:
+    """Without a spread, a prismatic reading moves by up to AMPLITUDE["m"] (the 3-PRS's sliders: 0.03 m, not the
+    0.1 that served for rad and m alike), and by a mapping's value for its unit."""
+    from pkm.core.identification.base import AMPLITUDE
+
+    m = model("prs3")
+    ref = m.mech.actuated_q(m.mech.q_reference)
+    drawn = candidates(m, 6, seed=2)
+    assert np.abs(drawn - ref).max() <= AMPLITUDE["m"] and np.abs(drawn - ref).max() > 0.5 * AMPLITUDE["m"]
+    assert np.array_equal(candidates(m, 6, seed=2, spread={"rad": 1.0, "m": AMPLITUDE["m"]}), drawn)

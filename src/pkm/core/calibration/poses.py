@@ -1,6 +1,7 @@
 """Pose selection: the calibration poses that make the base parameters best observed.
 
-Candidates are random actuator readings around the reference, within ``spread`` [rad or m] of it, kept where the
+Candidates are random actuator readings around the reference, within ``spread`` of it (per unit, rad or m: by default
+:data:`~pkm.core.identification.base.AMPLITUDE`, an excitation's amplitude), kept where the
 nominal mechanism closes, within its joint limits (:meth:`~pkm.core.Mechanism.outside_limits`: the workspace) and
 away from singularities: the closure system's smallest singular value over its largest (:func:`conditioning`) at
 least ``margin``. Among them, ``n`` poses are chosen greedily to maximise the observability index **O1** (Borm and
@@ -12,12 +13,14 @@ determinant lemma: ``log det(I + J_k A^{-1} J_k^T)``). O1 is the one optimised; 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
 from pkm.core.calibration.identifiable import BaseGeometry, base_geometry, stacked_jacobian
 from pkm.core.calibration.measurement import CalibrationModel
+from pkm.core.identification.base import AMPLITUDE, closed_draws, per_unit
 from pkm.errors import InvalidInputError, PkmError
 from pkm.validation import as_count, as_scalar
 
@@ -55,48 +58,42 @@ def conditioning(model: CalibrationModel, readings: np.ndarray, x: np.ndarray | 
     return s[:, -1 - model.idle] / s[:, 0]
 
 
-def candidates(model: CalibrationModel, n: int, *, spread: float = 0.1, margin: float = MARGIN,
-               seed: int = 0) -> np.ndarray:
-    """``n`` candidate readings (module doc). ``spread`` [rad or m]: the largest change of a reading from the
-    reference.
+def candidates(model: CalibrationModel, n: int, *, spread: float | Mapping[str, float] | None = None,
+               margin: float = MARGIN, seed: int = 0) -> np.ndarray:
+    """``n`` candidate readings (module doc), drawn by :func:`~pkm.core.identification.base.closed_draws` (as the
+    identification's random states are). ``spread`` [rad or m]: the largest change of a reading from the reference,
+    per unit (``{"rad": 0.3, "m": 0.03}``; default :data:`~pkm.core.identification.base.AMPLITUDE`), or one number
+    where the actuators are all revolute or all prismatic (:func:`~pkm.core.identification.base.per_unit`).
 
     Raises:
-        InvalidInputError: fewer than ``n`` of ``20 n`` draws qualify (a smaller spread or margin may help).
+        InvalidInputError: fewer than ``n`` of ``20 n`` draws qualify (a smaller spread or margin may help); one
+            ``spread`` for revolute and prismatic actuators alike.
     """
-    from pkm.core.kinematics.solve import close_loops
-
     n = as_count(n, "n")
-    spread = as_scalar(spread, "spread", low=0.0, strict_low=True)
+    bound = per_unit(model.mech, AMPLITUDE if spread is None else spread, "spread")
     margin = as_scalar(margin, "margin", low=0.0)
-    mech = model.mech
     rng = np.random.default_rng(seed)
-    qa0 = mech.actuated_q(mech.q_reference)
     out: list[np.ndarray] = []
-    for _ in range(20 * n):
-        if len(out) == n:
-            break
-        qa = qa0 + rng.uniform(-spread, spread, mech.na)
-        try:
-            q = close_loops(mech, qa, mech.q_reference).q
-        except PkmError:  # (outside the workspace: drawn again)
-            continue
-        if mech.outside_limits(q):
-            continue
+    for qa, _ in closed_draws(model.mech, rng, bound, 20 * n):
         try:
             if conditioning(model, qa[None])[0] < margin:
                 continue
         except PkmError:  # (a singular pose: drawn again)
             continue
         out.append(qa)
+        if len(out) == n:
+            break
     if len(out) < n:
         raise InvalidInputError("spread", f"only {len(out)} of {n} candidate poses closed within the limits and the "
                                           f"singularity margin {margin:g}", spread)
     return np.array(out)
 
 
-def calibration_poses(model: CalibrationModel, n: int, *, pool: int | None = None, spread: float = 0.1, margin: float = MARGIN,
-         seed: int = 0) -> PosePlan:
-    """``n`` poses maximising O1 among ``pool`` candidates (default ``4 n``) (module doc).
+def calibration_poses(model: CalibrationModel, n: int, *, pool: int | None = None,
+                      spread: float | Mapping[str, float] | None = None, margin: float = MARGIN,
+                      seed: int = 0) -> PosePlan:
+    """``n`` poses maximising O1 among ``pool`` candidates (default ``4 n``; ``spread`` as :func:`candidates`')
+    (module doc).
 
     Raises:
         InvalidInputError: too few poses for the base parameters, or too few candidates.
