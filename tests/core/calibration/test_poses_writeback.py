@@ -140,3 +140,22 @@ def test_candidates_spread_per_unit_by_default() -> None:
     drawn = candidates(m, 6, seed=2)
     assert np.abs(drawn - ref).max() <= AMPLITUDE["m"] and np.abs(drawn - ref).max() > 0.5 * AMPLITUDE["m"]
     assert np.array_equal(candidates(m, 6, seed=2, spread={"rad": 1.0, "m": AMPLITUDE["m"]}), drawn)
+
+
+def test_columns_given_as_a_dict_take_the_identification_route(tmp_path) -> None:
+    """``read_data`` reads a dict of columns as ``pkm.measurements`` does (one route: ``read_columns``): text is
+    refused naming its column (before: numpy turned "0.1" into 0.1), columns of unequal length are refused naming
+    theirs (before: numpy's raw error), and the same table as a dict and as a file reads the same."""
+    s = simulated("prs3")
+    m = s.model
+    path = write_data(m, tmp_path / "data.csv", s.readings, s.measured)
+    from pkm.core.identification.measurements import read_table
+
+    cols = read_table(path)
+    M, Y = read_data(m, cols)
+    assert np.array_equal(M, read_data(m, path)[0]) and np.array_equal(Y, read_data(m, path)[1])
+    with pytest.raises(pkm.errors.InvalidInputError, match=r"m\.slider_2") as err:
+        read_data(m, dict(cols, **{"m.slider_2": [str(v) for v in cols["m.slider_2"]]}))
+    assert err.value.name == "m.slider_2"
+    with pytest.raises(pkm.errors.InvalidInputError, match=r"column 'z' has shape") as err:
+        read_data(m, dict(cols, z=cols["z"][:-1]))
