@@ -84,9 +84,9 @@ def test_amounts_are_per_unit_and_one_number_is_refused_where_the_units_mix():
     joints = {"crank": SimpleNamespace(revolute=True), "slider": SimpleNamespace(revolute=False)}
     mixed = SimpleNamespace(joints=joints, actuated_names=("crank", "slider"), na=2)
     assert per_unit(mixed, {"rad": 0.3, "m": 0.03}, "spread").tolist() == [0.3, 0.03]
-    with pytest.raises(InvalidInputError, match="revolute and prismatic actuators alike"):
+    with pytest.raises(InvalidInputError, match="revolute and prismatic joints alike"):
         per_unit(mixed, 0.1, "spread")
-    with pytest.raises(InvalidInputError, match="no value for the m actuators"):
+    with pytest.raises(InvalidInputError, match="no value for the m joints"):
         per_unit(mixed, {"rad": 0.3}, "spread")
     alone = SimpleNamespace(joints=joints, actuated_names=("slider",), na=1)
     assert per_unit(alone, 0.2, "spread").tolist() == [0.2]

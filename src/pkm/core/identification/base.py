@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import re
 import weakref
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import TYPE_CHECKING
@@ -155,24 +155,26 @@ AMPLITUDE = {"rad": 0.3, "m": 0.03}
 STATE_SPREAD = {"rad": 0.1, "m": 0.1}
 
 
-def per_unit(mech: Mechanism, value: float | Mapping[str, float], name: str) -> np.ndarray:
-    """An amount per actuated coordinate (na) [rad or m]: ``value`` a mapping by unit (``{"rad": 0.3, "m": 0.03}``:
-    each actuator takes its joint's unit's), or one positive number, the same in every actuator's unit: refused on a
-    mechanism whose actuators mix revolute and prismatic joints (there it would mean rad and m alike).
+def per_unit(mech: Mechanism, value: float | Mapping[str, float], name: str, joints: Sequence[str] | None = None) \
+        -> np.ndarray:
+    """An amount per actuated coordinate (na; per joint of ``joints``, one-coordinate joints, where given) [rad or m]:
+    ``value`` a mapping by unit (``{"rad": 0.3, "m": 0.03}``: each joint takes its unit's), or one positive number,
+    the same in every joint's unit: refused where revolute and prismatic joints mix (there it would mean rad and m
+    alike).
 
     Raises:
         InvalidInputError: a number on a mixed mechanism, a missing unit, a value that is not positive.
     """
-    units = ["rad" if mech.joints[j].revolute else "m" for j in mech.actuated_names]
+    units = ["rad" if mech.joints[j].revolute else "m" for j in (mech.actuated_names if joints is None else joints)]
     if not isinstance(value, Mapping):
         number = as_scalar(value, name, low=0.0, strict_low=True)
         if len(set(units)) > 1:
-            raise InvalidInputError(name, f"one number ({number:g}) for revolute and prismatic actuators alike: give "
+            raise InvalidInputError(name, f"one number ({number:g}) for revolute and prismatic joints alike: give "
                                           f"one per unit, {{'rad': ..., 'm': ...}}", value)
-        return np.full(mech.na, number)
+        return np.full(len(units), number)
     missing = sorted(set(units) - set(value))
     if missing:
-        raise InvalidInputError(name, f"no value for the {', '.join(missing)} actuators (expected a mapping by unit, "
+        raise InvalidInputError(name, f"no value for the {', '.join(missing)} joints (expected a mapping by unit, "
                                       f"'rad' and 'm')", dict(value))
     return np.array([as_scalar(value[u], f"{name}[{u!r}]", low=0.0, strict_low=True) for u in units])
 

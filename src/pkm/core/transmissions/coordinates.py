@@ -39,6 +39,11 @@ from pkm.core.kinematics import constraints
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import ConvergenceError
 
+#: The transmissions' position solvers' tolerance on the closure residual, relative to the sub-mechanism's
+#: characteristic length (:func:`closure_tol`; 1e-13 m on a sub-mechanism of 0.1 m, where it was 1e-13 m on any):
+#: tight, so that a round trip motors -> outputs -> motors comes back to 1e-12.
+CLOSURE_RTOL = 1e-12
+
 
 @dataclass(frozen=True)
 class OutputSplit:
@@ -111,28 +116,33 @@ def drift_acceleration(sub: Mechanism, q: np.ndarray, v: np.ndarray, sp: OutputS
 
 
 def close_at_outputs(sub: Mechanism, qo: np.ndarray, guess: np.ndarray, out_q: np.ndarray, out_v: np.ndarray, *,
-                     tol: float = 1e-13, max_iter: int = 20) -> np.ndarray:
-    """The closed configuration with the outputs at ``qo`` nearest ``guess``: Gauss-Newton on the closures with the
-    outputs held (minimum-norm steps in the other joints), for a warm start a small step away (a simulation's
-    next state); :func:`pkm.solve_ik` (continuation, mode checks) is the general route.
+                     tol: float | None = None, max_iter: int = 20) -> np.ndarray:
+    """The closed configuration with the outputs at ``qo`` nearest ``guess``: pkm's bounded Gauss-Newton
+    (:func:`pkm.core.kinematics.solve._newton`: its step cap and backtracking) on the closures with the outputs held
+    (minimum-norm steps in the other joints), for a warm start a small step away (a simulation's next state);
+    :func:`pkm.solve_ik` (continuation, mode checks) is the general route. ``tol`` [m, rad] on the largest closure
+    residual, default :data:`CLOSURE_RTOL` times the sub-mechanism's characteristic length.
 
     Raises:
-        ConvergenceError: the closures not within ``tol`` [m, rad] after ``max_iter`` iterations.
+        ConvergenceError: the closures not within ``tol`` after ``max_iter`` iterations.
     """
+    from pkm.core.kinematics.solve import _newton
+
+    tol = closure_tol(sub) if tol is None else tol
     q = np.array(guess, dtype=float)
     q[out_q] = qo
     d_v = np.array([i for i in range(sub.nv) if i not in set(out_v)], dtype=int)
-    for it in range(max_iter + 1):
-        r, Jc = constraints.residual_and_jacobian(sub, q)
-        gap = float(np.abs(r).max(initial=0.0))
-        if gap <= tol:
-            return q
-        if it == max_iter:
-            break
-        dq = np.zeros(sub.nv)
-        dq[d_v] = -np.linalg.lstsq(Jc[:, d_v], r, rcond=None)[0]
-        q = pin.integrate(sub.model, q, dq)
-    raise ConvergenceError("loop closure at given outputs", gap, max_iter, tol, q)
+    q, gap, it = _newton(sub, lambda x: constraints.residual_and_jacobian(sub, x), q, d_v, tol, max_iter, 0.5)
+    if gap <= tol:
+        return q
+    raise ConvergenceError("loop closure at given outputs", gap, it, tol, q)
+
+
+def closure_tol(sub: Mechanism, rtol: float = CLOSURE_RTOL) -> float:
+    """The transmissions' position solvers' tolerance on the largest closure residual [m, rad]: ``rtol`` times the
+    sub-mechanism's characteristic length (the same for the sub-mechanism scaled in size, as
+    :data:`~pkm.core.kinematics.constraints.CLOSED_RTOL` is)."""
+    return rtol * sub.characteristic_length
 
 
 def serial_tree(model: pin.Model, outputs: Sequence[str]) -> pin.Model:
@@ -152,4 +162,5 @@ def serial_tree(model: pin.Model, outputs: Sequence[str]) -> pin.Model:
     return serial
 
 
-__all__ = ["OutputSplit", "drift_acceleration", "output_model", "output_split", "serial_tree"]
+__all__ = ["CLOSURE_RTOL", "OutputSplit", "close_at_outputs", "closure_tol", "drift_acceleration", "output_model",
+           "output_split", "serial_tree"]
