@@ -34,7 +34,7 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core.differential.idle import joint_inertia, without_idle
-from pkm.core.differential.velocity import RTOL
+from pkm.core.differential.velocity import RTOL, homogenised_pinv
 from pkm.core.kinematics import constraints
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import ConvergenceError
@@ -75,11 +75,8 @@ def output_split(sub: Mechanism, q: np.ndarray, out_v: np.ndarray, motor_v: np.n
     Jc = constraints.jacobian(sub, q)
     d_v = np.array([i for i in range(sub.nv) if i not in set(out_v)], dtype=int)
     Jh = scales.constraint(Jc)
-    U, s, Vt = np.linalg.svd(Jh[:, d_v], full_matrices=True)
+    Jd_pinv, s, Vt, r = homogenised_pinv(Jc[:, d_v], scales.constraint_rows, scales.columns[d_v], RTOL)
     smax = float(s[0]) if s.size else 0.0
-    r = int(np.sum(s > RTOL * smax)) if smax > 0.0 else 0
-    cd = scales.columns[d_v]
-    Jd_pinv = cd[:, None] * ((Vt[:r].T / s[:r]) @ U[:, :r].T) * scales.constraint_rows
     k = len(out_v)
     G = np.zeros((sub.nv, k))
     G[out_v, np.arange(k)] = 1.0
