@@ -18,7 +18,10 @@ ratio of singular values (a distance to a singularity, a condition index) is unc
 root-mean-square distance of the joints' origins from their centroid at the reference configuration
 (``mech.q_reference``), in [m]: a length of the mechanism itself, which scales exactly with it. Where every joint
 origin coincides, the frames' origins are used instead, and 1 m where they coincide too (nothing in the mechanism has
-a length). :attr:`Mechanism.jacobian_scales <pkm.core.model.mechanism.Mechanism.jacobian_scales>` holds the factors
+a length). It is a spread, not an extent: the plausibility rules bound masses and inertias by the extent ``E``, the
+largest width along x, y or z of every joint origin, frame origin and centre of mass
+(:func:`pkm.core.model.plausibility.size`: a bound must enclose the whole mechanism, a scale need only grow with it;
+both from :func:`reference_points`; ``E`` is 1.8 to 2.5 ``L`` on the shipped mechanisms). :attr:`Mechanism.jacobian_scales <pkm.core.model.mechanism.Mechanism.jacobian_scales>` holds the factors
 (:class:`JacobianScales`).
 
 :func:`~pkm.core.model.builder.scaled_mechanism` builds the copy of a mechanism with every length multiplied by a
@@ -43,11 +46,22 @@ if TYPE_CHECKING:
     from pkm.core.model.mechanism import Mechanism
 
 
-def _characteristic_length(model: pin.Model, q: np.ndarray) -> float:
+def reference_points(model: pin.Model, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A model's points at ``q`` (each n x 3) [m]: its joints' origins, its frames' origins and its bodies' centres of
+    mass (the bodies with mass). The one source of a mechanism's size: ``L`` (module doc) and the plausibility rules'
+    extent (:func:`pkm.core.model.plausibility.size`)."""
     data = model.createData()
     pin.framesForwardKinematics(model, data, q)
-    for points in (np.array([data.oMi[j].translation for j in range(1, model.njoints)]),
-                   np.array([f.translation for f in data.oMf])):
+    joints = np.array([data.oMi[j].translation for j in range(1, model.njoints)]).reshape(-1, 3)
+    frames = np.array([f.translation for f in data.oMf]).reshape(-1, 3)
+    centres = np.array([data.oMi[j].act(model.inertias[j].lever) for j in range(1, model.njoints)
+                        if model.inertias[j].mass > 0.0]).reshape(-1, 3)
+    return joints, frames, centres
+
+
+def _characteristic_length(model: pin.Model, q: np.ndarray) -> float:
+    joints, frames, _ = reference_points(model, q)
+    for points in (joints, frames):
         if len(points):
             length = float(np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=1))))
             if length > 0.0:
@@ -196,4 +210,4 @@ def length_entries(kind: str) -> int:
     return {"JointModelFreeFlyer": 3, "JointModelTranslation": 3, "JointModelPlanar": 2}.get(kind, 0)
 
 
-__all__ = ["JacobianScales", "length_entries", "scale_configuration", "scale_urdf"]
+__all__ = ["JacobianScales", "length_entries", "reference_points", "scale_configuration", "scale_urdf"]
