@@ -57,14 +57,13 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from pkm.core.differential.idle import joint_inertia, without_idle
-from pkm.core.differential.velocity import homogenised_pinv
+from pkm.core.differential.velocity import RTOL, homogenised_pinv  # (one rank threshold with pkm.diagnose's)
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import close_loops
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.validation import as_scalar, as_tolerance, finite_result
 
-RTOL = 1e-9
 COULOMB_VELOCITY = 1e-3  # [rad/s or m/s]: the Coulomb friction's sign is smoothed as tanh(v / this)
 _FD_STEP = 2e-5
 
