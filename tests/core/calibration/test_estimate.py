@@ -51,3 +51,22 @@ def test_a_robust_loss_resists_an_outlier() -> None:
     assert robust.method == "trf" and plain.method == "lm"
     err = [accuracy(s.model, c.x, s.held_out, s.held_truth).position[1] for c in (plain, robust)]
     assert err[1] < 3 * NOISE["m"] < err[0]
+    # (the chi-square on the loss's weights: near 1, the outlier set aside; before, 100 sigma squared over the rows
+    # inflated it, and the deviations with it, as the plain fit's)
+    assert robust.chi2 < 2.0 < 100.0 < plain.chi2
+    assert np.all(robust.std < plain.std)
+
+
+@pytest.mark.parametrize("loss", ["soft_l1", "huber", "cauchy", "arctan"])
+def test_robust_weights_are_the_losses_derivatives(loss) -> None:
+    """``robust_weights`` against central differences of scipy's losses ``rho(z)`` (its documentation's formulas),
+    on both sides of huber's bend; 1 for the plain loss."""
+    from pkm.core.calibration.estimate import robust_weights
+
+    rho = {"soft_l1": lambda z: 2.0 * (np.sqrt(1.0 + z) - 1.0),
+           "huber": lambda z: np.where(z <= 1.0, z, 2.0 * np.sqrt(z) - 1.0),
+           "cauchy": np.log1p, "arctan": np.arctan}[loss]
+    z = np.array([0.01, 0.5, 0.9, 1.5, 4.0, 100.0])
+    h = 1e-5 * z  # (a relative step: the differences' rounding stays under 1e-8 of the weight)
+    np.testing.assert_allclose(robust_weights(loss, z), (rho(z + h) - rho(z - h)) / (2 * h), rtol=1e-7)
+    assert np.array_equal(robust_weights("linear", z), np.ones_like(z))

@@ -12,7 +12,13 @@ loss, else the trust-region reflective method (``"trf"``) with the bounds and a 
 
 **Standard deviations**: ``sqrt(diag(s^2 (J^T J)^{-1}))`` of the weighted Jacobian at the solution, ``s^2`` the
 reduced chi-square (the sum of squared weighted residuals over rows minus free parameters: 1 when ``sigma`` is the
-noise); :attr:`Calibration.std` per free parameter.
+noise); :attr:`Calibration.std` per free parameter. With a robust loss, the residuals and the Jacobian's rows are
+weighted again by the loss's weights at the solution (``sqrt(rho'(r²))``, :func:`robust_weights`: the fit's own
+iteratively reweighted view), so that the chi-square and the deviations are those of the rows the fit kept, not
+inflated by the outliers it set aside (the 3-PRS with one pose 100 sigma off, Cauchy's loss: 0.41, where the
+unweighted residuals gave 490 and the deviations 22 times the clean fit's; they are now 0.78 of them). The loss
+weighs rows within the noise below 1 too (Cauchy's: 1/2 at one sigma), so that a robust chi-square sits under 1
+where the plain one would be 1.
 
 **Accuracy** (:func:`accuracy`): per pose, the position error ``|p - p_m|`` [m] and the orientation error (the
 angle of ``R_m^T R`` [rad]; the planar yaw's difference), their mean, RMS and maximum.
@@ -31,6 +37,7 @@ from numpy.typing import ArrayLike
 from pkm.core.calibration.identifiable import BaseGeometry, base_geometry
 from pkm.core.calibration.measurement import CalibrationModel
 from pkm.errors import ConvergenceError, InvalidInputError, PkmWarning, SingularityError, UnknownNameError
+from pkm.validation import wrap_angle
 
 #: The least squares stop when the cost or the step changes by less than this, relative.
 TOL = 1e-10
@@ -72,7 +79,8 @@ class Calibration:
         free: The indices of the estimated parameters (the base geometry's independent ones).
         std: Their standard deviations (SI).
         base: The base geometry at the nominal parameters.
-        chi2: The reduced chi-square (module doc).
+        chi2: The reduced chi-square (module doc): on the robust loss's weights where there is one, the outliers
+            weighing what the loss gives them.
         before: The accuracy of the starting parameters (``x0``, nominal by default) at the calibration poses.
         after: The residual accuracy of the calibrated model there.
         nfev: Residual evaluations.
@@ -122,7 +130,7 @@ def pose_errors(model: CalibrationModel, y: np.ndarray, measured: ArrayLike) -> 
     if model.kind == "position":
         return Accuracy(_stats(np.linalg.norm(y - Ym, axis=1)), None, len(y))
     if model.kind == "planar":
-        yaw = np.abs(np.angle(np.exp(1j * (y[:, 2] - Ym[:, 2]))))
+        yaw = np.abs(wrap_angle(y[:, 2] - Ym[:, 2]))
         return Accuracy(_stats(np.linalg.norm(y[:, :2] - Ym[:, :2], axis=1)), _stats(yaw), len(y))
     return Accuracy(_stats(np.abs(y - Ym).ravel()), None, len(y))
 
@@ -140,6 +148,21 @@ def _weights(model: CalibrationModel, sigma: Mapping[str, float]) -> np.ndarray:
             raise InvalidInputError("sigma", f"expected a positive standard deviation for the {u} rows", sigma)
         out.append(1.0 / s)
     return np.array(out)
+
+
+def robust_weights(loss: str, z: np.ndarray) -> np.ndarray:
+    """``rho'(z)`` of a least-squares ``loss`` (scipy's, ``f_scale`` 1) at ``z = r²`` (the squared weighted residuals):
+    each row's weight at the solution of the robust fit (iteratively reweighted least squares: the robust normal
+    equations are ``Jᵀ diag(rho') r = 0``); 1 for ``"linear"``."""
+    if loss == "soft_l1":
+        return 1.0 / np.sqrt(1.0 + z)
+    if loss == "huber":
+        return np.where(z <= 1.0, 1.0, 1.0 / np.sqrt(np.maximum(z, 1.0)))
+    if loss == "cauchy":
+        return 1.0 / (1.0 + z)
+    if loss == "arctan":
+        return 1.0 / (1.0 + z * z)
+    return np.ones_like(z)
 
 
 def calibrate(model: CalibrationModel, readings: ArrayLike, measured: ArrayLike, *,
@@ -246,6 +269,8 @@ def calibrate(model: CalibrationModel, readings: ArrayLike, measured: ArrayLike,
                                sol)
     x[free] = start + sol.x
     r, J = cached(sol.x)
+    w_robust = np.sqrt(robust_weights(loss, r * r))  # (1 for the plain loss; an outlier's row weighs less)
+    r, J = r * w_robust, J * w_robust[:, None]
     dof = rows - len(free)
     chi2 = float(r @ r / dof)
     scale = np.linalg.norm(J, axis=0)  # (unit columns: the conditioning of the parameters, not of their units)
@@ -300,4 +325,4 @@ def simulate(model: CalibrationModel, x_true: ArrayLike, readings: ArrayLike, *,
 
 
 __all__ = ["LOSSES", "SIGMA", "Accuracy", "Calibration", "accuracy", "calibrate", "perturbed", "pose_errors",
-           "simulate"]
+           "robust_weights", "simulate"]

@@ -1,6 +1,7 @@
 """Pose selection: the calibration poses that make the base parameters best observed.
 
-Candidates are random actuator readings around the reference, within ``spread`` [rad or m] of it, kept where the
+Candidates are random actuator readings around the reference, within ``spread`` of it (per unit, rad or m: by default
+0.3 rad, an excitation's amplitude, and 0.2 characteristic lengths: :func:`default_spread`), kept where the
 nominal mechanism closes, within its joint limits (:meth:`~pkm.core.Mechanism.outside_limits`: the workspace) and
 away from singularities: the closure system's smallest singular value over its largest (:func:`conditioning`) at
 least ``margin``. Among them, ``n`` poses are chosen greedily to maximise the observability index **O1** (Borm and
@@ -12,17 +13,31 @@ determinant lemma: ``log det(I + J_k A^{-1} J_k^T)``). O1 is the one optimised; 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
 from pkm.core.calibration.identifiable import BaseGeometry, base_geometry, stacked_jacobian
 from pkm.core.calibration.measurement import CalibrationModel
+from pkm.core.identification.base import AMPLITUDE, closed_draws, per_unit
+from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, PkmError
 from pkm.validation import as_count, as_scalar
 
 #: The closure system's default singularity margin (smallest over largest singular value).
 MARGIN = 1e-3
+#: The default spread of a prismatic reading, in characteristic lengths of the mechanism (a revolute one's:
+#: :data:`~pkm.core.identification.base.AMPLITUDE`'s 0.3 rad). An excitation's 0.03 m leaves the 3-PRS's sliders
+#: (L = 0.97 m) too little travel: its 16 poses' log O1 -214 and O4 5e-16; with 0.2 L, -104 and 2e-8 (the 0.1 that
+#: served rad and m alike: -146 and 3e-11; the Gough-Stewart's 30 poses: -103 with 0.2 L, -105 with 0.1 m).
+SPREAD_LENGTHS = 0.2
+
+
+def default_spread(mech: Mechanism) -> dict[str, float]:
+    """The candidates' default spread per unit: :data:`~pkm.core.identification.base.AMPLITUDE`'s for an angle,
+    :data:`SPREAD_LENGTHS` characteristic lengths for a length (a robot of 5 cm and one of 5 m are spread alike)."""
+    return {"rad": AMPLITUDE["rad"], "m": SPREAD_LENGTHS * mech.characteristic_length}
 
 
 @dataclass(frozen=True)
@@ -55,48 +70,42 @@ def conditioning(model: CalibrationModel, readings: np.ndarray, x: np.ndarray | 
     return s[:, -1 - model.idle] / s[:, 0]
 
 
-def candidates(model: CalibrationModel, n: int, *, spread: float = 0.1, margin: float = MARGIN,
-               seed: int = 0) -> np.ndarray:
-    """``n`` candidate readings (module doc). ``spread`` [rad or m]: the largest change of a reading from the
-    reference.
+def candidates(model: CalibrationModel, n: int, *, spread: float | Mapping[str, float] | None = None,
+               margin: float = MARGIN, seed: int = 0) -> np.ndarray:
+    """``n`` candidate readings (module doc), drawn by :func:`~pkm.core.identification.base.closed_draws` (as the
+    identification's random states are). ``spread`` [rad or m]: the largest change of a reading from the reference,
+    per unit (``{"rad": 0.3, "m": 0.1}``; default :func:`default_spread`: 0.3 rad, 0.2 characteristic lengths), or
+    one number where the actuators are all revolute or all prismatic (:func:`~pkm.core.identification.base.per_unit`).
 
     Raises:
-        InvalidInputError: fewer than ``n`` of ``20 n`` draws qualify (a smaller spread or margin may help).
+        InvalidInputError: fewer than ``n`` of ``20 n`` draws qualify (a smaller spread or margin may help); one
+            ``spread`` for revolute and prismatic actuators alike.
     """
-    from pkm.core.kinematics.solve import close_loops
-
     n = as_count(n, "n")
-    spread = as_scalar(spread, "spread", low=0.0, strict_low=True)
+    bound = per_unit(model.mech, default_spread(model.mech) if spread is None else spread, "spread")
     margin = as_scalar(margin, "margin", low=0.0)
-    mech = model.mech
     rng = np.random.default_rng(seed)
-    qa0 = mech.actuated_q(mech.q_reference)
     out: list[np.ndarray] = []
-    for _ in range(20 * n):
-        if len(out) == n:
-            break
-        qa = qa0 + rng.uniform(-spread, spread, mech.na)
-        try:
-            q = close_loops(mech, qa, mech.q_reference).q
-        except PkmError:  # (outside the workspace: drawn again)
-            continue
-        if mech.outside_limits(q):
-            continue
+    for qa, _ in closed_draws(model.mech, rng, bound, 20 * n):
         try:
             if conditioning(model, qa[None])[0] < margin:
                 continue
         except PkmError:  # (a singular pose: drawn again)
             continue
         out.append(qa)
+        if len(out) == n:
+            break
     if len(out) < n:
         raise InvalidInputError("spread", f"only {len(out)} of {n} candidate poses closed within the limits and the "
                                           f"singularity margin {margin:g}", spread)
     return np.array(out)
 
 
-def calibration_poses(model: CalibrationModel, n: int, *, pool: int | None = None, spread: float = 0.1, margin: float = MARGIN,
-         seed: int = 0) -> PosePlan:
-    """``n`` poses maximising O1 among ``pool`` candidates (default ``4 n``) (module doc).
+def calibration_poses(model: CalibrationModel, n: int, *, pool: int | None = None,
+                      spread: float | Mapping[str, float] | None = None, margin: float = MARGIN,
+                      seed: int = 0) -> PosePlan:
+    """``n`` poses maximising O1 among ``pool`` candidates (default ``4 n``; ``spread`` as :func:`candidates`')
+    (module doc).
 
     Raises:
         InvalidInputError: too few poses for the base parameters, or too few candidates.
@@ -133,4 +142,5 @@ def calibration_poses(model: CalibrationModel, n: int, *, pool: int | None = Non
     return PosePlan(C[chosen], float(np.sum(np.log(s))), float(s[-1] ** 2 / s[0]), len(C), base)
 
 
-__all__ = ["MARGIN", "PosePlan", "calibration_poses", "candidates", "conditioning"]
+__all__ = ["MARGIN", "SPREAD_LENGTHS", "PosePlan", "calibration_poses", "candidates", "conditioning",
+           "default_spread"]

@@ -57,6 +57,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from pkm.core.differential.idle import joint_inertia, without_idle
+from pkm.core.differential.velocity import RTOL, homogenised_pinv  # (one rank threshold with pkm.diagnose's)
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import close_loops
 from pkm.core.kinematics.task import TaskMap
@@ -65,7 +66,6 @@ from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.validation import as_scalar, as_tolerance, finite_result
 
-RTOL = 1e-9
 COULOMB_VELOCITY = 1e-3  # [rad/s or m/s]: the Coulomb friction's sign is smoothed as tanh(v / this)
 _FD_STEP = 2e-5
 
@@ -87,11 +87,8 @@ def _reduce(mech: Mechanism, q: np.ndarray, rtol: float) -> _Reduction:
     scales = JacobianScales.of(mech)
     Jc = constraints.jacobian(mech, q)
     pv, av = mech.passive_v, mech.act_v
-    cp = scales.columns[pv]
-    U, s, Vt = np.linalg.svd(scales.constraint(Jc)[:, pv], full_matrices=True)
+    Jp_pinv, s, Vt, r = homogenised_pinv(Jc[:, pv], scales.constraint_rows, scales.columns[pv], rtol)
     smax = float(s[0]) if s.size else 0.0
-    r = int(np.sum(s > rtol * smax)) if smax > 0.0 else 0
-    Jp_pinv = cp[:, None] * ((Vt[:r].T / s[:r]) @ U[:, :r].T) * scales.constraint_rows
     G = np.zeros((mech.nv, mech.na))
     G[av, np.arange(mech.na)] = 1.0
     G[pv] = -Jp_pinv @ Jc[:, av]

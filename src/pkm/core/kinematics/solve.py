@@ -46,7 +46,7 @@ from pkm.errors import (
     ModeChangeWarning,
     UnreachableError,
 )
-from pkm.validation import as_count, as_scalar, as_tolerance
+from pkm.validation import as_count, as_scalar, as_tolerance, wrap_angle
 
 DEFAULT_TOL = 1e-12
 MAX_STEPS = 1000  #: continuation steps planned at most (a farther target gets longer steps)
@@ -278,7 +278,7 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
     tol, max_iter, max_step = _settings(tol, max_iter, max_step)
     qa0 = mech.actuated_q(q)
     rev = np.array([j.revolute for j in mech.actuated], dtype=bool)  # angles go the short way round (+-pi)
-    qa1 = np.where(rev, qa0 + (qa1 - qa0 + np.pi) % (2.0 * np.pi) - np.pi, qa1)
+    qa1 = np.where(rev, qa0 + wrap_angle(qa1 - qa0), qa1)
     n_steps = _n_steps(np.max(np.abs(qa1 - qa0)), max_step)
 
     def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -24,7 +24,7 @@ from pkm._derived import derived
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.units import quantities, quantity
-from pkm.validation import ABSURD, as_array, as_vector
+from pkm.validation import ABSURD, as_array, as_vector, wrap_angle
 
 _ANGLES = ("roll", "pitch", "yaw")
 _POS = {"x": 0, "y": 1, "z": 2}
@@ -118,7 +118,7 @@ class _FrameTask:
         out = y_target - y
         for i, c in enumerate(self.comp):
             if c in _ANGLES:
-                out[i] = (out[i] + np.pi) % (2 * np.pi) - np.pi
+                out[i] = wrap_angle(out[i])
         return out
 
     def retract(self, y: np.ndarray, dy: np.ndarray) -> np.ndarray:

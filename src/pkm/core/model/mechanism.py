@@ -62,6 +62,20 @@ class JointInfo:
 REDUCE: Callable[[Mechanism], tuple[Callable[..., Mechanism], tuple[Any, ...]]] | None = None
 
 
+def reference_points(model: pin.Model, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A model's points at ``q`` (each n x 3) [m]: its joints' origins, its frames' origins and its bodies' centres of
+    mass (the bodies with mass). The one source of a mechanism's size: the characteristic length
+    (:attr:`Mechanism.characteristic_length`) and the plausibility rules' extent
+    (:func:`pkm.core.model.plausibility.size`)."""
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    joints = np.array([data.oMi[j].translation for j in range(1, model.njoints)]).reshape(-1, 3)
+    frames = np.array([f.translation for f in data.oMf]).reshape(-1, 3)
+    centres = np.array([data.oMi[j].act(model.inertias[j].lever) for j in range(1, model.njoints)
+                        if model.inertias[j].mass > 0.0]).reshape(-1, 3)
+    return joints, frames, centres
+
+
 class Mechanism:
     """A parallel mechanism on Pinocchio.
 
@@ -262,10 +276,8 @@ class Mechanism:
         their Jacobians by it (:meth:`JacobianScales.of(mech) <pkm.core.model.scale.JacobianScales.of>`), so that
         they judge a mechanism of 5 cm as the same one of 5 m. Where every joint origin coincides, the frames'
         origins are used instead, and 1 m where they coincide too (nothing in the mechanism has a length)."""
-        data = self.model.createData()
-        pin.framesForwardKinematics(self.model, data, self.q_reference)
-        for points in (np.array([data.oMi[j].translation for j in range(1, self.model.njoints)]),
-                       np.array([f.translation for f in data.oMf])):
+        joints, frames, _ = reference_points(self.model, self.q_reference)
+        for points in (joints, frames):
             if len(points):
                 length = float(np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=1))))
                 if length > 0.0:

@@ -5,7 +5,9 @@ Checked on every mechanism built (:func:`pkm.core.model.builder.build`), each fi
 :attr:`~pkm.core.Mechanism.notes`. The rules, all scale-aware (a mechanism of 5 cm and one of 5 m are judged alike):
 
 * **size** ``L`` [m]: the largest extent, along x, y or z, of the joint origins, the frames' origins and the bodies'
-  centres of mass at the reference configuration (no rule of size below applies when ``L`` is 0);
+  centres of mass at the reference configuration (no rule of size below applies when ``L`` is 0): an extent, not the
+  :attr:`~pkm.core.Mechanism.characteristic_length` that thresholds scale by (an RMS spread of the joints), since a
+  bound must enclose the whole mechanism; both come from :func:`pkm.core.model.mechanism.reference_points`;
 * **mass** (``kind="mass"``): a body heavier than a solid steel cube of side ``L`` (:data:`DENSITY` ``L³``), the
   heaviest solid that fits in a cube enclosing the whole mechanism;
 * **inertia** (``kind="inertia"``): a body whose largest principal moment about its centre of mass exceeds
@@ -28,7 +30,7 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.mechanism import Mechanism, reference_points
 from pkm.errors import ImplausibleModelWarning
 
 DENSITY = 8000.0  # [kg/m^3] steel: the mass bound is a steel cube of side L
@@ -36,16 +38,12 @@ TRIANGLE_TOL = 1e-4  # relative slack of the triangle inequality (a file's round
 
 
 def size(mech: Mechanism) -> float:
-    """The mechanism's size ``L`` [m] (module doc)."""
-    model = mech.model
-    data = model.createData()
-    pin.forwardKinematics(model, data, mech.q_reference)
-    pin.updateFramePlacements(model, data)
-    points = [data.oMi[j].translation for j in range(1, model.njoints)]
-    points += [data.oMf[k].translation for k in range(model.nframes)]
-    points += [data.oMi[j].act(model.inertias[j].lever) for j in range(1, model.njoints)
-               if model.inertias[j].mass > 0.0]
-    return float(np.ptp(np.array(points), axis=0).max()) if len(points) > 1 else 0.0
+    """The mechanism's extent [m] (module doc): the largest width of :func:`~pkm.core.model.mechanism.reference_points`
+    (joints, frames, centres of mass) at the reference. Not :attr:`~pkm.core.Mechanism.characteristic_length` (the
+    RMS spread of the joints about their centroid, what thresholds scale by): a bound on a body's mass or inertia
+    must enclose the whole mechanism."""
+    points = np.vstack(reference_points(mech.model, mech.q_reference))
+    return float(np.ptp(points, axis=0).max()) if len(points) > 1 else 0.0
 
 
 def _body_names(model: pin.Model) -> list[str]:

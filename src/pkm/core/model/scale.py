@@ -18,8 +18,11 @@ ratio of singular values (a distance to a singularity, a condition index) is unc
 root-mean-square distance of the joints' origins from their centroid at the reference configuration
 (``mech.q_reference``), in [m]: a length of the mechanism itself, which scales exactly with it. Where every joint
 origin coincides, the frames' origins are used instead, and 1 m where they coincide too (nothing in the mechanism has
-a length). :meth:`JacobianScales.of(mech) <JacobianScales.of>` holds the factors (made once per mechanism and
-reference).
+a length). It is a spread, not an extent: the plausibility rules bound masses and inertias by the extent ``E``, the
+largest width along x, y or z of every joint origin, frame origin and centre of mass
+(:func:`pkm.core.model.plausibility.size`: a bound must enclose the whole mechanism, a scale need only grow with it;
+both from :func:`~pkm.core.model.mechanism.reference_points`; ``E`` is 1.8 to 2.5 ``L`` on the shipped mechanisms).
+:meth:`JacobianScales.of(mech) <JacobianScales.of>` holds the factors (made once per mechanism and reference).
 
 :func:`~pkm.core.model.builder.scaled_mechanism` builds the copy of a mechanism with every length multiplied by a
 factor (:func:`scale_urdf`: the URDF's origins, prismatic limits and speed limits, geometry, the inertias' centres of

@@ -14,8 +14,9 @@ A transmission here is a mechanism ``mech`` (the closed sub-mechanism alone, ``a
   (pivots fixed at the reference) or, with idle motions (a rod spinning between two balls), the least-norm step
   (:meth:`TransmissionKernels._newton`), at most :data:`MAX_STEP` long. ``residual`` is the largest closure
   residual at ``q_out`` [m, rad];
-  ``status`` (:data:`STATUS`): 0 ``OK`` (``residual <= TOL``), 1 ``NOT_CONVERGED``, 2 ``SINGULAR`` (a pivot under
-  :data:`~pkm.core.twin.kernels.PIVOT_FLOOR` relative to the reference at some iteration);
+  ``status`` (:data:`STATUS`): 0 ``OK`` (``residual <= tol``, by default :data:`RTOL` times the characteristic
+  length), 1 ``NOT_CONVERGED``, 2 ``SINGULAR`` (a pivot under :data:`~pkm.core.twin.kernels.PIVOT_FLOOR` relative to
+  the reference at some iteration);
 * ``ik`` ``(q, qo) -> (q_out, qm, status, residual)``: outputs to motors, the same Newton with the outputs held;
 * ``maps`` ``(q) -> (J, J_inv, pivot)``: the velocity map ``qdot_o = J qdot_m`` (k x k) and its inverse, each from
   its own closure solve (motors driving, outputs driving); the effort maps are their transposes by power balance:
@@ -54,6 +55,7 @@ from numpy.typing import ArrayLike
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.scale import JacobianScales
+from pkm.core.transmissions.coordinates import closure_tol
 from pkm.core.transmissions.transmission import Transmission
 from pkm.core.twin.dynamics import ActuatorTwin, cholesky, cholesky_solve
 from pkm.core.twin.kernels import PIVOT_FLOOR
@@ -71,8 +73,10 @@ ITERATIONS = 8
 #: ankle's FK converges for 200 of 200 motor positions within ±0.05 rad, its IK for 180 with this bound, 171 with
 #: 0.2 and 187 without; the humanoid ankle's and the battobot's every sample either way.)
 MAX_STEP = 0.5
-#: The largest closure residual at which a solve counts as converged [m, rad].
-TOL = 1e-12
+#: The largest closure residual at which a solve counts as converged, relative to the sub-mechanism's characteristic
+#: length (:func:`~pkm.core.transmissions.coordinates.closure_tol`: 1e-12 m on a sub-mechanism of 0.1 m, where it was
+#: 1e-12 m on any).
+RTOL = 1e-11
 #: The status codes, in order from 0 (``INVALID_INPUT``: the C target's own check of its inputs, before the kernel).
 STATUS = ("OK", "NOT_CONVERGED", "SINGULAR", "INVALID_INPUT")
 
@@ -102,7 +106,8 @@ class TransmissionKernels:
         outputs: The output joints (as many as motors; one-coordinate joints of ``mech``).
         name: The transmission's name (default the mechanism's): C names, files.
         iterations: Newton iterations unrolled in ``fk`` and ``ik``.
-        tol: Convergence tolerance of ``fk`` and ``ik`` on the largest closure residual [m, rad].
+        tol: Convergence tolerance of ``fk`` and ``ik`` on the largest closure residual [m, rad] (default :data:`RTOL`
+            times the sub-mechanism's characteristic length).
 
     Raises:
         TransmissionError: the outputs are not one-coordinate joints of ``mech``, are motors, are not as many as
@@ -111,13 +116,13 @@ class TransmissionKernels:
     """
 
     def __init__(self, mech: Mechanism, outputs: Sequence[str], *, name: str | None = None,
-                 iterations: int = ITERATIONS, tol: float = TOL):
+                 iterations: int = ITERATIONS, tol: float | None = None):
         self.mech = check_mechanism(mech)
         self.name = name or mech.name
         self.outputs = tuple(outputs)
         self.motors = tuple(mech.actuated_names)
         self.iterations = as_count(iterations, "iterations", high=100)
-        self.tol = as_tolerance(tol, "tol")
+        self.tol = closure_tol(self.mech, RTOL) if tol is None else as_tolerance(tol, "tol")
         for o in self.outputs:
             j = mech.joints.get(o)
             if j is None or j.nq != 1 or j.nv != 1:
@@ -358,4 +363,4 @@ def c_identifier(name: str) -> str:
     return out if out and not out[0].isdigit() else f"t_{out}"
 
 
-__all__ = ["ITERATIONS", "KERNELS", "MAX_STEP", "STATUS", "TOL", "TransmissionKernels", "c_identifier"]
+__all__ = ["ITERATIONS", "KERNELS", "MAX_STEP", "RTOL", "STATUS", "TransmissionKernels", "c_identifier"]

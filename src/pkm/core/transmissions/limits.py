@@ -6,7 +6,9 @@ singularity (:mod:`pkm.core.analysis.region`: the same rules, ``singularity`` th
 * two outputs: :func:`pkm.feasible_region` in their plane (a polygon, each vertex naming what stops it), and its
   :meth:`~pkm.core.analysis.region.Region.box` (the largest box about the reference in the polygon's proportions);
 * one output: the interval about the reference, followed out each way by ``steps`` steps up to ``reach`` and the
-  first step out bisected to ``tol`` (the 1-D case of the same search), its ends the limits;
+  first step out bisected to ``tol`` (the 1-D case of the same search), its ends the limits; ``reach`` per unit (1 rad,
+  :data:`REACH_LENGTHS` characteristic lengths of the sub-mechanism) and ``tol`` relative (:data:`SEARCH_RTOL` rad or characteristic
+  lengths), so that a transmission of 5 cm and one of 5 m are searched alike;
 * more outputs: not traced (:class:`OutputLimits` with no limits; the export says so).
 
 Every corner of the box (both ends of the interval) is then solved by the inverse kinematics from the reference and
@@ -18,6 +20,7 @@ from __future__ import annotations
 
 import itertools
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,6 +29,7 @@ from pkm.core.analysis.region import SINGULARITY, _feasible, feasible_region, ma
 from pkm.core.model.joints import stated_limits
 from pkm.core.transmissions.transmission import Transmission
 from pkm.errors import PkmWarning
+from pkm.validation import as_scalar
 
 
 @dataclass(frozen=True)
@@ -70,11 +74,30 @@ def _interval(t: Transmission, singularity: float, reach: float, steps: int, tol
     return np.array(ends), (why[0], why[1])
 
 
-def output_limits(t: Transmission, *, singularity: float = SINGULARITY, reach: float = 1.0, directions: int = 24,
-                  steps: int = 20, tol: float = 1e-8) -> OutputLimits:
-    """The box limits of ``t``'s outputs and their feasible region (module doc); ``reach`` [rad or m] the largest
-    distance searched from the reference, ``directions`` rays for two outputs."""
+#: The search's bisection tolerance, relative: in rad, or in characteristic lengths of the sub-mechanism.
+SEARCH_RTOL = 1e-8
+#: A prismatic output's default reach, in characteristic lengths of the sub-mechanism (a revolute one's: 1 rad); the
+#: SDF slider-crank's rail travels 1.07 of them from its reference to its inverse singularity.
+REACH_LENGTHS = 8.0
+
+
+def output_limits(t: Transmission, *, singularity: float = SINGULARITY,
+                  reach: float | Mapping[str, float] | None = None, directions: int = 24, steps: int = 20,
+                  tol: float = SEARCH_RTOL) -> OutputLimits:
+    """The box limits of ``t``'s outputs and their feasible region (module doc); ``reach`` the largest distance
+    searched from the reference per output unit (``{"rad": ..., "m": ...}``, or one number where the outputs share
+    their unit: :func:`~pkm.core.identification.base.per_unit`'s rule), default 1 rad or :data:`REACH_LENGTHS`
+    characteristic lengths of the sub-mechanism; ``tol`` the bisection's, relative (rad, or characteristic lengths); ``directions`` rays for
+    two outputs (two outputs of different units: their plane's rays take the larger reach and the smaller
+    tolerance)."""
+    from pkm.core.identification.base import per_unit
+
     sub = t.mechanism
+    revolute = np.array([sub.joints[o].revolute for o in t.outputs])
+    unit = np.where(revolute, 1.0, sub.characteristic_length)  # (1 rad, or one characteristic length)
+    far = np.where(revolute, 1.0, REACH_LENGTHS * unit) if reach is None else per_unit(sub, reach, "reach", t.outputs)
+    tol = float(as_scalar(tol, "tol", low=0.0, strict_low=True) * unit.min())
+    reach = float(far.max())
     binding: tuple[str, ...]
     if t.k == 1:
         ends, binding = _interval(t, singularity, reach, steps, tol)
@@ -101,4 +124,4 @@ def output_limits(t: Transmission, *, singularity: float = SINGULARITY, reach: f
     return OutputLimits(t.outputs, None, None, polygon, tuple(binding), 0)
 
 
-__all__ = ["OutputLimits", "output_limits"]
+__all__ = ["REACH_LENGTHS", "SEARCH_RTOL", "OutputLimits", "output_limits"]

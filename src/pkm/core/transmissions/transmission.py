@@ -31,13 +31,10 @@ from pkm.core.differential.velocity import RTOL, forward_jacobian, inverse_jacob
 from pkm.core.kinematics.solve import close_loops, solve_ik
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.scale import JacobianScales
-from pkm.core.transmissions.coordinates import OutputSplit, output_model, output_split, serial_tree
+from pkm.core.transmissions.coordinates import OutputSplit, closure_tol, output_model, output_split, serial_tree
 from pkm.errors import SingularityError, TransmissionError
 from pkm.validation import as_vector
 
-#: The position solvers' tolerance on the closure residual and the task error [m, rad]: tight, so that a round trip
-#: motors -> outputs -> motors comes back to 1e-12.
-TOL = 1e-13
 #: Below this, an idle motion's motor component or the outputs' dependence (homogenised, relative) counts as zero.
 SINGULAR = 1e-7
 
@@ -103,19 +100,22 @@ class Transmission:
                                     f"at the reference: {exc}", self.motors, exc.sigma_min) from exc
 
     # ------------------------------------------------------------------ positions
-    def outputs_from_motors(self, qm: ArrayLike, guess: ArrayLike | None = None, *, tol: float = TOL,
+    def outputs_from_motors(self, qm: ArrayLike, guess: ArrayLike | None = None, *, tol: float | None = None,
                             max_iter: int = 30) -> tuple[np.ndarray, np.ndarray]:
         """Forward kinematics: ``(qo, q_sub)`` for the motors at ``qm`` [rad or m] (the sub-mechanism's loop closure,
-        seeded with the configuration ``guess``, default the reference). Raises
-        :class:`~pkm.errors.ConvergenceError` when the loops do not close within ``max_iter`` Newton iterations per
-        continuation step."""
+        seeded with the configuration ``guess``, default the reference; ``tol`` [m, rad] on the closure residual,
+        default relative to the sub-mechanism's size: :func:`~pkm.core.transmissions.coordinates.closure_tol`).
+        Raises :class:`~pkm.errors.ConvergenceError` when the loops do not close within ``max_iter`` Newton
+        iterations per continuation step."""
+        tol = closure_tol(self.mechanism) if tol is None else tol
         q = close_loops(self.mechanism, qm, guess, tol=tol, max_iter=max_iter).q
         return q[self.out_q].copy(), q
 
-    def motors_from_outputs(self, qo: ArrayLike, guess: ArrayLike | None = None, *, tol: float = TOL,
+    def motors_from_outputs(self, qo: ArrayLike, guess: ArrayLike | None = None, *, tol: float | None = None,
                             max_iter: int = 30) -> tuple[np.ndarray, np.ndarray]:
         """Inverse kinematics: ``(qm, q_sub)`` for the outputs at ``qo`` [rad or m] (the sub-mechanism's inverse
-        kinematics, seeded with ``guess``, default the reference)."""
+        kinematics, seeded with ``guess``, default the reference; ``tol`` as :meth:`outputs_from_motors`')."""
+        tol = closure_tol(self.mechanism) if tol is None else tol
         q = solve_ik(self.mechanism, as_vector(qo, self.k, "qo"), guess, tol=tol, max_iter=max_iter).q
         return self.mechanism.actuated_q(q), q
 
@@ -206,4 +206,4 @@ class Transmission:
         return self.output_model(q_sub, qd_o)[1] - self.serial_model(q_sub, qd_o)[1]
 
 
-__all__ = ["SINGULAR", "TOL", "Transmission"]
+__all__ = ["SINGULAR", "Transmission"]
