@@ -298,6 +298,9 @@ class SingularityError(PkmError):
 class ConvergenceError(PkmError):
     """An iterative solver did not converge.
 
+    ``message`` replaces the whole message where the failure is not a residual above a tolerance (a budget of
+    evaluations spent: ``residual`` and ``tolerance`` then hold what that message names).
+
     Attributes:
         what: The solver that failed (e.g. "loop closure").
         residual: Final residual norm (infinity norm, SI units of the equations).
@@ -312,7 +315,7 @@ class ConvergenceError(PkmError):
     """
 
     def __init__(self, what: str, residual: float, iterations: int, tolerance: float, result: object = None,
-                 detail: str = ""):
+                 detail: str = "", *, message: str | None = None):
         self.what = what
         self.residual = float(residual)
         self.iterations = int(iterations)
@@ -322,10 +325,10 @@ class ConvergenceError(PkmError):
         self.worst_gap: float = 0.0
         self.problem: object = None
         extra = f"; {detail}" if detail else ""
-        super().__init__(
+        super().__init__(message or (
             f"{what} did not converge: residual {self.residual:.3e} > tolerance {self.tolerance:.1e} "
             f"after {self.iterations} iterations{extra}"
-        )
+        ))
 
 
 class NonFiniteError(PkmError, ArithmeticError):
