@@ -113,13 +113,15 @@ class ModeChangeWarning(PkmWarning):
 
 class PoorIdentificationWarning(PkmWarning):
     """An identification whose data cannot carry its parameters (:func:`pkm.estimate`): fewer equations than three
-    per base parameter, or base parameters whose relative standard deviation exceeds 100 % (their estimate cannot
-    be told from zero). The same sentence is kept in ``Estimate.warnings``.
+    per base parameter, or poorly identified base parameters (a relative standard deviation above 100 %, their
+    estimate cannot be told from zero, and a deviation worth more than 1 % of the efforts:
+    :mod:`pkm.core.identification.estimate`). The same sentence is kept in ``Estimate.warnings``.
 
     Attributes:
         equations: The rows the estimate stacked (samples times actuators).
         n_base: The number of base parameters.
-        poor: ``((name, relative standard deviation [%]), ...)`` of each base parameter above 100 % (may be empty).
+        poor: ``((name, relative standard deviation [%]), ...)`` of each poorly identified base parameter (may be
+            empty).
     """
 
     def __init__(self, message: str, equations: int, n_base: int, poor: Iterable[tuple[str, float]] = ()):

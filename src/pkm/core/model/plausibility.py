@@ -4,8 +4,11 @@ Checked on every mechanism built (:func:`pkm.core.model.builder.build`), each fi
 :class:`~pkm.errors.ImplausibleModelWarning` (its bodies or joints and values as attributes) and a line of
 :attr:`~pkm.core.Mechanism.notes`. The rules, all scale-aware (a mechanism of 5 cm and one of 5 m are judged alike):
 
-* **size** ``L`` [m]: the largest extent, along x, y or z, of the joint origins, the frames' origins and the bodies'
-  centres of mass at the reference configuration (no rule of size below applies when ``L`` is 0);
+* **size** ``L`` [m]: the largest extent, along x, y or z, of the joint origins, the frames' origins and the
+  centres of mass of the bodies that weigh at least :data:`MASS_SHARE` of the whole at the reference configuration
+  (no rule of size below applies when ``L`` is 0). A lighter body's centre of mass (its first moment over its mass)
+  says nothing of the mechanism's extent: an identified body of almost no mass and a finite first moment has it
+  metres away (a Delta of 0.45 m measured 4.1 m so);
 * **mass** (``kind="mass"``): a body heavier than a solid steel cube of side ``L`` (:data:`DENSITY` ``L³``), the
   heaviest solid that fits in a cube enclosing the whole mechanism;
 * **inertia** (``kind="inertia"``): a body whose largest principal moment about its centre of mass exceeds
@@ -33,6 +36,7 @@ from pkm.errors import ImplausibleModelWarning
 
 DENSITY = 8000.0  # [kg/m^3] steel: the mass bound is a steel cube of side L
 TRIANGLE_TOL = 1e-4  # relative slack of the triangle inequality (a file's rounding of a flat body's moments)
+MASS_SHARE = 1e-2  # a body's centre of mass counts in the size where it weighs at least this share of the total
 
 
 def size(mech: Mechanism) -> float:
@@ -43,8 +47,9 @@ def size(mech: Mechanism) -> float:
     pin.updateFramePlacements(model, data)
     points = [data.oMi[j].translation for j in range(1, model.njoints)]
     points += [data.oMf[k].translation for k in range(model.nframes)]
+    total = sum(max(float(model.inertias[j].mass), 0.0) for j in range(1, model.njoints))
     points += [data.oMi[j].act(model.inertias[j].lever) for j in range(1, model.njoints)
-               if model.inertias[j].mass > 0.0]
+               if model.inertias[j].mass > 0.0 and model.inertias[j].mass >= MASS_SHARE * total]
     return float(np.ptp(np.array(points), axis=0).max()) if len(points) > 1 else 0.0
 
 
@@ -120,4 +125,4 @@ def _power_of_ten(x: float) -> bool:
     return x == float(10.0 ** k) or math.isclose(x, 10.0 ** k, rel_tol=1e-12)
 
 
-__all__ = ["DENSITY", "TRIANGLE_TOL", "findings", "size"]
+__all__ = ["DENSITY", "MASS_SHARE", "TRIANGLE_TOL", "findings", "size"]
