@@ -99,3 +99,24 @@ def test_an_identified_body_far_off_is_judged_by_the_mechanism_s_size_once_namin
     assert size(out) == pytest.approx(size(delta), rel=1e-12) and out.notes.count(str(found[0])) == 1
     with pytest.warns(ImplausibleModelWarning, match=r"^the model identified from .*delta"):
         identified_mechanism(delta, theta)
+
+
+def test_a_negligible_body_is_not_judged_by_the_inertia_rules(built):
+    """The consistent estimate's massless links of the identification tour (issue 52): 1.6e-7 kg carrying 2.9e-6
+    kg m^2, another breaking the triangle inequality by 4e-14 kg m^2, on a Delta whose M L^2 is 0.13 kg m^2: no
+    measurement sees them; inertias 1000 and 1e9 times larger are judged."""
+    from pkm.core.identification.export import identified_mechanism
+    from pkm.core.identification.regressor import parameters
+
+    delta = built("delta")
+    P = parameters(delta)
+    for scales, fired in (((1.0, 1.0), set()), ((1e3, 1e9), {"inertia", "triangle"})):
+        theta = P.values.copy()
+        for body, m, moments, scale in (("knee_cross_2", 1.6e-7, (2.9e-6, 2.9e-6, 2.9e-6), scales[0]),
+                                        ("knee_cross_3", 1e-3, (1e-13, 1e-13, 2.4e-13), scales[1])):
+            k = P.names.index(f"{body}.m")
+            theta[k:k + 10] = [m, 0, 0, 0, moments[0] * scale, 0, moments[1] * scale, 0, 0, moments[2] * scale]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ImplausibleModelWarning)
+            out = identified_mechanism(delta, theta)
+        assert {w.kind for w in findings(out)} == fired

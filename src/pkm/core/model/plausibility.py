@@ -15,6 +15,9 @@ Checked on every mechanism built (:func:`pkm.core.model.builder.build`), each fi
   ``m L²`` (its radius of gyration beyond the whole mechanism's extent);
 * **triangle** (``kind="triangle"``): principal moments ``I1 <= I2 <= I3`` about the centre of mass with
   ``I3 > I1 + I2`` by more than :data:`TRIANGLE_TOL` ``I3`` (no distribution of mass has them);
+* the inertia and triangle rules leave out a body whose ``I3`` is under :data:`NEGLIGIBLE` ``M L²`` (``M`` the
+  whole mass): no measurement sees it (an identified massless link: the consistent estimate's 1e-7 kg and 3e-6
+  kg m² on a Delta whose ``M L²`` is 0.13 kg m², its triangle broken by 4e-14 kg m²);
 * **limits** (``kind="limits"``): every actuated joint with the same effort limit and the same velocity limit,
   each a power of ten (``10^k``, ``k`` an integer: 1000 N m and 100 rad/s, an exporter's or a template's
   placeholders). A limit of 0 or of at least 1e6 in a file already reads as none (:mod:`pkm.core.model.actuators`).
@@ -37,6 +40,7 @@ from pkm.errors import ImplausibleModelWarning
 DENSITY = 8000.0  # [kg/m^3] steel: the mass bound is a steel cube of side L
 TRIANGLE_TOL = 1e-4  # relative slack of the triangle inequality (a file's rounding of a flat body's moments)
 MASS_SHARE = 1e-2  # a body's centre of mass counts in the size where it weighs at least this share of the total
+NEGLIGIBLE = 1e-4  # a body's largest principal moment under this times M L^2: left out of the inertia rules
 
 
 def size(mech: Mechanism) -> float:
@@ -47,10 +51,14 @@ def size(mech: Mechanism) -> float:
     pin.updateFramePlacements(model, data)
     points = [data.oMi[j].translation for j in range(1, model.njoints)]
     points += [data.oMf[k].translation for k in range(model.nframes)]
-    total = sum(max(float(model.inertias[j].mass), 0.0) for j in range(1, model.njoints))
+    total = _total_mass(model)
     points += [data.oMi[j].act(model.inertias[j].lever) for j in range(1, model.njoints)
                if model.inertias[j].mass > 0.0 and model.inertias[j].mass >= MASS_SHARE * total]
     return float(np.ptp(np.array(points), axis=0).max()) if len(points) > 1 else 0.0
+
+
+def _total_mass(model: pin.Model) -> float:
+    return sum(max(float(model.inertias[j].mass), 0.0) for j in range(1, model.njoints))
 
 
 def _body_names(model: pin.Model) -> list[str]:
@@ -71,6 +79,7 @@ def findings(mech: Mechanism) -> list[ImplausibleModelWarning]:
     model = mech.model
     names = _body_names(model)
     L = size(mech)
+    floor = NEGLIGIBLE * _total_mass(model) * L * L
     heavy, spread, skew = [], [], []
     for j in range(1, model.njoints):
         inertia = model.inertias[j]
@@ -80,6 +89,8 @@ def findings(mech: Mechanism) -> list[ImplausibleModelWarning]:
         e = np.linalg.eigvalsh(np.asarray(inertia.inertia, dtype=float))
         if L > 0.0 and m > DENSITY * L ** 3:
             heavy.append((names[j], m))
+        if e[2] <= floor:
+            continue
         if L > 0.0 and e[2] > m * L * L:
             spread.append((names[j], float(e[2]), m * L * L))
         if e[2] - e[0] - e[1] > TRIANGLE_TOL * e[2]:
@@ -125,4 +136,4 @@ def _power_of_ten(x: float) -> bool:
     return x == float(10.0 ** k) or math.isclose(x, 10.0 ** k, rel_tol=1e-12)
 
 
-__all__ = ["DENSITY", "MASS_SHARE", "TRIANGLE_TOL", "findings", "size"]
+__all__ = ["DENSITY", "MASS_SHARE", "NEGLIGIBLE", "TRIANGLE_TOL", "findings", "size"]
