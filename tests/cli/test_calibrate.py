@@ -37,3 +37,15 @@ def test_bad_table_is_one_error_line(tmp_path, capsys) -> None:
     assert cli.main(["calibrate", "prs3", str(table), "--out", str(tmp_path / "o")]) != 0
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("pkm: error: ") and "row 4, column 'z'" in err[0] and "mm" in err[0]
+
+
+def test_the_budget_and_the_spread_are_options_whose_help_states_the_defaults(capsys) -> None:
+    """Issue 52: the least squares' budget (a fixed 200) could not be reached from the command line."""
+    from pkm.core.calibration.estimate import NFEV_PER_PARAMETER
+    from pkm.core.calibration.poses import SPREAD
+
+    for argv in (["calibrate", "--help"], ["calibrate", "plan", "--help"]):
+        assert cli.main(argv) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"--max-evaluations N the least squares' budget of residual evaluations (default {NFEV_PER_PARAMETER} " in text
+    assert f"(default {SPREAD:g} rad for a revolute actuator, {SPREAD:g} x the mechanism's characteristic" in text

@@ -99,3 +99,10 @@ def test_bad_input_is_one_error_line(tmp_path):
     line = one_error_line(run("excite", "delta", "--harmonics", "5", "--samples", "4", "--out",
                               str(tmp_path / "e.csv")))
     assert "samples" in line
+
+
+def test_cutoff_help_states_the_decimation(capsys):
+    """Issue 52: ``--cutoff 2`` kept 29 of 5,001 rows and its help did not say that it decimates."""
+    assert cli.main(["identify", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "decimated to one in rate / (2 cutoff)" in text and "rows kept are reported" in text
