@@ -250,7 +250,10 @@ def calibrate(model: CalibrationModel, readings: ArrayLike, measured: ArrayLike,
                                        loss=loss, f_scale=1.0, bounds=(lo, hi) if method == "trf" else (-np.inf, np.inf),
                                        x_scale="jac", max_nfev=budget, **dict.fromkeys(("xtol", "ftol", "gtol"), tol))
     dof = rows - len(free)
-    if sol.status <= 0:  # (the fit is judged by its chi-square in units of the noise, the steps by tol: both said)
+    if sol.status < 0:  # (scipy's "improper input")
+        raise ConvergenceError(f"calibration least squares ({sol.message})", float(sol.fun @ sol.fun / dof),
+                               int(sol.nfev), tol, sol)
+    if sol.status == 0:  # (the fit is judged by its chi-square in units of the noise, the steps by tol: both said)
         chi2 = float(sol.fun @ sol.fun / dof)
         raise ConvergenceError("calibration least squares", chi2, int(sol.nfev), tol, sol, message=(
             f"calibration least squares ran out of evaluations ({sol.nfev}) before converging: reduced chi-square "
