@@ -131,18 +131,16 @@ def test_deviations_that_do_not_exist_are_refused() -> None:
 
 
 def test_candidates_spread_per_unit_by_default() -> None:
-    """Without a spread, a prismatic reading moves by up to SPREAD_LENGTHS characteristic lengths (the 3-PRS's sliders:
-    0.19 m), the same draw as a mapping's value for its unit; on the Delta (revolute) by up to 0.3 rad."""
-    from pkm.core.calibration.poses import SPREAD_LENGTHS
-    from pkm.core.identification.base import AMPLITUDE
+    """Without a spread, a prismatic reading moves by up to SPREAD characteristic lengths (the 3-PRS's sliders:
+    0.19 m), the same draw as a mapping's value for its unit; on the Delta (revolute) by up to SPREAD rad."""
+    from pkm.core.calibration.poses import SPREAD
 
-    for name, bound in (("prs3", SPREAD_LENGTHS * model("prs3").mech.characteristic_length),
-                        ("delta", AMPLITUDE["rad"])):
+    for name, bound in (("prs3", SPREAD * model("prs3").mech.characteristic_length), ("delta", SPREAD)):
         m = model(name, "pose")
         ref = m.mech.actuated_q(m.mech.q_reference)
         drawn = candidates(m, 6, seed=2)
         assert 0.5 * bound < np.abs(drawn - ref).max() <= bound
-        assert np.array_equal(candidates(m, 6, seed=2, spread={"rad": AMPLITUDE["rad"], "m": bound}), drawn)
+        assert np.array_equal(candidates(m, 6, seed=2, spread={"rad": SPREAD, "m": bound}), drawn)
 
 
 def test_columns_given_as_a_dict_take_the_identification_route(tmp_path) -> None:

@@ -1,7 +1,8 @@
 """Pose selection: the calibration poses that make the base parameters best observed.
 
 Candidates are random actuator readings around the reference, within ``spread`` of it (per unit, rad or m: by default
-0.3 rad, an excitation's amplitude, and 0.2 characteristic lengths: :func:`default_spread`), kept where the
+:data:`SPREAD` rad for a revolute actuator and :data:`SPREAD` characteristic lengths for a prismatic one,
+:func:`default_spread`: the same poses for a robot of 5 cm and of 5 m), kept where the
 nominal mechanism closes, within its joint limits (:meth:`~pkm.core.Mechanism.outside_limits`: the workspace) and
 away from singularities: the closure system's smallest singular value over its largest (:func:`conditioning`) at
 least ``margin``. Among them, ``n`` poses are chosen greedily to maximise the observability index **O1** (Borm and
@@ -20,24 +21,24 @@ import numpy as np
 
 from pkm.core.calibration.identifiable import BaseGeometry, base_geometry, stacked_jacobian
 from pkm.core.calibration.measurement import CalibrationModel
-from pkm.core.identification.base import AMPLITUDE, closed_draws, per_unit
+from pkm.core.identification.base import closed_draws, per_unit
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, PkmError
 from pkm.validation import as_count, as_scalar
 
 #: The closure system's default singularity margin (smallest over largest singular value).
 MARGIN = 1e-3
-#: The default spread of a prismatic reading, in characteristic lengths of the mechanism (a revolute one's:
-#: :data:`~pkm.core.identification.base.AMPLITUDE`'s 0.3 rad). An excitation's 0.03 m leaves the 3-PRS's sliders
-#: (L = 0.97 m) too little travel: its 16 poses' log O1 -214 and O4 5e-16; with 0.2 L, -104 and 2e-8 (the 0.1 that
-#: served rad and m alike: -146 and 3e-11; the Gough-Stewart's 30 poses: -103 with 0.2 L, -105 with 0.1 m).
-SPREAD_LENGTHS = 0.2
+#: The default spread of the readings about the reference: rad for a revolute actuator, characteristic lengths for a
+#: prismatic one (:func:`default_spread`). At 0.1, poses of the shipped Delta and 3-PRS see their base parameters so
+#: poorly that the least squares crawl (40 poses: 589 and 397 evaluations; at 0.2, 12 and 11); the 3-PRS's 16 poses:
+#: log O1 -104 with 0.2 L, -146 with 0.1 m; an excitation's 0.03 m gives -214.
+SPREAD = 0.2
 
 
 def default_spread(mech: Mechanism) -> dict[str, float]:
-    """The candidates' default spread per unit: :data:`~pkm.core.identification.base.AMPLITUDE`'s for an angle,
-    :data:`SPREAD_LENGTHS` characteristic lengths for a length (a robot of 5 cm and one of 5 m are spread alike)."""
-    return {"rad": AMPLITUDE["rad"], "m": SPREAD_LENGTHS * mech.characteristic_length}
+    """The candidates' default spread per unit: :data:`SPREAD` rad for an angle, :data:`SPREAD` characteristic
+    lengths for a length (a robot of 5 cm and one of 5 m are spread alike)."""
+    return {"rad": SPREAD, "m": SPREAD * mech.characteristic_length}
 
 
 @dataclass(frozen=True)
@@ -74,7 +75,7 @@ def candidates(model: CalibrationModel, n: int, *, spread: float | Mapping[str, 
                margin: float = MARGIN, seed: int = 0) -> np.ndarray:
     """``n`` candidate readings (module doc), drawn by :func:`~pkm.core.identification.base.closed_draws` (as the
     identification's random states are). ``spread`` [rad or m]: the largest change of a reading from the reference,
-    per unit (``{"rad": 0.3, "m": 0.1}``; default :func:`default_spread`: 0.3 rad, 0.2 characteristic lengths), or
+    per unit (``{"rad": 0.2, "m": 0.1}``; default :func:`default_spread`: 0.2 rad, 0.2 characteristic lengths), or
     one number where the actuators are all revolute or all prismatic (:func:`~pkm.core.identification.base.per_unit`).
 
     Raises:
@@ -97,7 +98,7 @@ def candidates(model: CalibrationModel, n: int, *, spread: float | Mapping[str, 
             break
     if len(out) < n:
         raise InvalidInputError("spread", f"only {len(out)} of {n} candidate poses closed within the limits and the "
-                                          f"singularity margin {margin:g}", spread)
+                                          f"singularity margin {margin:g}", np.asarray(bound).tolist())
     return np.array(out)
 
 
@@ -142,5 +143,4 @@ def calibration_poses(model: CalibrationModel, n: int, *, pool: int | None = Non
     return PosePlan(C[chosen], float(np.sum(np.log(s))), float(s[-1] ** 2 / s[0]), len(C), base)
 
 
-__all__ = ["MARGIN", "SPREAD_LENGTHS", "PosePlan", "calibration_poses", "candidates", "conditioning",
-           "default_spread"]
+__all__ = ["MARGIN", "SPREAD", "PosePlan", "calibration_poses", "candidates", "conditioning", "default_spread"]

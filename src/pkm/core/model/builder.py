@@ -90,12 +90,14 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
                                     "[reference] to have pkm assemble the mechanism (pkm.assemble)")
     fit = actuation(mech)
     mech.dependent_actuators = fit.dependent
-    if fit.problem:
+    said = set(notes)  # (a rebuild of a mechanism, pkm.with_actuators: its notes told already, not warned again)
+    if fit.problem and f"at the reference configuration, {fit.problem}" not in said:
         mech.notes += (f"at the reference configuration, {fit.problem}",)
         warnings.warn(f"{source}: at the reference configuration, {fit.problem}", PkmWarning, stacklevel=3)
     for finding in plausibility.findings(mech):  # (masses, inertias, limits no real mechanism has)
-        mech.notes += (str(finding),)
-        warnings.warn(finding, stacklevel=3)
+        if str(finding) not in said:
+            mech.notes += (str(finding),)
+            warnings.warn(finding, stacklevel=3)
     return mech
 
 

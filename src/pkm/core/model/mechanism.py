@@ -62,9 +62,10 @@ class JointInfo:
 REDUCE: Callable[[Mechanism], tuple[Callable[..., Mechanism], tuple[Any, ...]]] | None = None
 
 
-def reference_points(model: pin.Model, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def reference_points(model: pin.Model, q: np.ndarray, min_mass: float = 0.0) -> tuple[np.ndarray, np.ndarray,
+                                                                                     np.ndarray]:
     """A model's points at ``q`` (each n x 3) [m]: its joints' origins, its frames' origins and its bodies' centres of
-    mass (the bodies with mass). The one source of a mechanism's size: the characteristic length
+    mass (the bodies with mass, and at least ``min_mass`` [kg]). The one source of a mechanism's size: the characteristic length
     (:attr:`Mechanism.characteristic_length`) and the plausibility rules' extent
     (:func:`pkm.core.model.plausibility.size`)."""
     data = model.createData()
@@ -72,7 +73,7 @@ def reference_points(model: pin.Model, q: np.ndarray) -> tuple[np.ndarray, np.nd
     joints = np.array([data.oMi[j].translation for j in range(1, model.njoints)]).reshape(-1, 3)
     frames = np.array([f.translation for f in data.oMf]).reshape(-1, 3)
     centres = np.array([data.oMi[j].act(model.inertias[j].lever) for j in range(1, model.njoints)
-                        if model.inertias[j].mass > 0.0]).reshape(-1, 3)
+                        if model.inertias[j].mass > 0.0 and model.inertias[j].mass >= min_mass]).reshape(-1, 3)
     return joints, frames, centres
 
 
