@@ -42,9 +42,13 @@ does not keep, from the file itself:
   ``<body>_hinge``, ``<body>_hinge_2`` (the second), ``<body>_slide``, ``<body>_ball``; a body
   ``<parent>_child`` (``_child_2``...); a derived name never takes one the file uses;
 * the reference configuration: the ``<keyframe><key name="reference">`` (the one :func:`pkm.save` writes), held
-  (a ``qpos`` of another length is refused naming its line); without it the mechanism is assembled starting from
-  MuJoCo's ``qpos0`` (hinges and slides at their ``ref``, free bodies where the file puts them), where a
-  ``<connect>``'s second anchor is taken (also for the connects pkm re-anchors: those to free bodies);
+  (a ``qpos`` of another length is refused naming its line, as in every key); without it, the first key whose
+  hinges and slides lie inside their ranges (MuJoCo Menagerie's ``home``: a pose MuJoCo's soft equalities leave
+  open by a millimetre or so): its free bodies and actuated joints held, the loops closed by moving the other joints
+  from it (a note names the key, the keys passed over, and how far the closing moved them); without any, assembled starting from MuJoCo's ``qpos0`` (hinges and
+  slides at their ``ref``, free bodies where the file puts them), where a ``<connect>``'s second anchor is taken
+  (also for the connects pkm re-anchors: those to free bodies). An assembled reference outside a joint's range
+  is said (:func:`pkm.core.model.builder.build`);
 * ``euler`` angles in any ``<compiler eulerseq>`` (three of ``xyzXYZ``: lower case about the moving axes,
   upper case about the fixed ones, mixed allowed): pkm writes each ``euler`` (bodies, geoms, sites,
   inertials, cameras, default classes...) as the ``quat`` MuJoCo computes, in the copy Pinocchio reads;
@@ -400,7 +404,8 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             body_joints[names[0]] = names
     if derived:
         notes.append(f"names derived for what the file leaves unnamed: {', '.join(derived)}")
-    key_qpos = _keyframe(root, world, kinds, source)
+    keys = _keyframes(root, world, kinds, source)
+    key_name, key_qpos = _key_chosen(keys, limits, notes)
 
     equalities = []
     for el in [el for el in root.findall("equality/*") if isinstance(el.tag, str)]:
@@ -441,7 +446,7 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
     for k, el in enumerate(el for el in equalities if el not in on_sites):  # Pinocchio returns them by name
         el.set("name", f"pkm{k:06d}")
     unread = [el.tag for el in root if isinstance(el.tag, str) and el.tag in _UNREAD
-              and not (el.tag == "keyframe" and key_qpos and len(el) == 1)]
+              and not (el.tag == "keyframe" and key_qpos)]  # (the keys not read: noted by _key_chosen)
     for el in root.findall("keyframe"):  # (Pinocchio checks their sizes; pkm reads the reference key itself)
         root.remove(el)
     if unread:
@@ -532,9 +537,16 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
                   if j.get("type") == "continuous"}
     keyed = _pinocchio_values(key_qpos, kinds, dependent, continuous)
     seed = {} if keyed else {j: _value(v, j in continuous) for j, v in refs.items() if v != 0.0 and j not in dependent}
-    if keyed:
+    if keyed and key_name == _KEY:
         reference = keyed
         notes.append(f"the reference configuration is the <keyframe><key name={_KEY!r}> (the one pkm writes)")
+    elif keyed:  # another key (Menagerie's "home"): its free bodies and motors held, the passive joints closed from it
+        held = [j for j in keyed if kinds[j] == "free" or j in actuated]
+        reference = {j: keyed[j] for j in held}
+        seed = {j: v for j, v in keyed.items() if j not in held}
+        notes.append(f"the reference configuration is the <keyframe><key name={key_name!r}>, the first key inside "
+                     "every joint limit, its loops closed by moving the joints no actuator drives (its free bodies "
+                     "and actuated joints held)")
     elif seed:
         notes.append(f"assembled from the joints' ref (MuJoCo's qpos0, where the file's poses hold): "
                      f"{', '.join(seed)}")
@@ -554,25 +566,51 @@ def _value(angle: float, continuous: bool) -> tuple[float, ...]:
     return (float(np.cos(angle)), float(np.sin(angle))) if continuous else (float(angle),)
 
 
-def _keyframe(root: etree._Element, world: etree._Element, kinds: dict[str, str],
-              source: str) -> dict[str, list[float]]:
-    """``{joint: its qpos}`` of the ``<key name="reference">`` (MuJoCo's order: the joints as the file nests them),
-    ``{}`` without that key.
+def _keyframes(root: etree._Element, world: etree._Element, kinds: dict[str, str],
+               source: str) -> list[tuple[str, dict[str, list[float]]]]:
+    """``[(name, {joint: its qpos})]`` of the ``<keyframe><key>`` elements that state a ``qpos`` (MuJoCo's order: the
+    joints as the file nests them), in file order; an unnamed key is named ``key <k>`` (its rank).
 
     Raises:
         SpecError: a ``qpos`` of the wrong length, or not numbers (naming the key's line).
     """
-    key = next((k for k in root.findall("keyframe/key") if k.get("name") == _KEY), None)
-    if key is None or key.get("qpos") is None:
-        return {}
     joints = [str(j.get("name")) for j in world.iter("joint", "freejoint")]
     width = sum(_QPOS[kinds[j]] for j in joints)
-    qpos = _floats(key.get("qpos"), width, f"<keyframe><key name={_KEY!r}> (line {key.sourceline}) qpos", source)
-    out, k = {}, 0
-    for j in joints:
-        out[j] = [float(x) for x in qpos[k:k + _QPOS[kinds[j]]]]
-        k += _QPOS[kinds[j]]
+    out = []
+    for rank, key in enumerate(root.findall("keyframe/key"), 1):
+        if key.get("qpos") is None:
+            continue
+        name = key.get("name") or f"key {rank}"
+        qpos = _floats(key.get("qpos"), width, f"<keyframe><key name={name!r}> (line {key.sourceline}) qpos", source)
+        values, k = {}, 0
+        for j in joints:
+            values[j] = [float(x) for x in qpos[k:k + _QPOS[kinds[j]]]]
+            k += _QPOS[kinds[j]]
+        out.append((name, values))
     return out
+
+
+def _key_chosen(keys: list[tuple[str, dict[str, list[float]]]], limits: dict[str, tuple[float, float]],
+                notes: list[str]) -> tuple[str | None, dict[str, list[float]]]:
+    """The key the reference comes from: ``reference`` (pkm's, whatever its values), else the first key whose hinges
+    and slides lie inside their ranges (Menagerie's ``home``), else none; notes name the keys passed over (those
+    outside a range, with the joints) and those not read."""
+    chosen = next((k for k, (name, _) in enumerate(keys) if name == _KEY), None)
+    chosen_by_name = chosen is not None
+    skipped: list[str] = []
+    for k, (name, values) in enumerate(keys if chosen is None else ()):
+        outside = [j for j, (lo, hi) in limits.items() if j in values and not lo - 1e-9 <= values[j][0] <= hi + 1e-9]
+        if not outside:
+            chosen = k
+            break
+        skipped.append(f"{name!r} ({', '.join(outside)})")
+    if skipped:
+        notes.append(f"keys outside the joint limits not taken for the reference: {'; '.join(skipped)}")
+    unread = [name for k, (name, _) in enumerate(keys) if chosen is not None and k != chosen
+              and (chosen_by_name or k > chosen)]
+    if unread:
+        notes.append(f"keys not read (the reference is one key): {', '.join(map(repr, unread))}")
+    return (None, {}) if chosen is None else keys[chosen]
 
 
 def _pinocchio_values(qpos: dict[str, list[float]], kinds: dict[str, str], dependent: set[str],

@@ -17,7 +17,10 @@ that closes (the same every run; a closed configuration near the zero pose, not 
 symmetry). :func:`pkm.core.kinematics.solve.nearest_assembly` gives the nearest (a symmetric one where a symmetry
 of the mechanism fixes the zero pose); it is not the default because the nearest is often near a singularity (a
 URDF's zero pose with aligned links): Gepetto's disney_like and wl16_like would get references 3 and 2 mrad from one.
-Write a ``[reference]`` (or ``pkm.save`` a mechanism whose ``q_reference`` was set) to choose.
+Write a ``[reference]`` (or ``pkm.save`` a mechanism whose ``q_reference`` was set) to choose. An assembled reference
+outside a joint's position limits is assembled again from those joints at the middle of their ranges
+(:data:`LIMIT_ROUNDS`), else kept with a :class:`~pkm.errors.PkmWarning` naming them; where the files state a pose
+whose loops are open (an MJCF keyframe), a note says by how much and how far closing them moved the joints.
 Actuators that depend on the others, or freedom no actuator drives (:func:`pkm.core.differential.velocity.actuation`),
 are reported by a :class:`~pkm.errors.PkmWarning` and in :attr:`Mechanism.notes`; so are masses, inertias and
 drive limits no real mechanism has (:mod:`pkm.core.model.plausibility`: an
@@ -74,14 +77,21 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
         mech.q_reference = mech.q_from_dict({n: v for n, v in seed.items() if n not in spec.reference})
     missing = [n for n, j in mech.joints.items() if j.nq > 0 and n not in spec.reference]
     if missing:  # a partial (or no) reference: assembled from it, the other joints from the neutral configuration
+        start = mech.q_reference.copy()
         try:
-            mech.q_reference = assemble(mech, mech.q_reference, hold=tuple(spec.reference), tol=1e-12).q
+            mech.q_reference = assemble(mech, start, hold=tuple(spec.reference), tol=1e-12).q
         except AssemblyError as exc:
             if not spec.reference:  # (the file states no configuration: the loops themselves do not close)
                 raise SpecError(source, f"the loops cannot be closed: {exc}") from exc  # (its closures, gaps)
             raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found that keeps the "
                                     f"joints it states, the others starting from the neutral configuration "
                                     f"({exc}); give an assembled [reference]") from None
+        gap = constraints.worst_closure(mech, constraints.residual(mech, start))[0] if seed else 0.0
+        if gap > REFERENCE_TOL:  # (where the pose the files state was open, how far closing it moved it)
+            moved = float(np.abs(pin.difference(model, start, mech.q_reference)).max())
+            mech.notes += (f"the loops open by {gap:.3g} (m or rad) at the pose the files state were closed by "
+                           f"assembly, which moved the joints by {moved:.3g} at most (rad or m)",)
+        mech.q_reference = _inside_limits(mech, start, tuple(spec.reference), source)
     else:
         gap, _, closure = constraints.worst_closure(mech, constraints.residual(mech, mech.q_reference))
         if gap > REFERENCE_TOL:
@@ -97,6 +107,43 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
         mech.notes += (str(finding),)
         warnings.warn(finding, stacklevel=3)
     return mech
+
+
+#: Rounds of :func:`_inside_limits`: each assembles once more (one Levenberg-Marquardt run, no restarts).
+LIMIT_ROUNDS = 3
+
+
+def _inside_limits(mech: Mechanism, start: np.ndarray, hold: tuple[str, ...], source: str) -> np.ndarray:
+    """The assembled reference ``mech.q_reference`` if it lies inside every position limit. Else the assembly from
+    ``start`` with the joints it put outside their limits (those not held) moved to the middle of their ranges, and
+    again with those the last assembly put outside, :data:`LIMIT_ROUNDS` times at most: the first inside every limit
+    (a note says which joints were moved), else the first assembly, with a :class:`~pkm.errors.PkmWarning` naming the
+    joints outside."""
+    q = mech.q_reference
+    outside = mech.outside_limits(q)
+    if not outside:
+        return q
+    moved: list[str] = []
+    last = outside
+    for _ in range(LIMIT_ROUNDS):
+        more = [n for n in last if n not in hold and n not in moved]
+        if not more:
+            break
+        moved += more
+        retry = start.copy()
+        for n in moved:
+            retry[mech.joints[n].idx_q] = 0.5 * sum(mech.limits[n])
+        again = assemble(mech, retry, hold=hold, tol=1e-12, restarts=0, raise_on_failure=False)
+        if again.converged and not again.outside_limits:
+            mech.notes += (f"the assembly from the pose the files state left {list(outside)} outside their position "
+                           f"limits: assembled again from {moved} at the middle of their ranges, inside every limit",)
+            return again.q
+        last = again.outside_limits
+    said = (f"the assembled reference configuration lies outside the position limits of {list(outside)} (state a "
+            "[reference], or a keyframe, inside them)")
+    mech.notes += (said,)
+    warnings.warn(f"{source}: {said}", PkmWarning, stacklevel=4)
+    return q
 
 
 def from_strings(urdf: str, spec: ClosureSpec | str, params: Any = None, source: str = "<string>",
