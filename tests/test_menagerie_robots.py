@@ -93,3 +93,17 @@ def test_it_simulates_with_the_defaults(cassie):
     assert np.max(sim.residual) <= 1e-10
     balance = sim.kinetic + sim.potential + sim.dissipated - sim.work
     assert np.abs(balance - balance[0]).max() <= 1e-3 * (sim.potential[0] - sim.potential[-1])
+
+
+def test_its_leaf_springs_are_read_noted_and_saved(cassie, feet, tmp_path):
+    """The shin (1500 N m/rad) and heel (1250 N m/rad) leaf springs and the passive joints' damping are ``[springs]``
+    entries, named in the notes, written back by ``pkm.save`` (the spec loads back with the same tables) and carried
+    into the foot transmissions' sub-mechanisms."""
+    springs = cassie.spec.springs
+    assert springs["left-shin"] == {"stiffness": 1500.0, "rest": 0.0, "damping": 0.1}
+    assert springs["right-heel-spring"] == {"stiffness": 1250.0, "rest": 0.0}
+    assert any("left-shin (stiffness 1500, rest 0, damping 0.1)" in n for n in cassie.notes)
+    spec = pkm.ClosureSpec.from_toml(pkm.save(cassie, tmp_path / "cassie.closures.toml").read_text())
+    assert spec.springs == springs
+    assert all(t.mechanism.spec.springs == {f"{t.motors[0].partition('-')[0]}-foot-crank": {"damping": 1.0}}
+               for t in feet)

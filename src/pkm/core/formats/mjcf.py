@@ -33,7 +33,12 @@ does not keep, from the file itself:
   ``gear`` and the tendon's coefficient or the mimic scale; several actuators on one joint add; the joint's
   ``actuatorfrcrange`` caps the sum. An asymmetric range reads as its smaller magnitude, a one-sided one as its
   larger (a note says so), ``1e6`` or more as none. What is not stated stays at the defaults (no friction, no
-  limit); the servo gains (``kp``, ``kv``) and the drives of joints no actuator moves are not read (notes);
+  limit); the servo gains (``kp``, ``kv``) and the armature and friction of joints no actuator moves are not read
+  (notes);
+* joint springs and dampers (:attr:`Imported.springs`, a spec's ``[springs.<joint>]`` tables:
+  :mod:`pkm.core.model.springs`): a hinge's or slide's ``stiffness`` and ``springref`` (MuJoCo's rest position, in
+  degrees for a hinge as ``ref``), and the ``damping`` of a joint no actuator drives; named in the notes, not applied
+  by pkm's dynamics; a ball's and a coupled joint's are not read (a note);
 * joint names and position limits (``range``, in degrees unless ``<compiler angle="radian">``, for
   hinges only; a slide's range is a length), with ``<default>`` classes and ``childclass``; a body with
   several joints keeps each one's name (Pinocchio joins them into one composite joint). ``q`` is MuJoCo's
@@ -89,6 +94,7 @@ from lxml import etree
 from pkm.core.formats.base import Imported
 from pkm.core.model.actuators import UNLIMITED, Actuator
 from pkm.core.model.spec import Closure
+from pkm.core.model.springs import describe, parse_springs
 from pkm.core.model.urdf import floats, num, parse_xml, urdf_from_model
 from pkm.errors import InvalidInputError, SpecError, SpecNameError
 
@@ -552,8 +558,9 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
                      f"{', '.join(seed)}")
     if len(set(actuated)) < len(actuated):
         notes.append("several actuators drive the same joint: it is one input")
+    springs = _springs(world, defaults, kinds, set(actuated), dependent, degrees, notes, source)
     return Imported(urdf, tuple(closures), types, tuple(dict.fromkeys(actuated)), name, "mjcf", _floating_base(model),
-                    reference, tuple(notes), actuators, seed)
+                    reference, tuple(notes), actuators, seed, springs)
 
 
 #: The ``<keyframe><key>`` read as the reference configuration (:func:`pkm.save` writes it).
@@ -829,10 +836,44 @@ def _drives(drives: list[_Drive], defaults: _Defaults, world: etree._Element, no
         if values:
             out[joint] = values
     passive = [n for n, el in elements.items() if n not in efforts
-               and any((defaults.get(el, key) or "0").strip() not in ("0", "0.0") for key, _ in _DRIVE_KEYS)]
+               and any((defaults.get(el, key) or "0").strip() not in ("0", "0.0") for key in ("armature", "frictionloss"))]
     if passive:
-        notes.append(f"armature, damping and frictionloss of joints no actuator drives are not read: "
-                     f"{', '.join(passive)}")
+        notes.append(f"armature and frictionloss of joints no actuator drives are not read (their damping is a "
+                     f"[springs] entry): {', '.join(passive)}")
+    return out
+
+
+def _springs(world: etree._Element, defaults: _Defaults, kinds: dict[str, str], actuated: set[str],
+             dependent: set[str], degrees: bool, notes: list[str], source: str) -> dict[str, dict[str, float]]:
+    """``{joint: {"stiffness", "rest", "damping": value}}`` (:mod:`pkm.core.model.springs`) of the hinges and slides
+    whose ``stiffness`` or (for a joint no actuator drives: a driven joint's damping is its drive's) ``damping`` is not
+    zero: ``rest`` is MuJoCo's ``springref`` (in degrees for a hinge unless ``<compiler angle="radian">``, as ``ref``).
+    A note names them, and says that pkm's dynamics do not apply them; the springs of ball joints and of joints an
+    ``<equality><joint>`` ties are not read (a note)."""
+    out: dict[str, dict[str, float]] = {}
+    unread = []
+    for el in world.iter("joint"):
+        name = str(el.get("name"))
+        stiffness, damping, rest = (floats(defaults.get(el, key, "0"), 1, f"joint {name!r} {key}", source, np.inf)[0]
+                                    for key in ("stiffness", "damping", "springref"))
+        if name in actuated:
+            damping = 0.0
+        if stiffness == 0.0 and damping == 0.0:
+            continue
+        if kinds[name] not in ("hinge", "slide") or name in dependent:
+            unread.append(name)
+            continue
+        values = {"stiffness": stiffness, "rest": float(np.deg2rad(rest)) if kinds[name] == "hinge" and degrees
+                  else rest} if stiffness != 0.0 else {}
+        if damping != 0.0:
+            values["damping"] = damping
+        out[name] = values
+    if out:
+        notes.append(f"joint springs and dampers read into [springs], their forces not applied by pkm's dynamics: "
+                     f"{describe(parse_springs(out, source))}")
+    if unread:
+        notes.append(f"the stiffness and damping of ball joints and of joints an <equality><joint> ties are not "
+                     f"read: {', '.join(unread)}")
     return out
 
 

@@ -154,6 +154,8 @@ class Mechanism:
         for b in spec.branches.values():
             for n in b.signs:
                 scalar_joint(n, f"branch {b.name!r}")
+        for n in spec.springs:
+            scalar_joint(n, f"[springs.{n}]")
         #: The drive of each actuated joint, in ``actuated`` order: the model file's values, then the spec's
         #: ``[actuators.<joint>]`` tables (:mod:`pkm.core.model.actuators`); written into the model's fields.
         self.actuators: tuple[Actuator, ...] = ()

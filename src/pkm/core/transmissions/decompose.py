@@ -158,6 +158,7 @@ def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[
         reference={n: tuple(np.atleast_1d(q_ref[n]).tolist()) for n in sorted(keep) if n in q_ref},
         joint_types=types, actuators={a.joint: {f: float(getattr(a, f)) for f in NUMBERS}
                                       for a in mech.actuators if a.joint in motors},
+        springs={n: v for n, v in mech.spec.springs.items() if n in keep},
         description=f"the closed sub-mechanism {name!r} of {mech.name!r}")
     with warnings.catch_warnings():  # (what the robot's loading said already: kept in the notes, not said twice)
         warnings.simplefilter("ignore", PkmWarning)
