@@ -7,7 +7,9 @@ does not keep, from the file itself:
 * ``<connect>`` gives a ``point`` closure and ``<weld>`` a ``frame`` closure, named by the equality's
   ``name`` (else ``connect1``, ``weld2``...); their anchors become frames ``<name>_a`` (on ``body1``)
   and ``<name>_b`` (on ``body2``, the world when it is omitted); an equality between two sites
-  (``site1``, ``site2``) closes those sites' frames (origins for a connect, frames for a weld);
+  (``site1``, ``site2``) closes those sites' frames (origins for a connect, frames for a weld; a site whose name
+  a body or a joint shares, as MJCF allows, on a frame of its own, ``<site>_site``, that a lookup by name cannot
+  confuse with them);
   an equality with ``active="false"`` is left out (a note says so); a weld is read as MuJoCo reads it,
   ``X1 relpose = X2 T(anchor)``: ``relpose`` (body2's pose in body1's frame, position then quaternion ``w x y
   z``; without it the pose at ``qpos0``), ``anchor`` (the point of body2 it holds), ``torquescale="0"`` (the
@@ -483,26 +485,52 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
                                        if el.tag == "weld" and el not in on_sites], defaults, source)
     taken = set(model.names) | {f.name for f in model.frames}
     extra: list[tuple[str, int, pin.SE3]] = []
-    for site in world.iter("site"):  # the sites Pinocchio dropped (those of bodies without joints)
-        if site.get("name") and site.get("name") not in taken:
-            body = site.getparent().get("name")
-            if not model.existFrame(body, pin.FrameType.BODY):
-                continue
-            bf = model.frames[model.getFrameId(body, pin.FrameType.BODY)]
-            pos = _floats(defaults.get(site, "pos", "0 0 0"), 3, f"site {site.get('name')!r} pos", source)
-            extra.append((site.get("name"), bf.parentJoint, bf.placement * pin.SE3(_rotation(site, degrees, source),
-                                                                                     pos)))
-            taken.add(site.get("name"))
+    site_els = {str(site.get("name")): site for site in world.iter("site") if site.get("name")}
+
+    def site_placement(site: etree._Element) -> tuple[int, pin.SE3] | None:
+        """A site's joint and placement in it: Pinocchio's frame of the site, else from its body (None: a site of
+        a body Pinocchio does not have)."""
+        name = str(site.get("name"))
+        if model.existFrame(name, pin.FrameType.OP_FRAME):
+            f = model.frames[model.getFrameId(name, pin.FrameType.OP_FRAME)]
+            return f.parentJoint, f.placement
+        body = site.getparent().get("name")
+        if not model.existFrame(body, pin.FrameType.BODY):
+            return None
+        bf = model.frames[model.getFrameId(body, pin.FrameType.BODY)]
+        pos = _floats(defaults.get(site, "pos", "0 0 0"), 3, f"site {name!r} pos", source)
+        return bf.parentJoint, bf.placement * pin.SE3(_rotation(site, degrees, source), pos)
+
+    for sname, site in site_els.items():  # the sites Pinocchio dropped (those of bodies without joints)
+        if sname not in taken and (at := site_placement(site)) is not None:
+            extra.append((sname, *at))
+            taken.add(sname)
+    aliases: dict[str, str] = {}
+
+    def site_frame(sname: str) -> str:
+        """The frame a closure on site ``sname`` names: the site's own, else (its name shared by a body or a joint,
+        as MJCF allows, where a lookup by name would find those) a frame of a fresh name at the site."""
+        if sname in aliases:
+            return aliases[sname]
+        same = [f for f in model.frames if f.name == sname]
+        if [f.type for f in same] in ([pin.FrameType.OP_FRAME], []) and not model.existJointName(sname):
+            return sname
+        at = site_placement(site_els[sname])
+        assert at is not None  # (a site in taken: its body is in the model)
+        aliases[sname] = _fresh(f"{sname}_site", taken)
+        extra.append((aliases[sname], *at))
+        return aliases[sname]
+
     closures = []
     iters = {"connect": iter(points), "weld": iter(welds)}
-    site_names = sorted(str(site.get("name")) for site in world.iter("site") if site.get("name") in taken)
+    site_names = sorted(n for n in site_els if n in taken)
     for tag, name, on, kind, line in eq_names:
         if on is not None:  # the two sites coincide (connect: their origins; weld: their frames)
             for key, site_name in zip(("site1", "site2"), on):
                 if site_name not in taken:
                     raise SpecNameError(source, "site", str(site_name), site_names,
                                         f"<equality><{tag} name={name!r}> (line {line}) {key}")
-            closures.append(Closure(name, kind, *on))
+            closures.append(Closure(name, kind, *(site_frame(str(s)) for s in on)))
             continue
         cm = next(iters[tag])
         frames = []
@@ -515,6 +543,9 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             frames.append(fname)
         closures.append(Closure(name, kind, *frames))
 
+    if aliases:
+        notes.append(f"sites whose names a body or a joint shares are closed on frames of their own: "
+                     f"{', '.join(f'{s} -> {a}' for s, a in aliases.items())}")
     joint_names = {f"Composite_{first}": parts for first, parts in body_joints.items() if len(parts) > 1}
     name = root.get("model", "mjcf")
     locked = {j: v for j in kinds if (v := couplings.value(j)) is not None}
