@@ -52,10 +52,11 @@ does not keep, from the file itself:
   (a ``qpos`` of another length is refused naming its line, as in every key); without it, the first key whose
   hinges and slides lie inside their ranges (MuJoCo Menagerie's ``home``: a pose MuJoCo's soft equalities leave
   open by a millimetre or so): its free bodies and actuated joints held, the loops closed by moving the other joints
-  from it (a note names the key, the keys passed over, and how far the closing moved them); without any, assembled starting from MuJoCo's ``qpos0`` (hinges and
-  slides at their ``ref``, free bodies where the file puts them), where a ``<connect>``'s second anchor is taken
-  (also for the connects pkm re-anchors: those to free bodies). An assembled reference outside a joint's range
-  is said (:func:`pkm.core.model.builder.build`);
+  from it (a note names the key, the keys passed over, and how far the closing moved them); without any, assembled
+  starting from MuJoCo's ``qpos0`` (hinges and slides at their ``ref``, free bodies where the file puts them), where
+  a ``<connect>``'s second anchor is taken (also for the connects pkm re-anchors: those to free bodies). An
+  assembled reference outside a joint's range is assembled again inside it, else said
+  (:func:`pkm.core.model.builder.build`);
 * ``euler`` angles in any ``<compiler eulerseq>`` (three of ``xyzXYZ``: lower case about the moving axes,
   upper case about the fixed ones, mixed allowed): pkm writes each ``euler`` (bodies, geoms, sites,
   inertials, cameras, default classes...) as the ``quat`` MuJoCo computes, in the copy Pinocchio reads;

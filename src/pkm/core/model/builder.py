@@ -135,7 +135,7 @@ def _inside_limits(mech: Mechanism, start: np.ndarray, hold: tuple[str, ...], so
             retry[mech.joints[n].idx_q] = 0.5 * sum(mech.limits[n])
         again = assemble(mech, retry, hold=hold, tol=1e-12, restarts=0, raise_on_failure=False)
         if again.converged and not again.outside_limits:
-            mech.notes += (f"the assembly from the pose the files state left {list(outside)} outside their position "
+            mech.notes += (f"the first assembly left {list(outside)} outside their position "
                            f"limits: assembled again from {moved} at the middle of their ranges, inside every limit",)
             return again.q
         last = again.outside_limits
