@@ -67,3 +67,17 @@ def test_a_spring_on_a_joint_the_model_lacks_is_refused_naming_the_valid_ones(bu
         from_strings(delta_mech.urdf, spec)
     kept = from_strings(delta_mech.urdf, dataclasses.replace(delta_mech.spec, springs={"motor_1": {"stiffness": 1.0}}))
     assert kept.spec.springs == {"motor_1": {"stiffness": 1.0}}
+
+
+def test_a_scaled_copy_scales_a_prismatic_spring_s_rest_length_only(built):
+    """``scaled_mechanism(mech, 2)``: a prismatic joint's spring rest length doubles, a revolute's rest angle and every
+    stiffness and damping stay (exact)."""
+    from pkm.core.model.builder import from_strings, scaled_mechanism
+
+    mech = built("prs3")
+    prismatic, revolute = "slider_1", "knee_1"
+    assert (mech.joints[prismatic].kind, mech.joints[revolute].kind) == ("JointModelPX", "JointModelRY")
+    springs = {prismatic: {"stiffness": 300.0, "rest": 0.05, "damping": 2.0}, revolute: {"stiffness": 4.0, "rest": 0.3}}
+    sprung = from_strings(mech.urdf, dataclasses.replace(mech.spec, springs=springs))
+    assert scaled_mechanism(sprung, 2.0).spec.springs == {
+        prismatic: {"stiffness": 300.0, "rest": 0.1, "damping": 2.0}, revolute: {"stiffness": 4.0, "rest": 0.3}}

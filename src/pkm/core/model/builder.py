@@ -263,9 +263,10 @@ def with_actuators(mech: Mechanism, actuators: Mapping[str, Any]) -> Mechanism:
 def scaled_mechanism(mech: Mechanism, factor: float) -> Mechanism:
     """A copy of ``mech`` with every length multiplied by ``factor`` (> 0): its URDF
     (:func:`~pkm.core.model.scale.scale_urdf`: origins, prismatic limits, geometry, centres of mass, inertias times
-    ``factor^2``) and the spec's reference values of prismatic joints and of a floating base's position, assembled
-    from the scaled reference configuration (:func:`~pkm.core.model.scale.scale_configuration` maps any
-    configuration onto the copy). Masses, angles and the actuators' efforts are unchanged; the copy has no
+    ``factor^2``) and the spec's reference values of prismatic joints (and their springs' rest lengths) and of a
+    floating base's position, assembled from the scaled reference configuration
+    (:func:`~pkm.core.model.scale.scale_configuration` maps any configuration onto the copy). Masses, angles, the
+    actuators' efforts and the springs' stiffnesses are unchanged; the copy has no
     ``params`` (a mechanism's own parameters describe the original). Every singularity measure of the copy equals
     the original's (:mod:`pkm.core.model.scale`).
 
@@ -295,7 +296,10 @@ def scaled_mechanism(mech: Mechanism, factor: float) -> Mechanism:
         k = length_entries(mech.joints[name].kind)
         return tuple(float(v) * s if i < k else float(v) for i, v in enumerate(np.atleast_1d(values)))
 
-    spec = dataclasses.replace(mech.spec, reference={n: lengths(n, v) for n, v in mech.spec.reference.items()})
+    springs = {n: {k: lengths(n, v)[0] if k == "rest" else v for k, v in table.items()}
+               for n, table in mech.spec.springs.items()}  # (a prismatic spring's rest length)
+    spec = dataclasses.replace(mech.spec, reference={n: lengths(n, v) for n, v in mech.spec.reference.items()},
+                               springs=springs)
     seed = {n: np.array(lengths(n, v)) for n, v in mech.q_to_dict(mech.q_reference).items()}
     return from_strings(scale_urdf(mech.urdf, s), spec, None, f"{mech.source} (scaled by {s:g})", mech.notes,
                         seed=seed)
