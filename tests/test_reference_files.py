@@ -55,4 +55,6 @@ def test_wheel_ships_urdf_and_dynamics(tmp_path):
         assert f"pkm/_data/urdf/{name}.urdf" in shipped
         assert f"pkm/_data/urdf/{name}.closures.toml" in shipped
     assert "pkm/_data/dynamics/prs3_table2.toml" in shipped
+    for shipped_file in ("cassie.xml", "LICENSE", "SOURCE.txt"):  # (a third-party robot with its licence and source)
+        assert f"pkm/_data/urdf/menagerie/agility_cassie/{shipped_file}" in shipped
     assert "pkm/py.typed" in shipped

@@ -173,7 +173,7 @@ def load(name: str | os.PathLike[str], *, actuated: Sequence[str] | str | None =
     as links with several parents; it names no actuators, so it comes through a spec): see
     :mod:`pkm.core.formats`. Or a model an installed package ships, by name ``"<package>:<model>"``
     (``"example-robot-data:cassie"``: :mod:`pkm.core.formats.packages`), or a third-party robot pkm ships, by name
-    ``"<source>:<robot>"`` (``"gepetto:robot_delta"``: :mod:`pkm.core.formats.catalogue`).
+    ``"<source>:<robot>"`` (``"gepetto:robot_delta"``, ``"menagerie:cassie"``: :mod:`pkm.core.formats.catalogue`).
 
     A file that names no actuators (an MJCF with loops and no ``<actuator>``, an SDF, a Gepetto YAML with no
     ``name_mot``, a spec with ``actuated = []``) loads with them given in code: ``actuated`` (joint names, or

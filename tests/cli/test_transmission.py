@@ -48,3 +48,19 @@ def test_what_it_refuses_is_one_error_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--targets: choose among c, jax, warp" in err[0]
     assert not any(tmp_path.iterdir())
+
+
+def test_skip_unfit_writes_the_transmissions_of_a_robot_one_of_whose_loops_is_none(tmp_path, capsys):
+    """MuJoCo Menagerie's Cassie, whose knee loops are no transmission (tests/test_menagerie_robots.py): with
+    --skip-unfit its two foot four-bars are written, a warning naming each knee loop left out."""
+    import pytest
+
+    from pkm.errors import PkmWarning
+
+    with pytest.warns(PkmWarning, match="'right-tarsus'.*left out"):
+        assert cli.main(["transmission", "menagerie:cassie", "--out", str(tmp_path), "--targets", "c",
+                         "--skip-unfit", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [(t["motors"], t["outputs"]) for t in out["transmissions"]] == [
+        (["left-foot"], ["left-foot-crank"]), (["right-foot"], ["right-foot-crank"])]
+    assert (tmp_path / "left-foot-crank" / "left_foot_crank.c").is_file()

@@ -1,6 +1,7 @@
-"""``pkm transmission MECH --out DIR [--targets c,jax,warp] [--outputs NAME=J1,J2 ...] [--json]``: each closed
-sub-mechanism of a robot (:func:`pkm.transmissions`) as transmission kernels (motors <-> output joints, velocity and
-effort maps, ΔM and Δh: :mod:`pkm.core.transmissions.kernels`) written for a robot's software
+"""``pkm transmission MECH --out DIR [--targets c,jax,warp] [--outputs NAME=J1,J2 ...] [--skip-unfit] [--json]``: each
+closed sub-mechanism of a robot (:func:`pkm.transmissions`; ``--skip-unfit``: those that can be, a warning naming
+the others) as transmission kernels (motors <-> output joints, velocity and effort maps, ΔM and Δh:
+:mod:`pkm.core.transmissions.kernels`) written for a robot's software
 (:func:`pkm.core.transmissions.targets.write_transmission`), one folder ``DIR/<transmission>`` each: C99 with a C++17
 class in the method set of ros2_control's ``transmission_interface::Transmission``, a JAX module, a Warp module,
 ``transmission.json`` and a README (the ros2_control recipe)."""
@@ -23,6 +24,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="among c (C99 and the C++17 header), jax, warp (default: all three)")
     p.add_argument("--outputs", metavar="NAME=J1,J2", action="extend", nargs="+", default=[],
                    help="a transmission's name and output joints (default: the chain rule of pkm.transmissions)")
+    p.add_argument("--skip-unfit", action="store_true",
+                   help="leave out, with a warning saying why, a closed sub-mechanism that cannot be a transmission "
+                        "(a knee loop that moves springs too) and write the others")
     p.add_argument("--json", action="store_true", help="print JSON")
 
 
@@ -51,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
         raise InvalidInputError("--targets", f"choose among {', '.join(TARGETS)}", args.targets)
     mech = load_mechanism(args)
     out: list[dict[str, Any]] = []
-    for t in pkm.transmissions(mech, parse_outputs(args.outputs)):
+    for t in pkm.transmissions(mech, parse_outputs(args.outputs), skip_unfit=args.skip_unfit):
         tk = TransmissionKernels.of(t)
         files = write_transmission(tk, Path(args.out) / t.name, targets)
         out.append({"transmission": t.name, "root": t.root, "motors": list(t.motors), "outputs": list(t.outputs),

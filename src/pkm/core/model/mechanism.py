@@ -169,6 +169,8 @@ class Mechanism:
         for b in spec.branches.values():
             for n in b.signs:
                 scalar_joint(n, f"branch {b.name!r}")
+        for n in spec.springs:
+            scalar_joint(n, f"[springs.{n}]")
         #: The drive of each actuated joint, in ``actuated`` order: the model file's values, then the spec's
         #: ``[actuators.<joint>]`` tables (:mod:`pkm.core.model.actuators`); written into the model's fields.
         self.actuators: tuple[Actuator, ...] = ()
@@ -453,17 +455,26 @@ class Mechanism:
                 f"task={list(self.spec.task.components) + list(self.spec.task.joints)})")
 
 
+#: The frame a name means when frames of several types share it (MJCF bodies, joints and sites may share names; a
+#: URDF link and joint may): a body's, an operational frame's (a site, a closure's anchor), a fixed joint's, a
+#: joint's, a sensor's, in this order (the link's frame where a joint shares its name, as before).
+FRAME_TYPES = (pin.FrameType.BODY, pin.FrameType.OP_FRAME, pin.FrameType.FIXED_JOINT, pin.FrameType.JOINT,
+               pin.FrameType.SENSOR)
+
+
 def _frame_id(model: pin.Model, name: object, source: str) -> int | None:
-    """The frame called ``name`` (a link's frame when a joint shares its name); None if there is none."""
-    if not isinstance(name, str) or not model.existFrame(name):
+    """The frame called ``name``, looked up by name and type (the first type of :data:`FRAME_TYPES` that has one: a
+    link's frame when a joint shares its name); None if there is none."""
+    if not isinstance(name, str):
         return None
-    try:
-        return model.getFrameId(name)
-    except ValueError:  # several frames of that name: a link and a joint named alike
-        if model.existFrame(name, pin.FrameType.BODY):
-            return model.getFrameId(name, pin.FrameType.BODY)
-        raise SpecError(source, f"several frames are named {name!r}; give the links and joints distinct names") \
-            from None
+    for kind in FRAME_TYPES:
+        if model.existFrame(name, kind):
+            try:
+                return model.getFrameId(name, kind)
+            except ValueError:  # (two frames of one type and name: a model built by hand)
+                raise SpecError(source, f"several {kind.name} frames are named {name!r}; give them distinct names") \
+                    from None
+    return None
 
 
 def check_mechanism(mech: object, name: str = "mech") -> Mechanism:

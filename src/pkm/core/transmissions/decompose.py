@@ -45,7 +45,7 @@ import pinocchio as pin
 
 from pkm.core.model.actuators import NUMBERS
 from pkm.core.model.builder import from_strings
-from pkm.core.model.joints import stated_limits
+from pkm.core.model.joints import reduced_model, stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.spec import ClosureSpec, TaskSpec
 from pkm.core.model.urdf import urdf_from_model
@@ -148,7 +148,7 @@ def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[
     model = mech.model
     keep = {model.names[j] for j in joints}
     lock = [j for j in range(1, model.njoints) if model.names[j] not in keep]
-    reduced = pin.buildReducedModel(model, lock, mech.q_reference) if lock else model.copy()
+    reduced = reduced_model(model, lock, mech.q_reference) if lock else model.copy()
     stated = {n: lim for n, lim in mech.limits.items() if n in keep}
     urdf, types = urdf_from_model(reduced, name=name, limits=stated, source=mech.source)
     q_ref = mech.q_to_dict(mech.q_reference)
@@ -158,6 +158,7 @@ def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[
         reference={n: tuple(np.atleast_1d(q_ref[n]).tolist()) for n in sorted(keep) if n in q_ref},
         joint_types=types, actuators={a.joint: {f: float(getattr(a, f)) for f in NUMBERS}
                                       for a in mech.actuators if a.joint in motors},
+        springs={n: v for n, v in mech.spec.springs.items() if n in keep},
         description=f"the closed sub-mechanism {name!r} of {mech.name!r}")
     with warnings.catch_warnings():  # (what the robot's loading said already: kept in the notes, not said twice)
         warnings.simplefilter("ignore", PkmWarning)

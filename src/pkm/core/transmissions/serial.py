@@ -37,6 +37,7 @@ from lxml import etree
 
 from pkm.core.analysis.region import SINGULARITY
 from pkm.core.formats.to_mjcf import MIN_INERTIA, MIN_MASS, TIMESTEP, _joints, _num, _pose, qpos_of
+from pkm.core.model.joints import reduced_model
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.urdf import urdf_from_model
 from pkm.core.transmissions.decompose import transmissions as find
@@ -129,7 +130,7 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
     gone = [robot.joints[n].id for t in found for n in (*t.motors, *t.passive)]
     for j in gone:
         model.inertias[j] = pin.Inertia.Zero()
-    serial = pin.buildReducedModel(model, sorted(gone), robot.q_reference)
+    serial = reduced_model(model, sorted(gone), robot.q_reference)
     serial.name = f"{robot.name}_serial"
     armature = np.array(serial.armature, dtype=float)
     constant: dict[str, float] = {}
