@@ -178,8 +178,9 @@ class Transmission:
     @functools.cached_property
     def serial(self) -> pin.Model:
         """The serial-equivalent model of the sub-mechanism (:func:`pkm.core.transmissions.coordinates.serial_tree`):
-        its model with every joint but the outputs massless (their bodies, the motors' rotors removed)."""
-        return serial_tree(self.mechanism.model, self.outputs)
+        its model with every joint but the outputs welded to its parent at the reference (their bodies' mass carried
+        by the nearest output above them, or by the root; the motors' rotors removed)."""
+        return serial_tree(self.mechanism.model, self.outputs, self.mechanism.q_reference)
 
     def serial_model(self, q_sub: ArrayLike, qd_o: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """``(M_s, h_s)``: the serial-equivalent model's mass matrix and bias (Coriolis, centrifugal, gravity) in the
