@@ -33,7 +33,8 @@ Definitions. ``M_o``, ``h_o`` are the closed-loop model in output coordinates: t
 mechanism with the outputs as its actuated joints: ``M_o = G_oᵀ M G_o``, ``h_o = G_oᵀ (h + M Ġ_o qdot_o)`` with
 ``G_o = ∂q/∂o`` (rotor armature and gravity included, idle motions mass-orthogonal). ``M_s``, ``h_s`` are the
 serial-equivalent model's (:func:`pkm.core.transmissions.coordinates.serial_tree`): the tree with every joint but the
-outputs massless (the rods, the cranks and the rotors dropped; each output hangs from the root through outputs only),
+outputs welded to its parent at the reference (the rods' and the cranks' mass carried by the nearest output above
+them or by the root, the rotors dropped; each output hangs from the root through outputs only),
 as RNEA of the twin with only the outputs moving. Hence ``M_s + ΔM = M_o`` and ``h_s + Δh = h_o`` exactly, and
 ``M_a = Jᵀ M_o J`` (tested against :func:`pkm.mass_matrix`, :func:`pkm.bias_efforts` and
 :class:`~pkm.core.transmissions.transmission.Transmission`'s Python reference).

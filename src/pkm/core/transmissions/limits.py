@@ -12,12 +12,14 @@ singularity (:mod:`pkm.core.analysis.region`: the same rules, ``singularity`` th
   first step out bisected to ``tol`` (the 1-D case of the same search), its ends the limits;
 * more outputs: not traced (:class:`OutputLimits` with no limits; the export says so).
 
-The box's boundary (its corners and :data:`EDGE_POINTS` points inside each edge; both ends of the interval) is then
-solved by the inverse kinematics, walking round it from the reference's configuration (each point warm-started from
-the last: one working mode), and checked feasible by the region's own rule; the box is first pulled towards the
-point by a millionth (a corner on a joint's limit fails by round-off), and a point that fails shrinks it towards
-the point by 1 % until all pass. :attr:`OutputLimits.area_fraction` states the box's area against the region's; a
-:class:`~pkm.errors.PkmWarning` says so where it is under :data:`SMALL_BOX`.
+The box's boundary (its corners and :data:`EDGE_POINTS` points inside each edge; both ends of the interval, through
+the point between them) is then solved by the inverse kinematics, walking round it from the reference's
+configuration (each point warm-started from the last: one working mode), and checked feasible by the region's own
+rule; the box is first pulled towards the point by a millionth (a corner on a joint's limit fails by round-off),
+and a point that fails shrinks it towards the point by 1 % until all pass. Where the point itself is not feasible
+(a reference within ``singularity`` of a singularity: Gepetto's ``talos_like``), no box holds it: a warning says so
+and the box shrinks towards its own middle instead. :attr:`OutputLimits.area_fraction` states the box's area
+against the region's; a :class:`~pkm.errors.PkmWarning` says so where it is under :data:`SMALL_BOX`.
 """
 
 from __future__ import annotations
@@ -87,11 +89,12 @@ def _interval(t: Transmission, singularity: float, reach: float, steps: int, tol
     return np.array(ends), (why[0], why[1])
 
 
-def _boundary(lower: np.ndarray, upper: np.ndarray) -> list[np.ndarray]:
-    """The points of the box's boundary checked, in order round it: both ends of an interval; a rectangle's corners
-    and :data:`EDGE_POINTS` points inside each edge."""
+def _boundary(lower: np.ndarray, upper: np.ndarray, point: np.ndarray) -> list[np.ndarray]:
+    """The points of the box's boundary checked, in the order they are solved: an interval's lower end, ``point``
+    (back inside: the working mode of the reference), its upper end; a rectangle's corners and :data:`EDGE_POINTS`
+    points inside each edge, round it."""
     if lower.size == 1:
-        return [lower.copy(), upper.copy()]
+        return [lower.copy(), point.copy(), upper.copy()]
     corners = [np.array([lower[0], lower[1]]), np.array([upper[0], lower[1]]), np.array([upper[0], upper[1]]),
                np.array([lower[0], upper[1]])]
     points = []
@@ -141,10 +144,17 @@ def output_limits(t: Transmission, *, around: ArrayLike | None = None, singulari
     else:
         return OutputLimits(t.outputs, None, None, None, (), 0)
     lo, hi = _bounds(t)
+    anchor = point
+    why = _feasible(sub, dict(zip(t.outputs, map(float, point))), t.q_reference, lo, hi, singularity)[1]
+    if why:  # (Gepetto's talos_like: its reference 0.2 % from a direct singularity, under the bound)
+        anchor = (lower + upper) / 2.0
+        warnings.warn(PkmWarning(f"transmission {t.name!r}: {dict(zip(t.outputs, np.round(point, 6).tolist()))} is "
+                                 f"not feasible ({why}): no box holds it; the box is shrunk towards its middle "
+                                 "instead and leaves it out"), stacklevel=2)
     scale = 1.0 - 1e-6  # (a corner on a joint's limit itself fails by round-off: pulled in by a millionth)
     for _ in range(100):
-        box = point + scale * (lower - point), point + scale * (upper - point)
-        points = _boundary(*box)
+        box = anchor + scale * (lower - anchor), anchor + scale * (upper - anchor)
+        points = _boundary(*box, anchor)
         if _walk(t, points, lo, hi, singularity):
             found = scale ** t.k * fraction
             if found < SMALL_BOX:

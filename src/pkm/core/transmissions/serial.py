@@ -134,10 +134,16 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
             transmission's feasible region.
 
     Examples:
+        >>> import pinocchio as pin
         >>> import pkm
-        >>> se = pkm.serial_equivalent(pkm.load("examples/humanoid_ankle/ankle.closures.toml"), directions=8)
-        >>> se.outputs, round(se.regions["foot"].area_fraction, 2)
-        (('ankle_pitch', 'ankle_roll'), 0.55)
+        >>> bot = pkm.load("gepetto:battobot_6d")  # (two legs: a knee four-bar and a two-motor ankle each)
+        >>> se = pkm.serial_equivalent(bot, limits=False)  # (limits=True traces each region: seconds)
+        >>> se.outputs
+        ('knee_left', 'knee_right', 'ankley_right', 'anklex_right', 'ankley_left', 'anklex_left')
+        >>> round(pin.computeTotalMass(se.model), 6), round(pin.computeTotalMass(bot.model), 6)  # (rods welded)
+        (17.513222, 17.513222)
+        >>> round(se.armature["ankley_left"], 7)  # (ΔM's diagonal at the reference [kg m^2])
+        0.0002157
     """
     robot = check_mechanism(robot)
     found = tuple(find(robot) if transmissions is None else transmissions)
@@ -170,7 +176,7 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
         regions[t.name] = reg
         if reg.lower is not None and reg.upper is not None:
             ref = t.q_reference[t.out_q]
-            if not ((reg.lower <= ref) & (ref <= reg.upper)).all():
+            if set(named) & set(t.outputs) and not ((reg.lower <= ref) & (ref <= reg.upper)).all():
                 warnings.warn(PkmWarning(f"transmission {t.name!r}: its box about {dict(zip(t.outputs, point))} "
                                          f"leaves out the reference {dict(zip(t.outputs, ref.tolist()))}: the "
                                          "serial model's keyframe 'reference' lies outside its limits"), stacklevel=2)
@@ -224,7 +230,16 @@ def write_serial_equivalent(se: SerialEquivalent, folder: str | os.PathLike[str]
     """Write ``se`` into ``folder`` (made if missing): ``<robot>_serial.urdf``, ``<robot>_serial.xml`` (MJCF),
     each transmission's sub-mechanism as ``<robot>_<transmission>.urdf`` and ``.closures.toml`` (``pkm.load`` reads
     it back) and ``<robot>_transmissions.json`` (:meth:`SerialEquivalent.data`, with the files' names); returns
-    their paths, the data file last."""
+    their paths, the data file last.
+
+    Examples:
+        >>> import tempfile
+        >>> import pkm
+        >>> se = pkm.serial_equivalent(pkm.load("gepetto:talos_like"), limits=False)
+        >>> with tempfile.TemporaryDirectory() as folder:
+        ...     [p.name for p in pkm.write_serial_equivalent(se, folder)]
+        ['talos_like_serial.urdf', 'talos_like_serial.xml', 'talos_like_ankle.urdf', 'talos_like_ankle.closures.toml', 'talos_like_transmissions.json']
+    """
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
     stem = _safe(se.robot.name)
