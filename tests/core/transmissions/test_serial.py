@@ -152,3 +152,17 @@ def test_each_battobot_ankles_box_is_the_largest_its_region_holds_about_the_refe
         for b in np.linspace(0.0, 1.0, 4):
             _, q = t.motors_from_outputs(reg.lower + np.array([a, b]) * (reg.upper - reg.lower), q)
             assert np.all(q >= lo - 1e-9) and np.all(q <= hi + 1e-9)
+
+
+def test_a_small_box_is_said_and_a_point_outside_the_region_or_no_output_refused(monkeypatch):
+    """The humanoid knee's interval (the whole traced one: its share 1): under a bound of SMALL_BOX above 1 the
+    warning names the share; ``around`` outside the interval, or naming no output, is refused."""
+    t = transmissions("humanoid_knee")[0]
+    monkeypatch.setattr("pkm.core.transmissions.limits.SMALL_BOX", 1.5)
+    with pytest.warns(pkm.errors.PkmWarning, match=r"'shank': its box limits hold 100 % of the length"):
+        reg = output_limits(t, steps=4, tol=1e-4)
+    assert reg.area_fraction == pytest.approx(1.0, abs=1e-5) and reg.points_checked == 3
+    with pytest.raises(pkm.errors.InvalidInputError, match="outside its feasible interval"):
+        output_limits(t, around=[reg.upper[0] + 0.1], steps=4, tol=1e-4)
+    with pytest.raises(pkm.errors.InvalidInputError, match=r"\['nope'\] are no outputs"):
+        serial_equivalent(robot("humanoid_knee"), [t], around={"nope": 0.1})

@@ -159,7 +159,7 @@ def output_limits(t: Transmission, *, around: ArrayLike | None = None, singulari
             found = scale ** t.k * fraction
             if found < SMALL_BOX:
                 warnings.warn(PkmWarning(f"transmission {t.name!r}: its box limits hold {100 * found:.3g} % of the "
-                                         f"area of its feasible region (the region is far from a box about "
+                                         f"{'area' if t.k > 1 else 'length'} of its feasible region (the region is far from a box about "
                                          f"{dict(zip(t.outputs, np.round(point, 6).tolist()))}): the serial model "
                                          "leaves the rest out (OutputLimits.polygon: the whole region)"), stacklevel=2)
             return OutputLimits(t.outputs, box[0], box[1], polygon, tuple(binding), len(points), point, found)
