@@ -40,7 +40,8 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.analysis.reconfiguration": ("reconfigure",),
     "pkm.core.export": ("CLibrary", "export_c"),
     "pkm.core.modes": ("assembly_modes", "track_assembly_mode", "track_working_mode", "working_modes"),
-    "pkm.core.transmissions": ("Transmission", "transmissions"),
+    "pkm.core.transmissions": ("SerialEquivalent", "Transmission", "serial_equivalent", "transmissions",
+                               "write_serial_equivalent"),
     "pkm.core.timing": ("TimeOptimal", "time_optimal", "verify_time_optimal"),
     "pkm.core.twin": ("Kernels", "Twin"),
     "pkm.sweeps": ("sweep",),
@@ -151,7 +152,13 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.export import CLibrary, export_c
     from pkm.core.modes import assembly_modes, track_assembly_mode, track_working_mode, working_modes
     from pkm.core.timing import TimeOptimal, time_optimal, verify_time_optimal
-    from pkm.core.transmissions import Transmission, transmissions
+    from pkm.core.transmissions import (
+        SerialEquivalent,
+        Transmission,
+        serial_equivalent,
+        transmissions,
+        write_serial_equivalent,
+    )
     from pkm.core.twin import Kernels, Twin
     from pkm.sweeps import sweep
     from pkm.units import quantity

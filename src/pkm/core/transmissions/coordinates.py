@@ -143,22 +143,45 @@ def closure_tol(sub: Mechanism, rtol: float = CLOSURE_RTOL) -> float:
     return rtol * sub.characteristic_length
 
 
-def serial_tree(model: pin.Model, outputs: Sequence[str]) -> pin.Model:
-    """A copy of ``model`` (a sub-mechanism's) in which every joint but ``outputs`` is massless: its body's (and its
-    welded bodies') inertia zero, its armature zero. Since every output hangs from the root through outputs only,
-    the massless joints move nothing the outputs carry: the copy's mass matrix and bias, restricted to the outputs'
-    rows and columns, are the serial-equivalent model's."""
+def lumped_inertias(model: pin.Model, outputs: Sequence[str], q_reference: np.ndarray) -> list[pin.Inertia]:
+    """``model.inertias`` with every joint but ``outputs`` welded to its parent at ``q_reference``: each such joint's
+    body inertia (mass, centre of mass, rotational inertia) moved onto its nearest ancestor that is an output (or
+    the root, index 0), placed where ``q_reference`` puts it relative to that ancestor, and its own made zero (what
+    ``pinocchio.buildReducedModel`` does to a locked joint's body)."""
+    data = model.createData()
+    pin.forwardKinematics(model, data, q_reference)
+    keep = {model.getJointId(n) for n in outputs}
+    out = [pin.Inertia(model.inertias[j]) for j in range(model.njoints)]
+    for j in range(1, model.njoints):
+        if j in keep:
+            continue
+        anchor = int(model.parents[j])
+        while anchor != 0 and anchor not in keep:
+            anchor = int(model.parents[anchor])
+        out[anchor] = out[anchor] + (data.oMi[anchor].actInv(data.oMi[j])).act(model.inertias[j])
+        out[j] = pin.Inertia.Zero()
+    return out
+
+
+def serial_tree(model: pin.Model, outputs: Sequence[str], q_reference: np.ndarray) -> pin.Model:
+    """A copy of ``model`` (a sub-mechanism's) in which every joint but ``outputs`` is welded to its parent at
+    ``q_reference`` (:func:`lumped_inertias`: its body's mass carried by the nearest output above it, or by the
+    root) and has no armature (the rotors' reflected inertia is left to ``ΔM``). Since every output hangs from the
+    root through outputs only, the copy's mass matrix and bias with only the outputs moving, restricted to the
+    outputs' rows and columns, are the serial-equivalent model's (:func:`pkm.core.transmissions.serial_equivalent`
+    welds the same bodies the same way)."""
     serial = model.copy()
     keep = set(outputs)
+    for j, inertia in enumerate(lumped_inertias(model, outputs, q_reference)):
+        serial.inertias[j] = inertia
     armature = np.array(serial.armature, dtype=float)
     for j in range(1, serial.njoints):
         if serial.names[j] not in keep:
-            serial.inertias[j] = pin.Inertia.Zero()
             jm = serial.joints[j]
             armature[jm.idx_v:jm.idx_v + jm.nv] = 0.0
     serial.armature = armature
     return serial
 
 
-__all__ = ["CLOSURE_RTOL", "OutputSplit", "close_at_outputs", "closure_tol", "drift_acceleration", "output_model",
-           "output_split", "serial_tree"]
+__all__ = ["CLOSURE_RTOL", "OutputSplit", "close_at_outputs", "closure_tol", "drift_acceleration", "lumped_inertias",
+           "output_model", "output_split", "serial_tree"]

@@ -260,8 +260,15 @@ def _transmission(mech: Mechanism, name: str, closures: list[int], joints: set[i
     if bad:
         raise TransmissionError(name, "outputs", f"outputs {bad} have more than one coordinate: outputs are "
                                 "one-coordinate serial joints", bad)
-    carrying = [j for j in joints if j not in out_ids
-                and {i for i in range(1, model.njoints) if j in model.supports[i]} - joints]
+    carries = sorted(j for j in joints if {i for i in range(1, model.njoints) if j in model.supports[i]} - joints)
+    if len(carries) > len(motors):
+        names = [model.names[j] for j in carries]
+        raise TransmissionError(name, "outputs", f"{names} carry the rest of the robot, so that a serial model must "
+                                f"keep every one of them as an output, but its loops hold {len(motors)} motor(s) "
+                                f"{list(motors)}: no choice of outputs makes it a transmission; leave it out with "
+                                "skip_unfit=True (pkm transmission --skip-unfit) to get the robot's other "
+                                "transmissions", names)
+    carrying = [j for j in carries if j not in out_ids]
     if carrying:
         raise TransmissionError(name, "outputs", f"{[model.names[j] for j in carrying]} carry the rest of the robot "
                                 f"but are no outputs {list(outputs)}: a serial model cannot keep the rest of the robot "

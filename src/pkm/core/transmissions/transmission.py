@@ -12,10 +12,13 @@ simulator needs, in the sub-mechanism's configuration ``q_sub`` (its ``nq``, as 
 * the effort maps by the power balance ``τ_mᵀ ṁ = τ_oᵀ ȯ``: ``τ_m = Jᵀ τ_o`` and ``τ_o = J⁻ᵀ τ_m``, computed by the
   other route, the outputs independent (:mod:`pkm.core.transmissions.coordinates`), so that ``effort_map = Jᵀ`` is a
   check;
-* what the serial-equivalent model lacks (:func:`~pkm.core.transmissions.coordinates.serial_tree`: the tree with the outputs only and the
-  bodies they carry), in output coordinates: ``ΔM = M_o - M_s`` and ``Δh = h_o - h_s``, so that serial model + ΔM +
-  Δh is the closed-loop model exactly: ``(M_s + ΔM) ö + h_s + Δh = τ_o`` is the sub-mechanism's dynamics with the
-  root held where the robot's reference puts it.
+* what the serial-equivalent model lacks (:func:`~pkm.core.transmissions.coordinates.serial_tree`: the tree with
+  the outputs only, the bodies they carry, and every other joint's body welded to its parent at the reference, its
+  mass carried by the nearest output above it or by the root), in output coordinates: ``ΔM = M_o - M_s`` and
+  ``Δh = h_o - h_s`` (the welded bodies' motion about their anchors and the rotors, less the welded mass's own
+  share: a diagonal entry can be negative), so that serial model + ΔM + Δh is the closed-loop model exactly:
+  ``(M_s + ΔM) ö + h_s + Δh = τ_o`` is the sub-mechanism's dynamics with the root held where the robot's reference
+  puts it.
 """
 
 from __future__ import annotations
@@ -179,8 +182,9 @@ class Transmission:
     @functools.cached_property
     def serial(self) -> pin.Model:
         """The serial-equivalent model of the sub-mechanism (:func:`pkm.core.transmissions.coordinates.serial_tree`):
-        its model with every joint but the outputs massless (their bodies, the motors' rotors removed)."""
-        return serial_tree(self.mechanism.model, self.outputs)
+        its model with every joint but the outputs welded to its parent at the reference (their bodies' mass carried
+        by the nearest output above them, or by the root; the motors' rotors removed)."""
+        return serial_tree(self.mechanism.model, self.outputs, self.mechanism.q_reference)
 
     def serial_model(self, q_sub: ArrayLike, qd_o: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """``(M_s, h_s)``: the serial-equivalent model's mass matrix and bias (Coriolis, centrifugal, gravity) in the
@@ -195,8 +199,9 @@ class Transmission:
         return M[np.ix_(self.out_v, self.out_v)], h[self.out_v]
 
     def delta_mass(self, q_sub: ArrayLike) -> np.ndarray:
-        """``ΔM = M_o - M_s`` (k x k) [kg m^2]: the mass matrix the serial-equivalent model lacks (rods, cranks,
-        rotors), in output coordinates."""
+        """``ΔM = M_o - M_s`` (k x k) [kg m^2]: the mass matrix the serial-equivalent model (the rods and cranks
+        welded at the reference) lacks, in output coordinates: the rods' and cranks' motion about where they are
+        welded, the rotors, less the welded mass's share (it may be indefinite)."""
         zero = np.zeros(self.k)
         return self.output_model(q_sub, zero)[0] - self.serial_model(q_sub, zero)[0]
 
