@@ -519,12 +519,14 @@ class OperationalSpace:
         bias: ``μ = J⁻ᵀ h_a - Λ ÿ_b`` (n,).
         jacobian: ``J``, task rates from actuated rates (n x na, square).
         drift: ``ÿ_b``, the task acceleration at zero actuated acceleration (n,).
+        base: A floating base ``"free"`` or ``"fixed"`` (:attr:`ActuatorSpaceModel.base`).
     """
 
     inertia: np.ndarray
     bias: np.ndarray
     jacobian: np.ndarray
     drift: np.ndarray
+    base: str = "fixed"
 
 
 def operational_space(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None, *,
@@ -564,7 +566,8 @@ def operational_space(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None
     Lam = Jinv.T @ model.M @ Jinv
     Lam = 0.5 * (Lam + Lam.T)
     return OperationalSpace(finite_result(Lam, "operational-space inertia"),
-                            finite_result(Jinv.T @ model.h - Lam @ drift, "operational-space bias"), J, drift)
+                            finite_result(Jinv.T @ model.h - Lam @ drift, "operational-space bias"), J, drift,
+                            model.base)
 
 
 def forward_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: ArrayLike, *,
@@ -593,6 +596,7 @@ def forward_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: 
     return model.joint_accelerations(qdd, friction=friction, base_wrench=base_wrench)
 
 
-__all__ = ["BASES", "COULOMB_VELOCITY", "ActuatorSpaceModel", "OperationalSpace", "actuator_model", "bias_efforts",
+__all__ = ["BASES", "COULOMB_VELOCITY", "ActuatorSpaceModel", "OperationalSpace", "actuator_model", "base_choice",
+           "bias_efforts",
            "coriolis_matrix", "forward_dynamics", "gravity_efforts", "mass_matrix", "mass_matrix_derivatives",
            "operational_space"]

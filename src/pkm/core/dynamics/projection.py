@@ -438,6 +438,25 @@ def base_inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayL
 
     Raises:
         InvalidInputError: the mechanism has no floating base (its base's reaction is not modelled).
+
+    Examples:
+        >>> import dataclasses
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")  # hung on a free-flyer "pelvis" over a new ground link:
+        >>> urdf = delta.urdf.replace('<link name="base"/>', '<link name="ground"/><link name="base"/><joint '
+        ...                           'name="pelvis" type="floating"><parent link="ground"/><child link="base"/></joint>')
+        >>> robot = pkm.from_strings(urdf, dataclasses.replace(delta.spec, floating_base="pelvis", reference={}))
+        >>> q = pkm.close_loops(robot, delta.actuated_q(delta.q_reference)).q
+        >>> rest = np.zeros(robot.nv)
+        >>> held = pkm.base_inverse_dynamics(robot, q, rest, rest, base="fixed")  # the holder carries the weight
+        >>> np.round(held.base_wrench, 4)
+        array([ 0.    , -0.    ,  6.3765,  0.    ,  0.    , -0.    ])
+        >>> pkm.base_inverse_dynamics(robot, q, rest, rest).needs_base_wrench  # free, it cannot stay at rest
+        True
+        >>> a = pkm.forward_dynamics(robot, q, rest, held.efforts)  # (free by default: it falls)
+        >>> pkm.base_inverse_dynamics(robot, q, rest, a).needs_base_wrench
+        False
     """
     mech = check_mechanism(mech)
     if method not in METHODS:
@@ -608,6 +627,6 @@ def energy(mech: Mechanism, q: ArrayLike, v: ArrayLike) -> tuple[float, float]:
     return float(kinetic), float(potential)
 
 
-__all__ = ["FORWARD_METHODS", "METHODS", "KhalilProjection", "Leg", "Partition", "Projection", "constraint_dynamics", "energy",
-           "forward_dynamics", "inverse_dynamics",
+__all__ = ["BASE_WRENCH_RTOL", "FORWARD_METHODS", "METHODS", "BaseInverseDynamics", "KhalilProjection", "Leg", "Partition", "Projection", "base_inverse_dynamics", "constraint_dynamics",
+           "energy", "forward_dynamics", "inverse_dynamics",
            "partition", "virtual_work_dynamics"]

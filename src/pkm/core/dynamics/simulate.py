@@ -121,6 +121,8 @@ class Simulation(Trajectory):
         method: The integrator.
         saturated: Per actuator, the samples whose effort is at or beyond its limit (peak, else continuous): clipped
             there when the run saturates (the default), exceeded when it does not.
+        base: How a floating base moved: ``"free"`` (its own equations, no wrench on it) or ``"fixed"`` (held; every
+            mechanism without a floating base) (:mod:`pkm.core.dynamics.model`).
 
     Examples:
         >>> import pkm
@@ -139,6 +141,7 @@ class Simulation(Trajectory):
     event: Event | None = None
     method: str = "rk4"
     saturated: dict[str, int] = field(default_factory=dict)
+    base: str = "fixed"
 
     @property
     def energy(self) -> np.ndarray:
@@ -474,13 +477,13 @@ class _Recorder:
         loss = -np.array([m.friction @ m.qd for m in self.models]) if self.dyn.friction else np.zeros(n)
         residual = np.array([np.max(np.abs(constraints.residual(mech, qq)), initial=0.0) for qq in q])
         return _simulation(mech, np.array(self.t), q, v, a, qd, np.array(self.qdd), task, task_v, task_a, tau,
-                           residual, kinetic, potential, loss, event, method)
+                           residual, kinetic, potential, loss, event, method, self.dyn.base)
 
 
 def _simulation(mech: Mechanism, t: np.ndarray, q: np.ndarray, v: np.ndarray, a: np.ndarray, qd: np.ndarray,
                 qdd: np.ndarray, task: np.ndarray, task_v: np.ndarray, task_a: np.ndarray, tau: np.ndarray,
                 residual: np.ndarray, kinetic: np.ndarray, potential: np.ndarray, loss: np.ndarray, event: Event | None,
-                method: str) -> Simulation:
+                method: str, base: str = "fixed") -> Simulation:
     """The :class:`Simulation` of the samples' arrays (the work and the dissipated energy by the trapezoidal rule)."""
     power = np.einsum("ij,ij->i", tau, qd)
     steps = np.diff(t)
@@ -493,7 +496,7 @@ def _simulation(mech: Mechanism, t: np.ndarray, q: np.ndarray, v: np.ndarray, a:
     at = np.abs(tau) >= limit * (1.0 - 1e-12) if len(tau) else np.zeros((0, mech.na), dtype=bool)
     saturated = {name: int(n) for name, n in zip(mech.actuated_names, at.sum(axis=0))}
     return Simulation(q, v, a, q[:, mech.act_q], qd, qdd, task, task_v, task_a, tau, residual,
-                      (), units, t, kinetic, potential, work, dissipated, event, method, saturated)
+                      (), units, t, kinetic, potential, work, dissipated, event, method, saturated, base)
 
 
 def _start(dyn: _Dynamics, x: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, ActuatorSpaceModel,
