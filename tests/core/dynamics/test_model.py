@@ -276,3 +276,19 @@ def test_the_base_choice_is_checked_and_named():
         pkm.forward_dynamics(mech, q, np.zeros(mech.nv), [0.0], base="fixed", base_wrench=np.zeros(6))
     with pytest.raises(InvalidInputError, match="no twist"):
         constraint_dynamics(mech, q, np.r_[np.ones(6), np.zeros(mech.nv - 6)], [0.0], base="fixed")
+
+
+def test_an_undeclared_free_flyer_root_is_said_to_follow_the_idle_rule():
+    """The ankle on a free pelvis that the spec does not declare its floating base: the pelvis is a passive joint
+    whose motion is idle (the task is the ankle's joints), so the idle-motion rule, not gravity, sets its
+    acceleration; the model says so (a PkmWarning naming it)."""
+    from pkm.errors import PkmWarning
+    from tests.core.dynamics.floating import floating
+
+    declared = floating("ankle")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # (the builder's: the actuators fall short of the mobility)
+        mech = pkm.from_strings(declared.urdf, dataclasses.replace(declared.spec, floating_base=None))
+    q = pkm.close_loops(mech, [0.1, -0.1], mech.q_reference).q
+    with pytest.warns(PkmWarning, match="free-flyer 'pelvis' on the world is a passive joint"):
+        pkm.actuator_model(mech, q)

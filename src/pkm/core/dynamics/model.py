@@ -66,6 +66,8 @@ equals Pinocchio's ``constraintDynamics`` (proximal where closures are redundant
 
 from __future__ import annotations
 
+import warnings
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -76,7 +78,7 @@ from pkm.core.differential.idle import joint_inertia, without_idle
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import close_loops
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.errors import InvalidInputError, SingularityError, SpecError
+from pkm.errors import InvalidInputError, PkmWarning, SingularityError, SpecError
 from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
 
 RTOL = 1e-9
@@ -102,6 +104,25 @@ def base_choice(mech: Mechanism, base: str | None) -> str:
         raise InvalidInputError("base", "the mechanism has no floating base (spec.floating_base): its base is fixed",
                                 base)
     return base
+
+
+_WARNED: weakref.WeakSet[Mechanism] = weakref.WeakSet()
+
+
+def _warn_idle_free_flyer(mech: Mechanism, idle: np.ndarray) -> None:
+    """Warn (once per mechanism) where an idle motion moves a passive free-flyer on the world: a body that is a
+    floating base but not declared one, whose acceleration the idle-motion rule sets where gravity should."""
+    if mech in _WARNED:
+        return
+    for j in mech.joints.values():
+        if j.kind == "JointModelFreeFlyer" and mech.model.parents[j.id] == 0 and \
+                np.any(idle[j.idx_v:j.idx_v + 6] != 0.0):
+            _WARNED.add(mech)
+            warnings.warn(f"the free-flyer {j.name!r} on the world is a passive joint the actuators do not move: pkm "
+                          "sets its acceleration by the idle-motion rule (no motion in the mass metric), not by its "
+                          "own equations (gravity acts on it): declare it the spec's floating_base for a free "
+                          "base's dynamics", PkmWarning, stacklevel=4)
+            return
 
 
 @dataclass(frozen=True)
@@ -145,6 +166,7 @@ def _reduce(mech: Mechanism, q: np.ndarray, rtol: float, base: str = "fixed") ->
                                    "not hold the mechanism here, its dynamics in actuated coordinates is undefined",
                                    distance=sigma / smax if smax > 0.0 else 0.0)
         idle = scales.joint_motions(idle)  # (in joint rates, orthonormal)
+        _warn_idle_free_flyer(mech, idle)
     M = joint_inertia(mech, q)
     Gb = np.zeros((mech.nv, 0))
     if base == "free":
