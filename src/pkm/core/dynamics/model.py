@@ -229,6 +229,7 @@ class ActuatorSpaceModel:
     base_response: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     base_friction: np.ndarray = field(default_factory=lambda: np.zeros(0))
     _G_base: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    _friction_joint: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __post_init__(self) -> None:
         for value in vars(self).values():
@@ -242,6 +243,14 @@ class ActuatorSpaceModel:
         if self.base == "free":
             return float(0.5 * self.v @ self._M_joint @ self.v)
         return float(0.5 * self.qd @ self.M @ self.qd)
+
+    @property
+    def friction_power(self) -> float:
+        """The power of the joints' friction at this state [W] (<= 0): ``f_a · q̇_a``, with a free base the bodies'
+        ``f · v`` (the base's motion in it)."""
+        if self.base == "free":
+            return float(self._friction_joint @ self.v)
+        return float(self.friction @ self.qd)
 
     def efforts(self, qdd: ArrayLike) -> np.ndarray:
         r""":math:`M_a \ddot q_a + h_a` (na,) [N m, N]: the efforts for actuated accelerations ``qdd`` (no friction)."""
@@ -374,7 +383,7 @@ def _evaluate(mech: Mechanism, q: np.ndarray, qd: np.ndarray, rtol: float,
     M_a = 0.5 * (M_a + M_a.T)
     return ActuatorSpaceModel(mech, q, qd.copy(), v, G, a_b, finite_result(M_a, "actuator-space mass matrix"),
                               finite_result(Gt @ b, "actuator-space bias"), Gt @ g, Gt @ f_joint, red.idle,
-                              red.M, base, vb, response, base_friction, red.Gb)
+                              red.M, base, vb, response, base_friction, red.Gb, f_joint)
 
 
 def actuator_model(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None, *, rtol: float = RTOL,

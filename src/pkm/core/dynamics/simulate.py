@@ -474,7 +474,7 @@ class _Recorder:
         task_a = np.array([tm.jacobian(qq) @ aa + tm.bias(qq, vv) for qq, vv, aa in zip(q, v, a)])
         kinetic = np.array([m.kinetic_energy for m in self.models])
         potential = np.array([energy(mech, qq, np.zeros(mech.nv))[1] for qq in q])
-        loss = -np.array([m.friction @ m.qd for m in self.models]) if self.dyn.friction else np.zeros(n)
+        loss = -np.array([m.friction_power for m in self.models]) if self.dyn.friction else np.zeros(n)
         residual = np.array([np.max(np.abs(constraints.residual(mech, qq)), initial=0.0) for qq in q])
         return _simulation(mech, np.array(self.t), q, v, a, qd, np.array(self.qdd), task, task_v, task_a, tau,
                            residual, kinetic, potential, loss, event, method, self.dyn.base)
