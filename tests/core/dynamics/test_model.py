@@ -292,3 +292,26 @@ def test_an_undeclared_free_flyer_root_is_said_to_follow_the_idle_rule():
     q = pkm.close_loops(mech, [0.1, -0.1], mech.q_reference).q
     with pytest.warns(PkmWarning, match="free-flyer 'pelvis' on the world is a passive joint"):
         pkm.actuator_model(mech, q)
+
+
+def test_friction_on_a_free_base_enters_its_rows():
+    """The Delta on a free pelvis with viscous friction on its motors and a drag on the pelvis's joint: the forward
+    dynamics with friction balances every row of the equations of motion, ``[Ĝ Ĝ_b]ᵀ (rnea(q, v, a) - f) = [τ; 0]``
+    (f the joints' friction at v; 1e-10 relative): the inverse dynamics' base wrench is the drag's share, its
+    efforts ``τ + Ĝᵀ f``."""
+    from pkm.core.differential.velocity import passive_map
+    from tests.core.dynamics.floating import floating
+
+    base = floating("delta")
+    mech = pkm.with_actuators(base, {j: {"viscous": 0.05} for j in base.actuated_names})
+    mech.model.damping[mech.base_v] = 0.2  # (this mechanism's own model: with_actuators builds a new one)
+    q = pkm.close_loops(mech, mech.actuated_q(mech.q_reference) + 0.05, mech.q_reference).q
+    rates = np.zeros(mech.nv)
+    rates[mech.base_v], rates[mech.act_v] = [0.3, -0.2, 0.5, 1.0, -0.5, 2.0], 0.4
+    model = pkm.actuator_model(mech, q, rates)
+    tau = np.array([0.1, -0.2, 0.3])
+    a = dm.forward_dynamics(mech, q, model.v, tau, friction=True)
+    f = -np.asarray(mech.model.damping) * model.v
+    out = pkm.base_inverse_dynamics(mech, q, model.v, a)
+    assert rel(out.base_wrench, model.base_friction) <= 1e-10 and rel(model.base_friction, f[mech.base_v]) <= 1e-10
+    assert rel(out.efforts, tau + passive_map(mech, q).T @ f) <= 1e-10
