@@ -27,7 +27,7 @@ import pytest
 import pkm
 from pkm.core.dynamics import model as dm
 from pkm.core.dynamics.projection import constraint_dynamics, energy
-from pkm.errors import InvalidInputError, NonFiniteError, SingularityError
+from pkm.errors import InvalidInputError, NonFiniteError, SingularityError, SpecError
 from tests.fd import richardson
 from tests.test_acceptance import ACCEPTANCE, check_every_route_gives_back
 
@@ -276,6 +276,16 @@ def test_the_base_choice_is_checked_and_named():
         pkm.forward_dynamics(mech, q, np.zeros(mech.nv), [0.0], base="fixed", base_wrench=np.zeros(6))
     with pytest.raises(InvalidInputError, match="no twist"):
         constraint_dynamics(mech, q, np.r_[np.ones(6), np.zeros(mech.nv - 6)], [0.0], base="fixed")
+    delta = floating("delta")  # (its base tied to the ground by a closure: not a free body)
+    anchored = dataclasses.replace(delta.spec, closures=(*delta.spec.closures,
+                                                         pkm.Closure("anchor", "point", "ground", "base")))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # (the builder's: the actuators fall short of the mobility)
+        mech = pkm.from_strings(delta.urdf, anchored)
+    q = pkm.close_loops(mech, mech.actuated_q(delta.q_reference) + 0.05, mech.q_reference).q
+    with pytest.raises(SpecError, match="the closures hold the floating base 'pelvis'"):
+        pkm.actuator_model(mech, q)
+    assert pkm.actuator_model(mech, q, base="fixed").base == "fixed"
 
 
 def test_an_undeclared_free_flyer_root_is_said_to_follow_the_idle_rule():

@@ -178,8 +178,8 @@ def _reduce(mech: Mechanism, q: np.ndarray, rtol: float, base: str = "fixed") ->
         if gap > np.sqrt(rtol) * max(float(np.linalg.norm(scales.constraint(Jc), 2)), 1e-300):
             name = mech.base.name if mech.base is not None else ""
             raise SpecError(mech.source, f"the closures hold the floating base {name!r} (a closure to the "
-                                         "world?): it cannot move as a free body with the actuators locked; pass "
-                                         "base='fixed'")
+                                         "world?): it cannot move as a free body with the actuators locked (base='fixed' "
+                                         "holds it in the model; its reaction is not modelled)")
         Gb = without_idle(M, idle, Gb)
     return _Reduction(without_idle(M, idle, G), Jp_pinv, idle, M, Gb)
 
