@@ -9,6 +9,7 @@ import warnings
 from pathlib import Path
 
 import pkm
+from pkm.core.formats.load import load_texts
 
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 _CACHE: dict[str, pkm.Mechanism] = {}
@@ -43,9 +44,7 @@ def floating(name: str) -> pkm.Mechanism:
                 text = text.replace("<worldbody>", '<worldbody>\n    <body name="pelvis" pos="0 0 1"><freejoint '
                                     'name="root"/><geom type="sphere" size="0.05" mass="2"/>').replace(
                     "</worldbody>", "</body></worldbody>")
-                path = Path(__import__("tempfile").mkdtemp(prefix="pkm-floating-")) / "floating.xml"
-                path.write_text(text)
-                _CACHE[name] = pkm.load(path)
+                _CACHE[name] = load_texts({"floating.xml": text})
     return _CACHE[name]
 
 
