@@ -45,3 +45,21 @@ def test_positions_take_units_and_a_configuration_q_or_qa():
     for body in ({"q": mech.q_reference, "qa": qa}, {}):
         with pytest.raises(InvalidInputError, match="q, qa"):
             queries.dynamics(mech, body)
+
+
+def test_a_floating_base_s_batched_dynamics_is_the_model_s():
+    """The compiled kernels hold a floating base, the model lets it move free (pkm.core.dynamics.model): a batch on
+    a floating robot is answered by the model (the kernels are not asked), as one state is."""
+    import numpy as np
+
+    from tests.core.dynamics.floating import floating
+
+    class Held:  # (kernels that must not be asked)
+        def __getattr__(self, name):
+            raise AssertionError(f"the kernels were asked for {name}")
+
+    mech = floating("fourbar")
+    q = pkm.close_loops(mech, [0.4], mech.q_reference).q
+    out = queries.dynamics(mech, {"q": [q, q], "qd": [[0.3], [0.3]]}, Held())
+    model = pkm.actuator_model(mech, q, [0.3])
+    assert model.base == "free" and np.abs(out["h"][1] - model.h).max() <= 1e-12 * np.abs(model.h).max()

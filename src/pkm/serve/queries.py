@@ -462,8 +462,9 @@ def dynamics(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> d
         return out
 
     out: dict[str, Any] | None = None
-    if kernels is not None and n > 1 and not any(samples.errors):
-        try:  # (the compiled model in batches)
+    # (the compiled model in batches; not for a floating base, which the model lets move free and the kernels hold)
+    if kernels is not None and n > 1 and not any(samples.errors) and mech.base is None:
+        try:
             Q = np.ascontiguousarray(np.broadcast_to(q, (n, mech.nq)))
             QD = np.zeros((n, mech.na)) if qd is None else np.ascontiguousarray(np.broadcast_to(qd, (n, mech.na)))
             M, h = kernels.mass_and_bias(Q, QD)

@@ -117,7 +117,7 @@ def test_a_floating_base_is_an_input_the_solvers_hold():
     v = pkm.velocities(floating, fk.q, qd)
     a = pkm.accelerations(floating, fk.q, v, qdd)
     assert np.abs(v[floating.base_v]).max() == 0.0 and np.abs(a[floating.base_v]).max() == 0.0
-    tau = pkm.inverse_dynamics(floating, fk.q, v, a)
+    tau = pkm.inverse_dynamics(floating, fk.q, v, a, base="fixed")  # (the base held: a has none)
     fixed.model.gravity = pin.Motion(np.concatenate([R.T @ floating.model.gravity.linear, np.zeros(3)]))
     try:
         vf = pkm.velocities(fixed, ref.q, qd)

@@ -48,6 +48,7 @@ def model_dict(mech: pkm.Mechanism, model: ActuatorSpaceModel) -> dict[str, Any]
         "g": dict(zip(names, model.g)),
         "friction": dict(zip(names, model.friction)) if has_friction else None,
         "idle_motions": int(model.idle.shape[1]),
+        "base": model.base,
         "units": {
             "actuated": {n: "rad" if r else "m" for n, r in zip(names, revolute)},
             "rates": {n: "rad/s" if r else "m/s" for n, r in zip(names, revolute)},
@@ -84,6 +85,8 @@ def text(out: dict[str, Any]) -> str:
             continue
         lines.append(f"{label}:")
         lines += [f"  {n.ljust(width)}{_value(out[key][n], units[key][n]).rjust(col)}" for n in names]
+    if out["base"] == "free":
+        lines.append("floating base: free (no wrench on it; its motion eliminated from M_a, h_a, g_a)")
     if out["idle_motions"]:
         lines.append(f"idle motions: {out['idle_motions']} (left out of the state: their rates are those of least kinetic energy)")
     return "\n".join(lines)

@@ -93,8 +93,9 @@ class Mechanism:
         urdf: The URDF text, when known.
         base: The floating base's joint (``spec.floating_base``: a free-flyer on the world carrying the whole
             tree), or None. Its pose is an input like the actuators' values: the solvers hold it where ``q``
-            puts it, the rate maps give it no velocity, the efforts are those with the base held (its
-            reaction is not computed); Pinocchio's ``constraintDynamics`` lets it float.
+            puts it and the rate maps give it no velocity; the dynamics lets it move free by default (no
+            wrench on it, its own equations of motion), or holds it (``base="fixed"``):
+            :mod:`pkm.core.dynamics.model`.
         constraint_models: One ``pin.RigidConstraintModel`` per closure, in spec order.
             Point closures are ``CONTACT_3D`` in ``LOCAL_WORLD_ALIGNED``: their Jacobian is
             exactly d(p_A - p_B)/dq. Frame closures are ``CONTACT_6D`` in ``LOCAL`` (frame A):
