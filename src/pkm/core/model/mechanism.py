@@ -214,8 +214,13 @@ class Mechanism:
     def outside_limits(self, q: ArrayLike, *, tol: float = 1e-9) -> tuple[str, ...]:
         """The joints whose coordinate in ``q`` lies outside their stated position limits by more than ``tol``
         (m or rad), in model order. pkm's solvers do not enforce limits; their results report these."""
+        return tuple(n for n, _, _ in self.limit_violations(q, tol=tol))
+
+    def limit_violations(self, q: ArrayLike, *, tol: float = 1e-9) -> tuple[tuple[str, float, tuple[float, float]],
+                                                                             ...]:
+        """:meth:`outside_limits` with the data: ``(joint, value, (lower, upper))`` [m or rad] per joint outside."""
         q = np.asarray(q, dtype=float)
-        return tuple(n for n, (lo, hi) in self.limits.items()
+        return tuple((n, float(q[self.joints[n].idx_q]), (lo, hi)) for n, (lo, hi) in self.limits.items()
                      if n in self.joints and not lo - tol <= q[self.joints[n].idx_q] <= hi + tol)
 
     # ------------------------------------------------------------------ per-thread data, pickling
