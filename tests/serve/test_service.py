@@ -339,7 +339,8 @@ def test_the_compiled_batches_answer_as_the_python_route(client, delta):
                        ("dynamics", {"qa": qa, "qd": [0.1, 0.0, 0.0], "qdd": [1.0, 0.0, 0.0]})):
         served, local = client.query("delta", name, **body), queries.QUERIES[name](delta, body, None)
         assert served["status"] == local["status"] == ["ok"] * 4
-        for key in set(local) - {"status", "units"}:
+        assert served["outside_limits"] == local["outside_limits"] == [[]] * 4
+        for key in set(local) - {"status", "units", "outside_limits"}:
             assert np.abs(np.asarray(served[key], dtype=float) - local[key]).max() <= 1e-10, (name, key)
     assert served["units"] == local["units"] and served["units"]["M"][0][0] == "N m/(rad/s^2)"
     assert client.fk("delta", qa)["iterations"].dtype.kind == "i"

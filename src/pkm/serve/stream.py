@@ -2,7 +2,9 @@
 
 Each message is a map with ``qa`` (the actuated coordinates) and optionally ``qd`` (their rates) and ``qdd`` (their
 accelerations); the answer has ``q`` and ``y`` (the configuration and the task value, the loops closed from the
-previous sample's configuration: a stream stays on its assembly mode), the closure ``residual``, with ``qd`` the task
+previous sample's configuration: a stream stays on its assembly mode), the closure ``residual``, ``status`` (``"ok"``, or
+``"outside_limits"`` where ``outside_limits``, the joints outside the position limits the model states with their
+values and limits, is not empty), with ``qd`` the task
 rates ``yd``, with ``qd`` and ``qdd`` the actuator efforts ``tau`` (``M_a qdd + h_a``), and ``compute_s``.
 
 Where the mechanism's compiled kernels build (:class:`pkm.Kernels`: a C compiler, no idle motion), a sample is the
@@ -69,7 +71,9 @@ class Stream:
             r = close_loops(self.mech, qa, self.q)
             q, residual = r.q, r.residual
         self.q = q
-        out: dict[str, Any] = {"q": q, "y": self.mech.task_map.value(q), "residual": residual}
+        outside = [v._asdict() for v in self.mech.limit_violations(q)]
+        out: dict[str, Any] = {"q": q, "y": self.mech.task_map.value(q), "residual": residual,
+                               "status": "outside_limits" if outside else "ok", "outside_limits": outside}
         if qd is not None:
             if K is not None:
                 J = K.kernel("forward_jacobian")(q[None])[0].reshape(-1, self.mech.na, order="F")

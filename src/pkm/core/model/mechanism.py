@@ -21,7 +21,7 @@ import functools
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -60,6 +60,14 @@ class JointInfo:
 #: How a mechanism that :mod:`pkm.core.model.builder` made pickles, ``mech -> (rebuild, (urdf, spec, ...))``: set by
 #: the builder when it is imported (the model does not import its builder). None until then.
 REDUCE: Callable[[Mechanism], tuple[Callable[..., Mechanism], tuple[Any, ...]]] | None = None
+
+
+class LimitViolation(NamedTuple):
+    """A joint outside the position limits its model states (:meth:`Mechanism.limit_violations`)."""
+
+    joint: str
+    value: float  # [rad, m]
+    limit: tuple[float, float]  # (lower, upper) [rad, m]
 
 
 class Mechanism:
@@ -216,11 +224,11 @@ class Mechanism:
         (m or rad), in model order. pkm's solvers do not enforce limits; their results report these."""
         return tuple(n for n, _, _ in self.limit_violations(q, tol=tol))
 
-    def limit_violations(self, q: ArrayLike, *, tol: float = 1e-9) -> tuple[tuple[str, float, tuple[float, float]],
-                                                                             ...]:
-        """:meth:`outside_limits` with the data: ``(joint, value, (lower, upper))`` [m or rad] per joint outside."""
+    def limit_violations(self, q: ArrayLike, *, tol: float = 1e-9) -> tuple[LimitViolation, ...]:
+        """:meth:`outside_limits` with the data: a :class:`LimitViolation` (joint, value, limit) per joint outside
+        (``._asdict()``: what the command line and the service print)."""
         q = np.asarray(q, dtype=float)
-        return tuple((n, float(q[self.joints[n].idx_q]), (lo, hi)) for n, (lo, hi) in self.limits.items()
+        return tuple(LimitViolation(n, float(q[self.joints[n].idx_q]), (lo, hi)) for n, (lo, hi) in self.limits.items()
                      if n in self.joints and not lo - tol <= q[self.joints[n].idx_q] <= hi + tol)
 
     # ------------------------------------------------------------------ per-thread data, pickling
