@@ -132,6 +132,8 @@ def test_every_answer_matches_its_published_schema(service, openapi):
     assert failed["status"] == ["ok", "failed"] and failed["q"][1] is None and failed["failures"][0]["sample"] == 1
     call("ik", "/models/delta/ik", status=422, json={"y": [0.0, 0.0, -3.0]})  # (one sample: pkm's error)
     call("fk", "/models/delta/fk", status=422, json={"qa": qa0.tolist(), "foo": 1})  # (an unknown field)
+    absurd = call("fk", "/models/delta/fk", status=422, json={"qa": [1e308, 0.2, 0.3]})  # (never wrapped to 2.58 rad)
+    assert absurd["error"] == "InvalidInputError" and "beyond 1e+06" in absurd["message"]
     call("fk", "/models/nope/fk", status=404, json={"qa": qa0.tolist()})
 
     jobs = {"job_map": ("map", {"axes": {"x": [-0.05, 0.05, 3], "y": [-0.05, 0.05, 2]}, "fixed": {"z": -0.35},

@@ -31,7 +31,7 @@ import numpy as np
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, PkmError
 from pkm.units import KIND_OF_UNIT, parse_quantity
-from pkm.validation import as_array
+from pkm.validation import as_array, bounded
 
 #: Samples in one request at most.
 MAX_SAMPLES = 100_000
@@ -192,7 +192,7 @@ def _array(body: Mapping[str, Any], key: str, size: int, kinds: Sequence[str | N
     if not np.all(np.isfinite(a)):
         bad = np.argwhere(~np.isfinite(a))[0]
         raise InvalidInputError(key, f"sample {bad[0]}, entry {bad[1]} is not finite")
-    return a
+    return a if kinds is None else bounded(a, key)  # (positions: the library's bound, beyond it refused)
 
 
 def _is_single(body: Mapping[str, Any], *keys: str) -> bool:

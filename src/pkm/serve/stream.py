@@ -23,7 +23,7 @@ import numpy as np
 
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError
-from pkm.validation import as_array
+from pkm.validation import as_array, bounded
 
 
 class Stream:
@@ -60,6 +60,7 @@ class Stream:
         qa = self._vector(sample, "qa")
         if qa is None:
             raise InvalidInputError("qa", f"missing: give {self.mech.na} numbers")
+        bounded(qa, "qa")  # (the library's bound on coordinates: beyond it refused, never wrapped)
         qd, qdd = self._vector(sample, "qd"), self._vector(sample, "qdd")
         K = self.kernels
         q = residual = None

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.units import quantities, quantity
-from pkm.validation import ABSURD, as_array, as_vector
+from pkm.validation import as_array, as_vector, bounded
 
 if TYPE_CHECKING:  # (annotations only: the mechanism module imports this one)
     from pkm.core.model.mechanism import Mechanism
@@ -266,8 +266,7 @@ class TaskMap:
                                               f"{list(self.value_names)}, got shape {y.shape}", target)
         if not np.all(np.isfinite(y)):
             raise InvalidInputError("target", "holds non-finite values", target)
-        if np.abs(y).max() > ABSURD:
-            raise InvalidInputError("target", f"holds values beyond {ABSURD:g} (SI units: m, rad)", target)
+        bounded(y, "target", target)
         for g, part in zip(self._groups, self._parts(y)[0]):
             if g.pose and abs((qn := float(np.linalg.norm(part[3:7]))) - 1.0) > 1e-6:
                 raise InvalidInputError("target", f"quaternion norm {qn:.6g}, expected 1", target)

@@ -33,7 +33,7 @@ from pkm.core.dynamics.projection import inverse_dynamics
 from pkm.core.kinematics.solve import SolveResult, close_loops, solve_ik
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, SingularityError
-from pkm.validation import ABSURD, as_array, as_tolerance
+from pkm.validation import as_array, as_tolerance, bounded
 
 #: A sample's joint step beyond this multiple of the first-order prediction (plus 1e-9) is a jump.
 JUMP_RATIO = 1.0
@@ -105,9 +105,7 @@ def _samples(x: ArrayLike | None, n: int | None, size: int, what: str) -> np.nda
                                 x)
     if not np.all(np.isfinite(arr)):
         raise InvalidInputError(what, "holds non-finite values", x)
-    if np.abs(arr).max() > ABSURD:
-        raise InvalidInputError(what, f"holds values beyond {ABSURD:g} (SI units: m, rad)", x)
-    return arr
+    return bounded(arr, what, x)
 
 
 def _units(mech: Mechanism) -> dict[str, dict[str, str]]:

@@ -32,7 +32,7 @@ from pkm.core.model.spec import Branch, ClosureSpec
 from pkm.core.model.urdf import position_limits
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
 from pkm.units import quantities
-from pkm.validation import as_array, as_vector, wrap_angle
+from pkm.validation import as_array, as_vector, bounded, wrap_angle
 
 if TYPE_CHECKING:
     from pkm.core.kinematics.task import TaskMap
@@ -348,8 +348,9 @@ class Mechanism:
 
     # ------------------------------------------------------------------ vectors
     def check_q(self, q: ArrayLike, name: str = "q") -> np.ndarray:
-        """``q`` as a float array of shape (nq,), finite, with unit quaternions; else raise."""
-        q = as_vector(q, self.nq, name)
+        """``q`` as a float array of shape (nq,), finite, within :data:`~pkm.validation.ABSURD` (a coordinate beyond
+        is refused, never wrapped: :func:`~pkm.validation.bounded`), with unit quaternions; else raise."""
+        q = bounded(as_vector(q, self.nq, name), name, q)
         for j in self.joints.values():
             if j.kind == "JointModelFreeFlyer":
                 quat = q[j.idx_q + 3:j.idx_q + 7]
@@ -367,9 +368,11 @@ class Mechanism:
 
     def check_actuated(self, qa: ArrayLike, name: str = "q_actuated", *, positions: bool = False) -> np.ndarray:
         """Actuated values as a vector (``na``, SI). With ``positions``, entries may be strings with units
-        (``"5deg"``, ``"20mm"``); rates and efforts take numbers only (SI: m/s, rad/s, N, N m)."""
+        (``"5deg"``, ``"20mm"``) and are bounded (:func:`~pkm.validation.bounded`: beyond 1e6 m or rad refused, never
+        wrapped); rates and efforts take numbers only (SI: m/s, rad/s, N, N m)."""
         if positions:
             qa = quantities(qa, ["angle" if j.revolute else "length" for j in self.actuated], name)
+            return bounded(as_vector(qa, self.na, name), name, qa)
         return as_vector(qa, self.na, name)
 
     def actuated_q(self, q: ArrayLike) -> np.ndarray:
@@ -407,7 +410,7 @@ class Mechanism:
                 raise InvalidInputError(name, f"joint {name!r} takes {j.nq} coordinate(s), got {arr.shape}", val)
             if not np.all(np.isfinite(arr)):
                 raise InvalidInputError(name, "value is not finite", val)
-            q[j.idx_q:j.idx_q + j.nq] = arr
+            q[j.idx_q:j.idx_q + j.nq] = bounded(arr, name, val)
         return q
 
     def q_to_dict(self, q: ArrayLike) -> dict[str, np.ndarray | float]:

@@ -53,7 +53,7 @@ from pkm.core.twin.codegen import compile_library, numpy_function, pointers
 from pkm.core.twin.dynamics import ActuatorTwin
 from pkm.core.twin.tree import Twin
 from pkm.errors import InvalidInputError, NonFiniteError
-from pkm.validation import as_array, as_count, as_scalar, as_tolerance
+from pkm.validation import as_array, as_count, as_scalar, as_tolerance, bounded
 
 if TYPE_CHECKING:
     from pkm.core.kinematics.solve import SolveResult
@@ -464,7 +464,7 @@ class Kernels:
             a = x if type(x) is np.ndarray and x.dtype == np.float64 else as_array(x, what)
             if a.ndim not in (1, 2) or a.shape[-1] != size:
                 raise InvalidInputError(what, f"expected ({size},) or (n, {size})", x)
-            arrays.append(a)
+            arrays.append(bounded(a, what, x) if what == "q" else a)  # (a configuration: the coordinates' rule)
         single = arrays[0].ndim == 1
         if any((a.ndim == 1) != single for a in arrays):
             raise InvalidInputError(name, "give every input as one sample or every input as a batch")
@@ -640,6 +640,7 @@ class Kernels:
         t = np.atleast_2d(as_array(targets, "targets"))
         if t.shape[1] != kernel.in_size[1] or not np.all(np.isfinite(t)):
             raise InvalidInputError("targets", f"expected finite values of shape (n, {kernel.in_size[1]})", targets)
+        bounded(t, "targets", targets)
         prev = self.mech.q_reference.copy() if q0 is None else self.mech.check_q(q0, "q0")
         n = len(t)
         Q, res, its = np.empty((n, len(prev))), np.empty(n), np.zeros(n, dtype=np.int64)
