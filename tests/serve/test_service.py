@@ -275,6 +275,7 @@ def test_jobs_run_apart_and_give_json_and_parquet(client, service, delta):
     modes = client.result(client.job("rrr3", "assembly_modes", qa=rrr3.actuated_q(rrr3.q_reference))["id"])
     direct = pkm.assembly_modes(rrr3, rrr3.actuated_q(rrr3.q_reference))
     assert modes["count"] == len(direct.modes) >= 2 and np.abs(modes["q"] - np.array([m.q for m in direct.modes])).max() < 1e-9
+    assert [[o["joint"] for o in m] for m in modes["outside_limits"]] == [list(m.outside_limits) for m in direct.modes]
     from pkm.client import ServiceError
 
     bad = client.job("delta", "working_modes", y=[1.0, 2.0])  # (a wrong size: the job fails, with the message)

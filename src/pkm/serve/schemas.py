@@ -416,6 +416,11 @@ class SweepJob(_Request):
     workers: int | None = _field("Local workers (1 to 8).", None, None)
 
 
+_MODES_OUTSIDE = _field("Per mode, the joints outside the position limits the model states, each with its value "
+                        "and limits [rad, m] (empty: none; a mode is geometry, listed whether or not it is within).",
+                        [[]])
+
+
 class AssemblyModesResult(_Answer):
     count: int = _field("Assembly modes found.", 2)
     complete: bool = _field("Whether the search is certified complete.", True)
@@ -423,6 +428,7 @@ class AssemblyModesResult(_Answer):
     y: list[list[float]] = _field("Each mode's task value [m, rad].", [[0.0, 0.0, -0.35]])
     residual: list[float] = _field("Each mode's closure residual [m or rad].", [1e-15])
     labels: list[str] = _field("Each mode's label.", ["(1,)"])
+    outside_limits: list[list[OutsideLimit]] = _MODES_OUTSIDE
     seconds: float = _field("The search's time [s].", 0.5)
     units: Units = _field(UNITS, {"q": ["rad"] * 9 + ["m"] * 3, "y": ["m", "m", "m"], "residual": "m or rad",
                                   "seconds": "s"})
@@ -434,6 +440,7 @@ class WorkingModesResult(_Answer):
     q: list[list[float]] = _field("Each mode's configuration [rad, m].", [_Q_EXAMPLE])
     qa: list[list[float]] = _field("Each mode's actuated values [rad, m].", [_QA_EXAMPLE])
     labels: list[str] = _field("Each mode's label.", ["(1, 1, 1)"])
+    outside_limits: list[list[OutsideLimit]] = _MODES_OUTSIDE
     seconds: float = _field("The search's time [s].", 0.5)
     units: Units = _field(UNITS, {"q": ["rad"] * 9 + ["m"] * 3, "qa": ["rad"] * 3, "seconds": "s"})
 
