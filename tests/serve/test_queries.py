@@ -50,7 +50,8 @@ def test_positions_take_units_and_a_configuration_q_or_qa():
 def test_a_sample_outside_the_limits_is_not_ok_in_every_query():
     """The humanoid ankle at pitch 0.8 rad (range +-0.6; the motors then 1.047 and 1.032 rad, range +-1): ik and fk
     answer status outside_limits with the joints named, their values those of the answer's own q; the queries at a
-    configuration (jacobians) say the same; a failed sample has none (null), a sample inside them is ok."""
+    configuration (jacobians) and a stream's sample say the same; a failed sample has none (null), a sample inside
+    them is ok."""
     import numpy as np
 
     from tests.test_humanoid import EXAMPLES
@@ -68,3 +69,11 @@ def test_a_sample_outside_the_limits_is_not_ok_in_every_query():
     assert [o["joint"] for o in fk["outside_limits"][0]] == ["ankle_pitch", "motor_left", "motor_right"]
     assert np.isclose(fk["outside_limits"][0][0]["value"], 0.8, atol=1e-9)
     assert queries.jacobians(mech, {"q": ik["q"][0]})["status"] == ["outside_limits"]
+    from pkm.serve.stream import Stream
+
+    stream = Stream(mech)  # (the WebSocket's samples: the same report)
+    assert stream.step({"qa": [0.1, 0.1]})["status"] == "ok"
+    step = stream.step({"qa": qa.tolist()})
+    assert step["status"] == "outside_limits"
+    for a, b in zip(step["outside_limits"], fk["outside_limits"][0], strict=True):
+        assert a["joint"] == b["joint"] and a["limit"] == b["limit"] and abs(a["value"] - b["value"]) <= 1e-9

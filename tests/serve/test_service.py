@@ -194,12 +194,15 @@ def test_the_stream_warm_starts_and_answers_bad_messages(client, service, delta)
         answers = [s.send(qa=a, qd=[0.1, 0.0, 0.0], qdd=[1.0, 0.0, 0.0]) for a in qa]
     q = pkm.close_loops(delta, qa[0], delta.q_reference).q
     assert np.abs(answers[0]["q"] - q).max() <= 1e-10 and answers[0]["residual"] <= 1e-10
+    assert answers[0]["status"] == "ok" and answers[0]["outside_limits"] == []
     model = pkm.actuator_model(delta, answers[2]["q"], np.array([0.1, 0.0, 0.0]))
     assert np.abs(answers[2]["tau"] - (model.M @ np.array([1.0, 0.0, 0.0]) + model.h)).max() <= 1e-12
     url = "ws" + service.url[4:] + "/models/delta/stream"
     with connect(url, additional_headers=AUTH) as ws:  # JSON text, a bad message, then a good one
         ws.send(json.dumps({"qa": [1, 2]}))
         assert json.loads(ws.recv())["error"] == "InvalidInputError"
+        ws.send(json.dumps({"qa": [1e308, 0.2, 0.3]}))  # (beyond the coordinates' bound: refused, never wrapped)
+        assert "beyond 1e+06" in json.loads(ws.recv())["message"]
         ws.send("not json")
         assert json.loads(ws.recv())["error"] == "BadMessage"
         ws.send(json.dumps({"qa": qa[0].tolist()}))
