@@ -250,7 +250,8 @@ def test_the_compute_limit_answers_while_the_slot_stays_held():
 
 def test_a_short_fuzz_gets_no_500_and_the_service_goes_on(service):
     """300 malformed requests (:mod:`pkm.serve.fuzz`; CI sends 10,000 to a service of its own): none answered 500,
-    every error JSON with a message, the service answering afterwards."""
+    every error JSON with a message, no fk or ik of a coordinate beyond 1e6 (SI) answered as a success, the service
+    answering afterwards."""
     from pkm.serve.fuzz import fuzz
 
     out = fuzz(service.url, 300, token=TOKEN, seed=1)
