@@ -455,7 +455,8 @@ class PathError(PkmError):
     is not smooth, crosses a position limit the model states, or a limit cannot hold the mechanism still on it.
 
     Attributes:
-        index: The path point (0-based, in the planning grid or the waypoints, as ``what`` says) where it fails.
+        index: The path point (0-based, in the planning grid or the waypoints, or the grid's segment whose midpoint
+            fails, as ``what`` says) where it fails.
         s: The path parameter there (in [0, 1]).
         limit: What is violated: ``"workspace"``, ``"singularity"``, ``"smoothness"``, ``"position limit of
             motor_1"`` or the limit that cannot hold (``"peak effort of motor_1"``).
