@@ -31,7 +31,7 @@ from pkm.core.differential.velocity import (
 )
 from pkm.core.dynamics.projection import inverse_dynamics
 from pkm.core.kinematics.solve import SolveResult, close_loops, solve_ik
-from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.mechanism import LimitViolation, Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.validation import as_array, as_tolerance, bounded
 
@@ -71,6 +71,9 @@ class Trajectory:
         units: The unit of every actuated joint and named task coordinate (``{"actuated": {...}, "task": {...}}``;
             the task's keys are :attr:`pkm.core.TaskMap.keys`, a pose's orientation by its Z-Y-X angles, while
             :attr:`task` holds its quaternion).
+        outside_limits: Per joint that leaves the position limits the model states, ``(sample, violation)``: the
+            first sample outside and there its :class:`~pkm.core.model.mechanism.LimitViolation` (joint, value,
+            limit), in the order of the samples (empty: every joint within its limits throughout).
     """
 
     q: np.ndarray
@@ -86,6 +89,7 @@ class Trajectory:
     residual: np.ndarray
     jumps: tuple[Jump, ...]
     units: dict[str, dict[str, str]] = field(default_factory=dict)
+    outside_limits: tuple[tuple[int, LimitViolation], ...] = ()
 
     def __len__(self) -> int:
         return len(self.q)
@@ -172,7 +176,17 @@ def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int,
     ydd = np.array([task_acceleration(mech, qk, vk, ak) if np.all(np.isfinite(ak)) else np.full(mech.n_task, np.nan)
                     for qk, vk, ak in zip(q, v, a)])
     return Trajectory(q, v, a, q[:, mech.act_q], v[:, mech.act_v], a[:, mech.act_v], values, yd, ydd, tau, residual,
-                      tuple(jumps), _units(mech))
+                      tuple(jumps), _units(mech), first_outside(mech, q))
+
+
+def first_outside(mech: Mechanism, q: np.ndarray) -> tuple[tuple[int, LimitViolation], ...]:
+    """Per joint that leaves the position limits the model states along the configurations ``q`` (N x nq), the
+    first sample outside and there its violation, in the order of the samples (:attr:`Trajectory.outside_limits`)."""
+    first: dict[str, tuple[int, LimitViolation]] = {}
+    for k, qk in enumerate(q):
+        for violation in mech.limit_violations(qk):
+            first.setdefault(violation.joint, (k, violation))
+    return tuple(sorted(first.values(), key=lambda kv: kv[0]))
 
 
 def follow_task(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None = None, ydd: ArrayLike | None = None, *,
@@ -282,4 +296,4 @@ def task_values(mech: Mechanism, q: ArrayLike) -> dict[str, float]:
     return mech.task_map.named(mech.check_q(q))
 
 
-__all__ = ["JUMP_RATIO", "Jump", "Trajectory", "follow_actuators", "follow_task", "task_values"]
+__all__ = ["JUMP_RATIO", "Jump", "Trajectory", "first_outside", "follow_actuators", "follow_task", "task_values"]

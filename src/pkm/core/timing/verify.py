@@ -57,7 +57,8 @@ class Verification:
         simulated_duration: How long the simulation ran [s] (the cycle time, or less where it stopped: see
             ``event``).
         event: Why the simulation stopped early, or None.
-        outside_limits: The joints that leave their stated position limits at some check point (model order).
+        outside_limits: The joints that leave their stated position limits at some check point (in the order they
+            do).
         reason: Why the plan does not hold, in words (None where it holds).
     """
 
@@ -133,20 +134,17 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
                (("effort", effort), ("speed", speed), ("acceleration", acc)) if not use <= 1.0 + HOLD_RTOL]
     if traj.jumps:
         reasons.append("the motors' motion jumps (the path's inverse kinematics changed branch)")
-    outside: dict[str, str] = {}
-    for k in range(len(s)):
-        for joint, value, (lo, hi) in mech.limit_violations(traj.q[k]):
-            outside.setdefault(joint, f"{joint} = {value:.6g} at s = {s[k]:.6g}, outside its limits [{lo:.6g}, "
-                                      f"{hi:.6g}]")
-    if outside:
-        reasons.append("position limits crossed: " + "; ".join(outside.values()))
+    if traj.outside_limits:  # (per joint, the first check point outside)
+        reasons.append("position limits crossed: " + "; ".join(
+            f"{v.joint} = {v.value:.6g} at s = {s[k]:.6g}, outside its limits [{v.limit[0]:.6g}, {v.limit[1]:.6g}]"
+            for k, v in traj.outside_limits))
     holds = not reasons
     inactive = tuple(int(i) for i in np.flatnonzero(plan.usage < 1.0 - ACTIVE_RTOL))
     track, task_err, dur, event = None, None, 0.0, None
     if simulate:
         track, task_err, dur, event = _track(plan, t, traj, tau, dt)
     return Verification(s, t, tau, effort, speed, acc, holds, inactive, track, task_err, dur, event,
-                        tuple(n for n in mech.limits if n in outside), "; ".join(reasons) or None)
+                        tuple(v.joint for _, v in traj.outside_limits), "; ".join(reasons) or None)
 
 
 def _track(plan: TimeOptimal, t: np.ndarray, traj: object, tau: np.ndarray,
