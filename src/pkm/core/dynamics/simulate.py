@@ -65,7 +65,7 @@ from pkm.core.dynamics.projection import energy
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.newton import least_squares
 from pkm.core.kinematics.solve import close_loops
-from pkm.core.kinematics.trajectory import Trajectory, _units, first_outside
+from pkm.core.kinematics.trajectory import Trajectory, _units
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import CompilerError, ControllerError, InvalidInputError, PkmError, SingularityError, SpecError
 from pkm.validation import as_array, as_scalar
@@ -453,7 +453,7 @@ def _simulation(mech: Mechanism, t: np.ndarray, q: np.ndarray, v: np.ndarray, a:
     at = np.abs(tau) >= limit * (1.0 - 1e-12) if len(tau) else np.zeros((0, mech.na), dtype=bool)
     saturated = {name: int(n) for name, n in zip(mech.actuated_names, at.sum(axis=0))}
     return Simulation(q, v, a, q[:, mech.act_q], qd, qdd, task, task_v, task_a, tau, residual,
-                      (), units, first_outside(mech, q), t, kinetic, potential, work, dissipated, event, method,
+                      (), units, mech.limits_along(q), t, kinetic, potential, work, dissipated, event, method,
                       saturated)
 
 

@@ -73,7 +73,8 @@ class Trajectory:
             :attr:`task` holds its quaternion).
         outside_limits: Per joint that leaves the position limits the model states, ``(sample, violation)``: the
             first sample outside and there its :class:`~pkm.core.model.mechanism.LimitViolation` (joint, value,
-            limit), in the order of the samples (empty: every joint within its limits throughout).
+            limit), in the order of the samples (:meth:`~pkm.core.Mechanism.limits_along`; empty: every joint
+            within its limits throughout).
     """
 
     q: np.ndarray
@@ -176,17 +177,7 @@ def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int,
     ydd = np.array([task_acceleration(mech, qk, vk, ak) if np.all(np.isfinite(ak)) else np.full(mech.n_task, np.nan)
                     for qk, vk, ak in zip(q, v, a)])
     return Trajectory(q, v, a, q[:, mech.act_q], v[:, mech.act_v], a[:, mech.act_v], values, yd, ydd, tau, residual,
-                      tuple(jumps), _units(mech), first_outside(mech, q))
-
-
-def first_outside(mech: Mechanism, q: np.ndarray) -> tuple[tuple[int, LimitViolation], ...]:
-    """Per joint that leaves the position limits the model states along the configurations ``q`` (N x nq), the
-    first sample outside and there its violation, in the order of the samples (:attr:`Trajectory.outside_limits`)."""
-    first: dict[str, tuple[int, LimitViolation]] = {}
-    for k, qk in enumerate(q):
-        for violation in mech.limit_violations(qk):
-            first.setdefault(violation.joint, (k, violation))
-    return tuple(sorted(first.values(), key=lambda kv: kv[0]))
+                      tuple(jumps), _units(mech), mech.limits_along(q))
 
 
 def follow_task(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None = None, ydd: ArrayLike | None = None, *,
@@ -296,4 +287,4 @@ def task_values(mech: Mechanism, q: ArrayLike) -> dict[str, float]:
     return mech.task_map.named(mech.check_q(q))
 
 
-__all__ = ["JUMP_RATIO", "Jump", "Trajectory", "first_outside", "follow_actuators", "follow_task", "task_values"]
+__all__ = ["JUMP_RATIO", "Jump", "Trajectory", "follow_actuators", "follow_task", "task_values"]

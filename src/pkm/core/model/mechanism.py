@@ -227,9 +227,22 @@ class Mechanism:
     def limit_violations(self, q: ArrayLike, *, tol: float = 1e-9) -> tuple[LimitViolation, ...]:
         """:meth:`outside_limits` with the data: a :class:`LimitViolation` (joint, value, limit) per joint outside
         (``._asdict()``: what the command line and the service print)."""
-        q = np.asarray(q, dtype=float)
-        return tuple(LimitViolation(n, float(q[self.joints[n].idx_q]), (lo, hi)) for n, (lo, hi) in self.limits.items()
-                     if n in self.joints and not lo - tol <= q[self.joints[n].idx_q] <= hi + tol)
+        return tuple(v for _, v in self.limits_along(np.asarray(q, dtype=float)[None], tol=tol))
+
+    def limits_along(self, Q: ArrayLike, *, tol: float = 1e-9) -> tuple[tuple[int, LimitViolation], ...]:
+        """Along configurations ``Q`` (N x nq), per joint that leaves its stated position limits by more than
+        ``tol``: the first sample outside and there its :class:`LimitViolation`, in the order of the samples (as
+        :meth:`limit_violations` at each sample, vectorised: a path of 100,000 samples costs milliseconds)."""
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        named = [(n, self.joints[n].idx_q, lo, hi) for n, (lo, hi) in self.limits.items() if n in self.joints]
+        if not named or not len(Q):
+            return ()
+        names, idx, lo, hi = zip(*named)
+        X = Q[:, list(idx)]
+        with np.errstate(invalid="ignore"):
+            out = ~((np.array(lo) - tol <= X) & (X <= np.array(hi) + tol)) & ~np.isnan(X)
+        first = [(int(np.argmax(out[:, j])), j) for j in range(len(names)) if out[:, j].any()]
+        return tuple((k, LimitViolation(names[j], float(X[k, j]), (lo[j], hi[j]))) for k, j in sorted(first))
 
     # ------------------------------------------------------------------ per-thread data, pickling
     @property

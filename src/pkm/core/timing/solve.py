@@ -249,19 +249,21 @@ def check_positions(mech: Mechanism, C: PathCoefficients, between: PathCoefficie
     """Refuse a path that takes a joint outside the position limits the model states (every joint that has some:
     actuated, task, passive; :meth:`~pkm.core.Mechanism.limit_violations`): :class:`~pkm.errors.PathError` at the
     first grid point (or segment midpoint, ``between``) outside, naming the joint, its value and its limits."""
-    points = [(float(s), k, "path point", q) for k, (s, q) in enumerate(zip(C.s, C.q))]
-    if between is not None:
-        points += [(float(s), k, "segment", q) for k, (s, q) in enumerate(zip(between.s, between.q))]
-    for s, k, what, q in sorted(points, key=lambda p: p[0]):
-        outside = mech.limit_violations(q)
-        if outside:
-            joint, value, (lo, hi) = outside[0]
-            unit = "rad" if mech.joints[joint].revolute else "m"
-            more = f" (also outside: {', '.join(n for n, _, _ in outside[1:])})" if len(outside) > 1 else ""
-            raise PathError(k, s, f"position limit of {joint}",
-                            f"{joint} = {value:.6g} {unit}, outside its limits [{lo:.6g}, {hi:.6g}] {unit} (the "
-                            f"model's){more}: the path leaves the joints' range", what, joint=joint, value=value,
-                            bound=(lo, hi))
+    s = C.s if between is None else np.concatenate([C.s, between.s])
+    order = np.argsort(s, kind="stable")
+    Q = (C.q if between is None else np.concatenate([C.q, between.q]))[order]
+    along = mech.limits_along(Q)
+    if along:
+        i, (joint, value, (lo, hi)) = along[0]
+        o = int(order[i])
+        k, what = (o, "path point") if o < len(C.s) else (o - len(C.s), "segment")
+        unit = "rad" if mech.joints[joint].revolute else "m"
+        others = [v.joint for v in mech.limit_violations(Q[i]) if v.joint != joint]
+        more = f" (also outside: {', '.join(others)})" if others else ""
+        raise PathError(k, float(s[o]), f"position limit of {joint}",
+                        f"{joint} = {value:.6g} {unit}, outside its limits [{lo:.6g}, {hi:.6g}] {unit} (the "
+                        f"model's){more}: the path leaves the joints' range", what, joint=joint, value=value,
+                        bound=(lo, hi))
 
 
 def usage(C: PathCoefficients, L: Limits, sd: np.ndarray, sdd: np.ndarray,

@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pkm.core.dynamics.model import COULOMB_VELOCITY
-from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.mechanism import LimitViolation, Mechanism, check_mechanism
 from pkm.core.twin.codegen import C_INT as _I
 from pkm.core.twin.codegen import C_REAL_P as _P
 from pkm.core.twin.codegen import compile_library, numpy_function, pointers
@@ -120,6 +120,9 @@ class PathResult:
         fallback: The samples solved by the generic core instead (pivot under :data:`PIVOT_FLOOR`, or no
             convergence in ``max_iter`` kernel iterations).
         how: What ran the kernel.
+        outside_limits: Per joint that leaves the position limits the model states, the first sample outside and
+            there its violation (:meth:`pkm.core.Mechanism.limits_along`; pkm's solvers report limits, they do not
+            enforce them).
     """
 
     q: np.ndarray
@@ -127,6 +130,7 @@ class PathResult:
     iterations: np.ndarray
     fallback: tuple[int, ...] = field(default=())
     how: str = ""
+    outside_limits: tuple[tuple[int, LimitViolation], ...] = ()
 
 
 @functools.lru_cache(maxsize=1)
@@ -656,7 +660,7 @@ class Kernels:
             Q[end], res[end], its[end] = solved.q, solved.residual, 0
             fallback.append(end)
             prev, start = solved.q, end + 1
-        return PathResult(Q, res, its, tuple(fallback), kernel.how)
+        return PathResult(Q, res, its, tuple(fallback), kernel.how, self.mech.limits_along(Q))
 
 
 _PATHS = ("closure_newton", "ik_newton")  # the kernels with the path driver
