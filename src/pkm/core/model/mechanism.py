@@ -18,6 +18,7 @@ by tree traversal, not by file order). Mimic joints take no coordinate.
 from __future__ import annotations
 
 import functools
+import math
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -227,7 +228,13 @@ class Mechanism:
     def limit_violations(self, q: ArrayLike, *, tol: float = 1e-9) -> tuple[LimitViolation, ...]:
         """:meth:`outside_limits` with the data: a :class:`LimitViolation` (joint, value, limit) per joint outside
         (``._asdict()``: what the command line and the service print)."""
-        return tuple(v for _, v in self.limits_along(np.asarray(q, dtype=float)[None], tol=tol))
+        q = np.asarray(q, dtype=float)
+        out = []
+        for n, (lo, hi) in self.limits.items():  # (a loop: at one configuration, 10x faster than limits_along)
+            x = float(q[self.joints[n].idx_q]) if n in self.joints else math.nan
+            if not lo - tol <= x <= hi + tol and x == x:  # (NaN: not called outside, the caller's to refuse)
+                out.append(LimitViolation(n, x, (lo, hi)))
+        return tuple(out)
 
     def limits_along(self, Q: ArrayLike, *, tol: float = 1e-9) -> tuple[tuple[int, LimitViolation], ...]:
         """Along configurations ``Q`` (N x nq), per joint that leaves its stated position limits by more than
