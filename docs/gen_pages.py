@@ -1,8 +1,7 @@
 """The generated pages of the site, written by mkdocs-gen-files when the site is built (``make docs``).
 
-* ``reference/``: one API page per public module of ``src/pkm`` (no ``_private`` module, no deprecated alias of a
-  moved module), a package's page being its section's index, and ``reference/SUMMARY.md`` (literate-nav) as the
-  section's navigation. A package page renders the package's docstring and its own definitions, then a table of
+* ``reference/``: one API page per public module of ``src/pkm`` (no ``_private`` module), a package's page being its
+  section's index, and ``reference/SUMMARY.md`` (literate-nav) as the section's navigation. A package page renders the package's docstring and its own definitions, then a table of
   the names it re-exports, each linked to the page of the module that defines it (where it is documented once).
   The package ``pkm`` re-exports every name of ``pkm.__all__``: ``tests/test_docs.py`` checks the table covers it.
 * ``gallery.md``: the report's figures when ``make demo`` has made them (``out/figures/<paper>/*.png``, copied into
@@ -27,16 +26,13 @@ SRC = ROOT / "src"
 
 
 def public_modules() -> list[str]:
-    """Every public module of ``src/pkm``, sorted: no ``_private`` part, no ``__main__``, no deprecated alias of a
-    moved module (a module whose body is ``alias(__name__, ...)``: it has no content of its own)."""
+    """Every public module of ``src/pkm``, sorted: no ``_private`` part, no ``__main__``."""
     names = []
     for path in sorted(SRC.joinpath("pkm").rglob("*.py")):
         parts = list(path.relative_to(SRC).with_suffix("").parts)
         if parts[-1] == "__init__":
             parts.pop()
         if any(part.startswith("_") for part in parts):
-            continue
-        if "alias(__name__" in path.read_text(encoding="utf-8"):
             continue
         names.append(".".join(parts))
     return sorted(names)

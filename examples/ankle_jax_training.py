@@ -8,7 +8,7 @@ linear policy maps (motor angles, motor speeds, desired motor accelerations) to 
 between the accelerations those torques produce (the kernel, ``jax.vmap`` over a batch of closed states) and the
 desired ones; ``jax.value_and_grad`` differentiates it through the kernel, plain SGD follows (no flax, no optax).
 The learned torques end near the model's ``M_a qdd + h_a`` (the C kernel ``mass_and_bias``) on states not trained on.
-Needs JAX (``pip install "pkm[jax]"``). Run it from anywhere: python examples/ankle_jax_training.py
+Needs JAX (``pip install "pkm-robotics[jax]"``). Run it from anywhere: python examples/ankle_jax_training.py
 """
 
 import sys
@@ -22,7 +22,7 @@ try:
     import jax
     import jax.numpy as jnp
 except ImportError:
-    sys.exit('this example needs JAX: pip install "pkm[jax]"')
+    sys.exit('this example needs JAX: pip install "pkm-robotics[jax]"')
 
 ankle = pkm.load(Path(__file__).resolve().parent / "humanoid_ankle" / "ankle.closures.toml")
 K = pkm.Kernels(ankle)

@@ -39,7 +39,7 @@ try:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-except ImportError:  # (the figures: pip install "pkm[figures]")
+except ImportError:  # (the figures: pip install "pkm-robotics[figures]")
     plt = None
 else:
     OUT.mkdir(parents=True, exist_ok=True)

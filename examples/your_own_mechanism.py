@@ -23,7 +23,7 @@ print(f"{d.classification}; mobility {d.mobility}, of which idle: {d.idle_motion
       "(the coupler spinning about its own axis moves nothing)")
 
 fk = pkm.close_loops(mech, [0.3])  # forward kinematics: the crank at 0.3 rad
-ik = pkm.solve_ik(mech, mech.task_map.value(fk.q))  # and back
+ik = pkm.solve_ik(mech, pkm.TaskMap.of(mech).value(fk.q))  # and back
 print(f"FK residual {fk.residual:.1e}, IK back to {mech.actuated_q(ik.q)[0]:.12f} rad")
 
 v = pkm.velocities(mech, fk.q, [2.0])  # crank at 2 rad/s

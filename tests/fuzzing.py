@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+import pkm
 from pkm.mechanisms import module as mechanism_module
 from pkm.mechanisms import names as mechanism_names
 from pkm.papers.hexapod import pose_T_placement
@@ -533,9 +534,9 @@ def _follow(g, adv, task: bool):
     mm = c.mech[n]
     k = int(g.rng.integers(1, 4))
     if task:
-        y0 = mm.task_map.value(mm.q_reference)
+        y0 = pkm.TaskMap.of(mm).value(mm.q_reference)
         samples = np.array([y0] * k)
-        if not mm.task_map.pose:
+        if not pkm.TaskMap.of(mm).pose:
             samples = samples + g.near(np.zeros_like(samples), 0.01)
     else:
         samples = np.array([mm.actuated_q(mm.q_reference)] * k) + g.near(np.zeros((k, mm.na)), 0.01)

@@ -76,10 +76,10 @@ def test_it_loads_assembled(name):
 def test_forward_then_inverse_kinematics_round_trip(name):
     mech = load(name)
     q = moved(mech)
-    y = mech.task_map.value(q)
+    y = pkm.TaskMap.of(mech).value(q)
     ik = pkm.solve_ik(mech, y, mech.q_reference, tol=1e-12)
     assert np.abs(mech.actuated_q(ik.q) - mech.actuated_q(q)).max() <= 1e-9
-    assert np.abs(mech.task_map.error(y, mech.task_map.value(ik.q))).max() <= 1e-9
+    assert np.abs(pkm.TaskMap.of(mech).error(y, pkm.TaskMap.of(mech).value(ik.q))).max() <= 1e-9
 
 
 @pytest.mark.parametrize("name", ACCEPTANCE)
@@ -93,7 +93,7 @@ def check_every_route_gives_back(mech: pkm.Mechanism, q: np.ndarray, v: np.ndarr
     refuses some structures), fed to both forward routes (Pinocchio's ``constraintDynamics`` refuses mimic joints),
     give back the actuated accelerations ``qdd`` (1e-10 relative) and, through ``constraintDynamics``, the task
     accelerations (1e-10 relative)."""
-    J, bias = mech.task_map.jacobian(q), mech.task_map.bias(q, v)
+    J, bias = pkm.TaskMap.of(mech).jacobian(q), pkm.TaskMap.of(mech).bias(q, v)
     mimic = any(j.shortname() == "JointModelMimic" for j in mech.model.joints)
     for method in dynamics.METHODS:
         try:

@@ -1,5 +1,6 @@
 """Every third-party module that ``src/pkm`` imports is declared in ``pyproject.toml``: in the core
-(``[project] dependencies``, what ``pip install pkm`` gives) or in one extra (``pkm[sweeps]``, ``pkm[figures]``, ...).
+(``[project] dependencies``, what ``pip install pkm-robotics`` gives) or in one extra (``pkm-robotics[sweeps]``,
+``pkm-robotics[figures]``, ...).
 
 A module that arrives only as another package's dependency (scipy through proxsuite, umsgpack
 through meshcat) works until that package drops it; so every import must name its own distribution.
@@ -18,6 +19,8 @@ import tomllib
 from importlib.metadata import distributions, packages_distributions
 from importlib.util import find_spec
 from pathlib import Path
+
+from pkm.errors import DISTRIBUTION
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -92,9 +95,9 @@ def extra(name: str) -> set[str]:
 TOOLING = ("dev", "all", "docs", "contract")
 #: Modules of pkm that import an extra's module without checking it themselves, each with its reason.
 UNGUARDED = {
-    "pkm/sweeps/store.py": "internal: its callers (pkm.sweep, SweepResult.read) check pkm[sweeps] first",
-    "pkm/serve/wire.py": "internal: its callers (create_app, pkm.client.Client) check pkm[serve] first",
-    "pkm/serve/schemas.py": "internal: its caller (create_app) checks pkm[serve] first",
+    "pkm/sweeps/store.py": "internal: its callers (pkm.sweep, SweepResult.read) check pkm-robotics[sweeps] first",
+    "pkm/serve/wire.py": "internal: its callers (create_app, pkm.client.Client) check pkm-robotics[serve] first",
+    "pkm/serve/schemas.py": "internal: its caller (create_app) checks pkm-robotics[serve] first",
 }
 #: Modules of pkm that import an extra's module when they are imported, each with its reason (all in UNGUARDED).
 TOP_LEVEL = {
@@ -153,10 +156,10 @@ def test_every_third_party_import_is_a_declared_dependency():
         for f in sorted(files):
             text = (src / f).read_text(encoding="utf-8")
             assert mod not in top_level_imports(src / f) or f in TOP_LEVEL, \
-                f"{f} imports {mod} (pkm[{name}]) when it is imported"
+                f"{f} imports {mod} (pkm-robotics[{name}]) when it is imported"
             guarded = "pkm._optional" in text or "MissingDependencyError" in text or "unavailable" in text
             assert guarded or f in UNGUARDED, \
-                f"{f} imports {mod} (pkm[{name}]) without checking the extra first (pkm._optional.require)"
+                f"{f} imports {mod} (pkm-robotics[{name}]) without checking the extra first (pkm._optional.require)"
 
 
 def test_the_extras_table_is_pyprojects():
@@ -171,7 +174,38 @@ def test_the_extras_table_is_pyprojects():
         assert {_canonical(d) for d in modules.values()} == extra(name), name
         assert not extra(name) & declared(), name
     (everything,) = project["optional-dependencies"]["all"]
-    assert everything == f"pkm[{','.join(EXTRAS)}]"
+    assert everything == f"{DISTRIBUTION}[{','.join(EXTRAS)}]"
+
+
+def test_the_distribution_is_named_as_pip_installs_it():
+    """``pyproject.toml``'s ``[project] name`` is :data:`pkm.errors.DISTRIBUTION` (``pkm`` on PyPI is another
+    project), its extras refer to it by that name, and no document, example, tool or message of pkm tells to
+    ``pip install pkm`` or ``pip install "pkm[...]"`` (which would install that other project)."""
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert project["name"] == DISTRIBUTION != "pkm"
+    selves = {r.split("[")[0] for reqs in project["optional-dependencies"].values() for r in reqs
+              if _canonical(r.split("[")[0]) in ("pkm", _canonical(DISTRIBUTION))}
+    assert selves == {DISTRIBUTION}, selves
+    files = [ROOT / "README.md", ROOT / "pyproject.toml", ROOT / "Makefile", *sorted((ROOT / ".ci").iterdir())]
+    for folder, pattern in (("docs", "*.md"), ("src", "*.py"), ("examples", "*.py"), ("examples", "*.md"),
+                            ("tools", "*.py")):
+        files += sorted((ROOT / folder).rglob(pattern))
+    assert len(files) > 100 and ROOT / "src" / "pkm" / "_optional.py" in files
+    found = [f"{f.relative_to(ROOT)}:{n}: {line.strip()}" for f in files if f.is_file()
+             for n, line in enumerate(f.read_text(encoding="utf-8").splitlines(), 1) if OLD_NAME.search(line)]
+    assert not found, "pip install of the other project's name:\n" + "\n".join(found)
+
+
+#: ``pip install pkm``, ``pip install "pkm[x]"``, ``pip install 'pkm[x]'`` (not ``pkm-robotics``, not a path).
+OLD_NAME = re.compile(r"pip3? install\s+(-\S+\s+)*[\"']?pkm(\[|[\"'`)\s]|$)")
+
+
+def test_the_old_name_pattern_finds_what_it_is_for():
+    said = ["pip install pkm", 'pip install "pkm[sweeps]"', "pip install pkm[bench])", "`pip install pkm`, no",
+            "pip install --quiet 'pkm[all]'", "pip3 install pkm"]
+    fine = [f"pip install {DISTRIBUTION}", f'pip install "{DISTRIBUTION}[sweeps]"', "pip install pkm-no-such",
+            'pip install -e ".[dev,all]"', "pip install pkmx", "import pkm"]
+    assert [bool(OLD_NAME.search(s)) for s in said + fine] == [True] * len(said) + [False] * len(fine)
 
 
 def test_the_top_level_scan_skips_function_bodies(tmp_path):

@@ -47,7 +47,7 @@ CASES = [
     (E.ControllerError(0.25, "returned shape (2,)"), {"time": 0.25, "reason": "returned shape (2,)"},
      ["t = 0.25 s", "returned shape (2,)"]),
     (E.MissingDependencyError("dask", "sweeps", "pkm.sweep"), {"package": "dask", "extra": "sweeps"},
-     ["pkm.sweep needs dask", 'pip install "pkm[sweeps]"']),
+     ["pkm.sweep needs dask", 'pip install "pkm-robotics[sweeps]"']),
     (E.StructureError("leg 3", "not an arm-and-rod leg"), {"part": "leg 3"}, ["leg 3: not an arm-and-rod leg"]),
     (E.TransmissionError("foot", "singular", "outputs singular", ("ankle_pitch",), 3e-9),
      {"transmission": "foot", "reason": "singular", "joints": ("ankle_pitch",), "value": 3e-9},

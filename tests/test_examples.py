@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+
+from tests import bounded
 
 EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "examples").glob("*.py"))
 
@@ -17,7 +18,6 @@ def test_there_are_examples():
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.name)
 def test_the_example_runs(script, tmp_path):
-    proc = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True, timeout=300,
-                          check=False)
+    proc = bounded.run([sys.executable, str(script)], cwd=tmp_path, cpu=300)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip()

@@ -39,8 +39,9 @@ def gepetto(name: str) -> pkm.Mechanism:
 
 def test_the_catalogue_is_sorted_and_ships_the_ten_robots_with_their_licence():
     assert list(CATALOGUE) == sorted(CATALOGUE)
-    assert sorted(CATALOGUE) == sorted(f"gepetto:{n}" for n in (*ROBOTS, UNCLOSABLE))
-    for name in CATALOGUE:
+    gepetto_names = [n for n in CATALOGUE if n.startswith("gepetto:")]
+    assert gepetto_names == sorted(f"gepetto:{n}" for n in (*ROBOTS, UNCLOSABLE))
+    for name in gepetto_names:
         folder = catalogue_path(name)
         assert (folder / "robot.urdf").is_file() and (folder / "robot.yaml").is_file()
     root = catalogue_path("gepetto:robot_delta").parent

@@ -3,15 +3,18 @@
 The graph is read from the source (``ast``), every ``import`` and ``from ... import`` counted wherever it stands,
 deferred imports inside functions included, and ``importlib.import_module("pkm....")`` of a literal name too (a
 builder reached that way is still imported); only imports under ``if TYPE_CHECKING:`` (annotations, never run) are
-left out. An edge goes from a module to each pkm module it names: ``from pkm.a import b`` is an edge to
-``pkm.a.b`` when that is a module, else to ``pkm.a``. A package's ``__init__`` is the module of the package's name;
-importing a submodule is not counted as importing its parents (their ``__init__`` files import nothing at import
-time but what their own edges say).
+left out, except in the core (``pkm.core``), whose layers are strict: there an annotation's import counts too (the
+model is built by its builder and carries no import of what is built on it, its task map, its scales, its twin's
+task: those import the model, never the reverse). An edge goes from a module to each pkm module it names:
+``from pkm.a import b`` is an edge to ``pkm.a.b`` when that is a module, else to ``pkm.a``. A package's ``__init__``
+is the module of the package's name; importing a submodule is not counted as importing its parents (their
+``__init__`` files import nothing at import time but what their own edges say).
 """
 
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[1] / "src"
@@ -42,12 +45,13 @@ def _import_module(node: ast.Call) -> bool:
         isinstance(node.args[0].value, str)
 
 
-def _imports(tree: ast.AST, package: str) -> list[tuple[str, list[str]]]:
-    """``(module, names)`` of every import outside ``if TYPE_CHECKING:`` blocks (relative ones resolved)."""
+def _imports(tree: ast.AST, package: str, type_checking: bool = False) -> list[tuple[str, list[str]]]:
+    """``(module, names)`` of every import (relative ones resolved), those in ``if TYPE_CHECKING:`` blocks only with
+    ``type_checking``."""
     found: list[tuple[str, list[str]]] = []
 
     def visit(node: ast.AST) -> None:
-        if isinstance(node, ast.If) and _type_checking(node):
+        if isinstance(node, ast.If) and _type_checking(node) and not type_checking:
             for child in node.orelse:
                 visit(child)
             return
@@ -68,13 +72,15 @@ def _imports(tree: ast.AST, package: str) -> list[tuple[str, list[str]]]:
     return found
 
 
-def import_graph() -> dict[str, set[str]]:
-    """``{module: the pkm modules it imports}`` (module doc)."""
+@functools.cache
+def import_graph(type_checking: bool = False) -> dict[str, set[str]]:
+    """``{module: the pkm modules it imports}`` (module doc); ``type_checking``: the imports of ``if TYPE_CHECKING:``
+    blocks too. (Read once per session and argument: do not change what it returns.)"""
     modules = _modules()
     graph: dict[str, set[str]] = {m: set() for m in modules}
     for name, path in modules.items():
         package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-        for module, names in _imports(ast.parse(path.read_text()), package):
+        for module, names in _imports(ast.parse(path.read_text()), package, type_checking):
             if not module.startswith("pkm"):
                 continue
             targets = [f"{module}.{n}" for n in names if f"{module}.{n}" in modules]
@@ -134,6 +140,34 @@ def test_the_graph_is_read():
 def test_there_is_no_import_cycle():
     found = cycles(import_graph())
     assert not found, "import cycles (deferred imports count):\n" + "\n".join(" <-> ".join(c) for c in found)
+
+
+def core_graph() -> dict[str, set[str]]:
+    """The core's own graph (``pkm.core`` and its modules, the edges between them), ``TYPE_CHECKING`` imports and
+    deferred ones included."""
+    return {m: {t for t in targets if t.startswith("pkm.core")}
+            for m, targets in import_graph(type_checking=True).items() if m.startswith("pkm.core")}
+
+
+def test_the_core_has_no_cycle_even_through_annotations_and_deferred_imports():
+    """The mechanism imports neither its task map nor its scales (they import it), the twin not its task."""
+    graph = core_graph()
+    found = cycles(graph)
+    assert not found, "import cycles in pkm.core (TYPE_CHECKING and deferred imports count):\n" + \
+        "\n".join(" <-> ".join(c) for c in found)
+    mechanism = graph["pkm.core.model.mechanism"]
+    assert {"pkm.core.model.actuators", "pkm.core.model.spec"} <= mechanism  # (the graph is read)
+    assert not mechanism & {"pkm.core.kinematics.task", "pkm.core.model.scale", "pkm.core.model.builder"}
+    assert "pkm.core.model.mechanism" in graph["pkm.core.kinematics.task"] & graph["pkm.core.model.scale"]
+    assert "pkm.core.twin.task" not in graph["pkm.core.twin.tree"]
+    assert "pkm.core.twin.tree" in graph["pkm.core.twin.task"]
+
+
+def test_an_annotation_s_import_is_an_edge_only_when_asked():
+    tree = ast.parse("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from pkm.core.model import scale\n"
+                     "def f():\n    import pkm.core.kinematics.task\n")
+    assert _imports(tree, "pkm.core.model") == [("typing", ["TYPE_CHECKING"]), ("pkm.core.kinematics.task", [])]
+    assert ("pkm.core.model", ["scale"]) in _imports(tree, "pkm.core.model", type_checking=True)
 
 
 def test_a_literal_import_module_is_an_edge():

@@ -46,3 +46,18 @@ def test_the_static_view_of_the_lazy_names_is_the_declaration(package):
         static = {n: where[n] if m == "pkm.core" else m for n, m in static.items()}
     assert static == where
     assert set(where) <= set(mod.__all__)
+
+
+#: The flat paths of the modules that moved into pkm.core's concept packages in 0.2.0 (deprecated aliases until
+#: they were removed): old name -> the package it lives in.
+MOVED = {"compare": "model", "joints": "model", "mechanism": "model", "spec": "model", "urdf": "model",
+         "configuration": "kinematics", "constraints": "kinematics", "newton": "kinematics", "solve": "kinematics",
+         "task": "kinematics", "trajectory": "kinematics", "indices": "differential", "screws": "differential",
+         "maps": "analysis", "reconfiguration": "analysis", "redundant_parameter": "analysis"}
+
+
+def test_the_moved_modules_are_found_at_their_packages_only():
+    from importlib.util import find_spec
+
+    assert [old for old, pkg in MOVED.items() if find_spec(f"pkm.core.{pkg}.{old}") is None] == []
+    assert [old for old in MOVED if find_spec(f"pkm.core.{old}") is not None] == []

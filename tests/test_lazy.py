@@ -5,6 +5,7 @@ the packages that use them. (That pkm's declared lazy names resolve is ``tests/t
 
 from __future__ import annotations
 
+import importlib
 import sys
 
 import pytest
@@ -65,3 +66,16 @@ def test_the_delegating_packages_give_their_main_module_s_names():
     assert differential._passive_map is velocity._passive_map
     assert dynamics.KhalilProjection is projection.KhalilProjection
     assert not hasattr(differential, "__nothing__")
+
+
+def test_the_packages_give_the_names_of_the_modules_they_were():
+    """pkm.core.differential and pkm.core.dynamics are packages now; the names of the modules they were
+    (differential.py, dynamics.py) are read from them as before."""
+    differential = importlib.import_module("pkm.core.differential")
+    dynamics = importlib.import_module("pkm.core.dynamics")
+    velocity = importlib.import_module("pkm.core.differential.velocity")
+    projection = importlib.import_module("pkm.core.dynamics.projection")
+    assert differential.diagnose is velocity.diagnose and differential.actuation is velocity.actuation
+    assert dynamics.KhalilProjection is projection.KhalilProjection and dynamics.partition is projection.partition
+    with pytest.raises(AttributeError):
+        differential.nothing_of_that_name  # noqa: B018

@@ -27,7 +27,8 @@ def test_each_extra_is_complete_here_and_each_blocked_module_is_named_by_its_dis
     with pytest.raises(MissingDependencyError) as info:
         require(extra, "the thing")
     assert (info.value.package, info.value.extra) == (first, extra)
-    assert str(info.value) == f"the thing needs {first}, which pkm's {extra!r} extra installs: pip install \"pkm[{extra}]\""
+    assert str(info.value) == (f"the thing needs {first}, which pkm's {extra!r} extra installs: "
+                               f"pip install \"pkm-robotics[{extra}]\"")
 
 
 def test_only_the_modules_asked_for_are_checked(monkeypatch):

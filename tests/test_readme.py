@@ -21,6 +21,7 @@ from pathlib import Path
 
 import pytest
 
+from tests import bounded
 from tests.cli.helpers import default_sigint
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -89,8 +90,7 @@ def test_the_readme_is_short_and_its_links_resolve():
 
 @pytest.mark.parametrize("code", PYTHON, ids=list(_python_ids()))
 def test_python_block_runs(code, tmp_path):
-    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=_env(), capture_output=True, text=True,
-                          timeout=300)
+    proc = bounded.run([sys.executable, "-c", code], cwd=tmp_path, env=_env(), cpu=300)
     assert proc.returncode == 0, f"block failed ({_PYTHON[code]}):\n{code}\n--- stderr:\n{proc.stderr[-3000:]}"
 
 
@@ -112,6 +112,5 @@ def test_shell_line_runs(line, tmp_path):
         finally:
             proc.kill()
         return
-    proc = subprocess.run(["bash", "-c", command], cwd=cwd, env=_env(), capture_output=True, text=True,
-                          timeout=600)
+    proc = bounded.run(["bash", "-c", command], cwd=cwd, env=_env(), cpu=600)
     assert proc.returncode == 0, f"{command!r} ({_SHELL[command][0]}) exited {proc.returncode}:\n{proc.stderr[-3000:]}"

@@ -49,10 +49,12 @@ def test_wheel_ships_urdf_and_dynamics(tmp_path):
     """The wheel contains every reference design and the dynamics data under ``pkm/_data``."""
     subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps", "--no-build-isolation",
                     "-q", "-w", str(tmp_path)], check=True)
-    wheel = next(tmp_path.glob("pkm-*.whl"))
+    wheel = next(tmp_path.glob("pkm_robotics-*.whl"))
     shipped = set(zipfile.ZipFile(wheel).namelist())
     for name in names(with_files=True):
         assert f"pkm/_data/urdf/{name}.urdf" in shipped
         assert f"pkm/_data/urdf/{name}.closures.toml" in shipped
     assert "pkm/_data/dynamics/prs3_table2.toml" in shipped
+    for shipped_file in ("cassie.xml", "LICENSE", "SOURCE.txt"):  # (a third-party robot with its licence and source)
+        assert f"pkm/_data/urdf/menagerie/agility_cassie/{shipped_file}" in shipped
     assert "pkm/py.typed" in shipped

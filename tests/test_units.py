@@ -71,3 +71,25 @@ def test_rates_and_efforts_take_numbers_only():
     delta = pkm.load("delta")
     with pytest.raises(InvalidInputError):
         pkm.velocities(delta, delta.q_reference, ["5deg", 0.0, 0.0])
+
+
+@pytest.mark.parametrize("text,kind,expected", [
+    ("2.5 N m", "torque", 2.5), ("2.5N*m", "torque", 2.5), ("2.5 N * m", "torque", 2.5), ("2.5Nm", "torque", 2.5),
+    ("300 mN m", "torque", 0.3), ("1.2kN m", "torque", 1200.0), ("40 N", "force", 40.0),
+    ("3 rad/s", "angular velocity", 3.0), ("90deg/s", "angular velocity", math.pi / 2),
+    ("60 rpm", "angular velocity", 2 * math.pi), ("0.5m/s", "velocity", 0.5), ("250 mm/s", "velocity", 0.25)])
+def test_torques_and_rates_convert_to_si(text, kind, expected):
+    """An actuator's effort and speed limits take their units: torques (N m, N*m, Nm, mN m, kN m), forces, angular
+    velocities (rad/s, deg/s, rpm) and velocities (m/s, mm/s); against factors written out here (1 rpm = 2 pi / 60
+    rad/s)."""
+    assert math.isclose(parse_quantity(text, {kind}, "v", "?"), expected, rel_tol=1e-12)
+    assert math.isclose(pkm.quantity(text, kind), expected, rel_tol=1e-12)
+
+
+def test_torques_and_rates_are_refused_where_another_kind_is_expected():
+    with pytest.raises(UnitError, match="'N m' is a torque unit but tau is in \\[N\\]; use N, mN, kN or no unit"):
+        parse_quantity("2 Nm", {"force"}, "tau", "N")
+    with pytest.raises(UnitError, match="'rpm' is an angular velocity unit"):
+        pkm.quantity("100rpm", "velocity")
+    with pytest.raises(UnitError, match="unknown unit 'N mm'"):
+        parse_quantity("2 N mm", {"torque"}, "tau", "N m")

@@ -18,7 +18,6 @@ import json
 import os
 import re
 import shutil
-import subprocess
 from pathlib import Path
 
 import matplotlib.colors as mcolors
@@ -30,6 +29,7 @@ import umsgpack
 
 import pkm
 from pkm import viz
+from tests import bounded
 
 WIDTH, HEIGHT = 800, 600
 FOV = 75.0  # deg, vertical field of view of meshcat's default camera
@@ -52,7 +52,7 @@ def screenshot(page: str, folder: Path) -> np.ndarray:
     cmd = [chromium(), "--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
            "--disable-background-networking", f"--window-size={WIDTH},{HEIGHT}", "--virtual-time-budget=5000",
            f"--screenshot={png}", html.as_uri()]
-    run = subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=60)
+    run = bounded.run(cmd, cpu=60)
     assert run.returncode == 0 and png.exists(), f"chromium failed ({run.returncode}): {run.stderr[-2000:]}"
     return mimage.imread(png)[..., :3]
 

@@ -160,7 +160,7 @@ def others(points: int) -> dict:
                                             "effort_usage": check.effort_usage, "holds": check.holds,
                                             "active": {k: plan.active.count(k) for k in sorted(set(plan.active))}}
     gs = pkm.load("gough_stewart")
-    y0 = gs.task_map.value(gs.q_reference)
+    y0 = pkm.TaskMap.of(gs).value(gs.q_reference)
     th = np.linspace(0.0, np.pi, 25)
     W = np.array([y0 + np.r_[-0.05 * np.cos(a), 0.0, 0.03 * np.sin(a), 0, 0, 0, 0] for a in th])
     plan = pkm.time_optimal(gs, W, points=points)

@@ -114,7 +114,7 @@ def exercise(url: str, folder: Path) -> None:
     assert isinstance(entry, models.ModelEntry), entry
     ankle = pkm.load(files[1])
     out = api.queries.fk.sync(model=entry.id, client=client, body=models.FkRequest(qa=[0.1, -0.1]))
-    close(out.y[0], ankle.task_map.value(pkm.close_loops(ankle, [0.1, -0.1]).q), 1e-10,
+    close(out.y[0], pkm.TaskMap.of(ankle).value(pkm.close_loops(ankle, [0.1, -0.1]).q), 1e-10,
           f"upload {entry.name} ({entry.id}) and its FK")
 
     axes = models.MapJobAxes.from_dict({"x": [-0.05, 0.05, 5], "y": [-0.05, 0.05, 3]})

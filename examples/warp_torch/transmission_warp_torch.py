@@ -4,7 +4,8 @@ one.
 
 NOT run by the tests (tests/test_examples.py runs examples/*.py only, not this folder): PyTorch from the package
 index pulls several GB of CUDA libraries, so it is not in pkm's extras nor installed where pkm is tested. Needs
-``pip install "pkm[warp]" torch``; run from the checkout: ``python examples/warp_torch/transmission_warp_torch.py``.
+``pip install "pkm-robotics[warp]" torch``; run from the checkout:
+``python examples/warp_torch/transmission_warp_torch.py``.
 
 Layout: pkm's Warp kernels take structure-of-arrays float64 arrays ``(size, n)``: one row per entry, one column per
 robot. A sample-major tensor ``(n, size)`` (PyTorch's usual batch layout) is made so by ``.T.contiguous()`` (one copy

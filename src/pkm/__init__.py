@@ -40,7 +40,8 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.analysis.reconfiguration": ("reconfigure",),
     "pkm.core.export": ("CLibrary", "export_c"),
     "pkm.core.modes": ("assembly_modes", "track_assembly_mode", "track_working_mode", "working_modes"),
-    "pkm.core.transmissions": ("Transmission", "transmissions"),
+    "pkm.core.transmissions": ("SerialEquivalent", "Transmission", "serial_equivalent", "transmissions",
+                               "write_serial_equivalent"),
     "pkm.core.timing": ("TimeOptimal", "time_optimal", "verify_time_optimal"),
     "pkm.core.twin": ("Kernels", "Twin"),
     "pkm.sweeps": ("sweep",),
@@ -58,6 +59,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         Actuator,
         ActuatorSpaceModel,
         BaseGeometry,
+        BaseInverseDynamics,
         BaseParameters,
         Branch,
         Calibration,
@@ -94,6 +96,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         actuator_model,
         assemble,
         base_geometry,
+        base_inverse_dynamics,
         base_parameters,
         bias_efforts,
         branch_seed,
@@ -151,7 +154,13 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.export import CLibrary, export_c
     from pkm.core.modes import assembly_modes, track_assembly_mode, track_working_mode, working_modes
     from pkm.core.timing import TimeOptimal, time_optimal, verify_time_optimal
-    from pkm.core.transmissions import Transmission, transmissions
+    from pkm.core.transmissions import (
+        SerialEquivalent,
+        Transmission,
+        serial_equivalent,
+        transmissions,
+        write_serial_equivalent,
+    )
     from pkm.core.twin import Kernels, Twin
     from pkm.sweeps import sweep
     from pkm.units import quantity
@@ -173,7 +182,7 @@ def load(name: str | os.PathLike[str], *, actuated: Sequence[str] | str | None =
     as links with several parents; it names no actuators, so it comes through a spec): see
     :mod:`pkm.core.formats`. Or a model an installed package ships, by name ``"<package>:<model>"``
     (``"example-robot-data:cassie"``: :mod:`pkm.core.formats.packages`), or a third-party robot pkm ships, by name
-    ``"<source>:<robot>"`` (``"gepetto:robot_delta"``: :mod:`pkm.core.formats.catalogue`).
+    ``"<source>:<robot>"`` (``"gepetto:robot_delta"``, ``"menagerie:cassie"``: :mod:`pkm.core.formats.catalogue`).
 
     A file that names no actuators (an MJCF with loops and no ``<actuator>``, an SDF, a Gepetto YAML with no
     ``name_mot``, a spec with ``actuated = []``) loads with them given in code: ``actuated`` (joint names, or

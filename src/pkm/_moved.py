@@ -1,10 +1,10 @@
-"""Deprecated aliases: the old import path of a moved module gives the module at its new home, and the former name
-of a renamed keyword, field or function still works; each with a :class:`DeprecationWarning` naming the new one."""
+"""Deprecated aliases: the former name of a renamed keyword, field or function still works, with a
+:class:`DeprecationWarning` naming the new one. (The old import paths of the modules that moved into pkm.core's
+concept packages in 0.2.0, ``pkm.core.solve``..., are gone: import them from their packages.)"""
 
 from __future__ import annotations
 
 import functools
-import importlib
 import sys
 import warnings
 from collections.abc import Callable, Mapping
@@ -19,12 +19,6 @@ C = TypeVar("C", bound=type)
 
 #: The release that renamed what :func:`renamed` warns about; the former names go in the release after it.
 RENAMED_IN = "0.2.0"
-
-
-def alias(old: str, new: str) -> None:
-    """Make module ``old`` (being imported) the module ``new``, with a :class:`DeprecationWarning` naming it."""
-    warnings.warn(f"{old} moved to {new} (pkm 0.2.0); import it from there", DeprecationWarning, stacklevel=3)
-    sys.modules[old] = importlib.import_module(new)
 
 
 def renamed(what: str, old: str, new: str) -> None:
@@ -112,4 +106,4 @@ def current_name(cls: type, name: str) -> str:
     return cast(str, new)
 
 
-__all__ = ["RENAMED_IN", "alias", "current_name", "renamed", "renamed_fields", "renamed_keyword", "renamed_keywords"]
+__all__ = ["RENAMED_IN", "current_name", "renamed", "renamed_fields", "renamed_keyword", "renamed_keywords"]

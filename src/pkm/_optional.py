@@ -1,23 +1,24 @@
 """Optional dependencies: which pkm extra installs each, and the one check made where a capability needs them.
 
-``pip install pkm`` gives the library's core (loading, closing loops, kinematics, Jacobians, dynamics, the twin's
-kernels, previews); the rest is behind extras, named in ``pyproject.toml``'s ``[project.optional-dependencies]``
-(:data:`EXTRAS` mirrors it, a test keeps the two the same)::
+``pip install pkm-robotics`` (the distribution's name, :data:`~pkm.errors.DISTRIBUTION`: ``pkm`` on PyPI is another
+project; it installs the ``pkm`` package and command) gives the library's core (loading, closing loops, kinematics,
+Jacobians, dynamics, the twin's kernels, previews); the rest is behind extras, named in ``pyproject.toml``'s
+``[project.optional-dependencies]`` (:data:`EXTRAS` mirrors it, a test keeps the two the same)::
 
-    pip install "pkm[sweeps]"    # pkm.sweep and its Parquet results: Dask, pyarrow, cloudpickle
-    pip install "pkm[figures]"   # the papers' figures, sweep plots, CiMap.figure: matplotlib
-    pip install "pkm[homotopy]"  # every assembly mode (pkm.assembly_modes): Bertini 2 (GPL-3)
-    pip install "pkm[bench]"     # the benchmarks' baseline: MuJoCo
-    pip install "pkm[identify]"  # identification's physically consistent estimate: cvxpy with Clarabel
-    pip install "pkm[serve]"     # the service (pkm serve) and its client: FastAPI, uvicorn, msgpack, httpx, offline docs
-    pip install "pkm[jax]"       # the twin's kernels as JAX functions (jit, vmap, grad; GPU): JAX
-    pip install "pkm[warp]"      # transmission kernels on NVIDIA Warp (CPU, or a GPU where there is one)
-    pip install "pkm[plan]"      # time-optimal motion (pkm.time_optimal, pkm plan): toppra
-    pip install "pkm[all]"       # all of them
+    pip install "pkm-robotics[sweeps]"    # pkm.sweep and its Parquet results: Dask, pyarrow, cloudpickle
+    pip install "pkm-robotics[figures]"   # the papers' figures, sweep plots, CiMap.figure: matplotlib
+    pip install "pkm-robotics[homotopy]"  # every assembly mode (pkm.assembly_modes): Bertini 2 (GPL-3)
+    pip install "pkm-robotics[bench]"     # the benchmarks' baseline: MuJoCo
+    pip install "pkm-robotics[identify]"  # identification's physically consistent estimate: cvxpy with Clarabel
+    pip install "pkm-robotics[serve]"     # the service (pkm serve) and its client: FastAPI, uvicorn, httpx, ...
+    pip install "pkm-robotics[jax]"       # the twin's kernels as JAX functions (jit, vmap, grad; GPU): JAX
+    pip install "pkm-robotics[warp]"      # transmission kernels on NVIDIA Warp (CPU, or a GPU where there is one)
+    pip install "pkm-robotics[plan]"      # time-optimal motion (pkm.time_optimal, pkm plan): toppra
+    pip install "pkm-robotics[all]"       # all of them
 
 An extra is checked at the point of use, never at ``import pkm``: :func:`require` raises
-:class:`~pkm.errors.MissingDependencyError` naming the ``pip install "pkm[...]"`` line (the command line prints it
-as its one-line error), and :func:`module` imports one module of an extra after that check.
+:class:`~pkm.errors.MissingDependencyError` naming the ``pip install "pkm-robotics[...]"`` line (the command line
+prints it as its one-line error), and :func:`module` imports one module of an extra after that check.
 """
 
 from __future__ import annotations
@@ -70,7 +71,7 @@ def require(extra: str, what: str, modules: Iterable[str] | None = None) -> None
     """Check that ``extra`` is installed (every module of it, or ``modules`` only) before ``what`` uses it.
 
     Raises:
-        MissingDependencyError: naming the first missing distribution and ``pip install "pkm[extra]"``.
+        MissingDependencyError: naming the first missing distribution and ``pip install "pkm-robotics[extra]"``.
     """
     gone = missing(extra, modules)
     if gone:

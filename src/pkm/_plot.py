@@ -20,7 +20,7 @@ def pyplot():
     """``matplotlib.pyplot`` on the Agg backend (no display needed), imported once.
 
     Raises:
-        MissingDependencyError: matplotlib is not installed (``pip install "pkm[figures]"``).
+        MissingDependencyError: matplotlib is not installed (``pip install "pkm-robotics[figures]"``).
     """
     module("matplotlib", extra="figures", what=WHAT).use("Agg")
     return module("matplotlib.pyplot", extra="figures", what=WHAT)

@@ -113,13 +113,15 @@ class ModeChangeWarning(PkmWarning):
 
 class PoorIdentificationWarning(PkmWarning):
     """An identification whose data cannot carry its parameters (:func:`pkm.estimate`): fewer equations than three
-    per base parameter, or base parameters whose relative standard deviation exceeds 100 % (their estimate cannot
-    be told from zero). The same sentence is kept in ``Estimate.warnings``.
+    per base parameter, or poorly identified base parameters (a relative standard deviation above 100 %, their
+    estimate cannot be told from zero, and a deviation worth more than 1 % of the efforts:
+    :mod:`pkm.core.identification.estimate`). The same sentence is kept in ``Estimate.warnings``.
 
     Attributes:
         equations: The rows the estimate stacked (samples times actuators).
         n_base: The number of base parameters.
-        poor: ``((name, relative standard deviation [%]), ...)`` of each base parameter above 100 % (may be empty).
+        poor: ``((name, relative standard deviation [%]), ...)`` of each poorly identified base parameter (may be
+            empty).
     """
 
     def __init__(self, message: str, equations: int, n_base: int, poor: Iterable[tuple[str, float]] = ()):
@@ -298,6 +300,9 @@ class SingularityError(PkmError):
 class ConvergenceError(PkmError):
     """An iterative solver did not converge.
 
+    ``message`` replaces the whole message where the failure is not a residual above a tolerance (a budget of
+    evaluations spent: ``residual`` and ``tolerance`` then hold what that message names).
+
     Attributes:
         what: The solver that failed (e.g. "loop closure").
         residual: Final residual norm (infinity norm, SI units of the equations).
@@ -312,7 +317,7 @@ class ConvergenceError(PkmError):
     """
 
     def __init__(self, what: str, residual: float, iterations: int, tolerance: float, result: object = None,
-                 detail: str = ""):
+                 detail: str = "", *, message: str | None = None):
         self.what = what
         self.residual = float(residual)
         self.iterations = int(iterations)
@@ -322,10 +327,10 @@ class ConvergenceError(PkmError):
         self.worst_gap: float = 0.0
         self.problem: object = None
         extra = f"; {detail}" if detail else ""
-        super().__init__(
+        super().__init__(message or (
             f"{what} did not converge: residual {self.residual:.3e} > tolerance {self.tolerance:.1e} "
             f"after {self.iterations} iterations{extra}"
-        )
+        ))
 
 
 class NonFiniteError(PkmError, ArithmeticError):
@@ -386,19 +391,25 @@ class CompilerError(PkmError, RuntimeError):
         super().__init__(f"{what}: {how}")
 
 
+#: The distribution's name on PyPI (``pyproject.toml``'s ``[project] name``), in every ``pip install`` line pkm prints:
+#: ``pkm`` there is another project. It installs the ``pkm`` package (``import pkm``) and the ``pkm`` command.
+DISTRIBUTION = "pkm-robotics"
+
+
 class MissingDependencyError(PkmError, ImportError):
     """An optional dependency that a capability needs is not installed (raised where it is used, never at
     ``import pkm``; :mod:`pkm._optional` lists the extras).
 
     Attributes:
         package: The PyPI package to install.
-        extra: The pkm extra that installs it (``pip install "pkm[extra]"``).
+        extra: The pkm extra that installs it (``pip install "pkm-robotics[extra]"``).
     """
 
     def __init__(self, package: str, extra: str, what: str):
         self.package = package
         self.extra = extra
-        super().__init__(f"{what} needs {package}, which pkm's {extra!r} extra installs: pip install \"pkm[{extra}]\"")
+        super().__init__(f"{what} needs {package}, which pkm's {extra!r} extra installs: "
+                         f"pip install \"{DISTRIBUTION}[{extra}]\"")
 
 
 class StructureError(PkmError):

@@ -155,8 +155,8 @@ def run(out_dir, papers: Sequence[str] | None = None, *, figures: bool = True, s
     Raises:
         UnknownNameError: A name is not a paper (listing the valid ones), before anything runs.
         InvalidInputError: No paper, or one named twice.
-        MissingDependencyError: ``figures`` without matplotlib (``pip install "pkm[figures]"``), before anything
-            runs; a step that needs another extra (a series through :func:`pkm.sweep`) raises it when it runs.
+        MissingDependencyError: ``figures`` without matplotlib (``pip install "pkm-robotics[figures]"``), before
+            anything runs; a step that needs another extra (a series through :func:`pkm.sweep`) raises it when it runs.
     """
     names = _papers.names() if papers is None else tuple(papers)
     if not names:

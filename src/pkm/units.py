@@ -3,7 +3,9 @@ command line.
 
 pkm computes in SI (m, rad, kg). Wherever the API takes a joint value, a task coordinate or a design
 parameter, it also takes a string with a unit suffix, converted here: lengths ``m cm mm``, angles
-``rad deg``, masses ``kg g``, times ``s ms us`` (a simulation's duration and step). A plain number (or a string
+``rad deg``, masses ``kg g``, times ``s ms us`` (a simulation's duration and step), forces ``N mN kN``, torques
+``N m`` (or ``N*m``, ``Nm``), ``mN m``, ``kN m``, angular velocities ``rad/s deg/s rpm`` and velocities ``m/s mm/s`` (an
+actuator's effort and speed limits). A plain number (or a string
 without suffix) is SI. A suffix of another kind than the value's is refused (``"3deg"`` for a length), never
 silently converted::
 
@@ -24,27 +26,51 @@ from numpy.typing import ArrayLike
 from pkm.errors import InvalidInputError, UnitError
 from pkm.validation import as_scalar
 
-#: Unit suffixes: suffix -> (kind, factor to SI).
+#: Unit suffixes: suffix -> (kind, factor to SI). A product's parts are written with a space, ``*`` or nothing
+#: between them (``"N m"``, ``"N*m"``, ``"Nm"``: :func:`parse_quantity` reads the first two as the third's spelling).
 SUFFIXES: dict[str, tuple[str, float]] = {
     "m": ("length", 1.0), "cm": ("length", 1e-2), "mm": ("length", 1e-3),
     "rad": ("angle", 1.0), "deg": ("angle", math.pi / 180.0),
     "kg": ("mass", 1.0), "g": ("mass", 1e-3),
     "s": ("time", 1.0), "ms": ("time", 1e-3), "us": ("time", 1e-6),
+    "N": ("force", 1.0), "mN": ("force", 1e-3), "kN": ("force", 1e3),
+    "N m": ("torque", 1.0), "mN m": ("torque", 1e-3), "kN m": ("torque", 1e3),
+    "rad/s": ("angular velocity", 1.0), "deg/s": ("angular velocity", math.pi / 180.0),
+    "rpm": ("angular velocity", math.pi / 30.0),
+    "m/s": ("velocity", 1.0), "mm/s": ("velocity", 1e-3),
 }
 #: The SI unit of each kind a suffix can convert to.
-SI_UNITS = {"length": "m", "angle": "rad", "mass": "kg", "time": "s"}
-#: The kind of each SI unit (``"m" -> "length"``).
-KIND_OF_UNIT = {v: k for k, v in SI_UNITS.items()}
-_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z]*)\s*$")
+SI_UNITS = {"length": "m", "angle": "rad", "mass": "kg", "time": "s", "force": "N", "torque": "N m",
+            "angular velocity": "rad/s", "velocity": "m/s"}
+#: The kind of each SI unit (``"m" -> "length"``), its other spellings too (``"N*m"``, ``"Nm"``).
+KIND_OF_UNIT = {v: k for k, v in SI_UNITS.items()} | {"N*m": "torque", "Nm": "torque"}
+_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z](?:[A-Za-z*/ ]*[A-Za-z])?)?\s*$")
+_PRODUCT = re.compile(r"^(m|k)?N\s*\*?\s*m$")  # (N m, N*m, Nm; mN m, kN m)
+
+
+def _suffix(text: str) -> str:
+    """A suffix in :data:`SUFFIXES`' spelling: a torque's product written ``N m`` (from ``N*m``, ``Nm``, ``N  m``)."""
+    m = _PRODUCT.match(text)
+    return f"{m.group(1) or ''}N m" if m else text
+
+
+def _listing() -> str:
+    """Every suffix by kind, for messages: ``m, cm, mm (length), ...``."""
+    kinds: dict[str, list[str]] = {}
+    for suffix, (kind, _) in SUFFIXES.items():
+        kinds.setdefault(kind, []).append(suffix)
+    return "; ".join(f"{', '.join(v)} ({k})" for k, v in kinds.items())
 
 
 def parse_quantity(text: str, kinds: Collection[str | None], what: str = "value", unit: str = "SI") -> float:
     """A number with an optional unit suffix, converted to SI.
 
     Args:
-        text: ``"120mm"``, ``"-11deg"``, ``"0.81"``.
-        kinds: Kinds the quantity may have (``"length"``, ``"angle"``, ``"mass"``, ``"time"``; ``None``: a unit
-            without suffixes, e.g. ``kg m^2``); a plain number is always accepted (SI).
+        text: ``"120mm"``, ``"-11deg"``, ``"0.81"``, ``"2.5 N m"`` (``"2.5N*m"``, ``"2.5Nm"``), ``"300rpm"``,
+            ``"50 mm/s"``.
+        kinds: Kinds the quantity may have (:data:`SI_UNITS`' keys: ``"length"``, ``"angle"``, ``"torque"``,
+            ``"angular velocity"``...; ``None``: a unit without suffixes, e.g. ``kg m^2``); a plain number is always
+            accepted (SI).
         what: Name of the quantity, for messages.
         unit: Its unit(s) as documented, for messages.
 
@@ -55,16 +81,14 @@ def parse_quantity(text: str, kinds: Collection[str | None], what: str = "value"
         raise UnitError(what, f"expected a number or a string such as '20mm', got {type(text).__name__}", text)
     m = _NUMBER.match(text)
     if not m:
-        raise UnitError(what, f"{what}={text!r} is not a number (with an optional unit: m, cm, mm, rad, deg, kg, g, "
-                              "s, ms, us)", text)
-    value, suffix = float(m.group(1)), m.group(2)
+        raise UnitError(what, f"{what}={text!r} is not a number (with an optional unit: {_listing()})", text)
+    value, suffix = float(m.group(1)), _suffix(m.group(2) or "")
     if not math.isfinite(value):
         raise UnitError(what, f"{what}={text!r} is not finite", text)
     if not suffix:
         return value
     if suffix not in SUFFIXES:
-        raise UnitError(what, f"{what}={text}: unknown unit {suffix!r}; use m, cm, mm (lengths), rad, deg (angles), "
-                              f"kg, g (masses), s, ms, us (times), or no unit for SI", text)
+        raise UnitError(what, f"{what}={text}: unknown unit {suffix!r}; use {_listing()}, or no unit for SI", text)
     kind, factor = SUFFIXES[suffix]
     if kind not in kinds:
         accepted = [s for s, (k, _) in SUFFIXES.items() if k in kinds]
@@ -94,7 +118,8 @@ def quantity(value: object, kind: str | None = None, what: str = "value") -> flo
 
     Args:
         value: ``0.02``, ``"20mm"``, ``"5deg"``.
-        kind: ``"length"``, ``"angle"``, ``"mass"`` or ``"time"`` to accept only that kind's units; None: any.
+        kind: A kind of :data:`SI_UNITS` (``"length"``, ``"angle"``, ``"torque"``...) to accept only its units;
+            None: any.
         what: Its name, for messages.
 
     Raises:

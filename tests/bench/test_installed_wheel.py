@@ -12,7 +12,7 @@ from pkm.bench import time_optimal, transmissions
 def test_time_optimal_without_toppra_is_skipped_naming_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "toppra", None)  # (blocked: pkm._optional counts it missing)
     result = time_optimal.run(types.SimpleNamespace(n=10, repeat=1))
-    assert result == {"skipped": 'pip install "pkm[plan]" (missing: toppra)'}
+    assert result == {"skipped": 'pip install "pkm-robotics[plan]" (missing: toppra)'}
     assert time_optimal.table(result) == f"time-optimal planning: skipped ({result['skipped']})"
 
 

@@ -15,7 +15,8 @@ import pkm
 from pkm.bench.mujoco_baseline import MujocoRigid, unavailable
 from pkm.core.formats.to_mjcf import body_names
 
-pytestmark = pytest.mark.skipif(unavailable() is not None, reason="MuJoCo is the bench extra's (pip install pkm[bench])")
+pytestmark = pytest.mark.skipif(unavailable() is not None,
+                                reason='MuJoCo is the bench extra\'s (pip install "pkm-robotics[bench]")')
 
 
 def test_unavailable_says_how_to_install_when_mujoco_cannot_be_imported(monkeypatch):
@@ -23,7 +24,7 @@ def test_unavailable_says_how_to_install_when_mujoco_cannot_be_imported(monkeypa
     assert unavailable() is None
     monkeypatch.setitem(sys.modules, "mujoco", None)
     reason = unavailable()
-    assert reason.startswith("MuJoCo is not installed (") and reason.endswith('pip install "pkm[bench]"')
+    assert reason.startswith("MuJoCo is not installed (") and reason.endswith('pip install "pkm-robotics[bench]"')
 
 
 def _state(mech, seed: int):

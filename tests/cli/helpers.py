@@ -8,11 +8,13 @@ import subprocess
 import sys
 from pathlib import Path
 
+from tests import bounded
 
-def run(*args: str, cwd: Path | None = None, timeout: float = 120) -> subprocess.CompletedProcess:
-    """``python -m pkm ARGS`` in a subprocess (text output, no check), ended past ``timeout`` seconds (a hang)."""
-    return subprocess.run([sys.executable, "-m", "pkm", *args], check=False, capture_output=True, text=True,
-                          cwd=cwd, timeout=timeout)
+
+def run(*args: str, cwd: Path | None = None, cpu: float = 120) -> subprocess.CompletedProcess:
+    """``python -m pkm ARGS`` in a subprocess (text output, no check), ended past ``cpu`` seconds of CPU time (a
+    hang; :mod:`tests.bounded`: never because the machine is busy)."""
+    return bounded.run([sys.executable, "-m", "pkm", *args], cwd=cwd, cpu=cpu)
 
 
 def one_error_line(proc: subprocess.CompletedProcess) -> str:

@@ -107,7 +107,7 @@ def test_each_command_that_solves_takes_the_seed_and_a_warning_asking_for_one_na
         assert "--q0" in parsers[name].format_help(), name
     mech = built("fivebar")
     spec = pkm.save(mech, tmp_path / "five.closures.toml")
-    y = mech.task_map.named(mech.q_reference)["y"] - 0.3
+    y = pkm.TaskMap.of(mech).named(mech.q_reference)["y"] - 0.3
     with pytest.warns(ModeChangeWarning) as record:
         assert cli.main(["ik", str(spec), "--pose", f"y={y!r}"]) == 0
     assert "seed nearer the target (q0)" in str(record[0].message) and "the seed is --q0 NAME=V" in \

@@ -15,7 +15,7 @@ from pkm import cli
 def test_plan_simulate_calibrate_write_load(tmp_path, capsys) -> None:
     pytest.importorskip("matplotlib")
     data = tmp_path / "data.csv"
-    assert cli.main(["calibrate", "plan", "prs3", "--poses", "12", "--spread", "0.2", "--out", str(data),
+    assert cli.main(["calibrate", "plan", "prs3", "--poses", "12", "--out", str(data),  # (the default spread)
                      "--simulate", "3"]) == 0
     assert "12 poses" in capsys.readouterr().out
     out = tmp_path / "out"
@@ -23,7 +23,7 @@ def test_plan_simulate_calibrate_write_load(tmp_path, capsys) -> None:
                      "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     assert result["base"] == 34 and result["before"]["position_rms"] > 1e-3
-    assert result["after"]["position_rms"] < 3e-5 and 0.3 < result["chi2"] < 3.0
+    assert result["after"]["position_rms"] < 3e-5 and 0.3 < result["chi2"] < 3.0 and result["evaluations"] < 100
     assert pkm.load(result["spec"]).name == "prs3" and (tmp_path / "r.png").stat().st_size > 1000
     assert "knee_1.pitch" in result["unseen"]
 
@@ -37,3 +37,15 @@ def test_bad_table_is_one_error_line(tmp_path, capsys) -> None:
     assert cli.main(["calibrate", "prs3", str(table), "--out", str(tmp_path / "o")]) != 0
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("pkm: error: ") and "row 4, column 'z'" in err[0] and "mm" in err[0]
+
+
+def test_the_budget_and_the_spread_are_options_whose_help_states_the_defaults(capsys) -> None:
+    """Issue 52: the least squares' budget (a fixed 200) could not be reached from the command line."""
+    from pkm.core.calibration.estimate import NFEV_PER_PARAMETER
+    from pkm.core.calibration.poses import SPREAD
+
+    for argv in (["calibrate", "--help"], ["calibrate", "plan", "--help"]):
+        assert cli.main(argv) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"--max-evaluations N the least squares' budget of residual evaluations (default {NFEV_PER_PARAMETER} " in text
+    assert f"(default {SPREAD:g} rad for a revolute actuator, {SPREAD:g} x the mechanism's characteristic" in text

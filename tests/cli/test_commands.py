@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import pkgutil
 import re
-import subprocess
 import sys
 from importlib import import_module
 
@@ -14,6 +13,7 @@ import pytest
 from pkm import cli
 from pkm.cli import commands
 from pkm.cli.command import Command
+from tests import bounded
 
 
 def test_every_command_module_is_registered():
@@ -48,5 +48,6 @@ def test_help_imports_no_heavy_module():
     command imports them when it runs)."""
     code = ("import sys; from pkm.cli import main; main(['--help']); "
             "print(sorted(m for m in ('pinocchio', 'matplotlib', 'dask', 'meshcat', 'pkm.viz') if m in sys.modules))")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
+    proc = bounded.run([sys.executable, "-c", code], cpu=60)
+    assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip().splitlines()[-1] == "[]"

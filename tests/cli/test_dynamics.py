@@ -50,6 +50,21 @@ def test_delta_json_equals_the_library_at_the_state_given(capsys):
     assert not np.allclose(model.h, model.g)  # (the rates count)
     assert out["units"]["M"]["motor_1"]["motor_2"] == "kg m^2" and out["units"]["h"]["motor_3"] == "N m"
     assert out["units"]["rates"]["motor_1"] == "rad/s" and out["friction"] is None and out["idle_motions"] == 0
+    assert out["base"] == "fixed"
+
+
+def test_a_floating_base_is_said_free(tmp_path, capsys):
+    """The Delta hung on a free pelvis, saved and read back: the JSON names the base's choice and equals the
+    library's free-base model; the text says the base is free."""
+    from tests.core.dynamics.floating import floating
+
+    path = pkm.save(floating("delta"), tmp_path / "floating.closures.toml")
+    mech = pkm.load(path)
+    assert cli.main(["dynamics", str(path)]) == 0
+    assert "floating base: free" in capsys.readouterr().out
+    out = _json(capsys, str(path))
+    model = pkm.actuator_model(mech, mech.q_reference)
+    assert out["base"] == "free" and np.allclose(_matrix(out, "M"), model.M, rtol=RTOL, atol=0)
 
 
 def test_a_spec_file_prints_its_idle_motions_and_the_model_at_the_reference(capsys):

@@ -74,7 +74,8 @@ def test_excite_then_identify_the_delta(excited, capsys):
     # rate read from the times' steps is a hair under 500 Hz)
     assert result["table_rows"] == 10001 and result["decimate"] == 124
     assert result["equations"] == 3 * result["samples"] and result["cutoff_hz"] == 2.0
-    poor = [r["name"] for r in result["base"] if r["relative_std_percent"] > 100.0]
+    poor = [r["name"] for r in result["base"] if r["poor"]]
+    assert all(r["relative_std_percent"] > 100.0 and r["effort_share"] > 0.01 for r in result["base"] if r["poor"])
     assert poor and any(f"{len(poor)} of 48 base parameters" in w for w in result["warnings"])
     assert result["smallest_pseudo_inertia_eigenvalue"] >= -1e-9
     # least squares alone, on so few samples, is no real mechanism: the error says so and names --consistent
@@ -98,3 +99,10 @@ def test_bad_input_is_one_error_line(tmp_path):
     line = one_error_line(run("excite", "delta", "--harmonics", "5", "--samples", "4", "--out",
                               str(tmp_path / "e.csv")))
     assert "samples" in line
+
+
+def test_cutoff_help_states_the_decimation(capsys):
+    """Issue 52: ``--cutoff 2`` kept 29 of 5,001 rows and its help did not say that it decimates."""
+    assert cli.main(["identify", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "decimated to one in rate / (2 cutoff)" in text and "rows kept are reported" in text

@@ -4,20 +4,20 @@ from __future__ import annotations
 
 import json
 import re
-import subprocess
 import sys
 from pathlib import Path
 
 import pkm
 from pkm import cli
 from pkm.mechanisms import names
+from tests import bounded
 from tests.cli.helpers import one_error_line, run
 
 
 def test_console_script_lists_every_mechanism_as_json():
     """The installed ``pkm`` script prints every mechanism's parameters with defaults and units, SI."""
     script = Path(sys.executable).with_name("pkm")
-    proc = subprocess.run([str(script), "list", "--json"], check=False, capture_output=True, text=True, timeout=60)
+    proc = bounded.run([str(script), "list", "--json"], cpu=60)
     assert proc.returncode == 0, proc.stderr
     data = json.loads(proc.stdout)["mechanisms"]
     assert list(data) == list(names(with_files=True))  # a subprocess: the shipped registry

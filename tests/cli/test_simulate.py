@@ -196,12 +196,12 @@ def test_a_controller_that_raises_or_is_missing(tmp_path, capsys):
 
 
 def test_parquet_without_pyarrow_names_the_extra(tmp_path, capsys, monkeypatch):
-    """Without pyarrow, a Parquet output is refused before the run, naming ``pip install "pkm[sweeps]"``; a CSV one
-    needs nothing."""
+    """Without pyarrow, a Parquet output is refused before the run, naming ``pip install "pkm-robotics[sweeps]"``; a
+    CSV one needs nothing."""
     monkeypatch.setitem(sys.modules, "pyarrow", None)
     (tmp_path / "T.csv").write_text("t,motor_1,motor_2,motor_3\n0,0,0,0\n")
     status, err = _error(capsys, "delta", "--torques", str(tmp_path / "T.csv"), "--out", str(tmp_path / "r.parquet"))
-    assert status == 1 and 'pip install "pkm[sweeps]"' in err and not (tmp_path / "r.parquet").exists()
+    assert status == 1 and 'pip install "pkm-robotics[sweeps]"' in err and not (tmp_path / "r.parquet").exists()
 
 
 def test_the_command_runs_as_a_process(tmp_path):
@@ -232,14 +232,14 @@ def test_the_initial_configuration_takes_passive_joints_as_the_closure_s_seed(tm
     spec = pkm.save(mech, tmp_path / "five.closures.toml")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pkm.errors.ModeChangeWarning)
-        far = pkm.solve_ik(mech, mech.task_map.value(mech.q_reference) + [0.0, -0.3])  # (the other assembly mode)
+        far = pkm.solve_ik(mech, pkm.TaskMap.of(mech).value(mech.q_reference) + [0.0, -0.3])  # (the other mode)
     near = pkm.close_loops(mech, mech.actuated_q(far.q))
     start = {}
     for label, names in (("far", list(mech.joints)), ("near", list(mech.actuated_names))):
         q0 = [f"{n}={float(far.q[mech.joints[n].idx_q])!r}" for n in names]
         _summary(capsys, str(spec), "--q0", *q0, "--duration", "1ms", "--out", str(tmp_path / f"{label}.csv"))
         table = _read_csv(tmp_path / f"{label}.csv")
-        start[label] = np.array([table[f"task.{k}"][0] for k in mech.task_map.keys])
-    assert np.allclose(start["far"], mech.task_map.value(far.q), rtol=0, atol=1e-9)
-    assert np.allclose(start["near"], mech.task_map.value(near.q), rtol=0, atol=1e-9)
+        start[label] = np.array([table[f"task.{k}"][0] for k in pkm.TaskMap.of(mech).keys])
+    assert np.allclose(start["far"], pkm.TaskMap.of(mech).value(far.q), rtol=0, atol=1e-9)
+    assert np.allclose(start["near"], pkm.TaskMap.of(mech).value(near.q), rtol=0, atol=1e-9)
     assert np.abs(start["far"] - start["near"]).max() > 0.1

@@ -77,3 +77,21 @@ def test_a_sample_outside_the_limits_is_not_ok_in_every_query():
     assert step["status"] == "outside_limits"
     for a, b in zip(step["outside_limits"], fk["outside_limits"][0], strict=True):
         assert a["joint"] == b["joint"] and a["limit"] == b["limit"] and abs(a["value"] - b["value"]) <= 1e-9
+
+
+def test_a_floating_base_s_batched_dynamics_is_the_model_s():
+    """The compiled kernels hold a floating base, the model lets it move free (pkm.core.dynamics.model): a batch on
+    a floating robot is answered by the model (the kernels are not asked), as one state is."""
+    import numpy as np
+
+    from tests.core.dynamics.floating import floating
+
+    class Held:  # (kernels that must not be asked)
+        def __getattr__(self, name):
+            raise AssertionError(f"the kernels were asked for {name}")
+
+    mech = floating("fourbar")
+    q = pkm.close_loops(mech, [0.4], mech.q_reference).q
+    out = queries.dynamics(mech, {"q": [q, q], "qd": [[0.3], [0.3]]}, Held())
+    model = pkm.actuator_model(mech, q, [0.3])
+    assert model.base == "free" and np.abs(out["h"][1] - model.h).max() <= 1e-12 * np.abs(model.h).max()

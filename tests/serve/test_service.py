@@ -106,7 +106,7 @@ def test_uploads_are_content_addressed_kept_and_deleted(client, service, tmp_pat
     assert set(client._answer(client._http.get(f"/models/{entry['id']}/files"))["files"]) == {f.name for f in files}
     out = client.fk(entry["id"], [0.1, -0.1])
     mech = pkm.load(files[1])
-    assert np.abs(out["y"][0] - mech.task_map.value(pkm.close_loops(mech, [0.1, -0.1]).q)).max() <= 1e-12
+    assert np.abs(out["y"][0] - pkm.TaskMap.of(mech).value(pkm.close_loops(mech, [0.1, -0.1]).q)).max() <= 1e-12
     page = httpx.get(f"{client.url}/models/{entry['id']}/preview", headers=AUTH)
     assert page.status_code == 200 and "<html" in page.text.lower()
     again = Store(service_store(service))  # (a new service on the same folder serves it again)

@@ -19,6 +19,7 @@ from pkm import sweeps
 from pkm.errors import SweepError
 from pkm.mechanisms.rrr3 import workspace as maps
 from pkm.papers import rrr3 as paper
+from tests import bounded
 
 COLUMNS = [f"{c}={c}:step=0.04" for c in ("gci", "gci_area", "coverage", "min_area_ci")]
 SMALL = sweeps.grid(a="30cm:60cm:4", b="40cm", h="5cm:20cm:4")
@@ -93,7 +94,7 @@ def test_a_killed_sweep_resumes_where_it_stopped_and_gives_the_uninterrupted_tab
             "--objective", *objectives[:1], "--objective", objectives[1], "--scheduler", "serial", "--chunk", "1",
             "--out", str(out), "--no-progress"]
     env = {**os.environ, "PKM_TEST_KILL_AT": "0.5,0.15"}  # design 4 * 2 + 2 = 10 of 16
-    proc = subprocess.run(args, env=env, capture_output=True, text=True, timeout=120)
+    proc = bounded.run(args, env=env, cpu=120)
     assert proc.returncode == -signal.SIGKILL, proc.stderr
     parts = sorted((tmp_path / "r.parquet.parts").glob("part-*.parquet"))
     assert len(parts) == 10 and not out.exists()

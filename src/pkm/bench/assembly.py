@@ -99,8 +99,8 @@ def add_arguments(ap) -> None:
 
 
 def run(args) -> list[dict]:
-    if importlib.util.find_spec("bertini") is None:  # the homotopy's solver: the optional extra pkm[homotopy]
-        return [{"mechanism": name, "skipped": "bertini2 is not installed (pip install \"pkm[homotopy]\")"}
+    if importlib.util.find_spec("bertini") is None:  # the homotopy's solver: the optional extra pkm-robotics[homotopy]
+        return [{"mechanism": name, "skipped": "bertini2 is not installed (pip install \"pkm-robotics[homotopy]\")"}
                 for name in args.mechanisms]
     return [bench(name, args.budget_factor, args.from_scratch) for name in args.mechanisms]
 

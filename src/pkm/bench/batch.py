@@ -59,7 +59,7 @@ def _jax(K, args, repeat: int, reference: np.ndarray) -> dict:
     from pkm._optional import missing
 
     if missing("jax"):
-        return {"skipped": 'JAX is not installed (pip install "pkm[jax]")'}
+        return {"skipped": 'JAX is not installed (pip install "pkm-robotics[jax]")'}
     import jax
 
     f = jax.jit(jax.vmap(K.jax("inverse_dynamics")))

@@ -7,7 +7,8 @@ constraints' Jacobian ``J_c`` and ``mj_rne`` the joint forces ``M a + c(q, v)`` 
 efforts and the loops' multipliers solve ``B^T tau + J_c^T lambda = rne`` (``nv x (na + nc)``) by least squares.
 This is MuJoCo with hard constraints; ``mj_inverse`` itself treats them as soft and returns other efforts.
 
-MuJoCo is a benchmark-only dependency (the ``bench`` extra: ``pip install "pkm[bench]"``): :func:`unavailable` says why it cannot run.
+MuJoCo is a benchmark-only dependency (the ``bench`` extra: ``pip install "pkm-robotics[bench]"``): :func:`unavailable`
+says why it cannot run.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ def unavailable() -> str | None:
     try:
         import mujoco  # noqa: F401
     except ImportError as e:
-        return f"MuJoCo is not installed ({e}); pip install \"pkm[bench]\""
+        return f"MuJoCo is not installed ({e}); pip install \"pkm-robotics[bench]\""
     return None
 
 

@@ -64,7 +64,7 @@ def run(args) -> dict[str, Any]:
     from pkm._optional import missing
 
     if missing("serve"):
-        return {"skipped": f"pip install \"pkm[serve]\" (missing: {', '.join(missing('serve'))})"}
+        return {"skipped": f"pip install \"pkm-robotics[serve]\" (missing: {', '.join(missing('serve'))})"}
     import pkm
     from pkm.client import Client
     from pkm.serve.process import rss_mb, start
@@ -72,7 +72,7 @@ def run(args) -> dict[str, Any]:
     mech = pkm.load(MECHANISM)
     qa0 = mech.actuated_q(mech.q_reference)
     q = pkm.close_loops(mech, qa0 + 0.05, mech.q_reference).q
-    y = mech.task_map.value(q).tolist()
+    y = pkm.TaskMap.of(mech).value(q).tolist()
     bodies = [(f"/models/{MECHANISM}/fk", {"qa": (qa0 + 0.05).tolist()}),
               (f"/models/{MECHANISM}/ik", {"y": y}),
               (f"/models/{MECHANISM}/dynamics", {"q": q.tolist(), "qd": [0.1, 0.0, 0.0], "qdd": [1.0, 0.0, 0.0]})]

@@ -58,7 +58,7 @@ Every run is :func:`pkm.simulate` (RK4 in the actuated coordinates, the loops cl
    cos(2π f_j t)) / 2`` (``A`` = 0.05 rad or 5 mm, ``f_j = 0.5 (j + 1)`` Hz; starts at rest). With the exact model the
    error is the integrator's (<= 1e-6); with a controller whose platform is 10 % heavier (mass and rotational
    inertia of the end-effector's body times 1.1, a copy of the Pinocchio model), the error it leaves. ``--out DIR``
-   writes the figure ``DIR/simulation_tracking.png`` of both errors over time (matplotlib, ``pkm[figures]``).
+   writes the figure ``DIR/simulation_tracking.png`` of both errors over time (matplotlib, ``pkm-robotics[figures]``).
 
 Usage: ``python -m pkm.bench.simulation [--json] [--quick] [--duration 5] [--out DIR] [MECHANISM ...]``.
 """

@@ -23,7 +23,7 @@ def run(args) -> dict:
     from pkm._optional import missing
 
     if missing("plan"):  # (an installed wheel without the extra: said, as the other benchmarks say theirs)
-        return {"skipped": f"pip install \"pkm[plan]\" (missing: {', '.join(missing('plan'))})"}
+        return {"skipped": f"pip install \"pkm-robotics[plan]\" (missing: {', '.join(missing('plan'))})"}
     import pkm
     import pkm.core.timing.solve as solve_mod
     from pkm.core.timing.path import adept_waypoints

@@ -113,7 +113,7 @@ def solve_ik(mech: pkm.Mechanism, target, branch: str | None, q0: np.ndarray | N
             raise
         mod = pkm.mechanism_module(mech.name)
         try:
-            mod.closed_form_ik(mech.params, mech.task_map.parse(target), branch)
+            mod.closed_form_ik(mech.params, pkm.TaskMap.of(mech).parse(target), branch)
         except UnreachableError as unreachable:
             raise unreachable from exc
         except PkmError:

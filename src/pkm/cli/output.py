@@ -19,7 +19,7 @@ from pkm.report import jsonable
 
 def task_values(mech: pkm.Mechanism, q) -> dict[str, float]:
     """The task coordinates of ``q`` by name (:meth:`pkm.core.TaskMap.named`; angles Z-Y-X Euler) [m, rad]."""
-    return mech.task_map.named(q)
+    return pkm.TaskMap.of(mech).named(q)
 
 
 def _branch_of(mech: pkm.Mechanism, q) -> str | None:

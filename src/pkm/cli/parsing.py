@@ -176,7 +176,7 @@ def parse_pose(mech: pkm.Mechanism, items: Sequence[str]) -> tuple[dict[str, flo
         UnitError: a bad number or unit; UsageError: a missing ``=``.
         UnknownNameError: A name that is not a task coordinate.
     """
-    task = mech.task_map
+    task = pkm.TaskMap.of(mech)
     values = task.named(mech.q_reference)
     for item in items:
         name, text = split_item(item, "--pose")
@@ -253,7 +253,7 @@ def parse_axis(mech: pkm.Mechanism, item: str) -> tuple[str, np.ndarray]:
         UsageError: not of that form; UnitError: a bad number or unit; UnknownNameError: not a task coordinate.
     """
     name, text = split_item(item, "--axis")
-    task = mech.task_map
+    task = pkm.TaskMap.of(mech)
     if name not in task.kinds:
         raise UnknownNameError("task coordinate", name, list(task.keys), mech.name)
     try:

@@ -17,7 +17,8 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.differential.velocity": ("Diagnostics", "accelerations", "diagnose", "forward_jacobian", "idle_motions",
                               "inverse_accelerations", "inverse_jacobian", "inverse_velocities", "passive_map",
                               "task_acceleration", "task_velocity", "twist_jacobian", "velocities"),
-    "pkm.core.dynamics.projection": ("constraint_dynamics", "forward_dynamics", "inverse_dynamics"),
+    "pkm.core.dynamics.projection": ("BaseInverseDynamics", "base_inverse_dynamics", "constraint_dynamics",
+                                     "forward_dynamics", "inverse_dynamics"),
     "pkm.core.dynamics.model": ("ActuatorSpaceModel", "OperationalSpace", "actuator_model", "bias_efforts",
                                 "coriolis_matrix", "gravity_efforts", "mass_matrix", "operational_space"),
     "pkm.core.dynamics.simulate": ("Event", "Simulation", "simulate"),
@@ -85,7 +86,13 @@ if TYPE_CHECKING:  # the static view of the lazy names
         mass_matrix,
         operational_space,
     )
-    from pkm.core.dynamics.projection import constraint_dynamics, forward_dynamics, inverse_dynamics
+    from pkm.core.dynamics.projection import (
+        BaseInverseDynamics,
+        base_inverse_dynamics,
+        constraint_dynamics,
+        forward_dynamics,
+        inverse_dynamics,
+    )
     from pkm.core.dynamics.simulate import Event, Simulation, simulate
     from pkm.core.identification.base import BaseParameters, base_parameters
     from pkm.core.identification.consistent import ConsistentEstimate, consistent_estimate

@@ -170,7 +170,7 @@ def _modes_row(mech, qa, row_id: str, compare: Callable[[Any, Any], str] | None)
         modes = pkm.assembly_modes(mech, qa)
     except MissingDependencyError as exc:
         return Row(row_id, None, None, "", None, "reference configuration (no published count)", str(exc))
-    poses = "; ".join(", ".join(f"{k} {v:.4g}" for k, v in mech.task_map.named(m.q).items()) for m in modes)
+    poses = "; ".join(", ".join(f"{k} {v:.4g}" for k, v in pkm.TaskMap.of(mech).named(m.q).items()) for m in modes)
     note = compare(mech, modes) if compare is not None else ""
     text = (f"pkm.assembly_modes at the reference actuators: {modes.summary()}; every mode closed by the core "
             f"(worst {max(m.residual for m in modes):.1e}) and certified by Smale's alpha test (largest alpha "

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from pkm._plot import figure, save
-from pkm.core.kinematics.task import as_rotation
+from pkm.core.kinematics.task import TaskMap, as_rotation
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi
 from pkm.mechanisms.hexapod import reconfiguration as hr
@@ -128,9 +128,10 @@ def _against_multistart(mech, modes) -> str:
 
     qa = mech.actuated_q(mech.q_reference)
     found = multistart(mech, qa, n_starts=32)
-    poses = [mech.task_map.value(m.q) for m in modes]
+    task = TaskMap.of(mech)
+    poses = [task.value(m.q) for m in modes]
     missed = [k for k, y in enumerate(poses)
-              if not any(np.abs(mech.task_map.error(y, mech.task_map.value(f.q))).max() < 1e-7 for f in found)]
+              if not any(np.abs(task.error(y, task.value(f.q))).max() < 1e-7 for f in found)]
     extra = len(found) - (len(poses) - len(missed))
     text = (f"The paper's semi-closed FK (eqs. 4-13) from 32 seeds (hexapod.kinematics.assembly_modes) finds "
             f"{len(found)}; ")

@@ -58,7 +58,7 @@ def _working_modes_too(mech, modes) -> str:
     working modes at the reference pose."""
     import pkm
 
-    ws = pkm.working_modes(mech, mech.task_map.value(mech.q_reference))
+    ws = pkm.working_modes(mech, pkm.TaskMap.of(mech).value(mech.q_reference))
     return (f"The 3-PRS family has 16 generic solutions (the 16 paths: a parameter homotopy from them). At the "
             f"reference pose the inverse kinematics has {len(ws)} working modes (pkm.working_modes: each leg's two "
             "slider positions of eq. (10)). The paper gives no forward kinematics.")

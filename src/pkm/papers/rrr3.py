@@ -258,8 +258,10 @@ def reproduce() -> list[Row]:
 
 def _against_polynomial(mech, modes) -> str:
     """The homotopy's modes against the roots of the exact degree-4 trigonometric FK polynomial."""
+    import pkm
+
     exact = rrr3.kinematics.forward_kinematics(mech.params, mech.actuated_q(mech.q_reference))
-    gap = max(min(float(np.abs(mech.task_map.value(m.q)[:2] - s.y[:2]).max()) for m in modes) for s in exact)
+    gap = max(min(float(np.abs(pkm.TaskMap.of(mech).value(m.q)[:2] - s.y[:2]).max()) for m in modes) for s in exact)
     same = len(exact) == len(modes) and gap < 1e-8
     return (f"The exact FK polynomial (rrr3.kinematics.forward_kinematics) has {len(exact)} real roots; "
             f"{'the same set' if same else 'NOT the same set'} (largest position gap {gap:.1e} m). The "

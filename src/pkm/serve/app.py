@@ -32,7 +32,7 @@ error's 422, a batch answers 200 with each sample's status and ``null`` values f
 """
 
 # (no ``from __future__ import annotations`` here: FastAPI reads the routes' annotations, whose types are imported
-# inside create_app, when pkm[serve] is known to be installed)
+# inside create_app, when pkm-robotics[serve] is known to be installed)
 import asyncio
 import json
 import math

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+import pkm
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, PkmError, UnknownNameError
 
@@ -66,7 +67,8 @@ def _modes(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str
     qa = _array(body, "qa", mech.na, _position_kinds(mech, "qa"))[0]
     s = assembly_modes(mech, qa)
     Q = np.array([m.q for m in s.modes]) if s.modes else np.zeros((0, mech.nq))
-    Y = np.array([mech.task_map.value(q) for q in Q]) if len(Q) else np.zeros((0, mech.task_map.value_size))
+    task = pkm.TaskMap.of(mech)
+    Y = np.array([task.value(q) for q in Q]) if len(Q) else np.zeros((0, task.value_size))
     residual = np.array([m.residual for m in s.modes])
     out = {"count": len(s.modes), "complete": bool(s.complete), "q": Q, "y": Y, "residual": residual,
            "labels": [str(m.label) for m in s.modes], "outside_limits": _outside(mech, Q), "seconds": s.seconds,
@@ -80,7 +82,7 @@ def _working(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[s
     from pkm.core.modes import working_modes
     from pkm.serve.queries import _actuated_units, _array, _position_kinds, _q_units
 
-    y = _array(body, "y", mech.task_map.value_size, _position_kinds(mech, "y"))[0]
+    y = _array(body, "y", pkm.TaskMap.of(mech).value_size, _position_kinds(mech, "y"))[0]
     s = working_modes(mech, y)
     Q = np.array([m.q for m in s.modes]) if s.modes else np.zeros((0, mech.nq))
     QA = Q[:, mech.act_q] if len(Q) else np.zeros((0, mech.na))

@@ -21,7 +21,7 @@ def start(*options: str, timeout: float = 60.0) -> tuple[subprocess.Popen, str]:
     Its standard output is piped (the first line says where it listens), its errors are discarded.
 
     Raises:
-        MissingDependencyError: pkm[serve] is not installed.
+        MissingDependencyError: pkm-robotics[serve] is not installed.
         RuntimeError: it did not answer within ``timeout`` seconds (it is killed).
     """
     from pkm._optional import require

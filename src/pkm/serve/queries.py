@@ -28,6 +28,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
+import pkm
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, PkmError
 from pkm.units import KIND_OF_UNIT, parse_quantity
@@ -62,8 +63,8 @@ def _unit(mech: Mechanism, joint: str, kind: str = "position") -> str:
 @_per_mechanism
 def _task_units(mech: Mechanism) -> dict[str, str]:
     """The units of the task's tangent coordinates (:attr:`TaskMap.keys`: a pose's x y z roll pitch yaw)."""
-    kinds = mech.task_map.kinds
-    out = {k: ("m" if kinds.get(k) == "length" else "rad") for k in mech.task_map.keys}
+    kinds = pkm.TaskMap.of(mech).kinds
+    out = {k: ("m" if kinds.get(k) == "length" else "rad") for k in pkm.TaskMap.of(mech).keys}
     return out
 
 
@@ -71,8 +72,8 @@ def _task_units(mech: Mechanism) -> dict[str, str]:
 def _value_units(mech: Mechanism) -> list[str]:
     """The units of the task value's entries (:attr:`TaskMap.value_names`: a pose's x y z qx qy qz qw, whose
     quaternion is unitless, ``"1"``)."""
-    kinds = mech.task_map.kinds
-    return [("m" if kinds[k] == "length" else "rad") if k in kinds else "1" for k in mech.task_map.value_names]
+    kinds = pkm.TaskMap.of(mech).kinds
+    return [("m" if kinds[k] == "length" else "rad") if k in kinds else "1" for k in pkm.TaskMap.of(mech).value_names]
 
 
 def _joint_units(mech: Mechanism, which: int) -> list[str]:
@@ -370,7 +371,7 @@ def fk(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[st
     qa = _array(body, "qa", mech.na, _position_kinds(mech, "qa"))
     Q, residual, iterations, errors = _close(mech, qa, _seed(mech, body), kernels)
     samples = _Samples(len(qa), _is_single(body, "qa"), errors)
-    Y = [None if e is not None else mech.task_map.value(Q[k]) for k, e in enumerate(errors)]
+    Y = [None if e is not None else pkm.TaskMap.of(mech).value(Q[k]) for k, e in enumerate(errors)]
     out = samples.columns({"q": Q, "y": Y, "residual": residual, "iterations": iterations})
     out["units"] = {"q": _q_units(mech), "y": _value_units(mech), "residual": "m or rad", "iterations": "1",
                     "qa": _actuated_units(mech)}
@@ -384,7 +385,7 @@ def ik(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[st
     ``branch`` (a named branch of the spec) when given."""
     from pkm.core.kinematics.solve import solve_ik
 
-    y = _array(body, "y", mech.task_map.value_size, _position_kinds(mech, "y"))
+    y = _array(body, "y", pkm.TaskMap.of(mech).value_size, _position_kinds(mech, "y"))
     seed = _seed(mech, body)
     branch = body.get("branch")
     if branch is not None and not isinstance(branch, str):
@@ -497,8 +498,9 @@ def dynamics(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> d
         return out
 
     out: dict[str, Any] | None = None
-    if kernels is not None and n > 1 and not any(samples.errors):
-        try:  # (the compiled model in batches)
+    # (the compiled model in batches; not for a floating base, which the model lets move free and the kernels hold)
+    if kernels is not None and n > 1 and not any(samples.errors) and mech.base is None:
+        try:
             Q = np.ascontiguousarray(np.broadcast_to(q, (n, mech.nq)))
             QD = np.zeros((n, mech.na)) if qd is None else np.ascontiguousarray(np.broadcast_to(qd, (n, mech.na)))
             M, h = kernels.mass_and_bias(Q, QD)
@@ -594,8 +596,8 @@ def describe(mech: Mechanism) -> dict[str, Any]:
             "joints": list(mech.joints), "actuated": list(mech.actuated_names),
             "actuated_q": [int(i) for i in mech.act_q],
             "actuated_units": _actuated_units(mech),
-            "task": list(mech.task_map.keys), "task_units": _task_units(mech),
-            "task_value_names": list(mech.task_map.value_names), "task_value_units": _value_units(mech),
+            "task": list(pkm.TaskMap.of(mech).keys), "task_units": _task_units(mech),
+            "task_value_names": list(pkm.TaskMap.of(mech).value_names), "task_value_units": _value_units(mech),
             "q_reference": mech.q_reference, "q_units": _q_units(mech),
             "branches": list(mech.spec.branches), "limits": mech.limits}
 

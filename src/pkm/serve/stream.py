@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+import pkm
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError
 from pkm.validation import as_array, bounded
@@ -73,7 +74,7 @@ class Stream:
             q, residual = r.q, r.residual
         self.q = q
         outside = [v._asdict() for v in self.mech.limit_violations(q)]
-        out: dict[str, Any] = {"q": q, "y": self.mech.task_map.value(q), "residual": residual,
+        out: dict[str, Any] = {"q": q, "y": pkm.TaskMap.of(self.mech).value(q), "residual": residual,
                                "status": "outside_limits" if outside else "ok", "outside_limits": outside}
         if qd is not None:
             if K is not None:

@@ -187,7 +187,7 @@ def local_cluster(workers: int | None = None):
 
     Raises:
         SweepError: the workers could not start.
-        MissingDependencyError: the ``sweeps`` extra is not installed (``pip install "pkm[sweeps]"``).
+        MissingDependencyError: the ``sweeps`` extra is not installed (``pip install "pkm-robotics[sweeps]"``).
     """
     require("sweeps", "a local Dask cluster")
     import dask
@@ -301,7 +301,7 @@ def sweep(mechanism: str | os.PathLike[str] | Mechanism | Family, space: Space,
         SweepError: ``out`` holds another sweep; the scheduler cannot be reached or has no workers; designs were
             lost to the cluster (the finished chunks kept: a rerun resumes).
         MissingDependencyError: the ``sweeps`` extra (Dask, pyarrow, cloudpickle) is not installed: ``pip install
-            "pkm[sweeps]"``.
+            "pkm-robotics[sweeps]"``.
 
     Examples:
         >>> import numpy as np

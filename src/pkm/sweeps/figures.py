@@ -43,8 +43,8 @@ def plot(result, out_dir, pareto: Sequence[str] | None = None) -> list[Path]:
         The paths written.
 
     Raises:
-        MissingDependencyError: matplotlib (``pip install "pkm[figures]"``), or pyarrow to read a file
-            (``pkm[sweeps]``), is not installed.
+        MissingDependencyError: matplotlib (``pip install "pkm-robotics[figures]"``), or pyarrow to read a file
+            (``pkm-robotics[sweeps]``), is not installed.
     """
     require("figures", "pkm.sweeps.plot")
     from pkm._plot import figure, save

@@ -317,7 +317,9 @@ def _split_items(key: str, value: str) -> list[tuple[str, str]]:
 
 # ---------------------------------------------------------------------- generic routes
 def _task_value(mech, name: str, text: str) -> float:
-    task = mech.task_map
+    import pkm
+
+    task = pkm.TaskMap.of(mech)
     if name not in task.kinds:
         raise UnknownNameError("task coordinate", name, list(task.keys), mech.name)
     kind = task.kinds[name]
@@ -418,7 +420,7 @@ def _generic_condition(c, o):
     mech = c.mechanism
     target = {n: _task_value(mech, n, v) for n, v in (o.get("pose") or {}).items()}
     res = pkm.solve_ik(mech, target, branch=o.get("branch") or None)
-    scale = mech.task_map.rate_scale(o.get("length"))  # (as the maps do)
+    scale = pkm.TaskMap.of(mech).rate_scale(o.get("length"))  # (as the maps do)
     try:
         K = pkm.inverse_jacobian(mech, res.q)
     except SingularityError:
@@ -444,7 +446,7 @@ def _motion(c: Candidate, o: Mapping[str, Any]):
         if len(coords) != len(motion.coordinates):
             raise InvalidInputError("coordinates", f"name the motion's {len(motion.coordinates)} coordinates "
                                                    f"{motion.coordinates} as task coordinates", o.get("coordinates"))
-        task = mech.task_map
+        task = pkm.TaskMap.of(mech)
         missing = [k for k in coords if k not in task.value_names]
         if missing or len(coords) != len(task.keys):
             raise InvalidInputError("coordinates", f"the motion's coordinates {coords} must be the task's "

@@ -201,7 +201,7 @@ class SweepResult:
         """The results file a sweep wrote.
 
         Raises:
-            MissingDependencyError: pyarrow is not installed (``pip install "pkm[sweeps]"``).
+            MissingDependencyError: pyarrow is not installed (``pip install "pkm-robotics[sweeps]"``).
         """
         require("sweeps", "reading a sweep's Parquet results", ("pyarrow",))
         import pyarrow as pa

@@ -38,7 +38,7 @@ def excitation_figure(mech: Mechanism, excitation: Excitation, path: str | Path)
     its finite limits dashed; the caption gives the condition number reached and the margins.
 
     Raises:
-        MissingDependencyError: matplotlib is not installed (``pip install "pkm[figures]"``).
+        MissingDependencyError: matplotlib is not installed (``pip install "pkm-robotics[figures]"``).
     """
     require("figures", "the figure of an excitation (pkm.viz.identification)")
     from pkm._plot import figure
@@ -76,7 +76,7 @@ def fit_figure(mech: Mechanism, validation: Validation, path: str | Path, *, tit
     relative RMS error in each panel's legend.
 
     Raises:
-        MissingDependencyError: matplotlib is not installed (``pip install "pkm[figures]"``).
+        MissingDependencyError: matplotlib is not installed (``pip install "pkm-robotics[figures]"``).
     """
     require("figures", "the figure of an identified model (pkm.viz.identification)")
     from pkm._plot import figure

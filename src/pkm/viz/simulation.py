@@ -38,7 +38,7 @@ def plot(mech: Mechanism, sim: Simulation, path: str | Path, *, title: str | Non
         The path written (its folder created).
 
     Raises:
-        MissingDependencyError: matplotlib is not installed (``pip install "pkm[figures]"``).
+        MissingDependencyError: matplotlib is not installed (``pip install "pkm-robotics[figures]"``).
         InvalidInputError: ``sim`` is not a simulation of ``mech``.
     """
     require("figures", WHAT)

@@ -150,7 +150,7 @@ def test_both_map_routes_count_the_nodes_where_the_weight_cannot_be_held():
         assert cm.below_weight == 6 and cm.summary()["below_weight"] == 6
         assert (cm.isotropic["N"][~cm.inside] == 0.0).all() and cm.isotropic["N"][3] > 0.0
     assert np.allclose(python.isotropic["N"], compiled.isotropic["N"], rtol=1e-9, atol=0)
-    assert not capability(weak, pkm.solve_ik(weak, {"x": xs[0], "y": 0.0, "z": weak.task_map.named(
+    assert not capability(weak, pkm.solve_ik(weak, {"x": xs[0], "y": 0.0, "z": pkm.TaskMap.of(weak).named(
         weak.q_reference)["z"]}).q).origin_inside
 
 

@@ -112,5 +112,5 @@ def test_an_index_that_is_no_name_is_refused_by_pkm():
     """The fuzz's repro (issue 47): ``index=`` an array raised numpy's "truth value of an array is ambiguous"."""
     mech = pkm.load("hexapod")
     with pytest.raises(InvalidInputError, match="index"):
-        reconfigure(mech, [mech.task_map.value(mech.q_reference)], ["beta_1"], [(-0.5, 0.5)], length=0.1,
+        reconfigure(mech, [pkm.TaskMap.of(mech).value(mech.q_reference)], ["beta_1"], [(-0.5, 0.5)], length=0.1,
                     index=np.array(["a", "b"]))

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import pkm
-from pkm.core.analysis.region import feasible_region
+from pkm.core.analysis.region import Region, feasible_region, largest_box
 from pkm.errors import InvalidInputError, PkmWarning
 
 ANKLE = Path(__file__).resolve().parents[3] / "examples" / "ankle" / "ankle.closures.toml"
@@ -96,3 +96,21 @@ def test_a_limit_the_file_does_not_state_is_no_limit():
     assert np.all(five.model.lowerPositionLimit >= five.model.upperPositionLimit)  # (the file's placeholders)
     assert np.all(np.isinf(stated_limits(five.model)[0])) and not any("limit" in b for b in region.binding)
     assert np.ptp(region.vertices, axis=0).min() > 0.1  # (a region, not the reference point alone) [rad]
+
+
+def test_the_largest_box_about_a_point_is_found_where_it_is_known():
+    """The largest axis-aligned box inside a polygon that holds a point, not centred on it: in an L of a 5 x 1 arm
+    and a 1 x 4 arm, the arm the point is in (both at their corner: the longer); in the right triangle of legs 2, the
+    unit square (area 1, the inscribed rectangle's largest); a point outside the polygon is refused."""
+    ell = np.array([(0, 0), (5, 0), (5, 1), (1, 1), (1, 4), (0, 4)], dtype=float)
+    for point, (lo, hi) in (((0.5, 0.5), ((0, 0), (5, 1))), ((0.5, 2.0), ((0, 0), (1, 4))),
+                            ((3.0, 0.2), ((0, 0), (5, 1)))):
+        lower, upper = largest_box(ell, np.array(point))
+        np.testing.assert_allclose(np.concatenate([lower, upper]), np.concatenate([lo, hi]), rtol=0, atol=1e-6)
+    triangle = np.array([(0, 0), (2, 0), (0, 2)], dtype=float)
+    lower, upper = largest_box(triangle, np.array([0.2, 0.2]))
+    assert abs(float(np.prod(upper - lower)) - 1.0) <= 1e-6 and np.all(lower >= -1e-12)
+    region = Region(("x", "y"), {}, np.array([0.2, 0.2]), triangle, ("closure",) * 3, np.zeros(3), 1e-2)
+    assert np.allclose(region.largest_box()[1] - region.largest_box()[0], upper - lower)
+    with pytest.raises(InvalidInputError, match="around"):
+        region.largest_box([1.5, 1.5])

@@ -128,3 +128,35 @@ def test_deviations_that_do_not_exist_are_refused() -> None:
         calibrate(s.model, np.repeat(s.readings[:1], n, axis=0), np.repeat(s.measured[:1], n, axis=0),
                   base=s.cal.base)
     assert err.value.kind == "calibration" and err.value.distance < 1e-10
+
+
+def test_candidates_spread_per_unit_by_default() -> None:
+    """Without a spread, a prismatic reading moves by up to SPREAD characteristic lengths (the 3-PRS's sliders:
+    0.19 m), the same draw as a mapping's value for its unit; on the Delta (revolute) by up to SPREAD rad."""
+    from pkm.core.calibration.poses import SPREAD
+
+    for name, bound in (("prs3", SPREAD * model("prs3").mech.characteristic_length), ("delta", SPREAD)):
+        m = model(name, "pose")
+        ref = m.mech.actuated_q(m.mech.q_reference)
+        drawn = candidates(m, 6, seed=2)
+        assert 0.5 * bound < np.abs(drawn - ref).max() <= bound
+        assert np.array_equal(candidates(m, 6, seed=2, spread={"rad": SPREAD, "m": bound}), drawn)
+
+
+def test_columns_given_as_a_dict_take_the_identification_route(tmp_path) -> None:
+    """``read_data`` reads a dict of columns as ``pkm.measurements`` does (one route: ``read_columns``): text is
+    refused naming its column (before: numpy turned "0.1" into 0.1), columns of unequal length are refused naming
+    theirs (before: numpy's raw error), and the same table as a dict and as a file reads the same."""
+    s = simulated("prs3")
+    m = s.model
+    path = write_data(m, tmp_path / "data.csv", s.readings, s.measured)
+    from pkm.core.identification.measurements import read_table
+
+    cols = read_table(path)
+    M, Y = read_data(m, cols)
+    assert np.array_equal(M, read_data(m, path)[0]) and np.array_equal(Y, read_data(m, path)[1])
+    with pytest.raises(pkm.errors.InvalidInputError, match=r"m\.slider_2") as err:
+        read_data(m, dict(cols, **{"m.slider_2": [str(v) for v in cols["m.slider_2"]]}))
+    assert err.value.name == "m.slider_2"
+    with pytest.raises(pkm.errors.InvalidInputError, match=r"column 'z' has shape") as err:
+        read_data(m, dict(cols, z=cols["z"][:-1]))

@@ -83,9 +83,9 @@ def test_the_analyses_equal_one_configuration_snapshot(name, built):
     c2 = Configuration.at(mech, q2)  # a second snapshot leaves the first as it was
     np.testing.assert_array_equal(c1.constraint_jacobian, constraints.jacobian(mech, q1))
     np.testing.assert_array_equal(c1.residual, constraints.residual(mech, q1))
-    np.testing.assert_array_equal(c1.task_value, mech.task_map.value(q1))
-    np.testing.assert_array_equal(c1.task_jacobian, mech.task_map.jacobian(q1))
-    np.testing.assert_array_equal(c2.task_jacobian, mech.task_map.jacobian(q2))
+    np.testing.assert_array_equal(c1.task_value, pkm.TaskMap.of(mech).value(q1))
+    np.testing.assert_array_equal(c1.task_jacobian, pkm.TaskMap.of(mech).jacobian(q1))
+    np.testing.assert_array_equal(c2.task_jacobian, pkm.TaskMap.of(mech).jacobian(q2))
     G = pkm.passive_map(mech, q1)
     np.testing.assert_allclose(pkm.forward_jacobian(mech, q1), c1.task_jacobian @ G, rtol=0, atol=1e-13)
     with pytest.raises(InvalidInputError):
@@ -167,7 +167,7 @@ def test_an_idle_rod_spin_is_reported_and_is_not_a_singularity():
     spin, plain = _fivebar_with_spinning_rod()
     rng = np.random.default_rng(7)
     for _ in range(5):
-        y = plain.task_map.value(plain.q_reference) + 0.03 * rng.uniform(-1, 1, 2)
+        y = pkm.TaskMap.of(plain).value(plain.q_reference) + 0.03 * rng.uniform(-1, 1, 2)
         q0 = plain.q_from_dict(fivebar_ik(plain.params, y))
         q1 = spin.q_from_dict({**fivebar_ik(plain.params, y), "spin_1": [float(rng.uniform(-3, 3))]})
         d = pkm.diagnose(spin, q1)
@@ -196,7 +196,7 @@ def test_rank_decisions_are_relative_to_the_largest_singular_value():
     small = fivebar.build(fivebar.Params(d=0.2e-4, l1=0.25e-4, l2=0.3e-4))
     q_big = big.q_reference
     d_big = pkm.diagnose(big, q_big)
-    q_small = small.q_from_dict(fivebar_ik(small.params, 1e-4 * big.task_map.value(q_big)))
+    q_small = small.q_from_dict(fivebar_ik(small.params, 1e-4 * pkm.TaskMap.of(big).value(q_big)))
     d_small = pkm.diagnose(small, q_small)
     assert d_small.classification == d_big.classification == "regular"
     assert math.isclose(d_small.direct_distance, d_big.direct_distance, rel_tol=1e-9)

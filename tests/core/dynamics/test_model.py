@@ -27,7 +27,7 @@ import pytest
 import pkm
 from pkm.core.dynamics import model as dm
 from pkm.core.dynamics.projection import constraint_dynamics, energy
-from pkm.errors import InvalidInputError, NonFiniteError, SingularityError
+from pkm.errors import InvalidInputError, NonFiniteError, SingularityError, SpecError
 from tests.fd import richardson
 from tests.test_acceptance import ACCEPTANCE, check_every_route_gives_back
 
@@ -194,3 +194,134 @@ def test_the_inertia_test_does_not_depend_on_the_size():
         assert np.allclose(qdd, 1.0, rtol=1e-14)
     with pytest.raises(SingularityError):
         dm._solve_inertia(np.diag([1e-10, 1.0]), np.ones(2), np.ones(2))
+
+
+# ---------------------------------------------------------------------- a floating base (issue 51)
+def _floating_state(name: str, seed: int = 5):
+    """A floating robot closed away from its reference with its base turned and moved, random actuated rates and a
+    random base twist (all joint rates, nv)."""
+    from tests.core.dynamics.floating import floating
+
+    mech = floating(name)
+    rng = np.random.default_rng(seed)
+    q0 = mech.q_reference.copy()
+    at = mech.base.idx_q
+    q0[at:at + 7] = np.r_[rng.uniform(-0.5, 0.5, 3), pin.Quaternion(pin.rpy.rpyToMatrix(*rng.uniform(-1, 1, 3))).coeffs()]
+    q = pkm.close_loops(mech, mech.actuated_q(mech.q_reference) + 0.1 * rng.uniform(-1, 1, mech.na), q0).q
+    rates = np.zeros(mech.nv)
+    rates[mech.base_v], rates[mech.act_v] = rng.normal(size=6), rng.normal(size=mech.na)
+    return mech, q, rates, rng
+
+
+def _without_idle(N, a):
+    return a - N @ (N.T @ a)
+
+
+@pytest.mark.parametrize("name", ["ankle", "delta", "fourbar"])
+def test_a_free_base_moves_as_constraint_dynamics_and_newton_say(name):
+    """A floating robot's base is free by default: the forward dynamics (base twist and an applied base wrench
+    included) equals Pinocchio's constraintDynamics of the same model to 1e-8 relative (idle accelerations left out,
+    as above; 1e-14 measured), its centre of mass falls at g exactly under any motor effort (no wrench on a free
+    body but gravity), inverse then forward dynamics gives the efforts back with no base wrench asked; held
+    (base="fixed"), it equals constraintDynamics with the base welded, and its base does not move. Before issue 51
+    the base was held without a word: the floating ankle's motors were 35 to 105 rad/s^2 off constraintDynamics."""
+    mech, q, rates, rng = _floating_state(name)
+    model = pkm.actuator_model(mech, q, rates)
+    assert model.base == "free" and np.array_equal(model.base_velocity, rates[mech.base_v])
+    assert rel(model.kinetic_energy, energy(mech, q, model.v)[0]) <= 1e-12
+    N = model.idle
+    tau, wrench = rng.normal(size=mech.na), rng.normal(size=6)
+    for w in (None, wrench):
+        a = pkm.forward_dynamics(mech, q, model.v, tau, base_wrench=w)
+        a_cd = constraint_dynamics(mech, q, model.v, tau, base_wrench=w)
+        assert rel(_without_idle(N, a), _without_idle(N, a_cd)) <= 1e-8
+    a = pkm.forward_dynamics(mech, q, model.v, tau)
+    pin.centerOfMass(mech.model, mech.data, q, model.v, a)
+    assert np.abs(mech.data.acom[0] - mech.model.gravity.linear).max() <= 1e-8 * 9.81
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # (a motion of the free robot asks nothing of the base: no warning)
+        out = pkm.base_inverse_dynamics(mech, q, model.v, a)
+        assert rel(pkm.inverse_dynamics(mech, q, model.v, a), tau) <= 1e-8
+    assert rel(out.efforts, tau) <= 1e-8 and not out.needs_base_wrench and out.base == "free"
+    out = pkm.base_inverse_dynamics(mech, q, model.v, pkm.forward_dynamics(mech, q, model.v, tau, base_wrench=wrench))
+    assert rel(out.efforts, tau) <= 1e-8 and rel(out.base_wrench, wrench) <= 1e-8 and out.needs_base_wrench
+    held = pkm.actuator_model(mech, q, rates, base="fixed")
+    assert held.base == "fixed" and held.base_velocity.size == 0 and not np.any(held.v[mech.base_v])
+    a = pkm.forward_dynamics(mech, q, held.v, tau, base="fixed")
+    assert not np.any(a[mech.base_v])
+    assert rel(_without_idle(N, a), _without_idle(N, constraint_dynamics(mech, q, held.v, tau, base="fixed"))) <= 1e-8
+    assert rel(pkm.inverse_dynamics(mech, q, held.v, a, base="fixed"), tau) <= 1e-8
+
+
+def test_the_base_choice_is_checked_and_named():
+    """Every mechanism shipped has a fixed base (its model says so and is what it was); "free" there, an unknown
+    choice, a wrench on a held base, and the Christoffel symbols of a free base are refused by name."""
+    from tests.core.dynamics.floating import floating
+
+    delta = mechanism("delta")
+    model = pkm.actuator_model(delta, delta.q_reference, [0.3, 0.0, -0.2])
+    assert model.base == "fixed" and np.array_equal(model.M, pkm.actuator_model(delta, delta.q_reference,
+                                                                                 [0.3, 0.0, -0.2], base="fixed").M)
+    for kw, match in (({"base": "free"}, "no floating base"), ({"base": "floating"}, "use one of")):
+        with pytest.raises(InvalidInputError, match=match):
+            pkm.actuator_model(delta, delta.q_reference, **kw)
+    with pytest.raises(InvalidInputError, match="base_wrench"):
+        pkm.forward_dynamics(delta, delta.q_reference, np.zeros(3), np.zeros(3), base_wrench=np.zeros(6))
+    mech = floating("fourbar")
+    q = pkm.close_loops(mech, [0.4], mech.q_reference).q
+    with pytest.raises(InvalidInputError, match="base='fixed'"):
+        pkm.coriolis_matrix(mech, q, [0.1])
+    assert pkm.coriolis_matrix(mech, q, [0.1], base="fixed").shape == (1, 1)
+    with pytest.raises(InvalidInputError, match="base_wrench"):
+        pkm.forward_dynamics(mech, q, np.zeros(mech.nv), [0.0], base="fixed", base_wrench=np.zeros(6))
+    with pytest.raises(InvalidInputError, match="no twist"):
+        constraint_dynamics(mech, q, np.r_[np.ones(6), np.zeros(mech.nv - 6)], [0.0], base="fixed")
+    delta = floating("delta")  # (its base tied to the ground by a closure: not a free body)
+    anchored = dataclasses.replace(delta.spec, closures=(*delta.spec.closures,
+                                                         pkm.Closure("anchor", "point", "ground", "base")))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # (the builder's: the actuators fall short of the mobility)
+        mech = pkm.from_strings(delta.urdf, anchored)
+    q = pkm.close_loops(mech, mech.actuated_q(delta.q_reference) + 0.05, mech.q_reference).q
+    with pytest.raises(SpecError, match="the closures hold the floating base 'pelvis'"):
+        pkm.actuator_model(mech, q)
+    assert pkm.actuator_model(mech, q, base="fixed").base == "fixed"
+
+
+def test_an_undeclared_free_flyer_root_is_said_to_follow_the_idle_rule():
+    """The ankle on a free pelvis that the spec does not declare its floating base: the pelvis is a passive joint
+    whose motion is idle (the task is the ankle's joints), so the idle-motion rule, not gravity, sets its
+    acceleration; the model says so (a PkmWarning naming it)."""
+    from pkm.errors import PkmWarning
+    from tests.core.dynamics.floating import floating
+
+    declared = floating("ankle")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # (the builder's: the actuators fall short of the mobility)
+        mech = pkm.from_strings(declared.urdf, dataclasses.replace(declared.spec, floating_base=None))
+    q = pkm.close_loops(mech, [0.1, -0.1], mech.q_reference).q
+    with pytest.warns(PkmWarning, match="free-flyer 'pelvis' on the world is a passive joint"):
+        pkm.actuator_model(mech, q)
+
+
+def test_friction_on_a_free_base_enters_its_rows():
+    """The Delta on a free pelvis with viscous friction on its motors and a drag on the pelvis's joint: the forward
+    dynamics with friction balances every row of the equations of motion, ``[Ĝ Ĝ_b]ᵀ (rnea(q, v, a) - f) = [τ; 0]``
+    (f the joints' friction at v; 1e-10 relative): the inverse dynamics' base wrench is the drag's share, its
+    efforts ``τ + Ĝᵀ f``."""
+    from pkm.core.differential.velocity import passive_map
+    from tests.core.dynamics.floating import floating
+
+    base = floating("delta")
+    mech = pkm.with_actuators(base, {j: {"viscous": 0.05} for j in base.actuated_names})
+    mech.model.damping[mech.base_v] = 0.2  # (this mechanism's own model: with_actuators builds a new one)
+    q = pkm.close_loops(mech, mech.actuated_q(mech.q_reference) + 0.05, mech.q_reference).q
+    rates = np.zeros(mech.nv)
+    rates[mech.base_v], rates[mech.act_v] = [0.3, -0.2, 0.5, 1.0, -0.5, 2.0], 0.4
+    model = pkm.actuator_model(mech, q, rates)
+    tau = np.array([0.1, -0.2, 0.3])
+    a = dm.forward_dynamics(mech, q, model.v, tau, friction=True)
+    f = -np.asarray(mech.model.damping) * model.v
+    out = pkm.base_inverse_dynamics(mech, q, model.v, a)
+    assert rel(out.base_wrench, model.base_friction) <= 1e-10 and rel(model.base_friction, f[mech.base_v]) <= 1e-10
+    assert rel(out.efforts, tau + passive_map(mech, q).T @ f) <= 1e-10

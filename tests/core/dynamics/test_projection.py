@@ -215,7 +215,7 @@ def test_an_idle_motion_changes_no_effort():
     from tests.fivebar import inverse_kinematics
 
     spin, plain = _fivebar_with_spinning_rod()
-    y = plain.task_map.value(plain.q_reference) + np.array([0.01, -0.02])
+    y = pkm.TaskMap.of(plain).value(plain.q_reference) + np.array([0.01, -0.02])
     q0 = plain.q_from_dict(inverse_kinematics(plain.params, y))
     q1 = spin.q_from_dict({**inverse_kinematics(plain.params, y), "spin_1": [0.7]})
     qd, qdd = np.array([0.3, -0.2]), np.array([1.0, 0.5])
@@ -239,3 +239,42 @@ def test_bad_methods_frames_and_refused_structures_say_so(built):
     with pytest.raises(SpecError, match="drives the platform directly"):
         pkm.inverse_dynamics(built("rrr3"), built("rrr3").q_reference, np.zeros(built("rrr3").nv),
                              np.zeros(built("rrr3").nv), method="khalil")
+
+
+def test_a_floating_base_reports_the_wrench_the_motion_asks_of_it():
+    """At rest, the base held: the holder's wrench is the robot's weight carried at the base, world-aligned
+    ``(-m g, -(c - p) x m g)`` (c the centre of mass, p the base's origin; 1e-10), and the base-frame wrench is the
+    same turned into the base's axes. The base free, a motion the free robot cannot make (pkm.accelerations keeps
+    the base still: gravity would need a wrench) warns and says so; the held base does not warn."""
+    import warnings
+
+    from pkm.errors import InvalidInputError, PkmWarning
+    from tests.core.dynamics.floating import floating
+
+    mech = floating("delta")
+    q0 = mech.q_reference.copy()
+    at = mech.base.idx_q
+    R = pin.rpy.rpyToMatrix(0.4, -0.3, 0.8)
+    q0[at:at + 7] = np.r_[[0.2, -0.1, 0.7], pin.Quaternion(R).coeffs()]
+    q = pkm.close_loops(mech, mech.actuated_q(mech.q_reference) + 0.05, q0).q
+    rest = np.zeros(mech.nv)
+    held = pkm.base_inverse_dynamics(mech, q, rest, rest, base="fixed")
+    m, g = pin.computeTotalMass(mech.model), mech.model.gravity.linear
+    c = pin.centerOfMass(mech.model, mech.data, q)
+    weight = np.r_[-m * g, -np.cross(c - q0[at:at + 3], m * g)]
+    assert np.abs(held.base_wrench_world - weight).max() <= 1e-10 * m * 9.81
+    assert np.abs(held.base_wrench - np.r_[R.T @ weight[:3], R.T @ weight[3:]]).max() <= 1e-10 * m * 9.81
+    assert held.base == "fixed" and not held.needs_base_wrench
+    v = pkm.velocities(mech, q, [0.2, -0.1, 0.3])
+    a = pkm.accelerations(mech, q, v, [1.0, 0.0, -1.0])
+    with pytest.warns(PkmWarning, match="asks a wrench of the free floating base"):
+        tau = pkm.inverse_dynamics(mech, q, v, a)
+    free = pkm.base_inverse_dynamics(mech, q, v, a)
+    assert free.needs_base_wrench and np.array_equal(free.efforts, tau)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert np.array_equal(pkm.inverse_dynamics(mech, q, v, a, base="fixed"), tau)
+    with pytest.raises(InvalidInputError, match="no floating base"):
+        delta_fixed = pkm.load("delta")
+        pkm.base_inverse_dynamics(delta_fixed, delta_fixed.q_reference, np.zeros(delta_fixed.nv),
+                                  np.zeros(delta_fixed.nv))

@@ -236,3 +236,56 @@ def test_a_closure_that_fails_next_to_a_singularity_is_that_singularity():
     run = pkm.simulate(ankle, duration=0.5, friction=False, limits=False, backend="python")
     assert run.event.kind == "singularity" and "do not close" in run.event.detail
     assert 0.2 < run.event.time < 0.35
+
+
+@pytest.mark.parametrize(("name", "radau"), [("delta", False), ("fourbar", True)])
+def test_a_free_base_falls_as_a_free_body(name, radau):
+    """Hung on a free pelvis, thrown with a base twist and actuated rates, no effort, no friction: the total energy
+    stays within 1e-8 of the kinetic energy (RK4, 10 steps; the integrator and the model together), the centre of
+    mass moves on the parabola of g (its second difference, 1e-6 relative: Newton's law for the whole robot, which
+    an idle-motion rule for the base broke), the base's quaternion stays a unit one and Radau agrees (on the
+    four-bar: its finite-difference Jacobian costs 0.7 s on the Delta); held (base="fixed") the base stays where q0
+    puts it."""
+    from tests.core.dynamics.floating import floating
+
+    mech = pkm.with_actuators(floating(name), {j: {"velocity_limit": math.inf} for j in floating(name).actuated_names})
+    q0 = pkm.close_loops(mech, mech.actuated_q(mech.q_reference) + 0.05, mech.q_reference).q
+    v0 = np.zeros(mech.nv)
+    v0[mech.base_v], v0[mech.act_v] = [0.3, -0.2, 0.5, 1.0, -0.5, 2.0], 0.4
+    dt = 2e-3
+    run = pkm.simulate(mech, q0, v0, duration=10 * dt, dt=dt, friction=False, limits=False)
+    assert run.event is None and run.residual.max() <= 1e-12 and run.base == "free"
+    assert np.abs(run.energy - run.energy[0]).max() <= 1e-8 * run.kinetic.max()
+    at = mech.base.idx_q
+    assert np.abs(np.linalg.norm(run.q[:, at + 3:at + 7], axis=1) - 1.0).max() <= 1e-12
+    com = np.array([pin.centerOfMass(mech.model, mech.data, q) for q in run.q])
+    acc = (com[2:] - 2.0 * com[1:-1] + com[:-2]) / dt ** 2
+    assert np.abs(acc - mech.model.gravity.linear).max() <= 1e-6 * 9.81
+    if radau:
+        other = pkm.simulate(mech, q0, v0, duration=4 * dt, dt=dt, friction=False, limits=False, method="radau")
+        assert np.abs(other.q - run.q[:5]).max() <= 1e-8
+    held = pkm.simulate(mech, q0, v0, duration=4 * dt, dt=dt, friction=False, limits=False, base="fixed")
+    assert np.array_equal(held.q[:, at:at + 7], np.tile(q0[at:at + 7], (5, 1)))
+    assert not np.any(held.v[:, mech.base_v]) and held.base == "fixed"
+    with pytest.raises(InvalidInputError, match="held base"):
+        pkm.simulate(mech, q0, v0, duration=dt, dt=dt, backend="c")
+
+
+def test_friction_on_a_free_base_balances_the_energy():
+    """The four-bar on a free pelvis, viscous friction on its motor and on the pelvis's own joint (a drag: the
+    friction on the base's rows, which accelerates the base) and a constant effort: ``E(t) - E(0) = work -
+    dissipated`` to 1e-3 of the energy dissipated (10 1-ms samples, the trapezoidal rule's second order), the friction's
+    power counted on the bodies' motion (``f · v``, the base's in it; the eliminated model's ``f_a · q̇_a`` misses the
+    drag's: 0.98 of the dissipated energy off)."""
+    from tests.core.dynamics.floating import floating
+
+    base = floating("fourbar")
+    mech = pkm.with_actuators(base, {j: {"velocity_limit": math.inf, "viscous": 0.05} for j in base.actuated_names})
+    mech.model.damping[mech.base_v] = 0.2  # (a copy of the model: with_actuators builds a new mechanism)
+    q0 = pkm.close_loops(mech, mech.actuated_q(mech.q_reference) + 0.05, mech.q_reference).q
+    v0 = np.zeros(mech.nv)
+    v0[mech.base_v], v0[mech.act_v] = [0.3, -0.2, 0.5, 1.0, -0.5, 2.0], 0.4
+    run = pkm.simulate(mech, q0, v0, duration=0.01, dt=1e-3, limits=False, torques=([0.0], [[0.05]]))
+    assert run.event is None and np.all(np.diff(run.dissipated) > 0.0)
+    balance = run.energy - run.energy[0] - run.work + run.dissipated
+    assert np.abs(balance).max() <= 1e-3 * run.dissipated[-1]

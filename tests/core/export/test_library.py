@@ -73,12 +73,12 @@ def test_the_mode_asked_for_and_the_limits(built):
     got = h.run("fk", row[None])[0]
     assert STATUS[int(got[0])] == "LEFT_MODE" and got[3] == 0
     solved = pkm.close_loops(mech, qa + 0.01, ref, tol=1e-14)
-    assert np.abs(mech.task_map.error(mech.task_map.value(solved.q), got[4 + mech.nq:])).max() <= TOL
+    assert np.abs(pkm.TaskMap.of(mech).error(pkm.TaskMap.of(mech).value(solved.q), got[4 + mech.nq:])).max() <= TOL
     got = h.run("fk", np.hstack([qa + 0.01, ref, [0.0]])[None])[0]
     assert STATUS[int(got[0])] == "OK" and 1 <= got[1] <= 6
     knee, hk = built["knee"]
     assert hk.lib.limits
-    y = knee.task_map.value(knee.q_reference)
+    y = pkm.TaskMap.of(knee).value(knee.q_reference)
     far = hk.run("ik", np.hstack([y + 2.5, knee.q_reference, [-1.0]])[None])[0]
     assert STATUS[int(far[0])] in ("OUTSIDE_LIMITS", "NOT_CONVERGED", "SINGULAR") and np.isfinite(far).all()
 

@@ -52,7 +52,7 @@ def test_forward_and_inverse_kinematics_round_trip_and_the_jacobian_matches_diff
         qa = mech.actuated_q(mech.q_reference) + 0.1 * rng.uniform(-1, 1, mech.na)
         fk = pkm.close_loops(mech, qa)
         assert fk.residual <= 1e-10
-        ik = pkm.solve_ik(mech, mech.task_map.value(fk.q))
+        ik = pkm.solve_ik(mech, pkm.TaskMap.of(mech).value(fk.q))
         assert np.abs(mech.actuated_q(ik.q) - qa).max() <= 1e-9
         assert fd.forward_jacobian_error(mech, fk.q) <= 1e-6
 

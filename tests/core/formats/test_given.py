@@ -58,10 +58,10 @@ def test_actuated_and_task_in_code_load_it_and_fk_ik_round_trip(passive):
     (1e-9 rad), and the loop is closed (1e-10 m); the three forms of ``task`` give the same task."""
     mech = pkm.load(passive, actuated=["crank_joint"], task="coupler_tip:z")
     assert mech.actuated_names == ("crank_joint",) and mech.spec.end_effector == "coupler_tip"
-    assert list(mech.task_map.kinds) == ["z"] and [c.name for c in mech.spec.closures] == ["pin"]
+    assert list(pkm.TaskMap.of(mech).kinds) == ["z"] and [c.name for c in mech.spec.closures] == ["pin"]
     fk = pkm.close_loops(mech, [0.2])
     assert fk.residual < 1e-10
-    z = mech.task_map.named(fk.q)["z"]
+    z = pkm.TaskMap.of(mech).named(fk.q)["z"]
     ik = pkm.solve_ik(mech, {"z": z}, fk.q + 0.05)
     assert abs(ik.q[0] - 0.2) < 1e-9 and ik.residual < 1e-10
     for form in (("coupler_tip", "z"), ("coupler_tip", ["z"]), {"end_effector": "coupler_tip", "components": ["z"]}):
@@ -108,7 +108,7 @@ def test_a_spec_with_no_actuated_joints_takes_them_from_code(passive):
     with pytest.raises(SpecError, match="'actuated' must name at least one joint"):
         pkm.load(spec)
     mech = pkm.load(spec, actuated=["crank_joint"], task=("coupler_tip", "x"))
-    assert mech.actuated_names == ("crank_joint",) and list(mech.task_map.kinds) == ["x"]
+    assert mech.actuated_names == ("crank_joint",) and list(pkm.TaskMap.of(mech).kinds) == ["x"]
 
 
 def test_the_command_line_takes_actuated_and_task(passive, capsys):
@@ -118,7 +118,7 @@ def test_the_command_line_takes_actuated_and_task(passive, capsys):
                  "--joints", "crank_joint=0.2"]) == 0
     out = json.loads(capsys.readouterr().out)
     mech = pkm.load(passive, actuated=["crank_joint"], task="coupler_tip:z")
-    assert np.isclose(out["task"]["z"], mech.task_map.named(pkm.close_loops(mech, [0.2]).q)["z"], atol=1e-12)
+    assert np.isclose(out["task"]["z"], pkm.TaskMap.of(mech).named(pkm.close_loops(mech, [0.2]).q)["z"], atol=1e-12)
 
 
 @pytest.mark.filterwarnings("ignore::pkm.errors.ImplausibleModelWarning")  # (the file's 654 t spheres)

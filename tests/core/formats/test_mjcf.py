@@ -113,7 +113,7 @@ def test_a_spec_may_name_an_mjcf_file_and_add_a_task(tmp_path):
     spec.write_text('format = "pkm.closures/1"\nmechanism = "fb"\nurdf = "fourbar.xml"\nend_effector = "coupler_point"\n'
                     'actuated = ["crank_joint"]\n[task]\ncomponents = ["x"]\n')
     mech = pkm.load(spec)
-    assert [c.name for c in mech.spec.closures] == ["pin_c"] and mech.task_map.names == ("x",)
+    assert [c.name for c in mech.spec.closures] == ["pin_c"] and pkm.TaskMap.of(mech).names == ("x",)
     clash = spec.read_text() + '[[closure]]\nname = "pin_c"\ntype = "point"\nframe_a = "crank"\nframe_b = "rocker"\n'
     spec.write_text(clash)
     with pytest.raises(SpecError, match="'pin_c' is both in the spec"):
@@ -232,7 +232,7 @@ def test_the_drives_are_read_in_joint_units_as_mujoco_applies_them():
     assert any("'pc'" in n and "[-30, 50] is not symmetric" in n for n in imp.notes)
     assert any("'mb'" in n and "ctrlrange bounds joint jb" in n for n in imp.notes)
     assert any("gains of <position name='pc'>" in n for n in imp.notes)
-    assert any("no actuator drives are not read: jd" in n for n in imp.notes)
+    assert imp.springs["jd"] == {"damping": 7.0} and any("jd (damping 7)" in n for n in imp.notes)  # (passive)
     try:
         import mujoco
     except ImportError:
@@ -337,3 +337,39 @@ def test_the_reference_keyframe_is_the_reference_and_a_wrong_one_is_refused_by_l
     (tmp_path / "short.xml").write_text(text.replace("</mujoco>", key.replace("0.1 0.2 0.3", "0.1 0.2")))
     with pytest.raises(SpecError, match=r"short\.xml: <keyframe><key name='reference'> \(line \d+\) qpos"):
         pkm.load(tmp_path / "short.xml")
+
+
+def test_without_the_reference_key_the_first_key_inside_the_limits_is_closed_holding_its_motors(tmp_path):
+    """A key of another name (Menagerie's ``home``), its loops open by millimetres as MuJoCo's soft equalities leave
+    them: its motor held (the crank at 0.2, 1e-15), the other joints closed from it, the same configuration as
+    ``close_loops`` from the crank (1e-10); a key outside a range before it is passed over, both said in the notes."""
+    mech = pkm.load(_FOURBAR)
+    q = pkm.close_loops(mech, [0.2]).q
+    keys = (f'<keyframe><key name="bad" qpos="4 0 0"/><key name="home" qpos="0.2 {float(q[1]) + 0.01!r} '
+            f'{float(q[2]) - 0.01!r}"/><key name="later" qpos="0.1 0 0"/></keyframe>\n</mujoco>')
+    (tmp_path / "home.xml").write_text(_FOURBAR.read_text().replace("</mujoco>", keys))
+    keyed = pkm.load(tmp_path / "home.xml")
+    assert abs(keyed.q_reference[0] - 0.2) <= 1e-15 and np.abs(keyed.q_reference - q).max() < 1e-10
+    notes = " | ".join(keyed.notes)
+    assert "<key name='home'>" in notes and "'bad' (crank_joint)" in notes and "not read" in notes and "'later'" in notes
+    assert "loops open by 0.0051" in notes
+
+
+def test_an_assembled_reference_outside_a_range_is_assembled_again_inside_it_else_said(tmp_path):
+    """No key, ``qpos0`` outside the crank's range [10, 60] deg: the crank is restarted at the middle of its range and
+    the reference lands inside every limit, closed (1e-12), a note saying so; a rocker range no closure reaches keeps
+    the first assembly with a PkmWarning naming the joint (never a reference outside a limit without a word)."""
+    from pkm.core.kinematics import constraints
+    from pkm.errors import PkmWarning
+
+    text = _FOURBAR.read_text()
+    (tmp_path / "crank.xml").write_text(text.replace('range="-180 180"', 'range="10 60"'))
+    mech = pkm.load(tmp_path / "crank.xml")
+    assert mech.outside_limits(mech.q_reference) == ()
+    assert np.abs(constraints.residual(mech, mech.q_reference)).max() <= 1e-12
+    assert any("assembled again from ['crank_joint']" in n for n in mech.notes)
+    (tmp_path / "rocker.xml").write_text(text.replace('<joint name="rocker_joint"/>',
+                                                      '<joint name="rocker_joint" range="150 160"/>'))
+    with pytest.warns(PkmWarning, match=r"outside the position limits of \['rocker_joint'\]"):
+        rocker = pkm.load(tmp_path / "rocker.xml")
+    assert rocker.outside_limits(rocker.q_reference) == ("rocker_joint",)

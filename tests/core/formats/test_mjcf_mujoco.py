@@ -243,3 +243,75 @@ def test_two_unnamed_connects_between_the_same_bodies_are_both_read():
     assert [c.name for c in imp.closures] == ["connect1", "connect2"]
     for name, z in (("connect1_a", 1.0), ("connect2_a", 0.5)):
         assert np.abs(d.oMf[model.getFrameId(name)].translation - [0, 0, z]).max() <= TOL
+
+
+#: Springs and dampers on a hinge (springref in degrees, a class's stiffness), a slide, an actuated hinge (its damping
+#: is its drive's), a ball (not read) and a mimic follower (not read).
+SPRINGS = """<mujoco model="springs">
+  <compiler angle="{angle}"/>
+  <default><default class="soft"><joint stiffness="7"/></default></default>
+  <worldbody>
+    <body name="a"><joint name="ja" axis="0 0 1" class="soft" springref="{ref}" damping="0.5"/>
+      <geom type="sphere" size="0.05" mass="1"/>
+      <body name="b" pos="0.2 0 0"><joint name="jb" type="slide" axis="1 0 0" stiffness="300" springref="0.05"/>
+        <geom type="sphere" size="0.05" mass="1"/>
+        <body name="c" pos="0.2 0 0"><joint name="jc" type="ball" stiffness="2"/><geom type="sphere" size="0.05" mass="1"/>
+          <body name="d" pos="0.2 0 0"><joint name="jd" axis="0 1 0" damping="0.3"/><geom type="sphere" size="0.05" mass="1"/>
+            <body name="e" pos="0.2 0 0"><joint name="je" axis="0 1 0" stiffness="4"/><geom type="sphere" size="0.05" mass="1"/>
+            </body></body></body></body></body>
+  </worldbody>
+  <equality><joint joint1="je" joint2="jb"/></equality>
+  <actuator><motor joint="jd"/></actuator>
+</mujoco>"""
+
+
+@pytest.mark.parametrize(("angle", "ref"), [("degree", "30"), ("radian", "0.5235987755982988")])
+def test_joint_springs_are_read_as_mujoco_compiles_them(angle, ref):
+    """``stiffness``, ``springref`` (degrees for a hinge unless radians) and a passive joint's ``damping`` are the
+    ``[springs]`` entries, equal to MuJoCo's ``jnt_stiffness``, ``qpos_spring`` and ``dof_damping`` (1e-15); the
+    actuated joint's damping stays its drive's; a ball's and a mimic follower's spring are named as not read."""
+    text = SPRINGS.format(angle=angle, ref=ref)
+    imp = read_mjcf(text, "springs.xml")
+    assert set(imp.springs) == {"ja", "jb"} and imp.actuators["jd"]["viscous"] == 0.3
+    assert any("not read: jc, je" in n for n in imp.notes) and any("[springs]" in n for n in imp.notes)
+    mujoco, m = _mujoco_model(text)
+    for name, spring in imp.springs.items():
+        j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
+        expected = {"stiffness": m.jnt_stiffness[j], "rest": m.qpos_spring[m.jnt_qposadr[j]],
+                    "damping": m.dof_damping[m.jnt_dofadr[j]]}
+        assert all(abs(spring.get(k, 0.0) - v) <= 1e-15 for k, v in expected.items()), name
+
+
+#: A four-bar closed by a connect between two sites, each named as a body (and a joint) of the file: MJCF allows it.
+SHARED_SITES = """<mujoco model="shared">
+  <worldbody>
+    <body name="crank"><joint name="crank" axis="0 1 0"/><geom type="capsule" fromto="0 0 0 0 0 0.1" size="0.01"/>
+      <body name="coupler" pos="0 0 0.1"><joint name="coupler" axis="0 1 0"/>
+        <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.01"/><site name="rocker" pos="0.3 0 0"/></body></body>
+    <body name="rocker" pos="0.3 0 0"><joint name="rocker" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 0 0 0.1" size="0.01"/><site name="coupler" pos="0 0 0.1"/></body>
+  </worldbody>
+  <equality><connect site1="rocker" site2="coupler"/></equality>
+  <actuator><motor joint="crank"/></actuator>
+</mujoco>"""
+
+
+def test_a_closure_on_sites_named_as_bodies_closes_the_sites():
+    """The closure's frames are the sites (frames of their own, a note says so), not the bodies of the same names
+    (before: the bodies, 0.2 m apart: "cannot close"): at pkm's reference, MuJoCo puts the two sites together
+    (1e-12) where pkm puts its frames."""
+    from pkm.core.formats.load import load_texts
+
+    imp = read_mjcf(SHARED_SITES, "shared.xml")
+    assert [(c.frame_a, c.frame_b) for c in imp.closures] == [("rocker_site", "coupler_site")]
+    assert any("rocker -> rocker_site" in n for n in imp.notes)
+    mujoco, m = _mujoco_model(SHARED_SITES)
+    mech = load_texts({"shared.xml": SHARED_SITES})
+    d = mujoco.MjData(m)
+    d.qpos[:] = [mech.q_reference[mech.joints[mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)].idx_q]
+                 for j in range(m.njnt)]
+    mujoco.mj_kinematics(m, d)
+    a, b = (d.site(n).xpos for n in ("rocker", "coupler"))
+    assert np.abs(a - b).max() <= 1e-12
+    pin.framesForwardKinematics(mech.model, mech.data, mech.q_reference)
+    assert np.abs(mech.data.oMf[mech.frame_id("rocker_site")].translation - a).max() <= 1e-12

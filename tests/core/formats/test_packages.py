@@ -76,7 +76,10 @@ def test_cassie_rotors_are_mimic_joints_of_the_motor_outputs():
             assert jm.extract().scaling == pytest.approx(-1 / ratio, rel=1e-12)
             assert jm.idx_q == mech.joints[f"{side}-{joint}-op"].idx_q
     assert "gearbox 'left-knee-joint' read as a mimic joint: left-knee-ip = -16 left-knee-op" in mech.notes
-    assert any("spring stiffness of joints ['left-knee-shin-joint', 'left-tarsus-spring-joint'" in n for n in mech.notes)
+    assert any("left-knee-shin-joint (stiffness 1500, rest 0); left-tarsus-spring-joint (stiffness 1250" in n
+               for n in mech.notes)
+    assert mech.spec.springs["left-tarsus-spring-joint"] == {"stiffness": 1250.0, "rest": 0.0}
+    assert "left-knee-shin-joint" not in mech.spec.springs  # (pkm's spec holds the knee spring rigid: fixed)
 
 
 def test_an_unknown_model_or_package_lists_the_valid_names():

@@ -72,3 +72,23 @@ def test_tied_legs_lower_the_count_and_still_give_the_efforts(name):
     tau = Y @ tied.parameters.values
     assert np.abs(tied.regressor(Y) @ tied.values - tau).max() <= 1e-10 * np.abs(tau).max()
     assert np.allclose(tied.map @ tied.parameters.values, tied.values, rtol=1e-12, atol=1e-15)
+
+
+def test_amounts_are_per_unit_and_one_number_is_refused_where_the_units_mix():
+    """``per_unit``: a mapping gives each actuator its unit's value; one number serves where every actuator has the
+    same unit, and is refused where revolute and prismatic actuators mix (it would mean rad and m alike)."""
+    from types import SimpleNamespace
+
+    from pkm.core.identification.base import per_unit
+
+    joints = {"crank": SimpleNamespace(revolute=True), "slider": SimpleNamespace(revolute=False)}
+    mixed = SimpleNamespace(joints=joints, actuated_names=("crank", "slider"), na=2)
+    assert per_unit(mixed, {"rad": 0.3, "m": 0.03}, "spread").tolist() == [0.3, 0.03]
+    with pytest.raises(InvalidInputError, match="revolute and prismatic joints alike"):
+        per_unit(mixed, 0.1, "spread")
+    with pytest.raises(InvalidInputError, match="no value for the m joints"):
+        per_unit(mixed, {"rad": 0.3}, "spread")
+    alone = SimpleNamespace(joints=joints, actuated_names=("slider",), na=1)
+    assert per_unit(alone, 0.2, "spread").tolist() == [0.2]
+    with pytest.raises(InvalidInputError, match="spread"):
+        per_unit(alone, -0.2, "spread")

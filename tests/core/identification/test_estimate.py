@@ -1,16 +1,18 @@
 """pkm.core.identification.estimate: exact efforts give back the base parameters; efforts with noise (1 % of each
 actuator's range) give estimates within their stated standard deviations; bad data is refused by row; too few
-equations, and parameters that cannot be told from zero, are warned of (PoorIdentificationWarning)."""
+equations, and poorly identified parameters (not told from zero, their deviation a share of the efforts), are warned
+of (PoorIdentificationWarning); a parameter zero by symmetry, determined, is not."""
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
 import pytest
 
 from pkm.core.identification.base import base_parameters, random_states
-from pkm.core.identification.estimate import POOR_RELATIVE_STD, estimate
+from pkm.core.identification.estimate import POOR_EFFORT_SHARE, POOR_RELATIVE_STD, estimate
 from pkm.core.identification.regressor import regressor
 from pkm.errors import InvalidInputError, PoorIdentificationWarning, SingularityError
 from tests.core.dynamics.test_model import mechanism
@@ -28,23 +30,35 @@ def _data(name: str, n: int):
 @pytest.mark.parametrize("name", ["delta", "prs3"])
 def test_noisy_efforts_give_estimates_within_their_standard_deviations(name):
     """Weighted least squares on 300 random states: the errors over the stated deviations behave as a standard
-    normal sample (at least 95 % within 3, none beyond 4); without noise the estimate is exact (1e-8 relative)."""
+    normal sample (at least 95 % within 3, none beyond 4); without noise the estimate is exact (1e-8 relative) and
+    warns of nothing (issue 52: the parameters zero by symmetry, their relative deviations 0/0, were 'poor')."""
     mech, base, Q, QD, QDD, TAU = _data(name, 300)
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", PoorIdentificationWarning)  # (exact: the zero parameters' deviations are 0/0)
+        warnings.simplefilter("error", PoorIdentificationWarning)
         exact = estimate(mech, Q, QD, QDD, TAU, base=base, weighted=False)
     assert np.abs(exact.values - base.values).max() <= 1e-8 * np.abs(base.values).max()
+    assert exact.warnings == () and np.max(exact.relative_std) > POOR_RELATIVE_STD
     rng = np.random.default_rng(5)
     noisy = TAU + 0.01 * np.ptp(TAU, axis=0) * rng.standard_normal(TAU.shape)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         est = estimate(mech, Q, QD, QDD, noisy, base=base)
-    # 900 equations or more: no warning of too few; one naming exactly the parameters above 100 % (those whose true
-    # value is zero, a drive's friction and offset among them), its sentence kept in est.warnings
-    poor = [n for n, r in zip(base.names, est.relative_std) if r > POOR_RELATIVE_STD]
+    # 900 equations or more: no warning of too few; one naming exactly the poorly identified parameters (above
+    # 100 % and a deviation worth more than 1 % of the efforts), its sentence kept in est.warnings; parameters zero
+    # by symmetry whose deviation is worth little of the efforts are above 100 % but not poor
+    poor = [n for n, r, e in zip(base.names, est.relative_std, est.effort_share)
+            if r > POOR_RELATIVE_STD and e > POOR_EFFORT_SHARE]
     found = [w.message for w in caught if isinstance(w.message, PoorIdentificationWarning)]
-    assert poor and len(found) == 1 and [n for n, _ in found[0].poor] == poor
+    assert poor and len(found) == 1 and [n for n, _ in found[0].poor] == poor == list(np.array(base.names)[est.poor])
     assert est.warnings == (str(found[0]),) and f"{len(poor)} of {len(base)} base parameters" in est.warnings[0]
+    assert np.sum(est.relative_std > POOR_RELATIVE_STD) > len(poor)
+    # the share, by another route: the weighted efforts predicted with one parameter moved by its deviation
+    Y = np.vstack([regressor(mech, *s) for s in zip(Q, QD, QDD)])
+    w = np.tile(est.weights, len(Q))
+    for i in (int(np.argmax(est.effort_share)), int(np.argmin(est.effort_share))):
+        moved = dataclasses.replace(est, values=est.values + est.std[i] * np.eye(len(base))[i])
+        change = np.linalg.norm((moved.predict(Y) - est.predict(Y)) * w) / np.linalg.norm(noisy.reshape(-1) * w)
+        assert change == pytest.approx(est.effort_share[i], rel=1e-9)
     z = (est.values - base.values) / est.std
     assert est.method == "wls" and np.mean(np.abs(z) <= 3.0) >= 0.95 and np.abs(z).max() <= 4.0
     assert np.allclose(est.residual_rms, 0.01 * np.ptp(TAU, axis=0), rtol=0.15)  # (the noise, found again)

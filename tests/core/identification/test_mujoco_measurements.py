@@ -29,7 +29,7 @@ from pkm.core.identification.base import base_parameters
 from pkm.core.identification.estimate import estimate
 from pkm.core.identification.regressor import regressor
 
-mujoco = pytest.importorskip("mujoco")  # (the bench extra: installed by make test's venv, pkm[all])
+mujoco = pytest.importorskip("mujoco")  # (the bench extra: installed by make test's venv, pkm-robotics[all])
 
 PERIOD, DT, AMPLITUDE, HARMONICS, HZ, DAMPING = 4.0, 1e-3, 0.15, 4, 8.0, 0.8
 BOUND = {"delta": 0.01, "prs3": 0.001}  # validation relative RMS error, per actuator

@@ -10,6 +10,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+import pkm
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
 from pkm.errors import InvalidInputError
@@ -29,8 +30,8 @@ def test_each_field_equals_its_separate_call(built, where):
     expected = {
         "residual": constraints.residual(mech, q),
         "constraint_jacobian": constraints.jacobian(mech, q),
-        "task_value": mech.task_map.value(q),
-        "task_jacobian": mech.task_map.jacobian(q),
+        "task_value": pkm.TaskMap.of(mech).value(q),
+        "task_jacobian": pkm.TaskMap.of(mech).jacobian(q),
         "ee_jacobian": pin.computeFrameJacobian(mech.model, data, q, mech.ee_frame, pin.LOCAL_WORLD_ALIGNED),
     }
     for name, value in expected.items():

@@ -22,7 +22,7 @@ def test_an_ik_across_a_direct_singularity_warns_and_fk_confirms_the_other_assem
     (well posed there) into the other assembly mode and says so; the loop closure from the reference at the same
     actuators (an independent route) lands elsewhere, in the reference's assembly mode. A short move stays silent."""
     mech = built("fivebar")
-    y0 = mech.task_map.value(mech.q_reference)
+    y0 = pkm.TaskMap.of(mech).value(mech.q_reference)
     with warnings.catch_warnings():
         warnings.simplefilter("error", ModeChangeWarning)
         near = pkm.solve_ik(mech, y0 + [0.0, -0.1])

@@ -294,7 +294,7 @@ def test_a_failure_carries_its_problem_whose_jacobian_is_the_derivative_of_its_r
 
     sol = close_loops(delta, [-0.9, -0.85, -1.0])
     closure = ClosureProblem(delta, delta.actuated_q(sol.q))
-    ik = IKProblem(delta, delta.task_map.value(sol.q))
+    ik = IKProblem(delta, pkm.TaskMap.of(delta).value(sol.q))
     rng = np.random.default_rng(0)
     for problem in (closure, ik):
         assert np.abs(problem.residual(sol.q)).max() <= 1e-10

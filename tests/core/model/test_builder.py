@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import pkm
 from pkm.core.kinematics import constraints
 from pkm.core.model import builder
 from pkm.core.model.compare import mechanism_differences
@@ -42,7 +43,7 @@ def test_a_partial_reference_is_assembled_holding_the_joints_it_states(partial):
     mech, qa = partial
     np.testing.assert_array_equal(mech.actuated_q(mech.q_reference), qa)
     assert np.abs(constraints.residual(mech, mech.q_reference)).max() <= 1e-12
-    tip = mech.task_map.value(mech.q_reference)
+    tip = pkm.TaskMap.of(mech).value(mech.q_reference)
     assert np.abs(fivebar.closed_form_fk(mech.params, qa, seed=tip) - tip).max() <= 1e-9
     assert set(mech.spec.reference) == {"motor_1", "motor_2"}  # (the spec keeps what it stated)
 

@@ -11,7 +11,7 @@ import pinocchio as pin
 import pytest
 
 from pkm.core import ClosureSpec
-from pkm.core.model.joints import JOINT_TYPES, UNIVERSAL_AXES, retype_joints
+from pkm.core.model.joints import JOINT_TYPES, UNIVERSAL_AXES, reduced_model, retype_joints
 from pkm.core.model.urdf import load_model
 from pkm.errors import SpecError
 
@@ -67,3 +67,27 @@ def test_the_new_types_go_through_a_spec_s_toml_and_back():
     again = ClosureSpec.from_toml(spec.to_toml())
     assert again == spec and '[joint_types]\nu = "universal_zy"' in spec.to_toml()
     assert dataclasses.replace(spec, joint_types={"u": "universal_xz"}).to_toml().count("universal_xz") == 1
+
+
+#: A link and a joint named alike (``a``), as MJCF bodies and joints often are (MuJoCo Menagerie's Cassie).
+SHARED = URDF.replace('name="a"', 'name="u"').replace('link="a"', 'link="u"')
+
+
+def test_a_model_whose_link_and_joint_share_a_name_is_reduced_keeping_every_frame():
+    """Pinocchio's own reduction raises on such a model (its frames looked up by name alone); :func:`reduced_model`
+    keeps every frame's name and type, and the kept frames' placements at the locked value (1e-14)."""
+    model = load_model(SHARED)
+    assert [str(f.type) for f in model.frames if f.name == "u"] == ["JOINT", "BODY"]
+    q = np.array([0.3, -0.7])
+    with pytest.raises(ValueError, match="Several frames match"):
+        pin.buildReducedModel(model, [model.getJointId("u")], q)
+    reduced = reduced_model(model, [model.getJointId("u")], q)
+    assert sorted((f.name, str(f.type)) for f in reduced.frames) == sorted(
+        (f.name, "FIXED_JOINT" if f.name == "u" and f.type == pin.FrameType.JOINT else str(f.type))
+        for f in model.frames)
+    full, red = model.createData(), reduced.createData()
+    pin.framesForwardKinematics(model, full, q)
+    pin.framesForwardKinematics(reduced, red, q[1:])
+    for name in ("b", "u"):
+        a, b = (m.getFrameId(name, pin.FrameType.BODY) for m in (model, reduced))
+        assert np.abs((full.oMf[a].inverse() * red.oMf[b]).toActionMatrix() - np.eye(6)).max() < 1e-14

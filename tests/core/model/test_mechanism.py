@@ -110,14 +110,14 @@ def test_a_floating_base_is_an_input_the_solvers_hold():
     fk = pkm.close_loops(floating, qa, q0)
     assert np.array_equal(fk.q[at:at + 7], base)
     ref = pkm.close_loops(fixed, qa, fixed.q_reference)
-    assert np.abs(floating.task_map.value(fk.q) - fixed.task_map.value(ref.q)).max() <= 1e-10
-    ik = pkm.solve_ik(floating, floating.task_map.value(fk.q) + 0.01, fk.q)
+    assert np.abs(pkm.TaskMap.of(floating).value(fk.q) - pkm.TaskMap.of(fixed).value(ref.q)).max() <= 1e-10
+    ik = pkm.solve_ik(floating, pkm.TaskMap.of(floating).value(fk.q) + 0.01, fk.q)
     assert np.array_equal(ik.q[at:at + 7], base)
     qd, qdd = np.array([0.5, -0.3]), np.array([1.0, 2.0])
     v = pkm.velocities(floating, fk.q, qd)
     a = pkm.accelerations(floating, fk.q, v, qdd)
     assert np.abs(v[floating.base_v]).max() == 0.0 and np.abs(a[floating.base_v]).max() == 0.0
-    tau = pkm.inverse_dynamics(floating, fk.q, v, a)
+    tau = pkm.inverse_dynamics(floating, fk.q, v, a, base="fixed")  # (the base held: a has none)
     fixed.model.gravity = pin.Motion(np.concatenate([R.T @ floating.model.gravity.linear, np.zeros(3)]))
     try:
         vf = pkm.velocities(fixed, ref.q, qd)
@@ -205,3 +205,25 @@ def test_limits_along_a_path_are_the_first_sample_outside_per_joint(built):
     assert len(along) >= 3 and [k for k, _ in along] == sorted(k for k, _ in along)
     assert {v.joint: (k, v.value) for k, v in along} == expected
     assert all(v.limit == delta.limits[v.joint] for _, v in along)
+
+
+def test_the_task_map_and_the_scales_are_built_on_the_mechanism_and_kept_with_it():
+    """The mechanism imports neither (tests/test_import_graph.py): ``TaskMap.of`` and ``JacobianScales.of`` give
+    one object per mechanism, the old attributes say where they went, and a new reference makes new scales with
+    the characteristic length there (the legs extended: another L)."""
+    from pkm.core.model.scale import JacobianScales
+
+    loaded = pkm.load("gough_stewart")
+    mech = pkm.Mechanism(loaded.model, loaded.spec)  # (its own: its reference is changed below)
+    task = pkm.TaskMap.of(mech)
+    assert pkm.TaskMap.of(mech) is task and task.mech is mech and pkm.TaskMap.of(loaded) is not task
+    scales = JacobianScales.of(mech)
+    assert JacobianScales.of(mech) is scales and scales.length == mech.characteristic_length
+    with pytest.raises(AttributeError, match=r"moved to pkm\.TaskMap\.of\(mech\)"):
+        mech.task_map  # noqa: B018
+    with pytest.raises(AttributeError, match=r"moved to pkm\.core\.model\.scale\.JacobianScales\.of\(mech\)"):
+        mech.jacobian_scales  # noqa: B018
+    mech.q_reference = pkm.solve_ik(mech, {"z": task.named(mech.q_reference)["z"] + 0.05}).q
+    now = JacobianScales.of(mech)
+    assert now is not scales and now.length == mech.characteristic_length
+    assert abs(now.length - scales.length) > 1e-3 * scales.length

@@ -75,3 +75,48 @@ def test_triangle_inequality_and_placeholder_limits(built):
         pkm.with_actuators(delta, {**same, "motor_2": {"effort_limit": 999.0}})  # (not all alike: no warning)
         assert findings(delta) == []  # (the Delta's motors: a servo's 3.9 N m and 2.974 rad/s)
     assert delta.actuators[0].effort_limit == 3.9 and delta.actuators[0].velocity_limit == pytest.approx(2.974, abs=1e-3)
+
+
+def test_an_identified_body_far_off_is_judged_by_the_mechanism_s_size_once_naming_the_identified_model(built):
+    """Issue 52: an identified body of almost no mass with a first moment (its centre of mass 5 m out) made the
+    Delta's extent 5 m (the centres of mass counted), and the warning fired twice (the identified model built, then
+    rebuilt with its drives), naming the shipped spec. Now: one warning, against the Delta's 0.45 m, naming the
+    identified model."""
+    from pkm.core.identification.export import identified_mechanism
+    from pkm.core.identification.regressor import parameters
+
+    delta = built("delta")
+    P = parameters(delta)
+    theta = P.values.copy()
+    k = P.names.index("forearm_1.m")
+    theta[k:k + 10] = [1e-6, 5e-6, 0.0, 0.0, 1e-3, 0.0, 1e-3, 0.0, 0.0, 1e-3]  # (m, m c, inertia about the joint)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        out = identified_mechanism(delta, theta, source="out/delta.closures.toml")
+    found = [w.message for w in caught if isinstance(w.message, ImplausibleModelWarning)]
+    assert len(found) == 1 and found[0].kind == "inertia" and found[0].names == ("forearm_1",)
+    assert str(found[0]).startswith("out/delta.closures.toml: ") and "extent squared (0.4503 m)" in str(found[0])
+    assert size(out) == pytest.approx(size(delta), rel=1e-12) and out.notes.count(str(found[0])) == 1
+    with pytest.warns(ImplausibleModelWarning, match=r"^the model identified from .*delta"):
+        identified_mechanism(delta, theta)
+
+
+def test_a_negligible_body_is_not_judged_by_the_inertia_rules(built):
+    """The consistent estimate's massless links of the identification tour (issue 52): 1.6e-7 kg carrying 2.9e-6
+    kg m^2, another breaking the triangle inequality by 4e-14 kg m^2, on a Delta whose M L^2 is 0.13 kg m^2: no
+    measurement sees them; inertias 1000 and 1e9 times larger are judged."""
+    from pkm.core.identification.export import identified_mechanism
+    from pkm.core.identification.regressor import parameters
+
+    delta = built("delta")
+    P = parameters(delta)
+    for scales, fired in (((1.0, 1.0), set()), ((1e3, 1e9), {"inertia", "triangle"})):
+        theta = P.values.copy()
+        for body, m, moments, scale in (("knee_cross_2", 1.6e-7, (2.9e-6, 2.9e-6, 2.9e-6), scales[0]),
+                                        ("knee_cross_3", 1e-3, (1e-13, 1e-13, 2.4e-13), scales[1])):
+            k = P.names.index(f"{body}.m")
+            theta[k:k + 10] = [m, 0, 0, 0, moments[0] * scale, 0, moments[1] * scale, 0, 0, moments[2] * scale]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ImplausibleModelWarning)
+            out = identified_mechanism(delta, theta)
+        assert {w.kind for w in findings(out)} == fired

@@ -10,7 +10,7 @@ import pytest
 import pkm
 from pkm.core.kinematics import constraints
 from pkm.core.model.builder import scaled_mechanism
-from pkm.core.model.scale import scale_configuration
+from pkm.core.model.scale import JacobianScales, scale_configuration
 from pkm.errors import InvalidInputError
 from tests.test_gepetto_robots import gepetto
 
@@ -33,7 +33,7 @@ def test_the_homogenisation_scales_rotation_rows_angular_tasks_and_translation_c
 0.00022, before the homogenisation). diagnose's direct distance is the ratio of
     the singular values of J_p so scaled, rebuilt here by hand from the closure types and the joint kinds (1e-12)."""
     gs = pkm.load("gough_stewart")
-    sc = gs.jacobian_scales
+    sc = JacobianScales.of(gs)
     L = gs.characteristic_length
     legs = [gs.joints[f"leg{i}"].idx_v for i in range(1, 7)]
     base = gs.joints["platform"].idx_v

@@ -7,6 +7,7 @@ import time
 import numpy as np
 import pytest
 
+import pkm
 from pkm.core.model.builder import from_strings
 from pkm.core.model.urdf import UrdfBuilder, check_urdf, limit_notes, load_model, position_limits
 from pkm.errors import SpecError
@@ -102,14 +103,13 @@ def _fivebar_urdf(limit_attrs: str) -> str:
 def test_joints_without_position_limits_load_and_have_none():
     """``<limit effort velocity/>`` (as onshape-to-robot writes it) loads; the mechanism states no limits and no
     solver result reports a violation."""
-    import pkm
     from tests import fivebar
 
     text = _fivebar_urdf("")
     assert "lower=" not in text
     mech = from_strings(text, fivebar.closure_spec(fivebar.Params()))
     assert mech.limits == {}
-    assert pkm.solve_ik(mech, mech.task_map.value(mech.q_reference) + [0.01, 0.0]).outside_limits == ()
+    assert pkm.solve_ik(mech, pkm.TaskMap.of(mech).value(mech.q_reference) + [0.01, 0.0]).outside_limits == ()
 
 
 def test_one_sided_limits_are_refused_naming_the_joint():
@@ -120,13 +120,12 @@ def test_one_sided_limits_are_refused_naming_the_joint():
 def test_stated_limits_are_carried_and_violations_reported_by_the_solvers():
     """With |motor| <= 0.1 rad stated, the five-bar's reference solution (motors near 2 and 1 rad) is reported
     outside the limits, joint by joint, by solve_ik and close_loops; pkm does not enforce them."""
-    import pkm
     from tests import fivebar
 
     mech = from_strings(_fivebar_urdf(' lower="-0.1" upper="0.1"'), fivebar.closure_spec(fivebar.Params()))
     assert set(mech.limits.values()) == {(-0.1, 0.1)} and set(mech.limits) == {"motor_1", "motor_2", "elbow_1",
                                                                                  "elbow_2"}
-    ik = pkm.solve_ik(mech, mech.task_map.value(mech.q_reference))
+    ik = pkm.solve_ik(mech, pkm.TaskMap.of(mech).value(mech.q_reference))
     expected = tuple(n for n in mech.limits if abs(float(np.ravel(mech.q_to_dict(ik.q)[n])[0])) > 0.1)
     assert expected and ik.outside_limits == expected
     assert pkm.close_loops(mech, mech.actuated_q(ik.q)).outside_limits == expected

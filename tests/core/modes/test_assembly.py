@@ -26,14 +26,15 @@ def test_delta_has_its_two_sphere_intersection_roots():
     qa = delta.actuated_q(delta.q_reference) + np.array([0.1, -0.2, 0.15])
     modes = assembly_modes(delta, qa)
     assert modes.complete and len(modes) == 2 and modes.n_paths == 8 and modes.n_infinite == 6
-    z = sorted(delta.task_map.value(m.q)[2] for m in modes)
+    z = sorted(pkm.TaskMap.of(delta).value(m.q)[2] for m in modes)
     assert z[0] < 0.0 < z[1]  # below and above the base
     for m in modes:
         assert m.residual <= VERIFY_TOL and m.certificate.certified
         assert np.allclose(delta.actuated_q(m.q), qa, atol=1e-12)
     # the core's Newton from the reference lands on one of them
     below = pkm.close_loops(delta, qa).q
-    assert min(np.abs(delta.task_map.value(below) - delta.task_map.value(m.q)).max() for m in modes) < 1e-9
+    task = pkm.TaskMap.of(delta)
+    assert min(np.abs(task.value(below) - task.value(m.q)).max() for m in modes) < 1e-9
 
 
 def test_rrr3_modes_are_the_exact_polynomials_on_random_designs():
@@ -55,7 +56,7 @@ def test_rrr3_modes_are_the_exact_polynomials_on_random_designs():
             exact = ()
         modes = assembly_modes(mech, qa)
         assert modes.complete, modes.summary()
-        got = sorted((mech.task_map.value(m.q) for m in modes), key=lambda y: y[2] % (2 * np.pi))
+        got = sorted((pkm.TaskMap.of(mech).value(m.q) for m in modes), key=lambda y: y[2] % (2 * np.pi))
         want = sorted((s.y for s in exact), key=lambda y: y[2] % (2 * np.pi))
         assert len(got) == len(want), (mech.params, qa, modes.summary())
         for g, w in zip(got, want):

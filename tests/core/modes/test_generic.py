@@ -23,7 +23,7 @@ def test_a_fivebar_has_its_two_assembly_modes_and_four_working_modes(built):
     fk = pkm.assembly_modes(mech, qa)
     assert fk.complete and len(fk) == 2 and "no platform" in fk.reduction
     assert {mode_label(mech, m.q).assembly for m in fk} == {(1,), (-1,)}  # the two sides of the tip
-    y = mech.task_map.value(mech.q_reference)
+    y = pkm.TaskMap.of(mech).value(mech.q_reference)
     ik = pkm.working_modes(mech, y)
     assert ik.complete and len(ik) == 4
     assert {mode_label(mech, m.q).working for m in ik} == {(1, 1), (1, -1), (-1, 1), (-1, -1)}  # 2 elbows per leg
@@ -35,7 +35,7 @@ def test_a_fivebar_has_its_two_assembly_modes_and_four_working_modes(built):
     for m in fk:
         assert np.abs(mech.actuated_q(m.q) - qa).max() < 1e-12
     for m in ik:
-        assert np.abs(mech.task_map.error(y, mech.task_map.value(m.q))).max() < 1e-9
+        assert np.abs(pkm.TaskMap.of(mech).error(y, pkm.TaskMap.of(mech).value(m.q))).max() < 1e-9
     assert np.abs(mech.difference(fk[0].q, mech.q_reference)).max() < 1e-8  # mode 0: the reference's
     assert np.abs(mech.difference(ik[0].q, mech.q_reference)).max() < 1e-8
 

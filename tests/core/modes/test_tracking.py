@@ -49,7 +49,7 @@ def test_working_modes_followed_a_short_way_keep_their_signs_and_end_on_their_mo
     """3-RRR, its 8 working modes along 1 cm of x: every sample reached on the task asked for (1e-12), the elbow signs
     constant along each track, and each end one of the 8 working modes found at the last sample (1e-9), all distinct."""
     mech = built("rrr3")
-    y0 = mech.task_map.value(mech.q_reference)
+    y0 = pkm.TaskMap.of(mech).value(mech.q_reference)
     ys = y0 + np.linspace(0.0, 0.01, 5)[:, None] * np.array([1.0, 0.0, 0.0])
     start, end = pkm.working_modes(mech, ys[0]), pkm.working_modes(mech, ys[-1])
     assert len(start) == len(end) == 8
@@ -57,7 +57,7 @@ def test_working_modes_followed_a_short_way_keep_their_signs_and_end_on_their_mo
     for mode in start:
         t = pkm.track_working_mode(mech, mode, ys)
         assert t.reached == len(ys) and t.meeting is None
-        assert all(np.abs(mech.task_map.value(q) - y).max() <= 1e-12 for q, y in zip(t.q, ys))
+        assert all(np.abs(pkm.TaskMap.of(mech).value(q) - y).max() <= 1e-12 for q, y in zip(t.q, ys))
         assert len({tuple(mech.branch_signs(q).values()) for q in t.q}) == 1
         k, gap = _nearest(mech, t.q[-1], end)
         assert gap <= 1e-9

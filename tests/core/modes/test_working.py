@@ -19,12 +19,12 @@ def test_every_working_mode_at_the_reference(name, count):
     """Two solutions per leg, every combination: 2^legs working modes, each closing its loops (1e-10), reaching the
     task (1e-9) and distinct; the spec's branches are among them (their joint signs)."""
     mech = pkm.load(name)
-    y = mech.task_map.value(mech.q_reference)
+    y = pkm.TaskMap.of(mech).value(mech.q_reference)
     modes = pkm.working_modes(mech, y)
     assert modes.complete and len(modes) == count
     for m in modes:
         assert m.residual <= VERIFY_TOL and m.certificate.certified
-        assert np.abs(mech.task_map.error(y, mech.task_map.value(m.q))).max() < 1e-9
+        assert np.abs(pkm.TaskMap.of(mech).error(y, pkm.TaskMap.of(mech).value(m.q))).max() < 1e-9
     signs = {tuple(mech.branch_signs(m.q).values()) for m in modes}
     assert len(signs) == min(count, 2 ** len(mech.branch().signs))
     assert np.abs(mech.difference(modes[0].q, mech.q_reference)).max() < 1e-8  # mode 0: the reference's
@@ -43,7 +43,7 @@ def test_prs3_working_modes_are_the_closed_forms_sliders():
 
 def test_the_gough_stewarts_working_modes_include_negative_lengths_marked_outside_the_limits():
     mech = pkm.load("gough_stewart")
-    modes = pkm.working_modes(mech, mech.task_map.value(mech.q_reference))
+    modes = pkm.working_modes(mech, pkm.TaskMap.of(mech).value(mech.q_reference))
     inside = [m for m in modes if not m.outside_limits]
     assert len(modes) == 64 and len(inside) == 1
     assert np.allclose(mech.actuated_q(inside[0].q), mech.actuated_q(mech.q_reference), atol=1e-12)
@@ -64,7 +64,7 @@ def test_a_tracked_assembly_mode_stops_where_it_meets_another():
     assert np.isnan(tracks[0].q[k:]).all() and np.isfinite(tracks[0].q[:k]).all()
     a, b = (t.meeting for t in tracks)
     assert abs(a.s - b.s) < 1e-6 and max(a.sigma_min, b.sigma_min) < 1e-4
-    assert np.abs(mech.task_map.value(a.q) - mech.task_map.value(b.q)).max() < 1e-3
+    assert np.abs(pkm.TaskMap.of(mech).value(a.q) - pkm.TaskMap.of(mech).value(b.q)).max() < 1e-3
     before = pkm.assembly_modes(mech, path[k - 1])
     assert len(before) == 2 and len(pkm.assembly_modes(mech, path[k])) == 0
     # every sample reached is on the mode it started from: the nearer of the two at that sample
@@ -77,7 +77,7 @@ def test_a_tracked_working_mode_stays_and_reports_its_meeting():
     straight (an inverse singularity), where the track stops with the Jacobian nearly singular (1e-4, the distance
     diagnose gives there, 1e-6 relative)."""
     delta = pkm.load("delta")
-    y0 = delta.task_map.value(delta.q_reference)
+    y0 = pkm.TaskMap.of(delta).value(delta.q_reference)
     modes = pkm.working_modes(delta, y0)
     ys = y0 + np.linspace(0.0, 0.6, 61)[:, None] * np.array([1.0, 0.0, 0.0])
     t = pkm.track_working_mode(delta, modes[0], ys)

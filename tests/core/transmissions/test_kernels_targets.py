@@ -13,7 +13,7 @@ import sys
 import numpy as np
 import pytest
 
-from pkm.core.transmissions.kernels import KERNELS
+from pkm.core.transmissions.kernels import KERNELS, STATUS
 from pkm.core.transmissions.targets import write_transmission
 from pkm.errors import MissingDependencyError
 from tests.core.transmissions.test_kernels import ankle, knee, states
@@ -58,7 +58,9 @@ def test_c_jax_and_warp_agree_on_every_kernel():
 def test_the_c_library_and_the_cpp_class_round_trip(tmp_path):
     """``gcc -std=c99 -Wall -Wextra -Werror -pedantic`` and ``g++ -std=c++17 -Wall -Wextra -Werror`` build the
     ankle's library and example; actuator positions, velocities and efforts -> joints (FK, J, J_inv^T) -> actuators
-    (IK, J_inv, J^T) equal the in-process kernels' and come back to 1e-12."""
+    (IK, J_inv, J^T) equal the in-process kernels' and come back to 1e-12. Beyond a stated limit (the motors ±1 rad,
+    the pitch ±0.6 rad): FK of a motor at 1e6 rad (a closed configuration, 1e6 mod 2π) and IK of a pitch of 0.7 rad
+    converge, ``OUTSIDE_LIMITS``, the solution written all the same, in the C as in the in-process kernels."""
     tk = ankle()
     files = write_transmission(tk, tmp_path, ["c"])
     assert set(files) == {"foot.c", "foot.h", "foot_transmission.hpp", "example.cpp", "README.md", "transmission.json"}
@@ -80,11 +82,45 @@ def test_the_c_library_and_the_cpp_class_round_trip(tmp_path):
     assert np.abs(back - np.concatenate([qm, qdm, tau_m])).max() <= 1e-12
     bad = subprocess.run([str(tmp_path / "example"), "nan", *["0"] * 5], capture_output=True, text=True)
     assert bad.returncode == 1 and "fk failed with status 3" in bad.stderr  # (INVALID_INPUT)
+    far = subprocess.run([str(tmp_path / "example"), "1e6", *["0"] * 5], capture_output=True, text=True)
+    assert far.returncode == 1 and f"fk failed with status {STATUS.index('OUTSIDE_LIMITS')}" in far.stderr
+
+    (tmp_path / "limits.c").write_text("""#include <stdio.h>
+#include "foot.h"
+int main(void) {
+  double q[FOOT_NQ], y[FOOT_K], qm[FOOT_K] = {1e6, 0.0}, qo[FOOT_K] = {0.7, 0.0}, ok[FOOT_K] = {0.12, -0.07};
+  double sum = 0.0;
+  int i, s[3];
+  for (i = 0; i < FOOT_NQ; ++i) q[i] = foot_q_reference[i];
+  s[0] = foot_fk(qm, q, y, NULL);
+  for (i = 0; i < FOOT_NQ; ++i) sum += q[i];
+  printf("%d %.17g\\n", s[0], sum);
+  for (i = 0; i < FOOT_NQ; ++i) q[i] = foot_q_reference[i];
+  s[1] = foot_ik(qo, q, y, NULL);
+  printf("%d %.17g %.17g\\n", s[1], y[0], y[1]);
+  for (i = 0; i < FOOT_NQ; ++i) q[i] = foot_q_reference[i];
+  s[2] = foot_fk(ok, q, y, NULL);
+  printf("%d\\n", s[2]);
+  return 0;
+}
+""")
+    subprocess.run(["gcc", "-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", "-pedantic", "-o", "limits", "limits.c",
+                    "foot.o", "-lm"], cwd=tmp_path, check=True, capture_output=True)
+    lines = subprocess.run([str(tmp_path / "limits")], capture_output=True, text=True, check=True).stdout.split("\n")
+    outside = STATUS.index("OUTSIDE_LIMITS")
+    fk, ik, ok = (line.split() for line in lines[:3])
+    ref = tk.mech.q_reference
+    q_fk, _, status, _ = tk.run("fk", ref, np.array([1e6, 0.0]))
+    assert int(fk[0]) == outside == int(status[0]) and abs(float(fk[1]) - q_fk.sum()) <= 1e-6  # (1e6 written)
+    _, qm_ik, status, _ = tk.run("ik", ref, np.array([0.7, 0.0]))
+    assert int(ik[0]) == outside == int(status[0])
+    assert np.abs(np.array(ik[1:], dtype=float) - qm_ik).max() <= 1e-12
+    assert int(ok[0]) == 0
 
 
 @pytest.mark.parametrize("target, extra", [("jax", "jax"), ("warp", "warp")])
 def test_a_missing_extra_is_named(tmp_path, monkeypatch, target, extra):
     monkeypatch.setitem(sys.modules, extra, None)
-    with pytest.raises(MissingDependencyError, match=rf'pkm\[{extra}\]'):
+    with pytest.raises(MissingDependencyError, match=rf'pkm-robotics\[{extra}\]'):
         write_transmission(knee(), tmp_path, ["c", target])
     assert not any(tmp_path.iterdir())  # (checked before anything is written)

@@ -14,6 +14,8 @@ import pytest
 
 import pkm
 from pkm.core.analysis.region import Region, _feasible
+from pkm.core.model.joints import stated_limits
+from pkm.core.transmissions.limits import output_limits
 from pkm.core.transmissions.serial import serial_equivalent, write_serial_equivalent
 from tests.core.transmissions.robots import robot, transmissions
 
@@ -57,7 +59,7 @@ def test_the_box_lies_inside_the_feasible_region_every_corner_checked(ankle_file
     se, (*_, data) = ankle_files
     (t,) = se.transmissions
     region = se.regions[t.name]
-    assert region.corners_checked == 4
+    assert region.points_checked == 4 + 4 * 4
     lo, hi = region.lower, region.upper
     sub = t.mechanism
     bounds = np.array(sub.model.lowerPositionLimit), np.array(sub.model.upperPositionLimit)
@@ -80,3 +82,87 @@ def test_each_sub_mechanism_is_written_loads_back_the_same_and_pickles(ankle_fil
     np.testing.assert_allclose(back.delta_mass(back.q_reference), t.delta_mass(t.q_reference), rtol=1e-12)
     again = pickle.loads(pickle.dumps(t))
     np.testing.assert_allclose(again.velocity_map(t.q_reference), t.velocity_map(t.q_reference), rtol=1e-14)
+
+
+def test_the_welded_bodies_keep_the_whole_robots_mass_and_each_output_its_transmissions_inertia():
+    """battobot: the rods, cranks and motor bodies welded to their parents at the reference, not deleted (0.76 kg,
+    4.4 % of the robot, were): the serial model's mass and centre of mass at the reference are the closed robot's
+    to 1e-12; and each transmission's outputs carry in it what its ``M_s`` says (its diagonal plus the constant
+    armature: Pinocchio's CRBA adds the armature), the convention ``ΔM`` completes."""
+    bot = robot("battobot_6d")
+    se = serial_equivalent(bot, transmissions("battobot_6d"), limits=False)
+    mass = pin.computeTotalMass(bot.model)
+    assert abs(pin.computeTotalMass(se.model) - mass) <= 1e-12 * mass
+    com = pin.centerOfMass(bot.model, bot.model.createData(), bot.q_reference)
+    com_serial = pin.centerOfMass(se.model, se.model.createData(), se.q_reference)
+    assert np.abs(com_serial - com).max() <= 1e-12 * bot.characteristic_length
+    M = pin.crba(se.model, se.model.createData(), se.q_reference)
+    M = np.triu(M) + np.triu(M, 1).T
+    for t in se.transmissions:
+        idx = [se.model.joints[se.model.getJointId(o)].idx_v for o in t.outputs]
+        M_s = t.serial_model(t.q_reference, np.zeros(t.k))[0]
+        expected = M_s + np.diag([se.armature[o] for o in t.outputs])
+        np.testing.assert_allclose(M[np.ix_(idx, idx)], expected, rtol=0, atol=1e-12 * np.abs(M_s).max())
+
+
+def _largest_raster_box(polygon: np.ndarray, point: np.ndarray, n: int = 81) -> float:
+    """The largest area of an axis-aligned box of grid cells inside ``polygon`` (every cell centre in it, even-odd
+    rule) that holds the cell of ``point``: a brute force over the pairs of columns about the point, the rows
+    grown from its row while every cell of the span is inside (an independent route to the largest box)."""
+    lo, hi = polygon.min(axis=0), polygon.max(axis=0)
+    xs, ys = (np.linspace(lo[i], hi[i], n) for i in (0, 1))
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    inside = np.zeros(X.shape, dtype=bool)
+    for (x1, y1), (x2, y2) in zip(polygon, np.roll(polygon, -1, axis=0)):
+        crosses = (y1 > Y) != (y2 > Y)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inside ^= crosses & (X < x1 + (Y - y1) * (x2 - x1) / (y2 - y1))
+    i0, j0 = int(np.argmin(np.abs(xs - point[0]))), int(np.argmin(np.abs(ys - point[1])))
+    cell = (xs[1] - xs[0]) * (ys[1] - ys[0])
+    best = 0.0
+    for a in range(i0 + 1):
+        for b in range(i0, n):
+            rows = inside[a:b + 1].all(axis=0)
+            if not rows[j0]:
+                continue
+            down = j0 - next((j for j in range(j0, -1, -1) if not rows[j]), -1)
+            up = next((j for j in range(j0, n) if not rows[j]), n) - j0
+            best = max(best, (b - a) * (up + down - 2) * cell)
+    return best
+
+
+@pytest.mark.parametrize("ankle", ["foot_assembly", "foot_assembly_2"])
+def test_each_battobot_ankles_box_is_the_largest_its_region_holds_about_the_reference(ankle):
+    """The box was centred on the reference in the polygon's proportions (left ankle 1.7° x 3.0°, the reference
+    1.9° from the region's edge): it is now the largest box that holds the reference, at least 90 % of the largest
+    one a brute force over grid cells finds in the same traced region, its area stated against the region's; a grid
+    of points over it (edges and inside) solved by inverse kinematics lies within every joint's limits."""
+    t = next(x for x in transmissions("battobot_6d") if x.name == ankle)
+    reg = output_limits(t, directions=8, steps=5, tol=1e-4)
+    ref = t.q_reference[t.out_q]
+    area = float(np.prod(reg.upper - reg.lower))
+    assert np.all(reg.lower <= ref) and np.all(ref <= reg.upper) and np.array_equal(reg.around, ref)
+    assert area >= 0.9 * _largest_raster_box(reg.polygon, ref)
+    region = Region(t.outputs, {}, ref, reg.polygon, reg.binding, np.zeros(0), 1e-2)
+    assert reg.area_fraction == pytest.approx(area / region.area, rel=1e-12)
+    assert area >= (np.radians(15.0) * np.radians(23.0))  # (the issue's boxes: 1.7° x 3.0°, 5.8° x 7.6°)
+    lo, hi = (np.array(x) for x in stated_limits(t.mechanism.model))
+    q = t.q_reference
+    for a in np.linspace(0.0, 1.0, 4):
+        for b in np.linspace(0.0, 1.0, 4):
+            _, q = t.motors_from_outputs(reg.lower + np.array([a, b]) * (reg.upper - reg.lower), q)
+            assert np.all(q >= lo - 1e-9) and np.all(q <= hi + 1e-9)
+
+
+def test_a_small_box_is_said_and_a_point_outside_the_region_or_no_output_refused(monkeypatch):
+    """The humanoid knee's interval (the whole traced one: its share 1): under a bound of SMALL_BOX above 1 the
+    warning names the share; ``around`` outside the interval, or naming no output, is refused."""
+    t = transmissions("humanoid_knee")[0]
+    monkeypatch.setattr("pkm.core.transmissions.limits.SMALL_BOX", 1.5)
+    with pytest.warns(pkm.errors.PkmWarning, match=r"'shank': its box limits hold 100 % of the length"):
+        reg = output_limits(t, steps=4, tol=1e-4)
+    assert reg.area_fraction == pytest.approx(1.0, abs=1e-5) and reg.points_checked == 3
+    with pytest.raises(pkm.errors.InvalidInputError, match="outside its feasible interval"):
+        output_limits(t, around=[reg.upper[0] + 0.1], steps=4, tol=1e-4)
+    with pytest.raises(pkm.errors.InvalidInputError, match=r"\['nope'\] are no outputs"):
+        serial_equivalent(robot("humanoid_knee"), [t], around={"nope": 0.1})

@@ -120,11 +120,11 @@ def test_the_source_is_one_statement_per_instruction_and_the_inputs_are_checked(
 
 
 def test_without_jax_the_extra_is_named(monkeypatch):
-    """jax_function raises MissingDependencyError naming pip install "pkm[jax]" when JAX cannot be imported;
+    """jax_function raises MissingDependencyError naming pip install "pkm-robotics[jax]" when JAX cannot be imported;
     jax_source needs no JAX."""
     monkeypatch.setitem(sys.modules, "jax", None)
     fun = _every_operation()
     assert jax_source(fun)
-    with pytest.raises(MissingDependencyError, match=r'pip install "pkm\[jax\]"') as info:
+    with pytest.raises(MissingDependencyError, match=r'pip install "pkm-robotics\[jax\]"') as info:
         jax_function(fun)
     assert info.value.extra == "jax"

@@ -11,6 +11,7 @@ import pinocchio as pin
 import pytest
 
 import pkm
+from pkm.core.model.scale import JacobianScales
 from pkm.core.twin import Twin
 from pkm.core.twin.simulation import difference, integrate, quaternion, task_value
 from tests.core.twin.test_tree import FILES, zoo
@@ -57,7 +58,7 @@ def test_the_task_values_are_task_map_values(name):
     f = cs.Function("task", [tw.q], [task_value(tw)])
     qa = mech.actuated_q(mech.q_reference) + 0.02
     q = pkm.close_loops(mech, qa).q
-    assert np.abs(np.array(f(q)).ravel() - mech.task_map.value(q)).max() <= 1e-14
+    assert np.abs(np.array(f(q)).ravel() - pkm.TaskMap.of(mech).value(q)).max() <= 1e-14
 
 
 def test_the_compiled_singularity_check_reads_the_homogenised_passive_jacobian():
@@ -70,9 +71,9 @@ def test_the_compiled_singularity_check_reads_the_homogenised_passive_jacobian()
     from pkm.core.twin.simulation import Simulator
 
     mech = _mechanism("prs3")
-    assert not mech.jacobian_scales.trivial
+    assert not JacobianScales.of(mech).trivial
     rates = Simulator(Kernels(mech, compiled=False)).functions[1]
     q = pkm.close_loops(mech, mech.actuated_q(mech.q_reference) + 0.02).q
     got = np.array(rates(q, np.zeros(mech.na), [1.0, 1e-3])[5])
-    want = mech.jacobian_scales.constraint(constraints.jacobian(mech, q))[:, mech.passive_v]
+    want = JacobianScales.of(mech).constraint(constraints.jacobian(mech, q))[:, mech.passive_v]
     assert np.abs(got - want).max() <= 1e-12 * np.abs(want).max()

@@ -223,3 +223,17 @@ def test_the_twins_rate_maps_and_newton_step_equal_the_generic_core(name):
     for _ in range(8):
         qp = pin.integrate(mech.model, qp, np.array(step(qp)).ravel())
     assert np.abs(constraints.residual(mech, qp)).max() <= 1e-12
+
+
+def test_the_task_is_built_on_the_twin_and_kept_with_it():
+    """The twin does not import its task (tests/test_import_graph.py): ``TaskTwin.of`` gives one per twin, whose
+    target is laid out as the task map's values, and ``Twin.task`` says where it went."""
+    from pkm.core.twin.task import TaskTwin
+
+    mech = pkm.load("rrr3")
+    tw = Twin(mech)
+    task = TaskTwin.of(tw)
+    assert TaskTwin.of(tw) is task and task.tw is tw
+    assert task.task_target.shape == (pkm.TaskMap.of(mech).value_size, 1)
+    with pytest.raises(AttributeError, match=r"moved to pkm\.core\.twin\.task\.TaskTwin\.of\(twin\)"):
+        tw.task  # noqa: B018

@@ -22,7 +22,7 @@ def test_build_takes_the_users_points_and_the_leg_lengths_are_the_actuated_coord
     mech = _generic(1)
     assert mech.params.base[2] == pytest.approx(tuple(mech.params.base_points[2]))
     assert mech.params.leg_min == pytest.approx(0.3)
-    y = mech.task_map.value(mech.q_reference)
+    y = pkm.TaskMap.of(mech).value(mech.q_reference)
     rho = gs.inverse_kinematics(mech.params, y)
     assert np.allclose(mech.actuated_q(mech.q_reference), rho, atol=1e-12)
     # the universal joints are Pinocchio's, the ball joints point closures
@@ -34,7 +34,7 @@ def test_the_closed_form_inverse_is_the_cores():
     """The leg lengths of a pose equal those of the generic core's inverse kinematics (1e-10 m)."""
     mech = pkm.load("gough_stewart")
     R = pkm.core.zyx_matrix(0.05, -0.08, 0.1)
-    y = gs.task_vector(R, np.array([0.02, -0.03, mech.task_map.value(mech.q_reference)[2] + 0.04]))
+    y = gs.task_vector(R, np.array([0.02, -0.03, pkm.TaskMap.of(mech).value(mech.q_reference)[2] + 0.04]))
     q = pkm.solve_ik(mech, y).q
     assert np.abs(mech.actuated_q(q) - gs.closed_form_ik(mech.params, y)).max() < 1e-10
     with pytest.raises(UnreachableError, match="leg"):
@@ -56,7 +56,7 @@ def test_a_design_of_general_geometry_builds_from_its_points_alone(seed):
     pose with every leg inside the stroke where one is found (else the legs outside are named), away from a
     singularity (a least-squares fit over the whole pose would end on one)."""
     mech = _general(seed)
-    rho = gs.inverse_kinematics(mech.params, mech.task_map.value(mech.q_reference), check_limits=False)
+    rho = gs.inverse_kinematics(mech.params, pkm.TaskMap.of(mech).value(mech.q_reference), check_limits=False)
     outside = {f"leg{i + 1}" for i, r in enumerate(rho) if not mech.params.leg_min <= r <= mech.params.leg_max}
     assert set(mech.outside_limits(mech.q_reference)) == outside
     assert pkm.diagnose(mech, mech.q_reference).classification == "regular"
@@ -74,8 +74,8 @@ def test_generic_data_have_forty_complex_assembly_modes():
     assert modes.complete and modes.n_paths == 40
     assert len(modes) + modes.n_complex == 40 and modes.n_infinite == modes.n_exceptional == 0
     assert len(modes) >= 2 and len(modes) % 2 == 0  # complex solutions come in conjugate pairs
-    ref = mech.task_map.value(mech.q_reference)
-    assert min(np.abs(mech.task_map.value(m.q) - ref).max() for m in modes) < 1e-9  # the reference is one
+    ref = pkm.TaskMap.of(mech).value(mech.q_reference)
+    assert min(np.abs(pkm.TaskMap.of(mech).value(m.q) - ref).max() for m in modes) < 1e-9  # the reference is one
 
 
 @pytest.mark.parametrize("bad", [dict(base=[[0.0, 0.0, 0.0]] * 5), dict(platform=[[0.1, 0.0, 0.0]] * 6),

@@ -1,11 +1,12 @@
-"""``pkm calibrate MECH DATA --out DIR [--model pose|position|planar|passive] [--loss L] [--plot FILE.png]
-[--json]``: the kinematic calibration of a mechanism from a table of actuator readings and measurements
+"""``pkm calibrate MECH DATA --out DIR [--model pose|position|planar|passive] [--loss L] [--max-evaluations N]
+[--plot FILE.png] [--json]``: the kinematic calibration of a mechanism from a table of actuator readings and measurements
 (:mod:`pkm.core.calibration.writeback`): its identifiable (base) geometric parameters estimated with their standard
 deviations, the pose errors before and after, the calibrated mechanism written into ``DIR`` (a closure spec + URDF
 that ``pkm.load`` reads, and ``calibration.toml`` with the actuator offsets and gains and the measurement frames).
 
 ``pkm calibrate plan MECH --poses N --out poses.csv [--model M] [--spread S] [--simulate SEED]``: N poses chosen to
-maximise the observability index O1 within the joint limits and a singularity margin
+maximise the observability index O1 within the joint limits and a singularity margin, the readings within ``S`` of
+the reference (default 0.2 rad, or 0.2 x the characteristic length for a prismatic actuator)
 (:mod:`pkm.core.calibration.poses`); with ``--simulate``, the table filled with what an instrument would measure on
 a randomly perturbed robot (every joint origin within 2 mm and 0.5 degrees, noise 10 µm and 20 µrad): what ``pkm
 calibrate`` then reads."""
@@ -29,7 +30,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--model", default="pose", choices=("pose", "position", "planar", "passive"), help=KIND_HELP)
     p.add_argument("--loss", default="linear", choices=("linear", "soft_l1", "huber", "cauchy", "arctan"),
                    help="least-squares loss: linear (Levenberg-Marquardt) or a robust one (trust-region)")
-    p.add_argument("--plot", metavar="FILE.png", help="the residuals before and after, per pose (pkm[figures])")
+    p.add_argument("--max-evaluations", type=int, metavar="N",
+                   help="the least squares' budget of residual evaluations (default 100 per estimated parameter: "
+                        "pkm.core.calibration.estimate.NFEV_PER_PARAMETER)")
+    p.add_argument("--plot", metavar="FILE.png", help="the residuals before and after, per pose (pkm-robotics[figures])")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
 
 
@@ -43,10 +47,10 @@ def run(args: argparse.Namespace) -> int:
     mech = load_mechanism(args)
     model = CalibrationModel(mech, args.model)
     M, Y = read_data(model, args.data)
-    cal = calibrate(model, M, Y, loss=args.loss)
+    cal = calibrate(model, M, Y, loss=args.loss, max_nfev=args.max_evaluations)
     spec, toml, *mjcf = write_calibrated(cal, args.out)
     out: dict[str, Any] = {"mechanism": mech.name, "model": args.model, "poses": len(M), "base": len(cal.free),
-                           "chi2": cal.chi2, "before": cal.before.as_dict(), "after": cal.after.as_dict(),
+                           "chi2": cal.chi2, "evaluations": cal.nfev, "before": cal.before.as_dict(), "after": cal.after.as_dict(),
                            "estimated": {n: {"change": d, "std": s} for n, (d, s) in cal.changes().items()},
                            "unseen": list(cal.base.unseen), "spec": str(spec), "calibration": str(toml),
                            "mjcf": str(mjcf[0]) if mjcf else None}
@@ -56,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(out, indent=1))
         return 0
     print(f"{mech.name}: {len(M)} poses, {args.model} measurements, {len(cal.free)} base parameters of "
-          f"{len(model.names)} (reduced chi-square {cal.chi2:.3g})")
+          f"{len(model.names)} (reduced chi-square {cal.chi2:.3g}, {cal.nfev} evaluations)")
     for label, acc in (("before", cal.before), ("after", cal.after)):
         text = ", ".join(f"{k} {v:.4g}" for k, v in acc.as_dict().items())
         print(f"{label}: {text} (m, rad)")
@@ -92,7 +96,10 @@ def add_plan_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--poses", type=int, required=True, help="how many poses")
     p.add_argument("--out", metavar="FILE.csv", required=True, help="the table of readings (and measurements)")
     p.add_argument("--model", default="pose", choices=("pose", "position", "planar", "passive"), help=KIND_HELP)
-    p.add_argument("--spread", type=float, default=0.1, help="largest change of a reading from the reference [rad or m]")
+    p.add_argument("--spread", type=float,
+                   help="largest change of a reading from the reference [rad or m] (default 0.2 rad for a revolute "
+                        "actuator, 0.2 x the mechanism's characteristic length for a prismatic one: "
+                        "pkm.core.calibration.poses.SPREAD)")
     p.add_argument("--simulate", type=int, metavar="SEED", help="fill in simulated measurements of a perturbed robot")
 
 

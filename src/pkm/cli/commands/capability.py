@@ -16,6 +16,7 @@ import argparse
 import json
 from typing import Any
 
+import pkm
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, configuration, load_mechanism
 from pkm.cli.output import outside_limits, outside_line
@@ -28,7 +29,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-gravity", action="store_true", help="leave the mechanism's weight out")
     p.add_argument("--axis", metavar="NAME=START:STOP:COUNT", action="append", default=[],
                    help="map the capability over this task coordinate (once or twice)")
-    p.add_argument("--png", metavar="FILE", help="with --axis: draw the largest isotropic value (pkm[figures])")
+    p.add_argument("--png", metavar="FILE",
+                   help="with --axis: draw the largest isotropic value (pkm-robotics[figures])")
     p.add_argument("--csv", metavar="FILE", help="with --axis: every node's indices")
     p.add_argument("--json", action="store_true", help="print JSON (SI, units per axis, the polytopes)")
 
@@ -44,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
         return _map(mech, args)
     q = configuration(mech, args)
     limits = limit_sources(mech)
-    out: dict[str, Any] = {"mechanism": mech.name, "task": mech.task_map.named(q),
+    out: dict[str, Any] = {"mechanism": mech.name, "task": pkm.TaskMap.of(mech).named(q),
                            "limits": {j: {f: {"value": v, "source": src} for f, (v, src) in row.items()
                                           if f != "peak_effort"} for j, row in limits.items()},
                            "placeholder_limits": any(w.kind == "limits" for w in findings(mech)),

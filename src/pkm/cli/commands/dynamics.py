@@ -43,17 +43,18 @@ def model_dict(mech: pkm.Mechanism, model: ActuatorSpaceModel) -> dict[str, Any]
         "mechanism": mech.name,
         "actuated": dict(zip(names, mech.actuated_q(model.q))),
         "rates": dict(zip(names, model.qd)),
-        "task": mech.task_map.named(model.q),
+        "task": pkm.TaskMap.of(mech).named(model.q),
         "M": {a: dict(zip(names, row)) for a, row in zip(names, model.M)},
         "h": dict(zip(names, model.h)),
         "g": dict(zip(names, model.g)),
         "friction": dict(zip(names, model.friction)) if has_friction else None,
         "idle_motions": int(model.idle.shape[1]),
         "outside_limits": outside_limits(mech, model.q),
+        "base": model.base,
         "units": {
             "actuated": {n: "rad" if r else "m" for n, r in zip(names, revolute)},
             "rates": {n: "rad/s" if r else "m/s" for n, r in zip(names, revolute)},
-            "task": {k: "rad" if kind == "angle" else "m" for k, kind in mech.task_map.kinds.items()},
+            "task": {k: "rad" if kind == "angle" else "m" for k, kind in pkm.TaskMap.of(mech).kinds.items()},
             "M": {a: {b: _mass_unit(ra, rb) for b, rb in zip(names, revolute)} for a, ra in zip(names, revolute)},
             "h": effort, "g": effort, "friction": effort,
             "note": "M_a qdd + h_a = tau_a + friction; h_a: Coriolis, centrifugal, gravity and closure-drift efforts, "
@@ -88,6 +89,8 @@ def text(out: dict[str, Any]) -> str:
         lines += [f"  {n.ljust(width)}{_value(out[key][n], units[key][n]).rjust(col)}" for n in names]
     if out["outside_limits"]:
         lines.append(outside_line(out["outside_limits"]))
+    if out["base"] == "free":
+        lines.append("floating base: free (no wrench on it; its motion eliminated from M_a, h_a, g_a)")
     if out["idle_motions"]:
         lines.append(f"idle motions: {out['idle_motions']} (left out of the state: their rates are those of least kinetic energy)")
     return "\n".join(lines)

@@ -27,7 +27,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--tie-legs", action="store_true", help="condition the tied base parameters (legs alike)")
     p.add_argument("--out", metavar="FILE.csv", required=True, help="the samples table")
     p.add_argument("--motion", metavar="FILE.toml", help="also write the series as a motion file (pkm.motion)")
-    p.add_argument("--plot", metavar="FILE.png", help="draw positions, rates and efforts (pkm[figures])")
+    p.add_argument("--plot", metavar="FILE.png", help="draw positions, rates and efforts (pkm-robotics[figures])")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
 

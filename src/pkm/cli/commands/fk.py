@@ -14,7 +14,8 @@ from pkm.cli.parsing import parse_joints, parse_seed
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_mechanism_arguments(p, None, "required")
-    p.add_argument("--all", action="store_true", help="every assembly mode (homotopy continuation, pkm[homotopy])")
+    p.add_argument("--all", action="store_true",
+                   help="every assembly mode (homotopy continuation, pkm-robotics[homotopy])")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -2,16 +2,16 @@
 [--cutoff HZ] [--plot FILE.png] [--json]``: the dynamic parameters of a mechanism from its measurements (a table of
 ``time``, ``q.<joint>``, ``tau.<joint>``: :mod:`pkm.core.identification.measurements`): the base parameters by
 Gautier's weighted least squares with each one's relative standard deviation, with ``--consistent`` the physically
-consistent estimate (cvxpy and Clarabel: ``pkm[identify]``), written as a spec and URDF that ``pkm.load`` reads; with
-``--validate`` the identified model's efforts against a second table.
+consistent estimate (cvxpy and Clarabel: ``pkm-robotics[identify]``), written as a spec and URDF that ``pkm.load``
+reads; with ``--validate`` the identified model's efforts against a second table.
 
 The table printed (and ``base`` in ``--json``) holds, per base parameter, its value in the model written (``value``:
 ``P θ`` of the spec and URDF saved, so the consistent estimate's with ``--consistent``; an effort offset is not
 written, a drive's negative friction is written as 0), then the least-squares estimate, its standard deviation and
-relative standard deviation; the fit (or ``--validate``'s prediction) is the estimate's, its effort offsets
-included; the samples used, the decimation and the filter's cutoff are printed, and the
-estimate's warnings (:class:`~pkm.errors.PoorIdentificationWarning`: too few equations, parameters that cannot be
-told from zero)."""
+relative standard deviation (``--json``: also its ``effort_share`` and whether it is ``poor``ly identified,
+:mod:`pkm.core.identification.estimate`); the fit (or ``--validate``'s prediction) is the estimate's, its effort
+offsets included; the samples used, the decimation and the filter's cutoff are printed, and the estimate's warnings
+(:class:`~pkm.errors.PoorIdentificationWarning`: too few equations, poorly identified parameters)."""
 
 from __future__ import annotations
 
@@ -28,10 +28,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("data", metavar="DATA", help="measurements: CSV or Parquet with time, q.<joint>, tau.<joint>")
     p.add_argument("--out", metavar="FILE.closures.toml", required=True, help="the identified spec (URDF beside it)")
     p.add_argument("--tie-legs", action="store_true", help="one parameter set per kind of leg")
-    p.add_argument("--consistent", action="store_true", help="physically consistent estimate (pkm[identify])")
+    p.add_argument("--consistent", action="store_true", help="physically consistent estimate (pkm-robotics[identify])")
     p.add_argument("--validate", metavar="OTHER", help="a second table to predict")
-    p.add_argument("--cutoff", type=float, help="the zero-phase filter's cutoff [Hz] (default: a tenth of the rate)")
-    p.add_argument("--plot", metavar="FILE.png", help="measured against predicted efforts (pkm[figures])")
+    p.add_argument("--cutoff", type=float,
+                   help="the zero-phase filter's cutoff [Hz] (default: a tenth of the sampling rate); the filtered "
+                        "rows are then decimated to one in rate / (2 cutoff) and 3 cutoff periods left out at each "
+                        "end: a low cutoff keeps few rows (the rows kept are reported)")
+    p.add_argument("--plot", metavar="FILE.png", help="measured against predicted efforts (pkm-robotics[figures])")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
 
 
@@ -41,7 +44,7 @@ def run(args: argparse.Namespace) -> int:
     import pkm
     from pkm._optional import require
     from pkm.core.identification.base import base_parameters
-    from pkm.core.identification.estimate import POOR_RELATIVE_STD, estimate
+    from pkm.core.identification.estimate import POOR_EFFORT_SHARE, POOR_RELATIVE_STD, estimate
     from pkm.core.identification.export import identified_mechanism, standard_from_base, validate
     from pkm.core.identification.measurements import measurements
     from pkm.core.identification.regressor import parameters
@@ -67,7 +70,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         theta = standard_from_base(mech, base, ls.values)
     try:
-        identified = identified_mechanism(mech, theta)
+        identified = identified_mechanism(mech, theta, source=args.out)  # (what a warning is about: the file written)
     except (SpecError, InvalidInputError) as exc:
         if args.consistent:
             raise
@@ -80,8 +83,9 @@ def run(args: argparse.Namespace) -> int:
         "equations": ls.rows, "cutoff_hz": data.cutoff, "method": ls.method,
         "consistent": bool(args.consistent), "routes_agree": base.routes_agree,
         "base": [{"name": n, "value": float(w), "least_squares": float(v), "std": float(s),
-                  "relative_std_percent": float(r)}
-                 for n, w, v, s, r in zip(base.names, written, ls.values, ls.std, ls.relative_std)],
+                  "relative_std_percent": float(r), "effort_share": float(e), "poor": bool(p)}
+                 for n, w, v, s, r, e, p in zip(base.names, written, ls.values, ls.std, ls.relative_std,
+                                                ls.effort_share, ls.poor)],
         "residual_rms": dict(zip(mech.actuated_names, ls.residual_rms.tolist())),
         "warnings": list(ls.warnings),
         "out": str(pkm.save(identified, args.out)),
@@ -107,10 +111,11 @@ def run(args: argparse.Namespace) -> int:
           f"each end); the two rank routes {'agree' if base.routes_agree else 'DISAGREE'}")
     estimate_name = "physically consistent estimate" if args.consistent else f"least squares ({ls.method})"
     print(f"the model written ({estimate_name}); least squares ({ls.method}) ± standard deviation (relative), "
-          f"'!' above {POOR_RELATIVE_STD:g} %:")
+          f"'!' poorly identified (above {POOR_RELATIVE_STD:g} % and a deviation worth more than "
+          f"{100 * POOR_EFFORT_SHARE:g} % of the efforts):")
     width = max(len(n) for n in base.names)
     for row in out["base"]:
-        flag = "!" if not row["relative_std_percent"] <= POOR_RELATIVE_STD else " "
+        flag = "!" if row["poor"] else " "
         print(f"  {row['name'].ljust(width)}  {row['value']: .6g}  ({row['least_squares']: .6g} ± {row['std']:.2g}, "
               f"{row['relative_std_percent']:.3g} %){flag}")
     key = "validation" if args.validate else "fit"

@@ -98,9 +98,9 @@ def describe(name: str, mech: pkm.Mechanism | None = None) -> dict[str, Any]:
                            "title": entry.title if entry else mech.spec.description,
                            **source(name, mech),
                            "actuated": {j: SI_UNITS[joint_kind(mech, j)] for j in mech.actuated_names},
-                           "task": {k: SI_UNITS[kind] for k, kind in mech.task_map.kinds.items()},
+                           "task": {k: SI_UNITS[kind] for k, kind in pkm.TaskMap.of(mech).kinds.items()},
                            "task_origin": entry.origin if entry else frame,
-                           "reference_pose": mech.task_map.named(mech.q_reference),
+                           "reference_pose": pkm.TaskMap.of(mech).named(mech.q_reference),
                            "branches": list(mech.spec.branches),
                            "default_branch": mech.spec.default_branch,
                            "joints": len(mech.joints), "loops": len(mech.spec.closures)}

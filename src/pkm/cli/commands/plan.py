@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+import pkm
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, load_mechanism
 from pkm.errors import InvalidInputError
@@ -41,11 +42,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "the drives' own peak efforts and speed limits)")
     p.add_argument("--points", metavar="N", type=int, default=1000, help="grid points along the path (default 1000)")
     p.add_argument("--out", metavar="FILE", required=True, help="the trajectory: CSV when FILE ends in .csv, else "
-                                                                "Parquet (pkm[sweeps])")
+                                                                "Parquet (pkm-robotics[sweeps])")
     p.add_argument("--motion", metavar="FILE.toml", help="the motors' motion as a pkm.motion file (hermite laws of "
                                                          "the actuated joints; default: FILE of --out with the "
                                                          "suffix .motion.toml)")
-    p.add_argument("--plot", metavar="FILE.png", help="the speed profile, the active limit marked (pkm[figures])")
+    p.add_argument("--plot", metavar="FILE.png",
+                   help="the speed profile, the active limit marked (pkm-robotics[figures])")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
 
@@ -64,8 +66,9 @@ def read_path(mech: Mechanism, text: str, coordinates: str | None = None) -> tup
             start = [float(v) for v in text[6:].split(",")]
         except ValueError:
             raise InvalidInputError("--path", "adept:X,Y,Z: three numbers [m]", text) from None
-        if mech.task_map.value_names != ("x", "y", "z"):
-            raise InvalidInputError("--path", "the adept cycle is a path of a task x, y, z", mech.task_map.value_names)
+        task = pkm.TaskMap.of(mech).value_names
+        if task != ("x", "y", "z"):
+            raise InvalidInputError("--path", "the adept cycle is a path of a task x, y, z", task)
         return adept_waypoints(start), "task"
     file, case = text.rsplit(":", 1) if ".toml:" in text else (text, "")
     if file.endswith(".toml"):
@@ -83,9 +86,9 @@ def read_path(mech: Mechanism, text: str, coordinates: str | None = None) -> tup
     with path.open(newline="", encoding="utf-8") as fh:
         rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
     header = tuple(c.strip() for c in rows[0]) if rows else ()
-    spaces = {tuple(mech.task_map.value_names): "task", tuple(mech.actuated_names): "actuated"}
+    spaces = {tuple(pkm.TaskMap.of(mech).value_names): "task", tuple(mech.actuated_names): "actuated"}
     if header not in spaces:
-        raise InvalidInputError("--path", f"{file}: the header must read {','.join(mech.task_map.value_names)} "
+        raise InvalidInputError("--path", f"{file}: the header must read {','.join(pkm.TaskMap.of(mech).value_names)} "
                                           f"(task) or {','.join(mech.actuated_names)} (actuated)", header)
     try:
         values = np.array([[float(c) for c in r] for r in rows[1:]])
@@ -103,7 +106,7 @@ def columns(plan: TimeOptimal) -> dict[str, np.ndarray]:
         cols[f"{name}.rate"] = plan.qa_rate[:, i]
         cols[f"{name}.acceleration"] = plan.qa_acceleration[:, i]
         cols[f"{name}.effort"] = plan.efforts[:, i]
-    names = plan.mech.task_map.value_names if plan.path.space == "task" else ()
+    names = pkm.TaskMap.of(plan.mech).value_names if plan.path.space == "task" else ()
     for i, name in enumerate(names):
         cols[f"path.{name}"] = plan.coefficients.y[:, i]
     return cols

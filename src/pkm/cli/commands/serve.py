@@ -21,7 +21,7 @@ def routes() -> list[tuple[str, str, str]]:
     job kind (404 naming the valid ones) are left out; the summary is the route's own, else its description's first line, else its name.
 
     Raises:
-        MissingDependencyError: pkm[serve] is not installed.
+        MissingDependencyError: pkm-robotics[serve] is not installed.
     """
     from starlette.routing import Mount, WebSocketRoute
 

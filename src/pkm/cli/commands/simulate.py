@@ -50,9 +50,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-limits", action="store_true", help="do not stop at position or speed limits")
     p.add_argument("--no-saturate", action="store_true", help="apply the efforts asked for beyond the actuators' "
                                                               "limits (default: clip them; the summary counts them)")
-    p.add_argument("--out", metavar="FILE", required=True, help="the samples: Parquet (pkm[sweeps]), or CSV when FILE "
-                                                                "ends in .csv")
-    p.add_argument("--plot", metavar="FILE.png", help="draw positions, speeds, efforts and energies (pkm[figures])")
+    p.add_argument("--out", metavar="FILE", required=True,
+                   help="the samples: Parquet (pkm-robotics[sweeps]), or CSV when FILE ends in .csv")
+    p.add_argument("--plot", metavar="FILE.png",
+                   help="draw positions, speeds, efforts and energies (pkm-robotics[figures])")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
 

@@ -1,9 +1,10 @@
 """Capability under actuator limits: the task wrenches, twists and accelerations the actuators can produce at a pose.
 
-Everything here is in the mechanism's **task coordinates** ``y`` (:attr:`pkm.Mechanism.task_map`), with the forward
-Jacobian ``J`` (``ẏ = J q̇_a``, :func:`pkm.forward_jacobian`); the efforts ``w`` conjugate to them are those whose
-power is the actuators' (``wᵀ ẏ = τ_aᵀ q̇_a``, so ``τ_a = Jᵀ w``): forces [N] on length coordinates, moments [N m]
-about an angle coordinate's own axis on angles (at zero angles, the platform frame's axes).
+Everything here is in the mechanism's **task coordinates** ``y`` (:meth:`pkm.TaskMap.of(mech)
+<pkm.core.kinematics.task.TaskMap.of>`), with the forward Jacobian ``J`` (``ẏ = J q̇_a``,
+:func:`pkm.forward_jacobian`); the efforts ``w`` conjugate to them are those whose power is the actuators'
+(``wᵀ ẏ = τ_aᵀ q̇_a``, so ``τ_a = Jᵀ w``): forces [N] on length coordinates, moments [N m] about an
+angle coordinate's own axis on angles (at zero angles, the platform frame's axes).
 
 * **Wrenches** (static): ``{w : τ_min ≤ Jᵀ w + g_a ≤ τ_max}``: what the platform can hold, the actuators also
   holding the mechanism's own weight ``g_a`` (:func:`pkm.gravity_efforts`; ``gravity=False`` leaves it out).
@@ -37,7 +38,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, SingularityError
 
 if TYPE_CHECKING:
@@ -178,7 +181,7 @@ def capability(mech: Mechanism, q: ArrayLike, kind: str = "wrench", *, gravity: 
     if J.shape[0] != J.shape[1]:
         raise InvalidInputError("mech", f"{J.shape[1]} actuators for {J.shape[0]} task coordinates: the capability of "
                                         "redundant actuation needs a hull (pycapacity's force_polytope)", J.shape)
-    s = np.linalg.svd(mech.jacobian_scales.forward(J), compute_uv=False)  # (homogenised: the same at any size)
+    s = np.linalg.svd(JacobianScales.of(mech).forward(J), compute_uv=False)  # (homogenised: the same at any size)
     if not s[-1] > 1e-12 * s[0]:
         raise SingularityError("inverse" if s[-1] == 0.0 else "direct", float(s[-1]),
                                "the forward Jacobian is singular here: the capability is unbounded or flat",
@@ -198,7 +201,7 @@ def capability(mech: Mechanism, q: ArrayLike, kind: str = "wrench", *, gravity: 
             L = J @ np.linalg.inv(model.M)
             c = -L @ (model.h if gravity else model.h - model.g)
     V, A, b = _box_map(L, c, lo, hi)
-    kinds = mech.task_map.kinds
+    kinds = TaskMap.of(mech).kinds
     axes = tuple(kinds)
     units = tuple(UNITS[kind][kinds[a]] for a in axes)
     poly = Polytope(V, A, b, axes, units)
@@ -239,7 +242,7 @@ def capability_indices(mech: Mechanism, Q: ArrayLike, kind: str = "wrench", *, g
     if J.shape[1] != J.shape[2]:
         raise InvalidInputError("mech", f"{J.shape[2]} actuators for {J.shape[1]} task coordinates: the capability "
                                         "of redundant actuation needs a hull", J.shape[1:])
-    s = np.linalg.svd(mech.jacobian_scales.forward(J), compute_uv=False)
+    s = np.linalg.svd(JacobianScales.of(mech).forward(J), compute_uv=False)
     regular = s[:, -1] > 1e-12 * s[:, 0]
     J = np.where(regular[:, None, None], J, np.eye(J.shape[1]))  # (singular samples: NaN below)
     shift = kernels.gravity(Q) if gravity and kind != "twist" else np.zeros((len(Q), mech.na))
@@ -252,7 +255,7 @@ def capability_indices(mech: Mechanism, Q: ArrayLike, kind: str = "wrench", *, g
     A = np.concatenate([P, -P], axis=1)  # (n, 2 na, t): A x <= b
     b = np.concatenate([hi - shift, -lo + shift], axis=1)
     inside = np.all(b > 0.0, axis=1)
-    kinds = mech.task_map.kinds
+    kinds = TaskMap.of(mech).kinds
     axes = tuple(kinds)
     units = tuple(UNITS[kind][kinds[a]] for a in axes)
 
@@ -293,9 +296,9 @@ def map_capability(mech: Mechanism, wmap: WorkspaceMap, kind: str = "wrench", *,
     reachable[nodes[regular]] = True
     inside = np.zeros(int(np.prod(shape)), dtype=bool)
     inside[nodes[inside_n]] = True
-    kinds = mech.task_map.kinds
+    kinds = TaskMap.of(mech).kinds
     names = {n for n, _ in wmap.axes}
-    fixed = {k: float(v) for k, v in zip(mech.task_map.value_names, wmap.fixed) if k not in names}
+    fixed = {k: float(v) for k, v in zip(TaskMap.of(mech).value_names, wmap.fixed) if k not in names}
     return CapabilityMap(kind, wmap.axes, fixed, reachable.reshape(shape),
                          {a: (spread(p), spread(m)) for a, (p, m) in along_n.items()},
                          {u: spread(v) for u, v in iso_n.items()},
@@ -350,7 +353,7 @@ class CapabilityMap:
         torque map) (1 axis: a curve; 2 axes: a colour map with its colour bar; unreachable nodes blank).
 
         Raises:
-            MissingDependencyError: matplotlib is not installed (``pip install "pkm[figures]"``).
+            MissingDependencyError: matplotlib is not installed (``pip install "pkm-robotics[figures]"``).
             InvalidInputError: an unknown unit or axis.
         """
         from pathlib import Path
@@ -455,7 +458,7 @@ def capability_map(mech: Mechanism, axes: Mapping[str, ArrayLike], fixed: Mappin
     mech = check_mechanism(mech)
     if kind not in KINDS:
         raise InvalidInputError("kind", f"use one of {list(KINDS)}, got {kind!r}", kind)
-    names = list(mech.task_map.kinds)
+    names = list(TaskMap.of(mech).kinds)
     if not isinstance(axes, Mapping) or not 1 <= len(axes) <= 2:
         raise InvalidInputError("axes", "expected one or two task coordinates by name", axes)
     grid = []
@@ -498,7 +501,7 @@ def capability_map(mech: Mechanism, axes: Mapping[str, ArrayLike], fixed: Mappin
             units = dict(zip(c.polytope.axes, c.polytope.units))
             for u, r in c.isotropic.items():
                 iso.setdefault(u, np.full(shape, np.nan))[idx] = r
-    return CapabilityMap(kind, tuple(grid), rest, reachable, along, iso, units, dict(mech.task_map.kinds), mech.name,
+    return CapabilityMap(kind, tuple(grid), rest, reachable, along, iso, units, dict(TaskMap.of(mech).kinds), mech.name,
                          inside)
 
 

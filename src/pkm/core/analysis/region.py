@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PkmError, PkmWarning
@@ -92,6 +93,63 @@ class Region:
             lo, hi = (mid, hi) if fits(mid) else (lo, mid)
         return lo * shape
 
+    def largest_box(self, around: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """``(lower, upper)``: the axis-aligned box of the largest area inside the polygon that holds ``around`` (a
+        point of the plane inside it; default the center), not necessarily centred on it (:func:`largest_box`)."""
+        point = self.center if around is None else np.asarray(around, dtype=float)
+        if point.shape != (2,) or not np.isfinite(point).all() or not self.contains(point):
+            raise InvalidInputError("around", f"expected a point of the plane ({self.axes[0]}, {self.axes[1]}) inside "
+                                    "the feasible region", around)
+        return largest_box(self.vertices, point)
+
+
+def largest_box(vertices: np.ndarray, point: np.ndarray, *, cells: int = 64, rounds: int = 6) \
+        -> tuple[np.ndarray, np.ndarray]:
+    """``(lower, upper)``: the axis-aligned box of the largest area inside the polygon ``vertices`` (n x 2) that
+    holds ``point`` (inside it). For a span ``[a, b]`` of the first axis about the point, every edge's part over the
+    span lies wholly above the point (it bounds the box's top by its lowest y), wholly below (the bottom by its
+    highest y), or crosses the point's level (no box over that span): the tallest box of each span, exactly; the
+    spans are searched on a ``cells`` x ``cells`` grid, refined ``rounds`` times about the best (each round a grid
+    of four cells' width), so the area found is the optimum's to the last round's cell. A box so bounded meets no
+    edge and holds a point inside: it lies inside the polygon."""
+    x0, y0 = (float(v) for v in point)
+    p, q = vertices, np.roll(vertices, -1, axis=0)
+    lo_x, hi_x = float(vertices[:, 0].min()), float(vertices[:, 0].max())
+
+    def tallest(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The tallest box over each span ``[a, b]`` (arrays): its bottom, top and area (0 where none)."""
+        a, b = a[..., None], b[..., None]
+        dx = q[:, 0] - p[:, 0]
+        flat = np.abs(dx) <= 1e-300
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ta, tb = (a - p[:, 0]) / dx, (b - p[:, 0]) / dx
+        t0 = np.where(flat, 0.0, np.clip(np.minimum(ta, tb), 0.0, 1.0))
+        t1 = np.where(flat, 1.0, np.clip(np.maximum(ta, tb), 0.0, 1.0))
+        inside = np.where(flat, (p[:, 0] >= a) & (p[:, 0] <= b), (t0 <= t1) & ~((ta < 0) & (tb < 0))
+                          & ~((ta > 1) & (tb > 1)))
+        ya, yb = p[:, 1] + t0 * (q[:, 1] - p[:, 1]), p[:, 1] + t1 * (q[:, 1] - p[:, 1])
+        ymin, ymax = np.minimum(ya, yb), np.maximum(ya, yb)
+        top = np.where(inside & (ymin > y0), ymin, np.inf).min(axis=-1)
+        bottom = np.where(inside & (ymax < y0), ymax, -np.inf).max(axis=-1)
+        crossed = (inside & (ymin <= y0) & (ymax >= y0)).any(axis=-1)
+        area = np.where(crossed | ~np.isfinite(top - bottom), 0.0, (b[..., 0] - a[..., 0]) * (top - bottom))
+        return bottom, top, area
+
+    ranges = [(lo_x, x0), (x0, hi_x)]
+    best = (x0, x0)
+    for _ in range(rounds + 1):
+        a, b = np.meshgrid(np.linspace(*ranges[0], cells + 1), np.linspace(*ranges[1], cells + 1), indexing="ij")
+        area = tallest(a, b)[2]
+        i, j = np.unravel_index(int(np.argmax(area)), area.shape)
+        if area[i, j] > 0.0:
+            best = (float(a[i, j]), float(b[i, j]))
+        wa, wb = 2.0 * (ranges[0][1] - ranges[0][0]) / cells, 2.0 * (ranges[1][1] - ranges[1][0]) / cells
+        ranges = [(max(lo_x, best[0] - wa), min(x0, best[0] + wa)), (max(x0, best[1] - wb), min(hi_x, best[1] + wb))]
+    bottom, top, _ = tallest(np.array(best[0]), np.array(best[1]))
+    if not np.isfinite(top - bottom):
+        return np.array(point, dtype=float), np.array(point, dtype=float)
+    return np.array([best[0], float(bottom)]), np.array([best[1], float(top)])
+
 
 def _feasible(mech: Mechanism, target: dict[str, float], q0: np.ndarray, lo: np.ndarray, hi: np.ndarray,
               singularity: float) -> tuple[np.ndarray | None, str]:
@@ -126,7 +184,7 @@ def other_coordinates(mech: Mechanism, axes: object, fixed: Mapping[str, float] 
     """
     if fixed is not None and not isinstance(fixed, Mapping):
         raise InvalidInputError("fixed", "expected {task coordinate: value}", fixed)
-    reference = mech.task_map.named(mech.q_reference)
+    reference = TaskMap.of(mech).named(mech.q_reference)
     rest = {k: float(x) for k, x in reference.items() if k not in axes}  # type: ignore[operator]
     for k, x in (fixed or {}).items():
         if k not in rest:
@@ -190,7 +248,7 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
         (1.762, True)
     """
     mech = check_mechanism(mech)
-    names = list(mech.task_map.kinds)
+    names = list(TaskMap.of(mech).kinds)
     if not isinstance(axes, (tuple, list)) or len(axes) != 2 or axes[0] == axes[1] or any(a not in names
                                                                                         for a in axes):
         raise InvalidInputError("axes", f"expected two distinct task coordinates among {names}", axes)
@@ -216,7 +274,7 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
         lo[jm.idx_q:jm.idx_q + jm.nq] = low
         hi[jm.idx_q:jm.idx_q + jm.nq] = high
     rest = other_coordinates(mech, axes, fixed)
-    reference = mech.task_map.named(mech.q_reference)
+    reference = TaskMap.of(mech).named(mech.q_reference)
     center = np.array([reference[axes[0]], reference[axes[1]]], dtype=float)
 
     def at(point: np.ndarray, q0: np.ndarray) -> tuple[np.ndarray | None, str]:
@@ -243,4 +301,4 @@ def feasible_region(mech: Mechanism, axes: tuple[str, str], *, fixed: Mapping[st
     return Region((axes[0], axes[1]), rest, center, np.array(vertices), tuple(binding), angles, singularity)
 
 
-__all__ = ["SINGULARITY", "Region", "feasible_region", "march", "other_coordinates"]
+__all__ = ["SINGULARITY", "Region", "feasible_region", "largest_box", "march", "other_coordinates"]

@@ -42,6 +42,7 @@ from pkm.core.calibration.parameters import KINDS, CalibrationParameters, calibr
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.origins import ORIGIN
 from pkm.errors import ConvergenceError, InvalidInputError, PkmError, UnknownNameError
+from pkm.validation import wrap_angle
 
 #: The closure is solved to this infinity norm, relative to the mechanism's characteristic length [m / m, rad].
 CLOSURE_TOL = 1e-13
@@ -338,7 +339,7 @@ class CalibrationModel:
             return r, np.concatenate([J[:, :3, :], _vee(dA)], axis=1)
         r = y - Ym
         if self.kind == "planar":
-            r[:, 2] = np.angle(np.exp(1j * r[:, 2]))
+            r[:, 2] = wrap_angle(r[:, 2])
         return r, J
 
     def mechanism(self, x: ArrayLike | None = None) -> Mechanism:

@@ -7,8 +7,8 @@ model measures: ``x, y, z`` [m] and ``roll, pitch, yaw`` [rad] (URDF's ``Rz(yaw)
 for ``passive``. Other columns are ignored.
 
 **What is refused** (:class:`~pkm.errors.InvalidInputError` naming the row and the column): a missing column, a
-value that is not a finite number (NaN rows), a reading outside the joint's limits or beyond 2 pi rad / 10 m (a
-table in degrees or millimetres), a measured position farther from the base than ten times the mechanism's size
+value that is not a finite number (NaN rows), a reading outside the joint's limits or beyond 4 pi rad / 10 m (a
+table in degrees or millimetres: :func:`~pkm.core.identification.measurements.check_positions`), a measured position farther from the base than ten times the mechanism's size
 or an angle beyond pi (units again), too few poses for the base parameters, and a pose at which the nominal
 mechanism does not close (outside the workspace).
 
@@ -21,18 +21,19 @@ estimated parameter's standard deviation and the accuracy before and after.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from pkm.core.calibration.estimate import Calibration
 from pkm.core.calibration.measurement import CalibrationModel
+from pkm.core.identification.measurements import MAX_REVOLUTE
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError
 
-MAX_REVOLUTE = 2.0 * np.pi  # a reading beyond this [rad] is a table in degrees
-MAX_PRISMATIC = 10.0  # [m]: beyond, millimetres
 SIZE_FACTOR = 10.0  # a measured position beyond this many characteristic lengths: millimetres
 
 
@@ -63,42 +64,22 @@ def from_layout(model: CalibrationModel, y: np.ndarray) -> np.ndarray:
     return np.hstack([y[:, :3], np.array(rpy)])
 
 
-def read_data(model: CalibrationModel, data: str | Path | dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """The readings (n x na) and measurements (:meth:`CalibrationModel.evaluate`'s layout) of a table (module doc).
+def read_data(model: CalibrationModel, data: str | Path | Mapping[str, ArrayLike]) -> tuple[np.ndarray, np.ndarray]:
+    """The readings (n x na) and measurements (:meth:`CalibrationModel.evaluate`'s layout) of a table (module doc):
+    read, and the readings checked, by the identification's route
+    (:func:`~pkm.core.identification.measurements.read_columns`, :func:`~pkm.core.identification.measurements.
+    check_positions`).
 
     Raises:
         InvalidInputError: the cases of the module doc, naming the row and the column.
     """
-    from pkm.core.identification.measurements import read_table
+    from pkm.core.identification.measurements import check_positions, read_columns
 
-    source = str(data) if isinstance(data, (str, Path)) else "columns"
-    cols = read_table(data) if isinstance(data, (str, Path)) else {k: np.asarray(v, dtype=float)
-                                                                   for k, v in data.items()}
     reads, meas = columns(model)
-    wanted = reads + meas
-    missing = [c for c in wanted if c not in cols]
-    if missing:
-        raise InvalidInputError(missing[0], f"{source}: missing column{'s' * (len(missing) > 1)} {', '.join(missing)} "
-                                            f"(expected {', '.join(wanted)})", missing)
-    table = np.column_stack([np.asarray(cols[c], dtype=float).ravel() for c in wanted])
-    bad = ~np.isfinite(table)
-    if bad.any():
-        row, col = np.argwhere(bad)[0]
-        raise InvalidInputError(wanted[col], f"{source}, row {row + 1}, column {wanted[col]!r}: {table[row, col]} is "
-                                             f"not a finite number", table[row, col])
+    table, source = read_columns(data, reads + meas, ", ".join(reads + meas))
     mech = model.mech
     M = table[:, :mech.na]
-    for j, name in enumerate(mech.actuated_names):
-        revolute = mech.joints[name].revolute
-        lo, hi = mech.limits.get(name, (-np.inf, np.inf))
-        cap = MAX_REVOLUTE if revolute else MAX_PRISMATIC
-        lo, hi = max(lo, -cap), min(hi, cap)
-        out = np.flatnonzero((M[:, j] < lo - 1e-9) | (M[:, j] > hi + 1e-9))
-        if out.size:
-            r = int(out[0])
-            raise InvalidInputError(f"m.{name}", f"{source}, row {r + 1}, column 'm.{name}': {M[r, j]:.6g} is outside "
-                                                 f"the joint's range [{lo:.6g}, {hi:.6g}] (SI units: is the table in "
-                                                 f"{'degrees' if revolute else 'mm'}?)", M[r, j])
+    check_positions(mech, M, reads, source)
     Y = table[:, mech.na:]
     L = SIZE_FACTOR * max(mech.characteristic_length, 1e-9)
     for i, c in enumerate(meas):
@@ -124,13 +105,13 @@ def read_data(model: CalibrationModel, data: str | Path | dict[str, np.ndarray])
 
 
 def write_data(model: CalibrationModel, path: str | Path, readings: np.ndarray, measured: np.ndarray) -> Path:
-    """Write readings and measurements (:meth:`CalibrationModel.evaluate`'s layout) as a CSV table (module doc)."""
+    """Write readings and measurements (:meth:`CalibrationModel.evaluate`'s layout) as a CSV table (module doc), by
+    :func:`pkm.core.dynamics.samples.write_csv` (pkm's one CSV layout: numbers as ``repr`` of floats, exact)."""
+    from pkm.core.dynamics.samples import write_csv
+
     reads, meas = columns(model)
     table = np.hstack([readings, from_layout(model, measured)])
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    np.savetxt(path, table, delimiter=",", header=",".join(reads + meas), comments="", fmt="%.17g")
-    return path
+    return write_csv({name: table[:, k] for k, name in enumerate(reads + meas)}, path)
 
 
 def calibrated_mechanism(cal: Calibration) -> Mechanism:

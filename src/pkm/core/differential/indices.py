@@ -12,7 +12,7 @@ A Jacobian mixing translations and rotations must be made dimensionally homogene
 first (:func:`homogenize`), otherwise every one of these depends on the unit of length (and on the
 mechanism's size). These functions take the matrix they are given; a mechanism's own length for it is
 :attr:`Mechanism.characteristic_length <pkm.core.model.mechanism.Mechanism.characteristic_length>`, and
-``mech.jacobian_scales.forward(J)`` homogenises a forward Jacobian by it (:mod:`pkm.core.model.scale`),
+``JacobianScales.of(mech).forward(J)`` homogenises a forward Jacobian by it (:mod:`pkm.core.model.scale`),
 as :func:`pkm.diagnose` does its Jacobians.
 
 Condition numbers are computed on each matrix divided by its largest entry (they do not change),

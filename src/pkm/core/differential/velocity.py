@@ -42,7 +42,9 @@ from pkm.core.differential.idle import joint_inertia, without_idle
 from pkm.core.differential.indices import singularity_class
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.validation import as_tolerance, as_vector, finite_result
 
@@ -79,6 +81,21 @@ def _complement(B: np.ndarray, n: int) -> np.ndarray:
     return np.linalg.svd(B.T, full_matrices=True)[2][B.shape[1]:].T
 
 
+def homogenised_pinv(J: np.ndarray, rows: np.ndarray, columns: np.ndarray, rtol: float) \
+        -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """The pseudo-inverse of a block ``J`` of a closure Jacobian (its rows and the columns of some joints), taken on
+    the block homogenised by the mechanism's characteristic length (``Ĵ = rows J columns``,
+    :class:`~pkm.core.model.scale.JacobianScales`): ``J⁺ = columns Ĵ⁺ rows``, the singular values of ``Ĵ`` under
+    ``rtol`` times its largest dropped, so that the rank decision and the minimum norm are those of the mechanism
+    scaled in size. Returns ``(J⁺, s, Vt, rank)``: ``Ĵ``'s singular values (padded with zeros to its columns) and right
+    singular vectors (``Vt[rank:]`` spans its null space). The one pseudo-inverse of a closure block: the passive
+    joints' (:func:`pkm.diagnose`'s split, the actuator-space dynamics) and a transmission's with its outputs held."""
+    U, s, Vt = _svd(rows[:, None] * J * columns)
+    smax = float(s[0]) if s.size else 0.0
+    r = int(np.sum(s > rtol * smax)) if smax > 0.0 else 0
+    return columns[:, None] * ((Vt[:r].T / s[:r]) @ U[:, :r].T) * rows, s, Vt, r
+
+
 @dataclass(frozen=True)
 class _Split:
     """The motions at one configuration, split: idle, closure-keeping, singular (see the module doc).
@@ -86,16 +103,13 @@ class _Split:
     Every decomposition is of the Jacobians homogenised by the mechanism's characteristic length
     (:class:`~pkm.core.model.scale.JacobianScales`: rows ``r``, columns ``c``, ``Ĵ = r J c``), so that every rank
     decision and distance is the same for the mechanism scaled in size; the solutions are given back in joint rates.
-    ``Ĵp = Up diag(sp) Vpt`` (passive columns of ``Ĵ_c``, rank ``rp``); ``ÂC = Ua diag(sa) Vat`` with
+    ``Ĵp`` (passive columns of ``Ĵ_c``) is inverted by :func:`homogenised_pinv`; ``ÂC = Ua diag(sa) Vat`` with
     ``Â = [Ĵ_c; Ĵ_t]`` restricted to the complement ``C`` of the idle motions (in the homogenised rates).
     """
 
     mech: Mechanism
     idle: np.ndarray  # (nv, k) orthonormal, zero on the actuated rows (joint rates)
-    Up: np.ndarray
-    sp: np.ndarray
-    Vpt: np.ndarray
-    rp: int
+    Jp_pinv: np.ndarray  # (n_passive, n_constraints): J_p's pseudo-inverse (homogenised_pinv)
     sigma_direct: float  # smallest singular value of Ĵ_p off the idle motions [m]
     smax_direct: float
     direct_direction: np.ndarray  # the task motion of the weakest passive motion (unit), n_task
@@ -111,14 +125,13 @@ class _Split:
 
     @classmethod
     def of(cls, mech: Mechanism, Jc: np.ndarray, Jt: np.ndarray, rtol: float) -> _Split:
-        scales = mech.jacobian_scales
-        Jc, Jt, col = scales.constraint(Jc), scales.task(Jt), scales.columns
+        scales = JacobianScales.of(mech)
         pv, nv = mech.passive_v, mech.nv
+        Jp_pinv, sp, Vpt, rp = homogenised_pinv(Jc[:, pv], scales.constraint_rows, scales.columns[pv], rtol)
+        Jc, Jt, col = scales.constraint(Jc), scales.task(Jt), scales.columns
         Jp, Jtp = Jc[:, pv], Jt[:, pv]
-        Up, sp, Vpt = _svd(Jp)
         smax_d = float(sp[0]) if len(sp) else 0.0
-        null = sp <= rtol * smax_d
-        N = Vpt[null].T  # passive motions the closures allow with the actuators locked
+        N = Vpt[rp:].T  # passive motions the closures allow with the actuators locked
         t_ref = float(np.linalg.norm(Jt, 2)) if Jt.size else 0.0
         if N.shape[1]:
             _, t, Wt = _svd(Jtp @ N)
@@ -142,7 +155,7 @@ class _Split:
         w = col * (C @ Vat[-1]) if C.shape[1] else np.zeros(nv)
         act = w[mech.act_v]
         idle = scales.joint_motions(idle)  # (the idle motions in joint rates, orthonormal)
-        return cls(mech, idle, Up, sp, Vpt, int(np.sum(~null)), sigma_d, smax_d,
+        return cls(mech, idle, Jp_pinv, sigma_d, smax_d,
                    move / max(float(np.linalg.norm(move)), 1e-300), C, Ua, sa, Vat,
                    float(sa[-1]) if len(sa) else np.inf, float(sa[0]) if len(sa) else 0.0,
                    act / max(float(np.linalg.norm(act)), 1e-300),
@@ -166,13 +179,8 @@ class _Split:
 
     def passive_solve(self, rhs: np.ndarray) -> np.ndarray:
         """The minimum-norm passive rates ``x`` with ``J_p x = rhs`` (no idle motion in them; the norm of the
-        homogenised rates)."""
-        r = self.rp
-        nc = self.Up.shape[0]
-        rhs = self.rows[:nc].reshape((nc,) + (1,) * (rhs.ndim - 1)) * rhs
-        x = self.Vpt[:r].T @ ((self.Up[:, :r].T @ rhs) / self.sp[:r].reshape((r,) + (1,) * (rhs.ndim - 1)))
-        cp = self.columns[self.mech.passive_v]
-        return cp.reshape((len(cp),) + (1,) * (rhs.ndim - 1)) * x
+        homogenised rates: :func:`homogenised_pinv`)."""
+        return np.tensordot(self.Jp_pinv, rhs, axes=1)
 
     def joint_solve(self, rhs: np.ndarray) -> np.ndarray:
         """The joint rates ``v`` off the idle motions with ``[J_c; J_t] v = rhs`` (least squares)."""
@@ -426,7 +434,7 @@ def task_acceleration(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLik
     """
     mech, c = _at(mech, q)
     v, a = mech.check_v(v), mech.check_v(a, "a")
-    return finite_result(c.task_jacobian @ a + mech.task_map.bias(c.q, v), "task acceleration")
+    return finite_result(c.task_jacobian @ a + TaskMap.of(mech).bias(c.q, v), "task acceleration")
 
 
 def inverse_velocities(mech: Mechanism, q: ArrayLike | Configuration, yd: ArrayLike) -> np.ndarray:
@@ -468,7 +476,7 @@ def inverse_accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: Arra
     v = mech.check_v(v)
     ydd = as_vector(ydd, mech.n_task, "ydd")
     gamma_c = constraints.drift(mech, c.q, v)
-    gamma_t = mech.task_map.bias(c.q, v)
+    gamma_t = TaskMap.of(mech).bias(c.q, v)
     sp = _split(mech, c, RTOL)
     a = sp.joint_solve(np.concatenate([-gamma_c, ydd - gamma_t]))
     return finite_result(_convention(sp, c, a), "joint accelerations")
@@ -591,7 +599,7 @@ def actuation(mech: Mechanism, q: ArrayLike | Configuration | None = None, *, rt
 
 
 def _actuation(mech: Mechanism, c: Configuration, sp: _Split, rtol: float) -> Actuation:
-    Jc = mech.jacobian_scales.constraint(finite_result(c.constraint_jacobian, "constraint Jacobian"))
+    Jc = JacobianScales.of(mech).constraint(finite_result(c.constraint_jacobian, "constraint Jacobian"))
     keep = np.setdiff1d(np.arange(mech.nv), mech.base_v)
     _, s, Vt = _svd(Jc[:, keep])
     rank = int(np.sum(s > rtol * s[0])) if len(s) and s[0] > 0.0 else 0
@@ -630,7 +638,7 @@ def diagnose(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 1e-
     mech, c = _at(mech, q)
     rtol = as_tolerance(rtol, "rtol")
     near = max(as_tolerance(near, "near"), rtol)
-    Jc = mech.jacobian_scales.constraint(finite_result(c.constraint_jacobian, "constraint Jacobian"))
+    Jc = JacobianScales.of(mech).constraint(finite_result(c.constraint_jacobian, "constraint Jacobian"))
     s = np.linalg.svd(Jc, compute_uv=False)
     rank = int(np.sum(s > rtol * s[0])) if len(s) and s[0] > 0.0 else 0
     sp = _split(mech, c, rtol)

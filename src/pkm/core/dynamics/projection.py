@@ -37,6 +37,7 @@ core's passive map ``G = dq/dq_a``), :func:`constraint_dynamics` (Pinocchio's
 
 from __future__ import annotations
 
+import warnings
 import weakref
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -51,10 +52,14 @@ from pkm.core.dynamics import model as actuator_space
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.errors import InvalidInputError, PkmError, SingularityError, SpecError
+from pkm.core.model.scale import JacobianScales
+from pkm.errors import InvalidInputError, PkmError, PkmWarning, SingularityError, SpecError
 from pkm.validation import as_count, as_scalar, as_tolerance, as_vector, finite_result
 
 RTOL = 1e-9
+#: A free base "needs" a wrench where the one the motion asks of it exceeds this, relative to the wrenches it sums
+#: (inertia, velocity and gravity terms, external loads; moments over the characteristic length).
+BASE_WRENCH_RTOL = 1e-8
 
 
 @dataclass(frozen=True)
@@ -192,7 +197,7 @@ class KhalilProjection:
         # (computed on the Jacobian homogenised by the characteristic length, so that every rank decision is the same
         # for the mechanism scaled in size; the maps are given back in joint rates at the end)
         mech, part = self.mech, self.partition
-        scales = mech.jacobian_scales
+        scales = JacobianScales.of(mech)
         Jc = scales.constraint(finite_result(Jc, "constraint Jacobian"))
         na, n_p = mech.na, len(part.platform_v)
         A = np.zeros((na, n_p))
@@ -323,8 +328,16 @@ def _settle_idle(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wren
 
 
 def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None = None, *,
-                     wrenches: Mapping[str, ArrayLike] | None = None, method: str = "auto") -> np.ndarray:
+                     wrenches: Mapping[str, ArrayLike] | None = None, method: str = "auto",
+                     base: str | None = None) -> np.ndarray:
     """Actuator efforts (N or N m, in ``mech.actuated`` order) of any mechanism at a consistent state.
+
+    A floating base (``spec.floating_base``) is free by default (``base="free"``, :mod:`pkm.core.dynamics.model`):
+    motors alone cannot drive a free body, so a motion ``a`` is one of the free robot only where it asks no wrench
+    of the base. The efforts returned are those of the motion with the base given whatever wrench it asks; where
+    that wrench is not zero (:data:`BASE_WRENCH_RTOL`) a free base warns (:class:`~pkm.errors.PkmWarning`: the
+    motion is not the free robot's). :func:`base_inverse_dynamics` returns the wrench with the efforts;
+    ``base="fixed"`` says the base is held (no warning).
 
     Args:
         mech: The mechanism.
@@ -338,6 +351,7 @@ def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, 
             structure: mimic couplings, idle motions, redundant planar closures), or ``"auto"``: Khalil's
             where the structure allows it, virtual work otherwise. Both give the same efforts to 1e-10
             where both apply (tests).
+        base: A floating base ``"free"`` (default where there is one) or ``"fixed"`` (held).
 
     Raises:
         SingularityError: at a direct singularity (and, for ``"khalil"``, where a leg loses rank).
@@ -359,6 +373,25 @@ def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, 
     mech = check_mechanism(mech)
     if method not in METHODS:
         raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
+    if actuator_space.base_choice(mech, base) == "free":
+        out = base_inverse_dynamics(mech, q, v, a, wrench, wrenches=wrenches, method=method, base="free")
+        if out.needs_base_wrench:
+            name = mech.base.name if mech.base is not None else ""
+            warnings.warn(f"the motion asks a wrench of the free floating base {name!r} "
+                          f"({_wrench_text(out.base_wrench)}, base frame): motors alone cannot give it; the "
+                          "efforts are those with the base given it (pkm.base_inverse_dynamics returns it; "
+                          "base='fixed' says the base is held)", PkmWarning, stacklevel=2)
+        return out.efforts
+    return _motor_efforts(mech, q, v, a, wrench, wrenches, method)
+
+
+def _wrench_text(w: np.ndarray) -> str:
+    return f"force {np.array2string(w[:3], precision=4)} N, moment {np.array2string(w[3:], precision=4)} N m"
+
+
+def _motor_efforts(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None,
+                   wrenches: Mapping[str, ArrayLike] | None, method: str) -> np.ndarray:
+    """:func:`inverse_dynamics`'s efforts by ``method`` (checked), the base given what it asks."""
     if method == "virtual_work":
         return virtual_work_dynamics(mech, q, v, a, wrench, wrenches=wrenches)
     k = _khalil(mech)
@@ -367,6 +400,89 @@ def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, 
             raise k
         return virtual_work_dynamics(mech, q, v, a, wrench, wrenches=wrenches)
     return k.inverse_dynamics(q, v, _settle_idle(mech, q, v, a, wrench, wrenches), wrench, wrenches=wrenches)
+
+
+@dataclass(frozen=True)
+class BaseInverseDynamics:
+    """The inverse dynamics of a floating-base robot: the motors' efforts and the wrench the base needs.
+
+    Attributes:
+        efforts: The actuator efforts (na,) [N m, N], in ``mech.actuated`` order, with the base given
+            ``base_wrench`` (what :func:`inverse_dynamics` returns).
+        base_wrench: The wrench (6,) the motion asks of whatever acts on the base, beyond gravity and the external
+            wrenches given: Pinocchio's free-flyer generalised force, ``(f [N], m [N m])`` in the base's own frame
+            (the free-flyer's child frame), the moment about its origin. On a held base (``base="fixed"``) it is
+            the holder's reaction; on a free base it must be zero for the motion to be the free robot's.
+        base: ``"free"`` or ``"fixed"`` (:mod:`pkm.core.dynamics.model`).
+        needs_base_wrench: A free base only: ``base_wrench`` is not zero (:data:`BASE_WRENCH_RTOL` of the
+            wrenches it sums): ``a`` is not a motion of the free robot and ``efforts`` alone do not produce it.
+            False on a held base (the holder gives it).
+        base_wrench_world: ``base_wrench`` world-aligned (same point: the base's origin).
+    """
+
+    efforts: np.ndarray
+    base_wrench: np.ndarray
+    base: str
+    needs_base_wrench: bool
+    base_wrench_world: np.ndarray
+
+
+def base_inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike,
+                          wrench: ArrayLike | None = None, *, wrenches: Mapping[str, ArrayLike] | None = None,
+                          method: str = "auto", base: str | None = None) -> BaseInverseDynamics:
+    """The actuator efforts and the base wrench of a floating-base robot's motion (:class:`BaseInverseDynamics`).
+
+    ``(efforts, base_wrench) = [Ĝ Ĝ_b]ᵀ (rnea(q, v, a) - Σ J_fᵀ w_f)``: ``Ĝ`` the passive map (the efforts, as
+    :func:`inverse_dynamics`), ``Ĝ_b`` the joint rates of a unit base twist with the actuators locked
+    (:mod:`pkm.core.dynamics.model`). Arguments as :func:`inverse_dynamics`; ``v`` and ``a`` carry the base's twist
+    and acceleration on its free-flyer entries (zero: the base at rest).
+
+    Raises:
+        InvalidInputError: the mechanism has no floating base (its base's reaction is not modelled).
+
+    Examples:
+        >>> import dataclasses
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")  # hung on a free-flyer "pelvis" over a new ground link:
+        >>> urdf = delta.urdf.replace('<link name="base"/>', '<link name="ground"/><link name="base"/><joint '
+        ...                           'name="pelvis" type="floating"><parent link="ground"/><child link="base"/></joint>')
+        >>> robot = pkm.from_strings(urdf, dataclasses.replace(delta.spec, floating_base="pelvis", reference={}))
+        >>> q = pkm.close_loops(robot, delta.actuated_q(delta.q_reference)).q
+        >>> rest = np.zeros(robot.nv)
+        >>> held = pkm.base_inverse_dynamics(robot, q, rest, rest, base="fixed")  # the holder carries the weight
+        >>> np.round(held.base_wrench, 4) + 0.0  # (+ 0.0: a zero's sign is rounding's, not the model's)
+        array([0.    , 0.    , 6.3765, 0.    , 0.    , 0.    ])
+        >>> pkm.base_inverse_dynamics(robot, q, rest, rest).needs_base_wrench  # free, it cannot stay at rest
+        True
+        >>> a = pkm.forward_dynamics(robot, q, rest, held.efforts)  # (free by default: it falls)
+        >>> pkm.base_inverse_dynamics(robot, q, rest, a).needs_base_wrench
+        False
+    """
+    mech = check_mechanism(mech)
+    if method not in METHODS:
+        raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
+    if mech.base is None:
+        raise InvalidInputError("mech", "the mechanism has no floating base (spec.floating_base): its base is the "
+                                        "world, whose reaction pkm does not model", mech.base)
+    base = actuator_space.base_choice(mech, base)
+    q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
+    tau = _motor_efforts(mech, q, v, a, wrench, wrenches, method)
+    red = actuator_space._reduce(mech, q, RTOL, "free")
+    Gb = red.Gb
+    h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches)
+    w = finite_result(Gb.T @ h, "base wrench")
+    needs = False
+    if base == "free":
+        # relative to the wrenches it sums, moments over the characteristic length (the same for any size)
+        unit = np.r_[np.ones(3), np.full(3, 1.0 / mech.characteristic_length)]
+        bias = pin.rnea(mech.model, mech.data, q, v, np.zeros(mech.nv))
+        parts = (Gb.T @ (red.M @ a), Gb.T @ bias, Gb.T @ (h - pin.rnea(mech.model, mech.data, q, v, a)))
+        scale = sum(float(np.linalg.norm(unit * p)) for p in parts)
+        needs = bool(np.linalg.norm(unit * w) > BASE_WRENCH_RTOL * scale)
+    R = pin.XYZQUATToSE3(q[mech.base.idx_q:mech.base.idx_q + 7]).rotation
+    world = np.r_[R @ w[:3], R @ w[3:]]
+    return BaseInverseDynamics(tau, w, base, needs, world)
 
 
 def virtual_work_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None = None, *, wrenches: Mapping[str, ArrayLike] | None = None) \
@@ -385,8 +501,12 @@ FORWARD_METHODS = ("model", "constraint_dynamics")
 
 
 def forward_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: ArrayLike, *, method: str = "model",
-                     mu: float | None = None) -> np.ndarray:
+                     mu: float | None = None, base: str | None = None,
+                     base_wrench: ArrayLike | None = None) -> np.ndarray:
     """Joint accelerations (nv,) under actuator efforts.
+
+    A floating base is free by default: no wrench on it but ``base_wrench``, its acceleration from its own equations
+    (:mod:`pkm.core.dynamics.model`); ``base="fixed"`` holds it.
 
     Args:
         mech: The mechanism.
@@ -396,6 +516,9 @@ def forward_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: 
             (:func:`pkm.core.dynamics.model.forward_dynamics`), exact by rank on redundant closures;
             ``"constraint_dynamics"``: Pinocchio's, :func:`constraint_dynamics` (the independent check).
         mu: For ``"constraint_dynamics"`` only (see there).
+        base: A floating base ``"free"`` (default where there is one) or ``"fixed"`` (held).
+        base_wrench: A wrench applied to a free base: Pinocchio's free-flyer force ``(f [N], m [N m])`` in the
+            base's frame, about its origin.
 
     Examples:
         >>> import numpy as np
@@ -411,26 +534,33 @@ def forward_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: 
     if method not in FORWARD_METHODS:
         raise InvalidInputError("method", f"use one of {list(FORWARD_METHODS)}, got {method!r}", method)
     if method == "constraint_dynamics":
-        return constraint_dynamics(mech, q, v, tau_actuated, mu=mu)
+        return constraint_dynamics(mech, q, v, tau_actuated, mu=mu, base=base, base_wrench=base_wrench)
     if mu is not None:
         raise InvalidInputError("mu", "the model route needs no regularisation; mu is for "
                                       "method='constraint_dynamics'", mu)
-    return actuator_space.forward_dynamics(mech, q, v, tau_actuated)
+    return actuator_space.forward_dynamics(mech, q, v, tau_actuated, base=base, base_wrench=base_wrench)
 
 
 def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: ArrayLike, *,
-                        mu: float | None = None, max_iter: int = 1000) -> np.ndarray:
+                        mu: float | None = None, max_iter: int = 1000, base: str | None = None,
+                        base_wrench: ArrayLike | None = None) -> np.ndarray:
     """Joint accelerations by Pinocchio's ``constraintDynamics``: the closures enforced at the acceleration level
     with no Baumgarte correction (the state must be assembled and consistent).
+
+    A floating base is free by default (no generalised force on its rows but ``base_wrench``, as the model's);
+    ``base="fixed"`` welds it to the world where ``q`` puts it (a 6-D constraint; its twist in ``v`` must be zero).
 
     Args:
         mu: The proximal regularisation. Default: 0 where the closure equations are independent, else 1e-9 with
             up to ``max_iter`` proximal iterations (which converge to the exact accelerations; with ``mu=0`` a
             redundant closure, such as a planar loop closed with a 6-D frame, gives wrong accelerations or NaN).
         max_iter: Proximal iterations allowed.
+        base: A floating base ``"free"`` (default where there is one) or ``"fixed"`` (welded).
+        base_wrench: A wrench applied to a free base (:func:`forward_dynamics`).
 
     Raises:
         SingularityError: ``mu=0`` on redundant closures.
+        InvalidInputError: a held base given a twist, or a wrench.
         PkmError: The model has mimic joints (Pinocchio 4.1's ``constraintDynamics`` does not handle them).
 
     Examples:
@@ -449,7 +579,7 @@ def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuate
     tau_a = mech.check_actuated(tau_actuated, "tau_actuated")
     if _has_mimic(mech.model):
         raise PkmError("constraintDynamics does not support mimic joints on Pinocchio 4.1")
-    s = np.linalg.svd(mech.jacobian_scales.constraint(finite_result(constraints.jacobian(mech, q),
+    s = np.linalg.svd(JacobianScales.of(mech).constraint(finite_result(constraints.jacobian(mech, q),
                                                                      "constraint Jacobian")), compute_uv=False)
     redundant = bool(s.size) and (s.size < mech.n_constraints or s[-1] <= RTOL * float(s[0]))
     if mu is None:
@@ -460,12 +590,26 @@ def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuate
         raise SingularityError("constraint", float(s[-1]), "the closure equations are redundant (a planar "
                                                            "mechanism closed with 3-D points?): pass mu > 0, e.g. "
                                                            "mu=1e-9, or use method='model'")
+    base = actuator_space.base_choice(mech, base)
     tau = np.zeros(mech.nv)
     tau[mech.act_v] = tau_a
-    pin.initConstraintDynamics(mech.model, mech.data, mech.constraint_models, mech.constraint_datas)
+    models, datas = mech.constraint_models, mech.constraint_datas
+    if base == "free" and base_wrench is not None:
+        tau[mech.base_v] = as_vector(base_wrench, 6, "base_wrench")
+    elif base_wrench is not None:
+        raise InvalidInputError("base_wrench", "the base is fixed (held: no wrench to apply to it)", base_wrench)
+    if base == "fixed" and mech.base is not None:  # (the base welded to the world where q puts it)
+        if np.any(v[mech.base_v] != 0.0):
+            raise InvalidInputError("v", "a held base (base='fixed') has no twist: zero v on its free-flyer entries",
+                                    v[mech.base_v])
+        bq = mech.base.idx_q
+        weld = pin.RigidConstraintModel(pin.ContactType.CONTACT_6D, mech.model, mech.base.id, pin.SE3.Identity(), 0,
+                                        pin.XYZQUATToSE3(q[bq:bq + 7]), pin.LOCAL)
+        models = [*models, weld]
+        datas = [cm.createData() for cm in models]
+    pin.initConstraintDynamics(mech.model, mech.data, models, datas)
     settings = pin.ProximalSettings(1e-14, mu, max_iter if mu > 0.0 else 1)
-    a = pin.constraintDynamics(mech.model, mech.data, q, v, tau, mech.constraint_models, mech.constraint_datas,
-                               settings).copy()
+    a = pin.constraintDynamics(mech.model, mech.data, q, v, tau, models, datas, settings).copy()
     return finite_result(a, "joint accelerations", "constraintDynamics failed (a singular configuration?)")
 
 
@@ -484,6 +628,6 @@ def energy(mech: Mechanism, q: ArrayLike, v: ArrayLike) -> tuple[float, float]:
     return float(kinetic), float(potential)
 
 
-__all__ = ["FORWARD_METHODS", "METHODS", "KhalilProjection", "Leg", "Partition", "Projection", "constraint_dynamics", "energy",
-           "forward_dynamics", "inverse_dynamics",
+__all__ = ["BASE_WRENCH_RTOL", "FORWARD_METHODS", "METHODS", "BaseInverseDynamics", "KhalilProjection", "Leg", "Partition", "Projection", "base_inverse_dynamics", "constraint_dynamics",
+           "energy", "forward_dynamics", "inverse_dynamics",
            "partition", "virtual_work_dynamics"]

@@ -26,6 +26,7 @@ import numpy as np
 
 from pkm._optional import module
 from pkm.core.dynamics.simulate import Simulation
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError
 
@@ -54,7 +55,7 @@ def column_units(mech: Mechanism, sim: Simulation) -> dict[str, str]:
     units.update({f"qd.{n}": _RATE[u] for n, u in joints.items()})
     units.update({f"qdd.{n}": _ACCELERATION[u] for n, u in joints.items()})
     units.update({f"tau.{n}": "N m" if u == "rad" else "N" for n, u in joints.items()})
-    units.update({f"task.{k}": "rad" if kind == "angle" else "m" for k, kind in mech.task_map.kinds.items()})
+    units.update({f"task.{k}": "rad" if kind == "angle" else "m" for k, kind in TaskMap.of(mech).kinds.items()})
     units.update({e: "J" for e in ENERGIES})
     return units
 
@@ -72,8 +73,8 @@ def columns(mech: Mechanism, sim: Simulation) -> dict[str, np.ndarray]:
                            ("tau", sim.efforts)):
         values = np.zeros((len(sim), mech.na)) if values is None else np.asarray(values, dtype=float)
         out.update({f"{prefix}.{n}": values[:, i].copy() for i, n in enumerate(names)})
-    keys = mech.task_map.keys
-    task = np.array([[row[k] for k in keys] for row in map(mech.task_map.named, sim.q)]).reshape(len(sim), len(keys))
+    keys = TaskMap.of(mech).keys
+    task = np.array([[row[k] for k in keys] for row in map(TaskMap.of(mech).named, sim.q)]).reshape(len(sim), len(keys))
     out.update({f"task.{k}": task[:, i].copy() for i, k in enumerate(keys)})
     out.update(kinetic=sim.kinetic.copy(), potential=sim.potential.copy(), energy=sim.energy,
                work=sim.work.copy(), dissipated=sim.dissipated.copy())
@@ -122,7 +123,7 @@ def write(mech: Mechanism, sim: Simulation, path: str | Path) -> Path:
         The path written (its folder created).
 
     Raises:
-        MissingDependencyError: Parquet without pyarrow (``pip install "pkm[sweeps]"``).
+        MissingDependencyError: Parquet without pyarrow (``pip install "pkm-robotics[sweeps]"``).
         InvalidInputError: ``sim`` is not a simulation of ``mech``.
     """
     cols = columns(mech, sim)

@@ -33,6 +33,12 @@ The run stops with an :class:`Event`, keeping the samples up to it, where the mo
   :data:`SINGULAR_CLOSURE` ``* singular_tol`` of a direct singularity, the event is that singularity);
 * crosses a position limit stated by the model file, or exceeds an actuator's speed limit.
 
+A floating base (``spec.floating_base``) is free by default (``base="free"``, :mod:`pkm.core.dynamics.model`): no
+wrench acts on it, its acceleration comes from its own equations, and its pose (position and unit quaternion,
+integrated from its twist: ``ṗ = R v``, ``q̇ = ½ q ⊗ ω``, the quaternion normalised where it is used) and twist join
+the state; with no effort and no friction the energy is conserved (tests). ``base="fixed"`` holds it where ``q0``
+puts it. A free base runs in Python (the C route models a held base).
+
 A controller is a callable ``(t, q, v) -> τ_a`` (``q`` the whole configuration, nq; ``v`` the joint rates, nv; the
 actuated ones are ``q[mech.act_q]`` and ``v[mech.act_v]``), or a sampled table ``(times, efforts)`` interpolated
 linearly (held outside its span).
@@ -60,13 +66,15 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from pkm.core.dynamics.model import COULOMB_VELOCITY, RTOL, ActuatorSpaceModel, _evaluate, _solve_inertia
+from pkm.core.dynamics.model import COULOMB_VELOCITY, RTOL, ActuatorSpaceModel, _evaluate, _solve_inertia, base_choice
 from pkm.core.dynamics.projection import energy
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.newton import least_squares
 from pkm.core.kinematics.solve import close_loops
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.kinematics.trajectory import Trajectory, _units
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.errors import CompilerError, ControllerError, InvalidInputError, PkmError, SingularityError, SpecError
 from pkm.validation import as_array, as_scalar
 
@@ -115,6 +123,8 @@ class Simulation(Trajectory):
         method: The integrator.
         saturated: Per actuator, the samples whose effort is at or beyond its limit (peak, else continuous): clipped
             there when the run saturates (the default), exceeded when it does not.
+        base: How a floating base moved: ``"free"`` (its own equations, no wrench on it) or ``"fixed"`` (held; every
+            mechanism without a floating base) (:mod:`pkm.core.dynamics.model`).
 
     Examples:
         >>> import pkm
@@ -133,6 +143,7 @@ class Simulation(Trajectory):
     event: Event | None = None
     method: str = "rk4"
     saturated: dict[str, int] = field(default_factory=dict)
+    base: str = "fixed"
 
     @property
     def energy(self) -> np.ndarray:
@@ -153,7 +164,7 @@ def _passive_distance(mech: Mechanism, q: np.ndarray) -> tuple[float, float, int
     (:mod:`pkm.core.model.scale`) above ``RTOL`` times the largest, its ratio to the largest (the distance to a
     direct singularity that ``singular_tol`` is compared with: the same for the mechanism scaled in size), and how
     many there are: ``(sigma [m], distance, rank)``."""
-    s = np.linalg.svd(mech.jacobian_scales.constraint(constraints.jacobian(mech, q))[:, mech.passive_v],
+    s = np.linalg.svd(JacobianScales.of(mech).constraint(constraints.jacobian(mech, q))[:, mech.passive_v],
                       compute_uv=False)
     nonzero = s[s > RTOL * s[0]] if s.size and s[0] > 0.0 else s[:0]
     if not nonzero.size:
@@ -174,14 +185,19 @@ class _Dynamics:
     coulomb_velocity: float
     step_tol: float
     q: np.ndarray  # the last closed configuration (the next closure's seed)
+    base: str = "fixed"  # a floating base "free": x = (qa, qd, base pose (7), base twist (6)); else x = (qa, qd)
     limit: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
         self.limit = np.array([a.max_effort for a in self.mech.actuators])
 
-    def close(self, qa: np.ndarray, seed: np.ndarray, t: float) -> np.ndarray:
+    def close(self, qa: np.ndarray, seed: np.ndarray, t: float, pose: np.ndarray | None = None) -> np.ndarray:
         mech = self.mech
         q = mech.with_actuated(seed, qa)
+        if pose is not None and mech.base is not None:  # (a free base: its pose from the state, unit quaternion)
+            at = mech.base.idx_q
+            q[at:at + 3] = pose[:3]
+            q[at + 3:at + 7] = pose[3:] / np.linalg.norm(pose[3:])
         pv = mech.passive_v
         for _ in range(12):
             r, J = constraints.residual_and_jacobian(mech, q)
@@ -198,14 +214,15 @@ class _Dynamics:
         raise _Stop(Event("assembly_mode", t, f"the loops do not close from the previous configuration (closure "
                                               f"{closure!r} open by {gap:.3g}): the motion left its assembly mode"))
 
-    def state(self, t: float, qa: np.ndarray, qd: np.ndarray, seed: np.ndarray) -> tuple[ActuatorSpaceModel,
-                                                                                              np.ndarray]:
-        """The model at ``(qa, qd)`` (closed from ``seed``) and the efforts applied there."""
+    def state(self, t: float, qa: np.ndarray, qd: np.ndarray, seed: np.ndarray, pose: np.ndarray | None = None,
+              twist: np.ndarray | None = None) -> tuple[ActuatorSpaceModel, np.ndarray]:
+        """The model at ``(qa, qd)`` (closed from ``seed``; a free base at ``pose``, ``twist``) and the efforts
+        applied there."""
         if not (np.all(np.isfinite(qa)) and np.all(np.isfinite(qd))):
             raise _Stop(Event("singularity", t, "the state is no longer finite (a singularity crossed)"))
-        q = self.close(qa, seed, t)
+        q = self.close(qa, seed, t, pose)
         try:
-            model = _evaluate(self.mech, q, qd, RTOL, self.coulomb_velocity)
+            model = _evaluate(self.mech, q, qd, RTOL, self.coulomb_velocity, self.base, twist)
         except SingularityError as exc:
             raise _Stop(Event("singularity", t, str(exc)), exc.sigma_min, exc.distance) from None
         tau = self.efforts(t, q, model.v)
@@ -231,15 +248,30 @@ class _Dynamics:
 
     def rates(self, t: float, x: np.ndarray, seed: np.ndarray) -> tuple[np.ndarray, np.ndarray, ActuatorSpaceModel,
                                                                           np.ndarray]:
-        """``dx/dt`` for ``x = (qa, qd)``, with the closed configuration, the model and the efforts."""
+        """``dx/dt`` for ``x = (qa, qd)`` (a free base: ``(qa, qd, pose, twist)``), with the closed configuration, the
+        model and the efforts."""
         na = self.mech.na
-        model, tau = self.state(t, x[:na], x[na:], seed)
+        free = self.base == "free"
+        pose, twist = (x[2 * na:2 * na + 7], x[2 * na + 7:]) if free else (None, None)
+        model, tau = self.state(t, x[:na], x[na:2 * na], seed, pose, twist)
         rhs = tau + (model.friction if self.friction else 0.0) - model.h
         try:
-            qdd = _solve_inertia(model.M, rhs, self.mech.jacobian_scales.actuated)
+            qdd = _solve_inertia(model.M, rhs, JacobianScales.of(self.mech).actuated)
         except SingularityError as exc:
             raise _Stop(Event("singularity", t, str(exc)), exc.sigma_min, exc.distance) from None
-        return np.concatenate([x[na:], qdd]), model.q, model, tau
+        if not free or pose is None or twist is None:
+            return np.concatenate([x[na:2 * na], qdd]), model.q, model, tau
+        base_a = model.joint_accelerations(qdd, friction=self.friction)[self.mech.base_v]
+        return np.concatenate([x[na:2 * na], qdd, _pose_rate(pose, twist), base_a]), model.q, model, tau
+
+
+def _pose_rate(pose: np.ndarray, twist: np.ndarray) -> np.ndarray:
+    """The rate of a free-flyer's ``(p, quaternion x y z w)`` under its twist (linear, angular, in its own frame):
+    ``ṗ = R v``, ``q̇ = ½ q ⊗ (ω, 0)``."""
+    quat = pose[3:] / np.linalg.norm(pose[3:])
+    R = pin.Quaternion(quat[3], quat[0], quat[1], quat[2]).matrix()
+    xyz, w, omega = pose[3:6], pose[6], twist[3:]
+    return np.concatenate([R @ twist[:3], 0.5 * (w * omega + np.cross(xyz, omega)), [-0.5 * float(xyz @ omega)]])
 
 
 def _controller(mech: Mechanism, controller: object, torques: object) -> Callable[[float, np.ndarray, np.ndarray],
@@ -283,14 +315,16 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
              dt: float = 1e-3, controller: Controller | None = None, *,
              torques: tuple[ArrayLike, ArrayLike] | None = None, method: str = "rk4", friction: bool = True,
              saturate: bool = True, limits: bool = True, singular_tol: float = 1e-3, coulomb_velocity: float = COULOMB_VELOCITY,
-             step_tol: float = 1e-9, max_steps: int = MAX_STEPS, backend: str = "auto") -> Simulation:
+             step_tol: float = 1e-9, max_steps: int = MAX_STEPS, backend: str = "auto",
+             base: str | None = None) -> Simulation:
     """Simulate ``mech`` from ``(q0, v0)`` for ``duration`` seconds (module doc).
 
     Args:
         mech: The mechanism.
         q0: The initial configuration: assembled (nq,), or the actuated coordinates (na,) closed from the
             reference; default the reference.
-        v0: The initial actuated rates (na,) or joint rates (nv,) read on their actuated entries; default rest.
+        v0: The initial actuated rates (na,) or joint rates (nv,) read on their actuated entries (and a free base's
+            twist on its free-flyer entries; with actuated rates alone the base starts at rest); default rest.
         duration: Simulated time [s] (> 0).
         dt: The sample period [s], the step of ``"rk4"`` (> 0).
         controller: ``(t, q, v) -> τ_a`` (module doc); default no effort.
@@ -309,6 +343,8 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
             fast and a fixed step would lose accuracy, or the assembly mode.
         max_steps: Refuse runs of more samples than this.
         backend: ``"auto"``, ``"python"`` or ``"c"`` (module doc): where the ``"rk4"`` steps run.
+        base: A floating base ``"free"`` (default where there is one: no wrench on it) or ``"fixed"`` (held where
+            ``q0`` puts it) (module doc).
 
     Returns:
         A :class:`Simulation` (with its :class:`Event` if it stopped early).
@@ -340,6 +376,10 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
         raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
     if not isinstance(backend, str) or backend not in BACKENDS:
         raise InvalidInputError("backend", f"use one of {list(BACKENDS)}, got {backend!r}", backend)
+    base = base_choice(mech, base)
+    if base == "free" and backend == "c":
+        raise InvalidInputError("backend", "the C route models a held base: a free floating base runs in Python "
+                                           "(backend='python' or 'auto'), or pass base='fixed'", backend)
     duration = as_scalar(duration, "duration", low=0.0, strict_low=True)
     dt = as_scalar(dt, "dt", low=0.0, strict_low=True)
     singular_tol = as_scalar(singular_tol, "singular_tol", low=0.0)
@@ -362,6 +402,7 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
         if gap > 1e-9:
             raise InvalidInputError("q0", f"not assembled: closure {closure!r} open by {gap:.3g} (close it with "
                                           "pkm.close_loops)", gap)
+    twist = np.zeros(6 if base == "free" else 0)
     if v0 is None:
         qd = np.zeros(mech.na)
     else:
@@ -371,9 +412,13 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
             arr = np.zeros(0)
         qd = mech.check_v(arr, "v0")[mech.act_v] if arr.shape == (mech.nv,) and mech.nv != mech.na \
             else mech.check_actuated(v0, "v0")
-    dyn = _Dynamics(mech, ctrl, friction, saturate, bool(limits), singular_tol, coulomb_velocity, step_tol, q)
+        if len(twist) and arr.shape == (mech.nv,) and mech.nv != mech.na:
+            twist = arr[mech.base_v].copy()
+    dyn = _Dynamics(mech, ctrl, friction, saturate, bool(limits), singular_tol, coulomb_velocity, step_tol, q, base)
     x = np.concatenate([mech.actuated_q(q), qd])
-    sim = _compiled(mech, method, backend, n_steps)
+    if base == "free" and mech.base is not None:
+        x = np.concatenate([x, q[mech.base.idx_q:mech.base.idx_q + 7], twist])
+    sim = _compiled(mech, method, "python" if base == "free" else backend, n_steps)
     if sim is not None:
         table = ctrl if isinstance(ctrl, _Table) else _Table(np.zeros(1), np.zeros((1, mech.na))) \
             if controller is None else None
@@ -422,25 +467,25 @@ class _Recorder:
         n = len(self.t)
         q = np.array(self.q)
         v = np.array([m.v for m in self.models])
-        a = np.array([m.joint_accelerations(qdd) for m, qdd in zip(self.models, self.qdd)])
+        a = np.array([m.joint_accelerations(qdd, friction=self.dyn.friction) for m, qdd in zip(self.models, self.qdd)])
         qd = np.array([m.qd for m in self.models])
         tau = np.array(self.tau)
-        tm = mech.task_map
+        tm = TaskMap.of(mech)
         task = np.array([tm.value(qq) for qq in q])
         task_v = np.array([tm.jacobian(qq) @ vv for qq, vv in zip(q, v)])
         task_a = np.array([tm.jacobian(qq) @ aa + tm.bias(qq, vv) for qq, vv, aa in zip(q, v, a)])
         kinetic = np.array([m.kinetic_energy for m in self.models])
         potential = np.array([energy(mech, qq, np.zeros(mech.nv))[1] for qq in q])
-        loss = -np.array([m.friction @ m.qd for m in self.models]) if self.dyn.friction else np.zeros(n)
+        loss = -np.array([m.friction_power for m in self.models]) if self.dyn.friction else np.zeros(n)
         residual = np.array([np.max(np.abs(constraints.residual(mech, qq)), initial=0.0) for qq in q])
         return _simulation(mech, np.array(self.t), q, v, a, qd, np.array(self.qdd), task, task_v, task_a, tau,
-                           residual, kinetic, potential, loss, event, method)
+                           residual, kinetic, potential, loss, event, method, self.dyn.base)
 
 
 def _simulation(mech: Mechanism, t: np.ndarray, q: np.ndarray, v: np.ndarray, a: np.ndarray, qd: np.ndarray,
                 qdd: np.ndarray, task: np.ndarray, task_v: np.ndarray, task_a: np.ndarray, tau: np.ndarray,
                 residual: np.ndarray, kinetic: np.ndarray, potential: np.ndarray, loss: np.ndarray, event: Event | None,
-                method: str) -> Simulation:
+                method: str, base: str = "fixed") -> Simulation:
     """The :class:`Simulation` of the samples' arrays (the work and the dissipated energy by the trapezoidal rule)."""
     power = np.einsum("ij,ij->i", tau, qd)
     steps = np.diff(t)
@@ -454,7 +499,7 @@ def _simulation(mech: Mechanism, t: np.ndarray, q: np.ndarray, v: np.ndarray, a:
     saturated = {name: int(n) for name, n in zip(mech.actuated_names, at.sum(axis=0))}
     return Simulation(q, v, a, q[:, mech.act_q], qd, qdd, task, task_v, task_a, tau, residual,
                       (), units, mech.limits_along(q), t, kinetic, potential, work, dissipated, event, method,
-                      saturated)
+                      saturated, base)
 
 
 def _start(dyn: _Dynamics, x: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, ActuatorSpaceModel,
@@ -487,7 +532,9 @@ def _rk4_step(dyn: _Dynamics, t: float, h: float, x: np.ndarray, k1: np.ndarray,
     x_new = x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
     predicted = pin.integrate(integrate, q, h / 6.0 * (v1 + 2.0 * m2.v + 2.0 * m3.v + m4.v))
     k, q_new, model, tau = dyn.rates(t + h, x_new, predicted)
-    moved = float(np.abs(pin.difference(integrate, predicted, q_new)).max())
+    off = pin.difference(integrate, predicted, q_new)
+    off[mech.base_v] = 0.0  # (a free base's pose is the state's, not a closure's: RK4's, not the one-step prediction's)
+    moved = float(np.abs(off).max())
     if moved > dyn.step_tol and depth < MAX_HALVINGS:
         xm, qm, mm, _, km = _rk4_step(dyn, t, 0.5 * h, x, k1, q, v1, depth + 1)
         return _rk4_step(dyn, t + 0.5 * h, 0.5 * h, xm, km, qm, mm.v, depth + 1)
@@ -501,13 +548,13 @@ def _rk4(dyn: _Dynamics, x: np.ndarray, q: np.ndarray, dt: float, n_steps: int, 
     na = dyn.mech.na
     rec = _Recorder(dyn)
     k1, q, model, tau = _start(dyn, x, q)
-    rec.add(0.0, q, model, tau, k1[na:])
+    rec.add(0.0, q, model, tau, k1[na:2 * na])
     event = None
     try:
         for step in range(1, n_steps + 1):
             x, q, model, tau, k1 = _rk4_step(dyn, (step - 1) * dt, dt, x, k1, q, model.v, 0)
             rec.check(step * dt, model)
-            rec.add(step * dt, q, model, tau, k1[na:])
+            rec.add(step * dt, q, model, tau, k1[na:2 * na])
     except _Stop as stop:
         event = Event(stop.event.kind, rec.t[-1], stop.event.detail)
     return rec.result(event, method)
@@ -592,7 +639,7 @@ def _radau(dyn: _Dynamics, x0: np.ndarray, q: np.ndarray, dt: float, n_steps: in
         except _Stop as stop:
             event = stop.event
             break
-        rec.add(float(t), qq, model, tau, dx[na:])
+        rec.add(float(t), qq, model, tau, dx[na:2 * na])
     if event is not None:
         event = Event(event.kind, rec.t[-1], event.detail)
     return rec.result(event, method)
@@ -691,7 +738,7 @@ def _c_result(dyn: _Dynamics, sim: Simulator, rows: dict[str, np.ndarray], dt: f
     na = mech.na
     Q, V, QDD, X = rows["Q"], rows["V"], rows["QDD"], rows["X"]
     a, task, task_v, task_a, potential, residual, pivot = sim.samples(Q, V, QDD)
-    tm = mech.task_map
+    tm = TaskMap.of(mech)
     for k in np.flatnonzero(~(pivot[:, 0] >= PIVOT_FLOOR)):
         model = _evaluate(mech, Q[k], X[k, na:], RTOL, dyn.coulomb_velocity)
         a[k] = model.joint_accelerations(QDD[k])

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from pkm.core.export.library import CLibrary
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import CompilerError
 
@@ -288,7 +289,7 @@ def compare(mech: Mechanism, harness: Harness, samples: int = 4, step: float = 0
             move = move / 2
         closed.append(solved.q)
     Q = np.array(closed)
-    tm = mech.task_map
+    tm = TaskMap.of(mech)
     Y = np.array([tm.value(q) for q in Q])
     QA = np.array([mech.actuated_q(q) for q in Q])
     mode = np.full((samples, 1), -1.0)
@@ -385,7 +386,7 @@ def check_modes(mech: Mechanism, harness: Harness, step: float = 0.01) -> list[s
         if not (moved.converged and mech.on_branch(moved.q, name)):
             problems.append(f"branch {name!r}: pkm cannot move its configuration by {step} along it")
             continue
-        row = np.hstack([mech.task_map.value(moved.q), q, [values["ik", key]]])
+        row = np.hstack([TaskMap.of(mech).value(moved.q), q, [values["ik", key]]])
         got = harness.run("ik", row[None])[0]
         q_c = got[4:4 + mech.nq]
         if not (got[0] == 0 and got[3] == values["ik", key] and mech.on_branch(q_c, name)):
@@ -424,7 +425,7 @@ def domain(mech: Mechanism, harness: Harness, steps: int = 60) -> tuple[list[str
             statuses = got[:4] if kind == "maps" else got[:1]
             if not (statuses == invalid).all():
                 problems.append(f"{kind}({bad}) returned status {statuses.tolist()}")
-    scale = max(float(np.abs(mech.task_map.value(ref)).max()), 0.05)
+    scale = max(float(np.abs(TaskMap.of(mech).value(ref)).max()), 0.05)
     unit = np.array([0.05 if mech.joints[n].revolute else 0.05 * scale for n in mech.actuated_names])
     rng = np.random.default_rng(1)
     direction = rng.uniform(-1.0, 1.0, na)
@@ -442,7 +443,7 @@ def domain(mech: Mechanism, harness: Harness, steps: int = 60) -> tuple[list[str
             q = got[4:4 + nq]
             if np.abs(residual(mech, q)).max() > 1e-9:
                 problems.append(f"fk step {k}: OK at a configuration that does not close")
-    y0 = mech.task_map.value(ref)
+    y0 = TaskMap.of(mech).value(ref)
     for sign in (1.0, -1.0):
         row = np.hstack([y0 + sign * 10.0 * np.eye(ny)[0], ref, [-1.0]])
         got = harness.run("ik", row[None])[0]

@@ -39,6 +39,7 @@ import numpy as np
 from pkm.core.export import runtime
 from pkm.core.export.emit import c_constant, c_function
 from pkm.core.export.model import Block, ExportError, ExportModel, Newton, c_name
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.codegen import jacobi_sv, paper_counts
@@ -173,7 +174,8 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
     if closed is not None:
         kernels.append(closed)
     _check_at_reference(mech, model, kernels)
-    sizes = {"NQ": mech.nq, "NV": mech.nv, "NA": mech.na, "NY": mech.task_map.value_size, "NX": mech.task_map.size}
+    task = TaskMap.of(mech)
+    sizes = {"NQ": mech.nq, "NV": mech.nv, "NA": mech.na, "NY": task.value_size, "NX": task.size}
     ops = {}
     for fun in kernels:
         mul, add, other = paper_counts(fun)
@@ -214,7 +216,7 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
     constants = (f"const char* const {prefix}_limit_names[{len(limit_names)}] = {{"
                  + ", ".join(_quote(n) for n in limit_names) + "};\n"
                  + f"const char* const {prefix}_task_names[{prefix.upper()}_NY] = {{"
-                 + ", ".join(_quote(n) for n in mech.task_map.value_names) + "};\n"
+                 + ", ".join(_quote(n) for n in TaskMap.of(mech).value_names) + "};\n"
                  + _array("double", f"{prefix}_q_reference", [float(x) for x in mech.q_reference], c_constant,
                           public=True))
     functions = "".join(c_function(fun, f"p_k_{fun.name()}") for fun in kernels)
@@ -295,7 +297,7 @@ def mode_constants(mech: Mechanism, model: ExportModel) -> tuple[dict[str, dict[
             warnings.warn(why, PkmWarning, stacklevel=3)
             lines.append(why + ".")
             continue
-        ident, sigma = mode_id(model.ik, q, mech.task_map.value(q))
+        ident, sigma = mode_id(model.ik, q, TaskMap.of(mech).value(q))
         if not sigma > SINGULAR_TOL:
             why = (f"branch {name!r} ({signs}): no constant, its configuration at the reference task value is singular "
                    f"(relative smallest singular value {sigma:.3g})")
@@ -326,7 +328,7 @@ def _check_at_reference(mech: Mechanism, model: ExportModel, kernels: list[cs.Fu
     """Each kernel finite at the reference and both Newton solves converged there (the reference is closed: its
     step is a zero step)."""
     q = mech.q_reference
-    qa, y = mech.actuated_q(q), mech.task_map.value(q)
+    qa, y = mech.actuated_q(q), TaskMap.of(mech).value(q)
     zeros = np.zeros(mech.na)
     for newton, target, what in ((model.fk, qa, "forward"), (model.ik, y, "inverse")):
         q_next, r, pivot, *_ = (np.array(x).ravel() for x in newton.step(q, target))
@@ -358,7 +360,7 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
         "",
         f"Sizes: configuration q {sizes['NQ']} (Pinocchio's layout: a ball joint's quaternion x y z w), velocity "
         f"{sizes['NV']}, actuated {sizes['NA']} ({', '.join(mech.actuated_names)}), task value {sizes['NY']} "
-        f"({', '.join(mech.task_map.value_names)}), task rate {sizes['NX']}. SI units: m, rad, N, N m, kg.",
+        f"({', '.join(TaskMap.of(mech).value_names)}), task rate {sizes['NX']}. SI units: m, rad, N, N m, kg.",
         "",
         "Operations after common-subexpression elimination (multiplications, additions, other functions):",
     ]

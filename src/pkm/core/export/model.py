@@ -35,10 +35,12 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core.kinematics.blocks import block_triangular
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.dynamics import ActuatorTwin
 from pkm.core.twin.linear import PivotedLU
 from pkm.core.twin.spatial import Expr, zyx_angles
+from pkm.core.twin.task import TaskTwin
 from pkm.core.twin.tree import Twin
 from pkm.errors import PkmError, SpecError
 
@@ -133,7 +135,7 @@ class ExportModel:
         self.fk_columns = tuple(self.dyn.passive)
         self.ik_columns = tuple(c for c in range(mech.nv) if c not in base and c not in idle)
         self.qa = tw.target
-        self.y = tw.task.task_target
+        self.y = TaskTwin.of(tw).task_target
         self.dx_fk = cs.SX.sym("dx", len(self.fk_columns))
         self.dx_ik = cs.SX.sym("dx", len(self.ik_columns))
         self.closure_rhs = -tw.rotate_rows(tw.closure_residual)
@@ -196,7 +198,7 @@ class ExportModel:
     def ik(self) -> Newton:
         """The inverse kinematics for a task value ``target`` (laid out as :meth:`pkm.core.kinematics.task.TaskMap.value`):
         closure and task rows on every coordinate but a floating base's and the idle ones."""
-        tw, tk = self.twin, self.twin.task
+        tw, tk = self.twin, TaskTwin.of(self.twin)
         A = cs.vertcat(self.rows["jacobian"], tk.task_jacobian)[:, list(self.ik_columns)]
         rhs = cs.vertcat(self.closure_rhs, tk.task_error)
         residual = cs.vertcat(tw.closure_residual, tk.task_error)
@@ -211,7 +213,7 @@ class ExportModel:
     def task_value(self) -> cs.Function:
         """``q -> y``: the task value (as :meth:`pkm.core.kinematics.task.TaskMap.value`: positions, Z-Y-X angles,
         a pose's quaternion ``x y z w``, the joint outputs)."""
-        tw, tk = self.twin, self.twin.task
+        tw, tk = self.twin, TaskTwin.of(self.twin)
         out: list = []
         for fid, comps in tk._task_groups():
             M = tw.frame_placement(fid)
@@ -227,7 +229,7 @@ class ExportModel:
     def jacobians(self) -> cs.Function:
         """``q -> (J, K, pivot)``: the forward Jacobian ``J`` (task rates per actuated rate, task size x na), the
         inverse ``K`` (na x task size) and the smallest relative pivot of the two factorisations."""
-        tw, tk = self.twin, self.twin.task
+        tw, tk = self.twin, TaskTwin.of(self.twin)
         J = cs.jacobian(tk.task_jacobian @ self._rates, tw.qd)
         A = cs.vertcat(self.rows["jacobian"], tk.task_jacobian)[:, list(self.ik_columns)]
         lu = PivotedLU(A, tw.at_reference(A))
@@ -249,7 +251,7 @@ class ExportModel:
     def jdot_qdot(self) -> cs.Function:
         """``(q, qd) -> (c, pivot)``: the task acceleration at zero actuated acceleration, ``dJ/dt qd`` (task size),
         differentiated exactly along the closure's motion ``dq/dt = T(q) v``."""
-        tw, tk = self.twin, self.twin.task
+        tw, tk = self.twin, TaskTwin.of(self.twin)
         xd = tk.task_jacobian @ self._rates
         J = cs.jacobian(xd, tw.qd)
         c = cs.jtimes(J @ tw.qd, tw.q, tw.tangent @ self._rates)
@@ -324,7 +326,7 @@ class ExportModel:
             margin[k] = 1 - cs.fabs(ratio)
         fun = _function("ik_closed", [("y", self.y), ("signs", signs)],
                         [("qa", cs.vertcat(*qa)), ("margin", cs.vertcat(*margin))])
-        y_ref = mech.task_map.value(ref)
+        y_ref = TaskMap.of(mech).value(ref)
         chosen = []
         for k in range(mech.na):  # the reference's branch of each leg
             gaps = {}

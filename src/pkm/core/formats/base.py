@@ -39,6 +39,8 @@ class Imported:
             joint's ``armature``, its actuators' force limits...), under the spec's own.
         seed: Joint values where the assembly starts for the joints ``reference`` leaves out (an MJCF joint's
             ``ref``: MuJoCo's ``qpos0``, where the file's poses hold), instead of the neutral configuration.
+        springs: The joints' springs and dampers the file states, ``{joint: {"stiffness", "rest", "damping": value}}``
+            as a spec's ``[springs.<joint>]`` tables (:mod:`pkm.core.model.springs`), under the spec's own.
     """
 
     urdf: str
@@ -52,6 +54,7 @@ class Imported:
     notes: tuple[str, ...] = ()
     actuators: dict[str, dict[str, float]] = dataclasses.field(default_factory=dict)
     seed: dict[str, tuple[float, ...]] = dataclasses.field(default_factory=dict)
+    springs: dict[str, dict[str, float]] = dataclasses.field(default_factory=dict)
 
 
 @dataclass(frozen=True)

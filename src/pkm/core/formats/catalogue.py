@@ -9,6 +9,13 @@ as a user's own files would be: nothing in them was written for pkm. A name is `
 
 ``gepetto:kangaroo_like`` is shipped as a robot pkm must refuse: its 6-D loops do not close at any pose the file
 allows, and :func:`pkm.load` says which closure.
+
+MuJoCo Menagerie's robots (Google DeepMind's collection; each robot under its own licence, beside it) are MJCF files
+as published but for their meshes (mesh geoms and assets removed: kinematics and dynamics need none, every inertia is
+stated), in ``urdf/menagerie/<folder>/`` with the robot's ``LICENSE`` and a ``SOURCE.txt`` naming the repository, the
+path, the commit and every change. ``menagerie:cassie`` is Agility Robotics' Cassie (MIT): a real humanoid's legs,
+two loops each (the achilles rod from the hip to the heel spring, the plantar rod from the foot crank to the foot),
+a free-floating pelvis, ten motors, its reference the file's ``home`` key with its loops closed.
 """
 
 from __future__ import annotations
@@ -27,11 +34,14 @@ class CatalogueModel:
         folder: Its folder, relative to pkm's ``urdf/`` data folder.
         source: The project and licence it comes under (the licence file beside it).
         description: One line: what the robot is.
+        model: The file in ``folder`` that :func:`pkm.load` reads (an MJCF file alone), or ``""``: the folder itself
+            (a Gepetto URDF + YAML pair).
     """
 
     folder: str
     source: str
     description: str
+    model: str = ""
 
 
 _GEPETTO = "Gepetto/example-parallel-robots, BSD-3-Clause (urdf/gepetto/LICENSE)"
@@ -39,6 +49,11 @@ _GEPETTO = "Gepetto/example-parallel-robots, BSD-3-Clause (urdf/gepetto/LICENSE)
 
 def _gepetto(robot: str, description: str) -> tuple[str, CatalogueModel]:
     return f"gepetto:{robot}", CatalogueModel(f"gepetto/{robot}", _GEPETTO, description)
+
+
+def _menagerie(robot: str, folder: str, model: str, licence: str, description: str) -> tuple[str, CatalogueModel]:
+    source = f"google-deepmind/mujoco_menagerie, {licence} (urdf/menagerie/{folder}/LICENSE)"
+    return f"menagerie:{robot}", CatalogueModel(f"menagerie/{folder}", source, description, model)
 
 
 #: Every shipped third-party robot by name ``<source>:<robot>``, sorted.
@@ -53,24 +68,30 @@ CATALOGUE: dict[str, CatalogueModel] = dict([
     _gepetto("robot_delta", "a small Delta-like arm (links of about 5 cm): three 6-D loops, two motors"),
     _gepetto("talos_like", "a TALOS-like leg: one 6-D loop, six motors"),
     _gepetto("wl16_like", "a WL-16-like leg: five 6-D loops, six motors"),
+    _menagerie("cassie", "agility_cassie", "cassie.xml", "MIT",
+               "Agility Robotics' Cassie biped (MJCF, meshes removed): four 3-D loops, ten motors, a free pelvis"),
 ])
 
 
 def catalogue_path(name: str) -> Path:
-    """The folder of shipped robot ``name`` (``<source>:<robot>``).
+    """What :func:`pkm.load` reads of shipped robot ``name`` (``<source>:<robot>``): its folder, or its model file
+    (:attr:`CatalogueModel.model`).
 
     Raises:
         UnknownNameError: no such robot (the valid names listed).
-        SpecError: its folder is missing from this installation.
+        SpecError: its folder or file is missing from this installation.
     """
     from pkm.data import data_dir
 
     if name not in CATALOGUE:
         raise UnknownNameError("shipped robot", name, CATALOGUE, "pkm's catalogue of third-party robots")
-    folder = data_dir("urdf") / CATALOGUE[name].folder
-    if not folder.is_dir():
-        raise SpecError(name, f"the shipped robot's folder {folder} is missing from this installation")
-    return folder
+    entry = CATALOGUE[name]
+    folder = data_dir("urdf") / entry.folder
+    path = folder / entry.model if entry.model else folder
+    if not (path.is_file() if entry.model else path.is_dir()):
+        raise SpecError(name, f"the shipped robot's {'file' if entry.model else 'folder'} {path} is missing from "
+                              "this installation")
+    return path
 
 
 __all__ = ["CATALOGUE", "CatalogueModel", "catalogue_path"]

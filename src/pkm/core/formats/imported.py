@@ -66,24 +66,27 @@ def read_urdf(text: str, source: str = "<urdf>") -> Imported:
 
 
 def with_file(spec: ClosureSpec, imp: Imported, source: str) -> ClosureSpec:
-    """``spec`` with the loops, joint types, floating base and the spec's actuated joints' drive values of the model
-    file it names added (the spec's win, a drive's field by field).
+    """``spec`` with the loops, joint types, floating base, springs and the spec's actuated joints' drive values of the
+    model file it names added (the spec's win, a drive's or a spring's field by field; a joint the spec's
+    ``[joint_types]`` makes ``"fixed"`` keeps no spring: held rigid).
 
     Raises:
         SpecError: a closure named both in the spec and in the file.
     """
     if not imp.closures and not imp.joint_types and imp.floating_base is None and not imp.reference \
-            and not imp.actuators:
+            and not imp.actuators and not imp.springs:
         return spec
     clash = sorted({c.name for c in spec.closures} & {c.name for c in imp.closures})
     if clash:
         raise SpecError(source, f"closure {clash[0]!r} is both in the spec and in {spec.urdf!r}; rename the spec's")
-    return dataclasses.replace(spec, closures=imp.closures + spec.closures,
-                               joint_types={**imp.joint_types, **spec.joint_types},
+    joint_types = {**imp.joint_types, **spec.joint_types}
+    return dataclasses.replace(spec, closures=imp.closures + spec.closures, joint_types=joint_types,
                                floating_base=spec.floating_base or imp.floating_base,
                                reference={**imp.reference, **spec.reference},
                                actuators={j: {**imp.actuators.get(j, {}), **spec.actuators.get(j, {})}
-                                          for j in spec.actuated if j in imp.actuators or j in spec.actuators})
+                                          for j in spec.actuated if j in imp.actuators or j in spec.actuators},
+                               springs={j: {**imp.springs.get(j, {}), **spec.springs.get(j, {})}
+                                        for j in {**imp.springs, **spec.springs} if joint_types.get(j) != "fixed"})
 
 
 def spec_skeleton(path: Path) -> tuple[str, bool]:

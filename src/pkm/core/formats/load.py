@@ -163,7 +163,7 @@ def load_model_file(path: Path, given: Given = Given()) -> Mechanism:
     spec = ClosureSpec(mechanism=imp.name, urdf=path.name, end_effector=None, actuated=imp.actuated,
                        closures=imp.closures, task=TaskSpec((), imp.actuated), reference=dict(imp.reference),
                        description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types,
-                       floating_base=imp.floating_base, actuators=imp.actuators)
+                       floating_base=imp.floating_base, actuators=imp.actuators, springs=imp.springs)
     spec, read = with_given(spec, given, str(path))
     return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes + read, seed=imp.seed)
 

@@ -7,7 +7,9 @@ does not keep, from the file itself:
 * ``<connect>`` gives a ``point`` closure and ``<weld>`` a ``frame`` closure, named by the equality's
   ``name`` (else ``connect1``, ``weld2``...); their anchors become frames ``<name>_a`` (on ``body1``)
   and ``<name>_b`` (on ``body2``, the world when it is omitted); an equality between two sites
-  (``site1``, ``site2``) closes those sites' frames (origins for a connect, frames for a weld);
+  (``site1``, ``site2``) closes those sites' frames (origins for a connect, frames for a weld; a site whose name
+  a body or a joint shares, as MJCF allows, on a frame of its own, ``<site>_site``, that a lookup by name cannot
+  confuse with them);
   an equality with ``active="false"`` is left out (a note says so); a weld is read as MuJoCo reads it,
   ``X1 relpose = X2 T(anchor)``: ``relpose`` (body2's pose in body1's frame, position then quaternion ``w x y
   z``; without it the pose at ``qpos0``), ``anchor`` (the point of body2 it holds), ``torquescale="0"`` (the
@@ -33,7 +35,12 @@ does not keep, from the file itself:
   ``gear`` and the tendon's coefficient or the mimic scale; several actuators on one joint add; the joint's
   ``actuatorfrcrange`` caps the sum. An asymmetric range reads as its smaller magnitude, a one-sided one as its
   larger (a note says so), ``1e6`` or more as none. What is not stated stays at the defaults (no friction, no
-  limit); the servo gains (``kp``, ``kv``) and the drives of joints no actuator moves are not read (notes);
+  limit); the servo gains (``kp``, ``kv``) and the armature and friction of joints no actuator moves are not read
+  (notes);
+* joint springs and dampers (:attr:`Imported.springs`, a spec's ``[springs.<joint>]`` tables:
+  :mod:`pkm.core.model.springs`): a hinge's or slide's ``stiffness`` and ``springref`` (MuJoCo's rest position, in
+  degrees for a hinge as ``ref``), and the ``damping`` of a joint no actuator drives; named in the notes, not applied
+  by pkm's dynamics; a ball's and a coupled joint's are not read (a note);
 * joint names and position limits (``range``, in degrees unless ``<compiler angle="radian">``, for
   hinges only; a slide's range is a length), with ``<default>`` classes and ``childclass``; a body with
   several joints keeps each one's name (Pinocchio joins them into one composite joint). ``q`` is MuJoCo's
@@ -42,9 +49,14 @@ does not keep, from the file itself:
   ``<body>_hinge``, ``<body>_hinge_2`` (the second), ``<body>_slide``, ``<body>_ball``; a body
   ``<parent>_child`` (``_child_2``...); a derived name never takes one the file uses;
 * the reference configuration: the ``<keyframe><key name="reference">`` (the one :func:`pkm.save` writes), held
-  (a ``qpos`` of another length is refused naming its line); without it the mechanism is assembled starting from
-  MuJoCo's ``qpos0`` (hinges and slides at their ``ref``, free bodies where the file puts them), where a
-  ``<connect>``'s second anchor is taken (also for the connects pkm re-anchors: those to free bodies);
+  (a ``qpos`` of another length is refused naming its line, as in every key); without it, the first key whose
+  hinges and slides lie inside their ranges (MuJoCo Menagerie's ``home``: a pose MuJoCo's soft equalities leave
+  open by a millimetre or so): its free bodies and actuated joints held, the loops closed by moving the other joints
+  from it (a note names the key, the keys passed over, and how far the closing moved them); without any, assembled
+  starting from MuJoCo's ``qpos0`` (hinges and slides at their ``ref``, free bodies where the file puts them), where
+  a ``<connect>``'s second anchor is taken (also for the connects pkm re-anchors: those to free bodies). An
+  assembled reference outside a joint's range is assembled again inside it, else said
+  (:func:`pkm.core.model.builder.build`);
 * ``euler`` angles in any ``<compiler eulerseq>`` (three of ``xyzXYZ``: lower case about the moving axes,
   upper case about the fixed ones, mixed allowed): pkm writes each ``euler`` (bodies, geoms, sites,
   inertials, cameras, default classes...) as the ``quat`` MuJoCo computes, in the copy Pinocchio reads;
@@ -85,6 +97,7 @@ from lxml import etree
 from pkm.core.formats.base import Imported
 from pkm.core.model.actuators import UNLIMITED, Actuator
 from pkm.core.model.spec import Closure
+from pkm.core.model.springs import describe, parse_springs
 from pkm.core.model.urdf import floats, num, parse_xml, urdf_from_model
 from pkm.errors import InvalidInputError, SpecError, SpecNameError
 
@@ -400,7 +413,8 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             body_joints[names[0]] = names
     if derived:
         notes.append(f"names derived for what the file leaves unnamed: {', '.join(derived)}")
-    key_qpos = _keyframe(root, world, kinds, source)
+    keys = _keyframes(root, world, kinds, source)
+    key_name, key_qpos = _key_chosen(keys, limits, notes)
 
     equalities = []
     for el in [el for el in root.findall("equality/*") if isinstance(el.tag, str)]:
@@ -441,7 +455,7 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
     for k, el in enumerate(el for el in equalities if el not in on_sites):  # Pinocchio returns them by name
         el.set("name", f"pkm{k:06d}")
     unread = [el.tag for el in root if isinstance(el.tag, str) and el.tag in _UNREAD
-              and not (el.tag == "keyframe" and key_qpos and len(el) == 1)]
+              and not (el.tag == "keyframe" and key_qpos)]  # (the keys not read: noted by _key_chosen)
     for el in root.findall("keyframe"):  # (Pinocchio checks their sizes; pkm reads the reference key itself)
         root.remove(el)
     if unread:
@@ -472,26 +486,52 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
                                        if el.tag == "weld" and el not in on_sites], defaults, source)
     taken = set(model.names) | {f.name for f in model.frames}
     extra: list[tuple[str, int, pin.SE3]] = []
-    for site in world.iter("site"):  # the sites Pinocchio dropped (those of bodies without joints)
-        if site.get("name") and site.get("name") not in taken:
-            body = site.getparent().get("name")
-            if not model.existFrame(body, pin.FrameType.BODY):
-                continue
-            bf = model.frames[model.getFrameId(body, pin.FrameType.BODY)]
-            pos = _floats(defaults.get(site, "pos", "0 0 0"), 3, f"site {site.get('name')!r} pos", source)
-            extra.append((site.get("name"), bf.parentJoint, bf.placement * pin.SE3(_rotation(site, degrees, source),
-                                                                                     pos)))
-            taken.add(site.get("name"))
+    site_els = {str(site.get("name")): site for site in world.iter("site") if site.get("name")}
+
+    def site_placement(site: etree._Element) -> tuple[int, pin.SE3] | None:
+        """A site's joint and placement in it: Pinocchio's frame of the site, else from its body (None: a site of
+        a body Pinocchio does not have)."""
+        name = str(site.get("name"))
+        if model.existFrame(name, pin.FrameType.OP_FRAME):
+            f = model.frames[model.getFrameId(name, pin.FrameType.OP_FRAME)]
+            return f.parentJoint, f.placement
+        body = site.getparent().get("name")
+        if not model.existFrame(body, pin.FrameType.BODY):
+            return None
+        bf = model.frames[model.getFrameId(body, pin.FrameType.BODY)]
+        pos = _floats(defaults.get(site, "pos", "0 0 0"), 3, f"site {name!r} pos", source)
+        return bf.parentJoint, bf.placement * pin.SE3(_rotation(site, degrees, source), pos)
+
+    for sname, site in site_els.items():  # the sites Pinocchio dropped (those of bodies without joints)
+        if sname not in taken and (at := site_placement(site)) is not None:
+            extra.append((sname, *at))
+            taken.add(sname)
+    aliases: dict[str, str] = {}
+
+    def site_frame(sname: str) -> str:
+        """The frame a closure on site ``sname`` names: the site's own, else (its name shared by a body or a joint,
+        as MJCF allows, where a lookup by name would find those) a frame of a fresh name at the site."""
+        if sname in aliases:
+            return aliases[sname]
+        same = [f for f in model.frames if f.name == sname]
+        if [f.type for f in same] in ([pin.FrameType.OP_FRAME], []) and not model.existJointName(sname):
+            return sname
+        at = site_placement(site_els[sname])
+        assert at is not None  # (a site in taken: its body is in the model)
+        aliases[sname] = _fresh(f"{sname}_site", taken)
+        extra.append((aliases[sname], *at))
+        return aliases[sname]
+
     closures = []
     iters = {"connect": iter(points), "weld": iter(welds)}
-    site_names = sorted(str(site.get("name")) for site in world.iter("site") if site.get("name") in taken)
+    site_names = sorted(n for n in site_els if n in taken)
     for tag, name, on, kind, line in eq_names:
         if on is not None:  # the two sites coincide (connect: their origins; weld: their frames)
             for key, site_name in zip(("site1", "site2"), on):
                 if site_name not in taken:
                     raise SpecNameError(source, "site", str(site_name), site_names,
                                         f"<equality><{tag} name={name!r}> (line {line}) {key}")
-            closures.append(Closure(name, kind, *on))
+            closures.append(Closure(name, kind, *(site_frame(str(s)) for s in on)))
             continue
         cm = next(iters[tag])
         frames = []
@@ -504,6 +544,9 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             frames.append(fname)
         closures.append(Closure(name, kind, *frames))
 
+    if aliases:
+        notes.append(f"sites whose names a body or a joint shares are closed on frames of their own: "
+                     f"{', '.join(f'{s} -> {a}' for s, a in aliases.items())}")
     joint_names = {f"Composite_{first}": parts for first, parts in body_joints.items() if len(parts) > 1}
     name = root.get("model", "mjcf")
     locked = {j: v for j in kinds if (v := couplings.value(j)) is not None}
@@ -532,16 +575,24 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
                   if j.get("type") == "continuous"}
     keyed = _pinocchio_values(key_qpos, kinds, dependent, continuous)
     seed = {} if keyed else {j: _value(v, j in continuous) for j, v in refs.items() if v != 0.0 and j not in dependent}
-    if keyed:
+    if keyed and key_name == _KEY:
         reference = keyed
         notes.append(f"the reference configuration is the <keyframe><key name={_KEY!r}> (the one pkm writes)")
+    elif keyed:  # another key (Menagerie's "home"): its free bodies and motors held, the passive joints closed from it
+        held = [j for j in keyed if kinds[j] == "free" or j in actuated]
+        reference = {j: keyed[j] for j in held}
+        seed = {j: v for j, v in keyed.items() if j not in held}
+        notes.append(f"the reference configuration is the <keyframe><key name={key_name!r}>, the first key inside "
+                     "every joint limit, its loops closed by moving the joints no actuator drives (its free bodies "
+                     "and actuated joints held)")
     elif seed:
         notes.append(f"assembled from the joints' ref (MuJoCo's qpos0, where the file's poses hold): "
                      f"{', '.join(seed)}")
     if len(set(actuated)) < len(actuated):
         notes.append("several actuators drive the same joint: it is one input")
+    springs = _springs(world, defaults, kinds, set(actuated), dependent, degrees, notes, source)
     return Imported(urdf, tuple(closures), types, tuple(dict.fromkeys(actuated)), name, "mjcf", _floating_base(model),
-                    reference, tuple(notes), actuators, seed)
+                    reference, tuple(notes), actuators, seed, springs)
 
 
 #: The ``<keyframe><key>`` read as the reference configuration (:func:`pkm.save` writes it).
@@ -554,25 +605,51 @@ def _value(angle: float, continuous: bool) -> tuple[float, ...]:
     return (float(np.cos(angle)), float(np.sin(angle))) if continuous else (float(angle),)
 
 
-def _keyframe(root: etree._Element, world: etree._Element, kinds: dict[str, str],
-              source: str) -> dict[str, list[float]]:
-    """``{joint: its qpos}`` of the ``<key name="reference">`` (MuJoCo's order: the joints as the file nests them),
-    ``{}`` without that key.
+def _keyframes(root: etree._Element, world: etree._Element, kinds: dict[str, str],
+               source: str) -> list[tuple[str, dict[str, list[float]]]]:
+    """``[(name, {joint: its qpos})]`` of the ``<keyframe><key>`` elements that state a ``qpos`` (MuJoCo's order: the
+    joints as the file nests them), in file order; an unnamed key is named ``key <k>`` (its rank).
 
     Raises:
         SpecError: a ``qpos`` of the wrong length, or not numbers (naming the key's line).
     """
-    key = next((k for k in root.findall("keyframe/key") if k.get("name") == _KEY), None)
-    if key is None or key.get("qpos") is None:
-        return {}
     joints = [str(j.get("name")) for j in world.iter("joint", "freejoint")]
     width = sum(_QPOS[kinds[j]] for j in joints)
-    qpos = _floats(key.get("qpos"), width, f"<keyframe><key name={_KEY!r}> (line {key.sourceline}) qpos", source)
-    out, k = {}, 0
-    for j in joints:
-        out[j] = [float(x) for x in qpos[k:k + _QPOS[kinds[j]]]]
-        k += _QPOS[kinds[j]]
+    out = []
+    for rank, key in enumerate(root.findall("keyframe/key"), 1):
+        if key.get("qpos") is None:
+            continue
+        name = key.get("name") or f"key {rank}"
+        qpos = _floats(key.get("qpos"), width, f"<keyframe><key name={name!r}> (line {key.sourceline}) qpos", source)
+        values, k = {}, 0
+        for j in joints:
+            values[j] = [float(x) for x in qpos[k:k + _QPOS[kinds[j]]]]
+            k += _QPOS[kinds[j]]
+        out.append((name, values))
     return out
+
+
+def _key_chosen(keys: list[tuple[str, dict[str, list[float]]]], limits: dict[str, tuple[float, float]],
+                notes: list[str]) -> tuple[str | None, dict[str, list[float]]]:
+    """The key the reference comes from: ``reference`` (pkm's, whatever its values), else the first key whose hinges
+    and slides lie inside their ranges (Menagerie's ``home``), else none; notes name the keys passed over (those
+    outside a range, with the joints) and those not read."""
+    chosen = next((k for k, (name, _) in enumerate(keys) if name == _KEY), None)
+    chosen_by_name = chosen is not None
+    skipped: list[str] = []
+    for k, (name, values) in enumerate(keys if chosen is None else ()):
+        outside = [j for j, (lo, hi) in limits.items() if j in values and not lo - 1e-9 <= values[j][0] <= hi + 1e-9]
+        if not outside:
+            chosen = k
+            break
+        skipped.append(f"{name!r} ({', '.join(outside)})")
+    if skipped:
+        notes.append(f"keys outside the joint limits not taken for the reference: {'; '.join(skipped)}")
+    unread = [name for k, (name, _) in enumerate(keys) if chosen is not None and k != chosen
+              and (chosen_by_name or k > chosen)]
+    if unread:
+        notes.append(f"keys not read (the reference is one key): {', '.join(map(repr, unread))}")
+    return (None, {}) if chosen is None else keys[chosen]
 
 
 def _pinocchio_values(qpos: dict[str, list[float]], kinds: dict[str, str], dependent: set[str],
@@ -791,10 +868,44 @@ def _drives(drives: list[_Drive], defaults: _Defaults, world: etree._Element, no
         if values:
             out[joint] = values
     passive = [n for n, el in elements.items() if n not in efforts
-               and any((defaults.get(el, key) or "0").strip() not in ("0", "0.0") for key, _ in _DRIVE_KEYS)]
+               and any((defaults.get(el, key) or "0").strip() not in ("0", "0.0") for key in ("armature", "frictionloss"))]
     if passive:
-        notes.append(f"armature, damping and frictionloss of joints no actuator drives are not read: "
-                     f"{', '.join(passive)}")
+        notes.append(f"armature and frictionloss of joints no actuator drives are not read (their damping is a "
+                     f"[springs] entry): {', '.join(passive)}")
+    return out
+
+
+def _springs(world: etree._Element, defaults: _Defaults, kinds: dict[str, str], actuated: set[str],
+             dependent: set[str], degrees: bool, notes: list[str], source: str) -> dict[str, dict[str, float]]:
+    """``{joint: {"stiffness", "rest", "damping": value}}`` (:mod:`pkm.core.model.springs`) of the hinges and slides
+    whose ``stiffness`` or (for a joint no actuator drives: a driven joint's damping is its drive's) ``damping`` is not
+    zero: ``rest`` is MuJoCo's ``springref`` (in degrees for a hinge unless ``<compiler angle="radian">``, as ``ref``).
+    A note names them, and says that pkm's dynamics do not apply them; the springs of ball joints and of joints an
+    ``<equality><joint>`` ties are not read (a note)."""
+    out: dict[str, dict[str, float]] = {}
+    unread = []
+    for el in world.iter("joint"):
+        name = str(el.get("name"))
+        stiffness, damping, rest = (floats(defaults.get(el, key, "0"), 1, f"joint {name!r} {key}", source, np.inf)[0]
+                                    for key in ("stiffness", "damping", "springref"))
+        if name in actuated:
+            damping = 0.0
+        if stiffness == 0.0 and damping == 0.0:
+            continue
+        if kinds[name] not in ("hinge", "slide") or name in dependent:
+            unread.append(name)
+            continue
+        values = {"stiffness": stiffness, "rest": float(np.deg2rad(rest)) if kinds[name] == "hinge" and degrees
+                  else rest} if stiffness != 0.0 else {}
+        if damping != 0.0:
+            values["damping"] = damping
+        out[name] = values
+    if out:
+        notes.append(f"joint springs and dampers read into [springs], their forces not applied by pkm's dynamics: "
+                     f"{describe(parse_springs(out, source))}")
+    if unread:
+        notes.append(f"the stiffness and damping of ball joints and of joints an <equality><joint> ties are not "
+                     f"read: {', '.join(unread)}")
     return out
 
 

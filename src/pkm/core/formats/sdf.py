@@ -57,9 +57,10 @@ traversal of the URDF, which visits the children of a link in the order of their
 joint name sorts first (Cassie's ``left-knee-ip`` before ``left-knee-op``), pkm hangs the rotor's joint from a
 massless link ``<gearbox>__rotor_mount``, fixed to the reference body by a joint ``<output joint>__<gearbox>``,
 which sorts after the output's (a workaround of that Pinocchio 4.1 restriction, pinned by a test). The rotor's
-SDF position limits, if any, are dropped: its coordinate is the output's. Each gearbox so read, and the joints
-whose ``<spring_stiffness>`` is left unread, are listed in :attr:`Imported.notes
-<pkm.core.formats.base.Imported.notes>`. SDFormat booleans (``use_parent_model_frame``) are ``true`` or ``1``.
+SDF position limits, if any, are dropped: its coordinate is the output's. A revolute's or prismatic's
+``<spring_stiffness>`` and ``<spring_reference>`` are its ``[springs]`` entry (:mod:`pkm.core.model.springs`: read,
+not applied by pkm's dynamics; its ``<damping>`` is the joint's friction, as above). Each gearbox so read, and the
+springs, are listed in :attr:`Imported.notes <pkm.core.formats.base.Imported.notes>`. SDFormat booleans (``use_parent_model_frame``) are ``true`` or ``1``.
 
 Refused with a :class:`~pkm.errors.SpecError`: nested models, ``<include>``, universal and screw joints, a mimic
 without a multiplier or not between two tree joints, ``<pkm:position>`` on a joint cutting a loop, a
@@ -78,6 +79,7 @@ from lxml import etree
 
 from pkm.core.formats.base import Imported
 from pkm.core.model.spec import Closure
+from pkm.core.model.springs import describe, parse_springs
 from pkm.core.model.urdf import check_urdf, floats, num, origin, parse_xml
 from pkm.errors import SpecError
 
@@ -504,10 +506,21 @@ def _read_sdf(text: str, source: str) -> Imported:
     check_urdf(urdf, source)
     notes = [f"gearbox {gear!r} read as a mimic joint: {rotor} = {mult:.6g} {output}"
              for rotor, (output, mult, gear) in mimic.items()]
-    springs = [j.get("name") for j in joints if _text(j, "axis/dynamics/spring_stiffness") is not None]
+    springs = {}
+    for j in joints:
+        name = str(j.get("name"))
+        stiffness, rest = (floats(_text(j, f"axis/dynamics/{key}", "0"), 1, f"joint {name!r} {key}", source, np.inf)[0]
+                           for key in ("spring_stiffness", "spring_reference"))
+        if stiffness != 0.0 and (j.get("type") not in ("revolute", "prismatic") or name in mimic):
+            raise SpecError(source, f"joint {name!r}: a spring on a {j.get('type')} joint"
+                                    + (" that a gearbox drives" if name in mimic else "") + " (pkm reads the springs "
+                                    "of revolute and prismatic joints)")
+        if stiffness != 0.0:
+            springs[name] = {"stiffness": stiffness, "rest": rest}
     if springs:
-        notes.append(f"the spring stiffness of joints {springs} is not read: they are plain joints")
-    return Imported(urdf, tuple(closures), types, (), robot.get("name"), "sdf", notes=tuple(notes))
+        notes.append(f"joint springs read into [springs], their forces not applied by pkm's dynamics: "
+                     f"{describe(parse_springs(springs, source))}")
+    return Imported(urdf, tuple(closures), types, (), robot.get("name"), "sdf", notes=tuple(notes), springs=springs)
 
 
 __all__ = ["read_sdf"]

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import re
 import weakref
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import TYPE_CHECKING
@@ -29,11 +30,12 @@ from pkm.core.identification.regressor import Parameters, parameters, regressor
 from pkm.core.kinematics.solve import close_loops
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import ConvergenceError, InvalidInputError, SingularityError
+from pkm.validation import as_scalar
 
 if TYPE_CHECKING:
     from pkm.core.identification.precise import PreciseRank
 
-_STATES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # mechanism -> {(n, seed, spread): states}
+_STATES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # mechanism -> {(n, seed, spreads): states}
 MAX_SAMPLES = 10_000  # states stacked at most (each costs about a millisecond)
 COEFFICIENT_TOL = 1e-6  # coefficients of K on unit-norm columns under this are dropped (rounding of R_11^-1 R_12)
 
@@ -146,30 +148,73 @@ def _name(names: tuple[str, ...], lead: int, terms: list[tuple[int, float]]) -> 
     return out
 
 
-def random_states(mech: Mechanism, n: int, seed: int = 0, spread: float = 0.1) -> list[tuple[np.ndarray, np.ndarray,
-                                                                                              np.ndarray]]:
-    """``n`` random regular states ``(q, qd, qdd)``: each actuated coordinate moved by up to ``spread`` [rad or m]
-    from the reference and closed from it (states that do not close or are singular are drawn again), rates and
-    accelerations standard normal. The last few draws are kept per mechanism (the tied and untied base parameters
-    share theirs: the hexapod's 107 states cost 8 s)."""
+#: Default bound of ``|q_j - q_j,reference|`` per unit [rad or m]: an excitation's amplitude
+#: (:mod:`~pkm.core.identification.excitation`), a calibration pose's spread (:mod:`pkm.core.calibration.poses`).
+AMPLITUDE = {"rad": 0.3, "m": 0.03}
+#: The random states' spread per unit (:func:`random_states`: the base parameters need generic states, not large ones).
+STATE_SPREAD = {"rad": 0.1, "m": 0.1}
+
+
+def per_unit(mech: Mechanism, value: float | Mapping[str, float], name: str, joints: Sequence[str] | None = None) \
+        -> np.ndarray:
+    """An amount per actuated coordinate (na; per joint of ``joints``, one-coordinate joints, where given) [rad or m]:
+    ``value`` a mapping by unit (``{"rad": 0.3, "m": 0.03}``: each joint takes its unit's), or one positive number,
+    the same in every joint's unit: refused where revolute and prismatic joints mix (there it would mean rad and m
+    alike).
+
+    Raises:
+        InvalidInputError: a number on a mixed mechanism, a missing unit, a value that is not positive.
+    """
+    units = ["rad" if mech.joints[j].revolute else "m" for j in (mech.actuated_names if joints is None else joints)]
+    if not isinstance(value, Mapping):
+        number = as_scalar(value, name, low=0.0, strict_low=True)
+        if len(set(units)) > 1:
+            raise InvalidInputError(name, f"one number ({number:g}) for revolute and prismatic joints alike: give "
+                                          f"one per unit, {{'rad': ..., 'm': ...}}", value)
+        return np.full(len(units), number)
+    missing = sorted(set(units) - set(value))
+    if missing:
+        raise InvalidInputError(name, f"no value for the {', '.join(missing)} joints (expected a mapping by unit, "
+                                      f"'rad' and 'm')", dict(value))
+    return np.array([as_scalar(value[u], f"{name}[{u!r}]", low=0.0, strict_low=True) for u in units])
+
+
+def closed_draws(mech: Mechanism, rng: np.random.Generator, spread: np.ndarray, tries: int) \
+        -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Random actuator readings ``qa`` about the reference, each within ``spread`` (na) [rad or m] of it (uniform),
+    with their closed configurations ``q`` (closed from the reference, within the joint limits): ``(qa, q)`` for
+    each of ``tries`` draws that closes (one that does not close or is singular is passed over). The one draw of
+    :func:`random_states` and the calibration's candidate poses (:func:`pkm.core.calibration.poses.candidates`)."""
+    qa0 = mech.actuated_q(mech.q_reference)
+    for _ in range(tries):
+        qa = qa0 + rng.uniform(-spread, spread, mech.na)
+        try:
+            q = close_loops(mech, qa, mech.q_reference).q
+        except (ConvergenceError, SingularityError):
+            continue
+        if not mech.outside_limits(q):
+            yield qa, q
+
+
+def random_states(mech: Mechanism, n: int, seed: int = 0, spread: float | Mapping[str, float] | None = None) \
+        -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """``n`` random regular states ``(q, qd, qdd)``: each actuated coordinate moved by up to ``spread`` [rad or m;
+    :func:`per_unit`, default :data:`STATE_SPREAD`] from the reference and closed from it (:func:`closed_draws`:
+    states that do not close or are singular are drawn again), rates and accelerations standard normal. The last
+    few draws are kept per mechanism (the tied and untied base parameters share theirs: the hexapod's 107 states
+    cost 8 s)."""
     mech = check_mechanism(mech)
-    key = (n, seed, spread)
+    bound = per_unit(mech, STATE_SPREAD if spread is None else spread, "spread")
+    key = (n, seed, bound.tobytes())
     kept = _STATES.setdefault(mech, {})
     if key in kept:
         return [(q.copy(), qd.copy(), qdd.copy()) for q, qd, qdd in kept[key]]
     rng = np.random.default_rng(seed)
-    qa0 = mech.actuated_q(mech.q_reference)
     out: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
-    for _ in range(20 * n):
+    for _, q in closed_draws(mech, rng, bound, 20 * n):
+        out.append((q, rng.standard_normal(mech.na), rng.standard_normal(mech.na)))
         if len(out) == n:
             break
-        try:
-            q = close_loops(mech, qa0 + rng.uniform(-spread, spread, mech.na), mech.q_reference).q
-        except (ConvergenceError, SingularityError):
-            continue
-        if mech.outside_limits(q):
-            continue
-        out.append((q, rng.standard_normal(mech.na), rng.standard_normal(mech.na)))
     if len(out) < n:
         raise InvalidInputError("spread", f"only {len(out)} of {n} random states closed within the limits", spread)
     if len(kept) >= 4:
@@ -252,5 +297,5 @@ def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int 
                           T, names if T is not None else (), second)
 
 
-__all__ = ["CLEAR_GAP", "BaseParameters", "BaseSplit", "RankDecision", "base_parameters", "base_split", "decide_rank",
-           "leg_ties", "random_states"]
+__all__ = ["AMPLITUDE", "CLEAR_GAP", "STATE_SPREAD", "BaseParameters", "BaseSplit", "RankDecision", "base_parameters",
+           "base_split", "closed_draws", "decide_rank", "leg_ties", "per_unit", "random_states"]

@@ -80,7 +80,7 @@ def consistent_estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: Array
     """The physically consistent estimate from N samples (as :func:`pkm.estimate` takes them; module doc).
 
     Raises:
-        MissingDependencyError: cvxpy or Clarabel missing (``pip install "pkm[identify]"``).
+        MissingDependencyError: cvxpy or Clarabel missing (``pip install "pkm-robotics[identify]"``).
         ConvergenceError: the solver did not reach an optimal solution (its status in the message).
         InvalidInputError, SingularityError: as :func:`pkm.estimate`.
 

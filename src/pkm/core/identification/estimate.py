@@ -9,9 +9,15 @@ about 10 %: poorly).
 
 **Warnings** (:class:`~pkm.errors.PoorIdentificationWarning`, the same sentences in :attr:`Estimate.warnings`):
 fewer than :data:`EQUATIONS_PER_PARAMETER` equations (samples times actuators) per base parameter (the
-standard deviations themselves are then poorly known), and every base parameter whose relative standard deviation
-exceeds :data:`POOR_RELATIVE_STD` (its estimate cannot be told from zero: its true value may be zero, a drive
-without friction, or the motion does not excite it). Remedies: a longer or better-excited run (:func:`pkm.excite`),
+standard deviations themselves are then poorly known), and every base parameter that is poorly identified: its
+relative standard deviation above :data:`POOR_RELATIVE_STD` (its estimate cannot be told from zero) **and** its
+uncertainty a share of the efforts above :data:`POOR_EFFORT_SHARE` (``s_i |W_β,i| / |τ|`` on the weighted rows,
+:attr:`Estimate.effort_share`: the efforts a change of one standard deviation in it makes, over the efforts). The
+second condition is the parameter's own scale, which does not vanish with its value: a parameter zero by symmetry
+(a symmetric link's first moment, a drive without friction) is estimated near zero with a deviation that spans a
+tiny share of the efforts, so it is *determined* (to be zero), and its relative deviation, always above 100 %,
+says nothing; one the motion does not excite, or that is told apart from others only by the noise, spans more.
+Remedies: a longer or better-excited run (:func:`pkm.excite`),
 a higher filter cutoff (fewer samples decimated away, :func:`pkm.core.identification.measurements.measurements`),
 fewer parameters (legs tied: ``tie_legs=True``, ``pkm identify --tie-legs``).
 """
@@ -32,7 +38,11 @@ from pkm.errors import InvalidInputError, PoorIdentificationWarning, Singularity
 from pkm.validation import as_array
 
 EQUATIONS_PER_PARAMETER = 3  # fewer equations than this per base parameter: a warning
-POOR_RELATIVE_STD = 100.0  # [%] a base parameter's relative standard deviation above this: a warning
+POOR_RELATIVE_STD = 100.0  # [%] a base parameter's relative standard deviation above this: poor, where ...
+#: ... its standard deviation's efforts (``s_i |W_β,i|``) also exceed this share of the efforts ``|τ|`` (weighted
+#: rows): measured on 900 noisy equations (1 % of each actuator's range) of the Delta, its parameters zero by symmetry
+#: span 1e-4 to 1e-3 and those the noise confounds 0.08 to 0.1; on the identification tour's exact table, 3e-6 to 4e-3
+POOR_EFFORT_SHARE = 0.01
 SHOWN = 6  # a warning's message names this many poorly identified parameters (its ``poor`` attribute holds all)
 
 
@@ -45,6 +55,10 @@ class Estimate:
         values: ``β̂`` (n_base,).
         std: Their standard deviations (n_base,).
         relative_std: ``100 std / |values|`` [%] (inf where a value is zero).
+        effort_share: ``std |W_β,i| / |τ|`` on the weighted rows: the share of the efforts one standard deviation
+            of each parameter makes (module doc).
+        poor: (property) Which are poorly identified (module doc: ``relative_std`` above
+            :data:`POOR_RELATIVE_STD` and ``effort_share`` above :data:`POOR_EFFORT_SHARE`).
         residual_rms: Each actuator's residual RMS [N m, N] (unweighted).
         weights: Each actuator's weight (1 for ordinary least squares).
         method: ``"ols"`` or ``"wls"``.
@@ -56,11 +70,17 @@ class Estimate:
     values: np.ndarray
     std: np.ndarray
     relative_std: np.ndarray
+    effort_share: np.ndarray
     residual_rms: np.ndarray
     weights: np.ndarray
     method: str
     rows: int
     warnings: tuple[str, ...] = ()
+
+    @property
+    def poor(self) -> np.ndarray:
+        """Which base parameters are poorly identified (module doc), a boolean per parameter."""
+        return _poor(self.relative_std, self.effort_share)
 
     def predict(self, Y: ArrayLike) -> np.ndarray:
         """The efforts ``Y_β β̂`` of a standard regressor ``Y`` (rows as stacked by :func:`regressor`)."""
@@ -141,16 +161,17 @@ def estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, TAU: 
     std = np.sqrt(sigma2 * diag)
     with np.errstate(divide="ignore"):
         rel = np.where(beta != 0.0, 100.0 * std / np.abs(beta), np.inf)
+    share = std * np.linalg.norm(W * w[:, None], axis=0) / np.linalg.norm(y * w)
     rms = np.sqrt(np.mean(((y - W @ beta).reshape(n, mech.na)) ** 2, axis=0))
     with np.errstate(over="ignore"):
         beta, std, rms, weights = beta * s, std * s, rms * s, weights / s if weighted else weights
     if not all(np.all(np.isfinite(a)) for a in (beta, std, rms, weights)):
         raise InvalidInputError("TAU", f"efforts up to {peak:.3g} [N m, N] overflow the estimate (its values, "
                                        "standard deviations or residuals beyond 1.8e308)", peak)
-    found = _warnings(base, n, len(y), rel)
+    found = _warnings(base, n, len(y), rel, share)
     for warning in found:
         warnings.warn(warning, stacklevel=2)
-    return Estimate(base, beta, std, rel, rms, weights, "wls" if weighted else "ols", len(y),
+    return Estimate(base, beta, std, rel, share, rms, weights, "wls" if weighted else "ols", len(y),
                     tuple(str(w) for w in found))
 
 
@@ -161,11 +182,17 @@ def _scale(peak: float) -> float:
     return 1.0 if 2.0**-500 <= peak <= 2.0**500 or peak == 0.0 else math.ldexp(1.0, math.frexp(peak)[1] - 1)
 
 
-def _warnings(base: BaseParameters, samples: int, equations: int,
-              relative_std: np.ndarray) -> list[PoorIdentificationWarning]:
+def _poor(relative_std: np.ndarray, effort_share: np.ndarray) -> np.ndarray:
+    """The poorly identified parameters (module doc)."""
+    return ~(relative_std <= POOR_RELATIVE_STD) & ~(effort_share <= POOR_EFFORT_SHARE)
+
+
+def _warnings(base: BaseParameters, samples: int, equations: int, relative_std: np.ndarray,
+              effort_share: np.ndarray) -> list[PoorIdentificationWarning]:
     """The module doc's warnings of an estimate from ``samples`` samples (``equations`` rows)."""
     nb = len(base)
-    poor = [(name, float(r)) for name, r in zip(base.names, relative_std) if not r <= POOR_RELATIVE_STD]
+    poor = [(name, float(r)) for name, r, bad in zip(base.names, relative_std, _poor(relative_std, effort_share))
+            if bad]
     remedy = "a longer or better-excited run (pkm excite), a higher filter cutoff, or legs tied (--tie-legs)"
     out = []
     if equations < EQUATIONS_PER_PARAMETER * nb:
@@ -177,10 +204,11 @@ def _warnings(base: BaseParameters, samples: int, equations: int,
         shown = "; ".join(f"{name} ({r:.3g} %)" for name, r in poor[:SHOWN])
         more = f"; and {len(poor) - SHOWN} more" if len(poor) > SHOWN else ""
         out.append(PoorIdentificationWarning(
-            f"{len(poor)} of {nb} base parameters have a relative standard deviation above {POOR_RELATIVE_STD:g} % "
-            f"(cannot be told from zero: zero in truth, or not excited): {shown}{more}; for a better estimate: "
-            f"{remedy}", equations, nb, poor))
+            f"{len(poor)} of {nb} base parameters are poorly identified: a relative standard deviation above "
+            f"{POOR_RELATIVE_STD:g} % (cannot be told from zero) and one standard deviation worth more than "
+            f"{100 * POOR_EFFORT_SHARE:g} % of the efforts (not excited, or confounded by the noise): {shown}{more}; "
+            f"for a better estimate: {remedy}", equations, nb, poor))
     return out
 
 
-__all__ = ["EQUATIONS_PER_PARAMETER", "POOR_RELATIVE_STD", "Estimate", "estimate"]
+__all__ = ["EQUATIONS_PER_PARAMETER", "POOR_EFFORT_SHARE", "POOR_RELATIVE_STD", "Estimate", "estimate"]

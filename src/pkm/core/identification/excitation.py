@@ -35,12 +35,13 @@ outside the joint limits) raises :class:`~pkm.errors.InvalidInputError` naming t
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.optimize
 
-from pkm.core.identification.base import BaseParameters, base_parameters
+from pkm.core.identification.base import AMPLITUDE, BaseParameters, base_parameters, per_unit
 from pkm.core.identification.regressor import close_along, parameters, regressor_batch
 from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
@@ -51,7 +52,6 @@ SINGULARITY = 1e-2  # smallest relative distance to a direct or inverse singular
 DENSE = 4  # the checks run on this many times the optimisation's samples
 SHRINK = 0.8  # a motion that fails a check is shrunk by this, toward its offsets, until it holds
 MAX_SHRINK = 20  # ... at most this many times
-AMPLITUDE = {"rad": 0.3, "m": 0.03}  # default bound of |q_j - q_j,reference| [rad or m]
 
 
 def fourier(t: np.ndarray, offset: np.ndarray, a: np.ndarray, b: np.ndarray, omega: float) \
@@ -116,11 +116,10 @@ class Excitation:
         return fourier(np.atleast_1d(t), self.offset, self.a, self.b, self.omega)
 
 
-def _limits(mech: Mechanism, amplitude: float | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _limits(mech: Mechanism, amplitude: float | Mapping[str, float] | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     lo, hi = stated_limits(mech.model, mech.act_q)
     ref = mech.actuated_q(mech.q_reference)
-    kinds = ["rad" if mech.joints[name].revolute else "m" for name in mech.actuated_names]
-    amp = np.array([AMPLITUDE[k] if amplitude is None else amplitude for k in kinds])
+    amp = per_unit(mech, AMPLITUDE if amplitude is None else amplitude, "amplitude")
     lo, hi = np.maximum(lo, ref - amp), np.minimum(hi, ref + amp)
     bad = np.flatnonzero(~(lo < ref) | ~(ref < hi))
     if bad.size:
@@ -133,12 +132,15 @@ def _limits(mech: Mechanism, amplitude: float | None) -> tuple[np.ndarray, np.nd
 
 
 def excite(mech: Mechanism, *, period: float = 10.0, harmonics: int = 5, samples: int = 60,
-           base: BaseParameters | None = None, tie_legs: bool = False, amplitude: float | None = None,
+           base: BaseParameters | None = None, tie_legs: bool = False,
+           amplitude: float | Mapping[str, float] | None = None,
            singularity: float = SINGULARITY, seed: int = 0, max_iter: int = 60) -> Excitation:
     """An optimal excitation of ``mech`` (module doc): ``period`` ``T`` [s], ``harmonics`` ``L``, ``samples``
     ``M`` per period for the optimisation; ``base``: the base parameters whose regressor is conditioned (default
     :func:`base_parameters` with ``tie_legs``, double precision only); ``amplitude`` [rad or m] bounds each
-    actuated coordinate's excursion from its reference (default 0.3 rad, 0.03 m); ``singularity``: the smallest
+    actuated coordinate's excursion from its reference (per unit, ``{"rad": 0.3, "m": 0.03}`` by default:
+    :data:`AMPLITUDE`; one number where the actuators are all revolute or all prismatic:
+    :func:`~pkm.core.identification.base.per_unit`); ``singularity``: the smallest
     relative distance to a direct or inverse singularity; ``seed``: the random starting coefficients.
 
     Raises:

@@ -59,8 +59,10 @@ def _inertial(link: etree._Element, inertia: pin.Inertia) -> None:
                      iyy=repr(float(I[1, 1])), iyz=repr(float(I[1, 2])), izz=repr(float(I[2, 2])))
 
 
-def identified_mechanism(mech: Mechanism, theta: ArrayLike) -> Mechanism:
-    """A copy of ``mech`` whose bodies and drives carry the standard parameters ``theta`` (module doc).
+def identified_mechanism(mech: Mechanism, theta: ArrayLike, source: str | None = None) -> Mechanism:
+    """A copy of ``mech`` whose bodies and drives carry the standard parameters ``theta`` (module doc); ``source``
+    names it in its warnings and notes (default ``"the model identified from <mech's source>"``: the identified
+    numbers, not ``mech``'s file, are what a plausibility warning is about).
 
     Raises:
         InvalidInputError: ``theta`` of the wrong length or not finite; a body with a non-positive mass but other
@@ -98,7 +100,8 @@ def identified_mechanism(mech: Mechanism, theta: ArrayLike) -> Mechanism:
             _inertial(links[name], inertia)
     urdf = etree.tostring(root, encoding="unicode")
     spec = mech.spec
-    out = from_strings(urdf, spec.to_toml(), mech.params, source=f"{mech.source} (identified)")
+    out = from_strings(urdf, spec.to_toml(), mech.params,
+                       source=source or f"the model identified from {mech.source}")
     drives = {}
     for i, a in enumerate(mech.actuators):
         armature, viscous, coulomb = th[P.n_body + 4 * i:P.n_body + 4 * i + 3]
@@ -127,7 +130,7 @@ def write_identified(mech: Mechanism, theta: ArrayLike, spec_path: str | Path) -
     """
     import pkm
 
-    return pkm.save(identified_mechanism(mech, theta), spec_path, to="pkm")
+    return pkm.save(identified_mechanism(mech, theta, source=str(spec_path)), spec_path, to="pkm")
 
 
 @dataclass(frozen=True)

@@ -23,11 +23,13 @@ prismatic joint beyond 10 m), fewer rows than the filter needs.
 from __future__ import annotations
 
 import csv
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import scipy.signal
+from numpy.typing import ArrayLike
 
 from pkm._optional import module
 from pkm.core.model.joints import stated_limits
@@ -116,11 +118,69 @@ def read_table(path: str | Path) -> dict[str, np.ndarray]:
     return {name: values[:, i] for i, name in enumerate(header)}
 
 
+def read_columns(data: str | Path | Mapping[str, ArrayLike], wanted: Sequence[str], expected: str) \
+        -> tuple[np.ndarray, str]:
+    """The columns ``wanted`` of a table (a path: :func:`read_table`; or columns by name, each through
+    :func:`~pkm.validation.as_array`) stacked (rows x len(wanted)), and the table's name for messages (the path, or
+    ``"columns"``). The one reading of pkm's measurement tables (identification, calibration).
+
+    Raises:
+        InvalidInputError: not a path or a mapping; a missing column (every one named, then ``expected``); a column
+            that is not one value per row, as many as the first's; a value that is not a finite number (its row,
+            counted from 1, and column).
+    """
+    source = str(data) if isinstance(data, (str, Path)) else "columns"
+    if isinstance(data, (str, Path)):
+        cols = read_table(data)
+    elif isinstance(data, Mapping):
+        cols = {str(k): as_array(v, str(k)) for k, v in data.items()}
+    else:
+        raise InvalidInputError("data", "expected a path or a dict of columns", type(data).__name__)
+    missing = [c for c in wanted if c not in cols]
+    if missing:
+        raise InvalidInputError(missing[0], f"{source}: missing column{'s' * (len(missing) > 1)} "
+                                            f"{', '.join(missing)} (expected {expected})", missing)
+    n0 = cols[wanted[0]].shape
+    for c in wanted:
+        shape = cols[c].shape
+        if len(shape) != 1 or shape != n0:
+            raise InvalidInputError(c, f"{source}: column {c!r} has shape {shape}, {wanted[0]} {n0}: expected one "
+                                       f"value per row, as many as {wanted[0]!r}'s", shape)
+    table = np.column_stack([cols[c] for c in wanted])
+    bad = ~np.isfinite(table)
+    if bad.any():
+        row, col = np.argwhere(bad)[0]
+        raise InvalidInputError(wanted[col], f"{source}, row {row + 1}, column {wanted[col]!r}: "
+                                             f"{table[row, col]} is not a finite number", table[row, col])
+    return table, source
+
+
+def check_positions(mech: Mechanism, QA: np.ndarray, columns: Sequence[str], source: str) -> None:
+    """Refuse actuated positions (rows x na, columns named ``columns``) outside their joints' stated limits
+    (:func:`~pkm.core.model.joints.stated_limits`) or beyond :data:`MAX_REVOLUTE` [rad] / :data:`MAX_PRISMATIC` [m]
+    (a table in degrees or mm).
+
+    Raises:
+        InvalidInputError: the first such value, its row (from 1) and column.
+    """
+    lo, hi = stated_limits(mech.model, mech.act_q)
+    for j, name in enumerate(mech.actuated_names):
+        prismatic = not mech.joints[name].revolute
+        cap = MAX_PRISMATIC if prismatic else MAX_REVOLUTE
+        low, high = max(lo[j], -cap), min(hi[j], cap)
+        out = np.flatnonzero((QA[:, j] < low - 1e-9) | (QA[:, j] > high + 1e-9))
+        if out.size:
+            r = int(out[0])
+            raise InvalidInputError(columns[j], f"{source}, row {r + 1}, column {columns[j]!r}: {QA[r, j]:.6g} is "
+                                                f"outside the joint's range [{low:.6g}, {high:.6g}] (SI units: is "
+                                                f"the table in {'mm' if prismatic else 'degrees'}?)", QA[r, j])
+
+
 def _lowpass(x: np.ndarray, sos: np.ndarray, pad: int) -> np.ndarray:
     return scipy.signal.sosfiltfilt(sos, x, axis=0, padlen=min(pad, len(x) - 1))
 
 
-def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, cutoff: float | None = None,
+def measurements(mech: Mechanism, data: str | Path | Mapping[str, ArrayLike], *, cutoff: float | None = None,
                  decimate: int | None = None) -> Measurements:
     """Read (a path) or take (columns by name) measurements of ``mech`` and derive rates and accelerations (module
     doc). ``cutoff`` [Hz]: the low-pass filter's (default a tenth of the sampling rate); ``decimate``: keep one
@@ -144,34 +204,9 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
         ((98, 12), (98, 3), 500.0, 9)
     """
     mech = check_mechanism(mech)
-    source = str(data) if isinstance(data, (str, Path)) else "columns"
-    if isinstance(data, (str, Path)):
-        cols = read_table(data)
-    elif isinstance(data, dict):
-        cols = {}
-        for k, v in data.items():
-            cols[k] = as_array(v, str(k))
-    else:
-        raise InvalidInputError("data", "expected a path or a dict of columns", type(data).__name__)
     names = mech.actuated_names
     wanted = ["time", *(f"q.{j}" for j in names), *(f"tau.{j}" for j in names)]
-    missing = [c for c in wanted if c not in cols]
-    if missing:
-        raise InvalidInputError(missing[0], f"{source}: missing column{'s' * (len(missing) > 1)} "
-                                            f"{', '.join(missing)} (expected time, q.<joint> and tau.<joint> for "
-                                            f"{', '.join(names)})", missing)
-    lengths = {c: cols[c].shape for c in wanted}
-    n0 = lengths["time"]
-    for c, shape in lengths.items():
-        if len(shape) != 1 or shape != n0:
-            raise InvalidInputError(c, f"{source}: column {c!r} has shape {shape}, time {n0}: expected one value per "
-                                       f"row, as many as the times", shape)
-    table = np.column_stack([cols[c] for c in wanted])
-    bad = ~np.isfinite(table)
-    if bad.any():
-        row, col = np.argwhere(bad)[0]
-        raise InvalidInputError(wanted[col], f"{source}, row {row + 1}, column {wanted[col]!r}: "
-                                             f"{table[row, col]} is not a finite number", table[row, col])
+    table, source = read_columns(data, wanted, f"time, q.<joint> and tau.<joint> for {', '.join(names)}")
     t = table[:, 0]
     n = len(t)
     if n < 3:
@@ -188,18 +223,7 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
         raise InvalidInputError("time", f"{source}, row {row}: step {step[row - 2]:.6g} s where the sampling is "
                                         f"{dt:.6g} s (uniform sampling expected, to 1 %)", step[row - 2])
     QA, TAU = table[:, 1:1 + mech.na], table[:, 1 + mech.na:]
-    lo, hi = stated_limits(mech.model, mech.act_q)
-    for j, name in enumerate(names):
-        prismatic = not mech.joints[name].revolute
-        cap = MAX_PRISMATIC if prismatic else MAX_REVOLUTE
-        out = np.flatnonzero((QA[:, j] < max(lo[j], -cap) - 1e-9) | (QA[:, j] > min(hi[j], cap) + 1e-9))
-        if out.size:
-            r = int(out[0])
-            unit = "mm" if prismatic else "degrees"
-            raise InvalidInputError(f"q.{name}", f"{source}, row {r + 1}, column 'q.{name}': {QA[r, j]:.6g} "
-                                                     f"is outside the joint's range [{max(lo[j], -cap):.6g}, "
-                                                     f"{min(hi[j], cap):.6g}] (SI units: is the table in {unit}?)",
-                                    QA[r, j])
+    check_positions(mech, QA, [f"q.{j}" for j in names], source)
     rate = 1.0 / dt
     fc = 0.1 * rate if cutoff is None else as_scalar(cutoff, "cutoff")
     if not 2.0 * rate / n < fc < 0.5 * rate:
@@ -229,4 +253,5 @@ def measurements(mech: Mechanism, data: str | Path | dict[str, np.ndarray], *, c
     return Measurements(t[keep], Q, qd[keep], qdd[keep], tau[keep], fc, rate, every, source, n)
 
 
-__all__ = ["Measurements", "measurements", "read_table"]
+__all__ = ["MAX_PRISMATIC", "MAX_REVOLUTE", "Measurements", "check_positions", "measurements", "read_columns",
+           "read_table"]

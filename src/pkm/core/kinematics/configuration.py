@@ -17,6 +17,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from pkm.core.kinematics import constraints
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 
 
@@ -59,7 +60,7 @@ class Configuration:
         m, d = mech.model, mech.data
         pin.computeJointJacobians(m, d, q)
         pin.updateFramePlacements(m, d)
-        task = mech.task_map
+        task = TaskMap.of(mech)
         return cls(mech, np.array(q, dtype=float), constraints.residual_from(mech, d),
                    constraints.jacobian_from(mech, d), task.value_from(d, q), task.jacobian_from(d),
                    pin.getFrameJacobian(m, d, mech.ee_frame, pin.LOCAL_WORLD_ALIGNED))

@@ -21,7 +21,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-if TYPE_CHECKING:  # (annotations only: the mechanism module imports this one)
+from pkm.core.model.scale import JacobianScales
+
+if TYPE_CHECKING:
     from pkm.core.model.mechanism import Mechanism
 
 
@@ -113,7 +115,7 @@ def check_closed(mech: Mechanism, q: np.ndarray, what: str = "q") -> None:
 
     L = mech.characteristic_length
     raw = residual(mech, q)
-    gap, index, name = worst_closure(mech, raw[:mech.n_constraints] * mech.jacobian_scales.constraint_rows / L)
+    gap, index, name = worst_closure(mech, raw[:mech.n_constraints] * JacobianScales.of(mech).constraint_rows / L)
     if gap > CLOSED_RTOL:
         start = sum(cm.residualSize() for cm in mech.constraint_models[:index - 1])
         open_by = float(np.linalg.norm(raw[start:start + mech.constraint_models[index - 1].residualSize()]))

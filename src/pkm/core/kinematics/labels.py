@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike
 from pkm.core.kinematics.blocks import block_triangular
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.scale import JacobianScales
 
 
 @dataclass(frozen=True)
@@ -122,7 +123,7 @@ def _mats(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     same at any size)."""
     c = Configuration.compute(mech, q)
     J = np.array(c.closure_and_task_jacobian)
-    scales = mech.jacobian_scales
+    scales = JacobianScales.of(mech)
     Jc = scales.constraint(J[:mech.n_constraints])
     return Jc, np.vstack([Jc, scales.task(J[mech.n_constraints:])])
 

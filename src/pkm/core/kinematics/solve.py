@@ -36,6 +36,7 @@ from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.kinematics.labels import ModeLabel, mode_label
 from pkm.core.kinematics.newton import gauss_newton
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import (
     AssemblyError,
@@ -45,7 +46,7 @@ from pkm.errors import (
     ModeChangeWarning,
     UnreachableError,
 )
-from pkm.validation import as_count, as_scalar, as_tolerance
+from pkm.validation import as_count, as_scalar, as_tolerance, wrap_angle
 
 DEFAULT_TOL = 1e-12
 MAX_STEPS = 1000  #: continuation steps planned at most (a farther target gets longer steps)
@@ -146,7 +147,7 @@ class IKProblem:
     def evaluate(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(F(q), dF/dq)`` from one kinematics pass (``q`` unchecked: the solvers' iterations)."""
         c = Configuration.compute(self.mech, q)
-        return (np.concatenate([c.residual, -self.mech.task_map.error(self.target, c.task_value)]),
+        return (np.concatenate([c.residual, -TaskMap.of(self.mech).error(self.target, c.task_value)]),
                 np.array(c.closure_and_task_jacobian))
 
     def residual(self, q: ArrayLike) -> np.ndarray:
@@ -277,7 +278,7 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
     tol, max_iter, max_step = _settings(tol, max_iter, max_step)
     qa0 = mech.actuated_q(q)
     rev = np.array([j.revolute for j in mech.actuated], dtype=bool)  # angles go the short way round (+-pi)
-    qa1 = np.where(rev, qa0 + (qa1 - qa0 + np.pi) % (2.0 * np.pi) - np.pi, qa1)
+    qa1 = np.where(rev, qa0 + wrap_angle(qa1 - qa0), qa1)
     n_steps = _n_steps(np.max(np.abs(qa1 - qa0)), max_step)
 
     def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -328,7 +329,7 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
         {'x': 0.0, 'y': 0.0, 'z': -0.34}
     """
     mech = check_mechanism(mech)
-    task = mech.task_map
+    task = TaskMap.of(mech)
     y1 = task.parse(target)
     tol, max_iter, max_step = _settings(tol, max_iter, max_step)
     if branch is not None:
@@ -385,7 +386,7 @@ def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_i
     q = mech.q_reference.copy()
     if mech.on_branch(q, branch):
         return q
-    task = mech.task_map
+    task = TaskMap.of(mech)
     y_ref = task.value(q)
     wrapped = mech.wrap(q)
     pins = np.array([mech.joints[n].idx_v for n in b.signs])

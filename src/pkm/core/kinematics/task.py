@@ -14,18 +14,17 @@ world axes (``LOCAL_WORLD_ALIGNED``). Joint outputs follow in both.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from pkm._derived import derived
+from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.units import quantities, quantity
-from pkm.validation import as_array, as_vector, bounded
-
-if TYPE_CHECKING:  # (annotations only: the mechanism module imports this one)
-    from pkm.core.model.mechanism import Mechanism
+from pkm.validation import as_array, as_vector, bounded, wrap_angle
 
 _ANGLES = ("roll", "pitch", "yaw")
 _POS = {"x": 0, "y": 1, "z": 2}
@@ -119,7 +118,7 @@ class _FrameTask:
         out = y_target - y
         for i, c in enumerate(self.comp):
             if c in _ANGLES:
-                out[i] = (out[i] + np.pi) % (2 * np.pi) - np.pi
+                out[i] = wrap_angle(out[i])
         return out
 
     def retract(self, y: np.ndarray, dy: np.ndarray) -> np.ndarray:
@@ -166,7 +165,15 @@ def _euler_rows(R: np.ndarray) -> np.ndarray:
 
 class TaskMap:
     """Evaluates the task coordinates of ``mech`` (see module doc): the end effector's components, those of
-    the task's other frames (``[task.frames]``, keys ``frame.x``...), then the joint outputs."""
+    the task's other frames (``[task.frames]``, keys ``frame.x``...), then the joint outputs.
+
+    :meth:`of` gives a mechanism's own (made once; it holds no per-call state): the mechanism's module does not
+    import this one, which is built on it."""
+
+    @classmethod
+    def of(cls, mech: Mechanism) -> TaskMap:
+        """``mech``'s task map, made on the first call and kept with the mechanism."""
+        return derived(mech, cls)
 
     def __init__(self, mech: Mechanism):
         self.mech = mech

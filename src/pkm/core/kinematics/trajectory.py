@@ -31,6 +31,7 @@ from pkm.core.differential.velocity import (
 )
 from pkm.core.dynamics.projection import inverse_dynamics
 from pkm.core.kinematics.solve import SolveResult, close_loops, solve_ik
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import LimitViolation, Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.validation import as_array, as_tolerance, bounded
@@ -116,7 +117,7 @@ def _samples(x: ArrayLike | None, n: int | None, size: int, what: str) -> np.nda
 def _units(mech: Mechanism) -> dict[str, dict[str, str]]:
     unit = {"angle": "rad", "length": "m"}
     return {"actuated": {j.name: "rad" if j.revolute else "m" for j in mech.actuated},
-            "task": {k: unit[kind] for k, kind in mech.task_map.kinds.items()}}
+            "task": {k: unit[kind] for k, kind in TaskMap.of(mech).kinds.items()}}
 
 
 def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int, np.ndarray], SolveResult],
@@ -170,7 +171,7 @@ def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int,
             if not jumps or jumps[-1].index != k:
                 jumps.append(Jump(k, "singular", str(exc)))
         prev = res.q
-    task = mech.task_map
+    task = TaskMap.of(mech)
     values = np.array([task.value(qk) for qk in q])
     yd = np.array([task_velocity(mech, qk, vk) if np.all(np.isfinite(vk)) else np.full(mech.n_task, np.nan)
                    for qk, vk in zip(q, v)])
@@ -210,7 +211,7 @@ def follow_task(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None = None, ydd:
         array([0.1647, 0.1005, 0.2231])
     """
     mech = check_mechanism(mech)
-    task = mech.task_map
+    task = TaskMap.of(mech)
     Y = _samples(y, None, task.value_size, "y")
     n = len(Y)
     Yd, Ydd = _samples(yd, n, task.size, "yd"), _samples(ydd, n, task.size, "ydd")
@@ -284,7 +285,7 @@ def task_values(mech: Mechanism, q: ArrayLike) -> dict[str, float]:
         ['x', 'y', 'z', 'roll', 'pitch', 'yaw', 'beta_1']
     """
     mech = check_mechanism(mech)
-    return mech.task_map.named(mech.check_q(q))
+    return TaskMap.of(mech).named(mech.check_q(q))
 
 
 __all__ = ["JUMP_RATIO", "Jump", "Trajectory", "follow_actuators", "follow_task", "task_values"]

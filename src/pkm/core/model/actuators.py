@@ -124,31 +124,43 @@ UNITS = {"rotor_inertia": "kg m^2", "gear_ratio": "1", "armature": "kg m^2", "vi
 """The unit of each field for a revolute joint (a prismatic joint's: kg, N s/m, N, m/s)."""
 
 
+def number_tables(raw: object, section: str, keys: tuple[str, ...], source: str) -> dict[str, dict[str, float]]:
+    """A closure spec's ``[<section>.<joint>]`` tables of numbers (``[actuators]``, ``[springs]``): ``{joint: {key:
+    value}}``, each key one of ``keys``, each value a number (as a float; its range is the caller's to check).
+
+    Raises:
+        SpecError: not a table of tables, an unknown key, a value that is not a number.
+    """
+    if not isinstance(raw, Mapping):
+        raise SpecError(source, f"[{section}] must be a table of [{section}.<joint>] tables")
+    out: dict[str, dict[str, float]] = {}
+    for joint, table in raw.items():
+        if not isinstance(table, Mapping):
+            raise SpecError(source, f"{section}.{joint} must be a table (keys: {', '.join(keys)})")
+        unknown = sorted(set(table) - set(keys))
+        if unknown:
+            raise SpecError(source, f"{section}.{joint}: unknown keys {unknown}; known: {list(keys)}")
+        values = {}
+        for key, value in table.items():
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise SpecError(source, f"{section}.{joint}.{key} must be a number, got {type(value).__name__}")
+            values[key] = float(value)
+        out[str(joint)] = values
+    return out
+
+
 def parse_table(raw: object, source: str) -> dict[str, dict[str, float]]:
     """The ``[actuators]`` table of a closure spec: ``{joint: {field: value}}``, checked.
 
     Raises:
         SpecError: not a table of tables, an unknown key, a value that is not a number, negative or NaN.
     """
-    if not isinstance(raw, Mapping):
-        raise SpecError(source, "[actuators] must be a table of [actuators.<joint>] tables")
-    out: dict[str, dict[str, float]] = {}
-    for joint, table in raw.items():
-        if not isinstance(table, Mapping):
-            raise SpecError(source, f"actuators.{joint} must be a table (keys: {', '.join(NUMBERS)})")
-        unknown = sorted(set(table) - set(NUMBERS))
-        if unknown:
-            raise SpecError(source, f"actuators.{joint}: unknown keys {unknown}; known: {list(NUMBERS)}")
-        values = {}
-        for key, value in table.items():
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise SpecError(source, f"actuators.{joint}.{key} must be a number, got {type(value).__name__}")
-            values[key] = float(value)
+    out = number_tables(raw, "actuators", NUMBERS, source)
+    for joint, values in out.items():
         try:
             Actuator(str(joint), **values)
         except InvalidInputError as exc:
             raise SpecError(source, f"actuators.{joint}: {exc}") from None
-        out[str(joint)] = values
     return out
 
 

@@ -17,7 +17,10 @@ that closes (the same every run; a closed configuration near the zero pose, not 
 symmetry). :func:`pkm.core.kinematics.solve.nearest_assembly` gives the nearest (a symmetric one where a symmetry
 of the mechanism fixes the zero pose); it is not the default because the nearest is often near a singularity (a
 URDF's zero pose with aligned links): Gepetto's disney_like and wl16_like would get references 3 and 2 mrad from one.
-Write a ``[reference]`` (or ``pkm.save`` a mechanism whose ``q_reference`` was set) to choose.
+Write a ``[reference]`` (or ``pkm.save`` a mechanism whose ``q_reference`` was set) to choose. An assembled reference
+outside a joint's position limits is assembled again from those joints at the middle of their ranges
+(:data:`LIMIT_ROUNDS`), else kept with a :class:`~pkm.errors.PkmWarning` naming them; where the files state a pose
+whose loops are open (an MJCF keyframe), a note says by how much and how far closing them moved the joints.
 Actuators that depend on the others, or freedom no actuator drives (:func:`pkm.core.differential.velocity.actuation`),
 are reported by a :class:`~pkm.errors.PkmWarning` and in :attr:`Mechanism.notes`; so are masses, inertias and
 drive limits no real mechanism has (:mod:`pkm.core.model.plausibility`: an
@@ -74,14 +77,21 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
         mech.q_reference = mech.q_from_dict({n: v for n, v in seed.items() if n not in spec.reference})
     missing = [n for n, j in mech.joints.items() if j.nq > 0 and n not in spec.reference]
     if missing:  # a partial (or no) reference: assembled from it, the other joints from the neutral configuration
+        start = mech.q_reference.copy()
         try:
-            mech.q_reference = assemble(mech, mech.q_reference, hold=tuple(spec.reference), tol=1e-12).q
+            mech.q_reference = assemble(mech, start, hold=tuple(spec.reference), tol=1e-12).q
         except AssemblyError as exc:
             if not spec.reference:  # (the file states no configuration: the loops themselves do not close)
                 raise SpecError(source, f"the loops cannot be closed: {exc}") from exc  # (its closures, gaps)
             raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found that keeps the "
                                     f"joints it states, the others starting from the neutral configuration "
                                     f"({exc}); give an assembled [reference]") from None
+        gap = constraints.worst_closure(mech, constraints.residual(mech, start))[0] if seed else 0.0
+        if gap > REFERENCE_TOL:  # (where the pose the files state was open, how far closing it moved it)
+            moved = float(np.abs(pin.difference(model, start, mech.q_reference)).max())
+            mech.notes += (f"the loops open by {gap:.3g} (m or rad) at the pose the files state were closed by "
+                           f"assembly, which moved the joints by {moved:.3g} at most (rad or m)",)
+        mech.q_reference = _inside_limits(mech, start, tuple(spec.reference), source)
     else:
         gap, _, closure = constraints.worst_closure(mech, constraints.residual(mech, mech.q_reference))
         if gap > REFERENCE_TOL:
@@ -90,13 +100,52 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
                                     "[reference] to have pkm assemble the mechanism (pkm.assemble)")
     fit = actuation(mech)
     mech.dependent_actuators = fit.dependent
-    if fit.problem:
+    said = set(notes)  # (a rebuild of a mechanism, pkm.with_actuators: its notes told already, not warned again)
+    if fit.problem and f"at the reference configuration, {fit.problem}" not in said:
         mech.notes += (f"at the reference configuration, {fit.problem}",)
         warnings.warn(f"{source}: at the reference configuration, {fit.problem}", PkmWarning, stacklevel=3)
     for finding in plausibility.findings(mech):  # (masses, inertias, limits no real mechanism has)
-        mech.notes += (str(finding),)
-        warnings.warn(finding, stacklevel=3)
+        if str(finding) not in said:
+            mech.notes += (str(finding),)
+            warnings.warn(finding, stacklevel=3)
     return mech
+
+
+#: Rounds of :func:`_inside_limits`: each assembles once more (one Levenberg-Marquardt run, no restarts).
+LIMIT_ROUNDS = 3
+
+
+def _inside_limits(mech: Mechanism, start: np.ndarray, hold: tuple[str, ...], source: str) -> np.ndarray:
+    """The assembled reference ``mech.q_reference`` if it lies inside every position limit. Else the assembly from
+    ``start`` with the joints it put outside their limits (those not held) moved to the middle of their ranges, and
+    again with those the last assembly put outside, :data:`LIMIT_ROUNDS` times at most: the first inside every limit
+    (a note says which joints were moved), else the first assembly, with a :class:`~pkm.errors.PkmWarning` naming the
+    joints outside."""
+    q = mech.q_reference
+    outside = mech.outside_limits(q)
+    if not outside:
+        return q
+    moved: list[str] = []
+    last = outside
+    for _ in range(LIMIT_ROUNDS):
+        more = [n for n in last if n not in hold and n not in moved]
+        if not more:
+            break
+        moved += more
+        retry = start.copy()
+        for n in moved:
+            retry[mech.joints[n].idx_q] = 0.5 * sum(mech.limits[n])
+        again = assemble(mech, retry, hold=hold, tol=1e-12, restarts=0, raise_on_failure=False)
+        if again.converged and not again.outside_limits:
+            mech.notes += (f"the first assembly left {list(outside)} outside their position "
+                           f"limits: assembled again from {moved} at the middle of their ranges, inside every limit",)
+            return again.q
+        last = again.outside_limits
+    said = (f"the assembled reference configuration lies outside the position limits of {list(outside)} (state a "
+            "[reference], or a keyframe, inside them)")
+    mech.notes += (said,)
+    warnings.warn(f"{source}: {said}", PkmWarning, stacklevel=4)
+    return q
 
 
 def from_strings(urdf: str, spec: ClosureSpec | str, params: Any = None, source: str = "<string>",
@@ -128,7 +177,7 @@ def from_strings(urdf: str, spec: ClosureSpec | str, params: Any = None, source:
         ... frame_b = "closedloop3D_1B"
         ... '''
         >>> mech = pkm.from_strings(five.urdf, spec)
-        >>> mech.name, mech.na, mech.task_map.keys
+        >>> mech.name, mech.na, pkm.TaskMap.of(mech).keys
         ('my_fivebar', 2, ('x', 'z'))
         >>> {k: round(v, 4) for k, v in pkm.task_values(mech, mech.q_reference).items()}
         {'x': 0.1371, 'z': -0.6192}
@@ -216,9 +265,10 @@ def with_actuators(mech: Mechanism, actuators: Mapping[str, Any]) -> Mechanism:
 def scaled_mechanism(mech: Mechanism, factor: float) -> Mechanism:
     """A copy of ``mech`` with every length multiplied by ``factor`` (> 0): its URDF
     (:func:`~pkm.core.model.scale.scale_urdf`: origins, prismatic limits, geometry, centres of mass, inertias times
-    ``factor^2``) and the spec's reference values of prismatic joints and of a floating base's position, assembled
-    from the scaled reference configuration (:func:`~pkm.core.model.scale.scale_configuration` maps any
-    configuration onto the copy). Masses, angles and the actuators' efforts are unchanged; the copy has no
+    ``factor^2``) and the spec's reference values of prismatic joints (and their springs' rest lengths) and of a
+    floating base's position, assembled from the scaled reference configuration
+    (:func:`~pkm.core.model.scale.scale_configuration` maps any configuration onto the copy). Masses, angles, the
+    actuators' efforts and the springs' stiffnesses are unchanged; the copy has no
     ``params`` (a mechanism's own parameters describe the original). Every singularity measure of the copy equals
     the original's (:mod:`pkm.core.model.scale`).
 
@@ -248,7 +298,10 @@ def scaled_mechanism(mech: Mechanism, factor: float) -> Mechanism:
         k = length_entries(mech.joints[name].kind)
         return tuple(float(v) * s if i < k else float(v) for i, v in enumerate(np.atleast_1d(values)))
 
-    spec = dataclasses.replace(mech.spec, reference={n: lengths(n, v) for n, v in mech.spec.reference.items()})
+    springs = {n: {k: lengths(n, v)[0] if k == "rest" else v for k, v in table.items()}
+               for n, table in mech.spec.springs.items()}  # (a prismatic spring's rest length)
+    spec = dataclasses.replace(mech.spec, reference={n: lengths(n, v) for n, v in mech.spec.reference.items()},
+                               springs=springs)
     seed = {n: np.array(lengths(n, v)) for n, v in mech.q_to_dict(mech.q_reference).items()}
     return from_strings(scale_urdf(mech.urdf, s), spec, None, f"{mech.source} (scaled by {s:g})", mech.notes,
                         seed=seed)

@@ -17,6 +17,10 @@ Pinocchio 4.1 neither exposes a mimic joint's own joint model nor reduces a mode
 (``buildReducedModel`` fails), so they are rebuilt as plain joints about their axes, the model retyped and
 reduced, and each turned back into a mimic (``transformJointIntoMimic``); a mimic joint, or one that a mimic
 joint follows, cannot be retyped.
+
+Every reduction goes through :func:`reduced_model`: Pinocchio 4.1's ``buildReducedModel`` looks frames up by name
+alone and raises ``ValueError: Several frames match the filter`` on any model where two frames share a name (an MJCF
+body and its joint, a URDF link and joint named alike: MuJoCo Menagerie's Cassie).
 """
 
 from __future__ import annotations
@@ -84,10 +88,31 @@ def retype_joints(model: pin.Model, types: Mapping[str, str], source: str = "<mo
             continue  # the universe frame, which every model has
         new.addFrame(pin.Frame(f.name, ids[f.parentJoint], f.parentFrame, f.placement, f.type, f.inertia), False)
     locked = [new.getJointId(n) for n, kind in types.items() if kind == "fixed"]
-    new = pin.buildReducedModel(new, locked, pin.neutral(new)) if locked else new
+    new = reduced_model(new, locked, pin.neutral(new)) if locked else new
     for name, (leader, scaling, offset, _) in mimics.items():
         new = pin.transformJointIntoMimic(new, new.getJointId(leader), new.getJointId(name), scaling, offset)
     return new
+
+
+def reduced_model(model: pin.Model, locked: list[int], q: np.ndarray) -> pin.Model:
+    """``pinocchio.buildReducedModel(model, locked, q)`` (the ``locked`` joints fixed at their values in ``q``, their
+    bodies welded to their parents) for any model, also one where frames of different types share a name (a body
+    and a joint named alike, as MJCF allows): such frames (but the joint's own) are renamed apart in a copy for the
+    reduction, whose ``getFrameId`` by name alone would find several, and their names restored in the result. Every
+    frame keeps its name and type (a locked joint's frame becomes a ``FIXED_JOINT`` frame of the joint's name)."""
+    names = [f.name for f in model.frames]
+    shared = {n for n in names if names.count(n) > 1}
+    if not shared:
+        return pin.buildReducedModel(model, locked, q)
+    work, restore = model.copy(), {}
+    for k, f in enumerate(work.frames):
+        if f.name in shared and f.type != pin.FrameType.JOINT:
+            restore[f"{f.name}\x00{k}"] = f.name  # (a NUL no file's name holds)
+            f.name = f"{f.name}\x00{k}"
+    reduced = pin.buildReducedModel(work, locked, q)
+    for f in reduced.frames:
+        f.name = restore.get(f.name, f.name)
+    return reduced
 
 
 #: A model's limits and drives per configuration entry (``q``) and per velocity entry (``v``), as Pinocchio names them;
@@ -152,5 +177,6 @@ def _mimics(model: pin.Model) -> dict[str, tuple[str, float, float, pin.JointMod
     return out
 
 
-__all__ = ["JOINT_TYPES", "LIMITS_Q", "LIMITS_V", "UNIVERSAL_AXES", "copy_limits", "retype_joints", "stated_limits",
+__all__ = ["JOINT_TYPES", "LIMITS_Q", "LIMITS_V", "UNIVERSAL_AXES", "copy_limits", "reduced_model", "retype_joints",
+           "stated_limits",
            "universal_joint"]

@@ -8,6 +8,9 @@ It is made by :mod:`pkm.core.model.builder` (:func:`~pkm.core.model.builder.buil
 :func:`~pkm.core.model.builder.from_files`, which :func:`pkm.load` reaches), which assembles and checks its reference
 configuration; ``Mechanism(model, spec)`` alone takes the spec's ``[reference]`` over the neutral configuration as it
 is. The model never imports its builder: the builder registers how a mechanism it made pickles (:data:`REDUCE`).
+Nor does it import what is built on it: its task map is :meth:`TaskMap.of(mech) <pkm.core.kinematics.task.TaskMap.of>`,
+the factors that homogenise its Jacobians :meth:`JacobianScales.of(mech) <pkm.core.model.scale.JacobianScales.of>`,
+each made once and kept with the mechanism (:func:`pkm._derived.derived`).
 
 Joint coordinates follow Pinocchio: ``q`` has ``model.nq`` entries (a free-flyer
 takes 7: position and quaternion x y z w), velocities ``v`` have ``model.nv``.
@@ -22,22 +25,19 @@ import math
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from pkm._derived import SLOT
 from pkm.core.model.actuators import Actuator, from_model, write_model
 from pkm.core.model.spec import Branch, ClosureSpec
 from pkm.core.model.urdf import position_limits
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
 from pkm.units import quantities
 from pkm.validation import as_array, as_vector, bounded, wrap_angle
-
-if TYPE_CHECKING:
-    from pkm.core.kinematics.task import TaskMap
-    from pkm.core.model.scale import JacobianScales
 
 
 @dataclass(frozen=True)
@@ -71,6 +71,21 @@ class LimitViolation(NamedTuple):
     limit: tuple[float, float]  # (lower, upper) [rad, m]
 
 
+def reference_points(model: pin.Model, q: np.ndarray, min_mass: float = 0.0) -> tuple[np.ndarray, np.ndarray,
+                                                                                     np.ndarray]:
+    """A model's points at ``q`` (each n x 3) [m]: its joints' origins, its frames' origins and its bodies' centres of
+    mass (the bodies with mass, and at least ``min_mass`` [kg]). The one source of a mechanism's size: the characteristic length
+    (:attr:`Mechanism.characteristic_length`) and the plausibility rules' extent
+    (:func:`pkm.core.model.plausibility.size`)."""
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    joints = np.array([data.oMi[j].translation for j in range(1, model.njoints)]).reshape(-1, 3)
+    frames = np.array([f.translation for f in data.oMf]).reshape(-1, 3)
+    centres = np.array([data.oMi[j].act(model.inertias[j].lever) for j in range(1, model.njoints)
+                        if model.inertias[j].mass > 0.0 and model.inertias[j].mass >= min_mass]).reshape(-1, 3)
+    return joints, frames, centres
+
+
 class Mechanism:
     """A parallel mechanism on Pinocchio.
 
@@ -87,8 +102,9 @@ class Mechanism:
         urdf: The URDF text, when known.
         base: The floating base's joint (``spec.floating_base``: a free-flyer on the world carrying the whole
             tree), or None. Its pose is an input like the actuators' values: the solvers hold it where ``q``
-            puts it, the rate maps give it no velocity, the efforts are those with the base held (its
-            reaction is not computed); Pinocchio's ``constraintDynamics`` lets it float.
+            puts it and the rate maps give it no velocity; the dynamics lets it move free by default (no
+            wrench on it, its own equations of motion), or holds it (``base="fixed"``):
+            :mod:`pkm.core.dynamics.model`.
         constraint_models: One ``pin.RigidConstraintModel`` per closure, in spec order.
             Point closures are ``CONTACT_3D`` in ``LOCAL_WORLD_ALIGNED``: their Jacobian is
             exactly d(p_A - p_B)/dq. Frame closures are ``CONTACT_6D`` in ``LOCAL`` (frame A):
@@ -100,7 +116,7 @@ class Mechanism:
         >>> delta = pkm.load("delta")
         >>> delta.na, delta.nq, delta.nv, delta.actuated_names
         (3, 12, 12, ('motor_1', 'motor_2', 'motor_3'))
-        >>> delta.task_map.keys
+        >>> pkm.TaskMap.of(delta).keys
         ('x', 'y', 'z')
         >>> {k: round(v, 4) for k, v in delta.q_to_dict(delta.q_reference).items() if k.startswith("motor")}
         {'motor_1': 0.0017, 'motor_2': 0.0017, 'motor_3': 0.0017}
@@ -163,6 +179,8 @@ class Mechanism:
         for b in spec.branches.values():
             for n in b.signs:
                 scalar_joint(n, f"branch {b.name!r}")
+        for n in spec.springs:
+            scalar_joint(n, f"[springs.{n}]")
         #: The drive of each actuated joint, in ``actuated`` order: the model file's values, then the spec's
         #: ``[actuators.<joint>]`` tables (:mod:`pkm.core.model.actuators`); written into the model's fields.
         self.actuators: tuple[Actuator, ...] = ()
@@ -270,12 +288,12 @@ class Mechanism:
             self._local.constraint_datas = [cm.createData() for cm in self.constraint_models]
             return self._local.constraint_datas
 
-    @functools.cached_property
-    def task_map(self) -> TaskMap:
-        """The mechanism's :class:`~pkm.core.kinematics.task.TaskMap` (made once; it holds no per-call state)."""
-        from pkm.core.kinematics.task import TaskMap  # (pkm.core.kinematics.task imports this module)
-
-        return TaskMap(self)
+    @property
+    def task_map(self) -> Any:
+        """Moved: :meth:`pkm.TaskMap.of(mech) <pkm.core.kinematics.task.TaskMap.of>` (the task map is built on the
+        mechanism, whose module does not import it)."""
+        raise AttributeError("Mechanism.task_map moved to pkm.TaskMap.of(mech) (the same map, made once per "
+                             "mechanism): the task map is built on the mechanism, above it")
 
     @property
     def q_reference(self) -> np.ndarray:
@@ -285,25 +303,29 @@ class Mechanism:
     @q_reference.setter
     def q_reference(self, q: np.ndarray) -> None:
         self._q_reference = q
-        for cached in ("characteristic_length", "jacobian_scales"):  # (measured at the reference)
+        for cached in ("characteristic_length", SLOT):  # (measured at the reference; what was derived from it)
             self.__dict__.pop(cached, None)
 
     @functools.cached_property
     def characteristic_length(self) -> float:
         """The mechanism's characteristic length ``L`` [m]: the root-mean-square distance of its joints' origins from
         their centroid at :attr:`q_reference` (:mod:`pkm.core.model.scale`). The singularity measures homogenise
-        their Jacobians by it, so that they judge a mechanism of 5 cm as the same one of 5 m."""
-        from pkm.core.model.scale import _characteristic_length
+        their Jacobians by it (:meth:`JacobianScales.of(mech) <pkm.core.model.scale.JacobianScales.of>`), so that
+        they judge a mechanism of 5 cm as the same one of 5 m. Where every joint origin coincides, the frames'
+        origins are used instead, and 1 m where they coincide too (nothing in the mechanism has a length)."""
+        joints, frames, _ = reference_points(self.model, self.q_reference)
+        for points in (joints, frames):
+            if len(points):
+                length = float(np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=1))))
+                if length > 0.0:
+                    return length
+        return 1.0
 
-        return _characteristic_length(self.model, self.q_reference)
-
-    @functools.cached_property
-    def jacobian_scales(self) -> JacobianScales:
-        """The factors that homogenise the Jacobians by :attr:`characteristic_length`
-        (:class:`~pkm.core.model.scale.JacobianScales`)."""
-        from pkm.core.model.scale import _jacobian_scales
-
-        return _jacobian_scales(self)
+    @property
+    def jacobian_scales(self) -> Any:
+        """Moved: :meth:`pkm.core.model.scale.JacobianScales.of(mech) <pkm.core.model.scale.JacobianScales.of>`."""
+        raise AttributeError("Mechanism.jacobian_scales moved to pkm.core.model.scale.JacobianScales.of(mech): the "
+                             "scales are built on the mechanism, above it")
 
     def __reduce__(self) -> tuple[Callable[..., Mechanism], tuple[Any, ...]]:
         if self.urdf is None or REDUCE is None:
@@ -470,17 +492,26 @@ class Mechanism:
                 f"task={list(self.spec.task.components) + list(self.spec.task.joints)})")
 
 
+#: The frame a name means when frames of several types share it (MJCF bodies, joints and sites may share names; a
+#: URDF link and joint may): a body's, an operational frame's (a site, a closure's anchor), a fixed joint's, a
+#: joint's, a sensor's, in this order (the link's frame where a joint shares its name, as before).
+FRAME_TYPES = (pin.FrameType.BODY, pin.FrameType.OP_FRAME, pin.FrameType.FIXED_JOINT, pin.FrameType.JOINT,
+               pin.FrameType.SENSOR)
+
+
 def _frame_id(model: pin.Model, name: object, source: str) -> int | None:
-    """The frame called ``name`` (a link's frame when a joint shares its name); None if there is none."""
-    if not isinstance(name, str) or not model.existFrame(name):
+    """The frame called ``name``, looked up by name and type (the first type of :data:`FRAME_TYPES` that has one: a
+    link's frame when a joint shares its name); None if there is none."""
+    if not isinstance(name, str):
         return None
-    try:
-        return model.getFrameId(name)
-    except ValueError:  # several frames of that name: a link and a joint named alike
-        if model.existFrame(name, pin.FrameType.BODY):
-            return model.getFrameId(name, pin.FrameType.BODY)
-        raise SpecError(source, f"several frames are named {name!r}; give the links and joints distinct names") \
-            from None
+    for kind in FRAME_TYPES:
+        if model.existFrame(name, kind):
+            try:
+                return model.getFrameId(name, kind)
+            except ValueError:  # (two frames of one type and name: a model built by hand)
+                raise SpecError(source, f"several {kind.name} frames are named {name!r}; give them distinct names") \
+                    from None
+    return None
 
 
 def check_mechanism(mech: object, name: str = "mech") -> Mechanism:

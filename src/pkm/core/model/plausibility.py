@@ -4,14 +4,22 @@ Checked on every mechanism built (:func:`pkm.core.model.builder.build`), each fi
 :class:`~pkm.errors.ImplausibleModelWarning` (its bodies or joints and values as attributes) and a line of
 :attr:`~pkm.core.Mechanism.notes`. The rules, all scale-aware (a mechanism of 5 cm and one of 5 m are judged alike):
 
-* **size** ``L`` [m]: the largest extent, along x, y or z, of the joint origins, the frames' origins and the bodies'
-  centres of mass at the reference configuration (no rule of size below applies when ``L`` is 0);
+* **size** ``L`` [m]: the largest extent, along x, y or z, of the joint origins, the frames' origins and the
+  centres of mass of the bodies that weigh at least :data:`MASS_SHARE` of the whole at the reference configuration
+  (no rule of size below applies when ``L`` is 0). A lighter body's centre of mass (its first moment over its mass)
+  says nothing of the mechanism's extent: an identified body of almost no mass and a finite first moment has it
+  metres away (a Delta of 0.45 m measured 4.1 m so). An extent, not the
+  :attr:`~pkm.core.Mechanism.characteristic_length` that thresholds scale by (an RMS spread of the joints), since a
+  bound must enclose the whole mechanism; both come from :func:`pkm.core.model.mechanism.reference_points`;
 * **mass** (``kind="mass"``): a body heavier than a solid steel cube of side ``L`` (:data:`DENSITY` ``L³``), the
   heaviest solid that fits in a cube enclosing the whole mechanism;
 * **inertia** (``kind="inertia"``): a body whose largest principal moment about its centre of mass exceeds
   ``m L²`` (its radius of gyration beyond the whole mechanism's extent);
 * **triangle** (``kind="triangle"``): principal moments ``I1 <= I2 <= I3`` about the centre of mass with
   ``I3 > I1 + I2`` by more than :data:`TRIANGLE_TOL` ``I3`` (no distribution of mass has them);
+* the inertia and triangle rules leave out a body whose ``I3`` is under :data:`NEGLIGIBLE` ``M L²`` (``M`` the
+  whole mass): no measurement sees it (an identified massless link: the consistent estimate's 1e-7 kg and 3e-6
+  kg m² on a Delta whose ``M L²`` is 0.13 kg m², its triangle broken by 4e-14 kg m²);
 * **limits** (``kind="limits"``): every actuated joint with the same effort limit and the same velocity limit,
   each a power of ten (``10^k``, ``k`` an integer: 1000 N m and 100 rad/s, an exporter's or a template's
   placeholders). A limit of 0 or of at least 1e6 in a file already reads as none (:mod:`pkm.core.model.actuators`).
@@ -28,24 +36,27 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.mechanism import Mechanism, reference_points
 from pkm.errors import ImplausibleModelWarning
 
 DENSITY = 8000.0  # [kg/m^3] steel: the mass bound is a steel cube of side L
 TRIANGLE_TOL = 1e-4  # relative slack of the triangle inequality (a file's rounding of a flat body's moments)
+MASS_SHARE = 1e-2  # a body's centre of mass counts in the size where it weighs at least this share of the total
+NEGLIGIBLE = 1e-4  # a body's largest principal moment under this times M L^2: left out of the inertia rules
 
 
 def size(mech: Mechanism) -> float:
-    """The mechanism's size ``L`` [m] (module doc)."""
+    """The mechanism's extent [m] (module doc): the largest width of :func:`~pkm.core.model.mechanism.reference_points`
+    (joints, frames, the centres of mass of bodies of at least :data:`MASS_SHARE` of the whole) at the reference.
+    Not :attr:`~pkm.core.Mechanism.characteristic_length` (the RMS spread of the joints about their centroid, what
+    thresholds scale by): a bound on a body's mass or inertia must enclose the whole mechanism."""
     model = mech.model
-    data = model.createData()
-    pin.forwardKinematics(model, data, mech.q_reference)
-    pin.updateFramePlacements(model, data)
-    points = [data.oMi[j].translation for j in range(1, model.njoints)]
-    points += [data.oMf[k].translation for k in range(model.nframes)]
-    points += [data.oMi[j].act(model.inertias[j].lever) for j in range(1, model.njoints)
-               if model.inertias[j].mass > 0.0]
-    return float(np.ptp(np.array(points), axis=0).max()) if len(points) > 1 else 0.0
+    points = np.vstack(reference_points(model, mech.q_reference, min_mass=MASS_SHARE * _total_mass(model)))
+    return float(np.ptp(points, axis=0).max()) if len(points) > 1 else 0.0
+
+
+def _total_mass(model: pin.Model) -> float:
+    return sum(max(float(model.inertias[j].mass), 0.0) for j in range(1, model.njoints))
 
 
 def _body_names(model: pin.Model) -> list[str]:
@@ -66,6 +77,7 @@ def findings(mech: Mechanism) -> list[ImplausibleModelWarning]:
     model = mech.model
     names = _body_names(model)
     L = size(mech)
+    floor = NEGLIGIBLE * _total_mass(model) * L * L
     heavy, spread, skew = [], [], []
     for j in range(1, model.njoints):
         inertia = model.inertias[j]
@@ -75,6 +87,8 @@ def findings(mech: Mechanism) -> list[ImplausibleModelWarning]:
         e = np.linalg.eigvalsh(np.asarray(inertia.inertia, dtype=float))
         if L > 0.0 and m > DENSITY * L ** 3:
             heavy.append((names[j], m))
+        if e[2] <= floor:
+            continue
         if L > 0.0 and e[2] > m * L * L:
             spread.append((names[j], float(e[2]), m * L * L))
         if e[2] - e[0] - e[1] > TRIANGLE_TOL * e[2]:
@@ -120,4 +134,4 @@ def _power_of_ten(x: float) -> bool:
     return x == float(10.0 ** k) or math.isclose(x, 10.0 ** k, rel_tol=1e-12)
 
 
-__all__ = ["DENSITY", "TRIANGLE_TOL", "findings", "size"]
+__all__ = ["DENSITY", "MASS_SHARE", "NEGLIGIBLE", "TRIANGLE_TOL", "findings", "size"]

@@ -18,8 +18,11 @@ ratio of singular values (a distance to a singularity, a condition index) is unc
 root-mean-square distance of the joints' origins from their centroid at the reference configuration
 (``mech.q_reference``), in [m]: a length of the mechanism itself, which scales exactly with it. Where every joint
 origin coincides, the frames' origins are used instead, and 1 m where they coincide too (nothing in the mechanism has
-a length). :attr:`Mechanism.jacobian_scales <pkm.core.model.mechanism.Mechanism.jacobian_scales>` holds the factors
-(:class:`JacobianScales`).
+a length). It is a spread, not an extent: the plausibility rules bound masses and inertias by the extent ``E``, the
+largest width along x, y or z of every joint origin, frame origin and centre of mass
+(:func:`pkm.core.model.plausibility.size`: a bound must enclose the whole mechanism, a scale need only grow with it;
+both from :func:`~pkm.core.model.mechanism.reference_points`; ``E`` is 1.8 to 2.5 ``L`` on the shipped mechanisms).
+:meth:`JacobianScales.of(mech) <JacobianScales.of>` holds the factors (made once per mechanism and reference).
 
 :func:`~pkm.core.model.builder.scaled_mechanism` builds the copy of a mechanism with every length multiplied by a
 factor (:func:`scale_urdf`: the URDF's origins, prismatic limits and speed limits, geometry, the inertias' centres of
@@ -31,28 +34,14 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
-import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from pkm._derived import derived
+from pkm.core.kinematics.task import TaskMap
+from pkm.core.model.mechanism import Mechanism
 from pkm.validation import as_scalar
-
-if TYPE_CHECKING:
-    from pkm.core.model.mechanism import Mechanism
-
-
-def _characteristic_length(model: pin.Model, q: np.ndarray) -> float:
-    data = model.createData()
-    pin.framesForwardKinematics(model, data, q)
-    for points in (np.array([data.oMi[j].translation for j in range(1, model.njoints)]),
-                   np.array([f.translation for f in data.oMf])):
-        if len(points):
-            length = float(np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=1))))
-            if length > 0.0:
-                return length
-    return 1.0
 
 
 @dataclass(frozen=True)
@@ -102,13 +91,21 @@ class JacobianScales:
         """A forward Jacobian (task rates from actuated rates, ``(..., n_task, na)``) homogenised."""
         return J if self.trivial else self.task_rows[:, None] * J * self.actuated
 
+    @staticmethod
+    def of(mech: Mechanism) -> JacobianScales:
+        """The factors that homogenise ``mech``'s Jacobians by its
+        :attr:`~pkm.core.model.mechanism.Mechanism.characteristic_length`, made once per mechanism (again where its
+        ``q_reference`` changes)."""
+        return derived(mech, _jacobian_scales)
+
 
 def _jacobian_scales(mech: Mechanism) -> JacobianScales:
     L = mech.characteristic_length
     rows = []
     for c in mech.spec.closures:
         rows += [1.0] * 3 + ([L] * 3 if c.type == "frame" else [])
-    task = [L if mech.task_map.kinds[k] == "angle" else 1.0 for k in mech.task_map.keys]
+    task_map = TaskMap.of(mech)
+    task = [L if task_map.kinds[k] == "angle" else 1.0 for k in task_map.keys]
     columns = np.ones(mech.nv)
     for j in mech.joints.values():  # a translation's rate (prismatic, a free-flyer's first three) is a length
         columns[j.idx_v:j.idx_v + min(length_entries(j.kind), j.nv)] = L

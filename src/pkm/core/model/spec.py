@@ -50,6 +50,10 @@ Format ``pkm.closures/1`` (all values SI: m, rad)::
     rotor_inertia = 3.3e-5           # kg m^2; also gear_ratio, armature, viscous, coulomb,
     gear_ratio = 50.0                # effort_limit, peak_effort, velocity_limit (inf: none)
 
+    [springs.knee_spring]            # optional: a joint's spring and damper (pkm.core.model.springs),
+    stiffness = 1500.0               # N m/rad; rest = its rest angle (rad), damping (N m s/rad);
+    rest = 0.0                       # described only: pkm's dynamics do not apply them yet
+
     [transmission.left_ankle]        # optional: a closed sub-mechanism's name and output joints
     outputs = ["ankle_pitch", "ankle_roll"]   # (pkm.transmissions; pkm.core.transmissions.decompose)
 
@@ -105,6 +109,7 @@ from pathlib import Path, PurePosixPath
 from typing import Any
 
 from pkm.core.model.actuators import parse_table
+from pkm.core.model.springs import parse_springs
 from pkm.errors import InvalidInputError, SpecError
 from pkm.validation import ABSURD
 
@@ -190,6 +195,9 @@ class ClosureSpec:
     #: ``{actuated joint: {field: value}}``: the drives' values the spec states (``[actuators.<joint>]``, see
     #: :mod:`pkm.core.model.actuators`), over those of the model file.
     actuators: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    #: ``{joint: {"stiffness", "rest", "damping": value}}``: the joints' springs and dampers (``[springs.<joint>]``,
+    #: :mod:`pkm.core.model.springs`), over those of the model file; read and written, not applied by the dynamics.
+    springs: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     #: ``{transmission name: output joints}``: the ``[transmission.<name>]`` tables, the outputs
     #: :func:`pkm.transmissions` gives the closed sub-mechanism that holds them.
     transmissions: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
@@ -246,7 +254,7 @@ class ClosureSpec:
             raise SpecError(source, f"unsupported format {fmt!r}; this pkm reads {FORMAT!r}")
         known = {"format", "mechanism", "urdf", "end_effector", "actuated", "default_branch", "task",
                  "closure", "branch", "reference", "parameters", "description", "joint_types", "floating_base",
-                 "actuators", "transmission"}
+                 "actuators", "springs", "transmission"}
         unknown = sorted(set(raw) - known)
         if unknown:
             raise SpecError(source, f"unknown keys {unknown}; known keys: {sorted(known)}")
@@ -363,6 +371,8 @@ class ClosureSpec:
             raise SpecError(source, f"[actuators.{stray[0]}]: {stray[0]!r} is not an actuated joint; actuated: "
                                     f"{list(actuated)}")
 
+        springs = parse_springs(raw.get("springs", {}), source)
+
         transmissions = {}
         for tname, table in need(raw, "transmission", dict).items() if "transmission" in raw else ():
             where = f"[transmission.{tname}] "
@@ -385,6 +395,7 @@ class ClosureSpec:
             joint_types=dict(joint_types),
             floating_base=floating_base,
             actuators=actuators,
+            springs=springs,
             transmissions=transmissions,
         )
 
@@ -424,9 +435,11 @@ class ClosureSpec:
             out.append("signs = { " + ", ".join(f"{_key(k)} = {v:d}" for k, v in b.signs.items()) + " }")
         if self.joint_types:
             out += ["", "[joint_types]"] + [f"{_key(k)} = {_tv(v)}" for k, v in self.joint_types.items()]
-        for joint, values in self.actuators.items():
-            if values:
-                out += ["", f"[actuators.{_key(joint)}]"] + [f"{_key(k)} = {_tv(float(v))}" for k, v in values.items()]
+        for section, tables in (("actuators", self.actuators), ("springs", self.springs)):
+            for joint, values in tables.items():
+                if values:
+                    out += ["", f"[{section}.{_key(joint)}]"] + [f"{_key(k)} = {_tv(float(v))}"
+                                                                 for k, v in values.items()]
         for tname, outputs in self.transmissions.items():
             out += ["", f"[transmission.{_key(tname)}]", f"outputs = {_tv(list(outputs))}"]
         out += ["", "[reference]"]

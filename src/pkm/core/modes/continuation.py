@@ -15,7 +15,7 @@ and returns a :class:`Continuation`: one :class:`Path` per start point, classifi
 Why Bertini 2: it is the Bertini team's maintained library, with adaptive multiprecision path tracking (paths near
 singular ends or ill-conditioned stretches switch to higher precision instead of jumping to another path) and
 the endgames that make singular ends detectable. It is GPL-3; pkm (BSD-3) imports it only here, on first use, as
-the optional extra ``pkm[homotopy]``.
+the optional extra ``pkm-robotics[homotopy]``.
 """
 
 from __future__ import annotations

@@ -35,6 +35,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from pkm.core.kinematics.blocks import block_triangular
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.modes.certify import Certificate, alpha_test, polish
 from pkm.core.modes.continuation import Continuation, solve
@@ -204,7 +205,7 @@ def working_modes_generic(mech: Mechanism, task: ArrayLike | Mapping[str, Any], 
     """Every real working mode at the task coordinates ``task`` (:meth:`~pkm.core.kinematics.task.TaskMap.parse`),
     from the closures and the task in every joint (module doc)."""
     m = mech.model
-    tm = mech.task_map
+    tm = TaskMap.of(mech)
     y = tm.parse(task)
     comps = mech.spec.task.components
     q = mech.q_reference.copy()

@@ -23,8 +23,10 @@ from numpy.typing import ArrayLike
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.kinematics.solve import SolveResult, close_loops, solve_ik
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.kinematics.trajectory import Trajectory, follow_actuators, follow_task
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.core.modes.assembly import Mode
 
 #: Largest joint step [rad or m] accepted while bisecting towards a meeting (a larger one: another mode).
@@ -122,7 +124,7 @@ def track_assembly_mode(mech: Mechanism, mode: Mode, q_actuated: ArrayLike) -> M
         return close_loops(mech, A[k - 1] + s * (A[k] - A[k - 1]), q_from, raise_on_failure=False)
 
     return _track(mech, mode, traj, _FK_MEETING, between,
-                  lambda qq: mech.jacobian_scales.constraint(constraints.jacobian(mech, qq))[:, mech.passive_v])
+                  lambda qq: JacobianScales.of(mech).constraint(constraints.jacobian(mech, qq))[:, mech.passive_v])
 
 
 def track_working_mode(mech: Mechanism, mode: Mode, task: ArrayLike) -> ModeTrack:
@@ -142,13 +144,13 @@ def track_working_mode(mech: Mechanism, mode: Mode, task: ArrayLike) -> ModeTrac
     mech = check_mechanism(mech)
     traj = follow_task(mech, task, q0=mode.q, efforts=False)
     Y = np.asarray(task, dtype=float).reshape(len(traj.q), -1)
-    tm = mech.task_map
+    tm = TaskMap.of(mech)
 
     def between(k: int, s: float, q_from: np.ndarray) -> SolveResult:
         return solve_ik(mech, tm.interpolate(Y[k - 1], Y[k], s), q_from, raise_on_failure=False)
 
     def jac(qq: np.ndarray) -> np.ndarray:
-        c, sc = Configuration.compute(mech, qq), mech.jacobian_scales
+        c, sc = Configuration.compute(mech, qq), JacobianScales.of(mech)
         J = np.vstack([sc.constraint(c.constraint_jacobian), sc.task(c.task_jacobian)])
         return J if mech.free_v is None else J[:, mech.free_v]
 

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PathError
 from pkm.validation import as_array, bounded
@@ -107,8 +108,8 @@ def _homogenised(mech: Mechanism, space: str, columns: list[int]) -> np.ndarray:
     L = mech.characteristic_length
     if space == "actuated":
         return np.array([1.0 if mech.actuated[i].revolute else 1.0 / L for i in columns])
-    kinds = mech.task_map.kinds
-    names = mech.task_map.value_names
+    kinds = TaskMap.of(mech).kinds
+    names = TaskMap.of(mech).value_names
     return np.array([1.0 / L if kinds.get(names[i]) == "length" else 1.0 for i in columns])
 
 
@@ -130,7 +131,7 @@ def waypoint_path(mech: Mechanism, waypoints: ArrayLike, *, space: str = "task",
     mech = check_mechanism(mech)
     if space not in SPACES:
         raise InvalidInputError("space", f"use one of {list(SPACES)}", space)
-    task = mech.task_map
+    task = TaskMap.of(mech)
     size = task.value_size if space == "task" else mech.na
     W = as_array(waypoints, "waypoints", f"n x {size} waypoints")
     if W.ndim != 2 or W.shape[1] != size or len(W) < 2:
@@ -191,10 +192,10 @@ def motion_path(mech: Mechanism, motion: object, coordinates: tuple[str, ...] | 
     mech = check_mechanism(mech)
     if not isinstance(motion, Motion):
         raise InvalidInputError("motion", "expected a pkm.motion.Motion", motion)
-    names = tuple(mech.actuated_names if motion.space == "actuated" else mech.task_map.value_names)
+    names = tuple(mech.actuated_names if motion.space == "actuated" else TaskMap.of(mech).value_names)
     given = tuple(motion.coordinates if coordinates is None else coordinates)
     if sorted(given) != sorted(names) or len(given) != len(motion.coordinates) or (
-            motion.space == "task" and mech.task_map.value_size != mech.task_map.size):
+            motion.space == "task" and TaskMap.of(mech).value_size != TaskMap.of(mech).size):
         raise InvalidInputError("motion", f"the motion's coordinates {given} must be {names} (rename them: "
                                           "coordinates=...)", given)
     order = [given.index(n) for n in names]

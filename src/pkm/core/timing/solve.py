@@ -433,7 +433,7 @@ def time_optimal(mech: Mechanism, path: object, *, payload: float = 0.0, limits:
             position limits the model states, or a limit cannot hold the mechanism (and payload) still, at the point
             it names.
         InvalidInputError: bad limits, payload or grid.
-        MissingDependencyError: toppra is not installed (``pip install "pkm[plan]"``).
+        MissingDependencyError: toppra is not installed (``pip install "pkm-robotics[plan]"``).
 
     Examples:
         >>> import numpy as np

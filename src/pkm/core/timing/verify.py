@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.timing.solve import ACTIVE_RTOL, TimeOptimal
 from pkm.errors import InvalidInputError
 from pkm.validation import as_count
@@ -174,7 +175,7 @@ def _track(plan: TimeOptimal, t: np.ndarray, traj: object, tau: np.ndarray,
                    saturate=True, limits=False)
     ref = np.array([at(ref_q, time) for time in sim.time])
     track = np.max(np.abs(sim.actuated - ref), axis=0)
-    task = mech.task_map
+    task = TaskMap.of(mech)
     pos = [i for i, k in enumerate(task.value_names) if task.kinds.get(k) == "length"]
     yref = np.array([at(traj.task[order][:, pos], time) for time in sim.time])  # type: ignore[attr-defined]
     task_err = float(np.max(np.linalg.norm(sim.task[:, pos] - yref, axis=1))) if pos else 0.0

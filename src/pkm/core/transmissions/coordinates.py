@@ -34,10 +34,16 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core.differential.idle import joint_inertia, without_idle
-from pkm.core.differential.velocity import RTOL
+from pkm.core.differential.velocity import RTOL, homogenised_pinv
 from pkm.core.kinematics import constraints
 from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.errors import ConvergenceError
+
+#: The transmissions' position solvers' tolerance on the closure residual, relative to the sub-mechanism's
+#: characteristic length (:func:`closure_tol`; 1e-13 m on a sub-mechanism of 0.1 m, where it was 1e-13 m on any):
+#: tight, so that a round trip motors -> outputs -> motors comes back to 1e-12.
+CLOSURE_RTOL = 1e-12
 
 
 @dataclass(frozen=True)
@@ -66,15 +72,12 @@ class OutputSplit:
 
 def output_split(sub: Mechanism, q: np.ndarray, out_v: np.ndarray, motor_v: np.ndarray) -> OutputSplit:
     """:class:`OutputSplit` of the sub-mechanism ``sub`` at ``q`` (closed), outputs at velocity indices ``out_v``."""
-    scales = sub.jacobian_scales
+    scales = JacobianScales.of(sub)
     Jc = constraints.jacobian(sub, q)
     d_v = np.array([i for i in range(sub.nv) if i not in set(out_v)], dtype=int)
     Jh = scales.constraint(Jc)
-    U, s, Vt = np.linalg.svd(Jh[:, d_v], full_matrices=True)
+    Jd_pinv, s, Vt, r = homogenised_pinv(Jc[:, d_v], scales.constraint_rows, scales.columns[d_v], RTOL)
     smax = float(s[0]) if s.size else 0.0
-    r = int(np.sum(s > RTOL * smax)) if smax > 0.0 else 0
-    cd = scales.columns[d_v]
-    Jd_pinv = cd[:, None] * ((Vt[:r].T / s[:r]) @ U[:, :r].T) * scales.constraint_rows
     k = len(out_v)
     G = np.zeros((sub.nv, k))
     G[out_v, np.arange(k)] = 1.0
@@ -111,45 +114,74 @@ def drift_acceleration(sub: Mechanism, q: np.ndarray, v: np.ndarray, sp: OutputS
 
 
 def close_at_outputs(sub: Mechanism, qo: np.ndarray, guess: np.ndarray, out_q: np.ndarray, out_v: np.ndarray, *,
-                     tol: float = 1e-13, max_iter: int = 20) -> np.ndarray:
-    """The closed configuration with the outputs at ``qo`` nearest ``guess``: Gauss-Newton on the closures with the
-    outputs held (minimum-norm steps in the other joints), for a warm start a small step away (a simulation's
-    next state); :func:`pkm.solve_ik` (continuation, mode checks) is the general route.
+                     tol: float | None = None, max_iter: int = 20) -> np.ndarray:
+    """The closed configuration with the outputs at ``qo`` nearest ``guess``: pkm's bounded Gauss-Newton
+    (:func:`pkm.core.kinematics.solve._newton`: its step cap and backtracking) on the closures with the outputs held
+    (minimum-norm steps in the other joints), for a warm start a small step away (a simulation's next state);
+    :func:`pkm.solve_ik` (continuation, mode checks) is the general route. ``tol`` [m, rad] on the largest closure
+    residual, default :data:`CLOSURE_RTOL` times the sub-mechanism's characteristic length.
 
     Raises:
-        ConvergenceError: the closures not within ``tol`` [m, rad] after ``max_iter`` iterations.
+        ConvergenceError: the closures not within ``tol`` after ``max_iter`` iterations.
     """
+    from pkm.core.kinematics.solve import _newton
+
+    tol = closure_tol(sub) if tol is None else tol
     q = np.array(guess, dtype=float)
     q[out_q] = qo
     d_v = np.array([i for i in range(sub.nv) if i not in set(out_v)], dtype=int)
-    for it in range(max_iter + 1):
-        r, Jc = constraints.residual_and_jacobian(sub, q)
-        gap = float(np.abs(r).max(initial=0.0))
-        if gap <= tol:
-            return q
-        if it == max_iter:
-            break
-        dq = np.zeros(sub.nv)
-        dq[d_v] = -np.linalg.lstsq(Jc[:, d_v], r, rcond=None)[0]
-        q = pin.integrate(sub.model, q, dq)
-    raise ConvergenceError("loop closure at given outputs", gap, max_iter, tol, q)
+    q, gap, it = _newton(sub, lambda x: constraints.residual_and_jacobian(sub, x), q, d_v, tol, max_iter, 0.5)
+    if gap <= tol:
+        return q
+    raise ConvergenceError("loop closure at given outputs", gap, it, tol, q)
 
 
-def serial_tree(model: pin.Model, outputs: Sequence[str]) -> pin.Model:
-    """A copy of ``model`` (a sub-mechanism's) in which every joint but ``outputs`` is massless: its body's (and its
-    welded bodies') inertia zero, its armature zero. Since every output hangs from the root through outputs only,
-    the massless joints move nothing the outputs carry: the copy's mass matrix and bias, restricted to the outputs'
-    rows and columns, are the serial-equivalent model's."""
+def closure_tol(sub: Mechanism, rtol: float = CLOSURE_RTOL) -> float:
+    """The transmissions' position solvers' tolerance on the largest closure residual [m, rad]: ``rtol`` times the
+    sub-mechanism's characteristic length (the same for the sub-mechanism scaled in size, as
+    :data:`~pkm.core.kinematics.constraints.CLOSED_RTOL` is)."""
+    return rtol * sub.characteristic_length
+
+
+def lumped_inertias(model: pin.Model, outputs: Sequence[str], q_reference: np.ndarray) -> list[pin.Inertia]:
+    """``model.inertias`` with every joint but ``outputs`` welded to its parent at ``q_reference``: each such joint's
+    body inertia (mass, centre of mass, rotational inertia) moved onto its nearest ancestor that is an output (or
+    the root, index 0), placed where ``q_reference`` puts it relative to that ancestor, and its own made zero (what
+    ``pinocchio.buildReducedModel`` does to a locked joint's body)."""
+    data = model.createData()
+    pin.forwardKinematics(model, data, q_reference)
+    keep = {model.getJointId(n) for n in outputs}
+    out = [pin.Inertia(model.inertias[j]) for j in range(model.njoints)]
+    for j in range(1, model.njoints):
+        if j in keep:
+            continue
+        anchor = int(model.parents[j])
+        while anchor != 0 and anchor not in keep:
+            anchor = int(model.parents[anchor])
+        out[anchor] = out[anchor] + (data.oMi[anchor].actInv(data.oMi[j])).act(model.inertias[j])
+        out[j] = pin.Inertia.Zero()
+    return out
+
+
+def serial_tree(model: pin.Model, outputs: Sequence[str], q_reference: np.ndarray) -> pin.Model:
+    """A copy of ``model`` (a sub-mechanism's) in which every joint but ``outputs`` is welded to its parent at
+    ``q_reference`` (:func:`lumped_inertias`: its body's mass carried by the nearest output above it, or by the
+    root) and has no armature (the rotors' reflected inertia is left to ``ΔM``). Since every output hangs from the
+    root through outputs only, the copy's mass matrix and bias with only the outputs moving, restricted to the
+    outputs' rows and columns, are the serial-equivalent model's (:func:`pkm.core.transmissions.serial_equivalent`
+    welds the same bodies the same way)."""
     serial = model.copy()
     keep = set(outputs)
+    for j, inertia in enumerate(lumped_inertias(model, outputs, q_reference)):
+        serial.inertias[j] = inertia
     armature = np.array(serial.armature, dtype=float)
     for j in range(1, serial.njoints):
         if serial.names[j] not in keep:
-            serial.inertias[j] = pin.Inertia.Zero()
             jm = serial.joints[j]
             armature[jm.idx_v:jm.idx_v + jm.nv] = 0.0
     serial.armature = armature
     return serial
 
 
-__all__ = ["OutputSplit", "drift_acceleration", "output_model", "output_split", "serial_tree"]
+__all__ = ["CLOSURE_RTOL", "OutputSplit", "close_at_outputs", "closure_tol", "drift_acceleration", "lumped_inertias",
+           "output_model", "output_split", "serial_tree"]

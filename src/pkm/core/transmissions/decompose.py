@@ -45,7 +45,7 @@ import pinocchio as pin
 
 from pkm.core.model.actuators import NUMBERS
 from pkm.core.model.builder import from_strings
-from pkm.core.model.joints import stated_limits
+from pkm.core.model.joints import reduced_model, stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.spec import ClosureSpec, TaskSpec
 from pkm.core.model.urdf import urdf_from_model
@@ -148,7 +148,7 @@ def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[
     model = mech.model
     keep = {model.names[j] for j in joints}
     lock = [j for j in range(1, model.njoints) if model.names[j] not in keep]
-    reduced = pin.buildReducedModel(model, lock, mech.q_reference) if lock else model.copy()
+    reduced = reduced_model(model, lock, mech.q_reference) if lock else model.copy()
     stated = {n: lim for n, lim in mech.limits.items() if n in keep}
     urdf, types = urdf_from_model(reduced, name=name, limits=stated, source=mech.source)
     q_ref = mech.q_to_dict(mech.q_reference)
@@ -158,6 +158,7 @@ def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[
         reference={n: tuple(np.atleast_1d(q_ref[n]).tolist()) for n in sorted(keep) if n in q_ref},
         joint_types=types, actuators={a.joint: {f: float(getattr(a, f)) for f in NUMBERS}
                                       for a in mech.actuators if a.joint in motors},
+        springs={n: v for n, v in mech.spec.springs.items() if n in keep},
         description=f"the closed sub-mechanism {name!r} of {mech.name!r}")
     with warnings.catch_warnings():  # (what the robot's loading said already: kept in the notes, not said twice)
         warnings.simplefilter("ignore", PkmWarning)
@@ -259,8 +260,15 @@ def _transmission(mech: Mechanism, name: str, closures: list[int], joints: set[i
     if bad:
         raise TransmissionError(name, "outputs", f"outputs {bad} have more than one coordinate: outputs are "
                                 "one-coordinate serial joints", bad)
-    carrying = [j for j in joints if j not in out_ids
-                and {i for i in range(1, model.njoints) if j in model.supports[i]} - joints]
+    carries = sorted(j for j in joints if {i for i in range(1, model.njoints) if j in model.supports[i]} - joints)
+    if len(carries) > len(motors):
+        names = [model.names[j] for j in carries]
+        raise TransmissionError(name, "outputs", f"{names} carry the rest of the robot, so that a serial model must "
+                                f"keep every one of them as an output, but its loops hold {len(motors)} motor(s) "
+                                f"{list(motors)}: no choice of outputs makes it a transmission; leave it out with "
+                                "skip_unfit=True (pkm transmission --skip-unfit) to get the robot's other "
+                                "transmissions", names)
+    carrying = [j for j in carries if j not in out_ids]
     if carrying:
         raise TransmissionError(name, "outputs", f"{[model.names[j] for j in carrying]} carry the rest of the robot "
                                 f"but are no outputs {list(outputs)}: a serial model cannot keep the rest of the robot "

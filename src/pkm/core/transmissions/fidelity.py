@@ -6,7 +6,7 @@ reference at rest:
 * **(a) closed loop**: :func:`pkm.simulate` of the sub-mechanism (RK4 at ``dt``; no friction, no saturation, no limit
   watched);
 * **(b) constant armature**: MuJoCo's serial-equivalent model of the sub-mechanism (the outputs only, the rods and
-  rotors removed: :func:`~pkm.core.transmissions.serial.serial_equivalent`) with each output's armature ``ΔM``'s
+  cranks welded at the reference, the rotors removed: :func:`~pkm.core.transmissions.serial.serial_equivalent`) with each output's armature ``ΔM``'s
   diagonal at the reference (today's practice), driven by the output efforts ``τ_o = J⁻ᵀ τ_m`` (the exact effort map
   at the current outputs: today's firmware does as much);
 * **(c) exact**: the same model without that armature, with ``ΔM`` and ``Δh`` applied at every evaluation of the

@@ -14,8 +14,10 @@ A transmission here is a mechanism ``mech`` (the closed sub-mechanism alone, ``a
   (pivots fixed at the reference) or, with idle motions (a rod spinning between two balls), the least-norm step
   (:meth:`TransmissionKernels._newton`), at most :data:`MAX_STEP` long. ``residual`` is the largest closure
   residual at ``q_out`` [m, rad];
-  ``status`` (:data:`STATUS`): 0 ``OK`` (``residual <= TOL``), 1 ``NOT_CONVERGED``, 2 ``SINGULAR`` (a pivot under
-  :data:`~pkm.core.twin.kernels.PIVOT_FLOOR` relative to the reference at some iteration);
+  ``status`` (:data:`STATUS`): 0 ``OK`` (``residual <= tol``, by default :data:`RTOL` times the characteristic
+  length), 1 ``NOT_CONVERGED``, 2 ``SINGULAR`` (a pivot under :data:`~pkm.core.twin.kernels.PIVOT_FLOOR` relative to
+  the reference at some iteration), 4 ``OUTSIDE_LIMITS`` (converged, but a joint of ``q_out``, the motors' and the
+  outputs' among them, lies beyond the limit its file states: ``q_out`` is the solution all the same);
 * ``ik`` ``(q, qo) -> (q_out, qm, status, residual)``: outputs to motors, the same Newton with the outputs held;
 * ``maps`` ``(q) -> (J, J_inv, pivot)``: the velocity map ``qdot_o = J qdot_m`` (k x k) and its inverse, each from
   its own closure solve (motors driving, outputs driving); the effort maps are their transposes by power balance:
@@ -31,7 +33,8 @@ Definitions. ``M_o``, ``h_o`` are the closed-loop model in output coordinates: t
 mechanism with the outputs as its actuated joints: ``M_o = G_oᵀ M G_o``, ``h_o = G_oᵀ (h + M Ġ_o qdot_o)`` with
 ``G_o = ∂q/∂o`` (rotor armature and gravity included, idle motions mass-orthogonal). ``M_s``, ``h_s`` are the
 serial-equivalent model's (:func:`pkm.core.transmissions.coordinates.serial_tree`): the tree with every joint but the
-outputs massless (the rods, the cranks and the rotors dropped; each output hangs from the root through outputs only),
+outputs welded to its parent at the reference (the rods' and the cranks' mass carried by the nearest output above
+them or by the root, the rotors dropped; each output hangs from the root through outputs only),
 as RNEA of the twin with only the outputs moving. Hence ``M_s + ΔM = M_o`` and ``h_s + Δh = h_o`` exactly, and
 ``M_a = Jᵀ M_o J`` (tested against :func:`pkm.mass_matrix`, :func:`pkm.bias_efforts` and
 :class:`~pkm.core.transmissions.transmission.Transmission`'s Python reference).
@@ -49,10 +52,13 @@ from collections.abc import Callable, Sequence
 
 import casadi as cs
 import numpy as np
-import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from pkm.core.export.library import LIMIT_TOL
+from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
+from pkm.core.transmissions.coordinates import closure_tol, lumped_inertias
 from pkm.core.transmissions.transmission import Transmission
 from pkm.core.twin.dynamics import ActuatorTwin, cholesky, cholesky_solve
 from pkm.core.twin.kernels import PIVOT_FLOOR
@@ -70,10 +76,15 @@ ITERATIONS = 8
 #: ankle's FK converges for 200 of 200 motor positions within ±0.05 rad, its IK for 180 with this bound, 171 with
 #: 0.2 and 187 without; the humanoid ankle's and the battobot's every sample either way.)
 MAX_STEP = 0.5
-#: The largest closure residual at which a solve counts as converged [m, rad].
-TOL = 1e-12
+#: The largest closure residual at which a solve counts as converged, relative to the sub-mechanism's characteristic
+#: length (:func:`~pkm.core.transmissions.coordinates.closure_tol`: 1e-12 m on a sub-mechanism of 0.1 m, where it was
+#: 1e-12 m on any).
+RTOL = 1e-11
 #: The status codes, in order from 0 (``INVALID_INPUT``: the C target's own check of its inputs, before the kernel).
-STATUS = ("OK", "NOT_CONVERGED", "SINGULAR", "INVALID_INPUT")
+#: The status codes, in order from 0 (``INVALID_INPUT``: the C target's own check of its inputs, before the kernel;
+#: ``OUTSIDE_LIMITS``: a solve converged to a configuration with a joint beyond its stated limit by more than
+#: :data:`pkm.core.export.library.LIMIT_TOL`: a motor, an output or a rod's joint).
+STATUS = ("OK", "NOT_CONVERGED", "SINGULAR", "INVALID_INPUT", "OUTSIDE_LIMITS")
 
 #: Each kernel's inputs and outputs.
 KERNELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
@@ -101,7 +112,8 @@ class TransmissionKernels:
         outputs: The output joints (as many as motors; one-coordinate joints of ``mech``).
         name: The transmission's name (default the mechanism's): C names, files.
         iterations: Newton iterations unrolled in ``fk`` and ``ik``.
-        tol: Convergence tolerance of ``fk`` and ``ik`` on the largest closure residual [m, rad].
+        tol: Convergence tolerance of ``fk`` and ``ik`` on the largest closure residual [m, rad] (default :data:`RTOL`
+            times the sub-mechanism's characteristic length).
 
     Raises:
         TransmissionError: the outputs are not one-coordinate joints of ``mech``, are motors, are not as many as
@@ -110,13 +122,13 @@ class TransmissionKernels:
     """
 
     def __init__(self, mech: Mechanism, outputs: Sequence[str], *, name: str | None = None,
-                 iterations: int = ITERATIONS, tol: float = TOL):
+                 iterations: int = ITERATIONS, tol: float | None = None):
         self.mech = check_mechanism(mech)
         self.name = name or mech.name
         self.outputs = tuple(outputs)
         self.motors = tuple(mech.actuated_names)
         self.iterations = as_count(iterations, "iterations", high=100)
-        self.tol = as_tolerance(tol, "tol")
+        self.tol = closure_tol(self.mech, RTOL) if tol is None else as_tolerance(tol, "tol")
         for o in self.outputs:
             j = mech.joints.get(o)
             if j is None or j.nq != 1 or j.nv != 1:
@@ -158,7 +170,7 @@ class TransmissionKernels:
         Talos-like ankle's rods). A step longer than :data:`MAX_STEP` is shortened to it."""
         tw = at.tw
         mech = tw.mech
-        scale = mech.jacobian_scales.columns  # (a length in characteristic lengths)
+        scale = JacobianScales.of(mech).columns  # (a length in characteristic lengths)
         r = tw.rotate_rows(tw.closure_residual)
         if not at.idle:
             cols = list(at.passive)
@@ -195,7 +207,13 @@ class TransmissionKernels:
             q, p = newton(q, target)
             pivot = cs.fmin(pivot, p)
         residual = cs.mmax(cs.fabs(cs.substitute(tw.closure_residual, tw.q, q)))
-        status = cs.if_else(pivot < PIVOT_FLOOR, 2.0, cs.if_else(residual <= self.tol, 0.0, 1.0))
+        lo, hi = stated_limits(tw.mech.model)
+        outside = cs.SX(0.0)
+        for i in np.flatnonzero(np.isfinite(lo) | np.isfinite(hi)):
+            outside = outside + cs.if_else(q[int(i)] < lo[i] - LIMIT_TOL, 1.0, 0.0) \
+                + cs.if_else(q[int(i)] > hi[i] + LIMIT_TOL, 1.0, 0.0)
+        within = cs.if_else(outside > 0.0, float(STATUS.index("OUTSIDE_LIMITS")), 0.0)
+        status = cs.if_else(pivot < PIVOT_FLOOR, 2.0, cs.if_else(residual <= self.tol, within, 1.0))
         return q, status, residual
 
     @staticmethod
@@ -236,9 +254,8 @@ class TransmissionKernels:
         """``(ΔM, Δh, pivot)`` in :attr:`q` and the symbol :attr:`qdo`."""
         ao = self._twin_o
         M_o, h_o = self._in_q(ao, ao.mass_matrix), self._in_q(ao, ao.bias)
-        serial = Twin(self.mech)  # the serial-equivalent model: every joint but the outputs massless (serial_tree's)
-        keep = {self.mech.joints[n].id for n in self.outputs}
-        serial._inertia = [I if j in keep else pin.Inertia.Zero() for j, I in enumerate(serial._inertia)]
+        serial = Twin(self.mech)  # the serial-equivalent model: every joint but the outputs welded (serial_tree's)
+        serial._inertia = lumped_inertias(self.mech.model, self.outputs, self.mech.q_reference)
         qdd_o = cs.SX.sym("qdd_o", self.k)
         v, a = cs.SX.zeros(self.mech.nv), cs.SX.zeros(self.mech.nv)
         for r, c in enumerate(self.output_v):
@@ -318,7 +335,7 @@ class TransmissionKernels:
         for batches, ``jax.grad`` differentiates it).
 
         Raises:
-            MissingDependencyError: JAX is not installed (``pip install "pkm[jax]"``).
+            MissingDependencyError: JAX is not installed (``pip install "pkm-robotics[jax]"``).
         """
         from pkm.core.twin.jaxgen import jax_function
 
@@ -328,7 +345,7 @@ class TransmissionKernels:
         """``kernel`` as a Warp kernel (:func:`pkm.core.twin.warpgen.warp_kernel`).
 
         Raises:
-            MissingDependencyError: Warp is not installed (``pip install "pkm[warp]"``).
+            MissingDependencyError: Warp is not installed (``pip install "pkm-robotics[warp]"``).
         """
         from pkm.core.twin.warpgen import warp_kernel
 
@@ -357,4 +374,4 @@ def c_identifier(name: str) -> str:
     return out if out and not out[0].isdigit() else f"t_{out}"
 
 
-__all__ = ["ITERATIONS", "KERNELS", "MAX_STEP", "STATUS", "TOL", "TransmissionKernels", "c_identifier"]
+__all__ = ["ITERATIONS", "KERNELS", "MAX_STEP", "RTOL", "STATUS", "TransmissionKernels", "c_identifier"]

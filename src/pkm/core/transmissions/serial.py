@@ -1,23 +1,28 @@
-r"""The serial-equivalent model: the tree with only the output joints and the bodies they carry.
+r"""The serial-equivalent model: the tree with only the output joints, every other body welded where the reference puts it.
 
-Rule: every joint of a sub-mechanism that is not an output (the motors, the rods' joints) is removed with the bodies
-it carries, and its reflected inertia (the rotors') with it
-(:func:`~pkm.core.transmissions.coordinates.serial_tree`): their mass and inertia are dropped from the serial model
-and carried by ``ΔM`` and ``Δh`` (:class:`~pkm.core.transmissions.transmission.Transmission`). The outputs keep
+Rule: every joint of a sub-mechanism that is not an output (the motors, the rods' joints) is locked at the
+reference and its body welded to its parent there (Pinocchio's ``buildReducedModel``): its mass, centre of mass and
+rotational inertia are carried by the nearest output above it, or by the transmission's root (a motor's crank and
+its rod by the shank, a rod hung from the foot by the foot), so that the whole robot's mass and centre of mass at the
+reference are the closed robot's; the motors' rotors' reflected inertia (an armature) is dropped. The outputs keep
 their own armature, if the file gives one, in both models.
 
-For a whole robot, :func:`serial_equivalent` locks every transmission's motors and passive joints at the reference
-(Pinocchio's ``buildReducedModel``) after making their bodies massless: the serial tree keeps the robot's serial
-joints and the outputs. Each output gets a **constant armature**, ``ΔM``'s diagonal entry at the robot's reference
-(what a constant-armature model uses: exact at that pose for a diagonal ``ΔM``, neither its off-diagonal coupling nor
-its change with the pose nor ``Δh``), and **box limits** from its transmission's feasible region
-(:mod:`pkm.core.transmissions.limits`). :meth:`SerialEquivalent.urdf` and :meth:`SerialEquivalent.mjcf` write it;
+``ΔM`` and ``Δh`` (:class:`~pkm.core.transmissions.transmission.Transmission`) are what the sub-mechanism's serial
+model **with those bodies welded** (:func:`~pkm.core.transmissions.coordinates.serial_tree`) lacks: the welded
+bodies' motion relative to their anchor (a rod swinging as the foot turns, a crank turning), the rotors, and the
+welded mass's own share taken back: ``M_s + ΔM = M_o`` and ``h_s + Δh = h_o`` exactly.
+
+For a whole robot, :func:`serial_equivalent` locks every transmission's motors and passive joints at the reference:
+the serial tree keeps the robot's serial joints and the outputs. Each output gets a **constant armature**, ``ΔM``'s
+diagonal entry at the robot's reference (what a constant-armature model uses: exact at that pose for a diagonal
+``ΔM``, neither its off-diagonal coupling nor its change with the pose nor ``Δh``), and **box limits** from its
+transmission's feasible region (:mod:`pkm.core.transmissions.limits`: the largest box that holds the reference, or
+the point ``around`` gives). :meth:`SerialEquivalent.urdf` and :meth:`SerialEquivalent.mjcf` write it;
 :func:`write_serial_equivalent` writes both and a JSON data file describing each transmission for the kernels.
 
 Each transmission's ``ΔM`` and ``Δh`` are exact for its sub-mechanism with its root held. On a whole robot whose
 root moves (a knee carrying an ankle, a floating base), the rods' coupling with the joints above the root is not in
-them; and another transmission's rods below this one's outputs are welded at the reference in this one's
-sub-mechanism (so in its ``M_s``) but removed from the whole serial model (battobot's knee: 9 % of its ``M_s``).
+them.
 """
 
 from __future__ import annotations
@@ -26,7 +31,8 @@ import dataclasses
 import json
 import os
 import re
-from collections.abc import Sequence
+import warnings
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -37,12 +43,13 @@ from lxml import etree
 
 from pkm.core.analysis.region import SINGULARITY
 from pkm.core.formats.to_mjcf import MIN_INERTIA, MIN_MASS, TIMESTEP, _joints, _num, _pose, qpos_of
+from pkm.core.model.joints import reduced_model
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.urdf import urdf_from_model
 from pkm.core.transmissions.decompose import transmissions as find
 from pkm.core.transmissions.limits import OutputLimits, output_limits
 from pkm.core.transmissions.transmission import Transmission
-from pkm.errors import InvalidInputError
+from pkm.errors import InvalidInputError, PkmWarning
 
 
 @dataclass(frozen=True)
@@ -53,14 +60,15 @@ class SerialEquivalent:
         robot: The whole robot.
         transmissions: Its transmissions.
         model: The serial tree (Pinocchio): the robot's model with every transmission's motors and passive joints
-            locked at the reference and their bodies removed; each output's ``armature`` is its own plus the
-            constant armature.
+            locked at the reference and their bodies welded to their parents there (mass kept); each output's
+            ``armature`` is its own plus the constant armature.
         armature: ``{output: ΔM's diagonal entry at the reference}`` [kg m^2 or kg]: the constant armature a
             serial model uses in place of ``ΔM`` (today's practice; :func:`pkm.core.transmissions.fidelity` measures
             what it misses).
         limits: ``{joint: (lower, upper)}`` [rad or m]: each output's box limits
             (:func:`~pkm.core.transmissions.limits.output_limits`), the serial joints' stated limits.
-        regions: ``{transmission: OutputLimits}``: the feasible regions the boxes come from.
+        regions: ``{transmission: OutputLimits}``: the feasible regions the boxes come from, each box's point
+            and its area against its region's.
         q_reference: The serial model's reference configuration (the robot's).
     """
 
@@ -105,6 +113,8 @@ class SerialEquivalent:
                 "armature": [self.armature[o] for o in t.outputs],
                 "lower": None if reg.lower is None else reg.lower.tolist(),
                 "upper": None if reg.upper is None else reg.upper.tolist(),
+                "around": None if reg.around is None else reg.around.tolist(),
+                "area_fraction": reg.area_fraction,
                 "region": None if reg.polygon is None else reg.polygon.tolist(), "binding": list(reg.binding),
                 "q_reference": t.q_reference.tolist()})
         return {"format": "pkm.transmissions/1", "robot": self.robot.name, "source": str(self.robot.source),
@@ -112,11 +122,29 @@ class SerialEquivalent:
 
 
 def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | None = None, *,
-                      limits: bool = True, directions: int = 24, singularity: float = SINGULARITY) -> SerialEquivalent:
+                      limits: bool = True, around: Mapping[str, float] | None = None, directions: int = 24,
+                      singularity: float = SINGULARITY) -> SerialEquivalent:
     """The serial-equivalent model of ``robot`` (module doc); ``transmissions`` default ``pkm.transmissions(robot)``;
-    ``directions`` and ``singularity``: the feasible regions' (:func:`~pkm.core.transmissions.limits.output_limits`);
-    ``limits=False``: no limits at all (no region traced, the robot's stated limits left out: a model for a free
-    motion, as :mod:`pkm.core.transmissions.fidelity` runs it).
+    ``around``: ``{output: value}`` [rad or m], the point each transmission's box holds (its other outputs at the
+    reference; default every output's reference); ``directions`` and ``singularity``: the feasible regions'
+    (:func:`~pkm.core.transmissions.limits.output_limits`); ``limits=False``: no limits at all (no region traced, the
+    robot's stated limits left out: a model for a free motion, as :mod:`pkm.core.transmissions.fidelity` runs it).
+
+    Raises:
+        InvalidInputError: a closure no transmission covers; ``around`` naming no output, or a point outside its
+            transmission's feasible region.
+
+    Examples:
+        >>> import pinocchio as pin
+        >>> import pkm
+        >>> bot = pkm.load("gepetto:battobot_6d")  # (two legs: a knee four-bar and a two-motor ankle each)
+        >>> se = pkm.serial_equivalent(bot, limits=False)  # (limits=True traces each region: seconds)
+        >>> se.outputs
+        ('knee_left', 'knee_right', 'ankley_right', 'anklex_right', 'ankley_left', 'anklex_left')
+        >>> round(pin.computeTotalMass(se.model), 6), round(pin.computeTotalMass(bot.model), 6)  # (rods welded)
+        (17.513222, 17.513222)
+        >>> round(se.armature["ankley_left"], 7)  # (ΔM's diagonal at the reference [kg m^2])
+        0.0002157
     """
     robot = check_mechanism(robot)
     found = tuple(find(robot) if transmissions is None else transmissions)
@@ -125,11 +153,13 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
     if open_loops:
         raise InvalidInputError("transmissions", f"closures {open_loops} belong to no transmission given: the serial "
                                 "model would keep their joints with the loops open", open_loops)
-    model = robot.model.copy()
+    named = dict(around or {})
+    unknown = sorted(set(named) - {o for t in found for o in t.outputs})
+    if unknown:
+        raise InvalidInputError("around", f"{unknown} are no outputs; the outputs are "
+                                f"{[o for t in found for o in t.outputs]}", unknown)
     gone = [robot.joints[n].id for t in found for n in (*t.motors, *t.passive)]
-    for j in gone:
-        model.inertias[j] = pin.Inertia.Zero()
-    serial = pin.buildReducedModel(model, sorted(gone), robot.q_reference)
+    serial = reduced_model(robot.model, sorted(gone), robot.q_reference)  # (their bodies welded: mass kept)
     serial.name = f"{robot.name}_serial"
     armature = np.array(serial.armature, dtype=float)
     constant: dict[str, float] = {}
@@ -142,9 +172,15 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
             armature[serial.joints[serial.getJointId(o)].idx_v] += dM[i, i]
         if not limits:
             continue
-        reg = output_limits(t, directions=directions, singularity=singularity)
+        point = [float(named.get(o, t.q_reference[t.out_q[i]])) for i, o in enumerate(t.outputs)]
+        reg = output_limits(t, around=point, directions=directions, singularity=singularity)
         regions[t.name] = reg
         if reg.lower is not None and reg.upper is not None:
+            ref = t.q_reference[t.out_q]
+            if set(named) & set(t.outputs) and not ((reg.lower <= ref) & (ref <= reg.upper)).all():
+                warnings.warn(PkmWarning(f"transmission {t.name!r}: its box about {dict(zip(t.outputs, point))} "
+                                         f"leaves out the reference {dict(zip(t.outputs, ref.tolist()))}: the "
+                                         "serial model's keyframe 'reference' lies outside its limits"), stacklevel=2)
             bounds.update({o: (float(lo), float(hi)) for o, lo, hi in zip(t.outputs, reg.lower, reg.upper)})
     serial.armature = armature
     keep = [j for j in range(1, robot.model.njoints) if robot.model.names[j] not in
@@ -195,7 +231,16 @@ def write_serial_equivalent(se: SerialEquivalent, folder: str | os.PathLike[str]
     """Write ``se`` into ``folder`` (made if missing): ``<robot>_serial.urdf``, ``<robot>_serial.xml`` (MJCF),
     each transmission's sub-mechanism as ``<robot>_<transmission>.urdf`` and ``.closures.toml`` (``pkm.load`` reads
     it back) and ``<robot>_transmissions.json`` (:meth:`SerialEquivalent.data`, with the files' names); returns
-    their paths, the data file last."""
+    their paths, the data file last.
+
+    Examples:
+        >>> import tempfile
+        >>> import pkm
+        >>> se = pkm.serial_equivalent(pkm.load("gepetto:talos_like"), limits=False)
+        >>> with tempfile.TemporaryDirectory() as folder:
+        ...     [p.name for p in pkm.write_serial_equivalent(se, folder)]
+        ['talos_like_serial.urdf', 'talos_like_serial.xml', 'talos_like_ankle.urdf', 'talos_like_ankle.closures.toml', 'talos_like_transmissions.json']
+    """
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
     stem = _safe(se.robot.name)

@@ -68,7 +68,9 @@ Kernels (the same instruction list in every target; `transmission.json` lists ea
 `ik` (outputs → motors), `maps` (the velocity map `J`: q̇_o = J q̇_m, and its inverse; efforts by power balance
 τ_m = Jᵀ τ_o), `delta` (ΔM, Δh: what a serial-equivalent model of the outputs lacks, in output coordinates:
 serial model + ΔM q̈_o + Δh = the closed-loop model), `fk_j_dm` (fk, then J and ΔM, fused). SI units; matrices
-column-major; statuses {', '.join(f'{i} `{s}`' for i, s in enumerate(STATUS))}.
+column-major; statuses {', '.join(f'{i} `{s}`' for i, s in enumerate(STATUS))} (`OUTSIDE_LIMITS`: the solve
+converged, the solution is written, but a joint of it, a motor's, an output's or a rod's, lies beyond the limit the
+robot's file states; the C++ class throws on it as on every status but `OK`).
 
 ## C and C++
 

@@ -12,10 +12,13 @@ simulator needs, in the sub-mechanism's configuration ``q_sub`` (its ``nq``, as 
 * the effort maps by the power balance ``τ_mᵀ ṁ = τ_oᵀ ȯ``: ``τ_m = Jᵀ τ_o`` and ``τ_o = J⁻ᵀ τ_m``, computed by the
   other route, the outputs independent (:mod:`pkm.core.transmissions.coordinates`), so that ``effort_map = Jᵀ`` is a
   check;
-* what the serial-equivalent model lacks (:func:`~pkm.core.transmissions.coordinates.serial_tree`: the tree with the outputs only and the
-  bodies they carry), in output coordinates: ``ΔM = M_o - M_s`` and ``Δh = h_o - h_s``, so that serial model + ΔM +
-  Δh is the closed-loop model exactly: ``(M_s + ΔM) ö + h_s + Δh = τ_o`` is the sub-mechanism's dynamics with the
-  root held where the robot's reference puts it.
+* what the serial-equivalent model lacks (:func:`~pkm.core.transmissions.coordinates.serial_tree`: the tree with
+  the outputs only, the bodies they carry, and every other joint's body welded to its parent at the reference, its
+  mass carried by the nearest output above it or by the root), in output coordinates: ``ΔM = M_o - M_s`` and
+  ``Δh = h_o - h_s`` (the welded bodies' motion about their anchors and the rotors, less the welded mass's own
+  share: a diagonal entry can be negative), so that serial model + ΔM + Δh is the closed-loop model exactly:
+  ``(M_s + ΔM) ö + h_s + Δh = τ_o`` is the sub-mechanism's dynamics with the root held where the robot's reference
+  puts it.
 """
 
 from __future__ import annotations
@@ -30,13 +33,11 @@ from numpy.typing import ArrayLike
 from pkm.core.differential.velocity import RTOL, forward_jacobian, inverse_jacobian
 from pkm.core.kinematics.solve import close_loops, solve_ik
 from pkm.core.model.mechanism import Mechanism
-from pkm.core.transmissions.coordinates import OutputSplit, output_model, output_split, serial_tree
+from pkm.core.model.scale import JacobianScales
+from pkm.core.transmissions.coordinates import OutputSplit, closure_tol, output_model, output_split, serial_tree
 from pkm.errors import SingularityError, TransmissionError
 from pkm.validation import as_vector
 
-#: The position solvers' tolerance on the closure residual and the task error [m, rad]: tight, so that a round trip
-#: motors -> outputs -> motors comes back to 1e-12.
-TOL = 1e-13
 #: Below this, an idle motion's motor component or the outputs' dependence (homogenised, relative) counts as zero.
 SINGULAR = 1e-7
 
@@ -102,19 +103,22 @@ class Transmission:
                                     f"at the reference: {exc}", self.motors, exc.sigma_min) from exc
 
     # ------------------------------------------------------------------ positions
-    def outputs_from_motors(self, qm: ArrayLike, guess: ArrayLike | None = None, *, tol: float = TOL,
+    def outputs_from_motors(self, qm: ArrayLike, guess: ArrayLike | None = None, *, tol: float | None = None,
                             max_iter: int = 30) -> tuple[np.ndarray, np.ndarray]:
         """Forward kinematics: ``(qo, q_sub)`` for the motors at ``qm`` [rad or m] (the sub-mechanism's loop closure,
-        seeded with the configuration ``guess``, default the reference). Raises
-        :class:`~pkm.errors.ConvergenceError` when the loops do not close within ``max_iter`` Newton iterations per
-        continuation step."""
+        seeded with the configuration ``guess``, default the reference; ``tol`` [m, rad] on the closure residual,
+        default relative to the sub-mechanism's size: :func:`~pkm.core.transmissions.coordinates.closure_tol`).
+        Raises :class:`~pkm.errors.ConvergenceError` when the loops do not close within ``max_iter`` Newton
+        iterations per continuation step."""
+        tol = closure_tol(self.mechanism) if tol is None else tol
         q = close_loops(self.mechanism, qm, guess, tol=tol, max_iter=max_iter).q
         return q[self.out_q].copy(), q
 
-    def motors_from_outputs(self, qo: ArrayLike, guess: ArrayLike | None = None, *, tol: float = TOL,
+    def motors_from_outputs(self, qo: ArrayLike, guess: ArrayLike | None = None, *, tol: float | None = None,
                             max_iter: int = 30) -> tuple[np.ndarray, np.ndarray]:
         """Inverse kinematics: ``(qm, q_sub)`` for the outputs at ``qo`` [rad or m] (the sub-mechanism's inverse
-        kinematics, seeded with ``guess``, default the reference)."""
+        kinematics, seeded with ``guess``, default the reference; ``tol`` as :meth:`outputs_from_motors`')."""
+        tol = closure_tol(self.mechanism) if tol is None else tol
         q = solve_ik(self.mechanism, as_vector(qo, self.k, "qo"), guess, tol=tol, max_iter=max_iter).q
         return self.mechanism.actuated_q(q), q
 
@@ -152,7 +156,7 @@ class Transmission:
         singular value under :data:`pkm.core.differential.velocity.RTOL`)."""
         sub = self.mechanism
         Gm = self._split(q_sub).G[sub.act_v]
-        cols = sub.jacobian_scales.columns
+        cols = JacobianScales.of(sub).columns
         s = np.linalg.svd(Gm * cols[self.out_v][None, :] / cols[sub.act_v][:, None], compute_uv=False)
         if not s[-1] > RTOL * s[0]:
             raise SingularityError("direct", float(s[-1]), f"transmission {self.name!r}: the motors do not hold the "
@@ -178,8 +182,9 @@ class Transmission:
     @functools.cached_property
     def serial(self) -> pin.Model:
         """The serial-equivalent model of the sub-mechanism (:func:`pkm.core.transmissions.coordinates.serial_tree`):
-        its model with every joint but the outputs massless (their bodies, the motors' rotors removed)."""
-        return serial_tree(self.mechanism.model, self.outputs)
+        its model with every joint but the outputs welded to its parent at the reference (their bodies' mass carried
+        by the nearest output above them, or by the root; the motors' rotors removed)."""
+        return serial_tree(self.mechanism.model, self.outputs, self.mechanism.q_reference)
 
     def serial_model(self, q_sub: ArrayLike, qd_o: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """``(M_s, h_s)``: the serial-equivalent model's mass matrix and bias (Coriolis, centrifugal, gravity) in the
@@ -194,8 +199,9 @@ class Transmission:
         return M[np.ix_(self.out_v, self.out_v)], h[self.out_v]
 
     def delta_mass(self, q_sub: ArrayLike) -> np.ndarray:
-        """``ΔM = M_o - M_s`` (k x k) [kg m^2]: the mass matrix the serial-equivalent model lacks (rods, cranks,
-        rotors), in output coordinates."""
+        """``ΔM = M_o - M_s`` (k x k) [kg m^2]: the mass matrix the serial-equivalent model (the rods and cranks
+        welded at the reference) lacks, in output coordinates: the rods' and cranks' motion about where they are
+        welded, the rotors, less the welded mass's share (it may be indefinite)."""
         zero = np.zeros(self.k)
         return self.output_model(q_sub, zero)[0] - self.serial_model(q_sub, zero)[0]
 
@@ -205,4 +211,4 @@ class Transmission:
         return self.output_model(q_sub, qd_o)[1] - self.serial_model(q_sub, qd_o)[1]
 
 
-__all__ = ["SINGULAR", "TOL", "Transmission"]
+__all__ = ["SINGULAR", "Transmission"]

@@ -6,7 +6,7 @@
 * :mod:`~pkm.core.twin.tree`: :class:`Twin`, the tree's kinematics, closures and dynamics as expressions;
 * :mod:`~pkm.core.twin.task`: its task, inverse kinematics and map iterations;
 * :mod:`~pkm.core.twin.codegen`: generated C with batch and path drivers, compiled and loaded;
-* :mod:`~pkm.core.twin.jaxgen`: any kernel as a JAX function (jit, vmap, grad; ``pkm[jax]``);
+* :mod:`~pkm.core.twin.jaxgen`: any kernel as a JAX function (jit, vmap, grad; ``pkm-robotics[jax]``);
 * :mod:`~pkm.core.twin.kernels`: :class:`Kernels`, the twin's functions run on states, batches and paths;
 * :mod:`~pkm.core.twin.dynamics`: the actuator-space model (``M_a``, ``h_a``, forward dynamics) as expressions;
 * :mod:`~pkm.core.twin.simulation`: :func:`pkm.simulate`'s RK4 in generated C.

@@ -34,6 +34,7 @@ import casadi as cs
 import numpy as np
 
 from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.core.twin.linear import PivotedLU
 from pkm.core.twin.spatial import Expr
 from pkm.core.twin.tree import Twin
@@ -229,7 +230,7 @@ class ActuatorTwin:
         fails :data:`INERTIA_FLOOR`."""
         L, diag = cholesky(self.mass_matrix)
         rhs = self.tau + self.friction[0] * self.friction_efforts - self.bias
-        d = cs.vertcat(*diag) * cs.DM(self.tw.mech.jacobian_scales.actuated)  # (homogenised, as _solve_inertia)
+        d = cs.vertcat(*diag) * cs.DM(JacobianScales.of(self.tw.mech).actuated)  # (homogenised, as _solve_inertia)
         ok = cs.if_else(cs.mmin(d) > INERTIA_FLOOR * cs.mmax(d), 1.0, 0.0)
         return {"qdd": cholesky_solve(L, rhs), "pivot": cs.fmin(self.pivot, ok)}
 

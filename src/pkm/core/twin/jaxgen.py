@@ -12,8 +12,8 @@ each input and output a 1-D array of the CasADi function's nonzeros (column-majo
     f = jax_function(pkm.Kernels(mech).function("inverse_dynamics"))
     tau, pivot = jax.vmap(f)(Q, QD, QDD)  # (n, nq), (n, na), (n, na) -> (n, na), (n, 1)
 
-This is pkm's own translation of the twin (no third-party converter); JAX (``pip install "pkm[jax]"``) is imported
-when :func:`jax_function` is called, never by :func:`jax_source`.
+This is pkm's own translation of the twin (no third-party converter); JAX (``pip install "pkm-robotics[jax]"``) is
+imported when :func:`jax_function` is called, never by :func:`jax_source`.
 
 Precision: the kernels are double-precision, as their C; :func:`jax_function` turns JAX's 64-bit mode on
 (``jax.config.update("jax_enable_x64", True)``, process-wide) unless told not to. Constants are written as Python
@@ -86,7 +86,7 @@ def jax_function(fun: cs.Function, *, x64: bool = True) -> Callable[..., tuple[A
     and compiles, about 1 ms of XLA per instruction: slow for functions of tens of thousands of instructions.
 
     Raises:
-        MissingDependencyError: JAX is not installed (``pip install "pkm[jax]"``).
+        MissingDependencyError: JAX is not installed (``pip install "pkm-robotics[jax]"``).
         ValueError: ``fun`` is not an SX function, or uses an operation :data:`_JAX` lacks.
     """
     from pkm._optional import module

@@ -51,6 +51,7 @@ from pkm.core.twin.codegen import C_INT as _I
 from pkm.core.twin.codegen import C_REAL_P as _P
 from pkm.core.twin.codegen import compile_library, numpy_function, pointers
 from pkm.core.twin.dynamics import ActuatorTwin
+from pkm.core.twin.task import TaskTwin
 from pkm.core.twin.tree import Twin
 from pkm.errors import InvalidInputError, NonFiniteError
 from pkm.validation import as_array, as_count, as_scalar, as_tolerance, bounded
@@ -358,7 +359,7 @@ class Kernels:
     # ---------------------------------------------------------------- kernels
     def function(self, name: str) -> cs.Function:
         """The CasADi function of a kernel (:data:`KERNELS`), inputs and outputs dense, after CSE."""
-        tw, tk = self.twin, self.twin.task
+        tw, tk = self.twin, TaskTwin.of(self.twin)
         if name not in KERNELS:
             raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", name)
         if name == "regressor":  # (a twin of its own: the bodies' parameters as symbols)
@@ -408,7 +409,7 @@ class Kernels:
         output); mask on it.
 
         Raises:
-            MissingDependencyError: JAX is not installed (``pip install "pkm[jax]"``).
+            MissingDependencyError: JAX is not installed (``pip install "pkm-robotics[jax]"``).
         """
         from pkm.core.twin.jaxgen import jax_function
 

@@ -41,9 +41,11 @@ import casadi as cs
 import numpy as np
 
 from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.core.twin.codegen import C_INT, C_REAL_P, compile_library, jacobi_sv, pointers, source
 from pkm.core.twin.joint import _ONE_DOF
 from pkm.core.twin.spatial import SE3, Expr, log3, log6, quat_matrix, rodrigues, zyx_angles
+from pkm.core.twin.task import TaskTwin
 
 if TYPE_CHECKING:
     from pkm.core.twin.kernels import Kernels
@@ -400,7 +402,7 @@ def quaternion(R: Expr) -> list[Expr]:
 
 def task_value(twin: Twin) -> Expr:
     """The task value at :attr:`Twin.q`, laid out as :meth:`pkm.core.kinematics.task.TaskMap.value`."""
-    tk = twin.task
+    tk = TaskTwin.of(twin)
     out: list = []
     for fid, comps in tk._task_groups():
         M = twin.frame_placement(fid)
@@ -426,7 +428,7 @@ class Simulator:
         close = tw.closure_newton
         r0 = tw.with_actuated(cs.mmax(cs.fabs(tw.closure_residual))) if mech.n_constraints else cs.SX(0.0)
         passive = [int(c) for c in mech.passive_v]
-        scales = mech.jacobian_scales  # (J_p homogenised, as the Python route's check: the same for any size)
+        scales = JacobianScales.of(mech)  # (J_p homogenised, as the Python route's check: the same for any size)
         Jp = cs.diag(cs.DM(scales.constraint_rows)) @ tw.closure_rows["jacobian"][:, passive] \
             @ cs.diag(cs.DM(scales.columns[passive])) if mech.n_constraints else cs.SX(0, len(passive))
         self.shape_jp = Jp.shape
@@ -434,7 +436,7 @@ class Simulator:
         q1 = cs.SX.sym("q1", mech.model.nq)
         qdd = tw.qdd
         a = tw.accelerations
-        Jt = tw.task.task_jacobian
+        Jt = TaskTwin.of(tw).task_jacobian
         ta = Jt @ a + cs.jtimes(Jt @ tw.v, tw.q, tw.tangent @ tw.v)
         resid = cs.mmax(cs.fabs(tw.closure_residual)) if mech.n_constraints else cs.SX(0.0)
 
@@ -464,7 +466,8 @@ class Simulator:
             driver = driver.replace(f" {key}\n", f" {value}\n")
         driver = (driver.replace("JACOBI_SV\n", jacobi_sv("pkm_sim_sv", 1e-15, 1e-15)).replace("CLOSURE_TOL_", repr(CLOSURE_TOL)).replace("PIVOT_FLOOR_", repr(float(PIVOT_FLOOR)))
                   .replace("NEWTON_MAX_", str(NEWTON_MAX)).replace("INERTIA_FLOOR_", repr(INERTIA_FLOOR))
-                  .replace("ACT_SCALE_", "{" + ", ".join(repr(float(x)) for x in mech.jacobian_scales.actuated) + "}"))
+                  .replace("ACT_SCALE_", "{" + ", ".join(repr(float(x)) for x in JacobianScales.of(mech).actuated)
+                           + "}"))
         self.lib, self.how = compile_library(self.functions, directory=kernels.directory,
                                              text=source(self.functions) + driver)
         if self.lib is None:

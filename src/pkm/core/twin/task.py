@@ -1,21 +1,21 @@
 """The task of a mechanism's twin: its error and Jacobian, the forward and inverse Jacobians, and the Newton
 iterations of the inverse kinematics and of the maps (:mod:`pkm.core.analysis.maps`), as SX expressions of the twin's
-symbols (:class:`~pkm.core.twin.tree.Twin`, whose :attr:`~pkm.core.twin.tree.Twin.task` this is)."""
+symbols (:class:`~pkm.core.twin.tree.Twin`: :meth:`TaskTwin.of(twin) <TaskTwin.of>`, built on the twin, which does
+not import this module)."""
 
 from __future__ import annotations
 
 import functools
-from typing import TYPE_CHECKING
 
 import casadi as cs
 import numpy as np
 
+from pkm._derived import derived
+from pkm.core.kinematics.task import TaskMap
 from pkm.core.twin.linear import PivotedLU
 from pkm.core.twin.spatial import Expr, euler_rates, log3, quat_matrix, zyx_angles
+from pkm.core.twin.tree import Twin
 from pkm.errors import SpecError
-
-if TYPE_CHECKING:
-    from pkm.core.twin.tree import Twin
 
 _POS = {"x": 0, "y": 1, "z": 2}
 _ANGLES = ("roll", "pitch", "yaw")
@@ -23,6 +23,11 @@ _ANGLES = ("roll", "pitch", "yaw")
 
 class TaskTwin:
     """The task expressions of ``twin`` (see the module doc)."""
+
+    @classmethod
+    def of(cls, twin: Twin) -> TaskTwin:
+        """``twin``'s task expressions, made on the first call and kept with the twin."""
+        return derived(twin, cls)
 
     def __init__(self, twin: Twin):
         self.tw = twin
@@ -35,9 +40,7 @@ class TaskTwin:
     @functools.cached_property
     def task_target(self) -> Expr:
         """The symbol of a task target, laid out as :meth:`pkm.core.kinematics.task.TaskMap.value` gives values."""
-        from pkm.core.kinematics.task import TaskMap
-
-        return cs.SX.sym("y", TaskMap(self.tw.mech).value_size)
+        return cs.SX.sym("y", TaskMap.of(self.tw.mech).value_size)
 
     @functools.cached_property
     def task_error(self) -> Expr:

@@ -11,9 +11,9 @@ symbols ``q`` (nq), ``v`` (nv) and ``a`` (nv):
   actuated ones, the actuator efforts at a consistent state and from ``(q, qd, qdd)`` with their derivatives,
   every linear solve a sparse LU with pivots fixed at the reference (:mod:`~pkm.core.twin.linear`), the closure
   rows in the axes that make them cheapest;
-* the loop closure's Newton iteration, with a retraction on the configuration space; the task's expressions and
-  the Newton iterations of the inverse kinematics and the maps in :attr:`Twin.task`
-  (:class:`~pkm.core.twin.task.TaskTwin`).
+* the loop closure's Newton iteration, with a retraction on the configuration space. The task's expressions and
+  the Newton iterations of the inverse kinematics and the maps are built on the twin:
+  :meth:`TaskTwin.of(twin) <pkm.core.twin.task.TaskTwin.of>` (this module does not import it).
 
 :class:`~pkm.core.twin.kernels.Kernels` turns them into functions run on states, batches and paths, compiled to C.
 
@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import Any
 
 import casadi as cs
 import numpy as np
@@ -56,9 +56,6 @@ from pkm.core.twin.spatial import (
     motion_cross,
 )
 from pkm.errors import SpecError
-
-if TYPE_CHECKING:
-    from pkm.core.twin.task import TaskTwin
 
 
 def theta_times(th: Expr, m: Expr) -> Expr:
@@ -439,12 +436,11 @@ class Twin:
         return {"dtau_dqa": cs.jtimes(tau, self.q, self.tangent @ self.passive_map),  # na forward sweeps, not nq
                 "dtau_dqd": cs.jacobian(tau, self.qd), "dtau_dqdd": cs.jacobian(tau, self.qdd)}
 
-    @functools.cached_property
-    def task(self) -> TaskTwin:
-        """The task's expressions and the Newton iterations of the IK and the maps (:class:`TaskTwin`)."""
-        from pkm.core.twin.task import TaskTwin
-
-        return TaskTwin(self)
+    @property
+    def task(self) -> Any:
+        """Moved: :meth:`TaskTwin.of(twin) <pkm.core.twin.task.TaskTwin.of>` (built on the twin, above it)."""
+        raise AttributeError("Twin.task moved to pkm.core.twin.task.TaskTwin.of(twin): the task's expressions are "
+                             "built on the twin, above it")
 
     # ---------------------------------------------------------------- configuration space
     @functools.cached_property
@@ -493,9 +489,10 @@ class Twin:
 
     # ---------------------------------------------------------------- functions
     def function(self, name: str, outputs: dict, inputs: tuple[str, ...] = ("q", "v", "a")) -> cs.Function:
-        """``casadi.Function(name, inputs, outputs)`` over the twin's symbols."""
+        """``casadi.Function(name, inputs, outputs)`` over the twin's symbols (the task's are
+        :class:`~pkm.core.twin.task.TaskTwin`'s)."""
         sym = {"q": self.q, "v": self.v, "a": self.a, "qd": self.qd, "qdd": self.qdd, "target": self.target,
-               "y": self.task.task_target, "scale": self.task.scale, "design": self.p}
+               "design": self.p}
         return cs.Function(name, [sym[i] for i in inputs], list(outputs.values()), list(inputs), list(outputs))
 
 

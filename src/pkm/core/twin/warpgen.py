@@ -10,7 +10,7 @@ neighbouring addresses), the CasADi function's nonzeros column-major.
 
 Warp compiles a kernel from its Python source (``inspect``), so the source is written to a real file and imported
 (:func:`warp_module`: a file named by the hash of its source, under :func:`pkm.cache.cache_dir`'s ``warp``
-folder); Warp then caches its own compiled module (``~/.cache/warp``). Warp (``pip install "pkm[warp]"``)
+folder); Warp then caches its own compiled module (``~/.cache/warp``). Warp (``pip install "pkm-robotics[warp]"``)
 is imported by :func:`warp_module` and :func:`launch` only.
 
 Rounding: ``+ - * /``, square roots, ``abs``, the comparisons are IEEE operations as in the C; sines, cosines,
@@ -108,7 +108,7 @@ def warp_module(funs: cs.Function | Sequence[cs.Function], directory: str | os.P
     ``backward``: as :func:`warp_source`.
 
     Raises:
-        MissingDependencyError: Warp is not installed (``pip install "pkm[warp]"``).
+        MissingDependencyError: Warp is not installed (``pip install "pkm-robotics[warp]"``).
     """
     from pkm._optional import require
 
@@ -142,7 +142,7 @@ def warp_kernel(fun: cs.Function, directory: str | os.PathLike[str] | None = Non
     """``fun`` as a Warp kernel (:func:`warp_module` of ``fun`` alone); launch it with :func:`launch`.
 
     Raises:
-        MissingDependencyError: Warp is not installed (``pip install "pkm[warp]"``).
+        MissingDependencyError: Warp is not installed (``pip install "pkm-robotics[warp]"``).
     """
     return getattr(warp_module(fun, directory), fun.name())
 
