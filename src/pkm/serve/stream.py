@@ -2,7 +2,9 @@
 
 Each message is a map with ``qa`` (the actuated coordinates) and optionally ``qd`` (their rates) and ``qdd`` (their
 accelerations); the answer has ``q`` and ``y`` (the configuration and the task value, the loops closed from the
-previous sample's configuration: a stream stays on its assembly mode), the closure ``residual``, with ``qd`` the task
+previous sample's configuration: a stream stays on its assembly mode), the closure ``residual``, ``status`` (``"ok"``, or
+``"outside_limits"`` where ``outside_limits``, the joints outside the position limits the model states with their
+values and limits, is not empty), with ``qd`` the task
 rates ``yd``, with ``qd`` and ``qdd`` the actuator efforts ``tau`` (``M_a qdd + h_a``), and ``compute_s``.
 
 Where the mechanism's compiled kernels build (:class:`pkm.Kernels`: a C compiler, no idle motion), a sample is the
@@ -22,7 +24,7 @@ import numpy as np
 import pkm
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError
-from pkm.validation import as_array
+from pkm.validation import as_array, bounded
 
 
 class Stream:
@@ -59,6 +61,7 @@ class Stream:
         qa = self._vector(sample, "qa")
         if qa is None:
             raise InvalidInputError("qa", f"missing: give {self.mech.na} numbers")
+        bounded(qa, "qa")  # (the library's bound on coordinates: beyond it refused, never wrapped)
         qd, qdd = self._vector(sample, "qd"), self._vector(sample, "qdd")
         K = self.kernels
         q = residual = None
@@ -70,7 +73,9 @@ class Stream:
             r = close_loops(self.mech, qa, self.q)
             q, residual = r.q, r.residual
         self.q = q
-        out: dict[str, Any] = {"q": q, "y": pkm.TaskMap.of(self.mech).value(q), "residual": residual}
+        outside = [v._asdict() for v in self.mech.limit_violations(q)]
+        out: dict[str, Any] = {"q": q, "y": pkm.TaskMap.of(self.mech).value(q), "residual": residual,
+                               "status": "outside_limits" if outside else "ok", "outside_limits": outside}
         if qd is not None:
             if K is not None:
                 J = K.kernel("forward_jacobian")(q[None])[0].reshape(-1, self.mech.na, order="F")
