@@ -41,6 +41,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.model.actuators": ("Actuator",),
     "pkm.core.model.builder": ("from_strings", "scaled_mechanism", "with_actuators"),
     "pkm.core.model.mechanism": ("Mechanism",),
+    "pkm.core.dynamics.motors": ("joint_efforts", "motor_efforts", "motor_values"),
     "pkm.core.model.scale": ("scale_configuration",),
     "pkm.core.kinematics.labels": ("ModeLabel", "mode_label"),
     "pkm.core.kinematics.solve": ("ClosureProblem", "IKProblem", "SolveResult", "assemble", "branch_seed",
@@ -118,6 +119,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.model.actuators import Actuator
     from pkm.core.model.builder import from_strings, scaled_mechanism, with_actuators
     from pkm.core.model.mechanism import Mechanism
+    from pkm.core.dynamics.motors import joint_efforts, motor_efforts, motor_values
     from pkm.core.model.scale import scale_configuration
     from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 

@@ -24,8 +24,13 @@ does not keep, from the file itself:
   ``general``...), in file order; a mimic joint's actuator drives its leader; an actuator on a
   ``<tendon><fixed>`` drives the one independent joint the tendon's length is an affine function of, once
   the mimic couplings are substituted (Robotiq's ``0.5 right + 0.5 left`` with ``right = left`` drives
-  ``left`` with factor 1). A tendon of several independent joints (a differential) or a ``<spatial>``
-  tendon is refused; actuators on sites or bodies (forces, not joint inputs) are left out with a note;
+  ``left`` with factor 1). A tendon of several independent joints is a differential: those joints are
+  actuated and each motor on it a ``[motors]`` entry (:attr:`Imported.motors`, :mod:`pkm.core.model.motors`), its
+  coordinate the tendon length times the actuator's ``gear``, ``u = sum_j gear c_j q_j`` (the mimic couplings
+  substituted), its effort acting on the joints as ``tau_j = gear c_j f``; the motors that share joints must be as
+  many as those joints, their map invertible, and a joint in a differential has no actuator of its own (else
+  refused); their force ranges bound the motors, not a joint (a note). A ``<spatial>`` tendon is refused; actuators
+  on sites or bodies (forces, not joint inputs) are left out with a note;
 * the drive of each actuated joint (:attr:`Imported.actuators`, a spec's ``[actuators.<joint>]`` tables: the URDF
   text cannot carry them; :mod:`pkm.core.model.actuators`), class defaults included (MuJoCo's actuator elements
   share one default per class): the joint's ``armature`` (MuJoCo's is the reflected inertia) -> ``armature``,
@@ -51,8 +56,10 @@ does not keep, from the file itself:
 * the reference configuration: the ``<keyframe><key name="reference">`` (the one :func:`pkm.save` writes), held
   (a ``qpos`` of another length is refused naming its line, as in every key); without it, the first key whose
   hinges and slides lie inside their ranges (MuJoCo Menagerie's ``home``: a pose MuJoCo's soft equalities leave
-  open by a millimetre or so): its free bodies and actuated joints held, the loops closed by moving the other joints
-  from it (a note names the key, the keys passed over, and how far the closing moved them); without any, assembled
+  open by a millimetre or so): its floating base held, its free bodies and actuated joints held where the loops allow
+  (:attr:`Imported.hold`: redundant motors whose key values disagree are moved, a note and a warning say by how much),
+  the loops closed by moving the other joints from it (a note names the key, the keys passed over, and how far the
+  closing moved them); without any, assembled
   starting from MuJoCo's ``qpos0`` (hinges and slides at their ``ref``, free bodies where the file puts them), where
   a ``<connect>``'s second anchor is taken (also for the connects pkm re-anchors: those to free bodies). An
   assembled reference outside a joint's range is assembled again inside it, else said

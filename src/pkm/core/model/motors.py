@@ -9,7 +9,8 @@ actuated joint no motor names is driven by a motor of its own, ``u = q_joint``. 
 * positions and velocities: ``u = C q_a`` (up to a constant), ``du = C dq_a``;
 * efforts, by virtual work: the motors' forces ``f`` act on the joints as ``tau_a = C^T f``, so the motor efforts
   of actuated-joint efforts ``tau_a`` (:func:`pkm.inverse_dynamics`) are ``f = C^-T tau_a``
-  (:func:`motor_efforts`; :func:`joint_efforts` is the converse).
+  (:func:`pkm.core.dynamics.motors.motor_efforts`; :func:`~pkm.core.dynamics.motors.joint_efforts` is the
+  converse).
 
 The motors that name a set of joints must be as many as those joints, their map invertible (a differential of two
 motors on two joints; a joint named by a motor is driven by the motors only): else a :class:`~pkm.errors.SpecError`.
@@ -20,16 +21,10 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import ArrayLike
-
-if TYPE_CHECKING:
-    from pkm.core.model.mechanism import Mechanism
 
 from pkm.errors import SpecError
-from pkm.validation import as_vector
 
 #: The smallest ratio of the smallest to the largest singular value of a differential's map: below it the motors
 #: do not determine the joints.
@@ -112,32 +107,4 @@ def _check_groups(motors: Mapping[str, Mapping[str, float]], source: str) -> Non
                                     f"{C.tolist()} is singular (singular values {s[0]:.3g} and {s[-1]:.3g})")
 
 
-def motor_values(mech: object, q: ArrayLike) -> np.ndarray:
-    """The motors' coordinates ``C q_a`` (na) at the configuration ``q`` (module doc; each up to the constant the
-    model file may add: MuJoCo's tendon length has none)."""
-    m = _mech(mech)
-    return m.motor_map.matrix @ m.actuated_q(m.check_q(q))
-
-
-def motor_efforts(mech: object, tau_actuated: ArrayLike) -> np.ndarray:
-    """The motors' efforts ``f = C^-T tau_a`` (na, in motor order: :attr:`MotorMap.names`) that apply the actuated
-    joints' efforts ``tau_a`` (na, in ``actuated`` order; :func:`pkm.inverse_dynamics` gives them)."""
-    m = _mech(mech)
-    return np.linalg.solve(m.motor_map.matrix.T, as_vector(tau_actuated, m.na, "tau_actuated"))
-
-
-def joint_efforts(mech: object, motor_effort: ArrayLike) -> np.ndarray:
-    """The actuated joints' efforts ``tau_a = C^T f`` (na, ``actuated`` order) of the motors' efforts ``f`` (na, in
-    motor order): what :func:`pkm.forward_dynamics` and :func:`pkm.simulate` take."""
-    m = _mech(mech)
-    return m.motor_map.matrix.T @ as_vector(motor_effort, m.na, "motor_effort")
-
-
-def _mech(mech: object) -> Mechanism:
-    from pkm.core.model.mechanism import check_mechanism  # (late: the mechanism imports this module)
-
-
-    return check_mechanism(mech)
-
-
-__all__ = ["RCOND", "MotorMap", "joint_efforts", "motor_efforts", "motor_map", "motor_values"]
+__all__ = ["RCOND", "MotorMap", "motor_map"]
