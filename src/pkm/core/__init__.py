@@ -87,6 +87,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         mass_matrix,
         operational_space,
     )
+    from pkm.core.dynamics.motors import joint_efforts, motor_efforts, motor_values
     from pkm.core.dynamics.projection import (
         BaseInverseDynamics,
         base_inverse_dynamics,
@@ -119,7 +120,6 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.model.actuators import Actuator
     from pkm.core.model.builder import from_strings, scaled_mechanism, with_actuators
     from pkm.core.model.mechanism import Mechanism
-    from pkm.core.dynamics.motors import joint_efforts, motor_efforts, motor_values
     from pkm.core.model.scale import scale_configuration
     from pkm.core.model.spec import Branch, Closure, ClosureSpec, TaskSpec
 

@@ -14,10 +14,10 @@ import pinocchio as pin
 import pytest
 
 import pkm
+from pkm.core.dynamics.motors import joint_efforts, motor_efforts, motor_values
 from pkm.core.formats.to_mjcf import mjcf_from_mechanism, qpos_of
 from pkm.core.kinematics import constraints
-from pkm.core.dynamics.motors import joint_efforts, motor_efforts, motor_values
-from pkm.errors import PkmWarning
+from pkm.errors import PkmWarning, SpecError
 from tests.fd import constraint_jacobian_error, forward_jacobian_error
 
 mujoco = pytest.importorskip("mujoco")
@@ -184,3 +184,19 @@ def test_redundant_motor_values_of_a_key_are_released_not_refused(tmp_path):
     assert values["right_neck"] == pytest.approx(0.2, abs=1e-9)
     assert np.abs(constraints.residual(mech, mech.q_reference)).max() <= 1e-12
     assert mech.dependent_actuators == ("right_neck",)
+
+
+def test_loops_that_cannot_close_under_a_floating_base_are_said_so_not_blamed_on_the_reference(tmp_path):
+    """The file states only its floating base's pose (pkm's generated [reference]): a rod too long for its loop to
+    close is "the loops cannot be closed", not a "[reference] lacks joints" the user cannot mend."""
+    path = tmp_path / "long.xml"
+    path.write_text("""<mujoco><compiler angle="radian"/><worldbody><body name="base"><freejoint name="root"/>
+      <geom type="sphere" size="0.05"/><site name="anchor" pos="0.1 0 0"/>
+      <body name="crank"><joint name="crank" axis="0 1 0"/><geom type="sphere" size="0.01" pos="0.02 0 0"/>
+        <body name="rod" pos="0.02 0 0"><joint name="rod" axis="0 1 0"/><geom type="sphere" size="0.01"/>
+          <site name="tip" pos="0 0 0.5"/></body></body></body></worldbody>
+      <equality><connect site1="tip" site2="anchor"/></equality><actuator><motor joint="crank"/></actuator></mujoco>""",
+                    encoding="utf-8")
+    with pytest.raises(SpecError, match="the loops cannot be closed") as info:
+        pkm.load(path)
+    assert "[reference]" not in str(info.value)
