@@ -188,7 +188,8 @@ def test_redundant_motor_values_of_a_key_are_released_not_refused(tmp_path):
 
 def test_loops_that_cannot_close_under_a_floating_base_are_said_so_not_blamed_on_the_reference(tmp_path):
     """The file states only its floating base's pose (pkm's generated [reference]): a rod too long for its loop to
-    close is "the loops cannot be closed", not a "[reference] lacks joints" the user cannot mend."""
+    close is "the loops cannot be closed", not a "[reference] lacks joints" the user cannot mend; the redundant rows
+    of its planar loop are said (an over-constrained loop whose sites disagree by a rounding error fails alike)."""
     path = tmp_path / "long.xml"
     path.write_text("""<mujoco><compiler angle="radian"/><worldbody><body name="base"><freejoint name="root"/>
       <geom type="sphere" size="0.05"/><site name="anchor" pos="0.1 0 0"/>
@@ -200,3 +201,4 @@ def test_loops_that_cannot_close_under_a_floating_base_are_said_so_not_blamed_on
     with pytest.raises(SpecError, match="the loops cannot be closed") as info:
         pkm.load(path)
     assert "[reference]" not in str(info.value)
+    assert "the closures' 3 equations have rank 2 there: redundant" in str(info.value)  # (a planar loop)

@@ -108,11 +108,12 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
                 mech.notes += (release,)
                 warnings.warn(f"{source}: {release}", PkmWarning, stacklevel=3)
         except AssemblyError as exc:
+            hint = _redundancy(mech, start)
             if not set(spec.reference) - {spec.floating_base}:  # (the files state no joint: the loops do not close)
-                raise SpecError(source, f"the loops cannot be closed: {exc}") from exc  # (its closures, gaps)
+                raise SpecError(source, f"the loops cannot be closed: {exc}{hint}") from exc  # (its closures, gaps)
             raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found that keeps the "
                                     f"joints it states, the others starting from the neutral configuration "
-                                    f"({exc}); give an assembled [reference]") from None
+                                    f"({exc}){hint}; give an assembled [reference]") from None
         gap = constraints.worst_closure(mech, constraints.residual(mech, start))[0] if seed else 0.0
         if gap > REFERENCE_TOL:  # (where the pose the files state was open, how far closing it moved it)
             moved = float(np.abs(pin.difference(model, start, mech.q_reference)).max())
@@ -136,6 +137,20 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
             mech.notes += (str(finding),)
             warnings.warn(finding, stacklevel=3)
     return mech
+
+
+def _redundancy(mech: Mechanism, q: np.ndarray) -> str:
+    """Where the closures' rows are redundant at ``q`` (their Jacobian, the floating base held, has a smaller rank
+    than rows: over-constrained or planar loops), a sentence saying that such loops close only where their geometry
+    agrees exactly (MuJoCo's soft equalities absorb a disagreement that rigid loops cannot); else ``""``."""
+    J = constraints.jacobian(mech, q)[:, np.setdiff1d(np.arange(mech.nv), mech.base_v)]
+    s = np.linalg.svd(J, compute_uv=False)
+    rank = int(np.sum(s > 1e-9 * s[0])) if len(s) and s[0] > 0.0 else 0
+    if rank >= J.shape[0]:
+        return ""
+    return (f"; the closures' {J.shape[0]} equations have rank {rank} there: redundant (over-constrained or planar) "
+            "loops close only where their geometry agrees exactly, which MuJoCo's soft equalities do not require (a "
+            "site or anchor off by a rounding error is enough)")
 
 
 #: Rounds of :func:`_inside_limits`: each assembles once more (one Levenberg-Marquardt run, no restarts).
