@@ -775,8 +775,7 @@ def _actuated(root: etree._Element, defaults: _Defaults, kinds: dict[str, str], 
             motors[motor] = {j: gear * f for j, f in moving.items()}
             out += [_Drive(j, f, el, label, motor) for j, f in moving.items()]
             notes.append(f"{label} on tendon {tendon!r} read as motor {motor!r} of a differential, its coordinate "
-                         + " + ".join(f"{c:.6g} {j}" for j, c in motors[motor].items())
-                         + " (gear included; [motors]: its effort f acts on the joints as coef * f; its force range "
+                         + _linear(motors[motor].items()) + " (gear included; [motors]: its effort f acts on the joints as coef * f; its force range "
                            "bounds the motor, not read as a joint's effort limit)")
         else:
             target = next((f"{key} {el.get(key)!r}" for key in ("site", "body", "refsite") if el.get(key)), "nothing")
@@ -787,6 +786,14 @@ def _actuated(root: etree._Element, defaults: _Defaults, kinds: dict[str, str], 
         raise SpecError(source, f"joint {both[0]!r} is driven both by an actuator of its own and through a "
                                 "differential's tendon: pkm reads a differential's joints as driven by its motors only")
     return out, motors
+
+
+def _linear(terms: Iterable[tuple[str, float]]) -> str:
+    """``c1 j1 + c2 j2 - c3 j3``: a linear combination of joints, for the notes."""
+    out = ""
+    for j, c in terms:
+        out += (f"{c:.6g} {j}" if not out else f" - {-c:.6g} {j}" if c < 0 else f" + {c:.6g} {j}")
+    return out
 
 
 def _gear(el: etree._Element, defaults: _Defaults, label: str, source: str) -> float:
@@ -813,7 +820,7 @@ def _tendon_joints(label: str, tendon: str, tendons: dict[str, list[tuple[str, f
             a = couplings.get(j)
             factors[a.root] = factors.get(a.root, 0.0) + coef * a.scale
     moving = {j: f for j, f in factors.items() if abs(f) > _SMALL}
-    text = " + ".join(f"{c:.6g} {j}" for j, c in parts)
+    text = _linear(parts)
     if not moving:
         raise SpecError(source, f"{label} acts on tendon {tendon!r} ({text}), whose length no joint moves")
     if len(moving) == 1:
