@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike
 
 from pkm._derived import SLOT
 from pkm.core.model.actuators import Actuator, from_model, write_model
+from pkm.core.model.motors import motor_map
 from pkm.core.model.spec import Branch, ClosureSpec
 from pkm.core.model.urdf import position_limits
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
@@ -191,6 +192,8 @@ class Mechanism:
             raise SpecError(source, f"the drives of the model file with the spec's [actuators] tables: {exc}") from None
         for a, j in zip(self.actuators, self.actuated):
             write_model(model, a, j.idx_v)
+        #: The motors and their map onto the actuated joints (``[motors]``: a differential; else one per joint).
+        self.motor_map = motor_map(spec.actuated, spec.motors, source)
         self.act_q = np.array([j.idx_q for j in self.actuated])
         self.act_v = np.array([j.idx_v for j in self.actuated])
         self._revolute_q = np.array([j.idx_q for j in self.joints.values() if j.revolute], dtype=int)
