@@ -46,7 +46,7 @@ import numpy as np
 from pkm.errors import PkmError, UnknownNameError
 from pkm.report import jsonable
 from pkm.serve.store import Store
-from pkm.serve.wire import MSGPACK, pack, unpack
+from pkm.serve.wire import MSGPACK, ND_LAYOUT, pack, unpack
 
 
 def _error(status: int, kind: str, message: str, data: Any = None) -> Any:
@@ -171,7 +171,8 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
     limiter = Limiter(workers, queue)
     jobs = JobManager(job_workers)
     app = FastAPI(title="pkm", version=__version__,
-                  description="Kinematics and dynamics of closed-loop mechanisms: models, queries, streams.",
+                  description="Kinematics and dynamics of closed-loop mechanisms: models, queries, streams. Bodies "
+                              f"and answers are JSON, or msgpack (content-type, accept: {MSGPACK}). {ND_LAYOUT}",
                   docs_url=None, redoc_url=None)
     add_offline_docs(app)  # (/docs and /redoc from local files, not FastAPI's CDN: pkm.serve.offline)
 

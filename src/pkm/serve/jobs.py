@@ -57,9 +57,9 @@ class Job:
 def _modes(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """Every assembly mode at ``qa`` (:func:`pkm.assembly_modes`)."""
     from pkm.core.modes import assembly_modes
-    from pkm.serve.queries import _array, _position_kinds, _q_units, _value_units
+    from pkm.serve.queries import _array, _input_units, _q_units, _value_units
 
-    qa = _array(body, "qa", mech.na, _position_kinds(mech, "qa"))[0]
+    qa = _array(body, "qa", mech.na, _input_units(mech, "qa"))[0]
     s = assembly_modes(mech, qa)
     Q = np.array([m.q for m in s.modes]) if s.modes else np.zeros((0, mech.nq))
     task = pkm.TaskMap.of(mech)
@@ -75,9 +75,9 @@ def _modes(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str
 def _working(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """Every working mode at the task value ``y`` (:func:`pkm.working_modes`)."""
     from pkm.core.modes import working_modes
-    from pkm.serve.queries import _actuated_units, _array, _position_kinds, _q_units
+    from pkm.serve.queries import _actuated_units, _array, _input_units, _q_units
 
-    y = _array(body, "y", pkm.TaskMap.of(mech).value_size, _position_kinds(mech, "y"))[0]
+    y = _array(body, "y", pkm.TaskMap.of(mech).value_size, _input_units(mech, "y"))[0]
     s = working_modes(mech, y)
     Q = np.array([m.q for m in s.modes]) if s.modes else np.zeros((0, mech.nq))
     QA = Q[:, mech.act_q] if len(Q) else np.zeros((0, mech.na))

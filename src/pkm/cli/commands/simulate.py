@@ -45,7 +45,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="the initial configuration: actuated joint values (others keep the reference), and passive "
                         "ones as the loop closure's seed (its assembly mode is kept)")
     p.add_argument("--v0", metavar="NAME=V", action="extend", nargs="+", default=[],
-                   help="initial actuated rates [rad/s or m/s, numbers, no unit] (others zero)")
+                   help="initial actuated rates, e.g. motor_1=30deg/s (rad/s, deg/s, rpm; m/s, mm/s; a number: SI) "
+                        "(others zero)")
     p.add_argument("--no-friction", action="store_true", help="leave the joints' friction out")
     p.add_argument("--no-limits", action="store_true", help="do not stop at position or speed limits")
     p.add_argument("--no-saturate", action="store_true", help="apply the efforts asked for beyond the actuators' "

@@ -366,7 +366,7 @@ def velocities(mech: Mechanism, q: ArrayLike | Configuration, qd_actuated: Array
         array([ 0.0108, -0.0198,  0.0257])
     """
     G = passive_map(mech, q)
-    return finite_result(G @ mech.check_actuated(qd_actuated, "qd_actuated"), "joint velocities")
+    return finite_result(G @ mech.check_actuated(qd_actuated, "qd_actuated", order="rate"), "joint velocities")
 
 
 def accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, qdd_actuated: ArrayLike) -> np.ndarray:
