@@ -140,6 +140,32 @@ def test_an_archive_is_its_files(client, service):
     assert r.status_code == 422 and "link" in r.json()["message"]
 
 
+def test_an_uploaded_gepetto_robot_is_named_as_pkm_load_names_it(client, service):
+    """Gepetto's battobot is ``battobot_6d/robot.urdf`` + ``robot.yaml``: pkm.load names it ``battobot_6d``, an upload
+    named it "robot". Uploaded by path (the client sends the folder), as a zip of the folder, or with ``folder`` stated:
+    ``battobot_6d``, one id; kept so by a new service on the same store."""
+    import io
+    import zipfile
+
+    from pkm.serve.store import Store
+
+    folder = Path(__file__).resolve().parents[2] / "urdf" / "gepetto" / "battobot_6d"
+    paths = [folder / "robot.urdf", folder / "robot.yaml"]
+    name = pkm.load("gepetto:battobot_6d").name
+    entry = client.upload(paths)
+    assert name == "battobot_6d" and entry["name"] == name
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as z:
+        for p in paths:
+            z.writestr(f"battobot_6d/{p.name}", p.read_bytes())
+    assert client.upload({"anything.zip": buf.getvalue()})["id"] == entry["id"]
+    assert client.upload({p.name: p.read_bytes() for p in paths}, folder="battobot_6d")["id"] == entry["id"]
+    assert {e.id: e.name for e in Store(service_store(service)).entries()}[entry["id"]] == name
+    r = httpx.post(service.url + "/models", files=[("files", (p.name, p.read_bytes())) for p in paths],
+                   data={"folder": "../x"}, headers=AUTH)
+    assert r.status_code == 422 and "folder" in r.text
+
+
 def service_store(service) -> Path:
     return service.store_folder
 
