@@ -7,6 +7,7 @@ import json
 
 import numpy as np
 
+import pkm
 from pkm import cli
 from pkm.motion import load_motions
 
@@ -27,3 +28,18 @@ def test_plan_writes_the_trajectory_and_prints_the_cycle_time(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert status != 0 and err.startswith("pkm: error: path point 0") and "workspace" in err
     assert len(err.splitlines()) == 1
+
+
+def test_the_path_point_and_the_payload_take_units(tmp_path, capsys):
+    """``adept:X,Y,Z`` takes lengths (``-33cm``) and ``--payload`` a mass (``500g``), as every value of the command
+    line does: a unit of another kind is refused before any planning, naming it."""
+    from pkm.cli.commands.plan import read_path
+
+    mech = pkm.load("delta")
+    (with_units, _), (si, _) = read_path(mech, "adept:-15.25cm,0mm,-33cm"), read_path(mech, "adept:-0.1525,0,-0.33")
+    assert np.allclose(np.asarray(with_units), np.asarray(si), rtol=1e-15, atol=0)
+    out = str(tmp_path / "plan.csv")
+    for argv, says in ((["--path", "adept:0,0,-5deg"], "'deg' is an angle unit"),
+                       (["--path", "adept:0,0,-0.33", "--payload", "5mm"], "'mm' is a length unit but --payload")):
+        assert cli.main(["plan", "delta", *argv, "--out", out]) != 0
+        assert says in capsys.readouterr().err

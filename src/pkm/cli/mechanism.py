@@ -41,7 +41,8 @@ def add_mechanism_help(action: argparse.Action, before: str = "", after: str = "
     return late_help(action, lambda: before + mech_help() + after)
 
 
-def add_mechanism_arguments(p: argparse.ArgumentParser, pose: str | None, joints: str | None) -> None:
+def add_mechanism_arguments(p: argparse.ArgumentParser, pose: str | None, joints: str | None,
+                            seed: str = "the solver's seed") -> None:
     """``MECH``, ``--param``, ``--actuated``, ``--task``, ``--q0`` and, if asked (``"required"`` or
     ``"optional"``), ``--pose`` (with ``--branch``) and ``--joints`` (exclusive when both are taken): every command
     that takes a configuration takes it alike."""
@@ -63,7 +64,7 @@ def add_mechanism_arguments(p: argparse.ArgumentParser, pose: str | None, joints
     if pose:
         p.add_argument("--branch", metavar="NAME", help="the working mode --pose is solved on (see 'pkm list MECH')")
     if pose or joints:
-        add_seed_argument(p, "the solver's seed")
+        add_seed_argument(p, seed)
 
 
 def add_seed_argument(p: argparse.ArgumentParser, what: str) -> None:
