@@ -87,3 +87,24 @@ def test_rates_and_accelerations_take_their_units_as_the_library_and_the_cli_do(
     assert np.abs(v - queries.velocities(mech, {"qa": qa, "qd": [10 * np.pi, 0.0, 0.0]})["v"]).max() <= 1e-12
     with pytest.raises(UnitError, match=r"qdd\[0\].*\[rad/s\^2\]"):
         queries.dynamics(mech, {"qa": qa, "qdd": ["1deg", 0.0, 0.0]})
+
+
+def test_a_map_job_takes_units_as_pkm_map_does():
+    """A map job's axes ``["-40cm", "-30cm", 3]``, ``fixed`` and ``length`` with units (``pkm map --axis
+    z=-40cm:-30cm:3`` takes them so): the same nodes and condition indices as the SI numbers', to 1e-12; an angle
+    unit on a length axis refused naming it."""
+    import numpy as np
+    import pytest
+
+    from pkm.errors import UnitError
+    from pkm.serve import jobs
+
+    mech = pkm.load("delta")
+    units, _ = jobs._map(mech, {"axes": {"z": ["-40cm", "-30cm", 3]}, "fixed": {"x": "1cm"}, "length": "5cm"},
+                         jobs.Job("a", "map", "delta"))
+    si, _ = jobs._map(mech, {"axes": {"z": [-0.4, -0.3, 3]}, "fixed": {"x": 0.01}, "length": 0.05},
+                      jobs.Job("b", "map", "delta"))
+    assert np.allclose(units["axes"]["z"], si["axes"]["z"], rtol=1e-15, atol=0)
+    assert np.allclose(units["condition_index"], si["condition_index"], rtol=1e-12, atol=0)
+    with pytest.raises(UnitError, match=r"axes\.z"):
+        jobs._map(mech, {"axes": {"z": ["-40deg", "-30cm", 3]}}, jobs.Job("c", "map", "delta"))

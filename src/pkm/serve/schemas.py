@@ -397,12 +397,13 @@ class WorkingModesJob(_Request):
 class MapJob(_Request):
     """A workspace map (pkm.workspace_map), optionally with the capability at every node."""
 
-    axes: dict[str, list[float]] = _field("1 to 3 task coordinates, each [start, stop, count] (SI; count an integer).",
-                                          {"x": [-0.1, 0.1, 21], "y": [-0.1, 0.1, 21]})
+    axes: dict[str, list[float | str]] = _field("1 to 3 task coordinates, each [start, stop, count] (start and stop in "
+                                                "SI or strings with a unit, '-10cm'; count an integer).",
+                                                {"x": [-0.1, 0.1, 21], "y": ["-10cm", "10cm", 21]})
     fixed: dict[str, float | str] | None = _field("The other task coordinates' values (SI, or strings with a unit).",
                                                   {"z": -0.35}, None)
-    length: float | None = _field("The characteristic length of the condition index [m]; default the model's.",
-                                  None, None)
+    length: float | str | None = _field("The characteristic length of the condition index [m, or a string with a "
+                                        "unit: '5cm']; default the model's.", None, None)
     index: Literal["wrench", "twist", "acceleration"] | None = _field("A capability to map too.", None, None)
 
 
