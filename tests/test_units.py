@@ -76,6 +76,8 @@ def test_rates_and_efforts_take_their_own_units_in_the_library():
     assert np.allclose(v, pkm.velocities(delta, q, [10 * math.pi, -math.pi / 6, 0.0]), rtol=1e-15, atol=0)
     model = pkm.actuator_model(delta, q, [0.0, "90deg/s", 0.0])
     assert model.qd == pytest.approx([0.0, math.pi / 2, 0.0], rel=1e-15)
+    as_array = pkm.actuator_model(delta, q, np.array(["0", "90deg/s", "0"]))  # (numpy's strings: the list's)
+    assert np.array_equal(as_array.qd, model.qd)
     assert np.allclose(model.accelerations(["2 N m", "500mN m", 0.0]), model.accelerations([2.0, 0.5, 0.0]),
                        rtol=1e-15, atol=0)
     with pytest.raises(UnitError, match=r"'deg' is an angle unit but qd_actuated\[0\] is in \[rad/s\]"):

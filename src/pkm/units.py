@@ -21,6 +21,7 @@ import math
 import re
 from collections.abc import Collection, Sequence
 
+import numpy as np
 from numpy.typing import ArrayLike
 
 from pkm.errors import InvalidInputError, UnitError
@@ -175,7 +176,9 @@ def parse_joint_value(text: str, revolute: bool, order: str, what: str) -> float
 
 def quantities(values: ArrayLike, kinds: Sequence[str | None], what: str) -> ArrayLike:
     """``values`` (a sequence) with every string entry converted by the kind at its position; other entries as
-    they are (the numeric checks follow in :func:`pkm.validation.as_vector`)."""
+    they are (the numeric checks follow in :func:`pkm.validation.as_vector`); a numpy array of strings as its list."""
+    if isinstance(values, np.ndarray) and values.dtype.kind in "UO" and values.ndim == 1:
+        values = values.tolist()
     if isinstance(values, (str, bytes)) or not isinstance(values, (list, tuple)):
         return values
     if not any(isinstance(v, str) for v in values):
