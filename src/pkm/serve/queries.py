@@ -4,10 +4,11 @@ forward kinematics, the Jacobians and the dynamic model run through the model's 
 :class:`pkm.Kernels`, where they build; the same answers to 1e-12) and fall back to the library's Python route, sample
 by sample, where the kernels refuse a sample.
 
-Inputs follow the Python API's and the CLI's conventions: positions (``qa``, ``q``, ``y``, ``seed``) are numbers in SI
-or strings with a unit (``"10deg"``, ``"5mm"``, :mod:`pkm.units`); where a configuration is asked, either the full
-``q`` or the actuated ``qa`` (the loops then closed from ``seed``, default the reference, each sample from the
-previous one's solution), exactly one of the two. Inputs are checked by pkm's own validation: a bad one is a
+Inputs follow the Python API's and the CLI's conventions: positions (``qa``, ``q``, ``y``, ``seed``) and rates
+(``qd``) are numbers in SI or strings with a unit of their kind (``"10deg"``, ``"5mm"``; ``"-30deg/s"``, ``"300rpm"``:
+:mod:`pkm.units`, each entry by its column's unit, :func:`_input_units`), accelerations (``qdd``) numbers; where a
+configuration is asked, either the full ``q`` or the actuated ``qa`` (the loops then closed from ``seed``, default
+the reference, each sample from the previous one's solution), exactly one of the two. Inputs are checked by pkm's own validation: a bad one is a
 :class:`~pkm.errors.PkmError` naming the field, which the service answers with 422.
 
 Every answer carries ``units`` for every quantity it returns (SI: ``m``, ``rad``, ``N``, ``N m``, per coordinate;
