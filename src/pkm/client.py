@@ -98,8 +98,10 @@ class Client:
     def query(self, model: str, query: str, **body: Any) -> dict:
         """``POST /models/{model}/{query}`` with ``body`` (arrays as numpy arrays or lists; None values left out).
 
-        A batch (every array a list of samples) answers per sample: ``status``, ``failures``, None for a failed
-        sample's values; one sample that fails raises :class:`ServiceError` (422, pkm's error's name and data)."""
+        A batch (every array a list of samples) answers per sample: ``status`` (``"ok"``, ``"outside_limits"``: the
+        joints outside the model's position limits in ``outside_limits``, or ``"failed"``), ``failures``, None for a
+        failed sample's values; one sample that fails raises :class:`ServiceError` (422, pkm's error's name and
+        data)."""
         from pkm.serve.wire import MSGPACK, pack
 
         body = {k: v for k, v in body.items() if v is not None}

@@ -463,19 +463,24 @@ class TransmissionError(PkmError):
 
 class PathError(PkmError):
     """A geometric path cannot be timed (:func:`pkm.time_optimal`): it leaves the workspace, crosses a singularity,
-    is not smooth, or a limit cannot hold the mechanism still on it.
+    is not smooth, crosses a position limit the model states, or a limit cannot hold the mechanism still on it.
 
     Attributes:
-        index: The path point (0-based, in the planning grid or the waypoints, as ``what`` says) where it fails.
+        index: The path point (0-based, in the planning grid or the waypoints, or the grid's segment whose midpoint
+            fails, as ``what`` says) where it fails.
         s: The path parameter there (in [0, 1]).
-        limit: What is violated: ``"workspace"``, ``"singularity"``, ``"smoothness"`` or the limit that cannot hold
-            (``"peak effort of motor_1"``).
+        limit: What is violated: ``"workspace"``, ``"singularity"``, ``"smoothness"``, ``"position limit of
+            motor_1"`` or the limit that cannot hold (``"peak effort of motor_1"``).
         detail: What was measured.
+        joint, value, bound: For a position limit crossed: the joint, its coordinate there [rad, m] and its stated
+            limits ``(lower, upper)``; else None.
     """
 
-    def __init__(self, index: int, s: float, limit: str, detail: str, what: str = "path point"):
+    def __init__(self, index: int, s: float, limit: str, detail: str, what: str = "path point", *,
+                 joint: str | None = None, value: float | None = None, bound: tuple[float, float] | None = None):
         self.index = int(index)
         self.s = float(s)
         self.limit = limit
         self.detail = detail
+        self.joint, self.value, self.bound = joint, value, bound
         super().__init__(f"{what} {self.index} (s = {self.s:.6g}): {limit}: {detail}")

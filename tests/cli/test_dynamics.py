@@ -140,3 +140,19 @@ def test_the_command_runs_as_a_process():
     """``python -m pkm dynamics delta --json --rates motor_1=fast``: one error line, exit status 2."""
     bad = run("dynamics", "delta", "--json", "--rates", "motor_1=fast")
     assert bad.returncode == 2 and "is not a number" in one_error_line(bad)
+
+
+def test_a_state_outside_the_position_limits_says_so(capsys):
+    """The humanoid ankle's motors at 1.1 rad (range +-1, the pitch then past its +-0.6): the model is printed, with
+    the joints outside listed (the motors at the values given, as the state printed) and, as text, a warning line
+    naming them."""
+    spec = str(ROOT / "examples" / "humanoid_ankle" / "ankle.closures.toml")
+    out = _json(capsys, spec, "--joints", "motor_left=1.1", "motor_right=1.1")
+    outside = {o["joint"]: o for o in out["outside_limits"]}
+    assert list(outside) == ["ankle_pitch", "motor_left", "motor_right"] and outside["ankle_pitch"]["value"] > 0.6
+    for m in ("motor_left", "motor_right"):
+        assert outside[m]["value"] == out["actuated"][m] and abs(outside[m]["value"] - 1.1) <= 1e-12
+        assert outside[m]["limit"] == [-1.0, 1.0]
+    assert cli.main(["dynamics", spec, "--joints", "motor_left=1.1", "motor_right=1.1"]) == 0
+    assert "warning: outside the position limits the model states: ankle_pitch = 0.83" in capsys.readouterr().out
+    assert _json(capsys, spec, "--joints", "motor_left=0.1", "motor_right=0.1")["outside_limits"] == []

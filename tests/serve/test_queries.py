@@ -47,6 +47,38 @@ def test_positions_take_units_and_a_configuration_q_or_qa():
             queries.dynamics(mech, body)
 
 
+def test_a_sample_outside_the_limits_is_not_ok_in_every_query():
+    """The humanoid ankle at pitch 0.8 rad (range +-0.6; the motors then 1.047 and 1.032 rad, range +-1): ik and fk
+    answer status outside_limits with the joints named, their values those of the answer's own q; the queries at a
+    configuration (jacobians) and a stream's sample say the same; a failed sample has none (null), a sample inside
+    them is ok."""
+    import numpy as np
+
+    from tests.test_humanoid import EXAMPLES
+
+    mech = pkm.load(EXAMPLES / "humanoid_ankle" / "ankle.closures.toml")
+    ik = queries.ik(mech, {"y": [0.8, 0.0]})
+    assert ik["status"] == ["outside_limits"] and ik["units"]["outside_limits"].startswith("m or rad")
+    (outside,) = ik["outside_limits"]
+    assert [o["joint"] for o in outside] == ["ankle_pitch", "motor_left", "motor_right"]
+    for o in outside:
+        assert o["value"] == ik["q"][0][mech.joints[o["joint"]].idx_q] and not o["limit"][0] <= o["value"] <= o["limit"][1]
+    qa = ik["qa"][0]
+    fk = queries.fk(mech, {"qa": [qa.tolist(), [0.1, 0.1], [5.0, -5.0]]})
+    assert fk["status"] == ["outside_limits", "ok", "failed"] and fk["outside_limits"][1:] == [[], None]
+    assert [o["joint"] for o in fk["outside_limits"][0]] == ["ankle_pitch", "motor_left", "motor_right"]
+    assert np.isclose(fk["outside_limits"][0][0]["value"], 0.8, atol=1e-9)
+    assert queries.jacobians(mech, {"q": ik["q"][0]})["status"] == ["outside_limits"]
+    from pkm.serve.stream import Stream
+
+    stream = Stream(mech)  # (the WebSocket's samples: the same report)
+    assert stream.step({"qa": [0.1, 0.1]})["status"] == "ok"
+    step = stream.step({"qa": qa.tolist()})
+    assert step["status"] == "outside_limits"
+    for a, b in zip(step["outside_limits"], fk["outside_limits"][0], strict=True):
+        assert a["joint"] == b["joint"] and a["limit"] == b["limit"] and abs(a["value"] - b["value"]) <= 1e-9
+
+
 def test_a_floating_base_s_batched_dynamics_is_the_model_s():
     """The compiled kernels hold a floating base, the model lets it move free (pkm.core.dynamics.model): a batch on
     a floating robot is answered by the model (the kernels are not asked), as one state is."""

@@ -220,12 +220,15 @@ def test_the_stream_warm_starts_and_answers_bad_messages(client, service, delta)
         answers = [s.send(qa=a, qd=[0.1, 0.0, 0.0], qdd=[1.0, 0.0, 0.0]) for a in qa]
     q = pkm.close_loops(delta, qa[0], delta.q_reference).q
     assert np.abs(answers[0]["q"] - q).max() <= 1e-10 and answers[0]["residual"] <= 1e-10
+    assert answers[0]["status"] == "ok" and answers[0]["outside_limits"] == []
     model = pkm.actuator_model(delta, answers[2]["q"], np.array([0.1, 0.0, 0.0]))
     assert np.abs(answers[2]["tau"] - (model.M @ np.array([1.0, 0.0, 0.0]) + model.h)).max() <= 1e-12
     url = "ws" + service.url[4:] + "/models/delta/stream"
     with connect(url, additional_headers=AUTH) as ws:  # JSON text, a bad message, then a good one
         ws.send(json.dumps({"qa": [1, 2]}))
         assert json.loads(ws.recv())["error"] == "InvalidInputError"
+        ws.send(json.dumps({"qa": [1e308, 0.2, 0.3]}))  # (beyond the coordinates' bound: refused, never wrapped)
+        assert "beyond 1e+06" in json.loads(ws.recv())["message"]
         ws.send("not json")
         assert json.loads(ws.recv())["error"] == "BadMessage"
         ws.send(json.dumps({"qa": qa[0].tolist()}))
@@ -321,7 +324,8 @@ def test_the_compute_limit_answers_while_the_slot_stays_held():
 
 def test_a_short_fuzz_gets_no_500_and_the_service_goes_on(service):
     """300 malformed requests (:mod:`pkm.serve.fuzz`; CI sends 10,000 to a service of its own): none answered 500,
-    every error JSON with a message, the service answering afterwards."""
+    every error JSON with a message, no fk or ik of a coordinate beyond 1e6 (SI) answered as a success, the service
+    answering afterwards."""
     from pkm.serve.fuzz import fuzz
 
     out = fuzz(service.url, 300, token=TOKEN, seed=1)
@@ -349,6 +353,7 @@ def test_jobs_run_apart_and_give_json_and_parquet(client, service, delta):
     modes = client.result(client.job("rrr3", "assembly_modes", qa=rrr3.actuated_q(rrr3.q_reference))["id"])
     direct = pkm.assembly_modes(rrr3, rrr3.actuated_q(rrr3.q_reference))
     assert modes["count"] == len(direct.modes) >= 2 and np.abs(modes["q"] - np.array([m.q for m in direct.modes])).max() < 1e-9
+    assert [[o["joint"] for o in m] for m in modes["outside_limits"]] == [list(m.outside_limits) for m in direct.modes]
     from pkm.client import ServiceError
 
     bad = client.job("delta", "working_modes", y=[1.0, 2.0])  # (a wrong size: the job fails, with the message)
@@ -413,7 +418,8 @@ def test_the_compiled_batches_answer_as_the_python_route(client, delta):
                        ("dynamics", {"qa": qa, "qd": [0.1, 0.0, 0.0], "qdd": [1.0, 0.0, 0.0]})):
         served, local = client.query("delta", name, **body), queries.QUERIES[name](delta, body, None)
         assert served["status"] == local["status"] == ["ok"] * 4
-        for key in set(local) - {"status", "units"}:
+        assert served["outside_limits"] == local["outside_limits"] == [[]] * 4
+        for key in set(local) - {"status", "units", "outside_limits"}:
             assert np.abs(np.asarray(served[key], dtype=float) - local[key]).max() <= 1e-10, (name, key)
     assert served["units"] == local["units"] and served["units"]["M"][0][0] == "N m/(rad/s^2)"
     assert client.fk("delta", qa)["iterations"].dtype.kind == "i"

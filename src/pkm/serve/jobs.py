@@ -54,6 +54,11 @@ class Job:
                 "progress": self.progress, "error": self.error, "created": self.created, "finished": self.finished}
 
 
+def _outside(mech: Mechanism, Q: np.ndarray) -> list[list[dict[str, Any]]]:
+    """Per mode, the joints outside the position limits the model states (joint, value, limit)."""
+    return [[v._asdict() for v in mech.limit_violations(q)] for q in Q]
+
+
 def _modes(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """Every assembly mode at ``qa`` (:func:`pkm.assembly_modes`)."""
     from pkm.core.modes import assembly_modes
@@ -66,7 +71,7 @@ def _modes(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str
     Y = np.array([task.value(q) for q in Q]) if len(Q) else np.zeros((0, task.value_size))
     residual = np.array([m.residual for m in s.modes])
     out = {"count": len(s.modes), "complete": bool(s.complete), "q": Q, "y": Y, "residual": residual,
-           "labels": [str(m.label) for m in s.modes], "seconds": s.seconds,
+           "labels": [str(m.label) for m in s.modes], "outside_limits": _outside(mech, Q), "seconds": s.seconds,
            "units": {"q": _q_units(mech), "y": _value_units(mech), "residual": "m or rad", "seconds": "s"}}
     return out, {"mode": np.arange(len(Q)), **{f"q{i}": Q[:, i] for i in range(Q.shape[1])},
                  **{f"y{i}": Y[:, i] for i in range(Y.shape[1])}, "residual": residual}
@@ -82,7 +87,7 @@ def _working(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[s
     Q = np.array([m.q for m in s.modes]) if s.modes else np.zeros((0, mech.nq))
     QA = Q[:, mech.act_q] if len(Q) else np.zeros((0, mech.na))
     out = {"count": len(s.modes), "complete": bool(s.complete), "q": Q, "qa": QA,
-           "labels": [str(m.label) for m in s.modes], "seconds": s.seconds,
+           "labels": [str(m.label) for m in s.modes], "outside_limits": _outside(mech, Q), "seconds": s.seconds,
            "units": {"q": _q_units(mech), "qa": _actuated_units(mech), "seconds": "s"}}
     return out, {"mode": np.arange(len(Q)), **{f"qa{i}": QA[:, i] for i in range(QA.shape[1])}}
 

@@ -12,8 +12,10 @@ the reference, each sample from the previous one's solution), exactly one of the
 :class:`~pkm.errors.PkmError` naming the field, which the service answers with 422.
 
 Every answer carries ``units`` for every quantity it returns (SI: ``m``, ``rad``, ``N``, ``N m``, per coordinate;
-a matrix's per entry) and what certifies it: the status of each sample (``"ok"`` or ``"failed"``) and, where some
-failed, ``failures`` (each one's sample, error and message). A failed sample's values are ``None`` (JSON ``null``), the
+a matrix's per entry) and what certifies it: the status of each sample (``"ok"``, ``"outside_limits"`` or
+``"failed"``), ``outside_limits`` (per sample, the joints outside the position limits the model states, each with
+its value and limits: pkm's solvers report limits, they do not enforce them) and, where some failed, ``failures``
+(each one's sample, error and message). A failed sample's values are ``None`` (JSON ``null``), the
 batch keeps its length; a query given ONE sample (not a list of samples) whose sample fails raises that sample's
 :class:`~pkm.errors.PkmError` instead (the service's 4xx). Counts (``iterations``) are integers.
 """
@@ -31,7 +33,7 @@ import pkm
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, PkmError
 from pkm.units import KIND_OF_UNIT, joint_unit, parse_quantity
-from pkm.validation import as_array
+from pkm.validation import as_array, bounded
 
 #: Samples in one request at most.
 MAX_SAMPLES = 100_000
@@ -200,7 +202,8 @@ def _array(body: Mapping[str, Any], key: str, size: int, units: Sequence[str]) -
     if not np.all(np.isfinite(a)):
         bad = np.argwhere(~np.isfinite(a))[0]
         raise InvalidInputError(key, f"sample {bad[0]}, entry {bad[1]} is not finite")
-    return a
+    positions = all(u in ("m", "rad", "1") for u in units)
+    return bounded(a, key) if positions else a  # (positions: the library's bound, beyond it refused)
 
 
 def _is_single(body: Mapping[str, Any], *keys: str) -> bool:
@@ -279,6 +282,34 @@ class _Samples:
         return out
 
 
+def _limits(fn: _F) -> _F:
+    """``fn``'s answer with, per sample, ``outside_limits`` (its ``q``'s
+    :meth:`~pkm.core.Mechanism.limit_violations`, as maps ``joint``, ``value``, ``limit``; None for a failed sample) and the status ``"outside_limits"`` where that is not empty: pkm's solvers report limits, they do not
+    enforce them, and an answer outside them is not plain ``"ok"``."""
+    @functools.wraps(fn)
+    def answer(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
+        out = fn(mech, body, kernels)
+        status, q = out["status"], out["q"]
+        outside: list[list[dict[str, Any]] | None] = [None if st != "ok" else [] for st in status]
+        named = [n for n in mech.limits if n in mech.joints]
+        if named:
+            ok = [k for k, st in enumerate(status) if st == "ok"]
+            Q = np.array([q[k] for k in ok], dtype=float).reshape(len(ok), mech.nq)
+            idx = [mech.joints[n].idx_q for n in named]
+            lo, hi = np.array([mech.limits[n] for n in named]).T
+            near = np.flatnonzero(np.any((Q[:, idx] < lo) | (Q[:, idx] > hi), axis=1))  # (then with the tolerance)
+            for i in near:
+                k = ok[int(i)]
+                outside[k] = [v._asdict() for v in mech.limit_violations(Q[i])]
+                if outside[k]:
+                    status[k] = "outside_limits"
+        out["outside_limits"] = outside
+        out["units"]["outside_limits"] = "m or rad (each joint's, as in q)"
+        return out
+
+    return answer  # type: ignore[return-value]
+
+
 def _value(v: Any) -> Any:
     """One sample's value: an array as a numpy array, a number as a plain Python one."""
     if v is None or isinstance(v, (bool, int, float)):
@@ -341,6 +372,7 @@ def _actuated_units(mech: Mechanism, kind: str = "position") -> list[str]:
     return [_unit(mech, j, kind) for j in mech.actuated_names]
 
 
+@_limits
 def fk(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """Forward kinematics (the loop closure): ``qa`` (na per sample) -> ``q`` (nq), ``y`` (task value), the closure
     ``residual`` [m, rad], the Newton ``iterations``. Samples are solved in order, each from the previous one's
@@ -356,6 +388,7 @@ def fk(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[st
     return out
 
 
+@_limits
 def ik(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """Inverse kinematics: ``y`` (task values, laid out as ``task_value_names``) -> ``q``, ``qa``, ``residual``,
     ``iterations``; each sample from the previous one's solution (the first from ``seed``), in the working mode
@@ -386,6 +419,7 @@ def _jacobian_units(mech: Mechanism) -> dict[str, Any]:
     return {"J": _matrix_units(task, act), "K": _matrix_units(act, task), "q": _q_units(mech)}
 
 
+@_limits
 def jacobians(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations (``q``, or ``qa`` closed): the forward Jacobian ``J`` (task rates per actuated rate)
     and the inverse ``K`` (actuated rates per task rate), with ``q``."""
@@ -405,6 +439,7 @@ def jacobians(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> 
     return out
 
 
+@_limits
 def diagnose(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations (``q``, or ``qa`` closed): the distances to the direct and inverse singularities
     (:func:`pkm.diagnose`: smallest over largest singular value of the homogenised Jacobians, in [0, 1]), with
@@ -422,6 +457,7 @@ def diagnose(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> d
     return out
 
 
+@_limits
 def velocities(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations (``q``, or ``qa`` closed) and actuated rates ``qd``: every joint's rate ``v`` and the
     task rates ``yd``; with the actuated accelerations ``qdd`` too, every joint's acceleration ``a`` (the loops closed
@@ -451,6 +487,7 @@ def velocities(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) ->
     return out
 
 
+@_limits
 def dynamics(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """The actuator-space model at closed states (``q``, or ``qa`` closed; ``qd``, default 0): ``M`` (``M_a``),
     ``h`` (``h_a``), ``g`` (``g_a``), and with ``qdd`` the inverse dynamics ``tau = M_a qdd + h_a`` [N m, N]."""
@@ -491,6 +528,7 @@ def dynamics(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> d
     return out
 
 
+@_limits
 def capability(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations (``q``, or ``qa`` closed), the ``kind`` capability (``wrench``, ``twist``,
     ``acceleration``) under the actuators' limits: the largest value along each task axis each way, the largest
@@ -531,6 +569,7 @@ def _capability_labels(mech: Mechanism, kind: str) -> tuple[tuple[str, ...], tup
 _SCENES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
+@_limits
 def scene(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At configurations (``q``, or ``qa`` closed): the world placement of every body of the model's 3-D scene (the
     preview page's, :class:`pkm.viz.scene.Scene`), as ``paths`` (meshcat paths) and ``matrices`` (per sample and

@@ -155,14 +155,28 @@ class Failure(_Answer):
     message: str = _field("What went wrong, in words.", "pose unreachable: leg 1 misses by 0.64 m or rad")
 
 
-_STATUS = _field("Per sample: 'ok', or 'failed' (its values are then null, its error in failures).", ["ok"])
+_STATUS = _field("Per sample: 'ok'; 'outside_limits' (solved, but a joint lies outside the position limits the "
+                 "model states: named in outside_limits); or 'failed' (its values are then null, its error in "
+                 "failures).", ["ok"])
+_OUTSIDE = _field("Per sample, the joints outside the position limits the model states (empty: none; null: a failed "
+                  "sample), each with its value and limits [rad, m].",
+                  [[{"joint": "motor_1", "value": 1.62, "limit": [-1.5, 1.5]}]])
 _FAILURES = _field("The failed samples with their error (absent when every sample is ok).", None, None)
 _COMPUTE = _field("The server's time for the computation [s].", 0.0004)
 _ANSWER_Q = _field("The closed configurations (nq a sample: units in units.q).", [_Q_EXAMPLE])
 
 
+class OutsideLimit(_Answer):
+    """A joint outside the position limits the model states."""
+
+    joint: str = _field("The joint's name.", "motor_1")
+    value: float = _field("Its coordinate [rad, m].", 1.62)
+    limit: list[float | None] = _field("Its limits [lower, upper] [rad, m] (null: no limit that side).", [-1.5, 1.5])
+
+
 class _Batch(_Answer):
-    status: list[Literal["ok", "failed"]] = _STATUS
+    status: list[Literal["ok", "outside_limits", "failed"]] = _STATUS
+    outside_limits: list[list[OutsideLimit] | None] = _OUTSIDE
     failures: list[Failure] | None = _FAILURES
     compute_s: float = _COMPUTE
 
@@ -418,6 +432,11 @@ class SweepJob(_Request):
     workers: int | None = _field("Local workers (1 to 8).", None, None)
 
 
+_MODES_OUTSIDE = _field("Per mode, the joints outside the position limits the model states, each with its value "
+                        "and limits [rad, m] (empty: none; a mode is geometry, listed whether or not it is within).",
+                        [[]])
+
+
 class AssemblyModesResult(_Answer):
     count: int = _field("Assembly modes found.", 2)
     complete: bool = _field("Whether the search is certified complete.", True)
@@ -425,6 +444,7 @@ class AssemblyModesResult(_Answer):
     y: list[list[float]] = _field("Each mode's task value [m, rad].", [[0.0, 0.0, -0.35]])
     residual: list[float] = _field("Each mode's closure residual [m or rad].", [1e-15])
     labels: list[str] = _field("Each mode's label.", ["(1,)"])
+    outside_limits: list[list[OutsideLimit]] = _MODES_OUTSIDE
     seconds: float = _field("The search's time [s].", 0.5)
     units: Units = _field(UNITS, {"q": ["rad"] * 9 + ["m"] * 3, "y": ["m", "m", "m"], "residual": "m or rad",
                                   "seconds": "s"})
@@ -436,6 +456,7 @@ class WorkingModesResult(_Answer):
     q: list[list[float]] = _field("Each mode's configuration [rad, m].", [_Q_EXAMPLE])
     qa: list[list[float]] = _field("Each mode's actuated values [rad, m].", [_QA_EXAMPLE])
     labels: list[str] = _field("Each mode's label.", ["(1, 1, 1)"])
+    outside_limits: list[list[OutsideLimit]] = _MODES_OUTSIDE
     seconds: float = _field("The search's time [s].", 0.5)
     units: Units = _field(UNITS, {"q": ["rad"] * 9 + ["m"] * 3, "qa": ["rad"] * 3, "seconds": "s"})
 

@@ -2,11 +2,13 @@
 
 Each message is a map with ``qa`` (the actuated coordinates) and optionally ``qd`` (their rates) and ``qdd`` (their
 accelerations), read as the HTTP queries read them (:func:`pkm.serve.queries._array`): numbers in SI or strings with
-a unit of the entry's kind (``"10deg"``, ``"5mm"``; ``"-30deg/s"``, ``"300rpm"``), one sample; the answer has ``q`` and ``y`` (the configuration and the task value, the loops closed from the
-previous sample's configuration: a stream stays on its assembly mode), the closure ``residual``, with ``qd`` the task
-rates ``yd``, with ``qd`` and ``qdd`` the actuator efforts ``tau`` (``M_a qdd + h_a``), ``compute_s`` and ``units``
-(the unit of every quantity answered and given, as the HTTP answers carry them). A refused message is answered
-``{"error", "message"}``, the message naming the field and its units.
+a unit of the entry's kind (``"10deg"``, ``"5mm"``; ``"-30deg/s"``, ``"300rpm"``), one sample; the answer has ``q``
+and ``y`` (the configuration and the task value, the loops closed from the previous sample's configuration: a stream
+stays on its assembly mode), the closure ``residual``, ``status`` (``"ok"``, or ``"outside_limits"`` where
+``outside_limits``, the joints outside the position limits the model states with their values and limits, is not
+empty), with ``qd`` the task rates ``yd``, with ``qd`` and ``qdd`` the actuator efforts ``tau`` (``M_a qdd + h_a``),
+``compute_s`` and ``units`` (the unit of every quantity answered and given, as the HTTP answers carry them). A refused
+message is answered ``{"error", "message"}``, the message naming the field and its units.
 
 Where the mechanism's compiled kernels build (:class:`pkm.Kernels`: a C compiler, no idle motion), a sample is the
 kernels' (the closure's Newton warm-started in C, the Jacobian and ``M_a``, ``h_a`` from their generated C), each
@@ -25,6 +27,7 @@ import numpy as np
 import pkm
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError
+from pkm.validation import bounded
 
 
 class Stream:
@@ -71,6 +74,7 @@ class Stream:
         qa = self._vector(sample, "qa")
         if qa is None:
             raise InvalidInputError("qa", f"missing: give {self.mech.na} numbers")
+        bounded(qa, "qa")  # (the library's bound on coordinates: beyond it refused, never wrapped)
         qd, qdd = self._vector(sample, "qd"), self._vector(sample, "qdd")
         K = self.kernels
         q = residual = None
@@ -82,7 +86,9 @@ class Stream:
             r = close_loops(self.mech, qa, self.q)
             q, residual = r.q, r.residual
         self.q = q
-        out: dict[str, Any] = {"q": q, "y": pkm.TaskMap.of(self.mech).value(q), "residual": residual}
+        outside = [v._asdict() for v in self.mech.limit_violations(q)]
+        out: dict[str, Any] = {"q": q, "y": pkm.TaskMap.of(self.mech).value(q), "residual": residual,
+                               "status": "outside_limits" if outside else "ok", "outside_limits": outside}
         if qd is not None:
             if K is not None:
                 J = K.kernel("forward_jacobian")(q[None])[0].reshape(-1, self.mech.na, order="F")

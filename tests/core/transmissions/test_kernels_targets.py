@@ -58,7 +58,8 @@ def test_c_jax_and_warp_agree_on_every_kernel():
 def test_the_c_library_and_the_cpp_class_round_trip(tmp_path):
     """``gcc -std=c99 -Wall -Wextra -Werror -pedantic`` and ``g++ -std=c++17 -Wall -Wextra -Werror`` build the
     ankle's library and example; actuator positions, velocities and efforts -> joints (FK, J, J_inv^T) -> actuators
-    (IK, J_inv, J^T) equal the in-process kernels' and come back to 1e-12. Beyond a stated limit (the motors ±1 rad,
+    (IK, J_inv, J^T) equal the in-process kernels' and come back to 1e-12, each cycle with one evaluation of the
+    maps kernel. Beyond a stated limit (the motors ±1 rad,
     the pitch ±0.6 rad): FK of a motor at 1e6 rad (a closed configuration, 1e6 mod 2π) and IK of a pitch of 0.7 rad
     converge, ``OUTSIDE_LIMITS``, the solution written all the same, in the C as in the in-process kernels."""
     tk = ankle()
@@ -80,6 +81,7 @@ def test_the_c_library_and_the_cpp_class_round_trip(tmp_path):
     J, J_inv = (x.reshape(2, 2, order="F") for x in tk.run("maps", q)[:2])
     assert np.abs(joint - np.concatenate([qo, J @ qdm, J_inv.T @ tau_m])).max() <= 1e-12
     assert np.abs(back - np.concatenate([qm, qdm, tau_m])).max() <= 1e-12
+    assert lines["maps"].split() == ["1", "1"]  # (a cycle's velocity and effort mapped with one maps evaluation)
     bad = subprocess.run([str(tmp_path / "example"), "nan", *["0"] * 5], capture_output=True, text=True)
     assert bad.returncode == 1 and "fk failed with status 3" in bad.stderr  # (INVALID_INPUT)
     far = subprocess.run([str(tmp_path / "example"), "1e6", *["0"] * 5], capture_output=True, text=True)

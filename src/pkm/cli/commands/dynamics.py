@@ -13,6 +13,7 @@ import numpy as np
 import pkm
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, configuration, load_mechanism
+from pkm.cli.output import outside_limits, outside_line
 from pkm.cli.parsing import parse_rates
 from pkm.report import jsonable
 
@@ -49,6 +50,7 @@ def model_dict(mech: pkm.Mechanism, model: ActuatorSpaceModel) -> dict[str, Any]
         "g": dict(zip(names, model.g)),
         "friction": dict(zip(names, model.friction)) if has_friction else None,
         "idle_motions": int(model.idle.shape[1]),
+        "outside_limits": outside_limits(mech, model.q),
         "base": model.base,
         "units": {
             "actuated": {n: "rad" if r else "m" for n, r in zip(names, revolute)},
@@ -86,6 +88,8 @@ def text(out: dict[str, Any]) -> str:
             continue
         lines.append(f"{label}:")
         lines += [f"  {n.ljust(width)}{_value(out[key][n], units[key][n]).rjust(col)}" for n in names]
+    if out["outside_limits"]:
+        lines.append(outside_line(out["outside_limits"]))
     if out["base"] == "free":
         lines.append("floating base: free (no wrench on it; its motion eliminated from M_a, h_a, g_a)")
     if out["idle_motions"]:

@@ -498,7 +498,8 @@ def _simulation(mech: Mechanism, t: np.ndarray, q: np.ndarray, v: np.ndarray, a:
     at = np.abs(tau) >= limit * (1.0 - 1e-12) if len(tau) else np.zeros((0, mech.na), dtype=bool)
     saturated = {name: int(n) for name, n in zip(mech.actuated_names, at.sum(axis=0))}
     return Simulation(q, v, a, q[:, mech.act_q], qd, qdd, task, task_v, task_a, tau, residual,
-                      (), units, t, kinetic, potential, work, dissipated, event, method, saturated, base)
+                      (), units, mech.limits_along(q), t, kinetic, potential, work, dissipated, event, method,
+                      saturated, base)
 
 
 def _start(dyn: _Dynamics, x: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, ActuatorSpaceModel,

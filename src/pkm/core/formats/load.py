@@ -142,7 +142,8 @@ def with_given(spec: ClosureSpec, g: Given, source: str) -> tuple[ClosureSpec, t
     if g.task is not None:
         end_effector, task = g.end_effector, g.task
     return dataclasses.replace(spec, actuated=actuated, end_effector=end_effector, task=task,
-                               actuators={j: v for j, v in spec.actuators.items() if j in actuated}), notes
+                               actuators={j: v for j, v in spec.actuators.items() if j in actuated},
+                               motors={m: c for m, c in spec.motors.items() if set(c) <= set(actuated)}), notes
 
 
 def load_model_file(path: Path, given: Given = Given()) -> Mechanism:
@@ -163,9 +164,10 @@ def load_model_file(path: Path, given: Given = Given()) -> Mechanism:
     spec = ClosureSpec(mechanism=imp.name, urdf=path.name, end_effector=None, actuated=imp.actuated,
                        closures=imp.closures, task=TaskSpec((), imp.actuated), reference=dict(imp.reference),
                        description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types,
-                       floating_base=imp.floating_base, actuators=imp.actuators, springs=imp.springs)
+                       floating_base=imp.floating_base, actuators=imp.actuators, springs=imp.springs,
+                       motors=imp.motors)
     spec, read = with_given(spec, given, str(path))
-    return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes + read, seed=imp.seed)
+    return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes + read, seed=imp.seed, hold=imp.hold)
 
 
 #: A reader's loader: the mechanism, given what the caller states in code (:class:`Given`, default nothing).
