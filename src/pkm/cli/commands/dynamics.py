@@ -1,4 +1,4 @@
-"""``pkm dynamics MECH [--joints NAME=V ...] [--rates NAME=V ...] [--json]``: the actuator-space dynamic model
+"""``pkm dynamics MECH [--pose K=V ... | --joints NAME=V ...] [--rates NAME=V ...] [--json]``: the actuator-space dynamic model
 (:func:`pkm.actuator_model`) at one state: the mass matrix ``M_a``, the bias ``h_a``, the gravity ``g_a`` and, where
 the mechanism has friction, the friction efforts, each entry with its unit, by actuator name."""
 
@@ -22,9 +22,10 @@ if TYPE_CHECKING:
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    add_mechanism_arguments(p, None, "optional")
+    add_mechanism_arguments(p, "optional", "optional")
     p.add_argument("--rates", metavar="NAME=V", action="extend", nargs="+", default=[],
-                   help="actuated rates [rad/s or m/s, numbers, no unit] (others zero)")
+                   help="actuated rates, e.g. motor_1=-30deg/s (rad/s, deg/s, rpm; m/s, mm/s; a number: SI) "
+                        "(others zero)")
     p.add_argument("--json", action="store_true", help="print JSON (SI, with a units object)")
 
 

@@ -268,7 +268,7 @@ class ActuatorSpaceModel:
         Raises:
             SingularityError: ``kind="inertia"``: an actuated motion moves no mass (``M_a`` singular).
         """
-        tau = self.mech.check_actuated(tau, "tau")
+        tau = self.mech.check_actuated(tau, "tau", order="effort")
         rhs = tau + (self.friction if friction else 0.0) - self.h
         w = self._base_wrench(base_wrench)
         if w is not None:
@@ -344,7 +344,7 @@ def _check_state(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None, base: str 
     if arr is not None and arr.shape == (mech.nv,) and mech.nv != mech.na:
         arr = mech.check_v(arr, "qd")
         return mech, q, mech.check_actuated(arr[mech.act_v], "qd"), base, arr[mech.base_v] if len(rest) else rest
-    return mech, q, mech.check_actuated(qd, "qd"), base, rest
+    return mech, q, mech.check_actuated(qd, "qd", order="rate"), base, rest
 
 
 def _evaluate(mech: Mechanism, q: np.ndarray, qd: np.ndarray, rtol: float,

@@ -576,7 +576,7 @@ def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuate
     """
     mech = check_mechanism(mech)
     q, v = mech.check_q(q), mech.check_v(v)
-    tau_a = mech.check_actuated(tau_actuated, "tau_actuated")
+    tau_a = mech.check_actuated(tau_actuated, "tau_actuated", order="effort")
     if _has_mimic(mech.model):
         raise PkmError("constraintDynamics does not support mimic joints on Pinocchio 4.1")
     s = np.linalg.svd(JacobianScales.of(mech).constraint(finite_result(constraints.jacobian(mech, q),

@@ -411,7 +411,7 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
         except (TypeError, ValueError, OverflowError):  # (check_actuated says what is wrong)
             arr = np.zeros(0)
         qd = mech.check_v(arr, "v0")[mech.act_v] if arr.shape == (mech.nv,) and mech.nv != mech.na \
-            else mech.check_actuated(v0, "v0")
+            else mech.check_actuated(v0, "v0", order="rate")
         if len(twist) and arr.shape == (mech.nv,) and mech.nv != mech.na:
             twist = arr[mech.base_v].copy()
     dyn = _Dynamics(mech, ctrl, friction, saturate, bool(limits), singular_tol, coulomb_velocity, step_tol, q, base)

@@ -338,8 +338,19 @@ def _read_text(name: str, text: str) -> Imported:
     return format_of(name, text).read(text, name)
 
 
+#: The file name of a Gepetto robot's URDF: its folder names the robot (``urdf/gepetto/battobot_6d/robot.urdf``).
+GEPETTO_URDF = "robot.urdf"
+
+
+def gepetto_name(urdf: str, folder: str | None) -> str:
+    """The name of a Gepetto pair's mechanism: its URDF's stem, or, for :data:`GEPETTO_URDF`, its folder's name
+    (``"robot"`` without one); :func:`pkm.load` and an upload (:func:`load_texts`' ``folder``) name it alike."""
+    stem = Path(urdf).stem
+    return (folder or "robot") if stem == "robot" else stem
+
+
 def load_texts(files: Mapping[str, str], source: str = "<upload>", *, actuated: Sequence[str] | str | None = None,
-               task: TaskGiven = None) -> Mechanism:
+               task: TaskGiven = None, folder: str | None = None) -> Mechanism:
     """The mechanism of files given as ``{name: text}`` (an upload), read as :func:`load_path` reads them from a
     folder, without touching the file system (the names are labels: a spec's ``urdf`` must name one of them):
 
@@ -350,6 +361,8 @@ def load_texts(files: Mapping[str, str], source: str = "<upload>", *, actuated: 
 
     ``actuated``, ``task``: as :func:`pkm.load`'s (:func:`given`), over what the files state (:func:`with_given`): a
     file that names no actuated joint (SDF never does), or a spec or YAML that leaves them empty, loads with them.
+    ``folder``: the name of the folder the files came from, naming a Gepetto pair's mechanism as :func:`pkm.load`
+    names it from its folder (:func:`gepetto_name`: ``battobot_6d`` for ``battobot_6d/robot.urdf``).
 
     Raises:
         SpecError: none of these, or several; a spec naming a file that is not there; no actuated joint named by
@@ -358,7 +371,7 @@ def load_texts(files: Mapping[str, str], source: str = "<upload>", *, actuated: 
     """
     g = given(actuated, task)
     try:
-        return _load_texts(files, source, g)
+        return _load_texts(files, source, g, folder)
     except SpecNameError as exc:
         label = exc.source.removeprefix(f"{source}:")
         if label not in files or Path(label).suffix.lower() not in (".toml", ".yaml", ".yml"):
@@ -366,7 +379,7 @@ def load_texts(files: Mapping[str, str], source: str = "<upload>", *, actuated: 
         raise located(exc, files[label], "toml" if label.lower().endswith(".toml") else "yaml") from None
 
 
-def _load_texts(files: Mapping[str, str], source: str, g: Given) -> Mechanism:
+def _load_texts(files: Mapping[str, str], source: str, g: Given, folder: str | None = None) -> Mechanism:
     names = sorted(files)
     kind = {n: Path(n).suffix.lower() for n in names}
     specs = [n for n in names if kind[n] == ".toml"]
@@ -391,7 +404,7 @@ def _load_texts(files: Mapping[str, str], source: str, g: Given) -> Mechanism:
         where = f"{source}:{yamls[0]}"
         imported = _read_text(urdfs[0], files[urdfs[0]])
         joints = [str(j.get("name")) for j in check_urdf(imported.urdf, urdfs[0]).findall("joint")]
-        spec, read = read_gepetto(files[yamls[0]], urdfs[0], joints, Path(urdfs[0]).stem, where)
+        spec, read = read_gepetto(files[yamls[0]], urdfs[0], joints, gepetto_name(urdfs[0], folder), where)
         spec, replaced = with_given(spec, g, where)
         return from_strings(imported.urdf, spec, source=where, notes=imported.notes + read + replaced)
     if len(names) != 1:
@@ -426,10 +439,10 @@ def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = (), 
         raise SpecError(str(urdf_path), f"the model beside {yaml_path.name} is {imported.format.upper()}, not URDF: "
                                         "Gepetto's convention pairs a YAML with a URDF")
     joints = [str(j.get("name")) for j in check_urdf(imported.urdf, str(urdf_path)).findall("joint")]
-    name = urdf_path.parent.name if urdf_path.stem == "robot" else urdf_path.stem
+    name = gepetto_name(urdf_path.name, urdf_path.parent.name)
     text = read_text_file(yaml_path, "YAML")
     try:
-        spec, read = read_gepetto(text, urdf_path.name, joints, name or "robot", str(yaml_path))
+        spec, read = read_gepetto(text, urdf_path.name, joints, name, str(yaml_path))
         spec, replaced = with_given(spec, given, str(yaml_path))
         return from_strings(imported.urdf, spec, source=str(yaml_path), notes=tuple(notes) + imported.notes + read
                             + replaced)
@@ -473,5 +486,5 @@ def load_package_model(name: str, given: Given = Given()) -> Mechanism:
     return from_strings(imported.urdf, spec, source=f"{name} ({path})", notes=imported.notes + read)
 
 
-__all__ = ["READERS", "Given", "Loader", "Reader", "given", "given_task", "load_gepetto", "load_model_file",
-           "load_package_model", "load_path", "load_spec_file", "with_given"]
+__all__ = ["GEPETTO_URDF", "READERS", "Given", "Loader", "Reader", "gepetto_name", "given", "given_task",
+           "load_gepetto", "load_model_file", "load_package_model", "load_path", "load_spec_file", "with_given"]

@@ -224,8 +224,9 @@ def from_strings(urdf: str, spec: ClosureSpec | str, params: Any = None, source:
         ('my_fivebar', 2, ('x', 'z'))
         >>> {k: round(v, 4) for k, v in pkm.task_values(mech, mech.q_reference).items()}
         {'x': 0.1371, 'z': -0.6192}
-        >>> print(pkm.diagnose(mech, mech.q_reference))
-        regular
+        >>> print(pkm.diagnose(mech, mech.q_reference))  # doctest: +NORMALIZE_WHITESPACE
+        regular: mobility 2 (constraint rank 3 of 3 equations); distance to a direct singularity 0.244,
+        to an inverse one 0.0658 (0: singular, 1: far)
     """
     if not isinstance(urdf, str):
         raise InvalidInputError("urdf", f"expected the URDF text as a str, got {type(urdf).__name__}", urdf)

@@ -37,7 +37,7 @@ from pkm.core.model.motors import motor_map
 from pkm.core.model.spec import Branch, ClosureSpec
 from pkm.core.model.urdf import position_limits
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
-from pkm.units import quantities
+from pkm.units import joint_kind, quantities
 from pkm.validation import as_array, as_vector, bounded, wrap_angle
 
 
@@ -411,12 +411,18 @@ class Mechanism:
     def check_v(self, v: ArrayLike, name: str = "v") -> np.ndarray:
         return as_vector(v, self.nv, name)
 
-    def check_actuated(self, qa: ArrayLike, name: str = "q_actuated", *, positions: bool = False) -> np.ndarray:
-        """Actuated values as a vector (``na``, SI). With ``positions``, entries may be strings with units
-        (``"5deg"``, ``"20mm"``) and are bounded (:func:`~pkm.validation.bounded`: beyond 1e6 m or rad refused, never
-        wrapped); rates and efforts take numbers only (SI: m/s, rad/s, N, N m)."""
-        if positions:
-            qa = quantities(qa, ["angle" if j.revolute else "length" for j in self.actuated], name)
+    def check_actuated(self, qa: ArrayLike, name: str = "q_actuated", *, positions: bool = False,
+                       order: str | None = None) -> np.ndarray:
+        """Actuated values as a vector (``na``, SI). With ``order`` (``"position"``, ``"rate"``, ``"effort"``:
+        :data:`pkm.units.JOINT_KINDS`; ``positions``: ``"position"``), entries may be strings with a unit of that
+        order (``"5deg"``, ``"20mm"``; ``"-30deg/s"``, ``"300rpm"``, ``"50mm/s"``; ``"2 N m"``, ``"5N"``); without,
+        and for accelerations, numbers only (SI). Positions are bounded (:func:`~pkm.validation.bounded`: beyond 1e6
+        m or rad refused, never wrapped)."""
+        order = "position" if positions else order
+        kinds = None if order is None else [joint_kind(j.revolute, order) for j in self.actuated]
+        if kinds is not None and None not in kinds:
+            qa = quantities(qa, kinds, name)
+        if order == "position":
             return bounded(as_vector(qa, self.na, name), name, qa)
         return as_vector(qa, self.na, name)
 
