@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from pkm.core.formats.base import FORMATS, Imported, by_root, suffixes
-from pkm.core.formats.gepetto import find_gepetto, read_gepetto
+from pkm.core.formats.gepetto import find_gepetto, read_gepetto, unmimic_motors
 from pkm.core.formats.imported import format_of, import_model, root_tag, with_file
 from pkm.core.formats.packages import model_file
 from pkm.core.model.builder import from_files, from_imported, from_strings
@@ -391,7 +391,7 @@ def _load_texts(files: Mapping[str, str], source: str, g: Given) -> Mechanism:
         joints = [str(j.get("name")) for j in check_urdf(imported.urdf, urdfs[0]).findall("joint")]
         spec, read = read_gepetto(files[yamls[0]], urdfs[0], joints, Path(urdfs[0]).stem, where)
         spec, replaced = with_given(spec, g, where)
-        return from_strings(imported.urdf, spec, source=where, notes=imported.notes + read + replaced)
+        return _gepetto_mechanism(imported.urdf, spec, where, imported.notes + read + replaced)
     if len(names) != 1:
         raise SpecError(source, f"give a closure spec with its model file, a Gepetto YAML with its URDF, or one model "
                                 f"file alone (MJCF, SDF, or a URDF with URDF+ <loop> or urdfdom <constraint> "
@@ -429,12 +429,21 @@ def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = (), 
     try:
         spec, read = read_gepetto(text, urdf_path.name, joints, name or "robot", str(yaml_path))
         spec, replaced = with_given(spec, given, str(yaml_path))
-        return from_strings(imported.urdf, spec, source=str(yaml_path), notes=tuple(notes) + imported.notes + read
-                            + replaced)
+        return _gepetto_mechanism(imported.urdf, spec, str(yaml_path), tuple(notes) + imported.notes + read + replaced)
     except SpecNameError as exc:
         if exc.source != str(yaml_path):
             raise
         raise located(exc, text, "yaml") from None
+
+
+def _gepetto_mechanism(urdf: str, spec: ClosureSpec, source: str, notes: tuple[str, ...]) -> Mechanism:
+    """The mechanism of a Gepetto pair read: the ``<mimic>`` of the followers named as motors dropped, as the
+    toolbox loads them (:func:`~pkm.core.formats.gepetto.unmimic_motors`: a :class:`~pkm.errors.PkmWarning` and a
+    note naming each coupling dropped)."""
+    urdf, dropped = unmimic_motors(urdf, spec.actuated, source)
+    if dropped:
+        warnings.warn(f"{source}: {dropped[0]}", PkmWarning, stacklevel=4)
+    return from_strings(urdf, spec, source=source, notes=notes + dropped)
 
 
 _PACKAGE_FILES: dict[tuple[str, int, int], Imported] = {}  # (path, mtime [ns], size): the file read
