@@ -1,0 +1,86 @@
+"""A model whose inertias no distribution of mass has (a negative principal moment; moments that break the triangle
+inequality): it loads for its kinematics, which needs no inertia, with an ImplausibleModelWarning naming each body and
+rule (:mod:`pkm.core.model.plausibility`); its dynamics is refused by a NonPhysicalInertiaError naming them.
+
+The models: pkm's Gepetto five-bar (``examples/gepetto_fivebar``, a planar five-bar whose links carry physical
+inertias) with ``proximal1``'s ``iyy`` made negative, or ``distal1``'s ``izz`` made more than ``ixx + iyy``.
+"""
+
+from __future__ import annotations
+
+import pickle
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pkm
+from pkm.core.model.plausibility import nonphysical
+from pkm.errors import ImplausibleModelWarning, NonPhysicalInertiaError, PkmError
+from tests import fd
+
+FIVEBAR = Path(__file__).resolve().parents[3] / "examples" / "gepetto_fivebar"
+EDITS = {"negative": ('iyy="0.0005208333333333333"', 'iyy="-0.0005208333333333333"', "proximal1", -0.000520833),
+         "triangle": ('izz="0.0007499999999999999"', 'izz="0.0027499999999999999"', "distal1", 0.002)}
+
+
+def _load(tmp_path_factory, rule: str):
+    old, new, *_ = EDITS[rule]
+    folder = tmp_path_factory.mktemp(rule)
+    shutil.copy(FIVEBAR / "robot.yaml", folder)
+    (folder / "robot.urdf").write_text((FIVEBAR / "robot.urdf").read_text().replace(old, new, 1))
+    with pytest.warns(ImplausibleModelWarning) as caught:
+        mech = pkm.load(folder)
+    found = [w.message for w in caught if isinstance(w.message, ImplausibleModelWarning) and w.message.kind == rule]
+    return mech, found
+
+
+@pytest.fixture(scope="module", params=sorted(EDITS))
+def model(request, tmp_path_factory):
+    return request.param, *_load(tmp_path_factory, request.param)
+
+
+def test_it_loads_with_a_warning_naming_the_body_and_the_rule(model):
+    rule, mech, found = model
+    _, _, link, value = EDITS[rule]
+    (w,) = found
+    assert w.names == (link,) and w.values[0] == pytest.approx(value, rel=1e-6) and str(w) in mech.notes
+    assert nonphysical(mech) == ((link, rule, pytest.approx(value, rel=1e-6)),)
+
+
+def test_its_kinematics_is_answered_and_its_jacobian_matches_differences(model):
+    _, mech, _ = model
+    fk = pkm.close_loops(mech, mech.actuated_q(mech.q_reference) + np.array([0.1, -0.05]))
+    assert fk.residual <= 1e-10
+    assert fd.forward_jacobian_error(mech, fk.q) <= 1e-6
+    qd = np.array([0.3, -0.2])
+    assert np.all(np.isfinite(pkm.velocities(mech, fk.q, qd)))
+
+
+def test_its_dynamics_is_refused_naming_the_body(model):
+    rule, mech, _ = model
+    _, _, link, value = EDITS[rule]
+    q, v, na = mech.q_reference, np.zeros(mech.nv), mech.na
+    calls = {"inverse dynamics": lambda: pkm.inverse_dynamics(mech, q, v, v),
+             "dynamic model": lambda: pkm.mass_matrix(mech, q),
+             "forward dynamics": lambda: pkm.forward_dynamics(mech, q, v, np.zeros(na)),
+             "simulation": lambda: pkm.simulate(mech, duration=0.01),
+             "energy": lambda: pkm.core.dynamics.energy(mech, q, v)}
+    for what, call in calls.items():
+        with pytest.raises(NonPhysicalInertiaError, match=rf"{what}.* refused: the inertias of '{link}'") as exc:
+            call()
+        err = exc.value
+        assert isinstance(err, PkmError) and err.links == (link,) and err.rules == (rule,)
+        assert err.values[0] == pytest.approx(value, rel=1e-6)
+        back = pickle.loads(pickle.dumps(err))
+        assert back.links == err.links and str(back) == str(err)
+
+
+def test_the_regressor_needs_no_inertia_and_is_answered(model):
+    """Identifying the inertias needs none: the regressor of the non-physical model is the physical one's (the five-bar
+    has no idle motion, so the map Ĝ does not depend on the inertias)."""
+    _, mech, _ = model
+    good = pkm.load(FIVEBAR)
+    q, qd, qdd = good.q_reference, np.array([0.5, -0.2]), np.array([1.0, 2.0])
+    assert np.array_equal(pkm.regressor(mech, q, qd, qdd), pkm.regressor(good, q, qd, qdd))
