@@ -77,6 +77,21 @@ def test_its_dynamics_is_refused_naming_the_body(model):
         assert back.links == err.links and str(back) == str(err)
 
 
+def test_the_consistent_identification_and_the_compiled_dynamics_are_refused_too(model):
+    """The consistent estimate starts from the model's inertias (its prior); the twin's actuator-space model (the
+    compiled kernels' dynamics, the exported C library's) is built from them."""
+    from pkm.core.identification.consistent import consistent_estimate
+    from pkm.core.twin.kernels import Kernels
+
+    rule, mech, _ = model
+    z = np.zeros((1, mech.na))
+    with pytest.raises(NonPhysicalInertiaError, match="physically consistent estimate"):
+        consistent_estimate(mech, np.array([mech.q_reference]), z, z, z)
+    with pytest.raises(NonPhysicalInertiaError, match="compiled dynamics") as exc:
+        Kernels(mech).dynamics
+    assert exc.value.rules == (rule,)
+
+
 def test_the_regressor_needs_no_inertia_and_is_answered(model):
     """Identifying the inertias needs none: the regressor of the non-physical model is the physical one's (the five-bar
     has no idle motion, so the map Ĝ does not depend on the inertias)."""

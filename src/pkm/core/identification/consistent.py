@@ -103,10 +103,10 @@ def consistent_estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: Array
         (132,)
     """
     what = "the physically consistent estimate"
-    cp = module("cvxpy", extra="identify", what=what)
-    module("clarabel", extra="identify", what=what)
     mech = check_mechanism(mech)
     require_physical(mech, what + " (its prior: the model's inertias)")
+    cp = module("cvxpy", extra="identify", what=what)
+    module("clarabel", extra="identify", what=what)
     base = base if base is not None else base_parameters(mech, precise=False)
     ls = ls if ls is not None else estimate(mech, Q, QD, QDD, TAU, base=base)
     P = parameters(mech)
