@@ -88,7 +88,7 @@ def test_the_consistent_identification_and_the_compiled_dynamics_are_refused_too
     with pytest.raises(NonPhysicalInertiaError, match="physically consistent estimate"):
         consistent_estimate(mech, np.array([mech.q_reference]), z, z, z)
     with pytest.raises(NonPhysicalInertiaError, match="compiled dynamics") as exc:
-        Kernels(mech).dynamics
+        _ = Kernels(mech).dynamics
     assert exc.value.rules == (rule,)
 
 
