@@ -31,11 +31,31 @@ def _ry(a: float) -> np.ndarray:
     return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
+AXES = "            axis: [0., 0., 0., 0., 0., 1.]\n"
+#: The file as written (x and z), the three translations, and all six axes with the cut at a revolute pin (the rocker's
+#: tip turning about y on the rocker, tied whole to the coupler): the same four-bar each time.
+VARIANTS = {
+    "xz": (URDF, YAML),
+    "xyz": (URDF, YAML.replace(AXES, AXES + "          - name: loopTY\n            axis: [0., 0., 0., 0., 1., 0.]\n")),
+    "frame": (URDF.replace('<joint name="rocker_tip_fixed" type="fixed">', '<joint name="rocker_tip_fixed" '
+                           'type="revolute"><axis xyz="0 1 0"/><limit effort="1" velocity="1"/>'),
+              YAML.replace(AXES, AXES + "".join(f"          - name: r{k}\n            axis: {a}\n" for k, a in
+                                                enumerate(("[1., 0., 0., 0., 0., 0.]", "[0., 1., 0., 0., 0., 0.]",
+                                                           "[0., 0., 1., 0., 0., 0.]", "[0., 0., 0., 0., 1., 0.]"))))),
+}
+
+
 @pytest.fixture(scope="module")
 def fourbar():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # (its placeholder-free drives: nothing to say; any warning is not the test)
         return pkm.load(DATA)
+
+
+@pytest.fixture(scope="module", params=sorted(VARIANTS))
+def variant(request):
+    urdf, text = VARIANTS[request.param]
+    return request.param, load_texts({"fourbar.urdf": urdf, "submechanisms.yml": text})
 
 
 def test_the_folder_loads_with_the_file_s_drives_outputs_and_loop(fourbar):
@@ -47,8 +67,15 @@ def test_the_folder_loads_with_the_file_s_drives_outputs_and_loop(fourbar):
     assert any("jointnames not read" in n for n in mech.notes)
 
 
-def test_the_rocker_follows_the_four_bar_and_the_jacobian_matches_differences(fourbar):
-    mech = fourbar
+def test_each_variant_reads_its_closure_type(variant):
+    name, mech = variant
+    (c,) = mech.spec.closures
+    assert c.type == ("frame" if name == "frame" else "point")
+    assert any("translation axes of 3" in n for n in mech.notes) == (name == "xz")
+
+
+def test_the_rocker_follows_the_four_bar_and_the_jacobian_matches_differences(variant):
+    _, mech = variant
     act, out = mech.joints["act"].idx_q, mech.joints["out"].idx_q
     length = np.linalg.norm(C0 - B0)
     for theta in (-0.3, 0.0, 0.15, 0.3):
@@ -91,3 +118,10 @@ def test_a_loop_whose_left_out_translations_remove_a_motion_is_refused():
     text = YAML.replace("          - name: loopTZ\n            axis: [0., 0., 0., 0., 0., 1.]\n", "")
     with pytest.raises(SpecError, match=r"states 1 translation axes of 3: the others are not implied"):
         load_texts({"fourbar.urdf": URDF, "submechanisms.yml": text})
+
+
+def test_saved_as_a_pkm_spec_it_loads_back_the_same(fourbar, tmp_path):
+    from pkm.core.model.compare import mechanism_differences
+
+    path = pkm.save(fourbar, tmp_path / "fourbar.closures.toml")
+    assert mechanism_differences(pkm.load(path), fourbar) == []
