@@ -107,6 +107,7 @@ ANALYTIC = YAML.replace("type: NUMERICAL", "type: rrPr").split("    loop_constra
      r"constrain some rotations but not all six"),
     (YAML.replace("axis: [0., 0., 0., 1., 0., 0.]", "axis: [0., 0., 1.]"), SpecError, r"must be 6 finite numbers"),
     ("submechanisms: []\n", SpecError, r"non-empty submechanisms list"),
+    (YAML.replace("successor_body: coupler", "successor: coupler"), SpecError, r"successor_body must be a link name"),
 ])
 def test_what_pkm_cannot_read_is_refused_saying_what(text, error, message):
     with pytest.raises(error, match=message):

@@ -233,9 +233,14 @@ def read_hyrodyn(yaml_text: str, urdf_text: str, urdf_name: str, mechanism: str,
             if not isinstance(loop, dict):
                 raise SpecError(source, f"{lw} must be a mapping, got {loop!r}")
             cut = loop.get("cut_joint", loop.get("joint"))
-            if not isinstance(cut, str) or cut not in joints:
-                raise SpecNameError(source, "joint", str(cut), joints, f"{lw} cut_joint")
+            if not isinstance(cut, str) or not cut:
+                raise SpecError(source, f"{lw}: cut_joint must be a joint name, got {cut!r}")
+            if cut not in joints:
+                raise SpecNameError(source, "joint", cut, joints, f"{lw} cut_joint")
             pred, succ = (loop.get(key) for key in ("predecessor_body", "successor_body"))
+            for key, body in (("predecessor_body", pred), ("successor_body", succ)):
+                if not isinstance(body, str) or not body:
+                    raise SpecError(source, f"{lw}: {key} must be a link name, got {body!r}")
             T0p = placement(str(pred), f"{lw} predecessor_body")
             T0s = placement(str(succ), f"{lw} successor_body")
             axes = _axes(loop, lw, source)
