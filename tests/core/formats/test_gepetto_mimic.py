@@ -76,3 +76,13 @@ def test_an_upload_reads_it_alike():
         mech = load_texts(_texts())
     assert any("mimic coupling dropped" in str(w.message) for w in caught)
     assert mech.actuated_names == ("mot1", "mot2", "grip", "grip_inner")
+
+
+def test_a_closure_spec_naming_a_follower_as_actuated_says_what_it_is():
+    """pkm's own spec keeps the file's couplings: a follower named as actuated is refused, saying why and what to name."""
+    from pkm.errors import SpecError
+
+    spec = ('format = "pkm.closures/1"\nmechanism = "g"\nurdf = "robot.urdf"\nactuated = ["mot1", "grip_inner"]\n'
+            '[[closure]]\nname = "loop1"\ntype = "point"\nframe_a = "closedloop1_A"\nframe_b = "closedloop1_B"\n')
+    with pytest.raises(SpecError, match=r"actuated: joint 'grip_inner' follows another joint \(a URDF <mimic>\)"):
+        pkm.from_strings(_texts()["robot.urdf"], spec)
