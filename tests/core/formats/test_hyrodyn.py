@@ -126,3 +126,20 @@ def test_saved_as_a_pkm_spec_it_loads_back_the_same(fourbar, tmp_path):
 
     path = pkm.save(fourbar, tmp_path / "fourbar.closures.toml")
     assert mechanism_differences(pkm.load(path), fourbar) == []
+
+
+def test_a_smurf_file_is_read_as_the_pair_it_lists(fourbar, tmp_path):
+    """Phobos's SMURF main file, laid out as hyrodyn's robot/leg (smurf/leg.smurf naming ../urdf/...)."""
+    (tmp_path / "urdf").mkdir()
+    (tmp_path / "smurf").mkdir()
+    (tmp_path / "urdf" / "fourbar.urdf").write_text(URDF)
+    (tmp_path / "urdf" / "submechanisms.yml").write_text(YAML)
+    smurf = tmp_path / "smurf" / "fourbar.smurf"
+    smurf.write_text("modelname: fourbar\nfiles:\n- ../urdf/fourbar.urdf\n- ../urdf/submechanisms.yml\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        mech = pkm.load(smurf)
+    assert mech.spec.closures == fourbar.spec.closures and mech.actuated_names == fourbar.actuated_names
+    smurf.write_text("modelname: fourbar\nfiles:\n- ../urdf/fourbar.urdf\n")
+    with pytest.raises(SpecError, match=r"HyRoDyn URDF \+ submechanisms.yml: a SMURF file listing 1 URDF and 0"):
+        pkm.load(smurf)

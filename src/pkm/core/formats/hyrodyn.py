@@ -31,7 +31,9 @@ What pkm reads (the keys HyRoDyn's parser reads, ``RobotModel_HyRoDyn::load_robo
   floating base) is read as none: the base is fixed.
 
 The file is recognised by content: a YAML mapping with a ``submechanisms`` list. Its URDF is the one of its stem
-(``leg.yml``: ``leg.urdf``), else the folder's only URDF that no submechanism names as its ``file_path``.
+(``leg.yml``: ``leg.urdf``), else the folder's only URDF that no submechanism names as its ``file_path``. A Phobos
+SMURF file (``<model>.smurf``, a YAML whose ``files`` list names the URDF and the submechanisms file, relative to it:
+hyrodyn's ``robot/leg/smurf/leg.smurf``) is read as the pair it lists.
 """
 
 from __future__ import annotations
@@ -113,6 +115,8 @@ def find_hyrodyn(path: Path) -> tuple[Path, Path, tuple[str, ...]] | str:
                                        f"({', '.join(p.name for p in found)}): load the one you mean by its path")
         urdf, notes = _urdf_for(found[0])
         return urdf, found[0], notes
+    if path.suffix.lower() == ".smurf" and path.is_file():
+        return _smurf(path)
     if path.suffix.lower() in _YAML_SUFFIXES:
         why = hyrodyn_yaml(path)
         if why is not None:
@@ -125,7 +129,26 @@ def find_hyrodyn(path: Path) -> tuple[Path, Path, tuple[str, ...]] | str:
         if len(beside) == 1:
             return path, beside[0], (f"{path.name} read with {beside[0].name}",)
         return "a URDF with no (or several) HyRoDyn submechanisms files beside it"
-    return "neither a folder, nor YAML, nor a URDF"
+    return "neither a folder, nor YAML, nor a URDF, nor a SMURF file"
+
+
+def _smurf(path: Path) -> tuple[Path, Path, tuple[str, ...]] | str:
+    """The URDF and the submechanisms file a SMURF file lists (Phobos's ``<model>.smurf``: ``files``, paths relative to
+    it), or why it names no such pair."""
+    try:
+        raw = parse_yaml(read_text_file(path, "SMURF"), str(path))
+    except SpecError as exc:
+        return str(exc).removeprefix(f"{path}: ")
+    files = raw.get("files") if isinstance(raw, dict) else None
+    if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
+        return "a SMURF file without a files list"
+    listed = [path.parent / f for f in files]
+    urdfs = [p for p in listed if p.suffix.lower() == ".urdf" and p.is_file()]
+    subs = [p for p in listed if p.suffix.lower() in _YAML_SUFFIXES and p.is_file() and hyrodyn_yaml(p) is None]
+    if len(urdfs) != 1 or len(subs) != 1:
+        return (f"a SMURF file listing {len(urdfs)} URDF and {len(subs)} submechanisms files found (pkm reads a SMURF "
+                "model's loops from its one HyRoDyn submechanisms file, with its one URDF)")
+    return urdfs[0], subs[0], (f"{path.name}: read as its files {urdfs[0].name} and {subs[0].name}",)
 
 
 def _names(sub: dict, key: str, where: str, source: str, required: bool = True) -> list[str]:
