@@ -21,13 +21,20 @@ from pkm.errors import ImplausibleModelWarning, NonPhysicalInertiaError, PkmErro
 from tests import fd
 
 FIVEBAR = Path(__file__).resolve().parents[3] / "examples" / "gepetto_fivebar"
-EDITS = {"negative": ('iyy="0.0005208333333333333"', 'iyy="-0.0005208333333333333"', "proximal1", -0.000520833),
-         "triangle": ('izz="0.0007499999999999999"', 'izz="0.0027499999999999999"', "distal1", 0.002)}
+#: ``{case: (text replaced, by, link, rule, value)}``; "products": a tensor of products alone, as Phobos 0.7 wrote
+#: hyrodyn's RH5 leg (``LLAnkle_E11_Link``: ixx = iyy = izz = 0, iyz = 0.001; principal moments -0.001, 0, 0.001).
+EDITS = {"negative": ('iyy="0.0005208333333333333"', 'iyy="-0.0005208333333333333"', "proximal1", "negative",
+                      -0.000520833),
+         "products": ('<inertia ixx="0.0" ixy="0.0" ixz="0.0" iyy="0.0005208333333333333" iyz="0.0" '
+                      'izz="0.0005208333333333333"/>',
+                      '<inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0.001" izz="0"/>', "proximal1", "negative",
+                      -0.001),
+         "triangle": ('izz="0.0007499999999999999"', 'izz="0.0027499999999999999"', "distal1", "triangle", 0.002)}
 
 
-def _load(tmp_path_factory, rule: str):
-    old, new, *_ = EDITS[rule]
-    folder = tmp_path_factory.mktemp(rule)
+def _load(tmp_path_factory, case: str):
+    old, new, _, rule, _ = EDITS[case]
+    folder = tmp_path_factory.mktemp(case)
     shutil.copy(FIVEBAR / "robot.yaml", folder)
     (folder / "robot.urdf").write_text((FIVEBAR / "robot.urdf").read_text().replace(old, new, 1))
     with pytest.warns(ImplausibleModelWarning) as caught:
@@ -38,12 +45,12 @@ def _load(tmp_path_factory, rule: str):
 
 @pytest.fixture(scope="module", params=sorted(EDITS))
 def model(request, tmp_path_factory):
-    return request.param, *_load(tmp_path_factory, request.param)
+    _, _, link, rule, value = EDITS[request.param]
+    return (rule, link, value), *_load(tmp_path_factory, request.param)
 
 
 def test_it_loads_with_a_warning_naming_the_body_and_the_rule(model):
-    rule, mech, found = model
-    _, _, link, value = EDITS[rule]
+    (rule, link, value), mech, found = model
     (w,) = found
     assert w.names == (link,) and w.values[0] == pytest.approx(value, rel=1e-6) and str(w) in mech.notes
     assert nonphysical(mech) == ((link, rule, pytest.approx(value, rel=1e-6)),)
@@ -59,8 +66,7 @@ def test_its_kinematics_is_answered_and_its_jacobian_matches_differences(model):
 
 
 def test_its_dynamics_is_refused_naming_the_body(model):
-    rule, mech, _ = model
-    _, _, link, value = EDITS[rule]
+    (rule, link, value), mech, _ = model
     q, v, na = mech.q_reference, np.zeros(mech.nv), mech.na
     calls = {"inverse dynamics": lambda: pkm.inverse_dynamics(mech, q, v, v),
              "dynamic model": lambda: pkm.mass_matrix(mech, q),
@@ -83,7 +89,7 @@ def test_the_consistent_identification_and_the_compiled_dynamics_are_refused_too
     from pkm.core.identification.consistent import consistent_estimate
     from pkm.core.twin.kernels import Kernels
 
-    rule, mech, _ = model
+    (rule, _, _), mech, _ = model
     z = np.zeros((1, mech.na))
     with pytest.raises(NonPhysicalInertiaError, match="physically consistent estimate"):
         consistent_estimate(mech, np.array([mech.q_reference]), z, z, z)
