@@ -153,7 +153,7 @@ def nonphysical(mech: Mechanism) -> tuple[tuple[str, str, float], ...]:
 def _nonphysical(mech: Mechanism) -> tuple[tuple[str, str, float], ...]:
     model = mech.model
     moments = [np.linalg.eigvalsh(np.asarray(model.inertias[j].inertia, dtype=float)) for j in range(1, model.njoints)]
-    if all(e[0] >= 0.0 and e[2] - e[0] - e[1] <= TRIANGLE_TOL * e[2] for e in moments):
+    if all(e[0] >= -TRIANGLE_TOL * np.abs(e).max() and e[2] - e[0] - e[1] <= TRIANGLE_TOL * e[2] for e in moments):
         return ()  # (every body physical: the size, a forward kinematics, not needed)
     names = _body_names(model)
     L = size(mech)
