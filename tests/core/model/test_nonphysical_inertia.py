@@ -105,3 +105,21 @@ def test_the_regressor_needs_no_inertia_and_is_answered(model):
     good = pkm.load(FIVEBAR)
     q, qd, qdd = good.q_reference, np.array([0.5, -0.2]), np.array([1.0, 2.0])
     assert np.array_equal(pkm.regressor(mech, q, qd, qdd), pkm.regressor(good, q, qd, qdd))
+
+
+def test_a_design_that_sets_an_inertia_in_place_is_judged_on_its_own_inertias():
+    """design_mechanism sets the bodies' parameters in the built model: what was derived from the file's inertias is
+    made again, so its dynamics is refused for the design's negative moment, and answered again (the file's own
+    efforts) for a design that puts the file's moment back."""
+    from pkm.core.twin.design import design_mechanism
+
+    good = pkm.load(FIVEBAR)
+    q, v = good.q_reference, np.zeros(good.nv)
+    bad = design_mechanism(good, {"proximal1.Iyy": -1.0})
+    with pytest.raises(NonPhysicalInertiaError) as exc:
+        pkm.inverse_dynamics(bad, q, v, v)
+    assert exc.value.links == ("proximal1",) and exc.value.rules == ("negative",)
+    fixed = design_mechanism(bad, {"proximal1.Iyy": 5.2083333333333333e-4 + 0.1 * 0.125 ** 2})  # (about the joint)
+    a = pkm.accelerations(good, q, v, np.array([1.0, -0.5]))
+    tau = pkm.inverse_dynamics(good, q, v, a)
+    assert np.abs(tau).max() > 0 and np.allclose(pkm.inverse_dynamics(fixed, q, v, a), tau, rtol=1e-12, atol=0)
