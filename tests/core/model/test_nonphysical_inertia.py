@@ -123,3 +123,18 @@ def test_a_design_that_sets_an_inertia_in_place_is_judged_on_its_own_inertias():
     a = pkm.accelerations(good, q, v, np.array([1.0, -0.5]))
     tau = pkm.inverse_dynamics(good, q, v, a)
     assert np.abs(tau).max() > 0 and np.allclose(pkm.inverse_dynamics(fixed, q, v, a), tau, rtol=1e-12, atol=0)
+
+
+def test_the_compiled_kernels_at_a_non_physical_design_refuse_its_dynamics_not_its_kinematics():
+    """Kernels.at evaluates the shared kernels at a design's inertias: its dynamics kernels are refused there, its
+    kinematics kernels answer (the Jacobian the core's)."""
+    from pkm.core.twin.kernels import Kernels
+
+    good = pkm.load(FIVEBAR)
+    K = Kernels(good, design=("proximal1.Iyy",), compiled=False)
+    bad = K.at({"proximal1.Iyy": -1.0})
+    q, qd = good.q_reference, np.zeros(good.na)
+    with pytest.raises(NonPhysicalInertiaError, match="compiled inverse dynamics") as exc:
+        bad.inverse_dynamics(q, qd, qd)
+    assert exc.value.links == ("proximal1",)
+    assert np.allclose(bad.forward_jacobian(q), pkm.forward_jacobian(good, q), rtol=1e-12, atol=1e-14)
