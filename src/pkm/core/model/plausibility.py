@@ -30,8 +30,10 @@ Checked on every mechanism built (:func:`pkm.core.model.builder.build`), each fi
 The negative and triangle rules name the bodies whose inertias are not physical (:func:`nonphysical`): such a model
 loads for its kinematics, which needs no inertia, and its dynamics is refused (:func:`require_physical`: a
 :class:`~pkm.errors.NonPhysicalInertiaError` naming them), by inverse and forward dynamics, the mass matrix and the
-actuator-space model, the simulation, the energy and the consistent identification (which starts from the model's
-inertias).
+actuator-space model, the simulation, the energy, the transmissions' serial-equivalent model, the twin's
+actuator-space model (the compiled dynamics kernels, a :meth:`~pkm.core.twin.kernels.Kernels.at` design view judged
+on its own inertias, and the exported C library) and the consistent identification (which starts from the model's
+inertias). The regressor needs no inertia and is answered.
 
 Measured on pkm's shipped mechanisms, the acceptance set and Gepetto's examples: the heaviest body weighs at most
 1.2 % of the mass bound (Gepetto's ``5bar_linkage_iso3d``) and a radius of gyration at most 0.53 ``L`` (the knee
