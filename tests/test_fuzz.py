@@ -42,7 +42,7 @@ def test_harness_covers_the_public_entry_points(fuzz):
                 "hexapod_reconfigure.optimal_beta", "Prs3Dynamics.forces", "Prs3Dynamics.batch",
                 "KhalilProjection.inverse_dynamics", "hexapod.assembly_modes", "rrr3.forward_kinematics",
                 "pkm.inverse_dynamics", "pkm.assemble", "formats.spec_from_gepetto", "formats.read_mjcf",
-                "formats.read_sdf", "pkm.load(file)", "formats.spec_skeleton", "pkm.quantity", "pkm.follow_task",
+                "formats.read_sdf", "formats.read_hyrodyn", "pkm.load(file)", "formats.spec_skeleton", "pkm.quantity", "pkm.follow_task",
                 "pkm.follow_actuators", "Kernels.inverse_dynamics", "Kernels.close_loops_path", "maps.task_map",
                 "formats.mjcf_from_mechanism", "pkm.reconfigure", "pkm.sweep", "sweeps.space", "SweepResult",
                 "differential.actuation", "pkm.load(package)", "Actuator", "pkm.with_actuators", "spec.actuators",

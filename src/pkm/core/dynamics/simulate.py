@@ -74,6 +74,7 @@ from pkm.core.kinematics.solve import close_loops
 from pkm.core.kinematics.task import TaskMap
 from pkm.core.kinematics.trajectory import Trajectory, _units
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
 from pkm.errors import CompilerError, ControllerError, InvalidInputError, PkmError, SingularityError, SpecError
 from pkm.validation import as_array, as_scalar
@@ -372,6 +373,7 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
         array([-0.254375, -0.254375, -0.254375, -0.254375, -0.254375])
     """
     mech = check_mechanism(mech)
+    require_physical(mech, "the simulation")
     if method not in METHODS:
         raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
     if not isinstance(backend, str) or backend not in BACKENDS:

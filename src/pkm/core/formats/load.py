@@ -1,7 +1,7 @@
 """Loading a mechanism from files: every reader's result put through the builder
 (:mod:`pkm.core.model.builder`). :func:`load_path` (behind :func:`pkm.load`) tries :data:`READERS` in order on a
 file or folder, by content; :func:`load_model_file` reads an MJCF or SDF file alone; :func:`load_gepetto` a
-Gepetto URDF + YAML pair; :func:`load_package_model` a model an installed package ships, by name;
+Gepetto URDF + YAML pair; :func:`load_hyrodyn` a URDF with HyRoDyn's submechanisms file; :func:`load_package_model` a model an installed package ships, by name;
 :func:`load_texts` the same kinds of files given as texts (an upload: no file name reaches the file system).
 
 The readers themselves (:mod:`~pkm.core.formats.imported`, :mod:`~pkm.core.formats.gepetto`,
@@ -19,7 +19,9 @@ from pathlib import Path
 from typing import Any
 
 from pkm.core.formats.base import FORMATS, Imported, by_root, suffixes
-from pkm.core.formats.gepetto import find_gepetto, read_gepetto
+from pkm.core.formats.gepetto import find_gepetto, parse_yaml, read_gepetto, unmimic_motors
+from pkm.core.formats.hyrodyn import MARKER as HYRODYN_MARKER
+from pkm.core.formats.hyrodyn import PartialLoop, find_hyrodyn, read_hyrodyn
 from pkm.core.formats.imported import format_of, import_model, root_tag, with_file
 from pkm.core.formats.packages import model_file
 from pkm.core.model.builder import from_files, from_imported, from_strings
@@ -195,6 +197,11 @@ def _gepetto(path: Path) -> Loader | str:
     return found if isinstance(found, str) else (lambda given=Given(): load_gepetto(*found, given=given))
 
 
+def _hyrodyn(path: Path) -> Loader | str:
+    found = find_hyrodyn(path)
+    return found if isinstance(found, str) else (lambda given=Given(): load_hyrodyn(*found, given=given))
+
+
 def _head(path: Path) -> str | None:
     """The file's text, or None when it cannot be read as text (the readers that take it say why)."""
     try:
@@ -251,7 +258,8 @@ def _model_file(path: Path) -> Loader | str:
 
 
 #: The readers :func:`load_path` tries, in this order; the first that takes a path reads it.
-READERS = (Reader("Gepetto URDF + YAML", _gepetto), Reader("pkm closure spec", _closure_spec),
+READERS = (Reader("Gepetto URDF + YAML", _gepetto), Reader("HyRoDyn URDF + submechanisms.yml", _hyrodyn),
+           Reader("pkm closure spec", _closure_spec),
            Reader("model file (URDF, MJCF, SDF)", _model_file))
 
 
@@ -313,7 +321,8 @@ def located(exc: SpecNameError, text: str, kind: str) -> SpecNameError:
 
 def load_path(path: Path, given: Given = Given()) -> Mechanism:
     """The mechanism of a file or folder, read by the first of :data:`READERS` that takes it, by content: a folder
-    or YAML in Gepetto's convention (:mod:`pkm.core.formats.gepetto`), a closure spec (``.toml``, or TOML text
+    or YAML in Gepetto's convention (:mod:`pkm.core.formats.gepetto`), a URDF with HyRoDyn's submechanisms file
+    (:mod:`pkm.core.formats.hyrodyn`), a closure spec (``.toml``, or TOML text
     with a ``format`` key), an MJCF or SDF file (or a URDF alone, which then asks for a spec); ``given``: the
     actuated joints and task stated in code, over the files' (:func:`with_given`).
 
@@ -356,6 +365,8 @@ def load_texts(files: Mapping[str, str], source: str = "<upload>", *, actuated: 
 
     * a closure spec (``.toml``) and the model file it names (URDF, MJCF or SDF);
     * a Gepetto pair: a YAML and the URDF beside it (the only ``.urdf``);
+    * a HyRoDyn pair: a YAML with a ``submechanisms`` list and the robot URDF (the one of its stem, else the only
+      ``.urdf``);
     * an MJCF or SDF file alone (its loops and actuators from the file), or a URDF with URDF+ ``<loop>`` or urdfdom
       ``<constraint>`` elements.
 
@@ -397,6 +408,15 @@ def _load_texts(files: Mapping[str, str], source: str, g: Given, folder: str | N
         mech = from_imported(spec, _read_text(spec.urdf, files[spec.urdf]), where)
         mech.notes += read
         return mech
+    if yamls and _is_hyrodyn(files[yamls[0]]):
+        where = f"{source}:{yamls[0]}"
+        stem = [n for n in names if n == str(Path(yamls[0]).with_suffix(".urdf"))]
+        urdfs = stem or [n for n in names if kind[n] == ".urdf"]
+        if len(urdfs) != 1:
+            raise SpecError(source, f"a HyRoDyn submechanisms file goes with one robot URDF (or one named "
+                                    f"{Path(yamls[0]).stem}.urdf); given {urdfs or 'none'}")
+        imported = _read_text(urdfs[0], files[urdfs[0]])
+        return _hyrodyn_mechanism(imported, urdfs[0], files[yamls[0]], Path(urdfs[0]).stem, where, g, ())
     if yamls:
         urdfs = [n for n in names if kind[n] == ".urdf"]
         if len(urdfs) != 1:
@@ -406,7 +426,7 @@ def _load_texts(files: Mapping[str, str], source: str, g: Given, folder: str | N
         joints = [str(j.get("name")) for j in check_urdf(imported.urdf, urdfs[0]).findall("joint")]
         spec, read = read_gepetto(files[yamls[0]], urdfs[0], joints, gepetto_name(urdfs[0], folder), where)
         spec, replaced = with_given(spec, g, where)
-        return from_strings(imported.urdf, spec, source=where, notes=imported.notes + read + replaced)
+        return _gepetto_mechanism(imported.urdf, spec, where, imported.notes + read + replaced)
     if len(names) != 1:
         raise SpecError(source, f"give a closure spec with its model file, a Gepetto YAML with its URDF, or one model "
                                 f"file alone (MJCF, SDF, or a URDF with URDF+ <loop> or urdfdom <constraint> "
@@ -444,12 +464,92 @@ def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = (), 
     try:
         spec, read = read_gepetto(text, urdf_path.name, joints, name, str(yaml_path))
         spec, replaced = with_given(spec, given, str(yaml_path))
-        return from_strings(imported.urdf, spec, source=str(yaml_path), notes=tuple(notes) + imported.notes + read
-                            + replaced)
+        return _gepetto_mechanism(imported.urdf, spec, str(yaml_path), tuple(notes) + imported.notes + read + replaced)
     except SpecNameError as exc:
         if exc.source != str(yaml_path):
             raise
         raise located(exc, text, "yaml") from None
+
+
+def _gepetto_mechanism(urdf: str, spec: ClosureSpec, source: str, notes: tuple[str, ...]) -> Mechanism:
+    """The mechanism of a Gepetto pair read: the ``<mimic>`` of the followers named as motors dropped, as the
+    toolbox loads them (:func:`~pkm.core.formats.gepetto.unmimic_motors`: a :class:`~pkm.errors.PkmWarning` and a
+    note naming each coupling dropped)."""
+    urdf, dropped = unmimic_motors(urdf, spec.actuated, source)
+    if dropped:
+        warnings.warn(f"{source}: {dropped[0]}", PkmWarning, stacklevel=4)
+    return from_strings(urdf, spec, source=source, notes=notes + dropped)
+
+
+def _is_hyrodyn(text: str) -> bool:
+    try:
+        raw = parse_yaml(text)
+    except SpecError:
+        return False
+    return isinstance(raw, dict) and isinstance(raw.get(HYRODYN_MARKER), list)
+
+
+def load_hyrodyn(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = (), given: Given = Given()) -> Mechanism:
+    """The :class:`~pkm.core.Mechanism` of a robot URDF and HyRoDyn's ``submechanisms.yml``
+    (:mod:`pkm.core.formats.hyrodyn`); ``notes`` first (how the files were paired); ``given``: the actuated joints
+    and task stated in code (:func:`with_given`), over the file's."""
+    urdf_path, yaml_path = Path(urdf_path), Path(yaml_path)
+    imported = import_model(urdf_path)
+    if imported.format != "urdf":
+        raise SpecError(str(urdf_path), f"the model beside {yaml_path.name} is {imported.format.upper()}, not URDF: "
+                                        "HyRoDyn pairs its submechanisms file with a URDF")
+    name = urdf_path.stem
+    text = read_text_file(yaml_path, "YAML")
+    try:
+        return _hyrodyn_mechanism(imported, urdf_path.name, text, name, str(yaml_path), given, tuple(notes))
+    except SpecNameError as exc:
+        if exc.source != str(yaml_path):
+            raise
+        raise located(exc, text, "yaml") from None
+
+
+def _hyrodyn_mechanism(imported: Imported, urdf_name: str, yaml_text: str, name: str, source: str, given: Given,
+                       notes: tuple[str, ...]) -> Mechanism:
+    urdf, spec, read, partial = read_hyrodyn(yaml_text, imported.urdf, urdf_name, name or "robot", source)
+    spec, replaced = with_given(spec, given, source)
+    mech = from_strings(urdf, spec, source=source, notes=notes + imported.notes + read + replaced)
+    implied = [_implied(mech, loop, source) for loop in partial]
+    mech.notes += tuple(implied)
+    return mech
+
+
+def _implied(mech: Mechanism, loop: PartialLoop, source: str) -> str:
+    """The note saying that the translations ``loop`` leaves out are implied by the closures at the reference (the
+    closures' Jacobian keeps its rank without them); else a SpecError: read as a point closure they would remove
+    a motion the file leaves free."""
+    import numpy as np
+    import pinocchio as pin
+
+    from pkm.core.differential.velocity import RTOL
+    from pkm.core.kinematics import constraints
+
+    q = mech.q_reference
+    J = constraints.jacobian(mech, q)
+    start = sum(3 if c.type == "point" else 6 for c in mech.spec.closures[:[c.name for c in mech.spec.closures]
+                                                                        .index(loop.closure)])
+    R = mech.data.oMf[mech.model.getFrameId(loop.predecessor, pin.FrameType.BODY)].rotation
+    stated = loop.stated @ R.T @ J[start:start + 3]  # (the stated rows, in the predecessor's frame)
+    rest = np.vstack([J[:start], stated, J[start + 3:]])
+
+    def rank(A: np.ndarray) -> int:
+        s = np.linalg.svd(A, compute_uv=False)
+        return int(np.sum(s > RTOL * s[0])) if s.size and s[0] > 0 else 0
+
+    full, partial = rank(J), rank(rest)
+    if full != partial:
+        raise SpecError(source, f"closure {loop.closure!r} (predecessor {loop.predecessor!r}) states "
+                                f"{len(loop.stated)} translation axes of 3: the others are not implied by the loops "
+                                f"at the zero configuration (the closures' rank {partial} becomes {full} with them), so "
+                                "a point closure would remove a motion the file leaves free; pkm closes a point "
+                                "(three translations) or a frame (six)")
+    return (f"closure {loop.closure!r}: its file states {len(loop.stated)} translation axes of 3; read as a point "
+            f"closure, the others implied by the loops at the zero configuration (the closures' Jacobian has rank "
+            f"{full} with them and without)")
 
 
 _PACKAGE_FILES: dict[tuple[str, int, int], Imported] = {}  # (path, mtime [ns], size): the file read
@@ -487,4 +587,5 @@ def load_package_model(name: str, given: Given = Given()) -> Mechanism:
 
 
 __all__ = ["GEPETTO_URDF", "READERS", "Given", "Loader", "Reader", "gepetto_name", "given", "given_task",
-           "load_gepetto", "load_model_file", "load_package_model", "load_path", "load_spec_file", "with_given"]
+           "load_gepetto", "load_hyrodyn", "load_model_file", "load_package_model", "load_path", "load_spec_file",
+           "with_given"]

@@ -157,6 +157,9 @@ class Mechanism:
             if name not in self.joints:
                 raise SpecNameError(source, "joint", name, self.scalar_joint_names(), what)
             info = self.joints[name]
+            if info.kind == "JointModelMimic":
+                raise SpecError(source, f"{what}: joint {name!r} follows another joint (a URDF <mimic>) and has no "
+                                        "coordinate of its own: name the joint it mimics, or drop its <mimic>")
             if info.nq != 1 or info.nv != 1:
                 raise SpecError(source, f"{what}: joint {name!r} ({info.kind}) must have one coordinate")
             return info

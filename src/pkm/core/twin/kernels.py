@@ -47,6 +47,7 @@ from numpy.typing import ArrayLike
 
 from pkm.core.dynamics.model import COULOMB_VELOCITY
 from pkm.core.model.mechanism import LimitViolation, Mechanism, check_mechanism
+from pkm.core.model.plausibility import require_physical
 from pkm.core.twin.codegen import C_INT as _I
 from pkm.core.twin.codegen import C_REAL_P as _P
 from pkm.core.twin.codegen import compile_library, numpy_function, pointers
@@ -463,6 +464,8 @@ class Kernels:
         is diagnosed: non-finite input (:class:`InvalidInputError`) or a failed evaluation (:class:`NonFiniteError`;
         with ``pivoted``, only at samples whose pivot, the last output, is above the floor: the others are the
         caller's to redo)."""
+        if name in _DYNAMICS or name.startswith("inverse_dynamics"):  # (a design's own inertias: Kernels.at)
+            require_physical(self.mech, f"the compiled {name.replace('_', ' ')}")
         kernel = self._kernels.get(name) or self.kernel(name)
         arrays = []
         for what, size, x in zip(KERNELS[name][0], kernel.in_size, args):
