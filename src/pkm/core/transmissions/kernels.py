@@ -299,6 +299,25 @@ class TransmissionKernels:
         values = cs.cse([cs.densify(cs.SX(e)) for e in exprs])
         return cs.Function(f"{c_identifier(self.name)}_{kernel}", sym, values, list(ins), list(outs))
 
+    @functools.cache  # noqa: B019
+    def tangent(self, kernel: str) -> cs.Function:
+        """The derivative of a solve's solution by the implicit function theorem (the closure's, at the solution,
+        not through the Newton iterations), for ``kernel`` in :data:`SOLVES`: ``(q) -> (dq, dy)``, ``dq = ∂q_out/∂x``
+        (nq x k, the configuration's coordinates per target coordinate, column-major) and ``dy = ∂y/∂x`` (k x k) for
+        ``fk`` (``x = qm``, ``y = qo``: ``dy`` is ``maps``'s ``J``) and ``ik`` (``x = qo``, ``y = qm``: ``J_inv``); the
+        idle motions' coordinates (a rod's spin, which the closure leaves free) held. ``fk_j_dm``'s is ``fk``'s.
+        The warm start moves no solution: its derivative is zero."""
+        if kernel not in SOLVES:
+            raise InvalidInputError("kernel", f"use one of {list(SOLVES)}", kernel)
+        at, rows = (self._twin_o, self.motor_q) if kernel == "ik" else (self._twin_m, self.output_q)
+        tw = at.tw
+        dv = cs.SX.sym("dv", tw.mech.nv)
+        E = cs.substitute(cs.jacobian(tw.retract(dv), dv), dv, cs.DM.zeros(tw.mech.nv))  # (dq/dv: nq x nv)
+        dq = self._in_q(at, E @ self._rates(at, range(tw.mech.nv)))
+        dy = cs.vertcat(*[dq[i, :] for i in rows])
+        values = cs.cse([cs.densify(cs.SX(e)) for e in (dq, dy)])
+        return cs.Function(f"{c_identifier(self.name)}_{kernel}_tangent", [self.q], values, ["q"], ["dq", "dy"])
+
     # ---------------------------------------------------------------- evaluation (the C batch, in process)
     @functools.cache  # noqa: B019
     def kernel(self, kernel: str) -> Callable[..., list[np.ndarray]]:
@@ -332,14 +351,23 @@ class TransmissionKernels:
 
     def jax(self, kernel: str) -> Callable[..., tuple]:
         """``kernel`` as a jitted JAX function of one sample (:func:`pkm.core.twin.jaxgen.jax_function`; ``jax.vmap``
-        for batches, ``jax.grad`` differentiates it).
+        for batches). ``jax.jacfwd``, ``jax.grad`` differentiate it; a solve's (:data:`SOLVES`) by the implicit
+        function theorem (:data:`IMPLICIT`, :meth:`tangent`), never through its unrolled iterations.
 
         Raises:
             MissingDependencyError: JAX is not installed (``pip install "pkm-robotics[jax]"``).
         """
+        from pkm._optional import module
         from pkm.core.twin.jaxgen import jax_function
 
-        return jax_function(self.function(kernel))
+        f = jax_function(self.function(kernel))
+        if kernel not in SOLVES:
+            return f
+        jax = module("jax", extra="jax", what="TransmissionKernels.jax")
+        namespace: dict = {}
+        exec(compile(IMPLICIT, "<pkm implicit>", "exec"), namespace)  # (the constant source below, no input)
+        extra = [jax_function(self.function(k)) for k in ("maps", "delta")] if kernel == "fk_j_dm" else []
+        return jax.jit(namespace["implicit"](jax, jax.numpy, f, jax_function(self.tangent(kernel)), *extra))
 
     def warp(self, kernel: str, directory: str | os.PathLike[str] | None = None) -> object:
         """``kernel`` as a Warp kernel (:func:`pkm.core.twin.warpgen.warp_kernel`).
@@ -350,6 +378,44 @@ class TransmissionKernels:
         from pkm.core.twin.warpgen import warp_kernel
 
         return warp_kernel(self.function(kernel), directory)
+
+
+#: The kernels that solve the closure (Newton from a warm start): their JAX derivatives are :data:`IMPLICIT`'s.
+SOLVES = ("fk", "ik", "fk_j_dm")
+
+#: Python source of ``implicit(jax, jnp, solve, tangent, maps=None, delta=None)``: the JAX function ``solve(q, x)``
+#: (a kernel of :data:`SOLVES`, ``x`` its target) with its derivative by the implicit function theorem
+#: (:meth:`TransmissionKernels.tangent`'s ``dq``, ``dy`` at the solution) instead of through the unrolled Newton,
+#: which XLA took minutes and gigabytes to differentiate on a two-motor ankle; for ``fk_j_dm``, ``J`` and ``ΔM`` at the
+#: solution move with it (``maps``' and ``delta``'s derivative along ``dq``). The warm start's derivative is zero,
+#: ``status``' and ``residual``'s too (the derivative is the converged solution's: meaningless where ``status`` is not
+#: ``OK``). Written into the generated JAX module as it is run here.
+IMPLICIT = '''
+def implicit(jax, jnp, solve, tangent, maps=None, delta=None):
+    """solve(q, x) with its derivative by the implicit function theorem at the solution (pkm's kernels.IMPLICIT)."""
+
+    @jax.custom_jvp
+    def f(q, x):
+        return solve(q, x)
+
+    @f.defjvp
+    def f_jvp(primals, tangents):
+        out = solve(*primals)
+        dq_dx, dy_dx = tangent(out[0])
+        n = jnp.shape(primals[1])[0]  # (the targets: matrices column-major, one row per target here)
+        dq = dq_dx.reshape(n, -1).T @ tangents[1]
+        dy = dy_dx.reshape(n, n).T @ tangents[1]
+        rest = [jnp.zeros_like(o) for o in out[2:]]
+        if maps is not None:  # (fk_j_dm: J and dM at the solution)
+            rest[0] = jax.jvp(lambda z: maps(z)[0], (out[0],), (dq,))[1]
+            rest[1] = jax.jvp(lambda z: delta(z, jnp.zeros(n, out[0].dtype))[0], (out[0],), (dq,))[1]
+        return out, (dq, dy, *rest)
+
+    def checked(*args):
+        return f(*args) if len(args) == 2 else solve(*args)  # (solve refuses a wrong count, naming its inputs)
+
+    return checked
+'''
 
 
 def _independent_rows(A: np.ndarray, rtol: float = 1e-9) -> list[int]:
@@ -374,4 +440,4 @@ def c_identifier(name: str) -> str:
     return out if out and not out[0].isdigit() else f"t_{out}"
 
 
-__all__ = ["ITERATIONS", "KERNELS", "MAX_STEP", "RTOL", "STATUS", "TransmissionKernels", "c_identifier"]
+__all__ = ["IMPLICIT", "ITERATIONS", "KERNELS", "MAX_STEP", "RTOL", "SOLVES", "STATUS", "TransmissionKernels", "c_identifier"]
