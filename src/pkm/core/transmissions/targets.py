@@ -180,7 +180,8 @@ class {cls}Plugin : public transmission_interface::Transmission {{
 
 ## Python
 
-`{p}_jax.py`: `functions()["fk"](q, qm)` (jit; `jax.vmap` for a batch, `jax.grad` through it). `{p}_warp.py`: one
+`{p}_jax.py`: `functions()["fk"](q, qm)` (jit; `jax.vmap` for a batch; `jax.grad`, `jax.jacfwd` differentiate a
+solve at its solution, by the implicit function theorem: `dqo/dqm` is `J`). `{p}_warp.py`: one
 `@wp.kernel` a kernel, one thread a sample, arrays structure-of-arrays `(size, n)` float64 (on "cpu" or "cuda").
 """
 
