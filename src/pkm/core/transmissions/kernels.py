@@ -206,8 +206,8 @@ class TransmissionKernels:
     @functools.cache  # noqa: B019
     def step(self, twin: str) -> cs.Function:
         """One Newton iteration of the closure with the motors (``twin="m"``: ``fk``'s) or the outputs (``"o"``:
-        ``ik``'s) held at ``target``: ``(q, target) -> (q_next, pivot)``, the held coordinates of ``q`` set to
-        ``target`` first (:meth:`_newton`), after CSE. The targets unroll it :attr:`iterations` times (the in-process
+        ``ik``'s) held at ``target``: ``(q, qm or qo) -> (q_next, pivot)``, the held coordinates of ``q`` set to
+        the target first (:meth:`_newton`), after CSE. The targets unroll it :attr:`iterations` times (the in-process
         C, Warp: :meth:`function`) or loop over it (the exported C, JAX)."""
         at = {"m": self._twin_m, "o": self._twin_o}[twin]
         tw = at.tw
@@ -215,8 +215,8 @@ class TransmissionKernels:
         act = list(tw.mech.act_q)
         held = cs.vertcat(*[target[act.index(i)] if i in act else q[i] for i in range(tw.mech.nq)])
         values = cs.cse([cs.densify(cs.SX(e)) for e in self._newton(at)(held, target)])
-        return cs.Function(f"{c_identifier(self.name)}_newton_{twin}", [q, target], values, ["q", "target"],
-                           ["q_next", "pivot"])
+        return cs.Function(f"{c_identifier(self.name)}_newton_{twin}", [q, target], values, ["q", f"q{twin}"],
+                           ["q_next", "pivot"])  # (inputs named as the kernels': errors name them)
 
     @functools.cache  # noqa: B019
     def finish(self, kernel: str) -> cs.Function:
