@@ -22,7 +22,7 @@ import numpy as np
 
 from pkm.core.export.emit import c_constant, c_function
 from pkm.core.model.joints import stated_limits
-from pkm.core.transmissions.kernels import KERNELS, STATUS, TransmissionKernels
+from pkm.core.transmissions.kernels import KERNELS, SOLVES, STATUS, TransmissionKernels
 from pkm.core.twin.kernels import PIVOT_FLOOR
 
 
@@ -96,8 +96,27 @@ int {p}_fk_j_dm(const double* qm, double* q, double* qo, double* J, double* dM);
             f"const char* const {p}_output_names[{U}_K] = {{{', '.join(json.dumps(n) for n in tk.outputs)}}};",
             f"const double {p}_limit_low[{U}_NQ] = {{{', '.join(_bound(x) for x in low)}}};",
             f"const double {p}_limit_high[{U}_NQ] = {{{', '.join(_bound(x) for x in high)}}};", ""]
+    for twin in ("m", "o"):
+        body.append(c_function(tk.step(twin), f"{p}_k_newton_{twin}"))
     for name in KERNELS:
-        body.append(c_function(tk.function(name), f"{p}_k_{name}"))
+        if name not in SOLVES:
+            body.append(c_function(tk.function(name), f"{p}_k_{name}"))
+            continue
+        body.append(c_function(tk.finish(name), f"{p}_k_{name}_finish"))
+        outs = ", ".join(f"double* {o}" for o in KERNELS[name][1])
+        step = f"{p}_k_newton_{'o' if name == 'ik' else 'm'}"
+        body.append(f"""static void {p}_k_{name}(const double* q, const double* target, {outs}) {{
+  /* {tk.iterations} Newton iterations from q, then the solution's residual and status */
+  double a[{U}_NQ], b[{U}_NQ], pivot, least;
+  {step}(q, target, a, &least);
+  for (int i = 1; i < {tk.iterations}; ++i) {{
+    {step}(a, target, b, &pivot);
+    least = fmin(least, pivot);
+    memcpy(a, b, sizeof a);
+  }}
+  {p}_k_{name}_finish(a, &least, {', '.join(KERNELS[name][1])});
+}}
+""")
     body.append(f"""static int {p}_finite(const double* x, int n) {{
   for (int i = 0; i < n; ++i) if (!isfinite(x[i])) return 0;
   return 1;
