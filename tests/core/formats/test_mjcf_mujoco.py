@@ -283,7 +283,7 @@ def test_joint_springs_are_read_as_mujoco_compiles_them(angle, ref):
 
 
 #: A four-bar closed by a connect between two sites, each named as a body (and a joint) of the file: MJCF allows it.
-SHARED_SITES = """<mujoco model="shared">
+SHARED_SITES = """<mujoco model="shared_names">
   <worldbody>
     <body name="crank"><joint name="crank" axis="0 1 0"/><geom type="capsule" fromto="0 0 0 0 0 0.1" size="0.01"/>
       <body name="coupler" pos="0 0 0.1"><joint name="coupler" axis="0 1 0"/>
