@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 import pkm
 
 from .conftest import ARC, PITCH
@@ -32,3 +34,18 @@ def test_a_plan_across_position_limits_does_not_hold(ankle):
     assert not check.holds and set(check.outside_limits) == {"ankle_pitch", "motor_left", "motor_right"}
     assert check.reason.startswith("position limits crossed: ankle_pitch = 0.685714 at s = 0.857143, outside its "
                                    "limits [-0.6, 0.6]")  # (the first check point outside: s = 6/7, pitch 0.8 s)
+
+
+def test_labels_equal_the_plans_with_viscous_friction(ankle, delta):
+    """The ankle (viscous friction at its motors) on a short path within its limits: the rows the planner solved
+    are active on every segment, recomputed from verify's own efforts to 1e-9; the true limits are used under 1 on
+    some (the friction that helps braking is not counted by the planner), which the old definition called inactive.
+    The Delta with a motor line: the one switch, the same in both."""
+    plan = pkm.time_optimal(ankle, [[0.0, 0.0], [0.2, 0.05], [0.4, 0.1]], points=12)
+    check = pkm.verify_time_optimal(plan, factor=1, simulate=False)
+    assert check.holds and check.inactive == plan.inactive == ()
+    np.testing.assert_allclose(check.planned_usage, plan.planned_usage, rtol=0, atol=1e-9)
+    assert plan.usage.min() < 1.0 - 1e-3 and np.all(plan.usage <= plan.planned_usage + 1e-9)
+    line = pkm.time_optimal(delta, ARC[1:3], points=16, limits={"omega0": 8.0, "speed": 20.0})
+    check = pkm.verify_time_optimal(line, factor=1, simulate=False)
+    assert len(line.inactive) == 1 and check.inactive == line.inactive

@@ -11,8 +11,16 @@ r"""A time law checked, not just planned (:func:`verify`).
    are at most ``1 + 1e-6`` (:attr:`Verification.holds`); planned at ``1 - margin`` (:data:`~pkm.core.timing.limits.
    MARGIN`), they stay under 1 by the margin less what the grid misses between its points.
 2. **Pontryagin's structure**: on a time-optimal law some limit is active at every instant but the switching
-   points. :attr:`Verification.inactive` lists the planning segments where no limit is used to within
-   :data:`~pkm.core.timing.solve.ACTIVE_RTOL` (against the margin-reduced limits).
+   points. "Active" is the planner's definition (:func:`~pkm.core.timing.solve.planned_usage`): a row of the problem
+   it solved at its bound to within :data:`~pkm.core.timing.solve.ACTIVE_RTOL`, at a segment's end, with the
+   speed-dependent terms (a motor line, viscous friction) linearised where it linearised them and each row
+   tightened as it was. The efforts, joint rates and accelerations at the segments' ends are this check's own
+   (step 1); the linearisation point, the tightening factors and the viscous coefficient :math:`d` (to take the
+   term :math:`d \dot s` out of the recomputed efforts) are the plan's. :attr:`Verification.inactive` lists the
+   segments where no row is active: it equals :attr:`TimeOptimal.inactive <pkm.core.timing.solve.TimeOptimal>`
+   where the two routes agree (tested). Against the true limits, an active segment with viscous friction or a
+   motor line may use less than 1 (the tangent is an upper bound; a friction that helps is not counted):
+   :attr:`Verification.effort_usage` is the true use.
 3. **Position limits**: every joint the model states position limits for (actuated, task, passive) stays within
    them at every check point (:meth:`pkm.core.Mechanism.limit_violations`); the first one outside is named in
    :attr:`Verification.reason` and the plan does not hold.
@@ -30,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pkm.core.kinematics.task import TaskMap
-from pkm.core.timing.solve import ACTIVE_RTOL, TimeOptimal
+from pkm.core.timing.solve import ACTIVE_RTOL, TimeOptimal, planned_usage
 from pkm.errors import InvalidInputError
 from pkm.validation import as_count
 
@@ -51,7 +59,9 @@ class Verification:
         speed_usage, acceleration_usage: likewise for the speed and acceleration limits (0 where none).
         holds: Every usage is at most ``1 + HOLD_RTOL``, every joint within its position limits, and the motors'
             motion continuous.
-        inactive: Planning segments where no limit is active (switching points of the law).
+        inactive: Planning segments where no limit is active (switching points of the law; module doc).
+        planned_usage: Per segment, the largest use of the planner's rows recomputed from these efforts (1:
+            active).
         tracking_error: The largest actuated error of the simulated tracking (na,) [rad, m]; None if not run.
         task_error: The largest task-space distance of the simulated end effector from the plan's [m] (position
             coordinates); None if not run.
@@ -77,6 +87,7 @@ class Verification:
     event: str | None
     outside_limits: tuple[str, ...] = ()
     reason: str | None = None
+    planned_usage: np.ndarray | None = None
 
 
 def _points(plan: TimeOptimal, factor: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -140,12 +151,16 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
             f"{v.joint} = {v.value:.6g} at s = {s[k]:.6g}, outside its limits [{v.limit[0]:.6g}, {v.limit[1]:.6g}]"
             for k, v in traj.outside_limits))
     holds = not reasons
-    inactive = tuple(int(i) for i in np.flatnonzero(plan.usage < 1.0 - ACTIVE_RTOL))
+    ends = np.stack([np.arange(len(plan.sdd)) * (factor + 1), np.arange(len(plan.sdd)) * (factor + 1) + factor])
+    static = tau[ends] - np.stack([plan.coefficients.d[:-1], plan.coefficients.d[1:]]) * sd[ends][..., None]
+    planned, _ = planned_usage(plan.coefficients, L, plan.sd, plan.sdd, plan.tightened, plan.linearised_at,
+                               static, omega[ends], traj.actuated_acceleration[ends])
+    inactive = tuple(int(i) for i in np.flatnonzero(planned < 1.0 - ACTIVE_RTOL))
     track, task_err, dur, event = None, None, 0.0, None
     if simulate:
         track, task_err, dur, event = _track(plan, t, traj, tau, dt)
     return Verification(s, t, tau, effort, speed, acc, holds, inactive, track, task_err, dur, event,
-                        tuple(v.joint for _, v in traj.outside_limits), "; ".join(reasons) or None)
+                        tuple(v.joint for _, v in traj.outside_limits), "; ".join(reasons) or None, planned)
 
 
 def _track(plan: TimeOptimal, t: np.ndarray, traj: object, tau: np.ndarray,
