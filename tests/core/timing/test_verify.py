@@ -45,6 +45,10 @@ def test_labels_equal_the_plans_with_viscous_friction(ankle, delta):
     check = pkm.verify_time_optimal(plan, factor=1, simulate=False)
     assert check.holds and check.inactive == plan.inactive == ()
     np.testing.assert_allclose(check.planned_usage, plan.planned_usage, rtol=0, atol=1e-9)
+    C, idx = plan.coefficients, np.column_stack([np.arange(11), np.arange(1, 12)]).ravel()  # (the segments' ends)
+    sd, u = plan.sd[idx, None], np.repeat(plan.sdd, 2)[:, None]
+    planned = C.a[idx] * u + C.b[idx] * sd ** 2 + C.c[idx] + C.d[idx] * sd  # (the friction the model's, by G)
+    np.testing.assert_allclose(check.efforts, planned, rtol=0, atol=1e-9 * np.abs(planned).max())
     assert plan.usage.min() < 1.0 - 1e-3 and np.all(plan.usage <= plan.planned_usage + 1e-9)
     line = pkm.time_optimal(delta, ARC[1:3], points=16, limits={"omega0": 8.0, "speed": 20.0})
     check = pkm.verify_time_optimal(line, factor=1, simulate=False)

@@ -120,8 +120,9 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
         >>> check.holds, round(check.speed_usage, 3), check.inactive
         (True, 0.999, ())
     """
-    from pkm.core.dynamics.model import actuator_model
+    from pkm.core.differential.velocity import passive_map
     from pkm.core.kinematics.trajectory import follow_actuators, follow_task
+    from pkm.core.timing.coefficients import _friction
 
     if not isinstance(plan, TimeOptimal):
         raise InvalidInputError("plan", "expected a TimeOptimal (pkm.time_optimal)", plan)
@@ -134,11 +135,19 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
                   efforts=True, tol=1e-12)
     assert traj.efforts is not None
     tau = traj.efforts.copy()
-    if np.any(np.asarray(mech.model.damping) != 0.0) or np.any(np.asarray(mech.model.friction) != 0.0):
-        for k in range(len(s)):  # (the model's friction, Coulomb's sign exact as planned)
-            model = actuator_model(mech, traj.q[k], traj.actuated_velocity[k], coulomb_velocity=1e-12)
-            tau[k] -= model.friction
     omega = traj.actuated_velocity
+    rubbing = np.flatnonzero((np.asarray(mech.model.damping) != 0.0) | (np.asarray(mech.model.friction) != 0.0))
+    if rubbing.size:  # (the joints' friction through the passive map at each point, Coulomb's sign exact: the
+        # planner's law; the passive map's rows of the actuated joints are the identity: friction at the motors
+        # alone needs no more)
+        act = np.asarray(mech.act_v)
+        if np.isin(rubbing, act).all():
+            G = np.zeros((len(s), mech.nv, mech.na))
+            G[:, act, np.arange(mech.na)] = 1.0
+        else:
+            G = np.stack([passive_map(mech, qk) for qk in traj.q])
+        coulomb, viscous = _friction(mech, G, omega)
+        tau += coulomb + viscous
     effort = float(np.max(np.abs(tau) / L.effort_limit(omega)))
     speed = float(np.max(np.abs(omega) / L.speed[None]))
     acc = float(np.max(np.abs(traj.actuated_acceleration) / L.acceleration[None]))
