@@ -5,11 +5,13 @@ r"""A time law checked, not just planned (:func:`verify`).
    :math:`\ddot s` and :math:`\dot s^2 = \dot s_i^2 + 2 u_i (s - s_i)`; at each, the inverse kinematics of the path
    point, the joint rates and accelerations (:func:`pkm.follow_task` or :func:`pkm.follow_actuators`) and the
    efforts by :func:`pkm.inverse_dynamics` (Khalil's projection or virtual work: not the actuator-space model the
-   plan was built on) on the mechanism with its payload, plus the joints' friction (Coulomb's sign exact, as
-   planned). Each effort is compared with its actuator's curve at that speed, each speed and acceleration with
-   its limit: :attr:`Verification.effort_usage` etc., 1 at the true limit. The plan holds the limits where these
-   are at most ``1 + 1e-6`` (:attr:`Verification.holds`); planned at ``1 - margin`` (:data:`~pkm.core.timing.limits.
-   MARGIN`), they stay under 1 by the margin less what the grid misses between its points.
+   plan was built on) on the mechanism with its payload, plus the joints' friction (the planner's law,
+   :func:`pkm.core.timing.coefficients._friction`: Coulomb's sign exact, through the passive map at the point, which
+   is the identity on the actuated joints' rows where only they rub). Each effort is compared with its actuator's
+   curve at that speed, each speed and acceleration with its limit: :attr:`Verification.effort_usage` etc., 1 at
+   the true limit. The plan holds the limits where these are at most ``1 + 1e-6`` (:attr:`Verification.holds`);
+   planned at ``1 - margin`` (:data:`~pkm.core.timing.limits.MARGIN`), they stay under 1 by the margin less what
+   the grid misses between its points.
 2. **Pontryagin's structure**: on a time-optimal law some limit is active at every instant but the switching
    points. "Active" is the planner's definition (:func:`~pkm.core.timing.solve.planned_usage`): a row of the problem
    it solved at its bound to within :data:`~pkm.core.timing.solve.ACTIVE_RTOL`, at a segment's end, with the
@@ -29,6 +31,12 @@ r"""A time law checked, not just planned (:func:`verify`).
    \dot q_a)`, gains from the mass matrix at the start, :math:`K_p = \omega_n^2 \operatorname{diag} M_a`,
    :math:`K_d = 2 \zeta \omega_n \operatorname{diag} M_a` (:math:`\omega_n = 2\pi \cdot 20` rad/s,
    :math:`\zeta = 1`); the largest actuated and task-space tracking errors are reported.
+
+**Independent and shared**: the check's own are the inverse kinematics at every check point (not the plan's
+configurations), the joint rates and accelerations, the efforts (another dynamics route than the planner's
+actuator-space model) and the simulation; shared with the planner are the path, the law ``(s, sd, sdd)`` under
+test, the limits and their margin, the friction law, and for step 2 the linearisation point
+(:attr:`~pkm.core.timing.solve.TimeOptimal.linearised_at`), the tightening factors and the viscous coefficient.
 """
 
 from __future__ import annotations
@@ -106,8 +114,9 @@ def _points(plan: TimeOptimal, factor: int) -> tuple[np.ndarray, np.ndarray, np.
 
 def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: float | None = None) -> Verification:
     """Check ``plan`` (module doc): the efforts by :func:`pkm.inverse_dynamics` at ``factor`` times the planning
-    resolution against the limits, Pontryagin's structure, and a tracking simulation (``simulate``; step ``dt``,
-    default the cycle time / 2000).
+    resolution against the limits, Pontryagin's structure (the active limits by the planner's definition, from
+    these efforts), and a tracking simulation (``simulate``; step ``dt``, default the cycle time / 2000). What is
+    recomputed independently and what is the planner's: the module doc.
 
     Raises:
         InvalidInputError: ``plan`` is not a :class:`~pkm.core.timing.solve.TimeOptimal`.
