@@ -50,6 +50,8 @@ def test_labels_equal_the_plans_with_viscous_friction(ankle, delta):
     planned = C.a[idx] * u + C.b[idx] * sd ** 2 + C.c[idx] + C.d[idx] * sd  # (the friction the model's, by G)
     np.testing.assert_allclose(check.efforts, planned, rtol=0, atol=1e-9 * np.abs(planned).max())
     assert plan.usage.min() < 1.0 - 1e-3 and np.all(plan.usage <= plan.planned_usage + 1e-9)
+    tracked = pkm.verify_time_optimal(plan, factor=1, dt=plan.cycle_time / 40)  # (pitch and roll: no position)
+    assert tracked.task_error is None and tracked.tracking_error.shape == (2,)
     line = pkm.time_optimal(delta, ARC[1:3], points=16, limits={"omega0": 8.0, "speed": 20.0})
     check = pkm.verify_time_optimal(line, factor=1, simulate=False)
     assert len(line.inactive) == 1 and check.inactive == line.inactive

@@ -72,7 +72,8 @@ class Verification:
             active).
         tracking_error: The largest actuated error of the simulated tracking (na,) [rad, m]; None if not run.
         task_error: The largest task-space distance of the simulated end effector from the plan's [m] (position
-            coordinates); None if not run.
+            coordinates); None if not run or where the task has no position coordinates (an ankle's pitch and
+            roll: ``tracking_error`` has the motors').
         simulated_duration: How long the simulation ran [s] (the cycle time, or less where it stopped: see
             ``event``).
         event: Why the simulation stopped early, or None.
@@ -182,7 +183,7 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
 
 
 def _track(plan: TimeOptimal, t: np.ndarray, traj: object, tau: np.ndarray,
-           dt: float | None) -> tuple[np.ndarray, float, float, str | None]:
+           dt: float | None) -> tuple[np.ndarray, float | None, float, str | None]:
     from pkm.core.dynamics.model import actuator_model
     from pkm.core.dynamics.simulate import simulate
 
@@ -211,7 +212,7 @@ def _track(plan: TimeOptimal, t: np.ndarray, traj: object, tau: np.ndarray,
     task = TaskMap.of(mech)
     pos = [i for i, k in enumerate(task.value_names) if task.kinds.get(k) == "length"]
     yref = np.array([at(traj.task[order][:, pos], time) for time in sim.time])  # type: ignore[attr-defined]
-    task_err = float(np.max(np.linalg.norm(sim.task[:, pos] - yref, axis=1))) if pos else 0.0
+    task_err = float(np.max(np.linalg.norm(sim.task[:, pos] - yref, axis=1))) if pos else None  # (no lengths)
     return track, task_err, float(sim.time[-1]), None if sim.event is None else str(sim.event)
 
 
