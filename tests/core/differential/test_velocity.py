@@ -8,6 +8,7 @@ analytically (distal links collinear: direct; a leg stretched: inverse).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -293,3 +294,23 @@ def test_a_configuration_is_accepted_wherever_q_is_and_computed_once(monkeypatch
     np.testing.assert_array_equal(pkm.velocities(delta, c, [0.1, 0.2, 0.3]), pkm.velocities(delta, q, [0.1, 0.2, 0.3]))
     with pytest.raises(InvalidInputError, match="Configuration of 'delta'"):
         pkm.forward_jacobian(pkm.load("rrr3"), c)
+
+
+def test_the_split_is_kept_for_the_same_jacobians_and_given_out_as_copies():
+    """The split a path step asks for four times is made once per configuration: the same object for the same
+    Jacobians, bit for bit the one made afresh, another where they change; an idle basis written to by a caller does
+    not change the next answer (the humanoid ankle: its rods' spins are idle)."""
+    from pkm.core.differential import velocity
+
+    ankle = pkm.load(Path(__file__).resolve().parents[3] / "examples" / "humanoid_ankle" / "ankle.closures.toml")
+    q = _near_reference(ankle, 3)
+    c = Configuration.at(ankle, q)
+    kept = velocity._split(ankle, c, 1e-9)
+    assert velocity._split(ankle, Configuration.at(ankle, q), 1e-9) is kept
+    fresh = velocity._Split.of(ankle, c.constraint_jacobian, c.task_jacobian, 1e-9)
+    assert np.array_equal(kept.idle, fresh.idle) and np.array_equal(kept.Vat, fresh.Vat)
+    assert velocity._split(ankle, Configuration.at(ankle, _near_reference(ankle, 4)), 1e-9) is not kept
+    N = pkm.idle_motions(ankle, q)
+    assert N.shape[1] == 2
+    N[:] = 0.0
+    assert np.array_equal(pkm.idle_motions(ankle, q), fresh.idle)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 import pkm
 
 from .conftest import ARC, PITCH
@@ -32,3 +34,24 @@ def test_a_plan_across_position_limits_does_not_hold(ankle):
     assert not check.holds and set(check.outside_limits) == {"ankle_pitch", "motor_left", "motor_right"}
     assert check.reason.startswith("position limits crossed: ankle_pitch = 0.685714 at s = 0.857143, outside its "
                                    "limits [-0.6, 0.6]")  # (the first check point outside: s = 6/7, pitch 0.8 s)
+
+
+def test_labels_equal_the_plans_with_viscous_friction(ankle, delta):
+    """The ankle (viscous friction at its motors) on a short path within its limits: the rows the planner solved
+    are active on every segment, recomputed from verify's own efforts to 1e-9; the true limits are used under 1 on
+    some (the friction that helps braking is not counted by the planner), which the old definition called inactive.
+    The Delta with a motor line: the one switch, the same in both."""
+    plan = pkm.time_optimal(ankle, [[0.0, 0.0], [0.2, 0.05], [0.4, 0.1]], points=12)
+    check = pkm.verify_time_optimal(plan, factor=1, simulate=False)
+    assert check.holds and check.inactive == plan.inactive == ()
+    np.testing.assert_allclose(check.planned_usage, plan.planned_usage, rtol=0, atol=1e-9)
+    C, idx = plan.coefficients, np.column_stack([np.arange(11), np.arange(1, 12)]).ravel()  # (the segments' ends)
+    sd, u = plan.sd[idx, None], np.repeat(plan.sdd, 2)[:, None]
+    planned = C.a[idx] * u + C.b[idx] * sd ** 2 + C.c[idx] + C.d[idx] * sd  # (the friction the model's, by G)
+    np.testing.assert_allclose(check.efforts, planned, rtol=0, atol=1e-9 * np.abs(planned).max())
+    assert plan.usage.min() < 1.0 - 1e-3 and np.all(plan.usage <= plan.planned_usage + 1e-9)
+    tracked = pkm.verify_time_optimal(plan, factor=1, dt=plan.cycle_time / 40)  # (pitch and roll: no position)
+    assert tracked.task_error is None and tracked.tracking_error.shape == (2,)
+    line = pkm.time_optimal(delta, ARC[1:3], points=16, limits={"omega0": 8.0, "speed": 20.0})
+    check = pkm.verify_time_optimal(line, factor=1, simulate=False)
+    assert len(line.inactive) == 1 and check.inactive == line.inactive

@@ -171,14 +171,17 @@ def run(args: argparse.Namespace) -> int:
                                                      f"{plan.payload:g} kg, cycle {plan.cycle_time:.6g} s"))
     if args.plot:
         written["plot"] = str(plot(plan, args.plot))
-    counts = {k: plan.active.count(k) for k in sorted(set(plan.active))}
+    switches = set(plan.inactive)  # (no limit active: the law's switches, TimeOptimal.inactive)
+    held = [k for i, k in enumerate(plan.active) if i not in switches]
+    counts = {k: held.count(k) for k in sorted(set(held))}
     out = {"mechanism": mech.name, "cycle_time_s": plan.cycle_time, "payload_kg": plan.payload,
-           "points": len(plan.s), "active_segments": counts, "written": written}
+           "points": len(plan.s), "active_segments": counts, "switch_segments": len(switches), "written": written}
     if args.json:
         print(json.dumps(out, indent=2))
     else:
         print(f"cycle time: {plan.cycle_time:.6g} s ({mech.name}, payload {plan.payload:g} kg, {len(plan.s)} points)")
-        print("active limits (segments): " + ", ".join(f"{k}: {v}" for k, v in counts.items()))
+        print("active limits (segments): " + ", ".join(f"{k}: {v}" for k, v in counts.items())
+              + f"; switches (none active): {len(switches)}")
         for k, v in written.items():
             print(f"{k}: {v}")
     return 0

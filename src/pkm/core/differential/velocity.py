@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pkm._derived import derived
 from pkm.core.differential.idle import joint_inertia, without_idle
 from pkm.core.differential.indices import singularity_class
 from pkm.core.kinematics import constraints
@@ -192,8 +193,23 @@ class _Split:
         return self.columns.reshape((len(self.columns),) + extra) * (self.C @ (self.Vat[:n][keep].T @ y))
 
 
+def _last_splits(mech: Mechanism) -> dict[tuple[float, bytes, bytes], _Split]:
+    return {}
+
+
 def _split(mech: Mechanism, c: Configuration, rtol: float) -> _Split:
-    return _Split.of(mech, c.constraint_jacobian, c.task_jacobian, rtol)
+    """:meth:`_Split.of` at ``c``, the last one kept with the mechanism (:func:`pkm._derived.derived`: made again
+    where the mechanism changes) and given again for the same Jacobians, bit for bit, and ``rtol``: a path step asks
+    for it four times (its rates, accelerations and efforts, the next step's prediction)."""
+    Jc, Jt = c.constraint_jacobian, c.task_jacobian
+    key = (rtol, Jc.tobytes(), Jt.tobytes())
+    last = derived(mech, _last_splits)
+    found = last.get(key)
+    if found is None:
+        found = _Split.of(mech, Jc, Jt, rtol)
+        last.clear()
+        last[key] = found
+    return found
 
 
 def _direct_check(sp: _Split, rtol: float) -> None:
@@ -243,7 +259,7 @@ def idle_motions(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float =
         True
     """
     mech, c = _at(mech, q)
-    return _split(mech, c, as_tolerance(rtol, "rtol")).idle
+    return _split(mech, c, as_tolerance(rtol, "rtol")).idle.copy()  # (the split is kept: its arrays are not given)
 
 
 def passive_map(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = RTOL) -> np.ndarray:
@@ -663,4 +679,4 @@ def diagnose(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 1e-
     return Diagnostics(rank, mech.n_constraints - rank, mech.nv - rank, sp.sigma_direct, sp.sigma_inverse,
                        singularity_class(inverse, direct), sp.idle.shape[1], idle_joints, dd, di,
                        tuple(k for k, d in (("direct", dd), ("inverse", di)) if rtol < d < near),
-                       sp.direct_direction, sp.inverse_direction, fit.dependent, fit.unactuated, near)
+                       sp.direct_direction.copy(), sp.inverse_direction.copy(), fit.dependent, fit.unactuated, near)

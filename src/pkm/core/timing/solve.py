@@ -83,15 +83,22 @@ class TimeOptimal:
         qa, qa_rate, qa_acceleration: The actuated coordinates and their rates (n x na); the acceleration at a grid
             point is the one of the segment it starts (the last point: the last segment's).
         efforts: The efforts at each grid point (n x na) [N m, N], with the same acceleration.
-        active: At each segment, the limit most used (``"effort motor_1"``, ``"speed motor_2"``,
-            ``"acceleration motor_3"``).
-        usage: At each segment, how much of that limit is used (1: at the margin-reduced limit).
+        active: At each segment, the limit whose row, as solved, is most used (``"effort motor_1"``, ``"speed
+            motor_2"``, ``"acceleration motor_3"``; :attr:`planned_usage`).
+        usage: At each segment, the largest use of any true limit at its ends (1: at the margin-reduced limit; the
+            torque-speed curve and viscous friction exact), or inside it where a limit was held there.
         passes: toppra solves made (more than one where a limit depends on the speed, or where the limits were
             tightened between the grid points).
         tightened: The factors (>= 1, n x 3) the limits were tightened by so that they hold between the grid points
             too (:func:`solve`): per segment (row ``i``: segment ``i``) for the effort and acceleration columns 0
             and 2, per grid point for the speed column 1.
         jerk_limited: False: jerk is not limited (module doc).
+        planned_usage: At each segment, the largest use of the rows the planner solved (:func:`planned_usage`: the
+            speed-dependent terms linearised as solved, each row tightened as solved): 1 where a limit is
+            **active**; :attr:`inactive` lists where none is. With viscous friction or a motor line the true use
+            (:attr:`usage`) of an active row is at most this (the tangent is an upper bound, a term that helps is
+            dropped): active segments whose true use is under 1.
+        linearised_at: The :math:`\\dot s^2` the speed-dependent rows were linearised at (n,; None: none).
     """
 
     mech: Mechanism
@@ -113,6 +120,15 @@ class TimeOptimal:
     passes: int
     tightened: np.ndarray | None = None
     jerk_limited: bool = False
+    planned_usage: np.ndarray | None = None
+    linearised_at: np.ndarray | None = None
+
+    @property
+    def inactive(self) -> tuple[int, ...]:
+        """The segments where no row the planner solved is active (:attr:`planned_usage` under ``1 -
+        ACTIVE_RTOL``): the switches of a bang-bang law."""
+        use = self.usage if self.planned_usage is None else self.planned_usage
+        return tuple(int(i) for i in np.flatnonzero(use < 1.0 - ACTIVE_RTOL))
 
     def state_at(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         r"""``(t, sd, sdd)`` of the law at path parameters ``s`` (m,) in [0, 1]: on segment ``i``,
@@ -131,23 +147,11 @@ def _rows(C: PathCoefficients, L: Limits, x0: np.ndarray | None) -> tuple[np.nda
     linearised at ``x0`` (None: where no term depends on the speed), and each row's kind (m,: 0 effort, 2
     acceleration)."""
     n, na = C.a.shape
-    alpha, beta = L.lines[..., 0], L.lines[..., 1]  # (na x k)
+    alpha = L.lines[..., 0]  # (na x k)
     scale = 1.0 - L.margin
     Au, Ax, c0, g = [], [], [], []
     for sigma in (1.0, -1.0):
-        e = sigma * C.d[:, :, None] + scale * beta[None] * np.abs(C.dqa)[:, :, None]  # (n x na x k)
-        if x0 is None:  # (no speed-dependent term: e == 0)
-            lin_x, lin_c = np.zeros_like(e), np.zeros_like(e)
-        else:
-            # (the tangent's point: the last law's x, but no further than where the row's constant e sqrt(x0) / 2
-            # would take 3/4 of its slack at rest; any x0 > 0 gives an upper bound)
-            ep = np.where(e > 0.0, e, 0.0)
-            slack = np.maximum(scale * np.where(np.isfinite(alpha), alpha, 0.0)[None] - sigma * C.c[:, :, None],
-                               1e-12)
-            with np.errstate(divide="ignore"):
-                cap = np.where(ep > 0.0, (1.5 * slack / ep) ** 2, np.inf)
-            r0 = np.sqrt(np.maximum(np.minimum(x0[:, None, None], cap), 1e-9 * max(float(x0.max()), 1e-12)))
-            lin_x, lin_c = ep / (2.0 * r0), ep * r0 / 2.0
+        lin_x, lin_c = _tangent(C, L, x0, sigma)
         finite = np.isfinite(alpha)[None] & np.ones((n, 1, 1), dtype=bool)
         Au.append(np.where(finite, sigma * C.a[:, :, None], 0.0))
         Ax.append(np.where(finite, sigma * C.b[:, :, None] + lin_x, 0.0))
@@ -163,6 +167,67 @@ def _rows(C: PathCoefficients, L: Limits, x0: np.ndarray | None) -> tuple[np.nda
     flat = [np.concatenate([x.reshape(n, -1) for x in part], axis=1) for part in (Au, Ax, c0, g)]
     kinds = np.concatenate([np.zeros(Au[0].size // n + Au[1].size // n), np.full(2 * na, 2)]).astype(int)
     return (*flat, kinds)
+
+
+def _tangent(C: PathCoefficients, L: Limits, x0: np.ndarray | None, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    r"""The effort rows' speed-dependent term :math:`e \sqrt{x}` (:math:`e = \sigma d + \beta |q_a'|`, sign
+    ``sigma``) as the planner solves it, ``(lin_x, lin_c)`` (n x na x k): :math:`e \sqrt{x} \le` ``lin_x x +
+    lin_c``, the tangent at ``x0`` where :math:`e > 0`, nothing where :math:`e \le 0` (module doc); zeros for
+    ``x0`` None (no speed-dependent term)."""
+    alpha, beta = L.lines[..., 0], L.lines[..., 1]  # (na x k)
+    scale = 1.0 - L.margin
+    e = sigma * C.d[:, :, None] + scale * beta[None] * np.abs(C.dqa)[:, :, None]  # (n x na x k)
+    if x0 is None:  # (no speed-dependent term: e == 0)
+        return np.zeros_like(e), np.zeros_like(e)
+    # (the tangent's point: the last law's x, but no further than where the row's constant e sqrt(x0) / 2 would
+    # take 3/4 of its slack at rest; any x0 > 0 gives an upper bound)
+    ep = np.where(e > 0.0, e, 0.0)
+    slack = np.maximum(scale * np.where(np.isfinite(alpha), alpha, 0.0)[None] - sigma * C.c[:, :, None], 1e-12)
+    with np.errstate(divide="ignore"):
+        cap = np.where(ep > 0.0, (1.5 * slack / ep) ** 2, np.inf)
+    r0 = np.sqrt(np.maximum(np.minimum(x0[:, None, None], cap), 1e-9 * max(float(x0.max()), 1e-12)))
+    return ep / (2.0 * r0), ep * r0 / 2.0
+
+
+def planned_usage(C: PathCoefficients, L: Limits, sd: np.ndarray, sdd: np.ndarray, tight: np.ndarray | None,
+                  x0: np.ndarray | None, static: np.ndarray | None = None, rate: np.ndarray | None = None,
+                  acceleration: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    r"""Per segment, the largest use of the rows the planner solved (its definition of **active**), at the
+    segment's two ends with its ``sdd``, and which (an index, as :func:`usage`): each effort row
+    :math:`(\sigma (a u + b x + c) + \text{lin}_x x + \text{lin}_c) / ((1 - m) \alpha_k)` with the speed-dependent
+    term as linearised at ``x0`` (:func:`_tangent`: a motor line's and the viscous friction's tangent, the term
+    dropped where it helps), the speed and acceleration rows against ``(1 - m)`` of their limits, each times its
+    tightening factor ``tight``. 1: the row is at its bound (active); a segment where every row is under
+    ``1 - ACTIVE_RTOL`` is a switch.
+
+    ``static``, ``rate``, ``acceleration`` (2 x n - 1 x na: at the segments' starts and ends) replace the
+    efforts :math:`a u + b x + c` (without the viscous term :math:`d \dot s`), the joint rates and accelerations
+    the coefficients give (:func:`pkm.verify_time_optimal` passes its own, recomputed)."""
+    na = C.a.shape[1]
+    scale = 1.0 - L.margin
+    tight = np.ones((len(C.s), 3)) if tight is None else tight
+    alpha = L.lines[..., 0]  # (na x k)
+    finite = np.isfinite(alpha)
+    lins = {sigma: _tangent(C, L, x0, sigma) for sigma in (1.0, -1.0)}
+    out = []
+    for j in (0, 1):
+        idx = slice(0, -1) if j == 0 else slice(1, None)
+        x = sd[idx] ** 2
+        tau = C.a[idx] * sdd[:, None] + C.b[idx] * x[:, None] + C.c[idx] if static is None else static[j]
+        omega = C.dqa[idx] * sd[idx, None] if rate is None else rate[j]
+        acc = C.dqa[idx] * sdd[:, None] + C.ddqa[idx] * x[:, None] if acceleration is None else acceleration[j]
+        eff = np.zeros_like(tau)
+        for sigma, (lin_x, lin_c) in lins.items():
+            row = sigma * tau[..., None] + lin_x[idx] * x[:, None, None] + lin_c[idx]  # (n - 1 x na x k)
+            use = np.where(finite[None], row / (scale * np.where(finite, alpha, 1.0))[None], -np.inf)
+            eff = np.maximum(eff, use.max(axis=-1))
+        out.append(np.concatenate([eff * tight[:-1, 0, None], np.abs(omega) / (scale * L.speed[None]) *
+                                   tight[idx, 1, None], np.abs(acc) / (scale * L.acceleration[None]) *
+                                   tight[:-1, 2, None]], axis=1))
+    both = np.maximum(out[0], out[1])
+    k = np.argmax(both, axis=1)
+    assert both.shape[1] == 3 * na
+    return both[np.arange(len(k)), k], k
 
 
 def _x_bound(C: PathCoefficients, L: Limits, tight: np.ndarray) -> np.ndarray:
@@ -292,19 +357,21 @@ def usage(C: PathCoefficients, L: Limits, sd: np.ndarray, sdd: np.ndarray,
     return both[np.arange(len(k)), k], k
 
 
-def _law(C: PathCoefficients, L: Limits, tight: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
-    """``(sd, sdd, toppra solves)``: one solve, or the passes of the linearised speed-dependent limits."""
+def _law(C: PathCoefficients, L: Limits, tight: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, np.ndarray | None]:
+    """``(sd, sdd, toppra solves, x0)``: one solve, or the passes of the linearised speed-dependent limits (``x0``:
+    where the law kept was linearised; None for one solve)."""
     if not (L.speed_dependent or bool(np.any(C.d != 0.0))):
         sd, sdd = _toppra(C, L, None, tight)
-        return sd, sdd, 1
+        return sd, sdd, 1, None
     const = Limits(np.stack([L.lines[..., 0], np.zeros_like(L.lines[..., 1])], -1), L.speed, L.acceleration,
                    L.margin, L.names)  # (the constant-peak law: the first linearisation point)
     sd, sdd = _toppra(dataclasses.replace(C, d=np.zeros_like(C.d)), const, None, tight)
-    best: tuple[np.ndarray, np.ndarray] | None = None
+    best: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     T, passes = math.inf, 1
     for _ in range(MAX_PASSES):
+        x0 = sd ** 2
         try:
-            sd, sdd = _toppra(C, L, sd ** 2, tight)
+            sd, sdd = _toppra(C, L, x0, tight)
         except PkmError:
             if best is None:
                 raise
@@ -314,11 +381,11 @@ def _law(C: PathCoefficients, L: Limits, tight: np.ndarray) -> tuple[np.ndarray,
         if best is not None and T_new >= T:
             break
         converged = abs(T - T_new) <= PASS_RTOL * T_new
-        best, T = (sd, sdd), T_new
+        best, T = (sd, sdd, x0), T_new
         if converged:
             break
     assert best is not None
-    return best[0], best[1], passes
+    return best[0], best[1], passes, best[2]
 
 
 #: Where :func:`solve` checks the limits inside each segment (fractions of it): dense near the ends, where
@@ -366,7 +433,7 @@ def solve(mech: Mechanism, path: GeometricPath, C: PathCoefficients, L: Limits, 
     tight = np.ones((len(C.s), 3))
     passes, over = 0, None
     for _ in range(MAX_REFINE + 1):
-        sd, sdd, p = _law(C, L, tight)
+        sd, sdd, p, x0 = _law(C, L, tight)
         passes += p
         if between is None:
             break
@@ -391,14 +458,15 @@ def solve(mech: Mechanism, path: GeometricPath, C: PathCoefficients, L: Limits, 
     qa_rate = C.dqa * sd[:, None]
     qa_acc = C.dqa * u_pt[:, None] + C.ddqa * (sd ** 2)[:, None]
     efforts = C.efforts(u_pt, sd)
-    use, which = usage(C, L, sd, sdd, tight)
+    use, _ = usage(C, L, sd, sdd, tight)
     if over is not None:  # (a limit held inside a segment is the one active there)
         use = np.maximum(use, np.max(over, axis=1))
     na = mech.na
     kinds = ("effort", "speed", "acceleration")
+    planned, which = planned_usage(C, L, sd, sdd, tight, x0)
     active = tuple(f"{kinds[k // na]} {L.names[k % na]}" for k in which)
     return TimeOptimal(mech, path, L, C, payload, C.s, sd, sdd, t, float(t[-1]), C.qa, qa_rate, qa_acc, efforts,
-                       active, use, passes, tight)
+                       active, use, passes, tight, planned_usage=planned, linearised_at=x0)
 
 
 _KERNELS: dict[int, object] = {}
@@ -482,4 +550,4 @@ def time_optimal(mech: Mechanism, path: object, *, payload: float = 0.0, limits:
     return solve(timed, geo, C, lim, float(payload), mid)
 
 
-__all__ = ["ACTIVE_RTOL", "TimeOptimal", "check_positions", "solve", "time_optimal", "usage"]
+__all__ = ["ACTIVE_RTOL", "TimeOptimal", "check_positions", "planned_usage", "solve", "time_optimal", "usage"]

@@ -5,14 +5,24 @@ r"""A time law checked, not just planned (:func:`verify`).
    :math:`\ddot s` and :math:`\dot s^2 = \dot s_i^2 + 2 u_i (s - s_i)`; at each, the inverse kinematics of the path
    point, the joint rates and accelerations (:func:`pkm.follow_task` or :func:`pkm.follow_actuators`) and the
    efforts by :func:`pkm.inverse_dynamics` (Khalil's projection or virtual work: not the actuator-space model the
-   plan was built on) on the mechanism with its payload, plus the joints' friction (Coulomb's sign exact, as
-   planned). Each effort is compared with its actuator's curve at that speed, each speed and acceleration with
-   its limit: :attr:`Verification.effort_usage` etc., 1 at the true limit. The plan holds the limits where these
-   are at most ``1 + 1e-6`` (:attr:`Verification.holds`); planned at ``1 - margin`` (:data:`~pkm.core.timing.limits.
-   MARGIN`), they stay under 1 by the margin less what the grid misses between its points.
+   plan was built on) on the mechanism with its payload, plus the joints' friction (the planner's law,
+   :func:`pkm.core.timing.coefficients._friction`: Coulomb's sign exact, through the passive map at the point, which
+   is the identity on the actuated joints' rows where only they rub). Each effort is compared with its actuator's
+   curve at that speed, each speed and acceleration with its limit: :attr:`Verification.effort_usage` etc., 1 at
+   the true limit. The plan holds the limits where these are at most ``1 + 1e-6`` (:attr:`Verification.holds`);
+   planned at ``1 - margin`` (:data:`~pkm.core.timing.limits.MARGIN`), they stay under 1 by the margin less what
+   the grid misses between its points.
 2. **Pontryagin's structure**: on a time-optimal law some limit is active at every instant but the switching
-   points. :attr:`Verification.inactive` lists the planning segments where no limit is used to within
-   :data:`~pkm.core.timing.solve.ACTIVE_RTOL` (against the margin-reduced limits).
+   points. "Active" is the planner's definition (:func:`~pkm.core.timing.solve.planned_usage`): a row of the problem
+   it solved at its bound to within :data:`~pkm.core.timing.solve.ACTIVE_RTOL`, at a segment's end, with the
+   speed-dependent terms (a motor line, viscous friction) linearised where it linearised them and each row
+   tightened as it was. The efforts, joint rates and accelerations at the segments' ends are this check's own
+   (step 1); the linearisation point, the tightening factors and the viscous coefficient :math:`d` (to take the
+   term :math:`d \dot s` out of the recomputed efforts) are the plan's. :attr:`Verification.inactive` lists the
+   segments where no row is active: it equals :attr:`TimeOptimal.inactive <pkm.core.timing.solve.TimeOptimal>`
+   where the two routes agree (tested). Against the true limits, an active segment with viscous friction or a
+   motor line may use less than 1 (the tangent is an upper bound; a friction that helps is not counted):
+   :attr:`Verification.effort_usage` is the true use.
 3. **Position limits**: every joint the model states position limits for (actuated, task, passive) stays within
    them at every check point (:meth:`pkm.core.Mechanism.limit_violations`); the first one outside is named in
    :attr:`Verification.reason` and the plan does not hold.
@@ -21,6 +31,12 @@ r"""A time law checked, not just planned (:func:`verify`).
    \dot q_a)`, gains from the mass matrix at the start, :math:`K_p = \omega_n^2 \operatorname{diag} M_a`,
    :math:`K_d = 2 \zeta \omega_n \operatorname{diag} M_a` (:math:`\omega_n = 2\pi \cdot 20` rad/s,
    :math:`\zeta = 1`); the largest actuated and task-space tracking errors are reported.
+
+**Independent and shared**: the check's own are the inverse kinematics at every check point (not the plan's
+configurations), the joint rates and accelerations, the efforts (another dynamics route than the planner's
+actuator-space model) and the simulation; shared with the planner are the path, the law ``(s, sd, sdd)`` under
+test, the limits and their margin, the friction law, and for step 2 the linearisation point
+(:attr:`~pkm.core.timing.solve.TimeOptimal.linearised_at`), the tightening factors and the viscous coefficient.
 """
 
 from __future__ import annotations
@@ -30,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pkm.core.kinematics.task import TaskMap
-from pkm.core.timing.solve import ACTIVE_RTOL, TimeOptimal
+from pkm.core.timing.solve import ACTIVE_RTOL, TimeOptimal, planned_usage
 from pkm.errors import InvalidInputError
 from pkm.validation import as_count
 
@@ -51,10 +67,13 @@ class Verification:
         speed_usage, acceleration_usage: likewise for the speed and acceleration limits (0 where none).
         holds: Every usage is at most ``1 + HOLD_RTOL``, every joint within its position limits, and the motors'
             motion continuous.
-        inactive: Planning segments where no limit is active (switching points of the law).
+        inactive: Planning segments where no limit is active (switching points of the law; module doc).
+        planned_usage: Per segment, the largest use of the planner's rows recomputed from these efforts (1:
+            active).
         tracking_error: The largest actuated error of the simulated tracking (na,) [rad, m]; None if not run.
         task_error: The largest task-space distance of the simulated end effector from the plan's [m] (position
-            coordinates); None if not run.
+            coordinates); None if not run or where the task has no position coordinates (an ankle's pitch and
+            roll: ``tracking_error`` has the motors').
         simulated_duration: How long the simulation ran [s] (the cycle time, or less where it stopped: see
             ``event``).
         event: Why the simulation stopped early, or None.
@@ -77,6 +96,7 @@ class Verification:
     event: str | None
     outside_limits: tuple[str, ...] = ()
     reason: str | None = None
+    planned_usage: np.ndarray | None = None
 
 
 def _points(plan: TimeOptimal, factor: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -95,8 +115,9 @@ def _points(plan: TimeOptimal, factor: int) -> tuple[np.ndarray, np.ndarray, np.
 
 def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: float | None = None) -> Verification:
     """Check ``plan`` (module doc): the efforts by :func:`pkm.inverse_dynamics` at ``factor`` times the planning
-    resolution against the limits, Pontryagin's structure, and a tracking simulation (``simulate``; step ``dt``,
-    default the cycle time / 2000).
+    resolution against the limits, Pontryagin's structure (the active limits by the planner's definition, from
+    these efforts), and a tracking simulation (``simulate``; step ``dt``, default the cycle time / 2000). What is
+    recomputed independently and what is the planner's: the module doc.
 
     Raises:
         InvalidInputError: ``plan`` is not a :class:`~pkm.core.timing.solve.TimeOptimal`.
@@ -109,8 +130,9 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
         >>> check.holds, round(check.speed_usage, 3), check.inactive
         (True, 0.999, ())
     """
-    from pkm.core.dynamics.model import actuator_model
+    from pkm.core.differential.velocity import passive_map
     from pkm.core.kinematics.trajectory import follow_actuators, follow_task
+    from pkm.core.timing.coefficients import _friction
 
     if not isinstance(plan, TimeOptimal):
         raise InvalidInputError("plan", "expected a TimeOptimal (pkm.time_optimal)", plan)
@@ -123,11 +145,19 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
                   efforts=True, tol=1e-12)
     assert traj.efforts is not None
     tau = traj.efforts.copy()
-    if np.any(np.asarray(mech.model.damping) != 0.0) or np.any(np.asarray(mech.model.friction) != 0.0):
-        for k in range(len(s)):  # (the model's friction, Coulomb's sign exact as planned)
-            model = actuator_model(mech, traj.q[k], traj.actuated_velocity[k], coulomb_velocity=1e-12)
-            tau[k] -= model.friction
     omega = traj.actuated_velocity
+    rubbing = np.flatnonzero((np.asarray(mech.model.damping) != 0.0) | (np.asarray(mech.model.friction) != 0.0))
+    if rubbing.size:  # (the joints' friction through the passive map at each point, Coulomb's sign exact: the
+        # planner's law; the passive map's rows of the actuated joints are the identity: friction at the motors
+        # alone needs no more)
+        act = np.asarray(mech.act_v)
+        if np.isin(rubbing, act).all():
+            G = np.zeros((len(s), mech.nv, mech.na))
+            G[:, act, np.arange(mech.na)] = 1.0
+        else:
+            G = np.stack([passive_map(mech, qk) for qk in traj.q])
+        coulomb, viscous = _friction(mech, G, omega)
+        tau += coulomb + viscous
     effort = float(np.max(np.abs(tau) / L.effort_limit(omega)))
     speed = float(np.max(np.abs(omega) / L.speed[None]))
     acc = float(np.max(np.abs(traj.actuated_acceleration) / L.acceleration[None]))
@@ -140,16 +170,20 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
             f"{v.joint} = {v.value:.6g} at s = {s[k]:.6g}, outside its limits [{v.limit[0]:.6g}, {v.limit[1]:.6g}]"
             for k, v in traj.outside_limits))
     holds = not reasons
-    inactive = tuple(int(i) for i in np.flatnonzero(plan.usage < 1.0 - ACTIVE_RTOL))
+    ends = np.stack([np.arange(len(plan.sdd)) * (factor + 1), np.arange(len(plan.sdd)) * (factor + 1) + factor])
+    static = tau[ends] - np.stack([plan.coefficients.d[:-1], plan.coefficients.d[1:]]) * sd[ends][..., None]
+    planned, _ = planned_usage(plan.coefficients, L, plan.sd, plan.sdd, plan.tightened, plan.linearised_at,
+                               static, omega[ends], traj.actuated_acceleration[ends])
+    inactive = tuple(int(i) for i in np.flatnonzero(planned < 1.0 - ACTIVE_RTOL))
     track, task_err, dur, event = None, None, 0.0, None
     if simulate:
         track, task_err, dur, event = _track(plan, t, traj, tau, dt)
     return Verification(s, t, tau, effort, speed, acc, holds, inactive, track, task_err, dur, event,
-                        tuple(v.joint for _, v in traj.outside_limits), "; ".join(reasons) or None)
+                        tuple(v.joint for _, v in traj.outside_limits), "; ".join(reasons) or None, planned)
 
 
 def _track(plan: TimeOptimal, t: np.ndarray, traj: object, tau: np.ndarray,
-           dt: float | None) -> tuple[np.ndarray, float, float, str | None]:
+           dt: float | None) -> tuple[np.ndarray, float | None, float, str | None]:
     from pkm.core.dynamics.model import actuator_model
     from pkm.core.dynamics.simulate import simulate
 
@@ -178,7 +212,7 @@ def _track(plan: TimeOptimal, t: np.ndarray, traj: object, tau: np.ndarray,
     task = TaskMap.of(mech)
     pos = [i for i, k in enumerate(task.value_names) if task.kinds.get(k) == "length"]
     yref = np.array([at(traj.task[order][:, pos], time) for time in sim.time])  # type: ignore[attr-defined]
-    task_err = float(np.max(np.linalg.norm(sim.task[:, pos] - yref, axis=1))) if pos else 0.0
+    task_err = float(np.max(np.linalg.norm(sim.task[:, pos] - yref, axis=1))) if pos else None  # (no lengths)
     return track, task_err, float(sim.time[-1]), None if sim.event is None else str(sim.event)
 
 
