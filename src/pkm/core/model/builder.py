@@ -14,7 +14,9 @@ robot.yaml's or MJCF's keyframe read into it), which must close every loop to :d
 assembly :func:`pkm.core.kinematics.solve.assemble` reaches from the joints the files state (held) and the zero pose
 (Pinocchio's neutral configuration) for the others: Levenberg-Marquardt from there, then seeded restarts, the first
 that closes (the same every run; a closed configuration near the zero pose, not the nearest, and not chosen for
-symmetry). :func:`pkm.core.kinematics.solve.nearest_assembly` gives the nearest (a symmetric one where a symmetry
+symmetry; scale-free: the same files with every length scaled assemble to the same angles, by a metric in the
+spread of the joints at the zero pose, :func:`~pkm.core.model.mechanism.spread`, known before the reference).
+:func:`pkm.core.kinematics.solve.nearest_assembly` gives the nearest (a symmetric one where a symmetry
 of the mechanism fixes the zero pose); it is not the default because the nearest is often near a singularity (a
 URDF's zero pose with aligned links): Gepetto's disney_like and wl16_like would get references 3 and 2 mrad from one.
 Write a ``[reference]`` (or ``pkm.save`` a mechanism whose ``q_reference`` was set) to choose. An assembled reference
