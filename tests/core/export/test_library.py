@@ -7,6 +7,7 @@ mechanisms it refuses. Every shipped and acceptance-set mechanism is run by
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -112,6 +113,8 @@ def test_the_folder_builds_with_make_and_runs(built, tmp_path):
                           capture_output=True, check=False).returncode == 0
     run = subprocess.run(["./example"], cwd=folder, capture_output=True, text=True, check=False)
     assert run.returncode == 0 and "inverse dynamics: status 0" in run.stdout
+    first = re.search(r"```text\n(first fk: [^\n]*)\n```", (folder / "README.md").read_text()).group(1)
+    assert run.stdout.startswith(first + "\n")  # (the README's example prints what the README says)
     assert "ik: status 0, mode 0" in run.stdout and "working mode id 0 (the reference's)" in run.stdout
     header = (folder / "ankle.h").read_text()
     assert "ANKLE_MAX_ITER" in header and "fk_step" in header and " mul " in header and "ik bit 1" in header
