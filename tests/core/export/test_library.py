@@ -60,10 +60,12 @@ def test_outside_the_domain_a_status_never_a_nan(built, name):
     mech, h = built[name]
     problems, statuses = domain(mech, h)
     assert problems == []
-    # driven 3 rad along a line, each mechanism leaves its workspace: both their joint limits, the ankle its mode
+    # driven 3 rad along a line, each mechanism leaves its workspace: both their joint limits, the ankle its
+    # workspace through a fold, where fk, following its path in steps, stops NOT_CONVERGED as pkm.close_loops raises
+    # (before the path, one Newton jump left for the other assembly mode: LEFT_MODE)
     met = set(statuses) - {"OK"}
     assert met <= {"NOT_CONVERGED", "LEFT_MODE", "OUTSIDE_LIMITS", "SINGULAR"} and "OUTSIDE_LIMITS" in met
-    assert "LEFT_MODE" in met or name == "knee", statuses
+    assert "NOT_CONVERGED" in met or name == "knee", statuses
 
 
 def test_the_mode_asked_for_and_the_limits(built):
