@@ -467,7 +467,8 @@ _EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 #: The acceptance set's files in the formats pkm reads: (folder, the file pkm.load takes, the files beside it).
 _MODEL_FILES = (("mjcf_fourbar", "fourbar.xml", ()), ("sdf_slider_crank", "slider_crank.closures.toml",
                                                      ("slider_crank.sdf",)),
-                ("gepetto_rssr", "robot.yaml", ("robot.urdf",)), ("ankle", "ankle.closures.toml", ("ankle.urdf",)))
+                ("gepetto_rssr", "robot.yaml", ("robot.urdf",)), ("ankle", "ankle.closures.toml", ("ankle.urdf",)),
+                ("../tests/data/hyrodyn_fourbar", "submechanisms.yml", ("fourbar.urdf",)))
 
 
 @entry("formats.read_mjcf")
@@ -484,6 +485,15 @@ def _read_sdf(g, adv):
     text = (_EXAMPLES / "sdf_slider_crank" / "slider_crank.sdf").read_text()
     text = g.text_mutation(text) if adv or g.chance(0.5) else text
     return read_sdf, (g.hostile() if adv and g.chance(0.05) else text,), {}
+
+
+@entry("formats.read_hyrodyn")
+def _read_hyrodyn(g, adv):
+    from pkm.core.formats.hyrodyn import read_hyrodyn
+    folder = Path(__file__).resolve().parent / "data" / "hyrodyn_fourbar"
+    text, urdf = (folder / "submechanisms.yml").read_text(), (folder / "fourbar.urdf").read_text()
+    text = g.text_mutation(text) if adv or g.chance(0.5) else text
+    return read_hyrodyn, (g.hostile() if adv and g.chance(0.05) else text, urdf, "fourbar.urdf", "fourbar"), {}
 
 
 def _model_folder(g, adv) -> Path:

@@ -52,6 +52,9 @@ CASES = [
     (E.TransmissionError("foot", "singular", "outputs singular", ("ankle_pitch",), 3e-9),
      {"transmission": "foot", "reason": "singular", "joints": ("ankle_pitch",), "value": 3e-9},
      ["transmission 'foot': outputs singular"]),
+    (E.NonPhysicalInertiaError("inverse dynamics", ["arm"], ["negative"], [-2e-4], "arm.urdf"),
+     {"what": "inverse dynamics", "links": ("arm",), "rules": ("negative",), "values": (-2e-4,)},
+     ["arm.urdf: inverse dynamics refused", "'arm' (a negative principal moment -0.0002 kg m^2)"]),
     (E.PathError(12, 0.25, "peak effort of motor_1", "needs 5.1 N m to hold still, has 3.9"),
      {"index": 12, "s": 0.25, "limit": "peak effort of motor_1"}, ["path point 12 (s = 0.25)", "needs 5.1 N m"]),
 ]

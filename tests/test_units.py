@@ -9,7 +9,7 @@ import pytest
 
 import pkm
 from pkm.errors import InvalidInputError, UnitError
-from pkm.units import parse_quantity
+from pkm.units import parse_joint_value, parse_quantity
 
 
 @pytest.mark.parametrize("text,kinds,expected", [
@@ -66,11 +66,28 @@ def test_joint_values_task_targets_and_parameters_take_units():
     assert pkm.task_values(hexapod, ik.q) == pytest.approx({**ref, "yaw": math.radians(2)}, abs=1e-9)
 
 
-def test_rates_and_efforts_take_numbers_only():
-    """Positions take units; a rate or an effort with a length or angle unit is refused (rad/s is not rad)."""
+def test_rates_and_efforts_take_their_own_units_in_the_library():
+    """A rate takes a rate's unit (``"-30deg/s"``, ``"300rpm"``), an effort a torque's or a force's (``"2 N m"``), as
+    positions take theirs; a position's unit for a rate is refused (rad/s is not rad); the answers equal the SI
+    numbers' (factors written out here)."""
     delta = pkm.load("delta")
-    with pytest.raises(InvalidInputError):
-        pkm.velocities(delta, delta.q_reference, ["5deg", 0.0, 0.0])
+    q = delta.q_reference
+    v = pkm.velocities(delta, q, ["300rpm", "-30deg/s", 0.0])
+    assert np.allclose(v, pkm.velocities(delta, q, [10 * math.pi, -math.pi / 6, 0.0]), rtol=1e-15, atol=0)
+    model = pkm.actuator_model(delta, q, [0.0, "90deg/s", 0.0])
+    assert model.qd == pytest.approx([0.0, math.pi / 2, 0.0], rel=1e-15)
+    as_array = pkm.actuator_model(delta, q, np.array(["0", "90deg/s", "0"]))  # (numpy's strings: the list's)
+    assert np.array_equal(as_array.qd, model.qd)
+    assert np.allclose(model.accelerations(["2 N m", "500mN m", 0.0]), model.accelerations([2.0, 0.5, 0.0]),
+                       rtol=1e-15, atol=0)
+    with pytest.raises(UnitError, match=r"'deg' is an angle unit but qd_actuated\[0\] is in \[rad/s\]"):
+        pkm.velocities(delta, q, ["5deg", 0.0, 0.0])
+    with pytest.raises(UnitError, match=r"'N' is a force unit but tau\[0\] is in \[N m\]"):
+        model.accelerations(["2N", 0.0, 0.0])
+    assert parse_joint_value("-30deg/s", True, "rate", "m") == pytest.approx(-math.pi / 6, rel=1e-15)
+    assert parse_joint_value("50mm/s", False, "rate", "s") == pytest.approx(0.05, rel=1e-15)
+    with pytest.raises(UnitError, match=r"s2 is in \[rad/s\^2\]; give the number in that unit"):
+        parse_joint_value("1deg", True, "acceleration", "s2")
 
 
 @pytest.mark.parametrize("text,kind,expected", [

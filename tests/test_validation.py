@@ -10,6 +10,7 @@ import re
 import numpy as np
 import pytest
 
+import pkm.validation as V
 from pkm.errors import InvalidInputError, NonFiniteError
 from pkm.validation import as_array, as_count, as_scalar, as_tolerance, as_vector, finite_result, wrap_angle
 
@@ -82,6 +83,47 @@ def test_as_vector_takes_large_but_finite_ints():
     assert as_vector([10**300, 0, 1], 3, "q")[0] == 1e300
     with pytest.raises(InvalidInputError, match="not a \\(regular\\) array"):
         as_vector([10**309, 0, 1], 3, "q")
+
+
+# ---------------------------------------------------------------------- bounded
+def test_bounded_keeps_the_bound_and_names_the_first_entry_beyond():
+    """1e6 (SI) itself is kept (the same array, NaN left to the caller); beyond it the error names the argument, the
+    value and its entry, and carries what was given."""
+    a = np.array([[0.0, -V.ABSURD], [np.nan, V.ABSURD]])
+    assert V.bounded(a, "q") is a
+    with pytest.raises(InvalidInputError, match=r"holds -1e\+308 at entry \[1, 0\], beyond 1e\+06") as info:
+        V.bounded(np.array([[0.0, 1.0], [-1e308, 2e6]]), "qa", "given")
+    assert info.value.name == "qa" and info.value.value == "given"
+
+
+def test_a_coordinate_beyond_the_bound_is_refused_by_library_command_line_and_service(built, capsys):
+    """Issue 52's repro: the service's fk of qa = [1e308, 0.2, 0.3] on the Delta answered 200 "ok" with motor_1
+    echoed as 2.58 rad (1e308 wrapped). One rule (:func:`pkm.validation.bounded`) now refuses it everywhere: the
+    library's loop closure, a configuration q (a Jacobian), the command line's fk (one line, exit 1) and the
+    service's fk as one sample or in a batch (an InvalidInputError: its 422); 1e6 rad itself is still solved, its
+    wrap exact to the float spacing there (2e-10 rad)."""
+    import pkm
+    from pkm import cli
+    from pkm.serve import queries
+
+    delta = built("delta")
+    beyond = "beyond 1e+06 (SI units: m, rad)"
+    q = delta.q_reference.copy()
+    q[0] = 1e308
+    for call in (lambda: pkm.close_loops(delta, [1e308, 0.2, 0.3]), lambda: pkm.forward_jacobian(delta, q),
+                 lambda: queries.fk(delta, {"qa": [1e308, 0.2, 0.3]}),
+                 lambda: queries.fk(delta, {"qa": [[0.1, 0.2, 0.3], [1e308, 0.2, 0.3]]}),
+                 lambda: queries.jacobians(delta, {"qa": [0.1, 0.2, 0.3], "seed": q.tolist()})):
+        with pytest.raises(InvalidInputError) as info:
+            call()
+        assert beyond in str(info.value) and "1e+308" in str(info.value)
+    assert cli.main(["fk", "delta", "--joints", "motor_1=1e308", "motor_2=0.2", "motor_3=0.3"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("pkm: error: ") and beyond in err and len(err.splitlines()) == 1
+    near = pkm.close_loops(delta, [V.ABSURD, -0.8, -0.9]).q[delta.act_q[0]]
+    assert abs(near - math.remainder(V.ABSURD, 2 * math.pi)) <= 1e-9 and math.isclose(
+        near, pkm.close_loops(delta, [math.remainder(V.ABSURD, 2 * math.pi), -0.8, -0.9]).q[delta.act_q[0]],
+        abs_tol=1e-9)
 
 
 # ---------------------------------------------------------------------- as_scalar

@@ -74,10 +74,19 @@ class Client:
         """Every model: ``id``, ``kind`` (registered, uploaded), ``name``, ``files``."""
         return self._answer(self._http.get("/models"))["models"]
 
-    def upload(self, files: Iterable[str | Path] | Mapping[str, bytes]) -> dict:
-        """Upload a model's files (paths, or ``{name: bytes}``); returns its entry (``id``...)."""
-        items = files.items() if isinstance(files, Mapping) else ((Path(p).name, Path(p).read_bytes()) for p in files)
-        return self._answer(self._http.post("/models", files=[("files", (n, d)) for n, d in items]))
+    def upload(self, files: Iterable[str | Path] | Mapping[str, bytes], folder: str | None = None) -> dict:
+        """Upload a model's files (paths, or ``{name: bytes}``); returns its entry (``id``...). ``folder``: the name
+        of the folder they are in, which names a Gepetto ``robot.urdf`` as :func:`pkm.load` does (default: the
+        paths' folder, where they share one)."""
+        if isinstance(files, Mapping):
+            items = list(files.items())
+        else:
+            paths = [Path(p) for p in files]
+            items = [(p.name, p.read_bytes()) for p in paths]
+            parents = {p.resolve().parent.name for p in paths}
+            folder = parents.pop() if folder is None and len(parents) == 1 else folder
+        data = {} if folder is None else {"folder": folder}
+        return self._answer(self._http.post("/models", files=[("files", (n, d)) for n, d in items], data=data))
 
     def model(self, model: str) -> dict:
         """Sizes, names and units of ``model``."""
@@ -89,8 +98,10 @@ class Client:
     def query(self, model: str, query: str, **body: Any) -> dict:
         """``POST /models/{model}/{query}`` with ``body`` (arrays as numpy arrays or lists; None values left out).
 
-        A batch (every array a list of samples) answers per sample: ``status``, ``failures``, None for a failed
-        sample's values; one sample that fails raises :class:`ServiceError` (422, pkm's error's name and data)."""
+        A batch (every array a list of samples) answers per sample: ``status`` (``"ok"``, ``"outside_limits"``: the
+        joints outside the model's position limits in ``outside_limits``, or ``"failed"``), ``failures``, None for a
+        failed sample's values; one sample that fails raises :class:`ServiceError` (422, pkm's error's name and
+        data)."""
         from pkm.serve.wire import MSGPACK, pack
 
         body = {k: v for k, v in body.items() if v is not None}

@@ -137,13 +137,14 @@ class ImplausibleModelWarning(PkmWarning):
     inequality, drive limits that look like an exporter's placeholders.
 
     Attributes:
-        kind: ``"mass"``, ``"inertia"``, ``"triangle"`` or ``"limits"``.
+        kind: ``"mass"``, ``"inertia"``, ``"negative"`` (a negative principal moment), ``"triangle"`` or
+            ``"limits"``.
         names: The bodies (or, for ``"limits"``, the joints) concerned.
-        values: Each one's offending value (the mass [kg], the largest principal inertia [kg m^2], the triangle
-            inequality's excess [kg m^2]); for ``"limits"`` the effort and the velocity limit every joint shares
+        values: Each one's offending value (the mass [kg], the largest principal inertia [kg m^2], the negative
+            principal moment [kg m^2], the triangle inequality's excess [kg m^2]); for ``"limits"`` the effort and the velocity limit every joint shares
             [N m or N, rad/s or m/s].
         bound: The value the rule allows (the mass bound [kg], the largest of the inertia bounds [kg m^2], 0 for the
-            triangle); for ``"limits"`` the effort limit shared.
+            negative moments and the triangle); for ``"limits"`` the effort limit shared.
     """
 
     def __init__(self, message: str, kind: str, names: Iterable[str], values: Iterable[float], bound: float):
@@ -152,6 +153,34 @@ class ImplausibleModelWarning(PkmWarning):
         self.values = tuple(float(v) for v in values)
         self.bound = float(bound)
         super().__init__(message)
+
+
+class NonPhysicalInertiaError(PkmError):
+    """Dynamics asked of a mechanism whose bodies' inertias no distribution of mass has (a negative principal moment,
+    or principal moments that break the triangle inequality: :mod:`pkm.core.model.plausibility`). Its kinematics
+    needs no inertia and is answered; its dynamics (inverse and forward dynamics, the mass matrix, a simulation, an
+    identification that starts from the model's inertias) would be numbers of no mechanism, and is refused.
+
+    Attributes:
+        what: What was refused (``"inverse dynamics"``...).
+        links: The bodies concerned, each named by its first link.
+        rules: For each of ``links``, the rule it breaks: ``"negative"`` (a principal moment below zero) or
+            ``"triangle"``.
+        values: For each, the offending value [kg m^2]: the negative principal moment, or the triangle's excess.
+    """
+
+    def __init__(self, what: str, links: Iterable[str], rules: Iterable[str], values: Iterable[float],
+                 source: str = ""):
+        self.what = what
+        self.links = tuple(links)
+        self.rules = tuple(rules)
+        self.values = tuple(float(v) for v in values)
+        said = {"negative": "a negative principal moment", "triangle": "moments that break the triangle inequality"}
+        listed = ", ".join(f"{n!r} ({said.get(r, r)} {v:.6g} kg m^2)" for n, r, v in zip(self.links, self.rules,
+                                                                                           self.values))
+        super().__init__(f"{source + ': ' if source else ''}{what} refused: the inertias of {listed} are not "
+                         "physical (no distribution of mass has them); the kinematics needs none, the dynamics does: "
+                         "fix ixx..izz in the model file (about the centre of mass, kg m^2)")
 
 
 class InvalidInputError(PkmError, ValueError):
@@ -463,19 +492,24 @@ class TransmissionError(PkmError):
 
 class PathError(PkmError):
     """A geometric path cannot be timed (:func:`pkm.time_optimal`): it leaves the workspace, crosses a singularity,
-    is not smooth, or a limit cannot hold the mechanism still on it.
+    is not smooth, crosses a position limit the model states, or a limit cannot hold the mechanism still on it.
 
     Attributes:
-        index: The path point (0-based, in the planning grid or the waypoints, as ``what`` says) where it fails.
+        index: The path point (0-based, in the planning grid or the waypoints, or the grid's segment whose midpoint
+            fails, as ``what`` says) where it fails.
         s: The path parameter there (in [0, 1]).
-        limit: What is violated: ``"workspace"``, ``"singularity"``, ``"smoothness"`` or the limit that cannot hold
-            (``"peak effort of motor_1"``).
+        limit: What is violated: ``"workspace"``, ``"singularity"``, ``"smoothness"``, ``"position limit of
+            motor_1"`` or the limit that cannot hold (``"peak effort of motor_1"``).
         detail: What was measured.
+        joint, value, bound: For a position limit crossed: the joint, its coordinate there [rad, m] and its stated
+            limits ``(lower, upper)``; else None.
     """
 
-    def __init__(self, index: int, s: float, limit: str, detail: str, what: str = "path point"):
+    def __init__(self, index: int, s: float, limit: str, detail: str, what: str = "path point", *,
+                 joint: str | None = None, value: float | None = None, bound: tuple[float, float] | None = None):
         self.index = int(index)
         self.s = float(s)
         self.limit = limit
         self.detail = detail
+        self.joint, self.value, self.bound = joint, value, bound
         super().__init__(f"{what} {self.index} (s = {self.s:.6g}): {limit}: {detail}")

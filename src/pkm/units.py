@@ -21,6 +21,7 @@ import math
 import re
 from collections.abc import Collection, Sequence
 
+import numpy as np
 from numpy.typing import ArrayLike
 
 from pkm.errors import InvalidInputError, UnitError
@@ -44,6 +45,14 @@ SI_UNITS = {"length": "m", "angle": "rad", "mass": "kg", "time": "s", "force": "
             "angular velocity": "rad/s", "velocity": "m/s"}
 #: The kind of each SI unit (``"m" -> "length"``), its other spellings too (``"N*m"``, ``"Nm"``).
 KIND_OF_UNIT = {v: k for k, v in SI_UNITS.items()} | {"N*m": "torque", "Nm": "torque"}
+#: The kind of a joint's value of each order, for a revolute and a prismatic joint (``None``: no suffix, a plain
+#: number in SI): positions, rates and efforts take units alike in the API, the CLI and the service.
+JOINT_KINDS: dict[str, tuple[str | None, str | None]] = {
+    "position": ("angle", "length"), "rate": ("angular velocity", "velocity"), "acceleration": (None, None),
+    "effort": ("torque", "force")}
+#: The SI unit of a joint's value of each order, revolute and prismatic.
+JOINT_UNITS: dict[str, tuple[str, str]] = {
+    "position": ("rad", "m"), "rate": ("rad/s", "m/s"), "acceleration": ("rad/s^2", "m/s^2"), "effort": ("N m", "N")}
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z](?:[A-Za-z*/ ]*[A-Za-z])?)?\s*$")
 _PRODUCT = re.compile(r"^(m|k)?N\s*\*?\s*m$")  # (N m, N*m, Nm; mN m, kN m)
 
@@ -143,9 +152,33 @@ def quantity(value: object, kind: str | None = None, what: str = "value") -> flo
     return as_scalar(value, what)
 
 
+def joint_kind(revolute: bool, order: str = "position") -> str | None:
+    """The kind (:data:`SI_UNITS`' keys) of a joint's value of ``order`` (:data:`JOINT_KINDS`: ``"position"``,
+    ``"rate"``, ``"acceleration"``, ``"effort"``), revolute or prismatic; None: a plain number only."""
+    return JOINT_KINDS[order][0 if revolute else 1]
+
+
+def joint_unit(revolute: bool, order: str = "position") -> str:
+    """The SI unit of a joint's value of ``order`` (:data:`JOINT_UNITS`), revolute or prismatic."""
+    return JOINT_UNITS[order][0 if revolute else 1]
+
+
+def parse_joint_value(text: str, revolute: bool, order: str, what: str) -> float:
+    """A joint's value of ``order`` written ``"-30deg/s"``, ``"2 N m"``, ``"0.5"`` (SI), converted to SI: the one
+    route of the CLI's ``--joints``, ``--rates``, ``--q0`` and of the service's unit strings.
+
+    Raises:
+        UnitError: not a number, or a unit of another kind.
+    """
+    kind = joint_kind(revolute, order)
+    return parse_quantity(text, {kind} if kind else set(), what, joint_unit(revolute, order))
+
+
 def quantities(values: ArrayLike, kinds: Sequence[str | None], what: str) -> ArrayLike:
     """``values`` (a sequence) with every string entry converted by the kind at its position; other entries as
-    they are (the numeric checks follow in :func:`pkm.validation.as_vector`)."""
+    they are (the numeric checks follow in :func:`pkm.validation.as_vector`); a numpy array of strings as its list."""
+    if isinstance(values, np.ndarray) and values.dtype.kind in "UO" and values.ndim == 1:
+        values = values.tolist()
     if isinstance(values, (str, bytes)) or not isinstance(values, (list, tuple)):
         return values
     if not any(isinstance(v, str) for v in values):
@@ -154,4 +187,5 @@ def quantities(values: ArrayLike, kinds: Sequence[str | None], what: str) -> Arr
             enumerate(zip(values, kinds))] + list(values[len(kinds):])
 
 
-__all__ = ["KIND_OF_UNIT", "SI_UNITS", "SUFFIXES", "parse_quantity", "quantities", "quantity"]
+__all__ = ["JOINT_KINDS", "JOINT_UNITS", "KIND_OF_UNIT", "SI_UNITS", "SUFFIXES", "joint_kind", "joint_unit",
+           "parse_joint_value", "parse_quantity", "quantities", "quantity"]

@@ -56,6 +56,26 @@ def as_array(x: object, name: str, what: str = "numbers") -> np.ndarray:
     return arr
 
 
+def bounded(arr: np.ndarray, name: str, given: object = None) -> np.ndarray:
+    """``arr`` (coordinates: m, rad) unchanged where every entry's magnitude is at most :data:`ABSURD`, else an
+    :class:`InvalidInputError` naming ``name`` and the first entry beyond (a unit mistake or garbage).
+
+    The one rule for the coordinates every entry point takes (configurations, actuated values, seeds, task targets,
+    waypoints: the library, the command line and the service alike): a revolute coordinate of 1e308 rad is refused,
+    not wrapped into (-pi, pi] (a float that large has no digits left below 2 pi: its wrap is noise). Within the
+    bound an angle's wrap keeps 1e6 x eps = 2e-10 rad. Non-finite entries are the caller's to refuse."""
+    a = np.asarray(arr)
+    with np.errstate(invalid="ignore"):
+        over = np.abs(a) > ABSURD
+    if np.any(over):
+        at = tuple(int(i) for i in np.argwhere(over)[0])
+        where = f" at entry {at[0] if len(at) == 1 else list(at)}" if at else ""
+        raise InvalidInputError(name, f"holds {float(a[at]):.6g}{where}, beyond {ABSURD:g} (SI units: m, rad): a "
+                                      "unit mistake or garbage (a coordinate is never wrapped silently)",
+                                arr if given is None else given)
+    return arr
+
+
 def as_vector(x: object, n: int, name: str) -> np.ndarray:
     """``x`` as a finite float vector of shape (n,), or :class:`InvalidInputError` naming ``name``."""
     arr = as_array(x, name, f"{n} numbers")

@@ -53,6 +53,25 @@ def test_delta_json_equals_the_library_at_the_state_given(capsys):
     assert out["base"] == "fixed"
 
 
+def test_pose_and_rates_with_units_are_the_si_numbers_as_in_the_library(capsys):
+    """``pkm dynamics delta --pose z=-30cm --rates motor_3=-30deg/s`` (it took no --pose, and a rate unit was "not a
+    number"): the state is pkm.solve_ik's at that pose, the rates -pi/6 rad/s, the model the library's given the same
+    strings, to 1e-12; ``300rpm`` is 10 pi rad/s; ``--pose`` and ``--joints`` exclude each other."""
+    units = _json(capsys, "delta", "--pose", "z=-30cm", "--rates", "motor_3=-30deg/s", "motor_1=300rpm")
+    si = _json(capsys, "delta", "--pose", "z=-0.3", "--rates", f"motor_3={-math.pi / 6!r}",
+               f"motor_1={10 * math.pi!r}")
+    mech = pkm.load("delta")
+    q = pkm.solve_ik(mech, {"z": -0.3}).q
+    model = pkm.actuator_model(mech, q, ["300rpm", 0.0, "-30deg/s"])
+    assert np.allclose(model.qd, [10 * math.pi, 0.0, -math.pi / 6], rtol=1e-15, atol=0)
+    for out in (units, si):
+        assert np.allclose(_vector(out, "rates"), model.qd, rtol=1e-15, atol=0)
+        assert abs(out["task"]["z"] + 0.3) <= 1e-12 and np.allclose(_vector(out, "actuated"), mech.actuated_q(q))
+        assert np.allclose(_vector(out, "h"), model.h, rtol=RTOL, atol=1e-15)
+    assert cli.main(["dynamics", "delta", "--pose", "z=-30cm", "--joints", "motor_1=0"]) == 2
+    assert "not allowed with argument --pose" in capsys.readouterr().err
+
+
 def test_a_floating_base_is_said_free(tmp_path, capsys):
     """The Delta hung on a free pelvis, saved and read back: the JSON names the base's choice and equals the
     library's free-base model; the text says the base is free."""
@@ -121,3 +140,19 @@ def test_the_command_runs_as_a_process():
     """``python -m pkm dynamics delta --json --rates motor_1=fast``: one error line, exit status 2."""
     bad = run("dynamics", "delta", "--json", "--rates", "motor_1=fast")
     assert bad.returncode == 2 and "is not a number" in one_error_line(bad)
+
+
+def test_a_state_outside_the_position_limits_says_so(capsys):
+    """The humanoid ankle's motors at 1.1 rad (range +-1, the pitch then past its +-0.6): the model is printed, with
+    the joints outside listed (the motors at the values given, as the state printed) and, as text, a warning line
+    naming them."""
+    spec = str(ROOT / "examples" / "humanoid_ankle" / "ankle.closures.toml")
+    out = _json(capsys, spec, "--joints", "motor_left=1.1", "motor_right=1.1")
+    outside = {o["joint"]: o for o in out["outside_limits"]}
+    assert list(outside) == ["ankle_pitch", "motor_left", "motor_right"] and outside["ankle_pitch"]["value"] > 0.6
+    for m in ("motor_left", "motor_right"):
+        assert outside[m]["value"] == out["actuated"][m] and abs(outside[m]["value"] - 1.1) <= 1e-12
+        assert outside[m]["limit"] == [-1.0, 1.0]
+    assert cli.main(["dynamics", spec, "--joints", "motor_left=1.1", "motor_right=1.1"]) == 0
+    assert "warning: outside the position limits the model states: ankle_pitch = 0.83" in capsys.readouterr().out
+    assert _json(capsys, spec, "--joints", "motor_left=0.1", "motor_right=0.1")["outside_limits"] == []

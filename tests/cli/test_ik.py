@@ -60,3 +60,25 @@ def test_the_seed_the_solvers_suggest_is_an_option(capsys):
     assert abs(fk["joints"]["elbow_2"] - want.q[elbow]) < 1e-9
     bad = run("fk", "rrr3", "--joints", *qa, "--q0", "elbow_9=1")
     assert bad.returncode != 0 and "'elbow_9'" in one_error_line(bad)
+
+
+def test_a_solution_outside_the_limits_is_not_plain_ok(capsys):
+    """``pkm ik ankle.closures.toml --pose ankle_pitch=0.8``: converged, but its status is outside_limits and each
+    joint outside its MJCF range (the pitch +-0.6, the motors +-1) is named with its value (the motors': the
+    ankle's closed form, another route) and limits; a pose inside them is ok with none."""
+    from pkm import cli
+    from tests.test_humanoid import EXAMPLES, ankle_closed_form
+
+    spec = str(EXAMPLES / "humanoid_ankle" / "ankle.closures.toml")
+    assert cli.main(["ik", spec, "--pose", "ankle_pitch=0.8"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["converged"] and out["status"] == "outside_limits"
+    outside = {o["joint"]: o for o in out["outside_limits"]}
+    assert list(outside) == ["ankle_pitch", "motor_left", "motor_right"]
+    assert outside["ankle_pitch"]["limit"] == [-0.6, 0.6] and abs(outside["ankle_pitch"]["value"] - 0.8) <= 1e-9
+    motors = [outside[m]["value"] for m in ("motor_left", "motor_right")]
+    assert np.allclose(motors, ankle_closed_form(0.8, 0.0), atol=1e-9) and min(motors) > 1.03
+    assert all(outside[m]["limit"] == [-1.0, 1.0] for m in ("motor_left", "motor_right"))
+    assert cli.main(["ik", spec, "--pose", "ankle_pitch=0.3"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["status"] == "ok" and out["outside_limits"] == []

@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import csv
 import json
+from pathlib import Path
 
 import numpy as np
 
+import pkm
 from pkm import cli
 from pkm.motion import load_motions
+
+ANKLE = Path(__file__).resolve().parents[2] / "examples" / "humanoid_ankle" / "ankle.closures.toml"
 
 
 def test_plan_writes_the_trajectory_and_prints_the_cycle_time(tmp_path, capsys):
@@ -27,3 +31,31 @@ def test_plan_writes_the_trajectory_and_prints_the_cycle_time(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert status != 0 and err.startswith("pkm: error: path point 0") and "workspace" in err
     assert len(err.splitlines()) == 1
+
+
+def test_a_path_across_position_limits_exits_non_zero_naming_the_joint(tmp_path, capsys):
+    """The humanoid ankle's pitch to 0.8 rad (range +-0.6; the motors to 1.047 rad, range +-1): one error line
+    naming the check point, the joint, its value and its limits; nothing written."""
+    path = tmp_path / "p.csv"
+    path.write_text("ankle_pitch,ankle_roll\n0,0\n0.4,0\n0.8,0\n")
+    out = tmp_path / "o.csv"
+    status = cli.main(["plan", str(ANKLE), "--path", str(path), "--points", "12", "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert status == 1 and len(err.splitlines()) == 1 and not out.exists()
+    assert err.startswith("pkm: error: segment 8 (s = 0.772727): position limit of ankle_pitch: ankle_pitch = "
+                          "0.618182 rad, outside its limits [-0.6, 0.6] rad")
+
+
+def test_the_path_point_and_the_payload_take_units(tmp_path, capsys):
+    """``adept:X,Y,Z`` takes lengths (``-33cm``) and ``--payload`` a mass (``500g``), as every value of the command
+    line does: a unit of another kind is refused before any planning, naming it."""
+    from pkm.cli.commands.plan import read_path
+
+    mech = pkm.load("delta")
+    (with_units, _), (si, _) = read_path(mech, "adept:-15.25cm,0mm,-33cm"), read_path(mech, "adept:-0.1525,0,-0.33")
+    assert np.allclose(np.asarray(with_units), np.asarray(si), rtol=1e-15, atol=0)
+    out = str(tmp_path / "plan.csv")
+    for argv, says in ((["--path", "adept:0,0,-5deg"], "'deg' is an angle unit"),
+                       (["--path", "adept:0,0,-0.33", "--payload", "5mm"], "'mm' is a length unit but --payload")):
+        assert cli.main(["plan", "delta", *argv, "--out", out]) != 0
+        assert says in capsys.readouterr().err

@@ -243,3 +243,18 @@ def test_the_initial_configuration_takes_passive_joints_as_the_closure_s_seed(tm
     assert np.allclose(start["far"], pkm.TaskMap.of(mech).value(far.q), rtol=0, atol=1e-9)
     assert np.allclose(start["near"], pkm.TaskMap.of(mech).value(near.q), rtol=0, atol=1e-9)
     assert np.abs(start["far"] - start["near"]).max() > 0.1
+
+
+def test_the_initial_state_takes_joints_and_rates_with_units(tmp_path, capsys):
+    """``--joints motor_1=-30deg --v0 motor_2=30deg/s`` (a configuration as every command takes one; a rate with
+    its unit, which was "not a number"): the run is pkm.simulate's from the loops closed at those values with the
+    SI rates, every column to 1e-12."""
+    mech = pkm.load("delta")
+    _summary(capsys, "delta", "--joints", "motor_1=-30deg", "--v0", "motor_2=30deg/s", "--duration", "5ms",
+             "--dt", "1ms", "--out", str(tmp_path / "run.csv"))
+    qa = mech.actuated_q(mech.q_reference)
+    qa[0] = -math.pi / 6
+    sim = pkm.simulate(mech, pkm.close_loops(mech, qa).q, [0.0, math.pi / 6, 0.0], 0.005, 1e-3)
+    written = _read_csv(tmp_path / "run.csv")
+    for name, values in samples.columns(mech, sim).items():
+        assert np.allclose(written[name], values, rtol=RTOL, atol=1e-15), name

@@ -7,6 +7,7 @@ import importlib.util
 import json
 from pathlib import Path
 
+import numpy as np
 import pinocchio as pin
 import pytest
 
@@ -49,8 +50,16 @@ def test_transmission_writes_every_target(tmp_path, capsys):
         from tests.core.transmissions.test_kernels import knee
 
         tk = knee()
-        J = namespace["functions"]()["maps"](tk.mech.q_reference)[0]
-        assert abs(float(J[0]) - float(tk.run("maps", tk.mech.q_reference)[0][0])) <= 1e-12
+        import jax
+
+        fs, ref = namespace["functions"](), tk.mech.q_reference
+        J = fs["maps"](ref)[0]
+        assert abs(float(J[0]) - float(tk.run("maps", ref)[0][0])) <= 1e-12
+        qm = tk.mech.actuated_q(ref) + 0.1  # (fk's loop and its derivative at the solution: J there)
+        q, qo, status, _ = tk.run("fk", ref, qm)
+        assert status[0] == 0 and np.abs(np.asarray(fs["fk"](ref, qm)[1]) - qo).max() <= 1e-12
+        dqo = jax.jacfwd(lambda x: fs["fk"](ref, x)[1])(qm)
+        assert abs(float(dqo[0, 0]) - float(tk.run("maps", q)[0][0])) <= 1e-12
 
 
 def test_what_it_refuses_is_one_error_line(tmp_path, capsys):

@@ -25,7 +25,8 @@ from pkm.errors import InvalidParameterError, PkmError
 from pkm.mechanisms import definition, delta, hexapod, prs3, rrr3
 from pkm.mechanisms._common import rot_y
 
-#: ``max_examples`` of the ``ci`` profile; :func:`examples` scales every test's count from it.
+#: The reference ``max_examples`` :func:`examples` scales every test's count from: ``@examples(n)`` runs ``n`` examples
+#: where the profile's ``max_examples`` is this (the ``ci`` profile runs half of it, the ``long`` one ten times).
 CI_EXAMPLES = 10
 
 #: Worst value of each measured error over the run (key -> value).
@@ -33,7 +34,8 @@ WORST: dict[str, float] = {}
 
 
 def examples(n: int) -> settings:
-    """Settings running ``n`` examples under the ``ci`` profile, proportionally more under ``long``."""
+    """Settings running ``n`` examples at the reference count :data:`CI_EXAMPLES`, proportionally to the profile's
+    ``max_examples`` (``ci``: ``n / 2``; ``long``: ``10 n``)."""
     return settings(max_examples=max(1, round(n * settings.default.max_examples / CI_EXAMPLES)))
 
 

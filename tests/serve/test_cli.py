@@ -12,6 +12,7 @@ import numpy as np
 
 import pkm
 from pkm.serve.process import start
+from tests.bounded import tree_cpu
 
 
 def test_sigterm_drains_the_request_in_flight():
@@ -25,9 +26,12 @@ def test_sigterm_drains_the_request_in_flight():
         def slow() -> None:  # (4,000 samples: about a second of work)
             answer["r"] = httpx.post(url + "/models/delta/fk", json={"qa": qa.tolist()}, timeout=120)
 
+        before = tree_cpu(proc.pid)
         t = threading.Thread(target=slow)
         t.start()
-        time.sleep(0.3)
+        deadline = time.monotonic() + 120  # (a hang's bound: the wait is on the service's CPU time, not a clock)
+        while tree_cpu(proc.pid) < before + 0.1 and time.monotonic() < deadline:  # (the request is in flight)
+            time.sleep(0.01)
         proc.send_signal(signal.SIGTERM)
         t.join(timeout=120)
         assert answer["r"].status_code == 200 and answer["r"].json()["status"] == ["ok"] * 4000

@@ -37,7 +37,7 @@ def test_positions_take_units_and_a_configuration_q_or_qa():
     assert np.abs(ik["q"] - queries.ik(mech, {"y": [0.0, 0.0, -0.35]})["q"]).max() <= 1e-12
     with pytest.raises(UnitError, match=r"qa\[1\]"):
         queries.fk(mech, {"qa": [0.0, "3mm", 0.0]})
-    with pytest.raises(InvalidInputError, match="positions"):  # (no unit suffix for a rate: said, not numpy's words)
+    with pytest.raises(UnitError, match=r"'deg' is an angle unit but qd\[0\] is in \[rad/s\]"):  # (a position's unit)
         queries.velocities(mech, {"qa": qa, "qd": ["1deg", 0.0, 0.0]})
     at_qa = queries.jacobians(mech, {"qa": [qa, qa + 0.01]})
     at_q = queries.jacobians(mech, {"q": queries.fk(mech, {"qa": [qa, qa + 0.01]})["q"]})
@@ -45,6 +45,38 @@ def test_positions_take_units_and_a_configuration_q_or_qa():
     for body in ({"q": mech.q_reference, "qa": qa}, {}):
         with pytest.raises(InvalidInputError, match="q, qa"):
             queries.dynamics(mech, body)
+
+
+def test_a_sample_outside_the_limits_is_not_ok_in_every_query():
+    """The humanoid ankle at pitch 0.8 rad (range +-0.6; the motors then 1.047 and 1.032 rad, range +-1): ik and fk
+    answer status outside_limits with the joints named, their values those of the answer's own q; the queries at a
+    configuration (jacobians) and a stream's sample say the same; a failed sample has none (null), a sample inside
+    them is ok."""
+    import numpy as np
+
+    from tests.test_humanoid import EXAMPLES
+
+    mech = pkm.load(EXAMPLES / "humanoid_ankle" / "ankle.closures.toml")
+    ik = queries.ik(mech, {"y": [0.8, 0.0]})
+    assert ik["status"] == ["outside_limits"] and ik["units"]["outside_limits"].startswith("m or rad")
+    (outside,) = ik["outside_limits"]
+    assert [o["joint"] for o in outside] == ["ankle_pitch", "motor_left", "motor_right"]
+    for o in outside:
+        assert o["value"] == ik["q"][0][mech.joints[o["joint"]].idx_q] and not o["limit"][0] <= o["value"] <= o["limit"][1]
+    qa = ik["qa"][0]
+    fk = queries.fk(mech, {"qa": [qa.tolist(), [0.1, 0.1], [5.0, -5.0]]})
+    assert fk["status"] == ["outside_limits", "ok", "failed"] and fk["outside_limits"][1:] == [[], None]
+    assert [o["joint"] for o in fk["outside_limits"][0]] == ["ankle_pitch", "motor_left", "motor_right"]
+    assert np.isclose(fk["outside_limits"][0][0]["value"], 0.8, atol=1e-9)
+    assert queries.jacobians(mech, {"q": ik["q"][0]})["status"] == ["outside_limits"]
+    from pkm.serve.stream import Stream
+
+    stream = Stream(mech)  # (the WebSocket's samples: the same report)
+    assert stream.step({"qa": [0.1, 0.1]})["status"] == "ok"
+    step = stream.step({"qa": qa.tolist()})
+    assert step["status"] == "outside_limits"
+    for a, b in zip(step["outside_limits"], fk["outside_limits"][0], strict=True):
+        assert a["joint"] == b["joint"] and a["limit"] == b["limit"] and abs(a["value"] - b["value"]) <= 1e-9
 
 
 def test_a_floating_base_s_batched_dynamics_is_the_model_s():
@@ -63,3 +95,48 @@ def test_a_floating_base_s_batched_dynamics_is_the_model_s():
     out = queries.dynamics(mech, {"q": [q, q], "qd": [[0.3], [0.3]]}, Held())
     model = pkm.actuator_model(mech, q, [0.3])
     assert model.base == "free" and np.abs(out["h"][1] - model.h).max() <= 1e-12 * np.abs(model.h).max()
+
+
+def test_rates_and_accelerations_take_their_units_as_the_library_and_the_cli_do():
+    """A rate is ``"-30deg/s"`` (or ``"300rpm"``) over HTTP as in :func:`pkm.actuator_model` and ``pkm dynamics
+    --rates``: the answer is the SI number's to 1e-12; an acceleration has no suffix (``rad/s^2``), so ``"1deg"``
+    there is refused naming its unit, and a numpy array of strings (a msgpack body's) is read as the list."""
+    import numpy as np
+    import pytest
+
+    from pkm.errors import UnitError
+
+    mech = pkm.load("delta")
+    qa = mech.actuated_q(mech.q_reference)
+    si = [0.0, 0.0, -np.pi / 6]
+    plain = queries.dynamics(mech, {"qa": qa, "qd": si, "qdd": [1.0, 0.0, 0.0]})
+    for qd in (["0", "0rpm", "-30deg/s"], np.array(["0", "0", "-30deg/s"])):
+        units = queries.dynamics(mech, {"qa": qa, "qd": qd, "qdd": [1.0, 0.0, 0.0]})
+        assert np.abs(units["tau"] - plain["tau"]).max() <= 1e-12 * np.abs(plain["tau"]).max()
+    library = pkm.actuator_model(mech, plain["q"][0], ["0", "0", "-30deg/s"])
+    assert np.abs(library.h - plain["h"][0]).max() <= 1e-12 * np.abs(plain["h"]).max()
+    v = queries.velocities(mech, {"qa": qa, "qd": ["300rpm", 0.0, 0.0]})["v"]
+    assert np.abs(v - queries.velocities(mech, {"qa": qa, "qd": [10 * np.pi, 0.0, 0.0]})["v"]).max() <= 1e-12
+    with pytest.raises(UnitError, match=r"qdd\[0\].*\[rad/s\^2\]"):
+        queries.dynamics(mech, {"qa": qa, "qdd": ["1deg", 0.0, 0.0]})
+
+
+def test_a_map_job_takes_units_as_pkm_map_does():
+    """A map job's axes ``["-40cm", "-30cm", 3]``, ``fixed`` and ``length`` with units (``pkm map --axis
+    z=-40cm:-30cm:3`` takes them so): the same nodes and condition indices as the SI numbers', to 1e-12; an angle
+    unit on a length axis refused naming it."""
+    import numpy as np
+    import pytest
+
+    from pkm.errors import UnitError
+    from pkm.serve import jobs
+
+    mech = pkm.load("delta")
+    units, _ = jobs._map(mech, {"axes": {"z": ["-40cm", "-30cm", 3]}, "fixed": {"x": "1cm"}, "length": "5cm"},
+                         jobs.Job("a", "map", "delta"))
+    si, _ = jobs._map(mech, {"axes": {"z": [-0.4, -0.3, 3]}, "fixed": {"x": 0.01}, "length": 0.05},
+                      jobs.Job("b", "map", "delta"))
+    assert np.allclose(units["axes"]["z"], si["axes"]["z"], rtol=1e-15, atol=0)
+    assert np.allclose(units["condition_index"], si["condition_index"], rtol=1e-12, atol=0)
+    with pytest.raises(UnitError, match=r"axes\.z"):
+        jobs._map(mech, {"axes": {"z": ["-40deg", "-30cm", 3]}}, jobs.Job("c", "map", "delta"))

@@ -79,10 +79,12 @@ def test_the_check_sees_a_drift(openapi):
     import jsonschema
 
     check = Checker(openapi)
-    good = {"status": ["ok"], "q": [[0.1]], "y": [[0.0]], "residual": [0.0], "iterations": [3], "units": {},
-            "compute_s": 0.001}
+    good = {"status": ["ok"], "outside_limits": [[]], "q": [[0.1]], "y": [[0.0]], "residual": [0.0],
+            "iterations": [3], "units": {}, "compute_s": 0.001}
     check("fk", httpx.Response(200, json=good))
-    for bad in ({**good, "extra": 1}, {**good, "iterations": [3.5]}, {**good, "residual": ["nan"]}):
+    for bad in ({**good, "extra": 1}, {**good, "iterations": [3.5]}, {**good, "residual": ["nan"]},
+                {k: v for k, v in good.items() if k != "outside_limits"}, {**good, "status": ["outside"]},
+                {**good, "outside_limits": [["motor_1"]]}):
         with pytest.raises(jsonschema.ValidationError):
             check("fk", httpx.Response(200, json=bad))
 
@@ -108,6 +110,9 @@ def test_every_answer_matches_its_published_schema(service, openapi):
     files = [EXAMPLES / "humanoid_ankle" / "ankle.xml", EXAMPLES / "humanoid_ankle" / "ankle.closures.toml"]
     entry = call("upload", "/models", status=201, files=[("files", (f.name, f.read_bytes())) for f in files])
     call("model_files", f"/models/{entry['id']}/files", method="get")
+    outside = call("ik", f"/models/{entry['id']}/ik", json={"y": [[0.8, 0.0], [0.3, 0.0]]})  # (pitch range +-0.6)
+    assert outside["status"] == ["outside_limits", "ok"] and outside["outside_limits"][1] == []
+    assert [o["joint"] for o in outside["outside_limits"][0]] == ["ankle_pitch", "motor_left", "motor_right"]
 
     q0, qa0 = np.array(about["q_reference"]), np.array(about["q_reference"])[about["actuated_q"]]
     batch = [qa0.tolist(), (qa0 + 0.02).tolist()]
@@ -127,6 +132,8 @@ def test_every_answer_matches_its_published_schema(service, openapi):
     assert failed["status"] == ["ok", "failed"] and failed["q"][1] is None and failed["failures"][0]["sample"] == 1
     call("ik", "/models/delta/ik", status=422, json={"y": [0.0, 0.0, -3.0]})  # (one sample: pkm's error)
     call("fk", "/models/delta/fk", status=422, json={"qa": qa0.tolist(), "foo": 1})  # (an unknown field)
+    absurd = call("fk", "/models/delta/fk", status=422, json={"qa": [1e308, 0.2, 0.3]})  # (never wrapped to 2.58 rad)
+    assert absurd["error"] == "InvalidInputError" and "beyond 1e+06" in absurd["message"]
     call("fk", "/models/nope/fk", status=404, json={"qa": qa0.tolist()})
 
     jobs = {"job_map": ("map", {"axes": {"x": [-0.05, 0.05, 3], "y": [-0.05, 0.05, 2]}, "fixed": {"z": -0.35},

@@ -140,6 +140,32 @@ def test_an_archive_is_its_files(client, service):
     assert r.status_code == 422 and "link" in r.json()["message"]
 
 
+def test_an_uploaded_gepetto_robot_is_named_as_pkm_load_names_it(client, service):
+    """Gepetto's battobot is ``battobot_6d/robot.urdf`` + ``robot.yaml``: pkm.load names it ``battobot_6d``, an upload
+    named it "robot". Uploaded by path (the client sends the folder), as a zip of the folder, or with ``folder`` stated:
+    ``battobot_6d``, one id; kept so by a new service on the same store."""
+    import io
+    import zipfile
+
+    from pkm.serve.store import Store
+
+    folder = Path(__file__).resolve().parents[2] / "urdf" / "gepetto" / "battobot_6d"
+    paths = [folder / "robot.urdf", folder / "robot.yaml"]
+    name = pkm.load("gepetto:battobot_6d").name
+    entry = client.upload(paths)
+    assert name == "battobot_6d" and entry["name"] == name
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as z:
+        for p in paths:
+            z.writestr(f"battobot_6d/{p.name}", p.read_bytes())
+    assert client.upload({"anything.zip": buf.getvalue()})["id"] == entry["id"]
+    assert client.upload({p.name: p.read_bytes() for p in paths}, folder="battobot_6d")["id"] == entry["id"]
+    assert {e.id: e.name for e in Store(service_store(service)).entries()}[entry["id"]] == name
+    r = httpx.post(service.url + "/models", files=[("files", (p.name, p.read_bytes())) for p in paths],
+                   data={"folder": "../x"}, headers=AUTH)
+    assert r.status_code == 422 and "folder" in r.text
+
+
 def service_store(service) -> Path:
     return service.store_folder
 
@@ -194,12 +220,15 @@ def test_the_stream_warm_starts_and_answers_bad_messages(client, service, delta)
         answers = [s.send(qa=a, qd=[0.1, 0.0, 0.0], qdd=[1.0, 0.0, 0.0]) for a in qa]
     q = pkm.close_loops(delta, qa[0], delta.q_reference).q
     assert np.abs(answers[0]["q"] - q).max() <= 1e-10 and answers[0]["residual"] <= 1e-10
+    assert answers[0]["status"] == "ok" and answers[0]["outside_limits"] == []
     model = pkm.actuator_model(delta, answers[2]["q"], np.array([0.1, 0.0, 0.0]))
     assert np.abs(answers[2]["tau"] - (model.M @ np.array([1.0, 0.0, 0.0]) + model.h)).max() <= 1e-12
     url = "ws" + service.url[4:] + "/models/delta/stream"
     with connect(url, additional_headers=AUTH) as ws:  # JSON text, a bad message, then a good one
         ws.send(json.dumps({"qa": [1, 2]}))
         assert json.loads(ws.recv())["error"] == "InvalidInputError"
+        ws.send(json.dumps({"qa": [1e308, 0.2, 0.3]}))  # (beyond the coordinates' bound: refused, never wrapped)
+        assert "beyond 1e+06" in json.loads(ws.recv())["message"]
         ws.send("not json")
         assert json.loads(ws.recv())["error"] == "BadMessage"
         ws.send(json.dumps({"qa": qa[0].tolist()}))
@@ -209,6 +238,54 @@ def test_the_stream_warm_starts_and_answers_bad_messages(client, service, delta)
     with pytest.raises(InvalidStatus) as refused, connect(url):  # (no token: refused before the handshake ends)
         pass
     assert refused.value.response.status_code == 403
+
+
+def test_the_stream_reads_units_as_http_does_and_answers_with_units(client, service, delta):
+    """A stream's message takes the unit strings an HTTP body takes (``"-30deg"``, ``"-30deg/s"``): the answer is the
+    SI numbers' to 1e-12, with the HTTP answers' ``units``; a unit of the wrong kind is refused naming the entry and
+    its unit (it was "got an array of <U32", with no unit)."""
+    from pkm.client import ServiceError
+
+    qa = delta.actuated_q(delta.q_reference)
+    si = {"qa": [np.deg2rad(-30.0), qa[1], qa[2]], "qd": [0.0, 0.0, -np.pi / 6], "qdd": [1.0, 0.0, 0.0]}
+    with client.stream("delta") as s:
+        plain = s.send(**si)
+    with client.stream("delta") as s:
+        units = s.send(qa=["-30deg", qa[1], qa[2]], qd=["0", "0rpm", "-30deg/s"], qdd=[1.0, 0.0, 0.0])
+        with pytest.raises(ServiceError) as wrong:
+            s.send(qa=qa, qd=["1deg", 0.0, 0.0])
+    for key in ("q", "yd", "tau"):
+        assert np.abs(np.asarray(units[key]) - plain[key]).max() <= 1e-12 * max(1.0, np.abs(plain[key]).max())
+    http = client.dynamics("delta", qa=si["qa"], qd=si["qd"])["units"]
+    assert units["units"]["qd"] == ["rad/s"] * 3 and units["units"]["q"] == http["q"]
+    assert units["units"]["tau"] == ["N m"] * 3 and units["units"]["qa"] == ["rad"] * 3
+    assert wrong.value.kind == "UnitError" and "qd[0]" in str(wrong.value) and "[rad/s]" in str(wrong.value)
+
+
+def test_a_msgpack_answer_decodes_by_the_documented_layout_without_pkm(service, delta):
+    """The layout the docs state (docs/tour/robot.md, the schemas, pkm.serve.wire.ND_LAYOUT): extension type 1, its
+    payload msgpack ``[dtype, shape, data]``, C order; decoded here by msgpack alone, a request's arrays sent as
+    plain msgpack lists, the answer equal to the library's."""
+    import msgpack
+
+    from pkm.serve.wire import ND_LAYOUT
+
+    def ext_hook(code, payload):
+        assert code == 1
+        dtype, shape, data = msgpack.unpackb(payload)
+        assert len(data) == int(np.prod(shape)) * np.dtype(dtype).itemsize
+        return np.frombuffer(data, dtype=dtype).reshape(shape)
+
+    qa = _path(delta, 2)
+    r = httpx.post(service.url + "/models/delta/fk", content=msgpack.packb({"qa": qa.tolist()}),
+                   headers={**AUTH, "content-type": "application/msgpack", "accept": "application/msgpack"})
+    answer = msgpack.unpackb(r.content, ext_hook=ext_hook)
+    assert r.status_code == 200 and answer["q"].shape == (2, delta.nq) and answer["q"].dtype == np.dtype("<f8")
+    q = pkm.close_loops(delta, qa[0], delta.q_reference).q
+    assert np.abs(answer["q"][0] - q).max() <= 1e-10
+    assert answer["iterations"].dtype.kind == "i"
+    schema = httpx.get(service.url + "/openapi.json", headers=AUTH).json()
+    assert ND_LAYOUT in schema["info"]["description"] and ND_LAYOUT in json.dumps(schema["components"]["schemas"])
 
 
 def test_the_limiter_answers_busy_when_the_queue_is_full():
@@ -247,7 +324,8 @@ def test_the_compute_limit_answers_while_the_slot_stays_held():
 
 def test_a_short_fuzz_gets_no_500_and_the_service_goes_on(service):
     """300 malformed requests (:mod:`pkm.serve.fuzz`; CI sends 10,000 to a service of its own): none answered 500,
-    every error JSON with a message, the service answering afterwards."""
+    every error JSON with a message, no fk or ik of a coordinate beyond 1e6 (SI) answered as a success, the service
+    answering afterwards."""
     from pkm.serve.fuzz import fuzz
 
     out = fuzz(service.url, 300, token=TOKEN, seed=1)
@@ -275,6 +353,7 @@ def test_jobs_run_apart_and_give_json_and_parquet(client, service, delta):
     modes = client.result(client.job("rrr3", "assembly_modes", qa=rrr3.actuated_q(rrr3.q_reference))["id"])
     direct = pkm.assembly_modes(rrr3, rrr3.actuated_q(rrr3.q_reference))
     assert modes["count"] == len(direct.modes) >= 2 and np.abs(modes["q"] - np.array([m.q for m in direct.modes])).max() < 1e-9
+    assert [[o["joint"] for o in m] for m in modes["outside_limits"]] == [list(m.outside_limits) for m in direct.modes]
     from pkm.client import ServiceError
 
     bad = client.job("delta", "working_modes", y=[1.0, 2.0])  # (a wrong size: the job fails, with the message)
@@ -339,7 +418,8 @@ def test_the_compiled_batches_answer_as_the_python_route(client, delta):
                        ("dynamics", {"qa": qa, "qd": [0.1, 0.0, 0.0], "qdd": [1.0, 0.0, 0.0]})):
         served, local = client.query("delta", name, **body), queries.QUERIES[name](delta, body, None)
         assert served["status"] == local["status"] == ["ok"] * 4
-        for key in set(local) - {"status", "units"}:
+        assert served["outside_limits"] == local["outside_limits"] == [[]] * 4
+        for key in set(local) - {"status", "units", "outside_limits"}:
             assert np.abs(np.asarray(served[key], dtype=float) - local[key]).max() <= 1e-10, (name, key)
     assert served["units"] == local["units"] and served["units"]["M"][0][0] == "N m/(rad/s^2)"
     assert client.fk("delta", qa)["iterations"].dtype.kind == "i"

@@ -6,7 +6,7 @@ Usage::
     pkm preview MECH [--param K=V ...] [--pose K=V ... | --joints NAME=V ...] [--html FILE] [--no-wait]
     pkm ik MECH --pose K=V ... [--param K=V ...] [--branch NAME]
     pkm fk MECH --joints NAME=V ... [--param K=V ...]
-    pkm dynamics MECH [--joints NAME=V ...] [--rates NAME=V ...] [--json]
+    pkm dynamics MECH [--pose K=V ... | --joints NAME=V ...] [--rates NAME=V ...] [--json]
     pkm simulate MECH [--torques FILE.csv | --controller FILE.py:FN] [--duration 2s] [--dt 1ms] --out FILE
     pkm spec init MODEL [--out FILE] [--force]
     pkm report [--out DIR] [--paper NAME ...] [--no-figures] [--no-series]
@@ -20,7 +20,9 @@ MECH is anything :func:`pkm.load` takes (``pkm ik --help`` says what, from the f
 take it as ``--q0 NAME=V ...`` (any joints by name).
 
 Values are SI (m, rad, kg) unless they carry a unit: ``R=120mm``, ``beta=-11deg``, ``z=81cm``
-(lengths m, cm, mm; angles rad, deg; masses kg, g). A parameter's units are those of its field's
+(lengths m, cm, mm; angles rad, deg; masses kg, g), and so do joint values: ``--joints motor_1=-30deg``,
+``--rates motor_3=-30deg/s`` (rad/s, deg/s, rpm; m/s, mm/s), ``--q0``, ``--v0``, read by the route the library
+and the service use (:func:`pkm.units.parse_joint_value`). A parameter's units are those of its field's
 metadata (``La: float = param(0.110, "m")``, stated in brackets in the docstring too); a suffix of
 another kind is refused.
 Tuple parameters take comma-separated values (``home=0,0,-375mm``). Task coordinates not given

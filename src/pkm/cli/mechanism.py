@@ -41,9 +41,11 @@ def add_mechanism_help(action: argparse.Action, before: str = "", after: str = "
     return late_help(action, lambda: before + mech_help() + after)
 
 
-def add_mechanism_arguments(p: argparse.ArgumentParser, pose: str | None, joints: str | None) -> None:
+def add_mechanism_arguments(p: argparse.ArgumentParser, pose: str | None, joints: str | None,
+                            seed: str = "the solver's seed") -> None:
     """``MECH``, ``--param``, ``--actuated``, ``--task``, ``--q0`` and, if asked (``"required"`` or
-    ``"optional"``), ``--pose`` and ``--joints`` (exclusive when both are taken)."""
+    ``"optional"``), ``--pose`` (with ``--branch``) and ``--joints`` (exclusive when both are taken): every command
+    that takes a configuration takes it alike."""
     add_mechanism_help(p.add_argument("mechanism", metavar="MECH"))
     p.add_argument("--param", metavar="K=V", action="extend", nargs="+", default=[],
                    help="a design parameter (see 'pkm list'); default: the paper's design")
@@ -59,8 +61,10 @@ def add_mechanism_arguments(p: argparse.ArgumentParser, pose: str | None, joints
     if joints:
         g.add_argument("--joints", metavar="NAME=V", action="extend", nargs="+", required=joints == "required",
                        help="actuated joint values (others keep the reference; see 'pkm list MECH')")
+    if pose:
+        p.add_argument("--branch", metavar="NAME", help="the working mode --pose is solved on (see 'pkm list MECH')")
     if pose or joints:
-        add_seed_argument(p, "the solver's seed")
+        add_seed_argument(p, seed)
 
 
 def add_seed_argument(p: argparse.ArgumentParser, what: str) -> None:

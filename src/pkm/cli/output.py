@@ -27,8 +27,23 @@ def _branch_of(mech: pkm.Mechanism, q) -> str | None:
     return next((b for b in mech.spec.branches if mech.on_branch(q, b)), None)
 
 
+def outside_limits(mech: pkm.Mechanism, q) -> list[dict[str, Any]]:
+    """The joints of ``q`` outside the position limits the model states, each ``{"joint", "value", "limit"}``
+    [rad, m] (:meth:`pkm.core.Mechanism.limit_violations`): what every command that prints a configuration lists."""
+    return [v._asdict() for v in mech.limit_violations(q)]
+
+
+def outside_line(outside: list[dict[str, Any]]) -> str:
+    """The text line that says :func:`outside_limits` (empty where none is outside)."""
+    return "" if not outside else "warning: outside the position limits the model states: " + ", ".join(
+        f"{o['joint']} = {o['value']:.6g} (limits [{o['limit'][0]:.6g}, {o['limit'][1]:.6g}])" for o in outside)
+
+
 def solution_dict(mech: pkm.Mechanism, res: pkm.SolveResult, **extra) -> dict[str, Any]:
-    """What ``ik`` and ``fk`` print: the solution by name, in SI, with the solver's report."""
+    """What ``ik`` and ``fk`` print: the solution by name, in SI, with the solver's report; ``status`` is ``"ok"``,
+    or ``"outside_limits"`` where a joint lies outside the position limits the model states (``outside_limits``
+    names each with its value and limits: pkm's solvers report limits, they do not enforce them)."""
+    outside = outside_limits(mech, res.q)
     return jsonable({
         "mechanism": mech.name,
         "units": {"length": "m", "angle": "rad",
@@ -41,6 +56,8 @@ def solution_dict(mech: pkm.Mechanism, res: pkm.SolveResult, **extra) -> dict[st
         "residual": res.residual,
         "iterations": res.iterations,
         "converged": res.converged,
+        "status": "outside_limits" if outside else "ok",
+        "outside_limits": outside,
         "branch": _branch_of(mech, res.q) if mech.spec.branches else None,
         "mode": res.mode.as_dict(),
     })
@@ -57,7 +74,7 @@ def modes_dict(mech: pkm.Mechanism, modes, **extra) -> dict[str, Any]:
         "modes": [{"label": m.label, "actuated": dict(zip(mech.actuated_names, mech.actuated_q(m.q))),
                    "task": task_values(mech, m.q), "residual": m.residual, "alpha": m.certificate.alpha,
                    "certified_within": m.certificate.radius if m.certificate.certified else None,
-                   "outside_limits": list(m.outside_limits),
+                   "outside_limits": outside_limits(mech, m.q),
                    "branch": _branch_of(mech, m.q) if mech.spec.branches else None,
                    "mode": pkm.mode_label(mech, m.q).as_dict()} for m in modes],
     })

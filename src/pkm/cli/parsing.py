@@ -1,6 +1,7 @@
 """What the command line says, read: a mechanism's parameters with their units and descriptions (its ``Params``
-dataclass and docstring), and the ``NAME=VALUE`` items of ``--param``, ``--pose``, ``--joints`` and ``--axis``
-as SI values (units as :mod:`pkm.units` reads them)."""
+dataclass and docstring), and the ``NAME=VALUE`` items of ``--param``, ``--pose``, ``--joints``, ``--q0``,
+``--rates`` and ``--axis`` as SI values (units as :mod:`pkm.units` reads them, for joints by
+:func:`pkm.units.parse_joint_value`: the route the library and the service take)."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ import pkm
 from pkm._moved import current_name
 from pkm.cli.usage import UsageError
 from pkm.errors import InvalidInputError, UnknownNameError
-from pkm.units import KIND_OF_UNIT, SI_UNITS, parse_quantity, split_range
+from pkm.units import KIND_OF_UNIT, SI_UNITS, parse_joint_value, parse_quantity, split_range
 
 _UNIT = re.compile(r"\[([A-Za-z][A-Za-z0-9^ /*.-]*|-)\]")
 _ITEM = re.compile(r"^([A-Za-z_]\w*(?:\s*,\s*[A-Za-z_]\w*)*):\s*(.*)$")
@@ -169,6 +170,30 @@ def joint_kind(mech: pkm.Mechanism, name: str) -> str:
     return "angle" if mech.joints[name].revolute else "length"
 
 
+def joint_value(mech: pkm.Mechanism, name: str, text: str, order: str = "position") -> float:
+    """Joint ``name``'s value of ``order`` (``"position"``, ``"rate"``, ``"effort"``) written with or without its
+    unit, in SI (:func:`pkm.units.parse_joint_value`: the route the library and the service take too)."""
+    return parse_joint_value(text, mech.joints[name].revolute, order, name)
+
+
+def parse_task(mech: pkm.Mechanism, items: Sequence[str], option: str = "--pose") -> dict[str, float]:
+    """``--pose`` items ``NAME=VALUE`` (units allowed) as the task coordinates they name, in SI.
+
+    Raises:
+        UnitError: a bad number or unit; UsageError: a missing ``=``.
+        UnknownNameError: A name that is not a task coordinate.
+    """
+    task = pkm.TaskMap.of(mech)
+    out: dict[str, float] = {}
+    for item in items:
+        name, text = split_item(item, option)
+        if name not in task.kinds:
+            raise UnknownNameError("task coordinate", name, list(task.keys), mech.name)
+        kind = task.kinds[name]
+        out[name] = parse_quantity(text, {kind}, name, SI_UNITS[kind])
+    return out
+
+
 def parse_pose(mech: pkm.Mechanism, items: Sequence[str]) -> tuple[dict[str, float], Any]:
     """``--pose`` items as (named values, target for :func:`pkm.solve_ik`); others keep the reference.
 
@@ -176,14 +201,7 @@ def parse_pose(mech: pkm.Mechanism, items: Sequence[str]) -> tuple[dict[str, flo
         UnitError: a bad number or unit; UsageError: a missing ``=``.
         UnknownNameError: A name that is not a task coordinate.
     """
-    task = pkm.TaskMap.of(mech)
-    values = task.named(mech.q_reference)
-    for item in items:
-        name, text = split_item(item, "--pose")
-        if name not in values:
-            raise UnknownNameError("task coordinate", name, list(values), mech.name)
-        kind = task.kinds[name]
-        values[name] = parse_quantity(text, {kind}, name, SI_UNITS[kind])
+    values = pkm.TaskMap.of(mech).named(mech.q_reference) | parse_task(mech, items)
     return values, values
 
 
@@ -195,8 +213,7 @@ def parse_joints(mech: pkm.Mechanism, items: Sequence[str], option: str = "--joi
         UnknownNameError: A name that is not an actuated joint.
     """
     return _actuated_items(mech, items, option, mech.actuated_q(mech.q_reference),
-                           lambda name, text: parse_quantity(text, {joint_kind(mech, name)}, name,
-                                                             SI_UNITS[joint_kind(mech, name)]))
+                           lambda name, text: joint_value(mech, name, text))
 
 
 def parse_seed(mech: pkm.Mechanism, items: Sequence[str] | None, option: str = "--q0") -> np.ndarray | None:
@@ -215,22 +232,21 @@ def parse_seed(mech: pkm.Mechanism, items: Sequence[str] | None, option: str = "
         name, text = split_item(item, option)
         if name not in names:
             raise UnknownNameError("joint of one coordinate", name, names, mech.name)
-        q[mech.joints[name].idx_q] = parse_quantity(text, {joint_kind(mech, name)}, name,
-                                                    SI_UNITS[joint_kind(mech, name)])
+        q[mech.joints[name].idx_q] = joint_value(mech, name, text)
     return q
 
 
 def parse_rates(mech: pkm.Mechanism, items: Sequence[str], option: str = "--rates") -> np.ndarray:
-    """Items ``NAME=VALUE`` as actuated rates, SI numbers [rad/s or m/s] (a unit suffix is refused: rad/s is not
-    rad); actuated joints not named: zero.
+    """Items ``NAME=VALUE`` as actuated rates in SI [rad/s or m/s], written with or without a rate unit
+    (``-30deg/s``, ``300rpm``, ``50mm/s``; a position's unit is refused: deg is not deg/s); actuated joints not
+    named: zero.
 
     Raises:
-        UsageError: Missing ``=``; UnitError: not a number, or a unit suffix.
+        UsageError: Missing ``=``; UnitError: not a number, or a unit that is not a rate's.
         UnknownNameError: A name that is not an actuated joint.
     """
     return _actuated_items(mech, items, option, np.zeros(mech.na),
-                           lambda name, text: parse_quantity(text, {None}, name,
-                                                             "rad/s" if mech.joints[name].revolute else "m/s"))
+                           lambda name, text: joint_value(mech, name, text, "rate"))
 
 
 def _actuated_items(mech: pkm.Mechanism, items: Sequence[str], option: str, values: np.ndarray,

@@ -41,6 +41,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.model.actuators": ("Actuator",),
     "pkm.core.model.builder": ("from_strings", "scaled_mechanism", "with_actuators"),
     "pkm.core.model.mechanism": ("Mechanism",),
+    "pkm.core.dynamics.motors": ("joint_efforts", "motor_efforts", "motor_values"),
     "pkm.core.model.scale": ("scale_configuration",),
     "pkm.core.kinematics.labels": ("ModeLabel", "mode_label"),
     "pkm.core.kinematics.solve": ("ClosureProblem", "IKProblem", "SolveResult", "assemble", "branch_seed",
@@ -86,6 +87,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         mass_matrix,
         operational_space,
     )
+    from pkm.core.dynamics.motors import joint_efforts, motor_efforts, motor_values
     from pkm.core.dynamics.projection import (
         BaseInverseDynamics,
         base_inverse_dynamics,

@@ -46,7 +46,7 @@ import numpy as np
 from pkm.errors import PkmError, UnknownNameError
 from pkm.report import jsonable
 from pkm.serve.store import Store
-from pkm.serve.wire import MSGPACK, pack, unpack
+from pkm.serve.wire import MSGPACK, ND_LAYOUT, pack, unpack
 
 
 def _error(status: int, kind: str, message: str, data: Any = None) -> Any:
@@ -171,7 +171,8 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
     limiter = Limiter(workers, queue)
     jobs = JobManager(job_workers)
     app = FastAPI(title="pkm", version=__version__,
-                  description="Kinematics and dynamics of closed-loop mechanisms: models, queries, streams.",
+                  description="Kinematics and dynamics of closed-loop mechanisms: models, queries, streams. Bodies "
+                              f"and answers are JSON, or msgpack (content-type, accept: {MSGPACK}). {ND_LAYOUT}",
                   docs_url=None, redoc_url=None)
     add_offline_docs(app)  # (/docs and /redoc from local files, not FastAPI's CDN: pkm.serve.offline)
 
@@ -279,11 +280,13 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
                   "multipart/form-data": {"schema": {"$ref": "#/components/schemas/Upload"}}}}})
     async def upload(request: Request) -> Response:
         form = await request.form(max_files=16, max_fields=16)
-        files = {}
-        for _, value in form.multi_items():
+        files, folder = {}, None
+        for key, value in form.multi_items():
             if not isinstance(value, str):
                 files[str(value.filename or "")] = await value.read()
-        entry = await limiter.run(lambda: store.add(files))
+            elif key == "folder":
+                folder = value
+        entry = await limiter.run(lambda: store.add(files, folder=folder))
         return answer(request, vars(entry), 201)
 
     @app.get("/models/{model}", response_model=schemas.ModelDescription, tags=["models"], operation_id="describe_model",
@@ -460,7 +463,10 @@ def create_app(store: Store | None = None, *, token: str | None = None, workers:
             components.update(schemas.request_schemas())
             components["Upload"] = {"type": "object", "required": ["files"], "properties": {"files": {
                 "type": "array", "items": {"type": "string", "format": "binary"},
-                "description": "A model's files (URDF, MJCF, SDF, YAML, a closures TOML...) or one zip or tar of them"}}}
+                "description": "A model's files (URDF, MJCF, SDF, YAML, a closures TOML...) or one zip or tar of them"},
+                "folder": {"type": "string", "description": "The folder the files are in: it names a Gepetto pair "
+                           "whose URDF is robot.urdf, as pkm.load names it (default: an archive's folder, or its "
+                           "name)"}}}
             if token is not None:  # (the bearer scheme: Swagger UI's Authorize button then adds the header)
                 schema["components"]["securitySchemes"] = {"bearer": {
                     "type": "http", "scheme": "bearer", "description": "the token `pkm serve --token` was given"}}

@@ -1,7 +1,9 @@
 """Malformed requests against a running service: every endpoint with wrong types, shapes and units, huge arrays,
 unknown models and queries, broken uploads (bad XML, binary, traversal names, entity bombs), truncated and garbage
-bodies (JSON and msgpack), bad and missing tokens. None may be answered 500, every answer but a success must be
-JSON with a message, the service must still answer afterwards, and its memory must stay bounded.
+bodies (JSON and msgpack), bad and missing tokens, coordinates beyond :data:`pkm.validation.ABSURD`. None may be
+answered 500, every answer but a success must be JSON with a message, a query whose positions hold a coordinate beyond
+the bound must not succeed (it is refused, never wrapped), the service must still answer afterwards, and its memory
+must stay bounded.
 
 ``python -m pkm.serve.fuzz [--requests 10000] [--seed 0]`` starts a service of its own on a free port of 127.0.0.1
 (loopback only), sends the requests, stops it with SIGTERM and prints the counts; exit status 1 on any failure.
@@ -20,6 +22,10 @@ from typing import Any
 MODELS = ("delta", "rrr3", "prs3", "nope", "", "..", "%2e%2e", "a" * 300, "delta%00", "../../etc/passwd")
 QUERIES = ("fk", "ik", "jacobians", "diagnose", "velocities", "dynamics", "capability", "scene", "teleport", "",
            "jobs/map", "jobs/assembly_modes", "jobs/working_modes", "jobs/teleport", "variants")
+#: The queries (not the jobs, whose answer is 202 before their input is read).
+QUERY_NAMES = ("fk", "ik", "jacobians", "diagnose", "velocities", "dynamics", "capability", "scene")
+#: The fields of a query that hold coordinates (m, rad): a number beyond pkm.validation.ABSURD in one is refused.
+POSITIONS = ("qa", "q", "y", "seed")
 #: The typed operations' field names (pkm.serve.schemas), an unknown one and an empty one.
 KEYS = ("qa", "q", "y", "qd", "qdd", "seed", "kind", "branch", "axes", "fixed", "index", "length", "params", "x", "foo",
         "")
@@ -40,7 +46,10 @@ def _value(rng: random.Random, depth: int = 0) -> Any:
         row = [rng.choice(units) if rng.random() < 0.5 else rng.uniform(-1, 1) for _ in range(rng.choice([2, 3, 12]))]
         return row if rng.random() < 0.5 else [row] * rng.choice([1, 2, 5])
     if pick in (3, 4, 5):
-        return [rng.uniform(-3, 3) for _ in range(rng.choice([0, 1, 2, 3, 4, 15, 16, 100]))]
+        row = [rng.uniform(-3, 3) for _ in range(rng.choice([0, 1, 2, 3, 4, 15, 16, 100]))]
+        if row and pick == 5:  # (a coordinate beyond the bound: 1e308 rad was once wrapped and answered 200)
+            row[rng.randrange(len(row))] = rng.choice([1e308, -1e308, 1e7, -2e6])
+        return row
     if pick in (6, 7):
         n = rng.choice([1, 2, 3, 5])
         return [[rng.uniform(-3, 3) for _ in range(rng.choice([2, 3, 15]))] for _ in range(n)]
@@ -53,13 +62,23 @@ def _value(rng: random.Random, depth: int = 0) -> Any:
     return [rng.random()] * rng.choice([3, 50_000])
 
 
+def _absurd(value: Any) -> bool:
+    """Whether ``value`` (a field of a body) holds a finite number beyond :data:`pkm.validation.ABSURD`."""
+    from pkm.validation import ABSURD
+
+    if isinstance(value, (list, tuple)):
+        return any(_absurd(v) for v in value)
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and ABSURD < abs(value) < float("inf")
+
+
 def _body(rng: random.Random) -> tuple[bytes, dict[str, str]]:
     """A request body and its headers: JSON (sometimes truncated or not an object), msgpack (sometimes garbage or a
-    malformed array extension), or raw bytes."""
+    malformed array extension), or raw bytes; :data:`_SENT` keeps the last one's payload."""
     import msgpack  # type: ignore[import-untyped]
 
     kind = rng.randrange(10)
     payload = {rng.choice(KEYS): _value(rng) for _ in range(rng.randrange(1, 4))}
+    _SENT[0] = payload if kind < 7 and kind != 4 else None  # (as sent whole: JSON or msgpack)
     if kind < 5:
         text = json.dumps(payload).encode()
         if kind == 4:
@@ -77,6 +96,8 @@ def _body(rng: random.Random) -> tuple[bytes, dict[str, str]]:
         return bytes(rng.randrange(256) for _ in range(rng.randrange(64))), {"content-type": "application/msgpack"}
     return json.dumps(rng.choice([[1, 2, 3], "qa", 3, None])).encode(), {"content-type": "application/json"}
 
+
+_SENT: list[dict[str, Any] | None] = [None]
 
 _BOMB = (b"<?xml version='1.0'?><!DOCTYPE l [<!ENTITY a 'aaaaaaaaaa'><!ENTITY b '&a;&a;&a;&a;&a;&a;&a;&a;'>"
          b"<!ENTITY c '&b;&b;&b;&b;&b;&b;&b;&b;'><!ENTITY d '&c;&c;&c;&c;&c;&c;&c;&c;'>]><robot name='&d;'/>")
@@ -128,7 +149,14 @@ def fuzz(url: str, n: int, *, token: str | None = None, seed: int = 0) -> dict[s
             model, query = rng.choice(MODELS), rng.choice(QUERIES)
             what = rng.randrange(10)
             try:
-                if what < 6:
+                if what < 6 and rng.random() < 0.1:  # (a shipped model's well-formed fk or ik, one coordinate
+                    row = [rng.uniform(-0.5, 0.5) for _ in range(3)]  # beyond the bound: refused, never wrapped)
+                    row[rng.randrange(3)] = rng.choice([1e308, -1e308, 1e7, -2e6])
+                    model, query = rng.choice(("delta", "rrr3", "prs3")), rng.choice(("fk", "ik"))
+                    _SENT[0] = {"qa" if query == "fk" else "y": row}
+                    body, headers = json.dumps(_SENT[0]).encode(), {"content-type": "application/json"}
+                    r = c.post(f"/models/{model}/{query}", content=body, headers={**auth, **headers})
+                elif what < 6:
                     body, headers = _body(rng)
                     r = c.post(f"/models/{model}/{query}", content=body, headers={**auth, **headers})
                 elif what == 6:
@@ -150,6 +178,12 @@ def fuzz(url: str, n: int, *, token: str | None = None, seed: int = 0) -> dict[s
                 failures.append(f"request {k}: {type(e).__name__}: {e}")
                 continue
             statuses[r.status_code] += 1
+            sent = _SENT[0] if what < 6 else None
+            _SENT[0] = None
+            if r.status_code < 300 and sent is not None and query in QUERY_NAMES and \
+                    any(_absurd(sent.get(key)) for key in POSITIONS):
+                failures.append(f"request {k}: {query} answered {r.status_code} to a coordinate beyond the bound: "
+                                f"{json.dumps(sent)[:200]}")
             if r.status_code >= 500:
                 failures.append(f"request {k}: {r.status_code} {r.text[:200]}")
             elif r.status_code >= 400:

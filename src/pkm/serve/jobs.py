@@ -54,19 +54,24 @@ class Job:
                 "progress": self.progress, "error": self.error, "created": self.created, "finished": self.finished}
 
 
+def _outside(mech: Mechanism, Q: np.ndarray) -> list[list[dict[str, Any]]]:
+    """Per mode, the joints outside the position limits the model states (joint, value, limit)."""
+    return [[v._asdict() for v in mech.limit_violations(q)] for q in Q]
+
+
 def _modes(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """Every assembly mode at ``qa`` (:func:`pkm.assembly_modes`)."""
     from pkm.core.modes import assembly_modes
-    from pkm.serve.queries import _array, _position_kinds, _q_units, _value_units
+    from pkm.serve.queries import _array, _input_units, _q_units, _value_units
 
-    qa = _array(body, "qa", mech.na, _position_kinds(mech, "qa"))[0]
+    qa = _array(body, "qa", mech.na, _input_units(mech, "qa"))[0]
     s = assembly_modes(mech, qa)
     Q = np.array([m.q for m in s.modes]) if s.modes else np.zeros((0, mech.nq))
     task = pkm.TaskMap.of(mech)
     Y = np.array([task.value(q) for q in Q]) if len(Q) else np.zeros((0, task.value_size))
     residual = np.array([m.residual for m in s.modes])
     out = {"count": len(s.modes), "complete": bool(s.complete), "q": Q, "y": Y, "residual": residual,
-           "labels": [str(m.label) for m in s.modes], "seconds": s.seconds,
+           "labels": [str(m.label) for m in s.modes], "outside_limits": _outside(mech, Q), "seconds": s.seconds,
            "units": {"q": _q_units(mech), "y": _value_units(mech), "residual": "m or rad", "seconds": "s"}}
     return out, {"mode": np.arange(len(Q)), **{f"q{i}": Q[:, i] for i in range(Q.shape[1])},
                  **{f"y{i}": Y[:, i] for i in range(Y.shape[1])}, "residual": residual}
@@ -75,38 +80,46 @@ def _modes(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str
 def _working(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """Every working mode at the task value ``y`` (:func:`pkm.working_modes`)."""
     from pkm.core.modes import working_modes
-    from pkm.serve.queries import _actuated_units, _array, _position_kinds, _q_units
+    from pkm.serve.queries import _actuated_units, _array, _input_units, _q_units
 
-    y = _array(body, "y", pkm.TaskMap.of(mech).value_size, _position_kinds(mech, "y"))[0]
+    y = _array(body, "y", pkm.TaskMap.of(mech).value_size, _input_units(mech, "y"))[0]
     s = working_modes(mech, y)
     Q = np.array([m.q for m in s.modes]) if s.modes else np.zeros((0, mech.nq))
     QA = Q[:, mech.act_q] if len(Q) else np.zeros((0, mech.na))
     out = {"count": len(s.modes), "complete": bool(s.complete), "q": Q, "qa": QA,
-           "labels": [str(m.label) for m in s.modes], "seconds": s.seconds,
+           "labels": [str(m.label) for m in s.modes], "outside_limits": _outside(mech, Q), "seconds": s.seconds,
            "units": {"q": _q_units(mech), "qa": _actuated_units(mech), "seconds": "s"}}
     return out, {"mode": np.arange(len(Q)), **{f"qa{i}": QA[:, i] for i in range(QA.shape[1])}}
 
 
 def _map(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
-    """A workspace map (:func:`pkm.workspace_map`): ``axes`` ``{name: [start, stop, count]}`` (SI), ``fixed``,
-    ``length``; with ``index`` (``wrench``, ``twist``, ``acceleration``) the capability at every node."""
+    """A workspace map (:func:`pkm.workspace_map`): ``axes`` ``{name: [start, stop, count]}`` (SI, or start and stop
+    with units: ``["-5cm", "5cm", 11]``, as ``pkm map --axis x=-5cm:5cm:11``), ``fixed``, ``length`` (units allowed
+    too); with ``index`` (``wrench``, ``twist``, ``acceleration``) the capability at every node."""
     from pkm.core.analysis.maps import MAX_NODES, workspace_map
+    from pkm.units import quantity
 
     axes_in = body.get("axes")
     if not isinstance(axes_in, Mapping) or not 1 <= len(axes_in) <= 3:
         raise InvalidInputError("axes", "give {name: [start, stop, count]} for 1 to 3 task coordinates", axes_in)
     axes = {}
+    kinds = pkm.TaskMap.of(mech).kinds
     for name, spec in axes_in.items():
-        if not (isinstance(spec, (list, tuple)) and len(spec) == 3 and all(isinstance(x, (int, float)) for x in spec)
-                and float(spec[2]).is_integer() and 1 <= spec[2] <= MAX_NODES):
-            raise InvalidInputError(f"axes.{name}", "[start, stop, count] (SI, count a positive integer)", spec)
-        axes[str(name)] = np.linspace(float(spec[0]), float(spec[1]), int(spec[2]))
+        if not (isinstance(spec, (list, tuple)) and len(spec) == 3
+                and all(isinstance(x, (int, float, str)) and not isinstance(x, bool) for x in spec[:2])
+                and isinstance(spec[2], (int, float)) and float(spec[2]).is_integer() and 1 <= spec[2] <= MAX_NODES):
+            raise InvalidInputError(f"axes.{name}", "[start, stop, count] (SI numbers or strings with a unit, count a "
+                                                    "positive integer)", spec)
+        if name not in kinds:
+            raise UnknownNameError("task coordinate", str(name), list(kinds), mech.name)
+        start, stop = (quantity(x, kinds[name], f"axes.{name}") for x in spec[:2])
+        axes[str(name)] = np.linspace(start, stop, int(spec[2]))
     fixed = body.get("fixed")
     if fixed is not None and not isinstance(fixed, Mapping):
         raise InvalidInputError("fixed", "{task coordinate: value}", fixed)
     length = body.get("length")
     index = body.get("index")
-    m = workspace_map(mech, axes, fixed, length=None if length is None else float(length),
+    m = workspace_map(mech, axes, fixed, length=None if length is None else quantity(length, "length", "length"),
                       configurations=index is not None)
     job.progress = 0.7
     grids = np.meshgrid(*[v for _, v in reversed(m.axes)], indexing="ij")

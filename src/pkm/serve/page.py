@@ -200,6 +200,8 @@ async function update() {
     rows.push("<tr><td>direct singularity</td><td>" + fmt(diag.direct_distance[0]) + "</td></tr>");
     rows.push("<tr><td>inverse singularity</td><td>" + fmt(diag.inverse_distance[0]) + "</td></tr>");
     rows.push("<tr><td>closure residual</td><td>" + fmt(fk.residual[0]) + " m or rad</td></tr>");
+    const outside = fk.outside_limits[0].map(function (o) { return o.joint + " = " + fmt(o.value); });
+    rows.push("<tr><td>outside the limits</td><td>" + (outside.length ? outside.join(", ") : "none") + "</td></tr>");
     document.getElementById("readout").innerHTML = rows.join("");
     state.updates += 1;
     say("fk " + (fk.compute_s * 1e3).toFixed(2) + " ms", false);

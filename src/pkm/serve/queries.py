@@ -4,15 +4,18 @@ forward kinematics, the Jacobians and the dynamic model run through the model's 
 :class:`pkm.Kernels`, where they build; the same answers to 1e-12) and fall back to the library's Python route, sample
 by sample, where the kernels refuse a sample.
 
-Inputs follow the Python API's and the CLI's conventions: positions (``qa``, ``q``, ``y``, ``seed``) are numbers in SI
-or strings with a unit (``"10deg"``, ``"5mm"``, :mod:`pkm.units`); where a configuration is asked, either the full
-``q`` or the actuated ``qa`` (the loops then closed from ``seed``, default the reference, each sample from the
-previous one's solution), exactly one of the two. Inputs are checked by pkm's own validation: a bad one is a
+Inputs follow the Python API's and the CLI's conventions: positions (``qa``, ``q``, ``y``, ``seed``) and rates
+(``qd``) are numbers in SI or strings with a unit of their kind (``"10deg"``, ``"5mm"``; ``"-30deg/s"``, ``"300rpm"``:
+:mod:`pkm.units`, each entry by its column's unit, :func:`_input_units`), accelerations (``qdd``) numbers; where a
+configuration is asked, either the full ``q`` or the actuated ``qa`` (the loops then closed from ``seed``, default
+the reference, each sample from the previous one's solution), exactly one of the two. Inputs are checked by pkm's own validation: a bad one is a
 :class:`~pkm.errors.PkmError` naming the field, which the service answers with 422.
 
 Every answer carries ``units`` for every quantity it returns (SI: ``m``, ``rad``, ``N``, ``N m``, per coordinate;
-a matrix's per entry) and what certifies it: the status of each sample (``"ok"`` or ``"failed"``) and, where some
-failed, ``failures`` (each one's sample, error and message). A failed sample's values are ``None`` (JSON ``null``), the
+a matrix's per entry) and what certifies it: the status of each sample (``"ok"``, ``"outside_limits"`` or
+``"failed"``), ``outside_limits`` (per sample, the joints outside the position limits the model states, each with
+its value and limits: pkm's solvers report limits, they do not enforce them) and, where some failed, ``failures``
+(each one's sample, error and message). A failed sample's values are ``None`` (JSON ``null``), the
 batch keeps its length; a query given ONE sample (not a list of samples) whose sample fails raises that sample's
 :class:`~pkm.errors.PkmError` instead (the service's 4xx). Counts (``iterations``) are integers.
 """
@@ -29,8 +32,8 @@ import numpy as np
 import pkm
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, PkmError
-from pkm.units import KIND_OF_UNIT, parse_quantity
-from pkm.validation import as_array
+from pkm.units import KIND_OF_UNIT, joint_unit, parse_quantity
+from pkm.validation import as_array, bounded
 
 #: Samples in one request at most.
 MAX_SAMPLES = 100_000
@@ -53,9 +56,7 @@ def _per_mechanism(fn: _F) -> _F:
 
 
 def _unit(mech: Mechanism, joint: str, kind: str = "position") -> str:
-    revolute = mech.joints[joint].revolute
-    return {"position": "rad" if revolute else "m", "rate": "rad/s" if revolute else "m/s",
-            "acceleration": "rad/s^2" if revolute else "m/s^2", "effort": "N m" if revolute else "N"}[kind]
+    return joint_unit(mech.joints[joint].revolute, kind)
 
 
 @_per_mechanism
@@ -118,11 +119,17 @@ def _rates(units: Sequence[str], per: str = "/s") -> list[str]:
     return [u + per for u in units]
 
 
+#: The order (:data:`pkm.units.JOINT_UNITS`) of each actuated input.
+_ACTUATED = {"qa": "position", "qd": "rate", "qdd": "acceleration", "tau": "effort"}
+
+
 @_per_mechanism
-def _position_kinds(mech: Mechanism, what: str) -> list[str | None]:
-    """The :mod:`pkm.units` kinds of the entries of ``q``, ``qa`` or ``y`` (``what``)."""
-    units = {"q": _q_units, "qa": _actuated_units, "y": _value_units}[what](mech)
-    return _kinds(units)
+def _input_units(mech: Mechanism, what: str) -> tuple[str, ...]:
+    """The unit of every entry of the input ``what``: ``q``, ``y`` (positions), ``qa``, ``qd``, ``qdd``, ``tau``
+    (the actuated positions, rates, accelerations, efforts); a string entry takes a suffix of its unit's kind."""
+    if what in _ACTUATED:
+        return tuple(_actuated_units(mech, _ACTUATED[what]))
+    return tuple({"q": _q_units, "y": _value_units}[what](mech))
 
 
 def _kinds(units: Sequence[str]) -> list[str | None]:
@@ -131,8 +138,11 @@ def _kinds(units: Sequence[str]) -> list[str | None]:
     return [KIND_OF_UNIT.get(u) for u in units]
 
 
-def _with_units(raw: Any, key: str, kinds: Sequence[str | None]) -> Any:
-    """``raw`` (one sample or a list of samples) with every string entry converted to SI by its column's kind."""
+def _with_units(raw: Any, key: str, units: Sequence[str]) -> Any:
+    """``raw`` (one sample or a list of samples) with every string entry converted to SI by its column's unit (a
+    suffix of its kind, :func:`pkm.units.parse_quantity`; a unit without suffixes, ``rad/s^2``: a plain number)."""
+    kinds = _kinds(units)
+
     def convert(sample: Any, where: str) -> Any:
         if not isinstance(sample, (list, tuple)):
             return sample
@@ -140,8 +150,8 @@ def _with_units(raw: Any, key: str, kinds: Sequence[str | None]) -> Any:
         for i, v in enumerate(sample):
             if isinstance(v, str):
                 kind = kinds[i] if i < len(kinds) else None
-                v = parse_quantity(v, set() if kind is None else {kind}, f"{where}[{i}]",
-                                   {"length": "m", "angle": "rad"}.get(kind or "", "a plain number"))
+                unit = units[i] if i < len(units) and units[i] != "1" else "a plain number"
+                v = parse_quantity(v, set() if kind is None else {kind}, f"{where}[{i}]", unit)
             out.append(v)
         return out
 
@@ -153,45 +163,47 @@ def _with_units(raw: Any, key: str, kinds: Sequence[str | None]) -> Any:
 def _has_string(raw: Any) -> bool:
     if isinstance(raw, str):
         return True
+    if isinstance(raw, np.ndarray):
+        return raw.dtype.kind in "UO" and _has_string(raw.tolist())
     if isinstance(raw, (list, tuple)):
         return any(_has_string(v) for v in raw)
     return False
 
 
-def _optional(body: Mapping[str, Any], key: str, size: int, kinds: Sequence[str | None] | None = None
-              ) -> np.ndarray | None:
+def _optional(body: Mapping[str, Any], key: str, size: int, units: Sequence[str]) -> np.ndarray | None:
     """``body[key]`` as an (n, size) array (a single sample as n = 1), finite, at most :data:`MAX_SAMPLES` rows;
-    None when absent. With ``kinds`` (one per column), entries may be strings with units."""
+    None when absent. ``units`` (one per column, :func:`_input_units`): an entry may be a string with a unit of
+    its column's kind (``"10deg"``, ``"-30deg/s"``, ``"2 N m"``: :func:`pkm.units.parse_quantity`)."""
     if key not in body or body[key] is None:
         return None
-    return _array(body, key, size, kinds)
+    return _array(body, key, size, units)
 
 
-def _array(body: Mapping[str, Any], key: str, size: int, kinds: Sequence[str | None] | None = None) -> np.ndarray:
+def _array(body: Mapping[str, Any], key: str, size: int, units: Sequence[str]) -> np.ndarray:
     """``body[key]`` as :func:`_optional` gives it, required."""
+    what = f"{size} numbers a sample [{', '.join(units)}] or strings with a unit ('10deg', '-30deg/s')"
     if key not in body or body[key] is None:
-        raise InvalidInputError(key, f"missing: give {size} numbers, or a list of such samples")
+        raise InvalidInputError(key, f"missing: give {what}, or a list of such samples")
     raw = body[key]
-    what = f"numbers ({size} a sample)"
+    if isinstance(raw, np.ndarray) and raw.dtype.kind in "UO":
+        raw = raw.tolist()
     try:  # (numbers first: a batch of plain numbers is not walked in Python for strings)
         a = as_array(raw, key, what)  # (strings, booleans, ragged lists refused)
     except InvalidInputError:
         if not _has_string(raw):
             raise
-        if kinds is None:
-            raise InvalidInputError(key, "numbers in SI (rad/s, m/s, rad/s^2...): unit strings such as '10deg' are "
-                                         "taken for positions (qa, q, y, seed) only", raw) from None
-        a = as_array(_with_units(raw, key, kinds), key, what)  # (a unit string: pkm.units)
+        a = as_array(_with_units(raw, key, units), key, what)  # (a unit string: pkm.units)
     if a.ndim == 1:
         a = a[None]
     if a.ndim != 2 or a.shape[1] != size:
-        raise InvalidInputError(key, f"expected {size} numbers a sample, got shape {list(np.shape(raw))}")
+        raise InvalidInputError(key, f"expected {what}, got shape {list(np.shape(raw))}")
     if len(a) > MAX_SAMPLES:
         raise InvalidInputError(key, f"more than {MAX_SAMPLES} samples in one request: send them in parts", len(a))
     if not np.all(np.isfinite(a)):
         bad = np.argwhere(~np.isfinite(a))[0]
         raise InvalidInputError(key, f"sample {bad[0]}, entry {bad[1]} is not finite")
-    return a
+    positions = all(u in ("m", "rad", "1") for u in units)
+    return bounded(a, key) if positions else a  # (positions: the library's bound, beyond it refused)
 
 
 def _is_single(body: Mapping[str, Any], *keys: str) -> bool:
@@ -210,7 +222,7 @@ def _is_single(body: Mapping[str, Any], *keys: str) -> bool:
 
 def _seed(mech: Mechanism, body: Mapping[str, Any]) -> np.ndarray:
     """The configuration the first sample is solved from: ``seed`` (nq, one sample), default the reference."""
-    seed = _optional(body, "seed", mech.nq, _position_kinds(mech, "q"))
+    seed = _optional(body, "seed", mech.nq, _input_units(mech, "q"))
     if seed is not None and len(seed) != 1:
         raise InvalidInputError("seed", f"one configuration ({mech.nq} numbers), not {len(seed)}")
     return mech.q_reference if seed is None else seed[0]
@@ -270,6 +282,34 @@ class _Samples:
         return out
 
 
+def _limits(fn: _F) -> _F:
+    """``fn``'s answer with, per sample, ``outside_limits`` (its ``q``'s
+    :meth:`~pkm.core.Mechanism.limit_violations`, as maps ``joint``, ``value``, ``limit``; None for a failed sample) and the status ``"outside_limits"`` where that is not empty: pkm's solvers report limits, they do not
+    enforce them, and an answer outside them is not plain ``"ok"``."""
+    @functools.wraps(fn)
+    def answer(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
+        out = fn(mech, body, kernels)
+        status, q = out["status"], out["q"]
+        outside: list[list[dict[str, Any]] | None] = [None if st != "ok" else [] for st in status]
+        named = [n for n in mech.limits if n in mech.joints]
+        if named:
+            ok = [k for k, st in enumerate(status) if st == "ok"]
+            Q = np.array([q[k] for k in ok], dtype=float).reshape(len(ok), mech.nq)
+            idx = [mech.joints[n].idx_q for n in named]
+            lo, hi = np.array([mech.limits[n] for n in named]).T
+            near = np.flatnonzero(np.any((Q[:, idx] < lo) | (Q[:, idx] > hi), axis=1))  # (then with the tolerance)
+            for i in near:
+                k = ok[int(i)]
+                outside[k] = [v._asdict() for v in mech.limit_violations(Q[i])]
+                if outside[k]:
+                    status[k] = "outside_limits"
+        out["outside_limits"] = outside
+        out["units"]["outside_limits"] = "m or rad (each joint's, as in q)"
+        return out
+
+    return answer  # type: ignore[return-value]
+
+
 def _value(v: Any) -> Any:
     """One sample's value: an array as a numpy array, a number as a plain Python one."""
     if v is None or isinstance(v, (bool, int, float)):
@@ -320,9 +360,9 @@ def _configurations(mech: Mechanism, body: Mapping[str, Any], kernels: Any, *oth
                                          "closed from seed, default the reference)")
     single = _is_single(body, "q" if has_q else "qa", *others)
     if has_q:
-        q = _array(body, "q", mech.nq, _position_kinds(mech, "q"))
+        q = _array(body, "q", mech.nq, _input_units(mech, "q"))
         return q, _Samples(len(q), single)
-    qa = _array(body, "qa", mech.na, _position_kinds(mech, "qa"))
+    qa = _array(body, "qa", mech.na, _input_units(mech, "qa"))
     q, _, _, errors = _close(mech, qa, _seed(mech, body), kernels)
     return q, _Samples(len(q), single, errors)
 
@@ -332,12 +372,13 @@ def _actuated_units(mech: Mechanism, kind: str = "position") -> list[str]:
     return [_unit(mech, j, kind) for j in mech.actuated_names]
 
 
+@_limits
 def fk(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """Forward kinematics (the loop closure): ``qa`` (na per sample) -> ``q`` (nq), ``y`` (task value), the closure
     ``residual`` [m, rad], the Newton ``iterations``. Samples are solved in order, each from the previous one's
     solution (the first from ``seed``, default the reference): a stream of actuator values stays on one assembly
     mode."""
-    qa = _array(body, "qa", mech.na, _position_kinds(mech, "qa"))
+    qa = _array(body, "qa", mech.na, _input_units(mech, "qa"))
     Q, residual, iterations, errors = _close(mech, qa, _seed(mech, body), kernels)
     samples = _Samples(len(qa), _is_single(body, "qa"), errors)
     Y = [None if e is not None else pkm.TaskMap.of(mech).value(Q[k]) for k, e in enumerate(errors)]
@@ -347,13 +388,14 @@ def fk(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[st
     return out
 
 
+@_limits
 def ik(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """Inverse kinematics: ``y`` (task values, laid out as ``task_value_names``) -> ``q``, ``qa``, ``residual``,
     ``iterations``; each sample from the previous one's solution (the first from ``seed``), in the working mode
     ``branch`` (a named branch of the spec) when given."""
     from pkm.core.kinematics.solve import solve_ik
 
-    y = _array(body, "y", pkm.TaskMap.of(mech).value_size, _position_kinds(mech, "y"))
+    y = _array(body, "y", pkm.TaskMap.of(mech).value_size, _input_units(mech, "y"))
     seed = _seed(mech, body)
     branch = body.get("branch")
     if branch is not None and not isinstance(branch, str):
@@ -377,6 +419,7 @@ def _jacobian_units(mech: Mechanism) -> dict[str, Any]:
     return {"J": _matrix_units(task, act), "K": _matrix_units(act, task), "q": _q_units(mech)}
 
 
+@_limits
 def jacobians(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations (``q``, or ``qa`` closed): the forward Jacobian ``J`` (task rates per actuated rate)
     and the inverse ``K`` (actuated rates per task rate), with ``q``."""
@@ -396,6 +439,7 @@ def jacobians(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> 
     return out
 
 
+@_limits
 def diagnose(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations (``q``, or ``qa`` closed): the distances to the direct and inverse singularities
     (:func:`pkm.diagnose`: smallest over largest singular value of the homogenised Jacobians, in [0, 1]), with
@@ -413,6 +457,7 @@ def diagnose(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> d
     return out
 
 
+@_limits
 def velocities(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations (``q``, or ``qa`` closed) and actuated rates ``qd``: every joint's rate ``v`` and the
     task rates ``yd``; with the actuated accelerations ``qdd`` too, every joint's acceleration ``a`` (the loops closed
@@ -421,8 +466,8 @@ def velocities(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) ->
     from pkm.core.differential.velocity import velocities as joint_rates
 
     q, configured = _configurations(mech, body, kernels, "qd", "qdd")
-    qd = _array(body, "qd", mech.na)
-    qdd = _optional(body, "qdd", mech.na)
+    qd = _array(body, "qd", mech.na, _input_units(mech, "qd"))
+    qdd = _optional(body, "qdd", mech.na, _input_units(mech, "qdd"))
     n = _same_length(q=q, qd=qd, qdd=qdd)
     samples = _Samples(n, configured.single, [configured.errors[0 if len(q) == 1 else k] for k in range(n)])
 
@@ -442,14 +487,15 @@ def velocities(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) ->
     return out
 
 
+@_limits
 def dynamics(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """The actuator-space model at closed states (``q``, or ``qa`` closed; ``qd``, default 0): ``M`` (``M_a``),
     ``h`` (``h_a``), ``g`` (``g_a``), and with ``qdd`` the inverse dynamics ``tau = M_a qdd + h_a`` [N m, N]."""
     from pkm.core.dynamics.model import actuator_model
 
     q, configured = _configurations(mech, body, kernels, "qd", "qdd")
-    qd = _optional(body, "qd", mech.na)
-    qdd = _optional(body, "qdd", mech.na)
+    qd = _optional(body, "qd", mech.na, _input_units(mech, "qd"))
+    qdd = _optional(body, "qdd", mech.na, _input_units(mech, "qdd"))
     n = _same_length(q=q, qd=qd, qdd=qdd)
     samples = _Samples(n, configured.single, [configured.errors[0 if len(q) == 1 else k] for k in range(n)])
     keys = ("q", "M", "h", "g") + (("tau",) if qdd is not None else ())
@@ -482,6 +528,7 @@ def dynamics(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> d
     return out
 
 
+@_limits
 def capability(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At closed configurations (``q``, or ``qa`` closed), the ``kind`` capability (``wrench``, ``twist``,
     ``acceleration``) under the actuators' limits: the largest value along each task axis each way, the largest
@@ -522,6 +569,7 @@ def _capability_labels(mech: Mechanism, kind: str) -> tuple[tuple[str, ...], tup
 _SCENES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
+@_limits
 def scene(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
     """At configurations (``q``, or ``qa`` closed): the world placement of every body of the model's 3-D scene (the
     preview page's, :class:`pkm.viz.scene.Scene`), as ``paths`` (meshcat paths) and ``matrices`` (per sample and

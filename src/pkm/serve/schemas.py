@@ -4,8 +4,8 @@ an example.
 
 Arrays are NOT parsed by pydantic (a ``list[list[float]]`` of 10,000 samples would cost more than the query): an array
 field's type (:data:`Positions`, :data:`Numbers`) documents its JSON schema (one sample: an array of numbers; a batch:
-an array of such arrays; positions also as strings with a unit, ``"10deg"``, ``"5mm"``) and hands the raw value, a
-list or a numpy array from a msgpack body, to pkm's own parsing (:mod:`pkm.serve.queries`: :func:`pkm.validation.as_array`,
+an array of such arrays; positions and rates also as strings with a unit, ``"10deg"``, ``"5mm"``, ``"-30deg/s"``) and
+hands the raw value, a list or a numpy array from a msgpack body (:data:`pkm.serve.wire.ND_LAYOUT`), to pkm's own parsing (:mod:`pkm.serve.queries`: :func:`pkm.validation.as_array`,
 :mod:`pkm.units`). The answers' arrays are ``null`` for a failed sample (never NaN, never a number as a string).
 """
 
@@ -15,6 +15,8 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, WithJsonSchema
 
+from pkm.serve.wire import ND_LAYOUT
+
 _NUMBER: dict[str, Any] = {"type": "number"}
 _NUMBER_OR_UNIT: dict[str, Any] = {"anyOf": [_NUMBER, {"type": "string"}]}
 _VECTOR: dict[str, Any] = {"type": "array", "items": _NUMBER}
@@ -22,26 +24,37 @@ _MATRIX: dict[str, Any] = {"type": "array", "items": _VECTOR}
 
 
 def _samples(entry: dict[str, Any]) -> dict[str, Any]:
-    """One sample (an array of ``entry``) or a batch (an array of such arrays)."""
-    return {"anyOf": [{"type": "array", "items": entry}, {"type": "array", "items": {"type": "array", "items": entry}}]}
+    """One sample (an array of ``entry``) or a batch (an array of such arrays); in msgpack either one may be a numpy
+    array (:data:`pkm.serve.wire.ND_LAYOUT`, said in the schema: a field's own description replaces a type's)."""
+    return {"anyOf": [{"type": "array", "items": entry, "description": f"One sample. {ND_LAYOUT}"},
+                      {"type": "array", "items": {"type": "array", "items": entry},
+                       "description": f"A list of samples. {ND_LAYOUT}"}]}
 
 
 #: Positions: one sample (numbers in SI, or strings with a unit: ``"10deg"``, ``"5mm"``) or a list of samples.
 Positions = Annotated[Any, WithJsonSchema(_samples(_NUMBER_OR_UNIT))]
-#: Rates or accelerations (numbers in SI): one sample or a list of samples.
+#: Rates (numbers in SI, or strings with a rate's unit: ``"-30deg/s"``, ``"300rpm"``, ``"50mm/s"``): one sample or a
+#: list of samples.
+Rates = Positions
+#: Accelerations (numbers in SI: no unit suffix names one): one sample or a list of samples.
 Numbers = Annotated[Any, WithJsonSchema(_samples(_NUMBER))]
 #: One configuration (numbers in SI, or strings with a unit).
 Configuration = Annotated[Any, WithJsonSchema({"type": "array", "items": _NUMBER_OR_UNIT})]
 
+def _column(entry: dict[str, Any]) -> dict[str, Any]:
+    """An answer's column of ``entry`` per sample; in msgpack, where no sample failed, a numpy array (the layout in
+    its description: a field's own description replaces a type's, not a branch's)."""
+    return {"allOf": [{"type": "array", "items": {"anyOf": [*(entry if isinstance(entry, list) else [entry]),
+                                                             {"type": "null"}]},
+                       "description": f"One entry per sample, null where the sample failed. {ND_LAYOUT}"}]}
+
+
 #: An answer's column: one entry per sample (a number, a vector or a matrix), ``null`` where the sample failed.
-Column = Annotated[Any, WithJsonSchema({"type": "array", "items": {"anyOf": [_NUMBER, _VECTOR, _MATRIX,
-                                                                              {"type": "null"}]}})]
+Column = Annotated[Any, WithJsonSchema(_column([_NUMBER, _VECTOR, _MATRIX]))]
 #: Integers per sample (``null`` where the sample failed).
-IntColumn = Annotated[Any, WithJsonSchema({"type": "array", "items": {"anyOf": [{"type": "integer"},
-                                                                                 {"type": "null"}]}})]
+IntColumn = Annotated[Any, WithJsonSchema(_column({"type": "integer"}))]
 #: Booleans per sample (``null`` where the sample failed).
-BoolColumn = Annotated[Any, WithJsonSchema({"type": "array", "items": {"anyOf": [{"type": "boolean"},
-                                                                                  {"type": "null"}]}})]
+BoolColumn = Annotated[Any, WithJsonSchema(_column({"type": "boolean"}))]
 #: Units: a unit per quantity (one for all its entries), per entry, or per matrix entry.
 Units = dict[str, str | list[str] | list[list[str]]]
 UNITS = "The unit of every quantity of the answer and of its inputs: one for all entries, one per entry, or one per " \
@@ -111,7 +124,8 @@ class SceneRequest(_AtConfigurations):
 class VelocitiesRequest(_AtConfigurations):
     """Every joint's rate (and acceleration) from the actuated ones."""
 
-    qd: Numbers = _field("Actuated rates (na a sample: rad/s, m/s), one for every sample or one per sample.",
+    qd: Rates = _field("Actuated rates (na a sample: rad/s, m/s, or strings with a unit such as '-30deg/s', '300rpm', "
+                       "'50mm/s'), one for every sample or one per sample.",
                          [0.1, 0.0, 0.0])
     qdd: Numbers | None = _field("Actuated accelerations (na a sample: rad/s^2, m/s^2); with them the accelerations "
                                  "are answered too.", [1.0, 0.0, 0.0], None)
@@ -120,7 +134,8 @@ class VelocitiesRequest(_AtConfigurations):
 class DynamicsRequest(_AtConfigurations):
     """The actuator-space dynamic model, and the inverse dynamics with qdd."""
 
-    qd: Numbers | None = _field("Actuated rates (na a sample: rad/s, m/s); default 0.", [0.1, 0.0, 0.0], None)
+    qd: Rates | None = _field("Actuated rates (na a sample: rad/s, m/s, or strings with a unit such as '-30deg/s', "
+                              "'300rpm'); default 0.", [0.1, 0.0, 0.0], None)
     qdd: Numbers | None = _field("Actuated accelerations (na a sample: rad/s^2, m/s^2); with them the efforts tau are "
                                  "answered.", [1.0, 0.0, 0.0], None)
 
@@ -140,14 +155,28 @@ class Failure(_Answer):
     message: str = _field("What went wrong, in words.", "pose unreachable: leg 1 misses by 0.64 m or rad")
 
 
-_STATUS = _field("Per sample: 'ok', or 'failed' (its values are then null, its error in failures).", ["ok"])
+_STATUS = _field("Per sample: 'ok'; 'outside_limits' (solved, but a joint lies outside the position limits the "
+                 "model states: named in outside_limits); or 'failed' (its values are then null, its error in "
+                 "failures).", ["ok"])
+_OUTSIDE = _field("Per sample, the joints outside the position limits the model states (empty: none; null: a failed "
+                  "sample), each with its value and limits [rad, m].",
+                  [[{"joint": "motor_1", "value": 1.62, "limit": [-1.5, 1.5]}]])
 _FAILURES = _field("The failed samples with their error (absent when every sample is ok).", None, None)
 _COMPUTE = _field("The server's time for the computation [s].", 0.0004)
 _ANSWER_Q = _field("The closed configurations (nq a sample: units in units.q).", [_Q_EXAMPLE])
 
 
+class OutsideLimit(_Answer):
+    """A joint outside the position limits the model states."""
+
+    joint: str = _field("The joint's name.", "motor_1")
+    value: float = _field("Its coordinate [rad, m].", 1.62)
+    limit: list[float | None] = _field("Its limits [lower, upper] [rad, m] (null: no limit that side).", [-1.5, 1.5])
+
+
 class _Batch(_Answer):
-    status: list[Literal["ok", "failed"]] = _STATUS
+    status: list[Literal["ok", "outside_limits", "failed"]] = _STATUS
+    outside_limits: list[list[OutsideLimit] | None] = _OUTSIDE
     failures: list[Failure] | None = _FAILURES
     compute_s: float = _COMPUTE
 
@@ -382,12 +411,13 @@ class WorkingModesJob(_Request):
 class MapJob(_Request):
     """A workspace map (pkm.workspace_map), optionally with the capability at every node."""
 
-    axes: dict[str, list[float]] = _field("1 to 3 task coordinates, each [start, stop, count] (SI; count an integer).",
-                                          {"x": [-0.1, 0.1, 21], "y": [-0.1, 0.1, 21]})
+    axes: dict[str, list[float | str]] = _field("1 to 3 task coordinates, each [start, stop, count] (start and stop in "
+                                                "SI or strings with a unit, '-10cm'; count an integer).",
+                                                {"x": [-0.1, 0.1, 21], "y": ["-10cm", "10cm", 21]})
     fixed: dict[str, float | str] | None = _field("The other task coordinates' values (SI, or strings with a unit).",
                                                   {"z": -0.35}, None)
-    length: float | None = _field("The characteristic length of the condition index [m]; default the model's.",
-                                  None, None)
+    length: float | str | None = _field("The characteristic length of the condition index [m, or a string with a "
+                                        "unit: '5cm']; default the model's.", None, None)
     index: Literal["wrench", "twist", "acceleration"] | None = _field("A capability to map too.", None, None)
 
 
@@ -402,6 +432,11 @@ class SweepJob(_Request):
     workers: int | None = _field("Local workers (1 to 8).", None, None)
 
 
+_MODES_OUTSIDE = _field("Per mode, the joints outside the position limits the model states, each with its value "
+                        "and limits [rad, m] (empty: none; a mode is geometry, listed whether or not it is within).",
+                        [[]])
+
+
 class AssemblyModesResult(_Answer):
     count: int = _field("Assembly modes found.", 2)
     complete: bool = _field("Whether the search is certified complete.", True)
@@ -409,6 +444,7 @@ class AssemblyModesResult(_Answer):
     y: list[list[float]] = _field("Each mode's task value [m, rad].", [[0.0, 0.0, -0.35]])
     residual: list[float] = _field("Each mode's closure residual [m or rad].", [1e-15])
     labels: list[str] = _field("Each mode's label.", ["(1,)"])
+    outside_limits: list[list[OutsideLimit]] = _MODES_OUTSIDE
     seconds: float = _field("The search's time [s].", 0.5)
     units: Units = _field(UNITS, {"q": ["rad"] * 9 + ["m"] * 3, "y": ["m", "m", "m"], "residual": "m or rad",
                                   "seconds": "s"})
@@ -420,6 +456,7 @@ class WorkingModesResult(_Answer):
     q: list[list[float]] = _field("Each mode's configuration [rad, m].", [_Q_EXAMPLE])
     qa: list[list[float]] = _field("Each mode's actuated values [rad, m].", [_QA_EXAMPLE])
     labels: list[str] = _field("Each mode's label.", ["(1, 1, 1)"])
+    outside_limits: list[list[OutsideLimit]] = _MODES_OUTSIDE
     seconds: float = _field("The search's time [s].", 0.5)
     units: Units = _field(UNITS, {"q": ["rad"] * 9 + ["m"] * 3, "qa": ["rad"] * 3, "seconds": "s"})
 

@@ -3,7 +3,10 @@ store.
 
 An upload is a set of files ``{name: bytes}`` (a closure spec and its model file, a Gepetto URDF + YAML pair, an
 MJCF or SDF file alone), or one archive of them (zip, tar: :meth:`Store.unpack`), read in memory by pkm's loaders (:func:`pkm.core.formats.load.load_texts`): no uploaded name
-reaches the file system. Its id is a hash of the names and contents (the same files give the same id); with a
+reaches the file system. A Gepetto pair's ``robot.urdf`` is named after its folder, as :func:`pkm.load` names it
+(``battobot_6d``, not ``robot``): the folder an archive's files are in (else the archive's own name), or the
+``folder`` an upload of files states (the Python client sends the files' folder). Its id is a hash of the names and
+contents, and of that folder where it names the mechanism (the same files give the same id); with a
 folder (``pkm serve --store DIR``) each upload is kept as its blobs (named by their own hashes) and a manifest, and
 read back when the service starts again. Mechanisms are built once and kept in memory.
 """
@@ -37,12 +40,36 @@ class Entry:
     files: dict[str, int]
 
 
-def upload_id(files: dict[str, bytes]) -> str:
-    """The id of an upload: the first 20 hex digits of SHA-256 over its names and contents, in name order."""
+def upload_id(files: dict[str, bytes], folder: str | None = None) -> str:
+    """The id of an upload: the first 20 hex digits of SHA-256 over its names and contents, in name order, and the
+    folder that names it (:func:`naming_folder`), if any."""
     h = hashlib.sha256()
     for name in sorted(files):
         h.update(name.encode() + b"\0" + hashlib.sha256(files[name]).digest())
+    if folder is not None:
+        h.update(b"\0folder\0" + folder.encode())
     return h.hexdigest()[:20]
+
+
+def _plain_name(name: object) -> bool:
+    return isinstance(name, str) and bool(name) and len(name) <= 200 and not any(c in name for c in "/\\\0") \
+        and name not in (".", "..")
+
+
+def naming_folder(files: dict[str, bytes], folder: str | None) -> str | None:
+    """``folder`` where it names the upload's mechanism (Gepetto's ``robot.urdf``:
+    :func:`pkm.core.formats.load.gepetto_name`), else None (it changes nothing: not in the id either).
+
+    Raises:
+        InvalidInputError: a folder that is not a plain name.
+    """
+    from pkm.core.formats.load import GEPETTO_URDF
+
+    if folder is None or folder == "" or GEPETTO_URDF not in files:
+        return None
+    if not _plain_name(folder):
+        raise InvalidInputError("folder", "a plain name (no path)", folder)
+    return folder
 
 
 class Store:
@@ -66,9 +93,9 @@ class Store:
             self.folder.mkdir(parents=True, exist_ok=True)
             for manifest in sorted(self.folder.glob("*/manifest.json")):
                 try:
-                    names = json.loads(manifest.read_text())["files"]
-                    files = {n: (manifest.parent / f"{h}.blob").read_bytes() for n, h in names.items()}
-                    self.add(files, persist=False)
+                    kept = json.loads(manifest.read_text())
+                    files = {n: (manifest.parent / f"{h}.blob").read_bytes() for n, h in kept["files"].items()}
+                    self.add(files, persist=False, folder=kept.get("folder"))
                 except (OSError, ValueError, KeyError, SpecError, InvalidInputError):
                     continue  # (a damaged entry is skipped, never served)
 
@@ -79,10 +106,12 @@ class Store:
         return [Entry(n, "registered", n, {}) for n in self.registered] + uploads
 
     @staticmethod
-    def unpack(files: dict[str, bytes]) -> dict[str, bytes]:
+    def unpack(files: dict[str, bytes]) -> tuple[dict[str, bytes], str | None]:
         """An upload of one archive (``.zip``, ``.tar``, ``.tar.gz``, ``.tgz``) as its files, read in memory: each
-        member by its base name (folders dropped), at most :data:`MAX_FILES` regular files of at most
-        :data:`MAX_FILE_BYTES` (links and devices refused); any other upload as it is.
+        member by its base name, at most :data:`MAX_FILES` regular files of at most :data:`MAX_FILE_BYTES` (links and
+        devices refused), with the folder they are in (the last folder of the members' common one, else the
+        archive's name without its suffix: what names a Gepetto ``robot.urdf``); any other upload as it is (no
+        folder).
 
         Raises:
             InvalidInputError: a broken archive, too many or too large members, two members of one name.
@@ -92,15 +121,18 @@ class Store:
         import zipfile
 
         if len(files) != 1:
-            return files
+            return files, None
         (name, data), = files.items()
         lower = name.lower()
         members: dict[str, bytes] = {}
+        folders: set[str] = set()
 
         def take(member: str, content: bytes) -> None:
-            base = member.replace("\\", "/").rsplit("/", 1)[-1]
+            parts = member.replace("\\", "/").rsplit("/", 2)
+            base = parts[-1]
             if not base:
                 return
+            folders.add(parts[-2] if len(parts) > 1 else "")
             if base in members or len(members) >= MAX_FILES or len(content) > MAX_FILE_BYTES:
                 raise InvalidInputError(name, f"member {member!r}: a repeated name, more than {MAX_FILES} files or "
                                               f"over {MAX_FILE_BYTES} bytes")
@@ -123,15 +155,22 @@ class Store:
                             raise InvalidInputError(name, f"member {m.name!r} is a link or a device")
                         take(m.name, member.read(MAX_FILE_BYTES + 1))
             else:
-                return files
+                return files, None
         except (zipfile.BadZipFile, tarfile.TarError, EOFError, OSError) as e:
             raise InvalidInputError(name, f"not a readable archive: {e}") from None
         if not members:
             raise InvalidInputError(name, "the archive holds no file")
-        return members
+        (folder,) = folders if len(folders) == 1 else ("",)
+        stem = name.rsplit("/", 1)[-1]
+        for suffix in (".tar.gz", ".tgz", ".tar", ".zip"):
+            stem = stem[:-len(suffix)] if stem.lower().endswith(suffix) else stem
+        folder = folder if _plain_name(folder) else stem
+        return members, folder if _plain_name(folder) else None
 
-    def add(self, files: dict[str, bytes], *, persist: bool = True) -> Entry:
-        """Read an upload, keep it, return its entry (the same files: the same entry).
+    def add(self, files: dict[str, bytes], *, persist: bool = True, folder: str | None = None) -> Entry:
+        """Read an upload, keep it, return its entry (the same files: the same entry). ``folder``: the folder the
+        files are in, which names a Gepetto ``robot.urdf`` as :func:`pkm.load` does (an archive's own folder
+        otherwise).
 
         Raises:
             InvalidInputError: too many or too large files, a name that is not a plain file name, a file that is
@@ -140,14 +179,13 @@ class Store:
         """
         from pkm.core.formats.load import load_texts
 
-        files = self.unpack(files)
+        files, inside = self.unpack(files)
         if not files or len(files) > MAX_FILES:
             raise InvalidInputError("files", f"send 1 to {MAX_FILES} files", len(files))
         total = 0
         texts = {}
         for name, data in files.items():
-            if not isinstance(name, str) or not name or len(name) > 200 or any(c in name for c in "/\\\0") \
-                    or name in (".", ".."):
+            if not _plain_name(name):
                 raise InvalidInputError("files", "a file name must be a plain name (no folder)", name)
             if len(data) > MAX_FILE_BYTES:
                 raise InvalidInputError(name, f"larger than {MAX_FILE_BYTES} bytes", len(data))
@@ -158,11 +196,12 @@ class Store:
                 raise InvalidInputError(name, f"not UTF-8 text (byte {e.start})") from None
         if total > MAX_UPLOAD_BYTES:
             raise InvalidInputError("files", f"larger than {MAX_UPLOAD_BYTES} bytes in all", total)
-        key = upload_id(files)
+        folder = naming_folder(files, folder if folder is not None else inside)
+        key = upload_id(files, folder)
         with self._lock:
             if key in self._uploads:
                 return self._uploads[key]
-        mech = load_texts(texts, source=f"upload {key}")
+        mech = load_texts(texts, source=f"upload {key}", folder=folder)
         entry = Entry(key, "uploaded", mech.name, {n: len(d) for n, d in files.items()})
         with self._lock:
             self._uploads[key] = entry
@@ -176,7 +215,7 @@ class Store:
                 h = hashlib.sha256(data).hexdigest()
                 (place / f"{h}.blob").write_bytes(data)
                 hashes[name] = h
-            (place / "manifest.json").write_text(json.dumps({"files": hashes}))
+            (place / "manifest.json").write_text(json.dumps({"files": hashes, "folder": folder}))
         return entry
 
     def variant(self, model: str, params: dict[str, Any]) -> Entry:

@@ -1,9 +1,14 @@
 """The state of one WebSocket stream: actuator samples in, forward kinematics, task rates and efforts out.
 
 Each message is a map with ``qa`` (the actuated coordinates) and optionally ``qd`` (their rates) and ``qdd`` (their
-accelerations); the answer has ``q`` and ``y`` (the configuration and the task value, the loops closed from the
-previous sample's configuration: a stream stays on its assembly mode), the closure ``residual``, with ``qd`` the task
-rates ``yd``, with ``qd`` and ``qdd`` the actuator efforts ``tau`` (``M_a qdd + h_a``), and ``compute_s``.
+accelerations), read as the HTTP queries read them (:func:`pkm.serve.queries._array`): numbers in SI or strings with
+a unit of the entry's kind (``"10deg"``, ``"5mm"``; ``"-30deg/s"``, ``"300rpm"``), one sample; the answer has ``q``
+and ``y`` (the configuration and the task value, the loops closed from the previous sample's configuration: a stream
+stays on its assembly mode), the closure ``residual``, ``status`` (``"ok"``, or ``"outside_limits"`` where
+``outside_limits``, the joints outside the position limits the model states with their values and limits, is not
+empty), with ``qd`` the task rates ``yd``, with ``qd`` and ``qdd`` the actuator efforts ``tau`` (``M_a qdd + h_a``),
+``compute_s`` and ``units`` (the unit of every quantity answered and given, as the HTTP answers carry them). A refused
+message is answered ``{"error", "message"}``, the message naming the field and its units.
 
 Where the mechanism's compiled kernels build (:class:`pkm.Kernels`: a C compiler, no idle motion), a sample is the
 kernels' (the closure's Newton warm-started in C, the Jacobian and ``M_a``, ``h_a`` from their generated C), each
@@ -22,7 +27,7 @@ import numpy as np
 import pkm
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError
-from pkm.validation import as_array
+from pkm.validation import bounded
 
 
 class Stream:
@@ -34,12 +39,22 @@ class Stream:
         self.kernels = kernels
 
     def _vector(self, sample: Mapping[str, Any], key: str) -> np.ndarray | None:
-        if key not in sample or sample[key] is None:
-            return None
-        v = as_array(sample[key], key, f"{self.mech.na} numbers").ravel()
-        if v.shape != (self.mech.na,) or not np.all(np.isfinite(v)):
-            raise InvalidInputError(key, f"expected {self.mech.na} finite numbers", v.tolist()[:20])
-        return v
+        """``sample[key]`` (one sample, units allowed) as the HTTP queries read it; None when absent."""
+        from pkm.serve.queries import _input_units, _optional
+
+        a = _optional(sample, key, self.mech.na, _input_units(self.mech, key))
+        if a is not None and len(a) != 1:
+            raise InvalidInputError(key, f"one sample ({self.mech.na} numbers) a message, not {len(a)}", len(a))
+        return None if a is None else a[0]
+
+    def units(self) -> dict[str, Any]:
+        """The unit of every quantity of an answer and of a message (SI, per entry)."""
+        from pkm.serve.queries import _actuated_units, _q_units, _rates, _task_units, _value_units
+
+        return {"q": _q_units(self.mech), "y": _value_units(self.mech), "residual": "m or rad",
+                "yd": _rates(list(_task_units(self.mech).values())), "tau": _actuated_units(self.mech, "effort"),
+                "qa": _actuated_units(self.mech), "qd": _actuated_units(self.mech, "rate"),
+                "qdd": _actuated_units(self.mech, "acceleration"), "compute_s": "s"}
 
     def step(self, sample: Any) -> dict[str, Any]:
         """The answer to one message (see the module doc).
@@ -59,6 +74,7 @@ class Stream:
         qa = self._vector(sample, "qa")
         if qa is None:
             raise InvalidInputError("qa", f"missing: give {self.mech.na} numbers")
+        bounded(qa, "qa")  # (the library's bound on coordinates: beyond it refused, never wrapped)
         qd, qdd = self._vector(sample, "qd"), self._vector(sample, "qdd")
         K = self.kernels
         q = residual = None
@@ -70,7 +86,9 @@ class Stream:
             r = close_loops(self.mech, qa, self.q)
             q, residual = r.q, r.residual
         self.q = q
-        out: dict[str, Any] = {"q": q, "y": pkm.TaskMap.of(self.mech).value(q), "residual": residual}
+        outside = [v._asdict() for v in self.mech.limit_violations(q)]
+        out: dict[str, Any] = {"q": q, "y": pkm.TaskMap.of(self.mech).value(q), "residual": residual,
+                               "status": "outside_limits" if outside else "ok", "outside_limits": outside}
         if qd is not None:
             if K is not None:
                 J = K.kernel("forward_jacobian")(q[None])[0].reshape(-1, self.mech.na, order="F")
@@ -87,6 +105,7 @@ class Stream:
                     tau = m.M @ qdd + m.h
                 out["tau"] = tau
         out["compute_s"] = time.perf_counter() - t0
+        out["units"] = self.units()
         return out
 
 

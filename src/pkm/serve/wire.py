@@ -1,5 +1,12 @@
-"""The service's wire format besides JSON: msgpack, numpy arrays as an extension (dtype, shape, raw bytes), so that
-arrays travel without a round trip through text. Shared by the service and the client."""
+"""The service's wire format besides JSON: msgpack (``content-type`` or ``accept: application/msgpack``), numpy arrays
+as an extension, so that arrays travel without a round trip through text. Shared by the service and the client.
+
+The layout (:data:`ND_LAYOUT`, what any msgpack library can read and write without pkm): an array is a msgpack
+extension of type ``1`` whose payload is itself msgpack, an array of three entries ``[dtype, shape, data]``: ``dtype``
+a numpy type string (``"<f8"``: little-endian float64; ``"<i8"``, ``"|b1"``...), ``shape`` an array of integers,
+``data`` a bin of the entries' bytes in C order (row after row), ``prod(shape) * itemsize`` bytes. Plain msgpack
+arrays of numbers are read as well; the answers' arrays come in this form (float64 where SI values, int64 counts).
+"""
 
 from __future__ import annotations
 
@@ -11,6 +18,11 @@ import numpy as np
 MSGPACK = "application/msgpack"
 #: The msgpack extension type of a numpy array.
 ND_EXT = 1
+#: The layout of that extension, in words (the schemas' descriptions and the OpenAPI description say it).
+ND_LAYOUT = (f"In a msgpack body (application/msgpack) an array may be, and an answer's is, msgpack extension type "
+             f"{ND_EXT}: its payload a msgpack array [dtype, shape, data], dtype a numpy type string ('<f8': "
+             "little-endian float64), shape an array of integers, data a bin of the entries' bytes in C (row-major) "
+             "order.")
 
 
 def pack(obj: Any) -> bytes:
@@ -46,4 +58,4 @@ def unpack(data: bytes) -> Any:
 
 
 
-__all__ = ["MSGPACK", "ND_EXT", "pack", "unpack"]
+__all__ = ["MSGPACK", "ND_EXT", "ND_LAYOUT", "pack", "unpack"]

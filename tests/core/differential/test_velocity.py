@@ -214,7 +214,9 @@ def test_diagnose_grades_the_approach_to_a_direct_singularity(built):
         d = pkm.diagnose(mech, _fivebar_at(mech, (0.0, 0.15 + eps), "elbows_out"))
         dists.append(d.direct_distance)
         assert d.classification == "regular" and d.near == (("direct",) if d.direct_distance < 1e-3 else ())
-        assert str(d).startswith("regular, but near a direct singularity (distance ") if d.near else str(d) == "regular"
+        assert str(d).startswith("regular, but near a direct singularity (distance " if d.near else "regular: ")
+        assert f"mobility {d.mobility} (constraint rank {d.constraint_rank} of " in str(d)
+        assert f"distance to a direct singularity {d.direct_distance:.3g}, to an inverse one " in str(d)
         if eps <= 1e-3:
             assert abs(abs(d.direct_direction[1]) - 1.0) < 1e-3
     ratios = np.array(dists[:-1]) / np.array(dists[1:])

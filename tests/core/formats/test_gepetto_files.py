@@ -47,12 +47,15 @@ def test_a_yaml_that_is_not_the_convention_is_refused_about_yaml_naming_each_rea
     assert lines[0].endswith("config.yaml: no reader takes it:") and "TOML:" not in str(info.value)
     assert lines[1:] == ["  Gepetto URDF + YAML: a YAML mapping without the keys closed_loop or name_mot (its keys: "
                          "solver)",
+                         "  HyRoDyn URDF + submechanisms.yml: not a YAML mapping with a submechanisms list",
                          "  pkm closure spec: a YAML file: a pkm closure spec is TOML (NAME.closures.toml)",
                          "  model file (URDF, MJCF, SDF): not XML with a root element <robot>, <mujoco>, <sdf>"]
-    with pytest.raises(SpecError, match=r"Gepetto URDF \+ YAML: not valid YAML: .*\n  pkm closure spec: a YAML file"):
+    with pytest.raises(SpecError, match=r"Gepetto URDF \+ YAML: not valid YAML: .*\n  HyRoDyn URDF \+ "
+                                        r"submechanisms.yml: not valid YAML: .*\n  pkm closure spec: a YAML file"):
         pkm.load(write(tmp_path / "n", broken__yaml="closed_loop: [[a, b]\n") / "broken.yaml")
     with pytest.raises(SpecError, match=r"a folder with no YAML file in Gepetto's convention \(config.yaml: a YAML "
-                                        r"mapping without.*\n  pkm closure spec: a folder"):
+                                        r"mapping without.*\n  HyRoDyn URDF \+ submechanisms.yml: a folder with no "
+                                        r"YAML file holding a submechanisms list\n  pkm closure spec: a folder"):
         pkm.load(folder)
 
 

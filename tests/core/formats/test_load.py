@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from pkm.core.formats.load import READERS, load_gepetto, load_model_file, load_path
+from pkm.core.formats.load import READERS, load_gepetto, load_hyrodyn, load_model_file, load_path
 from pkm.core.model.builder import from_files
 from pkm.core.model.compare import mechanism_differences
 from pkm.errors import SpecError
@@ -17,6 +17,7 @@ EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 FOURBAR = EXAMPLES / "mjcf_fourbar" / "fourbar.xml"
 GEPETTO = EXAMPLES / "gepetto_fivebar"
 KNEE = EXAMPLES / "knee"
+HYRODYN = Path(__file__).resolve().parents[2] / "data" / "hyrodyn_fourbar"
 
 
 def _takers(path: Path) -> list[int]:
@@ -24,8 +25,10 @@ def _takers(path: Path) -> list[int]:
 
 
 def test_the_readers_are_tried_in_their_stated_order():
-    """Gepetto's convention first, then a closure spec, then a model file: the order the module documents."""
-    assert [r.name for r in READERS] == ["Gepetto URDF + YAML", "pkm closure spec", "model file (URDF, MJCF, SDF)"]
+    """Gepetto's convention first, then HyRoDyn's, then a closure spec, then a model file: the order the module
+    documents."""
+    assert [r.name for r in READERS] == ["Gepetto URDF + YAML", "HyRoDyn URDF + submechanisms.yml", "pkm closure spec",
+                                         "model file (URDF, MJCF, SDF)"]
 
 
 def _gepetto(_path: Path):
@@ -35,9 +38,11 @@ def _gepetto(_path: Path):
 @pytest.mark.parametrize("path, taker, route", [
     (GEPETTO, 0, _gepetto),
     (GEPETTO / "robot.yaml", 0, _gepetto),
-    (KNEE / "knee.closures.toml", 1, from_files),
-    (FOURBAR, 2, load_model_file),
-], ids=["gepetto folder", "gepetto yaml", "spec", "mjcf"])
+    (HYRODYN, 1, lambda _: load_hyrodyn(HYRODYN / "fourbar.urdf", HYRODYN / "submechanisms.yml")),
+    (HYRODYN / "fourbar.urdf", 1, lambda _: load_hyrodyn(HYRODYN / "fourbar.urdf", HYRODYN / "submechanisms.yml")),
+    (KNEE / "knee.closures.toml", 2, from_files),
+    (FOURBAR, 3, load_model_file),
+], ids=["gepetto folder", "gepetto yaml", "hyrodyn folder", "hyrodyn urdf", "spec", "mjcf"])
 def test_the_first_reader_that_takes_a_path_loads_it(path, taker, route):
     """Which readers take the path (each one's claim): the first is the expected one, and load_path gives the same
     mechanism as that reader's own loader (pkm.core.model.compare)."""
@@ -51,16 +56,16 @@ def test_a_closure_spec_is_recognised_by_its_content_whatever_its_suffix(tmp_pat
     for name in ("knee.urdf", "knee.closures.toml"):
         (tmp_path / name).write_text((KNEE / name).read_text())
     (tmp_path / "knee.cfg").write_text((KNEE / "knee.closures.toml").read_text())
-    assert _takers(tmp_path / "knee.cfg") == [1]
+    assert _takers(tmp_path / "knee.cfg") == [2]
     assert mechanism_differences(load_path(tmp_path / "knee.cfg"), from_files(KNEE / "knee.closures.toml")) == []
     (tmp_path / "other.cfg").write_text("x = 1\n")
-    assert READERS[1].claim(tmp_path / "other.cfg") == 'TOML without the key format = "pkm.closures/1"'
+    assert READERS[2].claim(tmp_path / "other.cfg") == 'TOML without the key format = "pkm.closures/1"'
 
 
 @pytest.mark.parametrize("name, content, reasons", [
-    ("page.txt", "<html/>", {1: "not TOML", 2: "XML whose root element is <html>"}),
-    ("data.bin", b"\xff\xfe\x00abc", {1: "not a readable text file", 2: "not XML"}),
-    ("plain.txt", "x = 1\n", {1: "TOML without the key format", 2: "not XML"}),
+    ("page.txt", "<html/>", {2: "not TOML", 3: "XML whose root element is <html>"}),
+    ("data.bin", b"\xff\xfe\x00abc", {2: "not a readable text file", 3: "not XML"}),
+    ("plain.txt", "x = 1\n", {2: "TOML without the key format", 3: "not XML"}),
 ])
 def test_a_path_no_reader_takes_lists_each_readers_reason_on_its_own_line(tmp_path, name, content, reasons):
     """The SpecError's first line names the path; then exactly one line per reader, in order, '  <reader>: <why>'
@@ -75,7 +80,7 @@ def test_a_path_no_reader_takes_lists_each_readers_reason_on_its_own_line(tmp_pa
         assert line.startswith(f"  {reader.name}: ") and len(line) > len(reader.name) + 4
     for k, why in reasons.items():
         assert lines[1 + k].startswith(f"  {READERS[k].name}: {why}"), lines[1 + k]
-    assert all(root in lines[3] for root in ("<robot>", "<mujoco>", "<sdf>"))
+    assert all(root in lines[4] for root in ("<robot>", "<mujoco>", "<sdf>"))
 
 
 def test_nothing_at_the_path_is_said_before_any_reader_is_tried(tmp_path):

@@ -162,7 +162,7 @@ def test_the_mimic_leader_is_the_joint_pinocchio_visits_first():
     (lambda s: s.replace('</tendon>', '<spatial name="rope"><site site="sa"/><site site="sb"/></spatial></tendon>')
      .replace('tendon="pair"', 'tendon="rope"'), "spatial tendon 'rope'"),
     (lambda s: s.replace('<joint name="follow"', '<joint name="follow" active="false"').replace('coef="0.75"', ''),
-     r"tendon 'pair' .*a differential of the independent joints \['j1', 'j2'\]"),
+     r"motors \['pair'\] drive the joints \['j1', 'j2'\]: pkm reads a differential of as many motors as joints"),
 ])
 def test_what_cannot_be_one_joint_input_is_refused_by_name(edit, message):
     with pytest.raises(SpecError, match=message):

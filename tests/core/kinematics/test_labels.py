@@ -67,3 +67,57 @@ def test_mode_label_takes_any_array_like_and_refuses_a_bad_configuration():
     assert pkm.mode_label(delta, list(q)) == pkm.mode_label(delta, q)
     with pytest.raises(pkm.errors.InvalidInputError):
         pkm.mode_label(delta, q[:-1])
+
+
+def _from_scratch(mech, q) -> pkm.ModeLabel:
+    """The label by the first route: a kinematics pass at ``q``, then each block's sign alone."""
+    from pkm.core.kinematics import labels
+
+    fk, ik = labels._structures(mech)
+    Jc, J = labels._scaled(mech, pkm.Configuration.at(mech, q).closure_and_task_jacobian)
+    return pkm.ModeLabel(*(() if b is None else tuple(labels._sign(A[np.ix_(b.rows, b.cols)][np.ix_(r, c)]) * s
+                                                      for r, c, s in b.blocks) for b, A in ((fk, Jc), (ik, J))))
+
+
+@pytest.mark.parametrize("name", ["delta", "hexapod", "gough_stewart", "prs3", "rrr3"])
+def test_the_solvers_label_from_their_own_newton_matrices_as_from_scratch(built, name, monkeypatch):
+    """The labels of close_loops and solve_ik come from the solver's Newton matrices (the last solve's result as the
+    next seed: its label kept), with no kinematics pass of their own, and equal the labels computed from scratch,
+    block by block (on the delta's knee-in branch too: signs -1)."""
+    from pkm.core.kinematics import labels
+
+    mech = built(name)
+    task = pkm.TaskMap.of(mech)
+    rng = np.random.default_rng(3)
+    labels._structures(mech)  # (the blocks, found once per mechanism from three passes)
+    passes = []
+    mats = labels._mats
+    monkeypatch.setattr(labels, "_mats", lambda m, q: passes.append(q) or mats(m, q))
+    for branch in [None] + (["knee_in"] if name == "delta" else []):
+        seed = mech.q_reference if branch is None else pkm.branch_seed(mech, branch)
+        fk = pkm.close_loops(mech, mech.actuated_q(seed) + 0.05 * rng.uniform(-1, 1, mech.na), seed)
+        fk2 = pkm.close_loops(mech, mech.actuated_q(fk.q) + 0.05 * rng.uniform(-1, 1, mech.na), fk.q)
+        ik = pkm.solve_ik(mech, task.retract(task.value(fk2.q), 0.005 * rng.uniform(-1, 1, task.size)), fk2.q)
+        assert passes == []
+        for res in (fk, fk2, ik):
+            assert res.mode == _from_scratch(mech, res.q) and res.mode.assembly
+    assert name != "delta" or ik.mode.working == (1, -1, -1, -1)
+
+
+def test_the_stacked_signs_equal_each_blocks_sign_near_and_far_from_singular():
+    """:func:`labels._signs` (one LAPACK call a stack, the SVD skipped where the determinant proves the block
+    regular) gives each block's :func:`labels._sign`: blocks whose smallest singular value is 1e-3 to 1e-12 of the
+    largest, either sign, around the threshold (1e-8) included."""
+    from pkm.core.kinematics import labels
+
+    rng = np.random.default_rng(7)
+    for n in (1, 3, 8):
+        stack = []
+        for smin in (1.0, 1e-3, 2e-7, 5e-8, 1.1e-8, 0.9e-8, 1e-9, 1e-12, 0.0):
+            U, _ = np.linalg.qr(rng.standard_normal((n, n)))
+            V, _ = np.linalg.qr(rng.standard_normal((n, n)))
+            s = np.linspace(1.0, smin, n) if n > 1 else np.array([smin])
+            stack.append(rng.choice([-1.0, 1.0]) * (U * s) @ V.T)
+        B = np.array(stack)
+        assert labels._signs(B) == [labels._sign(b) for b in B]
+        assert set(labels._signs(B)) >= {0} and set(labels._signs(B)) - {0}

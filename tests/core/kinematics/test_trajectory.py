@@ -91,3 +91,19 @@ def test_task_values_are_named():
     hexapod = pkm.load("hexapod")
     values = pkm.task_values(hexapod, hexapod.q_reference)
     assert list(values) == ["x", "y", "z", "roll", "pitch", "yaw", "beta_1"]
+
+
+def test_a_motion_across_the_position_limits_names_each_joint_where_it_first_leaves_them():
+    """The humanoid ankle's pitch 0 -> 0.8 rad in 9 samples (range +-0.6; its motors +-1): per joint, the first
+    sample outside with its value there (the trajectory's own coordinate) and limits; the sample before is within
+    (Mechanism.outside_limits, sample by sample); a motion within the limits has none."""
+    ankle = pkm.load(EXAMPLES / "humanoid_ankle" / "ankle.closures.toml")
+    y = np.column_stack([np.linspace(0.0, 0.8, 9), np.zeros(9)])
+    traj = pkm.follow_task(ankle, y, efforts=False)
+    first = {v.joint: (k, v) for k, v in traj.outside_limits}
+    assert traj.outside_limits[0][1].joint == "ankle_pitch" and first["ankle_pitch"][0] == 7  # (0.7)
+    assert set(first) == {"ankle_pitch", "motor_left", "motor_right"}
+    for joint, (k, v) in first.items():
+        assert v.value == traj.q[k, ankle.joints[joint].idx_q] and not v.limit[0] <= v.value <= v.limit[1]
+        assert joint in ankle.outside_limits(traj.q[k]) and joint not in ankle.outside_limits(traj.q[k - 1])
+    assert pkm.follow_task(ankle, y * 0.5, efforts=False).outside_limits == ()

@@ -123,7 +123,6 @@ def test_truncated_urdf_is_a_spec_error(delta_urdf, fraction):
     (('<mass value="1"/>', '<mass value="1e300"/>'), "absurdly large"),
     (('ixx="1"', 'ixx="nan"'), "not finite"),
     (('izz="1"', 'izz="-inf"'), "not finite"),
-    (('ixx="1"', 'ixx="-3"'), "negative principal moment"),
     (('<origin xyz="0 0 0" rpy="0 0 0"/><mass', '<origin xyz="0 nan 0"/><mass'), "inertial origin"),
     (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>'), "zero axis"),
     (('effort="1"', 'effort="nan"'), "effort"),

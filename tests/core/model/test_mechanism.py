@@ -183,6 +183,30 @@ def test_construction_moved_to_the_builder_says_where():
         pkm.Mechanism.from_files("my.closures.toml")
 
 
+def test_limits_along_a_path_are_the_first_sample_outside_per_joint(built):
+    """``limits_along`` (vectorised) against the plain rule ``lower - tol <= x <= upper + tol`` sample by sample on
+    the Delta's configurations scattered to +-4 (its limits +-pi, the platform's +-1.18 m): per joint the first sample
+    outside, its value and limits, in the order of the samples; ``limit_violations`` and ``outside_limits`` of each
+    sample are its joints outside, in the model's order; a NaN is not called outside (the caller's to refuse)."""
+    delta = built("delta")
+    rng = np.random.default_rng(3)
+    Q = np.tile(delta.q_reference, (40, 1))
+    Q[:, :] += rng.uniform(-4.0, 4.0, Q.shape) * (rng.random(Q.shape) < 0.1)
+    Q[5, 0] = np.nan
+    expected: dict[str, tuple[int, float]] = {}
+    for k, q in enumerate(Q):
+        row = [n for n, (lo, hi) in delta.limits.items() if not lo - 1e-9 <= q[delta.joints[n].idx_q] <= hi + 1e-9
+               and not np.isnan(q[delta.joints[n].idx_q])]
+        assert delta.outside_limits(q) == tuple(row)
+        assert [v.joint for v in delta.limit_violations(q)] == row
+        for n in row:
+            expected.setdefault(n, (k, float(q[delta.joints[n].idx_q])))
+    along = delta.limits_along(Q)
+    assert len(along) >= 3 and [k for k, _ in along] == sorted(k for k, _ in along)
+    assert {v.joint: (k, v.value) for k, v in along} == expected
+    assert all(v.limit == delta.limits[v.joint] for _, v in along)
+
+
 def test_the_task_map_and_the_scales_are_built_on_the_mechanism_and_kept_with_it():
     """The mechanism imports neither (tests/test_import_graph.py): ``TaskMap.of`` and ``JacobianScales.of`` give
     one object per mechanism, the old attributes say where they went, and a new reference makes new scales with

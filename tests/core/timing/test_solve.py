@@ -12,7 +12,7 @@ from pkm.core.timing import actuator_limits, waypoint_path
 from pkm.core.timing.solve import solve
 from pkm.errors import InvalidInputError, ModeChangeWarning, PathError
 
-from .conftest import ARC
+from .conftest import ARC, PITCH
 
 
 def test_bang_bang_in_closed_form(delta, arc):
@@ -116,3 +116,27 @@ def test_limits_are_held_between_the_grid_points(delta, arc):
     assert _between(mid, C, L, plain.sd, plain.sdd).max() > 1.0 + L.margin
     assert _between(mid, C, L, held.sd, held.sdd).max() <= 1.0 + 0.5 * L.margin
     assert held.cycle_time > plain.cycle_time
+
+
+def test_a_path_across_position_limits_is_refused_naming_point_joint_value_and_limit(ankle):
+    """Pitch 0 -> 0.8 rad on the ankle (range +-0.6): refused at the first check point outside (a straight line: the
+    pitch at s is 0.8 s exactly), never timed; with the motors' limits alone (+-1 rad), at the first point where a
+    motor is outside, its value that of the inverse kinematics there (another route)."""
+    import copy
+
+    with pytest.raises(PathError) as e:
+        pkm.time_optimal(ankle, PITCH, points=12)
+    err = e.value
+    assert (err.joint, err.bound, err.index) == ("ankle_pitch", (-0.6, 0.6), 8)  # (segment 8: s = 8.5/11)
+    assert err.s == pytest.approx(8.5 / 11, abs=1e-12) and err.value == pytest.approx(0.8 * 8.5 / 11, abs=1e-9)
+    assert "ankle_pitch = 0.618182 rad" in str(err) and "[-0.6, 0.6]" in str(err)
+    motors = copy.copy(ankle)
+    motors.limits = {k: v for k, v in ankle.limits.items() if k.startswith("motor")}
+    with pytest.raises(PathError) as e:
+        pkm.time_optimal(motors, PITCH, points=12)
+    err = e.value
+    assert err.joint == "motor_left" and err.bound == (-1.0, 1.0) and err.value > 1.0
+    ik = pkm.solve_ik(ankle, [0.8 * err.s, 0.0]).q
+    assert err.value == pytest.approx(ik[ankle.joints["motor_left"].idx_q], abs=1e-9)
+    before = pkm.solve_ik(ankle, [0.8 * (err.s - 0.5 / 11), 0.0]).q  # (the check point before: inside)
+    assert not motors.outside_limits(before)

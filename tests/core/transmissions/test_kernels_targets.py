@@ -1,6 +1,6 @@
 """The transmission kernels' three targets from one generator: compiled C, JAX (jit, vmap, jacfwd) and Warp (its
 CPU device) equal to 1e-12 on every kernel (the humanoid knee: small kernels, one Warp module compiled once; JAX's
-``fk`` checked within ``fk_j_dm``, and differentiated through); the C99 library and the C++17 class built strictly
+``fk`` checked within ``fk_j_dm``, and differentiated at the solution: the ankle's too); the C99 library and the C++17 class built strictly
 with gcc/g++ and run (the ankle's round trip); the extras named when missing. (Every test robot's transmissions:
 tools/transmission_targets.py; Warp on a GPU: tools/gpu_transmissions.py, not run here.)"""
 
@@ -35,10 +35,11 @@ def test_c_jax_and_warp_agree_on_every_kernel():
     tk = knee()
     inputs = _inputs(tk, 32)
     module = warp_module([tk.function(k) for k in KERNELS])  # (as pkm transmission writes it: one compile)
+    jitted: dict = {}
     for name, args in inputs.items():
         fun = tk.function(name)
         c = tk.run(name, *args)
-        j = c if name == "fk" else jax.vmap(tk.jax(name))(*args)  # (JAX's fk: within fk_j_dm, its compile saved)
+        j = c if name == "fk" else jax.vmap(jitted.setdefault(name, tk.jax(name)))(*args)  # (fk: within fk_j_dm)
         ins = [wp.array(np.ascontiguousarray(a.T), dtype=wp.float64, device="cpu") for a in args]
         outs = [wp.zeros((fun.nnz_out(i), len(args[0])), dtype=wp.float64, device="cpu") for i in range(fun.n_out())]
         wp.launch(getattr(module, fun.name()), dim=len(args[0]), inputs=ins, outputs=outs, device="cpu")
@@ -49,16 +50,40 @@ def test_c_jax_and_warp_agree_on_every_kernel():
             assert np.abs(w[i] - ref).max() <= 1e-12 * scale, (name, fun.name_out(i), "warp")
         if name in ("fk", "ik", "fk_j_dm"):
             assert (c[KERNELS[name][1].index("status")] == 0).all()
-    q, qm = inputs["maps"][0][0], inputs["fk"][1][0]  # (JAX differentiates through the unrolled Newton: J)
-    dqo_dqm = jax.jacfwd(lambda x: tk.jax("fk_j_dm")(q, x)[1])(qm)
-    assert abs(float(dqo_dqm[0, 0]) - float(tk.run("maps", q)[0][0])) <= 1e-10
+    q, qm = inputs["maps"][0][0], inputs["fk"][1][0]  # (JAX differentiates the solve at its solution: J; and J, ΔM
+    D = jax.jacfwd(lambda x: jitted["fk_j_dm"](q, x))(qm)  # move with it: central differences of the C; ik: J_inv)
+    J, J_inv, _ = tk.run("maps", q)
+    assert np.abs(np.asarray(D[1]).ravel() - J).max() <= 1e-12
+    assert np.abs(np.asarray(jax.jacfwd(lambda x: jitted["ik"](q, x)[1])(q[tk.output_q])).ravel() - J_inv).max() <= 1e-12
+    assert not np.asarray(jax.jacfwd(lambda w: jitted["fk_j_dm"](w, qm)[0])(q)).any()  # (the warm start: none)
+    h = 1e-6
+    up, down = tk.run("fk_j_dm", q, qm + h), tk.run("fk_j_dm", q, qm - h)
+    for i in (0, 2, 3):  # (q_out, J, ΔM)
+        assert np.abs(np.asarray(D[i]).ravel() - (up[i] - down[i]) / (2 * h)).max() <= 1e-8, KERNELS["fk_j_dm"][1][i]
+
+
+def test_jax_differentiates_the_ankles_fk_at_its_solution():
+    """``jax.jacfwd`` of the humanoid ankle's fk (two motors, rods between balls) by the implicit function theorem,
+    never through the unrolled Newton (which XLA compiled for over 15 minutes): ``dqo/dqm`` is the C's ``J`` to
+    1e-12; the configuration's derivative (the balls' quaternions among it) central differences of the C's fk."""
+    jax = pytest.importorskip("jax")
+    tk = ankle()
+    qm, q = states(tk, 1, seed=6)
+    D = jax.jacfwd(lambda x: tk.jax("fk")(q[0], x))(qm[0])
+    assert np.abs(np.asarray(D[1]) - tk.run("maps", q[0])[0].reshape(2, 2, order="F")).max() <= 1e-12
+    h, fd = 1e-6, []
+    for e in np.eye(2):
+        fd.append((tk.run("fk", q[0], qm[0] + h * e)[0] - tk.run("fk", q[0], qm[0] - h * e)[0]) / (2 * h))
+    assert np.abs(np.asarray(D[0]) - np.array(fd).T).max() <= 1e-8
+    assert not np.asarray(D[2]).any() and not np.asarray(D[3]).any()  # (status, residual: constant there)
 
 
 @pytest.mark.skipif(not (shutil.which("gcc") and shutil.which("g++")), reason="needs gcc and g++")
 def test_the_c_library_and_the_cpp_class_round_trip(tmp_path):
     """``gcc -std=c99 -Wall -Wextra -Werror -pedantic`` and ``g++ -std=c++17 -Wall -Wextra -Werror`` build the
     ankle's library and example; actuator positions, velocities and efforts -> joints (FK, J, J_inv^T) -> actuators
-    (IK, J_inv, J^T) equal the in-process kernels' and come back to 1e-12. Beyond a stated limit (the motors ±1 rad,
+    (IK, J_inv, J^T) equal the in-process kernels' and come back to 1e-12, each cycle with one evaluation of the
+    maps kernel. Beyond a stated limit (the motors ±1 rad,
     the pitch ±0.6 rad): FK of a motor at 1e6 rad (a closed configuration, 1e6 mod 2π) and IK of a pitch of 0.7 rad
     converge, ``OUTSIDE_LIMITS``, the solution written all the same, in the C as in the in-process kernels."""
     tk = ankle()
@@ -80,6 +105,7 @@ def test_the_c_library_and_the_cpp_class_round_trip(tmp_path):
     J, J_inv = (x.reshape(2, 2, order="F") for x in tk.run("maps", q)[:2])
     assert np.abs(joint - np.concatenate([qo, J @ qdm, J_inv.T @ tau_m])).max() <= 1e-12
     assert np.abs(back - np.concatenate([qm, qdm, tau_m])).max() <= 1e-12
+    assert lines["maps"].split() == ["1", "1"]  # (a cycle's velocity and effort mapped with one maps evaluation)
     bad = subprocess.run([str(tmp_path / "example"), "nan", *["0"] * 5], capture_output=True, text=True)
     assert bad.returncode == 1 and "fk failed with status 3" in bad.stderr  # (INVALID_INPUT)
     far = subprocess.run([str(tmp_path / "example"), "1e6", *["0"] * 5], capture_output=True, text=True)

@@ -25,7 +25,7 @@ import pinocchio as pin
 import pytest
 
 import pkm
-from pkm.core.transmissions.coordinates import drift_acceleration, output_split
+from pkm.core.transmissions.coordinates import drift_acceleration, output_rates, output_split
 from pkm.core.transmissions.serial import serial_equivalent
 from pkm.errors import TransmissionError, UnknownNameError
 from tests.core.transmissions.robots import FILES, ROBOTS, robot, transmissions
@@ -140,6 +140,18 @@ def test_the_drift_acceleration_is_the_derivative_of_the_joint_rates_along_the_m
     sp = output_split(sub, q, t.out_v, sub.act_v)
     assert sp.idle.shape[1] == 0
     assert rel(drift_acceleration(sub, q, sp.G @ qd_o, sp, t.out_v), fd) <= 1e-7
+
+
+@pytest.mark.parametrize("name", ["humanoid_ankle", "humanoid_knee"])
+def test_output_rates_are_the_splits_rates_to_the_last_bit(name):
+    """``Ĝ`` alone (the fidelity runs' effort map) is the full split's, bitwise: with idle motions removed in the mass
+    metric (the ankle's rods spin between their balls) and without (the knee)."""
+    t = transmissions(name)[0]
+    sub = t.mechanism
+    q = _moved(t, np.random.default_rng(4))
+    sp = output_split(sub, q, t.out_v, sub.act_v)
+    assert sp.idle.shape[1] == (2 if name == "humanoid_ankle" else 0)
+    assert np.array_equal(output_rates(sub, q, t.out_v), sp.G)
 
 
 def test_named_outputs_name_the_transmission_and_bad_ones_are_refused():

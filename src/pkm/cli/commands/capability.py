@@ -19,6 +19,7 @@ from typing import Any
 import pkm
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, configuration, load_mechanism
+from pkm.cli.output import outside_limits, outside_line
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -48,7 +49,8 @@ def run(args: argparse.Namespace) -> int:
     out: dict[str, Any] = {"mechanism": mech.name, "task": pkm.TaskMap.of(mech).named(q),
                            "limits": {j: {f: {"value": v, "source": src} for f, (v, src) in row.items()
                                           if f != "peak_effort"} for j, row in limits.items()},
-                           "placeholder_limits": any(w.kind == "limits" for w in findings(mech))}
+                           "placeholder_limits": any(w.kind == "limits" for w in findings(mech)),
+                           "outside_limits": outside_limits(mech, q)}
     for kind in KINDS if args.kind == "all" else (args.kind,):
         c = capability(mech, q, kind, gravity=not args.no_gravity)
         P = c.polytope
@@ -60,6 +62,8 @@ def run(args: argparse.Namespace) -> int:
         return 0
     pose = ", ".join(f"{k}={v:.6g}" for k, v in out["task"].items())
     print(f"{mech.name} at {pose}")
+    if out["outside_limits"]:
+        print(outside_line(out["outside_limits"]))
     texts: dict[str, list[str]] = {}  # (actuators with the same limits from the same places: one line)
     for j, row in limits.items():
         unit = ("N m", "rad/s") if mech.joints[j].revolute else ("N", "m/s")

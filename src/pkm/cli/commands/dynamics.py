@@ -1,4 +1,4 @@
-"""``pkm dynamics MECH [--joints NAME=V ...] [--rates NAME=V ...] [--json]``: the actuator-space dynamic model
+"""``pkm dynamics MECH [--pose K=V ... | --joints NAME=V ...] [--rates NAME=V ...] [--json]``: the actuator-space dynamic model
 (:func:`pkm.actuator_model`) at one state: the mass matrix ``M_a``, the bias ``h_a``, the gravity ``g_a`` and, where
 the mechanism has friction, the friction efforts, each entry with its unit, by actuator name."""
 
@@ -13,6 +13,7 @@ import numpy as np
 import pkm
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, configuration, load_mechanism
+from pkm.cli.output import outside_limits, outside_line
 from pkm.cli.parsing import parse_rates
 from pkm.report import jsonable
 
@@ -21,9 +22,10 @@ if TYPE_CHECKING:
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    add_mechanism_arguments(p, None, "optional")
+    add_mechanism_arguments(p, "optional", "optional")
     p.add_argument("--rates", metavar="NAME=V", action="extend", nargs="+", default=[],
-                   help="actuated rates [rad/s or m/s, numbers, no unit] (others zero)")
+                   help="actuated rates, e.g. motor_1=-30deg/s (rad/s, deg/s, rpm; m/s, mm/s; a number: SI) "
+                        "(others zero)")
     p.add_argument("--json", action="store_true", help="print JSON (SI, with a units object)")
 
 
@@ -48,6 +50,7 @@ def model_dict(mech: pkm.Mechanism, model: ActuatorSpaceModel) -> dict[str, Any]
         "g": dict(zip(names, model.g)),
         "friction": dict(zip(names, model.friction)) if has_friction else None,
         "idle_motions": int(model.idle.shape[1]),
+        "outside_limits": outside_limits(mech, model.q),
         "base": model.base,
         "units": {
             "actuated": {n: "rad" if r else "m" for n, r in zip(names, revolute)},
@@ -85,6 +88,8 @@ def text(out: dict[str, Any]) -> str:
             continue
         lines.append(f"{label}:")
         lines += [f"  {n.ljust(width)}{_value(out[key][n], units[key][n]).rjust(col)}" for n in names]
+    if out["outside_limits"]:
+        lines.append(outside_line(out["outside_limits"]))
     if out["base"] == "free":
         lines.append("floating base: free (no wrench on it; its motion eliminated from M_a, h_a, g_a)")
     if out["idle_motions"]:

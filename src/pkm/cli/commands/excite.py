@@ -36,8 +36,8 @@ def run(args: argparse.Namespace) -> int:
     from pkm.core.identification.excitation import excite, write_csv
 
     mech = load_mechanism(args)
-    period = parse_quantity(args.duration, "time", "--duration")
-    dt = parse_quantity(args.dt, "time", "--dt")
+    period = parse_quantity(args.duration, {"time"}, "--duration", "s")
+    dt = parse_quantity(args.dt, {"time"}, "--dt", "s")
     if not dt > 0.0:
         raise InvalidInputError("--dt", f"expected a positive sample period, got {args.dt}", args.dt)
     if args.plot:

@@ -48,6 +48,7 @@ def run(args: argparse.Namespace) -> int:
     from pkm.core.identification.export import identified_mechanism, standard_from_base, validate
     from pkm.core.identification.measurements import measurements
     from pkm.core.identification.regressor import parameters
+    from pkm.core.model.plausibility import nonphysical
     from pkm.errors import InvalidInputError, PoorIdentificationWarning, SpecError
     from pkm.report import jsonable
 
@@ -71,6 +72,10 @@ def run(args: argparse.Namespace) -> int:
         theta = standard_from_base(mech, base, ls.values)
     try:
         identified = identified_mechanism(mech, theta, source=args.out)  # (what a warning is about: the file written)
+        bad = nonphysical(identified)  # (it loads for its kinematics; a model written from an estimate must be real)
+        if bad:
+            raise SpecError(args.out, "inertias no distribution of mass has: " + ", ".join(
+                f"{n!r} ({r} {v:.6g} kg m^2)" for n, r, v in bad))
     except (SpecError, InvalidInputError) as exc:
         if args.consistent:
             raise

@@ -14,7 +14,6 @@ from pkm.cli.parsing import parse_pose, parse_seed
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_mechanism_arguments(p, "required", None)
-    p.add_argument("--branch", metavar="NAME", help="working mode the solution must lie on (see 'pkm list MECH')")
     p.add_argument("--all", action="store_true",
                    help="every working mode (homotopy continuation, pkm-robotics[homotopy])")
 

@@ -10,13 +10,11 @@ import argparse
 import json
 from typing import Any
 
-import pkm
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, add_seed_argument, load_mechanism
-from pkm.cli.parsing import parse_axis, parse_seed, split_item
+from pkm.cli.parsing import parse_axis, parse_seed, parse_task
 from pkm.cli.usage import UsageError
-from pkm.errors import UnknownNameError
-from pkm.units import SI_UNITS, parse_quantity
+from pkm.units import parse_quantity
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -45,12 +43,7 @@ def run(args: argparse.Namespace) -> int:
     axes = dict(parse_axis(mech, item) for item in args.axis)
     if len(axes) != len(args.axis):
         raise UsageError("name each --axis once")
-    fixed, task = {}, pkm.TaskMap.of(mech)
-    for item in args.pose or []:
-        name, text = split_item(item, "--pose")
-        if name not in task.kinds:
-            raise UnknownNameError("task coordinate", name, list(task.keys), mech.name)
-        fixed[name] = parse_quantity(text, {task.kinds[name]}, name, SI_UNITS[task.kinds[name]])
+    fixed = parse_task(mech, args.pose or [])
     length = None if args.length is None else parse_quantity(args.length, {"length"}, "--length", "m")
     if args.index and args.png and len(axes) > 2:
         raise UsageError("--index draws one or two axes: leave --png out of a 3-D map (its CSV has every node)")

@@ -5,7 +5,7 @@ times), its speed profile drawn with the active limit marked, and the cycle time
 
 ``--path`` is a CSV of waypoints whose header names the task's values (``pkm list`` names them; or the actuated
 joints', for a path in actuator space) [m, rad], a ``pkm.motion`` case ``FILE.toml:CASE``, or
-``adept:X,Y,Z`` (the 25/305/25 mm cycle from the point X, Y, Z [m] along +x). ``--limits`` takes ``peak``,
+``adept:X,Y,Z`` (the 25/305/25 mm cycle from the point X, Y, Z [m, or with units: ``adept:0,0,-35cm``] along +x). ``--limits`` takes ``peak``,
 ``omega0``, ``speed``, ``acceleration`` (:func:`pkm.core.timing.limits.parse_limits`).
 """
 
@@ -23,6 +23,7 @@ import pkm
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, load_mechanism
 from pkm.errors import InvalidInputError
+from pkm.units import parse_quantity
 
 if TYPE_CHECKING:
     from pkm.core.model.mechanism import Mechanism
@@ -36,10 +37,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "FILE.toml:CASE, or adept:X,Y,Z")
     p.add_argument("--coordinates", metavar="A,B,C", help="a motion case's coordinates as the task's names, in the "
                                                           "file's order (the 3-PRS's z,beta,phi: z,pitch,roll)")
-    p.add_argument("--payload", metavar="KG", type=float, default=0.0, help="a point mass at the end effector [kg]")
+    p.add_argument("--payload", metavar="KG", default="0", help="a point mass at the end effector, e.g. 500g [kg]")
     p.add_argument("--limits", metavar="K=V,...", default="",
-                   help="peak=N m, omega0=rad/s (a linear motor line), speed=rad/s, acceleration=rad/s^2 (default: "
-                        "the drives' own peak efforts and speed limits)")
+                   help="peak=N m, omega0=rad/s (a linear motor line), speed=rad/s, acceleration=rad/s^2, units "
+                        "allowed (speed=300rpm) (default: the drives' own peak efforts and speed limits)")
     p.add_argument("--points", metavar="N", type=int, default=1000, help="grid points along the path (default 1000)")
     p.add_argument("--out", metavar="FILE", required=True, help="the trajectory: CSV when FILE ends in .csv, else "
                                                                 "Parquet (pkm-robotics[sweeps])")
@@ -62,10 +63,7 @@ def read_path(mech: Mechanism, text: str, coordinates: str | None = None) -> tup
     from pkm.core.timing.path import adept_waypoints
 
     if text.startswith("adept:"):
-        try:
-            start = [float(v) for v in text[6:].split(",")]
-        except ValueError:
-            raise InvalidInputError("--path", "adept:X,Y,Z: three numbers [m]", text) from None
+        start = [parse_quantity(v.strip(), {"length"}, "--path adept:X,Y,Z", "m") for v in text[6:].split(",")]
         task = pkm.TaskMap.of(mech).value_names
         if task != ("x", "y", "z"):
             raise InvalidInputError("--path", "the adept cycle is a path of a task x, y, z", task)
@@ -160,8 +158,9 @@ def run(args: argparse.Namespace) -> int:
     path, space = read_path(mech, args.path, args.coordinates)
     from pkm.core.timing.coefficients import with_payload
 
-    limits = parse_limits(with_payload(mech, args.payload), args.limits)
-    plan = pkm.time_optimal(mech, path, payload=args.payload, limits=limits, points=args.points, space=space)
+    payload = parse_quantity(args.payload, {"mass"}, "--payload", "kg")
+    limits = parse_limits(with_payload(mech, payload), args.limits)
+    plan = pkm.time_optimal(mech, path, payload=payload, limits=limits, points=args.points, space=space)
     from pkm.motion import write_motion
 
     written = {"out": str(write(plan, args.out))}

@@ -1,6 +1,8 @@
 """``pkm simulate MECH (--torques FILE.csv | --controller FILE.py:FN) --out FILE [...]``: a forward simulation
 (:func:`pkm.simulate`) under a table of efforts or a controller of one's own, its samples written as Parquet or CSV
-(:mod:`pkm.core.dynamics.samples`), its figure drawn (:mod:`pkm.viz.simulation`), and a summary printed.
+(:mod:`pkm.core.dynamics.samples`), its figure drawn (:mod:`pkm.viz.simulation`), and a summary printed. The initial
+state: ``--pose`` or ``--joints`` (as every command takes a configuration) or ``--q0``, and ``--v0`` (rates, units
+allowed: ``motor_1=30deg/s``).
 
 The torque table is a CSV file whose header is ``t`` then the actuated joints' names in actuated order (``pkm list``
 names them): the time [s], then the efforts [N m or N], interpolated linearly between rows and held outside them.
@@ -21,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from pkm.cli.command import Command
-from pkm.cli.mechanism import add_mechanism_arguments, close_loops, load_mechanism
+from pkm.cli.mechanism import add_mechanism_arguments, close_loops, configuration, load_mechanism
 from pkm.cli.parsing import parse_rates, parse_seed
 from pkm.errors import InvalidInputError, UnknownNameError
 from pkm.units import parse_quantity
@@ -32,7 +34,9 @@ if TYPE_CHECKING:
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    add_mechanism_arguments(p, None, None)
+    add_mechanism_arguments(p, "optional", "optional", "alone, the initial configuration (actuated joints set the "
+                                                       "state, passive ones the closure's seed); with --pose or "
+                                                       "--joints, the solver's seed")
     drive = p.add_mutually_exclusive_group()  # (neither: no effort, the mechanism released)
     drive.add_argument("--torques", metavar="FILE.csv", help="efforts over time: a CSV whose header is t and the "
                                                              "actuated joints' names (time [s], efforts [N m or N])")
@@ -41,11 +45,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", metavar="T", default="2s", help="simulated time (s, ms, us; default 2s)")
     p.add_argument("--dt", metavar="DT", default="1ms", help="sample period, the RK4 step (default 1ms)")
     p.add_argument("--method", choices=("rk4", "radau"), default="rk4", help="integrator (default rk4)")
-    p.add_argument("--q0", metavar="NAME=V", action="extend", nargs="+", default=[],
-                   help="the initial configuration: actuated joint values (others keep the reference), and passive "
-                        "ones as the loop closure's seed (its assembly mode is kept)")
     p.add_argument("--v0", metavar="NAME=V", action="extend", nargs="+", default=[],
-                   help="initial actuated rates [rad/s or m/s, numbers, no unit] (others zero)")
+                   help="initial actuated rates, e.g. motor_1=30deg/s (rad/s, deg/s, rpm; m/s, mm/s; a number: SI) "
+                        "(others zero)")
     p.add_argument("--no-friction", action="store_true", help="leave the joints' friction out")
     p.add_argument("--no-limits", action="store_true", help="do not stop at position or speed limits")
     p.add_argument("--no-saturate", action="store_true", help="apply the efforts asked for beyond the actuators' "
@@ -173,7 +175,9 @@ def run(args: argparse.Namespace) -> int:
     dt = parse_quantity(args.dt, {"time"}, "--dt", "s")
     q0 = None
     seed = parse_seed(mech, args.q0)
-    if seed is not None:  # the actuators named set the state; the passive joints named, the closure's seed
+    if args.pose or args.joints:  # the initial configuration as every command takes one
+        q0 = configuration(mech, args)
+    elif seed is not None:  # the actuators named set the state; the passive joints named, the closure's seed
         qa = mech.actuated_q(seed)
         seed[mech.act_q] = mech.q_reference[mech.act_q]
         q0 = close_loops(mech, qa, seed).q

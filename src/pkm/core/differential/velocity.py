@@ -366,7 +366,7 @@ def velocities(mech: Mechanism, q: ArrayLike | Configuration, qd_actuated: Array
         array([ 0.0108, -0.0198,  0.0257])
     """
     G = passive_map(mech, q)
-    return finite_result(G @ mech.check_actuated(qd_actuated, "qd_actuated"), "joint velocities")
+    return finite_result(G @ mech.check_actuated(qd_actuated, "qd_actuated", order="rate"), "joint velocities")
 
 
 def accelerations(mech: Mechanism, q: ArrayLike | Configuration, v: ArrayLike, qdd_actuated: ArrayLike) -> np.ndarray:
@@ -531,13 +531,24 @@ class Diagnostics:
 
     @property
     def summary(self) -> str:
-        """One sentence: the class, how near a singularity a regular configuration is, the actuators that do not
-        fit the mobility (``str(diagnostics)``)."""
+        """One sentence (``str(diagnostics)``): the class, and how near a singularity a regular configuration is;
+        the rank and the mobility (idle motions, redundant equations); the distances to each kind of singularity;
+        the actuators that do not fit the mobility. The Delta at its reference: ``regular: mobility 3 (constraint
+        rank 9 of 9 equations); distance to a direct singularity 0.236, to an inverse one 0.068 (0: singular,
+        1: far)``."""
         out = self.classification
+        dist = {"direct": self.direct_distance, "inverse": self.inverse_distance}
         if self.near:
-            dist = {"direct": self.direct_distance, "inverse": self.inverse_distance}
             out += ", but near " + " and ".join(f"{'an' if k == 'inverse' else 'a'} {k} singularity (distance "
                                                  f"{dist[k]:.2g} < {self.near_threshold:g})" for k in self.near)
+        equations = self.constraint_rank + self.redundant_constraints
+        out += f": mobility {self.mobility} (constraint rank {self.constraint_rank} of {equations} equations"
+        if self.redundant_constraints:
+            out += f", {self.redundant_constraints} redundant"
+        if self.idle_motions:
+            out += f"; {self.idle_motions} idle motion(s), of {', '.join(self.idle_joints)}"
+        out += (f"); distance to a direct singularity {dist['direct']:.3g}, to an inverse one {dist['inverse']:.3g} "
+                "(0: singular, 1: far)")
         if self.dependent_actuators:
             out += f"; actuators {list(self.dependent_actuators)} depend on the others"
         if self.unactuated:
@@ -619,8 +630,9 @@ def _actuation(mech: Mechanism, c: Configuration, sp: _Split, rtol: float) -> Ac
 
 def diagnose(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 1e-7, near: float = 1e-3) -> Diagnostics:
     """Rank, mobility, idle motions, graded singularity measures and the actuators against the mobility at ``q``
-    (which should be assembled). ``str()`` of the result is one sentence (:attr:`Diagnostics.summary`): a regular
-    configuration inside the ``near`` band says how near it is.
+    (which should be assembled). ``str()`` of the result is one sentence (:attr:`Diagnostics.summary`): the class
+    (a regular configuration inside the ``near`` band says how near it is), the mobility and the constraint rank, the
+    distances to a direct and an inverse singularity.
 
     Args:
         rtol: Relative rank tolerance: a kind is singular where its distance is at most ``rtol``.
@@ -630,8 +642,9 @@ def diagnose(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 1e-
         >>> import pkm
         >>> delta = pkm.load("delta")
         >>> d = pkm.diagnose(delta, delta.q_reference)
-        >>> print(d)
-        regular
+        >>> print(d)  # doctest: +NORMALIZE_WHITESPACE
+        regular: mobility 3 (constraint rank 9 of 9 equations); distance to a direct singularity 0.236,
+        to an inverse one 0.068 (0: singular, 1: far)
         >>> d.mobility, round(d.direct_distance, 3), round(d.inverse_distance, 3)
         (3, 0.236, 0.068)
     """

@@ -80,6 +80,7 @@ from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import close_loops
 from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, PkmWarning, SingularityError, SpecError
 from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
@@ -268,7 +269,7 @@ class ActuatorSpaceModel:
         Raises:
             SingularityError: ``kind="inertia"``: an actuated motion moves no mass (``M_a`` singular).
         """
-        tau = self.mech.check_actuated(tau, "tau")
+        tau = self.mech.check_actuated(tau, "tau", order="effort")
         rhs = tau + (self.friction if friction else 0.0) - self.h
         w = self._base_wrench(base_wrench)
         if w is not None:
@@ -344,7 +345,7 @@ def _check_state(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None, base: str 
     if arr is not None and arr.shape == (mech.nv,) and mech.nv != mech.na:
         arr = mech.check_v(arr, "qd")
         return mech, q, mech.check_actuated(arr[mech.act_v], "qd"), base, arr[mech.base_v] if len(rest) else rest
-    return mech, q, mech.check_actuated(qd, "qd"), base, rest
+    return mech, q, mech.check_actuated(qd, "qd", order="rate"), base, rest
 
 
 def _evaluate(mech: Mechanism, q: np.ndarray, qd: np.ndarray, rtol: float,
@@ -423,6 +424,7 @@ def actuator_model(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None, *
         0.001489
     """
     mech, q, qd, base, vb = _check_state(mech, q, qd, base)
+    require_physical(mech, "the dynamic model (mass matrix, bias and gravity efforts, forward dynamics)")
     rtol = as_tolerance(rtol, "rtol")
     coulomb_velocity = as_scalar(coulomb_velocity, "coulomb_velocity", low=1e-12)
     return _evaluate(mech, q, qd, rtol, coulomb_velocity, base, vb)
@@ -491,6 +493,7 @@ def mass_matrix_derivatives(mech: Mechanism, q: ArrayLike, *, rtol: float = RTOL
             do not give its velocity terms; pass ``base="fixed"`` for the held base's.
     """
     mech = check_mechanism(mech)
+    require_physical(mech, "the mass matrix's derivatives")
     _held_only(mech, base)
     q = mech.check_q(q)
     rtol = as_tolerance(rtol, "rtol")
@@ -579,6 +582,7 @@ def operational_space(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None
         4.908
     """
     mech, q, qd, base, vb = _check_state(mech, q, qd, base)
+    require_physical(mech, "the operational-space model")
     if mech.n_task != mech.na:
         raise InvalidInputError("mech", f"the task has {mech.n_task} coordinates for {mech.na} actuators: the "
                                         "operational space needs as many", mech.n_task)

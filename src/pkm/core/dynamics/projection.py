@@ -52,6 +52,7 @@ from pkm.core.dynamics import model as actuator_space
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, PkmError, PkmWarning, SingularityError, SpecError
 from pkm.validation import as_count, as_scalar, as_tolerance, as_vector, finite_result
@@ -371,6 +372,7 @@ def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, 
         array([0.6013, 0.5016, 0.6976])
     """
     mech = check_mechanism(mech)
+    require_physical(mech, "inverse dynamics")
     if method not in METHODS:
         raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
     if actuator_space.base_choice(mech, base) == "free":
@@ -451,7 +453,7 @@ def base_inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayL
         >>> q = pkm.close_loops(robot, delta.actuated_q(delta.q_reference)).q
         >>> rest = np.zeros(robot.nv)
         >>> held = pkm.base_inverse_dynamics(robot, q, rest, rest, base="fixed")  # the holder carries the weight
-        >>> np.round(held.base_wrench, 4) + 0.0  # (+ 0.0: a round-off zero's sign dropped)
+        >>> np.round(held.base_wrench, 4) + 0.0  # (+ 0.0: a zero's sign is rounding's, not the model's)
         array([0.    , 0.    , 6.3765, 0.    , 0.    , 0.    ])
         >>> pkm.base_inverse_dynamics(robot, q, rest, rest).needs_base_wrench  # free, it cannot stay at rest
         True
@@ -460,6 +462,7 @@ def base_inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayL
         False
     """
     mech = check_mechanism(mech)
+    require_physical(mech, "inverse dynamics")
     if method not in METHODS:
         raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
     if mech.base is None:
@@ -491,6 +494,7 @@ def virtual_work_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayL
     motions mass-orthogonal: ``G^T M N = 0``, so that no idle acceleration in ``a`` changes the efforts): the
     whole-tree virtual-work route (external wrenches as in :func:`inverse_dynamics`)."""
     mech = check_mechanism(mech)
+    require_physical(mech, "inverse dynamics")
     q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
     G = passive_map(mech, q)
     h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches)
@@ -575,8 +579,9 @@ def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuate
         True
     """
     mech = check_mechanism(mech)
+    require_physical(mech, "forward dynamics")
     q, v = mech.check_q(q), mech.check_v(v)
-    tau_a = mech.check_actuated(tau_actuated, "tau_actuated")
+    tau_a = mech.check_actuated(tau_actuated, "tau_actuated", order="effort")
     if _has_mimic(mech.model):
         raise PkmError("constraintDynamics does not support mimic joints on Pinocchio 4.1")
     s = np.linalg.svd(JacobianScales.of(mech).constraint(finite_result(constraints.jacobian(mech, q),
@@ -616,6 +621,7 @@ def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuate
 def energy(mech: Mechanism, q: ArrayLike, v: ArrayLike) -> tuple[float, float]:
     """Kinetic [J] and potential [J] energy of every body (gravity ``mech.model.gravity``)."""
     mech = check_mechanism(mech)
+    require_physical(mech, "the energy")
     q, v = mech.check_q(q), mech.check_v(v)
     m, d = mech.model, mech.data
     if not _has_mimic(m):

@@ -74,6 +74,7 @@ from pkm.core.kinematics.solve import close_loops
 from pkm.core.kinematics.task import TaskMap
 from pkm.core.kinematics.trajectory import Trajectory, _units
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
 from pkm.errors import CompilerError, ControllerError, InvalidInputError, PkmError, SingularityError, SpecError
 from pkm.validation import as_array, as_scalar
@@ -372,6 +373,7 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
         array([-0.254375, -0.254375, -0.254375, -0.254375, -0.254375])
     """
     mech = check_mechanism(mech)
+    require_physical(mech, "the simulation")
     if method not in METHODS:
         raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
     if not isinstance(backend, str) or backend not in BACKENDS:
@@ -411,7 +413,7 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
         except (TypeError, ValueError, OverflowError):  # (check_actuated says what is wrong)
             arr = np.zeros(0)
         qd = mech.check_v(arr, "v0")[mech.act_v] if arr.shape == (mech.nv,) and mech.nv != mech.na \
-            else mech.check_actuated(v0, "v0")
+            else mech.check_actuated(v0, "v0", order="rate")
         if len(twist) and arr.shape == (mech.nv,) and mech.nv != mech.na:
             twist = arr[mech.base_v].copy()
     dyn = _Dynamics(mech, ctrl, friction, saturate, bool(limits), singular_tol, coulomb_velocity, step_tol, q, base)
@@ -498,7 +500,8 @@ def _simulation(mech: Mechanism, t: np.ndarray, q: np.ndarray, v: np.ndarray, a:
     at = np.abs(tau) >= limit * (1.0 - 1e-12) if len(tau) else np.zeros((0, mech.na), dtype=bool)
     saturated = {name: int(n) for name, n in zip(mech.actuated_names, at.sum(axis=0))}
     return Simulation(q, v, a, q[:, mech.act_q], qd, qdd, task, task_v, task_a, tau, residual,
-                      (), units, t, kinetic, potential, work, dissipated, event, method, saturated, base)
+                      (), units, mech.limits_along(q), t, kinetic, potential, work, dissipated, event, method,
+                      saturated, base)
 
 
 def _start(dyn: _Dynamics, x: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, ActuatorSpaceModel,

@@ -398,7 +398,8 @@ def check_modes(mech: Mechanism, harness: Harness, step: float = 0.01) -> list[s
 
 def domain(mech: Mechanism, harness: Harness, steps: int = 60) -> tuple[list[str], dict[str, int]]:
     """Calls outside the domain, each of which must return a status, never a NaN: NaN and infinite inputs to every
-    function (``INVALID_INPUT``); the forward kinematics warm-started along a straight motion of the actuators from
+    function and coordinates of 1e308 (beyond :data:`~pkm.validation.ABSURD`: never wrapped) to those taking
+    coordinates (``INVALID_INPUT``); the forward kinematics warm-started along a straight motion of the actuators from
     the reference (in mode 0) until far beyond the workspace (``steps`` of 0.05 rad, or 0.05 of the mechanism's
     size, each), through whatever singularity, mode change or limit it meets (a crank that turns fully meets none); the inverse kinematics of targets 10 units (m, rad) away.
     Returns what went wrong (empty when nothing did: a non-finite output, an OK whose configuration does not
@@ -411,7 +412,7 @@ def domain(mech: Mechanism, harness: Harness, steps: int = 60) -> tuple[list[str
     ref = mech.q_reference
     invalid = STATUS.index("INVALID_INPUT")
     problems = []
-    for bad in (np.nan, np.inf):
+    for bad in (np.nan, np.inf, 1e308):  # (1e308: a coordinate beyond pkm.validation.ABSURD, never wrapped)
         rows = {"fk": np.hstack([np.full(na, bad), ref, [-1.0]]), "ik": np.hstack([np.full(ny, bad), ref, [-1.0]]),
                 "jacobians": np.full(nq, bad), "jdot_qdot": np.hstack([ref, np.full(na, bad)]),
                 "inverse_dynamics": np.hstack([ref, np.zeros(na), np.full(na, bad)]), "mass_matrix": np.full(nq, bad),
@@ -419,6 +420,8 @@ def domain(mech: Mechanism, harness: Harness, steps: int = 60) -> tuple[list[str
         if not lib.closed_form:
             rows["ik_actuators"] = np.hstack([np.full(ny, bad), [0.0]])
         for kind, row in rows.items():
+            if bad == 1e308 and kind in ("jdot_qdot", "inverse_dynamics", "maps"):  # (rates, efforts: not bounded)
+                continue
             got = harness.run(kind, row[None])[0]
             statuses = got[:4] if kind == "maps" else got[:1]
             if not (statuses == invalid).all():

@@ -20,7 +20,8 @@ nothing, needs only ``<math.h>``, and returns a status:
   ``<name>_fk_distance`` gives the forward kinematics' one at any closed configuration);
 * ``OUTSIDE_LIMITS`` (``info.joint``: which limited joint, an index into ``<name>_limit_names``);
 * ``LEFT_MODE`` (``info.mode``: the mode id found, not the one asked for: see :mod:`pkm.core.export.model`);
-* ``INVALID_INPUT`` (a NaN or an infinity in an input);
+* ``INVALID_INPUT`` (a NaN or an infinity in an input, or a coordinate (``qa``, ``q``, ``y``) beyond
+  :data:`~pkm.validation.ABSURD`, 1e6 m or rad: refused, never wrapped, as the library refuses it);
 * ``PIVOT_ORDER``: the fixed elimination order of a kernel fails at this state although the matrix is regular
   (``info.pivot``); the kinematics fall back to a dense solve, the maps and the dynamics report it.
 
@@ -47,6 +48,7 @@ from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.scale import JacobianScales
 from pkm.core.twin.codegen import jacobi_sv, paper_counts
+from pkm.validation import ABSURD
 
 #: Newton iterations at most (each one evaluation of the step), the convergence tolerance on the largest closure
 #: residual or task error [m, rad], the relative pivot under which a solve goes dense, the relative smallest
@@ -211,7 +213,7 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
     tables = (_array("int", "p_actuated_q", [int(i) for i in mech.act_q], public=True)
               + _array("int", "p_actuated_revolute", [int(j.revolute) for j in mech.actuated])
               + _array("double", "p_actuated_unit", [float(u) for u in unit], c_constant)
-              + f"#define P_NLIMITS {len(limits)}\n"
+              + f"#define P_ABSURD {ABSURD!r}\n#define P_NLIMITS {len(limits)}\n"
               + _array("int", "p_limit_q", [q for _, q, _, _ in limits])
               + _array("double", "p_limit_low", [lo for _, _, lo, _ in limits], c_constant)
               + _array("double", "p_limit_high", [hi for _, _, _, hi in limits], c_constant)

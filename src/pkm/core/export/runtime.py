@@ -10,6 +10,13 @@ static int p_finite(const double* x, int n) {
   return 1;
 }
 
+/* coordinates (m, rad): finite and within P_ABSURD (pkm.validation.bounded's rule: beyond it refused, never wrapped) */
+static int p_coordinates(const double* x, int n) {
+  int i;
+  for (i = 0; i < n; ++i) if (!isfinite(x[i]) || fabs(x[i]) > P_ABSURD) return 0;
+  return 1;
+}
+
 static void p_copy(double* to, const double* from, int n) {
   int i;
   for (i = 0; i < n; ++i) to[i] = from[i];
@@ -181,7 +188,7 @@ int p_fk(const double qa[P_NA], const double q_prev[P_NQ], long mode, double q[P
   p_info local;
   int status;
   info = p_start(info, &local);
-  if (!p_finite(qa, P_NA) || !p_finite(q_prev, P_NQ)) return p_end(info, P_INVALID_INPUT);
+  if (!p_coordinates(qa, P_NA) || !p_coordinates(q_prev, P_NQ)) return p_end(info, P_INVALID_INPUT);
   status = p_follow_fk(qa, q_prev, mode, q, info);
   p_k_task_value(q, y);
   return status;
@@ -191,7 +198,7 @@ int p_ik(const double y[P_NY], const double q_prev[P_NQ], long mode, double q[P_
   p_info local;
   int status, k;
   info = p_start(info, &local);
-  if (!p_finite(y, P_NY) || !p_finite(q_prev, P_NQ)) return p_end(info, P_INVALID_INPUT);
+  if (!p_coordinates(y, P_NY) || !p_coordinates(q_prev, P_NQ)) return p_end(info, P_INVALID_INPUT);
   status = p_newton_ik(y, q_prev, mode, P_TOL, q, info);
   for (k = 0; k < P_NA; ++k) qa[k] = q[p_actuated_q[k]];
   return status;
@@ -200,7 +207,7 @@ int p_ik(const double y[P_NY], const double q_prev[P_NQ], long mode, double q[P_
 int p_fk_mode(const double q[P_NQ], long* mode) {
   double qa[P_NA], next[P_NQ], det[FKB], r, pv;
   int k;
-  if (!p_finite(q, P_NQ)) return P_INVALID_INPUT;
+  if (!p_coordinates(q, P_NQ)) return P_INVALID_INPUT;
   for (k = 0; k < P_NA; ++k) qa[k] = q[p_actuated_q[k]];
   p_k_fk_step(q, qa, next, &r, &pv, det);
   *mode = p_mode(FK_NBLOCKS, det);
@@ -209,7 +216,7 @@ int p_fk_mode(const double q[P_NQ], long* mode) {
 
 int p_ik_mode(const double q[P_NQ], long* mode) {
   double y[P_NY], next[P_NQ], det[IKB], r, pv;
-  if (!p_finite(q, P_NQ)) return P_INVALID_INPUT;
+  if (!p_coordinates(q, P_NQ)) return P_INVALID_INPUT;
   p_k_task_value(q, y);
   p_k_ik_step(q, y, next, &r, &pv, det);
   *mode = p_mode(IK_NBLOCKS, det);
@@ -217,7 +224,7 @@ int p_ik_mode(const double q[P_NQ], long* mode) {
 }
 
 int p_task_value(const double q[P_NQ], double y[P_NY]) {
-  if (!p_finite(q, P_NQ)) return P_INVALID_INPUT;
+  if (!p_coordinates(q, P_NQ)) return P_INVALID_INPUT;
   p_k_task_value(q, y);
   return P_OK;
 }
@@ -225,7 +232,7 @@ int p_task_value(const double q[P_NQ], double y[P_NY]) {
 int p_fk_distance(const double q[P_NQ], double* distance) {
   double qa[P_NA], A[FKN * FKN], b[FKN];
   int k;
-  if (!p_finite(q, P_NQ)) return P_INVALID_INPUT;
+  if (!p_coordinates(q, P_NQ)) return P_INVALID_INPUT;
   for (k = 0; k < P_NA; ++k) qa[k] = q[p_actuated_q[k]];
   p_k_fk_system(q, qa, A, b);
   *distance = p_distance(FKN, A, p_fk_row_scale, p_fk_col_scale);
@@ -242,7 +249,7 @@ static int p_pivot_failed(const double* q, p_info* info) {
 int p_jacobians(const double q[P_NQ], double J[P_NX * P_NA], double K[P_NA * P_NX], p_info* info) {
   p_info local;
   info = p_start(info, &local);
-  if (!p_finite(q, P_NQ)) return p_end(info, P_INVALID_INPUT);
+  if (!p_coordinates(q, P_NQ)) return p_end(info, P_INVALID_INPUT);
   p_k_jacobians(q, J, K, &info->pivot);
   if (!(info->pivot >= P_PIVOT_FLOOR)) return p_pivot_failed(q, info);
   return P_OK;
@@ -284,7 +291,7 @@ int p_actuator_effort(const double q[P_NQ], const double w[P_NX], double tau[P_N
 int p_jdot_qdot(const double q[P_NQ], const double qd[P_NA], double c[P_NX], p_info* info) {
   p_info local;
   info = p_start(info, &local);
-  if (!p_finite(q, P_NQ) || !p_finite(qd, P_NA)) return p_end(info, P_INVALID_INPUT);
+  if (!p_coordinates(q, P_NQ) || !p_finite(qd, P_NA)) return p_end(info, P_INVALID_INPUT);
   p_k_jdot_qdot(q, qd, c, &info->pivot);
   if (!(info->pivot >= P_PIVOT_FLOOR)) return p_pivot_failed(q, info);
   return P_OK;
@@ -294,7 +301,7 @@ int p_inverse_dynamics(const double q[P_NQ], const double qd[P_NA], const double
                        p_info* info) {
   p_info local;
   info = p_start(info, &local);
-  if (!p_finite(q, P_NQ) || !p_finite(qd, P_NA) || !p_finite(qdd, P_NA)) return p_end(info, P_INVALID_INPUT);
+  if (!p_coordinates(q, P_NQ) || !p_finite(qd, P_NA) || !p_finite(qdd, P_NA)) return p_end(info, P_INVALID_INPUT);
   p_k_inverse_dynamics(q, qd, qdd, tau, &info->pivot);
   if (!(info->pivot >= P_PIVOT_FLOOR)) return p_pivot_failed(q, info);
   return P_OK;
@@ -303,7 +310,7 @@ int p_inverse_dynamics(const double q[P_NQ], const double qd[P_NA], const double
 int p_mass_matrix(const double q[P_NQ], double M[P_NA * P_NA], p_info* info) {
   p_info local;
   info = p_start(info, &local);
-  if (!p_finite(q, P_NQ)) return p_end(info, P_INVALID_INPUT);
+  if (!p_coordinates(q, P_NQ)) return p_end(info, P_INVALID_INPUT);
   p_k_mass_matrix(q, M, &info->pivot);
   if (!(info->pivot >= P_PIVOT_FLOOR)) return p_pivot_failed(q, info);
   return P_OK;
@@ -312,7 +319,7 @@ int p_mass_matrix(const double q[P_NQ], double M[P_NA * P_NA], p_info* info) {
 int p_gravity(const double q[P_NQ], double g[P_NA], p_info* info) {
   p_info local;
   info = p_start(info, &local);
-  if (!p_finite(q, P_NQ)) return p_end(info, P_INVALID_INPUT);
+  if (!p_coordinates(q, P_NQ)) return p_end(info, P_INVALID_INPUT);
   p_k_gravity(q, g, &info->pivot);
   if (!(info->pivot >= P_PIVOT_FLOOR)) return p_pivot_failed(q, info);
   return P_OK;
@@ -327,7 +334,7 @@ int p_ik_actuators(const double y[P_NY], long mode, double qa[P_NA], p_info* inf
   double signs[P_NA], margin[P_NA];
   int k;
   info = p_start(info, &local);
-  if (!p_finite(y, P_NY)) return p_end(info, P_INVALID_INPUT);
+  if (!p_coordinates(y, P_NY)) return p_end(info, P_INVALID_INPUT);
   if (mode < 0) mode = 0;
   for (k = 0; k < P_NA; ++k) signs[k] = ((mode >> k) & 1L) ? -p_closed_sign[k] : p_closed_sign[k];
   p_k_ik_closed(y, signs, qa, margin);

@@ -2,6 +2,8 @@
 representation (:class:`~pkm.core.formats.base.Imported`: URDF text, loops, joint types, actuators):
 
 * :mod:`~pkm.core.formats.gepetto`: URDF + YAML in the convention of Gepetto's toolbox-parallel-robots;
+* :mod:`~pkm.core.formats.hyrodyn`: a robot URDF + HyRoDyn's ``submechanisms.yml`` (DFKI; Phobos's SMURF), loops as
+  numerical submechanisms' loop constraints;
 * :mod:`~pkm.core.formats.mjcf`: MuJoCo's MJCF, loops as ``<equality>`` connect/weld;
 * :mod:`~pkm.core.formats.sdf`: SDFormat, loops as links with several parent joints;
 * :mod:`~pkm.core.formats.urdfplus`: a URDF with MIT's URDF+ ``<loop>`` or urdfdom's proposed ``<constraint>``

@@ -41,6 +41,12 @@ class Imported:
             ``ref``: MuJoCo's ``qpos0``, where the file's poses hold), instead of the neutral configuration.
         springs: The joints' springs and dampers the file states, ``{joint: {"stiffness", "rest", "damping": value}}``
             as a spec's ``[springs.<joint>]`` tables (:mod:`pkm.core.model.springs`), under the spec's own.
+        hold: Joints of ``seed`` the assembly holds where the loops allow (an MJCF keyframe's actuated joints and
+            free bodies): values the file states, released (a note says how far they moved) where they over-determine
+            the loops, as ``reference`` is not (:func:`pkm.core.model.builder.build`).
+        motors: The motors that drive several actuated joints through a constant linear map (an MJCF differential:
+            motors on fixed tendons), ``{motor: {joint: coefficient}}`` as a spec's ``[motors.<name>]`` tables
+            (:mod:`pkm.core.model.motors`), under the spec's own.
     """
 
     urdf: str
@@ -55,6 +61,8 @@ class Imported:
     actuators: dict[str, dict[str, float]] = dataclasses.field(default_factory=dict)
     seed: dict[str, tuple[float, ...]] = dataclasses.field(default_factory=dict)
     springs: dict[str, dict[str, float]] = dataclasses.field(default_factory=dict)
+    motors: dict[str, dict[str, float]] = dataclasses.field(default_factory=dict)
+    hold: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,13 @@ example-parallel-robots; models exported with onshape-to-robot). A folder holds 
   :mod:`pkm.core.model.joints`). The toolbox splits a universal joint into two revolutes ``<name>_A``, ``<name>_B``;
   pkm keeps one joint ``<name>`` of two coordinates.
 
+A URDF ``<mimic>`` joint named among the motors (Gepetto's ``true_talos_2_legs`` names its grippers' followers in
+``name_mot``) is read as the toolbox reads it: the toolbox builds its model with Pinocchio's URDF parser, whose
+default ignores ``<mimic>`` (``buildModel(..., mimic=False)``), so each follower is a joint of its own, driven by
+its own motor. pkm drops the ``<mimic>`` of each follower named as a motor (:func:`unmimic_motors`) and says so
+(a :class:`~pkm.errors.PkmWarning` naming each coupling dropped, and a note); the followers no motor names keep
+their coupling.
+
 The convention is recognised by content, whatever the files are named (:func:`find_gepetto`): a YAML mapping
 with a ``closed_loop`` or ``name_mot`` key. Its URDF is the one of the YAML's stem (``leg.yaml``: ``leg.urdf``),
 else ``robot.urdf``, else the folder's only URDF; a URDF given by its path is paired with the YAML of its stem,
@@ -249,6 +256,33 @@ def read_gepetto(yaml_text: str, urdf_name: str, joint_names: list[str], mechani
     return spec, tuple(notes)
 
 
+def unmimic_motors(urdf_text: str, actuated: tuple[str, ...] | list[str], source: str = "<urdf>") \
+        -> tuple[str, tuple[str, ...]]:
+    """``urdf_text`` without the ``<mimic>`` of the joints ``actuated`` names (see the module doc: Gepetto's toolbox
+    loads every follower as a joint of its own), and the note naming each coupling dropped (none: the text as given).
+    """
+    from lxml import etree
+
+    from pkm.core.model.urdf import check_urdf
+
+    root = check_urdf(urdf_text, source)
+    dropped = []
+    for el in root.findall("joint"):
+        mim = el.find("mimic")
+        if el.get("name") in actuated and mim is not None and el.get("type") != "fixed":
+            dropped.append(f"{el.get('name')!r} = {float(mim.get('multiplier', 1.0)):g} {mim.get('joint')!r} "
+                           f"+ {float(mim.get('offset', 0.0)):g}")
+            for m in el.findall("mimic"):
+                el.remove(m)
+    if not dropped:
+        return urdf_text, ()
+    note = (f"mimic coupling{'s' if len(dropped) > 1 else ''} dropped: {', '.join(dropped)}: name_mot names "
+            f"{'these followers' if len(dropped) > 1 else 'this follower'} among the motors, and Gepetto's toolbox "
+            "loads the URDF without its mimic tags (Pinocchio's parser by default), each follower a joint driven by "
+            "its own motor")
+    return etree.tostring(root, encoding="unicode"), (note,)
+
+
 def spec_from_gepetto(yaml_text: str, urdf_name: str, joint_names: list[str], mechanism: str,
                       source: str = "<yaml>") -> ClosureSpec:
     """The closure spec a Gepetto ``robot.yaml`` states: :func:`read_gepetto` without its notes."""
@@ -256,4 +290,4 @@ def spec_from_gepetto(yaml_text: str, urdf_name: str, joint_names: list[str], me
 
 
 __all__ = ["JOINT_TYPES", "KEYS", "MARKERS", "find_gepetto", "gepetto_files", "gepetto_yaml",
-           "parse_yaml", "read_gepetto", "spec_from_gepetto"]
+           "parse_yaml", "read_gepetto", "spec_from_gepetto", "unmimic_motors"]

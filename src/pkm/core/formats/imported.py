@@ -66,15 +66,15 @@ def read_urdf(text: str, source: str = "<urdf>") -> Imported:
 
 
 def with_file(spec: ClosureSpec, imp: Imported, source: str) -> ClosureSpec:
-    """``spec`` with the loops, joint types, floating base, springs and the spec's actuated joints' drive values of the
-    model file it names added (the spec's win, a drive's or a spring's field by field; a joint the spec's
+    """``spec`` with the loops, joint types, floating base, springs, the spec's actuated joints' drive values and the
+    motors of its differentials (those on the spec's actuated joints) of the model file it names added (the spec's win, a drive's or a spring's field by field; a joint the spec's
     ``[joint_types]`` makes ``"fixed"`` keeps no spring: held rigid).
 
     Raises:
         SpecError: a closure named both in the spec and in the file.
     """
     if not imp.closures and not imp.joint_types and imp.floating_base is None and not imp.reference \
-            and not imp.actuators and not imp.springs:
+            and not imp.actuators and not imp.springs and not imp.motors:
         return spec
     clash = sorted({c.name for c in spec.closures} & {c.name for c in imp.closures})
     if clash:
@@ -86,7 +86,9 @@ def with_file(spec: ClosureSpec, imp: Imported, source: str) -> ClosureSpec:
                                actuators={j: {**imp.actuators.get(j, {}), **spec.actuators.get(j, {})}
                                           for j in spec.actuated if j in imp.actuators or j in spec.actuators},
                                springs={j: {**imp.springs.get(j, {}), **spec.springs.get(j, {})}
-                                        for j in {**imp.springs, **spec.springs} if joint_types.get(j) != "fixed"})
+                                        for j in {**imp.springs, **spec.springs} if joint_types.get(j) != "fixed"},
+                               motors={**{m: c for m, c in imp.motors.items() if set(c) <= set(spec.actuated)},
+                                       **spec.motors})
 
 
 def spec_skeleton(path: Path) -> tuple[str, bool]:

@@ -1,7 +1,7 @@
 """Loading a mechanism from files: every reader's result put through the builder
 (:mod:`pkm.core.model.builder`). :func:`load_path` (behind :func:`pkm.load`) tries :data:`READERS` in order on a
 file or folder, by content; :func:`load_model_file` reads an MJCF or SDF file alone; :func:`load_gepetto` a
-Gepetto URDF + YAML pair; :func:`load_package_model` a model an installed package ships, by name;
+Gepetto URDF + YAML pair; :func:`load_hyrodyn` a URDF with HyRoDyn's submechanisms file; :func:`load_package_model` a model an installed package ships, by name;
 :func:`load_texts` the same kinds of files given as texts (an upload: no file name reaches the file system).
 
 The readers themselves (:mod:`~pkm.core.formats.imported`, :mod:`~pkm.core.formats.gepetto`,
@@ -19,7 +19,9 @@ from pathlib import Path
 from typing import Any
 
 from pkm.core.formats.base import FORMATS, Imported, by_root, suffixes
-from pkm.core.formats.gepetto import find_gepetto, read_gepetto
+from pkm.core.formats.gepetto import find_gepetto, parse_yaml, read_gepetto, unmimic_motors
+from pkm.core.formats.hyrodyn import MARKER as HYRODYN_MARKER
+from pkm.core.formats.hyrodyn import PartialLoop, find_hyrodyn, read_hyrodyn
 from pkm.core.formats.imported import format_of, import_model, root_tag, with_file
 from pkm.core.formats.packages import model_file
 from pkm.core.model.builder import from_files, from_imported, from_strings
@@ -142,7 +144,8 @@ def with_given(spec: ClosureSpec, g: Given, source: str) -> tuple[ClosureSpec, t
     if g.task is not None:
         end_effector, task = g.end_effector, g.task
     return dataclasses.replace(spec, actuated=actuated, end_effector=end_effector, task=task,
-                               actuators={j: v for j, v in spec.actuators.items() if j in actuated}), notes
+                               actuators={j: v for j, v in spec.actuators.items() if j in actuated},
+                               motors={m: c for m, c in spec.motors.items() if set(c) <= set(actuated)}), notes
 
 
 def load_model_file(path: Path, given: Given = Given()) -> Mechanism:
@@ -163,9 +166,10 @@ def load_model_file(path: Path, given: Given = Given()) -> Mechanism:
     spec = ClosureSpec(mechanism=imp.name, urdf=path.name, end_effector=None, actuated=imp.actuated,
                        closures=imp.closures, task=TaskSpec((), imp.actuated), reference=dict(imp.reference),
                        description=f"read from {path.name} ({imp.format.upper()})", joint_types=imp.joint_types,
-                       floating_base=imp.floating_base, actuators=imp.actuators, springs=imp.springs)
+                       floating_base=imp.floating_base, actuators=imp.actuators, springs=imp.springs,
+                       motors=imp.motors)
     spec, read = with_given(spec, given, str(path))
-    return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes + read, seed=imp.seed)
+    return from_strings(imp.urdf, spec, source=str(path), notes=imp.notes + read, seed=imp.seed, hold=imp.hold)
 
 
 #: A reader's loader: the mechanism, given what the caller states in code (:class:`Given`, default nothing).
@@ -191,6 +195,11 @@ class Reader:
 def _gepetto(path: Path) -> Loader | str:
     found = find_gepetto(path)
     return found if isinstance(found, str) else (lambda given=Given(): load_gepetto(*found, given=given))
+
+
+def _hyrodyn(path: Path) -> Loader | str:
+    found = find_hyrodyn(path)
+    return found if isinstance(found, str) else (lambda given=Given(): load_hyrodyn(*found, given=given))
 
 
 def _head(path: Path) -> str | None:
@@ -249,7 +258,8 @@ def _model_file(path: Path) -> Loader | str:
 
 
 #: The readers :func:`load_path` tries, in this order; the first that takes a path reads it.
-READERS = (Reader("Gepetto URDF + YAML", _gepetto), Reader("pkm closure spec", _closure_spec),
+READERS = (Reader("Gepetto URDF + YAML", _gepetto), Reader("HyRoDyn URDF + submechanisms.yml", _hyrodyn),
+           Reader("pkm closure spec", _closure_spec),
            Reader("model file (URDF, MJCF, SDF)", _model_file))
 
 
@@ -311,7 +321,8 @@ def located(exc: SpecNameError, text: str, kind: str) -> SpecNameError:
 
 def load_path(path: Path, given: Given = Given()) -> Mechanism:
     """The mechanism of a file or folder, read by the first of :data:`READERS` that takes it, by content: a folder
-    or YAML in Gepetto's convention (:mod:`pkm.core.formats.gepetto`), a closure spec (``.toml``, or TOML text
+    or YAML in Gepetto's convention (:mod:`pkm.core.formats.gepetto`), a URDF with HyRoDyn's submechanisms file
+    (:mod:`pkm.core.formats.hyrodyn`), a closure spec (``.toml``, or TOML text
     with a ``format`` key), an MJCF or SDF file (or a URDF alone, which then asks for a spec); ``given``: the
     actuated joints and task stated in code, over the files' (:func:`with_given`).
 
@@ -336,18 +347,33 @@ def _read_text(name: str, text: str) -> Imported:
     return format_of(name, text).read(text, name)
 
 
+#: The file name of a Gepetto robot's URDF: its folder names the robot (``urdf/gepetto/battobot_6d/robot.urdf``).
+GEPETTO_URDF = "robot.urdf"
+
+
+def gepetto_name(urdf: str, folder: str | None) -> str:
+    """The name of a Gepetto pair's mechanism: its URDF's stem, or, for :data:`GEPETTO_URDF`, its folder's name
+    (``"robot"`` without one); :func:`pkm.load` and an upload (:func:`load_texts`' ``folder``) name it alike."""
+    stem = Path(urdf).stem
+    return (folder or "robot") if stem == "robot" else stem
+
+
 def load_texts(files: Mapping[str, str], source: str = "<upload>", *, actuated: Sequence[str] | str | None = None,
-               task: TaskGiven = None) -> Mechanism:
+               task: TaskGiven = None, folder: str | None = None) -> Mechanism:
     """The mechanism of files given as ``{name: text}`` (an upload), read as :func:`load_path` reads them from a
     folder, without touching the file system (the names are labels: a spec's ``urdf`` must name one of them):
 
     * a closure spec (``.toml``) and the model file it names (URDF, MJCF or SDF);
     * a Gepetto pair: a YAML and the URDF beside it (the only ``.urdf``);
+    * a HyRoDyn pair: a YAML with a ``submechanisms`` list and the robot URDF (the one of its stem, else the only
+      ``.urdf``);
     * an MJCF or SDF file alone (its loops and actuators from the file), or a URDF with URDF+ ``<loop>`` or urdfdom
       ``<constraint>`` elements.
 
     ``actuated``, ``task``: as :func:`pkm.load`'s (:func:`given`), over what the files state (:func:`with_given`): a
     file that names no actuated joint (SDF never does), or a spec or YAML that leaves them empty, loads with them.
+    ``folder``: the name of the folder the files came from, naming a Gepetto pair's mechanism as :func:`pkm.load`
+    names it from its folder (:func:`gepetto_name`: ``battobot_6d`` for ``battobot_6d/robot.urdf``).
 
     Raises:
         SpecError: none of these, or several; a spec naming a file that is not there; no actuated joint named by
@@ -356,7 +382,7 @@ def load_texts(files: Mapping[str, str], source: str = "<upload>", *, actuated: 
     """
     g = given(actuated, task)
     try:
-        return _load_texts(files, source, g)
+        return _load_texts(files, source, g, folder)
     except SpecNameError as exc:
         label = exc.source.removeprefix(f"{source}:")
         if label not in files or Path(label).suffix.lower() not in (".toml", ".yaml", ".yml"):
@@ -364,7 +390,7 @@ def load_texts(files: Mapping[str, str], source: str = "<upload>", *, actuated: 
         raise located(exc, files[label], "toml" if label.lower().endswith(".toml") else "yaml") from None
 
 
-def _load_texts(files: Mapping[str, str], source: str, g: Given) -> Mechanism:
+def _load_texts(files: Mapping[str, str], source: str, g: Given, folder: str | None = None) -> Mechanism:
     names = sorted(files)
     kind = {n: Path(n).suffix.lower() for n in names}
     specs = [n for n in names if kind[n] == ".toml"]
@@ -382,6 +408,15 @@ def _load_texts(files: Mapping[str, str], source: str, g: Given) -> Mechanism:
         mech = from_imported(spec, _read_text(spec.urdf, files[spec.urdf]), where)
         mech.notes += read
         return mech
+    if yamls and _is_hyrodyn(files[yamls[0]]):
+        where = f"{source}:{yamls[0]}"
+        stem = [n for n in names if n == str(Path(yamls[0]).with_suffix(".urdf"))]
+        urdfs = stem or [n for n in names if kind[n] == ".urdf"]
+        if len(urdfs) != 1:
+            raise SpecError(source, f"a HyRoDyn submechanisms file goes with one robot URDF (or one named "
+                                    f"{Path(yamls[0]).stem}.urdf); given {urdfs or 'none'}")
+        imported = _read_text(urdfs[0], files[urdfs[0]])
+        return _hyrodyn_mechanism(imported, urdfs[0], files[yamls[0]], Path(urdfs[0]).stem, where, g, ())
     if yamls:
         urdfs = [n for n in names if kind[n] == ".urdf"]
         if len(urdfs) != 1:
@@ -389,9 +424,9 @@ def _load_texts(files: Mapping[str, str], source: str, g: Given) -> Mechanism:
         where = f"{source}:{yamls[0]}"
         imported = _read_text(urdfs[0], files[urdfs[0]])
         joints = [str(j.get("name")) for j in check_urdf(imported.urdf, urdfs[0]).findall("joint")]
-        spec, read = read_gepetto(files[yamls[0]], urdfs[0], joints, Path(urdfs[0]).stem, where)
+        spec, read = read_gepetto(files[yamls[0]], urdfs[0], joints, gepetto_name(urdfs[0], folder), where)
         spec, replaced = with_given(spec, g, where)
-        return from_strings(imported.urdf, spec, source=where, notes=imported.notes + read + replaced)
+        return _gepetto_mechanism(imported.urdf, spec, where, imported.notes + read + replaced)
     if len(names) != 1:
         raise SpecError(source, f"give a closure spec with its model file, a Gepetto YAML with its URDF, or one model "
                                 f"file alone (MJCF, SDF, or a URDF with URDF+ <loop> or urdfdom <constraint> "
@@ -424,17 +459,97 @@ def load_gepetto(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = (), 
         raise SpecError(str(urdf_path), f"the model beside {yaml_path.name} is {imported.format.upper()}, not URDF: "
                                         "Gepetto's convention pairs a YAML with a URDF")
     joints = [str(j.get("name")) for j in check_urdf(imported.urdf, str(urdf_path)).findall("joint")]
-    name = urdf_path.parent.name if urdf_path.stem == "robot" else urdf_path.stem
+    name = gepetto_name(urdf_path.name, urdf_path.parent.name)
     text = read_text_file(yaml_path, "YAML")
     try:
-        spec, read = read_gepetto(text, urdf_path.name, joints, name or "robot", str(yaml_path))
+        spec, read = read_gepetto(text, urdf_path.name, joints, name, str(yaml_path))
         spec, replaced = with_given(spec, given, str(yaml_path))
-        return from_strings(imported.urdf, spec, source=str(yaml_path), notes=tuple(notes) + imported.notes + read
-                            + replaced)
+        return _gepetto_mechanism(imported.urdf, spec, str(yaml_path), tuple(notes) + imported.notes + read + replaced)
     except SpecNameError as exc:
         if exc.source != str(yaml_path):
             raise
         raise located(exc, text, "yaml") from None
+
+
+def _gepetto_mechanism(urdf: str, spec: ClosureSpec, source: str, notes: tuple[str, ...]) -> Mechanism:
+    """The mechanism of a Gepetto pair read: the ``<mimic>`` of the followers named as motors dropped, as the
+    toolbox loads them (:func:`~pkm.core.formats.gepetto.unmimic_motors`: a :class:`~pkm.errors.PkmWarning` and a
+    note naming each coupling dropped)."""
+    urdf, dropped = unmimic_motors(urdf, spec.actuated, source)
+    if dropped:
+        warnings.warn(f"{source}: {dropped[0]}", PkmWarning, stacklevel=4)
+    return from_strings(urdf, spec, source=source, notes=notes + dropped)
+
+
+def _is_hyrodyn(text: str) -> bool:
+    try:
+        raw = parse_yaml(text)
+    except SpecError:
+        return False
+    return isinstance(raw, dict) and isinstance(raw.get(HYRODYN_MARKER), list)
+
+
+def load_hyrodyn(urdf_path: Path, yaml_path: Path, notes: tuple[str, ...] = (), given: Given = Given()) -> Mechanism:
+    """The :class:`~pkm.core.Mechanism` of a robot URDF and HyRoDyn's ``submechanisms.yml``
+    (:mod:`pkm.core.formats.hyrodyn`); ``notes`` first (how the files were paired); ``given``: the actuated joints
+    and task stated in code (:func:`with_given`), over the file's."""
+    urdf_path, yaml_path = Path(urdf_path), Path(yaml_path)
+    imported = import_model(urdf_path)
+    if imported.format != "urdf":
+        raise SpecError(str(urdf_path), f"the model beside {yaml_path.name} is {imported.format.upper()}, not URDF: "
+                                        "HyRoDyn pairs its submechanisms file with a URDF")
+    name = urdf_path.stem
+    text = read_text_file(yaml_path, "YAML")
+    try:
+        return _hyrodyn_mechanism(imported, urdf_path.name, text, name, str(yaml_path), given, tuple(notes))
+    except SpecNameError as exc:
+        if exc.source != str(yaml_path):
+            raise
+        raise located(exc, text, "yaml") from None
+
+
+def _hyrodyn_mechanism(imported: Imported, urdf_name: str, yaml_text: str, name: str, source: str, given: Given,
+                       notes: tuple[str, ...]) -> Mechanism:
+    urdf, spec, read, partial = read_hyrodyn(yaml_text, imported.urdf, urdf_name, name or "robot", source)
+    spec, replaced = with_given(spec, given, source)
+    mech = from_strings(urdf, spec, source=source, notes=notes + imported.notes + read + replaced)
+    implied = [_implied(mech, loop, source) for loop in partial]
+    mech.notes += tuple(implied)
+    return mech
+
+
+def _implied(mech: Mechanism, loop: PartialLoop, source: str) -> str:
+    """The note saying that the translations ``loop`` leaves out are implied by the closures at the reference (the
+    closures' Jacobian keeps its rank without them); else a SpecError: read as a point closure they would remove
+    a motion the file leaves free."""
+    import numpy as np
+    import pinocchio as pin
+
+    from pkm.core.differential.velocity import RTOL
+    from pkm.core.kinematics import constraints
+
+    q = mech.q_reference
+    J = constraints.jacobian(mech, q)
+    start = sum(3 if c.type == "point" else 6 for c in mech.spec.closures[:[c.name for c in mech.spec.closures]
+                                                                        .index(loop.closure)])
+    R = mech.data.oMf[mech.model.getFrameId(loop.predecessor, pin.FrameType.BODY)].rotation
+    stated = loop.stated @ R.T @ J[start:start + 3]  # (the stated rows, in the predecessor's frame)
+    rest = np.vstack([J[:start], stated, J[start + 3:]])
+
+    def rank(A: np.ndarray) -> int:
+        s = np.linalg.svd(A, compute_uv=False)
+        return int(np.sum(s > RTOL * s[0])) if s.size and s[0] > 0 else 0
+
+    full, partial = rank(J), rank(rest)
+    if full != partial:
+        raise SpecError(source, f"closure {loop.closure!r} (predecessor {loop.predecessor!r}) states "
+                                f"{len(loop.stated)} translation axes of 3: the others are not implied by the loops "
+                                f"at the zero configuration (the closures' rank {partial} becomes {full} with them), so "
+                                "a point closure would remove a motion the file leaves free; pkm closes a point "
+                                "(three translations) or a frame (six)")
+    return (f"closure {loop.closure!r}: its file states {len(loop.stated)} translation axes of 3; read as a point "
+            f"closure, the others implied by the loops at the zero configuration (the closures' Jacobian has rank "
+            f"{full} with them and without)")
 
 
 _PACKAGE_FILES: dict[tuple[str, int, int], Imported] = {}  # (path, mtime [ns], size): the file read
@@ -471,5 +586,6 @@ def load_package_model(name: str, given: Given = Given()) -> Mechanism:
     return from_strings(imported.urdf, spec, source=f"{name} ({path})", notes=imported.notes + read)
 
 
-__all__ = ["READERS", "Given", "Loader", "Reader", "given", "given_task", "load_gepetto", "load_model_file",
-           "load_package_model", "load_path", "load_spec_file", "with_given"]
+__all__ = ["GEPETTO_URDF", "READERS", "Given", "Loader", "Reader", "gepetto_name", "given", "given_task",
+           "load_gepetto", "load_hyrodyn", "load_model_file", "load_package_model", "load_path", "load_spec_file",
+           "with_given"]

@@ -24,8 +24,13 @@ does not keep, from the file itself:
   ``general``...), in file order; a mimic joint's actuator drives its leader; an actuator on a
   ``<tendon><fixed>`` drives the one independent joint the tendon's length is an affine function of, once
   the mimic couplings are substituted (Robotiq's ``0.5 right + 0.5 left`` with ``right = left`` drives
-  ``left`` with factor 1). A tendon of several independent joints (a differential) or a ``<spatial>``
-  tendon is refused; actuators on sites or bodies (forces, not joint inputs) are left out with a note;
+  ``left`` with factor 1). A tendon of several independent joints is a differential: those joints are
+  actuated and each motor on it a ``[motors]`` entry (:attr:`Imported.motors`, :mod:`pkm.core.model.motors`), its
+  coordinate the tendon length times the actuator's ``gear``, ``u = sum_j gear c_j q_j`` (the mimic couplings
+  substituted), its effort acting on the joints as ``tau_j = gear c_j f``; the motors that share joints must be as
+  many as those joints, their map invertible, and a joint in a differential has no actuator of its own (else
+  refused); their force ranges bound the motors, not a joint (a note). A ``<spatial>`` tendon is refused; actuators
+  on sites or bodies (forces, not joint inputs) are left out with a note;
 * the drive of each actuated joint (:attr:`Imported.actuators`, a spec's ``[actuators.<joint>]`` tables: the URDF
   text cannot carry them; :mod:`pkm.core.model.actuators`), class defaults included (MuJoCo's actuator elements
   share one default per class): the joint's ``armature`` (MuJoCo's is the reflected inertia) -> ``armature``,
@@ -51,8 +56,10 @@ does not keep, from the file itself:
 * the reference configuration: the ``<keyframe><key name="reference">`` (the one :func:`pkm.save` writes), held
   (a ``qpos`` of another length is refused naming its line, as in every key); without it, the first key whose
   hinges and slides lie inside their ranges (MuJoCo Menagerie's ``home``: a pose MuJoCo's soft equalities leave
-  open by a millimetre or so): its free bodies and actuated joints held, the loops closed by moving the other joints
-  from it (a note names the key, the keys passed over, and how far the closing moved them); without any, assembled
+  open by a millimetre or so): its floating base held, its free bodies and actuated joints held where the loops allow
+  (:attr:`Imported.hold`: redundant motors whose key values disagree are moved, a note and a warning say by how much),
+  the loops closed by moving the other joints from it (a note names the key, the keys passed over, and how far the
+  closing moved them); without any, assembled
   starting from MuJoCo's ``qpos0`` (hinges and slides at their ``ref``, free bodies where the file puts them), where
   a ``<connect>``'s second anchor is taken (also for the connects pkm re-anchors: those to free bodies). An
   assembled reference outside a joint's range is assembled again inside it, else said
@@ -96,6 +103,7 @@ from lxml import etree
 
 from pkm.core.formats.base import Imported
 from pkm.core.model.actuators import UNLIMITED, Actuator
+from pkm.core.model.motors import motor_map
 from pkm.core.model.spec import Closure
 from pkm.core.model.springs import describe, parse_springs
 from pkm.core.model.urdf import floats, num, parse_xml, urdf_from_model
@@ -556,8 +564,9 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
         plain, _ = urdf_from_model(model, limits=limits, **kwargs)
         order = {n: k for k, n in enumerate(pin.buildModelFromXML(plain).names)}
         couplings.lead(order)
-    drives = _actuated(root, kinds, couplings, notes, source)
+    drives, motors = _actuated(root, defaults, kinds, couplings, notes, source)
     actuated = [d.joint for d in drives]
+    motor_map(list(dict.fromkeys(actuated)), motors, source)  # (a differential of as many motors as joints)
     actuators = _drives(drives, defaults, world, notes, source)
     mimic = couplings.followers()
     for j, (lead, m, c) in mimic.items():  # a follower's range bounds its leader; Pinocchio gives a mimic none
@@ -575,24 +584,27 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
                   if j.get("type") == "continuous"}
     keyed = _pinocchio_values(key_qpos, kinds, dependent, continuous)
     seed = {} if keyed else {j: _value(v, j in continuous) for j, v in refs.items() if v != 0.0 and j not in dependent}
+    hold: tuple[str, ...] = ()
     if keyed and key_name == _KEY:
         reference = keyed
         notes.append(f"the reference configuration is the <keyframe><key name={_KEY!r}> (the one pkm writes)")
     elif keyed:  # another key (Menagerie's "home"): its free bodies and motors held, the passive joints closed from it
-        held = [j for j in keyed if kinds[j] == "free" or j in actuated]
-        reference = {j: keyed[j] for j in held}
-        seed = {j: v for j, v in keyed.items() if j not in held}
+        base = _floating_base(model)
+        reference = {j: keyed[j] for j in keyed if j == base}  # (the others held where the loops allow: redundant
+        hold = tuple(j for j in keyed if j != base and (kinds[j] == "free" or j in actuated))  # motors may disagree)
+        seed = {j: v for j, v in keyed.items() if j != base}
         notes.append(f"the reference configuration is the <keyframe><key name={key_name!r}>, the first key inside "
                      "every joint limit, its loops closed by moving the joints no actuator drives (its free bodies "
                      "and actuated joints held)")
     elif seed:
         notes.append(f"assembled from the joints' ref (MuJoCo's qpos0, where the file's poses hold): "
                      f"{', '.join(seed)}")
-    if len(set(actuated)) < len(actuated):
+    direct = [d.joint for d in drives if d.motor is None]
+    if len(set(direct)) < len(direct):
         notes.append("several actuators drive the same joint: it is one input")
     springs = _springs(world, defaults, kinds, set(actuated), dependent, degrees, notes, source)
     return Imported(urdf, tuple(closures), types, tuple(dict.fromkeys(actuated)), name, "mjcf", _floating_base(model),
-                    reference, tuple(notes), actuators, seed, springs)
+                    reference, tuple(notes), actuators, seed, springs, motors, hold)
 
 
 #: The ``<keyframe><key>`` read as the reference configuration (:func:`pkm.save` writes it).
@@ -715,22 +727,26 @@ def _tendons(root: etree._Element, source: str) -> dict[str, list[tuple[str, flo
 
 
 class _Drive(NamedTuple):
-    """An ``<actuator>`` element on an independent joint."""
+    """An ``<actuator>`` element on an independent joint (a differential's: one per joint it moves)."""
 
     joint: str  # the independent joint it drives
     factor: float  # the effort on ``joint`` per unit of the transmission's effort (a mimic's scale, a tendon's coef)
     el: etree._Element
     label: str
+    motor: str | None = None  # the differential's motor (``[motors]``) it is a part of, else None
 
 
-def _actuated(root: etree._Element, kinds: dict[str, str], couplings: _Couplings, notes: list[str],
-              source: str) -> list[_Drive]:
-    """The ``<actuator>`` elements that drive independent joints, in file order (see the module doc)."""
+def _actuated(root: etree._Element, defaults: _Defaults, kinds: dict[str, str], couplings: _Couplings,
+              notes: list[str], source: str) -> tuple[list[_Drive], dict[str, dict[str, float]]]:
+    """The ``<actuator>`` elements that drive independent joints, in file order (see the module doc), and the motors
+    of the differentials (``{motor: {joint: coefficient}}``, :mod:`pkm.core.model.motors`)."""
     tendons = _tendons(root, source)
     driven = {el.get("tendon") for el in root.findall("actuator/*") if isinstance(el.tag, str)}
     if set(tendons) - driven:
         notes.append(f"tendons no actuator drives ({', '.join(sorted(set(tendons) - driven))}) not read")
     out: list[_Drive] = []
+    motors: dict[str, dict[str, float]] = {}
+    used = set(kinds)
     for k, el in enumerate(root.findall("actuator/*"), 1):
         if not isinstance(el.tag, str):
             continue
@@ -750,17 +766,46 @@ def _actuated(root: etree._Element, kinds: dict[str, str], couplings: _Couplings
                              f"joint {a.root}")
             out.append(_Drive(a.root, a.scale, el, label))
         elif tendon:
-            out.append(_Drive(*_tendon_joint(label, tendon, tendons, kinds, couplings, notes, source), el, label))
+            moving = _tendon_joints(label, tendon, tendons, kinds, couplings, notes, source)
+            if len(moving) == 1:
+                out.append(_Drive(*next(iter(moving.items())), el, label))
+                continue
+            gear = _gear(el, defaults, label, source)
+            motor = _fresh(el.get("name") or tendon, used)
+            motors[motor] = {j: gear * f for j, f in moving.items()}
+            out += [_Drive(j, f, el, label, motor) for j, f in moving.items()]
+            notes.append(f"{label} on tendon {tendon!r} read as motor {motor!r} of a differential, its coordinate "
+                         + _linear(motors[motor].items()) + " (gear included; [motors]: its effort f acts on the joints as coef * f; its force range "
+                           "bounds the motor, not read as a joint's effort limit)")
         else:
             target = next((f"{key} {el.get(key)!r}" for key in ("site", "body", "refsite") if el.get(key)), "nothing")
             notes.append(f"{label} acts on {target}, not on a joint coordinate: left out")
+    differential = {j for coefs in motors.values() for j in coefs}
+    both = sorted({d.joint for d in out if d.motor is None} & differential)
+    if both:
+        raise SpecError(source, f"joint {both[0]!r} is driven both by an actuator of its own and through a "
+                                "differential's tendon: pkm reads a differential's joints as driven by its motors only")
+    return out, motors
+
+
+def _linear(terms: Iterable[tuple[str, float]]) -> str:
+    """``c1 j1 + c2 j2 - c3 j3``: a linear combination of joints, for the notes."""
+    out = ""
+    for j, c in terms:
+        out += (f"{c:.6g} {j}" if not out else f" - {-c:.6g} {j}" if c < 0 else f" + {c:.6g} {j}")
     return out
 
 
-def _tendon_joint(label: str, tendon: str, tendons: dict[str, list[tuple[str, float]] | None],
-                  kinds: dict[str, str], couplings: _Couplings, notes: list[str], source: str) -> tuple[str, float]:
-    """The one independent joint a fixed tendon's length is an affine function of, with the mimic couplings, and
-    the length's rate per unit of that joint's."""
+def _gear(el: etree._Element, defaults: _Defaults, label: str, source: str) -> float:
+    """An actuator's (first) ``gear``, MuJoCo's default 1."""
+    return float(floats(((defaults.get(el, "gear") or "").split() or ["1"])[0], 1, f"{label} gear", source,
+                        np.inf)[0])
+
+
+def _tendon_joints(label: str, tendon: str, tendons: dict[str, list[tuple[str, float]] | None],
+                   kinds: dict[str, str], couplings: _Couplings, notes: list[str], source: str) -> dict[str, float]:
+    """The independent joints a fixed tendon's length is an affine function of, once the mimic couplings are
+    substituted, with the length's rate per unit of each joint's (one joint: a note says so)."""
     if tendon not in tendons:
         raise SpecNameError(source, "tendon", tendon, list(tendons), label)
     parts = tendons[tendon]
@@ -775,15 +820,14 @@ def _tendon_joint(label: str, tendon: str, tendons: dict[str, list[tuple[str, fl
             a = couplings.get(j)
             factors[a.root] = factors.get(a.root, 0.0) + coef * a.scale
     moving = {j: f for j, f in factors.items() if abs(f) > _SMALL}
-    text = " + ".join(f"{c:.6g} {j}" for j, c in parts)
-    if len(moving) != 1:
-        raise SpecError(source, f"{label} acts on tendon {tendon!r} ({text}), " + (
-            "whose length no joint moves" if not moving else
-            f"a differential of the independent joints {sorted(moving)}: pkm reads an actuator as one joint input"))
-    (joint, factor), = moving.items()
-    notes.append(f"tendon {tendon!r} ({text}) of {label} read as actuated joint {joint} (length = {factor:.6g} "
-                 f"{joint} + constant)")
-    return joint, factor
+    text = _linear(parts)
+    if not moving:
+        raise SpecError(source, f"{label} acts on tendon {tendon!r} ({text}), whose length no joint moves")
+    if len(moving) == 1:
+        (joint, factor), = moving.items()
+        notes.append(f"tendon {tendon!r} ({text}) of {label} read as actuated joint {joint} (length = {factor:.6g} "
+                     f"{joint} + constant)")
+    return moving
 
 
 _DRIVE_KEYS = (("armature", "armature"), ("damping", "viscous"), ("frictionloss", "coulomb"))  # MJCF -> Actuator
@@ -827,11 +871,13 @@ def _drives(drives: list[_Drive], defaults: _Defaults, world: etree._Element, no
     elements = {str(j.get("name")): j for j in world.iter("joint", "freejoint")}
     efforts: dict[str, float] = {}
     for d in drives:
-        gear = floats(((defaults.get(d.el, "gear") or "").split() or ["1"])[0], 1, f"{d.label} gear", source,
-                      np.inf)[0]
+        gear = _gear(d.el, defaults, d.label, source)
         scale = abs(gear * d.factor)
         if scale == 0.0:
             raise SpecError(source, f"{d.label} on joint {d.joint!r}: gear 0 transmits no effort")
+        if d.motor is not None:  # (a differential's motor: its force range bounds the motor, not one joint)
+            efforts[d.joint] = np.inf
+            continue
         limit = np.inf
         force = _range(d.el, defaults, "forcerange", f"{d.label} forcerange", source)
         if force is not None:

@@ -75,6 +75,9 @@ def gepetto_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
         dropped.append(f"closure names {names} (read back: loop1, loop2, ...)")
     if spec.actuators:
         dropped.append(f"drives stated in the spec ([actuators]): {json.dumps({k: dict(v) for k, v in spec.actuators.items()})}")
+    if spec.motors:
+        dropped.append(f"the differentials' motors ([motors]): {json.dumps({k: dict(v) for k, v in spec.motors.items()})}"
+                       " (read back, each actuated joint has a motor of its own)")
     if spec.branches:
         dropped.append(f"working modes ([branches]): {sorted(spec.branches)}, default {spec.default_branch!r}")
     if spec.parameters:

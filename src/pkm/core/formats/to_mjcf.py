@@ -5,7 +5,8 @@ fixed joints are merged), the joint itself (``hinge``, ``slide``, ``ball``, ``fr
 hinges of one body, about its first axis and then its second, each with the universal's range; a mimic joint as a
 joint of its own tied to its leader by a ``<joint>`` equality ``q = offset + scale q_leader``), a site at each closure
 frame, a ``<connect>`` (point closure) or ``<weld>`` (frame closure) between the two sites, a ``<motor>`` on each
-actuated joint, and the reference configuration as ``<keyframe><key name="reference">`` (:func:`mjcf_qpos`; MuJoCo's
+actuated joint (a differential's motors, the spec's ``[motors]``: each on a ``<tendon><fixed>`` of its joints and
+coefficients, ``gear="1"``; their joints get no motor of their own), and the reference configuration as ``<keyframe><key name="reference">`` (:func:`mjcf_qpos`; MuJoCo's
 ``mj_resetDataKeyframe(model, data, 0)`` starts from it, closed).
 Gravity is the model's, contacts are disabled; a one-coordinate joint with position limits
 (:attr:`~pkm.core.Mechanism.limits`) has them as its ``range`` (radians or metres: ``<compiler angle="radian">``).
@@ -191,7 +192,16 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
     root.append(equality)
     keyframe = etree.SubElement(root, "keyframe")
     etree.SubElement(keyframe, "key", name="reference", qpos=_num(mjcf_qpos(mech, mech.q_reference)))
+    if mech.spec.motors:  # a differential: each motor on a fixed tendon of its joints (read back as [motors])
+        tendon = etree.SubElement(root, "tendon")
+        for mname, coefs in mech.spec.motors.items():
+            fixed = etree.SubElement(tendon, "fixed", name=mname)
+            for jname, coef in coefs.items():
+                etree.SubElement(fixed, "joint", joint=jname, coef=repr(float(coef)))
     actuator = etree.SubElement(root, "actuator")
+    for mname in mech.spec.motors:
+        etree.SubElement(actuator, "motor", name=mname, tendon=mname, gear="1")
+    differential = {j for coefs in mech.spec.motors.values() for j in coefs}
     for joint, drive in zip(mech.actuated, mech.actuators):
         name = model.names[joint.id]
         el = next(e for e in world.iter("joint") if e.get("name") == name)
@@ -199,6 +209,8 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
                            ("frictionloss", drive.coulomb)):
             if value != 0.0:
                 el.set(key, repr(value))
+        if name in differential:
+            continue
         motor = etree.SubElement(actuator, "motor", name=f"{name}_motor", joint=name, gear="1")
         if np.isfinite(drive.max_effort):  # the peak limit when there is one, else the continuous one
             motor.set("forcelimited", "true")
@@ -284,15 +296,19 @@ def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
         out.append(f"working modes ([branches]): {sorted(spec.branches)}")
     if spec.parameters:
         out.append(f"design parameters ([parameters]): {json.dumps(dict(spec.parameters))}")
+    differential = {j for coefs in spec.motors.values() for j in coefs}
     for a in mech.actuators:
+        shared = a.joint in differential  # (a differential's joint has no motor of its own, no force range)
         lost = [f"{k} {v!r}" for k, v in (("velocity_limit", a.velocity_limit),
-                                          ("effort_limit", a.effort_limit if np.isfinite(a.peak_effort) else np.inf),
+                                          ("effort_limit", a.effort_limit if np.isfinite(a.peak_effort) or shared
+                                           else np.inf),
+                                          ("peak_effort", a.peak_effort if shared else np.inf),
                                           ("rotor_inertia", a.rotor_inertia),
                                           ("gear_ratio", a.gear_ratio if a.gear_ratio != 1.0 else 0.0))
                 if np.isfinite(v) and v != 0.0]
         if lost:
-            out.append(f"drive of {a.joint!r}: {', '.join(lost)} (MJCF has one force range, and armature for the "
-                       "rotor)")
+            out.append(f"drive of {a.joint!r}: {', '.join(lost)} (MJCF has one force range" + (
+                ", on the differential's motors, not this joint" if shared else "") + ", and armature for the rotor)")
     universal = [mech.model.names[j] for j in range(1, mech.model.njoints)
                  if mech.model.joints[j].shortname() == "JointModelUniversal"]
     if universal:

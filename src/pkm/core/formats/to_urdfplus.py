@@ -122,6 +122,9 @@ def urdfplus_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
         dropped.append("the task and end effector")
     if spec.actuators:
         dropped.append(f"the drives of {sorted(spec.actuators)}")
+    if spec.motors:
+        dropped.append(f"the differentials' motors {sorted(spec.motors)} (read back, each actuated joint has a motor "
+                       "of its own)")
     if spec.branches or spec.parameters:
         dropped.append("working modes and parameters")
     return etree.tostring(root, encoding="unicode") + "\n", tuple(dropped)

@@ -31,6 +31,7 @@ from pkm.core.identification.base import BaseParameters, base_parameters
 from pkm.core.identification.estimate import Estimate, _scale, estimate
 from pkm.core.identification.regressor import parameters, regressor_batch
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.plausibility import require_physical
 from pkm.errors import ConvergenceError, InvalidInputError
 
 REGULARISATION = 1e-6  # ε, relative to the weighted regressor's mean squared column norm
@@ -102,9 +103,10 @@ def consistent_estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: Array
         (132,)
     """
     what = "the physically consistent estimate"
+    mech = check_mechanism(mech)
+    require_physical(mech, what + " (its prior: the model's inertias)")
     cp = module("cvxpy", extra="identify", what=what)
     module("clarabel", extra="identify", what=what)
-    mech = check_mechanism(mech)
     base = base if base is not None else base_parameters(mech, precise=False)
     ls = ls if ls is not None else estimate(mech, Q, QD, QDD, TAU, base=base)
     P = parameters(mech)

@@ -32,7 +32,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from pkm.core.dynamics.model import COULOMB_VELOCITY, actuator_model
+from pkm.core.dynamics.model import COULOMB_VELOCITY, RTOL, _check_state, _evaluate
 from pkm.core.model.bodies import BODY_FIELDS, BODY_UNITS, body_names
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import CompilerError, InvalidInputError, SpecError
@@ -146,8 +146,8 @@ def regressor(mech: Mechanism, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> n
         >>> np.allclose(Y @ theta, pkm.actuator_model(delta, q, qd).efforts(qdd))
         True
     """
-    model = actuator_model(mech, q, qd)
-    mech = model.mech
+    mech, q, qd, base, vb = _check_state(mech, q, qd, None)  # (no inertia needed: a non-physical model has one)
+    model = _evaluate(mech, q, qd, RTOL, COULOMB_VELOCITY, base, vb)
     qdd = mech.check_actuated(qdd, "qdd")
     a = model.joint_accelerations(qdd)
     Yb = model.G.T @ tree_regressor(mech, model.q, model.v, a)

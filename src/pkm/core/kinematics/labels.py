@@ -17,6 +17,7 @@ a reference on a singularity) the label is empty: no mode is told.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -76,7 +77,21 @@ class _Blocks:
 
     def signs(self, A: np.ndarray) -> tuple[int, ...]:
         S = A[np.ix_(self.rows, self.cols)]
-        return tuple(_sign(S[np.ix_(r, c)]) * s for r, c, s in self.blocks)
+        out = [0] * len(self.blocks)
+        for which, r, c in self.stacks:  # (the blocks of one size as one stack: one LAPACK call for them all)
+            for k, sign in zip(which, _signs(S[r[:, :, None], c[:, None, :]])):
+                out[k] = sign * self.blocks[k][2]
+        return tuple(out)
+
+    @functools.cached_property
+    def stacks(self) -> tuple[tuple[tuple[int, ...], np.ndarray, np.ndarray], ...]:
+        """The blocks grouped by size: ``(their indices, their rows (b x n), their columns (b x n))`` per size."""
+        sizes: dict[int, list[int]] = {}
+        for k, (r, _, _) in enumerate(self.blocks):
+            sizes.setdefault(len(r), []).append(k)
+        return tuple((tuple(ks), np.array([self.blocks[k][0] for k in ks], dtype=int).reshape(len(ks), n),
+                      np.array([self.blocks[k][1] for k in ks], dtype=int).reshape(len(ks), n))
+                     for n, ks in sizes.items())
 
 
 #: A block whose smallest singular value is below this, relative to its largest, is singular: sign 0.
@@ -89,6 +104,20 @@ def _sign(B: np.ndarray) -> int:
     if not sv[-1] > SINGULAR * sv[0]:
         return 0
     return 1 if np.linalg.det(B) > 0 else -1
+
+
+def _signs(B: np.ndarray) -> list[int]:
+    """:func:`_sign` of each matrix of the stack ``B`` (b x n x n), by the same LAPACK routines on each. The SVD is
+    skipped where the determinant proves the matrix regular: ``|det| > 10 SINGULAR ‖B‖_F^n`` gives, as ``|det|`` is
+    the product of the singular values and ``‖B‖_F`` bounds the largest, a smallest above ``10 SINGULAR`` of the
+    largest (LU's rounding of ``det``, ``n eps`` of ``‖B‖^n``, far below the margin)."""
+    det = np.linalg.det(B)
+    n = B.shape[-1]
+    regular = np.abs(det) > 10.0 * SINGULAR * np.linalg.norm(B, axis=(-2, -1)) ** n
+    if not regular.all():
+        sv = np.linalg.svd(B[~regular], compute_uv=False)
+        regular[~regular] = sv[:, -1] > SINGULAR * sv[:, 0]
+    return [0 if not r else (1 if d > 0 else -1) for r, d in zip(regular, det)]
 
 
 def _structure(mats: list[np.ndarray], cols: np.ndarray) -> _Blocks | None:
@@ -118,11 +147,15 @@ def _structure(mats: list[np.ndarray], cols: np.ndarray) -> _Blocks | None:
 
 
 def _mats(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The closure and the closure-and-task Jacobians at ``q``, homogenised (:mod:`pkm.core.model.scale`: positive
-    row and column factors, so the determinants' signs are the raw matrices' and the singularity thresholds mean the
-    same at any size)."""
-    c = Configuration.compute(mech, q)
-    J = np.array(c.closure_and_task_jacobian)
+    """The closure and the closure-and-task Jacobians at ``q``, homogenised (:func:`_scaled`)."""
+    return _scaled(mech, Configuration.compute(mech, q).closure_and_task_jacobian)
+
+
+def _scaled(mech: Mechanism, J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The closure and the closure-and-task Jacobians from ``J``, the closure-and-task Jacobian, homogenised
+    (:mod:`pkm.core.model.scale`: positive row and column factors, so the determinants' signs are the raw matrices'
+    and the singularity thresholds mean the same at any size)."""
+    J = np.asarray(J, dtype=float)
     scales = JacobianScales.of(mech)
     Jc = scales.constraint(J[:mech.n_constraints])
     return Jc, np.vstack([Jc, scales.task(J[mech.n_constraints:])])
@@ -155,11 +188,33 @@ def mode_label(mech: Mechanism, q: ArrayLike) -> ModeLabel:
         >>> pkm.mode_label(delta, q).working
         (1, -1, -1, -1)
     """
+    return _label(mech, mech.check_q(q))
+
+
+def mode_label_at(mech: Mechanism, q: np.ndarray, jacobian: np.ndarray | None = None, *,
+                  result: bool = False) -> ModeLabel:
+    """:func:`mode_label` of the checked configuration ``q`` from ``jacobian``, the raw closure-and-task Jacobian
+    at ``q`` (:attr:`~pkm.core.kinematics.configuration.Configuration.closure_and_task_jacobian`, ``nv`` columns):
+    the solvers' own Newton matrix, so that the label costs no kinematics pass (the same numbers); None: computed
+    at ``q``. ``result``: ``q`` is a solve's result, whose label is kept (the last one, per mechanism and thread):
+    a solve seeded with the last solve's result (a path followed step by step) finds its seed's label there."""
+    return _label(mech, q, jacobian, result)
+
+
+def _label(mech: Mechanism, q: np.ndarray, jacobian: np.ndarray | None = None, keep: bool = False) -> ModeLabel:
+    """The label of ``q`` from ``jacobian`` (None: computed at ``q``), the one kept where it is ``q``'s; ``keep``:
+    kept (:func:`mode_label_at`)."""
     fk, ik = _structures(mech)
-    q = mech.check_q(q)
     if fk is None and ik is None:
         return ModeLabel()
     if np.array_equal(q, mech.q_reference):  # (the reference's own signs, by construction: no kinematics pass)
         return ModeLabel(() if fk is None else (1,) * len(fk.blocks), () if ik is None else (1,) * len(ik.blocks))
-    fk_m, ik_m = _mats(mech, q)
-    return ModeLabel(() if fk is None else fk.signs(fk_m), () if ik is None else ik.signs(ik_m))
+    key = (q.tobytes(), mech.q_reference.tobytes())
+    last = getattr(mech._local, "mode_label", None)
+    if last is not None and last[0] == key:
+        return last[1]
+    fk_m, ik_m = _mats(mech, q) if jacobian is None else _scaled(mech, jacobian)
+    label = ModeLabel(() if fk is None else fk.signs(fk_m), () if ik is None else ik.signs(ik_m))
+    if keep:
+        mech._local.mode_label = (key, label)
+    return label

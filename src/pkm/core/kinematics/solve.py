@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike
 
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
-from pkm.core.kinematics.labels import ModeLabel, mode_label
+from pkm.core.kinematics.labels import ModeLabel, mode_label, mode_label_at
 from pkm.core.kinematics.newton import gauss_newton
 from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism, spread
@@ -182,9 +182,45 @@ def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.nd
 
 
 def _result(mech: Mechanism, q: np.ndarray, converged: bool, residual: float, iterations: int,
-            steps: int) -> SolveResult:
+            steps: int, mode: ModeLabel | None = None) -> SolveResult:
     return SolveResult(q, converged, residual, iterations, steps, _signs(mech, q), mech.outside_limits(q),
-                       mode_label(mech, q))
+                       mode_label_at(mech, q, result=True) if mode is None else mode)
+
+
+class _Matrices:
+    """The Newton matrices a solve's mode labels need, kept as the solver makes them (no kinematics pass of their
+    own): the closure-and-task Jacobian at the last evaluation that met the final step's tolerance (the solution,
+    where the solver stops) and, with ``at_seed`` (the inverse kinematics, whose first Newton iterate is its seed),
+    at the first evaluation.
+
+    The kept function's Jacobian is the closure-and-task Jacobian, or, with ``task`` (the loop closure's, with the
+    closure rows only), the closure Jacobian: the task rows are then added at the solution only, from the kinematics
+    pass just made in ``mech.data``."""
+
+    def __init__(self, mech: Mechanism, *, at_seed: bool = False, task: TaskMap | None = None) -> None:
+        self.mech, self.task, self.at_seed = mech, task, at_seed
+        self.first: tuple[np.ndarray, np.ndarray] | None = None
+        self.last: tuple[np.ndarray, np.ndarray] | None = None
+
+    def keep(self, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], final: bool, tol: float
+             ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+        """``fun`` keeping its matrices; ``final``: the final step's, solved to ``tol``."""
+        def kept(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            r, J = fun(x)
+            if self.at_seed and self.first is None:
+                self.first = (x.copy(), J)
+            if final and float(np.max(np.abs(r), initial=0.0)) <= tol:
+                full = J if self.task is None else np.vstack([J, self.task.jacobian_from(self.mech.data)])
+                self.last = (x.copy(), full)
+            return r, J
+        return kept
+
+    def label(self, q: np.ndarray, at: np.ndarray | None = None) -> ModeLabel:
+        """The label of ``q``, from the matrices kept at ``at`` (``q``'s unwrapped copy: the same configuration;
+        given for the solve's result, default ``q``, the seed), or from scratch where none were kept there."""
+        kept = next((k for k in (self.last, self.first) if k is not None
+                     and np.array_equal(k[0], q if at is None else at)), None)
+        return mode_label_at(self.mech, q, None if kept is None else kept[1], result=at is not None)
 
 
 def _warn_mode_change(what: str, seed: ModeLabel, result: SolveResult) -> None:
@@ -196,7 +232,7 @@ def _warn_mode_change(what: str, seed: ModeLabel, result: SolveResult) -> None:
 
 
 def _follow(mech: Mechanism, what: str, solve_at: _StepSolver, q: np.ndarray, n_steps: int, tol: float,
-            raise_on_failure: bool) -> SolveResult:
+            raise_on_failure: bool, matrices: _Matrices) -> SolveResult:
     """Continuation from ``s = 0`` (the seed ``q``) to ``s = 1`` (the target).
 
     ``solve_at(q, s, tol) -> (q, residual, iterations)`` corrects at path parameter ``s`` from ``q``.
@@ -223,8 +259,8 @@ def _follow(mech: Mechanism, what: str, solve_at: _StepSolver, q: np.ndarray, n_
         if res <= t:
             q, s, steps = q_new, s_next, steps + 1
             if s >= 1.0:
-                q = mech.wrap(q)
-                return _result(mech, q, True, res, total, steps)
+                q_wrapped = mech.wrap(q)
+                return _result(mech, q_wrapped, True, res, total, steps, matrices.label(q_wrapped, q))
             ds = min(ds * 1.5, 1.0 / n_steps)
         else:
             ds *= 0.5
@@ -285,12 +321,15 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
     def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return constraints.residual_and_jacobian(mech, qq)
 
-    def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int]:
-        return _newton(mech, fun, mech.with_actuated(q, qa0 + s * (qa1 - qa0)), mech.passive_v, t, max_iter, 0.5)
+    matrices = _Matrices(mech, task=TaskMap.of(mech))
 
-    seed = mode_label(mech, q)
+    def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int]:
+        return _newton(mech, matrices.keep(fun, s >= 1.0, t), mech.with_actuated(q, qa0 + s * (qa1 - qa0)),
+                       mech.passive_v, t, max_iter, 0.5)
+
+    seed = mode_label(mech, q)  # (found kept where the seed is the last solve's result: a path followed)
     try:
-        result = _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure)
+        result = _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure, matrices)
     except ConvergenceError as exc:
         exc.problem = ClosureProblem(mech, qa1)
         raise
@@ -343,14 +382,16 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
     dist = np.max(np.abs(task.error(y1, y0)))
     n_steps = _n_steps(dist, max_step)
 
+    matrices = _Matrices(mech, at_seed=True)
+
     def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int]:
         goal = IKProblem(mech, y1 if s >= 1.0 else task.interpolate(y0, y1, s))
-        return _newton(mech, goal.evaluate, q, mech.free_v, t, max_iter, 0.5)
+        return _newton(mech, matrices.keep(goal.evaluate, s >= 1.0, t), q, mech.free_v, t, max_iter, 0.5)
 
     problem = IKProblem(mech, y1)
-    seed = mode_label(mech, q)
+    seed_q = q
     try:
-        result = _follow(mech, "inverse kinematics", solve_at, q, n_steps, tol, raise_on_failure)
+        result = _follow(mech, "inverse kinematics", solve_at, q, n_steps, tol, raise_on_failure, matrices)
     except ConvergenceError as exc:
         if isinstance(exc.result, SolveResult):
             _raise_if_out_of_reach(mech, problem.evaluate, exc.result.q, tol)
@@ -359,7 +400,7 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
     q = result.q
     if result.converged and branch is not None and not mech.on_branch(q, branch):
         raise BranchError(branch, dict(mech.branch(branch).signs), mech.branch_signs(q, branch))
-    _warn_mode_change("inverse kinematics", seed, result)
+    _warn_mode_change("inverse kinematics", matrices.label(seed_q), result)
     return result
 
 

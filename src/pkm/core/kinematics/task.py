@@ -24,7 +24,7 @@ from pkm._derived import derived
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, SingularityError
 from pkm.units import quantities, quantity
-from pkm.validation import ABSURD, as_array, as_vector, wrap_angle
+from pkm.validation import as_array, as_vector, bounded, wrap_angle
 
 _ANGLES = ("roll", "pitch", "yaw")
 _POS = {"x": 0, "y": 1, "z": 2}
@@ -273,8 +273,7 @@ class TaskMap:
                                               f"{list(self.value_names)}, got shape {y.shape}", target)
         if not np.all(np.isfinite(y)):
             raise InvalidInputError("target", "holds non-finite values", target)
-        if np.abs(y).max() > ABSURD:
-            raise InvalidInputError("target", f"holds values beyond {ABSURD:g} (SI units: m, rad)", target)
+        bounded(y, "target", target)
         for g, part in zip(self._groups, self._parts(y)[0]):
             if g.pose and abs((qn := float(np.linalg.norm(part[3:7]))) - 1.0) > 1e-6:
                 raise InvalidInputError("target", f"quaternion norm {qn:.6g}, expected 1", target)

@@ -32,9 +32,9 @@ from pkm.core.differential.velocity import (
 from pkm.core.dynamics.projection import inverse_dynamics
 from pkm.core.kinematics.solve import SolveResult, close_loops, solve_ik
 from pkm.core.kinematics.task import TaskMap
-from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.mechanism import LimitViolation, Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, SingularityError
-from pkm.validation import ABSURD, as_array, as_tolerance
+from pkm.validation import as_array, as_tolerance, bounded
 
 #: A sample's joint step beyond this multiple of the first-order prediction (plus 1e-9) is a jump.
 JUMP_RATIO = 1.0
@@ -72,6 +72,10 @@ class Trajectory:
         units: The unit of every actuated joint and named task coordinate (``{"actuated": {...}, "task": {...}}``;
             the task's keys are :attr:`pkm.core.TaskMap.keys`, a pose's orientation by its Z-Y-X angles, while
             :attr:`task` holds its quaternion).
+        outside_limits: Per joint that leaves the position limits the model states, ``(sample, violation)``: the
+            first sample outside and there its :class:`~pkm.core.model.mechanism.LimitViolation` (joint, value,
+            limit), in the order of the samples (:meth:`~pkm.core.Mechanism.limits_along`; empty: every joint
+            within its limits throughout).
     """
 
     q: np.ndarray
@@ -87,6 +91,7 @@ class Trajectory:
     residual: np.ndarray
     jumps: tuple[Jump, ...]
     units: dict[str, dict[str, str]] = field(default_factory=dict)
+    outside_limits: tuple[tuple[int, LimitViolation], ...] = ()
 
     def __len__(self) -> int:
         return len(self.q)
@@ -106,9 +111,7 @@ def _samples(x: ArrayLike | None, n: int | None, size: int, what: str) -> np.nda
                                 x)
     if not np.all(np.isfinite(arr)):
         raise InvalidInputError(what, "holds non-finite values", x)
-    if np.abs(arr).max() > ABSURD:
-        raise InvalidInputError(what, f"holds values beyond {ABSURD:g} (SI units: m, rad)", x)
-    return arr
+    return bounded(arr, what, x)
 
 
 def _units(mech: Mechanism) -> dict[str, dict[str, str]]:
@@ -175,7 +178,7 @@ def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int,
     ydd = np.array([task_acceleration(mech, qk, vk, ak) if np.all(np.isfinite(ak)) else np.full(mech.n_task, np.nan)
                     for qk, vk, ak in zip(q, v, a)])
     return Trajectory(q, v, a, q[:, mech.act_q], v[:, mech.act_v], a[:, mech.act_v], values, yd, ydd, tau, residual,
-                      tuple(jumps), _units(mech))
+                      tuple(jumps), _units(mech), mech.limits_along(q))
 
 
 def follow_task(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None = None, ydd: ArrayLike | None = None, *,

@@ -65,16 +65,20 @@ REFERENCE_TOL = 1e-9
 
 def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | None = None,
           source: str = "<model>", notes: tuple[str, ...] = (), *,
-          seed: Mapping[str, Any] | None = None) -> Mechanism:
+          seed: Mapping[str, Any] | None = None, hold: tuple[str, ...] = ()) -> Mechanism:
     """The mechanism of ``model`` and ``spec``, its reference assembled or checked (module doc).
 
     ``seed``: values of joints the ``[reference]`` leaves out, where the assembly starts instead of the neutral
     configuration (a design whose geometry moved, started from its former reference: the same assembly mode).
+    ``hold``: joints of ``seed`` the assembly holds where the loops allow it (the actuated joints of an MJCF keyframe:
+    values the model files state, not the spec); where they over-determine the loops (redundant actuators whose
+    stated values disagree), the assembly holds only the ``[reference]``, starting from them, and a note and a
+    :class:`~pkm.errors.PkmWarning` say how far it moved them.
 
     Raises:
         SpecError: the spec does not fit the model; no assembly keeps the joints a partial ``[reference]`` states
-            (or, with none stated, the loops cannot close: each open loop named with its gap, the
-            :class:`~pkm.errors.AssemblyError` as the cause); a complete ``[reference]`` leaves a loop open.
+            (or, with none stated but the floating base's pose, the loops cannot close: each open loop named with its
+            gap, the :class:`~pkm.errors.AssemblyError` as the cause); a complete ``[reference]`` leaves a loop open.
     """
     mech = Mechanism(model, spec, params, urdf, source, notes)
     if seed:
@@ -82,14 +86,38 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
     missing = [n for n, j in mech.joints.items() if j.nq > 0 and n not in spec.reference]
     if missing:  # a partial (or no) reference: assembled from it, the other joints from the neutral configuration
         start = mech.q_reference.copy()
+        held = tuple(spec.reference)
+        soft = tuple(n for n in hold if n in missing and seed and n in seed)
         try:
-            mech.q_reference = assemble(mech, start, hold=tuple(spec.reference), tol=1e-12).q
+            try:
+                mech.q_reference = assemble(mech, start, hold=held + soft, tol=1e-12).q
+                held += soft
+            except AssemblyError as exc:
+                if not soft:
+                    raise
+                loose = assemble(mech, start, hold=held, tol=1e-12)  # (all released; then only the redundant ones:)
+                redundant = set(actuation(mech, loose.q).dependent) & set(soft)
+                kept = tuple(n for n in soft if n not in redundant)
+                again = assemble(mech, start, hold=held + kept, tol=1e-12, raise_on_failure=False) \
+                    if redundant else None
+                if again is None or not again.converged:
+                    again, kept = loose, ()
+                mech.q_reference, held = again.q, held + kept
+                released = [n for n in soft if n not in kept]
+                moved = max(float(np.abs(pin.difference(model, start, mech.q_reference)[
+                    mech.joints[n].idx_v:mech.joints[n].idx_v + mech.joints[n].nv]).max()) for n in released)
+                release = (f"the values the model file states for {list(soft)} over-determine the loops (no "
+                           f"assembly holds them all: {exc}): assembled from them holding {list(held) or 'nothing'}, "
+                           f"which moved {released} by {moved:.3g} at most (rad or m)")
+                mech.notes += (release,)
+                warnings.warn(f"{source}: {release}", PkmWarning, stacklevel=3)
         except AssemblyError as exc:
-            if not spec.reference:  # (the file states no configuration: the loops themselves do not close)
-                raise SpecError(source, f"the loops cannot be closed: {exc}") from exc  # (its closures, gaps)
+            hint = _redundancy(mech, start)
+            if not set(spec.reference) - {spec.floating_base}:  # (the files state no joint: the loops do not close)
+                raise SpecError(source, f"the loops cannot be closed: {exc}{hint}") from exc  # (its closures, gaps)
             raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found that keeps the "
                                     f"joints it states, the others starting from the neutral configuration "
-                                    f"({exc}); give an assembled [reference]") from None
+                                    f"({exc}){hint}; give an assembled [reference]") from None
         raw = constraints.residual(mech, start)
         rel = constraints.worst_closure(mech, raw * JacobianScales.of(mech).constraint_rows
                                         / mech.characteristic_length)[0] if seed else 0.0
@@ -98,7 +126,7 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
             moved = float(np.abs(pin.difference(model, start, mech.q_reference)).max())
             mech.notes += (f"the loops open by {gap:.3g} (m or rad) at the pose the files state were closed by "
                            f"assembly, which moved the joints by {moved:.3g} at most (rad or m)",)
-        mech.q_reference = _inside_limits(mech, start, tuple(spec.reference), source)
+        mech.q_reference = _inside_limits(mech, start, held, source)
     else:
         raw = constraints.residual(mech, mech.q_reference)
         L = mech.characteristic_length
@@ -120,6 +148,20 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
             mech.notes += (str(finding),)
             warnings.warn(finding, stacklevel=3)
     return mech
+
+
+def _redundancy(mech: Mechanism, q: np.ndarray) -> str:
+    """Where the closures' rows are redundant at ``q`` (their Jacobian, the floating base held, has a smaller rank
+    than rows: over-constrained or planar loops), a sentence saying that such loops close only where their geometry
+    agrees exactly (MuJoCo's soft equalities absorb a disagreement that rigid loops cannot); else ``""``."""
+    J = constraints.jacobian(mech, q)[:, np.setdiff1d(np.arange(mech.nv), mech.base_v)]
+    s = np.linalg.svd(J, compute_uv=False)
+    rank = int(np.sum(s > 1e-9 * s[0])) if len(s) and s[0] > 0.0 else 0
+    if rank >= J.shape[0]:
+        return ""
+    return (f"; the closures' {J.shape[0]} equations have rank {rank} there: redundant (over-constrained or planar) "
+            "loops close only where their geometry agrees exactly, which MuJoCo's soft equalities do not require (a "
+            "site or anchor off by a rounding error is enough)")
 
 
 #: Rounds of :func:`_inside_limits`: each assembles once more (one Levenberg-Marquardt run, no restarts).
@@ -160,7 +202,8 @@ def _inside_limits(mech: Mechanism, start: np.ndarray, hold: tuple[str, ...], so
 
 
 def from_strings(urdf: str, spec: ClosureSpec | str, params: Any = None, source: str = "<string>",
-                 notes: tuple[str, ...] = (), *, seed: Mapping[str, Any] | None = None) -> Mechanism:
+                 notes: tuple[str, ...] = (), *, seed: Mapping[str, Any] | None = None,
+                 hold: tuple[str, ...] = ()) -> Mechanism:
     """Build from URDF text and a spec (object or TOML text); ``notes``: what the reader of its files interpreted
     or ignored (:attr:`Mechanism.notes`).
 
@@ -192,8 +235,9 @@ def from_strings(urdf: str, spec: ClosureSpec | str, params: Any = None, source:
         ('my_fivebar', 2, ('x', 'z'))
         >>> {k: round(v, 4) for k, v in pkm.task_values(mech, mech.q_reference).items()}
         {'x': 0.1371, 'z': -0.6192}
-        >>> print(pkm.diagnose(mech, mech.q_reference))
-        regular
+        >>> print(pkm.diagnose(mech, mech.q_reference))  # doctest: +NORMALIZE_WHITESPACE
+        regular: mobility 2 (constraint rank 3 of 3 equations); distance to a direct singularity 0.244,
+        to an inverse one 0.0658 (0: singular, 1: far)
     """
     if not isinstance(urdf, str):
         raise InvalidInputError("urdf", f"expected the URDF text as a str, got {type(urdf).__name__}", urdf)
@@ -203,7 +247,7 @@ def from_strings(urdf: str, spec: ClosureSpec | str, params: Any = None, source:
     if isinstance(spec, str):
         spec = ClosureSpec.from_toml(spec, source + " (closures)")
     return build(retype_joints(load_model(urdf, source), spec.joint_types, source), spec, params, urdf, source,
-                 notes, seed=seed)
+                 notes, seed=seed, hold=hold)
 
 
 def from_files(spec_path: str | Path, spec: ClosureSpec | None = None) -> Mechanism:
@@ -235,7 +279,7 @@ def from_imported(spec: ClosureSpec, imported: Imported, source: str) -> Mechani
     states added to the spec, then built (as :func:`from_files` does once it has read both)."""
     spec = with_file(spec, imported, source)
     model = retype_joints(load_model(imported.urdf, source), spec.joint_types, source)
-    return build(model, spec, None, imported.urdf, source, imported.notes, seed=imported.seed)
+    return build(model, spec, None, imported.urdf, source, imported.notes, seed=imported.seed, hold=imported.hold)
 
 
 def with_actuators(mech: Mechanism, actuators: Mapping[str, Any]) -> Mechanism:
@@ -318,14 +362,17 @@ def scaled_mechanism(mech: Mechanism, factor: float) -> Mechanism:
                         seed=seed)
 
 
-def rebuild(urdf: str, spec: str, params: Any, source: str) -> Mechanism:
-    """Unpickling: the mechanism again from its URDF and spec texts."""
-    return from_strings(urdf, spec, params, source=source)
+def rebuild(urdf: str, spec: str, params: Any, source: str, seed: Mapping[str, Any] | None = None) -> Mechanism:
+    """Unpickling: the mechanism again from its URDF and spec texts, assembled from ``seed`` (its reference
+    configuration: the one that the model files' values, which the spec does not keep, gave)."""
+    return from_strings(urdf, spec, params, source=source, seed=seed)
 
 
 def _reduce(mech: Mechanism) -> tuple[Any, tuple[Any, ...]]:
-    """Pickling (:data:`pkm.core.model.mechanism.REDUCE`): the URDF and spec texts, rebuilt by :func:`rebuild`."""
-    return rebuild, (mech.urdf, mech.spec.to_toml(), mech.params, mech.source)
+    """Pickling (:data:`pkm.core.model.mechanism.REDUCE`): the URDF and spec texts and the reference configuration,
+    rebuilt by :func:`rebuild`."""
+    seed = {n: tuple(float(x) for x in np.atleast_1d(v)) for n, v in mech.q_to_dict(mech.q_reference).items()}
+    return rebuild, (mech.urdf, mech.spec.to_toml(), mech.params, mech.source, seed)
 
 
 _mechanism.REDUCE = _reduce

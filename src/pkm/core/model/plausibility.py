@@ -15,14 +15,25 @@ Checked on every mechanism built (:func:`pkm.core.model.builder.build`), each fi
   heaviest solid that fits in a cube enclosing the whole mechanism;
 * **inertia** (``kind="inertia"``): a body whose largest principal moment about its centre of mass exceeds
   ``m L²`` (its radius of gyration beyond the whole mechanism's extent);
+* **negative** (``kind="negative"``): a principal moment about the centre of mass below zero by more than
+  :data:`TRIANGLE_TOL` times the body's largest one in magnitude (no distribution of mass has it);
 * **triangle** (``kind="triangle"``): principal moments ``I1 <= I2 <= I3`` about the centre of mass with
-  ``I3 > I1 + I2`` by more than :data:`TRIANGLE_TOL` ``I3`` (no distribution of mass has them);
-* the inertia and triangle rules leave out a body whose ``I3`` is under :data:`NEGLIGIBLE` ``M L²`` (``M`` the
+  ``I3 > I1 + I2`` by more than :data:`TRIANGLE_TOL` ``I3`` (no distribution of mass has them; a body with a negative
+  moment is named by the rule above only);
+* the inertia, negative and triangle rules leave out a body whose ``I3`` is under :data:`NEGLIGIBLE` ``M L²`` (``M`` the
   whole mass): no measurement sees it (an identified massless link: the consistent estimate's 1e-7 kg and 3e-6
   kg m² on a Delta whose ``M L²`` is 0.13 kg m², its triangle broken by 4e-14 kg m²);
 * **limits** (``kind="limits"``): every actuated joint with the same effort limit and the same velocity limit,
   each a power of ten (``10^k``, ``k`` an integer: 1000 N m and 100 rad/s, an exporter's or a template's
   placeholders). A limit of 0 or of at least 1e6 in a file already reads as none (:mod:`pkm.core.model.actuators`).
+
+The negative and triangle rules name the bodies whose inertias are not physical (:func:`nonphysical`): such a model
+loads for its kinematics, which needs no inertia, and its dynamics is refused (:func:`require_physical`: a
+:class:`~pkm.errors.NonPhysicalInertiaError` naming them), by inverse and forward dynamics, the mass matrix and the
+actuator-space model, the simulation, the energy, the transmissions' serial-equivalent model, the twin's
+actuator-space model (the compiled dynamics kernels, a :meth:`~pkm.core.twin.kernels.Kernels.at` design view judged
+on its own inertias, and the exported C library) and the consistent identification (which starts from the model's
+inertias). The regressor needs no inertia and is answered.
 
 Measured on pkm's shipped mechanisms, the acceptance set and Gepetto's examples: the heaviest body weighs at most
 1.2 % of the mass bound (Gepetto's ``5bar_linkage_iso3d``) and a radius of gyration at most 0.53 ``L`` (the knee
@@ -36,8 +47,9 @@ import math
 import numpy as np
 import pinocchio as pin
 
+from pkm._derived import derived
 from pkm.core.model.mechanism import Mechanism, reference_points
-from pkm.errors import ImplausibleModelWarning
+from pkm.errors import ImplausibleModelWarning, NonPhysicalInertiaError
 
 DENSITY = 8000.0  # [kg/m^3] steel: the mass bound is a steel cube of side L
 TRIANGLE_TOL = 1e-4  # relative slack of the triangle inequality (a file's rounding of a flat body's moments)
@@ -78,7 +90,7 @@ def findings(mech: Mechanism) -> list[ImplausibleModelWarning]:
     names = _body_names(model)
     L = size(mech)
     floor = NEGLIGIBLE * _total_mass(model) * L * L
-    heavy, spread, skew = [], [], []
+    heavy, spread = [], []
     for j in range(1, model.njoints):
         inertia = model.inertias[j]
         m = float(inertia.mass)
@@ -87,12 +99,11 @@ def findings(mech: Mechanism) -> list[ImplausibleModelWarning]:
         e = np.linalg.eigvalsh(np.asarray(inertia.inertia, dtype=float))
         if L > 0.0 and m > DENSITY * L ** 3:
             heavy.append((names[j], m))
-        if e[2] <= floor:
-            continue
-        if L > 0.0 and e[2] > m * L * L:
+        if e[2] > floor and L > 0.0 and e[2] > m * L * L:
             spread.append((names[j], float(e[2]), m * L * L))
-        if e[2] - e[0] - e[1] > TRIANGLE_TOL * e[2]:
-            skew.append((names[j], float(e[2] - e[0] - e[1])))
+    bad = nonphysical(mech)
+    negative = [(n, v) for n, r, v in bad if r == "negative"]
+    skew = [(n, v) for n, r, v in bad if r == "triangle"]
     out = []
     where = mech.source
     if heavy:
@@ -108,11 +119,18 @@ def findings(mech: Mechanism) -> list[ImplausibleModelWarning]:
             f"{where}: bodies whose largest principal moment of inertia exceeds their mass times the mechanism's "
             f"extent squared ({L:.4g} m): {_fmt(n, v, 'kg m^2')} (above {', '.join(f'{x:.4g}' for x in b)}); check "
             f"the inertias (units: kg m^2; about the centre of mass)", "inertia", n, v, float(max(b))))
+    if negative:
+        n, v = zip(*negative)
+        out.append(ImplausibleModelWarning(
+            f"{where}: inertias with a negative principal moment (about the centre of mass): {_fmt(n, v, 'kg m^2')}; "
+            f"no distribution of mass has them: the kinematics is answered, the dynamics refused", "negative", n, v,
+            0.0))
     if skew:
         n, v = zip(*skew)
         out.append(ImplausibleModelWarning(
             f"{where}: inertias that break the triangle inequality (the largest principal moment exceeds the sum of "
-            f"the two others by): {_fmt(n, v, 'kg m^2')}; no distribution of mass has them", "triangle", n, v, 0.0))
+            f"the two others by): {_fmt(n, v, 'kg m^2')}; no distribution of mass has them: the kinematics is answered, "
+            f"the dynamics refused", "triangle", n, v, 0.0))
     acts = mech.actuators
     effort = {a.effort_limit for a in acts}
     speed = {a.velocity_limit for a in acts}
@@ -127,6 +145,46 @@ def findings(mech: Mechanism) -> list[ImplausibleModelWarning]:
     return out
 
 
+def nonphysical(mech: Mechanism) -> tuple[tuple[str, str, float], ...]:
+    """``((body, rule, value), ...)``: the bodies whose inertias no distribution of mass has (the module doc's
+    negative and triangle rules), each named by its first link, with the rule (``"negative"``, ``"triangle"``) and
+    the offending value [kg m^2] (the negative moment; the triangle's excess); made once per mechanism."""
+    return derived(mech, _nonphysical)
+
+
+def _nonphysical(mech: Mechanism) -> tuple[tuple[str, str, float], ...]:
+    model = mech.model
+    moments = [np.linalg.eigvalsh(np.asarray(model.inertias[j].inertia, dtype=float)) for j in range(1, model.njoints)]
+    if all(e[0] >= -TRIANGLE_TOL * np.abs(e).max() and e[2] - e[0] - e[1] <= TRIANGLE_TOL * e[2] for e in moments):
+        return ()  # (every body physical: the size, a forward kinematics, not needed)
+    names = _body_names(model)
+    L = size(mech)
+    floor = NEGLIGIBLE * _total_mass(model) * L * L
+    out = []
+    for j, e in enumerate(moments, 1):
+        largest = float(np.abs(e).max())
+        if largest <= floor:
+            continue
+        if e[0] < -TRIANGLE_TOL * largest:
+            out.append((names[j], "negative", float(e[0])))
+        elif float(model.inertias[j].mass) > 0.0 and e[2] - e[0] - e[1] > TRIANGLE_TOL * e[2]:
+            out.append((names[j], "triangle", float(e[2] - e[0] - e[1])))
+    return tuple(out)
+
+
+def require_physical(mech: Mechanism, what: str) -> None:
+    """Nothing where every body's inertia is physical; else a :class:`~pkm.errors.NonPhysicalInertiaError` saying
+    that ``what`` (``"inverse dynamics"``...) is refused and naming the bodies (:func:`nonphysical`).
+
+    Raises:
+        NonPhysicalInertiaError: a body's inertia has a negative principal moment or breaks the triangle inequality.
+    """
+    bad = nonphysical(mech)
+    if bad:
+        links, rules, values = zip(*bad)
+        raise NonPhysicalInertiaError(what, links, rules, values, mech.source)
+
+
 def _power_of_ten(x: float) -> bool:
     if not (math.isfinite(x) and x > 0.0):
         return False
@@ -134,4 +192,4 @@ def _power_of_ten(x: float) -> bool:
     return x == float(10.0 ** k) or math.isclose(x, 10.0 ** k, rel_tol=1e-12)
 
 
-__all__ = ["DENSITY", "MASS_SHARE", "NEGLIGIBLE", "TRIANGLE_TOL", "findings", "size"]
+__all__ = ["DENSITY", "MASS_SHARE", "NEGLIGIBLE", "TRIANGLE_TOL", "findings", "nonphysical", "require_physical", "size"]

@@ -57,6 +57,11 @@ Format ``pkm.closures/1`` (all values SI: m, rad)::
     [transmission.left_ankle]        # optional: a closed sub-mechanism's name and output joints
     outputs = ["ankle_pitch", "ankle_roll"]   # (pkm.transmissions; pkm.core.transmissions.decompose)
 
+    [motors.waist_left]              # optional: a motor driving several actuated joints through a constant
+    waist_yaw = 1.0                  # linear map (a differential: MuJoCo's fixed tendon, ros2_control's
+    waist_roll = 1.0                 # DifferentialTransmission): its coordinate is sum(coef * q_joint)
+                                     # (pkm.core.model.motors)
+
 ``[joint_types]`` values (:mod:`pkm.core.model.joints`): ``"spherical"``; ``"universal_ab"`` with ``a``, ``b`` two
 distinct axes of ``x``, ``y``, ``z`` (``R = exp(q1 [a]) exp(q2 [b])``, Gepetto's ``UJOINT_AB``), ``"universal"``
 being ``"universal_xy"``; ``"fixed"``.
@@ -201,6 +206,9 @@ class ClosureSpec:
     #: ``{transmission name: output joints}``: the ``[transmission.<name>]`` tables, the outputs
     #: :func:`pkm.transmissions` gives the closed sub-mechanism that holds them.
     transmissions: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    #: ``{motor: {actuated joint: coefficient}}``: the ``[motors.<name>]`` tables, motors that drive several
+    #: actuated joints through a constant linear map (:mod:`pkm.core.model.motors`).
+    motors: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ reading
     @property
@@ -254,7 +262,7 @@ class ClosureSpec:
             raise SpecError(source, f"unsupported format {fmt!r}; this pkm reads {FORMAT!r}")
         known = {"format", "mechanism", "urdf", "end_effector", "actuated", "default_branch", "task",
                  "closure", "branch", "reference", "parameters", "description", "joint_types", "floating_base",
-                 "actuators", "springs", "transmission"}
+                 "actuators", "springs", "transmission", "motors"}
         unknown = sorted(set(raw) - known)
         if unknown:
             raise SpecError(source, f"unknown keys {unknown}; known keys: {sorted(known)}")
@@ -380,6 +388,19 @@ class ClosureSpec:
                 raise SpecError(source, f"{where}must hold one key, outputs = [joint, ...]")
             transmissions[str(tname)] = names(table, "outputs", where)
 
+        motors: dict[str, dict[str, float]] = {}
+        for mname, table in need(raw, "motors", dict).items() if "motors" in raw else ():
+            where = f"[motors.{mname}]"
+            if not isinstance(table, dict) or not table or not all(
+                    isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and abs(v) <= ABSURD
+                    for v in table.values()):
+                raise SpecError(source, f"{where} must be a table of actuated joint = finite coefficient (at least "
+                                        "one)")
+            stray = [j for j in table if j not in actuated]
+            if stray:
+                raise SpecError(source, f"{where}: {stray[0]!r} is not an actuated joint; actuated: {list(actuated)}")
+            motors[str(mname)] = {str(j): float(v) for j, v in table.items()}
+
         return cls(
             mechanism=need(raw, "mechanism", str),
             urdf=need(raw, "urdf", str),
@@ -397,6 +418,7 @@ class ClosureSpec:
             actuators=actuators,
             springs=springs,
             transmissions=transmissions,
+            motors=motors,
         )
 
     # ------------------------------------------------------------------ writing
@@ -442,6 +464,8 @@ class ClosureSpec:
                                                                  for k, v in values.items()]
         for tname, outputs in self.transmissions.items():
             out += ["", f"[transmission.{_key(tname)}]", f"outputs = {_tv(list(outputs))}"]
+        for mname, coefs in self.motors.items():
+            out += ["", f"[motors.{_key(mname)}]"] + [f"{_key(j)} = {_tv(float(c))}" for j, c in coefs.items()]
         out += ["", "[reference]"]
         out += [f"{_key(k)} = {_tv(list(v))}" for k, v in self.reference.items()]
         if self.parameters:

@@ -33,7 +33,8 @@ raises :class:`~pkm.errors.SpecError` for:
   read as no limit: an effort or velocity limit of any sign, a lower limit ``<= -1e6``, an upper limit
   ``>= 1e6`` (:func:`position_limits` gives that side as infinite); :func:`limit_notes` says which were read so;
   a lower limit ``>= 1e6`` or an upper one ``<= -1e6`` is refused;
-* a negative mass, an inertia tensor that is not positive semi-definite (beyond round-off);
+* a negative mass. An inertia tensor with a negative principal moment, or one that breaks the triangle inequality,
+  loads (the kinematics needs no inertia): :mod:`pkm.core.model.plausibility` warns and the dynamics refuses it;
 * a ``<mimic>`` naming an unknown joint.
 
 Whatever Pinocchio or yourdfpy still reject after these checks is reported as a
@@ -315,12 +316,7 @@ def check_urdf(text: str | bytes, source: str = "<string>") -> etree._Element:
                                     "iyz=... izz=...>")
         if iel is not None:
             keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-            ixx, ixy, ixz, iyy, iyz, izz = floats(" ".join(iel.get(k, "0") for k in keys), 6,
-                                                   f"link {lname!r} inertia {'/'.join(keys)}", source)
-            ev = np.linalg.eigvalsh(np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]))
-            if ev[0] < -1e-9 * max(1.0, float(np.abs(ev).max())):
-                raise SpecError(source, f"link {lname!r}: inertia tensor has a negative principal moment "
-                                        f"{ev[0]:.6g} kg m^2 (not physical); check ixx..izz")
+            floats(" ".join(iel.get(k, "0") for k in keys), 6, f"link {lname!r} inertia {'/'.join(keys)}", source)
     return root
 
 

@@ -88,9 +88,13 @@ class ModeSet:
         return self.modes[k]
 
     def summary(self) -> str:
+        """One sentence: the real assembly modes found, then the polynomial system's other solutions, counted as
+        what they are (not assembly modes, no failure: complex ones, real ones off the poses, paths to infinity),
+        the homotopy and whether the set is complete."""
         state = "complete" if self.complete else f"NOT complete: {len(self.failed)} path(s) failed"
-        return (f"{len(self.modes)} real solutions ({self.n_complex} complex, {self.n_exceptional} exceptional, "
-                f"{self.n_infinite} at infinity) from {self.n_paths} paths of {self.method}; {state}")
+        return (f"{len(self.modes)} real assembly mode(s); the polynomial system's other solutions, which are no "
+                f"assembly mode: {self.n_complex} complex, {self.n_exceptional} exceptional (real, not a pose: "
+                f"Study's e = 0), {self.n_infinite} at infinity; from {self.n_paths} paths of {self.method}; {state}")
 
 
 def _check(mech: Mechanism, q: np.ndarray) -> float:

@@ -142,12 +142,18 @@ def actuator_limits(mech: Mechanism, *, peak: ArrayLike | None = None, omega0: A
 
 def parse_limits(mech: Mechanism, text: str | None, margin: float = MARGIN) -> Limits:
     """The limits of the command line: ``"peak=3.9,omega0=10,speed=3,acceleration=500"`` (keys as
-    :func:`actuator_limits`' arguments, one number each, for every actuator; empty: the drives' own).
+    :func:`actuator_limits`' arguments, one number each, for every actuator; empty: the drives' own). Where the
+    actuators are all revolute (or all prismatic) a value may carry its unit, as every joint value does
+    (:func:`pkm.units.parse_joint_value`): ``peak=3.9 N m``, ``speed=300rpm``, ``omega0=600deg/s``.
 
     Raises:
-        InvalidInputError: an unknown key or a value that is not a number.
+        InvalidInputError: an unknown key or a value that is not a number (UnitError: a unit of another kind).
     """
+    from pkm.units import parse_joint_value, parse_quantity
+
     keys = ("peak", "omega0", "speed", "acceleration")
+    order = {"peak": "effort", "omega0": "rate", "speed": "rate", "acceleration": "acceleration"}
+    revolute = {j.revolute for j in mech.actuated}
     given: dict[str, float] = {}
     for part in (text or "").split(","):
         if not part.strip():
@@ -157,10 +163,10 @@ def parse_limits(mech: Mechanism, text: str | None, margin: float = MARGIN) -> L
         if key not in keys:
             raise InvalidInputError("limits", f"unknown limit {key!r}: use {', '.join(keys)} (key=value, comma "
                                               "separated)", text)
-        try:
-            given[key] = float(value)
-        except ValueError:
-            raise InvalidInputError("limits", f"{key}: expected a number, got {value!r}", text) from None
+        if len(revolute) == 1:
+            given[key] = parse_joint_value(value.strip(), next(iter(revolute)), order[key], key)
+        else:  # (mixed actuators: one number for all, SI)
+            given[key] = parse_quantity(value.strip(), set(), key, "SI")
     return actuator_limits(mech, margin=margin, **given)  # type: ignore[arg-type]
 
 

@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike
 from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PathError
-from pkm.validation import ABSURD, as_array
+from pkm.validation import as_array, bounded
 
 SPACES = ("task", "actuated")
 #: The largest turn of the chords at a waypoint [rad] before a path is refused as a corner.
@@ -137,8 +137,9 @@ def waypoint_path(mech: Mechanism, waypoints: ArrayLike, *, space: str = "task",
     if W.ndim != 2 or W.shape[1] != size or len(W) < 2:
         raise InvalidInputError("waypoints", f"expected n >= 2 waypoints of {size} values, got shape {W.shape}",
                                 waypoints)
-    if not np.all(np.isfinite(W)) or np.abs(W).max() > ABSURD:
-        raise InvalidInputError("waypoints", f"holds non-finite values or values beyond {ABSURD:g} (SI)", waypoints)
+    if not np.all(np.isfinite(W)):
+        raise InvalidInputError("waypoints", "holds non-finite values", waypoints)
+    bounded(W, "waypoints", waypoints)
     constant = None
     cols = list(range(size))
     if space == "task" and task.value_size != task.size:

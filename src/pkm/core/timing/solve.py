@@ -25,6 +25,11 @@ constant-peak solution). Where no limit depends on the speed, one pass: toppra's
 with unbounded jerk at its switches; a jerk-limited law needs a third-order method (not handled; stated by
 :attr:`TimeOptimal.jerk_limited`).
 
+**Position limits**: the path itself must keep every joint within the position limits the model states (actuated,
+task and passive joints alike, at every grid point and segment midpoint): one that leaves them is refused before any
+timing (:func:`check_positions`, :class:`~pkm.errors.PathError` naming the point, the joint, its value and its
+limits), never timed and reported as a success.
+
 The law between grid points: :math:`\ddot s = u_i` constant, :math:`\dot s^2` linear in :math:`s`, so that
 :math:`\Delta t_i = 2 \Delta s_i / (\dot s_i + \dot s_{i+1})`. **Between the grid points** the coefficients
 change and :math:`\dot s = \sqrt{x}` is concave (steepest just after a start from rest, where a torque-speed
@@ -240,6 +245,27 @@ def check_static(C: PathCoefficients, L: Limits) -> None:
                         f"{L.peak[i]:.6g} (planned at {peak[i]:.6g}): the limit cannot hold the payload")
 
 
+def check_positions(mech: Mechanism, C: PathCoefficients, between: PathCoefficients | None = None) -> None:
+    """Refuse a path that takes a joint outside the position limits the model states (every joint that has some:
+    actuated, task, passive; :meth:`~pkm.core.Mechanism.limit_violations`): :class:`~pkm.errors.PathError` at the
+    first grid point (or segment midpoint, ``between``) outside, naming the joint, its value and its limits."""
+    s = C.s if between is None else np.concatenate([C.s, between.s])
+    order = np.argsort(s, kind="stable")
+    Q = (C.q if between is None else np.concatenate([C.q, between.q]))[order]
+    along = mech.limits_along(Q)
+    if along:
+        i, (joint, value, (lo, hi)) = along[0]
+        o = int(order[i])
+        k, what = (o, "path point") if o < len(C.s) else (o - len(C.s), "segment")
+        unit = "rad" if mech.joints[joint].revolute else "m"
+        others = [v.joint for v in mech.limit_violations(Q[i]) if v.joint != joint]
+        more = f" (also outside: {', '.join(others)})" if others else ""
+        raise PathError(k, float(s[o]), f"position limit of {joint}",
+                        f"{joint} = {value:.6g} {unit}, outside its limits [{lo:.6g}, {hi:.6g}] {unit} (the "
+                        f"model's){more}: the path leaves the joints' range", what, joint=joint, value=value,
+                        bound=(lo, hi))
+
+
 def usage(C: PathCoefficients, L: Limits, sd: np.ndarray, sdd: np.ndarray,
           tight: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Per segment, the largest use of any limit at its two ends with its ``sdd`` against the margin-reduced
@@ -335,6 +361,7 @@ def solve(mech: Mechanism, path: GeometricPath, C: PathCoefficients, L: Limits, 
     are tightened (the segment's effort and acceleration rows, the speed bound at its two grid points) by the
     square of that use and the law solved again (up to :data:`MAX_REFINE` rounds): what the grid does not see
     between its points is held too, at the price of a segment or two used slightly under 1 on a coarse grid."""
+    check_positions(mech, C, between)
     check_static(C, L)
     tight = np.ones((len(C.s), 3))
     passes, over = 0, None
@@ -402,8 +429,9 @@ def time_optimal(mech: Mechanism, path: object, *, payload: float = 0.0, limits:
         A :class:`TimeOptimal`: the law, the motors' motion and efforts, the active limit per segment.
 
     Raises:
-        PathError: the path leaves the workspace, crosses a singularity, is not smooth, or a limit cannot hold the
-            mechanism (and payload) still, at the point it names.
+        PathError: the path leaves the workspace, crosses a singularity, is not smooth, takes a joint outside the
+            position limits the model states, or a limit cannot hold the mechanism (and payload) still, at the point
+            it names.
         InvalidInputError: bad limits, payload or grid.
         MissingDependencyError: toppra is not installed (``pip install "pkm-robotics[plan]"``).
 
@@ -454,4 +482,4 @@ def time_optimal(mech: Mechanism, path: object, *, payload: float = 0.0, limits:
     return solve(timed, geo, C, lim, float(payload), mid)
 
 
-__all__ = ["ACTIVE_RTOL", "TimeOptimal", "solve", "time_optimal", "usage"]
+__all__ = ["ACTIVE_RTOL", "TimeOptimal", "check_positions", "solve", "time_optimal", "usage"]

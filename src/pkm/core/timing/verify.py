@@ -13,7 +13,10 @@ r"""A time law checked, not just planned (:func:`verify`).
 2. **Pontryagin's structure**: on a time-optimal law some limit is active at every instant but the switching
    points. :attr:`Verification.inactive` lists the planning segments where no limit is used to within
    :data:`~pkm.core.timing.solve.ACTIVE_RTOL` (against the margin-reduced limits).
-3. **Tracking**: :func:`pkm.simulate` (the model's friction, Coulomb smoothed) under the planned efforts plus a
+3. **Position limits**: every joint the model states position limits for (actuated, task, passive) stays within
+   them at every check point (:meth:`pkm.core.Mechanism.limit_violations`); the first one outside is named in
+   :attr:`Verification.reason` and the plan does not hold.
+4. **Tracking**: :func:`pkm.simulate` (the model's friction, Coulomb smoothed) under the planned efforts plus a
    PD on the actuated coordinates, :math:`\tau = \tau_{plan}(t) + K_p (q_{a,ref} - q_a) + K_d (\dot q_{a,ref} -
    \dot q_a)`, gains from the mass matrix at the start, :math:`K_p = \omega_n^2 \operatorname{diag} M_a`,
    :math:`K_d = 2 \zeta \omega_n \operatorname{diag} M_a` (:math:`\omega_n = 2\pi \cdot 20` rad/s,
@@ -46,7 +49,8 @@ class Verification:
         efforts: :func:`pkm.inverse_dynamics`' efforts there, with friction (m x na) [N m, N].
         effort_usage: max over points and actuators of ``|tau| / T(|omega|)`` (1: at the true curve).
         speed_usage, acceleration_usage: likewise for the speed and acceleration limits (0 where none).
-        holds: Every usage is at most ``1 + HOLD_RTOL``.
+        holds: Every usage is at most ``1 + HOLD_RTOL``, every joint within its position limits, and the motors'
+            motion continuous.
         inactive: Planning segments where no limit is active (switching points of the law).
         tracking_error: The largest actuated error of the simulated tracking (na,) [rad, m]; None if not run.
         task_error: The largest task-space distance of the simulated end effector from the plan's [m] (position
@@ -54,6 +58,9 @@ class Verification:
         simulated_duration: How long the simulation ran [s] (the cycle time, or less where it stopped: see
             ``event``).
         event: Why the simulation stopped early, or None.
+        outside_limits: The joints that leave their stated position limits at some check point (in the order they
+            do).
+        reason: Why the plan does not hold, in words (None where it holds).
     """
 
     s: np.ndarray
@@ -68,6 +75,8 @@ class Verification:
     task_error: float | None
     simulated_duration: float
     event: str | None
+    outside_limits: tuple[str, ...] = ()
+    reason: str | None = None
 
 
 def _points(plan: TimeOptimal, factor: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -122,12 +131,21 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
     effort = float(np.max(np.abs(tau) / L.effort_limit(omega)))
     speed = float(np.max(np.abs(omega) / L.speed[None]))
     acc = float(np.max(np.abs(traj.actuated_acceleration) / L.acceleration[None]))
-    holds = bool(max(effort, speed, acc) <= 1.0 + HOLD_RTOL) and not traj.jumps
+    reasons = [f"{what} used to {use:.6g} of its limit" for what, use in
+               (("effort", effort), ("speed", speed), ("acceleration", acc)) if not use <= 1.0 + HOLD_RTOL]
+    if traj.jumps:
+        reasons.append("the motors' motion jumps (the path's inverse kinematics changed branch)")
+    if traj.outside_limits:  # (per joint, the first check point outside)
+        reasons.append("position limits crossed: " + "; ".join(
+            f"{v.joint} = {v.value:.6g} at s = {s[k]:.6g}, outside its limits [{v.limit[0]:.6g}, {v.limit[1]:.6g}]"
+            for k, v in traj.outside_limits))
+    holds = not reasons
     inactive = tuple(int(i) for i in np.flatnonzero(plan.usage < 1.0 - ACTIVE_RTOL))
     track, task_err, dur, event = None, None, 0.0, None
     if simulate:
         track, task_err, dur, event = _track(plan, t, traj, tau, dt)
-    return Verification(s, t, tau, effort, speed, acc, holds, inactive, track, task_err, dur, event)
+    return Verification(s, t, tau, effort, speed, acc, holds, inactive, track, task_err, dur, event,
+                        tuple(v.joint for _, v in traj.outside_limits), "; ".join(reasons) or None)
 
 
 def _track(plan: TimeOptimal, t: np.ndarray, traj: object, tau: np.ndarray,

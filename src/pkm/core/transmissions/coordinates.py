@@ -73,24 +73,41 @@ class OutputSplit:
 def output_split(sub: Mechanism, q: np.ndarray, out_v: np.ndarray, motor_v: np.ndarray) -> OutputSplit:
     """:class:`OutputSplit` of the sub-mechanism ``sub`` at ``q`` (closed), outputs at velocity indices ``out_v``."""
     scales = JacobianScales.of(sub)
+    Jc, G, Jd_pinv, s, r, null = _split(sub, q, out_v)
+    smax = float(s[0]) if s.size else 0.0
+    idle = scales.joint_motions(null)
+    leak = float(np.max(np.abs(null[motor_v]), initial=0.0))
+    dependence = float(np.linalg.norm(scales.constraint_rows[:, None] * (Jc @ G) * scales.columns[out_v], 2)
+                       / max(float(np.linalg.norm(scales.constraint(Jc), 2)), 1e-300))
+    M = joint_inertia(sub, q)
+    return OutputSplit(without_idle(M, idle, G), Jd_pinv, idle, M, leak, dependence,
+                       float(s[r - 1]) / smax if r else 0.0)
+
+
+def output_rates(sub: Mechanism, q: np.ndarray, out_v: np.ndarray) -> np.ndarray:
+    """``Ĝ`` alone (:attr:`OutputSplit.G`, the same numbers): what an effort map ``τ_o = Ĝ_mᵀ τ_m`` needs, without
+    the split's diagnostics, and the mass matrix only where there are idle motions to remove."""
+    _, G, _, _, _, null = _split(sub, q, out_v)
+    if not null.shape[1]:
+        return G
+    return without_idle(joint_inertia(sub, q), JacobianScales.of(sub).joint_motions(null), G)
+
+
+def _split(sub: Mechanism, q: np.ndarray, out_v: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, np.ndarray]:
+    """``(J_c, G, J_d⁺, J_d's singular values, its rank, its null space in joint rates (homogenised))`` at ``q``:
+    ``G`` before the idle motions are removed (module doc)."""
+    scales = JacobianScales.of(sub)
     Jc = constraints.jacobian(sub, q)
     d_v = np.array([i for i in range(sub.nv) if i not in set(out_v)], dtype=int)
-    Jh = scales.constraint(Jc)
     Jd_pinv, s, Vt, r = homogenised_pinv(Jc[:, d_v], scales.constraint_rows, scales.columns[d_v], RTOL)
-    smax = float(s[0]) if s.size else 0.0
     k = len(out_v)
     G = np.zeros((sub.nv, k))
     G[out_v, np.arange(k)] = 1.0
     G[d_v] = -Jd_pinv @ Jc[:, out_v]
     null = np.zeros((sub.nv, Vt.shape[0] - r))
     null[d_v] = Vt[r:].T
-    idle = scales.joint_motions(null)
-    leak = float(np.max(np.abs(null[motor_v]), initial=0.0))
-    dependence = float(np.linalg.norm(scales.constraint_rows[:, None] * (Jc @ G) * scales.columns[out_v], 2)
-                       / max(float(np.linalg.norm(Jh, 2)), 1e-300))
-    M = joint_inertia(sub, q)
-    return OutputSplit(without_idle(M, idle, G), Jd_pinv, idle, M, leak, dependence,
-                       float(s[r - 1]) / smax if r else 0.0)
+    return Jc, G, Jd_pinv, s, r, null
 
 
 def output_model(sub: Mechanism, q: np.ndarray, qd_o: np.ndarray, out_v: np.ndarray,
@@ -184,4 +201,4 @@ def serial_tree(model: pin.Model, outputs: Sequence[str], q_reference: np.ndarra
 
 
 __all__ = ["CLOSURE_RTOL", "OutputSplit", "close_at_outputs", "closure_tol", "drift_acceleration", "lumped_inertias",
-           "output_model", "output_split", "serial_tree"]
+           "output_model", "output_rates", "output_split", "serial_tree"]

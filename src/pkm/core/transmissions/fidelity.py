@@ -25,16 +25,18 @@ from (a) over the run [rad or m]; each integrator's own error is estimated by th
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from pkm._optional import module
 from pkm.core.dynamics.model import mass_matrix
 from pkm.core.dynamics.simulate import simulate
-from pkm.core.transmissions.coordinates import close_at_outputs, output_model
-from pkm.core.transmissions.serial import serial_equivalent
+from pkm.core.transmissions.coordinates import close_at_outputs, output_model, output_rates
+from pkm.core.transmissions.serial import SerialEquivalent, serial_equivalent
 from pkm.core.transmissions.transmission import Transmission
 from pkm.errors import ConvergenceError, InvalidInputError
 
@@ -78,8 +80,9 @@ def serial_run(t: Transmission, torque: Profile, duration: float, dt: float, *, 
     ``0, dt, ..., duration`` under ``torque`` (module doc); NaN from the first step whose outputs no closed
     configuration of the sub-mechanism reaches (the serial model went where the mechanism cannot)."""
     mujoco = module("mujoco", extra="bench", what="the serial-equivalent model's MuJoCo run")
-    se = serial_equivalent(t.mechanism, [t], limits=False)
-    m = mujoco.MjModel.from_xml_string(se.mjcf(timestep=dt))
+    se, compiled = _serial(t)
+    m = copy.copy(compiled)  # (MuJoCo's copy of the model: this run's timestep and armature its own)
+    m.opt.timestep = dt
     m.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     d = mujoco.MjData(m)
     mujoco.mj_resetDataKeyframe(m, d, 0)
@@ -96,11 +99,12 @@ def serial_run(t: Transmission, torque: Profile, duration: float, dt: float, *, 
         qo, od = data.qpos[qadr], data.qvel[dadr]  # type: ignore[attr-defined]
         q = close_at_outputs(sub, qo, state["q"], t.out_q, t.out_v)
         state["q"] = q
+        if not exact:  # (the effort map alone: Ĝ, not the output model)
+            G = output_rates(sub, q, t.out_v)
+            data.qfrc_applied[dadr] = G[sub.act_v].T @ torque(float(data.time))  # type: ignore[attr-defined]
+            return
         M_o, h_o, sp = output_model(sub, q, od, t.out_v, sub.act_v)
         tau_o = sp.G[sub.act_v].T @ torque(float(data.time))  # type: ignore[attr-defined]  # (J⁻ᵀ τ_m)
-        if not exact:
-            data.qfrc_applied[dadr] = tau_o  # type: ignore[attr-defined]
-            return
         mujoco.mj_fullM(m, data, full)
         M_s, h_s = full[np.ix_(dadr, dadr)], data.qfrc_bias[dadr]  # type: ignore[attr-defined]
         M_t, h_t = t.serial_model(q, od)
@@ -122,6 +126,19 @@ def serial_run(t: Transmission, torque: Profile, duration: float, dt: float, *, 
     finally:
         mujoco.set_mjcb_control(None)
     return out
+
+
+def _serial(t: Transmission) -> tuple[SerialEquivalent, Any]:
+    """``t``'s serial-equivalent model and its MuJoCo model, built once per transmission (and reference): every run
+    of a table copies the compiled model (its timestep set, :class:`mujoco.MjModel` the same as one compiled at it)."""
+    key = t.mechanism.q_reference.tobytes()
+    cached = t.__dict__.get("_fidelity_serial")
+    if cached is None or cached[0] != key:
+        mujoco = module("mujoco", extra="bench", what="the serial-equivalent model's MuJoCo run")
+        se = serial_equivalent(t.mechanism, [t], limits=False)
+        cached = (key, se, mujoco.MjModel.from_xml_string(se.mjcf()))
+        t.__dict__["_fidelity_serial"] = cached  # (as functools.cached_property keeps its values)
+    return cached[1], cached[2]
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,7 @@ import numpy as np
 
 from pkm.core.export.emit import c_constant, c_function
 from pkm.core.model.joints import stated_limits
-from pkm.core.transmissions.kernels import KERNELS, STATUS, TransmissionKernels
+from pkm.core.transmissions.kernels import KERNELS, SOLVES, STATUS, TransmissionKernels
 from pkm.core.twin.kernels import PIVOT_FLOOR
 
 
@@ -72,6 +72,9 @@ int {p}_velocity_to_outputs(const double* q, const double* qdot_m, double* qdot_
 int {p}_velocity_to_motors(const double* q, const double* qdot_o, double* qdot_m);
 int {p}_effort_to_motors(const double* q, const double* tau_o, double* tau_m);
 int {p}_effort_to_outputs(const double* q, const double* tau_m, double* tau_o);
+/* y = A x or (transposed) A^T x with A (K x K, column-major) a map {p}_maps gave: the four functions above at a q
+   whose J and J_inv are known (the C++ class's cycle maps its velocity and effort with one evaluation of them) */
+int {p}_mul(const double* A, int transposed, const double* x, double* y);
 /* what the serial-equivalent model lacks, in output coordinates: dM (K x K) [kg m^2, kg], dh (K) [N m, N] at
    (q, qdot_o): serial model + dM qddot_o + dh = the closed-loop model */
 int {p}_delta(const double* q, const double* qdot_o, double* dM, double* dh);
@@ -93,8 +96,27 @@ int {p}_fk_j_dm(const double* qm, double* q, double* qo, double* J, double* dM);
             f"const char* const {p}_output_names[{U}_K] = {{{', '.join(json.dumps(n) for n in tk.outputs)}}};",
             f"const double {p}_limit_low[{U}_NQ] = {{{', '.join(_bound(x) for x in low)}}};",
             f"const double {p}_limit_high[{U}_NQ] = {{{', '.join(_bound(x) for x in high)}}};", ""]
+    for twin in ("m", "o"):
+        body.append(c_function(tk.step(twin), f"{p}_k_newton_{twin}"))
     for name in KERNELS:
-        body.append(c_function(tk.function(name), f"{p}_k_{name}"))
+        if name not in SOLVES:
+            body.append(c_function(tk.function(name), f"{p}_k_{name}"))
+            continue
+        body.append(c_function(tk.finish(name), f"{p}_k_{name}_finish"))
+        outs = ", ".join(f"double* {o}" for o in KERNELS[name][1])
+        step = f"{p}_k_newton_{'o' if name == 'ik' else 'm'}"
+        body.append(f"""static void {p}_k_{name}(const double* q, const double* target, {outs}) {{
+  /* {tk.iterations} Newton iterations from q, then the solution's residual and status */
+  double a[{U}_NQ], b[{U}_NQ], pivot, least;
+  {step}(q, target, a, &least);
+  for (int i = 1; i < {tk.iterations}; ++i) {{
+    {step}(a, target, b, &pivot);
+    least = fmin(least, pivot);
+    memcpy(a, b, sizeof a);
+  }}
+  {p}_k_{name}_finish(a, &least, {', '.join(KERNELS[name][1])});
+}}
+""")
     body.append(f"""static int {p}_finite(const double* x, int n) {{
   for (int i = 0; i < n; ++i) if (!isfinite(x[i])) return 0;
   return 1;
@@ -123,19 +145,23 @@ int {p}_maps(const double* q, double* J, double* J_inv) {{
   return pivot >= {PIVOT_FLOOR!r} ? {U}_OK : {U}_SINGULAR;
 }}
 
-static int {p}_apply(const double* q, int inverse, int transposed, const double* x, double* y) {{
-  double J[{U}_K * {U}_K], J_inv[{U}_K * {U}_K];
-  int status;
+int {p}_mul(const double* A, int transposed, const double* x, double* y) {{
   if (!{p}_finite(x, {U}_K)) return {U}_INVALID_INPUT;
-  status = {p}_maps(q, J, J_inv);
-  if (status != {U}_OK) return status;
-  const double* A = inverse ? J_inv : J;
   for (int i = 0; i < {U}_K; ++i) {{
     double s = 0.0;
     for (int j = 0; j < {U}_K; ++j) s += (transposed ? A[i * {U}_K + j] : A[j * {U}_K + i]) * x[j];
     y[i] = s;
   }}
   return {U}_OK;
+}}
+
+static int {p}_apply(const double* q, int inverse, int transposed, const double* x, double* y) {{
+  double J[{U}_K * {U}_K], J_inv[{U}_K * {U}_K];
+  int status;
+  if (!{p}_finite(x, {U}_K)) return {U}_INVALID_INPUT;
+  status = {p}_maps(q, J, J_inv);
+  if (status != {U}_OK) return status;
+  return {p}_mul(inverse ? J_inv : J, transposed, x, y);
 }}
 
 int {p}_velocity_to_outputs(const double* q, const double* qdot_m, double* qdot_o) {{ return {p}_apply(q, 0, 0, qdot_m, qdot_o); }}
@@ -189,6 +215,7 @@ def cpp_class(tk: TransmissionKernels, p: str) -> str:
 #define {U}_TRANSMISSION_HPP
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <stdexcept>
 #include <string>
@@ -243,8 +270,9 @@ class {cls} {{
     read(actuator_.position, qm);
     check({p}_fk(qm, state_.data(), qo, nullptr), "fk");
     write(joint_.position, qo);
-    map(actuator_.velocity, joint_.velocity, state_, {p}_velocity_to_outputs, "velocity_to_outputs");
-    map(actuator_.effort, joint_.effort, state_, {p}_effort_to_outputs, "effort_to_outputs");
+    Maps maps;  // (J and J_inv at the state: evaluated once for the velocity and the effort)
+    map(actuator_.velocity, joint_.velocity, state_, maps, false, false, "velocity_to_outputs");
+    map(actuator_.effort, joint_.effort, state_, maps, true, true, "effort_to_outputs");
   }}
 
   // Command: the joints' position (IK, warm-started from the last command), velocity (J_inv) and effort (J^T) to
@@ -254,9 +282,14 @@ class {cls} {{
     read(joint_.position, qo);
     check({p}_ik(qo, command_.data(), qm, nullptr), "ik");
     write(actuator_.position, qm);
-    map(joint_.velocity, actuator_.velocity, command_, {p}_velocity_to_motors, "velocity_to_motors");
-    map(joint_.effort, actuator_.effort, command_, {p}_effort_to_motors, "effort_to_motors");
+    Maps maps;  // (J and J_inv at the command: evaluated once for the velocity and the effort)
+    map(joint_.velocity, actuator_.velocity, command_, maps, true, false, "velocity_to_motors");
+    map(joint_.effort, actuator_.effort, command_, maps, false, true, "effort_to_motors");
   }}
+
+  // Evaluations of the maps kernel ({p}_maps: J and J_inv) since construction: one per call of actuator_to_joint()
+  // or joint_to_actuator() that maps a velocity or an effort.
+  std::size_t maps_evaluations() const {{ return maps_evaluations_; }}
 
   // The sub-mechanism's configurations the state and the command were solved at ({p}_q_names' order).
   const std::array<double, {U}_NQ>& state_configuration() const {{ return state_; }}
@@ -301,16 +334,32 @@ class {cls} {{
     if (status != {U}_OK) throw TransmissionError(std::string("{p}: ") + what + " failed with status " + std::to_string(status), status);
   }}
 
-  static void map(const std::array<double*, {U}_K>& from, const std::array<double*, {U}_K>& to,
-                  const std::array<double, {U}_NQ>& q, int (*f)(const double*, const double*, double*), const char* what) {{
+  // J and J_inv of one cycle, evaluated at its first use.
+  struct Maps {{
+    bool ready = false;
+    double J[{U}_K * {U}_K], J_inv[{U}_K * {U}_K];
+  }};
+
+  // to = A from (A^T with transposed), A = J or J_inv (inverse) at q: as {p}_velocity_to_outputs ... compute it,
+  // with the same status for the same input, the maps evaluated only where the cycle has not yet.
+  void map(const std::array<double*, {U}_K>& from, const std::array<double*, {U}_K>& to,
+           const std::array<double, {U}_NQ>& q, Maps& maps, bool inverse, bool transposed, const char* what) {{
     if (from[0] == nullptr || to[0] == nullptr) return;
     double x[{U}_K], y[{U}_K];
     read(from, x);
-    check(f(q.data(), x, y), what);
+    for (double v : x)
+      if (!std::isfinite(v)) check({U}_INVALID_INPUT, what);
+    if (!maps.ready) {{
+      ++maps_evaluations_;
+      check({p}_maps(q.data(), maps.J, maps.J_inv), what);
+      maps.ready = true;
+    }}
+    check({p}_mul(inverse ? maps.J_inv : maps.J, transposed, x, y), what);
     write(to, y);
   }}
 
   Side joint_, actuator_;
+  std::size_t maps_evaluations_ = 0;
   std::array<double, {U}_NQ> state_{{}}, command_{{}};
 }};
 
@@ -362,7 +411,8 @@ int main(int argc, char** argv) {{
   for (double x : joint) std::printf(" %.17g", x);
   std::printf("\\nactuator");
   for (double x : back) std::printf(" %.17g", x);
-  std::printf("\\n");
+  // the maps kernel's evaluations in each cycle (velocity and effort mapped with one)
+  std::printf("\\nmaps %zu %zu\\n", state.maps_evaluations(), command.maps_evaluations());
   return 0;
 }}
 """

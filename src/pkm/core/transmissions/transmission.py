@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike
 from pkm.core.differential.velocity import RTOL, forward_jacobian, inverse_jacobian
 from pkm.core.kinematics.solve import close_loops, solve_ik
 from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
 from pkm.core.transmissions.coordinates import OutputSplit, closure_tol, output_model, output_split, serial_tree
 from pkm.errors import SingularityError, TransmissionError
@@ -189,6 +190,7 @@ class Transmission:
     def serial_model(self, q_sub: ArrayLike, qd_o: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """``(M_s, h_s)``: the serial-equivalent model's mass matrix and bias (Coriolis, centrifugal, gravity) in the
         outputs [kg m^2, N m]."""
+        require_physical(self.mechanism, "the serial-equivalent model")
         q = self.mechanism.check_q(q_sub, "q_sub")
         v = np.zeros(self.mechanism.nv)
         v[self.out_v] = as_vector(qd_o, self.k, "qd_o")

@@ -37,6 +37,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from pkm._derived import SLOT
 from pkm.core.model.bodies import BODY_FIELDS, body_names
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.origins import ORIGIN, joint_elements, origins_set
@@ -206,6 +207,8 @@ def design_mechanism(mech: Mechanism, values: Mapping[str, float]) -> Mechanism:
         theta = np.array(out.model.inertias[jid].toDynamicParameters())
         theta[BODY_FIELDS.index(field)] = value
         out.model.inertias[jid] = pin.Inertia.FromDynamicParameters(theta)
+    if inertial:
+        out.__dict__.pop(SLOT, None)  # (what was derived from the inertias, plausibility.nonphysical: made again)
     return out
 
 

@@ -34,6 +34,7 @@ import casadi as cs
 import numpy as np
 
 from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
 from pkm.core.twin.linear import PivotedLU
 from pkm.core.twin.spatial import Expr
@@ -110,6 +111,7 @@ class ActuatorTwin:
     def __init__(self, twin: Twin):
         self.tw = twin
         mech = twin.mech
+        require_physical(mech, "the compiled dynamics (the twin's actuator-space model)")
         self.tau = cs.SX.sym("tau", mech.na)
         self.friction = cs.SX.sym("friction", 2)
         self.idle = idle_columns(mech)

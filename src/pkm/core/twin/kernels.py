@@ -46,7 +46,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pkm.core.dynamics.model import COULOMB_VELOCITY
-from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.mechanism import LimitViolation, Mechanism, check_mechanism
+from pkm.core.model.plausibility import require_physical
 from pkm.core.twin.codegen import C_INT as _I
 from pkm.core.twin.codegen import C_REAL_P as _P
 from pkm.core.twin.codegen import compile_library, numpy_function, pointers
@@ -54,7 +55,7 @@ from pkm.core.twin.dynamics import ActuatorTwin
 from pkm.core.twin.task import TaskTwin
 from pkm.core.twin.tree import Twin
 from pkm.errors import InvalidInputError, NonFiniteError
-from pkm.validation import as_array, as_count, as_scalar, as_tolerance
+from pkm.validation import as_array, as_count, as_scalar, as_tolerance, bounded
 
 if TYPE_CHECKING:
     from pkm.core.kinematics.solve import SolveResult
@@ -121,6 +122,9 @@ class PathResult:
         fallback: The samples solved by the generic core instead (pivot under :data:`PIVOT_FLOOR`, or no
             convergence in ``max_iter`` kernel iterations).
         how: What ran the kernel.
+        outside_limits: Per joint that leaves the position limits the model states, the first sample outside and
+            there its violation (:meth:`pkm.core.Mechanism.limits_along`; pkm's solvers report limits, they do not
+            enforce them).
     """
 
     q: np.ndarray
@@ -128,6 +132,7 @@ class PathResult:
     iterations: np.ndarray
     fallback: tuple[int, ...] = field(default=())
     how: str = ""
+    outside_limits: tuple[tuple[int, LimitViolation], ...] = ()
 
 
 @functools.lru_cache(maxsize=1)
@@ -459,13 +464,15 @@ class Kernels:
         is diagnosed: non-finite input (:class:`InvalidInputError`) or a failed evaluation (:class:`NonFiniteError`;
         with ``pivoted``, only at samples whose pivot, the last output, is above the floor: the others are the
         caller's to redo)."""
+        if name in _DYNAMICS or name.startswith("inverse_dynamics"):  # (a design's own inertias: Kernels.at)
+            require_physical(self.mech, f"the compiled {name.replace('_', ' ')}")
         kernel = self._kernels.get(name) or self.kernel(name)
         arrays = []
         for what, size, x in zip(KERNELS[name][0], kernel.in_size, args):
             a = x if type(x) is np.ndarray and x.dtype == np.float64 else as_array(x, what)
             if a.ndim not in (1, 2) or a.shape[-1] != size:
                 raise InvalidInputError(what, f"expected ({size},) or (n, {size})", x)
-            arrays.append(a)
+            arrays.append(bounded(a, what, x) if what == "q" else a)  # (a configuration: the coordinates' rule)
         single = arrays[0].ndim == 1
         if any((a.ndim == 1) != single for a in arrays):
             raise InvalidInputError(name, "give every input as one sample or every input as a batch")
@@ -641,6 +648,7 @@ class Kernels:
         t = np.atleast_2d(as_array(targets, "targets"))
         if t.shape[1] != kernel.in_size[1] or not np.all(np.isfinite(t)):
             raise InvalidInputError("targets", f"expected finite values of shape (n, {kernel.in_size[1]})", targets)
+        bounded(t, "targets", targets)
         prev = self.mech.q_reference.copy() if q0 is None else self.mech.check_q(q0, "q0")
         n = len(t)
         Q, res, its = np.empty((n, len(prev))), np.empty(n), np.zeros(n, dtype=np.int64)
@@ -656,7 +664,7 @@ class Kernels:
             Q[end], res[end], its[end] = solved.q, solved.residual, 0
             fallback.append(end)
             prev, start = solved.q, end + 1
-        return PathResult(Q, res, its, tuple(fallback), kernel.how)
+        return PathResult(Q, res, its, tuple(fallback), kernel.how, self.mech.limits_along(Q))
 
 
 _PATHS = ("closure_newton", "ik_newton")  # the kernels with the path driver
