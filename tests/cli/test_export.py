@@ -19,7 +19,7 @@ def test_export_and_check(tmp_path, capsys):
                      "--check", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["name"] == "knee_c" and {f.rsplit("/", 1)[-1] for f in out["files"]} == {
-        "knee_c.h", "knee_c.c", "Makefile", "CMakeLists.txt", "main.c"}
+        "knee_c.h", "knee_c.c", "Makefile", "CMakeLists.txt", "main.c", "README.md"}
     worst = {k: v for k, v in out["check"]["largest_difference"].items() if k != "status"}
     assert max(worst.values()) <= 1e-12 and out["check"]["largest_difference"]["status"] == 0
     assert "malloc" not in out["check"]["undefined_symbols"]

@@ -7,6 +7,7 @@ mechanisms it refuses. Every shipped and acceptance-set mechanism is run by
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -59,10 +60,12 @@ def test_outside_the_domain_a_status_never_a_nan(built, name):
     mech, h = built[name]
     problems, statuses = domain(mech, h)
     assert problems == []
-    # driven 3 rad along a line, each mechanism leaves its workspace: both their joint limits, the ankle its mode
+    # driven 3 rad along a line, each mechanism leaves its workspace: both their joint limits, the ankle its
+    # workspace through a fold, where fk, following its path in steps, stops NOT_CONVERGED as pkm.close_loops raises
+    # (before the path, one Newton jump left for the other assembly mode: LEFT_MODE)
     met = set(statuses) - {"OK"}
     assert met <= {"NOT_CONVERGED", "LEFT_MODE", "OUTSIDE_LIMITS", "SINGULAR"} and "OUTSIDE_LIMITS" in met
-    assert "LEFT_MODE" in met or name == "knee", statuses
+    assert "NOT_CONVERGED" in met or name == "knee", statuses
 
 
 def test_the_mode_asked_for_and_the_limits(built):
@@ -112,6 +115,8 @@ def test_the_folder_builds_with_make_and_runs(built, tmp_path):
                           capture_output=True, check=False).returncode == 0
     run = subprocess.run(["./example"], cwd=folder, capture_output=True, text=True, check=False)
     assert run.returncode == 0 and "inverse dynamics: status 0" in run.stdout
+    first = re.search(r"```text\n(first fk: [^\n]*)\n```", (folder / "README.md").read_text()).group(1)
+    assert run.stdout.startswith(first + "\n")  # (the README's example prints what the README says)
     assert "ik: status 0, mode 0" in run.stdout and "working mode id 0 (the reference's)" in run.stdout
     header = (folder / "ankle.h").read_text()
     assert "ANKLE_MAX_ITER" in header and "fk_step" in header and " mul " in header and "ik bit 1" in header

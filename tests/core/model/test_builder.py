@@ -72,6 +72,35 @@ def test_a_complete_reference_that_leaves_a_loop_open_is_refused_naming_it(built
         builder.from_strings(mech.urdf, _with_reference(mech, reference))
 
 
+def test_a_complete_reference_is_judged_relative_to_the_size_the_same_in_millimetres_and_in_metres(built):
+    """elbow_1 moved so that the loop stays open by 0.5e-9, then 2e-9, of the characteristic length: the five-bar
+    and its files scaled by 100 (an open gap of 1.1e-8 m there, refused before by the absolute 1e-9 m) both accept
+    the first and both refuse the second."""
+    from pkm.core.model.scale import scale_urdf
+
+    mech = built("fivebar")
+    L = mech.characteristic_length
+
+    def moved(by):
+        reference = dict(mech.spec.reference)
+        reference["elbow_1"] = (reference["elbow_1"][0] + by,)
+        return reference
+
+    q = mech.q_reference.copy()
+    q[mech.joints["elbow_1"].idx_q] += 1e-6
+    per_rad = constraints.worst_closure(mech, constraints.residual(mech, q))[0] / 1e-6 / L  # (the gap's slope)
+    for rel, accepted in ((0.5e-9, True), (2e-9, False)):
+        for s in (1.0, 100.0):
+            spec = _with_reference(mech, moved(rel / per_rad))
+            if accepted:
+                copy = builder.from_strings(scale_urdf(mech.urdf, s), spec)
+                gap = constraints.worst_closure(copy, constraints.residual(copy, copy.q_reference))[0]
+                assert 0.3e-9 * s * L < gap < 0.7e-9 * s * L, (s, gap)
+            else:
+                with pytest.raises(SpecError, match=r"relative to the mechanism's size"):
+                    builder.from_strings(scale_urdf(mech.urdf, s), spec)
+
+
 def test_a_partial_reference_that_cannot_be_held_names_the_missing_joints_and_the_gap(built):
     """Motors at pi and 0 put the elbows 2 (l1 + d/2) = 0.7 m apart, beyond 2 l2 = 0.6 m: the message names the
     joints left out and the 0.1 m the loop is short by (the closed form)."""

@@ -1,7 +1,7 @@
 """``pkm export c MECH --out DIR [--name NAME] [--check] [--json]``: the mechanism's kinematics and dynamics as a
 self-contained C99 library (:func:`pkm.export_c`): ``<name>.h``, ``<name>.c``, a ``Makefile``, a
-``CMakeLists.txt`` and an example ``main.c``. ``--check`` builds it with ``cc -std=c99 -Wall -Wextra -Werror
--pedantic``, checks that it references no allocation or I/O, compares every function with pkm at four closed
+``CMakeLists.txt``, an example ``main.c`` and a ``README.md`` (how to get a first solution). ``--check`` builds it
+with ``cc -std=c99 -Wall -Wextra -Werror -pedantic``, checks that it references no allocation or I/O, compares every function with pkm at four closed
 configurations and proves each named mode id of the header on a configuration in its mode
 (:mod:`pkm.core.export.harness`)."""
 

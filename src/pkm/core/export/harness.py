@@ -14,7 +14,7 @@ tau = Jᵀ w``; ``jdot_qdot`` in ``q, qd`` out ``status, c``; ``inverse_dynamics
 ``status, tau``; ``mass_matrix`` in ``q`` out ``status, M``; ``gravity`` in ``q`` out ``status, g``;
 ``ik_actuators`` (the closed form, where the library has it; status -1 otherwise) in ``y, mode`` out
 ``status, residual, smallest margin, qa``; ``modes`` in ``q`` out ``fk_mode``'s status and id, ``ik_mode``'s status
-and id; ``mode_ids`` in nothing out the header's named mode ids as the C compiler reads them (``<NAME>_FK_MODE_*``
+and id, ``fk_distance`` (-1 where it fails); ``mode_ids`` in nothing out the header's named mode ids as the C compiler reads them (``<NAME>_FK_MODE_*``
 then ``<NAME>_IK_MODE_*``, in :attr:`CLibrary.modes <pkm.core.export.library.CLibrary.modes>`' order).
 :func:`check_modes` proves each named id on a configuration in its mode.
 """
@@ -50,7 +50,7 @@ def layouts(lib: CLibrary) -> dict[str, tuple[int, int]]:
     return {"fk": (na + nq + 1, 4 + nq + ny), "ik": (ny + nq + 1, 4 + nq + na), "jacobians": (nq, 1 + 2 * nx * na),
             "maps": (nq + 2 * na + 2 * nx, 4 + 2 * nx + 2 * na), "jdot_qdot": (nq + na, 1 + nx),
             "inverse_dynamics": (nq + 2 * na, 1 + na), "mass_matrix": (nq, 1 + na * na), "gravity": (nq, 1 + na),
-            "ik_actuators": (ny + 1, 3 + na), "modes": (nq, 4),
+            "ik_actuators": (ny + 1, 3 + na), "modes": (nq, 5),
             "mode_ids": (0, sum(len(lib.modes.get(k, {})) for k in ("fk", "ik")))}
 
 
@@ -115,6 +115,7 @@ static void one(int kind, const double* in, double* out) {
     out[0] = NAME_fk_mode(in, &mode); out[1] = (double) mode;
     mode = -1;
     out[2] = NAME_ik_mode(in, &mode); out[3] = (double) mode;
+    if (NAME_fk_distance(in, &out[4]) != U_OK) out[4] = -1.0;
     break;
   }
   case 10: {

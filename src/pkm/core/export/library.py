@@ -1,7 +1,8 @@
 """``pkm export c``: a mechanism's kinematics and dynamics as a self-contained C99 library a controller can link.
 
-:func:`export_c` writes into a folder ``<name>.h``, ``<name>.c``, a ``Makefile``, a ``CMakeLists.txt`` and an
-example ``main.c``. The library's functions (declared and documented in the header): forward kinematics (Newton,
+:func:`export_c` writes into a folder ``<name>.h``, ``<name>.c``, a ``Makefile``, a ``CMakeLists.txt``, an
+example ``main.c`` and a ``README.md`` (how to get a first forward kinematics solution: from the reference
+configuration, exported as ``<name>_q_reference``, along a path; what the example prints first). The library's functions (declared and documented in the header): forward kinematics (Newton,
 warm-started from the caller's previous solution, a fixed iteration bound), inverse kinematics (Newton, and in
 closed form, ``<name>_ik_actuators``, where the mechanism is made of crank legs on a body the task places:
 :attr:`~pkm.core.export.model.ExportModel.closed_form`), the assembly and working mode ids of a configuration (the
@@ -12,8 +13,11 @@ Every function is re-entrant (constant tables only, the caller owns every buffer
 nothing, needs only ``<math.h>``, and returns a status:
 
 * ``OK``; ``NOT_CONVERGED`` (``info.residual``: the largest residual at the last iterate);
-* ``SINGULAR`` (``info.sigma_min``: the Newton or closure matrix's smallest singular value, under ``SINGULAR_TOL``
-  times its largest);
+* ``SINGULAR`` (``info.sigma_min``: the Newton or closure matrix's smallest singular value relative to its largest,
+  under ``SINGULAR_TOL``, the matrix homogenised by the characteristic length as pkm's singularity measures are,
+  :class:`~pkm.core.model.scale.JacobianScales`: its row and column factors are the library's constants
+  ``<name>_fk_row_scale``..., so that a model in millimetres and the same in metres get the same verdicts;
+  ``<name>_fk_distance`` gives the forward kinematics' one at any closed configuration);
 * ``OUTSIDE_LIMITS`` (``info.joint``: which limited joint, an index into ``<name>_limit_names``);
 * ``LEFT_MODE`` (``info.mode``: the mode id found, not the one asked for: see :mod:`pkm.core.export.model`);
 * ``INVALID_INPUT`` (a NaN or an infinity in an input, or a coordinate (``qa``, ``q``, ``y``) beyond
@@ -42,14 +46,21 @@ from pkm.core.export.model import Block, ExportError, ExportModel, Newton, c_nam
 from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.core.twin.codegen import jacobi_sv, paper_counts
 from pkm.validation import ABSURD
 
 #: Newton iterations at most (each one evaluation of the step), the convergence tolerance on the largest closure
 #: residual or task error [m, rad], the relative pivot under which a solve goes dense, the relative smallest
-#: singular value under which a matrix counts as singular, the slack on joint limits [rad, m].
+#: singular value of the homogenised matrix under which it counts as singular, the slack on joint limits [rad, m].
 MAX_ITER = 20
 TOL = 1e-12
+#: The forward kinematics' continuation (:func:`pkm.core.kinematics.solve.close_loops`'s): the largest change of an
+#: actuated coordinate per step [rad, or characteristic lengths for a prismatic actuator], the steps at most, and
+#: the tolerance of the steps on the way (the last one's is :data:`TOL`) [m, rad].
+FK_STEP = 0.1
+MAX_STEPS = 64
+PATH_TOL = 1e-9
 PIVOT_FLOOR = 1e-6
 SINGULAR_TOL = 1e-9
 LIMIT_TOL = 1e-9
@@ -157,7 +168,7 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
         >>> rrr3 = pkm.load("rrr3")
         >>> lib = pkm.export_c(rrr3, tempfile.mkdtemp())
         >>> lib.name, sorted(f.name for f in lib.files)
-        ('rrr3', ['CMakeLists.txt', 'Makefile', 'main.c', 'rrr3.c', 'rrr3.h'])
+        ('rrr3', ['CMakeLists.txt', 'Makefile', 'README.md', 'main.c', 'rrr3.c', 'rrr3.h'])
         >>> lib.sizes
         {'NQ': 7, 'NV': 7, 'NA': 3, 'NY': 3, 'NX': 3}
     """
@@ -195,14 +206,21 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
         return text.replace("p_", f"{prefix}_").replace("P_", f"{prefix.upper()}_")
 
     stamp = datetime.date.today().isoformat()
+    qa_first = first_target(mech)
     header = _header(mech, prefix, sizes, ops, blocks, limits, fk, ik, __version__, stamp, no_closed_form, modes,
                      mode_lines)
+    unit = JacobianScales.of(mech).actuated  # (a prismatic actuator's step in characteristic lengths)
     tables = (_array("int", "p_actuated_q", [int(i) for i in mech.act_q], public=True)
+              + _array("int", "p_actuated_revolute", [int(j.revolute) for j in mech.actuated])
+              + _array("double", "p_actuated_unit", [float(u) for u in unit], c_constant)
               + f"#define P_ABSURD {ABSURD!r}\n#define P_NLIMITS {len(limits)}\n"
               + _array("int", "p_limit_q", [q for _, q, _, _ in limits])
               + _array("double", "p_limit_low", [lo for _, _, lo, _ in limits], c_constant)
               + _array("double", "p_limit_high", [hi for _, _, _, hi in limits], c_constant)
               + _blocks("fk", fk.blocks) + _blocks("ik", ik.blocks)
+              + "".join(_array("double", f"p_{kind}_{side}_scale", [float(x) for x in values], c_constant)
+                        for kind, newton in (("fk", fk), ("ik", ik))
+                        for side, values in (("row", newton.row_scale), ("col", newton.column_scale)))
               + (_array("int", "p_actuated_limit", [next((k for k, (_, qi, _, _) in enumerate(limits)
                                                            if qi == int(i)), -1) for i in mech.act_q])
                  + _array("int", "p_task_limit", [next((k for k, (name, *_) in enumerate(limits) if name == j.name), -1)
@@ -230,7 +248,8 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
               + prefixed(functions) + prefixed(runtime.HELPERS.replace("JACOBI_SV", sv)) + prefixed(newton)
               + prefixed(runtime.PUBLIC) + (prefixed(runtime.CLOSED_FORM) if closed else ""))
     files = {f"{prefix}.h": header, f"{prefix}.c": source, "Makefile": _MAKEFILE.replace("NAME", prefix),
-             "CMakeLists.txt": _CMAKE.replace("NAME", prefix), "main.c": _main(prefix, mech)}
+             "CMakeLists.txt": _CMAKE.replace("NAME", prefix), "main.c": _main(prefix, mech, qa_first),
+             "README.md": _readme(mech, prefix, qa_first, no_closed_form)}
     written = []
     for fname, text in files.items():
         path = out / fname
@@ -243,13 +262,14 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
 def mode_id(newton: Newton, q: np.ndarray, target: np.ndarray) -> tuple[int, float]:
     """The mode id of ``q`` for the Newton system ``newton`` (``ExportModel.fk`` or ``.ik``) and its target, from
     the dense determinants of the diagonal blocks (numpy's, not the kernel's fixed pivots: a second route to the
-    C's ids), and the square matrix's smallest singular value relative to its largest."""
+    C's ids), and the square matrix's smallest singular value relative to its largest, the matrix homogenised
+    (:meth:`Newton.homogenised`: scale-free, the C's singularity test's)."""
     A = np.array(newton.system(q, target)[0])
     ident = 0
     for k, b in enumerate(newton.blocks):
         if not np.linalg.det(A[np.ix_(b.rows, b.cols)]) * b.sign > 0:
             ident |= 1 << k
-    s = np.linalg.svd(A, compute_uv=False) if A.size else np.ones(1)
+    s = np.linalg.svd(newton.homogenised(A), compute_uv=False) if A.size else np.ones(1)
     return ident, float(s[-1] / s[0])
 
 
@@ -368,8 +388,10 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
         lines.append(f"  {k:18s} {mul:6d} mul {add:6d} add {other:5d} functions")
     lines += [
         "",
-        f"Forward kinematics: at most {U}_MAX_ITER = {MAX_ITER} evaluations of fk_step ({step('fk_step')} operations "
-        f"each), so at most {MAX_ITER * step('fk_step')} operations where the fixed pivots hold; an iteration where "
+        f"Forward kinematics: a path from q_prev in steps of at most {U}_FK_STEP = {FK_STEP:g} per actuator (rad, or "
+        f"characteristic lengths), one step where q_prev is that near (a warm start), {U}_MAX_STEPS = {MAX_STEPS} "
+        f"at most; per step at most {U}_MAX_ITER = {MAX_ITER} evaluations of fk_step ({step('fk_step')} operations "
+        f"each), so at most {MAX_ITER * step('fk_step')} operations a step where the fixed pivots hold; an iteration where "
         f"they fail also evaluates fk_system ({step('fk_system')} operations), a Jacobi SVD and a dense "
         f"{len(fk.columns)} x {len(fk.columns)} solve.",  # type: ignore[attr-defined]
         f"Inverse kinematics: at most {MAX_ITER} evaluations of ik_step ({step('ik_step')} operations each), at "
@@ -402,6 +424,9 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
              for key, ident in modes[kind].items()]
     defs += [f"#ifndef {U}_MAX_ITER\n#define {U}_MAX_ITER {MAX_ITER}\n#endif",
              f"#ifndef {U}_TOL\n#define {U}_TOL {TOL!r}\n#endif",
+             f"#ifndef {U}_FK_STEP\n#define {U}_FK_STEP {FK_STEP!r}\n#endif",
+             f"#ifndef {U}_MAX_STEPS\n#define {U}_MAX_STEPS {MAX_STEPS}\n#endif",
+             f"#ifndef {U}_PATH_TOL\n#define {U}_PATH_TOL {PATH_TOL!r}\n#endif",
              f"#ifndef {U}_PIVOT_FLOOR\n#define {U}_PIVOT_FLOOR {PIVOT_FLOOR!r}\n#endif",
              f"#ifndef {U}_SINGULAR_TOL\n#define {U}_SINGULAR_TOL {SINGULAR_TOL!r}\n#endif",
              f"#ifndef {U}_LIMIT_TOL\n#define {U}_LIMIT_TOL {LIMIT_TOL!r}\n#endif"]
@@ -409,7 +434,7 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
     info = (f"typedef struct {{\n  int status;        /* the status returned */\n"
             "  int iterations;    /* Newton step evaluations */\n"
             "  double residual;   /* the largest closure residual or task error at the last iterate [m, rad] */\n"
-            "  double sigma_min;  /* SINGULAR, PIVOT_ORDER: the smallest singular value of the matrix */\n"
+            "  double sigma_min;  /* SINGULAR, PIVOT_ORDER: the matrix's relative smallest singular value, homogenised */\n"
             "  double pivot;      /* the smallest relative pivot of the fixed elimination order */\n"
             "  int joint;         /* OUTSIDE_LIMITS: the joint (index into limit_names), else -1 */\n"
             "  long mode;         /* the mode id of the solution */\n"
@@ -423,6 +448,57 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
     return (comment + f"#ifndef {guard}\n#define {guard}\n\n#ifdef __cplusplus\nextern \"C\" {{\n#endif\n\n"
             + "\n".join(defs) + f"\n\nenum {{\n{status}\n}};\n\n" + info + "\n" + decls + body
             + "\n#ifdef __cplusplus\n}\n#endif\n\n#endif\n")
+
+
+def _readme(mech: Mechanism, prefix: str, qa_first: np.ndarray, no_closed_form: str) -> str:
+    """The library's README: the files, the build, how to get a first forward kinematics solution, and what the
+    example prints first (pkm's own answer, :func:`pkm.core.kinematics.solve.close_loops` from the reference)."""
+    from pkm.core.kinematics.solve import close_loops
+
+    U, closed = prefix.upper(), not no_closed_form
+    task = TaskMap.of(mech)
+    y = task.value(close_loops(mech, qa_first).q)
+    shown = " ".join(f"{n}={v}" for n, v in zip(task.value_names, _show(y)))
+    qa_text = ", ".join(f"{x:.9g}" for x in qa_first)
+    seed = (f"""
+From a task value instead (the closed form, no iteration): `{prefix}_ik_actuators(y_goal, 0, qa, &info)` gives the actuated
+coordinates of the reference's leg branches; then `{prefix}_fk(qa, {prefix}_q_reference, {U}_FK_MODE_REFERENCE, q, y, &info)`
+gives the whole configuration in the reference's assembly mode.
+""" if closed else f"""
+From a task value instead: the actuated coordinates `qa` for it (pkm's `pkm.solve_ik(mech, y_goal)` in Python, or a
+closed form of your own: this library has none, {no_closed_form}), then `{prefix}_fk(qa, {prefix}_q_reference,
+{U}_FK_MODE_REFERENCE, q, y, &info)` gives the whole configuration in the reference's assembly mode.
+""")
+    return f"""# `{prefix}`: the C99 library of the mechanism `{mech.name}` (generated by pkm)
+
+Files: `{prefix}.h` (every function documented, the sizes, the status codes, the mode ids), `{prefix}.c`, `main.c`
+(the example below), `Makefile`, `CMakeLists.txt`. SI units (m, rad), arrays column-major, `q` in Pinocchio's layout.
+
+```sh
+make && ./example
+```
+
+## A first forward kinematics solution
+
+`{prefix}_fk(qa, q_prev, mode, q, y, &info)` solves from the caller's previous solution `q_prev`. For the first one,
+start from the reference configuration, exported as the constant `{prefix}_q_reference` (its assembly mode is
+`{U}_FK_MODE_REFERENCE` = 0): where `qa` is more than `{U}_FK_STEP` from the reference's actuated coordinates, `fk`
+follows a path of steps to it (as `pkm.close_loops` does), so that the solution stays in the reference's assembly mode
+(or answers `NOT_CONVERGED` or `SINGULAR` where that mode cannot reach `qa` without crossing a singularity), then warm
+starts from each solution:
+
+```c
+double q[{U}_NQ], y[{U}_NY];
+{prefix}_info info;
+int status = {prefix}_fk(qa, {prefix}_q_reference, {U}_FK_MODE_REFERENCE, q, y, &info);
+```
+{seed}
+`main.c` does this for qa = ({qa_text}) and prints first (pkm's own answer, `pkm.close_loops` from the reference):
+
+```text
+first fk: status 0, {shown}
+```
+"""
 
 
 _MAKEFILE = """# Builds libNAME.a and the example. Override CC or CFLAGS as you like.
@@ -461,19 +537,61 @@ target_link_libraries(NAME_example NAME)
 """
 
 
-def _main(prefix: str, mech: Mechanism) -> str:
+def first_target(mech: Mechanism) -> np.ndarray:
+    """The actuated coordinates of the example's first solution (``main.c``, the README): the reference's moved by
+    0.5, 0.2, 0.1 or 0.05 (rad, or characteristic lengths for a prismatic actuator; alternating signs), the first
+    that :func:`pkm.core.kinematics.solve.close_loops` reaches from the reference in its assembly and working mode
+    and inside every limit; the reference's own where none does."""
+    import warnings
+
+    from pkm.core.kinematics.solve import close_loops
+    from pkm.errors import ModeChangeWarning, PkmError
+
+    qa0 = mech.actuated_q(mech.q_reference)
+    signs = np.where(np.arange(mech.na) % 2, -1.0, 1.0)
+    for step in (0.5, 0.2, 0.1, 0.05):
+        qa = qa0 + step * signs * JacobianScales.of(mech).actuated
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", ModeChangeWarning)
+                res = close_loops(mech, qa)
+        except (PkmError, ModeChangeWarning):
+            continue
+        if not res.outside_limits:
+            return qa
+    return qa0
+
+
+def _show(values: np.ndarray) -> list[str]:
+    """Task values as the example prints them (``%.6f``, a value within 5e-10 of zero as 0)."""
+    return [f"{0.0 if abs(v) < 5e-10 else float(v):.6f}" for v in values]
+
+
+def _main(prefix: str, mech: Mechanism, qa_first: np.ndarray) -> str:
     U = prefix.upper()
-    return f"""/* An example: the forward kinematics along a short motion of the actuators, warm-started from the previous
-   solution, then the inverse kinematics and the inverse dynamics at the last pose. Build: make; run: ./example */
+    first = ", ".join(repr(float(x)) for x in qa_first)
+    return f"""/* An example: a first forward kinematics solution from the reference configuration (exported as
+   {prefix}_q_reference, in the assembly mode {U}_FK_MODE_REFERENCE), the forward kinematics along a short motion of
+   the actuators, warm-started from the previous solution, then the inverse kinematics and the inverse dynamics at the
+   last pose. Build: make; run: ./example (README.md shows what it prints) */
 #include <stdio.h>
 #include "{prefix}.h"
 
+static double shown(double v) {{ return v > -5e-10 && v < 5e-10 ? 0.0 : v; }}  /* (no "-0.000000") */
+
 int main(void) {{
+  static const double qa_first[{U}_NA] = {{{first}}};
   double q_prev[{U}_NQ], q[{U}_NQ], y[{U}_NY], qa[{U}_NA], qa_ik[{U}_NA], qd[{U}_NA], qdd[{U}_NA], tau[{U}_NA];
   {prefix}_info info;
   int k, i, status = {U}_OK;
   long mode;
-  for (i = 0; i < {U}_NQ; ++i) q_prev[i] = {prefix}_q_reference[i];
+  /* a first solution: from the reference configuration, in its assembly mode (fk follows a path to qa_first) */
+  status = {prefix}_fk(qa_first, {prefix}_q_reference, {U}_FK_MODE_REFERENCE, q, y, &info);
+  printf("first fk: status %d,", status);
+  for (i = 0; i < {U}_NY; ++i) printf(" %s=%.6f", {prefix}_task_names[i], shown(y[i]));
+  printf("\\n");
+  if (status != {U}_OK) return 1;
+  for (i = 0; i < {U}_NQ; ++i) q_prev[i] = q[i];
   for (k = 1; k <= 10; ++k) {{
     for (i = 0; i < {U}_NA; ++i) qa[i] = q_prev[{prefix}_actuated_q[i]] + 0.002 * (i % 2 ? -1.0 : 1.0);
     status = {prefix}_fk(qa, q_prev, {U}_FK_MODE_REFERENCE, q, y, &info);  /* (stay in the reference's assembly mode) */

@@ -24,6 +24,7 @@ left out; the first :data:`MODE_BITS` blocks label the mode.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import re
 from collections.abc import Callable
@@ -37,6 +38,7 @@ import pinocchio as pin
 from pkm.core.kinematics.blocks import block_triangular
 from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.core.twin.dynamics import ActuatorTwin
 from pkm.core.twin.linear import PivotedLU
 from pkm.core.twin.spatial import Expr, zyx_angles
@@ -101,6 +103,10 @@ class Newton:
         retract: ``(q, dx, target) -> q_next``: a step ``dx`` solved elsewhere, applied.
         blocks: The blocks that label the mode.
         columns: The coordinates of ``dx`` (velocity indices).
+        row_scale: Per row of ``A``, the factor that homogenises it (:class:`~pkm.core.model.scale.JacobianScales`:
+            the characteristic length for a rotation row or an angular task row, else 1).
+        column_scale: Per column of ``A``, the characteristic length for a length (prismatic, translation), else 1:
+            ``row_scale[:, None] * A * column_scale``'s singular values are scale-free (the singularity test's).
     """
 
     step: cs.Function
@@ -108,6 +114,13 @@ class Newton:
     retract: cs.Function
     blocks: tuple[Block, ...]
     columns: tuple[int, ...]
+    row_scale: np.ndarray = dataclasses.field(default_factory=lambda: np.ones(0))
+    column_scale: np.ndarray = dataclasses.field(default_factory=lambda: np.ones(0))
+
+    def homogenised(self, A: np.ndarray) -> np.ndarray:
+        """The square system matrix ``A`` (of :attr:`system`) homogenised by :attr:`row_scale` and
+        :attr:`column_scale`."""
+        return self.row_scale[:, None] * A * self.column_scale
 
 
 class ExportModel:
@@ -148,9 +161,9 @@ class ExportModel:
         return out
 
     def _newton(self, name: str, A: Expr, rhs: Expr, residual: Expr, columns: tuple[int, ...], dx: Expr,
-                target: Expr, at: Callable[[Expr], Expr]) -> Newton:
+                target: Expr, at: Callable[[Expr], Expr], row_scale: np.ndarray) -> Newton:
         """The Newton functions of the system ``A dq[columns] = rhs`` (``at`` maps an expression of ``q`` to the
-        point the step is taken from)."""
+        point the step is taken from; ``row_scale``: the factors that homogenise ``A``'s rows)."""
         tw = self.twin
         A_ref = tw.at_reference(A)
         try:
@@ -182,7 +195,8 @@ class ExportModel:
         retract = cs.Function(f"{name}_retract", [tw.q, dx, target],
                               [cs.densify(at(tw.retract(self._spread(dx, columns))))], ["q", "dx", "target"],
                               ["q_next"])
-        return Newton(step, system, retract, tuple(blocks[:MODE_BITS]), columns)
+        return Newton(step, system, retract, tuple(blocks[:MODE_BITS]), columns, np.asarray(row_scale, float)[rows],
+                      JacobianScales.of(self.mech).columns[list(columns)])
 
     # ---------------------------------------------------------------- kinematics
     @functools.cached_property
@@ -192,7 +206,7 @@ class ExportModel:
         tw = self.twin
         A = self.rows["jacobian"][:, list(self.fk_columns)]
         return self._newton("fk", A, self.closure_rhs, tw.closure_residual, self.fk_columns, self.dx_fk, self.qa,
-                            tw.with_actuated)
+                            tw.with_actuated, JacobianScales.of(self.mech).constraint_rows)
 
     @functools.cached_property
     def ik(self) -> Newton:
@@ -202,7 +216,9 @@ class ExportModel:
         A = cs.vertcat(self.rows["jacobian"], tk.task_jacobian)[:, list(self.ik_columns)]
         rhs = cs.vertcat(self.closure_rhs, tk.task_error)
         residual = cs.vertcat(tw.closure_residual, tk.task_error)
-        return self._newton("ik", A, rhs, residual, self.ik_columns, self.dx_ik, self.y, lambda e: e)
+        scales = JacobianScales.of(self.mech)
+        return self._newton("ik", A, rhs, residual, self.ik_columns, self.dx_ik, self.y, lambda e: e,
+                            np.concatenate([scales.constraint_rows, scales.task_rows]))
 
     @functools.cached_property
     def _rates(self) -> Expr:

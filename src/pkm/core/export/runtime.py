@@ -65,12 +65,16 @@ static int p_lu(int n, double* A, double* b) {
 }
 
 JACOBI_SV
-/* the smallest and largest singular values of the column-major n x n A (kept) */
-static void p_extreme_sv(int n, const double* A, double* smin, double* smax) {
+/* the smallest singular value relative to the largest of the column-major n x n A (kept) homogenised, row i times
+   rows[i] and column j times cols[j] (a rotation row, an angular task row and a length column times the
+   characteristic length: pkm.core.model.scale.JacobianScales), so that the singularity test judges the mechanism
+   scaled in size alike; 0 where A is zero */
+static double p_distance(int n, const double* A, const double* rows, const double* cols) {
   double W[P_NMAX * P_NMAX], s[P_NMAX];
-  p_copy(W, A, n * n);
+  int i, j;
+  for (j = 0; j < n; ++j) for (i = 0; i < n; ++i) W[j * n + i] = rows[i] * A[j * n + i] * cols[j];
   p_sv(n, n, W, s);
-  *smax = s[0]; *smin = s[n - 1];
+  return s[0] > 0.0 ? s[n - 1] / s[0] : 0.0;
 }
 
 /* the mode id from the blocks' determinants relative to the reference's: bit k set unless the k-th is positive */
@@ -94,7 +98,7 @@ static int p_outside(const double* q) {
 
 #: The Newton driver of one solve (``$kind``: ``fk`` or ``ik``; ``$NX`` the unknowns, ``$NB`` the mode's blocks).
 NEWTON = r"""
-static int p_newton_$kind(const double* target, const double* q_prev, long mode, double* q, p_info* info) {
+static int p_newton_$kind(const double* target, const double* q_prev, long mode, double tol, double* q, p_info* info) {
   double cur[P_NQ], next[P_NQ], det[$NB], r = 0.0, pv = 0.0;
   int it;
   p_copy(cur, q_prev, P_NQ);
@@ -102,15 +106,14 @@ static int p_newton_$kind(const double* target, const double* q_prev, long mode,
     p_k_$kind_step(cur, target, next, &r, &pv, det);
     info->iterations = it; info->residual = r; info->pivot = pv;
     if (!(pv >= P_PIVOT_FLOOR)) {  /* the fixed pivots fail: the same system, densely */
-      double A[$NX * $NX], W[$NX * $NX], b[$NX], smin, smax;
+      double A[$NX * $NX], W[$NX * $NX], b[$NX];
       p_k_$kind_system(cur, target, A, b);
-      p_extreme_sv($NX, A, &smin, &smax);
-      info->sigma_min = smin;
-      if (!(smin > P_SINGULAR_TOL * smax)) { p_copy(q, q_prev, P_NQ); return p_end(info, P_SINGULAR); }
+      info->sigma_min = p_distance($NX, A, p_$kind_row_scale, p_$kind_col_scale);
+      if (!(info->sigma_min > P_SINGULAR_TOL)) { p_copy(q, q_prev, P_NQ); return p_end(info, P_SINGULAR); }
       p_copy(W, A, $NX * $NX);  /* (A kept for the mode's blocks) */
       p_lu($NX, W, b);
       p_k_$kind_retract(cur, b, target, next);
-      if (r <= P_TOL) {  /* the mode from the dense blocks */
+      if (r <= tol) {  /* the mode from the dense blocks */
         int k, i, j;
         for (k = 0; k < $KNBLOCKS; ++k) {
           double B[P_BMAX * P_BMAX];
@@ -123,7 +126,7 @@ static int p_newton_$kind(const double* target, const double* q_prev, long mode,
       }
     }
     if (!p_finite(next, P_NQ) || !(r < INFINITY)) break;
-    if (r <= P_TOL) {  /* converged at cur; next is one step further */
+    if (r <= tol) {  /* converged at cur; next is one step further */
       long found = p_mode($KNBLOCKS, det);
       int joint;
       p_copy(q, next, P_NQ);
@@ -142,13 +145,51 @@ static int p_newton_$kind(const double* target, const double* q_prev, long mode,
 
 #: The public functions (``p_`` prefix); declarations in :data:`HEADER_FUNCTIONS`.
 PUBLIC = r"""
+/* The forward kinematics from q_prev to the actuated coordinates qa as pkm.close_loops solves it: along the straight
+   path in actuated coordinates (a revolute one the short way round), in steps of at most P_FK_STEP per actuator (in
+   rad, or in characteristic lengths: p_actuated_unit) and P_MAX_STEPS steps at most, each corrected by Newton from
+   the last (to P_PATH_TOL on the way, P_TOL at qa), so that a solution far from q_prev (a first one, from
+   p_q_reference) stays in q_prev's assembly mode where a single Newton jump would leave it or fail. A step that does
+   not converge ends the path: P_NOT_CONVERGED, q_prev kept. info->iterations counts every step's iterations. */
+static int p_follow_fk(const double* qa, const double* q_prev, long mode, double* q, p_info* info) {
+  double start[P_NA], d[P_NA], sub[P_NA], cur[P_NQ], first[P_NQ];  /* (q may be q_prev's buffer) */
+  int k, s, n = 1, total = 0, status;
+  p_copy(first, q_prev, P_NQ);
+  for (k = 0; k < P_NA; ++k) {
+    double steps;
+    start[k] = q_prev[p_actuated_q[k]];
+    d[k] = qa[k] - start[k];
+    if (p_actuated_revolute[k]) d[k] = atan2(sin(d[k]), cos(d[k]));
+    steps = ceil(fabs(d[k]) / (P_FK_STEP * p_actuated_unit[k]));
+    if (!(steps <= P_MAX_STEPS)) steps = P_MAX_STEPS;
+    if (steps > n) n = (int) steps;
+  }
+  p_copy(cur, first, P_NQ);
+  for (s = 1; s < n; ++s) {
+    for (k = 0; k < P_NA; ++k) sub[k] = start[k] + d[k] * ((double) s / n);
+    status = p_newton_fk(sub, cur, -1, P_PATH_TOL, q, info);
+    total += info->iterations;
+    if (status != P_OK && status != P_OUTSIDE_LIMITS) {
+      info->iterations = total;
+      p_copy(q, first, P_NQ);
+      return status;
+    }
+    p_copy(cur, q, P_NQ);
+  }
+  info->joint = -1;
+  status = p_newton_fk(qa, cur, mode, P_TOL, q, info);
+  info->iterations += total;
+  if (status == P_NOT_CONVERGED || status == P_SINGULAR) p_copy(q, first, P_NQ);
+  return status;
+}
+
 /* ---------------------------------------------------------------- public functions */
 int p_fk(const double qa[P_NA], const double q_prev[P_NQ], long mode, double q[P_NQ], double y[P_NY], p_info* info) {
   p_info local;
   int status;
   info = p_start(info, &local);
   if (!p_coordinates(qa, P_NA) || !p_coordinates(q_prev, P_NQ)) return p_end(info, P_INVALID_INPUT);
-  status = p_newton_fk(qa, q_prev, mode, q, info);
+  status = p_follow_fk(qa, q_prev, mode, q, info);
   p_k_task_value(q, y);
   return status;
 }
@@ -158,7 +199,7 @@ int p_ik(const double y[P_NY], const double q_prev[P_NQ], long mode, double q[P_
   int status, k;
   info = p_start(info, &local);
   if (!p_coordinates(y, P_NY) || !p_coordinates(q_prev, P_NQ)) return p_end(info, P_INVALID_INPUT);
-  status = p_newton_ik(y, q_prev, mode, q, info);
+  status = p_newton_ik(y, q_prev, mode, P_TOL, q, info);
   for (k = 0; k < P_NA; ++k) qa[k] = q[p_actuated_q[k]];
   return status;
 }
@@ -188,15 +229,21 @@ int p_task_value(const double q[P_NQ], double y[P_NY]) {
   return P_OK;
 }
 
-/* a kernel's pivot under the floor: singular (the passive closure Jacobian's smallest singular value) or not */
-static int p_pivot_failed(const double* q, p_info* info) {
-  double qa[P_NA], A[FKN * FKN], b[FKN], smin, smax;
+int p_fk_distance(const double q[P_NQ], double* distance) {
+  double qa[P_NA], A[FKN * FKN], b[FKN];
   int k;
+  if (!p_coordinates(q, P_NQ)) return P_INVALID_INPUT;
   for (k = 0; k < P_NA; ++k) qa[k] = q[p_actuated_q[k]];
   p_k_fk_system(q, qa, A, b);
-  p_extreme_sv(FKN, A, &smin, &smax);
-  info->sigma_min = smin;
-  return p_end(info, smin > P_SINGULAR_TOL * smax ? P_PIVOT_ORDER : P_SINGULAR);
+  *distance = p_distance(FKN, A, p_fk_row_scale, p_fk_col_scale);
+  return P_OK;
+}
+
+/* a kernel's pivot under the floor: singular (the homogenised passive closure Jacobian's relative smallest singular
+   value) or not */
+static int p_pivot_failed(const double* q, p_info* info) {
+  p_fk_distance(q, &info->sigma_min);
+  return p_end(info, info->sigma_min > P_SINGULAR_TOL ? P_PIVOT_ORDER : P_SINGULAR);
 }
 
 int p_jacobians(const double q[P_NQ], double J[P_NX * P_NA], double K[P_NA * P_NX], p_info* info) {
@@ -331,8 +378,10 @@ HEADER_FUNCTIONS = r"""
    allocates, prints or keeps state: any number of threads may call them at once. Arrays are column-major. */
 
 /* Forward kinematics: the configuration q (P_NQ) and task value y (P_NY) for the actuated coordinates qa (P_NA),
-   by Newton from the caller's previous solution q_prev (P_MAX_ITER iterations at most). mode: the assembly mode
-   the solution must be in (a P_FK_MODE_* id; negative: any). q and y hold the solution for P_OK, P_LEFT_MODE
+   by Newton from the caller's previous solution q_prev (P_MAX_ITER iterations at most), along a path of steps of at
+   most P_FK_STEP per actuator where qa is farther (P_MAX_STEPS at most): a first solution from p_q_reference (mode
+   P_FK_MODE_REFERENCE) to any qa the reference's assembly mode reaches without crossing a singularity. mode: the
+   assembly mode the solution must be in (a P_FK_MODE_* id; negative: any). q may be q_prev's buffer. q and y hold the solution for P_OK, P_LEFT_MODE
    and P_OUTSIDE_LIMITS, else q_prev (nothing is written for P_INVALID_INPUT). */
 int p_fk(const double qa[P_NA], const double q_prev[P_NQ], long mode, double q[P_NQ], double y[P_NY], p_info* info);
 
@@ -343,6 +392,12 @@ int p_ik(const double y[P_NY], const double q_prev[P_NQ], long mode, double q[P_
 /* The assembly (forward kinematics) and working (inverse kinematics) mode ids of a closed configuration. */
 int p_fk_mode(const double q[P_NQ], long* mode);
 int p_ik_mode(const double q[P_NQ], long* mode);
+
+/* The distance of a closed configuration q from a direct singularity: the smallest singular value of the forward
+   kinematics' Newton matrix (the closure Jacobian on the passive coordinates) relative to its largest, the matrix
+   homogenised by the characteristic length (pkm.diagnose's direct_distance: the same for the mechanism scaled in
+   size); SINGULAR below P_SINGULAR_TOL. */
+int p_fk_distance(const double q[P_NQ], double* distance);
 
 /* The task value of a configuration (P_NY: see p_task_names). */
 int p_task_value(const double q[P_NQ], double y[P_NY]);

@@ -37,7 +37,8 @@ from pkm.core.kinematics.configuration import Configuration
 from pkm.core.kinematics.labels import ModeLabel, mode_label, mode_label_at
 from pkm.core.kinematics.newton import gauss_newton
 from pkm.core.kinematics.task import TaskMap
-from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.mechanism import Mechanism, check_mechanism, spread
+from pkm.core.model.scale import JacobianScales
 from pkm.errors import (
     AssemblyError,
     BranchError,
@@ -456,8 +457,13 @@ def assemble(mech: Mechanism, q0: ArrayLike | None = None, *, hold: Sequence[str
 
     Levenberg-Marquardt on the closure residual over every joint, on the configuration manifold, from
     ``q0`` (default: the reference); when it stalls above ``tol``, restarts from ``q0`` perturbed by
-    normal draws of growing size (0.1, 0.3, 1 rad or m), ``restarts`` times at most (seeded: the same
-    answer every run). Every joint moves but those named in ``hold``, which keep their values in ``q0``
+    normal draws of growing size (0.1, 0.3, 1 rad or ``L``), ``restarts`` times at most (seeded: the same
+    answer every run). Scale-free: the residual's translation rows and the prismatic (and translation) coordinates
+    are counted in ``L``, the :func:`~pkm.core.model.mechanism.spread` of the joints at ``q0`` (the configuration the
+    assembly starts from, known before any assembly: the characteristic length is measured at the reference, which
+    this finds), rotations and angles in rad; ``tol`` bounds that residual (a translation gap of ``tol * L`` m).
+    A copy of the mechanism with every length scaled (:func:`~pkm.core.model.builder.scaled_mechanism`), started
+    from ``q0`` scaled alike, assembles to the same angles and to lengths scaled alike (to round-off). Every joint moves but those named in ``hold``, which keep their values in ``q0``
     (a spec's partial ``[reference]`` holds the joints it states): with no ``hold`` this finds *an*
     assembly, not the one for given actuators (that is :func:`close_loops`).
 
@@ -489,34 +495,37 @@ def assemble(mech: Mechanism, q0: ArrayLike | None = None, *, hold: Sequence[str
         j = mech.joint(name)
         held[j.idx_v:j.idx_v + j.nv] = True
 
+    rows, cols = _assembly_metric(mech, q_seed)
+
     def closure(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         F, J = constraints.residual_and_jacobian(mech, qq)
         J[:, held] = 0.0  # (Levenberg-Marquardt's damping then leaves the held coordinates where they are)
-        return F, J
+        return rows * F, rows[:, None] * J * cols
 
     m = mech.model
-    best: tuple[float, np.ndarray] = (np.inf, q_seed)
+    best: tuple[float, np.ndarray, float] = (np.inf, q_seed, np.inf)
     total = 0
     for k in range(restarts + 1):
         scale = (0.0, 0.1, 0.3, 1.0)[min(k, 3)]
-        q = pin.integrate(m, q_seed, np.where(held, 0.0, scale * rng.standard_normal(m.nv))) if k else q_seed.copy()
-        q, r, it = _levenberg_marquardt(mech, closure, q, tol, max_iter)
+        q = (pin.integrate(m, q_seed, np.where(held, 0.0, scale * cols * rng.standard_normal(m.nv))) if k
+             else q_seed.copy())
+        q, r, it = _levenberg_marquardt(mech, closure, q, tol, max_iter, cols)
         total += it
-        res = float(np.abs(r).max())
+        res, raw = float(np.abs(r).max()), float(np.abs(r / rows).max())  # (scale-free; in m or rad)
         if res < best[0]:
-            best = (res, q)
+            best = (res, q, raw)
         if res <= tol:
             q = mech.wrap(q)
-            return _result(mech, q, True, res, total, k + 1)
-    result = _result(mech, best[1], False, best[0], total, restarts + 1)
+            return _result(mech, q, True, raw, total, k + 1)
+    result = _result(mech, best[1], False, best[2], total, restarts + 1)
     if not raise_on_failure:
         return result
     err = _failure(mech, "assembly", result, tol)
-    alone, detail = _open_alone(mech, q_seed, held, tol, max_iter, rng)
+    alone, detail = _open_alone(mech, q_seed, held, tol * (1.0 / rows).max(), max_iter, rng)
     detail = detail or (f"{restarts + 1} starts of Levenberg-Marquardt: each closure closes alone, not all of them "
                         f"together; at the best start closure {err.worst_closure!r} "
                         f"({_frames(mech, err.worst_closure)}) stays open by {err.worst_gap:.3g}")
-    raise AssemblyError(best[0], "m or rad", detail, subject="this mechanism",
+    raise AssemblyError(best[2], "m or rad", detail, subject="this mechanism",
                         closures=alone or ((str(err.worst_closure), err.worst_gap),))
 
 
@@ -668,19 +677,31 @@ def _open_alone(mech: Mechanism, q_seed: np.ndarray, held: np.ndarray, tol: floa
             f"{len(open_)} closure(s) cannot close even alone: " + "; ".join(w for _, _, w in open_) + fix)
 
 
-def _levenberg_marquardt(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray, tol: float, max_iter: int
-                         ) -> tuple[np.ndarray, np.ndarray, int]:
+def _assembly_metric(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`assemble`'s scale-free metric from its start ``q``: per closure row, ``1 / L`` for a translation and 1 for
+    a rotation (the residual in ``L`` and rad), and per velocity ``L`` for a length and 1 for an angle (a step in
+    ``L`` and rad), ``L`` the :func:`~pkm.core.model.mechanism.spread` of the joints at ``q``."""
+    L = spread(mech.model, q)
+    scales = JacobianScales.at(mech, L)
+    return scales.constraint_rows / L, scales.columns
+
+
+def _levenberg_marquardt(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray, tol: float, max_iter: int,
+                         columns: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, int]:
     """Levenberg-Marquardt on ``|F(q)|^2`` over every joint (``fun(q) -> (F, J)``, J on the tangent space), on the
     configuration manifold; stops at ``|F|_inf <= tol``, at a stationary point (no decrease for any damping) or
-    after ``max_iter`` iterations. Returns ``(q, F, iterations)``."""
+    after ``max_iter`` iterations. ``columns``: the units of J's columns (nv,), a step ``dq`` of the iteration moving
+    the joints by ``columns * dq`` (``fun``'s Jacobian homogenised by them: :func:`_assembly_metric`); default 1.
+    Returns ``(q, F, iterations)``."""
     m = mech.model
+    unit = np.ones(m.nv) if columns is None else columns
     F, J = fun(q)
     cost, lam, it = float(F @ F), 1e-3, 0
     while it < max_iter and np.abs(F).max() > tol:
         it += 1
         JtJ, g = J.T @ J, J.T @ F
         dq = -np.linalg.solve(JtJ + lam * (np.diag(np.diag(JtJ)) + 1e-12 * np.eye(m.nv)), g)
-        q_try = pin.integrate(m, q, dq)
+        q_try = pin.integrate(m, q, unit * dq)
         F_try, J_try = fun(q_try)
         cost_try = float(F_try @ F_try)
         if np.isfinite(cost_try) and cost_try < cost:

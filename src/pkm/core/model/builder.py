@@ -14,7 +14,9 @@ robot.yaml's or MJCF's keyframe read into it), which must close every loop to :d
 assembly :func:`pkm.core.kinematics.solve.assemble` reaches from the joints the files state (held) and the zero pose
 (Pinocchio's neutral configuration) for the others: Levenberg-Marquardt from there, then seeded restarts, the first
 that closes (the same every run; a closed configuration near the zero pose, not the nearest, and not chosen for
-symmetry). :func:`pkm.core.kinematics.solve.nearest_assembly` gives the nearest (a symmetric one where a symmetry
+symmetry; scale-free: the same files with every length scaled assemble to the same angles, by a metric in the
+spread of the joints at the zero pose, :func:`~pkm.core.model.mechanism.spread`, known before the reference).
+:func:`pkm.core.kinematics.solve.nearest_assembly` gives the nearest (a symmetric one where a symmetry
 of the mechanism fixes the zero pose); it is not the default because the nearest is often near a singularity (a
 URDF's zero pose with aligned links): Gepetto's disney_like and wl16_like would get references 3 and 2 mrad from one.
 Write a ``[reference]`` (or ``pkm.save`` a mechanism whose ``q_reference`` was set) to choose. An assembled reference
@@ -49,13 +51,15 @@ from pkm.core.model import plausibility
 from pkm.core.model.actuators import NUMBERS, Actuator, as_actuators
 from pkm.core.model.joints import retype_joints
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.core.model.scale import length_entries, scale_urdf
+from pkm.core.model.scale import JacobianScales, length_entries, scale_urdf
 from pkm.core.model.spec import ClosureSpec, as_path
 from pkm.core.model.urdf import load_model
 from pkm.errors import AssemblyError, InvalidInputError, PkmWarning, SpecError
 from pkm.validation import as_scalar
 
-#: A spec's [reference] must close every loop to this (m or rad); one that lacks joints is assembled.
+#: A spec's [reference] must close every loop to this, relative to the mechanism's characteristic length for a
+#: translation gap (:attr:`Mechanism.characteristic_length` at that reference), in rad for a rotation: the same
+#: verdict on the files in millimetres and in metres. One that lacks joints is assembled.
 REFERENCE_TOL = 1e-9
 
 
@@ -114,18 +118,25 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
             raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found that keeps the "
                                     f"joints it states, the others starting from the neutral configuration "
                                     f"({exc}){hint}; give an assembled [reference]") from None
-        gap = constraints.worst_closure(mech, constraints.residual(mech, start))[0] if seed else 0.0
-        if gap > REFERENCE_TOL:  # (where the pose the files state was open, how far closing it moved it)
+        raw = constraints.residual(mech, start)
+        rel = constraints.worst_closure(mech, raw * JacobianScales.of(mech).constraint_rows
+                                        / mech.characteristic_length)[0] if seed else 0.0
+        if rel > REFERENCE_TOL:  # (where the pose the files state was open, how far closing it moved it)
+            gap = constraints.worst_closure(mech, raw)[0]
             moved = float(np.abs(pin.difference(model, start, mech.q_reference)).max())
             mech.notes += (f"the loops open by {gap:.3g} (m or rad) at the pose the files state were closed by "
                            f"assembly, which moved the joints by {moved:.3g} at most (rad or m)",)
         mech.q_reference = _inside_limits(mech, start, held, source)
     else:
-        gap, _, closure = constraints.worst_closure(mech, constraints.residual(mech, mech.q_reference))
-        if gap > REFERENCE_TOL:
+        raw = constraints.residual(mech, mech.q_reference)
+        L = mech.characteristic_length
+        rel, _, closure = constraints.worst_closure(mech, raw * JacobianScales.of(mech).constraint_rows / L)
+        if rel > REFERENCE_TOL:
+            gap = constraints.worst_closure(mech, raw)[0]
             raise SpecError(source, f"the [reference] configuration leaves closure {closure!r} open by {gap:.3g} "
-                                    f"(m or rad; closed means <= {REFERENCE_TOL:g}): fix it, or leave joints out of "
-                                    "[reference] to have pkm assemble the mechanism (pkm.assemble)")
+                                    f"(m or rad; {rel:.3g} relative to the mechanism's size {L:.3g} m, closed means "
+                                    f"<= {REFERENCE_TOL:g}): fix it, or leave joints out of [reference] to have pkm "
+                                    "assemble the mechanism (pkm.assemble)")
     fit = actuation(mech)
     mech.dependent_actuators = fit.dependent
     said = set(notes)  # (a rebuild of a mechanism, pkm.with_actuators: its notes told already, not warned again)

@@ -87,6 +87,20 @@ def reference_points(model: pin.Model, q: np.ndarray, min_mass: float = 0.0) -> 
     return joints, frames, centres
 
 
+def spread(model: pin.Model, q: np.ndarray) -> float:
+    """The root-mean-square distance [m] of ``model``'s joint origins from their centroid at ``q`` (its frames'
+    origins where the joints' coincide, 1 m where those coincide too): :attr:`Mechanism.characteristic_length` at the
+    reference, and the assembly's scale at the configuration it starts from, before there is a reference
+    (:func:`pkm.core.kinematics.solve.assemble`). Scaling every length of the model and of ``q`` scales it alike."""
+    joints, frames, _ = reference_points(model, q)
+    for points in (joints, frames):
+        if len(points):
+            length = float(np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=1))))
+            if length > 0.0:
+                return length
+    return 1.0
+
+
 class Mechanism:
     """A parallel mechanism on Pinocchio.
 
@@ -319,13 +333,7 @@ class Mechanism:
         their Jacobians by it (:meth:`JacobianScales.of(mech) <pkm.core.model.scale.JacobianScales.of>`), so that
         they judge a mechanism of 5 cm as the same one of 5 m. Where every joint origin coincides, the frames'
         origins are used instead, and 1 m where they coincide too (nothing in the mechanism has a length)."""
-        joints, frames, _ = reference_points(self.model, self.q_reference)
-        for points in (joints, frames):
-            if len(points):
-                length = float(np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=1))))
-                if length > 0.0:
-                    return length
-        return 1.0
+        return spread(self.model, self.q_reference)
 
     @property
     def jacobian_scales(self) -> Any:

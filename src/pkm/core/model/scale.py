@@ -98,9 +98,15 @@ class JacobianScales:
         ``q_reference`` changes)."""
         return derived(mech, _jacobian_scales)
 
+    @staticmethod
+    def at(mech: Mechanism, length: float) -> JacobianScales:
+        """The factors that homogenise ``mech``'s Jacobians by the length ``length`` [m] (> 0) instead of its
+        characteristic length: the assembly's, before there is a reference (:func:`pkm.core.kinematics.solve.assemble`)."""
+        return _jacobian_scales(mech, length)
 
-def _jacobian_scales(mech: Mechanism) -> JacobianScales:
-    L = mech.characteristic_length
+
+def _jacobian_scales(mech: Mechanism, length: float | None = None) -> JacobianScales:
+    L = mech.characteristic_length if length is None else length
     rows = []
     for c in mech.spec.closures:
         rows += [1.0] * 3 + ([L] * 3 if c.type == "frame" else [])

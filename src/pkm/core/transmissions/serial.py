@@ -144,7 +144,7 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
         >>> round(pin.computeTotalMass(se.model), 6), round(pin.computeTotalMass(bot.model), 6)  # (rods welded)
         (17.513222, 17.513222)
         >>> round(se.armature["ankley_left"], 7)  # (ΔM's diagonal at the reference [kg m^2])
-        0.0002157
+        0.0002152
     """
     robot = check_mechanism(robot)
     found = tuple(find(robot) if transmissions is None else transmissions)
