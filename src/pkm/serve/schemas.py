@@ -41,12 +41,11 @@ Numbers = Annotated[Any, WithJsonSchema(_samples(_NUMBER))]
 #: One configuration (numbers in SI, or strings with a unit).
 Configuration = Annotated[Any, WithJsonSchema({"type": "array", "items": _NUMBER_OR_UNIT})]
 
-def _column(entry: dict[str, Any]) -> dict[str, Any]:
-    """An answer's column of ``entry`` per sample; in msgpack, where no sample failed, a numpy array (the layout in
-    its description: a field's own description replaces a type's, not a branch's)."""
-    return {"allOf": [{"type": "array", "items": {"anyOf": [*(entry if isinstance(entry, list) else [entry]),
-                                                             {"type": "null"}]},
-                       "description": f"One entry per sample, null where the sample failed. {ND_LAYOUT}"}]}
+def _column(entry: dict[str, Any] | list[dict[str, Any]]) -> dict[str, Any]:
+    """An answer's column of ``entry`` per sample, ``null`` where the sample failed; in msgpack, where no sample
+    failed, a numpy array (:data:`pkm.serve.wire.ND_LAYOUT`, stated in the requests' array schemas and the API's
+    description: an array schema, not an ``allOf`` wrapper, which generated clients read as an object)."""
+    return {"type": "array", "items": {"anyOf": [*(entry if isinstance(entry, list) else [entry]), {"type": "null"}]}}
 
 
 #: An answer's column: one entry per sample (a number, a vector or a matrix), ``null`` where the sample failed.
