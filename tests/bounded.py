@@ -23,8 +23,8 @@ POLL = 0.5
 _TICKS = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
 
 
-def _stats() -> dict[int, tuple[int, float]]:
-    """``{pid: (parent pid, CPU seconds of the process and its waited-for children)}`` of every process."""
+def processes() -> dict[int, tuple[int, float]]:
+    """``{pid: (parent pid, CPU seconds of the process and its waited-for children)}`` of every process (/proc)."""
     out = {}
     for stat in Path("/proc").glob("[0-9]*/stat"):
         try:
@@ -36,9 +36,20 @@ def _stats() -> dict[int, tuple[int, float]]:
     return out
 
 
+def children(pid: int) -> list[int]:
+    """Processes whose parent is ``pid``."""
+    return [c for c, (parent, _) in processes().items() if parent == pid]
+
+
 def tree_cpu(pid: int) -> float:
-    """CPU seconds used by ``pid`` and all its live descendants (and the children they have waited for)."""
-    stats = _stats()
+    """CPU seconds used by ``pid`` and all its live descendants (and the children they have waited for).
+
+    Raises:
+        ProcessLookupError: ``pid`` is gone (reaped).
+    """
+    stats = processes()
+    if pid not in stats:
+        raise ProcessLookupError(pid)
     total, frontier = 0.0, [pid]
     while frontier:
         p = frontier.pop()

@@ -9,7 +9,8 @@ from pathlib import Path
 import pytest
 
 import pkm.viz  # noqa: F401  (a regression in pkm.viz fails here, it is not skipped)
-from tests.cli.helpers import children, one_error_line, port_is_free, run, start_live_preview
+from tests.bounded import children
+from tests.cli.helpers import one_error_line, port_is_free, run, start_live_preview
 
 
 def test_preview_writes_html_and_refuses_an_unknown_mechanism(tmp_path):

@@ -11,6 +11,7 @@ import time
 import pytest
 
 from pkm import cli
+from tests.bounded import tree_cpu
 
 pytest.importorskip("fastapi")
 pytest.importorskip("uvicorn")
@@ -39,12 +40,6 @@ def test_the_help_lists_the_routes_of_the_application(capsys):
         in paths and ["GET", "/docs"] in paths
 
 
-def _cpu_seconds(pid: int) -> float:
-    """The processor time process ``pid`` has used [s] (Linux's /proc/<pid>/stat: user + system)."""
-    fields = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-
-
 def test_ctrl_c_stops_the_service_promptly_once_the_request_in_flight_is_answered():
     """SIGINT while a query of about half a second runs (FK of 4,000 samples, its kernels compiled by a first
     query; signalled once the service has computed 0.1 s on it), another client's keep-alive connection open and idle: the query is answered 200, then the process exits
@@ -67,15 +62,15 @@ def test_ctrl_c_stops_the_service_promptly_once_the_request_in_flight_is_answere
             r = httpx.post(url + "/models/delta/fk", json={"qa": qa}, timeout=120)
             answer["status"], answer["at"] = r.status_code, time.monotonic()
             try:
-                answer["cpu"] = _cpu_seconds(proc.pid)
-            except (OSError, IndexError):  # (already gone: it used none after)
+                answer["cpu"] = tree_cpu(proc.pid)
+            except ProcessLookupError:  # (already gone: it used none after)
                 answer["cpu"] = None
 
-        before = _cpu_seconds(proc.pid)
+        before = tree_cpu(proc.pid)
         t = threading.Thread(target=query)
         t.start()
         deadline = time.monotonic() + 120  # (a hang's bound)
-        while _cpu_seconds(proc.pid) < before + 0.1 and time.monotonic() < deadline:  # (the service is at it)
+        while tree_cpu(proc.pid) < before + 0.1 and time.monotonic() < deadline:  # (the service is at it)
             time.sleep(0.01)
         signalled = time.monotonic()
         proc.send_signal(signal.SIGINT)
