@@ -228,7 +228,6 @@ class ActuatorSpaceModel:
     base_velocity: np.ndarray = field(default_factory=lambda: np.zeros(0))
     base_response: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     base_friction: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    _G_base: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     _friction_joint: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __post_init__(self) -> None:
@@ -328,10 +327,10 @@ def _held_only(mech: Mechanism, base: str | None) -> str:
     return "fixed"
 
 
-def _check_state(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None, base: str | None = None) \
+def _check_state(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None, base: str | None = None, name: str = "qd") \
         -> tuple[Mechanism, np.ndarray, np.ndarray, str, np.ndarray]:
     """``(mech, q, qd, base, base_velocity)`` checked: all joint rates (nv,) give the actuated rates and, for a free
-    base, its twist; actuated rates (na,) a base at rest."""
+    base, its twist; actuated rates (na,) a base at rest; ``name``: the rates' name in an error."""
     mech = check_mechanism(mech)
     base = base_choice(mech, base)
     q = mech.check_q(q)
@@ -343,9 +342,9 @@ def _check_state(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None, base: str 
     except (TypeError, ValueError, OverflowError):  # (check_actuated says what is wrong)
         arr = None
     if arr is not None and arr.shape == (mech.nv,) and mech.nv != mech.na:
-        arr = mech.check_v(arr, "qd")
-        return mech, q, mech.check_actuated(arr[mech.act_v], "qd"), base, arr[mech.base_v] if len(rest) else rest
-    return mech, q, mech.check_actuated(qd, "qd", order="rate"), base, rest
+        arr = mech.check_v(arr, name)
+        return mech, q, mech.check_actuated(arr[mech.act_v], name), base, arr[mech.base_v] if len(rest) else rest
+    return mech, q, mech.check_actuated(qd, name, order="rate"), base, rest
 
 
 def _evaluate(mech: Mechanism, q: np.ndarray, qd: np.ndarray, rtol: float,
@@ -383,7 +382,7 @@ def _evaluate(mech: Mechanism, q: np.ndarray, qd: np.ndarray, rtol: float,
     M_a = 0.5 * (M_a + M_a.T)
     return ActuatorSpaceModel(mech, q, qd.copy(), v, G, a_b, finite_result(M_a, "actuator-space mass matrix"),
                               finite_result(Gt @ b, "actuator-space bias"), Gt @ g, Gt @ f_joint, red.idle,
-                              red.M, base, vb, response, base_friction, red.Gb, f_joint)
+                              red.M, base, vb, response, base_friction, f_joint)
 
 
 def actuator_model(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None, *, rtol: float = RTOL,

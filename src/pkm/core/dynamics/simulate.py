@@ -66,7 +66,15 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from pkm.core.dynamics.model import COULOMB_VELOCITY, RTOL, ActuatorSpaceModel, _evaluate, _solve_inertia, base_choice
+from pkm.core.dynamics.model import (
+    COULOMB_VELOCITY,
+    RTOL,
+    ActuatorSpaceModel,
+    _check_state,
+    _evaluate,
+    _solve_inertia,
+    base_choice,
+)
 from pkm.core.dynamics.projection import energy
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.newton import least_squares
@@ -404,18 +412,7 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
         if gap > 1e-9:
             raise InvalidInputError("q0", f"not assembled: closure {closure!r} open by {gap:.3g} (close it with "
                                           "pkm.close_loops)", gap)
-    twist = np.zeros(6 if base == "free" else 0)
-    if v0 is None:
-        qd = np.zeros(mech.na)
-    else:
-        try:
-            arr = np.asarray(v0, dtype=float) if not isinstance(v0, str) else np.zeros(0)
-        except (TypeError, ValueError, OverflowError):  # (check_actuated says what is wrong)
-            arr = np.zeros(0)
-        qd = mech.check_v(arr, "v0")[mech.act_v] if arr.shape == (mech.nv,) and mech.nv != mech.na \
-            else mech.check_actuated(v0, "v0", order="rate")
-        if len(twist) and arr.shape == (mech.nv,) and mech.nv != mech.na:
-            twist = arr[mech.base_v].copy()
+    _, _, qd, _, twist = _check_state(mech, q, v0, base, "v0")  # (all joint rates give a free base its twist)
     dyn = _Dynamics(mech, ctrl, friction, saturate, bool(limits), singular_tol, coulomb_velocity, step_tol, q, base)
     x = np.concatenate([mech.actuated_q(q), qd])
     if base == "free" and mech.base is not None:
