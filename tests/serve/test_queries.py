@@ -97,6 +97,28 @@ def test_a_floating_base_s_batched_dynamics_is_the_model_s():
     assert model.base == "free" and np.abs(out["h"][1] - model.h).max() <= 1e-12 * np.abs(model.h).max()
 
 
+def test_a_floating_base_s_streamed_efforts_are_the_model_s():
+    """The WebSocket's efforts on a floating robot are the model's (the base free), as HTTP's are: the compiled
+    inverse dynamics (which holds the base) is not asked; its kinematics kernels may be."""
+    import numpy as np
+
+    from pkm.serve.stream import Stream
+    from tests.core.dynamics.floating import floating
+
+    class Kinematics:  # (kernels whose dynamics must not be asked; their closure declines, the library closes)
+        def kernel(self, name):
+            if name == "closure_newton":
+                return type("Follow", (), {"follow": lambda self, q, qa, n, tol: (q[None], [np.inf], [[0.0]], None)})()
+            if name == "forward_jacobian":
+                return lambda Q: pkm.forward_jacobian(mech, Q[0]).reshape(1, -1, order="F")
+            raise AssertionError(f"the kernels were asked for {name}")
+
+    mech = floating("fourbar")
+    out = Stream(mech, kernels=Kinematics()).step({"qa": [0.4], "qd": [0.3], "qdd": [1.0]})
+    model = pkm.actuator_model(mech, out["q"], [0.3])
+    assert model.base == "free" and np.abs(out["tau"] - (model.M @ [1.0] + model.h)).max() <= 1e-12
+
+
 def test_rates_and_accelerations_take_their_units_as_the_library_and_the_cli_do():
     """A rate is ``"-30deg/s"`` (or ``"300rpm"``) over HTTP as in :func:`pkm.actuator_model` and ``pkm dynamics
     --rates``: the answer is the SI number's to 1e-12; an acceleration has no suffix (``rad/s^2``), so ``"1deg"``

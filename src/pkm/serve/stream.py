@@ -27,7 +27,6 @@ import numpy as np
 import pkm
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError
-from pkm.validation import bounded
 
 
 class Stream:
@@ -74,7 +73,6 @@ class Stream:
         qa = self._vector(sample, "qa")
         if qa is None:
             raise InvalidInputError("qa", f"missing: give {self.mech.na} numbers")
-        bounded(qa, "qa")  # (the library's bound on coordinates: beyond it refused, never wrapped)
         qd, qdd = self._vector(sample, "qd"), self._vector(sample, "qdd")
         K = self.kernels
         q = residual = None
@@ -97,7 +95,7 @@ class Stream:
             out["yd"] = J @ qd
             if qdd is not None:
                 tau = None
-                if K is not None:
+                if K is not None and self.mech.base is None:  # (the kernels hold a floating base; the model frees it)
                     t_k, p_k = K.kernel("inverse_dynamics")(q[None], qd[None], qdd[None])
                     tau = t_k[0] if p_k[0, 0] >= PIVOT_FLOOR and np.all(np.isfinite(t_k[0])) else None
                 if tau is None:
