@@ -99,6 +99,13 @@ def worst_closure(mech: Mechanism, r: np.ndarray) -> tuple[float, int, str | Non
     return worst
 
 
+def block_gap(mech: Mechanism, r: np.ndarray, index: int) -> float:
+    """The norm [m or rad] of closure ``index``'s block (1-based, as :func:`worst_closure` gives it) of the raw
+    residual ``r``: the number to print for the closure a scaled residual found worst."""
+    start = sum(cm.residualSize() for cm in mech.constraint_models[:index - 1])
+    return float(np.linalg.norm(r[start:start + mech.constraint_models[index - 1].residualSize()]))
+
+
 #: A configuration counts as assembled where no closure is open by more than this, relative to the mechanism's
 #: characteristic length (:attr:`~pkm.core.model.mechanism.Mechanism.characteristic_length`; a rotation's gap in rad).
 CLOSED_RTOL = 1e-6
@@ -117,8 +124,7 @@ def check_closed(mech: Mechanism, q: np.ndarray, what: str = "q") -> None:
     raw = residual(mech, q)
     gap, index, name = worst_closure(mech, raw[:mech.n_constraints] * JacobianScales.of(mech).constraint_rows / L)
     if gap > CLOSED_RTOL:
-        start = sum(cm.residualSize() for cm in mech.constraint_models[:index - 1])
-        open_by = float(np.linalg.norm(raw[start:start + mech.constraint_models[index - 1].residualSize()]))
+        open_by = block_gap(mech, raw, index)
         raise InvalidInputError(what, f"the loops are not closed: closure {name!r} is open by {open_by:.3g} (m or rad), "
                                       f"{gap:.3g} of the mechanism's size {L:.3g} m (at most {CLOSED_RTOL:g}); close "
                                       "them first (pkm.close_loops, pkm.solve_ik)", name)

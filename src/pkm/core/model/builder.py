@@ -118,21 +118,23 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
             raise SpecError(source, f"[reference] lacks joints {missing} and no assembly was found that keeps the "
                                     f"joints it states, the others starting from the neutral configuration "
                                     f"({exc}){hint}; give an assembled [reference]") from None
-        raw = constraints.residual(mech, start)
-        rel = constraints.worst_closure(mech, raw * JacobianScales.of(mech).constraint_rows
-                                        / mech.characteristic_length)[0] if seed else 0.0
-        if rel > REFERENCE_TOL:  # (where the pose the files state was open, how far closing it moved it)
-            gap = constraints.worst_closure(mech, raw)[0]
+        rel, index, raw = 0.0, 0, np.zeros(0)
+        if seed:  # (the pose the files state: how far open, relative to the mechanism's size)
+            raw = constraints.residual(mech, start)
+            rel, index, _ = constraints.worst_closure(mech, raw * JacobianScales.of(mech).constraint_rows
+                                                      / mech.characteristic_length)
+        mech.q_reference = _inside_limits(mech, start, held, source)
+        if rel > REFERENCE_TOL:  # (where it was open: its worst closure's gap, how far the reference kept moved it)
+            gap = constraints.block_gap(mech, raw, index)
             moved = float(np.abs(pin.difference(model, start, mech.q_reference)).max())
             mech.notes += (f"the loops open by {gap:.3g} (m or rad) at the pose the files state were closed by "
                            f"assembly, which moved the joints by {moved:.3g} at most (rad or m)",)
-        mech.q_reference = _inside_limits(mech, start, held, source)
     else:
         raw = constraints.residual(mech, mech.q_reference)
         L = mech.characteristic_length
-        rel, _, closure = constraints.worst_closure(mech, raw * JacobianScales.of(mech).constraint_rows / L)
+        rel, index, closure = constraints.worst_closure(mech, raw * JacobianScales.of(mech).constraint_rows / L)
         if rel > REFERENCE_TOL:
-            gap = constraints.worst_closure(mech, raw)[0]
+            gap = constraints.block_gap(mech, raw, index)
             raise SpecError(source, f"the [reference] configuration leaves closure {closure!r} open by {gap:.3g} "
                                     f"(m or rad; {rel:.3g} relative to the mechanism's size {L:.3g} m, closed means "
                                     f"<= {REFERENCE_TOL:g}): fix it, or leave joints out of [reference] to have pkm "
