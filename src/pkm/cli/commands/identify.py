@@ -48,8 +48,8 @@ def run(args: argparse.Namespace) -> int:
     from pkm.core.identification.export import identified_mechanism, standard_from_base, validate
     from pkm.core.identification.measurements import measurements
     from pkm.core.identification.regressor import parameters
-    from pkm.core.model.plausibility import nonphysical
-    from pkm.errors import InvalidInputError, PoorIdentificationWarning, SpecError
+    from pkm.core.model.plausibility import require_physical
+    from pkm.errors import InvalidInputError, NonPhysicalInertiaError, PoorIdentificationWarning, SpecError
     from pkm.report import jsonable
 
     mech = load_mechanism(args)
@@ -72,11 +72,9 @@ def run(args: argparse.Namespace) -> int:
         theta = standard_from_base(mech, base, ls.values)
     try:
         identified = identified_mechanism(mech, theta, source=args.out)  # (what a warning is about: the file written)
-        bad = nonphysical(identified)  # (it loads for its kinematics; a model written from an estimate must be real)
-        if bad:
-            raise SpecError(args.out, "inertias no distribution of mass has: " + ", ".join(
-                f"{n!r} ({r} {v:.6g} kg m^2)" for n, r, v in bad))
-    except (SpecError, InvalidInputError) as exc:
+        # (it loads for its kinematics; a model written from an estimate must be real)
+        require_physical(identified, f"writing the identified model {args.out}")
+    except (SpecError, InvalidInputError, NonPhysicalInertiaError) as exc:
         if args.consistent:
             raise
         raise InvalidInputError("--consistent", f"the least-squares estimate is no real mechanism and cannot be "
