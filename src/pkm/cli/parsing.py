@@ -165,11 +165,6 @@ def parse_params(mechanism: str, items: Sequence[str]) -> dict[str, Any]:
 
 
 
-def joint_kind(mech: pkm.Mechanism, name: str) -> str:
-    """``"angle"`` for a revolute joint, else ``"length"``."""
-    return "angle" if mech.joints[name].revolute else "length"
-
-
 def joint_value(mech: pkm.Mechanism, name: str, text: str, order: str = "position") -> float:
     """Joint ``name``'s value of ``order`` (``"position"``, ``"rate"``, ``"effort"``) written with or without its
     unit, in SI (:func:`pkm.units.parse_joint_value`: the route the library and the service take too)."""

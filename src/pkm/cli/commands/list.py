@@ -16,10 +16,10 @@ from typing import Any
 import pkm
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_help
-from pkm.cli.parsing import joint_kind, param_info
+from pkm.cli.parsing import param_info
 from pkm.errors import PkmError
 from pkm.report import jsonable
-from pkm.units import SI_UNITS
+from pkm.units import SI_UNITS, joint_unit
 
 DEPTH = 3
 """How many folder levels below a folder ``pkm list PATH`` searches (``urdf/gepetto/robot_delta`` from ``urdf``)."""
@@ -97,7 +97,7 @@ def describe(name: str, mech: pkm.Mechanism | None = None) -> dict[str, Any]:
     out: dict[str, Any] = {"name": mech.name,
                            "title": entry.title if entry else mech.spec.description,
                            **source(name, mech),
-                           "actuated": {j: SI_UNITS[joint_kind(mech, j)] for j in mech.actuated_names},
+                           "actuated": {j: joint_unit(mech.joints[j].revolute) for j in mech.actuated_names},
                            "task": {k: SI_UNITS[kind] for k, kind in pkm.TaskMap.of(mech).kinds.items()},
                            "task_origin": entry.origin if entry else frame,
                            "reference_pose": pkm.TaskMap.of(mech).named(mech.q_reference),
