@@ -62,8 +62,9 @@ def _unit(mech: Mechanism, joint: str, kind: str = "position") -> str:
 @_per_mechanism
 def _task_units(mech: Mechanism) -> dict[str, str]:
     """The units of the task's tangent coordinates (:attr:`TaskMap.keys`: a pose's x y z roll pitch yaw)."""
-    kinds = pkm.TaskMap.of(mech).kinds
-    out = {k: ("m" if kinds.get(k) == "length" else "rad") for k in pkm.TaskMap.of(mech).keys}
+    task = pkm.TaskMap.of(mech)
+    kinds = task.kinds
+    out = {k: ("m" if kinds.get(k) == "length" else "rad") for k in task.keys}
     return out
 
 
@@ -71,8 +72,8 @@ def _task_units(mech: Mechanism) -> dict[str, str]:
 def _value_units(mech: Mechanism) -> list[str]:
     """The units of the task value's entries (:attr:`TaskMap.value_names`: a pose's x y z qx qy qz qw, whose
     quaternion is unitless, ``"1"``)."""
-    kinds = pkm.TaskMap.of(mech).kinds
-    return [("m" if kinds[k] == "length" else "rad") if k in kinds else "1" for k in pkm.TaskMap.of(mech).value_names]
+    task = pkm.TaskMap.of(mech)
+    return [("m" if task.kinds[k] == "length" else "rad") if k in task.kinds else "1" for k in task.value_names]
 
 
 def _joint_units(mech: Mechanism, which: int) -> list[str]:
@@ -381,7 +382,8 @@ def fk(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[st
     qa = _array(body, "qa", mech.na, _input_units(mech, "qa"))
     Q, residual, iterations, errors = _close(mech, qa, _seed(mech, body), kernels)
     samples = _Samples(len(qa), _is_single(body, "qa"), errors)
-    Y = [None if e is not None else pkm.TaskMap.of(mech).value(Q[k]) for k, e in enumerate(errors)]
+    task = pkm.TaskMap.of(mech)
+    Y = [None if e is not None else task.value(Q[k]) for k, e in enumerate(errors)]
     out = samples.columns({"q": Q, "y": Y, "residual": residual, "iterations": iterations})
     out["units"] = {"q": _q_units(mech), "y": _value_units(mech), "residual": "m or rad", "iterations": "1",
                     "qa": _actuated_units(mech)}
