@@ -18,8 +18,6 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
-
 from pkm.core.export.emit import c_constant, c_function
 from pkm.core.model.joints import stated_limits
 from pkm.core.transmissions.kernels import KERNELS, SOLVES, STATUS, TransmissionKernels
@@ -41,7 +39,7 @@ def c_library(tk: TransmissionKernels, p: str) -> tuple[str, str]:
    FK and IK: Newton warm-started from q (in: the previous solution, {p}_q_reference at first; out: the solution,
    written only when {U}_OK or {U}_OUTSIDE_LIMITS), {tk.iterations} iterations, converged at a closure residual of
    {tk.tol!r} [m, rad]; {U}_OUTSIDE_LIMITS: converged, but a joint (a motor, an output, a rod's) lies beyond the
-   limit the robot's file states ({p}_limit_low, {p}_limit_high per entry of q; +-HUGE_VAL where none).
+   limit the robot's file states ({p}_limit_low, {p}_limit_high per entry of q; +-INFINITY where none).
    The effort maps are the velocity maps' transposes (power balance): tau_m = J^T tau_o, tau_o = J_inv^T tau_m. */
 #ifndef {U}_H
 #define {U}_H
@@ -94,8 +92,8 @@ int {p}_fk_j_dm(const double* qm, double* q, double* qo, double* J, double* dM);
             f"const char* const {p}_q_names[{U}_NQ] = {{{', '.join(json.dumps(n) for n in q_names(tk))}}};",
             f"const char* const {p}_motor_names[{U}_K] = {{{', '.join(json.dumps(n) for n in tk.motors)}}};",
             f"const char* const {p}_output_names[{U}_K] = {{{', '.join(json.dumps(n) for n in tk.outputs)}}};",
-            f"const double {p}_limit_low[{U}_NQ] = {{{', '.join(_bound(x) for x in low)}}};",
-            f"const double {p}_limit_high[{U}_NQ] = {{{', '.join(_bound(x) for x in high)}}};", ""]
+            f"const double {p}_limit_low[{U}_NQ] = {{{', '.join(c_constant(float(x)) for x in low)}}};",
+            f"const double {p}_limit_high[{U}_NQ] = {{{', '.join(c_constant(float(x)) for x in high)}}};", ""]
     for twin in ("m", "o"):
         body.append(c_function(tk.step(twin), f"{p}_k_newton_{twin}"))
     for name in KERNELS:
@@ -187,11 +185,6 @@ int {p}_fk_j_dm(const double* qm, double* q, double* qo, double* J, double* dM) 
 }}
 """)
     return header, "\n".join(body)
-
-
-def _bound(x: float) -> str:
-    """A limit as a C constant: ``HUGE_VAL`` (``<math.h>``) for none."""
-    return c_constant(x) if np.isfinite(x) else ("HUGE_VAL" if x > 0 else "-HUGE_VAL")
 
 
 def q_names(tk: TransmissionKernels) -> list[str]:
