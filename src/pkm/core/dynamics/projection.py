@@ -473,14 +473,15 @@ def base_inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayL
     tau = _motor_efforts(mech, q, v, a, wrench, wrenches, method)
     red = actuator_space._reduce(mech, q, RTOL, "free")
     Gb = red.Gb
-    h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches)
+    r = pin.rnea(mech.model, mech.data, q, v, a)  # (a copy: _external leaves it as it is)
+    h = _external(mech, q, r, wrench, wrenches)
     w = finite_result(Gb.T @ h, "base wrench")
     needs = False
     if base == "free":
         # relative to the wrenches it sums, moments over the characteristic length (the same for any size)
         unit = np.r_[np.ones(3), np.full(3, 1.0 / mech.characteristic_length)]
         bias = pin.rnea(mech.model, mech.data, q, v, np.zeros(mech.nv))
-        parts = (Gb.T @ (red.M @ a), Gb.T @ bias, Gb.T @ (h - pin.rnea(mech.model, mech.data, q, v, a)))
+        parts = (Gb.T @ (red.M @ a), Gb.T @ bias, Gb.T @ (h - r))
         scale = sum(float(np.linalg.norm(unit * p)) for p in parts)
         needs = bool(np.linalg.norm(unit * w) > BASE_WRENCH_RTOL * scale)
     R = pin.XYZQUATToSE3(q[mech.base.idx_q:mech.base.idx_q + 7]).rotation
