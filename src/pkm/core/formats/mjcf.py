@@ -585,11 +585,11 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
     keyed = _pinocchio_values(key_qpos, kinds, dependent, continuous)
     seed = {} if keyed else {j: _value(v, j in continuous) for j, v in refs.items() if v != 0.0 and j not in dependent}
     hold: tuple[str, ...] = ()
+    base = _floating_base(model)
     if keyed and key_name == _KEY:
         reference = keyed
         notes.append(f"the reference configuration is the <keyframe><key name={_KEY!r}> (the one pkm writes)")
     elif keyed:  # another key (Menagerie's "home"): its free bodies and motors held, the passive joints closed from it
-        base = _floating_base(model)
         reference = {j: keyed[j] for j in keyed if j == base}  # (the others held where the loops allow: redundant
         hold = tuple(j for j in keyed if j != base and (kinds[j] == "free" or j in actuated))  # motors may disagree)
         seed = {j: v for j, v in keyed.items() if j != base}
@@ -603,7 +603,7 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
     if len(set(direct)) < len(direct):
         notes.append("several actuators drive the same joint: it is one input")
     springs = _springs(world, defaults, kinds, set(actuated), dependent, degrees, notes, source)
-    return Imported(urdf, tuple(closures), types, tuple(dict.fromkeys(actuated)), name, "mjcf", _floating_base(model),
+    return Imported(urdf, tuple(closures), types, tuple(dict.fromkeys(actuated)), name, "mjcf", base,
                     reference, tuple(notes), actuators, seed, springs, motors, hold)
 
 
