@@ -149,7 +149,8 @@ def _name(names: tuple[str, ...], lead: int, terms: list[tuple[int, float]]) -> 
 
 
 #: Default bound of ``|q_j - q_j,reference|`` per unit [rad or m]: an excitation's amplitude
-#: (:mod:`~pkm.core.identification.excitation`), a calibration pose's spread (:mod:`pkm.core.calibration.poses`).
+#: (:mod:`~pkm.core.identification.excitation`; a calibration pose's spread is its own,
+#: :func:`pkm.core.calibration.poses.default_spread`, in characteristic lengths for a length).
 AMPLITUDE = {"rad": 0.3, "m": 0.03}
 #: The random states' spread per unit (:func:`random_states`: the base parameters need generic states, not large ones).
 STATE_SPREAD = {"rad": 0.1, "m": 0.1}
