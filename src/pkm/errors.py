@@ -513,3 +513,22 @@ class PathError(PkmError):
         self.detail = detail
         self.joint, self.value, self.bound = joint, value, bound
         super().__init__(f"{what} {self.index} (s = {self.s:.6g}): {limit}: {detail}")
+
+
+class StiffnessError(PkmError):
+    """A stiffness question with no finite answer (:func:`pkm.stiffness`): a motion that no spring resists moves the
+    end effector (``"free"``: the mechanism yields under a load), or the end effector cannot move along some
+    directions at all (``"rigid"``: its stiffness there is infinite: the links are rigid and the mechanism has fewer
+    degrees of freedom than six).
+
+    Attributes:
+        kind: ``"free"`` or ``"rigid"``.
+        joints: For ``"free"``: the joints the unresisted motion moves; else empty.
+        rank: The rank of the end effector's compliance (0 to 6).
+    """
+
+    def __init__(self, kind: str, message: str, joints: Iterable[str] = (), rank: int = 0):
+        self.kind = kind
+        self.joints = tuple(joints)
+        self.rank = int(rank)
+        super().__init__(message)

@@ -1,0 +1,462 @@
+r"""Joint compliance of a closed-loop mechanism with rigid links (the virtual-joint model): the Cartesian stiffness at
+the end effector, the deflection under a constant wrench, the natural frequencies.
+
+**The model.** Each one-coordinate joint is
+
+* *sprung*: a spring of stiffness :math:`k_j` [N m/rad, N/m] about its value in ``q``: the stiffness given in
+  ``joints=`` (a drive's servo stiffness, an axial leg spring), else its ``[springs.<joint>]`` stiffness in the spec
+  (:mod:`pkm.core.model.springs`);
+* *locked*: an actuated joint given no stiffness (a position-controlled drive taken as rigid);
+* *free*: any other joint (a passive joint with no spring); joints of several coordinates (spherical, universal
+  written as one joint, a floating base) are free.
+
+The links are rigid. At a closed ``q``, the motions the closures and the locked joints leave are the null space
+:math:`N` (nv x d) of :math:`[J_c; E]` (:math:`E` selects the locked joints), taken on the Jacobians homogenised by
+the characteristic length :math:`L` (:mod:`pkm.core.model.scale`), so that every rank decision is scale-free. On
+them the elastic energy is :math:`\tfrac12 s^\top H s`, :math:`H = N^\top K N` with :math:`K = \mathrm{diag}(k_j)`,
+and a wrench :math:`W = (f, m)` at the end effector's origin (world axes) does the work :math:`W^\top T s` with
+:math:`T = J_{ee} N`. Equilibrium, :math:`H s = T^\top W`, gives the end effector's small displacement
+:math:`\delta x = (\delta p, \delta\theta) = C W` with the compliance
+
+.. math:: C = T H^{+} T^\top
+
+provided every motion no spring resists (the kernel of :math:`H`: idle motions, free joints) leaves the end effector
+where it is; else a load moves the mechanism freely (:class:`~pkm.errors.StiffnessError` ``"free"``). The stiffness
+:math:`K_x = C^{-1}` exists where :math:`C` has full rank (six degrees of freedom resisted by springs); a mechanism
+with fewer is rigid along the others (``"rigid"``): the compliance, its rank and the principal stiffnesses (``inf``
+along rigid directions) still answer. With one axial spring per leg of a Gough-Stewart platform and every other
+joint free, :math:`K_x` is Gosselin's :math:`J^\top \mathrm{diag}(k) J` (tested against the legs' own geometry).
+
+**Assumptions** (stated in every result): ``q`` is the unloaded equilibrium, each spring at rest there (a spec
+spring's ``rest`` elsewhere preloads it: warned, its internal forces' geometric stiffness left out); gravity is not
+counted (add the weights to the wrench where they matter); links are rigid (beam compliance of the links is not
+modelled yet). :meth:`Stiffness.deflection` solves the exact large-displacement equilibrium under a constant wrench
+(the forces along the deflected members, hence the geometric stiffness of the loaded mode), with the first-order
+:math:`C W` beside it and their gap.
+
+**Vibrations.** :func:`vibration_modes`: the generalised eigenproblem :math:`H v = \omega^2 N^\top M N v` on the
+same motions (:math:`M` Pinocchio's joint-space mass matrix with the drives' reflected inertia), massless
+directions condensed statically; the motions no spring resists are counted as free (zero frequency), not listed.
+Checked against the linearised forward dynamics (:func:`pkm.forward_dynamics` with the springs' efforts).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from pkm.core.differential.idle import MASSLESS, joint_inertia
+from pkm.core.kinematics.configuration import Configuration
+from pkm.core.kinematics.constraints import check_closed
+from pkm.core.kinematics.newton import gauss_newton
+from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
+from pkm.errors import InvalidInputError, PkmWarning, StiffnessError, UnknownNameError
+from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
+
+#: Rank decisions (motions, stiffnesses, compliance) relative to the largest singular value or eigenvalue, on the
+#: homogenised matrices.
+RTOL = 1e-9
+#: The exact deflection's equilibrium is solved to this, relative (forces to the wrench, closures to ``L``).
+DEFLECTION_TOL = 1e-12
+#: Load steps at most when the full wrench does not converge at once (halved increments).
+MAX_LOAD_STEPS = 64
+
+
+@dataclass(frozen=True)
+class _Springs:
+    """Which joints are sprung, locked or free, at one configuration, and the motions they leave."""
+
+    mech: Mechanism
+    q: np.ndarray
+    k: np.ndarray  # (nv,) the joint stiffness on its velocity coordinate, 0 where none
+    sprung: dict[str, float]
+    locked: tuple[str, ...]
+    E: np.ndarray  # (n_locked, nv) rows selecting the locked joints
+    N: np.ndarray  # (nv, d) the motions the closures and the locked joints leave, in joint rates
+    H: np.ndarray  # (d, d) N^T K N
+    T: np.ndarray  # (6, d) J_ee N
+    length: float
+    columns: np.ndarray  # (nv,) the homogenising column factors (L for a length)
+
+
+def _joint_stiffness(mech: Mechanism, joints: Mapping[str, object] | None) -> dict[str, float]:
+    """``{joint: k}``: the spec's springs, then ``joints`` over them; each a one-coordinate joint, ``k >= 0`` finite."""
+    given: dict[str, float] = {n: float(t.get("stiffness", 0.0)) for n, t in mech.spec.springs.items()}
+    if joints is not None:
+        if not isinstance(joints, Mapping):
+            raise InvalidInputError("joints", "expected a mapping {joint: stiffness} [N m/rad or N/m]", joints)
+        for name, value in joints.items():
+            if name not in mech.joints:
+                raise UnknownNameError("joint", str(name), mech.joints, mech.name)
+            if mech.joints[name].nv != 1:
+                raise InvalidInputError("joints", f"{name!r} has {mech.joints[name].nv} coordinates: a spring "
+                                                  "stiffness is for a one-coordinate joint (revolute, prismatic)", name)
+            given[name] = as_scalar(value, f"joints[{name!r}]", low=0.0)
+    return given
+
+
+def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None, rtol: float) -> _Springs:
+    mech = check_mechanism(mech)
+    q = mech.check_q(q)
+    check_closed(mech, q)
+    given = _joint_stiffness(mech, joints)
+    sprung = {n: k for n, k in given.items() if k > 0.0}
+    locked = tuple(j.name for j in mech.actuated if j.name not in given)
+    k = np.zeros(mech.nv)
+    for n, value in sprung.items():
+        k[mech.joints[n].idx_v] = value
+    E = np.zeros((len(locked), mech.nv))
+    for row, n in enumerate(locked):
+        E[row, mech.joints[n].idx_v] = 1.0
+    _preloaded(mech, q, sprung)
+    c = Configuration.compute(mech, q)
+    scales = JacobianScales.of(mech)
+    A = np.vstack([scales.constraint(c.constraint_jacobian), E])  # (a locked row is unit in either coordinates)
+    _, s, Vt = np.linalg.svd(A) if A.size else (None, np.zeros(0), np.eye(mech.nv))
+    rank = int(np.sum(s > rtol * s[0])) if s.size and s[0] > 0.0 else 0
+    N = scales.columns[:, None] * Vt[rank:].T
+    return _Springs(mech, q, k, sprung, locked, E, N, N.T @ (k[:, None] * N), c.ee_jacobian @ N,
+                    mech.characteristic_length, scales.columns)
+
+
+def _preloaded(mech: Mechanism, q: np.ndarray, sprung: Mapping[str, float]) -> None:
+    """Warn where a spec spring's rest lies elsewhere than ``q`` puts its joint (a preload left out: module doc)."""
+    off = []
+    for n in sprung:
+        rest = mech.spec.springs.get(n, {}).get("rest")
+        if rest is None:
+            continue
+        j = mech.joints[n]
+        value = float(q[j.idx_q])
+        tol = 1e-9 * (1.0 if j.revolute else mech.characteristic_length)
+        if abs(value - rest) > tol:
+            off.append(f"{n} ({value:.6g} against its rest {rest:.6g})")
+    if off:
+        warnings.warn(PkmWarning(f"{mech.name}: springs not at rest in q: {', '.join(off)}; the stiffness is taken "
+                                 "about q, their preload's geometric stiffness left out"), stacklevel=4)
+
+
+def _homogeneous_rows(L: float) -> np.ndarray:
+    """Factors of a twist ``(v, w)`` (or of a compliance's rows) that make every entry a length: ``w`` times ``L``."""
+    return np.array([1.0, 1.0, 1.0, L, L, L])
+
+
+def _resisted(sp: _Springs, rtol: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(w, V)``: the eigenvalues [N m] and eigenvectors of ``H`` over the motions some spring resists (the motion
+    coordinates are homogeneous: ``N`` is the homogenised null space's orthonormal basis times the column factors,
+    so ``H``'s entries are all N m), after checking that no other motion moves the end effector.
+
+    Raises:
+        StiffnessError: ``"free"``, naming the joints of the unresisted motion that moves the end effector most.
+    """
+    w, V = np.linalg.eigh(sp.H) if sp.H.size else (np.zeros(0), np.zeros((0, 0)))
+    top = float(np.max(w, initial=0.0))
+    keep = w > rtol * top if top > 0.0 else np.zeros(len(w), dtype=bool)
+    free = V[:, ~keep]
+    Th = _homogeneous_rows(sp.length)[:, None] * sp.T
+    scale = float(np.linalg.norm(Th, 2)) if Th.size else 0.0
+    if free.shape[1] and scale > 0.0:
+        moved = np.linalg.norm(Th @ free, axis=0)
+        worst = int(np.argmax(moved))
+        if moved[worst] > math.sqrt(rtol) * scale:
+            motion = (sp.N / sp.columns[:, None]) @ free[:, worst]
+            big = 1e-6 * float(np.max(np.abs(motion)))
+            names = [j.name for j in sp.mech.joints.values()
+                     if j.nv and float(np.max(np.abs(motion[j.idx_v:j.idx_v + j.nv]))) > big]
+            raise StiffnessError("free", f"{sp.mech.name}: a motion no spring resists moves the end effector (it "
+                                         f"moves {', '.join(names)}): give one of those joints a stiffness "
+                                         "(joints=...), or leave the actuators out of joints= to lock them", names)
+    return w[keep], V[:, keep]
+
+
+def _rank(C: np.ndarray, length: float, rtol: float) -> int:
+    """The rank of a compliance, decided on its homogenised form (twist ``(v, w L)``, wrench ``(f, m / L)``)."""
+    R = _homogeneous_rows(length)
+    e = np.linalg.eigvalsh(R[:, None] * C * R[None, :])
+    top = float(np.max(e, initial=0.0))
+    return int(np.sum(e > rtol * top)) if top > 0.0 else 0
+
+
+def _wrench(value: ArrayLike) -> np.ndarray:
+    """A wrench ``(f [N], m [N m])`` at the end effector's origin, world axes (6,), finite."""
+    return as_vector(value, 6, "wrench")
+
+
+@dataclass(frozen=True)
+class Deflection:
+    """The end effector's displacement under a constant wrench (:meth:`Stiffness.deflection`).
+
+    Attributes:
+        q: The deflected equilibrium configuration (nq,).
+        displacement: The exact displacement ``(dp [m], dtheta [rad])``: the origin's move and the rotation vector of
+            ``R R0^T`` (world axes).
+        first_order: The small-displacement prediction ``C W``, same layout.
+        gap: ``|displacement - first_order|`` over ``|displacement|``, each homogenised by ``L`` (the first-order
+            model's relative error at this load).
+        load_steps: The load increments the equilibrium was followed in (1: the full wrench at once).
+    """
+
+    q: np.ndarray
+    displacement: np.ndarray
+    first_order: np.ndarray
+    gap: float
+    load_steps: int
+
+
+@dataclass(frozen=True)
+class Stiffness:
+    """The end effector's stiffness at a configuration (:func:`stiffness`; module doc).
+
+    Attributes:
+        compliance: ``C`` (6 x 6): the small displacement ``(dp, dtheta)`` per wrench ``(f, m)`` at the end
+            effector's origin, world axes [m/N, m/(N m); rad/N, rad/(N m)].
+        rank: The rank of ``C`` (6: every direction resisted by springs; fewer: rigid along the others).
+        sprung: ``{joint: stiffness}`` of the springs counted [N m/rad or N/m].
+        locked: The actuated joints held rigid (given no stiffness).
+        q: The configuration (nq,).
+    """
+
+    compliance: np.ndarray
+    rank: int
+    sprung: Mapping[str, float]
+    locked: tuple[str, ...]
+    q: np.ndarray
+    _springs: _Springs = field(repr=False, compare=False)
+    _rtol: float = field(repr=False, compare=False, default=RTOL)
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """``K = C^-1`` (6 x 6), twist order ``(v, w)``, at the end effector's origin, world axes [N/m, N/rad;
+        N m/m, N m/rad].
+
+        Raises:
+            StiffnessError: ``"rigid"`` where ``rank < 6`` (the stiffness is infinite along some directions: use
+                :attr:`compliance` or :meth:`principal`).
+        """
+        if self.rank < 6:
+            raise StiffnessError("rigid", f"{self._springs.mech.name}: the end effector's compliance has rank "
+                                          f"{self.rank} of 6: it is rigid along {6 - self.rank} directions (rigid "
+                                          "links, locked drives or fewer degrees of freedom than six), where the "
+                                          "stiffness is infinite; read .compliance, or .principal()", rank=self.rank)
+        return finite_result(np.linalg.inv(self.compliance), "stiffness matrix")
+
+    def principal(self, load: str = "force") -> tuple[np.ndarray, np.ndarray]:
+        """The principal stiffnesses and their directions under a pure force (``load="force"``: ``1 / eig(C_vf)``
+        [N/m], the translational block) or a pure moment (``"moment"``: ``1 / eig(C_wm)`` [N m/rad]), stiffest
+        last; ``inf`` along a direction the end effector cannot move.
+
+        Returns:
+            ``(k, directions)``: ``k`` (3,), ascending; the unit directions as columns (3 x 3), world axes.
+        """
+        if load not in ("force", "moment"):
+            raise InvalidInputError("load", "'force' or 'moment'", load)
+        block = self.compliance[:3, :3] if load == "force" else self.compliance[3:, 3:]
+        c, U = np.linalg.eigh(block)
+        top = float(np.max(c, initial=0.0))
+        with np.errstate(divide="ignore"):
+            k = np.where(c > self._rtol * top, 1.0 / np.where(c > 0.0, c, 1.0), np.inf) if top > 0.0 \
+                else np.full(3, np.inf)
+        return k[::-1].copy(), U[:, ::-1].copy()
+
+    def deflection(self, wrench: ArrayLike, *, tol: float = DEFLECTION_TOL) -> Deflection:
+        """The exact equilibrium under the constant wrench ``(f [N], m [N m])`` at the end effector's origin, world
+        axes (large displacements: the springs' forces and the wrench at the deflected configuration), with the
+        first-order ``C W`` beside it (module doc).
+
+        The equilibrium ``K (q - q0) = J_ee(q)^T W + J_c(q)^T lambda + E^T mu`` with the closures and the locked
+        joints held is solved by Newton's method on the configuration manifold (its Jacobian by central differences:
+        the residual is exact to ``tol`` whatever their accuracy), the load applied in halved increments where the
+        whole does not converge.
+
+        Raises:
+            ConvergenceError: no equilibrium within :data:`MAX_LOAD_STEPS` increments (a load past what the springs
+                hold: the mechanism snaps through, or leaves its workspace).
+        """
+        W = _wrench(wrench)
+        tol = as_tolerance(tol, "tol")
+        sp = self._springs
+        q, steps = _equilibrium(sp, W, tol)
+        first = self.compliance @ W
+        exact = _displacement(sp, q)
+        R = _homogeneous_rows(sp.length)
+        size = float(np.linalg.norm(R * exact))
+        gap = float(np.linalg.norm(R * (exact - first))) / size if size > 0.0 else 0.0
+        return Deflection(q, exact, first, gap, steps)
+
+
+def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: str = "rigid",
+              rtol: float = RTOL) -> Stiffness:
+    """The end effector's stiffness at the closed configuration ``q`` (module doc: the model and its assumptions).
+
+    Args:
+        mech: The mechanism.
+        q: A closed configuration (nq,): the unloaded equilibrium.
+        joints: ``{joint: stiffness}`` [N m/rad for a revolute, N/m for a prismatic joint], over the spec's
+            ``[springs.<joint>]``: a drive's servo stiffness, a leg's axial stiffness; ``0`` frees a joint. An
+            actuated joint left out is locked (rigid).
+        links: ``"rigid"`` (the only model yet: link compliance is not modelled).
+        rtol: Rank decisions, relative, on homogenised matrices.
+
+    Raises:
+        StiffnessError: ``"free"``: a motion no spring resists moves the end effector.
+        InvalidInputError: ``q`` not closed; a stiffness not finite or negative; a joint of several coordinates;
+            ``links`` other than ``"rigid"``.
+        UnknownNameError: a joint that does not exist.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> gs = pkm.load("gough_stewart")
+        >>> legs = {j: 1e6 for j in gs.actuated_names}  # N/m: one axial spring per leg
+        >>> K = pkm.stiffness(gs, gs.q_reference, joints=legs)
+        >>> K.rank, round(float(K.matrix[2, 2]) / 1e6, 3)  # vertical stiffness [MN/m]
+        (6, 5.274)
+    """
+    if links != "rigid":
+        raise InvalidInputError("links", "only 'rigid' links are modelled yet (joint compliance: joints=...)", links)
+    rtol = as_tolerance(rtol, "rtol")
+    sp = _springs(mech, q, joints, rtol)
+    w, V = _resisted(sp, rtol)
+    TV = sp.T @ V
+    C = finite_result((TV / w) @ TV.T if len(w) else np.zeros((6, 6)), "compliance")
+    C = 0.5 * (C + C.T)
+    return Stiffness(C, _rank(C, sp.length, rtol), dict(sp.sprung), sp.locked, sp.q.copy(), sp, rtol)
+
+
+def _pose(sp: _Springs, q: np.ndarray) -> pin.SE3:
+    m, d = sp.mech.model, sp.mech.data
+    pin.framesForwardKinematics(m, d, q)
+    return d.oMf[sp.mech.ee_frame].copy()
+
+
+def _displacement(sp: _Springs, q: np.ndarray) -> np.ndarray:
+    """``(p - p0, log(R R0^T))`` of the end effector from ``sp.q`` to ``q`` (world axes)."""
+    a, b = _pose(sp, sp.q), _pose(sp, q)
+    return np.concatenate([b.translation - a.translation, pin.log3(b.rotation @ a.rotation.T)])
+
+
+def _equilibrium(sp: _Springs, W: np.ndarray, tol: float) -> tuple[np.ndarray, int]:
+    """The deflected configuration under ``W`` and the load increments taken (:meth:`Stiffness.deflection`).
+
+    Unknowns: ``q`` (its steps homogenised: a prismatic joint's in ``L``) and the multipliers of the closures and the
+    locked joints, scaled by the load's size (``energy / L``, a rotation row's and a revolute's times ``L``), so that
+    every unknown and every residual is a pure number and Newton's step bound means the same on any robot."""
+    from pkm.errors import ConvergenceError
+
+    mech, m = sp.mech, sp.mech.model
+    nv, nq, nc, ne = mech.nv, mech.nq, mech.n_constraints, len(sp.locked)
+    L, cols = sp.length, sp.columns
+    energy = max(float(np.max(np.abs(W[:3]))) * L, float(np.max(np.abs(W[3:]))), 1e-300)  # [N m]
+    rows = JacobianScales.of(mech).constraint_rows
+    unit = np.concatenate([rows * energy / L, energy / (sp.E @ cols) if ne else np.zeros(0)])  # (multipliers)
+
+    def residual(q: np.ndarray, lam: np.ndarray, Wk: np.ndarray) -> np.ndarray:
+        c = Configuration.compute(mech, q)
+        dq = pin.difference(m, sp.q, q)
+        mu = lam * unit
+        force = sp.k * dq - c.ee_jacobian.T @ Wk - c.constraint_jacobian.T @ mu[:nc] - sp.E.T @ mu[nc:]
+        return np.concatenate([cols * force / energy, rows * c.residual[:nc] / L, sp.E @ (dq / cols)])
+
+    def solve(q: np.ndarray, lam: np.ndarray, Wk: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        def fun(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            qx, lx = x[:nq], x[nq:]
+            r = residual(qx, lx, Wk)
+            J = np.empty((len(r), nv + nc + ne))
+            h = 1e-6
+            for i in range(nv):
+                e = np.zeros(nv)
+                e[i] = h * cols[i]
+                J[:, i] = (residual(pin.integrate(m, qx, e), lx, Wk) - residual(pin.integrate(m, qx, -e), lx, Wk)) \
+                    / (2.0 * h)
+            for i in range(nc + ne):
+                e = np.zeros(nc + ne)
+                e[i] = 1.0
+                J[:, nv + i] = residual(qx, lx + e, Wk) - r  # (linear in the multipliers: exact)
+            return r, J
+
+        def retract(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
+            return np.concatenate([pin.integrate(m, x[:nq], cols * dx[:nv]), x[nq:] + dx[nv:]])
+
+        x, res, _ = gauss_newton(fun, np.concatenate([q, lam]), tol=tol, max_iter=50, max_step=0.1,
+                                 retract=retract)
+        return x[:nq], x[nq:], res
+
+    q, lam, res = sp.q.copy(), np.zeros(nc + ne), math.inf
+    steps = 1
+    while steps <= MAX_LOAD_STEPS:
+        qk, lk, ok = q, lam, True
+        for i in range(1, steps + 1):
+            qk, lk, res = solve(qk, lk, W * i / steps)
+            if not res <= tol:
+                ok = False
+                break
+        if ok:
+            return qk, steps
+        steps *= 2
+    raise ConvergenceError("deflection under the wrench", res, 50, tol, None,
+                           f"no equilibrium in {MAX_LOAD_STEPS} load increments: the springs do not hold this load "
+                           "near q (snap-through, or past the workspace)")
+
+
+@dataclass(frozen=True)
+class VibrationModes:
+    """The small free vibrations about a configuration (:func:`vibration_modes`; module doc).
+
+    Attributes:
+        frequencies: The natural frequencies [Hz], ascending (the motions some spring resists).
+        shapes: Their mode shapes as joint rates (nv x k), each of unit modal mass (``v^T M v = 1``).
+        twists: The end effector's twist ``(v, w)`` of each shape (6 x k).
+        free: How many motions no spring resists (zero frequency: idle motions, free joints), not listed.
+    """
+
+    frequencies: np.ndarray
+    shapes: np.ndarray
+    twists: np.ndarray
+    free: int
+
+
+def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None,
+                    rtol: float = RTOL) -> VibrationModes:
+    """The natural frequencies and mode shapes at the closed configuration ``q`` with the springs of
+    :func:`stiffness` (same ``joints``; the locked drives held): ``H v = w^2 N^T M N v`` (module doc).
+
+    Examples:
+        >>> import pkm
+        >>> gs = pkm.load("gough_stewart")
+        >>> modes = pkm.vibration_modes(gs, gs.q_reference, joints={j: 1e6 for j in gs.actuated_names})
+        >>> modes.frequencies.round(1)  # [Hz]: sway (twice), heave, tilt (twice), twist
+        array([ 29. ,  29. ,  51.3, 130.2, 158.6, 158.6])
+    """
+    from scipy.linalg import eigh
+
+    rtol = as_tolerance(rtol, "rtol")
+    sp = _springs(mech, q, joints, rtol)
+    Ms = sp.N.T @ joint_inertia(sp.mech, sp.q) @ sp.N
+    Ms = 0.5 * (Ms + Ms.T)
+    H = sp.H
+    m, U = np.linalg.eigh(Ms) if Ms.size else (np.zeros(0), np.zeros((0, 0)))
+    massive = m > MASSLESS * max(float(np.max(m, initial=0.0)), 1e-300)
+    Ua, Ub = U[:, massive], U[:, ~massive]
+    Haa, Hab, Hbb = Ua.T @ H @ Ua, Ua.T @ H @ Ub, Ub.T @ H @ Ub
+    Hc = Haa - Hab @ np.linalg.pinv(Hbb, rcond=rtol, hermitian=True) @ Hab.T  # (massless motions: static)
+    Hc = 0.5 * (Hc + Hc.T)
+    w2, Va = eigh(Hc, Ua.T @ Ms @ Ua) if Hc.size else (np.zeros(0), np.zeros((0, 0)))
+    top = float(np.max(np.abs(w2), initial=0.0))
+    resisted = w2 > rtol * top if top > 0.0 else np.zeros(len(w2), dtype=bool)
+    s = Ua @ Va[:, resisted]
+    if Ub.shape[1]:
+        s = s - Ub @ (np.linalg.pinv(Hbb, rcond=rtol, hermitian=True) @ (Hab.T @ Va[:, resisted]))
+    h = np.linalg.eigvalsh(H) if H.size else np.zeros(0)
+    free = int(np.sum(h <= rtol * float(np.max(h, initial=0.0)))) if h.size else 0
+    return VibrationModes(np.sqrt(w2[resisted]) / (2.0 * math.pi), sp.N @ s, sp.T @ s, free)
+
+
+__all__ = ["DEFLECTION_TOL", "MAX_LOAD_STEPS", "RTOL", "Deflection", "Stiffness", "VibrationModes", "stiffness",
+           "vibration_modes"]

@@ -1,0 +1,142 @@
+"""pkm.core.compliance.stiffness: the Gough-Stewart's stiffness is Gosselin's J^T diag(k) J from the legs' own
+geometry, its exact deflection the equilibrium of the legs' forces solved by another solver, its natural frequencies
+the linearised forward dynamics'; a Delta's compliance has rank 3 and says so; bad input is refused by name."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from scipy.optimize import root
+
+import pkm
+from pkm.core.compliance import stiffness, vibration_modes
+from pkm.errors import InvalidInputError, StiffnessError, UnknownNameError
+
+K_LEG = 2.0e6  # N/m: one axial spring per leg
+
+
+@pytest.fixture(scope="module")
+def gs():
+    return pkm.load("gough_stewart")
+
+
+@pytest.fixture(scope="module")
+def pose(gs):
+    """A configuration away from the reference: the legs 1 to 3 cm longer or shorter (the platform moved and tilted)."""
+    return pkm.close_loops(gs, gs.actuated_q(gs.q_reference) + [0.02, -0.01, 0.03, 0.0, 0.015, -0.02]).q
+
+
+def _legs(gs, q):
+    """``(b, p, P)``: each leg's base and platform anchors and the platform's origin (world), from the model."""
+    m, d = gs.model, gs.data
+    pin.forwardKinematics(m, d, q)
+    pin.updateFramePlacements(m, d)
+    b = np.array([d.oMi[m.getJointId(f"u{i}")].translation for i in range(1, 7)])
+    p = np.array([(d.oMi[cm.joint2_id] * cm.joint2_placement).translation for cm in gs.constraint_models])
+    return b, p, d.oMf[gs.ee_frame].translation.copy(), d.oMf[gs.ee_frame].rotation.copy()
+
+
+def test_the_gough_stewart_stiffness_is_gosselins(gs, pose):
+    """K = sum k r_i r_i^T, r_i = (u_i, (p_i - P) x u_i) from the anchors (Gosselin 1990), within 1e-9 relative,
+    at a pose away from the reference; the compliance is its inverse."""
+    K = stiffness(gs, pose, joints={j: K_LEG for j in gs.actuated_names})
+    b, p, P, _ = _legs(gs, pose)
+    u = (p - b) / np.linalg.norm(p - b, axis=1)[:, None]
+    r = np.hstack([u, np.cross(p - P, u)])
+    gosselin = K_LEG * r.T @ r
+    assert K.rank == 6 and not K.locked and set(K.sprung) == set(gs.actuated_names)
+    assert np.abs(K.matrix - gosselin).max() <= 1e-9 * np.abs(gosselin).max()
+    assert np.allclose(K.compliance @ gosselin, np.eye(6), atol=1e-9)
+    k, directions = K.principal("force")
+    assert np.all(np.diff(k) >= 0) and np.allclose(directions.T @ directions, np.eye(3), atol=1e-12)
+    c = np.linalg.eigvalsh(K.compliance[:3, :3])  # (a pure force: the platform may turn)
+    assert np.allclose(np.sort(1.0 / c), k, rtol=1e-12)
+
+
+def test_the_exact_deflection_is_the_legs_equilibrium(gs, pose):
+    """Under a constant wrench, the deflected pose balances the legs' spring forces and the wrench, solved over the
+    platform's pose by scipy's hybrid method from the anchors alone: within 1e-8 relative; the first-order C W
+    differs by the reported gap, which grows with the load."""
+    K = stiffness(gs, pose, joints={j: K_LEG for j in gs.actuated_names})
+    b, p0, P0, R0 = _legs(gs, pose)
+    local = (p0 - P0) @ R0  # (the anchors in the platform's frame)
+    l0 = np.linalg.norm(p0 - b, axis=1)
+    gaps = []
+    for W in (np.array([300.0, -200.0, -1500.0, 20.0, -10.0, 30.0]), np.array([3e4, -2e4, -1.5e5, 2e3, -1e3, 3e3])):
+        def balance(x, W=W):
+            P, R = P0 + x[:3], pin.exp3(x[3:]) @ R0
+            p = P + local @ R.T
+            leg = p - b
+            length = np.linalg.norm(leg, axis=1)
+            force = -K_LEG * (length - l0)[:, None] * leg / length[:, None]  # (on the platform)
+            return np.concatenate([force.sum(0) + W[:3], np.cross(p - P, force).sum(0) + W[3:]]) / np.abs(W).max()
+
+        sol = root(balance, K.compliance @ W, method="hybr", options={"xtol": 1e-14})
+        assert np.abs(balance(sol.x)).max() < 1e-12
+        d = K.deflection(W)
+        assert d.load_steps >= 1 and not gs.outside_limits(d.q)
+        assert np.abs(d.displacement - sol.x).max() <= 1e-8 * np.abs(sol.x).max()
+        assert np.allclose(d.first_order, K.compliance @ W)
+        gaps.append(d.gap)
+    assert 1e-5 < gaps[0] < gaps[1] < 1.0
+
+
+def test_the_natural_frequencies_are_the_linearised_dynamics(gs, pose):
+    """Without gravity, the legs' springs as efforts -k (l - l0) on the actuated joints: the eigenvalues of the
+    forward dynamics linearised by central differences (each side closed by pkm.close_loops) are -w^2 of
+    vibration_modes' frequencies, within 1e-5 relative; each mode shape has unit modal mass."""
+    mech = pkm.load("gough_stewart")
+    mech.model.gravity = pin.Motion.Zero()
+    modes = vibration_modes(mech, pose, joints={j: K_LEG for j in mech.actuated_names})
+    qa0 = mech.actuated_q(pose)
+    h = 1e-6
+    A = np.empty((mech.na, mech.na))
+    for i in range(mech.na):
+        side = []
+        for sign in (1.0, -1.0):
+            qa = qa0 + sign * h * np.eye(mech.na)[i]
+            q = pkm.close_loops(mech, qa, pose).q
+            side.append(pkm.forward_dynamics(mech, q, np.zeros(mech.na), -K_LEG * (qa - qa0))[mech.act_v])
+        A[:, i] = (side[0] - side[1]) / (2 * h)
+    f = np.sort(np.sqrt(-np.linalg.eigvals(A).real)) / (2 * math.pi)
+    assert modes.free == 0 and len(modes.frequencies) == 6
+    assert np.allclose(modes.frequencies, f, rtol=1e-5)
+    M = pkm.core.differential.idle.joint_inertia(mech, pose)
+    assert np.allclose(np.diag(modes.shapes.T @ M @ modes.shapes), 1.0, rtol=1e-9)
+
+
+def test_a_three_degree_of_freedom_delta_is_rigid_in_rotation_and_says_so():
+    """The Delta's motors as springs: a compliance of rank 3 (translations only), .matrix refused naming the rank,
+    principal stiffnesses finite under a force and infinite under a moment; its drives left out: all locked, the
+    compliance zero."""
+    delta = pkm.load("delta")
+    K = stiffness(delta, delta.q_reference, joints={j: 500.0 for j in delta.actuated_names})
+    assert K.rank == 3
+    with pytest.raises(StiffnessError, match="rank 3 of 6") as err:
+        _ = K.matrix
+    assert err.value.kind == "rigid" and err.value.rank == 3
+    assert np.all(np.isfinite(K.principal("force")[0])) and np.all(np.isinf(K.principal("moment")[0]))
+    locked = stiffness(delta, delta.q_reference)
+    assert locked.rank == 0 and set(locked.locked) == set(delta.actuated_names) and not locked.compliance.any()
+
+
+def test_a_motion_no_spring_resists_and_bad_input_are_refused(gs, pose):
+    legs = {j: K_LEG for j in gs.actuated_names}
+    with pytest.raises(StiffnessError, match="no spring resists") as err:
+        stiffness(gs, pose, joints={**legs, "leg3": 0.0})
+    assert err.value.kind == "free" and "leg3" in err.value.joints
+    with pytest.raises(UnknownNameError):
+        stiffness(gs, pose, joints={"leg7": 1.0})
+    with pytest.raises(InvalidInputError, match="one-coordinate"):
+        stiffness(gs, pose, joints={"u1": 1.0})
+    with pytest.raises(InvalidInputError):
+        stiffness(gs, pose, joints={"leg1": -1.0})
+    with pytest.raises(InvalidInputError, match="not closed"):
+        stiffness(gs, pin.integrate(gs.model, pose, np.r_[np.zeros(6), 0.01, np.zeros(gs.nv - 7)]), joints=legs)
+    with pytest.raises(InvalidInputError, match="rigid"):
+        stiffness(gs, pose, joints=legs, links="beams")
+    with pytest.raises(InvalidInputError):
+        stiffness(gs, pose, joints=legs).deflection([1.0, 2.0, math.nan, 0, 0, 0])
