@@ -25,6 +25,7 @@ from pkm.cli.commands import (
     serve,
     simulate,
     spec,
+    stiffness,
     sweep,
     transmission,
 )
@@ -45,6 +46,7 @@ COMMANDS: dict[str, Command] = {
     "calibrate": calibrate.COMMAND,
     "calibrate plan": calibrate.PLAN,
     "capability": capability.COMMAND,
+    "stiffness": stiffness.COMMAND,
     "export": export.COMMAND,
     "convert": convert.COMMAND,
     "spec": spec.COMMAND,

@@ -54,10 +54,11 @@ from numpy.typing import ArrayLike
 from pkm.core.differential.idle import MASSLESS, joint_inertia
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.kinematics.constraints import check_closed
+from pkm.core.kinematics.labels import mode_label
 from pkm.core.kinematics.newton import gauss_newton
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.scale import JacobianScales
-from pkm.errors import InvalidInputError, PkmWarning, StiffnessError, UnknownNameError
+from pkm.errors import InvalidInputError, ModeChangeWarning, PkmWarning, StiffnessError, UnknownNameError
 from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
 
 #: Rank decisions (motions, stiffnesses, compliance) relative to the largest singular value or eigenvalue, on the
@@ -134,8 +135,8 @@ def _preloaded(mech: Mechanism, q: np.ndarray, sprung: Mapping[str, float]) -> N
         if rest is None:
             continue
         j = mech.joints[n]
-        value = float(q[j.idx_q])
-        tol = 1e-9 * (1.0 if j.revolute else mech.characteristic_length)
+        value = float(q[j.idx_q]) if j.nq == 1 else math.atan2(q[j.idx_q + 1], q[j.idx_q])  # (an unbounded revolute)
+        tol = 1e-9 * (mech.characteristic_length if j.kind.startswith("JointModelP") else 1.0)
         if abs(value - rest) > tol:
             off.append(f"{n} ({value:.6g} against its rest {rest:.6g})")
     if off:
@@ -171,8 +172,8 @@ def _resisted(sp: _Springs, rtol: float) -> tuple[np.ndarray, np.ndarray]:
             names = [j.name for j in sp.mech.joints.values()
                      if j.nv and float(np.max(np.abs(motion[j.idx_v:j.idx_v + j.nv]))) > big]
             raise StiffnessError("free", f"{sp.mech.name}: a motion no spring resists moves the end effector (it "
-                                         f"moves {', '.join(names)}): give one of those joints a stiffness "
-                                         "(joints=...), or leave the actuators out of joints= to lock them", names)
+                                         f"moves {', '.join(names)}): give one of those joints a stiffness, or "
+                                         "hold the actuators rigid (give them none)", names)
     return w[keep], V[:, keep]
 
 
@@ -201,6 +202,7 @@ class Deflection:
         gap: ``|displacement - first_order|`` over ``|displacement|``, each homogenised by ``L`` (the first-order
             model's relative error at this load).
         load_steps: The load increments the equilibrium was followed in (1: the full wrench at once).
+        outside_limits: The joints ``q`` puts outside their position limits (empty: none).
     """
 
     q: np.ndarray
@@ -208,6 +210,7 @@ class Deflection:
     first_order: np.ndarray
     gap: float
     load_steps: int
+    outside_limits: tuple[str, ...]
 
 
 @dataclass(frozen=True)
@@ -244,7 +247,8 @@ class Stiffness:
             raise StiffnessError("rigid", f"{self._springs.mech.name}: the end effector's compliance has rank "
                                           f"{self.rank} of 6: it is rigid along {6 - self.rank} directions (rigid "
                                           "links, locked drives or fewer degrees of freedom than six), where the "
-                                          "stiffness is infinite; read .compliance, or .principal()", rank=self.rank)
+                                          "stiffness is infinite (the compliance and the principal stiffnesses "
+                                          "answer)", rank=self.rank)
         return finite_result(np.linalg.inv(self.compliance), "stiffness matrix")
 
     def principal(self, load: str = "force") -> tuple[np.ndarray, np.ndarray]:
@@ -275,6 +279,10 @@ class Stiffness:
         the residual is exact to ``tol`` whatever their accuracy), the load applied in halved increments where the
         whole does not converge.
 
+        An equilibrium in another assembly or working mode than ``q``'s (the load snapped the mechanism through a
+        singularity) warns (:class:`~pkm.errors.ModeChangeWarning`); joints past their limits are listed in the
+        result.
+
         Raises:
             ConvergenceError: no equilibrium within :data:`MAX_LOAD_STEPS` increments (a load past what the springs
                 hold: the mechanism snaps through, or leaves its workspace).
@@ -288,7 +296,11 @@ class Stiffness:
         R = _homogeneous_rows(sp.length)
         size = float(np.linalg.norm(R * exact))
         gap = float(np.linalg.norm(R * (exact - first))) / size if size > 0.0 else 0.0
-        return Deflection(q, exact, first, gap, steps)
+        before, after = mode_label(sp.mech, sp.q), mode_label(sp.mech, q)
+        changed = before.differs(after)
+        if changed:
+            warnings.warn(ModeChangeWarning("deflection under the wrench", changed, before, after), stacklevel=2)
+        return Deflection(q, exact, first, gap, steps, sp.mech.outside_limits(q))
 
 
 def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: str = "rigid",

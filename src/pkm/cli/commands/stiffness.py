@@ -1,0 +1,136 @@
+"""``pkm stiffness MECH [--pose K=V ... | --joints NAME=V ...] [--spring NAME=K ...] [--drives K] [--wrench K=V ...]
+[--frequencies] [--json]``: the end effector's stiffness at a configuration (:func:`pkm.stiffness`): the springs
+counted (``--spring``: a joint's stiffness, SI: N m/rad for a revolute, N/m for a prismatic joint; ``--drives``: every
+actuated joint's not named; the spec's ``[springs]`` too), the actuated joints held rigid, the compliance's rank,
+the 6 x 6 stiffness where it has rank 6 and the principal stiffnesses; with ``--wrench`` (``fx fy fz`` [N, or kN,
+mN], ``mx my mz`` [N m]) the exact deflection and the first-order one with their gap; with ``--frequencies`` the
+natural frequencies (:func:`pkm.vibration_modes`)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+import numpy as np
+
+from pkm.cli.command import Command
+from pkm.cli.mechanism import add_mechanism_arguments, configuration, load_mechanism
+from pkm.cli.output import outside_limits, outside_line
+from pkm.cli.parsing import split_item
+
+WRENCH = ("fx", "fy", "fz", "mx", "my", "mz")
+TWIST_UNITS = ("m", "m", "m", "rad", "rad", "rad")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    add_mechanism_arguments(p, "optional", "optional")
+    p.add_argument("--spring", metavar="NAME=K", action="extend", nargs="+", default=[],
+                   help="a joint's stiffness, SI (N m/rad, N/m); 0 frees it")
+    p.add_argument("--drives", metavar="K", type=float,
+                   help="every actuated joint's stiffness not given by --spring (SI); default: drives rigid")
+    p.add_argument("--wrench", metavar="K=V", action="extend", nargs="+", default=[],
+                   help="a load at the end effector's origin, world axes: fx fy fz (N, kN), mx my mz (N m)")
+    p.add_argument("--frequencies", action="store_true", help="the natural frequencies too")
+    p.add_argument("--json", action="store_true", help="print JSON (SI, with units)")
+
+
+def _springs(mech, args: argparse.Namespace) -> dict[str, float]:
+    from pkm.units import parse_quantity
+
+    out = {j: float(args.drives) for j in mech.actuated_names} if args.drives is not None else {}
+    for item in args.spring:
+        name, value = split_item(item, "--spring")
+        out[name] = parse_quantity(value, {None}, f"--spring {name}")
+    return out
+
+
+def _wrench(args: argparse.Namespace) -> np.ndarray | None:
+    from pkm.errors import InvalidInputError
+    from pkm.units import parse_quantity
+
+    if not args.wrench:
+        return None
+    W = np.zeros(6)
+    for item in args.wrench:
+        name, value = split_item(item, "--wrench")
+        if name not in WRENCH:
+            raise InvalidInputError("--wrench", f"{name!r} is no wrench component: {', '.join(WRENCH)}", name)
+        W[WRENCH.index(name)] = parse_quantity(value, {"force" if name[0] == "f" else "torque"}, f"--wrench {name}")
+    return W
+
+
+def run(args: argparse.Namespace) -> int:
+    import pkm
+    from pkm.errors import StiffnessError
+    from pkm.report import jsonable
+
+    mech = load_mechanism(args)
+    q = configuration(mech, args)
+    joints = _springs(mech, args)
+    K = pkm.stiffness(mech, q, joints=joints)
+    out: dict[str, Any] = {"mechanism": mech.name, "task": pkm.TaskMap.of(mech).named(q),
+                           "outside_limits": outside_limits(mech, q), "sprung": dict(K.sprung),
+                           "locked": list(K.locked), "rank": K.rank, "compliance": K.compliance}
+    try:
+        out["matrix"] = K.matrix
+    except StiffnessError as exc:
+        out["matrix"], out["rigid"] = None, str(exc)
+    for load in ("force", "moment"):
+        k, directions = K.principal(load)
+        out[f"principal_{load}"] = {"stiffness": k, "directions": directions.T}
+    W = _wrench(args)
+    if W is not None:
+        d = K.deflection(W)
+        out["wrench"] = W
+        out["deflection"] = {"exact": d.displacement, "first_order": d.first_order, "gap": d.gap,
+                             "load_steps": d.load_steps, "outside_limits": list(d.outside_limits)}
+    if args.frequencies:
+        modes = pkm.vibration_modes(mech, q, joints=joints)
+        out["frequencies"] = modes.frequencies
+        out["free_motions"] = modes.free
+    out["units"] = {"compliance": "m/N, m/(N m); rad/N, rad/(N m)", "matrix": "N/m, N/rad; N m/m, N m/rad",
+                    "principal_force": "N/m", "principal_moment": "N m/rad", "wrench": "N, N m",
+                    "deflection": "m, rad (rotation vector, world axes)", "frequencies": "Hz",
+                    "sprung": "N m/rad (revolute), N/m (prismatic)"}
+    if args.json:
+        print(json.dumps(jsonable(out), indent=2))
+        return 0
+    print(_text(out))
+    return 0
+
+
+def _text(out: dict[str, Any]) -> str:
+    pose = ", ".join(f"{k}={v:.6g}" for k, v in out["task"].items())
+    lines = [f"{out['mechanism']} at {pose}"]
+    if out["outside_limits"]:
+        lines.append(outside_line(out["outside_limits"]))
+    lines.append("springs: " + (", ".join(f"{j} {k:.6g}" for j, k in out["sprung"].items()) or "none")
+                 + "; held rigid: " + (", ".join(out["locked"]) or "none"))
+    if out["matrix"] is None:
+        lines.append(f"compliance of rank {out['rank']} of 6: {out['rigid']}")
+    else:
+        lines.append("stiffness at the end effector's origin, world axes, rows and columns (x, y, z, rx, ry, rz) "
+                     "[N/m, N/rad; N m/m, N m/rad]:")
+        lines += ["  " + " ".join(f"{v:12.5g}" for v in row) for row in out["matrix"]]
+    for load, unit in (("force", "N/m"), ("moment", "N m/rad")):
+        p = out[f"principal_{load}"]
+        lines.append(f"principal stiffnesses under a pure {load} [{unit}]: "
+                     + ", ".join(f"{k:.6g} along ({d[0]:.3f}, {d[1]:.3f}, {d[2]:.3f})"
+                                 for k, d in zip(p["stiffness"], p["directions"])))
+    if "deflection" in out:
+        d = out["deflection"]
+        lines.append("deflection (dx, dy, dz [m]; rx, ry, rz [rad]): exact "
+                     + " ".join(f"{v:.6g}" for v in d["exact"]) + "; first order "
+                     + " ".join(f"{v:.6g}" for v in d["first_order"]) + f" (gap {d['gap']:.3g})")
+        if d["outside_limits"]:
+            lines.append("warning: the deflected configuration is outside the position limits of "
+                         + ", ".join(d["outside_limits"]))
+    if "frequencies" in out:
+        lines.append("natural frequencies [Hz]: " + ", ".join(f"{f:.6g}" for f in out["frequencies"])
+                     + (f" ({out['free_motions']} motions no spring resists: free)" if out["free_motions"] else ""))
+    return "\n".join(lines)
+
+
+COMMAND = Command("the end effector's stiffness, deflection under a load and natural frequencies (joint springs)",
+                  add_arguments, run)
