@@ -1692,6 +1692,50 @@ def _capability(g, adv):
     return ctx().pkm.capability, (m, q, kind), {"gravity": g.chance(0.7)}
 
 
+def _springs_kw(g: Gen, adversarial: bool, n: str) -> dict:
+    """``joints=`` for pkm.stiffness: every actuated joint a stiffness (revolute N m/rad, prismatic N/m), or some
+    left out (locked), or hostile values and names."""
+    mm = ctx().mech[n]
+    joints: dict = {j: float(10.0 ** g.rng.uniform(2, 7)) for j in mm.actuated_names if g.chance(0.8)}
+    if adversarial:
+        what = int(g.rng.integers(0, 4))
+        if what == 0 and joints:
+            joints[g.pick(list(joints))] = g.hostile()
+        elif what == 1:
+            joints[g.pick(("nope", "", mm.actuated_names[0] + "x"))] = 1.0
+        elif what == 2:
+            return {"joints": g.hostile()}
+        else:
+            return {"joints": joints, g.pick(("links", "rtol")): g.hostile()}
+    return {"joints": joints}
+
+
+def _inf_along_rigid(res) -> bool:
+    """The principal stiffnesses are ``inf`` along rigid directions (documented); the rest is finite."""
+    compliance, (k, directions), displacement = res
+    return bool(np.all(np.isfinite(compliance)) and np.all(np.isfinite(displacement))
+                and np.all(np.isfinite(directions)) and not np.any(np.isnan(k)))
+
+
+@entry("pkm.stiffness", sentinel=_inf_along_rigid)
+def _stiffness(g, adv):
+    """The stiffness, its matrix or principal values, and a deflection under a random wrench."""
+    n, m, q, _ = _dyn_state(g, adv, ("delta", "prs3", "rrr3", "gough_stewart"))
+    kw = _springs_kw(g, adv, n)
+    W = g.value(g.rng.normal(size=6) * 10.0 ** g.rng.uniform(-1, 2), adv and g.chance(0.4), 100.0)
+
+    def run(m, q, W, **kw):
+        K = ctx().pkm.stiffness(m, q, **kw)
+        return K.compliance, K.principal("force"), K.deflection(W).displacement
+    return run, (m, q, W), kw
+
+
+@entry("pkm.vibration_modes")
+def _vibration_modes(g, adv):
+    n, m, q, _ = _dyn_state(g, adv, ("delta", "prs3", "rrr3", "gough_stewart"))
+    return ctx().pkm.vibration_modes, (m, q), _springs_kw(g, adv, n)
+
+
 @entry("pkm.measurements")
 def _measurements(g, adv):
     """A table of the Delta's: time, q.<joint>, tau.<joint> (a slow sine), with hostile cells, columns, times."""

@@ -36,6 +36,29 @@ def test_converges_quadratically_to_the_known_root():
     assert len(close) >= 2 and all(b <= 2.0 * a * a for a, b in close), errors
 
 
+def test_a_separate_jacobian_gives_the_same_iterates_made_at_the_kept_points_only():
+    """With ``jacobian=`` (fun the residual alone), the iterates equal those of fun returning both, bit for bit, and
+    the Jacobian is made once per iteration, at the points kept (never at a backtracking trial: atan from 2
+    backtracks)."""
+    for fun, x0 in ((circle_and_diagonal, np.array([3.0, 0.5])),
+                    (lambda x: (np.arctan(x), np.array([[1.0 / (1.0 + x[0] ** 2)]])), np.array([2.0]))):
+        made, trials = [], []
+
+        def residual(x, fun=fun, trials=trials):
+            trials.append(np.array(x))
+            return fun(x)[0]
+
+        def jacobian(x, r, fun=fun, made=made):
+            made.append(np.array(x))
+            assert np.array_equal(r, fun(x)[0])
+            return fun(x)[1]
+
+        eager = gauss_newton(fun, x0, tol=1e-14, max_iter=30)
+        lazy = gauss_newton(residual, x0, tol=1e-14, max_iter=30, jacobian=jacobian)
+        assert np.array_equal(eager[0], lazy[0]) and eager[1:] == lazy[1:]
+        assert len(made) == lazy[2] < len(trials)
+
+
 def test_stops_at_max_iter_and_makes_no_step_with_zero():
     """With max_iter=2 from a far start it makes exactly 2 iterations and reports the residual still above tol; with
     max_iter=0 it returns the start untouched and its residual."""

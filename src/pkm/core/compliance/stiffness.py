@@ -66,8 +66,12 @@ from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
 RTOL = 1e-9
 #: The exact deflection's equilibrium is solved to this, relative (forces to the wrench, closures to ``L``).
 DEFLECTION_TOL = 1e-12
-#: Load steps at most when the full wrench does not converge at once (halved increments).
+#: The smallest load increment is ``1 / MAX_LOAD_STEPS`` of the wrench (increments halve where Newton fails).
 MAX_LOAD_STEPS = 64
+#: Newton iterations per load increment.
+MAX_ITER = 20
+#: A load whose first-order joint motion exceeds this (rad, or characteristic lengths) is refused at once.
+MAX_FIRST_ORDER = math.pi
 
 
 @dataclass(frozen=True)
@@ -103,7 +107,12 @@ def _joint_stiffness(mech: Mechanism, joints: Mapping[str, object] | None) -> di
     return given
 
 
-def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None, rtol: float) -> _Springs:
+def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None, links: object, rtol: float) \
+        -> _Springs:
+    """The springs, the locked joints and the motions they leave at ``q`` (checked: closed, the joints' names and
+    stiffnesses, ``links``; ``rtol`` already checked by the caller)."""
+    if not isinstance(links, str) or links != "rigid":
+        raise InvalidInputError("links", "only 'rigid' links are modelled yet (joint compliance: joints=...)", links)
     mech = check_mechanism(mech)
     q = mech.check_q(q)
     check_closed(mech, q)
@@ -201,7 +210,8 @@ class Deflection:
         first_order: The small-displacement prediction ``C W``, same layout.
         gap: ``|displacement - first_order|`` over ``|displacement|``, each homogenised by ``L`` (the first-order
             model's relative error at this load).
-        load_steps: The load increments the equilibrium was followed in (1: the full wrench at once).
+        load_steps: The load increments the equilibrium was followed in (1: the full wrench at once; each failed
+            increment halved, each success doubling the next).
         outside_limits: The joints ``q`` puts outside their position limits (empty: none).
     """
 
@@ -275,17 +285,18 @@ class Stiffness:
         first-order ``C W`` beside it (module doc).
 
         The equilibrium ``K (q - q0) = J_ee(q)^T W + J_c(q)^T lambda + E^T mu`` with the closures and the locked
-        joints held is solved by Newton's method on the configuration manifold (its Jacobian by central differences:
-        the residual is exact to ``tol`` whatever their accuracy), the load applied in halved increments where the
-        whole does not converge.
+        joints held is solved by Newton's method on the configuration manifold (its Jacobian by forward differences:
+        the residual is exact to ``tol`` whatever their accuracy), the load applied in increments where the whole
+        does not converge at once (halved on failure, down to ``1 / MAX_LOAD_STEPS`` of it).
 
         An equilibrium in another assembly or working mode than ``q``'s (the load snapped the mechanism through a
         singularity) warns (:class:`~pkm.errors.ModeChangeWarning`); joints past their limits are listed in the
         result.
 
         Raises:
-            ConvergenceError: no equilibrium within :data:`MAX_LOAD_STEPS` increments (a load past what the springs
-                hold: the mechanism snaps through, or leaves its workspace).
+            ConvergenceError: an increment of ``1 / MAX_LOAD_STEPS`` of the load finds no equilibrium (a load past
+                what the springs hold: the mechanism snaps through, or leaves its workspace), or the load turns a
+                joint by more than :data:`MAX_FIRST_ORDER` rad (or characteristic lengths) at first order.
         """
         W = _wrench(wrench)
         tol = as_tolerance(tol, "tol")
@@ -331,10 +342,8 @@ def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | N
         >>> K.rank, round(float(K.matrix[2, 2]) / 1e6, 3)  # vertical stiffness [MN/m]
         (6, 5.274)
     """
-    if links != "rigid":
-        raise InvalidInputError("links", "only 'rigid' links are modelled yet (joint compliance: joints=...)", links)
     rtol = as_tolerance(rtol, "rtol")
-    sp = _springs(mech, q, joints, rtol)
+    sp = _springs(mech, q, joints, links, rtol)
     w, V = _resisted(sp, rtol)
     TV = sp.T @ V
     C = finite_result((TV / w) @ TV.T if len(w) else np.zeros((6, 6)), "compliance")
@@ -369,52 +378,56 @@ def _equilibrium(sp: _Springs, W: np.ndarray, tol: float) -> tuple[np.ndarray, i
     rows = JacobianScales.of(mech).constraint_rows
     unit = np.concatenate([rows * energy / L, energy / (sp.E @ cols) if ne else np.zeros(0)])  # (multipliers)
 
-    def residual(q: np.ndarray, lam: np.ndarray, Wk: np.ndarray) -> np.ndarray:
+    def residual(q: np.ndarray, lam: np.ndarray, Wk: np.ndarray) -> tuple[np.ndarray, Configuration]:
         c = Configuration.compute(mech, q)
         dq = pin.difference(m, sp.q, q)
         mu = lam * unit
         force = sp.k * dq - c.ee_jacobian.T @ Wk - c.constraint_jacobian.T @ mu[:nc] - sp.E.T @ mu[nc:]
-        return np.concatenate([cols * force / energy, rows * c.residual[:nc] / L, sp.E @ (dq / cols)])
+        return np.concatenate([cols * force / energy, rows * c.residual[:nc] / L, sp.E @ (dq / cols)]), c
 
     def solve(q: np.ndarray, lam: np.ndarray, Wk: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
-        def fun(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        def jacobian(x: np.ndarray, r: np.ndarray) -> np.ndarray:
             qx, lx = x[:nq], x[nq:]
-            r = residual(qx, lx, Wk)
-            J = np.empty((len(r), nv + nc + ne))
-            h = 1e-6
-            for i in range(nv):
+            J = np.zeros((len(r), nv + nc + ne))
+            h = 1e-7
+            for i in range(nv):  # (forward differences in the homogenised joint motions)
                 e = np.zeros(nv)
                 e[i] = h * cols[i]
-                J[:, i] = (residual(pin.integrate(m, qx, e), lx, Wk) - residual(pin.integrate(m, qx, -e), lx, Wk)) \
-                    / (2.0 * h)
-            for i in range(nc + ne):
-                e = np.zeros(nc + ne)
-                e[i] = 1.0
-                J[:, nv + i] = residual(qx, lx + e, Wk) - r  # (linear in the multipliers: exact)
-            return r, J
+                J[:, i] = (residual(pin.integrate(m, qx, e), lx, Wk)[0] - r) / h
+            Jc = Configuration.compute(mech, qx).constraint_jacobian
+            J[:nv, nv:nv + nc] = -(cols[:, None] * Jc.T) * unit[:nc] / energy  # (linear in the multipliers)
+            J[:nv, nv + nc:] = -(cols[:, None] * sp.E.T) * unit[nc:] / energy
+            return J
 
         def retract(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
             return np.concatenate([pin.integrate(m, x[:nq], cols * dx[:nv]), x[nq:] + dx[nv:]])
 
-        x, res, _ = gauss_newton(fun, np.concatenate([q, lam]), tol=tol, max_iter=50, max_step=0.1,
-                                 retract=retract)
+        x, res, _ = gauss_newton(lambda x: residual(x[:nq], x[nq:], Wk)[0], np.concatenate([q, lam]), tol=tol,
+                                 max_iter=MAX_ITER, max_step=0.1, retract=retract, jacobian=jacobian)
         return x[:nq], x[nq:], res
 
+    w, V = _resisted(sp, RTOL)
+    reach = float(np.max(np.abs(sp.N / cols[:, None] @ (V @ ((V.T @ (sp.T.T @ W)) / w))), initial=0.0))
+    if reach > MAX_FIRST_ORDER:  # (no equilibrium near q to follow: refused at once, not after 64 increments)
+        raise ConvergenceError("deflection under the wrench", math.inf, 0, tol, None,
+                               f"the load turns a joint by {reach:.3g} rad (or moves it {reach:.3g} L) at first "
+                               f"order, over {MAX_FIRST_ORDER:.3g}: far past what the springs hold near q")
     q, lam, res = sp.q.copy(), np.zeros(nc + ne), math.inf
-    steps = 1
-    while steps <= MAX_LOAD_STEPS:
-        qk, lk, ok = q, lam, True
-        for i in range(1, steps + 1):
-            qk, lk, res = solve(qk, lk, W * i / steps)
-            if not res <= tol:
-                ok = False
-                break
-        if ok:
-            return qk, steps
-        steps *= 2
-    raise ConvergenceError("deflection under the wrench", res, 50, tol, None,
-                           f"no equilibrium in {MAX_LOAD_STEPS} load increments: the springs do not hold this load "
-                           "near q (snap-through, or past the workspace)")
+    done, step, steps = 0.0, 1.0, 0
+    while done < 1.0:  # (the load in increments: halved where Newton fails, doubled again after a success)
+        target = min(1.0, done + step)
+        qk, lk, res = solve(q, lam, W * target)
+        if res <= tol:
+            q, lam, done, steps = qk, lk, target, steps + 1
+            step *= 2.0
+            continue
+        step *= 0.5
+        if step < 1.0 / MAX_LOAD_STEPS:
+            raise ConvergenceError("deflection under the wrench", res, steps, tol, None,
+                                   f"no equilibrium past {done:.0%} of the load (increments down to "
+                                   f"1/{MAX_LOAD_STEPS}): the springs do not hold this load near q (snap-through, "
+                                   "or past the workspace)")
+    return q, steps
 
 
 @dataclass(frozen=True)
@@ -434,10 +447,11 @@ class VibrationModes:
     free: int
 
 
-def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None,
+def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: str = "rigid",
                     rtol: float = RTOL) -> VibrationModes:
     """The natural frequencies and mode shapes at the closed configuration ``q`` with the springs of
-    :func:`stiffness` (same ``joints``; the locked drives held): ``H v = w^2 N^T M N v`` (module doc).
+    :func:`stiffness` (same ``joints``, ``links`` and ``rtol``; the locked drives held): ``H v = w^2 N^T M N v``
+    (module doc).
 
     Examples:
         >>> import pkm
@@ -449,7 +463,7 @@ def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, objec
     from scipy.linalg import eigh
 
     rtol = as_tolerance(rtol, "rtol")
-    sp = _springs(mech, q, joints, rtol)
+    sp = _springs(mech, q, joints, links, rtol)
     Ms = sp.N.T @ joint_inertia(sp.mech, sp.q) @ sp.N
     Ms = 0.5 * (Ms + Ms.T)
     H = sp.H
@@ -470,5 +484,5 @@ def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, objec
     return VibrationModes(np.sqrt(w2[resisted]) / (2.0 * math.pi), sp.N @ s, sp.T @ s, free)
 
 
-__all__ = ["DEFLECTION_TOL", "MAX_LOAD_STEPS", "RTOL", "Deflection", "Stiffness", "VibrationModes", "stiffness",
+__all__ = ["DEFLECTION_TOL", "MAX_FIRST_ORDER", "MAX_ITER", "MAX_LOAD_STEPS", "RTOL", "Deflection", "Stiffness", "VibrationModes", "stiffness",
            "vibration_modes"]

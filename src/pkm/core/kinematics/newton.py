@@ -35,9 +35,11 @@ def least_squares(A: np.ndarray, b: np.ndarray) -> np.ndarray:
         return np.zeros(A.shape[1])
 
 
-def gauss_newton(fun: Fun, x: np.ndarray, *, tol: float, max_iter: int, max_step: float = math.inf,
-                 retract: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None,
-                 halvings: int = 8, min_alpha: float = 0.02, stall: int = 3) -> tuple[np.ndarray, float, int]:
+def gauss_newton(fun: Fun | Callable[[np.ndarray], np.ndarray], x: np.ndarray, *, tol: float, max_iter: int,
+                 max_step: float = math.inf, retract: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None,
+                 halvings: int = 8, min_alpha: float = 0.02, stall: int = 3,
+                 jacobian: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None) \
+        -> tuple[np.ndarray, float, int]:
     """Gauss-Newton with a step cap and backtracking.
 
     Args:
@@ -51,17 +53,25 @@ def gauss_newton(fun: Fun, x: np.ndarray, *, tol: float, max_iter: int, max_step
             ``min_alpha`` of its length is taken as it is.
         stall: Stop after this many iterations in a row that lower the residual by less than 1 % (the
             least-squares point of a system with no solution).
+        jacobian: ``(x, residual) -> Jacobian``, where it costs more than the residual (finite differences): then
+            ``fun`` returns the residual alone, and the Jacobian is made at the iterates kept only, never at a
+            backtracking trial.
 
     Returns:
         ``(x, residual, iterations)``: the last iterate, ``max|residual|`` there (``inf`` if not finite) and
         the iterations made. It stops before a step that would make the residual or ``x`` non-finite.
     """
     move = retract if retract is not None else (lambda x0, dx: x0 + dx)
-    r, J = fun(x)
+
+    evaluate: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray | None]] = \
+        fun if jacobian is None else (lambda x: (fun(x), None))  # type: ignore[assignment, return-value]
+    r, J = evaluate(x)
     res = float(np.max(np.abs(r))) if r.size else 0.0
     it = stalled = 0
     while res > tol and it < max_iter and stalled < stall:
         it += 1
+        if J is None:
+            J = jacobian(x, r)  # type: ignore[misc]
         step = -least_squares(J, r)
         nrm = float(np.max(np.abs(step))) if step.size else 0.0
         if nrm > max_step:
@@ -69,7 +79,7 @@ def gauss_newton(fun: Fun, x: np.ndarray, *, tol: float, max_iter: int, max_step
         alpha = 1.0
         for _ in range(halvings):
             x_try = move(x, alpha * step)
-            r_try, J_try = fun(x_try)
+            r_try, J_try = evaluate(x_try)
             res_try = float(np.max(np.abs(r_try)))
             if res_try < res or alpha < min_alpha:
                 break
