@@ -3,8 +3,10 @@ as printed.
 
 Python blocks run one by one in a fresh interpreter, in a scratch directory. Shell lines run in
 bash, ``make`` lines in the checkout and ``pkm`` lines in the scratch directory, with the
-installed ``pkm`` first on ``PATH``. A line whose comment says ``Ctrl-C`` starts something that
-runs until stopped (the live viewer): it must print, then stop cleanly on Ctrl-C (SIGINT).
+installed ``pkm`` first on ``PATH``; a line of nothing but ``pkm`` commands (joined by ``&&``, no other shell
+syntax) runs them as ``pkm`` would, in this process (:func:`tests.cli.helpers.run`; the installed script itself is
+tests/cli/test_list.py's), but for :data:`PROCESS_COMMANDS`. A line whose comment says ``Ctrl-C`` starts something
+that runs until stopped (the live viewer): it must print, then stop cleanly on Ctrl-C (SIGINT).
 A block or command printed on several pages (the README's command lines are the tour's too) runs once.
 One line is not run: ``make test``, the command that runs this test (CI runs it).
 """
@@ -22,13 +24,18 @@ from pathlib import Path
 import pytest
 
 from tests import bounded
-from tests.cli.helpers import default_sigint
+from tests.cli.helpers import default_sigint, run
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The pages whose blocks run: the README, then the tour of the documentation site.
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs" / "tour").glob("*.md"))]
 FENCE = re.compile(r"^```(\w*)\n(.*?)^```", flags=re.S | re.M)
 SELF = "make test"
+#: The ``pkm`` commands a line runs in bash even with nothing else of the shell's: ``pkm sweep`` starts a local
+#: Dask cluster of worker processes (and Dask's logging), ``pkm serve`` a service until stopped.
+PROCESS_COMMANDS = ("sweep", "serve")
+#: The characters of a line of ``pkm`` commands that it can run in this process (none of the shell's syntax).
+PLAIN = re.compile(r"[\w\s=:,./+-]*")
 #: The README's size limit [bytes] (issue 42: what pkm is, the two commands, one example, links; the tour in docs/).
 README_MAX_BYTES = 12 * 1024
 
@@ -67,6 +74,17 @@ def _env() -> dict[str, str]:
     env = dict(os.environ, MPLBACKEND="Agg")
     env["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{env.get('PATH', '')}"
     return env
+
+
+def _pkm_commands(command: str) -> list[list[str]] | None:
+    """The words of each ``pkm`` command of a line that runs in this process (nothing but ``pkm`` commands joined by
+    ``&&``, none of :data:`PROCESS_COMMANDS`); None for a line that runs in bash."""
+    parts = command.split("&&")
+    commands = [part.split() for part in parts]
+    if all(PLAIN.fullmatch(part) for part in parts) and all(
+            len(words) > 1 and words[0] == "pkm" and words[1] not in PROCESS_COMMANDS for words in commands):
+        return commands
+    return None
 
 
 def test_the_pages_have_python_blocks_and_shell_lines():
@@ -111,6 +129,13 @@ def test_shell_line_runs(line, tmp_path):
             assert proc.wait(timeout=30) == 0, proc.stderr.read()
         finally:
             proc.kill()
+        return
+    commands = _pkm_commands(command)
+    if commands:
+        for words in commands:  # (as bash runs A && B: B once A exited 0)
+            proc = run(*words[1:], cwd=cwd)
+            assert proc.returncode == 0, f"{' '.join(words)!r} ({_SHELL[command][0]}) exited {proc.returncode}:\n" \
+                                         f"{proc.stderr[-3000:]}"
         return
     proc = bounded.run(["bash", "-c", command], cwd=cwd, env=_env(), cpu=600)
     assert proc.returncode == 0, f"{command!r} ({_SHELL[command][0]}) exited {proc.returncode}:\n{proc.stderr[-3000:]}"

@@ -1,5 +1,5 @@
-"""pkm.cli.app: the parser built from the registry and main's exit statuses and error lines, through the real entry
-point; every subcommand takes one's own closure spec file."""
+"""pkm.cli.app: the parser built from the registry and main's exit statuses and error lines, as ``python -m pkm``
+gives them (tests.cli.helpers.run); every subcommand takes one's own closure spec file."""
 
 from __future__ import annotations
 

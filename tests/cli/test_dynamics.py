@@ -13,7 +13,7 @@ import pytest
 import pkm
 from pkm import cli
 from pkm.cli.commands.dynamics import _mass_unit
-from tests.cli.helpers import one_error_line, run
+from tests.cli.helpers import one_error_line, run_process
 
 ROOT = Path(__file__).resolve().parents[2]
 ANKLE = ROOT / "examples" / "ankle" / "ankle.closures.toml"
@@ -138,7 +138,7 @@ def test_bad_input_is_one_error_line(argv, status, message, capsys):
 
 def test_the_command_runs_as_a_process():
     """``python -m pkm dynamics delta --json --rates motor_1=fast``: one error line, exit status 2."""
-    bad = run("dynamics", "delta", "--json", "--rates", "motor_1=fast")
+    bad = run_process("dynamics", "delta", "--json", "--rates", "motor_1=fast")
     assert bad.returncode == 2 and "is not a number" in one_error_line(bad)
 
 

@@ -10,7 +10,7 @@ import pytest
 
 import pkm.viz  # noqa: F401  (a regression in pkm.viz fails here, it is not skipped)
 from tests.bounded import children
-from tests.cli.helpers import one_error_line, port_is_free, run, start_live_preview
+from tests.cli.helpers import one_error_line, port_is_free, run, run_process, start_live_preview
 
 
 def test_preview_writes_html_and_refuses_an_unknown_mechanism(tmp_path):
@@ -26,7 +26,8 @@ def test_preview_writes_html_and_refuses_an_unknown_mechanism(tmp_path):
 def test_preview_opens_the_viewer_at_given_joints_and_returns_with_no_wait():
     """``pkm preview delta --joints motor_1=-50deg --no-wait`` starts a meshcat viewer, prints its URL and exits 0;
     an unknown joint exits 2 before any viewer starts."""
-    ok = run("preview", "delta", "--joints", "motor_1=-50deg", "--no-wait")
+    ok = run_process("preview", "delta", "--joints", "motor_1=-50deg", "--no-wait")  # (a process: the viewer
+    # stops with it)
     assert ok.returncode == 0, ok.stderr
     assert ok.stdout.startswith("viewer: http://")
     bad = run("preview", "delta", "--joints", "elbow=1", "--no-wait")

@@ -19,7 +19,7 @@ from pkm import cli
 from pkm.core.dynamics import samples
 from pkm.errors import InvalidInputError, UnitError
 from pkm.units import parse_quantity
-from tests.cli.helpers import one_error_line, run
+from tests.cli.helpers import one_error_line, run_process
 
 ROOT = Path(__file__).resolve().parents[2]
 ANKLE = ROOT / "examples" / "ankle" / "ankle.closures.toml"
@@ -207,7 +207,7 @@ def test_parquet_without_pyarrow_names_the_extra(tmp_path, capsys, monkeypatch):
 def test_the_command_runs_as_a_process(tmp_path):
     """``python -m pkm simulate`` with a wrong table: one error line, exit status 1, nothing written."""
     (tmp_path / "T.csv").write_text("t,motor_1\n0,0\n")
-    proc = run("simulate", "delta", "--torques", "T.csv", "--out", "run.csv", cwd=tmp_path)
+    proc = run_process("simulate", "delta", "--torques", "T.csv", "--out", "run.csv", cwd=tmp_path)
     assert proc.returncode == 1 and "the header must read t,motor_1,motor_2,motor_3" in one_error_line(proc)
     assert not (tmp_path / "run.csv").exists()
 
