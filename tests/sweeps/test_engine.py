@@ -107,6 +107,11 @@ def test_a_killed_sweep_resumes_where_it_stopped_and_gives_the_uninterrupted_tab
     assert resumed.manifest["objectives"][1]["sense"] == "max"
 
 
+# _dask_settings: distributed is imported before a test sets dask.config: dask.config.set's exit drops the keys that
+# did not exist when it was entered, the defaults importing distributed adds among them, and the next cluster of the
+# process (another test's, on the same pytest-xdist worker) would fail with KeyError: 'comm'.
+
+
 def test_an_existing_scheduler_and_worker_started_as_processes(tmp_path):
     """`dask scheduler` and `dask worker` as separate processes on this machine; the sweep goes to the
     scheduler's address and gives the serial loop's table."""
@@ -137,6 +142,7 @@ def test_an_existing_scheduler_and_worker_started_as_processes(tmp_path):
 
 def test_an_unreachable_scheduler_is_a_clear_error():
     import dask
+    import dask.distributed  # (before the setting: _dask_settings)
 
     with dask.config.set({"distributed.comm.timeouts.connect": "1s"}), \
             pytest.raises(SweepError, match=r"cannot reach the Dask scheduler at tcp://127\.0\.0\.1:9"):
@@ -160,6 +166,7 @@ def test_a_design_that_kills_its_worker_fails_alone(tmp_path):
     chunk are evaluated, and the sweep's context survives the dead workers. (Two chunks of four, one such design in
     each: four worker deaths, the chunks' and the designs' retried alone, each a worker process started again.)"""
     import dask
+    import dask.distributed  # (before the setting: _dask_settings)
 
     (tmp_path / "exit.py").write_text(EXIT, encoding="utf-8")
     space = sweeps.grid(a="30cm:60cm:2", h="5cm:20cm:4")
