@@ -38,11 +38,13 @@ def test_delta_has_its_two_sphere_intersection_roots():
 
 
 def test_rrr3_modes_are_the_exact_polynomials_on_random_designs():
-    """On 40 random designs and motor angles, the set equals the roots of the 3-RRR's exact FK polynomial
-    (:func:`pkm.mechanisms.rrr3.kinematics.forward_kinematics`), pose by pose to 1e-8 (m, rad)."""
-    rng = np.random.default_rng(7)
-    checked = total = 0
-    while checked < 40:
+    """On 20 random designs and motor angles, the set equals the roots of the 3-RRR's exact FK polynomial
+    (:func:`pkm.mechanisms.rrr3.kinematics.forward_kinematics`), pose by pose to 1e-8 (m, rad). (Each design is one
+    Bertini solve of 16 paths, a quarter of a second: 20 designs, drawn so that they meet every count of real modes
+    the 3-RRR has here, none, two, four and six, which the test asserts.)"""
+    rng = np.random.default_rng(0)
+    checked, counts = 0, set()
+    while checked < 20:
         H = rng.uniform(0.5, 1.5)
         h, a, b = H * rng.uniform(0.1, 0.5), H * rng.uniform(0.3, 0.7), H * rng.uniform(0.3, 0.7)
         try:
@@ -63,8 +65,8 @@ def test_rrr3_modes_are_the_exact_polynomials_on_random_designs():
             assert np.abs(g[:2] - w[:2]).max() < 1e-8
             assert abs((g[2] - w[2] + np.pi) % (2 * np.pi) - np.pi) < 1e-8
         checked += 1
-        total += len(got)
-    assert total > 40  # (designs with several modes were met: not a test of empty sets)
+        counts.add(len(got))
+    assert counts == {0, 2, 4, 6}  # (not a test of empty sets, nor of pairs alone)
 
 
 def test_a_dropped_path_is_reported_and_the_set_not_complete():

@@ -140,12 +140,14 @@ class _Reduction:
     Gb: np.ndarray  # nv x 6 (free base) or nv x 0: joint rates of a unit base twist, the actuators locked
 
 
-def _reduce(mech: Mechanism, q: np.ndarray, rtol: float, base: str = "fixed") -> _Reduction:
+def _reduce(mech: Mechanism, q: np.ndarray, rtol: float, base: str = "fixed", Jc: np.ndarray | None = None
+            ) -> _Reduction:
     """The rank of ``J_p`` and the idle motions are judged on the Jacobians homogenised by the mechanism's
     characteristic length (:mod:`pkm.core.model.scale`), as :func:`pkm.diagnose` judges them: the same for the
-    mechanism scaled in size."""
+    mechanism scaled in size. ``Jc``: the constraint Jacobian at ``q`` where the caller has it (the simulation's
+    loop closure ends with it), else computed here."""
     scales = JacobianScales.of(mech)
-    Jc = constraints.jacobian(mech, q)
+    Jc = constraints.jacobian(mech, q) if Jc is None else Jc
     pv, av = mech.passive_v, mech.act_v
     Jp_pinv, s, Vt, r = homogenised_pinv(Jc[:, pv], scales.constraint_rows, scales.columns[pv], rtol)
     smax = float(s[0]) if s.size else 0.0
@@ -349,8 +351,8 @@ def _check_state(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None, base: str 
 
 def _evaluate(mech: Mechanism, q: np.ndarray, qd: np.ndarray, rtol: float,
               coulomb_velocity: float = COULOMB_VELOCITY, base: str = "fixed",
-              base_velocity: np.ndarray | None = None) -> ActuatorSpaceModel:
-    red = _reduce(mech, q, rtol, base)
+              base_velocity: np.ndarray | None = None, Jc: np.ndarray | None = None) -> ActuatorSpaceModel:
+    red = _reduce(mech, q, rtol, base, Jc)
     m, d = mech.model, mech.data
     free = red.Gb.shape[1] > 0
     vb = np.zeros(red.Gb.shape[1]) if base_velocity is None else np.array(base_velocity, dtype=float)

@@ -200,7 +200,10 @@ class _Dynamics:
     def __post_init__(self) -> None:
         self.limit = np.array([a.max_effort for a in self.mech.actuators])
 
-    def close(self, qa: np.ndarray, seed: np.ndarray, t: float, pose: np.ndarray | None = None) -> np.ndarray:
+    def close(self, qa: np.ndarray, seed: np.ndarray, t: float, pose: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
+        """The loops closed from ``seed`` at ``qa``: the configuration and the constraint Jacobian there (the last
+        Newton pass's, which the model takes instead of computing it again)."""
         mech = self.mech
         q = mech.with_actuated(seed, qa)
         if pose is not None and mech.base is not None:  # (a free base: its pose from the state, unit quaternion)
@@ -211,7 +214,7 @@ class _Dynamics:
         for _ in range(12):
             r, J = constraints.residual_and_jacobian(mech, q)
             if np.max(np.abs(r), initial=0.0) <= CLOSURE_TOL:
-                return q
+                return q, J
             dv = np.zeros(mech.nv)
             dv[pv] = -least_squares(J[:, pv], r)
             q = pin.integrate(mech.model, q, dv)
@@ -229,9 +232,9 @@ class _Dynamics:
         applied there."""
         if not (np.all(np.isfinite(qa)) and np.all(np.isfinite(qd))):
             raise _Stop(Event("singularity", t, "the state is no longer finite (a singularity crossed)"))
-        q = self.close(qa, seed, t, pose)
+        q, Jc = self.close(qa, seed, t, pose)
         try:
-            model = _evaluate(self.mech, q, qd, RTOL, self.coulomb_velocity, self.base, twist)
+            model = _evaluate(self.mech, q, qd, RTOL, self.coulomb_velocity, self.base, twist, Jc)
         except SingularityError as exc:
             raise _Stop(Event("singularity", t, str(exc)), exc.sigma_min, exc.distance) from None
         tau = self.efforts(t, q, model.v)
