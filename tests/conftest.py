@@ -33,7 +33,8 @@ register(MechanismDefinition("fivebar", "toy planar five-bar (tests only)", "tes
 #: hexapod's alone cost 26 s of CPU), ``make demo`` first: one group that pytest-xdist runs on one worker
 #: (``--dist loadgroup``, as ``make test`` runs), at the start of the run, so that two workers never compute the same
 #: rows at once and the longest test does not start last.
-PAPER_ROWS = ("tests/test_readme.py::test_shell_line_runs[make demo]", "tests/papers/", "tests/test_report.py",
+PAPER_ROWS = ("tests/test_readme.py::test_shell_line_runs[make demo]",
+              "tests/test_readme.py::test_shell_line_runs[pkm report", "tests/papers/", "tests/test_report.py",
               "tests/test_report_rows_unchanged.py", "tests/cli/test_report.py",
               "tests/core/identification/test_precise.py")
 
