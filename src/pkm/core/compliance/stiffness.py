@@ -37,7 +37,8 @@ modelled yet). :meth:`Stiffness.deflection` solves the exact large-displacement 
 **Vibrations.** :func:`vibration_modes`: the generalised eigenproblem :math:`H v = \omega^2 N^\top M N v` on the
 same motions (:math:`M` Pinocchio's joint-space mass matrix with the drives' reflected inertia), massless
 directions condensed statically; the motions no spring resists are counted as free (zero frequency), not listed.
-Checked against the linearised forward dynamics (:func:`pkm.forward_dynamics` with the springs' efforts).
+Checked against the linearised forward dynamics (:func:`pkm.forward_dynamics` with the springs' efforts) and the
+Fourier transform of a free vibration simulated by :func:`pkm.simulate`.
 """
 
 from __future__ import annotations
