@@ -61,6 +61,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         BaseGeometry,
         BaseInverseDynamics,
         BaseParameters,
+        Beam,
         Branch,
         Calibration,
         CalibrationModel,

@@ -23,7 +23,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
                                 "coriolis_matrix", "gravity_efforts", "mass_matrix", "operational_space"),
     "pkm.core.dynamics.simulate": ("Event", "Simulation", "simulate"),
     "pkm.core.analysis.capability": ("Capability", "Polytope", "capability"),
-    "pkm.core.compliance": ("Stiffness", "VibrationModes", "stiffness", "vibration_modes"),
+    "pkm.core.compliance": ("Beam", "Stiffness", "VibrationModes", "stiffness", "vibration_modes"),
     "pkm.core.analysis.region": ("Region", "feasible_region"),
     "pkm.core.calibration.estimate": ("Calibration", "calibrate"),
     "pkm.core.calibration.identifiable": ("BaseGeometry", "base_geometry"),
@@ -63,7 +63,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.calibration.poses import PosePlan, calibration_poses
     from pkm.core.calibration.tolerance import ToleranceRow, tolerance_table
     from pkm.core.calibration.writeback import write_calibrated
-    from pkm.core.compliance import Stiffness, VibrationModes, stiffness, vibration_modes
+    from pkm.core.compliance import Beam, Stiffness, VibrationModes, stiffness, vibration_modes
     from pkm.core.differential.velocity import (
         Diagnostics,
         accelerations,

@@ -163,3 +163,78 @@ def test_a_free_vibration_simulated_has_the_natural_frequency():
     a, b, c = np.log(spectrum[i - 1:i + 2])
     peak = freq[i] + 0.5 * (a - c) / (a - 2 * b + c) * (freq[1] - freq[0])
     assert abs(peak / f - 1.0) < 0.01
+
+
+def _frame_element(p1, p2, EA, EI):
+    """The 2-D Euler-Bernoulli frame element's stiffness (6 x 6: ux, uy, rotation at each end), global axes."""
+    d = np.asarray(p2) - np.asarray(p1)
+    length = float(np.linalg.norm(d))
+    c, s = d / length
+    a, b1, b2, b3 = EA / length, 12 * EI / length**3, 6 * EI / length**2, EI / length
+    k = np.array([[a, 0, 0, -a, 0, 0], [0, b1, b2, 0, -b1, b2], [0, b2, 4 * b3, 0, -b2, 2 * b3],
+                  [-a, 0, 0, a, 0, 0], [0, -b1, -b2, 0, b1, -b2], [0, b2, 2 * b3, 0, -b2, 4 * b3]])
+    R = np.kron(np.eye(2), np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]]))
+    return R.T @ k @ R
+
+
+def test_compliant_links_agree_with_a_frame_finite_element_model():
+    """The 3-RRR with its six links as aluminium rods (Euler-Bernoulli) and servo springs on the motors: the in-plane
+    block (x, y, yaw) of pkm's compliance equals a 2-D frame finite-element model written here (one beam element a
+    link, hinges at the elbows and wrists, the platform rigid, the motors rotational springs to ground), within
+    1e-6 relative; the links' compliance adds to the motors' (the rigid-link compliance is smaller)."""
+    from pkm.core.compliance import Beam
+
+    rrr3 = pkm.load("rrr3")
+    q, k_m, rod = rrr3.q_reference, 2.0e3, Beam(E=7.0e10, radius=0.004)
+    links = {f"{part}_{i}": rod for part in ("proximal", "distal") for i in (1, 2, 3)}
+    motors = {j: k_m for j in rrr3.actuated_names}
+    C = stiffness(rrr3, q, joints=motors, links=links).compliance[np.ix_([0, 1, 5], [0, 1, 5])]
+    rigid = stiffness(rrr3, q, joints=motors).compliance[np.ix_([0, 1, 5], [0, 1, 5])]
+
+    m, d = rrr3.model, rrr3.data
+    pin.forwardKinematics(m, d, q)
+    pin.updateFramePlacements(m, d)
+    joint = lambda name: d.oMi[m.getJointId(name)].translation[:2]
+    P = d.oMf[rrr3.ee_frame].translation[:2]
+    EA, EI = rod.E * math.pi * rod.radius**2, rod.E * math.pi * rod.radius**4 / 4
+    n = 3 + 6 * 3  # platform (ux, uy, rotation); per leg: the elbow's ux, uy and the rotations A, B-, B+, C
+    K = np.zeros((n, n))
+    for i in (1, 2, 3):
+        A, B = joint(f"motor_{i}"), joint(f"elbow_{i}")
+        C_i = joint("wrist_1") if i == 1 else d.oMf[m.getFrameId(f"leg{i}_tip")].translation[:2]
+        o = 3 + 6 * (i - 1)
+        at = lambda *cols: np.array([[1.0 if c == j else 0.0 for j in range(n)] for c in cols])
+        at_A = np.vstack([np.zeros((2, n)), at(o + 2)])
+        at_B_proximal, at_B_distal = at(o, o + 1, o + 3), at(o, o + 1, o + 4)
+        rigid_C = np.zeros((3, n))
+        rigid_C[:2, :3] = [[1, 0, -(C_i - P)[1]], [0, 1, (C_i - P)[0]]]  # (the platform's point C_i)
+        rigid_C[2, o + 5] = 1.0
+        for p1, p2, T in ((A, B, np.vstack([at_A, at_B_proximal])), (B, C_i, np.vstack([at_B_distal, rigid_C]))):
+            K += T.T @ _frame_element(p1, p2, EA, EI) @ T
+        K[o + 2, o + 2] += k_m
+    fem = np.linalg.solve(K, np.eye(n)[:, :3])[:3]
+    assert np.abs(C - fem).max() <= 1e-6 * np.abs(fem).max()
+    assert np.all(np.linalg.eigvalsh(C - rigid) > 0.0)
+
+
+def test_bad_links_are_refused_by_name():
+    from pkm.core.compliance import Beam
+
+    rrr3 = pkm.load("rrr3")
+    q, motors, rod = rrr3.q_reference, {j: 2e3 for j in rrr3.actuated_names}, Beam(E=7e10, radius=0.004)
+    with pytest.raises(UnknownNameError, match="link 'proximal_9'"):
+        stiffness(rrr3, q, joints=motors, links={"proximal_9": rod})
+    with pytest.raises(InvalidInputError, match="symmetric positive definite"):
+        stiffness(rrr3, q, joints=motors, links={"proximal_1": -np.eye(6)})
+    with pytest.raises(InvalidInputError, match="carries no joint"):
+        stiffness(rrr3, q, joints=motors, links={"platform_center": rod})
+    with pytest.raises(InvalidInputError, match="rigid links"):
+        stiffness(rrr3, q, joints=motors, links={"proximal_1": rod}).deflection([1.0, 0, 0, 0, 0, 0])
+    with pytest.raises(InvalidInputError):
+        Beam(E=7e10, radius=0.004, inner=0.005)
+    m, d = rrr3.model, rrr3.data  # (a 6 x 6 of one's own, in the link's axes (x along it): the beam's, alike)
+    pin.framesForwardKinematics(m, d, q)
+    length = np.linalg.norm(d.oMi[m.getJointId("elbow_1")].translation - d.oMi[m.getJointId("motor_1")].translation)
+    own = stiffness(rrr3, q, joints=motors, links={"proximal_1": rod.compliance(length)}).compliance
+    beam = stiffness(rrr3, q, joints=motors, links={"proximal_1": rod}).compliance
+    assert np.abs(own - beam).max() <= 1e-9 * np.abs(beam).max()

@@ -1,9 +1,12 @@
-"""Compliance: the elastostatics and the small vibrations of a closed-loop mechanism whose joints are springs.
+"""Compliance: the elastostatics and the small vibrations of a closed-loop mechanism whose joints are springs and
+whose links may be beams.
 
-:mod:`~pkm.core.compliance.stiffness`: the Cartesian stiffness at the end-effector frame, the deflection under a
-constant wrench (exact and first order), and the natural frequencies with their mode shapes.
+* :mod:`~pkm.core.compliance.stiffness`: the Cartesian stiffness at the end-effector frame, the deflection under a
+  constant wrench (exact and first order), and the natural frequencies with their mode shapes;
+* :mod:`~pkm.core.compliance.links`: compliant links as virtual six-dimensional springs (:class:`Beam`).
 """
 
+from pkm.core.compliance.links import Beam
 from pkm.core.compliance.stiffness import Stiffness, VibrationModes, stiffness, vibration_modes
 
-__all__ = ["Stiffness", "VibrationModes", "stiffness", "vibration_modes"]
+__all__ = ["Beam", "Stiffness", "VibrationModes", "stiffness", "vibration_modes"]
