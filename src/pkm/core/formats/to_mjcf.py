@@ -54,6 +54,9 @@ simulation may apply, as :func:`pkm.simulate` saturates). MJCF has no joint spee
 velocity limit is not written, and a drive read back has ``F`` as its (continuous) ``effort_limit``, the rotor's
 inertia and ratio folded into ``armature``.
 
+The joint springs (``[springs]``, :mod:`pkm.core.model.springs`) are their joints' ``stiffness``, ``springref`` and
+(a passive joint's) ``damping``, as MuJoCo applies them.
+
 pkm's own MJCF reader loads the file back (:mod:`pkm.core.formats.mjcf`), which tests the writer; MuJoCo reads it
 for the benchmark baseline (:mod:`pkm.bench.mujoco_baseline`). Not written: planar and other composite joints, a
 free-flyer below the root (MuJoCo allows free joints only on top-level bodies), geometry; each refusal is a
@@ -215,6 +218,11 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
         if np.isfinite(drive.max_effort):  # the peak limit when there is one, else the continuous one
             motor.set("forcelimited", "true")
             motor.set("forcerange", _num([-drive.max_effort, drive.max_effort]))
+    for name, spring in mech.spec.springs.items():  # (MuJoCo's stiffness, springref and a passive joint's damping)
+        el = next(e for e in world.iter("joint") if e.get("name") == name)
+        for key, attr in (("stiffness", "stiffness"), ("rest", "springref"), ("damping", "damping")):
+            if spring.get(key, 0.0) != 0.0:
+                el.set(attr, repr(float(spring[key])))
     return etree.tostring(root, pretty_print=True, encoding="unicode")
 
 

@@ -35,6 +35,7 @@ from pkm._derived import SLOT
 from pkm.core.model.actuators import Actuator, from_model, write_model
 from pkm.core.model.motors import motor_map
 from pkm.core.model.spec import Branch, ClosureSpec
+from pkm.core.model.springs import JointSprings, joint_springs
 from pkm.core.model.urdf import position_limits
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
 from pkm.units import joint_kind, quantities
@@ -209,6 +210,19 @@ class Mechanism:
             raise SpecError(source, f"the drives of the model file with the spec's [actuators] tables: {exc}") from None
         for a, j in zip(self.actuators, self.actuated):
             write_model(model, a, j.idx_v)
+        driven = {j.name for j in self.actuated}
+        damped = [n for n, t in spec.springs.items() if "damping" in t and n in driven]
+        if damped:
+            raise SpecError(source, f"[springs.{damped[0]}] gives a damping to an actuated joint: its damping is its "
+                                    f"drive's viscous friction ([actuators.{damped[0]}] viscous)")
+        damping = np.array(model.damping, dtype=float)
+        for n, t in spec.springs.items():  # (a spring's damping is the joint's viscous friction, as a drive's)
+            if "damping" in t:
+                damping[self.joints[n].idx_v] = t["damping"]
+        model.damping = damping
+        #: The joint springs' stiffnesses about their rest positions (``[springs]``, :mod:`pkm.core.model.springs`):
+        #: the efforts every dynamics route applies; their damping is in the model's ``damping`` (friction).
+        self.springs: JointSprings = joint_springs(model, spec.springs)
         #: The motors and their map onto the actuated joints (``[motors]``: a differential; else one per joint).
         self.motor_map = motor_map(spec.actuated, spec.motors, source)
         self.act_q = np.array([j.idx_q for j in self.actuated])
