@@ -504,10 +504,10 @@ def spring_efforts(mech: Mechanism, q: ArrayLike, *, base: str | None = None) ->
         >>> import pkm
         >>> delta = pkm.load("delta")
         >>> sprung = pkm.from_strings(delta.urdf, dataclasses.replace(
-        ...     delta.spec, springs={"motor_1": {"stiffness": 2.0, "rest": 0.0}}))
+        ...     delta.spec, springs={"motor_1": {"stiffness": 2.0, "rest": -0.5}}))  # 2 N m/rad about -0.5 rad
         >>> q = sprung.q_reference
-        >>> bool(np.isclose(pkm.spring_efforts(sprung, q)[0], 2.0 * sprung.q_to_dict(q)["motor_1"][0]))
-        True
+        >>> np.round(pkm.spring_efforts(sprung, q), 4) + 0.0  # (motor_1 at 0.0017 rad: 2 (0.0017 + 0.5) on it alone)
+        array([1.0033, 0.    , 0.    ])
         >>> np.allclose(pkm.gravity_efforts(sprung, q) - pkm.spring_efforts(sprung, q), pkm.gravity_efforts(delta, q))
         True
     """

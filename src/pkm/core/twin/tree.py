@@ -344,9 +344,8 @@ class Twin:
             th = self._theta(j) if j in self.design.bodies else cs.DM(self._inertia[j].toDynamicParameters())
             out = out - cs.dot(g, th[0] * self.oMi[j].p + self.oMi[j].R @ th[1:4])  # (m times the centre of mass)
         sp = self.mech.springs  # (and the joint springs', as pkm.core.dynamics.projection.energy)
-        for iq, k, rest in zip(sp.idx_q, sp.stiffness, sp.rest):
-            out = out + 0.5 * float(k) * (self.q[int(iq)] - float(rest)) ** 2
-        return out
+        return out + sum((0.5 * float(k) * (self.q[int(iq)] - float(r)) ** 2
+                          for iq, k, r in zip(sp.idx_q, sp.stiffness, sp.rest)), cs.SX(0)) if sp else out
 
     def _theta(self, j: int) -> Expr:
         """Body ``j``'s ten inertial parameters, the design's as symbols."""
