@@ -15,6 +15,7 @@ import pytest
 import pkm
 from pkm.bench.mujoco_baseline import MujocoRigid, unavailable
 from pkm.core.dynamics.projection import energy
+from pkm.core.formats.to_mjcf import mjcf_from_mechanism
 from pkm.errors import SpecError
 from tests.fd import rel
 
@@ -48,15 +49,20 @@ def _state(mech: pkm.Mechanism, qa: float = 0.3, qd: float = 1.0, qdd: float = 2
     return q, v, pkm.accelerations(mech, q, v, [qdd])
 
 
-def test_the_springs_are_read_as_efforts_and_the_damping_as_friction(sprung):
+def test_the_springs_are_read_as_efforts_and_the_damping_as_friction(sprung, tmp_path):
     """The stiffness and rest (degrees to rad) of the three hinges; the coupler's damping is Pinocchio's ``damping``
-    there (the joint's viscous friction); the efforts ``-k (q - rest)`` on those joints alone."""
+    there (the joint's viscous friction); the efforts ``-k (q - rest)`` on those joints alone; pkm's MJCF writer
+    writes them and the file reads back as the same springs (1e-15)."""
     s = sprung.springs
     assert s.names == ("crank_joint", "coupler_joint", "rocker_joint")
     assert np.allclose(s.rest, np.deg2rad([5.0, 10.0, -20.0]), rtol=0, atol=1e-15)
     assert list(np.asarray(sprung.model.damping)) == [0.0, 0.02, 0.0]
     q = sprung.q_reference
     assert np.allclose(s.efforts(q), -np.array([0.3, 0.8, 0.5]) * (q - s.rest), rtol=0, atol=1e-15)
+    (tmp_path / "written.xml").write_text(mjcf_from_mechanism(sprung))
+    back = pkm.load(tmp_path / "written.xml").spec.springs
+    assert back.keys() == sprung.spec.springs.keys()
+    assert all(abs(back[j].get(k, 0.0) - v) <= 1e-15 for j, t in sprung.spec.springs.items() for k, v in t.items())
 
 
 def test_a_spring_s_effort_is_the_derivative_of_its_potential(sprung, rigid):
