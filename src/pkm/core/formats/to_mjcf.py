@@ -65,6 +65,8 @@ free-flyer below the root (MuJoCo allows free joints only on top-level bodies), 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import pinocchio as pin
 from lxml import etree
@@ -218,12 +220,17 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
         if np.isfinite(drive.max_effort):  # the peak limit when there is one, else the continuous one
             motor.set("forcelimited", "true")
             motor.set("forcerange", _num([-drive.max_effort, drive.max_effort]))
-    for name, spring in mech.spec.springs.items():  # (MuJoCo's stiffness, springref and a passive joint's damping)
-        el = next(e for e in world.iter("joint") if e.get("name") == name)
-        for key, attr in (("stiffness", "stiffness"), ("rest", "springref"), ("damping", "damping")):
-            if spring.get(key, 0.0) != 0.0:
-                el.set(attr, repr(float(spring[key])))
+    for name, spring in mech.spec.springs.items():
+        write_spring(next(e for e in world.iter("joint") if e.get("name") == name), spring)
     return etree.tostring(root, pretty_print=True, encoding="unicode")
+
+
+def write_spring(joint: etree._Element, spring: Mapping[str, float]) -> None:
+    """A ``[springs.<joint>]`` table (:mod:`pkm.core.model.springs`) as the MJCF ``joint``'s ``stiffness``,
+    ``springref`` and ``damping`` (those not zero)."""
+    for key, attr in (("stiffness", "stiffness"), ("rest", "springref"), ("damping", "damping")):
+        if spring.get(key, 0.0) != 0.0:
+            joint.set(attr, repr(float(spring[key])))
 
 
 def mjcf_qpos(mech: Mechanism, q: ArrayLike) -> np.ndarray:
@@ -336,4 +343,4 @@ def mimic_leader(model: pin.Model, j: int) -> int:
 
 __all__ = ["DAMPRATIO", "MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "TORQUESCALE", "body_names",
            "closure_softness", "joint_axis", "mimic_leader", "mjcf_from_mechanism", "mjcf_omissions", "mjcf_qpos",
-           "qpos_of"]
+           "qpos_of", "write_spring"]
