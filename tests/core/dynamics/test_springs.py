@@ -16,7 +16,6 @@ import pkm
 from pkm.bench.mujoco_baseline import MujocoRigid, unavailable
 from pkm.core.dynamics.projection import energy
 from pkm.core.formats.to_mjcf import mjcf_from_mechanism
-from pkm.errors import SpecError
 from tests.fd import rel
 
 FOURBAR = Path(__file__).resolve().parents[3] / "examples" / "mjcf_fourbar" / "fourbar.xml"
@@ -122,10 +121,17 @@ def test_khalil_s_projection_and_virtual_work_agree_on_a_sprung_delta(built):
     assert rel(pkm.inverse_dynamics(delta, q, v, a) + share, tau) <= 1e-10 and np.abs(share).min() > 1e-3
 
 
-def test_a_damping_on_an_actuated_joint_is_refused_naming_the_drive(rigid):
-    spec = dataclasses.replace(rigid.spec, springs={"crank_joint": {"stiffness": 1.0, "damping": 0.1}})
-    with pytest.raises(SpecError, match=r"\[springs.crank_joint\].*viscous"):
-        pkm.from_strings(rigid.urdf, spec)
+def test_a_damping_on_an_actuated_joint_adds_to_its_drive_s(rigid, tmp_path):
+    """A spring's damping on the driven crank is in parallel with the drive's viscous friction: Pinocchio's
+    ``damping`` is their sum (exact), the drive keeps its own; the MJCF written has the sum, read back as the drive's
+    viscous (the same friction)."""
+    spec = dataclasses.replace(rigid.spec, springs={"crank_joint": {"stiffness": 1.0, "damping": 0.1}},
+                               actuators={"crank_joint": {"viscous": 0.05}})
+    mech = pkm.from_strings(rigid.urdf, spec)
+    assert mech.model.damping[mech.act_v[0]] == 0.1 + 0.05 and mech.actuators[0].viscous == 0.05
+    (tmp_path / "crank.xml").write_text(mjcf_from_mechanism(mech))
+    back = pkm.load(tmp_path / "crank.xml")
+    assert back.actuators[0].viscous == 0.1 + 0.05 and back.model.damping[back.act_v[0]] == 0.1 + 0.05
 
 
 @pytest.mark.skipif(unavailable() is not None, reason="MuJoCo is a benchmark-only dependency")

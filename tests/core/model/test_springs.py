@@ -77,7 +77,7 @@ def test_a_scaled_copy_scales_a_prismatic_spring_s_rest_length_only(built):
     mech = built("prs3")
     prismatic, revolute = "slider_1", "knee_1"
     assert (mech.joints[prismatic].kind, mech.joints[revolute].kind) == ("JointModelPX", "JointModelRY")
-    springs = {prismatic: {"stiffness": 300.0, "rest": 0.05}, revolute: {"stiffness": 4.0, "rest": 0.3, "damping": 2.0}}
-    sprung = from_strings(mech.urdf, dataclasses.replace(mech.spec, springs=springs))  # (the slider's damping: its drive's)
+    springs = {prismatic: {"stiffness": 300.0, "rest": 0.05, "damping": 2.0}, revolute: {"stiffness": 4.0, "rest": 0.3}}
+    sprung = from_strings(mech.urdf, dataclasses.replace(mech.spec, springs=springs))
     assert scaled_mechanism(sprung, 2.0).spec.springs == {
-        prismatic: {"stiffness": 300.0, "rest": 0.1}, revolute: {"stiffness": 4.0, "rest": 0.3, "damping": 2.0}}
+        prismatic: {"stiffness": 300.0, "rest": 0.1, "damping": 2.0}, revolute: {"stiffness": 4.0, "rest": 0.3}}

@@ -55,7 +55,8 @@ velocity limit is not written, and a drive read back has ``F`` as its (continuou
 inertia and ratio folded into ``armature``.
 
 The joint springs (``[springs]``, :mod:`pkm.core.model.springs`) are their joints' ``stiffness``, ``springref`` and
-(a passive joint's) ``damping``, as MuJoCo applies them.
+``damping`` (on a driven joint added to its drive's: read back, the sum is the drive's ``viscous``), as MuJoCo
+applies them.
 
 pkm's own MJCF reader loads the file back (:mod:`pkm.core.formats.mjcf`), which tests the writer; MuJoCo reads it
 for the benchmark baseline (:mod:`pkm.bench.mujoco_baseline`). Not written: planar and other composite joints, a
@@ -227,10 +228,10 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
 
 def write_spring(joint: etree._Element, spring: Mapping[str, float]) -> None:
     """A ``[springs.<joint>]`` table (:mod:`pkm.core.model.springs`) as the MJCF ``joint``'s ``stiffness``,
-    ``springref`` and ``damping`` (those not zero)."""
+    ``springref`` and ``damping`` (those not zero; the damping added to a drive's, written there before)."""
     for key, attr in (("stiffness", "stiffness"), ("rest", "springref"), ("damping", "damping")):
         if spring.get(key, 0.0) != 0.0:
-            joint.set(attr, repr(float(spring[key])))
+            joint.set(attr, repr(float(spring[key]) + (float(joint.get(attr, 0.0)) if key == "damping" else 0.0)))
 
 
 def mjcf_qpos(mech: Mechanism, q: ArrayLike) -> np.ndarray:

@@ -210,15 +210,11 @@ class Mechanism:
             raise SpecError(source, f"the drives of the model file with the spec's [actuators] tables: {exc}") from None
         for a, j in zip(self.actuators, self.actuated):
             write_model(model, a, j.idx_v)
-        driven = {j.name for j in self.actuated}
-        damped = [n for n, t in spec.springs.items() if "damping" in t and n in driven]
-        if damped:
-            raise SpecError(source, f"[springs.{damped[0]}] gives a damping to an actuated joint: its damping is its "
-                                    f"drive's viscous friction ([actuators.{damped[0]}] viscous)")
+        driven = {j.name: a.viscous for j, a in zip(self.actuated, self.actuators)}
         damping = np.array(model.damping, dtype=float)
-        for n, t in spec.springs.items():  # (a spring's damping is the joint's viscous friction, as a drive's)
-            if "damping" in t:
-                damping[self.joints[n].idx_v] = t["damping"]
+        for n, t in spec.springs.items():  # (a spring's damping is the joint's viscous friction; on a driven joint
+            if "damping" in t:            # in parallel with its drive's)
+                damping[self.joints[n].idx_v] = t["damping"] + driven.get(n, 0.0)
         model.damping = damping
         #: The joint springs' stiffnesses about their rest positions (``[springs]``, :mod:`pkm.core.model.springs`):
         #: the efforts every dynamics route applies; their damping is in the model's ``damping`` (friction).

@@ -22,7 +22,9 @@ and the dynamics apply them:
   where a drive's ``viscous`` goes (:mod:`pkm.core.model.actuators`), it is part of the friction ``f_a``
   (``-c v``): applied where friction is (:func:`pkm.simulate`, by default; :func:`pkm.forward_dynamics` with
   ``friction=True``), counted in a simulation's dissipated energy, and left out of the inverse dynamics as a drive's
-  friction is. An actuated joint's damping is its drive's ``viscous``: a ``damping`` in its spring table is refused.
+  friction is. On an actuated joint it adds to its drive's ``viscous`` (a damper in parallel with the drive: a model
+  file's damping of a driven joint is its drive's, :mod:`pkm.core.formats.mjcf`, not a spring's); the drive's
+  ``viscous`` (:attr:`Mechanism.actuators <pkm.core.model.mechanism.Mechanism.actuators>`) stays its own.
 """
 
 from __future__ import annotations
