@@ -32,12 +32,15 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pinocchio as pin
 
 from pkm.core.model.actuators import number_tables
 from pkm.errors import SpecError
+
+if TYPE_CHECKING:
+    import pinocchio as pin
 
 #: The keys of a ``[springs.<joint>]`` table, each 0 when left out.
 SPRING_KEYS = ("stiffness", "rest", "damping")
@@ -61,7 +64,7 @@ def parse_springs(raw: object, source: str) -> dict[str, dict[str, float]]:
     return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class JointSprings:
     """A mechanism's joint springs, in its Pinocchio coordinates (the one-coordinate joints with a stiffness).
 
