@@ -142,6 +142,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         scaled_mechanism,
         simulate,
         solve_ik,
+        spring_efforts,
         stiffness,
         task_acceleration,
         task_values,

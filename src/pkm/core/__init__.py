@@ -20,7 +20,8 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "pkm.core.dynamics.projection": ("BaseInverseDynamics", "base_inverse_dynamics", "constraint_dynamics",
                                      "forward_dynamics", "inverse_dynamics"),
     "pkm.core.dynamics.model": ("ActuatorSpaceModel", "OperationalSpace", "actuator_model", "bias_efforts",
-                                "coriolis_matrix", "gravity_efforts", "mass_matrix", "operational_space"),
+                                "coriolis_matrix", "gravity_efforts", "mass_matrix", "operational_space",
+                                "spring_efforts"),
     "pkm.core.dynamics.simulate": ("Event", "Simulation", "simulate"),
     "pkm.core.analysis.capability": ("Capability", "Polytope", "capability"),
     "pkm.core.compliance": ("Beam", "Stiffness", "VibrationModes", "stiffness", "vibration_modes"),
@@ -88,6 +89,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         gravity_efforts,
         mass_matrix,
         operational_space,
+        spring_efforts,
     )
     from pkm.core.dynamics.motors import joint_efforts, motor_efforts, motor_values
     from pkm.core.dynamics.projection import (

@@ -239,8 +239,10 @@ class DynamicsAnswer(_Batch):
     q: Column = _ANSWER_Q
     M: Column = _field("Actuator-space mass matrices (na x na a sample; units per entry in units.M, e.g. "
                        "N m/(rad/s^2)).", [[[0.05, 0.0, 0.0], [0.0, 0.05, 0.0], [0.0, 0.0, 0.05]]])
-    h: Column = _field("Actuator-space bias efforts (na a sample: N m, N), gravity included.", [[0.3, 0.3, 0.3]])
-    g: Column = _field("Actuator-space gravity efforts (na a sample: N m, N).", [[0.3, 0.3, 0.3]])
+    h: Column = _field("Actuator-space bias efforts (na a sample: N m, N), gravity and joint springs included.",
+                       [[0.3, 0.3, 0.3]])
+    g: Column = _field("Actuator-space static efforts, gravity's and the joint springs' (na a sample: N m, N).",
+                       [[0.3, 0.3, 0.3]])
     tau: Column | None = _field("Actuator efforts tau = M qdd + h (na a sample: N m, N), with qdd.", [[0.35, 0.3, 0.3]],
                                 None)
     units: Units = _field(UNITS, {"M": [["N m/(rad/s^2)"] * 3] * 3, "h": ["N m"] * 3, "tau": ["N m"] * 3})

@@ -114,6 +114,6 @@ def test_a_finite_speed_limit_beside_an_infinite_one_is_checked():
     qd[:, 0] = 0.1
     W, theta = np.zeros((3 * mech.na, 1)), np.zeros(1)
     for speed, margin in (([0.2, np.inf, 100.0], 0.5), ([np.inf, np.inf, np.inf], 1.0)):
-        out = _check(mech, (qa, qd, None, q, W), lo, hi, (hi - lo) / 2, np.array(speed),
+        out = _check(mech, (qa, qd, None, q, W, np.zeros((3, mech.na))), lo, hi, (hi - lo) / 2, np.array(speed),
                      np.full(mech.na, np.inf), theta, 1e-9)
         assert out is not None and out["speed"] == pytest.approx(margin, rel=1e-12) and out["effort"] == 1.0

@@ -81,3 +81,29 @@ def test_a_batch_stacks_the_samples_and_bad_input_is_refused():
         regressor_batch(mech, Q, QD[:1], QDD)
     with pytest.raises(InvalidInputError):
         regressor(mech, Q[0], [0.0, np.nan, 0.0], QDD[0])
+
+
+def test_springs_and_passive_damping_are_known_efforts_the_estimate_takes_out(tmp_path):
+    """On the sprung four-bar (springs on its three hinges, damping on the passive coupler): the efforts the
+    actuator supplies (``M_a q̈_a + h_a - f_a``) are ``Y_a θ_true`` plus :func:`known_efforts` (1e-10 relative), and
+    pkm.estimate fits them to rounding (1e-9 N m); the known efforts are a good share of the efforts."""
+    from pkm.core.identification.regressor import known_efforts
+    from tests.core.dynamics.test_springs import FOURBAR, SPRUNG
+
+    text = FOURBAR.read_text()
+    for old, new in SPRUNG.items():
+        text = text.replace(old, new)
+    (tmp_path / "fourbar.xml").write_text(text)
+    mech = pkm.load(tmp_path / "fourbar.xml")
+    states = list(_states(mech, 36))
+    Q, QD, QDD = (np.array([s[i] for s in states]) for i in range(3))
+    TAU = np.array([(lambda m: m.efforts(qdd) - m.friction)(pkm.actuator_model(mech, q, qd))
+                    for q, qd, qdd in states])
+    known = known_efforts(mech, Q, QD)
+    theta = parameters(mech).values
+    for k in range(len(Q)):
+        assert np.linalg.norm(regressor(mech, Q[k], QD[k], QDD[k]) @ theta + known[k] - TAU[k]) <= \
+            RTOL * np.linalg.norm(TAU[k])
+    assert np.abs(known).min() > 0.1 * np.abs(TAU).max()  # (the springs carry a good share of the efforts)
+    est = pkm.estimate(mech, Q, QD, QDD, TAU, base=pkm.base_parameters(mech, 40, precise=False))
+    assert est.residual_rms.max() <= 1e-9

@@ -166,3 +166,22 @@ def test_a_small_box_is_said_and_a_point_outside_the_region_or_no_output_refused
         output_limits(t, around=[reg.upper[0] + 0.1], steps=4, tol=1e-4)
     with pytest.raises(pkm.errors.InvalidInputError, match=r"\['nope'\] are no outputs"):
         serial_equivalent(robot("humanoid_knee"), [t], around={"nope": 0.1})
+
+
+def test_a_kept_joint_s_spring_is_written_and_a_locked_one_s_said():
+    """Springs (``[springs]``) on an output (kept: its MJCF ``stiffness``, ``springref``, ``damping``, as MuJoCo
+    compiles them, 1e-15) and on a motor (locked in the serial model: a warning names it, its effort is the kernels'
+    Δh, not the files')."""
+    import dataclasses
+
+    bot = robot("humanoid_ankle")
+    springs = {"ankle_pitch": {"stiffness": 11.0, "rest": -0.05, "damping": 0.3}, "motor_left": {"stiffness": 2.0}}
+    sprung = pkm.from_strings(bot.urdf, dataclasses.replace(bot.spec, springs=springs))
+    with pytest.warns(pkm.errors.PkmWarning, match=r"springs of \['motor_left'\] \(locked"):
+        se = serial_equivalent(sprung, transmissions("humanoid_ankle"), limits=False)
+    text = se.mjcf()
+    assert text.count("stiffness=") == 1 and 'springref="-0.05"' in text and 'damping="0.3"' in text
+    mujoco = pytest.importorskip("mujoco")
+    m = mujoco.MjModel.from_xml_string(text)
+    j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "ankle_pitch")
+    assert (m.jnt_stiffness[j], m.qpos_spring[m.jnt_qposadr[j]], m.dof_damping[m.jnt_dofadr[j]]) == (11.0, -0.05, 0.3)

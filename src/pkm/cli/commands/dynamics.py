@@ -1,6 +1,7 @@
 """``pkm dynamics MECH [--pose K=V ... | --joints NAME=V ...] [--rates NAME=V ...] [--json]``: the actuator-space dynamic model
-(:func:`pkm.actuator_model`) at one state: the mass matrix ``M_a``, the bias ``h_a``, the gravity ``g_a`` and, where
-the mechanism has friction, the friction efforts, each entry with its unit, by actuator name."""
+(:func:`pkm.actuator_model`) at one state: the mass matrix ``M_a``, the bias ``h_a``, the static efforts ``g_a``
+(gravity's and the joint springs') and, where the mechanism has friction, the friction efforts, each entry with its
+unit, by actuator name."""
 
 from __future__ import annotations
 
@@ -58,8 +59,8 @@ def model_dict(mech: pkm.Mechanism, model: ActuatorSpaceModel) -> dict[str, Any]
             "task": {k: "rad" if kind == "angle" else "m" for k, kind in pkm.TaskMap.of(mech).kinds.items()},
             "M": {a: {b: _mass_unit(ra, rb) for b, rb in zip(names, revolute)} for a, ra in zip(names, revolute)},
             "h": effort, "g": effort, "friction": effort,
-            "note": "M_a qdd + h_a = tau_a + friction; h_a: Coriolis, centrifugal, gravity and closure-drift efforts, "
-                    "g_a: gravity alone",
+            "note": "M_a qdd + h_a = tau_a + friction; h_a: Coriolis, centrifugal, gravity, spring and closure-drift "
+                    "efforts, g_a: the static efforts (gravity and the joint springs)",
         },
     }
     return jsonable(out)
@@ -82,7 +83,8 @@ def text(out: dict[str, Any]) -> str:
     lines.append("M_a (mass matrix):")
     lines.append(" " * (width + 2) + "".join(n.rjust(col) for n in names))
     lines += [f"  {a.ljust(width)}" + "".join(c.rjust(col) for c in row) for a, row in zip(names, cells)]
-    for key, label in (("h", "h_a (Coriolis, centrifugal, gravity, closure drift)"), ("g", "g_a (gravity)"),
+    for key, label in (("h", "h_a (Coriolis, centrifugal, gravity, springs, closure drift)"),
+                       ("g", "g_a (static: gravity, springs)"),
                        ("friction", "friction efforts")):
         if out[key] is None:
             continue

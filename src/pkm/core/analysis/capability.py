@@ -7,10 +7,11 @@ Everything here is in the mechanism's **task coordinates** ``y`` (:meth:`pkm.Tas
 angle coordinate's own axis on angles (at zero angles, the platform frame's axes).
 
 * **Wrenches** (static): ``{w : τ_min ≤ Jᵀ w + g_a ≤ τ_max}``: what the platform can hold, the actuators also
-  holding the mechanism's own weight ``g_a`` (:func:`pkm.gravity_efforts`; ``gravity=False`` leaves it out).
+  holding the mechanism's own weight and its joint springs ``g_a`` (:func:`pkm.gravity_efforts`, the static
+  efforts; ``gravity=False`` leaves both out).
 * **Twists**: ``{J q̇_a : |q̇_a| ≤ q̇_max}``, from the actuators' speed limits.
 * **Accelerations** (from rest): ``{J M_a⁻¹ (τ - h_a) : τ_min ≤ τ ≤ τ_max}`` (``M_a``, ``h_a``:
-  :func:`pkm.actuator_model`; at rest ``h_a`` is the gravity's and the ``J̇ q̇`` term vanishes).
+  :func:`pkm.actuator_model`; at rest ``h_a`` is the static efforts ``g_a`` and the ``J̇ q̇`` term vanishes).
 
 Each is a :class:`Polytope` (vertices and half-spaces ``A x ≤ b``), the affine image or preimage of the limits' box,
 exact: with ``J`` square and regular the map is one-to-one, so the vertices are the box's ``2^na`` corners mapped

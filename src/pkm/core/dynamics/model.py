@@ -22,12 +22,16 @@ Then, with :math:`\tau_a` the actuator efforts,
 
 $$
 M_a(q)\,\ddot q_a + h_a(q, \dot q_a) = \tau_a + f_a(q, \dot q_a), \qquad
-M_a = \hat G^\top M \hat G, \qquad h_a = \hat G^\top \mathrm{rnea}(q, \hat G \dot q_a, a_b)
+M_a = \hat G^\top M \hat G, \qquad h_a = \hat G^\top \left(\mathrm{rnea}(q, \hat G \dot q_a, a_b) - \tau_s(q)\right)
 $$
 
-where :math:`h_a` holds the Coriolis, centrifugal and gravity terms and the drift of the closures,
-:math:`g_a = \hat G^\top g(q)` is gravity alone, and :math:`f_a = \hat G^\top (-D v - F \operatorname{sgn}(v))` the joints' friction (Pinocchio's
-``damping`` ``D`` and ``friction`` ``F``, the actuators' viscous and Coulomb friction among them; ``sgn`` a sign
+where :math:`h_a` holds the Coriolis, centrifugal, gravity and spring terms and the drift of the closures,
+:math:`\tau_s = -K (q - q_{rest})` the joint springs' efforts (``[springs]``, :mod:`pkm.core.model.springs`; zero
+without springs), :math:`g_a = \hat G^\top (g(q) - \tau_s(q))` the static efforts, gravity's and the springs' (the
+efforts that hold the mechanism still: :func:`gravity_efforts`; the springs' share
+:math:`s_a = -\hat G^\top \tau_s` is :func:`spring_efforts`), and :math:`f_a = \hat G^\top (-D v - F \operatorname{sgn}(v))` the joints' friction (Pinocchio's
+``damping`` ``D`` and ``friction`` ``F``, the actuators' viscous and Coulomb friction and the springs' damping among
+them; ``sgn`` a sign
 smoothed over ``coulomb_velocity``). :math:`\tfrac{1}{2} \dot q_a^\top M_a \dot q_a` is the kinetic energy. The
 Coriolis matrix :math:`C_a` is built from the Christoffel symbols of :math:`M_a` (:func:`coriolis_matrix`), so that
 :math:`\dot M_a - 2 C_a` is skew-symmetric; the derivatives of ``M_a``
@@ -199,9 +203,13 @@ class ActuatorSpaceModel:
         drift_acceleration: ``a_b`` (nv,): the joint accelerations at ``qdd = 0`` (closure drift compensated, no idle
             acceleration in the mass metric).
         M: ``M_a`` (na x na) [kg m^2, kg]: symmetric, positive definite away from singularities.
-        h: ``h_a`` (na,) [N m, N]: Coriolis, centrifugal, gravity and closure-drift efforts.
-        g: ``g_a`` (na,): the gravity part of ``h_a`` (the efforts that hold the mechanism still).
-        friction: ``f_a`` (na,): the joints' viscous and Coulomb friction at ``v`` (opposes the motion).
+        h: ``h_a`` (na,) [N m, N]: Coriolis, centrifugal, gravity, spring and closure-drift efforts.
+        g: ``g_a`` (na,): the static part of ``h_a``, gravity's and the joint springs' (the efforts that hold the
+            mechanism still; ``g_a - springs`` is gravity's alone).
+        friction: ``f_a`` (na,): the joints' viscous and Coulomb friction at ``v`` (opposes the motion; the springs'
+            damping among it).
+        springs: ``s_a = Ĝᵀ K (q - rest)`` (na,): the joint springs' part of ``g_a`` and ``h_a``, the efforts that
+            hold them (:mod:`pkm.core.model.springs`; zero without springs).
         idle: The idle motions (nv x k, orthonormal), carried by no rate in the mass metric.
         base: How a floating base moves: ``"free"`` (its own equations, no wrench unless applied: ``G``,
             ``drift_acceleration``, ``M``, ``h``, ``g`` and ``friction`` have the base's motion eliminated, module
@@ -231,6 +239,7 @@ class ActuatorSpaceModel:
     base_response: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     base_friction: np.ndarray = field(default_factory=lambda: np.zeros(0))
     _friction_joint: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    springs: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __post_init__(self) -> None:
         for value in vars(self).values():
@@ -361,8 +370,9 @@ def _evaluate(mech: Mechanism, q: np.ndarray, qd: np.ndarray, rtol: float,
     if mech.n_constraints:
         a_b[mech.passive_v] = -red.Jp_pinv @ constraints.drift(mech, q, v)
         a_b = without_idle(red.M, red.idle, a_b)
-    b = pin.rnea(m, d, q, v, a_b).copy()
-    g = pin.computeGeneralizedGravity(m, d, q)
+    spring = mech.springs.efforts(q)  # (τ_s = -k (q - rest): zero without springs)
+    b = pin.rnea(m, d, q, v, a_b) - spring
+    g = pin.computeGeneralizedGravity(m, d, q) - spring
     f_joint = -np.asarray(m.damping) * v - np.asarray(m.friction) * np.tanh(v / coulomb_velocity)
     G = red.G
     response, base_friction = np.zeros((mech.nv, 0)), np.zeros(0)
@@ -384,7 +394,7 @@ def _evaluate(mech: Mechanism, q: np.ndarray, qd: np.ndarray, rtol: float,
     M_a = 0.5 * (M_a + M_a.T)
     return ActuatorSpaceModel(mech, q, qd.copy(), v, G, a_b, finite_result(M_a, "actuator-space mass matrix"),
                               finite_result(Gt @ b, "actuator-space bias"), Gt @ g, Gt @ f_joint, red.idle,
-                              red.M, base, vb, response, base_friction, f_joint)
+                              red.M, base, vb, response, base_friction, f_joint, -(Gt @ spring))
 
 
 def actuator_model(mech: Mechanism, q: ArrayLike, qd: ArrayLike | None = None, *, rtol: float = RTOL,
@@ -451,8 +461,8 @@ def mass_matrix(mech: Mechanism, q: ArrayLike, *, base: str | None = None) -> np
 
 
 def bias_efforts(mech: Mechanism, q: ArrayLike, qd: ArrayLike, *, base: str | None = None) -> np.ndarray:
-    r"""The bias efforts :math:`h_a(q, \dot q_a)` (na,) [N m, N]: Coriolis, centrifugal, gravity and closure-drift
-    efforts, the efforts at :math:`\ddot q_a = 0` in :math:`M_a \ddot q_a + h_a = \tau_a + f_a` (module doc).
+    r"""The bias efforts :math:`h_a(q, \dot q_a)` (na,) [N m, N]: Coriolis, centrifugal, gravity, spring and
+    closure-drift efforts, the efforts at :math:`\ddot q_a = 0` in :math:`M_a \ddot q_a + h_a = \tau_a + f_a` (module doc).
 
     Examples:
         >>> import numpy as np
@@ -468,9 +478,10 @@ def bias_efforts(mech: Mechanism, q: ArrayLike, qd: ArrayLike, *, base: str | No
 
 
 def gravity_efforts(mech: Mechanism, q: ArrayLike, *, base: str | None = None) -> np.ndarray:
-    r"""The gravity efforts :math:`g_a(q) = \hat G^\top g(q)` (na,) [N m, N]: the actuator efforts that hold the
-    mechanism still against gravity (a free base: the efforts that keep the actuated joints still while the whole
-    robot falls; ``base="fixed"`` for those that hold it on a held base).
+    r"""The static efforts :math:`g_a(q) = \hat G^\top (g(q) - \tau_s(q))` (na,) [N m, N]: the actuator efforts that
+    hold the mechanism still against gravity and its joint springs (``[springs]``: :func:`spring_efforts` is their
+    share, zero without springs; a free base: the efforts that keep the actuated joints still while the whole robot
+    falls; ``base="fixed"`` for those that hold it on a held base).
 
     Examples:
         >>> import numpy as np
@@ -480,6 +491,27 @@ def gravity_efforts(mech: Mechanism, q: ArrayLike, *, base: str | None = None) -
         array([0.1797, 0.1797, 0.1797])
     """
     return actuator_model(mech, q, base=base).g.copy()
+
+
+def spring_efforts(mech: Mechanism, q: ArrayLike, *, base: str | None = None) -> np.ndarray:
+    r"""The joint springs' share of the static efforts, :math:`s_a(q) = -\hat G^\top \tau_s(q) = \hat G^\top K
+    (q - q_{rest})` (na,) [N m, N]: the actuator efforts that hold the springs (``[springs]``,
+    :mod:`pkm.core.model.springs`) where ``q`` puts them; zero without springs. :func:`gravity_efforts` includes it.
+
+    Examples:
+        >>> import dataclasses
+        >>> import numpy as np
+        >>> import pkm
+        >>> delta = pkm.load("delta")
+        >>> sprung = pkm.from_strings(delta.urdf, dataclasses.replace(
+        ...     delta.spec, springs={"motor_1": {"stiffness": 2.0, "rest": -0.5}}))  # 2 N m/rad about -0.5 rad
+        >>> q = sprung.q_reference
+        >>> np.round(pkm.spring_efforts(sprung, q), 4) + 0.0  # (motor_1 at 0.0017 rad: 2 (0.0017 + 0.5) on it alone)
+        array([1.0033, 0.    , 0.    ])
+        >>> np.allclose(pkm.gravity_efforts(sprung, q) - pkm.spring_efforts(sprung, q), pkm.gravity_efforts(delta, q))
+        True
+    """
+    return actuator_model(mech, q, base=base).springs.copy()
 
 
 def mass_matrix_derivatives(mech: Mechanism, q: ArrayLike, *, rtol: float = RTOL,
@@ -634,4 +666,4 @@ def forward_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: 
 __all__ = ["BASES", "COULOMB_VELOCITY", "ActuatorSpaceModel", "OperationalSpace", "actuator_model", "base_choice",
            "bias_efforts",
            "coriolis_matrix", "forward_dynamics", "gravity_efforts", "mass_matrix", "mass_matrix_derivatives",
-           "operational_space"]
+           "operational_space", "spring_efforts"]

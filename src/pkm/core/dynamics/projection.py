@@ -28,6 +28,9 @@ so this is the recursive Newton-Euler of every leg, and the platform's free join
 Newton-Euler wrench ``f_p``), ``h_a``/``h_{k,p}`` its actuated/passive leg entries, ``L_{k,p}``
 the passive rows of ``L_k`` (the paper's ``G_2``) and ``w`` an external wrench on the
 platform (world-aligned, at the end-effector frame: force then moment) of Jacobian ``P_e``.
+The joint springs (``[springs]``, :mod:`pkm.core.model.springs`) are efforts on the tree's joints: ``h`` is
+``rnea - τ_s`` on every route (their damping is friction, which the inverse dynamics leaves out), and
+:func:`constraint_dynamics` applies ``τ_s`` with the actuators' efforts.
 
 Independent routes, used by the tests: :func:`virtual_work_dynamics` (``G^T h`` with the
 core's passive map ``G = dq/dq_a``), :func:`constraint_dynamics` (Pinocchio's
@@ -249,7 +252,7 @@ class KhalilProjection:
         q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
         c = Configuration.compute(mech, q)
         proj = self._projection(c.constraint_jacobian)
-        h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches, c)
+        h = _external(mech, q, _tree_efforts(mech, q, v, a), wrench, wrenches, c)
         f = h[part.platform_v].copy()
         tau = np.zeros(mech.na)
         for leg, L in zip(part.legs, proj.L):
@@ -259,6 +262,15 @@ class KhalilProjection:
             f += L[p].T @ hk[p]
         return finite_result(tau + proj.Jk.T @ f, "actuator efforts", "the state is too large for the inertias "
                                                                       "(overflow); check the units")
+
+
+def _tree_efforts(mech: Mechanism, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """The open tree's joint efforts for ``(q, v, a)``: ``rnea(q, v, a) - τ_s(q)``, Pinocchio's inverse dynamics
+    less the joint springs' efforts (``τ_s = -K (q - rest)``, :mod:`pkm.core.model.springs`; a new array)."""
+    out = pin.rnea(mech.model, mech.data, q, v, a).copy()
+    if mech.springs:
+        out -= mech.springs.efforts(q)
+    return out
 
 
 def _external(mech: Mechanism, q: np.ndarray, h: np.ndarray, wrench: ArrayLike | None,
@@ -324,7 +336,7 @@ def _settle_idle(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wren
     N = idle_motions(mech, q)
     if not N.shape[1]:
         return a
-    h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches)
+    h = _external(mech, q, _tree_efforts(mech, q, v, a), wrench, wrenches)
     return a - N @ (idle_inertia_inverse(joint_inertia(mech, q), N) @ (N.T @ h))
 
 
@@ -473,14 +485,14 @@ def base_inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayL
     tau = _motor_efforts(mech, q, v, a, wrench, wrenches, method)
     red = actuator_space._reduce(mech, q, RTOL, "free")
     Gb = red.Gb
-    r = pin.rnea(mech.model, mech.data, q, v, a)  # (a copy: _external leaves it as it is)
+    r = _tree_efforts(mech, q, v, a)  # (a copy: _external leaves it as it is)
     h = _external(mech, q, r, wrench, wrenches)
     w = finite_result(Gb.T @ h, "base wrench")
     needs = False
     if base == "free":
         # relative to the wrenches it sums, moments over the characteristic length (the same for any size)
         unit = np.r_[np.ones(3), np.full(3, 1.0 / mech.characteristic_length)]
-        bias = pin.rnea(mech.model, mech.data, q, v, np.zeros(mech.nv))
+        bias = _tree_efforts(mech, q, v, np.zeros(mech.nv))
         parts = (Gb.T @ (red.M @ a), Gb.T @ bias, Gb.T @ (h - r))
         scale = sum(float(np.linalg.norm(unit * p)) for p in parts)
         needs = bool(np.linalg.norm(unit * w) > BASE_WRENCH_RTOL * scale)
@@ -498,7 +510,7 @@ def virtual_work_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayL
     require_physical(mech, "inverse dynamics")
     q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
     G = passive_map(mech, q)
-    h = _external(mech, q, pin.rnea(mech.model, mech.data, q, v, a), wrench, wrenches)
+    h = _external(mech, q, _tree_efforts(mech, q, v, a), wrench, wrenches)
     return finite_result(G.T @ h, "actuator efforts")
 
 
@@ -597,8 +609,8 @@ def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuate
                                                            "mechanism closed with 3-D points?): pass mu > 0, e.g. "
                                                            "mu=1e-9, or use method='model'")
     base = actuator_space.base_choice(mech, base)
-    tau = np.zeros(mech.nv)
-    tau[mech.act_v] = tau_a
+    tau = mech.springs.efforts(q)  # (the joint springs' efforts, applied as joint torques)
+    tau[mech.act_v] += tau_a
     models, datas = mech.constraint_models, mech.constraint_datas
     if base == "free" and base_wrench is not None:
         tau[mech.base_v] = as_vector(base_wrench, 6, "base_wrench")
@@ -620,19 +632,21 @@ def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuate
 
 
 def energy(mech: Mechanism, q: ArrayLike, v: ArrayLike) -> tuple[float, float]:
-    """Kinetic [J] and potential [J] energy of every body (gravity ``mech.model.gravity``)."""
+    """Kinetic [J] and potential [J] energy of every body: gravity's (``mech.model.gravity``) and the joint
+    springs' (``Σ ½ k (q - rest)²``, :mod:`pkm.core.model.springs`)."""
     mech = check_mechanism(mech)
     require_physical(mech, "the energy")
     q, v = mech.check_q(q), mech.check_v(v)
     m, d = mech.model, mech.data
     if not _has_mimic(m):
-        return float(pin.computeKineticEnergy(m, d, q, v)), float(pin.computePotentialEnergy(m, d, q))
+        return (float(pin.computeKineticEnergy(m, d, q, v)),
+                float(pin.computePotentialEnergy(m, d, q)) + mech.springs.energy(q))
     # Pinocchio 4.1's energy routines refuse mimic joints (the hexapod): sum over the bodies instead
     pin.forwardKinematics(m, d, q, v)
     bodies = range(1, m.njoints)
     kinetic = sum(0.5 * m.inertias[i].vtiv(d.v[i]) for i in bodies)
     potential = -sum(m.inertias[i].mass * float(m.gravity.linear @ d.oMi[i].act(m.inertias[i].lever)) for i in bodies)
-    return float(kinetic), float(potential)
+    return float(kinetic), float(potential) + mech.springs.energy(q)
 
 
 __all__ = ["BASE_WRENCH_RTOL", "FORWARD_METHODS", "METHODS", "BaseInverseDynamics", "KhalilProjection", "Leg", "Partition", "Projection", "base_inverse_dynamics", "constraint_dynamics",

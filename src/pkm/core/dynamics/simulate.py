@@ -36,7 +36,8 @@ The run stops with an :class:`Event`, keeping the samples up to it, where the mo
 A floating base (``spec.floating_base``) is free by default (``base="free"``, :mod:`pkm.core.dynamics.model`): no
 wrench acts on it, its acceleration comes from its own equations, and its pose (position and unit quaternion,
 integrated from its twist: ``ṗ = R v``, ``q̇ = ½ q ⊗ ω``, the quaternion normalised where it is used) and twist join
-the state; with no effort and no friction the energy is conserved (tests). ``base="fixed"`` holds it where ``q0``
+the state; with no effort and no friction the energy is conserved (tests). The joint springs (``[springs]``,
+:mod:`pkm.core.model.springs`) act in ``h_a`` and their energy is in the potential; their damping is friction. ``base="fixed"`` holds it where ``q0``
 puts it. A free base runs in Python (the C route models a held base).
 
 A controller is a callable ``(t, q, v) -> τ_a`` (``q`` the whole configuration, nq; ``v`` the joint rates, nv; the
@@ -125,9 +126,10 @@ class Simulation(Trajectory):
     Attributes:
         time: The sample times (N,) [s].
         kinetic: Kinetic energy (N,) [J] (reflected rotor inertias included).
-        potential: Potential energy under gravity (N,) [J].
+        potential: Potential energy under gravity and in the joint springs (``[springs]``) (N,) [J].
         work: The actuators' work since the start (N,) [J] (trapezoidal rule on the samples).
-        dissipated: The energy friction has taken since the start (N,) [J] (trapezoidal rule; >= 0).
+        dissipated: The energy friction has taken since the start (N,) [J] (trapezoidal rule; >= 0; the springs'
+            damping among it).
         event: Why the run stopped early, or None.
         method: The integrator.
         saturated: Per actuator, the samples whose effort is at or beyond its limit (peak, else continuous): clipped

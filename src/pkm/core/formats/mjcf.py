@@ -44,8 +44,8 @@ does not keep, from the file itself:
   (notes);
 * joint springs and dampers (:attr:`Imported.springs`, a spec's ``[springs.<joint>]`` tables:
   :mod:`pkm.core.model.springs`): a hinge's or slide's ``stiffness`` and ``springref`` (MuJoCo's rest position, in
-  degrees for a hinge as ``ref``), and the ``damping`` of a joint no actuator drives; named in the notes, not applied
-  by pkm's dynamics; a ball's and a coupled joint's are not read (a note);
+  degrees for a hinge as ``ref``), and the ``damping`` of a joint no actuator drives; named in the notes, applied
+  by pkm's dynamics (a damping as the joint's viscous friction); a ball's and a coupled joint's are not read (a note);
 * joint names and position limits (``range``, in degrees unless ``<compiler angle="radian">``, for
   hinges only; a slide's range is a length), with ``<default>`` classes and ``childclass``; a body with
   several joints keeps each one's name (Pinocchio joins them into one composite joint). ``q`` is MuJoCo's
@@ -926,7 +926,7 @@ def _springs(world: etree._Element, defaults: _Defaults, kinds: dict[str, str], 
     """``{joint: {"stiffness", "rest", "damping": value}}`` (:mod:`pkm.core.model.springs`) of the hinges and slides
     whose ``stiffness`` or (for a joint no actuator drives: a driven joint's damping is its drive's) ``damping`` is not
     zero: ``rest`` is MuJoCo's ``springref`` (in degrees for a hinge unless ``<compiler angle="radian">``, as ``ref``).
-    A note names them, and says that pkm's dynamics do not apply them; the springs of ball joints and of joints an
+    A note names them; the springs of ball joints and of joints an
     ``<equality><joint>`` ties are not read (a note)."""
     out: dict[str, dict[str, float]] = {}
     unread = []
@@ -947,7 +947,7 @@ def _springs(world: etree._Element, defaults: _Defaults, kinds: dict[str, str], 
             values["damping"] = damping
         out[name] = values
     if out:
-        notes.append(f"joint springs and dampers read into [springs], their forces not applied by pkm's dynamics: "
+        notes.append(f"joint springs and dampers read into [springs] (applied by pkm's dynamics): "
                      f"{describe(parse_springs(out, source))}")
     if unread:
         notes.append(f"the stiffness and damping of ball joints and of joints an <equality><joint> ties are not "

@@ -58,8 +58,8 @@ joint name sorts first (Cassie's ``left-knee-ip`` before ``left-knee-op``), pkm 
 massless link ``<gearbox>__rotor_mount``, fixed to the reference body by a joint ``<output joint>__<gearbox>``,
 which sorts after the output's (a workaround of that Pinocchio 4.1 restriction, pinned by a test). The rotor's
 SDF position limits, if any, are dropped: its coordinate is the output's. A revolute's or prismatic's
-``<spring_stiffness>`` and ``<spring_reference>`` are its ``[springs]`` entry (:mod:`pkm.core.model.springs`: read,
-not applied by pkm's dynamics; its ``<damping>`` is the joint's friction, as above). Each gearbox so read, and the
+``<spring_stiffness>`` and ``<spring_reference>`` are its ``[springs]`` entry (:mod:`pkm.core.model.springs`: read
+and applied by pkm's dynamics; its ``<damping>`` is the joint's friction, as above). Each gearbox so read, and the
 springs, are listed in :attr:`Imported.notes <pkm.core.formats.base.Imported.notes>`. SDFormat booleans (``use_parent_model_frame``) are ``true`` or ``1``.
 
 Refused with a :class:`~pkm.errors.SpecError`: nested models, ``<include>``, universal and screw joints, a mimic
@@ -518,7 +518,7 @@ def _read_sdf(text: str, source: str) -> Imported:
         if stiffness != 0.0:
             springs[name] = {"stiffness": stiffness, "rest": rest}
     if springs:
-        notes.append(f"joint springs read into [springs], their forces not applied by pkm's dynamics: "
+        notes.append(f"joint springs read into [springs] (applied by pkm's dynamics): "
                      f"{describe(parse_springs(springs, source))}")
     return Imported(urdf, tuple(closures), types, (), robot.get("name"), "sdf", notes=tuple(notes), springs=springs)
 

@@ -54,6 +54,10 @@ simulation may apply, as :func:`pkm.simulate` saturates). MJCF has no joint spee
 velocity limit is not written, and a drive read back has ``F`` as its (continuous) ``effort_limit``, the rotor's
 inertia and ratio folded into ``armature``.
 
+The joint springs (``[springs]``, :mod:`pkm.core.model.springs`) are their joints' ``stiffness``, ``springref`` and
+``damping`` (on a driven joint added to its drive's: read back, the sum is the drive's ``viscous``), as MuJoCo
+applies them.
+
 pkm's own MJCF reader loads the file back (:mod:`pkm.core.formats.mjcf`), which tests the writer; MuJoCo reads it
 for the benchmark baseline (:mod:`pkm.bench.mujoco_baseline`). Not written: planar and other composite joints, a
 free-flyer below the root (MuJoCo allows free joints only on top-level bodies), geometry; each refusal is a
@@ -61,6 +65,8 @@ free-flyer below the root (MuJoCo allows free joints only on top-level bodies), 
 """
 
 from __future__ import annotations
+
+from collections.abc import Mapping
 
 import numpy as np
 import pinocchio as pin
@@ -215,7 +221,17 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
         if np.isfinite(drive.max_effort):  # the peak limit when there is one, else the continuous one
             motor.set("forcelimited", "true")
             motor.set("forcerange", _num([-drive.max_effort, drive.max_effort]))
+    for name, spring in mech.spec.springs.items():
+        write_spring(next(e for e in world.iter("joint") if e.get("name") == name), spring)
     return etree.tostring(root, pretty_print=True, encoding="unicode")
+
+
+def write_spring(joint: etree._Element, spring: Mapping[str, float]) -> None:
+    """A ``[springs.<joint>]`` table (:mod:`pkm.core.model.springs`) as the MJCF ``joint``'s ``stiffness``,
+    ``springref`` and ``damping`` (those not zero; the damping added to a drive's, written there before)."""
+    for key, attr in (("stiffness", "stiffness"), ("rest", "springref"), ("damping", "damping")):
+        if spring.get(key, 0.0) != 0.0:
+            joint.set(attr, repr(float(spring[key]) + (float(joint.get(attr, 0.0)) if key == "damping" else 0.0)))
 
 
 def mjcf_qpos(mech: Mechanism, q: ArrayLike) -> np.ndarray:
@@ -328,4 +344,4 @@ def mimic_leader(model: pin.Model, j: int) -> int:
 
 __all__ = ["DAMPRATIO", "MIN_INERTIA", "MIN_MASS", "SOLIMP", "TIMESTEP", "TORQUESCALE", "body_names",
            "closure_softness", "joint_axis", "mimic_leader", "mjcf_from_mechanism", "mjcf_omissions", "mjcf_qpos",
-           "qpos_of"]
+           "qpos_of", "write_spring"]

@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike
 from pkm._optional import module
 from pkm.core.identification.base import BaseParameters, base_parameters
 from pkm.core.identification.estimate import Estimate, _scale, estimate
-from pkm.core.identification.regressor import parameters, regressor_batch
+from pkm.core.identification.regressor import known_efforts, parameters, regressor_batch
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.plausibility import require_physical
 from pkm.errors import ConvergenceError, InvalidInputError
@@ -112,6 +112,7 @@ def consistent_estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: Array
     P = parameters(mech)
     Q_, QD_, QDD_, TAU_ = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (Q, QD, QDD, TAU))
     Y = regressor_batch(mech, Q_, QD_, QDD_)
+    TAU_ = TAU_ - known_efforts(mech, Q_, QD_)  # (the springs' and the passive joints' friction: no parameter's)
     w = np.tile(ls.weights, len(Q_))
     Yw, yw = Y * w[:, None], TAU_.reshape(-1) * w
     Qf, R = np.linalg.qr(Yw)

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pkm.core.identification.base import BaseParameters, base_parameters
-from pkm.core.identification.regressor import regressor
+from pkm.core.identification.regressor import known_efforts, regressor
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PoorIdentificationWarning, SingularityError
 from pkm.validation import as_array
@@ -141,6 +141,7 @@ def estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, TAU: 
     if n * mech.na < len(base):
         raise InvalidInputError("Q", f"{n * mech.na} equations for {len(base)} base parameters: give more samples", n)
     W = base.regressor(np.vstack([regressor(mech, q, qd, qdd) for q, qd, qdd in zip(Q_, QD_, QDD_)]))
+    TAU_ = TAU_ - known_efforts(mech, Q_, QD_)  # (the springs' and the passive joints' friction: no parameter's)
     peak = float(np.abs(TAU_).max())
     s = _scale(peak)  # (the efforts' sums of squares overflow beyond 1e154: the fit runs on TAU / s, exactly)
     y = TAU_.reshape(-1) / s

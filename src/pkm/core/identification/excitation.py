@@ -42,7 +42,7 @@ import numpy as np
 import scipy.optimize
 
 from pkm.core.identification.base import AMPLITUDE, BaseParameters, base_parameters, per_unit
-from pkm.core.identification.regressor import close_along, parameters, regressor_batch
+from pkm.core.identification.regressor import close_along, known_efforts, parameters, regressor_batch
 from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PkmError
@@ -183,7 +183,7 @@ def excite(mech: Mechanism, *, period: float = 10.0, harmonics: int = 5, samples
         qa, qd, qdd = fourier(times, *unpack(x), omega)
         Q = close_along(mech, qa)
         W = regressor_batch(mech, Q, qd, qdd)
-        return qa, qd, qdd, Q, W
+        return qa, qd, qdd, Q, W, known_efforts(mech, Q, qd)  # (the springs' and passive friction's efforts)
 
     cache: dict[bytes, tuple[np.ndarray, ...] | None] = {}
 
@@ -211,19 +211,19 @@ def excite(mech: Mechanism, *, period: float = 10.0, harmonics: int = 5, samples
         s = evaluated(x)
         if s is None:
             return -np.ones(2 * M * na)
-        qa, qd, _, _, W = s
+        qa, qd, _, _, W, K = s
         out = [((qa - lo) / half).ravel(), ((hi - qa) / half).ravel()]
         if np.isfinite(speed).any():
             out.append((1.0 - np.abs(qd[:, np.isfinite(speed)]) / speed[np.isfinite(speed)]).ravel())
         if np.isfinite(effort).any():
-            tau = (W @ theta).reshape(M, na)
+            tau = (W @ theta).reshape(M, na) + K
             out.append((1.0 - np.abs(tau[:, np.isfinite(effort)]) / effort[np.isfinite(effort)]).ravel())
         return np.concatenate(out)
 
     # the efforts at the offsets alone (rest at the reference): no motion can do with less
     rest = evaluated(np.zeros(na + 2 * na * L))
     if rest is not None and np.isfinite(effort).any():
-        tau0 = (rest[4] @ theta).reshape(M, na)[0]
+        tau0 = (rest[4] @ theta).reshape(M, na)[0] + rest[5][0]
         over = np.abs(tau0) - effort
         if np.any(over > 0):
             j = int(np.argmax(over))
@@ -273,10 +273,10 @@ def excite(mech: Mechanism, *, period: float = 10.0, harmonics: int = 5, samples
     else:
         raise InvalidInputError("singularity", f"no motion within {MAX_SHRINK} shrinks keeps every limit and a "
                                                f"distance {singularity:g} from every singularity", singularity)
-    _, qd, qdd, Q, W = state(x, dense)
+    _, qd, qdd, Q, W, K = state(x, dense)
     offset, a, b = unpack(x)
     return Excitation(tuple(mech.actuated_names), period, offset, a, b, float(np.exp(log_condition(x))), start,
-                      dense, Q, qd, qdd, (W @ theta).reshape(len(dense), na), checked, shrunk, int(res.nit),
+                      dense, Q, qd, qdd, (W @ theta).reshape(len(dense), na) + K, checked, shrunk, int(res.nit),
                       np.column_stack([lo, hi]))
 
 
@@ -285,9 +285,9 @@ def _check(mech: Mechanism, s: tuple[np.ndarray, ...], lo: np.ndarray, hi: np.nd
     """Each limit's smallest margin on the dense samples (module doc), or None where one is not met."""
     from pkm.core.differential.velocity import diagnose
 
-    qa, qd, _, Q, W = s
+    qa, qd, _, Q, W, K = s
     na = mech.na
-    tau = (W @ theta).reshape(len(qa), na)
+    tau = (W @ theta).reshape(len(qa), na) + K
     out = {"joint": float(min(((qa - lo) / half).min(), ((hi - qa) / half).min()))}
     out["speed"] = float((1.0 - np.abs(qd) / speed).min())  # (an infinite limit: a margin of 1, unused)
     out["effort"] = float((1.0 - np.abs(tau) / effort).min())
@@ -318,6 +318,7 @@ def write_csv(mech: Mechanism, excitation: Excitation, path: str, *, periods: in
     qa, qd, qdd = excitation(t)
     Q = close_along(mech, qa)
     tau = (regressor_batch(mech, Q, qd, qdd) @ parameters(mech).values).reshape(len(t), mech.na)
+    tau += known_efforts(mech, Q, qd)  # (the springs' and the passive joints' friction)
     cols = {"time": t}
     for prefix, values in (("q", qa), ("qd", qd), ("qdd", qdd), ("tau", tau)):
         cols.update({f"{prefix}.{j}": values[:, k] for k, j in enumerate(mech.actuated_names)})

@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike
 from pkm.core.identification.base import BaseParameters
 from pkm.core.identification.estimate import Estimate, _scale
 from pkm.core.identification.measurements import Measurements
-from pkm.core.identification.regressor import parameters, regressor_batch
+from pkm.core.identification.regressor import known_efforts, parameters, regressor_batch
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError
 
@@ -175,6 +175,7 @@ def validate(mech: Mechanism, predict: Estimate | ConsistentEstimate, data: Meas
     mech = check_mechanism(mech)
     Y = regressor_batch(mech, data.Q, data.QD, data.QDD)
     pred = np.asarray(predict.predict(Y), dtype=float).reshape(data.TAU.shape)
+    pred = pred + known_efforts(mech, data.Q, data.QD)  # (the springs' and the passive joints' friction)
     if not np.all(np.isfinite(pred)):
         raise InvalidInputError("predict", "its predicted efforts overflow on these samples", predict)
     s = _scale(max(float(np.abs(pred).max(initial=0.0)), float(np.abs(data.TAU).max(initial=0.0))))

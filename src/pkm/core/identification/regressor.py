@@ -18,8 +18,10 @@ regressor takes :func:`~pkm.core.dynamics.model.actuator_model`'s map ``Ĝ`` (ma
 so that no idle acceleration changes the projected efforts), rates ``v = Ĝ q̇_a`` and accelerations. ``Ĝ`` depends on
 the model's own parameters where a rod's inertia is not symmetric about its axis (elsewhere it is the kinematic map):
 ``Y_a`` is then the regressor at those parameters. Passive joints' armature and friction are not parameters (none
-of pkm's mechanisms has any). With that, ``Y_a θ_true`` equals :func:`pkm.inverse_dynamics` plus the drives'
-friction (tests: 1e-10 relative, every shipped mechanism and the acceptance set).
+of pkm's mechanisms has any armature); the joint springs (``[springs]``) and the passive joints' friction (a spring's
+damping) are known efforts, not parameters: :func:`known_efforts`, which the estimates subtract from the measured
+efforts. With that, ``Y_a θ_true`` equals :func:`pkm.inverse_dynamics` plus the drives' friction, less the springs'
+share (tests: 1e-10 relative, every shipped mechanism and the acceptance set).
 """
 
 from __future__ import annotations
@@ -157,6 +159,30 @@ def regressor(mech: Mechanism, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> n
     return finite_result(np.hstack([Yb, drives]), "regressor")
 
 
+def known_efforts(mech: Mechanism, Q: ArrayLike, QD: ArrayLike) -> np.ndarray:
+    """The actuator efforts (N, na) [N m, N] at closed configurations ``Q`` (N, nq) and actuated rates ``QD`` (N, na)
+    that no parameter carries: the joint springs' share of the static efforts (``[springs]`` stiffness,
+    :func:`pkm.spring_efforts`) and the passive joints' friction (a spring's damping, Pinocchio's ``damping`` and
+    ``friction`` off the actuated joints) that the actuators overcome. Measured efforts are ``Y_a θ`` plus these: the
+    estimates subtract them (:func:`pkm.estimate`, :func:`pkm.consistent_estimate`) and the predictions add them
+    (:func:`pkm.validate`). Zero (and not evaluated) without springs or passive friction."""
+    mech = check_mechanism(mech)
+    Q, QD = np.atleast_2d(np.asarray(Q, dtype=float)), np.atleast_2d(np.asarray(QD, dtype=float))
+    out = np.zeros((len(Q), mech.na))
+    passive = np.ones(mech.nv, dtype=bool)
+    passive[mech.act_v] = False
+    passive[mech.base_v] = False
+    rubbing = bool(np.any(np.asarray(mech.model.damping)[passive] != 0.0)
+                   or np.any(np.asarray(mech.model.friction)[passive] != 0.0))
+    if not mech.springs and not rubbing:
+        return out
+    for i, (q, qd) in enumerate(zip(Q, QD)):
+        model = _evaluate(mech, mech.check_q(q), mech.check_actuated(qd, "qd"), RTOL, COULOMB_VELOCITY)
+        f = np.where(passive, model._friction_joint, 0.0)
+        out[i] = model.springs - model.G.T @ f
+    return out
+
+
 AUTO_SAMPLES = 2000  # "auto" compiles a mechanism's regressor for batches of at least this many samples
 BACKENDS = ("auto", "python", "c")
 _KERNELS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # mechanism -> (Kernels or None, why not)
@@ -250,5 +276,5 @@ def regressor_batch(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike
     return np.vstack([regressor(mech, q, qd, qdd) for q, qd, qdd in zip(Q, QD, QDD)])
 
 
-__all__ = ["AUTO_SAMPLES", "BACKENDS", "BODY_FIELDS", "BODY_UNITS", "DRIVE_FIELDS", "Parameters", "close_along", "parameters",
-           "regressor", "regressor_batch", "tree_regressor"]
+__all__ = ["AUTO_SAMPLES", "BACKENDS", "BODY_FIELDS", "BODY_UNITS", "DRIVE_FIELDS", "Parameters", "close_along", "known_efforts",
+           "parameters", "regressor", "regressor_batch", "tree_regressor"]

@@ -35,6 +35,7 @@ from pkm._derived import SLOT
 from pkm.core.model.actuators import Actuator, from_model, write_model
 from pkm.core.model.motors import motor_map
 from pkm.core.model.spec import Branch, ClosureSpec
+from pkm.core.model.springs import JointSprings, joint_springs
 from pkm.core.model.urdf import position_limits
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
 from pkm.units import joint_kind, quantities
@@ -209,6 +210,15 @@ class Mechanism:
             raise SpecError(source, f"the drives of the model file with the spec's [actuators] tables: {exc}") from None
         for a, j in zip(self.actuators, self.actuated):
             write_model(model, a, j.idx_v)
+        driven = {j.name: a.viscous for j, a in zip(self.actuated, self.actuators)}
+        damping = np.array(model.damping, dtype=float)
+        for n, t in spec.springs.items():  # (a spring's damping is the joint's viscous friction; on a driven joint
+            if "damping" in t:            # in parallel with its drive's)
+                damping[self.joints[n].idx_v] = t["damping"] + driven.get(n, 0.0)
+        model.damping = damping
+        #: The joint springs' stiffnesses about their rest positions (``[springs]``, :mod:`pkm.core.model.springs`):
+        #: the efforts every dynamics route applies; their damping is in the model's ``damping`` (friction).
+        self.springs: JointSprings = joint_springs(model, spec.springs)
         #: The motors and their map onto the actuated joints (``[motors]``: a differential; else one per joint).
         self.motor_map = motor_map(spec.actuated, spec.motors, source)
         self.act_q = np.array([j.idx_q for j in self.actuated])

@@ -52,7 +52,7 @@ Format ``pkm.closures/1`` (all values SI: m, rad)::
 
     [springs.knee_spring]            # optional: a joint's spring and damper (pkm.core.model.springs),
     stiffness = 1500.0               # N m/rad; rest = its rest angle (rad), damping (N m s/rad);
-    rest = 0.0                       # described only: pkm's dynamics do not apply them yet
+    rest = 0.0                       # applied by the dynamics (the damping as the joint's friction)
 
     [transmission.left_ankle]        # optional: a closed sub-mechanism's name and output joints
     outputs = ["ankle_pitch", "ankle_roll"]   # (pkm.transmissions; pkm.core.transmissions.decompose)
@@ -201,7 +201,7 @@ class ClosureSpec:
     #: :mod:`pkm.core.model.actuators`), over those of the model file.
     actuators: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     #: ``{joint: {"stiffness", "rest", "damping": value}}``: the joints' springs and dampers (``[springs.<joint>]``,
-    #: :mod:`pkm.core.model.springs`), over those of the model file; read and written, not applied by the dynamics.
+    #: :mod:`pkm.core.model.springs`), over those of the model file; read, written and applied by the dynamics.
     springs: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     #: ``{transmission name: output joints}``: the ``[transmission.<name>]`` tables, the outputs
     #: :func:`pkm.transmissions` gives the closed sub-mechanism that holds them.

@@ -16,7 +16,9 @@ M_o = \hat G^\top M \hat G, \qquad h_o = \hat G^\top \big(h(q, \hat G \dot o) + 
 $$
 
 with ``M`` Pinocchio's mass matrix with the motors' reflected inertia on its diagonal (the rotors included) and
-``h`` the Coriolis, centrifugal and gravity efforts. The motors' rates are ``Ĝ_m ȯ`` (``Ĝ_m = ∂m/∂o``, the inverse of
+``h`` the Coriolis, centrifugal and gravity efforts, less the joint springs' ``τ_s`` (``[springs]``,
+:mod:`pkm.core.model.springs`; those off the outputs are what a serial-equivalent model lacks, in ``Δh``). The motors'
+rates are ``Ĝ_m ȯ`` (``Ĝ_m = ∂m/∂o``, the inverse of
 the velocity map ``J = ∂o/∂m``), so the effort maps are ``τ_m = Jᵀ τ_o = Ĝ_m⁻ᵀ τ_o`` and ``τ_o = Ĝ_mᵀ τ_m``.
 
 Checked (tests) against the independent route of pkm's actuator-space model (the motors independent):
@@ -116,7 +118,7 @@ def output_model(sub: Mechanism, q: np.ndarray, qd_o: np.ndarray, out_v: np.ndar
     [kg m^2, N m; kg, N for prismatic outputs]."""
     sp = output_split(sub, q, out_v, motor_v)
     v = sp.G @ qd_o
-    tau = pin.rnea(sub.model, sub.data, q, v, drift_acceleration(sub, q, v, sp, out_v))
+    tau = pin.rnea(sub.model, sub.data, q, v, drift_acceleration(sub, q, v, sp, out_v)) - sub.springs.efforts(q)
     return sp.G.T @ sp.M @ sp.G, sp.G.T @ tau, sp
 
 

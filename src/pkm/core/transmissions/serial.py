@@ -19,6 +19,9 @@ diagonal entry at the robot's reference (what a constant-armature model uses: ex
 transmission's feasible region (:mod:`pkm.core.transmissions.limits`: the largest box that holds the reference, or
 the point ``around`` gives). :meth:`SerialEquivalent.urdf` and :meth:`SerialEquivalent.mjcf` write it;
 :func:`write_serial_equivalent` writes both and a JSON data file describing each transmission for the kernels.
+The joint springs (``[springs]``) of the joints the serial model keeps are in its MJCF; those of the locked motors
+and passive joints act through their loops, in the kernels' ``Δh``: the serial model's files lack them (a warning
+names them).
 
 Each transmission's ``ΔM`` and ``Δh`` are exact for its sub-mechanism with its root held. On a whole robot whose
 root moves (a knee carrying an ankle, a floating base), the rods' coupling with the joints above the root is not in
@@ -42,7 +45,7 @@ import pinocchio as pin
 from lxml import etree
 
 from pkm.core.analysis.region import SINGULARITY
-from pkm.core.formats.to_mjcf import MIN_INERTIA, MIN_MASS, TIMESTEP, _joints, _num, _pose, qpos_of
+from pkm.core.formats.to_mjcf import MIN_INERTIA, MIN_MASS, TIMESTEP, _joints, _num, _pose, qpos_of, write_spring
 from pkm.core.model.joints import reduced_model
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.urdf import urdf_from_model
@@ -86,8 +89,8 @@ class SerialEquivalent:
         return tuple(o for t in self.transmissions for o in t.outputs)
 
     def urdf(self) -> str:
-        """The serial model as URDF (Pinocchio loads it): the outputs' box limits; URDF has no armature (the data
-        file and the MJCF carry it)."""
+        """The serial model as URDF (Pinocchio loads it): the outputs' box limits; URDF has no armature and no joint
+        spring (the data file and the MJCF carry the armature, the MJCF the springs)."""
         text, types = urdf_from_model(self.model, name=f"{self.robot.name}_serial", limits=self.limits,
                                       source=self.robot.source)
         if types:
@@ -96,8 +99,9 @@ class SerialEquivalent:
 
     def mjcf(self, *, timestep: float = TIMESTEP) -> str:
         """The serial model as MJCF (MuJoCo loads it): one body per joint, the outputs' box limits as ``range``
-        (``limited``), their constant armature, a ``<motor>`` on every output and on every serial joint the robot
-        actuates, the reference as ``<keyframe><key name="reference">``; contacts disabled, the robot's gravity."""
+        (``limited``), their constant armature, the kept joints' springs (``[springs]``: ``stiffness``,
+        ``springref``, ``damping``), a ``<motor>`` on every output and on every serial joint the robot actuates, the
+        reference as ``<keyframe><key name="reference">``; contacts disabled, the robot's gravity."""
         return _mjcf(self, timestep)
 
     def data(self) -> dict[str, Any]:
@@ -183,6 +187,11 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
                                          "serial model's keyframe 'reference' lies outside its limits"), stacklevel=2)
             bounds.update({o: (float(lo), float(hi)) for o, lo, hi in zip(t.outputs, reg.lower, reg.upper)})
     serial.armature = armature
+    locked = [n for t in found for n in (*t.motors, *t.passive) if robot.spec.springs.get(n, {}).get("stiffness")]
+    if locked:
+        warnings.warn(PkmWarning(f"the springs of {locked} (locked in the serial model) act through their loops: "
+                                 "the transmissions' kernels have them (in Δh), the serial model's files do not"),
+                      stacklevel=2)
     keep = [j for j in range(1, robot.model.njoints) if robot.model.names[j] not in
             {robot.model.names[g] for g in gone}]
     q_ref = np.concatenate([robot.q_reference[robot.model.joints[j].idx_q:
@@ -217,6 +226,7 @@ def _mjcf(se: SerialEquivalent, timestep: float) -> str:
                 el.set("limited", "true")
             if armature[jm.idx_v] != 0.0:
                 el.set("armature", repr(float(armature[jm.idx_v])))
+            write_spring(el, se.robot.spec.springs.get(name, {}))  # (a kept joint's spring)
         bodies.append(body)
     keyframe = etree.SubElement(root, "keyframe")
     etree.SubElement(keyframe, "key", name="reference", qpos=_num(qpos))

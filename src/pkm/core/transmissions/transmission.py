@@ -197,8 +197,8 @@ class Transmission:
         data = self.serial.createData()
         M = pin.crba(self.serial, data, q)
         M = np.triu(M) + np.triu(M, 1).T
-        h = pin.rnea(self.serial, data, q, v, np.zeros(self.mechanism.nv))
-        return M[np.ix_(self.out_v, self.out_v)], h[self.out_v]
+        h = pin.rnea(self.serial, data, q, v, np.zeros(self.mechanism.nv)) - self.mechanism.springs.efforts(q)
+        return M[np.ix_(self.out_v, self.out_v)], h[self.out_v]  # (the outputs' own springs: their rows of τ_s)
 
     def delta_mass(self, q_sub: ArrayLike) -> np.ndarray:
         """``ΔM = M_o - M_s`` (k x k) [kg m^2]: the mass matrix the serial-equivalent model (the rods and cranks

@@ -6,7 +6,8 @@ symbols ``q`` (nq), ``v`` (nv) and ``a`` (nv):
 * joint and frame placements, world-aligned frame Jacobians (``LOCAL_WORLD_ALIGNED``, as Pinocchio's);
 * the closure residual (the conventions of :mod:`pkm.core.kinematics.constraints`), its Jacobian and drift
   ``gamma = dJ/dt v``;
-* RNEA (joint torques for ``q, v, a`` under ``model.gravity``), kinetic and potential energy;
+* RNEA (joint torques for ``q, v, a`` under ``model.gravity``, less the joint springs' efforts), kinetic and
+  potential energy (gravity's and the springs');
 * for mechanisms without idle motions: the passive map ``G``, the joint rates and accelerations from the
   actuated ones, the actuator efforts at a consistent state and from ``(q, qd, qdd)`` with their derivatives,
   every linear solve a sparse LU with pivots fixed at the reference (:mod:`~pkm.core.twin.linear`), the closure
@@ -307,7 +308,8 @@ class Twin:
     @functools.cached_property
     def rnea(self) -> Expr:
         """Joint torques (nv) for ``q, v, a`` under ``model.gravity`` (Pinocchio's ``rnea``, the model's ``armature``,
-        the actuators' reflected inertia, included: ``armature * a`` on each joint's diagonal)."""
+        the actuators' reflected inertia, included: ``armature * a`` on each joint's diagonal), less the joint springs'
+        efforts ``τ_s = -k (q - rest)`` (``[springs]``, :mod:`pkm.core.model.springs`), as pkm's inverse dynamics."""
         model = self.mech.model
         n = len(self.joints)
         g = cs.DM(model.gravity.vector)
@@ -325,6 +327,9 @@ class Twin:
         armature = np.asarray(model.armature, dtype=float)  # the actuators' reflected inertia, as Pinocchio's rnea
         for i in np.flatnonzero(armature):
             tau[int(i)] = tau[int(i)] + float(armature[i]) * self.a[int(i)]
+        sp = self.mech.springs
+        for iq, iv, k, rest in zip(sp.idx_q, sp.idx_v, sp.stiffness, sp.rest):
+            tau[int(iv)] = tau[int(iv)] + float(k) * (self.q[int(iq)] - float(rest))
         return tau
 
     @functools.cached_property
@@ -338,7 +343,9 @@ class Twin:
         for j in range(1, len(self.joints)):
             th = self._theta(j) if j in self.design.bodies else cs.DM(self._inertia[j].toDynamicParameters())
             out = out - cs.dot(g, th[0] * self.oMi[j].p + self.oMi[j].R @ th[1:4])  # (m times the centre of mass)
-        return out
+        sp = self.mech.springs  # (and the joint springs', as pkm.core.dynamics.projection.energy)
+        return out + sum((0.5 * float(k) * (self.q[int(iq)] - float(r)) ** 2
+                          for iq, k, r in zip(sp.idx_q, sp.stiffness, sp.rest)), cs.SX(0)) if sp else out
 
     def _theta(self, j: int) -> Expr:
         """Body ``j``'s ten inertial parameters, the design's as symbols."""
