@@ -90,10 +90,11 @@ class MujocoRigid:
         mj.mj_fwdPosition(m, d)
         mj.mj_comVel(m, d)  # the bodies' velocities, which mj_rne reads
         mj.mj_rne(m, d, 1, self._rne)
+        mj.mj_passive(m, d)  # (the joints' springs: efforts the actuators need not give; dampers, like pkm, left out)
         J = d.efc_J[:d.nefc * m.nv].reshape(d.nefc, m.nv) if d.nefc else np.zeros((0, m.nv))
         B = np.zeros((m.nv, len(self._act)))
         B[self._act, np.arange(len(self._act))] = 1.0
-        x = np.linalg.lstsq(np.hstack([B, J.T]), self._rne, rcond=None)[0]
+        x = np.linalg.lstsq(np.hstack([B, J.T]), self._rne - d.qfrc_spring, rcond=None)[0]
         return x[:len(self._act)]
 
 
