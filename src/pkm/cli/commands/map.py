@@ -1,8 +1,11 @@
 """``pkm map MECH --axis NAME=START:STOP:COUNT ... [--q0 NAME=V ...] [--index wrench|twist|acceleration
-[--no-gravity]] [--png FILE] [--csv FILE]``: a workspace and condition-index map over one to three task coordinates (JSON summary, PNG, CSV);
+[--no-gravity]] [--stiffness [--drives K] [--spring NAME=K ...] [--frequency]] [--png FILE] [--csv FILE]``: a
+workspace and condition-index map over one to three task coordinates (JSON summary, PNG, CSV);
 with ``--index``, the capability under actuator limits at every reachable node as well
 (:func:`pkm.core.analysis.capability.map_capability`: the largest value along each task axis each way and the
-largest isotropic value per unit; the PNG and CSV are then the capability's)."""
+largest isotropic value per unit; the PNG and CSV are then the capability's); with ``--stiffness``, the principal
+stiffnesses (and with ``--frequency`` the first natural frequency) at every reachable node
+(:func:`pkm.core.compliance.maps.stiffness_map`; the CSV is then theirs)."""
 
 from __future__ import annotations
 
@@ -11,6 +14,7 @@ import json
 from typing import Any
 
 from pkm.cli.command import Command
+from pkm.cli.commands.stiffness import add_spring_arguments, springs
 from pkm.cli.mechanism import add_mechanism_arguments, add_seed_argument, load_mechanism
 from pkm.cli.parsing import parse_axis, parse_seed, parse_task
 from pkm.cli.usage import UsageError
@@ -31,6 +35,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--index", choices=("wrench", "twist", "acceleration"),
                    help="the capability under the actuators' limits at every reachable node (pkm capability's)")
     p.add_argument("--no-gravity", action="store_true", help="with --index: leave the mechanism's weight out")
+    p.add_argument("--stiffness", action="store_true",
+                   help="the principal stiffnesses at every reachable node (pkm stiffness's; springs below)")
+    add_spring_arguments(p)
+    p.add_argument("--frequency", action="store_true", help="with --stiffness: the first natural frequency too")
     p.add_argument("--png", metavar="FILE", help="draw the condition index (a 3-D map: its middle slab); with "
                                                  "--index, the largest isotropic value (1 or 2 axes)")
     p.add_argument("--csv", metavar="FILE", help="write one row per node")
@@ -47,8 +55,14 @@ def run(args: argparse.Namespace) -> int:
     length = None if args.length is None else parse_quantity(args.length, {"length"}, "--length", "m")
     if args.index and args.png and len(axes) > 2:
         raise UsageError("--index draws one or two axes: leave --png out of a 3-D map (its CSV has every node)")
+    if args.stiffness and args.index:
+        raise UsageError("one of --index and --stiffness a map")
+    if not args.stiffness and (args.frequency or args.spring or args.drives is not None):
+        raise UsageError("--frequency, --spring and --drives go with --stiffness")
+    if args.stiffness and args.png:
+        raise UsageError("--stiffness writes its CSV (--csv), no figure yet")
     m = workspace_map(mech, axes, fixed, branch=args.branch, length=length, seed=parse_seed(mech, args.q0),
-                      configurations=bool(args.index))
+                      configurations=bool(args.index or args.stiffness))
     out: dict[str, Any] = {"mechanism": mech.name, "axes": {n: [float(v[0]), float(v[-1]), len(v)] for n, v in m.axes},
                            "nodes": int(m.reachable.size), "reachable": m.nodes, "size_SI": m.size, "size_unit": m.size_unit,
                            "gci_2": m.gci("2"), "gci_fro_normalized": m.gci("fro_normalized"), "how": m.how}
@@ -58,6 +72,12 @@ def run(args: argparse.Namespace) -> int:
 
         figures = map_capability(mech, m, args.index, gravity=not args.no_gravity)
         out["capability"] = {"kind": args.index, "regular": int(figures.reachable.sum()), **figures.summary()}
+    if args.stiffness:
+        from pkm.core.compliance.maps import stiffness_map
+        from pkm.report import jsonable
+
+        figures = stiffness_map(mech, m, joints=springs(mech, args), frequencies=args.frequency)
+        out["stiffness"] = jsonable(figures.summary())
     if args.csv:
         out["csv"] = str(figures.write_csv(args.csv))
     if args.png:

@@ -25,17 +25,23 @@ TWIST_UNITS = ("m", "m", "m", "rad", "rad", "rad")
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_mechanism_arguments(p, "optional", "optional")
-    p.add_argument("--spring", metavar="NAME=K", action="extend", nargs="+", default=[],
-                   help="a joint's stiffness, SI (N m/rad, N/m); 0 frees it")
-    p.add_argument("--drives", metavar="K", type=float,
-                   help="every actuated joint's stiffness not given by --spring (SI); default: drives rigid")
+    add_spring_arguments(p)
     p.add_argument("--wrench", metavar="K=V", action="extend", nargs="+", default=[],
                    help="a load at the end effector's origin, world axes: fx fy fz (N, kN), mx my mz (N m)")
     p.add_argument("--frequencies", action="store_true", help="the natural frequencies too")
     p.add_argument("--json", action="store_true", help="print JSON (SI, with units)")
 
 
-def _springs(mech, args: argparse.Namespace) -> dict[str, float]:
+def add_spring_arguments(p: argparse.ArgumentParser) -> None:
+    """``--spring NAME=K`` and ``--drives K``: the joints' stiffnesses (``pkm stiffness``, ``pkm map --stiffness``)."""
+    p.add_argument("--spring", metavar="NAME=K", action="extend", nargs="+", default=[],
+                   help="a joint's stiffness, SI (N m/rad, N/m); 0 frees it")
+    p.add_argument("--drives", metavar="K", type=float,
+                   help="every actuated joint's stiffness not given by --spring (SI); default: drives rigid")
+
+
+def springs(mech, args: argparse.Namespace) -> dict[str, float]:
+    """``{joint: stiffness}`` of ``--drives`` and ``--spring`` (SI)."""
     from pkm.units import parse_quantity
 
     out = {j: float(args.drives) for j in mech.actuated_names} if args.drives is not None else {}
@@ -67,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
 
     mech = load_mechanism(args)
     q = configuration(mech, args)
-    joints = _springs(mech, args)
+    joints = springs(mech, args)
     K = pkm.stiffness(mech, q, joints=joints)
     out: dict[str, Any] = {"mechanism": mech.name, "task": pkm.TaskMap.of(mech).named(q),
                            "outside_limits": outside_limits(mech, q), "sprung": dict(K.sprung),

@@ -68,6 +68,8 @@ from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, ModeChangeWarning, PkmWarning, StiffnessError, UnknownNameError
 from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
 
+#: ``links=``: ``"rigid"``, or ``{link: Beam(...) or a 6 x 6 compliance}`` (:mod:`pkm.core.compliance.links`).
+Links = str | Mapping[str, object]
 #: Rank decisions (motions, stiffnesses, compliance) relative to the largest singular value or eigenvalue, on the
 #: homogenised matrices.
 RTOL = 1e-9
@@ -339,7 +341,7 @@ class Stiffness:
         return Deflection(q, exact, first, gap, steps, sp.mech.outside_limits(q))
 
 
-def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: str = "rigid",
+def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: Links = "rigid",
               rtol: float = RTOL) -> Stiffness:
     """The end effector's stiffness at the closed configuration ``q`` (module doc: the model and its assumptions).
 
@@ -474,7 +476,7 @@ class VibrationModes:
     free: int
 
 
-def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: str = "rigid",
+def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: Links = "rigid",
                     rtol: float = RTOL) -> VibrationModes:
     """The natural frequencies and mode shapes at the closed configuration ``q`` with the springs of
     :func:`stiffness` (same ``joints``, ``links`` and ``rtol``; the locked drives held): ``H v = w^2 N^T M N v``
