@@ -30,6 +30,9 @@ CHECKS = {
     "designs": lambda r: r["gough_stewart"]["largest_difference"] <= 1e-12,
     "sweep": lambda r: all(v["equals_serial"] for k, v in r["runs"].items() if k != "serial"),
     "kinematics": lambda r: [row["mechanism"] for row in r] == list(names()) and {row["samples"] for row in r} == {3},
+    "workspace": lambda r: r[0]["generic_reach_agrees"] and all(
+        c["sample_reach_agrees"] and c["sample_max_ci_difference"] <= 1e-9 for c in r) and max(
+        r[0]["generic_max_ci_difference"], r[1]["generic_gci_difference"]) <= 1e-9,
     "dynamics": lambda r: r["max_force_difference_to_baseline_N"]["pkm"] < 1e-9,
     "time_optimal": lambda r: abs(r["cycle_time_s"] - r["cycle_time_core_s"]) <= 1e-6 and (
         "skipped" in r["ankle"] or (r["ankle"]["holds"] and r["ankle"]["labels_equal"])),
