@@ -9,6 +9,8 @@ Computed torque: 1e-6 with the exact model, far more with a 10 % heavier platfor
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -18,7 +20,7 @@ from pkm.bench import arguments, simulation
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
     out = tmp_path_factory.mktemp("simulation")
-    return simulation.run(arguments(simulation, ["--out", str(out)], quick=True)), out
+    return json.loads(json.dumps(simulation.run(arguments(simulation, ["--out", str(out)], quick=True)))), out
 
 
 def test_quick_sizes_apply_to_the_options_not_given():
