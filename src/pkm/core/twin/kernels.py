@@ -364,7 +364,7 @@ class Kernels:
         mechanism and design parameters, whichever of its :class:`Kernels` asks (compiled or not, any ``threads``)."""
         if name not in KERNELS:
             raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", name)
-        built = _FUNCTIONS.setdefault(self.mech, {})
+        built = _FUNCTIONS.setdefault(self.twin.mech, {})  # (a design view's: the twin's, shared)
         key = (tuple(self.design.names), name)
         if key not in built:
             built[key] = self._function(name)
