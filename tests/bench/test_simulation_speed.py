@@ -4,6 +4,8 @@ stable equilibrium (why the 10-s run stays regular); its table, with MuJoCo's ro
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 
 import pkm
@@ -26,7 +28,7 @@ def test_a_quick_run_compares_and_prints():
     assert "simulation_speed" in NAMES
     args = arguments(simulation_speed, quick=True)
     assert args.duration == 0.2 and args.python_duration == 0.05
-    result = simulation_speed.run(args)
+    result = json.loads(json.dumps(simulation_speed.run(args)))  # (JSON-ready, as pkm bench --json prints it)
     for name in ("prs3", "delta"):
         row = result["model"][name]
         assert row["max_relative_difference_to_python"] <= 1e-10 and row["c_batch_us"] > 0.0

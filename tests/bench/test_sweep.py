@@ -27,10 +27,12 @@ def test_the_peak_memory_is_in_megabytes():
 
 
 def test_options_and_quick_sizes():
-    """2048 designs at a 1 cm step by default; --quick 16 at 4 cm; the goals are 1.7 (speedup) and 5 % (overhead)."""
-    assert (arguments(bench_sweep, []).designs, arguments(bench_sweep, []).step) == (2048, 0.01)
+    """2048 designs at a 1 cm step on clusters of 1 and 2 workers by default; --quick 16 at 4 cm on the 2-worker one;
+    the goals are 1.7 (speedup) and 5 % (overhead)."""
+    full = arguments(bench_sweep, [])
+    assert (full.designs, full.step, full.clusters) == (2048, 0.01, "1,2")
     quick = arguments(bench_sweep, ["--quick"])
-    assert (quick.designs, quick.step) == (16, 0.04)
+    assert (quick.designs, quick.step, quick.clusters) == (16, 0.04, "2")
     assert (bench_sweep.GOAL_SPEEDUP, bench_sweep.GOAL_OVERHEAD) == (1.7, 0.05)
 
 
@@ -50,3 +52,6 @@ def test_the_table_has_a_line_per_run_and_the_verdict():
     assert [ln.split()[0] for ln in lines[2:5]] == ["local_1", "local_2", "serial"]
     assert lines[3].split()[-3:] == ["140", "150", "True"] and lines[4].split()[-2:] == ["300", "-"]
     assert "nan" in lines[4] and lines[-1].startswith("speedup 2 workers / 1: 1.82 (goal >= 1.7); overhead 5.0%")
+    del result["runs"]["local_1"]  # (--clusters 2, as --quick: no speedup)
+    assert bench_sweep.table({**result, "speedup_2_over_1": None}).splitlines()[-1].startswith(
+        "speedup 2 workers / 1: - (goal >= 1.7); overhead 5.0%")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -28,26 +29,38 @@ def test_bench_runs_a_benchmark_and_refuses_an_unknown_one(tmp_path):
 CHECKS = {
     "batch": lambda r: r["mechanisms"]["prs3"]["bit_for_bit"],
     "designs": lambda r: r["gough_stewart"]["largest_difference"] <= 1e-12,
-    "sweep": lambda r: all(v["equals_serial"] for k, v in r["runs"].items() if k != "serial"),
+    "sweep": lambda r: len(r["runs"]) > 1 and all(v["equals_serial"] for k, v in r["runs"].items() if k != "serial"),
     "kinematics": lambda r: [row["mechanism"] for row in r] == list(names()) and {row["samples"] for row in r} == {3},
+    "workspace": lambda r: r[0]["generic_reach_agrees"] and all(
+        c["sample_reach_agrees"] and c["sample_max_ci_difference"] <= 1e-9 for c in r) and max(
+        r[0]["generic_max_ci_difference"], r[1]["generic_gci_difference"]) <= 1e-9,
     "dynamics": lambda r: r["max_force_difference_to_baseline_N"]["pkm"] < 1e-9,
     "time_optimal": lambda r: abs(r["cycle_time_s"] - r["cycle_time_core_s"]) <= 1e-6 and (
         "skipped" in r["ankle"] or (r["ankle"]["holds"] and r["ankle"]["labels_equal"])),
 }
 
 
+#: Benchmarks whose quick run a test module of their own makes, its result JSON-ready and checked further than
+#: :data:`CHECKS` could: not run a second time here.
+OWN_TESTS = {"simulation": "tests/bench/test_simulation.py", "simulation_speed": "tests/bench/test_simulation_speed.py"}
+
+
 def test_bench_lists_every_benchmark_module():
     assert sorted(BENCHMARKS) == ["assembly", "batch", "designs", "dynamics", "export", "hexapod", "identification",
                                   "kinematics", "opcount", "serve", "simulation", "simulation_speed", "sweep",
                                   "time_optimal", "transmissions", "twin", "workspace"]
-    assert set(CHECKS) <= set(BENCHMARKS)
+    assert set(CHECKS) <= set(BENCHMARKS) - set(OWN_TESTS) and set(OWN_TESTS) <= set(BENCHMARKS)
+    root = Path(__file__).resolve().parents[2]
+    for name, path in OWN_TESTS.items():  # (each runs it quick and round-trips its result through JSON)
+        text = (root / path).read_text()
+        assert f"arguments({name}" in text and "quick=True" in text and "json.loads(json.dumps(" in text, path
 
 
-@pytest.mark.parametrize("name", BENCHMARKS)
+@pytest.mark.parametrize("name", [n for n in BENCHMARKS if n not in OWN_TESTS])
 def test_each_benchmark_runs_quick(name):
     """What ``pkm bench --quick`` runs, one benchmark a test, in this process (the suite's workers share them, their
     imports and compiled kernels; ``pkm bench --quick`` itself runs from the installed wheel in CI: .ci/wheel):
-    the JSON-ready result of its quick sizes, and the checks of :data:`CHECKS`."""
+    the JSON-ready result of its quick sizes, and the checks of :data:`CHECKS` (those of :data:`OWN_TESTS`: there)."""
     mod = bench.module(name)
     result = json.loads(json.dumps(mod.run(bench.arguments(mod, quick=True))))
     assert result and mod.table(result)

@@ -98,7 +98,7 @@ STIFF_SOLIMP = (0.99, 0.999, 0.001, 0.5, 2.0)  # MuJoCo's stiffer equality run: 
 MUJOCO_SOFTNESS = ([0.02, 1.0], [0.9, 0.95, 0.001, 0.5, 2.0])
 TRACKING_HZ, TRACKING_AMPLITUDE, MASS_ERROR = 5.0, (0.05, 0.005), 1.1
 
-QUICK = {"duration": 0.2, "chirp_duration": 0.2, "tracking_duration": 0.1, "mechanisms": ["delta", "ankle"]}
+QUICK = {"duration": 0.1, "chirp_duration": 0.1, "tracking_duration": 0.05, "mechanisms": ["delta", "ankle"]}
 
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:

@@ -13,7 +13,10 @@ compared between the routes:
 * ``gci_paper_grid``: one design (Fig. 9's) on the paper's map grid, 801 x 801 nodes every 2 mm,
   overall and area GCI. Goal <= 0.5 s.
 
-Usage: ``python -m pkm.bench.workspace [--json] [--quick] [--sample 2000] [--repeat 3]``.
+``--coarsen K`` keeps every K-th node of both grids along each axis (positions every K cm, orientations every K deg,
+the map every 2K mm); ``--quick`` takes K = 10 (4,477 and 6,561 nodes: a check that it runs, not its timings).
+
+Usage: ``python -m pkm.bench.workspace [--json] [--quick] [--sample 2000] [--repeat 3] [--coarsen 1]``.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from pkm.mechanisms import rrr3
 from pkm.mechanisms.rrr3 import workspace as maps
 from pkm.papers.rrr3 import paper_grid
 
-QUICK = {"sample": 10, "repeat": 1}
+QUICK = {"sample": 10, "repeat": 1, "coarsen": 10}
 
 
 def _best(fn, repeat: int) -> float:
@@ -55,10 +58,11 @@ def _generic(design, axes: dict, fixed: dict, repeat: int):
     return best_time(lambda: workspace_map(mech, axes, fixed, length=length, kernels=kernels), repeat)
 
 
-def bench_3d(sample: int, repeat: int, rng: np.random.Generator) -> dict:
+def bench_3d(sample: int, repeat: int, rng: np.random.Generator, coarsen: int = 1) -> dict:
     p = rrr3.Rrr3Params()
-    xs = np.linspace(0.0, p.H, 101)
-    phis = np.radians(np.arange(-180, 181))
+    xs = np.linspace(0.0, p.H, 100 // coarsen + 1)
+    phis = np.radians(np.linspace(-180.0, 180.0, 360 // coarsen + 1))
+    phi0 = int(np.argmin(np.abs(phis)))
     settings = maps.CiSettings()
     result = {}
 
@@ -85,13 +89,14 @@ def bench_3d(sample: int, repeat: int, rng: np.random.Generator) -> dict:
         "naive_extrapolated_s": per_node * sw.nodes, "ratio_naive_over_vectorised": per_node * sw.nodes / t_vec,
         "sample_reach_agrees": bool(np.array_equal(both, np.isfinite(vec))),
         "sample_max_ci_difference": float(np.max(np.abs(vec[both] - naive[both]))) if both.any() else 0.0,
-        "area_phi0_cm2": float(sw.areas[180] * 1e4), "gci_phi0": float(sw.gci[180]),
+        "area_phi0_cm2": float(sw.areas[phi0] * 1e4), "gci_phi0": float(sw.gci[phi0]),
     }
 
 
-def bench_gci(sample: int, repeat: int, rng: np.random.Generator) -> dict:
+def bench_gci(sample: int, repeat: int, rng: np.random.Generator, coarsen: int = 1) -> dict:
     d = maps.Design.similarity_law(2.0)
     grid = paper_grid(d)
+    grid = maps.Grid(grid.centre, grid.n // coarsen, grid.step * coarsen)
     settings = maps.CiSettings()
     result = {}
 
@@ -121,11 +126,12 @@ def bench_gci(sample: int, repeat: int, rng: np.random.Generator) -> dict:
 def add_arguments(ap) -> None:
     ap.add_argument("--sample", type=int, default=2000, help="nodes timed in the naive loop, per case")
     ap.add_argument("--repeat", type=int, default=3, help="vectorised runs per case (best is kept)")
+    ap.add_argument("--coarsen", type=int, default=1, help="every K-th node of each grid along each axis (default 1)")
 
 
 def run(args) -> list[dict]:
     rng = np.random.default_rng(0)
-    return [bench_3d(args.sample, args.repeat, rng), bench_gci(args.sample, args.repeat, rng)]
+    return [bench_3d(args.sample, args.repeat, rng, args.coarsen), bench_gci(args.sample, args.repeat, rng, args.coarsen)]
 
 
 def table(results: list[dict]) -> str:

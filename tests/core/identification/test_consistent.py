@@ -101,3 +101,15 @@ def test_efforts_of_order_1e300_give_a_finite_residual_rms():
     res = (tau - (pkm.regressor_batch(mech, Q, QD, QDD) @ est.theta).reshape(tau.shape)) / 1e300
     assert np.all(np.isfinite(est.residual_rms))
     assert np.allclose(est.residual_rms / 1e300, np.sqrt(np.mean(res**2, axis=0)), rtol=1e-12, atol=0)
+
+
+def test_cvxpy_is_imported_and_jax_left_importable():
+    """``_cvxpy`` hides JAX from cvxpy's solver probe only for the import (MPAX absent): afterwards ``sys.modules``
+    holds no ``None`` for JAX (``import jax`` works as before) and cvxpy knows Clarabel."""
+    import sys
+
+    from pkm.core.identification.consistent import _cvxpy
+
+    cp = _cvxpy("a test")
+    assert cp is sys.modules["cvxpy"] and "CLARABEL" in cp.installed_solvers()
+    assert sys.modules.get("jax", "not imported") is not None

@@ -22,6 +22,7 @@ the 1e-3 level; the problem is stated on the ``R`` factor of the weighted regres
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import ModuleType
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -35,6 +36,23 @@ from pkm.core.model.plausibility import require_physical
 from pkm.errors import ConvergenceError, InvalidInputError
 
 REGULARISATION = 1e-6  # ε, relative to the weighted regressor's mean squared column norm
+
+
+def _cvxpy(what: str) -> ModuleType:
+    """``cvxpy``, imported without JAX where the MPAX solver is absent: cvxpy's import asks every solver whether it is
+    installed by importing it, and MPAX's check imports JAX (1.5 s of CPU) before it fails on ``mpax``; pkm solves
+    with Clarabel. (JAX imports as usual afterwards.)"""
+    import importlib.util
+    import sys
+
+    hide = "cvxpy" not in sys.modules and "jax" not in sys.modules and importlib.util.find_spec("mpax") is None
+    if hide:
+        sys.modules["jax"] = None  # type: ignore[assignment]  # (import jax: ModuleNotFoundError, as when absent)
+    try:
+        return module("cvxpy", extra="identify", what=what)
+    finally:
+        if hide and "jax" in sys.modules and sys.modules["jax"] is None:
+            del sys.modules["jax"]
 
 
 def pseudo_inertia(theta10: ArrayLike) -> np.ndarray:
@@ -105,7 +123,7 @@ def consistent_estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: Array
     what = "the physically consistent estimate"
     mech = check_mechanism(mech)
     require_physical(mech, what + " (its prior: the model's inertias)")
-    cp = module("cvxpy", extra="identify", what=what)
+    cp = _cvxpy(what)
     module("clarabel", extra="identify", what=what)
     base = base if base is not None else base_parameters(mech, precise=False)
     ls = ls if ls is not None else estimate(mech, Q, QD, QDD, TAU, base=base)

@@ -36,6 +36,7 @@ import functools
 import itertools
 import os
 import threading
+import weakref
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -359,10 +360,18 @@ class Kernels:
 
     # ---------------------------------------------------------------- kernels
     def function(self, name: str) -> cs.Function:
-        """The CasADi function of a kernel (:data:`KERNELS`), inputs and outputs dense, after CSE."""
-        tw, tk = self.twin, TaskTwin.of(self.twin)
+        """The CasADi function of a kernel (:data:`KERNELS`), inputs and outputs dense, after CSE: built once per
+        mechanism and design parameters, whichever of its :class:`Kernels` asks (compiled or not, any ``threads``)."""
         if name not in KERNELS:
             raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", name)
+        built = _FUNCTIONS.setdefault(self.twin.mech, {})  # (a design view's: the twin's, shared)
+        key = (tuple(self.design.names), name)
+        if key not in built:
+            built[key] = self._function(name)
+        return built[key]
+
+    def _function(self, name: str) -> cs.Function:
+        tw, tk = self.twin, TaskTwin.of(self.twin)
         if name == "regressor":  # (a twin of its own: the bodies' parameters as symbols)
             from pkm.core.twin.regressor import regressor_function
 
@@ -668,6 +677,8 @@ class Kernels:
 
 
 _PATHS = ("closure_newton", "ik_newton")  # the kernels with the path driver
+#: mechanism -> {(design parameters, kernel): its CasADi function} (:meth:`Kernels.function`)
+_FUNCTIONS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _DYNAMICS = ("mass_matrix", "bias", "gravity", "mass_and_bias", "forward_dynamics")  # the actuator-space model's
 
 #: Each kernel's inputs and outputs.

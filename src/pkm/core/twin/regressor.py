@@ -19,6 +19,8 @@ handles them).
 
 from __future__ import annotations
 
+import weakref
+
 import casadi as cs
 
 from pkm.core.dynamics.model import COULOMB_VELOCITY
@@ -56,13 +58,22 @@ def regressor_function(mech: Mechanism) -> cs.Function:
     copy) and the passive solve's smallest relative pivot
     (:meth:`~pkm.core.twin.linear.PivotedLU.smallest_relative_pivot`).
 
+    Built once per mechanism (the compiled kernels and the 50-digit rank route take the same one).
+
     Raises:
         SpecError: the mechanism has idle motions, or a joint kind the twin does not handle.
     """
-    twin = ParametricTwin(check_mechanism(mech))
-    Y = regressor_expression(twin)
-    outs = cs.cse([cs.densify(Y.T), cs.densify(cs.SX(twin.passive_lu.smallest_relative_pivot()))])
-    return cs.Function("pkm_regressor", [twin.q, twin.qd, twin.qdd], outs, ["q", "qd", "qdd"], ["Yt", "pivot"])
+    mech = check_mechanism(mech)
+    if mech not in _FUNCTIONS:
+        twin = ParametricTwin(mech)
+        Y = regressor_expression(twin)
+        outs = cs.cse([cs.densify(Y.T), cs.densify(cs.SX(twin.passive_lu.smallest_relative_pivot()))])
+        _FUNCTIONS[mech] = cs.Function("pkm_regressor", [twin.q, twin.qd, twin.qdd], outs, ["q", "qd", "qdd"],
+                                       ["Yt", "pivot"])
+    return _FUNCTIONS[mech]
+
+
+_FUNCTIONS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # mechanism -> its regressor_function
 
 
 __all__ = ["ParametricTwin", "regressor_expression", "regressor_function"]
