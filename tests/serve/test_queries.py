@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import numpy as np
+import pytest
+
 import pkm
 from pkm.serve import queries
 
@@ -162,3 +165,26 @@ def test_a_map_job_takes_units_as_pkm_map_does():
     assert np.allclose(units["condition_index"], si["condition_index"], rtol=1e-12, atol=0)
     with pytest.raises(UnitError, match=r"axes\.z"):
         jobs._map(mech, {"axes": {"z": ["-40deg", "-30cm", 3]}}, jobs.Job("c", "map", "delta"))
+
+
+def test_the_stiffness_query_is_the_librarys():
+    """POST /models/{model}/stiffness: the compliance, rank, principal compliances (1 / the principal stiffnesses,
+    0 along rigid directions) and a wrench's deflection are pkm.stiffness's; a joint that does not exist is pkm's
+    error."""
+    from pkm.errors import UnknownNameError
+
+    QUERIES = queries.QUERIES
+    delta = pkm.load("delta")
+    qa = delta.actuated_q(delta.q_reference).tolist()
+    out = QUERIES["stiffness"](delta, {"qa": [qa, qa], "drives": 400.0, "springs": {"motor_2": 800.0},
+                                       "wrench": [1.0, 0.0, -10.0, 0.0, 0.0, 0.0]})
+    K = pkm.stiffness(delta, delta.q_reference, joints={"motor_1": 400.0, "motor_2": 800.0, "motor_3": 400.0})
+    assert out["status"] == ["ok", "ok"] and list(out["rank"]) == [3, 3]
+    assert np.allclose(out["compliance"][1], K.compliance, rtol=1e-12, atol=1e-18)
+    assert np.allclose(1.0 / out["force_compliance"][0], K.principal("force")[0], rtol=1e-9)
+    assert not np.any(out["moment_compliance"][0]) and out["units"]["force_compliance"] == "m/N"
+    d = K.deflection([1.0, 0.0, -10.0, 0.0, 0.0, 0.0])
+    assert np.allclose(out["displacement"][0], d.displacement, rtol=1e-9, atol=1e-15)
+    assert out["gap"][0] == pytest.approx(d.gap, rel=1e-6)  # (q closed from qa by the service: 1e-13 apart)
+    with pytest.raises(UnknownNameError):
+        QUERIES["stiffness"](delta, {"qa": qa, "springs": {"motor_9": 1.0}})

@@ -16,7 +16,7 @@ from tests.serve.conftest import TOKEN
 
 AUTH = {"authorization": f"Bearer {TOKEN}"}
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-QUERIES = ("fk", "ik", "jacobians", "diagnose", "velocities", "dynamics", "capability", "scene")
+QUERIES = ("fk", "ik", "jacobians", "diagnose", "velocities", "dynamics", "capability", "scene", "stiffness")
 
 
 @pytest.fixture(scope="module")
@@ -119,7 +119,8 @@ def test_every_answer_matches_its_published_schema(service, openapi):
     one = {"fk": {"qa": qa0.tolist()}, "ik": {"y": [0.0, 0.0, "-35cm"]},
            "velocities": {"qa": qa0.tolist(), "qd": [0.1, 0.0, 0.0], "qdd": [1.0, 0.0, 0.0]},
            "dynamics": {"q": q0.tolist(), "qd": [0.1, 0.0, 0.0], "qdd": [1.0, 0.0, 0.0]},
-           "capability": {"qa": qa0.tolist(), "kind": "twist"}}
+           "capability": {"qa": qa0.tolist(), "kind": "twist"},
+           "stiffness": {"qa": qa0.tolist(), "drives": 500.0, "wrench": [0.0, 0.0, -10.0, 0.0, 0.0, 0.0]}}
     for name in QUERIES:
         single = one.get(name, {"qa": qa0.tolist()})
         out = call(name, f"/models/delta/{name}", json=single)

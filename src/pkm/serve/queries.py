@@ -568,6 +568,47 @@ def _capability_labels(mech: Mechanism, kind: str) -> tuple[tuple[str, ...], tup
     return tuple(c0.polytope.axes), tuple(c0.polytope.units), tuple(c0.isotropic)
 
 
+@_limits
+def stiffness(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
+    """At closed configurations (``q``, or ``qa`` closed), the end effector's compliance with the joints' springs
+    (``springs`` by name, ``drives`` for every actuated joint not named; the others held rigid or free:
+    :func:`pkm.stiffness`), its rank, its principal compliances under a pure force and a pure moment with their
+    directions, and with ``wrench`` the exact and the first-order deflection."""
+    from pkm.core.compliance import stiffness as run
+    from pkm.validation import as_scalar
+
+    joints: dict[str, Any] = {}
+    if body.get("drives") is not None:
+        joints = dict.fromkeys(mech.actuated_names, as_scalar(body["drives"], "drives", low=0.0))
+    springs = body.get("springs")
+    if springs is not None:
+        if not isinstance(springs, Mapping):
+            raise InvalidInputError("springs", "a mapping {joint: stiffness} [N m/rad, N/m]", springs)
+        joints.update(springs)
+    wrench = body.get("wrench")
+    q, samples = _configurations(mech, body, kernels)
+
+    def one(k: int) -> dict[str, Any]:
+        K = run(mech, q[k], joints=joints)
+        out = {"q": q[k], "compliance": K.compliance, "rank": K.rank}
+        for load, block in (("force", K.compliance[:3, :3]), ("moment", K.compliance[3:, 3:])):
+            c, U = np.linalg.eigh(block)
+            out[f"{load}_compliance"], out[f"{load}_directions"] = np.maximum(c[::-1], 0.0), U[:, ::-1].T
+        if wrench is not None:
+            d = K.deflection(wrench)
+            out.update(displacement=d.displacement, first_order=d.first_order, gap=d.gap)
+        return out
+
+    keys = ("q", "compliance", "rank", "force_compliance", "force_directions", "moment_compliance",
+            "moment_directions") + (("displacement", "first_order", "gap") if wrench is not None else ())
+    out = samples.each(one, keys)
+    out["units"] = {"q": _q_units(mech), "compliance": [["m/N"] * 3 + ["m/(N m)"] * 3] * 3
+                    + [["rad/N"] * 3 + ["rad/(N m)"] * 3] * 3, "rank": "1", "force_compliance": "m/N",
+                    "force_directions": "1", "moment_compliance": "rad/(N m)", "moment_directions": "1",
+                    "displacement": ["m"] * 3 + ["rad"] * 3, "first_order": ["m"] * 3 + ["rad"] * 3, "gap": "1"}
+    return out
+
+
 _SCENES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
@@ -598,7 +639,7 @@ def scene(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict
 #: The queries by name (the endpoints ``POST /models/{model}/{name}``).
 QUERIES: dict[str, Callable[[Mechanism, Mapping[str, Any], Any], dict[str, Any]]] = {
     "fk": fk, "ik": ik, "jacobians": jacobians, "diagnose": diagnose, "velocities": velocities,
-    "dynamics": dynamics, "capability": capability, "scene": scene}
+    "dynamics": dynamics, "capability": capability, "scene": scene, "stiffness": stiffness}
 
 
 def describe(mech: Mechanism) -> dict[str, Any]:

@@ -265,6 +265,31 @@ class CapabilityAnswer(_Batch):
     units: Units = _field(UNITS, {"along": ["N", "N", "N"], "isotropic": ["N"]})
 
 
+class StiffnessAnswer(_Batch):
+    """The end effector's compliance (its inverse is the stiffness where rank is 6), its principal compliances and,
+    with a wrench, the exact and first-order deflections."""
+
+    q: Column = _ANSWER_Q
+    compliance: Column = _field("The compliance C (6 x 6 a sample): the small displacement (dx, dy, dz, rx, ry, rz) "
+                                "per wrench (fx, fy, fz, mx, my, mz) at the end effector's origin, world axes; units "
+                                "per entry in units.compliance.", [[[1e-5] + [0.0] * 5] * 6])
+    rank: IntColumn = _field("The rank of C (6: invert it for the stiffness; fewer: rigid along the others).", [3])
+    force_compliance: Column = _field("Under a pure force: the principal compliances, largest first [m/N] (1/each: "
+                                      "the principal stiffnesses; 0: rigid).", [[3e-5, 3e-5, 8e-6]])
+    force_directions: Column = _field("Their unit directions (3 x 3 a sample, one per row), world axes.",
+                                      [[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]])
+    moment_compliance: Column = _field("Under a pure moment: the principal compliances, largest first [rad/(N m)].",
+                                       [[0.0, 0.0, 0.0]])
+    moment_directions: Column = _field("Their unit directions (3 x 3 a sample), world axes.",
+                                       [[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]])
+    displacement: Column | None = _field("With a wrench: the exact deflection (dx, dy, dz [m], rotation vector [rad]).",
+                                         None, None)
+    first_order: Column | None = _field("With a wrench: the first-order deflection C W, same layout.", None, None)
+    gap: Column | None = _field("With a wrench: their relative difference (homogenised by the model's size).", None,
+                                None)
+    units: Units = _field(UNITS, {"force_compliance": "m/N", "moment_compliance": "rad/(N m)"})
+
+
 class SceneAnswer(_Batch):
     """The world placement of every body of the model's 3-D scene."""
 
@@ -274,6 +299,19 @@ class SceneAnswer(_Batch):
                               "(translation, entries 12 to 14, in m).",
                               [[[1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0.0, 0.0, 0.0, 1]]])
     units: Units = _field(UNITS, {"matrices": ["1"] * 12 + ["m"] * 3 + ["1"]})
+
+
+class StiffnessRequest(_AtConfigurations):
+    """The end effector's compliance with joint springs (pkm.stiffness), and a load's deflection."""
+
+    springs: dict[str, float] | None = _field("A joint's stiffness by name (N m/rad for a revolute, N/m for a "
+                                              "prismatic joint; 0 frees it), over the model's own springs.",
+                                              {"motor_1": 500.0}, None)
+    drives: float | None = _field("Every actuated joint's stiffness not named in springs (SI); default: the drives "
+                                  "held rigid.", 500.0, None)
+    wrench: list[float] | None = _field("A constant load at the end effector's origin, world axes (fx, fy, fz [N], "
+                                        "mx, my, mz [N m]): its exact deflection is answered too.",
+                                        [0.0, 0.0, -10.0, 0.0, 0.0, 0.0], None)
 
 
 #: Per query: (request model, answer model, summary).
@@ -286,6 +324,7 @@ QUERY_MODELS: dict[str, tuple[type[BaseModel], type[BaseModel], str]] = {
     "dynamics": (DynamicsRequest, DynamicsAnswer, "The actuator-space dynamic model and the inverse dynamics"),
     "capability": (CapabilityRequest, CapabilityAnswer, "The wrench, twist or acceleration capability"),
     "scene": (SceneRequest, SceneAnswer, "The 3-D scene's body placements"),
+    "stiffness": (StiffnessRequest, StiffnessAnswer, "The end effector's compliance with joint springs"),
 }
 
 
