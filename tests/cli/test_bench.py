@@ -35,6 +35,7 @@ CHECKS = {
         c["sample_reach_agrees"] and c["sample_max_ci_difference"] <= 1e-9 for c in r) and max(
         r[0]["generic_max_ci_difference"], r[1]["generic_gci_difference"]) <= 1e-9,
     "dynamics": lambda r: r["max_force_difference_to_baseline_N"]["pkm"] < 1e-9,
+    "stiffness": lambda r: r["max_relative_difference"] < 1e-9 and r["map"]["with_stiffness"] > 0,
     "time_optimal": lambda r: abs(r["cycle_time_s"] - r["cycle_time_core_s"]) <= 1e-6 and (
         "skipped" in r["ankle"] or (r["ankle"]["holds"] and r["ankle"]["labels_equal"])),
 }
@@ -47,8 +48,8 @@ OWN_TESTS = {"simulation": "tests/bench/test_simulation.py", "simulation_speed":
 
 def test_bench_lists_every_benchmark_module():
     assert sorted(BENCHMARKS) == ["assembly", "batch", "designs", "dynamics", "export", "hexapod", "identification",
-                                  "kinematics", "opcount", "serve", "simulation", "simulation_speed", "sweep",
-                                  "time_optimal", "transmissions", "twin", "workspace"]
+                                  "kinematics", "opcount", "serve", "simulation", "simulation_speed", "stiffness",
+                                  "sweep", "time_optimal", "transmissions", "twin", "workspace"]
     assert set(CHECKS) <= set(BENCHMARKS) - set(OWN_TESTS) and set(OWN_TESTS) <= set(BENCHMARKS)
     root = Path(__file__).resolve().parents[2]
     for name, path in OWN_TESTS.items():  # (each runs it quick and round-trips its result through JSON)

@@ -26,7 +26,8 @@ from typing import Any
 
 from pkm.errors import UnknownNameError
 
-NAMES = ("assembly", "batch", "designs", "dynamics", "export", "hexapod", "identification", "kinematics", "opcount", "serve", "simulation", "simulation_speed", "sweep", "time_optimal", "transmissions", "twin", "workspace")
+NAMES = ("assembly", "batch", "designs", "dynamics", "export", "hexapod", "identification", "kinematics", "opcount", "serve",
+         "simulation", "simulation_speed", "stiffness", "sweep", "time_optimal", "transmissions", "twin", "workspace")
 
 
 def module(name: str) -> ModuleType:
