@@ -91,8 +91,9 @@ def test_a_loaded_mechanism_sweeps_its_joint_origins():
 def test_the_capability_of_a_loaded_mechanism_s_designs_through_the_shared_twin():
     """The acceptance-set Gough-Stewart with two base joints moved: the capability objective (the smallest
     isotropic force and the mean isotropic moment its 1000 N legs give over a 6 x 6 map) through the family's shared
-    twin equals :func:`map_capability` on the design's own mechanism and kernels to 1e-12; a unit group the task
-    has not is refused, naming those it has."""
+    twin equals :func:`map_capability` on the design's own mechanism and kernels to 1e-12, the stiffness objective
+    (1e6 N/m legs) :func:`stiffness_map`'s smallest to 1e-9; a unit group the task has not is refused, naming those
+    it has."""
     from pkm.core.analysis.capability import map_capability
     from tests.core.twin.test_tree import FILES
 
@@ -100,7 +101,8 @@ def test_the_capability_of_a_loaded_mechanism_s_designs_through_the_shared_twin(
     region = "region=x=-0.1:0.1:6/y=-0.1:0.1:6,length=0.5"
     values = {"u1.x": 0.49, "u2.y": 0.14}
     res = pkm.sweep(mech, sweeps.table([values]), [f"f=capability:{region}",
-                                                   f"m=capability:{region},unit=N m,stat=mean"], scheduler="serial")
+                                                   f"m=capability:{region},unit=N m,stat=mean",
+                                                   f"k=stiffness:{region},drives=1e6"], scheduler="serial")
     design = sweeps.family_of(mech).mechanism(values)
     wmap = pkm.workspace_map(design, {"x": np.linspace(-0.1, 0.1, 6), "y": np.linspace(-0.1, 0.1, 6)},
                              length=0.5, configurations=True)
@@ -108,6 +110,10 @@ def test_the_capability_of_a_loaded_mechanism_s_designs_through_the_shared_twin(
     assert cap.reachable.sum() == 36
     np.testing.assert_allclose(res.column("f")[0], cap.isotropic["N"][cap.reachable].min(), rtol=1e-12)
     np.testing.assert_allclose(res.column("m")[0], cap.isotropic["N m"][cap.reachable].mean(), rtol=1e-12)
+    from pkm.core.compliance.maps import stiffness_map  # (the stiffness objective: its map's smallest, 1e6 N/m legs)
+
+    legs = stiffness_map(design, wmap, joints=dict.fromkeys(design.actuated_names, 1e6))
+    np.testing.assert_allclose(res.column("k")[0], legs.force_min[legs.reachable].min(), rtol=1e-9)
     bad = pkm.sweep(mech, sweeps.table([values]), [f"capability:{region},unit=kg"], scheduler="serial")
     assert bad.stats.failed == 1 and "N m" in bad.table.column("message")[0].as_py()
 

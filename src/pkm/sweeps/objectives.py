@@ -382,6 +382,20 @@ def _capability(c: Candidate, o: Mapping[str, Any]) -> float | None:
     return float(values.min() if o["stat"] == "min" else values.mean())
 
 
+def _stiffness(c: Candidate, o: Mapping[str, Any]) -> float | None:
+    """The smallest (or mean) principal stiffness under a pure force or moment over the map's nodes, every actuated
+    joint a spring of ``drives`` (:func:`pkm.core.compliance.maps.stiffness_map`); None where no node has one."""
+    from pkm.core.compliance.maps import stiffness_map
+
+    m = _generic_map(c, o, configurations=True)
+    joints = dict.fromkeys(c.mechanism.actuated_names, o["drives"])
+    sm = c.cached(("stiffness", _map_key(o), o["drives"]), lambda: stiffness_map(c.mechanism, m, joints=joints))
+    values = (sm.force_min if o["load"] == "force" else sm.moment_min)[sm.reachable]
+    if not values.size:
+        return None
+    return float(values.min() if o["stat"] == "min" else values.mean())
+
+
 def _generic_gci(c, o):
     return _generic_map(c, o).gci(o["kind"])
 
@@ -544,6 +558,14 @@ OBJECTIVES: dict[str, Definition] = {d.name: d for d in (
                 "gravity": ("text", "on", "wrenches and accelerations against gravity (on) or not (off)",
                             ("on", "off"))},
                _capability),
+    Definition("stiffness", "max", "N/m or N m/rad", "smallest (stat=mean: mean) principal stiffness under a pure "
+               "force (load=moment: moment) over the map's nodes, every actuated joint a spring of drives (inf along "
+               "a direction the mechanism cannot move)",
+               {**_MAP, "drives": ("float", 1.0, "every actuated joint's stiffness, N m/rad or N/m (default 1: the "
+                                   "stiffness per unit drive stiffness)", 0.0),
+                "load": ("text", "force", "force or moment", ("force", "moment")),
+                "stat": ("text", "min", "min or mean over the nodes", ("min", "mean"))},
+               _stiffness),
     Definition("operation_count", "min", "operations", "operations of a generated kernel after CSE",
                {"kernel": ("text", "inverse_dynamics", "the kernel"),
                 "count": ("text", "total", "total, mul, add", ("total", "mul", "add"))},
