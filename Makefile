@@ -22,7 +22,7 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(PY) -m ruff check src tests tools examples
 	$(PY) -m mypy src/pkm
-	$(PY) -m pytest -q -n 2 --dist loadgroup --durations=15  # two workers (CPU-bound, 2 cores; the papers' rows on one: tests/conftest.py); the 15 slowest printed: the budget
+	$(PY) -m pytest -q -n 2 --durations=15  # two workers (CPU-bound, 2 cores); the 15 slowest printed: the budget
 
 bench: $(STAMP)
 	$(PY) -m pkm bench

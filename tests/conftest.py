@@ -29,26 +29,21 @@ from pkm.mechanisms import MechanismDefinition, module, register
 register(MechanismDefinition("fivebar", "toy planar five-bar (tests only)", "tests.fivebar", task_scale=(0.03, 0.0, 0.0)))
 
 
-#: The tests that read the papers' rows (:func:`pkm.papers.rows`, computed once per run into the shared cache: the
-#: hexapod's alone cost 26 s of CPU), ``make demo`` first: one group that pytest-xdist runs on one worker
-#: (``--dist loadgroup``, as ``make test`` runs), at the start of the run, so that two workers never compute the same
-#: rows at once and the longest test does not start last.
+#: The tests that read the papers' rows (:func:`pkm.papers.rows`, computed once per run into the shared cache, the
+#: hexapod's alone 26 s of CPU), ``make demo`` first: ``make demo`` runs first (it computes them all, and is the
+#: longest test: last, it would end the run alone), the others last (the rows are on disk by then; a process asking
+#: for rows another is computing waits for them: :func:`pkm.cache.cached`).
 PAPER_ROWS = ("tests/test_readme.py::test_shell_line_runs[make demo]",
               "tests/test_readme.py::test_shell_line_runs[pkm report", "tests/papers/", "tests/test_report.py",
               "tests/test_report_rows_unchanged.py", "tests/cli/test_report.py",
               "tests/core/identification/test_precise.py")
 
 
-@pytest.hookimpl(tryfirst=True)  # (before pytest-xdist's own hook reads the groups)
 def pytest_collection_modifyitems(config, items):
     def rank(item) -> int:
-        return next((i for i, prefix in enumerate(PAPER_ROWS) if item.nodeid.startswith(prefix)), len(PAPER_ROWS))
+        return next((i for i, prefix in enumerate(PAPER_ROWS) if item.nodeid.startswith(prefix)), -1)
 
-    for item in items:
-        if rank(item) < len(PAPER_ROWS):
-            item.add_marker(pytest.mark.xdist_group("papers"))
-    items.sort(key=lambda item: (rank(item) > 0) + (rank(item) == len(PAPER_ROWS)))  # (stable: make demo, the
-    # group, then the rest in their order)
+    items.sort(key=lambda item: {0: 0, -1: 1}.get(rank(item), 2))  # (stable: make demo, the rest, the rows' readers)
 
 
 @pytest.fixture(scope="session")

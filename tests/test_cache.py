@@ -62,3 +62,40 @@ def test_the_twin_kernels_live_in_the_same_cache(folder):
     from pkm.core.twin.codegen import cache_dir
 
     assert cache_dir() == folder / "twin" == cache.cache_dir() / "twin"
+
+
+def _compute_once(folder, log, started, out):
+    """A child's cached call whose computation notes itself in ``log`` and holds on until a second asker waits; its
+    answer written to ``out``."""
+    import os
+    import time
+
+    os.environ["PKM_CACHE_DIR"] = str(folder)
+
+    def compute():
+        with open(log, "a") as fh:
+            fh.write("computed\n")
+        started.set()
+        time.sleep(0.3)  # (the other process asks meanwhile)
+        return {"pid": os.getpid()}
+
+    out.write_text(json.dumps(cache.cached("rows", "shared", compute)))
+
+
+def test_two_processes_asking_at_once_compute_once(folder, tmp_path):
+    """A second process asking for an entry being computed waits for it and reads it: one computation, one value
+    (the first's: its pid)."""
+    import multiprocessing
+
+    ctx = multiprocessing.get_context("fork")
+    log, started = tmp_path / "log.txt", ctx.Event()
+    first = ctx.Process(target=_compute_once, args=(folder, log, started, tmp_path / "a.json"))
+    first.start()
+    started.wait()
+    second = ctx.Process(target=_compute_once, args=(folder, log, started, tmp_path / "b.json"))
+    second.start()
+    first.join()
+    second.join()
+    assert first.exitcode == second.exitcode == 0
+    assert (tmp_path / "a.json").read_text() == (tmp_path / "b.json").read_text()
+    assert log.read_text() == "computed\n"

@@ -4,7 +4,8 @@ An entry is a JSON document stored under the SHA-256 of its key: the inputs (mec
 row id...), the pkm version, and the source text of every module whose code computes the result, so that a change
 of inputs or of code computes it anew. Entries are written atomically (a temporary file renamed), so that
 parallel processes (``pytest -n 2``, several ``pkm report`` runs) share them safely; a damaged or unreadable entry
-is computed again.
+is computed again. Processes asking for one entry at once compute it once: the first holds a lock on the entry
+(``fcntl.flock``), the others wait for it and read what it wrote.
 
 Where: ``$PKM_CACHE_DIR``, else ``$XDG_CACHE_HOME/pkm``, else ``~/.cache/pkm``. ``PKM_CACHE=0`` turns the cache off
 (every result computed); a folder that cannot be written is skipped silently (the result is computed and
@@ -13,12 +14,13 @@ returned).
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
 import sys
 import tempfile
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -78,19 +80,52 @@ def cached(kind: str, key: Any, compute: Callable[[], Any], *, code: Iterable[Mo
     text = json.dumps({"key": key, "version": pkm.__version__, "code": code_digest(code)}, sort_keys=True,
                       default=repr)
     path = cache_dir() / kind / f"{hashlib.sha256(text.encode()).hexdigest()}.json"
-    try:
-        return json.loads(path.read_text())["value"]
-    except (OSError, ValueError, KeyError, TypeError):
-        pass
-    value = compute()
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile("w", dir=path.parent, suffix=".tmp", delete=False) as fh:
-            json.dump({"value": value}, fh)
-        os.replace(fh.name, path)
-    except OSError:
-        pass
+    found = _read(path)
+    if found is not None:
+        return found[0]
+    with _entry_lock(path):  # (another process computing the same entry: wait for it, then read it)
+        found = _read(path)
+        if found is not None:
+            return found[0]
+        value = compute()
+        try:
+            with tempfile.NamedTemporaryFile("w", dir=path.parent, suffix=".tmp", delete=False) as fh:
+                json.dump({"value": value}, fh)
+            os.replace(fh.name, path)
+        except OSError:
+            pass
     return value
+
+
+def _read(path: Path) -> tuple[Any] | None:
+    """``(value,)`` of the entry at ``path``, None where it is missing or damaged."""
+    try:
+        return (json.loads(path.read_text())["value"],)
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+@contextlib.contextmanager
+def _entry_lock(path: Path) -> Iterator[None]:
+    """An exclusive lock on ``path``'s entry across processes (``fcntl.flock`` on a ``.lock`` file beside it), so that
+    parallel processes asking for one entry compute it once; none where the folder cannot be written or the platform
+    has no ``flock`` (each process then computes it). Entries nest in one order (a paper's rows, then its modes'), so
+    two processes never wait on each other."""
+    try:
+        import fcntl
+
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fh = open(path.with_suffix(".lock"), "a")  # (held across the yield)
+    except (ImportError, OSError):
+        fh = None
+    if fh is None:
+        yield
+        return
+    try:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        yield
+    finally:
+        fh.close()  # (closing releases the lock)
 
 
 __all__ = ["cache_dir", "cached", "code_digest", "file_digest"]
