@@ -79,7 +79,7 @@ def _compute_once(folder, log, started, out):
         time.sleep(0.3)  # (the other process asks meanwhile)
         return {"pid": os.getpid()}
 
-    out.write_text(json.dumps(cache.cached("rows", "shared", compute)))
+    out.write_text(json.dumps(cache.cached("rows", "asked twice", compute)))
 
 
 def test_two_processes_asking_at_once_compute_once(folder, tmp_path):
