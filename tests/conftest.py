@@ -30,20 +30,15 @@ register(MechanismDefinition("fivebar", "toy planar five-bar (tests only)", "tes
 
 
 #: The tests that read the papers' rows (:func:`pkm.papers.rows`, computed once per run into the shared cache, the
-#: hexapod's alone 26 s of CPU), ``make demo`` first: ``make demo`` runs first (it computes them all, and is the
-#: longest test: last, it would end the run alone), the others last (the rows are on disk by then; a process asking
-#: for rows another is computing waits for them: :func:`pkm.cache.cached`).
-PAPER_ROWS = ("tests/test_readme.py::test_shell_line_runs[make demo]",
-              "tests/test_readme.py::test_shell_line_runs[pkm report", "tests/papers/", "tests/test_report.py",
-              "tests/test_report_rows_unchanged.py", "tests/cli/test_report.py",
-              "tests/core/identification/test_precise.py")
+#: hexapod's alone 26 s of CPU): first, the longest work at the start of the run (a process asking for rows another
+#: is computing waits for them: :func:`pkm.cache.cached`).
+PAPER_ROWS = ("tests/core/identification/test_precise.py", "tests/test_readme.py::test_shell_line_runs[pkm report",
+              "tests/papers/", "tests/test_report.py", "tests/test_report_rows_unchanged.py",
+              "tests/cli/test_report.py")
 
 
 def pytest_collection_modifyitems(config, items):
-    def rank(item) -> int:
-        return next((i for i, prefix in enumerate(PAPER_ROWS) if item.nodeid.startswith(prefix)), -1)
-
-    items.sort(key=lambda item: {0: 0, -1: 1}.get(rank(item), 2))  # (stable: make demo, the rest, the rows' readers)
+    items.sort(key=lambda item: not item.nodeid.startswith(PAPER_ROWS))  # (stable: the rows' readers, then the rest)
 
 
 @pytest.fixture(scope="session")

@@ -8,7 +8,8 @@ syntax) runs them as ``pkm`` would, in this process (:func:`tests.cli.helpers.ru
 tests/cli/test_list.py's), but for :data:`PROCESS_COMMANDS`. A line whose comment says ``Ctrl-C`` starts something
 that runs until stopped (the live viewer): it must print, then stop cleanly on Ctrl-C (SIGINT).
 A block or command printed on several pages (the README's command lines are the tour's too) runs once.
-One line is not run: ``make test``, the command that runs this test (CI runs it).
+Two lines are not run here: ``make test``, the command that runs this test, and ``make demo``: CI runs both on its
+fresh clone (.ci/run; a test holds that it does).
 """
 
 from __future__ import annotations
@@ -31,6 +32,9 @@ ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs" / "tour").glob("*.md"))]
 FENCE = re.compile(r"^```(\w*)\n(.*?)^```", flags=re.S | re.M)
 SELF = "make test"
+#: ``make demo``, the README's other command: CI runs it on its fresh clone right after ``make test`` (.ci/run; a test
+#: below holds that), not this suite (its report is 80 s of CPU, half the papers' figures, which tests/papers draw).
+CI_RUNS = "make demo"
 #: The ``pkm`` commands a line runs in bash even with nothing else of the shell's: ``pkm sweep`` starts a local
 #: Dask cluster of worker processes (and Dask's logging), ``pkm serve`` a service until stopped.
 PROCESS_COMMANDS = ("sweep", "serve")
@@ -96,6 +100,14 @@ def test_the_pages_have_python_blocks_and_shell_lines():
     assert len(PYTHON) >= 10 and len(SHELL) >= 21
 
 
+def test_ci_runs_the_readmes_two_commands_on_its_fresh_clone():
+    """.ci/run runs ``make test`` and ``make demo`` (the line this suite skips), each a command of its own that stops
+    the run when it fails (``set -e``), and checks that the demo wrote its report."""
+    lines = [ln.split("#")[0].strip() for ln in (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()]
+    assert "set -euo pipefail" in lines and SELF in lines and CI_RUNS in lines
+    assert lines.index(CI_RUNS) > lines.index(SELF) and "test -s out/report.md" in lines
+
+
 def test_the_readme_is_short_and_its_links_resolve():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     size = len(text.encode("utf-8"))
@@ -117,6 +129,8 @@ def test_shell_line_runs(line, tmp_path):
     command = line.split("#")[0].strip()
     if command == SELF:
         pytest.skip("the command that runs this test (CI runs it)")
+    if command == CI_RUNS:
+        pytest.skip("the README's other command: CI runs it on its fresh clone after make test (.ci/run)")
     cwd = ROOT if command.startswith("make ") else tmp_path
     (tmp_path / "examples").symlink_to(ROOT / "examples")  # (a reader in a clone: `examples/...` from its root)
     if "Ctrl-C" in line:
