@@ -70,6 +70,22 @@ def test_unassemblable_motor_angles_raise_convergence_error_with_the_open_loop()
     assert "stays open" in str(err)
 
 
+def test_a_coarser_min_step_gives_up_sooner_and_closes_the_same():
+    """min_step (the random states' draws take 0.05): a hexapod target its path cannot reach fails after fewer Newton
+    iterations than with the default 1e-3; one it reaches closes to the same configuration, bit for bit; a min_step
+    outside (0, 1] is refused."""
+    hexapod = pkm.load("hexapod")
+    qa0 = hexapod.actuated_q(hexapod.q_reference)
+    far, near = qa0 + np.random.default_rng(0).uniform(-0.1, 0.1, hexapod.na), qa0 + 0.02  # (the first draw: out)
+    fine = close_loops(hexapod, far, raise_on_failure=False)
+    coarse = close_loops(hexapod, far, raise_on_failure=False, min_step=0.05)
+    assert not fine.converged and not coarse.converged and coarse.iterations < fine.iterations
+    assert np.array_equal(close_loops(hexapod, near).q, close_loops(hexapod, near, min_step=0.05).q)
+    for bad in (0.0, 1.5, math.nan):
+        with pytest.raises(InvalidInputError, match="min_step"):
+            close_loops(hexapod, near, min_step=bad)
+
+
 def test_a_target_outside_the_workspace_is_unreachable_not_a_convergence_failure(delta, built):
     """A platform position far outside the workspace, and the five-bar's tip beyond its reach (0.7 m up, links
     0.55 m), give UnreachableError naming the closure left open at the least-squares minimum, never NaN nor

@@ -231,13 +231,17 @@ def _warn_mode_change(what: str, seed: ModeLabel, result: SolveResult) -> None:
         warnings.warn(ModeChangeWarning(what, changed, seed, result.mode), stacklevel=3)
 
 
+#: The smallest continuation step, relative to the first, before a path is judged to leave the workspace.
+MIN_STEP = 1e-3
+
+
 def _follow(mech: Mechanism, what: str, solve_at: _StepSolver, q: np.ndarray, n_steps: int, tol: float,
-            raise_on_failure: bool, matrices: _Matrices) -> SolveResult:
+            raise_on_failure: bool, matrices: _Matrices, min_step: float = MIN_STEP) -> SolveResult:
     """Continuation from ``s = 0`` (the seed ``q``) to ``s = 1`` (the target).
 
     ``solve_at(q, s, tol) -> (q, residual, iterations)`` corrects at path parameter ``s`` from ``q``.
     Steps start at ``1 / n_steps``, halve on failure, grow again on success; intermediate points
-    are solved to 1e-9, the target to ``tol``. When the step falls below 1e-3 of its initial length
+    are solved to 1e-9, the target to ``tol``. When the step falls below ``min_step`` of its initial length
     the path has left the workspace: a last correction at the target gives the residual reported.
     """
     total, steps = 0, 0
@@ -264,7 +268,7 @@ def _follow(mech: Mechanism, what: str, solve_at: _StepSolver, q: np.ndarray, n_
             ds = min(ds * 1.5, 1.0 / n_steps)
         else:
             ds *= 0.5
-            if ds < 1e-3 / n_steps:
+            if ds < min_step / n_steps:
                 res_path = res
                 q_new, res, it = solve_at(q, 1.0, tol)
                 result = _result(mech, q_new, False, res, total + it, steps)
@@ -280,7 +284,8 @@ def _follow(mech: Mechanism, what: str, solve_at: _StepSolver, q: np.ndarray, n_
 
 
 def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = None, *, tol: float = DEFAULT_TOL,
-                max_iter: int = 30, max_step: float = 0.1, raise_on_failure: bool = True) -> SolveResult:
+                max_iter: int = 30, max_step: float = 0.1, raise_on_failure: bool = True,
+                min_step: float = MIN_STEP) -> SolveResult:
     """Forward position problem: passive coordinates for given actuated ones.
 
     Args:
@@ -293,6 +298,9 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
         max_iter: Newton iterations allowed per continuation step.
         max_step: Largest change of an actuated coordinate per continuation step [rad or m].
         raise_on_failure: Raise :class:`ConvergenceError` (default) instead of returning ``converged=False``.
+        min_step: The smallest continuation step, relative to the first, before the path is judged to leave the
+            workspace (in (0, 1]): a search that only keeps the targets that close (random states) gives up sooner
+            with a coarser one.
 
     Returns:
         A :class:`SolveResult` whose ``q`` has the requested actuated coordinates.
@@ -329,7 +337,8 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
 
     seed = mode_label(mech, q)  # (found kept where the seed is the last solve's result: a path followed)
     try:
-        result = _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure, matrices)
+        result = _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure, matrices,
+                         as_scalar(min_step, "min_step", low=0.0, high=1.0, strict_low=True))
     except ConvergenceError as exc:
         exc.problem = ClosureProblem(mech, qa1)
         raise
