@@ -129,6 +129,7 @@ def test_a_spec_may_name_an_mjcf_file_and_add_a_task(tmp_path):
     (lambda s: s.replace("<mujoco", "<robot").replace("</mujoco>", "</robot>"), "expected <mujoco>"),
     (lambda s: s.replace("<compiler", "<compiler eulerseq='zyxz'"), "eulerseq"),
     (lambda s: s[:200], "not well-formed"),
+    (lambda s: s.replace("<worldbody>", "<worldbody><joint type='hinge'/>", 1), "is in <worldbody>, not in a <body>"),
 ])
 def test_what_it_refuses_it_says(edit, message):
     with pytest.raises(SpecError, match=message):

@@ -421,6 +421,10 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             body_joints[names[0]] = names
     if derived:
         notes.append(f"names derived for what the file leaves unnamed: {', '.join(derived)}")
+    stray = next((j for j in world.iter("joint", "freejoint") if j.getparent().tag != "body"), None)
+    if stray is not None:  # (MuJoCo refuses it too: a joint moves the body it is in)
+        raise SpecError(source, f"<{stray.tag}> (line {stray.sourceline}) is in <{stray.getparent().tag}>, not in a "
+                                "<body>: a joint moves the body it is in")
     keys = _keyframes(root, world, kinds, source)
     key_name, key_qpos = _key_chosen(keys, limits, notes)
 
