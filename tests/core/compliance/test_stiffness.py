@@ -132,8 +132,9 @@ def test_a_motion_no_spring_resists_and_bad_input_are_refused(gs, pose):
         stiffness(gs, pose, joints={"leg7": 1.0})
     with pytest.raises(InvalidInputError, match="one-coordinate"):
         stiffness(gs, pose, joints={"u1": 1.0})
-    with pytest.raises(InvalidInputError):
-        stiffness(gs, pose, joints={"leg1": -1.0})
+    for bad in (-1.0, 1e308):  # (1e12 and more: a unit mistake, as in a spec's springs; a rigid joint is left out)
+        with pytest.raises(InvalidInputError, match="leg1"):
+            stiffness(gs, pose, joints={"leg1": bad})
     with pytest.raises(InvalidInputError, match="not closed"):
         stiffness(gs, pin.integrate(gs.model, pose, np.r_[np.zeros(6), 0.01, np.zeros(gs.nv - 7)]), joints=legs)
     with pytest.raises(InvalidInputError, match="rigid"):

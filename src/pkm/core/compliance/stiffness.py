@@ -65,6 +65,7 @@ from pkm.core.kinematics.labels import mode_label
 from pkm.core.kinematics.newton import gauss_newton
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.scale import JacobianScales
+from pkm.core.model.springs import MAGNITUDE
 from pkm.errors import InvalidInputError, ModeChangeWarning, PkmWarning, StiffnessError, UnknownNameError
 from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
 
@@ -114,7 +115,11 @@ def _joint_stiffness(mech: Mechanism, joints: Mapping[str, object] | None) -> di
             if mech.joints[name].nv != 1:
                 raise InvalidInputError("joints", f"{name!r} has {mech.joints[name].nv} coordinates: a spring "
                                                   "stiffness is for a one-coordinate joint (revolute, prismatic)", name)
-            given[name] = as_scalar(value, f"joints[{name!r}]", low=0.0)
+            k = as_scalar(value, f"joints[{name!r}]", low=0.0)
+            if k >= MAGNITUDE:  # (as the spec's springs: a unit mistake; a rigid joint is one left out, or locked)
+                raise InvalidInputError(f"joints[{name!r}]", f"a stiffness below {MAGNITUDE:g} (N m/rad, N/m); to "
+                                                             "hold an actuated joint rigid, leave it out", value)
+            given[name] = k
     return given
 
 

@@ -44,7 +44,8 @@ if TYPE_CHECKING:
 
 #: The keys of a ``[springs.<joint>]`` table, each 0 when left out.
 SPRING_KEYS = ("stiffness", "rest", "damping")
-_MAGNITUDE = 1e12  # (a stiffness or damping larger than this is no spring a file means: a unit mistake)
+#: A stiffness or damping at least this large is no spring a file (or a caller) means: a unit mistake.
+MAGNITUDE = 1e12
 
 
 def parse_springs(raw: object, source: str) -> dict[str, dict[str, float]]:
@@ -59,8 +60,8 @@ def parse_springs(raw: object, source: str) -> dict[str, dict[str, float]]:
         for key, value in values.items():
             if not math.isfinite(value):
                 raise SpecError(source, f"springs.{joint}.{key} must be a finite number, got {value!r}")
-            if key != "rest" and not 0.0 <= value < _MAGNITUDE:
-                raise SpecError(source, f"springs.{joint}.{key} = {value!r}: a {key} is >= 0 and below {_MAGNITUDE:g}")
+            if key != "rest" and not 0.0 <= value < MAGNITUDE:
+                raise SpecError(source, f"springs.{joint}.{key} = {value!r}: a {key} is >= 0 and below {MAGNITUDE:g}")
     return out
 
 
@@ -121,4 +122,4 @@ def describe(springs: Mapping[str, Mapping[str, float]]) -> str:
                      for j, values in springs.items())
 
 
-__all__ = ["SPRING_KEYS", "JointSprings", "describe", "joint_springs", "parse_springs"]
+__all__ = ["MAGNITUDE", "SPRING_KEYS", "JointSprings", "describe", "joint_springs", "parse_springs"]
