@@ -494,8 +494,9 @@ def gravity_efforts(mech: Mechanism, q: ArrayLike, *, base: str | None = None) -
 
 
 def spring_efforts(mech: Mechanism, q: ArrayLike, *, base: str | None = None) -> np.ndarray:
-    r"""The joint springs' share of the static efforts, :math:`s_a(q) = -\hat G^\top \tau_s(q) = \hat G^\top K
-    (q - q_{rest})` (na,) [N m, N]: the actuator efforts that hold the springs (``[springs]``,
+    r"""The joint springs' share of the static efforts,
+    :math:`s_a(q) = -\hat G^\top \tau_s(q) = \hat G^\top K (q - q_{rest})` (na,) [N m, N]: the actuator efforts that
+    hold the springs (``[springs]``,
     :mod:`pkm.core.model.springs`) where ``q`` puts them; zero without springs. :func:`gravity_efforts` includes it.
 
     Examples:
