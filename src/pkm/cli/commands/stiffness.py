@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
         out["deflection"] = {"exact": d.displacement, "first_order": d.first_order, "gap": d.gap,
                              "load_steps": d.load_steps, "outside_limits": list(d.outside_limits)}
     if args.frequencies:
-        modes = pkm.vibration_modes(mech, q, joints=joints)
+        modes = K.vibration_modes()
         out["frequencies"] = modes.frequencies
         out["free_motions"] = modes.free
     out["units"] = {"compliance": "m/N, m/(N m); rad/N, rad/(N m)", "matrix": "N/m, N/rad; N m/m, N m/rad",

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from pkm.core.analysis.maps import WorkspaceMap
-from pkm.core.compliance.stiffness import RTOL, Links, stiffness, vibration_modes
+from pkm.core.compliance.stiffness import RTOL, Links, stiffness
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PkmError, UnknownNameError
 
@@ -109,7 +109,7 @@ def stiffness_map(mech: Mechanism, wmap: WorkspaceMap, *, joints: Mapping[str, o
         try:
             K = stiffness(mech, q, joints=joints, links=links, rtol=rtol)
             if frequencies:
-                f = vibration_modes(mech, q, joints=joints, links=links, rtol=rtol).frequencies
+                f = K.vibration_modes().frequencies
                 values["freq"][idx] = f[0] if len(f) else np.nan
         except (InvalidInputError, UnknownNameError):
             raise  # (the springs or links given: the same at every node)

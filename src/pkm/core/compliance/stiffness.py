@@ -308,6 +308,11 @@ class Stiffness:
                 else np.full(3, np.inf)
         return k[::-1].copy(), U[:, ::-1].copy()
 
+    def vibration_modes(self) -> VibrationModes:
+        """:func:`vibration_modes` with these springs at this configuration (the null space and the stiffness this
+        result was computed from, not gathered again: a map's nodes)."""
+        return _modes(self._springs, self._rtol)
+
     def deflection(self, wrench: ArrayLike, *, tol: float = DEFLECTION_TOL) -> Deflection:
         """The exact equilibrium under the constant wrench ``(f [N], m [N m])`` at the end effector's origin, world
         axes (large displacements: the springs' forces and the wrench at the deflected configuration), with the
@@ -494,10 +499,14 @@ def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, objec
         >>> modes.frequencies.round(1)  # [Hz]: sway (twice), heave, tilt (twice), twist
         array([ 29. ,  29. ,  51.3, 130.2, 158.6, 158.6])
     """
+    rtol = as_tolerance(rtol, "rtol")
+    return _modes(_springs(mech, q, joints, links, rtol), rtol)
+
+
+def _modes(sp: _Springs, rtol: float) -> VibrationModes:
+    """:func:`vibration_modes` of springs already gathered."""
     from scipy.linalg import eigh
 
-    rtol = as_tolerance(rtol, "rtol")
-    sp = _springs(mech, q, joints, links, rtol)
     Nj = sp.N[:sp.mech.nv]  # (the links' virtual motions carry no mass: condensed below)
     Ms = Nj.T @ joint_inertia(sp.mech, sp.q) @ Nj
     Ms = 0.5 * (Ms + Ms.T)
@@ -505,15 +514,15 @@ def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, objec
     m, U = np.linalg.eigh(Ms) if Ms.size else (np.zeros(0), np.zeros((0, 0)))
     massive = m > MASSLESS * max(float(np.max(m, initial=0.0)), 1e-300)
     Ua, Ub = U[:, massive], U[:, ~massive]
-    Haa, Hab, Hbb = Ua.T @ H @ Ua, Ua.T @ H @ Ub, Ub.T @ H @ Ub
-    Hc = Haa - Hab @ np.linalg.pinv(Hbb, rcond=rtol, hermitian=True) @ Hab.T  # (massless motions: static)
+    Hab, Hbb_inv = Ua.T @ H @ Ub, np.linalg.pinv(Ub.T @ H @ Ub, rcond=rtol, hermitian=True)
+    Hc = Ua.T @ H @ Ua - Hab @ Hbb_inv @ Hab.T  # (massless motions: static)
     Hc = 0.5 * (Hc + Hc.T)
     w2, Va = eigh(Hc, Ua.T @ Ms @ Ua) if Hc.size else (np.zeros(0), np.zeros((0, 0)))
     top = float(np.max(np.abs(w2), initial=0.0))
     resisted = w2 > rtol * top if top > 0.0 else np.zeros(len(w2), dtype=bool)
     s = Ua @ Va[:, resisted]
     if Ub.shape[1]:
-        s = s - Ub @ (np.linalg.pinv(Hbb, rcond=rtol, hermitian=True) @ (Hab.T @ Va[:, resisted]))
+        s = s - Ub @ (Hbb_inv @ (Hab.T @ Va[:, resisted]))
     h = np.linalg.eigvalsh(H) if H.size else np.zeros(0)
     free = int(np.sum(h <= rtol * float(np.max(h, initial=0.0)))) if h.size else 0
     return VibrationModes(np.sqrt(w2[resisted]) / (2.0 * math.pi), Nj @ s, sp.T @ s, free)
