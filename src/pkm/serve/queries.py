@@ -591,9 +591,9 @@ def stiffness(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> 
     def one(k: int) -> dict[str, Any]:
         K = run(mech, q[k], joints=joints)
         out = {"q": q[k], "compliance": K.compliance, "rank": K.rank}
-        for load, block in (("force", K.compliance[:3, :3]), ("moment", K.compliance[3:, 3:])):
-            c, U = np.linalg.eigh(block)
-            out[f"{load}_compliance"], out[f"{load}_directions"] = np.maximum(c[::-1], 0.0), U[:, ::-1].T
+        for load in ("force", "moment"):  # (the principal stiffnesses' reciprocals: 0 along a rigid direction)
+            k, U = K.principal(load)
+            out[f"{load}_compliance"], out[f"{load}_directions"] = 1.0 / k, U.T
         if wrench is not None:
             d = K.deflection(wrench)
             out.update(displacement=d.displacement, first_order=d.first_order, gap=d.gap)
