@@ -592,8 +592,8 @@ def stiffness(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> 
         K = run(mech, q[k], joints=joints)
         out = {"q": q[k], "compliance": K.compliance, "rank": K.rank}
         for load in ("force", "moment"):  # (the principal stiffnesses' reciprocals: 0 along a rigid direction)
-            k, U = K.principal(load)
-            out[f"{load}_compliance"], out[f"{load}_directions"] = 1.0 / k, U.T
+            principal, U = K.principal(load)
+            out[f"{load}_compliance"], out[f"{load}_directions"] = 1.0 / principal, U.T
         if wrench is not None:
             d = K.deflection(wrench)
             out.update(displacement=d.displacement, first_order=d.first_order, gap=d.gap)
