@@ -161,3 +161,24 @@ def test_the_limits_read_as_none_are_noted_once_per_value():
         "joint 'k': upper limit 1e8 read as none (|x| >= 1e+06)")
     assert limit_notes(check_urdf(GOOD)) == ()
 
+
+
+def test_builder_writes_collision_primitives_with_their_placement():
+    """Each primitive comes back as the <collision> element it names, sizes in m, its origin's rpy the rotation's."""
+    import pinocchio as pin
+    from lxml import etree
+    b = UrdfBuilder("r")
+    b.link("a", 1.0, inertia=np.eye(3) * 1e-3)
+    R = pin.rpy.rpyToMatrix(0.1, -0.2, 0.3)
+    b.collision("a", "capsule", (0.0, 0.0, 0.1), R, radius=0.01, length=0.2)
+    b.collision("a", "box", x=0.1, y=0.2, z=0.3)
+    els = etree.fromstring(b.to_xml().encode()).findall("link/collision")
+    assert [e.find("geometry")[0].tag for e in els] == ["capsule", "box"]
+    assert float(els[0].find("geometry/capsule").get("length")) == 0.2
+    assert els[1].find("geometry/box").get("size") == "0.1 0.2 0.3"
+    rpy = [float(v) for v in els[0].find("origin").get("rpy").split()]
+    np.testing.assert_allclose(pin.rpy.rpyToMatrix(*rpy), R, atol=1e-15)
+    with pytest.raises(pkm.errors.InvalidInputError, match="takes"):
+        b.collision("a", "sphere", radius=0.1, length=1.0)
+    with pytest.raises(pkm.errors.InvalidInputError, match="positive"):
+        b.collision("a", "sphere", radius=-0.1)

@@ -72,6 +72,11 @@ def _origin(xyz: ArrayLike = (0.0, 0.0, 0.0), rotation: ArrayLike | None = None)
     return T
 
 
+#: The collision primitives :meth:`UrdfBuilder.collision` writes, and their sizes' names [m].
+COLLISION_SHAPES: dict[str, tuple[str, ...]] = {"box": ("x", "y", "z"), "cylinder": ("radius", "length"),
+                                                "capsule": ("radius", "length"), "sphere": ("radius",)}
+
+
 class UrdfBuilder:
     """Collects links and joints, then writes a validated URDF string.
 
@@ -84,6 +89,7 @@ class UrdfBuilder:
         self._links: list[yourdfpy.Link] = []
         self._joints: list[yourdfpy.Joint] = []
         self._mimic: dict[str, tuple[str, float, float]] = {}
+        self._collisions: dict[str, list[tuple[str, dict[str, float], np.ndarray]]] = {}
 
     def link(self, name: str, mass: float = 0.0, com: ArrayLike = (0.0, 0.0, 0.0),
              inertia: ArrayLike | None = None) -> str:
@@ -116,8 +122,26 @@ class UrdfBuilder:
         self.joint(f"{name}_fixed", "fixed", parent, name, xyz, rotation)
         return name
 
+    def collision(self, link: str, shape: str, xyz: ArrayLike = (0.0, 0.0, 0.0), rotation: ArrayLike | None = None,
+                  **size: float) -> str:
+        """Add a collision primitive to ``link``: ``shape`` one of :data:`COLLISION_SHAPES` with its sizes [m]
+        (``box``: ``size=(x, y, z)`` as ``x=, y=, z=``; ``cylinder``/``capsule``: ``radius=, length=`` along the
+        local z axis, a capsule's length between its hemispheres' centres; ``sphere``: ``radius=``), placed at
+        ``xyz``/``rotation`` in the link's frame. A capsule is written ``<capsule radius length>``, the element
+        Gazebo's URDF reader and pkm's geometry reader take (urdfdom's does not)."""
+        if shape not in COLLISION_SHAPES:
+            raise InvalidInputError("shape", f"one of {sorted(COLLISION_SHAPES)} expected", shape)
+        if set(size) != set(COLLISION_SHAPES[shape]):
+            raise InvalidInputError("size", f"a {shape} takes {COLLISION_SHAPES[shape]}", size)
+        for k, v in size.items():
+            if not (math.isfinite(v) and 0.0 < v <= ABSURD):
+                raise InvalidInputError(k, f"a {shape}'s {k} must be positive and finite [m]", v)
+        self._collisions.setdefault(link, []).append((shape, {k: float(v) for k, v in size.items()},
+                                                      _origin(xyz, rotation)))
+        return link
+
     def to_xml(self) -> str:
-        """The URDF text: yourdfpy-validated, ``<mimic>`` restored, pretty-printed."""
+        """The URDF text: yourdfpy-validated, ``<mimic>`` and ``<collision>`` restored, pretty-printed."""
         robot = yourdfpy.Robot(name=self.name, links=self._links, joints=self._joints)
         urdf = yourdfpy.URDF(robot=robot, build_scene_graph=False, load_meshes=False)
         if not urdf.validate():
@@ -127,6 +151,15 @@ class UrdfBuilder:
             if jel.get("name") in self._mimic:
                 leader, mult, off = self._mimic[jel.get("name")]
                 etree.SubElement(jel, "mimic", joint=leader, multiplier=repr(mult), offset=repr(off))
+        for lel in root.iter("link"):
+            for k, (shape, size, T) in enumerate(self._collisions.get(str(lel.get("name")), ())):
+                col = etree.SubElement(lel, "collision", name=f"{lel.get('name')}_{k}")
+                rpy = pin.rpy.matrixToRpy(T[:3, :3])
+                etree.SubElement(col, "origin", xyz=" ".join(map(repr, map(float, T[:3, 3]))),
+                                 rpy=" ".join(map(repr, map(float, rpy))))
+                attrs = ({"size": " ".join(repr(size[a]) for a in "xyz")} if shape == "box"
+                         else {a: repr(v) for a, v in size.items()})
+                etree.SubElement(etree.SubElement(col, "geometry"), shape, **attrs)
         etree.indent(root, space="  ")
         text = etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True).decode()
         check_urdf(text, f"<generated {self.name}>")
