@@ -58,3 +58,19 @@ def test_singularity_class_names_the_four_cases():
     assert [indices.singularity_class(i, d) for d in (False, True) for i in (False, True)] == list(
         indices.SINGULARITY_CLASSES) == ["regular", "inverse", "direct", "combined"]
     assert KINDS == dict(enumerate(indices.SINGULARITY_CLASSES))
+
+
+def test_several_kinds_from_one_decomposition_are_each_kind_s_own_bit_for_bit():
+    """``condition_numbers(J, kinds)`` (one SVD) gives what ``condition_number(J, kind)`` gives a kind at a time,
+    singular matrices (inf) included; a non-square stack takes the 2-norm kind only."""
+    from pkm.core.differential.indices import KINDS, condition_number, condition_numbers
+    rng = np.random.default_rng(3)
+    J = rng.normal(size=(50, 3, 3))
+    J[7] = np.diag([2.0, 1.0, 0.0])  # singular
+    many = condition_numbers(J, KINDS)
+    for kind in KINDS:
+        assert np.array_equal(many[kind], condition_number(J, kind)), kind
+    assert many["2"][7] == np.inf
+    assert condition_numbers(J[:, :2], ("2",))["2"].shape == (50,)
+    with pytest.raises(InvalidInputError, match="square"):
+        condition_numbers(J[:, :2], ("fro",))

@@ -84,25 +84,34 @@ def condition_number(J: ArrayLike, kind: str = "2") -> np.ndarray | float:
     Returns:
         A float for one matrix, an array of shape ``J.shape[:-2]`` for a stack.
     """
+    k = condition_numbers(J, (kind,))[kind]
+    return float(k) if np.ndim(k) == 0 else k
+
+
+def condition_numbers(J: ArrayLike, kinds: tuple[str, ...] = KINDS) -> dict[str, np.ndarray]:
+    """:func:`condition_number` of several ``kinds`` from one singular value decomposition of each matrix
+    (``{kind: array of shape J.shape[:-2]}``; the same numbers, bit for bit, as one call a kind)."""
     J = _normalized(_stack(J))
-    if not isinstance(kind, str) or kind not in KINDS:
-        raise InvalidInputError("kind", f"unknown condition number kind {kind!r}; known: {', '.join(KINDS)}", kind)
+    for kind in kinds:
+        if not isinstance(kind, str) or kind not in KINDS:
+            raise InvalidInputError("kind", f"unknown condition number kind {kind!r}; known: {', '.join(KINDS)}",
+                                    kind)
+    m, n = J.shape[-2:]
+    if m != n and any(kind != "2" for kind in kinds):
+        raise InvalidInputError("J", f"the Frobenius condition number needs a square matrix, got {m}x{n}")
     s = np.linalg.svd(J, compute_uv=False)
     smax, smin = s[..., 0], s[..., -1]
-    if kind == "2":
-        with np.errstate(divide="ignore"):
-            k = np.where(smin > 0.0, smax / np.where(smin > 0.0, smin, 1.0), np.inf)
-    else:
-        m, n = J.shape[-2:]
-        if m != n:
-            raise InvalidInputError("J", f"the Frobenius condition number needs a square matrix, got {m}x{n}")
-        # ||J||_F ||J^-1||_F = sqrt(sum s^2) sqrt(sum 1/s^2)
-        ok = smin > 0.0
-        inv2 = np.sum(1.0 / np.where(ok[..., None], s, 1.0) ** 2, axis=-1)
-        k = np.where(ok, np.sqrt(np.sum(s**2, axis=-1) * inv2), np.inf)
-        if kind == "fro_normalized":
-            k = k / n
-    return float(k) if np.ndim(k) == 0 else k
+    ok = smin > 0.0
+    out: dict[str, np.ndarray] = {}
+    for kind in kinds:
+        if kind == "2":
+            with np.errstate(divide="ignore"):
+                out[kind] = np.where(ok, smax / np.where(ok, smin, 1.0), np.inf)
+        else:  # ||J||_F ||J^-1||_F = sqrt(sum s^2) sqrt(sum 1/s^2)
+            inv2 = np.sum(1.0 / np.where(ok[..., None], s, 1.0) ** 2, axis=-1)
+            k = np.where(ok, np.sqrt(np.sum(s**2, axis=-1) * inv2), np.inf)
+            out[kind] = k / n if kind == "fro_normalized" else k
+    return out
 
 
 def inverse_condition(J: ArrayLike, kind: str = "2") -> np.ndarray | float:
@@ -140,4 +149,4 @@ def homogenize(J: ArrayLike, rotation_rows: int | slice | Sequence[int] | Sequen
     return finite_result(J, "homogenized Jacobian", "the rows scaled by length overflow")
 
 
-__all__ = ["KINDS", "condition_number", "homogenize", "inverse_condition", "manipulability", "singular_values"]
+__all__ = ["KINDS", "condition_number", "condition_numbers", "homogenize", "inverse_condition", "manipulability", "singular_values"]

@@ -19,7 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.differential.indices import KINDS, condition_number
+from pkm.core.differential.indices import KINDS
+from pkm.core.differential.indices import condition_numbers as core_condition_numbers
 from pkm.errors import InvalidInputError
 from pkm.mechanisms._common import check_params, circle_sphere, real
 from pkm.mechanisms.delta import PHI, DeltaParams, jacobian_factors
@@ -97,12 +98,13 @@ def condition_numbers(params: DeltaParams, points, branch="knee_out", kinds=KIND
     A, d = jacobian_factors(params, P[reachable], theta[reachable])
     ok = np.all(d != 0.0, axis=-1)
     Jinv = A / np.where(ok[..., None], d, 1.0)[..., None]
+    each = core_condition_numbers(Jinv[ok], tuple(kinds)) if ok.any() else {}
     out = {}
     for kind in kinds:
         K = np.full(P.shape[:-1], np.inf)
         k = np.full(len(A), np.inf)
         if ok.any():
-            k[ok] = condition_number(Jinv[ok], kind)
+            k[ok] = each[kind]
         K[reachable] = k
         out[kind] = K
     return out, reachable
