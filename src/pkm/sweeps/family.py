@@ -60,6 +60,10 @@ class Candidate:
             self._cache[key] = make()
         return self._cache[key]
 
+    def peek(self, key) -> Any:
+        """What :meth:`cached` keeps under ``key``, or None (nothing made)."""
+        return self._cache.get(key)
+
     def forget(self, key) -> None:
         """Drop what :meth:`cached` keeps under ``key`` (to make it again otherwise)."""
         self._cache.pop(key, None)

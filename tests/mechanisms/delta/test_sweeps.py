@@ -40,12 +40,17 @@ def test_declared_forms_and_units():
 
 def test_the_volumes_share_one_grid_and_bound_each_other():
     """On a 2 cm grid: one cached grid serves the three volumes; 0 < weighted <= workspace (1/K <= 1), conditioned
-    <= workspace, weighted >= conditioned / k_max, and an unbounded k_max conditions the whole workspace."""
+    <= workspace, weighted >= conditioned / k_max, and an unbounded k_max conditions the whole workspace. The volume
+    alone makes a grid without condition numbers (no SVD a node), of the same volume."""
     c = RegisteredFamily("delta").candidate({})
-    v = value("workspace_volume:spacing=2cm", c)
     cond = value("conditioned_volume:spacing=2cm,k_max=3", c)
+    v = value("workspace_volume:spacing=2cm", c)
     weighted = value("weighted_volume:spacing=2cm", c)
-    assert [k[0] for k in c._cache if isinstance(k, tuple)] == ["delta_grid"]
+    assert [k for k in c._cache if isinstance(k, tuple) and k[0] == "delta_grid"] == [("delta_grid", 0.02, "2", "")]
+    alone = RegisteredFamily("delta").candidate({})
+    assert value("workspace_volume:spacing=2cm", alone) == v
+    (grid,) = (g for k, g in alone._cache.items() if isinstance(k, tuple) and k[0] == "delta_grid")
+    assert grid.K == {}
     assert 0.0 < cond <= v and 0.0 < weighted <= v and weighted >= cond / 3.0
     assert value("conditioned_volume:spacing=2cm,k_max=1e12", c) == v
     assert 0.03 < v < 0.06  # (the paper design's reachable volume is about 0.045 m^3)

@@ -23,12 +23,16 @@ def _spacing(c, o) -> float:
     return o["spacing"] if o["spacing"] is not None else (c.params.La + c.params.Lb) / CELLS
 
 
-def _grid(c, o):
+def _grid(c, o, conditioned: bool = True):
+    """The design's workspace grid, with its condition numbers of ``o["kind"]`` (``conditioned``) or without (the
+    reachable nodes only: no SVD a node), made once a design; a conditioned grid made already serves both."""
     from pkm.mechanisms.delta.workspace import workspace
 
     kind, spacing = o["kind"], _spacing(c, o)
-    return c.cached(("delta_grid", spacing, kind, o["branch"]),
-                    lambda: workspace(c.params, spacing, o["branch"] or "knee_out", (kind,)))
+    key = ("delta_grid", spacing, kind, o["branch"])
+    if not conditioned and c.peek(key) is None:
+        key, kind = ("delta_grid", spacing, None, o["branch"]), None
+    return c.cached(key, lambda: workspace(c.params, spacing, o["branch"] or "knee_out", (kind,) if kind else ()))
 
 
 def _K(c, o):
@@ -37,7 +41,7 @@ def _K(c, o):
 
 
 def workspace_volume(c, o):
-    return float(_grid(c, o).volume)
+    return float(_grid(c, o, conditioned=False).volume)
 
 
 def conditioned_volume(c, o):

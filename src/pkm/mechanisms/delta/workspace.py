@@ -156,7 +156,8 @@ def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", ki
 
     The grid covers ``|x|, |y| <= La + Lb`` and ``-(La + Lb) <= z <= 0``, which contains every
     reachable point (each ball joint lies within ``La + Lb`` of its motor, and the motors
-    surround the axis). Computed z slice by z slice to bound memory.
+    surround the axis). Computed z slice by z slice to bound memory. ``kinds`` empty: the reachable nodes only
+    (no condition numbers).
 
     Raises:
         InvalidInputError: if ``spacing`` is not a finite length in (0, (La + Lb) / 4].
@@ -176,6 +177,9 @@ def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", ki
     X, Y = np.meshgrid(xy, xy, indexing="ij")
     for k, zk in enumerate(z):
         pts = np.stack([X, Y, np.full_like(X, zk)], axis=-1)
+        if not kinds:  # (the reachable nodes only)
+            reachable[:, :, k] = inverse_kinematics_batch(params, pts, branch)[1]
+            continue
         Kk, reachable[:, :, k] = condition_numbers(params, pts, branch, kinds)
         for kind in kinds:
             K[kind][:, :, k] = Kk[kind]
