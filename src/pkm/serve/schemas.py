@@ -307,7 +307,8 @@ class StiffnessRequest(_AtConfigurations):
     springs: dict[str, float] | None = _field("A joint's stiffness by name (N m/rad for a revolute, N/m for a "
                                               "prismatic joint; 0 frees it), over the model's own springs.",
                                               {"motor_1": 500.0}, None)
-    drives: float | None = _field("Every actuated joint's stiffness not named in springs (SI); default: the drives "
+    drives: float | None = _field("Every actuated joint's stiffness not named in springs (SI); default: each "
+                                  "drive's own servo stiffness (the spec's [actuators.<joint>] stiffness), else "
                                   "held rigid.", 500.0, None)
     wrench: list[float] | None = _field("A constant load at the end effector's origin, world axes (fx, fy, fz [N], "
                                         "mx, my, mz [N m]): its exact deflection is answered too.",
