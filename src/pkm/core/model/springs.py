@@ -120,4 +120,9 @@ def describe(springs: Mapping[str, Mapping[str, float]]) -> str:
                      for j, values in springs.items())
 
 
-__all__ = ["MAGNITUDE", "SPRING_KEYS", "JointSprings", "describe", "joint_springs", "parse_springs"]
+def spring_notes(springs: Mapping[str, Mapping[str, float]]) -> tuple[str, ...]:
+    """The load note naming the springs a model file states (none: no note)."""
+    return (f"joint springs read into [springs] (applied by pkm's dynamics): {describe(springs)}",) if springs else ()
+
+
+__all__ = ["MAGNITUDE", "SPRING_KEYS", "JointSprings", "describe", "joint_springs", "parse_springs", "spring_notes"]
