@@ -14,7 +14,8 @@ An :class:`Actuator` holds what the dynamics needs of a drive, in the joint's ow
 * the **servo stiffness** ``stiffness`` [N m/rad; N/m]: how stiffly the position-controlled drive holds its joint
   (the controller's proportional gain seen at the joint, the transmission's compliance in series), the compliance
   :func:`pkm.stiffness` gives an actuated joint its ``joints=`` argument does not; ``inf`` (the default): a rigid
-  drive.
+  drive. The dynamics do not apply it (it is a controller's gain: :func:`pkm.simulate`'s controllers hold the
+  drives), and no model file states it (MJCF's ``<position kp>`` is not read as one).
 
 Where the values come from, later sources overriding earlier ones per field:
 
