@@ -1449,10 +1449,10 @@ def _fwd_dyn(g, adv):
 # the dynamic model, actuators, simulation (issue 29) -----------------------
 def _drives(acts) -> list:
     """The numbers of drives (:class:`pkm.Actuator`), the reflected inertia and max effort with them; an ``inf``
-    limit (documented: none) read as 0, every other number must be finite."""
-    from pkm.core.model.actuators import LIMITS, NUMBERS
+    limit (documented: none) or servo stiffness (a rigid drive) read as 0, every other number must be finite."""
+    from pkm.core.model.actuators import INFINITE, NUMBERS
 
-    return [[0.0 if v == math.inf and f in (*LIMITS, "max_effort") else v
+    return [[0.0 if v == math.inf and f in (*INFINITE, "max_effort") else v
              for f, v in ((f, getattr(a, f)) for f in (*NUMBERS, "reflected_inertia", "max_effort"))] for a in acts]
 
 

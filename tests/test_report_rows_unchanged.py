@@ -35,7 +35,9 @@ ADDED = {"prs3.opcount.generic_mul", "prs3.opcount.generic_add", "delta.opcount.
          "hexapod.opcount.mul", "hexapod.opcount.add",  # issue 15
          "hexapod.fk.modes_reference", "rrr3.fk.modes_reference", "prs3.fk.modes_reference",  # issue 17
          *(f"{paper}.ident.{row}" for paper in ("rrr3", "delta", "prs3", "hexapod")
-           for row in ("n_base", "n_base_tied", "routes_agree"))}  # issue 30
+           for row in ("n_base", "n_base_tied", "routes_agree")),  # issue 30
+         *(f"delta.stiffness.{q}_R{R}" for q in ("force_min", "f1") for R in (100, 120, 150, 200)),  # issue 54
+         *(f"hexapod.stiffness.{q}_beta_{b}" for q in ("force_min", "f1") for b in ("m30", "m15", "0", "p15", "p30"))}
 
 BEFORE = json.loads((Path(__file__).parent / "data" / "report_rows_before_issue13.json").read_text())["papers"]
 

@@ -5,7 +5,8 @@ pkm computes in SI (m, rad, kg). Wherever the API takes a joint value, a task co
 parameter, it also takes a string with a unit suffix, converted here: lengths ``m cm mm``, angles
 ``rad deg``, masses ``kg g``, times ``s ms us`` (a simulation's duration and step), forces ``N mN kN``, torques
 ``N m`` (or ``N*m``, ``Nm``), ``mN m``, ``kN m``, angular velocities ``rad/s deg/s rpm`` and velocities ``m/s mm/s`` (an
-actuator's effort and speed limits). A plain number (or a string
+actuator's effort and speed limits), stiffnesses ``N m/rad kN m/rad N m/deg`` (a revolute joint's) and ``N/m N/mm kN/m``
+(a prismatic joint's: a drive's servo stiffness, a spring). A plain number (or a string
 without suffix) is SI. A suffix of another kind than the value's is refused (``"3deg"`` for a length), never
 silently converted::
 
@@ -39,28 +40,36 @@ SUFFIXES: dict[str, tuple[str, float]] = {
     "rad/s": ("angular velocity", 1.0), "deg/s": ("angular velocity", math.pi / 180.0),
     "rpm": ("angular velocity", math.pi / 30.0),
     "m/s": ("velocity", 1.0), "mm/s": ("velocity", 1e-3),
+    "N m/rad": ("rotational stiffness", 1.0), "kN m/rad": ("rotational stiffness", 1e3),
+    "N m/deg": ("rotational stiffness", 180.0 / math.pi),
+    "N/m": ("translational stiffness", 1.0), "N/mm": ("translational stiffness", 1e3),
+    "kN/m": ("translational stiffness", 1e3),
 }
 #: The SI unit of each kind a suffix can convert to.
 SI_UNITS = {"length": "m", "angle": "rad", "mass": "kg", "time": "s", "force": "N", "torque": "N m",
-            "angular velocity": "rad/s", "velocity": "m/s"}
-#: The kind of each SI unit (``"m" -> "length"``), its other spellings too (``"N*m"``, ``"Nm"``).
-KIND_OF_UNIT = {v: k for k, v in SI_UNITS.items()} | {"N*m": "torque", "Nm": "torque"}
+            "angular velocity": "rad/s", "velocity": "m/s", "rotational stiffness": "N m/rad",
+            "translational stiffness": "N/m"}
+#: The kind of each SI unit (``"m" -> "length"``), its other spellings too (``"N*m"``, ``"Nm"``, ``"Nm/rad"``).
+KIND_OF_UNIT = {v: k for k, v in SI_UNITS.items()} | {"N*m": "torque", "Nm": "torque", "N*m/rad": "rotational stiffness",
+                                                       "Nm/rad": "rotational stiffness"}
 #: The kind of a joint's value of each order, for a revolute and a prismatic joint (``None``: no suffix, a plain
 #: number in SI): positions, rates and efforts take units alike in the API, the CLI and the service.
 JOINT_KINDS: dict[str, tuple[str | None, str | None]] = {
     "position": ("angle", "length"), "rate": ("angular velocity", "velocity"), "acceleration": (None, None),
-    "effort": ("torque", "force")}
+    "effort": ("torque", "force"), "stiffness": ("rotational stiffness", "translational stiffness")}
 #: The SI unit of a joint's value of each order, revolute and prismatic.
 JOINT_UNITS: dict[str, tuple[str, str]] = {
-    "position": ("rad", "m"), "rate": ("rad/s", "m/s"), "acceleration": ("rad/s^2", "m/s^2"), "effort": ("N m", "N")}
+    "position": ("rad", "m"), "rate": ("rad/s", "m/s"), "acceleration": ("rad/s^2", "m/s^2"), "effort": ("N m", "N"),
+    "stiffness": ("N m/rad", "N/m")}
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z](?:[A-Za-z*/ ]*[A-Za-z])?)?\s*$")
-_PRODUCT = re.compile(r"^(m|k)?N\s*\*?\s*m$")  # (N m, N*m, Nm; mN m, kN m)
+_PRODUCT = re.compile(r"^(m|k)?N\s*\*?\s*m(/rad|/deg)?$")  # (N m, N*m, Nm; mN m, kN m; N m/rad, Nm/deg)
 
 
 def _suffix(text: str) -> str:
-    """A suffix in :data:`SUFFIXES`' spelling: a torque's product written ``N m`` (from ``N*m``, ``Nm``, ``N  m``)."""
+    """A suffix in :data:`SUFFIXES`' spelling: a torque's product written ``N m`` (from ``N*m``, ``Nm``, ``N  m``), a
+    rotational stiffness's ``N m/rad``."""
     m = _PRODUCT.match(text)
-    return f"{m.group(1) or ''}N m" if m else text
+    return f"{m.group(1) or ''}N m{m.group(2) or ''}" if m else text
 
 
 def _listing() -> str:

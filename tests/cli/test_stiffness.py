@@ -20,6 +20,7 @@ def test_the_gough_stewart_with_leg_springs_prints_the_librarys_numbers():
     joints = {**{j: 1e6 for j in gs.actuated_names}, "leg2": 2e6}
     K = pkm.stiffness(gs, gs.q_reference, joints=joints)
     assert out["rank"] == 6 and out["sprung"] == joints and out["locked"] == []
+    assert out["sources"] == dict.fromkeys(joints, "joints")
     assert np.allclose(out["matrix"], K.matrix, rtol=1e-12, atol=1e-9)
     d = K.deflection([0, 0, -2000.0, 5.0, 0, 0])
     assert np.allclose(out["deflection"]["exact"], d.displacement, rtol=1e-12, atol=1e-15)
@@ -32,5 +33,6 @@ def test_a_delta_is_rigid_in_rotation_and_a_free_motion_is_one_error_line():
     proc = run("stiffness", "delta", "--drives", "500")
     assert proc.returncode == 0, proc.stderr
     assert "compliance of rank 3 of 6" in proc.stdout and "pure moment [N m/rad]: inf along" in proc.stdout
+    assert "springs: motor_1 500 (joints)" in proc.stdout
     bad = run("stiffness", "gough_stewart", "--drives", "1e6", "--spring", "leg1=0")
     assert bad.returncode == 1 and "no spring resists" in one_error_line(bad) and "leg1" in bad.stderr

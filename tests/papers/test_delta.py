@@ -15,7 +15,8 @@ from tests.papers.figures import draw_checked, uncovered
 
 IDS = ["delta.fig5.K_F_R100", "delta.fig5.K_F_R200", "delta.fig5.K_2_R120", "delta.fig5.monotone_100_200",
        "delta.fig5.R_min_K2_mm", "delta.choice.R_mm", "delta.opcount.mul", "delta.opcount.add",  # the last two: issue 15
-       "delta.ident.n_base", "delta.ident.n_base_tied", "delta.ident.routes_agree"]  # issue 30
+       "delta.ident.n_base", "delta.ident.n_base_tied", "delta.ident.routes_agree",  # issue 30
+       *(f"delta.stiffness.{q}_R{R}" for q in ("force_min", "f1") for R in (100, 120, 150, 200))]  # issue 54
 
 
 @pytest.fixture(scope="module")
@@ -80,3 +81,26 @@ def test_figures_and_series_are_written(tmp_path, rows):
     assert float(table[1][0]) == 100.0 and float(table[1][1]) == pytest.approx(rows["delta.fig5.K_F_R100"].computed)
     with f2.open() as fh:
         assert next(csv.reader(fh))[0] == "R_mm"
+
+
+def test_the_stiffness_rows_are_the_closed_form_jacobians(rows):
+    """The stiffness rows (issue 54) against the closed-form Jacobian J = dX/dth (eqs. 12-14): with a servo spring k
+    on each motor and rigid links, C = J J^T / k, the smallest stiffness k / sigma_max(J)^2 (1e-9); the first natural
+    frequency from the actuator-space mass matrix, sqrt(eig(k I, M_a)) / 2 pi (pkm.mass_matrix, 1e-9)."""
+    from scipy.linalg import eigh
+
+    import pkm
+    from pkm.mechanisms.delta import kinematics, model
+    from pkm.papers import DRIVE_STIFFNESS
+
+    for R in S.STIFFNESS_R:
+        p = dataclasses.replace(S.PAPER, R=R)
+        mech = model.build(p)
+        J = kinematics.jacobian(p, mech.actuated_q(mech.q_reference), S.POSE)
+        k_min = DRIVE_STIFFNESS / np.linalg.svd(J, compute_uv=False)[0] ** 2
+        assert rows[f"delta.stiffness.force_min_R{R * 1e3:.0f}"].computed == pytest.approx(k_min, rel=1e-9)
+        Ma = pkm.mass_matrix(mech, mech.q_reference)
+        w2 = eigh(DRIVE_STIFFNESS * np.eye(3), Ma, eigvals_only=True)
+        f1 = math.sqrt(w2.min()) / (2 * math.pi)
+        assert rows[f"delta.stiffness.f1_R{R * 1e3:.0f}"].computed == pytest.approx(f1, rel=1e-9)
+        assert "1000 N m/rad" in rows[f"delta.stiffness.f1_R{R * 1e3:.0f}"].note

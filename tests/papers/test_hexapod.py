@@ -16,7 +16,9 @@ IDS = ("hexapod.poseT.beta_min_reachable_deg", "hexapod.poseT.beta_opt_wrot_deg"
        "hexapod.spiral.max_gap_rot_tras_deg", "hexapod.spiral.gain_after_40_wrot",
        "hexapod.opcount.mul", "hexapod.opcount.add",  # issue 15
        "hexapod.fk.modes_reference",  # issue 17
-       "hexapod.ident.n_base", "hexapod.ident.n_base_tied", "hexapod.ident.routes_agree")  # issue 30
+       "hexapod.ident.n_base", "hexapod.ident.n_base_tied", "hexapod.ident.routes_agree",  # issue 30
+       *(f"hexapod.stiffness.{q}_beta_{b}" for q in ("force_min", "f1")  # issue 54
+         for b in ("m30", "m15", "0", "p15", "p30")))
 
 
 @pytest.fixture(scope="module")
@@ -75,3 +77,35 @@ def test_figures_and_series_are_written(tmp_path):
     with spiral.open() as fh:
         rows = list(csv.reader(fh))
     assert len(rows) == 102 and rows[0][:3] == ["k", "w_rot_base", "w_rot_pointwise"]
+
+
+def test_the_stiffness_rows_are_the_forward_kinematics_jacobians(reproduced):
+    """The stiffness rows (issue 54) at beta = -30 and 30 deg against the platform's displacement under small moves
+    of each alpha drive (pkm.close_loops at beta held, central differences, 1e-5 rad): J = d(p, theta)/d(alpha),
+    C = J J^T / k, the smallest principal stiffness under a force 1 / lambda_max(C_ff) (1e-6 relative)."""
+    import pinocchio as pin
+
+    import pkm
+    from pkm.papers import DRIVE_STIFFNESS
+
+    rows = {r.id: r for r in reproduced}
+    mech = pkm.load("hexapod")
+    h = 1e-5
+    for b, key in ((-30, "m30"), (30, "p30")):
+        q = study.stiffness_configuration(mech, b)
+        qa = mech.actuated_q(q)
+
+        def pose(qa_, seed):
+            pin.framesForwardKinematics(mech.model, mech.data, pkm.close_loops(mech, qa_, seed, tol=1e-14).q)
+            return mech.data.oMf[mech.ee_frame].copy()
+
+        J = np.zeros((6, 6))
+        for i in range(6):  # (alpha_1..alpha_6; beta_1, the last actuated joint, held)
+            e = np.zeros(len(qa))
+            e[i] = h
+            a, c = pose(qa + e, q), pose(qa - e, q)
+            J[:3, i] = (a.translation - c.translation) / (2 * h)
+            J[3:, i] = pin.log3(a.rotation @ c.rotation.T) / (2 * h)
+        C = J @ J.T / DRIVE_STIFFNESS
+        k_min = 1.0 / np.linalg.eigvalsh(C[:3, :3]).max()
+        assert rows[f"hexapod.stiffness.force_min_beta_{key}"].computed == pytest.approx(k_min, rel=1e-6)

@@ -180,6 +180,7 @@ def test_the_stiffness_query_is_the_librarys():
                                        "wrench": [1.0, 0.0, -10.0, 0.0, 0.0, 0.0]})
     K = pkm.stiffness(delta, delta.q_reference, joints={"motor_1": 400.0, "motor_2": 800.0, "motor_3": 400.0})
     assert out["status"] == ["ok", "ok"] and list(out["rank"]) == [3, 3]
+    assert out["sprung"] == K.sprung and out["sources"] == dict.fromkeys(delta.actuated_names, "joints")
     assert np.allclose(out["compliance"][1], K.compliance, rtol=1e-12, atol=1e-18)
     assert np.allclose(1.0 / out["force_compliance"][0], K.principal("force")[0], rtol=1e-9)
     assert not np.any(out["moment_compliance"][0]) and out["units"]["force_compliance"] == "m/N"

@@ -19,7 +19,7 @@ from __future__ import annotations
 import functools
 import importlib
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from types import ModuleType
 from typing import Any
@@ -206,6 +206,45 @@ def cached_rows(paper: str) -> Callable[[Callable[[], list[Row]]], Callable[[], 
     return wrap
 
 
+#: The servo stiffness the studies' stiffness rows give the drives they name [N m/rad]: an assumed value (no paper
+#: states one); every stiffness of those rows scales with it, every natural frequency with its square root.
+DRIVE_STIFFNESS = 1000.0
+
+
+def stiffness_rows(prefix: str, cases: Sequence[tuple[str, str, Any, Any]], drives: Sequence[str]) -> list[Row]:
+    """Rows ``<prefix>force_min_<key>`` [N/m] then ``<prefix>f1_<key>`` [Hz] for each case ``(key, label, mech,
+    q)``: the smallest principal stiffness of the end effector under a pure force and its first natural frequency
+    (:func:`pkm.stiffness`, :meth:`~pkm.core.compliance.stiffness.Stiffness.vibration_modes`; the papers publish
+    none) at the closed configuration ``q``, the drives ``drives`` each given the servo stiffness
+    :data:`DRIVE_STIFFNESS` as their :attr:`Actuator.stiffness <pkm.core.model.actuators.Actuator.stiffness>`, every
+    other drive held rigid, every link rigid, every passive joint free. Each note states these sources (the ones
+    :attr:`Stiffness.sources <pkm.core.compliance.stiffness.Stiffness.sources>` gives), the principal stiffnesses under
+    a force and a moment and the frequencies."""
+    import pkm
+
+    def fmt(values: Any) -> str:
+        return ", ".join(f"{float(v):.6g}" for v in values)
+
+    stiff, freq = [], []
+    for key, label, mech, q in cases:
+        sprung = pkm.with_actuators(mech, {j: {"stiffness": DRIVE_STIFFNESS} for j in drives})
+        K = pkm.stiffness(sprung, q)
+        k, km = K.principal("force")[0], K.principal("moment")[0]
+        f = K.vibration_modes().frequencies
+        text = (f"pkm.stiffness at {label}: the drives {', '.join(K.sprung)} each a servo spring of "
+                f"{DRIVE_STIFFNESS:g} N m/rad (their Actuator.stiffness: source "
+                f"{'/'.join(sorted(set(K.sources.values())))}; assumed, the paper states none: every stiffness "
+                "scales with it, every frequency with its square root), "
+                + (f"{', '.join(K.locked)} held rigid, " if K.locked else "")
+                + "rigid links, every passive joint free (no spring); gravity not counted. Principal stiffnesses at "
+                f"the end effector's origin under a force {fmt(k)} N/m, under a moment {fmt(km)} N m/rad (inf: rigid); natural frequencies "
+                f"{fmt(f)} Hz (the links' inertias and the drives' reflected inertia; compliance rank {K.rank}).")
+        source = "stiffness at the reference pose (no published value)"
+        stiff.append(Row(f"{prefix}force_min_{key}", None, float(k[0]), "N/m", None, source, text))
+        freq.append(Row(f"{prefix}f1_{key}", None, float(f[0]), "Hz", None, source, text))
+    return stiff + freq
+
+
 def names() -> tuple[str, ...]:
     """The paper studies, in registry order: the ``paper`` of every registered mechanism that has one."""
     return tuple(d.paper for d in REGISTRY.values() if d.paper is not None)
@@ -218,4 +257,5 @@ def module(name: str) -> ModuleType:
     return importlib.import_module(f"pkm.papers.{name}")
 
 
-__all__ = ["Row", "cached_rows", "generic_count", "ident_rows", "modes_row", "module", "names", "opcount_rows"]
+__all__ = ["DRIVE_STIFFNESS", "Row", "cached_rows", "generic_count", "ident_rows", "modes_row", "module", "names",
+           "opcount_rows", "stiffness_rows"]

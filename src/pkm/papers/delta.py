@@ -34,6 +34,7 @@ no published number to compare with; the rows record ours with the convention na
 from __future__ import annotations
 
 import csv
+import dataclasses
 import math
 from functools import lru_cache
 from pathlib import Path
@@ -43,7 +44,7 @@ import numpy as np
 from pkm._plot import figure, save
 from pkm.mechanisms.delta import DeltaParams
 from pkm.mechanisms.delta import design as design
-from pkm.papers import Row, cached_rows, ident_rows, opcount_rows
+from pkm.papers import Row, cached_rows, ident_rows, opcount_rows, stiffness_rows
 
 TITLE = "Hernández Reyna & Sandoval-Castro (2018): kinematics and base-radius reconfiguration of a Delta robot"
 
@@ -176,7 +177,25 @@ def reproduce() -> list[Row]:
             "it shrinks as R grows over the paper's range, as the paper says",
             why=f"the choice moves with the unstated bound on K_2 ({sens}); 120 mm is the paper's guideline, "
                 "not an optimum of a stated criterion"),
-    ] + opcount_rows("delta", "delta.opcount.") + ident_rows("delta", "delta.ident.")
+    ] + opcount_rows("delta", "delta.opcount.") + ident_rows("delta", "delta.ident.") + stiffness_over_radius()
+
+
+#: The base radii of the stiffness rows [m]: the paper's range, its choice and Table 1's.
+STIFFNESS_R = (0.100, 0.120, 0.150, 0.200)
+
+
+def stiffness_over_radius() -> list[Row]:
+    """Rows ``delta.stiffness.force_min_R<mm>`` and ``delta.stiffness.f1_R<mm>`` (issue 54): the Delta's smallest
+    translational stiffness and first natural frequency at the study pose for each base radius of
+    :data:`STIFFNESS_R` (:func:`pkm.papers.stiffness_rows`: the motors' servo stiffness, rigid links)."""
+    from pkm.mechanisms.delta import model
+
+    cases = []
+    for R in STIFFNESS_R:
+        mech = model.build(dataclasses.replace(PAPER, R=R))
+        cases.append((f"R{R * 1e3:.0f}", f"R = {R * 1e3:.0f} mm, the pose (0, 0, -375) mm, knee out, Table 1's "
+                                         "other dimensions", mech, mech.q_reference))
+    return stiffness_rows("delta.stiffness.", cases, mech.actuated_names)
 
 
 K_BOUNDS = (2.5, 3.0, 4.0, 5.0)  # the bounds on K_2 whose conditioned volumes the R study draws

@@ -25,7 +25,7 @@ from pkm.core.kinematics.task import TaskMap, as_rotation
 from pkm.mechanisms import hexapod as hx
 from pkm.mechanisms.hexapod import indices as hi
 from pkm.mechanisms.hexapod import reconfiguration as hr
-from pkm.papers import Row, cached_rows, ident_rows, modes_row, opcount_rows
+from pkm.papers import Row, cached_rows, ident_rows, modes_row, opcount_rows, stiffness_rows
 
 TITLE = "Sanchez-Alonso et al. (2016), Kinematic analysis of a novel reconfigurable parallel robot, RIAI 13:247-257"
 
@@ -119,7 +119,36 @@ def reproduce() -> list[Row]:
             f"approaches 0 along the spiral ({math.degrees(pr.pointwise[-1]):.2f} deg at the end). The rate-limited "
             f"QP profile gives {100 * pr.mean_gain(GAIN_FROM):.2f} %."),
     ] + opcount_rows("hexapod", "hexapod.opcount.") + [
-        modes_row("hexapod", "hexapod.fk.modes_reference", _against_multistart)] + ident_rows("hexapod", "hexapod.ident.")
+        modes_row("hexapod", "hexapod.fk.modes_reference", _against_multistart)] + ident_rows("hexapod", "hexapod.ident.") \
+        + stiffness_over_beta()
+
+
+#: The reconfiguration angles of the stiffness rows [deg].
+STIFFNESS_BETA = (-30, -15, 0, 15, 30)
+
+
+def stiffness_configuration(mech, beta_deg: float) -> np.ndarray:
+    """The closed configuration at the model's reference pose of the platform with the reconfiguration angle
+    ``beta_deg`` [deg] (:func:`pkm.solve_ik` from the reference)."""
+    import pkm
+
+    task = TaskMap.of(mech).named(mech.q_reference)
+    return pkm.solve_ik(mech, {**task, "beta_1": math.radians(beta_deg)}).q
+
+
+def stiffness_over_beta() -> list[Row]:
+    """Rows ``hexapod.stiffness.force_min_beta_<m|p><deg>`` and ``hexapod.stiffness.f1_beta_...`` (issue 54): the
+    platform's smallest translational stiffness and first natural frequency at the reference pose for each
+    reconfiguration angle of :data:`STIFFNESS_BETA` (:func:`pkm.papers.stiffness_rows`: the six alpha drives' servo
+    stiffness, the reconfiguration drive beta_1 held rigid, rigid links)."""
+    import pkm
+
+    mech = pkm.load("hexapod")
+    pose = ", ".join(f"{k} {v:.6g}" for k, v in TaskMap.of(mech).named(mech.q_reference).items() if k != "beta_1")
+    cases = [(f"beta_{'m' if b < 0 else 'p' if b > 0 else ''}{abs(b)}",
+              f"beta = {b} deg, the model's reference pose of the platform ({pose} [m, rad]), Table 1's dimensions",
+              mech, stiffness_configuration(mech, b)) for b in STIFFNESS_BETA]
+    return stiffness_rows("hexapod.stiffness.", cases, [j for j in mech.actuated_names if j.startswith("alpha")])
 
 
 def _against_multistart(mech, modes) -> str:

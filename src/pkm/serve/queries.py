@@ -587,9 +587,13 @@ def stiffness(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> 
         joints.update(springs)
     wrench = body.get("wrench")
     q, samples = _configurations(mech, body, kernels)
+    sprung: dict[str, float] = {}
+    sources: dict[str, str] = {}
 
     def one(k: int) -> dict[str, Any]:
         K = run(mech, q[k], joints=joints)
+        sprung.update(K.sprung)  # (the same at every sample: the request's, the drives' and the spec's springs)
+        sources.update(K.sources)
         out = {"q": q[k], "compliance": K.compliance, "rank": K.rank}
         for load in ("force", "moment"):  # (the principal stiffnesses' reciprocals: 0 along a rigid direction)
             principal, U = K.principal(load)
@@ -602,10 +606,12 @@ def stiffness(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> 
     keys = ("q", "compliance", "rank", "force_compliance", "force_directions", "moment_compliance",
             "moment_directions") + (("displacement", "first_order", "gap") if wrench is not None else ())
     out = samples.each(one, keys)
+    out["sprung"], out["sources"] = sprung, sources
     out["units"] = {"q": _q_units(mech), "compliance": [["m/N"] * 3 + ["m/(N m)"] * 3] * 3
                     + [["rad/N"] * 3 + ["rad/(N m)"] * 3] * 3, "rank": "1", "force_compliance": "m/N",
                     "force_directions": "1", "moment_compliance": "rad/(N m)", "moment_directions": "1",
-                    "displacement": ["m"] * 3 + ["rad"] * 3, "first_order": ["m"] * 3 + ["rad"] * 3, "gap": "1"}
+                    "displacement": ["m"] * 3 + ["rad"] * 3, "first_order": ["m"] * 3 + ["rad"] * 3, "gap": "1",
+                    "sprung": "N m/rad (revolute), N/m (prismatic)", "sources": "1"}
     return out
 
 

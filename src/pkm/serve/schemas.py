@@ -287,6 +287,12 @@ class StiffnessAnswer(_Batch):
     first_order: Column | None = _field("With a wrench: the first-order deflection C W, same layout.", None, None)
     gap: Column | None = _field("With a wrench: their relative difference (homogenised by the model's size).", None,
                                 None)
+    sprung: dict[str, float] = _field("Each joint's stiffness counted (N m/rad for a revolute, N/m for a prismatic "
+                                      "joint); the actuated joints not named held rigid.", {"motor_1": 500.0})
+    sources: dict[str, str] = _field("Where each one came from: joints (this request's springs or drives), actuator "
+                                     "(the drive's own servo stiffness, the spec's [actuators.<joint>] stiffness), "
+                                     "spring (the model's [springs]), actuator+spring (both, in parallel).",
+                                     {"motor_1": "joints"})
     units: Units = _field(UNITS, {"force_compliance": "m/N", "moment_compliance": "rad/(N m)"})
 
 
@@ -307,7 +313,8 @@ class StiffnessRequest(_AtConfigurations):
     springs: dict[str, float] | None = _field("A joint's stiffness by name (N m/rad for a revolute, N/m for a "
                                               "prismatic joint; 0 frees it), over the model's own springs.",
                                               {"motor_1": 500.0}, None)
-    drives: float | None = _field("Every actuated joint's stiffness not named in springs (SI); default: the drives "
+    drives: float | None = _field("Every actuated joint's stiffness not named in springs (SI); default: each "
+                                  "drive's own servo stiffness (the spec's [actuators.<joint>] stiffness), else "
                                   "held rigid.", 500.0, None)
     wrench: list[float] | None = _field("A constant load at the end effector's origin, world axes (fx, fy, fz [N], "
                                         "mx, my, mz [N m]): its exact deflection is answered too.",

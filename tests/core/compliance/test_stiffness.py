@@ -4,6 +4,7 @@ the linearised forward dynamics'; a Delta's compliance has rank 3 and says so; b
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -13,6 +14,7 @@ from scipy.optimize import root
 
 import pkm
 from pkm.core.compliance import stiffness, vibration_modes
+from pkm.core.model.builder import from_strings
 from pkm.errors import InvalidInputError, StiffnessError, UnknownNameError
 
 K_LEG = 2.0e6  # N/m: one axial spring per leg
@@ -239,3 +241,24 @@ def test_bad_links_are_refused_by_name():
     own = stiffness(rrr3, q, joints=motors, links={"proximal_1": rod.compliance(length)}).compliance
     beam = stiffness(rrr3, q, joints=motors, links={"proximal_1": rod}).compliance
     assert np.abs(own - beam).max() <= 1e-9 * np.abs(beam).max()
+
+
+def test_the_drives_servo_stiffness_is_the_default_and_an_argument_wins(gs, pose):
+    """Actuator.stiffness (the spec's [actuators.<joint>] stiffness, with its unit) gives the same stiffness as the
+    same numbers in joints= (1e-12 relative); joints= wins where given; a [springs] spring on a driven joint adds in
+    parallel; each joint's source is stated."""
+    legs = gs.actuated_names
+    given = {j: f"{K_LEG * (1 + 0.1 * i) / 1e3:.17g} N/mm" for i, j in enumerate(legs)}  # (N/mm: 1e3 N/m)
+    driven = pkm.with_actuators(gs, {j: {"stiffness": v} for j, v in given.items()})
+    explicit = stiffness(gs, pose, joints={j: K_LEG * (1 + 0.1 * i) for i, j in enumerate(legs)})
+    field = stiffness(driven, pose)
+    assert field.sources == dict.fromkeys(legs, "actuator") and explicit.sources == dict.fromkeys(legs, "joints")
+    assert np.abs(field.matrix - explicit.matrix).max() <= 1e-12 * np.abs(explicit.matrix).max()
+    over = stiffness(driven, pose, joints={legs[0]: 3 * K_LEG})
+    assert over.sprung[legs[0]] == 3 * K_LEG and over.sources[legs[0]] == "joints"
+    assert over.sources[legs[1]] == "actuator"
+    spec = dataclasses.replace(driven.spec, springs={legs[0]: {"stiffness": 0.5 * K_LEG}})
+    both = from_strings(driven.urdf, spec, driven.params, "gs")
+    parallel = stiffness(both, pose)
+    assert parallel.sources[legs[0]] == "actuator+spring"
+    assert parallel.sprung[legs[0]] == pytest.approx(1.5 * K_LEG, rel=1e-15)

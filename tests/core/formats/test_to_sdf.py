@@ -111,3 +111,36 @@ def test_every_written_file_names_each_link_joint_and_frame_once():
         model = etree.fromstring(sdf_from_mechanism(original(case))[0].encode()).find("model")
         names = [el.get("name") for el in model if el.tag in ("link", "joint", "frame")]
         assert len(names) == len(set(names)), (case, sorted({n for n in names if names.count(n) > 1}))
+
+
+def _sprung_delta() -> pkm.Mechanism:
+    """The Delta with a spring on a passive knee (rest away from the reference, damped), one on a motor, and a
+    damper alone."""
+    import dataclasses
+
+    d = original("delta")
+    springs = {"knee_1": {"stiffness": 3.5, "rest": -2.0, "damping": 0.2}, "motor_2": {"stiffness": 7.0, "rest": 0.3},
+               "knee_2_b": {"damping": 0.05}}
+    return pkm.from_strings(d.urdf, dataclasses.replace(d.spec, springs=springs), d.params, "sprung delta")
+
+
+def test_the_springs_are_written_as_sdformat_s_and_read_back():
+    """The joint springs as ``<axis><dynamics>``: another reader sees the reference from the written pose (``rest -
+    q_ref``, as the limits) and the joint's whole damping; pkm's SDF reader alone (no spec beside) gives back the
+    springs' stiffness and rest (1e-12) and the damping (Pinocchio's, 1e-15)."""
+    mech = _sprung_delta()
+    text, _ = sdf_from_mechanism(mech)
+    root = etree.fromstring(text.encode())
+    ref = mech.q_to_dict(mech.q_reference)
+    dyn = {j.get("name"): j.find("axis/dynamics") for j in root.iter("joint") if j.find("axis/dynamics") is not None}
+    assert float(dyn["knee_1"].findtext("spring_reference")) == pytest.approx(-2.0 - ref["knee_1"], abs=1e-12)
+    assert float(dyn["knee_1"].findtext("damping")) == 0.2 and dyn["knee_2_b"].find("spring_stiffness") is None
+    assert float(dyn["motor_2"].findtext("spring_stiffness")) == 7.0
+    alone = read_sdf(text, "delta.sdf")
+    assert alone.springs.keys() == set(mech.springs.names)
+    for name, k, rest in zip(mech.springs.names, mech.springs.stiffness, mech.springs.rest):
+        assert alone.springs[name]["stiffness"] == k and abs(alone.springs[name]["rest"] - rest) <= 1e-12
+    plain = pin.buildModelFromXML(alone.urdf)
+    for name in ("knee_1", "knee_2_b", "motor_2"):
+        i, j = plain.joints[plain.getJointId(name)].idx_v, mech.joints[name].idx_v
+        assert abs(plain.damping[i] - mech.model.damping[j]) <= 1e-15, name

@@ -11,7 +11,7 @@ import pytest
 
 import pkm
 from pkm.errors import ImplausibleModelWarning, PkmWarning
-from tests.core.formats.test_urdfplus import ANGLES, CONSTRAINT, TREE, loaded, tip
+from tests.core.formats.test_urdfplus import ANGLES, CONSTRAINT, LOOP, TREE, loaded, tip
 
 
 def test_urdfplus_writer_round_trip(tmp_path):
@@ -62,3 +62,30 @@ def test_gepetto_five_bar_written_as_urdfplus_keeps_its_frame_closure(tmp_path):
     for name in shared:
         X, Y = mech.data.oMf[mech.frame_id(name)], back.data.oMf[back.frame_id(name)]
         assert np.linalg.norm(X.homogeneous - Y.homogeneous) < 1e-12, name
+
+
+def test_the_springs_are_written_with_gazebo_s_urdf_extension_and_read_back(tmp_path):
+    """URDF+ has no spring: the writer uses Gazebo's ``<gazebo reference><springStiffness><springReference>``, the
+    damping URDF's ``<dynamics damping>``; pkm.load gives back the springs (1e-12) and the joints' damping (1e-15);
+    a spring on a continuous joint is refused by name, a ``<gazebo>`` naming a link states none."""
+    from tests.core.formats.test_to_sdf import _sprung_delta
+
+    mech = _sprung_delta()
+    with pytest.warns(PkmWarning):
+        path = pkm.save(mech, tmp_path / "delta.urdf")
+    text = path.read_text()
+    assert text.count("<springStiffness>") == 2
+    back = pkm.load(path)
+    assert back.springs.names == mech.springs.names
+    assert np.abs(back.springs.stiffness - mech.springs.stiffness).max() <= 1e-12
+    assert np.abs(back.springs.rest - mech.springs.rest).max() <= 1e-12
+    for name in ("knee_1", "knee_2_b", "motor_2"):
+        assert abs(back.model.damping[back.joints[name].idx_v] - mech.model.damping[mech.joints[name].idx_v]) <= 1e-15
+    spring = "<gazebo reference='{0}'><springStiffness>2.0</springStiffness></gazebo>"
+    link = tmp_path / "link.urdf"
+    link.write_text(TREE.format(extra=LOOP + spring.format("crank")))
+    assert not pkm.load(link).springs
+    bad = tmp_path / "bad.urdf"
+    bad.write_text(TREE.format(extra=LOOP + spring.format("coupler_joint")))
+    with pytest.raises(pkm.errors.SpecError, match="a spring on a continuous joint"):
+        pkm.load(bad)

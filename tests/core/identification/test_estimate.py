@@ -121,3 +121,31 @@ def test_efforts_near_the_ends_of_the_float_range_scale_exactly_or_are_refused()
     assert np.all(np.isfinite(val.relative)) and np.allclose(val.relative, refs[False].relative, rtol=1e-9, atol=0)
     with pytest.raises(InvalidInputError, match=r"efforts up to 1\.7e\+308 \[N m, N\] overflow the estimate"):
         estimate(mech, Q, QD, QDD, 1.7e308 * np.sign(tau), base=base, weighted=False)
+
+
+def test_a_spring_is_identified_with_the_base_parameters():
+    """A spring on the Delta's passive knee (3.5 N m/rad about -2 rad) in simulated efforts (the forward model's,
+    pkm.actuator_model, springs applied there): estimate(springs=["knee_1"]) gives back its stiffness and rest
+    (1e-6 relative) and the base parameters, whether the model states the spring or not (it is a parameter, not a
+    known effort); a spring on a motor is not excited apart from its drive's offset, and says so."""
+    import pkm
+
+    plain = mechanism("delta")
+    sprung = pkm.from_strings(plain.urdf, dataclasses.replace(
+        plain.spec, springs={"knee_1": {"stiffness": 3.5, "rest": -2.0}}), plain.params, "sprung delta")
+    base = base_parameters(plain, precise=False)
+    states = random_states(sprung, 40, seed=11)
+    Q, QD, QDD = (np.array([s[i] for s in states]) for i in range(3))
+    TAU = np.array([pkm.actuator_model(sprung, q, qd).efforts(qdd) for q, qd, qdd in states])
+    for model in (sprung, plain):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PoorIdentificationWarning)  # (40 samples: fewer than 3 rows a parameter)
+            est = estimate(model, Q, QD, QDD, TAU, base=base, weighted=False, springs=["knee_1"])
+        (s,) = est.springs
+        assert s.joint == "knee_1" and abs(s.stiffness - 3.5) <= 1e-6 * 3.5 and abs(s.rest + 2.0) <= 1e-6 * 2.0
+        assert s.stiffness_std < 1e-6 * 3.5 and s.rest_std < 1e-6 * 2.0
+        assert np.abs(est.values - base.values).max() <= 1e-8 * np.abs(base.values).max()
+    with pytest.raises(SingularityError, match=r"rest of a spring on an actuated joint, \['motor_1'\], is its drive"):
+        estimate(sprung, Q, QD, QDD, TAU, base=base, springs=["motor_1"])
+    with pytest.raises(InvalidInputError, match="expected a list of joint names"):
+        estimate(sprung, Q, QD, QDD, TAU, base=base, springs="knee_1")

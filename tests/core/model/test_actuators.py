@@ -166,3 +166,44 @@ def test_the_reflected_inertia_is_not_counted_twice_without_urdf_text(five):
     geared = pkm.with_actuators(bare, {"motor_1": {"rotor_inertia": 1e-3, "gear_ratio": 10.0}})
     again = pkm.with_actuators(geared, {"motor_1": {"viscous": 0.1}})
     assert again.actuators[0].reflected_inertia == pytest.approx(0.1, rel=1e-15)
+
+
+def test_a_servo_stiffness_reads_with_its_unit_and_the_joints_kind(five, tmp_path):
+    """``stiffness`` in a spec: a number (SI) or a string with its unit, kept as written and converted at build with
+    the joint's kind (2 kN m/rad = 2000 N m/rad; 5 N/mm = 5000 N/m on the Gough-Stewart's prismatic legs); a
+    prismatic's unit on a revolute drive is refused, never converted; pkm.save writes the string back."""
+    assert parse_table({"motor_1": {"stiffness": "2 kN m/rad"}}, "s.toml") == {"motor_1": {"stiffness": "2 kN m/rad"}}
+    assert math.isinf(five.actuators[0].stiffness)  # (none stated: a rigid drive)
+    text = five.spec.to_toml() + '\n[actuators.motor_1]\nstiffness = "2 kN m/rad"\n\n[actuators.motor_2]\nstiffness = 1500\n'
+    spec = ClosureSpec.from_toml(text, "five.closures.toml")
+    sprung = pkm.with_actuators(five, {"motor_1": {"stiffness": "2 kN m/rad"}, "motor_2": {"stiffness": 1500}})
+    assert [a.stiffness for a in sprung.actuators] == [2000.0, 1500.0]
+    assert spec.actuators["motor_1"] == {"stiffness": "2 kN m/rad"}
+    assert ClosureSpec.from_toml(spec.to_toml()) == spec  # (the unit kept as written)
+    from pkm.core.model.builder import from_strings
+
+    built = from_strings(five.urdf, spec, five.params, "five")
+    assert [a.stiffness for a in built.actuators] == [2000.0, 1500.0]
+    again = pkm.load(pkm.save(built, tmp_path / "five.closures.toml"))
+    assert 'stiffness = "2 kN m/rad"' in (tmp_path / "five.closures.toml").read_text()
+    assert again.actuators == built.actuators
+    wrong = ClosureSpec.from_toml(text.replace("2 kN m/rad", "5 N/mm"), "five.closures.toml")
+    with pytest.raises(SpecError, match=r"'N/mm' is a translational stiffness unit but stiffness is in \[N m/rad\]"):
+        from_strings(five.urdf, wrong, five.params, "five")
+    gs = pkm.load("gough_stewart")
+    legs = pkm.with_actuators(gs, {gs.actuated_names[0]: {"stiffness": "5 N/mm"}})
+    assert legs.actuators[0].stiffness == 5000.0
+    with pytest.raises(InvalidInputError, match="'N m/rad' is a rotational stiffness unit"):
+        pkm.with_actuators(gs, {gs.actuated_names[0]: {"stiffness": "5 N m/rad"}})
+
+
+@pytest.mark.parametrize("raw, message", [
+    ({"motor_1": {"stiffness": "2 furlongs"}}, r"actuators.motor_1: .*unknown unit 'furlongs'"),
+    ({"motor_1": {"stiffness": "3 N m"}}, r"'N m' is a torque unit"),
+    ({"motor_1": {"viscous": "0.1 N m s/rad"}}, r"actuators.motor_1.viscous must be a number, got str"),
+    ({"motor_1": {"stiffness": 0.0}}, r"stiffness must be > 0 \(a drive that yields freely"),
+    ({"motor_1": {"stiffness": "1e12 N m/rad"}}, r"a servo stiffness below 1e\+12"),
+])
+def test_a_bad_servo_stiffness_is_a_spec_error(raw, message):
+    with pytest.raises(SpecError, match=message):
+        parse_table(raw, "s.toml")

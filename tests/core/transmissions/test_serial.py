@@ -185,3 +185,9 @@ def test_a_kept_joint_s_spring_is_written_and_a_locked_one_s_said():
     m = mujoco.MjModel.from_xml_string(text)
     j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "ankle_pitch")
     assert (m.jnt_stiffness[j], m.qpos_spring[m.jnt_qposadr[j]], m.dof_damping[m.jnt_dofadr[j]]) == (11.0, -0.05, 0.3)
+    from pkm.core.formats.imported import read_urdf
+
+    urdf = se.urdf()  # (Gazebo's URDF extension: pkm's URDF reader gives it back, Pinocchio the damping)
+    assert read_urdf(urdf, "serial.urdf").springs == {"ankle_pitch": {"stiffness": 11.0, "rest": -0.05}}
+    model = pin.buildModelFromXML(urdf)
+    assert model.damping[model.joints[model.getJointId("ankle_pitch")].idx_v] == 0.3

@@ -1,7 +1,8 @@
 """``pkm stiffness MECH [--pose K=V ... | --joints NAME=V ...] [--spring NAME=K ...] [--drives K] [--wrench K=V ...]
 [--frequencies] [--json]``: the end effector's stiffness at a configuration (:func:`pkm.stiffness`): the springs
 counted (``--spring``: a joint's stiffness, SI: N m/rad for a revolute, N/m for a prismatic joint; ``--drives``: every
-actuated joint's not named; the spec's ``[springs]`` too), the actuated joints held rigid, the compliance's rank,
+actuated joint's not named; the drives' own servo stiffness, the spec's ``[actuators.<joint>] stiffness``, and the
+spec's ``[springs]`` too) with where each came from, the actuated joints held rigid, the compliance's rank,
 the 6 x 6 stiffness where it has rank 6 and the principal stiffnesses; with ``--wrench`` (``fx fy fz`` [N, or kN,
 mN], ``mx my mz`` [N m]) the exact deflection and the first-order one with their gap; with ``--frequencies`` the
 natural frequencies (:func:`pkm.vibration_modes`)."""
@@ -37,7 +38,8 @@ def add_spring_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--spring", metavar="NAME=K", action="extend", nargs="+", default=[],
                    help="a joint's stiffness, SI (N m/rad, N/m); 0 frees it")
     p.add_argument("--drives", metavar="K", type=float,
-                   help="every actuated joint's stiffness not given by --spring (SI); default: drives rigid")
+                   help="every actuated joint's stiffness not given by --spring (SI); default: each drive's own "
+                        "servo stiffness (the spec's [actuators.<joint>] stiffness), else rigid")
 
 
 def springs(mech, args: argparse.Namespace) -> dict[str, float]:
@@ -77,6 +79,7 @@ def run(args: argparse.Namespace) -> int:
     K = pkm.stiffness(mech, q, joints=joints)
     out: dict[str, Any] = {"mechanism": mech.name, "task": pkm.TaskMap.of(mech).named(q),
                            "outside_limits": outside_limits(mech, q), "sprung": dict(K.sprung),
+                           "sources": dict(K.sources),
                            "locked": list(K.locked), "rank": K.rank, "compliance": K.compliance}
     try:
         out["matrix"] = K.matrix
@@ -111,7 +114,8 @@ def _text(out: dict[str, Any]) -> str:
     lines = [f"{out['mechanism']} at {pose}"]
     if out["outside_limits"]:
         lines.append(outside_line(out["outside_limits"]))
-    lines.append("springs: " + (", ".join(f"{j} {k:.6g}" for j, k in out["sprung"].items()) or "none")
+    lines.append("springs: " + (", ".join(f"{j} {k:.6g} ({out['sources'][j]})" for j, k in out["sprung"].items())
+                                or "none")
                  + "; held rigid: " + (", ".join(out["locked"]) or "none"))
     if out["matrix"] is None:
         lines.append(f"compliance of rank {out['rank']} of 6: {out['rigid']}")

@@ -4,9 +4,12 @@ the end effector, the deflection under a constant wrench, the natural frequencie
 **The model.** Each one-coordinate joint is
 
 * *sprung*: a spring of stiffness :math:`k_j` [N m/rad, N/m] about its value in ``q``: the stiffness given in
-  ``joints=`` (a drive's servo stiffness, an axial leg spring), else its ``[springs.<joint>]`` stiffness in the spec
-  (:mod:`pkm.core.model.springs`);
-* *locked*: an actuated joint given no stiffness (a position-controlled drive taken as rigid);
+  ``joints=`` (a drive's servo stiffness, an axial leg spring), else, on an actuated joint, its drive's servo
+  stiffness (:attr:`Actuator.stiffness <pkm.core.model.actuators.Actuator.stiffness>`, the spec's
+  ``[actuators.<joint>] stiffness``; in parallel with a ``[springs]`` spring on the same joint: their sum), else its
+  ``[springs.<joint>]`` stiffness in the spec (:mod:`pkm.core.model.springs`); :attr:`Stiffness.sources` says which;
+* *locked*: an actuated joint given no stiffness (a position-controlled drive taken as rigid: its
+  ``Actuator.stiffness`` left ``inf``);
 * *free*: any other joint (a passive joint with no spring); joints of several coordinates (spherical, universal
   written as one joint, a floating base) are free.
 
@@ -92,6 +95,7 @@ class _Springs:
     q: np.ndarray
     k: np.ndarray  # (nv,) the joint stiffness on its velocity coordinate, 0 where none
     sprung: dict[str, float]
+    sources: dict[str, str]  # {sprung joint: where its stiffness came from (SOURCES)}
     locked: tuple[str, ...]
     E: np.ndarray  # (n_locked, nv) rows selecting the locked joints
     N: np.ndarray  # (nv + 6 a, d) the motions the closures and the locked joints leave: joint rates, then the links'
@@ -103,9 +107,21 @@ class _Springs:
     links: tuple[Attachment, ...] = ()
 
 
-def _joint_stiffness(mech: Mechanism, joints: Mapping[str, object] | None) -> dict[str, float]:
-    """``{joint: k}``: the spec's springs, then ``joints`` over them; each a one-coordinate joint, ``k >= 0`` finite."""
+#: Where a joint's stiffness comes from (:attr:`Stiffness.sources`): the ``joints=`` argument, the drive's servo
+#: stiffness (:attr:`Actuator.stiffness <pkm.core.model.actuators.Actuator.stiffness>`), the spec's ``[springs]``, or
+#: the drive's and a spring's in parallel.
+SOURCES = ("joints", "actuator", "spring", "actuator+spring")
+
+
+def _joint_stiffness(mech: Mechanism, joints: Mapping[str, object] | None) -> tuple[dict[str, float], dict[str, str]]:
+    """``({joint: k}, {joint: source})``: the spec's springs, the drives' servo stiffnesses (in parallel with a spring
+    on the same joint), then ``joints`` over them; each a one-coordinate joint, ``k >= 0`` finite."""
     given: dict[str, float] = {n: float(t.get("stiffness", 0.0)) for n, t in mech.spec.springs.items()}
+    sources = dict.fromkeys(given, "spring")
+    for a in mech.actuators:
+        if math.isfinite(a.stiffness):  # (inf: a rigid drive, locked unless a spring or joints= says otherwise)
+            sources[a.joint] = "actuator+spring" if given.get(a.joint, 0.0) > 0.0 else "actuator"
+            given[a.joint] = a.stiffness + given.get(a.joint, 0.0)
     if joints is not None:
         if not isinstance(joints, Mapping):
             raise InvalidInputError("joints", "expected a mapping {joint: stiffness} [N m/rad or N/m]", joints)
@@ -119,8 +135,8 @@ def _joint_stiffness(mech: Mechanism, joints: Mapping[str, object] | None) -> di
             if k >= MAGNITUDE:  # (as the spec's springs: a unit mistake; a rigid joint is one left out, or locked)
                 raise InvalidInputError(f"joints[{name!r}]", f"a stiffness below {MAGNITUDE:g} (N m/rad, N/m); to "
                                                              "hold an actuated joint rigid, leave it out", value)
-            given[name] = k
-    return given
+            given[name], sources[name] = k, "joints"
+    return given, sources
 
 
 def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None, links: object, rtol: float) \
@@ -134,7 +150,7 @@ def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None,
     mech = check_mechanism(mech)
     q = mech.check_q(q)
     check_closed(mech, q)
-    given = _joint_stiffness(mech, joints)
+    given, sources = _joint_stiffness(mech, joints)
     sprung = {n: k for n, k in given.items() if k > 0.0}
     locked = tuple(j.name for j in mech.actuated if j.name not in given)
     k = np.zeros(mech.nv)
@@ -161,7 +177,7 @@ def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None,
     for i, a in enumerate(att):
         K[mech.nv + 6 * i:mech.nv + 6 * i + 6, mech.nv + 6 * i:mech.nv + 6 * i + 6] = a.stiffness
     H = N.T @ K @ N
-    return _Springs(mech, q, k, sprung, locked, E, N, 0.5 * (H + H.T), np.hstack([c.ee_jacobian, Vee]) @ N, L,
+    return _Springs(mech, q, k, sprung, {n: sources[n] for n in sprung}, locked, E, N, 0.5 * (H + H.T), np.hstack([c.ee_jacobian, Vee]) @ N, L,
                     scales.columns, tuple(att))
 
 
@@ -261,6 +277,9 @@ class Stiffness:
             effector's origin, world axes [m/N, m/(N m); rad/N, rad/(N m)].
         rank: The rank of ``C`` (6: every direction resisted by springs; fewer: rigid along the others).
         sprung: ``{joint: stiffness}`` of the springs counted [N m/rad or N/m].
+        sources: ``{joint: source}`` for each of ``sprung``: where its stiffness came from (:data:`SOURCES`:
+            ``"joints"`` the argument, ``"actuator"`` the drive's servo stiffness, ``"spring"`` the spec's
+            ``[springs]``, ``"actuator+spring"`` both in parallel).
         locked: The actuated joints held rigid (given no stiffness).
         q: The configuration (nq,).
     """
@@ -268,6 +287,7 @@ class Stiffness:
     compliance: np.ndarray
     rank: int
     sprung: Mapping[str, float]
+    sources: Mapping[str, str]
     locked: tuple[str, ...]
     q: np.ndarray
     _springs: _Springs = field(repr=False, compare=False)
@@ -358,9 +378,11 @@ def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | N
     Args:
         mech: The mechanism.
         q: A closed configuration (nq,): the unloaded equilibrium.
-        joints: ``{joint: stiffness}`` [N m/rad for a revolute, N/m for a prismatic joint], over the spec's
-            ``[springs.<joint>]``: a drive's servo stiffness, a leg's axial stiffness; ``0`` frees a joint. An
-            actuated joint left out is locked (rigid).
+        joints: ``{joint: stiffness}`` [N m/rad for a revolute, N/m for a prismatic joint], over the drives'
+            servo stiffnesses (:attr:`Actuator.stiffness <pkm.core.model.actuators.Actuator.stiffness>`) and the
+            spec's ``[springs.<joint>]``: a drive's servo stiffness, a leg's axial stiffness; ``0`` frees a joint. An
+            actuated joint left out whose drive states no stiffness is locked (rigid). :attr:`Stiffness.sources`
+            says where each came from.
         links: ``"rigid"`` (default), or ``{link: Beam(...) or a 6 x 6 compliance}``: those links compliant
             (:mod:`pkm.core.compliance.links`; the exact :meth:`Stiffness.deflection` takes rigid links).
         rtol: Rank decisions, relative, on homogenised matrices.
@@ -387,7 +409,8 @@ def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | N
     TV = sp.T @ V
     C = finite_result((TV / w) @ TV.T if len(w) else np.zeros((6, 6)), "compliance")
     C = 0.5 * (C + C.T)
-    return Stiffness(C, _rank(C, sp.length, rtol), dict(sp.sprung), sp.locked, sp.q.copy(), sp, rtol)
+    return Stiffness(C, _rank(C, sp.length, rtol), dict(sp.sprung), dict(sp.sources), sp.locked, sp.q.copy(), sp,
+                     rtol)
 
 
 def _pose(sp: _Springs, q: np.ndarray) -> pin.SE3:
@@ -528,5 +551,5 @@ def _modes(sp: _Springs, rtol: float) -> VibrationModes:
     return VibrationModes(np.sqrt(w2[resisted]) / (2.0 * math.pi), Nj @ s, sp.T @ s, free)
 
 
-__all__ = ["DEFLECTION_TOL", "MAX_FIRST_ORDER", "MAX_ITER", "MAX_LOAD_STEPS", "RTOL", "Deflection", "Stiffness", "VibrationModes", "stiffness",
-           "vibration_modes"]
+__all__ = ["DEFLECTION_TOL", "MAX_FIRST_ORDER", "MAX_ITER", "MAX_LOAD_STEPS", "RTOL", "SOURCES", "Deflection", "Stiffness",
+           "VibrationModes", "stiffness", "vibration_modes"]

@@ -12,7 +12,8 @@ from pathlib import Path
 
 from pkm.core.formats.base import FORMATS, Format, Imported, by_root, suffixes
 from pkm.core.model.spec import ClosureSpec, read_text_file
-from pkm.core.model.urdf import check_urdf, limit_notes
+from pkm.core.model.springs import spring_notes
+from pkm.core.model.urdf import check_urdf, gazebo_springs, limit_notes
 from pkm.errors import PkmWarning, SpecError
 
 
@@ -60,9 +61,12 @@ def _root_line(text: str) -> int | None:
 
 
 def read_urdf(text: str, source: str = "<urdf>") -> Imported:
-    """A URDF file (its loops come from a closure spec); exporters' "unlimited" limits noted."""
+    """A URDF file (its loops come from a closure spec); exporters' "unlimited" limits noted; the joint springs of
+    Gazebo's URDF extension read (:func:`~pkm.core.model.urdf.gazebo_springs`) and noted."""
     root = check_urdf(text, source)
-    return Imported(text, (), {}, (), str(root.get("name") or Path(source).stem), "urdf", notes=limit_notes(root))
+    springs = gazebo_springs(root, source)
+    return Imported(text, (), {}, (), str(root.get("name") or Path(source).stem), "urdf",
+                    notes=limit_notes(root) + spring_notes(springs), springs=springs)
 
 
 def with_file(spec: ClosureSpec, imp: Imported, source: str) -> ClosureSpec:

@@ -59,7 +59,8 @@ massless link ``<gearbox>__rotor_mount``, fixed to the reference body by a joint
 which sorts after the output's (a workaround of that Pinocchio 4.1 restriction, pinned by a test). The rotor's
 SDF position limits, if any, are dropped: its coordinate is the output's. A revolute's or prismatic's
 ``<spring_stiffness>`` and ``<spring_reference>`` are its ``[springs]`` entry (:mod:`pkm.core.model.springs`: read
-and applied by pkm's dynamics; its ``<damping>`` is the joint's friction, as above). Each gearbox so read, and the
+and applied by pkm's dynamics; the reference counts from the model's pose, as the limits do, its ``<pkm:position>``
+added; its ``<damping>`` is the joint's friction, as above). Each gearbox so read, and the
 springs, are listed in :attr:`Imported.notes <pkm.core.formats.base.Imported.notes>`. SDFormat booleans (``use_parent_model_frame``) are ``true`` or ``1``.
 
 Refused with a :class:`~pkm.errors.SpecError`: nested models, ``<include>``, universal and screw joints, a mimic
@@ -79,7 +80,7 @@ from lxml import etree
 
 from pkm.core.formats.base import Imported
 from pkm.core.model.spec import Closure
-from pkm.core.model.springs import describe, parse_springs
+from pkm.core.model.springs import parse_springs, spring_notes
 from pkm.core.model.urdf import check_urdf, floats, num, origin, parse_xml
 from pkm.errors import SpecError
 
@@ -515,11 +516,10 @@ def _read_sdf(text: str, source: str) -> Imported:
             raise SpecError(source, f"joint {name!r}: a spring on a {j.get('type')} joint"
                                     + (" that a gearbox drives" if name in mimic else "") + " (pkm reads the springs "
                                     "of revolute and prismatic joints)")
-        if stiffness != 0.0:
-            springs[name] = {"stiffness": stiffness, "rest": rest}
-    if springs:
-        notes.append(f"joint springs read into [springs] (applied by pkm's dynamics): "
-                     f"{describe(parse_springs(springs, source))}")
+        if stiffness != 0.0:  # (the reference counts from the model's pose, as the limits: pkm's zero put back)
+            springs[name] = {"stiffness": stiffness, "rest": rest + (float(position(j)[0]) if tree.get(name) is j
+                                                                     else 0.0)}
+    notes += spring_notes(parse_springs(springs, source))
     return Imported(urdf, tuple(closures), types, (), robot.get("name"), "sdf", notes=tuple(notes), springs=springs)
 
 

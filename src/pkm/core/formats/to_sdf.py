@@ -29,7 +29,12 @@ zero back where it was and adds it to the limits, so the mechanism reads back wi
   or as the frames the reader makes for the cut joints;
 * inertias as ``<inertial>`` (a massless body with ``<mass>0</mass>``: SDFormat's default inertial is 1 kg);
   actuated joints' effort and speed limits and friction as ``<limit><effort><velocity>`` and ``<dynamics>`` (their
-  whole drives are in the spec beside).
+  whole drives are in the spec beside);
+* the joint springs (:attr:`Mechanism.springs <pkm.core.model.mechanism.Mechanism.springs>`, ``[springs]``) as
+  ``<axis><dynamics>``: ``<spring_stiffness>``, ``<spring_reference>`` (counted from the written pose, as the limits
+  are: ``rest - q_ref``; pkm's reader adds its ``<pkm:position>`` back), and the joint's whole viscous damping (a
+  drive's and a spring's) as ``<damping>``; a continuous joint's spring is left out (said: SDFormat's would act on
+  the unwrapped angle) and kept in the spec beside, which states every spring too.
 
 Refused by name (:class:`~pkm.errors.SpecError`): planar and other composite joints, a floating base (the spec's
 ``floating_base``: pkm's SDF reader fixes the base), an actuated or task universal joint, a closure whose two
@@ -118,6 +123,7 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
     primary: set[str] = set()
     universals: list[str] = []
     joints: list[etree._Element] = []
+    at: dict[str, float] = {}  # a one-coordinate joint's coordinate at the written pose (SDFormat's zero)
     for j in range(1, model.njoints):
         jm, jname = model.joints[j], model.names[j]
         kind = jm.shortname().removeprefix("JointModel")
@@ -179,6 +185,7 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
             value = float(seg[0])
         sdf_kind = "continuous" if "Unbounded" in kind or kind.startswith("RUB") else \
             "revolute" if revolute else "prismatic"
+        at[jname] = value
         jel = _joint(jname, sdf_kind, parent, lname, repr(value), axis,
                      mech.limits.get(jname) if sdf_kind != "continuous" else None, value)
         if kind == "Mimic":
@@ -197,10 +204,7 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
         for key, value in (("effort", a.effort_limit), ("velocity", a.velocity_limit)):
             if np.isfinite(value):
                 _text(limit, key, repr(value))
-        if a.viscous or a.coulomb:
-            dyn = etree.SubElement(jel.find("axis"), "dynamics")
-            _text(dyn, "damping", repr(a.viscous))
-            _text(dyn, "friction", repr(a.coulomb))
+    unsprung = _dynamics(mech, joints, at)
     sdf_model.extend(joints)
     for c, (fa, fb) in zip(spec.closures, mech.closure_frames, strict=True):
         ja, jb = model.frames[fa].parentJoint, model.frames[fb].parentJoint
@@ -240,7 +244,40 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
     if unbounded:
         dropped.append(f"unbounded revolute joints {unbounded}: written as continuous joints, read back as revolute "
                        "joints without limits (one coordinate, not cos/sin)")
+    if unsprung:
+        dropped.append(f"the springs of the continuous joints {unsprung}: SDFormat's <spring_stiffness> of a continuous "
+                       "joint is not pkm's (kept in the spec beside)")
     return etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True).decode(), tuple(dropped)
+
+
+def _dynamics(mech: Mechanism, joints: list[etree._Element], at: dict[str, float]) -> list[str]:
+    """SDFormat's ``<axis><dynamics>`` of each actuated or sprung joint (``[springs]``): its whole viscous damping
+    (the drive's and the spring's, Pinocchio's ``damping``), its friction and its spring, the ``<spring_reference>``
+    counted from the written pose (``at``: the joint's coordinate there) as the limits are; the continuous joints
+    whose spring it leaves out (returned)."""
+    model = mech.model
+    damping, friction = np.asarray(model.damping, dtype=float), np.asarray(model.friction, dtype=float)
+    sprung = dict(zip(mech.springs.names, zip(mech.springs.stiffness.tolist(), mech.springs.rest.tolist())))
+    by_name = {str(el.get("name")): el for el in joints}
+    left: list[str] = []
+    for name in dict.fromkeys([*mech.actuated_names, *mech.spec.springs]):
+        jel = by_name.get(name)
+        if jel is None or jel.find("axis") is None or name not in at:
+            continue
+        iv = mech.joints[name].idx_v
+        k, rest = sprung.get(name, (0.0, 0.0))
+        if k and jel.get("type") == "continuous":
+            left.append(name)
+            k = 0.0
+        if not (damping[iv] or friction[iv] or k):
+            continue
+        dyn = etree.SubElement(jel.find("axis"), "dynamics")
+        _text(dyn, "damping", repr(float(damping[iv])))
+        _text(dyn, "friction", repr(float(friction[iv])))
+        if k:
+            _text(dyn, "spring_reference", repr(rest - at[name]))
+            _text(dyn, "spring_stiffness", repr(k))
+    return left
 
 
 def _joint(name: str, kind: str, parent: str, child: str, position: str | None = None,

@@ -10,6 +10,10 @@
   extension, which pkm's reader reads and other URDF+ readers refuse; the writer says so (:class:`~pkm.core.formats.writers.Written`'s
   ``dropped``, a :class:`~pkm.errors.PkmWarning` from :func:`pkm.save`);
 * the actuated joints: a ``<transmission>`` each (ROS's ``SimpleTransmission``);
+* the joint springs (``[springs]``): URDF+ (and URDF) has no spring, so they are written with Gazebo's URDF extension,
+  ``<gazebo reference="JOINT"><springStiffness><springReference>`` (:func:`~pkm.core.model.urdf.gazebo_springs`,
+  which pkm's URDF readers read: Gazebo's converter makes SDFormat's springs of them), a spring's damping as the
+  joint's ``<dynamics damping>`` (its whole viscous damping, a drive's with it);
 * the closures' frames that are massless leaf links fixed to their parent (and not the end effector or a task
   frame) are left out of the tree: the loop's origins place them, and the reader adds them back.
 
@@ -26,10 +30,16 @@ import pinocchio as pin
 from lxml import etree
 
 from pkm.core.model.mechanism import Mechanism
-from pkm.core.model.urdf import origin
+from pkm.core.model.urdf import origin, write_gazebo_springs
 from pkm.errors import SpecError
 
 _TOL = 1e-9  # relative tolerance on the two sides' axis lengths (they are written by a reader to 1e-16)
+
+
+def damping_of(mech: Mechanism) -> dict[str, float]:
+    """``{joint: its whole viscous damping}`` (Pinocchio's ``damping``: a drive's and a spring's) of each joint of
+    ``mech``'s ``[springs]`` that the model has."""
+    return {n: float(mech.model.damping[mech.joints[n].idx_v]) for n in mech.spec.springs if n in mech.joints}
 
 
 def _link_of(mech: Mechanism, frame_id: int, cut: set[str]) -> tuple[str, pin.SE3]:
@@ -105,6 +115,7 @@ def urdfplus_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
     for el in root.findall("transmission"):
         root.remove(el)
     root.extend(loops)
+    write_gazebo_springs(root, spec.springs, damping_of(mech))
     for j in spec.actuated:
         tr = etree.SubElement(root, "transmission", name=f"{j}_transmission")
         etree.SubElement(tr, "type").text = "transmission_interface/SimpleTransmission"

@@ -62,7 +62,8 @@ from lxml import etree
 from pkm.core.formats.base import Imported
 from pkm.core.formats.sdf import _AXIS_POINT
 from pkm.core.model.spec import Closure
-from pkm.core.model.urdf import check_urdf, limit_notes, origin, parse_xml
+from pkm.core.model.springs import spring_notes
+from pkm.core.model.urdf import check_urdf, gazebo_springs, limit_notes, origin, parse_xml
 from pkm.errors import SpecError, SpecNameError
 
 #: The elements under ``<robot>`` that make a URDF closed, and the format each marks.
@@ -217,8 +218,10 @@ def read_urdf(text: str, source: str = "<urdf>") -> Imported:
             a, b = (frame(f"{cut.name}_axis_{role}", link, X * pin.SE3(np.eye(3), _AXIS_POINT * axis), where)
                     for role, link, X, axis in zip(cut.roles, cut.links, cut.frames, cut.axes, strict=True))
             closures.append(Closure(f"{cut.name}_axis", "point", a, b))
+    springs = gazebo_springs(tree, source)
     return Imported(etree.tostring(tree, encoding="unicode"), tuple(closures), {}, _actuated(tree, joints, source),
-                    str(root.get("name") or "robot"), kind, notes=limit_notes(tree))
+                    str(root.get("name") or "robot"), kind, notes=limit_notes(tree) + spring_notes(springs),
+                    springs=springs)
 
 
 __all__ = ["ELEMENTS", "read_urdf"]

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pkm.core.identification.base import BaseParameters, base_parameters
-from pkm.core.identification.regressor import known_efforts, regressor
+from pkm.core.identification.regressor import known_efforts, regressor, spring_joints, spring_regressor
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PoorIdentificationWarning, SingularityError
 from pkm.validation import as_array
@@ -64,6 +64,7 @@ class Estimate:
         method: ``"ols"`` or ``"wls"``.
         rows: The number of equations.
         warnings: What the data cannot carry (module doc), one sentence each; empty when nothing.
+        springs: The springs identified with them (``estimate(..., springs=[joint, ...])``), one each.
     """
 
     base: BaseParameters
@@ -76,6 +77,7 @@ class Estimate:
     method: str
     rows: int
     warnings: tuple[str, ...] = ()
+    springs: tuple[SpringEstimate, ...] = ()
 
     @property
     def poor(self) -> np.ndarray:
@@ -87,7 +89,29 @@ class Estimate:
         return self.base.regressor(Y) @ self.values
 
 
-def _solve(W: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+@dataclass(frozen=True)
+class SpringEstimate:
+    """A joint spring identified with the base parameters (:func:`estimate`'s ``springs``): the actuators' efforts are
+    linear in ``k`` and ``k rest`` (:func:`~pkm.core.identification.regressor.spring_regressor`).
+
+    Attributes:
+        joint: The sprung joint.
+        stiffness: ``k`` [N m/rad, N/m].
+        rest: Its rest position ``(k rest) / k`` [rad, m].
+        stiffness_std: The standard deviation of ``k``.
+        rest_std: That of ``rest`` (first order in the two estimates' covariance).
+    """
+
+    joint: str
+    stiffness: float
+    rest: float
+    stiffness_std: float
+    rest_std: float
+
+
+def _solve(W: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(x, diag, Rinv)``: the least-squares solution, the diagonal of ``(WᵀW)⁻¹`` and ``R⁻¹`` (``(WᵀW)⁻¹ = R⁻¹
+    R⁻ᵀ``: the covariances)."""
     Q, R = np.linalg.qr(W)
     d = np.abs(np.diag(R))
     if d.min() <= 1e-12 * d.max():
@@ -95,17 +119,25 @@ def _solve(W: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
                                                                       "give more, or more varied, motion")
     beta = np.linalg.solve(R, Q.T @ y)
     Rinv = np.linalg.inv(R)
-    return beta, np.einsum("ij,ij->i", Rinv, Rinv)  # (diag of (W^T W)^-1)
+    return beta, np.einsum("ij,ij->i", Rinv, Rinv), Rinv  # (diag of (W^T W)^-1)
 
 
 def estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, TAU: ArrayLike, *,
-             base: BaseParameters | None = None, weighted: bool = True) -> Estimate:
+             base: BaseParameters | None = None, weighted: bool = True, springs: tuple[str, ...] | list[str] = ()) \
+        -> Estimate:
     """Estimate the base parameters from N samples: closed configurations ``Q`` (N, nq), actuated rates and
     accelerations ``QD``, ``QDD`` (N, na) and the measured efforts ``TAU`` (N, na) [N m, N] (module doc).
 
+    ``springs``: joints whose spring's stiffness and rest position are estimated too (:attr:`Estimate.springs`), as
+    two more columns each, ``k`` and ``k rest`` (:func:`~pkm.core.identification.regressor.spring_regressor`): a
+    spring the model lacks, or one whose ``[springs]`` values are to be checked (their share is then not subtracted
+    as known). They must be excited apart from the base parameters: the rest of a spring on an actuated joint is
+    its drive's offset (a :class:`~pkm.errors.SingularityError`).
+
     Raises:
-        InvalidInputError: arrays of the wrong shape, non-finite values (the row named), fewer rows than parameters.
-        SingularityError: the motion does not excite every base parameter.
+        InvalidInputError: arrays of the wrong shape, non-finite values (the row named), fewer rows than parameters;
+            a spring's joint of more than one coordinate.
+        SingularityError: the motion does not excite every base parameter (and spring).
 
     Examples:
         >>> import numpy as np
@@ -124,7 +156,9 @@ def estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, TAU: 
         True
     """
     mech = check_mechanism(mech)
+    sprung = spring_joints(mech, list(springs) if isinstance(springs, tuple) else springs)
     base = base if base is not None else base_parameters(mech)
+    nb, ns = len(base), 2 * len(sprung)
     arrays = []
     for name, x, cols in (("Q", Q, mech.nq), ("QD", QD, mech.na), ("QDD", QDD, mech.na), ("TAU", TAU, mech.na)):
         arr = as_array(x, name, f"N x {cols}")
@@ -138,42 +172,73 @@ def estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike, TAU: 
     n = len(Q_)
     if not all(len(a) == n for a in arrays):
         raise InvalidInputError("TAU", f"expected as many samples of each: {[len(a) for a in arrays]}", n)
-    if n * mech.na < len(base):
-        raise InvalidInputError("Q", f"{n * mech.na} equations for {len(base)} base parameters: give more samples", n)
+    if n * mech.na < nb + ns:
+        raise InvalidInputError("Q", f"{n * mech.na} equations for {nb + ns} parameters: give more samples", n)
     W = base.regressor(np.vstack([regressor(mech, q, qd, qdd) for q, qd, qdd in zip(Q_, QD_, QDD_)]))
-    TAU_ = TAU_ - known_efforts(mech, Q_, QD_)  # (the springs' and the passive joints' friction: no parameter's)
+    if sprung:
+        W = np.hstack([W, spring_regressor(mech, Q_, QD_, sprung)])
+    TAU_ = TAU_ - known_efforts(mech, Q_, QD_, sprung)  # (the known springs' and the passive joints' friction)
     peak = float(np.abs(TAU_).max())
     s = _scale(peak)  # (the efforts' sums of squares overflow beyond 1e154: the fit runs on TAU / s, exactly)
     y = TAU_.reshape(-1) / s
-    beta, diag = _solve(W, y)  # (a regressor that the samples do not excite: SingularityError)
+    try:
+        beta, diag, Rinv = _solve(W, y)  # (a regressor that the samples do not excite: SingularityError)
+    except SingularityError as exc:
+        if sprung:  # (the base alone excited: the springs are not told apart from it)
+            try:
+                _solve(W[:, :nb], y)
+            except SingularityError:
+                raise exc from None
+            driven = [j for j in sprung if j in mech.actuated_names]
+            raise SingularityError("regressor", exc.sigma_min, f"the samples do not excite the springs of {list(sprung)} "
+                                                           "apart from the base parameters"
+                                   + (f" (the rest of a spring on an actuated joint, {driven}, is its drive's "
+                                      "offset: the two cannot be told apart)" if driven else "")) from None
+        raise
     if peak == 0.0:
         raise InvalidInputError("TAU", "every effort is zero: the data carry no parameter (each relative deviation "
                                        "would be 0/0)", peak)
     weights = np.ones(mech.na)
     if weighted:
         r = (y - W @ beta).reshape(n, mech.na)
-        sd = np.sqrt(np.sum(r * r, axis=0) / max(n - len(base) / mech.na, 1.0))
+        sd = np.sqrt(np.sum(r * r, axis=0) / max(n - (nb + ns) / mech.na, 1.0))
         weights = 1.0 / np.maximum(sd, 1e-300)
         w = np.tile(weights, n)
-        beta, diag = _solve(W * w[:, None], y * w)
+        beta, diag, Rinv = _solve(W * w[:, None], y * w)
     w = np.tile(weights, n)
     r = (y - W @ beta) * w
-    sigma2 = float(r @ r) / max(len(y) - len(base), 1)
+    sigma2 = float(r @ r) / max(len(y) - (nb + ns), 1)
     std = np.sqrt(sigma2 * diag)
+    cov = sigma2 * Rinv[nb:] @ Rinv[nb:].T  # (the springs' columns' covariances)
     with np.errstate(divide="ignore"):
         rel = np.where(beta != 0.0, 100.0 * std / np.abs(beta), np.inf)
     share = std * np.linalg.norm(W * w[:, None], axis=0) / np.linalg.norm(y * w)
     rms = np.sqrt(np.mean(((y - W @ beta).reshape(n, mech.na)) ** 2, axis=0))
     with np.errstate(over="ignore"):
         beta, std, rms, weights = beta * s, std * s, rms * s, weights / s if weighted else weights
+        cov = cov * s * s
     if not all(np.all(np.isfinite(a)) for a in (beta, std, rms, weights)):
         raise InvalidInputError("TAU", f"efforts up to {peak:.3g} [N m, N] overflow the estimate (its values, "
                                        "standard deviations or residuals beyond 1.8e308)", peak)
-    found = _warnings(base, n, len(y), rel, share)
+    found = _warnings(base, n, len(y), rel[:nb], share[:nb])
     for warning in found:
         warnings.warn(warning, stacklevel=2)
-    return Estimate(base, beta, std, rel, share, rms, weights, "wls" if weighted else "ols", len(y),
-                    tuple(str(w) for w in found))
+    return Estimate(base, beta[:nb], std[:nb], rel[:nb], share[:nb], rms, weights, "wls" if weighted else "ols",
+                    len(y), tuple(str(w) for w in found), _springs(sprung, beta[nb:], cov))
+
+
+def _springs(joints: tuple[str, ...], x: np.ndarray, cov: np.ndarray) -> tuple[SpringEstimate, ...]:
+    """The springs' estimates from ``x = (k_1, (k rest)_1, ...)`` and its covariance: ``rest = (k rest) / k``, its
+    deviation to first order (``d rest = (d(k rest) - rest dk) / k``)."""
+    out = []
+    for i, joint in enumerate(joints):
+        k, kr = float(x[2 * i]), float(x[2 * i + 1])
+        rest = kr / k if k != 0.0 else math.nan
+        g = np.array([-rest, 1.0]) / k if k != 0.0 else np.full(2, math.nan)
+        C = cov[2 * i:2 * i + 2, 2 * i:2 * i + 2]
+        out.append(SpringEstimate(joint, k, rest, math.sqrt(max(float(C[0, 0]), 0.0)),
+                                  math.sqrt(max(float(g @ C @ g), 0.0)) if k != 0.0 else math.nan))
+    return tuple(out)
 
 
 def _scale(peak: float) -> float:
@@ -212,4 +277,4 @@ def _warnings(base: BaseParameters, samples: int, equations: int, relative_std: 
     return out
 
 
-__all__ = ["EQUATIONS_PER_PARAMETER", "POOR_EFFORT_SHARE", "POOR_RELATIVE_STD", "Estimate", "estimate"]
+__all__ = ["EQUATIONS_PER_PARAMETER", "POOR_EFFORT_SHARE", "POOR_RELATIVE_STD", "Estimate", "SpringEstimate", "estimate"]

@@ -20,7 +20,8 @@ the model's own parameters where a rod's inertia is not symmetric about its axis
 ``Y_a`` is then the regressor at those parameters. Passive joints' armature and friction are not parameters (none
 of pkm's mechanisms has any armature); the joint springs (``[springs]``) and the passive joints' friction (a spring's
 damping) are known efforts, not parameters: :func:`known_efforts`, which the estimates subtract from the measured
-efforts. With that, ``Y_a θ_true`` equals :func:`pkm.inverse_dynamics` plus the drives' friction, less the springs'
+efforts, but for the springs :func:`pkm.estimate` is asked to identify (``springs=``: two columns each,
+:func:`spring_regressor`, ``k`` and ``k rest``). With that, ``Y_a θ_true`` equals :func:`pkm.inverse_dynamics` plus the drives' friction, less the springs'
 share (tests: 1e-10 relative, every shipped mechanism and the acceptance set).
 """
 
@@ -159,13 +160,14 @@ def regressor(mech: Mechanism, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> n
     return finite_result(np.hstack([Yb, drives]), "regressor")
 
 
-def known_efforts(mech: Mechanism, Q: ArrayLike, QD: ArrayLike) -> np.ndarray:
+def known_efforts(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, without: tuple[str, ...] = ()) -> np.ndarray:
     """The actuator efforts (N, na) [N m, N] at closed configurations ``Q`` (N, nq) and actuated rates ``QD`` (N, na)
     that no parameter carries: the joint springs' share of the static efforts (``[springs]`` stiffness,
     :func:`pkm.spring_efforts`) and the passive joints' friction (a spring's damping, Pinocchio's ``damping`` and
     ``friction`` off the actuated joints) that the actuators overcome. Measured efforts are ``Y_a θ`` plus these: the
     estimates subtract them (:func:`pkm.estimate`, :func:`pkm.consistent_estimate`) and the predictions add them
-    (:func:`pkm.validate`). Zero (and not evaluated) without springs or passive friction."""
+    (:func:`pkm.validate`). Zero (and not evaluated) without springs or passive friction. ``without``: joints whose
+    springs are parameters (:func:`spring_regressor`), their share left out."""
     mech = check_mechanism(mech)
     Q, QD = np.atleast_2d(np.asarray(Q, dtype=float)), np.atleast_2d(np.asarray(QD, dtype=float))
     out = np.zeros((len(Q), mech.na))
@@ -176,11 +178,62 @@ def known_efforts(mech: Mechanism, Q: ArrayLike, QD: ArrayLike) -> np.ndarray:
                    or np.any(np.asarray(mech.model.friction)[passive] != 0.0))
     if not mech.springs and not rubbing:
         return out
+    s = mech.springs
+    own = np.zeros(mech.nv)  # (the stiffness of the springs that stay known)
+    own[s.idx_v] = [0.0 if n in without else k for n, k in zip(s.names, s.stiffness)]
     for i, (q, qd) in enumerate(zip(Q, QD)):
         model = _evaluate(mech, mech.check_q(q), mech.check_actuated(qd, "qd"), RTOL, COULOMB_VELOCITY)
         f = np.where(passive, model._friction_joint, 0.0)
-        out[i] = model.springs - model.G.T @ f
+        stretch = np.zeros(mech.nv)
+        stretch[s.idx_v] = s.stretch(model.q)
+        out[i] = model.G.T @ (own * stretch) - model.G.T @ f  # (= model.springs where every spring is known)
     return out
+
+
+#: Per identified spring (:func:`spring_regressor`): its stiffness ``k`` and ``k`` times its rest position.
+SPRING_FIELDS = ("stiffness", "stiffness_rest")
+
+
+def spring_joints(mech: Mechanism, joints: object) -> tuple[str, ...]:
+    """``joints`` checked as the names of distinct one-coordinate joints (revolute or prismatic, not an unbounded
+    revolute) whose springs are to be identified.
+
+    Raises:
+        InvalidInputError: not a sequence of names, a joint named twice or of other than one coordinate.
+        UnknownNameError: a joint the mechanism lacks.
+    """
+    from pkm.errors import UnknownNameError
+
+    if isinstance(joints, str) or not isinstance(joints, (list, tuple)):
+        raise InvalidInputError("springs", "expected a list of joint names", joints)
+    for n in joints:
+        if n not in mech.joints:
+            raise UnknownNameError("joint", str(n), mech.joints, mech.name)
+        if mech.joints[n].nq != 1 or mech.joints[n].nv != 1:
+            raise InvalidInputError("springs", f"{n!r}: a spring to identify is on a one-coordinate joint (revolute "
+                                               "or prismatic)", n)
+    if len(set(joints)) != len(joints):
+        raise InvalidInputError("springs", "a joint named twice", joints)
+    return tuple(str(n) for n in joints)
+
+
+def spring_regressor(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, joints: tuple[str, ...]) -> np.ndarray:
+    """The springs of ``joints`` as parameters: (N na) x 2 len(joints), sample after sample as
+    :func:`regressor_batch` stacks, two columns a joint for its :data:`SPRING_FIELDS`. A spring ``-k (q_j - rest)``
+    on joint ``j`` costs the actuators ``Ĝ_jᵀ k (q_j - rest) = (Ĝ_jᵀ q_j) k - Ĝ_jᵀ (k rest)`` (``Ĝ_j`` the map's
+    row of ``j``, :func:`~pkm.core.dynamics.model.actuator_model`): linear in ``(k, k rest)``, identifiable where
+    the motion excites them (the rest of a spring on an actuated joint is its drive's offset: ``Ĝ_j`` is constant)."""
+    mech = check_mechanism(mech)
+    Q, QD = np.atleast_2d(np.asarray(Q, dtype=float)), np.atleast_2d(np.asarray(QD, dtype=float))
+    out = np.zeros((len(Q) * mech.na, 2 * len(joints)))
+    iq = [mech.joints[n].idx_q for n in joints]
+    iv = [mech.joints[n].idx_v for n in joints]
+    for i, (q, qd) in enumerate(zip(Q, QD)):
+        model = _evaluate(mech, mech.check_q(q), mech.check_actuated(qd, "qd"), RTOL, COULOMB_VELOCITY)
+        rows = model.G[iv]  # (len(joints), na)
+        out[i * mech.na:(i + 1) * mech.na, 0::2] = (rows * model.q[iq][:, None]).T
+        out[i * mech.na:(i + 1) * mech.na, 1::2] = -rows.T
+    return finite_result(out, "spring regressor")
 
 
 AUTO_SAMPLES = 2000  # "auto" compiles a mechanism's regressor for batches of at least this many samples
@@ -276,5 +329,6 @@ def regressor_batch(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: ArrayLike
     return np.vstack([regressor(mech, q, qd, qdd) for q, qd, qdd in zip(Q, QD, QDD)])
 
 
-__all__ = ["AUTO_SAMPLES", "BACKENDS", "BODY_FIELDS", "BODY_UNITS", "DRIVE_FIELDS", "Parameters", "close_along", "known_efforts",
-           "parameters", "regressor", "regressor_batch", "tree_regressor"]
+__all__ = ["AUTO_SAMPLES", "BACKENDS", "BODY_FIELDS", "BODY_UNITS", "DRIVE_FIELDS", "SPRING_FIELDS", "Parameters",
+           "close_along", "known_efforts", "parameters", "regressor", "regressor_batch", "spring_joints",
+           "spring_regressor", "tree_regressor"]

@@ -10,7 +10,12 @@ An :class:`Actuator` holds what the dynamics needs of a drive, in the joint's ow
   ``<dynamics damping friction>``), opposing the joint's rate;
 * **limits**: ``effort_limit`` (continuous) and ``peak_effort`` [N m], ``velocity_limit`` [rad/s]; ``inf`` for
   none. The peak bounds what a simulation applies (:func:`pkm.simulate` saturates there), the continuous limit is
-  the one a capability analysis holds for ever.
+  the one a capability analysis holds for ever;
+* the **servo stiffness** ``stiffness`` [N m/rad; N/m]: how stiffly the position-controlled drive holds its joint
+  (the controller's proportional gain seen at the joint, the transmission's compliance in series), the compliance
+  :func:`pkm.stiffness` gives an actuated joint its ``joints=`` argument does not; ``inf`` (the default): a rigid
+  drive. The dynamics do not apply it (it is a controller's gain: :func:`pkm.simulate`'s controllers hold the
+  drives), and no model file states it (MJCF's ``<position kp>`` is not read as one).
 
 Where the values come from, later sources overriding earlier ones per field:
 
@@ -31,6 +36,11 @@ Where the values come from, later sources overriding earlier ones per field:
        effort_limit = 20.0          # N m, continuous
        peak_effort = 60.0           # N m
        velocity_limit = 6.0         # rad/s
+       stiffness = "2000 N m/rad"   # servo stiffness: a number (SI) or a string with its unit (pkm.units)
+
+Every field is a number in SI; ``stiffness`` may also be a string with its unit (``"2 kN m/rad"``, ``"5 N/mm"`` for a
+prismatic drive), kept as written in the spec (:func:`pkm.save` writes it back so) and converted when the mechanism is
+built, where the joint's kind is known: a prismatic joint's unit on a revolute drive is refused, never converted.
 
 The mechanism writes the merged values back into its Pinocchio model (``armature`` = the reflected inertia, so
 that ``crba``, ``rnea`` and the kinetic energy include it; ``damping``, ``friction``, the limits), so every
@@ -42,14 +52,18 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields, replace
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from pkm.errors import InvalidInputError, SpecError
+from pkm.errors import InvalidInputError, SpecError, UnitError
+from pkm.units import JOINT_KINDS, JOINT_UNITS, parse_joint_value, parse_quantity
 
 UNLIMITED = 1e6  # a file's limit at least this large (or 0) means "none": it reads as inf
+#: A stiffness (or damping) at least this large is no spring a file (or a caller) means: a unit mistake.
+MAGNITUDE = 1e12
 
 
 @dataclass(frozen=True)
@@ -67,6 +81,8 @@ class Actuator:
         effort_limit: Continuous effort limit [N m or N]; ``inf``: none.
         peak_effort: Peak effort limit [N m or N]; ``inf``: the continuous limit.
         velocity_limit: Joint speed limit [rad/s or m/s]; ``inf``: none.
+        stiffness: The servo stiffness [N m/rad or N/m] (> 0, below :data:`MAGNITUDE`); ``inf`` (default): a rigid
+            drive. :func:`pkm.stiffness` takes it where its ``joints=`` gives the joint none.
     """
 
     joint: str
@@ -78,6 +94,7 @@ class Actuator:
     effort_limit: float = math.inf
     peak_effort: float = math.inf
     velocity_limit: float = math.inf
+    stiffness: float = math.inf
 
     def __post_init__(self) -> None:
         if not isinstance(self.joint, str):
@@ -90,15 +107,20 @@ class Actuator:
                 value = float(value)
             except OverflowError:  # (an int beyond the floats)
                 value = math.inf if value > 0 else -math.inf
-            if math.isnan(value) or value < 0.0 or (math.isinf(value) and f not in LIMITS):
+            if math.isnan(value) or value < 0.0 or (math.isinf(value) and f not in INFINITE):
                 raise InvalidInputError(f, f"actuator {self.joint!r}: {f} must be a finite number >= 0"
-                                           f"{' (or inf: none)' if f in LIMITS else ''}, got {value!r}", value)
+                                           f"{' (or inf: none)' if f in INFINITE else ''}, got {value!r}", value)
             object.__setattr__(self, f, value)
-        if self.gear_ratio == 0.0 or self.effort_limit == 0.0 or self.peak_effort == 0.0 \
-                or self.velocity_limit == 0.0:
-            zero = next(f for f in ("gear_ratio", "effort_limit", "peak_effort", "velocity_limit")
-                        if getattr(self, f) == 0.0)
-            raise InvalidInputError(zero, f"actuator {self.joint!r}: {zero} must be > 0", 0.0)
+        zero = next((f for f in ("gear_ratio", "effort_limit", "peak_effort", "velocity_limit", "stiffness")
+                     if getattr(self, f) == 0.0), None)
+        if zero is not None:
+            free = " (a drive that yields freely: its joint given 0 in pkm.stiffness's joints=)" \
+                if zero == "stiffness" else ""
+            raise InvalidInputError(zero, f"actuator {self.joint!r}: {zero} must be > 0{free}", 0.0)
+        if MAGNITUDE <= self.stiffness < math.inf:
+            raise InvalidInputError("stiffness", f"actuator {self.joint!r}: a servo stiffness below {MAGNITUDE:g} "
+                                                 "(N m/rad, N/m: a unit mistake?), or inf for a rigid drive",
+                                    self.stiffness)
         if math.isfinite(self.peak_effort) and math.isfinite(self.effort_limit) and self.peak_effort < self.effort_limit:
             raise InvalidInputError("peak_effort", f"actuator {self.joint!r}: the peak effort {self.peak_effort:g} is "
                                                    f"below the continuous limit {self.effort_limit:g}", self.peak_effort)
@@ -119,17 +141,27 @@ class Actuator:
 
 NUMBERS = tuple(f.name for f in fields(Actuator) if f.name != "joint")
 LIMITS = ("effort_limit", "peak_effort", "velocity_limit")
+#: The fields that may be ``inf`` (a limit: none; the servo stiffness: a rigid drive).
+INFINITE = (*LIMITS, "stiffness")
+#: The fields a spec may write as a string with its unit (:mod:`pkm.units`): ``{field: its order}``
+#: (:data:`pkm.units.JOINT_KINDS`, a revolute's unit or a prismatic's).
+WITH_UNITS = {"stiffness": "stiffness"}
 UNITS = {"rotor_inertia": "kg m^2", "gear_ratio": "1", "armature": "kg m^2", "viscous": "N m s/rad",
-         "coulomb": "N m", "effort_limit": "N m", "peak_effort": "N m", "velocity_limit": "rad/s"}
+         "coulomb": "N m", "effort_limit": "N m", "peak_effort": "N m", "velocity_limit": "rad/s",
+         "stiffness": "N m/rad"}
 """The unit of each field for a revolute joint (a prismatic joint's: kg, N s/m, N, m/s)."""
 
 
-def number_tables(raw: object, section: str, keys: tuple[str, ...], source: str) -> dict[str, dict[str, float]]:
+def number_tables(raw: object, section: str, keys: tuple[str, ...], source: str,
+                  units: Mapping[str, str] | None = None) -> dict[str, dict[str, Any]]:
     """A closure spec's ``[<section>.<joint>]`` tables of numbers (``[actuators]``, ``[springs]``): ``{joint: {key:
-    value}}``, each key one of ``keys``, each value a number (as a float; its range is the caller's to check).
+    value}}``, each key one of ``keys``, each value a number (as a float; its range is the caller's to check), or, for
+    a key of ``units`` (``{key: a joint value's order}``, :data:`pkm.units.JOINT_KINDS`), a string with a unit of that
+    order, a revolute's or a prismatic's (kept as written: the joint's kind decides at build, :func:`si_value`).
 
     Raises:
-        SpecError: not a table of tables, an unknown key, a value that is not a number.
+        SpecError: not a table of tables, an unknown key, a value that is not a number, a string that is no
+            quantity of its order.
     """
     if not isinstance(raw, Mapping):
         raise SpecError(source, f"[{section}] must be a table of [{section}.<joint>] tables")
@@ -140,8 +172,15 @@ def number_tables(raw: object, section: str, keys: tuple[str, ...], source: str)
         unknown = sorted(set(table) - set(keys))
         if unknown:
             raise SpecError(source, f"{section}.{joint}: unknown keys {unknown}; known: {list(keys)}")
-        values = {}
+        values: dict[str, Any] = {}
         for key, value in table.items():
+            if isinstance(value, str) and units and key in units:
+                try:
+                    si_value(key, value)
+                except UnitError as exc:
+                    raise SpecError(source, f"{section}.{joint}: {exc}") from None
+                values[key] = value
+                continue
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise SpecError(source, f"{section}.{joint}.{key} must be a number, got {type(value).__name__}")
             values[key] = float(value)
@@ -149,19 +188,39 @@ def number_tables(raw: object, section: str, keys: tuple[str, ...], source: str)
     return out
 
 
-def parse_table(raw: object, source: str) -> dict[str, dict[str, float]]:
-    """The ``[actuators]`` table of a closure spec: ``{joint: {field: value}}``, checked.
+def parse_table(raw: object, source: str) -> dict[str, dict[str, Any]]:
+    """The ``[actuators]`` table of a closure spec: ``{joint: {field: value}}``, checked (a ``stiffness`` may be a
+    string with its unit, kept as written: module doc).
 
     Raises:
-        SpecError: not a table of tables, an unknown key, a value that is not a number, negative or NaN.
+        SpecError: not a table of tables, an unknown key, a value that is not a number, negative or NaN, a unit that
+            is no stiffness's.
     """
-    out = number_tables(raw, "actuators", NUMBERS, source)
+    out = number_tables(raw, "actuators", NUMBERS, source, WITH_UNITS)
     for joint, values in out.items():
         try:
-            Actuator(str(joint), **values)
+            Actuator(str(joint), **{k: si_value(k, v) for k, v in values.items()})
         except InvalidInputError as exc:
             raise SpecError(source, f"actuators.{joint}: {exc}") from None
     return out
+
+
+def si_value(key: str, value: float | str, revolute: bool | None = None) -> float:
+    """A spec table's value in SI: a number as it is, a string with a unit (a key of :data:`WITH_UNITS`) converted
+    with the unit of a revolute joint's value (``revolute``), of a prismatic's, or (``None``: the joint not known
+    yet) of either.
+
+    Raises:
+        UnitError: not a quantity, or a unit of another kind (a prismatic joint's stiffness on a revolute).
+    """
+    if not isinstance(value, str):
+        return float(value)
+    order = WITH_UNITS.get(key)
+    if order is None:
+        raise UnitError(key, f"{key} is a number (SI), got {value!r}", value)
+    if revolute is None:
+        return parse_quantity(value, set(JOINT_KINDS[order]), key, " or ".join(JOINT_UNITS[order]))
+    return parse_joint_value(value, revolute, order, key)
 
 
 def _limit(value: float) -> float:
@@ -169,9 +228,10 @@ def _limit(value: float) -> float:
     return math.inf if value == 0.0 or value >= UNLIMITED or not math.isfinite(value) else value
 
 
-def from_model(model: pin.Model, joint: str, idx_v: int, overrides: Mapping[str, float] | None = None) -> Actuator:
+def from_model(model: pin.Model, joint: str, idx_v: int, overrides: Mapping[str, float | str] | None = None) \
+        -> Actuator:
     """The actuator of ``joint`` (velocity index ``idx_v``) from Pinocchio's fields of ``model``, then
-    ``overrides`` (a spec's table).
+    ``overrides`` (a spec's table; a value with a unit converted with the joint's kind, :func:`si_value`).
 
     Pinocchio's ``armature`` is read as the whole reflected inertia (what its algorithms use), so the actuator's
     own ``armature`` is what it holds beyond ``rotorInertia * rotorGearRatio**2`` (none if it holds less): a model
@@ -187,7 +247,9 @@ def from_model(model: pin.Model, joint: str, idx_v: int, overrides: Mapping[str,
                     coulomb=max(float(model.friction[idx_v]), 0.0),
                     effort_limit=_limit(model.effortLimit[idx_v]),
                     velocity_limit=_limit(model.velocityLimit[idx_v]))
-    return replace(base, **dict(overrides or {}))  # type: ignore[arg-type]  # (field names checked by parse_table)
+    revolute = not model.joints[model.getJointId(joint)].shortname().startswith("JointModelP")
+    values = {k: si_value(k, v, revolute) for k, v in (overrides or {}).items()}
+    return replace(base, **values)  # type: ignore[arg-type]  # (field names checked by parse_table)
 
 
 def write_model(model: pin.Model, actuator: Actuator, idx_v: int) -> None:
@@ -222,8 +284,10 @@ def limit_sources(mech: object) -> dict[str, dict[str, tuple[float, str]]]:
     return out
 
 
-def as_actuators(values: ArrayLike | Mapping[str, object], names: tuple[str, ...]) -> dict[str, Actuator]:
-    """Checked ``{joint: Actuator}`` from ``{joint: Actuator | {field: value}}`` (joints among ``names``)."""
+def as_actuators(values: ArrayLike | Mapping[str, object], names: tuple[str, ...],
+                 revolute: Mapping[str, bool] | None = None) -> dict[str, Actuator]:
+    """Checked ``{joint: Actuator}`` from ``{joint: Actuator | {field: value}}`` (joints among ``names``; a
+    ``stiffness`` may be a string with its unit, of a revolute joint's or a prismatic's as ``revolute`` says)."""
     if not isinstance(values, Mapping):
         raise InvalidInputError("actuators", "expected {joint: Actuator or {field: value}}", values)
     out = {}
@@ -237,14 +301,18 @@ def as_actuators(values: ArrayLike | Mapping[str, object], names: tuple[str, ...
             if unknown:
                 raise InvalidInputError("actuators", f"{joint}: unknown fields {unknown}; known: {list(NUMBERS)}",
                                         unknown)
-            out[joint] = Actuator(joint, **{str(k): v for k, v in value.items()})  # type: ignore[arg-type]
+            kind = (revolute or {}).get(joint)
+            out[joint] = Actuator(joint, **{str(k): si_value(str(k), v, kind) if isinstance(v, str) else v
+                                            for k, v in value.items()})  # type: ignore[arg-type]
         else:
             raise InvalidInputError("actuators", f"{joint}: expected an Actuator or a table, got {value!r}", value)
     return out
 
 
 __all__ = [
+    "INFINITE",
     "LIMITS",
+    "MAGNITUDE",
     "NUMBERS",
     "UNITS",
     "Actuator",
@@ -252,5 +320,6 @@ __all__ = [
     "from_model",
     "limit_sources",
     "parse_table",
+    "si_value",
     "write_model",
 ]

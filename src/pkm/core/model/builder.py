@@ -305,7 +305,7 @@ def with_actuators(mech: Mechanism, actuators: Mapping[str, Any]) -> Mechanism:
     """
     if not isinstance(mech, Mechanism):
         raise InvalidInputError("mech", f"expected a pkm Mechanism, got {type(mech).__name__}", mech)
-    given = as_actuators(actuators, mech.actuated_names)
+    given = as_actuators(actuators, mech.actuated_names, {j.name: j.revolute for j in mech.actuated})
     tables = {j: dict(t) for j, t in mech.spec.actuators.items()}
     for joint, act in given.items():
         if isinstance(actuators[joint], Actuator):

@@ -48,7 +48,8 @@ Format ``pkm.closures/1`` (all values SI: m, rad)::
 
     [actuators.motor_1]              # optional: the drive of an actuated joint (pkm.core.model.actuators)
     rotor_inertia = 3.3e-5           # kg m^2; also gear_ratio, armature, viscous, coulomb,
-    gear_ratio = 50.0                # effort_limit, peak_effort, velocity_limit (inf: none)
+    gear_ratio = 50.0                # effort_limit, peak_effort, velocity_limit (inf: none),
+    stiffness = "2000 N m/rad"       # the servo stiffness (a number in SI, or a string with its unit)
 
     [springs.knee_spring]            # optional: a joint's spring and damper (pkm.core.model.springs),
     stiffness = 1500.0               # N m/rad; rest = its rest angle (rad), damping (N m s/rad);
@@ -199,7 +200,7 @@ class ClosureSpec:
     floating_base: str | None = None
     #: ``{actuated joint: {field: value}}``: the drives' values the spec states (``[actuators.<joint>]``, see
     #: :mod:`pkm.core.model.actuators`), over those of the model file.
-    actuators: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    actuators: Mapping[str, Mapping[str, float | str]] = field(default_factory=dict)
     #: ``{joint: {"stiffness", "rest", "damping": value}}``: the joints' springs and dampers (``[springs.<joint>]``,
     #: :mod:`pkm.core.model.springs`), over those of the model file; read, written and applied by the dynamics.
     springs: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
@@ -460,8 +461,8 @@ class ClosureSpec:
         for section, tables in (("actuators", self.actuators), ("springs", self.springs)):
             for joint, values in tables.items():
                 if values:
-                    out += ["", f"[{section}.{_key(joint)}]"] + [f"{_key(k)} = {_tv(float(v))}"
-                                                                 for k, v in values.items()]
+                    out += ["", f"[{section}.{_key(joint)}]"] + [  # (a value with its unit as written)
+                        f"{_key(k)} = {_tv(v if isinstance(v, str) else float(v))}" for k, v in values.items()]
         for tname, outputs in self.transmissions.items():
             out += ["", f"[transmission.{_key(tname)}]", f"outputs = {_tv(list(outputs))}"]
         for mname, coefs in self.motors.items():

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pkm.core.model.actuators import number_tables
+from pkm.core.model.actuators import MAGNITUDE, number_tables
 from pkm.errors import SpecError
 
 if TYPE_CHECKING:
@@ -44,8 +44,6 @@ if TYPE_CHECKING:
 
 #: The keys of a ``[springs.<joint>]`` table, each 0 when left out.
 SPRING_KEYS = ("stiffness", "rest", "damping")
-#: A stiffness or damping at least this large is no spring a file (or a caller) means: a unit mistake.
-MAGNITUDE = 1e12
 
 
 def parse_springs(raw: object, source: str) -> dict[str, dict[str, float]]:
@@ -122,4 +120,9 @@ def describe(springs: Mapping[str, Mapping[str, float]]) -> str:
                      for j, values in springs.items())
 
 
-__all__ = ["MAGNITUDE", "SPRING_KEYS", "JointSprings", "describe", "joint_springs", "parse_springs"]
+def spring_notes(springs: Mapping[str, Mapping[str, float]]) -> tuple[str, ...]:
+    """The load note naming the springs a model file states (none: no note)."""
+    return (f"joint springs read into [springs] (applied by pkm's dynamics): {describe(springs)}",) if springs else ()
+
+
+__all__ = ["MAGNITUDE", "SPRING_KEYS", "JointSprings", "describe", "joint_springs", "parse_springs", "spring_notes"]

@@ -629,3 +629,64 @@ def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: d
     text = etree.tostring(robot, xml_declaration=True, encoding="utf-8", pretty_print=True).decode()
     check_urdf(text, source)
     return text, types
+
+
+def gazebo_springs(root: etree._Element, source: str) -> dict[str, dict[str, float]]:
+    """The joint springs a URDF states with Gazebo's URDF extension, ``<gazebo reference="JOINT">`` holding
+    ``<springStiffness>`` and ``<springReference>`` (what the URDF-to-SDFormat converter makes SDFormat's ``<axis>
+    <dynamics><spring_stiffness>``, ``<spring_reference>`` of; sdformat's "SDFormat extensions to URDF"):
+    ``{joint: {"stiffness", "rest"}}`` as a spec's ``[springs]`` tables (:mod:`pkm.core.model.springs`), checked;
+    a ``<gazebo>`` element naming a link, or a stiffness of 0, states none. The joint's damping is URDF's own
+    ``<dynamics damping>``.
+
+    Raises:
+        SpecError: a value that is not a finite number, a negative stiffness, a spring on a joint neither revolute
+            nor prismatic.
+    """
+    from pkm.core.model.springs import parse_springs
+
+    types = {str(j.get("name")): j.get("type") for j in root.findall("joint")}
+    found: dict[str, dict[str, float]] = {}
+    for g in root.findall("gazebo"):
+        joint, k, rest = g.get("reference"), g.findtext("springStiffness"), g.findtext("springReference")
+        if joint not in types or (k is None and rest is None):
+            continue
+        try:
+            values = {"stiffness": float(k or 0.0), "rest": float(rest or 0.0)}
+        except ValueError:
+            raise SpecError(source, f'<gazebo reference="{joint}"> (line {g.sourceline}): springStiffness '
+                                    f"{k!r} or springReference {rest!r} is not a number") from None
+        if values["stiffness"] == 0.0:
+            continue
+        if types[joint] not in ("revolute", "prismatic"):
+            raise SpecError(source, f'<gazebo reference="{joint}"> (line {g.sourceline}): a spring on a '
+                                    f"{types[joint]} joint (pkm reads the springs of revolute and prismatic joints)")
+        found[str(joint)] = values
+    return parse_springs(found, source) if found else {}
+
+
+def write_gazebo_springs(root: etree._Element, springs: Mapping[str, Mapping[str, float]],
+                         damping: Mapping[str, float]) -> None:
+    """Write ``springs`` (``[springs]`` tables) into the URDF ``root`` as :func:`gazebo_springs` reads them: a
+    ``<gazebo reference="JOINT">`` with ``<springStiffness>`` and ``<springReference>`` for each of non-zero
+    stiffness, and ``damping`` (``{joint: its whole viscous damping}``, for the tables that state one) as the
+    joint's ``<dynamics damping>`` (its friction kept)."""
+    joints = {str(j.get("name")): j for j in root.findall("joint")}
+    for g in root.findall("gazebo"):  # (a spring the file stated already: replaced, not stated twice)
+        if g.get("reference") in springs:
+            for el in [*g.findall("springStiffness"), *g.findall("springReference")]:
+                g.remove(el)
+            if len(g) == 0:
+                root.remove(g)
+    for name, table in springs.items():
+        if name not in joints:
+            continue
+        if table.get("stiffness", 0.0) != 0.0:
+            g = etree.SubElement(root, "gazebo", reference=name)
+            etree.SubElement(g, "springStiffness").text = repr(float(table["stiffness"]))
+            etree.SubElement(g, "springReference").text = repr(float(table.get("rest", 0.0)))
+        if "damping" in table and name in damping:
+            dyn = joints[name].find("dynamics")
+            if dyn is None:
+                dyn = etree.SubElement(joints[name], "dynamics")
+            dyn.set("damping", repr(float(damping[name])))

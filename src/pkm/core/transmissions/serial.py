@@ -19,7 +19,8 @@ diagonal entry at the robot's reference (what a constant-armature model uses: ex
 transmission's feasible region (:mod:`pkm.core.transmissions.limits`: the largest box that holds the reference, or
 the point ``around`` gives). :meth:`SerialEquivalent.urdf` and :meth:`SerialEquivalent.mjcf` write it;
 :func:`write_serial_equivalent` writes both and a JSON data file describing each transmission for the kernels.
-The joint springs (``[springs]``) of the joints the serial model keeps are in its MJCF; those of the locked motors
+The joint springs (``[springs]``) of the joints the serial model keeps are in its MJCF and its URDF (Gazebo's
+extension); those of the locked motors
 and passive joints act through their loops, in the kernels' ``Δh``: the serial model's files lack them (a warning
 names them).
 
@@ -46,9 +47,10 @@ from lxml import etree
 
 from pkm.core.analysis.region import SINGULARITY
 from pkm.core.formats.to_mjcf import MIN_INERTIA, MIN_MASS, TIMESTEP, _joints, _num, _pose, qpos_of, write_spring
+from pkm.core.formats.to_urdfplus import damping_of
 from pkm.core.model.joints import reduced_model
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.core.model.urdf import urdf_from_model
+from pkm.core.model.urdf import urdf_from_model, write_gazebo_springs
 from pkm.core.transmissions.decompose import transmissions as find
 from pkm.core.transmissions.limits import OutputLimits, output_limits
 from pkm.core.transmissions.transmission import Transmission
@@ -89,10 +91,17 @@ class SerialEquivalent:
         return tuple(o for t in self.transmissions for o in t.outputs)
 
     def urdf(self) -> str:
-        """The serial model as URDF (Pinocchio loads it): the outputs' box limits; URDF has no armature and no joint
-        spring (the data file and the MJCF carry the armature, the MJCF the springs)."""
+        """The serial model as URDF (Pinocchio loads it): the outputs' box limits; the kept joints' springs
+        (``[springs]``) with Gazebo's URDF extension (:func:`~pkm.core.model.urdf.write_gazebo_springs`), their
+        damping as ``<dynamics damping>``; URDF has no armature (the data file and the MJCF carry it)."""
         text, types = urdf_from_model(self.model, name=f"{self.robot.name}_serial", limits=self.limits,
                                       source=self.robot.source)
+        springs = {n: t for n, t in self.robot.spec.springs.items() if self.model.existJointName(n)}
+        if springs:
+            root = etree.fromstring(text.encode())
+            write_gazebo_springs(root, springs, damping_of(self.robot))
+            etree.indent(root, space="  ")
+            text = etree.tostring(root, encoding="unicode") + "\n"
         if types:
             text = text.replace("<robot ", f"<!-- joint types URDF cannot state: {types} -->\n<robot ", 1)
         return text
