@@ -98,3 +98,12 @@ def test_the_compiled_route_equals_the_core_on_the_ankle(ankle, monkeypatch):
     assert abs(compiled.cycle_time / plan.cycle_time - 1.0) <= 1e-9 and compiled.inactive == plan.inactive
     with pytest.raises(InvalidInputError, match="kernels"):
         pkm.verify_time_optimal(plan, simulate=False, kernels=pkm.Kernels(free, compiled=False))
+
+
+def test_the_compiled_route_equals_the_core_on_the_delta(delta):
+    """The Delta (no idle motions: the efforts by the twin's projection; its knees' branch signs followed) with a
+    motor line, numpy over the samples: the core's verification (efforts 1e-10 relative, the one switch)."""
+    line = pkm.time_optimal(delta, ARC[1:3], points=8, limits={"omega0": 8.0, "speed": 20.0})
+    core = pkm.verify_time_optimal(line, factor=1, simulate=False)
+    _same(pkm.verify_time_optimal(line, factor=1, simulate=False, kernels=pkm.Kernels(delta, compiled=False)), core)
+    assert len(core.inactive) == 1
