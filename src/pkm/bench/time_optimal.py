@@ -91,7 +91,8 @@ def _ankle(points: int) -> dict:
             "cycle_time_difference": abs(plan_k.cycle_time / plan.cycle_time - 1.0), "verify_s": verify_s,
             "verify_core_s": core_s, "ratio": core_s / verify_s,
             "efforts_difference": float(np.abs(check.efforts - core.efforts).max() / np.abs(core.efforts).max()),
-            "target_s": 5.0, "within_target": verify_s <= 5.0, "holds": check.holds and core.holds,
+            "route": check.route, "target_s": 5.0, "within_target": verify_s <= 5.0 and check.route != "core",
+            "holds": check.holds and core.holds,
             "inactive": len(check.inactive),
             "labels_equal": check.inactive == plan.inactive == core.inactive == plan_k.inactive}
 

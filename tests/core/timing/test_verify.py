@@ -82,16 +82,19 @@ def test_the_compiled_route_equals_the_core_on_the_ankle(ankle, monkeypatch):
     K = pkm.Kernels(ankle, compiled=False)
     plan = pkm.time_optimal(ankle, [[0.0, 0.0], [0.2, 0.05], [0.4, 0.1]], points=12)
     core = pkm.verify_time_optimal(plan, factor=2, simulate=False)
-    _same(pkm.verify_time_optimal(plan, factor=2, simulate=False, kernels=K), core)
+    compiled = pkm.verify_time_optimal(plan, factor=2, simulate=False, kernels=K)
+    _same(compiled, core)
     assert core.holds and core.inactive == plan.inactive
+    assert compiled.route.startswith("kernels (numpy") and core.route == "core"
     free = copy.copy(ankle)
     free.limits = {}
     across = dataclasses.replace(pkm.time_optimal(free, PITCH, points=6), mech=ankle)
-    _same(pkm.verify_time_optimal(across, factor=1, simulate=False, kernels=K),
-          pkm.verify_time_optimal(across, factor=1, simulate=False))
+    outside = pkm.verify_time_optimal(across, factor=1, simulate=False, kernels=K)
+    _same(outside, pkm.verify_time_optimal(across, factor=1, simulate=False))
+    assert outside.route.startswith("kernels") and not outside.holds
     monkeypatch.setattr(trajectory, "JUMP_RATIO", -1.0)
     folded = pkm.verify_time_optimal(plan, factor=1, simulate=False, kernels=K)
-    assert not folded.holds and "jumps" in folded.reason
+    assert not folded.holds and "jumps" in folded.reason and folded.route == "core"
     monkeypatch.undo()
     compiled = pkm.time_optimal(ankle, [[0.0, 0.0], [0.2, 0.05], [0.4, 0.1]], points=12, kernels=K)
     assert compiled.coefficients.route.startswith("kernels")
@@ -105,5 +108,6 @@ def test_the_compiled_route_equals_the_core_on_the_delta(delta):
     motor line, numpy over the samples: the core's verification (efforts 1e-10 relative, the one switch)."""
     line = pkm.time_optimal(delta, ARC[1:3], points=8, limits={"omega0": 8.0, "speed": 20.0})
     core = pkm.verify_time_optimal(line, factor=1, simulate=False)
-    _same(pkm.verify_time_optimal(line, factor=1, simulate=False, kernels=pkm.Kernels(delta, compiled=False)), core)
-    assert len(core.inactive) == 1
+    compiled = pkm.verify_time_optimal(line, factor=1, simulate=False, kernels=pkm.Kernels(delta, compiled=False))
+    _same(compiled, core)
+    assert len(core.inactive) == 1 and compiled.route.startswith("kernels")

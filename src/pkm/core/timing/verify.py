@@ -105,6 +105,8 @@ class Verification:
         outside_limits: The joints that leave their stated position limits at some check point (in the order they
             do).
         reason: Why the plan does not hold, in words (None where it holds).
+        route: What recomputed the motion at the check points: ``"core"``, or ``"kernels (...)"`` (what ran them;
+            module doc, "Two routes").
     """
 
     s: np.ndarray
@@ -122,6 +124,7 @@ class Verification:
     outside_limits: tuple[str, ...] = ()
     reason: str | None = None
     planned_usage: np.ndarray | None = None
+    route: str = "core"
 
 
 def _points(plan: TimeOptimal, factor: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -205,14 +208,16 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
     if simulate:
         track, task_err, dur, event = _track(plan, t, traj, tau, dt)
     return Verification(s, t, tau, effort, speed, acc, holds, inactive, track, task_err, dur, event,
-                        tuple(v.joint for _, v in traj.outside_limits), "; ".join(reasons) or None, planned)
+                        tuple(v.joint for _, v in traj.outside_limits), "; ".join(reasons) or None, planned,
+                        traj.route)
 
 
 @dataclass(frozen=True)
 class _Motion:
     """The motion at the check points, from either route: configurations (m x nq), the actuated coordinates,
     rates and accelerations (m x na), the efforts without friction (m x na), the task values, whether the motion
-    leaves its branch, and the joints outside their position limits (:meth:`pkm.core.Mechanism.limits_along`)."""
+    leaves its branch, the joints outside their position limits (:meth:`pkm.core.Mechanism.limits_along`), and
+    the route."""
 
     q: np.ndarray
     actuated: np.ndarray
@@ -222,6 +227,7 @@ class _Motion:
     task: np.ndarray
     jumps: bool
     outside_limits: tuple
+    route: str = "core"
 
 
 def _core(plan: TimeOptimal, y: np.ndarray, yd: np.ndarray, ydd: np.ndarray) -> _Motion:
@@ -264,7 +270,7 @@ def _compiled(mech: Mechanism, K: Kernels, y: np.ndarray, yd: np.ndarray, ydd: n
         tau = np.einsum("kij,kj->ki", M.reshape(len(qd), mech.na, mech.na), qdd) + h  # (one motor: a column)
     else:
         tau = K.inverse_dynamics(res.q, qd, qdd)
-    return _Motion(res.q, res.q[:, mech.act_q], qd, qdd, tau, y, False, res.outside_limits)
+    return _Motion(res.q, res.q[:, mech.act_q], qd, qdd, tau, y, False, res.outside_limits, f"kernels ({res.how})")
 
 
 def _track(plan: TimeOptimal, t: np.ndarray, traj: object, tau: np.ndarray,
