@@ -182,3 +182,19 @@ def test_an_unevenly_spaced_axis_measures_each_node_s_own_cell():
     even = workspace_map(mech, {"x": np.linspace(0.45, 0.5, 6), "yaw": [0.0, 0.05], "y": [0.29]}, length=0.1)
     assert even.uniform and even.size == even.nodes * even.cell and even.size_unit == "m rad"
     assert np.allclose(even.cells, even.cell, rtol=1e-12)
+
+
+def test_a_mechanism_with_idle_motions_gets_its_map():
+    """The humanoid ankle (its rods spin between two balls: idle motions, held in the Newton steps): a 3 x 2 map of
+    pitch and roll, every node reachable, each node's singular values those of pkm.inverse_jacobian at its
+    configuration (the core's, whose rods' spin is of least norm) to 1e-10 relative."""
+    from pathlib import Path
+
+    mech = pkm.load(Path(__file__).resolve().parents[3] / "examples" / "humanoid_ankle" / "ankle.closures.toml")
+    pitch, roll = np.array([-0.3, 0.0, 0.3]), np.array([-0.2, 0.1])
+    m = workspace_map(mech, {"ankle_pitch": pitch, "ankle_roll": roll}, configurations=True)
+    assert m.reachable.all()
+    for iy, ix in np.ndindex(m.reachable.shape):
+        s = np.linalg.svd(pkm.inverse_jacobian(mech, m.q[iy, ix]) @ np.diag(m.scale), compute_uv=False)
+        np.testing.assert_allclose(m.singular_values[iy, ix], s, rtol=1e-10)
+        assert np.allclose(pkm.TaskMap(mech).value(m.q[iy, ix]), [pitch[ix], roll[iy]], rtol=0, atol=1e-10)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import pkm
 
@@ -55,3 +56,58 @@ def test_labels_equal_the_plans_with_viscous_friction(ankle, delta):
     line = pkm.time_optimal(delta, ARC[1:3], points=16, limits={"omega0": 8.0, "speed": 20.0})
     check = pkm.verify_time_optimal(line, factor=1, simulate=False)
     assert len(line.inactive) == 1 and check.inactive == line.inactive
+
+
+def _same(a, b) -> None:
+    """Two verifications of one plan equal: efforts to 1e-10 relative, usages, labels, verdicts."""
+    np.testing.assert_allclose(a.efforts, b.efforts, rtol=0, atol=1e-10 * np.abs(b.efforts).max())
+    for key in ("effort_usage", "speed_usage", "acceleration_usage"):
+        assert abs(getattr(a, key) - getattr(b, key)) <= 1e-10, key
+    np.testing.assert_allclose(a.planned_usage, b.planned_usage, rtol=0, atol=1e-10)
+    assert (a.holds, a.inactive, a.outside_limits, a.reason) == (b.holds, b.inactive, b.outside_limits, b.reason)
+
+
+def test_the_compiled_route_equals_the_core_on_the_ankle(ankle, monkeypatch):
+    """The humanoid ankle (idle motions: its rods spin between their balls) at 2x the resolution of a 12-point plan:
+    the kernels' verification (numpy over the samples: the expressions the C compiles) equals the core's (efforts
+    1e-10 relative, usages, labels, verdict); a plan across the position limits, the same reason; where every step
+    reads as a fold, the compiled route hands the path to the core, which names the jump; the planner's compiled
+    route on the ankle equals its core (cycle time 1e-9, labels)."""
+    import copy
+    import dataclasses
+
+    import pkm.core.kinematics.trajectory as trajectory
+    from pkm.errors import InvalidInputError
+
+    K = pkm.Kernels(ankle, compiled=False)
+    plan = pkm.time_optimal(ankle, [[0.0, 0.0], [0.2, 0.05], [0.4, 0.1]], points=12)
+    core = pkm.verify_time_optimal(plan, factor=2, simulate=False)
+    compiled = pkm.verify_time_optimal(plan, factor=2, simulate=False, kernels=K)
+    _same(compiled, core)
+    assert core.holds and core.inactive == plan.inactive
+    assert compiled.route.startswith("kernels (numpy") and core.route == "core"
+    free = copy.copy(ankle)
+    free.limits = {}
+    across = dataclasses.replace(pkm.time_optimal(free, PITCH, points=6), mech=ankle)
+    outside = pkm.verify_time_optimal(across, factor=1, simulate=False, kernels=K)
+    _same(outside, pkm.verify_time_optimal(across, factor=1, simulate=False))
+    assert outside.route.startswith("kernels") and not outside.holds
+    monkeypatch.setattr(trajectory, "JUMP_RATIO", -1.0)
+    folded = pkm.verify_time_optimal(plan, factor=1, simulate=False, kernels=K)
+    assert not folded.holds and "jumps" in folded.reason and folded.route == "core"
+    monkeypatch.undo()
+    compiled = pkm.time_optimal(ankle, [[0.0, 0.0], [0.2, 0.05], [0.4, 0.1]], points=12, kernels=K)
+    assert compiled.coefficients.route.startswith("kernels")
+    assert abs(compiled.cycle_time / plan.cycle_time - 1.0) <= 1e-9 and compiled.inactive == plan.inactive
+    with pytest.raises(InvalidInputError, match="kernels"):
+        pkm.verify_time_optimal(plan, simulate=False, kernels=pkm.Kernels(free, compiled=False))
+
+
+def test_the_compiled_route_equals_the_core_on_the_delta(delta):
+    """The Delta (no idle motions: the efforts by the twin's projection; its knees' branch signs followed) with a
+    motor line, numpy over the samples: the core's verification (efforts 1e-10 relative, the one switch)."""
+    line = pkm.time_optimal(delta, ARC[1:3], points=8, limits={"omega0": 8.0, "speed": 20.0})
+    core = pkm.verify_time_optimal(line, factor=1, simulate=False)
+    compiled = pkm.verify_time_optimal(line, factor=1, simulate=False, kernels=pkm.Kernels(delta, compiled=False))
+    _same(compiled, core)
+    assert len(core.inactive) == 1 and compiled.route.startswith("kernels")

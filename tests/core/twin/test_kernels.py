@@ -155,3 +155,35 @@ def test_a_mechanism_with_idle_motions_is_refused():
     mech = pkm.load(FILES["rssr"])
     with pytest.raises(SpecError, match="idle motions"):
         Kernels(mech).inverse_dynamics(mech.q_reference, np.zeros(mech.na), np.zeros(mech.na))
+
+
+@pytest.mark.parametrize("name", ["ankle", "rssr"])
+def test_idle_motions_are_held_by_the_task_kernels(name, monkeypatch):
+    """On mechanisms with idle motions (rods spinning between two balls) the inverse kinematics along a path, the
+    inverse Jacobian and the inverse rates (numpy over the samples: the expressions the C compiles) hold one
+    coordinate per idle motion: the configurations close the loops and reach the task (1e-12), the actuated rates
+    and accelerations are pkm.inverse_velocities' and pkm.inverse_accelerations' (1e-10 relative), the held
+    coordinates' rates are zero; under the pivot floor the core's come back, equal."""
+    mech = _mechanism(name)
+    K = Kernels(mech, compiled=False)
+    held = K.dynamics.idle
+    assert held
+    task = TaskMap(mech)
+    y0 = task.value(mech.q_reference)
+    rng = np.random.default_rng(2)
+    step = 0.03 * rng.standard_normal(task.size)
+    Y = np.array([task.retract(y0, t * step) for t in np.linspace(0.0, 1.0, 5)])
+    YD, YDD = rng.standard_normal((5, task.size)), rng.standard_normal((5, task.size))
+    ik = K.ik_path(Y, tol=1e-14)
+    assert ik.fallback == () and ik.residual.max() <= 1e-12
+    v, qdd = K.inverse_rates(ik.q, YD, YDD)
+    assert np.abs(v[:, held]).max() == 0.0
+    for k, q in enumerate(ik.q):
+        assert np.abs(pkm.solve_ik(mech, Y[k], q).q - q).max() <= 1e-12  # (the core's solve stays: solved)
+        vk = pkm.inverse_velocities(mech, q, YD[k])
+        assert rel(v[k, mech.act_v], vk[mech.act_v]) <= 1e-10
+        assert rel(qdd[k], pkm.inverse_accelerations(mech, q, vk, YDD[k])[mech.act_v]) <= 1e-10
+        assert rel(K.inverse_jacobian(q).reshape(mech.na, -1), pkm.inverse_jacobian(mech, q)) <= 1e-10
+    monkeypatch.setattr(kmod, "PIVOT_FLOOR", 2.0)
+    v_core, qdd_core = K.inverse_rates(ik.q, YD, YDD)
+    assert rel(v_core[:, mech.act_v], v[:, mech.act_v]) <= 1e-10 and rel(qdd_core, qdd) <= 1e-10

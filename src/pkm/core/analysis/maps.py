@@ -286,8 +286,9 @@ def workspace_map(mech: Mechanism, axes: Mapping[str, object], fixed: Mapping[st
     """The map of ``mech`` over the grid ``axes`` (see the module doc).
 
     Args:
-        mech: Any mechanism pkm loads, without idle motions, whose task has as many coordinates as it has degrees
-            of freedom.
+        mech: Any mechanism pkm loads whose task has as many coordinates as it has degrees of freedom; idle motions
+            (a rod spinning between two balls) are held in the Newton steps, one coordinate each (the indices, of
+            the actuated rates, do not depend on them).
         axes: Task coordinate name -> values (SI) of 1 to 3 axes, the first the fastest; names among
             :attr:`TaskMap.keys` that are entries of the task value (a pose task's ``x y z``).
         fixed: The other task coordinates by name (the rest from the seed configuration).

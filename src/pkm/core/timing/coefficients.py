@@ -25,11 +25,14 @@ Departure from the model: Coulomb's sign is taken exact (:math:`\operatorname{sg
 ``ik_path`` warm-started, ``inverse_jacobian``, ``mass_and_bias``, ``gravity``, ``velocities`` in batches), where
 :math:`q_a''` is the derivative of :math:`q_a'(s) = J^{-1} y'(s)` along the path by Richardson-extrapolated central
 differences (steps 1e-3 and 5e-4 in s: truncation O(h⁴)); tests hold both to 1e-9 relative of each other and of
-:func:`pkm.inverse_dynamics`.
+:func:`pkm.inverse_dynamics`. Idle motions (the humanoid ankle's rods spinning between their balls) are held in the
+kernels' inverse kinematics, one coordinate each, and mass-orthogonal in their model, as the core's; friction at
+the actuated joints alone reads the passive map's identity rows (:func:`friction_map`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -119,6 +122,21 @@ def _friction(mech: Mechanism, G: np.ndarray, dqa: np.ndarray) -> tuple[np.ndarr
     return np.einsum("kij,ki->kj", G, F * np.sign(v)), np.einsum("kij,ki->kj", G, D * v)
 
 
+def friction_map(mech: Mechanism, n: int, passive: Callable[[], np.ndarray]) -> np.ndarray | None:
+    """The passive map ``Ĝ`` (n x nv x na) as the friction reads it: None where no joint rubs (no damping nor
+    Coulomb friction in the model); where only actuated joints rub, the identity on their rows (``Ĝ``'s rows there;
+    the others, which the friction does not read, zero); else ``passive()``, the map itself at the n points."""
+    rubbing = np.flatnonzero((np.asarray(mech.model.damping) != 0.0) | (np.asarray(mech.model.friction) != 0.0))
+    if not rubbing.size:
+        return None
+    act = np.asarray(mech.act_v)
+    if not np.isin(rubbing, act).all():
+        return passive()
+    G = np.zeros((n, mech.nv, mech.na))
+    G[:, act, np.arange(mech.na)] = 1.0
+    return G
+
+
 def _core(mech: Mechanism, path: GeometricPath, s: np.ndarray, q0: np.ndarray | None) -> PathCoefficients:
     from pkm.core.dynamics.model import actuator_model
     from pkm.core.kinematics.trajectory import follow_actuators, follow_task
@@ -183,7 +201,8 @@ def _kernels(mech: Mechanism, kernels: object, path: GeometricPath, s: np.ndarra
             raise PathError(k, s[k], "workspace", f"the inverse kinematics does not reach the path here (residual "
                                                   f"{res.residual[bad[0]]:.3g}): outside the workspace")
         Q = res.q
-        dqa_all = np.einsum("kij,kj->ki", kernels.inverse_jacobian(Q), d1a)
+        Ji = kernels.inverse_jacobian(Q).reshape(len(Q), mech.na, d1a.shape[1])  # (a 1 x 1 comes back as a column)
+        dqa_all = np.einsum("kij,kj->ki", Ji, d1a)
         qa_all = Q[:, mech.act_q]
     else:
         Q, qa_all, dqa_all = kernels.close_loops_path(ya, q0).q, ya, d1a
@@ -193,10 +212,10 @@ def _kernels(mech: Mechanism, kernels: object, path: GeometricPath, s: np.ndarra
         ddqa = path.evaluate(s)[2]
     q, dqa, qa = Q[2::5], D[:, 2], qa_all[2::5]
     M, hq = kernels.mass_and_bias(q, dqa)
+    M = M.reshape(n, mech.na, mech.na)
     g = kernels.gravity(q)
-    G = None
-    if np.any(np.asarray(mech.model.damping) != 0.0) or np.any(np.asarray(mech.model.friction) != 0.0):
-        G = np.stack([kernels.velocities(q, np.tile(e, (n, 1))) for e in np.eye(mech.na)], axis=2)
+    G = friction_map(mech, n, lambda: np.stack([kernels.velocities(q, np.tile(e, (n, 1))) for e in np.eye(mech.na)],
+                                               axis=2))
     y0, dy0, ddy0 = path.evaluate(s)
     return _assemble(mech, s, q, y0, dy0, ddy0, qa, dqa, ddqa, M, hq, g, G, f"kernels ({kernels.how.get('mass_and_bias', '')})")
 
@@ -217,4 +236,4 @@ def path_coefficients(mech: Mechanism, path: GeometricPath, s: np.ndarray, *, q0
     return _kernels(mech, kernels, path, s, q0)
 
 
-__all__ = ["PathCoefficients", "path_coefficients", "with_payload"]
+__all__ = ["PathCoefficients", "friction_map", "path_coefficients", "with_payload"]

@@ -44,7 +44,7 @@ import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -54,6 +54,9 @@ from pkm.core.timing.coefficients import PathCoefficients
 from pkm.core.timing.limits import Limits
 from pkm.core.timing.path import GeometricPath
 from pkm.errors import InvalidInputError, PathError, PkmError
+
+if TYPE_CHECKING:
+    from pkm.core.twin.kernels import Kernels
 
 MAX_PASSES = 12
 #: Rounds of tightening where the limits are used beyond 1 between the grid points (:func:`solve`).
@@ -472,6 +475,27 @@ def solve(mech: Mechanism, path: GeometricPath, C: PathCoefficients, L: Limits, 
 _KERNELS: dict[int, object] = {}
 
 
+def kernels_of(mech: Mechanism, kernels: object) -> Kernels:
+    """``kernels`` checked as :class:`pkm.Kernels` of ``mech``; for True, the kernels of ``mech`` built on the first
+    call and kept (a few mechanisms at a time).
+
+    Raises:
+        InvalidInputError: ``kernels`` is neither True nor kernels of ``mech``.
+    """
+    from pkm.core.twin.kernels import Kernels
+
+    if kernels is True:
+        if id(mech) not in _KERNELS or _KERNELS[id(mech)].mech is not mech:  # type: ignore[attr-defined]
+            if len(_KERNELS) > 8:
+                _KERNELS.clear()
+            _KERNELS[id(mech)] = Kernels(mech)
+        kernels = _KERNELS[id(mech)]
+    if not isinstance(kernels, Kernels) or kernels.mech is not mech:
+        raise InvalidInputError("kernels", "expected True or pkm.Kernels of the plan's mechanism (with its payload: "
+                                           "pkm.core.timing.with_payload)", kernels)
+    return kernels
+
+
 def time_optimal(mech: Mechanism, path: object, *, payload: float = 0.0, limits: Limits | Mapping[str, Any] | None = None,
                  points: int = 1000, space: str = "task", kernels: object = None,
                  q0: ArrayLike | None = None) -> TimeOptimal:
@@ -536,13 +560,7 @@ def time_optimal(mech: Mechanism, path: object, *, payload: float = 0.0, limits:
         raise InvalidInputError("limits", f"limits for {len(lim.names)} actuators, the mechanism has {mech.na}",
                                 lim.names)
     if kernels is True:
-        from pkm.core.twin.kernels import Kernels
-
-        if id(timed) not in _KERNELS or _KERNELS[id(timed)].mech is not timed:  # type: ignore[attr-defined]
-            if len(_KERNELS) > 8:
-                _KERNELS.clear()
-            _KERNELS[id(timed)] = Kernels(timed)
-        kernels = _KERNELS[id(timed)]
+        kernels = kernels_of(timed, True)
     s = np.linspace(0.0, 1.0, n)
     start = None if q0 is None else timed.check_q(q0, "q0")
     C = path_coefficients(timed, geo, s, q0=start, kernels=kernels or None)
@@ -550,4 +568,4 @@ def time_optimal(mech: Mechanism, path: object, *, payload: float = 0.0, limits:
     return solve(timed, geo, C, lim, float(payload), mid)
 
 
-__all__ = ["ACTIVE_RTOL", "TimeOptimal", "check_positions", "planned_usage", "solve", "time_optimal", "usage"]
+__all__ = ["ACTIVE_RTOL", "TimeOptimal", "check_positions", "kernels_of", "planned_usage", "solve", "time_optimal", "usage"]

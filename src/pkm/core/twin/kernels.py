@@ -287,7 +287,10 @@ class Kernels:
     """The generated kernels of ``mech`` (see the module doc).
 
     Args:
-        mech: Any mechanism pkm loads, without idle motions (the actuator-space model's kernels take them too).
+        mech: Any mechanism pkm loads, without idle motions for the kernels of the passive solve (``velocities``,
+            ``accelerations``, ``inverse_dynamics``, ``closure_newton``...); the actuator-space model's take them, and
+            so do the task's (``ik_newton``, ``inverse_jacobian``, ``inverse_rates``, the maps'), one coordinate per
+            idle motion held (:func:`~pkm.core.twin.dynamics.idle_columns`, as the exported C holds it).
         design: Design parameters taken as kernel inputs (:mod:`~pkm.core.twin.design`: ``JOINT.x`` ...
             ``JOINT.yaw``, ``BODY.m`` ... ``BODY.Izz``): every kernel takes a last input ``design`` and one compiled
             library serves every design; :meth:`at` binds a design. Default none: the file's numbers are constants.
@@ -300,7 +303,7 @@ class Kernels:
         threads: Cores a compiled batch of ``2 THREAD_SAMPLES`` or more is split over (default: every core).
 
     Raises:
-        SpecError: ``mech`` has idle motions (on the first kernel that needs the passive solve, but the model's).
+        SpecError: ``mech`` has idle motions (on the first kernel that needs the passive solve).
         UnknownNameError: a design parameter ``mech`` does not have (the error lists those it has).
 
     Examples:
@@ -388,6 +391,7 @@ class Kernels:
                  "accelerations": lambda: {"a": tw.accelerations},
                  "forward_jacobian": lambda: {"J": tk.forward_jacobian},
                  "inverse_jacobian": lambda: {"J": tk.inverse_jacobian},
+                 "inverse_rates": lambda: tk.inverse_rates,
                  "closure_newton": lambda: tw.closure_newton, "ik_newton": lambda: tk.ik_newton,
                  "map_newton": lambda: tk.map_newton, "map_newton_qr": lambda: tk.map_newton_qr,
                  "map_indices": lambda: tk.map_indices,
@@ -401,6 +405,8 @@ class Kernels:
         assert tuple(exprs) == outputs
         sym = {"q": tw.q, "v": tw.v, "qd": tw.qd, "qdd": tw.qdd, "target": tw.target, "y": tk.task_target,
                "scale": tk.scale, "design": tw.p}
+        if name == "inverse_rates":
+            sym.update(zip(("yd", "ydd"), tk.task_rates))
         inputs = self.inputs(name)
         if name in _DYNAMICS:
             sym.update(tau=self.dynamics.tau, friction=self.dynamics.friction)
@@ -569,6 +575,23 @@ class Kernels:
         outs, single = self._run("inverse_jacobian", q)
         return self._shaped("inverse_jacobian", outs, single)[0]
 
+    def inverse_rates(self, q: ArrayLike, yd: ArrayLike, ydd: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """The joint rates ``v`` (nv, or n x nv) and the actuated accelerations (na, or n x na) for task rates and
+        accelerations ``yd, ydd`` (task size, or n x task size) at closed configurations ``q``: the actuated entries
+        as :func:`pkm.inverse_velocities` and :func:`pkm.inverse_accelerations` give them, exactly
+        (:attr:`~pkm.core.twin.task.TaskTwin.inverse_rates`); the idle coordinates (one per idle motion) at zero
+        rate, where the core's carry no idle motion in the mass metric. Samples under the pivot floor are the
+        core's (then ``v`` in the core's convention)."""
+        (v, qdd, pivot), single = self._run("inverse_rates", q, yd, ydd, pivoted=True)
+        if not pivot.min() >= PIVOT_FLOOR:
+            from pkm.core.differential.velocity import inverse_accelerations, inverse_velocities
+
+            Q, YD, YDD = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, yd, ydd))
+            for k in np.flatnonzero(~(pivot[:, 0] >= PIVOT_FLOOR)):
+                v[k] = inverse_velocities(self.mech, Q[k], YD[k])
+                qdd[k] = inverse_accelerations(self.mech, Q[k], v[k], YDD[k])[self.mech.act_v]
+        return (v[0], qdd[0]) if single else (v, qdd)
+
     # ---------------------------------------------------------------- the actuator-space model
     def _model_run(self, name: str, *args: ArrayLike) -> tuple[list[np.ndarray], bool]:
         """:meth:`_run` of a kernel of the actuator-space model, the samples under the pivot floor recomputed by
@@ -689,6 +712,7 @@ KERNELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "accelerations": (("q", "v", "qdd"), ("a",)),
     "forward_jacobian": (("q",), ("J",)),
     "inverse_jacobian": (("q",), ("J",)),
+    "inverse_rates": (("q", "yd", "ydd"), ("v", "qdd", "pivot")),
     "closure_newton": (("q", "target"), ("q_next", "residual", "pivot")),
     "ik_newton": (("q", "y"), ("q_next", "residual", "pivot")),
     "map_newton": (("q", "y"), ("q_next", "step", "pivot")),

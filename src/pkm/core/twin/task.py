@@ -85,8 +85,8 @@ class TaskTwin:
 
     @functools.cached_property
     def ik_lu(self) -> PivotedLU:
-        """``[closure rows; task Jacobian]`` over every velocity coordinate but a floating base's, factored (pivots
-        fixed at the reference)."""
+        """``[closure rows; task Jacobian]`` over every velocity coordinate but a floating base's and the idle motions'
+        own (:attr:`_free_cols`), factored (pivots fixed at the reference)."""
         A = cs.vertcat(self.tw.closure_rows["jacobian"], self.task_jacobian)[:, self._free_cols]
         try:
             return PivotedLU(A, self.tw.at_reference(A))
@@ -97,8 +97,12 @@ class TaskTwin:
 
     @functools.cached_property
     def _free_cols(self) -> list[int]:
-        base = set(self.tw.mech.base_v.tolist())
-        return [i for i in range(self.tw.mech.nv) if i not in base]
+        """The velocity coordinates the inverse kinematics solves for: all but a floating base's and the idle
+        motions' own (:func:`~pkm.core.twin.dynamics.idle_columns`: held, as the exported C holds them)."""
+        from pkm.core.twin.dynamics import idle_columns
+
+        held = set(self.tw.mech.base_v.tolist()) | set(idle_columns(self.tw.mech))
+        return [i for i in range(self.tw.mech.nv) if i not in held]
 
     def _on_free(self, values: Expr) -> cs.SX:
         out = cs.SX.zeros(self.tw.mech.nv)
@@ -175,6 +179,28 @@ class TaskTwin:
             x = self.ik_lu.solve(e)
             cols.append(cs.vertcat(*[x[at[int(c)]] for c in self.tw.mech.act_v]))
         return cs.horzcat(*cols)
+
+    @functools.cached_property
+    def task_rates(self) -> tuple[cs.SX, cs.SX]:
+        """The symbols of task rates and accelerations (task size each), in :attr:`task_jacobian`'s coordinates."""
+        n = self.task_jacobian.shape[0]
+        return cs.SX.sym("yd", n), cs.SX.sym("ydd", n)
+
+    @functools.cached_property
+    def inverse_rates(self) -> dict:
+        """The joint rates and the actuated accelerations for task rates and accelerations :attr:`task_rates` at a
+        closed configuration :attr:`q`: ``v`` (nv), ``[W J; J_task] v = [0; yd]`` on :attr:`_free_cols` (the idle
+        coordinates held at zero rate; the actuated entries, which the idle motions do not move, are
+        :func:`pkm.inverse_velocities`'); ``qdd`` (na), the time derivative of ``qd = K(q) yd`` (``K`` the
+        :attr:`inverse_jacobian`): ``K ydd + (dK/dq T v) yd``, exact (``T`` the :attr:`Twin.tangent`; ``K``
+        does not change along an idle motion, so the rate held there changes nothing); ``pivot`` as in
+        :attr:`ik_newton`."""
+        yd, ydd = self.task_rates
+        n_closure = self.tw.closure_rows["jacobian"].shape[0]
+        v = self._on_free(self.ik_lu.solve(cs.vertcat(cs.DM.zeros(n_closure), yd)))
+        qd = self.inverse_jacobian @ yd
+        qdd = self.inverse_jacobian @ ydd + cs.jtimes(qd, self.tw.q, self.tw.tangent @ v)
+        return {"v": v, "qdd": qdd, "pivot": self.ik_lu.smallest_relative_pivot()}
 
 
 __all__ = ["TaskTwin"]
