@@ -1,0 +1,210 @@
+"""pkm.clearance against independent routes: MuJoCo's mj_geomDistance on the humanoid ankle's MJCF (capsules and a
+box), a segment-to-segment distance on the Gough-Stewart's legs (capsules), differences of the minimum along the
+closed loops for its gradient; and the refusals."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pickle
+import warnings
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import pkm
+from pkm.core.collision import CollisionModel, clearance_map
+from pkm.errors import InvalidInputError, NoCollisionGeometryError, PkmWarning, UnknownNameError
+from tests.fd import richardson
+
+EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
+ANKLE = EXAMPLES / "humanoid_ankle"
+
+
+@pytest.fixture(scope="module")
+def ankle():
+    return pkm.load(ANKLE / "ankle.closures.toml")
+
+
+@pytest.fixture(scope="module")
+def ankle_poses(ankle):
+    """20 closed configurations of the ankle over its motors' range (seeded: the same every run)."""
+    rng = np.random.default_rng(55)
+    out, q = [], ankle.q_reference
+    while len(out) < 20:
+        res = pkm.close_loops(ankle, rng.uniform(-0.5, 0.5, 2), q)
+        if res.converged:
+            out.append(res.q)
+    return out
+
+
+def test_ankle_pairs_equal_mujocos_geom_distance(ankle, ankle_poses):
+    mujoco = pytest.importorskip("mujoco")  # (the bench extra, installed by make test: the reference, not a dependency)
+    m = mujoco.MjModel.from_xml_path(str(ANKLE / "ankle.xml"))
+    d = mujoco.MjData(m)
+    body_geoms: dict[str, list[int]] = {}
+    for g in range(m.ngeom):
+        body_geoms.setdefault(m.body(m.geom_bodyid[g]).name, []).append(g)
+    worst, n = 0.0, 0
+    for q in ankle_poses:
+        for name, j in ankle.joints.items():
+            adr = m.jnt_qposadr[m.joint(name).id]
+            x = q[j.idx_q:j.idx_q + j.nq]
+            d.qpos[adr:adr + j.nq] = x if j.nq == 1 else np.r_[x[3], x[:3]]  # (quaternion: MuJoCo's w first)
+        mujoco.mj_kinematics(m, d)
+        c = pkm.clearance(ankle, q)
+        for (a, b), dist in c.pairs.items():
+            ref = min(mujoco.mj_geomDistance(m, d, ga, gb, 1.0, None) for ga in body_geoms[a] for gb in body_geoms[b])
+            worst, n = max(worst, abs(dist - ref)), n + 1
+    assert n == 20 * len(CollisionModel.of(ankle).pairs) and n >= 20 * 6
+    assert worst <= 1e-6, worst
+
+
+def segment_distance(p1, q1, p2, q2) -> float:
+    """The distance between segments [p1, q1] and [p2, q2]: the clamped closed form (Ericson, Real-Time Collision
+    Detection, 5.1.9), written here independently of coal."""
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a, e, f = d1 @ d1, d2 @ d2, d2 @ r
+    c, b = d1 @ r, d1 @ d2
+    denom = a * e - b * b
+    s = np.clip((b * f - c * e) / denom, 0.0, 1.0) if denom > 1e-14 * a * e else 0.0
+    t = (b * s + f) / e
+    if t < 0.0:
+        t, s = 0.0, np.clip(-c / a, 0.0, 1.0)
+    elif t > 1.0:
+        t, s = 1.0, np.clip((b - c) / a, 0.0, 1.0)
+    return float(np.linalg.norm(p1 + s * d1 - (p2 + t * d2)))
+
+
+@pytest.fixture(scope="module")
+def gs():
+    return pkm.load("gough_stewart")
+
+
+def pose(gs, x, y, z, roll, pitch, yaw):
+    quat = pin.Quaternion(pin.rpy.rpyToMatrix(roll, pitch, yaw)).coeffs()
+    res = pkm.solve_ik(gs, [x, y, z, *quat])
+    assert res.converged
+    return res.q
+
+
+@pytest.fixture(scope="module")
+def gs_poses(gs):
+    """Poses away from the reference: turned up to 1.3 rad about z (the legs lean towards one another), tilted,
+    shifted."""
+    return [pose(gs, *p) for p in [(0.05, 0.0, 0.7, 0.0, 0.0, 0.9), (0.0, 0.05, 0.65, 0.1, -0.05, 1.3),
+                                   (-0.05, 0.02, 0.75, -0.1, 0.1, -1.1), (0.1, -0.1, 0.6, 0.05, 0.15, 0.4)]]
+
+
+def leg_errors(mech, q) -> list[float]:
+    """|pkm's distance - (segment distance - radii)| for every leg-leg pair at ``q``."""
+    p = mech.params
+    half = p.leg_min / 2
+    pin.framesForwardKinematics(mech.model, mech.data, q)
+    segments = {}
+    for k in range(1, 7):
+        a = mech.data.oMi[mech.model.getJointId(f"u{k}")].translation
+        b = mech.data.oMf[mech.frame_id(f"ball_{k}")].translation
+        u = (b - a) / np.linalg.norm(b - a)
+        segments[f"cylinder_{k}"] = (a, a + half * u, p.cylinder_radius)
+        segments[f"rod_{k}"] = (b - half * u, b, p.rod_radius)
+    out = []
+    for (m1, m2), dist in pkm.clearance(mech, q).pairs.items():
+        if m1 in segments and m2 in segments:
+            (a1, b1, r1), (a2, b2, r2) = segments[m1], segments[m2]
+            out.append(abs(dist - (segment_distance(a1, b1, a2, b2) - r1 - r2)))
+    return out
+
+
+def test_gough_stewart_leg_distances_equal_segment_distances_minus_radii(gs, gs_poses):
+    errors = [e for q in gs_poses for e in leg_errors(gs, q)]
+    assert len(errors) == 4 * 60  # (every leg pair: 12 capsules, the 6 cylinder-rod pairs of a leg its neighbours)
+    assert max(errors) <= 1e-9, max(errors)
+
+
+def test_gradient_matches_differences_along_the_closed_loops(gs, gs_poses):
+    q = gs_poses[1]
+    c = pkm.clearance(gs, q)
+    qa = gs.actuated_q(q)
+
+    def minimum(x):
+        return pkm.clearance(gs, pkm.close_loops(gs, x, q, tol=1e-13).q).minimum
+
+    def diff(h):
+        return np.array([(minimum(qa + e) - minimum(qa - e)) / (2 * h) for e in h * np.eye(gs.na)])
+
+    fd = richardson(diff, 1e-4)
+    assert np.linalg.norm(fd) > 1e-2  # (the legs' distance does change with their lengths)
+    assert np.linalg.norm(c.gradient - fd) <= 1e-6 * np.linalg.norm(fd), (c.gradient, fd)
+
+
+def test_map_pickle_and_result(gs, gs_poses):
+    again = pickle.loads(pickle.dumps(gs))
+    minima = clearance_map(again, np.array(gs_poses))
+    expected = [pkm.clearance(gs, q) for q in gs_poses]
+    assert np.allclose(minima, [c.minimum for c in expected], rtol=0, atol=1e-12)
+    c = expected[0]
+    pa, pb = c.witness[c.closest]
+    assert abs(np.linalg.norm(pb - pa) - c.minimum) <= 1e-9 and not c.interferes
+    assert abs(c.normals[c.closest] @ (pb - pa) - c.minimum) <= 1e-9
+    assert c.excluded[("cylinder_1", "rod_1")].startswith("neighbours")
+    assert c.excluded[("platform_link", "rod_1")].startswith("closure")
+
+
+def test_interference_is_the_penetration_depth():
+    """Legs made thick enough to cross at a turned pose: the distance negative, the capsules' penetration depth
+    (the segments' distance minus the radii)."""
+    thick = pkm.build("gough_stewart", cylinder_radius=0.12, rod_radius=0.12)
+    q = pose(thick, 0.0, 0.0, 0.65, 0.0, 0.0, 1.3)
+    c = pkm.clearance(thick, q)
+    assert c.interferes and c.minimum < -1e-2 and c.pairs[c.closest] == c.minimum
+    assert sum(d < 0 for d in c.pairs.values()) >= 2
+    assert max(leg_errors(thick, q)) <= 1e-9
+
+
+def _without_collisions(urdf: str) -> str:
+    import re
+    return re.sub(r"<collision.*?</collision>", "", urdf, flags=re.DOTALL)
+
+
+def test_refusals(gs):
+    bare = pkm.from_strings(_without_collisions(gs.urdf), gs.spec)
+    with pytest.raises(NoCollisionGeometryError, match="no collision geometry.*<collision>") as info:
+        pkm.clearance(bare, bare.q_reference)
+    assert info.value.kind == "no_geometry"
+    with pytest.raises(InvalidInputError, match="not closed"):
+        pkm.clearance(gs, gs.with_actuated(gs.q_reference, gs.actuated_q(gs.q_reference) + 0.01))
+    with pytest.raises(InvalidInputError):
+        pkm.clearance(gs, np.zeros(3))
+    with pytest.raises(InvalidInputError):
+        clearance_map(gs, np.full((2, gs.nq), np.nan))
+
+
+def test_spec_pairs_round_trip_and_names(gs):
+    import dataclasses
+
+    from pkm.core.model.spec import ClosureSpec
+
+    spec = dataclasses.replace(gs.spec, collision_exclude=(("rod_1", "rod_2"),),
+                               collision_include=(("cylinder_1", "rod_1"),))
+    assert ClosureSpec.from_toml(spec.to_toml()) == spec
+    mech = pkm.from_strings(gs.urdf, spec)
+    cm = CollisionModel.of(mech)
+    assert ("rod_1", "rod_2") not in cm.pairs and cm.excluded[("rod_1", "rod_2")].startswith("spec")
+    assert ("cylinder_1", "rod_1") in cm.pairs
+    wrong = pkm.from_strings(gs.urdf, dataclasses.replace(gs.spec, collision_exclude=(("rod_1", "rod_9"),)))
+    with pytest.raises(UnknownNameError, match="rod_9"):
+        pkm.clearance(wrong, wrong.q_reference)
+
+
+def test_missing_mesh_is_a_note_and_a_warning(gs):
+    urdf = gs.urdf.replace('<link name="base"/>', '<link name="base"><collision><geometry><mesh filename='
+                                                  '"package://nowhere/base.stl"/></geometry></collision></link>')
+    mech = pkm.from_strings(urdf, gs.spec)
+    with pytest.warns(PkmWarning, match="'base'.*nowhere/base.stl"):
+        cm = CollisionModel.of(mech)
+    assert any("base.stl" in n for n in cm.notes) and "base" not in cm.bodies
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert pkm.clearance(mech, mech.q_reference).minimum > 0.0
