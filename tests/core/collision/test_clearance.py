@@ -4,10 +4,9 @@ closed loops for its gradient; and the refusals."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pickle
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -170,7 +169,7 @@ def _without_collisions(urdf: str) -> str:
 
 def test_refusals(gs):
     bare = pkm.from_strings(_without_collisions(gs.urdf), gs.spec)
-    with pytest.raises(NoCollisionGeometryError, match="no collision geometry.*<collision>") as info:
+    with pytest.raises(NoCollisionGeometryError, match=r"no collision geometry.*<collision>") as info:
         pkm.clearance(bare, bare.q_reference)
     assert info.value.kind == "no_geometry"
     with pytest.raises(InvalidInputError, match="not closed"):

@@ -160,7 +160,7 @@ def resolve_mesh(filename: str, folders: Iterable[Path]) -> Path | None:
 
 def shape(c: Collision, folders: Iterable[Path]) -> tuple[object | None, str]:
     """The coal shape of ``c`` and, for a mesh, the file read (``(None, reason)`` where it cannot be loaded)."""
-    import coal
+    import coal  # type: ignore[import-untyped]  # (Pinocchio's collision library: no type information)
 
     s = c.size
     if c.kind == "box":
@@ -258,7 +258,7 @@ class CollisionModel:
             return j
 
         parent = {j: owner(model.parents[j]) if j else None for j in carriers}
-        closures = {}
+        closures: dict[frozenset[int | None], str] = {}
         for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
             ends = {owner(model.frames[fa].parentJoint), owner(model.frames[fb].parentJoint)}
             if None not in ends and len(ends) == 2:
@@ -375,5 +375,5 @@ class CollisionModel:
         return self
 
 
-__all__ = ["CONTACT_RTOL", "Collision", "CollisionModel", "PRIMITIVES", "model_folders", "read_collisions",
-           "resolve_mesh", "shape", "strip_geometry"]
+__all__ = ["CONTACT_RTOL", "PRIMITIVES", "Collision", "CollisionModel", "model_folders", "read_collisions",
+           "resolve_mesh", "shape"]
