@@ -13,6 +13,7 @@ import pinocchio as pin
 import pytest
 
 import pkm
+from pkm.bench.clearance import leg_distances
 from pkm.core.collision import CollisionModel, clearance_map
 from pkm.errors import InvalidInputError, NoCollisionGeometryError, PkmWarning, UnknownNameError
 from tests.fd import richardson
@@ -60,22 +61,6 @@ def test_ankle_pairs_equal_mujocos_geom_distance(ankle, ankle_poses):
     assert worst <= 1e-6, worst
 
 
-def segment_distance(p1, q1, p2, q2) -> float:
-    """The distance between segments [p1, q1] and [p2, q2]: the clamped closed form (Ericson, Real-Time Collision
-    Detection, 5.1.9), written here independently of coal."""
-    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
-    a, e, f = d1 @ d1, d2 @ d2, d2 @ r
-    c, b = d1 @ r, d1 @ d2
-    denom = a * e - b * b
-    s = np.clip((b * f - c * e) / denom, 0.0, 1.0) if denom > 1e-14 * a * e else 0.0
-    t = (b * s + f) / e
-    if t < 0.0:
-        t, s = 0.0, np.clip(-c / a, 0.0, 1.0)
-    elif t > 1.0:
-        t, s = 1.0, np.clip((b - c) / a, 0.0, 1.0)
-    return float(np.linalg.norm(p1 + s * d1 - (p2 + t * d2)))
-
-
 @pytest.fixture(scope="module")
 def gs():
     return pkm.load("gough_stewart")
@@ -97,23 +82,11 @@ def gs_poses(gs):
 
 
 def leg_errors(mech, q) -> list[float]:
-    """|pkm's distance - (segment distance - radii)| for every leg-leg pair at ``q``."""
-    p = mech.params
-    half = p.leg_min / 2
-    pin.framesForwardKinematics(mech.model, mech.data, q)
-    segments = {}
-    for k in range(1, 7):
-        a = mech.data.oMi[mech.model.getJointId(f"u{k}")].translation
-        b = mech.data.oMf[mech.frame_id(f"ball_{k}")].translation
-        u = (b - a) / np.linalg.norm(b - a)
-        segments[f"cylinder_{k}"] = (a, a + half * u, p.cylinder_radius)
-        segments[f"rod_{k}"] = (b - half * u, b, p.rod_radius)
-    out = []
-    for (m1, m2), dist in pkm.clearance(mech, q).pairs.items():
-        if m1 in segments and m2 in segments:
-            (a1, b1, r1), (a2, b2, r2) = segments[m1], segments[m2]
-            out.append(abs(dist - (segment_distance(a1, b1, a2, b2) - r1 - r2)))
-    return out
+    """|pkm's distance - (segment distance - radii)| for every leg-leg pair at ``q`` (the closed form of the
+    benchmark's baseline, :mod:`pkm.bench.clearance`)."""
+    pairs = pkm.clearance(mech, q).pairs
+    legs = [p for p in pairs if "platform_link" not in p]
+    return [abs(pairs[p] - d) for p, d in zip(legs, leg_distances(mech, q, legs))]
 
 
 def test_gough_stewart_leg_distances_equal_segment_distances_minus_radii(gs, gs_poses):

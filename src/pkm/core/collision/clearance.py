@@ -118,25 +118,23 @@ def clearance(mech: Mechanism, q: ArrayLike) -> Clearance:
     cm = CollisionModel.of(mech).require()
     q = mech.check_q(q)
     check_closed(mech, q)
-    d = cm.distances(q)
+    d = cm.distances(q).tolist()
     results = cm.data.distanceResults
-    best = np.full(len(cm.pairs), math.inf)
-    at = np.zeros(len(cm.pairs), dtype=int)
-    for k, (p, dist) in enumerate(zip(cm.pair_of, d)):
-        if dist < best[p]:
-            best[p], at[p] = dist, k
+    n = len(cm.pairs)
+    best, at = [math.inf] * n, [0] * n
+    for k, p in enumerate(cm.pair_of.tolist()):
+        if d[k] < best[p]:
+            best[p], at[p] = d[k], k
     pairs, witness, normals = {}, {}, {}
     for p, pair in enumerate(cm.pairs):
-        k = int(at[p])
+        k = at[p]
         r = results[k]
-        first = cm.shapes[cm.geometry.collisionPairs[k].first].link == pair[0]
-        pa, pb = np.array(r.getNearestPoint1()), np.array(r.getNearestPoint2())
-        n = np.array(r.normal)
-        if not first:
-            pa, pb, n = pb, pa, -n
-        pairs[pair] = float(best[p])
+        pa, pb, normal = r.getNearestPoint1().copy(), r.getNearestPoint2().copy(), r.normal.copy()
+        if cm.flipped[k]:  # (the shape pair's first shape is on body_b)
+            pa, pb, normal = pb, pa, -normal
+        pairs[pair] = best[p]
         witness[pair] = (pa, pb)
-        normals[pair] = n
+        normals[pair] = normal
     p_min = int(np.argmin(best))
     return Clearance(pairs, witness, normals, float(best[p_min]), cm.pairs[p_min], q.copy(),
                      mech.limit_violations(q), dict(cm.excluded), mech)
@@ -162,9 +160,8 @@ def clearance_map(mech: Mechanism, nodes: ArrayLike) -> np.ndarray:
     model, data, gm, gd = mech.model, mech.data, cm.geometry, cm.data
     results = gd.distanceResults
     out = np.empty(len(Q))
-    for i, q in enumerate(Q):
-        pin.computeDistances(model, data, gm, gd, q)
-        out[i] = min(r.min_distance for r in results)
+    for i, q in enumerate(Q):  # (computeDistances returns the closest pair: its result alone is read)
+        out[i] = results[pin.computeDistances(model, data, gm, gd, q)].min_distance
     return out
 
 

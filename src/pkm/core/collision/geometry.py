@@ -235,6 +235,7 @@ class CollisionModel:
         self.excluded: dict[tuple[str, str], str] = {}
         self.pairs: tuple[tuple[str, str], ...] = ()
         self.pair_of = np.zeros(0, dtype=int)
+        self.flipped = np.zeros(0, dtype=bool)
         if len(self.bodies) >= 2:
             self._choose_pairs()
 
@@ -319,7 +320,7 @@ class CollisionModel:
         index = {p: k for k, p in enumerate(pairs)}
         gm = self.geometry
         gm.removeAllCollisionPairs()
-        pair_of = []
+        pair_of, flipped = [], []
         for i in range(gm.ngeoms):
             for j in range(i + 1, gm.ngeoms):
                 p = self._ordered(self.shapes[i].link, self.shapes[j].link) \
@@ -327,7 +328,10 @@ class CollisionModel:
                 if p in index:
                     gm.addCollisionPair(pin.CollisionPair(i, j))
                     pair_of.append(index[p])
+                    flipped.append(self.shapes[i].link != p[0])
         self.pair_of = np.array(pair_of, dtype=int)
+        #: For each collision pair, whether its first shape is on the second body of its pair in :attr:`pairs`.
+        self.flipped = np.array(flipped, dtype=bool)
         self._local = threading.local()  # (the data follow the pairs)
 
     # ------------------------------------------------------------------ evaluation
