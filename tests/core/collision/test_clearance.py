@@ -180,3 +180,12 @@ def test_missing_mesh_is_a_note_and_a_warning(gs):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert pkm.clearance(mech, mech.q_reference).minimum > 0.0
+
+
+def test_scale_free(gs, gs_poses):
+    """The same Gough-Stewart at a tenth of the size: the same pairs checked, every distance a tenth."""
+    small = pkm.scaled_mechanism(gs, 0.1)
+    q = pkm.scale_configuration(gs, gs_poses[0], 0.1)
+    big, tenth = pkm.clearance(gs, gs_poses[0]), pkm.clearance(small, q)
+    assert tenth.pairs.keys() == big.pairs.keys() and tenth.excluded.keys() == big.excluded.keys()
+    assert max(abs(tenth.pairs[p] - 0.1 * d) for p, d in big.pairs.items()) <= 1e-9 * small.characteristic_length

@@ -4,7 +4,8 @@ closest pair, the witness points, and the derivative of the smallest distance wi
 coordinates along the closed loops.
 
 **Distances.** coal (Pinocchio's collision library) on the convex shapes, signed: GJK where the shapes are apart,
-EPA where they penetrate (the penetration depth), to :data:`~pkm.core.collision.geometry.GJK_TOLERANCE`; a pair of
+EPA where they penetrate (the penetration depth), to :data:`~pkm.core.collision.geometry.GJK_RTOL` of the
+characteristic length; a pair of
 bodies is as close as its closest pair of shapes. Checked against MuJoCo's ``mj_geomDistance`` on the humanoid ankle's
 capsules and box, and against a segment-to-segment distance on the Gough-Stewart's legs (tests).
 
@@ -112,7 +113,7 @@ def clearance(mech: Mechanism, q: ArrayLike) -> Clearance:
         >>> gs = pkm.load("gough_stewart")
         >>> c = pkm.clearance(gs, gs.q_reference)
         >>> c.closest, round(c.minimum, 4), c.interferes
-        (('cylinder_2', 'cylinder_3'), 0.1453, False)
+        (('rod_2', 'rod_3'), 0.1652, False)
     """
     mech = check_mechanism(mech)
     cm = CollisionModel.of(mech).require()
@@ -148,6 +149,15 @@ def clearance_map(mech: Mechanism, nodes: ArrayLike) -> np.ndarray:
     Raises:
         NoCollisionGeometryError: as :func:`clearance`.
         InvalidInputError: ``nodes`` not N x nq finite numbers.
+
+    Examples:
+        >>> import numpy as np
+        >>> import pkm
+        >>> from pkm.core.collision import clearance_map
+        >>> gs = pkm.load("gough_stewart")
+        >>> nodes = [pkm.close_loops(gs, gs.actuated_q(gs.q_reference) + dq).q for dq in (0.0, 0.05)]
+        >>> np.round(clearance_map(gs, nodes), 4)
+        array([0.1652, 0.1652])
     """
     mech = check_mechanism(mech)
     cm = CollisionModel.of(mech).require()

@@ -55,8 +55,9 @@ from pkm.errors import NoCollisionGeometryError, PkmWarning, SpecError, UnknownN
 #: A pair of bodies whose distance at the reference configuration is at most this times the characteristic length
 #: is in contact by design and not checked (scale-free: 0.1 mm on a robot of 1 m, 5 µm on one of 5 cm).
 CONTACT_RTOL = 1e-4
-#: coal's GJK and EPA tolerances (relative): distances to about 1e-9 of the shapes' size.
-GJK_TOLERANCE = 1e-10
+#: coal's GJK and EPA tolerances, the precision of a distance (coal's are in metres), are this times the
+#: characteristic length (scale-free): distances to about 1e-10 of the mechanism's size.
+GJK_RTOL = 1e-10
 #: The primitive shapes ``<collision>`` elements state and their attributes.
 PRIMITIVES: dict[str, tuple[tuple[str, int], ...]] = {
     "box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)), "capsule": (("radius", 1), ("length", 1)),
@@ -337,15 +338,17 @@ class CollisionModel:
     # ------------------------------------------------------------------ evaluation
     @property
     def data(self) -> pin.GeometryData:
-        """This thread's ``GeometryData``: signed distances (negative: penetration), coal's tolerances tight."""
+        """This thread's ``GeometryData``: signed distances (negative: penetration), to :data:`GJK_RTOL` of the
+        characteristic length."""
         try:
             return self._local.data
         except AttributeError:
             gd = self.geometry.createData()
+            tol = GJK_RTOL * self.mech.characteristic_length
             for r in gd.distanceRequests:
                 r.enable_signed_distance = True
-                r.gjk_tolerance = GJK_TOLERANCE
-                r.epa_tolerance = GJK_TOLERANCE
+                r.gjk_tolerance = tol
+                r.epa_tolerance = tol
             self._local.data = gd
             return gd
 
