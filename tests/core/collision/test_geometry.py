@@ -3,6 +3,9 @@ MJCF's geoms and their contype, URDF meshes), attached where the files put it; P
 
 from __future__ import annotations
 
+import warnings
+from pathlib import Path
+
 import numpy as np
 import pinocchio as pin
 
@@ -87,6 +90,32 @@ def test_a_mesh_is_read_as_its_convex_hull(tmp_path):
     as_box = gs.urdf.replace(disc, '<collision><geometry><box size="0.4 0.4 0.1"/></geometry></collision>')
     as_mesh = gs.urdf.replace(disc, f'<collision><geometry><mesh filename="{path}"/></geometry></collision>')
     q = gs.q_reference
-    box, mesh = (pkm.clearance(pkm.from_strings(u, gs.spec), q).pairs for u in (as_box, as_mesh))
+    meshed = pkm.from_strings(as_mesh, gs.spec)
+    box, mesh = pkm.clearance(pkm.from_strings(as_box, gs.spec), q).pairs, pkm.clearance(meshed, q).pairs
     assert box.keys() == mesh.keys()
     assert max(abs(box[k] - mesh[k]) for k in box) <= 1e-6  # (an STL's vertices are single precision)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # (the MJCF writer's other omissions)
+        pkm.save(meshed, tmp_path / "meshed.xml")
+    back = pkm.load(tmp_path / "meshed.xml")  # (the mesh an <asset><mesh>, read back as the same hull)
+    assert np.allclose(sorted(pkm.clearance(back, back.q_reference).pairs.values()), sorted(mesh.values()),
+                       rtol=0, atol=1e-9)
+
+
+def test_the_mjcf_and_sdf_writers_carry_the_geometry(tmp_path):
+    """The Gough-Stewart written as MJCF and as SDFormat and read back: the same distances (the MJCF bodies named
+    after their joints); what SDFormat cannot hold (a shape on the world: the ankle's shank) said."""
+    from pkm.core.formats.to_sdf import sdf_from_mechanism
+
+    gs = pkm.load("gough_stewart")
+    expected = sorted(pkm.clearance(gs, gs.q_reference).pairs.values())
+    for to, suffix in (("mjcf", ".xml"), ("sdf", ".toml")):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # (the writers' other omissions: the task, the universal joints)
+            pkm.save(gs, tmp_path / to, to=to)
+            back = pkm.load(next(f for f in (tmp_path / to).iterdir() if f.suffix == suffix))
+        got = sorted(pkm.clearance(back, back.q_reference).pairs.values())
+        assert len(got) == len(expected) and np.allclose(got, expected, rtol=0, atol=1e-10), to
+    ankle = pkm.load(Path(__file__).resolve().parents[3] / "examples" / "humanoid_ankle" / "ankle.closures.toml")
+    _, dropped = sdf_from_mechanism(ankle)
+    assert any("collision geometry of shank (on the world)" in d for d in dropped)

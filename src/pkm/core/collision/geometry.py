@@ -129,6 +129,21 @@ def read_collisions(urdf: str, source: str = "<urdf>") -> list[Collision]:
     return out
 
 
+def placed_collisions(mech: Mechanism) -> tuple[list[tuple[Collision, int, pin.SE3]], list[str]]:
+    """Each ``<collision>`` of ``mech``'s URDF text with the Pinocchio joint that moves it and its placement in that
+    joint's frame (the link's frame times its origin); and the links the model has no body of (their geometry left
+    out). What :class:`CollisionModel` builds on, and the writers of other formats write."""
+    model = mech.model
+    out, missing = [], []
+    for c in read_collisions(mech.urdf, mech.source) if mech.urdf is not None else []:
+        if not model.existFrame(c.link, pin.FrameType.BODY):
+            missing.append(c.link)
+            continue
+        f = model.frames[model.getFrameId(c.link, pin.FrameType.BODY)]
+        out.append((c, int(f.parentJoint), f.placement * c.origin))
+    return out, list(dict.fromkeys(missing))
+
+
 def model_folders(mech: Mechanism) -> list[Path]:
     """The folders a mechanism's relative mesh paths are read from: its model file's (and the spec's) folder."""
     source = mech.source
@@ -208,16 +223,13 @@ class CollisionModel:
         self.mech = mech
         self._local = threading.local()
         model = mech.model
-        notes: list[str] = []
-        read = read_collisions(mech.urdf, mech.source) if mech.urdf is not None else []
+        placed, missing = placed_collisions(mech)
+        notes = [f"link {link!r}: its collision geometry is left out (no body of the model)" for link in missing]
         folders = model_folders(mech)
         gm = pin.GeometryModel()
         shapes: list[Collision] = []
         joint_of: dict[str, int] = {}
-        for c in read:
-            if not model.existFrame(c.link, pin.FrameType.BODY):
-                notes.append(f"link {c.link!r}: its collision geometry is left out (no body of the model)")
-                continue
+        for c, joint, placement in placed:
             geom, what = shape(c, folders)
             if geom is None:
                 said = f"link {c.link!r}: {what}; its collision geometry is left out"
@@ -225,10 +237,9 @@ class CollisionModel:
                 warnings.warn(f"{mech.source}: {said}", PkmWarning, stacklevel=3)
                 continue
             fid = model.getFrameId(c.link, pin.FrameType.BODY)
-            f = model.frames[fid]
-            gm.addGeometryObject(pin.GeometryObject(c.name, f.parentJoint, fid, f.placement * c.origin, geom))
+            gm.addGeometryObject(pin.GeometryObject(c.name, joint, fid, placement, geom))
             shapes.append(c)
-            joint_of[c.link] = f.parentJoint
+            joint_of[c.link] = joint
         self.geometry = gm
         self.shapes: tuple[Collision, ...] = tuple(shapes)
         self.bodies: tuple[str, ...] = tuple(dict.fromkeys(c.link for c in shapes))
@@ -383,5 +394,5 @@ class CollisionModel:
         return self
 
 
-__all__ = ["CONTACT_RTOL", "PRIMITIVES", "Collision", "CollisionModel", "model_folders", "read_collisions",
-           "resolve_mesh", "shape"]
+__all__ = ["CONTACT_RTOL", "PRIMITIVES", "Collision", "CollisionModel", "model_folders", "placed_collisions",
+           "read_collisions", "resolve_mesh", "shape"]
