@@ -16,6 +16,8 @@ from pkm.core.formats.sdf import read_sdf
 from pkm.core.model.urdf import load_model
 from tests.core.formats.test_sdf import fourbar, mechanism
 
+ANKLE = Path(__file__).resolve().parents[3] / "examples" / "humanoid_ankle"
+
 
 def point_segment(p, a, b) -> float:
     t = np.clip((p - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
@@ -119,3 +121,26 @@ def test_the_mjcf_and_sdf_writers_carry_the_geometry(tmp_path):
     ankle = pkm.load(Path(__file__).resolve().parents[3] / "examples" / "humanoid_ankle" / "ankle.closures.toml")
     _, dropped = sdf_from_mechanism(ankle)
     assert any("collision geometry of shank (on the world)" in d for d in dropped)
+
+
+def test_mujocos_contype_and_conaffinity_filter_the_pairs(tmp_path):
+    """The ankle with contacts on and the right rod's bit masks apart from the others' (MuJoCo never collides them):
+    its pairs are filtered out, said so; written as MJCF and read back, the same filter."""
+    folder = tmp_path / "ankle"
+    folder.mkdir()
+    text = (ANKLE / "ankle.xml").read_text().replace('<geom contype="0" conaffinity="0"/>', "<geom/>").replace(
+        '<geom type="capsule" fromto="0 0 0 0 0 -0.19" size="0.004"/>',
+        '<geom type="capsule" fromto="0 0 0 0 0 -0.19" size="0.004" contype="2" conaffinity="2"/>')
+    (folder / "ankle.xml").write_text(text)
+    (folder / "ankle.closures.toml").write_text((ANKLE / "ankle.closures.toml").read_text())
+    mech = pkm.load(folder / "ankle.closures.toml")
+    cm = CollisionModel.of(mech)
+    filtered = {p for p, r in cm.excluded.items() if r.startswith("filtered")}
+    assert filtered and all("rod_right" in p for p in filtered) and not any("rod_right" in p for p in cm.pairs)
+    assert ("rod_left", "shank") in cm.pairs
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        pkm.save(mech, tmp_path / "again.xml")
+    back = CollisionModel.of(pkm.load(tmp_path / "again.xml"))
+    assert len(back.pairs) == len(cm.pairs) and sum(r.startswith("filtered") for r in back.excluded.values()) \
+        == len(filtered)

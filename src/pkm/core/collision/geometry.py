@@ -28,6 +28,9 @@ joints is a frame of the joint Pinocchio merges it into) times the ``<collision>
 * ``"contact at the reference"``: the pairs whose distance at :attr:`~pkm.core.Mechanism.q_reference` is at most
   :data:`CONTACT_RTOL` times the mechanism's characteristic length (touching or penetrating by design: a pin in its
   bore);
+* ``"filtered"``: bodies none of whose shapes may collide by the file's ``contype`` and ``conaffinity`` (an MJCF
+  file's bit masks, MuJoCo's rule: ``contype`` of one and ``conaffinity`` of the other share a bit; written as
+  attributes of ``<collision>``; a pair of bodies checked compares only the shapes that may collide);
 * ``"spec"``: the closure spec's ``[collision] exclude = [["body_a", "body_b"], ...]``.
 
 A spec's ``[collision] include = [...]`` checks a pair the rules above would leave out (not one it excludes).
@@ -77,6 +80,9 @@ class Collision:
             ellipsoid: its three radii); a mesh's scale.
         origin: Its placement in the link's frame.
         filename: A mesh's file name as the model states it (else None).
+        contype: MuJoCo's ``contype`` bit mask (an MJCF geom's; pkm's ``<collision contype>`` attribute), 1 by default.
+        conaffinity: MuJoCo's ``conaffinity``: two shapes may collide where ``contype`` of either and ``conaffinity``
+            of the other share a bit (MuJoCo's rule), 1 by default.
     """
 
     link: str
@@ -85,6 +91,12 @@ class Collision:
     size: tuple[float, ...]
     origin: pin.SE3
     filename: str | None = None
+    contype: int = 1
+    conaffinity: int = 1
+
+    def may_collide(self, other: Collision) -> bool:
+        """MuJoCo's filter: ``contype`` of one and ``conaffinity`` of the other share a bit, either way."""
+        return bool(self.contype & other.conaffinity or other.contype & self.conaffinity)
 
 
 def read_collisions(urdf: str, source: str = "<urdf>") -> list[Collision]:
@@ -108,12 +120,20 @@ def read_collisions(urdf: str, source: str = "<urdf>") -> list[Collision]:
                 raise SpecError(source, f"{where}: <geometry> must hold one shape, it holds {len(shapes)}")
             el = shapes[0]
             origin = pin.SE3(pin.rpy.rpyToMatrix(*rpy), np.array(xyz))
+            mask: dict[str, int] = {}
+            for key in ("contype", "conaffinity"):
+                if cel.get(key) is not None:
+                    v = floats(cel.get(key), 1, f"{where} {key}", source)[0]
+                    if v != int(v) or v < 0:
+                        raise SpecError(source, f"{where}: {key} must be a non-negative integer (a bit mask)")
+                    mask[key] = int(v)
             if el.tag == "mesh":
                 filename = el.get("filename")
                 if not filename:
                     raise SpecError(source, f"{where}: <mesh> without a filename")
                 scale = floats(el.get("scale", "1 1 1"), 3, f"{where} mesh scale", source)
-                out.append(Collision(link, f"{link}/{k}", "mesh", tuple(scale), origin, filename))
+                out.append(Collision(link, f"{link}/{k}", "mesh", tuple(scale), origin, filename,
+                                     mask.get("contype", 1), mask.get("conaffinity", 1)))
                 continue
             if el.tag not in PRIMITIVES:
                 raise SpecError(source, f"{where}: <{el.tag}> is not a shape pkm reads ({', '.join(PRIMITIVES)}, "
@@ -125,7 +145,8 @@ def read_collisions(urdf: str, source: str = "<urdf>") -> list[Collision]:
                 size += floats(el.get(attr), n, f"{where} {el.tag} {attr}", source)
             if not all(v > 0.0 for v in size):
                 raise SpecError(source, f"{where}: <{el.tag}> sizes must be positive [m], got {size}")
-            out.append(Collision(link, f"{link}/{k}", el.tag, tuple(size), origin))
+            out.append(Collision(link, f"{link}/{k}", el.tag, tuple(size), origin, None, mask.get("contype", 1),
+                                 mask.get("conaffinity", 1)))
     return out
 
 
@@ -288,6 +309,9 @@ class CollisionModel:
                     out[(a, b)] = f"neighbours: joint {model.names[child]!r} joins them"
                 elif frozenset((ja, jb)) in closures:
                     out[(a, b)] = f"closure: the loop closure {closures[frozenset((ja, jb))]!r} joins them"
+                elif not any(sa.may_collide(sb) for sa in self.shapes if sa.link == a
+                             for sb in self.shapes if sb.link == b):
+                    out[(a, b)] = "filtered: the file's contype and conaffinity let none of their shapes collide"
         return out
 
     def _named(self, pairs: Iterable[Iterable[str]], key: str) -> list[tuple[str, str]]:
@@ -316,7 +340,7 @@ class CollisionModel:
         excluded = {p: r for p, r in self._structural().items() if p not in include}
         excluded.update({p: "spec: the closure spec's [collision] exclude" for p in exclude})
         candidates = [(a, b) for i, a in enumerate(self.bodies) for b in self.bodies[i + 1:] if (a, b) not in excluded]
-        self._set_pairs(candidates)
+        self._set_pairs(candidates, include)
         if candidates:
             L = self.mech.characteristic_length
             d = self.body_distances(self.mech.q_reference)
@@ -326,9 +350,12 @@ class CollisionModel:
                                         f"the size {L:.3g} m")
         self.excluded = {p: excluded[p] for i, a in enumerate(self.bodies) for b in self.bodies[i + 1:]
                          if (p := (a, b)) in excluded}
-        self._set_pairs([p for p in candidates if p not in excluded])
+        self._set_pairs([p for p in candidates if p not in excluded], include)
 
-    def _set_pairs(self, pairs: list[tuple[str, str]]) -> None:
+    def _set_pairs(self, pairs: list[tuple[str, str]], include: set[tuple[str, str]] | None = None) -> None:
+        """Check ``pairs``: every pair of their shapes that may collide (MuJoCo's filter), all of those ``include``
+        names."""
+        include = include or set()
         self.pairs = tuple(pairs)
         index = {p: k for k, p in enumerate(pairs)}
         gm = self.geometry
@@ -338,7 +365,7 @@ class CollisionModel:
             for j in range(i + 1, gm.ngeoms):
                 p = self._ordered(self.shapes[i].link, self.shapes[j].link) \
                     if self.shapes[i].link != self.shapes[j].link else None
-                if p in index:
+                if p in index and (p in include or self.shapes[i].may_collide(self.shapes[j])):
                     gm.addCollisionPair(pin.CollisionPair(i, j))
                     pair_of.append(index[p])
                     flipped.append(self.shapes[i].link != p[0])

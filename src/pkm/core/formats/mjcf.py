@@ -624,12 +624,17 @@ def _geoms(root: etree._Element, world: etree._Element, defaults: _Defaults, deg
     half-extents, a capsule's and a cylinder's its radius and half-length), a mesh its ``<asset><mesh>``'s file
     (``<compiler meshdir>``, relative to the file's folder) and ``scale``. Geoms with ``contype`` and ``conaffinity``
     both 0 never collide in MuJoCo: left out (a note), unless every geom of the file is so (the file turns contacts
-    off for its simulation: its geoms are still its bodies' shapes, read so, a note says). Planes, height fields and
+    off for its simulation: its geoms are still its bodies' shapes, read so, a note says). The others' ``contype`` and
+    ``conaffinity`` (other than 1) are written on their ``<collision>`` (pkm's attributes): the geometry checks a pair
+    of shapes only where MuJoCo would collide them (:mod:`pkm.core.collision.geometry`). Planes, height fields and
     SDF geoms are left out (a note)."""
     geoms = [g for g in world.iter("geom") if g.getparent().tag in ("body", "worldbody")]
     if not geoms:
         return {}
-    off = [g for g in geoms if defaults.get(g, "contype", "1") == "0" and defaults.get(g, "conaffinity", "1") == "0"]
+    masks = {g: tuple(int(_floats(defaults.get(g, key, "1"), 1, f"<geom> {key}", source)[0])
+                      for key in ("contype", "conaffinity")) for g in geoms}
+    off = [g for g in geoms if masks[g] == (0, 0)]
+    filtered = len(off) < len(geoms)  # (all off: the shapes read without MuJoCo's filter)
     if off and len(off) == len(geoms):
         notes.append("every geom has contype and conaffinity 0 (contacts off in MuJoCo): their shapes are read as "
                      "the bodies' collision geometry")
@@ -669,6 +674,9 @@ def _geoms(root: etree._Element, world: etree._Element, defaults: _Defaults, deg
         if len(size) < need or not all(v > 0.0 for v in size[:need]):
             raise SpecError(source, f"{what}: a {kind} needs {need} positive size values, got {size}")
         col = etree.Element("collision", name=str(g.get("name") or f"geom_{g.sourceline}"))
+        if filtered and masks[g] != (1, 1):  # (pkm's attributes: MuJoCo's filter of the pairs, read by the geometry)
+            col.set("contype", str(masks[g][0]))
+            col.set("conaffinity", str(masks[g][1]))
         etree.SubElement(col, "origin", xyz=num(M.translation), rpy=num(pin.rpy.matrixToRpy(M.rotation)))
         geometry = etree.SubElement(col, "geometry")
         if kind == "sphere":

@@ -254,6 +254,9 @@ def _geoms(mech: Mechanism, bodies: list[etree._Element]) -> etree._Element:
             s = np.array(c.size)  # (MuJoCo's half-sizes: a box's half-extents, a capsule's radius and half-length)
             size = s / 2 if c.kind == "box" else [s[0], s[1] / 2] if c.kind in ("cylinder", "capsule") else s
             geom = etree.SubElement(bodies[j], "geom", name=name, type=c.kind, size=_num(size))
+        if (c.contype, c.conaffinity) != (1, 1):  # (MuJoCo's filter of the pairs, as read)
+            geom.set("contype", str(c.contype))
+            geom.set("conaffinity", str(c.conaffinity))
         _pose(geom, M)
     return assets
 
@@ -368,8 +371,8 @@ def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
 
 def geometry_omissions(mech: Mechanism, world: bool = False) -> list[str]:
     """The collision geometry a writer of another format than URDF leaves out, one line each: meshes not found (and,
-    ``world``, shapes on the world, which SDFormat gives no link); the other shapes are moved onto the body of the
-    joint that moves their link (named after it when read back)."""
+    ``world``, for SDFormat: shapes on the world, which it gives no link, and MJCF's contype and conaffinity); the
+    other shapes are moved onto the body of the joint that moves their link (named after it when read back)."""
     from pkm.core.collision.geometry import model_folders, placed_collisions, resolve_mesh
 
     placed, missing = placed_collisions(mech)
@@ -378,7 +381,11 @@ def geometry_omissions(mech: Mechanism, world: bool = False) -> list[str]:
             if c.kind == "mesh" and resolve_mesh(str(c.filename), folders) is None]
     lost += [f"{c.link} (on the world)" for c, j, _ in placed if world and j == 0]
     lost += [f"{link} (no body of the model)" for link in missing]
-    return [f"collision geometry of {', '.join(dict.fromkeys(lost))}"] if lost else []
+    out = [f"collision geometry of {', '.join(dict.fromkeys(lost))}"] if lost else []
+    if world and any((c.contype, c.conaffinity) != (1, 1) for c, _, _ in placed):  # (SDFormat's bitmasks differ)
+        out.append("the collision shapes' contype and conaffinity (MJCF's filter of the pairs checked): read back, "
+                   "every pair of shapes is checked")
+    return out
 
 
 def mimic_leader(model: pin.Model, j: int) -> int:
