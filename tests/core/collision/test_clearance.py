@@ -151,6 +151,11 @@ def test_refusals(gs):
         pkm.clearance(gs, np.zeros(3))
     with pytest.raises(InvalidInputError):
         clearance_map(gs, np.full((2, gs.nq), np.nan))
+    stretched = np.array([gs.q_reference, gs.q_reference])
+    at = gs.joints["platform"].idx_q + 3
+    stretched[1, at:at + 4] *= 2.0
+    with pytest.raises(InvalidInputError, match="node 1: the quaternion of joint 'platform'"):
+        clearance_map(gs, stretched)
 
 
 def test_spec_pairs_round_trip_and_names(gs):

@@ -33,6 +33,7 @@ from pkm.core.collision.geometry import CollisionModel
 from pkm.core.kinematics.constraints import check_closed
 from pkm.core.model.mechanism import LimitViolation, Mechanism, check_mechanism
 from pkm.errors import InvalidInputError
+from pkm.validation import bounded
 
 
 @dataclass(frozen=True)
@@ -143,12 +144,14 @@ def clearance(mech: Mechanism, q: ArrayLike) -> Clearance:
 
 def clearance_map(mech: Mechanism, nodes: ArrayLike) -> np.ndarray:
     """The smallest signed distance [m] between checked bodies (:func:`clearance`'s ``minimum``) at each of
-    ``nodes`` (N x nq configurations, evaluated as given: their loops are not checked here), for interference
-    maps: negative where bodies interpenetrate.
+    ``nodes`` (N x nq configurations, evaluated as given: their loops are not checked here; their coordinates
+    bounded and their quaternions of unit norm, as :meth:`~pkm.core.Mechanism.check_q`), for interference maps:
+    negative where bodies interpenetrate.
 
     Raises:
         NoCollisionGeometryError: as :func:`clearance`.
-        InvalidInputError: ``nodes`` not N x nq finite numbers.
+        InvalidInputError: ``nodes`` not N x nq finite numbers, a coordinate beyond 1e6, a quaternion not of unit
+            norm.
 
     Examples:
         >>> import numpy as np
@@ -167,6 +170,13 @@ def clearance_map(mech: Mechanism, nodes: ArrayLike) -> np.ndarray:
         raise InvalidInputError("nodes", f"expected N x {mech.nq} configurations", nodes) from None
     if Q.ndim != 2 or Q.shape[1] != mech.nq or not np.all(np.isfinite(Q)):
         raise InvalidInputError("nodes", f"expected N x {mech.nq} finite configurations, got shape {Q.shape}", nodes)
+    bounded(Q, "nodes", nodes)
+    for name, start in cm.quaternions if len(Q) else ():  # (as Mechanism.check_q, for every node at once)
+        norm = np.linalg.norm(Q[:, start:start + 4], axis=1)
+        k = int(np.argmax(np.abs(norm - 1.0)))
+        if abs(norm[k] - 1.0) > 1e-6:
+            raise InvalidInputError("nodes", f"node {k}: the quaternion of joint {name!r} has norm {norm[k]:.6g}, "
+                                             "expected 1", nodes)
     model, data, gm, gd = mech.model, mech.data, cm.geometry, cm.data
     results = gd.distanceResults
     out = np.empty(len(Q))

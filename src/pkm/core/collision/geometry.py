@@ -270,6 +270,10 @@ class CollisionModel:
         self.pairs: tuple[tuple[str, str], ...] = ()
         self.pair_of = np.zeros(0, dtype=int)
         self.flipped = np.zeros(0, dtype=bool)
+        #: ``(joint, start in q)`` of each quaternion of ``q`` (free-flyers', spherical joints'): the map's checks.
+        self.quaternions = tuple((j.name, j.idx_q + 3 if j.kind == "JointModelFreeFlyer" else j.idx_q)
+                                 for j in mech.joints.values() if j.kind in ("JointModelFreeFlyer",
+                                                                             "JointModelSpherical"))
         if len(self.bodies) >= 2:
             self._choose_pairs()
 
