@@ -95,22 +95,6 @@ def test_gough_stewart_leg_distances_equal_segment_distances_minus_radii(gs, gs_
     assert max(errors) <= 1e-9, max(errors)
 
 
-def test_gradient_matches_differences_along_the_closed_loops(gs, gs_poses):
-    q = gs_poses[1]
-    c = pkm.clearance(gs, q)
-    qa = gs.actuated_q(q)
-
-    def minimum(x):
-        return pkm.clearance(gs, pkm.close_loops(gs, x, q, tol=1e-13).q).minimum
-
-    def diff(h):
-        return np.array([(minimum(qa + e) - minimum(qa - e)) / (2 * h) for e in h * np.eye(gs.na)])
-
-    fd = richardson(diff, 1e-4)
-    assert np.linalg.norm(fd) > 1e-2  # (the legs' distance does change with their lengths)
-    assert np.linalg.norm(c.gradient - fd) <= 1e-6 * np.linalg.norm(fd), (c.gradient, fd)
-
-
 def test_map_pickle_and_result(gs, gs_poses):
     again = pickle.loads(pickle.dumps(gs))
     minima = clearance_map(again, np.array(gs_poses))
@@ -124,15 +108,40 @@ def test_map_pickle_and_result(gs, gs_poses):
     assert c.excluded[("platform_link", "rod_1")].startswith("closure")
 
 
+def fd_gradient(mech, q, h: float = 1e-4) -> np.ndarray:
+    """d minimum / d q_a by Richardson-extrapolated central differences along the closed loops."""
+    qa = mech.actuated_q(q)
+
+    def minimum(x):
+        return pkm.clearance(mech, pkm.close_loops(mech, x, q, tol=1e-13).q).minimum
+
+    def diff(hh):
+        return np.array([(minimum(qa + e) - minimum(qa - e)) / (2 * hh) for e in hh * np.eye(mech.na)])
+
+    return richardson(diff, h)
+
+
+def test_gradient_matches_differences_along_the_closed_loops(gs, gs_poses, ankle):
+    """The Gough-Stewart (a free platform, universal joints) and the ankle (ball joints: quaternions), each at a
+    configuration where one pair is the closest (where two tie, as at the ankle's symmetric poses, the minimum has a
+    kink)."""
+    for mech, q in ((gs, gs_poses[1]), (ankle, pkm.close_loops(ankle, [0.3, -0.2], ankle.q_reference).q)):
+        fd = fd_gradient(mech, q)
+        assert np.linalg.norm(fd) > 1e-2  # (the distance does change with the actuators)
+        assert np.linalg.norm(pkm.clearance(mech, q).gradient - fd) <= 1e-6 * np.linalg.norm(fd), mech.name
+
+
 def test_interference_is_the_penetration_depth():
-    """Legs made thick enough to cross at a turned pose: the distance negative, the capsules' penetration depth
-    (the segments' distance minus the radii)."""
+    """Legs made thick enough to cross at a turned pose (off centre: no two pairs tie): the distance negative, the
+    capsules' penetration depth (the segments' distance minus the radii), its gradient the differences'."""
     thick = pkm.build("gough_stewart", cylinder_radius=0.12, rod_radius=0.12)
-    q = pose(thick, 0.0, 0.0, 0.65, 0.0, 0.0, 1.3)
+    q = pose(thick, 0.03, 0.02, 0.65, 0.02, 0.0, 1.3)
     c = pkm.clearance(thick, q)
     assert c.interferes and c.minimum < -1e-2 and c.pairs[c.closest] == c.minimum
     assert sum(d < 0 for d in c.pairs.values()) >= 2
     assert max(leg_errors(thick, q)) <= 1e-9
+    fd = fd_gradient(thick, q)
+    assert np.linalg.norm(c.gradient - fd) <= 1e-6 * np.linalg.norm(fd)
 
 
 def _without_collisions(urdf: str) -> str:

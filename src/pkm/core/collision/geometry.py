@@ -274,8 +274,7 @@ class CollisionModel:
         self.quaternions = tuple((j.name, j.idx_q + 3 if j.kind == "JointModelFreeFlyer" else j.idx_q)
                                  for j in mech.joints.values() if j.kind in ("JointModelFreeFlyer",
                                                                              "JointModelSpherical"))
-        if len(self.bodies) >= 2:
-            self._choose_pairs()
+        self._choose_pairs()  # (the spec's pairs checked even where there are fewer than two bodies)
 
     @classmethod
     def of(cls, mech: Mechanism) -> CollisionModel:
