@@ -250,17 +250,21 @@ class CollisionModel:
         gm = pin.GeometryModel()
         shapes: list[Collision] = []
         joint_of: dict[str, int] = {}
+        lost: list[str] = []
         for c, joint, placement in placed:
             geom, what = shape(c, folders)
             if geom is None:
-                said = f"link {c.link!r}: {what}; its collision geometry is left out"
-                notes.append(said)
-                warnings.warn(f"{mech.source}: {said}", PkmWarning, stacklevel=3)
+                lost.append(f"link {c.link!r}: {what}")
                 continue
             fid = model.getFrameId(c.link, pin.FrameType.BODY)
             gm.addGeometryObject(pin.GeometryObject(c.name, joint, fid, placement, geom))
             shapes.append(c)
             joint_of[c.link] = joint
+        if lost:  # (one sentence and one warning for them all: a file may name a hundred meshes not shipped)
+            said = (f"{len(lost)} collision shape{'s' if len(lost) > 1 else ''} left out: " + "; ".join(lost[:5])
+                    + (f"; and {len(lost) - 5} more" if len(lost) > 5 else ""))
+            notes.append(said)
+            warnings.warn(f"{mech.source}: {said}", PkmWarning, stacklevel=3)
         self.geometry = gm
         self.shapes: tuple[Collision, ...] = tuple(shapes)
         self.bodies: tuple[str, ...] = tuple(dict.fromkeys(c.link for c in shapes))
@@ -411,8 +415,8 @@ class CollisionModel:
         """Itself, where it has pairs to check; else :class:`~pkm.errors.NoCollisionGeometryError` saying why."""
         if not self.bodies:
             raise NoCollisionGeometryError(self.mech.name, "no_geometry", (
-                f"{self.mech.name}: its files carry no collision geometry"
-                + (f" ({'; '.join(self.notes)})" if self.notes else "")
+                f"{self.mech.name}: " + (f"none of its collision geometry could be read ({'; '.join(self.notes)})"
+                                         if self.notes else "its files carry no collision geometry")
                 + ": add <collision> elements to the URDF's links (box, cylinder, sphere, <capsule radius length>, "
                   "mesh), geoms to an MJCF file's bodies, <collision> to an SDF file's links, or, for a shipped "
                   "design, UrdfBuilder.collision in its generator"))
