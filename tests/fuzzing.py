@@ -1730,6 +1730,27 @@ def _stiffness(g, adv):
     return run, (m, q, W), kw
 
 
+@entry("pkm.clearance")
+def _clearance(g, adv):
+    """The signed distances and the smallest's gradient (a design without collision geometry: refused)."""
+    _, m, q, _ = _dyn_state(g, adv, ("gough_stewart", "delta"))
+
+    def run(m, q):
+        c = ctx().pkm.clearance(m, q)
+        return np.array(list(c.pairs.values())), c.minimum, c.gradient
+    return run, (m, q), {}
+
+
+@entry("clearance_map")
+def _clearance_map(g, adv):
+    """The smallest distance over several configurations, some hostile."""
+    from pkm.core.collision import clearance_map
+
+    n, m = _mech(g, adv, ("gough_stewart",))
+    nodes = [_q(g, n, adv and g.chance(0.5)) for _ in range(int(g.rng.integers(1, 4)))]
+    return clearance_map, (m, g.maybe(nodes, adv)), {}
+
+
 @entry("pkm.vibration_modes")
 def _vibration_modes(g, adv):
     n, m, q, _ = _dyn_state(g, adv, ("delta", "prs3", "rrr3", "gough_stewart"))

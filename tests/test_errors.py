@@ -57,6 +57,8 @@ CASES = [
      ["arm.urdf: inverse dynamics refused", "'arm' (a negative principal moment -0.0002 kg m^2)"]),
     (E.StiffnessError("free", "a motion no spring resists moves the end effector (it moves leg1)", ["leg1"], 0),
      {"kind": "free", "joints": ("leg1",), "rank": 0}, ["no spring resists", "leg1"]),
+    (E.NoCollisionGeometryError("delta", "no_geometry", "delta: its files carry no collision geometry: add ..."),
+     {"mechanism": "delta", "kind": "no_geometry"}, ["no collision geometry"]),
     (E.PathError(12, 0.25, "peak effort of motor_1", "needs 5.1 N m to hold still, has 3.9"),
      {"index": 12, "s": 0.25, "limit": "peak effort of motor_1"}, ["path point 12 (s = 0.25)", "needs 5.1 N m"]),
 ]

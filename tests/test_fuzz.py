@@ -54,7 +54,8 @@ def test_harness_covers_the_public_entry_points(fuzz):
                 "pkm.actuator_model", "ActuatorSpaceModel", "pkm.mass_matrix", "pkm.bias_efforts",
                 "pkm.gravity_efforts", "pkm.coriolis_matrix", "pkm.operational_space", "pkm.forward_dynamics",
                 "pkm.constraint_dynamics", "pkm.simulate", "pkm.regressor", "pkm.base_parameters",
-                "pkm.estimate", "pkm.regressor_batch", "pkm.measurements", "pkm.capability", "Kernels.at"}
+                "pkm.estimate", "pkm.regressor_batch", "pkm.measurements", "pkm.capability", "Kernels.at",
+                "pkm.clearance", "clearance_map"}
     expected |= {f"pkm.build[{m}]" for m in names()}  # the registry, the tests' five-bar included
     expected |= {f"{m}.closed_form_ik" for m in names()}
     expected |= {f"{m}.closed_form_fk" for m in names() if module(m).closed_form_fk is not None}

@@ -532,3 +532,19 @@ class StiffnessError(PkmError):
         self.joints = tuple(joints)
         self.rank = int(rank)
         super().__init__(message)
+
+
+class NoCollisionGeometryError(PkmError):
+    """A collision question (:func:`pkm.clearance`) about a mechanism with nothing to check: its files carry no
+    collision geometry (``"no_geometry"``: the message says how to add it), or every pair of its bodies is excluded
+    (``"no_pairs"``: the message lists the pairs and why, :mod:`pkm.core.collision.geometry`).
+
+    Attributes:
+        mechanism: The mechanism's name.
+        kind: ``"no_geometry"`` or ``"no_pairs"``.
+    """
+
+    def __init__(self, mechanism: str, kind: str, message: str):
+        self.mechanism = mechanism
+        self.kind = kind
+        super().__init__(message)

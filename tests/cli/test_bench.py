@@ -36,6 +36,7 @@ CHECKS = {
         r[0]["generic_max_ci_difference"], r[1]["generic_gci_difference"]) <= 1e-9,
     "dynamics": lambda r: r["max_force_difference_to_baseline_N"]["pkm"] < 1e-9,
     "stiffness": lambda r: r["max_relative_difference"] < 1e-9 and r["map"]["with_stiffness"] > 0,
+    "clearance": lambda r: r["max_difference_m"] <= 1e-9 and r["map"]["within_limits"] > 0,
     "time_optimal": lambda r: abs(r["cycle_time_s"] - r["cycle_time_core_s"]) <= 1e-6 and (
         "skipped" in r["ankle"] or (r["ankle"]["holds"] and r["ankle"]["labels_equal"]
                                     and r["ankle"]["efforts_difference"] <= 1e-10
@@ -49,7 +50,7 @@ OWN_TESTS = {"simulation": "tests/bench/test_simulation.py", "simulation_speed":
 
 
 def test_bench_lists_every_benchmark_module():
-    assert sorted(BENCHMARKS) == ["assembly", "batch", "designs", "dynamics", "export", "hexapod", "identification",
+    assert sorted(BENCHMARKS) == ["assembly", "batch", "clearance", "designs", "dynamics", "export", "hexapod", "identification",
                                   "kinematics", "opcount", "serve", "simulation", "simulation_speed", "stiffness",
                                   "sweep", "time_optimal", "transmissions", "twin", "workspace"]
     assert set(CHECKS) <= set(BENCHMARKS) - set(OWN_TESTS) and set(OWN_TESTS) <= set(BENCHMARKS)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -189,3 +191,25 @@ def test_the_stiffness_query_is_the_librarys():
     assert out["gap"][0] == pytest.approx(d.gap, rel=1e-6)  # (q closed from qa by the service: 1e-13 apart)
     with pytest.raises(UnknownNameError):
         QUERIES["stiffness"](delta, {"qa": qa, "springs": {"motor_9": 1.0}})
+
+
+def test_the_clearance_query_is_the_librarys():
+    """POST /models/{model}/clearance: pkm.clearance's distances, minimum, closest pair and gradient per sample; a
+    model whose files carry no collision geometry is refused whole (pkm's error: 422)."""
+    from pkm.core.collision import CollisionModel
+    from pkm.errors import NoCollisionGeometryError
+
+    gs = pkm.load("gough_stewart")
+    qa = gs.actuated_q(gs.q_reference)
+    out = queries.QUERIES["clearance"](gs, {"qa": [qa.tolist(), (qa + 0.05).tolist()]})
+    assert out["status"] == ["ok", "ok"] and out["pairs"] == [list(p) for p in CollisionModel.of(gs).pairs]
+    c = pkm.clearance(gs, out["q"][1])
+    # (coal's GJK starts from the last call's support points: a disc's distance, approached iteratively, agrees to
+    # its tolerance, 1e-12 of the size)
+    assert np.allclose(out["distances"][1], [c.pairs[tuple(p)] for p in out["pairs"]], rtol=0, atol=1e-10)
+    assert abs(out["minimum"][1] - c.minimum) <= 1e-10 and tuple(out["pairs"][out["closest"][1]]) == c.closest
+    assert np.allclose(out["gradient"][1], c.gradient, rtol=1e-9, atol=1e-12) and not out["interferes"][1]
+    assert out["units"]["gradient"] == ["m/m"] * 6
+    bare = pkm.from_strings(re.sub(r"<collision.*?</collision>", "", gs.urdf, flags=re.DOTALL), gs.spec)
+    with pytest.raises(NoCollisionGeometryError):
+        queries.QUERIES["clearance"](bare, {"qa": qa.tolist()})

@@ -121,6 +121,10 @@ def test_every_answer_matches_its_published_schema(service, openapi):
            "dynamics": {"q": q0.tolist(), "qd": [0.1, 0.0, 0.0], "qdd": [1.0, 0.0, 0.0]},
            "capability": {"qa": qa0.tolist(), "kind": "twist"},
            "stiffness": {"qa": qa0.tolist(), "drives": 500.0, "wrench": [0.0, 0.0, -10.0, 0.0, 0.0, 0.0]}}
+    gs = call("describe_model", "/models/gough_stewart", method="get")  # (a design whose files carry collision geometry)
+    gs_qa0 = np.array(gs["q_reference"])[gs["actuated_q"]]
+    call("clearance", "/models/gough_stewart/clearance", json={"qa": gs_qa0.tolist()})
+    call("clearance", "/models/gough_stewart/clearance", json={"qa": [gs_qa0.tolist(), (gs_qa0 + 0.02).tolist()]})
     for name in QUERIES:
         single = one.get(name, {"qa": qa0.tolist()})
         out = call(name, f"/models/delta/{name}", json=single)

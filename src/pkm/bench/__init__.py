@@ -26,7 +26,7 @@ from typing import Any
 
 from pkm.errors import UnknownNameError
 
-NAMES = ("assembly", "batch", "designs", "dynamics", "export", "hexapod", "identification", "kinematics", "opcount", "serve",
+NAMES = ("assembly", "batch", "clearance", "designs", "dynamics", "export", "hexapod", "identification", "kinematics", "opcount", "serve",
          "simulation", "simulation_speed", "stiffness", "sweep", "time_optimal", "transmissions", "twin", "workspace")
 
 

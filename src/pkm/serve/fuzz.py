@@ -21,10 +21,11 @@ from typing import Any
 
 MODELS = ("delta", "rrr3", "prs3", "nope", "", "..", "%2e%2e", "a" * 300, "delta%00", "../../etc/passwd")
 QUERIES = ("fk", "ik", "jacobians", "diagnose", "velocities", "dynamics", "capability", "scene", "stiffness",
-           "teleport", "",
+           "clearance", "teleport", "",
            "jobs/map", "jobs/assembly_modes", "jobs/working_modes", "jobs/teleport", "variants")
 #: The queries (not the jobs, whose answer is 202 before their input is read).
-QUERY_NAMES = ("fk", "ik", "jacobians", "diagnose", "velocities", "dynamics", "capability", "scene", "stiffness")
+QUERY_NAMES = ("fk", "ik", "jacobians", "diagnose", "velocities", "dynamics", "capability", "scene", "stiffness",
+               "clearance")
 #: The fields of a query that hold coordinates (m, rad): a number beyond pkm.validation.ABSURD in one is refused.
 POSITIONS = ("qa", "q", "y", "seed")
 #: The typed operations' field names (pkm.serve.schemas), an unknown one and an empty one.

@@ -615,6 +615,36 @@ def stiffness(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> 
     return out
 
 
+@_limits
+def clearance(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict[str, Any]:
+    """At closed configurations (``q``, or ``qa`` closed), the signed distances between the bodies whose collision
+    geometry the model's files carry (:func:`pkm.clearance`; negative: interpenetrating), in the order of ``pairs``,
+    the smallest, the index of its pair, whether bodies interfere, and the derivative of the smallest distance by the
+    actuated coordinates (None at a direct singularity). A model whose files carry no collision geometry is refused
+    (422, ``NoCollisionGeometryError``, saying how to add it)."""
+    from pkm.core.collision import CollisionModel
+    from pkm.core.collision import clearance as run
+    from pkm.errors import SingularityError
+
+    cm = CollisionModel.of(mech).require()
+    q, samples = _configurations(mech, body, kernels)
+
+    def one(k: int) -> dict[str, Any]:
+        c = run(mech, q[k])
+        try:
+            gradient: np.ndarray | None = c.gradient
+        except SingularityError:
+            gradient = None
+        return {"q": q[k], "distances": np.array([c.pairs[p] for p in cm.pairs]), "minimum": c.minimum,
+                "closest": cm.pairs.index(c.closest), "interferes": c.interferes, "gradient": gradient}
+
+    out = samples.each(one, ("q", "distances", "minimum", "closest", "interferes", "gradient"))
+    out["pairs"] = [list(p) for p in cm.pairs]
+    out["units"] = {"q": _q_units(mech), "distances": "m", "minimum": "m", "closest": "1", "interferes": "1",
+                    "gradient": [f"m/{u}" for u in _actuated_units(mech)]}
+    return out
+
+
 _SCENES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
@@ -645,7 +675,7 @@ def scene(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> dict
 #: The queries by name (the endpoints ``POST /models/{model}/{name}``).
 QUERIES: dict[str, Callable[[Mechanism, Mapping[str, Any], Any], dict[str, Any]]] = {
     "fk": fk, "ik": ik, "jacobians": jacobians, "diagnose": diagnose, "velocities": velocities,
-    "dynamics": dynamics, "capability": capability, "scene": scene, "stiffness": stiffness}
+    "dynamics": dynamics, "capability": capability, "scene": scene, "stiffness": stiffness, "clearance": clearance}
 
 
 def describe(mech: Mechanism) -> dict[str, Any]:

@@ -296,6 +296,22 @@ class StiffnessAnswer(_Batch):
     units: Units = _field(UNITS, {"force_compliance": "m/N", "moment_compliance": "rad/(N m)"})
 
 
+class ClearanceAnswer(_Batch):
+    """The signed distances between the bodies' collision geometry, the smallest and its derivative."""
+
+    q: Column = _ANSWER_Q
+    pairs: list[list[str]] = _field("The pairs of bodies checked, in the order of distances.",
+                                    [["rod_1", "rod_2"], ["rod_1", "rod_3"]])
+    distances: Column = _field("Each pair's signed distance per sample [m] (negative: penetration depth).",
+                               [[0.17, 0.25]])
+    minimum: Column = _field("The smallest distance per sample [m].", [0.17])
+    closest: IntColumn = _field("The index in pairs of the closest pair per sample.", [0])
+    interferes: BoolColumn = _field("Whether two bodies interpenetrate (minimum < 0).", [False])
+    gradient: Column = _field("d minimum / d actuated coordinates per sample (na: m/rad, m/m); None at a direct "
+                              "singularity.", [[0.01, -0.02, 0.0]])
+    units: Units = _field(UNITS, {"distances": "m", "minimum": "m", "gradient": ["m/rad"] * 3})
+
+
 class SceneAnswer(_Batch):
     """The world placement of every body of the model's 3-D scene."""
 
@@ -321,6 +337,10 @@ class StiffnessRequest(_AtConfigurations):
                                         [0.0, 0.0, -10.0, 0.0, 0.0, 0.0], None)
 
 
+class ClearanceRequest(_AtConfigurations):
+    """The signed distances between the bodies at closed configurations (pkm.clearance)."""
+
+
 #: Per query: (request model, answer model, summary).
 QUERY_MODELS: dict[str, tuple[type[BaseModel], type[BaseModel], str]] = {
     "fk": (FkRequest, FkAnswer, "Forward kinematics: close the loops at actuated values"),
@@ -332,6 +352,7 @@ QUERY_MODELS: dict[str, tuple[type[BaseModel], type[BaseModel], str]] = {
     "capability": (CapabilityRequest, CapabilityAnswer, "The wrench, twist or acceleration capability"),
     "scene": (SceneRequest, SceneAnswer, "The 3-D scene's body placements"),
     "stiffness": (StiffnessRequest, StiffnessAnswer, "The end effector's compliance with joint springs"),
+    "clearance": (ClearanceRequest, ClearanceAnswer, "The signed distances between the bodies (collision geometry)"),
 }
 
 

@@ -95,6 +95,7 @@ from __future__ import annotations
 import os
 import tempfile
 from collections.abc import Iterable
+from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -474,6 +475,7 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
         notes.append(f"{', '.join(f'<{t}>' for t in dict.fromkeys(unread))} not read (kinematics and dynamics need "
                      "none of it)")
 
+    collisions = _geoms(root, world, defaults, degrees, notes, source)
     # Pinocchio reads one body under <worldbody>: wrap everything in one fixed body at the origin
     wrapper = etree.Element("body", name=_WORLD)
     for child in list(world):
@@ -581,7 +583,7 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
             del limits[j]
     for j in locked:
         limits.pop(j, None)
-    urdf, types = urdf_from_model(model, limits=limits, mimic=mimic, **kwargs)
+    urdf, types = urdf_from_model(model, limits=limits, mimic=mimic, collisions=collisions, **kwargs)
     reference = {model.names[j]: tuple(map(float, pin.SE3ToXYZQUAT(X))) for j, X in free.items()}
     dependent = set(mimic) | set(locked)
     continuous = {str(j.get("name")) for j in etree.fromstring(urdf.encode()).iter("joint")
@@ -609,6 +611,96 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
     springs = _springs(world, defaults, kinds, set(actuated), dependent, degrees, notes, source)
     return Imported(urdf, tuple(closures), types, tuple(dict.fromkeys(actuated)), name, "mjcf", base,
                     reference, tuple(notes), actuators, seed, springs, motors, hold)
+
+
+_GEOM_SKIPPED = ("plane", "hfield", "sdf")  # geom types that bound no body (a floor, a terrain) or pkm cannot read
+
+
+def _geoms(root: etree._Element, world: etree._Element, defaults: _Defaults, degrees: bool, notes: list[str],
+           source: str) -> dict[str, list[etree._Element]]:
+    """The collision geometry of the bodies, ``{body: [URDF <collision> element]}`` (the geoms directly in
+    ``<worldbody>`` under :data:`_WORLD`), placed in the body's frame: a geom's ``pos`` and orientation, or its
+    ``fromto`` (the axis from one point to the other); sizes from MuJoCo's half-sizes (a box's ``size`` its
+    half-extents, a capsule's and a cylinder's its radius and half-length), a mesh its ``<asset><mesh>``'s file
+    (``<compiler meshdir>``, relative to the file's folder) and ``scale``. Geoms with ``contype`` and ``conaffinity``
+    both 0 never collide in MuJoCo: left out (a note), unless every geom of the file is so (the file turns contacts
+    off for its simulation: its geoms are still its bodies' shapes, read so, a note says). The others' ``contype`` and
+    ``conaffinity`` (other than 1) are written on their ``<collision>`` (pkm's attributes): the geometry checks a pair
+    of shapes only where MuJoCo would collide them (:mod:`pkm.core.collision.geometry`). Planes, height fields and
+    SDF geoms are left out (a note)."""
+    geoms = [g for g in world.iter("geom") if g.getparent().tag in ("body", "worldbody")]
+    if not geoms:
+        return {}
+    masks = {g: tuple(int(_floats(defaults.get(g, key, "1"), 1, f"<geom> {key}", source)[0])
+                      for key in ("contype", "conaffinity")) for g in geoms}
+    off = [g for g in geoms if masks[g] == (0, 0)]
+    filtered = len(off) < len(geoms)  # (all off: the shapes read without MuJoCo's filter)
+    if off and len(off) == len(geoms):
+        notes.append("every geom has contype and conaffinity 0 (contacts off in MuJoCo): their shapes are read as "
+                     "the bodies' collision geometry")
+        off = []
+    elif off:
+        notes.append(f"{len(off)} geoms with contype and conaffinity 0 (never colliding in MuJoCo) are not "
+                     "collision geometry")
+    compiler = root.find("compiler")
+    folder = Path(source).parent if Path(source).is_file() else None
+    meshdir = (compiler.get("meshdir") or compiler.get("assetdir") or "") if compiler is not None else ""
+    meshes = {str(m.get("name") or Path(str(m.get("file", ""))).stem): m for m in root.findall("asset/mesh")}
+    out: dict[str, list[etree._Element]] = {}
+    skipped: dict[str, int] = {}
+    for g in geoms:
+        if g in off:
+            continue
+        kind = defaults.get(g, "type", "sphere") or "sphere"
+        what = f"<geom name={g.get('name')!r}> (line {g.sourceline})"
+        size = [float(v) for v in (defaults.get(g, "size", "") or "").split()]
+        fromto = defaults.get(g, "fromto")
+        if kind in _GEOM_SKIPPED or kind not in ("sphere", "capsule", "cylinder", "box", "ellipsoid", "mesh"):
+            skipped[kind] = skipped.get(kind, 0) + 1
+            continue
+        if fromto is not None and kind in ("capsule", "cylinder", "box", "ellipsoid"):
+            a, b = _floats(fromto, 6, f"{what} fromto", source).reshape(2, 3)
+            axis = b - a
+            half = float(np.linalg.norm(axis)) / 2.0
+            if half <= 0.0:
+                raise SpecError(source, f"{what}: fromto gives two equal points")
+            M = pin.SE3(pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis / (2 * half)).matrix(),
+                        (a + b) / 2.0)
+            size = size[:1] + ([size[0]] if kind in ("box", "ellipsoid") else []) + [half]
+        else:
+            M = pin.SE3(_rotation(g, degrees, source), _floats(defaults.get(g, "pos", "0 0 0"), 3, f"{what} pos",
+                                                               source))
+        need = {"sphere": 1, "capsule": 2, "cylinder": 2, "box": 3, "ellipsoid": 3, "mesh": 0}[kind]
+        if len(size) < need or not all(v > 0.0 for v in size[:need]):
+            raise SpecError(source, f"{what}: a {kind} needs {need} positive size values, got {size}")
+        col = etree.Element("collision", name=str(g.get("name") or f"geom_{g.sourceline}"))
+        if filtered and masks[g] != (1, 1):  # (pkm's attributes: MuJoCo's filter of the pairs, read by the geometry)
+            col.set("contype", str(masks[g][0]))
+            col.set("conaffinity", str(masks[g][1]))
+        etree.SubElement(col, "origin", xyz=num(M.translation), rpy=num(pin.rpy.matrixToRpy(M.rotation)))
+        geometry = etree.SubElement(col, "geometry")
+        if kind == "sphere":
+            etree.SubElement(geometry, "sphere", radius=repr(size[0]))
+        elif kind in ("capsule", "cylinder"):
+            etree.SubElement(geometry, kind, radius=repr(size[0]), length=repr(2.0 * size[1]))
+        elif kind == "box":
+            etree.SubElement(geometry, "box", size=num(2.0 * np.array(size[:3])))
+        elif kind == "ellipsoid":
+            etree.SubElement(geometry, "ellipsoid", radii=num(size[:3]))
+        else:
+            asset = meshes.get(str(g.get("mesh")))
+            if asset is None or not asset.get("file"):
+                raise SpecNameError(source, "mesh", str(g.get("mesh")), sorted(meshes), f"{what} mesh")
+            path = Path(meshdir) / str(asset.get("file"))
+            if folder is not None and not path.is_absolute():
+                path = folder / path
+            etree.SubElement(geometry, "mesh", filename=str(path), scale=asset.get("scale", "1 1 1"))
+        parent = g.getparent()
+        out.setdefault(_WORLD if parent.tag == "worldbody" else str(parent.get("name")), []).append(col)
+    if skipped:
+        notes.append("geoms not read as collision geometry: "
+                     + ", ".join(f"{n} {kind}{'s' if n > 1 else ''}" for kind, n in skipped.items()))
+    return out
 
 
 #: The ``<keyframe><key>`` read as the reference configuration (:func:`pkm.save` writes it).

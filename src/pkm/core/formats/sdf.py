@@ -73,6 +73,7 @@ a cycle of parents.
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -344,9 +345,15 @@ def _read_sdf(text: str, source: str) -> Imported:
     names = set(links) | {j.get("name") for j in joints} | set(frames)
     robot = etree.Element("robot", name=model.get("name") or "sdf")
     urdf_frame: dict[str, pin.SE3] = {"world": pin.SE3.Identity()}  # the URDF frame of each link (at its joint)
+    unread: list[str] = []  # the collision shapes not read
 
     def add_link(name: str, el: etree._Element | None = None) -> None:
         lel = etree.SubElement(robot, "link", name=ulink.get(name, name))
+        for k, col in enumerate(el.findall("collision") if el is not None else ()):
+            left = _collision(lel, col, urdf_frame[name].inverse() * pose_of(name), f"link {name!r} <collision> "
+                              f"{k + 1}", source)
+            if left is not None:
+                unread.append(f"{name} ({left})")
         inertial = el.find("inertial") if el is not None else None
         if inertial is None:
             return
@@ -507,6 +514,9 @@ def _read_sdf(text: str, source: str) -> Imported:
     check_urdf(urdf, source)
     notes = [f"gearbox {gear!r} read as a mimic joint: {rotor} = {mult:.6g} {output}"
              for rotor, (output, mult, gear) in mimic.items()]
+    if unread:
+        notes.append(f"collision shapes not read (pkm reads box, sphere, cylinder, capsule, ellipsoid, mesh): "
+                     f"{', '.join(unread)}")
     springs = {}
     for j in joints:
         name = str(j.get("name"))
@@ -521,6 +531,45 @@ def _read_sdf(text: str, source: str) -> Imported:
                                                                      else 0.0)}
     notes += spring_notes(parse_springs(springs, source))
     return Imported(urdf, tuple(closures), types, (), robot.get("name"), "sdf", notes=tuple(notes), springs=springs)
+
+
+#: SDFormat's shapes and the URDF ``<collision>`` they are written as (:mod:`pkm.core.collision.geometry`):
+#: ``{sdf shape: (urdf shape, ((sdf element, urdf attribute, numbers), ...))}``.
+_SHAPES = {"box": ("box", (("size", "size", 3),)), "sphere": ("sphere", (("radius", "radius", 1),)),
+           "cylinder": ("cylinder", (("radius", "radius", 1), ("length", "length", 1))),
+           "capsule": ("capsule", (("radius", "radius", 1), ("length", "length", 1))),
+           "ellipsoid": ("ellipsoid", (("radii", "radii", 3),))}
+
+
+def _collision(lel: etree._Element, col: etree._Element, X: pin.SE3, what: str, source: str) -> str | None:
+    """An SDF link's ``<collision>`` written on its URDF link ``lel`` (whose frame is ``X`` in the SDF link's):
+    its ``<pose>`` (in the link frame) and ``<geometry>`` (box, sphere, cylinder, capsule, ellipsoid: their sizes;
+    mesh: its ``<uri>``, relative to the file's folder, ``model://`` read as ``package://``, and ``<scale>``);
+    a plane, a height map or another shape is not collision geometry pkm reads: left out, its tag returned."""
+    M, rel = _pose(col, what, source)
+    if rel is not None:
+        raise SpecError(source, f"{what}: a pose relative_to is not read; give it in the link frame")
+    geometry = col.find("geometry")
+    shapes = [el for el in (geometry if geometry is not None else ()) if isinstance(el.tag, str)]
+    if len(shapes) != 1 or (shapes[0].tag not in _SHAPES and shapes[0].tag != "mesh"):
+        return ", ".join(str(el.tag) for el in shapes) or "no shape"
+    el = shapes[0]
+    out = etree.SubElement(lel, "collision", name=str(col.get("name") or ""))
+    origin(out, X * M)
+    g = etree.SubElement(out, "geometry")
+    if el.tag == "mesh":
+        uri = (_text(el, "uri") or "").strip()
+        if uri.startswith("model://"):
+            uri = "package://" + uri[len("model://"):]
+        elif uri and "://" not in uri and not Path(uri).is_absolute() and Path(source).is_file():
+            uri = str(Path(source).parent / uri)
+        scale = _numbers(_text(el, "scale", "1 1 1"), 3, f"{what} mesh scale", source)
+        etree.SubElement(g, "mesh", filename=uri, scale=num(scale))
+        return None
+    tag, fields = _SHAPES[el.tag]
+    etree.SubElement(g, tag, {attr: num(_numbers(_text(el, key), n, f"{what} {el.tag} {key}", source))
+                              for key, attr, n in fields})
+    return None
 
 
 __all__ = ["read_sdf"]

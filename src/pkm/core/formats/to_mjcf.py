@@ -60,8 +60,11 @@ applies them.
 
 pkm's own MJCF reader loads the file back (:mod:`pkm.core.formats.mjcf`), which tests the writer; MuJoCo reads it
 for the benchmark baseline (:mod:`pkm.bench.mujoco_baseline`). Not written: planar and other composite joints, a
-free-flyer below the root (MuJoCo allows free joints only on top-level bodies), geometry; each refusal is a
-:class:`~pkm.errors.SpecError`.
+free-flyer below the root (MuJoCo allows free joints only on top-level bodies); each refusal is a
+:class:`~pkm.errors.SpecError`. The collision geometry (the URDF text's ``<collision>`` elements,
+:mod:`pkm.core.collision.geometry`) is written as geoms of the bodies, MuJoCo's half-sizes, a mesh as an
+``<asset><mesh>`` of the file found (one not found: said by :func:`mjcf_omissions`); the file turns contacts off, so
+the geoms change no simulation.
 """
 
 from __future__ import annotations
@@ -184,6 +187,9 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
                              polycoef=_num([mimic.offset, mimic.scaling, 0, 0, 0]), solref=_num(solref),
                              solimp=_num(solimp))
         bodies.append(body)
+    assets = _geoms(mech, bodies)
+    if len(assets):
+        root.insert(list(root).index(world), assets)
     for c, (fa, fb) in zip(mech.spec.closures, mech.closure_frames):
         sites = []
         for side, f in (("a", fa), ("b", fb)):
@@ -224,6 +230,35 @@ def mjcf_from_mechanism(mech: Mechanism, model_name: str | None = None, *, times
     for name, spring in mech.spec.springs.items():
         write_spring(next(e for e in world.iter("joint") if e.get("name") == name), spring)
     return etree.tostring(root, pretty_print=True, encoding="unicode")
+
+
+def _geoms(mech: Mechanism, bodies: list[etree._Element]) -> etree._Element:
+    """The collision geometry of ``mech``'s URDF text (:mod:`pkm.core.collision.geometry`) as geoms of the bodies
+    (``bodies[j]``: joint ``j``'s), MuJoCo's half-sizes; a mesh's file found (as the geometry reads it) as an
+    ``<asset><mesh>``, returned (meshes not found: :func:`mjcf_omissions`). The file turns contacts off
+    (``<flag contact="disable">``): the geoms describe the bodies' shapes, they change no simulation."""
+    from pkm.core.collision.geometry import model_folders, placed_collisions, resolve_mesh
+
+    assets = etree.Element("asset")
+    placed, _ = placed_collisions(mech)
+    folders = model_folders(mech)
+    for c, j, M in placed:
+        name = c.name.replace("/", "_")
+        if c.kind == "mesh":
+            path = resolve_mesh(str(c.filename), folders)
+            if path is None:
+                continue
+            etree.SubElement(assets, "mesh", name=name, file=str(path.resolve()), scale=_num(c.size))
+            geom = etree.SubElement(bodies[j], "geom", name=name, type="mesh", mesh=name)
+        else:
+            s = np.array(c.size)  # (MuJoCo's half-sizes: a box's half-extents, a capsule's radius and half-length)
+            size = s / 2 if c.kind == "box" else [s[0], s[1] / 2] if c.kind in ("cylinder", "capsule") else s
+            geom = etree.SubElement(bodies[j], "geom", name=name, type=c.kind, size=_num(size))
+        if (c.contype, c.conaffinity) != (1, 1):  # (MuJoCo's filter of the pairs, as read)
+            geom.set("contype", str(c.contype))
+            geom.set("conaffinity", str(c.conaffinity))
+        _pose(geom, M)
+    return assets
 
 
 def write_spring(joint: etree._Element, spring: Mapping[str, float]) -> None:
@@ -325,12 +360,32 @@ def mjcf_omissions(mech: Mechanism) -> tuple[str, ...]:
         if lost:
             out.append(f"drive of {a.joint!r}: {', '.join(lost)} (MJCF has one force range" + (
                 ", on the differential's motors, not this joint" if shared else "") + ", and armature for the rotor)")
+    out += geometry_omissions(mech)
     universal = [mech.model.names[j] for j in range(1, mech.model.njoints)
                  if mech.model.joints[j].shortname() == "JointModelUniversal"]
     if universal:
         out.append(f"universal joints {universal}: written as two hinges <name>__1, <name>__2 of one body each (read "
                    "back as two revolute joints of those names)")
     return tuple(out)
+
+
+def geometry_omissions(mech: Mechanism, world: bool = False) -> list[str]:
+    """The collision geometry a writer of another format than URDF leaves out, one line each: meshes not found (and,
+    ``world``, for SDFormat: shapes on the world, which it gives no link, and MJCF's contype and conaffinity); the
+    other shapes are moved onto the body of the joint that moves their link (named after it when read back)."""
+    from pkm.core.collision.geometry import model_folders, placed_collisions, resolve_mesh
+
+    placed, missing = placed_collisions(mech)
+    folders = model_folders(mech)
+    lost = [f"{c.link} (mesh {c.filename!r} not found)" for c, _, _ in placed
+            if c.kind == "mesh" and resolve_mesh(str(c.filename), folders) is None]
+    lost += [f"{c.link} (on the world)" for c, j, _ in placed if world and j == 0]
+    lost += [f"{link} (no body of the model)" for link in missing]
+    out = [f"collision geometry of {', '.join(dict.fromkeys(lost))}"] if lost else []
+    if world and any((c.contype, c.conaffinity) != (1, 1) for c, _, _ in placed):  # (SDFormat's bitmasks differ)
+        out.append("the collision shapes' contype and conaffinity (MJCF's filter of the pairs checked): read back, "
+                   "every pair of shapes is checked")
+    return out
 
 
 def mimic_leader(model: pin.Model, j: int) -> int:

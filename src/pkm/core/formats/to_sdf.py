@@ -34,7 +34,10 @@ zero back where it was and adds it to the limits, so the mechanism reads back wi
   ``<axis><dynamics>``: ``<spring_stiffness>``, ``<spring_reference>`` (counted from the written pose, as the limits
   are: ``rest - q_ref``; pkm's reader adds its ``<pkm:position>`` back), and the joint's whole viscous damping (a
   drive's and a spring's) as ``<damping>``; a continuous joint's spring is left out (said: SDFormat's would act on
-  the unwrapped angle) and kept in the spec beside, which states every spring too.
+  the unwrapped angle) and kept in the spec beside, which states every spring too;
+* the collision geometry (the URDF text's ``<collision>`` elements, :mod:`pkm.core.collision.geometry`) as
+  ``<collision>`` elements of the link of the joint that moves it; what it cannot hold (shapes on the world, meshes
+  not found) said.
 
 Refused by name (:class:`~pkm.errors.SpecError`): planar and other composite joints, a floating base (the spec's
 ``floating_base``: pkm's SDF reader fixes the base), an actuated or task universal joint, a closure whose two
@@ -44,12 +47,14 @@ frames are on one body, a task frame named as a closure.
 from __future__ import annotations
 
 import dataclasses as dc
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 from lxml import etree
 
-from pkm.core.formats.to_mjcf import joint_axis, mimic_leader
+from pkm.core.collision.geometry import Collision, model_folders, placed_collisions, resolve_mesh
+from pkm.core.formats.to_mjcf import geometry_omissions, joint_axis, mimic_leader
 from pkm.core.model.actuators import NUMBERS
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.spec import ClosureSpec
@@ -120,6 +125,8 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
     root = etree.Element("sdf", nsmap={"pkm": PKM_NS}, version="1.11")
     sdf_model = etree.SubElement(root, "model", name=spec.mechanism)
     links = ["world"]  # the SDF link of each Pinocchio joint
+    geometry, _ = placed_collisions(mech)
+    folders = model_folders(mech)
     primary: set[str] = set()
     universals: list[str] = []
     joints: list[etree._Element] = []
@@ -145,6 +152,9 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
         for key, value in (("ixx", I[0, 0]), ("ixy", I[0, 1]), ("ixz", I[0, 2]), ("iyy", I[1, 1]), ("iyz", I[1, 2]),
                            ("izz", I[2, 2])):
             _text(iel, key, repr(float(value)))
+        for shape, joint_of, M in geometry:
+            if joint_of == j:
+                _collision(link, shape, M, folders)
         seg = q[jm.idx_q:jm.idx_q + jm.nq]
         parent = links[int(model.parents[j])]
         if kind == "FreeFlyer":
@@ -247,6 +257,7 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
     if unsprung:
         dropped.append(f"the springs of the continuous joints {unsprung}: SDFormat's <spring_stiffness> of a continuous "
                        "joint is not pkm's (kept in the spec beside)")
+    dropped += geometry_omissions(mech, world=True)
     return etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True).decode(), tuple(dropped)
 
 
@@ -278,6 +289,31 @@ def _dynamics(mech: Mechanism, joints: list[etree._Element], at: dict[str, float
             _text(dyn, "spring_reference", repr(rest - at[name]))
             _text(dyn, "spring_stiffness", repr(k))
     return left
+
+
+def _collision(link: etree._Element, c: Collision, M: pin.SE3, folders: list[Path]) -> None:
+    """A ``<collision>`` of ``link`` (at its joint's frame): ``c``'s shape at ``M``; a mesh's file as found (one not
+    found is left out: said by the writer)."""
+    shape = etree.Element("geometry")
+    if c.kind == "mesh":
+        path = resolve_mesh(str(c.filename), folders)
+        if path is None:
+            return
+        mesh = etree.SubElement(shape, "mesh")
+        _text(mesh, "uri", str(path.resolve()))
+        _text(mesh, "scale", _num(c.size))
+    else:
+        el = etree.SubElement(shape, c.kind)
+        keys = {"box": ("size",), "sphere": ("radius",), "cylinder": ("radius", "length"),
+                "capsule": ("radius", "length"), "ellipsoid": ("radii",)}[c.kind]
+        values = [c.size] if c.kind in ("box", "ellipsoid") else [[v] for v in c.size]
+        for key, v in zip(keys, values):
+            _text(el, key, _num(v))
+    col = etree.Element("collision", name=c.name.replace("/", "_"))
+    _pose(col, M)
+    col.append(shape)
+    inertial = link.find("inertial")
+    link.insert(list(link).index(inertial) if inertial is not None else len(link), col)
 
 
 def _joint(name: str, kind: str, parent: str, child: str, position: str | None = None,

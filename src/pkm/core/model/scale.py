@@ -119,7 +119,8 @@ def _jacobian_scales(mech: Mechanism, length: float | None = None) -> JacobianSc
 
 
 # ---------------------------------------------------------------------- a mechanism scaled in size
-_GEOMETRY = {"box": ("size",), "cylinder": ("radius", "length"), "sphere": ("radius",), "capsule": ("radius", "length")}
+_GEOMETRY = {"box": ("size",), "cylinder": ("radius", "length"), "sphere": ("radius",), "capsule": ("radius", "length"),
+             "ellipsoid": ("radii",)}
 
 
 def _times(text: str | None, s: float) -> str | None:

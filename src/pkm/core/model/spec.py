@@ -58,6 +58,10 @@ Format ``pkm.closures/1`` (all values SI: m, rad)::
     [transmission.left_ankle]        # optional: a closed sub-mechanism's name and output joints
     outputs = ["ankle_pitch", "ankle_roll"]   # (pkm.transmissions; pkm.core.transmissions.decompose)
 
+    [collision]                      # optional: the pairs of bodies pkm.clearance checks, over its rule
+    exclude = [["rod_1", "rod_2"]]   # (pkm.core.collision.geometry): pairs not checked; include: pairs
+    include = []                     # the rule leaves out (neighbours, closures, contact) checked
+
     [motors.waist_left]              # optional: a motor driving several actuated joints through a constant
     waist_yaw = 1.0                  # linear map (a differential: MuJoCo's fixed tendon, ros2_control's
     waist_roll = 1.0                 # DifferentialTransmission): its coordinate is sum(coef * q_joint)
@@ -210,6 +214,10 @@ class ClosureSpec:
     #: ``{motor: {actuated joint: coefficient}}``: the ``[motors.<name>]`` tables, motors that drive several
     #: actuated joints through a constant linear map (:mod:`pkm.core.model.motors`).
     motors: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    #: ``[collision] exclude``: pairs of bodies (links with collision geometry) :func:`pkm.clearance` does not check.
+    collision_exclude: tuple[tuple[str, str], ...] = ()
+    #: ``[collision] include``: pairs it checks though its rule leaves them out (:mod:`pkm.core.collision.geometry`).
+    collision_include: tuple[tuple[str, str], ...] = ()
 
     # ------------------------------------------------------------------ reading
     @property
@@ -263,7 +271,7 @@ class ClosureSpec:
             raise SpecError(source, f"unsupported format {fmt!r}; this pkm reads {FORMAT!r}")
         known = {"format", "mechanism", "urdf", "end_effector", "actuated", "default_branch", "task",
                  "closure", "branch", "reference", "parameters", "description", "joint_types", "floating_base",
-                 "actuators", "springs", "transmission", "motors"}
+                 "actuators", "springs", "transmission", "motors", "collision"}
         unknown = sorted(set(raw) - known)
         if unknown:
             raise SpecError(source, f"unknown keys {unknown}; known keys: {sorted(known)}")
@@ -402,6 +410,19 @@ class ClosureSpec:
                 raise SpecError(source, f"{where}: {stray[0]!r} is not an actuated joint; actuated: {list(actuated)}")
             motors[str(mname)] = {str(j): float(v) for j, v in table.items()}
 
+        collision = need(raw, "collision", dict) if "collision" in raw else {}
+        stray = sorted(set(collision) - {"exclude", "include"})
+        if stray:
+            raise SpecError(source, f"unknown keys {stray} in [collision]; known: exclude, include")
+        pairs: dict[str, tuple[tuple[str, str], ...]] = {}
+        for key in ("exclude", "include"):
+            val = collision.get(key, [])
+            if not isinstance(val, list) or not all(
+                    isinstance(p, list) and len(p) == 2 and all(isinstance(n, str) and n for n in p) for p in val):
+                raise SpecError(source, f"[collision] {key} must be a list of pairs of body names, "
+                                        f'[["body_a", "body_b"], ...]')
+            pairs[key] = tuple((str(a), str(b)) for a, b in val)
+
         return cls(
             mechanism=need(raw, "mechanism", str),
             urdf=need(raw, "urdf", str),
@@ -420,6 +441,8 @@ class ClosureSpec:
             springs=springs,
             transmissions=transmissions,
             motors=motors,
+            collision_exclude=pairs["exclude"],
+            collision_include=pairs["include"],
         )
 
     # ------------------------------------------------------------------ writing
@@ -467,6 +490,10 @@ class ClosureSpec:
             out += ["", f"[transmission.{_key(tname)}]", f"outputs = {_tv(list(outputs))}"]
         for mname, coefs in self.motors.items():
             out += ["", f"[motors.{_key(mname)}]"] + [f"{_key(j)} = {_tv(float(c))}" for j, c in coefs.items()]
+        if self.collision_exclude or self.collision_include:
+            out += ["", "[collision]"] + [f"{key} = {_tv([list(p) for p in pairs])}" for key, pairs in
+                                          (("exclude", self.collision_exclude), ("include", self.collision_include))
+                                          if pairs]
         out += ["", "[reference]"]
         out += [f"{_key(k)} = {_tv(list(v))}" for k, v in self.reference.items()]
         if self.parameters:

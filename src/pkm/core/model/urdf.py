@@ -44,6 +44,7 @@ yourdfpy drops ``<mimic>`` when it writes, so the builder puts those elements ba
 
 from __future__ import annotations
 
+import copy
 import io
 import math
 import re
@@ -380,6 +381,8 @@ def load_model(text: str, source: str = "<string>") -> pin.Model:
     root = check_urdf(text, source)
     if isinstance(text, bytes):
         text = text.decode("utf-8", errors="replace")
+    if without_geometry(root):  # (the tree needs none of it; urdfdom prints errors for a <capsule>)
+        text = etree.tostring(root, encoding="unicode")
     try:
         yourdfpy.URDF.load(io.BytesIO(text.encode()), build_scene_graph=False, load_meshes=False)
     except Exception as exc:  # yourdfpy raises a variety of types
@@ -396,6 +399,17 @@ def load_model(text: str, source: str = "<string>") -> pin.Model:
     except Exception as exc:
         raise SpecError(source, f"Pinocchio rejects the URDF: {exc}") from None
     return mimics_first(model, mimics, source)
+
+
+def without_geometry(root: etree._Element) -> bool:
+    """Remove the ``<collision>`` and ``<visual>`` elements of a URDF tree (in place): the kinematic and dynamic
+    model needs none of them (the collision geometry is :mod:`pkm.core.collision`'s, read from the text), and
+    urdfdom, Pinocchio's parser, prints errors for a ``<capsule>``. Whether there were any."""
+    found = [el for lel in root.findall("link") for el in lel if el.tag in ("collision", "visual")]
+    for el in found:
+        lel = el.getparent()
+        lel.remove(el)
+    return bool(found)
 
 
 def mimics_first(model: pin.Model, mimics: Mapping[str, tuple[str, float, float]], source: str) -> pin.Model:
@@ -516,6 +530,7 @@ def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: d
                     frames: Sequence[tuple[str, int, pin.SE3]] = (), skip_frames: tuple[str, ...] = (),
                     mimic: Mapping[str, tuple[str, float, float]] | None = None,
                     locked: Mapping[str, float] | None = None,
+                    collisions: Mapping[str, Sequence[etree._Element]] | None = None,
                     source: str = "<model>") -> tuple[str, dict[str, str]]:
     """The URDF text of a Pinocchio tree, and the ``[joint_types]`` that URDF cannot state.
 
@@ -530,7 +545,9 @@ def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: d
     ``{joint: (leader, multiplier, offset)}``: a URDF ``<mimic>``, ``q_joint = multiplier q_leader + offset``
     (:func:`load_model` builds Pinocchio's mimic joints, in any order).
     ``locked`` welds one-coordinate joints at a value, ``{joint: q [rad or m]}``: a fixed joint at the
-    placement the joint has there. :func:`load_model` and :func:`pkm.core.model.joints.retype_joints` give the
+    placement the joint has there. ``collisions`` gives bodies their ``<collision>`` elements, ``{frame name:
+    [element]}``, each placed in that frame (a body's, an operational frame's, or the root link's by its name):
+    written on the link made for it. :func:`load_model` and :func:`pkm.core.model.joints.retype_joints` give the
     same tree back (same ``q`` layout but for the mimic and locked joints, frames, inertias).
 
     Raises:
@@ -553,8 +570,12 @@ def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: d
 
     robot = etree.Element("robot", name=name or model.name or "robot")
 
-    def link(lname: str, inertia: pin.Inertia | None = None) -> None:
+    collisions = collisions or {}
+
+    def link(lname: str, inertia: pin.Inertia | None = None, frame: str | None = None) -> None:
         lel = etree.SubElement(robot, "link", name=lname)
+        for col in collisions.get(frame, ()) if frame is not None else ():
+            lel.append(copy.deepcopy(col))
         if inertia is not None and inertia.mass > 0.0:
             iel = etree.SubElement(lel, "inertial")
             origin(iel, pin.SE3(np.eye(3), inertia.lever))
@@ -577,7 +598,7 @@ def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: d
 
     root = unique("world")
     taken.update(skip_frames)
-    link(root)
+    link(root, frame=root)
     link_of = {0: root}
     primary = set()
     types: dict[str, str] = {}
@@ -600,7 +621,7 @@ def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: d
             kind, axis, pkm_type = _urdf_joint_kind(part, f"joint {pname!r}", source)
             last = k == len(parts) - 1
             child = (unique(body) if body is not None else unique(f"{pname}_link")) if last else unique(f"{pname}_link")
-            link(child, model.inertias[jid] if last else None)
+            link(child, model.inertias[jid] if last else None, body if last else None)
             M = model.jointPlacements[jid] * placement if k == 0 else placement
             if pname in locked:
                 M, kind, axis, pkm_type = M * _joint_motion(part, locked[pname], f"joint {pname!r}", source), \
@@ -623,7 +644,7 @@ def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: d
             raise SpecError(source, f"frame {fname!r} to add is already a name of the model")
     for fname, jid, M in extra + list(frames):
         child = unique(fname)
-        link(child)
+        link(child, frame=fname)
         joint(unique(f"{child}_fixed"), "fixed", link_of[jid], child, M)
     etree.indent(robot, space="  ")
     text = etree.tostring(robot, xml_declaration=True, encoding="utf-8", pretty_print=True).decode()

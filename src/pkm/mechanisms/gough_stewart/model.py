@@ -16,7 +16,11 @@ def urdf_xml(params: GoughStewartParams) -> str:
     """The tree: the platform on a free-flyer; per leg a cylinder on a universal joint at ``a_i`` (written as a
     revolute, made Pinocchio's ``JointModelUniversal`` by the spec's ``[joint_types]``) and a rod on the prismatic
     leg joint along the cylinder's z axis, its coordinate the leg length; the ball joint at the rod's tip is a
-    point closure on the platform."""
+    point closure on the platform. Collision geometry (:mod:`pkm.core.collision`): each cylinder a capsule of
+    ``cylinder_radius`` from the universal joint's centre ``leg_min / 2`` along the leg, each rod one of
+    ``rod_radius`` from the ball joint's centre ``leg_min / 2`` back (the frames ``cylinder_<n>_end`` and
+    ``rod_<n>_end`` are their far ends), the platform a disc of the platform points' largest radius and
+    ``platform_thickness``."""
     params = check_params(params, GoughStewartParams)
     b = UrdfBuilder(NAME)
     b.link("base")
@@ -24,6 +28,7 @@ def urdf_xml(params: GoughStewartParams) -> str:
     mp = params.m_platform
     b.link("platform_link", mp, inertia=np.diag([mp * radius ** 2 / 4, mp * radius ** 2 / 4, mp * radius ** 2 / 2]))
     b.joint("platform", "floating", "base", "platform_link")
+    b.collision("platform_link", "cylinder", radius=radius, length=params.platform_thickness)
     half, mid = params.m_leg / 2.0, 0.5 * (params.leg_min + params.leg_max)
     for i in range(6):
         n = i + 1
@@ -36,6 +41,10 @@ def urdf_xml(params: GoughStewartParams) -> str:
         b.frame(f"cylinder_{n}_end", f"cylinder_{n}", (0.0, 0.0, params.leg_min / 2))  # (drawn: the cylinder, the rod)
         b.frame(f"rod_{n}_end", f"rod_{n}", (0.0, 0.0, -params.leg_min / 2))
         b.frame(f"socket_{n}", "platform_link", params.platform[i])
+        b.collision(f"cylinder_{n}", "capsule", (0.0, 0.0, params.leg_min / 4), radius=params.cylinder_radius,
+                    length=params.leg_min / 2)
+        b.collision(f"rod_{n}", "capsule", (0.0, 0.0, -params.leg_min / 4), radius=params.rod_radius,
+                    length=params.leg_min / 2)
     return b.to_xml()
 
 

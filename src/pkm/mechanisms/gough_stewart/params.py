@@ -53,6 +53,12 @@ class GoughStewartParams:
         leg_max: Longest leg [m].
         m_leg: Mass of each leg [kg], half in its cylinder (on the universal joint), half in its rod.
         m_platform: Platform mass [kg] (a uniform disc of the platform points' largest radius).
+        cylinder_radius: Radius of each leg's cylinder [m]: its collision capsule, from the universal joint's centre
+            ``leg_min / 2`` along the leg (:mod:`pkm.core.collision`).
+        rod_radius: Radius of each leg's rod [m]: its collision capsule, from the ball joint's centre ``leg_min / 2``
+            back along the leg.
+        platform_thickness: Thickness of the platform [m]: its collision geometry, a disc of the platform points'
+            largest radius centred on the platform frame.
         reference: The reference pose ``(x, y, z [m], roll, pitch, yaw [rad])``; None (default): the level platform
             above the base centre at the height where the mean leg is mid-stroke.
     """
@@ -64,11 +70,14 @@ class GoughStewartParams:
     m_leg: float = param(1.0, "kg")
     m_platform: float = param(5.0, "kg")
     reference: tuple[float, float, float, float, float, float] | None = param(None, "m", "rad", length=6)
+    cylinder_radius: float = param(0.03, "m")
+    rod_radius: float = param(0.02, "m")
+    platform_thickness: float = param(0.02, "m")
 
     def __post_init__(self):
         _points(self, "base")
         _points(self, "platform")
-        check_positive(self, "leg_min", "leg_max", "m_platform")
+        check_positive(self, "leg_min", "leg_max", "m_platform", "cylinder_radius", "rod_radius", "platform_thickness")
         check_nonnegative(self, "m_leg")
         if not self.leg_min < self.leg_max:
             raise InvalidParameterError("leg_max", f"must exceed leg_min ({self.leg_min} m), got {self.leg_max}",
