@@ -345,12 +345,12 @@ def _stage(path: Path | None, name: str, gravity: np.ndarray, bodies: list[_Body
                 api.CreateMaxForceAttr(float(drive["maxForce"]))
         armature = custom.pop("armature", None)
         if armature is not None:
-            for key in ("newton:armature", "physxJoint:armature"):
-                prim.CreateAttribute(key, Sdf.ValueTypeNames.Float, custom=True).Set(float(armature))  # type: ignore[arg-type]
-        for key, value in custom.items():
-            kind: Any = Sdf.ValueTypeNames.String if isinstance(value, str) else \
+            for name_ in ("newton:armature", "physxJoint:armature"):
+                prim.CreateAttribute(name_, Sdf.ValueTypeNames.Float, custom=True).Set(float(armature))  # type: ignore[arg-type]
+        for key, v in custom.items():
+            kind: Any = Sdf.ValueTypeNames.String if isinstance(v, str) else \
                 Sdf.ValueTypeNames.Double if key.startswith("pkm:") else Sdf.ValueTypeNames.Float
-            prim.CreateAttribute(key, kind, custom=True).Set(value)
+            prim.CreateAttribute(key, kind, custom=True).Set(v)
     return stage
 
 
