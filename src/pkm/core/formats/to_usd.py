@@ -229,12 +229,29 @@ def _quat(R: np.ndarray) -> tuple[float, float, float, float]:
     return float(qt.w), float(qt.x), float(qt.y), float(qt.z)
 
 
-def _stage(path: Path | None, name: str, gravity: np.ndarray, bodies: list[_Body], joints: list[_Joint],
+def save(stage: Any, path: str | os.PathLike[str]) -> Path:
+    """Write ``stage`` at ``path`` (``.usda`` text, ``.usd`` and ``.usdc`` binary), replacing any file there.
+
+    Raises:
+        SpecError: the file cannot be written (naming it).
+    """
+    p = pxr("writing USD")
+    out = Path(path)
+    try:
+        ok = stage.GetRootLayer().Export(str(out))
+    except p.Tf.ErrorException as exc:
+        raise SpecError(str(out), f"cannot write USD: {' '.join(str(exc).split())[:300]}") from None
+    if not ok:
+        raise SpecError(str(out), "cannot write USD")
+    return out
+
+
+def _stage(name: str, gravity: np.ndarray, bodies: list[_Body], joints: list[_Joint],
            actuated: Sequence[str], extra: Mapping[str, str] | None = None) -> Any:
-    """The stage (written at ``path``, or in memory) of these bodies and joints (module doc)."""
+    """The stage (in memory) of these bodies and joints (module doc)."""
     p = pxr("writing USD")
     Gf, Sdf, Usd, UsdGeom, UsdPhysics, Tf = p.Gf, p.Sdf, p.Usd, p.UsdGeom, p.UsdPhysics, p.Tf
-    stage = Usd.Stage.CreateNew(str(path)) if path is not None else Usd.Stage.CreateInMemory()
+    stage = Usd.Stage.CreateInMemory()  # (written at path by save(): no layer registry entry for it)
     UsdGeom.SetStageMetersPerUnit(stage, 1.0)
     UsdPhysics.SetStageKilogramsPerUnit(stage, 1.0)
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
@@ -391,10 +408,9 @@ def usd_from_mechanism(mech: Mechanism, path: str | os.PathLike[str] | None = No
             raise SpecError(mech.source, f"actuated joint {a.joint!r}: USD drives a revolute or prismatic joint")
         _drive(by_name[a.joint], a, float(q[mech.joints[a.joint].idx_q]))
     joints += _loops(mech, links)
-    stage = _stage(None if path is None else Path(path), spec.mechanism, np.asarray(model.gravity.linear), bodies,
-                   joints, mech.actuated_names)
+    stage = _stage(spec.mechanism, np.asarray(model.gravity.linear), bodies, joints, mech.actuated_names)
     if path is not None:
-        stage.GetRootLayer().Save()
+        save(stage, path)
     dropped = ["the task, working modes and parameters (pkm's spec keeps them); the Coulomb friction in pkm's "
                "pkm:actuator:coulomb only (UsdPhysics has no joint friction torque)"]
     if spec.springs:
@@ -443,11 +459,11 @@ def serial_usd(se: SerialEquivalent, path: str | os.PathLike[str] | None = None)
         j.custom["pkm:transmission"] = owner.get(out, "")
     actuated = [o for o in se.outputs if o in by_name]
     data = json.dumps(se.data(), default=float)
-    stage = _stage(None if path is None else Path(path), f"{se.robot.name}_serial", np.asarray(model.gravity.linear),
-                   bodies, joints, actuated, {"pkm:transmissions": data})
+    stage = _stage(f"{se.robot.name}_serial", np.asarray(model.gravity.linear), bodies, joints, actuated,
+                   {"pkm:transmissions": data})
     if path is not None:
-        stage.GetRootLayer().Save()
+        save(stage, path)
     return stage
 
 
-__all__ = ["EXTRA", "pxr", "serial_usd", "usd_from_mechanism"]
+__all__ = ["EXTRA", "pxr", "save", "serial_usd", "usd_from_mechanism"]

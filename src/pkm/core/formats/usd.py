@@ -104,6 +104,9 @@ def _open(p: Any, text: str, source: str) -> Any:
             if not layer.ImportFromString(text):
                 raise SpecError(source, "not a USD layer pkm can parse (usda text)")
             return p.Usd.Stage.Open(layer)
+        layer = p.Sdf.Layer.Find(str(source))
+        if layer is not None:  # (one this process holds: read the file as it is now)
+            layer.Reload(True)
         stage = p.Usd.Stage.Open(str(source))
     except p.Tf.ErrorException as exc:
         detail = " ".join(str(exc).split())[:300]
