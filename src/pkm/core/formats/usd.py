@@ -45,6 +45,7 @@ no single coordinate, two prims of one name.
 from __future__ import annotations
 
 import math
+import re
 from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -109,7 +110,8 @@ def _open(p: Any, text: str, source: str) -> Any:
             layer.Reload(True)
         stage = p.Usd.Stage.Open(str(source))
     except p.Tf.ErrorException as exc:
-        detail = " ".join(str(exc).split())[:300]
+        detail = re.sub(r"Error in '[^']*' at line \d+ in file \S+ : |pxrInternal_v\w*?__pxrReserved__::", "",
+                        " ".join(str(exc).split()))[:300]
         raise SpecError(source, f"not a USD stage pkm can open: {detail}") from None
     if stage is None:
         raise SpecError(source, "not a USD stage pkm can open")

@@ -132,9 +132,10 @@ def _write_urdfplus(mech: Mechanism, files: tuple[Path, ...]) -> Written:
 
 
 def _write_usd(mech: Mechanism, files: tuple[Path, ...]) -> Written:
-    from pkm.core.formats.to_usd import usd_from_mechanism
+    from pkm.core.formats.to_usd import pxr, usd_from_mechanism
 
     (path,) = files
+    pxr("writing USD")  # (the missing extra said before any folder is made)
     path.parent.mkdir(parents=True, exist_ok=True)
     _, dropped = usd_from_mechanism(mech, path)
     return Written((path,), dropped, "usd")
