@@ -61,6 +61,8 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core.formats.to_mjcf import joint_axis, mimic_leader
+from pkm.core.formats.to_sdf import SCALAR_KINDS
+from pkm.core.formats.to_sdf import _closed as closed_reference
 from pkm.core.model.actuators import NUMBERS, Actuator
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import SpecError
@@ -120,12 +122,6 @@ def _onto(axis: np.ndarray) -> tuple[str, np.ndarray]:
     return "X", pin.Quaternion.FromTwoVectors(_BASIS["X"], a).matrix()
 
 
-def _closed(mech: Mechanism) -> np.ndarray:
-    from pkm.core.formats.to_sdf import _closed as closed
-
-    return closed(mech)
-
-
 def _tree(model: pin.Model, q: np.ndarray, limits: Mapping[str, tuple[float, float]], taken: set[str],
           source: str, refuse_universal: set[str]) -> tuple[list[str], list[_Body], list[_Joint]]:
     """The bodies and joints of ``model`` at ``q``: ``(body name of each Pinocchio joint, bodies, joints)``."""
@@ -177,8 +173,7 @@ def _tree(model: pin.Model, q: np.ndarray, limits: Mapping[str, tuple[float, flo
                 joints.append(_Joint(f"{jname}__{k + 1}", "revolute", p, c, L0 * Rf, L1 * Rf, token,
                                      None if lim is None else (float(lim[0]), float(lim[1]))))
             continue
-        if kind not in ("RX", "RY", "RZ", "PX", "PY", "PZ", "RUBX", "RUBY", "RUBZ", "RevoluteUnaligned",
-                        "PrismaticUnaligned", "RevoluteUnboundedUnaligned", "Mimic"):
+        if kind not in SCALAR_KINDS:
             raise SpecError(source, f"joint {jname!r}: USD (UsdPhysics) has no {jm.shortname()} (pkm writes revolute, "
                                     "prismatic, spherical, universal, free-flyer and mimic joints)")
         revolute, axis = joint_axis(jm)
@@ -396,7 +391,7 @@ def usd_from_mechanism(mech: Mechanism, path: str | os.PathLike[str] | None = No
     mech = check_mechanism(mech)
     pxr("writing USD")
     model, spec = mech.model, mech.spec
-    q = _closed(mech)
+    q = closed_reference(mech)
     taken = {f"{c.name}_{side}" for c in spec.closures for side in ("parent", "child")}
     links, bodies, joints = _tree(model, q, mech.limits, taken, mech.source, {*spec.actuated, *spec.task.joints})
     skip = {f"{c.name}_{side}" for c in spec.closures for side in ("parent", "child")} | \
