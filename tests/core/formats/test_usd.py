@@ -183,10 +183,11 @@ def _edit(old: str, new: str) -> str:
     ('quatd xformOp:orient = (0.79', 'float3 xformOp:scale = (2, 2, 2)\n        quatd xformOp:orient = (0.79',
      "/fourbar/rocker"),
     ("#usda 1.0", "#usda 1.0\ndef Xform (", "not a USD stage pkm can open: .*parse error"),
+    ('def Xform "rocker" (', 'def Xform "rocker" (\n        references = @/etc/hosts.usda@', "names other files"),
 ])
 def test_bad_files_are_refused_naming_the_prim(old, new, where):
     """A D6 joint, a joint naming a missing prim or one body twice, a prismatic loop joint, a scaled body, malformed
-    text: a SpecError naming the prim (or saying what)."""
+    text, text (an upload) naming a file of the machine: a SpecError naming the prim (or saying what)."""
     from pkm.core.formats.usd import read_usd
 
     text = _edit(old, new)

@@ -39,7 +39,8 @@ Not read: collision and visual shapes, materials, joint friction (but pkm's ``pk
 limits and the D6 joint's limits (a note), springs. Refused with a :class:`~pkm.errors.SpecError` naming the prim:
 a malformed stage, a plain ``PhysicsJoint`` (D6) or a distance joint, a joint naming several bodies or a missing one,
 a joint between a body and itself, a scaled body, a prismatic loop joint, a drive on a loop joint or on a joint with
-no single coordinate, two prims of one name.
+no single coordinate, two prims of one name; a stage given as text (an upload) that names other files (sublayers,
+references, payloads: those are read from a file's path only).
 """
 
 from __future__ import annotations
@@ -104,6 +105,10 @@ def _open(p: Any, text: str, source: str) -> Any:
             layer = p.Sdf.Layer.CreateAnonymous(".usda")
             if not layer.ImportFromString(text):
                 raise SpecError(source, "not a USD layer pkm can parse (usda text)")
+            named = sorted(layer.GetCompositionAssetDependencies())
+            if named:  # (text given, an upload: it may not make pkm open files of this machine)
+                raise SpecError(source, f"a USD stage given as text names other files ({named[:3]}): sublayers, "
+                                        "references and payloads are read from files only (pkm.load of the path)")
             return p.Usd.Stage.Open(layer)
         layer = p.Sdf.Layer.Find(str(source))
         if layer is not None:  # (one this process holds: read the file as it is now)
