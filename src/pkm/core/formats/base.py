@@ -29,7 +29,7 @@ class Imported:
         actuated: The actuated joints the file names (empty when it names none).
         name: The model's name.
         format: ``"urdf"``, ``"urdfplus"`` (URDF+ ``<loop>``), ``"urdfdom"`` (the proposed ``<constraint>``),
-            ``"mjcf"`` or ``"sdf"``.
+            ``"mjcf"``, ``"sdf"`` or ``"usd"``.
         floating_base: The free-flyer joint that carries the whole tree (an MJCF root ``<freejoint>``), or None.
         reference: Joint values the file states (an MJCF free body's pose), for ``[reference]``.
         notes: What the reader interpreted or ignored, one sentence each (a tendon actuator read as its joint, a
