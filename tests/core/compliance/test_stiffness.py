@@ -16,36 +16,16 @@ import pkm
 from pkm.core.compliance import stiffness, vibration_modes
 from pkm.core.model.builder import from_strings
 from pkm.errors import InvalidInputError, StiffnessError, UnknownNameError
+from tests.core.compliance.conftest import legs
 
 K_LEG = 2.0e6  # N/m: one axial spring per leg
-
-
-@pytest.fixture(scope="module")
-def gs():
-    return pkm.load("gough_stewart")
-
-
-@pytest.fixture(scope="module")
-def pose(gs):
-    """A configuration away from the reference: the legs 1 to 3 cm longer or shorter (the platform moved and tilted)."""
-    return pkm.close_loops(gs, gs.actuated_q(gs.q_reference) + [0.02, -0.01, 0.03, 0.0, 0.015, -0.02]).q
-
-
-def _legs(gs, q):
-    """``(b, p, P)``: each leg's base and platform anchors and the platform's origin (world), from the model."""
-    m, d = gs.model, gs.data
-    pin.forwardKinematics(m, d, q)
-    pin.updateFramePlacements(m, d)
-    b = np.array([d.oMi[m.getJointId(f"u{i}")].translation for i in range(1, 7)])
-    p = np.array([(d.oMi[cm.joint2_id] * cm.joint2_placement).translation for cm in gs.constraint_models])
-    return b, p, d.oMf[gs.ee_frame].translation.copy(), d.oMf[gs.ee_frame].rotation.copy()
 
 
 def test_the_gough_stewart_stiffness_is_gosselins(gs, pose):
     """K = sum k r_i r_i^T, r_i = (u_i, (p_i - P) x u_i) from the anchors (Gosselin 1990), within 1e-9 relative,
     at a pose away from the reference; the compliance is its inverse."""
     K = stiffness(gs, pose, joints={j: K_LEG for j in gs.actuated_names})
-    b, p, P, _ = _legs(gs, pose)
+    b, p, P, _ = legs(gs, pose)
     u = (p - b) / np.linalg.norm(p - b, axis=1)[:, None]
     r = np.hstack([u, np.cross(p - P, u)])
     gosselin = K_LEG * r.T @ r
@@ -63,7 +43,7 @@ def test_the_exact_deflection_is_the_legs_equilibrium(gs, pose):
     platform's pose by scipy's hybrid method from the anchors alone: within 1e-8 relative; the first-order C W
     differs by the reported gap, which grows with the load."""
     K = stiffness(gs, pose, joints={j: K_LEG for j in gs.actuated_names})
-    b, p0, P0, R0 = _legs(gs, pose)
+    b, p0, P0, R0 = legs(gs, pose)
     local = (p0 - P0) @ R0  # (the anchors in the platform's frame)
     l0 = np.linalg.norm(p0 - b, axis=1)
     gaps = []

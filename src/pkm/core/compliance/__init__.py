@@ -6,7 +6,7 @@ whose links may be beams.
 * :mod:`~pkm.core.compliance.links`: compliant links as virtual six-dimensional springs (:class:`Beam`).
 """
 
-from pkm.core.compliance.links import Beam
+from pkm.core.compliance.links import Beam, Material
 from pkm.core.compliance.stiffness import Stiffness, VibrationModes, stiffness, vibration_modes
 
-__all__ = ["Beam", "Stiffness", "VibrationModes", "stiffness", "vibration_modes"]
+__all__ = ["Beam", "Material", "Stiffness", "VibrationModes", "stiffness", "vibration_modes"]

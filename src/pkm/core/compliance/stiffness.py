@@ -60,7 +60,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from pkm.core.compliance.links import Attachment, attachments, virtual_columns
+from pkm.core.compliance.links import Attachment, Material, attachments, beams_from_collisions, virtual_columns
 from pkm.core.differential.idle import MASSLESS, joint_inertia
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.kinematics.constraints import check_closed
@@ -72,8 +72,9 @@ from pkm.core.model.springs import MAGNITUDE
 from pkm.errors import InvalidInputError, ModeChangeWarning, PkmWarning, StiffnessError, UnknownNameError
 from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
 
-#: ``links=``: ``"rigid"``, or ``{link: Beam(...) or a 6 x 6 compliance}`` (:mod:`pkm.core.compliance.links`).
-Links = str | Mapping[str, object]
+#: ``links=``: ``"rigid"``, a :class:`~pkm.core.compliance.links.Material` (each link a beam of its collision
+#: primitive), or ``{link: Beam(...) or a 6 x 6 compliance}`` (:mod:`pkm.core.compliance.links`).
+Links = str | Material | Mapping[str, object]
 #: Rank decisions (motions, stiffnesses, compliance) relative to the largest singular value or eigenvalue, on the
 #: homogenised matrices.
 RTOL = 1e-9
@@ -105,6 +106,8 @@ class _Springs:
     length: float
     columns: np.ndarray  # (nv,) the homogenising column factors (L for a length)
     links: tuple[Attachment, ...] = ()
+    rigid_links: dict[str, str] = field(default_factory=dict)  # ({link: why}: links=Material's links taken rigid)
+    laws: dict[str, object] = field(default_factory=dict)  # ({link: Beam or 6 x 6 compliance}: the compliant links)
 
 
 #: Where a joint's stiffness comes from (:attr:`Stiffness.sources`): the ``joints=`` argument, the drive's servo
@@ -145,11 +148,19 @@ def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None,
     stiffnesses, ``links``; ``rtol`` already checked by the caller)."""
     if isinstance(links, str) and links == "rigid":
         links = {}
-    if not isinstance(links, Mapping):
-        raise InvalidInputError("links", "'rigid', or a mapping {link: Beam(...) or a 6 x 6 compliance}", links)
+    if not isinstance(links, Mapping | Material):
+        raise InvalidInputError("links", "'rigid', a Material, or a mapping {link: Beam(...) or a 6 x 6 compliance}",
+                                links)
     mech = check_mechanism(mech)
     q = mech.check_q(q)
     check_closed(mech, q)
+    rigid_links: dict[str, str] = {}
+    if isinstance(links, Material):
+        pin.framesForwardKinematics(mech.model, mech.data, q)
+        links, rigid_links = beams_from_collisions(mech, mech.data, links)
+        if not links:
+            raise InvalidInputError("links", f"{mech.name}: no link is a beam of its collision geometry (" + "; ".join(
+                f"{n}: {why}" for n, why in rigid_links.items()) + "): give the links' Beam(...) by name", "Material")
     given, sources = _joint_stiffness(mech, joints)
     sprung = {n: k for n, k in given.items() if k > 0.0}
     locked = tuple(j.name for j in mech.actuated if j.name not in given)
@@ -178,7 +189,7 @@ def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None,
         K[mech.nv + 6 * i:mech.nv + 6 * i + 6, mech.nv + 6 * i:mech.nv + 6 * i + 6] = a.stiffness
     H = N.T @ K @ N
     return _Springs(mech, q, k, sprung, {n: sources[n] for n in sprung}, locked, E, N, 0.5 * (H + H.T), np.hstack([c.ee_jacobian, Vee]) @ N, L,
-                    scales.columns, tuple(att))
+                    scales.columns, tuple(att), rigid_links, dict(links))
 
 
 def _preloaded(mech: Mechanism, q: np.ndarray, sprung: Mapping[str, float]) -> None:
@@ -282,6 +293,11 @@ class Stiffness:
             ``[springs]``, ``"actuator+spring"`` both in parallel).
         locked: The actuated joints held rigid (given no stiffness).
         q: The configuration (nq,).
+        links: ``{link: Beam or 6 x 6 compliance}``: the compliant links counted (``links=``'s, or those a
+            :class:`~pkm.core.compliance.links.Material` made beams of their collision primitive).
+        rigid_links: ``{link: why}``: with ``links=Material(...)``, the links that carry something and were taken
+            rigid (no collision geometry, not one cylinder or capsule, a disc, a span of no length or across the
+            primitive's axis); empty otherwise.
     """
 
     compliance: np.ndarray
@@ -290,6 +306,8 @@ class Stiffness:
     sources: Mapping[str, str]
     locked: tuple[str, ...]
     q: np.ndarray
+    links: Mapping[str, object]
+    rigid_links: Mapping[str, str]
     _springs: _Springs = field(repr=False, compare=False)
     _rtol: float = field(repr=False, compare=False, default=RTOL)
 
@@ -384,14 +402,19 @@ def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | N
             actuated joint left out whose drive states no stiffness is locked (rigid). :attr:`Stiffness.sources`
             says where each came from.
         links: ``"rigid"`` (default), or ``{link: Beam(...) or a 6 x 6 compliance}``: those links compliant
-            (:mod:`pkm.core.compliance.links`; the exact :meth:`Stiffness.deflection` takes rigid links).
+            (:mod:`pkm.core.compliance.links`; the exact :meth:`Stiffness.deflection` takes rigid links); or a
+            :class:`~pkm.core.compliance.links.Material`: every link that carries something a solid circular beam of
+            its collision geometry's radius where that is one cylinder or capsule along its span
+            (:func:`~pkm.core.compliance.links.beams_from_collisions`), the others rigid and named in
+            :attr:`Stiffness.rigid_links`.
         rtol: Rank decisions, relative, on homogenised matrices.
 
     Raises:
         StiffnessError: ``"free"``: a motion no spring resists moves the end effector.
         InvalidInputError: ``q`` not closed; a stiffness not finite or negative; a joint of several coordinates;
             a link's law neither a :class:`~pkm.core.compliance.links.Beam` nor a symmetric positive definite 6 x 6
-            compliance, or a link that carries nothing.
+            compliance, or a link that carries nothing; ``links=Material(...)`` where no link is a beam of its
+            collision geometry (the message lists each link's reason).
         UnknownNameError: a joint or a link that does not exist.
 
     Examples:
@@ -409,8 +432,8 @@ def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | N
     TV = sp.T @ V
     C = finite_result((TV / w) @ TV.T if len(w) else np.zeros((6, 6)), "compliance")
     C = 0.5 * (C + C.T)
-    return Stiffness(C, _rank(C, sp.length, rtol), dict(sp.sprung), dict(sp.sources), sp.locked, sp.q.copy(), sp,
-                     rtol)
+    return Stiffness(C, _rank(C, sp.length, rtol), dict(sp.sprung), dict(sp.sources), sp.locked, sp.q.copy(),
+                     dict(sp.laws), dict(sp.rigid_links), sp, rtol)
 
 
 def _pose(sp: _Springs, q: np.ndarray) -> pin.SE3:
