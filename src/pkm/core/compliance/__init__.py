@@ -7,6 +7,6 @@ whose links may be beams.
 """
 
 from pkm.core.compliance.links import Beam, Material
-from pkm.core.compliance.stiffness import Stiffness, VibrationModes, stiffness, vibration_modes
+from pkm.core.compliance.stiffness import LoadedStiffness, Stiffness, VibrationModes, stiffness, vibration_modes
 
-__all__ = ["Beam", "Material", "Stiffness", "VibrationModes", "stiffness", "vibration_modes"]
+__all__ = ["Beam", "LoadedStiffness", "Material", "Stiffness", "VibrationModes", "stiffness", "vibration_modes"]
