@@ -273,3 +273,15 @@ def test_the_loaded_stiffness_is_the_derivative_of_the_deflection(gs, pose):
     assert np.abs(Kt - Kt.T).max() > 1e-5 * np.abs(Kt).max()
     force = K.loaded(np.r_[W[:3], 0.0, 0.0, 0.0]).matrix
     assert np.abs(force - force.T).max() <= 1e-9 * np.abs(force).max()
+
+
+def test_a_configuration_outside_the_limits_is_flagged(gs, pose):
+    """Legs 27 cm longer than the reference's (past their 1 m stroke): the stiffness is given, its outside_limits
+    names every leg as Mechanism.outside_limits does and its repr says so; inside them, nothing is flagged."""
+    legs = {j: K_LEG for j in gs.actuated_names}
+    far = pkm.close_loops(gs, gs.actuated_q(gs.q_reference) + 0.27).q
+    K = stiffness(gs, far, joints=legs)
+    assert K.outside_limits == gs.outside_limits(far) == tuple(gs.actuated_names)
+    assert "OUTSIDE the position limits: leg1" in repr(K)
+    inside = stiffness(gs, pose, joints=legs)
+    assert inside.outside_limits == () and "OUTSIDE" not in repr(inside)

@@ -313,6 +313,10 @@ class Stiffness:
         rigid_links: ``{link: why}``: with ``links=Material(...)``, the links that carry something and were taken
             rigid (no collision geometry, not one cylinder or capsule, a disc, a span of no length or across the
             primitive's axis); empty otherwise.
+        outside_limits: The joints ``q`` puts outside the position limits the model states
+            (:meth:`pkm.core.Mechanism.outside_limits`, as :attr:`SolveResult.outside_limits
+            <pkm.core.kinematics.solve.SolveResult.outside_limits>`): the stiffness is computed there all the same,
+            and the repr says so.
     """
 
     compliance: np.ndarray
@@ -323,8 +327,21 @@ class Stiffness:
     q: np.ndarray
     links: Mapping[str, object]
     rigid_links: Mapping[str, str]
+    outside_limits: tuple[str, ...]
     _springs: _Springs = field(repr=False, compare=False)
     _rtol: float = field(repr=False, compare=False, default=RTOL)
+
+    def __repr__(self) -> str:
+        k = self.principal("force")[0]
+        parts = [f"rank {self.rank}", f"sprung {len(self.sprung)}", f"locked {len(self.locked)}",
+                 "translational stiffness " + ", ".join(f"{v:.4g}" for v in k) + " N/m"]
+        if self.links:
+            parts.append(f"compliant links {len(self.links)}" + (f" ({len(self.rigid_links)} rigid: "
+                                                                  f"{', '.join(self.rigid_links)})"
+                                                                  if self.rigid_links else ""))
+        if self.outside_limits:
+            parts.append(f"OUTSIDE the position limits: {', '.join(self.outside_limits)}")
+        return f"Stiffness({self._springs.mech.name}: {'; '.join(parts)})"
 
     @property
     def matrix(self) -> np.ndarray:
@@ -531,7 +548,7 @@ def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | N
     C = finite_result((TV / w) @ TV.T if len(w) else np.zeros((6, 6)), "compliance")
     C = 0.5 * (C + C.T)
     return Stiffness(C, _rank(C, sp.length, rtol), dict(sp.sprung), dict(sp.sources), sp.locked, sp.q.copy(),
-                     dict(sp.laws), dict(sp.rigid_links), sp, rtol)
+                     dict(sp.laws), dict(sp.rigid_links), sp.mech.outside_limits(sp.q), sp, rtol)
 
 
 def _pose(sp: _Springs, q: np.ndarray) -> pin.SE3:
