@@ -56,3 +56,29 @@ def test_a_material_with_no_beam_is_refused_and_bad_materials_too():
         with pytest.raises(InvalidInputError):
             Material(**bad)
     assert Material(E=7e10).beam(0.01) == Beam(E=7e10, radius=0.01)
+
+
+def test_a_spec_states_a_links_compliance():
+    """[links.<link>] compliance = 6 x 6 in the spec: written and read back equal, taken by pkm.stiffness by default
+    as the same compliance given by name (exactly), links="rigid" overriding it; a 6 x 6 asymmetric by 1e-6 of its
+    largest entry refused whatever its scale (a steel bar's: once passed by an absolute 1e-8 test)."""
+    import dataclasses
+
+    from pkm.core.model.builder import from_strings
+    from pkm.core.model.spec import ClosureSpec
+
+    rrr3 = pkm.load("rrr3")
+    q, motors = rrr3.q_reference, {j: 2e3 for j in rrr3.actuated_names}
+    C = Beam(E=7e10, radius=0.004).compliance(0.2)
+    spec = dataclasses.replace(rrr3.spec, links={"proximal_1": tuple(map(tuple, C))})
+    assert ClosureSpec.from_toml(spec.to_toml()) == spec
+    stated = from_strings(rrr3.urdf, spec, rrr3.params, "rrr3")
+    K = stiffness(stated, q, joints=motors)
+    assert set(K.links) == {"proximal_1"}
+    assert np.array_equal(K.compliance, stiffness(rrr3, q, joints=motors, links={"proximal_1": C}).compliance)
+    assert np.array_equal(stiffness(stated, q, joints=motors, links="rigid").compliance,
+                          stiffness(rrr3, q, joints=motors).compliance)
+    skew = Beam(E=2.1e11, radius=0.02).compliance(0.2)  # (a steel bar: entries 8e-10 m/N to 1e-5 rad/(N m))
+    skew[0, 1] += 1e-6 * np.abs(skew).max()
+    with pytest.raises(InvalidInputError, match="symmetric positive definite"):
+        stiffness(rrr3, q, joints=motors, links={"proximal_1": skew})

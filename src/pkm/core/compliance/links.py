@@ -34,7 +34,7 @@ from pkm._derived import derived
 from pkm.core.collision.geometry import Collision, placed_collisions
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, UnknownNameError
-from pkm.validation import as_array, as_scalar
+from pkm.validation import as_array, as_scalar, symmetric_positive_definite
 
 
 @dataclass(frozen=True)
@@ -225,8 +225,7 @@ def attachments(mech: Mechanism, data: pin.Data, links: Mapping[str, object]) ->
         fid = bodies[name]
         if not isinstance(law, Beam):
             law = as_array(law, f"links[{name!r}]", "a Beam, or a 6 x 6 compliance [m/N, m/(N m); rad/N, rad/(N m)]")
-            if law.shape != (6, 6) or not np.all(np.isfinite(law)) or not np.allclose(law, law.T, rtol=1e-9) \
-                    or np.linalg.eigvalsh(0.5 * (law + law.T)).min() <= 0.0:
+            if law.shape != (6, 6) or not symmetric_positive_definite(law):
                 raise InvalidInputError(f"links[{name!r}]", "a 6 x 6 compliance is symmetric positive definite", law)
         carried = _carried(mech, data, fid)
         if not carried:

@@ -152,16 +152,18 @@ def _joint_stiffness(mech: Mechanism, joints: Mapping[str, object] | None) -> tu
     return given, sources
 
 
-def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None, links: object, rtol: float) \
+def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None, links: object | None, rtol: float) \
         -> _Springs:
     """The springs, the locked joints and the motions they leave at ``q`` (checked: closed, the joints' names and
     stiffnesses, ``links``; ``rtol`` already checked by the caller)."""
+    mech = check_mechanism(mech)
+    if links is None:
+        links = dict(mech.spec.links)
     if isinstance(links, str) and links == "rigid":
         links = {}
     if not isinstance(links, Mapping | Material):
         raise InvalidInputError("links", "'rigid', a Material, or a mapping {link: Beam(...) or a 6 x 6 compliance}",
                                 links)
-    mech = check_mechanism(mech)
     q = mech.check_q(q)
     check_closed(mech, q)
     rigid_links: dict[str, str] = {}
@@ -504,7 +506,7 @@ class LoadedStiffness:
         return finite_result(np.linalg.inv(self.compliance), "loaded stiffness matrix")
 
 
-def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: Links = "rigid",
+def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: Links | None = None,
               rtol: float = RTOL) -> Stiffness:
     """The end effector's stiffness at the closed configuration ``q`` (module doc: the model and its assumptions).
 
@@ -516,7 +518,9 @@ def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | N
             spec's ``[springs.<joint>]``: a drive's servo stiffness, a leg's axial stiffness; ``0`` frees a joint. An
             actuated joint left out whose drive states no stiffness is locked (rigid). :attr:`Stiffness.sources`
             says where each came from.
-        links: ``"rigid"`` (default), or ``{link: Beam(...) or a 6 x 6 compliance}``: those links compliant
+        links: ``None`` (default): the spec's ``[links.<link>] compliance`` tables (:attr:`ClosureSpec.links
+            <pkm.core.model.spec.ClosureSpec.links>`), rigid links where it states none; ``"rigid"``: every link
+            rigid; or ``{link: Beam(...) or a 6 x 6 compliance}``: those links compliant
             (:mod:`pkm.core.compliance.links`; the exact :meth:`Stiffness.deflection` takes rigid links); or a
             :class:`~pkm.core.compliance.links.Material`: every link that carries something a solid circular beam of
             its collision geometry's radius where that is one cylinder or capsule along its span
@@ -650,7 +654,8 @@ class VibrationModes:
     free: int
 
 
-def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: Links = "rigid",
+def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None,
+                    links: Links | None = None,
                     rtol: float = RTOL) -> VibrationModes:
     """The natural frequencies and mode shapes at the closed configuration ``q`` with the springs of
     :func:`stiffness` (same ``joints``, ``links`` and ``rtol``; the locked drives held): ``H v = w^2 N^T M N v``
