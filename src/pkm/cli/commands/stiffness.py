@@ -79,24 +79,20 @@ def _wrench(args: argparse.Namespace) -> np.ndarray | None:
 
 
 def links(value: str) -> Links | None:
-    """``--links``: None (the spec's), ``"rigid"``, or a :class:`pkm.Material`."""
-    from pkm.core.compliance.links import ALUMINIUM, STEEL, Material
+    """``--links``: ``spec``, ``rigid``, a material's name or ``E=PA[,G=PA]`` (:func:`pkm.core.compliance.links.as_links`)."""
+    from pkm.core.compliance.links import as_links
     from pkm.errors import InvalidInputError
     from pkm.units import parse_quantity
 
-    named: dict[str, Links | None] = {"spec": None, "rigid": "rigid", "steel": STEEL, "aluminium": ALUMINIUM, "aluminum": ALUMINIUM}
-    if value in named:
-        return named[value]
-    moduli = {}
+    if "=" not in value:
+        return as_links(value)
+    moduli: dict[str, float] = {}
     for item in value.split(","):
         name = item.partition("=")[0].strip()
         if "=" not in item or name not in ("E", "G") or name in moduli:
             raise InvalidInputError("--links", "spec, rigid, steel, aluminium, or E=PA[,G=PA] (moduli in Pa)", value)
-        name, number = split_item(item, "--links")
-        moduli[name] = parse_quantity(number, {None}, f"--links {name}")
-    if "E" not in moduli:
-        raise InvalidInputError("--links", "E=PA[,G=PA]: Young's modulus is needed", value)
-    return Material(E=moduli["E"], G=moduli.get("G"))
+        moduli[name] = parse_quantity(split_item(item, "--links")[1], {None}, f"--links {name}")
+    return as_links(moduli)
 
 
 def run(args: argparse.Namespace) -> int:

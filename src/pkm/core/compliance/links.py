@@ -118,6 +118,29 @@ class Material:
 STEEL = Material(E=2.1e11, G=8.1e10)
 #: Aluminium alloy (E 70 GPa, G 26 GPa).
 ALUMINIUM = Material(E=7.0e10, G=2.6e10)
+#: The materials named by :func:`as_links` (the command line's ``--links``, the service's ``links``).
+MATERIALS = {"steel": STEEL, "aluminium": ALUMINIUM, "aluminum": ALUMINIUM}
+
+
+def as_links(value: object) -> str | Material | None:
+    """A faces' ``links`` (the command line, the service) as :func:`pkm.stiffness` takes it: ``None`` or
+    ``"spec"`` (the spec's ``[links]``), ``"rigid"``, a name of :data:`MATERIALS`, or ``{"E": Pa, "G": Pa}`` (``G``
+    optional) a :class:`Material`.
+
+    Raises:
+        InvalidInputError: anything else, saying what is read.
+    """
+    if value is None or isinstance(value, Material):
+        return value
+    if isinstance(value, str) and value in ("spec", "rigid", *MATERIALS):
+        return None if value == "spec" else "rigid" if value == "rigid" else MATERIALS[value]
+    if isinstance(value, Mapping) and "E" in value and set(value) <= {"E", "G"}:
+        return Material(E=as_scalar(value["E"], "links E", unit="Pa"),
+                        G=as_scalar(value["G"], "links G", unit="Pa") if value.get("G") is not None else None)
+    raise InvalidInputError("links", "spec, rigid, " + ", ".join(MATERIALS) + ", or the moduli E [Pa] and optionally "
+                                     "G [Pa]", value)
+
+
 #: The largest angle between a cylinder's or capsule's axis and a span of its link for the primitive's radius to be
 #: taken as that beam's section [deg].
 AXIS_TOL_DEG = 5.0
@@ -321,5 +344,5 @@ def virtual_columns(mech: Mechanism, data: pin.Data, att: list[Attachment]) -> t
     return Vc, Vee
 
 
-__all__ = ["ALUMINIUM", "AXIS_TOL_DEG", "STEEL", "Attachment", "Beam", "Material", "attachments", "beams_from_collisions",
+__all__ = ["ALUMINIUM", "AXIS_TOL_DEG", "MATERIALS", "STEEL", "Attachment", "Beam", "Material", "as_links", "attachments", "beams_from_collisions",
            "virtual_columns"]
