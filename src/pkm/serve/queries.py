@@ -578,7 +578,7 @@ def stiffness(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> 
     (default: the spec's ``[links]`` compliances), ``"rigid"``, ``"steel"``, ``"aluminium"`` or ``{"E": Pa, "G": Pa}``:
     the links as beams of their collision cylinders and capsules, the compliant links and those taken rigid said."""
     from pkm.core.compliance import stiffness as run
-    from pkm.core.compliance.links import Beam, as_links
+    from pkm.core.compliance.links import as_links, law_fields
     from pkm.validation import as_scalar
 
     joints: dict[str, Any] = {}
@@ -601,9 +601,7 @@ def stiffness(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> 
         K = run(mech, q[k], joints=joints, links=links)
         sprung.update(K.sprung)  # (the same at every sample: the request's, the drives' and the spec's springs)
         sources.update(K.sources)
-        compliant.update({n: {"radius": v.radius, "inner": v.inner, "E": v.E, "G": v.G if v.G is not None else v.E / 2.6}
-                          if isinstance(v, Beam) else {"compliance": np.asarray(v, dtype=float)}
-                          for n, v in K.links.items()})
+        compliant.update({n: law_fields(v) for n, v in K.links.items()})
         rigid.update(K.rigid_links)
         out = {"q": q[k], "compliance": K.compliance, "rank": K.rank}
         for load in ("force", "moment"):  # (the principal stiffnesses' reciprocals: 0 along a rigid direction)

@@ -97,6 +97,7 @@ def links(value: str) -> Links | None:
 
 def run(args: argparse.Namespace) -> int:
     import pkm
+    from pkm.core.compliance.links import law_fields
     from pkm.errors import StiffnessError
     from pkm.report import jsonable
 
@@ -108,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
                            "outside_limits": outside_limits(mech, q), "sprung": dict(K.sprung),
                            "sources": dict(K.sources),
                            "locked": list(K.locked), "rank": K.rank, "compliance": K.compliance,
-                           "links": {n: _law(v) for n, v in K.links.items()}, "rigid_links": dict(K.rigid_links)}
+                           "links": {n: law_fields(v) for n, v in K.links.items()}, "rigid_links": dict(K.rigid_links)}
     try:
         out["matrix"] = K.matrix
     except StiffnessError as exc:
@@ -143,16 +144,6 @@ def run(args: argparse.Namespace) -> int:
         return 0
     print(_text(out))
     return 0
-
-
-def _law(law: object) -> dict[str, Any]:
-    """A compliant link's law for the output: a beam's section and moduli, or its 6 x 6 compliance."""
-    from pkm.core.compliance.links import Beam
-
-    if isinstance(law, Beam):
-        return {"radius": law.radius, "inner": law.inner, "E": law.E, "G": law.G if law.G is not None else law.E / 2.6,
-                "shear": law.shear}
-    return {"compliance": np.asarray(law, dtype=float)}
 
 
 def _text(out: dict[str, Any]) -> str:

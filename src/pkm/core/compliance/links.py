@@ -141,6 +141,15 @@ def as_links(value: object) -> str | Material | None:
                                      "G [Pa]", value)
 
 
+def law_fields(law: object) -> dict[str, object]:
+    """A compliant link's law as the faces answer it: a :class:`Beam`'s ``radius``, ``inner`` [m], ``E``, ``G``
+    [Pa] (``G`` as used) and ``shear``; else its 6 x 6 ``compliance``."""
+    if isinstance(law, Beam):
+        return {"radius": law.radius, "inner": law.inner, "E": law.E,
+                "G": law.G if law.G is not None else law.E / 2.6, "shear": law.shear}
+    return {"compliance": np.asarray(law, dtype=float)}
+
+
 #: The largest angle between a cylinder's or capsule's axis and a span of its link for the primitive's radius to be
 #: taken as that beam's section [deg].
 AXIS_TOL_DEG = 5.0
@@ -344,5 +353,5 @@ def virtual_columns(mech: Mechanism, data: pin.Data, att: list[Attachment]) -> t
     return Vc, Vee
 
 
-__all__ = ["ALUMINIUM", "AXIS_TOL_DEG", "MATERIALS", "STEEL", "Attachment", "Beam", "Material", "as_links", "attachments", "beams_from_collisions",
-           "virtual_columns"]
+__all__ = ["ALUMINIUM", "AXIS_TOL_DEG", "MATERIALS", "STEEL", "Attachment", "Beam", "Material", "as_links",
+           "attachments", "beams_from_collisions", "law_fields", "virtual_columns"]
