@@ -439,6 +439,8 @@ class Stiffness:
         the derivative of the closures' and the wrench's generalised forces taken by central differences along
         :math:`N^*`'s columns (steps of :data:`GEOMETRIC_STEP` rad or characteristic lengths). ``W = 0`` gives
         :attr:`matrix`. :math:`K_t` need not be symmetric: a constant moment in world axes is not conservative.
+        On an over-constrained mechanism :math:`\lambda^*` is the statically admissible set the equilibrium's Newton
+        solve found (least-norm increments): rigid-body statics does not fix it.
 
         Raises:
             InvalidInputError: compliant links (the exact equilibrium takes rigid links).
