@@ -82,3 +82,18 @@ def test_a_spec_states_a_links_compliance():
     skew[0, 1] += 1e-6 * np.abs(skew).max()
     with pytest.raises(InvalidInputError, match="symmetric positive definite"):
         stiffness(rrr3, q, joints=motors, links={"proximal_1": skew})
+
+
+def test_a_box_and_a_capsule_across_the_leg_are_taken_rigid(gs, pose):
+    """The Gough-Stewart's files edited: the first leg's capsule a box, the second's turned across the leg (90 deg
+    about x, past AXIS_TOL_DEG): both legs rigid with their reasons, the four others still beams."""
+    from pkm.core.model.builder import from_strings
+
+    urdf = gs.urdf.replace('<capsule radius="0.03" length="0.25"/>', '<box size="0.06 0.06 0.25"/>', 1)
+    head, sep, tail = urdf.partition('<collision name="cylinder_2_0">\n      <origin xyz="0.0 0.0 0.125" rpy="0.0')
+    assert sep
+    edited = from_strings(head + sep.replace('rpy="0.0', 'rpy="1.5708') + tail, gs.spec, gs.params, "gs")
+    K = stiffness(edited, pose, joints={j: K_LEG for j in gs.actuated_names}, links=STEEL)
+    assert "box, not one cylinder or capsule" in K.rigid_links["cylinder_1"]
+    assert "off its span to joint leg2" in K.rigid_links["cylinder_2"]
+    assert set(K.links) == {f"cylinder_{n}" for n in range(3, 7)}
