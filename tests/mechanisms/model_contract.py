@@ -13,7 +13,7 @@ from pkm.core.kinematics import constraints
 from pkm.core.model.spec import ClosureSpec
 from pkm.core.model.urdf import parse_xml
 from pkm.errors import InvalidParameterError
-from pkm.mechanisms._common import spec_parameters
+from pkm.mechanisms._common import ROD_SHAPE, spec_parameters
 
 
 def urdf_names(text: str) -> tuple[set[str], dict[str, tuple[str, str]]]:
@@ -105,8 +105,8 @@ def check_collision_primitives(mech, text: str, rods: dict, plates: dict, boxes:
     """The URDF's collision primitives against the model's forward kinematics at its reference (a closed
     configuration): every link with mass carries exactly one, and each is listed:
 
-    * ``rods = {link: (frame_start, frame_end, radius)}``: a cylinder of ``radius`` whose axis' end centres are the
-      world positions of the two frames (1e-12 m);
+    * ``rods = {link: (frame_start, frame_end, radius)}``: a :data:`~pkm.mechanisms._common.ROD_SHAPE` of ``radius``
+      whose axis' end centres (a capsule's hemispheres' centres) are the world positions of the two frames (1e-12 m);
     * ``plates = {link: (radius, thickness, [(frame, axial), ...])}``: a cylinder of that radius and thickness, each
       frame's point (or a world point given as an array) at ``radius`` from its axis and ``axial`` [m] from its
       mid-plane along its axis (1e-12 m);
@@ -131,7 +131,7 @@ def check_collision_primitives(mech, text: str, rods: dict, plates: dict, boxes:
         oM = data.oMf[model.getFrameId(link)] * M  # the primitive in the world
         if link in rods:
             a, b, radius = rods[link]
-            assert shape == "cylinder" and size["radius"] == pytest.approx(radius, abs=1e-15), (link, size)
+            assert shape == ROD_SHAPE and size["radius"] == pytest.approx(radius, abs=1e-15), (link, size)
             half = np.array([0.0, 0.0, size["length"] / 2.0])
             np.testing.assert_allclose(oM.act(-half), at(a), rtol=0, atol=1e-12, err_msg=link)
             np.testing.assert_allclose(oM.act(half), at(b), rtol=0, atol=1e-12, err_msg=link)
