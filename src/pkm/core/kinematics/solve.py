@@ -414,7 +414,7 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
 
 
 def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: ArrayLike | None = None, *,
-             branch: str | None = None, tol: float = DEFAULT_TOL, max_iter: int = 30, max_step: float = 0.05,
+             branch: str | None = None, tol: float = DEFAULT_TOL, max_iter: int = 30, max_step: float = 0.25,
              raise_on_failure: bool = True) -> SolveResult:
     """Inverse position problem: every joint coordinate for given task coordinates.
 
@@ -429,7 +429,8 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
         tol: Tolerance on the infinity norm of closure residual and task error, their lengths in units of the
             characteristic length ``L`` and their angles in rad (module doc: scale-free).
         max_iter: Newton iterations allowed per continuation step.
-        max_step: Largest task change per continuation step [``L`` or rad].
+        max_step: Largest task change per continuation step [``L`` or rad] (0.25: 5 cm on the Delta, whose
+            ``L`` is 0.21 m, as the 0.05 m of the former default in m; 0.25 rad).
         raise_on_failure: Raise :class:`ConvergenceError` instead of returning ``converged=False``.
 
     Examples:
