@@ -11,9 +11,12 @@ import pinocchio as pin
 import pytest
 
 import pkm
+from pkm.core.dynamics.projection import constraint_dynamics
 from pkm.core.formats.catalogue import CATALOGUE, catalogue_path
+from pkm.core.formats.to_mjcf import qpos_of
 from pkm.core.kinematics import constraints
 from pkm.errors import PkmWarning, TransmissionError
+from tests.fd import rel
 
 FEET = ("left-foot", "right-foot")
 
@@ -107,3 +110,81 @@ def test_its_leaf_springs_are_read_noted_and_saved(cassie, feet, tmp_path):
     assert spec.springs == springs
     assert all(t.mechanism.spec.springs == {f"{t.motors[0].partition('-')[0]}-foot-crank": {"damping": 1.0}}
                for t in feet)
+
+
+def _mujoco_at_rest(cassie, q, tau):
+    """MuJoCo on the same file at ``q`` (Pinocchio's), at rest, the motors' ``ctrl`` giving efforts ``tau`` through
+    the file's gears: the accelerations of its four connects held exactly (the KKT system of MuJoCo's own mass
+    matrix with the armature, bias, passive and actuator forces and equality Jacobian; ten of its twelve rows are
+    independent, each knee loop being planar: least squares, unique in the accelerations), ``mj_forward``'s soft ones
+    at the stiffest equalities MuJoCo allows (solref 1e-4 s, solimp 0.9999), and the map of Pinocchio's
+    accelerations to MuJoCo's dofs (a free joint's linear ones in world axes: at rest, ``R a``)."""
+    mujoco = pytest.importorskip("mujoco")  # (the bench extra: the reference, not a dependency)
+    m = mujoco.MjModel.from_xml_path(str(catalogue_path("menagerie:cassie")))
+    m.opt.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
+    d = mujoco.MjData(m)
+    joints = [cassie.model.getJointId(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, k) or cassie.base.name)
+              for k in range(m.njnt)]
+    for k, j in enumerate(joints):
+        seg = qpos_of(cassie.model, j, q)
+        d.qpos[m.jnt_qposadr[k]:m.jnt_qposadr[k] + len(seg)] = seg
+    efforts = dict(zip(cassie.actuated_names, tau))
+    names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, k) for k in range(m.nu)]
+    d.ctrl[:] = [efforts[n] / g for n, g in zip(names, m.actuator_gear[:, 0])]
+    assert np.all(np.abs(d.ctrl) <= m.actuator_ctrlrange[:, 1])  # (no control clamped)
+    mujoco.mj_forward(m, d)
+    M = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, M)
+    assert np.all(d.efc_type[:d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)  # (no limit, no contact)
+    J = d.efc_J[:d.nefc * m.nv].reshape(d.nefc, m.nv)
+    kkt = np.block([[M, J.T], [J, np.zeros((d.nefc, d.nefc))]])
+    exact = np.linalg.lstsq(kkt, np.r_[d.qfrc_actuator + d.qfrc_passive - d.qfrc_bias, np.zeros(d.nefc)])[0][:m.nv]
+    m.opt.timestep = 5e-5  # (MuJoCo clamps a time constant to twice the step)
+    m.eq_solref[:] = [1e-4, 1.0]
+    m.eq_solimp[:] = [0.9999, 0.9999, 0.001, 0.5, 2.0]
+    mujoco.mj_forward(m, d)
+    pin.forwardKinematics(cassie.model, cassie.data, q)
+
+    def dofs(a):
+        out = np.zeros(m.nv)
+        for k, j in enumerate(joints):
+            jm, at = cassie.model.joints[j], m.jnt_dofadr[k]
+            out[at:at + jm.nv] = a[jm.idx_v:jm.idx_v + jm.nv]
+            if m.jnt_type[k] == mujoco.mjtJoint.mjJNT_FREE:
+                out[at:at + 3] = cassie.data.oMi[j].rotation @ a[jm.idx_v:jm.idx_v + 3]
+        return out
+
+    return exact, d.qacc.copy(), dofs
+
+
+def test_its_free_pelvis_moves_as_pinocchio_and_mujoco_say(cassie):
+    """Forward dynamics with the pelvis free (the default), at a pose closed 0.1 rad from home, random motor efforts
+    and rates and a random pelvis twist: the motors', the pelvis' and every other acceleration out of the idle
+    motions equal Pinocchio's constraintDynamics of the same model to 1e-8 relative (measured 1.9e-13; the idle ones,
+    three per leg: the shin, tarsus and heel-spring leaf springs with the achilles rod's spin, are the convention's,
+    no idle motion in the mass metric, and are left out), and constraintDynamics' centre of mass falls at g (no
+    wrench on a free body but gravity; the convention's idle accelerations move the legs' mass, so pkm's full
+    vector does not: 4.75 m/s^2 off here). At rest, constraintDynamics (every joint, the leaf springs' efforts included) equals MuJoCo on the
+    same file with its four connects held exactly to 1e-8 (measured 1e-11); MuJoCo's own soft answer at its stiffest
+    equalities (solimp 0.9999) stays 5.3e-4 off: its softness, bounded here at 2e-3."""
+    rng = np.random.default_rng(3)
+    q = pkm.close_loops(cassie, cassie.actuated_q(cassie.q_reference) + 0.1 * rng.uniform(-1, 1, cassie.na),
+                        cassie.q_reference).q
+    tau = 10.0 * rng.normal(size=cassie.na)
+    rates = np.zeros(cassie.nv)
+    rates[cassie.base_v], rates[cassie.act_v] = rng.normal(size=6), rng.normal(size=cassie.na)
+    model = pkm.actuator_model(cassie, q, rates)
+    N = model.idle
+    assert model.base == "free" and N.shape[1] == 6 and not np.any(N[cassie.base_v]) and not np.any(N[cassie.act_v])
+    a = pkm.forward_dynamics(cassie, q, model.v, tau)
+    a_cd = constraint_dynamics(cassie, q, model.v, tau)
+    assert rel(a - N @ (N.T @ a), a_cd - N @ (N.T @ a_cd)) <= 1e-8
+    pin.centerOfMass(cassie.model, cassie.data, q, model.v, a_cd)
+    assert np.abs(cassie.data.acom[0] - cassie.model.gravity.linear).max() <= 1e-8 * 9.81
+    rest = np.zeros(cassie.nv)
+    a_cd = constraint_dynamics(cassie, q, rest, tau)
+    a = pkm.forward_dynamics(cassie, q, rest, tau)
+    assert rel(a[cassie.act_v], a_cd[cassie.act_v]) <= 1e-8 and rel(a[cassie.base_v], a_cd[cassie.base_v]) <= 1e-8
+    exact, soft, dofs = _mujoco_at_rest(cassie, q, tau)
+    assert rel(dofs(a_cd), exact) <= 1e-8
+    assert rel(soft, exact) <= 2e-3
