@@ -247,8 +247,14 @@ def _eulers_to_quats(root: etree._Element, degrees: bool, source: str) -> str:
 
 
 def _merge_defaults(root: etree._Element) -> int:
-    """The top-level ``<default>`` elements merged into the first (Pinocchio reads the first only); their number."""
+    """The top-level ``<default>`` elements merged into the first (Pinocchio reads the first only), placed before the
+    ``<worldbody>`` (MuJoCo reads the classes wherever they stand; Pinocchio 4.1 in document order, and a class it has
+    not met yet raised ``unordered_map::at``: ToddlerBot's files state them last); their number."""
     tops = root.findall("default")
+    world = root.find("worldbody")
+    if tops and world is not None and list(root).index(tops[0]) > list(root).index(world):
+        root.remove(tops[0])
+        root.insert(list(root).index(world), tops[0])
     for extra in tops[1:]:
         for child in list(extra):
             if not isinstance(child.tag, str):
