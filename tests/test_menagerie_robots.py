@@ -12,11 +12,12 @@ import pytest
 
 import pkm
 from pkm.core.dynamics.projection import constraint_dynamics
-from pkm.core.formats.catalogue import CATALOGUE, catalogue_path
+from pkm.core.formats.catalogue import catalogue_path
 from pkm.core.formats.to_mjcf import qpos_of
 from pkm.core.kinematics import constraints
 from pkm.errors import PkmWarning, TransmissionError
 from tests.fd import rel
+from tests.shipped import check_closes_from_a_moved_seed, check_round_trip, check_shipped
 
 FEET = ("left-foot", "right-foot")
 
@@ -33,13 +34,9 @@ def feet(cassie):
 
 
 def test_it_ships_with_its_licence_and_source_and_no_mesh():
-    path = catalogue_path("menagerie:cassie")
-    assert path.name == "cassie.xml" and "menagerie:cassie" in CATALOGUE
-    assert "Agility Robotics" in (path.parent / "LICENSE").read_text()
-    source = (path.parent / "SOURCE.txt").read_text()
-    assert all(s in source for s in ("google-deepmind/mujoco_menagerie", "agility_cassie/cassie.xml",
-                                     "1b428b08bb26ca6024e7b21e8ff21a59f847eb87"))
-    assert "mesh" not in path.read_text()
+    text = check_shipped("menagerie:cassie", "cassie.xml", "Agility Robotics", (
+        "google-deepmind/mujoco_menagerie", "agility_cassie/cassie.xml", "1b428b08bb26ca6024e7b21e8ff21a59f847eb87"))
+    assert "mesh" not in text
 
 
 def test_it_loads_at_its_home_key_closed_inside_every_limit_with_no_dependent_actuator(cassie):
@@ -58,11 +55,7 @@ def test_it_loads_at_its_home_key_closed_inside_every_limit_with_no_dependent_ac
 
 def test_it_assembles_and_its_loops_close_again_from_a_seed_moved_by_0_02_rad(cassie):
     assert pkm.assemble(cassie).residual <= 1e-12
-    qa = cassie.actuated_q(cassie.q_reference)
-    step = 0.02 * np.random.default_rng(0).uniform(-1.0, 1.0, cassie.nv)
-    step[cassie.act_v] = 0.0
-    fk = pkm.close_loops(cassie, qa, pin.integrate(cassie.model, cassie.q_reference, step))
-    assert fk.residual <= 1e-10 and np.abs(cassie.actuated_q(fk.q) - qa).max() <= 1e-12
+    check_closes_from_a_moved_seed(cassie)
 
 
 def test_its_two_foot_transmissions_are_found_and_round_trip(feet):
@@ -71,11 +64,7 @@ def test_its_two_foot_transmissions_are_found_and_round_trip(feet):
     by_motor = {t.motors: t for t in feet}
     assert {(m,) for m in FEET} <= set(by_motor)
     for motor in FEET:
-        t = by_motor[(motor,)]
-        qm = t.mechanism.actuated_q(t.q_reference) + 0.1
-        qo, q_sub = t.outputs_from_motors(qm)
-        back, _ = t.motors_from_outputs(qo, q_sub)
-        assert np.abs(back - qm).max() <= 1e-10, t.name
+        check_round_trip(by_motor[(motor,)])
 
 
 def test_its_knee_is_no_transmission_and_is_refused_by_name(cassie):
