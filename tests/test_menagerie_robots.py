@@ -12,12 +12,10 @@ import pytest
 
 import pkm
 from pkm.core.dynamics.projection import constraint_dynamics
-from pkm.core.formats.catalogue import catalogue_path
-from pkm.core.formats.to_mjcf import qpos_of
 from pkm.core.kinematics import constraints
 from pkm.errors import PkmWarning, TransmissionError
 from tests.fd import rel
-from tests.shipped import check_closes_from_a_moved_seed, check_round_trip, check_shipped
+from tests.shipped import MujocoAt, check_closes_from_a_moved_seed, check_round_trip, check_shipped
 
 FEET = ("left-foot", "right-foot")
 
@@ -101,51 +99,6 @@ def test_its_leaf_springs_are_read_noted_and_saved(cassie, feet, tmp_path):
                for t in feet)
 
 
-def _mujoco_at_rest(cassie, q, tau):
-    """MuJoCo on the same file at ``q`` (Pinocchio's), at rest, the motors' ``ctrl`` giving efforts ``tau`` through
-    the file's gears: the accelerations of its four connects held exactly (the KKT system of MuJoCo's own mass
-    matrix with the armature, bias, passive and actuator forces and equality Jacobian; ten of its twelve rows are
-    independent, each knee loop being planar: least squares, unique in the accelerations), ``mj_forward``'s soft ones
-    at the stiffest equalities MuJoCo allows (solref 1e-4 s, solimp 0.9999), and the map of Pinocchio's
-    accelerations to MuJoCo's dofs (a free joint's linear ones in world axes: at rest, ``R a``)."""
-    mujoco = pytest.importorskip("mujoco")  # (the bench extra: the reference, not a dependency)
-    m = mujoco.MjModel.from_xml_path(str(catalogue_path("menagerie:cassie")))
-    m.opt.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
-    d = mujoco.MjData(m)
-    joints = [cassie.model.getJointId(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, k) or cassie.base.name)
-              for k in range(m.njnt)]
-    for k, j in enumerate(joints):
-        seg = qpos_of(cassie.model, j, q)
-        d.qpos[m.jnt_qposadr[k]:m.jnt_qposadr[k] + len(seg)] = seg
-    efforts = dict(zip(cassie.actuated_names, tau))
-    names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, k) for k in range(m.nu)]
-    d.ctrl[:] = [efforts[n] / g for n, g in zip(names, m.actuator_gear[:, 0])]
-    assert np.all(np.abs(d.ctrl) <= m.actuator_ctrlrange[:, 1])  # (no control clamped)
-    mujoco.mj_forward(m, d)
-    M = np.zeros((m.nv, m.nv))
-    mujoco.mj_fullM(m, d, M)
-    assert np.all(d.efc_type[:d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)  # (no limit, no contact)
-    J = d.efc_J[:d.nefc * m.nv].reshape(d.nefc, m.nv)
-    kkt = np.block([[M, J.T], [J, np.zeros((d.nefc, d.nefc))]])
-    exact = np.linalg.lstsq(kkt, np.r_[d.qfrc_actuator + d.qfrc_passive - d.qfrc_bias, np.zeros(d.nefc)])[0][:m.nv]
-    m.opt.timestep = 5e-5  # (MuJoCo clamps a time constant to twice the step)
-    m.eq_solref[:] = [1e-4, 1.0]
-    m.eq_solimp[:] = [0.9999, 0.9999, 0.001, 0.5, 2.0]
-    mujoco.mj_forward(m, d)
-    pin.forwardKinematics(cassie.model, cassie.data, q)
-
-    def dofs(a):
-        out = np.zeros(m.nv)
-        for k, j in enumerate(joints):
-            jm, at = cassie.model.joints[j], m.jnt_dofadr[k]
-            out[at:at + jm.nv] = a[jm.idx_v:jm.idx_v + jm.nv]
-            if m.jnt_type[k] == mujoco.mjtJoint.mjJNT_FREE:
-                out[at:at + 3] = cassie.data.oMi[j].rotation @ a[jm.idx_v:jm.idx_v + 3]
-        return out
-
-    return exact, d.qacc.copy(), dofs
-
-
 def test_its_free_pelvis_moves_as_pinocchio_and_mujoco_say(cassie):
     """Forward dynamics with the pelvis free (the default), at a pose closed 0.1 rad from home, random motor efforts
     and rates and a random pelvis twist: the motors', the pelvis' and every other acceleration out of the idle
@@ -153,9 +106,11 @@ def test_its_free_pelvis_moves_as_pinocchio_and_mujoco_say(cassie):
     three per leg: the shin, tarsus and heel-spring leaf springs with the achilles rod's spin, are the convention's,
     no idle motion in the mass metric, and are left out), and constraintDynamics' centre of mass falls at g (no
     wrench on a free body but gravity; the convention's idle accelerations move the legs' mass, so pkm's full
-    vector does not: 4.75 m/s^2 off here). At rest, constraintDynamics (every joint, the leaf springs' efforts included) equals MuJoCo on the
-    same file with its four connects held exactly to 1e-8 (measured 1e-11); MuJoCo's own soft answer at its stiffest
-    equalities (solimp 0.9999) stays 5.3e-4 off: its softness, bounded here at 2e-3."""
+    vector does not: 4.75 m/s^2 off here). At rest, constraintDynamics (every joint, the leaf springs' efforts
+    included) equals MuJoCo on the same file, the efforts through its motors and gears, with its four connects held
+    exactly (:meth:`~tests.shipped.MujocoAt.held`; ten of the twelve rows independent, each knee loop being planar)
+    to 1e-8 (measured 1e-11); MuJoCo's own soft answer at its stiffest equalities (solref 1e-4 s, solimp 0.9999)
+    stays 5.3e-4 off: its softness, bounded here at 2e-3."""
     rng = np.random.default_rng(3)
     q = pkm.close_loops(cassie, cassie.actuated_q(cassie.q_reference) + 0.1 * rng.uniform(-1, 1, cassie.na),
                         cassie.q_reference).q
@@ -174,6 +129,17 @@ def test_its_free_pelvis_moves_as_pinocchio_and_mujoco_say(cassie):
     a_cd = constraint_dynamics(cassie, q, rest, tau)
     a = pkm.forward_dynamics(cassie, q, rest, tau)
     assert rel(a[cassie.act_v], a_cd[cassie.act_v]) <= 1e-8 and rel(a[cassie.base_v], a_cd[cassie.base_v]) <= 1e-8
-    exact, soft, dofs = _mujoco_at_rest(cassie, q, tau)
-    assert rel(dofs(a_cd), exact) <= 1e-8
-    assert rel(soft, exact) <= 2e-3
+    mj = MujocoAt(cassie, "menagerie:cassie", q)
+    m, d = mj.m, mj.d
+    efforts = dict(zip(cassie.actuated_names, tau))  # (through the file's motors and gears)
+    d.ctrl[:] = [efforts[mj.mujoco.mj_id2name(m, mj.mujoco.mjtObj.mjOBJ_ACTUATOR, k)] / m.actuator_gear[k, 0]
+                 for k in range(m.nu)]
+    assert np.all(np.abs(d.ctrl) <= m.actuator_ctrlrange[:, 1])  # (no control clamped)
+    mj.forward()
+    exact = mj.held()
+    assert rel(mj.dofs(a_cd), exact) <= 1e-8
+    m.opt.timestep = 5e-5  # (MuJoCo clamps a time constant to twice the step)
+    m.eq_solref[:] = [1e-4, 1.0]
+    m.eq_solimp[:] = [0.9999, 0.9999, 0.001, 0.5, 2.0]
+    mj.forward()
+    assert rel(d.qacc, exact) <= 2e-3

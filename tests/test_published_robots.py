@@ -9,16 +9,14 @@ per module (0.2 s)."""
 from __future__ import annotations
 
 import numpy as np
-import pinocchio as pin
 import pytest
 
 import pkm
 from pkm.core.formats.catalogue import catalogue_path
-from pkm.core.formats.to_mjcf import qpos_of
 from pkm.core.kinematics import constraints
 from pkm.errors import PkmWarning, TransmissionError
 from tests.fd import constraint_jacobian_error
-from tests.shipped import check_closes_from_a_moved_seed, check_round_trip, check_shipped
+from tests.shipped import MujocoAt, check_closes_from_a_moved_seed, check_round_trip, check_shipped
 
 KNEES = ("left_knee_act", "right_knee_act")
 
@@ -63,28 +61,16 @@ def test_it_assembles_its_loops_close_from_a_moved_seed_and_their_jacobian_is_th
 
 def test_mujoco_puts_every_body_where_pkm_does_and_finds_its_equalities_held(toddlerbot):
     """MuJoCo on the same file at pkm's closed pose moved 0.1 rad on every motor but the neck's (the mimic joints at
-    their gear ratios): every body at pkm's position (1e-12 m) and every equality row (six welds, nine gears) held to 1e-9 of
-    the robot's size (m, and rad times it)."""
-    mujoco = pytest.importorskip("mujoco")  # (the bench extra: the reference, not a dependency)
-    m = mujoco.MjModel.from_xml_path(str(catalogue_path("toddlerbot:toddlerbot")))
-    d = mujoco.MjData(m)
+    their gear ratios): every body at pkm's position (1e-12 m) and every equality row (six welds, nine gears) held
+    to 1e-9 of the robot's size (m, and rad times it)."""
     step = np.full(toddlerbot.na, 0.1)
     step[toddlerbot.actuated_names.index("neck_pitch_act")] = 0.0  # (the neck's rods lock it: see the neck's test)
     q = pkm.close_loops(toddlerbot, toddlerbot.actuated_q(toddlerbot.q_reference) + step, toddlerbot.q_reference).q
-    for k in range(m.njnt):
-        j = toddlerbot.model.getJointId(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, k) or toddlerbot.base.name)
-        seg = qpos_of(toddlerbot.model, j, q)
-        d.qpos[m.jnt_qposadr[k]:m.jnt_qposadr[k] + len(seg)] = seg
-    mujoco.mj_forward(m, d)
-    data = toddlerbot.data
-    pin.framesForwardKinematics(toddlerbot.model, data, q)
-    for b in range(1, m.nbody):
-        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b)
-        at = data.oMf[toddlerbot.model.getFrameId(name, pin.FrameType.BODY)].translation
-        assert np.abs(at - d.xpos[b]).max() <= 1e-12, name
-    rows = d.efc_type[:d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
-    assert rows.sum() == 6 * 6 + 9
-    assert np.abs(d.efc_pos[:d.nefc][rows]).max() <= 1e-9 * toddlerbot.characteristic_length
+    mj = MujocoAt(toddlerbot, "toddlerbot:toddlerbot", q)
+    mj.forward()
+    assert mj.body_gap() <= 1e-12
+    rows = mj.equality_rows()
+    assert rows.size == 6 * 6 + 9 and np.abs(rows).max() <= 1e-9 * toddlerbot.characteristic_length
 
 
 def test_its_knees_are_transmissions_and_its_neck_is_refused_by_name(toddlerbot):
