@@ -1,8 +1,11 @@
-"""MuJoCo Menagerie's Cassie (Agility Robotics, MIT: ``urdf/menagerie/agility_cassie/``, meshes removed, the commit
-and every change in its ``SOURCE.txt``), loaded by name (``pkm.load("menagerie:cassie")``:
-:mod:`pkm.core.formats.catalogue`): a real humanoid's legs as published, whose bodies and joints share names, whose
-reference is its ``home`` key (open by about 2 mm, as MuJoCo's soft equalities leave it), and whose knee loop is no
-transmission. One Cassie is loaded per module (0.15 s)."""
+"""MuJoCo Menagerie's robots shipped with pkm, loaded by name (:mod:`pkm.core.formats.catalogue`), meshes removed,
+the commit and every change in each folder's ``SOURCE.txt``.
+
+Cassie (Agility Robotics, MIT: ``urdf/menagerie/agility_cassie/``): a real humanoid's legs as published, whose bodies
+and joints share names, whose reference is its ``home`` key (open by about 2 mm, as MuJoCo's soft equalities leave
+it), and whose knee loop is no transmission. Robotiq's 2F-85 gripper (BSD-2-Clause:
+``urdf/menagerie/robotiq_2f85/``): two adaptive four-bar fingers closed by connects on bodies whose joints state a
+``pos``, one motor on a tendon over both drivers. One robot is loaded per module (0.15 s)."""
 
 from __future__ import annotations
 
@@ -14,7 +17,7 @@ import pkm
 from pkm.core.dynamics.projection import constraint_dynamics
 from pkm.core.kinematics import constraints
 from pkm.errors import PkmWarning, TransmissionError
-from tests.fd import rel
+from tests.fd import constraint_jacobian_error, rel
 from tests.shipped import MujocoAt, check_closes_from_a_moved_seed, check_round_trip, check_shipped
 
 FEET = ("left-foot", "right-foot")
@@ -143,3 +146,58 @@ def test_its_free_pelvis_moves_as_pinocchio_and_mujoco_say(cassie):
     m.eq_solimp[:] = [0.9999, 0.9999, 0.001, 0.5, 2.0]
     mj.forward()
     assert rel(d.qacc, exact) <= 2e-3
+
+
+# ---------------------------------------------------------------------- Robotiq's 2F-85 gripper
+@pytest.fixture(scope="module")
+def gripper() -> pkm.Mechanism:
+    return pkm.load("menagerie:robotiq_2f85")
+
+
+def test_the_gripper_ships_and_loads_with_its_motor_on_the_tendon_over_both_drivers(gripper):
+    """Menagerie's Robotiq 2F-85 (BSD-2-Clause, meshes removed): its one motor acts on the tendon ``split`` (half
+    of each driver), the drivers tied by a joint equality (the right one a mimic of the left): one actuated joint;
+    its two finger loops are point closures, closed at the reference (MuJoCo's qpos0) inside every limit, with no
+    dependent actuator; each adaptive finger keeps one freedom no motor drives (two idle motions), held by the
+    spring links' springs, which are read."""
+    check_shipped("menagerie:robotiq_2f85", "2f85.xml", "ROS-Industrial", (
+        "google-deepmind/mujoco_menagerie", "robotiq_2f85/2f85.xml", "1b428b08bb26ca6024e7b21e8ff21a59f847eb87",
+        "BSD-2-Clause"))
+    assert gripper.actuated_names == ("left_driver_joint",) and gripper.base is None
+    assert [c.type for c in gripper.spec.closures] == ["point", "point"]
+    notes = " ".join(gripper.notes)
+    assert "tendon 'split'" in notes and "right_driver_joint = 1 left_driver_joint" in notes
+    q = gripper.q_reference
+    assert constraints.worst_closure(gripper, constraints.residual(gripper, q))[0] <= 1e-12
+    assert gripper.outside_limits(q, tol=0.0) == () and gripper.dependent_actuators == ()
+    assert pkm.diagnose(gripper, q).idle_motions == 2
+    assert set(gripper.spec.springs) == {"left_spring_link_joint", "right_spring_link_joint"}
+    assert pkm.assemble(gripper).residual <= 1e-12
+    check_closes_from_a_moved_seed(gripper)
+    assert constraint_jacobian_error(gripper, q) <= 1e-7
+
+
+def test_mujoco_holds_the_gripper_s_connects_where_pkm_closes_them(gripper):
+    """At pkm's closed pose with the motor at 0.3 rad, MuJoCo on the same file puts every body where pkm does (1e-12
+    m) and finds its two connects and the drivers' equality held (1e-12 m or rad). Before, pkm took Pinocchio's
+    anchors, in the followers' joint frames (19 mm from their bodies'): the connects stood 0.46 mm open and the
+    followers were idle spins."""
+    q = pkm.close_loops(gripper, [0.3], gripper.q_reference).q
+    mj = MujocoAt(gripper, "menagerie:robotiq_2f85", q)
+    mj.forward()
+    assert mj.body_gap() <= 1e-12
+    rows = mj.equality_rows()
+    assert rows.size == 2 * 3 + 1 and np.abs(rows).max() <= 1e-12
+
+
+def test_the_gripper_s_underactuated_fingers_are_refused_as_transmissions(gripper):
+    """Each adaptive finger has two freedoms and one input: no transmission. The refusals are TransmissionErrors:
+    the left finger's outputs leave the motor free, the right finger's loop holds no actuated joint (its driver a
+    mimic), and with both left out nothing remains (``no_loop``)."""
+    with pytest.raises(TransmissionError):
+        pkm.transmissions(gripper)
+    with pytest.warns(PkmWarning) as caught, pytest.raises(TransmissionError) as err:
+        pkm.transmissions(gripper, skip_unfit=True)
+    assert err.value.reason == "no_loop"
+    said = " ".join(str(w.message) for w in caught)
+    assert "with the outputs held the motors can move" in said and "hold no actuated joint" in said
