@@ -192,8 +192,9 @@ def test_mujoco_holds_the_gripper_s_connects_where_pkm_closes_them(gripper):
 
 def test_the_gripper_s_underactuated_fingers_are_refused_as_transmissions(gripper):
     """Each adaptive finger has two freedoms and one input: no transmission. The refusals are TransmissionErrors:
-    the left finger's outputs leave the motor free, the right finger's loop holds no actuated joint (its driver a
-    mimic), and with both left out nothing remains (``no_loop``)."""
+    the left finger's outputs leave the motor free, the right finger's loop holds no actuated joint (its driver
+    follows the left one by the gear equality, which the refusal names), and with both left out nothing remains
+    (``no_loop``)."""
     with pytest.raises(TransmissionError):
         pkm.transmissions(gripper)
     with pytest.warns(PkmWarning) as caught, pytest.raises(TransmissionError) as err:
@@ -201,3 +202,4 @@ def test_the_gripper_s_underactuated_fingers_are_refused_as_transmissions(grippe
     assert err.value.reason == "no_loop"
     said = " ".join(str(w.message) for w in caught)
     assert "with the outputs held the motors can move" in said and "hold no actuated joint" in said
+    assert "'right_driver_joint' follows 'left_driver_joint'" in said
