@@ -106,3 +106,21 @@ class MujocoAt:
         """MuJoCo's violations of its equality rows (after :meth:`forward`): m, rad, or rad for a joint equality."""
         d = self.d
         return d.efc_pos[:d.nefc][d.efc_type[:d.nefc] == self.mujoco.mjtConstraint.mjCNSTR_EQUALITY]
+
+
+def check_mjcf_round_trip(mech: pkm.Mechanism, step: np.ndarray) -> None:
+    """pkm's MJCF of ``mech`` read back: the same motors, and at the motors moved by ``step`` from the reference
+    (closed by each model from its own reference) every joint where ``mech`` puts it (1e-12 m; the writer names the
+    bodies after their joints' links, so joints are what both name alike)."""
+    from pkm.core.formats.load import load_texts
+    from pkm.core.formats.to_mjcf import mjcf_from_mechanism
+
+    back = load_texts({f"{mech.name}.xml": mjcf_from_mechanism(mech)})
+    assert back.actuated_names == mech.actuated_names
+    models = []
+    for m in (mech, back):
+        q = pkm.close_loops(m, m.actuated_q(m.q_reference) + step, m.q_reference).q
+        pin.forwardKinematics(m.model, m.data, q)
+        models.append({m.model.names[j]: m.data.oMi[j].translation.copy() for j in range(1, m.model.njoints)})
+    assert set(models[1]) == set(models[0])
+    assert max(float(np.abs(models[0][j] - models[1][j]).max()) for j in models[0]) <= 1e-12

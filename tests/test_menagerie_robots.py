@@ -18,7 +18,13 @@ from pkm.core.dynamics.projection import constraint_dynamics
 from pkm.core.kinematics import constraints
 from pkm.errors import PkmWarning, TransmissionError
 from tests.fd import constraint_jacobian_error, rel
-from tests.shipped import MujocoAt, check_closes_from_a_moved_seed, check_round_trip, check_shipped
+from tests.shipped import (
+    MujocoAt,
+    check_closes_from_a_moved_seed,
+    check_mjcf_round_trip,
+    check_round_trip,
+    check_shipped,
+)
 
 FEET = ("left-foot", "right-foot")
 
@@ -181,13 +187,14 @@ def test_mujoco_holds_the_gripper_s_connects_where_pkm_closes_them(gripper):
     """At pkm's closed pose with the motor at 0.3 rad, MuJoCo on the same file puts every body where pkm does (1e-12
     m) and finds its two connects and the drivers' equality held (1e-12 m or rad). Before, pkm took Pinocchio's
     anchors, in the followers' joint frames (19 mm from their bodies'): the connects stood 0.46 mm open and the
-    followers were idle spins."""
+    followers were idle spins. pkm's MJCF of it, read back, closes there with every joint in place (1e-12 m)."""
     q = pkm.close_loops(gripper, [0.3], gripper.q_reference).q
     mj = MujocoAt(gripper, "menagerie:robotiq_2f85", q)
     mj.forward()
     assert mj.body_gap() <= 1e-12
     rows = mj.equality_rows()
     assert rows.size == 2 * 3 + 1 and np.abs(rows).max() <= 1e-12
+    check_mjcf_round_trip(gripper, np.array([0.3]))
 
 
 def test_the_gripper_s_underactuated_fingers_are_refused_as_transmissions(gripper):

@@ -16,7 +16,13 @@ from pkm.core.formats.catalogue import catalogue_path
 from pkm.core.kinematics import constraints
 from pkm.errors import PkmWarning, TransmissionError
 from tests.fd import constraint_jacobian_error
-from tests.shipped import MujocoAt, check_closes_from_a_moved_seed, check_round_trip, check_shipped
+from tests.shipped import (
+    MujocoAt,
+    check_closes_from_a_moved_seed,
+    check_mjcf_round_trip,
+    check_round_trip,
+    check_shipped,
+)
 
 KNEES = ("left_knee_act", "right_knee_act")
 
@@ -62,7 +68,8 @@ def test_it_assembles_its_loops_close_from_a_moved_seed_and_their_jacobian_is_th
 def test_mujoco_puts_every_body_where_pkm_does_and_finds_its_equalities_held(toddlerbot):
     """MuJoCo on the same file at pkm's closed pose moved 0.1 rad on every motor but the neck's (the mimic joints at
     their gear ratios): every body at pkm's position (1e-12 m) and every equality row (six welds, nine gears) held
-    to 1e-9 of the robot's size (m, and rad times it)."""
+    to 1e-9 of the robot's size (m, and rad times it). pkm's MJCF of it, read back, closes there with every joint in
+    place (1e-12 m)."""
     step = np.full(toddlerbot.na, 0.1)
     step[toddlerbot.actuated_names.index("neck_pitch_act")] = 0.0  # (the neck's rods lock it: see the neck's test)
     q = pkm.close_loops(toddlerbot, toddlerbot.actuated_q(toddlerbot.q_reference) + step, toddlerbot.q_reference).q
@@ -71,6 +78,7 @@ def test_mujoco_puts_every_body_where_pkm_does_and_finds_its_equalities_held(tod
     assert mj.body_gap() <= 1e-12
     rows = mj.equality_rows()
     assert rows.size == 6 * 6 + 9 and np.abs(rows).max() <= 1e-9 * toddlerbot.characteristic_length
+    check_mjcf_round_trip(toddlerbot, step)
 
 
 def test_its_knees_are_transmissions_and_its_neck_is_refused_by_name(toddlerbot):
