@@ -1,8 +1,11 @@
-"""MuJoCo Menagerie's Cassie (Agility Robotics, MIT: ``urdf/menagerie/agility_cassie/``, meshes removed, the commit
-and every change in its ``SOURCE.txt``), loaded by name (``pkm.load("menagerie:cassie")``:
-:mod:`pkm.core.formats.catalogue`): a real humanoid's legs as published, whose bodies and joints share names, whose
-reference is its ``home`` key (open by about 2 mm, as MuJoCo's soft equalities leave it), and whose knee loop is no
-transmission. One Cassie is loaded per module (0.15 s)."""
+"""MuJoCo Menagerie's robots shipped with pkm, loaded by name (:mod:`pkm.core.formats.catalogue`), meshes removed,
+the commit and every change in each folder's ``SOURCE.txt``.
+
+Cassie (Agility Robotics, MIT: ``urdf/menagerie/agility_cassie/``): a real humanoid's legs as published, whose bodies
+and joints share names, whose reference is its ``home`` key (open by about 2 mm, as MuJoCo's soft equalities leave
+it), and whose knee loop is no transmission. Robotiq's 2F-85 gripper (BSD-2-Clause:
+``urdf/menagerie/robotiq_2f85/``): two adaptive four-bar fingers closed by connects on bodies whose joints state a
+``pos``, one motor on a tendon over both drivers. One robot is loaded per module (0.15 s)."""
 
 from __future__ import annotations
 
@@ -11,9 +14,17 @@ import pinocchio as pin
 import pytest
 
 import pkm
-from pkm.core.formats.catalogue import CATALOGUE, catalogue_path
+from pkm.core.dynamics.projection import constraint_dynamics
 from pkm.core.kinematics import constraints
 from pkm.errors import PkmWarning, TransmissionError
+from tests.fd import constraint_jacobian_error, rel
+from tests.shipped import (
+    MujocoAt,
+    check_closes_from_a_moved_seed,
+    check_mjcf_round_trip,
+    check_round_trip,
+    check_shipped,
+)
 
 FEET = ("left-foot", "right-foot")
 
@@ -30,13 +41,9 @@ def feet(cassie):
 
 
 def test_it_ships_with_its_licence_and_source_and_no_mesh():
-    path = catalogue_path("menagerie:cassie")
-    assert path.name == "cassie.xml" and "menagerie:cassie" in CATALOGUE
-    assert "Agility Robotics" in (path.parent / "LICENSE").read_text()
-    source = (path.parent / "SOURCE.txt").read_text()
-    assert all(s in source for s in ("google-deepmind/mujoco_menagerie", "agility_cassie/cassie.xml",
-                                     "1b428b08bb26ca6024e7b21e8ff21a59f847eb87"))
-    assert "mesh" not in path.read_text()
+    text = check_shipped("menagerie:cassie", "cassie.xml", "Agility Robotics", (
+        "google-deepmind/mujoco_menagerie", "agility_cassie/cassie.xml", "1b428b08bb26ca6024e7b21e8ff21a59f847eb87"))
+    assert "mesh" not in text
 
 
 def test_it_loads_at_its_home_key_closed_inside_every_limit_with_no_dependent_actuator(cassie):
@@ -55,11 +62,7 @@ def test_it_loads_at_its_home_key_closed_inside_every_limit_with_no_dependent_ac
 
 def test_it_assembles_and_its_loops_close_again_from_a_seed_moved_by_0_02_rad(cassie):
     assert pkm.assemble(cassie).residual <= 1e-12
-    qa = cassie.actuated_q(cassie.q_reference)
-    step = 0.02 * np.random.default_rng(0).uniform(-1.0, 1.0, cassie.nv)
-    step[cassie.act_v] = 0.0
-    fk = pkm.close_loops(cassie, qa, pin.integrate(cassie.model, cassie.q_reference, step))
-    assert fk.residual <= 1e-10 and np.abs(cassie.actuated_q(fk.q) - qa).max() <= 1e-12
+    check_closes_from_a_moved_seed(cassie)
 
 
 def test_its_two_foot_transmissions_are_found_and_round_trip(feet):
@@ -68,11 +71,7 @@ def test_its_two_foot_transmissions_are_found_and_round_trip(feet):
     by_motor = {t.motors: t for t in feet}
     assert {(m,) for m in FEET} <= set(by_motor)
     for motor in FEET:
-        t = by_motor[(motor,)]
-        qm = t.mechanism.actuated_q(t.q_reference) + 0.1
-        qo, q_sub = t.outputs_from_motors(qm)
-        back, _ = t.motors_from_outputs(qo, q_sub)
-        assert np.abs(back - qm).max() <= 1e-10, t.name
+        check_round_trip(by_motor[(motor,)])
 
 
 def test_its_knee_is_no_transmission_and_is_refused_by_name(cassie):
@@ -107,3 +106,107 @@ def test_its_leaf_springs_are_read_noted_and_saved(cassie, feet, tmp_path):
     assert spec.springs == springs
     assert all(t.mechanism.spec.springs == {f"{t.motors[0].partition('-')[0]}-foot-crank": {"damping": 1.0}}
                for t in feet)
+
+
+def test_its_free_pelvis_moves_as_pinocchio_and_mujoco_say(cassie):
+    """Forward dynamics with the pelvis free (the default), at a pose closed 0.1 rad from home, random motor efforts
+    and rates and a random pelvis twist: the motors', the pelvis' and every other acceleration out of the idle
+    motions equal Pinocchio's constraintDynamics of the same model to 1e-8 relative (measured 1.9e-13; the idle ones,
+    three per leg: the shin, tarsus and heel-spring leaf springs with the achilles rod's spin, are the convention's,
+    no idle motion in the mass metric, and are left out), and constraintDynamics' centre of mass falls at g (no
+    wrench on a free body but gravity; the convention's idle accelerations move the legs' mass, so pkm's full
+    vector does not: 4.75 m/s^2 off here). At rest, constraintDynamics (every joint, the leaf springs' efforts
+    included) equals MuJoCo on the same file, the efforts through its motors and gears, with its four connects held
+    exactly (:meth:`~tests.shipped.MujocoAt.held`; ten of the twelve rows independent, each knee loop being planar)
+    to 1e-8 (measured 1e-11); MuJoCo's own soft answer at its stiffest equalities (solref 1e-4 s, solimp 0.9999)
+    stays 5.3e-4 off: its softness, bounded here at 2e-3."""
+    rng = np.random.default_rng(3)
+    q = pkm.close_loops(cassie, cassie.actuated_q(cassie.q_reference) + 0.1 * rng.uniform(-1, 1, cassie.na),
+                        cassie.q_reference).q
+    tau = 10.0 * rng.normal(size=cassie.na)
+    rates = np.zeros(cassie.nv)
+    rates[cassie.base_v], rates[cassie.act_v] = rng.normal(size=6), rng.normal(size=cassie.na)
+    model = pkm.actuator_model(cassie, q, rates)
+    N = model.idle
+    assert model.base == "free" and N.shape[1] == 6 and not np.any(N[cassie.base_v]) and not np.any(N[cassie.act_v])
+    a = pkm.forward_dynamics(cassie, q, model.v, tau)
+    a_cd = constraint_dynamics(cassie, q, model.v, tau)
+    assert rel(a - N @ (N.T @ a), a_cd - N @ (N.T @ a_cd)) <= 1e-8
+    pin.centerOfMass(cassie.model, cassie.data, q, model.v, a_cd)
+    assert np.abs(cassie.data.acom[0] - cassie.model.gravity.linear).max() <= 1e-8 * 9.81
+    rest = np.zeros(cassie.nv)
+    a_cd = constraint_dynamics(cassie, q, rest, tau)
+    a = pkm.forward_dynamics(cassie, q, rest, tau)
+    assert rel(a[cassie.act_v], a_cd[cassie.act_v]) <= 1e-8 and rel(a[cassie.base_v], a_cd[cassie.base_v]) <= 1e-8
+    mj = MujocoAt(cassie, "menagerie:cassie", q)
+    m, d = mj.m, mj.d
+    efforts = dict(zip(cassie.actuated_names, tau))  # (through the file's motors and gears)
+    d.ctrl[:] = [efforts[mj.mujoco.mj_id2name(m, mj.mujoco.mjtObj.mjOBJ_ACTUATOR, k)] / m.actuator_gear[k, 0]
+                 for k in range(m.nu)]
+    assert np.all(np.abs(d.ctrl) <= m.actuator_ctrlrange[:, 1])  # (no control clamped)
+    mj.forward()
+    exact = mj.held()
+    assert rel(mj.dofs(a_cd), exact) <= 1e-8
+    m.opt.timestep = 5e-5  # (MuJoCo clamps a time constant to twice the step)
+    m.eq_solref[:] = [1e-4, 1.0]
+    m.eq_solimp[:] = [0.9999, 0.9999, 0.001, 0.5, 2.0]
+    mj.forward()
+    assert rel(d.qacc, exact) <= 2e-3
+
+
+# ---------------------------------------------------------------------- Robotiq's 2F-85 gripper
+@pytest.fixture(scope="module")
+def gripper() -> pkm.Mechanism:
+    return pkm.load("menagerie:robotiq_2f85")
+
+
+def test_the_gripper_ships_and_loads_with_its_motor_on_the_tendon_over_both_drivers(gripper):
+    """Menagerie's Robotiq 2F-85 (BSD-2-Clause, meshes removed): its one motor acts on the tendon ``split`` (half
+    of each driver), the drivers tied by a joint equality (the right one a mimic of the left): one actuated joint;
+    its two finger loops are point closures, closed at the reference (MuJoCo's qpos0) inside every limit, with no
+    dependent actuator; each adaptive finger keeps one freedom no motor drives (two idle motions), held by the
+    spring links' springs, which are read."""
+    check_shipped("menagerie:robotiq_2f85", "2f85.xml", "ROS-Industrial", (
+        "google-deepmind/mujoco_menagerie", "robotiq_2f85/2f85.xml", "1b428b08bb26ca6024e7b21e8ff21a59f847eb87",
+        "BSD-2-Clause"))
+    assert gripper.actuated_names == ("left_driver_joint",) and gripper.base is None
+    assert [c.type for c in gripper.spec.closures] == ["point", "point"]
+    notes = " ".join(gripper.notes)
+    assert "tendon 'split'" in notes and "right_driver_joint = 1 left_driver_joint" in notes
+    q = gripper.q_reference
+    assert constraints.worst_closure(gripper, constraints.residual(gripper, q))[0] <= 1e-12
+    assert gripper.outside_limits(q, tol=0.0) == () and gripper.dependent_actuators == ()
+    assert pkm.diagnose(gripper, q).idle_motions == 2
+    assert set(gripper.spec.springs) == {"left_spring_link_joint", "right_spring_link_joint"}
+    assert pkm.assemble(gripper).residual <= 1e-12
+    check_closes_from_a_moved_seed(gripper)
+    assert constraint_jacobian_error(gripper, q) <= 1e-7
+
+
+def test_mujoco_holds_the_gripper_s_connects_where_pkm_closes_them(gripper):
+    """At pkm's closed pose with the motor at 0.3 rad, MuJoCo on the same file puts every body where pkm does (1e-12
+    m) and finds its two connects and the drivers' equality held (1e-12 m or rad). Before, pkm took Pinocchio's
+    anchors, in the followers' joint frames (19 mm from their bodies'): the connects stood 0.46 mm open and the
+    followers were idle spins. pkm's MJCF of it, read back, closes there with every joint in place (1e-12 m)."""
+    q = pkm.close_loops(gripper, [0.3], gripper.q_reference).q
+    mj = MujocoAt(gripper, "menagerie:robotiq_2f85", q)
+    mj.forward()
+    assert mj.body_gap() <= 1e-12
+    rows = mj.equality_rows()
+    assert rows.size == 2 * 3 + 1 and np.abs(rows).max() <= 1e-12
+    check_mjcf_round_trip(gripper, np.array([0.3]))
+
+
+def test_the_gripper_s_underactuated_fingers_are_refused_as_transmissions(gripper):
+    """Each adaptive finger has two freedoms and one input: no transmission. The refusals are TransmissionErrors:
+    the left finger's outputs leave the motor free, the right finger's loop holds no actuated joint (its driver
+    follows the left one by the gear equality, which the refusal names), and with both left out nothing remains
+    (``no_loop``)."""
+    with pytest.raises(TransmissionError):
+        pkm.transmissions(gripper)
+    with pytest.warns(PkmWarning) as caught, pytest.raises(TransmissionError) as err:
+        pkm.transmissions(gripper, skip_unfit=True)
+    assert err.value.reason == "no_loop"
+    said = " ".join(str(w.message) for w in caught)
+    assert "with the outputs held the motors can move" in said and "hold no actuated joint" in said
+    assert "'right_driver_joint' follows 'left_driver_joint'" in said

@@ -55,6 +55,8 @@ def test_wheel_ships_urdf_and_dynamics(tmp_path):
         assert f"pkm/_data/urdf/{name}.urdf" in shipped
         assert f"pkm/_data/urdf/{name}.closures.toml" in shipped
     assert "pkm/_data/dynamics/prs3_table2.toml" in shipped
-    for shipped_file in ("cassie.xml", "LICENSE", "SOURCE.txt"):  # (a third-party robot with its licence and source)
-        assert f"pkm/_data/urdf/menagerie/agility_cassie/{shipped_file}" in shipped
+    for folder, model in (("menagerie/agility_cassie", "cassie.xml"), ("menagerie/robotiq_2f85", "2f85.xml"),
+                          ("toddlerbot/toddlerbot", "toddlerbot.xml")):  # (third-party robots, licence and source)
+        for shipped_file in (model, "LICENSE", "SOURCE.txt"):
+            assert f"pkm/_data/urdf/{folder}/{shipped_file}" in shipped
     assert "pkm/py.typed" in shipped

@@ -223,6 +223,56 @@ def test_several_top_level_defaults_frames_and_class_positions_are_read_as_mujoc
         assert np.abs(d.oMf[model.getFrameId("s")].translation - md.site("s").xpos).max() <= TOL
 
 
+def test_a_default_stated_after_the_worldbody_is_read_as_mujoco_does():
+    """MuJoCo reads the <default> classes wherever they stand (ToddlerBot's files state them last); Pinocchio 4.1 in
+    document order ("unordered_map::at" before): pkm moves them before the <worldbody>, and a class's joint axis and
+    pos and site pos put every body and site where MuJoCo does."""
+    text = """<mujoco model="late"><compiler angle="radian"/>
+      <worldbody><body name="l" pos="0.3 0 0"><joint name="j" class="b"/><geom type="sphere" size="0.05" mass="1"/>
+        <site name="s" class="b"/><body name="m" pos="0.2 0 0"><joint name="k" axis="0 0 1"/>
+        <geom type="sphere" size="0.05" mass="1"/></body></body></worldbody>
+      <default><default class="b"><joint axis="0 1 0" pos="0 0 0.1"/><site pos="0.05 0 0"/></default></default>
+      </mujoco>"""
+    mujoco, mm = _mujoco_model(text)
+    md = mujoco.MjData(mm)
+    model, _ = _model(text)
+    d = model.createData()
+    md.qpos[:] = q = np.array([0.5, -0.8])
+    mujoco.mj_kinematics(mm, md)
+    pin.framesForwardKinematics(model, d, q)
+    for b in ("l", "m"):
+        assert np.abs(d.oMf[model.getFrameId(b, pin.FrameType.BODY)].translation - md.body(b).xpos).max() <= TOL
+    assert np.abs(d.oMf[model.getFrameId("s")].translation - md.site("s").xpos).max() <= TOL
+
+
+def test_a_connect_on_a_body_whose_joint_has_a_pos_closes_where_mujoco_does():
+    """A four-bar whose follower's hinge sits at ``pos`` in its body, closed by a connect at the body's origin
+    (Robotiq 2F-85's fingers): Pinocchio 4.1 put the anchor in the joint's frame, 0.1 m off here, and MuJoCo's connect
+    stood 8.1 mm open at pkm's closed pose; pkm reads the anchor in the body's frame: with the crank moved by
+    0.4 rad MuJoCo's connect holds to 1e-12 m."""
+    import pkm
+    from pkm.core.formats.load import load_texts
+    from pkm.core.formats.to_mjcf import qpos_of
+
+    text = """<mujoco model="offset"><compiler angle="radian"/><worldbody>
+      <body name="crank"><joint name="c" axis="0 1 0"/><geom type="sphere" size="0.01" mass="1"/>
+        <body name="coupler" pos="0.2 0 0"><joint name="k" axis="0 1 0"/><geom type="sphere" size="0.01" mass="1"/>
+        </body></body>
+      <body name="rocker" pos="0.5 0 0"><joint name="r" axis="0 1 0"/><geom type="sphere" size="0.01" mass="1"/>
+        <body name="follower" pos="0 0 0.4"><joint name="f" axis="0 1 0" pos="0 0 -0.1"/>
+          <geom type="sphere" size="0.01" mass="1"/></body></body>
+      </worldbody><equality><connect body1="follower" body2="coupler" anchor="0 0 0"/></equality>
+      <actuator><motor joint="c"/></actuator></mujoco>"""
+    mujoco, mm = _mujoco_model(text)
+    md = mujoco.MjData(mm)
+    mech = load_texts({"offset.xml": text})
+    q = pkm.close_loops(mech, mech.actuated_q(mech.q_reference) + 0.4, mech.q_reference).q
+    for k in range(mm.njnt):
+        md.qpos[mm.jnt_qposadr[k]] = qpos_of(mech.model, mech.model.getJointId(mm.joint(k).name), q)[0]
+    mujoco.mj_forward(mm, md)
+    assert np.abs(md.efc_pos[:md.nefc]).max() <= 1e-12
+
+
 def test_notes_say_what_is_left_out():
     notes = read_mjcf(COUPLED.replace("<actuator>", "<contact/><sensor/><actuator><motor site='sa'/>"), "t.xml").notes
     assert any("<contact>, <sensor> not read" in n for n in notes)

@@ -16,6 +16,13 @@ stated), in ``urdf/menagerie/<folder>/`` with the robot's ``LICENSE`` and a ``SO
 path, the commit and every change. ``menagerie:cassie`` is Agility Robotics' Cassie (MIT): a real humanoid's legs,
 two loops each (the achilles rod from the hip to the heel spring, the plantar rod from the foot crank to the foot),
 a free-floating pelvis, ten motors, its reference the file's ``home`` key with its loops closed.
+``menagerie:robotiq_2f85`` is Robotiq's 2F-85 gripper (BSD-2-Clause): two adaptive four-bar fingers (a spring on
+each, one passive freedom each), one motor on a tendon over the two drivers, which a joint equality ties.
+
+Robots published in their makers' own repositories are shipped the same way, in ``urdf/<project>/<robot>/`` with
+their ``LICENSE`` and ``SOURCE.txt``: ``toddlerbot:toddlerbot`` is Stanford's ToddlerBot (``hshi74/toddlerbot``,
+MIT): a 30-motor humanoid whose knees and neck pitch are rod linkages closed by six welds, nine gear pairs read as
+mimic couplings, a waist whose two limited fixed tendons no motor drives (noted, not read), a free torso.
 """
 
 from __future__ import annotations
@@ -51,9 +58,14 @@ def _gepetto(robot: str, description: str) -> tuple[str, CatalogueModel]:
     return f"gepetto:{robot}", CatalogueModel(f"gepetto/{robot}", _GEPETTO, description)
 
 
+def _published(project: str, repository: str, robot: str, folder: str, model: str, licence: str,
+               description: str) -> tuple[str, CatalogueModel]:
+    source = f"{repository}, {licence} (urdf/{project}/{folder}/LICENSE)"
+    return f"{project}:{robot}", CatalogueModel(f"{project}/{folder}", source, description, model)
+
+
 def _menagerie(robot: str, folder: str, model: str, licence: str, description: str) -> tuple[str, CatalogueModel]:
-    source = f"google-deepmind/mujoco_menagerie, {licence} (urdf/menagerie/{folder}/LICENSE)"
-    return f"menagerie:{robot}", CatalogueModel(f"menagerie/{folder}", source, description, model)
+    return _published("menagerie", "google-deepmind/mujoco_menagerie", robot, folder, model, licence, description)
 
 
 #: Every shipped third-party robot by name ``<source>:<robot>``, sorted.
@@ -70,6 +82,12 @@ CATALOGUE: dict[str, CatalogueModel] = dict([
     _gepetto("wl16_like", "a WL-16-like leg: five 6-D loops, six motors"),
     _menagerie("cassie", "agility_cassie", "cassie.xml", "MIT",
                "Agility Robotics' Cassie biped (MJCF, meshes removed): four 3-D loops, ten motors, a free pelvis"),
+    _menagerie("robotiq_2f85", "robotiq_2f85", "2f85.xml", "BSD-2-Clause",
+               "Robotiq's 2F-85 adaptive gripper (MJCF, meshes removed): two four-bar fingers closed by connects, "
+               "one motor on a tendon over the two drivers, a gear equality tying them"),
+    _published("toddlerbot", "hshi74/toddlerbot", "toddlerbot", "toddlerbot", "toddlerbot.xml", "MIT",
+               "Stanford's ToddlerBot humanoid (MJCF, meshes removed): rod-driven knees and neck closed by six "
+               "welds, nine gear couplings, 30 motors, a free torso"),
 ])
 
 

@@ -247,8 +247,14 @@ def _eulers_to_quats(root: etree._Element, degrees: bool, source: str) -> str:
 
 
 def _merge_defaults(root: etree._Element) -> int:
-    """The top-level ``<default>`` elements merged into the first (Pinocchio reads the first only); their number."""
+    """The top-level ``<default>`` elements merged into the first (Pinocchio reads the first only), placed before the
+    ``<worldbody>`` (MuJoCo reads the classes wherever they stand; Pinocchio 4.1 in document order, and a class it has
+    not met yet raised ``unordered_map::at``: ToddlerBot's files state them last); their number."""
     tops = root.findall("default")
+    world = root.find("worldbody")
+    if tops and world is not None and list(root).index(tops[0]) > list(root).index(world):
+        root.remove(tops[0])
+        root.insert(list(root).index(world), tops[0])
     for extra in tops[1:]:
         for child in list(extra):
             if not isinstance(child.tag, str):
@@ -494,8 +500,8 @@ def read_mjcf(text: str, source: str = "<mjcf>") -> Imported:
                                 f"states {body_based['connect']} and {body_based['weld']} between bodies")
 
     free = _free_bodies(model, world, degrees, source)
-    if free:
-        points = _anchored(model, free, refs, points)
+    points = _connects(model, free, refs, [(el, eq[1]) for el, eq in zip(equalities, eq_names)
+                                           if el.tag == "connect" and el not in on_sites], defaults, source)
     welds = _welds(model, free, refs, [(el, eq[1]) for el, eq in zip(equalities, eq_names)
                                        if el.tag == "weld" and el not in on_sites], defaults, source)
     taken = set(model.names) | {f.name for f in model.frames}
@@ -1078,19 +1084,6 @@ def _qpos0(model: pin.Model, free: dict[int, pin.SE3], refs: dict[str, float]) -
     return q0
 
 
-def _anchored(model: pin.Model, free: dict[int, pin.SE3], refs: dict[str, float],
-              constraints: Iterable[pin.RigidConstraintModel]) -> list[_Anchors]:
-    """The constraints with their second end re-anchored where the first is at qpos0 (:func:`_qpos0`)."""
-    q0 = _qpos0(model, free, refs)
-    d = model.createData()
-    pin.forwardKinematics(model, d, q0)
-    out = []
-    for cm in constraints:
-        world_a = d.oMi[cm.joint1_id] * cm.joint1_placement
-        out.append(_Anchors(cm.joint1_id, cm.joint1_placement, cm.joint2_id, d.oMi[cm.joint2_id].actInv(world_a)))
-    return out
-
-
 def _torquescale(el: etree._Element, name: str, defaults: _Defaults, source: str) -> float:
     """A weld's ``torquescale`` (MuJoCo's default 1); 0 makes it position-only."""
     where = f"<equality><weld name={name!r}> (line {el.sourceline}) torquescale"
@@ -1117,21 +1110,10 @@ def _welds(model: pin.Model, free: dict[int, pin.SE3], refs: dict[str, float],
     q0 = _qpos0(model, free, refs)
     data = model.createData()
     pin.framesForwardKinematics(model, data, q0)
-    bodies = [f.name for f in model.frames if f.type == pin.FrameType.BODY and f.name != _WORLD]
     out, moved = [], set()
     for el, name in welds:
         where = f"<equality><weld name={name!r}> (line {el.sourceline})"
-        ends = []
-        for key in ("body1", "body2"):
-            body = el.get(key)
-            if body in (None, "world", _WORLD):
-                ends.append((0, pin.SE3.Identity(), pin.SE3.Identity()))
-            elif model.existFrame(body, pin.FrameType.BODY):
-                fid = model.getFrameId(body, pin.FrameType.BODY)
-                ends.append((model.frames[fid].parentJoint, model.frames[fid].placement, data.oMf[fid]))
-            else:
-                raise SpecNameError(source, "body", str(body), bodies, f"{where} {key}")
-        (j1, P1, X1), (j2, P2, X2) = ends
+        (j1, P1, X1), (j2, P2, X2) = _ends(model, data, el, where, source)
         anchor = pin.SE3(np.eye(3), _floats(defaults.get(el, "anchor", "0 0 0"), 3, f"{where} anchor", source))
         relpose = _floats(defaults.get(el, "relpose", "0 1 0 0 0 0 0"), 7, f"{where} relpose", source)
         if np.linalg.norm(relpose[3:]) < 1e-15:  # (MuJoCo's mjMINVAL: no relpose, the pose at qpos0)
@@ -1148,6 +1130,43 @@ def _welds(model: pin.Model, free: dict[int, pin.SE3], refs: dict[str, float],
                     pin.framesForwardKinematics(model, data, q0)
                     break
         out.append(_Anchors(j1, P1 * rel, j2, P2 * anchor))
+    return out
+
+
+def _ends(model: pin.Model, data: pin.Data, el: etree._Element, where: str, source: str
+          ) -> list[tuple[int, pin.SE3, pin.SE3]]:
+    """The two bodies of a body-based equality: each its joint, its frame's placement in the joint and its pose at
+    the configuration ``data`` holds (the world: joint 0, identity)."""
+    ends = []
+    for key in ("body1", "body2"):
+        body = el.get(key)
+        if body in (None, "world", _WORLD):
+            ends.append((0, pin.SE3.Identity(), pin.SE3.Identity()))
+        elif model.existFrame(body, pin.FrameType.BODY):
+            fid = model.getFrameId(body, pin.FrameType.BODY)
+            ends.append((model.frames[fid].parentJoint, model.frames[fid].placement, data.oMf[fid]))
+        else:
+            bodies = [f.name for f in model.frames if f.type == pin.FrameType.BODY and f.name != _WORLD]
+            raise SpecNameError(source, "body", str(body), bodies, f"{where} {key}")
+    return ends
+
+
+def _connects(model: pin.Model, free: dict[int, pin.SE3], refs: dict[str, float],
+              connects: list[tuple[etree._Element, str]], defaults: _Defaults, source: str) -> list[_Anchors]:
+    """The two ends of the body-based ``<connect>`` elements (with their names), read from the file as MuJoCo reads
+    them: ``anchor`` in ``body1``'s frame, and the same point at ``qpos0`` (:func:`_qpos0`) in ``body2``'s.
+    Pinocchio 4.1's parser puts the anchor in body1's *joint* frame, off by the joint's ``pos`` where the file
+    states one (Robotiq 2F-85's followers: 19 mm, the loop then closing elsewhere than MuJoCo's), and misplaces
+    free bodies."""
+    q0 = _qpos0(model, free, refs)
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q0)
+    out = []
+    for el, name in connects:
+        where = f"<equality><connect name={name!r}> (line {el.sourceline})"
+        (j1, P1, X1), (j2, P2, X2) = _ends(model, data, el, where, source)
+        anchor = pin.SE3(np.eye(3), _floats(defaults.get(el, "anchor", "0 0 0"), 3, f"{where} anchor", source))
+        out.append(_Anchors(j1, P1 * anchor, j2, P2 * pin.SE3(np.eye(3), X2.actInv(X1 * anchor).translation)))
     return out
 
 

@@ -43,6 +43,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pinocchio as pin
 
+from pkm.core.formats.to_mjcf import mimic_leader
 from pkm.core.model.actuators import NUMBERS
 from pkm.core.model.builder import from_strings
 from pkm.core.model.joints import reduced_model, stated_limits
@@ -254,8 +255,13 @@ def _transmission(mech: Mechanism, name: str, closures: list[int], joints: set[i
     motors = tuple(n for n in mech.actuated_names if mech.joints[n].id in motor_ids)
     outputs = tuple(model.names[j] for j in out_ids)
     if not motors:
+        driven = [f"{model.names[j]!r} follows {model.names[lead]!r}" for j in order
+                  if model.joints[j].shortname() == "JointModelMimic"
+                  and model.names[lead := mimic_leader(model, j)] in mech.actuated_names]
+        why = (f" (its joint {', '.join(driven)}, an actuated joint of another sub-mechanism, by a coupling: a loop "
+               "driven through a coupling is not decomposed)" if driven else "")
         raise TransmissionError(name, "outputs", f"its loops ({[mech.spec.closures[i].name for i in closures]}) hold "
-                                "no actuated joint: a passive closed chain is no transmission", outputs)
+                                f"no actuated joint: a passive closed chain is no transmission{why}", outputs)
     bad = [model.names[j] for j in out_ids if mech.joints[model.names[j]].nv != 1]
     if bad:
         raise TransmissionError(name, "outputs", f"outputs {bad} have more than one coordinate: outputs are "
