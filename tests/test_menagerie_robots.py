@@ -108,6 +108,20 @@ def test_its_leaf_springs_are_read_noted_and_saved(cassie, feet, tmp_path):
                for t in feet)
 
 
+def test_its_leaf_springs_moved_by_the_idle_rule_are_said_once():
+    """The idle motions move Cassie's sprung leaf-spring joints: the first dynamics query warns, naming them, that
+    their motion follows the idle-motion rule and not the springs (once a mechanism: the next query is silent)."""
+    import warnings
+
+    cassie = pkm.load("menagerie:cassie")  # (a fresh one: the warning is once a mechanism)
+    with pytest.warns(PkmWarning, match=r"sprung joints \['left-shin', 'left-heel-spring', 'right-shin', "
+                                        r"'right-heel-spring'\].*idle-motion rule"):
+        pkm.actuator_model(cassie, cassie.q_reference)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pkm.actuator_model(cassie, cassie.q_reference)
+
+
 def test_its_free_pelvis_moves_as_pinocchio_and_mujoco_say(cassie):
     """Forward dynamics with the pelvis free (the default), at a pose closed 0.1 rad from home, random motor efforts
     and rates and a random pelvis twist: the motors', the pelvis' and every other acceleration out of the idle

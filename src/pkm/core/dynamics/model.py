@@ -132,6 +132,26 @@ def _warn_idle_free_flyer(mech: Mechanism, idle: np.ndarray) -> None:
             return
 
 
+_WARNED_SPRINGS: weakref.WeakSet[Mechanism] = weakref.WeakSet()
+
+
+def _warn_idle_springs(mech: Mechanism, idle: np.ndarray) -> None:
+    """Warn (once per mechanism) where an idle motion moves a sprung joint (Cassie's leaf springs): the motion is a
+    freedom of its own, which the idle-motion rule sets (no motion in the mass metric) where the springs and the
+    bodies' inertia should (issue 51)."""
+    springs = mech.springs
+    if mech in _WARNED_SPRINGS or not springs:
+        return
+    moved = [name for name, iv in zip(springs.names, springs.idx_v) if np.max(np.abs(idle[iv]), initial=0.0) > 1e-9]
+    if moved:
+        _WARNED_SPRINGS.add(mech)
+        warnings.warn(f"the idle motions move the sprung joints {moved}: pkm sets their rates and accelerations by the "
+                      "idle-motion rule (no motion in the mass metric), not by the springs and the bodies' inertia: "
+                      "the actuated coordinates' dynamics is exact, these joints' motion is not (a passive freedom "
+                      "the actuators do not hold, such as a leaf spring, is not simulated as one)", PkmWarning,
+                      stacklevel=4)
+
+
 @dataclass(frozen=True)
 class _Reduction:
     """What the model needs of the kinematics at ``q``: ``Ĝ``, the passive pseudo-inverse, the idle motions, and for
@@ -173,6 +193,7 @@ def _reduce(mech: Mechanism, q: np.ndarray, rtol: float, base: str = "fixed", Jc
                                    distance=sigma / smax if smax > 0.0 else 0.0)
         idle = scales.joint_motions(idle)  # (in joint rates, orthonormal)
         _warn_idle_free_flyer(mech, idle)
+        _warn_idle_springs(mech, idle)
     M = joint_inertia(mech, q)
     Gb = np.zeros((mech.nv, 0))
     if base == "free":
