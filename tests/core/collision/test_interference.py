@@ -1,0 +1,123 @@
+"""Interference in the workspace answers (pkm.core.collision.interference): the Gough-Stewart's map at a fixed
+orientation with legs thick enough to cross, its interference-free workspace beside the limits-only one (the sweep
+objectives), both against an independent count: each node's joints against their limits one by one, and the legs'
+segment-to-segment distances minus their radii (written here: the interior critical point or an end point against
+the other segment)."""
+
+from __future__ import annotations
+
+import itertools
+import warnings
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import pkm
+from pkm import sweeps
+from pkm.core.collision.interference import checks_collisions, first_interference, minimum_distances
+from pkm.errors import NoCollisionGeometryError
+from pkm.sweeps.family import RegisteredFamily
+from pkm.sweeps.objectives import OBJECTIVES, _map_key
+
+RADIUS = 0.095  # [m] cylinders and rods: at a yaw of 1 rad some nodes' legs cross, others' do not
+REGION = "region=x=-0.15:0.15:5/y=-0.15:0.15:5,pose=yaw=1.0,length=0.5"
+
+
+def point_segment(p, a, b) -> float:
+    t = np.clip((p - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
+    return float(np.linalg.norm(p - (a + t * (b - a))))
+
+
+def segment_segment(p1, q1, p2, q2) -> float:
+    """The distance between two segments: at the interior critical point of |p1 + s d1 - p2 - t d2| where it lies in
+    the unit square, else the least of the four end points' distances to the other segment."""
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    A = np.array([[d1 @ d1, -d1 @ d2], [-d1 @ d2, d2 @ d2]])
+    ends = min(point_segment(p1, p2, q2), point_segment(q1, p2, q2), point_segment(p2, p1, q1),
+               point_segment(q2, p1, q1))
+    if abs(np.linalg.det(A)) <= 1e-12 * A[0, 0] * A[1, 1]:
+        return ends
+    s, t = np.linalg.solve(A, [-d1 @ r, d2 @ r])
+    inside = np.linalg.norm(r + s * d1 - t * d2) if 0.0 <= s <= 1.0 and 0.0 <= t <= 1.0 else np.inf
+    return float(min(inside, ends))
+
+
+def legs_minimum(mech, q) -> float:
+    """The smallest distance between two legs' capsules (cylinder from the universal joint, rod to the ball, each
+    ``leg_min / 2`` long, as the design writes them) not of one leg, minus the radii."""
+    m, d, p = mech.model, mech.data, mech.params
+    pin.forwardKinematics(m, d, q)
+    pin.updateFramePlacements(m, d)
+    caps = []
+    for k in range(1, 7):
+        a = d.oMi[m.getJointId(f"u{k}")].translation
+        b = d.oMf[mech.frame_id(f"ball_{k}")].translation
+        u = (b - a) / np.linalg.norm(b - a)
+        caps += [(k, a, a + p.leg_min / 2 * u, p.cylinder_radius), (k, b - p.leg_min / 2 * u, b, p.rod_radius)]
+    return min(segment_segment(a1, b1, a2, b2) - r1 - r2
+               for (k1, a1, b1, r1), (k2, a2, b2, r2) in itertools.combinations(caps, 2) if k1 != k2)
+
+
+@pytest.fixture(scope="module")
+def thick():
+    """A Gough-Stewart design with thick legs, its limits-only and interference-free areas by the sweep objectives,
+    and the one map they share (configurations kept: 25 nodes)."""
+    c = RegisteredFamily("gough_stewart").candidate({"cylinder_radius": RADIUS, "rod_radius": RADIUS})
+    o = {k: sweeps.objective(f"{k}:{REGION}") for k in ("limits_volume", "interference_free_volume")}
+    values = {k: OBJECTIVES[k].generic(c, v.options) for k, v in o.items()}
+    return c, values, c.peek(_map_key(o["limits_volume"].options))
+
+
+def test_the_interference_free_area_beside_the_limits_only_area_equals_an_independent_count(thick):
+    c, values, m = thick
+    mech = c.mechanism
+    Q = m.q.reshape(-1, mech.nq)
+    reach = m.reachable.ravel()
+    inside = np.array([r and not mech.outside_limits(q) for r, q in zip(reach, Q)])
+    legs = np.array([legs_minimum(mech, q) if r else np.nan for r, q in zip(reach, Q)])
+    free = inside & (legs > 0.0)
+    assert reach.sum() == 25 and 0 < free.sum() < inside.sum() < 25  # (both bounds bite on this grid)
+    assert values["limits_volume"] == pytest.approx(inside.sum() * 0.075 ** 2, rel=1e-12)
+    assert values["interference_free_volume"] == pytest.approx(free.sum() * 0.075 ** 2, rel=1e-12)
+    # the map's clearance per node: the legs' where they are the closest pair (a cylinder may be closer to the
+    # platform's disc: never negative here)
+    clear = m.clearance.ravel()
+    assert np.all(clear <= legs + 1e-9) and np.all(clear[legs < 0.0] == pytest.approx(legs[legs < 0.0], abs=1e-9))
+    np.testing.assert_array_equal(m.interferes.ravel(), legs < 0.0)
+    np.testing.assert_array_equal(m.within_limits.ravel(), inside)
+    np.testing.assert_array_equal(m.feasible.ravel(), free)
+
+
+def test_a_map_marks_interference_only_where_asked_and_where_there_is_geometry(thick, tmp_path):
+    """collisions=False leaves the interference out (the same reach); unreached nodes' clearance is NaN; the CSV
+    carries the three columns; the first interfering configuration of a sequence names its pair."""
+    c, _, m = thick
+    mech = c.mechanism
+    again = pkm.workspace_map(mech, dict(m.axes), {"yaw": 1.0}, length=0.5, kernels=c.kernels, collisions=False)
+    assert again.clearance is None and again.interferes is None and again.within_limits is None
+    np.testing.assert_array_equal(again.reachable, m.reachable)
+    assert np.isnan(np.where(m.reachable, np.nan, m.clearance)).all()
+    header = m.write_csv(tmp_path / "m.csv").read_text().splitlines()[0].split(",")
+    assert header[-3:] == ["clearance", "within_limits", "interferes"]
+    Q = m.q.reshape(-1, mech.nq)
+    k = int(np.flatnonzero(m.interferes.ravel())[0])
+    hit = first_interference(mech, Q[k - 1:k + 1] if k else Q[k:k + 1])
+    assert hit is not None and hit.at == (1 if k else 0) and hit.distance == pytest.approx(m.clearance.ravel()[k])
+    assert pkm.clearance(mech, Q[k]).closest == hit.pair
+    assert np.isnan(minimum_distances(mech, np.full((1, mech.nq), np.nan))).all()
+
+
+def test_without_geometry_nothing_changes_and_nothing_is_said():
+    """A mechanism whose files carry no collision geometry: not checked, no warning; the objective refuses."""
+    delta = pkm.load("delta")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert not checks_collisions(delta)
+        m = pkm.workspace_map(delta, {"x": np.linspace(-0.05, 0.05, 3)}, {"z": -0.35})
+    assert m.clearance is None and m.within_limits is None and m.interferes is None
+    np.testing.assert_array_equal(m.feasible, m.reachable)
+    c = RegisteredFamily("delta").candidate({})
+    with pytest.raises(NoCollisionGeometryError):
+        OBJECTIVES["interference_free_volume"].generic(c, sweeps.objective(
+            "interference_free_volume:region=x=-0.05:0.05:3,pose=z=-0.35").options)
