@@ -265,12 +265,13 @@ class WorkspaceMap:
         return out
 
     def _marks(self, ax: Any, values: list[np.ndarray], sl: Any, ci: np.ndarray | None = None) -> list[Any]:
-        """Mark the reachable nodes outside the joints' limits (grey dots) and those that interfere (red crosses)
+        """Mark the reachable nodes outside the joints' limits (white rings) and those that interfere (red crosses)
         on the figure, where the map checked them; the legend's handles (said with their counts)."""
         out = []
         grids = np.meshgrid(*values) if len(values) > 1 else [values[0]]
         outside = None if self.within_limits is None else self.reachable & ~self.within_limits
-        for mask, style, what in ((outside, {"marker": ".", "color": "0.35", "s": 6}, "outside the joint limits"),
+        for mask, style, what in ((outside, {"marker": "o", "facecolors": "none", "edgecolors": "white", "s": 16,
+                                            "linewidths": 0.8}, "outside the joint limits"),
                                   (self.interferes, {"marker": "x", "color": "red", "s": 10, "linewidths": 0.8},
                                    "interferes")):
             if mask is None or not mask[sl].any():
