@@ -185,10 +185,16 @@ def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int,
                    for qk, vk in zip(q, v)])
     ydd = np.array([task_acceleration(mech, qk, vk, ak) if np.all(np.isfinite(ak)) else np.full(mech.n_task, np.nan)
                     for qk, vk, ak in zip(q, v, a)])
-    clear = minimum_distances(mech, q) if checks_collisions(mech) else None
     return Trajectory(q, v, a, q[:, mech.act_q], v[:, mech.act_v], a[:, mech.act_v], values, yd, ydd, tau, residual,
-                      tuple(jumps), _units(mech), mech.limits_along(q), clear,
-                      None if clear is None else first_interference(mech, q, clear))
+                      tuple(jumps), _units(mech), mech.limits_along(q), *interference_along(mech, q))
+
+
+def interference_along(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray | None, Interference | None]:
+    """:attr:`Trajectory.clearance` and :attr:`Trajectory.interference` of the samples ``q`` (N x nq)."""
+    if not checks_collisions(mech):
+        return None, None
+    clear = minimum_distances(mech, q)
+    return clear, first_interference(mech, q, clear)
 
 
 def follow_task(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None = None, ydd: ArrayLike | None = None, *,

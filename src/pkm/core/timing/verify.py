@@ -208,7 +208,7 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
             for k, v in traj.outside_limits))
     clearance = None
     if checks_collisions(mech):  # (about 20 us a check point)
-        minima = minimum_distances(mech, traj.q)
+        minima = traj.clearance if traj.clearance is not None else minimum_distances(mech, traj.q)
         clearance = float(np.nanmin(minima))
         hit = first_interference(mech, traj.q, minima)
         if hit is not None:
@@ -232,8 +232,8 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
 class _Motion:
     """The motion at the check points, from either route: configurations (m x nq), the actuated coordinates,
     rates and accelerations (m x na), the efforts without friction (m x na), the task values, whether the motion
-    leaves its branch, the joints outside their position limits (:meth:`pkm.core.Mechanism.limits_along`), and
-    the route."""
+    leaves its branch, the joints outside their position limits (:meth:`pkm.core.Mechanism.limits_along`), the
+    route, and the smallest distances between checked bodies where the route computed them (the core's)."""
 
     q: np.ndarray
     actuated: np.ndarray
@@ -244,6 +244,7 @@ class _Motion:
     jumps: bool
     outside_limits: tuple
     route: str = "core"
+    clearance: np.ndarray | None = None
 
 
 def _core(plan: TimeOptimal, y: np.ndarray, yd: np.ndarray, ydd: np.ndarray) -> _Motion:
@@ -255,7 +256,7 @@ def _core(plan: TimeOptimal, y: np.ndarray, yd: np.ndarray, ydd: np.ndarray) -> 
     traj = follow(plan.mech, y, yd, ydd, q0=plan.coefficients.q[0], efforts=True, tol=1e-12)
     assert traj.efforts is not None
     return _Motion(traj.q, traj.actuated, traj.actuated_velocity, traj.actuated_acceleration, traj.efforts,
-                   traj.task, bool(traj.jumps), traj.outside_limits)
+                   traj.task, bool(traj.jumps), traj.outside_limits, clearance=traj.clearance)
 
 
 def _compiled(mech: Mechanism, K: Kernels, y: np.ndarray, yd: np.ndarray, ydd: np.ndarray,
