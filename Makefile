@@ -26,7 +26,7 @@ test: $(STAMP)
 	$(PY) -m ruff check src tests tools examples
 	(env -u PYTHONDONTWRITEBYTECODE $(PY) -m pytest --collect-only -q -p no:cacheprovider >/dev/null 2>&1 || true) & \
 		$(PY) -m mypy src/pkm; status=$$?; wait; exit $$status
-	env -u PYTHONDONTWRITEBYTECODE $(PY) -m pytest -q -n 2 --durations=15  # two workers (CPU-bound, 2 cores); the 15 slowest printed: the budget
+	env -u PYTHONDONTWRITEBYTECODE $(PY) -m pytest -q -n 2 --dist worksteal --durations=15  # two workers (CPU-bound, 2 cores), the one done first taking the other's queued tests; the 15 slowest printed: the budget
 
 bench: $(STAMP)
 	$(PY) -m pkm bench

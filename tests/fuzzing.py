@@ -1730,6 +1730,24 @@ def _stiffness(g, adv):
     return run, (m, q, W), kw
 
 
+@entry("Stiffness.loaded")
+def _loaded_stiffness(g, adv):
+    """The tangent stiffness under a random wrench (rigid links); on the Gough-Stewart, at times, its links as beams
+    of their capsules and a material (random or hostile moduli)."""
+    n, m, q, _ = _dyn_state(g, adv, ("delta", "prs3", "rrr3", "gough_stewart"))
+    kw = _springs_kw(g, adv, n)
+    W = g.value(g.rng.normal(size=6) * 10.0 ** g.rng.uniform(-1, 2), adv and g.chance(0.4), 100.0)
+    E = (g.hostile() if adv and g.chance(0.3) else float(10.0 ** g.rng.uniform(9, 12))) \
+        if n == "gough_stewart" and "links" not in kw and g.chance(0.3) else None
+
+    def run(m, q, W, E=None, **kw):
+        if E is not None:
+            K = ctx().pkm.stiffness(m, q, links=ctx().pkm.Material(E=E), **kw)
+            return K.compliance
+        return ctx().pkm.stiffness(m, q, **kw).loaded(W).compliance
+    return run, (m, q, W), {**kw, "E": E}
+
+
 @entry("pkm.clearance")
 def _clearance(g, adv):
     """The signed distances and the smallest's gradient (a design without collision geometry: refused)."""

@@ -80,6 +80,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
         Excitation,
         IKProblem,
         Jump,
+        Material,
         Measurements,
         Mechanism,
         ModeLabel,

@@ -334,7 +334,9 @@ class ConvergenceError(PkmError):
 
     Attributes:
         what: The solver that failed (e.g. "loop closure").
-        residual: Final residual norm (infinity norm, SI units of the equations).
+        residual: Final residual norm (infinity norm, SI units of the equations; for pkm's loop closure and inverse
+            kinematics the one their tolerance bounds, lengths over the characteristic length, angles in rad:
+            :attr:`pkm.core.kinematics.solve.SolveResult.relative_residual`, the message saying so).
         iterations: Iterations performed.
         worst_closure: Name of the loop left most open (None if not applicable).
         worst_gap: Its gap (norm of its residual block, m or rad).

@@ -128,6 +128,17 @@ def as_tolerance(x: object, name: str = "tol", *, high: float = 1.0) -> float:
     return as_scalar(x, name, low=0.0, high=high, strict_low=True)
 
 
+def symmetric_positive_definite(A: np.ndarray, rtol: float = 1e-9) -> bool:
+    """Whether the square matrix ``A`` (finite) is symmetric to ``rtol`` of its largest entry (scale-free: a
+    compliance of 1e-9 m/N as a stiffness of 1e9 N/m) and positive definite."""
+    A = np.asarray(A, dtype=float)
+    if A.ndim != 2 or A.shape[0] != A.shape[1] or not A.size or not np.all(np.isfinite(A)):
+        return False
+    top = float(np.max(np.abs(A)))
+    return bool(top > 0.0 and np.max(np.abs(A - A.T)) <= rtol * top
+                and np.linalg.eigvalsh(0.5 * (A + A.T)).min() > 0.0)
+
+
 def finite_result(x: _T, what: str, detail: str = "") -> _T:
     """``x`` unchanged if every number in it is finite, else :class:`~pkm.errors.NonFiniteError`.
 

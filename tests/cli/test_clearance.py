@@ -4,6 +4,7 @@ error line for a mechanism whose files carry no collision geometry."""
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 
@@ -25,6 +26,10 @@ def test_the_gough_stewart_prints_the_librarys_numbers():
     assert {tuple(e["bodies"]) for e in out["excluded"]} == set(c.excluded) and out["units"]["minimum"] == "m"
 
 
-def test_no_collision_geometry_is_one_error_line():
-    bad = run("clearance", "delta" if not pkm.load("delta").urdf.count("<collision") else "rrr3")
+def test_no_collision_geometry_is_one_error_line(tmp_path):
+    """The Gough-Stewart's files without their <collision> elements."""
+    gs = pkm.load("gough_stewart")
+    (tmp_path / "gough_stewart.urdf").write_text(re.sub(r"<collision.*?</collision>", "", gs.urdf, flags=re.DOTALL))
+    (tmp_path / "gough_stewart.closures.toml").write_text(gs.spec.to_toml())
+    bad = run("clearance", str(tmp_path / "gough_stewart.closures.toml"))
     assert bad.returncode == 1 and "no collision geometry" in one_error_line(bad)

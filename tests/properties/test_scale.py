@@ -55,3 +55,44 @@ def test_a_mechanism_scaled_in_size_keeps_its_classification_and_distances(kind,
         for mine, theirs in ((d.sigma_direct, e.sigma_direct), (d.sigma_inverse, e.sigma_inverse)):
             if mine > 1e-7 * mech.characteristic_length and np.isfinite(mine):
                 assert math.isclose(theirs, s * mine, rel_tol=REL), (s, mine, theirs)
+
+
+#: Mechanisms whose solves are compared at three sizes, and a move of their actuators out of reach (None: none tried).
+SOLVED = (("gepetto", "robot_delta", None), ("shipped", "prs3", (1.0, -1.0, 0.0)))
+
+
+@pytest.mark.parametrize(("kind", "name", "away"), SOLVED, ids=[f"{k}:{n}" for k, n, _ in SOLVED])
+def test_a_mechanism_scaled_in_size_solves_in_the_same_iterations(kind, name, away):
+    """close_loops and solve_ik on the copies scaled by 0.1 and 10 (issue 52: their tolerance, Newton step cap and
+    continuation steps in the characteristic length): the same verdicts, iterations and continuation steps, the same
+    configurations scaled (1e-9), each relative residual within the tolerance; a target out of reach fails alike,
+    its relative residual the same (1e-9 relative: the 3-PRS's sliders moved apart by 2 L; its iterations within 2,
+    the stall test's 1 % deciding the last on round-off). (Before, in m and rad: the 3-PRS's sliders moved by 0.2 L took 2
+    continuation steps at its size and 20 ten times larger, its platform raised by 0.05 L 3 Newton iterations and 30;
+    robot_delta's motors turned by 0.2 rad 13, 14 and 15 iterations at 0.1, 1 and 10.)"""
+    mech = original(kind, name)
+    q0, L = mech.q_reference, mech.characteristic_length
+    rev = np.array([j.revolute for j in mech.actuated], dtype=bool)
+    near = mech.actuated_q(q0) + np.where(rev, 0.17, 0.17 * L)  # (several continuation steps)
+    far = None if away is None else mech.actuated_q(q0) + np.where(rev, 1.0, L) * np.array(away)
+    solves = {}
+    for s in (1.0, *FACTORS):
+        m = mech if s == 1.0 else scaled_mechanism(mech, s)
+        units = np.where(rev, 1.0, s)
+        fk = pkm.close_loops(m, units * near)
+        target = pkm.TaskMap.of(m).value(pkm.close_loops(m, units * near, max_step=0.01).q)
+        ik = pkm.solve_ik(m, target)
+        out = fk if far is None else pkm.close_loops(m, units * far, raise_on_failure=False)
+        solves[s] = (m, fk, ik, out)
+    m1, fk1, ik1, out1 = solves[1.0]
+    assert fk1.converged and ik1.converged and out1.converged == (far is None)
+    for s in FACTORS:
+        m, fk, ik, out = solves[s]
+        for mine, theirs in ((fk1, fk), (ik1, ik)):
+            assert (theirs.converged, theirs.iterations, theirs.steps) == (mine.converged, mine.iterations, mine.steps), s
+        for mine, theirs in ((fk1, fk), (ik1, ik)):
+            assert max(mine.relative_residual, theirs.relative_residual) <= 1e-12
+            assert np.abs(m.difference(scale_configuration(m1, mine.q, s), theirs.q)).max() <= REL * max(1.0, s), s
+        if far is not None:  # (its last iterations stall: a count one apart from round-off, not from the size)
+            assert not out.converged and abs(out.iterations - out1.iterations) <= 2, (s, out1, out)
+            assert math.isclose(out.relative_residual, out1.relative_residual, rel_tol=REL), (s, out1, out)

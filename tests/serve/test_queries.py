@@ -171,9 +171,9 @@ def test_a_map_job_takes_units_as_pkm_map_does():
 
 def test_the_stiffness_query_is_the_librarys():
     """POST /models/{model}/stiffness: the compliance, rank, principal compliances (1 / the principal stiffnesses,
-    0 along rigid directions) and a wrench's deflection are pkm.stiffness's; a joint that does not exist is pkm's
-    error."""
-    from pkm.errors import UnknownNameError
+    0 along rigid directions), a wrench's deflection and tangent compliance are pkm.stiffness's, and its links of a
+    material on the Gough-Stewart; a joint that does not exist, a material unknown, is pkm's error."""
+    from pkm.errors import InvalidInputError, UnknownNameError
 
     QUERIES = queries.QUERIES
     delta = pkm.load("delta")
@@ -189,8 +189,18 @@ def test_the_stiffness_query_is_the_librarys():
     d = K.deflection([1.0, 0.0, -10.0, 0.0, 0.0, 0.0])
     assert np.allclose(out["displacement"][0], d.displacement, rtol=1e-9, atol=1e-15)
     assert out["gap"][0] == pytest.approx(d.gap, rel=1e-6)  # (q closed from qa by the service: 1e-13 apart)
+    loaded = K.loaded([1.0, 0.0, -10.0, 0.0, 0.0, 0.0]).compliance
+    assert np.allclose(out["loaded_compliance"][0], loaded, rtol=1e-6, atol=1e-9 * np.abs(loaded).max())
+    assert out["links"] == {} and out["rigid_links"] == {}
     with pytest.raises(UnknownNameError):
         QUERIES["stiffness"](delta, {"qa": qa, "springs": {"motor_9": 1.0}})
+    gs = pkm.load("gough_stewart")
+    steel = QUERIES["stiffness"](gs, {"q": gs.q_reference.tolist(), "drives": 2e6, "links": {"E": 2.1e11, "G": 8.1e10}})
+    K = pkm.stiffness(gs, gs.q_reference, joints=dict.fromkeys(gs.actuated_names, 2e6), links=pkm.Material(2.1e11, 8.1e10))
+    assert np.allclose(steel["compliance"][0], K.compliance, rtol=1e-12, atol=1e-15 * np.abs(K.compliance).max())
+    assert steel["links"]["cylinder_1"]["radius"] == 0.03 and steel["rigid_links"] == K.rigid_links
+    with pytest.raises(InvalidInputError, match="steel"):
+        QUERIES["stiffness"](gs, {"q": gs.q_reference.tolist(), "drives": 2e6, "links": "wood"})
 
 
 def test_the_clearance_query_is_the_librarys():

@@ -20,11 +20,13 @@ from pkm.sweeps.family import Candidate, ModelFamily, RegisteredFamily, family_o
 
 
 def test_a_registered_family_s_parameters_are_the_scalar_fields_with_their_units():
-    """The 3-RRR's: its lengths [m], masses [kg] and branch (an integer, no unit); not home (a tuple); an unknown name
-    or a tuple field is refused listing the parameters."""
+    """The 3-RRR's: its lengths [m], masses [kg], branch (an integer, no unit) and collision sizes [m]; not home (a
+    tuple); an unknown name or a tuple field is refused listing the parameters."""
     fam = RegisteredFamily("rrr3")
-    assert fam.parameters() == ("a", "b", "h", "H", "branch", "m_proximal", "m_distal", "m_platform")
+    assert fam.parameters() == ("a", "b", "h", "H", "branch", "m_proximal", "m_distal", "m_platform", "link_radius",
+                                "platform_thickness")
     assert fam.units("a") == ({"length"}, "m") and fam.units("m_distal") == ({"mass"}, "kg")
+    assert fam.units("link_radius") == ({"length"}, "m")
     assert fam.units("branch") == ({None}, "-") and fam.integer("branch") and not fam.integer("a")
     for bad in ("home", "c"):
         with pytest.raises(UnknownNameError, match="'a', 'b', 'h', 'H', 'branch'") as info:

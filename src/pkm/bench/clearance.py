@@ -87,8 +87,8 @@ def run(args) -> dict:
     rng = np.random.default_rng(0)
     qa0 = gs.actuated_q(gs.q_reference)
     poses = [pkm.close_loops(gs, qa0 + rng.uniform(-0.1, 0.1, gs.na)).q for _ in range(10)]
-    diff = max(max(abs(pkm.clearance(gs, q).pairs[p] - d) for p, d in zip(legs, leg_distances(gs, q, legs)))
-               for q in poses)
+    diff = max(max(abs(pairs[p] - d) for p, d in zip(legs, leg_distances(gs, q, legs)))
+               for q in poses for pairs in (pkm.clearance(gs, q).pairs,))
     args_q = [(q,) for q in poses]
     t_base = median_us(lambda q: leg_distances(gs, q, legs), args_q, repeat=args.repeat)
     batch = np.array(poses * 10)  # (100 nodes a call: the map's route, its checks once a call)

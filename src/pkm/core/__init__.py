@@ -24,7 +24,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
                                 "spring_efforts"),
     "pkm.core.dynamics.simulate": ("Event", "Simulation", "simulate"),
     "pkm.core.analysis.capability": ("Capability", "Polytope", "capability"),
-    "pkm.core.compliance": ("Beam", "Stiffness", "VibrationModes", "stiffness", "vibration_modes"),
+    "pkm.core.compliance": ("Beam", "Material", "Stiffness", "VibrationModes", "stiffness", "vibration_modes"),
     "pkm.core.collision": ("Clearance", "CollisionModel", "clearance", "clearance_map"),
     "pkm.core.analysis.region": ("Region", "feasible_region"),
     "pkm.core.calibration.estimate": ("Calibration", "calibrate"),
@@ -66,7 +66,7 @@ if TYPE_CHECKING:  # the static view of the lazy names
     from pkm.core.calibration.tolerance import ToleranceRow, tolerance_table
     from pkm.core.calibration.writeback import write_calibrated
     from pkm.core.collision import Clearance, CollisionModel, clearance, clearance_map
-    from pkm.core.compliance import Beam, Stiffness, VibrationModes, stiffness, vibration_modes
+    from pkm.core.compliance import Beam, Material, Stiffness, VibrationModes, stiffness, vibration_modes
     from pkm.core.differential.velocity import (
         Diagnostics,
         accelerations,

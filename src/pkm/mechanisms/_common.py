@@ -10,9 +10,11 @@ from collections.abc import Callable, Iterable, Mapping
 from typing import TypeVar, cast
 
 import numpy as np
+import pinocchio as pin
 
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.spec import ClosureSpec
+from pkm.core.model.urdf import UrdfBuilder
 from pkm.errors import InvalidInputError, InvalidParameterError, PkmError, UnreachableError
 from pkm.validation import ABSURD, wrap_angle
 
@@ -84,6 +86,31 @@ def rod_inertia(mass: float, length: float, axis: int) -> np.ndarray:
     I = np.full(3, mass * length**2 / 12.0)
     I[axis] = 0.0
     return np.diag(I)
+
+
+#: The primitive the shipped designs draw a rod-like link as: a cylinder whose axis ends are the link's joint (or
+#: closure) points. (A capsule is the better envelope, but yourdfpy, which :func:`pkm.core.model.urdf.load_model`
+#: runs, refuses ``<capsule>`` ("Unknown tag"), and urdfdom, under Pinocchio, prints "Could not parse collision
+#: element" for it: the designs switch here once the loader reads collision elements itself.)
+ROD_SHAPE = "cylinder"
+
+
+def rod_collision(b: UrdfBuilder, link: str, start, end, radius: float) -> None:
+    """A rod of ``radius`` [m] on ``link`` from ``start`` to ``end`` (two points of the link's frame [m]): a
+    :data:`ROD_SHAPE` along the segment, its axis' two end centres at the two points."""
+    start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    d = end - start
+    length = float(np.linalg.norm(d))
+    R = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), d / length).matrix()
+    b.collision(link, ROD_SHAPE, (start + end) / 2.0, R, radius=float(radius), length=length)
+
+
+def disc_collision(b: UrdfBuilder, link: str, centre, axis, radius: float, thickness: float) -> None:
+    """A flat cylinder (a plate) on ``link``: ``radius`` and ``thickness`` [m], its mid-plane through ``centre``
+    normal to ``axis`` (in the link's frame)."""
+    n = np.asarray(axis, dtype=float)
+    R = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), n / np.linalg.norm(n)).matrix()
+    b.collision(link, "cylinder", centre, R, radius=float(radius), length=float(thickness))
 
 
 def _circle_sphere_terms(u, v, w, arm: float, rod: float) -> tuple[np.ndarray, ...]:

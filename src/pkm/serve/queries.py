@@ -573,8 +573,12 @@ def stiffness(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> 
     """At closed configurations (``q``, or ``qa`` closed), the end effector's compliance with the joints' springs
     (``springs`` by name, ``drives`` for every actuated joint not named; the others held rigid or free:
     :func:`pkm.stiffness`), its rank, its principal compliances under a pure force and a pure moment with their
-    directions, and with ``wrench`` the exact and the first-order deflection."""
+    directions, and with ``wrench`` the exact and the first-order deflection and the tangent stiffness's compliance
+    there (:meth:`Stiffness.loaded <pkm.core.compliance.stiffness.Stiffness.loaded>`). ``links``: ``"spec"``
+    (default: the spec's ``[links]`` compliances), ``"rigid"``, ``"steel"``, ``"aluminium"`` or ``{"E": Pa, "G": Pa}``:
+    the links as beams of their collision cylinders and capsules, the compliant links and those taken rigid said."""
     from pkm.core.compliance import stiffness as run
+    from pkm.core.compliance.links import as_links, law_fields
     from pkm.validation import as_scalar
 
     joints: dict[str, Any] = {}
@@ -586,32 +590,42 @@ def stiffness(mech: Mechanism, body: Mapping[str, Any], kernels: Any = None) -> 
             raise InvalidInputError("springs", "a mapping {joint: stiffness} [N m/rad, N/m]", springs)
         joints.update(springs)
     wrench = body.get("wrench")
+    links = as_links(body.get("links"))
     q, samples = _configurations(mech, body, kernels)
     sprung: dict[str, float] = {}
     sources: dict[str, str] = {}
+    compliant: dict[str, Any] = {}
+    rigid: dict[str, str] = {}
 
     def one(k: int) -> dict[str, Any]:
-        K = run(mech, q[k], joints=joints)
+        K = run(mech, q[k], joints=joints, links=links)
         sprung.update(K.sprung)  # (the same at every sample: the request's, the drives' and the spec's springs)
         sources.update(K.sources)
+        compliant.update({n: law_fields(v) for n, v in K.links.items()})
+        rigid.update(K.rigid_links)
         out = {"q": q[k], "compliance": K.compliance, "rank": K.rank}
         for load in ("force", "moment"):  # (the principal stiffnesses' reciprocals: 0 along a rigid direction)
             principal, U = K.principal(load)
             out[f"{load}_compliance"], out[f"{load}_directions"] = 1.0 / principal, U.T
         if wrench is not None:
-            d = K.deflection(wrench)
-            out.update(displacement=d.displacement, first_order=d.first_order, gap=d.gap)
+            loaded = K.loaded(wrench)
+            d = loaded.deflection
+            out.update(displacement=d.displacement, first_order=d.first_order, gap=d.gap,
+                       loaded_compliance=loaded.compliance)
         return out
 
     keys = ("q", "compliance", "rank", "force_compliance", "force_directions", "moment_compliance",
-            "moment_directions") + (("displacement", "first_order", "gap") if wrench is not None else ())
+            "moment_directions") + (("displacement", "first_order", "gap", "loaded_compliance")
+                                    if wrench is not None else ())
     out = samples.each(one, keys)
-    out["sprung"], out["sources"] = sprung, sources
+    out["sprung"], out["sources"], out["links"], out["rigid_links"] = sprung, sources, compliant, rigid
     out["units"] = {"q": _q_units(mech), "compliance": [["m/N"] * 3 + ["m/(N m)"] * 3] * 3
                     + [["rad/N"] * 3 + ["rad/(N m)"] * 3] * 3, "rank": "1", "force_compliance": "m/N",
                     "force_directions": "1", "moment_compliance": "rad/(N m)", "moment_directions": "1",
                     "displacement": ["m"] * 3 + ["rad"] * 3, "first_order": ["m"] * 3 + ["rad"] * 3, "gap": "1",
-                    "sprung": "N m/rad (revolute), N/m (prismatic)", "sources": "1"}
+                    "sprung": "N m/rad (revolute), N/m (prismatic)", "sources": "1",
+                    "loaded_compliance": [["m/N"] * 3 + ["m/(N m)"] * 3] * 3 + [["rad/N"] * 3 + ["rad/(N m)"] * 3] * 3,
+                    "links": "m (radius, inner), Pa (E, G); a 6 x 6 compliance as compliance's", "rigid_links": "1"}
     return out
 
 

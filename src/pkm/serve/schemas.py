@@ -287,6 +287,16 @@ class StiffnessAnswer(_Batch):
     first_order: Column | None = _field("With a wrench: the first-order deflection C W, same layout.", None, None)
     gap: Column | None = _field("With a wrench: their relative difference (homogenised by the model's size).", None,
                                 None)
+    loaded_compliance: Column | None = _field("With a wrench: the tangent compliance at the deflected equilibrium "
+                                              "(6 x 6 a sample; the geometric stiffness of the load included; not "
+                                              "symmetric in general), units as compliance's.", None, None)
+    links: dict[str, dict[str, Any]] = _field("The compliant links counted: a beam's radius, inner radius [m], E, G "
+                                              "[Pa], or a 6 x 6 compliance (the spec's).",
+                                              {"cylinder_1": {"radius": 0.03, "inner": 0.0, "E": 2.1e11, "G": 8.1e10}},
+                                              {})
+    rigid_links: dict[str, str] = _field("With a material: the links taken rigid and why (no collision geometry, not "
+                                         "one cylinder or capsule, a disc, a span of no length).",
+                                         {"base": "no collision geometry"}, {})
     sprung: dict[str, float] = _field("Each joint's stiffness counted (N m/rad for a revolute, N/m for a prismatic "
                                       "joint); the actuated joints not named held rigid.", {"motor_1": 500.0})
     sources: dict[str, str] = _field("Where each one came from: joints (this request's springs or drives), actuator "
@@ -335,6 +345,10 @@ class StiffnessRequest(_AtConfigurations):
     wrench: list[float] | None = _field("A constant load at the end effector's origin, world axes (fx, fy, fz [N], "
                                         "mx, my, mz [N m]): its exact deflection is answered too.",
                                         [0.0, 0.0, -10.0, 0.0, 0.0, 0.0], None)
+    links: str | dict[str, float] | None = _field("The links: spec (default: the spec's [links] compliances, else "
+                                                  "rigid), rigid, steel, aluminium, or {E, G} in Pa: every link whose "
+                                                  "collision geometry is one cylinder or capsule a beam of that "
+                                                  "material.", "steel", None)
 
 
 class ClearanceRequest(_AtConfigurations):

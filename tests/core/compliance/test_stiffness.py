@@ -16,36 +16,16 @@ import pkm
 from pkm.core.compliance import stiffness, vibration_modes
 from pkm.core.model.builder import from_strings
 from pkm.errors import InvalidInputError, StiffnessError, UnknownNameError
+from tests.core.compliance.conftest import legs
 
 K_LEG = 2.0e6  # N/m: one axial spring per leg
-
-
-@pytest.fixture(scope="module")
-def gs():
-    return pkm.load("gough_stewart")
-
-
-@pytest.fixture(scope="module")
-def pose(gs):
-    """A configuration away from the reference: the legs 1 to 3 cm longer or shorter (the platform moved and tilted)."""
-    return pkm.close_loops(gs, gs.actuated_q(gs.q_reference) + [0.02, -0.01, 0.03, 0.0, 0.015, -0.02]).q
-
-
-def _legs(gs, q):
-    """``(b, p, P)``: each leg's base and platform anchors and the platform's origin (world), from the model."""
-    m, d = gs.model, gs.data
-    pin.forwardKinematics(m, d, q)
-    pin.updateFramePlacements(m, d)
-    b = np.array([d.oMi[m.getJointId(f"u{i}")].translation for i in range(1, 7)])
-    p = np.array([(d.oMi[cm.joint2_id] * cm.joint2_placement).translation for cm in gs.constraint_models])
-    return b, p, d.oMf[gs.ee_frame].translation.copy(), d.oMf[gs.ee_frame].rotation.copy()
 
 
 def test_the_gough_stewart_stiffness_is_gosselins(gs, pose):
     """K = sum k r_i r_i^T, r_i = (u_i, (p_i - P) x u_i) from the anchors (Gosselin 1990), within 1e-9 relative,
     at a pose away from the reference; the compliance is its inverse."""
     K = stiffness(gs, pose, joints={j: K_LEG for j in gs.actuated_names})
-    b, p, P, _ = _legs(gs, pose)
+    b, p, P, _ = legs(gs, pose)
     u = (p - b) / np.linalg.norm(p - b, axis=1)[:, None]
     r = np.hstack([u, np.cross(p - P, u)])
     gosselin = K_LEG * r.T @ r
@@ -63,7 +43,7 @@ def test_the_exact_deflection_is_the_legs_equilibrium(gs, pose):
     platform's pose by scipy's hybrid method from the anchors alone: within 1e-8 relative; the first-order C W
     differs by the reported gap, which grows with the load."""
     K = stiffness(gs, pose, joints={j: K_LEG for j in gs.actuated_names})
-    b, p0, P0, R0 = _legs(gs, pose)
+    b, p0, P0, R0 = legs(gs, pose)
     local = (p0 - P0) @ R0  # (the anchors in the platform's frame)
     l0 = np.linalg.norm(p0 - b, axis=1)
     gaps = []
@@ -233,6 +213,8 @@ def test_bad_links_are_refused_by_name():
         stiffness(rrr3, q, joints=motors, links={"platform_center": rod})
     with pytest.raises(InvalidInputError, match="rigid links"):
         stiffness(rrr3, q, joints=motors, links={"proximal_1": rod}).deflection([1.0, 0, 0, 0, 0, 0])
+    with pytest.raises(InvalidInputError, match="rigid links"):
+        stiffness(rrr3, q, joints=motors, links={"proximal_1": rod}).loaded([1.0, 0, 0, 0, 0, 0])
     with pytest.raises(InvalidInputError):
         Beam(E=7e10, radius=0.004, inner=0.005)
     m, d = rrr3.model, rrr3.data  # (a 6 x 6 of one's own, in the link's axes (x along it): the beam's, alike)
@@ -262,3 +244,44 @@ def test_the_drives_servo_stiffness_is_the_default_and_an_argument_wins(gs, pose
     parallel = stiffness(both, pose)
     assert parallel.sources[legs[0]] == "actuator+spring"
     assert parallel.sprung[legs[0]] == pytest.approx(1.5 * K_LEG, rel=1e-15)
+
+
+def test_the_loaded_stiffness_is_the_derivative_of_the_deflection(gs, pose):
+    """Stiffness.loaded(W): the inverse of the deflected pose's derivative with respect to the wrench, by central
+    differences of .deflection (steps 1e-5 of the load; the pose's change as a world-aligned twist) within 1e-6
+    relative (2e-9 measured), 14 % from the unloaded stiffness; W = 0 gives .matrix (1e-12); a pure force (a
+    conservative load) gives a symmetric K_t, a moment in world axes (not conservative) an unsymmetric one."""
+    K = stiffness(gs, pose, joints={j: K_LEG for j in gs.actuated_names})
+    assert np.abs(K.loaded(np.zeros(6)).matrix - K.matrix).max() <= 1e-12 * np.abs(K.matrix).max()
+    W = np.array([3e4, -2e4, -1.5e5, 2e3, -1e3, 3e3])
+    loaded = K.loaded(W)
+    assert np.allclose(loaded.deflection.q, K.deflection(W).q, rtol=0, atol=1e-12)
+
+    def pose_of(q):
+        pin.framesForwardKinematics(gs.model, gs.data, q)
+        M = gs.data.oMf[gs.ee_frame]
+        return M.translation.copy(), M.rotation.copy()
+
+    C = np.empty((6, 6))
+    for i in range(6):
+        h = 1e-5 * np.abs(W[:3] if i < 3 else W[3:]).max()
+        (pp, Rp), (pm, Rm) = (pose_of(K.deflection(W + s * h * np.eye(6)[i]).q) for s in (1.0, -1.0))
+        C[:, i] = np.concatenate([pp - pm, pin.log3(Rp @ Rm.T)]) / (2 * h)
+    Kt = loaded.matrix
+    assert np.abs(np.linalg.inv(C) - Kt).max() <= 1e-6 * np.abs(Kt).max()
+    assert np.abs(Kt - K.matrix).max() > 0.1 * np.abs(K.matrix).max()
+    assert np.abs(Kt - Kt.T).max() > 1e-5 * np.abs(Kt).max()
+    force = K.loaded(np.r_[W[:3], 0.0, 0.0, 0.0]).matrix
+    assert np.abs(force - force.T).max() <= 1e-9 * np.abs(force).max()
+
+
+def test_a_configuration_outside_the_limits_is_flagged(gs, pose):
+    """Legs 27 cm longer than the reference's (past their 1 m stroke): the stiffness is given, its outside_limits
+    names every leg as Mechanism.outside_limits does and its repr says so; inside them, nothing is flagged."""
+    legs = {j: K_LEG for j in gs.actuated_names}
+    far = pkm.close_loops(gs, gs.actuated_q(gs.q_reference) + 0.27).q
+    K = stiffness(gs, far, joints=legs)
+    assert K.outside_limits == gs.outside_limits(far) == tuple(gs.actuated_names)
+    assert "OUTSIDE the position limits: leg1" in repr(K)
+    inside = stiffness(gs, pose, joints=legs)
+    assert inside.outside_limits == () and "OUTSIDE" not in repr(inside)

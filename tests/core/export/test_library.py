@@ -160,7 +160,8 @@ def test_the_files_names_reach_the_c_unchanged(tmp_path):
 
 
 def test_a_branch_without_a_constant_is_said_so_and_names_that_clash_are_refused(tmp_path):
-    """A branch pkm cannot reach at the reference task value (the Delta's platform_x < 0, the reference's x being 0)
+    """A branch pkm cannot reach at the reference task value (the Delta's platform_z > 0, the platform above the base,
+    the reference's z being -0.254 m; not platform_x < 0 at the reference's x = 0, which a solve may end at -3e-17)
     gets no constant: a PkmWarning and the header's line (:func:`mode_constants`) say why. Two branches whose names make one C identifier are refused
     before anything is written."""
     from pkm.core.export.library import mode_constants
@@ -171,13 +172,13 @@ def test_a_branch_without_a_constant_is_said_so_and_names_that_clash_are_refused
 
     folder = data_dir("urdf")
     spec = (folder / "delta.closures.toml").read_text()
-    extra = '\n[branch.left]\nsigns = { platform_x = -1 }\n'
+    extra = '\n[branch.up]\nsigns = { platform_z = 1 }\n'
     files = {"delta.urdf": (folder / "delta.urdf").read_text(), "delta.closures.toml": spec + extra}
     mech = load_texts(files)
-    with pytest.warns(PkmWarning, match="branch 'left'.*no constant"):
+    with pytest.warns(PkmWarning, match="branch 'up'.*no constant"):
         modes, lines = mode_constants(mech, ExportModel(mech))
     assert set(modes["ik"]) == {"REFERENCE", "KNEE_OUT", "KNEE_IN"}
-    assert any(line.startswith("branch 'left' (platform_x < 0): no constant, pkm finds no configuration")
+    assert any(line.startswith("branch 'up' (platform_z > 0): no constant, pkm finds no configuration")
                for line in lines)
     files["delta.closures.toml"] = spec + '\n[branch.Knee-In]\nsigns = { knee_1 = 1 }\n'
     with pytest.raises(ExportError, match="'knee_in' and 'Knee-In' make the same C name KNEE_IN"):

@@ -15,9 +15,11 @@ from tests import fivebar
 
 
 def test_the_table_names_every_format_pkm_reads():
-    assert set(base.FORMATS) == {"urdf", "mjcf", "sdf"}
-    assert base.suffixes() == {".urdf": "urdf", ".xml": "mjcf", ".mjcf": "mjcf", ".sdf": "sdf"}
+    assert set(base.FORMATS) == {"urdf", "mjcf", "sdf", "usd"}
+    assert base.suffixes() == {".urdf": "urdf", ".xml": "mjcf", ".mjcf": "mjcf", ".sdf": "sdf", ".usda": "usd",
+                               ".usd": "usd", ".usdc": "usd"}
     assert base.by_root("mujoco").name == "mjcf" and base.by_root("nothing") is None
+    assert base.by_root("") is None and base.FORMATS["usd"].opens  # (USD has no root element: its reader opens it)
     from pkm.core.formats import SUFFIXES  # (the old constant, read from the table)
 
     assert SUFFIXES == base.suffixes()

@@ -1,5 +1,5 @@
 """The round-trip matrix (issue 43): every writer (pkm.save: pkm's spec + URDF, MJCF, Gepetto's URDF + YAML, URDF+,
-SDF + spec) followed by pkm.load gives the same mechanism, for every shipped mechanism (pkm.MECHANISMS), tests/fivebar,
+SDF + spec, USD: issue 56, through pkm's double-precision attributes) followed by pkm.load gives the same mechanism, for every shipped mechanism (pkm.MECHANISMS), tests/fivebar,
 the acceptance set (tests/test_acceptance.py) and the other examples under examples/.
 
 "The same": the joint names (MJCF and SDF write a universal joint ``u`` as two hinges ``u__1``, ``u__2``: read

@@ -47,7 +47,7 @@ def _placements(mech: pkm.Mechanism, q: np.ndarray) -> dict[str, np.ndarray]:
 @pytest.mark.parametrize("to", list(WRITERS))
 def test_every_writer_reads_back_as_the_same_mechanism(to, tmp_path):
     """pkm.save by suffix, pkm.load of the main file: same joints, limits, actuators (in order) and closure types
-    (and names where the format has them: pkm, MJCF, URDF+; frames where it keeps them: pkm, Gepetto); at three random
+    (and names where the format has them: pkm, MJCF, URDF+, SDF, USD; frames where it keeps them: pkm, Gepetto); at three random
     actuator values near the reference the original's closed configuration closes the copy (1e-12) and is the copy's
     FK from it (close_loops moves it by <= 1e-12); every joint's placement agrees to 1e-12; pkm's spec keeps the task
     (the same task values). What the other formats cannot hold comes as a PkmWarning; pkm's spec loses nothing
@@ -68,7 +68,7 @@ def test_every_writer_reads_back_as_the_same_mechanism(to, tmp_path):
         assert [c.type for c in back.spec.closures] == [c.type for c in mech.spec.closures], name
         if to != "gepetto":
             assert [c.name for c in back.spec.closures] == [c.name for c in mech.spec.closures], name
-        if to not in ("mjcf", "urdfplus", "sdf"):
+        if to not in ("mjcf", "urdfplus", "sdf", "usd"):
             assert [(c.frame_a, c.frame_b) for c in back.spec.closures] == \
                 [(c.frame_a, c.frame_b) for c in mech.spec.closures], name
         rng = np.random.default_rng(7)

@@ -40,6 +40,10 @@ def test_shipped_specs_round_trip_byte_for_byte(name):
     (lambda t: t.replace("[task]", "[task"), "not valid TOML"),
     (lambda t: t.replace('actuated = ["motor_1", "motor_2", "motor_3"]', 'actuated = ["motor_1", "motor_1"]'),
      "twice"),
+    (lambda t: t + "\n[links.upper_1]\ncompliance = [[1e-8]]\n", "6 rows of 6"),
+    (lambda t: t + "\n[links.upper_1]\ncompliance = " + str((np.eye(6) + np.eye(6, k=1) * 1e-3).tolist()) + "\n",
+     "symmetric positive definite"),
+    (lambda t: t + "\n[links.upper_1]\nradius = 0.01\n", "one key, compliance"),
 ])
 def test_malformed_spec_raises_spec_error_saying_what(delta_text, edit, message):
     """Each defect of a spec file is reported as a SpecError naming the problem."""

@@ -27,11 +27,13 @@ def test_defaults_are_table_1_of_the_paper():
 
 def test_the_docstring_states_the_defaults_and_the_units_of_every_field():
     """The values in the Attributes section are the defaults, and each field's [unit] is its metadata's."""
-    check_documented_defaults(dp.DeltaParams, {"La", "Lb", "r", "R"})
+    check_documented_defaults(dp.DeltaParams, {"La", "Lb", "r", "R", "arm_radius", "rod_radius", "platform_thickness",
+                                               "base_thickness"})
     check_units_metadata(dp.DeltaParams)
 
 
-@pytest.mark.parametrize("field", ["La", "Lb", "r", "R", "m_arm", "m_forearm", "m_platform"])
+@pytest.mark.parametrize("field", ["La", "Lb", "r", "R", "m_arm", "m_forearm", "m_platform", "arm_radius",
+                                   "rod_radius", "platform_thickness", "base_thickness"])
 def test_lengths_and_masses_must_be_positive_finite_and_not_absurd(field):
     """0, negatives, NaN, +-inf and 2e6 (a value in mm given as m) are each refused naming the field."""
     for bad in NOT_POSITIVE:

@@ -1,6 +1,6 @@
 """pkm.mechanisms.hexapod.model: the hexapod's generated URDF holds every name its closure spec uses (mimic
-reconfiguration joints included), the spec survives TOML, and a design other than the paper's builds with its own
-lengths in the tree."""
+reconfiguration joints included), the spec survives TOML, a design other than the paper's builds with its own
+lengths in the tree, and its collision primitives span the links' joint and closure points."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ from pkm.mechanisms import delta, hexapod
 from pkm.mechanisms.hexapod.geometry import base_points, platform_local_points
 from tests.mechanisms.model_contract import (
     check_build_of_a_design,
+    check_collision_primitives,
     check_other_params_refused,
     check_spec_round_trip,
     check_urdf_holds_the_spec_names,
@@ -57,3 +58,18 @@ def test_a_design_builds_with_its_lengths_in_the_tree():
 def test_another_mechanisms_params_are_refused():
     """The Delta's design (or None) is not a hexapod's."""
     check_other_params_refused(hexapod, delta.DeltaParams())
+
+
+@pytest.mark.parametrize("params", [hexapod.HexapodParams(), hexapod.HexapodParams(LA=0.22, LB=0.42, Rr=0.14,
+                                                                                  link_radius=0.006)])
+def test_collision_primitives_span_the_links_at_a_closed_configuration(params):
+    """Reconfiguration links from F_i to A_i, arms from A_i to B_i, rods from B_i to the spherical joint closed on the
+    platform (the cylinders' end centres at the joints' world positions, 1e-12 m); the platform prism's cylinder
+    of radius r and height h with C_1..C_3 on its upper rim and C_4..C_6 on its lower one: read from the URDF's
+    text, placed by Pinocchio's forward kinematics at the reference; each size the design's."""
+    mech, p = hexapod.build(params), params
+    rods = {f"recon_{n}": (f"beta_{n}", f"alpha_{n}", p.link_radius) for n in (1, 2, 3)}
+    rods |= {f"arm_{n}": (f"alpha_{n}", f"knee_{n}", p.link_radius) for n in range(1, 7)}
+    rods |= {f"rod_{n}": (f"knee_{n}_b", f"platform_c_{n}", p.link_radius) for n in range(1, 7)}
+    rim = [(f"platform_c_{n}", p.h / 2 if n <= 3 else -p.h / 2) for n in range(1, 7)]
+    check_collision_primitives(mech, hexapod.urdf_xml(params), rods, {"platform_body": (p.r, p.h, rim)})

@@ -30,11 +30,12 @@ def test_defaults_are_table_1_of_the_paper():
 
 def test_the_docstring_states_the_defaults_and_the_units_of_every_field():
     """The values in the Attributes section (theta's six angles too) are the defaults; each [unit] is its metadata's."""
-    check_documented_defaults(hp.HexapodParams, {"Rf", "Rr", "R2", "H0", "LA", "LB", "h", "r", "theta"})
+    check_documented_defaults(hp.HexapodParams, {"Rf", "Rr", "R2", "H0", "LA", "LB", "h", "r", "theta", "link_radius"})
     check_units_metadata(hp.HexapodParams)
 
 
-@pytest.mark.parametrize("field", ["Rf", "Rr", "R2", "LA", "LB", "h", "r", "m_recon", "m_arm", "m_rod", "m_platform"])
+@pytest.mark.parametrize("field", ["Rf", "Rr", "R2", "LA", "LB", "h", "r", "m_recon", "m_arm", "m_rod", "m_platform",
+                                   "link_radius"])
 def test_lengths_and_masses_must_be_positive_finite_and_not_absurd(field):
     """0, negatives, NaN, +-inf and 2e6 are each refused naming the field."""
     for bad in NOT_POSITIVE:

@@ -9,10 +9,12 @@ import pytest
 from pkm.mechanisms import delta, prs3
 from tests.mechanisms.model_contract import (
     check_build_of_a_design,
+    check_collision_primitives,
     check_other_params_refused,
     check_spec_round_trip,
     check_urdf_holds_the_spec_names,
     frame_offset,
+    joint_offset,
 )
 
 DESIGN = prs3.Prs3Params(l=1.1, h=0.45, g=0.95)
@@ -48,3 +50,22 @@ def test_a_design_builds_with_its_lengths_in_the_tree():
 def test_another_mechanisms_params_are_refused():
     """The Delta's design (or None) is not a 3-PRS's."""
     check_other_params_refused(prs3, delta.DeltaParams())
+
+
+@pytest.mark.parametrize("params", [prs3.Prs3Params(), prs3.Prs3Params(l=1.1, h=0.45, g=0.95, gamma=1.2,
+                                                                        link_radius=0.03, slider_size=0.08,
+                                                                        platform_thickness=0.04,
+                                                                        base_thickness=0.07)])
+def test_collision_primitives_span_the_links_at_a_closed_configuration(params):
+    """Couplers from the knee to the spherical joint closed on the platform (the cylinders' end centres at the
+    joints' world positions, 1e-12 m), slider cubes centred on the knees, the platform disc's mid-plane through the
+    spherical joints at its rim, the base disc's upper face through the rails' feet a_i (the slider joints'
+    placements on the base) at its rim: read from the URDF's text, placed by Pinocchio's forward kinematics at the reference; each size the
+    design's."""
+    mech, p = prs3.build(params), params
+    rods = {f"coupler_{n}": (f"knee_{n}", f"platform_ball_{n}", p.link_radius) for n in (1, 2, 3)}
+    feet = [joint_offset(mech, f"slider_{n}") for n in (1, 2, 3)]  # (a_i: the rails' origins, on the base)
+    plates = {"platform_link": (p.h, p.platform_thickness, [(f"platform_ball_{n}", 0.0) for n in (1, 2, 3)]),
+              "base": (p.g, p.base_thickness, [(a, p.base_thickness / 2) for a in feet])}
+    boxes = {f"slider_link_{n}": (f"knee_{n}", p.slider_size) for n in (1, 2, 3)}
+    check_collision_primitives(mech, prs3.urdf_xml(params), rods, plates, boxes)

@@ -37,7 +37,8 @@ def test_defaults_are_the_stored_table_2():
 def test_the_docstring_states_the_defaults_and_the_units_of_every_field():
     """The values in the Attributes section (l 1 m, h 0.5 m, g 1 m, masses) are the defaults; each [unit] is its
     metadata's (the Table 2 fields' metadata is written by _from_table2)."""
-    check_documented_defaults(pp.Prs3Params, {"l", "h", "g", "m_slider", "m_coupler", "m_platform"})
+    check_documented_defaults(pp.Prs3Params, {"l", "h", "g", "m_slider", "m_coupler", "m_platform", "link_radius",
+                                             "slider_size", "platform_thickness", "base_thickness"})
     check_units_metadata(pp.Prs3Params)
 
 
@@ -47,7 +48,8 @@ def test_table_2_is_read_only():
         pp.table2()["l"] = 2.0  # type: ignore[index]
 
 
-@pytest.mark.parametrize("field", ["l", "h", "g", "m_platform"])
+@pytest.mark.parametrize("field", ["l", "h", "g", "m_platform", "link_radius", "slider_size", "platform_thickness",
+                                   "base_thickness"])
 def test_lengths_and_platform_mass_must_be_positive_finite_and_not_absurd(field):
     """0, negatives, NaN, +-inf and 2e6 are each refused naming the field."""
     for bad in NOT_POSITIVE:

@@ -22,11 +22,12 @@ from tests.mechanisms.params_contract import (
 def test_the_docstring_states_the_defaults_and_the_units_of_every_field():
     """The values in the Attributes section (a, b 40 cm, h 10 cm, H 100 cm) are the defaults; each field's [unit]
     is its metadata's (branch, an integer, has none)."""
-    check_documented_defaults(rp.Rrr3Params, {"a", "b", "h", "H"})
+    check_documented_defaults(rp.Rrr3Params, {"a", "b", "h", "H", "link_radius", "platform_thickness"})
     check_units_metadata(rp.Rrr3Params)
 
 
-@pytest.mark.parametrize("field", ["a", "b", "h", "H", "m_proximal", "m_distal", "m_platform"])
+@pytest.mark.parametrize("field", ["a", "b", "h", "H", "m_proximal", "m_distal", "m_platform", "link_radius",
+                                   "platform_thickness"])
 def test_lengths_and_masses_must_be_positive_finite_and_not_absurd(field):
     """0, negatives, NaN, +-inf and 2e6 are each refused naming the field."""
     for bad in NOT_POSITIVE:

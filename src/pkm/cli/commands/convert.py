@@ -18,7 +18,8 @@ from pkm.cli.usage import UsageError
 #: ``pkm --help`` imports no model code; tests/cli/test_convert.py keeps the two the same).
 FORMATS = {"pkm": ".closures.toml/.toml (pkm's closure spec + URDF)", "mjcf": ".xml/.mjcf (MuJoCo's MJCF)",
            "gepetto": ".yaml/.yml (Gepetto's URDF + YAML)", "urdfplus": ".urdf (MIT's URDF+)",
-           "sdf": ".sdf (SDFormat + pkm's closure spec)"}
+           "sdf": ".sdf (SDFormat + pkm's closure spec)",
+           "usd": ".usda/.usd/.usdc (USD: UsdPhysics, loops as joints excluded from the articulation)"}
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

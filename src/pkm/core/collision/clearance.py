@@ -91,7 +91,7 @@ def distance_gradient(mech: Mechanism, q: np.ndarray, witness: tuple[np.ndarray,
     from pkm.core.differential.velocity import passive_map
 
     cm = CollisionModel.of(mech)
-    ja, jb = (cm._joint_of[b] for b in pair)
+    ja, jb = (cm.body_joints[b] for b in pair)
     pin.computeJointJacobians(mech.model, mech.data, q)
     row = normal @ (_point_jacobian(mech, jb, witness[1]) - _point_jacobian(mech, ja, witness[0]))
     return np.asarray(row @ passive_map(mech, q), dtype=float)

@@ -237,6 +237,7 @@ class CollisionModel:
             starts with its rule (``"neighbours: ..."``).
         notes: What was left out (meshes not found) or read so, one sentence each.
         pair_of: For each of ``geometry``'s collision pairs, the index of its pair of bodies in :attr:`pairs`.
+        body_joints: ``{body: the Pinocchio joint that moves it}``.
     """
 
     def __init__(self, mech: Mechanism):
@@ -269,7 +270,7 @@ class CollisionModel:
         self.shapes: tuple[Collision, ...] = tuple(shapes)
         self.bodies: tuple[str, ...] = tuple(dict.fromkeys(c.link for c in shapes))
         self.notes: tuple[str, ...] = tuple(notes)
-        self._joint_of = joint_of
+        self.body_joints: dict[str, int] = joint_of
         self.excluded: dict[tuple[str, str], str] = {}
         self.pairs: tuple[tuple[str, str], ...] = ()
         self.pair_of = np.zeros(0, dtype=int)
@@ -290,7 +291,7 @@ class CollisionModel:
     def _structural(self) -> dict[tuple[str, str], str]:
         """The pairs the tree and the closures exclude, with their reasons."""
         mech, model = self.mech, self.mech.model
-        carriers = set(self._joint_of.values())
+        carriers = set(self.body_joints.values())
 
         def owner(j: int) -> int | None:  # the nearest joint at or above j that carries geometry
             while j not in carriers:
@@ -308,7 +309,7 @@ class CollisionModel:
         out = {}
         for i, a in enumerate(self.bodies):
             for b in self.bodies[i + 1:]:
-                ja, jb = self._joint_of[a], self._joint_of[b]
+                ja, jb = self.body_joints[a], self.body_joints[b]
                 if ja == jb:
                     out[(a, b)] = f"rigid: one body (joint {model.names[ja]!r}), their distance never changes"
                 elif parent[jb] == ja or parent[ja] == jb:

@@ -30,9 +30,11 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from pkm._derived import derived
+from pkm.core.collision.geometry import Collision, placed_collisions
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, UnknownNameError
-from pkm.validation import as_array, as_scalar
+from pkm.validation import as_array, as_scalar, symmetric_positive_definite
 
 
 @dataclass(frozen=True)
@@ -88,6 +90,125 @@ class Beam:
 
 
 @dataclass(frozen=True)
+class Material:
+    """A linear elastic isotropic material: the links as beams of their collision primitive's section
+    (``pkm.stiffness(mech, q, links=Material(...))``, :func:`beams_from_collisions`).
+
+    Attributes:
+        E: Young's modulus [Pa].
+        G: The shear modulus [Pa]; default ``E / 2.6`` (Poisson's ratio 0.3, as :class:`Beam`).
+        shear: Timoshenko's shear deflection on top of Euler-Bernoulli's bending (:class:`Beam`).
+    """
+
+    E: float
+    G: float | None = None
+    shear: bool = False
+
+    def __post_init__(self) -> None:
+        as_scalar(self.E, "Material.E", low=0.0, strict_low=True, unit="Pa")
+        if self.G is not None:
+            as_scalar(self.G, "Material.G", low=0.0, strict_low=True, unit="Pa")
+
+    def beam(self, radius: float) -> Beam:
+        """A solid circular beam of this material and ``radius`` [m]."""
+        return Beam(E=self.E, radius=radius, G=self.G, shear=self.shear)
+
+
+#: Structural steel (E 210 GPa, G 81 GPa).
+STEEL = Material(E=2.1e11, G=8.1e10)
+#: Aluminium alloy (E 70 GPa, G 26 GPa).
+ALUMINIUM = Material(E=7.0e10, G=2.6e10)
+#: The materials named by :func:`as_links` (the command line's ``--links``, the service's ``links``).
+MATERIALS = {"steel": STEEL, "aluminium": ALUMINIUM, "aluminum": ALUMINIUM}
+
+
+def as_links(value: object) -> str | Material | None:
+    """A faces' ``links`` (the command line, the service) as :func:`pkm.stiffness` takes it: ``None`` or
+    ``"spec"`` (the spec's ``[links]``), ``"rigid"``, a name of :data:`MATERIALS`, or ``{"E": Pa, "G": Pa}`` (``G``
+    optional) a :class:`Material`.
+
+    Raises:
+        InvalidInputError: anything else, saying what is read.
+    """
+    if value is None or isinstance(value, Material):
+        return value
+    if isinstance(value, str) and value in ("spec", "rigid", *MATERIALS):
+        return None if value == "spec" else "rigid" if value == "rigid" else MATERIALS[value]
+    if isinstance(value, Mapping) and "E" in value and set(value) <= {"E", "G"}:
+        return Material(E=as_scalar(value["E"], "links E", unit="Pa"),
+                        G=as_scalar(value["G"], "links G", unit="Pa") if value.get("G") is not None else None)
+    raise InvalidInputError("links", "spec, rigid, " + ", ".join(MATERIALS) + ", or the moduli E [Pa] and optionally "
+                                     "G [Pa]", value)
+
+
+def law_fields(law: object) -> dict[str, object]:
+    """A compliant link's law as the faces answer it: a :class:`Beam`'s ``radius``, ``inner`` [m], ``E``, ``G``
+    [Pa] (``G`` as used) and ``shear``; else its 6 x 6 ``compliance``."""
+    if isinstance(law, Beam):
+        return {"radius": law.radius, "inner": law.inner, "E": law.E,
+                "G": law.G if law.G is not None else law.E / 2.6, "shear": law.shear}
+    return {"compliance": np.asarray(law, dtype=float)}
+
+
+#: The largest angle between a cylinder's or capsule's axis and a span of its link for the primitive's radius to be
+#: taken as that beam's section [deg].
+AXIS_TOL_DEG = 5.0
+
+
+def _shapes(mech: Mechanism) -> dict[str, list[Collision]]:
+    """``{link: its collision shapes}`` (:func:`~pkm.core.collision.geometry.placed_collisions`), read once a
+    mechanism."""
+    out: dict[str, list[Collision]] = {}
+    for c, _, _ in placed_collisions(mech)[0]:
+        out.setdefault(c.link, []).append(c)
+    return out
+
+
+def beams_from_collisions(mech: Mechanism, data: pin.Data, material: Material) \
+        -> tuple[dict[str, Beam], dict[str, str]]:
+    """``({link: Beam}, {link: why it is taken rigid})``: each link that carries something (a joint, a closure or
+    the end-effector frame) as a solid circular :class:`Beam` of ``material``, its radius its collision geometry's
+    (:mod:`pkm.core.collision.geometry`) where that is one cylinder or capsule, at least as long as its diameter (a
+    disc is no beam), whose axis lies within :data:`AXIS_TOL_DEG` of each of the link's spans (from its origin to
+    what it carries, at the placements in ``data``); every other link that carries something is rigid, with the
+    reason."""
+    m = mech.model
+    shapes = derived(mech, _shapes)
+    beams: dict[str, Beam] = {}
+    rigid: dict[str, str] = {}
+    cos_tol = math.cos(math.radians(AXIS_TOL_DEG))
+    for fid in derived(mech, _carriers):
+        f = m.frames[fid]
+        carried = _carried(mech, data, fid)
+        own = shapes.get(f.name, [])
+        if not own:
+            rigid[f.name] = "no collision geometry"
+            continue
+        if len(own) > 1 or own[0].kind not in ("cylinder", "capsule"):
+            rigid[f.name] = f"its collision geometry is {', '.join(c.kind for c in own)}, not one cylinder or capsule"
+            continue
+        c = own[0]
+        radius, length = c.size
+        if length < 2.0 * radius:
+            rigid[f.name] = f"its {c.kind} is shorter ({length:.3g} m) than its diameter ({2 * radius:.3g} m): no beam"
+            continue
+        root = data.oMf[fid]
+        axis = root.rotation @ c.origin.rotation[:, 2]
+        spans = [(label, point - root.translation) for _, label, _, _, point in carried]
+        short = [label for label, d in spans if np.linalg.norm(d) == 0.0]
+        if short:
+            rigid[f.name] = f"its {', '.join(short)} at its origin: a beam of no length"
+            continue
+        across = [label for label, d in spans if abs(float(axis @ d)) < cos_tol * float(np.linalg.norm(d))]
+        if across:
+            rigid[f.name] = (f"its {c.kind}'s axis is more than {AXIS_TOL_DEG:g} deg off its span to "
+                             f"{', '.join(across)}")
+            continue
+        beams[f.name] = material.beam(radius)
+    return beams, rigid
+
+
+@dataclass(frozen=True)
 class Attachment:
     """One virtual spring: where a compliant link carries something (module doc).
 
@@ -136,14 +257,9 @@ def attachments(mech: Mechanism, data: pin.Data, links: Mapping[str, object]) ->
         fid = bodies[name]
         if not isinstance(law, Beam):
             law = as_array(law, f"links[{name!r}]", "a Beam, or a 6 x 6 compliance [m/N, m/(N m); rad/N, rad/(N m)]")
-            if law.shape != (6, 6) or not np.all(np.isfinite(law)) or not np.allclose(law, law.T, rtol=1e-9) \
-                    or np.linalg.eigvalsh(0.5 * (law + law.T)).min() <= 0.0:
+            if law.shape != (6, 6) or not symmetric_positive_definite(law):
                 raise InvalidInputError(f"links[{name!r}]", "a 6 x 6 compliance is symmetric positive definite", law)
-        carried = [(m.names[j], f"joint {m.names[j]}", frozenset(m.subtrees[j]), -1, data.oMi[j].translation)
-                   for j in range(1, m.njoints) if _carried_by(m, m.getFrameId(m.names[j], pin.FrameType.JOINT), fid)]
-        frames = {f for pair in mech.closure_frames for f in pair} | {mech.ee_frame}
-        carried += [(m.frames[f].name, f"frame {m.frames[f].name}", frozenset(), f, data.oMf[f].translation)
-                    for f in sorted(frames) if _carried_by(m, f, fid)]
+        carried = _carried(mech, data, fid)
         if not carried:
             raise InvalidInputError(f"links[{name!r}]", "the link carries no joint, closure or end effector: its "
                                                         "compliance would move nothing", name)
@@ -156,6 +272,32 @@ def attachments(mech: Mechanism, data: pin.Data, links: Mapping[str, object]) ->
             out.append(Attachment(name, what, point.copy(), np.linalg.inv(0.5 * (C_world + C_world.T)), beyond,
                                   frame))
     return out
+
+
+def _carriers(mech: Mechanism) -> dict[int, list[tuple[str, str, frozenset[int], int, int]]]:
+    """``{BODY frame: [(what, label, beyond, frame, joint), ...]}``: what each link carries (module doc; ``frame``
+    -1 for a joint, ``joint`` -1 for a frame), the links that carry nothing left out: the tree's, made once a
+    mechanism (:func:`pkm._derived.derived`)."""
+    m = mech.model
+    frames = {f for pair in mech.closure_frames for f in pair} | {mech.ee_frame}
+    out: dict[int, list[tuple[str, str, frozenset[int], int, int]]] = {}
+    for fid, f in enumerate(m.frames):
+        if f.type != pin.FrameType.BODY:
+            continue
+        carried = [(m.names[j], f"joint {m.names[j]}", frozenset(m.subtrees[j]), -1, j) for j in range(1, m.njoints)
+                   if _carried_by(m, m.getFrameId(m.names[j], pin.FrameType.JOINT), fid)]
+        carried += [(m.frames[g].name, f"frame {m.frames[g].name}", frozenset(), g, -1)
+                    for g in sorted(frames) if _carried_by(m, g, fid)]
+        if carried:
+            out[fid] = carried
+    return out
+
+
+def _carried(mech: Mechanism, data: pin.Data, fid: int) -> list[tuple[str, str, frozenset[int], int, np.ndarray]]:
+    """``(what, label, beyond, frame, point)`` of each joint, closure or end-effector frame the link of BODY frame
+    ``fid`` carries (module doc), at the placements in ``data``."""
+    return [(what, label, beyond, frame, data.oMf[frame].translation if frame >= 0 else data.oMi[j].translation)
+            for what, label, beyond, frame, j in derived(mech, _carriers).get(fid, [])]
 
 
 def _length(root: np.ndarray, point: np.ndarray, link: str, label: str) -> float:
@@ -211,4 +353,5 @@ def virtual_columns(mech: Mechanism, data: pin.Data, att: list[Attachment]) -> t
     return Vc, Vee
 
 
-__all__ = ["Attachment", "Beam", "attachments", "virtual_columns"]
+__all__ = ["ALUMINIUM", "AXIS_TOL_DEG", "MATERIALS", "STEEL", "Attachment", "Beam", "Material", "as_links",
+           "attachments", "beams_from_collisions", "law_fields", "virtual_columns"]

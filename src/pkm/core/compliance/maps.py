@@ -86,7 +86,7 @@ class StiffnessMap:
 
 
 def stiffness_map(mech: Mechanism, wmap: WorkspaceMap, *, joints: Mapping[str, object] | None = None,
-                  links: Links = "rigid", frequencies: bool = False, rtol: float = RTOL) -> StiffnessMap:
+                  links: Links | None = None, frequencies: bool = False, rtol: float = RTOL) -> StiffnessMap:
     """The stiffness indices (and with ``frequencies`` the first natural frequency) at every reachable node of
     ``wmap`` (:func:`pkm.workspace_map` with ``configurations=True``), the springs of ``joints`` and ``links`` as in
     :func:`pkm.stiffness`.

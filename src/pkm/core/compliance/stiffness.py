@@ -42,6 +42,13 @@ vibrations condense its deformation statically). :meth:`Stiffness.deflection` so
 (the forces along the deflected members, hence the geometric stiffness of the loaded mode), with the first-order
 :math:`C W` beside it and their gap.
 
+**The loaded mode** (:meth:`Stiffness.loaded`): the tangent stiffness :math:`K_t = \partial W / \partial x` at that
+deflected equilibrium, :math:`x` the end effector's world-aligned small twist at its deflected origin, the same sign
+as :math:`K` (the wrench's increment per the displacement it causes): :math:`H` becomes
+:math:`N^{*\top}(K - \partial_q (J_{ee}^\top W + J_c^\top \lambda^*)) N^*` at the deflected configuration, the
+geometric stiffness of the internal forces :math:`\lambda^*` and of the wrench carried by the moving end effector.
+Checked against the central differences of :meth:`Stiffness.deflection` with respect to the wrench (2e-9).
+
 **Vibrations.** :func:`vibration_modes`: the generalised eigenproblem :math:`H v = \omega^2 N^\top M N v` on the
 same motions (:math:`M` Pinocchio's joint-space mass matrix with the drives' reflected inertia), massless
 directions condensed statically; the motions no spring resists are counted as free (zero frequency), not listed.
@@ -60,7 +67,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from pkm.core.compliance.links import Attachment, attachments, virtual_columns
+from pkm.core.compliance.links import Attachment, Material, attachments, beams_from_collisions, virtual_columns
 from pkm.core.differential.idle import MASSLESS, joint_inertia
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.kinematics.constraints import check_closed
@@ -72,8 +79,9 @@ from pkm.core.model.springs import MAGNITUDE
 from pkm.errors import InvalidInputError, ModeChangeWarning, PkmWarning, StiffnessError, UnknownNameError
 from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
 
-#: ``links=``: ``"rigid"``, or ``{link: Beam(...) or a 6 x 6 compliance}`` (:mod:`pkm.core.compliance.links`).
-Links = str | Mapping[str, object]
+#: ``links=``: ``"rigid"``, a :class:`~pkm.core.compliance.links.Material` (each link a beam of its collision
+#: primitive), or ``{link: Beam(...) or a 6 x 6 compliance}`` (:mod:`pkm.core.compliance.links`).
+Links = str | Material | Mapping[str, object]
 #: Rank decisions (motions, stiffnesses, compliance) relative to the largest singular value or eigenvalue, on the
 #: homogenised matrices.
 RTOL = 1e-9
@@ -83,6 +91,9 @@ DEFLECTION_TOL = 1e-12
 MAX_LOAD_STEPS = 64
 #: Newton iterations per load increment.
 MAX_ITER = 20
+#: The central differences' step of the loaded stiffness's geometric term, along the homogenised motions (rad, or
+#: characteristic lengths): truncation about its square, rounding about the machine's epsilon over it.
+GEOMETRIC_STEP = 1e-5
 #: A load whose first-order joint motion exceeds this (rad, or characteristic lengths) is refused at once.
 MAX_FIRST_ORDER = math.pi
 
@@ -105,6 +116,8 @@ class _Springs:
     length: float
     columns: np.ndarray  # (nv,) the homogenising column factors (L for a length)
     links: tuple[Attachment, ...] = ()
+    rigid_links: dict[str, str] = field(default_factory=dict)  # ({link: why}: links=Material's links taken rigid)
+    laws: dict[str, object] = field(default_factory=dict)  # ({link: Beam or 6 x 6 compliance}: the compliant links)
 
 
 #: Where a joint's stiffness comes from (:attr:`Stiffness.sources`): the ``joints=`` argument, the drive's servo
@@ -139,17 +152,27 @@ def _joint_stiffness(mech: Mechanism, joints: Mapping[str, object] | None) -> tu
     return given, sources
 
 
-def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None, links: object, rtol: float) \
+def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None, links: object | None, rtol: float) \
         -> _Springs:
     """The springs, the locked joints and the motions they leave at ``q`` (checked: closed, the joints' names and
     stiffnesses, ``links``; ``rtol`` already checked by the caller)."""
+    mech = check_mechanism(mech)
+    if links is None:
+        links = dict(mech.spec.links)
     if isinstance(links, str) and links == "rigid":
         links = {}
-    if not isinstance(links, Mapping):
-        raise InvalidInputError("links", "'rigid', or a mapping {link: Beam(...) or a 6 x 6 compliance}", links)
-    mech = check_mechanism(mech)
+    if not isinstance(links, Mapping | Material):
+        raise InvalidInputError("links", "'rigid', a Material, or a mapping {link: Beam(...) or a 6 x 6 compliance}",
+                                links)
     q = mech.check_q(q)
     check_closed(mech, q)
+    rigid_links: dict[str, str] = {}
+    if isinstance(links, Material):
+        pin.framesForwardKinematics(mech.model, mech.data, q)
+        links, rigid_links = beams_from_collisions(mech, mech.data, links)
+        if not links:
+            raise InvalidInputError("links", f"{mech.name}: no link is a beam of its collision geometry (" + "; ".join(
+                f"{n}: {why}" for n, why in rigid_links.items()) + "): give the links' Beam(...) by name", "Material")
     given, sources = _joint_stiffness(mech, joints)
     sprung = {n: k for n, k in given.items() if k > 0.0}
     locked = tuple(j.name for j in mech.actuated if j.name not in given)
@@ -166,19 +189,24 @@ def _springs(mech: Mechanism, q: ArrayLike, joints: Mapping[str, object] | None,
     att = attachments(mech, mech.data, links) if links else []  # (the frames placed by Configuration.compute)
     Vc, Vee = virtual_columns(mech, mech.data, att)
     columns = np.concatenate([scales.columns, np.tile([L, L, L, 1.0, 1.0, 1.0], len(att))])
-    Jc = np.hstack([c.constraint_jacobian, Vc])
-    A = np.vstack([scales.constraint_rows[:, None] * Jc * columns,
-                   np.hstack([E, np.zeros((len(locked), Vc.shape[1]))])])  # (a locked row: unit in either units)
-    _, s, Vt = np.linalg.svd(A) if A.size else (None, np.zeros(0), np.eye(len(columns)))
-    rank = int(np.sum(s > rtol * s[0])) if s.size and s[0] > 0.0 else 0
-    N = columns[:, None] * Vt[rank:].T
+    N = _motions(np.hstack([c.constraint_jacobian, Vc]), E, scales.constraint_rows, columns, rtol)
     K = np.zeros((len(columns), len(columns)))
     K[:mech.nv, :mech.nv] = np.diag(k)
     for i, a in enumerate(att):
         K[mech.nv + 6 * i:mech.nv + 6 * i + 6, mech.nv + 6 * i:mech.nv + 6 * i + 6] = a.stiffness
     H = N.T @ K @ N
     return _Springs(mech, q, k, sprung, {n: sources[n] for n in sprung}, locked, E, N, 0.5 * (H + H.T), np.hstack([c.ee_jacobian, Vee]) @ N, L,
-                    scales.columns, tuple(att))
+                    scales.columns, tuple(att), rigid_links, dict(links))
+
+
+def _motions(Jc: np.ndarray, E: np.ndarray, rows: np.ndarray, columns: np.ndarray, rtol: float) -> np.ndarray:
+    """``N``: the motions the closures (their Jacobian ``Jc``, its rows homogenised by ``rows``) and the locked joints
+    (``E``) leave, the null space's orthonormal basis on the columns homogenised by ``columns``, times them."""
+    A = np.vstack([rows[:, None] * Jc * columns,
+                   np.hstack([E, np.zeros((len(E), Jc.shape[1] - E.shape[1]))])])  # (a locked row: unit in either)
+    _, s, Vt = np.linalg.svd(A) if A.size else (None, np.zeros(0), np.eye(len(columns)))
+    rank = int(np.sum(s > rtol * s[0])) if s.size and s[0] > 0.0 else 0
+    return columns[:, None] * Vt[rank:].T
 
 
 def _preloaded(mech: Mechanism, q: np.ndarray, sprung: Mapping[str, float]) -> None:
@@ -256,7 +284,7 @@ class Deflection:
         gap: ``|displacement - first_order|`` over ``|displacement|``, each homogenised by ``L`` (the first-order
             model's relative error at this load).
         load_steps: The load increments the equilibrium was followed in (1: the full wrench at once; each failed
-            increment halved, each success doubling the next).
+            increment halved, each success doubling the next; 0: a zero wrench, ``q`` itself).
         outside_limits: The joints ``q`` puts outside their position limits (empty: none).
     """
 
@@ -282,6 +310,15 @@ class Stiffness:
             ``[springs]``, ``"actuator+spring"`` both in parallel).
         locked: The actuated joints held rigid (given no stiffness).
         q: The configuration (nq,).
+        links: ``{link: Beam or 6 x 6 compliance}``: the compliant links counted (``links=``'s, or those a
+            :class:`~pkm.core.compliance.links.Material` made beams of their collision primitive).
+        rigid_links: ``{link: why}``: with ``links=Material(...)``, the links that carry something and were taken
+            rigid (no collision geometry, not one cylinder or capsule, a disc, a span of no length or across the
+            primitive's axis); empty otherwise.
+        outside_limits: The joints ``q`` puts outside the position limits the model states
+            (:meth:`pkm.core.Mechanism.outside_limits`, as :attr:`SolveResult.outside_limits
+            <pkm.core.kinematics.solve.SolveResult.outside_limits>`): the stiffness is computed there all the same,
+            and the repr says so.
     """
 
     compliance: np.ndarray
@@ -290,8 +327,23 @@ class Stiffness:
     sources: Mapping[str, str]
     locked: tuple[str, ...]
     q: np.ndarray
+    links: Mapping[str, object]
+    rigid_links: Mapping[str, str]
+    outside_limits: tuple[str, ...]
     _springs: _Springs = field(repr=False, compare=False)
     _rtol: float = field(repr=False, compare=False, default=RTOL)
+
+    def __repr__(self) -> str:
+        k = self.principal("force")[0]
+        parts = [f"rank {self.rank}", f"sprung {len(self.sprung)}", f"locked {len(self.locked)}",
+                 "translational stiffness " + ", ".join(f"{v:.4g}" for v in k) + " N/m"]
+        if self.links:
+            parts.append(f"compliant links {len(self.links)}" + (f" ({len(self.rigid_links)} rigid: "
+                                                                  f"{', '.join(self.rigid_links)})"
+                                                                  if self.rigid_links else ""))
+        if self.outside_limits:
+            parts.append(f"OUTSIDE the position limits: {', '.join(self.outside_limits)}")
+        return f"Stiffness({self._springs.mech.name}: {'; '.join(parts)})"
 
     @property
     def matrix(self) -> np.ndarray:
@@ -352,13 +404,16 @@ class Stiffness:
                 what the springs hold: the mechanism snaps through, or leaves its workspace), or the load turns a
                 joint by more than :data:`MAX_FIRST_ORDER` rad (or characteristic lengths) at first order.
         """
-        W = _wrench(wrench)
+        return self._deflect(_wrench(wrench), tol)[0]
+
+    def _deflect(self, W: np.ndarray, tol: float) -> tuple[Deflection, np.ndarray]:
+        """:meth:`deflection` and the multipliers at the equilibrium (:func:`_equilibrium`)."""
         tol = as_tolerance(tol, "tol")
         sp = self._springs
         if sp.links:
             raise InvalidInputError("links", "the exact deflection takes rigid links (compliant links: the first "
                                              "order, .compliance @ wrench)", tuple(a.link for a in sp.links))
-        q, steps = _equilibrium(sp, W, tol)
+        q, steps, multipliers = _equilibrium(sp, W, tol)
         first = self.compliance @ W
         exact = _displacement(sp, q)
         R = _homogeneous_rows(sp.length)
@@ -368,10 +423,92 @@ class Stiffness:
         changed = before.differs(after)
         if changed:
             warnings.warn(ModeChangeWarning("deflection under the wrench", changed, before, after), stacklevel=2)
-        return Deflection(q, exact, first, gap, steps, sp.mech.outside_limits(q))
+        return Deflection(q, exact, first, gap, steps, sp.mech.outside_limits(q)), multipliers
+
+    def loaded(self, wrench: ArrayLike, *, tol: float = DEFLECTION_TOL) -> LoadedStiffness:
+        r"""The tangent stiffness at the deflected equilibrium under the constant wrench ``(f [N], m [N m])`` at the
+        end effector's origin, world axes (:meth:`deflection`): how much more wrench a further small displacement
+        takes there, the geometric stiffness of the loaded members included (module doc; rigid links).
+
+        At the equilibrium :math:`q^*` with the closures' and locked joints' multipliers :math:`\lambda^*`, the
+        motions :math:`N^*` the closures and locked joints leave there and :math:`T^* = J_{ee}(q^*) N^*`:
+
+        .. math:: H_t = N^{*\top} \Big(K - \frac{\partial}{\partial q}\big(J_{ee}^\top W + J_c^\top
+                  \lambda^*\big)\Big) N^*, \qquad C_t = T^* H_t^{+} T^{*\top}, \qquad K_t = C_t^{-1},
+
+        the derivative of the closures' and the wrench's generalised forces taken by central differences along
+        :math:`N^*`'s columns (steps of :data:`GEOMETRIC_STEP` rad or characteristic lengths). ``W = 0`` gives
+        :attr:`matrix`. :math:`K_t` need not be symmetric: a constant moment in world axes is not conservative.
+        On an over-constrained mechanism :math:`\lambda^*` is the statically admissible set the equilibrium's Newton
+        solve found (least-norm increments): rigid-body statics does not fix it.
+
+        Raises:
+            InvalidInputError: compliant links (the exact equilibrium takes rigid links).
+            ConvergenceError: as :meth:`deflection`.
+        """
+        W = _wrench(wrench)
+        d, mult = self._deflect(W, tol)
+        sp = self._springs
+        mech, m, nc = sp.mech, sp.mech.model, sp.mech.n_constraints
+        c = Configuration.compute(mech, d.q)
+        N = _motions(c.constraint_jacobian, sp.E, JacobianScales.of(mech).constraint_rows, sp.columns, self._rtol)
+
+        def force(q: np.ndarray) -> np.ndarray:
+            ck = Configuration.compute(mech, q)
+            return ck.ee_jacobian.T @ W + ck.constraint_jacobian.T @ mult[:nc]
+
+        dF = np.empty_like(N)
+        if W.any():
+            for i in range(N.shape[1]):
+                step = GEOMETRIC_STEP * N[:, i]
+                dF[:, i] = (force(pin.integrate(m, d.q, step)) - force(pin.integrate(m, d.q, -step))) \
+                    / (2.0 * GEOMETRIC_STEP)
+        else:
+            dF[:] = 0.0
+        Ht = N.T @ (sp.k[:, None] * N) - N.T @ dF
+        T = c.ee_jacobian @ N
+        C = finite_result(T @ np.linalg.pinv(Ht, rcond=self._rtol) @ T.T if N.size else np.zeros((6, 6)),
+                          "loaded compliance")
+        R = _homogeneous_rows(sp.length)
+        sv = np.linalg.svd(R[:, None] * C * R[None, :], compute_uv=False)
+        rank = int(np.sum(sv > self._rtol * sv[0])) if sv[0] > 0.0 else 0
+        return LoadedStiffness(C, rank, W, d, mech.name)
 
 
-def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: Links = "rigid",
+@dataclass(frozen=True)
+class LoadedStiffness:
+    """The tangent stiffness at the deflected equilibrium under a constant wrench (:meth:`Stiffness.loaded`).
+
+    Attributes:
+        compliance: ``C_t`` (6 x 6): the further small displacement ``(dp, dtheta)`` of the end effector (world
+            axes, at its deflected origin) per further wrench ``(df, dm)`` there; not symmetric in general.
+        rank: Its rank (6: every direction resisted).
+        wrench: The constant wrench ``W`` it is loaded with (6,) [N, N m].
+        deflection: The deflected equilibrium (:class:`Deflection`).
+        mechanism: The mechanism's name.
+    """
+
+    compliance: np.ndarray
+    rank: int
+    wrench: np.ndarray
+    deflection: Deflection
+    mechanism: str
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """``K_t = C_t^-1`` (6 x 6): ``dW / dx`` at the deflected equilibrium, twist order ``(v, w)``, world axes
+        (the sign of :attr:`Stiffness.matrix`: the wrench's increment per the displacement it causes).
+
+        Raises:
+            StiffnessError: ``"rigid"`` where ``rank < 6``.
+        """
+        if self.rank < 6:
+            raise StiffnessError("rigid", f"{self.mechanism}: the loaded compliance has rank {self.rank} of 6: rigid "
+                                          f"along {6 - self.rank} directions", rank=self.rank)
+        return finite_result(np.linalg.inv(self.compliance), "loaded stiffness matrix")
+
+
+def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: Links | None = None,
               rtol: float = RTOL) -> Stiffness:
     """The end effector's stiffness at the closed configuration ``q`` (module doc: the model and its assumptions).
 
@@ -383,15 +520,22 @@ def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | N
             spec's ``[springs.<joint>]``: a drive's servo stiffness, a leg's axial stiffness; ``0`` frees a joint. An
             actuated joint left out whose drive states no stiffness is locked (rigid). :attr:`Stiffness.sources`
             says where each came from.
-        links: ``"rigid"`` (default), or ``{link: Beam(...) or a 6 x 6 compliance}``: those links compliant
-            (:mod:`pkm.core.compliance.links`; the exact :meth:`Stiffness.deflection` takes rigid links).
+        links: ``None`` (default): the spec's ``[links.<link>] compliance`` tables (:attr:`ClosureSpec.links
+            <pkm.core.model.spec.ClosureSpec.links>`), rigid links where it states none; ``"rigid"``: every link
+            rigid; or ``{link: Beam(...) or a 6 x 6 compliance}``: those links compliant
+            (:mod:`pkm.core.compliance.links`; the exact :meth:`Stiffness.deflection` takes rigid links); or a
+            :class:`~pkm.core.compliance.links.Material`: every link that carries something a solid circular beam of
+            its collision geometry's radius where that is one cylinder or capsule along its span
+            (:func:`~pkm.core.compliance.links.beams_from_collisions`), the others rigid and named in
+            :attr:`Stiffness.rigid_links`.
         rtol: Rank decisions, relative, on homogenised matrices.
 
     Raises:
         StiffnessError: ``"free"``: a motion no spring resists moves the end effector.
         InvalidInputError: ``q`` not closed; a stiffness not finite or negative; a joint of several coordinates;
             a link's law neither a :class:`~pkm.core.compliance.links.Beam` nor a symmetric positive definite 6 x 6
-            compliance, or a link that carries nothing.
+            compliance, or a link that carries nothing; ``links=Material(...)`` where no link is a beam of its
+            collision geometry (the message lists each link's reason).
         UnknownNameError: a joint or a link that does not exist.
 
     Examples:
@@ -409,8 +553,8 @@ def stiffness(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | N
     TV = sp.T @ V
     C = finite_result((TV / w) @ TV.T if len(w) else np.zeros((6, 6)), "compliance")
     C = 0.5 * (C + C.T)
-    return Stiffness(C, _rank(C, sp.length, rtol), dict(sp.sprung), dict(sp.sources), sp.locked, sp.q.copy(), sp,
-                     rtol)
+    return Stiffness(C, _rank(C, sp.length, rtol), dict(sp.sprung), dict(sp.sources), sp.locked, sp.q.copy(),
+                     dict(sp.laws), dict(sp.rigid_links), sp.mech.outside_limits(sp.q), sp, rtol)
 
 
 def _pose(sp: _Springs, q: np.ndarray) -> pin.SE3:
@@ -425,8 +569,9 @@ def _displacement(sp: _Springs, q: np.ndarray) -> np.ndarray:
     return np.concatenate([b.translation - a.translation, pin.log3(b.rotation @ a.rotation.T)])
 
 
-def _equilibrium(sp: _Springs, W: np.ndarray, tol: float) -> tuple[np.ndarray, int]:
-    """The deflected configuration under ``W`` and the load increments taken (:meth:`Stiffness.deflection`).
+def _equilibrium(sp: _Springs, W: np.ndarray, tol: float) -> tuple[np.ndarray, int, np.ndarray]:
+    """The deflected configuration under ``W``, the load increments taken (:meth:`Stiffness.deflection`) and the
+    multipliers there: the closures' forces (``J_c^T lambda``'s ``lambda``), then the locked joints' efforts.
 
     Unknowns: ``q`` (its steps homogenised: a prismatic joint's in ``L``) and the multipliers of the closures and the
     locked joints, scaled by the load's size (``energy / L``, a rotation row's and a revolute's times ``L``), so that
@@ -475,6 +620,8 @@ def _equilibrium(sp: _Springs, W: np.ndarray, tol: float) -> tuple[np.ndarray, i
                                f"the load turns a joint by {reach:.3g} rad (or moves it {reach:.3g} L) at first "
                                f"order, over {MAX_FIRST_ORDER:.3g}: far past what the springs hold near q")
     q, lam, res = sp.q.copy(), np.zeros(nc + ne), math.inf
+    if not W.any():
+        return q, 0, lam
     done, step, steps = 0.0, 1.0, 0
     while done < 1.0:  # (the load in increments: halved where Newton fails, doubled again after a success)
         target = min(1.0, done + step)
@@ -489,7 +636,7 @@ def _equilibrium(sp: _Springs, W: np.ndarray, tol: float) -> tuple[np.ndarray, i
                                    f"no equilibrium past {done:.0%} of the load (increments down to "
                                    f"1/{MAX_LOAD_STEPS}): the springs do not hold this load near q (snap-through, "
                                    "or past the workspace)")
-    return q, steps
+    return q, steps, lam * unit
 
 
 @dataclass(frozen=True)
@@ -509,7 +656,8 @@ class VibrationModes:
     free: int
 
 
-def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None, links: Links = "rigid",
+def vibration_modes(mech: Mechanism, q: ArrayLike, *, joints: Mapping[str, object] | None = None,
+                    links: Links | None = None,
                     rtol: float = RTOL) -> VibrationModes:
     """The natural frequencies and mode shapes at the closed configuration ``q`` with the springs of
     :func:`stiffness` (same ``joints``, ``links`` and ``rtol``; the locked drives held): ``H v = w^2 N^T M N v``
@@ -551,5 +699,6 @@ def _modes(sp: _Springs, rtol: float) -> VibrationModes:
     return VibrationModes(np.sqrt(w2[resisted]) / (2.0 * math.pi), Nj @ s, sp.T @ s, free)
 
 
-__all__ = ["DEFLECTION_TOL", "MAX_FIRST_ORDER", "MAX_ITER", "MAX_LOAD_STEPS", "RTOL", "SOURCES", "Deflection", "Stiffness",
+__all__ = ["DEFLECTION_TOL", "GEOMETRIC_STEP", "MAX_FIRST_ORDER", "MAX_ITER", "MAX_LOAD_STEPS", "RTOL", "SOURCES",
+           "Deflection", "LoadedStiffness", "Stiffness",
            "VibrationModes", "stiffness", "vibration_modes"]

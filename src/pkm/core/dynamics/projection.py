@@ -459,8 +459,8 @@ def base_inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayL
         >>> import numpy as np
         >>> import pkm
         >>> delta = pkm.load("delta")  # hung on a free-flyer "pelvis" over a new ground link:
-        >>> urdf = delta.urdf.replace('<link name="base"/>', '<link name="ground"/><link name="base"/><joint '
-        ...                           'name="pelvis" type="floating"><parent link="ground"/><child link="base"/></joint>')
+        >>> urdf = delta.urdf.replace('<link name="base">', '<link name="ground"/><joint name="pelvis" '
+        ...                           'type="floating"><parent link="ground"/><child link="base"/></joint><link name="base">')
         >>> robot = pkm.from_strings(urdf, dataclasses.replace(delta.spec, floating_base="pelvis", reference={}))
         >>> q = pkm.close_loops(robot, delta.actuated_q(delta.q_reference)).q
         >>> rest = np.zeros(robot.nv)

@@ -6,6 +6,8 @@ representation (:class:`~pkm.core.formats.base.Imported`: URDF text, loops, join
   numerical submechanisms' loop constraints;
 * :mod:`~pkm.core.formats.mjcf`: MuJoCo's MJCF, loops as ``<equality>`` connect/weld;
 * :mod:`~pkm.core.formats.sdf`: SDFormat, loops as links with several parent joints;
+* :mod:`~pkm.core.formats.usd`: USD, a UsdPhysics articulation, loops as joints excluded from it (``usd-core``, the
+  ``usd`` extra);
 * :mod:`~pkm.core.formats.urdfplus`: a URDF with MIT's URDF+ ``<loop>`` or urdfdom's proposed ``<constraint>``
   elements (read through the URDF format's reader);
 * :mod:`~pkm.core.formats.packages`: models an installed package ships, by name.
@@ -14,7 +16,7 @@ A closure spec's ``urdf`` key may name an MJCF or SDF file as well as a URDF: th
 joint types are added to the spec's (:func:`~pkm.core.formats.imported.import_model`).
 :mod:`~pkm.core.formats.load` makes mechanisms of them (through :mod:`pkm.core.model.builder`);
 :mod:`~pkm.core.formats.to_mjcf` writes any mechanism as MJCF (for MuJoCo, and back), :mod:`~pkm.core.formats.to_gepetto`
-as Gepetto's URDF + YAML, :mod:`~pkm.core.formats.to_urdfplus` as URDF+; :mod:`~pkm.core.formats.writers`
+as Gepetto's URDF + YAML, :mod:`~pkm.core.formats.to_urdfplus` as URDF+, :mod:`~pkm.core.formats.to_usd` as USD; :mod:`~pkm.core.formats.writers`
 chooses among them and pkm's spec by suffix (:func:`pkm.save`, ``pkm convert``).
 
 The names below are imported on first use, so that importing one format module does not import the others.

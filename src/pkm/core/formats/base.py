@@ -29,7 +29,7 @@ class Imported:
         actuated: The actuated joints the file names (empty when it names none).
         name: The model's name.
         format: ``"urdf"``, ``"urdfplus"`` (URDF+ ``<loop>``), ``"urdfdom"`` (the proposed ``<constraint>``),
-            ``"mjcf"`` or ``"sdf"``.
+            ``"mjcf"``, ``"sdf"`` or ``"usd"``.
         floating_base: The free-flyer joint that carries the whole tree (an MJCF root ``<freejoint>``), or None.
         reference: Joint values the file states (an MJCF free body's pose), for ``[reference]``.
         notes: What the reader interpreted or ignored, one sentence each (a tendon actuator read as its joint, a
@@ -74,12 +74,15 @@ class Format:
         suffixes: The file suffixes read as this format when the root element says nothing (lower case, with the dot).
         root: The XML root element that identifies it (``"mujoco"``), whatever the suffix.
         reader: ``read(text, source) -> Imported``, or its ``"module:function"`` name (imported on first use).
+        opens: The reader opens the file itself (a binary format, or one whose file names others: USD), given its
+            path as ``source`` and ``""`` as ``text``; its ``root`` is ``""`` (no XML root element).
     """
 
     name: str
     suffixes: tuple[str, ...]
     root: str
     reader: str | Callable[[str, str], Imported]
+    opens: bool = False
 
     def read(self, text: str, source: str) -> Imported:
         """The file's text read by this format's reader."""
@@ -96,6 +99,7 @@ FORMATS: dict[str, Format] = {
     "urdf": Format("urdf", (".urdf",), "robot", "pkm.core.formats.urdfplus:read_urdf"),  # (URDF+ and urdfdom loops too)
     "mjcf": Format("mjcf", (".xml", ".mjcf"), "mujoco", "pkm.core.formats.mjcf:read_mjcf"),
     "sdf": Format("sdf", (".sdf",), "sdf", "pkm.core.formats.sdf:read_sdf"),
+    "usd": Format("usd", (".usda", ".usd", ".usdc"), "", "pkm.core.formats.usd:read_usd", opens=True),
 }
 
 
@@ -115,7 +119,7 @@ def suffixes() -> dict[str, str]:
 
 def by_root(root: str | None) -> Format | None:
     """The registered format whose root element is ``root``, or None."""
-    return next((f for f in FORMATS.values() if f.root == root), None)
+    return next((f for f in FORMATS.values() if root and f.root == root), None)
 
 
 def __getattr__(name: str) -> object:

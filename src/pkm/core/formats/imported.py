@@ -40,6 +40,10 @@ def import_model(path: Path) -> Imported:
         SpecError: the file is missing, too large, malformed, or uses what its reader refuses.
     """
     named = FORMATS.get(suffixes().get(path.suffix.lower(), ""))
+    if named is not None and named.opens:  # (USD: binary crate files, layers that name others)
+        if not path.is_file():
+            raise SpecError(str(path), f"cannot read {named.name.upper()}: not a regular file")
+        return named.read("", str(path))
     fmt = named or FORMATS["urdf"]
     text = read_text_file(path, fmt.name.upper())
     fmt = format_of(path, text)

@@ -249,7 +249,7 @@ def _model_file(path: Path) -> Loader | str:
     kind = suffixes().get(path.suffix.lower())
     text = _head(path)
     root = root_tag(text) if text is not None else None
-    roots = [f.root for f in FORMATS.values()]
+    roots = [f.root for f in FORMATS.values() if f.root]
     if kind is None and root not in roots:
         known = ", ".join(f"<{r}>" for r in roots)
         return (f"not XML with a root element {known}" if root is None

@@ -21,7 +21,8 @@ rigid and leave the heel spring free: mobility 10, well conditioned, but the hee
 achilles loop as the knee turns (about -2 rad per rad near the file's pose), as the files' geometry forces.
 Which stiffnesses set the deflections is statics, outside a kinematic model. ``cassie_v2.sdf`` rounds its right
 foot's poses (roll 1.5708, pitches 1.3439 and 1.364), so its toe motor's axis is 7.4e-8 rad off the foot crank's:
-that plantar loop moves only by opening about 1e-9 m (``pkm.close_loops(..., tol=2e-9)``); the other loops close
+that plantar loop moves only by opening about 1e-9 m, 2.3e-9 of its characteristic length
+(``pkm.close_loops(..., tol=5e-9)``); the other loops close
 to round-off.
 """
 

@@ -62,6 +62,9 @@ from pkm.errors import SpecError
 
 #: The namespace of pkm's custom SDFormat elements (``<pkm:position>``, ``<pkm:free_joint>``).
 PKM_NS = "urn:pkm:sdf"
+#: The Pinocchio joints of one coordinate written as a revolute, continuous or prismatic joint (the USD writer's too).
+SCALAR_KINDS = ("RX", "RY", "RZ", "PX", "PY", "PZ", "RUBX", "RUBY", "RUBZ", "RevoluteUnaligned", "PrismaticUnaligned",
+                "RevoluteUnboundedUnaligned", "Mimic")
 _P = f"{{{PKM_NS}}}"
 
 
@@ -180,8 +183,7 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
                                      mech.limits.get(jname), float(seg[k])))
             universals.append(jname)
             continue
-        if kind not in ("RX", "RY", "RZ", "PX", "PY", "PZ", "RUBX", "RUBY", "RUBZ", "RevoluteUnaligned",
-                        "PrismaticUnaligned", "RevoluteUnboundedUnaligned", "Mimic"):
+        if kind not in SCALAR_KINDS:
             raise SpecError(source, f"joint {jname!r}: SDFormat has no {jm.shortname()} (pkm writes revolute, "
                                     "continuous, prismatic, ball, universal, free-flyer and mimic joints)")
         revolute, axis = joint_axis(jm)
@@ -353,4 +355,4 @@ def sdf_spec(mech: Mechanism, sdf_name: str) -> ClosureSpec:
     return dc.replace(mech.spec, urdf=sdf_name, closures=(), joint_types={}, reference=reference, actuators=drives)
 
 
-__all__ = ["PKM_NS", "sdf_from_mechanism", "sdf_spec"]
+__all__ = ["PKM_NS", "SCALAR_KINDS", "sdf_from_mechanism", "sdf_spec"]

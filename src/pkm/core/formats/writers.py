@@ -11,7 +11,9 @@
   (:mod:`pkm.core.formats.to_urdfplus`);
 * ``"sdf"`` (``.sdf``): SDFormat 1.11, loops as cut joints, posed at the reference configuration
   (:mod:`pkm.core.formats.to_sdf`), with a closure spec beside it (``<stem>.closures.toml``: the actuated joints,
-  the task, the drives, which SDFormat does not say): the spec is the main file, the one :func:`pkm.load` takes.
+  the task, the drives, which SDFormat does not say): the spec is the main file, the one :func:`pkm.load` takes;
+* ``"usd"`` (``.usda`` text, ``.usd``, ``.usdc`` binary): USD, a UsdPhysics articulation, loops as joints excluded
+  from it, drives as ``PhysicsDriveAPI`` (:mod:`pkm.core.formats.to_usd`; the ``usd`` extra: ``usd-core``).
 
 A path without a suffix, with ``to`` given, is a folder: the files go in it (``<mechanism>.closures.toml``,
 ``<mechanism>.xml``, ``robot.yaml``).
@@ -129,6 +131,16 @@ def _write_urdfplus(mech: Mechanism, files: tuple[Path, ...]) -> Written:
     return Written((path,), dropped, "urdfplus")
 
 
+def _write_usd(mech: Mechanism, files: tuple[Path, ...]) -> Written:
+    from pkm.core.formats.to_usd import pxr, usd_from_mechanism
+
+    (path,) = files
+    pxr("writing USD")  # (the missing extra said before any folder is made)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    _, dropped = usd_from_mechanism(mech, path)
+    return Written((path,), dropped, "usd")
+
+
 #: The writers by name (see the module doc).
 WRITERS: dict[str, Writer] = {w.name: w for w in (
     Writer("pkm", (".closures.toml", ".toml"), "pkm's closure spec + URDF", _write_pkm,
@@ -139,6 +151,8 @@ WRITERS: dict[str, Writer] = {w.name: w for w in (
     Writer("urdfplus", (".urdf",), "MIT's URDF+ (loops as <loop> elements)", _write_urdfplus),
     Writer("sdf", (".sdf",), "SDFormat (loops as cut joints) + pkm's closure spec", _write_sdf,
            lambda p: p.with_name(f"{p.name.removesuffix(p.suffix)}.closures.toml")),
+    Writer("usd", (".usda", ".usd", ".usdc"), "USD (UsdPhysics; loops as joints excluded from the articulation)",
+           _write_usd),
 )}
 
 

@@ -20,10 +20,20 @@ Every solver stops after a bounded number of iterations and raises
 per continuation step, at most :data:`MAX_STEPS` steps planned (a farther target takes longer
 steps, which fail early when it is out of reach), and at most :data:`MAX_TOTAL_ITER` Newton
 iterations for a whole solve. No solver returns a non-finite configuration.
+
+Scale-free: :func:`close_loops` and :func:`solve_ik` iterate in the metric of :mod:`pkm.core.model.scale`, every
+length counted in the mechanism's characteristic length ``L`` (:attr:`~pkm.core.Mechanism.characteristic_length`):
+their tolerance bounds the residual with a closure's translation rows and the task's lengths divided by ``L``
+(angles in rad), a Newton step is capped and a continuation step planned with prismatic coordinates and task lengths
+in ``L`` (angles in rad), and the least-squares steps are taken in that metric. A copy of a mechanism scaled in size
+(:func:`~pkm.core.model.builder.scaled_mechanism`) then takes the same steps, the same iterations and the same
+verdicts, its lengths scaled (to round-off). :attr:`SolveResult.relative_residual` is the residual so counted,
+:attr:`SolveResult.residual` the same equations' in m and rad.
 """
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -54,8 +64,9 @@ MAX_STEPS = 1000  #: continuation steps planned at most (a farther target gets l
 MAX_TOTAL_ITER = 5_000  #: Newton iterations at most for one solve, every continuation step included
 
 
-#: ``solve_at(q, s, tol) -> (q, residual, iterations)``: a continuation step's correction (:func:`_follow`).
-_StepSolver = Callable[[np.ndarray, float, float], tuple[np.ndarray, float, int]]
+#: ``solve_at(q, s, tol) -> (q, residual, iterations, residual in m and rad)``: a continuation step's correction
+#: (:func:`_follow`; the first residual the one ``tol`` bounds).
+_StepSolver = Callable[[np.ndarray, float, float], tuple[np.ndarray, float, int, float]]
 
 
 @dataclass(frozen=True)
@@ -74,6 +85,10 @@ class SolveResult:
             its seed's warns, :class:`~pkm.errors.ModeChangeWarning`).
         outside_limits: The joints whose coordinate at ``q`` lies outside the position limits their URDF
             states (:meth:`pkm.core.Mechanism.outside_limits`); pkm's solvers do not enforce limits.
+        relative_residual: The residual the solver's tolerance bounds (dimensionless): the infinity norm of the same
+            equations with lengths (a closure's translation rows, the task's lengths) divided by the characteristic
+            length ``L`` and angles in rad (:func:`close_loops`, :func:`solve_ik`; :func:`assemble`'s by its own
+            ``L``); NaN where a solver states none. ``converged`` is ``relative_residual <= tol``.
         clearance: The smallest signed distance between the bodies checked for collision at ``q`` [m] (negative:
             two interpenetrate; :func:`pkm.clearance` has every pair), where the solve was asked for it
             (``collisions=True``), else None; pkm's solvers do not avoid collisions.
@@ -87,6 +102,7 @@ class SolveResult:
     branch_signs: dict[str, int] = field(default_factory=dict)
     outside_limits: tuple[str, ...] = ()
     mode: ModeLabel = field(default_factory=ModeLabel)
+    relative_residual: float = math.nan
     clearance: float | None = None
 
     @property
@@ -190,10 +206,56 @@ def _newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.nd
     return gauss_newton(restricted, q, tol=tol, max_iter=max_iter, max_step=max_dq, retract=retract)
 
 
+@dataclass(frozen=True)
+class _Metric:
+    """The scale-free metric of :func:`close_loops` and :func:`solve_ik` (module doc): ``rows`` multiply the
+    residual (a translation or task length by ``1 / L``, an angle by 1), ``cols`` the Newton step in the joints
+    (a length by ``L``, an angle by 1: the step taken in ``L`` and rad)."""
+
+    rows: np.ndarray
+    cols: np.ndarray
+    length: float
+
+    @staticmethod
+    def of(mech: Mechanism, task: bool) -> _Metric:
+        """The closure rows' metric, and the task rows' after them with ``task``."""
+        s = JacobianScales.of(mech)
+        rows = s.constraint_rows / s.length
+        return _Metric(np.concatenate([rows, s.task_rows / s.length]) if task else rows, s.columns, s.length)
+
+
+def _scaled_newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray,
+                   cols: np.ndarray | None, tol: float, max_iter: int, max_dq: float, metric: _Metric
+                   ) -> tuple[np.ndarray, float, int, float]:
+    """:func:`_newton` in ``metric`` (the residual's rows and the step's columns homogenised: ``tol`` and ``max_dq``
+    in ``L`` and rad); returns (q, homogenised residual inf-norm, iterations, residual inf-norm in m and rad)."""
+    m = mech.model
+    cols = np.arange(m.nv) if cols is None else cols
+    units = metric.cols[cols]
+    seen: list[tuple[np.ndarray, float]] = []  # (the latest evaluations' points and raw residuals)
+
+    def scaled(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        r, J = fun(x)
+        seen.append((x, float(np.max(np.abs(r), initial=0.0))))
+        del seen[:-12]
+        return metric.rows * r, metric.rows[:, None] * J[:, cols] * units
+
+    def retract(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
+        full = np.zeros(m.nv)
+        full[cols] = units * dx
+        return pin.integrate(m, x, full)
+
+    x, res, it = gauss_newton(scaled, q, tol=tol, max_iter=max_iter, max_step=max_dq, retract=retract)
+    raw = next((r for xx, r in reversed(seen) if xx is x), None)
+    if raw is None:  # (not among the latest evaluations: evaluated again)
+        raw = float(np.max(np.abs(fun(x)[0]), initial=0.0))
+    return x, res, it, (raw if math.isfinite(raw) else math.inf)
+
+
 def _result(mech: Mechanism, q: np.ndarray, converged: bool, residual: float, iterations: int,
-            steps: int, mode: ModeLabel | None = None) -> SolveResult:
+            steps: int, mode: ModeLabel | None = None, relative: float = math.nan) -> SolveResult:
     return SolveResult(q, converged, residual, iterations, steps, _signs(mech, q), mech.outside_limits(q),
-                       mode_label_at(mech, q, result=True) if mode is None else mode)
+                       mode_label_at(mech, q, result=True) if mode is None else mode, relative)
 
 
 class _Matrices:
@@ -211,14 +273,15 @@ class _Matrices:
         self.first: tuple[np.ndarray, np.ndarray] | None = None
         self.last: tuple[np.ndarray, np.ndarray] | None = None
 
-    def keep(self, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], final: bool, tol: float
-             ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
-        """``fun`` keeping its matrices; ``final``: the final step's, solved to ``tol``."""
+    def keep(self, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], final: bool, tol: float,
+             rows: np.ndarray) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+        """``fun`` keeping its matrices; ``final``: the final step's, solved to ``tol`` (on the residual times
+        ``rows``: :class:`_Metric`)."""
         def kept(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             r, J = fun(x)
             if self.at_seed and self.first is None:
                 self.first = (x.copy(), J)
-            if final and float(np.max(np.abs(r), initial=0.0)) <= tol:
+            if final and float(np.max(np.abs(rows * r), initial=0.0)) <= tol:
                 full = J if self.task is None else np.vstack([J, self.task.jacobian_from(self.mech.data)])
                 self.last = (x.copy(), full)
             return r, J
@@ -248,7 +311,8 @@ def _follow(mech: Mechanism, what: str, solve_at: _StepSolver, q: np.ndarray, n_
             raise_on_failure: bool, matrices: _Matrices, min_step: float = MIN_STEP) -> SolveResult:
     """Continuation from ``s = 0`` (the seed ``q``) to ``s = 1`` (the target).
 
-    ``solve_at(q, s, tol) -> (q, residual, iterations)`` corrects at path parameter ``s`` from ``q``.
+    ``solve_at(q, s, tol) -> (q, residual, iterations, raw residual)`` corrects at path parameter ``s`` from
+    ``q``.
     Steps start at ``1 / n_steps``, halve on failure, grow again on success; intermediate points
     are solved to 1e-9, the target to ``tol``. When the step falls below ``min_step`` of its initial length
     the path has left the workspace: a last correction at the target gives the residual reported.
@@ -257,8 +321,8 @@ def _follow(mech: Mechanism, what: str, solve_at: _StepSolver, q: np.ndarray, n_
     s, ds = 0.0, 1.0 / n_steps
     while True:
         if total >= MAX_TOTAL_ITER:
-            q_new, res, it = solve_at(q, 1.0, tol)
-            result = _result(mech, q_new, False, res, total + it, steps)
+            q_new, res, it, raw = solve_at(q, 1.0, tol)
+            result = _result(mech, q_new, False, raw, total + it, steps, relative=res)
             if raise_on_failure:
                 err = _failure(mech, what, result, tol)
                 raise ConvergenceError(what, err.residual, err.iterations, tol, result,
@@ -267,20 +331,20 @@ def _follow(mech: Mechanism, what: str, solve_at: _StepSolver, q: np.ndarray, n_
             return result
         s_next = min(1.0, s + ds)
         t = tol if s_next >= 1.0 else max(tol, 1e-9)
-        q_new, res, it = solve_at(q, s_next, t)
+        q_new, res, it, raw = solve_at(q, s_next, t)
         total += it
         if res <= t:
             q, s, steps = q_new, s_next, steps + 1
             if s >= 1.0:
                 q_wrapped = mech.wrap(q)
-                return _result(mech, q_wrapped, True, res, total, steps, matrices.label(q_wrapped, q))
+                return _result(mech, q_wrapped, True, raw, total, steps, matrices.label(q_wrapped, q), res)
             ds = min(ds * 1.5, 1.0 / n_steps)
         else:
             ds *= 0.5
             if ds < min_step / n_steps:
                 res_path = res
-                q_new, res, it = solve_at(q, 1.0, tol)
-                result = _result(mech, q_new, False, res, total + it, steps)
+                q_new, res, it, raw = solve_at(q, 1.0, tol)
+                result = _result(mech, q_new, False, raw, total + it, steps, relative=res)
                 if raise_on_failure and res <= tol:  # the target closes, but not by following the seed's branch
                     raise ConvergenceError(f"{what} along the path from the seed", res_path, result.iterations,
                                            tol, result,
@@ -303,9 +367,11 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
         q0: Seed configuration (nq,); its assembly mode is kept (a result in another assembly or working mode, the
             path having crossed a singularity, warns: :class:`~pkm.errors.ModeChangeWarning`). Default: the
             reference configuration.
-        tol: Tolerance on the infinity norm of the closure residual [m, rad].
+        tol: Tolerance on the infinity norm of the closure residual, its translations in units of the characteristic
+            length ``L`` (a gap of ``tol * L`` m) and its rotations in rad (module doc: scale-free).
         max_iter: Newton iterations allowed per continuation step.
-        max_step: Largest change of an actuated coordinate per continuation step [rad or m].
+        max_step: Largest change of an actuated coordinate per continuation step [rad, or ``L`` for a prismatic
+            one].
         raise_on_failure: Raise :class:`ConvergenceError` (default) instead of returning ``converged=False``.
         min_step: The smallest continuation step, relative to the first, before the path is judged to leave the
             workspace (in (0, 1]): a search that only keeps the targets that close (random states) gives up sooner
@@ -336,16 +402,17 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
     qa0 = mech.actuated_q(q)
     rev = np.array([j.revolute for j in mech.actuated], dtype=bool)  # angles go the short way round (+-pi)
     qa1 = np.where(rev, qa0 + wrap_angle(qa1 - qa0), qa1)
-    n_steps = _n_steps(np.max(np.abs(qa1 - qa0)), max_step)
+    metric = _Metric.of(mech, task=False)
+    n_steps = _n_steps(np.max(np.abs(qa1 - qa0) / metric.cols[mech.act_v], initial=0.0), max_step)
 
     def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return constraints.residual_and_jacobian(mech, qq)
 
     matrices = _Matrices(mech, task=TaskMap.of(mech))
 
-    def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int]:
-        return _newton(mech, matrices.keep(fun, s >= 1.0, t), mech.with_actuated(q, qa0 + s * (qa1 - qa0)),
-                       mech.passive_v, t, max_iter, 0.5)
+    def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int, float]:
+        return _scaled_newton(mech, matrices.keep(fun, s >= 1.0, t, metric.rows),
+                              mech.with_actuated(q, qa0 + s * (qa1 - qa0)), mech.passive_v, t, max_iter, 0.5, metric)
 
     seed = mode_label(mech, q)  # (found kept where the seed is the last solve's result: a path followed)
     try:
@@ -370,7 +437,7 @@ def _with_clearance(mech: Mechanism, result: SolveResult) -> SolveResult:
 
 
 def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: ArrayLike | None = None, *,
-             branch: str | None = None, tol: float = DEFAULT_TOL, max_iter: int = 30, max_step: float = 0.05,
+             branch: str | None = None, tol: float = DEFAULT_TOL, max_iter: int = 30, max_step: float = 0.25,
              raise_on_failure: bool = True, collisions: bool = False) -> SolveResult:
     """Inverse position problem: every joint coordinate for given task coordinates.
 
@@ -382,9 +449,11 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
             the reference with that branch's joint signs imposed and the loops re-closed). A result in another
             working or assembly mode than the seed's warns (:class:`~pkm.errors.ModeChangeWarning`).
         branch: Working mode the solution must lie on; checked at the end (:class:`BranchError`).
-        tol: Tolerance on the infinity norm of closure residual and task error [m, rad].
+        tol: Tolerance on the infinity norm of closure residual and task error, their lengths in units of the
+            characteristic length ``L`` and their angles in rad (module doc: scale-free).
         max_iter: Newton iterations allowed per continuation step.
-        max_step: Largest task change per continuation step [m or rad].
+        max_step: Largest task change per continuation step [``L`` or rad] (0.25: 5 cm on the Delta, whose
+            ``L`` is 0.21 m, as the 0.05 m of the former default in m; 0.25 rad).
         raise_on_failure: Raise :class:`ConvergenceError` instead of returning ``converged=False``.
         collisions: Report the smallest distance between the bodies checked for collision at the result
             (:attr:`SolveResult.clearance`; about 25 us, under 1 % of a solve on the Gough-Stewart);
@@ -414,14 +483,16 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
     else:
         q = mech.check_q(q0, "q0")
     y0 = task.value(q)
-    dist = np.max(np.abs(task.error(y1, y0)))
+    metric = _Metric.of(mech, task=True)
+    dist = np.max(np.abs(task.error(y1, y0) * metric.rows[mech.n_constraints:]), initial=0.0)
     n_steps = _n_steps(dist, max_step)
 
     matrices = _Matrices(mech, at_seed=True)
 
-    def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int]:
+    def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int, float]:
         goal = IKProblem(mech, y1 if s >= 1.0 else task.interpolate(y0, y1, s))
-        return _newton(mech, matrices.keep(goal.evaluate, s >= 1.0, t), q, mech.free_v, t, max_iter, 0.5)
+        return _scaled_newton(mech, matrices.keep(goal.evaluate, s >= 1.0, t, metric.rows), q, mech.free_v, t,
+                              max_iter, 0.5, metric)
 
     problem = IKProblem(mech, y1)
     seed_q = q
@@ -429,7 +500,7 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
         result = _follow(mech, "inverse kinematics", solve_at, q, n_steps, tol, raise_on_failure, matrices)
     except ConvergenceError as exc:
         if isinstance(exc.result, SolveResult):
-            _raise_if_out_of_reach(mech, problem.evaluate, exc.result.q, tol)
+            _raise_if_out_of_reach(mech, problem.evaluate, exc.result.q, tol, metric)
         exc.problem = problem
         raise
     q = result.q
@@ -551,8 +622,8 @@ def assemble(mech: Mechanism, q0: ArrayLike | None = None, *, hold: Sequence[str
             best = (res, q, raw)
         if res <= tol:
             q = mech.wrap(q)
-            return _result(mech, q, True, raw, total, k + 1)
-    result = _result(mech, best[1], False, best[2], total, restarts + 1)
+            return _result(mech, q, True, raw, total, k + 1, relative=res)
+    result = _result(mech, best[1], False, best[2], total, restarts + 1, relative=best[0])
     if not raise_on_failure:
         return result
     err = _failure(mech, "assembly", result, tol)
@@ -748,23 +819,28 @@ def _levenberg_marquardt(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.n
     return q, F, it
 
 
-def _raise_if_out_of_reach(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray, tol: float) -> None:
+def _raise_if_out_of_reach(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray,
+                           tol: float, metric: _Metric) -> None:
     """:class:`UnreachableError` when the IK equations ``fun`` have a least-squares minimum that is not a solution
-    near ``q`` (Levenberg-Marquardt from ``q`` stalls with ``|F|_inf > max(tol, 1e-9)``): the target lies outside
-    the workspace. It names the closure left most open there, or the task when the loops close there (to a
-    thousandth of the task's miss: the least-squares minimum trades a little closure for a far target)."""
+    near ``q`` (Levenberg-Marquardt from ``q``, in ``metric``, stalls with ``|F|_inf > max(tol, 1e-9)``, lengths in
+    ``L``): the target lies outside the workspace. It names the closure left most open there, or the task when the
+    loops close there (to a thousandth of the task's miss: the least-squares minimum trades a little closure for a
+    far target); the gaps it prints are in m or rad."""
     def held(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # (a floating base stays where it is)
         F, J = fun(qq)
         J[:, mech.base_v] = 0.0
-        return F, J
+        return metric.rows * F, metric.rows[:, None] * J
 
     with np.errstate(over="ignore", invalid="ignore"):
-        q, F, _ = _levenberg_marquardt(mech, held, q, tol, 500)
+        q, Fs, _ = _levenberg_marquardt(mech, held, q, tol, 500, metric.cols)
+        F = Fs / metric.rows
         gap, index, name = constraints.worst_closure(mech, F)
+        gap_s = constraints.worst_closure(mech, Fs)[0]
         task_gap = float(np.linalg.norm(F[mech.n_constraints:]))
-    if not (np.isfinite(gap) and np.isfinite(task_gap) and np.abs(F).max() > max(tol, 1e-9)):
+        task_gap_s = float(np.linalg.norm(Fs[mech.n_constraints:]))
+    if not (np.isfinite(gap) and np.isfinite(task_gap) and np.abs(Fs).max() > max(tol, 1e-9)):
         return  # solved after all, or beyond the float range: the ConvergenceError stands
-    if gap > tol and gap > 1e-3 * task_gap:  # a loop that cannot close, not a trade-off with a task far away
+    if gap_s > tol and gap_s > 1e-3 * task_gap_s:  # a loop that cannot close, not a trade-off with a task far away
         raise UnreachableError(index, gap, "m or rad",
                                f"the target is out of the workspace: at the nearest configuration (a least-squares "
                                f"minimum) closure {name!r} stays open by {gap:.3g} and the task misses by "
@@ -776,13 +852,20 @@ def _raise_if_out_of_reach(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np
 
 def _failure(mech: Mechanism, what: str, result: SolveResult, tol: float) -> ConvergenceError:
     """A ConvergenceError naming the loop that stays most open and by how much."""
-    gap, _, name = constraints.worst_closure(mech, constraints.residual(mech, result.q))
+    F = constraints.residual(mech, result.q)
+    gap, _, name = constraints.worst_closure(mech, F)
+    scaled = math.isfinite(result.relative_residual)
+    open_ = (constraints.worst_closure(mech, _Metric.of(mech, task=False).rows * F)[0] if scaled else gap) > tol
     detail = (f"closure {name!r} stays open by {gap:.3g} (m or rad) at the last iterate"
-              if name is not None and gap > tol else "the task target is not met")
+              if name is not None and open_ else "the task target is not met")
     if what == "loop closure" and mech.dependent_actuators:
         detail += (f"; actuators {list(mech.dependent_actuators)} depend on the others (see mech.notes): values "
                    "that do not agree with the others' admit no assembly")
-    err = ConvergenceError(what, result.residual, result.iterations, tol, result, detail)
+    if scaled and what != "assembly":
+        detail += (f" (the residual counts lengths in the characteristic length L = {mech.characteristic_length:.4g} m, "
+                   f"angles in rad; in m and rad {result.residual:.3e})")
+    err = ConvergenceError(what, result.relative_residual if scaled else result.residual, result.iterations, tol,
+                           result, detail)
     err.worst_closure, err.worst_gap = name, gap
     return err
 

@@ -128,6 +128,11 @@ def _units(mech: Mechanism) -> dict[str, dict[str, str]]:
             "task": {k: unit[kind] for k, kind in TaskMap.of(mech).kinds.items()}}
 
 
+def _open(res: SolveResult, tol: float) -> bool:
+    """Whether a solve's residual is above ``tol`` (the one the solver's tolerance bounds, lengths in ``L``)."""
+    return bool(res.relative_residual > tol) if np.isfinite(res.relative_residual) else bool(res.residual > tol)
+
+
 def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int, np.ndarray], SolveResult],
             predict: Callable[[int, np.ndarray], np.ndarray],
             rates: Callable[[int, np.ndarray], tuple[np.ndarray, np.ndarray]], efforts: bool, wrench: ArrayLike | None,
@@ -150,7 +155,7 @@ def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int,
         res = solve(k, start if prev is None else prev)
         q[k], residual[k] = res.q, res.residual
         if not res.converged:
-            jumps.append(Jump(k, "did not converge", f"residual {res.residual:.3g} (m or rad)") if res.residual > tol
+            jumps.append(Jump(k, "did not converge", f"residual {res.residual:.3g} (m or rad)") if _open(res, tol)
                          else Jump(k, "corrected", "the continuation failed and a direct correction reached the "
                                                    "sample, possibly on another branch"))
         if prev is not None:
@@ -168,7 +173,7 @@ def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int,
             jumps.append(Jump(k, "branch", f"on {[b for b, on in now.items() if on]}, was on "
                                            f"{[b for b, on in signs.items() if on]}"))
         signs = now
-        if res.residual > tol:  # no rates nor efforts where the loops or the task are open
+        if _open(res, tol):  # no rates nor efforts where the loops or the task are open
             prev = res.q
             continue
         try:
@@ -209,7 +214,7 @@ def follow_task(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None = None, ydd:
             working mode.
         efforts: Also compute the actuator efforts (:func:`pkm.inverse_dynamics`).
         wrench: External wrench at the end effector (world-aligned f, m), the same at every sample.
-        tol: Solver tolerance [m, rad].
+        tol: Solver tolerance: lengths in the characteristic length ``L``, angles in rad (:func:`solve_ik`).
 
     Raises:
         InvalidInputError: samples of the wrong shape or not finite.

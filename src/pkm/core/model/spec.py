@@ -58,6 +58,11 @@ Format ``pkm.closures/1`` (all values SI: m, rad)::
     [transmission.left_ankle]        # optional: a closed sub-mechanism's name and output joints
     outputs = ["ankle_pitch", "ankle_roll"]   # (pkm.transmissions; pkm.core.transmissions.decompose)
 
+    [links.proximal_1]               # optional: a link's compliance (pkm.stiffness; pkm.core.compliance.links):
+    compliance = [[1e-8, 0, 0, 0, 0, 0], ...]  # 6 x 6, (dp, dtheta) per (f, m) at each thing it carries, the
+                                     # link frame's axes, SI (m/N, m/(N m); rad/N, rad/(N m)), symmetric positive
+                                     # definite
+
     [collision]                      # optional: the pairs of bodies pkm.clearance checks, over its rule
     exclude = [["rod_1", "rod_2"]]   # (pkm.core.collision.geometry): pairs not checked; include: pairs
     include = []                     # the rule leaves out (neighbours, closures, contact) checked
@@ -118,10 +123,12 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Any
 
+import numpy as np
+
 from pkm.core.model.actuators import parse_table
 from pkm.core.model.springs import parse_springs
 from pkm.errors import InvalidInputError, SpecError
-from pkm.validation import ABSURD
+from pkm.validation import ABSURD, symmetric_positive_definite
 
 FORMAT = "pkm.closures/1"
 MAX_FILE_BYTES = 16 * 1024 * 1024  # URDF, spec and motion files larger than this are refused
@@ -214,6 +221,9 @@ class ClosureSpec:
     #: ``{motor: {actuated joint: coefficient}}``: the ``[motors.<name>]`` tables, motors that drive several
     #: actuated joints through a constant linear map (:mod:`pkm.core.model.motors`).
     motors: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    #: ``{link: 6 x 6 compliance}``: the ``[links.<link>] compliance`` tables, the links :func:`pkm.stiffness` takes
+    #: compliant by default (:mod:`pkm.core.compliance.links`), rows of SI numbers.
+    links: Mapping[str, tuple[tuple[float, ...], ...]] = field(default_factory=dict)
     #: ``[collision] exclude``: pairs of bodies (links with collision geometry) :func:`pkm.clearance` does not check.
     collision_exclude: tuple[tuple[str, str], ...] = ()
     #: ``[collision] include``: pairs it checks though its rule leaves them out (:mod:`pkm.core.collision.geometry`).
@@ -271,7 +281,7 @@ class ClosureSpec:
             raise SpecError(source, f"unsupported format {fmt!r}; this pkm reads {FORMAT!r}")
         known = {"format", "mechanism", "urdf", "end_effector", "actuated", "default_branch", "task",
                  "closure", "branch", "reference", "parameters", "description", "joint_types", "floating_base",
-                 "actuators", "springs", "transmission", "motors", "collision"}
+                 "actuators", "springs", "transmission", "motors", "collision", "links"}
         unknown = sorted(set(raw) - known)
         if unknown:
             raise SpecError(source, f"unknown keys {unknown}; known keys: {sorted(known)}")
@@ -410,6 +420,9 @@ class ClosureSpec:
                 raise SpecError(source, f"{where}: {stray[0]!r} is not an actuated joint; actuated: {list(actuated)}")
             motors[str(mname)] = {str(j): float(v) for j, v in table.items()}
 
+        links = {str(n): _compliance(t, f"[links.{n}]", source)
+                 for n, t in (need(raw, "links", dict).items() if "links" in raw else ())}
+
         collision = need(raw, "collision", dict) if "collision" in raw else {}
         stray = sorted(set(collision) - {"exclude", "include"})
         if stray:
@@ -441,6 +454,7 @@ class ClosureSpec:
             springs=springs,
             transmissions=transmissions,
             motors=motors,
+            links=links,
             collision_exclude=pairs["exclude"],
             collision_include=pairs["include"],
         )
@@ -490,6 +504,9 @@ class ClosureSpec:
             out += ["", f"[transmission.{_key(tname)}]", f"outputs = {_tv(list(outputs))}"]
         for mname, coefs in self.motors.items():
             out += ["", f"[motors.{_key(mname)}]"] + [f"{_key(j)} = {_tv(float(c))}" for j, c in coefs.items()]
+        for link, C in self.links.items():
+            out += ["", f"[links.{_key(link)}]", "compliance = [" + ", ".join(_tv([float(v) for v in row]) for row in C)
+                    + "]"]
         if self.collision_exclude or self.collision_include:
             out += ["", "[collision]"] + [f"{key} = {_tv([list(p) for p in pairs])}" for key, pairs in
                                           (("exclude", self.collision_exclude), ("include", self.collision_include))
@@ -578,6 +595,23 @@ _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
 def _key(name: str) -> str:
     """A TOML key: bare when TOML allows it, else a quoted string (a joint named ``a/b`` or ``knee 1``)."""
     return name if _BARE_KEY.fullmatch(name) else _tv(name)
+
+
+def _compliance(table: object, where: str, source: str) -> tuple[tuple[float, ...], ...]:
+    """A ``[links.<link>]`` table's ``compliance``: 6 x 6 finite numbers, symmetric (1e-9 relative) and positive
+    definite."""
+    if not isinstance(table, dict) or set(table) != {"compliance"}:
+        raise SpecError(source, f"{where} must hold one key, compliance = [[6 numbers] x 6] (SI)")
+    rows = table["compliance"]
+    if not (isinstance(rows, list) and len(rows) == 6 and all(
+            isinstance(r, list) and len(r) == 6 and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                        and math.isfinite(v) for v in r) for r in rows)):
+        raise SpecError(source, f"{where} compliance must be 6 rows of 6 finite numbers (SI: m/N, m/(N m); rad/N, "
+                                "rad/(N m))")
+    C = np.array(rows, dtype=float)
+    if not symmetric_positive_definite(C):
+        raise SpecError(source, f"{where} compliance must be symmetric positive definite")
+    return tuple(tuple(float(v) for v in r) for r in rows)
 
 
 def _tv(value: object) -> str:

@@ -35,7 +35,7 @@ from pkm.core.kinematics.solve import close_loops, solve_ik
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
-from pkm.core.transmissions.coordinates import OutputSplit, closure_tol, output_model, output_split, serial_tree
+from pkm.core.transmissions.coordinates import CLOSURE_RTOL, OutputSplit, output_model, output_split, serial_tree
 from pkm.errors import SingularityError, TransmissionError
 from pkm.validation import as_vector
 
@@ -107,11 +107,12 @@ class Transmission:
     def outputs_from_motors(self, qm: ArrayLike, guess: ArrayLike | None = None, *, tol: float | None = None,
                             max_iter: int = 30) -> tuple[np.ndarray, np.ndarray]:
         """Forward kinematics: ``(qo, q_sub)`` for the motors at ``qm`` [rad or m] (the sub-mechanism's loop closure,
-        seeded with the configuration ``guess``, default the reference; ``tol`` [m, rad] on the closure residual,
-        default relative to the sub-mechanism's size: :func:`~pkm.core.transmissions.coordinates.closure_tol`).
+        seeded with the configuration ``guess``, default the reference; ``tol`` on the closure residual, its
+        lengths in the sub-mechanism's characteristic length as :func:`~pkm.core.kinematics.solve.close_loops`',
+        default :data:`~pkm.core.transmissions.coordinates.CLOSURE_RTOL`).
         Raises :class:`~pkm.errors.ConvergenceError` when the loops do not close within ``max_iter`` Newton
         iterations per continuation step."""
-        tol = closure_tol(self.mechanism) if tol is None else tol
+        tol = CLOSURE_RTOL if tol is None else tol
         q = close_loops(self.mechanism, qm, guess, tol=tol, max_iter=max_iter).q
         return q[self.out_q].copy(), q
 
@@ -119,7 +120,7 @@ class Transmission:
                             max_iter: int = 30) -> tuple[np.ndarray, np.ndarray]:
         """Inverse kinematics: ``(qm, q_sub)`` for the outputs at ``qo`` [rad or m] (the sub-mechanism's inverse
         kinematics, seeded with ``guess``, default the reference; ``tol`` as :meth:`outputs_from_motors`')."""
-        tol = closure_tol(self.mechanism) if tol is None else tol
+        tol = CLOSURE_RTOL if tol is None else tol
         q = solve_ik(self.mechanism, as_vector(qo, self.k, "qo"), guess, tol=tol, max_iter=max_iter).q
         return self.mechanism.actuated_q(q), q
 

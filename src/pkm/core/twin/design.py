@@ -234,17 +234,17 @@ def read_design(mech: Mechanism, names: Sequence[str] | None = None) -> dict[str
 
 
 def structure(mech: Mechanism) -> str:
-    """What a twin with design inputs fixes of ``mech``, as text: its URDF without origins, inertials and limits, its
-    spec without reference, parameters and description, its model's joint kinds. Designs of one family that share it
-    can share a twin (the kernels read no position, effort or speed limit: a design whose limits move with its
-    lengths shares it too)."""
+    """What a twin with design inputs fixes of ``mech``, as text: its URDF without origins, inertials, limits and
+    geometry (collision and visual elements), its spec without reference, parameters and description, its model's
+    joint kinds. Designs of one family that share it can share a twin (the kernels read no position, effort or speed
+    limit and no geometry: a design whose limits or link radii move with its lengths shares it too)."""
     from lxml import etree
 
     parts = [dataclasses.replace(mech.spec, reference={}, parameters={}, description="").to_toml(),
              " ".join(j.shortname() for j in mech.model.joints)]
     if mech.urdf is not None:
         root, _ = joint_elements(mech.urdf)
-        for el in list(root.iter("origin", "inertial", "limit", "safety_controller")):
+        for el in list(root.iter("origin", "inertial", "limit", "safety_controller", "collision", "visual")):
             if el.getparent() is not None:
                 el.getparent().remove(el)
         parts.append(etree.tostring(root, encoding="unicode"))

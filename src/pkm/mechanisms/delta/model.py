@@ -1,4 +1,20 @@
-"""The Delta as a Pinocchio tree plus loop closures: URDF, closure spec and the mechanism built from parameters."""
+"""The Delta as a Pinocchio tree plus loop closures: URDF, closure spec and the mechanism built from parameters.
+
+Collision primitives (``<collision>`` elements of the URDF, sizes from :class:`DeltaParams`):
+
+* ``base``: a disc of radius ``R`` (to the motor axes) and thickness ``base_thickness``, its lower face in the
+  plane of the motor axes (the plate the motors hang from);
+* ``arm_i``: a cylinder of radius ``arm_radius`` from the motor axis (joint ``motor_i``) to the elbow axis (joint
+  ``knee_i``);
+* ``forearm_i``: a cylinder of radius ``rod_radius`` on the parallelogram's centre line, from the elbow (joint
+  ``knee_i_b``) to the ball line (frame ``forearm_i_tip``, closed on ``platform_ball_i``). Its two rods are not
+  drawn apart: their offset, along the motor axis, turns in the centre line's frame as ``knee_i_b`` turns, and a
+  primitive is fixed in its link;
+* ``platform``: a disc of radius ``r`` and thickness ``platform_thickness`` whose mid-plane holds the ball points.
+
+The massless links (``knee_cross_i``, the guide) carry none. Neighbours touch where they are jointed (arm and
+forearm at the elbow, forearm and platform at the balls, arm and base at the motor).
+"""
 
 from __future__ import annotations
 
@@ -10,7 +26,9 @@ from pkm.core.model.urdf import UrdfBuilder
 from pkm.mechanisms._common import (
     PM54_040,
     check_params,
+    disc_collision,
     make_mechanism,
+    rod_collision,
     rod_inertia,
     rot_z,
     spec_parameters,
@@ -27,6 +45,7 @@ def urdf_xml(params: DeltaParams) -> str:
     params = check_params(params, DeltaParams)
     b = UrdfBuilder(NAME)
     b.link("base")
+    disc_collision(b, "base", (0.0, 0.0, params.base_thickness / 2), (0.0, 0.0, 1.0), params.R, params.base_thickness)
     reach = 2.0 * (params.R + params.La + params.Lb)
     for i in range(3):
         n = i + 1
@@ -34,16 +53,19 @@ def urdf_xml(params: DeltaParams) -> str:
         b.link(f"arm_{n}", params.m_arm, (0.0, params.La / 2, 0.0), rod_inertia(params.m_arm, params.La, 1))
         b.joint(f"motor_{n}", "revolute", "base", f"arm_{n}", Rz @ np.array([0.0, params.R, 0.0]), Rz,
                 axis=(1.0, 0.0, 0.0), effort=PM54_040.effort, velocity=PM54_040.speed)
+        rod_collision(b, f"arm_{n}", (0.0, 0.0, 0.0), (0.0, params.La, 0.0), params.arm_radius)
         b.link(f"knee_cross_{n}")
         b.joint(f"knee_{n}", "revolute", f"arm_{n}", f"knee_cross_{n}", (0.0, params.La, 0.0), axis=(1.0, 0.0, 0.0))
         b.link(f"forearm_{n}", params.m_forearm, (0.0, params.Lb / 2, 0.0),
                rod_inertia(params.m_forearm, params.Lb, 1))
+        rod_collision(b, f"forearm_{n}", (0.0, 0.0, 0.0), (0.0, params.Lb, 0.0), params.rod_radius)
         b.joint(f"knee_{n}_b", "revolute", f"knee_cross_{n}", f"forearm_{n}", axis=(0.0, 0.0, 1.0))
         b.frame(f"forearm_{n}_tip", f"forearm_{n}", (0.0, params.Lb, 0.0))
     b.link("guide_x")
     b.link("guide_y")
     mp, r = params.m_platform, params.r
     b.link("platform", mp, inertia=np.diag([mp * r * r / 4, mp * r * r / 4, mp * r * r / 2]))
+    disc_collision(b, "platform", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), r, params.platform_thickness)
     b.joint("platform_x", "prismatic", "base", "guide_x", axis=(1.0, 0.0, 0.0), limits=(-reach, reach))
     b.joint("platform_y", "prismatic", "guide_x", "guide_y", axis=(0.0, 1.0, 0.0), limits=(-reach, reach))
     b.joint("platform_z", "prismatic", "guide_y", "platform", axis=(0.0, 0.0, 1.0), limits=(-reach, reach))

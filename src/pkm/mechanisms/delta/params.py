@@ -36,6 +36,12 @@ class DeltaParams:
         m_arm: Arm mass [kg] (illustrative; not in the paper).
         m_forearm: Mass of one parallelogram (both rods) [kg] (illustrative).
         m_platform: Platform mass [kg] (illustrative).
+        arm_radius: Radius of an arm's collision cylinder [m] (10 mm; illustrative: the paper
+            gives no sizes).
+        rod_radius: Radius of a forearm's collision cylinder, drawn on the parallelogram's centre line [m]
+            (5 mm).
+        platform_thickness: Thickness of the platform's collision disc (radius ``r``) [m] (10 mm).
+        base_thickness: Thickness of the base's collision disc (radius ``R``, above the motor axes) [m] (10 mm).
     """
 
     La: float = param(0.110, "m")
@@ -46,9 +52,14 @@ class DeltaParams:
     m_arm: float = param(0.10, "kg")
     m_forearm: float = param(0.05, "kg")
     m_platform: float = param(0.20, "kg")
+    arm_radius: float = param(0.010, "m")
+    rod_radius: float = param(0.005, "m")
+    platform_thickness: float = param(0.010, "m")
+    base_thickness: float = param(0.010, "m")
 
     def __post_init__(self):
-        check_positive(self, "La", "Lb", "r", "R", "m_arm", "m_forearm", "m_platform")
+        check_positive(self, "La", "Lb", "r", "R", "m_arm", "m_forearm", "m_platform", "arm_radius", "rod_radius",
+                       "platform_thickness", "base_thickness")
         if self.home is not None:
             check_numbers(self, "home", 3, "(a point x, y, z in m)")
 

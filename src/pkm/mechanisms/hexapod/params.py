@@ -61,6 +61,8 @@ class HexapodParams:
         m_arm: Mass of an arm ``LA`` [kg] (illustrative).
         m_rod: Mass of a rod ``LB`` [kg] (illustrative).
         m_platform: Platform mass [kg] (illustrative).
+        link_radius: Radius of the collision cylinders of the reconfiguration links, arms and rods [m] (10 mm;
+            illustrative: the paper gives no sizes). The platform's is the prism's own ``r`` and ``h``.
     """
 
     Rf: float = param(0.050, "m")
@@ -80,9 +82,11 @@ class HexapodParams:
     m_arm: float = param(0.25, "kg")
     m_rod: float = param(0.15, "kg")
     m_platform: float = param(0.80, "kg")
+    link_radius: float = param(0.010, "m")
 
     def __post_init__(self):
-        check_positive(self, "Rf", "Rr", "R2", "LA", "LB", "h", "r", "m_recon", "m_arm", "m_rod", "m_platform")
+        check_positive(self, "Rf", "Rr", "R2", "LA", "LB", "h", "r", "m_recon", "m_arm", "m_rod", "m_platform",
+                       "link_radius")
         check_finite(self, "H0", "home_beta")
         if not isinstance(self.layout, str) or self.layout not in LAYOUTS:
             raise InvalidParameterError("layout", f"must be one of {sorted(LAYOUTS)}, got {self.layout!r}",

@@ -1,4 +1,18 @@
-"""The 3-PRS as a Pinocchio tree plus loop closures: URDF, closure spec and the mechanism built from parameters."""
+"""The 3-PRS as a Pinocchio tree plus loop closures: URDF, closure spec and the mechanism built from parameters.
+
+Collision primitives (``<collision>`` elements of the URDF, sizes from :class:`Prs3Params`):
+
+* ``base``: a disc of radius ``g`` and thickness ``base_thickness`` under the base plane (``z = 0``), the rails
+  standing on its rim at ``a_i``;
+* ``slider_link_i``: a cube of edge ``slider_size`` centred on the knee axis on the rail (the origin of joint
+  ``knee_i``), edges along the rail, the knee axis and ``w_i``;
+* ``coupler_i``: a cylinder of radius ``link_radius`` from the knee (joint ``knee_i``) to the spherical joint
+  (frame ``coupler_i_tip``, closed on ``platform_ball_i``);
+* ``platform_link``: a disc of radius ``h`` and thickness ``platform_thickness`` whose mid-plane holds the
+  spherical joints' centres.
+
+The rails are not drawn (their length is not a design parameter). Neighbours touch where they are jointed.
+"""
 
 from __future__ import annotations
 
@@ -9,7 +23,9 @@ from pkm.mechanisms._common import (
     PH54_200,
     SA2_PD,
     check_params,
+    disc_collision,
     make_mechanism,
+    rod_collision,
     rod_inertia,
     rot_y,
     rot_z,
@@ -25,6 +41,8 @@ def urdf_xml(params: Prs3Params) -> str:
     params = check_params(params, Prs3Params)
     b = UrdfBuilder(NAME)
     b.link("base")
+    disc_collision(b, "base", (0.0, 0.0, -params.base_thickness / 2), (0.0, 0.0, 1.0), params.g,
+                   params.base_thickness)
     reach = 2.0 * (params.g + params.h + 2.0 * params.l)  # slider travel (informative: pkm reads no limits)
     a, _, _, _, bp = leg_geometry(params)
     for i in range(3):
@@ -33,13 +51,17 @@ def urdf_xml(params: Prs3Params) -> str:
         b.link(f"slider_link_{n}", params.m_slider)
         b.joint(f"slider_{n}", "prismatic", "base", f"slider_link_{n}", a[i], rot_z(PHI[i]) @ rot_y(-params.gamma),
                 axis=(1.0, 0.0, 0.0), limits=(-reach, reach), effort=SA2_PD.effort, velocity=SA2_PD.speed)  # (Linearmech SA 2 PD: 310 N, 0.5 m/s)
+        e = params.slider_size
+        b.collision(f"slider_link_{n}", "box", x=e, y=e, z=e)
         b.link(f"coupler_{n}", params.m_coupler, (0.0, 0.0, params.l / 2), rod_inertia(params.m_coupler, params.l, 2))
         knee = params.actuation == "R"  # (the knees actuated: a ROBOTIS PH54-200-S500-R drives each)
         b.joint(f"knee_{n}", "revolute", f"slider_link_{n}", f"coupler_{n}", axis=(0.0, 1.0, 0.0),
                 effort=PH54_200.effort if knee else 1e3, velocity=PH54_200.speed if knee else 1e2)
+        rod_collision(b, f"coupler_{n}", (0.0, 0.0, 0.0), (0.0, 0.0, params.l), params.link_radius)
         b.frame(f"coupler_{n}_tip", f"coupler_{n}", (0.0, 0.0, params.l))
     # link "platform_link": Pinocchio 4.1 refuses a name shared by a body frame and a joint frame
     b.link("platform_link", params.m_platform, inertia=params.platform_inertia)
+    disc_collision(b, "platform_link", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), params.h, params.platform_thickness)
     b.joint("platform", "floating", "base", "platform_link")
     for i in range(3):
         b.frame(f"platform_ball_{i + 1}", "platform_link", bp[i])

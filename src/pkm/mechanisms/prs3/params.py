@@ -102,6 +102,12 @@ class Prs3Params:
         reference: Reference independent coordinates ``(z_p [m], beta [rad], phi [rad])``; None
             (default): found for the design (``reference_pose``: level, at the best-conditioned
             height). The sec. 5 trajectories start at z = 0.81 m (eq. 41).
+        link_radius: Radius of a coupler's collision cylinder [m] (25 mm; illustrative: the paper
+            gives no sizes).
+        slider_size: Edge of a slider's collision cube, centred on the knee axis on the rail [m] (100 mm).
+        platform_thickness: Thickness of the platform's collision disc (radius ``h``) [m] (50 mm).
+        base_thickness: Thickness of the base's collision disc (radius ``g``, under the plane where the rails meet
+            it) [m] (50 mm).
     """
 
     gamma: float = _from_table2("gamma", "rad")
@@ -119,9 +125,14 @@ class Prs3Params:
     Ixz3: float = _from_table2("Ixz3", "kg m^2")
     Iyz3: float = _from_table2("Iyz3", "kg m^2")
     reference: tuple[float, float, float] | None = param(None, "m", "rad", length=3)
+    link_radius: float = param(0.025, "m")
+    slider_size: float = param(0.100, "m")
+    platform_thickness: float = param(0.050, "m")
+    base_thickness: float = param(0.050, "m")
 
     def __post_init__(self):
-        check_positive(self, "l", "h", "g", "m_platform")
+        check_positive(self, "l", "h", "g", "m_platform", "link_radius", "slider_size", "platform_thickness",
+                       "base_thickness")
         check_nonnegative(self, "m_slider", "m_coupler")
         check_finite(self, "gamma", "Ixx3", "Iyy3", "Izz3", "Ixy3", "Ixz3", "Iyz3")
         if not 0.0 < self.gamma < math.pi:

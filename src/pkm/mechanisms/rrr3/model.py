@@ -1,4 +1,19 @@
-"""The planar 3-RRR as a Pinocchio tree plus loop closures: URDF, closure spec and the mechanism built from parameters."""
+"""The planar 3-RRR as a Pinocchio tree plus loop closures: URDF, closure spec and the mechanism built from parameters.
+
+Collision primitives (``<collision>`` elements of the URDF, sizes from :class:`Rrr3Params`), all centred on the
+mechanism's plane:
+
+* ``proximal_i``: a cylinder of radius ``link_radius`` from the base vertex (joint ``motor_i``) to the elbow
+  ``D_i`` (joint ``elbow_i``);
+* ``distal_i``: a cylinder of radius ``link_radius`` from ``D_i`` to the platform vertex (``A``: joint
+  ``wrist_1`` for leg 1; ``B``, ``C``: frames ``leg2_tip``, ``leg3_tip``, closed on ``platform_B``, ``platform_C``);
+* ``platform``: the triangle's circumscribed disc (centre ``G``, radius ``h / sqrt 3``, through ``A``, ``B``,
+  ``C``), ``platform_thickness`` thick.
+
+The base carries none: it is the ground plate under the plane that every link would touch. The links of one
+plane model a mechanism whose legs cannot cross (a built one stacks them at different heights).
+Neighbours touch where they are jointed.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +25,9 @@ from pkm.core.model.urdf import UrdfBuilder
 from pkm.mechanisms._common import (
     PM54_040,
     check_params,
+    disc_collision,
     make_mechanism,
+    rod_collision,
     rod_inertia,
     spec_parameters,
 )
@@ -30,7 +47,9 @@ def urdf_xml(params: Rrr3Params) -> str:
                rod_inertia(params.m_proximal, params.a, 0))
         b.joint(f"motor_{n}", "revolute", "base", f"proximal_{n}", (vertex[0], vertex[1], 0.0),
                 effort=PM54_040.effort, velocity=PM54_040.speed)  # (a ROBOTIS PM54-040-S250-R: 3.9 N m, 28.4 rev/min, its datasheet)
+        rod_collision(b, f"proximal_{n}", (0.0, 0.0, 0.0), (params.a, 0.0, 0.0), params.link_radius)
         b.link(f"distal_{n}", params.m_distal, (params.b / 2.0, 0.0, 0.0), rod_inertia(params.m_distal, params.b, 0))
+        rod_collision(b, f"distal_{n}", (0.0, 0.0, 0.0), (params.b, 0.0, 0.0), params.link_radius)
         b.joint(f"elbow_{n}", "revolute", f"proximal_{n}", f"distal_{n}", (params.a, 0.0, 0.0))
         if n > 1:
             b.frame(f"leg{n}_tip", f"distal_{n}", (params.b, 0.0, 0.0))
@@ -38,6 +57,7 @@ def urdf_xml(params: Rrr3Params) -> str:
     g_local = (h / 2.0, h / (2.0 * SQRT3), 0.0)
     # thin equilateral plate of side h: polar moment m h^2 / 12 about its centroid
     b.link("platform", m, g_local, np.diag([m * h * h / 24.0, m * h * h / 24.0, m * h * h / 12.0]))
+    disc_collision(b, "platform", g_local, (0.0, 0.0, 1.0), h / SQRT3, params.platform_thickness)
     b.joint("wrist_1", "revolute", "distal_1", "platform", (params.b, 0.0, 0.0))
     b.frame("platform_A", "platform")
     b.frame("platform_B", "platform", (h, 0.0, 0.0))

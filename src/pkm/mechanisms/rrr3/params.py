@@ -50,6 +50,9 @@ class Rrr3Params:
         m_proximal: Mass of a proximal link [kg] (illustrative; not in the paper).
         m_distal: Mass of a distal link [kg] (illustrative).
         m_platform: Platform mass [kg] (illustrative).
+        link_radius: Radius of the links' collision cylinders [m] (10 mm; illustrative: the paper
+            gives no sizes).
+        platform_thickness: Thickness of the platform's collision disc, normal to the plane [m] (20 mm).
     """
 
     a: float = param(0.40, "m")
@@ -61,9 +64,12 @@ class Rrr3Params:
     m_proximal: float = param(0.20, "kg")
     m_distal: float = param(0.15, "kg")
     m_platform: float = param(0.10, "kg")
+    link_radius: float = param(0.010, "m")
+    platform_thickness: float = param(0.020, "m")
 
     def __post_init__(self):
-        check_positive(self, "a", "b", "h", "H", "m_proximal", "m_distal", "m_platform")
+        check_positive(self, "a", "b", "h", "H", "m_proximal", "m_distal", "m_platform", "link_radius",
+                       "platform_thickness")
         if isinstance(self.branch, bool) or not isinstance(self.branch, int) or not 1 <= self.branch <= 8:
             raise InvalidParameterError("branch", f"must be an integer 1..8 (working mode 'mode1'..'mode8'), got "
                                                   f"{self.branch!r}", self.branch)
