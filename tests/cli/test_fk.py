@@ -34,7 +34,7 @@ def test_fk_and_ik_all_print_every_mode_and_the_sets_account():
     ik = json.loads(run("ik", "prs3", "--pose", "z=90cm", "pitch=3deg", "--all").stdout)
     assert ik["complete"] and len(ik["modes"]) == 8
     assert all(abs(m["task"]["z"] - 0.9) < 1e-9 for m in ik["modes"])
-    assert "clearance" not in ik["modes"][0]  # (no collision geometry)
+    assert all(m["interferes"] == (m["clearance"] < 0.0) for m in ik["modes"])  # (its links' collision geometry)
 
 
 def test_ik_all_says_which_modes_interfere(capsys):

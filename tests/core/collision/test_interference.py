@@ -109,15 +109,77 @@ def test_a_map_marks_interference_only_where_asked_and_where_there_is_geometry(t
 
 
 def test_without_geometry_nothing_changes_and_nothing_is_said():
-    """A mechanism whose files carry no collision geometry: not checked, no warning; the objective refuses."""
+    """The Delta with its collision elements taken out of its URDF: not checked, no warning, its map that of the
+    Delta with collisions=False; the objective refuses."""
+    import types
+
+    from tests.core.collision.test_clearance import _without_collisions
+
     delta = pkm.load("delta")
+    bare = pkm.from_strings(_without_collisions(delta.urdf), delta.spec)
+    axes = {"x": np.linspace(-0.05, 0.05, 3)}
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        assert not checks_collisions(delta)
-        m = pkm.workspace_map(delta, {"x": np.linspace(-0.05, 0.05, 3)}, {"z": -0.35})
+        assert not checks_collisions(bare) and checks_collisions(delta)
+        m = pkm.workspace_map(bare, axes, {"z": -0.35})
     assert m.clearance is None and m.within_limits is None and m.interferes is None
     np.testing.assert_array_equal(m.feasible, m.reachable)
-    c = RegisteredFamily("delta").candidate({})
+    np.testing.assert_array_equal(m.singular_values, pkm.workspace_map(delta, axes, {"z": -0.35},
+                                                                       collisions=False).singular_values)
     with pytest.raises(NoCollisionGeometryError):
-        OBJECTIVES["interference_free_volume"].generic(c, sweeps.objective(
+        OBJECTIVES["interference_free_volume"].generic(types.SimpleNamespace(mechanism=bare), sweeps.objective(
             "interference_free_volume:region=x=-0.05:0.05:3,pose=z=-0.35").options)
+
+
+def test_a_configuration_s_distances_do_not_depend_on_those_computed_before():
+    """The Delta's forearms (thin parallel cylinders) along its arc in 40 samples: the smallest distances computed
+    forwards, backwards and one configuration a call are equal (Pinocchio's requests warm-started each GJK from the
+    pair's last result: backwards, a forearm pair came out -1.8e308 m)."""
+    from pkm.core.collision import clearance_map
+    from pkm.core.timing import waypoint_path
+    from tests.core.timing.conftest import ARC
+
+    delta = pkm.load("delta")
+    Q = pkm.follow_task(delta, waypoint_path(delta, ARC).evaluate(np.linspace(0.0, 1.0, 40))[0], efforts=False).q
+    forwards, backwards = clearance_map(delta, Q), clearance_map(delta, Q[::-1])[::-1]
+    alone = np.array([clearance_map(delta, q[None])[0] for q in Q])
+    assert np.all((forwards > 0.05) & (forwards < 0.1))  # (the forearms about 8 cm apart)
+    np.testing.assert_array_equal(forwards, backwards)
+    np.testing.assert_array_equal(forwards, alone)
+
+
+#: A configuration of the Delta on its arc where coal's GJK fails on its base disc and a forearm at 1e-12 of the size.
+GJK_FAILS = [-0.4664982539902116, -1.6700480254981542, 0.11045207434554571, -0.4782990241148424, -1.6641276802412222,
+             -0.11422052849577913, -0.8061882192855698, -1.4897321395782104, 0.0037447077819097174,
+             -0.036375118446675465, 0.02242810640238015, -0.3263578403964298]
+
+
+def test_a_pair_coal_s_gjk_fails_on_is_computed_again():
+    """coal answers -DBL_MAX for the Delta's base disc and forearm_2 at GJK_FAILS (its GJK at 1e-12 of the size);
+    pkm.clearance and clearance_map answer that pair again with Nesterov's acceleration: the distance of the plain GJK
+    at 1e-9 of the size, to 1e-9 m."""
+    import pinocchio as pin
+
+    from pkm.core.collision import CollisionModel, clearance_map
+    from pkm.core.collision.geometry import GJK_RTOL
+
+    delta = pkm.load("delta")
+    q = np.array(GJK_FAILS)
+    cm = CollisionModel.of(delta)
+
+    def plain(rtol: float) -> np.ndarray:
+        gd = cm.geometry.createData()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)
+            for r in gd.distanceRequests:
+                r.enable_signed_distance, r.enable_cached_gjk_guess = True, False
+                r.gjk_tolerance = r.epa_tolerance = rtol * delta.characteristic_length
+        pin.computeDistances(delta.model, delta.data, cm.geometry, gd, q)
+        return np.array([r.min_distance for r in gd.distanceResults])
+
+    assert plain(GJK_RTOL).min() < -1e300  # (the failure this guards against)
+    loose = plain(1e-9)
+    c = pkm.clearance(delta, q)
+    k = cm.pairs.index(("base", "forearm_2"))
+    assert abs(c.pairs[("base", "forearm_2")] - loose[cm.pair_of == k].min()) <= 1e-9
+    assert clearance_map(delta, q[None])[0] == c.minimum > 0.05

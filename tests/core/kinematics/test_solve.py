@@ -334,7 +334,7 @@ def test_a_failure_carries_its_problem_whose_jacobian_is_the_derivative_of_its_r
 def test_a_solve_reports_interference_only_when_asked(delta):
     """collisions=True: the Gough-Stewart with 9.5 cm legs turned 1.2 rad interferes (its legs cross by 0.8 mm), at
     the reference it does not; the clearance is pkm.clearance's minimum; not asked, None; a mechanism without
-    collision geometry refuses the question."""
+    collision geometry (the Delta's URDF without its collision elements) refuses the question."""
     from pkm.errors import NoCollisionGeometryError
 
     thick = pkm.build("gough_stewart", cylinder_radius=0.095, rod_radius=0.095)
@@ -344,5 +344,8 @@ def test_a_solve_reports_interference_only_when_asked(delta):
     for res in (turned, home):
         assert res.clearance == pkm.clearance(thick, res.q).minimum
     assert solve_ik(thick, {"yaw": 1.2}).clearance is None
+    from tests.core.collision.test_clearance import _without_collisions
+
+    bare = pkm.from_strings(_without_collisions(delta.urdf), delta.spec)
     with pytest.raises(NoCollisionGeometryError):
-        close_loops(delta, delta.actuated_q(delta.q_reference), collisions=True)
+        close_loops(bare, bare.actuated_q(bare.q_reference), collisions=True)
