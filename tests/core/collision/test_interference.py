@@ -89,14 +89,21 @@ def test_the_interference_free_area_beside_the_limits_only_area_equals_an_indepe
     np.testing.assert_array_equal(m.feasible.ravel(), free)
 
 
-def test_a_map_marks_interference_only_where_asked_and_where_there_is_geometry(thick, tmp_path):
-    """collisions=False leaves the interference out (the same reach); unreached nodes' clearance is NaN; the CSV
-    carries the three columns; the first interfering configuration of a sequence names its pair."""
+def test_a_map_marks_interference_only_where_asked_and_where_there_is_geometry(thick, tmp_path, monkeypatch):
+    """collisions=False leaves the interference out (the same reach), as a grid larger than COLLISION_NODES does
+    unless collisions=True; unreached nodes' clearance is NaN; the CSV carries the three columns; the first
+    interfering configuration of a sequence names its pair."""
+    from pkm.core.analysis import maps
+
     c, _, m = thick
     mech = c.mechanism
     again = pkm.workspace_map(mech, dict(m.axes), {"yaw": 1.0}, length=0.5, kernels=c.kernels, collisions=False)
     assert again.clearance is None and again.interferes is None and again.within_limits is None
     np.testing.assert_array_equal(again.reachable, m.reachable)
+    monkeypatch.setattr(maps, "COLLISION_NODES", 24)  # (the grid has 25)
+    assert pkm.workspace_map(mech, dict(m.axes), {"yaw": 1.0}, length=0.5, kernels=c.kernels).clearance is None
+    forced = pkm.workspace_map(mech, dict(m.axes), {"yaw": 1.0}, length=0.5, kernels=c.kernels, collisions=True)
+    np.testing.assert_array_equal(forced.clearance, m.clearance)
     assert np.isnan(np.where(m.reachable, np.nan, m.clearance)).all()
     header = m.write_csv(tmp_path / "m.csv").read_text().splitlines()[0].split(",")
     assert header[-3:] == ["clearance", "within_limits", "interferes"]

@@ -64,6 +64,9 @@ CONTACT_RTOL = 1e-4
 GJK_RTOL = 1e-12
 #: coal answers a pair whose GJK failed with ``-DBL_MAX``; a distance at or below this [m] is that failure.
 FAILED = -1e300
+#: The tolerances (times the characteristic length) a pair whose GJK failed at :data:`GJK_RTOL` is computed again at,
+#: in turn (the 3-RRR's crossing distal cylinders converge at 1e-6 of the size only: 12 mm deep to 1e-6 m).
+FALLBACK_RTOLS = (1e-9, 1e-6)
 #: The primitive shapes ``<collision>`` elements state and their attributes.
 PRIMITIVES: dict[str, tuple[tuple[str, int], ...]] = {
     "box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)), "capsule": (("radius", 1), ("length", 1)),
@@ -411,10 +414,11 @@ class CollisionModel:
     def compute(self, q: np.ndarray) -> int:
         """Every collision pair's signed distance at ``q`` (nq, not checked) into :attr:`data`'s results; the index
         of the closest pair. Where coal's GJK fails on a pair (it answers ``-DBL_MAX``: the Delta's base disc and a
-        forearm 5 mm thick at 1e-12 of the size), that pair again with Nesterov's acceleration, which converges.
+        forearm 5 mm thick at 1e-12 of the size), that pair again with Nesterov's acceleration, then at each of
+        :data:`FALLBACK_RTOLS` of the size (plain, then accelerated), until one converges.
 
         Raises:
-            NonFiniteError: a pair fails both ways (named).
+            NonFiniteError: a pair fails every way (named).
         """
         gd, model, data, gm = self.data, self.mech.model, self.mech.data, self.geometry
         results = gd.distanceResults
@@ -423,20 +427,26 @@ class CollisionModel:
             return int(k)
         import coal  # type: ignore[import-untyped]
 
+        L, tol = self.mech.characteristic_length, GJK_RTOL * self.mech.characteristic_length
+        nesterov, plain = coal.GJKVariant.NesterovAcceleration, coal.GJKVariant.DefaultGJK
         bad = [i for i, r in enumerate(results) if not r.min_distance > FAILED]
-        for i in bad:
-            gd.distanceRequests[i].gjk_variant = coal.GJKVariant.NesterovAcceleration
         try:
-            k = pin.computeDistances(model, data, gm, gd, q)
+            for variant, rtol in ((nesterov, GJK_RTOL), *((v, t) for t in FALLBACK_RTOLS for v in (plain, nesterov))):
+                for i in bad:
+                    r = gd.distanceRequests[i]
+                    r.gjk_variant, r.gjk_tolerance, r.epa_tolerance = variant, rtol * L, rtol * L
+                k = pin.computeDistances(model, data, gm, gd, q)
+                if results[k].min_distance > FAILED:
+                    return int(k)
         finally:
             for i in bad:
-                gd.distanceRequests[i].gjk_variant = coal.GJKVariant.DefaultGJK
-        if not results[k].min_distance > FAILED:
-            pair = gm.collisionPairs[k]
-            raise NonFiniteError(f"the distance of {gm.geometryObjects[pair.first].name} and "
-                                 f"{gm.geometryObjects[pair.second].name}", results[k].min_distance,
-                                 "coal's GJK failed with and without Nesterov's acceleration")
-        return int(k)
+                r = gd.distanceRequests[i]
+                r.gjk_variant, r.gjk_tolerance, r.epa_tolerance = plain, tol, tol
+        pair = gm.collisionPairs[k]
+        raise NonFiniteError(f"the distance of {gm.geometryObjects[pair.first].name} and "
+                             f"{gm.geometryObjects[pair.second].name}", results[k].min_distance,
+                             f"coal's GJK failed at {GJK_RTOL:g} and {FALLBACK_RTOLS} of the size, with and without "
+                             "Nesterov's acceleration")
 
     def distances(self, q: np.ndarray) -> np.ndarray:
         """The signed distance [m] of each of ``geometry``'s collision pairs at ``q`` (nq, not checked; as
