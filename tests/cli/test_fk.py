@@ -34,3 +34,21 @@ def test_fk_and_ik_all_print_every_mode_and_the_sets_account():
     ik = json.loads(run("ik", "prs3", "--pose", "z=90cm", "pitch=3deg", "--all").stdout)
     assert ik["complete"] and len(ik["modes"]) == 8
     assert all(abs(m["task"]["z"] - 0.9) < 1e-9 for m in ik["modes"])
+    assert all(m["interferes"] == (m["clearance"] < 0.0) for m in ik["modes"])  # (its links' collision geometry)
+
+
+def test_ik_all_says_which_modes_interfere(capsys):
+    """``pkm ik gough_stewart --all`` at the reference pose (its legs written as capsules): each mode's clearance and
+    whether it interferes, the library's (1e-12 m: the pose read back from its angles), in process."""
+    import pkm
+    from pkm import cli
+
+    pytest.importorskip("bertini")
+    assert cli.main(["ik", "gough_stewart", "--pose", "x=0", "--all"]) == 0
+    modes = json.loads(capsys.readouterr().out)["modes"]
+    gs = pkm.load("gough_stewart")
+    expected = pkm.working_modes(gs, pkm.TaskMap.of(gs).value(gs.q_reference))
+    assert all(m["interferes"] == (m["clearance"] < 0.0) for m in modes)
+    np.testing.assert_allclose(sorted(m["clearance"] for m in modes), sorted(m.clearance for m in expected), rtol=0,
+                               atol=1e-12)  # (as sets: modes equally far from the reference come in either order)
+    assert 0 < sum(m["interferes"] for m in modes) < len(modes) == 64

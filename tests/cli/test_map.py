@@ -70,3 +70,21 @@ def test_the_map_starts_from_the_seed_given(monkeypatch):
     want = mech.q_reference.copy()
     want[mech.joints["elbow_2"].idx_q] = np.radians(-40.0)
     assert np.array_equal(got.value.args[0], want)
+
+
+def test_the_map_of_a_mechanism_with_collision_geometry_marks_interference(tmp_path, capsys):
+    """The Gough-Stewart with 9.5 cm legs turned 1 rad (in process, 5 x 5): the summary's counts are the CSV's
+    (within the limits, interfering, free of both), the figure passes the check with its marks in the legend."""
+    args = ["map", "gough_stewart", "--param", "cylinder_radius=9.5cm", "rod_radius=9.5cm", "--axis",
+              "x=-15cm:15cm:5", "--axis", "y=-15cm:15cm:5", "--pose", "yaw=1", "--length", "0.5"]
+    with inspected(paper=False) as found:
+        assert cli.main([*args, "--png", str(tmp_path / "m.png"), "--csv", str(tmp_path / "m.csv")]) == 0
+    assert found == {"m": []}
+    out = json.loads(capsys.readouterr().out)["interference"]
+    rows = [r for r in csv.DictReader((tmp_path / "m.csv").open()) if r["reachable"] == "1"]
+    inside = [r for r in rows if r["within_limits"] == "1"]
+    free = [r for r in inside if r["interferes"] == "0"]
+    assert (out["within_limits"], out["interference_free_within_limits"]) == (len(inside), len(free)) == (20, 7)
+    assert out["interfering"] == sum(float(r["clearance"]) < 0.0 for r in rows) > 0
+    assert math.isclose(out["size_interference_free_SI"], 7 * 0.075 ** 2, rel_tol=1e-12)
+    assert out["smallest_clearance_m"] == min(float(r["clearance"]) for r in rows)

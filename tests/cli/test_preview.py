@@ -23,6 +23,18 @@ def test_preview_writes_html_and_refuses_an_unknown_mechanism(tmp_path):
     assert page.stat().st_size > 1000 and "<html" in page.read_text()[:1000].lower()
 
 
+def test_preview_marks_interference_unless_told_not_to(tmp_path, capsys):
+    """``pkm preview`` of the Gough-Stewart with 9.5 cm legs turned 1.2 rad (in process): the page's legend names the
+    crossing rods; with --no-collisions it does not."""
+    from pkm import cli
+
+    args = ["preview", "gough_stewart", "--param", "cylinder_radius=9.5cm", "rod_radius=9.5cm", "--pose", "yaw=1.2"]
+    assert cli.main([*args, "--html", str(tmp_path / "a.html")]) == 0
+    assert cli.main([*args, "--no-collisions", "--html", str(tmp_path / "b.html")]) == 0
+    assert "rod_1 and rod_6 interpenetrate by" in (tmp_path / "a.html").read_text()
+    assert "interpenetrate" not in (tmp_path / "b.html").read_text()
+
+
 def test_preview_opens_the_viewer_at_given_joints_and_returns_with_no_wait():
     """``pkm preview delta --joints motor_1=-50deg --no-wait`` starts a meshcat viewer, prints its URL and exits 0;
     an unknown joint exits 2 before any viewer starts."""

@@ -64,7 +64,8 @@ def solution_dict(mech: pkm.Mechanism, res: pkm.SolveResult, **extra) -> dict[st
 
 
 def modes_dict(mech: pkm.Mechanism, modes, **extra) -> dict[str, Any]:
-    """What ``ik --all`` and ``fk --all`` print: every mode by name, in SI, and the set's account."""
+    """What ``ik --all`` and ``fk --all`` print: every mode by name, in SI, and the set's account; where the
+    mechanism has collision geometry, each mode's ``clearance`` [m] and whether it ``interferes``."""
     return jsonable({
         "mechanism": mech.name, "units": {"length": "m", "angle": "rad"}, **extra,
         "complete": modes.complete, "summary": modes.summary(), "method": modes.method, "paths": modes.n_paths,
@@ -75,6 +76,7 @@ def modes_dict(mech: pkm.Mechanism, modes, **extra) -> dict[str, Any]:
                    "task": task_values(mech, m.q), "residual": m.residual, "alpha": m.certificate.alpha,
                    "certified_within": m.certificate.radius if m.certificate.certified else None,
                    "outside_limits": outside_limits(mech, m.q),
+                   **({} if m.clearance is None else {"clearance": m.clearance, "interferes": m.interferes}),
                    "branch": _branch_of(mech, m.q) if mech.spec.branches else None,
                    "mode": pkm.mode_label(mech, m.q).as_dict()} for m in modes],
     })

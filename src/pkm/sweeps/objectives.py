@@ -331,9 +331,11 @@ def _task_value(mech, name: str, text: str) -> float:
 KEEP_CONFIGURATIONS = 100_000
 
 
-def _generic_map(c: Candidate, o: Mapping[str, Any], configurations: bool = False):
+def _generic_map(c: Candidate, o: Mapping[str, Any], configurations: bool = False, collisions: bool = False):
     """The :func:`pkm.workspace_map` of the design over ``region`` (cached per design and region), through the
-    design's kernels (:attr:`Candidate.kernels`: one compiled twin for every design of a family that has one)."""
+    design's kernels (:attr:`Candidate.kernels`: one compiled twin for every design of a family that has one); with
+    ``collisions``, its interference too where the design has collision geometry (the other objectives' maps leave
+    it out: no cost where it is not asked for)."""
     if not o.get("region"):
         raise InvalidInputError("region", "the generic route maps a region: give region=x=START:STOP:COUNT/...")
     nodes = int(np.prod([k for _, _, k in o["region"].values()]))
@@ -346,14 +348,21 @@ def _generic_map(c: Candidate, o: Mapping[str, Any], configurations: bool = Fals
                 for n, (a, b, k) in o["region"].items()}
         fixed = {n: _task_value(mech, n, v) for n, v in (o.get("pose") or {}).items()}
         return workspace_map(mech, axes, fixed, length=o.get("length"), branch=o.get("branch") or None,
-                             kernels=c.kernels, configurations=configurations or nodes <= KEEP_CONFIGURATIONS)
+                             kernels=c.kernels, configurations=configurations or nodes <= KEEP_CONFIGURATIONS,
+                             collisions=collisions)
 
     key = _map_key(o)
     found = c.cached(key, make)
-    if configurations and found.q is None:  # (a large map made without them for another objective)
-        c.forget(key)
+    if (configurations and found.q is None) or (collisions and found.clearance is None and _collides(c)):
+        c.forget(key)  # (a large map made without them, or one made without interference, for another objective)
         found = c.cached(key, make)
     return found
+
+
+def _collides(c: Candidate) -> bool:
+    from pkm.core.collision.interference import checks_collisions
+
+    return checks_collisions(c.mechanism)
 
 
 def _map_key(o: Mapping[str, Any]) -> tuple:
@@ -412,6 +421,23 @@ def _generic_min_ci(c, o):
 
 def _generic_volume(c, o):
     return float(_generic_map(c, o).size)
+
+
+def _limits_volume(c, o):
+    m = _generic_map(c, o, configurations=True)
+    assert m.within_limits is not None  # (the configurations kept: the limits checked)
+    return float(m.measure(m.reachable & m.within_limits))
+
+
+def _interference_free_volume(c, o):
+    """The reachable size within the joints' limits where no two checked bodies interpenetrate (the map's
+    :attr:`~pkm.core.analysis.maps.WorkspaceMap.feasible`); a design without collision geometry is refused: its
+    value would be the limits' alone, said as if checked."""
+    from pkm.core.collision import CollisionModel
+
+    CollisionModel.of(c.mechanism).require()
+    m = _generic_map(c, o, configurations=True, collisions=True)
+    return float(m.measure(m.feasible))
 
 
 def _generic_conditioned_volume(c, o):
@@ -527,6 +553,11 @@ OBJECTIVES: dict[str, Definition] = {d.name: d for d in (
                _MAP, _generic_min_ci),
     Definition("workspace_volume", "max", _REGION_UNIT, "reachable length, area or volume (generic: of the region)",
                _MAP, _generic_volume),
+    Definition("limits_volume", "max", _REGION_UNIT, "reachable length, area or volume within the joints' stated "
+               "position limits (generic: of the region)", _MAP, _limits_volume),
+    Definition("interference_free_volume", "max", _REGION_UNIT, "reachable size within the joints' limits where no "
+               "two bodies interpenetrate (collision geometry needed; beside limits_volume)", _MAP,
+               _interference_free_volume),
     Definition("conditioned_volume", "max", _REGION_UNIT, "volume of the reachable nodes with kappa <= k_max",
                {**_MAP, "k_max": ("float", 3.0, "bound on kappa", 1.0)}, _generic_conditioned_volume),
     Definition("weighted_volume", "max", _REGION_UNIT, "integral of 1/kappa over the workspace (volume x GCI)",

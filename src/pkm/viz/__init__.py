@@ -25,6 +25,10 @@ closure spec say:
 * the world and end-effector frames as triads (x red, y green, z blue);
 * each closure as a small white sphere on ``frame_a`` inside a translucent bubble on
   ``frame_b``: the two are concentric when the loop is closed.
+* where the mechanism has collision geometry (:mod:`pkm.core.collision`), at one configuration: the links of
+  every pair of bodies that interpenetrate in red, with their witness points (a sphere each, a bar between), or,
+  where none does, the closest pair's witness points in black, each said in the legend with its distance
+  (:mod:`~pkm.viz.interference`; ``collisions=False``: not).
 
 The page of :func:`snapshot_html` carries a legend of these colours (:meth:`Scene.legend`).
 
@@ -47,6 +51,7 @@ Modules: :mod:`~pkm.viz.colors` (the palette), :mod:`~pkm.viz.body` (one drawn p
 :mod:`~pkm.viz.hull` (convex hulls), :mod:`~pkm.viz.bodies` (the bodies of a mechanism),
 :mod:`~pkm.viz.scene` (:class:`Scene`), :mod:`~pkm.viz.encode` (meshcat commands),
 :mod:`~pkm.viz.page` (the HTML page), :mod:`~pkm.viz.viewer` (the live viewer),
+:mod:`~pkm.viz.interference` (the interference marks),
 :mod:`~pkm.viz.backend` (meshcat, imported on first use), :mod:`~pkm.viz.simulation` (the figure of a
 simulation: positions, speeds, efforts, energy).
 """

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import base64
+import dataclasses
 import json
 import math
 import uuid
@@ -16,6 +17,7 @@ from pkm.errors import InvalidInputError
 from pkm.viz.backend import load_meshcat
 from pkm.viz.body import Body
 from pkm.viz.colors import BACKGROUND
+from pkm.viz.interference import interference_marks
 from pkm.viz.scene import Scene
 
 FPS = 30.0
@@ -73,7 +75,8 @@ def _primitive(mc, body: Body):
     return obj
 
 
-def scene_commands(scene: Scene, q=None, *, trajectory=None, times=None, loop: bool = True) -> list:
+def scene_commands(scene: Scene, q=None, *, trajectory=None, times=None, loop: bool = True,
+                   collisions: bool = True) -> list:
     """The meshcat commands that draw ``scene`` at ``q`` and, optionally, animate a trajectory.
 
     Args:
@@ -82,6 +85,9 @@ def scene_commands(scene: Scene, q=None, *, trajectory=None, times=None, loop: b
         trajectory: Configurations to animate, (N, nq), or None.
         times: Time of each configuration [s], (N,), strictly increasing; default ``arange(N) / 30``.
         loop: Whether the animation repeats forever (else it plays once).
+        collisions: At one configuration (no trajectory), where the mechanism has collision geometry, colour the
+            bodies that interpenetrate and mark the witness points (:func:`~pkm.viz.interference.interference_marks`);
+            False: not.
 
     Returns:
         A list of ``meshcat.commands`` objects (``SetProperty``, ``SetTransform``, ``SetObject``,
@@ -89,7 +95,7 @@ def scene_commands(scene: Scene, q=None, *, trajectory=None, times=None, loop: b
         moved to the mechanism's z = 0 plane should it be shown again, the mechanism's node
         shifted so that its centre sits at meshcat's origin, where the camera looks, and the
         camera placed to frame it), then one ``SetObject`` and one ``SetTransform`` per body
-        (its world placement, under that node), then the animation.
+        (its world placement, under that node), then the interference marks, then the animation.
     """
     mc, _ = load_meshcat()
     mech = scene.mechanism
@@ -120,7 +126,13 @@ def scene_commands(scene: Scene, q=None, *, trajectory=None, times=None, loop: b
                                 meshcat_path(mc, "/Cameras/default/rotated/<object>")),
         mc.commands.SetTransform(shift, meshcat_path(mc, scene.root)),
     ]
-    for body, m in zip(scene.bodies, scene.transforms(q).values()):
+    marks = interference_marks(scene, q) if collisions and traj is None else None
+    colors = {} if marks is None else marks.colors
+    placed = list(zip(scene.bodies, scene.transforms(q).values()))
+    placed += [(b, b.offset) for b in (marks.bodies if marks is not None else ())]  # (on the world frame)
+    for body, m in placed:
+        if body.path in colors:
+            body = dataclasses.replace(body, color=colors[body.path])
         cmds.append(mc.commands.SetObject(_primitive(mc, body), path=meshcat_path(mc, body.path)))
         cmds.append(mc.commands.SetTransform(m, meshcat_path(mc, body.path)))
     if traj is not None:

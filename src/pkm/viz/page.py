@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import html
 import json
+from collections.abc import Iterable
 from pathlib import Path
 
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError
 from pkm.viz.backend import VizDependencyError, load_meshcat
 from pkm.viz.encode import pack_commands, scene_commands
+from pkm.viz.interference import interference_marks
 from pkm.viz.scene import Scene
 
 _PAGE = """<!DOCTYPE html>
@@ -65,7 +67,7 @@ def _viewer_js(mc) -> str:
 
 
 def snapshot_html(mech: Mechanism, q=None, *, trajectory=None, times=None, loop: bool = True,
-                  legend: bool = True) -> str:
+                  legend: bool = True, collisions: bool = True) -> str:
     """A self-contained HTML page showing ``mech`` at ``q``, and animating ``trajectory`` if given.
 
     The page inlines meshcat's viewer and carries the drawing commands itself; it needs no
@@ -78,6 +80,9 @@ def snapshot_html(mech: Mechanism, q=None, *, trajectory=None, times=None, loop:
         times: Time of each configuration [s], (N,); default 30 configurations per second.
         loop: Whether the animation repeats forever.
         legend: Whether the page shows the legend of the colours (:meth:`Scene.legend`) in its lower left corner.
+        collisions: At one configuration (no trajectory), where the mechanism has collision geometry, colour the
+            bodies that interpenetrate and mark the witness points, said in the legend with their distance
+            (:mod:`pkm.viz.interference`); False: not.
 
     Returns:
         The HTML text. The commands are a JSON list of base64 strings in the element
@@ -89,16 +94,21 @@ def snapshot_html(mech: Mechanism, q=None, *, trajectory=None, times=None, loop:
     """
     mc, _ = load_meshcat()
     scene = Scene.from_mechanism(mech)
-    packed = pack_commands(scene_commands(scene, q, trajectory=trajectory, times=times, loop=loop))
+    packed = pack_commands(scene_commands(scene, q, trajectory=trajectory, times=times, loop=loop,
+                                          collisions=collisions))
+    marks = None
+    if collisions and trajectory is None:
+        marks = interference_marks(scene, mech.check_q(mech.q_reference if q is None else q))
     return _PAGE.format(title=html.escape(f"pkm: {mech.name}"), viewer_js=_viewer_js(mc),
-                        legend=_legend_html(scene) if legend else "",
+                        legend=_legend_html(scene, marks.legend if marks is not None else ()) if legend else "",
                         commands="[\n" + ",\n".join(json.dumps(p) for p in packed) + "\n]")
 
 
-def _legend_html(scene: Scene) -> str:
-    """The ``<div id="pkm-legend">`` listing :meth:`Scene.legend`: a swatch and a label per colour."""
+def _legend_html(scene: Scene, extra: Iterable[tuple[str, tuple[int, ...]]] = ()) -> str:
+    """The ``<div id="pkm-legend">`` listing :meth:`Scene.legend` (then ``extra``): a swatch and a label per
+    colour."""
     rows = "".join("<div>" + "".join(f'<i style="background:#{c:06x}"></i>' for c in colors)
-                   + f"{html.escape(label)}</div>" for label, colors in scene.legend())
+                   + f"{html.escape(label)}</div>" for label, colors in [*scene.legend(), *extra])
     return f'<div id="pkm-legend"><b>{html.escape(scene.mechanism.name)}</b>{rows}</div>'
 
 

@@ -14,7 +14,7 @@ from pkm.viz.encode import check_trajectory, meshcat_path, scene_commands
 from pkm.viz.scene import Scene
 
 
-def show(mech: Mechanism, q=None, *, trajectory=None, times=None, vis=None):
+def show(mech: Mechanism, q=None, *, trajectory=None, times=None, vis=None, collisions: bool = True):
     """Draw ``mech`` at ``q`` (and animate ``trajectory``) in a live meshcat viewer.
 
     Args:
@@ -23,6 +23,8 @@ def show(mech: Mechanism, q=None, *, trajectory=None, times=None, vis=None):
         trajectory: Configurations to animate, (N, nq), or None.
         times: Time of each configuration [s], (N,); default 30 configurations per second.
         vis: A ``meshcat.Visualizer``; None starts one (a meshcat server process; open ``vis.url()``).
+        collisions: At one configuration, colour the bodies that interpenetrate and mark the witness points
+            (:func:`~pkm.viz.encode.scene_commands`).
 
     Returns:
         The visualizer. The mechanism is drawn under ``<vis path>/pkm``, replacing an earlier drawing.
@@ -35,7 +37,7 @@ def show(mech: Mechanism, q=None, *, trajectory=None, times=None, vis=None):
             vis = meshcat.visualizer.Visualizer()
     root = vis.path.append("pkm")
     scene = Scene.from_mechanism(mech, root=root.lower())
-    cmds = scene_commands(scene, q, trajectory=trajectory, times=times)
+    cmds = scene_commands(scene, q, trajectory=trajectory, times=times, collisions=collisions)
     vis.window.send(mc.commands.Delete(root))
     for c in cmds:
         vis.window.send(c)
@@ -53,7 +55,7 @@ class Viewer:
 
     def __init__(self, mech: Mechanism, vis=None):
         self.mech = mech
-        self.vis = show(mech, vis=vis)
+        self.vis = show(mech, vis=vis, collisions=False)  # (display() moves the bodies: marks would stay behind)
         self.scene = Scene.from_mechanism(mech, root=self.vis.path.append("pkm").lower())  # where show() drew it
 
     def url(self) -> str:

@@ -289,3 +289,16 @@ def test_friction_on_a_free_base_balances_the_energy():
     assert run.event is None and np.all(np.diff(run.dissipated) > 0.0)
     balance = run.energy - run.energy[0] - run.work + run.dissipated
     assert np.abs(balance).max() <= 1e-3 * run.dissipated[-1]
+
+
+def test_a_simulation_carries_its_interference():
+    """A Simulation is a Trajectory: the Gough-Stewart with 9.5 cm legs left to fall from a pose turned 1.2 rad, whose
+    rods cross, has each sample's clearance (clearance_map's) and the first interfering sample named; the energies
+    keep their own fields (5 samples)."""
+    from pkm.core.collision import clearance_map
+
+    thick = pkm.build("gough_stewart", cylinder_radius=0.095, rod_radius=0.095)
+    sim = pkm.simulate(thick, q0=pkm.solve_ik(thick, {"yaw": 1.2}).q, duration=0.004, dt=0.001)
+    np.testing.assert_array_equal(sim.clearance, clearance_map(thick, sim.q))
+    assert sim.interference.at == 0 and sim.interference.distance == sim.clearance[0] < 0.0
+    np.testing.assert_allclose(sim.time, [0.0, 0.001, 0.002, 0.003, 0.004], rtol=0, atol=1e-15)

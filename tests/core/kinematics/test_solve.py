@@ -329,3 +329,23 @@ def test_a_failure_carries_its_problem_whose_jacobian_is_the_derivative_of_its_r
     assert isinstance(err.problem, ClosureProblem) and np.allclose(err.problem.q_actuated, [-0.7, -0.4, 0.2])
     closure_part = err.problem.residual(err.result.q)[:short.n_constraints]
     assert np.abs(closure_part).max() == pytest.approx(err.result.residual, rel=1e-9)
+
+
+def test_a_solve_reports_interference_only_when_asked(delta):
+    """collisions=True: the Gough-Stewart with 9.5 cm legs turned 1.2 rad interferes (its legs cross by 0.8 mm), at
+    the reference it does not; the clearance is pkm.clearance's minimum; not asked, None; a mechanism without
+    collision geometry (the Delta's URDF without its collision elements) refuses the question."""
+    from pkm.errors import NoCollisionGeometryError
+
+    thick = pkm.build("gough_stewart", cylinder_radius=0.095, rod_radius=0.095)
+    turned = solve_ik(thick, {"yaw": 1.2}, collisions=True)
+    home = close_loops(thick, thick.actuated_q(thick.q_reference), collisions=True)
+    assert turned.interferes and -1e-3 < turned.clearance < 0.0 and not home.interferes and home.clearance > 0.0
+    for res in (turned, home):
+        assert res.clearance == pkm.clearance(thick, res.q).minimum
+    assert solve_ik(thick, {"yaw": 1.2}).clearance is None
+    from tests.core.collision.test_clearance import _without_collisions
+
+    bare = pkm.from_strings(_without_collisions(delta.urdf), delta.spec)
+    with pytest.raises(NoCollisionGeometryError):
+        close_loops(bare, bare.actuated_q(bare.q_reference), collisions=True)

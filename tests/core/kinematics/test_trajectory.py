@@ -107,3 +107,20 @@ def test_a_motion_across_the_position_limits_names_each_joint_where_it_first_lea
         assert v.value == traj.q[k, ankle.joints[joint].idx_q] and not v.limit[0] <= v.value <= v.limit[1]
         assert joint in ankle.outside_limits(traj.q[k]) and joint not in ankle.outside_limits(traj.q[k - 1])
     assert pkm.follow_task(ankle, y * 0.5, efforts=False).outside_limits == ()
+
+
+def test_a_motion_into_interference_names_the_first_sample_and_the_pair(knee):
+    """The Gough-Stewart with 9.5 cm legs turning from 0 to 1.2 rad of yaw in 7 samples: each sample's clearance is
+    pkm.clearance's minimum, the first negative one is named with its pair and depth; a mechanism without collision
+    geometry has none (None)."""
+    thick = pkm.build("gough_stewart", cylinder_radius=0.095, rod_radius=0.095)
+    task = pkm.TaskMap.of(thick)
+    y = np.array([task.value(pkm.solve_ik(thick, {"yaw": yaw}).q) for yaw in np.linspace(0.0, 1.2, 7)])
+    traj = pkm.follow_task(thick, y, efforts=False)
+    minima = [pkm.clearance(thick, q) for q in traj.q]
+    np.testing.assert_allclose(traj.clearance, [c.minimum for c in minima], rtol=0, atol=1e-12)
+    k = next(i for i, c in enumerate(minima) if c.interferes)
+    assert 0 < k < 7 and traj.interference.at == k and traj.interference.pair == minima[k].closest
+    assert traj.interference.distance == pytest.approx(minima[k].minimum, abs=1e-12)
+    plain = pkm.follow_actuators(knee, np.array([knee.actuated_q(knee.q_reference)] * 2), efforts=False)
+    assert plain.clearance is None and plain.interference is None

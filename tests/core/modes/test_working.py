@@ -41,12 +41,17 @@ def test_prs3_working_modes_are_the_closed_forms_sliders():
     assert got == want
 
 
-def test_the_gough_stewarts_working_modes_include_negative_lengths_marked_outside_the_limits():
+def test_the_gough_stewarts_working_modes_include_negative_lengths_marked_outside_the_limits_and_interference():
     mech = pkm.load("gough_stewart")
     modes = pkm.working_modes(mech, pkm.TaskMap.of(mech).value(mech.q_reference))
     inside = [m for m in modes if not m.outside_limits]
     assert len(modes) == 64 and len(inside) == 1
     assert np.allclose(mech.actuated_q(inside[0].q), mech.actuated_q(mech.q_reference), atol=1e-12)
+    # each mode's clearance (legs written as capsules) is pkm.clearance's; the machine's own mode is free, legs
+    # pointing down through the base cross others
+    assert all(m.clearance == pytest.approx(pkm.clearance(mech, m.q).minimum, abs=1e-12) for m in modes)
+    assert inside[0].label not in modes.interfering and 0 < len(modes.interfering) < 64
+    assert modes.interfering == tuple(m.label for m in modes if pkm.clearance(mech, m.q).interferes)
 
 
 def test_a_tracked_assembly_mode_stops_where_it_meets_another():

@@ -111,3 +111,31 @@ def test_the_compiled_route_equals_the_core_on_the_delta(delta):
     compiled = pkm.verify_time_optimal(line, factor=1, simulate=False, kernels=pkm.Kernels(delta, compiled=False))
     _same(compiled, core)
     assert len(core.inactive) == 1 and compiled.route.startswith("kernels")
+
+
+def test_a_plan_through_interference_does_not_hold(ankle):
+    """The ankle as shipped: its plan to 0.8 rad of pitch (limits lifted) keeps 7.5 mm between the rods and the
+    shank, the smallest distance over the check points reported; with the shank's capsule 12 mm thicker (37 mm) the
+    rods cut into it on the way: holds is False, the first check point and the pair named, the depth pkm.clearance's
+    there."""
+    import copy
+
+    from pkm.core.collision import CollisionModel
+
+    free = copy.copy(ankle)
+    free.limits = {}
+    check = pkm.verify_time_optimal(pkm.time_optimal(free, PITCH, points=8), factor=1, simulate=False)
+    assert check.holds and check.clearance == pytest.approx(0.00747690, abs=1e-7)
+    urdf = ankle.urdf.replace('<capsule radius="0.025"', '<capsule radius="0.037"')
+    thick = pkm.from_strings(urdf, ankle.spec)
+    thick.limits = {}
+    assert ("rod_left", "shank") in CollisionModel.of(thick).pairs  # (6 mm apart at the reference: checked)
+    check = pkm.verify_time_optimal(pkm.time_optimal(thick, PITCH, points=8), factor=1, simulate=False)
+    assert not check.holds and check.clearance < -1e-3
+    k = int(np.argmax(np.isclose(check.s, float(check.reason.split("at s = ")[1]))))
+    q = pkm.solve_ik(thick, [PITCH[-1, 0] * check.s[k], 0.0]).q
+    c = pkm.clearance(thick, q)
+    assert check.reason.startswith(f"bodies interpenetrate: {c.closest[0]} and {c.closest[1]} by "
+                                   f"{-c.minimum:.6g} m at s = ")
+    assert c.interferes and not pkm.clearance(thick, pkm.solve_ik(thick, [PITCH[-1, 0] * check.s[k - 1], 0.0]).q) \
+        .interferes

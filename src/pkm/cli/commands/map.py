@@ -5,13 +5,20 @@ with ``--index``, the capability under actuator limits at every reachable node a
 (:func:`pkm.core.analysis.capability.map_capability`: the largest value along each task axis each way and the
 largest isotropic value per unit; the PNG and CSV are then the capability's); with ``--stiffness``, the principal
 stiffnesses (and with ``--frequency`` the first natural frequency) at every reachable node
-(:func:`pkm.core.compliance.maps.stiffness_map`; the CSV is then theirs)."""
+(:func:`pkm.core.compliance.maps.stiffness_map`; the CSV is then theirs). A mechanism with collision geometry gets its
+interference at every reachable node as well (on a grid of at most 100,000 nodes; ``--collisions``: any;
+``--no-collisions``: not): the JSON counts the nodes within the joints'
+limits and those of them free of interference (with their sizes) and gives the smallest clearance; the CSV has a
+``clearance``, ``within_limits`` and ``interferes`` column, the PNG marks the nodes outside the limits and those
+that interfere."""
 
 from __future__ import annotations
 
 import argparse
 import json
 from typing import Any
+
+import numpy as np
 
 from pkm.cli.command import Command
 from pkm.cli.commands.stiffness import add_spring_arguments, springs
@@ -42,10 +49,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--png", metavar="FILE", help="draw the condition index (a 3-D map: its middle slab); with "
                                                  "--index, the largest isotropic value (1 or 2 axes)")
     p.add_argument("--csv", metavar="FILE", help="write one row per node")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--collisions", action="store_true", help="the interference of a mechanism with collision "
+                   "geometry on a grid of any size (by default on grids of at most 100,000 nodes)")
+    g.add_argument("--no-collisions", action="store_true",
+                   help="leave out the interference of a mechanism with collision geometry (its clearance per node)")
 
 
 def run(args: argparse.Namespace) -> int:
-    from pkm.core.analysis.maps import workspace_map
+    from pkm.core.analysis.maps import COLLISION_NODES, workspace_map
+    from pkm.core.collision.interference import checks_collisions
 
     mech = load_mechanism(args)
     axes = dict(parse_axis(mech, item) for item in args.axis)
@@ -62,10 +75,20 @@ def run(args: argparse.Namespace) -> int:
     if args.stiffness and args.png:
         raise UsageError("--stiffness writes its CSV (--csv), no figure yet")
     m = workspace_map(mech, axes, fixed, branch=args.branch, length=length, seed=parse_seed(mech, args.q0),
-                      configurations=bool(args.index or args.stiffness))
+                      configurations=bool(args.index or args.stiffness),
+                      collisions=True if args.collisions else False if args.no_collisions else None)
     out: dict[str, Any] = {"mechanism": mech.name, "axes": {n: [float(v[0]), float(v[-1]), len(v)] for n, v in m.axes},
                            "nodes": int(m.reachable.size), "reachable": m.nodes, "size_SI": m.size, "size_unit": m.size_unit,
                            "gci_2": m.gci("2"), "gci_fro_normalized": m.gci("fro_normalized"), "how": m.how}
+    if m.clearance is not None and m.within_limits is not None and m.interferes is not None:
+        out["interference"] = {
+            "within_limits": int(m.within_limits.sum()), "size_within_limits_SI": m.measure(m.within_limits),
+            "interfering": int(m.interferes.sum()), "interference_free_within_limits": int(m.feasible.sum()),
+            "size_interference_free_SI": m.measure(m.feasible),
+            "smallest_clearance_m": float(np.nanmin(m.clearance)) if m.nodes else None}
+    elif not args.no_collisions and checks_collisions(mech):
+        out["interference"] = (f"not computed: {m.reachable.size} nodes, more than {COLLISION_NODES} (--collisions "
+                               "computes it)")
     figures: Any = m
     if args.index:
         from pkm.core.analysis.capability import map_capability

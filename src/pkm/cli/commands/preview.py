@@ -1,5 +1,7 @@
-"""``pkm preview MECH [--pose ... | --joints ...] [--html FILE] [--no-wait]``: a configuration in the live meshcat
-viewer (until Ctrl-C, SIGTERM or SIGHUP, which stop its server too) or as a self-contained HTML page."""
+"""``pkm preview MECH [--pose ... | --joints ...] [--html FILE] [--no-wait] [--no-collisions]``: a configuration in
+the live meshcat viewer (until Ctrl-C, SIGTERM or SIGHUP, which stop its server too) or as a self-contained HTML page;
+a mechanism with collision geometry is shown with the bodies that interpenetrate in red and the witness points marked
+(:mod:`pkm.viz.interference`; ``--no-collisions``: not)."""
 
 from __future__ import annotations
 
@@ -16,6 +18,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_mechanism_arguments(p, "optional", "optional")
     p.add_argument("--html", metavar="FILE", help="write a self-contained HTML scene instead of opening the viewer")
     p.add_argument("--no-wait", action="store_true", help="return once the viewer is up instead of waiting for Ctrl-C")
+    p.add_argument("--no-collisions", action="store_true",
+                   help="leave out the interference marks of a mechanism with collision geometry")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -24,10 +28,10 @@ def run(args: argparse.Namespace) -> int:
     from pkm import viz
 
     if args.html:
-        path = viz.write_html(args.html, mech, q)
+        path = viz.write_html(args.html, mech, q, collisions=not args.no_collisions)
         print(f"wrote {path}")
         return 0
-    vis = viz.show(mech, q)
+    vis = viz.show(mech, q, collisions=not args.no_collisions)
     if args.no_wait:
         print(f"viewer: {vis.url()}", flush=True)
         return 0  # the server stops with this process (meshcat's atexit hook)

@@ -152,6 +152,8 @@ def clearance_map(mech: Mechanism, nodes: ArrayLike) -> np.ndarray:
         NoCollisionGeometryError: as :func:`clearance`.
         InvalidInputError: ``nodes`` not N x nq finite numbers, a coordinate beyond 1e6, a quaternion not of unit
             norm.
+        NonFiniteError: coal's GJK fails on a pair with and without Nesterov's acceleration
+            (:meth:`~pkm.core.collision.geometry.CollisionModel.compute`).
 
     Examples:
         >>> import numpy as np
@@ -177,11 +179,10 @@ def clearance_map(mech: Mechanism, nodes: ArrayLike) -> np.ndarray:
         if abs(norm[k] - 1.0) > 1e-6:
             raise InvalidInputError("nodes", f"node {k}: the quaternion of joint {name!r} has norm {norm[k]:.6g}, "
                                              "expected 1", nodes)
-    model, data, gm, gd = mech.model, mech.data, cm.geometry, cm.data
-    results = gd.distanceResults
+    results, compute = cm.data.distanceResults, cm.compute
     out = np.empty(len(Q))
-    for i, q in enumerate(Q):  # (computeDistances returns the closest pair: its result alone is read)
-        out[i] = results[pin.computeDistances(model, data, gm, gd, q)].min_distance
+    for i, q in enumerate(Q):  # (the closest pair's result alone is read)
+        out[i] = results[compute(q)].min_distance
     return out
 
 

@@ -53,7 +53,7 @@ import pinocchio as pin
 from pkm._derived import derived
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.urdf import floats, parse_xml
-from pkm.errors import NoCollisionGeometryError, PkmWarning, SpecError, UnknownNameError
+from pkm.errors import NoCollisionGeometryError, NonFiniteError, PkmWarning, SpecError, UnknownNameError
 
 #: A pair of bodies whose distance at the reference configuration is at most this times the characteristic length
 #: is in contact by design and not checked (scale-free: 0.1 mm on a robot of 1 m, 5 µm on one of 5 cm).
@@ -62,6 +62,11 @@ CONTACT_RTOL = 1e-4
 #: characteristic length (scale-free): distances to about 1e-12 of the mechanism's size (a cylinder's, which GJK
 #: approaches iteratively, to 3e-12 of it; the time is the same as at 1e-10).
 GJK_RTOL = 1e-12
+#: coal answers a pair whose GJK failed with ``-DBL_MAX``; a distance at or below this [m] is that failure.
+FAILED = -1e300
+#: The tolerances (times the characteristic length) a pair whose GJK failed at :data:`GJK_RTOL` is computed again at,
+#: in turn (the 3-RRR's crossing distal cylinders converge at 1e-6 of the size only: 12 mm deep to 1e-6 m).
+FALLBACK_RTOLS = (1e-9, 1e-6)
 #: The primitive shapes ``<collision>`` elements state and their attributes.
 PRIMITIVES: dict[str, tuple[tuple[str, int], ...]] = {
     "box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)), "capsule": (("radius", 1), ("length", 1)),
@@ -386,25 +391,68 @@ class CollisionModel:
     @property
     def data(self) -> pin.GeometryData:
         """This thread's ``GeometryData``: signed distances (negative: penetration), to :data:`GJK_RTOL` of the
-        characteristic length."""
+        characteristic length, each configuration's independent of those computed before (GJK from coal's default
+        guess, not the pair's last result)."""
         try:
             return self._local.data
         except AttributeError:
             gd = self.geometry.createData()
             tol = GJK_RTOL * self.mech.characteristic_length
-            for r in gd.distanceRequests:
-                r.enable_signed_distance = True
-                r.gjk_tolerance = tol
-                r.epa_tolerance = tol
+            with warnings.catch_warnings():  # (coal deprecates the flag for gjk_initial_guess, which it overrides)
+                warnings.simplefilter("ignore", DeprecationWarning)
+                for r in gd.distanceRequests:
+                    r.enable_signed_distance = True
+                    r.gjk_tolerance = tol
+                    r.epa_tolerance = tol
+                    # Pinocchio's requests start each GJK from the pair's last result: on the Delta's thin parallel
+                    # forearms that warm start returned -1.8e308 or a distance 1 cm off, depending on the
+                    # configurations computed before; every configuration from coal's default guess instead
+                    r.enable_cached_gjk_guess = False
             self._local.data = gd
             return gd
 
+    def compute(self, q: np.ndarray) -> int:
+        """Every collision pair's signed distance at ``q`` (nq, not checked) into :attr:`data`'s results; the index
+        of the closest pair. Where coal's GJK fails on a pair (it answers ``-DBL_MAX``: the Delta's base disc and a
+        forearm 5 mm thick at 1e-12 of the size), that pair again with Nesterov's acceleration, then at each of
+        :data:`FALLBACK_RTOLS` of the size (plain, then accelerated), until one converges.
+
+        Raises:
+            NonFiniteError: a pair fails every way (named).
+        """
+        gd, model, data, gm = self.data, self.mech.model, self.mech.data, self.geometry
+        results = gd.distanceResults
+        k = pin.computeDistances(model, data, gm, gd, q)
+        if results[k].min_distance > FAILED:  # (a failure is the smallest: its result alone is read)
+            return int(k)
+        import coal  # type: ignore[import-untyped]
+
+        L, tol = self.mech.characteristic_length, GJK_RTOL * self.mech.characteristic_length
+        nesterov, plain = coal.GJKVariant.NesterovAcceleration, coal.GJKVariant.DefaultGJK
+        bad = [i for i, r in enumerate(results) if not r.min_distance > FAILED]
+        try:
+            for variant, rtol in ((nesterov, GJK_RTOL), *((v, t) for t in FALLBACK_RTOLS for v in (plain, nesterov))):
+                for i in bad:
+                    r = gd.distanceRequests[i]
+                    r.gjk_variant, r.gjk_tolerance, r.epa_tolerance = variant, rtol * L, rtol * L
+                k = pin.computeDistances(model, data, gm, gd, q)
+                if results[k].min_distance > FAILED:
+                    return int(k)
+        finally:
+            for i in bad:
+                r = gd.distanceRequests[i]
+                r.gjk_variant, r.gjk_tolerance, r.epa_tolerance = plain, tol, tol
+        pair = gm.collisionPairs[k]
+        raise NonFiniteError(f"the distance of {gm.geometryObjects[pair.first].name} and "
+                             f"{gm.geometryObjects[pair.second].name}", results[k].min_distance,
+                             f"coal's GJK failed at {GJK_RTOL:g} and {FALLBACK_RTOLS} of the size, with and without "
+                             "Nesterov's acceleration")
+
     def distances(self, q: np.ndarray) -> np.ndarray:
-        """The signed distance [m] of each of ``geometry``'s collision pairs at ``q`` (nq, not checked); the
-        results (witness points, normals) are left in :attr:`data`."""
-        gd = self.data
-        pin.computeDistances(self.mech.model, self.mech.data, self.geometry, gd, q)
-        return np.array([r.min_distance for r in gd.distanceResults])
+        """The signed distance [m] of each of ``geometry``'s collision pairs at ``q`` (nq, not checked; as
+        :meth:`compute`); the results (witness points, normals) are left in :attr:`data`."""
+        self.compute(q)
+        return np.array([r.min_distance for r in self.data.distanceResults])
 
     def body_distances(self, q: np.ndarray) -> np.ndarray:
         """The signed distance [m] of each pair of :attr:`pairs` at ``q``: its shapes' closest."""

@@ -81,7 +81,7 @@ from pkm.core.kinematics import constraints
 from pkm.core.kinematics.newton import least_squares
 from pkm.core.kinematics.solve import close_loops
 from pkm.core.kinematics.task import TaskMap
-from pkm.core.kinematics.trajectory import Trajectory, _units
+from pkm.core.kinematics.trajectory import Trajectory, _units, interference_along
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
@@ -502,8 +502,9 @@ def _simulation(mech: Mechanism, t: np.ndarray, q: np.ndarray, v: np.ndarray, a:
     at = np.abs(tau) >= limit * (1.0 - 1e-12) if len(tau) else np.zeros((0, mech.na), dtype=bool)
     saturated = {name: int(n) for name, n in zip(mech.actuated_names, at.sum(axis=0))}
     return Simulation(q, v, a, q[:, mech.act_q], qd, qdd, task, task_v, task_a, tau, residual,
-                      (), units, mech.limits_along(q), t, kinetic, potential, work, dissipated, event, method,
-                      saturated, base)
+                      (), units, mech.limits_along(q), *interference_along(mech, q), time=t, kinetic=kinetic,
+                      potential=potential, work=work, dissipated=dissipated, event=event, method=method,
+                      saturated=saturated, base=base)
 
 
 def _start(dyn: _Dynamics, x: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, ActuatorSpaceModel,

@@ -89,6 +89,9 @@ class SolveResult:
             equations with lengths (a closure's translation rows, the task's lengths) divided by the characteristic
             length ``L`` and angles in rad (:func:`close_loops`, :func:`solve_ik`; :func:`assemble`'s by its own
             ``L``); NaN where a solver states none. ``converged`` is ``relative_residual <= tol``.
+        clearance: The smallest signed distance between the bodies checked for collision at ``q`` [m] (negative:
+            two interpenetrate; :func:`pkm.clearance` has every pair), where the solve was asked for it
+            (``collisions=True``), else None; pkm's solvers do not avoid collisions.
     """
 
     q: np.ndarray
@@ -100,6 +103,12 @@ class SolveResult:
     outside_limits: tuple[str, ...] = ()
     mode: ModeLabel = field(default_factory=ModeLabel)
     relative_residual: float = math.nan
+    clearance: float | None = None
+
+    @property
+    def interferes(self) -> bool:
+        """Whether two checked bodies interpenetrate at ``q`` (False where the clearance was not asked for)."""
+        return self.clearance is not None and self.clearance < 0.0
 
     def check(self, mech: Mechanism, *, tol: float = 1e-9) -> bool:
         """Whether this result still holds on ``mech``, checked again from ``q`` alone (as qpsolvers'
@@ -349,7 +358,7 @@ def _follow(mech: Mechanism, what: str, solve_at: _StepSolver, q: np.ndarray, n_
 
 def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = None, *, tol: float = DEFAULT_TOL,
                 max_iter: int = 30, max_step: float = 0.1, raise_on_failure: bool = True,
-                min_step: float = MIN_STEP) -> SolveResult:
+                min_step: float = MIN_STEP, collisions: bool = False) -> SolveResult:
     """Forward position problem: passive coordinates for given actuated ones.
 
     Args:
@@ -367,6 +376,9 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
         min_step: The smallest continuation step, relative to the first, before the path is judged to leave the
             workspace (in (0, 1]): a search that only keeps the targets that close (random states) gives up sooner
             with a coarser one.
+        collisions: Report the smallest distance between the bodies checked for collision at the result
+            (:attr:`SolveResult.clearance`; about 25 us a solve on the Gough-Stewart's 66 pairs, 5 % of a close
+            solve); :class:`~pkm.errors.NoCollisionGeometryError` where ``mech`` has no collision geometry.
 
     Returns:
         A :class:`SolveResult` whose ``q`` has the requested actuated coordinates.
@@ -410,12 +422,23 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
         exc.problem = ClosureProblem(mech, qa1)
         raise
     _warn_mode_change("loop closure", seed, result)
-    return result
+    return _with_clearance(mech, result) if collisions else result
+
+
+def _with_clearance(mech: Mechanism, result: SolveResult) -> SolveResult:
+    """``result`` with its :attr:`SolveResult.clearance`."""
+    import dataclasses
+
+    from pkm.core.collision import CollisionModel
+    from pkm.core.collision.interference import minimum_distances
+
+    CollisionModel.of(mech).require()
+    return dataclasses.replace(result, clearance=float(minimum_distances(mech, result.q[None])[0]))
 
 
 def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: ArrayLike | None = None, *,
              branch: str | None = None, tol: float = DEFAULT_TOL, max_iter: int = 30, max_step: float = 0.25,
-             raise_on_failure: bool = True) -> SolveResult:
+             raise_on_failure: bool = True, collisions: bool = False) -> SolveResult:
     """Inverse position problem: every joint coordinate for given task coordinates.
 
     Args:
@@ -432,6 +455,9 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
         max_step: Largest task change per continuation step [``L`` or rad] (0.25: 5 cm on the Delta, whose
             ``L`` is 0.21 m, as the 0.05 m of the former default in m; 0.25 rad).
         raise_on_failure: Raise :class:`ConvergenceError` instead of returning ``converged=False``.
+        collisions: Report the smallest distance between the bodies checked for collision at the result
+            (:attr:`SolveResult.clearance`; about 25 us, under 1 % of a solve on the Gough-Stewart);
+            :class:`~pkm.errors.NoCollisionGeometryError` where ``mech`` has no collision geometry.
 
     Examples:
         >>> import numpy as np
@@ -481,7 +507,7 @@ def solve_ik(mech: Mechanism, target: ArrayLike | Mapping[str, object], q0: Arra
     if result.converged and branch is not None and not mech.on_branch(q, branch):
         raise BranchError(branch, dict(mech.branch(branch).signs), mech.branch_signs(q, branch))
     _warn_mode_change("inverse kinematics", matrices.label(seed_q), result)
-    return result
+    return _with_clearance(mech, result) if collisions else result
 
 
 def branch_seed(mech: Mechanism, branch: str, *, tol: float = DEFAULT_TOL, max_iter: int = 50) -> np.ndarray:

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pkm.core.collision.interference import Interference, checks_collisions, first_interference, minimum_distances
 from pkm.core.differential.velocity import (
     accelerations,
     inverse_accelerations,
@@ -76,6 +77,11 @@ class Trajectory:
             first sample outside and there its :class:`~pkm.core.model.mechanism.LimitViolation` (joint, value,
             limit), in the order of the samples (:meth:`~pkm.core.Mechanism.limits_along`; empty: every joint
             within its limits throughout).
+        clearance: The smallest signed distance between the bodies checked for collision at each sample (N) [m]
+            (negative: two interpenetrate), where the mechanism has collision geometry (:mod:`pkm.core.collision`,
+            about 20 us a sample); else None.
+        interference: The first sample where two checked bodies interpenetrate, with the pair and the distance
+            there (:class:`~pkm.core.collision.interference.Interference`); None where none does (or no geometry).
     """
 
     q: np.ndarray
@@ -92,6 +98,8 @@ class Trajectory:
     jumps: tuple[Jump, ...]
     units: dict[str, dict[str, str]] = field(default_factory=dict)
     outside_limits: tuple[tuple[int, LimitViolation], ...] = ()
+    clearance: np.ndarray | None = None
+    interference: Interference | None = None
 
     def __len__(self) -> int:
         return len(self.q)
@@ -183,7 +191,15 @@ def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int,
     ydd = np.array([task_acceleration(mech, qk, vk, ak) if np.all(np.isfinite(ak)) else np.full(mech.n_task, np.nan)
                     for qk, vk, ak in zip(q, v, a)])
     return Trajectory(q, v, a, q[:, mech.act_q], v[:, mech.act_v], a[:, mech.act_v], values, yd, ydd, tau, residual,
-                      tuple(jumps), _units(mech), mech.limits_along(q))
+                      tuple(jumps), _units(mech), mech.limits_along(q), *interference_along(mech, q))
+
+
+def interference_along(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray | None, Interference | None]:
+    """:attr:`Trajectory.clearance` and :attr:`Trajectory.interference` of the samples ``q`` (N x nq)."""
+    if not checks_collisions(mech):
+        return None, None
+    clear = minimum_distances(mech, q)
+    return clear, first_interference(mech, q, clear)
 
 
 def follow_task(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None = None, ydd: ArrayLike | None = None, *,

@@ -25,7 +25,7 @@ from pkm.core.modes.certify import Certificate, alpha_test, polish
 from pkm.core.modes.continuation import Continuation, solve, track
 from pkm.core.modes.equations import FKSystem, equations
 from pkm.core.modes.generic import assembly_modes_generic, working_modes_generic
-from pkm.core.modes.modeset import REAL_TOL, VERIFY_TOL, Mode, ModeSet, _check
+from pkm.core.modes.modeset import REAL_TOL, VERIFY_TOL, Mode, ModeSet, _check, _clearance
 from pkm.core.modes.polynomial import System, variables
 from pkm.core.modes.reduce import Reduction, reduce_mechanism
 from pkm.core.modes.starts import generic_start, path_parameters
@@ -208,7 +208,7 @@ def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "aut
     for x, cert, paths in found:
         R, t = system.displacement(x)
         q = recover(mech, red, qa, R, t)
-        modes.append((q, _check(mech, q), x, cert, tuple(paths), mech.outside_limits(q)))
+        modes.append((q, _check(mech, q), x, cert, tuple(paths), mech.outside_limits(q), _clearance(mech, q)))
     ref = mech.q_reference
     modes.sort(key=lambda m: float(np.linalg.norm(mech.difference(ref, m[0]))))
     out = tuple(Mode(k, *m) for k, m in enumerate(modes))

@@ -39,7 +39,7 @@ from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.modes.certify import Certificate, alpha_test, polish
 from pkm.core.modes.continuation import Continuation, solve
-from pkm.core.modes.modeset import REAL_TOL, Mode, ModeSet, _check
+from pkm.core.modes.modeset import REAL_TOL, Mode, ModeSet, _check, _clearance
 from pkm.core.modes.polynomial import Poly, System, fix
 from pkm.core.modes.tree import REVOLUTE, PolyTree, joint_axis
 from pkm.errors import StructureError
@@ -196,7 +196,7 @@ def assembly_modes_generic(mech: Mechanism, qa: np.ndarray, *, precision: str = 
     modes = []
     for x, cert, paths in found:
         qq = tree.configuration(q, x, mech.q_reference)
-        modes.append((qq, _check(mech, qq), x, cert, tuple(paths), mech.outside_limits(qq)))
+        modes.append((qq, _check(mech, qq), x, cert, tuple(paths), mech.outside_limits(qq), _clearance(mech, qq)))
     return _mode_set(mech, conts, modes, n_complex, "every passive joint")
 
 
@@ -239,5 +239,5 @@ def working_modes_generic(mech: Mechanism, task: ArrayLike | Mapping[str, Any], 
         qq = tree.configuration(q, x, mech.q_reference)
         if np.abs(tm.error(y, tm.value(qq))).max() > 1e-9:  # the yaw's other half-turn
             continue
-        modes.append((qq, _check(mech, qq), x, cert, tuple(paths), mech.outside_limits(qq)))
+        modes.append((qq, _check(mech, qq), x, cert, tuple(paths), mech.outside_limits(qq), _clearance(mech, qq)))
     return _mode_set(mech, conts, modes, n_complex, "every joint and the task")

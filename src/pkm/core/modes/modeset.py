@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pkm.core.collision.interference import checks_collisions, minimum_distances
 from pkm.core.kinematics import constraints
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.modes.certify import Certificate
@@ -36,6 +37,9 @@ class Mode:
             a working mode).
         outside_limits: The joints outside the position limits the files state (kept: a mode is geometry; whether
             the machine can reach it is the limits' business).
+        clearance: The smallest signed distance between the bodies checked for collision [m] (negative: two
+            interpenetrate; kept, as a mode outside the limits), where the mechanism has collision geometry
+            (:mod:`pkm.core.collision`); else None.
     """
 
     label: int
@@ -45,6 +49,12 @@ class Mode:
     certificate: Certificate
     path: tuple[int, ...]
     outside_limits: tuple[str, ...] = ()
+    clearance: float | None = None
+
+    @property
+    def interferes(self) -> bool:
+        """Whether two checked bodies interpenetrate in this mode (False where none are checked)."""
+        return self.clearance is not None and self.clearance < 0.0
 
 
 @dataclass(frozen=True)
@@ -87,6 +97,11 @@ class ModeSet:
     def __getitem__(self, k: int) -> Mode:
         return self.modes[k]
 
+    @property
+    def interfering(self) -> tuple[int, ...]:
+        """The labels of the modes in which two checked bodies interpenetrate (:attr:`Mode.interferes`)."""
+        return tuple(m.label for m in self.modes if m.interferes)
+
     def summary(self) -> str:
         """One sentence: the real assembly modes found, then the polynomial system's other solutions, counted as
         what they are (not assembly modes, no failure: complex ones, real ones off the poses, paths to infinity),
@@ -95,6 +110,11 @@ class ModeSet:
         return (f"{len(self.modes)} real assembly mode(s); the polynomial system's other solutions, which are no "
                 f"assembly mode: {self.n_complex} complex, {self.n_exceptional} exceptional (real, not a pose: "
                 f"Study's e = 0), {self.n_infinite} at infinity; from {self.n_paths} paths of {self.method}; {state}")
+
+
+def _clearance(mech: Mechanism, q: np.ndarray) -> float | None:
+    """:attr:`Mode.clearance` at ``q``."""
+    return float(minimum_distances(mech, q[None])[0]) if checks_collisions(mech) else None
 
 
 def _check(mech: Mechanism, q: np.ndarray) -> float:

@@ -25,7 +25,10 @@ r"""A time law checked, not just planned (:func:`verify`).
    :attr:`Verification.effort_usage` is the true use.
 3. **Position limits**: every joint the model states position limits for (actuated, task, passive) stays within
    them at every check point (:meth:`pkm.core.Mechanism.limit_violations`); the first one outside is named in
-   :attr:`Verification.reason` and the plan does not hold.
+   :attr:`Verification.reason` and the plan does not hold. Where the mechanism has collision geometry
+   (:mod:`pkm.core.collision`), no two checked bodies interpenetrate at any check point either
+   (:attr:`Verification.clearance`, the smallest distance; the first point and pair where two do named in the
+   reason).
 4. **Tracking**: :func:`pkm.simulate` (the model's friction, Coulomb smoothed) under the planned efforts plus a
    PD on the actuated coordinates, :math:`\tau = \tau_{plan}(t) + K_p (q_{a,ref} - q_a) + K_d (\dot q_{a,ref} -
    \dot q_a)`, gains from the mass matrix at the start, :math:`K_p = \omega_n^2 \operatorname{diag} M_a`,
@@ -66,6 +69,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from pkm.core.collision.interference import checks_collisions, first_interference, minimum_distances
 from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.timing.solve import ACTIVE_RTOL, TimeOptimal, planned_usage
@@ -90,8 +94,8 @@ class Verification:
         efforts: :func:`pkm.inverse_dynamics`' efforts there, with friction (m x na) [N m, N].
         effort_usage: max over points and actuators of ``|tau| / T(|omega|)`` (1: at the true curve).
         speed_usage, acceleration_usage: likewise for the speed and acceleration limits (0 where none).
-        holds: Every usage is at most ``1 + HOLD_RTOL``, every joint within its position limits, and the motors'
-            motion continuous.
+        holds: Every usage is at most ``1 + HOLD_RTOL``, every joint within its position limits, no two bodies
+            interpenetrating (where the mechanism has collision geometry), and the motors' motion continuous.
         inactive: Planning segments where no limit is active (switching points of the law; module doc).
         planned_usage: Per segment, the largest use of the planner's rows recomputed from these efforts (1:
             active).
@@ -105,6 +109,9 @@ class Verification:
         outside_limits: The joints that leave their stated position limits at some check point (in the order they
             do).
         reason: Why the plan does not hold, in words (None where it holds).
+        clearance: The smallest signed distance between the bodies checked for collision over the check points [m]
+            (negative: two interpenetrate, the reason names the first point and the pair), where the mechanism has
+            collision geometry (:mod:`pkm.core.collision`); else None.
         route: What recomputed the motion at the check points: ``"core"``, or ``"kernels (...)"`` (what ran them;
             module doc, "Two routes").
     """
@@ -125,6 +132,7 @@ class Verification:
     reason: str | None = None
     planned_usage: np.ndarray | None = None
     route: str = "core"
+    clearance: float | None = None
 
 
 def _points(plan: TimeOptimal, factor: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -198,6 +206,14 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
         reasons.append("position limits crossed: " + "; ".join(
             f"{v.joint} = {v.value:.6g} at s = {s[k]:.6g}, outside its limits [{v.limit[0]:.6g}, {v.limit[1]:.6g}]"
             for k, v in traj.outside_limits))
+    clearance = None
+    if checks_collisions(mech):  # (about 20 us a check point)
+        minima = traj.clearance if traj.clearance is not None else minimum_distances(mech, traj.q)
+        clearance = float(np.nanmin(minima))
+        hit = first_interference(mech, traj.q, minima)
+        if hit is not None:
+            reasons.append(f"bodies interpenetrate: {hit.pair[0]} and {hit.pair[1]} by {-hit.distance:.6g} m at "
+                           f"s = {s[hit.at]:.6g}")
     holds = not reasons
     ends = np.stack([np.arange(len(plan.sdd)) * (factor + 1), np.arange(len(plan.sdd)) * (factor + 1) + factor])
     static = tau[ends] - np.stack([plan.coefficients.d[:-1], plan.coefficients.d[1:]]) * sd[ends][..., None]
@@ -209,15 +225,15 @@ def verify(plan: TimeOptimal, *, factor: int = 10, simulate: bool = True, dt: fl
         track, task_err, dur, event = _track(plan, t, traj, tau, dt)
     return Verification(s, t, tau, effort, speed, acc, holds, inactive, track, task_err, dur, event,
                         tuple(v.joint for _, v in traj.outside_limits), "; ".join(reasons) or None, planned,
-                        traj.route)
+                        traj.route, clearance)
 
 
 @dataclass(frozen=True)
 class _Motion:
     """The motion at the check points, from either route: configurations (m x nq), the actuated coordinates,
     rates and accelerations (m x na), the efforts without friction (m x na), the task values, whether the motion
-    leaves its branch, the joints outside their position limits (:meth:`pkm.core.Mechanism.limits_along`), and
-    the route."""
+    leaves its branch, the joints outside their position limits (:meth:`pkm.core.Mechanism.limits_along`), the
+    route, and the smallest distances between checked bodies where the route computed them (the core's)."""
 
     q: np.ndarray
     actuated: np.ndarray
@@ -228,6 +244,7 @@ class _Motion:
     jumps: bool
     outside_limits: tuple
     route: str = "core"
+    clearance: np.ndarray | None = None
 
 
 def _core(plan: TimeOptimal, y: np.ndarray, yd: np.ndarray, ydd: np.ndarray) -> _Motion:
@@ -239,7 +256,7 @@ def _core(plan: TimeOptimal, y: np.ndarray, yd: np.ndarray, ydd: np.ndarray) -> 
     traj = follow(plan.mech, y, yd, ydd, q0=plan.coefficients.q[0], efforts=True, tol=1e-12)
     assert traj.efforts is not None
     return _Motion(traj.q, traj.actuated, traj.actuated_velocity, traj.actuated_acceleration, traj.efforts,
-                   traj.task, bool(traj.jumps), traj.outside_limits)
+                   traj.task, bool(traj.jumps), traj.outside_limits, clearance=traj.clearance)
 
 
 def _compiled(mech: Mechanism, K: Kernels, y: np.ndarray, yd: np.ndarray, ydd: np.ndarray,
