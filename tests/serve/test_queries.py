@@ -165,6 +165,8 @@ def test_a_map_job_takes_units_as_pkm_map_does():
                       jobs.Job("b", "map", "delta"))
     assert np.allclose(units["axes"]["z"], si["axes"]["z"], rtol=1e-15, atol=0)
     assert np.allclose(units["condition_index"], si["condition_index"], rtol=1e-12, atol=0)
+    assert np.array_equal(si["feasible"], si["reachable"] & si["within_limits"] & ~si["interferes"])
+    assert si["units"]["clearance"] == "m" and np.all(si["clearance"][si["reachable"]] > 0.0)  # (the Delta's bodies)
     with pytest.raises(UnitError, match=r"axes\.z"):
         jobs._map(mech, {"axes": {"z": ["-40deg", "-30cm", 3]}}, jobs.Job("c", "map", "delta"))
 

@@ -131,6 +131,14 @@ def _map(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, 
                            "gci": m.gci("2"), "how": m.how,
                            "units": {"axes": {n: ("m" if k == "length" else "rad") for (n, _), k in zip(m.axes, m.kinds)},
                                      "size": m.size_unit, "condition_index": "1", "gci": "1"}}
+    if m.within_limits is not None:  # (the joints' limits and the interference, where the map checked them)
+        rows["within_limits"] = m.within_limits.ravel()
+        out["within_limits"] = m.within_limits
+    if m.clearance is not None and m.interferes is not None:
+        rows["clearance"], rows["interferes"] = m.clearance.ravel(), m.interferes.ravel()
+        out["clearance"], out["interferes"] = m.clearance, m.interferes
+        out["units"]["clearance"] = "m"
+    out["feasible"] = m.feasible
     if index is not None:
         from pkm.core.analysis.capability import map_capability
 

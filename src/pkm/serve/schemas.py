@@ -559,6 +559,15 @@ class MapResult(_Answer):
     size: float = _field("The reachable region's length, area or volume (in units.size: m^2, m rad...).", 0.01)
     gci: float | None = _field("The global condition index (its mean over the reachable nodes) [1].", 0.5)
     how: str = _field("How the map was computed.", "ik")
+    within_limits: Any = _field("Whether each node's configuration lies within the joints' position limits (absent "
+                                "where the map did not check them).", [[True]], None)
+    clearance: Any = _field("The smallest signed distance between the bodies checked for collision at each node [m] "
+                            "(negative: interpenetration; null: unreachable; absent: no collision geometry, or a map "
+                            "too large to check by default).", [[0.01]], None)
+    interferes: Any = _field("Whether two bodies interpenetrate at each node (absent where not checked).",
+                             [[False]], None)
+    feasible: Any = _field("Each node reachable, within the limits and free of interference, as far as checked.",
+                           [[True]])
     capability: MapCapability | None = _field("With index: the capability at every node.", None, None)
     units: dict[str, Any] = _field("The units: of each axis (m, rad), of size, of the condition index (1).",
                                    {"axes": {"x": "m", "y": "m"}, "size": "m^2", "condition_index": "1", "gci": "1"})
