@@ -71,6 +71,8 @@ from pkm.errors import InvalidInputError, TransmissionError
 WHAT = "pkm.learn.mjwarp (transmissions inside MuJoCo Warp's batched step)"
 #: MuJoCo integrators by name (MuJoCo's ``mjtIntegrator``).
 INTEGRATORS = {"euler": 0, "rk4": 1, "implicit": 2, "implicitfast": 3}
+#: The RK4 stages' times, in time steps, in the order MuJoCo Warp evaluates them (:attr:`TransmissionWorlds.stage_offset`).
+STAGES = {INTEGRATORS["rk4"]: (0.0, 0.5, 0.5, 1.0)}
 #: The fused kernel's outputs, in order (:func:`step_function`).
 OUTPUTS = ("q_out", "qm", "qdm", "tau_o", "dM", "dh", "residual", "status")
 
@@ -202,7 +204,10 @@ class TransmissionWorlds:
         torque_source: None (the torques of :meth:`set_motor_torques`, held over the step), or a function of the
             worlds called at every evaluation of the dynamics before the transmissions (each RK4 stage: ``data.time``
             is the stage's), which writes each unit's ``tau_m`` (Warp arrays ``(k, nworld)`` float64) itself: a
-            torque profile of time evaluated as continuously as a CPU ``mjcb_control`` evaluates it.
+            torque profile of time evaluated as continuously as a CPU ``mjcb_control`` evaluates it. The stage's
+            time is ``data.time + stage_offset``: MuJoCo Warp 4.0's RK4 leaves ``data.time`` at the step's start in
+            its stages (MuJoCo's C sets it to each stage's), so ``stage_offset`` [s] gives the stage's offset
+            (0, dt/2, dt/2, dt; 0 for the other integrators).
 
     Raises:
         MissingDependencyError: MuJoCo Warp is not installed (``pip install "pkm-robotics[mjwarp]"``).
@@ -241,6 +246,7 @@ class TransmissionWorlds:
         self.outputs = tuple(o for u in self.units for o in u.t.outputs)
         self._gather, self._scatter = _glue()
         self.torque_source: Callable[[TransmissionWorlds], None] | None = None
+        self.stage_offset, self._stage = 0.0, 0
         self.model.callback.control = self._control
         self.reset()
 
@@ -262,6 +268,9 @@ class TransmissionWorlds:
 
     def _control(self, m: Any, d: Any) -> None:  # (MuJoCo Warp's control callback: M and the bias are the state's)
         if self.torque_source is not None:
+            stages = STAGES.get(int(self.mj_model.opt.integrator), (0.0,))
+            self.stage_offset = stages[min(self._stage, len(stages) - 1)] * float(self.mj_model.opt.timestep)
+            self._stage += 1
             self.torque_source(self)
         self._evaluate(True)
 
@@ -301,6 +310,7 @@ class TransmissionWorlds:
         """``substeps`` steps of MuJoCo Warp (every world), then the motor states at the new state."""
         with self._wp.ScopedDevice(self.device):
             for _ in range(substeps):
+                self._stage = 0
                 self._mjw.step(self.model, self.data)
             self._evaluate(False)
 
@@ -348,4 +358,4 @@ class TransmissionWorlds:
         return self.units[i].q.numpy().T.copy()
 
 
-__all__ = ["INTEGRATORS", "OUTPUTS", "TransmissionWorlds", "step_function"]
+__all__ = ["INTEGRATORS", "OUTPUTS", "STAGES", "TransmissionWorlds", "step_function"]
