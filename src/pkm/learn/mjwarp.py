@@ -246,7 +246,7 @@ class TransmissionWorlds:
         self.outputs = tuple(o for u in self.units for o in u.t.outputs)
         self._gather, self._scatter = _glue()
         self.torque_source: Callable[[TransmissionWorlds], None] | None = None
-        self.stage_offset, self._stage = 0.0, 0
+        self.stage_offset, self._stage, self._stale = 0.0, 0, False
         self.model.callback.control = self._control
         self.reset()
 
@@ -294,6 +294,7 @@ class TransmissionWorlds:
                                   device=self.device))
             u.tau_m.zero_()
         self._evaluate(False)
+        self._stale = False
 
     def set_motor_torques(self, tau_m: ArrayLike) -> None:
         """The motor torques ``(nworld, len(self.motors))`` (or one row for all) [N m or N], held until set again."""
@@ -307,14 +308,23 @@ class TransmissionWorlds:
             col += u.t.k
 
     def step(self, substeps: int = 1) -> None:
-        """``substeps`` steps of MuJoCo Warp (every world), then the motor states at the new state."""
+        """``substeps`` steps of MuJoCo Warp (every world). The motor states at the new state are evaluated when first
+        read (one more run of the kernels: :meth:`observe`)."""
         with self._wp.ScopedDevice(self.device):
             for _ in range(substeps):
                 self._stage = 0
                 self._mjw.step(self.model, self.data)
+        self._stale = True
+
+    def observe(self) -> None:
+        """The transmissions' kernels at the current state (the motor states, the residuals, the statuses), if a step
+        has moved it since they last ran; the properties below call it."""
+        if self._stale:
             self._evaluate(False)
+            self._stale = False
 
     def _out(self, name: str) -> np.ndarray:
+        self.observe()
         j = OUTPUTS.index(name)
         return np.concatenate([u.outs[j].numpy().T for u in self.units], axis=1)
 
@@ -331,6 +341,7 @@ class TransmissionWorlds:
     @property
     def output_q(self) -> np.ndarray:
         """The outputs' positions ``(nworld, len(self.outputs))`` [rad or m]."""
+        self.observe()
         return np.concatenate([u.qo.numpy().T for u in self.units], axis=1)
 
     @property
@@ -355,6 +366,7 @@ class TransmissionWorlds:
 
     def sub_q(self, i: int = 0) -> np.ndarray:
         """Transmission ``i``'s sub-mechanism configurations ``(nworld, nq)`` (Pinocchio's order)."""
+        self.observe()
         return self.units[i].q.numpy().T.copy()
 
 
