@@ -1,4 +1,4 @@
-"""Fidelity of the humanoid ankle in MuJoCo Warp (issue 56): the same 1 s motor-torque chirp
+"""Fidelity of the humanoid ankle and knee in MuJoCo Warp (issue 56): the same 1 s motor-torque chirp
 (:func:`pkm.core.transmissions.fidelity.profiles`, 0.5 to 4 Hz over 1 s) from the reference at rest, RK4 at 1 ms, on
 
 * (a) the closed loop, :func:`pkm.simulate` (float64; closure exact);
@@ -6,9 +6,11 @@
   float32 state, float64 kernels);
 * (w64) the same algorithm in CPU MuJoCo, float64 (:func:`pkm.core.transmissions.fidelity.serial_run`, ``exact``):
   (w) against (w64) is what MuJoCo Warp's float32 costs;
-* (s) the soft-loop MJCF (``examples/humanoid_ankle/ankle.xml``: the rods on ball joints, the loops
-  ``<equality><connect>`` with its ``solref="0.002 1"``, its joint damping removed as pkm.simulate has none) in MuJoCo
-  Warp, the torques on its motors' joints;
+* (s) soft-loop MJCF in MuJoCo Warp, the torques on its motors' joints, its joint damping and limits off as
+  pkm.simulate has none here: the ankle's own file (``examples/humanoid_ankle/ankle.xml``: the rods on ball joints,
+  the loops ``<equality><connect>`` with its ``solref="0.002 1"``) and (s_pkm) pkm's MJCF writer's
+  (:func:`pkm.core.formats.to_mjcf.mjcf_from_mechanism`: stiff connects between sites, ``solref = (2 dt,
+  0.5)``, ``solimp`` 0.9999), the knee's only that one;
 * (b) the constant-armature serial model in MuJoCo Warp (``exact=False``: ΔM's diagonal at the reference, no Δh,
   the effort map exact).
 
@@ -111,11 +113,14 @@ def run_transmission(robot, t, torque: Chirp, exact: bool, sample: int = 10):
     return out, states, time.process_time() - start
 
 
-def soft_model():
-    """The soft-loop MJCF in MuJoCo (CPU model), RK4 at DT, its joint damping removed."""
-    m = mujoco.MjModel.from_xml_path(str(ANKLE / "ankle.xml"))
+def soft_model(source: Path | str):
+    """A soft-loop MJCF (a file, or MJCF text) in MuJoCo (CPU model), RK4 at DT, its joint damping and its joint limits
+    off (pkm.simulate has neither here: the ankle's roll reaches the file's 0.35 rad under the constant torques), the
+    energy computed."""
+    m = mujoco.MjModel.from_xml_path(str(source)) if isinstance(source, Path) else mujoco.MjModel.from_xml_string(source)
     m.opt.timestep, m.opt.integrator = DT, mujoco.mjtIntegrator.mjINT_RK4
     m.dof_damping[:] = 0.0
+    m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_LIMIT  # (pkm.simulate's runs watch no limit either)
     m.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
     return m
 
@@ -124,23 +129,29 @@ def connect_residual(m, d) -> float:
     """The largest distance of a ``<connect>``'s two anchors [m] at ``d``'s kinematics."""
     worst = 0.0
     for e in range(m.neq):
-        b1, b2 = m.eq_obj1id[e], m.eq_obj2id[e]
-        p1 = d.xpos[b1] + d.xmat[b1].reshape(3, 3) @ m.eq_data[e, 0:3]
-        p2 = d.xpos[b2] + d.xmat[b2].reshape(3, 3) @ m.eq_data[e, 3:6]
+        a, b = m.eq_obj1id[e], m.eq_obj2id[e]
+        if m.eq_objtype[e] == mujoco.mjtObj.mjOBJ_SITE:  # (pkm's MJCF writer: a site at each closure frame)
+            p1, p2 = d.site_xpos[a], d.site_xpos[b]
+        else:  # (bodies, the anchors in eq_data)
+            p1 = d.xpos[a] + d.xmat[a].reshape(3, 3) @ m.eq_data[e, 0:3]
+            p2 = d.xpos[b] + d.xmat[b].reshape(3, 3) @ m.eq_data[e, 3:6]
         worst = max(worst, float(np.linalg.norm(p1 - p2)))
     return worst
 
 
-def run_soft(torque_of, motors: list[str], sample: int = 10):
-    """(s): pitch and roll (N+1, 2), the connects' residual at the end, and every ``sample`` steps MuJoCo's energy
-    (potential + kinetic) and the motors' positions."""
-    mjm = soft_model()
-    dadr = np.array([mjm.jnt_dofadr[mjm.joint(n).id] for n in motors])
+def run_soft(source, torque_of, t, sample: int = 10):
+    """(s): the outputs (N+1, k) of the soft-loop model ``source`` from its reference keyframe (else ``qpos0``), the
+    connects' residual at the end, and every ``sample`` steps MuJoCo's energy (potential, kinetic) and the motors'
+    positions."""
+    mjm = soft_model(source)
+    dadr = np.array([mjm.jnt_dofadr[mjm.joint(n).id] for n in t.motors])
     torque = torque_of(dadr)
-    qadr = [mjm.jnt_qposadr[mjm.joint(n).id] for n in ("ankle_pitch", "ankle_roll")]
-    madr = [mjm.jnt_qposadr[mjm.joint(n).id] for n in motors]
+    qadr = [mjm.jnt_qposadr[mjm.joint(n).id] for n in t.outputs]
+    madr = [mjm.jnt_qposadr[mjm.joint(n).id] for n in t.motors]
+    start_qpos = mjm.key_qpos[0].copy() if mjm.nkey else mjm.qpos0.copy()
     m = mjw.put_model(mjm)
     d = mjw.make_data(mjm, nworld=1)
+    d.qpos.assign(start_qpos[None, :].astype(np.float32))
     stage = [0]
     stages = STAGES[int(mujoco.mjtIntegrator.mjINT_RK4)]
 
@@ -150,7 +161,8 @@ def run_soft(torque_of, motors: list[str], sample: int = 10):
 
     m.callback.control = control
     n = round(DURATION / DT)
-    out = np.zeros((n + 1, 2))
+    out = np.zeros((n + 1, t.k))
+    out[0] = start_qpos[qadr]
     states = []
     start = time.process_time()
     for i in range(n):
@@ -163,10 +175,13 @@ def run_soft(torque_of, motors: list[str], sample: int = 10):
     cpu = time.process_time() - start
     cd = mujoco.MjData(mjm)
     energy = []  # (MuJoCo's energy at each sampled state, in float64 on the CPU model: potential, kinetic)
-    for qpos, qvel in [(mjm.qpos0.copy(), np.zeros(mjm.nv)), *states]:
+    for qpos, qvel in [(start_qpos, np.zeros(mjm.nv)), *states]:
         cd.qpos[:], cd.qvel[:] = qpos, qvel
         mujoco.mj_forward(mjm, cd)
-        energy.append((float(cd.energy.sum()), qpos[madr], float(cd.energy[1])))
+        full = np.zeros((mjm.nv, mjm.nv))
+        mujoco.mj_fullM(mjm, cd, full)
+        kinetic = 0.5 * qvel @ full @ qvel  # (with the rotors' armature)
+        energy.append((float(cd.energy[0] + kinetic), qpos[madr], float(kinetic)))
     return out, connect_residual(mjm, cd), energy, cpu
 
 
@@ -185,62 +200,82 @@ def drift(values: list[tuple[float, float]]) -> float:
     return float(np.abs(E - E[0]).max() / T.max())
 
 
-def main(argv: list[str]) -> None:
-    wp.config.quiet = True
-    out_dir = Path(argv[0]) if argv else ROOT / "tools" / "reports"
-    robot = pkm.load(ANKLE / "ankle.closures.toml")
+ROBOTS = {  # name: (the pkm file, the soft-loop MJCFs: (label, a file or None for pkm's own MJCF writer))
+    "humanoid_ankle": (ANKLE / "ankle.closures.toml", (("s", ANKLE / "ankle.xml"), ("s_pkm", None))),
+    "humanoid_knee": (ROOT / "examples" / "humanoid_knee" / "knee.closures.toml", (("s_pkm", None),)),
+}
+SOFT = {"s": "the file's own `<connect>`s (`solref=\"0.002 1\"`)",
+        "s_pkm": "pkm's MJCF writer (`pkm.save`: stiff `<connect>`s, `solref=(2 dt, 0.5)`, `solimp` 0.9999)"}
+
+
+def one_robot(name: str) -> dict:
+    from pkm.core.formats.to_mjcf import mjcf_from_mechanism
+
+    path, softs = ROBOTS[name]
+    robot = pkm.load(path)
     (t,) = pkm.transmissions(robot)
     hold, amp, phase = chirp_parts(t)
     f = profiles(t, DURATION)["chirp"]
-    motors = list(t.motors)
-    result: dict = {"robot": "humanoid_ankle", "transmission": t.name, "duration_s": DURATION, "dt_s": DT,
-                    "integrator": "RK4", "device": f"Warp 'cpu' ({platform.processor() or platform.machine()}), "
-                    "no GPU lent", "command": "PYTHONPATH=src python tools/mjwarp_fidelity.py",
-                    "mujoco_warp": mjw.__version__ if hasattr(mjw, "__version__") else "4.0.0",
-                    "warp": wp.config.version}
+    ks = list(range(t.k))
+    sources = {label: (src if src is not None else mjcf_from_mechanism(robot, timestep=DT)) for label, src in softs}
     a = closed_loop(t, f, DURATION, DT)
     w64 = serial_run(t, f, DURATION, DT, exact=True)
     b64 = serial_run(t, f, DURATION, DT, exact=False)
-    w, w_states, w_cpu = run_transmission(robot, t, Chirp(hold, amp, phase, [0, 1], 1), True)
-    b, _, b_cpu = run_transmission(robot, t, Chirp(hold, amp, phase, [0, 1], 1), False)
-    s, s_res, _, s_cpu = run_soft(lambda dadr: Chirp(hold, amp, phase, dadr, 1), motors)
+    w, w_states, w_cpu = run_transmission(robot, t, Chirp(hold, amp, phase, ks, 1), True)
+    b, _, b_cpu = run_transmission(robot, t, Chirp(hold, amp, phase, ks, 1), False)
+    traces = {"w": w, "w64": w64, "b": b, "b64": b64}
+    cpu = {"w": w_cpu, "b": b_cpu}
+    residuals = {}
+    for label, src in sources.items():
+        traces[label], residuals[label], _, cpu[label] = run_soft(src, lambda dadr: Chirp(hold, amp, phase, dadr, 1), t)
     _, q_end, _, kernel_res = w_states[-1]
-    err = {key: float(np.abs(x - a).max()) for key, x in (("w", w), ("w64", w64), ("s", s), ("b", b), ("b64", b64))}
-    result["chirp"] = {
-        "motion_rad": float(np.abs(a - a[0]).max()),
-        "error_rad": err, "float32_cost_rad": float(np.abs(w - w64).max()),
-        "closure_residual_m": {"w_kernel": kernel_res,
-                               "w_pkm": float(np.abs(residual(t.mechanism, q_end)).max()),
-                               "s_connect": s_res},
-        "cpu_s": {"w": w_cpu, "b": b_cpu, "s": s_cpu}}
+    out: dict = {"transmission": t.name, "outputs": list(t.outputs), "motion": float(np.abs(a - a[0]).max()),
+                 "error": {key: float(np.abs(x - a).max()) for key, x in traces.items()},
+                 "float32_cost": float(np.abs(w - w64).max()),
+                 "closure_residual_m": {"w_kernel": kernel_res, "w_pkm": float(np.abs(residual(t.mechanism, q_end)).max()),
+                                        **residuals},
+                 "cpu_s": cpu, "soft_models": {label: SOFT[label] for label in sources}}
     # energy drift: constant torques from rest
-    const = hold + 0.5 * amp * np.array([1.0, -1.0])
+    const = hold + 0.5 * amp * np.where(np.arange(t.k) % 2 == 0, 1.0, -1.0)
     zero = np.zeros_like(amp)
     sim = pkm.simulate(t.mechanism, t.q_reference, None, DURATION, DT, lambda *_: const, friction=False,
                        saturate=False, limits=False, backend="python")
     qs, vs = np.asarray(sim.q), np.asarray(sim.v)
-    e_a = [closed_energy(t, qs[i], vs[i][t.out_v], const) for i in range(0, len(qs), 10)]
-    _, w_states, _ = run_transmission(robot, t, Chirp(const, zero, zero, [0, 1], 1), True)
-    e_w = [closed_energy(t, q, od, const) for _, q, od, _ in w_states]
-    e_w = [closed_energy(t, t.q_reference, np.zeros(2), const), *e_w]
-    _, _, energy, _ = run_soft(lambda dadr: Chirp(const, zero, zero, dadr, 1), motors)
-    e_s = [(float(E - const @ qm), float(T)) for E, qm, T in energy]
-    result["energy_drift"] = {"torque_Nm": const.tolist(), "relative_to_max_kinetic": {
-        "a": drift(e_a), "w": drift(e_w), "s": drift(e_s)}}
+    drifts = {"a": drift([closed_energy(t, qs[i], vs[i][t.out_v], const) for i in range(0, len(qs), 10)])}
+    _, w_states, _ = run_transmission(robot, t, Chirp(const, zero, zero, ks, 1), True)
+    e_w = [closed_energy(t, t.q_reference, np.zeros(t.k), const)]
+    drifts["w"] = drift(e_w + [closed_energy(t, q, od, const) for _, q, od, _ in w_states])
+    for label, src in sources.items():
+        _, _, energy, _ = run_soft(src, lambda dadr: Chirp(const, zero, zero, dadr, 1), t)
+        drifts[label] = drift([(float(E - const @ qm), float(T)) for E, qm, T in energy])
+    out["energy_drift"] = {"torque": const.tolist(), "relative_to_max_kinetic": drifts}
+    return out
+
+
+def main(argv: list[str]) -> None:
+    wp.config.quiet = True
+    out_dir = Path(argv[0]) if argv else ROOT / "tools" / "reports"
+    result: dict = {"duration_s": DURATION, "dt_s": DT, "integrator": "RK4",
+                    "device": f"Warp 'cpu' ({platform.machine()}); GPU: missing, no GPU was lent to this session",
+                    "command": "PYTHONPATH=src python tools/mjwarp_fidelity.py",
+                    "mujoco_warp": "4.0.0", "warp": wp.config.version,
+                    "robots": {name: one_robot(name) for name in ROBOTS}}
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "mjwarp_fidelity.json").write_text(json.dumps(result, indent=2) + "\n")
-    c = result["chirp"]
-    e = result["energy_drift"]["relative_to_max_kinetic"]
-    md = ["| route | pitch/roll error vs pkm.simulate [rad] | closure residual after 1 s [m] | energy drift (rel.) |",
-          "|---|---|---|---|",
-          f"| (a) pkm.simulate, closed loop (float64) | — | exact (Newton) | {e['a']:.1e} |",
-          f"| (w) MuJoCo Warp + exact transmission (float32 state) | {err['w']:.2e} | {c['closure_residual_m']['w_kernel']:.1e} "
-          f"(kernel), {c['closure_residual_m']['w_pkm']:.1e} (pkm) | {e['w']:.1e} |",
-          f"| (w64) CPU MuJoCo + exact transmission (float64) | {err['w64']:.2e} | exact (Newton) | — |",
-          f"| (s) soft loops (`<connect>`) in MuJoCo Warp | {err['s']:.2e} | {s_res:.1e} | {e['s']:.1e} |",
-          f"| (b) constant armature in MuJoCo Warp | {err['b']:.2e} | — | — |",
-          f"| (b64) constant armature in CPU MuJoCo | {err['b64']:.2e} | — | — |",
-          "", f"Motion {c['motion_rad']:.3g} rad; float32's cost, (w) against (w64): {c['float32_cost_rad']:.1e} rad."]
+    md = ["| robot | route | output error vs pkm.simulate [rad] | closure residual after 1 s [m] | energy drift (rel.) |",
+          "|---|---|---|---|---|"]
+    for name, r in result["robots"].items():
+        e, err, res = r["energy_drift"]["relative_to_max_kinetic"], r["error"], r["closure_residual_m"]
+        md += [f"| {name} | (a) pkm.simulate, closed loop (float64) | — | exact (Newton) | {e['a']:.1e} |",
+               f"| {name} | (w) MuJoCo Warp + exact transmission (float32 state) | {err['w']:.2e} | "
+               f"{res['w_kernel']:.1e} (kernel), {res['w_pkm']:.1e} (pkm) | {e['w']:.1e} |",
+               f"| {name} | (w64) CPU MuJoCo + exact transmission (float64) | {err['w64']:.2e} | exact (Newton) | — |"]
+        md += [f"| {name} | ({label}) soft loops in MuJoCo Warp: {SOFT[label]} | {err[label]:.2e} | {res[label]:.1e} "
+               f"| {e[label]:.1e} |" for label in r["soft_models"]]
+        md += [f"| {name} | (b) constant armature in MuJoCo Warp | {err['b']:.2e} | — | — |",
+               f"| {name} | (b64) constant armature in CPU MuJoCo | {err['b64']:.2e} | — | — |"]
+    md += [""] + [f"{name}: motion {r['motion']:.3g} rad; float32's cost, (w) against (w64): {r['float32_cost']:.1e} rad."
+                  for name, r in result["robots"].items()]
     (out_dir / "mjwarp_fidelity.md").write_text("\n".join(md) + "\n")
     print("\n".join(md))
 
