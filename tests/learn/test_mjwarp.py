@@ -85,3 +85,21 @@ def test_without_mujoco_warp_the_extra_is_named(monkeypatch):
     with pytest.raises(MissingDependencyError) as e:
         TransmissionWorlds(None, 1)  # type: ignore[arg-type]  (the extra is checked first)
     assert e.value.extra == "mjwarp" and 'pip install "pkm-robotics[mjwarp]"' in str(e.value)
+
+
+def test_outputs_on_two_branches_have_no_place_in_mujocos_sparse_mass_matrix():
+    """ΔM's off-diagonal entry of two outputs goes where MuJoCo's sparse M has the entry of the later dof and its
+    ancestor; outputs hanging from one body side by side have none: refused, not dropped."""
+    mujoco = pytest.importorskip("mujoco")
+    from pkm.errors import TransmissionError
+    from pkm.learn.mjwarp import _mass_addresses
+
+    chain = mujoco.MjModel.from_xml_string(
+        "<mujoco><worldbody><body><joint name='a'/><geom size='.1'/><body><joint name='b'/><geom size='.1'/>"
+        "</body></body></worldbody></mujoco>")
+    assert _mass_addresses(chain, [0, 1]).tolist() == [0, 1, -1, 2]  # (M's CSR: row 0 [0,0]; row 1 [1,0], [1,1])
+    siblings = mujoco.MjModel.from_xml_string(
+        "<mujoco><worldbody><body><joint name='a'/><geom size='.1'/></body><body><joint name='b'/><geom size='.1'/>"
+        "</body></worldbody></mujoco>")
+    with pytest.raises(TransmissionError, match="different branches"):
+        _mass_addresses(siblings, [0, 1])
