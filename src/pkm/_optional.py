@@ -15,6 +15,7 @@ Jacobians, dynamics, the twin's kernels, previews); the rest is behind extras, n
     pip install "pkm-robotics[warp]"      # transmission kernels on NVIDIA Warp (CPU, or a GPU where there is one)
     pip install "pkm-robotics[plan]"      # time-optimal motion (pkm.time_optimal, pkm plan): toppra
     pip install "pkm-robotics[usd]"       # USD in and out (UsdPhysics articulations, loop joints): usd-core
+    pip install "pkm-robotics[mjwarp]"    # exact transmissions inside MuJoCo Warp's batched step: mujoco-warp
     pip install "pkm-robotics[all]"       # all of them
 
 An extra is checked at the point of use, never at ``import pkm``: :func:`require` raises
@@ -45,6 +46,7 @@ EXTRAS: dict[str, dict[str, str]] = {
     "warp": {"warp": "warp-lang"},
     "plan": {"toppra": "toppra"},
     "usd": {"pxr": "usd-core"},
+    "mjwarp": {"mujoco_warp": "mujoco-warp"},
 }
 
 
