@@ -19,12 +19,14 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(PY) -m pkm report --out out
 
-# mypy holds one core: the tests are collected on the other meanwhile (a first collection compiles and rewrites
-# every test module's assertions, about 10 s of CPU, which each pytest worker would otherwise pay), bytecode caches
-# written whatever PYTHONDONTWRITEBYTECODE says; the collection's own failures are the test run's to report.
+# mypy holds one core; meanwhile the tests are collected (a first collection compiles and rewrites every test
+# module's assertions, about 10 s of CPU each pytest worker would otherwise pay; bytecode caches written whatever
+# PYTHONDONTWRITEBYTECODE says) and MuJoCo Warp's kernels compiled into Warp's cache (tools/warm_caches.py: 30 s of
+# CPU the first time on a machine). Their own failures are the test run's to report.
 test: $(STAMP)
 	$(PY) -m ruff check src tests tools examples
 	(env -u PYTHONDONTWRITEBYTECODE $(PY) -m pytest --collect-only -q -p no:cacheprovider >/dev/null 2>&1 || true) & \
+		($(PY) tools/warm_caches.py >/dev/null || true) & \
 		$(PY) -m mypy src/pkm; status=$$?; wait; exit $$status
 	env -u PYTHONDONTWRITEBYTECODE $(PY) -m pytest -q -n 2 --dist worksteal --durations=15  # two workers (CPU-bound, 2 cores), the one done first taking the other's queued tests; the 15 slowest printed: the budget
 
