@@ -6,6 +6,7 @@ import csv
 import json
 import math
 
+import pkm
 from pkm import cli
 from tests.cli.helpers import run
 from tests.papers.figures import inspected
@@ -70,3 +71,16 @@ def test_the_map_starts_from_the_seed_given(monkeypatch):
     want = mech.q_reference.copy()
     want[mech.joints["elbow_2"].idx_q] = np.radians(-40.0)
     assert np.array_equal(got.value.args[0], want)
+
+
+def test_a_mixed_task_defaults_to_the_characteristic_length_and_says_so():
+    """A 3-RRR map (its task: x, y, yaw) without ``--length``: the mechanism's characteristic length, said on stderr
+    and in the summary, and the same map as with that ``--length`` given."""
+    L = pkm.load("rrr3").characteristic_length
+    axes = ("--axis", "x=45cm:55cm:3")
+    default, given = run("map", "rrr3", *axes), run("map", "rrr3", *axes, "--length", f"{L!r}")
+    assert default.returncode == 0 and given.returncode == 0, default.stderr + given.stderr
+    assert f"characteristic length L = {L:.6g} m (--length to change it)" in default.stderr
+    assert "characteristic length" not in given.stderr
+    a, b = json.loads(default.stdout), json.loads(given.stdout)
+    assert a["length_SI"] == b["length_SI"] == L and a["gci_2"] == b["gci_2"] and a["reachable"] == b["reachable"] > 0
