@@ -15,9 +15,14 @@ import walk_commands  # (tools/ is no package: imported from its folder)
 
 
 def test_every_command_and_every_documented_command_has_a_recipe():
-    assert set(walk_commands.RECIPES) == set(COMMANDS)
+    import argparse
+
+    from pkm.cli.app import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    assert {walk_commands.command_of([name]) for name in sub.choices} == set(walk_commands.RECIPES) == set(COMMANDS)
     lines = list(walk_commands.documented_lines())
-    documented = {walk_commands.command_of(argv) for _, line in lines for argv in walk_commands.split_line(line)}
+    documented = {walk_commands.command_of(argv) for _, line, _ in lines for argv in walk_commands.split_line(line)}
     assert len(lines) >= 20 and {"calibrate plan", "sweep plot", "sweep best", "identify"} <= documented
     assert documented <= set(COMMANDS), documented - set(COMMANDS)  # (a documented command pkm does not have)
     for recipe in walk_commands.RECIPES.values():  # (a skipped command says why; a run one has steps)

@@ -126,19 +126,20 @@ RECIPES: dict[str, Recipe] = {
 checks that every command and every documented ``pkm X`` has one)."""
 
 
-def documented_lines(root: Path = ROOT) -> Iterator[tuple[str, str]]:
-    """``(where, line)`` for each ``pkm ...`` command of the fenced blocks of README.md and docs/**/*.md (a
-    ``$ `` prompt and a trailing ``# comment`` taken off; a line ``A && B`` gives one entry)."""
+def documented_lines(root: Path = ROOT) -> Iterator[tuple[str, str, str]]:
+    """``(where, line, block)`` for each ``pkm ...`` command of the fenced blocks of README.md and docs/**/*.md (a
+    ``$ `` prompt taken off; a line ``A && B`` gives one entry; ``block``: where its fenced block starts, the lines
+    of one block run in order in one folder, a line reading what one above it wrote)."""
     for path in [root / "README.md", *sorted((root / "docs").rglob("*.md"))]:
-        fenced = False
+        block = ""
         for k, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
             text = line.strip()
             if text.startswith("```"):
-                fenced = not fenced
+                block = "" if block else f"{path.relative_to(root)}:{k}"
                 continue
             text = text.removeprefix("$ ")
-            if fenced and text.startswith("pkm "):
-                yield f"{path.relative_to(root)}:{k}", text
+            if block and text.startswith("pkm "):
+                yield f"{path.relative_to(root)}:{k}", text, block
 
 
 def command_of(argv: list[str]) -> str:
@@ -228,6 +229,8 @@ class Cell:
     verdict: str = ""
     detail: str = ""
     seconds: float = 0.0
+    group: str = ""
+    """Cells of one group run in order in one folder (a documented block's lines); "": a folder of its own."""
 
 
 OUTSIDE = re.compile(r'"status": "outside_limits"|outside the position limits the model states')
@@ -251,14 +254,14 @@ def judge(proc) -> tuple[str, str]:
     return "FAILED", f"exit {proc.returncode}: {last}"
 
 
-def run_cell(cell: Cell, steps: list) -> Cell:
-    """Run ``steps`` (argv lists, or callables ``fn(folder)``) in a fresh temporary folder; the last is judged, a
-    step before it that does not succeed is the cell's verdict."""
+def run_cell(cell: Cell, steps: list, folder: Path | None = None) -> Cell:
+    """Run ``steps`` (argv lists, or callables ``fn(folder)``) in ``folder`` (default: a fresh temporary one); the
+    last is judged, a step before it that does not succeed is the cell's verdict."""
     from tests.cli.helpers import run
 
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="pkm-walk-") as tmp:
-        folder = Path(tmp)
+        folder = Path(tmp) if folder is None else folder
         for step in steps:
             if callable(step):
                 step(folder)
@@ -277,13 +280,15 @@ def run_cell(cell: Cell, steps: list) -> Cell:
     return cell
 
 
-def _work(item: tuple[Cell, list]) -> Cell:
-    cell, steps = item
-    try:
-        return run_cell(cell, steps)
-    except Exception as exc:  # (the walk's own failure to set a cell up: reported as the cell's)
-        cell.verdict, cell.detail = "FAILED", f"{type(exc).__name__}: {exc}"
-        return cell
+def _work(group: list[tuple[Cell, list]]) -> list[Cell]:
+    """Run a group's cells in order in one temporary folder."""
+    with tempfile.TemporaryDirectory(prefix="pkm-walk-") as tmp:
+        for cell, steps in group:
+            try:
+                run_cell(cell, steps, Path(tmp))
+            except Exception as exc:  # (the walk's own failure to set a cell up: reported as the cell's)
+                cell.verdict, cell.detail = "FAILED", f"{type(exc).__name__}: {exc}"
+    return [cell for cell, _ in group]
 
 
 def cells(only: set[str] | None, mechanisms: tuple[str, ...], docs: bool, defaults: bool,
@@ -325,12 +330,12 @@ def cells(only: set[str] | None, mechanisms: tuple[str, ...], docs: bool, defaul
                     continue
                 yield cell, [_bind(s, info) if callable(s) else s for s in steps]
     if docs:
-        for where, line in documented_lines():
+        for where, line, block in documented_lines():
             parts = split_line(line)
             command = command_of(parts[-1])
             if only and not {command_of(p) for p in parts} & only:
                 continue
-            cell = Cell(command, where)
+            cell = Cell(command, where, group=block)
             skip = next((why for start, why in DOC_SKIPS.items() if line.startswith(start)), "")
             if skip and not (line.startswith("pkm preview") and "--html" in line):
                 cell.argv, cell.verdict, cell.detail = parts[-1], "skipped", skip
@@ -402,21 +407,27 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     todo = list(cells(set(args.only) if args.only else None, tuple(args.mechanism), not args.no_docs,
                       not args.no_defaults, args.full))
-    runs = [item for item in todo if item[1]]
+    groups: dict[str, list[tuple[Cell, list]]] = {}
+    for k, (cell, steps) in enumerate(todo):
+        if steps:
+            groups.setdefault(cell.group or str(k), []).append((cell, steps))
 
-    def progress(cell: Cell) -> Cell:
-        print(f"  {cell.verdict:<9} {cell.seconds:5.1f}s  {cell.command} [{cell.column}]", file=sys.stderr, flush=True)
-        return cell
+    def progress(group: list[Cell]) -> list[Cell]:
+        for cell in group:
+            print(f"  {cell.verdict:<9} {cell.seconds:5.1f}s  {cell.command} [{cell.column}]", file=sys.stderr,
+                  flush=True)
+        return group
 
+    ran: dict[int, Cell] = {}
     if args.jobs > 1:
         with ProcessPoolExecutor(args.jobs) as pool:
-            futures = [pool.submit(_work, item) for item in runs]
+            futures = {pool.submit(_work, g): g for g in groups.values()}
             for f in as_completed(futures):
-                progress(f.result())
-            finished = iter([f.result() for f in futures])
+                ran.update(zip((id(c) for c, _ in futures[f]), progress(f.result())))
     else:
-        finished = (progress(_work(item)) for item in runs)
-    done = [next(finished) if steps else cell for cell, steps in todo]  # (in the walk's order)
+        for g in groups.values():
+            ran.update(zip((id(c) for c, _ in g), progress(_work(g))))
+    done = [ran.get(id(cell), cell) for cell, _ in todo]  # (in the walk's order)
     print(table(done))
     wall = time.perf_counter() - t0
     print(f"walk: {len(done)} cells in {wall:.1f} s ({args.jobs} processes)")
