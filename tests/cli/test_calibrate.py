@@ -5,11 +5,14 @@ figure), in process; bad input as one error line."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
 import pkm
 from pkm import cli
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_plan_simulate_calibrate_write_load(tmp_path, capsys) -> None:
@@ -49,3 +52,12 @@ def test_the_budget_and_the_spread_are_options_whose_help_states_the_defaults(ca
     text = " ".join(capsys.readouterr().out.split())
     assert f"--max-evaluations N the least squares' budget of residual evaluations (default {NFEV_PER_PARAMETER} " in text
     assert f"(default {SPREAD:g} rad for a revolute actuator, {SPREAD:g} x the mechanism's characteristic" in text
+
+
+def test_a_model_the_mechanism_cannot_measure_names_the_option(tmp_path, capsys) -> None:
+    """The humanoid ankle has no end effector: ``--model pose`` (the default) is refused naming ``--model passive``,
+    the option of the command line (the library's message names ``kind='passive'``)."""
+    assert cli.main(["calibrate", "plan", str(ROOT / "examples/humanoid_ankle/ankle.closures.toml"), "--poses", "5",
+                     "--out", str(tmp_path / "d.csv")]) == 1
+    err = capsys.readouterr().err
+    assert "use --model passive with encoders on passive joints" in err and "kind=" not in err, err

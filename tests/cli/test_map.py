@@ -6,6 +6,7 @@ import csv
 import json
 import math
 
+import pkm
 from pkm import cli
 from tests.cli.helpers import run
 from tests.papers.figures import inspected
@@ -88,3 +89,16 @@ def test_the_map_of_a_mechanism_with_collision_geometry_marks_interference(tmp_p
     assert out["interfering"] == sum(float(r["clearance"]) < 0.0 for r in rows) > 0
     assert math.isclose(out["size_interference_free_SI"], 7 * 0.075 ** 2, rel_tol=1e-12)
     assert out["smallest_clearance_m"] == min(float(r["clearance"]) for r in rows)
+
+
+def test_a_mixed_task_defaults_to_the_characteristic_length_and_says_so():
+    """A 3-RRR map (its task: x, y, yaw) without ``--length``: the mechanism's characteristic length, said on stderr
+    and in the summary, and the same map as with that ``--length`` given."""
+    L = pkm.load("rrr3").characteristic_length
+    axes = ("--axis", "x=45cm:55cm:3")
+    default, given = run("map", "rrr3", *axes), run("map", "rrr3", *axes, "--length", f"{L!r}")
+    assert default.returncode == 0 and given.returncode == 0, default.stderr + given.stderr
+    assert f"characteristic length L = {L:.6g} m (--length to change it)" in default.stderr
+    assert "characteristic length" not in given.stderr
+    a, b = json.loads(default.stdout), json.loads(given.stdout)
+    assert a["length_SI"] == b["length_SI"] == L and a["gci_2"] == b["gci_2"] and a["reachable"] == b["reachable"] > 0

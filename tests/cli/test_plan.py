@@ -60,3 +60,23 @@ def test_the_path_point_and_the_payload_take_units(tmp_path, capsys):
                        (["--path", "adept:0,0,-0.33", "--payload", "5mm"], "'mm' is a length unit but --payload")):
         assert cli.main(["plan", "delta", *argv, "--out", out]) != 0
         assert says in capsys.readouterr().err
+
+
+def test_a_path_csv_names_a_pose_as_pose_does(tmp_path):
+    """A Gough-Stewart path headed ``x,y,z,roll,pitch,yaw`` (as ``--pose`` and ``pkm list`` name the task) reads as
+    the same waypoints headed with the task's values ``x,y,z,qx,qy,qz,qw`` (the quaternions of those angles)."""
+    from pkm.cli.commands.plan import read_path
+
+    mech = pkm.load("gough_stewart")
+    task = pkm.TaskMap.of(mech)
+    poses = [task.named(mech.q_reference), dict(task.named(mech.q_reference), x=0.01, roll=0.05)]
+    values = [task.parse(p) for p in poses]
+    for name, header, rows in (("named.csv", task.keys, [[p[k] for k in task.keys] for p in poses]),
+                               ("values.csv", task.value_names, values)):
+        (tmp_path / name).write_text(",".join(header) + "\n" + "\n".join(",".join(map(repr, map(float, r)))
+                                                                           for r in rows) + "\n")
+    (named, space), (given, space_given) = read_path(mech, str(tmp_path / "named.csv")), read_path(
+        mech, str(tmp_path / "values.csv"))
+    assert space == space_given == "task" and task.keys != task.value_names
+    assert np.allclose(named, given, rtol=0, atol=1e-15)
+    assert not np.allclose(named[1, 3:], named[0, 3:])  # (the roll of the second waypoint is in its quaternion)

@@ -260,3 +260,15 @@ def test_a_design_that_does_not_follow_the_motion_fails_saying_where(tmp_path):
     res = pkm.sweep("prs3", sweeps.grid(l=[1.0]), [f"peak_effort:file={motion},motion=up"], scheduler="serial")
     (failure,) = res.failures()
     assert not res.ok.any() and "does not follow motion 'up': at sample 9 of 21, did not converge" in failure["message"]
+
+
+def test_the_condition_of_a_mixed_task_defaults_to_each_designs_characteristic_length():
+    """The 3-RRR (task x, y, yaw) swept over its proximal length ``a`` without ``length``: each design's condition
+    number is the one with that design's own characteristic length given (so a design's scale changes it as its
+    geometry does, not by an absolute length)."""
+    res = pkm.sweep("rrr3", sweeps.table({"a": [0.36, 0.44]}), ["condition"], scheduler="serial")
+    assert res.stats.failed == 0
+    for a, kappa in zip((0.36, 0.44), res.column("condition")):
+        L = pkm.build("rrr3", a=a).characteristic_length
+        given = pkm.sweep("rrr3", sweeps.table({"a": [a]}), [f"condition=condition:length={L!r}"], scheduler="serial")
+        assert kappa == given.column("condition")[0] and math.isfinite(kappa)

@@ -119,7 +119,8 @@ def _map(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, 
         raise InvalidInputError("fixed", "{task coordinate: value}", fixed)
     length = body.get("length")
     index = body.get("index")
-    m = workspace_map(mech, axes, fixed, length=None if length is None else quantity(length, "length", "length"),
+    length = pkm.TaskMap.of(mech).default_length(None if length is None else quantity(length, "length", "length"))
+    m = workspace_map(mech, axes, fixed, length=length,
                       configurations=index is not None)
     job.progress = 0.7
     grids = np.meshgrid(*[v for _, v in reversed(m.axes)], indexing="ij")
@@ -128,9 +129,9 @@ def _map(mech: Mechanism, body: Mapping[str, Any], job: Job) -> tuple[dict[str, 
     rows["ci_2"] = m.condition_index("2").ravel()
     out: dict[str, Any] = {"axes": {n: v for n, v in m.axes}, "reachable": m.reachable,
                            "condition_index": m.condition_index("2"), "nodes": m.nodes, "size": m.size,
-                           "gci": m.gci("2"), "how": m.how,
+                           "gci": m.gci("2"), "how": m.how, "length": length,
                            "units": {"axes": {n: ("m" if k == "length" else "rad") for (n, _), k in zip(m.axes, m.kinds)},
-                                     "size": m.size_unit, "condition_index": "1", "gci": "1"}}
+                                     "size": m.size_unit, "condition_index": "1", "gci": "1", "length": "m"}}
     if m.within_limits is not None:  # (the joints' limits and the interference, where the map checked them)
         rows["within_limits"] = m.within_limits.ravel()
         out["within_limits"] = m.within_limits

@@ -559,6 +559,9 @@ class MapResult(_Answer):
     size: float = _field("The reachable region's length, area or volume (in units.size: m^2, m rad...).", 0.01)
     gci: float | None = _field("The global condition index (its mean over the reachable nodes) [1].", 0.5)
     how: str = _field("How the map was computed.", "ik")
+    length: float | None = _field("The characteristic length dividing the angular rates [m] (given, else the "
+                                  "mechanism's where the task mixes lengths and angles; null: a task of one kind).",
+                                  0.2, None)
     within_limits: Any = _field("Whether each node's configuration lies within the joints' position limits (absent "
                                 "where the map did not check them).", [[True]], None)
     clearance: Any = _field("The smallest signed distance between the bodies checked for collision at each node [m] "

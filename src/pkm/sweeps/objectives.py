@@ -341,13 +341,15 @@ def _generic_map(c: Candidate, o: Mapping[str, Any], configurations: bool = Fals
     nodes = int(np.prod([k for _, _, k in o["region"].values()]))
 
     def make():
+        import pkm
         from pkm.core.analysis.maps import workspace_map
 
         mech = c.mechanism
         axes = {n: np.linspace(_task_value(mech, n, a), _task_value(mech, n, b), k)
                 for n, (a, b, k) in o["region"].items()}
         fixed = {n: _task_value(mech, n, v) for n, v in (o.get("pose") or {}).items()}
-        return workspace_map(mech, axes, fixed, length=o.get("length"), branch=o.get("branch") or None,
+        length = pkm.TaskMap.of(mech).default_length(o.get("length"))  # (None: the design's own, on a mixed task)
+        return workspace_map(mech, axes, fixed, length=length, branch=o.get("branch") or None,
                              kernels=c.kernels, configurations=configurations or nodes <= KEEP_CONFIGURATIONS,
                              collisions=collisions)
 
@@ -460,7 +462,8 @@ def _generic_condition(c, o):
     mech = c.mechanism
     target = {n: _task_value(mech, n, v) for n, v in (o.get("pose") or {}).items()}
     res = pkm.solve_ik(mech, target, branch=o.get("branch") or None)
-    scale = pkm.TaskMap.of(mech).rate_scale(o.get("length"))  # (as the maps do)
+    task = pkm.TaskMap.of(mech)
+    scale = task.rate_scale(task.default_length(o.get("length")))  # (as the maps do)
     try:
         K = pkm.inverse_jacobian(mech, res.q)
     except SingularityError:
@@ -537,7 +540,8 @@ def _generic_interval(c, o):
 _REGION_UNIT = "m^i rad^j"  # (the product of the region's axes' units)
 _MAP = {"region": ("region", None, "task coordinates mapped (generic): x=START:STOP:COUNT/y=..."),
         "pose": ("pose", None, "the other task coordinates (generic): x=2cm/z=-36cm"),
-        "length": ("length", None, "characteristic length dividing angular rates (generic), e.g. 5cm"),
+        "length": ("length", None, "characteristic length dividing angular rates (generic), e.g. 5cm; default "
+                                   "where the task mixes lengths and angles: each design's characteristic length"),
         "branch": ("text", "", "working mode (default: the spec's; a closed form may name its own modes)"),
         "kind": ("text", "2", "condition-index convention: 2 or fro_normalized", ("2", "fro_normalized"))}
 

@@ -15,10 +15,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 from typing import Any
 
 from pkm.cli.command import Command
 from pkm.cli.mechanism import add_mechanism_arguments, load_mechanism
+from pkm.errors import InvalidInputError
 
 KIND_HELP = "what is measured: pose (6-D), position (3-D), planar (x, y, yaw), passive (encoders on passive joints)"
 
@@ -37,15 +39,28 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print the result as JSON")
 
 
+def calibration_model(mech: Any, kind: str) -> Any:
+    """:class:`~pkm.core.calibration.measurement.CalibrationModel` of ``--model kind``; the library's refusal of
+    a ``kind`` names the option (``kind='passive'``: ``--model passive``)."""
+    from pkm.core.calibration.measurement import CalibrationModel
+
+    try:
+        return CalibrationModel(mech, kind)
+    except InvalidInputError as exc:
+        if exc.name != "kind":
+            raise
+        text = str(exc).removeprefix("kind: ")
+        raise InvalidInputError("--model", re.sub(r"kind='(\w+)'", r"--model \1", text), kind) from None
+
+
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from pkm.core.calibration.estimate import calibrate
-    from pkm.core.calibration.measurement import CalibrationModel
     from pkm.core.calibration.writeback import read_data, write_calibrated
 
     mech = load_mechanism(args)
-    model = CalibrationModel(mech, args.model)
+    model = calibration_model(mech, args.model)
     M, Y = read_data(model, args.data)
     cal = calibrate(model, M, Y, loss=args.loss, max_nfev=args.max_evaluations)
     spec, toml, *mjcf = write_calibrated(cal, args.out)
@@ -105,12 +120,11 @@ def add_plan_arguments(p: argparse.ArgumentParser) -> None:
 
 def run_plan(args: argparse.Namespace) -> int:
     from pkm.core.calibration.estimate import perturbed, simulate
-    from pkm.core.calibration.measurement import CalibrationModel
     from pkm.core.calibration.poses import calibration_poses
     from pkm.core.calibration.writeback import write_data
 
     mech = load_mechanism(args)
-    model = CalibrationModel(mech, args.model)
+    model = calibration_model(mech, args.model)
     chosen = calibration_poses(model, args.poses, spread=args.spread)
     x = model.parameters.nominal if args.simulate is None else perturbed(model, args.simulate)
     y = simulate(model, x, chosen.readings, seed=args.simulate or 0,

@@ -16,10 +16,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from typing import Any
 
 import numpy as np
 
+import pkm
 from pkm.cli.command import Command
 from pkm.cli.commands.stiffness import add_spring_arguments, springs
 from pkm.cli.mechanism import add_mechanism_arguments, add_seed_argument, load_mechanism
@@ -35,7 +37,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--pose", metavar="K=V", action="extend", nargs="+", default=[],
                    help="the other task coordinates (default: the reference's)")
     p.add_argument("--length", metavar="L", help="characteristic length dividing the angular rates, e.g. 5cm "
-                                                 "(needed when the task mixes lengths and angles)")
+                                                 "(default where the task mixes lengths and angles: the mechanism's "
+                                                 "characteristic length, said on stderr)")
     p.add_argument("--branch", metavar="NAME", help="working mode of the map (see 'pkm list')")
     add_seed_argument(p, "the configuration the map starts from (its working mode is the map's; default: the "
                          "reference, or the branch's)")
@@ -66,6 +69,9 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("name each --axis once")
     fixed = parse_task(mech, args.pose or [])
     length = None if args.length is None else parse_quantity(args.length, {"length"}, "--length", "m")
+    if length is None and (length := pkm.TaskMap.of(mech).default_length(None)) is not None:
+        print(f"note: the task mixes lengths and angles: the angular rates divided by the mechanism's "
+              f"characteristic length L = {length:.6g} m (--length to change it)", file=sys.stderr)
     if args.index and args.png and len(axes) > 2:
         raise UsageError("--index draws one or two axes: leave --png out of a 3-D map (its CSV has every node)")
     if args.stiffness and args.index:
@@ -78,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
                       configurations=bool(args.index or args.stiffness),
                       collisions=True if args.collisions else False if args.no_collisions else None)
     out: dict[str, Any] = {"mechanism": mech.name, "axes": {n: [float(v[0]), float(v[-1]), len(v)] for n, v in m.axes},
-                           "nodes": int(m.reachable.size), "reachable": m.nodes, "size_SI": m.size, "size_unit": m.size_unit,
+                           "length_SI": length, "nodes": int(m.reachable.size), "reachable": m.nodes, "size_SI": m.size, "size_unit": m.size_unit,
                            "gci_2": m.gci("2"), "gci_fro_normalized": m.gci("fro_normalized"), "how": m.how}
     if m.clearance is not None and m.within_limits is not None and m.interferes is not None:
         out["interference"] = {

@@ -3,8 +3,9 @@
 Parquet) and as a ``pkm.motion`` file (the actuated joints' ``hermite`` laws: positions and rates at the plan's
 times), its speed profile drawn with the active limit marked, and the cycle time printed.
 
-``--path`` is a CSV of waypoints whose header names the task's values (``pkm list`` names them; or the actuated
-joints', for a path in actuator space) [m, rad], a ``pkm.motion`` case ``FILE.toml:CASE``, or
+``--path`` is a CSV of waypoints whose header names the task's coordinates as ``--pose`` does (``pkm list`` names
+them: a pose as ``x y z roll pitch yaw``), or its values (a pose as ``x y z qx qy qz qw``), or the actuated
+joints' (a path in actuator space) [m, rad], a ``pkm.motion`` case ``FILE.toml:CASE``, or
 ``adept:X,Y,Z`` (the 25/305/25 mm cycle from the point X, Y, Z [m, or with units: ``adept:0,0,-35cm``] along +x). ``--limits`` takes ``peak``,
 ``omega0``, ``speed``, ``acceleration`` (:func:`pkm.core.timing.limits.parse_limits`).
 """
@@ -33,7 +34,8 @@ if TYPE_CHECKING:
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_mechanism_arguments(p, None, None)
     p.add_argument("--path", metavar="PATH", required=True,
-                   help="waypoints (CSV, header: the task's value names or the actuated joints'), a motion case "
+                   help="waypoints (CSV, header: the task's coordinates as --pose names them, its values, or the "
+                        "actuated joints'), a motion case "
                         "FILE.toml:CASE, or adept:X,Y,Z")
     p.add_argument("--coordinates", metavar="A,B,C", help="a motion case's coordinates as the task's names, in the "
                                                           "file's order (the 3-PRS's z,beta,phi: z,pitch,roll)")
@@ -64,9 +66,9 @@ def read_path(mech: Mechanism, text: str, coordinates: str | None = None) -> tup
 
     if text.startswith("adept:"):
         start = [parse_quantity(v.strip(), {"length"}, "--path adept:X,Y,Z", "m") for v in text[6:].split(",")]
-        task = pkm.TaskMap.of(mech).value_names
-        if task != ("x", "y", "z"):
-            raise InvalidInputError("--path", "the adept cycle is a path of a task x, y, z", task)
+        task_values = pkm.TaskMap.of(mech).value_names
+        if task_values != ("x", "y", "z"):
+            raise InvalidInputError("--path", "the adept cycle is a path of a task x, y, z", task_values)
         return adept_waypoints(start), "task"
     file, case = text.rsplit(":", 1) if ".toml:" in text else (text, "")
     if file.endswith(".toml"):
@@ -84,14 +86,18 @@ def read_path(mech: Mechanism, text: str, coordinates: str | None = None) -> tup
     with path.open(newline="", encoding="utf-8") as fh:
         rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
     header = tuple(c.strip() for c in rows[0]) if rows else ()
-    spaces = {tuple(pkm.TaskMap.of(mech).value_names): "task", tuple(mech.actuated_names): "actuated"}
+    task = pkm.TaskMap.of(mech)
+    spaces = {tuple(task.keys): "named", tuple(task.value_names): "task", tuple(mech.actuated_names): "actuated"}
     if header not in spaces:
-        raise InvalidInputError("--path", f"{file}: the header must read {','.join(pkm.TaskMap.of(mech).value_names)} "
-                                          f"(task) or {','.join(mech.actuated_names)} (actuated)", header)
+        named = "" if task.keys == task.value_names else f", {','.join(task.keys)} (task, as --pose names it)"
+        raise InvalidInputError("--path", f"{file}: the header must read {','.join(task.value_names)} "
+                                          f"(task){named} or {','.join(mech.actuated_names)} (actuated)", header)
     try:
         values = np.array([[float(c) for c in r] for r in rows[1:]])
     except ValueError as exc:
         raise InvalidInputError("--path", f"{file}: {exc}", file) from None
+    if spaces[header] == "named":  # (a pose by x y z roll pitch yaw, as --pose and 'pkm list' name it)
+        return np.array([task.parse(dict(zip(header, row))) for row in values]), "task"
     return values, spaces[header]
 
 

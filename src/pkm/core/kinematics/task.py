@@ -200,6 +200,13 @@ class TaskMap:
         self.kinds = {k: v for g in groups for k, v in g.kinds.items()}
         self.kinds.update({j: "angle" if mech.joints[j].revolute else "length" for j in self.spec.joints})
 
+    def default_length(self, length: float | None) -> float | None:
+        """``length``, or where it is None and the task mixes lengths and angles, the mechanism's characteristic
+        length [m] (:attr:`Mechanism.characteristic_length <pkm.core.model.mechanism.Mechanism.characteristic_length>`):
+        the default of the command line's and the service's maps (the library's functions ask for it)."""
+        mixed = {"angle", "length"} <= set(self.kinds.values())
+        return float(self.mech.characteristic_length) if length is None and mixed else length
+
     def rate_scale(self, length: float | None, keys: Sequence[str] | None = None) -> np.ndarray:
         """The scales of the task rates ``keys`` (default: all, in :attr:`keys` order): 1 for a length, ``1/length``
         for an angle, the homogenisation by a characteristic length ``L`` [m] that makes every rate a speed.

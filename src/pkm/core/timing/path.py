@@ -152,7 +152,10 @@ def waypoint_path(mech: Mechanism, waypoints: ArrayLike, *, space: str = "task",
         cols = [i for i in range(size) if i not in quat]
         constant = W[0].copy()
         if [task.value_names[i] for i in cols] != list(task.keys[: len(cols)]):
-            raise InvalidInputError("waypoints", "this task's rates do not start with its position values",
+            raise InvalidInputError("waypoints", f"this task's rates {list(task.keys)} do not start with its values "
+                                                 f"{[task.value_names[i] for i in cols]} (a pose and joint outputs): "
+                                                 "give the path in actuator space (space='actuated'; on the command "
+                                                 f"line a CSV headed {','.join(mech.actuated_names)})",
                                     task.value_names)
     chords = np.diff(W[:, cols], axis=0) * _homogenised(mech, space, cols)
     length = np.linalg.norm(chords, axis=1)
