@@ -22,7 +22,6 @@ from tests.cli.helpers import one_error_line, run
     (("ik", "delta", "--pose", "z=-0.36", "--branch", "up"), 2, "'knee_out', 'knee_in'"),
     (("map", "rrr3", "--axis", "x=0:1"), 2, "expected NAME=START:STOP:COUNT"),
     (("map", "rrr3", "--axis", "q=0:1:3"), 2, "valid task coordinates: 'x', 'y', 'yaw'"),
-    (("map", "rrr3", "--axis", "x=20cm:80cm:5"), 1, "give the characteristic length"),
 ])
 def test_bad_command_lines_give_one_helpful_line(args, status, message):
     """Unknown names, bad units, a missing '=' exit 2, an invalid parameter value exits 1; one line each."""
