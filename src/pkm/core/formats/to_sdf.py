@@ -58,6 +58,7 @@ from pkm.core.formats.to_mjcf import geometry_omissions, joint_axis, mimic_leade
 from pkm.core.model.actuators import NUMBERS
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.spec import ClosureSpec
+from pkm.core.model.urdf import unique_name
 from pkm.errors import SpecError
 
 #: The namespace of pkm's custom SDFormat elements (``<pkm:position>``, ``<pkm:free_joint>``).
@@ -82,7 +83,7 @@ def _pose(parent: etree._Element, M: pin.SE3) -> None:
     _text(parent, "pose", _num([*M.translation, *pin.rpy.matrixToRpy(M.rotation)]))
 
 
-def _closed(mech: Mechanism) -> np.ndarray:
+def closed_reference(mech: Mechanism) -> np.ndarray:
     """The reference configuration, its loops closed to the last bit where the solver gets there from it within
     1e-9 (the file's poses place each cut joint's two frames at one point: the residual left in the reference, 5e-13
     on the acceptance set's 3-RPR, would move them apart by as much; the polish moves it by 2.5e-12 there), else the
@@ -108,7 +109,7 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
         raise SpecError(source, f"SDFormat (as pkm reads it) has no floating base ({spec.floating_base!r}): pkm's "
                                 "reader fixes the base link; write pkm's spec or MJCF")
     data = model.createData()
-    q = _closed(mech)
+    q = closed_reference(mech)
     pin.forwardKinematics(model, data, q)
     pin.updateFramePlacements(model, data)
     names = {model.names[j] for j in range(model.njoints)}
@@ -117,12 +118,10 @@ def sdf_from_mechanism(mech: Mechanism) -> tuple[str, tuple[str, ...]]:
     cut_frames = {f"{c.name}_{side}" for c in spec.closures for side in ("parent", "child")}
     cut_frames |= {f"{n}_fixed" for n in cut_frames}
 
+    reserved = frame_names | names
+
     def unique(base: str) -> str:
-        out, k = base, 1
-        while out in taken or (out != base and (out in frame_names or out in names)):
-            out, k = f"{base}_{k}", k + 1
-        taken.add(out)
-        return out
+        return unique_name(base, taken, reserved)
 
     taken |= names | cut_frames
     root = etree.Element("sdf", nsmap={"pkm": PKM_NS}, version="1.11")
@@ -345,7 +344,7 @@ def sdf_spec(mech: Mechanism, sdf_name: str) -> ClosureSpec:
     names) and every actuated joint's whole drive (:class:`~pkm.core.model.actuators.Actuator`'s fields)."""
     mech = check_mechanism(mech)
     reference: dict[str, tuple[float, ...]] = {}
-    for name, value in mech.q_to_dict(_closed(mech)).items():
+    for name, value in mech.q_to_dict(closed_reference(mech)).items():
         v = tuple(float(x) for x in np.atleast_1d(value))
         if mech.model.joints[mech.joints[name].id].shortname() == "JointModelUniversal":
             reference[f"{name}__1"], reference[f"{name}__2"] = (v[0],), (v[1],)

@@ -61,10 +61,10 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core.formats.to_mjcf import joint_axis, mimic_leader
-from pkm.core.formats.to_sdf import SCALAR_KINDS
-from pkm.core.formats.to_sdf import _closed as closed_reference
+from pkm.core.formats.to_sdf import SCALAR_KINDS, closed_reference
 from pkm.core.model.actuators import NUMBERS, Actuator
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.urdf import unique_name
 from pkm.errors import SpecError
 
 if TYPE_CHECKING:
@@ -130,11 +130,7 @@ def _tree(model: pin.Model, q: np.ndarray, limits: Mapping[str, tuple[float, flo
     names = {model.names[j] for j in range(model.njoints)}
 
     def unique(base: str) -> str:
-        out, k = base, 1
-        while out in taken or (out != base and out in names):
-            out, k = f"{base}_{k}", k + 1
-        taken.add(out)
-        return out
+        return unique_name(base, taken, names)
 
     links: list[str] = [""]  # the body of each joint ("" : the world)
     bodies: list[_Body] = []

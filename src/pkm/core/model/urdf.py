@@ -48,7 +48,7 @@ import copy
 import io
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Container, Mapping, Sequence
 
 import numpy as np
 import pinocchio as pin
@@ -71,6 +71,16 @@ def _origin(xyz: ArrayLike = (0.0, 0.0, 0.0), rotation: ArrayLike | None = None)
     if rotation is not None:
         T[:3, :3] = rotation
     return T
+
+
+def unique_name(base: str, taken: set[str], reserved: Container[str] = ()) -> str:
+    """``base``, else ``base_1``, ``base_2``...: the first name not ``taken`` (a numbered one not ``reserved``
+    either), added to ``taken``; the writers' names for bodies, joints and frames."""
+    out, k = base, 1
+    while out in taken or (out != base and out in reserved):
+        out, k = f"{base}_{k}", k + 1
+    taken.add(out)
+    return out
 
 
 #: The collision primitives :meth:`UrdfBuilder.collision` writes, and their sizes' names [m].
@@ -562,11 +572,7 @@ def urdf_from_model(model: pin.Model, *, name: str | None = None, joint_names: d
     taken: set[str] = set()
 
     def unique(base: str) -> str:
-        out, k = base, 1
-        while out in taken or (out != base and out in fnames):
-            out, k = f"{base}_{k}", k + 1
-        taken.add(out)
-        return out
+        return unique_name(base, taken, fnames)
 
     robot = etree.Element("robot", name=name or model.name or "robot")
 
