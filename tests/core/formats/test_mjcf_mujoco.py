@@ -213,14 +213,19 @@ def test_several_top_level_defaults_frames_and_class_positions_are_read_as_mujoc
     md = mujoco.MjData(mm)
     model, notes = _model(text)
     assert any("<default>" in n for n in notes) and any("<frame>" in n for n in notes)
-    d = model.createData()
     for q in (np.zeros(2), np.array([0.5, -0.8])):
-        md.qpos[:] = q
-        mujoco.mj_kinematics(mm, md)
-        pin.framesForwardKinematics(model, d, q)
-        for b in ("l", "m"):
-            assert np.abs(d.oMf[model.getFrameId(b, pin.FrameType.BODY)].translation - md.body(b).xpos).max() <= TOL
-        assert np.abs(d.oMf[model.getFrameId("s")].translation - md.site("s").xpos).max() <= TOL
+        _bodies_and_site_where_mujoco_puts_them(mujoco, mm, md, model, q)
+
+
+def _bodies_and_site_where_mujoco_puts_them(mujoco, mm, md, model, q):
+    """Bodies ``l``, ``m`` and site ``s`` at ``q``: Pinocchio's frames where MuJoCo's kinematics puts them (TOL)."""
+    d = model.createData()
+    md.qpos[:] = q
+    mujoco.mj_kinematics(mm, md)
+    pin.framesForwardKinematics(model, d, q)
+    for b in ("l", "m"):
+        assert np.abs(d.oMf[model.getFrameId(b, pin.FrameType.BODY)].translation - md.body(b).xpos).max() <= TOL
+    assert np.abs(d.oMf[model.getFrameId("s")].translation - md.site("s").xpos).max() <= TOL
 
 
 def test_a_default_stated_after_the_worldbody_is_read_as_mujoco_does():
@@ -236,13 +241,7 @@ def test_a_default_stated_after_the_worldbody_is_read_as_mujoco_does():
     mujoco, mm = _mujoco_model(text)
     md = mujoco.MjData(mm)
     model, _ = _model(text)
-    d = model.createData()
-    md.qpos[:] = q = np.array([0.5, -0.8])
-    mujoco.mj_kinematics(mm, md)
-    pin.framesForwardKinematics(model, d, q)
-    for b in ("l", "m"):
-        assert np.abs(d.oMf[model.getFrameId(b, pin.FrameType.BODY)].translation - md.body(b).xpos).max() <= TOL
-    assert np.abs(d.oMf[model.getFrameId("s")].translation - md.site("s").xpos).max() <= TOL
+    _bodies_and_site_where_mujoco_puts_them(mujoco, mm, md, model, np.array([0.5, -0.8]))
 
 
 def test_a_connect_on_a_body_whose_joint_has_a_pos_closes_where_mujoco_does():
