@@ -91,7 +91,13 @@ def run(args: argparse.Namespace) -> int:
     for t in found:
         tk = TransmissionKernels.of(t)
         files = write_transmission(tk, Path(args.out) / t.name, targets)
+        maps = t.mechanism.motor_map
         out.append({"transmission": t.name, "root": t.root, "motors": list(t.motors), "outputs": list(t.outputs),
+                    "drives": list(t.drives), "constant": t.constant,
+                    "motor_map": None if maps.identity else {
+                        m: {d: float(c) for d, c in zip(t.drives, row) if c != 0.0}
+                        for m, row in zip(t.motors, t.motor_matrix)},
+                    "motor_equations": [] if maps.identity else list(maps.equations(t.drives)),
                     "folder": str(Path(args.out) / t.name), "files": sorted(files),
                     "instructions": {k: tk.function(k).n_instructions() for k in ("fk", "ik", "maps", "delta")}})
     model: dict[str, Any] | None = None
@@ -108,6 +114,9 @@ def run(args: argparse.Namespace) -> int:
     for o in out:
         print(f"{o['transmission']}: motors {', '.join(o['motors'])} -> outputs {', '.join(o['outputs'])}; "
               f"{', '.join(targets)} in {o['folder']}")
+        if o["motor_equations"]:
+            print(f"  motors through a constant map{' (a differential: constant maps)' if o['constant'] else ''}: "
+                  + "; ".join(o["motor_equations"]))
         print("  instructions: " + ", ".join(f"{k} {n}" for k, n in o["instructions"].items()))
     if serial is not None and model is not None:
         print(f"serial-equivalent model: {', '.join(Path(f).name for f in model['files'])} in {args.out}")

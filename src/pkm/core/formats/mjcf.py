@@ -104,7 +104,7 @@ from lxml import etree
 
 from pkm.core.formats.base import Imported
 from pkm.core.model.actuators import UNLIMITED, Actuator
-from pkm.core.model.motors import motor_map
+from pkm.core.model.motors import linear_text, motor_map
 from pkm.core.model.spec import Closure
 from pkm.core.model.springs import describe, parse_springs
 from pkm.core.model.urdf import floats, num, parse_xml, urdf_from_model
@@ -877,7 +877,7 @@ def _actuated(root: etree._Element, defaults: _Defaults, kinds: dict[str, str], 
             motors[motor] = {j: gear * f for j, f in moving.items()}
             out += [_Drive(j, f, el, label, motor) for j, f in moving.items()]
             notes.append(f"{label} on tendon {tendon!r} read as motor {motor!r} of a differential, its coordinate "
-                         + _linear(motors[motor].items()) + " (gear included; [motors]: its effort f acts on the joints as coef * f; its force range "
+                         + linear_text(motors[motor].items()) + " (gear included; [motors]: its effort f acts on the joints as coef * f; its force range "
                            "bounds the motor, not read as a joint's effort limit)")
         else:
             target = next((f"{key} {el.get(key)!r}" for key in ("site", "body", "refsite") if el.get(key)), "nothing")
@@ -888,14 +888,6 @@ def _actuated(root: etree._Element, defaults: _Defaults, kinds: dict[str, str], 
         raise SpecError(source, f"joint {both[0]!r} is driven both by an actuator of its own and through a "
                                 "differential's tendon: pkm reads a differential's joints as driven by its motors only")
     return out, motors
-
-
-def _linear(terms: Iterable[tuple[str, float]]) -> str:
-    """``c1 j1 + c2 j2 - c3 j3``: a linear combination of joints, for the notes."""
-    out = ""
-    for j, c in terms:
-        out += (f"{c:.6g} {j}" if not out else f" - {-c:.6g} {j}" if c < 0 else f" + {c:.6g} {j}")
-    return out
 
 
 def _gear(el: etree._Element, defaults: _Defaults, label: str, source: str) -> float:
@@ -922,7 +914,7 @@ def _tendon_joints(label: str, tendon: str, tendons: dict[str, list[tuple[str, f
             a = couplings.get(j)
             factors[a.root] = factors.get(a.root, 0.0) + coef * a.scale
     moving = {j: f for j, f in factors.items() if abs(f) > _SMALL}
-    text = _linear(parts)
+    text = linear_text(parts)
     if not moving:
         raise SpecError(source, f"{label} acts on tendon {tendon!r} ({text}), whose length no joint moves")
     if len(moving) == 1:

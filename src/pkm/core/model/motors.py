@@ -19,7 +19,7 @@ The rows are ordered by the first actuated joint each names (the motors of one d
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,6 +47,20 @@ class MotorMap:
     def identity(self) -> bool:
         """Whether every actuated joint has a motor of its own (no ``[motors]``)."""
         return bool(np.array_equal(self.matrix, np.eye(len(self.names))))
+
+    def equations(self, actuated: Sequence[str]) -> tuple[str, ...]:
+        """Each motor's coordinate as text, ``"m = 1 a + 1 b"``, the columns named ``actuated`` (the mechanism's
+        actuated joints): what the C and the command line show of a motor (a differential's map, not a joint)."""
+        return tuple(f"{n} = " + linear_text((j, float(c)) for j, c in zip(actuated, row) if c != 0.0)
+                     for n, row in zip(self.names, self.matrix))
+
+
+def linear_text(terms: Iterable[tuple[str, float]]) -> str:
+    """``c1 j1 + c2 j2 - c3 j3``: a linear combination of joints, for notes and listings."""
+    out = ""
+    for j, c in terms:
+        out += (f"{c:.6g} {j}" if not out else f" - {-c:.6g} {j}" if c < 0 else f" + {c:.6g} {j}")
+    return out
 
 
 def motor_map(actuated: Sequence[str], motors: Mapping[str, Mapping[str, float]], source: str = "<spec>") -> MotorMap:
@@ -107,4 +121,4 @@ def _check_groups(motors: Mapping[str, Mapping[str, float]], source: str) -> Non
                                     f"{C.tolist()} is singular (singular values {s[0]:.3g} and {s[-1]:.3g})")
 
 
-__all__ = ["RCOND", "MotorMap", "motor_map"]
+__all__ = ["RCOND", "MotorMap", "linear_text", "motor_map"]

@@ -33,6 +33,15 @@ The rules, in order:
    (every field in ``[actuators.<motor>]``), its outputs as the task (``TaskSpec(components=(), joints=outputs)``),
    the robot's reference. It has files and pickles. A joint whose position limits are an empty interval (``lower >=
    upper``: Pinocchio's placeholder where a file states none) is unlimited there.
+5. **Constant maps** (a differential: the spec's ``[motors.<name>]`` tables, :mod:`pkm.core.model.motors`; MuJoCo's
+   motors on fixed tendons over several joints). The motors whose tables share joints (transitively) are one group;
+   its map ``C`` (``u = C q_a``, the motors' coordinates from the actuated joints') is constant. A group whose joints
+   lie in no loop is a transmission of its own: its sub-mechanism is those joints alone (no closure, the rest locked
+   at the reference, rooted as rule 1's), its outputs those joints, its motors the group's motors, its maps constant
+   (:class:`Transmission`: ``qo = C⁻¹ u``, ``J = C⁻¹``, efforts ``τ_m = C⁻ᵀ τ_o``, ``ΔM = 0``, ``Δh = 0``), named by
+   the chain rule's body. A group whose joints are motors of one closed sub-mechanism drives it: that
+   transmission's motors are the group's (its maps composed with ``C``). A group that spans a loop and other joints,
+   or two sub-mechanisms, is refused (``reason="outputs"``).
 """
 
 from __future__ import annotations
@@ -48,7 +57,7 @@ from pkm.core.model.actuators import NUMBERS
 from pkm.core.model.builder import from_strings
 from pkm.core.model.joints import reduced_model, stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
-from pkm.core.model.spec import ClosureSpec, TaskSpec
+from pkm.core.model.spec import Closure, ClosureSpec, TaskSpec
 from pkm.core.model.urdf import urdf_from_model
 from pkm.core.transmissions.transmission import Transmission
 from pkm.errors import InvalidInputError, PkmError, PkmWarning, TransmissionError, UnknownNameError
@@ -96,10 +105,36 @@ def _groups(mech: Mechanism) -> list[tuple[list[int], set[int], int]]:
     return list(out.values())
 
 
+def _differentials(mech: Mechanism, loops: list[tuple[list[int], set[int], int]]
+                   ) -> list[tuple[list[int], set[int], int]]:
+    """Rule 5: the groups of ``[motors]`` (motors that share joints, transitively) whose joints lie in no loop of
+    ``loops``, each as a sub-mechanism ``([], its joints, its root)``: the root the deepest joint above every one of
+    them that is none of them."""
+    model = mech.model
+    groups: list[set[int]] = []
+    for coefs in mech.spec.motors.values():
+        ids = {mech.joints[j].id for j in coefs}
+        touching = [g for g in groups if g & ids]
+        for g in touching:
+            ids |= g
+            groups.remove(g)
+        groups.append(ids)
+    out: list[tuple[list[int], set[int], int]] = []
+    in_loops = set().union(*(js for _, js, _ in loops))
+    for ids in sorted(groups, key=min):
+        if ids & in_loops:
+            continue  # (rule 5: it drives a closed sub-mechanism, or spans one and is refused there)
+        common = [j for j in model.supports[min(ids)] if all(j in model.supports[i] for i in ids) and j not in ids]
+        out.append(([], ids, common[-1]))
+    return out
+
+
 def _root_body(model: pin.Model, joints: set[int], root: int) -> str:
     """The body the sub-mechanism's first joints hang from: the frame the first of them is attached to (Pinocchio's
     readers attach a joint's frame to its parent link's frame)."""
-    first = min(j for j in joints if model.parents[j] == root)
+    first = min((j for j in joints if model.parents[j] == root), default=None)
+    if first is None:  # (a differential's joints below serial joints of their own root: rule 5)
+        return _distal_body(model, root) if root else model.names[0]
     fid = model.getFrameId(model.names[first], pin.FrameType.JOINT)
     frame = model.frames[model.frames[fid].parentFrame]
     if frame.parentJoint == root:
@@ -142,6 +177,17 @@ def _unique(names: list[str]) -> list[str]:
     return out
 
 
+def _idle_closure(urdf: str) -> tuple[Closure]:
+    """A differential's sub-mechanism (rule 5: no loop) holds one closure that closes nothing: its root link's frame
+    on itself (no equation any motion moves: a pkm mechanism has a closure)."""
+    from lxml import etree
+
+    links = {el.get("name") for el in etree.fromstring(urdf.encode()).iter("link")}
+    children = {el.find("child").get("link") for el in etree.fromstring(urdf.encode()).iter("joint")}
+    root = sorted(links - children)[0]
+    return (Closure(name="differential", type="point", frame_a=root, frame_b=root),)
+
+
 def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[int], motors: tuple[str, ...],
                    outputs: tuple[str, ...]) -> Mechanism:
     """Rule 4: the sub-mechanism alone, rooted where the robot's reference puts its root, built from its own URDF
@@ -153,13 +199,21 @@ def _sub_mechanism(mech: Mechanism, name: str, closures: list[int], joints: set[
     stated = {n: lim for n, lim in mech.limits.items() if n in keep}
     urdf, types = urdf_from_model(reduced, name=name, limits=stated, source=mech.source)
     q_ref = mech.q_to_dict(mech.q_reference)
+    tables = {m: dict(c) for m, c in mech.spec.motors.items() if set(c) & set(motors)}
+    split = {m: sorted(set(c) - set(motors)) for m, c in tables.items() if not set(c) <= set(motors)}
+    if split:
+        m, rest = next(iter(split.items()))
+        raise TransmissionError(name, "outputs", f"its motor {m!r} ([motors]: a constant map) also drives {rest}, "
+                                f"joints outside its motors {list(motors)}: a differential across a closed "
+                                "sub-mechanism and other joints is no transmission", (m, *rest))
     spec = ClosureSpec(
         mechanism=name, urdf=f"{name}.urdf", end_effector=None, actuated=motors,
-        closures=tuple(mech.spec.closures[i] for i in closures), task=TaskSpec(components=(), joints=outputs),
+        closures=tuple(mech.spec.closures[i] for i in closures) or _idle_closure(urdf),
+        task=TaskSpec(components=(), joints=outputs),
         reference={n: tuple(np.atleast_1d(q_ref[n]).tolist()) for n in sorted(keep) if n in q_ref},
         joint_types=types, actuators={a.joint: {f: float(getattr(a, f)) for f in NUMBERS}
                                       for a in mech.actuators if a.joint in motors},
-        springs={n: v for n, v in mech.spec.springs.items() if n in keep},
+        springs={n: v for n, v in mech.spec.springs.items() if n in keep}, motors=tables,
         description=f"the closed sub-mechanism {name!r} of {mech.name!r}")
     with warnings.catch_warnings():  # (what the robot's loading said already: kept in the notes, not said twice)
         warnings.simplefilter("ignore", PkmWarning)
@@ -210,6 +264,7 @@ def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None =
             mech.joint(j)  # (UnknownNameError naming the valid joints)
         named[str(tname)] = tuple(joints)
     groups = _groups(mech)
+    groups += _differentials(mech, groups)
     actuated = {mech.joints[n].id for n in mech.actuated_names}
     claimed: dict[str, int] = {}
     for tname, joints in named.items():
@@ -229,6 +284,10 @@ def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None =
         if g in by_group:
             out_ids = [mech.joints[j].id for j in named[by_group[g]]]
             plans.append((by_group[g], closures, members, root, motor_ids, out_ids))
+        elif not closures:  # (rule 5: a differential's outputs are its joints)
+            out_ids = sorted(members)
+            plans.append((_distal_body(model, max(out_ids, key=lambda j: len(model.supports[j]))), closures,
+                          members, root, motor_ids, out_ids))
         else:
             out_ids, deepest = _chain_outputs(mech, closures, members, len(motor_ids))
             label = _distal_body(model, deepest) if deepest is not None else model.names[min(members)]
@@ -244,7 +303,8 @@ def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None =
             warnings.warn(PkmWarning(f"{exc}: left out (skip_unfit)"), stacklevel=2)
     if not result:
         raise TransmissionError(mech.name, "no_loop", "the robot has no closed sub-mechanism that is a transmission"
-                                if plans else "the robot has no closure: no closed sub-mechanism")
+                                if plans else "the robot has no closure and no differential ([motors]): no "
+                                "closed sub-mechanism")
     return result
 
 
@@ -300,8 +360,8 @@ def _transmission(mech: Mechanism, name: str, closures: list[int], joints: set[i
         raise
     except PkmError as exc:
         raise TransmissionError(name, "outputs", f"its sub-mechanism cannot be built: {exc}", outputs) from exc
-    t = Transmission(name=name, mechanism=sub, root=_root_body(model, joints, root), motors=motors, outputs=outputs,
-                     passive=passive)
+    t = Transmission(name=name, mechanism=sub, root=_root_body(model, joints, root), motors=sub.motor_map.names,
+                     outputs=outputs, passive=passive)
     t.check()  # (the rank conditions at the reference: TransmissionError "singular")
     return t
 

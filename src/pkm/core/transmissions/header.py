@@ -29,6 +29,17 @@ def class_name(p: str) -> str:
     return "".join(w.capitalize() for w in p.split("_")) + "Transmission"
 
 
+def _motor_comment(tk: TransmissionKernels, p: str) -> str:
+    """The header's lines on the motors: each one's map where ``[motors]`` drive the joints through a constant map
+    (a differential), the motors being no joints of q."""
+    if tk.mech.motor_map.identity:
+        return (f"\n   Motors: the joints {p}_drive_names of q themselves ({p}_motor_map the identity: qm = C q_a, "
+                "column-major).")
+    lines = "; ".join(tk.mech.motor_map.equations(tk.drives))
+    return (f"\n   Motors: {lines} (qm = C q_a, C = {p}_motor_map, K x K column-major, the joints {p}_drive_names of "
+            f"q; a differential's motors are no joints of q){'; constant maps: no loop' if tk.constant else ''}.")
+
+
 def c_library(tk: TransmissionKernels, p: str) -> tuple[str, str]:
     """``(header, source)`` of the C99 library ``p`` (see the module doc)."""
     U, k, nq = p.upper(), tk.k, tk.mech.nq
@@ -40,7 +51,7 @@ def c_library(tk: TransmissionKernels, p: str) -> tuple[str, str]:
    written only when {U}_OK or {U}_OUTSIDE_LIMITS), {tk.iterations} iterations, converged at a closure residual of
    {tk.tol!r} [m, rad]; {U}_OUTSIDE_LIMITS: converged, but a joint (a motor, an output, a rod's) lies beyond the
    limit the robot's file states ({p}_limit_low, {p}_limit_high per entry of q; +-INFINITY where none).
-   The effort maps are the velocity maps' transposes (power balance): tau_m = J^T tau_o, tau_o = J_inv^T tau_m. */
+   The effort maps are the velocity maps' transposes (power balance): tau_m = J^T tau_o, tau_o = J_inv^T tau_m.{_motor_comment(tk, p)} */
 #ifndef {U}_H
 #define {U}_H
 
@@ -56,6 +67,8 @@ extern const double {p}_q_reference[{U}_NQ];
 extern const char* const {p}_q_names[{U}_NQ];
 extern const char* const {p}_motor_names[{U}_K];
 extern const char* const {p}_output_names[{U}_K];
+extern const char* const {p}_drive_names[{U}_K];
+extern const double {p}_motor_map[{U}_K * {U}_K];
 extern const double {p}_limit_low[{U}_NQ];
 extern const double {p}_limit_high[{U}_NQ];
 
@@ -92,6 +105,9 @@ int {p}_fk_j_dm(const double* qm, double* q, double* qo, double* J, double* dM);
             f"const char* const {p}_q_names[{U}_NQ] = {{{', '.join(json.dumps(n) for n in q_names(tk))}}};",
             f"const char* const {p}_motor_names[{U}_K] = {{{', '.join(json.dumps(n) for n in tk.motors)}}};",
             f"const char* const {p}_output_names[{U}_K] = {{{', '.join(json.dumps(n) for n in tk.outputs)}}};",
+            f"const char* const {p}_drive_names[{U}_K] = {{{', '.join(json.dumps(n) for n in tk.drives)}}};",
+            f"const double {p}_motor_map[{U}_K * {U}_K] = "
+            f"{{{', '.join(c_constant(float(x)) for x in tk.motor_matrix.ravel(order='F'))}}};",
             f"const double {p}_limit_low[{U}_NQ] = {{{', '.join(c_constant(float(x)) for x in low)}}};",
             f"const double {p}_limit_high[{U}_NQ] = {{{', '.join(c_constant(float(x)) for x in high)}}};", ""]
     for twin in ("m", "o"):

@@ -106,7 +106,7 @@ KERNELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
 
 def _driven(mech: Mechanism, actuated: Sequence[str]) -> Mechanism:
     """``mech`` with ``actuated`` as its actuated joints (the same Pinocchio model, closures and reference)."""
-    out = Mechanism(mech.model, dataclasses.replace(mech.spec, actuated=tuple(actuated)), urdf=mech.urdf,
+    out = Mechanism(mech.model, dataclasses.replace(mech.spec, actuated=tuple(actuated), motors={}), urdf=mech.urdf,
                     source=mech.source)
     out.q_reference = mech.q_reference.copy()
     return out
@@ -134,7 +134,14 @@ class TransmissionKernels:
         self.mech = check_mechanism(mech)
         self.name = name or mech.name
         self.outputs = tuple(outputs)
-        self.motors = tuple(mech.actuated_names)
+        #: The motors (:attr:`pkm.Transmission.motors`) and the actuated joints they drive through the constant map
+        #: ``C`` (:attr:`motor_matrix`: ``u = C q_a``, the identity without ``[motors]``); ``constant``: a
+        #: differential over serial joints (its sub-mechanism's one closure ties a frame to itself), its outputs
+        #: its drives.
+        self.motors = tuple(mech.motor_map.names)
+        self.drives = tuple(mech.actuated_names)
+        self.motor_matrix = mech.motor_map.matrix
+        self.constant = all(fa == fb for fa, fb in mech.closure_frames)
         self.iterations = as_count(iterations, "iterations", high=100)
         self.tol = closure_tol(self.mech, RTOL) if tol is None else as_tolerance(tol, "tol")
         for o in self.outputs:
@@ -142,8 +149,11 @@ class TransmissionKernels:
             if j is None or j.nq != 1 or j.nv != 1:
                 raise TransmissionError(self.name, "outputs", f"output {o!r} is not a one-coordinate joint of the "
                                         f"sub-mechanism (its joints: {sorted(mech.joints)})", (o,))
-            if o in self.motors:
+            if o in self.drives and not self.constant:
                 raise TransmissionError(self.name, "outputs", f"output {o!r} is a motor", (o,))
+        if self.constant and set(self.outputs) != set(self.drives):
+            raise TransmissionError(self.name, "outputs", f"a differential's outputs are its joints "
+                                    f"{list(self.drives)}", self.outputs)
         if len(set(self.outputs)) != len(self.motors):
             raise TransmissionError(self.name, "outputs", f"{len(set(self.outputs))} distinct outputs for "
                                     f"{len(self.motors)} motors {list(self.motors)}", self.outputs)
@@ -158,12 +168,20 @@ class TransmissionKernels:
         self.q = self._twin_m.tw.q  # the one configuration symbol every kernel takes
         self.qdo = self._twin_o.tw.qd  # the output rates' symbol
         self.k = len(self.motors)
-        self.motor_q = [mech.joints[m].idx_q for m in self.motors]
+        self.motor_q = [mech.joints[m].idx_q for m in self.drives]
         self.output_q = [mech.joints[o].idx_q for o in self.outputs]
-        self.motor_v = [mech.joints[m].idx_v for m in self.motors]
+        self.motor_v = [mech.joints[m].idx_v for m in self.drives]
         self.output_v = [mech.joints[o].idx_v for o in self.outputs]
 
     # ---------------------------------------------------------------- expressions
+    def _from_drives(self, X: Expr) -> Expr:
+        """``C X``: the drives' rows of ``X`` as the motors' (``X`` itself without ``[motors]``)."""
+        return X if self.mech.motor_map.identity else cs.DM(self.motor_matrix) @ X
+
+    def _per_motor(self, X: Expr) -> Expr:
+        """``X C⁻¹``: the columns per drive of ``X`` per motor (``X`` itself without ``[motors]``)."""
+        return X if self.mech.motor_map.identity else X @ cs.DM(np.linalg.inv(self.motor_matrix))
+
     def _in_q(self, at: ActuatorTwin, expr: Expr) -> Expr:
         """An expression of ``at``'s configuration symbol in terms of :attr:`q`."""
         return cs.substitute(expr, at.tw.q, self.q) if at.tw.q is not self.q else expr
@@ -213,9 +231,10 @@ class TransmissionKernels:
         at = {"m": self._twin_m, "o": self._twin_o}[twin]
         tw = at.tw
         q, target = cs.SX.sym("q", tw.mech.nq), cs.SX.sym("target", self.k)
+        drives = self._per_motor(target.T).T if twin == "m" else target  # (the motors' u as the drives' C⁻¹ u)
         act = list(tw.mech.act_q)
-        held = cs.vertcat(*[target[act.index(i)] if i in act else q[i] for i in range(tw.mech.nq)])
-        values = cs.cse([cs.densify(cs.SX(e)) for e in self._newton(at)(held, target)])
+        held = cs.vertcat(*[drives[act.index(i)] if i in act else q[i] for i in range(tw.mech.nq)])
+        values = cs.cse([cs.densify(cs.SX(e)) for e in self._newton(at)(held, drives)])
         return cs.Function(f"{c_identifier(self.name)}_newton_{twin}", [q, target], values, ["q", f"q{twin}"],
                            ["q_next", "pivot"])  # (inputs named as the kernels': errors name them)
 
@@ -237,7 +256,8 @@ class TransmissionKernels:
                 + cs.if_else(q[int(i)] > hi[i] + LIMIT_TOL, 1.0, 0.0)
         within = cs.if_else(outside > 0.0, float(STATUS.index("OUTSIDE_LIMITS")), 0.0)
         status = cs.if_else(pivot < PIVOT_FLOOR, 2.0, cs.if_else(residual <= self.tol, within, 1.0))
-        y = cs.vertcat(*[q[i] for i in (self.motor_q if kernel == "ik" else self.output_q)])
+        y = (self._from_drives(cs.vertcat(*[q[i] for i in self.motor_q])) if kernel == "ik"
+             else cs.vertcat(*[q[i] for i in self.output_q]))
         if kernel == "fk_j_dm":  # (J and ΔM at the solution; their solves' pivots under the floor: SINGULAR too)
             J, _, p_maps = self._maps
             dM, _, p_delta = self._delta
@@ -269,8 +289,8 @@ class TransmissionKernels:
     def _maps(self) -> tuple[Expr, Expr, Expr]:
         """``(J, J_inv, pivot)`` in :attr:`q`."""
         am, ao = self._twin_m, self._twin_o
-        J = self._rates(am, self.output_v)
-        J_inv = self._in_q(ao, self._rates(ao, self.motor_v))
+        J = self._per_motor(self._rates(am, self.output_v))
+        J_inv = self._from_drives(self._in_q(ao, self._rates(ao, self.motor_v)))
         pm = am.lu.smallest_relative_pivot() if am.lu is not None else cs.SX(1.0)
         po = self._in_q(ao, ao.lu.smallest_relative_pivot()) if ao.lu is not None else cs.SX(1.0)
         return J, J_inv, cs.fmin(pm, po)
@@ -339,7 +359,11 @@ class TransmissionKernels:
         dv = cs.SX.sym("dv", tw.mech.nv)
         E = cs.substitute(cs.jacobian(tw.retract(dv), dv), dv, cs.DM.zeros(tw.mech.nv))  # (dq/dv: nq x nv)
         dq = self._in_q(at, E @ self._rates(at, range(tw.mech.nv)))
-        dy = cs.vertcat(*[dq[i, :] for i in rows])
+        if kernel == "ik":  # (x = qo; y = C q_a)
+            dy = self._from_drives(cs.vertcat(*[dq[i, :] for i in rows]))
+        else:  # (x = u = C q_a)
+            dq = self._per_motor(dq)
+            dy = cs.vertcat(*[dq[i, :] for i in rows])
         values = cs.cse([cs.densify(cs.SX(e)) for e in (dq, dy)])
         return cs.Function(f"{c_identifier(self.name)}_{kernel}_tangent", [self.q], values, ["q"], ["dq", "dy"])
 

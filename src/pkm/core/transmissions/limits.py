@@ -125,6 +125,20 @@ def _walk(t: Transmission, points: list[np.ndarray], lo: np.ndarray, hi: np.ndar
     return True
 
 
+def _stated_box(t: Transmission, point: np.ndarray, around: ArrayLike | None) -> OutputLimits:
+    """A differential's (:attr:`Transmission.constant`) limits: its output joints' stated limits, the whole region
+    (every point between them closes: no loop; no IK to check); none where a limit is not stated."""
+    lo, hi = (b[t.out_q] for b in _bounds(t))
+    if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
+        return OutputLimits(t.outputs, None, None, None, (), 0, point, None)
+    if not ((lo <= point) & (point <= hi)).all():
+        raise InvalidInputError("around", f"transmission {t.name!r}: {dict(zip(t.outputs, point.tolist()))} lies "
+                                f"outside its outputs' limits {list(zip(lo.tolist(), hi.tolist()))}", around)
+    corners = np.array([lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]]) if t.k == 2 else np.array([lo, hi])
+    binding = tuple(f"joint {o} at its {side} limit" for o in t.outputs for side in ("low", "high"))
+    return OutputLimits(t.outputs, lo.copy(), hi.copy(), corners if t.k <= 2 else None, binding, 0, point, 1.0)
+
+
 def output_limits(t: Transmission, *, around: ArrayLike | None = None, singularity: float = SINGULARITY,
                   reach: float | Mapping[str, float] | None = None, directions: int = 24, steps: int = 20,
                   tol: float = SEARCH_RTOL) -> OutputLimits:
@@ -150,6 +164,8 @@ def output_limits(t: Transmission, *, around: ArrayLike | None = None, singulari
     binding: tuple[str, ...]
     reference = t.q_reference[t.out_q]
     point = reference.copy() if around is None else as_vector(around, t.k, "around")
+    if t.constant:
+        return _stated_box(t, point, around)
     if t.k == 1:
         ends, binding = _interval(t, singularity, reach, steps, tol)
         polygon: np.ndarray | None = ends[:, None]

@@ -122,7 +122,8 @@ class SerialEquivalent:
             reg = self.regions.get(t.name, none)
             out.append({
                 "name": t.name, "root": t.root, "motors": list(t.motors), "outputs": list(t.outputs),
-                "passive": list(t.passive), "closures": [c.name for c in t.mechanism.spec.closures],
+                "passive": list(t.passive), "closures": [] if t.constant else [c.name for c in t.mechanism.spec.closures],
+                "drives": list(t.drives), "motor_map": t.motor_matrix.tolist(),
                 "armature": [self.armature[o] for o in t.outputs],
                 "lower": None if reg.lower is None else reg.lower.tolist(),
                 "upper": None if reg.upper is None else reg.upper.tolist(),
@@ -171,7 +172,7 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
     if unknown:
         raise InvalidInputError("around", f"{unknown} are no outputs; the outputs are "
                                 f"{[o for t in found for o in t.outputs]}", unknown)
-    gone = [robot.joints[n].id for t in found for n in (*t.motors, *t.passive)]
+    gone = [robot.joints[n].id for t in found for n in t.welded]
     serial = reduced_model(robot.model, sorted(gone), robot.q_reference)  # (their bodies welded: mass kept)
     serial.name = f"{robot.name}_serial"
     armature = np.array(serial.armature, dtype=float)
@@ -196,7 +197,7 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
                                          "serial model's keyframe 'reference' lies outside its limits"), stacklevel=2)
             bounds.update({o: (float(lo), float(hi)) for o, lo, hi in zip(t.outputs, reg.lower, reg.upper)})
     serial.armature = armature
-    locked = [n for t in found for n in (*t.motors, *t.passive) if robot.spec.springs.get(n, {}).get("stiffness")]
+    locked = [n for t in found for n in t.welded if robot.spec.springs.get(n, {}).get("stiffness")]
     if locked:
         warnings.warn(PkmWarning(f"the springs of {locked} (locked in the serial model) act through their loops: "
                                  "the transmissions' kernels have them (in Δh), the serial model's files do not"),

@@ -19,6 +19,15 @@ simulator needs, in the sub-mechanism's configuration ``q_sub`` (its ``nq``, as 
   share: a diagonal entry can be negative), so that serial model + ΔM + Δh is the closed-loop model exactly:
   ``(M_s + ΔM) ö + h_s + Δh = τ_o`` is the sub-mechanism's dynamics with the root held where the robot's reference
   puts it.
+
+Its motors may drive the sub-mechanism's actuated joints ``q_a`` (:attr:`Transmission.drives`) through a constant
+map (a differential: the spec's ``[motors]``, :mod:`pkm.core.model.motors`): the motors' coordinates are
+``u = C q_a`` (:attr:`Transmission.motor_matrix`, the identity without ``[motors]``), and every map above is in the
+motors' coordinates: positions ``q_a = C⁻¹ u``, ``J = J_a C⁻¹``, ``τ_m = C⁻ᵀ J_aᵀ τ_o`` (``J_a = ∂o/∂q_a``). A
+differential over serial joints alone (no loop) is a transmission whose outputs are those joints: ``qo = C⁻¹ u``,
+``J = C⁻¹`` constant, ``τ_m = C⁻ᵀ τ_o``, ``τ_o = Cᵀ τ_m``, and ``ΔM = 0``, ``Δh = 0`` (the serial model keeps
+every body it moves; the reflected inertia pkm models per actuated joint, ``[actuators]`` or MJCF's ``armature``,
+stays on the output joints it belongs to).
 """
 
 from __future__ import annotations
@@ -52,7 +61,8 @@ class Transmission:
         mechanism: The closed sub-mechanism alone, rooted at ``root`` (held where the robot's reference puts it),
             the motors actuated, the outputs its task (``TaskSpec(components=(), joints=outputs)``).
         root: The robot's body the sub-mechanism hangs from.
-        motors: The actuated joints (names as in the whole robot).
+        motors: The motors: the actuated joints (names as in the whole robot), or the ``[motors]`` that drive them
+            through a constant map (:attr:`motor_matrix`; a differential's motors by their names).
         outputs: The serial joints the serial-equivalent model keeps (as many as motors).
         passive: The sub-mechanism's other joints (rods, cranks' balls), in the model's order.
     """
@@ -79,6 +89,42 @@ class Transmission:
     def k(self) -> int:
         """The number of motors (= of outputs)."""
         return len(self.motors)
+
+    @property
+    def drives(self) -> tuple[str, ...]:
+        """The actuated joints the motors drive (:attr:`motors` themselves without ``[motors]``)."""
+        return self.mechanism.actuated_names
+
+    @property
+    def welded(self) -> tuple[str, ...]:
+        """The sub-mechanism's joints the serial-equivalent model welds at the reference: the drives that are no
+        outputs (the motors' joints; none for a differential, whose drives are its outputs) and the passive joints."""
+        return (*(d for d in self.drives if d not in self.outputs), *self.passive)
+
+    @property
+    def motor_matrix(self) -> np.ndarray:
+        """``C`` (k x k): the motors' coordinates ``u = C q_a`` from :attr:`drives`' (module doc; the identity
+        without ``[motors]``). Its rows are :attr:`motors`, its columns :attr:`drives`."""
+        return self.mechanism.motor_map.matrix
+
+    @property
+    def constant(self) -> bool:
+        """Whether the maps are constant: a differential over serial joints (no loop: its sub-mechanism's one closure
+        ties a frame to itself; module doc)."""
+        return all(fa == fb for fa, fb in self.mechanism.closure_frames)
+
+    def _to_drives(self, qm: ArrayLike) -> np.ndarray:
+        """The drives' coordinates ``C⁻¹ u`` of the motors' ``u``."""
+        u = as_vector(qm, self.k, "qm")
+        return u if self.mechanism.motor_map.identity else np.linalg.solve(self.motor_matrix, u)
+
+    def _from_drives(self, X: np.ndarray) -> np.ndarray:
+        """``C X``: the drives' rows of ``X`` as the motors'."""
+        return X if self.mechanism.motor_map.identity else self.motor_matrix @ X
+
+    def _per_motor(self, X: np.ndarray) -> np.ndarray:
+        """``X C⁻¹``: columns per drive of ``X`` as per motor."""
+        return X if self.mechanism.motor_map.identity else np.linalg.solve(self.motor_matrix.T, X.T).T
 
     @property
     def q_reference(self) -> np.ndarray:
@@ -112,27 +158,37 @@ class Transmission:
         default :data:`~pkm.core.transmissions.coordinates.CLOSURE_RTOL`).
         Raises :class:`~pkm.errors.ConvergenceError` when the loops do not close within ``max_iter`` Newton
         iterations per continuation step."""
+        if self.constant:  # (a differential: q_a = C⁻¹ u, no loop to close)
+            q = self.mechanism.with_actuated(self._guess(guess), self._to_drives(qm))
+            return q[self.out_q].copy(), q
         tol = CLOSURE_RTOL if tol is None else tol
-        q = close_loops(self.mechanism, qm, guess, tol=tol, max_iter=max_iter).q
+        q = close_loops(self.mechanism, self._to_drives(qm), guess, tol=tol, max_iter=max_iter).q
         return q[self.out_q].copy(), q
 
     def motors_from_outputs(self, qo: ArrayLike, guess: ArrayLike | None = None, *, tol: float | None = None,
                             max_iter: int = 30) -> tuple[np.ndarray, np.ndarray]:
         """Inverse kinematics: ``(qm, q_sub)`` for the outputs at ``qo`` [rad or m] (the sub-mechanism's inverse
         kinematics, seeded with ``guess``, default the reference; ``tol`` as :meth:`outputs_from_motors`')."""
+        if self.constant:  # (a differential: its outputs are its drives)
+            q = self._guess(guess)
+            q[self.out_q] = as_vector(qo, self.k, "qo")
+            return self._from_drives(self.mechanism.actuated_q(q)), q
         tol = CLOSURE_RTOL if tol is None else tol
         q = solve_ik(self.mechanism, as_vector(qo, self.k, "qo"), guess, tol=tol, max_iter=max_iter).q
-        return self.mechanism.actuated_q(q), q
+        return self._from_drives(self.mechanism.actuated_q(q)), q
+
+    def _guess(self, guess: ArrayLike | None) -> np.ndarray:
+        return (self.q_reference if guess is None else self.mechanism.check_q(guess, "guess")).copy()
 
     # ------------------------------------------------------------------ rates and efforts
     def velocity_map(self, q_sub: ArrayLike) -> np.ndarray:
         """``J = ∂o/∂m`` (k x k): ``ȯ = J ṁ`` at the closed configuration ``q_sub``."""
-        return forward_jacobian(self.mechanism, q_sub)
+        return self._per_motor(forward_jacobian(self.mechanism, q_sub))
 
     def inverse_velocity_map(self, q_sub: ArrayLike) -> np.ndarray:
         """``J⁻¹ = ∂m/∂o`` (k x k): ``ṁ = J⁻¹ ȯ``; :class:`~pkm.errors.SingularityError` where the outputs do not hold
         the motors."""
-        return inverse_jacobian(self.mechanism, q_sub)
+        return self._from_drives(inverse_jacobian(self.mechanism, q_sub))
 
     def _held(self, sp: OutputSplit) -> OutputSplit:
         """``sp``, or :class:`~pkm.errors.SingularityError` (kind ``"outputs"``) where the outputs do not determine
@@ -164,12 +220,12 @@ class Transmission:
             raise SingularityError("direct", float(s[-1]), f"transmission {self.name!r}: the motors do not hold the "
                                    "outputs here: no motor efforts balance an output effort",
                                    distance=float(s[-1] / s[0]) if s[0] > 0.0 else 0.0)
-        return np.linalg.inv(Gm).T
+        return self._per_motor(np.linalg.inv(Gm)).T
 
     def inverse_effort_map(self, q_sub: ArrayLike) -> np.ndarray:
         """``J⁻ᵀ`` (k x k): the output efforts ``τ_o = J⁻ᵀ τ_m`` the motor efforts ``τ_m`` produce [N m or N];
         :class:`~pkm.errors.SingularityError` where the outputs do not determine the sub-mechanism."""
-        return self._split(q_sub).G[self.mechanism.act_v].T
+        return self._from_drives(self._split(q_sub).G[self.mechanism.act_v]).T
 
     # ------------------------------------------------------------------ dynamics in output coordinates
     def output_model(self, q_sub: ArrayLike, qd_o: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
