@@ -184,3 +184,38 @@ def test_a_branch_without_a_constant_is_said_so_and_names_that_clash_are_refused
     with pytest.raises(ExportError, match="'knee_in' and 'Knee-In' make the same C name KNEE_IN"):
         export_c(load_texts(files), tmp_path / "clash")
     assert not (tmp_path / "clash").exists()
+
+
+def test_motors_driving_the_joints_through_a_map_are_named_with_it(tmp_path):
+    """A differential on the 3-RRR's first two motors (``[motors]``): the header names each motor by its name and
+    coefficients, and the built library's ``motor_names`` and ``motor_map`` (C, column-major) are the mechanism's;
+    without ``[motors]``, the actuated joints and the identity."""
+    import dataclasses
+
+    from pkm.core.export.harness import STRICT
+
+    rrr3 = pkm.load("rrr3")
+    a = rrr3.actuated_names
+    spec = dataclasses.replace(rrr3.spec, motors={"sum": {a[0]: 1.0, a[1]: 1.0}, "diff": {a[0]: 0.5, a[1]: -2.0}})
+    geared = pkm.from_strings(rrr3.urdf, spec)
+    lib = export_c(geared, tmp_path)
+    header = lib.header.read_text()
+    assert f"sum = 1 {a[0]} + 1 {a[1]}; diff = 0.5 {a[0]} - 2 {a[1]}; {a[2]} = 1 {a[2]}." in header
+    (tmp_path / "main.c").write_text("""#include <stdio.h>
+#include "rrr3.h"
+int main(void) {
+  int i;
+  for (i = 0; i < RRR3_NA; ++i) printf("%s ", rrr3_motor_names[i]);
+  printf("\\n");
+  for (i = 0; i < RRR3_NA * RRR3_NA; ++i) printf("%.17g ", rrr3_motor_map[i]);
+  printf("\\n");
+  return 0;
+}
+""")
+    subprocess.run(["cc", *STRICT, "-O0", "-o", "main", "main.c", str(lib.source), "-lm"], cwd=tmp_path, check=True,
+                   capture_output=True)
+    names, matrix = subprocess.run([str(tmp_path / "main")], capture_output=True, text=True,
+                                   check=True).stdout.splitlines()
+    assert tuple(names.split()) == geared.motor_map.names == ("sum", "diff", a[2])
+    assert np.array(matrix.split(), dtype=float).tolist() == geared.motor_map.matrix.ravel(order="F").tolist()
+    assert "Motors: one per actuated joint" in export_c(rrr3, tmp_path / "plain").header.read_text()

@@ -236,7 +236,11 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
                  + f"const char* const {prefix}_task_names[{prefix.upper()}_NY] = {{"
                  + ", ".join(_quote(n) for n in TaskMap.of(mech).value_names) + "};\n"
                  + _array("double", f"{prefix}_q_reference", [float(x) for x in mech.q_reference], c_constant,
-                          public=True))
+                          public=True)
+                 + f"const char* const {prefix}_motor_names[{prefix.upper()}_NA] = {{"
+                 + ", ".join(_quote(n) for n in mech.motor_map.names) + "};\n"
+                 + _array("double", f"{prefix}_motor_map", [float(x) for x in mech.motor_map.matrix.ravel(order="F")],
+                          c_constant, public=True))
     functions = "".join(c_function(fun, f"p_k_{fun.name()}") for fun in kernels)
     newton = "".join(runtime.NEWTON.replace("$KNBLOCKS", f"{k.upper()}_NBLOCKS").replace("$kind", k)
                      .replace("$NX", str(n)).replace("$NB", str(max(len(b), 1)))
@@ -369,6 +373,18 @@ def _check_at_reference(mech: Mechanism, model: ExportModel, kernels: list[cs.Fu
                                          "without inertia of its own?)")
 
 
+def _motors_line(mech: Mechanism, prefix: str) -> str:
+    """The header's paragraph on the motors (:attr:`Mechanism.motor_map`): one per actuated joint, or ``[motors]``
+    that drive them through a constant map (a differential: each motor by its name and coefficients)."""
+    if mech.motor_map.identity:
+        return (f"Motors: one per actuated joint, named as it ({prefix}_motor_names; {prefix}_motor_map the identity); "
+                "tau is their efforts.")
+    return (f"Motors ({prefix}_motor_names), driving the actuated joints through a constant map (a differential: "
+            f"u = C qa, C = {prefix}_motor_map, NA x NA column-major, its rows the motors, its columns the actuated "
+            "joints; the motors' efforts f act on the actuated joints as tau = C^T f, so f = C^-T tau): "
+            + "; ".join(mech.motor_map.equations(mech.actuated_names)) + ".")
+
+
 def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, tuple[int, int, int]],
             blocks: dict[str, list[list[str]]], limits: list, fk: object, ik: object, version: str, stamp: str,
             no_closed_form: str, modes: dict[str, dict[str, int]], mode_lines: list[str]) -> str:
@@ -381,6 +397,8 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
         f"Sizes: configuration q {sizes['NQ']} (Pinocchio's layout: a ball joint's quaternion x y z w), velocity "
         f"{sizes['NV']}, actuated {sizes['NA']} ({', '.join(mech.actuated_names)}), task value {sizes['NY']} "
         f"({', '.join(TaskMap.of(mech).value_names)}), task rate {sizes['NX']}. SI units: m, rad, N, N m, kg.",
+        "",
+        _motors_line(mech, prefix),
         "",
         "Operations after common-subexpression elimination (multiplications, additions, other functions):",
     ]
@@ -442,7 +460,9 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
     decls = (f"extern const char* const {prefix}_limit_names[{max(len(limits), 1)}];\n"
              f"extern const char* const {prefix}_task_names[{U}_NY];\n"
              f"extern const double {prefix}_q_reference[{U}_NQ];  /* the reference configuration (mode 0) */\n"
-             f"extern const int {prefix}_actuated_q[{U}_NA];  /* where the actuated coordinates are in q */\n")
+             f"extern const int {prefix}_actuated_q[{U}_NA];  /* where the actuated coordinates are in q */\n"
+             f"extern const char* const {prefix}_motor_names[{U}_NA];  /* the motors (see above) */\n"
+             f"extern const double {prefix}_motor_map[{U}_NA * {U}_NA];  /* u = C qa, column-major (see above) */\n")
     body = (runtime.HEADER_FUNCTIONS + ("" if no_closed_form else runtime.HEADER_CLOSED_FORM)) \
         .replace("p_", f"{prefix}_").replace("P_", f"{U}_")
     return (comment + f"#ifndef {guard}\n#define {guard}\n\n#ifdef __cplusplus\nextern \"C\" {{\n#endif\n\n"

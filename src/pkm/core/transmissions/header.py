@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import json
+import textwrap
 
 from pkm.core.export.emit import c_constant, c_function
 from pkm.core.model.joints import stated_limits
@@ -33,11 +34,12 @@ def _motor_comment(tk: TransmissionKernels, p: str) -> str:
     """The header's lines on the motors: each one's map where ``[motors]`` drive the joints through a constant map
     (a differential), the motors being no joints of q."""
     if tk.mech.motor_map.identity:
-        return (f"\n   Motors: the joints {p}_drive_names of q themselves ({p}_motor_map the identity: qm = C q_a, "
-                "column-major).")
-    lines = "; ".join(tk.mech.motor_map.equations(tk.drives))
-    return (f"\n   Motors: {lines} (qm = C q_a, C = {p}_motor_map, K x K column-major, the joints {p}_drive_names of "
-            f"q; a differential's motors are no joints of q){'; constant maps: no loop' if tk.constant else ''}.")
+        text = f"Motors: the joints {p}_drive_names of q themselves ({p}_motor_map the identity: qm = C q_a)."
+    else:
+        text = (f"Motors: {'; '.join(tk.mech.motor_map.equations(tk.drives))} (qm = C q_a, C = {p}_motor_map, "
+                f"K x K column-major, q_a the joints {p}_drive_names of q: a differential's motors are no joints of "
+                f"q){'; every map constant (no loop)' if tk.constant else ''}.")
+    return "\n" + textwrap.fill(text, 116, initial_indent="   ", subsequent_indent="   ", break_on_hyphens=False)
 
 
 def c_library(tk: TransmissionKernels, p: str) -> tuple[str, str]:

@@ -5,8 +5,11 @@
 (``pkm transmission``).
 
 A transmission here is a mechanism ``mech`` (the closed sub-mechanism alone, ``actuated`` = its motors ``m``) and
-``k = na`` output joints ``o`` (one-coordinate joints of the tree: revolute or prismatic). The kernels
-(:data:`KERNELS`), each an SX function of one sample after CSE:
+``k = na`` output joints ``o`` (one-coordinate joints of the tree: revolute or prismatic). Where ``[motors]`` drive
+the actuated joints ``q_a`` through a constant map (a differential: ``u = C q_a``, :mod:`pkm.core.model.motors`), the
+motors' coordinates are ``u``: every kernel's ``qm``, ``J`` and ``J_inv`` are composed with ``C`` (``q_a = C⁻¹ u``,
+``J = J_a C⁻¹``, ``J_inv = C J_a⁻¹``); a differential over serial joints (no loop: its outputs are its joints) has
+constant maps and ``ΔM = Δh = 0``. The kernels (:data:`KERNELS`), each an SX function of one sample after CSE:
 
 * ``fk`` ``(q, qm) -> (q_out, qo, status, residual)``: motors to outputs. Newton on the closure with the motors set
   to ``qm``, warm-started from ``q`` (the previous solution), :data:`ITERATIONS` iterations of one step
