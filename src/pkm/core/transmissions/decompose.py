@@ -236,10 +236,12 @@ def transmissions(mech: Mechanism, outputs: Mapping[str, Sequence[str]] | None =
             transmission (Gepetto's ``cassie_like``: its ankle, not its knee).
 
     Returns:
-        The transmissions, in the order of their first closure in the spec.
+        The transmissions, in the order of their first closure in the spec, then the differentials over serial
+        joints (rule 5), in the model's order.
 
     Raises:
-        TransmissionError: no closure; a sub-mechanism with no motor; outputs that do not determine their
+        TransmissionError: no closure and no differential; a sub-mechanism with no motor; a differential across a
+            loop and other joints (rule 5); outputs that do not determine their
             sub-mechanism (count, not in a loop, not scalar, below a joint that is not an output), or singular at the
             reference (``reason`` and the joints on the error).
         UnknownNameError: an output joint the robot does not have.
