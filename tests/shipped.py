@@ -83,13 +83,15 @@ class MujocoAt:
 
     def dofs(self, x: np.ndarray) -> np.ndarray:
         """Pinocchio's joint-space vector ``x`` (accelerations at rest, or efforts) in MuJoCo's dofs (a free joint's
-        linear entries in world axes: at rest, ``R x``)."""
+        linear entries in world axes: at rest, ``R x``; a mimic joint's, its leader's times its scaling)."""
         mech, m = self.mech, self.m
         pin.forwardKinematics(mech.model, mech.data, self.q)
         out = np.zeros(m.nv)
         for k, j in enumerate(self.joints):
             jm, at = mech.model.joints[j], m.jnt_dofadr[k]
             out[at:at + jm.nv] = x[jm.idx_v:jm.idx_v + jm.nv]
+            if jm.shortname() == "JointModelMimic":
+                out[at] = jm.extract().scaling * x[jm.idx_v]
             if m.jnt_type[k] == self.mujoco.mjtJoint.mjJNT_FREE:
                 out[at:at + 3] = mech.data.oMi[j].rotation @ x[jm.idx_v:jm.idx_v + 3]
         return out

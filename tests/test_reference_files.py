@@ -56,6 +56,7 @@ def test_wheel_ships_urdf_and_dynamics(tmp_path):
         assert f"pkm/_data/urdf/{name}.closures.toml" in shipped
     assert "pkm/_data/dynamics/prs3_table2.toml" in shipped
     for folder, model in (("menagerie/agility_cassie", "cassie.xml"), ("menagerie/robotiq_2f85", "2f85.xml"),
+                          ("menagerie/ufactory_xarm7", "xarm7.xml"),
                           ("toddlerbot/toddlerbot", "toddlerbot.xml")):  # (third-party robots, licence and source)
         for shipped_file in (model, "LICENSE", "SOURCE.txt"):
             assert f"pkm/_data/urdf/{folder}/{shipped_file}" in shipped

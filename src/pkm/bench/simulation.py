@@ -79,6 +79,7 @@ import pinocchio as pin
 import pkm
 from pkm.bench import main
 from pkm.bench.mujoco_baseline import unavailable
+from pkm.core.differential.idle import joint_inertia
 from pkm.core.dynamics.projection import energy
 from pkm.core.kinematics import constraints
 from pkm.core.model.mechanism import Mechanism
@@ -278,8 +279,7 @@ def sensitivity(mech: Mechanism, q: np.ndarray, law: ChirpLaw) -> float:
     joints moved by ``P r``, central differences of 1e-6); on 400 frequencies from 0.1 to 10⁴ rad/s and 0. At high
     frequency ``T → M_a⁻¹ Ĝᵀ M P`` (the inertial coupling), at 0 ``(K_p + H)⁻¹ D`` (the sag under gravity)."""
     model = pkm.actuator_model(mech, q)
-    M = pin.crba(mech.model, mech.data, q)
-    M = np.triu(M) + np.triu(M, 1).T
+    M = joint_inertia(mech, q)
     J = constraints.jacobian(mech, q)
     P = np.zeros((mech.nv, J.shape[0]))
     P[mech.passive_v] = np.linalg.pinv(J[:, mech.passive_v], rcond=1e-9)

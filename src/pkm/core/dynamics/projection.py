@@ -54,6 +54,7 @@ from pkm.core.differential.velocity import idle_motions, passive_map
 from pkm.core.dynamics import model as actuator_space
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
+from pkm.core.model.joints import has_mimic
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
@@ -115,7 +116,7 @@ def partition(mech: Mechanism) -> Partition:
     mech = check_mechanism(mech)
     model = mech.model
     src = mech.source
-    if _has_mimic(model):
+    if has_mimic(model):
         raise SpecError(src, "the Khalil projection does not support mimic joints yet")
     if mech.base is not None:
         raise SpecError(src, "the Khalil projection cuts a fixed base; a floating base takes the virtual-work route")
@@ -307,10 +308,6 @@ def _khalil(mech: Mechanism) -> KhalilProjection | SpecError:
         except SpecError as exc:
             _KHALIL[mech] = exc
     return _KHALIL[mech]
-
-
-def _has_mimic(model: pin.Model) -> bool:
-    return any(jm.shortname() == "JointModelMimic" for jm in model.joints)
 
 
 METHODS = ("auto", "khalil", "virtual_work")
@@ -595,7 +592,7 @@ def constraint_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuate
     require_physical(mech, "forward dynamics")
     q, v = mech.check_q(q), mech.check_v(v)
     tau_a = mech.check_actuated(tau_actuated, "tau_actuated", order="effort")
-    if _has_mimic(mech.model):
+    if has_mimic(mech.model):
         raise PkmError("constraintDynamics does not support mimic joints on Pinocchio 4.1")
     s = np.linalg.svd(JacobianScales.of(mech).constraint(finite_result(constraints.jacobian(mech, q),
                                                                      "constraint Jacobian")), compute_uv=False)
@@ -638,7 +635,7 @@ def energy(mech: Mechanism, q: ArrayLike, v: ArrayLike) -> tuple[float, float]:
     require_physical(mech, "the energy")
     q, v = mech.check_q(q), mech.check_v(v)
     m, d = mech.model, mech.data
-    if not _has_mimic(m):
+    if not has_mimic(m):
         return (float(pin.computeKineticEnergy(m, d, q, v)),
                 float(pin.computePotentialEnergy(m, d, q)) + mech.springs.energy(q))
     # Pinocchio 4.1's energy routines refuse mimic joints (the hexapod): sum over the bodies instead

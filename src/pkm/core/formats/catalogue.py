@@ -18,6 +18,9 @@ two loops each (the achilles rod from the hip to the heel spring, the plantar ro
 a free-floating pelvis, ten motors, its reference the file's ``home`` key with its loops closed.
 ``menagerie:robotiq_2f85`` is Robotiq's 2F-85 gripper (BSD-2-Clause): two adaptive four-bar fingers (a spring on
 each, one passive freedom each), one motor on a tendon over the two drivers, which a joint equality ties.
+``menagerie:xarm7`` is UFACTORY's xArm7 (BSD-3-Clause): a seven-joint arm carrying a gripper whose two fingers are
+parallelograms closed by connects (no passive freedom), one motor on a tendon over the two drivers, a joint equality
+tying them; its reference the file's ``home`` key.
 
 Robots published in their makers' own repositories are shipped the same way, in ``urdf/<project>/<robot>/`` with
 their ``LICENSE`` and ``SOURCE.txt``: ``toddlerbot:toddlerbot`` is Stanford's ToddlerBot (``hshi74/toddlerbot``,
@@ -85,6 +88,9 @@ CATALOGUE: dict[str, CatalogueModel] = dict([
     _menagerie("robotiq_2f85", "robotiq_2f85", "2f85.xml", "BSD-2-Clause",
                "Robotiq's 2F-85 adaptive gripper (MJCF, meshes removed): two four-bar fingers closed by connects, "
                "one motor on a tendon over the two drivers, a gear equality tying them"),
+    _menagerie("xarm7", "ufactory_xarm7", "xarm7.xml", "BSD-3-Clause",
+               "UFACTORY's xArm7 arm with its gripper (MJCF, meshes removed): seven motors, two parallelogram "
+               "fingers closed by connects, one motor on a tendon over the two drivers, a gear equality tying them"),
     _published("toddlerbot", "hshi74/toddlerbot", "toddlerbot", "toddlerbot", "toddlerbot.xml", "MIT",
                "Stanford's ToddlerBot humanoid (MJCF, meshes removed): rod-driven knees and neck closed by six "
                "welds, nine gear couplings, 30 motors, a free torso"),

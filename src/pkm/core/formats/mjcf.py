@@ -325,12 +325,12 @@ class _Couplings:
     def members(self, root: str) -> list[str]:
         return [j for j, a in self.of.items() if a.root == root] + ([] if root in self.of else [root])
 
-    def tie(self, name: str, j1: str, j2: str, a1: float, c: float) -> None:
-        """``q[j1] = a1 q[j2] + c`` (``a1 != 0``)."""
+    def tie(self, where: str, j1: str, j2: str, a1: float, c: float) -> None:
+        """``q[j1] = a1 q[j2] + c`` (``a1 != 0``), stated by the equality ``where`` names."""
         r1, r2 = self.get(j1), self.get(j2)
         if r1.root == r2.root:  # a redundant (or contradicting) coupling
             if abs(r1.scale - a1 * r2.scale) > _SMALL or abs(r1.offset - (a1 * r2.offset + c)) > _SMALL:
-                raise SpecError(self.source, f"<equality><joint name={name!r}> contradicts the couplings before it")
+                raise SpecError(self.source, f"{where} contradicts the couplings before it")
             return
         # r1.root = (q[j1] - r1.offset) / r1.scale, with q[j1] = a1 (r2.scale q[r2.root] + r2.offset) + c
         s, o = a1 * r2.scale / r1.scale, (a1 * r2.offset + c - r1.offset) / r1.scale
@@ -338,13 +338,13 @@ class _Couplings:
             a = self.get(j)
             self.of[j] = _Affine(r2.root, a.scale * s, a.scale * o + a.offset)
         if r1.root in self.locked:
-            self.lock(name, r2.root, (self.locked.pop(r1.root) - o) / s)
+            self.lock(where, r2.root, (self.locked.pop(r1.root) - o) / s)
 
-    def lock(self, name: str, j: str, value: float) -> None:
+    def lock(self, where: str, j: str, value: float) -> None:
         a = self.get(j)
         root_value = (value - a.offset) / a.scale
         if a.root in self.locked and abs(self.locked[a.root] - root_value) > _SMALL:
-            raise SpecError(self.source, f"<equality><joint name={name!r}> locks joint {j!r} at another value than "
+            raise SpecError(self.source, f"{where} locks joint {j!r} at another value than "
                                          "the couplings before it")
         self.locked[a.root] = root_value
 
@@ -790,8 +790,8 @@ def _joint_equalities(els: list[etree._Element], kinds: dict[str, str], refs: di
     ``qpos`` (the polynomial is MuJoCo's, about the joints' ``ref``); taken out of Pinocchio's copy."""
     couplings = _Couplings(source)
     for k, el in enumerate(els, 1):
-        name = el.get("name") or f"joint{k}"
-        where = f"<equality><joint name={name!r}>"
+        name = el.get("name")  # (an unnamed one by its rank: "joint1" may name a joint of the file, as xArm7's)
+        where = f"<equality><joint name={name!r}>" if name else f"<equality><joint> {k} (unnamed)"
         j1, j2 = el.get("joint1"), el.get("joint2")
         if not j1:
             raise SpecError(source, f"{where}: no joint1")
@@ -807,11 +807,11 @@ def _joint_equalities(els: list[etree._Element], kinds: dict[str, str], refs: di
                                     f"{int(np.flatnonzero(a)[-1])} in {j2}; pkm represents only the linear coupling "
                                     "(a2 = a3 = a4 = 0), a mimic joint")
         if j2 is None or a[1] == 0.0:
-            couplings.lock(name, j1, refs[j1] + a[0])
+            couplings.lock(where, j1, refs[j1] + a[0])
             notes.append(f"{where} read as joint {j1} locked at {refs[j1] + a[0]:.6g}")
         else:
             c = a[0] + refs[j1] - a[1] * refs[j2]
-            couplings.tie(name, j1, j2, float(a[1]), float(c))
+            couplings.tie(where, j1, j2, float(a[1]), float(c))
             notes.append(f"{where} read as a mimic coupling: {j1} = {a[1]:.6g} {j2} + {c:.6g}")
         el.getparent().remove(el)
     return couplings

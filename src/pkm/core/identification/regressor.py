@@ -37,6 +37,7 @@ from numpy.typing import ArrayLike
 
 from pkm.core.dynamics.model import COULOMB_VELOCITY, RTOL, _check_state, _evaluate
 from pkm.core.model.bodies import BODY_FIELDS, BODY_UNITS, body_names
+from pkm.core.model.joints import has_mimic
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import CompilerError, InvalidInputError, SpecError
 from pkm.validation import as_array, finite_result
@@ -96,17 +97,13 @@ def parameters(mech: Mechanism) -> Parameters:
     return Parameters(tuple(names), np.concatenate([*values, np.array(drives)]), units, bodies)
 
 
-def _has_mimic(model: pin.Model) -> bool:
-    return any("Mimic" in model.joints[j].shortname() for j in range(1, model.njoints))
-
-
 def tree_regressor(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike) -> np.ndarray:
     """``Y`` (nv x 10 n_bodies): the tree's joint efforts ``rnea(q, v, a)`` (armature left out) as ``Y θ_b``;
     Pinocchio's regressor, or the linearity route where the model has mimic joints (module doc)."""
     mech = check_mechanism(mech)
     q, v, a = mech.check_q(q), mech.check_v(v), mech.check_v(a, "a")
     model = mech.model
-    if not _has_mimic(model):
+    if not has_mimic(model):
         return pin.computeJointTorqueRegressor(model, mech.data, q, v, a).copy()
     return _linear_columns(mech, q, v, a)
 

@@ -156,11 +156,16 @@ def copy_limits(model: pin.Model, new: pin.Model, joints: list[tuple[int, int]],
         setattr(new, k, v)
 
 
+def has_mimic(model: pin.Model) -> bool:
+    """Whether Pinocchio's ``model`` has a mimic joint (a URDF ``<mimic>``, an MJCF gear ``<equality><joint>``)."""
+    return any(jm.shortname() == "JointModelMimic" for jm in model.joints)
+
+
 def _mimics(model: pin.Model) -> dict[str, tuple[str, float, float, pin.JointModel]]:
     """``{mimic joint: (the joint it follows, scaling, offset, a plain joint about its axis)}`` (revolute or
     prismatic: the axis is its motion subspace over its scaling)."""
     out: dict[str, tuple[str, float, float, pin.JointModel]] = {}
-    if all(jm.shortname() != "JointModelMimic" for jm in model.joints):
+    if not has_mimic(model):
         return out
     data = model.createData()
     pin.forwardKinematics(model, data, pin.neutral(model))
@@ -177,6 +182,5 @@ def _mimics(model: pin.Model) -> dict[str, tuple[str, float, float, pin.JointMod
     return out
 
 
-__all__ = ["JOINT_TYPES", "LIMITS_Q", "LIMITS_V", "UNIVERSAL_AXES", "copy_limits", "reduced_model", "retype_joints",
-           "stated_limits",
-           "universal_joint"]
+__all__ = ["JOINT_TYPES", "LIMITS_Q", "LIMITS_V", "UNIVERSAL_AXES", "copy_limits", "has_mimic", "reduced_model",
+           "retype_joints", "stated_limits", "universal_joint"]
