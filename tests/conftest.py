@@ -10,6 +10,7 @@ which proves that a mechanism is one folder plus one registry entry.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import shutil
 import tempfile
@@ -52,6 +53,19 @@ def built():
         return cache[name]
 
     return get
+
+
+@pytest.fixture(scope="session")
+def all_actuated():
+    """The toy five-bar with its elbows actuated too: no passive coordinate, the loop closure only a check that the
+    actuated values close the loop (built with the warning that the elbows depend on the motors)."""
+    import pkm
+    from pkm.errors import PkmWarning
+
+    five = module("fivebar").build()  # (not the fixture built: a test module may define its own)
+    with pytest.warns(PkmWarning, match=r"\['elbow_1', 'elbow_2'\] depend on the others"):
+        return pkm.from_strings(five.urdf, dataclasses.replace(five.spec, actuated=("motor_1", "motor_2", "elbow_1",
+                                                                                     "elbow_2")))
 
 
 def pytest_configure(config):

@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import re
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -843,9 +844,27 @@ def _target(g: Gen, n: str, adversarial: bool):
     return task.retract(y, g.near(np.zeros(task.size), g.pick((1e-3, 1e-2, 0.05, 0.2, 1.0))))
 
 
+#: The mechanisms whose every joint can be actuated (scalar joints only: no free-flyer, no ball joint).
+ALL_ACTUATED = ("rrr3", "delta")
+
+
+def _all_actuated(n: str):
+    """Mechanism ``n`` with every joint actuated: no passive coordinate, the loop closure only a check that the
+    actuated values close the loops (built once, from its files with the spec's ``actuated`` list replaced)."""
+    c = ctx()
+
+    def make():
+        joints = ", ".join(f'"{j}"' for j in c.mech[n].joints)
+        return c.pkm.from_strings(c.urdf[n], re.sub(r"(?m)^actuated = \[.*\]$", f"actuated = [{joints}]", c.spec[n]))
+
+    return c.lazy(f"all actuated {n}", make)
+
+
 @entry("pkm.solve_ik")
 def _solve_ik(g, adv):
     n, m = _mech(g, adv)
+    if adv and n in ALL_ACTUATED and g.chance(0.1):
+        m = _all_actuated(n)
     kw = _solver_kwargs(g, adv)
     if g.chance(0.2):
         kw["q0"] = _q(g, n, adv)
@@ -864,6 +883,10 @@ def _close_loops(g, adv):
         kw["q0"] = _q(g, n, adv)
     if adv and g.chance(0.1):
         kw["raise_on_failure"] = False
+    if adv and n in ALL_ACTUATED and g.chance(0.1):  # (its own actuated values, closing the loops or near them)
+        m = _all_actuated(n)
+        qa = m.actuated_q(m.q_reference)
+        return ctx().pkm.close_loops, (m, qa if g.chance(0.5) else g.near(qa, g.pick((1e-3, 1e-2)))), kw
     return ctx().pkm.close_loops, (m, g.value(qa, adv, g.pick((1e-3, 1e-2, 0.05, 0.2)))), kw
 
 

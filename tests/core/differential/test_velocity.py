@@ -254,6 +254,17 @@ def test_actuators_beyond_the_mobility_are_named_when_the_model_loads_and_by_dia
         pkm.close_loops(mech, qa)
 
 
+def test_with_every_joint_actuated_no_direct_singularity_is_told(all_actuated):
+    """No passive coordinate: nothing the actuators leave free, so no direct singularity (sigma inf, distance 1:
+    the empty passive Jacobian was graded 0, a 'direct' singularity); the passive map is the identity on the
+    actuated rows."""
+    mech = all_actuated
+    d = pkm.diagnose(mech, mech.q_reference)
+    assert d.classification == "regular" and d.sigma_direct == math.inf and d.direct_distance == 1.0
+    assert d.near == () and d.dependent_actuators == ("elbow_1", "elbow_2") and d.mobility == 2
+    assert np.array_equal(pkm.passive_map(mech, mech.q_reference)[mech.act_v], np.eye(mech.nv))
+
+
 def test_actuators_short_of_the_mobility_are_reported():
     """A five-bar driven by one motor keeps one degree of freedom with it locked, which moves the tip: reported
     (not an idle motion); the registered mechanisms and the toy five-bar fit theirs exactly."""

@@ -122,9 +122,11 @@ def test_the_folder_builds_with_make_and_runs(built, tmp_path):
     assert "ANKLE_MAX_ITER" in header and "fk_step" in header and " mul " in header and "ik bit 1" in header
 
 
-def test_what_cannot_be_exported_is_refused(tmp_path, monkeypatch):
-    """A task that does not fix the joints, and a joint kind the twin does not write (the twin's refusal, forced
-    here: no shipped file has a helical joint), are refused with the mechanism and the reason."""
+def test_what_cannot_be_exported_is_refused(tmp_path, monkeypatch, all_actuated):
+    """A task that does not fix the joints, a mechanism with no passive joint for the forward kinematics (every
+    joint actuated: it was refused as 'structurally singular'), and a joint kind the twin does not write (the
+    twin's refusal, forced here: no shipped file has a helical joint), are refused with the mechanism and the
+    reason."""
     spec = Path(ACCEPTANCE["ankle"][0])
     shutil.copy(spec.parent / "ankle.urdf", tmp_path)
     (tmp_path / spec.name).write_text(spec.read_text().replace('joints = ["ankle_pitch", "ankle_roll"]',
@@ -134,6 +136,8 @@ def test_what_cannot_be_exported_is_refused(tmp_path, monkeypatch):
         export_c(mech, tmp_path / "out")
     assert e.value.mechanism == mech.name and isinstance(e.value, PkmError)
     assert not (tmp_path / "out").exists()
+    with pytest.raises(ExportError, match="no passive coordinate for the forward kinematics to solve for"):
+        export_c(all_actuated, tmp_path / "all")
 
     def helical(mech):
         raise SpecError(mech.source, "joint 'screw': the symbolic twin does not handle a JointModelHelical")

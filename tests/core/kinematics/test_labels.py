@@ -121,3 +121,28 @@ def test_the_stacked_signs_equal_each_blocks_sign_near_and_far_from_singular():
         B = np.array(stack)
         assert labels._signs(B) == [labels._sign(b) for b in B]
         assert set(labels._signs(B)) >= {0} and set(labels._signs(B)) - {0}
+
+
+def test_every_joint_actuated_the_closure_checks_the_actuators_and_labels_the_working_mode(built, all_actuated):
+    """The five-bar with its elbows actuated too (no passive coordinate: the labels' reduction over the empty
+    passive columns raised numpy's ValueError): the loop closure at the actuated values of a five-bar's closed
+    configuration, one away from the reference's and one in its other working mode, is that configuration (no path,
+    no iteration, no mode-change warning), with no assembly label and the five-bar's own working label (the same
+    closure-and-task matrix); values that open the loop are refused naming the closure; the inverse kinematics
+    agrees with the five-bar's."""
+    five, mech = built("fivebar"), all_actuated
+    assert len(mech.passive_v) == 0
+    y0 = pkm.TaskMap.of(five).value(five.q_reference)
+    away, inner = pkm.solve_ik(five, y0 + [0.02, -0.03]).q, pkm.solve_ik(five, y0, branch="elbows_in").q
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ModeChangeWarning)
+        for q in (away, inner):
+            res = pkm.close_loops(mech, mech.actuated_q(q))
+            assert res.converged and res.iterations == 0 and np.abs(mech.difference(q, res.q)).max() < 1e-12
+            assert res.mode == pkm.mode_label(mech, q) == pkm.ModeLabel((), pkm.mode_label(five, q).working)
+    assert pkm.mode_label(mech, inner).differs(pkm.mode_label(mech, away)) == ("working",)
+    with pytest.raises(pkm.errors.ConvergenceError) as info:
+        pkm.close_loops(mech, mech.actuated_q(away) + [0.0, 0.0, 0.01, 0.0])
+    assert info.value.worst_closure == "tip" and info.value.worst_gap > 1e-4
+    ik = pkm.solve_ik(mech, y0 + [0.02, -0.03])
+    assert ik.converged and np.abs(mech.difference(away, ik.q)).max() < 1e-9

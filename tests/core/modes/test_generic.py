@@ -46,3 +46,9 @@ def test_the_generic_route_refuses_with_the_class_and_the_alternative(built):
     gs = pkm.load("gough_stewart")
     with pytest.raises(StructureError, match=r"FreeFlyer joint.*revolute and prismatic joints only.*pkm\.close_loops"):
         pkm.assembly_modes(gs, gs.actuated_q(gs.q_reference), method="generic")
+
+
+def test_with_every_joint_actuated_there_is_no_mode_to_find(all_actuated):
+    """No unknown joint (every one actuated): a StructureError saying so (it was an IndexError on the empty system)."""
+    with pytest.raises(StructureError, match=r"no unknown joint: the given values fix every joint"):
+        pkm.assembly_modes(all_actuated, all_actuated.actuated_q(all_actuated.q_reference))

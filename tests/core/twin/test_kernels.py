@@ -110,6 +110,26 @@ def test_paths_warm_start_and_equal_the_core(name):
     assert max(np.abs(mech.difference(a, b)).max() for a, b in zip(ik.q, r.q[::6])) <= 1e-9
 
 
+def test_every_joint_actuated_the_kernels_equal_the_core(built, all_actuated):
+    """No passive coordinate (the passive solve's factorisation of the empty matrix raised numpy's ValueError):
+    CasADi's kernels give the rates, the forward Jacobian and the efforts of pkm's core at the five-bar's closed
+    configurations, and close the loop along its actuated path in place."""
+    five, mech = built("fivebar"), all_actuated
+    y0 = TaskMap(five).value(five.q_reference)
+    Q = np.array([pkm.solve_ik(five, y0 + [0.01 * k, -0.01 * k]).q for k in range(3)])
+    K = Kernels(mech, compiled=False)
+    r = K.close_loops_path(Q[:, mech.act_q])
+    assert r.fallback == () and r.residual.max() <= 1e-12 and np.abs(r.q - Q).max() <= 1e-12
+    for q in Q:
+        v = pkm.velocities(five, q, [0.3, -0.2])  # (closure-consistent rates of every joint)
+        a = pkm.accelerations(five, q, v, [1.0, 0.5])
+        qd, qdd = v[mech.act_v], a[mech.act_v]
+        assert np.abs(K.velocities(q, qd) - v).max() <= 1e-12 and np.abs(pkm.velocities(mech, q, qd) - v).max() <= 1e-12
+        assert np.abs(K.forward_jacobian(q) - pkm.forward_jacobian(mech, q)).max() <= 1e-12
+        tau = pkm.inverse_dynamics(mech, q, v, a)
+        assert np.abs(K.inverse_dynamics(q, qd, qdd) - tau).max() <= 1e-10 * max(1.0, np.abs(tau).max())
+
+
 def test_samples_under_the_pivot_floor_fall_back_to_the_core(monkeypatch):
     """With the floor above every pivot, each path sample and each effort comes from the core, listed as such, and
     the answers are the same."""

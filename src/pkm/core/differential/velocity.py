@@ -164,7 +164,10 @@ class _Split:
 
     @property
     def direct_distance(self) -> float:
-        """``sigma_direct`` over the largest singular value of ``Ĵ_p``, in [0, 1] (0 where ``Ĵ_p`` is zero)."""
+        """``sigma_direct`` over the largest singular value of ``Ĵ_p``, in [0, 1] (0 where ``Ĵ_p`` is zero; 1 where
+        no passive motion is left to lock: every joint actuated, or every passive motion idle)."""
+        if self.sigma_direct == np.inf:
+            return 1.0
         return min(self.sigma_direct / self.smax_direct, 1.0) if self.smax_direct > 0.0 else 0.0
 
     @property
@@ -508,7 +511,8 @@ class Diagnostics:
             closed with 3-D points have some).
         mobility: Instantaneous degrees of freedom, ``nv - constraint_rank`` (idle motions included).
         sigma_direct: Smallest singular value of the passive columns ``J_p`` off the idle motions, the Jacobian
-            homogenised by the characteristic length (module doc; type 2 measure) [m]: it scales with the mechanism.
+            homogenised by the characteristic length (module doc; type 2 measure) [m]: it scales with the mechanism;
+            inf where no passive motion is left (every joint actuated).
         sigma_inverse: Smallest singular value of ``[J_c; J_t]`` off the idle motions, homogenised (type 1
             measure) [m].
         classification: ``"regular"``, ``"inverse"``, ``"direct"`` or ``"combined"``.
@@ -516,7 +520,7 @@ class Diagnostics:
             (a rod spinning about its axis between two ball joints; coaxial revolutes): not singularities.
         idle_joints: The joints those motions turn.
         direct_distance: ``sigma_direct`` over the largest singular value of the homogenised ``J_p``, in [0, 1]:
-            dimensionless, the same for the mechanism scaled in size.
+            dimensionless, the same for the mechanism scaled in size; 1 where no passive motion is left.
         inverse_distance: ``sigma_inverse`` over the largest singular value of the homogenised ``[J_c; J_t]``.
         near: The kinds (``"direct"``, ``"inverse"``) whose distance is below ``near`` but above
             ``rtol``: regular, but the Jacobians are large there.

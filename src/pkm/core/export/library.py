@@ -158,7 +158,8 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
 
     Raises:
         ExportError: the mechanism cannot be exported, and why: a joint kind the twin does not write; the closures
-            (or closures and task) do not fix the joints at the reference; two branches that make one C name (or a
+            (or closures and task) do not fix the joints at the reference; no passive joint for the forward
+            kinematics to solve for (every joint actuated); two branches that make one C name (or a
             branch named ``reference`` in another mode, :func:`mode_constants`); a Newton solve that does not converge
             at the reference; a non-finite kernel value at the reference.
 

@@ -204,6 +204,9 @@ class ExportModel:
         """The loop closure for actuated coordinates ``target`` (na): the closure rows on the passive, non-idle
         coordinates, taken at ``q`` with its actuated coordinates set to the target."""
         tw = self.twin
+        if not self.fk_columns:
+            raise ExportError(self.mech.name, "no passive coordinate for the forward kinematics to solve for (every "
+                                              "joint actuated or idle): the actuators fix the whole configuration")
         A = self.rows["jacobian"][:, list(self.fk_columns)]
         return self._newton("fk", A, self.closure_rhs, tw.closure_residual, self.fk_columns, self.dx_fk, self.qa,
                             tw.with_actuated, JacobianScales.of(self.mech).constraint_rows)

@@ -122,12 +122,14 @@ def _signs(B: np.ndarray) -> list[int]:
 
 def _structure(mats: list[np.ndarray], cols: np.ndarray) -> _Blocks | None:
     """The blocks of ``mats[0]`` (the reference's matrix) on ``cols``, the sparsity from every matrix of ``mats``."""
+    n = len(cols)
+    if n == 0:  # (no coordinate to label: every joint actuated, or a floating base alone)
+        return None
     A = [M[:, cols] for M in mats]
-    scale = max(float(np.abs(M).max()) for M in A) or 1.0
+    scale = max(float(np.abs(M).max(initial=0.0)) for M in A) or 1.0
     nz = np.any([np.abs(M) > 1e-12 * scale for M in A], axis=0)
     rows = np.flatnonzero(nz.any(axis=1))
-    n = len(cols)
-    if len(rows) < n or n == 0:
+    if len(rows) < n:
         return None
     if len(rows) > n:
         _, _, piv = scipy.linalg.qr(A[0][rows].T, pivoting=True)

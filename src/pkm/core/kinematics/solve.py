@@ -381,7 +381,10 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
             solve); :class:`~pkm.errors.NoCollisionGeometryError` where ``mech`` has no collision geometry.
 
     Returns:
-        A :class:`SolveResult` whose ``q`` has the requested actuated coordinates.
+        A :class:`SolveResult` whose ``q`` has the requested actuated coordinates. Where every joint is actuated
+        (no passive coordinate), ``q`` is the actuated values themselves, only checked: converged where they close
+        the loops, else the :class:`ConvergenceError` naming the open closure (no path followed, no mode change
+        told: the seed plays no part).
 
     Examples:
         >>> import numpy as np
@@ -404,6 +407,9 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
     qa1 = np.where(rev, qa0 + wrap_angle(qa1 - qa0), qa1)
     metric = _Metric.of(mech, task=False)
     n_steps = _n_steps(np.max(np.abs(qa1 - qa0) / metric.cols[mech.act_v], initial=0.0), max_step)
+    min_step = as_scalar(min_step, "min_step", low=0.0, high=1.0, strict_low=True)
+    if not len(mech.passive_v):  # (every joint actuated: no path to follow, the target only checked: one step)
+        n_steps, min_step = 1, 1.0
 
     def fun(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return constraints.residual_and_jacobian(mech, qq)
@@ -416,12 +422,12 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
 
     seed = mode_label(mech, q)  # (found kept where the seed is the last solve's result: a path followed)
     try:
-        result = _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure, matrices,
-                         as_scalar(min_step, "min_step", low=0.0, high=1.0, strict_low=True))
+        result = _follow(mech, "loop closure", solve_at, q, n_steps, tol, raise_on_failure, matrices, min_step)
     except ConvergenceError as exc:
         exc.problem = ClosureProblem(mech, qa1)
         raise
-    _warn_mode_change("loop closure", seed, result)
+    if len(mech.passive_v):
+        _warn_mode_change("loop closure", seed, result)
     return _with_clearance(mech, result) if collisions else result
 
 

@@ -102,7 +102,11 @@ def _unknowns(mech: Mechanism, joints: list[int]) -> None:
 
 def _square(polys: list[Poly], n: int, what: str, d: pin.Data) -> list[Poly]:
     """The equations that are not constants (rounding below 1e-12 of the mechanism's size dropped), as many as the
-    unknowns, else a StructureError."""
+    unknowns, else a StructureError (also where there is no unknown: the given values fix every joint)."""
+    if n == 0:
+        raise StructureError(what, "no unknown joint: the given values fix every joint (every joint actuated, or in "
+                                   "the task), so there is no mode to find; pkm.close_loops tells whether they close "
+                                   "the loops")
     size = max(1.0, max(float(np.linalg.norm(M.translation)) for M in d.oMi))
     polys = [q for q in (p.cleaned(size) for p in polys) if q.degree > 0]
     if len(polys) != n:

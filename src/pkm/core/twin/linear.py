@@ -43,7 +43,7 @@ class PivotedLU:
         m, n = A.shape
         if m < n:
             raise ValueError(f"a {m} x {n} matrix: PivotedLU needs at least as many rows as columns")
-        scale = max(float(np.abs(A_ref).max()), 1e-300)
+        scale = max(float(np.abs(A_ref).max(initial=0.0)), 1e-300)  # (n = 0: no column, every joint actuated)
         rows: list[dict[int, cs.SX]] = [{j: A[i, j] for j in range(n) if not A[i, j].is_zero()} for i in range(m)]
         num = [{j: float(A_ref[i, j]) for j in r} for i, r in enumerate(rows)]
         free_rows, free_cols = set(range(m)), set(range(n))
@@ -93,7 +93,10 @@ class PivotedLU:
         self.reference_pivots = np.array([num[p][c] for p, c in self.order])
 
     def smallest_relative_pivot(self) -> Expr:
-        """``min_k |pivot_k| / |pivot_k(reference)|`` (SX): near 0, the fixed pivot order fails here."""
+        """``min_k |pivot_k| / |pivot_k(reference)|`` (SX): near 0, the fixed pivot order fails here; 1 without a
+        pivot (no column: nothing to fail)."""
+        if not self.pivots:
+            return cs.SX(1.0)
         return cs.mmin(cs.vertcat(*[cs.fabs(u) / abs(r) for u, r in zip(self.pivots, self.reference_pivots)]))
 
     def solve(self, b: Expr) -> Expr:
@@ -109,7 +112,7 @@ class PivotedLU:
                 if j != c:
                     s = s - u * x[j]
             x[c] = s / self._u[p][c]
-        return cs.vertcat(*x)
+        return cs.vertcat(*x) if x else cs.SX(0, 1)
 
     def solve_transposed(self, b: Expr) -> Expr:
         """``y`` (m) with ``A^T y = b`` (b: n rows of SX), zero on the rows without a pivot."""
