@@ -39,7 +39,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 #: name: what pkm.load reads
 CASES = {"humanoid_ankle": "examples/humanoid_ankle/ankle.closures.toml",
-         "delta": "delta", "gepetto_5bar": "gepetto:5bar_linkage"}
+         "delta": "delta", "gepetto_5bar": "gepetto:5bar_linkage", "gepetto_5bar_iso3d": "gepetto:5bar_linkage_iso3d"}
 SAMPLES, SPREAD, SEED = 16, 0.1, 56
 #: Kamino's FK solver configurations compared: its defaults (dense normal equations), and its sparse path (conjugate
 #: gradients), which alone holds the five-bar's 6-D loop (redundant constraints: three of six in a planar loop)
