@@ -257,11 +257,15 @@ class TransmissionWorlds:
         the kernels at ``data``'s state each time they are read.
 
         Args:
-            robot, transmissions, exact, device: as for :class:`TransmissionWorlds`.
+            robot: The whole robot, as for :class:`TransmissionWorlds`.
             mj_model: The compiled MuJoCo model (``mujoco.MjModel``) ``model`` was put from.
-            model, data: MuJoCo Warp's ``Model`` and ``Data`` (its worlds: ``data.nworld``).
+            model: MuJoCo Warp's ``Model`` (its ``callback.control`` is set).
+            data: MuJoCo Warp's ``Data`` (its worlds: ``data.nworld``).
+            transmissions: Its transmissions (default :func:`pkm.transmissions`).
             joints: The MuJoCo joint of each output, where the names differ (Newton names a joint by its USD path,
                 ``/robot/joints/ankle_pitch`` as ``_robot_joints_ankle_pitch``); default the output's own name.
+            exact: As for :class:`TransmissionWorlds` (the armature checked against it).
+            device: Warp's device of ``model`` and ``data``.
 
         Raises:
             UnknownNameError: an output's joint is not in ``mj_model``.
