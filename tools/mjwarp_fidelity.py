@@ -1,4 +1,6 @@
-"""Fidelity of the humanoid ankle and knee in MuJoCo Warp (issue 56): the same 1 s motor-torque chirp
+"""Fidelity of the humanoid ankle and knee and of Gepetto's battobot's two ankles (``gepetto:battobot_6d``'s
+``foot_assembly``, right, and ``foot_assembly_2``, left: each alone, its root held, as (a) runs it) in MuJoCo Warp
+(issue 56): the same 1 s motor-torque chirp
 (:func:`pkm.core.transmissions.fidelity.profiles`, 0.5 to 4 Hz over 1 s) from the reference at rest, RK4 at 1 ms, on
 
 * (a) the closed loop, :func:`pkm.simulate` (float64; closure exact);
@@ -22,10 +24,18 @@ half the chirp's amplitude, opposite on the two motors) from the reference at re
 (conserved), its largest change over the run relative to the largest kinetic energy; (a) and (w) from pkm's closed-loop
 model in output coordinates at each sampled state, (s) from MuJoCo's energy.
 
-    PYTHONPATH=src python tools/mjwarp_fidelity.py [OUT_DIR]
+    PYTHONPATH=src python tools/mjwarp_fidelity.py [OUT_DIR] [--only=battobot_ankle_right,...]
 
-Writes ``OUT_DIR/mjwarp_fidelity.json`` and ``.md`` (default ``tools/reports``). Needs the ``mjwarp`` and ``bench``
-extras. Takes a few minutes on a CPU.
+Writes ``OUT_DIR/mjwarp_fidelity.json`` and ``.md`` (default ``tools/reports``); ``--only`` runs those robots and keeps
+the others' results from the JSON already there. Needs the ``mjwarp`` and ``bench`` extras. Takes a few minutes per
+robot on a CPU.
+
+(b) can leave the workspace (a battobot ankle's does, as in ``tools/transmission_fidelity.py``): its error is then
+over the time before, the time said (MuJoCo Warp's: the transmission kernel's closure solve failing at its outputs;
+CPU MuJoCo's: :func:`serial_run`'s NaN). A ``<weld>``'s residual (battobot's 6-D loops) is its sites' distance [m]
+and the angle between their frames [rad]. MuJoCo Warp itself has no float64 build: its arrays and kernels are
+typed with Python's ``float``, which Warp compiles as float32, and no option changes it; (w64), the same algorithm
+in CPU MuJoCo in float64, is what (w) is held against.
 """
 
 from __future__ import annotations
@@ -96,21 +106,25 @@ def chirp_parts(t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def run_transmission(robot, t, torque: Chirp, exact: bool, sample: int = 10):
-    """(w) or (b): outputs (N+1, 2), and every ``sample`` steps (time, q_sub, output rates, kernel residual)."""
+    """(w) or (b): outputs (N+1, 2), every ``sample`` steps (time, q_sub, output rates, kernel residual), the CPU
+    seconds and the time the outputs first left the sub-mechanism's workspace (the kernel's closure solve failing:
+    its status not OK), or None."""
     worlds = TransmissionWorlds(robot, 1, transmissions=[t], exact=exact, dt=DT, integrator="rk4", limits=False)
     unit = worlds.units[0]
     worlds.torque_source = lambda w: torque.launch(w.data, w.stage_offset, False, unit.tau_m)
     n = round(DURATION / DT)
     out = np.zeros((n + 1, t.k))
     out[0] = worlds.output_q[0]
-    states = []
+    states, left = [], None
     start = time.process_time()
     for i in range(n):
         worlds.step()
         out[i + 1] = worlds.output_q[0]
+        if left is None and worlds.status.max() != 0:
+            left = (i + 1) * DT
         if (i + 1) % sample == 0:
             states.append(((i + 1) * DT, worlds.sub_q(0)[0], worlds.qvel[0].astype(float), float(worlds.residual.max())))
-    return out, states, time.process_time() - start
+    return out, states, time.process_time() - start, left
 
 
 def soft_model(source: Path | str):
@@ -125,18 +139,22 @@ def soft_model(source: Path | str):
     return m
 
 
-def connect_residual(m, d) -> float:
-    """The largest distance of a ``<connect>``'s two anchors [m] at ``d``'s kinematics."""
-    worst = 0.0
+def connect_residual(m, d) -> tuple[float, float]:
+    """The largest distance of a ``<connect>``'s or ``<weld>``'s two anchors [m] at ``d``'s kinematics, and the
+    largest angle between a site ``<weld>``'s two frames [rad] (0 without welds)."""
+    worst, angle = 0.0, 0.0
     for e in range(m.neq):
         a, b = m.eq_obj1id[e], m.eq_obj2id[e]
         if m.eq_objtype[e] == mujoco.mjtObj.mjOBJ_SITE:  # (pkm's MJCF writer: a site at each closure frame)
             p1, p2 = d.site_xpos[a], d.site_xpos[b]
-        else:  # (bodies, the anchors in eq_data)
+            if m.eq_type[e] == mujoco.mjtEq.mjEQ_WELD:  # (a frame closure: the sites' frames coincide)
+                R = d.site_xmat[a].reshape(3, 3).T @ d.site_xmat[b].reshape(3, 3)
+                angle = max(angle, float(np.arccos(np.clip(0.5 * (np.trace(R) - 1.0), -1.0, 1.0))))
+        else:  # (bodies, the anchors in eq_data: a connect)
             p1 = d.xpos[a] + d.xmat[a].reshape(3, 3) @ m.eq_data[e, 0:3]
             p2 = d.xpos[b] + d.xmat[b].reshape(3, 3) @ m.eq_data[e, 3:6]
         worst = max(worst, float(np.linalg.norm(p1 - p2)))
-    return worst
+    return worst, angle
 
 
 def run_soft(source, torque_of, t, sample: int = 10):
@@ -200,20 +218,26 @@ def drift(values: list[tuple[float, float]]) -> float:
     return float(np.abs(E - E[0]).max() / T.max())
 
 
-ROBOTS = {  # name: (the pkm file, the soft-loop MJCFs: (label, a file or None for pkm's own MJCF writer))
-    "humanoid_ankle": (ANKLE / "ankle.closures.toml", (("s", ANKLE / "ankle.xml"), ("s_pkm", None))),
-    "humanoid_knee": (ROOT / "examples" / "humanoid_knee" / "knee.closures.toml", (("s_pkm", None),)),
+ROBOTS = {  # name: (what pkm.load reads, the transmission (None: the only one), the soft-loop MJCFs: (label, a file or
+    # None for pkm's own MJCF writer))
+    "humanoid_ankle": (ANKLE / "ankle.closures.toml", None, (("s", ANKLE / "ankle.xml"), ("s_pkm", None))),
+    "humanoid_knee": (ROOT / "examples" / "humanoid_knee" / "knee.closures.toml", None, (("s_pkm", None),)),
+    "battobot_ankle_right": ("gepetto:battobot_6d", "foot_assembly", (("s_pkm", None),)),
+    "battobot_ankle_left": ("gepetto:battobot_6d", "foot_assembly_2", (("s_pkm", None),)),
 }
 SOFT = {"s": "the file's own `<connect>`s (`solref=\"0.002 1\"`)",
-        "s_pkm": "pkm's MJCF writer (`pkm.save`: stiff `<connect>`s, `solref=(2 dt, 0.5)`, `solimp` 0.9999)"}
+        "s_pkm": "pkm's MJCF writer (`pkm.save`: stiff `<connect>`s or `<weld>`s, `solref=(2 dt, 0.5)`, `solimp` 0.9999)"}
 
 
 def one_robot(name: str) -> dict:
     from pkm.core.formats.to_mjcf import mjcf_from_mechanism
 
-    path, softs = ROBOTS[name]
+    path, pick, softs = ROBOTS[name]
     robot = pkm.load(path)
-    (t,) = pkm.transmissions(robot)
+    found = pkm.transmissions(robot)
+    (t,) = found if pick is None else [x for x in found if x.name == pick]
+    if pick is not None:  # (a whole robot's transmission alone, its root held, as (a) runs it)
+        robot = t.mechanism
     hold, amp, phase = chirp_parts(t)
     f = profiles(t, DURATION)["chirp"]
     ks = list(range(t.k))
@@ -221,16 +245,24 @@ def one_robot(name: str) -> dict:
     a = closed_loop(t, f, DURATION, DT)
     w64 = serial_run(t, f, DURATION, DT, exact=True)
     b64 = serial_run(t, f, DURATION, DT, exact=False)
-    w, w_states, w_cpu = run_transmission(robot, t, Chirp(hold, amp, phase, ks, 1), True)
-    b, _, b_cpu = run_transmission(robot, t, Chirp(hold, amp, phase, ks, 1), False)
-    traces = {"w": w, "w64": w64, "b": b, "b64": b64}
+    w, w_states, w_cpu, _ = run_transmission(robot, t, Chirp(hold, amp, phase, ks, 1), True)
+    b, _, b_cpu, b_left = run_transmission(robot, t, Chirp(hold, amp, phase, ks, 1), False)
+    nan = np.flatnonzero(~np.isfinite(b64).all(axis=1))  # (serial_run: NaN once out of the workspace)
+    left = {"b": b_left, "b64": float(nan[0] * DT) if nan.size else None}
+    if b_left is not None:  # (the errors over the time before: after, no closed configuration compares)
+        b = b[:round(b_left / DT)]
+    traces = {"w": w, "w64": w64, "b": b, "b64": b64[:nan[0]] if nan.size else b64}
     cpu = {"w": w_cpu, "b": b_cpu}
     residuals = {}
     for label, src in sources.items():
-        traces[label], residuals[label], _, cpu[label] = run_soft(src, lambda dadr: Chirp(hold, amp, phase, dadr, 1), t)
+        traces[label], (residuals[label], angle), _, cpu[label] = run_soft(
+            src, lambda dadr: Chirp(hold, amp, phase, dadr, 1), t)
+        if any(c.type == "frame" for c in t.mechanism.spec.closures):
+            residuals[f"{label}_rad"] = angle
     _, q_end, _, kernel_res = w_states[-1]
     out: dict = {"transmission": t.name, "outputs": list(t.outputs), "motion": float(np.abs(a - a[0]).max()),
-                 "error": {key: float(np.abs(x - a).max()) for key, x in traces.items()},
+                 "error": {key: float(np.abs(x - a[:len(x)]).max()) for key, x in traces.items()},
+                 "left_workspace_s": left,
                  "float32_cost": float(np.abs(w - w64).max()),
                  "closure_residual_m": {"w_kernel": kernel_res, "w_pkm": float(np.abs(residual(t.mechanism, q_end)).max()),
                                         **residuals},
@@ -242,7 +274,7 @@ def one_robot(name: str) -> dict:
                        saturate=False, limits=False, backend="python")
     qs, vs = np.asarray(sim.q), np.asarray(sim.v)
     drifts = {"a": drift([closed_energy(t, qs[i], vs[i][t.out_v], const) for i in range(0, len(qs), 10)])}
-    _, w_states, _ = run_transmission(robot, t, Chirp(const, zero, zero, ks, 1), True)
+    _, w_states, _, _ = run_transmission(robot, t, Chirp(const, zero, zero, ks, 1), True)
     e_w = [closed_energy(t, t.q_reference, np.zeros(t.k), const)]
     drifts["w"] = drift(e_w + [closed_energy(t, q, od, const) for _, q, od, _ in w_states])
     for label, src in sources.items():
@@ -254,14 +286,27 @@ def one_robot(name: str) -> dict:
 
 def main(argv: list[str]) -> None:
     wp.config.quiet = True
-    out_dir = Path(argv[0]) if argv else ROOT / "tools" / "reports"
+    only = next((a.split("=", 1)[1].split(",") for a in argv if a.startswith("--only=")), None)
+    paths = [a for a in argv if not a.startswith("--")]
+    out_dir = Path(paths[0]) if paths else ROOT / "tools" / "reports"
+    unknown = sorted(set(only or ()) - set(ROBOTS))
+    if unknown:
+        sys.exit(f"--only: unknown {unknown}; known {sorted(ROBOTS)}")
+    previous = json.loads((out_dir / "mjwarp_fidelity.json").read_text())["robots"] if only else {}
     result: dict = {"duration_s": DURATION, "dt_s": DT, "integrator": "RK4",
                     "device": f"Warp 'cpu' ({platform.machine()}); GPU: missing, no GPU was lent to this session",
                     "command": "PYTHONPATH=src python tools/mjwarp_fidelity.py",
                     "mujoco_warp": "4.0.0", "warp": wp.config.version,
-                    "robots": {name: one_robot(name) for name in ROBOTS}}
+                    "robots": {name: (one_robot(name) if only is None or name in only else previous[name])
+                               for name in ROBOTS if only is None or name in only or name in previous}}
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "mjwarp_fidelity.json").write_text(json.dumps(result, indent=2) + "\n")
+    (out_dir / "mjwarp_fidelity.md").write_text("\n".join(table(result)) + "\n")
+    print("\n".join(table(result)))
+
+
+def table(result: dict) -> list[str]:
+    """The markdown table and notes of ``result`` (the JSON's)."""
     md = ["| robot | route | output error vs pkm.simulate [rad] | closure residual after 1 s [m] | energy drift (rel.) |",
           "|---|---|---|---|---|"]
     for name, r in result["robots"].items():
@@ -270,14 +315,16 @@ def main(argv: list[str]) -> None:
                f"| {name} | (w) MuJoCo Warp + exact transmission (float32 state) | {err['w']:.2e} | "
                f"{res['w_kernel']:.1e} (kernel), {res['w_pkm']:.1e} (pkm) | {e['w']:.1e} |",
                f"| {name} | (w64) CPU MuJoCo + exact transmission (float64) | {err['w64']:.2e} | exact (Newton) | — |"]
-        md += [f"| {name} | ({label}) soft loops in MuJoCo Warp: {SOFT[label]} | {err[label]:.2e} | {res[label]:.1e} "
-               f"| {e[label]:.1e} |" for label in r["soft_models"]]
-        md += [f"| {name} | (b) constant armature in MuJoCo Warp | {err['b']:.2e} | — | — |",
-               f"| {name} | (b64) constant armature in CPU MuJoCo | {err['b64']:.2e} | — | — |"]
+        md += [f"| {name} | ({label}) soft loops in MuJoCo Warp: {SOFT[label]} | {err[label]:.2e} | {res[label]:.1e}"
+               + (f", {res[label + '_rad']:.1e} rad" if label + "_rad" in res else "") + f" | {e[label]:.1e} |"
+               for label in r["soft_models"]]
+        gone = {key: "" if at is None else f" (left the workspace at {at:.3g} s)"
+                for key, at in r.get("left_workspace_s", {"b": None, "b64": None}).items()}
+        md += [f"| {name} | (b) constant armature in MuJoCo Warp | {err['b']:.2e}{gone['b']} | — | — |",
+               f"| {name} | (b64) constant armature in CPU MuJoCo | {err['b64']:.2e}{gone['b64']} | — | — |"]
     md += [""] + [f"{name}: motion {r['motion']:.3g} rad; float32's cost, (w) against (w64): {r['float32_cost']:.1e} rad."
                   for name, r in result["robots"].items()]
-    (out_dir / "mjwarp_fidelity.md").write_text("\n".join(md) + "\n")
-    print("\n".join(md))
+    return md
 
 
 if __name__ == "__main__":

@@ -103,3 +103,34 @@ def test_outputs_on_two_branches_have_no_place_in_mujocos_sparse_mass_matrix():
         "</body></worldbody></mujoco>")
     with pytest.raises(TransmissionError, match="different branches"):
         _mass_addresses(siblings, [0, 1])
+
+
+def test_attached_to_a_model_built_elsewhere(stepped):
+    """TransmissionWorlds.attach (how Newton's SolverMuJoCo gets the transmissions: tools/mjwarp_newton.py) puts the
+    same kernels on another MuJoCo Warp model's control callback: at that model's state it gives the motors the
+    owning worlds give; stepping and setting the state are its owner's, refused; an output joint the model lacks or an
+    armature counting ΔM's diagonal twice (or not at all) is refused, not run."""
+    import pkm
+    from pkm.errors import InvalidInputError, UnknownNameError
+    from pkm.learn.mjwarp import TransmissionWorlds
+
+    env, *_ = stepped
+    w = env.worlds
+    t = w.units[0].t
+    robot = pkm.load(ENV.parents[1] / "humanoid_ankle" / "ankle.closures.toml")
+    try:
+        attached = TransmissionWorlds.attach(robot, w.mj_model, w.model, w.data, transmissions=[t])
+        assert w.model.callback.control == attached._control and attached.nworld == N
+        assert np.abs(attached.motor_q - w.motor_q).max() <= 1e-12
+        with pytest.raises(InvalidInputError, match="stepped by their owner"):
+            attached.step()
+        with pytest.raises(InvalidInputError, match="owner"):
+            attached.reset(outputs=[0.0, 0.0])
+    finally:
+        w.model.callback.control = w._control
+    with pytest.raises(InvalidInputError, match="armature") as e:  # (the exact model's outputs carry none)
+        TransmissionWorlds.attach(robot, w.mj_model, w.model, w.data, transmissions=[t], exact=False)
+    assert e.value.value == 0.0
+    with pytest.raises(UnknownNameError):
+        TransmissionWorlds.attach(robot, w.mj_model, w.model, w.data, transmissions=[t],
+                                  joints={t.outputs[0]: "_robot_joints_" + t.outputs[0]})

@@ -43,6 +43,10 @@ The module owns ``Data.qfrc_applied`` at the outputs' degrees of freedom (it is 
 outputs' ``<motor>`` actuators of the serial MJCF are left at zero ``ctrl`` (the motors drive the outputs through
 this module). Other actuated joints of the robot (not in a transmission) keep their MJCF motors (``Data.ctrl``).
 
+:meth:`TransmissionWorlds.attach` puts the same kernels on a MuJoCo Warp model that another library built and steps:
+Newton's ``SolverMuJoCo`` (which converts a Newton model, here pkm's serial-equivalent USD, to MuJoCo and steps it with
+``mujoco_warp.step``), its outputs' armature zero for the exact route (``tools/mjwarp_newton.py``).
+
 Needs ``pip install "pkm-robotics[mjwarp]"`` (MuJoCo Warp, which brings Warp and MuJoCo). The first step of a
 process compiles MuJoCo Warp's kernels and pkm's (about 30 s on a CPU; Warp caches them on disk for the next
 process).
@@ -51,7 +55,7 @@ process).
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import casadi as cs
@@ -65,7 +69,7 @@ from pkm.core.transmissions.kernels import STATUS, TransmissionKernels, c_identi
 from pkm.core.transmissions.serial import SerialEquivalent, serial_equivalent
 from pkm.core.transmissions.transmission import Transmission
 from pkm.core.twin.kernels import PIVOT_FLOOR
-from pkm.errors import InvalidInputError, TransmissionError
+from pkm.errors import InvalidInputError, TransmissionError, UnknownNameError
 
 #: What :func:`require` names when MuJoCo Warp is missing.
 WHAT = "pkm.learn.mjwarp (transmissions inside MuJoCo Warp's batched step)"
@@ -157,14 +161,13 @@ def _mass_addresses(mjm: Any, dadr: Sequence[int] | np.ndarray) -> np.ndarray:
 class _Unit:
     """One transmission's kernel, addresses and float64 buffers (entry-major, ``(size, nworld)``)."""
 
-    def __init__(self, t: Transmission, mjm: Any, nworld: int, device: str, wp: Any):
+    def __init__(self, t: Transmission, mjm: Any, nworld: int, device: str, wp: Any, ids: Sequence[int]):
         from pkm.core.twin.warpgen import warp_kernel
 
         self.t = t
         self.tk = TransmissionKernels.of(t)
         self.fun = step_function(self.tk)
         self.kernel = warp_kernel(self.fun)
-        ids = [mjm.joint(o).id for o in t.outputs]
         self.qadr = np.array([mjm.jnt_qposadr[j] for j in ids], dtype=np.int32)
         self.dadr = np.array([mjm.jnt_dofadr[j] for j in ids], dtype=np.int32)
         try:
@@ -230,18 +233,82 @@ class TransmissionWorlds:
             raise InvalidInputError("integrator", f"one of {sorted(INTEGRATORS)}", integrator)
         robot = check_mechanism(robot)
         found = tuple(find_transmissions(robot) if transmissions is None else transmissions)
-        self.serial: SerialEquivalent = serial_equivalent(robot, found, limits=limits)
-        mjm = mujoco.MjModel.from_xml_string(self.serial.mjcf(timestep=dt))
+        serial = serial_equivalent(robot, found, limits=limits)
+        mjm = mujoco.MjModel.from_xml_string(serial.mjcf(timestep=dt))
         mjm.opt.integrator = INTEGRATORS[integrator.lower()]
         if exact:  # (ΔM whole, in place of its diagonal at the reference)
-            for o, a in self.serial.armature.items():
+            for o, a in serial.armature.items():
                 mjm.dof_armature[mjm.jnt_dofadr[mjm.joint(o).id]] -= a
-        self.mj_model, self.nworld, self.exact, self.device = mjm, int(nworld), bool(exact), device
-        self._wp, self._mjw = wp, mjw
         with wp.ScopedDevice(device):
-            self.model = mjw.put_model(mjm)
-            self.data = mjw.make_data(mjm, nworld=self.nworld)
-            self.units = [_Unit(t, mjm, self.nworld, device, wp) for t in found]
+            model = mjw.put_model(mjm)
+            data = mjw.make_data(mjm, nworld=int(nworld))
+        self._wire(serial, found, mjm, model, data, exact, device, {}, owned=True)
+
+    @classmethod
+    def attach(cls, robot: Mechanism, mj_model: Any, model: Any, data: Any, *,
+               transmissions: Sequence[Transmission] | None = None, joints: Mapping[str, str] | None = None,
+               exact: bool = True, device: str = "cpu") -> TransmissionWorlds:
+        """``robot``'s transmissions inside a MuJoCo Warp model that another library built and steps: Newton's
+        ``SolverMuJoCo`` (``solver.mj_model``, ``solver.mjw_model``, ``solver.mjw_data``) of the serial-equivalent
+        model (:func:`pkm.core.formats.to_usd.serial_usd`, read by ``newton.ModelBuilder.add_usd``). The same
+        kernels run from ``model.callback.control`` (which this sets) at every evaluation of the dynamics inside the
+        owner's step; the owner sets the state and steps (Newton: ``solver.step``, its state copied into ``data``
+        before each step), :meth:`step` and :meth:`reset` with ``outputs`` are refused, and the properties evaluate
+        the kernels at ``data``'s state each time they are read.
+
+        Args:
+            robot: The whole robot, as for :class:`TransmissionWorlds`.
+            mj_model: The compiled MuJoCo model (``mujoco.MjModel``) ``model`` was put from.
+            model: MuJoCo Warp's ``Model`` (its ``callback.control`` is set).
+            data: MuJoCo Warp's ``Data`` (its worlds: ``data.nworld``).
+            transmissions: Its transmissions (default :func:`pkm.transmissions`).
+            joints: The MuJoCo joint of each output, where the names differ (Newton names a joint by its USD path,
+                ``/robot/joints/ankle_pitch`` as ``_robot_joints_ankle_pitch``); default the output's own name.
+            exact: As for :class:`TransmissionWorlds` (the armature checked against it).
+            device: Warp's device of ``model`` and ``data``.
+
+        Raises:
+            UnknownNameError: an output's joint is not in ``mj_model``.
+            InvalidInputError: an output's armature is not what ``exact`` needs: zero (``ΔM`` whole is added, its
+                diagonal included), or ``ΔM``'s diagonal at the reference for ``exact=False``, to float32 (1e-6
+                relative): the mass would otherwise be counted twice or not at all.
+            TransmissionError: as for :class:`TransmissionWorlds`.
+        """
+        require("mjwarp", WHAT)
+        robot = check_mechanism(robot)
+        found = tuple(find_transmissions(robot) if transmissions is None else transmissions)
+        serial = serial_equivalent(robot, found, limits=False)
+        names = dict(joints or {})
+        valid = [mj_model.joint(j).name for j in range(mj_model.njnt)]
+        for t in found:
+            for o in t.outputs:
+                name = names.setdefault(o, o)
+                if name not in valid:
+                    raise UnknownNameError("joint", name, valid, "the MuJoCo model (attach's joints= maps pkm's "
+                                                                  "output names to its joints)")
+                armature = float(mj_model.dof_armature[mj_model.jnt_dofadr[mj_model.joint(name).id]])
+                expected = 0.0 if exact else serial.armature[o]
+                if abs(armature - expected) > 1e-6 * max(abs(serial.armature[o]), 1e-300):
+                    raise InvalidInputError(
+                        "mj_model", f"joint {name!r} (output {o!r}) has armature {armature:.9g} kg m^2, where "
+                        f"exact={exact} needs {expected:.9g} (ΔM's diagonal at the reference is "
+                        f"{serial.armature[o]:.9g}): set it before building the model", armature)
+        worlds = cls.__new__(cls)
+        worlds._wire(serial, found, mj_model, model, data, exact, device, names, owned=False)
+        return worlds
+
+    def _wire(self, serial: SerialEquivalent, found: tuple[Transmission, ...], mjm: Any, model: Any, data: Any,
+              exact: bool, device: str, names: Mapping[str, str], *, owned: bool) -> None:
+        """The kernels, their buffers and the control callback on ``model`` (``names``: the MuJoCo joint of an
+        output, where not its own name)."""
+        wp = module("warp", extra="warp", what=WHAT)
+        self._wp, self._mjw = wp, module("mujoco_warp", extra="mjwarp", what=WHAT)
+        self.serial = serial
+        self.mj_model, self.model, self.data = mjm, model, data
+        self.nworld, self.exact, self.device, self._owned = int(data.nworld), bool(exact), device, owned
+        with wp.ScopedDevice(device):
+            self.units = [_Unit(t, mjm, self.nworld, device, wp, [mjm.joint(names.get(o, o)).id for o in t.outputs])
+                          for t in found]
         self.motors = tuple(m for u in self.units for m in u.t.motors)
         self.outputs = tuple(o for u in self.units for o in u.t.outputs)
         self._gather, self._scatter = _glue()
@@ -269,7 +336,7 @@ class TransmissionWorlds:
     def _control(self, m: Any, d: Any) -> None:  # (MuJoCo Warp's control callback: M and the bias are the state's)
         if self.torque_source is not None:
             stages = STAGES.get(int(self.mj_model.opt.integrator), (0.0,))
-            self.stage_offset = stages[min(self._stage, len(stages) - 1)] * float(self.mj_model.opt.timestep)
+            self.stage_offset = stages[self._stage % len(stages)] * float(self.mj_model.opt.timestep)
             self._stage += 1
             self.torque_source(self)
         self._evaluate(True)
@@ -277,8 +344,22 @@ class TransmissionWorlds:
     # ------------------------------------------------------------------ the API
     def reset(self, outputs: ArrayLike | None = None) -> None:
         """Every world at rest: the outputs at the reference, or at ``outputs`` (``(nworld, len(self.outputs))`` or
-        one row for all) [rad or m]; the motor torques zero. The motor states are then the closure's at them."""
+        one row for all) [rad or m]; the motor torques zero. The motor states are then the closure's at them.
+        Attached (:meth:`attach`): the warm starts and the torques only, the state being the owner's.
+
+        Raises:
+            InvalidInputError: ``outputs`` not finite, or given to attached worlds."""
         wp, mjm = self._wp, self.mj_model
+        if not self._owned:
+            if outputs is not None:
+                raise InvalidInputError("outputs", "attached worlds' state is their owner's (Newton: set state.joint_q)",
+                                        outputs)
+            for u in self.units:
+                wp.copy(u.q, wp.array(np.repeat(u.t.q_reference[:, None], self.nworld, axis=1), dtype=wp.float64,
+                                      device=self.device))
+                u.tau_m.zero_()
+            self._evaluate(False)
+            return
         qpos = np.repeat(np.asarray(mjm.key_qpos[0], dtype=np.float32)[None, :], self.nworld, axis=0)
         if outputs is not None:
             qo = np.broadcast_to(np.asarray(outputs, dtype=float), (self.nworld, len(self.outputs)))
@@ -309,7 +390,12 @@ class TransmissionWorlds:
 
     def step(self, substeps: int = 1) -> None:
         """``substeps`` steps of MuJoCo Warp (every world). The motor states at the new state are evaluated when first
-        read (one more run of the kernels: :meth:`observe`)."""
+        read (one more run of the kernels: :meth:`observe`).
+
+        Raises:
+            InvalidInputError: attached worlds (:meth:`attach`), which their owner steps."""
+        if not self._owned:
+            raise InvalidInputError("step", "attached worlds are stepped by their owner (Newton: solver.step)")
         with self._wp.ScopedDevice(self.device):
             for _ in range(substeps):
                 self._stage = 0
@@ -318,8 +404,9 @@ class TransmissionWorlds:
 
     def observe(self) -> None:
         """The transmissions' kernels at the current state (the motor states, the residuals, the statuses), if a step
-        has moved it since they last ran; the properties below call it."""
-        if self._stale:
+        has moved it since they last ran (attached worlds: every time, the owner stepping them); the properties below
+        call it."""
+        if self._stale or not self._owned:
             self._evaluate(False)
             self._stale = False
 
