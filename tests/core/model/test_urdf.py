@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -63,6 +64,31 @@ def test_malformed_urdf_is_refused_with_a_reason(text, message):
     """Each defect gives a SpecError saying what is wrong (instead of Pinocchio's bare ValueError)."""
     with pytest.raises(SpecError, match=message):
         load_model(text)
+
+
+@pytest.mark.parametrize("word", ["1", "-2.5", "+.5", "1.", "3e-7", "1E+3", "nan", "-Inf", "infinity", "1_000",
+                                  "\u0661", "0x10", "1e", "--1", "1,5", "one"])
+def test_a_number_is_read_as_the_pattern_reads_it(word):
+    """``floats``' fast path (float() on ASCII text without "_") takes exactly the words its pattern takes."""
+    from pkm.core.model.urdf import _NUMBER, floats
+
+    if _NUMBER.fullmatch(word) and math.isfinite(float(word)):
+        assert floats(word, 1, "w", "<t>") == [float(word)]
+    elif _NUMBER.fullmatch(word):
+        with pytest.raises(SpecError, match="is not finite"):
+            floats(word, 1, "w", "<t>")
+    else:
+        with pytest.raises(SpecError, match="not a list of numbers"):
+            floats(word, 1, "w", "<t>")
+
+
+def test_a_text_checked_once_is_refused_alike_when_changed_and_loads_alike_again():
+    """The checked texts are remembered by their whole text: the same text loads again to the same model (checked
+    once), and a one-character change is checked anew."""
+    first, again = load_model(GOOD), load_model(GOOD)
+    assert first == again
+    with pytest.raises(SpecError, match="zero axis"):
+        load_model(GOOD.replace('xyz="0 0 1"', 'xyz="0 0 0"'))
 
 
 def test_entity_expansion_bomb_is_refused_quickly():
