@@ -181,9 +181,11 @@ def per_unit(mech: Mechanism, value: float | Mapping[str, float], name: str, joi
 
 
 #: A draw's path gives up when its continuation step falls below this fraction of the first (1e-3 for a closure
-#: that must succeed): a draw outside the workspace is passed over at a fifth of the cost (the hexapod's 107 states
-#: 8.6 -> 3.3 s), and the states drawn on the shipped mechanisms are the same to the last bit.
-DRAW_MIN_STEP = 0.05
+#: that must succeed): after one halving of a step that failed. A draw outside the workspace is passed over at a
+#: twelfth of the cost (the hexapod's 107 states: 8.6 s at 1e-3, 5.4 s at 0.05, 2.0 s), and the states drawn on the
+#: shipped mechanisms are the same to the last bit at 1e-3, 0.05 and 0.5 (a draw is random: one that needs a path
+#: finer than this is passed over for the next).
+DRAW_MIN_STEP = 0.5
 
 
 def closed_draws(mech: Mechanism, rng: np.random.Generator, spread: np.ndarray, tries: int) \
