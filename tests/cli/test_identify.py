@@ -106,3 +106,21 @@ def test_cutoff_help_states_the_decimation(capsys):
     assert cli.main(["identify", "--help"]) == 0
     text = " ".join(capsys.readouterr().out.split())
     assert "decimated to one in rate / (2 cutoff)" in text and "rows kept are reported" in text
+
+
+def test_a_mechanism_with_idle_motions_is_refused_before_any_work(tmp_path):
+    """Issue 52: pkm identify refused the humanoid ankle (two rods spinning between balls: idle motions, which the
+    precise rank's twin regressor cannot take) only after pkm excite had run (73 s) and the table was read. Both
+    refuse up front, with the SpecError pkm.base_parameters raises, naming the double-precision route: identify before
+    it reads its table (here a file that does not exist), excite before it writes one."""
+    from pkm.core.identification.base import base_parameters
+    from pkm.errors import SpecError
+
+    ankle = "examples/humanoid_ankle/ankle.closures.toml"
+    for args in (("identify", ankle, str(tmp_path / "missing.csv"), "--out", str(tmp_path / "id.closures.toml")),
+                 ("excite", ankle, "--out", str(tmp_path / "exc.csv"))):
+        line = one_error_line(run(*args))
+        assert "idle motions" in line and "humanoid_ankle has 2" in line and "precise=False" in line, line
+    assert not (tmp_path / "exc.csv").exists()
+    with pytest.raises(SpecError, match="has 2: pass precise=False"):
+        base_parameters(pkm.load(ankle))

@@ -30,6 +30,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 import pkm
+from pkm.core.kinematics import constraints
 from pkm.core.model.mechanism import Mechanism
 from pkm.errors import InvalidInputError, PkmError
 from pkm.units import KIND_OF_UNIT, joint_unit, parse_quantity
@@ -329,8 +330,8 @@ def _close(mech: Mechanism, qa: np.ndarray, q0: np.ndarray, kernels: Any
     n = len(qa)
     if kernels is not None and n > 1:
         try:  # (the compiled path, warm-started in C; any sample it cannot solve: the per-sample route below)
-            path = kernels.close_loops_path(qa, q0)
-            return (np.asarray(path.q), np.asarray(path.residual, dtype=float),
+            path = kernels.close_loops_path(qa, q0)  # (its residual counts lengths in L: the m and rad reported)
+            return (np.asarray(path.q), constraints.largest(mech, np.asarray(path.q)),
                     np.asarray(path.iterations).astype(np.int64), [None] * n)
         except PkmError:
             pass

@@ -64,6 +64,7 @@ class Stream:
         """
         from pkm.core.differential.velocity import forward_jacobian
         from pkm.core.dynamics.model import actuator_model
+        from pkm.core.kinematics import constraints
         from pkm.core.kinematics.solve import close_loops
         from pkm.core.twin.kernels import PIVOT_FLOOR
 
@@ -79,7 +80,7 @@ class Stream:
         if K is not None:  # (the kernels called directly: a stream's samples are checked here, one at a time)
             q_k, r_k, p_k, _ = K.kernel("closure_newton").follow(self.q, qa[None], 10, 1e-12)
             if r_k[0] <= 1e-12 and p_k[0] >= PIVOT_FLOOR and np.all(np.isfinite(q_k[0])):
-                q, residual = q_k[0], float(r_k[0])
+                q, residual = q_k[0], float(constraints.largest(self.mech, q_k[0])[0])  # (m or rad, as close_loops')
         if q is None:
             r = close_loops(self.mech, qa, self.q)
             q, residual = r.q, r.residual

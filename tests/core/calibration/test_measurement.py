@@ -80,3 +80,27 @@ def test_bad_parameters_and_sensors_are_refused() -> None:
         calibration_parameters(mechanism("prs3"), "pose", joints=["nope"])
     with pytest.raises(pkm.errors.InvalidInputError, match="row 2"):
         model("prs3").close(None, [[0.1, 0.1, 0.1], [np.nan, 0.1, 0.1]])
+
+
+@pytest.mark.filterwarnings("ignore::pkm.errors.ImplausibleModelWarning")  # (the 0.1 copy's masses are the original's)
+def test_the_closure_tolerance_counts_lengths_in_the_characteristic_length(monkeypatch) -> None:
+    """The calibration model's loop closure on the 3-PRS and its copies scaled by 0.1 and 10, each perturbed alike
+    (its lengths by 2 mm times the scale), stopped after one Newton pass: the residual its ConvergenceError states is
+    the same at every size (1e-9 relative: lengths over L), against CLOSURE_TOL, and the message says so (issue 52:
+    before, CLOSURE_TOL * max(1, L) bounded a residual in m, so the copy 10 times smaller stated one 10 times
+    smaller)."""
+    from pkm.core.calibration import measurement
+    from pkm.core.calibration.estimate import perturbed
+    from pkm.errors import ConvergenceError
+
+    monkeypatch.setattr(measurement, "MAX_NEWTON", 1)
+    m = model("prs3", "pose")
+    readings = m.mech.actuated_q(m.mech.q_reference)[None] + 0.05 * m.mech.characteristic_length
+    stated = []
+    for s in (1.0, 0.1, 10.0):
+        copy = m if s == 1.0 else CalibrationModel(pkm.scaled_mechanism(m.mech, s), "pose")
+        with pytest.raises(ConvergenceError, match="characteristic length") as err:
+            copy.close(perturbed(copy, seed=1, length=2e-3 * s), readings * s)  # (the sliders' readings: lengths)
+        assert err.value.tolerance == measurement.CLOSURE_TOL
+        stated.append(err.value.residual)
+    assert stated[0] > 1e-6 and np.allclose(stated[1:], stated[0], rtol=1e-9, atol=0.0), stated

@@ -143,6 +143,24 @@ def test_candidates_spread_per_unit_by_default() -> None:
         assert np.array_equal(candidates(m, 6, seed=2, spread={"rad": SPREAD, "m": bound}), drawn)
 
 
+@pytest.mark.filterwarnings("ignore::pkm.errors.ImplausibleModelWarning")  # (the 0.1 copy's masses are the original's)
+def test_the_singularity_margin_is_the_same_for_a_copy_scaled_in_size() -> None:
+    """The candidates' singularity margin (conditioning, homogenised by the characteristic length) at three poses of
+    the 3-PRS (prismatic actuators: their rows and columns in lengths) equals its copies' scaled by 0.1 and 10 (1e-9
+    relative). (Before, on the raw matrix in m and rad, the copies' were 0.106 and 0.54 times the original's: a margin
+    that meant another thing at every size.)"""
+    from pkm.core.calibration.measurement import CalibrationModel
+    from pkm.core.calibration.poses import conditioning
+
+    m = model("prs3", "pose")
+    readings = candidates(m, 3, seed=5)
+    mine = conditioning(m, readings)
+    assert np.all(mine > 1e-3)
+    for s in (0.1, 10.0):
+        copy = CalibrationModel(pkm.scaled_mechanism(m.mech, s), "pose")
+        np.testing.assert_allclose(conditioning(copy, readings * s), mine, rtol=1e-9)  # (sliders: lengths)
+
+
 def test_columns_given_as_a_dict_take_the_identification_route(tmp_path) -> None:
     """``read_data`` reads a dict of columns as ``pkm.measurements`` does (one route: ``read_columns``): text is
     refused naming its column (before: numpy turned "0.1" into 0.1), columns of unequal length are refused naming

@@ -1,7 +1,8 @@
 """The exported C's singularity test is homogenised (:class:`pkm.core.export.model.Newton`'s row and column factors,
 :class:`~pkm.core.model.scale.JacobianScales`'): on a slider-crank scaled by 1000 (a model in millimetres read as
 metres), compiled once, ``fk_distance`` (what SINGULAR is decided on) is pkm's direct distance of the copy and of
-the original, where the raw matrix's ratio is 136 times smaller."""
+the original, where the raw matrix's ratio is 136 times smaller; its Newton tolerance counts lengths in the
+characteristic length (the same iterations at every size)."""
 
 from __future__ import annotations
 
@@ -60,3 +61,52 @@ def test_the_factors_are_emitted_as_constants(scaled):
             found = re.search(rf"{h.lib.name}_{kind}_{side}_scale\[\d+\] = \{{([^}}]*)\}}", text).group(1)
             assert np.allclose([float(x) for x in found.split(",")], values, rtol=1e-15), (kind, side)
     assert np.isclose(model.fk.column_scale.max(), L, rtol=1e-15) and L > 10.0  # (a length column, in a 1000x copy)
+
+
+def _newton_iterations(newton, q, target):
+    """The C's Newton loop (runtime.NEWTON, a warm start: one step of the path) on the step kernel: (iterations,
+    residual at the last iterate), (None, residual) where it does not converge in MAX_ITER."""
+    from pkm.core.export.library import MAX_ITER, TOL
+
+    for it in range(1, MAX_ITER + 1):
+        q_next, r, *_ = (np.array(x).ravel() for x in newton.step(q, target))
+        if r[0] <= TOL:
+            return it, float(r[0])
+        q = q_next
+    return None, float(r[0])
+
+
+@pytest.mark.filterwarnings("ignore::pkm.errors.ImplausibleModelWarning")  # (the 0.1 copy's masses are the original's)
+def test_the_newton_tolerance_counts_lengths_in_the_characteristic_length(scaled):
+    """The slider-crank and its copies scaled by 0.1 and 10 (the step kernels the C is written from) and the compiled
+    copy scaled by 1000, warm-started from the reference toward three actuated values and their task values: the same
+    iterations, the first residual the same (1e-9 relative, lengths in L: TOL means the same at every size), and the
+    C's status and iterations those of the Python kernels (issue 52: before, TOL was 1e-12 m, and the copies 10 and
+    1000 times larger took 5 IK iterations where the original took 4)."""
+    mech, big, h = scaled
+    qa0, L = mech.actuated_q(mech.q_reference), mech.characteristic_length
+    moves = [qa0 + d * np.where([j.revolute for j in mech.actuated], 1.0, L) for d in (0.05, -0.08, 0.1)]
+    runs = {}
+    for s in (1.0, 0.1, 10.0, 1000.0):
+        m = {1.0: mech, 1000.0: big}.get(s) or pkm.scaled_mechanism(mech, s)
+        model, ref = ExportModel(m), scale_configuration(mech, mech.q_reference, s)
+        out = []
+        for qa in moves:
+            qa = qa * np.where([j.revolute for j in m.actuated], 1.0, s)
+            y = pkm.TaskMap.of(m).value(pkm.close_loops(m, qa).q)
+            first = [float(np.array(n.step(ref, t)[1])[0, 0]) for n, t in ((model.fk, qa), (model.ik, y))]
+            out.append((_newton_iterations(model.fk, ref, qa)[0], _newton_iterations(model.ik, ref, y)[0], first,
+                        qa, y))
+        runs[s] = out
+    assert all(fk is not None and ik is not None and fk >= 3 for fk, ik, *_ in runs[1.0])
+    for s in (0.1, 10.0, 1000.0):
+        for (fk1, ik1, first1, *_), (fk, ik, first, *_) in zip(runs[1.0], runs[s]):
+            assert (fk, ik) == (fk1, ik1), s
+            assert np.allclose(first, first1, rtol=1e-9, atol=0.0), (s, first, first1)
+    ref = big.q_reference
+    for fk, ik, _, qa, y in runs[1000.0]:
+        row = h.run("fk", np.hstack([qa, ref, [0.0]])[None])[0]
+        assert (int(row[0]), int(row[1])) == (0, fk) and row[2] <= 1e-12, row[:3]
+        row = h.run("ik", np.hstack([y, ref, [0.0]])[None])[0]
+        assert (int(row[0]), int(row[1])) == (0, ik) and row[2] <= 1e-12, row[:3]
+    assert f"characteristic length L = {big.characteristic_length:.6g} m" in h.lib.header.read_text()

@@ -300,6 +300,37 @@ def test_a_result_checks_itself_again_and_assemble_follows_the_solvers_failure_r
     assert not failed.converged and failed.residual > 1e-3 and failed.check(tight)
 
 
+@pytest.mark.filterwarnings("ignore::pkm.errors.ImplausibleModelWarning")  # (the 0.1 copy's masses are the original's)
+def test_a_result_checks_itself_alike_on_copies_scaled_in_size(delta):
+    """SolveResult.check's tol counts a closure's gap in the characteristic length L (issue 52): the Delta and its
+    copies scaled by 0.1 and 10, a solution moved off the loops by 1e-8 rad at a passive joint (a gap g of about 1.6e-8
+    L, computed here from the point closures' residual over L): it holds to 2 g and not to g / 2 at every size, and
+    its own solution holds to the default. (Before, in m: to tol = 1e-9 the copy 10 times smaller held, the others not.)"""
+    import dataclasses
+
+    from pkm.core.kinematics import constraints
+    from pkm.core.model.builder import scaled_mechanism
+    from pkm.core.model.scale import scale_configuration
+
+    qa = np.array([-0.9, -0.85, -1.0])
+    res = close_loops(delta, qa)
+    moved = res.q.copy()
+    moved[delta.passive_v[0]] += 1e-8
+    verdicts = []
+    for s in (1.0, 0.1, 10.0):
+        m = delta if s == 1.0 else scaled_mechanism(delta, s)
+        q = scale_configuration(delta, moved, s)
+        r = constraints.residual(m, q)
+        assert len(r) == 3 * len(m.spec.closures)  # (point closures: every row a length)
+        gap = max(np.linalg.norm(r[k:k + 3]) for k in range(0, len(r), 3)) / m.characteristic_length
+        assert 1e-9 < gap < 1e-7, (s, gap)
+        mine = close_loops(m, qa)
+        assert mine.check(m)
+        off = dataclasses.replace(mine, q=q)
+        verdicts.append((off.check(m, tol=2.0 * gap), off.check(m, tol=0.5 * gap), off.check(m, tol=1e-9)))
+    assert verdicts == [(True, False, False)] * 3, verdicts
+
+
 def test_a_failure_carries_its_problem_whose_jacobian_is_the_derivative_of_its_residual(delta):
     """ConvergenceError.problem (ClosureProblem, IKProblem): residual(q) is zero at a solution and equals the
     failure's residual at its last iterate; jacobian(q) equals central differences of residual along random

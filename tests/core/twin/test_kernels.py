@@ -130,6 +130,32 @@ def test_every_joint_actuated_the_kernels_equal_the_core(built, all_actuated):
         assert np.abs(K.inverse_dynamics(q, qd, qdd) - tau).max() <= 1e-10 * max(1.0, np.abs(tau).max())
 
 
+def test_paths_on_copies_scaled_in_size_take_the_same_iterations():
+    """The 3-RRR and its copies scaled by 0.1 and 10 (CasADi's virtual machine: no compiler), the loop closure along
+    4 samples 0.2 rad apart and the IK back along their task values: the same iterations per sample, no fallback, the
+    same residuals (lengths counted in the characteristic length, 1e-14) (issue 52: before, the tolerance was 1e-12 m,
+    and the copy 10 times larger took 5 IK iterations where the original took 4)."""
+    from pkm.core.model.scale import scale_configuration
+
+    mech = _mechanism("rrr3")
+    qa = mech.actuated_q(mech.q_reference) + np.linspace(0.0, 0.6, 4)[:, None] * np.array([1.0, -0.5, 1.0])
+    runs = {}
+    for s in (1.0, 0.1, 10.0):
+        m = mech if s == 1.0 else pkm.scaled_mechanism(mech, s)
+        K = Kernels(m, compiled=False)
+        fk = K.close_loops_path(qa)
+        ik = K.ik_path(np.array([TaskMap.of(m).value(q) for q in fk.q[::-1]]), fk.q[-1])
+        runs[s] = (m, fk, ik)
+    _, fk1, ik1 = runs[1.0]
+    assert fk1.iterations.max() >= 4 and ik1.iterations.max() >= 4  # (several Newton iterations per sample)
+    for s in (0.1, 10.0):
+        m, fk, ik = runs[s]
+        for mine, theirs in ((fk1, fk), (ik1, ik)):
+            assert theirs.fallback == () == mine.fallback and theirs.iterations.tolist() == mine.iterations.tolist(), s
+            assert np.abs(theirs.residual - mine.residual).max() <= 1e-14 and theirs.residual.max() <= 1e-12, s
+        assert max(np.abs(m.difference(scale_configuration(mech, a, s), b)).max() for a, b in zip(fk1.q, fk.q)) <= 1e-9
+
+
 def test_samples_under_the_pivot_floor_fall_back_to_the_core(monkeypatch):
     """With the floor above every pivot, each path sample and each effort comes from the core, listed as such, and
     the answers are the same."""

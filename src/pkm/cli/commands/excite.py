@@ -33,9 +33,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from pkm._optional import require
+    from pkm.core.identification.base import require_precise
     from pkm.core.identification.excitation import excite, write_csv
 
     mech = load_mechanism(args)
+    require_precise(mech, "pkm identify, which reads pkm excite's table,")  # (before the excitation: minutes)
     period = parse_quantity(args.duration, {"time"}, "--duration", "s")
     dt = parse_quantity(args.dt, {"time"}, "--dt", "s")
     if not dt > 0.0:

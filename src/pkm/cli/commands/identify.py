@@ -43,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
 
     import pkm
     from pkm._optional import require
-    from pkm.core.identification.base import base_parameters
+    from pkm.core.identification.base import base_parameters, require_precise
     from pkm.core.identification.estimate import POOR_EFFORT_SHARE, POOR_RELATIVE_STD, estimate
     from pkm.core.identification.export import identified_mechanism, standard_from_base, validate
     from pkm.core.identification.measurements import measurements
@@ -53,6 +53,7 @@ def run(args: argparse.Namespace) -> int:
     from pkm.report import jsonable
 
     mech = load_mechanism(args)
+    require_precise(mech, "pkm identify")  # (before the measurements are read: the rank needs the twin's regressor)
     if args.consistent:
         require("identify", "the physically consistent estimate (pkm identify --consistent)")
     if args.plot:

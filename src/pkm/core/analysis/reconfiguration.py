@@ -152,7 +152,7 @@ def _unreached(f: _Index, k: int, x: np.ndarray, i: int, advice: str) -> Unreach
     miss = float(f.residual[i]) if np.isfinite(f.residual[i]) and f.residual[i] > 0 else 0.0
     where = dict(zip(f.parameter_names, map(float, np.atleast_1d(x))))
     mode = "" if miss > 1e-10 else " (solved, but in another working mode)"
-    return UnreachableError(0, miss, "m or rad", f"pose {k} with {where}{mode}: {advice}")
+    return UnreachableError(0, miss, "characteristic lengths or rad", f"pose {k} with {where}{mode}: {advice}")
 
 
 def reconfigure(mech: Mechanism, poses: np.ndarray | Sequence[ArrayLike | Mapping[str, Any]],

@@ -41,10 +41,12 @@ from numpy.typing import ArrayLike
 from pkm.core.calibration.parameters import KINDS, CalibrationParameters, calibration_parameters
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.origins import ORIGIN
+from pkm.core.model.scale import JacobianScales
 from pkm.errors import ConvergenceError, InvalidInputError, PkmError, UnknownNameError
 from pkm.validation import wrap_angle
 
-#: The closure is solved to this infinity norm, relative to the mechanism's characteristic length [m / m, rad].
+#: The closure is solved to this infinity norm, a length relative to the mechanism's characteristic length (its
+#: closure rows' and a prismatic actuator's row over ``L``), an angle in rad.
 CLOSURE_TOL = 1e-13
 #: Newton iterations at most per closure.
 MAX_NEWTON = 30
@@ -277,12 +279,14 @@ class CalibrationModel:
         x, M = self.vector(x), self._readings(readings)
         Q = np.array(self.seeds(M) if seeds is None else seeds, dtype=float, copy=True)
         model = self.mech.model
-        tol = CLOSURE_TOL * max(1.0, self.mech.characteristic_length)
+        tol = CLOSURE_TOL
+        scales = JacobianScales.of(self.mech)  # (per row: a length over L, an angle in rad)
+        w = np.concatenate([scales.closure_residual, 1.0 / scales.actuated])[:, None]
         f = self._map("close", len(M))
         g, Gq = f(Q.T, M.T, x)
         for _ in range(MAX_NEWTON):
             g = np.array(g).T  # (n, rows)
-            worst = np.max(np.abs(g), axis=1)
+            worst = np.max(np.abs(g * w.T), axis=1)
             if np.all(worst < tol):
                 return Q
             G = np.array(Gq).reshape(g.shape[1], len(M), -1).transpose(1, 0, 2)
@@ -291,14 +295,15 @@ class CalibrationModel:
             for _ in range(8):  # (halved where the residual grows: a pose far from its seed)
                 new = np.array([pin.integrate(model, q, t * d) for q, d, t in zip(Q, dq, step)])
                 g_new, Gq_new = f(new.T, M.T, x)
-                grew = np.max(np.abs(np.array(g_new)), axis=0) > np.maximum(worst, tol)
+                grew = np.max(np.abs(np.array(g_new) * w), axis=0) > np.maximum(worst, tol)
                 if not grew.any():
                     break
                 step[grew] *= 0.5
             Q, g, Gq = new, g_new, Gq_new
         k = int(np.argmax(worst))
         raise ConvergenceError(f"loop closure of the calibration model at pose {k + 1}", float(worst[k]), MAX_NEWTON,
-                               tol)
+                               tol, detail=f"the residual counts lengths in the characteristic length L = "
+                                           f"{scales.length:.4g} m, angles in rad")
 
     # ------------------------------------------------------------------ measurements
     def evaluate(self, x: ArrayLike | None, readings: ArrayLike, Q: np.ndarray | None = None,

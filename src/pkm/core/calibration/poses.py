@@ -23,10 +23,12 @@ from pkm.core.calibration.identifiable import BaseGeometry, base_geometry, stack
 from pkm.core.calibration.measurement import CalibrationModel
 from pkm.core.identification.base import closed_draws, per_unit
 from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, PkmError
 from pkm.validation import as_count, as_scalar
 
-#: The closure system's default singularity margin (smallest over largest singular value).
+#: The closure system's default singularity margin (smallest over largest singular value, the matrix homogenised:
+#: :func:`conditioning`).
 MARGIN = 1e-3
 #: The default spread of the readings about the reference: rad for a revolute actuator, characteristic lengths for a
 #: prismatic one (:func:`default_spread`). At 0.1, poses of the shipped Delta and 3-PRS see their base parameters so
@@ -62,12 +64,17 @@ class PosePlan:
 
 def conditioning(model: CalibrationModel, readings: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
     """The closure system's ``sigma_min / sigma_max`` at each pose (the twin's closure and actuated rows, along the
-    tangent space; the idle motions' zeros left out: :attr:`CalibrationModel.idle`): 0 at a singularity."""
+    tangent space; the idle motions' zeros left out: :attr:`CalibrationModel.idle`): 0 at a singularity. The matrix
+    is homogenised by the characteristic length ``L`` as pkm's singularity measures are
+    (:class:`~pkm.core.model.scale.JacobianScales`: a rotation row and a revolute actuator's row times ``L``, a
+    length column times ``L``), so that a robot of 5 cm and one of 5 m have the same margin."""
     M = np.atleast_2d(readings)
     Q = model.close(x, M)
     _, Gq = model._map("close", len(M))(Q.T, M.T, model.vector(x))
     G = np.array(Gq).reshape(-1, len(M), model.mech.nv).transpose(1, 0, 2)
-    s = np.linalg.svd(G, compute_uv=False)
+    scales = JacobianScales.of(model.mech)
+    rows = np.concatenate([scales.constraint_rows, scales.length / scales.actuated])
+    s = np.linalg.svd(rows[:, None] * G * scales.columns, compute_uv=False)
     return s[:, -1 - model.idle] / s[:, 0]
 
 

@@ -4,7 +4,8 @@ The state is the actuated coordinates and rates ``(q_a, qd)``; the equations are
 :mod:`pkm.core.dynamics.model`, ``M_a qdd = sat(τ_a) + f_a - h_a``, with the actuators' torque saturation (each
 effort clipped to its peak, else continuous, limit) and the joints' viscous and Coulomb friction. At every stage
 of the integrator the passive joints are found by closing the loops from the previous configuration (a few Newton
-iterations, to 1e-12): the loops are exact at every step, there is no drift to stabilise and no Baumgarte gain to
+iterations, to 1e-12 with lengths counted in the characteristic length: the same iterations for a copy scaled in
+size): the loops are exact at every step, there is no drift to stabilise and no Baumgarte gain to
 tune.
 
 Integrators:
@@ -95,7 +96,7 @@ METHODS = ("rk4", "radau")
 BACKENDS = ("auto", "python", "c")
 AUTO_STEPS = 2000  # "auto" builds a mechanism's compiled simulation for runs of at least this many steps
 MAX_STEPS = 10_000_000  # a run of more steps than this is refused (its arrays alone would be gigabytes)
-CLOSURE_TOL = 1e-12
+CLOSURE_TOL = 1e-12  #: the loop closure's largest residual, lengths in the characteristic length (angles in rad)
 SINGULAR_CLOSURE = 10.0  # a closure that fails within this many singular_tol of a direct singularity: "singularity"
 MAX_HALVINGS = 8  # an RK4 step is halved at most this many times (a 1-ms step down to 4 us)
 RADAU_EVALUATIONS = 10 * 2 ** MAX_HALVINGS  # "radau" stops past this many evaluations a sample (RK4's worst case)
@@ -212,10 +213,10 @@ class _Dynamics:
             at = mech.base.idx_q
             q[at:at + 3] = pose[:3]
             q[at + 3:at + 7] = pose[3:] / np.linalg.norm(pose[3:])
-        pv = mech.passive_v
+        pv, weights = mech.passive_v, JacobianScales.of(mech).closure_residual
         for _ in range(12):
             r, J = constraints.residual_and_jacobian(mech, q)
-            if np.max(np.abs(r), initial=0.0) <= CLOSURE_TOL:
+            if np.max(np.abs(r * weights), initial=0.0) <= CLOSURE_TOL:
                 return q, J
             dv = np.zeros(mech.nv)
             dv[pv] = -least_squares(J[:, pv], r)
@@ -481,7 +482,7 @@ class _Recorder:
         kinetic = np.array([m.kinetic_energy for m in self.models])
         potential = np.array([energy(mech, qq, np.zeros(mech.nv))[1] for qq in q])
         loss = -np.array([m.friction_power for m in self.models]) if self.dyn.friction else np.zeros(n)
-        residual = np.array([np.max(np.abs(constraints.residual(mech, qq)), initial=0.0) for qq in q])
+        residual = constraints.largest(mech, q)
         return _simulation(mech, np.array(self.t), q, v, a, qd, np.array(self.qdd), task, task_v, task_a, tau,
                            residual, kinetic, potential, loss, event, method, self.dyn.base)
 
@@ -750,7 +751,7 @@ def _c_result(dyn: _Dynamics, sim: Simulator, rows: dict[str, np.ndarray], dt: f
         task[k], task_v[k] = tm.value(Q[k]), tm.jacobian(Q[k]) @ V[k]
         task_a[k] = tm.jacobian(Q[k]) @ a[k] + tm.bias(Q[k], V[k])
         potential[k] = energy(mech, Q[k], np.zeros(mech.nv))[1]
-        residual[k] = np.max(np.abs(constraints.residual(mech, Q[k])), initial=0.0)
+        residual[k] = constraints.largest(mech, Q[k])[0]
     loss = -rows["FQD"] if dyn.friction else np.zeros(len(Q))
     return _simulation(mech, np.arange(len(Q)) * dt, Q, V, a, X[:, na:], QDD, task, task_v, task_a, rows["TAU"],
                        residual[:, 0], rows["KIN"], potential[:, 0], loss, event, "rk4")

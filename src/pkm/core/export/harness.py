@@ -403,11 +403,13 @@ def domain(mech: Mechanism, harness: Harness, steps: int = 60) -> tuple[list[str
     the reference (in mode 0) until far beyond the workspace (``steps`` of 0.05 rad, or 0.05 of the mechanism's
     size, each), through whatever singularity, mode change or limit it meets (a crank that turns fully meets none); the inverse kinematics of targets 10 units (m, rad) away.
     Returns what went wrong (empty when nothing did: a non-finite output, an OK whose configuration does not
-    close, checked by pkm to 1e-9) and how many of the forward kinematics' steps ended in each status."""
+    close, checked by pkm to 1e-9, lengths in the characteristic length as the C's tolerance counts them) and how many of the forward kinematics' steps ended in each status."""
     from pkm.core.export.library import STATUS
-    from pkm.core.kinematics.constraints import residual
+    from pkm.core.kinematics.constraints import residual, worst_closure
+    from pkm.core.model.scale import JacobianScales
 
     lib = harness.lib
+    weights = JacobianScales.of(mech).closure_residual
     na, nq, ny = mech.na, mech.nq, lib.sizes["NY"]
     ref = mech.q_reference
     invalid = STATUS.index("INVALID_INPUT")
@@ -442,7 +444,7 @@ def domain(mech: Mechanism, harness: Harness, steps: int = 60) -> tuple[list[str
         seen.append(STATUS[int(got[0])])
         if got[0] in (0, STATUS.index("OUTSIDE_LIMITS"), STATUS.index("LEFT_MODE")):
             q = got[4:4 + nq]
-            if np.abs(residual(mech, q)).max() > 1e-9:
+            if worst_closure(mech, residual(mech, q) * weights)[0] > 1e-9:
                 problems.append(f"fk step {k}: OK at a configuration that does not close")
     y0 = TaskMap.of(mech).value(ref)
     for sign in (1.0, -1.0):

@@ -12,7 +12,9 @@ effort maps between actuators and task, ``J̇ q̇``, inverse dynamics, ``M_a`` a
 Every function is re-entrant (constant tables only, the caller owns every buffer), allocates nothing, prints
 nothing, needs only ``<math.h>``, and returns a status:
 
-* ``OK``; ``NOT_CONVERGED`` (``info.residual``: the largest residual at the last iterate);
+* ``OK``; ``NOT_CONVERGED`` (``info.residual``: the largest residual at the last iterate, lengths counted in the
+  characteristic length ``L`` and angles in rad, as :func:`pkm.close_loops`' tolerance counts it: the same
+  iterations and verdicts for a model in millimetres and the same in metres);
 * ``SINGULAR`` (``info.sigma_min``: the Newton or closure matrix's smallest singular value relative to its largest,
   under ``SINGULAR_TOL``, the matrix homogenised by the characteristic length as pkm's singularity measures are,
   :class:`~pkm.core.model.scale.JacobianScales`: its row and column factors are the library's constants
@@ -51,13 +53,13 @@ from pkm.core.twin.codegen import jacobi_sv, paper_counts
 from pkm.validation import ABSURD
 
 #: Newton iterations at most (each one evaluation of the step), the convergence tolerance on the largest closure
-#: residual or task error [m, rad], the relative pivot under which a solve goes dense, the relative smallest
+#: residual or task error (lengths in the characteristic length ``L``, angles in rad: scale-free), the relative pivot under which a solve goes dense, the relative smallest
 #: singular value of the homogenised matrix under which it counts as singular, the slack on joint limits [rad, m].
 MAX_ITER = 20
 TOL = 1e-12
 #: The forward kinematics' continuation (:func:`pkm.core.kinematics.solve.close_loops`'s): the largest change of an
 #: actuated coordinate per step [rad, or characteristic lengths for a prismatic actuator], the steps at most, and
-#: the tolerance of the steps on the way (the last one's is :data:`TOL`) [m, rad].
+#: the tolerance of the steps on the way (the last one's is :data:`TOL`; in ``L`` and rad).
 FK_STEP = 0.1
 MAX_STEPS = 64
 PATH_TOL = 1e-9
@@ -417,7 +419,8 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
         f"most {MAX_ITER * step('ik_step')} operations where the fixed pivots hold; an iteration where they fail also "
         f"evaluates ik_system ({step('ik_system')} operations), a Jacobi SVD and a dense {len(ik.columns)} x "  # type: ignore[attr-defined]
         f"{len(ik.columns)} solve.",  # type: ignore[attr-defined]
-        f"Converged when the largest closure residual (and task error) is at most {U}_TOL = {TOL:g} [m, rad].",
+        f"Converged when the largest closure residual (and task error) is at most {U}_TOL = {TOL:g}, lengths counted "
+        f"in the characteristic length L = {mech.characteristic_length:.6g} m and angles in rad (scale-free).",
         (f"Closed-form inverse kinematics of the actuators ({prefix}_ik_actuators): {step('ik_closed')} operations, "
          "no iteration." if not no_closed_form else f"No closed-form inverse kinematics: {no_closed_form}."),
         "",
@@ -452,7 +455,7 @@ def _header(mech: Mechanism, prefix: str, sizes: dict[str, int], ops: dict[str, 
     status = "\n".join(f"  {U}_{s} = {i}," for i, s in enumerate(STATUS))
     info = (f"typedef struct {{\n  int status;        /* the status returned */\n"
             "  int iterations;    /* Newton step evaluations */\n"
-            "  double residual;   /* the largest closure residual or task error at the last iterate [m, rad] */\n"
+            "  double residual;   /* the largest closure residual or task error at the last iterate (lengths in L, rad) */\n"
             "  double sigma_min;  /* SINGULAR, PIVOT_ORDER: the matrix's relative smallest singular value, homogenised */\n"
             "  double pivot;      /* the smallest relative pivot of the fixed elimination order */\n"
             "  int joint;         /* OUTSIDE_LIMITS: the joint (index into limit_names), else -1 */\n"

@@ -96,7 +96,8 @@ class Newton:
 
     Attributes:
         step: ``(q, target) -> (q_next, residual, pivot, mode)``: the next iterate by the fixed-pivot LU, the largest
-            residual at ``q``, the smallest relative pivot (of the LU and of the blocks' own), and per diagonal block
+            residual at ``q`` (lengths counted in the characteristic length, angles in rad: scale-free, as
+            :func:`pkm.close_loops`' tolerance counts it), the smallest relative pivot (of the LU and of the blocks' own), and per diagonal block
             its determinant relative to the reference's (positive: the reference's sign; see the module doc).
         system: ``(q, target) -> (A, b)``: the square system ``A dx = b`` the step solves (``A`` column-major), for
             the dense fallback and the smallest singular value.
@@ -208,7 +209,7 @@ class ExportModel:
             raise ExportError(self.mech.name, "no passive coordinate for the forward kinematics to solve for (every "
                                               "joint actuated or idle): the actuators fix the whole configuration")
         A = self.rows["jacobian"][:, list(self.fk_columns)]
-        return self._newton("fk", A, self.closure_rhs, tw.closure_residual, self.fk_columns, self.dx_fk, self.qa,
+        return self._newton("fk", A, self.closure_rhs, tw.relative_closure_residual, self.fk_columns, self.dx_fk, self.qa,
                             tw.with_actuated, JacobianScales.of(self.mech).constraint_rows)
 
     @functools.cached_property
@@ -218,7 +219,7 @@ class ExportModel:
         tw, tk = self.twin, TaskTwin.of(self.twin)
         A = cs.vertcat(self.rows["jacobian"], tk.task_jacobian)[:, list(self.ik_columns)]
         rhs = cs.vertcat(self.closure_rhs, tk.task_error)
-        residual = cs.vertcat(tw.closure_residual, tk.task_error)
+        residual = cs.vertcat(tw.relative_closure_residual, tk.relative_task_error)
         scales = JacobianScales.of(self.mech)
         return self._newton("ik", A, rhs, residual, self.ik_columns, self.dx_ik, self.y, lambda e: e,
                             np.concatenate([scales.constraint_rows, scales.task_rows]))

@@ -253,6 +253,25 @@ def leg_ties(names: tuple[str, ...]) -> tuple[np.ndarray, tuple[str, ...]]:
     return T, tied
 
 
+def require_precise(mech: Mechanism, what: str = "pkm.base_parameters(precise=True)") -> None:
+    """Refuse, before any work, a mechanism on which the precise route of :func:`base_parameters` cannot run: its
+    rank decided a second time in 50-digit arithmetic takes the twin's regressor, which needs a mechanism without idle
+    motions (:meth:`pkm.core.twin.tree.Twin`). ``what`` names the asker in the message.
+
+    Raises:
+        SpecError: ``mech`` has idle motions at its reference (naming how many, and the double-precision route).
+    """
+    from pkm.core.differential.velocity import idle_motions
+    from pkm.errors import SpecError
+
+    idle = idle_motions(mech, mech.q_reference).shape[1]
+    if idle:
+        raise SpecError(mech.source, f"{what} decides the base parameters' rank a second time in 50-digit arithmetic "
+                                     f"on the twin's regressor, which needs a mechanism without idle motions, and "
+                                     f"{mech.name} has {idle}: pass precise=False to pkm.base_parameters (the "
+                                     "double-precision route alone) and identify it in Python")
+
+
 def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int = 0,
                     tie_legs: bool = False, precise: bool = True) -> BaseParameters:
     """The base parameters of ``mech`` by the numerical route (module doc), from ``n_samples`` random states
@@ -266,7 +285,7 @@ def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int 
     Raises:
         InvalidInputError: fewer states than needed for as many rows as parameters, or more than ``MAX_SAMPLES``.
         SpecError: ``precise`` on a mechanism whose twin cannot build the regressor (idle motions): pass
-            ``precise=False``.
+            ``precise=False`` (refused before any work, :func:`require_precise`).
 
     Examples:
         >>> import pkm
@@ -278,6 +297,8 @@ def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int 
         'arm_1.mz'
     """
     mech = check_mechanism(mech)
+    if precise:
+        require_precise(mech)
     P = parameters(mech)
     p = len(P)
     n = n_samples if n_samples is not None else max(10, -(-3 * p // mech.na))
@@ -307,4 +328,4 @@ def base_parameters(mech: Mechanism, n_samples: int | None = None, *, seed: int 
 
 
 __all__ = ["AMPLITUDE", "CLEAR_GAP", "STATE_SPREAD", "BaseParameters", "BaseSplit", "RankDecision", "base_parameters",
-           "base_split", "closed_draws", "decide_rank", "leg_ties", "per_unit", "random_states"]
+           "base_split", "closed_draws", "decide_rank", "leg_ties", "per_unit", "random_states", "require_precise"]

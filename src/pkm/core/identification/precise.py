@@ -58,7 +58,7 @@ from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import ConvergenceError, InvalidInputError, SpecError
 
 DIGITS = 50  # the working precision [decimal digits]
-CLOSURE_TOL = 1e-45  # the loops closed again to this (largest residual, m or rad)
+CLOSURE_TOL = 1e-45  # the loops closed again to this (largest residual, lengths in the characteristic length, rad)
 MAX_NEWTON = 8  # Newton iterations at most (from a double-precision closure, three suffice)
 MAX_DENOMINATOR = 10**6  # a constant is recognised as a fraction of denominator up to this times 1, √2, √3, √6
 ZERO = 1e-14  # constants under this (absolute) are rounding of a zero (cos(fl(π/2)) = 6.1e-17)

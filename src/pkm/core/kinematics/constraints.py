@@ -85,6 +85,12 @@ def pinocchio_jacobian(mech: Mechanism, q: np.ndarray) -> np.ndarray:
     return pin.getConstraintsJacobian(m, d, mech.constraint_models, mech.constraint_datas)
 
 
+def largest(mech: Mechanism, Q: np.ndarray) -> np.ndarray:
+    """The largest closure residual [m or rad] at each configuration of ``Q`` (n x nq): what a result reports as its
+    ``residual`` where a solver's own residual counts lengths in the characteristic length."""
+    return np.array([np.max(np.abs(residual(mech, q)), initial=0.0) for q in np.atleast_2d(Q)])
+
+
 def worst_closure(mech: Mechanism, r: np.ndarray) -> tuple[float, int, str | None]:
     """The closure left most open by the residual ``r`` (its first ``n_constraints`` entries, in spec order):
     ``(norm of its block [m or rad], its 1-based index, its name)``; ``(0.0, 0, None)`` without closures."""
@@ -122,7 +128,7 @@ def check_closed(mech: Mechanism, q: np.ndarray, what: str = "q") -> None:
 
     L = mech.characteristic_length
     raw = residual(mech, q)
-    gap, index, name = worst_closure(mech, raw[:mech.n_constraints] * JacobianScales.of(mech).constraint_rows / L)
+    gap, index, name = worst_closure(mech, raw[:mech.n_constraints] * JacobianScales.of(mech).closure_residual)
     if gap > CLOSED_RTOL:
         open_by = block_gap(mech, raw, index)
         raise InvalidInputError(what, f"the loops are not closed: closure {name!r} is open by {open_by:.3g} (m or rad), "

@@ -113,16 +113,19 @@ class SolveResult:
     def check(self, mech: Mechanism, *, tol: float = 1e-9) -> bool:
         """Whether this result still holds on ``mech``, checked again from ``q`` alone (as qpsolvers'
         ``Solution.is_optimal``): ``q`` a valid configuration of ``mech``; when converged, its loops closed to
-        ``max(tol, residual)`` (m or rad); the branch signs and the joints outside their limits as recorded.
-        A result of another mechanism, or one edited since, does not hold."""
+        ``max(tol, relative_residual)``, each closure's gap counted as the solvers' tolerance counts it (lengths in the
+        characteristic length ``L``, angles in rad: the same verdict for a copy scaled in size); the branch signs and
+        the joints outside their limits as recorded. A result of another mechanism, or one edited since, does not
+        hold."""
         mech = check_mechanism(mech)
         tol = as_tolerance(tol, "tol")
         try:
             q = mech.check_q(self.q)
         except InvalidInputError:
             return False
-        gap = constraints.worst_closure(mech, constraints.residual(mech, q))[0]
-        return bool((not self.converged or gap <= max(tol, self.residual))
+        gap = constraints.worst_closure(mech, constraints.residual(mech, q) * JacobianScales.of(mech).closure_residual)[0]
+        bound = max(tol, self.relative_residual) if math.isfinite(self.relative_residual) else tol
+        return bool((not self.converged or gap <= bound)
                     and self.branch_signs == _signs(mech, q) and self.outside_limits == mech.outside_limits(q))
 
 
@@ -220,8 +223,8 @@ class _Metric:
     def of(mech: Mechanism, task: bool) -> _Metric:
         """The closure rows' metric, and the task rows' after them with ``task``."""
         s = JacobianScales.of(mech)
-        rows = s.constraint_rows / s.length
-        return _Metric(np.concatenate([rows, s.task_rows / s.length]) if task else rows, s.columns, s.length)
+        rows = s.closure_residual
+        return _Metric(np.concatenate([rows, s.task_residual]) if task else rows, s.columns, s.length)
 
 
 def _scaled_newton(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray,

@@ -132,7 +132,7 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
     else:
         raw = constraints.residual(mech, mech.q_reference)
         L = mech.characteristic_length
-        rel, index, closure = constraints.worst_closure(mech, raw * JacobianScales.of(mech).constraint_rows / L)
+        rel, index, closure = constraints.worst_closure(mech, raw * JacobianScales.of(mech).closure_residual)
         if rel > REFERENCE_TOL:
             gap = constraints.block_gap(mech, raw, index)
             raise SpecError(source, f"the [reference] configuration leaves closure {closure!r} open by {gap:.3g} "

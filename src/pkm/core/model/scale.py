@@ -69,6 +69,19 @@ class JacobianScales:
         return bool(np.all(self.constraint_rows == 1.0) and np.all(self.task_rows == 1.0)
                     and np.all(self.columns == 1.0))
 
+    @functools.cached_property
+    def closure_residual(self) -> np.ndarray:
+        """Per closure equation (n_constraints,), the factor that counts its residual in ``L``: ``1 / L`` for a
+        translation row, 1 for a rotation row (:func:`pkm.core.kinematics.solve.close_loops`' tolerance, the
+        exported C's and the twin's Newton kernels' residual: scale-free)."""
+        return self.constraint_rows / self.length
+
+    @functools.cached_property
+    def task_residual(self) -> np.ndarray:
+        """Per task coordinate (n_task,), the factor that counts its error in ``L``: ``1 / L`` for a length, 1 for
+        an angle (as :attr:`closure_residual`)."""
+        return self.task_rows / self.length
+
     def constraint(self, Jc: np.ndarray) -> np.ndarray:
         """The constraint Jacobian (n_constraints x nv) homogenised."""
         return Jc if self.trivial else self.constraint_rows[:, None] * Jc * self.columns

@@ -118,7 +118,9 @@ class PathResult:
 
     Attributes:
         q: The configurations (n x nq).
-        residual: The largest closure residual (and task error, for the IK) at each (n) [m, rad].
+        residual: The largest closure residual (and task error, for the IK) at each (n), lengths counted in the
+            characteristic length ``L`` and angles in rad (:attr:`pkm.core.kinematics.solve.SolveResult.relative_residual`,
+            what ``tol`` bounds: the same iterations and verdicts for a copy scaled in size).
         iterations: Newton iterations per sample in the kernel (n).
         fallback: The samples solved by the generic core instead (pivot under :data:`PIVOT_FLOOR`, or no
             convergence in ``max_iter`` kernel iterations).
@@ -660,7 +662,8 @@ class Kernels:
     # ---------------------------------------------------------------- paths
     def close_loops_path(self, q_actuated: ArrayLike, q0: ArrayLike | None = None, *, tol: float = 1e-12, max_iter: int = 10) -> PathResult:
         """The loop closure along a path of actuated coordinates (n x na), each solve warm-started from the previous
-        solution (the first from ``q0``, default the reference), as :func:`pkm.close_loops` per sample."""
+        solution (the first from ``q0``, default the reference), as :func:`pkm.close_loops` per sample (``tol`` as
+        its: the largest residual with lengths in the characteristic length, angles in rad)."""
         from pkm.core.kinematics.solve import close_loops
 
         return self._path("closure_newton", q_actuated, q0, tol, max_iter,
@@ -668,7 +671,8 @@ class Kernels:
 
     def ik_path(self, targets: ArrayLike, q0: ArrayLike | None = None, *, tol: float = 1e-12, max_iter: int = 10) -> PathResult:
         """The inverse kinematics along a path of task values (n x task value size, laid out as
-        :meth:`pkm.core.kinematics.task.TaskMap.value`), warm-started, as :func:`pkm.solve_ik` per sample."""
+        :meth:`pkm.core.kinematics.task.TaskMap.value`), warm-started, as :func:`pkm.solve_ik` per sample (``tol`` as
+        its, scale-free)."""
         from pkm.core.kinematics.solve import solve_ik
 
         return self._path("ik_newton", targets, q0, tol, max_iter, lambda q, t: solve_ik(self.mech, t, q, tol=tol))
@@ -693,7 +697,7 @@ class Kernels:
             if end == n:
                 break
             solved = core(prev if end == start else Q[end - 1], t[end])  # the core, from the last good sample
-            Q[end], res[end], its[end] = solved.q, solved.residual, 0
+            Q[end], res[end], its[end] = solved.q, solved.relative_residual, 0
             fallback.append(end)
             prev, start = solved.q, end + 1
         return PathResult(Q, res, its, tuple(fallback), kernel.how, self.mech.limits_along(Q))

@@ -14,7 +14,8 @@ the driver ``pkm_sim_run``:
   what a :class:`~pkm.core.dynamics.simulate.Simulation` holds per sample, run over every sample after the run.
 
 Each stage does what the Python route does, in the same order and with the same floating-point expressions: the
-actuated coordinates set in the seed, Newton to ``1e-12`` (at most 11 iterations), the model, the efforts (a torque
+actuated coordinates set in the seed, Newton to ``1e-12`` (lengths in the characteristic length, as the Python
+route's :data:`~pkm.core.dynamics.simulate.CLOSURE_TOL`; at most 11 iterations), the model, the efforts (a torque
 table interpolated as ``numpy.interp`` does and clipped to the actuators' peak efforts; or a Python controller,
 called back through :mod:`ctypes` once per stage), ``M_a``'s Cholesky factorisation with
 :func:`pkm.core.dynamics.model._solve_inertia`'s test. After each step the end is checked as
@@ -54,7 +55,7 @@ if TYPE_CHECKING:
 #: Why the driver stopped: the run is done, or it hands step ``last + 1`` to Python.
 CODES = {0: "done", 1: "a compiled function failed", 2: "halve", 3: "near an event", 4: "pivot", 5: "no closure",
          6: "inertia", 7: "not finite", 8: "controller"}
-CLOSURE_TOL = 1e-12
+CLOSURE_TOL = 1e-12  #: as :data:`pkm.core.dynamics.simulate.CLOSURE_TOL` (lengths in ``L``, angles in rad)
 NEWTON_MAX = 11  # (the Python route accepts the 12th iterate at most, q_0 ... q_11)
 
 #: ``int controller(t, q, v, tau)``: the Python controller called back from C (0: efforts written to ``tau``).
@@ -426,7 +427,7 @@ class Simulator:
         self.mech = mech
         dyn = kernels.dynamics
         close = tw.closure_newton
-        r0 = tw.with_actuated(cs.mmax(cs.fabs(tw.closure_residual))) if mech.n_constraints else cs.SX(0.0)
+        r0 = tw.with_actuated(cs.mmax(cs.fabs(tw.relative_closure_residual))) if mech.n_constraints else cs.SX(0.0)
         passive = [int(c) for c in mech.passive_v]
         scales = JacobianScales.of(mech)  # (J_p homogenised, as the Python route's check: the same for any size)
         Jp = cs.diag(cs.DM(scales.constraint_rows)) @ tw.closure_rows["jacobian"][:, passive] \

@@ -12,6 +12,7 @@ import numpy as np
 
 from pkm._derived import derived
 from pkm.core.kinematics.task import TaskMap
+from pkm.core.model.scale import JacobianScales
 from pkm.core.twin.linear import PivotedLU
 from pkm.core.twin.spatial import Expr, euler_rates, log3, quat_matrix, zyx_angles
 from pkm.core.twin.tree import Twin
@@ -67,6 +68,12 @@ class TaskTwin:
         return cs.vertcat(*out)
 
     @functools.cached_property
+    def relative_task_error(self) -> Expr:
+        """:attr:`task_error` counted in the characteristic length ``L`` (a length divided by ``L``, an angle in rad:
+        :attr:`~pkm.core.model.scale.JacobianScales.task_residual`), as :func:`pkm.solve_ik`'s tolerance counts it."""
+        return self.task_error * cs.DM(JacobianScales.of(self.tw.mech).task_residual)
+
+    @functools.cached_property
     def task_jacobian(self) -> Expr:
         """``d(task)/dq`` on the tangent space (task size x nv), as :meth:`pkm.core.kinematics.task.TaskMap.jacobian`."""
         rows = []
@@ -114,11 +121,13 @@ class TaskTwin:
     def ik_newton(self) -> dict:
         """One Newton iteration of the inverse kinematics toward :attr:`task_target` from :attr:`q` (closure and task
         together, a floating base held): ``q_next`` (the next iterate), ``residual`` (the largest closure residual or task
-        error there), ``pivot`` (as in :attr:`closure_newton`)."""
+        error there, lengths counted in the characteristic length as :attr:`relative_task_error`), ``pivot`` (as in
+        :attr:`closure_newton`)."""
         rhs = cs.vertcat(-self.tw.rotate_rows(self.tw.closure_residual), self.task_error)
         q_next = self.tw.retract(self._on_free(self.ik_lu.solve(rhs)))
         return {"q_next": q_next,
-                "residual": self.tw.largest_at(cs.vertcat(self.tw.closure_residual, self.task_error), q_next),
+                "residual": self.tw.largest_at(cs.vertcat(self.tw.relative_closure_residual, self.relative_task_error),
+                                               q_next),
                 "pivot": self.ik_lu.smallest_relative_pivot()}
 
     @functools.cached_property

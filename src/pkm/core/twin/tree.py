@@ -45,6 +45,7 @@ import numpy as np
 import pinocchio as pin
 
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.scale import JacobianScales
 from pkm.core.twin.design import design_of
 from pkm.core.twin.joint import Joint
 from pkm.core.twin.linear import PivotedLU
@@ -484,11 +485,20 @@ class Twin:
     @functools.cached_property
     def closure_newton(self) -> dict:
         """One Newton iteration of the loop closure for the actuated coordinates :attr:`target`, from :attr:`q`:
-        ``q_next`` (the next iterate, its actuated coordinates set), ``residual`` (the largest closure residual there) and
-        ``pivot`` (:meth:`PivotedLU.smallest_relative_pivot` at the iterate it starts from)."""
+        ``q_next`` (the next iterate, its actuated coordinates set), ``residual`` (the largest closure residual there,
+        counted in the characteristic length: :attr:`relative_closure_residual`) and ``pivot``
+        (:meth:`PivotedLU.smallest_relative_pivot` at the iterate it starts from)."""
         q_next = self.with_actuated(self.retract(self.closure_step))
-        return {"q_next": q_next, "residual": self.largest_at(self.closure_residual, q_next),
+        return {"q_next": q_next, "residual": self.largest_at(self.relative_closure_residual, q_next),
                 "pivot": self.with_actuated(self.passive_lu.smallest_relative_pivot())}
+
+    @functools.cached_property
+    def relative_closure_residual(self) -> Expr:
+        """:attr:`closure_residual` counted in the mechanism's characteristic length ``L`` (a translation row divided by
+        ``L``, a rotation row in rad: :attr:`~pkm.core.model.scale.JacobianScales.closure_residual`), as
+        :func:`pkm.close_loops`' tolerance counts it: the Newton kernels' residual, the same for a copy scaled in
+        size."""
+        return self.closure_residual * cs.DM(JacobianScales.of(self.mech).closure_residual)
 
     def largest_at(self, residual: Expr, q: Expr) -> Expr:
         """The largest entry of ``residual`` (an expression of :attr:`q`) at the configuration ``q``."""
