@@ -59,7 +59,7 @@ from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, PkmError, PkmWarning, SingularityError, SpecError
-from pkm.validation import as_count, as_scalar, as_tolerance, as_vector, finite_result
+from pkm.validation import as_choice, as_count, as_scalar, as_tolerance, as_vector, finite_result
 
 RTOL = 1e-9
 #: A free base "needs" a wrench where the one the motion asks of it exceeds this, relative to the wrenches it sums
@@ -382,8 +382,7 @@ def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, 
     """
     mech = check_mechanism(mech)
     require_physical(mech, "inverse dynamics")
-    if method not in METHODS:
-        raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
+    method = as_choice(method, METHODS, "method")
     if actuator_space.base_choice(mech, base) == "free":
         out = base_inverse_dynamics(mech, q, v, a, wrench, wrenches=wrenches, method=method, base="free")
         if out.needs_base_wrench:
@@ -472,8 +471,7 @@ def base_inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayL
     """
     mech = check_mechanism(mech)
     require_physical(mech, "inverse dynamics")
-    if method not in METHODS:
-        raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
+    method = as_choice(method, METHODS, "method")
     if mech.base is None:
         raise InvalidInputError("mech", "the mechanism has no floating base (spec.floating_base): its base is the "
                                         "world, whose reaction pkm does not model", mech.base)
@@ -545,8 +543,7 @@ def forward_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: 
         >>> np.allclose(pkm.inverse_dynamics(delta, q, v, a), [0.5, 0.5, 0.5])
         True
     """
-    if method not in FORWARD_METHODS:
-        raise InvalidInputError("method", f"use one of {list(FORWARD_METHODS)}, got {method!r}", method)
+    method = as_choice(method, FORWARD_METHODS, "method")
     if method == "constraint_dynamics":
         return constraint_dynamics(mech, q, v, tau_actuated, mu=mu, base=base, base_wrench=base_wrench)
     if mu is not None:

@@ -39,7 +39,7 @@ from pkm.core.model.springs import JointSprings, joint_springs
 from pkm.core.model.urdf import position_limits
 from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
 from pkm.units import joint_kind, quantities
-from pkm.validation import as_array, as_vector, bounded, wrap_angle
+from pkm.validation import as_array, as_vector, bounded, instance_of, wrap_angle
 
 
 @dataclass(frozen=True)
@@ -546,9 +546,6 @@ def _frame_id(model: pin.Model, name: object, source: str) -> int | None:
 
 def check_mechanism(mech: object, name: str = "mech") -> Mechanism:
     """``mech`` itself if it is a :class:`Mechanism`, else :class:`InvalidInputError` saying how to get one."""
-    if not isinstance(mech, Mechanism):
-        raise InvalidInputError(name, f"expected a pkm.Mechanism (from pkm.load(name) or pkm.build(name, ...)), "
-                                      f"got {type(mech).__name__}", mech)
-    return mech
+    return instance_of(mech, Mechanism, name, "a pkm.Mechanism (from pkm.load(name) or pkm.build(name, ...))")
 
 

@@ -365,7 +365,7 @@ class Kernels:
     def function(self, name: str) -> cs.Function:
         """The CasADi function of a kernel (:data:`KERNELS`), inputs and outputs dense, after CSE: built once per
         mechanism and design parameters, whichever of its :class:`Kernels` asks (compiled or not, any ``threads``)."""
-        if name not in KERNELS:
+        if not isinstance(name, str) or name not in KERNELS:
             raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", name)
         built = _FUNCTIONS.setdefault(self.twin.mech, {})  # (a design view's: the twin's, shared)
         key = (tuple(self.design.names), name)
@@ -429,7 +429,7 @@ class Kernels:
         """
         from pkm.core.twin.jaxgen import jax_function
 
-        if name not in KERNELS:
+        if not isinstance(name, str) or name not in KERNELS:
             raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", name)
         return self.cached(("jax", name, x64), lambda: jax_function(self.function(name), x64=x64))  # type: ignore
 
@@ -466,7 +466,7 @@ class Kernels:
         """The operations of the kernel's main output (``tau``, ``q_next``) after CSE: see :class:`OperationCount`."""
         from pkm.core.twin.codegen import paper_counts
 
-        if name not in BOUNDARIES:
+        if not isinstance(name, str) or name not in BOUNDARIES:
             raise InvalidInputError("kernel", f"operation counts are stated for {sorted(BOUNDARIES)}", name)
         fun = self.function(name)
         args = fun.sx_in()
