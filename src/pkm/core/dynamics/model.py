@@ -83,10 +83,10 @@ from pkm.core.differential.velocity import RTOL, homogenised_pinv  # (one rank t
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import close_loops
 from pkm.core.kinematics.task import TaskMap
-from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.mechanism import Mechanism, check_mechanism, require_independent_actuators
 from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
-from pkm.errors import InvalidInputError, PkmWarning, SingularityError, SpecError, StructureError
+from pkm.errors import InvalidInputError, PkmWarning, SingularityError, SpecError
 from pkm.validation import as_scalar, as_tolerance, as_vector, finite_result
 
 COULOMB_VELOCITY = 1e-3  # [rad/s or m/s]: the Coulomb friction's sign is smoothed as tanh(v / this)
@@ -552,14 +552,9 @@ def mass_matrix_derivatives(mech: Mechanism, q: ArrayLike, *, rtol: float = RTOL
             load the mechanism with the independent ones actuated (its ``M_a`` and ``C_a`` in their coordinates).
     """
     mech = check_mechanism(mech)
-    if mech.dependent_actuators:
-        independent = [n for n in mech.actuated_names if n not in mech.dependent_actuators]
-        raise StructureError("actuated", f"{mech.name}: actuators {list(mech.dependent_actuators)} depend on the "
-                                         f"others (redundant actuation): moving one actuated coordinate alone opens "
-                                         "the loops, so M_a has no derivative along it and its Christoffel symbols "
-                                         "(the Coriolis matrix) are undefined in these coordinates; load the "
-                                         f"mechanism with {independent} actuated for them in the independent "
-                                         "coordinates")
+    require_independent_actuators(mech, "moving one actuated coordinate alone opens the loops, so M_a has no "
+                                        "derivative along it and its Christoffel symbols (the Coriolis matrix) are "
+                                        "undefined in these coordinates", "for them in the independent coordinates")
     require_physical(mech, "the mass matrix's derivatives")
     _held_only(mech, base)
     q = mech.check_q(q)
