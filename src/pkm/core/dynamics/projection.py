@@ -238,7 +238,9 @@ class KhalilProjection:
 
     def inverse_dynamics(self, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None = None, *, wrenches: Mapping[str, ArrayLike] | None = None) \
             -> np.ndarray:
-        """Actuator efforts (N or N m, in ``mech.actuated`` order) for a consistent state.
+        """Actuator efforts (N or N m, in ``mech.actuated`` order) for a consistent state. Under redundant actuation
+        (the efforts not unique) one valid distribution, the least-squares platform map's, not pkm's convention (the
+        virtual work's, :func:`inverse_dynamics`).
 
         Args:
             q: Assembled configuration (nq,).
@@ -360,7 +362,14 @@ def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, 
             ``"virtual_work"`` (:func:`virtual_work_dynamics`: ``G^T`` of the tree's forces, any
             structure: mimic couplings, idle motions, redundant planar closures), or ``"auto"``: Khalil's
             where the structure allows it, virtual work otherwise. Both give the same efforts to 1e-10
-            where both apply (tests).
+            where both apply (tests), but under redundant actuation, where the efforts are not unique
+            (:attr:`~pkm.core.Mechanism.dependent_actuators`): every distribution ``tau`` with ``Tᵀ tau`` the
+            independent actuators' efforts (``T`` the actuated rates of theirs) does the motion's work. pkm's
+            convention there is the virtual work's, which ``"auto"`` then takes: ``tau = Gᵀ h`` with the
+            homogenised pseudo-inverse's ``G`` (:func:`pkm.passive_map`), i.e. the closure multipliers of least
+            norm (lengths in the characteristic length; not the efforts of least norm), as
+            :func:`pkm.actuator_model` and :meth:`pkm.Kernels.inverse_dynamics <pkm.core.twin.kernels.Kernels.inverse_dynamics>`
+            give them; ``"khalil"`` gives another valid one (its platform map by least squares).
         base: A floating base ``"free"`` (default where there is one) or ``"fixed"`` (held).
 
     Raises:
@@ -402,7 +411,7 @@ def _wrench_text(w: np.ndarray) -> str:
 def _motor_efforts(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None,
                    wrenches: Mapping[str, ArrayLike] | None, method: str) -> np.ndarray:
     """:func:`inverse_dynamics`'s efforts by ``method`` (checked), the base given what it asks."""
-    if method == "virtual_work":
+    if method == "virtual_work" or (method == "auto" and mech.dependent_actuators):  # (redundant: the convention)
         return virtual_work_dynamics(mech, q, v, a, wrench, wrenches=wrenches)
     k = _khalil(mech)
     if isinstance(k, SpecError):

@@ -519,7 +519,9 @@ class Kernels:
     def inverse_dynamics(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """Actuator efforts (na, or n x na) at closed configurations ``q`` (nq or n x nq) for actuated rates and
         accelerations ``qd, qdd`` (na or n x na) [N, N m]: :attr:`Twin.inverse_dynamics`, samples under the pivot
-        floor recomputed by :func:`pkm.inverse_dynamics`."""
+        floor recomputed by :func:`pkm.inverse_dynamics`. Under redundant actuation (the efforts not unique) the same
+        distribution as :func:`pkm.inverse_dynamics`: ``Gᵀ h`` with the core's homogenised pseudo-inverse, the
+        closure multipliers of least norm (:attr:`Twin.passive_solve`)."""
         (tau, pivot), single = self._run("inverse_dynamics", q, qd, qdd, pivoted=True)
         if not pivot.min() >= PIVOT_FLOOR:
             bad = np.flatnonzero(~(pivot[:, 0] >= PIVOT_FLOOR))
