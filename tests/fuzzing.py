@@ -860,6 +860,26 @@ def _all_actuated(n: str):
     return c.lazy(f"all actuated {n}", make)
 
 
+#: A passive joint to actuate too: redundant actuation with passive joints left (the joint depends on the motors).
+REDUNDANT = {"rrr3": "elbow_1", "delta": "knee_1"}
+
+
+def _redundant(n: str):
+    """Mechanism ``n`` with :data:`REDUNDANT`'s joint actuated too (built once, its warning that the joint depends on
+    the others silenced): the loop closure follows the independent actuators, the dependent one released."""
+    import warnings
+
+    c = ctx()
+
+    def make():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", c.pkm.errors.PkmWarning)
+            return c.pkm.from_strings(c.urdf[n], dataclasses.replace(
+                c.mech[n].spec, actuated=c.mech[n].actuated_names + (REDUNDANT[n],)))
+
+    return c.lazy(f"redundant {n}", make)
+
+
 @entry("pkm.solve_ik")
 def _solve_ik(g, adv):
     n, m = _mech(g, adv)
@@ -887,6 +907,11 @@ def _close_loops(g, adv):
         m = _all_actuated(n)
         qa = m.actuated_q(m.q_reference)
         return ctx().pkm.close_loops, (m, qa if g.chance(0.5) else g.near(qa, g.pick((1e-3, 1e-2)))), kw
+    if n in REDUNDANT and g.chance(0.1):  # (the actuated values of a closed configuration, or near them: inconsistent)
+        m = _redundant(n)
+        qa = m.actuated_q(g.pick(ctx().assembled[n]))
+        kw.pop("q0", None)
+        return ctx().pkm.close_loops, (m, qa if not adv else g.near(qa, g.pick((1e-3, 1e-2)))), kw
     return ctx().pkm.close_loops, (m, g.value(qa, adv, g.pick((1e-3, 1e-2, 0.05, 0.2)))), kw
 
 
