@@ -68,6 +68,18 @@ def all_actuated():
                                                                                      "elbow_2")))
 
 
+@pytest.fixture(scope="session")
+def redundant():
+    """The toy five-bar with one elbow actuated too: redundant actuation with passive joints left (three actuators,
+    mobility two; built with the warning that the elbow depends on the motors)."""
+    import pkm
+    from pkm.errors import PkmWarning
+
+    five = module("fivebar").build()
+    with pytest.warns(PkmWarning, match=r"\['elbow_1'\] depend on the others"):
+        return pkm.from_strings(five.urdf, dataclasses.replace(five.spec, actuated=("motor_1", "motor_2", "elbow_1")))
+
+
 def pytest_configure(config):
     """One cache folder for the whole run (``PKM_CACHE_DIR``: compiled twins, the papers' rows), made by the
     controlling process before pytest-xdist starts its workers, which inherit it with the subprocesses they start:

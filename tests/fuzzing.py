@@ -535,7 +535,7 @@ def _quantity(g, adv):
     text = g.pick(("20mm", "5deg", "-3.5e-2 m", "0.81", "1g", "12 cm", "7 rad"))
     if adv:
         text = g.pick((g.hostile(), text[::-1], text + "x", "1e999mm", "--3mm", "mm", " ", "5 deg deg", "nanmm"))
-    kind = g.pick((None, "length", "angle", "mass") + (("volume", 3) if adv else ()))
+    kind = g.pick((None, "length", "angle", "mass") + (("volume", 3, np.zeros(3)) if adv else ()))
     return ctx().pkm.quantity, (text, kind), {}
 
 
@@ -860,6 +860,26 @@ def _all_actuated(n: str):
     return c.lazy(f"all actuated {n}", make)
 
 
+#: A passive joint to actuate too: redundant actuation with passive joints left (the joint depends on the motors).
+REDUNDANT = {"rrr3": "elbow_1", "delta": "knee_1"}
+
+
+def _redundant(n: str):
+    """Mechanism ``n`` with :data:`REDUNDANT`'s joint actuated too (built once, its warning that the joint depends on
+    the others silenced): the loop closure follows the independent actuators, the dependent one released."""
+    import warnings
+
+    c = ctx()
+
+    def make():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", c.pkm.errors.PkmWarning)
+            return c.pkm.from_strings(c.urdf[n], dataclasses.replace(
+                c.mech[n].spec, actuated=c.mech[n].actuated_names + (REDUNDANT[n],)))
+
+    return c.lazy(f"redundant {n}", make)
+
+
 @entry("pkm.solve_ik")
 def _solve_ik(g, adv):
     n, m = _mech(g, adv)
@@ -887,6 +907,11 @@ def _close_loops(g, adv):
         m = _all_actuated(n)
         qa = m.actuated_q(m.q_reference)
         return ctx().pkm.close_loops, (m, qa if g.chance(0.5) else g.near(qa, g.pick((1e-3, 1e-2)))), kw
+    if n in REDUNDANT and g.chance(0.1):  # (the actuated values of a closed configuration, or near them: inconsistent)
+        m = _redundant(n)
+        qa = m.actuated_q(g.pick(ctx().assembled[n]))
+        kw.pop("q0", None)
+        return ctx().pkm.close_loops, (m, qa if not adv else g.near(qa, g.pick((1e-3, 1e-2)))), kw
     return ctx().pkm.close_loops, (m, g.value(qa, adv, g.pick((1e-3, 1e-2, 0.05, 0.2)))), kw
 
 
@@ -1711,8 +1736,28 @@ def _regressor_batch(g, adv):
 @entry("pkm.capability")
 def _capability(g, adv):
     _, m, q, _ = _dyn_state(g, adv, ("delta", "prs3", "rrr3", "gough_stewart"))
-    kind = g.pick(("wrench", "twist", "acceleration")) if not adv or g.chance(0.5) else g.pick(("power", 3, None))
+    kind = g.pick(("wrench", "twist", "acceleration")) if not adv or g.chance(0.5) else \
+        g.pick(("power", 3, None, np.zeros(3)))  # (an array: ``kind in KINDS`` raised numpy's ValueError)
     return ctx().pkm.capability, (m, q, kind), {"gravity": g.chance(0.7)}
+
+
+@entry("pkm.calibration_parameters")
+def _calibration_parameters(g, adv):
+    """The unknowns of a measurement model (cheap: names only); adversarial, a configuration or a hostile object in
+    ``kind``'s place (an array raised numpy's ValueError), or hostile joint and sensor names."""
+    c = ctx()
+    n, m = _mech(g, adv, ("delta", "prs3", "rrr3"))
+    kind = g.pick(("pose", "position", "planar"))
+    kw: dict = {"origins": g.pick(("all", "position"))}
+    if adv:
+        r = int(g.rng.integers(3))
+        if r == 0:
+            kind = g.pick((c.mech[n].q_reference, "Pose", "volume") + ADV_OBJECTS[:8])
+        elif r == 1:
+            kw[g.pick(("joints", "sensors"))] = g.pick((["no_such_joint"], "motor_1", c.mech[n].q_reference, [3]))
+        else:
+            kw["origins"] = g.hostile()
+    return c.pkm.calibration_parameters, (m, kind), kw
 
 
 def _springs_kw(g: Gen, adversarial: bool, n: str) -> dict:

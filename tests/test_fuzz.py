@@ -55,6 +55,7 @@ def test_harness_covers_the_public_entry_points(fuzz):
                 "pkm.gravity_efforts", "pkm.coriolis_matrix", "pkm.operational_space", "pkm.forward_dynamics",
                 "pkm.constraint_dynamics", "pkm.simulate", "pkm.regressor", "pkm.base_parameters",
                 "pkm.estimate", "pkm.regressor_batch", "pkm.measurements", "pkm.capability", "Kernels.at",
+                "pkm.calibration_parameters",
                 "pkm.clearance", "clearance_map"}
     expected |= {f"pkm.build[{m}]" for m in names()}  # the registry, the tests' five-bar included
     expected |= {f"{m}.closed_form_ik" for m in names()}

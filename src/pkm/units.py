@@ -153,7 +153,7 @@ def quantity(value: object, kind: str | None = None, what: str = "value") -> flo
         >>> pkm.quantity(0.5)
         0.5
     """
-    if kind is not None and kind not in SI_UNITS:
+    if kind is not None and (not isinstance(kind, str) or kind not in SI_UNITS):
         raise InvalidInputError("kind", f"use one of {list(SI_UNITS)} or None", kind)
     if isinstance(value, str):
         kinds = {kind} if kind else set(SI_UNITS)

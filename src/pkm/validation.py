@@ -56,6 +56,24 @@ def as_array(x: object, name: str, what: str = "numbers") -> np.ndarray:
     return arr
 
 
+def instance_of(x: object, cls: type[_T] | tuple[type[_T], ...], name: str, what: str) -> _T:
+    """``x`` itself if it is a ``cls``, else an :class:`InvalidInputError` naming ``name`` and saying what was
+    expected (``what``: the kind of object and where to get one) and what came (a configuration array passed where
+    a mode or a calibration model belongs: never the ``AttributeError`` the first use of it would raise)."""
+    if not isinstance(x, cls):
+        raise InvalidInputError(name, f"expected {what}, got {type(x).__name__}", x)
+    return x
+
+
+def as_choice(x: object, choices: tuple[str, ...], name: str) -> str:
+    """``x`` if it is one of the names ``choices``, else an :class:`InvalidInputError` naming ``name`` and listing
+    them (an array in its place too: ``x in choices`` would compare it element by element and raise numpy's
+    ``ValueError``)."""
+    if not isinstance(x, str) or x not in choices:
+        raise InvalidInputError(name, f"use one of {list(choices)}, got {x!r}", x)
+    return x
+
+
 def bounded(arr: np.ndarray, name: str, given: object = None) -> np.ndarray:
     """``arr`` (coordinates: m, rad) unchanged where every entry's magnitude is at most :data:`ABSURD`, else an
     :class:`InvalidInputError` naming ``name`` and the first entry beyond (a unit mistake or garbage).

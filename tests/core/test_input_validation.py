@@ -79,6 +79,41 @@ def test_core_functions_refuse_what_is_not_a_mechanism(fn, mech, delta):
         fn(mech, delta.q_reference)
 
 
+#: A configuration (or the mechanism) passed where another kind of object belongs: ``(call, the argument named)``.
+WRONG_TYPES = [
+    (lambda m, q: pkm.calibration_parameters(m, q), "kind"),
+    (lambda m, q: pkm.CalibrationModel(m, q), "kind"),
+    (lambda m, q: pkm.track_assembly_mode(m, q, [m.actuated_q(q)]), "mode"),
+    (lambda m, q: pkm.track_working_mode(m, q, [[0.0, 0.0, -0.36]]), "mode"),
+    (lambda m, q: pkm.serial_equivalent(m, q), "transmissions[0]"),
+    (lambda m, q: pkm.serial_equivalent(m, 3), "transmissions"),
+    (lambda m, q: pkm.serial_equivalent(m, (), around=q), "around"),
+    (lambda m, q: pkm.tolerance_table(m, q), "model"),
+    (lambda m, q: pkm.base_geometry(m, q), "model"),
+    (lambda m, q: pkm.calibrate(m, q, q), "model"),
+    (lambda m, q: pkm.calibration_poses(m, 5), "model"),
+    (lambda m, q: pkm.write_calibrated(m, q), "cal"),
+    (lambda m, q: pkm.write_serial_equivalent(m, q), "se"),
+    (lambda m, q: pkm.export_c(m, q), "directory"),
+    (lambda m, q: pkm.validate(m, q, q), "predict"),
+    (lambda m, q: pkm.capability(m, q, q), "kind"),
+    (lambda m, q: pkm.inverse_dynamics(m, q, 0 * q[:m.nv], 0 * q[:m.nv], method=q), "method"),
+    (lambda m, q: pkm.quantity(1.0, q), "kind"),
+    (lambda m, q: pkm.zyx_matrix(m, 0.0, 0.0), "roll"),
+]
+
+
+@pytest.mark.parametrize("call, name", WRONG_TYPES, ids=[f"{k}-{n}" for k, (_, n) in enumerate(WRONG_TYPES)])
+def test_wrong_kinds_of_object_are_refused_naming_the_argument(call, name, delta):
+    """A configuration array (or the mechanism) passed where a measurement model's name, a mode, a calibration model,
+    transmissions, a folder or a method belongs: an InvalidInputError naming that argument and carrying what came,
+    before any work (numpy's ValueError of an array's truth value, or an AttributeError, before)."""
+    with pytest.raises(InvalidInputError) as info:
+        call(delta, delta.q_reference)
+    assert info.value.name == name and str(info.value).startswith(f"{name}: ")
+    assert info.value.value is not None
+
+
 def test_task_rates_are_checked_like_every_other_vector(delta):
     """inverse_velocities/inverse_accelerations check yd, ydd (shape, finiteness) instead of failing in lstsq."""
     q, v = delta.q_reference, np.zeros(delta.nv)

@@ -27,7 +27,7 @@ import pytest
 import pkm
 from pkm.core.dynamics import model as dm
 from pkm.core.dynamics.projection import constraint_dynamics, energy
-from pkm.errors import InvalidInputError, NonFiniteError, SingularityError, SpecError
+from pkm.errors import InvalidInputError, NonFiniteError, SingularityError, SpecError, StructureError
 from tests.fd import richardson
 from tests.test_acceptance import ACCEPTANCE, check_every_route_gives_back
 
@@ -325,3 +325,14 @@ def test_friction_on_a_free_base_enters_its_rows():
     out = pkm.base_inverse_dynamics(mech, q, model.v, a)
     assert rel(out.base_wrench, model.base_friction) <= 1e-10 and rel(model.base_friction, f[mech.base_v]) <= 1e-10
     assert rel(out.efforts, tau + passive_map(mech, q).T @ f) <= 1e-10
+
+
+def test_the_coriolis_matrix_of_a_redundantly_actuated_mechanism_is_refused_naming_the_dependent_actuator(redundant):
+    """The five-bar with one elbow actuated too: M_a's derivative along one actuated coordinate alone opens the loops
+    (a ConvergenceError from the nudged loop closure before); refused up front, the elbow named with the actuators
+    to load instead, before any loop closure (the mass matrix itself stays defined on the rates that agree)."""
+    q = redundant.q_reference
+    with pytest.raises(StructureError, match=r"\['elbow_1'\] depend on the others.*\['motor_1', 'motor_2'\]") as info:
+        pkm.coriolis_matrix(redundant, q, [0.1, 0.2, 0.0])
+    assert info.value.part == "actuated"
+    assert pkm.mass_matrix(redundant, q).shape == (3, 3)

@@ -5,6 +5,9 @@ Pinocchio's constrained forward dynamics (``constraintDynamics``: the efforts mu
 prescribed accelerations) and the energy balance of the bodies along a motion.
 """
 
+import dataclasses
+import warnings
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -278,3 +281,27 @@ def test_a_floating_base_reports_the_wrench_the_motion_asks_of_it():
         delta_fixed = pkm.load("delta")
         pkm.base_inverse_dynamics(delta_fixed, delta_fixed.q_reference, np.zeros(delta_fixed.nv),
                                   np.zeros(delta_fixed.nv))
+
+
+def test_redundant_actuation_auto_takes_the_virtual_work_convention_the_other_routes_share():
+    """The Delta with a knee actuated too (the efforts not unique, Khalil's projection applies): "auto" took
+    Khalil's least-squares distribution (0.08 N m from the virtual work's, which pkm.actuator_model and the
+    Kernels give); now the virtual work's, equal to the actuator-space model's to 1e-12; Khalil's stays another valid
+    one: each does the Delta's own efforts' work through the knee's rate map (T^T tau, an independent route)."""
+    d = pkm.load("delta")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pkm.errors.PkmWarning)  # (knee_1 depends on the motors)
+        mech = pkm.from_strings(d.urdf, dataclasses.replace(d.spec, actuated=d.actuated_names + ("knee_1",)))
+    assert mech.dependent_actuators == ("knee_1",)
+    q = pkm.solve_ik(d, [0.02, 0.01, -0.36]).q
+    T = pkm.passive_map(d, q)[mech.act_v]  # (the four actuated rates of the three motors')
+    v = pkm.velocities(d, q, [0.3, -0.2, 0.1])
+    a = pkm.accelerations(d, q, v, [1.0, -0.5, 0.2])
+    tau = pkm.inverse_dynamics(mech, q, v, a)
+    scale = np.abs(tau).max()
+    assert np.abs(tau - pkm.inverse_dynamics(mech, q, v, a, method="virtual_work")).max() <= 1e-12 * scale
+    assert np.abs(tau - pkm.actuator_model(mech, q, v[mech.act_v]).efforts(a[mech.act_v])).max() <= 1e-12 * scale
+    khalil = pkm.inverse_dynamics(mech, q, v, a, method="khalil")
+    assert np.abs(khalil - tau).max() > 1e-3 * scale
+    for t in (tau, khalil):
+        assert np.abs(T.T @ t - pkm.inverse_dynamics(d, q, v, a)).max() <= 1e-12 * scale

@@ -380,3 +380,21 @@ def test_a_solve_reports_interference_only_when_asked(delta):
     bare = pkm.from_strings(_without_collisions(delta.urdf), delta.spec)
     with pytest.raises(NoCollisionGeometryError):
         close_loops(bare, bare.actuated_q(bare.q_reference), collisions=True)
+
+
+def test_redundant_actuation_closes_along_the_independent_actuators_and_names_the_dependent_one(built, redundant):
+    """The five-bar with one elbow actuated too (3 actuators, mobility 2): the straight path from the reference's
+    actuated values to a target's crosses values where the elbow disagrees with the motors (no assembly: a
+    ConvergenceError at 0 % of the way before); now the elbow is released along the way and held at the target only.
+    The result equals the five-bar's inverse kinematics (an independent route) to 1e-12; an elbow that disagrees
+    with the motors is refused naming the open closure and the dependent actuator."""
+    five, mech = built("fivebar"), redundant
+    assert mech.dependent_actuators == ("elbow_1",) and len(mech.passive_v)
+    y0 = pkm.TaskMap.of(five).value(five.q_reference)
+    for dy in ([0.02, -0.03], [0.05, 0.04]):
+        q = solve_ik(five, y0 + dy).q
+        res = close_loops(mech, mech.actuated_q(q))
+        assert res.converged and res.steps >= 2 and np.abs(mech.difference(q, res.q)).max() < 1e-12
+    with pytest.raises(ConvergenceError, match=r"actuators \['elbow_1'\] depend on the others") as info:
+        close_loops(mech, mech.actuated_q(q) + [0.0, 0.0, 1e-3])
+    assert info.value.worst_closure == "tip" and info.value.worst_gap > 1e-5

@@ -156,6 +156,31 @@ def test_paths_on_copies_scaled_in_size_take_the_same_iterations():
         assert max(np.abs(m.difference(scale_configuration(mech, a, s), b)).max() for a, b in zip(fk1.q, fk.q)) <= 1e-9
 
 
+def test_redundant_actuation_the_kernels_equal_the_core(built, redundant):
+    """One elbow actuated too (3 actuators, mobility 2): the efforts are not unique; the kernels' passive solve kept
+    the closure rows with a pivot (another distribution than the core's, 9 % off; its mass matrix 22 %, and the
+    samples under the pivot floor got the core's), now the core's homogenised pseudo-inverse: the efforts, the
+    actuator-space model, the regressor and the rates of an actuator alone equal the core's to 1e-12, and the
+    efforts do the five-bar's work (its own efforts through the elbow's rate map: an independent route)."""
+    five, mech = built("fivebar"), redundant
+    y0 = TaskMap(five).value(five.q_reference)
+    K = Kernels(mech, compiled=False)
+    for k in range(2):
+        q = pkm.solve_ik(five, y0 + [0.02 * k, -0.03 * k]).q
+        v = pkm.velocities(five, q, [0.7, -0.4])  # (closure-consistent rates of every joint)
+        a = pkm.accelerations(five, q, v, [1.0, 2.0])
+        qd, qdd = v[mech.act_v], a[mech.act_v]
+        tau, model = pkm.inverse_dynamics(mech, q, v, a), pkm.actuator_model(mech, q, qd)
+        scale = np.abs(tau).max()
+        assert np.abs(K.inverse_dynamics(q, qd, qdd) - tau).max() <= 1e-12 * scale
+        assert np.abs(K.mass_matrix(q) - model.M).max() <= 1e-12 * np.abs(model.M).max()
+        assert np.abs(K.bias(q, qd) - model.h).max() <= 1e-12 * np.abs(model.h).max()
+        assert np.abs(K.regressor(q, qd, qdd) - pkm.regressor(mech, q, qd, qdd)).max() <= 1e-12
+        assert np.abs(K.velocities(q, [1.0, 0.0, 0.0]) - pkm.passive_map(mech, q)[:, 0]).max() <= 1e-12
+        T = np.column_stack([pkm.velocities(five, q, e) for e in np.eye(2)])[mech.act_v]  # (3 rates of 2 motors')
+        assert np.abs(T.T @ tau - pkm.inverse_dynamics(five, q, v, a)).max() <= 1e-12 * scale
+
+
 def test_samples_under_the_pivot_floor_fall_back_to_the_core(monkeypatch):
     """With the floor above every pivot, each path sample and each effort comes from the core, listed as such, and
     the answers are the same."""

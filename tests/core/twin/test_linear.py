@@ -8,7 +8,8 @@ import casadi as cs
 import numpy as np
 import pytest
 
-from pkm.core.twin.linear import PivotedLU
+from pkm.core.differential.velocity import homogenised_pinv
+from pkm.core.twin.linear import HomogenisedPinv, PivotedLU
 
 
 def _parametric(n: int, seed: int):
@@ -82,3 +83,23 @@ def test_what_cannot_be_factored_is_refused():
         PivotedLU(cs.SX(np.ones((1, 2))), np.ones((1, 2)))
     with pytest.raises(ValueError, match=r"rank 1 < 2 at the reference: no pivot for columns \[\d\]"):
         PivotedLU(cs.SX(np.array([[1.0, 2.0], [2.0, 4.0]])), np.array([[1.0, 2.0], [2.0, 4.0]]))
+
+
+def test_the_homogenised_pseudo_inverse_equals_the_cores_away_from_the_reference():
+    """A tall 7 x 3 matrix of full column rank, rows and columns weighted (a rotation row by L, a length column by L):
+    the solves by the normal equations (factored at the reference, evaluated elsewhere) equal the core's SVD route
+    (homogenised_pinv) to 1e-12: least squares for a right-hand side outside the range, the transposed solve's
+    multipliers of least weighted norm (and they solve A^T y = b)."""
+    rng = np.random.default_rng(3)
+    rows, cols = np.array([1.0, 1.0, 1.0, 0.2, 0.2, 0.2, 1.0]), np.array([1.0, 0.2, 1.0])
+    A_ref = rng.standard_normal((7, 3))
+    x = cs.SX.sym("x", 7, 3)
+    P = HomogenisedPinv(x, A_ref, rows, cols)
+    b, c = cs.SX.sym("b", 7), cs.SX.sym("c", 3)
+    f = cs.Function("f", [x, b, c], [P.solve(b), P.solve_transposed(c)])
+    A = A_ref + 0.3 * rng.standard_normal((7, 3))
+    bv, cv = rng.standard_normal(7), rng.standard_normal(3)
+    xs, ys = (np.array(o).ravel() for o in f(A, bv, cv))
+    pinv = homogenised_pinv(A, rows, cols, 1e-12)[0]
+    assert np.abs(xs - pinv @ bv).max() <= 1e-12 and np.abs(ys - pinv.T @ cv).max() <= 1e-12
+    assert np.abs(A.T @ ys - cv).max() <= 1e-12

@@ -43,6 +43,7 @@ from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, SingularityError
+from pkm.validation import as_choice
 
 if TYPE_CHECKING:
     from pkm.core.analysis.maps import WorkspaceMap
@@ -174,8 +175,7 @@ def capability(mech: Mechanism, q: ArrayLike, kind: str = "wrench", *, gravity: 
     from pkm.core.kinematics.constraints import check_closed
 
     mech = check_mechanism(mech)
-    if kind not in KINDS:
-        raise InvalidInputError("kind", f"use one of {list(KINDS)}, got {kind!r}", kind)
+    kind = as_choice(kind, KINDS, "kind")
     q = mech.check_q(q)
     check_closed(mech, q)
     J = forward_jacobian(mech, q)
@@ -234,8 +234,7 @@ def capability_indices(mech: Mechanism, Q: ArrayLike, kind: str = "wrench", *, g
     from pkm.core.twin import Kernels
 
     mech = check_mechanism(mech)
-    if kind not in KINDS:
-        raise InvalidInputError("kind", f"use one of {list(KINDS)}, got {kind!r}", kind)
+    kind = as_choice(kind, KINDS, "kind")
     kernels = Kernels(mech) if kernels is None else kernels
     Q = np.atleast_2d(np.asarray(Q, dtype=float))
     lo, hi = _limits(mech, kind)
@@ -457,8 +456,7 @@ def capability_map(mech: Mechanism, axes: Mapping[str, ArrayLike], fixed: Mappin
     from pkm.validation import as_array
 
     mech = check_mechanism(mech)
-    if kind not in KINDS:
-        raise InvalidInputError("kind", f"use one of {list(KINDS)}, got {kind!r}", kind)
+    kind = as_choice(kind, KINDS, "kind")
     names = list(TaskMap.of(mech).kinds)
     if not isinstance(axes, Mapping) or not 1 <= len(axes) <= 2:
         raise InvalidInputError("axes", "expected one or two task coordinates by name", axes)

@@ -35,7 +35,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from pkm.core.calibration.identifiable import BaseGeometry, base_geometry
-from pkm.core.calibration.measurement import CalibrationModel
+from pkm.core.calibration.measurement import CalibrationModel, check_model
 from pkm.errors import ConvergenceError, InvalidInputError, PkmWarning, SingularityError, UnknownNameError
 from pkm.validation import as_count, wrap_angle
 
@@ -189,7 +189,8 @@ def calibrate(model: CalibrationModel, readings: ArrayLike, measured: ArrayLike,
             ``pkm calibrate --max-evaluations``).
 
     Raises:
-        InvalidInputError: fewer residual rows than free parameters, shapes that do not match, an unknown loss.
+        InvalidInputError: fewer residual rows than free parameters, shapes that do not match, an unknown loss;
+            ``model`` no :class:`CalibrationModel`.
         UnknownNameError: a bound on a parameter that is not estimated.
         ConvergenceError: the least squares ran out of evaluations (``max_nfev``) before they converged: its
             ``residual`` the reduced chi-square reached, its ``iterations`` the evaluations.
@@ -208,12 +209,13 @@ def calibrate(model: CalibrationModel, readings: ArrayLike, measured: ArrayLike,
     """
     import scipy.optimize
 
+    model = check_model(model)
     M = model._readings(readings)
     Ym = np.asarray(measured, dtype=float)
     ny = model.measure(None, M[:1]).shape[1]
     if Ym.shape != (len(M), ny):
         raise InvalidInputError("measured", f"expected {len(M)} x {ny} measurements ({model.kind})", Ym.shape)
-    if loss not in LOSSES:
+    if not isinstance(loss, str) or loss not in LOSSES:
         raise UnknownNameError("loss", loss, LOSSES)
     sig = dict(SIGMA, **(sigma or {}))
     w = _weights(model, sig)

@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from pkm.core.calibration.measurement import CalibrationModel
+from pkm.core.calibration.measurement import CalibrationModel, check_model
 from pkm.core.identification.base import base_split
 from pkm.core.identification.rank import RankDecision, decide_rank
 from pkm.errors import InvalidInputError
@@ -95,7 +95,8 @@ def base_geometry(model: CalibrationModel, readings: ArrayLike, *, precise: bool
     enough for as many rows as parameters, plus two poses) (module doc).
 
     Raises:
-        InvalidInputError: fewer rows than the parameters the measurements see.
+        InvalidInputError: fewer rows than the parameters the measurements see; ``model`` no
+            :class:`CalibrationModel`.
 
     Examples:
         >>> import pkm
@@ -107,6 +108,7 @@ def base_geometry(model: CalibrationModel, readings: ArrayLike, *, precise: bool
         >>> sorted(base.absorbed["slider_1.offset"])  # (a slider's offset: seen only with its tilt and the tracker's)
         ['slider_1.pitch', 'slider_2.pitch', 'slider_3.pitch', 'tracker.pitch', 'tracker.z']
     """
+    model = check_model(model)
     M = np.atleast_2d(np.asarray(readings, dtype=float))
     W = stacked_jacobian(model, M)
     names = model.names

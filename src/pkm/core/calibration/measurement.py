@@ -38,12 +38,12 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from pkm.core.calibration.parameters import KINDS, CalibrationParameters, calibration_parameters
+from pkm.core.calibration.parameters import CalibrationParameters, calibration_parameters, check_kind
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.origins import ORIGIN
 from pkm.core.model.scale import JacobianScales
-from pkm.errors import ConvergenceError, InvalidInputError, PkmError, UnknownNameError
-from pkm.validation import wrap_angle
+from pkm.errors import ConvergenceError, InvalidInputError, PkmError
+from pkm.validation import instance_of, wrap_angle
 
 #: The closure is solved to this infinity norm, a length relative to the mechanism's characteristic length (its
 #: closure rows' and a prismatic actuator's row over ``L``), an angle in rad.
@@ -97,9 +97,7 @@ class CalibrationModel:
         from pkm.core.twin.tree import Twin
 
         self.mech = mech = check_mechanism(mech)
-        if kind not in KINDS:
-            raise UnknownNameError("measurement model", kind, KINDS)
-        self.kind = kind
+        self.kind = kind = check_kind(kind)
         self.twin = tw = Twin(mech)  # (replaced below by the twin with design inputs)
         idle = self._idle_joints()
         if kind == "passive":
@@ -361,6 +359,12 @@ class CalibrationModel:
         return self.evaluate(x, readings, jacobian=False)[0]
 
 
+def check_model(model: object, name: str = "model") -> CalibrationModel:
+    """``model`` itself if it is a :class:`CalibrationModel`, else :class:`InvalidInputError` saying how to get one
+    (a mechanism or a configuration passed in its place)."""
+    return instance_of(model, CalibrationModel, name, "a pkm.CalibrationModel (pkm.CalibrationModel(mech, kind))")
+
+
 def _closure(tw: Any) -> cs.SX:
     """The closure rows of twin ``tw`` (module doc: smooth through a closed frame closure)."""
     rows = []
@@ -375,4 +379,4 @@ def _vee(A: np.ndarray) -> np.ndarray:
     return 0.5 * np.stack([A[:, 2, 1] - A[:, 1, 2], A[:, 0, 2] - A[:, 2, 0], A[:, 1, 0] - A[:, 0, 1]], axis=1)
 
 
-__all__ = ["ADMISSIBLE", "CLOSURE_TOL", "MAX_NEWTON", "CalibrationModel", "Rows"]
+__all__ = ["ADMISSIBLE", "CLOSURE_TOL", "MAX_NEWTON", "CalibrationModel", "Rows", "check_model"]

@@ -26,9 +26,10 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.origins import ORIGIN
 from pkm.errors import InvalidInputError, UnknownNameError
+from pkm.validation import as_choice
 
 #: The measurement models: what the instrument reads per pose.
 KINDS = ("pose", "position", "planar", "passive")
@@ -72,6 +73,17 @@ class CalibrationParameters:
         return CalibrationParameters(tuple(self.names[k] for k in keep), self.nominal[keep].copy(),
                                      tuple(self.units[k] for k in keep),
                                      tuple(i for i, k in enumerate(keep) if k in self.origins))
+
+
+def check_kind(kind: object) -> str:
+    """``kind`` if it is a measurement model's name (:data:`KINDS`), else :class:`UnknownNameError` (a name it does
+    not know: the close ones told) or :class:`InvalidInputError` (not a name: a configuration array in its place)."""
+    if not isinstance(kind, str):
+        raise InvalidInputError("kind", f"expected a measurement model's name, one of {list(KINDS)}, got "
+                                        f"{type(kind).__name__}", kind)
+    if kind not in KINDS:
+        raise UnknownNameError("measurement model", kind, KINDS)
+    return kind
 
 
 def kinematic_joints(mech: Mechanism) -> tuple[str, ...]:
@@ -125,10 +137,8 @@ def calibration_parameters(mech: Mechanism, kind: str = "pose", *, joints: Seque
     """
     from pkm.core.twin.design import _urdf_joints
 
-    if kind not in KINDS:
-        raise UnknownNameError("measurement model", kind, KINDS)
-    if origins not in ("all", "position"):
-        raise InvalidInputError("origins", "expected 'all' or 'position'", origins)
+    mech, kind = check_mechanism(mech), check_kind(kind)
+    origins = as_choice(origins, ("all", "position"), "origins")
     urdf = _urdf_joints(mech)
     chosen = kinematic_joints(mech) if joints is None else tuple(joints)
     for j in chosen:
@@ -175,4 +185,4 @@ def calibration_parameters(mech: Mechanism, kind: str = "pose", *, joints: Seque
     return CalibrationParameters(tuple(names), np.array(values, dtype=float), tuple(units), origin_idx)
 
 
-__all__ = ["FRAMES", "KINDS", "CalibrationParameters", "calibration_parameters", "kinematic_joints"]
+__all__ = ["FRAMES", "KINDS", "CalibrationParameters", "calibration_parameters", "check_kind", "kinematic_joints"]

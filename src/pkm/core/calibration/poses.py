@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pkm.core.calibration.identifiable import BaseGeometry, base_geometry, stacked_jacobian
-from pkm.core.calibration.measurement import CalibrationModel
+from pkm.core.calibration.measurement import CalibrationModel, check_model
 from pkm.core.identification.base import closed_draws, per_unit
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.scale import JacobianScales
@@ -125,7 +125,7 @@ def calibration_poses(model: CalibrationModel, n: int, *, pool: int | None = Non
         >>> plan.readings.shape, plan.candidates, len(plan.base)
         ((12, 3), 14, 34)
     """
-    n = as_count(n, "n")
+    model, n = check_model(model), as_count(n, "n")
     C = candidates(model, pool or 4 * n, spread=spread, margin=margin, seed=seed)
     base = base_geometry(model, C, precise=False)
     rows = len(model.rows.labels)

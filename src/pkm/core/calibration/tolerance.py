@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from pkm.core.calibration.measurement import CalibrationModel
+from pkm.core.calibration.measurement import CalibrationModel, check_model
 from pkm.errors import InvalidInputError
 
 #: The default errors by unit: 0.1 mm, 0.1 degree, 1e-4 of a gain.
@@ -40,7 +40,7 @@ def tolerance_table(model: CalibrationModel, readings: ArrayLike, delta: dict[st
     the most costly parameter first; parameters that move nothing are left out.
 
     Raises:
-        InvalidInputError: a ``planar`` or ``passive`` model.
+        InvalidInputError: a ``planar`` or ``passive`` model, or ``model`` no :class:`CalibrationModel`.
 
     Examples:
         >>> import pkm
@@ -49,6 +49,7 @@ def tolerance_table(model: CalibrationModel, readings: ArrayLike, delta: dict[st
         >>> rows[0].name, round(rows[0].position[1] * 1e3, 2)  # (0.1 degree on the slider's pitch: mm at the tool)
         ('slider_2.pitch', 2.26)
     """
+    model = check_model(model)
     if model.kind not in ("pose", "position"):
         raise InvalidInputError("model", "a tolerance table needs a pose or position model", model.kind)
     d = dict(DELTA, **(delta or {}))

@@ -32,7 +32,9 @@ from pkm.core.calibration.estimate import Calibration
 from pkm.core.calibration.measurement import CalibrationModel
 from pkm.core.identification.measurements import MAX_REVOLUTE
 from pkm.core.model.mechanism import Mechanism
+from pkm.core.model.spec import as_path
 from pkm.errors import InvalidInputError
+from pkm.validation import instance_of
 
 SIZE_FACTOR = 10.0  # a measured position beyond this many characteristic lengths: millimetres
 
@@ -136,7 +138,8 @@ def write_calibrated(cal: Calibration, out: str | Path) -> tuple[Path, ...]:
     """
     from pkm.core.formats.writers import write
 
-    out = Path(out)
+    cal, out = instance_of(cal, Calibration, "cal", "a pkm.Calibration (pkm.calibrate(model, readings, measured))"), \
+        as_path(out, "out")
     mech = calibrated_mechanism(cal)
     spec = write(mech, out, "pkm").files[0]
     lines = [f"# pkm calibration of {cal.model.mech.name} ({cal.model.kind} measurements); SI units",

@@ -83,7 +83,7 @@ from pkm.core.differential.velocity import RTOL, homogenised_pinv  # (one rank t
 from pkm.core.kinematics import constraints
 from pkm.core.kinematics.solve import close_loops
 from pkm.core.kinematics.task import TaskMap
-from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.mechanism import Mechanism, check_mechanism, require_independent_actuators
 from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, PkmWarning, SingularityError, SpecError
@@ -546,8 +546,15 @@ def mass_matrix_derivatives(mech: Mechanism, q: ArrayLike, *, rtol: float = RTOL
         InvalidInputError: ``base="free"`` (the default on a floating base): the base's motion is not a function
             of ``q_a`` (its momentum is a state of its own), so the Christoffel symbols of the eliminated ``M_a``
             do not give its velocity terms; pass ``base="fixed"`` for the held base's.
+        StructureError: redundant actuation (:attr:`~pkm.core.Mechanism.dependent_actuators`): a derivative along one
+            actuated coordinate alone moves it away from the others' values, where the loops do not close (no
+            configuration to difference); the Christoffel symbols need every one. The dependent actuators named;
+            load the mechanism with the independent ones actuated (its ``M_a`` and ``C_a`` in their coordinates).
     """
     mech = check_mechanism(mech)
+    require_independent_actuators(mech, "moving one actuated coordinate alone opens the loops, so M_a has no "
+                                        "derivative along it and its Christoffel symbols (the Coriolis matrix) are "
+                                        "undefined in these coordinates", "for them in the independent coordinates")
     require_physical(mech, "the mass matrix's derivatives")
     _held_only(mech, base)
     q = mech.check_q(q)
@@ -580,6 +587,8 @@ def coriolis_matrix(mech: Mechanism, q: ArrayLike, qd: ArrayLike, *, rtol: float
 
     Pinocchio's own ``computeCoriolisMatrix`` is not used: on Pinocchio 4.1 it is wrong for universal joints (NaN)
     and mimic joints (tested). A floating base must be held (``base="fixed"``: :func:`mass_matrix_derivatives`).
+    Under redundant actuation the symbols are undefined in the actuated coordinates (one cannot move alone): a
+    :class:`~pkm.errors.StructureError` names the dependent actuators (:func:`mass_matrix_derivatives`).
 
     Examples:
         >>> import numpy as np

@@ -59,7 +59,7 @@ from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
 from pkm.errors import InvalidInputError, PkmError, PkmWarning, SingularityError, SpecError
-from pkm.validation import as_count, as_scalar, as_tolerance, as_vector, finite_result
+from pkm.validation import as_choice, as_count, as_scalar, as_tolerance, as_vector, finite_result
 
 RTOL = 1e-9
 #: A free base "needs" a wrench where the one the motion asks of it exceeds this, relative to the wrenches it sums
@@ -238,7 +238,9 @@ class KhalilProjection:
 
     def inverse_dynamics(self, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None = None, *, wrenches: Mapping[str, ArrayLike] | None = None) \
             -> np.ndarray:
-        """Actuator efforts (N or N m, in ``mech.actuated`` order) for a consistent state.
+        """Actuator efforts (N or N m, in ``mech.actuated`` order) for a consistent state. Under redundant actuation
+        (the efforts not unique) one valid distribution, the least-squares platform map's, not pkm's convention (the
+        virtual work's, :func:`inverse_dynamics`).
 
         Args:
             q: Assembled configuration (nq,).
@@ -360,7 +362,14 @@ def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, 
             ``"virtual_work"`` (:func:`virtual_work_dynamics`: ``G^T`` of the tree's forces, any
             structure: mimic couplings, idle motions, redundant planar closures), or ``"auto"``: Khalil's
             where the structure allows it, virtual work otherwise. Both give the same efforts to 1e-10
-            where both apply (tests).
+            where both apply (tests), but under redundant actuation, where the efforts are not unique
+            (:attr:`~pkm.core.Mechanism.dependent_actuators`): every distribution ``tau`` with ``Tᵀ tau`` the
+            independent actuators' efforts (``T`` the actuated rates of theirs) does the motion's work. pkm's
+            convention there is the virtual work's, which ``"auto"`` then takes: ``tau = Gᵀ h`` with the
+            homogenised pseudo-inverse's ``G`` (:func:`pkm.passive_map`), i.e. the closure multipliers of least
+            norm (lengths in the characteristic length; not the efforts of least norm), as
+            :func:`pkm.actuator_model` and :meth:`pkm.Kernels.inverse_dynamics <pkm.core.twin.kernels.Kernels.inverse_dynamics>`
+            give them; ``"khalil"`` gives another valid one (its platform map by least squares).
         base: A floating base ``"free"`` (default where there is one) or ``"fixed"`` (held).
 
     Raises:
@@ -382,8 +391,7 @@ def inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, 
     """
     mech = check_mechanism(mech)
     require_physical(mech, "inverse dynamics")
-    if method not in METHODS:
-        raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
+    method = as_choice(method, METHODS, "method")
     if actuator_space.base_choice(mech, base) == "free":
         out = base_inverse_dynamics(mech, q, v, a, wrench, wrenches=wrenches, method=method, base="free")
         if out.needs_base_wrench:
@@ -403,7 +411,7 @@ def _wrench_text(w: np.ndarray) -> str:
 def _motor_efforts(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayLike, wrench: ArrayLike | None,
                    wrenches: Mapping[str, ArrayLike] | None, method: str) -> np.ndarray:
     """:func:`inverse_dynamics`'s efforts by ``method`` (checked), the base given what it asks."""
-    if method == "virtual_work":
+    if method == "virtual_work" or (method == "auto" and mech.dependent_actuators):  # (redundant: the convention)
         return virtual_work_dynamics(mech, q, v, a, wrench, wrenches=wrenches)
     k = _khalil(mech)
     if isinstance(k, SpecError):
@@ -472,8 +480,7 @@ def base_inverse_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, a: ArrayL
     """
     mech = check_mechanism(mech)
     require_physical(mech, "inverse dynamics")
-    if method not in METHODS:
-        raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
+    method = as_choice(method, METHODS, "method")
     if mech.base is None:
         raise InvalidInputError("mech", "the mechanism has no floating base (spec.floating_base): its base is the "
                                         "world, whose reaction pkm does not model", mech.base)
@@ -545,8 +552,7 @@ def forward_dynamics(mech: Mechanism, q: ArrayLike, v: ArrayLike, tau_actuated: 
         >>> np.allclose(pkm.inverse_dynamics(delta, q, v, a), [0.5, 0.5, 0.5])
         True
     """
-    if method not in FORWARD_METHODS:
-        raise InvalidInputError("method", f"use one of {list(FORWARD_METHODS)}, got {method!r}", method)
+    method = as_choice(method, FORWARD_METHODS, "method")
     if method == "constraint_dynamics":
         return constraint_dynamics(mech, q, v, tau_actuated, mu=mu, base=base, base_wrench=base_wrench)
     if mu is not None:

@@ -87,7 +87,7 @@ from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
 from pkm.errors import CompilerError, ControllerError, InvalidInputError, PkmError, SingularityError, SpecError
-from pkm.validation import as_array, as_scalar
+from pkm.validation import as_array, as_choice, as_scalar
 
 if TYPE_CHECKING:
     from pkm.core.twin.simulation import Simulator
@@ -388,8 +388,7 @@ def simulate(mech: Mechanism, q0: ArrayLike | None = None, v0: ArrayLike | None 
     """
     mech = check_mechanism(mech)
     require_physical(mech, "the simulation")
-    if method not in METHODS:
-        raise InvalidInputError("method", f"use one of {list(METHODS)}, got {method!r}", method)
+    method = as_choice(method, METHODS, "method")
     if not isinstance(backend, str) or backend not in BACKENDS:
         raise InvalidInputError("backend", f"use one of {list(BACKENDS)}, got {backend!r}", backend)
     base = base_choice(mech, base)

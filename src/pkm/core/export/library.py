@@ -49,6 +49,7 @@ from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.joints import stated_limits
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.scale import JacobianScales
+from pkm.core.model.spec import as_path
 from pkm.core.twin.codegen import jacobi_sv, paper_counts
 from pkm.validation import ABSURD
 
@@ -177,7 +178,7 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
     """
     from pkm import __version__
 
-    mech = check_mechanism(mech)
+    mech, out = check_mechanism(mech), as_path(directory, "directory")
     prefix = c_name(name or mech.name)
     model = ExportModel(mech)
     modes, mode_lines = mode_constants(mech, model)
@@ -198,7 +199,6 @@ def export_c(mech: Mechanism, directory: str | os.PathLike[str], *, name: str | 
     blocks = {kind: [[vnames[newton.columns[c]] for c in b.cols] for b in newton.blocks]
               for kind, newton in (("fk", fk), ("ik", ik))}
     limits = _limits(mech)
-    out = Path(directory)
     out.mkdir(parents=True, exist_ok=True)
     nfk, nik = len(fk.columns), len(ik.columns)
     fill = {"FKN": str(nfk), "IKN": str(nik), "FKB": str(max(len(fk.blocks), 1)), "IKB": str(max(len(ik.blocks), 1))}

@@ -28,7 +28,7 @@ from numpy.typing import ArrayLike
 from pkm.core.identification.rank import CLEAR_GAP, RankDecision, decide_rank
 from pkm.core.identification.regressor import Parameters, parameters, regressor
 from pkm.core.kinematics.solve import close_loops
-from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.mechanism import Mechanism, check_mechanism, require_independent_actuators
 from pkm.errors import ConvergenceError, InvalidInputError, SingularityError
 from pkm.validation import as_scalar
 
@@ -193,7 +193,16 @@ def closed_draws(mech: Mechanism, rng: np.random.Generator, spread: np.ndarray, 
     """Random actuator readings ``qa`` about the reference, each within ``spread`` (na) [rad or m] of it (uniform),
     with their closed configurations ``q`` (closed from the reference, within the joint limits): ``(qa, q)`` for
     each of ``tries`` draws that closes (one that does not close or is singular is passed over). The one draw of
-    :func:`random_states` and the calibration's candidate poses (:func:`pkm.core.calibration.poses.candidates`)."""
+    :func:`random_states` and the calibration's candidate poses (:func:`pkm.core.calibration.poses.candidates`).
+
+    Raises:
+        StructureError: redundant actuation (:attr:`~pkm.core.Mechanism.dependent_actuators`), at the first draw:
+            readings drawn one by one never agree with the actuators the others fix, so no draw would close; the
+            dependent actuators named, with the independent ones to load the mechanism with instead.
+    """
+    require_independent_actuators(mech, "random readings drawn one by one never agree with them, so no random state "
+                                        "closes its loops", "to draw states (identification, excitation, calibration "
+                                        "poses)")
     qa0 = mech.actuated_q(mech.q_reference)
     for _ in range(tries):
         qa = qa0 + rng.uniform(-spread, spread, mech.na)

@@ -35,6 +35,7 @@ from pkm.core.identification.measurements import Measurements
 from pkm.core.identification.regressor import known_efforts, parameters, regressor_batch
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError
+from pkm.validation import instance_of
 
 if TYPE_CHECKING:
     from pkm.core.identification.consistent import ConsistentEstimate
@@ -172,7 +173,12 @@ def validate(mech: Mechanism, predict: Estimate | ConsistentEstimate, data: Meas
         >>> val.rms.shape, bool(val.rms.max() < 1e-9)
         ((3,), True)
     """
+    from pkm.core.identification.consistent import ConsistentEstimate
+
     mech = check_mechanism(mech)
+    instance_of(predict, (Estimate, ConsistentEstimate), "predict", "a pkm.Estimate or ConsistentEstimate "
+                "(pkm.estimate or pkm.consistent_estimate)")
+    data = instance_of(data, Measurements, "data", "pkm.Measurements (pkm.measurements)")
     Y = regressor_batch(mech, data.Q, data.QD, data.QDD)
     pred = np.asarray(predict.predict(Y), dtype=float).reshape(data.TAU.shape)
     pred = pred + known_efforts(mech, data.Q, data.QD)  # (the springs' and the passive joints' friction)

@@ -387,7 +387,11 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
         A :class:`SolveResult` whose ``q`` has the requested actuated coordinates. Where every joint is actuated
         (no passive coordinate), ``q`` is the actuated values themselves, only checked: converged where they close
         the loops, else the :class:`ConvergenceError` naming the open closure (no path followed, no mode change
-        told: the seed plays no part).
+        told: the seed plays no part). Under redundant actuation (:attr:`~pkm.core.Mechanism.dependent_actuators`:
+        actuators whose values the others fix), the path moves the independent actuators with the dependent ones
+        released (solved for with the passive joints: the straight path between two consistent targets crosses
+        inconsistent values), every actuator held at the target only; values that disagree with the others' end in
+        the :class:`ConvergenceError` naming the open closure and the dependent actuators.
 
     Examples:
         >>> import numpy as np
@@ -419,9 +423,19 @@ def close_loops(mech: Mechanism, q_actuated: ArrayLike, q0: ArrayLike | None = N
 
     matrices = _Matrices(mech, task=TaskMap.of(mech))
 
+    # (redundant actuation, joints left to solve for: the dependent actuators released along the way, solved for
+    # with the passive joints while the others move; every actuator held at its value at the target only)
+    held = np.array([n not in mech.dependent_actuators for n in mech.actuated_names], dtype=bool)
+    released = np.sort(np.concatenate([mech.passive_v, mech.act_v[~held]]))
+
     def solve_at(q: np.ndarray, s: float, t: float) -> tuple[np.ndarray, float, int, float]:
-        return _scaled_newton(mech, matrices.keep(fun, s >= 1.0, t, metric.rows),
-                              mech.with_actuated(q, qa0 + s * (qa1 - qa0)), mech.passive_v, t, max_iter, 0.5, metric)
+        qa = qa0 + s * (qa1 - qa0)
+        if s < 1.0 and not held.all() and len(mech.passive_v):
+            return _scaled_newton(mech, matrices.keep(fun, False, t, metric.rows),
+                                  mech.with_actuated(q, np.where(held, qa, mech.actuated_q(q))), released, t,
+                                  max_iter, 0.5, metric)
+        return _scaled_newton(mech, matrices.keep(fun, s >= 1.0, t, metric.rows), mech.with_actuated(q, qa),
+                              mech.passive_v, t, max_iter, 0.5, metric)
 
     seed = mode_label(mech, q)  # (found kept where the seed is the last solve's result: a path followed)
     try:

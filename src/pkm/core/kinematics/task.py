@@ -61,7 +61,8 @@ def zyx_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
         >>> np.allclose(R.T @ R, np.eye(3))
         True
     """
-    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
+    r, p, y = (as_array(a, n, "an angle [rad]") for a, n in ((roll, "roll"), (pitch, "pitch"), (yaw, "yaw")))
+    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
     return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
                      [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
                      [-sp, cp * sr, cp * cr]])

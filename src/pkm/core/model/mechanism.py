@@ -37,9 +37,9 @@ from pkm.core.model.motors import motor_map
 from pkm.core.model.spec import Branch, ClosureSpec
 from pkm.core.model.springs import JointSprings, joint_springs
 from pkm.core.model.urdf import position_limits
-from pkm.errors import InvalidInputError, SpecError, SpecNameError, UnknownNameError
+from pkm.errors import InvalidInputError, SpecError, SpecNameError, StructureError, UnknownNameError
 from pkm.units import joint_kind, quantities
-from pkm.validation import as_array, as_vector, bounded, wrap_angle
+from pkm.validation import as_array, as_vector, bounded, instance_of, wrap_angle
 
 
 @dataclass(frozen=True)
@@ -544,11 +544,19 @@ def _frame_id(model: pin.Model, name: object, source: str) -> int | None:
     return None
 
 
+def require_independent_actuators(mech: Mechanism, why: str, instead: str) -> None:
+    """Nothing where no actuator depends on the others, else (redundant actuation,
+    :attr:`Mechanism.dependent_actuators`) a :class:`StructureError` naming them, saying ``why`` the method cannot
+    serve such a mechanism, and the independent actuators to load it with ``instead`` (what for)."""
+    if mech.dependent_actuators:
+        independent = [n for n in mech.actuated_names if n not in mech.dependent_actuators]
+        raise StructureError("actuated", f"{mech.name}: actuators {list(mech.dependent_actuators)} depend on the "
+                                         f"others (redundant actuation): {why}; load the mechanism with "
+                                         f"{independent} actuated {instead}")
+
+
 def check_mechanism(mech: object, name: str = "mech") -> Mechanism:
     """``mech`` itself if it is a :class:`Mechanism`, else :class:`InvalidInputError` saying how to get one."""
-    if not isinstance(mech, Mechanism):
-        raise InvalidInputError(name, f"expected a pkm.Mechanism (from pkm.load(name) or pkm.build(name, ...)), "
-                                      f"got {type(mech).__name__}", mech)
-    return mech
+    return instance_of(mech, Mechanism, name, "a pkm.Mechanism (from pkm.load(name) or pkm.build(name, ...))")
 
 

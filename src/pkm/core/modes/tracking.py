@@ -28,6 +28,7 @@ from pkm.core.kinematics.trajectory import Trajectory, follow_actuators, follow_
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.scale import JacobianScales
 from pkm.core.modes.assembly import Mode
+from pkm.validation import instance_of
 
 #: Largest joint step [rad or m] accepted while bisecting towards a meeting (a larger one: another mode).
 _STEP = 0.5
@@ -76,6 +77,13 @@ class ModeTrack:
     meeting: Meeting | None
 
 
+def _check_mode(mode: object, kind: str) -> Mode:
+    """``mode`` itself if it is a :class:`Mode`, else :class:`InvalidInputError` saying where one comes from (a
+    configuration passed in its place: its seed is ``mode.q``)."""
+    return instance_of(mode, Mode, "mode", f"a pkm {kind} mode (one of pkm.{kind}_modes(mech, ...).modes; a "
+                                           "configuration is no mode)")
+
+
 def _sigma(J: np.ndarray) -> float:
     sv = np.linalg.svd(J, compute_uv=False)
     return float(sv[-1] / sv[0]) if sv.size and sv[0] > 0 else 0.0
@@ -105,6 +113,9 @@ def track_assembly_mode(mech: Mechanism, mode: Mode, q_actuated: ArrayLike) -> M
     """The assembly mode ``mode`` (of :func:`pkm.assembly_modes` at the first sample) along actuator samples
     ``q_actuated`` (N x na) [rad or m].
 
+    Raises:
+        InvalidInputError: ``mech`` no mechanism, ``mode`` no :class:`Mode` (a configuration in its place).
+
     Examples:
         >>> import numpy as np
         >>> import pkm
@@ -116,7 +127,7 @@ def track_assembly_mode(mech: Mechanism, mode: Mode, q_actuated: ArrayLike) -> M
         >>> track.reached, track.q.shape, track.meeting
         (5, (5, 7), None)
     """
-    mech = check_mechanism(mech)
+    mech, mode = check_mechanism(mech), _check_mode(mode, "assembly")
     traj = follow_actuators(mech, q_actuated, q0=mode.q, efforts=False)
     A = np.asarray(q_actuated, dtype=float).reshape(len(traj.q), -1)  # the samples asked for (checked by the core)
 
@@ -131,6 +142,9 @@ def track_working_mode(mech: Mechanism, mode: Mode, task: ArrayLike) -> ModeTrac
     """The working mode ``mode`` (of :func:`pkm.working_modes` at the first sample) along task samples ``task``
     (N x the task's value size, as :meth:`pkm.core.TaskMap.value`).
 
+    Raises:
+        InvalidInputError: ``mech`` no mechanism, ``mode`` no :class:`Mode` (a configuration in its place).
+
     Examples:
         >>> import numpy as np
         >>> import pkm
@@ -141,7 +155,7 @@ def track_working_mode(mech: Mechanism, mode: Mode, task: ArrayLike) -> ModeTrac
         >>> track.reached, track.q.shape, track.meeting
         (4, (4, 12), None)
     """
-    mech = check_mechanism(mech)
+    mech, mode = check_mechanism(mech), _check_mode(mode, "working")
     traj = follow_task(mech, task, q0=mode.q, efforts=False)
     Y = np.asarray(task, dtype=float).reshape(len(traj.q), -1)
     tm = TaskMap.of(mech)

@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike
 from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.errors import InvalidInputError, PathError
-from pkm.validation import as_array, bounded
+from pkm.validation import as_array, as_choice, bounded
 
 SPACES = ("task", "actuated")
 #: The largest turn of the chords at a waypoint [rad] before a path is refused as a corner.
@@ -129,8 +129,7 @@ def waypoint_path(mech: Mechanism, waypoints: ArrayLike, *, space: str = "task",
         PathError: coinciding waypoints or a corner (``limit="smoothness"``, ``index`` the waypoint).
     """
     mech = check_mechanism(mech)
-    if space not in SPACES:
-        raise InvalidInputError("space", f"use one of {list(SPACES)}", space)
+    space = as_choice(space, SPACES, "space")
     task = TaskMap.of(mech)
     size = task.value_size if space == "task" else mech.na
     W = as_array(waypoints, "waypoints", f"n x {size} waypoints")

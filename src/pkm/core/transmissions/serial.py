@@ -36,7 +36,7 @@ import json
 import os
 import re
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -50,11 +50,13 @@ from pkm.core.formats.to_mjcf import MIN_INERTIA, MIN_MASS, TIMESTEP, _joints, _
 from pkm.core.formats.to_urdfplus import damping_of
 from pkm.core.model.joints import reduced_model
 from pkm.core.model.mechanism import Mechanism, check_mechanism
+from pkm.core.model.spec import as_path
 from pkm.core.model.urdf import urdf_from_model, write_gazebo_springs
 from pkm.core.transmissions.decompose import transmissions as find
 from pkm.core.transmissions.limits import OutputLimits, output_limits
 from pkm.core.transmissions.transmission import Transmission
 from pkm.errors import InvalidInputError, PkmWarning
+from pkm.validation import instance_of
 
 
 @dataclass(frozen=True)
@@ -145,8 +147,8 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
     robot's stated limits left out: a model for a free motion, as :mod:`pkm.core.transmissions.fidelity` runs it).
 
     Raises:
-        InvalidInputError: a closure no transmission covers; ``around`` naming no output, or a point outside its
-            transmission's feasible region.
+        InvalidInputError: ``transmissions`` not :class:`Transmission` objects, ``around`` no mapping; a closure no
+            transmission covers; ``around`` naming no output, or a point outside its transmission's feasible region.
 
     Examples:
         >>> import pinocchio as pin
@@ -161,13 +163,21 @@ def serial_equivalent(robot: Mechanism, transmissions: Sequence[Transmission] | 
         0.0002152
     """
     robot = check_mechanism(robot)
-    found = tuple(find(robot) if transmissions is None else transmissions)
+    named = dict(instance_of({} if around is None else around, Mapping, "around",
+                             "a mapping {output: value} [rad or m]"))
+    if transmissions is None:
+        found = tuple(find(robot))
+    elif isinstance(transmissions, (str, bytes)) or not isinstance(transmissions, Iterable):
+        raise InvalidInputError("transmissions", "expected a sequence of pkm.Transmission (pkm.transmissions(robot)), "
+                                                 f"got {type(transmissions).__name__}", transmissions)
+    else:
+        found = tuple(instance_of(t, Transmission, f"transmissions[{k}]", "a pkm.Transmission "
+                                  "(one of pkm.transmissions(robot))") for k, t in enumerate(transmissions))
     covered = {c.name for t in found for c in t.mechanism.spec.closures}
     open_loops = [c.name for c in robot.spec.closures if c.name not in covered]
     if open_loops:
         raise InvalidInputError("transmissions", f"closures {open_loops} belong to no transmission given: the serial "
                                 "model would keep their joints with the loops open", open_loops)
-    named = dict(around or {})
     unknown = sorted(set(named) - {o for t in found for o in t.outputs})
     if unknown:
         raise InvalidInputError("around", f"{unknown} are no outputs; the outputs are "
@@ -261,7 +271,8 @@ def write_serial_equivalent(se: SerialEquivalent, folder: str | os.PathLike[str]
         ...     [p.name for p in pkm.write_serial_equivalent(se, folder)]
         ['talos_like_serial.urdf', 'talos_like_serial.xml', 'talos_like_ankle.urdf', 'talos_like_ankle.closures.toml', 'talos_like_transmissions.json']
     """
-    out = Path(folder)
+    se, out = instance_of(se, SerialEquivalent, "se", "a pkm.SerialEquivalent (pkm.serial_equivalent(robot))"), \
+        as_path(folder, "folder")
     out.mkdir(parents=True, exist_ok=True)
     stem = _safe(se.robot.name)
     urdf, mjcf, data = out / f"{stem}_serial.urdf", out / f"{stem}_serial.xml", out / f"{stem}_transmissions.json"

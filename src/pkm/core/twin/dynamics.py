@@ -3,7 +3,8 @@ the friction ``f_a`` and the forward dynamics, for the kernels (:class:`~pkm.cor
 compiled simulation (:mod:`~pkm.core.twin.simulation`).
 
 With the closure rows ``W J = [J_a J_p]`` (:attr:`Twin.closure_rows`), the joint rates ``v = G qd`` and
-accelerations ``a = G qdd + a_b`` come from the sparse LU of ``J_p`` with its pivots fixed at the reference, and
+accelerations ``a = G qdd + a_b`` come from the sparse LU of ``J_p`` with its pivots fixed at the reference (under
+redundant actuation the core's pseudo-inverse, :attr:`~pkm.core.twin.tree.Twin.passive_solve`: the same ``G``), and
 ``τ(q, qd, qdd) = Gᵀ rnea(q, v, a)`` is the twin's inverse dynamics (one transposed solve, no matrix ``G``). It is
 linear in ``qdd``, so
 
@@ -36,7 +37,7 @@ import numpy as np
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.model.plausibility import require_physical
 from pkm.core.model.scale import JacobianScales
-from pkm.core.twin.linear import PivotedLU
+from pkm.core.twin.linear import HomogenisedPinv, PivotedLU
 from pkm.core.twin.spatial import Expr
 from pkm.core.twin.tree import Twin
 from pkm.errors import SpecError
@@ -121,6 +122,12 @@ class ActuatorTwin:
         Jp = rows["jacobian"][:, self.passive]
         try:
             self.lu = PivotedLU(Jp, twin.at_reference(Jp)) if self.passive else None
+            #: The solves of the rates and the efforts: the LU's, or under redundant actuation the core's
+            #: pseudo-inverse (:attr:`pkm.core.twin.tree.Twin.passive_solve`); the LU's pivots still judge the sample.
+            self.solve: PivotedLU | HomogenisedPinv | None = self.lu
+            if self.lu is not None and mech.dependent_actuators:
+                sc = JacobianScales.of(mech)
+                self.solve = HomogenisedPinv(Jp, twin.at_reference(Jp), sc.constraint_rows, sc.columns[self.passive])
         except ValueError as e:
             raise SpecError(mech.source, f"the closures do not fix the passive joints at the reference ({e})") from None
         self._Ja = rows["jacobian"][:, self.extended]
@@ -136,16 +143,16 @@ class ActuatorTwin:
 
     def _rates(self, ext: Expr, rhs: Expr | int = 0) -> cs.SX:
         """Joint rates (or accelerations, with the drift as ``rhs``) from the extended coordinates' ``ext``."""
-        if self.lu is None:
+        if self.solve is None:
             return self._spread(ext, cs.SX(0, 1))
-        return self._spread(ext, -self.lu.solve(self._Ja @ ext + rhs))
+        return self._spread(ext, -self.solve.solve(self._Ja @ ext + rhs))
 
     def project(self, x: Expr) -> Expr:
         """``G_eᵀ x`` for joint efforts ``x`` (nv): ``x_e - J_eᵀ λ`` with ``J_pᵀ λ = x_p``."""
         ext = cs.vertcat(*[x[c] for c in self.extended])
-        if self.lu is None:
+        if self.solve is None:
             return ext
-        lam = self.lu.solve_transposed(cs.vertcat(*[x[c] for c in self.passive]))
+        lam = self.solve.solve_transposed(cs.vertcat(*[x[c] for c in self.passive]))
         return ext - self._Ja.T @ lam
 
     @functools.cached_property

@@ -367,7 +367,7 @@ class Kernels:
     def function(self, name: str) -> cs.Function:
         """The CasADi function of a kernel (:data:`KERNELS`), inputs and outputs dense, after CSE: built once per
         mechanism and design parameters, whichever of its :class:`Kernels` asks (compiled or not, any ``threads``)."""
-        if name not in KERNELS:
+        if not isinstance(name, str) or name not in KERNELS:
             raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", name)
         built = _FUNCTIONS.setdefault(self.twin.mech, {})  # (a design view's: the twin's, shared)
         key = (tuple(self.design.names), name)
@@ -431,7 +431,7 @@ class Kernels:
         """
         from pkm.core.twin.jaxgen import jax_function
 
-        if name not in KERNELS:
+        if not isinstance(name, str) or name not in KERNELS:
             raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", name)
         return self.cached(("jax", name, x64), lambda: jax_function(self.function(name), x64=x64))  # type: ignore
 
@@ -468,7 +468,7 @@ class Kernels:
         """The operations of the kernel's main output (``tau``, ``q_next``) after CSE: see :class:`OperationCount`."""
         from pkm.core.twin.codegen import paper_counts
 
-        if name not in BOUNDARIES:
+        if not isinstance(name, str) or name not in BOUNDARIES:
             raise InvalidInputError("kernel", f"operation counts are stated for {sorted(BOUNDARIES)}", name)
         fun = self.function(name)
         args = fun.sx_in()
@@ -521,7 +521,9 @@ class Kernels:
     def inverse_dynamics(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """Actuator efforts (na, or n x na) at closed configurations ``q`` (nq or n x nq) for actuated rates and
         accelerations ``qd, qdd`` (na or n x na) [N, N m]: :attr:`Twin.inverse_dynamics`, samples under the pivot
-        floor recomputed by :func:`pkm.inverse_dynamics`."""
+        floor recomputed by :func:`pkm.inverse_dynamics`. Under redundant actuation (the efforts not unique) the same
+        distribution as :func:`pkm.inverse_dynamics`: ``Gᵀ h`` with the core's homogenised pseudo-inverse, the
+        closure multipliers of least norm (:attr:`Twin.passive_solve`)."""
         (tau, pivot), single = self._run("inverse_dynamics", q, qd, qdd, pivoted=True)
         if not pivot.min() >= PIVOT_FLOOR:
             bad = np.flatnonzero(~(pivot[:, 0] >= PIVOT_FLOOR))

@@ -128,3 +128,31 @@ class PivotedLU:
             for i, f in step:
                 z[p] = z[p] - f * z[i]
         return cs.vertcat(*z)
+
+
+class HomogenisedPinv:
+    """The solves of :func:`pkm.core.differential.velocity.homogenised_pinv`'s pseudo-inverse ``A⁺ = columns Â⁺
+    rows`` (``Â = rows A columns``) for an SX matrix ``A`` (m x n) of rank n whose rows are not all needed
+    (redundant actuation: where :class:`PivotedLU`'s zeros on the rows without a pivot give one valid solution among
+    many, and another map than the generic core's): ``x = A⁺ b`` (least squares) and ``y = (A⁺)ᵀ b`` (the solution
+    of ``Aᵀ y = b`` of least ``|y / rows|``), by the normal equations ``ÂᵀÂ`` (n x n, factored by
+    :class:`PivotedLU`, pivots chosen at the reference).
+
+    Raises:
+        ValueError: ``A_ref`` has rank below n.
+    """
+
+    def __init__(self, A: Expr, A_ref: np.ndarray, rows: np.ndarray, columns: np.ndarray):
+        self.rows, self.columns = cs.DM(rows), cs.DM(columns)
+        weight = np.outer(rows, columns)
+        self.A_hat = A * cs.DM(weight)  # (elementwise)
+        ref = np.asarray(A_ref, dtype=float) * weight
+        self.lu = PivotedLU(self.A_hat.T @ self.A_hat, ref.T @ ref)
+
+    def solve(self, b: Expr) -> Expr:
+        """``x = A⁺ b`` (n; b: m rows of SX): ``A x = b`` where ``b`` is in ``A``'s range, else least squares."""
+        return self.columns * self.lu.solve(self.A_hat.T @ (self.rows * cs.vertcat(b)))
+
+    def solve_transposed(self, b: Expr) -> Expr:
+        """``y = (A⁺)ᵀ b`` (m; b: n rows of SX): ``Aᵀ y = b`` with the least ``|y / rows|``."""
+        return self.rows * (self.A_hat @ self.lu.solve(self.columns * cs.vertcat(b)))

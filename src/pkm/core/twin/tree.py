@@ -48,7 +48,7 @@ from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.scale import JacobianScales
 from pkm.core.twin.design import design_of
 from pkm.core.twin.joint import Joint
-from pkm.core.twin.linear import PivotedLU
+from pkm.core.twin.linear import HomogenisedPinv, PivotedLU
 from pkm.core.twin.spatial import (
     SE3,
     Expr,
@@ -372,6 +372,22 @@ class Twin:
         Jp = self.closure_rows["jacobian"][:, self.mech.passive_v.tolist()]
         return PivotedLU(Jp, self.at_reference(Jp))
 
+    @functools.cached_property
+    def passive_solve(self) -> PivotedLU | HomogenisedPinv:
+        """The solves of ``J_p`` the rate maps and the efforts use: :attr:`passive_lu`'s, or, under redundant actuation
+        (:attr:`~pkm.core.Mechanism.dependent_actuators`: more closure rows than the passive joints need, so that
+        an actuated rate alone has no exact passive answer, and the efforts' closure multipliers are not unique),
+        the generic core's homogenised pseudo-inverse (:func:`pkm.passive_map`'s ``G``, its ``G^T`` the efforts'),
+        so that the kernels give the core's maps and efforts (:class:`~pkm.core.twin.linear.HomogenisedPinv`)."""
+        lu = self.passive_lu  # (idle motions refused)
+        if not self.mech.dependent_actuators:
+            return lu
+        from pkm.core.model.scale import JacobianScales
+
+        sc, pv = JacobianScales.of(self.mech), self.mech.passive_v
+        Jp = self.closure_rows["jacobian"][:, pv.tolist()]
+        return HomogenisedPinv(Jp, self.at_reference(Jp), sc.constraint_rows, sc.columns[pv])
+
     def _passive(self, values: Expr) -> cs.SX:
         """An nv vector: ``values`` (passive) on the passive rows, zero elsewhere."""
         out = cs.SX.zeros(self.mech.nv)
@@ -389,21 +405,21 @@ class Twin:
     def passive_map(self) -> Expr:
         """``G = dq/dq_a`` (nv x na), as :func:`pkm.passive_map` (mechanisms without idle motions)."""
         Ja = self.closure_rows["jacobian"][:, self.mech.act_v.tolist()]
-        return cs.horzcat(*[self._actuated(np.eye(self.mech.na)[k]) - self._passive(self.passive_lu.solve(Ja[:, k]))
+        return cs.horzcat(*[self._actuated(np.eye(self.mech.na)[k]) - self._passive(self.passive_solve.solve(Ja[:, k]))
                             for k in range(self.mech.na)])
 
     @functools.cached_property
     def velocities(self) -> Expr:
         """All joint rates for the actuated rates :attr:`qd` (symbol, na), as :func:`pkm.velocities`."""
         Ja = self.closure_rows["jacobian"][:, self.mech.act_v.tolist()]
-        return self._actuated(self.qd) - self._passive(self.passive_lu.solve(Ja @ self.qd))
+        return self._actuated(self.qd) - self._passive(self.passive_solve.solve(Ja @ self.qd))
 
     @functools.cached_property
     def accelerations(self) -> Expr:
         """All joint accelerations at ``(q, v)`` for the actuated accelerations :attr:`qdd` (symbol, na), as
         :func:`pkm.accelerations`: the passive ones close the loops at the acceleration level (drift included)."""
         Ja = self.closure_rows["jacobian"][:, self.mech.act_v.tolist()]
-        return self._actuated(self.qdd) - self._passive(self.passive_lu.solve(Ja @ self.qdd + self.closure_rows["drift"]))
+        return self._actuated(self.qdd) - self._passive(self.passive_solve.solve(Ja @ self.qdd + self.closure_rows["drift"]))
 
     @functools.cached_property
     def closure_step(self) -> Expr:
@@ -415,14 +431,15 @@ class Twin:
     def actuated_efforts(self) -> Expr:
         """Actuator efforts (na) at a consistent state ``(q, v, a)``: ``G^T rnea``
         (:func:`pkm.core.dynamics.projection.virtual_work_dynamics`), computed as ``tau_a - J_a^T lambda`` with
-        ``J_p^T lambda = tau_p`` (one transposed solve instead of the matrix ``G``).
+        ``J_p^T lambda = tau_p`` (one transposed solve instead of the matrix ``G``; under redundant actuation the
+        least-norm ``lambda`` of :attr:`passive_solve`, the core's: the same efforts as :func:`pkm.inverse_dynamics`).
 
         Raises:
             SpecError: the mechanism has idle motions (their accelerations need the dynamics:
                 :func:`pkm.inverse_dynamics` handles them).
         """
         mech, tau = self.mech, self.rnea
-        lam = self.passive_lu.solve_transposed(cs.vertcat(*[tau[int(r)] for r in mech.passive_v]))
+        lam = self.passive_solve.solve_transposed(cs.vertcat(*[tau[int(r)] for r in mech.passive_v]))
         Ja = self.closure_rows["jacobian"][:, mech.act_v.tolist()]
         return cs.vertcat(*[tau[int(c)] for c in mech.act_v]) - Ja.T @ lam
 
