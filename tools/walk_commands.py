@@ -51,10 +51,7 @@ NOT_APPLICABLE = {("transmission", m): r"outputs are one-coordinate serial joint
 
 #: Cells known to fail, each with what is known (shown as ``known`` with their message; the exit status ignores them):
 #: remove an entry once fixed (the walk then checks it like any other).
-KNOWN = {("calibrate plan", "hexapod"): "issue 52: a third of the O1-chosen poses (2 to 10 % of the distance to a "
-                                        "direct singularity) do not close on the simulated perturbed hexapod "
-                                        "(2 mm, 0.5 deg), --spread 0.05 neither",
-         ("calibrate", "hexapod"): "issue 52: its input, 'pkm calibrate plan hexapod --simulate 1', fails (above)"}
+KNOWN: dict[tuple[str, str], str] = {}
 
 #: Documented lines not run, with the reason (a server or a live viewer runs until Ctrl-C).
 DOC_SKIPS = {"pkm serve": "a server that runs until Ctrl-C (tests/cli/test_serve.py starts and stops it)",

@@ -61,3 +61,20 @@ def test_a_model_the_mechanism_cannot_measure_names_the_option(tmp_path, capsys)
                      "--out", str(tmp_path / "d.csv")]) == 1
     err = capsys.readouterr().err
     assert "use --model passive with encoders on passive joints" in err and "kind=" not in err, err
+
+
+def test_a_pose_the_simulated_robot_does_not_reach_is_left_out_with_a_warning(tmp_path, capsys, monkeypatch) -> None:
+    """Issue 52: ``pkm calibrate plan hexapod --simulate 1`` failed where the perturbed robot did not reach an
+    O1-chosen pose. A 3-PRS perturbed by 1 cm and 1 degree stands in (the hexapod's plan takes 10 s): the pose it
+    does not reach is said, left out and replaced, and the table holds the 12 poses asked for (each measured on
+    that robot: ``simulate`` refuses a pose it does not reach)."""
+    from pkm.core.calibration import estimate
+
+    far = estimate.perturbed
+    monkeypatch.setattr(estimate, "perturbed", lambda model, seed=0: far(model, seed, length=0.01, angle=0.02))
+    data = tmp_path / "data.csv"
+    with pytest.warns(pkm.errors.PkmWarning, match=r"the robot does not reach 1 of the 13 poses"):
+        assert cli.main(["calibrate", "plan", "prs3", "--poses", "12", "--out", str(data), "--simulate", "4"]) == 0
+    assert "12 poses of 48 candidates (1 more left out: the perturbed robot does not reach them)" in \
+        capsys.readouterr().out
+    assert len(data.read_text().splitlines()) == 13

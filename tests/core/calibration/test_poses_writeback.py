@@ -178,3 +178,37 @@ def test_columns_given_as_a_dict_take_the_identification_route(tmp_path) -> None
     assert err.value.name == "m.slider_2"
     with pytest.raises(pkm.errors.InvalidInputError, match=r"column 'z' has shape") as err:
         read_data(m, dict(cols, z=cols["z"][:-1]))
+
+
+def test_a_pose_the_robot_does_not_reach_is_left_out_and_the_next_best_taken() -> None:
+    """Issue 52: the hexapod's simulated robot did not reach a third of the poses O1 picked on the nominal one, and
+    ``pkm calibrate plan --simulate`` failed. A 3-PRS 1 cm and 1 degree off does not reach one of 12: pkm's own
+    loop closure on the mechanism written with that geometry fails there too (a second solver) and closes at the
+    pose taken instead; the picks before the refused one are the plain choice's to the bit; a robot that reaches
+    none is refused naming the options."""
+    from pkm.core.calibration.estimate import perturbed, simulate
+
+    m = model("prs3")
+    truth = perturbed(m, 1, length=0.01, angle=0.02)
+    plain = calibration_poses(m, 12, spread=0.2, pool=18)
+    reached = m.reaches(truth, plain.readings)
+    assert reached.sum() == 11
+    with pytest.raises(pkm.errors.ConvergenceError, match=r"does not reach this pose.*reachable="):
+        simulate(m, truth, plain.readings)
+    with pytest.warns(pkm.errors.PkmWarning, match=r"does not reach 1 of the 13 poses .*of the 18 candidates: \d+;"):
+        plan = calibration_poses(m, 12, spread=0.2, pool=18, reachable=lambda r: bool(m.reaches(truth, r)[0]))
+    first = int(np.argmin(reached))
+    assert np.array_equal(plan.refused, plain.readings[first:first + 1])
+    assert np.array_equal(plan.readings[:first], plain.readings[:first]) and len(plan.readings) == 12
+    assert m.reaches(truth, plan.readings).all() and simulate(m, truth, plan.readings).shape == (12, 12)
+    robot, values = m.mechanism(truth), dict(zip(m.names, truth))
+    for r, closes in ((plan.refused[0], False), (plan.readings[first], True)):
+        qa = [values[f"{a}.gain"] * v + values[f"{a}.offset"] for a, v in zip(robot.actuated_names, r)]
+        try:
+            pkm.close_loops(robot, qa, m.close(None, r[None])[0])
+            assert closes
+        except pkm.errors.ConvergenceError:
+            assert not closes
+    assert plain.refused.shape == (0, 3)
+    with pytest.raises(pkm.errors.InvalidInputError, match=r"reaches only 0 of the 18 .*--poses, --spread"):
+        calibration_poses(m, 12, spread=0.2, pool=18, reachable=lambda r: False)

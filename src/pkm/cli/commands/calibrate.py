@@ -9,7 +9,9 @@ maximise the observability index O1 within the joint limits and a singularity ma
 the reference (default 0.2 rad, or 0.2 x the characteristic length for a prismatic actuator)
 (:mod:`pkm.core.calibration.poses`); with ``--simulate``, the table filled with what an instrument would measure on
 a randomly perturbed robot (every joint origin within 2 mm and 0.5 degrees, noise 10 µm and 20 µrad): what ``pkm
-calibrate`` then reads."""
+calibrate`` then reads. A pose that robot does not reach (its loops do not close there) is left out with a warning
+and the next best candidate measured instead, as a real campaign meets a pose the robot refuses
+(:attr:`~pkm.core.calibration.poses.PosePlan.refused`)."""
 
 from __future__ import annotations
 
@@ -125,13 +127,16 @@ def run_plan(args: argparse.Namespace) -> int:
 
     mech = load_mechanism(args)
     model = calibration_model(mech, args.model)
-    chosen = calibration_poses(model, args.poses, spread=args.spread)
     x = model.parameters.nominal if args.simulate is None else perturbed(model, args.simulate)
+    reachable = None if args.simulate is None else lambda m: bool(model.reaches(x, m)[0])
+    chosen = calibration_poses(model, args.poses, spread=args.spread, reachable=reachable)
     y = simulate(model, x, chosen.readings, seed=args.simulate or 0,
                  sigma=None if args.simulate is not None else {"m": 0.0, "rad": 0.0})
     path = write_data(model, args.out, chosen.readings, y)
-    print(f"{mech.name}: {len(chosen.readings)} poses of {chosen.candidates} candidates, log O1 {chosen.o1:.4g}, "
-          f"O4 {chosen.o4:.3g}, {len(chosen.base)} base parameters; "
+    refused = (f" ({len(chosen.refused)} more left out: the perturbed robot does not reach them)"
+               if len(chosen.refused) else "")
+    print(f"{mech.name}: {len(chosen.readings)} poses of {chosen.candidates} candidates{refused}, log O1 "
+          f"{chosen.o1:.4g}, O4 {chosen.o4:.3g}, {len(chosen.base)} base parameters; "
           + ("measurements simulated (perturbed robot, seed " + str(args.simulate) + ")" if args.simulate is not None
              else "measured columns hold the nominal model's predictions: replace them with the instrument's")
           + f"\nout: {path}")

@@ -324,11 +324,18 @@ def simulate(model: CalibrationModel, x_true: ArrayLike, readings: ArrayLike, *,
     per axis, its orientation turned by a random rotation vector of ``sigma["rad"]`` per axis.
 
     Raises:
-        ConvergenceError: the mechanism of ``x_true`` does not reach a pose (its loops do not close there).
+        ConvergenceError: the mechanism of ``x_true`` does not reach a pose (its loops do not close there): choose
+            poses it reaches (:func:`~pkm.core.calibration.poses.calibration_poses`' ``reachable``, with
+            :meth:`CalibrationModel.reaches <pkm.core.calibration.measurement.CalibrationModel.reaches>`).
     """
     rng = np.random.default_rng(seed)
     sig = dict(SIGMA, **(sigma or {}))
-    y = model.measure(x_true, readings)
+    try:
+        y = model.measure(x_true, readings)
+    except ConvergenceError as exc:
+        raise ConvergenceError(exc.what, exc.residual, exc.iterations, exc.tolerance, exc.result, message=(
+            f"{exc}: the simulated robot does not reach this pose; choose poses it reaches (calibration_poses(..., "
+            f"reachable=lambda m: model.reaches(x_true, m)[0]))")) from None
     if model.kind == "pose":
         y[:, :3] += rng.normal(0.0, sig["m"], (len(y), 3))
         for k in range(len(y)):

@@ -274,6 +274,25 @@ class CalibrationModel:
         Raises:
             ConvergenceError: a pose does not close (its row named).
         """
+        Q, worst = self._newton(x, readings, seeds)
+        if np.all(worst < CLOSURE_TOL):
+            return Q
+        k = int(np.argmax(worst))
+        raise ConvergenceError(f"loop closure of the calibration model at pose {k + 1}", float(worst[k]), MAX_NEWTON,
+                               CLOSURE_TOL, detail=f"the residual counts lengths in the characteristic length L = "
+                                                   f"{JacobianScales.of(self.mech).length:.4g} m, angles in rad")
+
+    def reaches(self, x: ArrayLike | None, readings: ArrayLike) -> np.ndarray:
+        """Whether the mechanism of parameters ``x`` reaches each pose of ``readings`` (n booleans): its loops close
+        there by :meth:`close`'s Newton iterations from the nominal mechanism's closed configuration (the assembly
+        the robot is in; a pose beyond the workspace of this robot, or across a singularity from that assembly,
+        is not reached)."""
+        return self._newton(x, readings, None)[1] < CLOSURE_TOL
+
+    def _newton(self, x: ArrayLike | None, readings: ArrayLike,
+                seeds: ArrayLike | None) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`close`'s iterations: the configurations and each pose's closure residual (infinity norm, lengths
+        over the characteristic length), below :data:`CLOSURE_TOL` where the pose closed."""
         x, M = self.vector(x), self._readings(readings)
         Q = np.array(self.seeds(M) if seeds is None else seeds, dtype=float, copy=True)
         model = self.mech.model
@@ -286,7 +305,7 @@ class CalibrationModel:
             g = np.array(g).T  # (n, rows)
             worst = np.max(np.abs(g * w.T), axis=1)
             if np.all(worst < tol):
-                return Q
+                return Q, worst
             G = np.array(Gq).reshape(g.shape[1], len(M), -1).transpose(1, 0, 2)
             dq = -np.einsum("kij,kj->ki", np.linalg.pinv(G), g)
             step = np.ones(len(M))
@@ -298,10 +317,7 @@ class CalibrationModel:
                     break
                 step[grew] *= 0.5
             Q, g, Gq = new, g_new, Gq_new
-        k = int(np.argmax(worst))
-        raise ConvergenceError(f"loop closure of the calibration model at pose {k + 1}", float(worst[k]), MAX_NEWTON,
-                               tol, detail=f"the residual counts lengths in the characteristic length L = "
-                                           f"{scales.length:.4g} m, angles in rad")
+        return Q, worst
 
     # ------------------------------------------------------------------ measurements
     def evaluate(self, x: ArrayLike | None, readings: ArrayLike, Q: np.ndarray | None = None,
