@@ -11,6 +11,7 @@ import time
 import pytest
 
 from pkm import cli
+from tests import http
 from tests.bounded import tree_cpu
 
 pytest.importorskip("fastapi")
@@ -59,7 +60,7 @@ def test_ctrl_c_stops_the_service_promptly_once_the_request_in_flight_is_answere
         answer: dict = {}
 
         def query() -> None:
-            r = httpx.post(url + "/models/delta/fk", json={"qa": qa}, timeout=120)
+            r = http.post(url + "/models/delta/fk", json={"qa": qa}, timeout=120)
             answer["status"], answer["at"] = r.status_code, time.monotonic()
             try:
                 answer["cpu"] = tree_cpu(proc.pid)

@@ -7,11 +7,11 @@ import signal
 import threading
 import time
 
-import httpx
 import numpy as np
 
 import pkm
 from pkm.serve.process import start
+from tests import http
 from tests.bounded import tree_cpu
 
 
@@ -24,7 +24,7 @@ def test_sigterm_drains_the_request_in_flight():
         answer = {}
 
         def slow() -> None:  # (4,000 samples: about a second of work)
-            answer["r"] = httpx.post(url + "/models/delta/fk", json={"qa": qa.tolist()}, timeout=120)
+            answer["r"] = http.post(url + "/models/delta/fk", json={"qa": qa.tolist()}, timeout=120)
 
         before = tree_cpu(proc.pid)
         t = threading.Thread(target=slow)

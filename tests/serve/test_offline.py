@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import re
 
-import httpx
 import pytest
 
+from tests import http
 from tests.browser import OfflineBrowser
 from tests.serve.conftest import TOKEN
 from tests.test_viz_browser import chromium
@@ -25,7 +25,7 @@ def browser(tmp_path_factory):
 
 def operations(service) -> set[str]:
     """The operationId of every operation in the service's schema."""
-    schema = httpx.get(f"{service.url}/openapi.json", headers={"authorization": f"Bearer {TOKEN}"}).json()
+    schema = http.get(f"{service.url}/openapi.json", headers={"authorization": f"Bearer {TOKEN}"}).json()
     return {op["operationId"] for path in schema["paths"].values() for op in path.values()}
 
 
@@ -70,9 +70,9 @@ def test_the_docs_pages_stay_behind_the_token(service):
     """Nothing is exempted from the token for the docs: without it the pages, their files and the schema are 401;
     a page opened with ``?token=`` passes it on to everything it loads (and no CDN address is in it)."""
     for path in ("/docs", "/redoc", "/openapi.json", "/docs-static/redoc.js", "/docs-static/swagger-ui.css"):
-        assert httpx.get(f"{service.url}{path}").status_code == 401, path
+        assert http.get(f"{service.url}{path}").status_code == 401, path
     for path in ("/docs", "/redoc"):
-        page = httpx.get(f"{service.url}{path}?token={TOKEN}")
+        page = http.get(f"{service.url}{path}?token={TOKEN}")
         assert page.status_code == 200
         urls = re.findall(r"""(?:src|href|url|spec-url)[=:]\s*["']([^"']+)["']""", page.text)
         assert len(urls) >= 3 and all(u.startswith("/") and u.endswith(f"?token={TOKEN}") for u in urls), urls

@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import time
 
-import httpx
 import numpy as np
 
 import pkm
+from tests import http
 from tests.browser import OfflineBrowser
 from tests.serve.conftest import TOKEN
 from tests.test_viz_browser import chromium
@@ -67,7 +67,7 @@ def test_moving_a_slider_moves_the_mechanism(service, tmp_path):
     assert np.abs(q1 - pkm.close_loops(delta, qa, q0).q).max() <= 1e-9 and np.abs(q1 - q0).max() > 0.05
     assert modes == len(pkm.assembly_modes(delta, qa).modes) and nodes > 0
     assert abs(y2[2] - z) <= 1e-9  # (the pose shown reaches the task slider's z)
-    assert httpx.get(f"{service.url}/models/{variant}", headers={"authorization": f"Bearer {TOKEN}"}).json()["kind"] \
+    assert http.get(f"{service.url}/models/{variant}", headers={"authorization": f"Bearer {TOKEN}"}).json()["kind"] \
         == "variant"
     view = slice(None), slice(320, None)  # (the 3-D view, right of the side panel)
     changed = np.abs(after[view] - before[view]).max(axis=-1) > 0.1

@@ -12,6 +12,7 @@ import httpx
 import numpy as np
 import pytest
 
+from tests import http
 from tests.serve.conftest import TOKEN
 
 AUTH = {"authorization": f"Bearer {TOKEN}"}
@@ -21,7 +22,7 @@ QUERIES = ("fk", "ik", "jacobians", "diagnose", "velocities", "dynamics", "capab
 
 @pytest.fixture(scope="module")
 def openapi(service) -> dict:
-    return httpx.get(service.url + "/openapi.json", headers=AUTH).json()
+    return http.get(service.url + "/openapi.json", headers=AUTH).json()
 
 
 def _operations(openapi: dict) -> dict[str, tuple[str, str, dict]]:
@@ -96,11 +97,11 @@ def test_every_answer_matches_its_published_schema(service, openapi):
     url = service.url
 
     def call(operation: str, path: str, *, method: str = "post", status: int = 200, **kw) -> dict:
-        r = httpx.request(method, url + path, headers=AUTH, timeout=120, **kw)
+        r = http.request(method, url + path, headers=AUTH, timeout=120, **kw)
         assert r.status_code == status, (operation, r.text)
         return check(operation, r)
 
-    check("health", httpx.get(url + "/health"))
+    check("health", http.get(url + "/health"))
     call("list_models", "/models", method="get")
     about = call("describe_model", "/models/delta", method="get")
     call("describe_model", "/models/nope", method="get", status=404)
@@ -145,7 +146,7 @@ def test_every_answer_matches_its_published_schema(service, openapi):
                                 "index": "wrench"}),
             "job_working_modes": ("working_modes", {"y": [0.0, 0.0, -0.35]})}
     started = {op: call(op, f"/models/delta/jobs/{kind}", status=202, json=body) for op, (kind, body) in jobs.items()}
-    rrr3 = httpx.get(url + "/models/rrr3", headers=AUTH).json()
+    rrr3 = http.get(url + "/models/rrr3", headers=AUTH).json()
     qa_rrr3 = np.array(rrr3["q_reference"])[rrr3["actuated_q"]].tolist()
     started["job_assembly_modes"] = call("job_assembly_modes", "/models/rrr3/jobs/assembly_modes", status=202,
                                          json={"qa": qa_rrr3})
@@ -184,5 +185,5 @@ def test_the_token_is_a_declared_bearer_scheme(openapi, service):
     for path, item in openapi["paths"].items():
         for op in item.values():
             assert op["security"] == ([] if path in ("/", "/health") else [{"bearer": []}]), path
-    assert httpx.get(service.url + "/health").status_code == 200
-    assert httpx.get(service.url + "/models").status_code == 401
+    assert http.get(service.url + "/health").status_code == 200
+    assert http.get(service.url + "/models").status_code == 401

@@ -8,11 +8,11 @@ import asyncio
 import json
 from pathlib import Path
 
-import httpx
 import numpy as np
 import pytest
 
 import pkm
+from tests import http
 from tests.serve.conftest import TOKEN
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -29,12 +29,12 @@ def _path(mech, n=5):
 
 
 def test_health_is_open_and_everything_else_needs_the_token(service):
-    assert httpx.get(service.url + "/health").json()["status"] == "ok"
+    assert http.get(service.url + "/health").json()["status"] == "ok"
     for path in ("/models", "/models/delta", "/openapi.json"):
-        r = httpx.get(service.url + path)
+        r = http.get(service.url + path)
         assert r.status_code == 401 and r.json()["error"] == "Unauthorized"
-    assert httpx.get(service.url + "/models", headers={"authorization": "Bearer wrong"}).status_code == 401
-    schema = httpx.get(service.url + "/openapi.json", headers=AUTH).json()
+    assert http.get(service.url + "/models", headers={"authorization": "Bearer wrong"}).status_code == 401
+    schema = http.get(service.url + "/openapi.json", headers=AUTH).json()
     assert {"/models", "/models/{model}/fk", "/models/{model}/preview"} <= set(schema["paths"])
 
 
@@ -70,7 +70,7 @@ def test_the_queries_answer_what_the_library_does(client, delta):
     cap = client.capability("delta", fk["q"][0], "twist")
     c = pkm.capability(delta, fk["q"][0], "twist")
     assert np.allclose(cap["along"][0], np.array(list(c.along.values())), rtol=1e-12) and cap["axes"] == ["x", "y", "z"]
-    raw = httpx.post(client.url + "/models/delta/fk", json={"qa": qa.tolist()}, headers=AUTH).json()  # JSON
+    raw = http.post(client.url + "/models/delta/fk", json={"qa": qa.tolist()}, headers=AUTH).json()  # JSON
     assert np.abs(np.array(raw["q"]) - fk["q"]).max() == 0.0
 
 
@@ -85,7 +85,7 @@ def test_a_failing_sample_does_not_fail_the_batch_but_fails_alone(client, servic
     assert out["failures"][0]["error"] in ("ConvergenceError", "UnreachableError")
     assert out["q"][1] is None and out["iterations"][1] is None and np.isfinite(out["q"][0]).all()
     assert isinstance(out["iterations"][0], int)
-    raw = httpx.post(service.url + "/models/delta/ik", json={"y": y}, headers=AUTH)
+    raw = http.post(service.url + "/models/delta/ik", json={"y": y}, headers=AUTH)
     assert raw.status_code == 200 and raw.json()["q"][1] is None and "nan" not in raw.text.lower()
     with pytest.raises(ServiceError) as e:
         client.ik("delta", y[1])
@@ -107,7 +107,7 @@ def test_uploads_are_content_addressed_kept_and_deleted(client, service, tmp_pat
     out = client.fk(entry["id"], [0.1, -0.1])
     mech = pkm.load(files[1])
     assert np.abs(out["y"][0] - pkm.TaskMap.of(mech).value(pkm.close_loops(mech, [0.1, -0.1]).q)).max() <= 1e-12
-    page = httpx.get(f"{client.url}/models/{entry['id']}/preview", headers=AUTH)
+    page = http.get(f"{client.url}/models/{entry['id']}/preview", headers=AUTH)
     assert page.status_code == 200 and "<html" in page.text.lower()
     again = Store(service_store(service))  # (a new service on the same folder serves it again)
     assert entry["id"] in {e.id for e in again.entries()}
@@ -136,7 +136,7 @@ def test_an_archive_is_its_files(client, service):
         link = tarfile.TarInfo("ankle.xml")
         link.type, link.linkname = tarfile.SYMTYPE, "/etc/passwd"
         t.addfile(link)
-    r = httpx.post(service.url + "/models", files=[("files", ("m.tgz", tar.getvalue()))], headers=AUTH)
+    r = http.post(service.url + "/models", files=[("files", ("m.tgz", tar.getvalue()))], headers=AUTH)
     assert r.status_code == 422 and "link" in r.json()["message"]
 
 
@@ -161,7 +161,7 @@ def test_an_uploaded_gepetto_robot_is_named_as_pkm_load_names_it(client, service
     assert client.upload({"anything.zip": buf.getvalue()})["id"] == entry["id"]
     assert client.upload({p.name: p.read_bytes() for p in paths}, folder="battobot_6d")["id"] == entry["id"]
     assert {e.id: e.name for e in Store(service_store(service)).entries()}[entry["id"]] == name
-    r = httpx.post(service.url + "/models", files=[("files", (p.name, p.read_bytes())) for p in paths],
+    r = http.post(service.url + "/models", files=[("files", (p.name, p.read_bytes())) for p in paths],
                    data={"folder": "../x"}, headers=AUTH)
     assert r.status_code == 422 and "folder" in r.text
 
@@ -179,7 +179,7 @@ def service_store(service) -> Path:
     ({"only.urdf": b"<robot name='r'><link name='a'/></robot>"}, 422, "spec"),
 ])
 def test_bad_uploads_are_refused(service, files, status, says, tmp_path):
-    r = httpx.post(service.url + "/models", files=[("files", (n, d)) for n, d in files.items()], headers=AUTH)
+    r = http.post(service.url + "/models", files=[("files", (n, d)) for n, d in files.items()], headers=AUTH)
     assert r.status_code == status, r.text
     assert says in r.json()["message"] and "Traceback" not in r.text
     assert not (tmp_path.parent / "evil.urdf").exists()
@@ -205,11 +205,11 @@ def test_bad_uploads_are_refused(service, files, status, says, tmp_path):
     ("/models/delta/fk", b"x" * (2**20 + 10), {}, 413),
 ])
 def test_bad_requests_are_4xx_with_their_message(service, path, body, headers, status):
-    r = httpx.post(service.url + path, content=body, headers={**AUTH, **headers})
+    r = http.post(service.url + path, content=body, headers={**AUTH, **headers})
     assert r.status_code == status, r.text
     answer = r.json()
     assert answer["message"] and set(answer) == {"error", "message", "data"} and "Traceback" not in r.text
-    assert httpx.get(service.url + "/health").status_code == 200  # (still answering)
+    assert http.get(service.url + "/health").status_code == 200  # (still answering)
 
 
 def test_the_stream_warm_starts_and_answers_bad_messages(client, service, delta):
@@ -277,14 +277,14 @@ def test_a_msgpack_answer_decodes_by_the_documented_layout_without_pkm(service, 
         return np.frombuffer(data, dtype=dtype).reshape(shape)
 
     qa = _path(delta, 2)
-    r = httpx.post(service.url + "/models/delta/fk", content=msgpack.packb({"qa": qa.tolist()}),
+    r = http.post(service.url + "/models/delta/fk", content=msgpack.packb({"qa": qa.tolist()}),
                    headers={**AUTH, "content-type": "application/msgpack", "accept": "application/msgpack"})
     answer = msgpack.unpackb(r.content, ext_hook=ext_hook)
     assert r.status_code == 200 and answer["q"].shape == (2, delta.nq) and answer["q"].dtype == np.dtype("<f8")
     q = pkm.close_loops(delta, qa[0], delta.q_reference).q
     assert np.abs(answer["q"][0] - q).max() <= 1e-10
     assert answer["iterations"].dtype.kind == "i"
-    schema = httpx.get(service.url + "/openapi.json", headers=AUTH).json()
+    schema = http.get(service.url + "/openapi.json", headers=AUTH).json()
     assert ND_LAYOUT in schema["info"]["description"] and ND_LAYOUT in json.dumps(schema["components"]["schemas"])
 
 
@@ -346,7 +346,7 @@ def test_jobs_run_apart_and_give_json_and_parquet(client, service, delta):
     wmap = pkm.workspace_map(delta, {"x": np.linspace(-0.1, 0.1, 7), "y": np.linspace(-0.05, 0.05, 5)}, {"z": -0.35})
     assert np.array_equal(result["reachable"], wmap.reachable) and result["nodes"] == wmap.nodes
     assert result["capability"]["units"]["x"] == "N" and result["capability"]["isotropic"]["N"].shape == (5, 7)
-    table = pq.read_table(io.BytesIO(httpx.get(f"{client.url}/jobs/{job['id']}/result", params={"format": "parquet"},
+    table = pq.read_table(io.BytesIO(http.get(f"{client.url}/jobs/{job['id']}/result", params={"format": "parquet"},
                                                headers=AUTH).content))
     assert table.num_rows == 35 and {"x", "y", "reachable", "ci_2", "isotropic [N]"} <= set(table.column_names)
     rrr3 = pkm.load("rrr3")
@@ -397,12 +397,12 @@ def test_a_sweep_job_is_pkm_sweep(client):
 
     job = client.job("delta", "sweep", grid={"R": "10cm:20cm:3"}, objectives=["condition"], scheduler="serial")
     result = client.result(job["id"])
-    answer = httpx.get(f"{client.url}/jobs/{job['id']}/result", headers=AUTH)
-    Checker(httpx.get(client.url + "/openapi.json", headers=AUTH).json())("job_result", answer)  # (its schema)
+    answer = http.get(f"{client.url}/jobs/{job['id']}/result", headers=AUTH)
+    Checker(http.get(client.url + "/openapi.json", headers=AUTH).json())("job_result", answer)  # (its schema)
     direct = sweeps.sweep("delta", sweeps.grid(R="10cm:20cm:3"), ["condition"], scheduler="serial", progress=False)
     assert result["designs"] == 3 and result["failed"] == 0
     assert np.allclose(result["rows"]["condition"], direct.table.column("condition").to_pylist(), rtol=1e-12)
-    table = pq.read_table(io.BytesIO(httpx.get(f"{client.url}/jobs/{job['id']}/result", params={"format": "parquet"},
+    table = pq.read_table(io.BytesIO(http.get(f"{client.url}/jobs/{job['id']}/result", params={"format": "parquet"},
                                                headers=AUTH).content))
     assert table.num_rows == 3 and "condition" in table.column_names
 
