@@ -1,7 +1,8 @@
 """Every Python block and every shell command line of the README and of the tour (``docs/tour/*.md``) runs, exactly
 as printed.
 
-Python blocks run one by one in a fresh interpreter, in a scratch directory. Shell lines run in
+Python blocks run one by one in a fresh process (``python -c`` as :mod:`tests.warm` forks it from a warm
+interpreter: the imports paid once), in a scratch directory. Shell lines run in
 bash, ``make`` lines in the checkout and ``pkm`` lines in the scratch directory, with the
 installed ``pkm`` first on ``PATH``; a line of nothing but ``pkm`` commands (joined by ``&&``, no other shell
 syntax) runs them as ``pkm`` would, in this process (:func:`tests.cli.helpers.run`; the installed script itself is
@@ -119,8 +120,8 @@ def test_the_readme_is_short_and_its_links_resolve():
 
 
 @pytest.mark.parametrize("code", PYTHON, ids=list(_python_ids()))
-def test_python_block_runs(code, tmp_path):
-    proc = bounded.run([sys.executable, "-c", code], cwd=tmp_path, env=_env(), cpu=300)
+def test_python_block_runs(code, tmp_path, zygote):
+    proc = zygote.run(code=code, cwd=tmp_path, env=_env(), cpu=300)
     assert proc.returncode == 0, f"block failed ({_PYTHON[code]}):\n{code}\n--- stderr:\n{proc.stderr[-3000:]}"
 
 
