@@ -8,8 +8,9 @@ be: its own session, working directory, environment, ``sys.argv``, ``sys.path[0]
 output in files; so a block still needs its own imports and leaves nothing behind for the next one. Its CPU time is
 bounded as :func:`tests.bounded.run` bounds a subprocess's: ended past ``cpu`` seconds of CPU of its process tree,
 or past ``idle`` seconds in which it used none (never a wall-clock timeout that a busy machine trips).
-Code that spawns processes of its own (a ``__main__`` guard: Dask's local workers) runs where it would: in a plain
-subprocess (:func:`tests.bounded.run`); so does code when ``/proc`` cannot be read.
+Processes the code spawns (Dask's local workers) start as they would from ``python -c``: a ``__main__`` without a
+file, which they do not import. Where ``/proc`` cannot be read, the code runs in a plain subprocess
+(:func:`tests.bounded.run`).
 """
 
 from __future__ import annotations
@@ -142,7 +143,7 @@ class Zygote:
         process's), as :func:`tests.bounded.run` runs it: ``returncode``, ``stdout``, ``stderr``."""
         env = dict(os.environ if env is None else env)
         args = [sys.executable, "-c", code] if script is None else [sys.executable, str(script)]
-        if (script is None and "__main__" in code) or not Path("/proc/self/stat").exists():
+        if not Path("/proc/self/stat").exists():
             from tests import bounded
 
             return bounded.run(args, cwd=cwd, env=env, cpu=cpu, idle=idle)
