@@ -56,6 +56,17 @@ def built():
 
 
 @pytest.fixture(scope="session")
+def zygote():
+    """:class:`tests.warm.Zygote`: Python blocks and example scripts each run in a fresh process forked from one warm
+    interpreter (its imports paid once a worker, not once a process), closed at the session's end."""
+    from tests.warm import Zygote
+
+    z = Zygote()
+    yield z
+    z.close()
+
+
+@pytest.fixture(scope="session")
 def all_actuated():
     """The toy five-bar with its elbows actuated too: no passive coordinate, the loop closure only a check that the
     actuated values close the loop (built with the warning that the elbows depend on the motors)."""

@@ -2,12 +2,9 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
-
-from tests import bounded
 
 EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "examples").glob("*.py"))
 
@@ -17,7 +14,8 @@ def test_there_are_examples():
 
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.name)
-def test_the_example_runs(script, tmp_path):
-    proc = bounded.run([sys.executable, str(script)], cwd=tmp_path, cpu=300)
+def test_the_example_runs(script, tmp_path, zygote):
+    """``python examples/X.py`` from a scratch directory (a process of its own, as :mod:`tests.warm` forks it)."""
+    proc = zygote.run(script=script, cwd=tmp_path, cpu=300)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip()

@@ -1,7 +1,8 @@
 """Every Python block and every shell command line of the README and of the tour (``docs/tour/*.md``) runs, exactly
 as printed.
 
-Python blocks run one by one in a fresh interpreter, in a scratch directory. Shell lines run in
+Python blocks run one by one in a fresh process (``python -c`` as :mod:`tests.warm` forks it from a warm
+interpreter: the imports paid once), in a scratch directory. Shell lines run in
 bash, ``make`` lines in the checkout and ``pkm`` lines in the scratch directory, with the
 installed ``pkm`` first on ``PATH``; a line of nothing but ``pkm`` commands (joined by ``&&``, no other shell
 syntax) runs them as ``pkm`` would, in this process (:func:`tests.cli.helpers.run`; the installed script itself is
@@ -14,8 +15,10 @@ fresh clone (.ci/run; a test holds that it does).
 
 from __future__ import annotations
 
+import itertools
 import os
 import re
+import shlex
 import signal
 import subprocess
 import sys
@@ -36,10 +39,26 @@ SELF = "make test"
 #: below holds that), not this suite (its report is 80 s of CPU, half the papers' figures, which tests/papers draw).
 CI_RUNS = "make demo"
 #: The ``pkm`` commands a line runs in bash even with nothing else of the shell's: ``pkm sweep`` starts a local
-#: Dask cluster of worker processes (and Dask's logging), ``pkm serve`` a service until stopped.
+#: Dask cluster of worker processes (and Dask's logging), ``pkm serve`` a service until stopped; but for
+#: :func:`_in_process`'s ``pkm sweep``.
 PROCESS_COMMANDS = ("sweep", "serve")
-#: The characters of a line of ``pkm`` commands that it can run in this process (none of the shell's syntax).
-PLAIN = re.compile(r"[\w\s=:,./+-]*")
+
+
+def _in_process(words: list[str]) -> bool:
+    """Whether ``pkm`` command ``words`` runs in this process: none of :data:`PROCESS_COMMANDS`, or a ``pkm sweep``
+    that starts no cluster (``--scheduler serial``: the designs in its own process; ``pkm sweep plot`` and ``pkm
+    sweep best``, which read a results file)."""
+    if len(words) < 2 or words[0] != "pkm":
+        return False
+    if words[1] != "sweep":
+        return words[1] not in PROCESS_COMMANDS
+    serial = "--scheduler=serial" in words or ("--scheduler", "serial") in itertools.pairwise(words)
+    return serial or words[2:3] in (["plot"], ["best"])
+
+
+#: The characters of a line of ``pkm`` commands that it can run in this process (none of the shell's syntax but
+#: quotes, which :func:`shlex.split` takes off as bash does).
+PLAIN = re.compile(r"[\w\s=:,./+\"'-]*")
 #: The README's size limit [bytes] (issue 42: what pkm is, the two commands, one example, links; the tour in docs/).
 README_MAX_BYTES = 12 * 1024
 
@@ -82,13 +101,12 @@ def _env() -> dict[str, str]:
 
 def _pkm_commands(command: str) -> list[list[str]] | None:
     """The words of each ``pkm`` command of a line that runs in this process (nothing but ``pkm`` commands joined by
-    ``&&``, none of :data:`PROCESS_COMMANDS`); None for a line that runs in bash."""
+    ``&&``, each :func:`_in_process`); None for a line that runs in bash."""
     parts = command.split("&&")
-    commands = [part.split() for part in parts]
-    if all(PLAIN.fullmatch(part) for part in parts) and all(
-            len(words) > 1 and words[0] == "pkm" and words[1] not in PROCESS_COMMANDS for words in commands):
-        return commands
-    return None
+    if not all(PLAIN.fullmatch(part) for part in parts):
+        return None
+    commands = [shlex.split(part) for part in parts]
+    return commands if all(_in_process(words) for words in commands) else None
 
 
 def test_the_pages_have_python_blocks_and_shell_lines():
@@ -119,8 +137,8 @@ def test_the_readme_is_short_and_its_links_resolve():
 
 
 @pytest.mark.parametrize("code", PYTHON, ids=list(_python_ids()))
-def test_python_block_runs(code, tmp_path):
-    proc = bounded.run([sys.executable, "-c", code], cwd=tmp_path, env=_env(), cpu=300)
+def test_python_block_runs(code, tmp_path, zygote):
+    proc = zygote.run(code=code, cwd=tmp_path, env=_env(), cpu=300)
     assert proc.returncode == 0, f"block failed ({_PYTHON[code]}):\n{code}\n--- stderr:\n{proc.stderr[-3000:]}"
 
 

@@ -27,7 +27,9 @@ What the libraries print on a worker's stdout and stderr (urdfdom's parser messa
 LAPACK's, loggers') goes to a temporary file, not to the run's stderr: each entry point reports how many of its
 calls printed (``output_calls``), how many lines (``output_lines``) and the start of the first (``output_example``).
 
-Time bounds: the whole run may take ``--total-seconds`` (default 2700: 45 minutes) plus at most one call's bound.
+Time bounds: the whole run may take ``--total-seconds`` (default 2700: 45 minutes; counted from when its workers
+are started, so that a slow fork of a large process on a busy machine spends none of it) plus at most one call's
+bound.
 Every entry point may spend (its calls' wall time, summed over its chunks) ``--entry-seconds`` if given, else its
 share of the total, re-divided whenever a chunk is handed out: the time left (``x --jobs``) plus what the entry
 points not finished have spent, divided equally among them. So the time a cheap entry point leaves unused goes to
@@ -299,7 +301,7 @@ def run(names: list[str], n: int, *, seed: int = 0, jobs: int = 1, timeout: floa
     os.dup2(2, 1)  # what C libraries print (LAPACK's "On entry to DLASCL...") must not mix with --json
     try:
         _run_tasks(tasks, totals, max(1, jobs), progress, len(names) * n, timeout + grace, entry_seconds,
-                   None if total_seconds is None else time.monotonic() + total_seconds)
+                   total_seconds)
     finally:
         sys.stdout.flush()
         os.dup2(saved_stdout, 1)
@@ -310,9 +312,10 @@ def run(names: list[str], n: int, *, seed: int = 0, jobs: int = 1, timeout: floa
 
 
 def _run_tasks(tasks: deque, totals: dict, jobs: int, progress: bool, calls: int, kill_after: float,
-               entry_seconds: float | None, deadline: float | None) -> None:
+               entry_seconds: float | None, total_seconds: float | None) -> None:
     """Hand the chunks to ``jobs`` workers; count every call; kill a worker whose call outlives ``kill_after``
-    and go on with the rest of its chunk in a new one; stop giving an entry (or anything) chunks past its bound."""
+    and go on with the rest of its chunk in a new one; stop giving an entry (or anything) chunks past its bound
+    (the run's: ``total_seconds`` after the workers are started)."""
     bar = None
     if progress:
         try:
@@ -322,6 +325,7 @@ def _run_tasks(tasks: deque, totals: dict, jobs: int, progress: bool, calls: int
             bar = None
     mp = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
     workers = [_Worker(mp) for _ in range(min(jobs, len(tasks)) or 1)]
+    deadline = None if total_seconds is None else time.monotonic() + total_seconds
     open_chunks = Counter(t[0] for t in tasks)  # an entry's chunks not finished (queued, waiting or running)
 
     def bounds(now: float) -> dict[str, tuple[float, str]]:

@@ -30,12 +30,29 @@ def serial_columns(res: maps.SweepResult) -> list[np.ndarray]:
             np.ma.filled(res.min_area_ci, np.nan)]
 
 
-def test_the_paper_sweep_on_two_local_workers_equals_the_serial_loop_exactly():
-    """The 1,000 designs of sec. VII on a 2-worker LocalCluster (the default path) give, bit for bit, what the
-    serial loop of pkm.mechanisms.rrr3.workspace.sweep gives; so does the paper module's own route."""
+@pytest.fixture(scope="module")
+def two_workers():
+    """A client of the 2-worker local cluster pkm.sweep starts without a scheduler (pkm.sweeps.engine.local_cluster:
+    its worker processes, allocator and Dask settings), started once for the tests that need real worker
+    processes: their start (each worker's imports, about 2 s of CPU) paid once, not once a test. Dask's retries set to
+    none (the scheduler reads the setting when it starts): a design that kills its worker fails at once."""
+    import dask
+    import dask.distributed  # (before the setting: _dask_settings)
+
+    from pkm.sweeps.engine import local_cluster
+
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), local_cluster(2) as cluster, \
+            dask.distributed.Client(cluster, set_as_default=False) as client:
+        yield client
+
+
+def test_the_paper_sweep_on_two_local_workers_equals_the_serial_loop_exactly(two_workers):
+    """The 1,000 designs of sec. VII on a 2-worker LocalCluster give, bit for bit, what the serial loop of
+    pkm.mechanisms.rrr3.workspace.sweep gives; so does the paper module's own route."""
     designs = paper.paper_sweep_designs()
     space = sweeps.table({k: [getattr(d, k) for d in designs] for k in ("a", "b", "h", "H")})
-    res = pkm.sweep("rrr3", space, COLUMNS, workers=2, progress=False)
+    two_workers.wait_for_workers(2, timeout=120)  # (a worker a test before ended is started again)
+    res = pkm.sweep("rrr3", space, COLUMNS, client=two_workers, progress=False)
     assert res.stats.workers == 2 and res.stats.chunks >= 2 * 16 and res.stats.failed == 0
     loop = maps.sweep(designs, step=0.04, progress=False)
     for name, expected in zip(("gci", "gci_area", "coverage", "min_area_ci"), serial_columns(loop)):
@@ -160,19 +177,16 @@ def area(design):
 '''
 
 
-def test_a_design_that_kills_its_worker_fails_alone(tmp_path):
+def test_a_design_that_kills_its_worker_fails_alone(tmp_path, two_workers):
     """On a 2-worker cluster, the design whose evaluation ends its worker process is recorded as failed
     (KilledWorker; Dask's retries set to none to keep the test short); the others of its chunk and every other
     chunk are evaluated, and the sweep's context survives the dead workers. (Two chunks of four, one such design in
     the first: two worker deaths, the chunk's and the design's retried alone, each a worker process started
     again.)"""
-    import dask
-    import dask.distributed  # (before the setting: _dask_settings)
-
     (tmp_path / "exit.py").write_text(EXIT, encoding="utf-8")
     space = sweeps.grid(a="30cm:60cm:2", h="5cm:20cm:4")
-    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
-        res = pkm.sweep("rrr3", space, [f"{tmp_path / 'exit.py'}:area"], workers=2, chunk_size=4, progress=False)
+    two_workers.wait_for_workers(2, timeout=120)
+    res = pkm.sweep("rrr3", space, [f"{tmp_path / 'exit.py'}:area"], client=two_workers, chunk_size=4, progress=False)
     h = res.column("h")
     failed = ~res.ok
     assert np.array_equal(failed, np.isclose(h, 0.10) & np.isclose(res.column("a"), 0.30))
