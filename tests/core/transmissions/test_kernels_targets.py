@@ -34,7 +34,7 @@ def test_c_jax_and_warp_agree_on_every_kernel():
 
     tk = knee()
     inputs = _inputs(tk, 32)
-    module = warp_module([tk.function(k) for k in KERNELS])  # (as pkm transmission writes it: one compile)
+    module = warp_module([tk.looped(k) for k in KERNELS])  # (as pkm transmission writes it: one compile)
     jitted: dict = {}
     for name, args in inputs.items():
         fun = tk.function(name)

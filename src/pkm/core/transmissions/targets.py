@@ -227,7 +227,7 @@ def write_transmission(tk: TransmissionKernels, directory: str | os.PathLike[str
     if "warp" in targets:
         from pkm.core.twin.warpgen import warp_source
 
-        files[f"{p}_warp.py"] = warp_source([tk.function(k) for k in KERNELS])
+        files[f"{p}_warp.py"] = warp_source([tk.looped(k) for k in KERNELS])
     description = {
         "format": "pkm.transmission/1", "name": tk.name, "prefix": p, "motors": list(tk.motors),
         "outputs": list(tk.outputs), "passive": [n for n in tk.mech.joints if n not in tk.drives + tk.outputs],
