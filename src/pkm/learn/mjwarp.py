@@ -9,7 +9,8 @@ step, four times per RK4 step) from MuJoCo Warp's control callback (``Model.call
 (:mod:`pkm.core.twin.warpgen`, float64) takes the outputs ``o``, ``ȯ`` and the motor torques ``τ_m`` and gives
 
 * the closed sub-mechanism's configuration ``q`` at ``o`` (the ``ik`` kernel's Newton iterations, warm-started from
-  the previous evaluation's ``q``; one copy of the Newton step in a loop: :func:`step_loop`), hence the motors' positions ``q_m``, and ``q̇_m = J⁻¹ ȯ``;
+  the previous evaluation's ``q``; one copy of the Newton step in a loop: :func:`step_loop`), hence the motors'
+  positions ``q_m``, and ``q̇_m = J⁻¹ ȯ``;
 * ``τ_o = J⁻ᵀ τ_m`` (the exact effort map at ``q``), ``ΔM(q)`` and ``Δh(q, ȯ)`` (the ``maps`` and ``delta``
   kernels);
 

@@ -17,9 +17,10 @@ constant maps and ``ΔM = Δh = 0``. The kernels (:data:`KERNELS`), each an SX f
   :meth:`TransmissionKernels.finish`: unrolled in the in-process C (:meth:`TransmissionKernels.function`), a loop
   over the one step in the exported C, in JAX and in Warp (:meth:`TransmissionKernels.looped`; the battobot ankle's C
   file 1.8 MB -> 0.5 MB, gcc -O2 four times faster; JAX's first jit of its fk 74 s -> 10 s; its Warp module
-  WARP_NUMBERS); each step the twin's sparse LU of the passive columns
-  (pivots fixed at the reference) or, with idle motions (a rod spinning between two balls), the least-norm step
-  (:meth:`TransmissionKernels._newton`), at most :data:`MAX_STEP` long. ``residual`` is the largest closure
+  1.94 MB -> 0.64 MB, its cold compile on Warp's CPU device 42-52 s -> 12-15 s of CPU, bit for bit the same
+  outputs); each step the twin's sparse LU of the passive columns (pivots fixed at the reference) or, with idle
+  motions (a rod spinning between two balls), the least-norm step (:meth:`TransmissionKernels._newton`), at most
+  :data:`MAX_STEP` long. ``residual`` is the largest closure
   residual at ``q_out`` [m, rad];
   ``status`` (:data:`STATUS`): 0 ``OK`` (``residual <= tol``, by default :data:`RTOL` times the characteristic
   length), 1 ``NOT_CONVERGED``, 2 ``SINGULAR`` (a pivot under :data:`~pkm.core.twin.kernels.PIVOT_FLOOR` relative to
@@ -328,8 +329,8 @@ class TransmissionKernels:
     @functools.cache  # noqa: B019  (one function per kernel for the life of the kernels)
     def function(self, kernel: str) -> cs.Function:
         """The CasADi SX function of ``kernel`` (:data:`KERNELS`), dense, after CSE; a solve's (:data:`SOLVES`) is its
-        :meth:`step` unrolled :attr:`iterations` times and its :meth:`finish`, the parts the exported C, JAX and Warp loop
-        over. Its name is ``<name>_<kernel>`` (C identifiers)."""
+        :meth:`step` unrolled :attr:`iterations` times and its :meth:`finish`, the parts the exported C, JAX and Warp
+        (:meth:`looped`) loop over. Its name is ``<name>_<kernel>`` (C identifiers)."""
         if kernel not in KERNELS:
             raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", kernel)
         if kernel in SOLVES:  # (iterations of the step unrolled: no branch, one instruction list)
