@@ -72,7 +72,7 @@ def check(t, jax_on: bool, warp_on: bool) -> dict:
 
         wp.config.log_level = wp.LOG_WARNING
         t0 = time.perf_counter()
-        module = warp_module([tk.function(n) for n in KERNELS])
+        module = warp_module([tk.looped(n) for n in KERNELS])
         out["warp_vs_c"] = {n: max(float(np.abs(x - y).max()) for x, y in
                                    zip(launch(getattr(module, tk.function(n).name()), tk.function(n), *a), c[n]))
                             for n, a in inputs.items()}

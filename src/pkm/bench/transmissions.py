@@ -128,7 +128,7 @@ def run(args) -> dict:
 
         wp.config.log_level = wp.LOG_WARNING  # (Warp prints its start to stdout: --json)
         t0 = time.perf_counter()  # (the module of every kernel, as pkm transmission writes it)
-        kern = getattr(warp_module([tk.function(k) for k in KERNELS]), fun.name())
+        kern = getattr(warp_module([tk.looped(k) for k in KERNELS]), fun.name())
         ins: list = [wp.array(np.ascontiguousarray(a.T), dtype=wp.float64, device="cpu") for a in (Q0, QM)]
         outs_w = [wp.zeros((fun.nnz_out(j), n), dtype=wp.float64, device="cpu") for j in range(fun.n_out())]
         wp.launch(kern, dim=n, inputs=ins, outputs=outs_w, device="cpu")

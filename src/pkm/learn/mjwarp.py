@@ -9,7 +9,8 @@ step, four times per RK4 step) from MuJoCo Warp's control callback (``Model.call
 (:mod:`pkm.core.twin.warpgen`, float64) takes the outputs ``o``, ``ȯ`` and the motor torques ``τ_m`` and gives
 
 * the closed sub-mechanism's configuration ``q`` at ``o`` (the ``ik`` kernel's Newton iterations, warm-started from
-  the previous evaluation's ``q``), hence the motors' positions ``q_m``, and ``q̇_m = J⁻¹ ȯ``;
+  the previous evaluation's ``q``; one copy of the Newton step in a loop: :func:`step_loop`), hence the motors'
+  positions ``q_m``, and ``q̇_m = J⁻¹ ȯ``;
 * ``τ_o = J⁻ᵀ τ_m`` (the exact effort map at ``q``), ``ΔM(q)`` and ``Δh(q, ȯ)`` (the ``maps`` and ``delta``
   kernels);
 
@@ -69,6 +70,7 @@ from pkm.core.transmissions.kernels import STATUS, TransmissionKernels, c_identi
 from pkm.core.transmissions.serial import SerialEquivalent, serial_equivalent
 from pkm.core.transmissions.transmission import Transmission
 from pkm.core.twin.kernels import PIVOT_FLOOR
+from pkm.core.twin.warpgen import Loop
 from pkm.errors import InvalidInputError, TransmissionError, UnknownNameError
 
 #: What :func:`require` names when MuJoCo Warp is missing.
@@ -86,19 +88,37 @@ def step_function(tk: TransmissionKernels) -> cs.Function:
     qm, qdm, tau_o, dM, dh, residual, status)``: ``ik`` at ``qo`` warm-started from ``q``, then at its solution
     ``q̇_m = J⁻¹ ȯ``, ``τ_o = J⁻ᵀ τ_m`` (``maps``), ``ΔM``, ``Δh`` (``delta``; matrices column-major); ``status`` is
     ``ik``'s (:data:`~pkm.core.transmissions.kernels.STATUS`), ``SINGULAR`` where ``maps``' or ``delta``'s pivot is
-    under the floor."""
+    under the floor. Its Newton iterations unrolled: the kernel Warp runs is :func:`step_loop`'s, the same outputs."""
+    q, qo = cs.SX.sym("q", tk.mech.nq), cs.SX.sym("qo", tk.k)
+    qdo, tau_m = cs.SX.sym("qdo", tk.k), cs.SX.sym("tau_m", tk.k)
+    return cs.Function(f"{c_identifier(tk.name)}_mjwarp_step", [q, qo, qdo, tau_m],
+                       _at_solution(tk, tk.function("ik")(q, qo), qdo, tau_m), ["q", "qo", "qdo", "tau_m"],
+                       list(OUTPUTS))
+
+
+def step_loop(tk: TransmissionKernels) -> Loop:
+    """:func:`step_function` as Warp runs it (:class:`~pkm.core.twin.warpgen.Loop`): ``ik``'s Newton step
+    (:meth:`~pkm.core.transmissions.kernels.TransmissionKernels.step`) in a loop, then ``ik``'s finish and the maps
+    at its solution, ``(q, pivot, qdo, tau_m) -> outputs``: one copy of the step in the kernel's source."""
+    q, pivot = cs.SX.sym("q", tk.mech.nq), cs.SX.sym("pivot")
+    qdo, tau_m = cs.SX.sym("qdo", tk.k), cs.SX.sym("tau_m", tk.k)
+    name = f"{c_identifier(tk.name)}_mjwarp_step"
+    finish = cs.Function(f"{name}_finish", [q, pivot, qdo, tau_m],
+                         _at_solution(tk, tk.finish("ik")(q, pivot), qdo, tau_m), ["q", "pivot", "qdo", "tau_m"],
+                         list(OUTPUTS))
+    return Loop(name, tk.step("o"), finish, tk.iterations)
+
+
+def _at_solution(tk: TransmissionKernels, ik: Any, qdo: cs.SX, tau_m: cs.SX) -> list[cs.SX]:
+    """:data:`OUTPUTS` from ``ik``'s outputs ``(q_out, qm, status, residual)``, after CSE (:func:`step_function`)."""
     k = tk.k
-    q, qo = cs.SX.sym("q", tk.mech.nq), cs.SX.sym("qo", k)
-    qdo, tau_m = cs.SX.sym("qdo", k), cs.SX.sym("tau_m", k)
-    q_out, qm, status, residual = tk.function("ik")(q, qo)
+    q_out, qm, status, residual = ik
     _, J_inv, p_maps = tk.function("maps")(q_out)
     dM, dh, p_delta = tk.function("delta")(q_out, qdo)
     J_inv = cs.reshape(J_inv, k, k)  # (column-major nonzeros: q̇_m = J⁻¹ ȯ)
     status = cs.if_else(cs.fmin(p_maps, p_delta) < PIVOT_FLOOR, float(STATUS.index("SINGULAR")), status)
-    values = cs.cse([cs.densify(cs.SX(e)) for e in (q_out, qm, J_inv @ qdo, J_inv.T @ tau_m, dM, dh, residual,
-                                                    status)])
-    return cs.Function(f"{c_identifier(tk.name)}_mjwarp_step", [q, qo, qdo, tau_m], values,
-                       ["q", "qo", "qdo", "tau_m"], list(OUTPUTS))
+    return cs.cse([cs.densify(cs.SX(e)) for e in (q_out, qm, J_inv @ qdo, J_inv.T @ tau_m, dM, dh, residual,
+                                                   status)])
 
 
 @functools.cache
@@ -166,7 +186,7 @@ class _Unit:
 
         self.t = t
         self.tk = TransmissionKernels.of(t)
-        self.fun = step_function(self.tk)
+        self.fun = step_loop(self.tk)
         self.kernel = warp_kernel(self.fun)
         self.qadr = np.array([mjm.jnt_qposadr[j] for j in ids], dtype=np.int32)
         self.dadr = np.array([mjm.jnt_dofadr[j] for j in ids], dtype=np.int32)
@@ -457,4 +477,4 @@ class TransmissionWorlds:
         return self.units[i].q.numpy().T.copy()
 
 
-__all__ = ["INTEGRATORS", "OUTPUTS", "STAGES", "TransmissionWorlds", "step_function"]
+__all__ = ["INTEGRATORS", "OUTPUTS", "STAGES", "TransmissionWorlds", "step_function", "step_loop"]

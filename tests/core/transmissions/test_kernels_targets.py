@@ -30,11 +30,15 @@ def _inputs(tk, n: int) -> dict[str, list[np.ndarray]]:
 def test_c_jax_and_warp_agree_on_every_kernel():
     jax = pytest.importorskip("jax")
     wp = pytest.importorskip("warp")
-    from pkm.core.twin.warpgen import warp_module
+    from pkm.core.twin.warpgen import warp_module, warp_source
 
     tk = knee()
     inputs = _inputs(tk, 32)
-    module = warp_module([tk.function(k) for k in KERNELS])  # (as pkm transmission writes it: one compile)
+    module = warp_module([tk.looped(k) for k in KERNELS])  # (as pkm transmission writes it: one compile)
+    for name, twin in (("fk", "m"), ("ik", "o")):  # (a solve holds one copy of its Newton step, in a loop)
+        lines = warp_source(tk.looped(name)).count("\n")
+        assert lines <= tk.step(twin).n_instructions() + tk.finish(name).n_instructions() + 3 * tk.mech.nq + 20
+        assert warp_source(tk.function(name)).count("\n") > 2 * lines  # (unrolled: 8 copies)
     jitted: dict = {}
     for name, args in inputs.items():
         fun = tk.function(name)

@@ -14,11 +14,13 @@ constant maps and ``ΔM = Δh = 0``. The kernels (:data:`KERNELS`), each an SX f
 * ``fk`` ``(q, qm) -> (q_out, qo, status, residual)``: motors to outputs. Newton on the closure with the motors set
   to ``qm``, warm-started from ``q`` (the previous solution), :data:`ITERATIONS` iterations of one step
   (:meth:`TransmissionKernels.step`; no branch: the same instructions for every sample and every GPU thread), then
-  :meth:`TransmissionKernels.finish`: unrolled in the in-process C and in Warp (:meth:`TransmissionKernels.function`),
-  a loop over the one step in the exported C and in JAX (the battobot ankle's C file 1.8 MB -> 0.5 MB, gcc -O2 four
-  times faster; JAX's first jit of its fk 74 s -> 10 s); each step the twin's sparse LU of the passive columns
-  (pivots fixed at the reference) or, with idle motions (a rod spinning between two balls), the least-norm step
-  (:meth:`TransmissionKernels._newton`), at most :data:`MAX_STEP` long. ``residual`` is the largest closure
+  :meth:`TransmissionKernels.finish`: unrolled in the in-process C (:meth:`TransmissionKernels.function`), a loop
+  over the one step in the exported C, in JAX and in Warp (:meth:`TransmissionKernels.looped`; the battobot ankle's C
+  file 1.8 MB -> 0.5 MB, gcc -O2 four times faster; JAX's first jit of its fk 74 s -> 10 s; its Warp module
+  1.94 MB -> 0.64 MB, its cold compile on Warp's CPU device 42-52 s -> 12-15 s of CPU, bit for bit the same
+  outputs); each step the twin's sparse LU of the passive columns (pivots fixed at the reference) or, with idle
+  motions (a rod spinning between two balls), the least-norm step (:meth:`TransmissionKernels._newton`), at most
+  :data:`MAX_STEP` long. ``residual`` is the largest closure
   residual at ``q_out`` [m, rad];
   ``status`` (:data:`STATUS`): 0 ``OK`` (``residual <= tol``, by default :data:`RTOL` times the characteristic
   length), 1 ``NOT_CONVERGED``, 2 ``SINGULAR`` (a pivot under :data:`~pkm.core.twin.kernels.PIVOT_FLOOR` relative to
@@ -75,10 +77,11 @@ from pkm.core.twin.dynamics import ActuatorTwin, cholesky, cholesky_solve
 from pkm.core.twin.kernels import PIVOT_FLOOR
 from pkm.core.twin.spatial import Expr
 from pkm.core.twin.tree import Twin
+from pkm.core.twin.warpgen import Loop
 from pkm.errors import InvalidInputError, SpecError, TransmissionError
 from pkm.validation import as_array, as_count, as_tolerance
 
-#: Newton iterations unrolled in ``fk`` and ``ik``: on the humanoid ankle, 3 reach 1e-12 from a warm start 0.01 rad
+#: Newton iterations of ``fk`` and ``ik``: on the humanoid ankle, 3 reach 1e-12 from a warm start 0.01 rad
 #: away (a controller's previous solution: 2 do not), 5 from the reference over ±0.25 rad of both motors (4 do not,
 #: for 15% of the samples: ``NOT_CONVERGED``); 8 leave a margin.
 ITERATIONS = 8
@@ -122,7 +125,7 @@ class TransmissionKernels:
         mech: The closed sub-mechanism, its actuated joints the motors.
         outputs: The output joints (as many as motors; one-coordinate joints of ``mech``).
         name: The transmission's name (default the mechanism's): C names, files.
-        iterations: Newton iterations unrolled in ``fk`` and ``ik``.
+        iterations: Newton iterations of ``fk`` and ``ik``.
         tol: Convergence tolerance of ``fk`` and ``ik`` on the largest closure residual [m, rad] (default :data:`RTOL`
             times the sub-mechanism's characteristic length).
 
@@ -230,7 +233,7 @@ class TransmissionKernels:
         """One Newton iteration of the closure with the motors (``twin="m"``: ``fk``'s) or the outputs (``"o"``:
         ``ik``'s) held at ``target``: ``(q, qm or qo) -> (q_next, pivot)``, the held coordinates of ``q`` set to
         the target first (:meth:`_newton`), after CSE. The targets unroll it :attr:`iterations` times (the in-process
-        C, Warp: :meth:`function`) or loop over it (the exported C, JAX)."""
+        C: :meth:`function`) or loop over it (the exported C, JAX, Warp: :meth:`looped`)."""
         at = {"m": self._twin_m, "o": self._twin_o}[twin]
         tw = at.tw
         q, target = cs.SX.sym("q", tw.mech.nq), cs.SX.sym("target", self.k)
@@ -326,8 +329,8 @@ class TransmissionKernels:
     @functools.cache  # noqa: B019  (one function per kernel for the life of the kernels)
     def function(self, kernel: str) -> cs.Function:
         """The CasADi SX function of ``kernel`` (:data:`KERNELS`), dense, after CSE; a solve's (:data:`SOLVES`) is its
-        :meth:`step` unrolled :attr:`iterations` times and its :meth:`finish`, the parts the exported C and JAX loop
-        over. Its name is ``<name>_<kernel>`` (C identifiers)."""
+        :meth:`step` unrolled :attr:`iterations` times and its :meth:`finish`, the parts the exported C, JAX and Warp
+        (:meth:`looped`) loop over. Its name is ``<name>_<kernel>`` (C identifiers)."""
         if kernel not in KERNELS:
             raise InvalidInputError("kernel", f"use one of {sorted(KERNELS)}", kernel)
         if kernel in SOLVES:  # (iterations of the step unrolled: no branch, one instruction list)
@@ -432,15 +435,26 @@ class TransmissionKernels:
 
         return jax.jit(run)
 
+    def looped(self, kernel: str) -> cs.Function | Loop:
+        """``kernel`` as Warp writes it: a solve (:data:`SOLVES`) as a :class:`~pkm.core.twin.warpgen.Loop` over its
+        :meth:`step` then its :meth:`finish` (one copy of the step in the source: the battobot ankle's Warp module
+        5x smaller), the others their :meth:`function`. The same outputs as :meth:`function`'s, instruction for
+        instruction."""
+        fun = self.function(kernel)  # (an unknown kernel refused; the stages built once)
+        if kernel not in SOLVES:
+            return fun
+        return Loop(fun.name(), self.step("o" if kernel == "ik" else "m"), self.finish(kernel), self.iterations)
+
     def warp(self, kernel: str, directory: str | os.PathLike[str] | None = None) -> object:
-        """``kernel`` as a Warp kernel (:func:`pkm.core.twin.warpgen.warp_kernel`).
+        """``kernel`` as a Warp kernel (:func:`pkm.core.twin.warpgen.warp_kernel` of :meth:`looped`: a solve loops
+        over its Newton step).
 
         Raises:
             MissingDependencyError: Warp is not installed (``pip install "pkm-robotics[warp]"``).
         """
         from pkm.core.twin.warpgen import warp_kernel
 
-        return warp_kernel(self.function(kernel), directory)
+        return warp_kernel(self.looped(kernel), directory)
 
 
 #: The kernels that solve the closure (Newton from a warm start): :meth:`TransmissionKernels.step` iterated, then

@@ -12,7 +12,8 @@ ros2_control's ``transmission_interface::Transmission``, a JAX module and a Warp
   :meth:`~pkm.core.transmissions.kernels.TransmissionKernels.jax` runs them (its Newton step in a loop,
   differentiated at the solution: :data:`~pkm.core.transmissions.kernels.JAX_RUNTIME`);
 * ``p_warp.py`` (target ``warp``): each kernel as a ``@wp.kernel`` (:func:`pkm.core.twin.warpgen.warp_source`,
-  structure-of-arrays, one thread a sample);
+  structure-of-arrays, one thread a sample; the solves' Newton step in a loop:
+  :meth:`~pkm.core.transmissions.kernels.TransmissionKernels.looped`);
 * ``transmission.json``: names, sizes, the reference configuration, the kernels' inputs and outputs, the status
   codes; ``README.md``: the kernels' conventions and the ros2_control recipe.
 """
@@ -227,7 +228,7 @@ def write_transmission(tk: TransmissionKernels, directory: str | os.PathLike[str
     if "warp" in targets:
         from pkm.core.twin.warpgen import warp_source
 
-        files[f"{p}_warp.py"] = warp_source([tk.function(k) for k in KERNELS])
+        files[f"{p}_warp.py"] = warp_source([tk.looped(k) for k in KERNELS])
     description = {
         "format": "pkm.transmission/1", "name": tk.name, "prefix": p, "motors": list(tk.motors),
         "outputs": list(tk.outputs), "passive": [n for n in tk.mech.joints if n not in tk.drives + tk.outputs],
