@@ -67,6 +67,28 @@ def pseudo_inertia(theta10: ArrayLike) -> np.ndarray:
     return J
 
 
+def _projected(theta: np.ndarray, n_bodies: int, n_body: int, na: int) -> np.ndarray:
+    """``theta`` with every body's pseudo-inertia projected onto the positive semidefinite cone (its negative
+    eigenvalues set to zero: the nearest consistent body in the Frobenius norm) and every drive's inertia and
+    friction clipped at zero. Clarabel meets the constraints to its tolerance only: a massless body (the Delta's
+    guides) came out at -3e-11 kg, a mass no file holds (the URDF reader refuses it); the projection moves the
+    parameters by as little, and the mass it gives, a sum of non-negative terms, is never negative."""
+    out = theta.copy()
+    for b in range(n_bodies):
+        lam, V = np.linalg.eigh(pseudo_inertia(theta[10 * b:10 * b + 10]))
+        if lam.min() >= 0.0:
+            continue
+        J = (V * np.maximum(lam, 0.0)) @ V.T
+        sigma = J[:3, :3]
+        inertia = np.trace(sigma) * np.eye(3) - sigma  # (Σ = ½ tr(Ī) 1 - Ī, so tr Σ = ½ tr Ī)
+        out[10 * b:10 * b + 10] = (J[3, 3], *J[:3, 3], inertia[0, 0], inertia[0, 1], inertia[1, 1], inertia[0, 2],
+                                   inertia[1, 2], inertia[2, 2])
+    for i in range(na):
+        k = n_body + 4 * i
+        out[k:k + 3] = np.maximum(out[k:k + 3], 0.0)
+    return out
+
+
 @dataclass(frozen=True)
 class ConsistentEstimate:
     """A physically consistent estimate (module doc).
@@ -75,7 +97,7 @@ class ConsistentEstimate:
         theta: Every standard parameter (:func:`pkm.parameters`' order).
         base_values: ``P θ``: the base parameters it implies (comparable with least squares').
         smallest_eigenvalue: The smallest eigenvalue of every body's pseudo-inertia [kg m^2 or kg]: ``≥ 0`` up to
-            the solver's tolerance.
+            rounding (the solver's answer is projected onto the constraints: :func:`_projected`).
         residual_rms: Each actuator's residual RMS on the data [N m, N].
         least_squares: The least-squares estimate it started from (its weights used).
         status: The solver's status.
@@ -156,7 +178,7 @@ def consistent_estimate(mech: Mechanism, Q: ArrayLike, QD: ArrayLike, QDD: Array
         raise ConvergenceError(f"{what} (Clarabel: {exc})", float("nan"), 0, 0.0) from None
     if problem.status not in ("optimal", "optimal_inaccurate") or theta.value is None:
         raise ConvergenceError(f"{what} (Clarabel's status: {problem.status})", float("nan"), 0, 0.0)
-    th = np.asarray(theta.value, dtype=float)
+    th = _projected(np.asarray(theta.value, dtype=float), len(P.bodies), P.n_body, mech.na)
     smallest = min(float(np.linalg.eigvalsh(pseudo_inertia(th[10 * b:10 * b + 10])).min())
                    for b in range(len(P.bodies)))
     s = _scale(float(np.abs(TAU_).max()))  # (the residuals' squares overflow beyond 1e154: taken divided by s)

@@ -60,6 +60,13 @@ def _inertial(link: etree._Element, inertia: pin.Inertia) -> None:
                      iyy=repr(float(I[1, 1])), iyz=repr(float(I[1, 2])), izz=repr(float(I[2, 2])))
 
 
+#: A body of zero mass whose other parameters are all within this fraction of the largest body parameter is written
+#: massless: the consistent estimate of a massless body (zero mass once projected, and moments of inertia at the
+#: solver's tolerance, Clarabel's 1e-8: 1.4e-9 kg m^2 on the Delta's guides against a largest parameter of 0.2, 7e-9
+#: of it), which no body of zero mass can hold.
+MASSLESS = 1e-7
+
+
 def identified_mechanism(mech: Mechanism, theta: ArrayLike, source: str | None = None) -> Mechanism:
     """A copy of ``mech`` whose bodies and drives carry the standard parameters ``theta`` (module doc); ``source``
     names it in its warnings and notes (default ``"the model identified from <mech's source>"``: the identified
@@ -67,8 +74,8 @@ def identified_mechanism(mech: Mechanism, theta: ArrayLike, source: str | None =
 
     Raises:
         InvalidInputError: ``theta`` of the wrong length or not finite; a body with a non-positive mass but other
-            parameters not zero (no link can hold it: estimate it physically consistent instead); a mechanism
-            without URDF text.
+            parameters not zero (beyond :data:`MASSLESS`: no link can hold it; estimate it physically consistent
+            instead); a mechanism without URDF text.
     """
     import pkm
     from pkm.core.model.builder import from_strings
@@ -83,6 +90,7 @@ def identified_mechanism(mech: Mechanism, theta: ArrayLike, source: str | None =
     root = etree.fromstring(mech.urdf.encode(), etree.XMLParser(resolve_entities=False, no_network=True))
     links = {el.get("name"): el for el in root.findall("link")}
     model = mech.model
+    scale = float(np.abs(th[:P.n_body]).max(initial=0.0))
     for b, name in enumerate(P.bodies):
         t = th[10 * b:10 * b + 10]
         j = b + 1
@@ -90,7 +98,9 @@ def identified_mechanism(mech: Mechanism, theta: ArrayLike, source: str | None =
         for f in frames[1:]:  # (merged links: the body holds them already)
             for old in links[f.name].findall("inertial") if f.name in links else []:
                 links[f.name].remove(old)
-        if not np.any(t):
+        if not np.any(t) or (t[0] == 0.0 and np.abs(t).max() <= MASSLESS * scale):  # (massless: no <inertial>)
+            for old in links[name].findall("inertial") if name in links else []:
+                links[name].remove(old)
             continue
         if t[0] <= 0.0:
             raise InvalidInputError("theta", f"body {name!r}: mass {t[0]:.6g} kg is not positive (write a physically "
