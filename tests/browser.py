@@ -216,4 +216,24 @@ class OfflineBrowser:
                 break
             if self.proc.poll() is None:
                 self.proc.wait(timeout=30)
+            if not _running_in_group(self.proc.pid):  # (zombies only: nothing writes any more; waited 5 s before)
+                break
             time.sleep(0.05)
+
+
+def _running_in_group(pgid: int) -> bool:
+    """Whether a process of group ``pgid`` other than a zombie is left (Linux's ``/proc``; elsewhere True, so that the
+    caller waits out its deadline as before)."""
+    if not os.path.isdir("/proc/self"):
+        return True
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat") as fh:
+                fields = fh.read().rsplit(")", 1)[1].split()  # (after the command name, which may hold spaces)
+        except OSError:
+            continue
+        if int(fields[2]) == pgid and fields[0] != "Z":  # (fields: state, ppid, pgrp, ...)
+            return True
+    return False
