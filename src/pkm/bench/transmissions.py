@@ -3,8 +3,9 @@
 
 The samples: motor positions uniform in ±0.25 rad around the reference, each warm-started from its solution a
 1 kHz tick earlier (the motors 0.01 rad away: what a controller or a batch of simulated robots gives the kernel);
-the fused kernel ``fk_j_dm`` (:mod:`pkm.core.transmissions.kernels`, ``--iterations`` Newton iterations unrolled:
-3 by default, enough from such a warm start; the statuses are counted) on each target, µs a sample:
+the fused kernel ``fk_j_dm`` (:mod:`pkm.core.transmissions.kernels`, ``--iterations`` Newton iterations, unrolled in
+the C, looped in JAX and Warp: 3 by default, enough from such a warm start; the statuses are counted) on each
+target, µs a sample:
 
 * ``c_vector``: the generated C in process, its vector driver (:mod:`pkm.core.twin.simd`, several samples a vector
   instruction), on one core (``--threads``);
@@ -47,7 +48,7 @@ def add_arguments(ap) -> None:
     ap.add_argument("--calls", type=int, default=200, help="samples of the Python baseline")
     ap.add_argument("--threads", type=int, default=1, help="cores of the C batches (default 1)")
     ap.add_argument("--iterations", type=int, default=3,
-                    help="Newton iterations unrolled (default 3: enough from a warm start a tick away; the statuses "
+                    help="Newton iterations (unrolled in the C; default 3: enough from a warm start a tick away; the statuses "
                          "are counted)")
     ap.add_argument("--mechanism", choices=sorted(MECHANISMS), default="ankle",
                     help="the transmission (default the ankle; --quick: the knee)")

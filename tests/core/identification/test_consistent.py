@@ -138,16 +138,18 @@ def test_a_solution_a_hair_outside_the_constraints_is_projected_onto_them():
 
 
 def test_a_body_of_zero_mass_with_moments_at_the_solver_tolerance_is_written_massless():
-    """A consistent estimate gives a massless body zero mass and moments of inertia at the solver's tolerance (the
-    Delta's guides: 1.4e-9 kg m^2, 7e-9 of the largest parameter); written, it is massless. Moments 1e-3 of the
-    largest are a body no link can hold: refused, naming it."""
+    """A consistent estimate gives a massless body a mass of about 1e-16 kg once projected and moments of inertia at
+    the solver's tolerance (the Delta's guides: 1.4e-9 kg m^2, 7e-9 of the largest parameter); written, it is
+    massless (not a body whose centre of mass lies 100 m away). Moments 1e-3 of the largest, with no mass, are a body
+    no link can hold: refused, naming it."""
     mech = mechanism("delta")
     P = parameters(mech)
     b = P.bodies.index("guide_x")
     theta = P.values.copy()
-    theta[10 * b:10 * b + 10] = [0.0, 0.0, 0.0, 0.0, 1.4e-9, 0.0, 1.4e-9, 0.0, 0.0, 1.4e-9]
+    theta[10 * b:10 * b + 10] = [6.6e-17, 8e-15, 0.0, -1.7e-14, 1.4e-9, 0.0, 1.4e-9, 0.0, 0.0, 1.4e-9]
     back = parameters(identified_mechanism(mech, theta))
     assert not np.any(back.values[10 * b:10 * b + 10]) and back.values[0] == P.values[0]
+    theta[10 * b] = 0.0
     theta[10 * b + 4] = 1e-3 * np.abs(P.values[:P.n_body]).max()
     with pytest.raises(InvalidInputError, match="guide_x"):
         identified_mechanism(mech, theta)

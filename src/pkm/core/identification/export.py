@@ -60,9 +60,9 @@ def _inertial(link: etree._Element, inertia: pin.Inertia) -> None:
                      iyy=repr(float(I[1, 1])), iyz=repr(float(I[1, 2])), izz=repr(float(I[2, 2])))
 
 
-#: A body of zero mass whose other parameters are all within this fraction of the largest body parameter is written
-#: massless: the consistent estimate of a massless body (zero mass once projected, and moments of inertia at the
-#: solver's tolerance, Clarabel's 1e-8: 1.4e-9 kg m^2 on the Delta's guides against a largest parameter of 0.2, 7e-9
+#: A body whose ten parameters, its mass included, are all within this fraction of the largest body parameter is
+#: written massless: the consistent estimate of a massless body (a mass of 1e-16 kg once projected, its first moment
+#: as small and its moments of inertia at the solver's tolerance, Clarabel's 1e-8: 1.4e-9 kg m^2 on the Delta's guides against a largest parameter of 0.2, 7e-9
 #: of it), which no body of zero mass can hold.
 MASSLESS = 1e-7
 
@@ -98,7 +98,7 @@ def identified_mechanism(mech: Mechanism, theta: ArrayLike, source: str | None =
         for f in frames[1:]:  # (merged links: the body holds them already)
             for old in links[f.name].findall("inertial") if f.name in links else []:
                 links[f.name].remove(old)
-        if not np.any(t) or (t[0] == 0.0 and np.abs(t).max() <= MASSLESS * scale):  # (massless: no <inertial>)
+        if np.abs(t).max() <= MASSLESS * scale:  # (massless, the mass too: no <inertial>)
             for old in links[name].findall("inertial") if name in links else []:
                 links[name].remove(old)
             continue

@@ -382,8 +382,6 @@ class Twin:
         lu = self.passive_lu  # (idle motions refused)
         if not self.mech.dependent_actuators:
             return lu
-        from pkm.core.model.scale import JacobianScales
-
         sc, pv = JacobianScales.of(self.mech), self.mech.passive_v
         Jp = self.closure_rows["jacobian"][:, pv.tolist()]
         return HomogenisedPinv(Jp, self.at_reference(Jp), sc.constraint_rows, sc.columns[pv])
