@@ -296,7 +296,6 @@ class CalibrationModel:
         x, M = self.vector(x), self._readings(readings)
         Q = np.array(self.seeds(M) if seeds is None else seeds, dtype=float, copy=True)
         model = self.mech.model
-        tol = CLOSURE_TOL
         scales = JacobianScales.of(self.mech)  # (per row: a length over L, an angle in rad)
         w = np.concatenate([scales.closure_residual, 1.0 / scales.actuated])[:, None]
         f = self._map("close", len(M))
@@ -304,7 +303,7 @@ class CalibrationModel:
         for _ in range(MAX_NEWTON):
             g = np.array(g).T  # (n, rows)
             worst = np.max(np.abs(g * w.T), axis=1)
-            if np.all(worst < tol):
+            if np.all(worst < CLOSURE_TOL):
                 return Q, worst
             G = np.array(Gq).reshape(g.shape[1], len(M), -1).transpose(1, 0, 2)
             dq = -np.einsum("kij,kj->ki", np.linalg.pinv(G), g)
@@ -312,7 +311,7 @@ class CalibrationModel:
             for _ in range(8):  # (halved where the residual grows: a pose far from its seed)
                 new = np.array([pin.integrate(model, q, t * d) for q, d, t in zip(Q, dq, step)])
                 g_new, Gq_new = f(new.T, M.T, x)
-                grew = np.max(np.abs(np.array(g_new) * w), axis=0) > np.maximum(worst, tol)
+                grew = np.max(np.abs(np.array(g_new) * w), axis=0) > np.maximum(worst, CLOSURE_TOL)
                 if not grew.any():
                     break
                 step[grew] *= 0.5

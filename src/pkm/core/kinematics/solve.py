@@ -810,9 +810,8 @@ def _assembly_metric(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, np.nda
     """:func:`assemble`'s scale-free metric from its start ``q``: per closure row, ``1 / L`` for a translation and 1 for
     a rotation (the residual in ``L`` and rad), and per velocity ``L`` for a length and 1 for an angle (a step in
     ``L`` and rad), ``L`` the :func:`~pkm.core.model.mechanism.spread` of the joints at ``q``."""
-    L = spread(mech.model, q)
-    scales = JacobianScales.at(mech, L)
-    return scales.constraint_rows / L, scales.columns
+    scales = JacobianScales.at(mech, spread(mech.model, q))
+    return scales.closure_residual, scales.columns
 
 
 def _levenberg_marquardt(mech: Mechanism, fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], q: np.ndarray, tol: float, max_iter: int,

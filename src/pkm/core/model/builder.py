@@ -121,8 +121,7 @@ def build(model: pin.Model, spec: ClosureSpec, params: Any = None, urdf: str | N
         rel, index, raw = 0.0, 0, np.zeros(0)
         if seed:  # (the pose the files state: how far open, relative to the mechanism's size)
             raw = constraints.residual(mech, start)
-            rel, index, _ = constraints.worst_closure(mech, raw * JacobianScales.of(mech).constraint_rows
-                                                      / mech.characteristic_length)
+            rel, index, _ = constraints.worst_closure(mech, raw * JacobianScales.of(mech).closure_residual)
         mech.q_reference = _inside_limits(mech, start, held, source)
         if rel > REFERENCE_TOL:  # (where it was open: its worst closure's gap, how far the reference kept moved it)
             gap = constraints.block_gap(mech, raw, index)
