@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from pkm.core.modes.continuation import Continuation, Path, _crossings, bezout, solve, track
+from pkm.core.modes.continuation import Continuation, Path, _crossings, _retrack, bezout, solve, track
 from pkm.core.modes.polynomial import variables
 
 pytest.importorskip("bertini")
@@ -89,6 +89,41 @@ def test_a_parameter_homotopy_carries_each_start_to_its_target():
     cont = track([x * x - (1.0 - t) * 2.0 - t * 1.0], [X * X - 2.0], [np.array([1.0]), np.array([-1.0])])
     assert cont.start == "parameter homotopy" and cont.bound == 2 and cont.complete
     assert np.allclose([p.point[0] for p in cont.paths], [math.sqrt(2.0), -math.sqrt(2.0)], rtol=0, atol=1e-10)
+
+
+def test_auto_precision_tracks_again_adaptively_only_the_paths_double_precision_leaves_in_doubt():
+    """precision="auto" (the default): x^2 = (1 - t) 2 + t tracked in double precision, no path again (both ends
+    nonsingular and distinct), the ends those of adaptive precision to 1e-12; x^2 = t (a double root at t = 0):
+    both singular ends tracked again in adaptive precision."""
+    x, t = variables(2)
+    (X,) = variables(1)
+    starts = [np.array([1.0]), np.array([-1.0])]
+    auto = track([x * x - (1.0 - t) * 2.0 - t * 1.0], [X * X - 2.0], starts)
+    adaptive = track([x * x - (1.0 - t) * 2.0 - t * 1.0], [X * X - 2.0], starts, precision="adaptive")
+    assert auto.settings["mptype"] == "auto" and auto.settings["retracked"] == [] and auto.complete
+    assert np.allclose([p.point for p in auto.paths], [p.point for p in adaptive.paths], rtol=0, atol=1e-12)
+    double = track([x * x - t], [X * X], starts)
+    assert double.settings["retracked"] == [0, 1] and all(p.singular for p in double.paths)
+
+
+def test_a_double_precision_end_in_doubt_is_tracked_again_until_none_is_shared():
+    """(Bookkeeping, a planted adaptive tracker.) Paths 1 and 2 share an end, 3 is singular, 4 went to infinity,
+    5 failed: those are tracked again; path 2's adaptive end is path 0's double one, so 0 is tracked again in a
+    second round; path 6 stays as double precision left it."""
+    double = [_path(0, [1.0]), _path(1, [2.0]), _path(2, [2.0]), _path(3, [0.0], True),
+              Path(4, "infinite", "GoingToInfinity", None, False, math.nan, math.nan, 1),
+              Path(5, "failed", "MinStepSizeReached", None, False, math.nan, math.nan, 1), _path(6, [5.0])]
+    truth = {0: [7.0], 1: [2.0], 2: [1.0], 3: [0.0], 4: [3.0], 5: [4.0]}
+    rounds = []
+
+    def adaptive(indices):
+        rounds.append(indices)
+        return [_path(i, truth[i], singular=i == 3) for i in indices]
+
+    paths, again = _retrack(double, adaptive)
+    assert rounds == [[1, 2, 3, 4, 5], [0]] and again == [0, 1, 2, 3, 4, 5]
+    assert [p.index for p in paths] == list(range(7))
+    assert [p.point[0].real for p in paths] == [7.0, 2.0, 1.0, 0.0, 3.0, 4.0, 5.0]
 
 
 def _path(k, point, singular=False):

@@ -25,7 +25,7 @@ from pkm.core.modes.certify import Certificate, alpha_test, polish
 from pkm.core.modes.continuation import Continuation, solve, track
 from pkm.core.modes.equations import FKSystem, equations
 from pkm.core.modes.generic import assembly_modes_generic, working_modes_generic
-from pkm.core.modes.modeset import REAL_TOL, VERIFY_TOL, Mode, ModeSet, _check, _clearance
+from pkm.core.modes.modeset import REAL_TOL, VERIFY_TOL, Mode, ModeSet, _check, _clearance, by_distance
 from pkm.core.modes.polynomial import System, variables
 from pkm.core.modes.reduce import Reduction, reduce_mechanism
 from pkm.core.modes.starts import generic_start, path_parameters
@@ -99,7 +99,7 @@ def real_solutions(cont: Continuation, sys_: FKSystem, distinct: float = 1e-7) \
             continue
         polys, x, k = sys_.affine(p.point)
         S = System(polys)
-        x = polish(S, x)
+        x = x if p.singular else polish(S, x)  # (Newton at a singular end is no polish: it leaves the end)
         cert = alpha_test(S, x)
         full = x if k is None else np.insert(x, k, 1.0)
         if not sys_.is_pose(full):
@@ -118,7 +118,7 @@ def real_solutions(cont: Continuation, sys_: FKSystem, distinct: float = 1e-7) \
     return found, n_complex, n_exc
 
 
-def parameter_homotopy(system: FKSystem, *, precision: str = "adaptive", threads: int = 2) -> Continuation:
+def parameter_homotopy(system: FKSystem, *, precision: str = "auto", threads: int = 2) -> Continuation:
     """The system solved from its family's generic start (:mod:`pkm.core.modes.starts`): a path per generic
     solution, along the straight line from the generic parameters to this system's."""
     start = generic_start(system.signature)
@@ -129,6 +129,14 @@ def parameter_homotopy(system: FKSystem, *, precision: str = "adaptive", threads
                  threads=threads)
     cont.settings.update(generic_paths=start.total_degree, start_complete=start.complete)
     return cont
+
+
+def _precision(cont: Continuation) -> str:
+    """How a continuation's paths were tracked, in words."""
+    if cont.settings.get("mptype") != "auto":
+        return f"{cont.settings.get('mptype')} precision"
+    again = len(cont.settings.get("retracked", ()))
+    return f"double precision, {again} of its {len(cont.paths)} paths again in adaptive precision"
 
 
 def _generic(mech: Mechanism, refused: StructureError, precision: str, *, qa: np.ndarray | None = None,
@@ -144,7 +152,7 @@ def _generic(mech: Mechanism, refused: StructureError, precision: str, *, qa: np
                                        f"it too ({refused})") from None
 
 
-def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "auto", precision: str = "adaptive",
+def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "auto", precision: str = "auto",
                    threads: int = 2, continuation: Continuation | None = None) -> ModeSet:
     """Every real assembly mode of ``mech`` at the actuator values ``q_actuated`` (module doc).
 
@@ -158,7 +166,11 @@ def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "aut
             every passive joint, :mod:`pkm.core.modes.generic`) or ``"auto"`` (parameter for a spatial platform,
             total degree for the small planar and translational systems, generic where the reduction finds no
             platform: a task point on a leg).
-        precision: Bertini's precision mode (``"adaptive"``: the safe default).
+        precision: Bertini's precision mode: ``"auto"`` (default) tracks a parameter homotopy's paths in double
+            precision and again in adaptive precision each that did not end at a nonsingular finite point of its
+            own (:func:`pkm.core.modes.continuation.track`; the hexapod 16 -> 4 s of CPU, the same modes), and
+            every other homotopy in adaptive precision; ``"adaptive"``, ``"double"`` or ``"multiple"`` for every
+            path.
         threads: Bertini's tracking threads.
         continuation: A finished :class:`~pkm.core.modes.continuation.Continuation` of this very system to use
             instead of solving (tests plant failures this way).
@@ -209,10 +221,8 @@ def assembly_modes(mech: Mechanism, q_actuated: ArrayLike, *, method: str = "aut
         R, t = system.displacement(x)
         q = recover(mech, red, qa, R, t)
         modes.append((q, _check(mech, q), x, cert, tuple(paths), mech.outside_limits(q), _clearance(mech, q)))
-    ref = mech.q_reference
-    modes.sort(key=lambda m: float(np.linalg.norm(mech.difference(ref, m[0]))))
-    out = tuple(Mode(k, *m) for k, m in enumerate(modes))
-    how = f"a {cont.start} (Bertini 2, {cont.settings.get('mptype')} precision)"
+    out = tuple(Mode(k, *m) for k, m in enumerate(by_distance(mech, modes)))
+    how = f"a {cont.start} (Bertini 2, {_precision(cont)})"
     if cont.start == "parameter homotopy":
         how += (f" from the {cont.bound} generic solutions of family {system.signature} (a "
                 f"{cont.settings['generic_paths']}-path total-degree solve)")

@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from types import ModuleType
 from typing import Any
@@ -32,6 +32,12 @@ import numpy as np
 
 from pkm.core.modes.polynomial import Poly
 from pkm.errors import MissingDependencyError
+
+#: Steps a path may take in :func:`track`'s double-precision pass (``"auto"``) before it is given up to adaptive
+#: precision (Bertini's own bound: 100,000). The 3-PRS's paths near its singular ends took up to 8 s of CPU in double
+#: precision, where adaptive precision tracks all 16 in 2 s; at 2,000 steps its double pass takes 1.2-1.7 s and
+#: hands 2-3 paths on (at 500: 4 paths, and the hexapod's double pass hands on 10 of 40, not 3).
+DOUBLE_MAX_STEPS = 2000
 
 #: Bertini's success codes of paths that went to infinity.
 _INFINITE = {"GoingToInfinity", "SecurityMaxNormReached"}
@@ -165,7 +171,9 @@ def solve(polys: Sequence[Poly], groups: Sequence[Sequence[int]] | None = None, 
             Bertini's multihomogeneous start system, which tracks fewer paths when the groups fit the equations.
         projective: The single group is homogeneous coordinates of a projective space (each polynomial
             homogeneous); Bertini works on a random affine patch of it.
-        precision: Bertini's ``mptype``: ``"adaptive"`` (default: the safe one), ``"double"``, ``"multiple"``.
+        precision: Bertini's ``mptype``: ``"adaptive"`` (default: the safe one), ``"double"``, ``"multiple"``;
+            ``"auto"`` (:func:`track`'s default) is ``"adaptive"`` here: a start system's paths going to infinity
+            are the rule, not a sign of a jump, so double precision first would re-track most of them.
         endgame: ``"powerseries"`` or ``"cauchy"``.
         threads: Bertini's worker threads.
     """
@@ -186,15 +194,16 @@ def solve(polys: Sequence[Poly], groups: Sequence[Sequence[int]] | None = None, 
     start = "total-degree homotopy" if len(groups) == 1 else "multihomogeneous homotopy"
     bound = bezout(polys, groups)
     t0 = time.perf_counter()
+    precision = "adaptive" if precision == "auto" else precision
     zd = b.ZeroDimSolver(system, startsystem="infer", endgame=endgame, mptype=precision)
     zd.set(num_threads=threads)
     zd.solve(show_progress=False)
     settings = {"mptype": precision, "endgame": endgame, "threads": threads, "projective": projective}
-    return _collect(zd, start, bound, time.perf_counter() - t0, settings)
+    return Continuation(_crossings(_paths(zd, projective)), bound, start, time.perf_counter() - t0, settings)
 
 
 def track(homotopy: Sequence[Poly], target: Sequence[Poly], start_points: Sequence[np.ndarray], *,
-          projective: bool = False, precision: str = "adaptive", endgame: str = "powerseries",
+          projective: bool = False, precision: str = "auto", endgame: str = "powerseries",
           threads: int = 1, start: str = "parameter homotopy") -> Continuation:
     """Track the given start points along a homotopy to the target system (a parameter homotopy).
 
@@ -204,6 +213,14 @@ def track(homotopy: Sequence[Poly], target: Sequence[Poly], start_points: Sequen
         target: The target system (``n`` variables).
         start_points: The start system's solutions (complex, ``n`` coordinates).
         projective: The variables are homogeneous coordinates (one group).
+        precision: Bertini's ``mptype`` for every path (``"adaptive"``, ``"double"``, ``"multiple"``), or
+            ``"auto"`` (default): every path in double precision (at most :data:`DOUBLE_MAX_STEPS` steps), then
+            in adaptive precision each path that did not end at a nonsingular finite point of its own (failed,
+            at infinity, singular, or at another path's end), until no double-precision end is shared
+            (:func:`_retrack`). A path tracked in double
+            precision can jump to another path; where the jump is seen (two paths at one end, a path lost to
+            infinity or to a singular end), both are tracked again adaptively; a jump unseen is a permutation of
+            nonsingular ends, which loses no solution. ``settings["retracked"]`` lists the paths tracked again.
     """
     b = _bertini()
     n = target[0].n
@@ -223,30 +240,69 @@ def track(homotopy: Sequence[Poly], target: Sequence[Poly], start_points: Sequen
         T.copy_patches(H)
         points = [np.asarray(H.rescale_point_to_fit_patch(x), dtype=complex) for x in points]
     t0 = time.perf_counter()
-    solver = b.HomotopySolver(H, points, T, mptype=precision, endgame=endgame)
-    solver.set(num_threads=threads)
-    solver.solve(show_progress=False)
     settings = {"mptype": precision, "endgame": endgame, "threads": threads, "projective": projective}
-    return _collect(solver, start, len(points), time.perf_counter() - t0, settings)
+
+    def run(indices: Sequence[int], mptype: str) -> list[Path]:
+        solver = b.HomotopySolver(H, [points[i] for i in indices], T, mptype=mptype, endgame=endgame)
+        solver.set(num_threads=threads)
+        if mptype == "double":  # (a path that needs more steps is one for adaptive precision)
+            solver.configure(stepping={"max_num_steps": DOUBLE_MAX_STEPS})
+        solver.solve(show_progress=False)
+        return [replace(p, index=indices[p.index]) for p in _paths(solver, projective)]
+
+    everyone = list(range(len(points)))
+    if precision != "auto":
+        paths = run(everyone, precision)
+    else:
+        paths, retracked = _retrack(run(everyone, "double"), lambda idx: run(idx, "adaptive"))
+        settings["retracked"] = retracked
+    return Continuation(_crossings(paths), len(points), start, time.perf_counter() - t0, settings)
 
 
-def _collect(solver: Any, start: str, bound: int, seconds: float, settings: dict) -> Continuation:
+def _retrack(paths: list[Path], adaptive: Callable[[list[int]], list[Path]]) -> tuple[list[Path], list[int]]:
+    """Double-precision ``paths`` made safe (:func:`track`'s ``"auto"``): each that did not end at a nonsingular
+    finite point, or whose end another path shares, is tracked again by ``adaptive`` (its indices -> their
+    paths), round after round, until no double-precision path shares its end (each round takes at least one more
+    path). Returns the paths (in index order) and the re-tracked indices."""
+    by_index = {p.index: p for p in paths}
+    again: set[int] = set()
+    todo = {p.index for p in paths if p.status != "finite" or p.singular} | _shared_ends(paths)
+    while todo:
+        for p in adaptive(sorted(todo)):
+            by_index[p.index] = p
+        again |= todo
+        todo = _shared_ends(list(by_index.values())) - again
+    return [by_index[i] for i in sorted(by_index)], sorted(again)
+
+
+def _same_end(x: np.ndarray, y: np.ndarray, tol: float = 1e-8) -> bool:
+    return bool(np.abs(x - y).max() <= tol * max(1.0, float(np.abs(x).max())))
+
+
+def _shared_ends(paths: list[Path]) -> set[int]:
+    """The paths that ended at a nonsingular finite point another path ended at too (:func:`_same_end`)."""
+    ends = [(p.index, p.point) for p in paths if p.point is not None and not p.singular]
+    return {i for k, (a, x) in enumerate(ends) for b, y in ends[k + 1:] if _same_end(x, y) for i in (a, b)}
+
+
+def _paths(solver: Any, projective: bool) -> list[Path]:
+    """A finished Bertini solver's paths, classified from its metadata (module doc), numbered from 0."""
     paths = []
     for k, (pt, md) in enumerate(zip(solver.all_solutions(), solver.solution_metadata())):
         code = str(md.endgame_success_code).rsplit(".", 1)[-1]
         if code == "Success" and md.is_finite:
             x = np.array([complex(float(v[0]), float(v[1])) if isinstance(v, tuple) else complex(v) for v in pt])
-            if settings["projective"]:
+            if projective:
                 x = x / x[np.argmax(np.abs(x))]
             paths.append(Path(k, "finite", code, x, bool(md.is_singular), float(md.condition_number),
                               float(md.function_residual), int(md.cycle_num)))
         else:
             status = "infinite" if code in _INFINITE or (code == "Success" and not md.is_finite) else "failed"
             paths.append(Path(k, status, code, None, False, math.nan, math.nan, int(md.cycle_num)))
-    return Continuation(_crossings(paths), bound, start, seconds, settings)
+    return paths
 
 
-def _crossings(paths: list[Path], tol: float = 1e-8) -> tuple[Path, ...]:
+def _crossings(paths: list[Path]) -> tuple[Path, ...]:
     """Paths that ended at the nonsingular end of another: one of them jumped (a path crossing) and a solution
     may be lost, so every such later path is marked failed (``PathCrossing``). Several paths may end at one
     *singular* point (its multiplicity); a nonsingular point ends exactly one."""
@@ -255,7 +311,7 @@ def _crossings(paths: list[Path], tol: float = 1e-8) -> tuple[Path, ...]:
     for p in paths:
         if p.point is not None and not p.singular:
             x = p.point
-            if any(np.abs(x - y).max() <= tol * max(1.0, float(np.abs(x).max())) for y in seen):
+            if any(_same_end(x, y) for y in seen):
                 out.append(Path(p.index, "failed", "PathCrossing", None, False, p.condition, p.residual, p.cycle))
                 continue
             seen.append(x)

@@ -39,7 +39,7 @@ from pkm.core.kinematics.task import TaskMap
 from pkm.core.model.mechanism import Mechanism
 from pkm.core.modes.certify import Certificate, alpha_test, polish
 from pkm.core.modes.continuation import Continuation, solve
-from pkm.core.modes.modeset import REAL_TOL, Mode, ModeSet, _check, _clearance
+from pkm.core.modes.modeset import REAL_TOL, Mode, ModeSet, _check, _clearance, by_distance
 from pkm.core.modes.polynomial import Poly, System, fix
 from pkm.core.modes.tree import REVOLUTE, PolyTree, joint_axis
 from pkm.errors import StructureError
@@ -154,7 +154,7 @@ def _solutions(polys: list[Poly], groups: list[list[int]], precision: str) \
             for path in cont.paths:
                 if path.point is None:
                     continue
-                x = polish(S, path.point)
+                x = path.point if path.singular else polish(S, path.point)  # (as assembly.real_solutions)
                 if np.abs(x.imag).max() > REAL_TOL * max(1.0, float(np.abs(x).max())):
                     n_complex += 1
                     continue
@@ -172,9 +172,7 @@ def _solutions(polys: list[Poly], groups: list[list[int]], precision: str) \
 
 
 def _mode_set(mech: Mechanism, conts: list[Continuation], modes: list[tuple], n_complex: int, what: str) -> ModeSet:
-    ref = mech.q_reference
-    modes.sort(key=lambda m: float(np.linalg.norm(mech.difference(ref, m[0]))))
-    out = tuple(Mode(k, *m) for k, m in enumerate(modes))
+    out = tuple(Mode(k, *m) for k, m in enumerate(by_distance(mech, modes)))
     how = (f"{len(conts)} multihomogeneous homotop{'y' if len(conts) == 1 else 'ies'}, block by block, on the loop "
            f"closures in {what} (Bertini 2, {conts[0].settings.get('mptype')} precision)")
     return ModeSet(out, all(c.complete for c in conts), how, sum(len(c.paths) for c in conts),

@@ -22,6 +22,19 @@ REAL_TOL = 1e-8
 VERIFY_TOL = 1e-10
 
 
+def by_distance(mech: Mechanism, modes: list[tuple]) -> list[tuple]:
+    """Modes (tuples whose first item is a configuration) sorted by distance from the reference configuration, the
+    distance to 10 significant digits and then the configuration to 1e-9 deciding: modes at one distance (a
+    symmetric mechanism's mirror modes) keep one order whatever the last bits of their homotopy paths."""
+    ref = mech.q_reference
+
+    def key(m: tuple) -> tuple:
+        d = float(np.linalg.norm(mech.difference(ref, m[0])))
+        return (float(f"{d:.9e}"), tuple(np.round(np.asarray(m[0], dtype=float), 9) + 0.0))
+
+    return sorted(modes, key=key)
+
+
 @dataclass(frozen=True)
 class Mode:
     """One real solution: an assembly mode (or, from :func:`~pkm.core.modes.working.working_modes`, a working mode).

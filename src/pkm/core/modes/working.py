@@ -29,7 +29,7 @@ from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.modes.assembly import _generic, recover
 from pkm.core.modes.certify import Certificate, alpha_test, polish
 from pkm.core.modes.continuation import Path, solve
-from pkm.core.modes.modeset import REAL_TOL, Mode, ModeSet, _check, _clearance
+from pkm.core.modes.modeset import REAL_TOL, Mode, ModeSet, _check, _clearance, by_distance
 from pkm.core.modes.polynomial import Poly, System, dot
 from pkm.core.modes.reduce import Leg, reduce_mechanism
 from pkm.core.modes.tree import PolyTree
@@ -141,8 +141,7 @@ def working_modes(mech: Mechanism, task: ArrayLike | Mapping[str, Any], *, preci
         point = np.concatenate([x for x, _, _ in combo])
         worst = max(combo, key=lambda s: s[1].alpha)[1]
         modes.append((q, _check(mech, q), point, worst, tuple(p for _, _, p in combo), mech.outside_limits(q), _clearance(mech, q)))
-    modes.sort(key=lambda m: float(np.linalg.norm(mech.difference(ref, m[0]))))
-    out = tuple(Mode(k, *m) for k, m in enumerate(modes))
+    out = tuple(Mode(k, *m) for k, m in enumerate(by_distance(mech, modes)))
     failed: tuple[Path, ...] = tuple(p for c in conts for p in c.failed)
     return ModeSet(out, all(c.complete for c in conts), f"one total-degree homotopy per leg ({len(conts)} legs, "
                    f"Bertini 2, {precision} precision)", sum(len(c.paths) for c in conts), sum(c.bound for c in conts),
