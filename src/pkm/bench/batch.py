@@ -12,7 +12,8 @@ For the 3-PRS, the Delta and the hexapod, ``-n`` (100,000) closed states along a
   the fallback test included), against ``threads=1``;
 * ``jax``: the kernel translated to JAX (:meth:`pkm.Kernels.jax`) under ``jax.jit(jax.vmap(...))`` on JAX's default
   device (the CPU here; the same code on a GPU where JAX has one), after its compile, when JAX is installed; its
-  largest difference to the C.
+  largest difference to the C (``--quick``: XLA's backend unoptimised, :data:`pkm.bench.QUICK_XLA`: a check that it
+  runs and agrees, not its time).
 
 Flops a sample are the kernel's ``+ - * /`` (squares and doublings counted as one, negations free: the
 papers' count, :meth:`pkm.Kernels.operation_count`); the achieved GFLOP/s are over this core's vector peak
@@ -30,7 +31,7 @@ import time
 
 import numpy as np
 
-from pkm.bench import main
+from pkm.bench import jax_batch, main
 from pkm.bench.twin import _path
 
 QUICK = {"n": 1024, "repeat": 1, "mechanisms": "prs3"}
@@ -55,16 +56,17 @@ def _median(fn, repeat: int) -> float:
     return statistics.median(times)
 
 
-def _jax(K, args, repeat: int, reference: np.ndarray) -> dict:
+def _jax(K, args, repeat: int, reference: np.ndarray, quick: bool = False) -> dict:
     from pkm._optional import missing
 
     if missing("jax"):
         return {"skipped": 'JAX is not installed (pip install "pkm-robotics[jax]")'}
     import jax
 
-    f = jax.jit(jax.vmap(K.jax("inverse_dynamics")))
+    fn = K.jax("inverse_dynamics")
     arrays = [jax.device_put(a) for a in args]
     t0 = time.perf_counter()
+    f = jax_batch(fn, arrays, quick)  # (quick: compiled here, unoptimised)
     out = f(*arrays)[0].block_until_ready()
     compile_s = time.perf_counter() - t0
     seconds = _median(lambda: f(*arrays)[0].block_until_ready(), repeat)
@@ -136,7 +138,7 @@ def run(args) -> dict:
                "kernels_scaling_2": one_s / two_s,
                "vector_gflops": flops / vector_s / 1e9,
                "fraction_of_peak": flops / vector_s / 1e9 / peak.get("mul_add", float("nan")),
-               "goal_us": GOALS_US.get(name), "jax": _jax(K1, ins, args.repeat, tau1)}
+               "goal_us": GOALS_US.get(name), "jax": _jax(K1, ins, args.repeat, tau1, args.quick)}
         out["mechanisms"][name] = row
     out["goal_scaling"] = GOAL_SCALING
     return out

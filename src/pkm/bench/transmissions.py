@@ -11,7 +11,7 @@ target, µs a sample:
   instruction), on one core (``--threads``);
 * ``c_scalar``: the same C, one sample after another (CasADi's C), one core;
 * ``jax``: ``jax.jit(jax.vmap(f))`` of the JAX translation (the ``jax`` extra; skipped without it), on JAX's CPU
-  device (its threads);
+  device (its threads; ``--quick``: XLA's backend unoptimised, :data:`pkm.bench.QUICK_XLA`);
 * ``warp_cpu``: the Warp kernel (the ``warp`` extra; skipped without it), one thread a sample on Warp's ``"cpu"``
   device, structure-of-arrays (a GPU: ``tools/gpu_transmissions.py``); its compile time is the module's of every
   kernel (as ``pkm transmission`` writes it);
@@ -32,7 +32,7 @@ import time
 
 import numpy as np
 
-from pkm.bench import best_time, main, median_us
+from pkm.bench import best_time, jax_batch, main, median_us
 
 #: The quick run: the knee, the kernels' default iterations (the tests' kernels: their compiled C and Warp module are
 #: found in the caches).
@@ -112,8 +112,9 @@ def run(args) -> dict:
     try:
         import jax
 
-        g = jax.jit(jax.vmap(tk.jax("fk_j_dm")))
+        fn = tk.jax("fk_j_dm")
         t0 = time.perf_counter()
+        g = jax_batch(fn, (Q0, QM), args.quick)  # (quick: compiled here, unoptimised)
         jax.block_until_ready(g(Q0, QM))
         comp["jax"] = time.perf_counter() - t0
         wall, outs = best_time(lambda: jax.block_until_ready(g(Q0, QM)), args.repeat)

@@ -445,14 +445,15 @@ SWEEP_COLUMNS = ("gci", "gci_area", "coverage", "min_area_ci")
 
 
 @functools.cache
-def design_sweep(step: float = 0.01, scheduler: str | None = None) -> maps.SweepResult:
-    """The 1,000-design sweep of sec. VII (:func:`paper_sweep_designs`) through :func:`pkm.sweep`: a local Dask
-    cluster by default (``scheduler`` as :func:`pkm.sweep`'s), the 3-RRR's closed-form CI maps at ``step`` [m]; the
-    same numbers as the serial loop :func:`pkm.mechanisms.rrr3.workspace.sweep` (tested)."""
+def design_sweep(step: float = 0.01, scheduler: str | None = None, n: int = 10) -> maps.SweepResult:
+    """The 1,000-design sweep of sec. VII (:func:`paper_sweep_designs`: ``n^3`` designs, ``n`` 10 by default) through
+    :func:`pkm.sweep`: a local Dask cluster by default (``scheduler`` as :func:`pkm.sweep`'s), the 3-RRR's closed-form
+    CI maps at ``step`` [m]; the same numbers as the serial loop :func:`pkm.mechanisms.rrr3.workspace.sweep`
+    (tested)."""
     import pkm
     from pkm import sweeps
 
-    designs = paper_sweep_designs()
+    designs = paper_sweep_designs(n=n)
     space = sweeps.table({k: [getattr(d, k) for d in designs] for k in ("a", "b", "h", "H")})
     res = pkm.sweep("rrr3", space, [f"{c}={c}:step={step!r}" for c in SWEEP_COLUMNS], scheduler=scheduler)
     if res.stats.failed:
