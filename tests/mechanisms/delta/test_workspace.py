@@ -73,6 +73,22 @@ def test_workspace_volume_converges_with_the_grid():
         assert reached == fine.reachable[i, j, k]
 
 
+@pytest.mark.parametrize("chunk", [1, 1000, 1 << 20])
+def test_workspace_grid_is_the_batch_of_every_node(monkeypatch, chunk):
+    """The grid, computed in chunks of z slices (one slice, several with a partial last, all at once), reachable
+    nodes first: its mask and K are those of :func:`condition_numbers` on every node at once, bit for bit."""
+    import pkm.mechanisms.delta.workspace as W
+
+    monkeypatch.setattr(W, "CHUNK_NODES", chunk)
+    grid = workspace(P, 0.04)
+    nodes = np.stack(np.meshgrid(*grid.axes, indexing="ij"), axis=-1)
+    K, reachable = condition_numbers(P, nodes)
+    assert 0.1 < reachable.mean() < 0.9
+    np.testing.assert_array_equal(grid.reachable, reachable)
+    for kind in KINDS:
+        np.testing.assert_array_equal(grid.K[kind], K[kind])
+
+
 def test_workspace_volumes_are_ordered_and_threefold_symmetric():
     """Conditioned volume <= volume, growing with the bound; the integral of 1/K <= volume; the mask is
     invariant under the 120 deg rotation of the base (up to nodes on the boundary: 0.5 %)."""

@@ -22,12 +22,13 @@ import numpy as np
 from pkm.core.differential.indices import KINDS
 from pkm.core.differential.indices import condition_numbers as core_condition_numbers
 from pkm.errors import InvalidInputError
-from pkm.mechanisms._common import check_params, circle_sphere, real
+from pkm.mechanisms._common import check_params, circle_sphere, circle_sphere_reach, real
 from pkm.mechanisms.delta import PHI, DeltaParams, jacobian_factors
 from pkm.mechanisms.delta.kinematics import branch_signs
 from pkm.validation import as_array
 
-MAX_NODES = 16_000_000  #: grid nodes of :func:`workspace` at most (memory)
+MAX_NODES = 16_000_000  #: grid nodes of :func:`workspace` at most (the grids it returns: memory)
+CHUNK_NODES = 1 << 20  #: grid nodes :func:`workspace` evaluates at once (whole z slices; its temporaries: memory)
 
 __all__ = ["WorkspaceGrid", "condition_numbers", "inverse_kinematics_batch", "workspace"]
 
@@ -156,8 +157,10 @@ def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", ki
 
     The grid covers ``|x|, |y| <= La + Lb`` and ``-(La + Lb) <= z <= 0``, which contains every
     reachable point (each ball joint lies within ``La + Lb`` of its motor, and the motors
-    surround the axis). Computed z slice by z slice to bound memory. ``kinds`` empty: the reachable nodes only
-    (no condition numbers).
+    surround the axis). Computed in chunks of whole z slices (at most :data:`CHUNK_NODES` nodes, or one slice) to
+    bound memory; in each, which nodes every arm reaches first (no angle needed), then the angles and the condition
+    numbers of those nodes only (the same numbers, bit for bit, as :func:`condition_numbers` of every node).
+    ``kinds`` empty: the reachable nodes only (no condition numbers).
 
     Raises:
         InvalidInputError: if ``spacing`` is not a finite length in (0, (La + Lb) / 4].
@@ -174,13 +177,25 @@ def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", ki
     z = -(np.arange(n)[::-1] + 0.5) * spacing
     reachable = np.zeros((len(xy), len(xy), len(z)), dtype=bool)
     K = {kind: np.full(reachable.shape, np.inf) for kind in kinds}
-    X, Y = np.meshgrid(xy, xy, indexing="ij")
-    for k, zk in enumerate(z):
-        pts = np.stack([X, Y, np.full_like(X, zk)], axis=-1)
-        if not kinds:  # (the reachable nodes only)
-            reachable[:, :, k] = inverse_kinematics_batch(params, pts, branch)[1]
-            continue
-        Kk, reachable[:, :, k] = condition_numbers(params, pts, branch, kinds)
-        for kind in kinds:
-            K[kind][:, :, k] = Kk[kind]
+    step = max(1, CHUNK_NODES // len(xy) ** 2)  # z slices per chunk
+    for k0 in range(0, len(z), step):
+        X, Y, Z = np.meshgrid(xy, xy, z[k0:k0 + step], indexing="ij")
+        pts = np.stack([X, Y, Z], axis=-1)
+        reach = _reaches(params, pts)
+        reachable[:, :, k0:k0 + step] = reach
+        if kinds and reach.any():  # the angles and the Jacobians of the reachable nodes only
+            Kk, _ = condition_numbers(params, pts[reach], branch, kinds)
+            for kind in kinds:
+                K[kind][:, :, k0:k0 + step][reach] = Kk[kind]
     return WorkspaceGrid(params, branch, float(spacing), (xy, xy.copy(), z), reachable, K)
+
+
+def _reaches(params: DeltaParams, P: np.ndarray) -> np.ndarray:
+    """The ``reachable`` mask of :func:`inverse_kinematics_batch` (the same test, bit for bit), without the angles."""
+    reachable = np.ones(P.shape[:-1], dtype=bool)
+    for i in range(3):
+        ci, si = math.cos(PHI[i]), math.sin(PHI[i])
+        w = ci * P[..., 0] + si * P[..., 1]
+        u = -si * P[..., 0] + ci * P[..., 1] - (params.R - params.r)
+        reachable &= circle_sphere_reach(u, P[..., 2], w, params.La, params.Lb)
+    return reachable
