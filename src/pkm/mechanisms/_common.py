@@ -121,9 +121,10 @@ def _circle_sphere_rho_k(u, v, w, arm: float, rod: float) -> tuple[np.ndarray, .
 
 
 def _meets(rho: np.ndarray, K: np.ndarray) -> np.ndarray:
-    """The rod meets the circle: ``|K| <= rho`` but for the round-off of a double root."""
-    with np.errstate(invalid="ignore"):
-        return np.abs(K) <= rho * (1.0 + 1e-12)
+    """The rod meets the circle: ``|K| <= rho`` but for the round-off of a double root (and ``rho`` finite: a point
+    beyond the float range reaches nothing)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        return (np.abs(K) <= rho * (1.0 + 1e-12)) & (rho < np.inf)
 
 
 def _circle_sphere_terms(u, v, w, arm: float, rod: float) -> tuple[np.ndarray, ...]:

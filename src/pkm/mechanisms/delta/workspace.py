@@ -57,14 +57,19 @@ def inverse_kinematics_batch(params: DeltaParams, points, branch="knee_out") -> 
         clipped arc cosine), finite but meaningless: use the mask.
     """
     params = check_params(params, DeltaParams)
-    P = _points(points)
+    return _inverse_kinematics(params, _points(points), branch, params.R)
+
+
+def _inverse_kinematics(params: DeltaParams, P: np.ndarray, branch, R) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`inverse_kinematics_batch` with the base radius ``R`` [m] in place of ``params.R`` (a float, or an
+    array of shape ``P.shape[:-1]``: one design a point)."""
     signs = branch_signs(branch)
     theta = np.empty(P.shape)
     reachable = np.ones(P.shape[:-1], dtype=bool)
     for i in range(3):
         ci, si = math.cos(PHI[i]), math.sin(PHI[i])
         w = ci * P[..., 0] + si * P[..., 1]  # along the motor axis
-        u = -si * P[..., 0] + ci * P[..., 1] - (params.R - params.r)
+        u = -si * P[..., 0] + ci * P[..., 1] - (R - params.r)
         theta[..., i], reach_i, _, _ = circle_sphere(u, P[..., 2], w, params.La, params.Lb, signs[i])
         reachable &= reach_i
     return theta, reachable
@@ -89,14 +94,20 @@ def condition_numbers(params: DeltaParams, points, branch="knee_out", kinds=KIND
         stretched or folded onto its forearm, and the ``reachable`` mask.
     """
     params = check_params(params, DeltaParams)
-    P = _points(points)
+    return _condition_numbers(params, _points(points), branch, kinds, params.R)
+
+
+def _condition_numbers(params: DeltaParams, P: np.ndarray, branch, kinds, R) -> tuple[dict[str, np.ndarray],
+                                                                                       np.ndarray]:
+    """:func:`condition_numbers` with the base radius ``R`` [m] in place of ``params.R`` (a float, or an array of
+    shape ``P.shape[:-1]``: one design a point)."""
     if isinstance(kinds, str) or not isinstance(kinds, (tuple, list)):
         raise InvalidInputError("kinds", f"expected a tuple of kinds among {KINDS}, got {kinds!r}", kinds)
     unknown = [k for k in kinds if not isinstance(k, str) or k not in KINDS]
     if unknown or not kinds:
         raise InvalidInputError("kinds", f"choose among {KINDS}, got {tuple(kinds)!r}", kinds)
-    theta, reachable = inverse_kinematics_batch(params, P, branch)
-    A, d = jacobian_factors(params, P[reachable], theta[reachable])
+    theta, reachable = _inverse_kinematics(params, P, branch, R)
+    A, d = jacobian_factors(params, P[reachable], theta[reachable], R if np.ndim(R) == 0 else R[reachable])
     ok = np.all(d != 0.0, axis=-1)
     Jinv = A / np.where(ok[..., None], d, 1.0)[..., None]
     each = core_condition_numbers(Jinv[ok], tuple(kinds)) if ok.any() else {}
