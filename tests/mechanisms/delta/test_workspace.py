@@ -76,17 +76,21 @@ def test_workspace_volume_converges_with_the_grid():
 @pytest.mark.parametrize("chunk", [1, 1000, 1 << 20])
 def test_workspace_grid_is_the_batch_of_every_node(monkeypatch, chunk):
     """The grid, computed in chunks of z slices (one slice, several with a partial last, all at once), reachable
-    nodes first: its mask and K are those of :func:`condition_numbers` on every node at once, bit for bit."""
+    nodes first: its mask and K are those of :func:`condition_numbers` on every node at once (Jacobi rotations), bit
+    for bit, and those of LAPACK's SVD within 10 eps K relative."""
     import pkm.mechanisms.delta.workspace as W
 
     monkeypatch.setattr(W, "CHUNK_NODES", chunk)
     grid = workspace(P, 0.04)
     nodes = np.stack(np.meshgrid(*grid.axes, indexing="ij"), axis=-1)
-    K, reachable = condition_numbers(P, nodes)
+    K, reachable = condition_numbers(P, nodes, method="jacobi")
+    lapack, _ = condition_numbers(P, nodes)
     assert 0.1 < reachable.mean() < 0.9
     np.testing.assert_array_equal(grid.reachable, reachable)
     for kind in KINDS:
         np.testing.assert_array_equal(grid.K[kind], K[kind])
+        k, ref = K[kind][reachable], lapack[kind][reachable]
+        assert np.all(np.abs(k / ref - 1.0) <= 10 * np.finfo(float).eps * ref)
 
 
 def test_workspace_volumes_are_ordered_and_threefold_symmetric():

@@ -75,8 +75,8 @@ def _inverse_kinematics(params: DeltaParams, P: np.ndarray, branch, R) -> tuple[
     return theta, reachable
 
 
-def condition_numbers(params: DeltaParams, points, branch="knee_out", kinds=KINDS) -> tuple[dict[str, np.ndarray],
-                                                                                             np.ndarray]:
+def condition_numbers(params: DeltaParams, points, branch="knee_out", kinds=KINDS,
+                      method: str = "lapack") -> tuple[dict[str, np.ndarray], np.ndarray]:
     """Condition numbers of ``J = dX/dth`` at many platform centres.
 
     They are computed on ``J^-1 = diag(d)^-1 A`` (no inversion needed; every kind of
@@ -88,17 +88,19 @@ def condition_numbers(params: DeltaParams, points, branch="knee_out", kinds=KIND
         branch: Working mode (see :func:`inverse_kinematics_batch`).
         kinds: Which conventions (``"fro"``: raw ``||J||_F ||J^-1||_F`` >= 3; ``"fro_normalized"``:
             the same over 3, >= 1; ``"2"``: ``sigma_max / sigma_min`` >= 1).
+        method: The singular values' route, ``"lapack"`` or ``"jacobi"`` (faster on many points; see
+            :func:`pkm.core.differential.indices.condition_numbers`).
 
     Returns:
         ``{kind: K}`` each of shape (...), ``inf`` at unreachable points and where an arm is
         stretched or folded onto its forearm, and the ``reachable`` mask.
     """
     params = check_params(params, DeltaParams)
-    return _condition_numbers(params, _points(points), branch, kinds, params.R)
+    return _condition_numbers(params, _points(points), branch, kinds, params.R, method)
 
 
-def _condition_numbers(params: DeltaParams, P: np.ndarray, branch, kinds, R) -> tuple[dict[str, np.ndarray],
-                                                                                       np.ndarray]:
+def _condition_numbers(params: DeltaParams, P: np.ndarray, branch, kinds, R,
+                       method: str = "lapack") -> tuple[dict[str, np.ndarray], np.ndarray]:
     """:func:`condition_numbers` with the base radius ``R`` [m] in place of ``params.R`` (a float, or an array of
     shape ``P.shape[:-1]``: one design a point)."""
     if isinstance(kinds, str) or not isinstance(kinds, (tuple, list)):
@@ -110,7 +112,7 @@ def _condition_numbers(params: DeltaParams, P: np.ndarray, branch, kinds, R) -> 
     A, d = jacobian_factors(params, P[reachable], theta[reachable], R if np.ndim(R) == 0 else R[reachable])
     ok = np.all(d != 0.0, axis=-1)
     Jinv = A / np.where(ok[..., None], d, 1.0)[..., None]
-    each = core_condition_numbers(Jinv[ok], tuple(kinds)) if ok.any() else {}
+    each = core_condition_numbers(Jinv[ok], tuple(kinds), method) if ok.any() else {}
     out = {}
     for kind in kinds:
         K = np.full(P.shape[:-1], np.inf)
@@ -170,7 +172,8 @@ def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", ki
     reachable point (each ball joint lies within ``La + Lb`` of its motor, and the motors
     surround the axis). Computed in chunks of whole z slices (at most :data:`CHUNK_NODES` nodes, or one slice) to
     bound memory; in each, which nodes every arm reaches first (no angle needed), then the angles and the condition
-    numbers of those nodes only (the same numbers, bit for bit, as :func:`condition_numbers` of every node).
+    numbers of those nodes only, by Jacobi rotations (the same numbers, bit for bit, as :func:`condition_numbers` of
+    every node with ``method="jacobi"``; those of ``np.linalg.svd`` to a few ``eps * K`` relative).
     ``kinds`` empty: the reachable nodes only (no condition numbers).
 
     Raises:
@@ -195,7 +198,7 @@ def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", ki
         reach = _reaches(params, pts)
         reachable[:, :, k0:k0 + step] = reach
         if kinds and reach.any():  # the angles and the Jacobians of the reachable nodes only
-            Kk, _ = condition_numbers(params, pts[reach], branch, kinds)
+            Kk, _ = condition_numbers(params, pts[reach], branch, kinds, "jacobi")
             for kind in kinds:
                 K[kind][:, :, k0:k0 + step][reach] = Kk[kind]
     return WorkspaceGrid(params, branch, float(spacing), (xy, xy.copy(), z), reachable, K)
