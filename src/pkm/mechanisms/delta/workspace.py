@@ -192,24 +192,26 @@ def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", ki
     reachable = np.zeros((len(xy), len(xy), len(z)), dtype=bool)
     K = {kind: np.full(reachable.shape, np.inf) for kind in kinds}
     step = max(1, CHUNK_NODES // len(xy) ** 2)  # z slices per chunk
+    X, Y = np.meshgrid(xy, xy, indexing="ij")
     for k0 in range(0, len(z), step):
-        X, Y, Z = np.meshgrid(xy, xy, z[k0:k0 + step], indexing="ij")
-        pts = np.stack([X, Y, Z], axis=-1)
-        reach = _reaches(params, pts)
+        zk = z[k0:k0 + step]
+        reach = _reaches(params, X[..., None], Y[..., None], zk)  # (the x, y terms once for every slice)
         reachable[:, :, k0:k0 + step] = reach
         if kinds and reach.any():  # the angles and the Jacobians of the reachable nodes only
-            Kk, _ = condition_numbers(params, pts[reach], branch, kinds, "jacobi")
+            i, j, k = np.nonzero(reach)
+            Kk, _ = condition_numbers(params, np.stack([xy[i], xy[j], zk[k]], axis=-1), branch, kinds, "jacobi")
             for kind in kinds:
                 K[kind][:, :, k0:k0 + step][reach] = Kk[kind]
     return WorkspaceGrid(params, branch, float(spacing), (xy, xy.copy(), z), reachable, K)
 
 
-def _reaches(params: DeltaParams, P: np.ndarray) -> np.ndarray:
-    """The ``reachable`` mask of :func:`inverse_kinematics_batch` (the same test, bit for bit), without the angles."""
-    reachable = np.ones(P.shape[:-1], dtype=bool)
+def _reaches(params: DeltaParams, x, y, z) -> np.ndarray:
+    """The ``reachable`` mask of :func:`inverse_kinematics_batch` (the same test, bit for bit), without the angles,
+    at the points of coordinates ``x, y, z`` [m] (arrays that broadcast together)."""
+    reachable = np.ones(np.broadcast_shapes(np.shape(x), np.shape(y), np.shape(z)), dtype=bool)
     for i in range(3):
         ci, si = math.cos(PHI[i]), math.sin(PHI[i])
-        w = ci * P[..., 0] + si * P[..., 1]
-        u = -si * P[..., 0] + ci * P[..., 1] - (params.R - params.r)
-        reachable &= circle_sphere_reach(u, P[..., 2], w, params.La, params.Lb)
+        w = ci * x + si * y
+        u = -si * x + ci * y - (params.R - params.r)
+        reachable &= circle_sphere_reach(u, z, w, params.La, params.Lb)
     return reachable
