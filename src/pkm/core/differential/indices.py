@@ -92,7 +92,7 @@ def condition_number(J: ArrayLike, kind: str = "2") -> np.ndarray | float:
 
 #: Matrices :func:`jacobi_singular_values` rotates at once (its temporaries stay in the cache: 3x faster on 3x3).
 JACOBI_BLOCK = 8192
-#: Sweeps after which :func:`jacobi_singular_values` hands a matrix that has not converged to LAPACK.
+#: Sweeps after which :func:`jacobi_singular_values` hands a matrix still turning to LAPACK.
 JACOBI_SWEEPS = 30
 
 
@@ -109,10 +109,11 @@ def jacobi_singular_values(J: ArrayLike) -> np.ndarray:
     Each sweep rotates every pair of columns ``(p, q)`` (of the transposes if ``m < n``) whose
     ``|a_p . a_q| > 3 eps |a_p| |a_q|`` so that they become orthogonal, and leaves the others exactly as they are; a
     matrix whose pairs are all orthogonal to that tolerance no longer changes, and its singular values are its column
-    norms. So each matrix's values depend on it alone, not on the others of the stack. Like LAPACK's, the route is
-    backward stable: each singular value within a few ``eps * sigma_max`` of the exact one (the two routes agree to
-    ``10 eps sigma_max``, tested), so a small one has a large relative error, as with any backward-stable route. A
-    matrix not converged after :data:`JACOBI_SWEEPS` sweeps (columns that underflow) is handed to ``np.linalg.svd``.
+    norms (and it leaves the batch). So each matrix's values depend on it alone, not on the others of the stack. Like
+    LAPACK's, the route is backward stable: each singular value within a few ``eps * sigma_max`` of the exact one (the
+    two routes agree to ``10 eps sigma_max``, tested), so a small one has a large relative error, as with any
+    backward-stable route. A matrix still turning after :data:`JACOBI_SWEEPS` sweeps (columns that underflow) is
+    handed to ``np.linalg.svd``.
     The matrices are not scaled here (entries near the float range overflow: :func:`condition_numbers` passes them
     divided by their largest entry).
     """
@@ -126,33 +127,36 @@ def jacobi_singular_values(J: ArrayLike) -> np.ndarray:
     tol2 = (3.0 * np.finfo(float).eps) ** 2
     for b0 in range(0, len(flat), JACOBI_BLOCK):
         block = flat[b0:b0 + JACOBI_BLOCK]
+        sv = np.empty((len(block), n))
         cols = [[np.ascontiguousarray(block[:, r, c]) for r in range(m)] for c in range(n)]
+        active = np.arange(len(block))  # the matrices still turning, whose columns cols holds
         for _ in range(JACOBI_SWEEPS):
-            rotated = False
+            moved = np.zeros(len(active), dtype=bool)
             for p, q in pairs:
                 x, y = cols[p], cols[q]
                 alpha, beta, gamma = _dot(x, x), _dot(y, y), _dot(x, y)
                 with np.errstate(under="ignore"):
                     turn = gamma * gamma > tol2 * (alpha * beta)  # (else the pair is left exactly as it is)
+                if not turn.any():
+                    continue
+                moved |= turn
+                with np.errstate(under="ignore"):
                     # t = tan of the angle zeroing x . y, the smaller root of t^2 gamma + t (beta - alpha) - gamma = 0
                     d = beta - alpha
                     den = d + np.copysign(np.sqrt(d * d + 4.0 * gamma * gamma), d)
                     t = np.where(turn, 2.0 * gamma / np.where(turn, den, 1.0), 0.0)
                     c = 1.0 / np.sqrt(1.0 + t * t)
                     sn = c * t
-                if turn.any():
-                    rotated = True
-                    cols[p], cols[q] = [c * a - sn * b for a, b in zip(x, y)], [sn * a + c * b for a, b in zip(x, y)]
-            if not rotated:
-                break
-        sv = np.sqrt(np.stack([_dot(col, col) for col in cols], axis=-1))
-        if rotated:  # the matrices whose columns are still not orthogonal after JACOBI_SWEEPS sweeps
-            late = np.zeros(len(block), dtype=bool)
-            for p, q in pairs:
-                g = _dot(cols[p], cols[q])
-                with np.errstate(under="ignore"):
-                    late |= g * g > tol2 * (_dot(cols[p], cols[p]) * _dot(cols[q], cols[q]))
-            sv[late] = np.linalg.svd(block[late], compute_uv=False)
+                cols[p], cols[q] = [c * a - sn * b for a, b in zip(x, y)], [sn * a + c * b for a, b in zip(x, y)]
+            if not moved.all():  # a sweep that turned no pair of a matrix: its columns are final
+                done = ~moved
+                sv[active[done]] = np.sqrt(np.stack([_dot(col, col)[done] for col in cols], axis=-1))
+                active = active[moved]
+                cols = [[a[moved] for a in col] for col in cols]
+                if not len(active):
+                    break
+        if len(active):  # still turning after JACOBI_SWEEPS sweeps: LAPACK's
+            sv[active] = np.linalg.svd(block[active], compute_uv=False)
         out[b0:b0 + JACOBI_BLOCK] = -np.sort(-sv, axis=-1)
     return out.reshape(J.shape[:-2] + (n,))
 
