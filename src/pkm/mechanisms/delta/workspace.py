@@ -170,8 +170,9 @@ def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", ki
 
     The grid covers ``|x|, |y| <= La + Lb`` and ``-(La + Lb) <= z <= 0``, which contains every
     reachable point (each ball joint lies within ``La + Lb`` of its motor, and the motors
-    surround the axis). Computed in chunks of whole z slices (at most :data:`CHUNK_NODES` nodes, or one slice) to
-    bound memory; in each, which nodes every arm reaches first (no angle needed), then the angles and the condition
+    surround the axis). Computed on the vertical lines of the grid that may hold a reachable node (a necessary test,
+    with a margin), in chunks of whole z slices (at most :data:`CHUNK_NODES` nodes, or one slice) to bound memory; in
+    each, which nodes every arm reaches first (no angle needed), then the angles and the condition
     numbers of those nodes only, by Jacobi rotations (the same numbers, bit for bit, as :func:`condition_numbers` of
     every node with ``method="jacobi"``; those of ``np.linalg.svd`` to a few ``eps * K`` relative).
     ``kinds`` empty: the reachable nodes only (no condition numbers).
@@ -191,18 +192,38 @@ def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", ki
     z = -(np.arange(n)[::-1] + 0.5) * spacing
     reachable = np.zeros((len(xy), len(xy), len(z)), dtype=bool)
     K = {kind: np.full(reachable.shape, np.inf) for kind in kinds}
-    step = max(1, CHUNK_NODES // len(xy) ** 2)  # z slices per chunk
     X, Y = np.meshgrid(xy, xy, indexing="ij")
+    near = _columns(params, X, Y)
+    xs, ys = X[near][:, None], Y[near][:, None]
+    step = max(1, CHUNK_NODES // max(len(xs), 1))  # z slices per chunk
     for k0 in range(0, len(z), step):
         zk = z[k0:k0 + step]
-        reach = _reaches(params, X[..., None], Y[..., None], zk)  # (the x, y terms once for every slice)
-        reachable[:, :, k0:k0 + step] = reach
+        reach = _reaches(params, xs, ys, zk)  # (ncolumns, nz): the x, y terms once for every slice
+        reachable[:, :, k0:k0 + step][near] = reach
         if kinds and reach.any():  # the angles and the Jacobians of the reachable nodes only
-            i, j, k = np.nonzero(reach)
-            Kk, _ = condition_numbers(params, np.stack([xy[i], xy[j], zk[k]], axis=-1), branch, kinds, "jacobi")
+            c, k = np.nonzero(reach)
+            Kk, _ = condition_numbers(params, np.stack([xs[c, 0], ys[c, 0], zk[k]], axis=-1), branch, kinds, "jacobi")
             for kind in kinds:
-                K[kind][:, :, k0:k0 + step][reach] = Kk[kind]
+                column = np.full(reach.shape, np.inf)
+                column[reach] = Kk[kind]
+                K[kind][:, :, k0:k0 + step][near] = column
     return WorkspaceGrid(params, branch, float(spacing), (xy, xy.copy(), z), reachable, K)
+
+
+def _columns(params: DeltaParams, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Which vertical lines ``(x, y)`` [m] may hold a reachable point: for every arm, the forearm sphere meets the arm's
+    plane (``w^2 <= Lb^2``, ``s = sqrt(Lb^2 - w^2)``) and the elbow circle can come within ``s`` of the line
+    (``|u| <= La + s``, as ``rho >= |u|``), each with a margin (1e-5 of ``La + Lb``, of its square) far above what
+    the reach test's ``1e-12`` slack and round-off allow: a line left out holds no node that test calls reachable."""
+    L = params.La + params.Lb
+    near = np.ones(np.shape(x), dtype=bool)
+    for i in range(3):
+        ci, si = math.cos(PHI[i]), math.sin(PHI[i])
+        w2 = (ci * x + si * y) ** 2
+        u = -si * x + ci * y - (params.R - params.r)
+        near &= (w2 <= params.Lb**2 + 1e-5 * L**2) & (
+            np.abs(u) <= params.La + np.sqrt(np.maximum(params.Lb**2 - w2, 0.0)) + 1e-5 * L)
+    return near
 
 
 def _reaches(params: DeltaParams, x, y, z) -> np.ndarray:
