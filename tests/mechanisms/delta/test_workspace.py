@@ -124,6 +124,8 @@ def test_bad_grid_inputs_raise_pkm_errors():
         condition_numbers(P, [[0.0, 0.0, np.nan]])
     with pytest.raises(InvalidInputError):
         condition_numbers(P, [[0.0, 0.0, -0.3]], kinds=("inf",))
+    with pytest.raises(InvalidInputError, match="method"):  # (also where no point is reachable)
+        condition_numbers(P, [[0.0, 0.0, -2.0]], method="qr")
     with pytest.raises(InvalidInputError):
         workspace(P, 0.0)
     grid = workspace(P, 0.11, kinds=("2",))

@@ -161,14 +161,24 @@ def jacobi_singular_values(J: ArrayLike) -> np.ndarray:
     return out.reshape(J.shape[:-2] + (n,))
 
 
+#: The routes to singular values :func:`condition_numbers` takes.
+METHODS = ("lapack", "jacobi")
+
+
+def check_method(method: object) -> str:
+    """``method`` if it is one of :data:`METHODS`, else :class:`InvalidInputError`."""
+    if not isinstance(method, str) or method not in METHODS:
+        raise InvalidInputError("method", f"choose one of {METHODS}, got {method!r}", method)
+    return method
+
+
 def condition_numbers(J: ArrayLike, kinds: tuple[str, ...] = KINDS, method: str = "lapack") -> dict[str, np.ndarray]:
     """:func:`condition_number` of several ``kinds`` from one singular value decomposition of each matrix
     (``{kind: array of shape J.shape[:-2]}``; the same numbers, bit for bit, as one call a kind).
 
     ``method``: ``"lapack"`` (``np.linalg.svd``) or ``"jacobi"`` (:func:`jacobi_singular_values`: faster on large
     stacks of small matrices, the same numbers to a few ``eps * K`` relative)."""
-    if method not in ("lapack", "jacobi"):
-        raise InvalidInputError("method", f"choose 'lapack' or 'jacobi', got {method!r}", method)
+    check_method(method)
     J = _normalized(_stack(J))
     for kind in kinds:
         if not isinstance(kind, str) or kind not in KINDS:
@@ -227,5 +237,5 @@ def homogenize(J: ArrayLike, rotation_rows: int | slice | Sequence[int] | Sequen
     return finite_result(J, "homogenized Jacobian", "the rows scaled by length overflow")
 
 
-__all__ = ["KINDS", "condition_number", "condition_numbers", "homogenize", "inverse_condition", "jacobi_singular_values",
+__all__ = ["KINDS", "METHODS", "check_method", "condition_number", "condition_numbers", "homogenize", "inverse_condition", "jacobi_singular_values",
            "manipulability", "singular_values"]

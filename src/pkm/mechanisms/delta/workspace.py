@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.differential.indices import KINDS
+from pkm.core.differential.indices import KINDS, check_method
 from pkm.core.differential.indices import condition_numbers as core_condition_numbers
 from pkm.errors import InvalidInputError
 from pkm.mechanisms._common import check_params, circle_sphere, circle_sphere_reach, real
@@ -108,6 +108,7 @@ def _condition_numbers(params: DeltaParams, P: np.ndarray, branch, kinds, R,
     unknown = [k for k in kinds if not isinstance(k, str) or k not in KINDS]
     if unknown or not kinds:
         raise InvalidInputError("kinds", f"choose among {KINDS}, got {tuple(kinds)!r}", kinds)
+    check_method(method)
     theta, reachable = _inverse_kinematics(params, P, branch, R)
     A, d = jacobian_factors(params, P[reachable], theta[reachable], R if np.ndim(R) == 0 else R[reachable])
     ok = np.all(d != 0.0, axis=-1)
