@@ -113,12 +113,24 @@ def disc_collision(b: UrdfBuilder, link: str, centre, axis, radius: float, thick
     b.collision(link, "cylinder", centre, R, radius=float(radius), length=float(thickness))
 
 
-def _circle_sphere_terms(u, v, w, arm: float, rod: float) -> tuple[np.ndarray, ...]:
-    """``(u, v, rho, K, 1 / rho, cos delta)`` of :func:`circle_sphere` (arrays; inf or NaN beyond the float range)."""
+def _circle_sphere_rho_k(u, v, w, arm: float, rod: float) -> tuple[np.ndarray, ...]:
+    """``(u, v, rho, K)`` of :func:`circle_sphere` (arrays; inf or NaN beyond the float range)."""
     u, v, w = (np.asarray(x, dtype=float) for x in (u, v, w))
     with np.errstate(over="ignore", invalid="ignore"):
-        rho = np.hypot(u, v)
-        K = (u * u + v * v + w * w + arm * arm - rod * rod) / (2.0 * arm)
+        return u, v, np.hypot(u, v), (u * u + v * v + w * w + arm * arm - rod * rod) / (2.0 * arm)
+
+
+def _meets(rho: np.ndarray, K: np.ndarray) -> np.ndarray:
+    """The rod meets the circle: ``|K| <= rho`` but for the round-off of a double root (and ``rho`` finite: a point
+    beyond the float range reaches nothing)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        return (np.abs(K) <= rho * (1.0 + 1e-12)) & (rho < np.inf)
+
+
+def _circle_sphere_terms(u, v, w, arm: float, rod: float) -> tuple[np.ndarray, ...]:
+    """``(u, v, rho, K, 1 / rho, cos delta)`` of :func:`circle_sphere` (arrays; inf or NaN beyond the float range)."""
+    u, v, rho, K = _circle_sphere_rho_k(u, v, w, arm, rod)
+    with np.errstate(over="ignore", invalid="ignore"):
         inv = 1.0 / np.maximum(rho, 1e-300)  # rho = 0: the point on the axis, any t
         return u, v, rho, K, inv, np.clip(K / np.maximum(rho, 1e-300), -1.0, 1.0)
 
@@ -140,8 +152,13 @@ def circle_sphere(u, v, w, arm: float, rod: float, sign) -> tuple[np.ndarray, np
     """
     u, v, rho, K, _, cd = _circle_sphere_terms(u, v, w, arm, rod)
     with np.errstate(invalid="ignore"):
-        reachable = np.abs(K) <= rho * (1.0 + 1e-12)
-        return wrap_angle(np.arctan2(v, u) + sign * np.arccos(cd)), reachable, rho, K
+        return wrap_angle(np.arctan2(v, u) + sign * np.arccos(cd)), _meets(rho, K), rho, K
+
+
+def circle_sphere_reach(u, v, w, arm: float, rod: float) -> np.ndarray:
+    """The ``reachable`` mask of :func:`circle_sphere` alone (the same test), without the angle's arc functions."""
+    _, _, rho, K = _circle_sphere_rho_k(u, v, w, arm, rod)
+    return _meets(rho, K)
 
 
 def circle_sphere_cs(u, v, w, arm: float, rod: float, sign) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -74,3 +74,42 @@ def test_several_kinds_from_one_decomposition_are_each_kind_s_own_bit_for_bit():
     assert condition_numbers(J[:, :2], ("2",))["2"].shape == (50,)
     with pytest.raises(InvalidInputError, match="square"):
         condition_numbers(J[:, :2], ("fro",))
+
+
+def _prescribed(rng, n, sigma):
+    """Matrices ``U diag(sigma) V^T`` (random orthogonal U, V) with the singular values ``sigma`` (rows, largest first)."""
+    U = np.linalg.qr(rng.normal(size=(n, 3, 3)))[0]
+    V = np.linalg.qr(rng.normal(size=(n, 3, 3)))[0]
+    return U * sigma[:, None, :] @ np.swapaxes(V, -1, -2)
+
+
+def test_jacobi_singular_values_are_lapack_s(monkeypatch):
+    """One-sided Jacobi against np.linalg.svd (LAPACK's bidiagonal route) and against prescribed singular values, on
+    random 3x3, near-singular ones (sigma_min down to 1e-16), exactly singular ones, wide and tall stacks, over several
+    blocks: every singular value within 10 eps sigma_max of both, and independent of the rest of the stack; K_2 through condition_numbers within 10 eps K
+    relative; a matrix not converged within the allowed sweeps is LAPACK's, bit for bit."""
+    eps = np.finfo(float).eps
+    rng = np.random.default_rng(4)
+    monkeypatch.setattr(indices, "JACOBI_BLOCK", 700)
+    sigma = np.stack([np.ones(2000), 10 ** rng.uniform(-8, 0, 2000), 10 ** rng.uniform(-16, 0, 2000)], axis=-1)
+    sigma = -np.sort(-sigma, axis=-1)
+    near = _prescribed(rng, 2000, sigma)
+    assert np.all(np.abs(indices.jacobi_singular_values(near) - sigma) <= 10 * eps)
+    singular = rng.normal(size=(50, 3, 3))
+    singular[:, :, 1] = 0.0
+    cases = [rng.normal(size=(2000, 3, 3)), near, singular, rng.normal(size=(40, 2, 5)), rng.normal(size=(40, 6, 4)),
+             rng.normal(size=(4, 5, 3, 3))]
+    for J in cases:
+        s, ref = indices.jacobi_singular_values(J), np.linalg.svd(J, compute_uv=False)
+        assert s.shape == ref.shape
+        assert np.all(np.abs(s - ref) <= 10 * eps * ref[..., :1])
+    assert np.all(indices.jacobi_singular_values(singular)[:, -1] == 0.0)
+    whole = indices.jacobi_singular_values(near)  # each matrix's values its own, whatever the others of its block
+    assert np.array_equal(indices.jacobi_singular_values(near[350:1000]), whole[350:1000])
+    J = cases[0] / np.max(np.abs(cases[0]), axis=(1, 2), keepdims=True)
+    K, ref = (indices.condition_numbers(J, ("2",), method)["2"] for method in ("jacobi", "lapack"))
+    assert np.all(np.abs(K / ref - 1.0) <= 10 * eps * ref)
+    monkeypatch.setattr(indices, "JACOBI_SWEEPS", 1)
+    assert np.array_equal(indices.jacobi_singular_values(J), np.linalg.svd(J, compute_uv=False))
+    with pytest.raises(InvalidInputError, match="method"):
+        indices.condition_numbers(J, ("2",), "qr")

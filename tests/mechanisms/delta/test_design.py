@@ -39,6 +39,21 @@ def test_reach_limit_of_the_study_pose_is_the_stretched_arm():
     assert info.value.leg == 1 and info.value.excess == pytest.approx(1e-9 * (hi - P.r) / (P.La + P.Lb), rel=1e-3)
 
 
+@pytest.mark.parametrize("branch", ["knee_out", "knee_in"])
+def test_condition_vs_radius_is_each_design_on_its_own(branch):
+    """Every radius at once (off the axis, both working modes): the condition numbers of each design built with that
+    R, one at a time, bit for bit; the first radius out of reach in a list raises, naming it."""
+    p = np.array([0.03, -0.05, -0.36])
+    R = np.linspace(0.06, 0.24, 37)
+    K = G.condition_vs_radius(P, p, R, branch)
+    for j, R_j in enumerate(R):
+        one = G.condition_numbers(dataclasses.replace(P, R=float(R_j)), p, branch)[0]
+        assert all(K[kind][j] == one[kind] for kind in KINDS)
+    (_, hi), = G.reachable_radii(P, p)
+    with pytest.raises(UnreachableError, match=f"at R = {hi + 0.01:.6g} m"):
+        G.condition_vs_radius(P, p, [0.1, hi + 0.01, 0.2, hi + 0.02], branch)
+
+
 def test_reachable_radii_agree_with_the_inverse_kinematics_off_the_axis():
     """For 40 random poses, R is inside the closed-form intervals exactly when every arm reaches
     (checked on 200 radii from 1 to 400 mm, skipping radii within 1e-9 m of an interval end)."""

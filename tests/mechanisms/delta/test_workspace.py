@@ -73,6 +73,28 @@ def test_workspace_volume_converges_with_the_grid():
         assert reached == fine.reachable[i, j, k]
 
 
+@pytest.mark.parametrize("chunk, design", [(1, P), (1000, P), (1 << 20, P),
+                                           (1000, D.DeltaParams(La=0.3, Lb=0.12, R=0.25, r=0.03))])
+def test_workspace_grid_is_the_batch_of_every_node(monkeypatch, chunk, design):
+    """The grid, computed on the vertical lines that may reach, in chunks of z slices (one slice, several with a
+    partial last, all at once), reachable nodes first: its mask and K are those of :func:`condition_numbers` on every
+    node of the grid at once (Jacobi rotations), bit for bit, and those of LAPACK's SVD within 10 eps K relative (the
+    paper's proportions, and long arms on short forearms)."""
+    import pkm.mechanisms.delta.workspace as W
+
+    monkeypatch.setattr(W, "CHUNK_NODES", chunk)
+    grid = workspace(design, 0.04 * (design.La + design.Lb) / (P.La + P.Lb))
+    nodes = np.stack(np.meshgrid(*grid.axes, indexing="ij"), axis=-1)
+    K, reachable = condition_numbers(design, nodes, method="jacobi")
+    lapack, _ = condition_numbers(design, nodes)
+    assert 0.01 < reachable.mean() < 0.9
+    np.testing.assert_array_equal(grid.reachable, reachable)
+    for kind in KINDS:
+        np.testing.assert_array_equal(grid.K[kind], K[kind])
+        k, ref = K[kind][reachable], lapack[kind][reachable]
+        assert np.all(np.abs(k / ref - 1.0) <= 10 * np.finfo(float).eps * ref)
+
+
 def test_workspace_volumes_are_ordered_and_threefold_symmetric():
     """Conditioned volume <= volume, growing with the bound; the integral of 1/K <= volume; the mask is
     invariant under the 120 deg rotation of the base (up to nodes on the boundary: 0.5 %)."""
@@ -102,6 +124,8 @@ def test_bad_grid_inputs_raise_pkm_errors():
         condition_numbers(P, [[0.0, 0.0, np.nan]])
     with pytest.raises(InvalidInputError):
         condition_numbers(P, [[0.0, 0.0, -0.3]], kinds=("inf",))
+    with pytest.raises(InvalidInputError, match="method"):  # (also where no point is reachable)
+        condition_numbers(P, [[0.0, 0.0, -2.0]], method="qr")
     with pytest.raises(InvalidInputError):
         workspace(P, 0.0)
     grid = workspace(P, 0.11, kinds=("2",))

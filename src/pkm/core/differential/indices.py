@@ -22,6 +22,8 @@ singular matrix (or a condition number beyond the float range), never NaN.
 
 from __future__ import annotations
 
+import functools
+import operator
 from collections.abc import Sequence
 
 import numpy as np
@@ -88,9 +90,95 @@ def condition_number(J: ArrayLike, kind: str = "2") -> np.ndarray | float:
     return float(k) if np.ndim(k) == 0 else k
 
 
-def condition_numbers(J: ArrayLike, kinds: tuple[str, ...] = KINDS) -> dict[str, np.ndarray]:
+#: Matrices :func:`jacobi_singular_values` rotates at once (its temporaries stay in the cache: 3x faster on 3x3).
+JACOBI_BLOCK = 8192
+#: Sweeps after which :func:`jacobi_singular_values` hands a matrix still turning to LAPACK.
+JACOBI_SWEEPS = 30
+
+
+def _dot(u: list[np.ndarray], v: list[np.ndarray]) -> np.ndarray:
+    """``sum_r u[r] v[r]``: the dot products of two columns given as lists of their components over a stack."""
+    return functools.reduce(operator.add, map(operator.mul, u, v))
+
+
+def jacobi_singular_values(J: ArrayLike) -> np.ndarray:
+    """Singular values, largest first, of a stack ``(..., m, n)`` of small matrices, by one-sided (Hestenes) Jacobi
+    rotations vectorised over the stack: a route independent of LAPACK's, 3x faster than ``np.linalg.svd`` on large
+    stacks of 3x3 (whose cost is its call per matrix).
+
+    Each sweep rotates every pair of columns ``(p, q)`` (of the transposes if ``m < n``) whose
+    ``|a_p . a_q| > 3 eps |a_p| |a_q|`` so that they become orthogonal, and leaves the others exactly as they are; a
+    matrix whose pairs are all orthogonal to that tolerance no longer changes, and its singular values are its column
+    norms (and it leaves the batch). So each matrix's values depend on it alone, not on the others of the stack. Like
+    LAPACK's, the route is backward stable: each singular value within a few ``eps * sigma_max`` of the exact one (the
+    two routes agree to ``10 eps sigma_max``, tested), so a small one has a large relative error, as with any
+    backward-stable route. A matrix still turning after :data:`JACOBI_SWEEPS` sweeps (columns that underflow) is
+    handed to ``np.linalg.svd``.
+    The matrices are not scaled here (entries near the float range overflow: :func:`condition_numbers` passes them
+    divided by their largest entry).
+    """
+    J = _stack(J)
+    if J.shape[-2] < J.shape[-1]:
+        J = np.swapaxes(J, -1, -2)
+    m, n = J.shape[-2:]
+    flat = J.reshape(-1, m, n)
+    out = np.empty((len(flat), n))
+    pairs = [(p, q) for p in range(n) for q in range(p + 1, n)]
+    tol2 = (3.0 * np.finfo(float).eps) ** 2
+    for b0 in range(0, len(flat), JACOBI_BLOCK):
+        block = flat[b0:b0 + JACOBI_BLOCK]
+        sv = np.empty((len(block), n))
+        cols = [[np.ascontiguousarray(block[:, r, c]) for r in range(m)] for c in range(n)]
+        active = np.arange(len(block))  # the matrices still turning, whose columns cols holds
+        for _ in range(JACOBI_SWEEPS):
+            moved = np.zeros(len(active), dtype=bool)
+            for p, q in pairs:
+                x, y = cols[p], cols[q]
+                alpha, beta, gamma = _dot(x, x), _dot(y, y), _dot(x, y)
+                with np.errstate(under="ignore"):
+                    turn = gamma * gamma > tol2 * (alpha * beta)  # (else the pair is left exactly as it is)
+                if not turn.any():
+                    continue
+                moved |= turn
+                with np.errstate(under="ignore"):
+                    # t = tan of the angle zeroing x . y, the smaller root of t^2 gamma + t (beta - alpha) - gamma = 0
+                    d = beta - alpha
+                    den = d + np.copysign(np.sqrt(d * d + 4.0 * gamma * gamma), d)
+                    t = np.where(turn, 2.0 * gamma / np.where(turn, den, 1.0), 0.0)
+                    c = 1.0 / np.sqrt(1.0 + t * t)
+                    sn = c * t
+                cols[p], cols[q] = [c * a - sn * b for a, b in zip(x, y)], [sn * a + c * b for a, b in zip(x, y)]
+            if not moved.all():  # a sweep that turned no pair of a matrix: its columns are final
+                done = ~moved
+                sv[active[done]] = np.sqrt(np.stack([_dot(col, col)[done] for col in cols], axis=-1))
+                active = active[moved]
+                cols = [[a[moved] for a in col] for col in cols]
+                if not len(active):
+                    break
+        if len(active):  # still turning after JACOBI_SWEEPS sweeps: LAPACK's
+            sv[active] = np.linalg.svd(block[active], compute_uv=False)
+        out[b0:b0 + JACOBI_BLOCK] = -np.sort(-sv, axis=-1)
+    return out.reshape(J.shape[:-2] + (n,))
+
+
+#: The routes to singular values :func:`condition_numbers` takes.
+METHODS = ("lapack", "jacobi")
+
+
+def check_method(method: object) -> str:
+    """``method`` if it is one of :data:`METHODS`, else :class:`InvalidInputError`."""
+    if not isinstance(method, str) or method not in METHODS:
+        raise InvalidInputError("method", f"choose one of {METHODS}, got {method!r}", method)
+    return method
+
+
+def condition_numbers(J: ArrayLike, kinds: tuple[str, ...] = KINDS, method: str = "lapack") -> dict[str, np.ndarray]:
     """:func:`condition_number` of several ``kinds`` from one singular value decomposition of each matrix
-    (``{kind: array of shape J.shape[:-2]}``; the same numbers, bit for bit, as one call a kind)."""
+    (``{kind: array of shape J.shape[:-2]}``; the same numbers, bit for bit, as one call a kind).
+
+    ``method``: ``"lapack"`` (``np.linalg.svd``) or ``"jacobi"`` (:func:`jacobi_singular_values`: faster on large
+    stacks of small matrices, the same numbers to a few ``eps * K`` relative)."""
+    check_method(method)
     J = _normalized(_stack(J))
     for kind in kinds:
         if not isinstance(kind, str) or kind not in KINDS:
@@ -99,7 +187,7 @@ def condition_numbers(J: ArrayLike, kinds: tuple[str, ...] = KINDS) -> dict[str,
     m, n = J.shape[-2:]
     if m != n and any(kind != "2" for kind in kinds):
         raise InvalidInputError("J", f"the Frobenius condition number needs a square matrix, got {m}x{n}")
-    s = np.linalg.svd(J, compute_uv=False)
+    s = np.linalg.svd(J, compute_uv=False) if method == "lapack" else jacobi_singular_values(J)
     smax, smin = s[..., 0], s[..., -1]
     ok = smin > 0.0
     out: dict[str, np.ndarray] = {}
@@ -149,4 +237,5 @@ def homogenize(J: ArrayLike, rotation_rows: int | slice | Sequence[int] | Sequen
     return finite_result(J, "homogenized Jacobian", "the rows scaled by length overflow")
 
 
-__all__ = ["KINDS", "condition_number", "condition_numbers", "homogenize", "inverse_condition", "manipulability", "singular_values"]
+__all__ = ["KINDS", "METHODS", "check_method", "condition_number", "condition_numbers", "homogenize", "inverse_condition", "jacobi_singular_values",
+           "manipulability", "singular_values"]

@@ -22,9 +22,10 @@ from scipy.optimize import minimize_scalar
 
 from pkm.core.differential.indices import KINDS
 from pkm.errors import InvalidInputError, UnreachableError
-from pkm.mechanisms._common import check_params, real
+from pkm.mechanisms._common import check_params, circle_sphere_reach, real
 from pkm.mechanisms.delta import PHI, DeltaParams, arm_angles
-from pkm.mechanisms.delta.workspace import condition_numbers, workspace
+from pkm.mechanisms.delta.kinematics import _arm_frame_points
+from pkm.mechanisms.delta.workspace import _condition_numbers, condition_numbers, workspace
 from pkm.validation import as_array, as_count, as_vector
 
 __all__ = ["RadiusStudy", "condition_vs_radius", "radius_minimising_condition", "reachable_radii",
@@ -78,7 +79,8 @@ def reachable_radii(params: DeltaParams, p) -> tuple[tuple[float, float], ...]:
 
 
 def condition_vs_radius(params: DeltaParams, p, R_values, branch="knee_out", kinds=KINDS) -> dict[str, np.ndarray]:
-    """Condition numbers of ``J`` at the pose ``p`` [m] for each base radius in ``R_values`` [m].
+    """Condition numbers of ``J`` at the pose ``p`` [m] for each base radius in ``R_values`` [m] (every radius in
+    one batch: the numbers, bit for bit, of :func:`~pkm.mechanisms.delta.workspace.condition_numbers` of each design).
 
     Raises:
         UnreachableError: if ``p`` is out of reach for one of the radii (arm and distance named).
@@ -88,13 +90,15 @@ def condition_vs_radius(params: DeltaParams, p, R_values, branch="knee_out", kin
     R_values = np.atleast_1d(as_array(R_values, "R_values", "base radii [m]"))
     if R_values.ndim != 1 or not np.all(np.isfinite(R_values)) or np.any(R_values <= 0.0):
         raise InvalidInputError("R_values", "must be finite radii > 0 [m]", R_values)
-    out = {kind: np.empty(len(R_values)) for kind in kinds}
-    for j, R in enumerate(R_values):
-        arm_angles(params.La, params.Lb, R - params.r, p, (1, 1, 1), f" at R = {R:.6g} m")  # reach, or which arm
-        K, _ = condition_numbers(dataclasses.replace(params, R=float(R)), p, branch, kinds)
-        for kind in kinds:
-            out[kind][j] = K[kind]
-    return out
+    x, y, z = _arm_frame_points(p)  # the reach test of arm_angles, every radius at once
+    misses = np.flatnonzero(~circle_sphere_reach(y - (R_values - params.r)[:, None], z, x, params.La, params.Lb)
+                            .all(axis=-1))
+    for R in R_values[misses[:1]]:
+        arm_angles(params.La, params.Lb, R - params.r, p, (1, 1, 1), f" at R = {R:.6g} m")  # which arm, how far
+    if len(R_values):
+        dataclasses.replace(params, R=float(np.max(R_values)))  # (a design: R within the checked range)
+    K, _ = _condition_numbers(params, np.broadcast_to(p, (len(R_values), 3)), branch, kinds, R_values)
+    return K
 
 
 def radius_minimising_condition(params: DeltaParams, p, branch="knee_out", kind: str = "2",

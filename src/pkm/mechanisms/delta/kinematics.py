@@ -109,7 +109,7 @@ def forward_kinematics(params: DeltaParams, theta, *, both: bool = False) -> np.
     return sols if both else sols[0]
 
 
-def jacobian_factors(params: DeltaParams, p, theta) -> tuple[np.ndarray, np.ndarray]:
+def jacobian_factors(params: DeltaParams, p, theta, R=None) -> tuple[np.ndarray, np.ndarray]:
     """The two factors of the velocity equations ``A Xd = diag(d) thd``, over stacks of poses.
 
     Differentiating the sphere equations (8), ``f_i = |E + Rz(phi_i)(0, r, 0) - B_i(th_i)|^2 - Lb^2 = 0``,
@@ -121,12 +121,15 @@ def jacobian_factors(params: DeltaParams, p, theta) -> tuple[np.ndarray, np.ndar
         params: The design.
         p: Platform centres [m], shape (..., 3).
         theta: Motor angles [rad] assembled with ``p``, shape (..., 3).
+        R: The base radius [m] in place of ``params.R``: a float, or an array of shape (...) (a family of
+            designs, one pose each; as :func:`pkm.mechanisms.delta.design.condition_vs_radius` sweeps R).
 
     Returns:
         ``A`` of shape (..., 3, 3) and ``d`` of shape (..., 3).
     """
     params = check_params(params, DeltaParams)
     p, theta = np.asarray(p, dtype=float), np.asarray(theta, dtype=float)
+    R = params.R if R is None else R
     c, s = np.cos(theta), np.sin(theta)
     A = np.empty(p.shape[:-1] + (3, 3))
     d = np.empty(p.shape[:-1] + (3,))
@@ -134,7 +137,7 @@ def jacobian_factors(params: DeltaParams, p, theta) -> tuple[np.ndarray, np.ndar
         ci, si = math.cos(PHI[i]), math.sin(PHI[i])
         # arm frame: forearm vector (x, y, z) and dB/dth = (0, -La s, La c); back to the base by Rz(phi_i)
         x = ci * p[..., 0] + si * p[..., 1]
-        y = -si * p[..., 0] + ci * p[..., 1] + params.r - params.R - params.La * c[..., i]
+        y = -si * p[..., 0] + ci * p[..., 1] + params.r - R - params.La * c[..., i]
         z = p[..., 2] - params.La * s[..., i]
         A[..., i, 0], A[..., i, 1], A[..., i, 2] = ci * x - si * y, si * x + ci * y, z
         d[..., i] = params.La * (z * c[..., i] - y * s[..., i])

@@ -19,15 +19,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pkm.core.differential.indices import KINDS
+from pkm.core.differential.indices import KINDS, check_method
 from pkm.core.differential.indices import condition_numbers as core_condition_numbers
 from pkm.errors import InvalidInputError
-from pkm.mechanisms._common import check_params, circle_sphere, real
+from pkm.mechanisms._common import check_params, circle_sphere, circle_sphere_reach, real
 from pkm.mechanisms.delta import PHI, DeltaParams, jacobian_factors
 from pkm.mechanisms.delta.kinematics import branch_signs
 from pkm.validation import as_array
 
-MAX_NODES = 16_000_000  #: grid nodes of :func:`workspace` at most (memory)
+MAX_NODES = 16_000_000  #: grid nodes of :func:`workspace` at most (the grids it returns: memory)
+CHUNK_NODES = 1 << 20  #: grid nodes :func:`workspace` evaluates at once (whole z slices; its temporaries: memory)
 
 __all__ = ["WorkspaceGrid", "condition_numbers", "inverse_kinematics_batch", "workspace"]
 
@@ -56,21 +57,26 @@ def inverse_kinematics_batch(params: DeltaParams, points, branch="knee_out") -> 
         clipped arc cosine), finite but meaningless: use the mask.
     """
     params = check_params(params, DeltaParams)
-    P = _points(points)
+    return _inverse_kinematics(params, _points(points), branch, params.R)
+
+
+def _inverse_kinematics(params: DeltaParams, P: np.ndarray, branch, R) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`inverse_kinematics_batch` with the base radius ``R`` [m] in place of ``params.R`` (a float, or an
+    array of shape ``P.shape[:-1]``: one design a point)."""
     signs = branch_signs(branch)
     theta = np.empty(P.shape)
     reachable = np.ones(P.shape[:-1], dtype=bool)
     for i in range(3):
         ci, si = math.cos(PHI[i]), math.sin(PHI[i])
         w = ci * P[..., 0] + si * P[..., 1]  # along the motor axis
-        u = -si * P[..., 0] + ci * P[..., 1] - (params.R - params.r)
+        u = -si * P[..., 0] + ci * P[..., 1] - (R - params.r)
         theta[..., i], reach_i, _, _ = circle_sphere(u, P[..., 2], w, params.La, params.Lb, signs[i])
         reachable &= reach_i
     return theta, reachable
 
 
-def condition_numbers(params: DeltaParams, points, branch="knee_out", kinds=KINDS) -> tuple[dict[str, np.ndarray],
-                                                                                             np.ndarray]:
+def condition_numbers(params: DeltaParams, points, branch="knee_out", kinds=KINDS,
+                      method: str = "lapack") -> tuple[dict[str, np.ndarray], np.ndarray]:
     """Condition numbers of ``J = dX/dth`` at many platform centres.
 
     They are computed on ``J^-1 = diag(d)^-1 A`` (no inversion needed; every kind of
@@ -82,23 +88,32 @@ def condition_numbers(params: DeltaParams, points, branch="knee_out", kinds=KIND
         branch: Working mode (see :func:`inverse_kinematics_batch`).
         kinds: Which conventions (``"fro"``: raw ``||J||_F ||J^-1||_F`` >= 3; ``"fro_normalized"``:
             the same over 3, >= 1; ``"2"``: ``sigma_max / sigma_min`` >= 1).
+        method: The singular values' route, ``"lapack"`` or ``"jacobi"`` (faster on many points; see
+            :func:`pkm.core.differential.indices.condition_numbers`).
 
     Returns:
         ``{kind: K}`` each of shape (...), ``inf`` at unreachable points and where an arm is
         stretched or folded onto its forearm, and the ``reachable`` mask.
     """
     params = check_params(params, DeltaParams)
-    P = _points(points)
+    return _condition_numbers(params, _points(points), branch, kinds, params.R, method)
+
+
+def _condition_numbers(params: DeltaParams, P: np.ndarray, branch, kinds, R,
+                       method: str = "lapack") -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """:func:`condition_numbers` with the base radius ``R`` [m] in place of ``params.R`` (a float, or an array of
+    shape ``P.shape[:-1]``: one design a point)."""
     if isinstance(kinds, str) or not isinstance(kinds, (tuple, list)):
         raise InvalidInputError("kinds", f"expected a tuple of kinds among {KINDS}, got {kinds!r}", kinds)
     unknown = [k for k in kinds if not isinstance(k, str) or k not in KINDS]
     if unknown or not kinds:
         raise InvalidInputError("kinds", f"choose among {KINDS}, got {tuple(kinds)!r}", kinds)
-    theta, reachable = inverse_kinematics_batch(params, P, branch)
-    A, d = jacobian_factors(params, P[reachable], theta[reachable])
+    check_method(method)
+    theta, reachable = _inverse_kinematics(params, P, branch, R)
+    A, d = jacobian_factors(params, P[reachable], theta[reachable], R if np.ndim(R) == 0 else R[reachable])
     ok = np.all(d != 0.0, axis=-1)
     Jinv = A / np.where(ok[..., None], d, 1.0)[..., None]
-    each = core_condition_numbers(Jinv[ok], tuple(kinds)) if ok.any() else {}
+    each = core_condition_numbers(Jinv[ok], tuple(kinds), method) if ok.any() else {}
     out = {}
     for kind in kinds:
         K = np.full(P.shape[:-1], np.inf)
@@ -156,8 +171,12 @@ def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", ki
 
     The grid covers ``|x|, |y| <= La + Lb`` and ``-(La + Lb) <= z <= 0``, which contains every
     reachable point (each ball joint lies within ``La + Lb`` of its motor, and the motors
-    surround the axis). Computed z slice by z slice to bound memory. ``kinds`` empty: the reachable nodes only
-    (no condition numbers).
+    surround the axis). Computed on the vertical lines of the grid that may hold a reachable node (a necessary test,
+    with a margin), in chunks of whole z slices (at most :data:`CHUNK_NODES` nodes, or one slice) to bound memory; in
+    each, which nodes every arm reaches first (no angle needed), then the angles and the condition
+    numbers of those nodes only, by Jacobi rotations (the same numbers, bit for bit, as :func:`condition_numbers` of
+    every node with ``method="jacobi"``; those of ``np.linalg.svd`` to a few ``eps * K`` relative).
+    ``kinds`` empty: the reachable nodes only (no condition numbers).
 
     Raises:
         InvalidInputError: if ``spacing`` is not a finite length in (0, (La + Lb) / 4].
@@ -175,12 +194,46 @@ def workspace(params: DeltaParams, spacing: float = 0.008, branch="knee_out", ki
     reachable = np.zeros((len(xy), len(xy), len(z)), dtype=bool)
     K = {kind: np.full(reachable.shape, np.inf) for kind in kinds}
     X, Y = np.meshgrid(xy, xy, indexing="ij")
-    for k, zk in enumerate(z):
-        pts = np.stack([X, Y, np.full_like(X, zk)], axis=-1)
-        if not kinds:  # (the reachable nodes only)
-            reachable[:, :, k] = inverse_kinematics_batch(params, pts, branch)[1]
-            continue
-        Kk, reachable[:, :, k] = condition_numbers(params, pts, branch, kinds)
-        for kind in kinds:
-            K[kind][:, :, k] = Kk[kind]
+    near = _columns(params, X, Y)
+    xs, ys = X[near][:, None], Y[near][:, None]
+    step = max(1, CHUNK_NODES // max(len(xs), 1))  # z slices per chunk
+    for k0 in range(0, len(z), step):
+        zk = z[k0:k0 + step]
+        reach = _reaches(params, xs, ys, zk)  # (ncolumns, nz): the x, y terms once for every slice
+        reachable[:, :, k0:k0 + step][near] = reach
+        if kinds and reach.any():  # the angles and the Jacobians of the reachable nodes only
+            c, k = np.nonzero(reach)
+            Kk, _ = condition_numbers(params, np.stack([xs[c, 0], ys[c, 0], zk[k]], axis=-1), branch, kinds, "jacobi")
+            for kind in kinds:
+                column = np.full(reach.shape, np.inf)
+                column[reach] = Kk[kind]
+                K[kind][:, :, k0:k0 + step][near] = column
     return WorkspaceGrid(params, branch, float(spacing), (xy, xy.copy(), z), reachable, K)
+
+
+def _columns(params: DeltaParams, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Which vertical lines ``(x, y)`` [m] may hold a reachable point: for every arm, the forearm sphere meets the arm's
+    plane (``w^2 <= Lb^2``, ``s = sqrt(Lb^2 - w^2)``) and the elbow circle can come within ``s`` of the line
+    (``|u| <= La + s``, as ``rho >= |u|``), each with a margin (1e-5 of ``La + Lb``, of its square) far above what
+    the reach test's ``1e-12`` slack and round-off allow: a line left out holds no node that test calls reachable."""
+    L = params.La + params.Lb
+    near = np.ones(np.shape(x), dtype=bool)
+    for i in range(3):
+        ci, si = math.cos(PHI[i]), math.sin(PHI[i])
+        w2 = (ci * x + si * y) ** 2
+        u = -si * x + ci * y - (params.R - params.r)
+        near &= (w2 <= params.Lb**2 + 1e-5 * L**2) & (
+            np.abs(u) <= params.La + np.sqrt(np.maximum(params.Lb**2 - w2, 0.0)) + 1e-5 * L)
+    return near
+
+
+def _reaches(params: DeltaParams, x, y, z) -> np.ndarray:
+    """The ``reachable`` mask of :func:`inverse_kinematics_batch` (the same test, bit for bit), without the angles,
+    at the points of coordinates ``x, y, z`` [m] (arrays that broadcast together)."""
+    reachable = np.ones(np.broadcast_shapes(np.shape(x), np.shape(y), np.shape(z)), dtype=bool)
+    for i in range(3):
+        ci, si = math.cos(PHI[i]), math.sin(PHI[i])
+        w = ci * x + si * y
+        u = -si * x + ci * y - (params.R - params.r)
+        reachable &= circle_sphere_reach(u, z, w, params.La, params.Lb)
+    return reachable
