@@ -577,15 +577,27 @@ def _follow_actuators(g, adv):
     return _follow(g, adv, False)
 
 
+#: The mechanisms the compiled kernels' entries (``Kernels.inverse_dynamics``, ``Kernels.close_loops_path``,
+#: ``maps.task_map``) draw from: None, every registered one (the full run). A smoke run may name fewer
+#: (tests/test_fuzz.py): each mechanism's kernels are a twin built and a C library compiled per kernel, 0.3 to 1.8 s of
+#: CPU each (the hexapod's map), where the calls themselves take milliseconds.
+KERNEL_MECHANISMS: tuple[str, ...] | None = None
+
+
 def _kernels(n: str):
     c = ctx()
     return c.lazy(f"kernels:{n}", lambda: c.pkm.Kernels(c.mech[n]))
 
 
+def _kernel_mechanism(g: Gen) -> str:
+    """A mechanism for a compiled kernels' entry: one of :data:`KERNEL_MECHANISMS` (default every registered one)."""
+    return g.pick(KERNEL_MECHANISMS or ctx().names)
+
+
 @entry("Kernels.inverse_dynamics")
 def _kernels_inverse_dynamics(g, adv):
     c = ctx()
-    n = g.pick(c.names)
+    n = _kernel_mechanism(g)
     m = c.mech[n]
     batch = g.chance(0.3)
     q = np.array([_q(g, n, False) for _ in range(3)]) if batch else _q(g, n, False)
@@ -622,7 +634,7 @@ def _kernels_at(g, adv):
 @entry("Kernels.close_loops_path")
 def _kernels_path(g, adv):
     c = ctx()
-    n = g.pick(c.names)
+    n = _kernel_mechanism(g)
     k = int(g.rng.integers(1, 5))
     targets = np.array([c.qa_ref[n]] * k) + g.near(np.zeros((k, c.mech[n].na)), 0.005)
     kw: dict = {}
@@ -641,7 +653,7 @@ def _task_map(g, adv):
     from pkm.core.analysis.maps import workspace_map
 
     c = ctx()
-    n = g.pick(c.names)
+    n = _kernel_mechanism(g)
     task = c.task[n]
     names = [k for k in task.keys if k in task.value_names]
     y0 = task.named(c.mech[n].q_reference)

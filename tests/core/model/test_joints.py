@@ -11,7 +11,8 @@ import pinocchio as pin
 import pytest
 
 from pkm.core import ClosureSpec
-from pkm.core.model.joints import JOINT_TYPES, UNIVERSAL_AXES, reduced_model, retype_joints
+from pkm.core.model import joints
+from pkm.core.model.joints import JOINT_TYPES, UNIVERSAL_AXES, has_mimic, reduced_model, retype_joints
 from pkm.core.model.urdf import load_model
 from pkm.errors import SpecError
 
@@ -91,3 +92,20 @@ def test_a_model_whose_link_and_joint_share_a_name_is_reduced_keeping_every_fram
     for name in ("b", "u"):
         a, b = (m.getFrameId(name, pin.FrameType.BODY) for m in (model, reduced))
         assert np.abs((full.oMf[a].inverse() * red.oMf[b]).toActionMatrix() - np.eye(6)).max() < 1e-14
+
+
+def test_has_mimic_remembers_a_model_while_it_lives_and_asks_again_after_a_joint_is_added():
+    """has_mimic's answer, remembered by the model's id, is the scan's: False for two revolutes, True for the model
+    that turns the second into a mimic, False again for the first; a joint added since is scanned; a freed model's
+    entry is gone (no later model takes its answer with its id)."""
+    model = pin.Model()
+    a = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "a")
+    b = model.addJoint(a, pin.JointModelRZ(), pin.SE3.Identity(), "b")
+    assert not has_mimic(model) and not has_mimic(model)
+    mimic = pin.transformJointIntoMimic(model, a, b, 2.0, 0.0)
+    assert has_mimic(mimic) and has_mimic(mimic) and not has_mimic(model)
+    model.addJoint(b, pin.JointModelRX(), pin.SE3.Identity(), "c")
+    assert not has_mimic(model) and joints._MIMIC[id(model)] == (4, False)  # (its joint count changed: scanned again)
+    key = id(mimic)
+    del mimic
+    assert key not in joints._MIMIC

@@ -38,13 +38,16 @@ def test_delta_has_its_two_sphere_intersection_roots():
 
 
 def test_rrr3_modes_are_the_exact_polynomials_on_random_designs():
-    """On 20 random designs and motor angles, the set equals the roots of the 3-RRR's exact FK polynomial
-    (:func:`pkm.mechanisms.rrr3.kinematics.forward_kinematics`), pose by pose to 1e-8 (m, rad). (Each design is one
-    Bertini solve of 16 paths, a quarter of a second: 20 designs, drawn so that they meet every count of real modes
-    the 3-RRR has here, none, two, four and six, which the test asserts.)"""
+    """On random designs and motor angles, the set equals the roots of the 3-RRR's exact FK polynomial
+    (:func:`pkm.mechanisms.rrr3.kinematics.forward_kinematics`), pose by pose to 1e-8 (m, rad), for every count of
+    real modes the 3-RRR has here: none, two, four and six. (Each design checked is one Bertini solve of 16 paths, a
+    quarter of a second; the designs are drawn until each count has been met, at most two checked per count: six
+    solves, where the first twenty designs drawn were fifteen of two modes or none, 5 s of CPU.)"""
     rng = np.random.default_rng(0)
-    checked, counts = 0, set()
-    while checked < 20:
+    checked: dict[int, int] = {}
+    for _ in range(200):  # (the 16th draw meets the last count, four)
+        if set(checked) == {0, 2, 4, 6}:
+            break
         H = rng.uniform(0.5, 1.5)
         h, a, b = H * rng.uniform(0.1, 0.5), H * rng.uniform(0.3, 0.7), H * rng.uniform(0.3, 0.7)
         try:
@@ -56,6 +59,8 @@ def test_rrr3_modes_are_the_exact_polynomials_on_random_designs():
             exact = rrr3_kinematics.forward_kinematics(mech.params, qa)
         except pkm.errors.AssemblyError:
             exact = ()
+        if checked.get(len(exact), 0) >= 2:
+            continue
         modes = assembly_modes(mech, qa)
         assert modes.complete, modes.summary()
         got = sorted((pkm.TaskMap.of(mech).value(m.q) for m in modes), key=lambda y: y[2] % (2 * np.pi))
@@ -64,9 +69,8 @@ def test_rrr3_modes_are_the_exact_polynomials_on_random_designs():
         for g, w in zip(got, want):
             assert np.abs(g[:2] - w[:2]).max() < 1e-8
             assert abs((g[2] - w[2] + np.pi) % (2 * np.pi) - np.pi) < 1e-8
-        checked += 1
-        counts.add(len(got))
-    assert counts == {0, 2, 4, 6}  # (not a test of empty sets, nor of pairs alone)
+        checked[len(got)] = checked.get(len(got), 0) + 1
+    assert set(checked) == {0, 2, 4, 6}, checked  # (not a test of empty sets, nor of pairs alone)
 
 
 def test_a_dropped_path_is_reported_and_the_set_not_complete():

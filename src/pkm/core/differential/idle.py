@@ -26,6 +26,8 @@ grams, is 7e-8 of it on ``talos_like``).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pinocchio as pin
 
@@ -54,8 +56,16 @@ def joint_inertia(mech: Mechanism, q: np.ndarray) -> np.ndarray:
         rest = pin.rnea(model, data, q, zero, zero).copy()
         M = np.column_stack([pin.rnea(model, data, q, zero, e) - rest for e in np.eye(model.nv)])
     else:
-        M = pin.crba(model, data, q)
-    return finite_result(np.triu(M) + np.triu(M, 1).T, "joint-space mass matrix")
+        M = pin.crba(model, data, q)  # (a copy of data.M: its upper triangle)
+    lower = _lower(model.nv)
+    M[lower] = M.T[lower]  # (the upper triangle mirrored: np.triu(M) + np.triu(M, 1).T, a fifth of its time)
+    return finite_result(M, "joint-space mass matrix")
+
+
+@functools.lru_cache(maxsize=64)
+def _lower(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The indices of the strictly lower triangle of an n x n matrix."""
+    return np.tril_indices(n, -1)
 
 
 def idle_inertia_inverse(M: np.ndarray, N: np.ndarray) -> np.ndarray:

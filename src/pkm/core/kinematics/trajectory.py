@@ -15,7 +15,7 @@ efforts and a Jump.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -133,12 +133,22 @@ def _open(res: SolveResult, tol: float) -> bool:
     return bool(res.relative_residual > tol) if np.isfinite(res.relative_residual) else bool(res.residual > tol)
 
 
+#: The continuation's default tolerance (:func:`follow_task`, :func:`follow_actuators`): lengths in the characteristic
+#: length, angles in rad.
+FOLLOW_TOL = 1e-10
+#: A path's steps for :func:`_follow`: its sample count, ``solve``, ``predict`` and ``rates``.
+_Steps = tuple[int, Callable[[int, np.ndarray], SolveResult], Callable[[int, np.ndarray], np.ndarray],
+               Callable[[int, np.ndarray], tuple[np.ndarray, np.ndarray]]]
+
+
 def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int, np.ndarray], SolveResult],
             predict: Callable[[int, np.ndarray], np.ndarray],
             rates: Callable[[int, np.ndarray], tuple[np.ndarray, np.ndarray]], efforts: bool, wrench: ArrayLike | None,
-            tol: float) -> Trajectory:
+            tol: float, until: Collection[str] = ()) -> Trajectory:
     """The samples one by one: ``solve(k, q_from)`` from the previous sample (``q0`` for the first),
-    ``predict(k, q_prev)`` the first-order step, ``rates(k, q) -> (v, a)``."""
+    ``predict(k, q_prev)`` the first-order step, ``rates(k, q) -> (v, a)``. With ``until``, the trajectory ends at
+    the first sample with a jump of one of these reasons (the samples after it not solved: a mode's track stops
+    there, :mod:`pkm.core.modes.tracking`)."""
     start = mech.q_reference if q0 is None else mech.check_q(q0, "q0")
     if not isinstance(efforts, (bool, np.bool_)):
         raise InvalidInputError("efforts", f"expected True or False, got {type(efforts).__name__}", efforts)
@@ -152,6 +162,10 @@ def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int,
     prev = None
     signs = None
     for k in range(n):
+        if any(j.index == k - 1 and j.reason in until for j in jumps[-4:]):  # (the sample before ended the path)
+            q, v, a, residual = q[:k], v[:k], a[:k], residual[:k]
+            tau = None if tau is None else tau[:k]
+            break
         res = solve(k, start if prev is None else prev)
         q[k], residual[k] = res.q, res.residual
         if not res.converged:
@@ -203,7 +217,7 @@ def interference_along(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray | Non
 
 
 def follow_task(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None = None, ydd: ArrayLike | None = None, *,
-                q0: ArrayLike | None = None, efforts: bool = True, wrench: ArrayLike | None = None, tol: float = 1e-10) -> Trajectory:
+                q0: ArrayLike | None = None, efforts: bool = True, wrench: ArrayLike | None = None, tol: float = FOLLOW_TOL) -> Trajectory:
     """Inverse kinematics, rates and efforts along task samples, tracking one working mode.
 
     Args:
@@ -232,6 +246,12 @@ def follow_task(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None = None, ydd:
         array([0.1647, 0.1005, 0.2231])
     """
     mech = check_mechanism(mech)
+    n, solve, predict, rates = _task_steps(mech, y, yd, ydd, tol)
+    return _follow(mech, n, q0, solve, predict, rates, efforts, wrench, tol)
+
+
+def _task_steps(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None, ydd: ArrayLike | None, tol: float) -> _Steps:
+    """:func:`follow_task`'s samples, checked, and its steps for :func:`_follow`: ``(n, solve, predict, rates)``."""
     task = TaskMap.of(mech)
     Y = _samples(y, None, task.value_size, "y")
     n = len(Y)
@@ -247,11 +267,11 @@ def follow_task(mech: Mechanism, y: ArrayLike, yd: ArrayLike | None = None, ydd:
         vk = inverse_velocities(mech, qk, Yd[k])
         return vk, inverse_accelerations(mech, qk, vk, Ydd[k])
 
-    return _follow(mech, n, q0, solve, predict, rates, efforts, wrench, tol)
+    return n, solve, predict, rates
 
 
 def follow_actuators(mech: Mechanism, qa: ArrayLike, qd: ArrayLike | None = None, qdd: ArrayLike | None = None, *,
-                     q0: ArrayLike | None = None, efforts: bool = True, wrench: ArrayLike | None = None, tol: float = 1e-10) -> Trajectory:
+                     q0: ArrayLike | None = None, efforts: bool = True, wrench: ArrayLike | None = None, tol: float = FOLLOW_TOL) -> Trajectory:
     """Forward kinematics, rates and efforts along actuator samples, tracking one assembly mode.
 
     Args:
@@ -276,6 +296,14 @@ def follow_actuators(mech: Mechanism, qa: ArrayLike, qd: ArrayLike | None = None
         True
     """
     mech = check_mechanism(mech)
+    n, solve, predict, rates = _actuator_steps(mech, qa, qd, qdd, tol)
+    return _follow(mech, n, q0, solve, predict, rates, efforts, wrench, tol)
+
+
+def _actuator_steps(mech: Mechanism, qa: ArrayLike, qd: ArrayLike | None, qdd: ArrayLike | None,
+                    tol: float) -> _Steps:
+    """:func:`follow_actuators`' samples, checked, and its steps for :func:`_follow`: ``(n, solve, predict,
+    rates)``."""
     A = _samples(qa, None, mech.na, "qa")
     n = len(A)
     Ad, Add = _samples(qd, n, mech.na, "qd"), _samples(qdd, n, mech.na, "qdd")
@@ -290,7 +318,7 @@ def follow_actuators(mech: Mechanism, qa: ArrayLike, qd: ArrayLike | None = None
         vk = velocities(mech, qk, Ad[k])
         return vk, accelerations(mech, qk, vk, Add[k])
 
-    return _follow(mech, n, q0, solve, predict, rates, efforts, wrench, tol)
+    return n, solve, predict, rates
 
 
 def task_values(mech: Mechanism, q: ArrayLike) -> dict[str, float]:
@@ -309,4 +337,4 @@ def task_values(mech: Mechanism, q: ArrayLike) -> dict[str, float]:
     return TaskMap.of(mech).named(mech.check_q(q))
 
 
-__all__ = ["JUMP_RATIO", "Jump", "Trajectory", "follow_actuators", "follow_task", "task_values"]
+__all__ = ["FOLLOW_TOL", "JUMP_RATIO", "Jump", "Trajectory", "follow_actuators", "follow_task", "task_values"]

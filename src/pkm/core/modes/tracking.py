@@ -6,10 +6,11 @@ The track starts from a :class:`~pkm.core.modes.assembly.Mode` (its configuratio
 picks it) and runs the core's continuation (:func:`pkm.core.follow_actuators`, :func:`pkm.core.follow_task`),
 whose every step is checked against its first-order prediction: a step far beyond it, a map singular at a sample,
 or (inverse kinematics) a working mode's joint signs changing mark a meeting. Samples from the meeting on are
-not reached (NaN). The meeting is then located by bisection between the last sample reached and the next
-(the mode followed in ever smaller steps, to 1e-9 of the interval): its fraction ``s`` of the interval, the
-configuration there, and the smallest singular value (relative to the largest) of the map that loses rank where
-the modes meet: the closure Jacobian in the passive joints (forward), closure and task in every joint (inverse).
+not reached (NaN; the continuation stops at the meeting, the samples after it are not solved). The meeting is then
+located by bisection between the last sample reached and the next (the mode followed in ever smaller steps, to 1e-9
+of the interval): its fraction ``s`` of the interval, the configuration there, and the smallest singular value
+(relative to the largest) of the map that loses rank where the modes meet: the closure Jacobian in the passive joints
+(forward), closure and task in every joint (inverse).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from pkm.core.kinematics import constraints
 from pkm.core.kinematics.configuration import Configuration
 from pkm.core.kinematics.solve import SolveResult, close_loops, solve_ik
 from pkm.core.kinematics.task import TaskMap
-from pkm.core.kinematics.trajectory import Trajectory, follow_actuators, follow_task
+from pkm.core.kinematics.trajectory import FOLLOW_TOL, _actuator_steps, _follow, _Steps, _task_steps
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.model.scale import JacobianScales
 from pkm.core.modes.assembly import Mode
@@ -89,10 +90,14 @@ def _sigma(J: np.ndarray) -> float:
     return float(sv[-1] / sv[0]) if sv.size and sv[0] > 0 else 0.0
 
 
-def _track(mech: Mechanism, mode: Mode, traj: Trajectory, reasons: set[str],
+def _track(mech: Mechanism, mode: Mode, steps: _Steps, reasons: set[str],
            solve_between: Callable[[int, float, np.ndarray], SolveResult],
            jacobian: Callable[[np.ndarray], np.ndarray]) -> ModeTrack:
-    q = traj.q.copy()
+    # (the core's continuation from the mode, ended at the first meeting: the samples after it are not the mode's)
+    n, solve, predict, rates = steps
+    traj = _follow(mech, n, mode.q, solve, predict, rates, False, None, FOLLOW_TOL, until=reasons)
+    q = np.full((n, mech.nq), np.nan)
+    q[:len(traj.q)] = traj.q
     stop = next((j for j in traj.jumps if j.reason in reasons), None)
     if stop is None:
         return ModeTrack(mode.label, q, len(q), None)
@@ -128,13 +133,13 @@ def track_assembly_mode(mech: Mechanism, mode: Mode, q_actuated: ArrayLike) -> M
         (5, (5, 7), None)
     """
     mech, mode = check_mechanism(mech), _check_mode(mode, "assembly")
-    traj = follow_actuators(mech, q_actuated, q0=mode.q, efforts=False)
-    A = np.asarray(q_actuated, dtype=float).reshape(len(traj.q), -1)  # the samples asked for (checked by the core)
+    steps = _actuator_steps(mech, q_actuated, None, None, FOLLOW_TOL)
+    A = np.asarray(q_actuated, dtype=float).reshape(steps[0], -1)  # the samples asked for (checked by the core)
 
     def between(k: int, s: float, q_from: np.ndarray) -> SolveResult:
         return close_loops(mech, A[k - 1] + s * (A[k] - A[k - 1]), q_from, raise_on_failure=False)
 
-    return _track(mech, mode, traj, _FK_MEETING, between,
+    return _track(mech, mode, steps, _FK_MEETING, between,
                   lambda qq: JacobianScales.of(mech).constraint(constraints.jacobian(mech, qq))[:, mech.passive_v])
 
 
@@ -156,8 +161,8 @@ def track_working_mode(mech: Mechanism, mode: Mode, task: ArrayLike) -> ModeTrac
         (4, (4, 12), None)
     """
     mech, mode = check_mechanism(mech), _check_mode(mode, "working")
-    traj = follow_task(mech, task, q0=mode.q, efforts=False)
-    Y = np.asarray(task, dtype=float).reshape(len(traj.q), -1)
+    steps = _task_steps(mech, task, None, None, FOLLOW_TOL)
+    Y = np.asarray(task, dtype=float).reshape(steps[0], -1)
     tm = TaskMap.of(mech)
 
     def between(k: int, s: float, q_from: np.ndarray) -> SolveResult:
@@ -168,4 +173,4 @@ def track_working_mode(mech: Mechanism, mode: Mode, task: ArrayLike) -> ModeTrac
         J = np.vstack([sc.constraint(c.constraint_jacobian), sc.task(c.task_jacobian)])
         return J if mech.free_v is None else J[:, mech.free_v]
 
-    return _track(mech, mode, traj, _IK_MEETING, between, jac)
+    return _track(mech, mode, steps, _IK_MEETING, between, jac)
