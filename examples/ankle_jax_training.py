@@ -48,7 +48,7 @@ SCALE = float(np.mean(np.diag(K.mass_matrix(ankle.q_reference))))  # torque per 
 
 
 def policy(params: dict, x: jnp.ndarray) -> jnp.ndarray:
-    """Motor torques [N m]: linear in the normalised features."""
+    """Motor torques [N m]: linear in the normalised features (JAX arrays in training, numpy arrays after)."""
     return SCALE * (((x - MEAN) / STD) @ params["W"] + params["b"])
 
 
@@ -72,14 +72,15 @@ for k in range(41):
         print(f"step {k:3d}: loss {float(value):10.4f} (rad/s^2)^2")
 
 # on states not trained on: the policy's torques against the model's M_a qdd + h_a (the compiled C kernel)
+params = {k: np.asarray(p) for k, p in params.items()}  # (the trained policy in numpy from here: no XLA compile)
 Qt, QDt, QDDt = states(64, seed=1)
 Xt = np.hstack([np.array([ankle.actuated_q(q) for q in Qt]), QDt, QDDt])
 M, h = K.mass_and_bias(Qt, QDt)
 exact = np.einsum("nij,nj->ni", M, QDDt) + h
-learned = np.asarray(policy(params, jnp.asarray(Xt)))
-held_out = np.mean((K.forward_dynamics(Qt, QDt, learned) - QDDt) ** 2)  # (the loss through the C kernel: no new XLA compile)
+learned = policy(params, Xt)
+held_out = np.mean((K.forward_dynamics(Qt, QDt, learned) - QDDt) ** 2)  # (the loss through the C kernel)
 print(f"held-out states: loss {held_out:.4f} (rad/s^2)^2; torques within "
       f"{np.abs(learned - exact).max():.4f} N m of M_a qdd + h_a (largest {np.abs(exact).max():.2f} N m)")
-print("learned torque per unit desired acceleration [kg m^2]:\n", np.round(SCALE * np.asarray(params["W"][4:]) /
-                                                                          STD[4:, None], 4))
+print("learned torque per unit desired acceleration [kg m^2]:\n", np.round(SCALE * params["W"][4:] / STD[4:, None],
+                                                                          4))
 print("the model's M_a at neutral:\n", np.round(K.mass_matrix(ankle.q_reference), 4))

@@ -112,7 +112,7 @@ if shutil.which("cc"):
 
     with tempfile.TemporaryDirectory() as tmp:
         lib = pkm.export_c(ankle, Path(tmp) / "ankle", name="ankle")
-        h = build(lib)
+        h = build(lib, optimise="-O0")  # (pkm's test harness, built quickly: the numbers are -O2's; optimise yours)
         y = np.array([[0.3, 0.1], [-0.4, -0.2], [0.0, 0.3]])
         rows_in = np.hstack([y, np.tile(ankle.q_reference, (len(y), 1)), np.zeros((len(y), 1))])
         out = h.run("ik", rows_in)

@@ -325,3 +325,15 @@ def test_the_split_is_kept_for_the_same_jacobians_and_given_out_as_copies():
     assert N.shape[1] == 2
     N[:] = 0.0
     assert np.array_equal(pkm.idle_motions(ankle, q), fresh.idle)
+
+
+def test_singularity_distances_are_diagnoses(built):
+    """``singularity_distances`` (the searches' shortcut) gives diagnose's two distances bit for bit, far from and near
+    a direct singularity of the five-bar, at a non-default rtol too."""
+    from pkm.core.differential.velocity import singularity_distances
+
+    mech = built("fivebar")
+    for eps, rtol in ((1e-1, 1e-7), (1e-3, 1e-7), (1e-3, 1e-2)):
+        q = _fivebar_at(mech, (0.0, 0.15 + eps), "elbows_out")
+        d = pkm.diagnose(mech, q, rtol=rtol)
+        assert singularity_distances(mech, q, rtol=rtol) == (d.direct_distance, d.inverse_distance)

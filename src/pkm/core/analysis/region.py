@@ -154,7 +154,7 @@ def largest_box(vertices: np.ndarray, point: np.ndarray, *, cells: int = 64, rou
 def _feasible(mech: Mechanism, target: dict[str, float], q0: np.ndarray, lo: np.ndarray, hi: np.ndarray,
               singularity: float) -> tuple[np.ndarray | None, str]:
     """The closed configuration at ``target`` (warm-started from ``q0``) if feasible, else None and why."""
-    from pkm.core.differential.velocity import diagnose
+    from pkm.core.differential.velocity import singularity_distances
     from pkm.core.kinematics.solve import solve_ik
 
     try:
@@ -166,12 +166,12 @@ def _feasible(mech: Mechanism, target: dict[str, float], q0: np.ndarray, lo: np.
         i, side = (int(low[0]), "low") if low.size else (int(high[0]), "high")
         return None, f"joint {_joint_of(mech, i)} at its {side} limit"
     try:
-        d = diagnose(mech, q)
+        direct, inverse = singularity_distances(mech, q)
     except PkmError:
         return None, "direct singularity"
-    if d.direct_distance < singularity:
+    if direct < singularity:
         return None, "direct singularity"
-    if d.inverse_distance < singularity:
+    if inverse < singularity:
         return None, "inverse singularity"
     return q, ""
 

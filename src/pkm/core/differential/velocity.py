@@ -684,3 +684,13 @@ def diagnose(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 1e-
                        singularity_class(inverse, direct), sp.idle.shape[1], idle_joints, dd, di,
                        tuple(k for k, d in (("direct", dd), ("inverse", di)) if rtol < d < near),
                        sp.direct_direction.copy(), sp.inverse_direction.copy(), fit.dependent, fit.unactuated, near)
+
+
+def singularity_distances(mech: Mechanism, q: ArrayLike | Configuration, *, rtol: float = 1e-7) -> tuple[float, float]:
+    """:func:`diagnose`'s ``(direct_distance, inverse_distance)`` at ``q``, the same numbers, without the rest of the
+    diagnosis (the constraint rank's SVD and the actuators against the mobility: over half its cost): what a search
+    that asks at each of its points how far the singularities are needs (:func:`pkm.feasible_region`, an
+    excitation's check)."""
+    mech, c = _at(mech, q)
+    sp = _split(mech, c, as_tolerance(rtol, "rtol"))
+    return sp.direct_distance, sp.inverse_distance

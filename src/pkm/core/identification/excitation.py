@@ -283,7 +283,7 @@ def excite(mech: Mechanism, *, period: float = 10.0, harmonics: int = 5, samples
 def _check(mech: Mechanism, s: tuple[np.ndarray, ...], lo: np.ndarray, hi: np.ndarray, half: np.ndarray,
            speed: np.ndarray, effort: np.ndarray, theta: np.ndarray, singularity: float) -> dict[str, float] | None:
     """Each limit's smallest margin on the dense samples (module doc), or None where one is not met."""
-    from pkm.core.differential.velocity import diagnose
+    from pkm.core.differential.velocity import singularity_distances
 
     qa, qd, _, Q, W, K = s
     na = mech.na
@@ -295,8 +295,7 @@ def _check(mech: Mechanism, s: tuple[np.ndarray, ...], lo: np.ndarray, hi: np.nd
         return None
     worst = np.inf
     for q in Q[::max(1, len(Q) // (4 * 60))]:  # (every sample up to 240 of them)
-        d = diagnose(mech, q)
-        worst = min(worst, d.direct_distance, d.inverse_distance)
+        worst = min(worst, *singularity_distances(mech, q))
     if worst < singularity:
         return None
     out["singularity"] = float(worst / singularity)
