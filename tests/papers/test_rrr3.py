@@ -100,7 +100,7 @@ def coarse(monkeypatch):
     monkeypatch.setattr(study, "FIG3_STEP", 0.01)
     monkeypatch.setattr(study, "FIG3_SWEEP", (21, 37))
     monkeypatch.setattr(study, "fig7_design", lambda: Design.similarity_law(1.5))
-    monkeypatch.setattr(study, "paper_sweep_designs", lambda: PAPER_SWEEP(n=3))
+    monkeypatch.setattr(study, "paper_sweep_designs", lambda n=10: PAPER_SWEEP(n=3))  # (coarse: 3^3 whatever asked)
     monkeypatch.setattr(study, "design_sweep", lambda: sweep(step=0.05, scheduler="serial"))
     for f in cached:
         f.cache_clear()

@@ -71,7 +71,9 @@ QUICK_XLA: dict[str, str | bool] = {"xla_backend_optimization_level": "0"}
 def jax_batch(fn: Callable[..., Any], args: Sequence[Any], quick: bool = False) -> Callable[..., Any]:
     """``jax.jit(jax.vmap(fn))``, compiled on its first call; ``quick``: compiled here for ``args``' shapes with
     :data:`QUICK_XLA` (call it with arrays of those shapes)."""
-    import jax
+    from pkm._optional import module as optional
+
+    jax = optional("jax", extra="jax", what="the benchmarks' JAX route")
 
     f = jax.jit(jax.vmap(fn))
     return f.lower(*args).compile(QUICK_XLA) if quick else f
