@@ -45,9 +45,11 @@ def _import_module(node: ast.Call) -> bool:
         isinstance(node.args[0].value, str)
 
 
-def _imports(tree: ast.AST, package: str, type_checking: bool = False) -> list[tuple[str, list[str]]]:
+def _imports(tree: ast.AST, package: str, type_checking: bool = False, calls: bool = True) \
+        -> list[tuple[str, list[str]]]:
     """``(module, names)`` of every import (relative ones resolved), those in ``if TYPE_CHECKING:`` blocks only with
-    ``type_checking``."""
+    ``type_checking``; ``calls`` False: the statements alone are walked, not their expressions (for a source
+    without the text ``import_module``, which has no such call: nine nodes in ten are expressions)."""
     found: list[tuple[str, list[str]]] = []
 
     def visit(node: ast.AST) -> None:
@@ -66,10 +68,17 @@ def _imports(tree: ast.AST, package: str, type_checking: bool = False) -> list[t
                 base = ".".join(parent + ([base] if base else []))
             found.append((base, [a.name for a in node.names]))
         for child in ast.iter_child_nodes(node):
-            visit(child)
+            if calls or isinstance(child, (ast.stmt, ast.excepthandler, ast.match_case)):
+                visit(child)
 
     visit(tree)
     return found
+
+
+@functools.cache
+def _tree(path: Path) -> ast.Module:
+    """A module's syntax tree, parsed once a session (both graphs read it)."""
+    return ast.parse(path.read_text())
 
 
 @functools.cache
@@ -80,7 +89,8 @@ def import_graph(type_checking: bool = False) -> dict[str, set[str]]:
     graph: dict[str, set[str]] = {m: set() for m in modules}
     for name, path in modules.items():
         package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-        for module, names in _imports(ast.parse(path.read_text()), package, type_checking):
+        text = path.read_text()
+        for module, names in _imports(_tree(path), package, type_checking, calls="import_module" in text):
             if not module.startswith("pkm"):
                 continue
             targets = [f"{module}.{n}" for n in names if f"{module}.{n}" in modules]
@@ -173,6 +183,16 @@ def test_an_annotation_s_import_is_an_edge_only_when_asked():
 def test_a_literal_import_module_is_an_edge():
     tree = ast.parse('import importlib\ndef f():\n    return importlib.import_module("pkm.core.model.builder")\n')
     assert ("pkm.core.model.builder", []) in _imports(tree, "pkm.core.model")
+
+
+def test_the_statements_alone_hold_every_import_statement():
+    """calls=False (a source without ``import_module``) finds the imports nested in classes, functions, ``with``,
+    ``for``, ``try``'s handlers and ``else``, and ``match``'s cases, as the whole walk does."""
+    tree = ast.parse("class C:\n    def g(self):\n        with x:\n            for i in y:\n                try:\n"
+                     "                    import pkm.a\n                except E:\n                    from pkm import b\n"
+                     "                else:\n                    import pkm.c\nmatch v:\n    case 1:\n        import pkm.d\n")
+    assert _imports(tree, "pkm", calls=False) == _imports(tree, "pkm") == \
+        [("pkm.a", []), ("pkm", ["b"]), ("pkm.c", []), ("pkm.d", [])]
 
 
 def test_a_planted_cycle_is_found():
