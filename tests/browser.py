@@ -37,7 +37,8 @@ def leaves_the_machine(url: str) -> bool:
 
 
 class OfflineBrowser:
-    """One headless Chromium page with the outside network off (see the module doc).
+    """One headless Chromium page with the outside network off (see the module doc), its viewport ``width`` by
+    ``height`` pixels (as :meth:`screenshot` shows it).
 
     :attr:`requests` holds the URL of every request since the last :meth:`load`, :attr:`errors` the console errors,
     uncaught exceptions and failed requests (with their URL and reason).
@@ -84,6 +85,8 @@ class OfflineBrowser:
             self.call(f"{domain}.enable")
         # (no cache: every page's requests go to the network, where they are seen; a cached file was seen once)
         self.call("Network.setCacheDisabled", cacheDisabled=not cache)
+        # (the window's size is not the page's: a headless window keeps some of it for itself)
+        self.call("Emulation.setDeviceMetricsOverride", width=width, height=height, deviceScaleFactor=1, mobile=False)
         self.call("Target.setAutoAttach", autoAttach=True, waitForDebuggerOnStart=False, flatten=True)
 
     def __enter__(self) -> OfflineBrowser:
@@ -161,6 +164,12 @@ class OfflineBrowser:
             if value or time.monotonic() > deadline:
                 return value
             time.sleep(0.05)
+
+    def frames(self, n: int = 2) -> None:
+        """Return once the page has drawn ``n`` more animation frames (a page that draws on its next frame, such as
+        meshcat's viewer, has drawn what it was given before the call)."""
+        self.evaluate(f"new Promise(r => {{ let n = {n}; const f = () => --n > 0 ? requestAnimationFrame(f) : r(); "
+                      "requestAnimationFrame(f); })")
 
     def screenshot(self) -> np.ndarray:
         """The page as it shows now: an (height, width, 3) RGB array in [0, 1]."""
