@@ -1,8 +1,8 @@
 """pkm.viz in a real browser: headless Chromium renders the Delta's snapshot, and the picture shows it.
 
-One Chromium (:class:`tests.browser.OfflineBrowser`, the outside network off) serves the module: each page is loaded
-afresh into it, and its picture taken once the page has drawn two frames after its load event (meshcat's viewer
-draws the commands the page gave it on its next frame); no console error, exception or failed request may occur.
+The session's Chromium (:class:`tests.browser.OfflineBrowser`, the outside network off) shows each page, loaded
+afresh, and its picture is taken once the page has drawn two frames after its load event (meshcat's viewer draws the
+commands the page gave it on its next frame); no console error, exception or failed request may occur.
 
 Skipped when Chromium is not installed, unless ``PKM_REQUIRE_BROWSER`` is set (CI sets it and
 installs the Debian package ``chromium``): then a missing Chromium is a failure.
@@ -20,9 +20,7 @@ from __future__ import annotations
 import base64
 import hashlib
 import json
-import os
 import re
-import shutil
 from pathlib import Path
 
 import matplotlib.colors as mcolors
@@ -39,21 +37,10 @@ WIDTH, HEIGHT = 800, 600
 FOV = 75.0  # deg, vertical field of view of meshcat's default camera
 
 
-def chromium() -> str:
-    """The Chromium executable; skip (or fail when PKM_REQUIRE_BROWSER is set) if there is none."""
-    exe = shutil.which("chromium") or ("/usr/bin/chromium" if Path("/usr/bin/chromium").exists() else None)
-    if exe is None:
-        if os.environ.get("PKM_REQUIRE_BROWSER", "") not in ("", "0"):
-            pytest.fail("PKM_REQUIRE_BROWSER is set but chromium is not installed (Debian package 'chromium')")
-        pytest.skip("chromium is not installed; set PKM_REQUIRE_BROWSER=1 to make this a failure")
-    return exe
-
-
-@pytest.fixture(scope="module")
-def browser(tmp_path_factory):
-    """One headless Chromium for the module, its page WIDTH by HEIGHT pixels."""
-    with OfflineBrowser(chromium(), tmp_path_factory.mktemp("chromium"), width=WIDTH, height=HEIGHT) as b:
-        yield b
+@pytest.fixture
+def browser(offline_browser):
+    """The session's headless Chromium, its page WIDTH by HEIGHT pixels."""
+    return offline_browser(WIDTH, HEIGHT)
 
 
 def screenshot(page: str, browser: OfflineBrowser, folder: Path) -> np.ndarray:
