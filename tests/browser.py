@@ -1,7 +1,9 @@
 """Headless Chromium with the outside network off, over the DevTools protocol: every request a page makes recorded.
 
-Used by ``tests/serve/test_offline.py`` (the service's pages) and ``tools/offline_site.py`` (every page of the docs
-site). Outside traffic is blocked twice: every host name but ``127.0.0.1`` resolves to nothing
+Used by ``tests/serve/test_offline.py`` (the service's pages), ``tests/serve/test_page.py`` (the design page),
+``tests/test_viz_browser.py`` (pkm.viz's pictures) and ``tools/offline_site.py`` (every page of the docs site); the
+tests share one Chromium a session (:class:`Shared`, the fixture ``offline_browser`` of ``tests/conftest.py``: starting
+one costs about 2 s of CPU), each test its own page, loaded afresh. Outside traffic is blocked twice: every host name but ``127.0.0.1`` resolves to nothing
 (``--host-resolver-rules``), and every request that is not to the loopback goes to a proxy that is not there
 (``--proxy-server`` on a closed port of 127.0.0.1; Chromium sends loopback requests directly), so that an address
 written as a number fails too. The pages' requests are recorded (the Network domain), whether they succeeded or not,
@@ -16,6 +18,7 @@ import io
 import json
 import os
 import re
+import shutil
 import signal
 import subprocess
 import threading
@@ -37,7 +40,8 @@ def leaves_the_machine(url: str) -> bool:
 
 
 class OfflineBrowser:
-    """One headless Chromium page with the outside network off (see the module doc).
+    """One headless Chromium page with the outside network off (see the module doc), its viewport ``width`` by
+    ``height`` pixels (as :meth:`screenshot` shows it).
 
     :attr:`requests` holds the URL of every request since the last :meth:`load`, :attr:`errors` the console errors,
     uncaught exceptions and failed requests (with their URL and reason).
@@ -82,9 +86,16 @@ class OfflineBrowser:
         self._loaded = False
         for domain in ("Runtime", "Log", "Page", "Network"):
             self.call(f"{domain}.enable")
+        self.configure(width, height, cache)
+        self.call("Target.setAutoAttach", autoAttach=True, waitForDebuggerOnStart=False, flatten=True)
+
+    def configure(self, width: int = 1200, height: int = 900, cache: bool = False) -> None:
+        """The page's viewport ``width`` by ``height`` pixels, and its cache on (emptied) or off, from now on."""
         # (no cache: every page's requests go to the network, where they are seen; a cached file was seen once)
         self.call("Network.setCacheDisabled", cacheDisabled=not cache)
-        self.call("Target.setAutoAttach", autoAttach=True, waitForDebuggerOnStart=False, flatten=True)
+        self.call("Network.clearBrowserCache")
+        # (the window's size is not the page's: a headless window keeps some of it for itself)
+        self.call("Emulation.setDeviceMetricsOverride", width=width, height=height, deviceScaleFactor=1, mobile=False)
 
     def __enter__(self) -> OfflineBrowser:
         return self
@@ -162,6 +173,12 @@ class OfflineBrowser:
                 return value
             time.sleep(0.05)
 
+    def frames(self, n: int = 2) -> None:
+        """Return once the page has drawn ``n`` more animation frames (a page that draws on its next frame, such as
+        meshcat's viewer, has drawn what it was given before the call)."""
+        self.evaluate(f"new Promise(r => {{ let n = {n}; const f = () => --n > 0 ? requestAnimationFrame(f) : r(); "
+                      "requestAnimationFrame(f); })")
+
     def screenshot(self) -> np.ndarray:
         """The page as it shows now: an (height, width, 3) RGB array in [0, 1]."""
         import matplotlib.image as mimage
@@ -237,3 +254,43 @@ def _running_in_group(pgid: int) -> bool:
         if int(fields[2]) == pgid and fields[0] != "Z":  # (fields: state, ppid, pgrp, ...)
             return True
     return False
+
+
+def chromium() -> str:
+    """The Chromium executable; skip the test (or fail it when ``PKM_REQUIRE_BROWSER`` is set) if there is none."""
+    import pytest
+
+    exe = shutil.which("chromium") or ("/usr/bin/chromium" if Path("/usr/bin/chromium").exists() else None)
+    if exe is None:
+        if os.environ.get("PKM_REQUIRE_BROWSER", "") not in ("", "0"):
+            pytest.fail("PKM_REQUIRE_BROWSER is set but chromium is not installed (Debian package 'chromium')")
+        pytest.skip("chromium is not installed; set PKM_REQUIRE_BROWSER=1 to make this a failure")
+    return exe
+
+
+class Shared:
+    """One :class:`OfflineBrowser` for many tests: ``shared(width, height, cache)`` is it, on a blank page (loaded:
+    nothing of the last test's page left to come), configured (:meth:`OfflineBrowser.configure`); started at the
+    first call, and again if it has stopped. :meth:`close` stops it."""
+
+    def __init__(self, folder: Path):
+        self.folder, self.browser, self.started = folder, None, 0
+
+    def __call__(self, width: int = 1200, height: int = 900, cache: bool = False) -> OfflineBrowser:
+        if self.browser is not None:
+            try:
+                if self.browser.proc.poll() is not None:
+                    raise RuntimeError("chromium stopped")
+                self.browser.load("about:blank")
+                self.browser.configure(width, height, cache)
+                return self.browser
+            except Exception:  # (a test left it broken, its connection closed ...: another one, for this test)
+                self.close()
+        self.started += 1
+        self.browser = OfflineBrowser(chromium(), self.folder / f"profile-{self.started}", width, height, cache)
+        return self.browser
+
+    def close(self) -> None:
+        if self.browser is not None:
+            browser, self.browser = self.browser, None
+            browser.close()

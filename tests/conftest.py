@@ -43,6 +43,19 @@ def pytest_collection_modifyitems(config, items):
 
 
 @pytest.fixture(scope="session")
+def offline_browser(tmp_path_factory):
+    """``offline_browser(width, height, cache)``: the session's headless Chromium with the outside network off, on a
+    blank page of that size (:class:`tests.browser.Shared`: one Chromium a worker, not one a test)."""
+    from tests.browser import Shared
+
+    shared = Shared(tmp_path_factory.mktemp("chromium"))
+    try:
+        yield shared
+    finally:
+        shared.close()
+
+
+@pytest.fixture(scope="session")
 def built():
     """``built(name)``: the reference design of a mechanism, generated from its parameters, cached."""
     cache = {}

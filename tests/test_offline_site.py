@@ -1,14 +1,12 @@
 """``tools/offline_site.py`` (run by CI on the built docs site) finds what it looks for: on a small site written here,
 a page that loads a CDN's script, a page showing raw TeX, a page without an h1 and a formula with no size are each
-reported, and a page with typeset maths (MathML) and nothing from outside is not. Chromium as in
-``tests/test_viz_browser.py`` (skipped without it unless ``PKM_REQUIRE_BROWSER`` is set)."""
+reported, and a page with typeset maths (MathML) and nothing from outside is not. The session's Chromium
+(``offline_browser``; skipped without it unless ``PKM_REQUIRE_BROWSER`` is set)."""
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
-
-from tests.test_viz_browser import chromium
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
 import offline_site  # (tools/ is no package: imported from its folder)
@@ -23,14 +21,14 @@ PAGES = {
 }
 
 
-def test_the_site_check_reports_each_fault_and_only_those(tmp_path):
+def test_the_site_check_reports_each_fault_and_only_those(offline_browser, tmp_path):
     site = tmp_path / "site"
     for name, body in PAGES.items():
         (site / name).parent.mkdir(parents=True, exist_ok=True)
         (site / name).write_text(f'<!DOCTYPE html><html><head><meta charset="utf-8"><link rel="icon" href="data:,">'
                                  f"</head><body>{body}</body></html>", encoding="utf-8")
     assert offline_site.pages(site) == ["blank/", "cdn/", "hidden/", "", "tex/"]
-    findings, counts = offline_site.check(site, chromium())
+    findings, counts = offline_site.check(site, browser=offline_browser(cache=True))
     assert counts["pages"] == 5 and counts["maths"] == 2
     by_page: dict[str, list[str]] = {}
     for line in findings:

@@ -1,5 +1,9 @@
 """pkm.viz in a real browser: headless Chromium renders the Delta's snapshot, and the picture shows it.
 
+The session's Chromium (:class:`tests.browser.OfflineBrowser`, the outside network off) shows each page, loaded
+afresh, and its picture is taken once the page has drawn two frames after its load event (meshcat's viewer draws the
+commands the page gave it on its next frame); no console error, exception or failed request may occur.
+
 Skipped when Chromium is not installed, unless ``PKM_REQUIRE_BROWSER`` is set (CI sets it and
 installs the Debian package ``chromium``): then a missing Chromium is a failure.
 
@@ -14,14 +18,12 @@ and each of its six legs in its own colour.
 from __future__ import annotations
 
 import base64
+import hashlib
 import json
-import os
 import re
-import shutil
 from pathlib import Path
 
 import matplotlib.colors as mcolors
-import matplotlib.image as mimage
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -29,41 +31,39 @@ import umsgpack
 
 import pkm
 from pkm import viz
-from tests import bounded
+from tests.browser import OfflineBrowser
 
 WIDTH, HEIGHT = 800, 600
 FOV = 75.0  # deg, vertical field of view of meshcat's default camera
 
 
-def chromium() -> str:
-    """The Chromium executable; skip (or fail when PKM_REQUIRE_BROWSER is set) if there is none."""
-    exe = shutil.which("chromium") or ("/usr/bin/chromium" if Path("/usr/bin/chromium").exists() else None)
-    if exe is None:
-        if os.environ.get("PKM_REQUIRE_BROWSER", "") not in ("", "0"):
-            pytest.fail("PKM_REQUIRE_BROWSER is set but chromium is not installed (Debian package 'chromium')")
-        pytest.skip("chromium is not installed; set PKM_REQUIRE_BROWSER=1 to make this a failure")
-    return exe
+@pytest.fixture
+def browser(offline_browser):
+    """The session's headless Chromium, its page WIDTH by HEIGHT pixels."""
+    return offline_browser(WIDTH, HEIGHT)
 
 
-def screenshot(page: str, folder: Path) -> np.ndarray:
+def screenshot(page: str, browser: OfflineBrowser, folder: Path) -> np.ndarray:
     """RGB image (HEIGHT, WIDTH, 3) in [0, 1] of ``page`` rendered by headless Chromium."""
-    html, png = folder / "page.html", folder / "shot.png"
+    html = folder / f"page-{hashlib.sha1(page.encode()).hexdigest()[:12]}.html"  # (one file a page: loaded afresh)
     html.write_text(page, encoding="utf-8")
-    cmd = [chromium(), "--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-           "--disable-background-networking", f"--window-size={WIDTH},{HEIGHT}", "--virtual-time-budget=5000",
-           f"--screenshot={png}", html.as_uri()]
-    run = bounded.run(cmd, cpu=60)
-    assert run.returncode == 0 and png.exists(), f"chromium failed ({run.returncode}): {run.stderr[-2000:]}"
-    return mimage.imread(png)[..., :3]
+    browser.load(html.as_uri())
+    browser.frames()
+    img = browser.screenshot()
+    assert browser.errors == []
+    return img
 
 
-def colour_mask(img: np.ndarray, rgb: int) -> np.ndarray:
-    """Pixels of the hue of ``rgb`` (within 7 degrees), saturated (at least 0.6 of its saturation, 0.5 at most) and
-    not dark: its lit and shaded surfaces."""
-    ref = mcolors.rgb_to_hsv(np.array([(rgb >> 16) & 255, (rgb >> 8) & 255, rgb & 255]) / 255.0)
+def colour_masks(img: np.ndarray, *rgbs: int) -> list[np.ndarray]:
+    """For each colour of ``rgbs``: the pixels of its hue (within 7 degrees), saturated (at least 0.6 of its
+    saturation, 0.5 at most) and not dark: its lit and shaded surfaces. (The image turned to HSV once: 0.25 s each.)"""
     hsv = mcolors.rgb_to_hsv(img)
-    dh = np.abs((hsv[..., 0] - ref[0] + 0.5) % 1.0 - 0.5)
-    return (dh < 0.02) & (hsv[..., 1] > min(0.5, 0.6 * ref[1])) & (hsv[..., 2] > 0.2)
+    out = []
+    for rgb in rgbs:
+        ref = mcolors.rgb_to_hsv(np.array([(rgb >> 16) & 255, (rgb >> 8) & 255, rgb & 255]) / 255.0)
+        dh = np.abs((hsv[..., 0] - ref[0] + 0.5) % 1.0 - 0.5)
+        out.append((dh < 0.02) & (hsv[..., 1] > min(0.5, 0.6 * ref[1])) & (hsv[..., 2] > 0.2))
+    return out
 
 
 def camera(cmds: list[dict]):
@@ -87,16 +87,15 @@ def project(points: np.ndarray, eye: np.ndarray) -> np.ndarray:
     return np.c_[WIDTH / 2 + (rel @ r) / depth / t * HEIGHT / 2, HEIGHT / 2 - (rel @ u) / depth / t * HEIGHT / 2]
 
 
-def test_headless_chromium_shows_the_delta_where_the_camera_looks(tmp_path):
+def test_headless_chromium_shows_the_delta_where_the_camera_looks(browser, tmp_path):
     """The Delta's snapshot renders with its motors, passive joints and platform in their colours, framed."""
     mech = pkm.load("delta")
     page = viz.snapshot_html(mech, legend=False)  # (the 3-D drawing alone; the legend: the last test)
-    img = screenshot(page, tmp_path)
+    img = screenshot(page, browser, tmp_path)
     assert img.shape == (HEIGHT, WIDTH, 3)
     assert img.std() > 0.05  # not blank
 
-    actuated, passive = colour_mask(img, viz.ACTUATED_COLOR), colour_mask(img, viz.PASSIVE_COLOR)
-    platform = colour_mask(img, viz.PLATFORM_COLOR)
+    actuated, passive, platform = colour_masks(img, viz.ACTUATED_COLOR, viz.PASSIVE_COLOR, viz.PLATFORM_COLOR)
     assert actuated.sum() > 600 and passive.sum() > 600 and platform.sum() > 150
 
     # where the snapshot's camera says each joint and the platform are
@@ -122,14 +121,14 @@ def test_headless_chromium_shows_the_delta_where_the_camera_looks(tmp_path):
     assert rows.min() > 0.02 * HEIGHT and rows.max() < 0.95 * HEIGHT
 
 
-def test_a_five_bar_from_its_files_shows_every_joint_link_and_the_base(tmp_path):
+def test_a_five_bar_from_its_files_shows_every_joint_link_and_the_base(browser, tmp_path):
     """The Gepetto-format five-bar (loaded from its files, not generated by pkm): every joint's centre, projected
     through the snapshot's camera, lands on its colour (actuated or passive); every link's midpoint, the base
     between the motors (a bar, off the world triad) and the closure point land on drawn pixels, not on the
     background."""
     mech = pkm.load(Path(__file__).resolve().parents[1] / "examples" / "gepetto_fivebar")
     page = viz.snapshot_html(mech, legend=False)  # (the 3-D drawing alone; the legend: the last test)
-    img = screenshot(page, tmp_path)
+    img = screenshot(page, browser, tmp_path)
     cmds = [umsgpack.unpackb(base64.b64decode(s)) for s in json.loads(
         re.search(r'id="pkm-meshcat-commands">(.*?)</script>', page, re.DOTALL).group(1))]
     eye, shift = camera(cmds)
@@ -145,7 +144,7 @@ def test_a_five_bar_from_its_files_shows_every_joint_link_and_the_base(tmp_path)
         assert all(0 <= c < WIDTH and 0 <= r < HEIGHT for c, r in out)
         return out
 
-    masks = {True: colour_mask(img, viz.ACTUATED_COLOR), False: colour_mask(img, viz.PASSIVE_COLOR)}
+    masks = dict(zip((True, False), colour_masks(img, viz.ACTUATED_COLOR, viz.PASSIVE_COLOR), strict=True))
     for j in range(1, model.njoints):
         ((col, row),) = at(data.oMi[j].translation)
         mask = masks[model.names[j] in mech.actuated_names]
@@ -159,19 +158,19 @@ def test_a_five_bar_from_its_files_shows_every_joint_link_and_the_base(tmp_path)
         assert drawn[max(row - 3, 0):row + 4, max(col - 3, 0):col + 4].any(), (col, row)
 
 
-def test_the_hexapods_legs_show_in_their_colours_and_the_legend_in_the_corner(tmp_path):
+def test_the_hexapods_legs_show_in_their_colours_and_the_legend_in_the_corner(browser, tmp_path):
     """The hexapod, cluttered in grey before: each of its six legs shows in its own colour (hundreds of pixels each),
     and the page with its legend differs from the page without only in the lower left corner, where the legend
     shows every leg's colour."""
     mech = pkm.load("hexapod")
-    bare = screenshot(viz.snapshot_html(mech, legend=False), tmp_path)
-    shown = screenshot(viz.snapshot_html(mech), tmp_path)
+    bare = screenshot(viz.snapshot_html(mech, legend=False), browser, tmp_path)
+    shown = screenshot(viz.snapshot_html(mech), browser, tmp_path)
     legs = [c for _, (c, *_) in viz.Scene.from_mechanism(mech).legend() if c in viz.LEG_COLORS]
     assert len(legs) == 6
-    for color in legs:
-        assert colour_mask(bare, color).sum() > 150, f"#{color:06x}"
+    for color, mask in zip(legs, colour_masks(bare, *legs), strict=True):
+        assert mask.sum() > 150, f"#{color:06x}"
     rows, cols = np.nonzero(np.abs(shown - bare).max(axis=-1) > 0.05)
     assert len(rows) > 2000 and cols.max() < 0.6 * WIDTH and rows.min() > 0.2 * HEIGHT  # the corner
     corner = shown[rows.min():, :cols.max() + 1]
-    for color in legs:
-        assert colour_mask(corner, color).sum() >= 40, f"#{color:06x} not in the legend"
+    for color, mask in zip(legs, colour_masks(corner, *legs), strict=True):
+        assert mask.sum() >= 40, f"#{color:06x} not in the legend"

@@ -96,24 +96,34 @@ def _visit(browser: OfflineBrowser, url: str, name: str, timeout: float) -> tupl
     return findings, {"pages": 1, "maths": seen["maths"], "requests": len(browser.requests)}
 
 
-def check(site: Path, chromium: str, timeout: float = 30.0, jobs: int = 1) -> tuple[list[str], dict]:
+def check(site: Path, chromium: str | None = None, timeout: float = 30.0, jobs: int = 1,
+          browser: OfflineBrowser | None = None) -> tuple[list[str], dict]:
     """The findings (one line each, in the pages' order; none: the site works offline) and the counts of the run;
-    ``jobs`` browsers load the pages side by side."""
+    ``jobs`` browsers of the executable ``chromium`` load the pages side by side, or ``browser`` (one already started,
+    its cache on, as these are) loads them all."""
+    if browser is None and chromium is None:
+        raise ValueError("offline_site.check: neither a Chromium executable nor a browser given")
     server = ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(_Quiet, directory=str(site)))
     threading.Thread(target=server.serve_forever, daemon=True).start()
     base = f"http://127.0.0.1:{server.server_address[1]}/"
     names = pages(site)
     results: dict[str, tuple[list[str], dict]] = {}
 
+    def visit(browser: OfflineBrowser, share: list[str]) -> None:
+        for page in share:
+            results[page] = _visit(browser, base + page, page or "/", timeout)
+
     def work(share: list[str]) -> None:
         with (tempfile.TemporaryDirectory(ignore_cleanup_errors=True) as folder,
-              OfflineBrowser(chromium, Path(folder), cache=True) as browser):
-            for page in share:
-                results[page] = _visit(browser, base + page, page or "/", timeout)
+              OfflineBrowser(str(chromium), Path(folder), cache=True) as browser):
+            visit(browser, share)
 
     try:
-        with ThreadPoolExecutor(max(1, jobs)) as pool:
-            list(pool.map(work, [names[i::max(1, jobs)] for i in range(max(1, jobs))]))
+        if browser is not None:
+            visit(browser, names)
+        else:
+            with ThreadPoolExecutor(max(1, jobs)) as pool:
+                list(pool.map(work, [names[i::max(1, jobs)] for i in range(max(1, jobs))]))
     finally:
         server.shutdown()
         server.server_close()

@@ -12,15 +12,13 @@ import re
 import pytest
 
 from tests import http
-from tests.browser import OfflineBrowser
 from tests.serve.conftest import TOKEN
-from tests.test_viz_browser import chromium
 
 
-@pytest.fixture(scope="module")
-def browser(tmp_path_factory):
-    with OfflineBrowser(chromium(), tmp_path_factory.mktemp("chromium")) as b:
-        yield b
+@pytest.fixture
+def browser(offline_browser):
+    """The session's headless Chromium, its cache off (every request seen)."""
+    return offline_browser()
 
 
 def operations(service) -> set[str]:

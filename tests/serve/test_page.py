@@ -8,15 +8,12 @@ is set, as ``tests/test_viz_browser.py``)."""
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
 import pkm
 from tests import http
 from tests.browser import OfflineBrowser
 from tests.serve.conftest import TOKEN
-from tests.test_viz_browser import chromium
 
 
 def _wait(browser: OfflineBrowser, expression: str, timeout: float = 60.0):
@@ -26,41 +23,38 @@ def _wait(browser: OfflineBrowser, expression: str, timeout: float = 60.0):
     return value
 
 
-def test_moving_a_slider_moves_the_mechanism(service, tmp_path):
-    browser = OfflineBrowser(chromium(), tmp_path, width=1000, height=700, cache=True)
-    try:
-        browser.load(f"{service.url}/?token={TOKEN}&model=delta")
-        _wait(browser, "window.pkmState && pkmState.updates >= 1 && !pkmState.busy")
-        time.sleep(0.5)  # (the view renders on its next animation frame)
-        before = browser.screenshot()
-        q0 = np.array(browser.evaluate("pkmState.q"))
-        target = browser.evaluate("(function () { const s = document.getElementById('qa-0');"
-                                  " s.value = parseFloat(s.min) + 0.8 * (s.max - s.min);"
-                                  " s.dispatchEvent(new Event('input')); return parseFloat(s.value); })()")
-        _wait(browser, "pkmState.updates >= 2 && !pkmState.busy && !pkmState.pending")
-        time.sleep(0.5)
-        after = browser.screenshot()
-        import matplotlib.image as mimage
+def test_moving_a_slider_moves_the_mechanism(service, offline_browser, tmp_path):
+    browser = offline_browser(1000, 700, cache=True)
+    browser.load(f"{service.url}/?token={TOKEN}&model=delta")
+    _wait(browser, "window.pkmState && pkmState.updates >= 1 && !pkmState.busy")
+    browser.frames()  # (the view draws on its next animation frame)
+    before = browser.screenshot()
+    q0 = np.array(browser.evaluate("pkmState.q"))
+    target = browser.evaluate("(function () { const s = document.getElementById('qa-0');"
+                              " s.value = parseFloat(s.min) + 0.8 * (s.max - s.min);"
+                              " s.dispatchEvent(new Event('input')); return parseFloat(s.value); })()")
+    _wait(browser, "pkmState.updates >= 2 && !pkmState.busy && !pkmState.pending")
+    browser.frames()
+    after = browser.screenshot()
+    import matplotlib.image as mimage
 
-        mimage.imsave(tmp_path / "page.png", after)
-        q1 = np.array(browser.evaluate("pkmState.q"))
-        updates = browser.evaluate("pkmState.updates")
-        z = browser.evaluate("(function () { const s = document.getElementById('y-2');"  # (a task slider: the IK)
-                             " s.value = parseFloat(s.value) - 0.02; s.dispatchEvent(new Event('input'));"
-                             " return parseFloat(s.value); })()")
-        _wait(browser, f"pkmState.updates > {updates} && !pkmState.busy")
-        y2 = browser.evaluate("pkmState.y")
-        browser.evaluate("document.getElementById('modes-button').click()")  # (the assembly modes job)
-        modes = _wait(browser, "pkmState.modes && pkmState.modes.length")
-        browser.evaluate("document.getElementById('map-button').click()")  # (the map job)
-        nodes = _wait(browser, "pkmState.map && pkmState.map.nodes")
-        updates = browser.evaluate("pkmState.updates")
-        browser.evaluate("document.getElementById('param-R').value = 0.16;"  # (another design, built and shown)
-                         " document.getElementById('params-button').click()")
-        variant = _wait(browser, f"pkmState.model.startsWith('delta@') && pkmState.updates > {updates} && pkmState.model")
-        assert browser.evaluate("pkmState.errors") == [] and browser.errors == []
-    finally:
-        browser.close()
+    mimage.imsave(tmp_path / "page.png", after)
+    q1 = np.array(browser.evaluate("pkmState.q"))
+    updates = browser.evaluate("pkmState.updates")
+    z = browser.evaluate("(function () { const s = document.getElementById('y-2');"  # (a task slider: the IK)
+                         " s.value = parseFloat(s.value) - 0.02; s.dispatchEvent(new Event('input'));"
+                         " return parseFloat(s.value); })()")
+    _wait(browser, f"pkmState.updates > {updates} && !pkmState.busy")
+    y2 = browser.evaluate("pkmState.y")
+    browser.evaluate("document.getElementById('modes-button').click()")  # (the assembly modes job)
+    modes = _wait(browser, "pkmState.modes && pkmState.modes.length")
+    browser.evaluate("document.getElementById('map-button').click()")  # (the map job)
+    nodes = _wait(browser, "pkmState.map && pkmState.map.nodes")
+    updates = browser.evaluate("pkmState.updates")
+    browser.evaluate("document.getElementById('param-R').value = 0.16;"  # (another design, built and shown)
+                     " document.getElementById('params-button').click()")
+    variant = _wait(browser, f"pkmState.model.startsWith('delta@') && pkmState.updates > {updates} && pkmState.model")
+    assert browser.evaluate("pkmState.errors") == [] and browser.errors == []
     delta = pkm.load("delta")
     qa = delta.actuated_q(q0)
     qa[0] = target
