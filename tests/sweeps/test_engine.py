@@ -59,6 +59,8 @@ def test_the_paper_sweep_on_two_local_workers_equals_the_serial_loop_exactly(two
         np.testing.assert_array_equal(res.column(name), expected)
     np.testing.assert_array_equal(res.column("design"), np.arange(1000))
     assert np.isnan(res.column("gci")).any() and res.ok.all()  # empty workspaces: nulls, not failures
+    loaded = two_workers.run(eval, "__import__('sys').modules.keys() & {'yourdfpy', 'trimesh'}")
+    assert not any(loaded.values()), loaded  # (the maps read no file: the loaders' imports, a second a worker, unpaid)
 
 
 def test_a_failing_design_is_recorded_and_the_others_go_on(tmp_path):
