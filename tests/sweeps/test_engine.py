@@ -59,6 +59,8 @@ def test_the_paper_sweep_on_two_local_workers_equals_the_serial_loop_exactly(two
         np.testing.assert_array_equal(res.column(name), expected)
     np.testing.assert_array_equal(res.column("design"), np.arange(1000))
     assert np.isnan(res.column("gci")).any() and res.ok.all()  # empty workspaces: nulls, not failures
+    loaded = two_workers.run(eval, "__import__('sys').modules.keys() & {'yourdfpy', 'trimesh'}")
+    assert not any(loaded.values()), loaded  # (the maps read no file: the loaders' imports, a second a worker, unpaid)
 
 
 def test_a_failing_design_is_recorded_and_the_others_go_on(tmp_path):
@@ -130,8 +132,9 @@ def test_a_killed_sweep_resumes_where_it_stopped_and_gives_the_uninterrupted_tab
 
 
 def test_an_existing_scheduler_and_worker_started_as_processes(tmp_path):
-    """`dask scheduler` and `dask worker` as separate processes on this machine; the sweep goes to the
-    scheduler's address and gives the serial loop's table."""
+    """`dask scheduler` and `dask worker` as separate processes on this machine (the worker without a nanny: one
+    process, not a nanny and the worker it spawns); the sweep goes to the scheduler's address and gives the serial
+    loop's table."""
     dask = Path(sys.executable).with_name("dask")
     file = tmp_path / "scheduler.json"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
@@ -144,7 +147,7 @@ def test_an_existing_scheduler_and_worker_started_as_processes(tmp_path):
         while not file.exists() and time.monotonic() < deadline:
             time.sleep(0.1)
         address = json.loads(file.read_text())["address"]
-        worker = subprocess.Popen([str(dask), "worker", address, "--nworkers", "1", "--nthreads", "1",
+        worker = subprocess.Popen([str(dask), "worker", address, "--no-nanny", "--nthreads", "1",
                                    "--no-dashboard"], **common)
         res = pkm.sweep("rrr3", SMALL, ["gci:step=4cm"], scheduler=address, workers=1, progress=False)
         assert res.stats.workers == 1

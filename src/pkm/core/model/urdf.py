@@ -50,16 +50,20 @@ import math
 import re
 import threading
 from collections.abc import Container, Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
-import yourdfpy
 from lxml import etree
 from numpy.typing import ArrayLike
 
 from pkm.core.model.joints import copy_limits
 from pkm.errors import InvalidInputError, SpecError
 from pkm.validation import ABSURD
+
+if TYPE_CHECKING:  # (imported where used: yourdfpy brings trimesh, scipy and networkx, a second of CPU a process
+    # that only reads a tree, as a sweep's worker evaluating a closed-form map, never pays)
+    import yourdfpy
 
 _JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
 _MAX_BYTES = 16 * 1024 * 1024
@@ -106,6 +110,8 @@ class UrdfBuilder:
     def link(self, name: str, mass: float = 0.0, com: ArrayLike = (0.0, 0.0, 0.0),
              inertia: ArrayLike | None = None) -> str:
         """Add a link; a massless link gets no ``<inertial>``."""
+        import yourdfpy
+
         inertial = None
         if mass > 0.0:
             I = np.zeros((3, 3)) if inertia is None else np.asarray(inertia, dtype=float)
@@ -117,6 +123,8 @@ class UrdfBuilder:
               rotation: ArrayLike | None = None, axis: ArrayLike = (0.0, 0.0, 1.0), limits: tuple[float, float] | None = None, effort: float = 1e3,
               velocity: float = 1e2, mimic: tuple[str, float, float] | None = None) -> str:
         """Add a joint. ``mimic = (leader, multiplier, offset)`` makes it follow ``leader``."""
+        import yourdfpy
+
         limit = None
         if type in ("revolute", "prismatic"):
             lo, hi = limits if limits is not None else (-math.pi, math.pi)
@@ -154,6 +162,8 @@ class UrdfBuilder:
 
     def to_xml(self) -> str:
         """The URDF text: yourdfpy-validated, ``<mimic>`` and ``<collision>`` restored, pretty-printed."""
+        import yourdfpy
+
         robot = yourdfpy.Robot(name=self.name, links=self._links, joints=self._joints)
         urdf = yourdfpy.URDF(robot=robot, build_scene_graph=False, load_meshes=False)
         if not urdf.validate():
@@ -424,6 +434,8 @@ def load_model(text: str, source: str = "<string>") -> pin.Model:
     if without_geometry(root):  # (the tree needs none of it; urdfdom prints errors for a <capsule>)
         text = etree.tostring(root, encoding="unicode")
     if not validated:  # (a text yourdfpy took already, as UrdfBuilder.to_xml's: not again)
+        import yourdfpy
+
         try:
             yourdfpy.URDF.load(io.BytesIO(text.encode()), build_scene_graph=False, load_meshes=False)
         except Exception as exc:  # yourdfpy raises a variety of types
