@@ -47,6 +47,7 @@ from pkm.core.differential.indices import inverse_condition
 from pkm.errors import InvalidInputError, SingularityError, UnreachableError
 from pkm.mechanisms import rrr3
 from pkm.mechanisms._common import check_positive, real
+from pkm.mechanisms.rrr3.kinematics import leg_reach
 from pkm.validation import as_array, as_scalar, as_vector
 
 #: The condition-index kinds these maps compute in closed form: a subset of
@@ -223,17 +224,28 @@ AREA_SIDE = 0.30  # m: default side of the square area of interest of area_gci (
 
 
 # ---------------------------------------------------------------------- vectorised closed forms
-def _legs(d: Design, gx: np.ndarray, gy: np.ndarray, phi, signs):
-    """Per leg: reachable mask, platform vertex, unit distal direction and ``s = a sin psi`` (arrays like ``gx``).
+def _reach(d: Design, gx, gy, phi) -> tuple[np.ndarray, list]:
+    """The nodes where every leg reaches (the broadcast shape of ``gx, gy, phi``) and :func:`_vertices`' legs."""
+    reach = np.ones(np.broadcast_shapes(np.shape(gx), np.shape(gy), np.shape(phi)), dtype=bool)
+    legs = list(_vertices(d, gx, gy, phi))
+    for _, _, _, tx, ty in legs:
+        reach &= leg_reach(d.a, d.b, tx, ty)[2]
+    return reach, legs
+
+
+def _legs(d: Design, gx: np.ndarray, gy: np.ndarray, phi, signs, *, reachable_only: bool = False):
+    """Per leg: reachable mask, platform vertex, unit distal direction and ``s = a sin psi`` (arrays like ``gx``;
+    ``reachable_only``: the reachable nodes' only, in row-major order, the elbows placed on those alone).
 
     ``phi`` broadcasts against ``gx``. Same conventions as :func:`pkm.mechanisms.rrr3.inverse_kinematics`:
     ``psi_i`` has the sign of the working mode.
     """
-    reach = np.ones(np.broadcast_shapes(np.shape(gx), np.shape(gy), np.shape(phi)), dtype=bool)
+    reach, legs = _reach(d, gx, gy, phi)
     out = []
-    for i, vx, vy, tx, ty in _vertices(d, gx, gy, phi):
-        Dx, Dy, _, reach_i = rrr3.leg_elbows(d.a, d.b, tx, ty, signs[i])
-        reach &= reach_i
+    for i, vx, vy, tx, ty in legs:
+        if reachable_only:
+            vx, vy, tx, ty = (np.broadcast_to(v, reach.shape)[reach] for v in (vx, vy, tx, ty))
+        Dx, Dy, _, _ = rrr3.leg_elbows(d.a, d.b, tx, ty, signs[i])
         ux, uy = (tx - Dx) / d.b, (ty - Dy) / d.b
         s = Dx * uy - Dy * ux  # (D - O) x u = a sin psi
         out.append((vx, vy, ux, uy, s))
@@ -374,11 +386,10 @@ def condition_index_phi(design, gx, gy, phi, settings: CiSettings = CiSettings()
     for start in range(0, gx.size, _CHUNK):
         sl = slice(start, start + _CHUNK)
         x, y, p = gx[sl], gy[sl], (phi[:1] if constant else phi[sl])
-        ok, legs = _legs(d, x, y, p, signs)
+        ok, legs = _legs(d, x, y, p, signs, reachable_only=True)
         if not np.any(ok):
             continue
         x, y, p = x[ok], y[ok], (p if constant else p[ok])
-        legs = [tuple(v[ok] for v in leg) for leg in legs]
         px, py = _moment_point(d, x, y, p, settings.reference)
         rows = [(ux, uy, ((vx - px) * uy - (vy - py) * ux) / L) for vx, vy, ux, uy, _ in legs]
         idx = np.flatnonzero(ok) + start
@@ -500,7 +511,7 @@ def workspace(design, phi: float = 0.0, grid: Grid | None = None) -> Workspace:
     d = Design.of(design)
     phi = as_scalar(phi, "phi", unit="rad")
     g = workspace_grid(d) if grid is None else _grid(grid)
-    reach, _ = _legs(d, g.xs[None, :], g.ys[:, None], phi, (1, 1, 1))
+    reach, _ = _reach(d, g.xs[None, :], g.ys[:, None], phi)
     return Workspace(d, phi, g, reach)
 
 
@@ -571,12 +582,13 @@ def direct_singularity_crossings(design, grid: Grid, settings: CiSettings = CiSe
     """
     d = Design.of(design)
     X, Y = grid.xs[None, :], grid.ys[:, None]
-    reach, legs = _legs(d, X, Y, settings.phi, rrr3.branch_signs(settings.branch))
+    reach, legs = _legs(d, X, Y, settings.phi, rrr3.branch_signs(settings.branch), reachable_only=True)
+    X, Y = (np.broadcast_to(v, reach.shape)[reach] for v in (X, Y))
     (ax, ay), (bx, by), (cx, cy) = [(ux, uy) for _, _, ux, uy, _ in legs]
     mx = [((vx - X) * uy - (vy - Y) * ux) for vx, vy, ux, uy, _ in legs]
-    det = ax * (by * mx[2] - mx[1] * cy) - ay * (bx * mx[2] - mx[1] * cx) + mx[0] * (bx * cy - by * cx)
     ok = reach if region is None else reach & region
-    sgn = np.sign(det)
+    sgn = np.zeros(reach.shape)  # (unreachable nodes: never counted)
+    sgn[reach] = np.sign(ax * (by * mx[2] - mx[1] * cy) - ay * (bx * mx[2] - mx[1] * cx) + mx[0] * (bx * cy - by * cx))
     h = ok[:, 1:] & ok[:, :-1] & (sgn[:, 1:] * sgn[:, :-1] <= 0)
     v = ok[1:, :] & ok[:-1, :] & (sgn[1:, :] * sgn[:-1, :] <= 0)
     return int(h.sum() + v.sum())
