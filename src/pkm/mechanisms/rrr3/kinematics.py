@@ -82,12 +82,17 @@ def leg_elbows(a: float, b: float, tx, ty, sign) -> tuple[np.ndarray, np.ndarray
         ``REACH_TOL``) and is not 0 (there the elbow is the clipped one: finite, but no assembly).
     """
     d2, dist, reachable = leg_reach(a, b, tx, ty)
+    return (*elbow_at(a, b, tx, ty, sign, d2, dist), dist, reachable)
+
+
+def elbow_at(a: float, b: float, tx, ty, sign, d2, dist) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`leg_elbows`' elbow ``(Dx, Dy)`` [m] from :func:`leg_reach`'s ``d2, dist`` at the same ``tx, ty``."""
     with np.errstate(over="ignore", invalid="ignore"):  # beyond the float range: not reachable
         safe = np.where(dist > 0.0, dist, 1.0)
         ex, ey = tx / safe, ty / safe
         along = (a * a - b * b + d2) / (2.0 * safe)  # the elbow's projection on base vertex -> platform vertex
         off = np.sqrt(np.clip(a * a - along * along, 0.0, None))
-        return along * ex + sign * off * ey, along * ey - sign * off * ex, dist, reachable
+        return along * ex + sign * off * ey, along * ey - sign * off * ex
 
 
 def _solve(params: Rrr3Params, a_point: np.ndarray, phi: float, branch: int | str | None) -> tuple[np.ndarray, np.ndarray]:
