@@ -180,13 +180,12 @@ def to_mp(x: np.ndarray) -> np.ndarray:
 
 @functools.lru_cache(maxsize=8)
 def _programs(mech: Mechanism) -> tuple[Program, Program]:
-    from pkm.core.twin.regressor import regressor_function
-    from pkm.core.twin.tree import Twin
+    from pkm.core.twin.regressor import ParametricTwin, regressor_function
 
-    twin = Twin(mech)
-    newton = twin.closure_newton
+    twin = ParametricTwin(mech)  # (one twin for both: the regressor reuses the closure rows and passive solve built
+    newton = twin.closure_newton  # for the Newton step; the kinematics are a plain Twin's, the same instructions)
     step = Program(cs.Function("newton", [twin.q, twin.target], [newton["q_next"], newton["residual"]]))
-    return step, Program(regressor_function(mech))
+    return step, Program(regressor_function(mech, twin))
 
 
 def close_precisely(mech: Mechanism, Q: np.ndarray, step: Program) -> np.ndarray:
