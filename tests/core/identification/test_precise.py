@@ -14,9 +14,11 @@ import pytest
 import pkm
 from pkm.core.identification.base import base_parameters, random_states
 from pkm.core.identification.precise import (
+    BITS,
     DIGITS,
     MODEL_FLOOR,
     Program,
+    _fixed,
     precise_regressor,
     recognise,
     to_mp,
@@ -113,3 +115,15 @@ def test_the_report_rows_count_the_base_parameters_by_both_routes(paper):
     assert (rows[f"{paper}.ident.n_base"].computed, rows[f"{paper}.ident.n_base_tied"].computed) == REPORTED[paper]
     assert rows[f"{paper}.ident.routes_agree"].computed is True
     assert "agree" in rows[f"{paper}.ident.n_base"].note
+
+
+def test_the_qr_fixed_point_rounds_as_mpmath_nint():
+    """The QR's fixed point (``_fixed``, on the raw ``mpf``) is ``int(mpmath.nint(x * 2**BITS))`` to the last bit:
+    on random numbers of every scale, on exact ties (half-integers after the shift: to even), zero and one."""
+    rng = np.random.default_rng(3)
+    with mpmath.workdps(DIGITS):
+        xs = [mpmath.mpf(float(v)) / 3 * mpmath.mpf(10) ** -int(e)
+              for v, e in zip(rng.uniform(-1.0, 1.0, 300), rng.integers(0, 75, 300))]
+        xs += [mpmath.mpf(k) / 2 ** (BITS + 1) for k in range(-9, 10)] + [mpmath.mpf(0), mpmath.mpf(1), mpmath.mpf(-1)]
+        assert [_fixed(x) for x in xs] == [int(mpmath.nint(x * (1 << BITS))) for x in xs]
+        assert _fixed(mpmath.mpf(3) / 2 ** (BITS + 1)) == 2 and _fixed(mpmath.mpf(5) / 2 ** (BITS + 1)) == 2

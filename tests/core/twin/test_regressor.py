@@ -43,3 +43,28 @@ def test_backends_and_their_refusals():
     bad[1, 0] = np.nan
     with pytest.raises(InvalidInputError):
         regressor_batch(mech, bad, QD, QDD, backend="c")
+
+
+def test_the_regressor_built_on_a_shared_twin_is_the_same_function():
+    """regressor_function on a ParametricTwin whose Newton step was built first (the 50-digit route's one twin) holds
+    the very instructions (operations, operands, constants) of one built on a twin of its own; a twin of another
+    mechanism, or not parametric, is refused."""
+    import casadi as cs
+
+    import pkm
+    from pkm.core.twin.regressor import ParametricTwin, regressor_function
+    from pkm.core.twin.tree import Twin
+
+    def listing(f):
+        return [(f.instruction_id(k), f.instruction_input(k), f.instruction_output(k),
+                 float(f.instruction_constant(k)) if f.instruction_id(k) == cs.OP_CONST else None)
+                for k in range(f.n_instructions())]
+
+    own, shared = pkm.load("rrr3"), pkm.load("rrr3")
+    twin = ParametricTwin(shared)
+    assert twin.closure_newton["q_next"].shape[0] == shared.model.nq
+    assert listing(regressor_function(shared, twin)) == listing(regressor_function(own))
+    with pytest.raises(InvalidInputError, match="twin"):
+        regressor_function(own, ParametricTwin(pkm.load("rrr3")))
+    with pytest.raises(InvalidInputError, match="twin"):
+        regressor_function(own, Twin(own))  # type: ignore[arg-type]

@@ -155,6 +155,27 @@ def test_direct_singularity_crossings_separate_the_working_modes():
     assert maps.direct_singularity_crossings(d, grid, CiSettings(branch=2)) > 10
 
 
+@pytest.mark.parametrize("design", [FIG5, Design(0.30, 0.30, 0.10, 1.00), Design.similarity_law(3.0)],
+                         ids=["fig5", "small", "large"])
+def test_ci_map_evaluates_inside_its_reach_box_alone_with_the_same_map(design):
+    """ci_map evaluates the nodes of its reach box only (_reach_box, a map's cost): the map equals condition_index on
+    every node of the grid, to the bit, on a design whose box cuts the grid, a small one (a box of 5 % of the grid) and
+    one that fills it; the crossings alike (counted on a whole-grid mask region); a region of another shape is
+    refused."""
+    grid, st = Grid.square(design.base_centroid, 0.8, 0.02), CiSettings(phi=0.3, branch=2)
+    m = maps.ci_map(design, grid, st)
+    ci, ok = maps.condition_index(design, grid.xs[None, :], grid.ys[:, None], st)
+    np.testing.assert_array_equal(m.reachable, ok)
+    np.testing.assert_array_equal(m.ci, ci)
+    rows, cols = maps._reach_box(design, grid, st.phi)
+    assert ok.any() and ok[rows, cols].sum() == ok.sum()
+    full = np.ones(ok.shape, dtype=bool)
+    assert maps.direct_singularity_crossings(design, grid, st) == maps.direct_singularity_crossings(design, grid, st,
+                                                                                                    full)
+    with pytest.raises(InvalidInputError, match="region"):
+        maps.direct_singularity_crossings(design, grid, st, full[1:])
+
+
 def test_sweep_is_the_per_design_maps_with_masked_empties():
     """A small sweep (with its progress bar) equals ci_map per design; the design that cannot reach is masked."""
     designs = tuple(Design(a, b, h, 1.0) for a in (0.2, 0.65) for b in (0.2, 0.65) for h in (0.05, 0.5))

@@ -27,6 +27,7 @@ from pkm.core.dynamics.model import COULOMB_VELOCITY
 from pkm.core.model.mechanism import Mechanism, check_mechanism
 from pkm.core.twin.spatial import Expr
 from pkm.core.twin.tree import Twin, theta_times
+from pkm.errors import InvalidInputError
 
 
 class ParametricTwin(Twin):
@@ -52,20 +53,25 @@ def regressor_expression(twin: ParametricTwin) -> cs.SX:
     return cs.horzcat(bodies, drives)
 
 
-def regressor_function(mech: Mechanism) -> cs.Function:
+def regressor_function(mech: Mechanism, twin: ParametricTwin | None = None) -> cs.Function:
     """``pkm_regressor(q, qd, qdd) -> (Yt, pivot)``: the regressor transposed (p x na, dense, after CSE: its
     column-major nonzeros are ``Y_a`` row after row, so that a batch's output is the stacked regressor without a
     copy) and the passive solve's smallest relative pivot
     (:meth:`~pkm.core.twin.linear.PivotedLU.smallest_relative_pivot`).
 
-    Built once per mechanism (the compiled kernels and the 50-digit rank route take the same one).
+    Built once per mechanism (the compiled kernels and the 50-digit rank route take the same one), on ``twin`` where
+    given (a :class:`ParametricTwin` of ``mech`` whose kinematics, closure rows and passive solve another expression
+    has built already: the 50-digit route's Newton step), else on a new one.
 
     Raises:
         SpecError: the mechanism has idle motions, or a joint kind the twin does not handle.
+        InvalidInputError: ``twin`` is not a :class:`ParametricTwin` of ``mech``.
     """
     mech = check_mechanism(mech)
+    if twin is not None and (not isinstance(twin, ParametricTwin) or twin.mech is not mech):
+        raise InvalidInputError("twin", "expected a ParametricTwin of the mechanism given", type(twin).__name__)
     if mech not in _FUNCTIONS:
-        twin = ParametricTwin(mech)
+        twin = ParametricTwin(mech) if twin is None else twin
         Y = regressor_expression(twin)
         outs = cs.cse([cs.densify(Y.T), cs.densify(cs.SX(twin.passive_lu.smallest_relative_pivot()))])
         _FUNCTIONS[mech] = cs.Function("pkm_regressor", [twin.q, twin.qd, twin.qdd], outs, ["q", "qd", "qdd"],

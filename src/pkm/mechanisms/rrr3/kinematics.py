@@ -55,6 +55,18 @@ def a_from_centroid(params: Rrr3Params, g_point, phi: float) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------- closed forms
+def leg_reach(a: float, b: float, tx, ty) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(d2, dist, reachable)`` of an RR leg (:func:`leg_elbows`' test, alone: a map decides reachability on every
+    node and places the elbows on the reachable ones only): the squared distance and the distance from the base
+    vertex to the platform vertex ``(tx, ty)`` [m^2, m] and whether it lies in ``[|a - b|, a + b]`` (to
+    ``REACH_TOL``) and is not 0."""
+    lo, hi = abs(a - b), a + b
+    with np.errstate(over="ignore", invalid="ignore"):  # beyond the float range: not reachable
+        d2 = tx * tx + ty * ty
+        dist = np.sqrt(d2)
+        return d2, dist, (dist <= hi * (1.0 + REACH_TOL)) & (dist >= lo - hi * REACH_TOL) & (dist > 0.0)
+
+
 def leg_elbows(a: float, b: float, tx, ty, sign) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The elbow of an RR leg, vectorised over the leading axes of ``tx, ty`` (and ``sign``): the one
     closed form of the 3-RRR leg (eqs. 6-9), for single poses and for maps.
@@ -69,16 +81,18 @@ def leg_elbows(a: float, b: float, tx, ty, sign) -> tuple[np.ndarray, np.ndarray
         base vertex to the platform vertex [m] and whether it lies in ``[|a - b|, a + b]`` (to
         ``REACH_TOL``) and is not 0 (there the elbow is the clipped one: finite, but no assembly).
     """
-    lo, hi = abs(a - b), a + b
+    d2, dist, reachable = leg_reach(a, b, tx, ty)
+    return (*elbow_at(a, b, tx, ty, sign, d2, dist), dist, reachable)
+
+
+def elbow_at(a: float, b: float, tx, ty, sign, d2, dist) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`leg_elbows`' elbow ``(Dx, Dy)`` [m] from :func:`leg_reach`'s ``d2, dist`` at the same ``tx, ty``."""
     with np.errstate(over="ignore", invalid="ignore"):  # beyond the float range: not reachable
-        d2 = tx * tx + ty * ty
-        dist = np.sqrt(d2)
-        reachable = (dist <= hi * (1.0 + REACH_TOL)) & (dist >= lo - hi * REACH_TOL) & (dist > 0.0)
         safe = np.where(dist > 0.0, dist, 1.0)
         ex, ey = tx / safe, ty / safe
         along = (a * a - b * b + d2) / (2.0 * safe)  # the elbow's projection on base vertex -> platform vertex
         off = np.sqrt(np.clip(a * a - along * along, 0.0, None))
-        return along * ex + sign * off * ey, along * ey - sign * off * ex, dist, reachable
+        return along * ex + sign * off * ey, along * ey - sign * off * ex
 
 
 def _solve(params: Rrr3Params, a_point: np.ndarray, phi: float, branch: int | str | None) -> tuple[np.ndarray, np.ndarray]:

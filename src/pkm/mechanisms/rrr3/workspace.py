@@ -47,6 +47,7 @@ from pkm.core.differential.indices import inverse_condition
 from pkm.errors import InvalidInputError, SingularityError, UnreachableError
 from pkm.mechanisms import rrr3
 from pkm.mechanisms._common import check_positive, real
+from pkm.mechanisms.rrr3.kinematics import elbow_at, leg_reach
 from pkm.validation import as_array, as_scalar, as_vector
 
 #: The condition-index kinds these maps compute in closed form: a subset of
@@ -223,17 +224,31 @@ AREA_SIDE = 0.30  # m: default side of the square area of interest of area_gci (
 
 
 # ---------------------------------------------------------------------- vectorised closed forms
-def _legs(d: Design, gx: np.ndarray, gy: np.ndarray, phi, signs):
-    """Per leg: reachable mask, platform vertex, unit distal direction and ``s = a sin psi`` (arrays like ``gx``).
+def _reach(d: Design, gx, gy, phi) -> tuple[np.ndarray, list]:
+    """The nodes where every leg reaches (the broadcast shape of ``gx, gy, phi``) and per leg :func:`_vertices`'
+    ``(i, vx, vy, tx, ty)`` and :func:`~pkm.mechanisms.rrr3.kinematics.leg_reach`'s ``(d2, dist)``."""
+    reach = np.ones(np.broadcast_shapes(np.shape(gx), np.shape(gy), np.shape(phi)), dtype=bool)
+    legs = []
+    for i, vx, vy, tx, ty in _vertices(d, gx, gy, phi):
+        d2, dist, reach_i = leg_reach(d.a, d.b, tx, ty)
+        reach &= reach_i
+        legs.append((i, vx, vy, tx, ty, d2, dist))
+    return reach, legs
+
+
+def _legs(d: Design, gx: np.ndarray, gy: np.ndarray, phi, signs, *, reachable_only: bool = False):
+    """Per leg: reachable mask, platform vertex, unit distal direction and ``s = a sin psi`` (arrays like ``gx``;
+    ``reachable_only``: the reachable nodes' only, in row-major order, the elbows placed on those alone).
 
     ``phi`` broadcasts against ``gx``. Same conventions as :func:`pkm.mechanisms.rrr3.inverse_kinematics`:
     ``psi_i`` has the sign of the working mode.
     """
-    reach = np.ones(np.broadcast_shapes(np.shape(gx), np.shape(gy), np.shape(phi)), dtype=bool)
+    reach, legs = _reach(d, gx, gy, phi)
     out = []
-    for i, vx, vy, tx, ty in _vertices(d, gx, gy, phi):
-        Dx, Dy, _, reach_i = rrr3.leg_elbows(d.a, d.b, tx, ty, signs[i])
-        reach &= reach_i
+    for i, vx, vy, tx, ty, d2, dist in legs:
+        if reachable_only:
+            vx, vy, tx, ty, d2, dist = (np.broadcast_to(v, reach.shape)[reach] for v in (vx, vy, tx, ty, d2, dist))
+        Dx, Dy = elbow_at(d.a, d.b, tx, ty, signs[i], d2, dist)
         ux, uy = (tx - Dx) / d.b, (ty - Dy) / d.b
         s = Dx * uy - Dy * ux  # (D - O) x u = a sin psi
         out.append((vx, vy, ux, uy, s))
@@ -374,11 +389,10 @@ def condition_index_phi(design, gx, gy, phi, settings: CiSettings = CiSettings()
     for start in range(0, gx.size, _CHUNK):
         sl = slice(start, start + _CHUNK)
         x, y, p = gx[sl], gy[sl], (phi[:1] if constant else phi[sl])
-        ok, legs = _legs(d, x, y, p, signs)
+        ok, legs = _legs(d, x, y, p, signs, reachable_only=True)
         if not np.any(ok):
             continue
         x, y, p = x[ok], y[ok], (p if constant else p[ok])
-        legs = [tuple(v[ok] for v in leg) for leg in legs]
         px, py = _moment_point(d, x, y, p, settings.reference)
         rows = [(ux, uy, ((vx - px) * uy - (vy - py) * ux) / L) for vx, vy, ux, uy, _ in legs]
         idx = np.flatnonzero(ok) + start
@@ -455,8 +469,28 @@ def ci_map(design, grid: Grid | None = None, settings: CiSettings = CiSettings()
     """The CI map of ``design`` over ``grid`` (default :func:`workspace_grid`: every reachable centroid)."""
     d = Design.of(design)
     g = workspace_grid(d) if grid is None else _grid(grid)
-    ci, reach = condition_index(d, g.xs[None, :], g.ys[:, None], settings)
+    rows, cols = _reach_box(d, g, _settings(settings).phi)
+    ci, reach = np.full((g.ys.size, g.xs.size), np.nan), np.zeros((g.ys.size, g.xs.size), dtype=bool)
+    if rows.stop > rows.start and cols.stop > cols.start:
+        ci[rows, cols], reach[rows, cols] = condition_index(d, g.xs[None, cols], g.ys[rows, None], settings)
     return CiMap(d, settings, g, ci, reach)
+
+
+def _reach_box(d: Design, g: Grid, phi: float) -> tuple[slice, slice]:
+    """The rows and columns of ``g`` outside which no node is reachable at orientation ``phi``: leg ``i`` reaches
+    only where ``G`` lies within ``(a + b)(1 + REACH_TOL)`` of its base vertex less the platform vertex's offset, so
+    each leg bounds a box; their intersection, widened by a step (rounding: the nodes outside are unreachable by far
+    more than that). A map evaluates the nodes inside only (those outside are NaN, unreachable, as evaluated)."""
+    reach = (d.a + d.b) * (1.0 + rrr3.REACH_TOL) + g.step
+    x_lo = y_lo = -math.inf
+    x_hi = y_hi = math.inf
+    for _, _, _, tx, ty in _vertices(d, 0.0, 0.0, phi):  # (G = 0: t = offset - base, the disc's centre is -t)
+        x_lo, x_hi = max(x_lo, -float(tx) - reach), min(x_hi, -float(tx) + reach)
+        y_lo, y_hi = max(y_lo, -float(ty) - reach), min(y_hi, -float(ty) + reach)
+    xs, ys = g.xs, g.ys
+    cols = slice(int(np.searchsorted(xs, x_lo)), int(np.searchsorted(xs, x_hi, side="right")))
+    rows = slice(int(np.searchsorted(ys, y_lo)), int(np.searchsorted(ys, y_hi, side="right")))
+    return rows, cols
 
 
 @dataclass(frozen=True, eq=False)
@@ -500,7 +534,7 @@ def workspace(design, phi: float = 0.0, grid: Grid | None = None) -> Workspace:
     d = Design.of(design)
     phi = as_scalar(phi, "phi", unit="rad")
     g = workspace_grid(d) if grid is None else _grid(grid)
-    reach, _ = _legs(d, g.xs[None, :], g.ys[:, None], phi, (1, 1, 1))
+    reach, _ = _reach(d, g.xs[None, :], g.ys[:, None], phi)
     return Workspace(d, phi, g, reach)
 
 
@@ -570,13 +604,21 @@ def direct_singularity_crossings(design, grid: Grid, settings: CiSettings = CiSe
     region is free of direct singularities at the grid's resolution.
     """
     d = Design.of(design)
-    X, Y = grid.xs[None, :], grid.ys[:, None]
-    reach, legs = _legs(d, X, Y, settings.phi, rrr3.branch_signs(settings.branch))
+    grid, settings = _grid(grid), _settings(settings)
+    if region is not None and np.shape(region) != (grid.ys.size, grid.xs.size):
+        raise InvalidInputError("region", f"mask shape {np.shape(region)} is not the grid's "
+                                          f"{(grid.ys.size, grid.xs.size)}", np.shape(region))
+    rows, cols = _reach_box(d, grid, settings.phi)  # (outside, no node is reachable: no pair counts)
+    if rows.stop <= rows.start or cols.stop <= cols.start:
+        return 0
+    X, Y = grid.xs[None, cols], grid.ys[rows, None]
+    reach, legs = _legs(d, X, Y, settings.phi, rrr3.branch_signs(settings.branch), reachable_only=True)
+    X, Y = (np.broadcast_to(v, reach.shape)[reach] for v in (X, Y))
     (ax, ay), (bx, by), (cx, cy) = [(ux, uy) for _, _, ux, uy, _ in legs]
     mx = [((vx - X) * uy - (vy - Y) * ux) for vx, vy, ux, uy, _ in legs]
-    det = ax * (by * mx[2] - mx[1] * cy) - ay * (bx * mx[2] - mx[1] * cx) + mx[0] * (bx * cy - by * cx)
-    ok = reach if region is None else reach & region
-    sgn = np.sign(det)
+    ok = reach if region is None else reach & np.asarray(region, dtype=bool)[rows, cols]
+    sgn = np.zeros(reach.shape)  # (unreachable nodes: never counted)
+    sgn[reach] = np.sign(ax * (by * mx[2] - mx[1] * cy) - ay * (bx * mx[2] - mx[1] * cx) + mx[0] * (bx * cy - by * cx))
     h = ok[:, 1:] & ok[:, :-1] & (sgn[:, 1:] * sgn[:, :-1] <= 0)
     v = ok[1:, :] & ok[:-1, :] & (sgn[1:, :] * sgn[:-1, :] <= 0)
     return int(h.sum() + v.sum())
