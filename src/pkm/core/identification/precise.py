@@ -289,8 +289,9 @@ def _key(states: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> str:
     return hashlib.sha256(b"".join(np.ascontiguousarray(x).tobytes() for s in states for x in s)).hexdigest()
 
 
-#: mechanism -> {the states' digest: (W, constants, unrecognised)} (weakly: a mechanism made anew, a model changed
-#: in between, is computed anew, as :func:`~pkm.core.identification.base.random_states` keeps its draws)
+#: mechanism -> {the states' digest: (W, constants, unrecognised)} (weakly: a mechanism made anew is computed anew,
+#: as :func:`~pkm.core.identification.base.random_states` keeps its draws; a model is not changed in place:
+#: :class:`~pkm.core.model.mechanism.Mechanism`)
 _REGRESSORS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 

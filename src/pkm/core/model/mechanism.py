@@ -105,7 +105,9 @@ def spread(model: pin.Model, q: np.ndarray) -> float:
 class Mechanism:
     """A parallel mechanism on Pinocchio.
 
-    The model, the spec and every index are fixed once built; the Pinocchio data the algorithms
+    The model, the spec and every index are fixed once built: pkm keeps what it derives from them with the mechanism
+    (compiled kernels, 50-digit programs, scales, random states), so a model changed in place (its gravity, a mass)
+    would be answered for partly as it was: build a new mechanism instead. The Pinocchio data the algorithms
     write into are per thread (:attr:`data`, :attr:`constraint_datas`), so that one mechanism can be
     used from several threads at once. A mechanism pickles (it is rebuilt from its URDF and spec),
     so it can travel to worker processes.
