@@ -17,12 +17,15 @@ import tempfile
 
 import pytest
 
-# Before numpy loads (pkm imports it below), unless the caller set it: OpenBLAS's idle threads sleep at once instead of
-# spinning 2^28 cycles (its default) after each call. The suite runs two pytest-xdist workers on two cores, each with
-# OpenBLAS's threads (one a core): spinning threads took the CPU the other worker needed (tests/core/identification
-# with tests/cli/test_identify.py: 115 s of CPU -> 76 s alone, 136 s -> 75 s of wall). The thread count, hence every
-# result to the last bit, is unchanged (a thread count of 1 would change the SVDs' rounding, and the Delta's
-# identification acceptance row with it). The subprocesses the tests start inherit it.
+# Before numpy loads (pkm imports it below; no plugin has loaded it by now), unless the caller set them: OpenBLAS runs
+# one thread in each test process. The suite runs two pytest-xdist workers on two cores, each with OpenBLAS's
+# threads (one a core): they only oversubscribed the cores (a 360 x 130 SVD: 18 ms of CPU on two threads, 2 ms on
+# one; the whole suite 284-289 -> 270 s of pytest), and a thread count that follows the machine's cores made the
+# SVDs' last bits depend on the machine CI runs on (the suite's warnings: 49 at two threads, 43 at one; every test
+# passes either way). OpenBLAS's idle threads, where a caller sets more, sleep at once instead of
+# spinning 2^28 cycles after each call (spinning threads took the CPU the other worker needed). The subprocesses the
+# tests start inherit both.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 
 from pkm.mechanisms import MechanismDefinition, module, register
