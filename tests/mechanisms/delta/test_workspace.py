@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -37,6 +38,18 @@ def test_batch_inverse_kinematics_is_the_scalar_one(cloud, branch):
             continue
         assert ok
         np.testing.assert_allclose(th, ref, atol=1e-12)
+
+
+def test_points_near_the_float_range_reach_nothing_and_get_finite_angles():
+    """Coordinates whose terms overflow (1.7e308 on two axes: their sum is inf, their difference NaN) are unreachable,
+    their angles finite (0) as the docstring says, their condition numbers inf; no overflow warning."""
+    far = np.array([[1.7e308, 1.7e308, -1.7e308], [-1.7e308, 1.7e308, 0.0], [1e308, 0.0, -0.3]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        theta, reachable = inverse_kinematics_batch(P, far)
+        K, _ = condition_numbers(P, far)
+    assert not reachable.any() and np.all(np.isfinite(theta))
+    assert all(np.all(np.isinf(k)) for k in K.values())
 
 
 def test_batch_condition_numbers_are_those_of_the_jacobian(cloud):

@@ -54,7 +54,8 @@ def inverse_kinematics_batch(params: DeltaParams, points, branch="knee_out") -> 
     Returns:
         ``theta`` [rad] of shape (..., 3) and ``reachable`` (bool, shape (...)): every arm reaches.
         Where an arm does not reach, its angle is that of the nearest elbow position (the
-        clipped arc cosine), finite but meaningless: use the mask.
+        clipped arc cosine; 0 where the point's terms overflow, near the float range), finite but meaningless: use
+        the mask.
     """
     params = check_params(params, DeltaParams)
     return _inverse_kinematics(params, _points(points), branch, params.R)
@@ -68,10 +69,12 @@ def _inverse_kinematics(params: DeltaParams, P: np.ndarray, branch, R) -> tuple[
     reachable = np.ones(P.shape[:-1], dtype=bool)
     for i in range(3):
         ci, si = math.cos(PHI[i]), math.sin(PHI[i])
-        w = ci * P[..., 0] + si * P[..., 1]  # along the motor axis
-        u = -si * P[..., 0] + ci * P[..., 1] - (R - params.r)
+        with np.errstate(over="ignore", invalid="ignore"):  # (coordinates near the float range: unreachable)
+            w = ci * P[..., 0] + si * P[..., 1]  # along the motor axis
+            u = -si * P[..., 0] + ci * P[..., 1] - (R - params.r)
         theta[..., i], reach_i, _, _ = circle_sphere(u, P[..., 2], w, params.La, params.Lb, signs[i])
         reachable &= reach_i
+    theta[~np.isfinite(theta)] = 0.0  # (a point whose terms overflow reaches nothing: its angles 0, finite)
     return theta, reachable
 
 
