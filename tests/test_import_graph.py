@@ -76,9 +76,11 @@ def _imports(tree: ast.AST, package: str, type_checking: bool = False, calls: bo
 
 
 @functools.cache
-def _tree(path: Path) -> ast.Module:
-    """A module's syntax tree, parsed once a session (both graphs read it)."""
-    return ast.parse(path.read_text())
+def _tree(path: Path) -> tuple[ast.Module, bool]:
+    """A module's syntax tree, parsed once a session (both graphs read it), and whether its text names
+    ``import_module`` (else its expressions hold no import: :func:`_imports`' ``calls``)."""
+    text = path.read_text()
+    return ast.parse(text), "import_module" in text
 
 
 @functools.cache
@@ -89,8 +91,8 @@ def import_graph(type_checking: bool = False) -> dict[str, set[str]]:
     graph: dict[str, set[str]] = {m: set() for m in modules}
     for name, path in modules.items():
         package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-        text = path.read_text()
-        for module, names in _imports(_tree(path), package, type_checking, calls="import_module" in text):
+        tree, calls = _tree(path)
+        for module, names in _imports(tree, package, type_checking, calls=calls):
             if not module.startswith("pkm"):
                 continue
             targets = [f"{module}.{n}" for n in names if f"{module}.{n}" in modules]

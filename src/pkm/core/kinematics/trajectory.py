@@ -161,11 +161,13 @@ def _follow(mech: Mechanism, n: int, q0: ArrayLike | None, solve: Callable[[int,
     jumps: list[Jump] = []
     prev = None
     signs = None
+    before = 0  # (the jumps of the samples before the last one)
     for k in range(n):
-        if any(j.index == k - 1 and j.reason in until for j in jumps[-4:]):  # (the sample before ended the path)
+        if any(j.reason in until for j in jumps[before:]):  # (the sample before ended the path)
             q, v, a, residual = q[:k], v[:k], a[:k], residual[:k]
             tau = None if tau is None else tau[:k]
             break
+        before = len(jumps)
         res = solve(k, start if prev is None else prev)
         q[k], residual[k] = res.q, res.residual
         if not res.converged:

@@ -95,8 +95,8 @@ def condition_vs_radius(params: DeltaParams, p, R_values, branch="knee_out", kin
                             .all(axis=-1))
     for R in R_values[misses[:1]]:
         arm_angles(params.La, params.Lb, R - params.r, p, (1, 1, 1), f" at R = {R:.6g} m")  # which arm, how far
-    if len(R_values):
-        dataclasses.replace(params, R=float(np.max(R_values)))  # (a design: R within the checked range)
+    if len(R_values):  # (DeltaParams' own bound on R, 1e6 m, as when each radius made its design: the largest checked)
+        dataclasses.replace(params, R=float(np.max(R_values)))
     K, _ = _condition_numbers(params, np.broadcast_to(p, (len(R_values), 3)), branch, kinds, R_values)
     return K
 
