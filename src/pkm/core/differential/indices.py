@@ -116,6 +116,17 @@ def jacobi_singular_values(J: ArrayLike) -> np.ndarray:
     handed to ``np.linalg.svd``.
     The matrices are not scaled here (entries near the float range overflow: :func:`condition_numbers` passes them
     divided by their largest entry).
+
+    Examples:
+        >>> import numpy as np
+        >>> from pkm.core.differential.indices import jacobi_singular_values
+        >>> J = np.array([[[3.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 1.0]],
+        ...               [[1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]])
+        >>> jacobi_singular_values(J).round(6)  # (the second: the golden ratio, 1, its inverse)
+        array([[3.      , 2.      , 1.      ],
+               [1.618034, 1.      , 0.618034]])
+        >>> bool(np.allclose(jacobi_singular_values(J), np.linalg.svd(J, compute_uv=False), rtol=0, atol=1e-15))
+        True
     """
     J = _stack(J)
     if J.shape[-2] < J.shape[-1]:
